@@ -1,0 +1,198 @@
+//! The nonlinear right-hand side (`../shared/spec/vehicle-model.md`), generic over [`Scalar`].
+
+use crate::params::VehicleParams;
+use crate::scalar::Scalar;
+
+/// Number of continuous states: `x, y, psi, v_x, v_y, yaw_rate` and the four servo angles.
+///
+/// The servo angles are always states (an FMU has a fixed state vector); with the steering
+/// servo off their derivative is zero and the applied steer is the clamped command.
+pub const N_STATES: usize = 10;
+
+/// Indices into the state vector.
+pub mod idx {
+    pub const X: usize = 0;
+    pub const Y: usize = 1;
+    pub const PSI: usize = 2;
+    pub const V_X: usize = 3;
+    pub const V_Y: usize = 4;
+    pub const YAW_RATE: usize = 5;
+    /// First servo angle (FL); FR, RL, RR follow.
+    pub const SERVO: usize = 6;
+}
+
+/// Continuous state vector.
+pub type State<T> = [T; N_STATES];
+
+/// Inputs of the plant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs<T> {
+    /// Steering commands [rad], FL, FR, RL, RR.
+    pub delta: [T; 4],
+    /// Drive torques [N.m].
+    pub tau: [T; 4],
+    /// Road friction coefficients [-].
+    pub mu: [T; 4],
+    /// Head wind force [N], positive opposes forward motion.
+    pub wind_head: T,
+    /// Side wind force [N], positive toward body +y, at the geometric centre.
+    pub wind_side: T,
+}
+
+impl<T: Scalar> Inputs<T> {
+    /// Zero steer, zero torque, no wind, `mu_i = mu`.
+    pub fn coasting(mu: f64) -> Self {
+        let z = T::constant(0.0);
+        Inputs { delta: [z; 4], tau: [z; 4], mu: [T::constant(mu); 4], wind_head: z, wind_side: z }
+    }
+}
+
+/// Everything the model computes at one point: derivatives and outputs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Evaluation<T> {
+    pub derivatives: State<T>,
+    /// Body slip angle `atan2(v_y, v_x)` [rad].
+    pub beta: T,
+    /// `hypot(v_x, v_y)` [m/s].
+    pub speed: T,
+    /// Body-frame lateral acceleration `dv_y/dt + r v_x` [m/s2].
+    pub lateral_accel: T,
+    /// Tire slip angles alpha_i [rad].
+    pub slip_angle: [T; 4],
+    /// Lateral tire forces F_y,i in the wheel frame [N].
+    pub force_lat: [T; 4],
+    /// Drive forces F_d,i in the wheel frame [N].
+    pub force_drive: [T; 4],
+    /// Steering angles actually applied [rad].
+    pub delta_applied: [T; 4],
+}
+
+/// The model at one point: derivatives and all outputs.
+pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
+    let zero = T::constant(0.0);
+    let one = T::constant(1.0);
+    let v_x = s[idx::V_X];
+    let v_y = s[idx::V_Y];
+    let r = s[idx::YAW_RATE];
+    let psi = s[idx::PSI];
+    let pos = p.wheel_positions();
+    let loads = p.normal_loads();
+    let dmax = T::constant(p.delta_max);
+
+    let mut der = [zero; N_STATES];
+    let mut slip_angle = [zero; 4];
+    let mut force_lat = [zero; 4];
+    let mut force_drive = [zero; 4];
+    let mut delta_applied = [zero; 4];
+    let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+
+    for i in 0..4 {
+        let (xi, yi) = pos[i];
+        let cmd = u.delta[i].clamp_s(-dmax, dmax);
+        let delta = if p.steering_servo {
+            let sv = s[idx::SERVO + i];
+            let rate = T::constant(p.servo_rate_max);
+            der[idx::SERVO + i] = ((cmd - sv) / p.servo_time_constant).clamp_s(-rate, rate);
+            sv
+        } else {
+            cmd
+        };
+        let (sd, cd) = (delta.sin(), delta.cos());
+        // wheel-centre velocity, body frame and wheel frame
+        let ui = v_x - r * yi;
+        let wi = v_y + r * xi;
+        let v_lon = ui * cd + wi * sd;
+        let v_lat = wi * cd - ui * sd;
+        let alpha = -v_lat.atan2(v_lon.abs());
+        let fade = (ui.hypot(wi) / p.v_fade).min_s(one);
+        let mu = u.mu[i];
+        let mut f_lat = mu * alpha * p.c[i] * fade;
+        let cap = mu * loads[i];
+        let mut f_drive = (u.tau[i] / p.r_wheel).clamp_s(-cap, cap);
+        if p.motor_speed_limit && f_drive.value() > 0.0 {
+            let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
+            f_drive = f_drive * scale;
+        }
+        if p.friction_circle {
+            let h = f_drive.hypot(f_lat);
+            if h.value() > cap.value() && h.value() > 0.0 {
+                let k = cap / h;
+                f_drive = f_drive * k;
+                f_lat = f_lat * k;
+            }
+        }
+        let fx = f_drive * cd - f_lat * sd;
+        let fy = f_drive * sd + f_lat * cd;
+        fx_sum = fx_sum + fx;
+        fy_sum = fy_sum + fy;
+        mz = mz + fy * xi - fx * yi;
+        slip_angle[i] = alpha;
+        force_lat[i] = f_lat;
+        force_drive[i] = f_drive;
+        delta_applied[i] = delta;
+    }
+    mz = mz + u.wind_side * p.x_c();
+    let lat_force = fy_sum + u.wind_side;
+    let (sp, cp) = (psi.sin(), psi.cos());
+    der[idx::X] = v_x * cp - v_y * sp;
+    der[idx::Y] = v_x * sp + v_y * cp;
+    der[idx::PSI] = r;
+    der[idx::V_X] = (fx_sum - u.wind_head) / p.m + r * v_y;
+    der[idx::V_Y] = lat_force / p.m - r * v_x;
+    der[idx::YAW_RATE] = mz / p.i_z;
+
+    Evaluation {
+        derivatives: der,
+        beta: v_y.atan2(v_x),
+        speed: v_x.hypot(v_y),
+        lateral_accel: lat_force / p.m,
+        slip_angle,
+        force_lat,
+        force_drive,
+        delta_applied,
+    }
+}
+
+/// Only the derivatives (the hot path of integrators).
+#[inline]
+pub fn derivatives(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
+    evaluate(p, s, u).derivatives
+}
+
+/// One classical Runge-Kutta step of size `h` with inputs held constant.
+pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
+    let add = |a: &State<f64>, k: &State<f64>, c: f64| {
+        let mut o = *a;
+        for j in 0..N_STATES {
+            o[j] += c * k[j];
+        }
+        o
+    };
+    let k1 = derivatives(p, s, u);
+    let k2 = derivatives(p, &add(s, &k1, 0.5 * h), u);
+    let k3 = derivatives(p, &add(s, &k2, 0.5 * h), u);
+    let k4 = derivatives(p, &add(s, &k3, h), u);
+    let mut o = *s;
+    for j in 0..N_STATES {
+        o[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    }
+    o
+}
+
+/// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`.
+pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
+    let n = (h / max_step).ceil().max(1.0) as usize;
+    let dt = h / n as f64;
+    let mut x = *s;
+    for _ in 0..n {
+        x = rk4_step(p, &x, u, dt);
+    }
+    x
+}
+
+/// A state at straight running with speed `v` (everything else zero).
+pub fn straight_running(v: f64) -> State<f64> {
+    let mut s = [0.0; N_STATES];
+    s[idx::V_X] = v;
+    s
+}

@@ -1,0 +1,223 @@
+//! A small scalar abstraction so that one right-hand side serves both plain `f64`
+//! evaluation and forward-mode automatic differentiation (exact directional derivatives).
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// The operations the vehicle right-hand side needs.
+///
+/// Comparisons (`value()`) decide branches (clamps, fades); the branch taken is then
+/// differentiated exactly, which is the usual convention for piecewise-smooth models.
+pub trait Scalar:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+{
+    fn constant(v: f64) -> Self;
+    fn value(self) -> f64;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    fn abs(self) -> Self;
+    /// `atan2(self, x)`, with derivative 0 at the origin (where it is undefined).
+    fn atan2(self, x: Self) -> Self;
+    /// `sqrt(self^2 + y^2)`, with derivative 0 at the origin.
+    fn hypot(self, y: Self) -> Self;
+
+    fn min_s(self, other: Self) -> Self {
+        if other.value() < self.value() {
+            other
+        } else {
+            self
+        }
+    }
+    fn max_s(self, other: Self) -> Self {
+        if other.value() > self.value() {
+            other
+        } else {
+            self
+        }
+    }
+    fn clamp_s(self, lo: Self, hi: Self) -> Self {
+        self.max_s(lo).min_s(hi)
+    }
+}
+
+impl Scalar for f64 {
+    #[inline]
+    fn constant(v: f64) -> Self {
+        v
+    }
+    #[inline]
+    fn value(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        f64::cos(self)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        f64::atan2(self, x)
+    }
+    #[inline]
+    fn hypot(self, y: Self) -> Self {
+        f64::hypot(self, y)
+    }
+}
+
+/// A forward-mode dual number `v + d ε` (one tangent direction).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Dual {
+    pub v: f64,
+    pub d: f64,
+}
+
+impl Dual {
+    pub const fn new(v: f64, d: f64) -> Self {
+        Dual { v, d }
+    }
+}
+
+impl Add for Dual {
+    type Output = Dual;
+    #[inline]
+    fn add(self, o: Dual) -> Dual {
+        Dual::new(self.v + o.v, self.d + o.d)
+    }
+}
+impl Sub for Dual {
+    type Output = Dual;
+    #[inline]
+    fn sub(self, o: Dual) -> Dual {
+        Dual::new(self.v - o.v, self.d - o.d)
+    }
+}
+impl Mul for Dual {
+    type Output = Dual;
+    #[inline]
+    fn mul(self, o: Dual) -> Dual {
+        Dual::new(self.v * o.v, self.d * o.v + self.v * o.d)
+    }
+}
+impl Div for Dual {
+    type Output = Dual;
+    #[inline]
+    fn div(self, o: Dual) -> Dual {
+        Dual::new(self.v / o.v, (self.d * o.v - self.v * o.d) / (o.v * o.v))
+    }
+}
+impl Neg for Dual {
+    type Output = Dual;
+    #[inline]
+    fn neg(self) -> Dual {
+        Dual::new(-self.v, -self.d)
+    }
+}
+impl Add<f64> for Dual {
+    type Output = Dual;
+    #[inline]
+    fn add(self, o: f64) -> Dual {
+        Dual::new(self.v + o, self.d)
+    }
+}
+impl Sub<f64> for Dual {
+    type Output = Dual;
+    #[inline]
+    fn sub(self, o: f64) -> Dual {
+        Dual::new(self.v - o, self.d)
+    }
+}
+impl Mul<f64> for Dual {
+    type Output = Dual;
+    #[inline]
+    fn mul(self, o: f64) -> Dual {
+        Dual::new(self.v * o, self.d * o)
+    }
+}
+impl Div<f64> for Dual {
+    type Output = Dual;
+    #[inline]
+    fn div(self, o: f64) -> Dual {
+        Dual::new(self.v / o, self.d / o)
+    }
+}
+
+impl Scalar for Dual {
+    #[inline]
+    fn constant(v: f64) -> Self {
+        Dual::new(v, 0.0)
+    }
+    #[inline]
+    fn value(self) -> f64 {
+        self.v
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        Dual::new(self.v.sin(), self.d * self.v.cos())
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        Dual::new(self.v.cos(), -self.d * self.v.sin())
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        if self.v < 0.0 {
+            -self
+        } else {
+            self
+        }
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        let r2 = self.v * self.v + x.v * x.v;
+        let d = if r2 > 0.0 { (x.v * self.d - self.v * x.d) / r2 } else { 0.0 };
+        Dual::new(self.v.atan2(x.v), d)
+    }
+    #[inline]
+    fn hypot(self, y: Self) -> Self {
+        let h = self.v.hypot(y.v);
+        let d = if h > 0.0 { (self.v * self.d + y.v * y.d) / h } else { 0.0 };
+        Dual::new(h, d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fd<F: Fn(f64) -> f64>(f: F, x: f64) -> f64 {
+        let h = 1e-6;
+        (f(x + h) - f(x - h)) / (2.0 * h)
+    }
+
+    #[test]
+    fn dual_derivatives_match_central_differences() {
+        let x = 0.37;
+        let f = |t: Dual| (t * t).sin() / (t.cos() + 2.0) + t.atan2(Dual::constant(0.5) + t) - t.hypot(t * 3.0);
+        let g = |t: f64| (t * t).sin() / (t.cos() + 2.0) + t.atan2(0.5 + t) - t.hypot(t * 3.0);
+        let d = f(Dual::new(x, 1.0));
+        assert!((d.v - g(x)).abs() < 1e-15);
+        assert!((d.d - fd(g, x)).abs() < 1e-8, "{} vs {}", d.d, fd(g, x));
+    }
+
+    #[test]
+    fn dual_is_finite_at_the_origin() {
+        let z = Dual::new(0.0, 1.0);
+        assert_eq!(z.atan2(z).d, 0.0);
+        assert_eq!(z.hypot(z).d, 0.0);
+    }
+}
