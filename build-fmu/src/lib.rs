@@ -1,1 +1,212 @@
+//! Packaging of FMUs: the archive layout importers expect, generated from the models'
+//! declarations, written deterministically (fixed order, timestamps and permissions).
 
+use std::fmt::Write as _;
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use fmi2_export::model_description::{ModelDescription, VariableType};
+use fmi2_export::{Declaration, Model};
+use zip::write::SimpleFileOptions;
+
+/// One FMU this workspace ships.
+pub struct FmuTarget {
+    /// Cargo package that builds the shared library.
+    pub package: &'static str,
+    /// `modelIdentifier`: the library is `lib<id>.so` in cargo's output, `<id>.so` in the archive.
+    pub model_identifier: &'static str,
+    /// The generated description (the same declaration the binary dispatches on).
+    pub description: fn() -> &'static ModelDescription,
+    /// Generated `documentation/index.html`.
+    pub documentation: fn() -> String,
+    /// A few lines on the equations, for the documentation.
+    pub equations: &'static str,
+}
+
+fn description_of<M: Model>() -> &'static ModelDescription {
+    M::declaration().model_description()
+}
+
+/// Everything `build-fmu` builds.
+pub fn targets() -> Vec<FmuTarget> {
+    vec![FmuTarget {
+        package: "fmu-plant",
+        model_identifier: nigel_plant::MODEL_IDENTIFIER,
+        description: description_of::<nigel_plant::Plant>,
+        documentation: || documentation(nigel_plant::Plant::declaration(), PLANT_EQUATIONS),
+        equations: PLANT_EQUATIONS,
+    }]
+}
+
+const PLANT_EQUATIONS: &str = r#"<p>For each wheel i (order FL, FR, RL, RR) at (x_i, y_i) from the CG, with the steer
+delta_i clamped to [-delta_max, delta_max] (or the servo angle, when the servo is on):</p>
+<pre>
+u_i = v_x - r y_i,  w_i = v_y + r x_i
+v_lon,i = u_i cos(delta_i) + w_i sin(delta_i),   v_lat,i = -u_i sin(delta_i) + w_i cos(delta_i)
+alpha_i = -atan2(v_lat,i, |v_lon,i|)
+F_y,i = mu_i C_i alpha_i min(1, |(u_i, w_i)| / v_fade)
+F_d,i = clamp(tau_i / r_wheel, -mu_i N_i, mu_i N_i)
+F_x,i = F_d,i cos(delta_i) - F_y,i sin(delta_i),   F_yb,i = F_d,i sin(delta_i) + F_y,i cos(delta_i)
+
+M_z     = sum_i (x_i F_yb,i - y_i F_x,i) + x_c F_sw,     x_c = (l_f - l_r)/2
+dv_x/dt = (sum_i F_x,i - F_hw)/m + r v_y
+dv_y/dt = (sum_i F_yb,i + F_sw)/m - r v_x
+dr/dt   = M_z / I_z
+dX/dt = v_x cos(psi) - v_y sin(psi),  dY/dt = v_x sin(psi) + v_y cos(psi),  dpsi/dt = r
+</pre>
+<p>Static normal loads N_front = m g l_r / (2 l), N_rear = m g l_f / (2 l). The "real" fidelity
+switches add a friction circle (hypot(F_d, F_y) &lt;= mu N), a first-order rate-limited steering
+servo, and a drive-motor speed limit. Co-Simulation integrates with classical RK4 sub-steps no
+longer than <code>cs_substep_max</code>; Model Exchange exposes the 10 states to the importer's
+integrator. Linearised at straight running this model is Eq. 2.2 of the paper.</p>"#;
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// `documentation/index.html`: every variable with unit, start value and meaning, then the equations.
+pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String {
+    let md = declaration.model_description();
+    let mut html = String::new();
+    let _ = write!(
+        html,
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\
+         <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}\
+         td,th{{border:1px solid #ccc;padding:2px 6px;text-align:left}}</style></head><body>\n\
+         <h1>{name}</h1>\n<p>{desc}</p>\n<p>FMI 2.0, Co-Simulation and Model Exchange. GUID <code>{guid}</code>. \
+         All quantities SI, angles in rad.</p>\n<h2>Variables</h2>\n<table>\n\
+         <tr><th>name</th><th>vr</th><th>causality</th><th>variability</th><th>unit</th><th>start</th><th>description</th></tr>\n",
+        name = escape(&md.model_name),
+        desc = escape(md.description.as_deref().unwrap_or("")),
+        guid = escape(&md.guid),
+    );
+    for v in &md.model_variables {
+        let (unit, start) = match &v.variable_type {
+            VariableType::Real { unit, start, .. } => (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::Integer { start, .. } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::Boolean { start } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::String { start } => (String::new(), start.clone().unwrap_or_default()),
+        };
+        let _ = writeln!(
+            html,
+            "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(&v.name),
+            v.value_reference,
+            v.causality,
+            v.variability,
+            escape(&unit),
+            escape(&start),
+            escape(v.description.as_deref().unwrap_or("")),
+        );
+    }
+    let _ = write!(html, "</table>\n<h2>Equations</h2>\n{equations}\n</body></html>\n");
+    html
+}
+
+/// Errors of packaging.
+#[derive(Debug)]
+pub enum BuildError {
+    Cargo(String),
+    Io(PathBuf, std::io::Error),
+    Zip(String),
+}
+
+impl std::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BuildError::Cargo(m) => write!(f, "cargo build failed: {m}"),
+            BuildError::Io(p, e) => write!(f, "{}: {e}", p.display()),
+            BuildError::Zip(m) => write!(f, "zip: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+/// The archive bytes: `modelDescription.xml`, `binaries/linux64/<id>.so`,
+/// `documentation/index.html`, in that order, with fixed timestamps and modes.
+pub fn archive(xml: &str, library: &[u8], model_identifier: &str, documentation: &str) -> Result<Vec<u8>, BuildError> {
+    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    let options = SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .last_modified_time(zip::DateTime::default())
+        .unix_permissions(0o644);
+    let err = |e: zip::result::ZipError| BuildError::Zip(e.to_string());
+    let entries: [(String, &[u8], u32); 3] = [
+        ("modelDescription.xml".into(), xml.as_bytes(), 0o644),
+        (format!("binaries/linux64/{model_identifier}.so"), library, 0o755),
+        ("documentation/index.html".into(), documentation.as_bytes(), 0o644),
+    ];
+    for (name, bytes, mode) in entries {
+        zip.start_file(name, options.unix_permissions(mode)).map_err(err)?;
+        zip.write_all(bytes).map_err(|e| BuildError::Zip(e.to_string()))?;
+    }
+    Ok(zip.finish().map_err(err)?.into_inner())
+}
+
+/// The workspace's target directory (honours `CARGO_TARGET_DIR`).
+pub fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap_or(Path::new(".")).join("target"))
+}
+
+/// Builds the shared library of `target` (release, with the fmi2 symbols exported)
+/// and returns its path.
+pub fn build_library(target: &FmuTarget) -> Result<PathBuf, BuildError> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
+    let status = Command::new(cargo)
+        .args(["build", "--release", "--quiet", "--package", target.package, "--features", "fmi-export", "--manifest-path"])
+        .arg(&manifest)
+        .status()
+        .map_err(|e| BuildError::Cargo(e.to_string()))?;
+    if !status.success() {
+        return Err(BuildError::Cargo(format!("{} exited with {status}", target.package)));
+    }
+    Ok(target_dir().join("release").join(format!("lib{}.so", target.model_identifier)))
+}
+
+/// Builds and writes `<out_dir>/<id>.fmu`; returns its path and size.
+pub fn build(target: &FmuTarget, out_dir: &Path) -> Result<(PathBuf, usize), BuildError> {
+    let library_path = build_library(target)?;
+    let library = std::fs::read(&library_path).map_err(|e| BuildError::Io(library_path.clone(), e))?;
+    let description = (target.description)();
+    let bytes = archive(&description.to_xml(), &library, target.model_identifier, &(target.documentation)())?;
+    std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
+    let path = out_dir.join(format!("{}.fmu", target.model_identifier));
+    std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
+    Ok((path, bytes.len()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn archive_is_byte_identical_and_has_the_layout_importers_expect() {
+        let t = &targets()[0];
+        let xml = (t.description)().to_xml();
+        let doc = (t.documentation)();
+        let a = archive(&xml, b"\x7fELF fake", t.model_identifier, &doc).unwrap();
+        let b = archive(&xml, b"\x7fELF fake", t.model_identifier, &doc).unwrap();
+        assert_eq!(a, b);
+        let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
+        let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
+        assert_eq!(names, ["modelDescription.xml", "binaries/linux64/nigel_plant.so", "documentation/index.html"]);
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut z.by_name("modelDescription.xml").unwrap(), &mut text).unwrap();
+        assert_eq!(text, xml);
+    }
+
+    #[test]
+    fn documentation_lists_every_variable_with_its_unit() {
+        let t = &targets()[0];
+        let doc = (t.documentation)();
+        for v in &(t.description)().model_variables {
+            assert!(doc.contains(&format!("<code>{}</code>", escape(&v.name))), "{} missing", v.name);
+        }
+        assert!(doc.contains("<td>N.m</td>") && doc.contains("<td>rad</td>"));
+    }
+}

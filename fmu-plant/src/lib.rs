@@ -1,1 +1,584 @@
+//! The Nigel plant FMU: the nonlinear 4WD4WS yaw-plane model of `nigel-vehicle` behind
+//! the shared FMI 2.0 layer. This file is only the binding: the declaration of the
+//! variables (the one source of the XML and the dispatch) and the [`Model`] impl.
 
+use std::sync::OnceLock;
+
+use fmi2_export::model_description::{DefaultExperiment, Unit};
+use fmi2_export::{si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, Start, VarDecl};
+use nigel_vehicle::dynamics::idx;
+use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
+
+/// The model identifier (file name of the shared library and of the `.fmu`).
+pub const MODEL_IDENTIFIER: &str = "nigel_plant";
+
+/// Default upper bound of the internal RK4 sub-step in Co-Simulation [s].
+pub const DEFAULT_CS_SUBSTEP_MAX: f64 = 5e-4;
+
+/// Real parameters (value references 100 + index).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Param {
+    Mass,
+    YawInertia,
+    CgToFront,
+    CgToRear,
+    Track,
+    WheelRadius,
+    CorneringStiffness(usize),
+    Gravity,
+    FadeSpeed,
+    SteerLimit,
+    ServoTimeConstant,
+    ServoRateMax,
+    WheelSpeedMax,
+    MotorTaper,
+    CsSubstepMax,
+}
+
+/// Boolean parameters (fidelity switches).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    FrictionCircle,
+    SteeringServo,
+    MotorSpeedLimit,
+}
+
+/// Inputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    Steer(usize),
+    Torque(usize),
+    Friction(usize),
+    WindHead,
+    WindSide,
+}
+
+/// Calculated outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    Beta,
+    Speed,
+    LateralAccel,
+    SlipAngle(usize),
+    ForceLat(usize),
+    ForceDrive(usize),
+    SteerApplied(usize),
+}
+
+/// What a value reference stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlantVar {
+    Param(Param),
+    Switch(Switch),
+    Input(Input),
+    /// Continuous state `i` of [`nigel_vehicle::State`].
+    State(usize),
+    /// Time derivative of state `i`.
+    Derivative(usize),
+    Output(Output),
+}
+
+const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
+const STATE_NAMES: [&str; N_STATES] =
+    ["x", "y", "psi", "v_x", "v_y", "yaw_rate", "servo_angle_fl", "servo_angle_fr", "servo_angle_rl", "servo_angle_rr"];
+const DER_NAMES: [&str; N_STATES] = [
+    "der(x)",
+    "der(y)",
+    "der(psi)",
+    "der(v_x)",
+    "der(v_y)",
+    "der(yaw_rate)",
+    "der(servo_angle_fl)",
+    "der(servo_angle_fr)",
+    "der(servo_angle_rl)",
+    "der(servo_angle_rr)",
+];
+
+/// Value references. Grouped by kind; the declaration below is the only table.
+pub mod vr {
+    pub const STATE: u32 = 0; // 0..10
+    pub const DERIVATIVE: u32 = 10; // 10..20
+    pub const STEER: u32 = 20;
+    pub const TORQUE: u32 = 24;
+    pub const FRICTION: u32 = 28;
+    pub const WIND_HEAD: u32 = 32;
+    pub const WIND_SIDE: u32 = 33;
+    pub const BETA: u32 = 40;
+    pub const SPEED: u32 = 41;
+    pub const LATERAL_ACCEL: u32 = 42;
+    pub const SLIP_ANGLE: u32 = 43;
+    pub const FORCE_LAT: u32 = 47;
+    pub const FORCE_DRIVE: u32 = 51;
+    pub const STEER_APPLIED: u32 = 55;
+    pub const PARAM: u32 = 100;
+    /// Boolean value references.
+    pub const FRICTION_CIRCLE: u32 = 0;
+    pub const STEERING_SERVO: u32 = 1;
+    pub const MOTOR_SPEED_LIMIT: u32 = 2;
+}
+
+fn leak(s: String) -> &'static str {
+    // Names built once for the process-wide declaration (a few hundred bytes in all).
+    Box::leak(s.into_boxed_str())
+}
+
+fn state_vr(i: usize) -> u32 {
+    vr::STATE + i as u32
+}
+
+/// Knowns the body dynamics depend on (states and inputs), as value references.
+fn body_knowns() -> Vec<u32> {
+    let mut k: Vec<u32> = (idx::V_X..N_STATES).map(state_vr).collect();
+    k.extend((0..4).flat_map(|i| [vr::STEER + i, vr::TORQUE + i, vr::FRICTION + i]));
+    k.extend([vr::WIND_HEAD, vr::WIND_SIDE]);
+    k
+}
+
+fn wheel_knowns(i: usize) -> Vec<u32> {
+    let i32_ = i as u32;
+    vec![
+        state_vr(idx::V_X),
+        state_vr(idx::V_Y),
+        state_vr(idx::YAW_RATE),
+        state_vr(idx::SERVO + i),
+        vr::STEER + i32_,
+        vr::TORQUE + i32_,
+        vr::FRICTION + i32_,
+    ]
+}
+
+fn build_declaration() -> DeclarationSpec<PlantVar> {
+    let d = VehicleParams::table2();
+    let mut v: Vec<VarDecl<PlantVar>> = Vec::new();
+    let real = |name: &'static str, vr: u32, b: PlantVar| VarDecl::real(name, vr, b);
+
+    // inputs
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            real(leak(format!("delta_{w}")), vr::STEER + i as u32, PlantVar::Input(Input::Steer(i)))
+                .input(Start::Real(0.0))
+                .unit("rad")
+                .describe("steering command, clamped to [-delta_max, delta_max]"),
+        );
+    }
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            real(leak(format!("tau_{w}")), vr::TORQUE + i as u32, PlantVar::Input(Input::Torque(i)))
+                .input(Start::Real(0.0))
+                .unit("N.m")
+                .describe("drive torque at the wheel"),
+        );
+    }
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            real(leak(format!("mu_{w}")), vr::FRICTION + i as u32, PlantVar::Input(Input::Friction(i)))
+                .input(Start::Real(0.4))
+                .min(0.0)
+                .describe("road-tire friction coefficient (>= 0)"),
+        );
+    }
+    v.push(
+        real("wind_head", vr::WIND_HEAD, PlantVar::Input(Input::WindHead))
+            .input(Start::Real(0.0))
+            .unit("N")
+            .describe("head wind force, positive opposes forward motion"),
+    );
+    v.push(
+        real("wind_side", vr::WIND_SIDE, PlantVar::Input(Input::WindSide))
+            .input(Start::Real(0.0))
+            .unit("N")
+            .describe("side wind force toward body +y, at the geometric centre"),
+    );
+
+    // states (the first six are outputs too) and their derivatives
+    let state_info: [(&str, &str, &str); N_STATES] = [
+        ("m", "m/s", "global position X of the CG"),
+        ("m", "m/s", "global position Y of the CG"),
+        ("rad", "rad/s", "yaw angle, counter-clockwise positive"),
+        ("m/s", "m/s2", "longitudinal velocity (body frame)"),
+        ("m/s", "m/s2", "lateral velocity (body frame)"),
+        ("rad/s", "rad/s2", "yaw rate"),
+        ("rad", "rad/s", "steering servo angle FL (a state only when steering_servo is on)"),
+        ("rad", "rad/s", "steering servo angle FR"),
+        ("rad", "rad/s", "steering servo angle RL"),
+        ("rad", "rad/s", "steering servo angle RR"),
+    ];
+    for i in 0..N_STATES {
+        let (unit, _, text) = state_info[i];
+        v.push(
+            real(STATE_NAMES[i], state_vr(i), PlantVar::State(i))
+                .state(0.0, i < idx::SERVO)
+                .unit(unit)
+                .describe(text),
+        );
+    }
+
+    // outputs
+    let vel = vec![state_vr(idx::V_X), state_vr(idx::V_Y)];
+    v.push(
+        real("beta", vr::BETA, PlantVar::Output(Output::Beta))
+            .output(Dependencies::On(vel.clone()))
+            .unit("rad")
+            .describe("body slip angle atan2(v_y, v_x)"),
+    );
+    v.push(
+        real("speed", vr::SPEED, PlantVar::Output(Output::Speed))
+            .output(Dependencies::On(vel))
+            .unit("m/s")
+            .describe("hypot(v_x, v_y)"),
+    );
+    v.push(
+        real("lateral_accel", vr::LATERAL_ACCEL, PlantVar::Output(Output::LateralAccel))
+            .output(Dependencies::On(body_knowns()))
+            .unit("m/s2")
+            .describe("body-frame lateral acceleration dv_y/dt + r v_x"),
+    );
+    type Per = (fn(usize) -> Output, u32, &'static str, &'static str, &'static str);
+    let per_wheel: [Per; 4] = [
+        (Output::SlipAngle, vr::SLIP_ANGLE, "slip_angle", "rad", "tire slip angle"),
+        (Output::ForceLat, vr::FORCE_LAT, "force_lat", "N", "lateral tire force (wheel frame)"),
+        (Output::ForceDrive, vr::FORCE_DRIVE, "force_drive", "N", "drive force (wheel frame), capped by friction"),
+        (Output::SteerApplied, vr::STEER_APPLIED, "delta_applied", "rad", "steering angle actually applied"),
+    ];
+    for (make, base, stem, unit, text) in per_wheel {
+        for (i, w) in WHEEL.iter().enumerate() {
+            v.push(
+                real(leak(format!("{stem}_{w}")), base + i as u32, PlantVar::Output(make(i)))
+                    .output(Dependencies::On(wheel_knowns(i)))
+                    .unit(unit)
+                    .describe(text),
+            );
+        }
+    }
+
+    for i in 0..N_STATES {
+        let deps = match i {
+            idx::X | idx::Y => vec![state_vr(idx::PSI), state_vr(idx::V_X), state_vr(idx::V_Y)],
+            idx::PSI => vec![state_vr(idx::YAW_RATE)],
+            idx::V_X | idx::V_Y | idx::YAW_RATE => body_knowns(),
+            servo => vec![state_vr(servo), vr::STEER + (servo - idx::SERVO) as u32],
+        };
+        v.push(
+            real(DER_NAMES[i], vr::DERIVATIVE + i as u32, PlantVar::Derivative(i))
+                .derivative(state_vr(i), Dependencies::On(deps))
+                .unit(state_info[i].1),
+        );
+    }
+
+    // parameters
+    let params: [(&'static str, Param, f64, &'static str, &'static str); 18] = [
+        ("m", Param::Mass, d.m, "kg", "vehicle mass"),
+        ("I_z", Param::YawInertia, d.i_z, "kg.m2", "yaw moment of inertia"),
+        ("l_f", Param::CgToFront, d.l_f, "m", "CG to front axle"),
+        ("l_r", Param::CgToRear, d.l_r, "m", "CG to rear axle"),
+        ("track", Param::Track, d.track, "m", "track width (full)"),
+        ("r_wheel", Param::WheelRadius, d.r_wheel, "m", "wheel radius"),
+        ("c_fl", Param::CorneringStiffness(0), d.c[0], "N/rad", "cornering stiffness FL"),
+        ("c_fr", Param::CorneringStiffness(1), d.c[1], "N/rad", "cornering stiffness FR"),
+        ("c_rl", Param::CorneringStiffness(2), d.c[2], "N/rad", "cornering stiffness RL"),
+        ("c_rr", Param::CorneringStiffness(3), d.c[3], "N/rad", "cornering stiffness RR"),
+        ("g", Param::Gravity, d.g, "m/s2", "gravity"),
+        ("v_fade", Param::FadeSpeed, d.v_fade, "m/s", "speed below which tire forces fade to zero"),
+        ("delta_max", Param::SteerLimit, d.delta_max, "rad", "steering limit"),
+        ("servo_time_constant", Param::ServoTimeConstant, d.servo_time_constant, "s", "steering servo time constant (real fidelity)"),
+        ("servo_rate_max", Param::ServoRateMax, d.servo_rate_max, "rad/s", "steering servo rate limit (real fidelity)"),
+        ("wheel_speed_max", Param::WheelSpeedMax, d.wheel_speed_max, "m/s", "motor speed limit as wheel rolling speed (real fidelity)"),
+        ("motor_taper", Param::MotorTaper, d.motor_taper, "m/s", "width of the linear drive-force taper below wheel_speed_max"),
+        ("cs_substep_max", Param::CsSubstepMax, DEFAULT_CS_SUBSTEP_MAX, "s", "Co-Simulation: largest internal RK4 sub-step"),
+    ];
+    for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
+        v.push(real(name, vr::PARAM + k as u32, PlantVar::Param(p)).parameter(Start::Real(start)).unit(unit).describe(text));
+    }
+    let switches = [
+        ("friction_circle", Switch::FrictionCircle, vr::FRICTION_CIRCLE, "real fidelity: friction-circle tire, hypot(F_d, F_y) <= mu N"),
+        ("steering_servo", Switch::SteeringServo, vr::STEERING_SERVO, "real fidelity: first-order rate-limited steering servo"),
+        ("motor_speed_limit", Switch::MotorSpeedLimit, vr::MOTOR_SPEED_LIMIT, "real fidelity: drive motor speed limit"),
+    ];
+    for (name, s, r, text) in switches {
+        v.push(VarDecl::boolean(name, r, PlantVar::Switch(s)).parameter(Start::Boolean(false)).describe(text));
+    }
+
+    let units: Vec<Unit> = vec![
+        si_unit("m", 0, 1, 0, 0),
+        si_unit("rad", 0, 0, 0, 1),
+        si_unit("s", 0, 0, 1, 0),
+        si_unit("kg", 1, 0, 0, 0),
+        si_unit("m/s", 0, 1, -1, 0),
+        si_unit("m/s2", 0, 1, -2, 0),
+        si_unit("rad/s", 0, 0, -1, 1),
+        si_unit("rad/s2", 0, 0, -2, 1),
+        si_unit("N", 1, 1, -2, 0),
+        si_unit("N.m", 1, 2, -2, 0),
+        si_unit("kg.m2", 1, 2, 0, 0),
+        si_unit("N/rad", 1, 1, -2, -1),
+    ];
+    DeclarationSpec {
+        model_name: "Nigel 4WD4WS plant",
+        model_identifier: MODEL_IDENTIFIER,
+        description: "Nonlinear yaw-plane dynamics of the over-actuated 1:14 vehicle Nigel \
+                      (independent four-wheel drive and steer), paper Section III",
+        version: env!("CARGO_PKG_VERSION"),
+        interfaces: Interfaces { model_exchange: true, co_simulation: true },
+        units,
+        default_experiment: Some(DefaultExperiment { start_time: Some(0.0), stop_time: Some(10.0), tolerance: Some(1e-8), step_size: Some(1e-3) }),
+        variables: v,
+    }
+}
+
+/// The plant instance: parameters, inputs, state, and a lazily computed evaluation.
+#[derive(Clone, Debug)]
+pub struct Plant {
+    pub params: VehicleParams,
+    pub inputs: Inputs<f64>,
+    pub state: State<f64>,
+    pub cs_substep_max: f64,
+    cache: Option<Evaluation<f64>>,
+}
+
+impl Default for Plant {
+    fn default() -> Self {
+        Plant {
+            params: VehicleParams::table2(),
+            inputs: Inputs::coasting(0.4),
+            state: [0.0; N_STATES],
+            cs_substep_max: DEFAULT_CS_SUBSTEP_MAX,
+            cache: None,
+        }
+    }
+}
+
+fn param_slot(p: &mut VehicleParams, which: Param) -> Option<&mut f64> {
+    Some(match which {
+        Param::Mass => &mut p.m,
+        Param::YawInertia => &mut p.i_z,
+        Param::CgToFront => &mut p.l_f,
+        Param::CgToRear => &mut p.l_r,
+        Param::Track => &mut p.track,
+        Param::WheelRadius => &mut p.r_wheel,
+        Param::CorneringStiffness(i) => &mut p.c[i],
+        Param::Gravity => &mut p.g,
+        Param::FadeSpeed => &mut p.v_fade,
+        Param::SteerLimit => &mut p.delta_max,
+        Param::ServoTimeConstant => &mut p.servo_time_constant,
+        Param::ServoRateMax => &mut p.servo_rate_max,
+        Param::WheelSpeedMax => &mut p.wheel_speed_max,
+        Param::MotorTaper => &mut p.motor_taper,
+        Param::CsSubstepMax => return None,
+    })
+}
+
+fn switch_slot(p: &mut VehicleParams, which: Switch) -> &mut bool {
+    match which {
+        Switch::FrictionCircle => &mut p.friction_circle,
+        Switch::SteeringServo => &mut p.steering_servo,
+        Switch::MotorSpeedLimit => &mut p.motor_speed_limit,
+    }
+}
+
+fn input_slot<T>(u: &mut Inputs<T>, which: Input) -> &mut T {
+    match which {
+        Input::Steer(i) => &mut u.delta[i],
+        Input::Torque(i) => &mut u.tau[i],
+        Input::Friction(i) => &mut u.mu[i],
+        Input::WindHead => &mut u.wind_head,
+        Input::WindSide => &mut u.wind_side,
+    }
+}
+
+fn output_of<T: Copy>(e: &Evaluation<T>, which: Output) -> T {
+    match which {
+        Output::Beta => e.beta,
+        Output::Speed => e.speed,
+        Output::LateralAccel => e.lateral_accel,
+        Output::SlipAngle(i) => e.slip_angle[i],
+        Output::ForceLat(i) => e.force_lat[i],
+        Output::ForceDrive(i) => e.force_drive[i],
+        Output::SteerApplied(i) => e.delta_applied[i],
+    }
+}
+
+impl Plant {
+    /// The evaluation at the current state and inputs (computed once per change).
+    pub fn evaluation(&mut self) -> &Evaluation<f64> {
+        let (p, s, u) = (&self.params, &self.state, &self.inputs);
+        self.cache.get_or_insert_with(|| evaluate(p, s, u))
+    }
+
+    fn changed(&mut self) {
+        self.cache = None;
+    }
+}
+
+impl Model for Plant {
+    type Binding = PlantVar;
+
+    fn declaration() -> &'static Declaration<PlantVar> {
+        static DECLARATION: OnceLock<Declaration<PlantVar>> = OnceLock::new();
+        DECLARATION.get_or_init(|| {
+            Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("plant declaration is invalid: {e}"))
+        })
+    }
+
+    fn instantiate(_context: &InstantiateContext) -> Result<Self, String> {
+        Ok(Plant::default())
+    }
+
+    fn get_real(&mut self, b: PlantVar) -> Result<f64, String> {
+        Ok(match b {
+            PlantVar::Param(Param::CsSubstepMax) => self.cs_substep_max,
+            PlantVar::Param(p) => *param_slot(&mut self.params, p).ok_or("no such parameter")?,
+            PlantVar::Input(i) => *input_slot(&mut self.inputs, i),
+            PlantVar::State(i) => self.state[i],
+            PlantVar::Derivative(i) => self.evaluation().derivatives[i],
+            PlantVar::Output(o) => output_of(self.evaluation(), o),
+            PlantVar::Switch(_) => return Err("a Boolean, not a Real".into()),
+        })
+    }
+
+    fn set_real(&mut self, b: PlantVar, value: f64) -> Result<(), String> {
+        match b {
+            PlantVar::Param(Param::CsSubstepMax) => {
+                if !(value > 0.0) {
+                    return Err(format!("cs_substep_max = {value} must be > 0"));
+                }
+                self.cs_substep_max = value;
+            }
+            PlantVar::Param(p) => {
+                let mut candidate = self.params;
+                *param_slot(&mut candidate, p).ok_or("no such parameter")? = value;
+                candidate.validate().map_err(|e| e.to_string())?;
+                self.params = candidate;
+            }
+            PlantVar::Input(Input::Friction(i)) if value < 0.0 => {
+                return Err(format!("mu_{} = {value} refused: friction must be >= 0", WHEEL[i]));
+            }
+            PlantVar::Input(i) => *input_slot(&mut self.inputs, i) = value,
+            PlantVar::State(i) => self.state[i] = value,
+            PlantVar::Derivative(_) | PlantVar::Output(_) => return Err("a calculated variable cannot be set".into()),
+            PlantVar::Switch(_) => return Err("a Boolean, not a Real".into()),
+        }
+        self.changed();
+        Ok(())
+    }
+
+    fn get_boolean(&mut self, b: PlantVar) -> Result<bool, String> {
+        match b {
+            PlantVar::Switch(s) => Ok(*switch_slot(&mut self.params, s)),
+            _ => Err(format!("{b:?} is not a Boolean")),
+        }
+    }
+
+    fn set_boolean(&mut self, b: PlantVar, value: bool) -> Result<(), String> {
+        let PlantVar::Switch(s) = b else { return Err(format!("{b:?} is not a Boolean")) };
+        let mut candidate = self.params;
+        *switch_slot(&mut candidate, s) = value;
+        candidate.validate().map_err(|e| e.to_string())?;
+        self.params = candidate;
+        self.changed();
+        Ok(())
+    }
+
+    fn exit_initialization(&mut self) -> Result<(), String> {
+        self.params.validate().map_err(|e| e.to_string())?;
+        if let Some(i) = self.inputs.mu.iter().position(|&m| m < 0.0) {
+            return Err(format!("mu_{} = {} must be >= 0", WHEEL[i], self.inputs.mu[i]));
+        }
+        Ok(())
+    }
+
+    fn do_step(&mut self, _time: f64, step: f64) -> Result<(), String> {
+        let next = nigel_vehicle::integrate(&self.params, &self.state, &self.inputs, step, self.cs_substep_max);
+        if let Some(i) = next.iter().position(|x| !x.is_finite()) {
+            return Err(format!("state {} became {} (step {step} s)", STATE_NAMES[i], next[i]));
+        }
+        self.state = next;
+        self.changed();
+        Ok(())
+    }
+
+    fn directional_derivative(&mut self, unknowns: &[PlantVar], knowns: &[PlantVar], dv_known: &[f64], out: &mut [f64]) -> Result<(), String> {
+        let mut s: State<Dual> = self.state.map(Dual::constant);
+        let u = &self.inputs;
+        let mut ud = Inputs {
+            delta: u.delta.map(Dual::constant),
+            tau: u.tau.map(Dual::constant),
+            mu: u.mu.map(Dual::constant),
+            wind_head: Dual::constant(u.wind_head),
+            wind_side: Dual::constant(u.wind_side),
+        };
+        for (&k, &dv) in knowns.iter().zip(dv_known) {
+            match k {
+                PlantVar::State(i) => s[i].d += dv,
+                PlantVar::Input(i) => input_slot(&mut ud, i).d += dv,
+                other => return Err(format!("{other:?} is not a known (only states and inputs are)")),
+            }
+        }
+        let e = evaluate(&self.params, &s, &ud);
+        for (o, &unknown) in out.iter_mut().zip(unknowns) {
+            *o = match unknown {
+                PlantVar::Derivative(i) => e.derivatives[i].d,
+                PlantVar::Output(w) => output_of(&e, w).d,
+                PlantVar::State(i) => s[i].d,
+                other => return Err(format!("{other:?} is not an unknown (only derivatives, outputs and states are)")),
+            };
+        }
+        Ok(())
+    }
+
+    fn save(&self, out: &mut Vec<f64>) {
+        let p = &self.params;
+        out.extend_from_slice(&[p.m, p.i_z, p.l_f, p.l_r, p.track, p.r_wheel]);
+        out.extend_from_slice(&p.c);
+        out.extend_from_slice(&[p.g, p.v_fade, p.delta_max, p.servo_time_constant, p.servo_rate_max, p.wheel_speed_max, p.motor_taper]);
+        out.extend([p.friction_circle, p.steering_servo, p.motor_speed_limit].map(|b| b as u8 as f64));
+        out.push(self.cs_substep_max);
+        let u = &self.inputs;
+        out.extend_from_slice(&u.delta);
+        out.extend_from_slice(&u.tau);
+        out.extend_from_slice(&u.mu);
+        out.extend_from_slice(&[u.wind_head, u.wind_side]);
+        out.extend_from_slice(&self.state);
+    }
+
+    fn load(&mut self, data: &[f64]) -> Result<(), String> {
+        const LEN: usize = 6 + 4 + 7 + 3 + 1 + 14 + N_STATES;
+        if data.len() != LEN {
+            return Err(format!("plant state has {} numbers, expected {LEN}", data.len()));
+        }
+        let mut it = data.iter().copied();
+        let mut next = || it.next().unwrap_or(f64::NAN);
+        let mut p = VehicleParams::table2();
+        for slot in [&mut p.m, &mut p.i_z, &mut p.l_f, &mut p.l_r, &mut p.track, &mut p.r_wheel] {
+            *slot = next();
+        }
+        for c in &mut p.c {
+            *c = next();
+        }
+        for slot in [&mut p.g, &mut p.v_fade, &mut p.delta_max, &mut p.servo_time_constant, &mut p.servo_rate_max, &mut p.wheel_speed_max, &mut p.motor_taper] {
+            *slot = next();
+        }
+        for slot in [&mut p.friction_circle, &mut p.steering_servo, &mut p.motor_speed_limit] {
+            *slot = next() != 0.0;
+        }
+        p.validate().map_err(|e| format!("serialized parameters: {e}"))?;
+        let cs_substep_max = next();
+        let mut u = Inputs::coasting(0.0);
+        for slot in u.delta.iter_mut().chain(u.tau.iter_mut()).chain(u.mu.iter_mut()) {
+            *slot = next();
+        }
+        u.wind_head = next();
+        u.wind_side = next();
+        let mut state = [0.0; N_STATES];
+        for s in &mut state {
+            *s = next();
+        }
+        if !(cs_substep_max > 0.0) || !state.iter().chain(&u.delta).chain(&u.tau).chain(&u.mu).all(|x| x.is_finite()) {
+            return Err("serialized state holds non-finite or invalid numbers".into());
+        }
+        *self = Plant { params: p, inputs: u, state, cs_substep_max, cache: None };
+        Ok(())
+    }
+}
+
+#[cfg(feature = "fmi-export")]
+fmi2_export::export_fmi2!(Plant);

@@ -155,7 +155,7 @@ pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Ev
 
 /// Only the derivatives (the hot path of integrators).
 #[inline]
-pub fn derivatives(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
+pub fn derivatives_of(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
     evaluate(p, s, u).derivatives
 }
 
@@ -168,10 +168,10 @@ pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> S
         }
         o
     };
-    let k1 = derivatives(p, s, u);
-    let k2 = derivatives(p, &add(s, &k1, 0.5 * h), u);
-    let k3 = derivatives(p, &add(s, &k2, 0.5 * h), u);
-    let k4 = derivatives(p, &add(s, &k3, h), u);
+    let k1 = derivatives_of(p, s, u);
+    let k2 = derivatives_of(p, &add(s, &k1, 0.5 * h), u);
+    let k3 = derivatives_of(p, &add(s, &k2, 0.5 * h), u);
+    let k4 = derivatives_of(p, &add(s, &k3, h), u);
     let mut o = *s;
     for j in 0..N_STATES {
         o[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);

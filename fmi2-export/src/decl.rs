@@ -1,0 +1,398 @@
+//! The Rust declaration of a model's variables: the one source of truth from which the
+//! layer dispatches value references AND generates `modelDescription.xml`.
+
+use std::collections::HashMap;
+
+use model_description as md;
+pub use model_description::{Causality, Initial, Variability};
+
+/// Base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BaseType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+/// Start value (its variant also fixes the base type).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Start {
+    None,
+    Real(f64),
+    Integer(i32),
+    Boolean(bool),
+}
+
+/// What an Unknown of the ModelStructure depends on.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Dependencies {
+    /// Attribute absent: depends on all knowns.
+    All,
+    /// Value references (of Reals) of the knowns it depends on; empty: none.
+    On(Vec<u32>),
+}
+
+/// One declared variable, bound to the model's own handle `B` for it.
+#[derive(Clone, Debug)]
+pub struct VarDecl<B> {
+    pub name: &'static str,
+    pub value_reference: u32,
+    pub base_type: BaseType,
+    pub description: &'static str,
+    pub causality: Causality,
+    pub variability: Variability,
+    pub initial: Option<Initial>,
+    pub start: Start,
+    pub unit: Option<&'static str>,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub nominal: Option<f64>,
+    /// Value reference of the state this variable is the time derivative of.
+    pub derivative_of: Option<u32>,
+    /// For outputs and derivatives: what they depend on (ModelStructure).
+    pub dependencies: Dependencies,
+    pub binding: B,
+}
+
+impl<B> VarDecl<B> {
+    fn new(name: &'static str, value_reference: u32, base_type: BaseType, binding: B) -> Self {
+        VarDecl {
+            name,
+            value_reference,
+            base_type,
+            description: "",
+            causality: Causality::Local,
+            variability: Variability::Continuous,
+            initial: None,
+            start: Start::None,
+            unit: None,
+            min: None,
+            max: None,
+            nominal: None,
+            derivative_of: None,
+            dependencies: Dependencies::All,
+            binding,
+        }
+    }
+
+    /// A Real variable.
+    pub fn real(name: &'static str, value_reference: u32, binding: B) -> Self {
+        Self::new(name, value_reference, BaseType::Real, binding)
+    }
+
+    /// A Boolean variable.
+    pub fn boolean(name: &'static str, value_reference: u32, binding: B) -> Self {
+        Self::new(name, value_reference, BaseType::Boolean, binding)
+    }
+
+    /// An Integer variable.
+    pub fn integer(name: &'static str, value_reference: u32, binding: B) -> Self {
+        Self::new(name, value_reference, BaseType::Integer, binding)
+    }
+
+    pub fn describe(mut self, text: &'static str) -> Self {
+        self.description = text;
+        self
+    }
+    pub fn unit(mut self, unit: &'static str) -> Self {
+        self.unit = Some(unit);
+        self
+    }
+    pub fn min(mut self, v: f64) -> Self {
+        self.min = Some(v);
+        self
+    }
+    pub fn max(mut self, v: f64) -> Self {
+        self.max = Some(v);
+        self
+    }
+    pub fn nominal(mut self, v: f64) -> Self {
+        self.nominal = Some(v);
+        self
+    }
+
+    /// `causality="parameter" variability="fixed" initial="exact"` with a start value.
+    pub fn parameter(mut self, start: Start) -> Self {
+        self.causality = Causality::Parameter;
+        self.variability = Variability::Fixed;
+        self.initial = Some(Initial::Exact);
+        self.start = start;
+        self
+    }
+
+    /// `causality="input"` (continuous for Reals, discrete otherwise) with a start value.
+    pub fn input(mut self, start: Start) -> Self {
+        self.causality = Causality::Input;
+        self.variability = if self.base_type == BaseType::Real { Variability::Continuous } else { Variability::Discrete };
+        self.initial = None;
+        self.start = start;
+        self
+    }
+
+    /// A continuous state whose start value (`initial="exact"`) is the initial condition;
+    /// `output` makes it a model output too.
+    pub fn state(mut self, start: f64, output: bool) -> Self {
+        self.causality = if output { Causality::Output } else { Causality::Local };
+        self.variability = Variability::Continuous;
+        self.initial = Some(Initial::Exact);
+        self.start = Start::Real(start);
+        if output {
+            self.dependencies = Dependencies::On(vec![self.value_reference]);
+        }
+        self
+    }
+
+    /// The derivative of the state with value reference `state_vr` (local, calculated).
+    pub fn derivative(mut self, state_vr: u32, dependencies: Dependencies) -> Self {
+        self.causality = Causality::Local;
+        self.variability = Variability::Continuous;
+        self.initial = Some(Initial::Calculated);
+        self.derivative_of = Some(state_vr);
+        self.dependencies = dependencies;
+        self
+    }
+
+    /// A calculated continuous output.
+    pub fn output(mut self, dependencies: Dependencies) -> Self {
+        self.causality = Causality::Output;
+        self.variability = Variability::Continuous;
+        self.initial = Some(Initial::Calculated);
+        self.dependencies = dependencies;
+        self
+    }
+}
+
+/// Interfaces an FMU offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Interfaces {
+    pub model_exchange: bool,
+    pub co_simulation: bool,
+}
+
+/// Everything the layer needs to know about a model, and all that goes into the XML.
+#[derive(Clone, Debug)]
+pub struct DeclarationSpec<B> {
+    pub model_name: &'static str,
+    pub model_identifier: &'static str,
+    pub description: &'static str,
+    pub version: &'static str,
+    pub interfaces: Interfaces,
+    /// Units used by the variables (`(name, base unit)`); undeclared units are a build error.
+    pub units: Vec<md::Unit>,
+    pub default_experiment: Option<md::DefaultExperiment>,
+    pub variables: Vec<VarDecl<B>>,
+}
+
+/// A checked declaration with lookup tables, the generated description and its GUID.
+#[derive(Debug)]
+pub struct Declaration<B> {
+    pub spec: DeclarationSpec<B>,
+    lookup: HashMap<(BaseType, u32), usize>,
+    /// Rows of the continuous states, in the order of the state vector (= Derivatives order).
+    pub state_rows: Vec<usize>,
+    /// Rows of the derivatives, same order.
+    pub derivative_rows: Vec<usize>,
+    description: md::ModelDescription,
+    xml: String,
+}
+
+/// Log categories every FMU of ours offers.
+pub const LOG_CATEGORIES: [(&str, &str); 4] = [
+    ("logStatusError", "Errors (always logged)"),
+    ("logStatusWarning", "Warnings"),
+    ("logEvents", "Mode changes and events"),
+    ("logCalls", "Every fmi2 call"),
+];
+
+impl<B> Declaration<B> {
+    /// Checks the spec (unique names and value references, derivatives refer to Real states,
+    /// dependencies refer to declared Reals), builds the lookup tables and generates the
+    /// description, then runs the modelDescription validator over it.
+    pub fn new(spec: DeclarationSpec<B>) -> Result<Self, String> {
+        let mut lookup = HashMap::new();
+        let mut names = HashMap::new();
+        for (row, v) in spec.variables.iter().enumerate() {
+            if lookup.insert((v.base_type, v.value_reference), row).is_some() {
+                return Err(format!("duplicate value reference {} ({:?}) at {}", v.value_reference, v.base_type, v.name));
+            }
+            if names.insert(v.name, row).is_some() {
+                return Err(format!("duplicate variable name {}", v.name));
+            }
+        }
+        let real_row = |vr: u32| lookup.get(&(BaseType::Real, vr)).copied();
+        let mut state_rows = Vec::new();
+        let mut derivative_rows = Vec::new();
+        for (row, v) in spec.variables.iter().enumerate() {
+            if let Some(state_vr) = v.derivative_of {
+                let state = real_row(state_vr).ok_or_else(|| format!("{}: derivative of unknown Real vr {state_vr}", v.name))?;
+                state_rows.push(state);
+                derivative_rows.push(row);
+            }
+        }
+        let index = |row: usize| row as u32 + 1;
+        let deps = |v: &VarDecl<B>| -> Result<Option<Vec<u32>>, String> {
+            match &v.dependencies {
+                Dependencies::All => Ok(None),
+                Dependencies::On(vrs) => vrs
+                    .iter()
+                    .map(|&vr| real_row(vr).map(index).ok_or_else(|| format!("{}: dependency on unknown Real vr {vr}", v.name)))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map(|mut d| {
+                        d.sort_unstable();
+                        Some(d)
+                    }),
+            }
+        };
+        let mut structure = md::ModelStructure::default();
+        for (row, v) in spec.variables.iter().enumerate() {
+            if v.causality == Causality::Output {
+                structure.outputs.push(md::Unknown { index: index(row), dependencies: deps(v)?, dependencies_kind: None });
+            }
+        }
+        for &row in &derivative_rows {
+            let v = &spec.variables[row];
+            structure.derivatives.push(md::Unknown { index: index(row), dependencies: deps(v)?, dependencies_kind: None });
+        }
+        // InitialUnknowns: outputs with initial approx/calculated, calculated parameters, and
+        // states/derivatives with initial approx/calculated (FMI 2.0 section 2.2.8), ascending.
+        let is_state = |row: usize| state_rows.contains(&row);
+        let is_derivative = |row: usize| derivative_rows.contains(&row);
+        for (row, v) in spec.variables.iter().enumerate() {
+            let approx_or_calc = matches!(v.initial, Some(Initial::Approx) | Some(Initial::Calculated));
+            let listed = (v.causality == Causality::Output && approx_or_calc)
+                || v.causality == Causality::CalculatedParameter
+                || ((is_state(row) || is_derivative(row)) && approx_or_calc);
+            if listed {
+                structure.initial_unknowns.push(md::Unknown { index: index(row), dependencies: None, dependencies_kind: None });
+            }
+        }
+
+        let variables = spec
+            .variables
+            .iter()
+            .map(|v| md::ScalarVariable {
+                name: v.name.to_string(),
+                value_reference: v.value_reference,
+                description: (!v.description.is_empty()).then(|| v.description.to_string()),
+                causality: v.causality,
+                variability: v.variability,
+                initial: v.initial,
+                variable_type: match v.base_type {
+                    BaseType::Real => md::VariableType::Real {
+                        start: match v.start {
+                            Start::Real(x) => Some(x),
+                            _ => None,
+                        },
+                        unit: v.unit.map(str::to_string),
+                        derivative: v.derivative_of.and_then(real_row).map(index),
+                        min: v.min,
+                        max: v.max,
+                        nominal: v.nominal,
+                    },
+                    BaseType::Integer => md::VariableType::Integer {
+                        start: match v.start {
+                            Start::Integer(x) => Some(x),
+                            _ => None,
+                        },
+                        min: v.min.map(|x| x as i32),
+                        max: v.max.map(|x| x as i32),
+                    },
+                    BaseType::Boolean => md::VariableType::Boolean {
+                        start: match v.start {
+                            Start::Boolean(x) => Some(x),
+                            _ => None,
+                        },
+                    },
+                },
+            })
+            .collect();
+
+        let capabilities_cs = md::CoSimulation {
+            model_identifier: spec.model_identifier.to_string(),
+            can_handle_variable_communication_step_size: true,
+            can_not_use_memory_management_functions: true,
+            can_get_and_set_fmu_state: true,
+            can_serialize_fmu_state: true,
+            provides_directional_derivative: true,
+            ..Default::default()
+        };
+        let capabilities_me = md::ModelExchange {
+            model_identifier: spec.model_identifier.to_string(),
+            completed_integrator_step_not_needed: true,
+            can_not_use_memory_management_functions: true,
+            can_get_and_set_fmu_state: true,
+            can_serialize_fmu_state: true,
+            provides_directional_derivative: true,
+            ..Default::default()
+        };
+        let description = md::ModelDescription {
+            fmi_version: "2.0".into(),
+            model_name: spec.model_name.into(),
+            guid: String::new(),
+            description: Some(spec.description.into()),
+            author: Some("nigel-fmi".into()),
+            version: Some(spec.version.into()),
+            copyright: None,
+            license: Some("MIT OR Apache-2.0".into()),
+            generation_tool: Some(format!("nigel-fmi fmi2-export {}", env!("CARGO_PKG_VERSION"))),
+            generation_date_and_time: None,
+            variable_naming_convention: Some("structured".into()),
+            number_of_event_indicators: 0,
+            model_exchange: spec.interfaces.model_exchange.then_some(capabilities_me),
+            co_simulation: spec.interfaces.co_simulation.then_some(capabilities_cs),
+            unit_definitions: spec.units.clone(),
+            log_categories: LOG_CATEGORIES
+                .iter()
+                .map(|(n, d)| md::LogCategory { name: n.to_string(), description: Some(d.to_string()) })
+                .collect(),
+            default_experiment: spec.default_experiment.clone(),
+            model_variables: variables,
+            model_structure: structure,
+        }
+        .with_content_guid();
+        let problems = description.validate();
+        if !problems.is_empty() {
+            let list: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+            return Err(format!("the declaration of {} is not a valid FMI 2.0 description: {}", spec.model_name, list.join("; ")));
+        }
+        let xml = description.to_xml();
+        Ok(Declaration { spec, lookup, state_rows, derivative_rows, description, xml })
+    }
+
+    /// Row of the variable with this base type and value reference.
+    #[inline]
+    pub fn row(&self, base_type: BaseType, vr: u32) -> Option<usize> {
+        self.lookup.get(&(base_type, vr)).copied()
+    }
+
+    #[inline]
+    pub fn variable(&self, row: usize) -> &VarDecl<B> {
+        &self.spec.variables[row]
+    }
+
+    /// The generated description (with its content GUID).
+    pub fn model_description(&self) -> &md::ModelDescription {
+        &self.description
+    }
+
+    /// The generated `modelDescription.xml`.
+    pub fn xml(&self) -> &str {
+        &self.xml
+    }
+
+    pub fn guid(&self) -> &str {
+        &self.description.guid
+    }
+
+    pub fn number_of_states(&self) -> usize {
+        self.state_rows.len()
+    }
+}
+
+/// A unit with base-unit exponents `[kg, m, s, rad]`.
+pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
+    md::Unit {
+        name: name.to_string(),
+        base_unit: Some(md::BaseUnit { kg, m, s, rad, factor: 1.0, ..Default::default() }),
+    }
+}

@@ -1,0 +1,669 @@
+//! The reader: `modelDescription.xml` text to [`ModelDescription`].
+//!
+//! Tolerant of attribute order, whitespace, comments, processing instructions, unknown
+//! attributes and unknown elements (TypeDefinitions are used only to resolve the
+//! `unit`/`min`/`max`/`nominal` of a `declaredType`; VendorAnnotations, Annotations,
+//! SourceFiles, DisplayUnits, ... are skipped). Strict about what the standard requires
+//! (see [`ReadError`]). Never panics.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::Reader;
+
+use crate::types::*;
+
+/// A place in the input: byte offset plus 1-based line and (byte) column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Position {
+    /// 0-based byte offset.
+    pub byte: usize,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column, counted in bytes.
+    pub column: usize,
+}
+
+impl Position {
+    /// The position of byte offset `byte` in `src` (clamped to its length).
+    pub fn in_text(src: &str, byte: usize) -> Position {
+        let bytes = src.as_bytes();
+        let byte = byte.min(bytes.len());
+        let before = &bytes[..byte];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+        Position { byte, line, column: byte - line_start + 1 }
+    }
+}
+
+impl fmt::Display for Position {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}, column {}", self.line, self.column)
+    }
+}
+
+/// Why [`ModelDescription::from_xml`] refused a document. `element` names the element
+/// (for variables: `ScalarVariable "name"`), `position` points at its start tag.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReadError {
+    /// Not well-formed XML (syntax error, mismatched end tag, bad escape, duplicate
+    /// attribute, ...).
+    Xml { message: String, position: Position },
+    /// The document ended inside `element`.
+    UnexpectedEof { element: String, position: Position },
+    /// No root element, or the root is not `<fmiModelDescription>`.
+    NotAModelDescription { found: Option<String>, position: Position },
+    /// A required attribute is absent.
+    MissingAttribute { element: String, attribute: String, position: Position },
+    /// An attribute that must be a number (or a list of numbers) is not.
+    BadNumber { element: String, attribute: String, value: String, position: Position },
+    /// An enumerated attribute (causality, variability, initial, dependenciesKind,
+    /// a boolean) has a value outside its enumeration.
+    UnknownEnumValue { element: String, attribute: String, value: String, position: Position },
+    /// `fmiVersion` is not `"2.0"`.
+    UnsupportedFmiVersion { found: String, position: Position },
+    /// A ScalarVariable has no `<Real>`, `<Integer>`, `<Boolean>`, `<String>` or
+    /// `<Enumeration>` child.
+    MissingTypeChild { variable: String, position: Position },
+    /// An element that may occur once occurs again.
+    DuplicateElement { element: String, position: Position },
+}
+
+impl ReadError {
+    /// Where in the input the problem is.
+    pub fn position(&self) -> Position {
+        match self {
+            ReadError::Xml { position, .. }
+            | ReadError::UnexpectedEof { position, .. }
+            | ReadError::NotAModelDescription { position, .. }
+            | ReadError::MissingAttribute { position, .. }
+            | ReadError::BadNumber { position, .. }
+            | ReadError::UnknownEnumValue { position, .. }
+            | ReadError::UnsupportedFmiVersion { position, .. }
+            | ReadError::MissingTypeChild { position, .. }
+            | ReadError::DuplicateElement { position, .. } => *position,
+        }
+    }
+}
+
+impl fmt::Display for ReadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ReadError::Xml { message, position } => {
+                write!(f, "malformed XML at {position}: {message}")
+            }
+            ReadError::UnexpectedEof { element, position } => {
+                write!(f, "document ends inside <{element}> (opened at {position})")
+            }
+            ReadError::NotAModelDescription { found: Some(name), position } => write!(
+                f,
+                "root element is <{name}> at {position}, expected <fmiModelDescription>"
+            ),
+            ReadError::NotAModelDescription { found: None, position } => {
+                write!(f, "no root element (expected <fmiModelDescription>), at {position}")
+            }
+            ReadError::MissingAttribute { element, attribute, position } => {
+                write!(f, "{element} at {position}: missing required attribute {attribute}")
+            }
+            ReadError::BadNumber { element, attribute, value, position } => write!(
+                f,
+                "{element} at {position}: attribute {attribute}=\"{value}\" is not a valid number"
+            ),
+            ReadError::UnknownEnumValue { element, attribute, value, position } => write!(
+                f,
+                "{element} at {position}: attribute {attribute} has unknown value \"{value}\""
+            ),
+            ReadError::UnsupportedFmiVersion { found, position } => write!(
+                f,
+                "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"2.0\")"
+            ),
+            ReadError::MissingTypeChild { variable, position } => write!(
+                f,
+                "ScalarVariable \"{variable}\" at {position}: no type element (<Real>, <Integer>, <Boolean>, <String> or <Enumeration>)"
+            ),
+            ReadError::DuplicateElement { element, position } => {
+                write!(f, "duplicate <{element}> at {position}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ReadError {}
+
+// ---------------------------------------------------------------------------------------
+// A tiny element tree (depth-limited: nothing of FMI 2.0 we read is deeper than 4).
+
+const MAX_DEPTH: usize = 4;
+
+struct Node {
+    name: String,
+    attrs: Vec<(String, String)>,
+    pos: usize,
+    children: Vec<Node>,
+}
+
+impl Node {
+    fn get(&self, key: &str) -> Option<&str> {
+        self.attrs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+    }
+}
+
+fn xml_err(src: &str, e: impl fmt::Display, pos: u64) -> ReadError {
+    ReadError::Xml { message: e.to_string(), position: Position::in_text(src, pos as usize) }
+}
+
+/// Start of the tag that begins at or after `from` (the first `<`).
+fn tag_start(src: &str, from: usize) -> usize {
+    let bytes = src.as_bytes();
+    let from = from.min(bytes.len());
+    bytes[from..].iter().position(|&b| b == b'<').map_or(from, |p| from + p)
+}
+
+fn make_node(src: &str, reader: &Reader<&[u8]>, e: &BytesStart<'_>, pos: usize) -> Result<Node, ReadError> {
+    let name = std::str::from_utf8(e.name().as_ref())
+        .map_err(|err| xml_err(src, err, pos as u64))?
+        .to_string();
+    let mut attrs = Vec::new();
+    for a in e.attributes() {
+        let a = a.map_err(|err| xml_err(src, err, pos as u64))?;
+        let key = std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
+        let value = a
+            .decode_and_unescape_value(reader.decoder())
+            .map_err(|err| xml_err(src, format!("attribute {key} of <{name}>: {err}"), pos as u64))?;
+        attrs.push((key.to_string(), value.into_owned()));
+    }
+    Ok(Node { name, attrs, pos, children: Vec::new() })
+}
+
+fn parse_tree(src: &str) -> Result<Node, ReadError> {
+    let mut reader = Reader::from_str(src);
+    reader.config_mut().trim_text(true);
+    // Open elements: the stored ones (depth <= MAX_DEPTH) and a count of deeper ones.
+    let mut stack: Vec<Node> = Vec::new();
+    let mut deeper = 0usize;
+    let mut root: Option<Node> = None;
+    loop {
+        let before = reader.buffer_position() as usize;
+        let ev = reader.read_event().map_err(|e| xml_err(src, e, reader.error_position()))?;
+        match ev {
+            Event::Start(_) | Event::Empty(_) if root.is_some() && stack.is_empty() => {
+                let pos = tag_start(src, before);
+                return Err(ReadError::Xml {
+                    message: "a second root element".to_string(),
+                    position: Position::in_text(src, pos),
+                });
+            }
+            Event::Start(e) => {
+                let pos = tag_start(src, before);
+                if stack.len() < MAX_DEPTH && deeper == 0 {
+                    stack.push(make_node(src, &reader, &e, pos)?);
+                } else {
+                    // Still check its attributes for well-formedness.
+                    make_node(src, &reader, &e, pos)?;
+                    deeper += 1;
+                }
+            }
+            Event::Empty(e) => {
+                let pos = tag_start(src, before);
+                let node = make_node(src, &reader, &e, pos)?;
+                if stack.len() < MAX_DEPTH && deeper == 0 {
+                    match stack.last_mut() {
+                        Some(parent) => parent.children.push(node),
+                        None => root = Some(node),
+                    }
+                }
+            }
+            Event::End(_) => {
+                if deeper > 0 {
+                    deeper -= 1;
+                } else if let Some(node) = stack.pop() {
+                    match stack.last_mut() {
+                        Some(parent) => parent.children.push(node),
+                        None => root = Some(node),
+                    }
+                } else {
+                    // check_end_names makes quick-xml report this itself; be safe anyway.
+                    return Err(ReadError::Xml {
+                        message: "end tag without start tag".to_string(),
+                        position: Position::in_text(src, tag_start(src, before)),
+                    });
+                }
+            }
+            Event::Eof => {
+                if let Some(open) = stack.last() {
+                    return Err(ReadError::UnexpectedEof {
+                        element: open.name.clone(),
+                        position: Position::in_text(src, open.pos),
+                    });
+                }
+                return root.ok_or(ReadError::NotAModelDescription {
+                    found: None,
+                    position: Position::in_text(src, src.len()),
+                });
+            }
+            // Text, CDATA, comments, declarations, processing instructions, DOCTYPE.
+            _ => {}
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Attribute access with typed errors.
+
+struct Ctx<'a> {
+    src: &'a str,
+}
+
+impl Ctx<'_> {
+    fn pos(&self, n: &Node) -> Position {
+        Position::in_text(self.src, n.pos)
+    }
+
+    fn req<'n>(&self, n: &'n Node, label: &str, key: &str) -> Result<&'n str, ReadError> {
+        n.get(key).ok_or_else(|| ReadError::MissingAttribute {
+            element: label.to_string(),
+            attribute: key.to_string(),
+            position: self.pos(n),
+        })
+    }
+
+    fn bad_number(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
+        ReadError::BadNumber {
+            element: label.to_string(),
+            attribute: key.to_string(),
+            value: value.to_string(),
+            position: self.pos(n),
+        }
+    }
+
+    fn bad_enum(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
+        ReadError::UnknownEnumValue {
+            element: label.to_string(),
+            attribute: key.to_string(),
+            value: value.to_string(),
+            position: self.pos(n),
+        }
+    }
+
+    fn f64_of(&self, n: &Node, label: &str, key: &str, value: &str) -> Result<f64, ReadError> {
+        parse_xs_double(value).ok_or_else(|| self.bad_number(n, label, key, value))
+    }
+
+    fn opt_f64(&self, n: &Node, label: &str, key: &str) -> Result<Option<f64>, ReadError> {
+        n.get(key).map(|v| self.f64_of(n, label, key, v)).transpose()
+    }
+
+    fn opt_u32(&self, n: &Node, label: &str, key: &str) -> Result<Option<u32>, ReadError> {
+        n.get(key)
+            .map(|v| v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v)))
+            .transpose()
+    }
+
+    fn req_u32(&self, n: &Node, label: &str, key: &str) -> Result<u32, ReadError> {
+        let v = self.req(n, label, key)?;
+        v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))
+    }
+
+    fn opt_i32(&self, n: &Node, label: &str, key: &str) -> Result<Option<i32>, ReadError> {
+        n.get(key)
+            .map(|v| v.trim().parse::<i32>().map_err(|_| self.bad_number(n, label, key, v)))
+            .transpose()
+    }
+
+    fn opt_bool(&self, n: &Node, label: &str, key: &str) -> Result<Option<bool>, ReadError> {
+        n.get(key)
+            .map(|v| match v.trim() {
+                "true" | "1" => Ok(true),
+                "false" | "0" => Ok(false),
+                _ => Err(self.bad_enum(n, label, key, v)),
+            })
+            .transpose()
+    }
+
+    fn flag(&self, n: &Node, label: &str, key: &str) -> Result<bool, ReadError> {
+        Ok(self.opt_bool(n, label, key)?.unwrap_or(false))
+    }
+
+    fn opt_enum<T>(
+        &self,
+        n: &Node,
+        label: &str,
+        key: &str,
+        parse: fn(&str) -> Option<T>,
+    ) -> Result<Option<T>, ReadError> {
+        n.get(key).map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v))).transpose()
+    }
+
+    fn opt_string(n: &Node, key: &str) -> Option<String> {
+        n.get(key).map(str::to_string)
+    }
+}
+
+/// Parses an `xs:double` (surrounding whitespace allowed; `INF`, `+INF`, `-INF`, `NaN`,
+/// and whatever Rust's `f64` parser accepts).
+pub fn parse_xs_double(s: &str) -> Option<f64> {
+    let t = s.trim_matches(|c| matches!(c, ' ' | '\t' | '\n' | '\r'));
+    match t {
+        "INF" | "+INF" => Some(f64::INFINITY),
+        "-INF" => Some(f64::NEG_INFINITY),
+        "NaN" => Some(f64::NAN),
+        _ => t.parse::<f64>().ok(),
+    }
+}
+
+/// Attributes a `<SimpleType>` passes on to variables declaring it as `declaredType`.
+#[derive(Default, Clone)]
+struct TypeDefaults {
+    unit: Option<String>,
+    min: Option<String>,
+    max: Option<String>,
+    nominal: Option<String>,
+}
+
+fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> Result<(), ReadError> {
+    if slot.is_some() {
+        return Err(ReadError::DuplicateElement { element: n.name.clone(), position: ctx.pos(n) });
+    }
+    *slot = Some(n);
+    Ok(())
+}
+
+impl ModelDescription {
+    /// Reads a `modelDescription.xml`. See [`ReadError`] for what is refused; unknown
+    /// elements and attributes are skipped. `<Enumeration>` variables are read as
+    /// `Integer`; a `declaredType`'s `unit`, `min`, `max` and `nominal` are copied onto
+    /// variables that do not set them.
+    pub fn from_xml(xml: &str) -> Result<ModelDescription, ReadError> {
+        let root = parse_tree(xml)?;
+        let ctx = Ctx { src: xml };
+        if root.name != "fmiModelDescription" {
+            return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(&root) });
+        }
+        let label = "fmiModelDescription";
+        let fmi_version = ctx.req(&root, label, "fmiVersion")?;
+        if fmi_version.trim() != "2.0" {
+            return Err(ReadError::UnsupportedFmiVersion { found: fmi_version.to_string(), position: ctx.pos(&root) });
+        }
+        let model_name = ctx.req(&root, label, "modelName")?.to_string();
+        let guid = ctx.req(&root, label, "guid")?.to_string();
+        let number_of_event_indicators = ctx.opt_u32(&root, label, "numberOfEventIndicators")?.unwrap_or(0);
+
+        let mut me_node = None;
+        let mut cs_node = None;
+        let mut units_node = None;
+        let mut types_node = None;
+        let mut logs_node = None;
+        let mut exp_node = None;
+        let mut vars_node = None;
+        let mut struct_node = None;
+        for c in &root.children {
+            match c.name.as_str() {
+                "ModelExchange" => once(&ctx, &mut me_node, c)?,
+                "CoSimulation" => once(&ctx, &mut cs_node, c)?,
+                "UnitDefinitions" => once(&ctx, &mut units_node, c)?,
+                "TypeDefinitions" => once(&ctx, &mut types_node, c)?,
+                "LogCategories" => once(&ctx, &mut logs_node, c)?,
+                "DefaultExperiment" => once(&ctx, &mut exp_node, c)?,
+                "ModelVariables" => once(&ctx, &mut vars_node, c)?,
+                "ModelStructure" => once(&ctx, &mut struct_node, c)?,
+                _ => {} // VendorAnnotations and anything unknown
+            }
+        }
+
+        let model_exchange = me_node
+            .map(|n| -> Result<ModelExchange, ReadError> {
+                let l = "ModelExchange";
+                Ok(ModelExchange {
+                    model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
+                    needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
+                    completed_integrator_step_not_needed: ctx.flag(n, l, "completedIntegratorStepNotNeeded")?,
+                    can_be_instantiated_only_once_per_process: ctx
+                        .flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
+                    can_not_use_memory_management_functions: ctx
+                        .flag(n, l, "canNotUseMemoryManagementFunctions")?,
+                    can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
+                    can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
+                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
+                })
+            })
+            .transpose()?;
+
+        let co_simulation = cs_node
+            .map(|n| -> Result<CoSimulation, ReadError> {
+                let l = "CoSimulation";
+                Ok(CoSimulation {
+                    model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
+                    needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
+                    can_handle_variable_communication_step_size: ctx
+                        .flag(n, l, "canHandleVariableCommunicationStepSize")?,
+                    can_interpolate_inputs: ctx.flag(n, l, "canInterpolateInputs")?,
+                    max_output_derivative_order: ctx.opt_u32(n, l, "maxOutputDerivativeOrder")?.unwrap_or(0),
+                    can_run_asynchronuously: ctx.flag(n, l, "canRunAsynchronuously")?,
+                    can_be_instantiated_only_once_per_process: ctx
+                        .flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
+                    can_not_use_memory_management_functions: ctx
+                        .flag(n, l, "canNotUseMemoryManagementFunctions")?,
+                    can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
+                    can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
+                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
+                })
+            })
+            .transpose()?;
+
+        let mut unit_definitions = Vec::new();
+        if let Some(units) = units_node {
+            for u in units.children.iter().filter(|c| c.name == "Unit") {
+                let name = ctx.req(u, "Unit", "name")?.to_string();
+                let ul = format!("Unit \"{name}\"");
+                let mut base_node = None;
+                for b in u.children.iter().filter(|c| c.name == "BaseUnit") {
+                    once(&ctx, &mut base_node, b)?;
+                }
+                let base_unit = base_node
+                    .map(|b| -> Result<BaseUnit, ReadError> {
+                        let bl = format!("BaseUnit of {ul}");
+                        let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
+                        Ok(BaseUnit {
+                            kg: e("kg")?,
+                            m: e("m")?,
+                            s: e("s")?,
+                            a: e("A")?,
+                            k: e("K")?,
+                            mol: e("mol")?,
+                            cd: e("cd")?,
+                            rad: e("rad")?,
+                            factor: ctx.opt_f64(b, &bl, "factor")?.unwrap_or(1.0),
+                            offset: ctx.opt_f64(b, &bl, "offset")?.unwrap_or(0.0),
+                        })
+                    })
+                    .transpose()?;
+                unit_definitions.push(Unit { name, base_unit });
+            }
+        }
+
+        // declaredType defaults (raw strings, parsed in the variable's context).
+        let mut type_defaults: HashMap<String, TypeDefaults> = HashMap::new();
+        if let Some(types) = types_node {
+            for t in types.children.iter().filter(|c| c.name == "SimpleType") {
+                let Some(name) = t.get("name") else { continue };
+                if let Some(inner) = t.children.iter().find(|c| c.name == "Real" || c.name == "Integer") {
+                    type_defaults.insert(
+                        name.to_string(),
+                        TypeDefaults {
+                            unit: Ctx::opt_string(inner, "unit"),
+                            min: Ctx::opt_string(inner, "min"),
+                            max: Ctx::opt_string(inner, "max"),
+                            nominal: Ctx::opt_string(inner, "nominal"),
+                        },
+                    );
+                }
+            }
+        }
+
+        let mut log_categories = Vec::new();
+        if let Some(logs) = logs_node {
+            for c in logs.children.iter().filter(|c| c.name == "Category") {
+                log_categories.push(LogCategory {
+                    name: ctx.req(c, "Category", "name")?.to_string(),
+                    description: Ctx::opt_string(c, "description"),
+                });
+            }
+        }
+
+        let default_experiment = exp_node
+            .map(|n| -> Result<DefaultExperiment, ReadError> {
+                let l = "DefaultExperiment";
+                Ok(DefaultExperiment {
+                    start_time: ctx.opt_f64(n, l, "startTime")?,
+                    stop_time: ctx.opt_f64(n, l, "stopTime")?,
+                    tolerance: ctx.opt_f64(n, l, "tolerance")?,
+                    step_size: ctx.opt_f64(n, l, "stepSize")?,
+                })
+            })
+            .transpose()?;
+
+        let mut model_variables = Vec::new();
+        if let Some(vars) = vars_node {
+            for v in vars.children.iter().filter(|c| c.name == "ScalarVariable") {
+                model_variables.push(read_variable(&ctx, v, &type_defaults)?);
+            }
+        }
+
+        let mut model_structure = ModelStructure::default();
+        if let Some(ms) = struct_node {
+            let (mut outs, mut ders, mut inits) = (None, None, None);
+            for c in &ms.children {
+                match c.name.as_str() {
+                    "Outputs" => once(&ctx, &mut outs, c)?,
+                    "Derivatives" => once(&ctx, &mut ders, c)?,
+                    "InitialUnknowns" => once(&ctx, &mut inits, c)?,
+                    _ => {}
+                }
+            }
+            let read_list = |n: Option<&Node>| -> Result<Vec<Unknown>, ReadError> {
+                let Some(n) = n else { return Ok(Vec::new()) };
+                n.children
+                    .iter()
+                    .filter(|c| c.name == "Unknown")
+                    .map(|u| read_unknown(&ctx, u, &n.name))
+                    .collect()
+            };
+            model_structure.outputs = read_list(outs)?;
+            model_structure.derivatives = read_list(ders)?;
+            model_structure.initial_unknowns = read_list(inits)?;
+        }
+
+        Ok(ModelDescription {
+            fmi_version: fmi_version.to_string(),
+            model_name,
+            guid,
+            description: Ctx::opt_string(&root, "description"),
+            author: Ctx::opt_string(&root, "author"),
+            version: Ctx::opt_string(&root, "version"),
+            copyright: Ctx::opt_string(&root, "copyright"),
+            license: Ctx::opt_string(&root, "license"),
+            generation_tool: Ctx::opt_string(&root, "generationTool"),
+            generation_date_and_time: Ctx::opt_string(&root, "generationDateAndTime"),
+            variable_naming_convention: Ctx::opt_string(&root, "variableNamingConvention"),
+            number_of_event_indicators,
+            model_exchange,
+            co_simulation,
+            unit_definitions,
+            log_categories,
+            default_experiment,
+            model_variables,
+            model_structure,
+        })
+    }
+}
+
+fn read_variable(
+    ctx: &Ctx,
+    v: &Node,
+    type_defaults: &HashMap<String, TypeDefaults>,
+) -> Result<ScalarVariable, ReadError> {
+    let name = ctx.req(v, "ScalarVariable", "name")?.to_string();
+    let l = format!("ScalarVariable \"{name}\"");
+    let value_reference = ctx.req_u32(v, &l, "valueReference")?;
+    let causality = ctx.opt_enum(v, &l, "causality", Causality::parse)?.unwrap_or(Causality::Local);
+    let variability = ctx.opt_enum(v, &l, "variability", Variability::parse)?.unwrap_or(Variability::Continuous);
+    let initial = ctx.opt_enum(v, &l, "initial", Initial::parse)?;
+
+    let Some(t) = v
+        .children
+        .iter()
+        .find(|c| matches!(c.name.as_str(), "Real" | "Integer" | "Boolean" | "String" | "Enumeration"))
+    else {
+        return Err(ReadError::MissingTypeChild { variable: name, position: ctx.pos(v) });
+    };
+    let tl = format!("{} of {l}", t.name);
+    let defaults = t.get("declaredType").and_then(|d| type_defaults.get(d)).cloned().unwrap_or_default();
+    // The variable's own attribute, else the declared type's.
+    let attr = |key: &str, inherited: &Option<String>| -> Option<String> {
+        t.get(key).map(str::to_string).or_else(|| inherited.clone())
+    };
+    let f64_attr = |key: &str, inherited: &Option<String>| -> Result<Option<f64>, ReadError> {
+        attr(key, inherited).map(|s| ctx.f64_of(t, &tl, key, &s)).transpose()
+    };
+    let i32_attr = |key: &str, inherited: &Option<String>| -> Result<Option<i32>, ReadError> {
+        attr(key, inherited)
+            .map(|s| s.trim().parse::<i32>().map_err(|_| ctx.bad_number(t, &tl, key, &s)))
+            .transpose()
+    };
+
+    let variable_type = match t.name.as_str() {
+        "Real" => VariableType::Real {
+            start: ctx.opt_f64(t, &tl, "start")?,
+            unit: attr("unit", &defaults.unit),
+            derivative: ctx.opt_u32(t, &tl, "derivative")?,
+            min: f64_attr("min", &defaults.min)?,
+            max: f64_attr("max", &defaults.max)?,
+            nominal: f64_attr("nominal", &defaults.nominal)?,
+        },
+        "Integer" => VariableType::Integer {
+            start: ctx.opt_i32(t, &tl, "start")?,
+            min: i32_attr("min", &defaults.min)?,
+            max: i32_attr("max", &defaults.max)?,
+        },
+        "Enumeration" => VariableType::Integer {
+            start: ctx.opt_i32(t, &tl, "start")?,
+            min: ctx.opt_i32(t, &tl, "min")?,
+            max: ctx.opt_i32(t, &tl, "max")?,
+        },
+        "Boolean" => VariableType::Boolean { start: ctx.opt_bool(t, &tl, "start")? },
+        _ => VariableType::String { start: Ctx::opt_string(t, "start") },
+    };
+
+    Ok(ScalarVariable {
+        name,
+        value_reference,
+        description: Ctx::opt_string(v, "description"),
+        causality,
+        variability,
+        initial,
+        variable_type,
+    })
+}
+
+fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
+    let l = format!("Unknown of {list}");
+    let index = ctx.req_u32(u, &l, "index")?;
+    let dependencies = u
+        .get("dependencies")
+        .map(|s| {
+            s.split_ascii_whitespace()
+                .map(|tok| tok.parse::<u32>().map_err(|_| ctx.bad_number(u, &l, "dependencies", tok)))
+                .collect::<Result<Vec<u32>, ReadError>>()
+        })
+        .transpose()?;
+    let dependencies_kind = u
+        .get("dependenciesKind")
+        .map(|s| {
+            s.split_ascii_whitespace()
+                .map(|tok| DependencyKind::parse(tok).ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok)))
+                .collect::<Result<Vec<DependencyKind>, ReadError>>()
+        })
+        .transpose()?;
+    Ok(Unknown { index, dependencies, dependencies_kind })
+}
