@@ -67,8 +67,51 @@ pub struct Evaluation<T> {
     pub delta_applied: [T; 4],
 }
 
-/// The model at one point: derivatives and all outputs.
-pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
+/// Applied steering angles with their sines and cosines, and the servo derivatives.
+///
+/// With the servo off these depend on the inputs only, so an integrator holding the
+/// inputs over a step computes them once per step instead of once per stage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Steering<T> {
+    pub delta: [T; 4],
+    pub sin: [T; 4],
+    pub cos: [T; 4],
+    /// `d servo_angle_i / dt` (zero with the servo off).
+    pub servo_rate: [T; 4],
+}
+
+/// The steering actually applied at this state and input.
+pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Steering<T> {
+    let zero = T::constant(0.0);
+    let dmax = T::constant(p.delta_max);
+    let mut st = Steering { delta: [zero; 4], sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
+    for i in 0..4 {
+        let cmd = u.delta[i].clamp_s(-dmax, dmax);
+        st.delta[i] = if p.steering_servo {
+            let sv = s[idx::SERVO + i];
+            let rate = T::constant(p.servo_rate_max);
+            st.servo_rate[i] = ((cmd - sv) / p.servo_time_constant).clamp_s(-rate, rate);
+            sv
+        } else {
+            cmd
+        };
+        st.sin[i] = st.delta[i].sin();
+        st.cos[i] = st.delta[i].cos();
+    }
+    st
+}
+
+/// Derivatives and per-wheel quantities, without the body outputs (the hot path).
+struct Core<T> {
+    derivatives: State<T>,
+    lateral_force: T,
+    slip_angle: [T; 4],
+    force_lat: [T; 4],
+    force_drive: [T; 4],
+}
+
+#[inline(always)]
+fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>) -> Core<T> {
     let zero = T::constant(0.0);
     let one = T::constant(1.0);
     let v_x = s[idx::V_X];
@@ -77,34 +120,27 @@ pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Ev
     let psi = s[idx::PSI];
     let pos = p.wheel_positions();
     let loads = p.normal_loads();
-    let dmax = T::constant(p.delta_max);
+    let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
     let mut slip_angle = [zero; 4];
     let mut force_lat = [zero; 4];
     let mut force_drive = [zero; 4];
-    let mut delta_applied = [zero; 4];
     let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
 
     for i in 0..4 {
         let (xi, yi) = pos[i];
-        let cmd = u.delta[i].clamp_s(-dmax, dmax);
-        let delta = if p.steering_servo {
-            let sv = s[idx::SERVO + i];
-            let rate = T::constant(p.servo_rate_max);
-            der[idx::SERVO + i] = ((cmd - sv) / p.servo_time_constant).clamp_s(-rate, rate);
-            sv
-        } else {
-            cmd
-        };
-        let (sd, cd) = (delta.sin(), delta.cos());
+        let (sd, cd) = (st.sin[i], st.cos[i]);
+        der[idx::SERVO + i] = st.servo_rate[i];
         // wheel-centre velocity, body frame and wheel frame
         let ui = v_x - r * yi;
         let wi = v_y + r * xi;
         let v_lon = ui * cd + wi * sd;
         let v_lat = wi * cd - ui * sd;
         let alpha = -v_lat.atan2(v_lon.abs());
-        let fade = (ui.hypot(wi) / p.v_fade).min_s(one);
+        // min(1, |(u, w)| / v_fade), with the square root only inside the fade zone
+        let speed_sq = ui * ui + wi * wi;
+        let fade = if speed_sq.value() < v_fade_sq { speed_sq.sqrt() / p.v_fade } else { one };
         let mu = u.mu[i];
         let mut f_lat = mu * alpha * p.c[i] * fade;
         let cap = mu * loads[i];
@@ -129,38 +165,61 @@ pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Ev
         slip_angle[i] = alpha;
         force_lat[i] = f_lat;
         force_drive[i] = f_drive;
-        delta_applied[i] = delta;
     }
     mz = mz + u.wind_side * p.x_c();
-    let lat_force = fy_sum + u.wind_side;
+    let lateral_force = fy_sum + u.wind_side;
     let (sp, cp) = (psi.sin(), psi.cos());
     der[idx::X] = v_x * cp - v_y * sp;
     der[idx::Y] = v_x * sp + v_y * cp;
     der[idx::PSI] = r;
     der[idx::V_X] = (fx_sum - u.wind_head) / p.m + r * v_y;
-    der[idx::V_Y] = lat_force / p.m - r * v_x;
+    der[idx::V_Y] = lateral_force / p.m - r * v_x;
     der[idx::YAW_RATE] = mz / p.i_z;
+    Core { derivatives: der, lateral_force, slip_angle, force_lat, force_drive }
+}
 
+/// The model at one point: derivatives and all outputs.
+pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
+    let st = steering(p, s, u);
+    let c = core(p, s, u, &st);
+    let (v_x, v_y) = (s[idx::V_X], s[idx::V_Y]);
     Evaluation {
-        derivatives: der,
+        derivatives: c.derivatives,
         beta: v_y.atan2(v_x),
         speed: v_x.hypot(v_y),
-        lateral_accel: lat_force / p.m,
-        slip_angle,
-        force_lat,
-        force_drive,
-        delta_applied,
+        lateral_accel: c.lateral_force / p.m,
+        slip_angle: c.slip_angle,
+        force_lat: c.force_lat,
+        force_drive: c.force_drive,
+        delta_applied: st.delta,
     }
 }
 
 /// Only the derivatives (the hot path of integrators).
 #[inline]
 pub fn derivatives_of(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
-    evaluate(p, s, u).derivatives
+    core(p, s, u, &steering(p, s, u)).derivatives
+}
+
+/// The derivatives with the steering given (valid while it does not depend on the state,
+/// i.e. with the servo off).
+#[inline]
+fn derivatives_steered(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, st: &Steering<f64>) -> State<f64> {
+    core(p, s, u, st).derivatives
 }
 
 /// One classical Runge-Kutta step of size `h` with inputs held constant.
 pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
+    let held = (!p.steering_servo).then(|| steering(p, s, u));
+    rk4(p, s, u, h, held.as_ref())
+}
+
+#[inline]
+fn rk4(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, held: Option<&Steering<f64>>) -> State<f64> {
+    let f = |x: &State<f64>| match held {
+        Some(st) => derivatives_steered(p, x, u, st),
+        None => derivatives_of(p, x, u),
+    };
     let add = |a: &State<f64>, k: &State<f64>, c: f64| {
         let mut o = *a;
         for j in 0..N_STATES {
@@ -168,10 +227,10 @@ pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> S
         }
         o
     };
-    let k1 = derivatives_of(p, s, u);
-    let k2 = derivatives_of(p, &add(s, &k1, 0.5 * h), u);
-    let k3 = derivatives_of(p, &add(s, &k2, 0.5 * h), u);
-    let k4 = derivatives_of(p, &add(s, &k3, h), u);
+    let k1 = f(s);
+    let k2 = f(&add(s, &k1, 0.5 * h));
+    let k3 = f(&add(s, &k2, 0.5 * h));
+    let k4 = f(&add(s, &k3, h));
     let mut o = *s;
     for j in 0..N_STATES {
         o[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
@@ -179,13 +238,15 @@ pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> S
     o
 }
 
-/// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`.
+/// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`, inputs held.
+/// With the servo off the steering trigonometry is computed once for the whole interval.
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
     let n = (h / max_step).ceil().max(1.0) as usize;
     let dt = h / n as f64;
+    let held = (!p.steering_servo).then(|| steering(p, s, u));
     let mut x = *s;
     for _ in 0..n {
-        x = rk4_step(p, &x, u, dt);
+        x = rk4(p, &x, u, dt, held.as_ref());
     }
     x
 }

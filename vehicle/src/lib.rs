@@ -8,7 +8,7 @@ pub mod linear;
 pub mod params;
 pub mod scalar;
 
-pub use dynamics::{derivatives_of, evaluate, integrate, rk4_step, straight_running, Evaluation, Inputs, State, N_STATES};
+pub use dynamics::{derivatives_of, evaluate, steering, Steering, integrate, rk4_step, straight_running, Evaluation, Inputs, State, N_STATES};
 pub use linear::{linear_model, DisturbanceColumn, LinearModel};
 pub use params::{ParamError, VehicleParams, WHEELS};
 pub use scalar::{Dual, Scalar};

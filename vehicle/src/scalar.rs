@@ -24,6 +24,8 @@ pub trait Scalar:
     fn sin(self) -> Self;
     fn cos(self) -> Self;
     fn abs(self) -> Self;
+    /// Square root, with derivative 0 at 0 (where it is infinite).
+    fn sqrt(self) -> Self;
     /// `atan2(self, x)`, with derivative 0 at the origin (where it is undefined).
     fn atan2(self, x: Self) -> Self;
     /// `sqrt(self^2 + y^2)`, with derivative 0 at the origin.
@@ -68,6 +70,10 @@ impl Scalar for f64 {
     #[inline]
     fn abs(self) -> Self {
         f64::abs(self)
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
     }
     #[inline]
     fn atan2(self, x: Self) -> Self {
@@ -180,6 +186,11 @@ impl Scalar for Dual {
         } else {
             self
         }
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        let q = self.v.sqrt();
+        Dual::new(q, if q > 0.0 { self.d / (2.0 * q) } else { 0.0 })
     }
     #[inline]
     fn atan2(self, x: Self) -> Self {
