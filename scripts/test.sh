@@ -4,11 +4,26 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup-system.sh
+target_dir="${CARGO_TARGET_DIR:-target}"
 echo "== building the FMUs"
 cargo run --release --quiet -p build-fmu
+echo "== rebuilding from touched sources must give byte-identical archives"
+touch fmu-plant/src/lib.rs fmi2-export/src/abi.rs
+cargo run --release --quiet -p build-fmu -- "$target_dir/fmu-rebuild" >/dev/null
+for f in "$target_dir"/fmu/*.fmu; do
+    cmp "$f" "$target_dir/fmu-rebuild/$(basename "$f")" && echo "identical: $(basename "$f")"
+done
+echo "== exported symbols"
+for so in "$target_dir"/release/libnigel_*.so; do
+    n=$(nm -D --defined-only "$so" | grep -c ' T fmi2')
+    [ "$n" -eq 44 ] || { echo "$so exports $n fmi2 symbols, expected 44" >&2; exit 1; }
+    echo "$(basename "$so"): 44 fmi2 symbols"
+done
+echo "== Python venv with fmpy"
+bash scripts/python-env.sh >/dev/null
+export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
+[ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 echo "== Rust tests"
 cargo test --release --workspace
 echo "== fmpy cross-checks"
-bash scripts/python-env.sh >/dev/null
-target_dir="${CARGO_TARGET_DIR:-target}"
 "$target_dir/venv/bin/python" -m pytest tests/python -q

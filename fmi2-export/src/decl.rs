@@ -263,7 +263,21 @@ impl<B> Declaration<B> {
                 || v.causality == Causality::CalculatedParameter
                 || ((is_state(row) || is_derivative(row)) && approx_or_calc);
             if listed {
-                structure.initial_unknowns.push(md::Unknown { index: index(row), dependencies: None, dependencies_kind: None });
+                // At initialization the knowns are the declared ones plus every variable
+                // with initial="exact" that is a parameter (their start values count too).
+                let dependencies = deps(v)?.map(|mut d| {
+                    d.extend(
+                        spec.variables
+                            .iter()
+                            .enumerate()
+                            .filter(|(_, p)| p.causality == Causality::Parameter && p.initial == Some(Initial::Exact))
+                            .map(|(k, _)| index(k)),
+                    );
+                    d.sort_unstable();
+                    d.dedup();
+                    d
+                });
+                structure.initial_unknowns.push(md::Unknown { index: index(row), dependencies, dependencies_kind: None });
             }
         }
 

@@ -9,6 +9,27 @@
 //!
 //! All indices (`derivative`, `Unknown::index`, `dependencies`, [`ModelDescription::index_of`],
 //! [`ModelDescription::states`]) are 1-based indices into `model_variables`.
+//!
+//! ```
+//! use model_description::ModelDescription;
+//!
+//! let xml = r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="{0}">
+//!   <CoSimulation modelIdentifier="m"/>
+//!   <ModelVariables>
+//!     <ScalarVariable name="k" valueReference="0" causality="parameter" variability="fixed">
+//!       <Real start="2"/>
+//!     </ScalarVariable>
+//!   </ModelVariables>
+//!   <ModelStructure/>
+//! </fmiModelDescription>"#;
+//! let md = ModelDescription::from_xml(xml)?.with_content_guid();
+//! assert!(md.validate().is_empty());
+//! assert_eq!(md.index_of("k"), Some(1));
+//! assert_eq!(ModelDescription::from_xml(&md.to_xml())?, md);
+//! # Ok::<(), model_description::ReadError>(())
+//! ```
+
+#![warn(missing_docs)]
 
 pub mod types;
 pub use types::*;

@@ -32,8 +32,15 @@ impl Position {
         let byte = byte.min(bytes.len());
         let before = &bytes[..byte];
         let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-        let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
-        Position { byte, line, column: byte - line_start + 1 }
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1);
+        Position {
+            byte,
+            line,
+            column: byte - line_start + 1,
+        }
     }
 }
 
@@ -44,30 +51,87 @@ impl fmt::Display for Position {
 }
 
 /// Why [`ModelDescription::from_xml`] refused a document. `element` names the element
-/// (for variables: `ScalarVariable "name"`), `position` points at its start tag.
+/// (for variables: `ScalarVariable "name"`, for their type element:
+/// `Real of ScalarVariable "name"`), `position` points at its start tag (for
+/// [`ReadError::Xml`], at the offending markup).
 #[derive(Clone, Debug, PartialEq)]
 pub enum ReadError {
     /// Not well-formed XML (syntax error, mismatched end tag, bad escape, duplicate
-    /// attribute, ...).
-    Xml { message: String, position: Position },
+    /// attribute, second root element, ...).
+    Xml {
+        /// quick-xml's description of the problem.
+        message: String,
+        /// Where it is.
+        position: Position,
+    },
     /// The document ended inside `element`.
-    UnexpectedEof { element: String, position: Position },
+    UnexpectedEof {
+        /// The innermost element still open.
+        element: String,
+        /// Its start tag.
+        position: Position,
+    },
     /// No root element, or the root is not `<fmiModelDescription>`.
-    NotAModelDescription { found: Option<String>, position: Position },
+    NotAModelDescription {
+        /// The root element found, if any.
+        found: Option<String>,
+        /// Its start tag (or the end of the input).
+        position: Position,
+    },
     /// A required attribute is absent.
-    MissingAttribute { element: String, attribute: String, position: Position },
+    MissingAttribute {
+        /// The element lacking it.
+        element: String,
+        /// The attribute's name.
+        attribute: String,
+        /// The element's start tag.
+        position: Position,
+    },
     /// An attribute that must be a number (or a list of numbers) is not.
-    BadNumber { element: String, attribute: String, value: String, position: Position },
+    BadNumber {
+        /// The element.
+        element: String,
+        /// The attribute's name.
+        attribute: String,
+        /// The offending value (for lists: the offending item).
+        value: String,
+        /// The element's start tag.
+        position: Position,
+    },
     /// An enumerated attribute (causality, variability, initial, dependenciesKind,
     /// a boolean) has a value outside its enumeration.
-    UnknownEnumValue { element: String, attribute: String, value: String, position: Position },
+    UnknownEnumValue {
+        /// The element.
+        element: String,
+        /// The attribute's name.
+        attribute: String,
+        /// The offending value (for lists: the offending item).
+        value: String,
+        /// The element's start tag.
+        position: Position,
+    },
     /// `fmiVersion` is not `"2.0"`.
-    UnsupportedFmiVersion { found: String, position: Position },
+    UnsupportedFmiVersion {
+        /// The value found.
+        found: String,
+        /// The root's start tag.
+        position: Position,
+    },
     /// A ScalarVariable has no `<Real>`, `<Integer>`, `<Boolean>`, `<String>` or
     /// `<Enumeration>` child.
-    MissingTypeChild { variable: String, position: Position },
+    MissingTypeChild {
+        /// The variable's name.
+        variable: String,
+        /// Its start tag.
+        position: Position,
+    },
     /// An element that may occur once occurs again.
-    DuplicateElement { element: String, position: Position },
+    DuplicateElement {
+        /// The element's name.
+        element: String,
+        /// The second occurrence's start tag.
+        position: Position,
+    },
 }
 
 impl ReadError {
@@ -145,47 +209,76 @@ struct Node {
 
 impl Node {
     fn get(&self, key: &str) -> Option<&str> {
-        self.attrs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+        self.attrs
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
     }
 }
 
 fn xml_err(src: &str, e: impl fmt::Display, pos: u64) -> ReadError {
-    ReadError::Xml { message: e.to_string(), position: Position::in_text(src, pos as usize) }
+    ReadError::Xml {
+        message: e.to_string(),
+        position: Position::in_text(src, pos as usize),
+    }
 }
 
 /// Start of the tag that begins at or after `from` (the first `<`).
 fn tag_start(src: &str, from: usize) -> usize {
     let bytes = src.as_bytes();
     let from = from.min(bytes.len());
-    bytes[from..].iter().position(|&b| b == b'<').map_or(from, |p| from + p)
+    bytes[from..]
+        .iter()
+        .position(|&b| b == b'<')
+        .map_or(from, |p| from + p)
 }
 
-fn make_node(src: &str, reader: &Reader<&[u8]>, e: &BytesStart<'_>, pos: usize) -> Result<Node, ReadError> {
+fn make_node(
+    src: &str,
+    reader: &Reader<&[u8]>,
+    e: &BytesStart<'_>,
+    pos: usize,
+) -> Result<Node, ReadError> {
     let name = std::str::from_utf8(e.name().as_ref())
         .map_err(|err| xml_err(src, err, pos as u64))?
         .to_string();
     let mut attrs = Vec::new();
     for a in e.attributes() {
         let a = a.map_err(|err| xml_err(src, err, pos as u64))?;
-        let key = std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
+        let key =
+            std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
         let value = a
             .decode_and_unescape_value(reader.decoder())
-            .map_err(|err| xml_err(src, format!("attribute {key} of <{name}>: {err}"), pos as u64))?;
+            .map_err(|err| {
+                xml_err(
+                    src,
+                    format!("attribute {key} of <{name}>: {err}"),
+                    pos as u64,
+                )
+            })?;
         attrs.push((key.to_string(), value.into_owned()));
     }
-    Ok(Node { name, attrs, pos, children: Vec::new() })
+    Ok(Node {
+        name,
+        attrs,
+        pos,
+        children: Vec::new(),
+    })
 }
 
 fn parse_tree(src: &str) -> Result<Node, ReadError> {
     let mut reader = Reader::from_str(src);
     reader.config_mut().trim_text(true);
-    // Open elements: the stored ones (depth <= MAX_DEPTH) and a count of deeper ones.
+    // Open elements: the stored ones (depth <= MAX_DEPTH), and name and position of
+    // deeper ones (kept only for the end-of-input message).
     let mut stack: Vec<Node> = Vec::new();
-    let mut deeper = 0usize;
+    let mut deeper: Vec<(String, usize)> = Vec::new();
     let mut root: Option<Node> = None;
     loop {
         let before = reader.buffer_position() as usize;
-        let ev = reader.read_event().map_err(|e| xml_err(src, e, reader.error_position()))?;
+        let ev = reader
+            .read_event()
+            .map_err(|e| xml_err(src, e, reader.error_position()))?;
         match ev {
             Event::Start(_) | Event::Empty(_) if root.is_some() && stack.is_empty() => {
                 let pos = tag_start(src, before);
@@ -196,28 +289,27 @@ fn parse_tree(src: &str) -> Result<Node, ReadError> {
             }
             Event::Start(e) => {
                 let pos = tag_start(src, before);
-                if stack.len() < MAX_DEPTH && deeper == 0 {
+                if stack.len() < MAX_DEPTH && deeper.is_empty() {
                     stack.push(make_node(src, &reader, &e, pos)?);
                 } else {
                     // Still check its attributes for well-formedness.
-                    make_node(src, &reader, &e, pos)?;
-                    deeper += 1;
+                    let node = make_node(src, &reader, &e, pos)?;
+                    deeper.push((node.name, pos));
                 }
             }
             Event::Empty(e) => {
                 let pos = tag_start(src, before);
                 let node = make_node(src, &reader, &e, pos)?;
-                if stack.len() < MAX_DEPTH && deeper == 0 {
+                if stack.len() < MAX_DEPTH && deeper.is_empty() {
                     match stack.last_mut() {
                         Some(parent) => parent.children.push(node),
                         None => root = Some(node),
                     }
                 }
             }
+            Event::End(_) if deeper.pop().is_some() => {}
             Event::End(_) => {
-                if deeper > 0 {
-                    deeper -= 1;
-                } else if let Some(node) = stack.pop() {
+                if let Some(node) = stack.pop() {
                     match stack.last_mut() {
                         Some(parent) => parent.children.push(node),
                         None => root = Some(node),
@@ -231,6 +323,12 @@ fn parse_tree(src: &str) -> Result<Node, ReadError> {
                 }
             }
             Event::Eof => {
+                if let Some((name, pos)) = deeper.pop() {
+                    return Err(ReadError::UnexpectedEof {
+                        element: name,
+                        position: Position::in_text(src, pos),
+                    });
+                }
                 if let Some(open) = stack.last() {
                     return Err(ReadError::UnexpectedEof {
                         element: open.name.clone(),
@@ -291,23 +389,35 @@ impl Ctx<'_> {
     }
 
     fn opt_f64(&self, n: &Node, label: &str, key: &str) -> Result<Option<f64>, ReadError> {
-        n.get(key).map(|v| self.f64_of(n, label, key, v)).transpose()
+        n.get(key)
+            .map(|v| self.f64_of(n, label, key, v))
+            .transpose()
     }
 
     fn opt_u32(&self, n: &Node, label: &str, key: &str) -> Result<Option<u32>, ReadError> {
         n.get(key)
-            .map(|v| v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v)))
+            .map(|v| {
+                v.trim()
+                    .parse::<u32>()
+                    .map_err(|_| self.bad_number(n, label, key, v))
+            })
             .transpose()
     }
 
     fn req_u32(&self, n: &Node, label: &str, key: &str) -> Result<u32, ReadError> {
         let v = self.req(n, label, key)?;
-        v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| self.bad_number(n, label, key, v))
     }
 
     fn opt_i32(&self, n: &Node, label: &str, key: &str) -> Result<Option<i32>, ReadError> {
         n.get(key)
-            .map(|v| v.trim().parse::<i32>().map_err(|_| self.bad_number(n, label, key, v)))
+            .map(|v| {
+                v.trim()
+                    .parse::<i32>()
+                    .map_err(|_| self.bad_number(n, label, key, v))
+            })
             .transpose()
     }
 
@@ -332,7 +442,9 @@ impl Ctx<'_> {
         key: &str,
         parse: fn(&str) -> Option<T>,
     ) -> Result<Option<T>, ReadError> {
-        n.get(key).map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v))).transpose()
+        n.get(key)
+            .map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v)))
+            .transpose()
     }
 
     fn opt_string(n: &Node, key: &str) -> Option<String> {
@@ -363,7 +475,10 @@ struct TypeDefaults {
 
 fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> Result<(), ReadError> {
     if slot.is_some() {
-        return Err(ReadError::DuplicateElement { element: n.name.clone(), position: ctx.pos(n) });
+        return Err(ReadError::DuplicateElement {
+            element: n.name.clone(),
+            position: ctx.pos(n),
+        });
     }
     *slot = Some(n);
     Ok(())
@@ -378,16 +493,24 @@ impl ModelDescription {
         let root = parse_tree(xml)?;
         let ctx = Ctx { src: xml };
         if root.name != "fmiModelDescription" {
-            return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(&root) });
+            return Err(ReadError::NotAModelDescription {
+                found: Some(root.name.clone()),
+                position: ctx.pos(&root),
+            });
         }
         let label = "fmiModelDescription";
         let fmi_version = ctx.req(&root, label, "fmiVersion")?;
         if fmi_version.trim() != "2.0" {
-            return Err(ReadError::UnsupportedFmiVersion { found: fmi_version.to_string(), position: ctx.pos(&root) });
+            return Err(ReadError::UnsupportedFmiVersion {
+                found: fmi_version.to_string(),
+                position: ctx.pos(&root),
+            });
         }
         let model_name = ctx.req(&root, label, "modelName")?.to_string();
         let guid = ctx.req(&root, label, "guid")?.to_string();
-        let number_of_event_indicators = ctx.opt_u32(&root, label, "numberOfEventIndicators")?.unwrap_or(0);
+        let number_of_event_indicators = ctx
+            .opt_u32(&root, label, "numberOfEventIndicators")?
+            .unwrap_or(0);
 
         let mut me_node = None;
         let mut cs_node = None;
@@ -417,14 +540,28 @@ impl ModelDescription {
                 Ok(ModelExchange {
                     model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
                     needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
-                    completed_integrator_step_not_needed: ctx.flag(n, l, "completedIntegratorStepNotNeeded")?,
-                    can_be_instantiated_only_once_per_process: ctx
-                        .flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
-                    can_not_use_memory_management_functions: ctx
-                        .flag(n, l, "canNotUseMemoryManagementFunctions")?,
+                    completed_integrator_step_not_needed: ctx.flag(
+                        n,
+                        l,
+                        "completedIntegratorStepNotNeeded",
+                    )?,
+                    can_be_instantiated_only_once_per_process: ctx.flag(
+                        n,
+                        l,
+                        "canBeInstantiatedOnlyOncePerProcess",
+                    )?,
+                    can_not_use_memory_management_functions: ctx.flag(
+                        n,
+                        l,
+                        "canNotUseMemoryManagementFunctions",
+                    )?,
                     can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
                     can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
+                    provides_directional_derivative: ctx.flag(
+                        n,
+                        l,
+                        "providesDirectionalDerivative",
+                    )?,
                 })
             })
             .transpose()?;
@@ -435,18 +572,33 @@ impl ModelDescription {
                 Ok(CoSimulation {
                     model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
                     needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
-                    can_handle_variable_communication_step_size: ctx
-                        .flag(n, l, "canHandleVariableCommunicationStepSize")?,
+                    can_handle_variable_communication_step_size: ctx.flag(
+                        n,
+                        l,
+                        "canHandleVariableCommunicationStepSize",
+                    )?,
                     can_interpolate_inputs: ctx.flag(n, l, "canInterpolateInputs")?,
-                    max_output_derivative_order: ctx.opt_u32(n, l, "maxOutputDerivativeOrder")?.unwrap_or(0),
+                    max_output_derivative_order: ctx
+                        .opt_u32(n, l, "maxOutputDerivativeOrder")?
+                        .unwrap_or(0),
                     can_run_asynchronuously: ctx.flag(n, l, "canRunAsynchronuously")?,
-                    can_be_instantiated_only_once_per_process: ctx
-                        .flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
-                    can_not_use_memory_management_functions: ctx
-                        .flag(n, l, "canNotUseMemoryManagementFunctions")?,
+                    can_be_instantiated_only_once_per_process: ctx.flag(
+                        n,
+                        l,
+                        "canBeInstantiatedOnlyOncePerProcess",
+                    )?,
+                    can_not_use_memory_management_functions: ctx.flag(
+                        n,
+                        l,
+                        "canNotUseMemoryManagementFunctions",
+                    )?,
                     can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
                     can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
+                    provides_directional_derivative: ctx.flag(
+                        n,
+                        l,
+                        "providesDirectionalDerivative",
+                    )?,
                 })
             })
             .transpose()?;
@@ -463,7 +615,9 @@ impl ModelDescription {
                 let base_unit = base_node
                     .map(|b| -> Result<BaseUnit, ReadError> {
                         let bl = format!("BaseUnit of {ul}");
-                        let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
+                        let e = |k: &str| -> Result<i32, ReadError> {
+                            Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0))
+                        };
                         Ok(BaseUnit {
                             kg: e("kg")?,
                             m: e("m")?,
@@ -487,7 +641,11 @@ impl ModelDescription {
         if let Some(types) = types_node {
             for t in types.children.iter().filter(|c| c.name == "SimpleType") {
                 let Some(name) = t.get("name") else { continue };
-                if let Some(inner) = t.children.iter().find(|c| c.name == "Real" || c.name == "Integer") {
+                if let Some(inner) = t
+                    .children
+                    .iter()
+                    .find(|c| c.name == "Real" || c.name == "Integer")
+                {
                     type_defaults.insert(
                         name.to_string(),
                         TypeDefaults {
@@ -586,29 +744,47 @@ fn read_variable(
     let name = ctx.req(v, "ScalarVariable", "name")?.to_string();
     let l = format!("ScalarVariable \"{name}\"");
     let value_reference = ctx.req_u32(v, &l, "valueReference")?;
-    let causality = ctx.opt_enum(v, &l, "causality", Causality::parse)?.unwrap_or(Causality::Local);
-    let variability = ctx.opt_enum(v, &l, "variability", Variability::parse)?.unwrap_or(Variability::Continuous);
+    let causality = ctx
+        .opt_enum(v, &l, "causality", Causality::parse)?
+        .unwrap_or(Causality::Local);
+    let variability = ctx
+        .opt_enum(v, &l, "variability", Variability::parse)?
+        .unwrap_or(Variability::Continuous);
     let initial = ctx.opt_enum(v, &l, "initial", Initial::parse)?;
 
-    let Some(t) = v
-        .children
-        .iter()
-        .find(|c| matches!(c.name.as_str(), "Real" | "Integer" | "Boolean" | "String" | "Enumeration"))
-    else {
-        return Err(ReadError::MissingTypeChild { variable: name, position: ctx.pos(v) });
+    let Some(t) = v.children.iter().find(|c| {
+        matches!(
+            c.name.as_str(),
+            "Real" | "Integer" | "Boolean" | "String" | "Enumeration"
+        )
+    }) else {
+        return Err(ReadError::MissingTypeChild {
+            variable: name,
+            position: ctx.pos(v),
+        });
     };
     let tl = format!("{} of {l}", t.name);
-    let defaults = t.get("declaredType").and_then(|d| type_defaults.get(d)).cloned().unwrap_or_default();
+    let defaults = t
+        .get("declaredType")
+        .and_then(|d| type_defaults.get(d))
+        .cloned()
+        .unwrap_or_default();
     // The variable's own attribute, else the declared type's.
     let attr = |key: &str, inherited: &Option<String>| -> Option<String> {
         t.get(key).map(str::to_string).or_else(|| inherited.clone())
     };
     let f64_attr = |key: &str, inherited: &Option<String>| -> Result<Option<f64>, ReadError> {
-        attr(key, inherited).map(|s| ctx.f64_of(t, &tl, key, &s)).transpose()
+        attr(key, inherited)
+            .map(|s| ctx.f64_of(t, &tl, key, &s))
+            .transpose()
     };
     let i32_attr = |key: &str, inherited: &Option<String>| -> Result<Option<i32>, ReadError> {
         attr(key, inherited)
-            .map(|s| s.trim().parse::<i32>().map_err(|_| ctx.bad_number(t, &tl, key, &s)))
+            .map(|s| {
+                s.trim()
+                    .parse::<i32>()
+                    .map_err(|_| ctx.bad_number(t, &tl, key, &s))
+            })
             .transpose()
     };
 
@@ -631,8 +807,12 @@ fn read_variable(
             min: ctx.opt_i32(t, &tl, "min")?,
             max: ctx.opt_i32(t, &tl, "max")?,
         },
-        "Boolean" => VariableType::Boolean { start: ctx.opt_bool(t, &tl, "start")? },
-        _ => VariableType::String { start: Ctx::opt_string(t, "start") },
+        "Boolean" => VariableType::Boolean {
+            start: ctx.opt_bool(t, &tl, "start")?,
+        },
+        _ => VariableType::String {
+            start: Ctx::opt_string(t, "start"),
+        },
     };
 
     Ok(ScalarVariable {
@@ -653,7 +833,10 @@ fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
         .get("dependencies")
         .map(|s| {
             s.split_ascii_whitespace()
-                .map(|tok| tok.parse::<u32>().map_err(|_| ctx.bad_number(u, &l, "dependencies", tok)))
+                .map(|tok| {
+                    tok.parse::<u32>()
+                        .map_err(|_| ctx.bad_number(u, &l, "dependencies", tok))
+                })
                 .collect::<Result<Vec<u32>, ReadError>>()
         })
         .transpose()?;
@@ -661,9 +844,83 @@ fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
         .get("dependenciesKind")
         .map(|s| {
             s.split_ascii_whitespace()
-                .map(|tok| DependencyKind::parse(tok).ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok)))
+                .map(|tok| {
+                    DependencyKind::parse(tok)
+                        .ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok))
+                })
                 .collect::<Result<Vec<DependencyKind>, ReadError>>()
         })
         .transpose()?;
-    Ok(Unknown { index, dependencies, dependencies_kind })
+    Ok(Unknown {
+        index,
+        dependencies,
+        dependencies_kind,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positions_are_one_based_lines_and_columns() {
+        let s = "ab\ncd\n\nef";
+        assert_eq!(
+            Position::in_text(s, 0),
+            Position {
+                byte: 0,
+                line: 1,
+                column: 1
+            }
+        );
+        assert_eq!(
+            Position::in_text(s, 4),
+            Position {
+                byte: 4,
+                line: 2,
+                column: 2
+            }
+        );
+        assert_eq!(
+            Position::in_text(s, 7),
+            Position {
+                byte: 7,
+                line: 4,
+                column: 1
+            }
+        );
+        assert_eq!(Position::in_text(s, 999).byte, s.len());
+        assert_eq!(Position::in_text(s, 4).to_string(), "line 2, column 2");
+    }
+
+    #[test]
+    fn xs_double_parsing() {
+        assert_eq!(parse_xs_double("\n 1e3\t"), Some(1000.0));
+        assert_eq!(parse_xs_double("-INF"), Some(f64::NEG_INFINITY));
+        assert_eq!(parse_xs_double(""), None);
+        assert_eq!(parse_xs_double("1 2"), None);
+    }
+
+    #[test]
+    fn tree_is_depth_limited() {
+        let t = parse_tree("<a><b><c><d><e><f/></e></d></c></b></a>").unwrap();
+        let d = &t.children[0].children[0].children[0];
+        assert_eq!(d.name, "d");
+        assert!(d.children.is_empty());
+    }
+
+    #[test]
+    fn control_characters_round_trip_through_char_refs() {
+        let mut md = ModelDescription::from_xml(
+            r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g"/>"#,
+        )
+        .unwrap();
+        md.description = Some("a\u{1}b\rc\nd\te".into());
+        let xml = md.to_xml();
+        assert!(xml.contains("a&#1;b&#13;c&#10;d&#9;e"), "{xml}");
+        assert_eq!(
+            ModelDescription::from_xml(&xml).unwrap().description,
+            md.description
+        );
+    }
 }

@@ -1,0 +1,150 @@
+//! Cross-check with an independent importer: fmpy validates what we write against the
+//! FMI 2.0 XSD and its own rules, and reads back the same variables. Runs when
+//! `$FMPY_PYTHON` (default `python3`) can import fmpy. When `$FMPY_PYTHON` is set (the
+//! README's test command sets it to its venv), fmpy missing is a failure, not a skip.
+
+mod common;
+
+use common::*;
+use model_description::*;
+use std::process::Command;
+
+fn python() -> String {
+    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
+}
+
+fn fmpy_available() -> bool {
+    Command::new(python())
+        .args(["-c", "import fmpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+}
+
+const SCRIPT: &str = r#"
+import sys
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+d = sys.argv[1]
+for p in validate_fmu(d):
+    print("PROBLEM", p.replace("\n", " "))
+md = read_model_description(d, validate=False)
+for v in md.modelVariables:
+    print("VAR", v.name, v.valueReference, v.type, v.causality, v.variability, v.initial, repr(v.start))
+for u in md.outputs:
+    print("OUT", md.modelVariables.index(u.variable) + 1)
+for u in md.initialUnknowns:
+    print("INIT", md.modelVariables.index(u.variable) + 1)
+"#;
+
+#[test]
+fn fmpy_accepts_and_reads_what_we_write() {
+    if !fmpy_available() {
+        assert!(
+            std::env::var_os("FMPY_PYTHON").is_none(),
+            "FMPY_PYTHON={} cannot import fmpy",
+            python()
+        );
+        eprintln!("fmpy not importable with {}: cross-check skipped (set FMPY_PYTHON to require it)", python());
+        return;
+    }
+    let base = std::env::temp_dir().join(format!("md-fmpy-{}", std::process::id()));
+    for (name, md) in [
+        ("rich", rich()),
+        ("minimal", minimal()),
+        (
+            "BouncingBall",
+            ModelDescription::from_xml(&fixture("BouncingBall.xml")).unwrap(),
+        ),
+        (
+            "VanDerPol",
+            ModelDescription::from_xml(&fixture("VanDerPol.xml")).unwrap(),
+        ),
+    ] {
+        let md = md.with_content_guid();
+        let dir = base.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("modelDescription.xml"), md.to_xml()).unwrap();
+        let out = Command::new(python())
+            .args(["-c", SCRIPT])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{name}: {}\n{stdout}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let problems: Vec<&str> = stdout
+            .lines()
+            .filter(|l| l.starts_with("PROBLEM"))
+            .collect();
+        assert!(
+            problems.is_empty(),
+            "{name}: fmpy problems:\n{}",
+            problems.join("\n")
+        );
+
+        let vars: Vec<Vec<&str>> = stdout
+            .lines()
+            .filter_map(|l| l.strip_prefix("VAR "))
+            .map(|l| l.split(' ').collect())
+            .collect();
+        assert_eq!(vars.len(), md.model_variables.len(), "{name}");
+        for (f, v) in vars.iter().zip(&md.model_variables) {
+            // Names with spaces do not occur in these samples.
+            assert_eq!(f[0], v.name, "{name}");
+            assert_eq!(f[1], v.value_reference.to_string(), "{name} {}", v.name);
+            assert_eq!(f[2], v.variable_type.type_name(), "{name} {}", v.name);
+            assert_eq!(f[3], v.causality.as_str(), "{name} {}", v.name);
+            assert_eq!(f[4], v.variability.as_str(), "{name} {}", v.name);
+            // fmpy reports the effective initial, and (FMI 3.0 style) "exact" for inputs,
+            // where FMI 2.0 allows no initial attribute.
+            let init = match v.causality {
+                Causality::Input => "exact",
+                _ => v.effective_initial().map_or("None", |i| i.as_str()),
+            };
+            assert_eq!(f[5], init, "{name} {}", v.name);
+            if let VariableType::Real { start: Some(s), .. } = v.variable_type {
+                // fmpy keeps the start as the attribute string: it must parse to our value.
+                let text = f[6].trim_matches('\'');
+                assert_eq!(
+                    parse_xs_double(text).map(f64::to_bits),
+                    Some(s.to_bits()),
+                    "{name} {}",
+                    v.name
+                );
+            }
+        }
+        let outs: Vec<u32> = stdout
+            .lines()
+            .filter_map(|l| l.strip_prefix("OUT "))
+            .map(|s| s.parse().unwrap())
+            .collect();
+        assert_eq!(
+            outs,
+            md.model_structure
+                .outputs
+                .iter()
+                .map(|u| u.index)
+                .collect::<Vec<_>>(),
+            "{name}"
+        );
+        let inits: Vec<u32> = stdout
+            .lines()
+            .filter_map(|l| l.strip_prefix("INIT "))
+            .map(|s| s.parse().unwrap())
+            .collect();
+        assert_eq!(
+            inits,
+            md.model_structure
+                .initial_unknowns
+                .iter()
+                .map(|u| u.index)
+                .collect::<Vec<_>>(),
+            "{name}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&base);
+}
