@@ -410,3 +410,64 @@ pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
         base_unit: Some(md::BaseUnit { kg, m, s, rad, factor: 1.0, ..Default::default() }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(variables: Vec<VarDecl<u8>>) -> DeclarationSpec<u8> {
+        DeclarationSpec {
+            model_name: "toy",
+            model_identifier: "toy",
+            description: "a toy",
+            version: "0",
+            interfaces: Interfaces { model_exchange: true, co_simulation: true },
+            units: vec![si_unit("m", 0, 1, 0, 0), si_unit("m/s", 0, 1, -1, 0)],
+            default_experiment: None,
+            variables,
+        }
+    }
+
+    fn toy() -> Vec<VarDecl<u8>> {
+        vec![
+            VarDecl::real("u", 5, 0).input(Start::Real(0.0)),
+            VarDecl::real("x", 1, 1).state(0.0, true).unit("m"),
+            VarDecl::real("der(x)", 2, 2).derivative(1, Dependencies::On(vec![5])).unit("m/s"),
+            VarDecl::real("k", 3, 3).parameter(Start::Real(2.0)),
+            VarDecl::boolean("on", 1, 4).parameter(Start::Boolean(true)),
+        ]
+    }
+
+    #[test]
+    fn structure_is_derived_with_one_based_indices() {
+        let d = Declaration::new(spec(toy())).unwrap();
+        let md = d.model_description();
+        assert_eq!(md.model_structure.outputs[0].index, 2);
+        assert_eq!(md.model_structure.outputs[0].dependencies, Some(vec![2]));
+        assert_eq!(md.model_structure.derivatives[0].index, 3);
+        assert_eq!(md.model_structure.derivatives[0].dependencies, Some(vec![1]));
+        // der(x) at initialization: the input and the exact parameters k and on
+        assert_eq!(md.model_structure.initial_unknowns[0].dependencies, Some(vec![1, 4, 5]));
+        assert_eq!(d.state_rows, vec![1]);
+        assert_eq!(d.row(BaseType::Boolean, 1), Some(4));
+        assert_eq!(d.row(BaseType::Real, 4), None);
+        assert_eq!(md.guid, md.content_guid());
+        assert!(d.xml().contains(&md.guid));
+    }
+
+    #[test]
+    fn bad_declarations_are_refused_with_the_reason() {
+        let mut v = toy();
+        v[3].value_reference = 1; // clashes with x
+        assert!(Declaration::new(spec(v)).unwrap_err().contains("duplicate value reference 1"));
+        let mut v = toy();
+        v[2].derivative_of = Some(42);
+        assert!(Declaration::new(spec(v)).unwrap_err().contains("derivative of unknown Real vr 42"));
+        let mut v = toy();
+        v[0] = VarDecl::real("u", 5, 0).input(Start::None);
+        assert!(Declaration::new(spec(v)).unwrap_err().contains("not a valid FMI 2.0 description"));
+        let mut v = toy();
+        v[1].unit = Some("furlong");
+        assert!(Declaration::new(spec(v)).unwrap_err().contains("furlong"));
+    }
+}

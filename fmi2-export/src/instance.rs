@@ -342,7 +342,12 @@ impl<M: Model> Instance<M> {
         self.require_interface(Interface::ModelExchange)?;
         self.require(&Self::ME_READ, "fmi2GetContinuousStates")?;
         self.check_state_count(out.len())?;
-        for (o, &row) in out.iter_mut().zip(&decl::<M>().state_rows) {
+        self.read_rows(&decl::<M>().state_rows, out)
+    }
+
+    /// Reads the Reals of `rows` into `out` (the state or derivative vector).
+    fn read_rows(&mut self, rows: &[usize], out: &mut [f64]) -> OpResult {
+        for (o, &row) in out.iter_mut().zip(rows) {
             *o = self.model.get_real(decl::<M>().variable(row).binding)?;
         }
         Ok(())
@@ -369,10 +374,7 @@ impl<M: Model> Instance<M> {
         self.require_interface(Interface::ModelExchange)?;
         self.require(&Self::ME_READ, "fmi2GetDerivatives")?;
         self.check_state_count(out.len())?;
-        for (o, &row) in out.iter_mut().zip(&decl::<M>().derivative_rows) {
-            *o = self.model.get_real(decl::<M>().variable(row).binding)?;
-        }
-        Ok(())
+        self.read_rows(&decl::<M>().derivative_rows, out)
     }
 
     pub fn get_nominals(&mut self, out: &mut [f64]) -> OpResult {
