@@ -11,7 +11,7 @@ repo="$(cd "$(dirname "$0")/.." && pwd)"
 target="${CARGO_TARGET_DIR:-$repo/target}"
 case "$target" in
     /*) ;;
-    *) target="$repo/$target" ;; # cargo resolves a relative CARGO_TARGET_DIR from the workspace root
+    *) target="$repo/$target" ;; # relative to the repo root, as scripts/test.sh (run from there) uses it
 esac
 venv="$target/venv"
 python="${PYTHON:-python3}"
