@@ -203,3 +203,22 @@ fn servo_follows_with_rate_limit() {
     assert_eq!(e.derivatives[idx::SERVO + 3], -5.51);
     assert_eq!(e.delta_applied, [0.0; 4]);
 }
+
+#[test]
+fn a_car_coasting_to_rest_ends_exactly_at_rest_not_in_subnormals() {
+    let p = VehicleParams::table2();
+    // sliding sideways and spinning, wheels straight: the tires stop the car
+    let mut s = [0.0; N_STATES];
+    s[idx::V_Y] = 0.01;
+    s[idx::YAW_RATE] = 0.05;
+    let u = Inputs::coasting(0.4);
+    for step in 0..5_000 {
+        s = integrate(&p, &s, &u, 1e-3, 5e-4);
+        assert!(s.iter().all(|x| x.is_normal() || *x == 0.0), "subnormal state at step {step}: {s:?}");
+    }
+    // (v_x keeps the small forward speed the spin handed it: the model has no rolling resistance)
+    for k in [idx::V_Y, idx::YAW_RATE] {
+        assert_eq!(s[k], 0.0, "sliding and spinning stopped exactly: state {k} = {:e}", s[k]);
+    }
+    assert!(s.iter().all(|x| x.is_normal() || *x == 0.0), "no subnormal states: {s:?}");
+}
