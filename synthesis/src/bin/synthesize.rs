@@ -1,0 +1,287 @@
+//! `synthesize`: robust mixed H2/H-inf state feedback for Nigel (thin CLI over
+//! `nigel_synthesis`). Run with `--help` for the options.
+//!
+//! Exit codes: 0 = designed and verified; 1 = no design (infeasible, solver trouble,
+//! refused parameters, I/O); 2 = bad command line; 3 = designed but the independent
+//! verification failed.
+
+use std::process::ExitCode;
+
+use nigel_synthesis::report::{render_text, run, Objective, Request};
+use nigel_synthesis::{Architecture, DisturbanceVariant, PlantSpec, PoleRegion, Region, SweepProgress};
+
+const USAGE: &str = "\
+synthesize: robust mixed H2/H-inf state feedback with D-stability over Nigel's
+16-vertex friction polytope (paper Section IV), solved with clarabel and verified
+independently (closed-loop poles, Hamiltonian/sweep H-inf, Lyapunov/Gramian H2).
+
+USAGE: synthesize [OPTIONS]
+
+Plant:
+  --arch 4ws|ackermann        steering architecture (default 4ws = 4WD4WS)
+  --d2 paper|physical         disturbance column and geometry (default paper:
+                              d2 = (l_f - l_r)/2 as printed, l_r = 0.07924;
+                              physical: d2 = (l_f - l_r)/(2 I_z), Table II)
+  --speed V                   design speed [m/s] (default 0.35)
+  --mu-min X, --mu-max X      friction box (default 0.1, 1.0)
+Pole region (intersection; the default is Re(s) < -0.1 and the 135-degree sector):
+  --half-plane A              add Re(s) < A
+  --sector DEG                add a conic sector of inner angle DEG degrees at the origin
+  --disk R[,C]                add the disk |s - C| < R (C defaults to 0)
+  --no-default-region         drop the paper's default region
+Objective:
+  --objective pareto|hinf|h2|weighted|baseline   (default pareto)
+  --hinf-bound G              h2: also require gamma <= G
+  --weight-hinf A, --weight-h2 B                 weighted: min A gamma^2 + B nu^2 (default 1, 1)
+  --baseline-alpha A, --baseline-mu M            baseline: Re(s) < A at mu = M (default -2, 0.4)
+  --step S, --g-max G         Pareto grid (default 0.01, 0.5)
+  --margin EPS                strictness margin of the LMIs (default 1e-7)
+  --threads N                 threads for the Pareto grid (default: all cores)
+Verification:
+  --interior N                random interior points (default 64)
+  --seed S                    their seed (default 0x5eed0f4157)
+Output:
+  --json PATH                 write the full report as JSON
+  --plot PATH                 write an SVG figure (Pareto curve, pole map)
+  --quiet                     no progress lines on stderr
+  -h, --help                  this text
+
+gamma is the bound on the induced L2 gain from w = F_sw to z = [beta, r, u].
+Exit codes: 0 ok, 1 no design, 2 bad command line, 3 verification failed.
+";
+
+struct Cli {
+    request: Request,
+    json: Option<String>,
+    plot: Option<String>,
+    quiet: bool,
+}
+
+fn parse_f64(opt: &str, v: &str) -> Result<f64, String> {
+    let x: f64 = v.trim().parse().map_err(|_| format!("{opt}: '{v}' is not a number"))?;
+    if !x.is_finite() {
+        return Err(format!("{opt}: '{v}' must be finite"));
+    }
+    Ok(x)
+}
+
+fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
+    let mut arch = Architecture::FourWheelSteering;
+    let mut d2 = DisturbanceVariant::Paper;
+    let mut speed = None;
+    let mut mu_min = None;
+    let mut mu_max = None;
+    let mut extra_regions = Vec::new();
+    let mut default_region = true;
+    let mut objective = "pareto".to_string();
+    let mut hinf_bound = None;
+    let (mut w_hinf, mut w_h2) = (1.0, 1.0);
+    let (mut b_alpha, mut b_mu) = (-2.0, 0.4);
+    let mut request = Request::paper(arch);
+    let mut json = None;
+    let mut plot = None;
+    let mut quiet = false;
+    let mut i = 0;
+    while i < args.len() {
+        let a = args[i].as_str();
+        // accept --opt=value as well as --opt value
+        let (name, inline) = match a.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n, Some(v.to_string())),
+            _ => (a, None),
+        };
+        const FLAGS: [&str; 4] = ["--no-default-region", "--quiet", "-h", "--help"];
+        const WITH_VALUE: [&str; 22] = [
+            "--arch",
+            "--d2",
+            "--speed",
+            "--mu-min",
+            "--mu-max",
+            "--half-plane",
+            "--sector",
+            "--disk",
+            "--objective",
+            "--hinf-bound",
+            "--weight-hinf",
+            "--weight-h2",
+            "--baseline-alpha",
+            "--baseline-mu",
+            "--step",
+            "--g-max",
+            "--margin",
+            "--threads",
+            "--interior",
+            "--seed",
+            "--json",
+            "--plot",
+        ];
+        if !FLAGS.contains(&name) && !WITH_VALUE.contains(&name) {
+            return Err(format!("unknown option '{a}'"));
+        }
+        let takes_value = WITH_VALUE.contains(&name);
+        let value = if takes_value {
+            match inline {
+                Some(v) => v,
+                None => {
+                    i += 1;
+                    args.get(i).cloned().ok_or_else(|| format!("{name} needs a value"))?
+                }
+            }
+        } else {
+            if inline.is_some() {
+                return Err(format!("{name} takes no value"));
+            }
+            String::new()
+        };
+        let v = value.as_str();
+        match name {
+            "-h" | "--help" => return Ok(None),
+            "--arch" => {
+                arch = match v.to_ascii_lowercase().as_str() {
+                    "4ws" | "4wd4ws" => Architecture::FourWheelSteering,
+                    "ackermann" => Architecture::Ackermann,
+                    _ => return Err(format!("--arch: '{v}' is not one of 4ws, ackermann")),
+                }
+            }
+            "--d2" => {
+                d2 = match v {
+                    "paper" => DisturbanceVariant::Paper,
+                    "physical" => DisturbanceVariant::Physical,
+                    _ => return Err(format!("--d2: '{v}' is not one of paper, physical")),
+                }
+            }
+            "--speed" => speed = Some(parse_f64(name, v)?),
+            "--mu-min" => mu_min = Some(parse_f64(name, v)?),
+            "--mu-max" => mu_max = Some(parse_f64(name, v)?),
+            "--half-plane" => extra_regions.push(Region::half_plane(parse_f64(name, v)?)),
+            "--sector" => extra_regions.push(Region::sector_inner_angle_deg(parse_f64(name, v)?)),
+            "--disk" => {
+                let (r, c) = match v.split_once(',') {
+                    Some((r, c)) => (parse_f64(name, r)?, parse_f64(name, c)?),
+                    None => (parse_f64(name, v)?, 0.0),
+                };
+                extra_regions.push(Region::disk(c, r));
+            }
+            "--no-default-region" => default_region = false,
+            "--objective" => {
+                if !matches!(v, "pareto" | "hinf" | "h2" | "weighted" | "baseline") {
+                    return Err(format!("--objective: '{v}' is not one of pareto, hinf, h2, weighted, baseline"));
+                }
+                objective = v.to_string();
+            }
+            "--hinf-bound" => hinf_bound = Some(parse_f64(name, v)?),
+            "--weight-hinf" => w_hinf = parse_f64(name, v)?,
+            "--weight-h2" => w_h2 = parse_f64(name, v)?,
+            "--baseline-alpha" => b_alpha = parse_f64(name, v)?,
+            "--baseline-mu" => b_mu = parse_f64(name, v)?,
+            "--step" => request.sweep.step = parse_f64(name, v)?,
+            "--g-max" => request.sweep.g_max = parse_f64(name, v)?,
+            "--margin" => request.options.margin = parse_f64(name, v)?,
+            "--threads" => request.sweep.threads = v.parse().map_err(|_| format!("--threads: '{v}' is not a count"))?,
+            "--interior" => {
+                request.verify.interior_points = v.parse().map_err(|_| format!("--interior: '{v}' is not a count"))?
+            }
+            "--seed" => {
+                request.verify.seed = match v.strip_prefix("0x") {
+                    Some(hex) => u64::from_str_radix(hex, 16),
+                    None => v.parse(),
+                }
+                .map_err(|_| format!("--seed: '{v}' is not an integer"))?
+            }
+            "--json" => json = Some(value.clone()),
+            "--plot" => {
+                if !v.to_ascii_lowercase().ends_with(".svg") {
+                    return Err(format!("--plot: '{v}': only SVG output is supported (use a .svg name)"));
+                }
+                plot = Some(value.clone())
+            }
+            "--quiet" => quiet = true,
+            _ => return Err(format!("unknown option '{a}'")),
+        }
+        i += 1;
+    }
+    let mut spec = PlantSpec::with_variant(arch, d2);
+    if let Some(s) = speed {
+        spec.speed = s;
+    }
+    if let Some(m) = mu_min {
+        spec.mu_min = m;
+    }
+    if let Some(m) = mu_max {
+        spec.mu_max = m;
+    }
+    let mut region = if default_region { PoleRegion::paper() } else { PoleRegion::none() };
+    region.parts.extend(extra_regions);
+    request.spec = spec;
+    request.region = region;
+    request.objective = match objective.as_str() {
+        "hinf" => Objective::Hinf,
+        "h2" => Objective::H2 { hinf_bound },
+        "weighted" => Objective::Weighted { weight_hinf: w_hinf, weight_h2: w_h2 },
+        "baseline" => Objective::Baseline { mu_nominal: b_mu, alpha: b_alpha },
+        _ => Objective::Pareto,
+    };
+    Ok(Some(Cli { request, json, plot, quiet }))
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let cli = match parse_args(&args) {
+        Ok(Some(c)) => c,
+        Ok(None) => {
+            print!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("synthesize: {e}\n(run 'synthesize --help' for the options)");
+            return ExitCode::from(2);
+        }
+    };
+    let progress = |p: SweepProgress| {
+        eprintln!(
+            "  [{:>2}/{}] k = {:>2}  g = {:.5}  nu = {}",
+            p.done,
+            p.total,
+            p.k,
+            p.g,
+            p.nu.map_or("failed".to_string(), |nu| format!("{nu:.5}"))
+        );
+    };
+    if !cli.quiet && cli.request.objective == Objective::Pareto {
+        eprintln!("synthesize: gamma*, then the Pareto grid ...");
+    }
+    let progress_ref: Option<&(dyn Fn(SweepProgress) + Sync)> = if cli.quiet { None } else { Some(&progress) };
+    let report = match run(&cli.request, progress_ref) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("synthesize: no controller: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    print!("{}", render_text(&report));
+    if let Some(path) = &cli.json {
+        let text = match serde_json::to_string_pretty(&report) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("synthesize: cannot serialise the report: {e}");
+                return ExitCode::from(1);
+            }
+        };
+        if let Err(e) = std::fs::write(path, text + "\n") {
+            eprintln!("synthesize: cannot write {path}: {e}");
+            return ExitCode::from(1);
+        }
+        println!("wrote {path}");
+    }
+    if let Some(path) = &cli.plot {
+        if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_svg(&report)) {
+            eprintln!("synthesize: cannot write {path}: {e}");
+            return ExitCode::from(1);
+        }
+        println!("wrote {path}");
+    }
+    if !report.verification.passed {
+        eprintln!("synthesize: the independent verification FAILED (see above)");
+        return ExitCode::from(3);
+    }
+    ExitCode::SUCCESS
+}
