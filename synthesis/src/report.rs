@@ -152,41 +152,6 @@ pub struct ChosenPoint {
     pub nu: Option<f64>,
 }
 
-/// Closed-loop poles and norms at one vertex.
-#[derive(Clone, Debug, Serialize)]
-pub struct VertexReport {
-    /// Friction FL, FR, RL, RR.
-    pub mu: [f64; 4],
-    /// Closed-loop poles `[re, im]`.
-    pub poles: Vec<[f64; 2]>,
-    /// Smallest pole margin inside the region (positive = inside).
-    pub region_margin: f64,
-    /// H-inf norm (Hamiltonian bisection).
-    pub hinf: f64,
-    /// H-inf norm (frequency sweep).
-    pub hinf_sweep: f64,
-    /// H2 norm (Lyapunov).
-    pub h2: f64,
-    /// H2 norm (Gramian integration).
-    pub h2_integrated: f64,
-    /// H2 norm (dual Lyapunov).
-    pub h2_dual: f64,
-}
-
-impl From<&PointCheck> for VertexReport {
-    fn from(p: &PointCheck) -> Self {
-        VertexReport {
-            mu: p.mu,
-            poles: p.poles.clone(),
-            region_margin: p.region_margin,
-            hinf: p.hinf,
-            hinf_sweep: p.hinf_sweep,
-            h2: p.h2,
-            h2_integrated: p.h2_integrated,
-            h2_dual: p.h2_dual,
-        }
-    }
-}
 
 /// Certified bounds against actual norms, worst case over vertices and interior points.
 #[derive(Clone, Debug, Serialize)]
@@ -318,7 +283,7 @@ pub struct SynthesisReport {
     #[serde(rename = "X")]
     pub x: [[f64; 2]; 2],
     /// Closed-loop poles and norms at the 16 vertices.
-    pub vertices: Vec<VertexReport>,
+    pub vertices: Vec<PointCheck>,
     /// Certified bounds and actual worst-case norms.
     pub actual: ActualNorms,
     /// The independent verification.
@@ -456,7 +421,7 @@ pub fn run(
         k_rows: WHEEL_NAMES,
         k_columns: ["beta", "r"],
         x: [[x[(0, 0)], x[(0, 1)]], [x[(1, 0)], x[(1, 1)]]],
-        vertices: v.vertices.iter().map(VertexReport::from).collect(),
+        vertices: v.vertices.clone(),
         actual: ActualNorms {
             hinf_bound: v.gamma_bound,
             hinf_worst: v.worst_hinf,
