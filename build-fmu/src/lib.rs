@@ -83,7 +83,9 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
     );
     for v in &md.model_variables {
         let (unit, start) = match &v.variable_type {
-            VariableType::Real { unit, start, .. } => (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::Real { unit, start, .. } => {
+                (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default())
+            }
             VariableType::Integer { start, .. } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
             VariableType::Boolean { start } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
             VariableType::String { start } => (String::new(), start.clone().unwrap_or_default()),
@@ -158,7 +160,16 @@ pub fn build_library(target: &FmuTarget) -> Result<PathBuf, BuildError> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
     let status = Command::new(cargo)
-        .args(["build", "--release", "--quiet", "--package", target.package, "--features", "fmi-export", "--manifest-path"])
+        .args([
+            "build",
+            "--release",
+            "--quiet",
+            "--package",
+            target.package,
+            "--features",
+            "fmi-export",
+            "--manifest-path",
+        ])
         .arg(&manifest)
         .status()
         .map_err(|e| BuildError::Cargo(e.to_string()))?;

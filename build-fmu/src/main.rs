@@ -5,7 +5,8 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let out_dir = std::env::args_os().nth(1).map(std::path::PathBuf::from).unwrap_or_else(|| build_fmu::target_dir().join("fmu"));
+    let out_dir =
+        std::env::args_os().nth(1).map(std::path::PathBuf::from).unwrap_or_else(|| build_fmu::target_dir().join("fmu"));
     for target in build_fmu::targets() {
         match build_fmu::build(&target, &out_dir) {
             Ok((path, size)) => {

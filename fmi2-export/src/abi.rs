@@ -71,7 +71,11 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// Runs `f` on the instance behind `c`: null check, panic guard, logging, error state.
-unsafe fn with<M: Model>(c: fmi2Component, function: &str, f: impl FnOnce(&mut Component<M>) -> OpResult) -> Fmi2Status {
+unsafe fn with<M: Model>(
+    c: fmi2Component,
+    function: &str,
+    f: impl FnOnce(&mut Component<M>) -> OpResult,
+) -> Fmi2Status {
     if c.is_null() {
         return Fmi2Status::Error;
     }
@@ -131,7 +135,12 @@ pub fn get_version() -> *const c_char {
     c"2.0".as_ptr()
 }
 
-pub unsafe fn set_debug_logging<M: Model>(c: fmi2Component, logging_on: fmi2Boolean, n: usize, categories: *const fmi2String) -> Fmi2Status {
+pub unsafe fn set_debug_logging<M: Model>(
+    c: fmi2Component,
+    logging_on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> Fmi2Status {
     with::<M>(c, "fmi2SetDebugLogging", |comp| {
         let names = slice(categories, n, "categories")?;
         let mut enabled = [n == 0; LOG_CATEGORIES.len()];
@@ -199,12 +208,22 @@ pub unsafe fn instantiate<M: Model>(
         Ok(Ok(component)) => {
             if component.instance.context.resource_path.is_none() && !resource_location.is_null() {
                 let given = CStr::from_ptr(resource_location).to_string_lossy();
-                component.log(Fmi2Status::Warning, CAT_WARNING, &format!("fmi2Instantiate: resource location {given:?} is not a usable file URI"));
+                component.log(
+                    Fmi2Status::Warning,
+                    CAT_WARNING,
+                    &format!("fmi2Instantiate: resource location {given:?} is not a usable file URI"),
+                );
             }
             Box::into_raw(component) as fmi2Component
         }
         Ok(Err(message)) => {
-            emit(&callbacks, &name, Fmi2Status::Error, LOG_CATEGORIES[CAT_ERROR].0, &format!("fmi2Instantiate: {message}"));
+            emit(
+                &callbacks,
+                &name,
+                Fmi2Status::Error,
+                LOG_CATEGORIES[CAT_ERROR].0,
+                &format!("fmi2Instantiate: {message}"),
+            );
             std::ptr::null_mut()
         }
         Err(payload) => {
@@ -311,7 +330,12 @@ pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, 
     })
 }
 
-pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const fmi2Boolean) -> Fmi2Status {
+pub unsafe fn set_boolean<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    value: *const fmi2Boolean,
+) -> Fmi2Status {
     with::<M>(c, "fmi2SetBoolean", |comp| {
         let vr = slice(vr, n, "vr")?;
         let values: Vec<bool> = slice(value, n, "value")?.iter().map(|&b| b != FMI2_FALSE).collect();
@@ -319,7 +343,12 @@ pub unsafe fn set_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, 
     })
 }
 
-pub unsafe fn set_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, _value: *const fmi2String) -> Fmi2Status {
+pub unsafe fn set_string<M: Model>(
+    c: fmi2Component,
+    vr: *const u32,
+    n: usize,
+    _value: *const fmi2String,
+) -> Fmi2Status {
     get_string::<M>(c, vr, n, std::ptr::null_mut())
 }
 
@@ -356,7 +385,11 @@ pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstat
     })
 }
 
-pub unsafe fn serialized_fmu_state_size<M: Model>(c: fmi2Component, state: fmi2FMUstate, size: *mut usize) -> Fmi2Status {
+pub unsafe fn serialized_fmu_state_size<M: Model>(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> Fmi2Status {
     with::<M>(c, "fmi2SerializedFMUstateSize", |_| {
         let saved = (state as *const SavedState<M>).as_ref().ok_or("FMUstate is NULL")?;
         *out_ptr(size, "size")? = Instance::serialize(saved).len();
@@ -364,7 +397,12 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(c: fmi2Component, state: fmi2F
     })
 }
 
-pub unsafe fn serialize_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> Fmi2Status {
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    bytes: *mut fmi2Byte,
+    size: usize,
+) -> Fmi2Status {
     with::<M>(c, "fmi2SerializeFMUstate", |_| {
         let saved = (state as *const SavedState<M>).as_ref().ok_or("FMUstate is NULL")?;
         let data = Instance::serialize(saved);
@@ -377,7 +415,12 @@ pub unsafe fn serialize_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstat
     })
 }
 
-pub unsafe fn deserialize_fmu_state<M: Model>(c: fmi2Component, bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate) -> Fmi2Status {
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> Fmi2Status {
     with::<M>(c, "fmi2DeSerializeFMUstate", |comp| {
         let data = slice(bytes as *const u8, size, "serializedState")?;
         let slot = out_ptr(state, "FMUstate")?;
@@ -411,11 +454,23 @@ pub unsafe fn get_directional_derivative<M: Model>(
 
 // ------------------------------------------------------------------ Co-Simulation
 
-pub unsafe fn set_real_input_derivatives<M: Model>(c: fmi2Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *const f64) -> Fmi2Status {
+pub unsafe fn set_real_input_derivatives<M: Model>(
+    c: fmi2Component,
+    _vr: *const u32,
+    _n: usize,
+    _order: *const c_int,
+    _value: *const f64,
+) -> Fmi2Status {
     with::<M>(c, "fmi2SetRealInputDerivatives", |_| Err("not supported (canInterpolateInputs is false)".into()))
 }
 
-pub unsafe fn get_real_output_derivatives<M: Model>(c: fmi2Component, _vr: *const u32, _n: usize, _order: *const c_int, _value: *mut f64) -> Fmi2Status {
+pub unsafe fn get_real_output_derivatives<M: Model>(
+    c: fmi2Component,
+    _vr: *const u32,
+    _n: usize,
+    _order: *const c_int,
+    _value: *mut f64,
+) -> Fmi2Status {
     with::<M>(c, "fmi2GetRealOutputDerivatives", |_| Err("not supported (maxOutputDerivativeOrder is 0)".into()))
 }
 

@@ -123,7 +123,8 @@ impl<B> VarDecl<B> {
     /// `causality="input"` (continuous for Reals, discrete otherwise) with a start value.
     pub fn input(mut self, start: Start) -> Self {
         self.causality = Causality::Input;
-        self.variability = if self.base_type == BaseType::Real { Variability::Continuous } else { Variability::Discrete };
+        self.variability =
+            if self.base_type == BaseType::Real { Variability::Continuous } else { Variability::Discrete };
         self.initial = None;
         self.start = start;
         self
@@ -213,7 +214,10 @@ impl<B> Declaration<B> {
         let mut names = HashMap::new();
         for (row, v) in spec.variables.iter().enumerate() {
             if lookup.insert((v.base_type, v.value_reference), row).is_some() {
-                return Err(format!("duplicate value reference {} ({:?}) at {}", v.value_reference, v.base_type, v.name));
+                return Err(format!(
+                    "duplicate value reference {} ({:?}) at {}",
+                    v.value_reference, v.base_type, v.name
+                ));
             }
             if names.insert(v.name, row).is_some() {
                 return Err(format!("duplicate variable name {}", v.name));
@@ -224,7 +228,8 @@ impl<B> Declaration<B> {
         let mut derivative_rows = Vec::new();
         for (row, v) in spec.variables.iter().enumerate() {
             if let Some(state_vr) = v.derivative_of {
-                let state = real_row(state_vr).ok_or_else(|| format!("{}: derivative of unknown Real vr {state_vr}", v.name))?;
+                let state = real_row(state_vr)
+                    .ok_or_else(|| format!("{}: derivative of unknown Real vr {state_vr}", v.name))?;
                 state_rows.push(state);
                 derivative_rows.push(row);
             }
@@ -235,7 +240,9 @@ impl<B> Declaration<B> {
                 Dependencies::All => Ok(None),
                 Dependencies::On(vrs) => vrs
                     .iter()
-                    .map(|&vr| real_row(vr).map(index).ok_or_else(|| format!("{}: dependency on unknown Real vr {vr}", v.name)))
+                    .map(|&vr| {
+                        real_row(vr).map(index).ok_or_else(|| format!("{}: dependency on unknown Real vr {vr}", v.name))
+                    })
                     .collect::<Result<Vec<_>, _>>()
                     .map(|mut d| {
                         d.sort_unstable();
@@ -246,12 +253,20 @@ impl<B> Declaration<B> {
         let mut structure = md::ModelStructure::default();
         for (row, v) in spec.variables.iter().enumerate() {
             if v.causality == Causality::Output {
-                structure.outputs.push(md::Unknown { index: index(row), dependencies: deps(v)?, dependencies_kind: None });
+                structure.outputs.push(md::Unknown {
+                    index: index(row),
+                    dependencies: deps(v)?,
+                    dependencies_kind: None,
+                });
             }
         }
         for &row in &derivative_rows {
             let v = &spec.variables[row];
-            structure.derivatives.push(md::Unknown { index: index(row), dependencies: deps(v)?, dependencies_kind: None });
+            structure.derivatives.push(md::Unknown {
+                index: index(row),
+                dependencies: deps(v)?,
+                dependencies_kind: None,
+            });
         }
         // InitialUnknowns: outputs with initial approx/calculated, calculated parameters, and
         // states/derivatives with initial approx/calculated (FMI 2.0 section 2.2.8), ascending.
@@ -277,7 +292,11 @@ impl<B> Declaration<B> {
                     d.dedup();
                     d
                 });
-                structure.initial_unknowns.push(md::Unknown { index: index(row), dependencies, dependencies_kind: None });
+                structure.initial_unknowns.push(md::Unknown {
+                    index: index(row),
+                    dependencies,
+                    dependencies_kind: None,
+                });
             }
         }
 
@@ -367,7 +386,11 @@ impl<B> Declaration<B> {
         let problems = description.validate();
         if !problems.is_empty() {
             let list: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
-            return Err(format!("the declaration of {} is not a valid FMI 2.0 description: {}", spec.model_name, list.join("; ")));
+            return Err(format!(
+                "the declaration of {} is not a valid FMI 2.0 description: {}",
+                spec.model_name,
+                list.join("; ")
+            ));
         }
         let xml = description.to_xml();
         Ok(Declaration { spec, lookup, state_rows, derivative_rows, description, xml })

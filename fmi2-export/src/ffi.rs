@@ -44,14 +44,8 @@ pub const FMI2_LAST_SUCCESSFUL_TIME: c_int = 2;
 pub const FMI2_TERMINATED: c_int = 3;
 
 /// The importer's logger: C-variadic, printf-style. Always called with `"%s"` as format.
-pub type Fmi2CallbackLogger = unsafe extern "C" fn(
-    fmi2ComponentEnvironment,
-    fmi2String,
-    c_int,
-    fmi2String,
-    fmi2String,
-    ...
-);
+pub type Fmi2CallbackLogger =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, c_int, fmi2String, fmi2String, ...);
 pub type Fmi2CallbackAllocateMemory = unsafe extern "C" fn(usize, usize) -> *mut c_void;
 pub type Fmi2CallbackFreeMemory = unsafe extern "C" fn(*mut c_void);
 pub type Fmi2StepFinished = unsafe extern "C" fn(fmi2ComponentEnvironment, c_int);

@@ -168,7 +168,9 @@ impl<M: Model> Instance<M> {
 
     fn rows(&self, base_type: BaseType, vrs: &[u32]) -> OpResult<Vec<usize>> {
         vrs.iter()
-            .map(|&vr| decl::<M>().row(base_type, vr).ok_or_else(|| format!("unknown {base_type:?} value reference {vr}")))
+            .map(|&vr| {
+                decl::<M>().row(base_type, vr).ok_or_else(|| format!("unknown {base_type:?} value reference {vr}"))
+            })
             .collect()
     }
 
@@ -227,7 +229,10 @@ impl<M: Model> Instance<M> {
         for (&row, &value) in rows.iter().zip(values) {
             let v = decl::<M>().variable(row);
             if !self.settable(row) {
-                return Err(format!("{} ({:?}, {:?}) cannot be set in state {:?}", v.name, v.causality, v.variability, self.machine));
+                return Err(format!(
+                    "{} ({:?}, {:?}) cannot be set in state {:?}",
+                    v.name, v.causality, v.variability, self.machine
+                ));
             }
             check(v.name, value)?;
         }
@@ -247,7 +252,13 @@ impl<M: Model> Instance<M> {
             BaseType::Real,
             vrs,
             values,
-            |name, x: f64| if x.is_finite() { Ok(()) } else { Err(format!("{name} = {x} refused: not a finite number")) },
+            |name, x: f64| {
+                if x.is_finite() {
+                    Ok(())
+                } else {
+                    Err(format!("{name} = {x} refused: not a finite number"))
+                }
+            },
             |m, b, x| m.set_real(b, x),
         )
     }
@@ -284,10 +295,7 @@ impl<M: Model> Instance<M> {
 
     pub fn set_time(&mut self, time: f64) -> OpResult {
         self.require_interface(Interface::ModelExchange)?;
-        self.require(
-            &[Machine::InitializationMode, Machine::EventMode, Machine::ContinuousTimeMode],
-            "fmi2SetTime",
-        )?;
+        self.require(&[Machine::InitializationMode, Machine::EventMode, Machine::ContinuousTimeMode], "fmi2SetTime")?;
         if !time.is_finite() {
             return Err(format!("time {time} is not finite"));
         }
@@ -358,7 +366,11 @@ impl<M: Model> Instance<M> {
         self.require(&[Machine::EventMode, Machine::ContinuousTimeMode], "fmi2SetContinuousStates")?;
         self.check_state_count(x.len())?;
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(format!("state {} = {} refused: not a finite number", decl::<M>().variable(decl::<M>().state_rows[i]).name, x[i]));
+            return Err(format!(
+                "state {} = {} refused: not a finite number",
+                decl::<M>().variable(decl::<M>().state_rows[i]).name,
+                x[i]
+            ));
         }
         let backup = self.model.clone();
         for (&value, &row) in x.iter().zip(&decl::<M>().state_rows) {
@@ -399,7 +411,13 @@ impl<M: Model> Instance<M> {
 
     // ---------------------------------------------------------------- derivatives
 
-    pub fn directional_derivative(&mut self, unknowns: &[u32], knowns: &[u32], dv_known: &[f64], out: &mut [f64]) -> OpResult {
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        out: &mut [f64],
+    ) -> OpResult {
         self.require(
             &[
                 Machine::InitializationMode,
@@ -441,7 +459,10 @@ impl<M: Model> Instance<M> {
             _ => true,
         };
         if !fits {
-            return Err(format!("a state saved in {:?} cannot be restored into a {:?} instance", state.machine, self.context.interface));
+            return Err(format!(
+                "a state saved in {:?} cannot be restored into a {:?} instance",
+                state.machine, self.context.interface
+            ));
         }
         self.machine = state.machine;
         self.time = state.time;

@@ -6,6 +6,9 @@
 //! logging through the importer's callback, FMU state get/set/serialize, and the
 //! generation of `modelDescription.xml` from the same declaration the binary dispatches on.
 
+// `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod abi;
 pub mod decl;
 pub mod ffi;
@@ -13,7 +16,10 @@ pub mod instance;
 pub mod model;
 pub mod uri;
 
-pub use decl::{si_unit, BaseType, Causality, Declaration, DeclarationSpec, Dependencies, Initial, Interfaces, Start, VarDecl, Variability};
+pub use decl::{
+    si_unit, BaseType, Causality, Declaration, DeclarationSpec, Dependencies, Initial, Interfaces, Start, VarDecl,
+    Variability,
+};
 pub use instance::{Instance, Machine};
 pub use model::{InstantiateContext, Interface, Model};
 pub use model_description;
@@ -38,7 +44,12 @@ macro_rules! export_fmi2 {
                 abi::get_version()
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetDebugLogging(c: fmi2Component, on: fmi2Boolean, n: usize, cats: *const fmi2String) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetDebugLogging(
+                c: fmi2Component,
+                on: fmi2Boolean,
+                n: usize,
+                cats: *const fmi2String,
+            ) -> Fmi2Status {
                 abi::set_debug_logging::<M>(c, on, n, cats)
             }
             #[no_mangle]
@@ -58,7 +69,14 @@ macro_rules! export_fmi2 {
                 abi::free_instance::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetupExperiment(c: fmi2Component, tol_def: fmi2Boolean, tol: f64, start: f64, stop_def: fmi2Boolean, stop: f64) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetupExperiment(
+                c: fmi2Component,
+                tol_def: fmi2Boolean,
+                tol: f64,
+                start: f64,
+                stop_def: fmi2Boolean,
+                stop: f64,
+            ) -> Fmi2Status {
                 abi::setup_experiment::<M>(c, tol_def, tol, start, stop_def, stop)
             }
             #[no_mangle]
@@ -78,35 +96,75 @@ macro_rules! export_fmi2 {
                 abi::reset::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetReal(c: fmi2Component, vr: *const u32, n: usize, v: *mut f64) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetReal(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *mut f64,
+            ) -> Fmi2Status {
                 abi::get_real::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetInteger(c: fmi2Component, vr: *const u32, n: usize, v: *mut c_int) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetInteger(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *mut c_int,
+            ) -> Fmi2Status {
                 abi::get_integer::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBoolean(c: fmi2Component, vr: *const u32, n: usize, v: *mut fmi2Boolean) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetBoolean(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *mut fmi2Boolean,
+            ) -> Fmi2Status {
                 abi::get_boolean::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetString(c: fmi2Component, vr: *const u32, n: usize, v: *mut fmi2String) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetString(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *mut fmi2String,
+            ) -> Fmi2Status {
                 abi::get_string::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetReal(c: fmi2Component, vr: *const u32, n: usize, v: *const f64) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetReal(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *const f64,
+            ) -> Fmi2Status {
                 abi::set_real::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetInteger(c: fmi2Component, vr: *const u32, n: usize, v: *const c_int) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetInteger(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *const c_int,
+            ) -> Fmi2Status {
                 abi::set_integer::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetBoolean(c: fmi2Component, vr: *const u32, n: usize, v: *const fmi2Boolean) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetBoolean(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *const fmi2Boolean,
+            ) -> Fmi2Status {
                 abi::set_boolean::<M>(c, vr, n, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetString(c: fmi2Component, vr: *const u32, n: usize, v: *const fmi2String) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetString(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                v: *const fmi2String,
+            ) -> Fmi2Status {
                 abi::set_string::<M>(c, vr, n, v)
             }
             #[no_mangle]
@@ -122,15 +180,29 @@ macro_rules! export_fmi2 {
                 abi::free_fmu_state::<M>(c, s)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: fmi2Component, s: fmi2FMUstate, size: *mut usize) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+                c: fmi2Component,
+                s: fmi2FMUstate,
+                size: *mut usize,
+            ) -> Fmi2Status {
                 abi::serialized_fmu_state_size::<M>(c, s, size)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SerializeFMUstate(c: fmi2Component, s: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SerializeFMUstate(
+                c: fmi2Component,
+                s: fmi2FMUstate,
+                bytes: *mut fmi2Byte,
+                size: usize,
+            ) -> Fmi2Status {
                 abi::serialize_fmu_state::<M>(c, s, bytes, size)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: fmi2Component, bytes: *const fmi2Byte, size: usize, s: *mut fmi2FMUstate) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+                c: fmi2Component,
+                bytes: *const fmi2Byte,
+                size: usize,
+                s: *mut fmi2FMUstate,
+            ) -> Fmi2Status {
                 abi::deserialize_fmu_state::<M>(c, bytes, size, s)
             }
             #[no_mangle]
@@ -146,15 +218,32 @@ macro_rules! export_fmi2 {
                 abi::get_directional_derivative::<M>(c, unknown, n_unknown, known, n_known, dv_known, dv_unknown)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: fmi2Component, vr: *const u32, n: usize, order: *const c_int, v: *const f64) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                order: *const c_int,
+                v: *const f64,
+            ) -> Fmi2Status {
                 abi::set_real_input_derivatives::<M>(c, vr, n, order, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c: fmi2Component, vr: *const u32, n: usize, order: *const c_int, v: *mut f64) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+                c: fmi2Component,
+                vr: *const u32,
+                n: usize,
+                order: *const c_int,
+                v: *mut f64,
+            ) -> Fmi2Status {
                 abi::get_real_output_derivatives::<M>(c, vr, n, order, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_set_prior: fmi2Boolean) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2DoStep(
+                c: fmi2Component,
+                t: f64,
+                h: f64,
+                no_set_prior: fmi2Boolean,
+            ) -> Fmi2Status {
                 abi::do_step::<M>(c, t, h, no_set_prior)
             }
             #[no_mangle]
@@ -174,11 +263,19 @@ macro_rules! export_fmi2 {
                 abi::get_integer_status::<M>(c, kind, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetBooleanStatus(c: fmi2Component, kind: c_int, v: *mut fmi2Boolean) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetBooleanStatus(
+                c: fmi2Component,
+                kind: c_int,
+                v: *mut fmi2Boolean,
+            ) -> Fmi2Status {
                 abi::get_boolean_status::<M>(c, kind, v)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetStringStatus(c: fmi2Component, kind: c_int, v: *mut fmi2String) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetStringStatus(
+                c: fmi2Component,
+                kind: c_int,
+                v: *mut fmi2String,
+            ) -> Fmi2Status {
                 abi::get_string_status::<M>(c, kind, v)
             }
             #[no_mangle]
@@ -186,7 +283,10 @@ macro_rules! export_fmi2 {
                 abi::enter_event_mode::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut abi::Fmi2EventInfo) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2NewDiscreteStates(
+                c: fmi2Component,
+                info: *mut abi::Fmi2EventInfo,
+            ) -> Fmi2Status {
                 abi::new_discrete_states::<M>(c, info)
             }
             #[no_mangle]
@@ -194,7 +294,12 @@ macro_rules! export_fmi2 {
                 abi::enter_continuous_time_mode::<M>(c)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(c: fmi2Component, no_set_prior: fmi2Boolean, enter: *mut fmi2Boolean, terminate: *mut fmi2Boolean) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+                c: fmi2Component,
+                no_set_prior: fmi2Boolean,
+                enter: *mut fmi2Boolean,
+                terminate: *mut fmi2Boolean,
+            ) -> Fmi2Status {
                 abi::completed_integrator_step::<M>(c, no_set_prior, enter, terminate)
             }
             #[no_mangle]
@@ -218,7 +323,11 @@ macro_rules! export_fmi2 {
                 abi::get_continuous_states::<M>(c, x, nx)
             }
             #[no_mangle]
-            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(c: fmi2Component, x: *mut f64, nx: usize) -> Fmi2Status {
+            pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
+                c: fmi2Component,
+                x: *mut f64,
+                nx: usize,
+            ) -> Fmi2Status {
                 abi::get_nominals_of_continuous_states::<M>(c, x, nx)
             }
         };

@@ -25,7 +25,8 @@ fn component(kind: c_int) -> *mut c_void {
         component_environment: std::ptr::null_mut(),
     }));
     let guid = CString::new(Plant::declaration().guid()).unwrap();
-    let c = unsafe { abi::instantiate::<Plant>(c"bench".as_ptr(), kind, guid.as_ptr(), std::ptr::null(), callbacks, 0, 0) };
+    let c =
+        unsafe { abi::instantiate::<Plant>(c"bench".as_ptr(), kind, guid.as_ptr(), std::ptr::null(), callbacks, 0, 0) };
     assert!(!c.is_null());
     let vr = [3u32, 20, 21, 22, 23];
     let values = [0.35, 0.2, 0.2, -0.2, -0.2];
@@ -46,10 +47,16 @@ fn benches(cr: &mut Criterion) {
     let mut u = Inputs::coasting(0.4);
     u.delta = [0.2, 0.2, -0.2, -0.2];
     u.tau = [0.01; 4];
-    cr.bench_function("rhs (derivatives only, paper fidelity)", |b| b.iter(|| derivatives_of(black_box(&p), black_box(&s), black_box(&u))));
+    cr.bench_function("rhs (derivatives only, paper fidelity)", |b| {
+        b.iter(|| derivatives_of(black_box(&p), black_box(&s), black_box(&u)))
+    });
     let real = VehicleParams::real_fidelity();
-    cr.bench_function("rhs (derivatives only, real fidelity)", |b| b.iter(|| derivatives_of(black_box(&real), black_box(&s), black_box(&u))));
-    cr.bench_function("rhs + all outputs", |b| b.iter(|| nigel_vehicle::evaluate(black_box(&p), black_box(&s), black_box(&u))));
+    cr.bench_function("rhs (derivatives only, real fidelity)", |b| {
+        b.iter(|| derivatives_of(black_box(&real), black_box(&s), black_box(&u)))
+    });
+    cr.bench_function("rhs + all outputs", |b| {
+        b.iter(|| nigel_vehicle::evaluate(black_box(&p), black_box(&s), black_box(&u)))
+    });
 
     // Steps are timed in runs of 1000 (1 s of driving) from the same saved state, so the
     // benchmark stays at a realistic operating point (a coasting car that has come to rest

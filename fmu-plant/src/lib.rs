@@ -2,10 +2,15 @@
 //! the shared FMI 2.0 layer. This file is only the binding: the declaration of the
 //! variables (the one source of the XML and the dispatch) and the [`Model`] impl.
 
+// `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
-use fmi2_export::{si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, Start, VarDecl};
+use fmi2_export::{
+    si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, Start, VarDecl,
+};
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
 
@@ -206,10 +211,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     for i in 0..N_STATES {
         let (unit, _, text) = state_info[i];
         v.push(
-            real(STATE_NAMES[i], state_vr(i), PlantVar::State(i))
-                .state(0.0, i < idx::SERVO)
-                .unit(unit)
-                .describe(text),
+            real(STATE_NAMES[i], state_vr(i), PlantVar::State(i)).state(0.0, i < idx::SERVO).unit(unit).describe(text),
         );
     }
 
@@ -280,18 +282,57 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         ("g", Param::Gravity, d.g, "m/s2", "gravity"),
         ("v_fade", Param::FadeSpeed, d.v_fade, "m/s", "speed below which tire forces fade to zero"),
         ("delta_max", Param::SteerLimit, d.delta_max, "rad", "steering limit"),
-        ("servo_time_constant", Param::ServoTimeConstant, d.servo_time_constant, "s", "steering servo time constant (real fidelity)"),
+        (
+            "servo_time_constant",
+            Param::ServoTimeConstant,
+            d.servo_time_constant,
+            "s",
+            "steering servo time constant (real fidelity)",
+        ),
         ("servo_rate_max", Param::ServoRateMax, d.servo_rate_max, "rad/s", "steering servo rate limit (real fidelity)"),
-        ("wheel_speed_max", Param::WheelSpeedMax, d.wheel_speed_max, "m/s", "motor speed limit as wheel rolling speed (real fidelity)"),
-        ("motor_taper", Param::MotorTaper, d.motor_taper, "m/s", "width of the linear drive-force taper below wheel_speed_max"),
-        ("cs_substep_max", Param::CsSubstepMax, DEFAULT_CS_SUBSTEP_MAX, "s", "Co-Simulation: largest internal RK4 sub-step"),
+        (
+            "wheel_speed_max",
+            Param::WheelSpeedMax,
+            d.wheel_speed_max,
+            "m/s",
+            "motor speed limit as wheel rolling speed (real fidelity)",
+        ),
+        (
+            "motor_taper",
+            Param::MotorTaper,
+            d.motor_taper,
+            "m/s",
+            "width of the linear drive-force taper below wheel_speed_max",
+        ),
+        (
+            "cs_substep_max",
+            Param::CsSubstepMax,
+            DEFAULT_CS_SUBSTEP_MAX,
+            "s",
+            "Co-Simulation: largest internal RK4 sub-step",
+        ),
     ];
     for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
-        v.push(real(name, vr::PARAM + k as u32, PlantVar::Param(p)).parameter(Start::Real(start)).unit(unit).describe(text));
+        v.push(
+            real(name, vr::PARAM + k as u32, PlantVar::Param(p))
+                .parameter(Start::Real(start))
+                .unit(unit)
+                .describe(text),
+        );
     }
     let switches = [
-        ("friction_circle", Switch::FrictionCircle, vr::FRICTION_CIRCLE, "real fidelity: friction-circle tire, hypot(F_d, F_y) <= mu N"),
-        ("steering_servo", Switch::SteeringServo, vr::STEERING_SERVO, "real fidelity: first-order rate-limited steering servo"),
+        (
+            "friction_circle",
+            Switch::FrictionCircle,
+            vr::FRICTION_CIRCLE,
+            "real fidelity: friction-circle tire, hypot(F_d, F_y) <= mu N",
+        ),
+        (
+            "steering_servo",
+            Switch::SteeringServo,
+            vr::STEERING_SERVO,
+            "real fidelity: first-order rate-limited steering servo",
+        ),
         ("motor_speed_limit", Switch::MotorSpeedLimit, vr::MOTOR_SPEED_LIMIT, "real fidelity: drive motor speed limit"),
     ];
     for (name, s, r, text) in switches {
@@ -320,7 +361,12 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         units,
-        default_experiment: Some(DefaultExperiment { start_time: Some(0.0), stop_time: Some(10.0), tolerance: Some(1e-8), step_size: Some(1e-3) }),
+        default_experiment: Some(DefaultExperiment {
+            start_time: Some(0.0),
+            stop_time: Some(10.0),
+            tolerance: Some(1e-8),
+            step_size: Some(1e-3),
+        }),
         variables: v,
     }
 }
@@ -496,7 +542,13 @@ impl Model for Plant {
         Ok(())
     }
 
-    fn directional_derivative(&mut self, unknowns: &[PlantVar], knowns: &[PlantVar], dv_known: &[f64], out: &mut [f64]) -> Result<(), String> {
+    fn directional_derivative(
+        &mut self,
+        unknowns: &[PlantVar],
+        knowns: &[PlantVar],
+        dv_known: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), String> {
         let mut s: State<Dual> = self.state.map(Dual::constant);
         let u = &self.inputs;
         let mut ud = Inputs {
@@ -529,7 +581,15 @@ impl Model for Plant {
         let p = &self.params;
         out.extend_from_slice(&[p.m, p.i_z, p.l_f, p.l_r, p.track, p.r_wheel]);
         out.extend_from_slice(&p.c);
-        out.extend_from_slice(&[p.g, p.v_fade, p.delta_max, p.servo_time_constant, p.servo_rate_max, p.wheel_speed_max, p.motor_taper]);
+        out.extend_from_slice(&[
+            p.g,
+            p.v_fade,
+            p.delta_max,
+            p.servo_time_constant,
+            p.servo_rate_max,
+            p.wheel_speed_max,
+            p.motor_taper,
+        ]);
         out.extend([p.friction_circle, p.steering_servo, p.motor_speed_limit].map(|b| b as u8 as f64));
         out.push(self.cs_substep_max);
         let u = &self.inputs;
@@ -554,7 +614,15 @@ impl Model for Plant {
         for c in &mut p.c {
             *c = next();
         }
-        for slot in [&mut p.g, &mut p.v_fade, &mut p.delta_max, &mut p.servo_time_constant, &mut p.servo_rate_max, &mut p.wheel_speed_max, &mut p.motor_taper] {
+        for slot in [
+            &mut p.g,
+            &mut p.v_fade,
+            &mut p.delta_max,
+            &mut p.servo_time_constant,
+            &mut p.servo_rate_max,
+            &mut p.wheel_speed_max,
+            &mut p.motor_taper,
+        ] {
             *slot = next();
         }
         for slot in [&mut p.friction_circle, &mut p.steering_servo, &mut p.motor_speed_limit] {

@@ -13,14 +13,7 @@ impl ModelDescription {
         copy.guid = String::new();
         let digest = Sha256::digest(copy.to_xml().as_bytes());
         let hex: String = digest.iter().take(16).map(|b| format!("{b:02x}")).collect();
-        format!(
-            "{{{}-{}-{}-{}-{}}}",
-            &hex[0..8],
-            &hex[8..12],
-            &hex[12..16],
-            &hex[16..20],
-            &hex[20..32]
-        )
+        format!("{{{}-{}-{}-{}-{}}}", &hex[0..8], &hex[8..12], &hex[12..16], &hex[16..20], &hex[20..32])
     }
 
     /// Sets `guid` to [`ModelDescription::content_guid`].

@@ -5,10 +5,7 @@ use crate::types::*;
 impl ModelDescription {
     /// 1-based index of the variable called `name` (the first one, if names repeat).
     pub fn index_of(&self, name: &str) -> Option<u32> {
-        self.model_variables
-            .iter()
-            .position(|v| v.name == name)
-            .and_then(|i| u32::try_from(i + 1).ok())
+        self.model_variables.iter().position(|v| v.name == name).and_then(|i| u32::try_from(i + 1).ok())
     }
 
     /// The variable called `name` (the first one, if names repeat).
@@ -18,17 +15,13 @@ impl ModelDescription {
 
     /// The variable with 1-based `index`.
     pub fn variable_at(&self, index: u32) -> Option<&ScalarVariable> {
-        (index as usize)
-            .checked_sub(1)
-            .and_then(|i| self.model_variables.get(i))
+        (index as usize).checked_sub(1).and_then(|i| self.model_variables.get(i))
     }
 
     /// Value reference of the Real variable called `name` (`None` if there is none or it
     /// is not Real).
     pub fn real_value_reference(&self, name: &str) -> Option<u32> {
-        self.variable(name)
-            .filter(|v| v.is_real())
-            .map(|v| v.value_reference)
+        self.variable(name).filter(|v| v.is_real()).map(|v| v.value_reference)
     }
 
     /// 1-based indices of the state derivatives: Real continuous variables with a
@@ -37,9 +30,7 @@ impl ModelDescription {
         self.model_variables
             .iter()
             .enumerate()
-            .filter(|(_, v)| {
-                v.variability == Variability::Continuous && v.variable_type.derivative().is_some()
-            })
+            .filter(|(_, v)| v.variability == Variability::Continuous && v.variable_type.derivative().is_some())
             .filter_map(|(i, _)| u32::try_from(i + 1).ok())
             .collect()
     }
@@ -52,10 +43,7 @@ impl ModelDescription {
     pub fn states(&self) -> Vec<u32> {
         let mut out: Vec<u32> = Vec::new();
         for d in self.state_derivatives() {
-            let Some(s) = self
-                .variable_at(d)
-                .and_then(|v| v.variable_type.derivative())
-            else {
+            let Some(s) = self.variable_at(d).and_then(|v| v.variable_type.derivative()) else {
                 continue;
             };
             if self.variable_at(s).is_some() && !out.contains(&s) {
@@ -71,32 +59,17 @@ impl ModelDescription {
     /// InitialUnknowns = outputs with initial approx/calculated, calculated parameters,
     /// and states and state derivatives with initial approx/calculated, sorted by index.
     pub fn expected_model_structure(&self) -> ModelStructure {
-        let unknown = |index: u32| Unknown {
-            index,
-            dependencies: None,
-            dependencies_kind: None,
-        };
-        let indexed = || {
-            self.model_variables
-                .iter()
-                .enumerate()
-                .filter_map(|(i, v)| u32::try_from(i + 1).ok().map(|k| (k, v)))
-        };
-        let outputs: Vec<Unknown> = indexed()
-            .filter(|(_, v)| v.causality == Causality::Output)
-            .map(|(k, _)| unknown(k))
-            .collect();
+        let unknown = |index: u32| Unknown { index, dependencies: None, dependencies_kind: None };
+        let indexed =
+            || self.model_variables.iter().enumerate().filter_map(|(i, v)| u32::try_from(i + 1).ok().map(|k| (k, v)));
+        let outputs: Vec<Unknown> =
+            indexed().filter(|(_, v)| v.causality == Causality::Output).map(|(k, _)| unknown(k)).collect();
         let ders = self.state_derivatives();
-        let not_exact = |v: &ScalarVariable| {
-            matches!(
-                v.effective_initial(),
-                Some(Initial::Approx | Initial::Calculated)
-            )
-        };
+        let not_exact =
+            |v: &ScalarVariable| matches!(v.effective_initial(), Some(Initial::Approx | Initial::Calculated));
         let mut init: std::collections::BTreeSet<u32> = indexed()
             .filter(|(_, v)| {
-                (v.causality == Causality::Output && not_exact(v))
-                    || v.causality == Causality::CalculatedParameter
+                (v.causality == Causality::Output && not_exact(v)) || v.causality == Causality::CalculatedParameter
             })
             .map(|(k, _)| k)
             .collect();

@@ -32,15 +32,8 @@ impl Position {
         let byte = byte.min(bytes.len());
         let before = &bytes[..byte];
         let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-        let line_start = before
-            .iter()
-            .rposition(|&b| b == b'\n')
-            .map_or(0, |p| p + 1);
-        Position {
-            byte,
-            line,
-            column: byte - line_start + 1,
-        }
+        let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+        Position { byte, line, column: byte - line_start + 1 }
     }
 }
 
@@ -209,61 +202,33 @@ struct Node {
 
 impl Node {
     fn get(&self, key: &str) -> Option<&str> {
-        self.attrs
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
+        self.attrs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }
 }
 
 fn xml_err(src: &str, e: impl fmt::Display, pos: u64) -> ReadError {
-    ReadError::Xml {
-        message: e.to_string(),
-        position: Position::in_text(src, pos as usize),
-    }
+    ReadError::Xml { message: e.to_string(), position: Position::in_text(src, pos as usize) }
 }
 
 /// Start of the tag that begins at or after `from` (the first `<`).
 fn tag_start(src: &str, from: usize) -> usize {
     let bytes = src.as_bytes();
     let from = from.min(bytes.len());
-    bytes[from..]
-        .iter()
-        .position(|&b| b == b'<')
-        .map_or(from, |p| from + p)
+    bytes[from..].iter().position(|&b| b == b'<').map_or(from, |p| from + p)
 }
 
-fn make_node(
-    src: &str,
-    reader: &Reader<&[u8]>,
-    e: &BytesStart<'_>,
-    pos: usize,
-) -> Result<Node, ReadError> {
-    let name = std::str::from_utf8(e.name().as_ref())
-        .map_err(|err| xml_err(src, err, pos as u64))?
-        .to_string();
+fn make_node(src: &str, reader: &Reader<&[u8]>, e: &BytesStart<'_>, pos: usize) -> Result<Node, ReadError> {
+    let name = std::str::from_utf8(e.name().as_ref()).map_err(|err| xml_err(src, err, pos as u64))?.to_string();
     let mut attrs = Vec::new();
     for a in e.attributes() {
         let a = a.map_err(|err| xml_err(src, err, pos as u64))?;
-        let key =
-            std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
+        let key = std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
         let value = a
             .decode_and_unescape_value(reader.decoder())
-            .map_err(|err| {
-                xml_err(
-                    src,
-                    format!("attribute {key} of <{name}>: {err}"),
-                    pos as u64,
-                )
-            })?;
+            .map_err(|err| xml_err(src, format!("attribute {key} of <{name}>: {err}"), pos as u64))?;
         attrs.push((key.to_string(), value.into_owned()));
     }
-    Ok(Node {
-        name,
-        attrs,
-        pos,
-        children: Vec::new(),
-    })
+    Ok(Node { name, attrs, pos, children: Vec::new() })
 }
 
 fn parse_tree(src: &str) -> Result<Node, ReadError> {
@@ -276,9 +241,7 @@ fn parse_tree(src: &str) -> Result<Node, ReadError> {
     let mut root: Option<Node> = None;
     loop {
         let before = reader.buffer_position() as usize;
-        let ev = reader
-            .read_event()
-            .map_err(|e| xml_err(src, e, reader.error_position()))?;
+        let ev = reader.read_event().map_err(|e| xml_err(src, e, reader.error_position()))?;
         match ev {
             Event::Start(_) | Event::Empty(_) if root.is_some() && stack.is_empty() => {
                 let pos = tag_start(src, before);
@@ -324,10 +287,7 @@ fn parse_tree(src: &str) -> Result<Node, ReadError> {
             }
             Event::Eof => {
                 if let Some((name, pos)) = deeper.pop() {
-                    return Err(ReadError::UnexpectedEof {
-                        element: name,
-                        position: Position::in_text(src, pos),
-                    });
+                    return Err(ReadError::UnexpectedEof { element: name, position: Position::in_text(src, pos) });
                 }
                 if let Some(open) = stack.last() {
                     return Err(ReadError::UnexpectedEof {
@@ -389,36 +349,20 @@ impl Ctx<'_> {
     }
 
     fn opt_f64(&self, n: &Node, label: &str, key: &str) -> Result<Option<f64>, ReadError> {
-        n.get(key)
-            .map(|v| self.f64_of(n, label, key, v))
-            .transpose()
+        n.get(key).map(|v| self.f64_of(n, label, key, v)).transpose()
     }
 
     fn opt_u32(&self, n: &Node, label: &str, key: &str) -> Result<Option<u32>, ReadError> {
-        n.get(key)
-            .map(|v| {
-                v.trim()
-                    .parse::<u32>()
-                    .map_err(|_| self.bad_number(n, label, key, v))
-            })
-            .transpose()
+        n.get(key).map(|v| v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))).transpose()
     }
 
     fn req_u32(&self, n: &Node, label: &str, key: &str) -> Result<u32, ReadError> {
         let v = self.req(n, label, key)?;
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| self.bad_number(n, label, key, v))
+        v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))
     }
 
     fn opt_i32(&self, n: &Node, label: &str, key: &str) -> Result<Option<i32>, ReadError> {
-        n.get(key)
-            .map(|v| {
-                v.trim()
-                    .parse::<i32>()
-                    .map_err(|_| self.bad_number(n, label, key, v))
-            })
-            .transpose()
+        n.get(key).map(|v| v.trim().parse::<i32>().map_err(|_| self.bad_number(n, label, key, v))).transpose()
     }
 
     fn opt_bool(&self, n: &Node, label: &str, key: &str) -> Result<Option<bool>, ReadError> {
@@ -442,9 +386,7 @@ impl Ctx<'_> {
         key: &str,
         parse: fn(&str) -> Option<T>,
     ) -> Result<Option<T>, ReadError> {
-        n.get(key)
-            .map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v)))
-            .transpose()
+        n.get(key).map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v))).transpose()
     }
 
     fn opt_string(n: &Node, key: &str) -> Option<String> {
@@ -475,10 +417,7 @@ struct TypeDefaults {
 
 fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> Result<(), ReadError> {
     if slot.is_some() {
-        return Err(ReadError::DuplicateElement {
-            element: n.name.clone(),
-            position: ctx.pos(n),
-        });
+        return Err(ReadError::DuplicateElement { element: n.name.clone(), position: ctx.pos(n) });
     }
     *slot = Some(n);
     Ok(())
@@ -493,24 +432,16 @@ impl ModelDescription {
         let root = parse_tree(xml)?;
         let ctx = Ctx { src: xml };
         if root.name != "fmiModelDescription" {
-            return Err(ReadError::NotAModelDescription {
-                found: Some(root.name.clone()),
-                position: ctx.pos(&root),
-            });
+            return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(&root) });
         }
         let label = "fmiModelDescription";
         let fmi_version = ctx.req(&root, label, "fmiVersion")?;
         if fmi_version.trim() != "2.0" {
-            return Err(ReadError::UnsupportedFmiVersion {
-                found: fmi_version.to_string(),
-                position: ctx.pos(&root),
-            });
+            return Err(ReadError::UnsupportedFmiVersion { found: fmi_version.to_string(), position: ctx.pos(&root) });
         }
         let model_name = ctx.req(&root, label, "modelName")?.to_string();
         let guid = ctx.req(&root, label, "guid")?.to_string();
-        let number_of_event_indicators = ctx
-            .opt_u32(&root, label, "numberOfEventIndicators")?
-            .unwrap_or(0);
+        let number_of_event_indicators = ctx.opt_u32(&root, label, "numberOfEventIndicators")?.unwrap_or(0);
 
         let mut me_node = None;
         let mut cs_node = None;
@@ -540,28 +471,12 @@ impl ModelDescription {
                 Ok(ModelExchange {
                     model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
                     needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
-                    completed_integrator_step_not_needed: ctx.flag(
-                        n,
-                        l,
-                        "completedIntegratorStepNotNeeded",
-                    )?,
-                    can_be_instantiated_only_once_per_process: ctx.flag(
-                        n,
-                        l,
-                        "canBeInstantiatedOnlyOncePerProcess",
-                    )?,
-                    can_not_use_memory_management_functions: ctx.flag(
-                        n,
-                        l,
-                        "canNotUseMemoryManagementFunctions",
-                    )?,
+                    completed_integrator_step_not_needed: ctx.flag(n, l, "completedIntegratorStepNotNeeded")?,
+                    can_be_instantiated_only_once_per_process: ctx.flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
+                    can_not_use_memory_management_functions: ctx.flag(n, l, "canNotUseMemoryManagementFunctions")?,
                     can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
                     can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(
-                        n,
-                        l,
-                        "providesDirectionalDerivative",
-                    )?,
+                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
                 })
             })
             .transpose()?;
@@ -578,27 +493,13 @@ impl ModelDescription {
                         "canHandleVariableCommunicationStepSize",
                     )?,
                     can_interpolate_inputs: ctx.flag(n, l, "canInterpolateInputs")?,
-                    max_output_derivative_order: ctx
-                        .opt_u32(n, l, "maxOutputDerivativeOrder")?
-                        .unwrap_or(0),
+                    max_output_derivative_order: ctx.opt_u32(n, l, "maxOutputDerivativeOrder")?.unwrap_or(0),
                     can_run_asynchronuously: ctx.flag(n, l, "canRunAsynchronuously")?,
-                    can_be_instantiated_only_once_per_process: ctx.flag(
-                        n,
-                        l,
-                        "canBeInstantiatedOnlyOncePerProcess",
-                    )?,
-                    can_not_use_memory_management_functions: ctx.flag(
-                        n,
-                        l,
-                        "canNotUseMemoryManagementFunctions",
-                    )?,
+                    can_be_instantiated_only_once_per_process: ctx.flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
+                    can_not_use_memory_management_functions: ctx.flag(n, l, "canNotUseMemoryManagementFunctions")?,
                     can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
                     can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(
-                        n,
-                        l,
-                        "providesDirectionalDerivative",
-                    )?,
+                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
                 })
             })
             .transpose()?;
@@ -615,9 +516,7 @@ impl ModelDescription {
                 let base_unit = base_node
                     .map(|b| -> Result<BaseUnit, ReadError> {
                         let bl = format!("BaseUnit of {ul}");
-                        let e = |k: &str| -> Result<i32, ReadError> {
-                            Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0))
-                        };
+                        let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
                         Ok(BaseUnit {
                             kg: e("kg")?,
                             m: e("m")?,
@@ -641,11 +540,7 @@ impl ModelDescription {
         if let Some(types) = types_node {
             for t in types.children.iter().filter(|c| c.name == "SimpleType") {
                 let Some(name) = t.get("name") else { continue };
-                if let Some(inner) = t
-                    .children
-                    .iter()
-                    .find(|c| c.name == "Real" || c.name == "Integer")
-                {
+                if let Some(inner) = t.children.iter().find(|c| c.name == "Real" || c.name == "Integer") {
                     type_defaults.insert(
                         name.to_string(),
                         TypeDefaults {
@@ -701,11 +596,7 @@ impl ModelDescription {
             }
             let read_list = |n: Option<&Node>| -> Result<Vec<Unknown>, ReadError> {
                 let Some(n) = n else { return Ok(Vec::new()) };
-                n.children
-                    .iter()
-                    .filter(|c| c.name == "Unknown")
-                    .map(|u| read_unknown(&ctx, u, &n.name))
-                    .collect()
+                n.children.iter().filter(|c| c.name == "Unknown").map(|u| read_unknown(&ctx, u, &n.name)).collect()
             };
             model_structure.outputs = read_list(outs)?;
             model_structure.derivatives = read_list(ders)?;
@@ -744,48 +635,28 @@ fn read_variable(
     let name = ctx.req(v, "ScalarVariable", "name")?.to_string();
     let l = format!("ScalarVariable \"{name}\"");
     let value_reference = ctx.req_u32(v, &l, "valueReference")?;
-    let causality = ctx
-        .opt_enum(v, &l, "causality", Causality::parse)?
-        .unwrap_or(Causality::Local);
-    let variability = ctx
-        .opt_enum(v, &l, "variability", Variability::parse)?
-        .unwrap_or(Variability::Continuous);
+    let causality = ctx.opt_enum(v, &l, "causality", Causality::parse)?.unwrap_or(Causality::Local);
+    let variability = ctx.opt_enum(v, &l, "variability", Variability::parse)?.unwrap_or(Variability::Continuous);
     let initial = ctx.opt_enum(v, &l, "initial", Initial::parse)?;
 
-    let Some(t) = v.children.iter().find(|c| {
-        matches!(
-            c.name.as_str(),
-            "Real" | "Integer" | "Boolean" | "String" | "Enumeration"
-        )
-    }) else {
-        return Err(ReadError::MissingTypeChild {
-            variable: name,
-            position: ctx.pos(v),
-        });
+    let Some(t) = v
+        .children
+        .iter()
+        .find(|c| matches!(c.name.as_str(), "Real" | "Integer" | "Boolean" | "String" | "Enumeration"))
+    else {
+        return Err(ReadError::MissingTypeChild { variable: name, position: ctx.pos(v) });
     };
     let tl = format!("{} of {l}", t.name);
-    let defaults = t
-        .get("declaredType")
-        .and_then(|d| type_defaults.get(d))
-        .cloned()
-        .unwrap_or_default();
+    let defaults = t.get("declaredType").and_then(|d| type_defaults.get(d)).cloned().unwrap_or_default();
     // The variable's own attribute, else the declared type's.
     let attr = |key: &str, inherited: &Option<String>| -> Option<String> {
         t.get(key).map(str::to_string).or_else(|| inherited.clone())
     };
     let f64_attr = |key: &str, inherited: &Option<String>| -> Result<Option<f64>, ReadError> {
-        attr(key, inherited)
-            .map(|s| ctx.f64_of(t, &tl, key, &s))
-            .transpose()
+        attr(key, inherited).map(|s| ctx.f64_of(t, &tl, key, &s)).transpose()
     };
     let i32_attr = |key: &str, inherited: &Option<String>| -> Result<Option<i32>, ReadError> {
-        attr(key, inherited)
-            .map(|s| {
-                s.trim()
-                    .parse::<i32>()
-                    .map_err(|_| ctx.bad_number(t, &tl, key, &s))
-            })
-            .transpose()
+        attr(key, inherited).map(|s| s.trim().parse::<i32>().map_err(|_| ctx.bad_number(t, &tl, key, &s))).transpose()
     };
 
     let variable_type = match t.name.as_str() {
@@ -807,12 +678,8 @@ fn read_variable(
             min: ctx.opt_i32(t, &tl, "min")?,
             max: ctx.opt_i32(t, &tl, "max")?,
         },
-        "Boolean" => VariableType::Boolean {
-            start: ctx.opt_bool(t, &tl, "start")?,
-        },
-        _ => VariableType::String {
-            start: Ctx::opt_string(t, "start"),
-        },
+        "Boolean" => VariableType::Boolean { start: ctx.opt_bool(t, &tl, "start")? },
+        _ => VariableType::String { start: Ctx::opt_string(t, "start") },
     };
 
     Ok(ScalarVariable {
@@ -833,10 +700,7 @@ fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
         .get("dependencies")
         .map(|s| {
             s.split_ascii_whitespace()
-                .map(|tok| {
-                    tok.parse::<u32>()
-                        .map_err(|_| ctx.bad_number(u, &l, "dependencies", tok))
-                })
+                .map(|tok| tok.parse::<u32>().map_err(|_| ctx.bad_number(u, &l, "dependencies", tok)))
                 .collect::<Result<Vec<u32>, ReadError>>()
         })
         .transpose()?;
@@ -844,18 +708,11 @@ fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
         .get("dependenciesKind")
         .map(|s| {
             s.split_ascii_whitespace()
-                .map(|tok| {
-                    DependencyKind::parse(tok)
-                        .ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok))
-                })
+                .map(|tok| DependencyKind::parse(tok).ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok)))
                 .collect::<Result<Vec<DependencyKind>, ReadError>>()
         })
         .transpose()?;
-    Ok(Unknown {
-        index,
-        dependencies,
-        dependencies_kind,
-    })
+    Ok(Unknown { index, dependencies, dependencies_kind })
 }
 
 #[cfg(test)]
@@ -865,30 +722,9 @@ mod tests {
     #[test]
     fn positions_are_one_based_lines_and_columns() {
         let s = "ab\ncd\n\nef";
-        assert_eq!(
-            Position::in_text(s, 0),
-            Position {
-                byte: 0,
-                line: 1,
-                column: 1
-            }
-        );
-        assert_eq!(
-            Position::in_text(s, 4),
-            Position {
-                byte: 4,
-                line: 2,
-                column: 2
-            }
-        );
-        assert_eq!(
-            Position::in_text(s, 7),
-            Position {
-                byte: 7,
-                line: 4,
-                column: 1
-            }
-        );
+        assert_eq!(Position::in_text(s, 0), Position { byte: 0, line: 1, column: 1 });
+        assert_eq!(Position::in_text(s, 4), Position { byte: 4, line: 2, column: 2 });
+        assert_eq!(Position::in_text(s, 7), Position { byte: 7, line: 4, column: 1 });
         assert_eq!(Position::in_text(s, 999).byte, s.len());
         assert_eq!(Position::in_text(s, 4).to_string(), "line 2, column 2");
     }
@@ -911,16 +747,11 @@ mod tests {
 
     #[test]
     fn control_characters_round_trip_through_char_refs() {
-        let mut md = ModelDescription::from_xml(
-            r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g"/>"#,
-        )
-        .unwrap();
+        let mut md =
+            ModelDescription::from_xml(r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g"/>"#).unwrap();
         md.description = Some("a\u{1}b\rc\nd\te".into());
         let xml = md.to_xml();
         assert!(xml.contains("a&#1;b&#13;c&#10;d&#9;e"), "{xml}");
-        assert_eq!(
-            ModelDescription::from_xml(&xml).unwrap().description,
-            md.description
-        );
+        assert_eq!(ModelDescription::from_xml(&xml).unwrap().description, md.description);
     }
 }

@@ -140,18 +140,7 @@ pub struct BaseUnit {
 
 impl Default for BaseUnit {
     fn default() -> Self {
-        BaseUnit {
-            kg: 0,
-            m: 0,
-            s: 0,
-            a: 0,
-            k: 0,
-            mol: 0,
-            cd: 0,
-            rad: 0,
-            factor: 1.0,
-            offset: 0.0,
-        }
+        BaseUnit { kg: 0, m: 0, s: 0, a: 0, k: 0, mol: 0, cd: 0, rad: 0, factor: 1.0, offset: 0.0 }
     }
 }
 
@@ -504,8 +493,7 @@ impl ScalarVariable {
     /// (causality, variability); `None` for inputs, the independent variable and
     /// illegal combinations without an explicit `initial`.
     pub fn effective_initial(&self) -> Option<Initial> {
-        self.initial
-            .or_else(|| Initial::default_for(self.causality, self.variability))
+        self.initial.or_else(|| Initial::default_for(self.causality, self.variability))
     }
 
     /// Whether this is a Real variable.
@@ -517,16 +505,7 @@ impl ScalarVariable {
 impl Unit {
     /// A unit defined by SI exponents (factor 1, offset 0).
     pub fn si(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> Unit {
-        Unit {
-            name: name.to_string(),
-            base_unit: Some(BaseUnit {
-                kg,
-                m,
-                s,
-                rad,
-                ..BaseUnit::default()
-            }),
-        }
+        Unit { name: name.to_string(), base_unit: Some(BaseUnit { kg, m, s, rad, ..BaseUnit::default() }) }
     }
 }
 
@@ -555,22 +534,10 @@ mod tests {
     fn default_initial() {
         use Causality as C;
         use Variability as V;
-        assert_eq!(
-            Initial::default_for(C::Parameter, V::Fixed),
-            Some(Initial::Exact)
-        );
-        assert_eq!(
-            Initial::default_for(C::CalculatedParameter, V::Tunable),
-            Some(Initial::Calculated)
-        );
-        assert_eq!(
-            Initial::default_for(C::Output, V::Continuous),
-            Some(Initial::Calculated)
-        );
-        assert_eq!(
-            Initial::default_for(C::Local, V::Constant),
-            Some(Initial::Exact)
-        );
+        assert_eq!(Initial::default_for(C::Parameter, V::Fixed), Some(Initial::Exact));
+        assert_eq!(Initial::default_for(C::CalculatedParameter, V::Tunable), Some(Initial::Calculated));
+        assert_eq!(Initial::default_for(C::Output, V::Continuous), Some(Initial::Calculated));
+        assert_eq!(Initial::default_for(C::Local, V::Constant), Some(Initial::Exact));
         assert_eq!(Initial::default_for(C::Input, V::Continuous), None);
         assert_eq!(Initial::default_for(C::Independent, V::Continuous), None);
         assert_eq!(Initial::default_for(C::Parameter, V::Continuous), None);

@@ -134,11 +134,7 @@ struct Checker<'a> {
 
 impl Checker<'_> {
     fn push(&mut self, rule: Rule, variable: Option<&str>, message: String) {
-        self.problems.push(Problem {
-            rule,
-            variable: variable.map(str::to_string),
-            message,
-        });
+        self.problems.push(Problem { rule, variable: variable.map(str::to_string), message });
     }
 
     fn var_name(&self, index: u32) -> Option<&str> {
@@ -158,10 +154,7 @@ impl ModelDescription {
     /// Checks the description against the FMI 2.0 rules (see [`Rule`]); an empty
     /// vector means no problem was found. Problems come in a deterministic order.
     pub fn validate(&self) -> Vec<Problem> {
-        let mut c = Checker {
-            md: self,
-            problems: Vec::new(),
-        };
+        let mut c = Checker { md: self, problems: Vec::new() };
         self.check_header(&mut c);
         self.check_variables(&mut c);
         self.check_structure(&mut c);
@@ -170,28 +163,14 @@ impl ModelDescription {
 
     fn check_header(&self, c: &mut Checker) {
         if self.fmi_version != "2.0" {
-            c.push(
-                Rule::FmiVersion,
-                None,
-                format!("fmiVersion is \"{}\", must be \"2.0\"", self.fmi_version),
-            );
+            c.push(Rule::FmiVersion, None, format!("fmiVersion is \"{}\", must be \"2.0\"", self.fmi_version));
         }
         if self.model_exchange.is_none() && self.co_simulation.is_none() {
-            c.push(
-                Rule::NoInterface,
-                None,
-                "neither <ModelExchange> nor <CoSimulation> is present".into(),
-            );
+            c.push(Rule::NoInterface, None, "neither <ModelExchange> nor <CoSimulation> is present".into());
         }
         let ids = [
-            (
-                "ModelExchange",
-                self.model_exchange.as_ref().map(|m| &m.model_identifier),
-            ),
-            (
-                "CoSimulation",
-                self.co_simulation.as_ref().map(|m| &m.model_identifier),
-            ),
+            ("ModelExchange", self.model_exchange.as_ref().map(|m| &m.model_identifier)),
+            ("CoSimulation", self.co_simulation.as_ref().map(|m| &m.model_identifier)),
         ];
         for (elem, id) in ids {
             if let Some(id) = id {
@@ -207,22 +186,14 @@ impl ModelDescription {
         let mut seen = HashSet::new();
         for u in &self.unit_definitions {
             if !seen.insert(u.name.as_str()) {
-                c.push(
-                    Rule::DuplicateUnit,
-                    None,
-                    format!("unit \"{}\" is defined more than once", u.name),
-                );
+                c.push(Rule::DuplicateUnit, None, format!("unit \"{}\" is defined more than once", u.name));
             }
         }
     }
 
     fn check_variables(&self, c: &mut Checker) {
         let n = self.model_variables.len();
-        let units: HashSet<&str> = self
-            .unit_definitions
-            .iter()
-            .map(|u| u.name.as_str())
-            .collect();
+        let units: HashSet<&str> = self.unit_definitions.iter().map(|u| u.name.as_str()).collect();
         let mut names: HashMap<&str, usize> = HashMap::new();
         let mut vrs: HashMap<(&'static str, u32), usize> = HashMap::new();
         let mut independent: Option<usize> = None;
@@ -231,18 +202,10 @@ impl ModelDescription {
             let name = Some(v.name.as_str());
             let index = i + 1;
             if v.name.is_empty() {
-                c.push(
-                    Rule::EmptyName,
-                    None,
-                    format!("variable {index} has an empty name"),
-                );
+                c.push(Rule::EmptyName, None, format!("variable {index} has an empty name"));
             } else if let Some(first) = names.insert(v.name.as_str(), index) {
                 names.insert(v.name.as_str(), first);
-                c.push(
-                    Rule::DuplicateName,
-                    name,
-                    format!("name used by variables {first} and {index}"),
-                );
+                c.push(Rule::DuplicateName, name, format!("name used by variables {first} and {index}"));
             }
             let base = v.variable_type.type_name();
             if let Some(first) = vrs.get(&(base, v.value_reference)) {
@@ -250,10 +213,7 @@ impl ModelDescription {
                 c.push(
                     Rule::DuplicateValueReference,
                     name,
-                    format!(
-                        "{base} valueReference {} is also used by \"{other}\"",
-                        v.value_reference
-                    ),
+                    format!("{base} valueReference {} is also used by \"{other}\"", v.value_reference),
                 );
             } else {
                 vrs.insert((base, v.value_reference), index);
@@ -284,10 +244,8 @@ impl ModelDescription {
                         ),
                     );
                 } else if legal && !Initial::allowed(v.causality, v.variability).contains(&init) {
-                    let allowed: Vec<&str> = Initial::allowed(v.causality, v.variability)
-                        .iter()
-                        .map(|i| i.as_str())
-                        .collect();
+                    let allowed: Vec<&str> =
+                        Initial::allowed(v.causality, v.variability).iter().map(|i| i.as_str()).collect();
                     c.push(
                         Rule::Initial,
                         name,
@@ -303,18 +261,14 @@ impl ModelDescription {
             }
             let eff = v.effective_initial();
             let has_start = v.variable_type.has_start();
-            let start_required = v.causality == Causality::Input
-                || matches!(eff, Some(Initial::Exact | Initial::Approx));
-            let start_forbidden =
-                v.causality == Causality::Independent || eff == Some(Initial::Calculated);
+            let start_required =
+                v.causality == Causality::Input || matches!(eff, Some(Initial::Exact | Initial::Approx));
+            let start_forbidden = v.causality == Causality::Independent || eff == Some(Initial::Calculated);
             if start_required && !start_forbidden && !has_start {
                 let why = match (v.causality, eff) {
                     (Causality::Input, _) => "inputs need a start value".to_string(),
                     (_, Some(i)) if v.initial.is_none() => {
-                        format!(
-                            "initial defaults to \"{}\" here, which needs a start value",
-                            i.as_str()
-                        )
+                        format!("initial defaults to \"{}\" here, which needs a start value", i.as_str())
                     }
                     (_, Some(i)) => format!("initial=\"{}\" needs a start value", i.as_str()),
                     _ => "a start value is required".to_string(),
@@ -331,40 +285,21 @@ impl ModelDescription {
             }
             if v.causality == Causality::Independent {
                 if !v.is_real() {
-                    c.push(
-                        Rule::Independent,
-                        name,
-                        format!("the independent variable must be Real, is {base}"),
-                    );
+                    c.push(Rule::Independent, name, format!("the independent variable must be Real, is {base}"));
                 }
                 if let Some(first) = independent {
                     let other = &self.model_variables[first - 1].name;
-                    c.push(
-                        Rule::Independent,
-                        name,
-                        format!("second independent variable (first is \"{other}\")"),
-                    );
+                    c.push(Rule::Independent, name, format!("second independent variable (first is \"{other}\")"));
                 } else {
                     independent = Some(index);
                 }
             }
             if v.variability == Variability::Continuous && !v.is_real() {
-                c.push(
-                    Rule::ContinuousNonReal,
-                    name,
-                    format!("{base} variables cannot be continuous"),
-                );
+                c.push(Rule::ContinuousNonReal, name, format!("{base} variables cannot be continuous"));
             }
 
             match &v.variable_type {
-                VariableType::Real {
-                    start,
-                    unit,
-                    derivative,
-                    min,
-                    max,
-                    nominal,
-                } => {
+                VariableType::Real { start, unit, derivative, min, max, nominal } => {
                     if let Some(u) = unit {
                         if !units.contains(u.as_str()) {
                             c.push(
@@ -376,11 +311,9 @@ impl ModelDescription {
                     }
                     if let Some(d) = *derivative {
                         match (d as usize).checked_sub(1).and_then(|k| self.model_variables.get(k)) {
-                            None => c.push(
-                                Rule::Derivative,
-                                name,
-                                format!("derivative=\"{d}\" is not an index in 1..={n}"),
-                            ),
+                            None => {
+                                c.push(Rule::Derivative, name, format!("derivative=\"{d}\" is not an index in 1..={n}"))
+                            }
                             Some(_) if d as usize == index => {
                                 c.push(Rule::Derivative, name, format!("derivative=\"{d}\" refers to itself"))
                             }
@@ -403,13 +336,7 @@ impl ModelDescription {
                     }
                 }
                 VariableType::Integer { start, min, max } => {
-                    check_bounds(
-                        c,
-                        name,
-                        min.map(f64::from),
-                        max.map(f64::from),
-                        start.map(f64::from),
-                    );
+                    check_bounds(c, name, min.map(f64::from), max.map(f64::from), start.map(f64::from));
                 }
                 _ => {}
             }
@@ -423,11 +350,9 @@ impl ModelDescription {
         let in_range = |i: u32| i >= 1 && i <= n;
 
         // Indices and dependency lists (range, order, kinds).
-        for (list_name, list) in [
-            ("Outputs", &ms.outputs),
-            ("Derivatives", &ms.derivatives),
-            ("InitialUnknowns", &ms.initial_unknowns),
-        ] {
+        for (list_name, list) in
+            [("Outputs", &ms.outputs), ("Derivatives", &ms.derivatives), ("InitialUnknowns", &ms.initial_unknowns)]
+        {
             for u in list {
                 let who = c.var_name(u.index).map(str::to_string);
                 let who = who.as_deref();
@@ -444,10 +369,7 @@ impl ModelDescription {
                             c.push(
                                 Rule::IndexOutOfRange,
                                 who,
-                                format!(
-                                    "<{list_name}> Unknown {}: dependency {d} is not in 1..={n}",
-                                    u.index
-                                ),
+                                format!("<{list_name}> Unknown {}: dependency {d} is not in 1..={n}", u.index),
                             );
                         }
                     }
@@ -455,7 +377,10 @@ impl ModelDescription {
                         c.push(
                             Rule::DependencyOrder,
                             who,
-                            format!("<{list_name}> Unknown {}: dependencies must be ascending without duplicates", u.index),
+                            format!(
+                                "<{list_name}> Unknown {}: dependencies must be ascending without duplicates",
+                                u.index
+                            ),
                         );
                     }
                 }
@@ -463,10 +388,7 @@ impl ModelDescription {
                     (None, Some(_)) => c.push(
                         Rule::DependenciesKind,
                         who,
-                        format!(
-                            "<{list_name}> Unknown {}: dependenciesKind without dependencies",
-                            u.index
-                        ),
+                        format!("<{list_name}> Unknown {}: dependenciesKind without dependencies", u.index),
                     ),
                     (Some(d), Some(k)) if d.len() != k.len() => c.push(
                         Rule::DependenciesKind,
@@ -543,9 +465,7 @@ impl ModelDescription {
             let Some(v) = vars.get((d as usize).wrapping_sub(1)) else {
                 return true;
             };
-            is_run_known(d)
-                || v.causality == Causality::Parameter
-                || v.effective_initial() == Some(Initial::Exact)
+            is_run_known(d) || v.causality == Causality::Parameter || v.effective_initial() == Some(Initial::Exact)
         };
         for (list_name, list, init) in [
             ("Outputs", &ms.outputs, false),
@@ -557,11 +477,7 @@ impl ModelDescription {
                     continue;
                 };
                 for &d in deps {
-                    let known = if init {
-                        is_init_known(d)
-                    } else {
-                        is_run_known(d)
-                    };
+                    let known = if init { is_init_known(d) } else { is_run_known(d) };
                     if !known {
                         let allowed = if init {
                             "inputs, states, parameters, variables with initial=\"exact\" and the independent variable"
@@ -573,7 +489,10 @@ impl ModelDescription {
                         c.push(
                             Rule::DependencyNotKnown,
                             who.as_deref(),
-                            format!("<{list_name}> Unknown {}: dependency {dep} is not a known (allowed: {allowed})", u.index),
+                            format!(
+                                "<{list_name}> Unknown {}: dependency {dep} is not a known (allowed: {allowed})",
+                                u.index
+                            ),
                         );
                     }
                 }
@@ -584,27 +503,16 @@ impl ModelDescription {
     fn names_of(&self, indices: &[u32]) -> String {
         let parts: Vec<String> = indices
             .iter()
-            .map(|&i| {
-                match (i as usize)
-                    .checked_sub(1)
-                    .and_then(|k| self.model_variables.get(k))
-                {
-                    Some(v) => format!("{i} \"{}\"", v.name),
-                    None => i.to_string(),
-                }
+            .map(|&i| match (i as usize).checked_sub(1).and_then(|k| self.model_variables.get(k)) {
+                Some(v) => format!("{i} \"{}\"", v.name),
+                None => i.to_string(),
             })
             .collect();
         format!("[{}]", parts.join(", "))
     }
 }
 
-fn check_bounds(
-    c: &mut Checker,
-    name: Option<&str>,
-    min: Option<f64>,
-    max: Option<f64>,
-    start: Option<f64>,
-) {
+fn check_bounds(c: &mut Checker, name: Option<&str>, min: Option<f64>, max: Option<f64>, start: Option<f64>) {
     if let (Some(lo), Some(hi)) = (min, max) {
         if lo > hi {
             c.push(Rule::Bounds, name, format!("min={lo} > max={hi}"));

@@ -32,9 +32,7 @@ pub fn format_f64(x: f64) -> String {
 /// (U+0000 cannot be represented in XML at all: it is written as `&#0;`, which readers,
 /// ours included, refuse.)
 fn escape_attr(s: &str) -> Cow<'_, str> {
-    let needs = s
-        .chars()
-        .any(|c| matches!(c, '&' | '<' | '>' | '"' | '\'') || (c as u32) < 0x20);
+    let needs = s.chars().any(|c| matches!(c, '&' | '<' | '>' | '"' | '\'') || (c as u32) < 0x20);
     if !needs {
         return Cow::Borrowed(s);
     }
@@ -60,9 +58,7 @@ struct Elem {
 
 impl Elem {
     fn new(name: &'static str) -> Self {
-        Elem {
-            start: BytesStart::new(name),
-        }
+        Elem { start: BytesStart::new(name) }
     }
     fn attr(&mut self, key: &str, value: &str) -> &mut Self {
         let v = escape_attr(value);
@@ -116,10 +112,7 @@ impl Out {
 }
 
 fn join_u32(v: &[u32]) -> String {
-    v.iter()
-        .map(|i| i.to_string())
-        .collect::<Vec<_>>()
-        .join(" ")
+    v.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")
 }
 
 fn unknown_elem(u: &Unknown) -> Elem {
@@ -143,9 +136,7 @@ impl ModelDescription {
     /// round-trip through [`ModelDescription::from_xml`] (except U+0000, which XML
     /// cannot carry).
     pub fn to_xml(&self) -> String {
-        let mut o = Out {
-            w: Writer::new_with_indent(Vec::new(), b' ', 2),
-        };
+        let mut o = Out { w: Writer::new_with_indent(Vec::new(), b' ', 2) };
         o.ev(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)));
 
         let mut root = Elem::new("fmiModelDescription");
@@ -160,66 +151,36 @@ impl ModelDescription {
             .opt_str("generationTool", &self.generation_tool)
             .opt_str("generationDateAndTime", &self.generation_date_and_time)
             .opt_str("variableNamingConvention", &self.variable_naming_convention)
-            .attr(
-                "numberOfEventIndicators",
-                &self.number_of_event_indicators.to_string(),
-            );
+            .attr("numberOfEventIndicators", &self.number_of_event_indicators.to_string());
         o.open(root);
 
         if let Some(me) = &self.model_exchange {
             let mut e = Elem::new("ModelExchange");
             e.attr("modelIdentifier", &me.model_identifier)
                 .flag("needsExecutionTool", me.needs_execution_tool)
-                .flag(
-                    "completedIntegratorStepNotNeeded",
-                    me.completed_integrator_step_not_needed,
-                )
-                .flag(
-                    "canBeInstantiatedOnlyOncePerProcess",
-                    me.can_be_instantiated_only_once_per_process,
-                )
-                .flag(
-                    "canNotUseMemoryManagementFunctions",
-                    me.can_not_use_memory_management_functions,
-                )
+                .flag("completedIntegratorStepNotNeeded", me.completed_integrator_step_not_needed)
+                .flag("canBeInstantiatedOnlyOncePerProcess", me.can_be_instantiated_only_once_per_process)
+                .flag("canNotUseMemoryManagementFunctions", me.can_not_use_memory_management_functions)
                 .flag("canGetAndSetFMUstate", me.can_get_and_set_fmu_state)
                 .flag("canSerializeFMUstate", me.can_serialize_fmu_state)
-                .flag(
-                    "providesDirectionalDerivative",
-                    me.provides_directional_derivative,
-                );
+                .flag("providesDirectionalDerivative", me.provides_directional_derivative);
             o.empty(e);
         }
         if let Some(cs) = &self.co_simulation {
             let mut e = Elem::new("CoSimulation");
             e.attr("modelIdentifier", &cs.model_identifier)
                 .flag("needsExecutionTool", cs.needs_execution_tool)
-                .flag(
-                    "canHandleVariableCommunicationStepSize",
-                    cs.can_handle_variable_communication_step_size,
-                )
+                .flag("canHandleVariableCommunicationStepSize", cs.can_handle_variable_communication_step_size)
                 .flag("canInterpolateInputs", cs.can_interpolate_inputs);
             if cs.max_output_derivative_order != 0 {
-                e.attr(
-                    "maxOutputDerivativeOrder",
-                    &cs.max_output_derivative_order.to_string(),
-                );
+                e.attr("maxOutputDerivativeOrder", &cs.max_output_derivative_order.to_string());
             }
             e.flag("canRunAsynchronuously", cs.can_run_asynchronuously)
-                .flag(
-                    "canBeInstantiatedOnlyOncePerProcess",
-                    cs.can_be_instantiated_only_once_per_process,
-                )
-                .flag(
-                    "canNotUseMemoryManagementFunctions",
-                    cs.can_not_use_memory_management_functions,
-                )
+                .flag("canBeInstantiatedOnlyOncePerProcess", cs.can_be_instantiated_only_once_per_process)
+                .flag("canNotUseMemoryManagementFunctions", cs.can_not_use_memory_management_functions)
                 .flag("canGetAndSetFMUstate", cs.can_get_and_set_fmu_state)
                 .flag("canSerializeFMUstate", cs.can_serialize_fmu_state)
-                .flag(
-                    "providesDirectionalDerivative",
-                    cs.provides_directional_derivative,
-                );
+                .flag("providesDirectionalDerivative", cs.provides_directional_derivative);
             o.empty(e);
         }
 
@@ -266,8 +227,7 @@ impl ModelDescription {
             o.open(Elem::new("LogCategories"));
             for c in &self.log_categories {
                 let mut e = Elem::new("Category");
-                e.attr("name", &c.name)
-                    .opt_str("description", &c.description);
+                e.attr("name", &c.name).opt_str("description", &c.description);
                 o.empty(e);
             }
             o.close("LogCategories");
@@ -298,14 +258,7 @@ impl ModelDescription {
                 }
                 o.open(e);
                 let t = match &v.variable_type {
-                    VariableType::Real {
-                        start,
-                        unit,
-                        derivative,
-                        min,
-                        max,
-                        nominal,
-                    } => {
+                    VariableType::Real { start, unit, derivative, min, max, nominal } => {
                         let mut t = Elem::new("Real");
                         t.opt_str("unit", unit)
                             .opt_disp("derivative", *derivative)
@@ -317,9 +270,7 @@ impl ModelDescription {
                     }
                     VariableType::Integer { start, min, max } => {
                         let mut t = Elem::new("Integer");
-                        t.opt_disp("min", *min)
-                            .opt_disp("max", *max)
-                            .opt_disp("start", *start);
+                        t.opt_disp("min", *min).opt_disp("max", *max).opt_disp("start", *start);
                         t
                     }
                     VariableType::Boolean { start } => {
@@ -344,11 +295,9 @@ impl ModelDescription {
             o.empty(Elem::new("ModelStructure"));
         } else {
             o.open(Elem::new("ModelStructure"));
-            for (name, list) in [
-                ("Outputs", &ms.outputs),
-                ("Derivatives", &ms.derivatives),
-                ("InitialUnknowns", &ms.initial_unknowns),
-            ] {
+            for (name, list) in
+                [("Outputs", &ms.outputs), ("Derivatives", &ms.derivatives), ("InitialUnknowns", &ms.initial_unknowns)]
+            {
                 if list.is_empty() {
                     continue;
                 }
@@ -365,7 +314,6 @@ impl ModelDescription {
         let mut bytes = o.w.into_inner();
         bytes.push(b'\n');
         // Everything written came from &str and ASCII markup: valid UTF-8.
-        String::from_utf8(bytes)
-            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+        String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
     }
 }

@@ -14,11 +14,7 @@ fn python() -> String {
 }
 
 fn fmpy_available() -> bool {
-    Command::new(python())
-        .args(["-c", "import fmpy"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
+    Command::new(python()).args(["-c", "import fmpy"]).output().map(|o| o.status.success()).unwrap_or(false)
 }
 
 const SCRIPT: &str = r#"
@@ -40,11 +36,7 @@ for u in md.initialUnknowns:
 #[test]
 fn fmpy_accepts_and_reads_what_we_write() {
     if !fmpy_available() {
-        assert!(
-            std::env::var_os("FMPY_PYTHON").is_none(),
-            "FMPY_PYTHON={} cannot import fmpy",
-            python()
-        );
+        assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
         eprintln!("fmpy not importable with {}: cross-check skipped (set FMPY_PYTHON to require it)", python());
         return;
     }
@@ -52,45 +44,21 @@ fn fmpy_accepts_and_reads_what_we_write() {
     for (name, md) in [
         ("rich", rich()),
         ("minimal", minimal()),
-        (
-            "BouncingBall",
-            ModelDescription::from_xml(&fixture("BouncingBall.xml")).unwrap(),
-        ),
-        (
-            "VanDerPol",
-            ModelDescription::from_xml(&fixture("VanDerPol.xml")).unwrap(),
-        ),
+        ("BouncingBall", ModelDescription::from_xml(&fixture("BouncingBall.xml")).unwrap()),
+        ("VanDerPol", ModelDescription::from_xml(&fixture("VanDerPol.xml")).unwrap()),
     ] {
         let md = md.with_content_guid();
         let dir = base.join(name);
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("modelDescription.xml"), md.to_xml()).unwrap();
-        let out = Command::new(python())
-            .args(["-c", SCRIPT])
-            .arg(&dir)
-            .output()
-            .unwrap();
+        let out = Command::new(python()).args(["-c", SCRIPT]).arg(&dir).output().unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{name}: {}\n{stdout}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let problems: Vec<&str> = stdout
-            .lines()
-            .filter(|l| l.starts_with("PROBLEM"))
-            .collect();
-        assert!(
-            problems.is_empty(),
-            "{name}: fmpy problems:\n{}",
-            problems.join("\n")
-        );
+        assert!(out.status.success(), "{name}: {}\n{stdout}", String::from_utf8_lossy(&out.stderr));
+        let problems: Vec<&str> = stdout.lines().filter(|l| l.starts_with("PROBLEM")).collect();
+        assert!(problems.is_empty(), "{name}: fmpy problems:\n{}", problems.join("\n"));
 
-        let vars: Vec<Vec<&str>> = stdout
-            .lines()
-            .filter_map(|l| l.strip_prefix("VAR "))
-            .map(|l| l.split(' ').collect())
-            .collect();
+        let vars: Vec<Vec<&str>> =
+            stdout.lines().filter_map(|l| l.strip_prefix("VAR ")).map(|l| l.split(' ').collect()).collect();
         assert_eq!(vars.len(), md.model_variables.len(), "{name}");
         for (f, v) in vars.iter().zip(&md.model_variables) {
             // Names with spaces do not occur in these samples.
@@ -109,42 +77,15 @@ fn fmpy_accepts_and_reads_what_we_write() {
             if let VariableType::Real { start: Some(s), .. } = v.variable_type {
                 // fmpy keeps the start as the attribute string: it must parse to our value.
                 let text = f[6].trim_matches('\'');
-                assert_eq!(
-                    parse_xs_double(text).map(f64::to_bits),
-                    Some(s.to_bits()),
-                    "{name} {}",
-                    v.name
-                );
+                assert_eq!(parse_xs_double(text).map(f64::to_bits), Some(s.to_bits()), "{name} {}", v.name);
             }
         }
-        let outs: Vec<u32> = stdout
-            .lines()
-            .filter_map(|l| l.strip_prefix("OUT "))
-            .map(|s| s.parse().unwrap())
-            .collect();
-        assert_eq!(
-            outs,
-            md.model_structure
-                .outputs
-                .iter()
-                .map(|u| u.index)
-                .collect::<Vec<_>>(),
-            "{name}"
-        );
-        let inits: Vec<u32> = stdout
-            .lines()
-            .filter_map(|l| l.strip_prefix("INIT "))
-            .map(|s| s.parse().unwrap())
-            .collect();
-        assert_eq!(
-            inits,
-            md.model_structure
-                .initial_unknowns
-                .iter()
-                .map(|u| u.index)
-                .collect::<Vec<_>>(),
-            "{name}"
-        );
+        let outs: Vec<u32> =
+            stdout.lines().filter_map(|l| l.strip_prefix("OUT ")).map(|s| s.parse().unwrap()).collect();
+        assert_eq!(outs, md.model_structure.outputs.iter().map(|u| u.index).collect::<Vec<_>>(), "{name}");
+        let inits: Vec<u32> =
+            stdout.lines().filter_map(|l| l.strip_prefix("INIT ")).map(|s| s.parse().unwrap()).collect();
+        assert_eq!(inits, md.model_structure.initial_unknowns.iter().map(|u| u.index).collect::<Vec<_>>(), "{name}");
     }
     let _ = std::fs::remove_dir_all(&base);
 }

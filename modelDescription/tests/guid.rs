@@ -43,12 +43,7 @@ fn stable_and_independent_of_the_current_guid() {
     assert_eq!(with.content_guid(), a, "idempotent");
     assert!(with.to_xml().contains(&format!("guid=\"{a}\"")));
     // Survives a write/read cycle.
-    assert_eq!(
-        ModelDescription::from_xml(&with.to_xml())
-            .unwrap()
-            .content_guid(),
-        a
-    );
+    assert_eq!(ModelDescription::from_xml(&with.to_xml()).unwrap().content_guid(), a);
 }
 
 #[test]
@@ -64,14 +59,7 @@ fn changes_when_any_variable_changes() {
             |v| v.description = Some(format!("{:?}", v.description)),
             |v| {
                 v.variable_type = match v.variable_type.clone() {
-                    VariableType::Real {
-                        start,
-                        unit,
-                        derivative,
-                        min,
-                        max,
-                        nominal,
-                    } => VariableType::Real {
+                    VariableType::Real { start, unit, derivative, min, max, nominal } => VariableType::Real {
                         start: Some(start.unwrap_or(0.0) + 1e-12),
                         unit,
                         derivative,
@@ -79,17 +67,13 @@ fn changes_when_any_variable_changes() {
                         max,
                         nominal,
                     },
-                    VariableType::Integer { start, min, max } => VariableType::Integer {
-                        start: Some(start.unwrap_or(0) + 1),
-                        min,
-                        max,
-                    },
-                    VariableType::Boolean { start } => VariableType::Boolean {
-                        start: Some(!start.unwrap_or(false)),
-                    },
-                    VariableType::String { start } => VariableType::String {
-                        start: Some(start.unwrap_or_default() + "!"),
-                    },
+                    VariableType::Integer { start, min, max } => {
+                        VariableType::Integer { start: Some(start.unwrap_or(0) + 1), min, max }
+                    }
+                    VariableType::Boolean { start } => VariableType::Boolean { start: Some(!start.unwrap_or(false)) },
+                    VariableType::String { start } => {
+                        VariableType::String { start: Some(start.unwrap_or_default() + "!") }
+                    }
                 }
             },
         ];

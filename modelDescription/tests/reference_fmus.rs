@@ -14,32 +14,16 @@ fn bouncing_ball() {
     assert_eq!(md.number_of_event_indicators, 1);
     let me = md.model_exchange.as_ref().unwrap();
     assert_eq!(me.model_identifier, "BouncingBall");
-    assert!(
-        me.can_not_use_memory_management_functions
-            && me.can_get_and_set_fmu_state
-            && me.can_serialize_fmu_state
-    );
+    assert!(me.can_not_use_memory_management_functions && me.can_get_and_set_fmu_state && me.can_serialize_fmu_state);
     assert!(!me.provides_directional_derivative);
     let cs = md.co_simulation.as_ref().unwrap();
     assert!(cs.can_handle_variable_communication_step_size);
     assert_eq!(md.unit_definitions.len(), 3);
-    assert_eq!(
-        md.unit_definitions[2].base_unit,
-        Some(BaseUnit {
-            m: 1,
-            s: -2,
-            ..BaseUnit::default()
-        })
-    );
+    assert_eq!(md.unit_definitions[2].base_unit, Some(BaseUnit { m: 1, s: -2, ..BaseUnit::default() }));
     assert_eq!(md.log_categories.len(), 2);
     assert_eq!(
         md.default_experiment,
-        Some(DefaultExperiment {
-            start_time: Some(0.0),
-            stop_time: Some(3.0),
-            tolerance: None,
-            step_size: Some(1e-3)
-        })
+        Some(DefaultExperiment { start_time: Some(0.0), stop_time: Some(3.0), tolerance: None, step_size: Some(1e-3) })
     );
     assert_eq!(md.model_variables.len(), 7);
 
@@ -59,51 +43,25 @@ fn bouncing_ball() {
             nominal: None
         }
     );
-    assert_eq!(
-        md.variable("der(v)").unwrap().variable_type.unit(),
-        Some("m/s2")
-    );
+    assert_eq!(md.variable("der(v)").unwrap().variable_type.unit(), Some("m/s2"));
     // v_min has no causality attribute: local.
     let v_min = md.variable("v_min").unwrap();
-    assert_eq!(
-        (v_min.causality, v_min.variability, v_min.initial),
-        (Causality::Local, Variability::Constant, None)
-    );
+    assert_eq!((v_min.causality, v_min.variability, v_min.initial), (Causality::Local, Variability::Constant, None));
     let e = md.variable("e").unwrap();
-    assert!(matches!(
-        e.variable_type,
-        VariableType::Real {
-            min: Some(0.5),
-            max: Some(1.0),
-            start: Some(0.7),
-            ..
-        }
-    ));
+    assert!(matches!(e.variable_type, VariableType::Real { min: Some(0.5), max: Some(1.0), start: Some(0.7), .. }));
 
     assert_eq!(md.index_of("v"), Some(3));
     assert_eq!(md.real_value_reference("g"), Some(5));
     // The quirk: the parameter g carries derivative="2" (of der(h)); it is not a state derivative.
-    assert_eq!(
-        md.variable("g").unwrap().variable_type.derivative(),
-        Some(2)
-    );
+    assert_eq!(md.variable("g").unwrap().variable_type.derivative(), Some(2));
     assert_eq!(md.state_derivatives(), vec![2, 4]);
     assert_eq!(md.states(), vec![1, 3]);
 
     let ms = &md.model_structure;
-    assert_eq!(
-        ms.outputs.iter().map(|u| u.index).collect::<Vec<_>>(),
-        vec![1, 3]
-    );
+    assert_eq!(ms.outputs.iter().map(|u| u.index).collect::<Vec<_>>(), vec![1, 3]);
     assert_eq!(ms.outputs[0].dependencies, None);
-    assert_eq!(
-        ms.derivatives.iter().map(|u| u.index).collect::<Vec<_>>(),
-        vec![2, 4]
-    );
-    assert_eq!(
-        ms.initial_unknowns[1],
-        unknown(4, Some(vec![5]), Some(vec![DependencyKind::Constant]))
-    );
+    assert_eq!(ms.derivatives.iter().map(|u| u.index).collect::<Vec<_>>(), vec![2, 4]);
+    assert_eq!(ms.initial_unknowns[1], unknown(4, Some(vec![5]), Some(vec![DependencyKind::Constant])));
 
     assert_eq!(md.validate(), vec![], "BouncingBall should validate");
 }
@@ -120,11 +78,7 @@ fn van_der_pol() {
     assert_eq!(ms.outputs[0].dependencies_kind, None);
     assert_eq!(
         ms.derivatives[1],
-        unknown(
-            4,
-            Some(vec![1, 3]),
-            Some(vec![DependencyKind::Dependent, DependencyKind::Dependent])
-        )
+        unknown(4, Some(vec![1, 3]), Some(vec![DependencyKind::Dependent, DependencyKind::Dependent]))
     );
     assert_eq!(ms.initial_unknowns[1].dependencies, Some(vec![1, 3, 5]));
     assert_eq!(md.validate(), vec![]);
@@ -137,36 +91,20 @@ fn feedthrough() {
     assert_eq!(md.model_variables.len(), 11);
     // Absent variability means continuous, absent causality means local.
     let rci = md.variable("real_continuous_in").unwrap();
-    assert_eq!(
-        (rci.causality, rci.variability),
-        (Causality::Input, Variability::Continuous)
-    );
+    assert_eq!((rci.causality, rci.variability), (Causality::Input, Variability::Continuous));
     assert_eq!(rci.description.as_deref(), Some(""));
     assert_eq!(
         md.variable("int_in").unwrap().variable_type,
-        VariableType::Integer {
-            start: Some(0),
-            min: None,
-            max: None
-        }
+        VariableType::Integer { start: Some(0), min: None, max: None }
     );
-    assert_eq!(
-        md.variable("bool_in").unwrap().variable_type,
-        VariableType::Boolean { start: Some(false) }
-    );
+    assert_eq!(md.variable("bool_in").unwrap().variable_type, VariableType::Boolean { start: Some(false) });
     assert_eq!(
         md.variable("string_param").unwrap().variable_type,
-        VariableType::String {
-            start: Some("Set me!".into())
-        }
+        VariableType::String { start: Some("Set me!".into()) }
     );
     assert_eq!(
         md.variable("int_out").unwrap().variable_type,
-        VariableType::Integer {
-            start: None,
-            min: None,
-            max: None
-        }
+        VariableType::Integer { start: None, min: None, max: None }
     );
     assert_eq!(md.default_experiment.as_ref().unwrap().stop_time, Some(2.0));
     assert!(md.model_structure.derivatives.is_empty());
@@ -178,11 +116,7 @@ fn feedthrough() {
     assert_eq!(problems.len(), 1, "{problems:#?}");
     assert_eq!(problems[0].rule, Rule::DependencyNotKnown);
     assert_eq!(problems[0].variable.as_deref(), Some("real_continuous_out"));
-    assert!(
-        problems[0].to_string().contains("\"real_fixed_param\""),
-        "{}",
-        problems[0]
-    );
+    assert!(problems[0].to_string().contains("\"real_fixed_param\""), "{}", problems[0]);
 }
 
 #[test]
@@ -228,32 +162,12 @@ fn tolerant_of_order_whitespace_comments_and_unknown_elements() {
     let md = ModelDescription::from_xml(xml).unwrap();
     assert_eq!(md.model_name, "M");
     assert_eq!(md.guid, "{g}");
-    assert!(
-        md.co_simulation
-            .as_ref()
-            .unwrap()
-            .can_handle_variable_communication_step_size
-    );
-    assert_eq!(
-        md.unit_definitions[0].base_unit.as_ref().unwrap().factor,
-        2.0
-    );
+    assert!(md.co_simulation.as_ref().unwrap().can_handle_variable_communication_step_size);
+    assert_eq!(md.unit_definitions[0].base_unit.as_ref().unwrap().factor, 2.0);
     assert_eq!(md.model_variables[0].value_reference, 7);
-    assert!(
-        matches!(md.model_variables[0].variable_type, VariableType::Real { start: Some(s), .. } if s == 1.5)
-    );
-    assert_eq!(
-        md.model_structure.outputs,
-        vec![unknown(
-            2,
-            Some(vec![1]),
-            Some(vec![DependencyKind::Dependent])
-        )]
-    );
-    assert_eq!(
-        md.model_structure.initial_unknowns,
-        vec![unknown(2, Some(vec![]), None)]
-    );
+    assert!(matches!(md.model_variables[0].variable_type, VariableType::Real { start: Some(s), .. } if s == 1.5));
+    assert_eq!(md.model_structure.outputs, vec![unknown(2, Some(vec![1]), Some(vec![DependencyKind::Dependent]))]);
+    assert_eq!(md.model_structure.initial_unknowns, vec![unknown(2, Some(vec![]), None)]);
     assert_eq!(md.validate(), vec![]);
 }
 
@@ -284,21 +198,7 @@ fn declared_type_defaults_and_enumerations() {
             nominal: Some(2.0)
         }
     );
-    assert_eq!(
-        md.model_variables[1].variable_type,
-        VariableType::Integer {
-            start: None,
-            min: Some(0),
-            max: Some(9)
-        }
-    );
-    assert_eq!(
-        md.model_variables[2].variable_type,
-        VariableType::Integer {
-            start: Some(2),
-            min: None,
-            max: None
-        }
-    );
+    assert_eq!(md.model_variables[1].variable_type, VariableType::Integer { start: None, min: Some(0), max: Some(9) });
+    assert_eq!(md.model_variables[2].variable_type, VariableType::Integer { start: Some(2), min: None, max: None });
     assert_eq!(md.model_variables[3].variable_type.unit(), None);
 }

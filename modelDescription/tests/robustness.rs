@@ -14,11 +14,7 @@ fn read(xml: &str) -> ReadError {
 
 #[test]
 fn every_prefix_of_valid_documents_is_handled() {
-    for doc in [
-        rich().to_xml(),
-        fixture("BouncingBall.xml"),
-        fixture("Feedthrough.xml"),
-    ] {
+    for doc in [rich().to_xml(), fixture("BouncingBall.xml"), fixture("Feedthrough.xml")] {
         let full_ok = ModelDescription::from_xml(&doc).is_ok();
         assert!(full_ok);
         let mut ok_prefixes = 0;
@@ -47,9 +43,7 @@ fn random_bytes_do_not_panic() {
         let bytes: Vec<u8> = if round % 2 == 0 {
             (0..len).map(|_| rng.next_u64() as u8).collect()
         } else {
-            (0..len)
-                .map(|_| alphabet[rng.below(alphabet.len())])
-                .collect()
+            (0..len).map(|_| alphabet[rng.below(alphabet.len())]).collect()
         };
         let s = String::from_utf8_lossy(&bytes);
         let _ = ModelDescription::from_xml(&s);
@@ -106,9 +100,7 @@ fn mutated_documents_do_not_panic() {
 #[test]
 fn deep_nesting_does_not_overflow() {
     let depth = 200_000;
-    let mut s = String::from(
-        r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g"><VendorAnnotations>"#,
-    );
+    let mut s = String::from(r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g"><VendorAnnotations>"#);
     s.push_str(&"<a>".repeat(depth));
     s.push_str(&"</a>".repeat(depth));
     s.push_str("</VendorAnnotations></fmiModelDescription>");
@@ -117,9 +109,7 @@ fn deep_nesting_does_not_overflow() {
     // Unclosed, too.
     let opened = s.find("</a>").unwrap();
     let e = read(&s[..opened]);
-    let ReadError::UnexpectedEof { element, position } = &e else {
-        panic!("{e}")
-    };
+    let ReadError::UnexpectedEof { element, position } = &e else { panic!("{e}") };
     assert_eq!(element, "a");
     assert_eq!(position.byte, opened - 3, "the innermost open element");
 }
@@ -136,10 +126,7 @@ fn malformed_xml_names_the_position() {
     assert!(matches!(e, ReadError::Xml { .. }), "{e:?}");
     assert_eq!(e.position().line, 3, "{e}");
     let msg = e.to_string();
-    assert!(
-        msg.contains("malformed XML") && msg.contains("line 3"),
-        "{msg}"
-    );
+    assert!(msg.contains("malformed XML") && msg.contains("line 3"), "{msg}");
 
     let e = read(&doc(
         r#"<ModelVariables><ScalarVariable name="a&b" valueReference="0"><Real/></ScalarVariable></ModelVariables>"#,
@@ -147,27 +134,17 @@ fn malformed_xml_names_the_position() {
     assert!(matches!(e, ReadError::Xml { .. }), "{e:?}");
     assert!(e.to_string().contains("line 2"), "{e}");
 
-    let e =
-        read(r#"<fmiModelDescription fmiVersion="2.0" fmiVersion="2.0" modelName="m" guid="g"/>"#);
-    assert!(
-        matches!(e, ReadError::Xml { .. }),
-        "duplicate attribute: {e:?}"
-    );
+    let e = read(r#"<fmiModelDescription fmiVersion="2.0" fmiVersion="2.0" modelName="m" guid="g"/>"#);
+    assert!(matches!(e, ReadError::Xml { .. }), "duplicate attribute: {e:?}");
 
-    let e = read(&format!(
-        "{HEAD}</fmiModelDescription><fmiModelDescription/>"
-    ));
+    let e = read(&format!("{HEAD}</fmiModelDescription><fmiModelDescription/>"));
     assert!(e.to_string().contains("second root"), "{e}");
 }
 
 #[test]
 fn unexpected_eof_names_the_open_element() {
-    let e = read(&format!(
-        "{HEAD}\n  <ModelVariables>\n    <ScalarVariable name=\"x\" valueReference=\"1\">"
-    ));
-    let ReadError::UnexpectedEof { element, position } = &e else {
-        panic!("{e:?}")
-    };
+    let e = read(&format!("{HEAD}\n  <ModelVariables>\n    <ScalarVariable name=\"x\" valueReference=\"1\">"));
+    let ReadError::UnexpectedEof { element, position } = &e else { panic!("{e:?}") };
     assert_eq!(element, "ScalarVariable");
     assert_eq!(position.line, 3);
     assert!(e.to_string().contains("<ScalarVariable>"), "{e}");
@@ -175,14 +152,8 @@ fn unexpected_eof_names_the_open_element() {
 
 #[test]
 fn not_a_model_description() {
-    assert!(matches!(
-        read(""),
-        ReadError::NotAModelDescription { found: None, .. }
-    ));
-    assert!(matches!(
-        read("   <!-- nothing -->  "),
-        ReadError::NotAModelDescription { found: None, .. }
-    ));
+    assert!(matches!(read(""), ReadError::NotAModelDescription { found: None, .. }));
+    assert!(matches!(read("   <!-- nothing -->  "), ReadError::NotAModelDescription { found: None, .. }));
     let e = read("<fmiModelDescriptions/>");
     assert!(e.to_string().contains("<fmiModelDescriptions>"), "{e}");
 }
@@ -190,42 +161,18 @@ fn not_a_model_description() {
 #[test]
 fn missing_required_attributes() {
     let cases: [(&str, &str, &str); 7] = [
+        (r#"<fmiModelDescription modelName="m" guid="g"/>"#, "fmiModelDescription", "fmiVersion"),
+        (r#"<fmiModelDescription fmiVersion="2.0" guid="g"/>"#, "fmiModelDescription", "modelName"),
+        (r#"<fmiModelDescription fmiVersion="2.0" modelName="m"/>"#, "fmiModelDescription", "guid"),
+        (&doc(r#"<CoSimulation/>"#), "CoSimulation", "modelIdentifier"),
+        (&doc(r#"<ModelExchange canGetAndSetFMUstate="true"/>"#), "ModelExchange", "modelIdentifier"),
         (
-            r#"<fmiModelDescription modelName="m" guid="g"/>"#,
-            "fmiModelDescription",
-            "fmiVersion",
-        ),
-        (
-            r#"<fmiModelDescription fmiVersion="2.0" guid="g"/>"#,
-            "fmiModelDescription",
-            "modelName",
-        ),
-        (
-            r#"<fmiModelDescription fmiVersion="2.0" modelName="m"/>"#,
-            "fmiModelDescription",
-            "guid",
-        ),
-        (
-            &doc(r#"<CoSimulation/>"#),
-            "CoSimulation",
-            "modelIdentifier",
-        ),
-        (
-            &doc(r#"<ModelExchange canGetAndSetFMUstate="true"/>"#),
-            "ModelExchange",
-            "modelIdentifier",
-        ),
-        (
-            &doc(
-                r#"<ModelVariables><ScalarVariable valueReference="1"><Real/></ScalarVariable></ModelVariables>"#,
-            ),
+            &doc(r#"<ModelVariables><ScalarVariable valueReference="1"><Real/></ScalarVariable></ModelVariables>"#),
             "ScalarVariable",
             "name",
         ),
         (
-            &doc(
-                r#"<ModelVariables><ScalarVariable name="speed"><Real/></ScalarVariable></ModelVariables>"#,
-            ),
+            &doc(r#"<ModelVariables><ScalarVariable name="speed"><Real/></ScalarVariable></ModelVariables>"#),
             "ScalarVariable \"speed\"",
             "valueReference",
         ),
@@ -233,30 +180,16 @@ fn missing_required_attributes() {
     for (xml, elem, attr) in cases {
         let e = read(xml);
         match &e {
-            ReadError::MissingAttribute {
-                element, attribute, ..
-            } => {
-                assert_eq!(
-                    (element.as_str(), attribute.as_str()),
-                    (elem, attr),
-                    "{xml}"
-                );
+            ReadError::MissingAttribute { element, attribute, .. } => {
+                assert_eq!((element.as_str(), attribute.as_str()), (elem, attr), "{xml}");
             }
             other => panic!("{xml}: {other:?}"),
         }
         let msg = e.to_string();
-        assert!(
-            msg.contains(attr) && msg.contains(elem) && msg.contains("missing required attribute"),
-            "{msg}"
-        );
+        assert!(msg.contains(attr) && msg.contains(elem) && msg.contains("missing required attribute"), "{msg}");
     }
-    let e = read(&doc(
-        r#"<ModelStructure><Outputs><Unknown dependencies="1"/></Outputs></ModelStructure>"#,
-    ));
-    assert!(
-        e.to_string().contains("Unknown of Outputs") && e.to_string().contains("index"),
-        "{e}"
-    );
+    let e = read(&doc(r#"<ModelStructure><Outputs><Unknown dependencies="1"/></Outputs></ModelStructure>"#));
+    assert!(e.to_string().contains("Unknown of Outputs") && e.to_string().contains("index"), "{e}");
     let e = read(&doc(r#"<UnitDefinitions><Unit/></UnitDefinitions>"#));
     assert!(matches!(e, ReadError::MissingAttribute { .. }), "{e}");
 }
@@ -286,22 +219,12 @@ fn bad_numbers() {
             "1.5",
         ),
         (
-            doc(
-                r#"<ModelStructure><Outputs><Unknown index="1" dependencies="1 two 3"/></Outputs></ModelStructure>"#,
-            ),
+            doc(r#"<ModelStructure><Outputs><Unknown index="1" dependencies="1 two 3"/></Outputs></ModelStructure>"#),
             "dependencies",
             "two",
         ),
-        (
-            doc(r#"<DefaultExperiment stopTime="ten"/>"#),
-            "stopTime",
-            "ten",
-        ),
-        (
-            doc(r#"<UnitDefinitions><Unit name="u"><BaseUnit m="1.0"/></Unit></UnitDefinitions>"#),
-            "m",
-            "1.0",
-        ),
+        (doc(r#"<DefaultExperiment stopTime="ten"/>"#), "stopTime", "ten"),
+        (doc(r#"<UnitDefinitions><Unit name="u"><BaseUnit m="1.0"/></Unit></UnitDefinitions>"#), "m", "1.0"),
         (
             r#"<fmiModelDescription fmiVersion="2.0" modelName="m" guid="g" numberOfEventIndicators="x"/>"#.to_string(),
             "numberOfEventIndicators",
@@ -310,26 +233,15 @@ fn bad_numbers() {
     ];
     for (xml, attr, val) in cases {
         let e = read(&xml);
-        let ReadError::BadNumber {
-            attribute, value, ..
-        } = &e
-        else {
-            panic!("{xml}: {e:?}")
-        };
+        let ReadError::BadNumber { attribute, value, .. } = &e else { panic!("{xml}: {e:?}") };
         assert_eq!((attribute.as_str(), value.as_str()), (attr, val));
         let msg = e.to_string();
-        assert!(
-            msg.contains(attr) && msg.contains(val) && msg.contains("not a valid number"),
-            "{msg}"
-        );
+        assert!(msg.contains(attr) && msg.contains(val) && msg.contains("not a valid number"), "{msg}");
     }
     let e = read(&doc(
         r#"<ModelVariables><ScalarVariable name="x" valueReference="1"><Real start="1,5"/></ScalarVariable></ModelVariables>"#,
     ));
-    assert!(
-        e.to_string().contains("Real of ScalarVariable \"x\""),
-        "{e}"
-    );
+    assert!(e.to_string().contains("Real of ScalarVariable \"x\""), "{e}");
 }
 
 #[test]
@@ -344,31 +256,15 @@ fn unknown_enum_values() {
             r#"<ModelVariables><ScalarVariable name="x" valueReference="1" {text}><Real/></ScalarVariable></ModelVariables>"#
         ));
         let e = read(&xml);
-        let ReadError::UnknownEnumValue {
-            attribute,
-            value,
-            element,
-            ..
-        } = &e
-        else {
-            panic!("{e:?}")
-        };
-        assert_eq!(
-            (attribute.as_str(), value.as_str(), element.as_str()),
-            (attr, val, "ScalarVariable \"x\"")
-        );
+        let ReadError::UnknownEnumValue { attribute, value, element, .. } = &e else { panic!("{e:?}") };
+        assert_eq!((attribute.as_str(), value.as_str(), element.as_str()), (attr, val, "ScalarVariable \"x\""));
         assert!(e.to_string().contains("unknown value"), "{e}");
     }
     let e = read(&doc(
         r#"<ModelStructure><Derivatives><Unknown index="1" dependencies="1" dependenciesKind="linear"/></Derivatives></ModelStructure>"#,
     ));
-    assert!(
-        matches!(&e, ReadError::UnknownEnumValue { value, .. } if value == "linear"),
-        "{e:?}"
-    );
-    let e = read(&doc(
-        r#"<CoSimulation modelIdentifier="m" canInterpolateInputs="yes"/>"#,
-    ));
+    assert!(matches!(&e, ReadError::UnknownEnumValue { value, .. } if value == "linear"), "{e:?}");
+    let e = read(&doc(r#"<CoSimulation modelIdentifier="m" canInterpolateInputs="yes"/>"#));
     assert!(
         matches!(&e, ReadError::UnknownEnumValue { attribute, .. } if attribute == "canInterpolateInputs"),
         "{e:?}"
@@ -378,12 +274,8 @@ fn unknown_enum_values() {
 #[test]
 fn fmi_version_must_be_2_0() {
     for v in ["1.0", "3.0", "2.0.1", ""] {
-        let e = read(&format!(
-            r#"<fmiModelDescription fmiVersion="{v}" modelName="m" guid="g"/>"#
-        ));
-        let ReadError::UnsupportedFmiVersion { found, .. } = &e else {
-            panic!("{e:?}")
-        };
+        let e = read(&format!(r#"<fmiModelDescription fmiVersion="{v}" modelName="m" guid="g"/>"#));
+        let ReadError::UnsupportedFmiVersion { found, .. } = &e else { panic!("{e:?}") };
         assert_eq!(found, v);
         assert!(e.to_string().contains("fmiVersion"), "{e}");
     }
@@ -395,9 +287,7 @@ fn scalar_variable_needs_a_type_child() {
   <ScalarVariable name="ok" valueReference="0"><Real/></ScalarVariable>
   <ScalarVariable name="untyped" valueReference="1"><Annotations/></ScalarVariable>
 </ModelVariables>"#));
-    let ReadError::MissingTypeChild { variable, position } = &e else {
-        panic!("{e:?}")
-    };
+    let ReadError::MissingTypeChild { variable, position } = &e else { panic!("{e:?}") };
     assert_eq!(variable, "untyped");
     assert_eq!(position.line, 4);
     assert!(e.to_string().contains("\"untyped\""), "{e}");
@@ -405,20 +295,10 @@ fn scalar_variable_needs_a_type_child() {
 
 #[test]
 fn duplicate_singletons() {
-    let e = read(&doc(
-        r#"<CoSimulation modelIdentifier="a"/><CoSimulation modelIdentifier="b"/>"#,
-    ));
-    assert!(
-        matches!(&e, ReadError::DuplicateElement { element, .. } if element == "CoSimulation"),
-        "{e:?}"
-    );
-    let e = read(&doc(
-        r#"<ModelStructure><Outputs/><Outputs/></ModelStructure>"#,
-    ));
-    assert!(
-        matches!(&e, ReadError::DuplicateElement { element, .. } if element == "Outputs"),
-        "{e:?}"
-    );
+    let e = read(&doc(r#"<CoSimulation modelIdentifier="a"/><CoSimulation modelIdentifier="b"/>"#));
+    assert!(matches!(&e, ReadError::DuplicateElement { element, .. } if element == "CoSimulation"), "{e:?}");
+    let e = read(&doc(r#"<ModelStructure><Outputs/><Outputs/></ModelStructure>"#));
+    assert!(matches!(&e, ReadError::DuplicateElement { element, .. } if element == "Outputs"), "{e:?}");
 }
 
 #[test]

@@ -43,21 +43,12 @@ fn writes_are_byte_identical() {
 #[test]
 fn header_and_declaration() {
     let xml = rich().to_xml();
-    assert!(
-        xml.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription "),
-        "{xml}"
-    );
+    assert!(xml.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription "), "{xml}");
     assert!(xml.ends_with("</fmiModelDescription>\n"));
 }
 
 fn positions(xml: &str, needles: &[&str]) -> Vec<usize> {
-    needles
-        .iter()
-        .map(|n| {
-            xml.find(n)
-                .unwrap_or_else(|| panic!("{n} missing in\n{xml}"))
-        })
-        .collect()
+    needles.iter().map(|n| xml.find(n).unwrap_or_else(|| panic!("{n} missing in\n{xml}"))).collect()
 }
 
 #[test]
@@ -112,14 +103,8 @@ fn scalar_variable_and_real_attribute_order() {
         sv.trim(),
         "<ScalarVariable name=\"k\" valueReference=\"7\" causality=\"parameter\" variability=\"tunable\" initial=\"exact\">"
     );
-    let real = xml
-        .lines()
-        .find(|l| l.contains("<Real unit=\"m\""))
-        .unwrap();
-    assert_eq!(
-        real.trim(),
-        "<Real unit=\"m\" min=\"-INF\" max=\"INF\" nominal=\"1.5\" start=\"0.5\"/>"
-    );
+    let real = xml.lines().find(|l| l.contains("<Real unit=\"m\"")).unwrap();
+    assert_eq!(real.trim(), "<Real unit=\"m\" min=\"-INF\" max=\"INF\" nominal=\"1.5\" start=\"0.5\"/>");
     let der = xml.lines().find(|l| l.contains("derivative=")).unwrap();
     assert_eq!(der.trim(), "<Real unit=\"m/s\" derivative=\"2\"/>");
     // initial omitted when None
@@ -146,36 +131,20 @@ fn empty_lists_are_omitted_but_variables_and_structure_are_not() {
     assert!(xml.contains("<ModelStructure/>"));
     // Only non-empty ModelStructure children.
     let mut md2 = minimal();
-    md2.model_structure
-        .initial_unknowns
-        .push(common::unknown(1, None, None));
+    md2.model_structure.initial_unknowns.push(common::unknown(1, None, None));
     let xml2 = md2.to_xml();
-    assert!(
-        xml2.contains("<InitialUnknowns>")
-            && !xml2.contains("<Outputs")
-            && !xml2.contains("<Derivatives")
-    );
+    assert!(xml2.contains("<InitialUnknowns>") && !xml2.contains("<Outputs") && !xml2.contains("<Derivatives"));
 }
 
 #[test]
 fn capability_flags_only_when_true() {
     let xml = rich().to_xml();
-    let me = xml
-        .lines()
-        .find(|l| l.contains("<ModelExchange"))
-        .unwrap()
-        .trim()
-        .to_string();
+    let me = xml.lines().find(|l| l.contains("<ModelExchange")).unwrap().trim().to_string();
     assert_eq!(
         me,
         "<ModelExchange modelIdentifier=\"rich_model\" completedIntegratorStepNotNeeded=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"true\"/>"
     );
-    let cs = xml
-        .lines()
-        .find(|l| l.contains("<CoSimulation"))
-        .unwrap()
-        .trim()
-        .to_string();
+    let cs = xml.lines().find(|l| l.contains("<CoSimulation")).unwrap().trim().to_string();
     assert_eq!(
         cs,
         "<CoSimulation modelIdentifier=\"rich_model\" canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"1\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\"/>"
@@ -186,10 +155,7 @@ fn capability_flags_only_when_true() {
 #[test]
 fn units_write_nonzero_exponents_and_nondefault_factor_offset() {
     let xml = rich().to_xml();
-    assert!(
-        xml.contains("<Unit name=\"m\">\n      <BaseUnit m=\"1\"/>\n    </Unit>"),
-        "{xml}"
-    );
+    assert!(xml.contains("<Unit name=\"m\">\n      <BaseUnit m=\"1\"/>\n    </Unit>"), "{xml}");
     assert!(xml.contains("<BaseUnit kg=\"1\" m=\"1\" s=\"-2\"/>"));
     assert!(xml.contains("<BaseUnit K=\"1\" offset=\"273.15\"/>"));
     assert!(xml.contains("<BaseUnit m=\"1\" s=\"-1\" factor=\"0.2777777777777778\"/>"));
@@ -202,14 +168,11 @@ fn units_write_nonzero_exponents_and_nondefault_factor_offset() {
 #[test]
 fn dependencies_absent_empty_and_listed() {
     let xml = rich().to_xml();
-    assert!(
-        xml.contains("<Unknown index=\"2\" dependencies=\"\"/>"),
-        "{xml}"
-    );
+    assert!(xml.contains("<Unknown index=\"2\" dependencies=\"\"/>"), "{xml}");
     assert!(xml.contains("<Unknown index=\"11\"/>"));
-    assert!(xml.contains(
-        "<Unknown index=\"16\" dependencies=\"2 4 6\" dependenciesKind=\"dependent constant fixed\"/>"
-    ));
+    assert!(
+        xml.contains("<Unknown index=\"16\" dependencies=\"2 4 6\" dependenciesKind=\"dependent constant fixed\"/>")
+    );
     let back = ModelDescription::from_xml(&xml).unwrap();
     assert_eq!(back.model_structure.outputs[0].dependencies, Some(vec![]));
     assert_eq!(back.model_structure.outputs[1].dependencies, None);
@@ -219,21 +182,12 @@ fn dependencies_absent_empty_and_listed() {
 fn text_is_escaped_and_survives() {
     let md = rich();
     let xml = md.to_xml();
-    assert!(
-        xml.contains("modelName=\"Rich &amp; &lt;odd&gt; &quot;model&quot;\""),
-        "{xml}"
-    );
+    assert!(xml.contains("modelName=\"Rich &amp; &lt;odd&gt; &quot;model&quot;\""), "{xml}");
     assert!(xml.contains("multi&#10;line&#9;description"));
     let back = ModelDescription::from_xml(&xml).unwrap();
     assert_eq!(back.model_name, md.model_name);
-    assert_eq!(
-        back.model_variables[6].description,
-        md.model_variables[6].description
-    );
-    assert_eq!(
-        back.model_variables[13].variable_type,
-        md.model_variables[13].variable_type
-    );
+    assert_eq!(back.model_variables[6].description, md.model_variables[6].description);
+    assert_eq!(back.model_variables[13].variable_type, md.model_variables[13].variable_type);
 }
 
 #[test]

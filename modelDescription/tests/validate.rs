@@ -13,10 +13,7 @@ fn problems_of(md: &ModelDescription) -> Vec<Problem> {
 #[track_caller]
 fn expect(md: &ModelDescription, rule: Rule, var: Option<&str>) -> Problem {
     let ps = problems_of(md);
-    match ps
-        .iter()
-        .find(|p| p.rule == rule && (var.is_none() || p.variable.as_deref() == var))
-    {
+    match ps.iter().find(|p| p.rule == rule && (var.is_none() || p.variable.as_deref() == var)) {
         Some(p) => {
             // Display names the rule and, when there is one, the variable.
             let s = p.to_string();
@@ -31,10 +28,7 @@ fn expect(md: &ModelDescription, rule: Rule, var: Option<&str>) -> Problem {
 }
 
 fn var_mut<'a>(md: &'a mut ModelDescription, name: &str) -> &'a mut ScalarVariable {
-    md.model_variables
-        .iter_mut()
-        .find(|v| v.name == name)
-        .unwrap()
+    md.model_variables.iter_mut().find(|v| v.name == name).unwrap()
 }
 
 fn set_start(v: &mut ScalarVariable, value: Option<f64>) {
@@ -58,10 +52,7 @@ fn expected_model_structure_matches_rich() {
     let idx = |l: &[Unknown]| l.iter().map(|u| u.index).collect::<Vec<_>>();
     assert_eq!(idx(&want.outputs), idx(&md.model_structure.outputs));
     assert_eq!(idx(&want.derivatives), idx(&md.model_structure.derivatives));
-    assert_eq!(
-        idx(&want.initial_unknowns),
-        idx(&md.model_structure.initial_unknowns)
-    );
+    assert_eq!(idx(&want.initial_unknowns), idx(&md.model_structure.initial_unknowns));
     assert_eq!(md.states(), vec![2, 4]);
     assert_eq!(md.state_derivatives(), vec![3, 5]);
     // A description whose structure is exactly the expected one validates.
@@ -120,10 +111,7 @@ fn unique_value_references_per_base_type() {
     let mut md = rich();
     var_mut(&mut md, "k").value_reference = 6; // = mass
     let p = expect(&md, Rule::DuplicateValueReference, Some("k"));
-    assert!(
-        p.message.contains("\"mass\"") && p.message.contains("Real"),
-        "{p}"
-    );
+    assert!(p.message.contains("\"mass\"") && p.message.contains("Real"), "{p}");
     let mut md = rich();
     var_mut(&mut md, "flag").value_reference = 0; // = on (Boolean)
     expect(&md, Rule::DuplicateValueReference, Some("flag"));
@@ -159,31 +147,16 @@ fn causality_variability_initial_table() {
                 "C" => &[Initial::Calculated, Initial::Exact, Initial::Approx],
                 _ => &[],
             };
-            assert_eq!(
-                legal_combination(causality, variability),
-                cell != "-",
-                "{causality:?} {variability:?}"
-            );
-            assert_eq!(
-                Initial::allowed(causality, variability),
-                allowed,
-                "{causality:?} {variability:?}"
-            );
-            for initial in [
-                None,
-                Some(Initial::Exact),
-                Some(Initial::Approx),
-                Some(Initial::Calculated),
-            ] {
+            assert_eq!(legal_combination(causality, variability), cell != "-", "{causality:?} {variability:?}");
+            assert_eq!(Initial::allowed(causality, variability), allowed, "{causality:?} {variability:?}");
+            for initial in [None, Some(Initial::Exact), Some(Initial::Approx), Some(Initial::Calculated)] {
                 let mut md = minimal();
                 let eff = initial.or(allowed.first().copied());
-                let needs_start = causality == Causality::Input
-                    || matches!(eff, Some(Initial::Exact | Initial::Approx));
-                let forbids_start =
-                    causality == Causality::Independent || eff == Some(Initial::Calculated);
+                let needs_start =
+                    causality == Causality::Input || matches!(eff, Some(Initial::Exact | Initial::Approx));
+                let forbids_start = causality == Causality::Independent || eff == Some(Initial::Calculated);
                 let start = (needs_start && !forbids_start).then_some(1.0);
-                md.model_variables =
-                    vec![real("x", 0, causality, variability, initial, start, None)];
+                md.model_variables = vec![real("x", 0, causality, variability, initial, start, None)];
                 md.model_structure = md.expected_model_structure();
                 let ps = problems_of(&md);
                 let table_rules: Vec<Rule> = ps
@@ -201,10 +174,7 @@ fn causality_variability_initial_table() {
                         want.push(Rule::Initial);
                     }
                 }
-                assert_eq!(
-                    table_rules, want,
-                    "{causality:?} {variability:?} {initial:?}: {ps:#?}"
-                );
+                assert_eq!(table_rules, want, "{causality:?} {variability:?} {initial:?}: {ps:#?}");
                 if cell != "-" && want.is_empty() {
                     assert_eq!(ps, vec![], "{causality:?} {variability:?} {initial:?}");
                 }
@@ -218,10 +188,7 @@ fn illegal_combinations_are_named() {
     let mut md = rich();
     var_mut(&mut md, "mass").variability = Variability::Continuous;
     let p = expect(&md, Rule::CausalityVariability, Some("mass"));
-    assert!(
-        p.message.contains("parameter") && p.message.contains("continuous"),
-        "{p}"
-    );
+    assert!(p.message.contains("parameter") && p.message.contains("continuous"), "{p}");
     let mut md = rich();
     var_mut(&mut md, "u").variability = Variability::Fixed;
     expect(&md, Rule::CausalityVariability, Some("u"));
@@ -297,23 +264,11 @@ fn start_forbidden() {
 #[test]
 fn independent_variable() {
     let mut md = rich();
-    var_mut(&mut md, "time").variable_type = VariableType::Integer {
-        start: None,
-        min: None,
-        max: None,
-    };
+    var_mut(&mut md, "time").variable_type = VariableType::Integer { start: None, min: None, max: None };
     expect(&md, Rule::Independent, Some("time"));
     expect(&md, Rule::ContinuousNonReal, Some("time"));
     let mut md = rich();
-    md.model_variables.push(real(
-        "time2",
-        99,
-        Causality::Independent,
-        Variability::Continuous,
-        None,
-        None,
-        None,
-    ));
+    md.model_variables.push(real("time2", 99, Causality::Independent, Variability::Continuous, None, None, None));
     let p = expect(&md, Rule::Independent, Some("time2"));
     assert!(p.message.contains("\"time\""), "{p}");
 }
@@ -339,16 +294,11 @@ fn units_must_be_declared() {
 #[test]
 fn derivative_must_point_at_a_real_continuous_variable() {
     let n = rich().model_variables.len() as u32;
-    for (target, why) in [
-        (0, "in 1..="),
-        (n + 1, "in 1..="),
-        (3, "itself"),
-        (7, "not a Real continuous"),
-        (10, "not a Real continuous"),
-    ] {
+    for (target, why) in
+        [(0, "in 1..="), (n + 1, "in 1..="), (3, "itself"), (7, "not a Real continuous"), (10, "not a Real continuous")]
+    {
         let mut md = rich();
-        if let VariableType::Real { derivative, .. } = &mut var_mut(&mut md, "der(x)").variable_type
-        {
+        if let VariableType::Real { derivative, .. } = &mut var_mut(&mut md, "der(x)").variable_type {
             *derivative = Some(target);
         }
         let p = expect(&md, Rule::Derivative, Some("der(x)"));
@@ -377,19 +327,11 @@ fn bounds() {
     let p = expect(&md, Rule::Bounds, Some("u"));
     assert!(p.message.contains("> max"), "{p}");
     let md = set(&|md| {
-        var_mut(md, "gear").variable_type = VariableType::Integer {
-            start: Some(7),
-            min: Some(-1),
-            max: Some(6),
-        }
+        var_mut(md, "gear").variable_type = VariableType::Integer { start: Some(7), min: Some(-1), max: Some(6) }
     });
     expect(&md, Rule::Bounds, Some("gear"));
     let md = set(&|md| {
-        var_mut(md, "gear").variable_type = VariableType::Integer {
-            start: Some(0),
-            min: Some(1),
-            max: Some(0),
-        }
+        var_mut(md, "gear").variable_type = VariableType::Integer { start: Some(0), min: Some(1), max: Some(0) }
     });
     expect(&md, Rule::Bounds, Some("gear"));
     // Infinite bounds are fine (x has min=-INF, max=INF).
@@ -448,10 +390,7 @@ fn derivatives_exactly() {
 #[test]
 fn initial_unknowns_exactly_sorted() {
     let mut md = rich();
-    assert_eq!(
-        indices(&md.model_structure.initial_unknowns),
-        vec![3, 4, 5, 9, 11, 13, 16]
-    );
+    assert_eq!(indices(&md.model_structure.initial_unknowns), vec![3, 4, 5, 9, 11, 13, 16]);
     md.model_structure.initial_unknowns.retain(|u| u.index != 9); // calculated parameter
     let p = expect(&md, Rule::InitialUnknowns, None);
     assert!(p.message.contains("\"w\""), "{p}");
@@ -459,22 +398,16 @@ fn initial_unknowns_exactly_sorted() {
     md.model_structure.initial_unknowns.retain(|u| u.index != 4); // state with approx
     expect(&md, Rule::InitialUnknowns, None);
     let mut md = rich();
-    md.model_structure
-        .initial_unknowns
-        .retain(|u| u.index != 16); // output calculated
+    md.model_structure.initial_unknowns.retain(|u| u.index != 16); // output calculated
     expect(&md, Rule::InitialUnknowns, None);
     let mut md = rich();
-    md.model_structure
-        .initial_unknowns
-        .insert(0, unknown(2, None, None)); // output exact: not an unknown
+    md.model_structure.initial_unknowns.insert(0, unknown(2, None, None)); // output exact: not an unknown
     expect(&md, Rule::InitialUnknowns, None);
     let mut md = rich();
     md.model_structure.initial_unknowns.swap(0, 1);
     expect(&md, Rule::InitialUnknowns, None);
     let mut md = rich();
-    md.model_structure
-        .initial_unknowns
-        .push(unknown(16, None, None));
+    md.model_structure.initial_unknowns.push(unknown(16, None, None));
     expect(&md, Rule::InitialUnknowns, None);
 }
 
@@ -541,8 +474,5 @@ fn problems_display_rule_and_variable() {
     set_start(var_mut(&mut md, "u"), None);
     let ps = problems_of(&md);
     assert_eq!(ps.len(), 1, "{ps:#?}");
-    assert_eq!(
-        ps[0].to_string(),
-        "[start-required] variable \"u\": inputs need a start value"
-    );
+    assert_eq!(ps[0].to_string(), "[start-required] variable \"u\": inputs need a start value");
 }

@@ -152,7 +152,6 @@ pub struct ChosenPoint {
     pub nu: Option<f64>,
 }
 
-
 /// Certified bounds against actual norms, worst case over vertices and interior points.
 #[derive(Clone, Debug, Serialize)]
 pub struct ActualNorms {

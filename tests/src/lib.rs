@@ -62,12 +62,18 @@ impl LogSink {
 }
 
 #[no_mangle]
-unsafe extern "C" fn nigel_test_record_log(env: *mut c_void, status: c_int, category: *const c_char, message: *const c_char) {
+unsafe extern "C" fn nigel_test_record_log(
+    env: *mut c_void,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
     if env.is_null() {
         return;
     }
     let sink = &*(env as *const LogSink);
-    let text = |p: *const c_char| if p.is_null() { String::new() } else { CStr::from_ptr(p).to_string_lossy().into_owned() };
+    let text =
+        |p: *const c_char| if p.is_null() { String::new() } else { CStr::from_ptr(p).to_string_lossy().into_owned() };
     if let Ok(mut r) = sink.records.lock() {
         r.push(LogRecord { status, category: text(category), message: text(message) });
     }
@@ -80,6 +86,9 @@ macro_rules! fmi2_functions {
         pub struct Functions { $(pub $field: unsafe extern "C" fn($($arg),*) $(-> $ret)?,)* }
         impl Functions {
             /// Resolves all symbols; the first missing one is the error.
+            ///
+            /// # Safety
+            /// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
             pub unsafe fn load(lib: &libloading::Library) -> Result<Functions, String> {
                 Ok(Functions { $($field: *lib.get::<unsafe extern "C" fn($($arg),*) $(-> $ret)?>(concat!($symbol, "\0").as_bytes()).map_err(|e| format!("{}: {e}", $symbol))?,)* })
             }
@@ -157,7 +166,10 @@ pub fn built_fmu(model_identifier: &str) -> Result<PathBuf, String> {
     if path.is_file() {
         Ok(path)
     } else {
-        Err(format!("{} not found: run `cargo run --release -p build-fmu` first (the README's test command does)", path.display()))
+        Err(format!(
+            "{} not found: run `cargo run --release -p build-fmu` first (the README's test command does)",
+            path.display()
+        ))
     }
 }
 
@@ -214,7 +226,9 @@ impl Fmu {
         let name_c = CString::new(name).unwrap();
         let guid_c = CString::new(guid).unwrap();
         let uri = CString::new(self.resource_uri()).unwrap();
-        let c = unsafe { (self.functions.instantiate)(name_c.as_ptr(), kind, guid_c.as_ptr(), uri.as_ptr(), &*callbacks, 0, 0) };
+        let c = unsafe {
+            (self.functions.instantiate)(name_c.as_ptr(), kind, guid_c.as_ptr(), uri.as_ptr(), &*callbacks, 0, 0)
+        };
         if c.is_null() {
             (None, sink)
         } else {

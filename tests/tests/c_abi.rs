@@ -150,7 +150,11 @@ fn nan_and_inf_are_refused_and_not_applied() {
         // the good value in the same call is not applied either (all or nothing)
         assert_eq!(i.set_real(&[tau, delta], &[0.01, bad]), ERROR);
         assert!(log.last_error().unwrap().contains("delta_fl"));
-        assert_eq!(i.get_real(&[delta, tau]).unwrap(), vec![0.1, 0.0], "values unchanged (read in the error state for diagnosis)");
+        assert_eq!(
+            i.get_real(&[delta, tau]).unwrap(),
+            vec![0.1, 0.0],
+            "values unchanged (read in the error state for diagnosis)"
+        );
         assert_eq!(i.reset(), OK);
         i.initialize();
         assert_eq!(i.set_real(&[delta], &[0.1]), OK);
@@ -159,7 +163,9 @@ fn nan_and_inf_are_refused_and_not_applied() {
 
 #[test]
 fn impossible_parameters_give_error_with_the_reason() {
-    for (name, value, expect) in [("m", -1.0, "m = -1"), ("l_f", 0.0, "l_f"), ("c_rr", -5.0, "c_rr"), ("delta_max", 4.0, "delta_max")] {
+    for (name, value, expect) in
+        [("m", -1.0, "m = -1"), ("l_f", 0.0, "l_f"), ("c_rr", -5.0, "c_rr"), ("delta_max", 4.0, "delta_max")]
+    {
         let (i, log) = cs();
         assert_eq!(i.set_real(&[fmu().vr(name)], &[value]), ERROR, "{name}");
         let msg = log.last_error().unwrap();
@@ -362,7 +368,8 @@ fn declared_dependencies_cover_the_numerical_sparsity() {
     let md = &fmu().description;
     let (i, _log) = fmu().instantiate("me", MODEL_EXCHANGE, fmu().guid());
     let i = i.unwrap();
-    let switches: Vec<u32> = ["friction_circle", "steering_servo", "motor_speed_limit"].iter().map(|n| fmu().vr(n)).collect();
+    let switches: Vec<u32> =
+        ["friction_circle", "steering_servo", "motor_speed_limit"].iter().map(|n| fmu().vr(n)).collect();
     assert_eq!(i.set_boolean(&switches, &[true, true, true]), OK);
     let knowns: Vec<(u32, u32)> = md
         .model_variables
@@ -391,7 +398,13 @@ fn declared_dependencies_cover_the_numerical_sparsity() {
             let s = unsafe { (i.f().get_directional_derivative)(i.c, &uv, 1, &vr, 1, &1.0, out.as_mut_ptr()) };
             assert_eq!(s, OK);
             if out[0] != 0.0 {
-                assert!(declared.contains(&index), "{} depends on {} (d = {})", md.model_variables[u.index as usize - 1].name, md.model_variables[index as usize - 1].name, out[0]);
+                assert!(
+                    declared.contains(&index),
+                    "{} depends on {} (d = {})",
+                    md.model_variables[u.index as usize - 1].name,
+                    md.model_variables[index as usize - 1].name,
+                    out[0]
+                );
                 checked += 1;
             }
         }

@@ -33,4 +33,3 @@ fn ten_thousand_instantiate_free_cycles_do_not_grow_memory() {
     let after = rss_kib();
     assert!(after <= before + 1024, "RSS grew from {before} KiB to {after} KiB");
 }
-

@@ -3,12 +3,20 @@
 //! The same parameter type and right-hand side serve the plant FMU, the synthesis crate
 //! (through [`linear_model`]) and the master's in-process reference runs.
 
+// `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Wheel loops index several per-wheel arrays at once; an index reads clearer than zips.
+#![allow(clippy::needless_range_loop)]
+
 pub mod dynamics;
 pub mod linear;
 pub mod params;
 pub mod scalar;
 
-pub use dynamics::{derivatives_of, evaluate, steering, Steering, integrate, rk4_step, straight_running, Evaluation, Inputs, State, N_STATES};
+pub use dynamics::{
+    derivatives_of, evaluate, integrate, rk4_step, steering, straight_running, Evaluation, Inputs, State, Steering,
+    N_STATES,
+};
 pub use linear::{linear_model, DisturbanceColumn, LinearModel};
 pub use params::{ParamError, VehicleParams, WHEELS};
 pub use scalar::{Dual, Scalar};

@@ -46,12 +46,7 @@ pub fn linear_model(p: &VehicleParams, mu: [f64; 4], v: f64) -> LinearModel {
         b[(0, i)] = k / (p.m * v);
         b[(1, i)] = xi * k / p.i_z;
     }
-    let a = Matrix2::new(
-        -s0 / (p.m * v),
-        -s1 / (p.m * v * v) - 1.0,
-        -s1 / p.i_z,
-        -s2 / (p.i_z * v),
-    );
+    let a = Matrix2::new(-s0 / (p.m * v), -s1 / (p.m * v * v) - 1.0, -s1 / p.i_z, -s2 / (p.i_z * v));
     LinearModel {
         a,
         b,

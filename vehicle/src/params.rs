@@ -105,12 +105,7 @@ impl VehicleParams {
     /// Table II with every "real"-fidelity option switched on (friction circle,
     /// steering servo T_s = 0.03 s / 5.51 rad/s, motor limit 0.442 m/s).
     pub fn real_fidelity() -> Self {
-        VehicleParams {
-            friction_circle: true,
-            steering_servo: true,
-            motor_speed_limit: true,
-            ..Self::table2()
-        }
+        VehicleParams { friction_circle: true, steering_servo: true, motor_speed_limit: true, ..Self::table2() }
     }
 
     /// Refuses physically impossible values with the reason.

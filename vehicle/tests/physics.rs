@@ -1,6 +1,8 @@
 //! Physics checks against independent derivations: Eq. 2.2 of the paper, the linear
 //! steady state, and straight running.
 
+#![allow(clippy::needless_range_loop)] // per-wheel and matrix index loops mirror the equations
+
 use nalgebra::{Matrix2, Vector2, Vector4};
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, integrate, linear_model, Dual, Inputs, Scalar, State, VehicleParams, N_STATES};
@@ -66,18 +68,19 @@ fn closed_form_matches_the_numbers_in_the_spec() {
 #[test]
 fn jacobian_at_straight_running_equals_eq_2_2() {
     let p = VehicleParams::table2();
-    let points: [([f64; 4], f64); 4] = [
-        ([0.4; 4], 0.35),
-        ([0.1; 4], 0.2),
-        ([1.0, 0.7, 0.3, 0.55], 0.5),
-        ([0.25, 0.9, 0.6, 0.15], 1.3),
-    ];
+    let points: [([f64; 4], f64); 4] =
+        [([0.4; 4], 0.35), ([0.1; 4], 0.2), ([1.0, 0.7, 0.3, 0.55], 0.5), ([0.25, 0.9, 0.6, 0.15], 1.3)];
     for (mu, v) in points {
         let lm = linear_model(&p, mu, v);
         let (a, b, d) = nonlinear_jacobian(&p, mu, v);
         for r in 0..2 {
             for c in 0..2 {
-                assert!(rel(a[(r, c)], lm.a[(r, c)]) < 1e-6, "mu {mu:?} v {v}: A[{r}{c}] {} vs {}", a[(r, c)], lm.a[(r, c)]);
+                assert!(
+                    rel(a[(r, c)], lm.a[(r, c)]) < 1e-6,
+                    "mu {mu:?} v {v}: A[{r}{c}] {} vs {}",
+                    a[(r, c)],
+                    lm.a[(r, c)]
+                );
             }
             for c in 0..4 {
                 assert!(rel(b[r][c], lm.b[(r, c)]) < 1e-6, "mu {mu:?} v {v}: B[{r}{c}]");

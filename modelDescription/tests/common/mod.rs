@@ -38,11 +38,7 @@ pub fn with_derivative(mut v: ScalarVariable, of: u32) -> ScalarVariable {
 }
 
 pub fn unknown(index: u32, deps: Option<Vec<u32>>, kinds: Option<Vec<DependencyKind>>) -> Unknown {
-    Unknown {
-        index,
-        dependencies: deps,
-        dependencies_kind: kinds,
-    }
+    Unknown { index, dependencies: deps, dependencies_kind: kinds }
 }
 
 /// 16 variables of all four types; see the comments for their 1-based indices.
@@ -53,98 +49,25 @@ pub fn rich() -> ModelDescription {
     use Variability as V;
     let mut vars = vec![
         // 1
-        real(
-            "time",
-            0,
-            C::Independent,
-            V::Continuous,
-            None,
-            None,
-            Some("s"),
-        ),
+        real("time", 0, C::Independent, V::Continuous, None, None, Some("s")),
         // 2: state, output
-        real(
-            "x",
-            1,
-            C::Output,
-            V::Continuous,
-            Some(I::Exact),
-            Some(0.5),
-            Some("m"),
-        ),
+        real("x", 1, C::Output, V::Continuous, Some(I::Exact), Some(0.5), Some("m")),
         // 3
-        with_derivative(
-            real(
-                "der(x)",
-                2,
-                C::Local,
-                V::Continuous,
-                Some(I::Calculated),
-                None,
-                Some("m/s"),
-            ),
-            2,
-        ),
+        with_derivative(real("der(x)", 2, C::Local, V::Continuous, Some(I::Calculated), None, Some("m/s")), 2),
         // 4: state
-        real(
-            "v",
-            3,
-            C::Local,
-            V::Continuous,
-            Some(I::Approx),
-            Some(0.0),
-            Some("m/s"),
-        ),
+        real("v", 3, C::Local, V::Continuous, Some(I::Approx), Some(0.0), Some("m/s")),
         // 5
-        with_derivative(
-            real(
-                "der(v)",
-                4,
-                C::Local,
-                V::Continuous,
-                None,
-                None,
-                Some("m/s2"),
-            ),
-            4,
-        ),
+        with_derivative(real("der(v)", 4, C::Local, V::Continuous, None, None, Some("m/s2")), 4),
         // 6
         real("u", 5, C::Input, V::Continuous, None, Some(0.0), Some("N")),
         // 7
-        real(
-            "mass",
-            6,
-            C::Parameter,
-            V::Fixed,
-            None,
-            Some(1200.0),
-            Some("kg"),
-        ),
+        real("mass", 6, C::Parameter, V::Fixed, None, Some(1200.0), Some("kg")),
         // 8
-        real(
-            "k",
-            7,
-            C::Parameter,
-            V::Tunable,
-            Some(I::Exact),
-            Some(1e-3),
-            None,
-        ),
+        real("k", 7, C::Parameter, V::Tunable, Some(I::Exact), Some(1e-3), None),
         // 9
-        real(
-            "w",
-            8,
-            C::CalculatedParameter,
-            V::Fixed,
-            None,
-            None,
-            Some("kg"),
-        ),
+        real("w", 8, C::CalculatedParameter, V::Fixed, None, None, Some("kg")),
     ];
-    if let VariableType::Real {
-        min, max, nominal, ..
-    } = &mut vars[1].variable_type
-    {
+    if let VariableType::Real { min, max, nominal, .. } = &mut vars[1].variable_type {
         *min = Some(f64::NEG_INFINITY);
         *max = Some(f64::INFINITY);
         *nominal = Some(1.5);
@@ -163,11 +86,7 @@ pub fn rich() -> ModelDescription {
         causality: C::Input,
         variability: V::Discrete,
         initial: None,
-        variable_type: VariableType::Integer {
-            start: Some(1),
-            min: Some(-1),
-            max: Some(6),
-        },
+        variable_type: VariableType::Integer { start: Some(1), min: Some(-1), max: Some(6) },
     });
     vars.push(ScalarVariable {
         // 11
@@ -177,11 +96,7 @@ pub fn rich() -> ModelDescription {
         causality: C::Output,
         variability: V::Discrete,
         initial: Some(I::Calculated),
-        variable_type: VariableType::Integer {
-            start: None,
-            min: Some(i32::MIN),
-            max: Some(i32::MAX),
-        },
+        variable_type: VariableType::Integer { start: None, min: Some(i32::MIN), max: Some(i32::MAX) },
     });
     vars.push(ScalarVariable {
         // 12
@@ -211,30 +126,12 @@ pub fn rich() -> ModelDescription {
         causality: C::Parameter,
         variability: V::Fixed,
         initial: None,
-        variable_type: VariableType::String {
-            start: Some("a \"quoted\" <label> & 'x'\n\ttab  two spaces".into()),
-        },
+        variable_type: VariableType::String { start: Some("a \"quoted\" <label> & 'x'\n\ttab  two spaces".into()) },
     });
     // 15
-    vars.push(real(
-        "c",
-        9,
-        C::Local,
-        V::Constant,
-        None,
-        Some(std::f64::consts::PI),
-        None,
-    ));
+    vars.push(real("c", 9, C::Local, V::Constant, None, Some(std::f64::consts::PI), None));
     // 16
-    vars.push(real(
-        "temp",
-        10,
-        C::Output,
-        V::Continuous,
-        Some(I::Calculated),
-        None,
-        Some("degC"),
-    ));
+    vars.push(real("temp", 10, C::Output, V::Continuous, Some(I::Calculated), None, Some("degC")));
 
     let units = vec![
         Unit::si("s", 0, 0, 1, 0),
@@ -243,22 +140,10 @@ pub fn rich() -> ModelDescription {
         Unit::si("m/s2", 0, 1, -2, 0),
         Unit::si("N", 1, 1, -2, 0),
         Unit::si("kg", 1, 0, 0, 0),
-        Unit {
-            name: "degC".into(),
-            base_unit: Some(BaseUnit {
-                k: 1,
-                offset: 273.15,
-                ..BaseUnit::default()
-            }),
-        },
+        Unit { name: "degC".into(), base_unit: Some(BaseUnit { k: 1, offset: 273.15, ..BaseUnit::default() }) },
         Unit {
             name: "km/h".into(),
-            base_unit: Some(BaseUnit {
-                m: 1,
-                s: -1,
-                factor: 1.0 / 3.6,
-                ..BaseUnit::default()
-            }),
+            base_unit: Some(BaseUnit { m: 1, s: -1, factor: 1.0 / 3.6, ..BaseUnit::default() }),
         },
         Unit {
             name: "odd".into(),
@@ -275,10 +160,7 @@ pub fn rich() -> ModelDescription {
                 offset: -1e300,
             }),
         },
-        Unit {
-            name: "1".into(),
-            base_unit: None,
-        },
+        Unit { name: "1".into(), base_unit: None },
     ];
 
     let structure = ModelStructure {
@@ -286,19 +168,11 @@ pub fn rich() -> ModelDescription {
             unknown(2, Some(vec![]), None),
             unknown(11, None, None),
             unknown(13, Some(vec![12]), Some(vec![K::Dependent])),
-            unknown(
-                16,
-                Some(vec![2, 4, 6]),
-                Some(vec![K::Dependent, K::Constant, K::Fixed]),
-            ),
+            unknown(16, Some(vec![2, 4, 6]), Some(vec![K::Dependent, K::Constant, K::Fixed])),
         ],
         derivatives: vec![
             unknown(3, Some(vec![4]), Some(vec![K::Constant])),
-            unknown(
-                5,
-                Some(vec![1, 2, 4, 6]),
-                Some(vec![K::Tunable, K::Discrete, K::Dependent, K::Constant]),
-            ),
+            unknown(5, Some(vec![1, 2, 4, 6]), Some(vec![K::Tunable, K::Discrete, K::Dependent, K::Constant])),
         ],
         initial_unknowns: vec![
             unknown(3, Some(vec![4]), None),
@@ -342,14 +216,8 @@ pub fn rich() -> ModelDescription {
         }),
         unit_definitions: units,
         log_categories: vec![
-            LogCategory {
-                name: "logEvents".into(),
-                description: Some("Log events".into()),
-            },
-            LogCategory {
-                name: "logStatusError".into(),
-                description: None,
-            },
+            LogCategory { name: "logEvents".into(), description: Some("Log events".into()) },
+            LogCategory { name: "logStatusError".into(), description: None },
         ],
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
@@ -378,22 +246,11 @@ pub fn minimal() -> ModelDescription {
         variable_naming_convention: None,
         number_of_event_indicators: 0,
         model_exchange: None,
-        co_simulation: Some(CoSimulation {
-            model_identifier: "m".into(),
-            ..Default::default()
-        }),
+        co_simulation: Some(CoSimulation { model_identifier: "m".into(), ..Default::default() }),
         unit_definitions: vec![],
         log_categories: vec![],
         default_experiment: None,
-        model_variables: vec![real(
-            "p",
-            0,
-            Causality::Parameter,
-            Variability::Fixed,
-            None,
-            Some(1.0),
-            None,
-        )],
+        model_variables: vec![real("p", 0, Causality::Parameter, Variability::Fixed, None, Some(1.0), None)],
         model_structure: ModelStructure::default(),
     }
 }
