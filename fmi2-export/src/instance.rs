@@ -192,9 +192,21 @@ impl<M: Model> Instance<M> {
         self.check_get()?;
         let rows = self.rows(BaseType::Real, vrs)?;
         for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.model.get_real(decl::<M>().variable(row).binding)?;
+            *o = self.finite_real(row)?;
         }
         Ok(())
+    }
+
+    /// A Real of the model, refusing a non-finite result (an overflowed state, say)
+    /// rather than handing NaN or Inf to the importer's solver.
+    fn finite_real(&mut self, row: usize) -> OpResult<f64> {
+        let v = decl::<M>().variable(row);
+        let x = self.model.get_real(v.binding)?;
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(format!("{} evaluated to {x} (the state or inputs are out of the model's range)", v.name))
+        }
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
@@ -356,7 +368,7 @@ impl<M: Model> Instance<M> {
     /// Reads the Reals of `rows` into `out` (the state or derivative vector).
     fn read_rows(&mut self, rows: &[usize], out: &mut [f64]) -> OpResult {
         for (o, &row) in out.iter_mut().zip(rows) {
-            *o = self.model.get_real(decl::<M>().variable(row).binding)?;
+            *o = self.finite_real(row)?;
         }
         Ok(())
     }

@@ -17,6 +17,10 @@ use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehiclePa
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
 
+/// Largest number of RK4 sub-steps one `fmi2DoStep` may take (about 10 s of computing);
+/// a longer step is refused instead of hanging the importer.
+pub const MAX_SUBSTEPS_PER_STEP: usize = 10_000_000;
+
 /// Default upper bound of the internal RK4 sub-step in Co-Simulation [s].
 pub const DEFAULT_CS_SUBSTEP_MAX: f64 = 5e-4;
 
@@ -533,6 +537,14 @@ impl Model for Plant {
     }
 
     fn do_step(&mut self, _time: f64, step: f64) -> Result<(), String> {
+        let substeps = nigel_vehicle::dynamics::substeps(step, self.cs_substep_max);
+        if substeps > MAX_SUBSTEPS_PER_STEP {
+            return Err(format!(
+                "a step of {step} s would take {substeps} RK4 sub-steps of at most cs_substep_max = {} s \
+                 (limit {MAX_SUBSTEPS_PER_STEP}); take shorter steps or raise cs_substep_max",
+                self.cs_substep_max
+            ));
+        }
         let next = nigel_vehicle::integrate(&self.params, &self.state, &self.inputs, step, self.cs_substep_max);
         if let Some(i) = next.iter().position(|x| !x.is_finite()) {
             return Err(format!("state {} became {} (step {step} s)", STATE_NAMES[i], next[i]));

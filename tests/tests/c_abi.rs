@@ -114,6 +114,14 @@ fn illegal_call_orders_are_refused_and_only_reset_recovers() {
     assert_eq!(i.do_step(0.0, -1e-3), ERROR, "h < 0");
     assert_eq!(i.reset(), OK);
     i.initialize();
+    assert_eq!(i.do_step(0.0, 1e9), ERROR, "a step that would take 2e12 sub-steps is refused, not run");
+    assert!(log.last_error().unwrap().contains("raise cs_substep_max"));
+    assert_eq!(i.reset(), OK);
+    assert_eq!(i.set_real(&[fmu().vr("cs_substep_max")], &[1e-300]), OK);
+    i.initialize();
+    assert_eq!(i.do_step(0.0, 1e-3), ERROR, "a vanishing sub-step is refused, not run");
+    assert_eq!(i.reset(), OK);
+    i.initialize();
     assert_eq!(i.do_step(0.0, 1e-3), OK);
     assert_eq!(i.do_step(0.5, 1e-3), ERROR, "start time is not the previous end time");
     assert!(log.last_error().unwrap().contains("not the end of the previous step"));
@@ -349,6 +357,15 @@ fn model_exchange_walks_the_state_machine_and_derivatives_match_the_model() {
         assert_eq!(dx, expected);
         assert_eq!((f.get_derivatives)(i.c, dx.as_mut_ptr(), 9), ERROR, "wrong nx");
         assert!(log.last_error().unwrap().contains("nx = 9"));
+        assert_eq!(i.reset(), OK);
+        i.initialize();
+        assert_eq!((f.enter_continuous_time_mode)(i.c), OK);
+        // a state so large that the right-hand side overflows: the derivatives are refused
+        x[3] = 1e300;
+        x[5] = 1e300;
+        assert_eq!((f.set_continuous_states)(i.c, x.as_ptr(), 10), OK);
+        assert_eq!((f.get_derivatives)(i.c, dx.as_mut_ptr(), 10), ERROR);
+        assert!(log.last_error().unwrap().contains("evaluated to"), "{:?}", log.last_error());
         assert_eq!(i.reset(), OK);
         i.initialize();
         assert_eq!((f.enter_continuous_time_mode)(i.c), OK);

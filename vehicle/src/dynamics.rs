@@ -238,12 +238,19 @@ fn rk4(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, held: Option<
     o
 }
 
+/// Number of RK4 sub-steps [`integrate`] takes for a step `h` (at least 1).
+///
+/// The slack keeps a step a few rounding units above a multiple of `max_step` (as masters
+/// that accumulate time produce) from costing one more sub-step. Callers facing untrusted
+/// `h` and `max_step` check this count before integrating (it can be astronomically large).
+pub fn substeps(h: f64, max_step: f64) -> usize {
+    (h / max_step - 1e-9).ceil().max(1.0) as usize
+}
+
 /// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`, inputs held.
 /// With the servo off the steering trigonometry is computed once for the whole interval.
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
-    // The slack keeps a step a few rounding units above a multiple of `max_step` (as
-    // masters that accumulate time produce) from costing one more sub-step.
-    let n = (h / max_step - 1e-9).ceil().max(1.0) as usize;
+    let n = substeps(h, max_step);
     let dt = h / n as f64;
     let held = (!p.steering_servo).then(|| steering(p, s, u));
     let mut x = *s;
