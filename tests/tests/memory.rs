@@ -31,5 +31,6 @@ fn ten_thousand_instantiate_free_cycles_do_not_grow_memory() {
         cycle();
     }
     let after = rss_kib();
+    eprintln!("RSS before {before} KiB, after 10,000 cycles {after} KiB");
     assert!(after <= before + 1024, "RSS grew from {before} KiB to {after} KiB");
 }
