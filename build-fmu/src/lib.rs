@@ -20,8 +20,6 @@ pub struct FmuTarget {
     pub description: fn() -> &'static ModelDescription,
     /// Generated `documentation/index.html`.
     pub documentation: fn() -> String,
-    /// A few lines on the equations, for the documentation.
-    pub equations: &'static str,
 }
 
 fn description_of<M: Model>() -> &'static ModelDescription {
@@ -35,7 +33,6 @@ pub fn targets() -> Vec<FmuTarget> {
         model_identifier: nigel_plant::MODEL_IDENTIFIER,
         description: description_of::<nigel_plant::Plant>,
         documentation: || documentation(nigel_plant::Plant::declaration(), PLANT_EQUATIONS),
-        equations: PLANT_EQUATIONS,
     }]
 }
 

@@ -52,6 +52,15 @@ pub struct Instance<M: Model> {
     pub model: M,
 }
 
+/// The states from `fmi2EnterInitializationMode` on, short of the error state.
+const INITIALIZING_OR_LATER: [Machine; 5] = [
+    Machine::InitializationMode,
+    Machine::StepComplete,
+    Machine::EventMode,
+    Machine::ContinuousTimeMode,
+    Machine::Terminated,
+];
+
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
 const SERIAL_VERSION: u32 = 1;
 
@@ -175,17 +184,11 @@ impl<M: Model> Instance<M> {
     }
 
     fn check_get(&self) -> OpResult {
-        self.require(
-            &[
-                Machine::InitializationMode,
-                Machine::StepComplete,
-                Machine::EventMode,
-                Machine::ContinuousTimeMode,
-                Machine::Terminated,
-                Machine::Error,
-            ],
-            "getting values",
-        )
+        // values can be read once initialization has started, and in the error state for diagnosis
+        if self.machine == Machine::Error {
+            return Ok(());
+        }
+        self.require(&INITIALIZING_OR_LATER, "getting values")
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
@@ -430,16 +433,7 @@ impl<M: Model> Instance<M> {
         dv_known: &[f64],
         out: &mut [f64],
     ) -> OpResult {
-        self.require(
-            &[
-                Machine::InitializationMode,
-                Machine::StepComplete,
-                Machine::EventMode,
-                Machine::ContinuousTimeMode,
-                Machine::Terminated,
-            ],
-            "fmi2GetDirectionalDerivative",
-        )?;
+        self.require(&INITIALIZING_OR_LATER, "fmi2GetDirectionalDerivative")?;
         if let Some(x) = dv_known.iter().find(|x| !x.is_finite()) {
             return Err(format!("dvKnown contains {x}"));
         }
