@@ -569,6 +569,8 @@ impl Model for Plant {
             mu: u.mu.map(Dual::constant),
             wind_head: Dual::constant(u.wind_head),
             wind_side: Dual::constant(u.wind_side),
+            wind_x: Dual::constant(u.wind_x),
+            wind_y: Dual::constant(u.wind_y),
         };
         for (&k, &dv) in knowns.iter().zip(dv_known) {
             match k {

@@ -37,13 +37,27 @@ pub struct Inputs<T> {
     pub wind_head: T,
     /// Side wind force [N], positive toward body +y, at the geometric centre.
     pub wind_side: T,
+    /// Wind force along world +X [N], at the geometric centre. Rotated into the body frame
+    /// with the instantaneous heading inside the right-hand side (every RK4 stage), and
+    /// added to `wind_head` / `wind_side`.
+    pub wind_x: T,
+    /// Wind force along world +Y [N], at the geometric centre (see `wind_x`).
+    pub wind_y: T,
 }
 
 impl<T: Scalar> Inputs<T> {
     /// Zero steer, zero torque, no wind, `mu_i = mu`.
     pub fn coasting(mu: f64) -> Self {
         let z = T::constant(0.0);
-        Inputs { delta: [z; 4], tau: [z; 4], mu: [T::constant(mu); 4], wind_head: z, wind_side: z }
+        Inputs {
+            delta: [z; 4],
+            tau: [z; 4],
+            mu: [T::constant(mu); 4],
+            wind_head: z,
+            wind_side: z,
+            wind_x: z,
+            wind_y: z,
+        }
     }
 }
 
@@ -166,13 +180,16 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
         force_lat[i] = f_lat;
         force_drive[i] = f_drive;
     }
-    mz = mz + u.wind_side * p.x_c();
-    let lateral_force = fy_sum + u.wind_side;
     let (sp, cp) = (psi.sin(), psi.cos());
+    // world-frame wind (wind_x, wind_y) in body axes: forward = x cos + y sin, left = -x sin + y cos
+    let wind_head = u.wind_head - (u.wind_x * cp + u.wind_y * sp);
+    let wind_side = u.wind_side + (u.wind_y * cp - u.wind_x * sp);
+    mz = mz + wind_side * p.x_c();
+    let lateral_force = fy_sum + wind_side;
     der[idx::X] = v_x * cp - v_y * sp;
     der[idx::Y] = v_x * sp + v_y * cp;
     der[idx::PSI] = r;
-    der[idx::V_X] = (fx_sum - u.wind_head) / p.m + r * v_y;
+    der[idx::V_X] = (fx_sum - wind_head) / p.m + r * v_y;
     der[idx::V_Y] = lateral_force / p.m - r * v_x;
     der[idx::YAW_RATE] = mz / p.i_z;
     Core { derivatives: der, lateral_force, slip_angle, force_lat, force_drive }

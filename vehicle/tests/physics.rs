@@ -225,3 +225,41 @@ fn a_car_coasting_to_rest_ends_exactly_at_rest_not_in_subnormals() {
     }
     assert!(s.iter().all(|x| x.is_normal() || *x == 0.0), "no subnormal states: {s:?}");
 }
+
+/// World-frame wind is the body-frame wind rotated with the instantaneous heading, at every
+/// evaluation (so at every RK4 stage): a car turning in place with constant world wind.
+#[test]
+fn world_frame_wind_is_rotated_at_every_stage() {
+    use nigel_vehicle::dynamics::{derivatives_of, idx, rk4_step, Inputs, N_STATES};
+    use nigel_vehicle::VehicleParams;
+    let p = VehicleParams::table2();
+    let (fx, fy) = (0.3, -0.2);
+    let mut s = [0.0; N_STATES];
+    s[idx::V_X] = 0.2;
+    s[idx::YAW_RATE] = 2.0;
+    for psi in [0.0, 0.7, 2.5, -1.9] {
+        s[idx::PSI] = psi;
+        let mut world = Inputs::<f64>::coasting(0.5);
+        world.delta = [0.3, 0.3, -0.3, -0.3];
+        world.wind_x = fx;
+        world.wind_y = fy;
+        let mut body = world;
+        body.wind_x = 0.0;
+        body.wind_y = 0.0;
+        body.wind_head = -(fx * psi.cos() + fy * psi.sin());
+        body.wind_side = -fx * psi.sin() + fy * psi.cos();
+        let (a, b) = (derivatives_of(&p, &s, &world), derivatives_of(&p, &s, &body));
+        for j in 0..N_STATES {
+            assert!((a[j] - b[j]).abs() <= 1e-15 * (1.0 + b[j].abs()), "psi {psi}, state {j}: {} vs {}", a[j], b[j]);
+        }
+    }
+    // An RK4 step with world wind is not a step with the wind frozen at the initial heading:
+    // the heading moves by r h = 0.2 rad over the step.
+    s[idx::PSI] = 0.0;
+    let mut world = Inputs::<f64>::coasting(0.5);
+    world.wind_y = 1.0;
+    let mut frozen = Inputs::<f64>::coasting(0.5);
+    frozen.wind_side = 1.0;
+    let (a, b) = (rk4_step(&p, &s, &world, 0.1), rk4_step(&p, &s, &frozen, 0.1));
+    assert!((a[idx::V_X] - b[idx::V_X]).abs() > 1e-4, "{} vs {}", a[idx::V_X], b[idx::V_X]);
+}
