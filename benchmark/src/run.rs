@@ -295,3 +295,124 @@ impl Benchmark {
         Ok(ClosedLoopRun { controller, trajectory, metric })
     }
 }
+
+/// Everything the test bench puts out at sample `k` (held over `[t_k, t_k+1)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchSample {
+    /// Feed-forward steering, the program [rad], FL, FR, RL, RR.
+    pub delta_ff: [f64; 4],
+    /// Reference body slip angle [rad].
+    pub beta_ref: f64,
+    /// Reference yaw rate [rad/s].
+    pub yaw_rate_ref: f64,
+    /// Speed to hold [m/s].
+    pub speed_ref: f64,
+    /// Reference pose: world X [m].
+    pub x_ref: f64,
+    /// Reference pose: world Y [m].
+    pub y_ref: f64,
+    /// Reference pose: heading, unwrapped [rad].
+    pub psi_ref: f64,
+    /// Road friction per wheel [-].
+    pub mu: [f64; 4],
+    /// Wind along world X [N] (always 0 in maneuvers.md).
+    pub wind_x: f64,
+    /// Wind along world Y [N].
+    pub wind_y: f64,
+    /// What the controller measures: beta [rad].
+    pub beta_meas: f64,
+    /// What the controller measures: yaw rate [rad/s].
+    pub yaw_rate_meas: f64,
+}
+
+impl Benchmark {
+    /// Number of samples the reference covers: outputs exist for `k = 0 ..= n_samples`.
+    pub fn horizon(&self) -> usize {
+        self.reference.trajectory.n_samples()
+    }
+
+    /// The test bench at sample `k` given the plant's true `beta` and `yaw_rate` there;
+    /// `None` beyond the reference ([`Benchmark::horizon`]).
+    pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
+        let r = &self.reference.trajectory;
+        if k > self.horizon() {
+            return None;
+        }
+        let d = self.scenario.disturbances();
+        let (beta_meas, yaw_rate_meas) = d.measure(k, beta, yaw_rate);
+        Some(BenchSample {
+            delta_ff: self.reference.program.steering(k),
+            beta_ref: r.beta[k],
+            yaw_rate_ref: r.yaw_rate[k],
+            speed_ref: self.scenario.speed_ref,
+            x_ref: r.x[k],
+            y_ref: r.y[k],
+            psi_ref: r.psi[k],
+            mu: d.friction(k),
+            wind_x: 0.0,
+            wind_y: d.wind_y(k),
+            beta_meas,
+            yaw_rate_meas,
+        })
+    }
+}
+
+/// One cell of Table III.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableCell {
+    /// The column.
+    pub fidelity: Fidelity,
+    /// The row.
+    pub maneuver: Maneuver,
+    /// The controller.
+    pub controller: Controller,
+    /// `epsilon` and the rest.
+    pub metric: Metric,
+}
+
+/// Table III of maneuvers.md for one seed: every fidelity, maneuver and controller of
+/// `controllers` (the figure-8 table computed once), on up to `threads` threads (0 = all
+/// cores). Cells come in the order fidelity, maneuver, controller.
+pub fn table3(seed: u64, controllers: &[Controller], threads: usize) -> Result<Vec<TableCell>, SettingError> {
+    let scenario = |fidelity, maneuver| Scenario { seed, ..Scenario::new(maneuver, fidelity) };
+    scenario(Fidelity::Paper, Maneuver::Straight).validate()?;
+    let switches = figure8_switches(crate::DEFAULT_STEER_AMPLITUDE, crate::DEFAULT_SPEED, crate::N_SAMPLES)?;
+    let jobs: Vec<(Fidelity, Maneuver)> =
+        Fidelity::ALL.iter().flat_map(|&f| Maneuver::ALL.iter().map(move |&m| (f, m))).collect();
+    let work = |&(fidelity, maneuver): &(Fidelity, Maneuver)| -> Result<Vec<TableCell>, SettingError> {
+        let sw = if maneuver == Maneuver::Figure8 { switches.clone() } else { Vec::new() };
+        let bench = Benchmark::prepare_with_switches(scenario(fidelity, maneuver), sw)?;
+        controllers
+            .iter()
+            .map(|&controller| Ok(TableCell { fidelity, maneuver, controller, metric: bench.run(controller)?.metric }))
+            .collect()
+    };
+    let threads = match threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        t => t,
+    }
+    .clamp(1, jobs.len());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let slots: Vec<std::sync::Mutex<Option<Result<Vec<TableCell>, SettingError>>>> =
+        jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                let Some(job) = jobs.get(i) else { break };
+                let result = work(job);
+                if let Ok(mut slot) = slots[i].lock() {
+                    *slot = Some(result);
+                }
+            });
+        }
+    });
+    let mut cells = Vec::with_capacity(jobs.len() * controllers.len());
+    for slot in slots {
+        let result = slot.into_inner().ok().flatten().unwrap_or_else(|| {
+            Err(SettingError { name: "table3", value: f64::NAN, reason: "a worker thread did not finish" })
+        });
+        cells.extend(result?);
+    }
+    Ok(cells)
+}

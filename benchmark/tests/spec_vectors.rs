@@ -159,3 +159,24 @@ fn bad_scenarios_are_refused_naming_the_value() {
     k[1][0] = f64::INFINITY;
     assert_eq!(bench.run(Controller::Custom(k)).unwrap_err().name, "k_beta_fr");
 }
+
+#[test]
+fn test_bench_sample_is_the_reference_the_program_and_the_disturbances() {
+    let mut s = Scenario::new(Maneuver::LaneChange, Fidelity::Real);
+    s.n_samples = 15_100;
+    let bench = Benchmark::prepare(s).unwrap();
+    assert_eq!(bench.horizon(), 15_100);
+    let t = &bench.reference.trajectory;
+    let k = 15_050;
+    let o = bench.sample(k, 0.01, -0.02).unwrap();
+    let d = s.disturbances();
+    let a = PI / 6.0;
+    assert_eq!(o.delta_ff, [-a, -a, a, a]);
+    assert_eq!((o.beta_ref, o.yaw_rate_ref, o.speed_ref), (t.beta[k], t.yaw_rate[k], 0.35));
+    assert_eq!((o.x_ref, o.y_ref, o.psi_ref), (t.x[k], t.y[k], t.psi[k]));
+    assert_eq!((o.mu, o.wind_x, o.wind_y), (d.friction(k), 0.0, d.wind_y(k)));
+    assert_eq!((o.beta_meas, o.yaw_rate_meas), d.measure(k, 0.01, -0.02));
+    assert!(o.beta_meas != 0.01, "real fidelity measures with noise");
+    assert!(bench.sample(15_100, 0.0, 0.0).is_some());
+    assert!(bench.sample(15_101, 0.0, 0.0).is_none(), "no reference beyond the horizon");
+}
