@@ -393,8 +393,8 @@ pub fn table3(seed: u64, controllers: &[Controller], threads: usize) -> Result<V
     }
     .clamp(1, jobs.len());
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let slots: Vec<std::sync::Mutex<Option<Result<Vec<TableCell>, SettingError>>>> =
-        jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    type Slot = std::sync::Mutex<Option<Result<Vec<TableCell>, SettingError>>>;
+    let slots: Vec<Slot> = jobs.iter().map(|_| std::sync::Mutex::new(None)).collect();
     std::thread::scope(|s| {
         for _ in 0..threads {
             s.spawn(|| loop {
@@ -409,9 +409,8 @@ pub fn table3(seed: u64, controllers: &[Controller], threads: usize) -> Result<V
     });
     let mut cells = Vec::with_capacity(jobs.len() * controllers.len());
     for slot in slots {
-        let result = slot.into_inner().ok().flatten().unwrap_or_else(|| {
-            Err(SettingError { name: "table3", value: f64::NAN, reason: "a worker thread did not finish" })
-        });
+        let unfinished = SettingError { name: "table3", value: f64::NAN, reason: "a worker thread did not finish" };
+        let result = slot.into_inner().ok().flatten().unwrap_or(Err(unfinished));
         cells.extend(result?);
     }
     Ok(cells)
