@@ -331,6 +331,30 @@ impl Benchmark {
         self.reference.trajectory.n_samples()
     }
 
+    /// The test bench at sample 0 without computing anything: the reference starts at the
+    /// origin, heading +X, at `speed_ref` (so `beta_ref = r_ref = 0`), and every program's
+    /// first sample is known (the figure-8 starts with front +a). Equal to
+    /// `Benchmark::prepare(scenario)?.sample(0, beta, yaw_rate)`.
+    pub fn initial_sample(scenario: &Scenario, beta: f64, yaw_rate: f64) -> BenchSample {
+        let program = Program::new(scenario.maneuver, scenario.steer_amplitude, Vec::new());
+        let d = scenario.disturbances();
+        let (beta_meas, yaw_rate_meas) = d.measure(0, beta, yaw_rate);
+        BenchSample {
+            delta_ff: program.steering(0),
+            beta_ref: 0.0,
+            yaw_rate_ref: 0.0,
+            speed_ref: scenario.speed_ref,
+            x_ref: 0.0,
+            y_ref: 0.0,
+            psi_ref: 0.0,
+            mu: d.friction(0),
+            wind_x: 0.0,
+            wind_y: d.wind_y(0),
+            beta_meas,
+            yaw_rate_meas,
+        }
+    }
+
     /// The test bench at sample `k` given the plant's true `beta` and `yaw_rate` there;
     /// `None` beyond the reference ([`Benchmark::horizon`]).
     pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {

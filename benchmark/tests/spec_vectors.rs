@@ -180,3 +180,20 @@ fn test_bench_sample_is_the_reference_the_program_and_the_disturbances() {
     assert!(bench.sample(15_100, 0.0, 0.0).is_some());
     assert!(bench.sample(15_101, 0.0, 0.0).is_none(), "no reference beyond the horizon");
 }
+
+#[test]
+fn initial_sample_needs_no_reference_and_equals_sample_zero() {
+    for m in Maneuver::ALL {
+        for f in Fidelity::ALL {
+            let mut s = Scenario::new(m, f);
+            s.n_samples = 20;
+            s.steer_amplitude = 0.3;
+            let bench = if m == Maneuver::Figure8 {
+                Benchmark::prepare_with_switches(s, vec![10]).unwrap()
+            } else {
+                Benchmark::prepare(s).unwrap()
+            };
+            assert_eq!(Benchmark::initial_sample(&s, 0.01, 0.02), bench.sample(0, 0.01, 0.02).unwrap(), "{m} {f:?}");
+        }
+    }
+}
