@@ -448,8 +448,14 @@ impl<M: Model> Instance<M> {
             return err(format!("time {time} is not finite"));
         }
         if let Some(stop) = self.core.stop_time {
+            // Variable-step integrators (CVode in fmpy, say) evaluate the right-hand side
+            // past the output time and interpolate back, so a time past stopTime is not an
+            // error in Model Exchange; it is a warning (fmi2Warning, logged). A
+            // Co-Simulation step past stopTime is an error.
             if time > stop + time_eps(stop) {
-                return err(format!("time {time} is after the stopTime {stop} of fmi2SetupExperiment"));
+                self.context
+                    .logger
+                    .warning(&format!("fmi2SetTime: time {time} is after the stopTime {stop} of fmi2SetupExperiment"));
             }
         }
         self.core.time = time;

@@ -343,12 +343,14 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         ),
     ];
     for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
-        v.push(
-            real(name, vr::PARAM + k as u32, PlantVar::Param(p))
-                .parameter(Start::Real(start))
-                .unit(unit)
-                .describe(text),
-        );
+        let mut var = real(name, vr::PARAM + k as u32, PlantVar::Param(p))
+            .parameter(Start::Real(start))
+            .unit(unit)
+            .describe(text);
+        if p == Param::SteerLimit {
+            var = var.max(std::f64::consts::FRAC_PI_2);
+        }
+        v.push(var);
     }
     let switches = [
         (
