@@ -52,7 +52,11 @@ impl FmuTarget {
 
 /// Everything `build-fmu` builds: a new FMU is one entry here.
 pub fn targets() -> Vec<FmuTarget> {
-    vec![FmuTarget::of::<nigel_plant::Plant>("fmu-plant", PLANT_EQUATIONS)]
+    vec![
+        FmuTarget::of::<nigel_plant::Plant>("fmu-plant", PLANT_EQUATIONS),
+        FmuTarget::of::<nigel_controller::Controller>("fmu-controller", nigel_controller::DOCUMENTATION),
+        FmuTarget::of::<nigel_maneuver::TestBench>("fmu-maneuver", nigel_maneuver::DOCUMENTATION),
+    ]
 }
 
 /// `manifest.json` written next to the archives (and printed by `build-fmu --list`): one

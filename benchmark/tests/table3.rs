@@ -1,0 +1,72 @@
+//! Table III of maneuvers.md against the self-check table of an independent implementation
+//! (seed 0, epsilon): agreement to 1e-4 relative in the sim column and 1e-3 in the real one.
+
+use nigel_benchmark::{table3, Benchmark, Controller, Fidelity, Maneuver, Scenario};
+
+/// `(column, maneuver, open_loop, robust)` from the independent implementation.
+const SELF_CHECK: [(Fidelity, Maneuver, f64, f64); 12] = [
+    (Fidelity::Paper, Maneuver::Straight, 0.0205799, 0.0238091),
+    (Fidelity::Paper, Maneuver::LaneChange, 0.0593189, 0.0420524),
+    (Fidelity::Paper, Maneuver::Skidpad, 0.791631, 0.325539),
+    (Fidelity::Paper, Maneuver::Fishhook, 0.292381, 0.114311),
+    (Fidelity::Paper, Maneuver::Slalom, 1.12056, 0.509415),
+    (Fidelity::Paper, Maneuver::Figure8, 0.617197, 0.262837),
+    (Fidelity::Real, Maneuver::Straight, 0.0205799, 0.0198954),
+    (Fidelity::Real, Maneuver::LaneChange, 0.0298599, 0.0184275),
+    (Fidelity::Real, Maneuver::Skidpad, 0.874354, 0.463698),
+    (Fidelity::Real, Maneuver::Fishhook, 0.290312, 0.135593),
+    (Fidelity::Real, Maneuver::Slalom, 0.970792, 0.500319),
+    (Fidelity::Real, Maneuver::Figure8, 0.650735, 0.42491),
+];
+
+#[test]
+fn table3_epsilon_matches_the_independent_implementation() {
+    let cells = table3(0, &Controller::TABLE, 0).unwrap();
+    assert_eq!(cells.len(), 36);
+    let epsilon = |f: Fidelity, m: Maneuver, c: Controller| {
+        let cell = cells.iter().find(|x| x.fidelity == f && x.maneuver == m && x.controller == c).unwrap();
+        cell.metric.epsilon
+    };
+    let results: Vec<(Fidelity, Maneuver, f64, f64, f64, f64)> = SELF_CHECK
+        .iter()
+        .map(|&(f, m, ol, rb)| (f, m, epsilon(f, m, Controller::OpenLoop), ol, epsilon(f, m, Controller::Robust), rb))
+        .collect();
+    for c in &cells {
+        if c.controller == Controller::PolePlacement {
+            eprintln!("{:>4} {:>12}  pole_placement {:.7}", c.fidelity.column(), c.maneuver.name(), c.metric.epsilon);
+        }
+    }
+    let mut failures = Vec::new();
+    for (fidelity, maneuver, ol, ol_expect, rb, rb_expect) in results {
+        // The brief expects 1e-4 (sim) and 1e-3 (real); the table prints 6 significant
+        // digits and this implementation agrees to within their rounding (<= 4.4e-6), so the
+        // test holds it to 1e-5: a definition that differs anywhere shows up here.
+        let tol = match fidelity {
+            Fidelity::Paper => 1e-5,
+            Fidelity::Real => 1e-5,
+        };
+        let rel_ol = (ol - ol_expect).abs() / ol_expect;
+        let rel_rb = (rb - rb_expect).abs() / rb_expect;
+        eprintln!(
+            "{:>4} {:>12}  open_loop {ol:.7} ({rel_ol:.1e})  robust {rb:.7} ({rel_rb:.1e})",
+            fidelity.column(),
+            maneuver.name()
+        );
+        if rel_ol > tol || rel_rb > tol {
+            failures.push(format!("{} {}: {ol} vs {ol_expect}, {rb} vs {rb_expect}", fidelity.column(), maneuver));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn table3_cells_equal_single_runs() {
+    // the threaded table is the same computation as a plain run, bit for bit
+    let cells = table3(3, &[Controller::Robust], 2).unwrap();
+    let cell = cells.iter().find(|c| c.fidelity == Fidelity::Real && c.maneuver == Maneuver::Slalom).unwrap();
+    let bench = Benchmark::prepare(Scenario { seed: 3, ..Scenario::new(Maneuver::Slalom, Fidelity::Real) }).unwrap();
+    assert_eq!(bench.run(Controller::Robust).unwrap().metric, cell.metric);
+    // and another seed gives another number
+    let seed0 = Benchmark::prepare(Scenario::new(Maneuver::Slalom, Fidelity::Real)).unwrap();
+    assert!((seed0.run(Controller::Robust).unwrap().metric.epsilon - cell.metric.epsilon).abs() > 1e-6);
+}

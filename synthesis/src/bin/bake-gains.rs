@@ -1,0 +1,103 @@
+//! `bake-gains`: runs the robust synthesis and writes the gains the controller FMU and the
+//! benchmark use into `benchmark/src/gains.rs` (generated Rust source, committed).
+//!
+//! ```sh
+//! cargo run --release -p nigel-synthesis --bin bake-gains            # rewrite benchmark/src/gains.rs
+//! cargo run --release -p nigel-synthesis --bin bake-gains -- OUT.rs  # write elsewhere
+//! ```
+//! Baked: the robust gain (paper variant, 4WD4WS, the Pareto point nearest the origin)
+//! and the pole-placement baseline (`Re(s) < -2` at `mu_i = 0.4`, same polytope). The test
+//! `synthesis/tests/baked_gains.rs` re-runs the synthesis and fails if the committed file
+//! differs from it by more than 1e-9, so the file cannot drift from the synthesis.
+//!
+//! Exit codes: 0 written, 1 synthesis failed, 2 bad command line or I/O error.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use nalgebra::DMatrix;
+use nigel_synthesis::{
+    pareto_sweep, pole_placement_baseline, Architecture, PlantSpec, PoleRegion, SweepOptions, SynthesisOptions,
+};
+
+fn rows(k: &DMatrix<f64>) -> Result<[[f64; 2]; 4], String> {
+    if k.shape() != (4, 2) {
+        return Err(format!("gain has shape {:?}, expected 4x2", k.shape()));
+    }
+    Ok([[k[(0, 0)], k[(0, 1)]], [k[(1, 0)], k[(1, 1)]], [k[(2, 0)], k[(2, 1)]], [k[(3, 0)], k[(3, 1)]]])
+}
+
+fn matrix_literal(k: &[[f64; 2]; 4]) -> String {
+    // `{:?}` prints the shortest decimal that reads back to the same f64 (round trip exact)
+    let wheel = ["FL", "FR", "RL", "RR"];
+    let mut s = String::from("[\n");
+    for (row, name) in k.iter().zip(wheel) {
+        s.push_str(&format!("    [{:?}, {:?}], // {name}\n", row[0], row[1]));
+    }
+    s.push(']');
+    s
+}
+
+fn generate() -> Result<String, String> {
+    let spec = PlantSpec::paper(Architecture::FourWheelSteering);
+    let poly = spec.polytope().map_err(|e| e.to_string())?;
+    let opts = SynthesisOptions::default();
+    let sweep = pareto_sweep(&poly, &PoleRegion::paper(), &SweepOptions::default(), &opts, None)
+        .map_err(|e| format!("Pareto sweep: {e}"))?;
+    let chosen = sweep.chosen_point();
+    let design = sweep.chosen_design().ok_or("the chosen Pareto point has no design")?;
+    let robust = rows(&design.gain)?;
+    let baseline = pole_placement_baseline(&poly, 0.4, -2.0, &opts).map_err(|e| format!("baseline: {e}"))?;
+    let pole = rows(&baseline.design.gain)?;
+    let nu = chosen.nu().unwrap_or(f64::NAN);
+    Ok(format!(
+        "//! Controller gains baked from the robust synthesis. GENERATED, do not edit: regenerate with\n\
+         //! `cargo run --release -p nigel-synthesis --bin bake-gains`\n\
+         //! (`synthesis/tests/baked_gains.rs` fails when this file and a fresh synthesis differ by more\n\
+         //! than 1e-9).\n\
+         //!\n\
+         //! Convention: `delta = delta_ff + K (x - x_ref)`, `x = [beta, yaw_rate]`, rows FL, FR, RL, RR.\n\n\
+         /// Robust mixed H2/H-inf gain: paper variant (printed `d2`, `l_r = 0.07924`), 4WD4WS, the Pareto\n\
+         /// point nearest the origin: k = {k}, H-inf bound g = {g:?},\n\
+         /// H2 bound nu = {nu:?} (gamma* = {gs:?}).\n\
+         pub const ROBUST: [[f64; 2]; 4] = {robust};\n\n\
+         /// Non-robust baseline: pole placement `Re(s) < {alpha:?}` on the nominal model `mu_i = {mu:?}` (same\n\
+         /// plant as `ROBUST`); stabilises all 16 friction vertices: {stab}\n\
+         /// (largest closed-loop real part over them {re:?}).\n\
+         pub const POLE_PLACEMENT: [[f64; 2]; 4] = {pole};\n",
+        k = chosen.k,
+        g = chosen.g,
+        gs = sweep.gamma_star(),
+        robust = matrix_literal(&robust),
+        alpha = baseline.alpha,
+        mu = baseline.mu_nominal,
+        stab = baseline.stabilises_all_vertices,
+        re = baseline.max_real_part_over_vertices,
+        pole = matrix_literal(&pole),
+    ))
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "-h" || a == "--help") || args.len() > 1 {
+        eprintln!("usage: bake-gains [OUT.rs]   (default: benchmark/src/gains.rs of this workspace)");
+        return ExitCode::from(if args.len() > 1 { 2 } else { 0 });
+    }
+    let out = match args.first() {
+        Some(p) => PathBuf::from(p),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../benchmark/src/gains.rs"),
+    };
+    let text = match generate() {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("bake-gains: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    if let Err(e) = std::fs::write(&out, text) {
+        eprintln!("bake-gains: cannot write {}: {e}", out.display());
+        return ExitCode::from(2);
+    }
+    eprintln!("bake-gains: wrote {}", out.display());
+    ExitCode::SUCCESS
+}
