@@ -125,7 +125,7 @@ pub struct InstanceSpec {
 }
 
 /// A system: instances and checked connections. Build it with [`SystemBuilder`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct System {
     /// Instances, in the order they were added.
     pub instances: Vec<InstanceSpec>,
@@ -140,11 +140,6 @@ pub struct SystemBuilder {
     names: HashMap<String, usize>,
 }
 
-impl Default for System {
-    fn default() -> Self {
-        System { instances: Vec::new(), connections: Vec::new() }
-    }
-}
 
 /// Splits `instance.variable` at the first `.`.
 pub fn split_name(full: &str) -> Option<(&str, &str)> {
