@@ -38,7 +38,8 @@ pub use design::{
 };
 pub use lmi::{SolveError, SolverSettings, SolverStats};
 pub use plant::{
-    Architecture, DesignModel, DisturbanceVariant, PlantError, PlantSpec, Polytope, TrackingSpec, TrackingWeights, Vertex,
+    Architecture, DesignModel, DisturbanceVariant, PlantError, PlantSpec, Polytope, TrackingSpec, TrackingWeights,
+    Vertex,
 };
 pub use region::{PoleRegion, Region, RegionError};
 pub use verify::{verify_design, ClosedLoop, VerificationReport, VerifyOptions};

@@ -13,10 +13,11 @@ use crate::design::{
 };
 use crate::lmi::SolverStats;
 use crate::plant::{Architecture, PlantSpec, TrackingSpec, TrackingWeights};
+use crate::region::{PoleRegion, Region};
 use crate::tracking::{
     design_tracking, offset_recovery, servo_loop_max_real_part, tracking_region, wind_step, ResponsePeaks,
+    TrackingDesign,
 };
-use crate::region::{PoleRegion, Region};
 use crate::verify::{verify_design, PointCheck, VerifyOptions};
 
 /// Wheel names in the order of the rows of the full 4x2 gain.
@@ -720,9 +721,18 @@ pub fn run_tracking(
 ) -> Result<TrackingReport, SynthesisError> {
     let t0 = Instant::now();
     req.region.validate()?;
-    let poly = req.spec.polytope()?;
     let d = design_tracking(&req.spec, &req.region, &req.options, &req.verify, req.threads, progress)?;
-    let design_s = t0.elapsed().as_secs_f64();
+    tracking_report(req, &d, t0.elapsed().as_secs_f64())
+}
+
+/// The report of a finished tracking design `d` made from `req` (adds the linear study);
+/// `design_s` is the wall time the design and its verification took.
+pub fn tracking_report(
+    req: &TrackingRequest,
+    d: &TrackingDesign,
+    design_s: f64,
+) -> Result<TrackingReport, SynthesisError> {
+    let poly = req.spec.polytope()?;
     let chosen_design =
         d.sweep.chosen_design().ok_or_else(|| SynthesisError::Invalid("chosen point has no design".into()))?;
     let gain = &chosen_design.gain;
@@ -786,7 +796,8 @@ pub fn run_tracking(
         region: req.region.parts.clone(),
         region_description: req.region.describe(),
         margin: req.options.margin,
-        gamma_meaning: "bound on the induced L2 gain (H-inf norm) from w = F_sw [N] to z = [q_y e_y, q_psi e_psi, r_u u], \
+        gamma_meaning:
+            "bound on the induced L2 gain (H-inf norm) from w = F_sw [N] to z = [q_y e_y, q_psi e_psi, r_u u], \
                         not squared",
         gamma_star: d.sweep.gamma_star(),
         pareto,
@@ -834,7 +845,7 @@ pub fn run_tracking(
             max_constraint_violation: max_violation,
             strict_lmis_hold: max_violation < req.options.margin,
         },
-        timings: Timings { design_s, verification_s, total_s: t0.elapsed().as_secs_f64() },
+        timings: Timings { design_s, verification_s, total_s: design_s + verification_s },
     })
 }
 
@@ -950,7 +961,10 @@ pub fn render_tracking_text(r: &TrackingReport) -> String {
     let _ = writeln!(
         s,
         "  {} m lateral offset: steering peak {:.4} rad, rate peak {:.4} rad/s, e_y after 2 s {:.5} m",
-        st.offset, st.offset_recovery.steering_peak, st.offset_recovery.steering_rate_peak, st.offset_recovery.lateral_final
+        st.offset,
+        st.offset_recovery.steering_peak,
+        st.offset_recovery.steering_rate_peak,
+        st.offset_recovery.lateral_final
     );
     let _ = writeln!(
         s,

@@ -88,13 +88,7 @@ impl ClosedLoop {
 
     /// The closed loop of plant `v` with gain `k` and performance output
     /// `z = c x + d_u u`: `C_cl = c + d_u k`.
-    pub fn with_outputs(
-        v: &Vertex,
-        bw: &DMatrix<f64>,
-        k: &DMatrix<f64>,
-        c: &DMatrix<f64>,
-        d_u: &DMatrix<f64>,
-    ) -> Self {
+    pub fn with_outputs(v: &Vertex, bw: &DMatrix<f64>, k: &DMatrix<f64>, c: &DMatrix<f64>, d_u: &DMatrix<f64>) -> Self {
         ClosedLoop { a: &v.a + &v.b * k, bw: bw.clone(), c: c + d_u * k }
     }
 

@@ -269,7 +269,9 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
     region.parts.extend(extra_regions);
     if tracking {
         if objective_given && objective != "pareto" {
-            return Err(format!("--objective {objective}: the tracking model is designed with the Pareto objective only"));
+            return Err(format!(
+                "--objective {objective}: the tracking model is designed with the Pareto objective only"
+            ));
         }
         if grid_given {
             return Err("--step/--g-max: the tracking grid is relative to gamma* (see --help)".into());
@@ -277,7 +279,8 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
         if plot.is_some() {
             return Err("--plot: not available for the tracking model yet".into());
         }
-        let weights = allowances.map_or_else(TrackingWeights::chosen, |a| TrackingWeights::from_allowances(a[0], a[1], a[2]));
+        let weights =
+            allowances.map_or_else(TrackingWeights::chosen, |a| TrackingWeights::from_allowances(a[0], a[1], a[2]));
         let req = TrackingRequest {
             spec: TrackingSpec { plant: spec, weights },
             region,
