@@ -3,7 +3,9 @@
 //!
 //! All designs are state feedback `u = K x` with one common Lyapunov matrix for every
 //! vertex of the polytope (quadratic stability), variables `X = X' > 0`, `Y = K X`, and
-//! `K = Y X^-1`. With `M_j = A_j X + B_j Y` and `Z = C X + D_u Y` (`z = [x; u]`):
+//! `K = Y X^-1`. With `M_j = A_j X + B_j Y` and `Z = C X + D_u Y` (`z = C x + D_u u`: the
+//! paper's `z = [x; u]`, or the tracking model's weighted outputs, see
+//! [`crate::plant::DesignModel`]); every problem is the same for any number of states:
 //!
 //! * D-stability, for each region part `(L, M)`: `L ⊗ X + M ⊗ M_j + M' ⊗ M_j' < 0`.
 //! * H-inf, **gamma-squared form** (as MATLAB's `msfsyn`, which the authors used):
@@ -110,9 +112,10 @@ impl From<SolveError> for SynthesisError {
 /// A state-feedback gain with what the solver certified about it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Design {
-    /// `K`, n_inputs x 2 (rows follow the steered wheels, columns `[beta, r]`).
+    /// `K`, n_inputs x n_states (rows follow the steered wheels, columns the states:
+    /// `[beta, r]` for the paper's model, see [`Polytope::state_names`]).
     pub gain: DMatrix<f64>,
-    /// The common Lyapunov matrix `X` (2x2).
+    /// The common Lyapunov matrix `X` (n_states x n_states).
     pub lyapunov: DMatrix<f64>,
     /// Certified bound on the induced L2 gain `w -> z` over the polytope, if constrained.
     pub gamma: Option<f64>,
@@ -142,7 +145,7 @@ struct Built {
 }
 
 fn check_inputs(poly: &Polytope, region: &PoleRegion, opts: &SynthesisOptions) -> Result<(), SynthesisError> {
-    poly.spec.validate()?;
+    poly.validate()?;
     region.validate()?;
     if !(opts.margin.is_finite() && opts.margin >= 0.0) {
         return Err(SynthesisError::Invalid(format!("margin {} must be finite and >= 0", opts.margin)));
@@ -514,7 +517,7 @@ pub fn pole_placement_baseline(
     alpha: f64,
     opts: &SynthesisOptions,
 ) -> Result<Baseline, SynthesisError> {
-    poly.spec.validate()?;
+    poly.validate()?;
     if !(mu_nominal.is_finite() && mu_nominal > 0.0) {
         return Err(SynthesisError::Invalid(format!("nominal friction {mu_nominal} must be finite and > 0")));
     }

@@ -12,6 +12,8 @@
 //! * [`verify`]: closed-loop poles, H-inf and H2 norms computed from `K` alone, two ways each.
 //! * [`report`]: the serialisable summary the `synthesize` CLI prints and writes.
 //! * [`plot`]: the SVG figure (Pareto curve and pole map).
+//! * [`tracking`]: the robust path-tracking design (issue 9) on the 4-state tracking error
+//!   model of [`nigel_vehicle::tracking`], and its linear closed-loop study.
 //!
 //! Conventions: `gamma` is always the bound on the induced L2 gain (not its square);
 //! `nu` bounds the H2 norm; strict LMIs carry the margin [`design::DEFAULT_MARGIN`].
@@ -27,6 +29,7 @@ pub mod plant;
 pub mod plot;
 pub mod region;
 pub mod report;
+pub mod tracking;
 pub mod verify;
 
 pub use design::{
@@ -34,6 +37,9 @@ pub use design::{
     SweepOptions, SweepProgress, SynthesisError, SynthesisOptions, DEFAULT_MARGIN,
 };
 pub use lmi::{SolveError, SolverSettings, SolverStats};
-pub use plant::{Architecture, DisturbanceVariant, PlantError, PlantSpec, Polytope, Vertex};
+pub use plant::{
+    Architecture, DesignModel, DisturbanceVariant, PlantError, PlantSpec, Polytope, TrackingSpec, TrackingWeights,
+    Vertex,
+};
 pub use region::{PoleRegion, Region, RegionError};
 pub use verify::{verify_design, ClosedLoop, VerificationReport, VerifyOptions};

@@ -8,7 +8,7 @@
 use std::fmt;
 
 use nalgebra::DMatrix;
-use nigel_vehicle::{linear_model, DisturbanceColumn, VehicleParams};
+use nigel_vehicle::{linear_model, tracking_model, DisturbanceColumn, VehicleParams};
 use serde::Serialize;
 
 /// Which wheels steer.
@@ -156,7 +156,12 @@ impl PlantSpec {
         }
         let lm = linear_model(&self.params, [self.mu_min; 4], self.speed);
         let d = lm.disturbance(self.disturbance.column());
-        Ok(Polytope { spec: *self, vertices, bw: DMatrix::from_column_slice(2, 1, d.as_slice()) })
+        Ok(Polytope {
+            spec: *self,
+            vertices,
+            bw: DMatrix::from_column_slice(2, 1, d.as_slice()),
+            model: DesignModel::SideslipYawRate,
+        })
     }
 
     fn vertex_at(&self, mu: [f64; 4]) -> Vertex {
@@ -169,6 +174,146 @@ impl PlantSpec {
             b[(1, col)] = lm.b[(1, w)];
         }
         Vertex { mu, a, b }
+    }
+
+    fn tracking_vertex_at(&self, mu: [f64; 4]) -> Vertex {
+        let tm = tracking_model(&self.params, mu, self.speed, self.disturbance.column());
+        let a = DMatrix::from_iterator(4, 4, tm.a.iter().copied());
+        let wheels = self.architecture.steered_wheels();
+        let b = DMatrix::from_fn(4, wheels.len(), |i, col| tm.b[(i, wheels[col])]);
+        Vertex { mu, a, b }
+    }
+}
+
+/// Performance-output weights of the tracking design: `z = [q_y e_y; q_psi e_psi; r_u u]`.
+///
+/// Each weight is the reciprocal of the size of its quantity that is "as bad as" the
+/// others (Bryson's rule): `lateral = 1 / e_y` [1/m], `heading = 1 / e_psi` [1/rad],
+/// `steering = 1 / delta` [1/rad]. `gamma` and `nu` are then in units of these normalised
+/// outputs per newton of lateral force.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TrackingWeights {
+    /// `q_y` [1/m], weight of the lateral error `e_y`.
+    pub lateral: f64,
+    /// `q_psi` [1/rad], weight of the heading error `e_psi`.
+    pub heading: f64,
+    /// `r_u` [1/rad], weight of every steering correction `u_i`.
+    pub steering: f64,
+}
+
+impl TrackingWeights {
+    /// The weights chosen from the study in `synthesis/examples/tracking_study.rs`
+    /// (see [`crate::tracking`] for the reasoning): 2 cm of lateral error, 0.1 rad of
+    /// heading error and 0.1 rad of steering correction are equally bad.
+    pub fn chosen() -> Self {
+        Self::from_allowances(0.02, 0.1, 0.1)
+    }
+
+    /// The weights `1 / allowance` from the allowed lateral error [m], heading error [rad]
+    /// and steering correction [rad].
+    pub fn from_allowances(lateral: f64, heading: f64, steering: f64) -> Self {
+        TrackingWeights { lateral: 1.0 / lateral, heading: 1.0 / heading, steering: 1.0 / steering }
+    }
+
+    /// Refuses NaN, infinite and negative weights, and a zero steering weight (without
+    /// it the H2/H-inf problems have no reason to keep the gain finite).
+    pub fn validate(&self) -> Result<(), PlantError> {
+        for (name, value) in [("lateral weight", self.lateral), ("heading weight", self.heading)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(PlantError::Invalid { name, value, reason: "must be finite and >= 0" });
+            }
+        }
+        if !(self.steering.is_finite() && self.steering > 0.0) {
+            return Err(PlantError::Invalid {
+                name: "steering weight",
+                value: self.steering,
+                reason: "must be finite and > 0",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Which linear model a [`Polytope`] holds: its states and its performance outputs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum DesignModel {
+    /// Eq. 2.2 of the paper: `x = [beta, r]`, `z = [x; u]` (the paper's design).
+    SideslipYawRate,
+    /// The tracking error model ([`nigel_vehicle::tracking`]):
+    /// `x = [e_y, e_psi, beta - beta_ref, r - r_ref]`, `z = [q_y e_y; q_psi e_psi; r_u u]`.
+    Tracking {
+        /// The output weights.
+        weights: TrackingWeights,
+    },
+}
+
+impl DesignModel {
+    /// Number of states.
+    pub fn n_states(&self) -> usize {
+        match self {
+            DesignModel::SideslipYawRate => 2,
+            DesignModel::Tracking { .. } => nigel_vehicle::N_TRACKING_STATES,
+        }
+    }
+    /// Names of the states (the columns of `K`).
+    pub fn state_names(&self) -> &'static [&'static str] {
+        match self {
+            DesignModel::SideslipYawRate => &["beta", "r"],
+            DesignModel::Tracking { .. } => &nigel_vehicle::TRACKING_STATE_NAMES,
+        }
+    }
+    /// Refuses invalid weights.
+    pub fn validate(&self) -> Result<(), PlantError> {
+        match self {
+            DesignModel::SideslipYawRate => Ok(()),
+            DesignModel::Tracking { weights } => weights.validate(),
+        }
+    }
+}
+
+/// The tracking design model: the plant's friction polytope, speed and disturbance column,
+/// with the tracking error states and the output weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrackingSpec {
+    /// Vehicle, architecture, disturbance column, speed and friction box.
+    pub plant: PlantSpec,
+    /// Performance-output weights.
+    pub weights: TrackingWeights,
+}
+
+impl TrackingSpec {
+    /// The tracking design: Table II with the physical disturbance column
+    /// (`d2 = x_c / I_z`), four-wheel steering, `v = 0.35 m/s`, `mu in [0.1, 1.0]`, and the
+    /// [`TrackingWeights::chosen`] weights.
+    pub fn default_design() -> Self {
+        TrackingSpec { plant: PlantSpec::physical(Architecture::FourWheelSteering), weights: TrackingWeights::chosen() }
+    }
+
+    /// Refuses invalid plants and weights.
+    pub fn validate(&self) -> Result<(), PlantError> {
+        self.plant.validate()?;
+        self.weights.validate()
+    }
+
+    /// The 16-vertex polytope of the tracking model (validates first). Vertex order as
+    /// [`PlantSpec::polytope`].
+    pub fn polytope(&self) -> Result<Polytope, PlantError> {
+        self.validate()?;
+        let corners = self.plant.polytope()?;
+        let vertices = corners.vertices.iter().map(|v| self.plant.tracking_vertex_at(v.mu)).collect();
+        let tm = tracking_model(
+            &self.plant.params,
+            [self.plant.mu_min; 4],
+            self.plant.speed,
+            self.plant.disturbance.column(),
+        );
+        Ok(Polytope {
+            spec: self.plant,
+            vertices,
+            bw: DMatrix::from_column_slice(4, 1, tm.d.as_slice()),
+            model: DesignModel::Tracking { weights: self.weights },
+        })
     }
 }
 
@@ -204,9 +349,9 @@ impl std::error::Error for PlantError {}
 pub struct Vertex {
     /// Friction coefficients FL, FR, RL, RR.
     pub mu: [f64; 4],
-    /// `A(mu)`, 2x2.
+    /// `A(mu)`, n_states x n_states.
     pub a: DMatrix<f64>,
-    /// `B(mu)`, 2 x n_inputs (steered wheels only).
+    /// `B(mu)`, n_states x n_inputs (steered wheels only).
     pub b: DMatrix<f64>,
 }
 
@@ -218,35 +363,65 @@ pub struct Polytope {
     /// The 16 vertices; vertex `j` has `mu_i = mu_max` where bit `3 - i` of `j` is set
     /// (FL is the most significant bit), so vertex 0 is all `mu_min` and 15 all `mu_max`.
     pub vertices: Vec<Vertex>,
-    /// Disturbance input `B_w`, 2x1 (independent of mu).
+    /// Disturbance input `B_w`, n_states x 1 (independent of mu).
     pub bw: DMatrix<f64>,
+    /// Which model (states and performance outputs).
+    pub model: DesignModel,
 }
 
 impl Polytope {
-    /// Number of states (2).
+    /// Number of states (2 for the paper's model, 4 for tracking).
     pub fn n_states(&self) -> usize {
-        2
+        self.model.n_states()
     }
     /// Number of control inputs (4 or 2).
     pub fn n_inputs(&self) -> usize {
         self.spec.architecture.n_inputs()
     }
-    /// Number of performance outputs `z = [x; u]`.
+    /// Number of performance outputs: `z = [x; u]` (paper) or `[q_y e_y; q_psi e_psi; r_u u]`
+    /// (tracking).
     pub fn n_outputs(&self) -> usize {
-        self.n_states() + self.n_inputs()
+        match self.model {
+            DesignModel::SideslipYawRate => self.n_states() + self.n_inputs(),
+            DesignModel::Tracking { .. } => 2 + self.n_inputs(),
+        }
     }
-    /// `C = [I_2; 0]`, the state part of `z`.
+    /// `C`, the state part of `z`: `[I_2; 0]` (paper) or `[diag(q_y, q_psi) 0; 0]` (tracking).
     pub fn c(&self) -> DMatrix<f64> {
         let (n, nz) = (self.n_states(), self.n_outputs());
-        DMatrix::from_fn(nz, n, |i, j| if i == j { 1.0 } else { 0.0 })
+        match self.model {
+            DesignModel::SideslipYawRate => DMatrix::from_fn(nz, n, |i, j| if i == j { 1.0 } else { 0.0 }),
+            DesignModel::Tracking { weights } => {
+                let mut c = DMatrix::zeros(nz, n);
+                c[(0, 0)] = weights.lateral;
+                c[(1, 1)] = weights.heading;
+                c
+            }
+        }
     }
-    /// `D_u = [0; I_m]`, the input part of `z`.
+    /// `D_u`, the input part of `z`: `[0; I_m]` (paper) or `[0; r_u I_m]` (tracking).
     pub fn d_u(&self) -> DMatrix<f64> {
-        let (n, m, nz) = (self.n_states(), self.n_inputs(), self.n_outputs());
-        DMatrix::from_fn(nz, m, |i, j| if i == n + j { 1.0 } else { 0.0 })
+        let (m, nz) = (self.n_inputs(), self.n_outputs());
+        let (first, weight) = match self.model {
+            DesignModel::SideslipYawRate => (self.n_states(), 1.0),
+            DesignModel::Tracking { weights } => (2, weights.steering),
+        };
+        DMatrix::from_fn(nz, m, |i, j| if i == first + j { weight } else { 0.0 })
+    }
+    /// Names of the states (the columns of `K`).
+    pub fn state_names(&self) -> &'static [&'static str] {
+        self.model.state_names()
     }
     /// The plant at any friction vector (for interior points and the nominal model).
     pub fn at(&self, mu: [f64; 4]) -> Vertex {
-        self.spec.vertex_at(mu)
+        match self.model {
+            DesignModel::SideslipYawRate => self.spec.vertex_at(mu),
+            DesignModel::Tracking { .. } => self.spec.tracking_vertex_at(mu),
+        }
+    }
+    /// Refuses an invalid plant or model.
+    pub fn validate(&self) -> Result<(), PlantError> {
+        self.spec.validate()?;
+        self.model.validate()
     }
 }

@@ -12,8 +12,12 @@ use crate::design::{
     SynthesisError, SynthesisOptions,
 };
 use crate::lmi::SolverStats;
-use crate::plant::{Architecture, PlantSpec};
+use crate::plant::{Architecture, PlantSpec, TrackingSpec, TrackingWeights};
 use crate::region::{PoleRegion, Region};
+use crate::tracking::{
+    design_tracking, offset_recovery, servo_loop_max_real_part, tracking_region, wind_step, ResponsePeaks,
+    TrackingDesign,
+};
 use crate::verify::{verify_design, PointCheck, VerifyOptions};
 
 /// Wheel names in the order of the rows of the full 4x2 gain.
@@ -592,4 +596,395 @@ impl PlantReport {
     fn architecture_name(&self) -> &'static str {
         self.architecture.name()
     }
+}
+
+/// A tracking-design request (the `synthesize --model tracking` run).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackingRequest {
+    /// The tracking design model.
+    pub spec: TrackingSpec,
+    /// The pole region ([`tracking_region`] by default).
+    pub region: PoleRegion,
+    /// Margin and solver settings.
+    pub options: SynthesisOptions,
+    /// Verification settings.
+    pub verify: VerifyOptions,
+    /// Threads for the Pareto grid (0 = all cores).
+    pub threads: usize,
+}
+
+impl Default for TrackingRequest {
+    fn default() -> Self {
+        TrackingRequest {
+            spec: TrackingSpec::default_design(),
+            region: tracking_region(),
+            options: SynthesisOptions::default(),
+            verify: VerifyOptions::default(),
+            threads: 0,
+        }
+    }
+}
+
+/// The linear closed-loop figures of the tracking gain at the 16 vertices (worst case).
+#[derive(Clone, Debug, Serialize)]
+pub struct TrackingStudy {
+    /// Step of lateral force (wind) for the first figure [N].
+    pub wind_step_force: f64,
+    /// Response to that step from zero error, 10 s.
+    pub wind_step: ResponsePeaks,
+    /// Initial lateral offset of the second figure [m] (the lateral allowance).
+    pub offset: f64,
+    /// Recovery from that offset, no wind, 2 s.
+    pub offset_recovery: ResponsePeaks,
+    /// Steering servo time constant inserted for the servo check [s].
+    pub servo_time_constant: f64,
+    /// Largest real part of the closed loop with the servo inserted, over the vertices.
+    pub servo_loop_max_real_part: f64,
+}
+
+/// Everything a tracking run produced (what `synthesize --model tracking --json` writes).
+#[derive(Clone, Debug, Serialize)]
+pub struct TrackingReport {
+    /// Producer (`nigel-synthesis`).
+    pub tool: &'static str,
+    /// Crate version.
+    pub version: &'static str,
+    /// `tracking`.
+    pub model: &'static str,
+    /// `pareto`.
+    pub objective: &'static str,
+    /// The vehicle and friction box (`bw` here is `[d1, d2]`, the last two rows of `B_w`).
+    pub plant: PlantReport,
+    /// `B_w` of the tracking model, `[0, 0, d1, d2]`.
+    pub bw_tracking: [f64; 4],
+    /// The output weights `z = [q_y e_y; q_psi e_psi; r_u u]`.
+    pub weights: TrackingWeights,
+    /// How to apply `K`.
+    pub control_law: &'static str,
+    /// The sign conventions of the errors.
+    pub sign_conventions: &'static str,
+    /// The pole region (intersection of these parts).
+    pub region: Vec<Region>,
+    /// The region in words.
+    pub region_description: String,
+    /// Strictness margin `eps`.
+    pub margin: f64,
+    /// What `gamma`/`g` means.
+    pub gamma_meaning: &'static str,
+    /// `gamma*`.
+    pub gamma_star: f64,
+    /// The Pareto grid.
+    pub pareto: Vec<ParetoEntry>,
+    /// The chosen point.
+    pub chosen: ChosenPoint,
+    /// `K_track`, 4 rows (FL, FR, RL, RR) x 4 columns; rows of unsteered wheels are 0.
+    #[serde(rename = "K")]
+    pub k: [[f64; 4]; 4],
+    /// Row names of `K`.
+    #[serde(rename = "K_rows")]
+    pub k_rows: [&'static str; 4],
+    /// Column names of `K` (the states).
+    #[serde(rename = "K_columns")]
+    pub k_columns: [&'static str; 4],
+    /// The Lyapunov matrix `X` (4x4).
+    #[serde(rename = "X")]
+    pub x: Vec<Vec<f64>>,
+    /// Closed-loop poles and norms at the 16 vertices.
+    pub vertices: Vec<PointCheck>,
+    /// Certified bounds and actual worst-case norms.
+    pub actual: ActualNorms,
+    /// The independent verification.
+    pub verification: VerificationSummary,
+    /// The linear closed-loop figures.
+    pub study: TrackingStudy,
+    /// Solver totals.
+    pub solver: SolverSummary,
+    /// Wall times (`design_s` includes the verification, `verification_s` is the linear study).
+    pub timings: Timings,
+}
+
+/// The control law, as the report states it.
+pub const TRACKING_CONTROL_LAW: &str =
+    "delta = delta_ff + K e, e = [e_y, e_psi, beta - beta_ref, r - r_ref] of the car relative to the reference car \
+     (nigel_vehicle::tracking_errors), delta_ff the reference car's steering; rows FL, FR, RL, RR; rad, m, rad/s";
+
+/// The sign conventions, as the report states them.
+pub const TRACKING_SIGN_CONVENTIONS: &str =
+    "errors in the reference car's body frame (x forward, y left): e_y > 0 car left of the reference [m]; \
+     e_psi = psi - psi_ref wrapped to (-pi, pi] > 0 car turned counter-clockwise [rad]; beta = atan2(v_y, v_x); \
+     steering angles positive counter-clockwise (to the left), as the plant";
+
+/// Runs the tracking design, its verification and its linear study.
+pub fn run_tracking(
+    req: &TrackingRequest,
+    progress: Option<&(dyn Fn(SweepProgress) + Sync)>,
+) -> Result<TrackingReport, SynthesisError> {
+    let t0 = Instant::now();
+    req.region.validate()?;
+    let d = design_tracking(&req.spec, &req.region, &req.options, &req.verify, req.threads, progress)?;
+    tracking_report(req, &d, t0.elapsed().as_secs_f64())
+}
+
+/// The report of a finished tracking design `d` made from `req` (adds the linear study);
+/// `design_s` is the wall time the design and its verification took.
+pub fn tracking_report(
+    req: &TrackingRequest,
+    d: &TrackingDesign,
+    design_s: f64,
+) -> Result<TrackingReport, SynthesisError> {
+    let poly = req.spec.polytope()?;
+    let chosen_design =
+        d.sweep.chosen_design().ok_or_else(|| SynthesisError::Invalid("chosen point has no design".into()))?;
+    let gain = &chosen_design.gain;
+    let t1 = Instant::now();
+    let v = &d.verification;
+    let offset = 1.0 / req.spec.weights.lateral;
+    let study = TrackingStudy {
+        wind_step_force: 0.25,
+        wind_step: wind_step(&poly, gain, 0.25, 10.0),
+        offset,
+        offset_recovery: offset_recovery(&poly, gain, offset, 2.0),
+        servo_time_constant: req.spec.plant.params.servo_time_constant,
+        servo_loop_max_real_part: servo_loop_max_real_part(&poly, gain, req.spec.plant.params.servo_time_constant),
+    };
+    let verification_s = t1.elapsed().as_secs_f64();
+    let mut all_stats = vec![d.sweep.hinf_optimum.stats.clone()];
+    let mut pareto = Vec::new();
+    for p in &d.sweep.points {
+        let stats = p.result.as_ref().ok().map(|d| d.stats.clone());
+        if let Some(s) = &stats {
+            all_stats.push(s.clone());
+        }
+        pareto.push(ParetoEntry {
+            k: p.k,
+            g: p.g,
+            nu: p.nu(),
+            distance: p.distance(),
+            error: p.result.as_ref().err().map(|e| e.to_string()),
+            solver: stats,
+        });
+    }
+    let all: Vec<&PointCheck> = v.vertices.iter().chain(v.interior.iter()).collect();
+    let spec = &req.spec.plant;
+    let max_violation = all_stats.iter().map(|s| s.max_constraint_violation).fold(0.0, f64::max);
+    let x = &chosen_design.lyapunov;
+    Ok(TrackingReport {
+        tool: "nigel-synthesis",
+        version: env!("CARGO_PKG_VERSION"),
+        model: "tracking",
+        objective: "pareto",
+        plant: PlantReport {
+            architecture: spec.architecture,
+            d2: spec.disturbance.name(),
+            speed: spec.speed,
+            mu_min: spec.mu_min,
+            mu_max: spec.mu_max,
+            m: spec.params.m,
+            i_z: spec.params.i_z,
+            l_f: spec.params.l_f,
+            l_r: spec.params.l_r,
+            track: spec.params.track,
+            cornering_stiffness: spec.params.c,
+            bw: [poly.bw[(2, 0)], poly.bw[(3, 0)]],
+            n_vertices: poly.vertices.len(),
+            steered_wheels: spec.architecture.steered_wheels().iter().map(|&w| WHEEL_NAMES[w]).collect(),
+        },
+        bw_tracking: [poly.bw[(0, 0)], poly.bw[(1, 0)], poly.bw[(2, 0)], poly.bw[(3, 0)]],
+        weights: req.spec.weights,
+        control_law: TRACKING_CONTROL_LAW,
+        sign_conventions: TRACKING_SIGN_CONVENTIONS,
+        region: req.region.parts.clone(),
+        region_description: req.region.describe(),
+        margin: req.options.margin,
+        gamma_meaning:
+            "bound on the induced L2 gain (H-inf norm) from w = F_sw [N] to z = [q_y e_y, q_psi e_psi, r_u u], \
+                        not squared",
+        gamma_star: d.sweep.gamma_star(),
+        pareto,
+        chosen: ChosenPoint { k: Some(d.sweep.chosen_point().k), g: Some(d.gamma), nu: Some(d.nu) },
+        k: d.k_track,
+        k_rows: WHEEL_NAMES,
+        k_columns: nigel_vehicle::TRACKING_STATE_NAMES,
+        x: (0..x.nrows()).map(|i| (0..x.ncols()).map(|j| x[(i, j)]).collect()).collect(),
+        vertices: v.vertices.clone(),
+        actual: ActualNorms {
+            hinf_bound: v.gamma_bound,
+            hinf_worst: v.worst_hinf,
+            hinf_worst_sweep: all.iter().map(|p| p.hinf_sweep).fold(0.0, f64::max),
+            h2_bound: v.nu_bound,
+            h2_worst: v.worst_h2,
+            h2_worst_integrated: all.iter().map(|p| p.h2_integrated).fold(0.0, f64::max),
+            hinf_methods_rel_diff: v.hinf_methods_rel_diff,
+            h2_methods_rel_diff: v.h2_methods_rel_diff,
+        },
+        verification: VerificationSummary {
+            passed: v.passed(),
+            all_stable: v.all_stable,
+            poles_in_region: v.poles_in_region,
+            hinf_within_bound: v.hinf_within_bound,
+            h2_within_bound: v.h2_within_bound,
+            worst_region_margin: v.worst_region_margin,
+            max_real_part: v.max_real_part,
+            interior_points: v.interior.len(),
+            seed: req.verify.seed,
+        },
+        study,
+        solver: SolverSummary {
+            solver: "clarabel 0.11",
+            n_solves: all_stats.len(),
+            total_iterations: all_stats.iter().map(|s| s.iterations as u64).sum(),
+            total_solve_time_s: all_stats.iter().map(|s| s.solve_time_s).sum(),
+            statuses: {
+                let mut s: Vec<String> = all_stats.iter().map(|s| s.status.clone()).collect();
+                s.sort();
+                s.dedup();
+                s
+            },
+            gamma_star: Some(d.sweep.hinf_optimum.stats.clone()),
+            design: chosen_design.stats.clone(),
+            max_constraint_violation: max_violation,
+            strict_lmis_hold: max_violation < req.options.margin,
+        },
+        timings: Timings { design_s, verification_s, total_s: design_s + verification_s },
+    })
+}
+
+/// The readable table `synthesize --model tracking` prints.
+pub fn render_tracking_text(r: &TrackingReport) -> String {
+    let mut s = String::new();
+    let p = &r.plant;
+    let w = &r.weights;
+    let _ = writeln!(
+        s,
+        "nigel-synthesis: tracking model [e_y, e_psi, beta - beta_ref, r - r_ref], {} pareto, d2 = {} \
+         (B_w = [0, 0, {:.5}, {:.5}]), v = {} m/s, mu in [{}, {}], {} vertices",
+        p.architecture_name(),
+        p.d2,
+        r.bw_tracking[2],
+        r.bw_tracking[3],
+        p.speed,
+        p.mu_min,
+        p.mu_max,
+        p.n_vertices
+    );
+    let _ = writeln!(
+        s,
+        "weights: z = [{:.4} e_y; {:.4} e_psi; {:.4} u] (allowances {:.4} m, {:.4} rad, {:.4} rad)",
+        w.lateral,
+        w.heading,
+        w.steering,
+        1.0 / w.lateral,
+        1.0 / w.heading,
+        1.0 / w.steering
+    );
+    let _ = writeln!(s, "pole region: {}", r.region_description);
+    let _ = writeln!(s, "strictness margin eps = {:e}; gamma = {}", r.margin, r.gamma_meaning);
+    let _ = writeln!(s, "gamma* = {:.6}", r.gamma_star);
+    let _ = writeln!(s, "\n   k        g        nu   sqrt(g^2+nu^2)  iters");
+    for e in &r.pareto {
+        let mark = if Some(e.k) == r.chosen.k { "  <- chosen" } else { "" };
+        match &e.error {
+            None => {
+                let _ = writeln!(
+                    s,
+                    "  {:2}  {:.5}  {:.5}  {:.6}        {:3}{mark}",
+                    e.k,
+                    e.g,
+                    e.nu.unwrap_or(f64::NAN),
+                    e.distance.unwrap_or(f64::NAN),
+                    e.solver.as_ref().map_or(0, |s| s.iterations)
+                );
+            }
+            Some(err) => {
+                let _ = writeln!(s, "  {:2}  {:.5}  failed: {err}", e.k, e.g);
+            }
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nchosen: k = {}, g = {}, nu = {}",
+        r.chosen.k.map_or("-".to_string(), |k| k.to_string()),
+        opt(r.chosen.g, 5),
+        opt(r.chosen.nu, 5)
+    );
+    let _ = writeln!(s, "\nK_track (delta = delta_ff + K e):  e_y [rad/m]  e_psi [-]  e_beta [-]  e_r [s]");
+    for (name, row) in r.k_rows.iter().zip(&r.k) {
+        let _ = writeln!(s, "  {name}  {:>12.6} {:>12.6} {:>12.6} {:>12.6}", row[0], row[1], row[2], row[3]);
+    }
+    let _ = writeln!(s, "  signs: {}", r.sign_conventions);
+    let a = &r.actual;
+    let v = &r.verification;
+    let _ = writeln!(
+        s,
+        "\nverification (16 vertices + {} interior points, seed {:#x}): {}",
+        v.interior_points,
+        v.seed,
+        if v.passed { "PASSED" } else { "FAILED" }
+    );
+    let _ = writeln!(
+        s,
+        "  H-inf: certified bound {}, actual worst {:.6} (Hamiltonian) / {:.6} (frequency sweep), rel. diff {:.1e}{}",
+        opt(a.hinf_bound, 6),
+        a.hinf_worst,
+        a.hinf_worst_sweep,
+        a.hinf_methods_rel_diff,
+        if v.hinf_within_bound { "" } else { "  EXCEEDS BOUND" }
+    );
+    let _ = writeln!(
+        s,
+        "  H2:    certified bound {}, actual worst {:.6} (Lyapunov) / {:.6} (Gramian integration), rel. diff {:.1e}{}",
+        opt(a.h2_bound, 6),
+        a.h2_worst,
+        a.h2_worst_integrated,
+        a.h2_methods_rel_diff,
+        if v.h2_within_bound { "" } else { "  EXCEEDS BOUND" }
+    );
+    let _ = writeln!(
+        s,
+        "  poles: max real part {:.4}, smallest margin inside the region {:.4}{}",
+        v.max_real_part,
+        v.worst_region_margin,
+        if v.poles_in_region { "" } else { "  OUTSIDE THE REGION" }
+    );
+    let st = &r.study;
+    let _ = writeln!(
+        s,
+        "\nlinear study (worst of the 16 vertices):\n  {} N wind step: e_y peak {:.5} m, after 10 s {:.5} m, e_psi peak {:.5} rad, \
+         steering peak {:.4} rad, rate peak {:.4} rad/s",
+        st.wind_step_force,
+        st.wind_step.lateral_peak,
+        st.wind_step.lateral_final,
+        st.wind_step.heading_peak,
+        st.wind_step.steering_peak,
+        st.wind_step.steering_rate_peak
+    );
+    let _ = writeln!(
+        s,
+        "  {} m lateral offset: steering peak {:.4} rad, rate peak {:.4} rad/s, e_y after 2 s {:.5} m",
+        st.offset,
+        st.offset_recovery.steering_peak,
+        st.offset_recovery.steering_rate_peak,
+        st.offset_recovery.lateral_final
+    );
+    let _ = writeln!(
+        s,
+        "  with the {} s steering servo in the loop: max real part {:.4}",
+        st.servo_time_constant, st.servo_loop_max_real_part
+    );
+    let _ = writeln!(
+        s,
+        "\nsolver: {} solves, {} iterations, {:.3} s in clarabel, statuses {:?}, max constraint violation {:.1e} ({})",
+        r.solver.n_solves,
+        r.solver.total_iterations,
+        r.solver.total_solve_time_s,
+        r.solver.statuses,
+        r.solver.max_constraint_violation,
+        if r.solver.strict_lmis_hold { "< margin: the strict LMIs hold" } else { "NOT below the margin" }
+    );
+    let _ = writeln!(
+        s,
+        "time: design and verification {:.3} s, linear study {:.3} s, total {:.3} s",
+        r.timings.design_s, r.timings.verification_s, r.timings.total_s
+    );
+    s
 }

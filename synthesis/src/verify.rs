@@ -1,8 +1,8 @@
 //! Verification that does not trust the solver.
 //!
 //! For a gain `K`, the closed loop at a plant `(A, B)` is `x' = (A + B K) x + B_w w`,
-//! `z = [x; u] = [I; K] x` (`C_cl = C + D_u K`, no feedthrough). This module computes,
-//! from `K` alone:
+//! `z = C x + D_u u = (C + D_u K) x` (no feedthrough; the paper's `z = [x; u] = [I; K] x`).
+//! This module computes, from `K` alone:
 //!
 //! * the closed-loop poles and their position relative to a [`PoleRegion`];
 //! * the H-inf norm by bisection on the Hamiltonian
@@ -84,6 +84,12 @@ impl ClosedLoop {
         c.view_mut((0, 0), (n, n)).fill_with_identity();
         c.view_mut((n, 0), (k.nrows(), n)).copy_from(k);
         ClosedLoop { a, bw: bw.clone(), c }
+    }
+
+    /// The closed loop of plant `v` with gain `k` and performance output
+    /// `z = c x + d_u u`: `C_cl = c + d_u k`.
+    pub fn with_outputs(v: &Vertex, bw: &DMatrix<f64>, k: &DMatrix<f64>, c: &DMatrix<f64>, d_u: &DMatrix<f64>) -> Self {
+        ClosedLoop { a: &v.a + &v.b * k, bw: bw.clone(), c: c + d_u * k }
     }
 
     /// Eigenvalues of `A + B K`.
@@ -419,7 +425,7 @@ fn rel_diff(a: f64, b: f64) -> f64 {
     }
 }
 
-/// Checks one plant.
+/// Checks one plant with the paper's performance output `z = [x; u]`.
 pub fn check_point(
     plant: &Vertex,
     bw: &DMatrix<f64>,
@@ -428,7 +434,16 @@ pub fn check_point(
     kind: PointKind,
     opts: &VerifyOptions,
 ) -> PointCheck {
-    let cl = ClosedLoop::new(plant, bw, gain);
+    check_closed_loop(ClosedLoop::new(plant, bw, gain), plant.mu, region, kind, opts)
+}
+
+fn check_closed_loop(
+    cl: ClosedLoop,
+    mu: [f64; 4],
+    region: &PoleRegion,
+    kind: PointKind,
+    opts: &VerifyOptions,
+) -> PointCheck {
     let poles = cl.poles();
     let region_margin = if region.parts.is_empty() {
         -poles.iter().map(|p| p.re).fold(f64::NEG_INFINITY, f64::max)
@@ -438,7 +453,7 @@ pub fn check_point(
     let inf = f64::INFINITY;
     PointCheck {
         kind,
-        mu: plant.mu,
+        mu,
         poles: poles.iter().map(|p| [p.re, p.im]).collect(),
         region_margin,
         hinf: cl.hinf_norm_hamiltonian(opts.bisection_tol).map_or(inf, |b| b.upper),
@@ -450,7 +465,9 @@ pub fn check_point(
 }
 
 /// Verifies a gain at the 16 vertices and at `opts.interior_points` random interior
-/// points of the friction box, against the region and the certified bounds.
+/// points of the friction box, against the region and the certified bounds. The norms are
+/// those of `w -> z` with the polytope's own performance output ([`Polytope::c`],
+/// [`Polytope::d_u`]).
 pub fn verify_design(
     poly: &Polytope,
     region: &PoleRegion,
@@ -459,8 +476,11 @@ pub fn verify_design(
     nu_bound: Option<f64>,
     opts: &VerifyOptions,
 ) -> VerificationReport {
-    let vertices: Vec<PointCheck> =
-        poly.vertices.iter().map(|v| check_point(v, &poly.bw, gain, region, PointKind::Vertex, opts)).collect();
+    let (c, d_u) = (poly.c(), poly.d_u());
+    let check = |plant: &Vertex, kind: PointKind| {
+        check_closed_loop(ClosedLoop::with_outputs(plant, &poly.bw, gain, &c, &d_u), plant.mu, region, kind, opts)
+    };
+    let vertices: Vec<PointCheck> = poly.vertices.iter().map(|v| check(v, PointKind::Vertex)).collect();
     let mut rng = SplitMix64::new(opts.seed);
     let (lo, hi) = (poly.spec.mu_min, poly.spec.mu_max);
     let interior: Vec<PointCheck> = (0..opts.interior_points)
@@ -469,7 +489,7 @@ pub fn verify_design(
             for m in mu.iter_mut() {
                 *m = lo + (hi - lo) * rng.next_f64();
             }
-            check_point(&poly.at(mu), &poly.bw, gain, region, PointKind::Interior, opts)
+            check(&poly.at(mu), PointKind::Interior)
         })
         .collect();
     let all: Vec<&PointCheck> = vertices.iter().chain(interior.iter()).collect();

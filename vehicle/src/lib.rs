@@ -12,6 +12,7 @@ pub mod dynamics;
 pub mod linear;
 pub mod params;
 pub mod scalar;
+pub mod tracking;
 
 pub use dynamics::{
     derivatives_of, evaluate, integrate, rk4_step, steering, straight_running, Evaluation, Inputs, State, Steering,
@@ -20,3 +21,7 @@ pub use dynamics::{
 pub use linear::{linear_model, DisturbanceColumn, LinearModel};
 pub use params::{ParamError, VehicleParams, WHEELS};
 pub use scalar::{Dual, Scalar};
+pub use tracking::{
+    tracking_error_rates, tracking_errors, tracking_model, TrackingErrors, TrackingModel, N_TRACKING_STATES,
+    TRACKING_STATE_NAMES,
+};

@@ -7,8 +7,13 @@
 
 use std::process::ExitCode;
 
-use nigel_synthesis::report::{render_text, run, Objective, Request};
-use nigel_synthesis::{Architecture, DisturbanceVariant, PlantSpec, PoleRegion, Region, SweepProgress};
+use nigel_synthesis::report::{
+    render_text, render_tracking_text, run, run_tracking, Objective, Request, TrackingRequest,
+};
+use nigel_synthesis::tracking::tracking_region;
+use nigel_synthesis::{
+    Architecture, DisturbanceVariant, PlantSpec, PoleRegion, Region, SweepProgress, TrackingSpec, TrackingWeights,
+};
 
 const USAGE: &str = "\
 synthesize: robust mixed H2/H-inf state feedback with D-stability over Nigel's
@@ -17,9 +22,19 @@ independently (closed-loop poles, Hamiltonian/sweep H-inf, Lyapunov/Gramian H2).
 
 USAGE: synthesize [OPTIONS]
 
+Model:
+  --model paper|tracking      paper (default): states [beta, r], z = [x; u] (the paper's
+                              design). tracking: states [e_y, e_psi, beta - beta_ref,
+                              r - r_ref], z = [e_y/A_y, e_psi/A_psi, u/A_u], Pareto objective
+                              on a grid relative to gamma* (gamma* (1 + 0.05 k) up to
+                              3 gamma*), default d2 physical, default region Re(s) < -0.5
+                              and the 135-degree sector; K_track: delta = delta_ff + K e
+  --tracking-allowances A_y,A_psi,A_u
+                              tracking: allowed lateral error [m], heading error [rad]
+                              and steering correction [rad] (default 0.02,0.1,0.1)
 Plant:
   --arch 4ws|ackermann        steering architecture (default 4ws = 4WD4WS)
-  --d2 paper|physical         disturbance column and geometry (default paper:
+  --d2 paper|physical         disturbance column and geometry (default paper, tracking: physical;
                               d2 = (l_f - l_r)/2 as printed, l_r = 0.07924;
                               physical: d2 = (l_f - l_r)/(2 I_z), Table II)
   --speed V                   design speed [m/s] (default 0.35)
@@ -50,8 +65,13 @@ gamma is the bound on the induced L2 gain from w = F_sw to z = [beta, r, u].
 Exit codes: 0 ok, 1 no design, 2 bad command line, 3 verification failed.
 ";
 
+enum Job {
+    Paper(Request),
+    Tracking(TrackingRequest),
+}
+
 struct Cli {
-    request: Request,
+    job: Job,
     json: Option<String>,
     plot: Option<String>,
     quiet: bool,
@@ -67,7 +87,11 @@ fn parse_f64(opt: &str, v: &str) -> Result<f64, String> {
 
 fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
     let mut arch = Architecture::FourWheelSteering;
-    let mut d2 = DisturbanceVariant::Paper;
+    let mut d2 = None;
+    let mut tracking = false;
+    let mut allowances = None;
+    let mut objective_given = false;
+    let mut grid_given = false;
     let mut speed = None;
     let mut mu_min = None;
     let mut mu_max = None;
@@ -90,7 +114,9 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
             _ => (a, None),
         };
         const FLAGS: [&str; 4] = ["--no-default-region", "--quiet", "-h", "--help"];
-        const WITH_VALUE: [&str; 22] = [
+        const WITH_VALUE: [&str; 24] = [
+            "--model",
+            "--tracking-allowances",
             "--arch",
             "--d2",
             "--speed",
@@ -135,6 +161,27 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
         let v = value.as_str();
         match name {
             "-h" | "--help" => return Ok(None),
+            "--model" => {
+                tracking = match v {
+                    "paper" => false,
+                    "tracking" => true,
+                    _ => return Err(format!("--model: '{v}' is not one of paper, tracking")),
+                }
+            }
+            "--tracking-allowances" => {
+                let parts: Vec<&str> = v.split(',').collect();
+                if parts.len() != 3 {
+                    return Err(format!("--tracking-allowances: '{v}' is not three numbers A_y,A_psi,A_u"));
+                }
+                let mut a = [0.0; 3];
+                for (slot, part) in a.iter_mut().zip(&parts) {
+                    *slot = parse_f64(name, part)?;
+                    if *slot <= 0.0 {
+                        return Err(format!("--tracking-allowances: '{part}' must be > 0"));
+                    }
+                }
+                allowances = Some(a);
+            }
             "--arch" => {
                 arch = match v.to_ascii_lowercase().as_str() {
                     "4ws" | "4wd4ws" => Architecture::FourWheelSteering,
@@ -143,11 +190,11 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
                 }
             }
             "--d2" => {
-                d2 = match v {
+                d2 = Some(match v {
                     "paper" => DisturbanceVariant::Paper,
                     "physical" => DisturbanceVariant::Physical,
                     _ => return Err(format!("--d2: '{v}' is not one of paper, physical")),
-                }
+                })
             }
             "--speed" => speed = Some(parse_f64(name, v)?),
             "--mu-min" => mu_min = Some(parse_f64(name, v)?),
@@ -167,14 +214,21 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
                     return Err(format!("--objective: '{v}' is not one of pareto, hinf, h2, weighted, baseline"));
                 }
                 objective = v.to_string();
+                objective_given = true;
             }
             "--hinf-bound" => hinf_bound = Some(parse_f64(name, v)?),
             "--weight-hinf" => w_hinf = parse_f64(name, v)?,
             "--weight-h2" => w_h2 = parse_f64(name, v)?,
             "--baseline-alpha" => b_alpha = parse_f64(name, v)?,
             "--baseline-mu" => b_mu = parse_f64(name, v)?,
-            "--step" => request.sweep.step = parse_f64(name, v)?,
-            "--g-max" => request.sweep.g_max = parse_f64(name, v)?,
+            "--step" => {
+                request.sweep.step = parse_f64(name, v)?;
+                grid_given = true;
+            }
+            "--g-max" => {
+                request.sweep.g_max = parse_f64(name, v)?;
+                grid_given = true;
+            }
             "--margin" => request.options.margin = parse_f64(name, v)?,
             "--threads" => request.sweep.threads = v.parse().map_err(|_| format!("--threads: '{v}' is not a count"))?,
             "--interior" => {
@@ -199,7 +253,8 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
         }
         i += 1;
     }
-    let mut spec = PlantSpec::with_variant(arch, d2);
+    let default_d2 = if tracking { DisturbanceVariant::Physical } else { DisturbanceVariant::Paper };
+    let mut spec = PlantSpec::with_variant(arch, d2.unwrap_or(default_d2));
     if let Some(s) = speed {
         spec.speed = s;
     }
@@ -209,8 +264,35 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
     if let Some(m) = mu_max {
         spec.mu_max = m;
     }
-    let mut region = if default_region { PoleRegion::paper() } else { PoleRegion::none() };
+    let default = if tracking { tracking_region() } else { PoleRegion::paper() };
+    let mut region = if default_region { default } else { PoleRegion::none() };
     region.parts.extend(extra_regions);
+    if tracking {
+        if objective_given && objective != "pareto" {
+            return Err(format!(
+                "--objective {objective}: the tracking model is designed with the Pareto objective only"
+            ));
+        }
+        if grid_given {
+            return Err("--step/--g-max: the tracking grid is relative to gamma* (see --help)".into());
+        }
+        if plot.is_some() {
+            return Err("--plot: not available for the tracking model yet".into());
+        }
+        let weights =
+            allowances.map_or_else(TrackingWeights::chosen, |a| TrackingWeights::from_allowances(a[0], a[1], a[2]));
+        let req = TrackingRequest {
+            spec: TrackingSpec { plant: spec, weights },
+            region,
+            options: request.options,
+            verify: request.verify,
+            threads: request.sweep.threads,
+        };
+        return Ok(Some(Cli { job: Job::Tracking(req), json, plot, quiet }));
+    }
+    if allowances.is_some() {
+        return Err("--tracking-allowances needs --model tracking".into());
+    }
     request.spec = spec;
     request.region = region;
     request.objective = match objective.as_str() {
@@ -220,7 +302,14 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
         "baseline" => Objective::Baseline { mu_nominal: b_mu, alpha: b_alpha },
         _ => Objective::Pareto,
     };
-    Ok(Some(Cli { request, json, plot, quiet }))
+    Ok(Some(Cli { job: Job::Paper(request), json, plot, quiet }))
+}
+
+fn write_json<T: serde::Serialize>(path: &str, report: &T) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(report).map_err(|e| format!("cannot serialise the report: {e}"))?;
+    std::fs::write(path, text + "\n").map_err(|e| format!("cannot write {path}: {e}"))?;
+    println!("wrote {path}");
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -246,40 +335,57 @@ fn main() -> ExitCode {
             p.nu.map_or("failed".to_string(), |nu| format!("{nu:.5}"))
         );
     };
-    if !cli.quiet && cli.request.objective == Objective::Pareto {
-        eprintln!("synthesize: gamma*, then the Pareto grid ...");
-    }
     let progress_ref: Option<&(dyn Fn(SweepProgress) + Sync)> = if cli.quiet { None } else { Some(&progress) };
-    let report = match run(&cli.request, progress_ref) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("synthesize: no controller: {e}");
-            return ExitCode::from(1);
+    let passed = match &cli.job {
+        Job::Paper(request) => {
+            if !cli.quiet && request.objective == Objective::Pareto {
+                eprintln!("synthesize: gamma*, then the Pareto grid ...");
+            }
+            let report = match run(request, progress_ref) {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("synthesize: no controller: {e}");
+                    return ExitCode::from(1);
+                }
+            };
+            print!("{}", render_text(&report));
+            if let Some(path) = &cli.json {
+                if let Err(e) = write_json(path, &report) {
+                    eprintln!("synthesize: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            if let Some(path) = &cli.plot {
+                if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_svg(&report)) {
+                    eprintln!("synthesize: cannot write {path}: {e}");
+                    return ExitCode::from(1);
+                }
+                println!("wrote {path}");
+            }
+            report.verification.passed
+        }
+        Job::Tracking(request) => {
+            if !cli.quiet {
+                eprintln!("synthesize: tracking model: gamma*, then the Pareto grid ...");
+            }
+            let report = match run_tracking(request, progress_ref) {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("synthesize: no controller: {e}");
+                    return ExitCode::from(1);
+                }
+            };
+            print!("{}", render_tracking_text(&report));
+            if let Some(path) = &cli.json {
+                if let Err(e) = write_json(path, &report) {
+                    eprintln!("synthesize: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+            report.verification.passed
         }
     };
-    print!("{}", render_text(&report));
-    if let Some(path) = &cli.json {
-        let text = match serde_json::to_string_pretty(&report) {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("synthesize: cannot serialise the report: {e}");
-                return ExitCode::from(1);
-            }
-        };
-        if let Err(e) = std::fs::write(path, text + "\n") {
-            eprintln!("synthesize: cannot write {path}: {e}");
-            return ExitCode::from(1);
-        }
-        println!("wrote {path}");
-    }
-    if let Some(path) = &cli.plot {
-        if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_svg(&report)) {
-            eprintln!("synthesize: cannot write {path}: {e}");
-            return ExitCode::from(1);
-        }
-        println!("wrote {path}");
-    }
-    if !report.verification.passed {
+    if !passed {
         eprintln!("synthesize: the independent verification FAILED (see above)");
         return ExitCode::from(3);
     }
