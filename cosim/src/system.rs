@@ -25,7 +25,7 @@ impl BaseType {
     pub fn of(v: &ScalarVariable) -> BaseType {
         match v.variable_type {
             VariableType::Real { .. } => BaseType::Real,
-            VariableType::Integer { .. } => BaseType::Integer,
+            VariableType::Integer { .. } | VariableType::Enumeration { .. } => BaseType::Integer,
             VariableType::Boolean { .. } => BaseType::Boolean,
             VariableType::String { .. } => BaseType::String,
         }
@@ -139,7 +139,6 @@ pub struct SystemBuilder {
     system: System,
     names: HashMap<String, usize>,
 }
-
 
 /// Splits `instance.variable` at the first `.`.
 pub fn split_name(full: &str) -> Option<(&str, &str)> {

@@ -186,6 +186,13 @@ fn info(path: &Path) -> Result<(), Error> {
         let start = match &v.variable_type {
             model_description::VariableType::Real { start, .. } => start.map(|x| x.to_string()),
             model_description::VariableType::Integer { start, .. } => start.map(|x| x.to_string()),
+            model_description::VariableType::Enumeration { start, declared_type, .. } => start.map(|x| {
+                let item = md.type_definitions.iter().find(|t| &t.name == declared_type).and_then(|t| t.item(x));
+                match item {
+                    Some(item) => format!("{x} ({})", item.name),
+                    None => x.to_string(),
+                }
+            }),
             model_description::VariableType::Boolean { start } => start.map(|x| x.to_string()),
             model_description::VariableType::String { start } => start.clone(),
         };
