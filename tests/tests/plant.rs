@@ -220,3 +220,44 @@ fn directional_derivatives_never_hand_out_non_finite_numbers() {
     assert!(msg.contains("fmi2GetDirectionalDerivative") && msg.contains("der(v_y)"), "{msg}");
     assert_eq!(i.reset(), OK);
 }
+
+#[test]
+fn the_stable_substep_keeps_coasting_dissipative_over_random_vehicles() {
+    use nigel_vehicle::dynamics::rk4_step;
+    // Random vehicles (mass, inertia, stiffness, fade speed, friction up to the maximum),
+    // slow random sliding states (inside the fade zone, where the tires are stiffest):
+    // with the stability-limited step no coasting step may add energy.
+    let mut seed = 0x5eed_u64;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut cases = 0;
+    for _ in 0..300 {
+        let mut p = VehicleParams::table2();
+        p.m *= 0.3 + 2.0 * rnd();
+        p.i_z *= 0.3 + 2.0 * rnd();
+        p.c = [0, 1, 2, 3].map(|_| 22.4768 * (0.2 + 3.0 * rnd()));
+        p.v_fade = 0.005 + 0.05 * rnd();
+        let mut u = Inputs::<f64>::coasting(0.0);
+        u.mu = [0, 1, 2, 3].map(|_| nigel_plant::MU_MAX * rnd());
+        u.delta = [0, 1, 2, 3].map(|_| (rnd() - 0.5) * 3.0);
+        let h = stable_rk4_step(&p, &u);
+        let mut s = [0.0; N_STATES];
+        s[idx::V_X] = (rnd() - 0.5) * 2.0 * p.v_fade;
+        s[idx::V_Y] = (rnd() - 0.5) * 2.0 * p.v_fade;
+        s[idx::YAW_RATE] = (rnd() - 0.5) * 2.0;
+        let energy = |s: &State<f64>| {
+            0.5 * p.m * (s[idx::V_X].powi(2) + s[idx::V_Y].powi(2)) + 0.5 * p.i_z * s[idx::YAW_RATE].powi(2)
+        };
+        let mut e = energy(&s);
+        for k in 0..400 {
+            s = rk4_step(&p, &s, &u, h);
+            let next = energy(&s);
+            assert!(next <= e * (1.0 + 1e-9) + 1e-300, "case {cases}, step {k}: {e} -> {next} (h = {h})");
+            e = next;
+        }
+        cases += 1;
+    }
+    assert_eq!(cases, 300);
+}
