@@ -603,6 +603,15 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
+    /// The declared variables a serialized state holds (none when the model overrides).
+    fn saved_rows() -> &'static [usize] {
+        if M::SAVE_DECLARED_VARIABLES {
+            &decl::<M>().saved_rows
+        } else {
+            &[]
+        }
+    }
+
     /// Bytes of a saved state: magic, version, the GUID (a state belongs to one model),
     /// then the layer's numbers (machine state, time, stop time, next event), the declared
     /// variables of [`Declaration::saved_rows`] and the model's internal numbers, all
@@ -623,7 +632,7 @@ impl<M: Model> Instance<M> {
             next_event.unwrap_or(0.0),
             flag(state.iteration_pending),
         ];
-        for &row in &decl::<M>().saved_rows {
+        for &row in Self::saved_rows() {
             let v = decl::<M>().variable(row);
             numbers.push(match v.base_type {
                 BaseType::Real => model.get_real(v.binding)?,
@@ -673,7 +682,7 @@ impl<M: Model> Instance<M> {
         }
         let count = u64::from_le_bytes(take(8)?.try_into().unwrap_or_default());
         let header = 8 + 4 + 4 + guid_len + 8;
-        let saved = decl::<M>().saved_rows.len();
+        let saved = Self::saved_rows().len();
         if count.checked_mul(8) != Some((bytes.len() - header) as u64)
             || (count as usize) < SERIAL_HEADER_NUMBERS + saved
         {
@@ -703,7 +712,7 @@ impl<M: Model> Instance<M> {
         }
         let mut model = Self::fresh_model(&self.context)?;
         let values = &numbers[SERIAL_HEADER_NUMBERS..SERIAL_HEADER_NUMBERS + saved];
-        for (&row, &x) in decl::<M>().saved_rows.iter().zip(values) {
+        for (&row, &x) in Self::saved_rows().iter().zip(values) {
             let v = decl::<M>().variable(row);
             Self::check_value(row, x).map_err(|e| format!("serialized state: {e}"))?;
             let r = match v.base_type {

@@ -280,6 +280,58 @@ impl Model for Bare {
     }
 }
 
+/// The toy with its own FMU-state format (the override): only its internal numbers.
+#[derive(Clone, Debug)]
+struct Own(Toy);
+
+impl Model for Own {
+    type Binding = V;
+    const SAVE_DECLARED_VARIABLES: bool = false;
+    fn declaration() -> &'static Declaration<V> {
+        static D: OnceLock<Declaration<V>> = OnceLock::new();
+        D.get_or_init(|| {
+            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+            let cs = Interfaces { model_exchange: false, co_simulation: true };
+            Declaration::new(spec(caps, cs, "own")).unwrap()
+        })
+    }
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
+        Toy::instantiate(context).map(Own)
+    }
+    fn get_real(&mut self, b: V) -> ModelResult<f64> {
+        self.0.get_real(b)
+    }
+    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
+        self.0.set_real(b, x)
+    }
+    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
+        self.0.get_integer(b)
+    }
+    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
+        self.0.set_integer(b, x)
+    }
+    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
+        self.0.get_boolean(b)
+    }
+    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
+        self.0.set_boolean(b, x)
+    }
+    fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
+        self.0.event_update(t)
+    }
+    fn save_internal(&self, out: &mut Vec<f64>) {
+        let t = &self.0;
+        out.extend([t.u, t.gain, t.period, t.acc, t.y, t.samples as f64, t.k as f64]);
+    }
+    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+        let [u, gain, period, acc, y, samples, k] = data else { return Err("7 numbers expected".into()) };
+        let t = &mut self.0;
+        (t.u, t.gain, t.period, t.acc, t.y, t.samples, t.k) =
+            (*u, *gain, *period, *acc, *y, *samples as i32, *k as u64);
+        Ok(())
+    }
+}
+
 // The macro must expand for a model with Integer/Boolean/Enumeration and defaults only.
 export_fmi2!(Toy);
 
@@ -812,4 +864,35 @@ fn booleans_and_integers_read_back_and_enabled_switch_acts() {
     let t = FMI2_TRUE;
     assert_eq!(unsafe { abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &t) }, ERR);
     assert!(f.last_error().contains("enabled"), "{}", f.last_error());
+}
+
+#[test]
+fn a_model_can_override_the_fmu_state_format() {
+    let f = Fmu::<Own>::cs();
+    f.init(None);
+    assert_eq!(f.set_real(vr::U, 1.5), OK);
+    assert_eq!(f.step(0.0, 0.25), OK);
+    let mut s: fmi2FMUstate = null_mut();
+    let bytes = unsafe {
+        assert_eq!(abi::get_fmu_state::<Own>(f.c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(abi::serialized_fmu_state_size::<Own>(f.c, s, &mut size), OK);
+        let mut b = vec![0u8; size];
+        assert_eq!(abi::serialize_fmu_state::<Own>(f.c, s, b.as_mut_ptr() as *mut c_char, size), OK);
+        b
+    };
+    // the layer's 7 numbers and the model's own 7, no declared variables
+    let guid = Own::declaration().guid().len();
+    assert_eq!(bytes.len(), 8 + 4 + 4 + guid + 8 + 8 * (7 + 7));
+    let g = Fmu::<Own>::cs();
+    let mut copy: fmi2FMUstate = null_mut();
+    unsafe {
+        let st = abi::deserialize_fmu_state::<Own>(g.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut copy);
+        assert_eq!(st, OK, "{}", g.last_error());
+        assert_eq!(abi::set_fmu_state::<Own>(g.c, copy), OK);
+    }
+    assert_eq!(g.step(0.25, 0.1), OK);
+    assert_eq!(f.step(0.25, 0.1), OK);
+    assert_eq!(g.real(vr::Y).to_bits(), f.real(vr::Y).to_bits());
+    assert_eq!(g.int(vr::SAMPLES), 4);
 }
