@@ -24,6 +24,8 @@ pub struct Core<M> {
     pub next_event: Option<f64>,
     /// Model Exchange: the model asked for another event iteration.
     pub iteration_pending: bool,
+    /// The model asked to end the simulation (`fmi2GetBooleanStatus(fmi2Terminated)`).
+    pub terminate_requested: bool,
     pub model: M,
     /// Co-Simulation: the model (and its next event) before the events at the current
     /// time were run (lazily, at the first read or step). Setting an input afterwards
@@ -70,6 +72,7 @@ impl<M: Model> Instance<M> {
                 stop_time: None,
                 next_event: None,
                 iteration_pending: false,
+                terminate_requested: false,
                 model,
                 pre_event: None,
             },
@@ -183,6 +186,7 @@ impl<M: Model> Instance<M> {
             stop_time: None,
             next_event: None,
             iteration_pending: false,
+            terminate_requested: false,
             model,
             pre_event: None,
         };
@@ -267,6 +271,7 @@ impl<M: Model> Instance<M> {
         for _ in 0..MAX_EVENT_ITERATIONS {
             let update = self.event_update(time)?;
             if update.terminate_simulation {
+                self.core.terminate_requested = true;
                 return Err(ModelError::Discard(format!("the model asked to terminate the simulation at t = {time}")));
             }
             let due = matches!(self.core.next_event, Some(te) if te <= time + time_eps(time));
@@ -288,6 +293,7 @@ impl<M: Model> Instance<M> {
         }
         self.core.next_event = update.next_event_time;
         self.core.iteration_pending = update.new_discrete_states_needed;
+        self.core.terminate_requested |= update.terminate_simulation;
         Ok(update)
     }
 
@@ -731,7 +737,16 @@ impl<M: Model> Instance<M> {
         if !matches!(machine, Machine::Instantiated | Machine::InitializationMode) {
             model.exit_initialization().map_err(|e| format!("serialized state: {e}"))?;
         }
-        Ok(Core { machine, time, stop_time, next_event, iteration_pending, model, pre_event: None })
+        Ok(Core {
+            machine,
+            time,
+            stop_time,
+            next_event,
+            iteration_pending,
+            terminate_requested: false,
+            model,
+            pre_event: None,
+        })
     }
 }
 

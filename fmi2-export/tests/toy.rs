@@ -37,6 +37,7 @@ enum V {
 
 const SUM: i32 = 1;
 const SETTLE: i32 = 2;
+const STOP_AT_3: i32 = 3;
 
 thread_local! {
     /// Live toy models of this thread (every test runs on its own thread).
@@ -89,7 +90,11 @@ fn spec(capabilities: Capabilities, interfaces: Interfaces, identifier: &'static
         enumerations: vec![enumeration_type(
             "Mode",
             "what a sample does",
-            &[("sum", SUM, "one iteration"), ("settle", SETTLE, "two iterations")],
+            &[
+                ("sum", SUM, "one iteration"),
+                ("settle", SETTLE, "two iterations"),
+                ("stop_at_3", STOP_AT_3, "asks to end the simulation at the third sample"),
+            ],
         )],
         units: vec![si_unit("s", 0, 0, 1, 0)],
         variables: vec![
@@ -206,6 +211,9 @@ impl Model for Toy {
         }
         if self.u > 100.0 {
             self.logger.warning(&format!("u = {} is beyond the toy's calibrated range", self.u));
+        }
+        if self.mode == STOP_AT_3 && self.samples == 2 {
+            return Ok(EventUpdate { terminate_simulation: true, ..Default::default() });
         }
         let y = if self.enabled { self.gain * self.u + self.acc + self.offset as f64 } else { 0.0 };
         if y.abs() > 1e6 {
@@ -452,7 +460,7 @@ fn description_has_enumerations_tunables_discrete_outputs_and_the_declared_capab
     let md = Toy::declaration().model_description();
     let xml = Toy::declaration().xml();
     assert_eq!(md.type_definitions[0].name, "Mode");
-    assert_eq!(md.type_definitions[0].items.len(), 2);
+    assert_eq!(md.type_definitions[0].items.len(), 3);
     assert!(xml.contains(r#"<Item name="settle" value="2" description="two iterations"/>"#), "{xml}");
     let var = |n: &str| md.model_variables.iter().find(|v| v.name == n).unwrap();
     assert!(
@@ -895,4 +903,49 @@ fn a_model_can_override_the_fmu_state_format() {
     assert_eq!(f.step(0.25, 0.1), OK);
     assert_eq!(g.real(vr::Y).to_bits(), f.real(vr::Y).to_bits());
     assert_eq!(g.int(vr::SAMPLES), 4);
+}
+
+#[test]
+fn a_model_can_ask_to_end_the_simulation() {
+    // Co-Simulation: the step is discarded and fmi2Terminated reports it
+    let f = Fmu::<Toy>::cs();
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(f.set_int(vr::MODE, STOP_AT_3), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+    }
+    let mut terminated = -1;
+    assert_eq!(f.step(0.0, 0.15), OK);
+    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    assert_eq!(terminated, FMI2_FALSE);
+    assert_eq!(f.step(0.15, 0.1), Fmi2Status::Discard);
+    assert!(f.last_error().contains("asked to terminate"), "{}", f.last_error());
+    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    assert_eq!(terminated, FMI2_TRUE);
+    unsafe { assert_eq!(abi::terminate::<Toy>(f.c), OK) };
+    // Model Exchange: fmi2NewDiscreteStates says terminateSimulation
+    let g = Fmu::<Toy>::me();
+    let mut info = Fmi2EventInfo {
+        new_discrete_states_needed: 0,
+        terminate_simulation: 0,
+        nominals_of_continuous_states_changed: 0,
+        values_of_continuous_states_changed: 0,
+        next_event_time_defined: 0,
+        next_event_time: 0.0,
+    };
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(g.set_int(vr::MODE, STOP_AT_3), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(g.c), OK);
+        for k in 0..3 {
+            assert_eq!(abi::new_discrete_states::<Toy>(g.c, &mut info), OK);
+            assert_eq!(info.terminate_simulation, (k == 2) as c_int, "sample {k}");
+            if k < 2 {
+                assert_eq!(abi::enter_continuous_time_mode::<Toy>(g.c), OK);
+                assert_eq!(abi::set_time::<Toy>(g.c, info.next_event_time), OK);
+                assert_eq!(abi::enter_event_mode::<Toy>(g.c), OK);
+            }
+        }
+        assert_eq!(abi::terminate::<Toy>(g.c), OK);
+    }
 }
