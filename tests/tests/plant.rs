@@ -86,6 +86,7 @@ fn world_wind_on_a_car_turning_in_place_is_the_body_wind_rotated_at_every_stage(
             worst = worst.max((got[j] - s[j]).abs() / (1.0 + s[j].abs()));
         }
     }
+    println!("world wind vs body wind rotated per stage: largest relative difference {worst:e}, psi {}", s[idx::PSI]);
     assert!(worst <= 1e-12, "largest relative difference {worst:e}");
     // the car turned more than a full circle, so the wind went all the way round the body
     assert!(s[idx::PSI].abs() > 2.0 * std::f64::consts::PI, "psi = {}", s[idx::PSI]);
