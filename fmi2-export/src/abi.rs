@@ -559,11 +559,11 @@ pub unsafe fn get_integer_status<M: Model>(c: fmi2Component, kind: c_int, _value
 }
 
 pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut fmi2Boolean) -> Fmi2Status {
-    with::<M>(c, Function::GetBooleanStatus, |_| {
+    with::<M>(c, Function::GetBooleanStatus, |comp| {
         let out = out_ptr(value, "value")?;
         if kind == FMI2_TERMINATED {
-            // The model asks to terminate only through fmi2Discard with a logged reason.
-            *out = FMI2_FALSE;
+            // after a Discard because the model asked to end the simulation
+            *out = if comp.instance.core.terminate_requested { FMI2_TRUE } else { FMI2_FALSE };
             Ok(())
         } else {
             Err(format!("status kind {kind} has no Boolean value").into())

@@ -163,6 +163,14 @@ impl<B> VarDecl<B> {
         self
     }
 
+    /// Sets the start value and `initial` (e.g. a discrete output with an exact start
+    /// value: `.discrete_output(deps).start_value(Start::Real(0.0), Initial::Exact)`).
+    pub fn start_value(mut self, start: Start, initial: Initial) -> Self {
+        self.start = start;
+        self.initial = Some(initial);
+        self
+    }
+
     /// `causality="input"` (continuous for Reals, discrete otherwise) with a start value.
     pub fn input(mut self, start: Start) -> Self {
         self.causality = Causality::Input;

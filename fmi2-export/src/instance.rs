@@ -24,6 +24,8 @@ pub struct Core<M> {
     pub next_event: Option<f64>,
     /// Model Exchange: the model asked for another event iteration.
     pub iteration_pending: bool,
+    /// The model asked to end the simulation (`fmi2GetBooleanStatus(fmi2Terminated)`).
+    pub terminate_requested: bool,
     pub model: M,
     /// Co-Simulation: the model (and its next event) before the events at the current
     /// time were run (lazily, at the first read or step). Setting an input afterwards
@@ -70,6 +72,7 @@ impl<M: Model> Instance<M> {
                 stop_time: None,
                 next_event: None,
                 iteration_pending: false,
+                terminate_requested: false,
                 model,
                 pre_event: None,
             },
@@ -183,6 +186,7 @@ impl<M: Model> Instance<M> {
             stop_time: None,
             next_event: None,
             iteration_pending: false,
+            terminate_requested: false,
             model,
             pre_event: None,
         };
@@ -267,6 +271,7 @@ impl<M: Model> Instance<M> {
         for _ in 0..MAX_EVENT_ITERATIONS {
             let update = self.event_update(time)?;
             if update.terminate_simulation {
+                self.core.terminate_requested = true;
                 return Err(ModelError::Discard(format!("the model asked to terminate the simulation at t = {time}")));
             }
             let due = matches!(self.core.next_event, Some(te) if te <= time + time_eps(time));
@@ -288,6 +293,7 @@ impl<M: Model> Instance<M> {
         }
         self.core.next_event = update.next_event_time;
         self.core.iteration_pending = update.new_discrete_states_needed;
+        self.core.terminate_requested |= update.terminate_simulation;
         Ok(update)
     }
 
@@ -603,6 +609,15 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
+    /// The declared variables a serialized state holds (none when the model overrides).
+    fn saved_rows() -> &'static [usize] {
+        if M::SAVE_DECLARED_VARIABLES {
+            &decl::<M>().saved_rows
+        } else {
+            &[]
+        }
+    }
+
     /// Bytes of a saved state: magic, version, the GUID (a state belongs to one model),
     /// then the layer's numbers (machine state, time, stop time, next event), the declared
     /// variables of [`Declaration::saved_rows`] and the model's internal numbers, all
@@ -623,7 +638,7 @@ impl<M: Model> Instance<M> {
             next_event.unwrap_or(0.0),
             flag(state.iteration_pending),
         ];
-        for &row in &decl::<M>().saved_rows {
+        for &row in Self::saved_rows() {
             let v = decl::<M>().variable(row);
             numbers.push(match v.base_type {
                 BaseType::Real => model.get_real(v.binding)?,
@@ -673,7 +688,7 @@ impl<M: Model> Instance<M> {
         }
         let count = u64::from_le_bytes(take(8)?.try_into().unwrap_or_default());
         let header = 8 + 4 + 4 + guid_len + 8;
-        let saved = decl::<M>().saved_rows.len();
+        let saved = Self::saved_rows().len();
         if count.checked_mul(8) != Some((bytes.len() - header) as u64)
             || (count as usize) < SERIAL_HEADER_NUMBERS + saved
         {
@@ -703,7 +718,7 @@ impl<M: Model> Instance<M> {
         }
         let mut model = Self::fresh_model(&self.context)?;
         let values = &numbers[SERIAL_HEADER_NUMBERS..SERIAL_HEADER_NUMBERS + saved];
-        for (&row, &x) in decl::<M>().saved_rows.iter().zip(values) {
+        for (&row, &x) in Self::saved_rows().iter().zip(values) {
             let v = decl::<M>().variable(row);
             Self::check_value(row, x).map_err(|e| format!("serialized state: {e}"))?;
             let r = match v.base_type {
@@ -722,7 +737,16 @@ impl<M: Model> Instance<M> {
         if !matches!(machine, Machine::Instantiated | Machine::InitializationMode) {
             model.exit_initialization().map_err(|e| format!("serialized state: {e}"))?;
         }
-        Ok(Core { machine, time, stop_time, next_event, iteration_pending, model, pre_event: None })
+        Ok(Core {
+            machine,
+            time,
+            stop_time,
+            next_event,
+            iteration_pending,
+            terminate_requested: false,
+            model,
+            pre_event: None,
+        })
     }
 }
 

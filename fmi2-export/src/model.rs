@@ -174,6 +174,12 @@ pub trait Model: Clone + Send + Sized + 'static {
         Err("not supported (providesDirectionalDerivative is false)".into())
     }
 
+    /// Whether the serialized FMU state holds the declared variables (through the getters
+    /// and setters, with the setters' checks). A model that keeps its whole state its own
+    /// way sets this to `false` and writes everything in [`Model::save_internal`] /
+    /// [`Model::load_internal`] (the override; `exit_initialization` still checks the result).
+    const SAVE_DECLARED_VARIABLES: bool = true;
+
     /// Internal data that is not a declared variable (a sample counter, say), appended
     /// to the FMU state after the declared variables. Bit-exact as f64.
     fn save_internal(&self, _out: &mut Vec<f64>) {}

@@ -37,6 +37,7 @@ enum V {
 
 const SUM: i32 = 1;
 const SETTLE: i32 = 2;
+const STOP_AT_3: i32 = 3;
 
 thread_local! {
     /// Live toy models of this thread (every test runs on its own thread).
@@ -89,7 +90,11 @@ fn spec(capabilities: Capabilities, interfaces: Interfaces, identifier: &'static
         enumerations: vec![enumeration_type(
             "Mode",
             "what a sample does",
-            &[("sum", SUM, "one iteration"), ("settle", SETTLE, "two iterations")],
+            &[
+                ("sum", SUM, "one iteration"),
+                ("settle", SETTLE, "two iterations"),
+                ("stop_at_3", STOP_AT_3, "asks to end the simulation at the third sample"),
+            ],
         )],
         units: vec![si_unit("s", 0, 0, 1, 0)],
         variables: vec![
@@ -207,6 +212,9 @@ impl Model for Toy {
         if self.u > 100.0 {
             self.logger.warning(&format!("u = {} is beyond the toy's calibrated range", self.u));
         }
+        if self.mode == STOP_AT_3 && self.samples == 2 {
+            return Ok(EventUpdate { terminate_simulation: true, ..Default::default() });
+        }
         let y = if self.enabled { self.gain * self.u + self.acc + self.offset as f64 } else { 0.0 };
         if y.abs() > 1e6 {
             return Err(ModelError::Discard(format!("y = {y} would saturate the toy")));
@@ -277,6 +285,58 @@ impl Model for Bare {
     }
     fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
         self.0.event_update(t)
+    }
+}
+
+/// The toy with its own FMU-state format (the override): only its internal numbers.
+#[derive(Clone, Debug)]
+struct Own(Toy);
+
+impl Model for Own {
+    type Binding = V;
+    const SAVE_DECLARED_VARIABLES: bool = false;
+    fn declaration() -> &'static Declaration<V> {
+        static D: OnceLock<Declaration<V>> = OnceLock::new();
+        D.get_or_init(|| {
+            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+            let cs = Interfaces { model_exchange: false, co_simulation: true };
+            Declaration::new(spec(caps, cs, "own")).unwrap()
+        })
+    }
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
+        Toy::instantiate(context).map(Own)
+    }
+    fn get_real(&mut self, b: V) -> ModelResult<f64> {
+        self.0.get_real(b)
+    }
+    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
+        self.0.set_real(b, x)
+    }
+    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
+        self.0.get_integer(b)
+    }
+    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
+        self.0.set_integer(b, x)
+    }
+    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
+        self.0.get_boolean(b)
+    }
+    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
+        self.0.set_boolean(b, x)
+    }
+    fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
+        self.0.event_update(t)
+    }
+    fn save_internal(&self, out: &mut Vec<f64>) {
+        let t = &self.0;
+        out.extend([t.u, t.gain, t.period, t.acc, t.y, t.samples as f64, t.k as f64]);
+    }
+    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+        let [u, gain, period, acc, y, samples, k] = data else { return Err("7 numbers expected".into()) };
+        let t = &mut self.0;
+        (t.u, t.gain, t.period, t.acc, t.y, t.samples, t.k) =
+            (*u, *gain, *period, *acc, *y, *samples as i32, *k as u64);
+        Ok(())
     }
 }
 
@@ -400,7 +460,7 @@ fn description_has_enumerations_tunables_discrete_outputs_and_the_declared_capab
     let md = Toy::declaration().model_description();
     let xml = Toy::declaration().xml();
     assert_eq!(md.type_definitions[0].name, "Mode");
-    assert_eq!(md.type_definitions[0].items.len(), 2);
+    assert_eq!(md.type_definitions[0].items.len(), 3);
     assert!(xml.contains(r#"<Item name="settle" value="2" description="two iterations"/>"#), "{xml}");
     let var = |n: &str| md.model_variables.iter().find(|v| v.name == n).unwrap();
     assert!(
@@ -812,4 +872,80 @@ fn booleans_and_integers_read_back_and_enabled_switch_acts() {
     let t = FMI2_TRUE;
     assert_eq!(unsafe { abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &t) }, ERR);
     assert!(f.last_error().contains("enabled"), "{}", f.last_error());
+}
+
+#[test]
+fn a_model_can_override_the_fmu_state_format() {
+    let f = Fmu::<Own>::cs();
+    f.init(None);
+    assert_eq!(f.set_real(vr::U, 1.5), OK);
+    assert_eq!(f.step(0.0, 0.25), OK);
+    let mut s: fmi2FMUstate = null_mut();
+    let bytes = unsafe {
+        assert_eq!(abi::get_fmu_state::<Own>(f.c, &mut s), OK);
+        let mut size = 0;
+        assert_eq!(abi::serialized_fmu_state_size::<Own>(f.c, s, &mut size), OK);
+        let mut b = vec![0u8; size];
+        assert_eq!(abi::serialize_fmu_state::<Own>(f.c, s, b.as_mut_ptr() as *mut c_char, size), OK);
+        b
+    };
+    // the layer's 7 numbers and the model's own 7, no declared variables
+    let guid = Own::declaration().guid().len();
+    assert_eq!(bytes.len(), 8 + 4 + 4 + guid + 8 + 8 * (7 + 7));
+    let g = Fmu::<Own>::cs();
+    let mut copy: fmi2FMUstate = null_mut();
+    unsafe {
+        let st = abi::deserialize_fmu_state::<Own>(g.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut copy);
+        assert_eq!(st, OK, "{}", g.last_error());
+        assert_eq!(abi::set_fmu_state::<Own>(g.c, copy), OK);
+    }
+    assert_eq!(g.step(0.25, 0.1), OK);
+    assert_eq!(f.step(0.25, 0.1), OK);
+    assert_eq!(g.real(vr::Y).to_bits(), f.real(vr::Y).to_bits());
+    assert_eq!(g.int(vr::SAMPLES), 4);
+}
+
+#[test]
+fn a_model_can_ask_to_end_the_simulation() {
+    // Co-Simulation: the step is discarded and fmi2Terminated reports it
+    let f = Fmu::<Toy>::cs();
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(f.set_int(vr::MODE, STOP_AT_3), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+    }
+    let mut terminated = -1;
+    assert_eq!(f.step(0.0, 0.15), OK);
+    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    assert_eq!(terminated, FMI2_FALSE);
+    assert_eq!(f.step(0.15, 0.1), Fmi2Status::Discard);
+    assert!(f.last_error().contains("asked to terminate"), "{}", f.last_error());
+    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    assert_eq!(terminated, FMI2_TRUE);
+    unsafe { assert_eq!(abi::terminate::<Toy>(f.c), OK) };
+    // Model Exchange: fmi2NewDiscreteStates says terminateSimulation
+    let g = Fmu::<Toy>::me();
+    let mut info = Fmi2EventInfo {
+        new_discrete_states_needed: 0,
+        terminate_simulation: 0,
+        nominals_of_continuous_states_changed: 0,
+        values_of_continuous_states_changed: 0,
+        next_event_time_defined: 0,
+        next_event_time: 0.0,
+    };
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(g.set_int(vr::MODE, STOP_AT_3), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(g.c), OK);
+        for k in 0..3 {
+            assert_eq!(abi::new_discrete_states::<Toy>(g.c, &mut info), OK);
+            assert_eq!(info.terminate_simulation, (k == 2) as c_int, "sample {k}");
+            if k < 2 {
+                assert_eq!(abi::enter_continuous_time_mode::<Toy>(g.c), OK);
+                assert_eq!(abi::set_time::<Toy>(g.c, info.next_event_time), OK);
+                assert_eq!(abi::enter_event_mode::<Toy>(g.c), OK);
+            }
+        }
+        assert_eq!(abi::terminate::<Toy>(g.c), OK);
+    }
 }

@@ -147,26 +147,30 @@ fn state_vr(i: usize) -> u32 {
     vr::STATE + i as u32
 }
 
-/// Knowns the body dynamics depend on (states and inputs), as value references.
-fn body_knowns() -> Vec<u32> {
+/// Knowns the body dynamics depend on (states and inputs), as value references: all
+/// velocities, servo angles and wheel inputs, the world-frame wind through the heading psi,
+/// and of the body-frame wind the head wind for the longitudinal equation only, the side
+/// wind for the lateral and yaw equations only (it acts at the geometric centre).
+fn body_knowns(longitudinal: bool) -> Vec<u32> {
     let mut k: Vec<u32> = (idx::V_X..N_STATES).map(state_vr).collect();
     k.extend((0..4).flat_map(|i| [vr::STEER + i, vr::TORQUE + i, vr::FRICTION + i]));
-    // world-frame wind enters through the heading psi
-    k.extend([vr::WIND_HEAD, vr::WIND_SIDE, vr::WIND_X, vr::WIND_Y, state_vr(idx::PSI)]);
+    k.extend([if longitudinal { vr::WIND_HEAD } else { vr::WIND_SIDE }, vr::WIND_X, vr::WIND_Y, state_vr(idx::PSI)]);
     k
 }
 
-fn wheel_knowns(i: usize) -> Vec<u32> {
+/// What a per-wheel output depends on: the applied steering angle is the servo state
+/// (servo on) or the command (servo off); the slip angle adds the body velocities; the
+/// forces add the friction and the torque (the friction circle couples them).
+fn wheel_knowns(output: fn(usize) -> Output, i: usize) -> Vec<u32> {
     let i32_ = i as u32;
-    vec![
-        state_vr(idx::V_X),
-        state_vr(idx::V_Y),
-        state_vr(idx::YAW_RATE),
-        state_vr(idx::SERVO + i),
-        vr::STEER + i32_,
-        vr::TORQUE + i32_,
-        vr::FRICTION + i32_,
-    ]
+    let mut k = vec![state_vr(idx::SERVO + i), vr::STEER + i32_];
+    if output(i) != Output::SteerApplied(i) {
+        k.extend([state_vr(idx::V_X), state_vr(idx::V_Y), state_vr(idx::YAW_RATE)]);
+    }
+    if matches!(output(i), Output::ForceLat(_) | Output::ForceDrive(_)) {
+        k.extend([vr::TORQUE + i32_, vr::FRICTION + i32_]);
+    }
+    k
 }
 
 fn build_declaration() -> DeclarationSpec<PlantVar> {
@@ -261,7 +265,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     );
     v.push(
         real("lateral_accel", vr::LATERAL_ACCEL, PlantVar::Output(Output::LateralAccel))
-            .output(Dependencies::On(body_knowns()))
+            .output(Dependencies::On(body_knowns(false)))
             .unit("m/s2")
             .describe("body-frame lateral acceleration dv_y/dt + r v_x"),
     );
@@ -276,7 +280,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         for (i, w) in WHEEL.iter().enumerate() {
             v.push(
                 real(leak(format!("{stem}_{w}")), base + i as u32, PlantVar::Output(make(i)))
-                    .output(Dependencies::On(wheel_knowns(i)))
+                    .output(Dependencies::On(wheel_knowns(make, i)))
                     .unit(unit)
                     .describe(text),
             );
@@ -287,7 +291,8 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         let deps = match i {
             idx::X | idx::Y => vec![state_vr(idx::PSI), state_vr(idx::V_X), state_vr(idx::V_Y)],
             idx::PSI => vec![state_vr(idx::YAW_RATE)],
-            idx::V_X | idx::V_Y | idx::YAW_RATE => body_knowns(),
+            idx::V_X => body_knowns(true),
+            idx::V_Y | idx::YAW_RATE => body_knowns(false),
             servo => vec![state_vr(servo), vr::STEER + (servo - idx::SERVO) as u32],
         };
         v.push(

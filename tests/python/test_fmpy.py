@@ -49,7 +49,7 @@ INPUTS = (
     [f"delta_{w}" for w in WHEELS]
     + [f"tau_{w}" for w in WHEELS]
     + [f"mu_{w}" for w in WHEELS]
-    + ["wind_head", "wind_side"]
+    + ["wind_head", "wind_side", "wind_x", "wind_y"]
 )
 
 DT = 1e-3  # communication step / output interval / input sample time
@@ -67,11 +67,14 @@ BASE = {
     **{f"mu_{w}": 0.4 for w in WHEELS},
     "wind_head": 0.0,
     "wind_side": 0.0,
+    "wind_x": 0.0,
+    "wind_y": 0.0,
 }
 CHANGES = [
     (0.5, {"delta_fl": 0.2, "delta_fr": 0.2, "delta_rl": -0.2, "delta_rr": -0.2}),  # steering step
     (1.2, {"mu_rr": 0.15}),  # friction drop at the rear-right wheel
-    (2.0, {"wind_head": 0.1, "wind_side": 0.3}),  # wind gust
+    (2.0, {"wind_head": 0.1, "wind_side": 0.3}),  # wind gust (body frame)
+    (2.5, {"wind_x": 0.2, "wind_y": -0.15}),  # world-frame wind, turning with the car
 ]
 
 
@@ -164,12 +167,16 @@ class Reference:
             fx_sum += fx
             fy_sum += fy
             mz += xi * fy - yi * fx
-        mz += self.x_c * u["wind_side"]
+        # world-frame wind in body axes at this stage's heading (maneuvers.md)
+        wx, wy = u.get("wind_x", 0.0), u.get("wind_y", 0.0)
+        head = u["wind_head"] - (wx * math.cos(psi) + wy * math.sin(psi))
+        side = u["wind_side"] + (wy * math.cos(psi) - wx * math.sin(psi))
+        mz += self.x_c * side
         d[0] = vx * math.cos(psi) - vy * math.sin(psi)
         d[1] = vx * math.sin(psi) + vy * math.cos(psi)
         d[2] = r
-        d[3] = (fx_sum - u["wind_head"]) / p["m"] + r * vy
-        d[4] = (fy_sum + u["wind_side"]) / p["m"] - r * vx
+        d[3] = (fx_sum - head) / p["m"] + r * vy
+        d[4] = (fy_sum + side) / p["m"] - r * vx
         d[5] = mz / p["I_z"]
         return d
 
@@ -563,7 +570,7 @@ JAC_INPUTS = {
     "delta_fl": 0.2, "delta_fr": 0.18, "delta_rl": -0.1, "delta_rr": -0.12,
     "tau_fl": 0.094, "tau_fr": 0.004, "tau_rl": -0.01, "tau_rr": 0.015,
     "mu_fl": 0.4, "mu_fr": 0.35, "mu_rl": 0.3, "mu_rr": 0.25,
-    "wind_head": 0.05, "wind_side": -0.03,
+    "wind_head": 0.05, "wind_side": -0.03, "wind_x": 0.04, "wind_y": -0.06,
 }
 
 
