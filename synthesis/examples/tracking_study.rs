@@ -1,8 +1,7 @@
 //! The short study behind the tracking weights ([`nigel_synthesis::tracking`]): for each
 //! candidate (lateral, heading and steering allowances), the min-H-inf design `gamma*`, the
 //! Pareto point, and the linear closed loop at the 16 vertices: a 0.25 N wind step, the
-//! recovery from a lateral offset as large as the lateral allowance, and the loop with the
-//! 0.03 s steering servo.
+//! recovery from a 2 cm lateral offset, and the loop with the 0.03 s steering servo.
 //!
 //! `cargo run --release -p nigel-synthesis --example tracking_study`
 
@@ -43,7 +42,7 @@ fn main() {
             let slow = v.vertices.iter().flat_map(|p| p.poles.iter().map(|z| -z[0])).fold(f64::INFINITY, f64::min);
             let fast = v.vertices.iter().flat_map(|p| p.poles.iter().map(|z| z[0].hypot(z[1]))).fold(0.0, f64::max);
             let wind = wind_step(&poly, k, 0.25, 10.0);
-            let off = offset_recovery(&poly, k, ly, 2.0);
+            let off = offset_recovery(&poly, k, 0.02, 2.0);
             let servo = servo_loop_max_real_part(&poly, k, 0.03);
             let ky = (0..k.nrows()).map(|i| k[(i, 0)].abs()).fold(0.0, f64::max);
             let kp = (0..k.nrows()).map(|i| k[(i, 1)].abs()).fold(0.0, f64::max);

@@ -4,7 +4,8 @@
 use std::fmt::Write as _;
 
 use crate::region::Region;
-use crate::report::SynthesisReport;
+use crate::report::{ChosenPoint, ParetoEntry, PlantReport, SynthesisReport, TrackingReport, VerificationSummary};
+use crate::verify::PointCheck;
 
 const W: f64 = 1100.0;
 const H: f64 = 480.0;
@@ -159,8 +160,51 @@ fn region_polygon(parts: &[Region], f: &Frame) -> Vec<(f64, f64)> {
     poly
 }
 
-/// Renders the figure as an SVG document.
+/// What the figure shows, borrowed from a report.
+struct PlotView<'a> {
+    plant: &'a PlantReport,
+    objective: &'a str,
+    pareto: &'a [ParetoEntry],
+    chosen: &'a ChosenPoint,
+    gamma_star: Option<f64>,
+    vertices: &'a [PointCheck],
+    region: &'a [Region],
+    region_description: &'a str,
+    verification: &'a VerificationSummary,
+}
+
+/// Renders the figure of the paper's (2-state) design as an SVG document.
 pub fn render_svg(r: &SynthesisReport) -> String {
+    render(&PlotView {
+        plant: &r.plant,
+        objective: r.objective,
+        pareto: &r.pareto,
+        chosen: &r.chosen,
+        gamma_star: r.gamma_star,
+        vertices: &r.vertices,
+        region: &r.region,
+        region_description: &r.region_description,
+        verification: &r.verification,
+    })
+}
+
+/// Renders the figure of the tracking design (Pareto curve, poles of the 4-state closed
+/// loop at the 16 vertices) as an SVG document.
+pub fn render_tracking_svg(r: &TrackingReport) -> String {
+    render(&PlotView {
+        plant: &r.plant,
+        objective: "tracking pareto",
+        pareto: &r.pareto,
+        chosen: &r.chosen,
+        gamma_star: Some(r.gamma_star),
+        vertices: &r.vertices,
+        region: &r.region,
+        region_description: &r.region_description,
+        verification: &r.verification,
+    })
+}
+
+fn render(r: &PlotView) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -260,7 +304,7 @@ pub fn render_svg(r: &SynthesisReport) -> String {
     let mut xmin = poles.iter().map(|p| p[0]).fold(0.0, f64::min);
     let mut xmax: f64 = poles.iter().map(|p| p[0]).fold(0.0, f64::max);
     let mut yabs = poles.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
-    for part in &r.region {
+    for part in r.region {
         if let Region::HalfPlane { alpha } = part {
             xmin = xmin.min(*alpha);
             xmax = xmax.max(*alpha);
@@ -279,7 +323,7 @@ pub fn render_svg(r: &SynthesisReport) -> String {
     let yabs = yabs.max(0.45 * (xmax - xmin)) * 1.05;
     let f = Frame { x0: 600.0, y0: 60.0, w: 460.0, h: 360.0, xmin, xmax, ymin: -yabs, ymax: yabs };
     axes(&mut s, &f, "Closed-loop poles at the 16 vertices", "Re(s)", "Im(s)");
-    let region_poly = region_polygon(&r.region, &f);
+    let region_poly = region_polygon(r.region, &f);
     if region_poly.len() >= 3 && !r.region.is_empty() {
         let pts: Vec<String> = region_poly.iter().map(|p| format!("{:.1},{:.1}", f.px(p.0), f.py(p.1))).collect();
         let _ = writeln!(

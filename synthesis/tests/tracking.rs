@@ -183,6 +183,7 @@ fn the_report_carries_the_gain_the_bounds_and_the_study() {
     assert_eq!(r.k_columns, ["e_y", "e_psi", "beta - beta_ref", "r - r_ref"]);
     assert_eq!(r.k_rows, ["FL", "FR", "RL", "RR"]);
     assert!(r.verification.passed);
+    assert!(r.design_strict_lmis_hold, "chosen design violates its LMIs by {:e}", r.design_max_constraint_violation);
     assert_eq!(r.chosen.g, Some(design().gamma));
     // the wind-step steady offset equals -(A + B K)^-1 d w at the worst vertex: check it is the
     // largest over the vertices of that closed form
@@ -202,14 +203,21 @@ fn the_report_carries_the_gain_the_bounds_and_the_study() {
 fn cli_writes_the_tracking_json_and_refuses_what_does_not_apply() {
     let json = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("synthesize-{}-tracking.json", std::process::id()));
+    let svg = json.with_extension("svg");
     let out = Command::new(env!("CARGO_BIN_EXE_synthesize"))
         .args(["--model", "tracking", "--interior", "4", "--quiet", "--json"])
         .arg(&json)
+        .arg("--plot")
+        .arg(&svg)
         .output()
         .unwrap();
     assert!(out.status.success(), "{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let _ = std::fs::remove_file(&json);
+    let figure = std::fs::read_to_string(&svg).unwrap();
+    let _ = std::fs::remove_file(&svg);
+    assert!(figure.starts_with("<svg") && figure.trim_end().ends_with("</svg>"));
+    assert!(figure.contains("tracking pareto"));
     assert_eq!(v["model"], "tracking");
     let k = v["K"].as_array().unwrap();
     assert_eq!(k.len(), 4);

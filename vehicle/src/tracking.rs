@@ -71,8 +71,9 @@
 //! synthesis (`u = K_track e`), the steering command is
 //! `delta = delta_ff + K_track e`, with `e` computed by [`tracking_errors`] from the measured
 //! car and the reference car, each `delta_i` positive counter-clockwise (to the left) as in
-//! the plant. E.g. a car left of its reference (`e_y > 0`) must be steered right, so the
-//! `e_y` column of a stabilising `K_track` is negative on the front wheels.
+//! the plant. E.g. a car left of its reference (`e_y > 0`) is steered back to the right: the
+//! synthesized `K_track` has a negative `e_y` column on the front wheels (checked on the
+//! nonlinear car in `synthesis/tests/tracking.rs`).
 
 use crate::dynamics::{evaluate, idx, Inputs, State};
 use crate::linear::{linear_model, DisturbanceColumn};

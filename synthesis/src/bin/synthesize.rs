@@ -276,9 +276,6 @@ fn parse_args(args: &[String]) -> Result<Option<Cli>, String> {
         if grid_given {
             return Err("--step/--g-max: the tracking grid is relative to gamma* (see --help)".into());
         }
-        if plot.is_some() {
-            return Err("--plot: not available for the tracking model yet".into());
-        }
         let weights =
             allowances.map_or_else(TrackingWeights::chosen, |a| TrackingWeights::from_allowances(a[0], a[1], a[2]));
         let req = TrackingRequest {
@@ -381,6 +378,13 @@ fn main() -> ExitCode {
                     eprintln!("synthesize: {e}");
                     return ExitCode::from(1);
                 }
+            }
+            if let Some(path) = &cli.plot {
+                if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_tracking_svg(&report)) {
+                    eprintln!("synthesize: cannot write {path}: {e}");
+                    return ExitCode::from(1);
+                }
+                println!("wrote {path}");
             }
             report.verification.passed
         }
