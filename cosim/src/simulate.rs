@@ -6,6 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
+use crate::me::MeUnit;
 use crate::system::{BaseType, System, Value, VariableRef};
 use model_description::Causality;
 use std::time::{Duration, Instant};
@@ -51,6 +52,8 @@ pub struct Experiment {
     pub profile: bool,
     /// Called with the fraction done (0..=1) at each output point.
     pub progress: Option<fn(f64)>,
+    /// Integration method of Model Exchange instances.
+    pub solver: crate::me::Solver,
 }
 
 impl Experiment {
@@ -65,6 +68,7 @@ impl Experiment {
             record: None,
             profile: false,
             progress: None,
+            solver: crate::me::Solver::default(),
         }
     }
 }
@@ -145,6 +149,10 @@ pub struct Summary {
     pub instance_time: Vec<(String, Duration)>,
     /// Warnings the FMUs logged (instance, message).
     pub warnings: Vec<(String, String)>,
+    /// Events of Model Exchange instances.
+    pub events: Vec<crate::me::Event>,
+    /// Internal integrator steps of Model Exchange instances (accepted, rejected).
+    pub integrator_steps: (u64, u64),
 }
 
 impl Summary {
@@ -152,7 +160,9 @@ impl Summary {
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "steps": self.steps,
-            "events": 0,
+            "events": self.events.len(),
+            "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
+            "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
@@ -506,12 +516,6 @@ fn schedule(e: &Experiment) -> Result<(u64, u64)> {
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
     let wall = Instant::now();
     let (steps, stride) = schedule(experiment)?;
-    if let Some(spec) = system.instances.iter().find(|s| s.fmu.interface() != Interface::CoSimulation) {
-        return Err(Error::Experiment(format!(
-            "instance {} is loaded for Model Exchange; this master steps Co-Simulation FMUs only",
-            spec.name
-        )));
-    }
     let record: Vec<VariableRef> = match &experiment.record {
         None => default_record(system),
         Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
@@ -569,9 +573,15 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         }
     };
     propagate_initial(&mut plan, &mut instances, &mut values)?;
+    let mut units: Vec<Option<MeUnit>> = Vec::with_capacity(instances.len());
     for inst in instances.iter_mut() {
         inst.exit_initialization_mode()?;
+        units.push(match inst.fmu().interface() {
+            Interface::ModelExchange => Some(MeUnit::initialize(inst)?),
+            Interface::CoSimulation => None,
+        });
     }
+    let solver = experiment.solver;
     propagate_initial(&mut plan, &mut instances, &mut values)?;
     run_ops(&mut record_gets, &mut instances, &mut values, None)?;
     push_row(&mut results, t0, &values, &record_slots);
@@ -583,13 +593,14 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         let t = t0 + n as f64 * h;
         let t_next = t0 + (n + 1) as f64 * h;
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
-        for (i, inst) in instances.iter_mut().enumerate() {
-            if profile {
-                let c = Instant::now();
-                inst.do_step(t, dt)?;
+        for (i, (inst, unit)) in instances.iter_mut().zip(units.iter_mut()).enumerate() {
+            let c = profile.then(Instant::now);
+            match unit {
+                None => inst.do_step(t, dt)?,
+                Some(unit) => unit.advance(inst, solver, t, t_next)?,
+            }
+            if let Some(c) = c {
                 clocks[i] += c.elapsed();
-            } else {
-                inst.do_step(t, dt)?;
             }
         }
         let clk = if profile { Some(&mut clocks[..]) } else { None };
@@ -619,6 +630,11 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         }
     }
     let mut summary = Summary { steps, wall_time: Duration::ZERO, ..Summary::default() };
+    for unit in units.into_iter().flatten() {
+        summary.integrator_steps.0 += unit.steps;
+        summary.integrator_steps.1 += unit.rejected;
+        summary.events.extend(unit.events);
+    }
     for inst in instances.iter_mut() {
         inst.terminate()?;
         for rec in inst.take_log() {
