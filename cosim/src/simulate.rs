@@ -382,11 +382,9 @@ impl Plan {
         for i in 0..system.instances.len() {
             for ty in [BaseType::Real, BaseType::Integer, BaseType::Boolean] {
                 let mut get = Op::new(i, OpKind::Get, ty);
+                // only the connected outputs: recorded variables are read at output points
                 for (k, s) in sources.iter().enumerate() {
-                    if s.instance == i && s.base_type == ty && !get.vrs.contains(&s.value_reference) {
-                        get.push(s.value_reference, k, (1.0, 0.0));
-                    } else if s.instance == i && s.base_type == ty {
-                        // same value reference (an alias): read it again into its own slot
+                    if s.instance == i && s.base_type == ty && connected_outputs.contains(s) {
                         get.push(s.value_reference, k, (1.0, 0.0));
                     }
                 }
