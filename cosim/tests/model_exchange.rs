@@ -51,7 +51,9 @@ fn ball_run(
     h: f64,
     kick: Option<(f64, f64)>,
 ) -> (nigel_cosim::Results, nigel_cosim::Summary) {
-    let dir = work_dir("ball");
+    // one folder per call: tests run in parallel threads
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let dir = work_dir(&format!("ball-{}", CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)));
     let mut b = SystemBuilder::new();
     b.add_instance("ball", Fmu::load(&build_ball(&dir)).unwrap()).unwrap();
     if let Some((t, k)) = kick {
