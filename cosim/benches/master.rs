@@ -38,7 +38,7 @@ fn trivial_fmu(dir: &Path) -> PathBuf {
         .unwrap_or(false);
     assert!(ok, "cc failed");
     let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="gain" guid="{test}" numberOfEventIndicators="0">
+<fmiModelDescription fmiVersion="2.0" modelName="gain" guid="{test-gain}" numberOfEventIndicators="0">
   <CoSimulation modelIdentifier="gain" canHandleVariableCommunicationStepSize="true"/>
   <ModelVariables>
     <ScalarVariable name="u" valueReference="0" causality="input"><Real start="0"/></ScalarVariable>
@@ -177,8 +177,12 @@ fn main() {
     }
 
     if let Some(python) = std::env::var_os("COSIM_BENCH_PYTHON") {
+        // relative to the workspace root (cargo runs benches in the package folder)
+        let python = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(python);
         let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/external.py");
-        let status = Command::new(python).arg(script).arg(&plant).status();
+        let ssp = dir.join("plant.ssp");
+        nigel_cosim::write_ssp(&system, "plant", Some(30.0), &ssp).unwrap();
+        let status = Command::new(python).arg(script).arg(&plant).arg(&ssp).status();
         if !status.map(|s| s.success()).unwrap_or(false) {
             eprintln!("external tools: the Python script failed");
         }

@@ -64,7 +64,7 @@ impl Model {
     pub fn model_description(self) -> String {
         format!(
             r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test}}" numberOfEventIndicators="0">
+<fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test-{id}}}" numberOfEventIndicators="0">
   <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true"/>
   <UnitDefinitions>
     <Unit name="m"><BaseUnit m="1"/></Unit>
