@@ -54,6 +54,11 @@ pub struct Experiment {
     pub progress: Option<fn(f64)>,
     /// Integration method of Model Exchange instances.
     pub solver: crate::me::Solver,
+    /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
+    /// handle variable steps: restore the state and retry in halves (at most 2^10
+    /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
+    /// stops the run with [`Error::Fmi`].
+    pub retry_discard: bool,
 }
 
 impl Experiment {
@@ -69,6 +74,7 @@ impl Experiment {
             profile: false,
             progress: None,
             solver: crate::me::Solver::default(),
+            retry_discard: false,
         }
     }
 }
@@ -153,6 +159,8 @@ pub struct Summary {
     pub events: Vec<crate::me::Event>,
     /// Internal integrator steps of Model Exchange instances (accepted, rejected).
     pub integrator_steps: (u64, u64),
+    /// Steps redone in halves after an fmi2Discard.
+    pub discard_retries: u64,
 }
 
 impl Summary {
@@ -162,6 +170,7 @@ impl Summary {
             "steps": self.steps,
             "events": self.events.len(),
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
+            "discard_retries": self.discard_retries,
             "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
@@ -580,6 +589,14 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         });
     }
     let solver = experiment.solver;
+    let mut saved: Vec<Option<crate::fmu::FmuState>> = Vec::with_capacity(instances.len());
+    for inst in instances.iter_mut() {
+        let capable = inst.fmu().interface() == Interface::CoSimulation
+            && inst.fmu().can_get_and_set_state()
+            && inst.fmu().can_handle_variable_step();
+        saved.push(if experiment.retry_discard && capable { Some(inst.get_state()?) } else { None });
+    }
+    let mut retries = 0u64;
     propagate_initial(&mut plan, &mut instances, &mut values)?;
     run_ops(&mut record_gets, &mut instances, &mut values, None)?;
     push_row(&mut results, t0, &values, &record_slots);
@@ -593,9 +610,10 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         for (i, (inst, unit)) in instances.iter_mut().zip(units.iter_mut()).enumerate() {
             let c = profile.then(Instant::now);
-            match unit {
-                None => inst.do_step(t, dt)?,
-                Some(unit) => unit.advance(inst, solver, t, t_next)?,
+            match (unit, &mut saved[i]) {
+                (Some(unit), _) => unit.advance(inst, solver, t, t_next)?,
+                (None, None) => inst.do_step(t, dt)?,
+                (None, Some(state)) => retries += step_with_retry(inst, state, t, dt, 0)?,
             }
             if let Some(c) = c {
                 clocks[i] += c.elapsed();
@@ -627,7 +645,12 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             }
         }
     }
-    let mut summary = Summary { steps, wall_time: Duration::ZERO, ..Summary::default() };
+    let mut summary = Summary { steps, wall_time: Duration::ZERO, discard_retries: retries, ..Summary::default() };
+    for (inst, state) in instances.iter_mut().zip(saved) {
+        if let Some(state) = state {
+            inst.free_state(state)?;
+        }
+    }
     for unit in units.into_iter().flatten() {
         summary.integrator_steps.0 += unit.steps;
         summary.integrator_steps.1 += unit.rejected;
@@ -645,6 +668,23 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(clocks).collect();
     summary.wall_time = wall.elapsed();
     Ok((results, summary))
+}
+
+/// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
+/// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.
+fn step_with_retry(inst: &mut Instance, state: &mut crate::fmu::FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
+    inst.update_state(state)?;
+    match inst.do_step(t, dt) {
+        Ok(()) => Ok(0),
+        Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
+            inst.set_state(state)?;
+            let half = 0.5 * dt;
+            let a = step_with_retry(inst, state, t, half, depth + 1)?;
+            let b = step_with_retry(inst, state, t + half, dt - half, depth + 1)?;
+            Ok(1 + a + b)
+        }
+        Err(e) => Err(e),
+    }
 }
 
 #[inline]

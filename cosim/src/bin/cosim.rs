@@ -53,6 +53,10 @@ struct RunArgs {
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
+    /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
+    /// get/set their state and vary their step).
+    #[arg(long)]
+    retry_discard: bool,
     /// CSV file of the results (fmpy's format).
     #[arg(long, short)]
     output: Option<PathBuf>,
@@ -148,6 +152,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         return Err(Error::Experiment("--max-step must be positive".into()));
     }
     experiment.output_interval = args.output_interval;
+    experiment.retry_discard = args.retry_discard;
     experiment.profile = true;
     if !args.record.is_empty() {
         experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());

@@ -49,7 +49,8 @@ impl Model {
             Model::Faulty => {
                 r#"<ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
     <ScalarVariable name="fail_time" valueReference="1" causality="parameter" variability="fixed"><Real start="0.5"/></ScalarVariable>
-    <ScalarVariable name="mode" valueReference="2" causality="parameter" variability="fixed"><Real start="3"/></ScalarVariable>"#
+    <ScalarVariable name="mode" valueReference="2" causality="parameter" variability="fixed"><Real start="3"/></ScalarVariable>
+    <ScalarVariable name="max_ok_step" valueReference="3" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>"#
             }
         }
     }
@@ -65,7 +66,7 @@ impl Model {
         format!(
             r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test-{id}}}" numberOfEventIndicators="0">
-  <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true"/>
+  <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="{state}"/>
   <UnitDefinitions>
     <Unit name="m"><BaseUnit m="1"/></Unit>
     <Unit name="mm"><BaseUnit m="1" factor="0.001"/></Unit>
@@ -78,6 +79,7 @@ impl Model {
 </fmiModelDescription>
 "#,
             id = self.id(),
+            state = self == Model::Faulty,
             vars = self.variables(),
             structure = self.structure()
         )
