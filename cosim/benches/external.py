@@ -73,6 +73,7 @@ try:
         t = time.perf_counter()
         ex.simulate_until(30_000_000_000)
         return time.perf_counter() - t
-    report("libcosim (libcosimpy 0.0.6), same .ssp", min(libcosim_ssp_run() for _ in range(3)))
+    report("libcosim (libcosimpy 0.0.6), same .ssp", min(libcosim_ssp_run() for _ in range(3)),
+           "(libcosim ignores inline bindings: car at rest)")
 except Exception as e:
     print("libcosim:", e)
