@@ -22,10 +22,16 @@ python="${PYTHON:-python3}"
 # source-code FMU builds (a wheel from PyPI, nothing is downloaded at run time).
 # ecospy (ecos, needs Debian's libtbb12) and libcosimpy (libcosim) are the co-simulation
 # masters the master's cross-checks (cosim/tests/python) compare with; no dependencies.
+# fmu-manipulation-toolbox (fmucontainer: a container FMU with its own C runtime around our
+# FMUs) needs colorama, elementpath and xmlschema.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
 libcosimpy==0.0.6
+fmu-manipulation-toolbox==2.0
+colorama==0.4.6
+elementpath==5.1.4
+xmlschema==4.3.2
 numpy==2.4.6
 pytest==9.2.0
 lxml==6.1.3
