@@ -557,7 +557,9 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut values = vec![0.0; plan.sources.len()];
     let rows = steps / stride + 1;
-    let mut results = Results { names, values: Vec::with_capacity((rows as usize) * (record.len() + 1)) };
+    // reserve for the whole run, up to 64 MiB up front (a huge run grows as it goes)
+    let wanted = (rows as usize).saturating_mul(record.len() + 1).min(8 << 20);
+    let mut results = Results { names, values: Vec::with_capacity(wanted) };
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
     let mut instances: Vec<Instance> = Vec::with_capacity(system.instances.len());
