@@ -29,9 +29,9 @@ enum Command {
 struct RunArgs {
     /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
-    /// FMI interface: cs (Co-Simulation) or me (Model Exchange).
-    #[arg(long, default_value = "cs")]
-    interface: String,
+    /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
+    #[arg(long)]
+    interface: Option<String>,
     /// Start time, s.
     #[arg(long, default_value_t = 0.0)]
     start_time: f64,
@@ -112,13 +112,14 @@ fn progress(fraction: f64) {
 }
 
 fn run(args: RunArgs) -> Result<(), Error> {
-    let interface = match args.interface.as_str() {
-        "cs" => Interface::CoSimulation,
-        "me" => Interface::ModelExchange,
-        other => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+    let interface = match args.interface.as_deref() {
+        None => None,
+        Some("cs") => Some(Interface::CoSimulation),
+        Some("me") => Some(Interface::ModelExchange),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
-    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    let options = ImportOptions { interface, ..ImportOptions::default() };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
         let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions::default())?;
         let builder = SystemBuilder::from_system(ssp.system.clone());
