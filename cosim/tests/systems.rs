@@ -120,7 +120,7 @@ fn connections_are_checked_for_causality_type_and_unit() {
 fn experiment_is_checked() {
     let dir = work_dir("experiment");
     let system = chain(&dir).build();
-    for (stop, step, interval) in [(1.0, 0.3, None), (1.0, 0.0, None), (f64::NAN, 0.1, None), (1.0, 0.1, Some(0.15))] {
+    for (stop, step, interval) in [(1.0, 0.0, None), (f64::NAN, 0.1, None), (1.0, 0.1, Some(0.15))] {
         let mut e = Experiment::new(stop, step);
         e.output_interval = interval;
         assert!(matches!(simulate(&system, &e), Err(Error::Experiment(_))), "{stop} {step} {interval:?}");
@@ -129,6 +129,22 @@ fn experiment_is_checked() {
     e.output_interval = Some(0.5);
     let (r, _) = simulate(&system, &e).unwrap();
     assert_eq!(r.column("time").unwrap(), vec![0.0, 0.5, 1.0]);
+    // not a whole number of steps: these FMUs can take a shorter last step, which ends
+    // exactly at the stop time
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.3)).unwrap();
+    assert_eq!(r.column("time").unwrap(), vec![0.0, 0.3, 0.6, 0.3 * 3.0, 1.0]);
+    assert_eq!(r.column("src.y").unwrap().last(), Some(&1.0));
+    // an FMU that cannot is named
+    let fixed = Model::Gain.model_description().replace(
+        r#"canHandleVariableCommunicationStepSize="true""#,
+        r#"canHandleVariableCommunicationStepSize="false""#,
+    );
+    let mut b = SystemBuilder::new();
+    b.add_instance("rigid", Fmu::load(&build_fmu_with(Model::Gain, &dir, "rigid", &fixed)).unwrap()).unwrap();
+    match simulate(&b.build(), &Experiment::new(1.0, 0.3)) {
+        Err(Error::Experiment(m)) => assert!(m.contains("rigid") && m.contains("canHandleVariable"), "{m}"),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
 }
 
 #[test]
@@ -156,5 +172,34 @@ fn a_library_without_do_step_is_refused_by_name() {
     match Fmu::load(&fmu) {
         Err(Error::MissingSymbol { symbol, .. }) => assert_eq!(symbol, "fmi2DoStep"),
         other => panic!("expected a missing symbol, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_discarded_step_is_restored_and_retried_in_halves() {
+    let dir = work_dir("discard");
+    let fmu = Fmu::load(&build_fmu(Model::Faulty, &dir, &[])).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("f", fmu).unwrap();
+    b.set("f.mode", Value::Real(2.0)).unwrap();
+    b.set("f.fail_time", Value::Real(10.0)).unwrap(); // never fails on time
+    b.set("f.max_ok_step", Value::Real(0.03)).unwrap(); // 0.1 s steps are discarded
+    let system = b.build();
+    let mut e = Experiment::new(0.5, 0.1);
+    // without retries: a clear error naming the Discard
+    match simulate(&system, &e) {
+        Err(Error::Fmi { status: Status::Discard, function: "fmi2DoStep", log, .. }) => {
+            assert!(log.contains("discarded"), "{log}")
+        }
+        other => panic!("expected a Discard, got {other:?}"),
+    }
+    e.retry_discard = true;
+    let (r, s) = simulate(&system, &e).unwrap();
+    // each 0.1 s step: halves 0.05 (discarded again), quarters 0.025 (accepted): 1 + 2 retries
+    assert_eq!(s.discard_retries, 5 * 3);
+    // y = t, the FMU's own clock, reached every communication point
+    let (t, y) = (r.column("time").unwrap(), r.column("y").unwrap());
+    for (a, b) in t.iter().zip(&y) {
+        assert!((a - b).abs() < 1e-15, "{a} vs {b}");
     }
 }

@@ -15,22 +15,23 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate MODEL.fmu (as a one-instance system).
-    Run(RunArgs),
-    /// List the variables (causality, type, unit, start) of an FMU.
+    /// Simulate MODEL.fmu (as a one-instance system) or SYSTEM.ssp / SYSTEM.ssd.
+    Run(Box<RunArgs>),
+    /// List the variables (causality, type, unit, start) of an FMU, or the instances and
+    /// connections of an SSP.
     Info {
-        /// The .fmu file.
+        /// The .fmu, .ssp or .ssd file.
         model: PathBuf,
     },
 }
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// The .fmu file.
+    /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
-    /// FMI interface: cs (Co-Simulation) or me (Model Exchange).
-    #[arg(long, default_value = "cs")]
-    interface: String,
+    /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
+    #[arg(long)]
+    interface: Option<String>,
     /// Start time, s.
     #[arg(long, default_value_t = 0.0)]
     start_time: f64,
@@ -43,6 +44,19 @@ struct RunArgs {
     /// ordered or jacobi.
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
+    /// Model Exchange solver: rk4 or dopri5.
+    #[arg(long, default_value = "rk4")]
+    solver: String,
+    /// Relative tolerance of dopri5 (absolute: rtol / 100).
+    #[arg(long, default_value_t = 1e-6)]
+    rtol: f64,
+    /// Largest RK4 step, s (default: the communication step).
+    #[arg(long)]
+    max_step: Option<f64>,
+    /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
+    /// get/set their state and vary their step).
+    #[arg(long)]
+    retry_discard: bool,
     /// CSV file of the results (fmpy's format).
     #[arg(long, short)]
     output: Option<PathBuf>,
@@ -63,7 +77,7 @@ struct RunArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run(args) => run(args),
+        Command::Run(args) => run(*args),
         Command::Info { model } => info(&model),
     };
     match result {
@@ -98,33 +112,51 @@ fn progress(fraction: f64) {
 }
 
 fn run(args: RunArgs) -> Result<(), Error> {
-    let interface = match args.interface.as_str() {
-        "cs" => Interface::CoSimulation,
-        "me" => Interface::ModelExchange,
-        other => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+    let interface = match args.interface.as_deref() {
+        None => None,
+        Some("cs") => Some(Interface::CoSimulation),
+        Some("me") => Some(Interface::ModelExchange),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
-    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
-    let fmu = Fmu::load_with(&args.model, &options)?;
-    let default = fmu.description().default_experiment.clone().unwrap_or_default();
-    let mut builder = SystemBuilder::new();
-    builder.add_instance(SINGLE, fmu)?;
+    let options = ImportOptions { interface, ..ImportOptions::default() };
+    let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
+        let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions::default())?;
+        let builder = SystemBuilder::from_system(ssp.system.clone());
+        (builder, ssp.default_start_stop.1, None, false, Some(ssp))
+    } else {
+        let fmu = Fmu::load_with(&args.model, &options)?;
+        let default = fmu.description().default_experiment.clone().unwrap_or_default();
+        let mut builder = SystemBuilder::new();
+        builder.add_instance(SINGLE, fmu)?;
+        (builder, default.stop_time, default.step_size, true, None)
+    };
     for s in &args.set {
         let (name, value) =
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
-        builder.set_text(&qualify(name.trim(), true), value)?;
+        builder.set_text(&qualify(name.trim(), single), value)?;
     }
     let system: System = builder.build();
-    let mut experiment = Experiment::new(
-        args.stop_time.or(default.stop_time).unwrap_or(1.0),
-        args.step.or(default.step_size).unwrap_or(1e-3),
-    );
+    let mut experiment =
+        Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
     experiment.algorithm = algorithm;
+    experiment.solver = match args.solver.as_str() {
+        "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
+        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
+            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
+        }
+        "dopri5" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5)"))),
+    };
+    if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+        return Err(Error::Experiment("--max-step must be positive".into()));
+    }
     experiment.output_interval = args.output_interval;
+    experiment.retry_discard = args.retry_discard;
     experiment.profile = true;
     if !args.record.is_empty() {
-        experiment.record = Some(args.record.iter().map(|r| qualify(r, true)).collect());
+        experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
     }
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
@@ -148,7 +180,51 @@ fn run(args: RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+fn is_ssp(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
+}
+
+fn info_ssp(path: &Path) -> Result<(), Error> {
+    use std::io::Write;
+    let ssp = nigel_cosim::read_ssp(path, &ImportOptions::default())?;
+    let s = &ssp.system;
+    let mut out = std::io::stdout().lock();
+    let mut lines = vec![format!(
+        "system {} ({} instances, {} connections)",
+        path.display(),
+        s.instances.len(),
+        s.connections.len()
+    )];
+    for i in &s.instances {
+        lines.push(format!("instance {:<20} {} ({})", i.name, i.fmu.source().display(), i.fmu.interface().as_str()));
+        for (index, v) in &i.start_values {
+            lines.push(format!("  start {} = {v:?}", i.fmu.description().model_variables[*index].name));
+        }
+    }
+    for c in &s.connections {
+        let unit = |r: &nigel_cosim::VariableRef| s.variable(r).variable_type.unit().unwrap_or("-").to_string();
+        lines.push(format!(
+            "connection {} [{}] -> {} [{}]  (x {} + {})",
+            s.name_of(&c.from),
+            unit(&c.from),
+            s.name_of(&c.to),
+            unit(&c.to),
+            c.gain,
+            c.offset
+        ));
+    }
+    for l in lines {
+        if writeln!(out, "{l}").is_err() {
+            break;
+        }
+    }
+    Ok(())
+}
+
 fn info(path: &Path) -> Result<(), Error> {
+    if is_ssp(path) {
+        return info_ssp(path);
+    }
     use std::io::Write;
     // a closed pipe (`cosim info X | head`) ends the listing quietly
     macro_rules! w {
