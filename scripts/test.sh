@@ -27,3 +27,5 @@ echo "== Rust tests"
 cargo test --release --workspace
 echo "== fmpy cross-checks"
 "$target_dir/venv/bin/python" -m pytest tests/python -q
+echo "== co-simulation master cross-checks"
+"$target_dir/venv/bin/python" -m pytest cosim/tests/python -q

@@ -1,0 +1,204 @@
+//! `cosim`: run an FMU or a system of FMUs, or list what is in one.
+
+use clap::{Parser, Subcommand};
+use nigel_cosim::{simulate, Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "cosim", version, about = "FMI 2.0 co-simulation master")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate MODEL.fmu (as a one-instance system).
+    Run(RunArgs),
+    /// List the variables (causality, type, unit, start) of an FMU.
+    Info {
+        /// The .fmu file.
+        model: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// The .fmu file.
+    model: PathBuf,
+    /// FMI interface: cs (Co-Simulation) or me (Model Exchange).
+    #[arg(long, default_value = "cs")]
+    interface: String,
+    /// Start time, s.
+    #[arg(long, default_value_t = 0.0)]
+    start_time: f64,
+    /// Stop time, s (default: the FMU's DefaultExperiment, else 1).
+    #[arg(long)]
+    stop_time: Option<f64>,
+    /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
+    #[arg(long)]
+    step: Option<f64>,
+    /// ordered or jacobi.
+    #[arg(long, default_value = "jacobi")]
+    algorithm: String,
+    /// CSV file of the results (fmpy's format).
+    #[arg(long, short)]
+    output: Option<PathBuf>,
+    /// Output interval, s (a whole multiple of the step; default: every step).
+    #[arg(long)]
+    output_interval: Option<f64>,
+    /// Start value or parameter: instance.variable=value (or variable=value for one FMU).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// Variables to record (default: all outputs), repeatable.
+    #[arg(long = "record", value_name = "NAME")]
+    record: Vec<String>,
+    /// JSON run summary file ("-" for standard output).
+    #[arg(long)]
+    summary: Option<PathBuf>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => run(args),
+        Command::Info { model } => info(&model),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("cosim: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+const SINGLE: &str = "model";
+
+fn qualify(name: &str, single: bool) -> String {
+    if single && !name.starts_with(&format!("{SINGLE}.")) {
+        format!("{SINGLE}.{name}")
+    } else {
+        name.to_string()
+    }
+}
+
+fn progress(fraction: f64) {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static LAST: AtomicU64 = AtomicU64::new(u64::MAX);
+    let pct = (fraction * 100.0).floor() as u64;
+    if LAST.swap(pct, Ordering::Relaxed) != pct {
+        eprint!("\r{pct:3}%");
+        if pct == 100 {
+            eprintln!();
+        }
+    }
+}
+
+fn run(args: RunArgs) -> Result<(), Error> {
+    let interface = match args.interface.as_str() {
+        "cs" => Interface::CoSimulation,
+        "me" => Interface::ModelExchange,
+        other => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+    };
+    let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
+    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    let fmu = Fmu::load_with(&args.model, &options)?;
+    let default = fmu.description().default_experiment.clone().unwrap_or_default();
+    let mut builder = SystemBuilder::new();
+    builder.add_instance(SINGLE, fmu)?;
+    for s in &args.set {
+        let (name, value) =
+            s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
+        builder.set_text(&qualify(name.trim(), true), value)?;
+    }
+    let system: System = builder.build();
+    let mut experiment = Experiment::new(
+        args.stop_time.or(default.stop_time).unwrap_or(1.0),
+        args.step.or(default.step_size).unwrap_or(1e-3),
+    );
+    experiment.start_time = args.start_time;
+    experiment.algorithm = algorithm;
+    experiment.output_interval = args.output_interval;
+    experiment.profile = true;
+    if !args.record.is_empty() {
+        experiment.record = Some(args.record.iter().map(|r| qualify(r, true)).collect());
+    }
+    if std::io::stderr().is_terminal() {
+        experiment.progress = Some(progress);
+    }
+    let (results, summary) = simulate(&system, &experiment)?;
+    let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
+        std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
+    };
+    if let Some(path) = &args.output {
+        write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?;
+    }
+    let json = serde_json::to_string_pretty(&summary.to_json()).unwrap_or_default();
+    match &args.summary {
+        Some(p) if p.as_os_str() == "-" => println!("{json}"),
+        Some(p) => write(p, &|mut f| std::io::Write::write_all(&mut f, json.as_bytes()))?,
+        None => {}
+    }
+    for (instance, message) in &summary.warnings {
+        eprintln!("cosim: warning from {instance}: {message}");
+    }
+    Ok(())
+}
+
+fn info(path: &Path) -> Result<(), Error> {
+    use std::io::Write;
+    // a closed pipe (`cosim info X | head`) ends the listing quietly
+    macro_rules! w {
+        ($o:expr, $($a:tt)*) => {
+            if writeln!($o, $($a)*).is_err() {
+                return Ok(());
+            }
+        };
+    }
+    let mut out = std::io::stdout().lock();
+    let fmu = Fmu::load(path)?;
+    let md = fmu.description();
+    w!(out, "model {} (FMI {}), guid {}", md.model_name, md.fmi_version, md.guid);
+    let cs = md.co_simulation.as_ref().map(|c| c.model_identifier.as_str());
+    let me = md.model_exchange.as_ref().map(|c| c.model_identifier.as_str());
+    w!(
+        out,
+        "interfaces: {}{}",
+        cs.map(|id| format!("CoSimulation ({id}) ")).unwrap_or_default(),
+        me.map(|id| format!("ModelExchange ({id})")).unwrap_or_default()
+    );
+    w!(out, "continuous states: {}, event indicators: {}", md.states().len(), md.number_of_event_indicators);
+    if let Some(d) = &md.default_experiment {
+        w!(
+            out,
+            "default experiment: start {:?}, stop {:?}, step {:?}, tolerance {:?}",
+            d.start_time,
+            d.stop_time,
+            d.step_size,
+            d.tolerance
+        );
+    }
+    w!(out, "{:<28} {:<20} {:<11} {:<8} {:<10} start", "name", "causality", "variability", "type", "unit");
+    for v in &md.model_variables {
+        let start = match &v.variable_type {
+            model_description::VariableType::Real { start, .. } => start.map(|x| x.to_string()),
+            model_description::VariableType::Integer { start, .. } => start.map(|x| x.to_string()),
+            model_description::VariableType::Boolean { start } => start.map(|x| x.to_string()),
+            model_description::VariableType::String { start } => start.clone(),
+        };
+        w!(
+            out,
+            "{:<28} {:<20} {:<11} {:<8} {:<10} {}",
+            v.name,
+            v.causality.as_str(),
+            v.variability.as_str(),
+            v.variable_type.type_name(),
+            v.variable_type.unit().unwrap_or("-"),
+            start.unwrap_or_default()
+        );
+    }
+    Ok(())
+}

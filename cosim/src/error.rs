@@ -1,0 +1,263 @@
+//! The one error type of the master: every failure names its cause.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// FMI 2.0 status codes (`fmi2Status`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// `fmi2OK`.
+    Ok,
+    /// `fmi2Warning`.
+    Warning,
+    /// `fmi2Discard`.
+    Discard,
+    /// `fmi2Error`.
+    Error,
+    /// `fmi2Fatal`.
+    Fatal,
+    /// `fmi2Pending` (asynchronous doStep: refused by this master).
+    Pending,
+    /// Any other integer: a broken FMU.
+    Invalid(i32),
+}
+
+impl Status {
+    /// From the C integer.
+    pub fn from_raw(raw: i32) -> Status {
+        match raw {
+            0 => Status::Ok,
+            1 => Status::Warning,
+            2 => Status::Discard,
+            3 => Status::Error,
+            4 => Status::Fatal,
+            5 => Status::Pending,
+            other => Status::Invalid(other),
+        }
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Status::Ok => f.write_str("fmi2OK"),
+            Status::Warning => f.write_str("fmi2Warning"),
+            Status::Discard => f.write_str("fmi2Discard"),
+            Status::Error => f.write_str("fmi2Error"),
+            Status::Fatal => f.write_str("fmi2Fatal"),
+            Status::Pending => f.write_str("fmi2Pending"),
+            Status::Invalid(v) => write!(f, "invalid status {v}"),
+        }
+    }
+}
+
+/// Everything that can go wrong in import, system building and simulation.
+#[derive(Debug)]
+pub enum Error {
+    /// A file could not be read or written.
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The archive is not a readable zip file.
+    Archive {
+        /// The archive.
+        path: PathBuf,
+        /// What the zip reader said.
+        reason: String,
+    },
+    /// An archive entry would be written outside the unpack folder, or is a link.
+    UnsafeEntry {
+        /// The entry's name as stored in the archive.
+        entry: String,
+        /// Why it is refused.
+        reason: &'static str,
+    },
+    /// An archive entry (declared or actual size) or the whole archive exceeds a limit.
+    ArchiveLimit {
+        /// The entry (or `"<total>"`, `"<entries>"`).
+        entry: String,
+        /// Declared or counted size (bytes or entries).
+        size: u64,
+        /// The limit (raise it in [`crate::UnpackLimits`]).
+        limit: u64,
+    },
+    /// `modelDescription.xml` is missing or malformed.
+    ModelDescription {
+        /// The FMU.
+        path: PathBuf,
+        /// The reader's message, with line and column.
+        reason: String,
+    },
+    /// The FMU does not implement the requested interface.
+    NoInterface {
+        /// The FMU.
+        path: PathBuf,
+        /// "CoSimulation" or "ModelExchange".
+        interface: &'static str,
+    },
+    /// `binaries/linux64/<modelIdentifier>.so` is not in the FMU.
+    MissingBinary {
+        /// The path expected inside the FMU.
+        expected: String,
+        /// The platform folders the FMU does have under `binaries/`.
+        platforms: Vec<String>,
+    },
+    /// The shared library could not be loaded.
+    LoadLibrary {
+        /// The library.
+        path: PathBuf,
+        /// The loader's message.
+        reason: String,
+    },
+    /// The shared library lacks a function the chosen interface needs.
+    MissingSymbol {
+        /// The library.
+        path: PathBuf,
+        /// The function, e.g. `fmi2DoStep`.
+        symbol: &'static str,
+    },
+    /// `fmi2Instantiate` returned NULL.
+    Instantiate {
+        /// The instance name.
+        instance: String,
+        /// The last messages the FMU logged.
+        log: String,
+    },
+    /// An fmi2 function returned Discard, Error, Fatal, Pending or an invalid status.
+    Fmi {
+        /// The instance name.
+        instance: String,
+        /// The function, e.g. `fmi2DoStep`.
+        function: &'static str,
+        /// What it returned.
+        status: Status,
+        /// The simulation time of the call, when it is one.
+        time: Option<f64>,
+        /// The last messages the FMU logged.
+        log: String,
+    },
+    /// A call made in a state where the standard forbids it (a bug of the caller).
+    IllegalCall {
+        /// The instance name.
+        instance: String,
+        /// The function.
+        function: &'static str,
+        /// The instance's state.
+        state: &'static str,
+    },
+    /// An instance name is unknown, repeated or malformed.
+    Instance {
+        /// The name.
+        name: String,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// A variable is unknown in an instance.
+    UnknownVariable {
+        /// The instance.
+        instance: String,
+        /// The variable.
+        variable: String,
+    },
+    /// A value cannot be given to a variable (wrong type, unparsable, wrong causality).
+    InvalidValue {
+        /// `instance.variable`.
+        variable: String,
+        /// The value as given.
+        value: String,
+        /// Why.
+        reason: String,
+    },
+    /// A connection is illegal (type, causality, unit, duplicate).
+    Connection {
+        /// `instance.variable` of the source.
+        from: String,
+        /// `instance.variable` of the destination.
+        to: String,
+        /// Why.
+        reason: String,
+    },
+    /// Direct-feedthrough dependencies form a cycle (for the `ordered` algorithm).
+    AlgebraicLoop {
+        /// The variables on the loop, `instance.variable`, in order.
+        variables: Vec<String>,
+    },
+    /// The experiment is not simulable as given (times, step, output interval).
+    Experiment(String),
+    /// An SSP file is malformed or uses a part this master does not support.
+    Ssp {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong or unsupported, named.
+        reason: String,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            Error::Archive { path, reason } => write!(f, "{}: not a readable zip archive: {reason}", path.display()),
+            Error::UnsafeEntry { entry, reason } => write!(f, "archive entry {entry:?} refused: {reason}"),
+            Error::ArchiveLimit { entry, size, limit } => {
+                write!(f, "archive entry {entry:?}: {size} exceeds the limit {limit} (raise it in the unpack limits)")
+            }
+            Error::ModelDescription { path, reason } => {
+                write!(f, "{}: modelDescription.xml: {reason}", path.display())
+            }
+            Error::NoInterface { path, interface } => {
+                write!(f, "{}: the FMU has no {interface} interface", path.display())
+            }
+            Error::MissingBinary { expected, platforms } => write!(
+                f,
+                "the FMU has no {expected}; platforms it has: {}",
+                if platforms.is_empty() { "none".to_string() } else { platforms.join(", ") }
+            ),
+            Error::LoadLibrary { path, reason } => write!(f, "{}: cannot load: {reason}", path.display()),
+            Error::MissingSymbol { path, symbol } => write!(f, "{}: missing function {symbol}", path.display()),
+            Error::Instantiate { instance, log } => write!(f, "{instance}: fmi2Instantiate returned NULL{}", tail(log)),
+            Error::Fmi { instance, function, status, time, log } => {
+                write!(f, "{instance}: {function} returned {status}")?;
+                if let Some(t) = time {
+                    write!(f, " at t = {t}")?;
+                }
+                f.write_str(&tail(log))
+            }
+            Error::IllegalCall { instance, function, state } => {
+                write!(f, "{instance}: {function} is not allowed in state {state}")
+            }
+            Error::Instance { name, reason } => write!(f, "instance {name:?}: {reason}"),
+            Error::UnknownVariable { instance, variable } => write!(f, "{instance} has no variable {variable:?}"),
+            Error::InvalidValue { variable, value, reason } => write!(f, "{variable} = {value:?}: {reason}"),
+            Error::Connection { from, to, reason } => write!(f, "connection {from} -> {to}: {reason}"),
+            Error::AlgebraicLoop { variables } => {
+                write!(f, "algebraic loop (direct feedthrough cycle): {}", variables.join(" -> "))
+            }
+            Error::Experiment(m) => write!(f, "experiment: {m}"),
+            Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
+        }
+    }
+}
+
+fn tail(log: &str) -> String {
+    if log.is_empty() {
+        String::new()
+    } else {
+        format!(" ({log})")
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+/// `Result` with [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,774 @@
+//! Import of one FMI 2.0 FMU: unpack, read the model description, load the library,
+//! resolve the functions of the chosen interface; and [`Instance`], whose every fmi2 call
+//! returns a typed [`Result`]. An instance terminates and frees itself on drop.
+
+use crate::error::{Error, Result, Status};
+use crate::unpack::{unpack, UnpackLimits};
+use model_description::ModelDescription;
+use std::collections::VecDeque;
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+type Component = *mut c_void;
+type RawStatus = c_int;
+
+/// The FMI interface an instance uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interface {
+    /// Co-Simulation: the FMU steps itself (`fmi2DoStep`).
+    CoSimulation,
+    /// Model Exchange: the master integrates the FMU's derivatives.
+    ModelExchange,
+}
+
+impl Interface {
+    /// The XML element name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Interface::CoSimulation => "CoSimulation",
+            Interface::ModelExchange => "ModelExchange",
+        }
+    }
+    fn fmi_type(self) -> c_int {
+        match self {
+            Interface::ModelExchange => 0,
+            Interface::CoSimulation => 1,
+        }
+    }
+}
+
+#[repr(C)]
+pub(crate) struct CallbackFunctions {
+    logger: unsafe extern "C" fn(),
+    allocate_memory: unsafe extern "C" fn(usize, usize) -> *mut c_void,
+    free_memory: unsafe extern "C" fn(*mut c_void),
+    step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
+    component_environment: *mut c_void,
+}
+
+/// `fmi2EventInfo`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EventInfo {
+    /// `newDiscreteStatesNeeded`.
+    pub new_discrete_states_needed: c_int,
+    /// `terminateSimulation`.
+    pub terminate_simulation: c_int,
+    /// `nominalsOfContinuousStatesChanged`.
+    pub nominals_of_continuous_states_changed: c_int,
+    /// `valuesOfContinuousStatesChanged`.
+    pub values_of_continuous_states_changed: c_int,
+    /// `nextEventTimeDefined`.
+    pub next_event_time_defined: c_int,
+    /// `nextEventTime`.
+    pub next_event_time: f64,
+}
+
+extern "C" {
+    fn nigel_cosim_logger();
+    fn calloc(n: usize, size: usize) -> *mut c_void;
+    fn free(p: *mut c_void);
+}
+
+unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {
+    calloc(n, size)
+}
+unsafe extern "C" fn release(p: *mut c_void) {
+    free(p)
+}
+
+/// One message an FMU logged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogRecord {
+    /// The status the FMU gave it.
+    pub status: Status,
+    /// The category.
+    pub category: String,
+    /// The formatted message.
+    pub message: String,
+}
+
+/// The last messages of one instance (at most [`LogSink::CAPACITY`]).
+#[derive(Debug, Default)]
+pub struct LogSink {
+    records: Mutex<VecDeque<LogRecord>>,
+}
+
+impl LogSink {
+    /// Messages kept per instance.
+    pub const CAPACITY: usize = 64;
+
+    /// Takes the kept messages.
+    pub fn take(&self) -> Vec<LogRecord> {
+        self.records.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
+    }
+
+    /// The last messages at Warning or worse, joined, for an error message.
+    fn recent_problems(&self) -> String {
+        let Ok(records) = self.records.lock() else { return String::new() };
+        let v: Vec<&str> =
+            records.iter().rev().filter(|r| r.status != Status::Ok).take(3).map(|r| r.message.as_str()).collect();
+        v.into_iter().rev().collect::<Vec<_>>().join("; ")
+    }
+}
+
+#[no_mangle]
+unsafe extern "C" fn nigel_cosim_record_log(
+    env: *mut c_void,
+    _instance_name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    if env.is_null() {
+        return;
+    }
+    let _ = std::panic::catch_unwind(|| {
+        // SAFETY: env is the address of the LogSink the instance owns for its whole life.
+        let sink = unsafe { &*(env as *const LogSink) };
+        let text = |p: *const c_char| {
+            if p.is_null() {
+                String::new()
+            } else {
+                // SAFETY: NUL-terminated strings from the FMU / the C shim's buffer.
+                unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+            }
+        };
+        if let Ok(mut r) = sink.records.lock() {
+            if r.len() == LogSink::CAPACITY {
+                r.pop_front();
+            }
+            r.push_back(LogRecord {
+                status: Status::from_raw(status),
+                category: text(category),
+                message: text(message),
+            });
+        }
+    });
+}
+
+macro_rules! fmi2_table {
+    (required { $($rf:ident : $rs:literal => fn($($ra:ty),*) $(-> $rr:ty)?;)* }
+     optional { $($of:ident : $os:literal => fn($($oa:ty),*) $(-> $or:ty)?;)* }) => {
+        /// The fmi2 functions of a library: the ones every interface needs, the rest optional
+        /// (absent when the library lacks them; calling one is then an error naming it).
+        #[allow(missing_docs, dead_code)]
+        pub(crate) struct Functions {
+            $(pub(crate) $rf: unsafe extern "C" fn($($ra),*) $(-> $rr)?,)*
+            $(pub(crate) $of: Option<unsafe extern "C" fn($($oa),*) $(-> $or)?>,)*
+        }
+        impl Functions {
+            /// # Safety
+            /// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
+            unsafe fn load(lib: &libloading::Library, path: &Path) -> Result<Functions> {
+                Ok(Functions {
+                    $($rf: *lib.get::<unsafe extern "C" fn($($ra),*) $(-> $rr)?>(concat!($rs, "\0").as_bytes())
+                        .map_err(|_| Error::MissingSymbol { path: path.to_path_buf(), symbol: $rs })?,)*
+                    $($of: lib.get::<unsafe extern "C" fn($($oa),*) $(-> $or)?>(concat!($os, "\0").as_bytes()).ok().map(|s| *s),)*
+                })
+            }
+        }
+    };
+}
+
+fmi2_table! {
+    required {
+        get_version: "fmi2GetVersion" => fn() -> *const c_char;
+        instantiate: "fmi2Instantiate" => fn(*const c_char, c_int, *const c_char, *const c_char, *const CallbackFunctions, c_int, c_int) -> Component;
+        free_instance: "fmi2FreeInstance" => fn(Component);
+        setup_experiment: "fmi2SetupExperiment" => fn(Component, c_int, f64, f64, c_int, f64) -> RawStatus;
+        enter_initialization_mode: "fmi2EnterInitializationMode" => fn(Component) -> RawStatus;
+        exit_initialization_mode: "fmi2ExitInitializationMode" => fn(Component) -> RawStatus;
+        terminate: "fmi2Terminate" => fn(Component) -> RawStatus;
+        get_real: "fmi2GetReal" => fn(Component, *const u32, usize, *mut f64) -> RawStatus;
+        get_integer: "fmi2GetInteger" => fn(Component, *const u32, usize, *mut c_int) -> RawStatus;
+        get_boolean: "fmi2GetBoolean" => fn(Component, *const u32, usize, *mut c_int) -> RawStatus;
+        get_string: "fmi2GetString" => fn(Component, *const u32, usize, *mut *const c_char) -> RawStatus;
+        set_real: "fmi2SetReal" => fn(Component, *const u32, usize, *const f64) -> RawStatus;
+        set_integer: "fmi2SetInteger" => fn(Component, *const u32, usize, *const c_int) -> RawStatus;
+        set_boolean: "fmi2SetBoolean" => fn(Component, *const u32, usize, *const c_int) -> RawStatus;
+        set_string: "fmi2SetString" => fn(Component, *const u32, usize, *const *const c_char) -> RawStatus;
+    }
+    optional {
+        reset: "fmi2Reset" => fn(Component) -> RawStatus;
+        get_fmu_state: "fmi2GetFMUstate" => fn(Component, *mut *mut c_void) -> RawStatus;
+        set_fmu_state: "fmi2SetFMUstate" => fn(Component, *mut c_void) -> RawStatus;
+        free_fmu_state: "fmi2FreeFMUstate" => fn(Component, *mut *mut c_void) -> RawStatus;
+        do_step: "fmi2DoStep" => fn(Component, f64, f64, c_int) -> RawStatus;
+        get_boolean_status: "fmi2GetBooleanStatus" => fn(Component, c_int, *mut c_int) -> RawStatus;
+        get_real_status: "fmi2GetRealStatus" => fn(Component, c_int, *mut f64) -> RawStatus;
+        enter_event_mode: "fmi2EnterEventMode" => fn(Component) -> RawStatus;
+        new_discrete_states: "fmi2NewDiscreteStates" => fn(Component, *mut EventInfo) -> RawStatus;
+        enter_continuous_time_mode: "fmi2EnterContinuousTimeMode" => fn(Component) -> RawStatus;
+        completed_integrator_step: "fmi2CompletedIntegratorStep" => fn(Component, c_int, *mut c_int, *mut c_int) -> RawStatus;
+        set_time: "fmi2SetTime" => fn(Component, f64) -> RawStatus;
+        set_continuous_states: "fmi2SetContinuousStates" => fn(Component, *const f64, usize) -> RawStatus;
+        get_derivatives: "fmi2GetDerivatives" => fn(Component, *mut f64, usize) -> RawStatus;
+        get_event_indicators: "fmi2GetEventIndicators" => fn(Component, *mut f64, usize) -> RawStatus;
+        get_continuous_states: "fmi2GetContinuousStates" => fn(Component, *mut f64, usize) -> RawStatus;
+        get_nominals_of_continuous_states: "fmi2GetNominalsOfContinuousStates" => fn(Component, *mut f64, usize) -> RawStatus;
+    }
+}
+
+/// The functions each interface needs beyond the common ones (checked at load).
+const CS_NEEDS: &[&str] = &["fmi2DoStep"];
+const ME_NEEDS: &[&str] = &[
+    "fmi2EnterEventMode",
+    "fmi2NewDiscreteStates",
+    "fmi2EnterContinuousTimeMode",
+    "fmi2CompletedIntegratorStep",
+    "fmi2SetTime",
+    "fmi2SetContinuousStates",
+    "fmi2GetDerivatives",
+    "fmi2GetEventIndicators",
+    "fmi2GetContinuousStates",
+];
+
+impl Functions {
+    fn has(&self, symbol: &str) -> bool {
+        match symbol {
+            "fmi2DoStep" => self.do_step.is_some(),
+            "fmi2EnterEventMode" => self.enter_event_mode.is_some(),
+            "fmi2NewDiscreteStates" => self.new_discrete_states.is_some(),
+            "fmi2EnterContinuousTimeMode" => self.enter_continuous_time_mode.is_some(),
+            "fmi2CompletedIntegratorStep" => self.completed_integrator_step.is_some(),
+            "fmi2SetTime" => self.set_time.is_some(),
+            "fmi2SetContinuousStates" => self.set_continuous_states.is_some(),
+            "fmi2GetDerivatives" => self.get_derivatives.is_some(),
+            "fmi2GetEventIndicators" => self.get_event_indicators.is_some(),
+            "fmi2GetContinuousStates" => self.get_continuous_states.is_some(),
+            _ => false,
+        }
+    }
+}
+
+/// How to import: unpack limits and the interface to load.
+#[derive(Clone, Debug, Default)]
+pub struct ImportOptions {
+    /// Archive limits.
+    pub limits: UnpackLimits,
+    /// The interface; `None`: Co-Simulation if the FMU has it, else Model Exchange.
+    pub interface: Option<Interface>,
+}
+
+/// An imported FMU: its unpacked folder (removed on drop), model description and library.
+/// Share it between instances with `Arc`; it outlives them.
+pub struct Fmu {
+    pub(crate) functions: Functions,
+    // field order matters: the library is unloaded before the folder holding it is removed
+    _library: libloading::Library,
+    description: ModelDescription,
+    interface: Interface,
+    source: PathBuf,
+    resource_uri: CString,
+    dir: tempfile::TempDir,
+}
+
+impl std::fmt::Debug for Fmu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Fmu").field("source", &self.source).field("interface", &self.interface).finish()
+    }
+}
+
+/// Reads `modelDescription.xml` of an unpacked FMU.
+pub fn read_model_description(dir: &Path, source: &Path) -> Result<ModelDescription> {
+    let path = dir.join("modelDescription.xml");
+    let xml = std::fs::read(&path)
+        .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") })?;
+    let xml = String::from_utf8(xml)
+        .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: format!("not UTF-8: {e}") })?;
+    ModelDescription::from_xml(&xml)
+        .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: e.to_string() })
+}
+
+fn file_uri(path: &Path) -> String {
+    let mut uri = String::from("file://");
+    for b in path.to_string_lossy().bytes() {
+        if b.is_ascii_alphanumeric() || b"/-._~".contains(&b) {
+            uri.push(b as char);
+        } else {
+            uri.push_str(&format!("%{b:02X}"));
+        }
+    }
+    uri
+}
+
+impl Fmu {
+    /// Imports `path` with default limits, Co-Simulation preferred.
+    pub fn load(path: &Path) -> Result<Arc<Fmu>> {
+        Fmu::load_with(path, &ImportOptions::default())
+    }
+
+    /// Imports `path`: unpack, read the XML, find and load `binaries/linux64/<id>.so`,
+    /// resolve the functions of the interface.
+    pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Arc<Fmu>> {
+        let dir = unpack(path, &options.limits)?;
+        let description = read_model_description(dir.path(), path)?;
+        let interface = match options.interface {
+            Some(i) => i,
+            None if description.co_simulation.is_some() => Interface::CoSimulation,
+            None => Interface::ModelExchange,
+        };
+        let identifier = match interface {
+            Interface::CoSimulation => description.co_simulation.as_ref().map(|c| c.model_identifier.clone()),
+            Interface::ModelExchange => description.model_exchange.as_ref().map(|m| m.model_identifier.clone()),
+        }
+        .ok_or(Error::NoInterface { path: path.to_path_buf(), interface: interface.as_str() })?;
+        if !model_description::is_c_identifier(&identifier) {
+            return Err(Error::ModelDescription {
+                path: path.to_path_buf(),
+                reason: format!("modelIdentifier {identifier:?} is not a C identifier"),
+            });
+        }
+        let relative = format!("binaries/linux64/{identifier}.so");
+        let so = dir.path().join(&relative);
+        if !so.is_file() {
+            let mut platforms: Vec<String> = std::fs::read_dir(dir.path().join("binaries"))
+                .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+                .unwrap_or_default();
+            platforms.sort();
+            return Err(Error::MissingBinary { expected: relative, platforms });
+        }
+        // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
+        let library = unsafe { libloading::Library::new(&so) }
+            .map_err(|e| Error::LoadLibrary { path: so.clone(), reason: e.to_string() })?;
+        // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
+        let functions = unsafe { Functions::load(&library, &so)? };
+        let needs = match interface {
+            Interface::CoSimulation => CS_NEEDS,
+            Interface::ModelExchange => ME_NEEDS,
+        };
+        if let Some(missing) = needs.iter().find(|s| !functions.has(s)) {
+            let symbol = [CS_NEEDS, ME_NEEDS].concat().into_iter().find(|s| s == missing).unwrap_or("fmi2?");
+            return Err(Error::MissingSymbol { path: so, symbol });
+        }
+        let resource_uri = CString::new(file_uri(&dir.path().join("resources")))
+            .map_err(|_| Error::Experiment("temporary folder path contains NUL".into()))?;
+        Ok(Arc::new(Fmu {
+            functions,
+            _library: library,
+            description,
+            interface,
+            source: path.to_path_buf(),
+            resource_uri,
+            dir,
+        }))
+    }
+
+    /// The model description.
+    pub fn description(&self) -> &ModelDescription {
+        &self.description
+    }
+
+    /// The loaded interface.
+    pub fn interface(&self) -> Interface {
+        self.interface
+    }
+
+    /// The archive it came from.
+    pub fn source(&self) -> &Path {
+        &self.source
+    }
+
+    /// The private folder it is unpacked in (removed when the last `Arc` is dropped).
+    pub fn unpacked_dir(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// `canHandleVariableCommunicationStepSize` (false for Model Exchange).
+    pub fn can_handle_variable_step(&self) -> bool {
+        self.interface == Interface::CoSimulation
+            && self.description.co_simulation.as_ref().is_some_and(|c| c.can_handle_variable_communication_step_size)
+    }
+
+    /// `canGetAndSetFMUstate` of the loaded interface, and the functions present.
+    pub fn can_get_and_set_state(&self) -> bool {
+        let flag = match self.interface {
+            Interface::CoSimulation => {
+                self.description.co_simulation.as_ref().is_some_and(|c| c.can_get_and_set_fmu_state)
+            }
+            Interface::ModelExchange => {
+                self.description.model_exchange.as_ref().is_some_and(|c| c.can_get_and_set_fmu_state)
+            }
+        };
+        flag && self.functions.get_fmu_state.is_some()
+            && self.functions.set_fmu_state.is_some()
+            && self.functions.free_fmu_state.is_some()
+    }
+}
+
+/// Life-cycle state of an instance (what the standard allows next).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InstanceState {
+    /// After `fmi2Instantiate`.
+    Instantiated,
+    /// After `fmi2EnterInitializationMode`.
+    Initialization,
+    /// After `fmi2ExitInitializationMode` (step complete / event or continuous-time mode).
+    Running,
+    /// After `fmi2Terminate`.
+    Terminated,
+    /// After an `fmi2Error`: only free is called.
+    Errored,
+    /// After an `fmi2Fatal`: nothing is called any more, not even free.
+    Fatal,
+}
+
+impl InstanceState {
+    fn as_str(self) -> &'static str {
+        match self {
+            InstanceState::Instantiated => "instantiated",
+            InstanceState::Initialization => "initialization mode",
+            InstanceState::Running => "running",
+            InstanceState::Terminated => "terminated",
+            InstanceState::Errored => "errored",
+            InstanceState::Fatal => "fatal",
+        }
+    }
+}
+
+/// A saved FMU state (`fmi2FMUstate`), freed by [`Instance::free_state`] or with the instance.
+#[derive(Debug)]
+pub struct FmuState(*mut c_void);
+
+/// One instance of an FMU. Every call returns `Ok` for fmi2OK and fmi2Warning (the
+/// warning stays in the log), else a typed [`Error::Fmi`] with the FMU's last messages.
+/// Dropping it terminates it (unless it errored or is not initialized) and frees it
+/// (unless it had a fatal error).
+pub struct Instance {
+    component: Component,
+    state: InstanceState,
+    name: String,
+    _name_c: CString,
+    log: Box<LogSink>,
+    _callbacks: Box<CallbackFunctions>,
+    saved: Vec<*mut c_void>,
+    fmu: Arc<Fmu>,
+}
+
+// SAFETY: an FMI 2.0 instance may be used from any thread as long as calls to it are not
+// concurrent (the standard's rule); `&mut self` on every call guarantees that.
+unsafe impl Send for Instance {}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Instance").field("name", &self.name).field("state", &self.state).finish()
+    }
+}
+
+macro_rules! call {
+    ($self:ident, $name:literal, $time:expr, $f:expr) => {{
+        $self.check_callable($name)?;
+        // SAFETY: the component is live (not freed), the arguments are valid for the call.
+        let raw = unsafe { $f };
+        $self.status($name, raw, $time)
+    }};
+}
+
+impl Instance {
+    /// `fmi2Instantiate` with the FMU's interface, logging off (warnings and errors are
+    /// still logged by the FMU and kept).
+    pub fn new(fmu: &Arc<Fmu>, name: &str) -> Result<Instance> {
+        let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
+        let guid = CString::new(fmu.description.guid.as_str())
+            .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
+        let log = Box::<LogSink>::default();
+        let callbacks = Box::new(CallbackFunctions {
+            logger: nigel_cosim_logger,
+            allocate_memory: allocate,
+            free_memory: release,
+            step_finished: None,
+            component_environment: &*log as *const LogSink as *mut c_void,
+        });
+        // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
+        let component = unsafe {
+            (fmu.functions.instantiate)(
+                name_c.as_ptr(),
+                fmu.interface.fmi_type(),
+                guid.as_ptr(),
+                fmu.resource_uri.as_ptr(),
+                &*callbacks,
+                0,
+                0,
+            )
+        };
+        if component.is_null() {
+            return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
+        }
+        Ok(Instance {
+            component,
+            state: InstanceState::Instantiated,
+            name: name.into(),
+            _name_c: name_c,
+            log,
+            _callbacks: callbacks,
+            saved: Vec::new(),
+            fmu: fmu.clone(),
+        })
+    }
+
+    /// The instance name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The FMU.
+    pub fn fmu(&self) -> &Arc<Fmu> {
+        &self.fmu
+    }
+
+    /// The life-cycle state.
+    pub fn state(&self) -> InstanceState {
+        self.state
+    }
+
+    /// Takes the messages the FMU logged (the last [`LogSink::CAPACITY`]).
+    pub fn take_log(&self) -> Vec<LogRecord> {
+        self.log.take()
+    }
+
+    fn check_callable(&self, function: &'static str) -> Result<()> {
+        match self.state {
+            InstanceState::Errored | InstanceState::Fatal | InstanceState::Terminated => {
+                Err(Error::IllegalCall { instance: self.name.clone(), function, state: self.state.as_str() })
+            }
+            _ => Ok(()),
+        }
+    }
+
+    fn status(&mut self, function: &'static str, raw: RawStatus, time: Option<f64>) -> Result<()> {
+        let status = Status::from_raw(raw);
+        match status {
+            Status::Ok | Status::Warning => return Ok(()),
+            Status::Discard => {}
+            Status::Error | Status::Pending | Status::Invalid(_) => self.state = InstanceState::Errored,
+            Status::Fatal => self.state = InstanceState::Fatal,
+        }
+        Err(Error::Fmi { instance: self.name.clone(), function, status, time, log: self.log.recent_problems() })
+    }
+
+    fn optional<T>(&self, f: Option<T>, function: &'static str) -> Result<T> {
+        f.ok_or_else(|| Error::MissingSymbol { path: self.fmu.source.clone(), symbol: function })
+    }
+
+    /// `fmi2SetupExperiment`.
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, stop_time: Option<f64>) -> Result<()> {
+        if self.state != InstanceState::Instantiated {
+            return Err(Error::IllegalCall {
+                instance: self.name.clone(),
+                function: "fmi2SetupExperiment",
+                state: self.state.as_str(),
+            });
+        }
+        let f = self.fmu.functions.setup_experiment;
+        let c = self.component;
+        call!(
+            self,
+            "fmi2SetupExperiment",
+            Some(start_time),
+            f(
+                c,
+                tolerance.is_some() as c_int,
+                tolerance.unwrap_or(0.0),
+                start_time,
+                stop_time.is_some() as c_int,
+                stop_time.unwrap_or(0.0)
+            )
+        )
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization_mode(&mut self) -> Result<()> {
+        let (f, c) = (self.fmu.functions.enter_initialization_mode, self.component);
+        call!(self, "fmi2EnterInitializationMode", None, f(c))?;
+        self.state = InstanceState::Initialization;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`.
+    pub fn exit_initialization_mode(&mut self) -> Result<()> {
+        let (f, c) = (self.fmu.functions.exit_initialization_mode, self.component);
+        call!(self, "fmi2ExitInitializationMode", None, f(c))?;
+        self.state = InstanceState::Running;
+        Ok(())
+    }
+
+    /// `fmi2Terminate` (only from initialization or running; otherwise nothing to do).
+    pub fn terminate(&mut self) -> Result<()> {
+        if !matches!(self.state, InstanceState::Running | InstanceState::Initialization) {
+            return Ok(());
+        }
+        let (f, c) = (self.fmu.functions.terminate, self.component);
+        call!(self, "fmi2Terminate", None, f(c))?;
+        self.state = InstanceState::Terminated;
+        Ok(())
+    }
+
+    /// `fmi2Reset`: back to instantiated (also after an fmi2Error).
+    pub fn reset(&mut self) -> Result<()> {
+        if self.state == InstanceState::Fatal {
+            return Err(Error::IllegalCall { instance: self.name.clone(), function: "fmi2Reset", state: "fatal" });
+        }
+        let f = self.optional(self.fmu.functions.reset, "fmi2Reset")?;
+        // SAFETY: live component.
+        let raw = unsafe { f(self.component) };
+        self.state = InstanceState::Instantiated;
+        self.status("fmi2Reset", raw, None)
+    }
+
+    /// `fmi2GetReal` of `vrs` into `values` (same length).
+    #[inline]
+    pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "get_real: one value per value reference");
+        let (f, c) = (self.fmu.functions.get_real, self.component);
+        call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+    }
+
+    /// `fmi2SetReal`.
+    #[inline]
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "set_real: one value per value reference");
+        let (f, c) = (self.fmu.functions.set_real, self.component);
+        call!(self, "fmi2SetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+    }
+
+    /// `fmi2GetInteger`.
+    #[inline]
+    pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "get_integer: one value per value reference");
+        let (f, c) = (self.fmu.functions.get_integer, self.component);
+        call!(self, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+    }
+
+    /// `fmi2SetInteger`.
+    #[inline]
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "set_integer: one value per value reference");
+        let (f, c) = (self.fmu.functions.set_integer, self.component);
+        call!(self, "fmi2SetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+    }
+
+    /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true).
+    #[inline]
+    pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "get_boolean: one value per value reference");
+        let (f, c) = (self.fmu.functions.get_boolean, self.component);
+        call!(self, "fmi2GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+    }
+
+    /// `fmi2SetBoolean`.
+    #[inline]
+    pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "set_boolean: one value per value reference");
+        let (f, c) = (self.fmu.functions.set_boolean, self.component);
+        call!(self, "fmi2SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+    }
+
+    /// `fmi2GetString` of one variable (copied).
+    pub fn get_string(&mut self, vr: u32) -> Result<String> {
+        let mut p: *const c_char = std::ptr::null();
+        let (f, c) = (self.fmu.functions.get_string, self.component);
+        call!(self, "fmi2GetString", None, f(c, &vr, 1, &mut p))?;
+        if p.is_null() {
+            return Ok(String::new());
+        }
+        // SAFETY: the FMU returns a NUL-terminated string valid until the next call.
+        Ok(unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+    }
+
+    /// `fmi2SetString` of one variable.
+    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        let s = CString::new(value).map_err(|_| Error::InvalidValue {
+            variable: format!("{}.<vr {vr}>", self.name),
+            value: value.into(),
+            reason: "NUL in string".into(),
+        })?;
+        let p = s.as_ptr();
+        let (f, c) = (self.fmu.functions.set_string, self.component);
+        call!(self, "fmi2SetString", None, f(c, &vr, 1, &p))
+    }
+
+    /// `fmi2DoStep` from `time` over `step` (Co-Simulation).
+    #[inline]
+    pub fn do_step(&mut self, time: f64, step: f64) -> Result<()> {
+        let f = self.optional(self.fmu.functions.do_step, "fmi2DoStep")?;
+        let c = self.component;
+        call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))
+    }
+
+    /// `fmi2GetFMUstate`: saves the current state.
+    pub fn get_state(&mut self) -> Result<FmuState> {
+        let f = self.optional(self.fmu.functions.get_fmu_state, "fmi2GetFMUstate")?;
+        let mut s: *mut c_void = std::ptr::null_mut();
+        let c = self.component;
+        call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?;
+        self.saved.push(s);
+        Ok(FmuState(s))
+    }
+
+    /// `fmi2GetFMUstate` into an existing state (overwritten).
+    pub fn update_state(&mut self, state: &mut FmuState) -> Result<()> {
+        let f = self.optional(self.fmu.functions.get_fmu_state, "fmi2GetFMUstate")?;
+        let c = self.component;
+        let mut s = state.0;
+        call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?;
+        if s != state.0 {
+            self.saved.retain(|p| *p != state.0);
+            self.saved.push(s);
+            state.0 = s;
+        }
+        Ok(())
+    }
+
+    /// `fmi2SetFMUstate`: restores a saved state.
+    pub fn set_state(&mut self, state: &FmuState) -> Result<()> {
+        let f = self.optional(self.fmu.functions.set_fmu_state, "fmi2SetFMUstate")?;
+        let c = self.component;
+        call!(self, "fmi2SetFMUstate", None, f(c, state.0))
+    }
+
+    /// `fmi2FreeFMUstate`.
+    pub fn free_state(&mut self, state: FmuState) -> Result<()> {
+        let f = self.optional(self.fmu.functions.free_fmu_state, "fmi2FreeFMUstate")?;
+        self.saved.retain(|p| *p != state.0);
+        let mut s = state.0;
+        let c = self.component;
+        call!(self, "fmi2FreeFMUstate", None, f(c, &mut s))
+    }
+
+    /// `fmi2GetBooleanStatus(fmi2Terminated)` after a Discard: whether the FMU wants to stop.
+    pub fn terminated_status(&mut self) -> Option<bool> {
+        let f = self.fmu.functions.get_boolean_status?;
+        let mut v: c_int = 0;
+        // SAFETY: live component, valid out pointer; 3 = fmi2Terminated.
+        let raw = unsafe { f(self.component, 3, &mut v) };
+        (raw == 0).then_some(v != 0)
+    }
+
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    pub fn last_successful_time(&mut self) -> Option<f64> {
+        let f = self.fmu.functions.get_real_status?;
+        let mut v = 0.0;
+        // SAFETY: live component, valid out pointer; 2 = fmi2LastSuccessfulTime.
+        let raw = unsafe { f(self.component, 2, &mut v) };
+        (raw == 0).then_some(v)
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        if self.state == InstanceState::Fatal {
+            return; // the standard: nothing may be called after fmi2Fatal
+        }
+        let _ = self.terminate();
+        if let Some(free_state) = self.fmu.functions.free_fmu_state {
+            for mut s in std::mem::take(&mut self.saved) {
+                // SAFETY: states we obtained from this instance and did not free.
+                unsafe { free_state(self.component, &mut s) };
+            }
+        }
+        // SAFETY: the component came from fmi2Instantiate and is freed once.
+        unsafe { (self.fmu.functions.free_instance)(self.component) };
+    }
+}

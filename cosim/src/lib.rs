@@ -1,0 +1,32 @@
+//! `nigel_cosim`: an FMI 2.0 co-simulation master.
+//!
+//! - [`Fmu::load`] imports any FMI 2.0 `.fmu` safely ([`unpack`]: no path escapes, no
+//!   links, limits against archive bombs) and resolves the functions of its interface;
+//!   [`Instance`] wraps every fmi2 call in a typed [`Result`].
+//! - [`SystemBuilder`] makes a [`System`] of instances, start values and connections
+//!   checked for type, causality and unit.
+//! - [`simulate`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
+//!   [`Algorithm::Ordered`], time `t0 + n h`, into [`Results`] (CSV as fmpy writes it).
+//!
+//! ```no_run
+//! use nigel_cosim::{Fmu, System, Experiment, simulate};
+//! let fmu = Fmu::load("target/fmu/nigel_plant.fmu".as_ref())?;
+//! let system = System::single("plant", fmu)?;
+//! let (results, summary) = simulate(&system, &Experiment::new(1.0, 1e-3))?;
+//! results.write_csv(std::fs::File::create("out.csv").unwrap()).unwrap();
+//! # Ok::<(), nigel_cosim::Error>(())
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod fmu;
+pub mod simulate;
+pub mod system;
+pub mod unpack;
+
+pub use error::{Error, Result, Status};
+pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
+pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};
+pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};
+pub use unpack::UnpackLimits;

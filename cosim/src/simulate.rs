@@ -1,0 +1,655 @@
+//! Fixed-step Co-Simulation of a [`System`]: initialization per the standard, `jacobi`
+//! and `ordered` communication, results at output points. Time is `t0 + n h`.
+//!
+//! Before the loop everything is resolved to value references and buffer slots: the
+//! loop does not allocate and looks nothing up by name.
+
+use crate::error::{Error, Result};
+use crate::fmu::{Instance, Interface};
+use crate::system::{BaseType, System, Value, VariableRef};
+use model_description::Causality;
+use std::time::{Duration, Instant};
+
+/// How connections are updated at communication points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Algorithm {
+    /// Every connection delayed by one step (all outputs read, then all inputs set), as
+    /// fmpy `simulate_ssp`, libcosim and ecos do.
+    Jacobi,
+    /// Outputs flow along direct-feedthrough chains in topological order, so an input sees
+    /// its source at the same communication point; algebraic loops are refused by name.
+    Ordered,
+}
+
+impl std::str::FromStr for Algorithm {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "jacobi" => Ok(Algorithm::Jacobi),
+            "ordered" => Ok(Algorithm::Ordered),
+            _ => Err(format!("unknown algorithm {s:?} (jacobi, ordered)")),
+        }
+    }
+}
+
+/// What to simulate.
+#[derive(Clone, Debug)]
+pub struct Experiment {
+    /// Start time t0, s.
+    pub start_time: f64,
+    /// Stop time, s.
+    pub stop_time: f64,
+    /// Communication step h, s.
+    pub step: f64,
+    /// Algorithm.
+    pub algorithm: Algorithm,
+    /// Output interval (a whole multiple of `step`); `None`: every step.
+    pub output_interval: Option<f64>,
+    /// Variables to record (`instance.variable`); `None`: every output of every instance.
+    pub record: Option<Vec<String>>,
+    /// Measure the time spent in each FMU (two clock reads per call).
+    pub profile: bool,
+    /// Called with the fraction done (0..=1) at each output point.
+    pub progress: Option<fn(f64)>,
+}
+
+impl Experiment {
+    /// `stop_time` with step `h` from 0, jacobi, every step recorded.
+    pub fn new(stop_time: f64, step: f64) -> Experiment {
+        Experiment {
+            start_time: 0.0,
+            stop_time,
+            step,
+            algorithm: Algorithm::Jacobi,
+            output_interval: None,
+            record: None,
+            profile: false,
+            progress: None,
+        }
+    }
+}
+
+/// Results: one row per output point, `time` first.
+#[derive(Clone, Debug, Default)]
+pub struct Results {
+    /// Column names after `time` (`instance.variable`, or the bare name for a one-instance system).
+    pub names: Vec<String>,
+    /// Row-major values: `time, v1, v2, ...` per row.
+    pub values: Vec<f64>,
+}
+
+impl Results {
+    /// Number of columns including time.
+    pub fn width(&self) -> usize {
+        self.names.len() + 1
+    }
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.values.len() / self.width()
+    }
+    /// Row `k` (time first).
+    pub fn row(&self, k: usize) -> &[f64] {
+        &self.values[k * self.width()..(k + 1) * self.width()]
+    }
+    /// The column called `name` (`"time"` for time).
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let j = if name == "time" { 0 } else { self.names.iter().position(|n| n == name)? + 1 };
+        Some((0..self.rows()).map(|k| self.row(k)[j]).collect())
+    }
+
+    /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
+    /// in the shortest form that reads back to the same f64.
+    pub fn write_csv<W: std::io::Write>(&self, mut w: W) -> std::io::Result<()> {
+        let mut line = String::from("\"time\"");
+        for n in &self.names {
+            line.push_str(",\"");
+            line.push_str(&n.replace('"', "\"\""));
+            line.push('"');
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
+        for k in 0..self.rows() {
+            line.clear();
+            for (j, v) in self.row(k).iter().enumerate() {
+                if j > 0 {
+                    line.push(',');
+                }
+                push_number(&mut line, *v);
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        w.flush()
+    }
+}
+
+/// Shortest round-trip text of `v` (exponent form for very small or large magnitudes).
+pub fn push_number(out: &mut String, v: f64) {
+    use std::fmt::Write;
+    let a = v.abs();
+    if v == 0.0 || (1e-5..1e16).contains(&a) || !v.is_finite() {
+        let _ = write!(out, "{v}");
+    } else {
+        let _ = write!(out, "{v:e}");
+    }
+}
+
+/// A JSON-able run summary.
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    /// Communication steps taken.
+    pub steps: u64,
+    /// Wall time of initialization + loop.
+    pub wall_time: Duration,
+    /// Per instance: name and time spent in its fmi2 calls (zero unless profiling).
+    pub instance_time: Vec<(String, Duration)>,
+    /// Warnings the FMUs logged (instance, message).
+    pub warnings: Vec<(String, String)>,
+}
+
+impl Summary {
+    /// As a JSON value.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "steps": self.steps,
+            "events": 0,
+            "wall_time_s": self.wall_time.as_secs_f64(),
+            "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
+            "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
+        })
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OpKind {
+    Get,
+    Set,
+}
+
+/// One batched fmi2Get/fmi2Set call of one instance and one base type.
+#[derive(Debug)]
+struct Op {
+    instance: usize,
+    kind: OpKind,
+    base_type: BaseType,
+    vrs: Vec<u32>,
+    /// Get: slot each value goes to. Set: (slot, gain, offset) each value comes from.
+    slots: Vec<usize>,
+    gains: Vec<(f64, f64)>,
+    reals: Vec<f64>,
+    ints: Vec<i32>,
+}
+
+impl Op {
+    fn new(instance: usize, kind: OpKind, base_type: BaseType) -> Op {
+        Op { instance, kind, base_type, vrs: vec![], slots: vec![], gains: vec![], reals: vec![], ints: vec![] }
+    }
+    fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64)) {
+        self.vrs.push(vr);
+        self.slots.push(slot);
+        self.gains.push(gain);
+        self.reals.push(0.0);
+        self.ints.push(0);
+    }
+
+    #[inline]
+    fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
+        match (self.kind, self.base_type) {
+            (OpKind::Get, BaseType::Real) => {
+                inst.get_real(&self.vrs, &mut self.reals)?;
+                for (s, v) in self.slots.iter().zip(&self.reals) {
+                    values[*s] = *v;
+                }
+            }
+            (OpKind::Get, BaseType::Integer) => {
+                inst.get_integer(&self.vrs, &mut self.ints)?;
+                for (s, v) in self.slots.iter().zip(&self.ints) {
+                    values[*s] = f64::from(*v);
+                }
+            }
+            (OpKind::Get, BaseType::Boolean) => {
+                inst.get_boolean(&self.vrs, &mut self.ints)?;
+                for (s, v) in self.slots.iter().zip(&self.ints) {
+                    values[*s] = if *v != 0 { 1.0 } else { 0.0 };
+                }
+            }
+            (OpKind::Set, BaseType::Real) => {
+                for ((r, s), (g, o)) in self.reals.iter_mut().zip(&self.slots).zip(&self.gains) {
+                    *r = g * values[*s] + o;
+                }
+                inst.set_real(&self.vrs, &self.reals)?;
+            }
+            (OpKind::Set, BaseType::Integer) => {
+                for (r, s) in self.ints.iter_mut().zip(&self.slots) {
+                    *r = values[*s] as i32;
+                }
+                inst.set_integer(&self.vrs, &self.ints)?;
+            }
+            (OpKind::Set, BaseType::Boolean) => {
+                for (r, s) in self.ints.iter_mut().zip(&self.slots) {
+                    *r = (values[*s] != 0.0) as i32;
+                }
+                inst.set_boolean(&self.vrs, &self.ints)?;
+            }
+            (_, BaseType::String) => {}
+        }
+        Ok(())
+    }
+}
+
+/// Appends `node` to the op list, merging into the last op when it is the same call.
+fn emit(ops: &mut Vec<Op>, instance: usize, kind: OpKind, ty: BaseType, vr: u32, slot: usize, gain: (f64, f64)) {
+    match ops.last_mut() {
+        Some(op) if op.instance == instance && op.kind == kind && op.base_type == ty => {
+            if kind == OpKind::Get && op.vrs.contains(&vr) && op.slots.contains(&slot) {
+                return;
+            }
+            op.push(vr, slot, gain)
+        }
+        _ => {
+            let mut op = Op::new(instance, kind, ty);
+            op.push(vr, slot, gain);
+            ops.push(op);
+        }
+    }
+}
+
+/// The communication plan of a system: slots for every connected output and recorded
+/// variable, and the ordered list of batched calls.
+#[derive(Debug)]
+struct Plan {
+    /// Slot of each source variable, indexed like `sources`.
+    sources: Vec<VariableRef>,
+    /// (instance, kind, type) node list for ordered propagation, as ops.
+    ordered: Option<Vec<Op>>,
+    jacobi_gets: Vec<Op>,
+    jacobi_sets: Vec<Op>,
+}
+
+fn slot_of(sources: &mut Vec<VariableRef>, r: &VariableRef) -> usize {
+    if let Some(k) = sources.iter().position(|s| s == r) {
+        return k;
+    }
+    sources.push(r.clone());
+    sources.len() - 1
+}
+
+/// Whether output `out` of an FMU depends directly on input `input` (0-based indices).
+fn depends(md: &model_description::ModelDescription, out: usize, input: usize) -> bool {
+    let index = out as u32 + 1;
+    match md.model_structure.outputs.iter().find(|u| u.index == index) {
+        Some(u) => match &u.dependencies {
+            None => true,
+            Some(deps) => deps.contains(&(input as u32 + 1)),
+        },
+        None => true, // not listed: assume the worst
+    }
+}
+
+/// Topological order of the variable-level graph (connections and direct feedthrough),
+/// or the algebraic loop by name.
+fn ordered_nodes(system: &System, connected_outputs: &[VariableRef]) -> Result<Vec<(bool, usize)>> {
+    // nodes: outputs (is_output = true, index into connected_outputs) and connections' inputs
+    let n_out = connected_outputs.len();
+    let n = n_out + system.connections.len();
+    let mut edges: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (c, conn) in system.connections.iter().enumerate() {
+        let src = connected_outputs.iter().position(|o| *o == conn.from).unwrap_or(0);
+        edges[src].push(n_out + c); // output -> input (connection)
+        for (o, out) in connected_outputs.iter().enumerate() {
+            if out.instance == conn.to.instance && depends(system.description(out.instance), out.index, conn.to.index) {
+                edges[n_out + c].push(o); // input -> output of the same FMU (feedthrough)
+            }
+        }
+    }
+    let mut indegree = vec![0usize; n];
+    for e in edges.iter().flatten() {
+        indegree[*e] += 1;
+    }
+    let node_instance =
+        |k: usize| if k < n_out { connected_outputs[k].instance } else { system.connections[k - n_out].to.instance };
+    let mut ready: Vec<usize> = (0..n).filter(|k| indegree[*k] == 0).collect();
+    let mut order = Vec::with_capacity(n);
+    let mut last: Option<(usize, bool)> = None;
+    while !ready.is_empty() {
+        // prefer the same instance and kind as the last node: fewer, larger batches
+        let pick = last
+            .and_then(|(i, is_out)| ready.iter().position(|k| node_instance(*k) == i && (*k < n_out) == is_out))
+            .unwrap_or(0);
+        let k = ready.swap_remove(pick);
+        last = Some((node_instance(k), k < n_out));
+        order.push(k);
+        for &e in &edges[k] {
+            indegree[e] -= 1;
+            if indegree[e] == 0 {
+                ready.push(e);
+            }
+        }
+    }
+    if order.len() < n {
+        // a cycle remains among nodes with indegree > 0: walk it from any of them
+        let name = |k: usize| {
+            if k < n_out {
+                system.name_of(&connected_outputs[k])
+            } else {
+                system.name_of(&system.connections[k - n_out].to)
+            }
+        };
+        let mut k = (0..n).find(|k| indegree[*k] > 0).unwrap_or(0);
+        let mut path: Vec<usize> = Vec::new();
+        loop {
+            if let Some(p) = path.iter().position(|x| *x == k) {
+                let cycle: Vec<String> = path[p..].iter().map(|x| name(*x)).chain([name(k)]).collect();
+                return Err(Error::AlgebraicLoop { variables: cycle });
+            }
+            path.push(k);
+            k = match edges[k].iter().find(|e| indegree[**e] > 0) {
+                Some(e) => *e,
+                None => return Err(Error::AlgebraicLoop { variables: path.iter().map(|x| name(*x)).collect() }),
+            };
+        }
+    }
+    Ok(order.into_iter().map(|k| if k < n_out { (true, k) } else { (false, k - n_out) }).collect())
+}
+
+impl Plan {
+    fn new(system: &System, record: &[VariableRef], algorithm: Algorithm) -> Result<Plan> {
+        let mut sources: Vec<VariableRef> = Vec::new();
+        let mut connected_outputs: Vec<VariableRef> = Vec::new();
+        for c in &system.connections {
+            slot_of(&mut sources, &c.from);
+            if !connected_outputs.contains(&c.from) {
+                connected_outputs.push(c.from.clone());
+            }
+        }
+        for r in record {
+            slot_of(&mut sources, r);
+        }
+        // jacobi: per instance and type one get of its connected outputs and recorded
+        // variables, then per instance and type one set of its connected inputs
+        let mut jacobi_gets = Vec::new();
+        let mut jacobi_sets = Vec::new();
+        for i in 0..system.instances.len() {
+            for ty in [BaseType::Real, BaseType::Integer, BaseType::Boolean] {
+                let mut get = Op::new(i, OpKind::Get, ty);
+                for (k, s) in sources.iter().enumerate() {
+                    if s.instance == i && s.base_type == ty && !get.vrs.contains(&s.value_reference) {
+                        get.push(s.value_reference, k, (1.0, 0.0));
+                    } else if s.instance == i && s.base_type == ty {
+                        // same value reference (an alias): read it again into its own slot
+                        get.push(s.value_reference, k, (1.0, 0.0));
+                    }
+                }
+                if !get.vrs.is_empty() {
+                    jacobi_gets.push(get);
+                }
+                let mut set = Op::new(i, OpKind::Set, ty);
+                for c in system.connections.iter().filter(|c| c.to.instance == i && c.to.base_type == ty) {
+                    let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+                    set.push(c.to.value_reference, slot, (c.gain, c.offset));
+                }
+                if !set.vrs.is_empty() {
+                    jacobi_sets.push(set);
+                }
+            }
+        }
+        let ordered = match ordered_nodes(system, &connected_outputs) {
+            Ok(nodes) => {
+                let mut ops = Vec::new();
+                for (is_output, k) in nodes {
+                    if is_output {
+                        let r = &connected_outputs[k];
+                        let slot = sources.iter().position(|s| s == r).unwrap_or(0);
+                        emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
+                    } else {
+                        let c = &system.connections[k];
+                        let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+                        emit(
+                            &mut ops,
+                            c.to.instance,
+                            OpKind::Set,
+                            c.to.base_type,
+                            c.to.value_reference,
+                            slot,
+                            (c.gain, c.offset),
+                        );
+                    }
+                }
+                Some(ops)
+            }
+            Err(e) if algorithm == Algorithm::Ordered => return Err(e),
+            Err(_) => None,
+        };
+        Ok(Plan { sources, ordered, jacobi_gets, jacobi_sets })
+    }
+}
+
+fn run_ops(
+    ops: &mut [Op],
+    instances: &mut [Instance],
+    values: &mut [f64],
+    clocks: Option<&mut [Duration]>,
+) -> Result<()> {
+    match clocks {
+        None => {
+            for op in ops.iter_mut() {
+                op.run(&mut instances[op.instance], values)?;
+            }
+        }
+        Some(clocks) => {
+            for op in ops.iter_mut() {
+                let t = Instant::now();
+                op.run(&mut instances[op.instance], values)?;
+                clocks[op.instance] += t.elapsed();
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The variables recorded by default: every output of every instance.
+pub fn default_record(system: &System) -> Vec<VariableRef> {
+    let mut out = Vec::new();
+    for (i, spec) in system.instances.iter().enumerate() {
+        for (index, v) in spec.fmu.description().model_variables.iter().enumerate() {
+            if v.causality == Causality::Output && BaseType::of(v) != BaseType::String {
+                out.push(VariableRef {
+                    instance: i,
+                    index,
+                    value_reference: v.value_reference,
+                    base_type: BaseType::of(v),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Number of steps and the output stride for an experiment, checked.
+fn schedule(e: &Experiment) -> Result<(u64, u64)> {
+    let ok = |x: f64| x.is_finite();
+    if !(ok(e.start_time) && ok(e.stop_time) && ok(e.step)) || e.step <= 0.0 || e.stop_time < e.start_time {
+        return Err(Error::Experiment(format!(
+            "need finite times with stop >= start and step > 0 (start {}, stop {}, step {})",
+            e.start_time, e.stop_time, e.step
+        )));
+    }
+    let span = (e.stop_time - e.start_time) / e.step;
+    let steps = span.round();
+    if (span - steps).abs() > 1e-9 * span.max(1.0) {
+        return Err(Error::Experiment(format!(
+            "the interval {} s is not a whole number of steps of {} s",
+            e.stop_time - e.start_time,
+            e.step
+        )));
+    }
+    if steps > 1e12 {
+        return Err(Error::Experiment(format!("{steps} steps is too many")));
+    }
+    let stride = match e.output_interval {
+        None => 1.0,
+        Some(d) => {
+            let r = d / e.step;
+            if !(d.is_finite() && d > 0.0) || (r - r.round()).abs() > 1e-9 * r.max(1.0) || r.round() < 1.0 {
+                return Err(Error::Experiment(format!(
+                    "the output interval {d} s must be a whole multiple of the step {} s",
+                    e.step
+                )));
+            }
+            r.round()
+        }
+    };
+    Ok((steps as u64, stride as u64))
+}
+
+/// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
+pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
+    let wall = Instant::now();
+    let (steps, stride) = schedule(experiment)?;
+    if let Some(spec) = system.instances.iter().find(|s| s.fmu.interface() != Interface::CoSimulation) {
+        return Err(Error::Experiment(format!(
+            "instance {} is loaded for Model Exchange; this master steps Co-Simulation FMUs only",
+            spec.name
+        )));
+    }
+    let record: Vec<VariableRef> = match &experiment.record {
+        None => default_record(system),
+        Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
+    };
+    if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
+        return Err(Error::InvalidValue {
+            variable: system.name_of(r),
+            value: String::new(),
+            reason: "String variables cannot be recorded in CSV".into(),
+        });
+    }
+    let mut plan = Plan::new(system, &record, experiment.algorithm)?;
+    let record_slots: Vec<usize> =
+        record.iter().map(|r| plan.sources.iter().position(|s| s == r).unwrap_or(0)).collect();
+    let mut record_gets: Vec<Op> = Vec::new();
+    for r in &record {
+        let slot = plan.sources.iter().position(|s| s == r).unwrap_or(0);
+        emit(&mut record_gets, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
+    }
+    // merge the record gets per instance and type
+    record_gets.sort_by_key(|op| (op.instance, op.base_type));
+    let mut merged: Vec<Op> = Vec::new();
+    for op in record_gets {
+        for k in 0..op.vrs.len() {
+            emit(&mut merged, op.instance, OpKind::Get, op.base_type, op.vrs[k], op.slots[k], (1.0, 0.0));
+        }
+    }
+    let mut record_gets = merged;
+
+    let single = system.instances.len() == 1;
+    let names: Vec<String> =
+        record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
+    let mut values = vec![0.0; plan.sources.len()];
+    let rows = steps / stride + 1;
+    let mut results = Results { names, values: Vec::with_capacity((rows as usize) * (record.len() + 1)) };
+
+    // instantiate and initialize (FMI 2.0 section 4.2.4)
+    let mut instances: Vec<Instance> = Vec::with_capacity(system.instances.len());
+    for spec in &system.instances {
+        instances.push(Instance::new(&spec.fmu, &spec.name)?);
+    }
+    let t0 = experiment.start_time;
+    for (inst, spec) in instances.iter_mut().zip(&system.instances) {
+        inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
+        apply_start_values(inst, spec)?;
+        inst.enter_initialization_mode()?;
+    }
+    let propagate_initial = |plan: &mut Plan, instances: &mut [Instance], values: &mut [f64]| -> Result<()> {
+        match plan.ordered.as_mut() {
+            Some(ops) => run_ops(ops, instances, values, None),
+            None => {
+                run_ops(&mut plan.jacobi_gets, instances, values, None)?;
+                run_ops(&mut plan.jacobi_sets, instances, values, None)
+            }
+        }
+    };
+    propagate_initial(&mut plan, &mut instances, &mut values)?;
+    for inst in instances.iter_mut() {
+        inst.exit_initialization_mode()?;
+    }
+    propagate_initial(&mut plan, &mut instances, &mut values)?;
+    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+    push_row(&mut results, t0, &values, &record_slots);
+
+    let mut clocks = vec![Duration::ZERO; instances.len()];
+    let profile = experiment.profile;
+    let h = experiment.step;
+    for n in 0..steps {
+        let t = t0 + n as f64 * h;
+        let t_next = t0 + (n + 1) as f64 * h;
+        let dt = t_next - t; // as fmpy: the step is the difference of the two points
+        for (i, inst) in instances.iter_mut().enumerate() {
+            if profile {
+                let c = Instant::now();
+                inst.do_step(t, dt)?;
+                clocks[i] += c.elapsed();
+            } else {
+                inst.do_step(t, dt)?;
+            }
+        }
+        let clk = if profile { Some(&mut clocks[..]) } else { None };
+        let output_point = (n + 1) % stride == 0;
+        match (experiment.algorithm, plan.ordered.as_mut()) {
+            (Algorithm::Ordered, Some(ops)) => {
+                run_ops(ops, &mut instances, &mut values, clk)?;
+                if output_point {
+                    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+                }
+            }
+            _ => {
+                // outputs (and recorded values) right after the step, then the inputs
+                if output_point {
+                    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+                }
+                let mut clk = clk;
+                run_ops(&mut plan.jacobi_gets, &mut instances, &mut values, clk.as_deref_mut())?;
+                run_ops(&mut plan.jacobi_sets, &mut instances, &mut values, clk)?;
+            }
+        }
+        if output_point {
+            push_row(&mut results, t_next, &values, &record_slots);
+            if let Some(p) = experiment.progress {
+                p((n + 1) as f64 / steps as f64);
+            }
+        }
+    }
+    let mut summary = Summary { steps, wall_time: Duration::ZERO, ..Summary::default() };
+    for inst in instances.iter_mut() {
+        inst.terminate()?;
+        for rec in inst.take_log() {
+            if rec.status != crate::error::Status::Ok {
+                summary.warnings.push((inst.name().to_string(), rec.message));
+            }
+        }
+    }
+    drop(instances);
+    summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(clocks).collect();
+    summary.wall_time = wall.elapsed();
+    Ok((results, summary))
+}
+
+#[inline]
+fn push_row(results: &mut Results, t: f64, values: &[f64], slots: &[usize]) {
+    results.values.push(t);
+    results.values.extend(slots.iter().map(|s| values[*s]));
+}
+
+/// Sets the start values of an instance (before initialization mode), one call each.
+pub fn apply_start_values(inst: &mut Instance, spec: &crate::system::InstanceSpec) -> Result<()> {
+    let md = spec.fmu.description();
+    for (index, value) in &spec.start_values {
+        let vr = md.model_variables[*index].value_reference;
+        match value {
+            Value::Real(x) => inst.set_real(&[vr], &[*x])?,
+            Value::Integer(x) => inst.set_integer(&[vr], &[*x])?,
+            Value::Boolean(x) => inst.set_boolean(&[vr], &[*x as i32])?,
+            Value::String(s) => inst.set_string(vr, s)?,
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,363 @@
+//! Systems of FMU instances: the builder (start values, checked connections) and the
+//! resolved [`System`] that the stepping code runs.
+
+use crate::error::{Error, Result};
+use crate::fmu::{Fmu, Interface};
+use model_description::{BaseUnit, Causality, ModelDescription, ScalarVariable, Variability, VariableType};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// The base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BaseType {
+    /// `Real`.
+    Real,
+    /// `Integer` (and Enumeration).
+    Integer,
+    /// `Boolean`.
+    Boolean,
+    /// `String`.
+    String,
+}
+
+impl BaseType {
+    /// Of a variable.
+    pub fn of(v: &ScalarVariable) -> BaseType {
+        match v.variable_type {
+            VariableType::Real { .. } => BaseType::Real,
+            VariableType::Integer { .. } => BaseType::Integer,
+            VariableType::Boolean { .. } => BaseType::Boolean,
+            VariableType::String { .. } => BaseType::String,
+        }
+    }
+    /// The XML name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BaseType::Real => "Real",
+            BaseType::Integer => "Integer",
+            BaseType::Boolean => "Boolean",
+            BaseType::String => "String",
+        }
+    }
+}
+
+/// A value to set.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    /// Real.
+    Real(f64),
+    /// Integer.
+    Integer(i32),
+    /// Boolean.
+    Boolean(bool),
+    /// String.
+    String(String),
+}
+
+impl Value {
+    /// Parses `text` for a variable of type `ty` (`true`/`false`/`1`/`0` for Boolean).
+    pub fn parse(ty: BaseType, text: &str) -> std::result::Result<Value, String> {
+        let t = text.trim();
+        match ty {
+            BaseType::Real => t
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .map(Value::Real)
+                .ok_or_else(|| "not a finite number".to_string()),
+            BaseType::Integer => t.parse::<i32>().map(Value::Integer).map_err(|e| format!("not an Integer: {e}")),
+            BaseType::Boolean => match t {
+                "true" | "1" => Ok(Value::Boolean(true)),
+                "false" | "0" => Ok(Value::Boolean(false)),
+                _ => Err("not a Boolean (true, false, 1, 0)".into()),
+            },
+            BaseType::String => Ok(Value::String(text.to_string())),
+        }
+    }
+    fn base_type(&self) -> BaseType {
+        match self {
+            Value::Real(_) => BaseType::Real,
+            Value::Integer(_) => BaseType::Integer,
+            Value::Boolean(_) => BaseType::Boolean,
+            Value::String(_) => BaseType::String,
+        }
+    }
+}
+
+/// A variable of an instance, resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariableRef {
+    /// Index of the instance in the system.
+    pub instance: usize,
+    /// 0-based index into the instance's ModelVariables.
+    pub index: usize,
+    /// Value reference.
+    pub value_reference: u32,
+    /// Base type.
+    pub base_type: BaseType,
+}
+
+/// A checked connection: `to = gain * from + offset` (unit conversion and linear
+/// transformation folded in; gain 1 and offset 0 for non-Real).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Connection {
+    /// Source output.
+    pub from: VariableRef,
+    /// Destination input.
+    pub to: VariableRef,
+    /// Factor applied to the source value.
+    pub gain: f64,
+    /// Offset added after the factor.
+    pub offset: f64,
+    /// The SSP LinearTransformation as given (factor, offset), before unit conversion.
+    pub linear_transformation: Option<(f64, f64)>,
+}
+
+/// One instance of a system.
+#[derive(Debug, Clone)]
+pub struct InstanceSpec {
+    /// Name (no `.`).
+    pub name: String,
+    /// The FMU.
+    pub fmu: Arc<Fmu>,
+    /// Start values and parameters, set before initialization.
+    pub start_values: Vec<(usize, Value)>,
+}
+
+/// A system: instances and checked connections. Build it with [`SystemBuilder`].
+#[derive(Debug, Clone)]
+pub struct System {
+    /// Instances, in the order they were added.
+    pub instances: Vec<InstanceSpec>,
+    /// Connections, in the order they were added.
+    pub connections: Vec<Connection>,
+}
+
+/// Builds a [`System`], checking every name, value and connection as it is added.
+#[derive(Debug, Default)]
+pub struct SystemBuilder {
+    system: System,
+    names: HashMap<String, usize>,
+}
+
+impl Default for System {
+    fn default() -> Self {
+        System { instances: Vec::new(), connections: Vec::new() }
+    }
+}
+
+/// Splits `instance.variable` at the first `.`.
+pub fn split_name(full: &str) -> Option<(&str, &str)> {
+    full.split_once('.').filter(|(a, b)| !a.is_empty() && !b.is_empty())
+}
+
+impl System {
+    /// A one-instance system of a single FMU.
+    pub fn single(name: &str, fmu: Arc<Fmu>) -> Result<System> {
+        let mut b = SystemBuilder::new();
+        b.add_instance(name, fmu)?;
+        Ok(b.build())
+    }
+
+    /// Index of the instance called `name`.
+    pub fn instance_index(&self, name: &str) -> Option<usize> {
+        self.instances.iter().position(|i| i.name == name)
+    }
+
+    /// The model description of instance `i`.
+    pub fn description(&self, i: usize) -> &ModelDescription {
+        self.instances[i].fmu.description()
+    }
+
+    /// Resolves `instance.variable`.
+    pub fn resolve(&self, full: &str) -> Result<VariableRef> {
+        let (inst, var) = split_name(full)
+            .ok_or_else(|| Error::Instance { name: full.into(), reason: "expected instance.variable" })?;
+        self.resolve_parts(inst, var)
+    }
+
+    /// Resolves an instance name and a variable name.
+    pub fn resolve_parts(&self, instance: &str, variable: &str) -> Result<VariableRef> {
+        let i = self
+            .instance_index(instance)
+            .ok_or_else(|| Error::Instance { name: instance.into(), reason: "unknown instance" })?;
+        let md = self.description(i);
+        let index = md
+            .model_variables
+            .iter()
+            .position(|v| v.name == variable)
+            .ok_or_else(|| Error::UnknownVariable { instance: instance.into(), variable: variable.into() })?;
+        let v = &md.model_variables[index];
+        Ok(VariableRef { instance: i, index, value_reference: v.value_reference, base_type: BaseType::of(v) })
+    }
+
+    /// `instance.variable` of a resolved reference.
+    pub fn name_of(&self, r: &VariableRef) -> String {
+        format!("{}.{}", self.instances[r.instance].name, self.variable(r).name)
+    }
+
+    /// The ScalarVariable of a resolved reference.
+    pub fn variable(&self, r: &VariableRef) -> &ScalarVariable {
+        &self.description(r.instance).model_variables[r.index]
+    }
+}
+
+fn base_unit<'a>(md: &'a ModelDescription, unit: &str) -> Option<&'a BaseUnit> {
+    md.unit_definitions.iter().find(|u| u.name == unit).and_then(|u| u.base_unit.as_ref())
+}
+
+/// `(gain, offset)` converting a value in the source unit to the destination unit, or why not.
+fn unit_conversion(
+    from_md: &ModelDescription,
+    from: &ScalarVariable,
+    to_md: &ModelDescription,
+    to: &ScalarVariable,
+) -> std::result::Result<(f64, f64), String> {
+    let (Some(fu), Some(tu)) = (from.variable_type.unit(), to.variable_type.unit()) else {
+        return Ok((1.0, 0.0)); // a unitless side: nothing to check
+    };
+    let (fb, tb) = (base_unit(from_md, fu), base_unit(to_md, tu));
+    match (fb, tb) {
+        (Some(a), Some(b)) => {
+            let dims = |u: &BaseUnit| [u.kg, u.m, u.s, u.a, u.k, u.mol, u.cd, u.rad];
+            if dims(a) != dims(b) {
+                return Err(format!("units {fu:?} and {tu:?} have different dimensions"));
+            }
+            // SI = a.factor * v + a.offset ; to = (SI - b.offset) / b.factor
+            Ok((a.factor / b.factor, (a.offset - b.offset) / b.factor))
+        }
+        _ if fu == tu => Ok((1.0, 0.0)),
+        _ => Err(format!("units {fu:?} and {tu:?} differ and are not both defined by base units")),
+    }
+}
+
+impl SystemBuilder {
+    /// An empty system.
+    pub fn new() -> SystemBuilder {
+        SystemBuilder::default()
+    }
+
+    /// Adds an instance of `fmu` called `name` (unique, non-empty, without `.`); returns its index.
+    pub fn add_instance(&mut self, name: &str, fmu: Arc<Fmu>) -> Result<usize> {
+        if name.is_empty() || name.contains('.') || name.contains('\0') {
+            return Err(Error::Instance {
+                name: name.into(),
+                reason: "instance names are non-empty, without '.' or NUL",
+            });
+        }
+        if self.names.contains_key(name) {
+            return Err(Error::Instance { name: name.into(), reason: "instance name used twice" });
+        }
+        let i = self.system.instances.len();
+        self.system.instances.push(InstanceSpec { name: name.into(), fmu, start_values: Vec::new() });
+        self.names.insert(name.into(), i);
+        Ok(i)
+    }
+
+    /// Sets a start value or parameter (`instance.variable`), checked for type and causality.
+    pub fn set(&mut self, variable: &str, value: Value) -> Result<&mut Self> {
+        let r = self.system.resolve(variable)?;
+        let v = self.system.variable(&r);
+        let bad =
+            |reason: String| Error::InvalidValue { variable: variable.into(), value: format!("{value:?}"), reason };
+        let value = match (r.base_type, &value) {
+            (BaseType::Real, Value::Integer(i)) => Value::Real(f64::from(*i)),
+            (t, v) if t == v.base_type() => v.clone(),
+            (t, _) => return Err(bad(format!("the variable is {}", t.as_str()))),
+        };
+        if let Value::Real(x) = value {
+            if !x.is_finite() {
+                return Err(bad("not finite".into()));
+            }
+        }
+        let settable = v.variability != Variability::Constant
+            && (matches!(v.causality, Causality::Parameter | Causality::Input)
+                || v.variable_type.has_start() && v.causality != Causality::CalculatedParameter);
+        if !settable {
+            return Err(bad(format!(
+                "a {} {} variable without start value cannot be set",
+                v.variability.as_str(),
+                v.causality.as_str()
+            )));
+        }
+        let spec = &mut self.system.instances[r.instance];
+        spec.start_values.retain(|(i, _)| *i != r.index);
+        spec.start_values.push((r.index, value));
+        Ok(self)
+    }
+
+    /// Sets a value given as text, parsed for the variable's type.
+    pub fn set_text(&mut self, variable: &str, text: &str) -> Result<&mut Self> {
+        let r = self.system.resolve(variable)?;
+        let value = Value::parse(r.base_type, text).map_err(|reason| Error::InvalidValue {
+            variable: variable.into(),
+            value: text.into(),
+            reason,
+        })?;
+        self.set(variable, value)
+    }
+
+    /// Connects output `from` to input `to` (`instance.variable` each).
+    pub fn connect(&mut self, from: &str, to: &str) -> Result<&mut Self> {
+        self.connect_linear(from, to, None)
+    }
+
+    /// Connects with an SSP-style linear transformation `to = factor * from + offset`
+    /// (applied after unit conversion, in the destination unit).
+    pub fn connect_linear(&mut self, from: &str, to: &str, linear: Option<(f64, f64)>) -> Result<&mut Self> {
+        let err = |reason: String| Error::Connection { from: from.into(), to: to.into(), reason };
+        let a = self.system.resolve(from).map_err(|e| err(e.to_string()))?;
+        let b = self.system.resolve(to).map_err(|e| err(e.to_string()))?;
+        let (va, vb) = (self.system.variable(&a), self.system.variable(&b));
+        if va.causality != Causality::Output {
+            return Err(err(format!("the source is a {} variable, not an output", va.causality.as_str())));
+        }
+        if vb.causality != Causality::Input {
+            return Err(err(format!("the destination is a {} variable, not an input", vb.causality.as_str())));
+        }
+        if a.base_type != b.base_type {
+            return Err(err(format!("types differ: {} -> {}", a.base_type.as_str(), b.base_type.as_str())));
+        }
+        if a.base_type == BaseType::String {
+            return Err(err("String connections are not supported".into()));
+        }
+        if a.instance == b.instance {
+            // legal in FMI, but a direct self-loop through an FMU is rarely meant; allowed
+        }
+        if self.system.connections.iter().any(|c| c.to == b) {
+            return Err(err("the input is already connected".into()));
+        }
+        let (mut gain, mut offset) = (1.0, 0.0);
+        if a.base_type == BaseType::Real {
+            (gain, offset) =
+                unit_conversion(self.system.description(a.instance), va, self.system.description(b.instance), vb)
+                    .map_err(err)?;
+        }
+        if let Some((f, o)) = linear {
+            if a.base_type != BaseType::Real && (f != 1.0 || o != 0.0) {
+                return Err(err("a linear transformation needs Real variables".into()));
+            }
+            if !f.is_finite() || !o.is_finite() {
+                return Err(err("non-finite linear transformation".into()));
+            }
+            (gain, offset) = (f * gain, f * offset + o);
+        }
+        self.system.connections.push(Connection { from: a, to: b, gain, offset, linear_transformation: linear });
+        Ok(self)
+    }
+
+    /// The system so far (for inspection while building).
+    pub fn system(&self) -> &System {
+        &self.system
+    }
+
+    /// The finished system.
+    pub fn build(self) -> System {
+        self.system
+    }
+}
+
+/// Whether an instance's interface is Co-Simulation.
+pub fn is_cs(spec: &InstanceSpec) -> bool {
+    spec.fmu.interface() == Interface::CoSimulation
+}

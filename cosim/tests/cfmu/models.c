@@ -1,0 +1,136 @@
+/* Tiny FMI 2.0 Co-Simulation test models for the master's tests, one per MODEL value:
+ *   1 source:     output y = slope * t                     (y depends on nothing)
+ *   2 gain:       input u, output y = k * u                 (direct feedthrough)
+ *   3 integrator: input u, output x, x' = u (exact for inputs held over a step)
+ *   4 faulty:     output y = t; from t >= fail_time doStep returns `mode` (3 Error, 2 Discard)
+ * Value references: Reals 0.. in the order listed in each modelDescription.xml.
+ * Built with -DOMIT_DOSTEP the library lacks fmi2DoStep. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef int fmi2Status;
+typedef unsigned int fmi2ValueReference;
+typedef struct {
+    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void *stepFinished;
+    void *componentEnvironment;
+} fmi2CallbackFunctions;
+
+#define NR 8
+typedef struct {
+    double r[NR];
+    double time;
+    fmi2CallbackFunctions cb;
+    char name[64];
+} Model;
+
+#define EXPORT __attribute__((visibility("default")))
+
+static void log_msg(Model *m, fmi2Status s, const char *msg) {
+    if (m->cb.logger) m->cb.logger(m->cb.componentEnvironment, m->name, s, "log", "%s", msg);
+}
+
+static void defaults(Model *m) {
+    memset(m->r, 0, sizeof m->r);
+#if MODEL == 1
+    m->r[1] = 1.0; /* slope */
+#elif MODEL == 2
+    m->r[2] = 2.0; /* k */
+#elif MODEL == 4
+    m->r[1] = 0.5; /* fail_time */
+    m->r[2] = 3.0; /* mode */
+#endif
+}
+
+static void outputs(Model *m) {
+#if MODEL == 1
+    m->r[0] = m->r[1] * m->time;
+#elif MODEL == 2
+    m->r[1] = m->r[2] * m->r[0];
+#elif MODEL == 4
+    m->r[0] = m->time;
+#endif
+}
+
+EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cat[]) { return 0; }
+
+EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
+                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
+    Model *m;
+    if (!cb || !cb->logger) return NULL;
+    if (strcmp(guid, "{test}") != 0) {
+        cb->logger(cb->componentEnvironment, name, 3, "log", "%s", "wrong GUID");
+        return NULL;
+    }
+    m = calloc(1, sizeof *m);
+    m->cb = *cb;
+    snprintf(m->name, sizeof m->name, "%s", name);
+    defaults(m);
+    return m;
+}
+EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int tolDef, double tol, double t0, int stopDef, double stop) {
+    ((Model *)c)->time = t0;
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults((Model *)c); return 0; }
+
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
+    Model *m = c;
+    size_t i;
+    outputs(m);
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= NR) { log_msg(m, 3, "bad value reference"); return 3; }
+        v[i] = m->r[vr[i]];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
+    Model *m = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= NR) { log_msg(m, 3, "bad value reference"); return 3; }
+        m->r[vr[i]] = v[i];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? 3 : 0; }
+EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? 3 : 0; }
+EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? 3 : 0; }
+EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? 3 : 0; }
+EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? 3 : 0; }
+EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? 3 : 0; }
+
+#ifndef OMIT_DOSTEP
+EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior) {
+    Model *m = c;
+#if MODEL == 3
+    m->r[1] += m->r[0] * h;
+#elif MODEL == 4
+    if (t >= m->r[1]) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "failing on purpose at t = %g", t);
+        log_msg(m, (int)m->r[2], msg);
+        return (int)m->r[2];
+    }
+#endif
+    m->time = t + h;
+    return 0;
+}
+#endif
+EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return 3; }
+EXPORT fmi2Status fmi2GetStatus(fmi2Component c, int s, int *v) { return 3; }
+EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, int s, double *v) { *v = ((Model *)c)->time; return 0; }
+EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return 3; }
+EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { *v = 0; return 0; }
+EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return 3; }

@@ -1,0 +1,177 @@
+//! Test FMUs written in C (tests/cfmu/models.c), compiled with the system `cc` and zipped
+//! as proper FMI 2.0 archives: modelDescription.xml + binaries/linux64/<id>.so.
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    Source,
+    Gain,
+    Integrator,
+    Faulty,
+}
+
+impl Model {
+    fn number(self) -> u32 {
+        match self {
+            Model::Source => 1,
+            Model::Gain => 2,
+            Model::Integrator => 3,
+            Model::Faulty => 4,
+        }
+    }
+    pub fn id(self) -> &'static str {
+        match self {
+            Model::Source => "source",
+            Model::Gain => "gain",
+            Model::Integrator => "integrator",
+            Model::Faulty => "faulty",
+        }
+    }
+    pub fn variables(self) -> &'static str {
+        match self {
+            Model::Source => {
+                r#"<ScalarVariable name="y" valueReference="0" causality="output"><Real unit="m"/></ScalarVariable>
+    <ScalarVariable name="slope" valueReference="1" causality="parameter" variability="fixed"><Real start="1" unit="m/s"/></ScalarVariable>"#
+            }
+            Model::Gain => {
+                r#"<ScalarVariable name="u" valueReference="0" causality="input"><Real start="0" unit="m"/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output"><Real unit="m"/></ScalarVariable>
+    <ScalarVariable name="k" valueReference="2" causality="parameter" variability="fixed"><Real start="2"/></ScalarVariable>"#
+            }
+            Model::Integrator => {
+                r#"<ScalarVariable name="u" valueReference="0" causality="input"><Real start="0" unit="m"/></ScalarVariable>
+    <ScalarVariable name="x" valueReference="1" causality="output" initial="exact"><Real start="0" unit="m"/></ScalarVariable>"#
+            }
+            Model::Faulty => {
+                r#"<ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
+    <ScalarVariable name="fail_time" valueReference="1" causality="parameter" variability="fixed"><Real start="0.5"/></ScalarVariable>
+    <ScalarVariable name="mode" valueReference="2" causality="parameter" variability="fixed"><Real start="3"/></ScalarVariable>"#
+            }
+        }
+    }
+    fn structure(self) -> &'static str {
+        match self {
+            Model::Source => r#"<Outputs><Unknown index="1" dependencies=""/></Outputs>"#,
+            Model::Gain => r#"<Outputs><Unknown index="2" dependencies="1"/></Outputs>"#,
+            Model::Integrator => r#"<Outputs><Unknown index="2" dependencies=""/></Outputs>"#,
+            Model::Faulty => r#"<Outputs><Unknown index="1" dependencies=""/></Outputs>"#,
+        }
+    }
+    pub fn model_description(self) -> String {
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test}}" numberOfEventIndicators="0">
+  <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true"/>
+  <UnitDefinitions>
+    <Unit name="m"><BaseUnit m="1"/></Unit>
+    <Unit name="mm"><BaseUnit m="1" factor="0.001"/></Unit>
+    <Unit name="m/s"><BaseUnit m="1" s="-1"/></Unit>
+  </UnitDefinitions>
+  <ModelVariables>
+    {vars}
+  </ModelVariables>
+  <ModelStructure>{structure}</ModelStructure>
+</fmiModelDescription>
+"#,
+            id = self.id(),
+            vars = self.variables(),
+            structure = self.structure()
+        )
+    }
+}
+
+/// A fresh folder for one test's files, under target/cosim-tests/.
+pub fn work_dir(test: &str) -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
+    let dir = target.join("cosim-tests").join(format!("{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("work dir");
+    dir
+}
+
+/// Compiles models.c for `model` into `out` (with extra `cc` flags).
+pub fn compile(model: Model, out: &Path, extra: &[&str]) {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/models.c");
+    let status = Command::new("cc")
+        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
+        .arg(format!("-DMODEL={}", model.number()))
+        .args(extra)
+        .arg(&src)
+        .arg("-o")
+        .arg(out)
+        .status()
+        .expect("run cc");
+    assert!(status.success(), "cc failed for {model:?}");
+}
+
+/// Zips `entries` (name, bytes) into `path`.
+pub fn zip_entries(path: &Path, entries: &[(&str, Vec<u8>)]) {
+    let file = std::fs::File::create(path).expect("create zip");
+    let mut zip = zip::ZipWriter::new(file);
+    let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    for (name, bytes) in entries {
+        zip.start_file(*name, options).expect("zip entry");
+        zip.write_all(bytes).expect("zip write");
+    }
+    zip.finish().expect("zip finish");
+}
+
+/// Builds `<dir>/<id>.fmu` for `model`; `extra` cc flags (e.g. -DOMIT_DOSTEP).
+pub fn build_fmu(model: Model, dir: &Path, extra: &[&str]) -> PathBuf {
+    let so = dir.join(format!("{}.so", model.id()));
+    compile(model, &so, extra);
+    let fmu = dir.join(format!("{}.fmu", model.id()));
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", model.model_description().into_bytes()),
+            (&format!("binaries/linux64/{}.so", model.id()), std::fs::read(&so).expect("read so")),
+        ],
+    );
+    fmu
+}
+
+/// Entries of the folder where the master unpacks (`nigel-cosim-*` in the temp dir).
+pub fn unpack_dirs() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(std::env::temp_dir())
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .map(|e| e.path())
+                .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("nigel-cosim-")))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The plant FMU built by `cargo run --release -p build-fmu`.
+pub fn plant_fmu() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
+    let p = target.join("fmu").join("nigel_plant.fmu");
+    assert!(p.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", p.display());
+    p
+}
+
+/// Builds `<dir>/<file_stem>.fmu` for `model` with a modified modelDescription.xml.
+pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> PathBuf {
+    let so = dir.join(format!("{file_stem}.so"));
+    compile(model, &so, &[]);
+    let fmu = dir.join(format!("{file_stem}.fmu"));
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", xml.as_bytes().to_vec()),
+            (&format!("binaries/linux64/{}.so", model.id()), std::fs::read(&so).expect("read so")),
+        ],
+    );
+    fmu
+}
