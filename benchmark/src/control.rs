@@ -233,12 +233,20 @@ impl SampledController {
         }
     }
 
+    /// What [`SampledController::advance`] adds to the integrator: `e T`, or 0 while the
+    /// force saturates.
+    pub fn increment(&self, x: &ControllerInputs) -> f64 {
+        let (_, saturated) = self.force(x);
+        if saturated {
+            0.0
+        } else {
+            (x.speed_ref - x.speed) * self.settings.sample_period
+        }
+    }
+
     /// Moves the integrator past the current sample: `I += e T` unless the force saturates.
     pub fn advance(&mut self, x: &ControllerInputs) {
-        let (_, saturated) = self.force(x);
-        if !saturated {
-            self.integral += (x.speed_ref - x.speed) * self.settings.sample_period;
-        }
+        self.integral += self.increment(x);
     }
 
     /// [`SampledController::outputs`] then [`SampledController::advance`].

@@ -10,30 +10,74 @@ use fmi2_export::model_description::{ModelDescription, VariableType};
 use fmi2_export::{Declaration, Model};
 use zip::write::SimpleFileOptions;
 
-/// One FMU this workspace ships.
+/// One FMU this workspace ships. Everything but the package name comes from the model's
+/// declaration (identifier, interfaces, variables, documentation).
 pub struct FmuTarget {
-    /// Cargo package that builds the shared library.
+    /// Cargo package that builds the shared library (its `[lib] name` must be the model
+    /// identifier; a test checks it).
     pub package: &'static str,
     /// `modelIdentifier`: the library is `lib<id>.so` in cargo's output, `<id>.so` in the archive.
-    pub model_identifier: &'static str,
+    pub model_identifier: String,
     /// The generated description (the same declaration the binary dispatches on).
-    pub description: fn() -> &'static ModelDescription,
+    pub description: &'static ModelDescription,
     /// Generated `documentation/index.html`.
-    pub documentation: fn() -> String,
+    pub documentation: String,
 }
 
-fn description_of<M: Model>() -> &'static ModelDescription {
-    M::declaration().model_description()
+impl FmuTarget {
+    /// The target of model `M`, built by cargo package `package`; `equations` is the
+    /// HTML the documentation shows after the variable table.
+    pub fn of<M: Model>(package: &'static str, equations: &str) -> FmuTarget {
+        let declaration = M::declaration();
+        FmuTarget {
+            package,
+            model_identifier: declaration.spec.model_identifier.to_string(),
+            description: declaration.model_description(),
+            documentation: documentation(declaration, equations),
+        }
+    }
+
+    /// The interfaces the description declares, as fmpy names them.
+    pub fn interfaces(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        if self.description.co_simulation.is_some() {
+            v.push("CoSimulation");
+        }
+        if self.description.model_exchange.is_some() {
+            v.push("ModelExchange");
+        }
+        v
+    }
 }
 
-/// Everything `build-fmu` builds.
+/// Everything `build-fmu` builds: a new FMU is one entry here.
 pub fn targets() -> Vec<FmuTarget> {
-    vec![FmuTarget {
-        package: "fmu-plant",
-        model_identifier: nigel_plant::MODEL_IDENTIFIER,
-        description: description_of::<nigel_plant::Plant>,
-        documentation: || documentation(nigel_plant::Plant::declaration(), PLANT_EQUATIONS),
-    }]
+    vec![
+        FmuTarget::of::<nigel_plant::Plant>("fmu-plant", PLANT_EQUATIONS),
+        FmuTarget::of::<nigel_controller::Controller>("fmu-controller", nigel_controller::DOCUMENTATION),
+        FmuTarget::of::<nigel_maneuver::TestBench>("fmu-maneuver", nigel_maneuver::DOCUMENTATION),
+    ]
+}
+
+/// `manifest.json` written next to the archives (and printed by `build-fmu --list`): one
+/// object per FMU with its model identifier, package, archive file name and interfaces,
+/// so that tests iterate over exactly what was built.
+pub fn manifest(targets: &[FmuTarget]) -> String {
+    let entries: Vec<String> = targets
+        .iter()
+        .map(|t| {
+            let interfaces: Vec<String> = t.interfaces().iter().map(|i| format!("\"{i}\"")).collect();
+            format!(
+                "  {{\"model_identifier\": \"{id}\", \"package\": \"{package}\", \"fmu\": \"{id}.fmu\", \
+                 \"guid\": \"{guid}\", \"interfaces\": [{interfaces}]}}",
+                id = t.model_identifier,
+                package = t.package,
+                guid = t.description.guid,
+                interfaces = interfaces.join(", "),
+            )
+        })
+        .collect();
+    format!("[\n{}\n]\n", entries.join(",\n"))
 }
 
 const PLANT_EQUATIONS: &str = r#"<p>For each wheel i (order FL, FR, RL, RR) at (x_i, y_i) from the CG, with the steer
@@ -71,12 +115,17 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\
          <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}\
          td,th{{border:1px solid #ccc;padding:2px 6px;text-align:left}}</style></head><body>\n\
-         <h1>{name}</h1>\n<p>{desc}</p>\n<p>FMI 2.0, Co-Simulation and Model Exchange. GUID <code>{guid}</code>. \
+         <h1>{name}</h1>\n<p>{desc}</p>\n<p>FMI 2.0, {interfaces}. GUID <code>{guid}</code>. \
          All quantities SI, angles in rad.</p>\n<h2>Variables</h2>\n<table>\n\
          <tr><th>name</th><th>vr</th><th>causality</th><th>variability</th><th>unit</th><th>start</th><th>description</th></tr>\n",
         name = escape(&md.model_name),
         desc = escape(md.description.as_deref().unwrap_or("")),
         guid = escape(&md.guid),
+        interfaces = match (md.co_simulation.is_some(), md.model_exchange.is_some()) {
+            (true, true) => "Co-Simulation and Model Exchange",
+            (true, false) => "Co-Simulation",
+            _ => "Model Exchange",
+        },
     );
     for v in &md.model_variables {
         let (unit, start) = match &v.variable_type {
@@ -84,6 +133,15 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
                 (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default())
             }
             VariableType::Integer { start, .. } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::Enumeration { declared_type, start, .. } => {
+                let items = md
+                    .type_definitions
+                    .iter()
+                    .find(|t| &t.name == declared_type)
+                    .map(|t| t.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect::<Vec<_>>().join(", "))
+                    .unwrap_or_default();
+                (format!("{declared_type}: {items}"), start.map(|s| s.to_string()).unwrap_or_default())
+            }
             VariableType::Boolean { start } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
             VariableType::String { start } => (String::new(), start.clone().unwrap_or_default()),
         };
@@ -180,8 +238,7 @@ pub fn build_library(target: &FmuTarget) -> Result<PathBuf, BuildError> {
 pub fn build(target: &FmuTarget, out_dir: &Path) -> Result<(PathBuf, usize), BuildError> {
     let library_path = build_library(target)?;
     let library = std::fs::read(&library_path).map_err(|e| BuildError::Io(library_path.clone(), e))?;
-    let description = (target.description)();
-    let bytes = archive(&description.to_xml(), &library, target.model_identifier, &(target.documentation)())?;
+    let bytes = archive(&target.description.to_xml(), &library, &target.model_identifier, &target.documentation)?;
     std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
     let path = out_dir.join(format!("{}.fmu", target.model_identifier));
     std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
@@ -195,10 +252,10 @@ mod tests {
     #[test]
     fn archive_is_byte_identical_and_has_the_layout_importers_expect() {
         let t = &targets()[0];
-        let xml = (t.description)().to_xml();
-        let doc = (t.documentation)();
-        let a = archive(&xml, b"\x7fELF fake", t.model_identifier, &doc).unwrap();
-        let b = archive(&xml, b"\x7fELF fake", t.model_identifier, &doc).unwrap();
+        let xml = t.description.to_xml();
+        let doc = &t.documentation;
+        let a = archive(&xml, b"\x7fELF fake", &t.model_identifier, doc).unwrap();
+        let b = archive(&xml, b"\x7fELF fake", &t.model_identifier, doc).unwrap();
         assert_eq!(a, b);
         let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
         let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
@@ -211,10 +268,72 @@ mod tests {
     #[test]
     fn documentation_lists_every_variable_with_its_unit() {
         let t = &targets()[0];
-        let doc = (t.documentation)();
-        for v in &(t.description)().model_variables {
+        let doc = &t.documentation;
+        for v in &t.description.model_variables {
             assert!(doc.contains(&format!("<code>{}</code>", escape(&v.name))), "{} missing", v.name);
         }
         assert!(doc.contains("<td>N.m</td>") && doc.contains("<td>rad</td>"));
+    }
+
+    /// `[lib] name` of the package in the workspace, read from its Cargo.toml.
+    fn library_name(package: &str) -> Option<String> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent()?;
+        for entry in std::fs::read_dir(root).ok()?.flatten() {
+            let Ok(text) = std::fs::read_to_string(entry.path().join("Cargo.toml")) else { continue };
+            let mut section = String::new();
+            let (mut name, mut lib) = (None, None);
+            for line in text.lines().map(str::trim) {
+                if line.starts_with('[') {
+                    section = line.to_string();
+                } else if let Some(v) = line.strip_prefix("name").map(str::trim).and_then(|r| r.strip_prefix('=')) {
+                    let v = v.trim().trim_matches('"').to_string();
+                    match section.as_str() {
+                        "[package]" => name = Some(v),
+                        "[lib]" => lib = Some(v),
+                        _ => {}
+                    }
+                }
+            }
+            if name.as_deref() == Some(package) {
+                return lib;
+            }
+        }
+        None
+    }
+
+    #[test]
+    fn every_target_library_is_named_after_its_model_identifier() {
+        for t in targets() {
+            let lib = library_name(t.package);
+            assert_eq!(
+                lib.as_deref(),
+                Some(t.model_identifier.as_str()),
+                "{}: [lib] name must be the model identifier",
+                t.package
+            );
+            let md = t.description;
+            for id in [
+                md.co_simulation.as_ref().map(|c| &c.model_identifier),
+                md.model_exchange.as_ref().map(|m| &m.model_identifier),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                assert_eq!(id, &t.model_identifier);
+            }
+        }
+        // the check itself finds a mismatch
+        assert_eq!(library_name("fmu-plant").as_deref(), Some("nigel_plant"));
+        assert_eq!(library_name("no-such-package"), None);
+    }
+
+    #[test]
+    fn manifest_lists_every_target_with_its_interfaces() {
+        let ts = targets();
+        let m = manifest(&ts);
+        for t in &ts {
+            assert!(m.contains(&format!("\"fmu\": \"{}.fmu\"", t.model_identifier)), "{m}");
+        }
+        assert!(m.contains(r#""interfaces": ["CoSimulation", "ModelExchange"]"#), "{m}");
     }
 }

@@ -51,6 +51,9 @@ pub struct VarDecl<B> {
     pub derivative_of: Option<u32>,
     /// For outputs and derivatives: what they depend on (ModelStructure).
     pub dependencies: Dependencies,
+    /// For an Enumeration (base type Integer): the name of its type in
+    /// [`DeclarationSpec::enumerations`].
+    pub declared_type: Option<&'static str>,
     pub binding: B,
 }
 
@@ -71,6 +74,7 @@ impl<B> VarDecl<B> {
             nominal: None,
             derivative_of: None,
             dependencies: Dependencies::All,
+            declared_type: None,
             binding,
         }
     }
@@ -88,6 +92,16 @@ impl<B> VarDecl<B> {
     /// An Integer variable.
     pub fn integer(name: &'static str, value_reference: u32, binding: B) -> Self {
         Self::new(name, value_reference, BaseType::Integer, binding)
+    }
+
+    /// An Enumeration variable of the type `type_name` (declared in
+    /// [`DeclarationSpec::enumerations`]). It is an Integer for the C API (same value
+    /// references, `fmi2GetInteger`/`fmi2SetInteger`); the layer refuses values that are
+    /// not items of the type.
+    pub fn enumeration(name: &'static str, value_reference: u32, type_name: &'static str, binding: B) -> Self {
+        let mut v = Self::new(name, value_reference, BaseType::Integer, binding);
+        v.declared_type = Some(type_name);
+        v
     }
 
     pub fn describe(mut self, text: &'static str) -> Self {
@@ -117,6 +131,35 @@ impl<B> VarDecl<B> {
         self.variability = Variability::Fixed;
         self.initial = Some(Initial::Exact);
         self.start = start;
+        self
+    }
+
+    /// `causality="parameter" variability="tunable" initial="exact"`: settable between
+    /// Co-Simulation steps and in Model Exchange event mode too.
+    pub fn tunable_parameter(mut self, start: Start) -> Self {
+        self = self.parameter(start);
+        self.variability = Variability::Tunable;
+        self
+    }
+
+    /// A discrete state (`causality="local" variability="discrete" initial="exact"`): it
+    /// changes only at events; saved with the FMU state through the model's setter.
+    pub fn discrete_state(mut self, start: Start) -> Self {
+        self.causality = Causality::Local;
+        self.variability = Variability::Discrete;
+        self.initial = Some(Initial::Exact);
+        self.start = start;
+        self
+    }
+
+    /// A discrete output (`variability="discrete"`, `initial="calculated"`): held between
+    /// events, computed by the model at events; saved with the FMU state through the
+    /// model's setter (a held value is not a function of the current inputs).
+    pub fn discrete_output(mut self, dependencies: Dependencies) -> Self {
+        self.causality = Causality::Output;
+        self.variability = Variability::Discrete;
+        self.initial = Some(Initial::Calculated);
+        self.dependencies = dependencies;
         self
     }
 
@@ -164,10 +207,22 @@ impl<B> VarDecl<B> {
 }
 
 /// Interfaces an FMU offers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Interfaces {
     pub model_exchange: bool,
     pub co_simulation: bool,
+}
+
+/// Optional capabilities, all opt-in: the XML flags follow them, and a call of a function
+/// the model did not opt in to gets `fmi2Error` with a logged "not supported".
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Capabilities {
+    /// `providesDirectionalDerivative`: the model implements [`crate::Model::directional_derivative`].
+    pub directional_derivatives: bool,
+    /// `canGetAndSetFMUstate`: `fmi2GetFMUstate`, `fmi2SetFMUstate`, `fmi2FreeFMUstate`.
+    pub fmu_state: bool,
+    /// `canSerializeFMUstate` (needs `fmu_state`).
+    pub serialize_fmu_state: bool,
 }
 
 /// Everything the layer needs to know about a model, and all that goes into the XML.
@@ -178,10 +233,48 @@ pub struct DeclarationSpec<B> {
     pub description: &'static str,
     pub version: &'static str,
     pub interfaces: Interfaces,
+    /// Optional capabilities (none by default).
+    pub capabilities: Capabilities,
+    /// Enumeration types (`<TypeDefinitions>`), referred to by [`VarDecl::enumeration`].
+    pub enumerations: Vec<md::EnumerationType>,
     /// Units used by the variables (`(name, base unit)`); undeclared units are a build error.
     pub units: Vec<md::Unit>,
     pub default_experiment: Option<md::DefaultExperiment>,
     pub variables: Vec<VarDecl<B>>,
+}
+
+impl<B> Default for DeclarationSpec<B> {
+    /// Empty: no interfaces, no capabilities, no variables (fill in with `..Default::default()`).
+    fn default() -> Self {
+        DeclarationSpec {
+            model_name: "",
+            model_identifier: "",
+            description: "",
+            version: "",
+            interfaces: Interfaces::default(),
+            capabilities: Capabilities::default(),
+            enumerations: Vec::new(),
+            units: Vec::new(),
+            default_experiment: None,
+            variables: Vec::new(),
+        }
+    }
+}
+
+/// An enumeration type with items `(name, value, description)`.
+pub fn enumeration_type(name: &str, description: &str, items: &[(&str, i32, &str)]) -> md::EnumerationType {
+    md::EnumerationType {
+        name: name.to_string(),
+        description: (!description.is_empty()).then(|| description.to_string()),
+        items: items
+            .iter()
+            .map(|&(n, v, d)| md::EnumerationItem {
+                name: n.to_string(),
+                value: v,
+                description: (!d.is_empty()).then(|| d.to_string()),
+            })
+            .collect(),
+    }
 }
 
 /// A checked declaration with lookup tables, the generated description and its GUID.
@@ -193,6 +286,9 @@ pub struct Declaration<B> {
     pub state_rows: Vec<usize>,
     /// Rows of the derivatives, same order.
     pub derivative_rows: Vec<usize>,
+    /// Rows saved with the FMU state, in declaration order: parameters, inputs,
+    /// continuous states and discrete variables (locals and outputs).
+    pub saved_rows: Vec<usize>,
     description: md::ModelDescription,
     xml: String,
 }
@@ -322,14 +418,17 @@ impl<B> Declaration<B> {
                         max: v.max,
                         nominal: v.nominal,
                     },
-                    BaseType::Integer => md::VariableType::Integer {
-                        start: match v.start {
+                    BaseType::Integer => {
+                        let start = match v.start {
                             Start::Integer(x) => Some(x),
                             _ => None,
-                        },
-                        min: v.min.map(|x| x as i32),
-                        max: v.max.map(|x| x as i32),
-                    },
+                        };
+                        let (min, max) = (v.min.map(|x| x as i32), v.max.map(|x| x as i32));
+                        match v.declared_type {
+                            Some(t) => md::VariableType::Enumeration { declared_type: t.to_string(), start, min, max },
+                            None => md::VariableType::Integer { start, min, max },
+                        }
+                    }
                     BaseType::Boolean => md::VariableType::Boolean {
                         start: match v.start {
                             Start::Boolean(x) => Some(x),
@@ -340,22 +439,33 @@ impl<B> Declaration<B> {
             })
             .collect();
 
+        let caps = spec.capabilities;
+        if caps.serialize_fmu_state && !caps.fmu_state {
+            return Err(format!("{}: serialize_fmu_state needs fmu_state", spec.model_name));
+        }
+        for v in &spec.variables {
+            if let Some(t) = v.declared_type {
+                if !spec.enumerations.iter().any(|e| e.name == t) {
+                    return Err(format!("{}: enumeration type {t} is not declared", v.name));
+                }
+            }
+        }
         let capabilities_cs = md::CoSimulation {
             model_identifier: spec.model_identifier.to_string(),
             can_handle_variable_communication_step_size: true,
             can_not_use_memory_management_functions: true,
-            can_get_and_set_fmu_state: true,
-            can_serialize_fmu_state: true,
-            provides_directional_derivative: true,
+            can_get_and_set_fmu_state: caps.fmu_state,
+            can_serialize_fmu_state: caps.serialize_fmu_state,
+            provides_directional_derivative: caps.directional_derivatives,
             ..Default::default()
         };
         let capabilities_me = md::ModelExchange {
             model_identifier: spec.model_identifier.to_string(),
             completed_integrator_step_not_needed: true,
             can_not_use_memory_management_functions: true,
-            can_get_and_set_fmu_state: true,
-            can_serialize_fmu_state: true,
-            provides_directional_derivative: true,
+            can_get_and_set_fmu_state: caps.fmu_state,
+            can_serialize_fmu_state: caps.serialize_fmu_state,
+            provides_directional_derivative: caps.directional_derivatives,
             ..Default::default()
         };
         let description = md::ModelDescription {
@@ -374,6 +484,7 @@ impl<B> Declaration<B> {
             model_exchange: spec.interfaces.model_exchange.then_some(capabilities_me),
             co_simulation: spec.interfaces.co_simulation.then_some(capabilities_cs),
             unit_definitions: spec.units.clone(),
+            type_definitions: spec.enumerations.clone(),
             log_categories: LOG_CATEGORIES
                 .iter()
                 .map(|(n, d)| md::LogCategory { name: n.to_string(), description: Some(d.to_string()) })
@@ -393,7 +504,16 @@ impl<B> Declaration<B> {
             ));
         }
         let xml = description.to_xml();
-        Ok(Declaration { spec, lookup, state_rows, derivative_rows, description, xml })
+        let saved_rows = (0..spec.variables.len())
+            .filter(|&row| {
+                let v = &spec.variables[row];
+                matches!(v.causality, Causality::Parameter | Causality::Input)
+                    || state_rows.contains(&row)
+                    || (v.variability == Variability::Discrete
+                        && matches!(v.causality, Causality::Local | Causality::Output))
+            })
+            .collect();
+        Ok(Declaration { spec, lookup, state_rows, derivative_rows, saved_rows, description, xml })
     }
 
     /// Row of the variable with this base type and value reference.
@@ -424,6 +544,12 @@ impl<B> Declaration<B> {
     pub fn number_of_states(&self) -> usize {
         self.state_rows.len()
     }
+
+    /// The enumeration type of variable `row`, if it is an Enumeration.
+    pub fn enumeration_of(&self, row: usize) -> Option<&md::EnumerationType> {
+        let t = self.variable(row).declared_type?;
+        self.spec.enumerations.iter().find(|e| e.name == t)
+    }
 }
 
 /// A unit with base-unit exponents `[kg, m, s, rad]`.
@@ -446,8 +572,8 @@ mod tests {
             version: "0",
             interfaces: Interfaces { model_exchange: true, co_simulation: true },
             units: vec![si_unit("m", 0, 1, 0, 0), si_unit("m/s", 0, 1, -1, 0)],
-            default_experiment: None,
             variables,
+            ..Default::default()
         }
     }
 

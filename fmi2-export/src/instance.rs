@@ -1,199 +1,299 @@
-//! One FMU instance in safe Rust: the FMI 2.0 state machine, variable access checks and
-//! FMU state handling. The C ABI in [`crate::abi`] only translates pointers to slices.
+//! One FMU instance in safe Rust: the FMI 2.0 state machine (one table, [`crate::states`]),
+//! variable access checks, time events and FMU state handling. The C ABI in
+//! [`crate::abi`] only translates pointers to slices.
 
-use crate::decl::{BaseType, Causality, Declaration, Initial, Variability};
-use crate::model::{InstantiateContext, Interface, Model};
-
-/// The FMI 2.0 instance states (standard sections 3.2.3 and 4.2.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Machine {
-    Instantiated,
-    InitializationMode,
-    /// Co-Simulation, between steps.
-    StepComplete,
-    /// Model Exchange.
-    EventMode,
-    /// Model Exchange.
-    ContinuousTimeMode,
-    Terminated,
-    /// After any `fmi2Error`: only reset, free, FMU state restore and diagnostic gets.
-    Error,
-}
-
-impl Machine {
-    fn code(self) -> f64 {
-        self as u8 as f64
-    }
-    fn from_code(c: f64) -> Option<Machine> {
-        use Machine::*;
-        [Instantiated, InitializationMode, StepComplete, EventMode, ContinuousTimeMode, Terminated, Error]
-            .into_iter()
-            .find(|m| m.code() == c)
-    }
-}
+use crate::decl::{BaseType, Causality, Declaration, Initial, Start, Variability};
+use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
+pub use crate::states::{Function, Machine, Scope};
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
-pub type OpResult<T = ()> = Result<T, String>;
+pub type OpResult<T = ()> = Result<T, ModelError>;
 
-/// A saved FMU state (`fmi2FMUstate`): model data and the layer's own, never the callbacks.
+/// Most event iterations at one time instant before the layer gives up (a model that
+/// keeps asking for another iteration, or keeps scheduling events at the same time).
+pub const MAX_EVENT_ITERATIONS: usize = 1000;
+
+/// The part of an instance a saved FMU state holds (never the callbacks).
 #[derive(Clone)]
-pub struct SavedState<M> {
-    machine: Machine,
-    time: f64,
-    model: M,
+pub struct Core<M> {
+    pub machine: Machine,
+    pub time: f64,
+    pub stop_time: Option<f64>,
+    /// The next time event; in both interfaces the start time right after initialization
+    /// (the initial event).
+    pub next_event: Option<f64>,
+    /// Model Exchange: the model asked for another event iteration.
+    pub iteration_pending: bool,
+    pub model: M,
+    /// Co-Simulation: the model (and its next event) before the events at the current
+    /// time were run (lazily, at the first read or step). Setting an input afterwards
+    /// restores it, so the events see the inputs of their own time instant.
+    pre_event: Option<Box<(M, Option<f64>)>>,
 }
+
+/// A saved FMU state (`fmi2FMUstate`).
+pub type SavedState<M> = Core<M>;
 
 /// One instance of model `M`.
 pub struct Instance<M: Model> {
     pub context: InstantiateContext,
-    pub machine: Machine,
-    pub time: f64,
-    pub stop_time: Option<f64>,
-    pub model: M,
+    pub core: Core<M>,
 }
 
-/// The states from `fmi2EnterInitializationMode` on, short of the error state.
-const INITIALIZING_OR_LATER: [Machine; 5] = [
-    Machine::InitializationMode,
-    Machine::StepComplete,
-    Machine::EventMode,
-    Machine::ContinuousTimeMode,
-    Machine::Terminated,
-];
-
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
-const SERIAL_VERSION: u32 = 1;
+const SERIAL_VERSION: u32 = 2;
+/// Numbers of the layer ahead of the model's in a serialized state.
+const SERIAL_HEADER_NUMBERS: usize = 7;
 
 fn decl<M: Model>() -> &'static Declaration<M::Binding> {
     M::declaration()
+}
+
+fn err<T>(message: impl Into<String>) -> OpResult<T> {
+    Err(ModelError::Error(message.into()))
+}
+
+/// Time tolerance for "this event is now": relative 1e-12 of the time scale.
+fn time_eps(t: f64) -> f64 {
+    1e-12 * t.abs().max(1.0)
 }
 
 impl<M: Model> Instance<M> {
     /// A new instance with every declared start value applied.
     pub fn new(context: InstantiateContext) -> OpResult<Self> {
         let model = Self::fresh_model(&context)?;
-        Ok(Instance { context, machine: Machine::Instantiated, time: 0.0, stop_time: None, model })
+        Ok(Instance {
+            context,
+            core: Core {
+                machine: Machine::Instantiated,
+                time: 0.0,
+                stop_time: None,
+                next_event: None,
+                iteration_pending: false,
+                model,
+                pre_event: None,
+            },
+        })
+    }
+
+    pub fn machine(&self) -> Machine {
+        self.core.machine
+    }
+
+    pub fn time(&self) -> f64 {
+        self.core.time
+    }
+
+    pub fn model(&mut self) -> &mut M {
+        &mut self.core.model
     }
 
     fn fresh_model(context: &InstantiateContext) -> OpResult<M> {
         let mut model = M::instantiate(context)?;
         for v in &decl::<M>().spec.variables {
             let r = match v.start {
-                crate::decl::Start::None => Ok(()),
-                crate::decl::Start::Real(x) => model.set_real(v.binding, x),
-                crate::decl::Start::Integer(x) => model.set_integer(v.binding, x),
-                crate::decl::Start::Boolean(x) => model.set_boolean(v.binding, x),
+                Start::None => Ok(()),
+                Start::Real(x) => model.set_real(v.binding, x),
+                Start::Integer(x) => model.set_integer(v.binding, x),
+                Start::Boolean(x) => model.set_boolean(v.binding, x),
             };
             r.map_err(|e| format!("start value of {} refused: {e}", v.name))?;
         }
         Ok(model)
     }
 
-    fn require(&self, allowed: &[Machine], what: &str) -> OpResult {
-        if allowed.contains(&self.machine) {
-            Ok(())
-        } else {
-            Err(format!("{what} is not allowed in state {:?}", self.machine))
+    /// The one gate every call passes: the function belongs to this instance's interface,
+    /// the model opted in to it, and the standard allows it in the current state.
+    pub fn check_call(&self, function: Function) -> OpResult {
+        let interface = self.context.interface;
+        match (function.scope(), interface) {
+            (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
+                return err(format!("not available: this instance was created for {interface:?}"));
+            }
+            _ => {}
         }
-    }
-
-    fn require_interface(&self, interface: Interface) -> OpResult {
-        if self.context.interface == interface {
-            Ok(())
-        } else {
-            Err(format!("this instance was created for {:?}, the call is {:?} only", self.context.interface, interface))
+        let caps = decl::<M>().spec.capabilities;
+        let supported = match function {
+            Function::GetFMUstate | Function::SetFMUstate | Function::FreeFMUstate => caps.fmu_state,
+            Function::SerializedFMUstateSize | Function::SerializeFMUstate | Function::DeSerializeFMUstate => {
+                caps.serialize_fmu_state
+            }
+            Function::GetDirectionalDerivative => caps.directional_derivatives,
+            _ => true,
+        };
+        if !supported {
+            return err(format!(
+                "not supported: {} did not declare this capability",
+                decl::<M>().spec.model_identifier
+            ));
         }
+        if !function.allowed_in(self.core.machine) {
+            return err(format!("not allowed in state {:?}", self.core.machine));
+        }
+        Ok(())
     }
 
     pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, stop_time: Option<f64>) -> OpResult {
-        self.require(&[Machine::Instantiated], "fmi2SetupExperiment")?;
         if !start_time.is_finite() {
-            return Err(format!("startTime {start_time} is not finite"));
+            return err(format!("startTime {start_time} is not finite"));
         }
         if let Some(stop) = stop_time {
-            if !(stop >= start_time) {
-                return Err(format!("stopTime {stop} is before startTime {start_time}"));
+            if !stop.is_finite() || !(stop >= start_time) {
+                return err(format!("stopTime {stop} must be finite and not before startTime {start_time}"));
             }
         }
         if let Some(tol) = tolerance {
-            if !(tol > 0.0) {
-                return Err(format!("tolerance {tol} must be > 0"));
+            if !(tol > 0.0) || !tol.is_finite() {
+                return err(format!("tolerance {tol} must be finite and > 0"));
             }
         }
-        self.time = start_time;
-        self.stop_time = stop_time;
-        self.model.set_time(start_time);
+        self.core.time = start_time;
+        self.core.stop_time = stop_time;
+        self.core.model.set_time(start_time);
         Ok(())
     }
 
     pub fn enter_initialization_mode(&mut self) -> OpResult {
-        self.require(&[Machine::Instantiated], "fmi2EnterInitializationMode")?;
-        self.machine = Machine::InitializationMode;
+        self.core.machine = Machine::InitializationMode;
         Ok(())
     }
 
     pub fn exit_initialization_mode(&mut self) -> OpResult {
-        self.require(&[Machine::InitializationMode], "fmi2ExitInitializationMode")?;
-        self.model.exit_initialization()?;
-        self.machine = match self.context.interface {
+        self.core.model.exit_initialization()?;
+        self.core.machine = match self.context.interface {
             Interface::CoSimulation => Machine::StepComplete,
             Interface::ModelExchange => Machine::EventMode,
         };
+        // the initial event, at the start time
+        self.core.next_event = Some(self.core.time);
         Ok(())
     }
 
     pub fn terminate(&mut self) -> OpResult {
-        self.require(&[Machine::StepComplete, Machine::EventMode, Machine::ContinuousTimeMode], "fmi2Terminate")?;
-        self.machine = Machine::Terminated;
+        self.core.machine = Machine::Terminated;
         Ok(())
     }
 
     /// Back to `Instantiated` with the start values, keeping name, interface and callbacks.
     pub fn reset(&mut self) -> OpResult {
-        self.model = Self::fresh_model(&self.context)?;
-        self.machine = Machine::Instantiated;
-        self.time = 0.0;
-        self.stop_time = None;
+        let model = Self::fresh_model(&self.context)?;
+        self.core = Core {
+            machine: Machine::Instantiated,
+            time: 0.0,
+            stop_time: None,
+            next_event: None,
+            iteration_pending: false,
+            model,
+            pre_event: None,
+        };
         Ok(())
     }
 
-    /// Whether variable `row` may be set in the current state (FMI 2.0 tables).
-    fn settable(&self, row: usize) -> bool {
+    /// Whether variable `row` may be set in the current state (FMI 2.0 section 2.2.7 and
+    /// the state tables); the reason when not.
+    fn settable(&self, row: usize) -> Result<(), String> {
         let v = decl::<M>().variable(row);
-        if v.variability == Variability::Constant || v.causality == Causality::Independent {
-            return false;
+        let why = |reason: &str| Err(format!("{} cannot be set {reason}", v.name));
+        if v.variability == Variability::Constant {
+            return why("(a constant)");
+        }
+        if matches!(v.causality, Causality::Independent | Causality::CalculatedParameter) {
+            return why("(calculated)");
         }
         let has_start = matches!(v.initial, Some(Initial::Exact) | Some(Initial::Approx));
-        match self.machine {
-            Machine::Instantiated | Machine::InitializationMode => has_start || v.causality == Causality::Input,
-            Machine::StepComplete | Machine::EventMode => {
-                v.causality == Causality::Input
-                    || (v.causality == Causality::Parameter && v.variability == Variability::Tunable)
+        let machine = self.core.machine;
+        match machine {
+            Machine::Instantiated | Machine::InitializationMode => {
+                if has_start || v.causality == Causality::Input {
+                    Ok(())
+                } else {
+                    why("(no start value: it is calculated)")
+                }
             }
-            Machine::ContinuousTimeMode => v.causality == Causality::Input && v.variability == Variability::Continuous,
-            Machine::Terminated | Machine::Error => false,
+            Machine::StepComplete | Machine::EventMode => match (v.causality, v.variability) {
+                (Causality::Input, _) | (Causality::Parameter, Variability::Tunable) => Ok(()),
+                (Causality::Parameter, _) => why("after initialization (a fixed parameter; only tunable ones can)"),
+                _ => why(&format!("in {machine:?} (only inputs and tunable parameters)")),
+            },
+            Machine::ContinuousTimeMode => {
+                if v.causality == Causality::Input && v.variability == Variability::Continuous {
+                    Ok(())
+                } else {
+                    why("in ContinuousTimeMode (only continuous inputs)")
+                }
+            }
+            _ => why(&format!("in {machine:?}")),
         }
     }
 
     fn rows(&self, base_type: BaseType, vrs: &[u32]) -> OpResult<Vec<usize>> {
         vrs.iter()
             .map(|&vr| {
-                decl::<M>().row(base_type, vr).ok_or_else(|| format!("unknown {base_type:?} value reference {vr}"))
+                decl::<M>()
+                    .row(base_type, vr)
+                    .ok_or_else(|| format!("unknown {base_type:?} value reference {vr}").into())
             })
             .collect()
     }
 
-    fn check_get(&self) -> OpResult {
-        // values can be read once initialization has started, and in the error state for diagnosis
-        if self.machine == Machine::Error {
+    /// Co-Simulation: runs the events due at the current time (lazily, so that they see
+    /// the inputs set for this instant), remembering the model from before them.
+    fn settle_events(&mut self) -> OpResult {
+        if self.context.interface != Interface::CoSimulation || self.core.machine != Machine::StepComplete {
             return Ok(());
         }
-        self.require(&INITIALIZING_OR_LATER, "getting values")
+        let now = self.core.time;
+        if matches!(self.core.next_event, Some(te) if te <= now + time_eps(now)) {
+            if self.core.pre_event.is_none() {
+                self.core.pre_event = Some(Box::new((self.core.model.clone(), self.core.next_event)));
+            }
+            self.run_events_at(now)?;
+        }
+        Ok(())
+    }
+
+    /// Before a set in Co-Simulation: undo the events run lazily at this instant.
+    fn unsettle_events(&mut self) {
+        if let Some(pre) = self.core.pre_event.take() {
+            let (model, next) = *pre;
+            self.core.model = model;
+            self.core.next_event = next;
+        }
+    }
+
+    /// The event iteration at `time`, until the model needs no more and its next event
+    /// is later.
+    fn run_events_at(&mut self, time: f64) -> OpResult {
+        for _ in 0..MAX_EVENT_ITERATIONS {
+            let update = self.event_update(time)?;
+            if update.terminate_simulation {
+                return Err(ModelError::Discard(format!("the model asked to terminate the simulation at t = {time}")));
+            }
+            let due = matches!(self.core.next_event, Some(te) if te <= time + time_eps(time));
+            if !update.new_discrete_states_needed && !due {
+                return Ok(());
+            }
+        }
+        err(format!("no end of the event iteration at t = {time} after {MAX_EVENT_ITERATIONS} iterations"))
+    }
+
+    /// One call of the model's event update, with its next event time checked.
+    fn event_update(&mut self, time: f64) -> OpResult<EventUpdate> {
+        self.core.model.set_time(time);
+        let update = self.core.model.event_update(time)?;
+        if let Some(te) = update.next_event_time {
+            if !te.is_finite() || !(te > time) {
+                return err(format!("the model's next event time {te} is not after the current time {time}"));
+            }
+        }
+        self.core.next_event = update.next_event_time;
+        self.core.iteration_pending = update.new_discrete_states_needed;
+        Ok(update)
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
-        self.check_get()?;
         let rows = self.rows(BaseType::Real, vrs)?;
+        self.settle_events()?;
         for (o, row) in out.iter_mut().zip(rows) {
             *o = self.finite_real(row)?;
         }
@@ -204,144 +304,186 @@ impl<M: Model> Instance<M> {
     /// rather than handing NaN or Inf to the importer's solver.
     fn finite_real(&mut self, row: usize) -> OpResult<f64> {
         let v = decl::<M>().variable(row);
-        let x = self.model.get_real(v.binding)?;
+        let x = self.core.model.get_real(v.binding)?;
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(format!("{} evaluated to {x} (the state or inputs are out of the model's range)", v.name))
+            err(format!("{} evaluated to {x} (the state or inputs are out of the model's range)", v.name))
         }
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
-        self.check_get()?;
         let rows = self.rows(BaseType::Integer, vrs)?;
+        self.settle_events()?;
         for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.model.get_integer(decl::<M>().variable(row).binding)?;
+            *o = self.core.model.get_integer(decl::<M>().variable(row).binding)?;
         }
         Ok(())
     }
 
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
-        self.check_get()?;
         let rows = self.rows(BaseType::Boolean, vrs)?;
+        self.settle_events()?;
         for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.model.get_boolean(decl::<M>().variable(row).binding)?;
+            *o = self.core.model.get_boolean(decl::<M>().variable(row).binding)?;
+        }
+        Ok(())
+    }
+
+    /// Whether `value` fits variable `row` (min/max of the declaration, enumeration items).
+    fn check_value(row: usize, value: f64) -> Result<(), String> {
+        let v = decl::<M>().variable(row);
+        if !value.is_finite() {
+            return Err(format!("{} = {value} refused: not a finite number", v.name));
+        }
+        if let Some(e) = decl::<M>().enumeration_of(row) {
+            if e.item(value as i32).is_none() {
+                let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
+                return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
+            }
+        }
+        if let Some(min) = v.min.filter(|&m| value < m) {
+            return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
+        }
+        if let Some(max) = v.max.filter(|&m| value > m) {
+            return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
         }
         Ok(())
     }
 
     /// Sets all or nothing: every value reference, permission and value is checked first,
     /// and if the model refuses one value the earlier ones are rolled back.
-    fn set_values<T: Copy>(
+    fn set_values<T: Copy + Into<f64>>(
         &mut self,
         base_type: BaseType,
         vrs: &[u32],
         values: &[T],
-        check: impl Fn(&str, T) -> OpResult,
         mut apply: impl FnMut(&mut M, M::Binding, T) -> OpResult,
     ) -> OpResult {
         let rows = self.rows(base_type, vrs)?;
         for (&row, &value) in rows.iter().zip(values) {
-            let v = decl::<M>().variable(row);
-            if !self.settable(row) {
-                return Err(format!(
-                    "{} ({:?}, {:?}) cannot be set in state {:?}",
-                    v.name, v.causality, v.variability, self.machine
-                ));
-            }
-            check(v.name, value)?;
+            self.settable(row)?;
+            Self::check_value(row, value.into())?;
         }
-        let backup = self.model.clone();
+        self.unsettle_events();
+        let backup = self.core.model.clone();
         for (&row, &value) in rows.iter().zip(values) {
             let v = decl::<M>().variable(row);
-            if let Err(e) = apply(&mut self.model, v.binding, value) {
-                self.model = backup;
-                return Err(format!("{}: {e}", v.name));
+            if let Err(e) = apply(&mut self.core.model, v.binding, value) {
+                self.core.model = backup;
+                return Err(match e {
+                    ModelError::Error(m) => ModelError::Error(format!("{}: {m}", v.name)),
+                    ModelError::Discard(m) => ModelError::Discard(format!("{}: {m}", v.name)),
+                });
             }
         }
         Ok(())
     }
 
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> OpResult {
-        self.set_values(
-            BaseType::Real,
-            vrs,
-            values,
-            |name, x: f64| {
-                if x.is_finite() {
-                    Ok(())
-                } else {
-                    Err(format!("{name} = {x} refused: not a finite number"))
-                }
-            },
-            |m, b, x| m.set_real(b, x),
-        )
+        self.set_values(BaseType::Real, vrs, values, |m, b, x| m.set_real(b, x))
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> OpResult {
-        self.set_values(BaseType::Integer, vrs, values, |_, _| Ok(()), |m, b, x| m.set_integer(b, x))
+        self.set_values(BaseType::Integer, vrs, values, |m, b, x| m.set_integer(b, x))
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> OpResult {
-        self.set_values(BaseType::Boolean, vrs, values, |_, _| Ok(()), |m, b, x| m.set_boolean(b, x))
+        let as_f64: Vec<BoolAsF64> = values.iter().map(|&b| BoolAsF64(b)).collect();
+        self.set_values(BaseType::Boolean, vrs, &as_f64, |m, b, x| m.set_boolean(b, x.0))
     }
 
     // ---------------------------------------------------------------- Co-Simulation
 
+    /// `fmi2DoStep`: the model's time events inside the step run in order at their time
+    /// (those at the step's start with the inputs just set); the continuous part is
+    /// integrated between them; events exactly at the step's end wait for the next
+    /// read or step (so that they see the inputs of that instant).
     pub fn do_step(&mut self, current_time: f64, step: f64) -> OpResult {
-        self.require_interface(Interface::CoSimulation)?;
-        self.require(&[Machine::StepComplete], "fmi2DoStep")?;
         if !(step > 0.0) || !step.is_finite() {
-            return Err(format!("communicationStepSize {step} must be finite and > 0"));
+            return err(format!("communicationStepSize {step} must be finite and > 0"));
         }
-        let tolerance = 1e-9 * self.time.abs().max(1.0);
-        if !current_time.is_finite() || (current_time - self.time).abs() > tolerance {
-            return Err(format!(
-                "currentCommunicationPoint {current_time} is not the end of the previous step ({})",
-                self.time
+        let now = self.core.time;
+        if !current_time.is_finite() || (current_time - now).abs() > 1e-9 * now.abs().max(1.0) {
+            return err(format!(
+                "currentCommunicationPoint {current_time} is not the end of the previous step ({now})"
             ));
         }
-        self.model.do_step(self.time, step)?;
-        self.time = current_time + step;
-        Ok(())
+        let end = now + step;
+        if let Some(stop) = self.core.stop_time {
+            if end > stop + time_eps(stop) {
+                return err(format!("the step would end at {end}, after the stopTime {stop} of fmi2SetupExperiment"));
+            }
+        }
+        self.settle_events()?;
+        self.core.pre_event = None;
+        loop {
+            match self.core.next_event {
+                Some(te) if te < end - time_eps(end) => {
+                    let t = self.core.time;
+                    if te > t {
+                        self.core.model.do_step(t, te - t)?;
+                        self.core.time = te;
+                    }
+                    self.run_events_at(te)?;
+                }
+                _ => {
+                    let t = self.core.time;
+                    // without an event inside, exactly the importer's step size
+                    let rest = if t == now { step } else { end - t };
+                    if rest > 0.0 {
+                        self.core.model.do_step(t, rest)?;
+                    }
+                    self.core.time = end;
+                    return Ok(());
+                }
+            }
+        }
     }
 
     // ---------------------------------------------------------------- Model Exchange
 
     pub fn set_time(&mut self, time: f64) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::InitializationMode, Machine::EventMode, Machine::ContinuousTimeMode], "fmi2SetTime")?;
         if !time.is_finite() {
-            return Err(format!("time {time} is not finite"));
+            return err(format!("time {time} is not finite"));
         }
-        self.time = time;
-        self.model.set_time(time);
+        if let Some(stop) = self.core.stop_time {
+            // Variable-step integrators (CVode in fmpy, say) evaluate the right-hand side
+            // past the output time and interpolate back, so a time past stopTime is not an
+            // error in Model Exchange; it is a warning (fmi2Warning, logged). A
+            // Co-Simulation step past stopTime is an error.
+            if time > stop + time_eps(stop) {
+                self.context
+                    .logger
+                    .warning(&format!("fmi2SetTime: time {time} is after the stopTime {stop} of fmi2SetupExperiment"));
+            }
+        }
+        self.core.time = time;
+        self.core.model.set_time(time);
         Ok(())
     }
 
     pub fn enter_event_mode(&mut self) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::EventMode, Machine::ContinuousTimeMode], "fmi2EnterEventMode")?;
-        self.machine = Machine::EventMode;
+        self.core.machine = Machine::EventMode;
         Ok(())
     }
 
     pub fn enter_continuous_time_mode(&mut self) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::EventMode], "fmi2EnterContinuousTimeMode")?;
-        self.machine = Machine::ContinuousTimeMode;
+        self.core.machine = Machine::ContinuousTimeMode;
         Ok(())
     }
 
-    /// `fmi2NewDiscreteStates`: these models have no discrete states or events.
-    pub fn new_discrete_states(&mut self) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::EventMode], "fmi2NewDiscreteStates")
-    }
-
-    pub fn completed_integrator_step(&mut self) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::ContinuousTimeMode], "fmi2CompletedIntegratorStep")
+    /// `fmi2NewDiscreteStates`: one event iteration when a time event is due (or the
+    /// model asked for another); the next event time for the importer.
+    pub fn new_discrete_states(&mut self) -> OpResult<EventUpdate> {
+        let now = self.core.time;
+        let due = matches!(self.core.next_event, Some(te) if te <= now + time_eps(now));
+        if due || self.core.iteration_pending {
+            let update = self.event_update(now)?;
+            Ok(update)
+        } else {
+            Ok(EventUpdate { next_event_time: self.core.next_event, ..Default::default() })
+        }
     }
 
     fn check_state_count(&self, n: usize) -> OpResult {
@@ -349,21 +491,11 @@ impl<M: Model> Instance<M> {
         if n == expected {
             Ok(())
         } else {
-            Err(format!("nx = {n}, the model has {expected} continuous states"))
+            err(format!("nx = {n}, the model has {expected} continuous states"))
         }
     }
 
-    const ME_READ: [Machine; 5] = [
-        Machine::InitializationMode,
-        Machine::EventMode,
-        Machine::ContinuousTimeMode,
-        Machine::Terminated,
-        Machine::Error,
-    ];
-
     pub fn get_continuous_states(&mut self, out: &mut [f64]) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&Self::ME_READ, "fmi2GetContinuousStates")?;
         self.check_state_count(out.len())?;
         self.read_rows(&decl::<M>().state_rows, out)
     }
@@ -377,20 +509,18 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn set_continuous_states(&mut self, x: &[f64]) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&[Machine::EventMode, Machine::ContinuousTimeMode], "fmi2SetContinuousStates")?;
         self.check_state_count(x.len())?;
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
+            return err(format!(
                 "state {} = {} refused: not a finite number",
                 decl::<M>().variable(decl::<M>().state_rows[i]).name,
                 x[i]
             ));
         }
-        let backup = self.model.clone();
+        let backup = self.core.model.clone();
         for (&value, &row) in x.iter().zip(&decl::<M>().state_rows) {
-            if let Err(e) = self.model.set_real(decl::<M>().variable(row).binding, value) {
-                self.model = backup;
+            if let Err(e) = self.core.model.set_real(decl::<M>().variable(row).binding, value) {
+                self.core.model = backup;
                 return Err(e);
             }
         }
@@ -398,15 +528,11 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn get_derivatives(&mut self, out: &mut [f64]) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&Self::ME_READ, "fmi2GetDerivatives")?;
         self.check_state_count(out.len())?;
         self.read_rows(&decl::<M>().derivative_rows, out)
     }
 
     pub fn get_nominals(&mut self, out: &mut [f64]) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&Self::ME_READ, "fmi2GetNominalsOfContinuousStates")?;
         self.check_state_count(out.len())?;
         for (o, &row) in out.iter_mut().zip(&decl::<M>().state_rows) {
             *o = decl::<M>().variable(row).nominal.unwrap_or(1.0);
@@ -415,12 +541,10 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn get_event_indicators(&mut self, out: &mut [f64]) -> OpResult {
-        self.require_interface(Interface::ModelExchange)?;
-        self.require(&Self::ME_READ, "fmi2GetEventIndicators")?;
         if out.is_empty() {
             Ok(())
         } else {
-            Err(format!("ni = {}, the model has no event indicators", out.len()))
+            err(format!("ni = {}, the model has no event indicators", out.len()))
         }
     }
 
@@ -433,55 +557,81 @@ impl<M: Model> Instance<M> {
         dv_known: &[f64],
         out: &mut [f64],
     ) -> OpResult {
-        self.require(&INITIALIZING_OR_LATER, "fmi2GetDirectionalDerivative")?;
         if let Some(x) = dv_known.iter().find(|x| !x.is_finite()) {
-            return Err(format!("dvKnown contains {x}"));
+            return err(format!("dvKnown contains {x}"));
         }
         let binding = |vr: u32| -> OpResult<M::Binding> {
             decl::<M>()
                 .row(BaseType::Real, vr)
                 .map(|r| decl::<M>().variable(r).binding)
-                .ok_or_else(|| format!("unknown Real value reference {vr}"))
+                .ok_or_else(|| format!("unknown Real value reference {vr}").into())
         };
         let u: Vec<_> = unknowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
         let k: Vec<_> = knowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
-        self.model.directional_derivative(&u, &k, dv_known, out)
+        self.core.model.directional_derivative(&u, &k, dv_known, out)?;
+        if let Some(i) = out.iter().position(|x| !x.is_finite()) {
+            let name = decl::<M>().row(BaseType::Real, unknowns[i]).map(|r| decl::<M>().variable(r).name);
+            return err(format!(
+                "the derivative of {} evaluated to {} (seed or state out of the model's range)",
+                name.unwrap_or("?"),
+                out[i]
+            ));
+        }
+        Ok(())
     }
 
     // ---------------------------------------------------------------- FMU state
 
-    pub fn save_state(&self) -> OpResult<SavedState<M>> {
-        if self.machine == Machine::Error {
-            return Err("fmi2GetFMUstate: the instance is in the error state".into());
-        }
-        Ok(SavedState { machine: self.machine, time: self.time, model: self.model.clone() })
+    pub fn save_state(&self) -> SavedState<M> {
+        self.core.clone()
     }
 
     /// Restores a saved state (the callbacks stay the current instance's).
     pub fn restore_state(&mut self, state: &SavedState<M>) -> OpResult {
         let fits = match state.machine {
-            Machine::StepComplete => self.context.interface == Interface::CoSimulation,
+            Machine::StepComplete | Machine::StepFailed => self.context.interface == Interface::CoSimulation,
             Machine::EventMode | Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,
             _ => true,
         };
         if !fits {
-            return Err(format!(
+            return err(format!(
                 "a state saved in {:?} cannot be restored into a {:?} instance",
                 state.machine, self.context.interface
             ));
         }
-        self.machine = state.machine;
-        self.time = state.time;
-        self.model = state.model.clone();
+        self.core = state.clone();
         Ok(())
     }
 
     /// Bytes of a saved state: magic, version, the GUID (a state belongs to one model),
-    /// then machine state, time and the model's numbers, all little-endian.
-    pub fn serialize(state: &SavedState<M>) -> Vec<u8> {
+    /// then the layer's numbers (machine state, time, stop time, next event), the declared
+    /// variables of [`Declaration::saved_rows`] and the model's internal numbers, all
+    /// little-endian f64. Events run lazily at the current time are saved as not run.
+    pub fn serialize(state: &SavedState<M>) -> OpResult<Vec<u8>> {
         let guid = decl::<M>().guid().as_bytes();
-        let mut numbers = vec![state.machine.code(), state.time];
-        state.model.save(&mut numbers);
+        let (mut model, next_event) = match &state.pre_event {
+            Some(pre) => (pre.0.clone(), pre.1),
+            None => (state.model.clone(), state.next_event),
+        };
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let mut numbers = vec![
+            state.machine.code(),
+            state.time,
+            flag(state.stop_time.is_some()),
+            state.stop_time.unwrap_or(0.0),
+            flag(next_event.is_some()),
+            next_event.unwrap_or(0.0),
+            flag(state.iteration_pending),
+        ];
+        for &row in &decl::<M>().saved_rows {
+            let v = decl::<M>().variable(row);
+            numbers.push(match v.base_type {
+                BaseType::Real => model.get_real(v.binding)?,
+                BaseType::Integer => model.get_integer(v.binding)? as f64,
+                BaseType::Boolean => flag(model.get_boolean(v.binding)?),
+            });
+        }
+        model.save_internal(&mut numbers);
         let mut out = Vec::with_capacity(8 + 4 + 4 + guid.len() + 8 + numbers.len() * 8);
         out.extend_from_slice(SERIAL_MAGIC);
         out.extend_from_slice(&SERIAL_VERSION.to_le_bytes());
@@ -491,50 +641,97 @@ impl<M: Model> Instance<M> {
         for x in numbers {
             out.extend_from_slice(&x.to_le_bytes());
         }
-        out
+        Ok(out)
     }
 
     /// Parses bytes from [`Instance::serialize`]; refuses anything else with the reason.
+    /// The variables go through the same checks and setters as `fmi2Set*`, and a state
+    /// past initialization through the model's `exit_initialization` check.
     pub fn deserialize(&self, bytes: &[u8]) -> OpResult<SavedState<M>> {
         let mut rest = bytes;
         let mut take = |n: usize| -> OpResult<&[u8]> {
             if rest.len() < n {
-                return Err(format!("serialized state truncated ({} bytes)", bytes.len()));
+                return err(format!("serialized state truncated ({} bytes)", bytes.len()));
             }
             let (head, tail) = rest.split_at(n);
             rest = tail;
             Ok(head)
         };
         if take(8)? != SERIAL_MAGIC {
-            return Err("not a serialized FMU state of this layer (bad magic)".into());
+            return err("not a serialized FMU state of this layer (bad magic)");
         }
         let version = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default());
         if version != SERIAL_VERSION {
-            return Err(format!("serialized state version {version}, expected {SERIAL_VERSION}"));
+            return err(format!("serialized state version {version}, expected {SERIAL_VERSION}"));
         }
         let guid_len = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default()) as usize;
         if guid_len > 256 {
-            return Err("serialized state has an implausible GUID length".into());
+            return err("serialized state has an implausible GUID length");
         }
         if take(guid_len)? != decl::<M>().guid().as_bytes() {
-            return Err("serialized state belongs to another model (GUID differs)".into());
+            return err("serialized state belongs to another model (GUID differs)");
         }
         let count = u64::from_le_bytes(take(8)?.try_into().unwrap_or_default());
-        let expected_bytes = count.checked_mul(8).filter(|&n| n == (bytes.len() - (8 + 4 + 4 + guid_len + 8)) as u64);
-        if expected_bytes.is_none() || count < 2 {
-            return Err("serialized state length does not match its header".into());
+        let header = 8 + 4 + 4 + guid_len + 8;
+        let saved = decl::<M>().saved_rows.len();
+        if count.checked_mul(8) != Some((bytes.len() - header) as u64)
+            || (count as usize) < SERIAL_HEADER_NUMBERS + saved
+        {
+            return err("serialized state length does not match its header");
         }
         let numbers: Vec<f64> = take(count as usize * 8)?
             .chunks_exact(8)
             .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
             .collect();
         let machine = Machine::from_code(numbers[0]).ok_or("serialized state has an unknown instance state")?;
+        let flag = |x: f64, what: &str| -> OpResult<bool> {
+            if x == 0.0 || x == 1.0 {
+                Ok(x == 1.0)
+            } else {
+                err(format!("serialized {what} flag is {x}, not 0 or 1"))
+            }
+        };
         let time = numbers[1];
-        if !time.is_finite() {
-            return Err("serialized state has a non-finite time".into());
+        let stop_time = flag(numbers[2], "stop time")?.then_some(numbers[3]);
+        let next_event = flag(numbers[4], "next event")?.then_some(numbers[5]);
+        let iteration_pending = flag(numbers[6], "event iteration")?;
+        if !time.is_finite() || stop_time.is_some_and(|s| !s.is_finite() || s < time - time_eps(time)) {
+            return err("serialized state has a non-finite time or a stop time before it");
         }
-        let mut model = self.model.clone();
-        model.load(&numbers[2..])?;
-        Ok(SavedState { machine, time, model })
+        if next_event.is_some_and(|t| !t.is_finite() || t < time - time_eps(time)) {
+            return err("serialized state has a next event time that is non-finite or past");
+        }
+        let mut model = Self::fresh_model(&self.context)?;
+        let values = &numbers[SERIAL_HEADER_NUMBERS..SERIAL_HEADER_NUMBERS + saved];
+        for (&row, &x) in decl::<M>().saved_rows.iter().zip(values) {
+            let v = decl::<M>().variable(row);
+            Self::check_value(row, x).map_err(|e| format!("serialized state: {e}"))?;
+            let r = match v.base_type {
+                BaseType::Real => model.set_real(v.binding, x),
+                BaseType::Integer => {
+                    if x != (x as i32) as f64 {
+                        return err(format!("serialized state: {} = {x} is not an Integer", v.name));
+                    }
+                    model.set_integer(v.binding, x as i32)
+                }
+                BaseType::Boolean => model.set_boolean(v.binding, flag(x, v.name)?),
+            };
+            r.map_err(|e| format!("serialized state: {}: {e}", v.name))?;
+        }
+        model.load_internal(&numbers[SERIAL_HEADER_NUMBERS + saved..])?;
+        if !matches!(machine, Machine::Instantiated | Machine::InitializationMode) {
+            model.exit_initialization().map_err(|e| format!("serialized state: {e}"))?;
+        }
+        Ok(Core { machine, time, stop_time, next_event, iteration_pending, model, pre_event: None })
+    }
+}
+
+/// A Boolean seen as a number for the shared value check (always finite, no bounds).
+#[derive(Clone, Copy)]
+struct BoolAsF64(bool);
+
+impl From<BoolAsF64> for f64 {
+    fn from(b: BoolAsF64) -> f64 {
+        b.0 as u8 as f64
     }
 }

@@ -1,10 +1,118 @@
 //! The one shared FMI 2.0 export layer of nigel-fmi.
 //!
 //! A model implements the safe [`Model`] trait and declares its variables once in a
-//! [`Declaration`]; this crate owns everything else: the C ABI (all 44 `fmi2*` functions,
-//! exported unmangled by [`export_fmi2!`]), the instance state machine, the GUID check,
-//! logging through the importer's callback, FMU state get/set/serialize, and the
-//! generation of `modelDescription.xml` from the same declaration the binary dispatches on.
+//! [`DeclarationSpec`]; this crate owns everything else: the C ABI (all 44 `fmi2*`
+//! functions, exported unmangled by [`export_fmi2!`]), the instance state machine (one
+//! table of allowed states, [`states`]), the GUID check, typed logging through the
+//! importer's callback ([`Logger`]), time events and event iteration, FMU state
+//! get/set/serialize, and the generation of `modelDescription.xml` from the same
+//! declaration the binary dispatches on.
+//!
+//! # Writing a new FMU
+//!
+//! 1. A crate `fmu-xyz` with `[lib] name = "<model identifier>"`,
+//!    `crate-type = ["rlib", "cdylib"]` and a feature `fmi-export = []` (the symbols are
+//!    exported only with it, so several FMU crates can be linked into one test binary).
+//! 2. A binding enum (what each value reference stands for) and the declaration: every
+//!    variable once, with causality, start value, unit, min/max, dependencies. Enumerations
+//!    are Integers with a named type ([`VarDecl::enumeration`], [`enumeration_type`]);
+//!    capabilities (directional derivatives, FMU state, serialization) are opt-in in
+//!    [`Capabilities`]; interfaces in [`Interfaces`].
+//! 3. `impl Model`: [`Model::declaration`], [`Model::instantiate`], get/set by binding.
+//!    A sampled (discrete-time) model adds [`Model::event_update`]: it is called at the
+//!    initial event (the start time) and whenever the `next_event_time` it returned is
+//!    reached; it computes the sample and returns the next sample time. That is all:
+//!    - Model Exchange: `fmi2NewDiscreteStates` calls it and reports
+//!      `nextEventTimeDefined`/`nextEventTime`; `newDiscreteStatesNeeded` iterates;
+//!    - Co-Simulation: `fmi2DoStep` runs the events inside the step in order (a model
+//!      without continuous states needs no `do_step`). Events at a step's start run with
+//!      the inputs set just before it; an event exactly at a step's end runs lazily at the
+//!      next read or step, and setting a value at that instant redoes it, so a sample at
+//!      `t_k` always sees the inputs (and tunable parameters) of `t_k`: outputs with direct
+//!      feed-through work with Gauss-Seidel and Jacobi masters alike;
+//!    - FMU state save/load comes from the declaration: every parameter, input, continuous
+//!      state and discrete variable through your getters and setters (so discrete outputs
+//!      and discrete states must be settable by binding), plus [`Model::save_internal`] /
+//!      [`Model::load_internal`] for data that is no variable (a sample counter). A loaded
+//!      state goes through the same checks as `fmi2Set*` and `exit_initialization`.
+//! 4. `fmi2_export::export_fmi2!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
+//!    entry `FmuTarget::of::<MyModel>("fmu-xyz", EQUATIONS_HTML)` in `build-fmu`'s list:
+//!    the identifier, interfaces and documentation come from the declaration, and the
+//!    generic C-ABI and fmpy tests then cover the new FMU.
+//!
+//! The layer checks value references, base types, the state table, who may be set when
+//! (fixed parameters only before initialization ends, tunable ones between steps and in
+//! event mode, continuous-time mode only continuous inputs), finite Reals, min/max, Boolean
+//! 0/1 and enumeration items before the model sees a value. Errors are [`ModelError`]s:
+//! `Error` (instance to the error state), `Discard` (a failed `fmi2DoStep` goes to
+//! stepFailed; continue with `fmi2SetFMUstate` or `fmi2Reset`); a warning logged through
+//! [`Logger::warning`] makes the call return `fmi2Warning`.
+//!
+//! ```
+//! use std::sync::OnceLock;
+//! use fmi2_export::*;
+//!
+//! #[derive(Clone, Copy, Debug)]
+//! enum B { U, Gain, Mode, Y }
+//!
+//! #[derive(Clone, Debug, Default)]
+//! struct Sampler { u: f64, gain: f64, mode: i32, y: f64, k: u64 }
+//!
+//! const PERIOD: f64 = 0.01;
+//!
+//! impl Model for Sampler {
+//!     type Binding = B;
+//!     fn declaration() -> &'static Declaration<B> {
+//!         static D: OnceLock<Declaration<B>> = OnceLock::new();
+//!         D.get_or_init(|| {
+//!             Declaration::new(DeclarationSpec {
+//!                 model_name: "sampler",
+//!                 model_identifier: "sampler",
+//!                 description: "y_k = gain u(t_k) at t_k = k 10 ms, held",
+//!                 version: "1",
+//!                 interfaces: Interfaces { model_exchange: true, co_simulation: true },
+//!                 capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, ..Default::default() },
+//!                 enumerations: vec![enumeration_type("Mode", "", &[("on", 1, ""), ("off", 2, "")])],
+//!                 variables: vec![
+//!                     VarDecl::real("u", 0, B::U).input(Start::Real(0.0)),
+//!                     VarDecl::real("gain", 1, B::Gain).tunable_parameter(Start::Real(1.0)).min(0.0),
+//!                     VarDecl::enumeration("mode", 0, "Mode", B::Mode).parameter(Start::Integer(1)),
+//!                     VarDecl::real("y", 2, B::Y).discrete_output(Dependencies::On(vec![0])),
+//!                 ],
+//!                 ..Default::default()
+//!             })
+//!             .expect("valid declaration")
+//!         })
+//!     }
+//!     fn instantiate(_: &InstantiateContext) -> ModelResult<Self> {
+//!         Ok(Sampler::default())
+//!     }
+//!     fn get_real(&mut self, b: B) -> ModelResult<f64> {
+//!         match b { B::U => Ok(self.u), B::Gain => Ok(self.gain), B::Y => Ok(self.y), B::Mode => Err("not a Real".into()) }
+//!     }
+//!     fn set_real(&mut self, b: B, x: f64) -> ModelResult {
+//!         match b { B::U => self.u = x, B::Gain => self.gain = x, B::Y => self.y = x, B::Mode => return Err("not a Real".into()) }
+//!         Ok(())
+//!     }
+//!     fn get_integer(&mut self, _: B) -> ModelResult<i32> { Ok(self.mode) }
+//!     fn set_integer(&mut self, _: B, x: i32) -> ModelResult { self.mode = x; Ok(()) }
+//!     fn event_update(&mut self, _time: f64) -> ModelResult<EventUpdate> {
+//!         self.y = if self.mode == 1 { self.gain * self.u } else { 0.0 };
+//!         self.k += 1;
+//!         Ok(EventUpdate::next_at(self.k as f64 * PERIOD))
+//!     }
+//!     fn save_internal(&self, out: &mut Vec<f64>) { out.push(self.k as f64) }
+//!     fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+//!         match data {
+//!             [k] if *k >= 0.0 && k.fract() == 0.0 => { self.k = *k as u64; Ok(()) }
+//!             _ => Err("sample counter expected".into()),
+//!         }
+//!     }
+//! }
+//!
+//! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi2_export::export_fmi2!(Sampler);
+//! assert!(Sampler::declaration().xml().contains(r#"<Enumeration declaredType="Mode" start="1"/>"#));
+//! ```
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -13,16 +121,20 @@ pub mod abi;
 pub mod decl;
 pub mod ffi;
 pub mod instance;
+pub mod log;
 pub mod model;
+pub mod states;
 pub mod uri;
 
 pub use decl::{
-    si_unit, BaseType, Causality, Declaration, DeclarationSpec, Dependencies, Initial, Interfaces, Start, VarDecl,
-    Variability,
+    enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, Initial,
+    Interfaces, Start, VarDecl, Variability,
 };
-pub use instance::{Instance, Machine};
-pub use model::{InstantiateContext, Interface, Model};
+pub use instance::Instance;
+pub use log::{LogCategory, Logger};
+pub use model::{EventUpdate, InstantiateContext, Interface, Model, ModelError, ModelResult};
 pub use model_description;
+pub use states::{Function, Machine};
 
 /// Exports the 44 FMI 2.0 functions for model type `$model` from the calling crate
 /// (which should be a `cdylib`). Invoke it once per shared library.

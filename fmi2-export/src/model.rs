@@ -4,14 +4,17 @@
 use std::path::PathBuf;
 
 use crate::decl::Declaration;
+use crate::log::Logger;
 
 /// What the model learns at instantiation.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct InstantiateContext {
     pub instance_name: String,
     pub interface: Interface,
     /// The FMU's `resources/` folder, when the importer gave a usable `file:` URI.
     pub resource_path: Option<PathBuf>,
+    /// The instance's logger (categories, Warning status); clone it to keep it.
+    pub logger: Logger,
 }
 
 /// The interface an instance was created for.
@@ -21,60 +24,165 @@ pub enum Interface {
     CoSimulation,
 }
 
+/// Why a model call failed.
+///
+/// `Error` puts the instance in the error state (only reset, free, FMU-state restore and
+/// diagnostic gets remain). `Discard` is the standard's "this step or value cannot be
+/// computed, the instance is still sound": `fmi2DoStep` then moves to `stepFailed` (the
+/// importer continues after `fmi2SetFMUstate` or `fmi2Reset`), elsewhere the state stays.
+/// Both carry the reason, which the layer logs with the function's name.
+///
+/// `From<String>` and `From<&str>` give an `Error`, so `Err(format!(..).into())` and `?`
+/// on `Result<_, String>` work.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ModelError {
+    Error(String),
+    Discard(String),
+}
+
+impl ModelError {
+    pub fn message(&self) -> &str {
+        match self {
+            ModelError::Error(m) | ModelError::Discard(m) => m,
+        }
+    }
+}
+
+impl From<String> for ModelError {
+    fn from(m: String) -> Self {
+        ModelError::Error(m)
+    }
+}
+
+impl From<&str> for ModelError {
+    fn from(m: &str) -> Self {
+        ModelError::Error(m.to_string())
+    }
+}
+
+impl std::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+/// Result of a model call.
+pub type ModelResult<T = ()> = Result<T, ModelError>;
+
+/// What an event update reports (FMI 2.0 `fmi2EventInfo`, from the model's side).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct EventUpdate {
+    /// The next time event (e.g. the next sample instant), if any. Must be later than the
+    /// current time; the layer refuses anything else.
+    pub next_event_time: Option<f64>,
+    /// Another event iteration at the same time is needed (the layer calls
+    /// [`Model::event_update`] again at the same time).
+    pub new_discrete_states_needed: bool,
+    /// The model changed its continuous states (Model Exchange importers re-read them).
+    pub values_of_continuous_states_changed: bool,
+    /// The model asks the importer to stop the simulation.
+    pub terminate_simulation: bool,
+}
+
+impl EventUpdate {
+    /// Nothing more to do; the next time event at `t`.
+    pub fn next_at(t: f64) -> Self {
+        EventUpdate { next_event_time: Some(t), ..Default::default() }
+    }
+}
+
 /// A model behind the FMI layer.
 ///
 /// Variables are addressed by the model's own `Binding` (taken from its [`Declaration`]);
 /// the layer has already checked the value reference, the base type, whether the
-/// variable may be set now, and that a Real is finite. Errors are plain messages: the
-/// layer logs them with the function's name and returns `fmi2Error`.
+/// variable may be set now, that a Real is finite, that a Boolean is 0 or 1 and that an
+/// Enumeration value is one of its items. Errors are [`ModelError`]s: the layer logs them
+/// with the function's name and returns the status.
+///
+/// Only [`Model::declaration`], [`Model::instantiate`], [`Model::get_real`] and
+/// [`Model::set_real`] are required; everything else has a default:
+/// - a model without continuous states needs no `do_step`: the layer runs its time events
+///   ([`Model::event_update`]) inside `fmi2DoStep`;
+/// - FMU state save/load comes from the declaration (every parameter, input, continuous
+///   and discrete variable through the getters and setters) plus
+///   [`Model::save_internal`] / [`Model::load_internal`] for data not declared as a variable.
 pub trait Model: Clone + Send + Sized + 'static {
     type Binding: Copy + std::fmt::Debug + Send + Sync + 'static;
 
-    /// The declaration (variables, units, interfaces), built once.
+    /// The declaration (variables, units, interfaces, capabilities), built once.
     fn declaration() -> &'static Declaration<Self::Binding>;
 
     /// A fresh instance. The layer then applies every declared start value through the
     /// setters, so the declaration is the one place start values live.
-    fn instantiate(context: &InstantiateContext) -> Result<Self, String>;
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self>;
 
-    fn get_real(&mut self, binding: Self::Binding) -> Result<f64, String>;
-    fn set_real(&mut self, binding: Self::Binding, value: f64) -> Result<(), String>;
+    fn get_real(&mut self, binding: Self::Binding) -> ModelResult<f64>;
+    fn set_real(&mut self, binding: Self::Binding, value: f64) -> ModelResult;
 
-    fn get_integer(&mut self, binding: Self::Binding) -> Result<i32, String> {
-        Err(format!("{binding:?} is not an Integer"))
+    /// Integers and Enumerations.
+    fn get_integer(&mut self, binding: Self::Binding) -> ModelResult<i32> {
+        Err(format!("{binding:?} is not an Integer").into())
     }
-    fn set_integer(&mut self, binding: Self::Binding, _value: i32) -> Result<(), String> {
-        Err(format!("{binding:?} is not an Integer"))
+    fn set_integer(&mut self, binding: Self::Binding, _value: i32) -> ModelResult {
+        Err(format!("{binding:?} is not an Integer").into())
     }
-    fn get_boolean(&mut self, binding: Self::Binding) -> Result<bool, String> {
-        Err(format!("{binding:?} is not a Boolean"))
+    fn get_boolean(&mut self, binding: Self::Binding) -> ModelResult<bool> {
+        Err(format!("{binding:?} is not a Boolean").into())
     }
-    fn set_boolean(&mut self, binding: Self::Binding, _value: bool) -> Result<(), String> {
-        Err(format!("{binding:?} is not a Boolean"))
+    fn set_boolean(&mut self, binding: Self::Binding, _value: bool) -> ModelResult {
+        Err(format!("{binding:?} is not a Boolean").into())
     }
 
-    /// Checks the parameters as a whole when initialization ends.
-    fn exit_initialization(&mut self) -> Result<(), String> {
+    /// Checks the parameters as a whole when initialization ends, and after a serialized
+    /// FMU state was loaded (so a state file cannot hold what the setters would refuse).
+    fn exit_initialization(&mut self) -> ModelResult {
         Ok(())
     }
 
-    /// Co-Simulation: advance from `time` by `step` with inputs held.
-    fn do_step(&mut self, time: f64, step: f64) -> Result<(), String>;
+    /// An event at `time`: the initial event (at the start time, right after
+    /// initialization in both interfaces), and every time the `next_event_time` it
+    /// returned is reached. A sampled model computes its sample here and returns the next
+    /// sample instant. Default: no events.
+    fn event_update(&mut self, _time: f64) -> ModelResult<EventUpdate> {
+        Ok(EventUpdate::default())
+    }
+
+    /// Co-Simulation: advance the continuous states from `time` by `step` with inputs held.
+    /// The layer has already split the communication step at the time events, so there
+    /// is no event strictly inside `(time, time + step)`. The default serves models
+    /// without continuous states (it does nothing).
+    fn do_step(&mut self, _time: f64, _step: f64) -> ModelResult {
+        if Self::declaration().number_of_states() == 0 {
+            Ok(())
+        } else {
+            Err("the model has continuous states but implements no Co-Simulation do_step".into())
+        }
+    }
 
     /// Model Exchange: the importer's time (for time-dependent models).
     fn set_time(&mut self, _time: f64) {}
 
     /// Exact directional derivative `dv_unknown = J dv_known`, J = d unknowns / d knowns.
+    /// Called only when the declaration opts in to `directional_derivatives`.
     fn directional_derivative(
         &mut self,
-        unknowns: &[Self::Binding],
-        knowns: &[Self::Binding],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<(), String>;
+        _unknowns: &[Self::Binding],
+        _knowns: &[Self::Binding],
+        _dv_known: &[f64],
+        _dv_unknown: &mut [f64],
+    ) -> ModelResult {
+        Err("not supported (providesDirectionalDerivative is false)".into())
+    }
 
-    /// The whole model state as numbers (bit-exact; Booleans as 0/1), for serialization.
-    fn save(&self, out: &mut Vec<f64>);
-    /// Restores what [`Model::save`] wrote; refuses data of the wrong length or content.
-    fn load(&mut self, data: &[f64]) -> Result<(), String>;
+    /// Internal data that is not a declared variable (a sample counter, say), appended
+    /// to the FMU state after the declared variables. Bit-exact as f64.
+    fn save_internal(&self, _out: &mut Vec<f64>) {}
+    /// Restores what [`Model::save_internal`] wrote (exactly those numbers).
+    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+        if data.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("{} internal numbers, the model keeps none", data.len()).into())
+        }
+    }
 }

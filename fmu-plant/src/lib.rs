@@ -9,7 +9,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
 use fmi2_export::{
-    si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, Start, VarDecl,
+    si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model,
+    ModelError, ModelResult, Start, VarDecl,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
@@ -21,8 +22,14 @@ pub const MODEL_IDENTIFIER: &str = "nigel_plant";
 /// a longer step is refused instead of hanging the importer.
 pub const MAX_SUBSTEPS_PER_STEP: usize = 10_000_000;
 
-/// Default upper bound of the internal RK4 sub-step in Co-Simulation [s].
+/// Default upper bound of the internal RK4 sub-step in Co-Simulation [s]. The sub-step
+/// actually taken is also bounded by the tires' stability limit
+/// ([`nigel_vehicle::dynamics::stable_rk4_step`]), so no accepted friction makes it unstable.
 pub const DEFAULT_CS_SUBSTEP_MAX: f64 = 5e-4;
+
+/// Largest accepted road-tire friction coefficient: above any tire on any road (racing
+/// slicks on dry asphalt reach about 2).
+pub const MU_MAX: f64 = 3.0;
 
 /// Real parameters (value references 100 + index).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +67,9 @@ pub enum Input {
     Friction(usize),
     WindHead,
     WindSide,
+    /// World-frame wind, rotated into the body frame with the instantaneous heading.
+    WindX,
+    WindY,
 }
 
 /// Calculated outputs.
@@ -112,6 +122,8 @@ pub mod vr {
     pub const FRICTION: u32 = 28;
     pub const WIND_HEAD: u32 = 32;
     pub const WIND_SIDE: u32 = 33;
+    pub const WIND_X: u32 = 34;
+    pub const WIND_Y: u32 = 35;
     pub const BETA: u32 = 40;
     pub const SPEED: u32 = 41;
     pub const LATERAL_ACCEL: u32 = 42;
@@ -139,7 +151,8 @@ fn state_vr(i: usize) -> u32 {
 fn body_knowns() -> Vec<u32> {
     let mut k: Vec<u32> = (idx::V_X..N_STATES).map(state_vr).collect();
     k.extend((0..4).flat_map(|i| [vr::STEER + i, vr::TORQUE + i, vr::FRICTION + i]));
-    k.extend([vr::WIND_HEAD, vr::WIND_SIDE]);
+    // world-frame wind enters through the heading psi
+    k.extend([vr::WIND_HEAD, vr::WIND_SIDE, vr::WIND_X, vr::WIND_Y, state_vr(idx::PSI)]);
     k
 }
 
@@ -183,7 +196,8 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             real(leak(format!("mu_{w}")), vr::FRICTION + i as u32, PlantVar::Input(Input::Friction(i)))
                 .input(Start::Real(0.4))
                 .min(0.0)
-                .describe("road-tire friction coefficient (>= 0)"),
+                .max(MU_MAX)
+                .describe("road-tire friction coefficient, 0 .. 3"),
         );
     }
     v.push(
@@ -197,6 +211,18 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             .input(Start::Real(0.0))
             .unit("N")
             .describe("side wind force toward body +y, at the geometric centre"),
+    );
+    v.push(
+        real("wind_x", vr::WIND_X, PlantVar::Input(Input::WindX))
+            .input(Start::Real(0.0))
+            .unit("N")
+            .describe("wind force along world +X at the geometric centre, rotated with the instantaneous psi"),
+    );
+    v.push(
+        real("wind_y", vr::WIND_Y, PlantVar::Input(Input::WindY))
+            .input(Start::Real(0.0))
+            .unit("N")
+            .describe("wind force along world +Y at the geometric centre, rotated with the instantaneous psi"),
     );
 
     // states (the first six are outputs too) and their derivatives
@@ -317,12 +343,14 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         ),
     ];
     for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
-        v.push(
-            real(name, vr::PARAM + k as u32, PlantVar::Param(p))
-                .parameter(Start::Real(start))
-                .unit(unit)
-                .describe(text),
-        );
+        let mut var = real(name, vr::PARAM + k as u32, PlantVar::Param(p))
+            .parameter(Start::Real(start))
+            .unit(unit)
+            .describe(text);
+        if p == Param::SteerLimit {
+            var = var.max(std::f64::consts::FRAC_PI_2);
+        }
+        v.push(var);
     }
     let switches = [
         (
@@ -364,6 +392,8 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
                       (independent four-wheel drive and steer), paper Section III",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
+        capabilities: Capabilities { directional_derivatives: true, fmu_state: true, serialize_fmu_state: true },
+        enumerations: Vec::new(),
         units,
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
@@ -432,6 +462,8 @@ fn input_slot<T>(u: &mut Inputs<T>, which: Input) -> &mut T {
         Input::Friction(i) => &mut u.mu[i],
         Input::WindHead => &mut u.wind_head,
         Input::WindSide => &mut u.wind_side,
+        Input::WindX => &mut u.wind_x,
+        Input::WindY => &mut u.wind_y,
     }
 }
 
@@ -447,7 +479,21 @@ fn output_of<T: Copy>(e: &Evaluation<T>, which: Output) -> T {
     }
 }
 
+/// The parameter checks of `nigel-vehicle` with every fidelity switch on: a parameter of a
+/// switched-off feature must be possible too (it is refused even while its switch is off,
+/// so that switching it on later cannot make an accepted instance impossible).
+fn validate_all(p: &VehicleParams) -> Result<(), String> {
+    let strict = VehicleParams { friction_circle: true, steering_servo: true, motor_speed_limit: true, ..*p };
+    strict.validate().map_err(|e| e.to_string())
+}
+
 impl Plant {
+    /// The RK4 sub-step of Co-Simulation: `cs_substep_max`, or shorter where the tire
+    /// forces' stability limit at the current friction and torques requires it.
+    pub fn substep(&self) -> f64 {
+        self.cs_substep_max.min(nigel_vehicle::dynamics::stable_rk4_step(&self.params, &self.inputs))
+    }
+
     /// The evaluation at the current state and inputs (computed once per change).
     pub fn evaluation(&mut self) -> &Evaluation<f64> {
         let (p, s, u) = (&self.params, &self.state, &self.inputs);
@@ -469,11 +515,11 @@ impl Model for Plant {
         })
     }
 
-    fn instantiate(_context: &InstantiateContext) -> Result<Self, String> {
+    fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
         Ok(Plant::default())
     }
 
-    fn get_real(&mut self, b: PlantVar) -> Result<f64, String> {
+    fn get_real(&mut self, b: PlantVar) -> ModelResult<f64> {
         Ok(match b {
             PlantVar::Param(Param::CsSubstepMax) => self.cs_substep_max,
             PlantVar::Param(p) => *param_slot(&mut self.params, p).ok_or("no such parameter")?,
@@ -485,22 +531,22 @@ impl Model for Plant {
         })
     }
 
-    fn set_real(&mut self, b: PlantVar, value: f64) -> Result<(), String> {
+    fn set_real(&mut self, b: PlantVar, value: f64) -> ModelResult {
         match b {
             PlantVar::Param(Param::CsSubstepMax) => {
-                if !(value > 0.0) {
-                    return Err(format!("cs_substep_max = {value} must be > 0"));
+                if !(value > 0.0) || !value.is_finite() {
+                    return Err(format!("cs_substep_max = {value} must be finite and > 0").into());
                 }
                 self.cs_substep_max = value;
             }
             PlantVar::Param(p) => {
                 let mut candidate = self.params;
                 *param_slot(&mut candidate, p).ok_or("no such parameter")? = value;
-                candidate.validate().map_err(|e| e.to_string())?;
+                validate_all(&candidate)?;
                 self.params = candidate;
             }
-            PlantVar::Input(Input::Friction(i)) if value < 0.0 => {
-                return Err(format!("mu_{} = {value} refused: friction must be >= 0", WHEEL[i]));
+            PlantVar::Input(Input::Friction(i)) if !(0.0..=MU_MAX).contains(&value) => {
+                return Err(format!("mu_{} = {value} refused: friction must be in [0, {MU_MAX}]", WHEEL[i]).into());
             }
             PlantVar::Input(i) => *input_slot(&mut self.inputs, i) = value,
             PlantVar::State(i) => self.state[i] = value,
@@ -511,43 +557,48 @@ impl Model for Plant {
         Ok(())
     }
 
-    fn get_boolean(&mut self, b: PlantVar) -> Result<bool, String> {
+    fn get_boolean(&mut self, b: PlantVar) -> ModelResult<bool> {
         match b {
             PlantVar::Switch(s) => Ok(*switch_slot(&mut self.params, s)),
-            _ => Err(format!("{b:?} is not a Boolean")),
+            _ => Err(format!("{b:?} is not a Boolean").into()),
         }
     }
 
-    fn set_boolean(&mut self, b: PlantVar, value: bool) -> Result<(), String> {
-        let PlantVar::Switch(s) = b else { return Err(format!("{b:?} is not a Boolean")) };
+    fn set_boolean(&mut self, b: PlantVar, value: bool) -> ModelResult {
+        let PlantVar::Switch(s) = b else { return Err(format!("{b:?} is not a Boolean").into()) };
         let mut candidate = self.params;
         *switch_slot(&mut candidate, s) = value;
-        candidate.validate().map_err(|e| e.to_string())?;
+        validate_all(&candidate)?;
         self.params = candidate;
         self.changed();
         Ok(())
     }
 
-    fn exit_initialization(&mut self) -> Result<(), String> {
-        self.params.validate().map_err(|e| e.to_string())?;
-        if let Some(i) = self.inputs.mu.iter().position(|&m| m < 0.0) {
-            return Err(format!("mu_{} = {} must be >= 0", WHEEL[i], self.inputs.mu[i]));
+    fn exit_initialization(&mut self) -> ModelResult {
+        validate_all(&self.params)?;
+        if let Some(i) = self.inputs.mu.iter().position(|m| !(0.0..=MU_MAX).contains(m)) {
+            return Err(format!("mu_{} = {} must be in [0, {MU_MAX}]", WHEEL[i], self.inputs.mu[i]).into());
+        }
+        if !(self.cs_substep_max > 0.0 && self.cs_substep_max.is_finite()) {
+            return Err(format!("cs_substep_max = {} must be finite and > 0", self.cs_substep_max).into());
         }
         Ok(())
     }
 
-    fn do_step(&mut self, _time: f64, step: f64) -> Result<(), String> {
-        let substeps = nigel_vehicle::dynamics::substeps(step, self.cs_substep_max);
+    fn do_step(&mut self, _time: f64, step: f64) -> ModelResult {
+        let substep = self.substep();
+        let substeps = nigel_vehicle::dynamics::substeps(step, substep);
         if substeps > MAX_SUBSTEPS_PER_STEP {
-            return Err(format!(
-                "a step of {step} s would take {substeps} RK4 sub-steps of at most cs_substep_max = {} s \
-                 (limit {MAX_SUBSTEPS_PER_STEP}); take shorter steps or raise cs_substep_max",
+            return Err(ModelError::Discard(format!(
+                "a step of {step} s would take {substeps} RK4 sub-steps of {substep} s (the smaller of \
+                 cs_substep_max = {} s and the tires' stability limit; limit {MAX_SUBSTEPS_PER_STEP}); \
+                 take shorter communication steps",
                 self.cs_substep_max
-            ));
+            )));
         }
-        let next = nigel_vehicle::integrate(&self.params, &self.state, &self.inputs, step, self.cs_substep_max);
+        let next = nigel_vehicle::integrate(&self.params, &self.state, &self.inputs, step, substep);
         if let Some(i) = next.iter().position(|x| !x.is_finite()) {
-            return Err(format!("state {} became {} (step {step} s)", STATE_NAMES[i], next[i]));
+            return Err(format!("state {} became {} (step {step} s)", STATE_NAMES[i], next[i]).into());
         }
         self.state = next;
         self.changed();
@@ -560,7 +611,7 @@ impl Model for Plant {
         knowns: &[PlantVar],
         dv_known: &[f64],
         out: &mut [f64],
-    ) -> Result<(), String> {
+    ) -> ModelResult {
         let mut s: State<Dual> = self.state.map(Dual::constant);
         let u = &self.inputs;
         let mut ud = Inputs {
@@ -576,7 +627,7 @@ impl Model for Plant {
             match k {
                 PlantVar::State(i) => s[i].d += dv,
                 PlantVar::Input(i) => input_slot(&mut ud, i).d += dv,
-                other => return Err(format!("{other:?} is not a known (only states and inputs are)")),
+                other => return Err(format!("{other:?} is not a known (only states and inputs are)").into()),
             }
         }
         let e = evaluate(&self.params, &s, &ud);
@@ -585,79 +636,11 @@ impl Model for Plant {
                 PlantVar::Derivative(i) => e.derivatives[i].d,
                 PlantVar::Output(w) => output_of(&e, w).d,
                 PlantVar::State(i) => s[i].d,
-                other => return Err(format!("{other:?} is not an unknown (only derivatives, outputs and states are)")),
+                other => {
+                    return Err(format!("{other:?} is not an unknown (only derivatives, outputs and states are)").into())
+                }
             };
         }
-        Ok(())
-    }
-
-    fn save(&self, out: &mut Vec<f64>) {
-        let p = &self.params;
-        out.extend_from_slice(&[p.m, p.i_z, p.l_f, p.l_r, p.track, p.r_wheel]);
-        out.extend_from_slice(&p.c);
-        out.extend_from_slice(&[
-            p.g,
-            p.v_fade,
-            p.delta_max,
-            p.servo_time_constant,
-            p.servo_rate_max,
-            p.wheel_speed_max,
-            p.motor_taper,
-        ]);
-        out.extend([p.friction_circle, p.steering_servo, p.motor_speed_limit].map(|b| b as u8 as f64));
-        out.push(self.cs_substep_max);
-        let u = &self.inputs;
-        out.extend_from_slice(&u.delta);
-        out.extend_from_slice(&u.tau);
-        out.extend_from_slice(&u.mu);
-        out.extend_from_slice(&[u.wind_head, u.wind_side]);
-        out.extend_from_slice(&self.state);
-    }
-
-    fn load(&mut self, data: &[f64]) -> Result<(), String> {
-        const LEN: usize = 6 + 4 + 7 + 3 + 1 + 14 + N_STATES;
-        if data.len() != LEN {
-            return Err(format!("plant state has {} numbers, expected {LEN}", data.len()));
-        }
-        let mut it = data.iter().copied();
-        let mut next = || it.next().unwrap_or(f64::NAN);
-        let mut p = VehicleParams::table2();
-        for slot in [&mut p.m, &mut p.i_z, &mut p.l_f, &mut p.l_r, &mut p.track, &mut p.r_wheel] {
-            *slot = next();
-        }
-        for c in &mut p.c {
-            *c = next();
-        }
-        for slot in [
-            &mut p.g,
-            &mut p.v_fade,
-            &mut p.delta_max,
-            &mut p.servo_time_constant,
-            &mut p.servo_rate_max,
-            &mut p.wheel_speed_max,
-            &mut p.motor_taper,
-        ] {
-            *slot = next();
-        }
-        for slot in [&mut p.friction_circle, &mut p.steering_servo, &mut p.motor_speed_limit] {
-            *slot = next() != 0.0;
-        }
-        p.validate().map_err(|e| format!("serialized parameters: {e}"))?;
-        let cs_substep_max = next();
-        let mut u = Inputs::coasting(0.0);
-        for slot in u.delta.iter_mut().chain(u.tau.iter_mut()).chain(u.mu.iter_mut()) {
-            *slot = next();
-        }
-        u.wind_head = next();
-        u.wind_side = next();
-        let mut state = [0.0; N_STATES];
-        for s in &mut state {
-            *s = next();
-        }
-        if !(cs_substep_max > 0.0) || !state.iter().chain(&u.delta).chain(&u.tau).chain(&u.mu).all(|x| x.is_finite()) {
-            return Err("serialized state holds non-finite or invalid numbers".into());
-        }
-        *self = Plant { params: p, inputs: u, state, cs_substep_max, cache: None };
         Ok(())
     }
 }

@@ -189,9 +189,10 @@ impl fmt::Display for ReadError {
 impl std::error::Error for ReadError {}
 
 // ---------------------------------------------------------------------------------------
-// A tiny element tree (depth-limited: nothing of FMI 2.0 we read is deeper than 4).
+// A tiny element tree (depth-limited: nothing of FMI 2.0 we read is deeper than 5,
+// the enumeration items of TypeDefinitions/SimpleType/Enumeration/Item).
 
-const MAX_DEPTH: usize = 4;
+const MAX_DEPTH: usize = 5;
 
 struct Node {
     name: String,
@@ -554,6 +555,30 @@ impl ModelDescription {
             }
         }
 
+        let mut type_definitions = Vec::new();
+        if let Some(types) = types_node {
+            for t in types.children.iter().filter(|c| c.name == "SimpleType") {
+                let Some(e) = t.children.iter().find(|c| c.name == "Enumeration") else { continue };
+                let tl = "Item of Enumeration";
+                let mut items = Vec::new();
+                for item in e.children.iter().filter(|c| c.name == "Item") {
+                    items.push(EnumerationItem {
+                        name: ctx.req(item, tl, "name")?.to_string(),
+                        value: {
+                            let text = ctx.req(item, tl, "value")?;
+                            text.trim().parse::<i32>().map_err(|_| ctx.bad_number(item, tl, "value", text))?
+                        },
+                        description: Ctx::opt_string(item, "description"),
+                    });
+                }
+                type_definitions.push(EnumerationType {
+                    name: ctx.req(t, "SimpleType", "name")?.to_string(),
+                    description: Ctx::opt_string(t, "description"),
+                    items,
+                });
+            }
+        }
+
         let mut log_categories = Vec::new();
         if let Some(logs) = logs_node {
             for c in logs.children.iter().filter(|c| c.name == "Category") {
@@ -619,6 +644,7 @@ impl ModelDescription {
             model_exchange,
             co_simulation,
             unit_definitions,
+            type_definitions,
             log_categories,
             default_experiment,
             model_variables,
@@ -673,7 +699,8 @@ fn read_variable(
             min: i32_attr("min", &defaults.min)?,
             max: i32_attr("max", &defaults.max)?,
         },
-        "Enumeration" => VariableType::Integer {
+        "Enumeration" => VariableType::Enumeration {
+            declared_type: ctx.req(t, &tl, "declaredType")?.to_string(),
             start: ctx.opt_i32(t, &tl, "start")?,
             min: ctx.opt_i32(t, &tl, "min")?,
             max: ctx.opt_i32(t, &tl, "max")?,
@@ -740,9 +767,9 @@ mod tests {
     #[test]
     fn tree_is_depth_limited() {
         let t = parse_tree("<a><b><c><d><e><f/></e></d></c></b></a>").unwrap();
-        let d = &t.children[0].children[0].children[0];
-        assert_eq!(d.name, "d");
-        assert!(d.children.is_empty());
+        let e = &t.children[0].children[0].children[0].children[0];
+        assert_eq!(e.name, "e");
+        assert!(e.children.is_empty());
     }
 
     #[test]

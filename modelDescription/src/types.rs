@@ -79,6 +79,19 @@ pub enum VariableType {
         /// `max` attribute.
         max: Option<i32>,
     },
+    /// `<Enumeration declaredType=..>`: an Integer (same value-reference space, accessed
+    /// through `fmi2GetInteger`/`fmi2SetInteger`) whose values are the items of the
+    /// [`EnumerationType`] named `declared_type` in `<TypeDefinitions>`.
+    Enumeration {
+        /// `declaredType` attribute: the name of a `<SimpleType>` with an `<Enumeration>`.
+        declared_type: String,
+        /// `start` attribute.
+        start: Option<i32>,
+        /// `min` attribute.
+        min: Option<i32>,
+        /// `max` attribute.
+        max: Option<i32>,
+    },
     /// `<Boolean>`.
     Boolean {
         /// `start` attribute.
@@ -151,6 +164,35 @@ pub struct Unit {
     pub name: String,
     /// Optional SI base-unit definition.
     pub base_unit: Option<BaseUnit>,
+}
+
+/// One `<Item>` of an enumeration type.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnumerationItem {
+    /// Item name (unique in its type).
+    pub name: String,
+    /// Its Integer value (unique in its type).
+    pub value: i32,
+    /// Optional description.
+    pub description: Option<String>,
+}
+
+/// A `<SimpleType name=..><Enumeration>..</Enumeration></SimpleType>` of `<TypeDefinitions>`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnumerationType {
+    /// The type name, used as `declaredType` by variables.
+    pub name: String,
+    /// Optional description.
+    pub description: Option<String>,
+    /// The named items.
+    pub items: Vec<EnumerationItem>,
+}
+
+impl EnumerationType {
+    /// The item with this value.
+    pub fn item(&self, value: i32) -> Option<&EnumerationItem> {
+        self.items.iter().find(|i| i.value == value)
+    }
 }
 
 /// One `<Category>` of `<LogCategories>`.
@@ -295,6 +337,9 @@ pub struct ModelDescription {
     pub co_simulation: Option<CoSimulation>,
     /// `<UnitDefinitions>` (element omitted when empty).
     pub unit_definitions: Vec<Unit>,
+    /// Enumeration types of `<TypeDefinitions>` (element omitted when empty).
+    #[serde(default)]
+    pub type_definitions: Vec<EnumerationType>,
     /// `<LogCategories>` (element omitted when empty).
     pub log_categories: Vec<LogCategory>,
     /// `<DefaultExperiment>`.
@@ -451,11 +496,12 @@ impl DependencyKind {
 }
 
 impl VariableType {
-    /// The element name: `"Real"`, `"Integer"`, `"Boolean"` or `"String"`.
+    /// The base type: `"Real"`, `"Integer"`, `"Boolean"` or `"String"` (an Enumeration is an
+    /// `"Integer"`: it shares the Integer value-reference space and access functions).
     pub fn type_name(&self) -> &'static str {
         match self {
             VariableType::Real { .. } => "Real",
-            VariableType::Integer { .. } => "Integer",
+            VariableType::Integer { .. } | VariableType::Enumeration { .. } => "Integer",
             VariableType::Boolean { .. } => "Boolean",
             VariableType::String { .. } => "String",
         }
@@ -465,7 +511,7 @@ impl VariableType {
     pub fn has_start(&self) -> bool {
         match self {
             VariableType::Real { start, .. } => start.is_some(),
-            VariableType::Integer { start, .. } => start.is_some(),
+            VariableType::Integer { start, .. } | VariableType::Enumeration { start, .. } => start.is_some(),
             VariableType::Boolean { start } => start.is_some(),
             VariableType::String { start } => start.is_some(),
         }

@@ -57,6 +57,9 @@ pub enum Rule {
     DependencyNotKnown,
     /// `dependenciesKind` needs `dependencies` of the same length.
     DependenciesKind,
+    /// An Enumeration's `declaredType` must name an enumeration type of `<TypeDefinitions>`
+    /// whose item names and values are unique, and its start must be one of the items.
+    DeclaredType,
 }
 
 impl Rule {
@@ -87,6 +90,7 @@ impl Rule {
             Rule::DependencyOrder => "dependency-order",
             Rule::DependencyNotKnown => "dependency-not-known",
             Rule::DependenciesKind => "dependencies-kind",
+            Rule::DeclaredType => "declared-type",
         }
     }
 }
@@ -187,6 +191,26 @@ impl ModelDescription {
         for u in &self.unit_definitions {
             if !seen.insert(u.name.as_str()) {
                 c.push(Rule::DuplicateUnit, None, format!("unit \"{}\" is defined more than once", u.name));
+            }
+        }
+        let mut type_names = HashSet::new();
+        for t in &self.type_definitions {
+            if !type_names.insert(t.name.as_str()) {
+                c.push(Rule::DeclaredType, None, format!("type \"{}\" is defined more than once", t.name));
+            }
+            if t.items.is_empty() {
+                c.push(Rule::DeclaredType, None, format!("enumeration \"{}\" has no items", t.name));
+            }
+            let mut item_names = HashSet::new();
+            let mut values = HashSet::new();
+            for item in &t.items {
+                if !item_names.insert(item.name.as_str()) || !values.insert(item.value) {
+                    c.push(
+                        Rule::DeclaredType,
+                        None,
+                        format!("enumeration \"{}\": item {} = {} is not unique", t.name, item.name, item.value),
+                    );
+                }
             }
         }
     }
@@ -337,6 +361,25 @@ impl ModelDescription {
                 }
                 VariableType::Integer { start, min, max } => {
                     check_bounds(c, name, min.map(f64::from), max.map(f64::from), start.map(f64::from));
+                }
+                VariableType::Enumeration { declared_type, start, min, max } => {
+                    check_bounds(c, name, min.map(f64::from), max.map(f64::from), start.map(f64::from));
+                    match self.type_definitions.iter().find(|t| &t.name == declared_type) {
+                        None => c.push(
+                            Rule::DeclaredType,
+                            name,
+                            format!("declaredType \"{declared_type}\" is not an enumeration type of TypeDefinitions"),
+                        ),
+                        Some(t) => {
+                            if let Some(s) = start.filter(|&s| t.item(s).is_none()) {
+                                c.push(
+                                    Rule::DeclaredType,
+                                    name,
+                                    format!("start={s} is not a value of the enumeration \"{declared_type}\""),
+                                );
+                            }
+                        }
+                    }
                 }
                 _ => {}
             }

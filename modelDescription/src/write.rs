@@ -223,6 +223,26 @@ impl ModelDescription {
             o.close("UnitDefinitions");
         }
 
+        if !self.type_definitions.is_empty() {
+            o.open(Elem::new("TypeDefinitions"));
+            for t in &self.type_definitions {
+                let mut e = Elem::new("SimpleType");
+                e.attr("name", &t.name).opt_str("description", &t.description);
+                o.open(e);
+                o.open(Elem::new("Enumeration"));
+                for item in &t.items {
+                    let mut ie = Elem::new("Item");
+                    ie.attr("name", &item.name)
+                        .attr("value", &item.value.to_string())
+                        .opt_str("description", &item.description);
+                    o.empty(ie);
+                }
+                o.close("Enumeration");
+                o.close("SimpleType");
+            }
+            o.close("TypeDefinitions");
+        }
+
         if !self.log_categories.is_empty() {
             o.open(Elem::new("LogCategories"));
             for c in &self.log_categories {
@@ -271,6 +291,14 @@ impl ModelDescription {
                     VariableType::Integer { start, min, max } => {
                         let mut t = Elem::new("Integer");
                         t.opt_disp("min", *min).opt_disp("max", *max).opt_disp("start", *start);
+                        t
+                    }
+                    VariableType::Enumeration { declared_type, start, min, max } => {
+                        let mut t = Elem::new("Enumeration");
+                        t.attr("declaredType", declared_type)
+                            .opt_disp("min", *min)
+                            .opt_disp("max", *max)
+                            .opt_disp("start", *start);
                         t
                     }
                     VariableType::Boolean { start } => {

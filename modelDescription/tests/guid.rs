@@ -70,6 +70,9 @@ fn changes_when_any_variable_changes() {
                     VariableType::Integer { start, min, max } => {
                         VariableType::Integer { start: Some(start.unwrap_or(0) + 1), min, max }
                     }
+                    VariableType::Enumeration { declared_type, start, min, max } => {
+                        VariableType::Enumeration { declared_type, start: Some(start.unwrap_or(0) + 1), min, max }
+                    }
                     VariableType::Boolean { start } => VariableType::Boolean { start: Some(!start.unwrap_or(false)) },
                     VariableType::String { start } => {
                         VariableType::String { start: Some(start.unwrap_or_default() + "!") }

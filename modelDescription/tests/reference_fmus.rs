@@ -199,6 +199,11 @@ fn declared_type_defaults_and_enumerations() {
         }
     );
     assert_eq!(md.model_variables[1].variable_type, VariableType::Integer { start: None, min: Some(0), max: Some(9) });
-    assert_eq!(md.model_variables[2].variable_type, VariableType::Integer { start: Some(2), min: None, max: None });
+    assert_eq!(
+        md.model_variables[2].variable_type,
+        VariableType::Enumeration { declared_type: "Mode".into(), start: Some(2), min: None, max: None }
+    );
+    assert_eq!(md.type_definitions.len(), 1, "only the enumeration is kept as a type");
+    assert_eq!(md.type_definitions[0].item(2).map(|i| i.name.as_str()), Some("b"));
     assert_eq!(md.model_variables[3].variable_type.unit(), None);
 }

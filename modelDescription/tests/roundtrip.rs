@@ -15,6 +15,58 @@ fn rich_description_round_trips() {
     assert_eq!(back.to_xml(), xml);
 }
 
+fn with_enumeration() -> ModelDescription {
+    let mut md = minimal();
+    md.type_definitions.push(EnumerationType {
+        name: "Gear".into(),
+        description: Some("gear box position".into()),
+        items: vec![
+            EnumerationItem { name: "reverse".into(), value: -1, description: None },
+            EnumerationItem { name: "neutral".into(), value: 0, description: Some("no drive".into()) },
+            EnumerationItem { name: "first".into(), value: 1, description: None },
+        ],
+    });
+    md.model_variables.push(ScalarVariable {
+        name: "gear".into(),
+        value_reference: 77,
+        description: None,
+        causality: Causality::Parameter,
+        variability: Variability::Fixed,
+        initial: Some(Initial::Exact),
+        variable_type: VariableType::Enumeration { declared_type: "Gear".into(), start: Some(0), min: None, max: None },
+    });
+    md
+}
+
+#[test]
+fn enumeration_types_and_variables_round_trip_and_validate() {
+    let md = with_enumeration();
+    assert!(md.validate().is_empty(), "{:?}", md.validate());
+    let xml = md.to_xml();
+    assert!(xml.contains("<TypeDefinitions>"), "{xml}");
+    assert!(xml.contains(r#"<Item name="reverse" value="-1"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Enumeration declaredType="Gear" start="0"/>"#), "{xml}");
+    // TypeDefinitions sit between UnitDefinitions and LogCategories (schema order).
+    let pos = |s: &str| xml.find(s).unwrap_or(usize::MAX);
+    assert!(pos("<TypeDefinitions>") < pos("<ModelVariables>"));
+    assert_eq!(ModelDescription::from_xml(&xml).unwrap(), md);
+
+    let mut bad = with_enumeration();
+    if let VariableType::Enumeration { start, .. } = &mut bad.model_variables.last_mut().unwrap().variable_type {
+        *start = Some(5);
+    }
+    let problems = bad.validate();
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert_eq!(problems[0].rule, Rule::DeclaredType);
+    assert!(problems[0].to_string().contains("start=5"), "{}", problems[0]);
+    let mut bad = with_enumeration();
+    bad.type_definitions[0].items[2].value = 0;
+    assert!(bad.validate().iter().any(|p| p.rule == Rule::DeclaredType && p.to_string().contains("not unique")));
+    let mut bad = with_enumeration();
+    bad.type_definitions[0].name = "Other".into();
+    assert!(bad.validate().iter().any(|p| p.to_string().contains("declaredType \"Gear\"")));
+}
+
 #[test]
 fn minimal_description_round_trips() {
     let md = minimal();

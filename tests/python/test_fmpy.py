@@ -320,6 +320,8 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
         expected[f"mu_{w}"] = (28 + i, "Real", "input", None, 0.4)
     expected["wind_head"] = (32, "Real", "input", "N", 0.0)
     expected["wind_side"] = (33, "Real", "input", "N", 0.0)
+    expected["wind_x"] = (34, "Real", "input", "N", 0.0)
+    expected["wind_y"] = (35, "Real", "input", "N", 0.0)
     units = ["m", "m", "rad", "m/s", "m/s", "rad/s", "rad", "rad", "rad", "rad"]
     der_units = ["m/s", "m/s", "rad/s", "m/s2", "m/s2", "rad/s2", "rad/s", "rad/s", "rad/s", "rad/s"]
     for i, name in enumerate(BODY_STATES + SERVO_STATES):
@@ -359,6 +361,7 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
         if unit is not None:
             assert unit in declared_units, f"{name}: unit {unit} not in UnitDefinitions"
     assert got["mu_fl"].min is not None and float(got["mu_fl"].min) == 0.0
+    assert got["mu_fl"].max is not None and float(got["mu_fl"].max) == 3.0, "a physical maximum of friction"
     for i, name in enumerate(BODY_STATES + SERVO_STATES):
         assert got[f"der({name})"].derivative is got[name]
     assert [d.variable.name for d in md.derivatives] == [f"der({n})" for n in BODY_STATES + SERVO_STATES]
@@ -377,7 +380,7 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
     consts = dict((k, int(v)) for k, v in re.findall(r"pub const ([A-Z_]+): u32 = (\d+);", src))
     assert consts["STATE"] == 0 and consts["DERIVATIVE"] == 10 and consts["STEER"] == 20
     assert consts["TORQUE"] == 24 and consts["FRICTION"] == 28 and consts["WIND_HEAD"] == 32
-    assert consts["WIND_SIDE"] == 33 and consts["BETA"] == 40 and consts["SLIP_ANGLE"] == 43
+    assert consts["WIND_SIDE"] == 33 and consts["WIND_X"] == 34 and consts["WIND_Y"] == 35 and consts["BETA"] == 40 and consts["SLIP_ANGLE"] == 43
     assert consts["FORCE_LAT"] == 47 and consts["FORCE_DRIVE"] == 51 and consts["STEER_APPLIED"] == 55
     assert consts["PARAM"] == 100 and consts["MOTOR_SPEED_LIMIT"] == 2
 

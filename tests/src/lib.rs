@@ -12,6 +12,8 @@ pub use model_description::ModelDescription;
 pub type Component = *mut c_void;
 pub type Status = c_int;
 pub const OK: Status = 0;
+pub const WARNING: Status = 1;
+pub const DISCARD: Status = 2;
 pub const ERROR: Status = 3;
 
 #[repr(C)]
@@ -56,8 +58,9 @@ impl LogSink {
     pub fn take(&self) -> Vec<LogRecord> {
         std::mem::take(&mut *self.records.lock().unwrap_or_else(|e| e.into_inner()))
     }
+    /// The last message logged with status Discard or worse.
     pub fn last_error(&self) -> Option<String> {
-        self.records.lock().ok()?.iter().rev().find(|r| r.status >= ERROR).map(|r| r.message.clone())
+        self.records.lock().ok()?.iter().rev().find(|r| r.status >= DISCARD).map(|r| r.message.clone())
     }
 }
 

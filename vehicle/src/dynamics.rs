@@ -264,6 +264,51 @@ pub fn substeps(h: f64, max_step: f64) -> usize {
     (h / max_step - 1e-9).ceil().max(1.0) as usize
 }
 
+/// Real-axis stability limit of classical RK4: `|h lambda| <= 2.785` for a real negative
+/// eigenvalue `lambda`.
+pub const RK4_REAL_STABILITY_LIMIT: f64 = 2.785;
+
+/// An upper bound [1/s] of the fastest decay rate of the velocity dynamics at these
+/// parameters and inputs, from the tires' velocity stiffness.
+///
+/// A tire's lateral force changes with the contact-point velocity by at most
+/// `k_i = (pi/2) mu_i C_i / v_fade`: above `v_fade` the slip-angle slope is
+/// `mu C / |v| <= mu C / v_fade`, and inside the fade zone the force grows like
+/// `mu C |alpha| |v| / v_fade` with `|alpha| <= pi/2`, largest at standstill. A unit force
+/// at wheel `i` accelerates the body velocity `(v_x, v_y, r)` by at most
+/// `1/m + (x_i^2 + y_i^2)/I_z` in the mass metric, so the spectral radius of the velocity
+/// Jacobian is at most `sum_i k_i (1/m + (x_i^2 + y_i^2)/I_z)` (a sum of rank-one
+/// positive terms). The drive-motor taper adds `|tau_i| / (r_wheel motor_taper)` per
+/// wheel when the speed limit is on, and the steering servo its rate `1/servo_time_constant`.
+pub fn stiffness_rate_bound(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
+    let half_track = 0.5 * p.track;
+    let lever_sq = [p.l_f * p.l_f, p.l_f * p.l_f, p.l_r * p.l_r, p.l_r * p.l_r].map(|x2| x2 + half_track * half_track);
+    let mut rate = 0.0;
+    for i in 0..4 {
+        let mut stiffness = core::f64::consts::FRAC_PI_2 * u.mu[i].abs() * p.c[i] / p.v_fade;
+        if p.motor_speed_limit {
+            stiffness += u.tau[i].abs() / (p.r_wheel * p.motor_taper);
+        }
+        rate += stiffness * (1.0 / p.m + lever_sq[i] / p.i_z);
+    }
+    if p.steering_servo {
+        rate = rate.max(1.0 / p.servo_time_constant);
+    }
+    rate
+}
+
+/// The longest RK4 step that keeps the linearised tire dynamics stable at these
+/// parameters and inputs, with a 10 % margin on [`RK4_REAL_STABILITY_LIMIT`]
+/// (`f64::INFINITY` when nothing is stiff, e.g. zero friction).
+pub fn stable_rk4_step(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
+    let rate = stiffness_rate_bound(p, u);
+    if rate > 0.0 {
+        0.9 * RK4_REAL_STABILITY_LIMIT / rate
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`, inputs held.
 /// With the servo off the steering trigonometry is computed once for the whole interval.
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {

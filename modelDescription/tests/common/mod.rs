@@ -215,6 +215,7 @@ pub fn rich() -> ModelDescription {
             ..Default::default()
         }),
         unit_definitions: units,
+        type_definitions: vec![],
         log_categories: vec![
             LogCategory { name: "logEvents".into(), description: Some("Log events".into()) },
             LogCategory { name: "logStatusError".into(), description: None },
@@ -248,6 +249,7 @@ pub fn minimal() -> ModelDescription {
         model_exchange: None,
         co_simulation: Some(CoSimulation { model_identifier: "m".into(), ..Default::default() }),
         unit_definitions: vec![],
+        type_definitions: vec![],
         log_categories: vec![],
         default_experiment: None,
         model_variables: vec![real("p", 0, Causality::Parameter, Variability::Fixed, None, Some(1.0), None)],

@@ -1,0 +1,815 @@
+//! Every layer feature on a small sampled toy model, through the layer's C entry points
+//! (`fmi2_export::abi`, what `export_fmi2!` exports): Integer/Boolean/Enumeration,
+//! tunable and fixed parameters, time events in Model Exchange and inside `fmi2DoStep`,
+//! event iteration, the default FMU state from the declaration, opt-in capabilities,
+//! Warning/Discard, bad input, stopTime, and the FMU states an instance owns.
+//!
+//! The toy: a sampled integrator with feed-through, zero continuous states. At every
+//! sample t_k = k T (T = `sample_period`):
+//!   y_k = gain u(t_k) + acc_k + offset (when `enabled`),  acc_{k+1} = acc_k + T u(t_k),
+//! held between samples; `samples` counts the samples; mode `settle` asks for one extra
+//! event iteration per sample (counted in `iterations`).
+#![allow(clippy::missing_safety_doc)]
+
+use std::cell::RefCell;
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ptr::null_mut;
+use std::sync::OnceLock;
+
+use fmi2_export::abi::{self, Fmi2EventInfo};
+use fmi2_export::ffi::*;
+use fmi2_export::model_description::{Causality, Variability, VariableType};
+use fmi2_export::*;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum V {
+    U,
+    Gain,
+    Period,
+    Mode,
+    Offset,
+    Enabled,
+    Acc,
+    Y,
+    Samples,
+    Iterations,
+}
+
+const SUM: i32 = 1;
+const SETTLE: i32 = 2;
+
+thread_local! {
+    /// Live toy models of this thread (every test runs on its own thread).
+    static LIVE: RefCell<i64> = const { RefCell::new(0) };
+}
+
+fn live() -> i64 {
+    LIVE.with(|l| *l.borrow())
+}
+
+#[derive(Debug)]
+struct Toy {
+    logger: Logger,
+    u: f64,
+    gain: f64,
+    period: f64,
+    mode: i32,
+    offset: i32,
+    enabled: bool,
+    acc: f64,
+    y: f64,
+    samples: i32,
+    iterations: i32,
+    /// internal (not a declared variable): the index of the next sample
+    k: u64,
+    settling: bool,
+}
+
+impl Clone for Toy {
+    fn clone(&self) -> Self {
+        LIVE.with(|l| *l.borrow_mut() += 1);
+        Toy { logger: self.logger.clone(), ..*self }
+    }
+}
+
+impl Drop for Toy {
+    fn drop(&mut self) {
+        LIVE.with(|l| *l.borrow_mut() -= 1);
+    }
+}
+
+fn spec(capabilities: Capabilities, interfaces: Interfaces, identifier: &'static str) -> DeclarationSpec<V> {
+    DeclarationSpec {
+        model_name: "toy",
+        model_identifier: identifier,
+        description: "sampled toy",
+        version: "1",
+        interfaces,
+        capabilities,
+        enumerations: vec![enumeration_type(
+            "Mode",
+            "what a sample does",
+            &[("sum", SUM, "one iteration"), ("settle", SETTLE, "two iterations")],
+        )],
+        units: vec![si_unit("s", 0, 0, 1, 0)],
+        variables: vec![
+            VarDecl::real("u", 0, V::U).input(Start::Real(0.0)),
+            VarDecl::real("gain", 1, V::Gain).tunable_parameter(Start::Real(2.0)).min(0.0),
+            VarDecl::real("sample_period", 2, V::Period).parameter(Start::Real(0.1)).min(1e-6).unit("s"),
+            VarDecl::enumeration("mode", 0, "Mode", V::Mode).parameter(Start::Integer(SUM)),
+            VarDecl::integer("offset", 1, V::Offset).parameter(Start::Integer(0)).min(-100.0).max(100.0),
+            VarDecl::boolean("enabled", 0, V::Enabled).parameter(Start::Boolean(true)),
+            VarDecl::real("acc", 3, V::Acc).discrete_state(Start::Real(0.0)),
+            VarDecl::real("y", 4, V::Y).discrete_output(Dependencies::On(vec![0])),
+            VarDecl::integer("samples", 2, V::Samples).discrete_output(Dependencies::On(vec![])),
+            VarDecl::integer("iterations", 3, V::Iterations).discrete_output(Dependencies::On(vec![])),
+        ],
+        ..Default::default()
+    }
+}
+
+impl Model for Toy {
+    type Binding = V;
+
+    fn declaration() -> &'static Declaration<V> {
+        static D: OnceLock<Declaration<V>> = OnceLock::new();
+        D.get_or_init(|| {
+            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+            let both = Interfaces { model_exchange: true, co_simulation: true };
+            Declaration::new(spec(caps, both, "toy")).unwrap()
+        })
+    }
+
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
+        LIVE.with(|l| *l.borrow_mut() += 1);
+        Ok(Toy {
+            logger: context.logger.clone(),
+            u: 0.0,
+            gain: 0.0,
+            period: 0.0,
+            mode: 0,
+            offset: 0,
+            enabled: false,
+            acc: 0.0,
+            y: 0.0,
+            samples: 0,
+            iterations: 0,
+            k: 0,
+            settling: false,
+        })
+    }
+
+    fn get_real(&mut self, b: V) -> ModelResult<f64> {
+        Ok(match b {
+            V::U => self.u,
+            V::Gain => self.gain,
+            V::Period => self.period,
+            V::Acc => self.acc,
+            V::Y => self.y,
+            _ => return Err("not a Real".into()),
+        })
+    }
+
+    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
+        match b {
+            V::U => self.u = x,
+            V::Gain => self.gain = x,
+            V::Period => self.period = x,
+            V::Acc => self.acc = x,
+            V::Y => self.y = x,
+            _ => return Err("not a Real".into()),
+        }
+        Ok(())
+    }
+
+    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
+        Ok(match b {
+            V::Mode => self.mode,
+            V::Offset => self.offset,
+            V::Samples => self.samples,
+            V::Iterations => self.iterations,
+            _ => return Err("not an Integer".into()),
+        })
+    }
+
+    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
+        match b {
+            V::Mode => self.mode = x,
+            V::Offset => self.offset = x,
+            V::Samples => self.samples = x,
+            V::Iterations => self.iterations = x,
+            _ => return Err("not an Integer".into()),
+        }
+        Ok(())
+    }
+
+    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
+        match b {
+            V::Enabled => Ok(self.enabled),
+            _ => Err("not a Boolean".into()),
+        }
+    }
+
+    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
+        match b {
+            V::Enabled => self.enabled = x,
+            _ => return Err("not a Boolean".into()),
+        }
+        Ok(())
+    }
+
+    fn event_update(&mut self, _time: f64) -> ModelResult<EventUpdate> {
+        self.iterations += 1;
+        if self.settling {
+            self.settling = false;
+            return Ok(EventUpdate::next_at((self.k as f64) * self.period));
+        }
+        if self.u > 100.0 {
+            self.logger.warning(&format!("u = {} is beyond the toy's calibrated range", self.u));
+        }
+        let y = if self.enabled { self.gain * self.u + self.acc + self.offset as f64 } else { 0.0 };
+        if y.abs() > 1e6 {
+            return Err(ModelError::Discard(format!("y = {y} would saturate the toy")));
+        }
+        self.y = y;
+        self.acc += self.period * self.u;
+        self.samples += 1;
+        self.k += 1;
+        if self.mode == SETTLE {
+            self.settling = true;
+            return Ok(EventUpdate {
+                new_discrete_states_needed: true,
+                ..EventUpdate::next_at(self.k as f64 * self.period)
+            });
+        }
+        Ok(EventUpdate::next_at(self.k as f64 * self.period))
+    }
+
+    fn save_internal(&self, out: &mut Vec<f64>) {
+        out.push(self.k as f64);
+        out.push(self.settling as u8 as f64);
+    }
+
+    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+        let [k, settling] = data else { return Err("toy internal data: 2 numbers expected".into()) };
+        if !(*k >= 0.0 && k.fract() == 0.0 && *k < 1e15) || !(*settling == 0.0 || *settling == 1.0) {
+            return Err(format!("toy internal data {data:?} refused").into());
+        }
+        self.k = *k as u64;
+        self.settling = *settling == 1.0;
+        Ok(())
+    }
+}
+
+/// The same toy with no optional capability and Co-Simulation only.
+#[derive(Clone, Debug)]
+struct Bare(Toy);
+
+impl Model for Bare {
+    type Binding = V;
+    fn declaration() -> &'static Declaration<V> {
+        static D: OnceLock<Declaration<V>> = OnceLock::new();
+        D.get_or_init(|| {
+            let cs = Interfaces { model_exchange: false, co_simulation: true };
+            Declaration::new(spec(Capabilities::default(), cs, "bare")).unwrap()
+        })
+    }
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
+        Toy::instantiate(context).map(Bare)
+    }
+    fn get_real(&mut self, b: V) -> ModelResult<f64> {
+        self.0.get_real(b)
+    }
+    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
+        self.0.set_real(b, x)
+    }
+    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
+        self.0.get_integer(b)
+    }
+    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
+        self.0.set_integer(b, x)
+    }
+    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
+        self.0.get_boolean(b)
+    }
+    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
+        self.0.set_boolean(b, x)
+    }
+    fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
+        self.0.event_update(t)
+    }
+}
+
+// The macro must expand for a model with Integer/Boolean/Enumeration and defaults only.
+export_fmi2!(Toy);
+
+// ------------------------------------------------------------------ a tiny importer
+
+#[derive(Default)]
+struct Log(RefCell<Vec<(c_int, String, String)>>);
+
+/// The importer's logger. FMI's is C-variadic; the layer always passes ("%s", message),
+/// and on x86-64 System V a fixed-argument callee reads those from the same registers.
+unsafe extern "C" fn record(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    _format: *const c_char,
+    message: *const c_char,
+) {
+    let log = &*(env as *const Log);
+    let text = |p: *const c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
+    log.0.borrow_mut().push((status, text(category), text(message)));
+}
+
+struct Fmu<M: Model> {
+    c: fmi2Component,
+    log: Box<Log>,
+    _m: std::marker::PhantomData<M>,
+}
+
+const OK: Fmi2Status = Fmi2Status::Ok;
+const ERR: Fmi2Status = Fmi2Status::Error;
+
+impl<M: Model> Fmu<M> {
+    fn new(kind: c_int) -> Self {
+        let log = Box::<Log>::default();
+        let callbacks = Fmi2CallbackFunctions {
+            // SAFETY: see `record`.
+            logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
+            component_environment: &*log as *const Log as *mut c_void,
+        };
+        let name = CString::new("toy1").unwrap();
+        let guid = CString::new(M::declaration().guid()).unwrap();
+        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &callbacks, 0, 1) };
+        assert!(!c.is_null(), "{:?}", log.0.borrow());
+        Fmu { c, log, _m: std::marker::PhantomData }
+    }
+    fn cs() -> Self {
+        Self::new(1)
+    }
+    fn me() -> Self {
+        Self::new(0)
+    }
+    fn last_error(&self) -> String {
+        self.log.0.borrow().iter().rev().find(|r| r.0 >= 2).map(|r| r.2.clone()).unwrap_or_default()
+    }
+    fn init(&self, stop: Option<f64>) {
+        unsafe {
+            assert_eq!(
+                abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, stop.is_some() as c_int, stop.unwrap_or(0.0)),
+                OK
+            );
+            assert_eq!(abi::enter_initialization_mode::<M>(self.c), OK);
+            assert_eq!(abi::exit_initialization_mode::<M>(self.c), OK, "{}", self.last_error());
+        }
+    }
+    fn real(&self, vr: u32) -> f64 {
+        let mut x = f64::NAN;
+        let s = unsafe { abi::get_real::<M>(self.c, &vr, 1, &mut x) };
+        assert_eq!(s, OK, "{}", self.last_error());
+        x
+    }
+    fn int(&self, vr: u32) -> i32 {
+        let mut x = -7;
+        let s = unsafe { abi::get_integer::<M>(self.c, &vr, 1, &mut x) };
+        assert_eq!(s, OK, "{}", self.last_error());
+        x
+    }
+    fn set_real(&self, vr: u32, x: f64) -> Fmi2Status {
+        unsafe { abi::set_real::<M>(self.c, &vr, 1, &x) }
+    }
+    fn set_int(&self, vr: u32, x: i32) -> Fmi2Status {
+        unsafe { abi::set_integer::<M>(self.c, &vr, 1, &x) }
+    }
+    fn step(&self, t: f64, h: f64) -> Fmi2Status {
+        unsafe { abi::do_step::<M>(self.c, t, h, 1) }
+    }
+    fn reset(&self) -> Fmi2Status {
+        unsafe { abi::reset::<M>(self.c) }
+    }
+}
+
+impl<M: Model> Drop for Fmu<M> {
+    fn drop(&mut self) {
+        unsafe { abi::free_instance::<M>(self.c) }
+    }
+}
+
+mod vr {
+    pub const U: u32 = 0;
+    pub const GAIN: u32 = 1;
+    pub const PERIOD: u32 = 2;
+    pub const ACC: u32 = 3;
+    pub const Y: u32 = 4;
+    pub const MODE: u32 = 0;
+    pub const OFFSET: u32 = 1;
+    pub const SAMPLES: u32 = 2;
+    pub const ITERATIONS: u32 = 3;
+    pub const ENABLED: u32 = 0;
+}
+
+// ------------------------------------------------------------------ tests
+
+#[test]
+fn description_has_enumerations_tunables_discrete_outputs_and_the_declared_capabilities() {
+    let md = Toy::declaration().model_description();
+    let xml = Toy::declaration().xml();
+    assert_eq!(md.type_definitions[0].name, "Mode");
+    assert_eq!(md.type_definitions[0].items.len(), 2);
+    assert!(xml.contains(r#"<Item name="settle" value="2" description="two iterations"/>"#), "{xml}");
+    let var = |n: &str| md.model_variables.iter().find(|v| v.name == n).unwrap();
+    assert!(
+        matches!(&var("mode").variable_type, VariableType::Enumeration { declared_type, start: Some(1), .. } if declared_type == "Mode")
+    );
+    assert_eq!(var("gain").variability, Variability::Tunable);
+    assert_eq!(var("sample_period").variability, Variability::Fixed);
+    assert_eq!((var("y").causality, var("y").variability), (Causality::Output, Variability::Discrete));
+    // y depends on u directly (feed-through at a sample): index of u is 1
+    assert_eq!(md.model_structure.outputs[0].dependencies, Some(vec![1]));
+    let cs = md.co_simulation.as_ref().unwrap();
+    assert!(cs.can_get_and_set_fmu_state && cs.can_serialize_fmu_state && !cs.provides_directional_derivative);
+    assert!(!xml.contains("providesDirectionalDerivative"));
+    assert!(md.validate().is_empty());
+
+    let bare = Bare::declaration().model_description();
+    assert!(bare.model_exchange.is_none());
+    let xml = Bare::declaration().xml();
+    for flag in ["canGetAndSetFMUstate", "canSerializeFMUstate", "providesDirectionalDerivative"] {
+        assert!(!xml.contains(flag), "{flag} in {xml}");
+    }
+    // the saved rows are the parameters, the input and the discrete variables
+    let saved: Vec<&str> = Toy::declaration().saved_rows.iter().map(|&r| Toy::declaration().variable(r).name).collect();
+    assert_eq!(saved, ["u", "gain", "sample_period", "mode", "offset", "enabled", "acc", "y", "samples", "iterations"]);
+}
+
+/// y_k and acc after samples with inputs `u[k]` (independent of the layer).
+fn expected(gain: f64, period: f64, u: &[f64]) -> (f64, f64) {
+    let mut acc = 0.0;
+    let mut y = 0.0;
+    for &uk in u {
+        y = gain * uk + acc;
+        acc += period * uk;
+    }
+    (y, acc)
+}
+
+#[test]
+fn co_simulation_runs_the_samples_inside_do_step_with_the_inputs_of_their_instant() {
+    let f = Fmu::<Toy>::cs();
+    f.init(None);
+    assert_eq!(f.set_real(vr::U, 1.0), OK);
+    // one step over three samples: t = 0, 0.1, 0.2 run inside, 0.3 is later
+    assert_eq!(f.step(0.0, 0.25), OK);
+    assert_eq!(f.int(vr::SAMPLES), 3);
+    let (y, acc) = expected(2.0, 0.1, &[1.0, 1.0, 1.0]);
+    assert_eq!(f.real(vr::Y), y);
+    assert_eq!(f.real(vr::ACC), acc);
+    // a step ending on the sample at 0.3: that sample waits for the inputs of t = 0.3
+    assert_eq!(f.step(0.25, 0.05), OK);
+    assert_eq!(f.set_real(vr::U, 2.0), OK);
+    assert_eq!(f.real(vr::Y), expected(2.0, 0.1, &[1.0, 1.0, 1.0, 2.0]).0, "sample at 0.3 sees u(0.3) = 2");
+    assert_eq!(f.int(vr::SAMPLES), 4);
+    // the master corrects the input at the same instant (an algebraic-loop iteration):
+    // the sample is redone, not run twice
+    assert_eq!(f.set_real(vr::U, 3.0), OK);
+    assert_eq!(f.real(vr::Y), expected(2.0, 0.1, &[1.0, 1.0, 1.0, 3.0]).0);
+    assert_eq!(f.int(vr::SAMPLES), 4);
+    // a tunable gain set at the same instant counts for that instant's sample too
+    assert_eq!(f.set_real(vr::GAIN, 5.0), OK);
+    let acc3 = 0.1 * (1.0 + 1.0 + 1.0);
+    assert_eq!(f.step(0.3, 0.05), OK);
+    assert_eq!(f.real(vr::Y), 5.0 * 3.0 + acc3);
+    assert_eq!(f.int(vr::SAMPLES), 4);
+    // held until the next sample, whatever the input does meanwhile
+    assert_eq!(f.set_real(vr::U, -1.0), OK);
+    assert_eq!(f.real(vr::Y), 5.0 * 3.0 + acc3);
+    assert_eq!(f.step(0.35, 0.1), OK);
+    assert_eq!(f.int(vr::SAMPLES), 5);
+    let acc4 = acc3 + 0.1 * 3.0;
+    assert_eq!(f.real(vr::Y), -5.0 + acc4, "gain 5 times u(0.4) = -1");
+}
+
+#[test]
+fn model_exchange_reports_the_next_time_event_and_iterates() {
+    let f = Fmu::<Toy>::me();
+    unsafe {
+        assert_eq!(abi::setup_experiment::<Toy>(f.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(f.set_int(vr::MODE, SETTLE), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(f.set_real(vr::U, 1.0), OK);
+        let mut info = Fmi2EventInfo {
+            new_discrete_states_needed: 0,
+            terminate_simulation: 0,
+            nominals_of_continuous_states_changed: 0,
+            values_of_continuous_states_changed: 0,
+            next_event_time_defined: 0,
+            next_event_time: 0.0,
+        };
+        let mut t = 0.0;
+        for k in 1..=3 {
+            // the event iteration: settle asks once for another round
+            assert_eq!(abi::new_discrete_states::<Toy>(f.c, &mut info), OK);
+            assert_eq!(info.new_discrete_states_needed, FMI2_TRUE);
+            assert_eq!(abi::new_discrete_states::<Toy>(f.c, &mut info), OK);
+            assert_eq!(info.new_discrete_states_needed, FMI2_FALSE);
+            assert_eq!(info.next_event_time_defined, FMI2_TRUE);
+            assert_eq!(info.next_event_time, k as f64 * 0.1);
+            assert_eq!(f.int(vr::SAMPLES), k);
+            assert_eq!(f.int(vr::ITERATIONS), 2 * k);
+            // zero continuous states: nx = 0 everywhere
+            assert_eq!(abi::enter_continuous_time_mode::<Toy>(f.c), OK);
+            assert_eq!(abi::get_derivatives::<Toy>(f.c, null_mut(), 0), OK);
+            assert_eq!(abi::set_continuous_states::<Toy>(f.c, std::ptr::null(), 0), OK);
+            // integrating up to just before the event changes nothing
+            assert_eq!(abi::set_time::<Toy>(f.c, info.next_event_time - 1e-3), OK);
+            let (mut enter, mut term) = (7, 7);
+            assert_eq!(abi::completed_integrator_step::<Toy>(f.c, 1, &mut enter, &mut term), OK);
+            assert_eq!((enter, term), (FMI2_FALSE, FMI2_FALSE));
+            assert_eq!(f.int(vr::SAMPLES), k);
+            t = info.next_event_time;
+            assert_eq!(abi::set_time::<Toy>(f.c, t), OK);
+            assert_eq!(abi::enter_event_mode::<Toy>(f.c), OK);
+        }
+        assert_eq!(t, 0.30000000000000004);
+        // a Co-Simulation call on a Model Exchange instance
+        assert_eq!(f.step(t, 0.1), ERR);
+        assert!(
+            f.last_error().contains("fmi2DoStep") && f.last_error().contains("ModelExchange"),
+            "{}",
+            f.last_error()
+        );
+    }
+    // the same model in Co-Simulation runs both iterations per sample inside the step
+    let g = Fmu::<Toy>::cs();
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(g.set_int(vr::MODE, SETTLE), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(g.c), OK);
+    }
+    assert_eq!(g.set_real(vr::U, 1.0), OK);
+    assert_eq!(g.step(0.0, 0.25), OK);
+    assert_eq!((g.int(vr::SAMPLES), g.int(vr::ITERATIONS)), (3, 6));
+}
+
+#[test]
+fn tunable_parameters_change_between_steps_fixed_ones_are_refused_naming_the_variable() {
+    let f = Fmu::<Toy>::cs();
+    f.init(None);
+    assert_eq!(f.set_real(vr::GAIN, 3.0), OK);
+    assert_eq!(f.set_real(vr::PERIOD, 0.2), ERR);
+    let e = f.last_error();
+    assert!(e.contains("fmi2SetReal") && e.contains("sample_period") && e.contains("fixed"), "{e}");
+    assert_eq!(f.reset(), OK);
+    // after reset the start values are back and everything works again
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    assert_eq!(f.real(vr::GAIN), 2.0);
+    // values cannot be read before initialization (FMI 2.0 state table)
+    assert_eq!(f.reset(), OK);
+    let (g, mut x) = (vr::GAIN, 0.0);
+    assert_eq!(unsafe { abi::get_real::<Toy>(f.c, &g, 1, &mut x) }, ERR);
+}
+
+#[test]
+fn bad_values_are_refused_naming_the_variable_and_reset_recovers() {
+    let f = Fmu::<Toy>::cs();
+    type Setter = Box<dyn Fn(&Fmu<Toy>) -> Fmi2Status>;
+    let cases: [(&str, Setter); 5] = [
+        ("mode", Box::new(|f| f.set_int(vr::MODE, 7))),
+        ("gain", Box::new(|f| f.set_real(vr::GAIN, -1.0))),
+        ("u", Box::new(|f| f.set_real(vr::U, f64::NAN))),
+        ("offset", Box::new(|f| f.set_int(vr::OFFSET, 101))),
+        ("sample_period", Box::new(|f| f.set_real(vr::PERIOD, f64::INFINITY))),
+    ];
+    for (name, bad) in cases {
+        unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+        assert_eq!(bad(&f), ERR, "{name}");
+        let e = f.last_error();
+        assert!(e.contains(name) && e.contains("refused"), "{name}: {e}");
+        // the error state: the next step is refused, reset brings it back
+        assert_eq!(f.step(0.0, 0.1), ERR);
+        assert_eq!(f.reset(), OK);
+        f.init(None);
+        assert_eq!(f.set_real(vr::U, 1.0), OK);
+        assert_eq!(f.step(0.0, 0.05), OK);
+        assert_eq!(f.real(vr::Y), 2.0);
+        assert_eq!(f.reset(), OK);
+    }
+    // an enumeration out of range in a serialized state file is refused the same way
+}
+
+unsafe fn serialize<M: Model>(c: fmi2Component, s: fmi2FMUstate) -> Vec<u8> {
+    let mut size = 0;
+    assert_eq!(abi::serialized_fmu_state_size::<M>(c, s, &mut size), OK);
+    let mut bytes = vec![0u8; size];
+    assert_eq!(abi::serialize_fmu_state::<M>(c, s, bytes.as_mut_ptr() as *mut c_char, size), OK);
+    bytes
+}
+
+#[test]
+fn fmu_state_from_the_declaration_round_trips_bit_exactly_and_refuses_hostile_bytes() {
+    let f = Fmu::<Toy>::cs();
+    f.init(None);
+    assert_eq!(f.set_real(vr::U, 0.3), OK);
+    assert_eq!(f.set_real(vr::GAIN, 1.7), OK);
+    assert_eq!(f.step(0.0, 0.25), OK);
+    let mut state: fmi2FMUstate = null_mut();
+    let bytes = unsafe {
+        assert_eq!(abi::get_fmu_state::<Toy>(f.c, &mut state), OK);
+        serialize::<Toy>(f.c, state)
+    };
+    let run = |f: &Fmu<Toy>| -> Vec<u64> {
+        let mut out = Vec::new();
+        let mut t = 0.25;
+        for k in 0..7 {
+            assert_eq!(f.set_real(vr::U, 0.1 * k as f64 - 0.2), OK);
+            assert_eq!(f.step(t, 0.07), OK);
+            t += 0.07;
+            out.extend([f.real(vr::Y), f.real(vr::ACC)].map(f64::to_bits));
+            out.push(f.int(vr::SAMPLES) as u64);
+        }
+        out
+    };
+    let first = run(&f);
+    // restore the in-memory state, and a deserialized copy in a second instance
+    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(f.c, state), OK) };
+    assert_eq!(run(&f), first);
+    let g = Fmu::<Toy>::cs();
+    let mut copy: fmi2FMUstate = null_mut();
+    unsafe {
+        assert_eq!(de_serialize(&g, &bytes, &mut copy), OK, "{}", g.last_error());
+        assert_eq!(abi::set_fmu_state::<Toy>(g.c, copy), OK);
+    }
+    assert_eq!(run(&g), first, "the sample counter (internal data) travels too");
+
+    // hostile bytes: each one a single number changed, each refused with the reason
+    let numbers_at = bytes.len() - 8 * (7 + 10 + 2);
+    let patch = |index: usize, x: f64| {
+        let mut b = bytes.clone();
+        b[numbers_at + 8 * index..numbers_at + 8 * index + 8].copy_from_slice(&x.to_le_bytes());
+        b
+    };
+    let cases = [
+        (patch(7 + 1, -1.0), "gain"),
+        (patch(7 + 3, 9.0), "mode"),
+        (patch(7 + 5, 2.0), "enabled"),
+        (patch(7 + 4, 0.5), "offset"),
+        (patch(7 + 6, f64::NAN), "acc"),
+        (patch(7 + 10, -3.0), "internal"),
+        (patch(1, f64::INFINITY), "time"),
+        (bytes[..bytes.len() - 1].to_vec(), "length"),
+    ];
+    for (bad, what) in cases {
+        let mut s: fmi2FMUstate = null_mut();
+        assert_eq!(unsafe { de_serialize(&g, &bad, &mut s) }, ERR, "{what}");
+        assert!(s.is_null());
+        assert!(g.last_error().contains("fmi2DeSerializeFMUstate"), "{}", g.last_error());
+        assert_eq!(g.reset(), OK);
+    }
+    unsafe {
+        assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut state), OK);
+        assert!(state.is_null());
+    }
+}
+
+unsafe fn de_serialize(f: &Fmu<Toy>, bytes: &[u8], s: &mut fmi2FMUstate) -> Fmi2Status {
+    abi::deserialize_fmu_state::<Toy>(f.c, bytes.as_ptr() as *const c_char, bytes.len(), s)
+}
+
+#[test]
+fn fmu_states_belong_to_their_instance_and_are_freed_with_it() {
+    let before = live();
+    {
+        let f = Fmu::<Toy>::cs();
+        let g = Fmu::<Toy>::cs();
+        f.init(None);
+        let mut states = [null_mut(); 3];
+        for s in &mut states {
+            unsafe { assert_eq!(abi::get_fmu_state::<Toy>(f.c, s), OK) };
+        }
+        // a state of another instance, a freed one, a made-up pointer: refused, not used
+        let mut foreign: fmi2FMUstate = null_mut();
+        unsafe {
+            assert_eq!(abi::set_fmu_state::<Toy>(g.c, states[0]), ERR);
+            assert!(g.last_error().contains("not made by this instance"), "{}", g.last_error());
+            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut states[2]), OK);
+            let freed = states[1];
+            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut states[1]), OK);
+            assert_eq!(f.reset(), OK);
+            assert_eq!(abi::set_fmu_state::<Toy>(f.c, freed), ERR);
+            let mut made_up = 0x1234usize as fmi2FMUstate;
+            assert_eq!(f.reset(), OK);
+            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut made_up), ERR);
+            assert_eq!(abi::get_fmu_state::<Toy>(g.c, &mut foreign), OK);
+        }
+        // f still owns states[0], g owns `foreign`: freeing the instances frees them
+        assert!(live() > before + 2);
+    }
+    assert_eq!(live(), before, "every model clone (instances and FMU states) was dropped");
+}
+
+#[test]
+fn capabilities_not_declared_are_refused_as_not_supported() {
+    let f = Fmu::<Bare>::cs();
+    f.init(None);
+    let mut s: fmi2FMUstate = null_mut();
+    unsafe {
+        assert_eq!(abi::get_fmu_state::<Bare>(f.c, &mut s), ERR);
+        assert!(f.last_error().contains("fmi2GetFMUstate: not supported"), "{}", f.last_error());
+        assert_eq!(f.reset(), OK);
+    }
+    // Model Exchange is not offered: instantiation fails with the reason
+    let log = Box::<Log>::default();
+    let callbacks = Fmi2CallbackFunctions {
+        logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
+        allocate_memory: None,
+        free_memory: None,
+        step_finished: None,
+        component_environment: &*log as *const Log as *mut c_void,
+    };
+    let guid = CString::new(Bare::declaration().guid()).unwrap();
+    let c = unsafe { abi::instantiate::<Bare>(c"x".as_ptr(), 0, guid.as_ptr(), null_mut(), &callbacks, 0, 0) };
+    assert!(c.is_null());
+    assert!(log.0.borrow()[0].2.contains("does not offer ModelExchange"));
+    // the toy has FMU state but not directional derivatives
+    let t = Fmu::<Toy>::cs();
+    t.init(None);
+    let (vy, vu, dv) = (vr::Y, vr::U, 1.0);
+    let mut out = 0.0;
+    unsafe {
+        assert_eq!(abi::get_directional_derivative::<Toy>(t.c, &vy, 1, &vu, 1, &dv, &mut out), ERR);
+    }
+    assert!(t.last_error().contains("fmi2GetDirectionalDerivative: not supported"), "{}", t.last_error());
+}
+
+#[test]
+fn warning_and_discard_and_step_failed() {
+    let f = Fmu::<Toy>::cs();
+    f.init(None);
+    let mut saved: fmi2FMUstate = null_mut();
+    unsafe { assert_eq!(abi::get_fmu_state::<Toy>(f.c, &mut saved), OK) };
+    assert_eq!(f.set_real(vr::U, 200.0), OK);
+    assert_eq!(f.step(0.0, 0.05), Fmi2Status::Warning);
+    assert!(f.log.0.borrow().iter().any(|r| r.0 == 1 && r.1 == "logStatusWarning" && r.2.contains("u = 200")));
+    assert_eq!(f.step(0.05, 0.1), Fmi2Status::Warning);
+    // a sample that cannot be computed: Discard, stepFailed, the last good time
+    assert_eq!(f.set_real(vr::U, 1e7), OK);
+    assert_eq!(f.step(0.15, 0.1), Fmi2Status::Discard);
+    assert!(f.last_error().contains("fmi2DoStep: y = "), "{}", f.last_error());
+    let (mut t, mut status) = (f64::NAN, -1);
+    unsafe {
+        assert_eq!(abi::get_real_status::<Toy>(f.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t), OK);
+        assert_eq!(abi::get_status::<Toy>(f.c, FMI2_DO_STEP_STATUS, &mut status), OK);
+    }
+    assert_eq!(t, 0.15 + 0.05, "the sample at 0.2 failed");
+    assert_eq!(status, Fmi2Status::Discard as c_int);
+    assert_eq!(f.real(vr::Y), 2.0 * 200.0 + 0.1 * 200.0, "outputs of the last good sample (0.1)");
+    // stepFailed: the saved state continues (as the standard says)
+    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(f.c, saved), OK) };
+    assert_eq!(f.set_real(vr::U, 1.0), OK);
+    assert_eq!(f.step(0.0, 0.1), OK);
+    assert_eq!(f.real(vr::Y), 2.0 + 0.1, "the sample at the step's end, t = 0.1, with u(0.1)");
+    // and stepFailed refuses steps and sets
+    assert_eq!(f.set_real(vr::U, 1e7), OK);
+    assert_eq!(f.step(0.1, 0.1), Fmi2Status::Discard);
+    assert_eq!(f.set_real(vr::U, 1.0), ERR, "no set in stepFailed");
+    assert!(f.last_error().contains("not allowed in state StepFailed"), "{}", f.last_error());
+    assert_eq!(f.reset(), OK);
+    f.init(None);
+    assert_eq!(f.step(0.0, 0.1), OK);
+}
+
+#[test]
+fn stop_time_is_enforced_and_setup_refuses_non_finite_numbers() {
+    let f = Fmu::<Toy>::cs();
+    f.init(Some(0.3));
+    assert_eq!(f.step(0.0, 0.2), OK);
+    assert_eq!(f.step(0.2, 0.1), OK);
+    assert_eq!(f.step(0.3, 0.1), ERR);
+    assert!(f.last_error().contains("stopTime 0.3"), "{}", f.last_error());
+    for (tol, start, stop) in
+        [(f64::NAN, 0.0, 1.0), (1e-6, f64::INFINITY, 1.0), (1e-6, 0.0, f64::NAN), (1e-6, 1.0, 0.5)]
+    {
+        assert_eq!(f.reset(), OK);
+        assert_eq!(unsafe { abi::setup_experiment::<Toy>(f.c, 1, tol, start, 1, stop) }, ERR, "{tol} {start} {stop}");
+    }
+    let g = Fmu::<Toy>::me();
+    unsafe {
+        assert_eq!(abi::setup_experiment::<Toy>(g.c, 0, 0.0, 0.0, 1, 1.0), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(abi::set_time::<Toy>(g.c, 0.5), ERR, "SetTime is not allowed in Initialization Mode");
+        assert_eq!(g.reset(), OK);
+        g.init(Some(1.0));
+        // Model Exchange: integrators evaluate past the output time; a warning, not an error
+        assert_eq!(abi::set_time::<Toy>(g.c, 1.5), Fmi2Status::Warning);
+        assert!(g.log.0.borrow().iter().any(|r| r.0 == 1 && r.2.contains("after the stopTime 1")));
+    }
+}
+
+#[test]
+fn booleans_and_integers_read_back_and_enabled_switch_acts() {
+    let f = Fmu::<Toy>::cs();
+    unsafe {
+        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        let (b, off) = (FMI2_FALSE, 5);
+        assert_eq!(abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &b), OK);
+        assert_eq!(f.set_int(vr::OFFSET, off), OK);
+        let mut back = 9;
+        assert_eq!(abi::get_boolean::<Toy>(f.c, &vr::ENABLED, 1, &mut back), OK);
+        assert_eq!(back, FMI2_FALSE);
+        assert_eq!(f.int(vr::OFFSET), 5);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+    }
+    assert_eq!(f.set_real(vr::U, 1.0), OK);
+    assert_eq!(f.step(0.0, 0.1), OK);
+    assert_eq!(f.real(vr::Y), 0.0, "disabled");
+    // a fixed Boolean after initialization: refused
+    let t = FMI2_TRUE;
+    assert_eq!(unsafe { abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &t) }, ERR);
+    assert!(f.last_error().contains("enabled"), "{}", f.last_error());
+}

@@ -1,0 +1,501 @@
+//! The controller FMU (`nigel_controller`): the sampled law of maneuvers.md,
+//! [`nigel_benchmark::SampledController`], behind the shared FMI 2.0 layer. This file is
+//! only the binding: the declaration of the variables and a small [`Model`] impl.
+//!
+//! Sampled data: at every sample instant `t_k = t_start + k sample_period` the layer calls
+//! [`Model::event_update`] (a time event in Model Exchange; inside `fmi2DoStep`, or lazily at
+//! the first read or step after the importer set the inputs of that instant, in
+//! Co-Simulation). There the speed integrator first takes the step of the previous sample
+//! (`I_k = I_(k-1) + e_(k-1) T` unless that sample saturated: it advances when time moves
+//! past `t_(k-1)`), then the law runs on the inputs of `t_k` with `I_k`, and its outputs
+//! are latched and held until `t_(k+1)`. So `speed_integral` read at `t_k` is the `I_k`
+//! of the outputs read there. The outputs depend
+//! directly on the inputs (declared in the ModelStructure), so a master that sets the
+//! inputs at `t_k` and reads the outputs before `fmi2DoStep` sees the law applied to them.
+
+// `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use std::sync::OnceLock;
+
+use fmi2_export::model_description::DefaultExperiment;
+use fmi2_export::{
+    enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate,
+    Initial, InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+};
+use nigel_benchmark::control::{FORCE_MAX, KI_SPEED, KP_SPEED};
+use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
+use nigel_benchmark::{ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
+
+/// The model identifier (file name of the shared library and of the `.fmu`).
+pub const MODEL_IDENTIFIER: &str = "nigel_controller";
+
+/// The items of the `controller` enumeration.
+pub mod mode {
+    /// `K = 0`: the steering is the feed-forward alone.
+    pub const OPEN_LOOP: i32 = 1;
+    /// The non-robust pole-placement baseline.
+    pub const POLE_PLACEMENT: i32 = 2;
+    /// The robust mixed H2/H-inf gain (default).
+    pub const ROBUST: i32 = 3;
+    /// The tunable gains `k_beta_* / k_yaw_rate_*`.
+    pub const CUSTOM: i32 = 4;
+}
+
+/// What a value reference stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Var {
+    Beta,
+    YawRate,
+    Speed,
+    BetaRef,
+    YawRateRef,
+    SpeedRef,
+    SteerFeedForward(usize),
+    Steer(usize),
+    Torque(usize),
+    DriveForce,
+    SpeedIntegral,
+    SamplePeriod,
+    KpSpeed,
+    KiSpeed,
+    ForceMax,
+    WheelRadius,
+    SteerLimit,
+    /// Tunable custom gain, wheel `i`, column `j` (0 = beta, 1 = yaw rate).
+    CustomGain(usize, usize),
+    /// The gain in use (calculated parameter), wheel `i`, column `j`.
+    GainInUse(usize, usize),
+    Controller,
+}
+
+/// Value references (Reals unless stated).
+pub mod vr {
+    pub const BETA: u32 = 0;
+    pub const YAW_RATE: u32 = 1;
+    pub const SPEED: u32 = 2;
+    pub const BETA_REF: u32 = 3;
+    pub const YAW_RATE_REF: u32 = 4;
+    pub const SPEED_REF: u32 = 5;
+    /// `delta_ff_fl .. delta_ff_rr`: 6..10.
+    pub const DELTA_FF: u32 = 6;
+    /// `delta_fl .. delta_rr`: 10..14.
+    pub const DELTA: u32 = 10;
+    /// `tau_fl .. tau_rr`: 14..18.
+    pub const TAU: u32 = 14;
+    pub const DRIVE_FORCE: u32 = 18;
+    pub const SPEED_INTEGRAL: u32 = 20;
+    pub const SAMPLE_PERIOD: u32 = 30;
+    pub const KP_SPEED: u32 = 31;
+    pub const KI_SPEED: u32 = 32;
+    pub const FORCE_MAX: u32 = 33;
+    pub const R_WHEEL: u32 = 34;
+    pub const DELTA_MAX: u32 = 35;
+    /// `k_beta_fl, k_yaw_rate_fl, k_beta_fr, ...`: 40..48 (row-major, wheel then column).
+    pub const K_CUSTOM: u32 = 40;
+    /// `gain_beta_fl, gain_yaw_rate_fl, ...`: 50..58, the gain in use.
+    pub const GAIN_IN_USE: u32 = 50;
+    /// Integer (Enumeration) value reference of `controller`.
+    pub const CONTROLLER: u32 = 0;
+}
+
+const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
+const COLUMN: [&str; 2] = ["beta", "yaw_rate"];
+
+fn leak(s: String) -> &'static str {
+    // Names built once for the process-wide declaration (a few hundred bytes in all).
+    Box::leak(s.into_boxed_str())
+}
+
+fn build_declaration() -> DeclarationSpec<Var> {
+    let mut v: Vec<VarDecl<Var>> = vec![
+        VarDecl::real("beta", vr::BETA, Var::Beta)
+            .input(Start::Real(0.0))
+            .unit("rad")
+            .describe("measured body slip angle atan2(v_y, v_x)"),
+        VarDecl::real("yaw_rate", vr::YAW_RATE, Var::YawRate)
+            .input(Start::Real(0.0))
+            .unit("rad/s")
+            .describe("measured yaw rate"),
+        VarDecl::real("speed", vr::SPEED, Var::Speed)
+            .input(Start::Real(0.35))
+            .unit("m/s")
+            .describe("measured speed hypot(v_x, v_y)"),
+        VarDecl::real("beta_ref", vr::BETA_REF, Var::BetaRef)
+            .input(Start::Real(0.0))
+            .unit("rad")
+            .describe("reference body slip angle"),
+        VarDecl::real("yaw_rate_ref", vr::YAW_RATE_REF, Var::YawRateRef)
+            .input(Start::Real(0.0))
+            .unit("rad/s")
+            .describe("reference yaw rate"),
+        VarDecl::real("speed_ref", vr::SPEED_REF, Var::SpeedRef)
+            .input(Start::Real(0.35))
+            .unit("m/s")
+            .describe("speed the PI holds"),
+    ];
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            VarDecl::real(leak(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
+                .input(Start::Real(0.0))
+                .unit("rad")
+                .describe("feed-forward steering (the maneuver's program)"),
+        );
+    }
+    let steer_deps = |i: u32| vec![vr::BETA, vr::YAW_RATE, vr::BETA_REF, vr::YAW_RATE_REF, vr::DELTA_FF + i];
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            VarDecl::real(leak(format!("delta_{w}")), vr::DELTA + i as u32, Var::Steer(i))
+                .discrete_output(Dependencies::On(steer_deps(i as u32)))
+                .unit("rad")
+                .describe("steering command delta_ff + K (x - x_ref), clamped to +-delta_max; held over a sample"),
+        );
+    }
+    for (i, w) in WHEEL.iter().enumerate() {
+        v.push(
+            VarDecl::real(leak(format!("tau_{w}")), vr::TAU + i as u32, Var::Torque(i))
+                .discrete_output(Dependencies::On(vec![vr::SPEED, vr::SPEED_REF]))
+                .unit("N.m")
+                .describe("drive torque F r_wheel / 4; held over a sample"),
+        );
+    }
+    v.push(
+        VarDecl::real("drive_force", vr::DRIVE_FORCE, Var::DriveForce)
+            .discrete_output(Dependencies::On(vec![vr::SPEED, vr::SPEED_REF]))
+            .unit("N")
+            .describe("total drive force F = kp e + ki I, |F| <= force_max"),
+    );
+    v.push(
+        VarDecl::real("speed_integral", vr::SPEED_INTEGRAL, Var::SpeedIntegral)
+            .discrete_state(Start::Real(0.0))
+            .unit("m")
+            .describe("speed-error integrator I (frozen while F saturates)"),
+    );
+    let params: [(&'static str, u32, Var, f64, &'static str, &'static str); 6] = [
+        ("sample_period", vr::SAMPLE_PERIOD, Var::SamplePeriod, 1e-3, "s", "sample period of the law"),
+        ("kp_speed", vr::KP_SPEED, Var::KpSpeed, KP_SPEED, "N.s/m", "speed PI proportional gain"),
+        ("ki_speed", vr::KI_SPEED, Var::KiSpeed, KI_SPEED, "N/m", "speed PI integral gain"),
+        ("force_max", vr::FORCE_MAX, Var::ForceMax, FORCE_MAX, "N", "largest total drive force"),
+        ("r_wheel", vr::R_WHEEL, Var::WheelRadius, 0.0325, "m", "wheel radius (force to torque)"),
+        (
+            "delta_max",
+            vr::DELTA_MAX,
+            Var::SteerLimit,
+            core::f64::consts::FRAC_PI_2,
+            "rad",
+            "steering clamp (the plant's limit)",
+        ),
+    ];
+    for (name, r, b, start, unit, text) in params {
+        let mut p = VarDecl::real(name, r, b).parameter(Start::Real(start)).unit(unit).describe(text).min(0.0);
+        if b == Var::SteerLimit {
+            p = p.max(core::f64::consts::FRAC_PI_2);
+        }
+        v.push(p);
+    }
+    for (i, w) in WHEEL.iter().enumerate() {
+        for (j, c) in COLUMN.iter().enumerate() {
+            let r = vr::K_CUSTOM + (2 * i + j) as u32;
+            v.push(
+                VarDecl::real(leak(format!("k_{c}_{w}")), r, Var::CustomGain(i, j))
+                    .tunable_parameter(Start::Real(ROBUST[i][j]))
+                    .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
+                    .describe("custom gain (used when controller = custom; tunable between steps)"),
+            );
+        }
+    }
+    for (i, w) in WHEEL.iter().enumerate() {
+        for (j, c) in COLUMN.iter().enumerate() {
+            let r = vr::GAIN_IN_USE + (2 * i + j) as u32;
+            let mut g = VarDecl::real(leak(format!("gain_{c}_{w}")), r, Var::GainInUse(i, j))
+                .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
+                .describe("the gain in use (from controller and the custom gains)");
+            g.causality = Causality::CalculatedParameter;
+            g.variability = Variability::Tunable;
+            g.initial = Some(Initial::Calculated);
+            v.push(g);
+        }
+    }
+    v.push(
+        VarDecl::enumeration("controller", vr::CONTROLLER, "Controller", Var::Controller)
+            .parameter(Start::Integer(mode::ROBUST))
+            .describe("which steering feedback"),
+    );
+    DeclarationSpec {
+        model_name: "nigel_controller",
+        model_identifier: MODEL_IDENTIFIER,
+        description: "Nigel's sampled controller: delta = delta_ff + K ([beta, yaw_rate] - ref) clamped to \
+                      +-delta_max, and the speed-hold PI with anti-windup (maneuvers.md); robust gain baked \
+                      from the synthesis",
+        version: env!("CARGO_PKG_VERSION"),
+        interfaces: Interfaces { model_exchange: true, co_simulation: true },
+        capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
+        enumerations: vec![enumeration_type(
+            "Controller",
+            "steering feedback",
+            &[
+                ("open_loop", mode::OPEN_LOOP, "K = 0: the feed-forward alone"),
+                ("pole_placement", mode::POLE_PLACEMENT, "non-robust baseline, Re(s) < -2 at mu = 0.4"),
+                ("robust", mode::ROBUST, "robust mixed H2/H-inf gain (paper variant, 4WD4WS, Pareto point)"),
+                ("custom", mode::CUSTOM, "the tunable gains k_beta_* / k_yaw_rate_*"),
+            ],
+        )],
+        units: vec![
+            si_unit("rad", 0, 0, 0, 0),
+            si_unit("rad/s", 0, 0, -1, 0),
+            si_unit("m/s", 0, 1, -1, 0),
+            si_unit("m", 0, 1, 0, 0),
+            si_unit("s", 0, 0, 1, 0),
+            si_unit("N", 1, 1, -2, 0),
+            si_unit("N.m", 1, 2, -2, 0),
+            si_unit("N.s/m", 1, 0, -1, 0),
+            si_unit("N/m", 1, 0, -2, 0),
+            si_unit("rad/rad", 0, 0, 0, 0),
+            si_unit("rad.s/rad", 0, 0, 1, 0),
+        ],
+        default_experiment: Some(DefaultExperiment {
+            start_time: Some(0.0),
+            stop_time: Some(30.0),
+            tolerance: None,
+            step_size: Some(1e-3),
+        }),
+        variables: v,
+    }
+}
+
+/// The controller instance.
+#[derive(Clone, Debug)]
+pub struct Controller {
+    inputs: ControllerInputs,
+    settings: ControllerSettings,
+    custom: [[f64; 2]; 4],
+    mode: i32,
+    integral: f64,
+    /// The outputs of the last sample, held until the next one.
+    held: ControllerOutputs,
+    /// `e T` of the last sample (0 if it saturated): what the integrator adds when the
+    /// next sample comes.
+    pending_increment: f64,
+    /// Samples run so far (the next sample is `k`).
+    k: u64,
+    /// Time of sample 0.
+    start_time: f64,
+}
+
+impl Controller {
+    /// The gain the `controller` parameter selects.
+    pub fn gain_in_use(&self) -> [[f64; 2]; 4] {
+        match self.mode {
+            mode::OPEN_LOOP => [[0.0; 2]; 4],
+            mode::POLE_PLACEMENT => POLE_PLACEMENT,
+            mode::CUSTOM => self.custom,
+            _ => ROBUST,
+        }
+    }
+
+    fn law(&self) -> Result<SampledController, String> {
+        let settings = ControllerSettings { gain: self.gain_in_use(), ..self.settings };
+        let mut c = SampledController::new(settings).map_err(|e| e.to_string())?;
+        c.set_integral(self.integral);
+        Ok(c)
+    }
+
+    /// The outputs an importer reads: the held sample, or before the first sample the law
+    /// on the current inputs (what the initial event will latch).
+    fn outputs(&self) -> ModelResult<ControllerOutputs> {
+        if self.k > 0 {
+            return Ok(self.held);
+        }
+        Ok(self.law()?.outputs(&self.inputs))
+    }
+
+    fn set_parameter(slot: &mut f64, name: &str, value: f64, positive: bool) -> ModelResult {
+        if positive && !(value > 0.0) {
+            return Err(format!("{name} = {value} refused: must be > 0").into());
+        }
+        *slot = value;
+        Ok(())
+    }
+}
+
+impl Model for Controller {
+    type Binding = Var;
+
+    fn declaration() -> &'static Declaration<Var> {
+        static DECLARATION: OnceLock<Declaration<Var>> = OnceLock::new();
+        DECLARATION.get_or_init(|| {
+            Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("controller declaration is invalid: {e}"))
+        })
+    }
+
+    fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
+        let settings = ControllerSettings::default();
+        Ok(Controller {
+            inputs: ControllerInputs {
+                beta: 0.0,
+                yaw_rate: 0.0,
+                speed: 0.0,
+                beta_ref: 0.0,
+                yaw_rate_ref: 0.0,
+                speed_ref: 0.0,
+                delta_ff: [0.0; 4],
+            },
+            settings,
+            custom: ROBUST,
+            mode: mode::ROBUST,
+            integral: 0.0,
+            held: ControllerOutputs { delta: [0.0; 4], tau: [0.0; 4], force: 0.0, saturated: false },
+            pending_increment: 0.0,
+            k: 0,
+            start_time: 0.0,
+        })
+    }
+
+    fn get_real(&mut self, b: Var) -> ModelResult<f64> {
+        let x = &self.inputs;
+        let s = &self.settings;
+        Ok(match b {
+            Var::Beta => x.beta,
+            Var::YawRate => x.yaw_rate,
+            Var::Speed => x.speed,
+            Var::BetaRef => x.beta_ref,
+            Var::YawRateRef => x.yaw_rate_ref,
+            Var::SpeedRef => x.speed_ref,
+            Var::SteerFeedForward(i) => x.delta_ff[i],
+            Var::Steer(i) => self.outputs()?.delta[i],
+            Var::Torque(i) => self.outputs()?.tau[i],
+            Var::DriveForce => self.outputs()?.force,
+            Var::SpeedIntegral => self.integral,
+            Var::SamplePeriod => s.sample_period,
+            Var::KpSpeed => s.kp_speed,
+            Var::KiSpeed => s.ki_speed,
+            Var::ForceMax => s.force_max,
+            Var::WheelRadius => s.r_wheel,
+            Var::SteerLimit => s.delta_max,
+            Var::CustomGain(i, j) => self.custom[i][j],
+            Var::GainInUse(i, j) => self.gain_in_use()[i][j],
+            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+        })
+    }
+
+    fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
+        let x = &mut self.inputs;
+        let s = &mut self.settings;
+        match b {
+            Var::Beta => x.beta = value,
+            Var::YawRate => x.yaw_rate = value,
+            Var::Speed => x.speed = value,
+            Var::BetaRef => x.beta_ref = value,
+            Var::YawRateRef => x.yaw_rate_ref = value,
+            Var::SpeedRef => x.speed_ref = value,
+            Var::SteerFeedForward(i) => x.delta_ff[i] = value,
+            // held outputs come back through here when an FMU state is restored
+            Var::Steer(i) => self.held.delta[i] = value,
+            Var::Torque(i) => self.held.tau[i] = value,
+            Var::DriveForce => self.held.force = value,
+            Var::SpeedIntegral => self.integral = value,
+            Var::SamplePeriod => Self::set_parameter(&mut s.sample_period, "sample_period", value, true)?,
+            Var::KpSpeed => Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?,
+            Var::KiSpeed => Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?,
+            Var::ForceMax => Self::set_parameter(&mut s.force_max, "force_max", value, true)?,
+            Var::WheelRadius => Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?,
+            Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
+            Var::CustomGain(i, j) => self.custom[i][j] = value,
+            Var::GainInUse(..) => return Err("the gains in use are calculated".into()),
+            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+        }
+        Ok(())
+    }
+
+    fn get_integer(&mut self, b: Var) -> ModelResult<i32> {
+        match b {
+            Var::Controller => Ok(self.mode),
+            _ => Err(format!("{b:?} is not an Integer").into()),
+        }
+    }
+
+    fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
+        match b {
+            Var::Controller if (mode::OPEN_LOOP..=mode::CUSTOM).contains(&value) => {
+                self.mode = value;
+                Ok(())
+            }
+            Var::Controller => Err(format!("controller = {value} refused: not one of 1..4").into()),
+            _ => Err(format!("{b:?} is not an Integer").into()),
+        }
+    }
+
+    fn exit_initialization(&mut self) -> ModelResult {
+        self.law()?;
+        if !self.integral.is_finite() {
+            return Err(format!("speed_integral = {} refused: must be finite", self.integral).into());
+        }
+        Ok(())
+    }
+
+    fn event_update(&mut self, time: f64) -> ModelResult<EventUpdate> {
+        if self.k == 0 {
+            self.start_time = time;
+        } else {
+            // time has moved past the previous sample: its integrator step
+            self.integral += self.pending_increment;
+        }
+        let law = self.law()?;
+        self.held = law.outputs(&self.inputs);
+        self.pending_increment = law.increment(&self.inputs);
+        self.k += 1;
+        // sample instants from the start time and an integer count: no drift
+        let next = self.start_time + self.k as f64 * self.settings.sample_period;
+        Ok(EventUpdate::next_at(next))
+    }
+
+    fn save_internal(&self, out: &mut Vec<f64>) {
+        out.push(self.k as f64);
+        out.push(self.start_time);
+        out.push(self.held.saturated as u8 as f64);
+        out.push(self.pending_increment);
+    }
+
+    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
+        let [k, start_time, saturated, pending] = data else {
+            return Err(format!("controller internal data: 4 numbers expected, got {}", data.len()).into());
+        };
+        if !(*k >= 0.0 && k.fract() == 0.0 && *k < 9e15 && start_time.is_finite() && pending.is_finite()) {
+            return Err(format!("controller internal data {data:?} refused").into());
+        }
+        if !(*saturated == 0.0 || *saturated == 1.0) {
+            return Err(format!("controller internal data {data:?} refused").into());
+        }
+        self.k = *k as u64;
+        self.start_time = *start_time;
+        self.held.saturated = *saturated == 1.0;
+        self.pending_increment = *pending;
+        Ok(())
+    }
+}
+
+#[cfg(feature = "fmi-export")]
+fmi2_export::export_fmi2!(Controller);
+
+/// The law and its timing, for `documentation/index.html`.
+pub const DOCUMENTATION: &str = r#"<h2>Law (shared/spec/maneuvers.md)</h2>
+<pre>
+x = [beta, yaw_rate],  x_ref = [beta_ref, yaw_rate_ref]
+delta_i = clamp(delta_ff_i + K_i (x - x_ref), -delta_max, delta_max)      (rows i = FL, FR, RL, RR)
+e = speed_ref - speed,   F = kp_speed e + ki_speed I
+if |F| > force_max:  F = +-force_max and I is frozen,   else  I := I + e sample_period  (at the next sample)
+tau_i = F r_wheel / 4
+</pre>
+<p><code>controller</code> selects K: <code>open_loop</code> (K = 0), <code>pole_placement</code> (the non-robust
+baseline, Re(s) &lt; -2 at mu = 0.4), <code>robust</code> (the mixed H2/H-inf gain of the paper variant, 4WD4WS,
+Pareto point; default) or <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>, which
+start at the robust gain and may change between steps). The gain in use is readable as <code>gain_*</code>.
+The robust and pole-placement gains are baked from the synthesis crate
+(<code>cargo run --release -p nigel-synthesis --bin bake-gains</code>).</p>
+<h2>Sampling</h2>
+<p>The law runs at t_k = t_start + k sample_period on the inputs at t_k; the outputs are held until t_(k+1).
+The outputs depend directly on the inputs: an importer that sets the inputs at t_k and reads the outputs before
+<code>fmi2DoStep</code> gets the law applied to them. <code>speed_integral</code> read at t_k is the I used there;
+it takes the step of sample k when time moves past t_k. A Co-Simulation step spanning several samples runs them in
+order (one 10 ms step equals ten 1 ms steps with the same inputs, bit for bit); in Model Exchange the samples are
+time events.</p>"#;

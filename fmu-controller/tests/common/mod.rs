@@ -1,0 +1,170 @@
+//! A tiny importer over the layer's C entry points (`fmi2_export::abi`, what the shared
+//! library exports), for the tests of the controller and test-bench FMUs. It records the
+//! log so that tests can check the messages.
+#![allow(dead_code)]
+
+use std::cell::RefCell;
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ptr::null_mut;
+
+use fmi2_export::abi::{self, Fmi2EventInfo};
+use fmi2_export::ffi::*;
+use fmi2_export::Model;
+
+#[derive(Default)]
+pub struct Log(pub RefCell<Vec<(c_int, String, String)>>);
+
+/// The importer's logger. FMI's is C-variadic; the layer always passes ("%s", message),
+/// and on x86-64 System V a fixed-argument callee reads those from the same registers.
+unsafe extern "C" fn record(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    _format: *const c_char,
+    message: *const c_char,
+) {
+    let log = &*(env as *const Log);
+    let text = |p: *const c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
+    log.0.borrow_mut().push((status, text(category), text(message)));
+}
+
+pub const OK: Fmi2Status = Fmi2Status::Ok;
+pub const ERR: Fmi2Status = Fmi2Status::Error;
+
+pub struct Fmu<M: Model> {
+    pub c: fmi2Component,
+    pub log: Box<Log>,
+    _m: std::marker::PhantomData<M>,
+}
+
+impl<M: Model> Fmu<M> {
+    fn new(kind: c_int) -> Self {
+        let log = Box::<Log>::default();
+        let callbacks = Fmi2CallbackFunctions {
+            // SAFETY: see `record`.
+            logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
+            component_environment: &*log as *const Log as *mut c_void,
+        };
+        let name = CString::new("test").unwrap();
+        let guid = CString::new(M::declaration().guid()).unwrap();
+        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &callbacks, 0, 1) };
+        assert!(!c.is_null(), "{:?}", log.0.borrow());
+        Fmu { c, log, _m: std::marker::PhantomData }
+    }
+    pub fn cs() -> Self {
+        Self::new(1)
+    }
+    pub fn me() -> Self {
+        Self::new(0)
+    }
+    /// The last message logged with status Error or worse.
+    pub fn last_error(&self) -> String {
+        self.log.0.borrow().iter().rev().find(|r| r.0 >= 3).map(|r| r.2.clone()).unwrap_or_default()
+    }
+    pub fn setup(&self) -> Fmi2Status {
+        unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, 0, 0.0) }
+    }
+    pub fn enter_init(&self) -> Fmi2Status {
+        unsafe { abi::enter_initialization_mode::<M>(self.c) }
+    }
+    pub fn exit_init(&self) -> Fmi2Status {
+        unsafe { abi::exit_initialization_mode::<M>(self.c) }
+    }
+    /// setup, enter and exit initialization, all Ok.
+    pub fn init(&self) {
+        assert_eq!(self.setup(), OK, "{}", self.last_error());
+        assert_eq!(self.enter_init(), OK, "{}", self.last_error());
+        assert_eq!(self.exit_init(), OK, "{}", self.last_error());
+    }
+    pub fn real(&self, vr: u32) -> f64 {
+        let mut x = f64::NAN;
+        let s = unsafe { abi::get_real::<M>(self.c, &vr, 1, &mut x) };
+        assert_eq!(s, OK, "get_real({vr}): {}", self.last_error());
+        x
+    }
+    pub fn reals(&self, vrs: &[u32]) -> Vec<f64> {
+        vrs.iter().map(|&vr| self.real(vr)).collect()
+    }
+    pub fn int(&self, vr: u32) -> i32 {
+        let mut x = -7;
+        let s = unsafe { abi::get_integer::<M>(self.c, &vr, 1, &mut x) };
+        assert_eq!(s, OK, "{}", self.last_error());
+        x
+    }
+    pub fn set_real(&self, vr: u32, x: f64) -> Fmi2Status {
+        unsafe { abi::set_real::<M>(self.c, &vr, 1, &x) }
+    }
+    pub fn set_int(&self, vr: u32, x: i32) -> Fmi2Status {
+        unsafe { abi::set_integer::<M>(self.c, &vr, 1, &x) }
+    }
+    pub fn set_bool(&self, vr: u32, x: bool) -> Fmi2Status {
+        let v = x as fmi2Boolean;
+        unsafe { abi::set_boolean::<M>(self.c, &vr, 1, &v) }
+    }
+    pub fn step(&self, t: f64, h: f64) -> Fmi2Status {
+        unsafe { abi::do_step::<M>(self.c, t, h, 1) }
+    }
+    pub fn reset(&self) -> Fmi2Status {
+        unsafe { abi::reset::<M>(self.c) }
+    }
+    // Model Exchange
+    pub fn set_time(&self, t: f64) -> Fmi2Status {
+        unsafe { abi::set_time::<M>(self.c, t) }
+    }
+    pub fn enter_event_mode(&self) -> Fmi2Status {
+        unsafe { abi::enter_event_mode::<M>(self.c) }
+    }
+    pub fn enter_continuous_time_mode(&self) -> Fmi2Status {
+        unsafe { abi::enter_continuous_time_mode::<M>(self.c) }
+    }
+    /// One event iteration; the next event time if defined.
+    pub fn new_discrete_states(&self) -> Option<f64> {
+        let mut info = Fmi2EventInfo {
+            new_discrete_states_needed: 0,
+            terminate_simulation: 0,
+            nominals_of_continuous_states_changed: 0,
+            values_of_continuous_states_changed: 0,
+            next_event_time_defined: 0,
+            next_event_time: 0.0,
+        };
+        let s = unsafe { abi::new_discrete_states::<M>(self.c, &mut info) };
+        assert_eq!(s, OK, "{}", self.last_error());
+        assert_eq!(info.new_discrete_states_needed, 0);
+        (info.next_event_time_defined != 0).then_some(info.next_event_time)
+    }
+    /// FMU state round trip through serialization.
+    pub fn serialized_state(&self) -> Vec<u8> {
+        unsafe {
+            let mut s: fmi2FMUstate = null_mut();
+            assert_eq!(abi::get_fmu_state::<M>(self.c, &mut s), OK, "{}", self.last_error());
+            let mut n = 0usize;
+            assert_eq!(abi::serialized_fmu_state_size::<M>(self.c, s, &mut n), OK);
+            let mut bytes = vec![0u8; n];
+            assert_eq!(abi::serialize_fmu_state::<M>(self.c, s, bytes.as_mut_ptr() as *mut fmi2Byte, n), OK);
+            assert_eq!(abi::free_fmu_state::<M>(self.c, &mut s), OK);
+            bytes
+        }
+    }
+    pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi2Status {
+        unsafe {
+            let mut s: fmi2FMUstate = null_mut();
+            let st = abi::deserialize_fmu_state::<M>(self.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut s);
+            if st != OK {
+                return st;
+            }
+            let st = abi::set_fmu_state::<M>(self.c, s);
+            abi::free_fmu_state::<M>(self.c, &mut s);
+            st
+        }
+    }
+}
+
+impl<M: Model> Drop for Fmu<M> {
+    fn drop(&mut self) {
+        unsafe { abi::free_instance::<M>(self.c) }
+    }
+}

@@ -1,0 +1,365 @@
+//! The controller FMU through the layer's C entry points: the law by hand in every mode,
+//! saturation and anti-windup, direct feedthrough, sample timing (Co-Simulation and Model
+//! Exchange), a 10 ms step equal to ten 1 ms steps bit for bit, tunable custom gains,
+//! FMU state, and bad input.
+
+// The by-hand law clamps with max/min and indexes wheels and columns on purpose: it is
+// written out independently of nigel_benchmark's code.
+#![allow(clippy::manual_clamp, clippy::needless_range_loop)]
+
+mod common;
+
+use std::f64::consts::FRAC_PI_2;
+
+use common::{Fmu, ERR, OK};
+use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
+use nigel_controller::{mode, vr, Controller};
+
+type C = Fmu<Controller>;
+
+const T: f64 = 1e-3;
+const R_WHEEL: f64 = 0.0325;
+
+/// One set of inputs: beta, yaw_rate, speed, beta_ref, yaw_rate_ref, speed_ref, delta_ff.
+#[derive(Clone, Copy, Debug)]
+struct In {
+    beta: f64,
+    yaw_rate: f64,
+    speed: f64,
+    beta_ref: f64,
+    yaw_rate_ref: f64,
+    speed_ref: f64,
+    ff: [f64; 4],
+}
+
+const SETS: [In; 4] = [
+    In {
+        beta: 0.02,
+        yaw_rate: -0.1,
+        speed: 0.34,
+        beta_ref: 0.01,
+        yaw_rate_ref: 0.05,
+        speed_ref: 0.35,
+        ff: [0.1, 0.1, -0.1, -0.1],
+    },
+    In { beta: -0.3, yaw_rate: 1.2, speed: 0.36, beta_ref: 0.0, yaw_rate_ref: 0.0, speed_ref: 0.35, ff: [0.0; 4] },
+    In {
+        beta: 0.0,
+        yaw_rate: 0.0,
+        speed: 0.35,
+        beta_ref: 0.0,
+        yaw_rate_ref: 0.0,
+        speed_ref: 0.35,
+        ff: [0.5, -0.2, 0.3, 1.5],
+    },
+    // far off: the steering clamps at pi/2
+    In {
+        beta: 1.0,
+        yaw_rate: -4.0,
+        speed: 0.3,
+        beta_ref: -1.0,
+        yaw_rate_ref: 4.0,
+        speed_ref: 0.35,
+        ff: [1.5, -1.5, 1.5, -1.5],
+    },
+];
+
+fn set_inputs(c: &C, x: &In) {
+    for (r, v) in [
+        (vr::BETA, x.beta),
+        (vr::YAW_RATE, x.yaw_rate),
+        (vr::SPEED, x.speed),
+        (vr::BETA_REF, x.beta_ref),
+        (vr::YAW_RATE_REF, x.yaw_rate_ref),
+        (vr::SPEED_REF, x.speed_ref),
+    ] {
+        assert_eq!(c.set_real(r, v), OK, "{}", c.last_error());
+    }
+    for i in 0..4 {
+        assert_eq!(c.set_real(vr::DELTA_FF + i as u32, x.ff[i]), OK);
+    }
+}
+
+fn deltas(c: &C) -> [f64; 4] {
+    std::array::from_fn(|i| c.real(vr::DELTA + i as u32))
+}
+
+fn taus(c: &C) -> [f64; 4] {
+    std::array::from_fn(|i| c.real(vr::TAU + i as u32))
+}
+
+/// The law written out by hand (maneuvers.md), independent of nigel_benchmark's code.
+fn by_hand(k: &[[f64; 2]; 4], x: &In, integral: f64) -> ([f64; 4], f64) {
+    let delta = std::array::from_fn(|i| {
+        let d = x.ff[i] + k[i][0] * (x.beta - x.beta_ref) + k[i][1] * (x.yaw_rate - x.yaw_rate_ref);
+        d.max(-FRAC_PI_2).min(FRAC_PI_2)
+    });
+    let f = 53.6 * (x.speed_ref - x.speed) + 268.0 * integral;
+    (delta, f.max(-20.0).min(20.0))
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-14 * (1.0 + b.abs())
+}
+
+#[test]
+fn outputs_are_the_law_in_every_mode() {
+    let custom = [[0.3, -0.2], [1.0, 0.0], [-0.7, 0.25], [0.0, 2.0]];
+    for m in [mode::OPEN_LOOP, mode::POLE_PLACEMENT, mode::ROBUST, mode::CUSTOM] {
+        let gain = match m {
+            mode::OPEN_LOOP => [[0.0; 2]; 4],
+            mode::POLE_PLACEMENT => POLE_PLACEMENT,
+            mode::ROBUST => ROBUST,
+            _ => custom,
+        };
+        let c = C::cs();
+        assert_eq!(c.set_int(vr::CONTROLLER, m), OK);
+        for i in 0..4 {
+            for j in 0..2 {
+                assert_eq!(c.set_real(vr::K_CUSTOM + (2 * i + j) as u32, custom[i][j]), OK);
+            }
+        }
+        c.init();
+        // the gains in use are readable
+        for i in 0..4 {
+            for j in 0..2 {
+                assert_eq!(c.real(vr::GAIN_IN_USE + (2 * i + j) as u32), gain[i][j], "mode {m}");
+            }
+        }
+        let mut integral = 0.0;
+        for (n, x) in SETS.iter().enumerate() {
+            let t = n as f64 * T;
+            set_inputs(&c, x);
+            // read before the step: the law on the inputs just set (direct feedthrough)
+            let (delta, force) = by_hand(&gain, x, integral);
+            let got = deltas(&c);
+            for i in 0..4 {
+                assert!(close(got[i], delta[i]), "mode {m} set {n} wheel {i}: {} vs {}", got[i], delta[i]);
+            }
+            for tau in taus(&c) {
+                assert!(close(tau, force * R_WHEEL / 4.0), "mode {m} set {n}: tau {tau} vs F {force}");
+            }
+            assert!(close(c.real(vr::DRIVE_FORCE), force));
+            assert_eq!(c.step(t, T), OK, "{}", c.last_error());
+            if force.abs() < 20.0 {
+                integral += (x.speed_ref - x.speed) * T;
+            }
+            assert!(close(c.real(vr::SPEED_INTEGRAL), integral), "{} vs {integral}", c.real(vr::SPEED_INTEGRAL));
+        }
+        // the last set drives the steering into the clamp (the by-hand law clamps too)
+        if m != mode::OPEN_LOOP {
+            assert!(deltas(&c).iter().any(|d| d.abs() == FRAC_PI_2), "{:?}", deltas(&c));
+        }
+    }
+}
+
+#[test]
+fn force_saturates_and_the_integrator_freezes() {
+    let c = C::cs();
+    c.init();
+    let mut x = SETS[2];
+    x.speed = 0.0; // e = 0.35: F = 18.76 < 20
+    set_inputs(&c, &x);
+    assert!(close(c.real(vr::DRIVE_FORCE), 53.6 * 0.35));
+    assert_eq!(c.step(0.0, T), OK);
+    let i1 = c.real(vr::SPEED_INTEGRAL);
+    assert!(close(i1, 0.35e-3));
+    // F = 18.76 + 268 * 0.35e-3 = 18.8538, still linear; then 1 m/s short: saturates
+    x.speed_ref = 1.0;
+    set_inputs(&c, &x);
+    assert_eq!(c.real(vr::DRIVE_FORCE), 20.0);
+    assert_eq!(taus(&c), [20.0 * R_WHEEL / 4.0; 4]);
+    for k in 1..50 {
+        assert_eq!(c.step(k as f64 * T, T), OK);
+        assert_eq!(c.real(vr::SPEED_INTEGRAL), i1, "frozen while saturated (sample {k})");
+    }
+    // negative saturation too, still frozen
+    x.speed = 3.0;
+    set_inputs(&c, &x);
+    assert_eq!(c.real(vr::DRIVE_FORCE), -20.0);
+    assert_eq!(c.step(50.0 * T, T), OK);
+    assert_eq!(c.real(vr::SPEED_INTEGRAL), i1);
+    // back in the linear range the integrator runs again
+    x.speed = 0.99;
+    set_inputs(&c, &x);
+    let f = c.real(vr::DRIVE_FORCE);
+    assert!(close(f, 53.6 * 0.01 + 268.0 * i1), "{f}");
+    assert_eq!(c.step(51.0 * T, T), OK);
+    assert!(close(c.real(vr::SPEED_INTEGRAL), i1 + 0.01 * T));
+}
+
+#[test]
+fn outputs_follow_inputs_set_at_the_sample_instant_and_hold_between_samples() {
+    let c = C::cs();
+    c.init();
+    set_inputs(&c, &SETS[0]);
+    let a = deltas(&c);
+    // the importer changes its mind at the same instant: the outputs follow
+    set_inputs(&c, &SETS[1]);
+    let b = deltas(&c);
+    assert_ne!(a, b);
+    assert!(close(b[0], by_hand(&ROBUST, &SETS[1], 0.0).0[0]));
+    // half a sample: the inputs change, the held outputs do not
+    assert_eq!(c.step(0.0, 0.5 * T), OK);
+    set_inputs(&c, &SETS[2]);
+    assert_eq!(deltas(&c), b);
+    assert_eq!(c.step(0.5 * T, 0.5 * T), OK);
+    // at t_1 the new inputs apply
+    assert!(close(deltas(&c)[3], by_hand(&ROBUST, &SETS[2], 0.0).0[3]));
+    // the integrator moved with the inputs of t_0 (SETS[1]: e = -0.01)
+    assert!(close(c.real(vr::SPEED_INTEGRAL), -0.01 * T));
+}
+
+#[test]
+fn one_10ms_step_equals_ten_1ms_steps_bit_for_bit() {
+    let big = C::cs();
+    let small = C::cs();
+    for c in [&big, &small] {
+        assert_eq!(c.set_int(vr::CONTROLLER, mode::POLE_PLACEMENT), OK);
+        c.init();
+    }
+    let mut t = 0.0;
+    for x in SETS.iter().chain(SETS.iter()) {
+        set_inputs(&big, x);
+        set_inputs(&small, x);
+        assert_eq!(big.step(t, 10.0 * T), OK);
+        for k in 0..10 {
+            assert_eq!(small.step(t + k as f64 * T, T), OK, "{}", small.last_error());
+        }
+        t += 10.0 * T;
+        let read = |c: &C| {
+            let mut v = c.reals(&[vr::SPEED_INTEGRAL, vr::DRIVE_FORCE]);
+            v.extend(deltas(c));
+            v.extend(taus(c));
+            v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>()
+        };
+        assert_eq!(read(&big), read(&small), "t = {t}");
+    }
+}
+
+#[test]
+fn custom_gains_can_change_between_steps() {
+    let c = C::cs();
+    assert_eq!(c.set_int(vr::CONTROLLER, mode::CUSTOM), OK);
+    c.init();
+    let x = SETS[0];
+    set_inputs(&c, &x);
+    let before = deltas(&c);
+    assert!(close(before[0], by_hand(&ROBUST, &x, 0.0).0[0]), "custom starts at the robust gain");
+    assert_eq!(c.step(0.0, T), OK);
+    let mut k = ROBUST;
+    k[0] = [2.0, -1.0];
+    assert_eq!(c.set_real(vr::K_CUSTOM, 2.0), OK, "{}", c.last_error());
+    assert_eq!(c.set_real(vr::K_CUSTOM + 1, -1.0), OK);
+    assert_eq!(c.real(vr::GAIN_IN_USE), 2.0);
+    let after = deltas(&c);
+    assert!(close(after[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", after[0], by_hand(&k, &x, 0.0).0[0]);
+    assert_eq!(after[1..], before[1..]);
+    // a fixed parameter cannot change after initialization
+    assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST), ERR);
+}
+
+#[test]
+fn model_exchange_samples_are_time_events() {
+    let c = C::me();
+    c.init();
+    set_inputs(&c, &SETS[0]);
+    // the initial event at t = 0 (event mode after initialization)
+    assert_eq!(c.new_discrete_states(), Some(T));
+    assert_eq!(c.enter_continuous_time_mode(), OK);
+    let d0 = deltas(&c);
+    assert!(close(d0[0], by_hand(&ROBUST, &SETS[0], 0.0).0[0]));
+    // inputs move in continuous time: the outputs hold until the event at t_1
+    for (n, t) in [0.2e-3, 0.5e-3, 0.99e-3].into_iter().enumerate() {
+        assert_eq!(c.set_time(t), OK);
+        set_inputs(&c, &SETS[1 + n % 2]);
+        assert_eq!(deltas(&c), d0, "t = {t}");
+    }
+    assert_eq!(c.set_time(T), OK);
+    set_inputs(&c, &SETS[1]);
+    assert_eq!(deltas(&c), d0, "before the event is handled");
+    assert_eq!(c.enter_event_mode(), OK);
+    assert_eq!(c.new_discrete_states(), Some(2.0 * T));
+    let d1 = deltas(&c);
+    assert!(close(d1[2], by_hand(&ROBUST, &SETS[1], 0.01 * T).0[2]));
+    // at t_1 the integrator holds I_1: one sample of SETS[0] (e = 0.01)
+    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T), "{}", c.real(vr::SPEED_INTEGRAL));
+}
+
+#[test]
+fn fmu_state_round_trip_reproduces_the_run() {
+    let c = C::cs();
+    c.init();
+    let mut t = 0.0;
+    for x in &SETS[..2] {
+        set_inputs(&c, x);
+        assert_eq!(c.step(t, T), OK);
+        t += T;
+    }
+    let saved = c.serialized_state();
+    let run = |c: &C, t0: f64| {
+        let mut out = Vec::new();
+        let mut t = t0;
+        for x in &SETS {
+            set_inputs(c, x);
+            assert_eq!(c.step(t, T), OK);
+            t += T;
+            out.extend(deltas(c).map(f64::to_bits));
+            out.push(c.real(vr::SPEED_INTEGRAL).to_bits());
+        }
+        out
+    };
+    let first = run(&c, t);
+    assert_eq!(c.restore_serialized(&saved), OK, "{}", c.last_error());
+    assert_eq!(run(&c, t), first);
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
+    let c = C::cs();
+    // an out-of-range enumeration
+    assert_eq!(c.set_int(vr::CONTROLLER, 7), ERR);
+    assert!(c.last_error().contains("controller"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    // a negative sample period
+    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, -1e-3), ERR);
+    assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    // zero is refused too (by the model)
+    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, 0.0), ERR);
+    assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    // NaN gains
+    assert_eq!(c.set_real(vr::K_CUSTOM + 3, f64::NAN), ERR);
+    assert!(c.last_error().contains("k_yaw_rate_fr"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    assert_eq!(c.set_real(vr::BETA, f64::INFINITY), ERR);
+    assert!(c.last_error().contains("beta"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    assert_eq!(c.set_real(vr::DELTA_MAX, 2.0), ERR);
+    assert!(c.last_error().contains("delta_max"), "{}", c.last_error());
+    // after reset: the start values and a normal run
+    assert_eq!(c.reset(), OK);
+    c.init();
+    assert_eq!(c.int(vr::CONTROLLER), mode::ROBUST);
+    assert_eq!(c.real(vr::SAMPLE_PERIOD), T);
+    set_inputs(&c, &SETS[0]);
+    assert_eq!(c.step(0.0, T), OK);
+    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
+}
+
+#[test]
+fn declaration_has_feedthrough_and_the_interfaces() {
+    use fmi2_export::Model;
+    let md = Controller::declaration().model_description();
+    assert!(md.validate().is_empty(), "{:?}", md.validate());
+    assert!(md.model_exchange.is_some() && md.co_simulation.is_some());
+    let index = |n: &str| md.model_variables.iter().position(|v| v.name == n).unwrap() as u32 + 1;
+    let out = md.model_structure.outputs.iter().find(|u| u.index == index("delta_rl")).unwrap();
+    let mut expect =
+        vec![index("beta"), index("yaw_rate"), index("beta_ref"), index("yaw_rate_ref"), index("delta_ff_rl")];
+    expect.sort();
+    assert_eq!(out.dependencies.as_ref(), Some(&expect));
+    let out = md.model_structure.outputs.iter().find(|u| u.index == index("tau_fl")).unwrap();
+    assert_eq!(out.dependencies.as_ref(), Some(&vec![index("speed"), index("speed_ref")]));
+}

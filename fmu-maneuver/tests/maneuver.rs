@@ -1,0 +1,212 @@
+//! The test-bench FMU through the layer's C entry points: the spec's test vectors bit for
+//! bit, the reference and the programs equal to nigel-benchmark's, every maneuver and
+//! fidelity initializes, direct feedthrough of the measurement, Model Exchange time
+//! events, FMU state, and bad input.
+
+#[path = "../../fmu-controller/tests/common/mod.rs"]
+mod common;
+
+use std::f64::consts::PI;
+
+use common::{Fmu, ERR, OK};
+use nigel_benchmark::noise::g;
+use nigel_benchmark::{Benchmark, Fidelity, Maneuver, Scenario};
+use nigel_maneuver::{fidelity_value, maneuver_value, vr, TestBench};
+
+type B = Fmu<TestBench>;
+const T: f64 = 1e-3;
+
+fn bench(m: Maneuver, f: Fidelity, duration: f64) -> B {
+    let b = B::cs();
+    assert_eq!(b.set_int(vr::MANEUVER, maneuver_value(m)), OK);
+    assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(f)), OK);
+    assert_eq!(b.set_real(vr::DURATION, duration), OK);
+    b.init();
+    b
+}
+
+#[test]
+fn spec_vectors_bit_exact() {
+    let b = bench(Maneuver::Straight, Fidelity::Real, 1.5);
+    // k = 0: mu_fl, and beta_meas with beta = 0 is 0.005 g(0, 5, 0)
+    assert_eq!(b.real(vr::MU), 0.5883310808213643);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * 0.014334745996352224);
+    assert_eq!(b.real(vr::YAW_RATE_MEAS), 0.01 * g(0, 6, 0));
+    assert_eq!(b.step(0.0, T), OK);
+    assert_eq!(b.real(vr::MU), 0.5486795484644006);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * 0.5906209568869251);
+    assert_eq!(b.step(T, 998.0 * T), OK);
+    assert_eq!(b.real(vr::WIND_Y), 0.007915537544713306, "k = 999");
+    assert_eq!(b.step(999.0 * T, T), OK);
+    assert_eq!(b.real(vr::WIND_Y), 0.2629350570802014, "k = 1000");
+    assert_eq!(b.real(vr::WIND_X), 0.0);
+}
+
+#[test]
+fn figure8_switches_at_the_spec_samples() {
+    let b = bench(Maneuver::Figure8, Fidelity::Paper, 9.5);
+    let a = PI / 6.0;
+    let mut sign = 1.0;
+    let mut flips = Vec::new();
+    for k in 0..9_500u32 {
+        let front = b.real(vr::DELTA_FF);
+        assert_eq!(b.real(vr::DELTA_FF + 2), -front);
+        if front != sign * a {
+            assert_eq!(front, -sign * a, "k = {k}");
+            sign = -sign;
+            flips.push(k);
+        }
+        assert_eq!(b.step(k as f64 * T, T), OK);
+    }
+    assert_eq!(flips, [3144, 6267, 9390]);
+}
+
+#[test]
+fn reference_and_program_are_the_benchmark_library_s() {
+    for (m, f) in [(Maneuver::LaneChange, Fidelity::Real), (Maneuver::Slalom, Fidelity::Paper)] {
+        let b = bench(m, f, 16.0);
+        let lib = Benchmark::prepare(Scenario { n_samples: 16_000, ..Scenario::new(m, f) }).unwrap();
+        let r = &lib.reference.trajectory;
+        let mut t = 0.0;
+        let beta = 0.01;
+        assert_eq!(b.set_real(vr::BETA, beta), OK);
+        for k in 0..=16_000usize {
+            if k % 7 == 0 || (14_790..15_210).contains(&k) {
+                let got = b.reals(&[vr::X_REF, vr::Y_REF, vr::PSI_REF, vr::BETA_REF, vr::YAW_RATE_REF, vr::SPEED_REF]);
+                assert_eq!(got, [r.x[k], r.y[k], r.psi[k], r.beta[k], r.yaw_rate[k], 0.35], "{m} k = {k}");
+                let s = lib.sample(k, beta, 0.0).unwrap();
+                assert_eq!(b.real(vr::DELTA_FF + 1), s.delta_ff[1], "{m} k = {k}");
+                assert_eq!(b.real(vr::MU + 3), s.mu[3]);
+                assert_eq!(b.real(vr::BETA_MEAS), s.beta_meas);
+            }
+            if k < 16_000 {
+                assert_eq!(b.step(t, T), OK, "{}", b.last_error());
+                t = (k + 1) as f64 * T;
+            }
+        }
+        // the reference is not continued past `duration`: the sample at t + 1 ms is refused
+        assert_eq!(b.step(t, T), OK);
+        let mut x = 0.0;
+        let s = unsafe { fmi2_export::abi::get_real::<TestBench>(b.c, &vr::X_REF, 1, &mut x) };
+        assert_eq!(s, ERR);
+        assert!(b.last_error().contains("duration"), "{}", b.last_error());
+    }
+}
+
+#[test]
+fn every_maneuver_and_fidelity_initializes() {
+    for m in Maneuver::ALL {
+        for f in Fidelity::ALL {
+            let b = bench(m, f, 30.0);
+            assert_eq!(b.step(0.0, 10.0 * T), OK, "{m} {f:?}: {}", b.last_error());
+            let x = b.real(vr::X_REF);
+            assert!(x > 0.0033 && x < 0.0036, "{m} {f:?}: x_ref = {x}");
+        }
+    }
+}
+
+#[test]
+fn measurement_is_fed_through_and_held() {
+    let b = bench(Maneuver::Skidpad, Fidelity::Real, 1.0);
+    assert_eq!(b.step(0.0, T), OK);
+    assert_eq!(b.set_real(vr::BETA, 0.2), OK);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.2 + 0.005 * g(0, 5, 1), "the input of t_1 at t_1");
+    assert_eq!(b.set_real(vr::BETA, 0.3), OK);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.3 + 0.005 * g(0, 5, 1), "set again at the same instant");
+    assert_eq!(b.step(T, 0.5 * T), OK);
+    assert_eq!(b.set_real(vr::BETA, -0.3), OK);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.3 + 0.005 * g(0, 5, 1), "held between samples");
+    // paper fidelity and the noise switch off: the true value
+    for (f, noise) in [(Fidelity::Paper, true), (Fidelity::Real, false)] {
+        let b = B::cs();
+        assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(f)), OK);
+        assert_eq!(b.set_bool(vr::MEASUREMENT_NOISE, noise), OK);
+        assert_eq!(b.set_real(vr::DURATION, 0.1), OK);
+        b.init();
+        assert_eq!(b.set_real(vr::YAW_RATE, 0.7), OK);
+        assert_eq!(b.real(vr::YAW_RATE_MEAS), 0.7);
+    }
+}
+
+#[test]
+fn disturbance_switches_and_seed() {
+    let b = B::cs();
+    assert_eq!(b.set_bool(vr::FRICTION_VARIATION, false), OK);
+    assert_eq!(b.set_bool(vr::WIND, false), OK);
+    assert_eq!(b.set_int(vr::SEED, 7), OK);
+    assert_eq!(b.set_real(vr::DURATION, 2.0), OK);
+    b.init();
+    assert_eq!(b.step(0.0, 1.5), OK);
+    assert_eq!(b.reals(&[vr::MU, vr::MU + 1, vr::MU + 2, vr::MU + 3, vr::WIND_Y]), [0.4, 0.4, 0.4, 0.4, 0.0]);
+    let c = B::cs();
+    assert_eq!(c.set_int(vr::SEED, 7), OK);
+    assert_eq!(c.set_real(vr::DURATION, 2.0), OK);
+    c.init();
+    let expect = 0.55 + 0.1 * nigel_benchmark::noise::u(7, 0, 0) - 0.05; // sin(0) = 0 at k = 0
+    assert!((c.real(vr::MU) - expect).abs() < 1e-15, "{} vs {expect}", c.real(vr::MU));
+    assert!((c.real(vr::MU) - 0.5883310808213643).abs() > 1e-3, "seed 7 is not seed 0");
+}
+
+#[test]
+fn model_exchange_outputs_change_at_the_events() {
+    let b = B::me();
+    assert_eq!(b.set_int(vr::MANEUVER, maneuver_value(Maneuver::LaneChange)), OK);
+    assert_eq!(b.set_real(vr::DURATION, 15.0), OK);
+    b.init();
+    assert_eq!(b.new_discrete_states(), Some(T));
+    assert_eq!(b.enter_continuous_time_mode(), OK);
+    let mu0 = b.real(vr::MU);
+    assert_eq!(b.set_time(0.7e-3), OK);
+    assert_eq!(b.real(vr::MU), mu0);
+    // to the lane change at 14.8 s event by event
+    let mut t = T;
+    for k in 1..=14_800u32 {
+        assert_eq!(b.set_time(t), OK);
+        assert_eq!(b.enter_event_mode(), OK);
+        let next = b.new_discrete_states().unwrap();
+        assert_eq!(b.enter_continuous_time_mode(), OK);
+        assert!((next - (k + 1) as f64 * T).abs() < 1e-12);
+        t = next;
+    }
+    assert_eq!(b.real(vr::DELTA_FF), PI / 6.0);
+}
+
+#[test]
+fn fmu_state_round_trip() {
+    let b = bench(Maneuver::Fishhook, Fidelity::Real, 3.0);
+    assert_eq!(b.step(0.0, 0.5), OK);
+    let saved = b.serialized_state();
+    let read = |b: &B| b.reals(&[vr::X_REF, vr::DELTA_FF, vr::MU, vr::BETA_MEAS]);
+    assert_eq!(b.step(0.5, 2.0), OK);
+    let first = read(&b);
+    assert_eq!(b.restore_serialized(&saved), OK, "{}", b.last_error());
+    assert_eq!(b.step(0.5, 2.0), OK);
+    assert_eq!(read(&b), first);
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
+    let b = B::cs();
+    assert_eq!(b.set_int(vr::MANEUVER, 7), ERR);
+    assert!(b.last_error().contains("maneuver"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_int(vr::FIDELITY, 0), ERR);
+    assert!(b.last_error().contains("fidelity"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_int(vr::SEED, -1), ERR);
+    assert!(b.last_error().contains("seed"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::STEER_AMPLITUDE, f64::NAN), ERR);
+    assert!(b.last_error().contains("steer_amplitude"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::SPEED_TARGET, 0.0), ERR);
+    assert!(b.last_error().contains("speed_target"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::DURATION, -1.0), ERR);
+    assert!(b.last_error().contains("duration"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::DURATION, 0.01), OK);
+    b.init();
+    assert_eq!(b.int(vr::MANEUVER), 1);
+    assert_eq!(b.step(0.0, 0.01), OK);
+}
