@@ -256,8 +256,7 @@ pub struct ImportOptions {
 /// Share it between instances with `Arc`; it outlives them.
 pub struct Fmu {
     pub(crate) functions: Functions,
-    // field order matters: the library is unloaded before the folder holding it is removed
-    _library: libloading::Library,
+    _library: Arc<libloading::Library>,
     description: ModelDescription,
     interface: Interface,
     source: PathBuf,
@@ -269,6 +268,34 @@ impl std::fmt::Debug for Fmu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Fmu").field("source", &self.source).field("interface", &self.interface).finish()
     }
+}
+
+/// Libraries loaded so far, by the SHA-256 of their bytes. A binary loaded once stays
+/// loaded for the life of the process and later imports of the same binary share it:
+/// the dynamic loader cannot unload libraries that registered thread-local destructors
+/// (every Rust cdylib using std's thread locals), so loading a fresh copy from each new
+/// temporary folder would map it again and again (about 90 KiB of resident memory per
+/// import of our plant). The cost is bounded by the number of distinct binaries.
+static LIBRARIES: std::sync::OnceLock<Mutex<std::collections::HashMap<[u8; 32], Arc<libloading::Library>>>> =
+    std::sync::OnceLock::new();
+
+fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloading::Library>> {
+    use sha2::Digest;
+    let bytes = std::fs::read(so).map_err(|source| Error::Io { path: shown.to_path_buf(), source })?;
+    let key: [u8; 32] = sha2::Sha256::digest(&bytes).into();
+    let cache = LIBRARIES.get_or_init(Default::default);
+    let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(lib) = cache.get(&key) {
+        return Ok(lib.clone());
+    }
+    // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
+    let library = unsafe { libloading::Library::new(so) }.map_err(|e| Error::LoadLibrary {
+        path: shown.to_path_buf(),
+        reason: e.to_string().replace(&so.display().to_string(), relative),
+    })?;
+    let library = Arc::new(library);
+    cache.insert(key, library.clone());
+    Ok(library)
 }
 
 /// Reads `modelDescription.xml` of an unpacked FMU.
@@ -330,18 +357,18 @@ impl Fmu {
             platforms.sort();
             return Err(Error::MissingBinary { expected: relative, platforms });
         }
-        // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
-        let library = unsafe { libloading::Library::new(&so) }
-            .map_err(|e| Error::LoadLibrary { path: so.clone(), reason: e.to_string() })?;
+        // errors name the library inside the archive, not the temporary copy
+        let shown = path.join(&relative);
+        let library = load_library(&so, &shown, &relative)?;
         // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
-        let functions = unsafe { Functions::load(&library, &so)? };
+        let functions = unsafe { Functions::load(&library, &shown)? };
         let needs = match interface {
             Interface::CoSimulation => CS_NEEDS,
             Interface::ModelExchange => ME_NEEDS,
         };
         if let Some(missing) = needs.iter().find(|s| !functions.has(s)) {
             let symbol = [CS_NEEDS, ME_NEEDS].concat().into_iter().find(|s| s == missing).unwrap_or("fmi2?");
-            return Err(Error::MissingSymbol { path: so, symbol });
+            return Err(Error::MissingSymbol { path: shown, symbol });
         }
         let resource_uri = CString::new(file_uri(&dir.path().join("resources")))
             .map_err(|_| Error::Experiment("temporary folder path contains NUL".into()))?;

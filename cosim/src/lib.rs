@@ -22,11 +22,13 @@
 pub mod error;
 pub mod fmu;
 pub mod simulate;
+pub mod ssp;
 pub mod system;
 pub mod unpack;
 
 pub use error::{Error, Result, Status};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};
+pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};
 pub use unpack::UnpackLimits;

@@ -125,7 +125,7 @@ pub struct InstanceSpec {
 }
 
 /// A system: instances and checked connections. Build it with [`SystemBuilder`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct System {
     /// Instances, in the order they were added.
     pub instances: Vec<InstanceSpec>,
@@ -138,12 +138,6 @@ pub struct System {
 pub struct SystemBuilder {
     system: System,
     names: HashMap<String, usize>,
-}
-
-impl Default for System {
-    fn default() -> Self {
-        System { instances: Vec::new(), connections: Vec::new() }
-    }
 }
 
 /// Splits `instance.variable` at the first `.`.
@@ -169,11 +163,24 @@ impl System {
         self.instances[i].fmu.description()
     }
 
-    /// Resolves `instance.variable`.
+    /// Resolves `instance.variable` (instance names of flattened nested systems contain
+    /// `.` themselves: the longest instance name that prefixes `full` wins).
     pub fn resolve(&self, full: &str) -> Result<VariableRef> {
-        let (inst, var) = split_name(full)
-            .ok_or_else(|| Error::Instance { name: full.into(), reason: "expected instance.variable" })?;
-        self.resolve_parts(inst, var)
+        let best = self
+            .instances
+            .iter()
+            .filter(|i| {
+                full.len() > i.name.len() + 1 && full.starts_with(&i.name) && full.as_bytes()[i.name.len()] == b'.'
+            })
+            .max_by_key(|i| i.name.len());
+        match best {
+            Some(i) => self.resolve_parts(&i.name, &full[i.name.len() + 1..]),
+            None => {
+                let (inst, var) = split_name(full)
+                    .ok_or_else(|| Error::Instance { name: full.into(), reason: "expected instance.variable" })?;
+                self.resolve_parts(inst, var)
+            }
+        }
     }
 
     /// Resolves an instance name and a variable name.
@@ -237,12 +244,19 @@ impl SystemBuilder {
         SystemBuilder::default()
     }
 
-    /// Adds an instance of `fmu` called `name` (unique, non-empty, without `.`); returns its index.
+    /// Continues building an existing system (e.g. one read from an SSP).
+    pub fn from_system(system: System) -> SystemBuilder {
+        let names = system.instances.iter().enumerate().map(|(i, s)| (s.name.clone(), i)).collect();
+        SystemBuilder { system, names }
+    }
+
+    /// Adds an instance of `fmu` called `name` (unique, non-empty; `.` only between the
+    /// element names of a flattened nested system); returns its index.
     pub fn add_instance(&mut self, name: &str, fmu: Arc<Fmu>) -> Result<usize> {
-        if name.is_empty() || name.contains('.') || name.contains('\0') {
+        if name.is_empty() || name.contains('\0') || name.split('.').any(|p| p.is_empty()) {
             return Err(Error::Instance {
                 name: name.into(),
-                reason: "instance names are non-empty, without '.' or NUL",
+                reason: "instance names are non-empty dotted paths without NUL",
             });
         }
         if self.names.contains_key(name) {
@@ -305,6 +319,16 @@ impl SystemBuilder {
     /// Connects with an SSP-style linear transformation `to = factor * from + offset`
     /// (applied after unit conversion, in the destination unit).
     pub fn connect_linear(&mut self, from: &str, to: &str, linear: Option<(f64, f64)>) -> Result<&mut Self> {
+        self.connect_with(from, to, linear, true)
+    }
+
+    /// Connects without unit conversion (SSP `suppressUnitConversion`), types and
+    /// causalities still checked.
+    pub fn connect_unconverted(&mut self, from: &str, to: &str, linear: Option<(f64, f64)>) -> Result<&mut Self> {
+        self.connect_with(from, to, linear, false)
+    }
+
+    fn connect_with(&mut self, from: &str, to: &str, linear: Option<(f64, f64)>, convert: bool) -> Result<&mut Self> {
         let err = |reason: String| Error::Connection { from: from.into(), to: to.into(), reason };
         let a = self.system.resolve(from).map_err(|e| err(e.to_string()))?;
         let b = self.system.resolve(to).map_err(|e| err(e.to_string()))?;
@@ -328,7 +352,7 @@ impl SystemBuilder {
             return Err(err("the input is already connected".into()));
         }
         let (mut gain, mut offset) = (1.0, 0.0);
-        if a.base_type == BaseType::Real {
+        if a.base_type == BaseType::Real && convert {
             (gain, offset) =
                 unit_conversion(self.system.description(a.instance), va, self.system.description(b.instance), vb)
                     .map_err(err)?;

@@ -15,18 +15,19 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate MODEL.fmu (as a one-instance system).
+    /// Simulate MODEL.fmu (as a one-instance system) or SYSTEM.ssp / SYSTEM.ssd.
     Run(RunArgs),
-    /// List the variables (causality, type, unit, start) of an FMU.
+    /// List the variables (causality, type, unit, start) of an FMU, or the instances and
+    /// connections of an SSP.
     Info {
-        /// The .fmu file.
+        /// The .fmu, .ssp or .ssd file.
         model: PathBuf,
     },
 }
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// The .fmu file.
+    /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
     /// FMI interface: cs (Co-Simulation) or me (Model Exchange).
     #[arg(long, default_value = "cs")]
@@ -105,26 +106,31 @@ fn run(args: RunArgs) -> Result<(), Error> {
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
     let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
-    let fmu = Fmu::load_with(&args.model, &options)?;
-    let default = fmu.description().default_experiment.clone().unwrap_or_default();
-    let mut builder = SystemBuilder::new();
-    builder.add_instance(SINGLE, fmu)?;
+    let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
+        let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions::default())?;
+        let builder = SystemBuilder::from_system(ssp.system.clone());
+        (builder, ssp.default_start_stop.1, None, false, Some(ssp))
+    } else {
+        let fmu = Fmu::load_with(&args.model, &options)?;
+        let default = fmu.description().default_experiment.clone().unwrap_or_default();
+        let mut builder = SystemBuilder::new();
+        builder.add_instance(SINGLE, fmu)?;
+        (builder, default.stop_time, default.step_size, true, None)
+    };
     for s in &args.set {
         let (name, value) =
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
-        builder.set_text(&qualify(name.trim(), true), value)?;
+        builder.set_text(&qualify(name.trim(), single), value)?;
     }
     let system: System = builder.build();
-    let mut experiment = Experiment::new(
-        args.stop_time.or(default.stop_time).unwrap_or(1.0),
-        args.step.or(default.step_size).unwrap_or(1e-3),
-    );
+    let mut experiment =
+        Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
     experiment.algorithm = algorithm;
     experiment.output_interval = args.output_interval;
     experiment.profile = true;
     if !args.record.is_empty() {
-        experiment.record = Some(args.record.iter().map(|r| qualify(r, true)).collect());
+        experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
     }
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
@@ -148,7 +154,51 @@ fn run(args: RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+fn is_ssp(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
+}
+
+fn info_ssp(path: &Path) -> Result<(), Error> {
+    use std::io::Write;
+    let ssp = nigel_cosim::read_ssp(path, &ImportOptions::default())?;
+    let s = &ssp.system;
+    let mut out = std::io::stdout().lock();
+    let mut lines = vec![format!(
+        "system {} ({} instances, {} connections)",
+        path.display(),
+        s.instances.len(),
+        s.connections.len()
+    )];
+    for i in &s.instances {
+        lines.push(format!("instance {:<20} {} ({})", i.name, i.fmu.source().display(), i.fmu.interface().as_str()));
+        for (index, v) in &i.start_values {
+            lines.push(format!("  start {} = {v:?}", i.fmu.description().model_variables[*index].name));
+        }
+    }
+    for c in &s.connections {
+        let unit = |r: &nigel_cosim::VariableRef| s.variable(r).variable_type.unit().unwrap_or("-").to_string();
+        lines.push(format!(
+            "connection {} [{}] -> {} [{}]  (x {} + {})",
+            s.name_of(&c.from),
+            unit(&c.from),
+            s.name_of(&c.to),
+            unit(&c.to),
+            c.gain,
+            c.offset
+        ));
+    }
+    for l in lines {
+        if writeln!(out, "{l}").is_err() {
+            break;
+        }
+    }
+    Ok(())
+}
+
 fn info(path: &Path) -> Result<(), Error> {
+    if is_ssp(path) {
+        return info_ssp(path);
+    }
     use std::io::Write;
     // a closed pipe (`cosim info X | head`) ends the listing quietly
     macro_rules! w {

@@ -134,3 +134,29 @@ EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, int s, double *v) { *v = ((
 EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return 3; }
 EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { *v = 0; return 0; }
 EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return 3; }
+
+/* The remaining functions of the 44 (importers such as fmpy resolve all of them);
+ * these models have no FMU state, no derivatives and no Model Exchange: fmi2Error. */
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return 3; }
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) { return 3; }
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { return 3; }
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return 3; }
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return 3; }
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return 3; }
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                               const fmi2ValueReference z[], size_t nz, const double dv[],
+                                               double dz[]) { return 3; }
+EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                              const int order[], const double v[]) { return 3; }
+EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                               const int order[], double v[]) { return 3; }
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 3; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, void *info) { return 3; }
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 3; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int a, int *b, int *d) { return 3; }
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { return 3; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return 3; }
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return 3; }
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return 3; }
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return 3; }
+EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return 3; }

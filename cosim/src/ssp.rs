@@ -1,0 +1,559 @@
+//! SSP 1.0 import (`.ssp` archives and bare `.ssd` files) into a [`System`], and export of
+//! a [`System`] built in Rust as an `.ssp` that fmpy, ecos and libcosim can run.
+//!
+//! Supported: Components of type `application/x-fmu-sharedlibrary`, their Connectors,
+//! Connections with `LinearTransformation` (factor defaults to 1, offset to 0),
+//! `suppressUnitConversion`, ParameterBindings inline or from `.ssv` files (with
+//! `prefix`), nested Systems (flattened: instance names are the element paths joined
+//! with `.`; connections through system connectors are followed), DefaultExperiment.
+//! Refused by name: signal dictionaries, parameter mappings, other transformations,
+//! other component types. Geometry, annotations and graphical elements are ignored.
+
+use crate::error::{Error, Result};
+use crate::fmu::{Fmu, ImportOptions};
+use crate::system::{BaseType, System, SystemBuilder, Value};
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A small element tree of an XML document (local names, namespaces dropped).
+#[derive(Debug, Clone, Default)]
+struct Element {
+    name: String,
+    attributes: Vec<(String, String)>,
+    children: Vec<Element>,
+}
+
+impl Element {
+    fn attr(&self, name: &str) -> Option<&str> {
+        self.attributes.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+    }
+    fn child(&self, name: &str) -> Option<&Element> {
+        self.children.iter().find(|c| c.name == name)
+    }
+    fn all<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a Element> + 'a {
+        self.children.iter().filter(move |c| c.name == name)
+    }
+}
+
+fn parse_xml(text: &str, path: &Path) -> Result<Element> {
+    use quick_xml::events::Event;
+    let err = |reason: String| Error::Ssp { path: path.to_path_buf(), reason };
+    let mut reader = quick_xml::Reader::from_str(text);
+    reader.config_mut().trim_text(true);
+    let mut stack: Vec<Element> = vec![Element::default()];
+    let open = |e: &quick_xml::events::BytesStart| -> Result<Element> {
+        let mut el =
+            Element { name: String::from_utf8_lossy(e.local_name().as_ref()).into_owned(), ..Element::default() };
+        for a in e.attributes() {
+            let a = a.map_err(|x| err(format!("malformed XML attribute: {x}")))?;
+            let v = a.unescape_value().map_err(|x| err(format!("malformed XML attribute value: {x}")))?;
+            el.attributes.push((String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned(), v.into_owned()));
+        }
+        Ok(el)
+    };
+    loop {
+        let pos = reader.buffer_position();
+        match reader.read_event() {
+            Ok(Event::Start(e)) => {
+                if stack.len() > 64 {
+                    return Err(err("XML nested deeper than 64 elements".into()));
+                }
+                stack.push(open(&e)?)
+            }
+            Ok(Event::Empty(e)) => {
+                let el = open(&e)?;
+                if let Some(p) = stack.last_mut() {
+                    p.children.push(el);
+                }
+            }
+            Ok(Event::End(_)) => {
+                let el = stack.pop().ok_or_else(|| err("unbalanced XML".into()))?;
+                match stack.last_mut() {
+                    Some(p) => p.children.push(el),
+                    None => return Err(err("unbalanced XML".into())),
+                }
+            }
+            Ok(Event::Eof) => break,
+            Ok(_) => {}
+            Err(e) => return Err(err(format!("malformed XML at byte {pos}: {e}"))),
+        }
+    }
+    if stack.len() != 1 {
+        return Err(err("XML ends inside an element".into()));
+    }
+    let mut root = stack.pop().unwrap_or_default();
+    root.children.pop().ok_or_else(|| err("empty XML document".into()))
+}
+
+/// An SSP system, imported: the flattened [`System`], its default experiment and the
+/// private folder holding the unpacked archive.
+pub struct SspSystem {
+    /// The flattened system.
+    pub system: System,
+    /// `DefaultExperiment` start and stop time, if given.
+    pub default_start_stop: (Option<f64>, Option<f64>),
+    _dir: Option<tempfile::TempDir>,
+}
+
+/// One endpoint in the SSD before flattening: an FMU variable or a system connector.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Node {
+    Variable { instance: String, variable: String },
+    SystemConnector { system: String, connector: String },
+}
+
+struct Flattener<'a> {
+    root: &'a Path,
+    path: &'a Path,
+    options: &'a ImportOptions,
+    fmus: HashMap<PathBuf, Arc<Fmu>>,
+    builder: SystemBuilder,
+    /// edges (from, to, factor, offset, suppress_unit_conversion)
+    edges: Vec<(Node, Node, f64, f64, bool)>,
+    parameters: Vec<(String, String, String)>, // (instance.variable, type, value text)
+}
+
+const FMU_TYPE: &str = "application/x-fmu-sharedlibrary";
+
+impl Flattener<'_> {
+    fn err(&self, reason: String) -> Error {
+        Error::Ssp { path: self.path.to_path_buf(), reason }
+    }
+
+    fn resource(&self, source: &str) -> Result<PathBuf> {
+        let rel = source.strip_prefix("file:").map(|s| s.trim_start_matches("//")).unwrap_or(source);
+        if source.contains("://") && !source.starts_with("file:") {
+            return Err(self.err(format!("source {source:?}: only files inside the package are supported")));
+        }
+        let rel = crate::unpack::safe_relative_path(rel)
+            .map_err(|why| self.err(format!("source {source:?} refused: {why}")))?;
+        Ok(self.root.join(rel))
+    }
+
+    fn system(&mut self, el: &Element, prefix: &str) -> Result<()> {
+        let here = |name: &str| if prefix.is_empty() { name.to_string() } else { format!("{prefix}.{name}") };
+        for unsupported in ["SignalDictionaries"] {
+            if el.child(unsupported).is_some() {
+                return Err(self.err(format!("system {prefix:?}: {unsupported} are not supported")));
+            }
+        }
+        let mut element_names: Vec<&str> = Vec::new();
+        if let Some(elements) = el.child("Elements") {
+            for e in &elements.children {
+                let name = e.attr("name").ok_or_else(|| self.err(format!("an element {} without name", e.name)))?;
+                if name.contains('.') || name.is_empty() || element_names.contains(&name) {
+                    return Err(self.err(format!("element name {name:?}: empty, containing '.' or repeated")));
+                }
+                element_names.push(name);
+                match e.name.as_str() {
+                    "Component" => self.component(e, &here(name))?,
+                    "System" => self.system(e, &here(name))?,
+                    other => return Err(self.err(format!("element {name:?}: {other} is not supported"))),
+                }
+            }
+        }
+        if let Some(bindings) = el.child("ParameterBindings") {
+            self.bindings(bindings, prefix, true)?;
+        }
+        if let Some(connections) = el.child("Connections") {
+            for c in connections.all("Connection") {
+                let node = |element: Option<&str>, connector: &str| match element {
+                    Some(e) => {
+                        // a component's variable, or a connector of a nested system
+                        Node::Variable { instance: here(e), variable: connector.to_string() }
+                    }
+                    None => Node::SystemConnector { system: prefix.to_string(), connector: connector.to_string() },
+                };
+                for end in [c.attr("startElement"), c.attr("endElement")].into_iter().flatten() {
+                    if !element_names.contains(&end) {
+                        return Err(
+                            self.err(format!("connection names an unknown element {end:?} of system {prefix:?}"))
+                        );
+                    }
+                }
+                let start =
+                    c.attr("startConnector").ok_or_else(|| self.err("Connection without startConnector".into()))?;
+                let end = c.attr("endConnector").ok_or_else(|| self.err("Connection without endConnector".into()))?;
+                let (mut factor, mut offset) = (1.0, 0.0);
+                for t in &c.children {
+                    match t.name.as_str() {
+                        "LinearTransformation" => {
+                            let num = |a: &str, d: f64| -> Result<f64> {
+                                t.attr(a).map_or(Ok(d), |v| {
+                                    model_description::parse_xs_double(v).filter(|x| x.is_finite()).ok_or_else(|| {
+                                        self.err(format!("LinearTransformation {a}={v:?} is not a finite number"))
+                                    })
+                                })
+                            };
+                            factor = num("factor", 1.0)?;
+                            offset = num("offset", 0.0)?;
+                        }
+                        "ConnectionGeometry" | "Annotations" => {}
+                        other => {
+                            return Err(self.err(format!(
+                                "connection {}.{start} -> {}.{end}: {other} is not supported",
+                                c.attr("startElement").unwrap_or(""),
+                                c.attr("endElement").unwrap_or("")
+                            )))
+                        }
+                    }
+                }
+                let suppress = c.attr("suppressUnitConversion") == Some("true");
+                self.edges.push((
+                    node(c.attr("startElement"), start),
+                    node(c.attr("endElement"), end),
+                    factor,
+                    offset,
+                    suppress,
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn component(&mut self, el: &Element, name: &str) -> Result<()> {
+        let ty = el.attr("type").unwrap_or(FMU_TYPE);
+        if ty != FMU_TYPE {
+            return Err(self.err(format!("component {name:?}: type {ty:?} is not supported (only {FMU_TYPE})")));
+        }
+        let source = el.attr("source").ok_or_else(|| self.err(format!("component {name:?} has no source")))?;
+        let file = self.resource(source)?;
+        let fmu = match self.fmus.get(&file) {
+            Some(f) => f.clone(),
+            None => {
+                let mut options = self.options.clone();
+                match el.attr("implementation") {
+                    Some("ModelExchange") => options.interface = Some(crate::Interface::ModelExchange),
+                    Some("CoSimulation") => options.interface = Some(crate::Interface::CoSimulation),
+                    _ => {}
+                }
+                let f = Fmu::load_with(&file, &options)?;
+                self.fmus.insert(file.clone(), f.clone());
+                f
+            }
+        };
+        self.builder.add_instance(name, fmu.clone())?;
+        if let Some(connectors) = el.child("Connectors") {
+            for c in connectors.all("Connector") {
+                let cname = c.attr("name").unwrap_or("");
+                let v = fmu.description().variable(cname).ok_or_else(|| {
+                    self.err(format!(
+                        "component {name:?}: connector {cname:?} is not a variable of {}",
+                        fmu.source().display()
+                    ))
+                })?;
+                if let Some(t) = c.children.iter().find(|t| {
+                    ["Real", "Integer", "Boolean", "String", "Enumeration", "Binary"].contains(&t.name.as_str())
+                }) {
+                    let declared = match t.name.as_str() {
+                        "Enumeration" => "Integer",
+                        n => n,
+                    };
+                    if declared != BaseType::of(v).as_str() {
+                        return Err(self.err(format!(
+                            "component {name:?}: connector {cname:?} is declared {declared} but the variable is {}",
+                            BaseType::of(v).as_str()
+                        )));
+                    }
+                }
+            }
+        }
+        if let Some(bindings) = el.child("ParameterBindings") {
+            self.bindings(bindings, name, false)?;
+        }
+        Ok(())
+    }
+
+    fn bindings(&mut self, el: &Element, owner: &str, is_system: bool) -> Result<()> {
+        for b in el.all("ParameterBinding") {
+            if b.child("ParameterMapping").is_some() {
+                return Err(self.err(format!("{owner:?}: ParameterMapping is not supported")));
+            }
+            if let Some(t) = b.attr("type") {
+                if t != "application/x-ssp-parameter-set" {
+                    return Err(self.err(format!("{owner:?}: parameter binding type {t:?} is not supported")));
+                }
+            }
+            let set = match (b.attr("source"), b.child("ParameterValues")) {
+                (Some(src), _) => {
+                    let file = self.resource(src)?;
+                    let text = std::fs::read_to_string(&file)
+                        .map_err(|e| self.err(format!("{owner:?}: parameter file {src:?}: {e}")))?;
+                    parse_xml(&text, &file)?
+                }
+                (None, Some(values)) => values
+                    .child("ParameterSet")
+                    .cloned()
+                    .ok_or_else(|| self.err(format!("{owner:?}: ParameterValues without ParameterSet")))?,
+                (None, None) => return Err(self.err(format!("{owner:?}: ParameterBinding without source or values"))),
+            };
+            let prefix = b.attr("prefix").unwrap_or("");
+            let Some(params) = set.child("Parameters") else { continue };
+            for p in params.all("Parameter") {
+                let pname = p.attr("name").unwrap_or("");
+                let Some(rest) = pname.strip_prefix(prefix) else { continue };
+                // a component's binding names its variables; a system's names
+                // `element.variable` relative to the system: both are prefixed with the owner
+                let _ = is_system;
+                let target = if owner.is_empty() { rest.to_string() } else { format!("{owner}.{rest}") };
+                let v = p
+                    .children
+                    .iter()
+                    .find(|c| c.name != "Annotations")
+                    .ok_or_else(|| self.err(format!("parameter {pname:?} has no value")))?;
+                let value = v.attr("value").ok_or_else(|| self.err(format!("parameter {pname:?} has no value")))?;
+                if v.attr("unit").is_some() {
+                    // values in another unit than the variable's would need the ssv's unit
+                    // definitions; refused rather than guessed
+                    let unit = v.attr("unit").unwrap_or("");
+                    self.parameters.push((target.clone(), format!("unit:{unit}"), value.to_string()));
+                    continue;
+                }
+                self.parameters.push((target, v.name.clone(), value.to_string()));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Reads an `.ssp` archive or a bare `.ssd` file (FMU sources relative to its folder).
+pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
+    let is_ssd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssd"));
+    let (dir, root, ssd_path) = if is_ssd {
+        let root = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        (None, root, path.to_path_buf())
+    } else {
+        let dir = crate::unpack::unpack(path, &options.limits)?;
+        let root = dir.path().to_path_buf();
+        let ssd = root.join("SystemStructure.ssd");
+        (Some(dir), root, ssd)
+    };
+    let text = std::fs::read_to_string(&ssd_path).map_err(|e| Error::Ssp {
+        path: path.to_path_buf(),
+        reason: format!("cannot read SystemStructure.ssd: {e}"),
+    })?;
+    let doc = parse_xml(&text, path)?;
+    if doc.name != "SystemStructureDescription" {
+        return Err(Error::Ssp {
+            path: path.to_path_buf(),
+            reason: format!("root element is {}, not SystemStructureDescription", doc.name),
+        });
+    }
+    let mut f = Flattener {
+        root: &root,
+        path,
+        options,
+        fmus: HashMap::new(),
+        builder: SystemBuilder::new(),
+        edges: Vec::new(),
+        parameters: Vec::new(),
+    };
+    let system_el = doc.child("System").ok_or_else(|| f.err("no System".into()))?;
+    f.system(system_el, "")?;
+    // follow connections through system connectors: every edge ending at an FMU input
+    // is traced back to an FMU output, composing the linear transformations
+    let instances: Vec<String> = f.builder.system().instances.iter().map(|i| i.name.clone()).collect();
+    let is_instance = |n: &Node| matches!(n, Node::Variable { instance, .. } if instances.contains(instance));
+    // a Variable node naming a nested system is that system's connector
+    let normalize = |n: &Node| match n {
+        Node::Variable { instance, variable } if !instances.contains(instance) => {
+            Node::SystemConnector { system: instance.clone(), connector: variable.clone() }
+        }
+        other => other.clone(),
+    };
+    let edges: Vec<(Node, Node, f64, f64, bool)> =
+        f.edges.iter().map(|(a, b, k, o, s)| (normalize(a), normalize(b), *k, *o, *s)).collect();
+    for (a, b, k, o, s) in &edges {
+        if !is_instance(b) {
+            continue;
+        }
+        let (mut src, mut factor, mut offset, mut suppress) = (a.clone(), *k, *o, *s);
+        let mut hops = 0;
+        while !is_instance(&src) {
+            let Some((a2, _, k2, o2, s2)) = edges.iter().find(|(_, b2, ..)| *b2 == src) else { break };
+            // to = k (k2 x + o2) + o
+            offset += factor * o2;
+            factor *= k2;
+            suppress |= s2;
+            src = a2.clone();
+            hops += 1;
+            if hops > edges.len() {
+                return Err(f.err("connections through system connectors form a cycle".into()));
+            }
+        }
+        let (Node::Variable { instance: ai, variable: av }, Node::Variable { instance: bi, variable: bv }) = (&src, b)
+        else {
+            continue; // fed by an unconnected system input: left at its start value
+        };
+        let from = format!("{ai}.{av}");
+        let to = format!("{bi}.{bv}");
+        let linear = if factor == 1.0 && offset == 0.0 { None } else { Some((factor, offset)) };
+        if suppress {
+            f.builder.connect_unconverted(&from, &to, linear)?;
+        } else {
+            f.builder.connect_linear(&from, &to, linear)?;
+        }
+    }
+    let parameters = std::mem::take(&mut f.parameters);
+    for (target, kind, value) in parameters {
+        if let Some(unit) = kind.strip_prefix("unit:") {
+            let r = f.builder.system().resolve(&target)?;
+            let declared = f.builder.system().variable(&r).variable_type.unit().unwrap_or("").to_string();
+            if unit != declared {
+                return Err(f.err(format!(
+                    "parameter {target}: value in unit {unit:?}, the variable is in {declared:?} (conversion of parameter values is not supported)"
+                )));
+            }
+        }
+        f.builder.set_text(&target, &value)?;
+    }
+    let default_start_stop = doc
+        .child("DefaultExperiment")
+        .map(|d| {
+            (
+                d.attr("startTime").and_then(model_description::parse_xs_double),
+                d.attr("stopTime").and_then(model_description::parse_xs_double),
+            )
+        })
+        .unwrap_or((None, None));
+    Ok(SspSystem { system: f.builder.build(), default_start_stop, _dir: dir })
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn num(v: f64) -> String {
+    let mut s = String::new();
+    crate::simulate::push_number(&mut s, v);
+    s
+}
+
+/// Writes `system` as an SSP 1.0 archive: `SystemStructure.ssd` plus each FMU archive
+/// under `resources/` (one copy per distinct FMU), start values as inline parameter
+/// bindings, connections with their linear transformations.
+pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
+    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    // FMU files, one per distinct source
+    let mut files: Vec<(PathBuf, String)> = Vec::new();
+    for spec in &system.instances {
+        let src = spec.fmu.source().to_path_buf();
+        if !files.iter().any(|(p, _)| *p == src) {
+            let stem = src.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "fmu".into());
+            let mut file = format!("resources/{stem}.fmu");
+            let mut k = 1;
+            while files.iter().any(|(_, f)| *f == file) {
+                file = format!("resources/{stem}_{k}.fmu");
+                k += 1;
+            }
+            files.push((src, file));
+        }
+    }
+    let mut x = String::new();
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    x.push_str("<ssd:SystemStructureDescription xmlns:ssc=\"http://ssp-standard.org/SSP1/SystemStructureCommon\" xmlns:ssd=\"http://ssp-standard.org/SSP1/SystemStructureDescription\" xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"1.0\"");
+    x.push_str(&format!(" name=\"{}\" generationTool=\"nigel-cosim\">\n", esc(name)));
+    x.push_str(&format!("  <ssd:System name=\"{}\">\n    <ssd:Elements>\n", esc(name)));
+    for (i, spec) in system.instances.iter().enumerate() {
+        let md = spec.fmu.description();
+        let file = &files.iter().find(|(p, _)| p == spec.fmu.source()).map(|(_, f)| f.clone()).unwrap_or_default();
+        x.push_str(&format!(
+            "      <ssd:Component name=\"{}\" type=\"application/x-fmu-sharedlibrary\" source=\"{}\">\n",
+            esc(&spec.name),
+            esc(file)
+        ));
+        // connectors: every output, and the inputs that are connected (an unconnected
+        // input connector would be driven with 0 by fmpy's simulate_ssp, not left at its start)
+        let vars: Vec<_> = md
+            .model_variables
+            .iter()
+            .enumerate()
+            .filter(|(index, v)| match v.causality {
+                model_description::Causality::Output => true,
+                model_description::Causality::Input => {
+                    system.connections.iter().any(|c| c.to.instance == i && c.to.index == *index)
+                }
+                _ => false,
+            })
+            .map(|(_, v)| v)
+            .collect();
+        if !vars.is_empty() {
+            x.push_str("        <ssd:Connectors>\n");
+            for v in vars {
+                x.push_str(&format!(
+                    "          <ssd:Connector name=\"{}\" kind=\"{}\"><ssc:{}/></ssd:Connector>\n",
+                    esc(&v.name),
+                    v.causality.as_str(),
+                    BaseType::of(v).as_str()
+                ));
+            }
+            x.push_str("        </ssd:Connectors>\n");
+        }
+        if !spec.start_values.is_empty() {
+            x.push_str("        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n            <ssd:ParameterValues>\n");
+            x.push_str(&format!(
+                "              <ssv:ParameterSet version=\"1.0\" name=\"{}\">\n                <ssv:Parameters>\n",
+                esc(&spec.name)
+            ));
+            for (index, value) in &spec.start_values {
+                let vname = &md.model_variables[*index].name;
+                let v = match value {
+                    Value::Real(r) => format!("<ssv:Real value=\"{}\"/>", num(*r)),
+                    Value::Integer(k) => format!("<ssv:Integer value=\"{k}\"/>"),
+                    Value::Boolean(b) => format!("<ssv:Boolean value=\"{b}\"/>"),
+                    Value::String(s) => format!("<ssv:String value=\"{}\"/>", esc(s)),
+                };
+                x.push_str(&format!("                  <ssv:Parameter name=\"{}\">{v}</ssv:Parameter>\n", esc(vname)));
+            }
+            x.push_str("                </ssv:Parameters>\n              </ssv:ParameterSet>\n            </ssd:ParameterValues>\n          </ssd:ParameterBinding>\n        </ssd:ParameterBindings>\n");
+        }
+        x.push_str("      </ssd:Component>\n");
+    }
+    x.push_str("    </ssd:Elements>\n");
+    if !system.connections.is_empty() {
+        x.push_str("    <ssd:Connections>\n");
+        for c in &system.connections {
+            let (fi, ti) = (&system.instances[c.from.instance].name, &system.instances[c.to.instance].name);
+            let (fv, tv) = (&system.variable(&c.from).name, &system.variable(&c.to).name);
+            x.push_str(&format!(
+                "      <ssd:Connection startElement=\"{}\" startConnector=\"{}\" endElement=\"{}\" endConnector=\"{}\"",
+                esc(fi),
+                esc(fv),
+                esc(ti),
+                esc(tv)
+            ));
+            match c.linear_transformation {
+                Some((f, o)) => x.push_str(&format!(
+                    "><ssc:LinearTransformation factor=\"{}\" offset=\"{}\"/></ssd:Connection>\n",
+                    num(f),
+                    num(o)
+                )),
+                None => x.push_str("/>\n"),
+            }
+        }
+        x.push_str("    </ssd:Connections>\n");
+    }
+    x.push_str("  </ssd:System>\n");
+    if let Some(stop) = stop_time {
+        x.push_str(&format!("  <ssd:DefaultExperiment startTime=\"0\" stopTime=\"{}\"/>\n", num(stop)));
+    }
+    x.push_str("</ssd:SystemStructureDescription>\n");
+
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut zip = zip::ZipWriter::new(file);
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .last_modified_time(zip::DateTime::default());
+    let zerr = |e: zip::result::ZipError| Error::Archive { path: path.to_path_buf(), reason: e.to_string() };
+    zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
+    zip.write_all(x.as_bytes()).map_err(io)?;
+    for (src, file) in &files {
+        let bytes = std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?;
+        zip.start_file(file.as_str(), options).map_err(zerr)?;
+        zip.write_all(&bytes).map_err(io)?;
+    }
+    zip.finish().map_err(zerr)?;
+    Ok(())
+}
