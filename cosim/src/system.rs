@@ -25,7 +25,7 @@ impl BaseType {
     pub fn of(v: &ScalarVariable) -> BaseType {
         match v.variable_type {
             VariableType::Real { .. } => BaseType::Real,
-            VariableType::Integer { .. } => BaseType::Integer,
+            VariableType::Integer { .. } | VariableType::Enumeration { .. } => BaseType::Integer,
             VariableType::Boolean { .. } => BaseType::Boolean,
             VariableType::String { .. } => BaseType::String,
         }

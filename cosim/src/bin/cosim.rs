@@ -235,7 +235,8 @@ fn info(path: &Path) -> Result<(), Error> {
     for v in &md.model_variables {
         let start = match &v.variable_type {
             model_description::VariableType::Real { start, .. } => start.map(|x| x.to_string()),
-            model_description::VariableType::Integer { start, .. } => start.map(|x| x.to_string()),
+            model_description::VariableType::Integer { start, .. }
+            | model_description::VariableType::Enumeration { start, .. } => start.map(|x| x.to_string()),
             model_description::VariableType::Boolean { start } => start.map(|x| x.to_string()),
             model_description::VariableType::String { start } => start.clone(),
         };
