@@ -241,8 +241,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
             ],
         )],
         units: vec![
-            si_unit("rad", 0, 0, 0, 0),
-            si_unit("rad/s", 0, 0, -1, 0),
+            si_unit("rad", 0, 0, 0, 1),
+            si_unit("rad/s", 0, 0, -1, 1),
             si_unit("m/s", 0, 1, -1, 0),
             si_unit("m", 0, 1, 0, 0),
             si_unit("s", 0, 0, 1, 0),
