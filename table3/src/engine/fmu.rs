@@ -25,6 +25,7 @@ pub struct FmuEngine {
     maneuver_values: [i32; 6],
     fidelity_values: [i32; 2],
     controller_values: [i32; 3],
+    gains: [[[f64; 2]; 4]; 3],
     /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
     /// connection by one step).
     pub algorithm: Algorithm,
@@ -110,6 +111,29 @@ fn enumeration_values<const N: usize>(
     Ok(out)
 }
 
+/// The calculated parameters `gain_*` of the controller FMU with `controller = value`,
+/// read after initialization by the master (a run of zero steps).
+fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 2]; 4], Error> {
+    let ctx = |source| Error::Cosim { context: format!("reading the gains of {}", FMU_FILES[1]), source };
+    let mut b = SystemBuilder::new();
+    b.add_instance("controller", fmu.clone()).map_err(ctx)?;
+    b.set("controller.controller", Value::Integer(value)).map_err(ctx)?;
+    let names: Vec<String> =
+        WHEELS.iter().flat_map(|w| ["beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}"))).collect();
+    let experiment = Experiment { record: Some(names.clone()), ..Experiment::new(0.0, SAMPLE_PERIOD) };
+    let (results, _) = simulate(&b.build(), &experiment).map_err(ctx)?;
+    let mut k = [[0.0; 2]; 4];
+    for (i, name) in names.iter().enumerate() {
+        let bare = name.trim_start_matches("controller.");
+        let v = results
+            .column(bare)
+            .and_then(|c| c.first().copied())
+            .ok_or_else(|| Error::BadRun { run: FMU_FILES[1].into(), reason: format!("no value of {name}") })?;
+        k[i / 2][i % 2] = v;
+    }
+    Ok(k)
+}
+
 fn index<T: PartialEq>(all: &[T], x: &T) -> usize {
     all.iter().position(|a| a == x).unwrap_or(0)
 }
@@ -132,6 +156,10 @@ impl FmuEngine {
         let fidelity_values = enumeration_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
         let controller_values =
             enumeration_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
+        let mut gains = [[[0.0; 2]; 4]; 3];
+        for (g, value) in gains.iter_mut().zip(controller_values) {
+            *g = controller_gain(&c, value)?;
+        }
         Ok(FmuEngine {
             plant: p,
             controller: c,
@@ -139,8 +167,15 @@ impl FmuEngine {
             maneuver_values,
             fidelity_values,
             controller_values,
+            gains,
             algorithm: Algorithm::Ordered,
         })
+    }
+
+    /// The gain the controller FMU uses for each controller of Table III (its calculated
+    /// parameters `gain_beta_fl .. gain_yaw_rate_rr` after initialization).
+    pub fn gains(&self) -> [[[f64; 2]; 4]; 3] {
+        self.gains
     }
 
     /// The same engine with another communication algorithm.
@@ -218,9 +253,6 @@ impl FmuEngine {
         for stem in ["controller.delta", "maneuver.mu"] {
             v.extend(WHEELS.iter().map(|w| format!("{stem}_{w}")));
         }
-        for w in WHEELS {
-            v.extend(["beta", "yaw_rate"].iter().map(|c| format!("controller.gain_{c}_{w}")));
-        }
         v
     }
 }
@@ -255,12 +287,7 @@ impl Engine for FmuEngine {
             let c: Vec<Vec<f64>> = WHEELS.iter().map(|w| col(&format!("{stem}_{w}"))).collect::<Result<_, _>>()?;
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
-        let mut gain = [[0.0; 2]; 4];
-        for (i, w) in WHEELS.iter().enumerate() {
-            for (j, c) in ["beta", "yaw_rate"].iter().enumerate() {
-                gain[i][j] = col(&format!("controller.gain_{c}_{w}"))?.first().copied().unwrap_or(f64::NAN);
-            }
-        }
+        let gain = self.gains[index(&Controller::TABLE, &job.controller)];
         let run = Run {
             job: *job,
             gain,
