@@ -54,6 +54,17 @@ fn plot_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Plot { path: path.to_path_buf(), reason: e.to_string() }
 }
 
+/// Tick label: at most three decimals, no trailing zeros, never `-0`.
+fn tick(v: &f64) -> String {
+    let s = format!("{v:.3}");
+    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if !lo.is_finite() || !hi.is_finite() {
@@ -108,6 +119,8 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 15))
         .light_line_style(WHITE.mix(0.0))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .draw()
         .map_err(&err)?;
     for r in runs {
@@ -125,11 +138,16 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
     Ok(())
 }
 
-/// Fig. 7 for one column: the XY paths of every maneuver in `runs` (2 x 3 panels).
+/// Fig. 7 for one column: the XY paths of every maneuver in `runs` (2 x 3 panels for six).
 pub fn xy_figure(runs: &[Run], fidelity: Fidelity, path: &Path) -> Result<(), Error> {
     register_font().map_err(plot_err(path))?;
     let err = plot_err(path);
-    let root = BitMapBackend::new(path, (1800, 1200)).into_drawing_area();
+    let maneuvers: Vec<Maneuver> = Maneuver::ALL
+        .into_iter()
+        .filter(|m| runs.iter().any(|r| r.job.fidelity == fidelity && r.job.maneuver == *m))
+        .collect();
+    let (rows, cols) = if maneuvers.len() <= 3 { (1, maneuvers.len().max(1)) } else { (2, 3) };
+    let root = BitMapBackend::new(path, (1800, 90 + 555 * rows as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(&err)?;
     let title = format!(
         "Fig. 7 ({} column, seed {}): paths of the reference and the three controllers",
@@ -140,8 +158,8 @@ pub fn xy_figure(runs: &[Run], fidelity: Fidelity, path: &Path) -> Result<(), Er
     let (top, body) = root.split_vertically(36);
     let column: Vec<&Run> = runs.iter().filter(|r| r.job.fidelity == fidelity).collect();
     legend_strip(&top, &controller_legend(&column), path)?;
-    let panels = body.split_evenly((2, 3));
-    for (panel, m) in panels.iter().zip(Maneuver::ALL) {
+    let panels = body.split_evenly((rows, cols));
+    for (panel, &m) in panels.iter().zip(&maneuvers) {
         let rs = runs_of(runs, fidelity, m);
         xy_panel(panel, m, &rs, path)?;
     }
@@ -219,6 +237,8 @@ fn time_panel(
         .label_style(("sans-serif", 13))
         .axis_desc_style(("sans-serif", 14))
         .light_line_style(WHITE.mix(0.0))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .draw()
         .map_err(&err)?;
     for s in series {
