@@ -47,6 +47,18 @@ pub fn controller_name(c: Controller) -> &'static str {
     c.name()
 }
 
+/// A job from `column/maneuver/controller` (`sim/lane_change/robust`), seed and disturbances
+/// as given.
+pub fn parse_job(text: &str, seed: u64) -> Result<Job, Error> {
+    let bad = || Error::Usage(format!("{text:?} is not column/maneuver/controller (e.g. sim/lane_change/robust)"));
+    let parts: Vec<&str> = text.split('/').collect();
+    let [column, maneuver, controller] = parts[..] else { return Err(bad()) };
+    let fidelity = Fidelity::ALL.into_iter().find(|f| f.column() == column).ok_or_else(bad)?;
+    let maneuver = parse_maneuver(maneuver)?;
+    let controller = Controller::TABLE.into_iter().find(|c| c.name() == controller).ok_or_else(bad)?;
+    Ok(Job::new(seed, fidelity, maneuver, controller))
+}
+
 /// The inverse of [`Maneuver::name`], as a clear error.
 pub fn parse_maneuver(name: &str) -> Result<Maneuver, Error> {
     Maneuver::from_name(name).ok_or_else(|| Error::UnknownManeuver(name.to_string()))

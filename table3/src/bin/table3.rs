@@ -61,6 +61,12 @@ struct Args {
     /// Time the whole table this many times and print the median wall time.
     #[arg(long, value_name = "REPEATS", num_args = 0..=1, default_missing_value = "5")]
     bench: Option<usize>,
+    /// Only write the closed loop of one job (--ssp-job) as an SSP archive to PATH and exit.
+    #[arg(long, value_name = "PATH")]
+    ssp: Option<PathBuf>,
+    /// The job --ssp writes: column/maneuver/controller.
+    #[arg(long, value_name = "JOB", default_value = "sim/lane_change/robust")]
+    ssp_job: String,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -101,6 +107,13 @@ fn engine(args: &Args) -> Result<Box<dyn Engine>, Error> {
 }
 
 fn run(args: &Args) -> Result<(), Error> {
+    if let Some(path) = &args.ssp {
+        let job = nigel_table3::parse_job(&args.ssp_job, args.seed)?;
+        let dir = args.fmu_dir.clone().unwrap_or_else(default_fmu_dir);
+        FmuEngine::load_dir(&dir)?.write_ssp(&job, path)?;
+        eprintln!("wrote {} ({})", path.display(), job.label());
+        return Ok(());
+    }
     let engine = engine(args)?;
     let mut options = Options::new(args.seed);
     options.threads = args.threads;

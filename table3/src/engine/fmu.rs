@@ -237,6 +237,18 @@ impl FmuEngine {
         Ok(b.build())
     }
 
+    /// Writes the closed loop of `job` as an SSP 1.0 archive (`SystemStructure.ssd` and the
+    /// three FMUs; parameters as inline bindings), to run in other tools (fmpy's
+    /// `simulate_ssp`, ecos, libcosim). Its default experiment is 0 .. 30 s.
+    pub fn write_ssp(&self, job: &Job, path: &Path) -> Result<(), Error> {
+        let system = self.system(job)?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(crate::error::io(dir))?;
+        }
+        nigel_cosim::write_ssp(&system, "nigel_closed_loop", Some(N_SAMPLES as f64 * SAMPLE_PERIOD), path)
+            .map_err(|source| Error::Cosim { context: format!("writing {}", path.display()), source })
+    }
+
     /// The variables a run records.
     pub fn recorded() -> Vec<String> {
         let mut v: Vec<String> = ["plant.x", "plant.y", "plant.psi", "plant.beta", "plant.yaw_rate"]
@@ -273,14 +285,21 @@ impl Engine for FmuEngine {
     }
 
     fn run(&self, job: &Job) -> Result<Run, Error> {
-        let system = self.system(job)?;
+        self.run_system(&self.system(job)?, job)
+    }
+}
+
+impl FmuEngine {
+    /// Runs `system` (instances `plant`, `controller`, `maneuver` wired for `job`, e.g. an
+    /// SSP read back with `nigel_cosim::read_ssp`) over the benchmark horizon and records it.
+    pub fn run_system(&self, system: &System, job: &Job) -> Result<Run, Error> {
         let experiment = Experiment {
             algorithm: self.algorithm,
             record: Some(FmuEngine::recorded()),
             ..Experiment::new(N_SAMPLES as f64 * SAMPLE_PERIOD, SAMPLE_PERIOD)
         };
         let (results, _summary) =
-            simulate(&system, &experiment).map_err(|source| Error::Cosim { context: job.label(), source })?;
+            simulate(system, &experiment).map_err(|source| Error::Cosim { context: job.label(), source })?;
         let col = |name: &str| column(&results, name, job);
         let n = results.rows().saturating_sub(1);
         let wheels = |stem: &str| -> Result<Vec<[f64; 4]>, Error> {
