@@ -20,8 +20,18 @@ python="${PYTHON:-python3}"
 # msgpack, nbformat, numpy) are pinned with their dependencies; lxml is what fmpy's
 # validate_fmu and its SSP reader (XML schema validation) use, cmake is only for fmpy's
 # source-code FMU builds (a wheel from PyPI, nothing is downloaded at run time).
+# ecospy (ecos, needs Debian's libtbb12) and libcosimpy (libcosim) are the co-simulation
+# masters the master's cross-checks (cosim/tests/python) compare with; no dependencies.
+# fmu-manipulation-toolbox (fmucontainer: a container FMU with its own C runtime around our
+# FMUs) needs colorama, elementpath and xmlschema.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
+ecospy==0.7.2
+libcosimpy==0.0.6
+fmu-manipulation-toolbox==2.0
+colorama==0.4.6
+elementpath==5.1.4
+xmlschema==4.3.2
 numpy==2.4.6
 pytest==9.2.0
 lxml==6.1.3
@@ -73,6 +83,6 @@ trap 'rm -f "$req_file"' EXIT
 printf '%s\n' "$requirements" >"$req_file"
 PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-input --quiet -r "$req_file" >&2
 # a smoke check of the pieces the tests use, before the marker says "done"
-"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest' >&2
+"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest, ecospy, libcosimpy' >&2
 printf '%s\n' "$hash" >"$marker"
 echo "$venv"

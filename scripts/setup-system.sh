@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the workspace links against (clarabel's SDP cones need
-# BLAS/LAPACK): libopenblas-dev and libgfortran-12-dev. Does nothing when present.
+# BLAS/LAPACK): libopenblas-dev and libgfortran-12-dev; and libtbb12, which ecos (the
+# co-simulation master the cross-checks compare with) needs at run time. Does nothing when present.
 set -euo pipefail
 needed=()
-for pkg in libopenblas-dev libgfortran-12-dev; do
+for pkg in libopenblas-dev libgfortran-12-dev libtbb12; do
     dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || needed+=("$pkg")
 done
 if [ ${#needed[@]} -eq 0 ]; then

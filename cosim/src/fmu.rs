@@ -764,6 +764,77 @@ impl Instance {
         call!(self, "fmi2FreeFMUstate", None, f(c, &mut s))
     }
 
+    /// `fmi2SetTime` (Model Exchange).
+    #[inline]
+    pub fn set_time(&mut self, time: f64) -> Result<()> {
+        let f = self.optional(self.fmu.functions.set_time, "fmi2SetTime")?;
+        let c = self.component;
+        call!(self, "fmi2SetTime", Some(time), f(c, time))
+    }
+
+    /// `fmi2SetContinuousStates`.
+    #[inline]
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<()> {
+        let f = self.optional(self.fmu.functions.set_continuous_states, "fmi2SetContinuousStates")?;
+        let c = self.component;
+        call!(self, "fmi2SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
+    }
+
+    /// `fmi2GetContinuousStates`.
+    pub fn get_continuous_states(&mut self, x: &mut [f64]) -> Result<()> {
+        let f = self.optional(self.fmu.functions.get_continuous_states, "fmi2GetContinuousStates")?;
+        let c = self.component;
+        call!(self, "fmi2GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
+    }
+
+    /// `fmi2GetDerivatives`.
+    #[inline]
+    pub fn get_derivatives(&mut self, dx: &mut [f64]) -> Result<()> {
+        let f = self.optional(self.fmu.functions.get_derivatives, "fmi2GetDerivatives")?;
+        let c = self.component;
+        call!(self, "fmi2GetDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
+    }
+
+    /// `fmi2GetEventIndicators`.
+    #[inline]
+    pub fn get_event_indicators(&mut self, z: &mut [f64]) -> Result<()> {
+        let f = self.optional(self.fmu.functions.get_event_indicators, "fmi2GetEventIndicators")?;
+        let c = self.component;
+        call!(self, "fmi2GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
+    }
+
+    /// `fmi2EnterEventMode`.
+    pub fn enter_event_mode(&mut self) -> Result<()> {
+        let f = self.optional(self.fmu.functions.enter_event_mode, "fmi2EnterEventMode")?;
+        let c = self.component;
+        call!(self, "fmi2EnterEventMode", None, f(c))
+    }
+
+    /// `fmi2NewDiscreteStates`.
+    pub fn new_discrete_states(&mut self) -> Result<EventInfo> {
+        let f = self.optional(self.fmu.functions.new_discrete_states, "fmi2NewDiscreteStates")?;
+        let c = self.component;
+        let mut info = EventInfo::default();
+        call!(self, "fmi2NewDiscreteStates", None, f(c, &mut info))?;
+        Ok(info)
+    }
+
+    /// `fmi2EnterContinuousTimeMode`.
+    pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
+        let f = self.optional(self.fmu.functions.enter_continuous_time_mode, "fmi2EnterContinuousTimeMode")?;
+        let c = self.component;
+        call!(self, "fmi2EnterContinuousTimeMode", None, f(c))
+    }
+
+    /// `fmi2CompletedIntegratorStep`: (enter event mode, terminate simulation).
+    pub fn completed_integrator_step(&mut self) -> Result<(bool, bool)> {
+        let f = self.optional(self.fmu.functions.completed_integrator_step, "fmi2CompletedIntegratorStep")?;
+        let c = self.component;
+        let (mut event, mut terminate) = (0, 0);
+        call!(self, "fmi2CompletedIntegratorStep", None, f(c, 1, &mut event, &mut terminate))?;
+        Ok((event != 0, terminate != 0))
+    }
+
     /// `fmi2GetBooleanStatus(fmi2Terminated)` after a Discard: whether the FMU wants to stop.
     pub fn terminated_status(&mut self) -> Option<bool> {
         let f = self.fmu.functions.get_boolean_status?;

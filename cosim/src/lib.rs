@@ -21,6 +21,7 @@
 
 pub mod error;
 pub mod fmu;
+pub mod me;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
@@ -28,6 +29,7 @@ pub mod unpack;
 
 pub use error::{Error, Result, Status};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
+pub use me::{Event, Solver};
 pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};
 pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};

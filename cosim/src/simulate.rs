@@ -6,6 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
+use crate::me::MeUnit;
 use crate::system::{BaseType, System, Value, VariableRef};
 use model_description::Causality;
 use std::time::{Duration, Instant};
@@ -51,6 +52,13 @@ pub struct Experiment {
     pub profile: bool,
     /// Called with the fraction done (0..=1) at each output point.
     pub progress: Option<fn(f64)>,
+    /// Integration method of Model Exchange instances.
+    pub solver: crate::me::Solver,
+    /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
+    /// handle variable steps: restore the state and retry in halves (at most 2^10
+    /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
+    /// stops the run with [`Error::Fmi`].
+    pub retry_discard: bool,
 }
 
 impl Experiment {
@@ -65,6 +73,8 @@ impl Experiment {
             record: None,
             profile: false,
             progress: None,
+            solver: crate::me::Solver::default(),
+            retry_discard: false,
         }
     }
 }
@@ -145,6 +155,12 @@ pub struct Summary {
     pub instance_time: Vec<(String, Duration)>,
     /// Warnings the FMUs logged (instance, message).
     pub warnings: Vec<(String, String)>,
+    /// Events of Model Exchange instances.
+    pub events: Vec<crate::me::Event>,
+    /// Internal integrator steps of Model Exchange instances (accepted, rejected).
+    pub integrator_steps: (u64, u64),
+    /// Steps redone in halves after an fmi2Discard.
+    pub discard_retries: u64,
 }
 
 impl Summary {
@@ -152,7 +168,10 @@ impl Summary {
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "steps": self.steps,
-            "events": 0,
+            "events": self.events.len(),
+            "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
+            "discard_retries": self.discard_retries,
+            "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
@@ -372,11 +391,9 @@ impl Plan {
         for i in 0..system.instances.len() {
             for ty in [BaseType::Real, BaseType::Integer, BaseType::Boolean] {
                 let mut get = Op::new(i, OpKind::Get, ty);
+                // only the connected outputs: recorded variables are read at output points
                 for (k, s) in sources.iter().enumerate() {
-                    if s.instance == i && s.base_type == ty && !get.vrs.contains(&s.value_reference) {
-                        get.push(s.value_reference, k, (1.0, 0.0));
-                    } else if s.instance == i && s.base_type == ty {
-                        // same value reference (an alias): read it again into its own slot
+                    if s.instance == i && s.base_type == ty && connected_outputs.contains(s) {
                         get.push(s.value_reference, k, (1.0, 0.0));
                     }
                 }
@@ -506,12 +523,6 @@ fn schedule(e: &Experiment) -> Result<(u64, u64)> {
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
     let wall = Instant::now();
     let (steps, stride) = schedule(experiment)?;
-    if let Some(spec) = system.instances.iter().find(|s| s.fmu.interface() != Interface::CoSimulation) {
-        return Err(Error::Experiment(format!(
-            "instance {} is loaded for Model Exchange; this master steps Co-Simulation FMUs only",
-            spec.name
-        )));
-    }
     let record: Vec<VariableRef> = match &experiment.record {
         None => default_record(system),
         Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
@@ -546,7 +557,9 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut values = vec![0.0; plan.sources.len()];
     let rows = steps / stride + 1;
-    let mut results = Results { names, values: Vec::with_capacity((rows as usize) * (record.len() + 1)) };
+    // reserve for the whole run, up to 64 MiB up front (a huge run grows as it goes)
+    let wanted = (rows as usize).saturating_mul(record.len() + 1).min(8 << 20);
+    let mut results = Results { names, values: Vec::with_capacity(wanted) };
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
     let mut instances: Vec<Instance> = Vec::with_capacity(system.instances.len());
@@ -569,9 +582,23 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         }
     };
     propagate_initial(&mut plan, &mut instances, &mut values)?;
+    let mut units: Vec<Option<MeUnit>> = Vec::with_capacity(instances.len());
     for inst in instances.iter_mut() {
         inst.exit_initialization_mode()?;
+        units.push(match inst.fmu().interface() {
+            Interface::ModelExchange => Some(MeUnit::initialize(inst)?),
+            Interface::CoSimulation => None,
+        });
     }
+    let solver = experiment.solver;
+    let mut saved: Vec<Option<crate::fmu::FmuState>> = Vec::with_capacity(instances.len());
+    for inst in instances.iter_mut() {
+        let capable = inst.fmu().interface() == Interface::CoSimulation
+            && inst.fmu().can_get_and_set_state()
+            && inst.fmu().can_handle_variable_step();
+        saved.push(if experiment.retry_discard && capable { Some(inst.get_state()?) } else { None });
+    }
+    let mut retries = 0u64;
     propagate_initial(&mut plan, &mut instances, &mut values)?;
     run_ops(&mut record_gets, &mut instances, &mut values, None)?;
     push_row(&mut results, t0, &values, &record_slots);
@@ -583,13 +610,15 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         let t = t0 + n as f64 * h;
         let t_next = t0 + (n + 1) as f64 * h;
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
-        for (i, inst) in instances.iter_mut().enumerate() {
-            if profile {
-                let c = Instant::now();
-                inst.do_step(t, dt)?;
+        for (i, (inst, unit)) in instances.iter_mut().zip(units.iter_mut()).enumerate() {
+            let c = profile.then(Instant::now);
+            match (unit, &mut saved[i]) {
+                (Some(unit), _) => unit.advance(inst, solver, t, t_next)?,
+                (None, None) => inst.do_step(t, dt)?,
+                (None, Some(state)) => retries += step_with_retry(inst, state, t, dt, 0)?,
+            }
+            if let Some(c) = c {
                 clocks[i] += c.elapsed();
-            } else {
-                inst.do_step(t, dt)?;
             }
         }
         let clk = if profile { Some(&mut clocks[..]) } else { None };
@@ -618,7 +647,17 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             }
         }
     }
-    let mut summary = Summary { steps, wall_time: Duration::ZERO, ..Summary::default() };
+    let mut summary = Summary { steps, wall_time: Duration::ZERO, discard_retries: retries, ..Summary::default() };
+    for (inst, state) in instances.iter_mut().zip(saved) {
+        if let Some(state) = state {
+            inst.free_state(state)?;
+        }
+    }
+    for unit in units.into_iter().flatten() {
+        summary.integrator_steps.0 += unit.steps;
+        summary.integrator_steps.1 += unit.rejected;
+        summary.events.extend(unit.events);
+    }
     for inst in instances.iter_mut() {
         inst.terminate()?;
         for rec in inst.take_log() {
@@ -631,6 +670,23 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(clocks).collect();
     summary.wall_time = wall.elapsed();
     Ok((results, summary))
+}
+
+/// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
+/// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.
+fn step_with_retry(inst: &mut Instance, state: &mut crate::fmu::FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
+    inst.update_state(state)?;
+    match inst.do_step(t, dt) {
+        Ok(()) => Ok(0),
+        Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
+            inst.set_state(state)?;
+            let half = 0.5 * dt;
+            let a = step_with_retry(inst, state, t, half, depth + 1)?;
+            let b = step_with_retry(inst, state, t + half, dt - half, depth + 1)?;
+            Ok(1 + a + b)
+        }
+        Err(e) => Err(e),
+    }
 }
 
 #[inline]

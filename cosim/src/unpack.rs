@@ -73,7 +73,7 @@ pub fn unpack(archive: &Path, limits: &UnpackLimits) -> Result<tempfile::TempDir
 fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()> {
     let file = std::fs::File::open(archive).map_err(|source| Error::Io { path: archive.to_path_buf(), source })?;
     let bad = |e: zip::result::ZipError| Error::Archive { path: archive.to_path_buf(), reason: e.to_string() };
-    let mut zip = zip::ZipArchive::new(file).map_err(bad)?;
+    let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file)).map_err(bad)?;
     let count = zip.len() as u64;
     if count > limits.max_entries {
         return Err(Error::ArchiveLimit {

@@ -136,7 +136,7 @@ fn hostile_inputs_are_refused_by_name_and_leave_nothing_behind() {
     let guid = case(
         "guid",
         &[
-            ("modelDescription.xml", Model::Gain.model_description().replace("{test}", "{other}").into_bytes()),
+            ("modelDescription.xml", Model::Gain.model_description().replace("{test-gain}", "{other}").into_bytes()),
             ("binaries/linux64/gain.so", so.clone()),
         ],
     );

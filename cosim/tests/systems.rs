@@ -158,3 +158,32 @@ fn a_library_without_do_step_is_refused_by_name() {
         other => panic!("expected a missing symbol, got {other:?}"),
     }
 }
+
+#[test]
+fn a_discarded_step_is_restored_and_retried_in_halves() {
+    let dir = work_dir("discard");
+    let fmu = Fmu::load(&build_fmu(Model::Faulty, &dir, &[])).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("f", fmu).unwrap();
+    b.set("f.mode", Value::Real(2.0)).unwrap();
+    b.set("f.fail_time", Value::Real(10.0)).unwrap(); // never fails on time
+    b.set("f.max_ok_step", Value::Real(0.03)).unwrap(); // 0.1 s steps are discarded
+    let system = b.build();
+    let mut e = Experiment::new(0.5, 0.1);
+    // without retries: a clear error naming the Discard
+    match simulate(&system, &e) {
+        Err(Error::Fmi { status: Status::Discard, function: "fmi2DoStep", log, .. }) => {
+            assert!(log.contains("discarded"), "{log}")
+        }
+        other => panic!("expected a Discard, got {other:?}"),
+    }
+    e.retry_discard = true;
+    let (r, s) = simulate(&system, &e).unwrap();
+    // each 0.1 s step: halves 0.05 (discarded again), quarters 0.025 (accepted): 1 + 2 retries
+    assert_eq!(s.discard_retries, 5 * 3);
+    // y = t, the FMU's own clock, reached every communication point
+    let (t, y) = (r.column("time").unwrap(), r.column("y").unwrap());
+    for (a, b) in t.iter().zip(&y) {
+        assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+    }
+}

@@ -16,7 +16,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Simulate MODEL.fmu (as a one-instance system) or SYSTEM.ssp / SYSTEM.ssd.
-    Run(RunArgs),
+    Run(Box<RunArgs>),
     /// List the variables (causality, type, unit, start) of an FMU, or the instances and
     /// connections of an SSP.
     Info {
@@ -29,9 +29,9 @@ enum Command {
 struct RunArgs {
     /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
-    /// FMI interface: cs (Co-Simulation) or me (Model Exchange).
-    #[arg(long, default_value = "cs")]
-    interface: String,
+    /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
+    #[arg(long)]
+    interface: Option<String>,
     /// Start time, s.
     #[arg(long, default_value_t = 0.0)]
     start_time: f64,
@@ -44,6 +44,19 @@ struct RunArgs {
     /// ordered or jacobi.
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
+    /// Model Exchange solver: rk4 or dopri5.
+    #[arg(long, default_value = "rk4")]
+    solver: String,
+    /// Relative tolerance of dopri5 (absolute: rtol / 100).
+    #[arg(long, default_value_t = 1e-6)]
+    rtol: f64,
+    /// Largest RK4 step, s (default: the communication step).
+    #[arg(long)]
+    max_step: Option<f64>,
+    /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
+    /// get/set their state and vary their step).
+    #[arg(long)]
+    retry_discard: bool,
     /// CSV file of the results (fmpy's format).
     #[arg(long, short)]
     output: Option<PathBuf>,
@@ -64,7 +77,7 @@ struct RunArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run(args) => run(args),
+        Command::Run(args) => run(*args),
         Command::Info { model } => info(&model),
     };
     match result {
@@ -99,13 +112,14 @@ fn progress(fraction: f64) {
 }
 
 fn run(args: RunArgs) -> Result<(), Error> {
-    let interface = match args.interface.as_str() {
-        "cs" => Interface::CoSimulation,
-        "me" => Interface::ModelExchange,
-        other => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+    let interface = match args.interface.as_deref() {
+        None => None,
+        Some("cs") => Some(Interface::CoSimulation),
+        Some("me") => Some(Interface::ModelExchange),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
-    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    let options = ImportOptions { interface, ..ImportOptions::default() };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
         let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions::default())?;
         let builder = SystemBuilder::from_system(ssp.system.clone());
@@ -127,7 +141,19 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
     experiment.algorithm = algorithm;
+    experiment.solver = match args.solver.as_str() {
+        "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
+        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
+            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
+        }
+        "dopri5" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5)"))),
+    };
+    if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+        return Err(Error::Experiment("--max-step must be positive".into()));
+    }
     experiment.output_interval = args.output_interval;
+    experiment.retry_discard = args.retry_discard;
     experiment.profile = true;
     if !args.record.is_empty() {
         experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());

@@ -44,6 +44,7 @@ static void defaults(Model *m) {
 #elif MODEL == 4
     m->r[1] = 0.5; /* fail_time */
     m->r[2] = 3.0; /* mode */
+    m->r[3] = 0.0; /* max_ok_step: larger steps are discarded (0: off) */
 #endif
 }
 
@@ -65,7 +66,7 @@ EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *gui
                                      const fmi2CallbackFunctions *cb, int visible, int logging) {
     Model *m;
     if (!cb || !cb->logger) return NULL;
-    if (strcmp(guid, "{test}") != 0) {
+    if (strncmp(guid, "{test-", 6) != 0) { /* each model has its own GUID {test-<id>} */
         cb->logger(cb->componentEnvironment, name, 3, "log", "%s", "wrong GUID");
         return NULL;
     }
@@ -117,6 +118,10 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior
 #if MODEL == 3
     m->r[1] += m->r[0] * h;
 #elif MODEL == 4
+    if (m->r[3] > 0.0 && h > m->r[3] * (1.0 + 1e-9)) {
+        log_msg(m, 2, "step too large, discarded");
+        return 2;
+    }
     if (t >= m->r[1]) {
         char msg[128];
         snprintf(msg, sizeof msg, "failing on purpose at t = %g", t);
@@ -135,11 +140,21 @@ EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return 
 EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { *v = 0; return 0; }
 EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return 3; }
 
-/* The remaining functions of the 44 (importers such as fmpy resolve all of them);
- * these models have no FMU state, no derivatives and no Model Exchange: fmi2Error. */
-EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return 3; }
-EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) { return 3; }
-EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { return 3; }
+/* FMU state: a copy of the instance. The remaining functions of the 44 (importers such as
+ * fmpy resolve all of them): no serialization, derivatives or Model Exchange: fmi2Error. */
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) {
+    if (!*s) *s = malloc(sizeof(Model));
+    memcpy(*s, c, sizeof(Model));
+    return 0;
+}
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) {
+    Model *m = c;
+    fmi2CallbackFunctions cb = m->cb; /* keep the current instance's callbacks */
+    memcpy(m, s, sizeof(Model));
+    m->cb = cb;
+    return 0;
+}
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { free(*s); *s = NULL; return 0; }
 EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return 3; }
 EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return 3; }
 EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return 3; }

@@ -49,7 +49,8 @@ impl Model {
             Model::Faulty => {
                 r#"<ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
     <ScalarVariable name="fail_time" valueReference="1" causality="parameter" variability="fixed"><Real start="0.5"/></ScalarVariable>
-    <ScalarVariable name="mode" valueReference="2" causality="parameter" variability="fixed"><Real start="3"/></ScalarVariable>"#
+    <ScalarVariable name="mode" valueReference="2" causality="parameter" variability="fixed"><Real start="3"/></ScalarVariable>
+    <ScalarVariable name="max_ok_step" valueReference="3" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>"#
             }
         }
     }
@@ -64,8 +65,8 @@ impl Model {
     pub fn model_description(self) -> String {
         format!(
             r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test}}" numberOfEventIndicators="0">
-  <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true"/>
+<fmiModelDescription fmiVersion="2.0" modelName="{id}" guid="{{test-{id}}}" numberOfEventIndicators="0">
+  <CoSimulation modelIdentifier="{id}" canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="{state}"/>
   <UnitDefinitions>
     <Unit name="m"><BaseUnit m="1"/></Unit>
     <Unit name="mm"><BaseUnit m="1" factor="0.001"/></Unit>
@@ -78,6 +79,7 @@ impl Model {
 </fmiModelDescription>
 "#,
             id = self.id(),
+            state = self == Model::Faulty,
             vars = self.variables(),
             structure = self.structure()
         )
@@ -172,6 +174,45 @@ pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> P
             ("modelDescription.xml", xml.as_bytes().to_vec()),
             (&format!("binaries/linux64/{}.so", model.id()), std::fs::read(&so).expect("read so")),
         ],
+    );
+    fmu
+}
+
+/// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
+pub fn build_ball(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/ball.c");
+    let so = dir.join("ball.so");
+    let status = Command::new("cc")
+        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden"])
+        .arg(&src)
+        .arg("-o")
+        .arg(&so)
+        .status()
+        .expect("run cc");
+    assert!(status.success());
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="ball" guid="{ball}" numberOfEventIndicators="1">
+  <ModelExchange modelIdentifier="ball"/>
+  <ModelVariables>
+    <ScalarVariable name="h" valueReference="0" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="v" valueReference="1" causality="output" initial="exact"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="der(h)" valueReference="2"><Real derivative="1"/></ScalarVariable>
+    <ScalarVariable name="der(v)" valueReference="3"><Real derivative="2"/></ScalarVariable>
+    <ScalarVariable name="g" valueReference="4" causality="parameter" variability="fixed"><Real start="9.81"/></ScalarVariable>
+    <ScalarVariable name="e" valueReference="5" causality="parameter" variability="fixed"><Real start="0.7"/></ScalarVariable>
+    <ScalarVariable name="t_kick" valueReference="6" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="kick" valueReference="7" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="1" dependencies=""/><Unknown index="2" dependencies=""/></Outputs>
+    <Derivatives><Unknown index="3" dependencies="2"/><Unknown index="4" dependencies=""/></Derivatives>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    let fmu = dir.join("ball.fmu");
+    zip_entries(
+        &fmu,
+        &[("modelDescription.xml", xml.as_bytes().to_vec()), ("binaries/linux64/ball.so", std::fs::read(&so).unwrap())],
     );
     fmu
 }

@@ -1,0 +1,150 @@
+/* Bouncing ball, FMI 2.0 Model Exchange: h' = v, v' = -g; event indicator z = h; at
+ * h <= 0 with v < 0 the ball bounces: v = -e v, h = 0. A time event at t_kick (if > 0)
+ * adds `kick` to v. Value references: 0 h, 1 v, 2 der(h), 3 der(v), 4 g, 5 e,
+ * 6 t_kick, 7 kick. */
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef int fmi2Status;
+typedef unsigned int fmi2ValueReference;
+typedef struct {
+    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void *stepFinished;
+    void *componentEnvironment;
+} fmi2CallbackFunctions;
+typedef struct {
+    int newDiscreteStatesNeeded, terminateSimulation, nominalsOfContinuousStatesChanged,
+        valuesOfContinuousStatesChanged, nextEventTimeDefined;
+    double nextEventTime;
+} fmi2EventInfo;
+
+typedef struct {
+    double r[8];
+    double time;
+    int kicked;
+} Ball;
+
+#define EXPORT __attribute__((visibility("default")))
+#define ERR 3
+
+static void defaults(Ball *b) {
+    memset(b, 0, sizeof *b);
+    b->r[0] = 1.0;  /* h */
+    b->r[4] = 9.81; /* g */
+    b->r[5] = 0.7;  /* e */
+}
+
+EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cat[]) { return 0; }
+EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
+                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
+    Ball *b;
+    if (!cb || !cb->logger || type != 0) return NULL;
+    b = calloc(1, sizeof *b);
+    defaults(b);
+    return b;
+}
+EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
+    ((Ball *)c)->time = t0;
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
+    Ball *b = c;
+    size_t i;
+    b->r[2] = b->r[1];
+    b->r[3] = -b->r[4];
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= 8) return ERR;
+        v[i] = b->r[vr[i]];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
+    Ball *b = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= 8) return ERR;
+        b->r[vr[i]] = v[i];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? ERR : 0; }
+
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    Ball *b = c;
+    memset(info, 0, sizeof *info);
+    if (b->r[0] <= 0.0 && b->r[1] < 0.0) {
+        b->r[0] = 0.0;
+        b->r[1] = -b->r[5] * b->r[1];
+        info->valuesOfContinuousStatesChanged = 1;
+    }
+    if (b->r[6] > 0.0 && !b->kicked && b->time >= b->r[6]) {
+        b->r[1] += b->r[7];
+        b->kicked = 1;
+        info->valuesOfContinuousStatesChanged = 1;
+    }
+    if (b->r[6] > 0.0 && !b->kicked) {
+        info->nextEventTimeDefined = 1;
+        info->nextEventTime = b->r[6];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
+    *enterEventMode = 0;
+    *terminate = 0;
+    return 0;
+}
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Ball *)c)->time = t; return 0; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
+    if (n != 2) return ERR;
+    ((Ball *)c)->r[0] = x[0];
+    ((Ball *)c)->r[1] = x[1];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) {
+    if (n != 2) return ERR;
+    x[0] = ((Ball *)c)->r[0];
+    x[1] = ((Ball *)c)->r[1];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
+    if (n != 2) return ERR;
+    dx[0] = ((Ball *)c)->r[1];
+    dx[1] = -((Ball *)c)->r[4];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) {
+    if (n != 1) return ERR;
+    z[0] = ((Ball *)c)->r[0];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
+    size_t i;
+    for (i = 0; i < n; i++) x[i] = 1.0;
+    return 0;
+}
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return ERR; }
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) { return ERR; }
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { return ERR; }
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return ERR; }
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return ERR; }
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return ERR; }
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                               const fmi2ValueReference z[], size_t nz, const double dv[],
+                                               double dz[]) { return ERR; }
