@@ -13,8 +13,11 @@ cargo run --release --quiet -p build-fmu -- "$target_dir/fmu-rebuild" >/dev/null
 for f in "$target_dir"/fmu/*.fmu; do
     cmp "$f" "$target_dir/fmu-rebuild/$(basename "$f")" && echo "identical: $(basename "$f")"
 done
-echo "== exported symbols"
-for so in "$target_dir"/release/libnigel_*.so; do
+echo "== exported symbols (every FMU of build-fmu's list, from target/fmu/manifest.json)"
+ids=$(grep -o '"model_identifier": "[^"]*"' "$target_dir/fmu/manifest.json" | cut -d'"' -f4)
+[ -n "$ids" ] || { echo "no FMU in $target_dir/fmu/manifest.json" >&2; exit 1; }
+for id in $ids; do
+    so="$target_dir/release/lib$id.so"
     n=$(nm -D --defined-only "$so" | grep -c ' T fmi2')
     [ "$n" -eq 44 ] || { echo "$so exports $n fmi2 symbols, expected 44" >&2; exit 1; }
     echo "$(basename "$so"): 44 fmi2 symbols"

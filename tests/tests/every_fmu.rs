@@ -298,3 +298,29 @@ fn every_measured_input_to_output_dependency_is_declared() {
         assert!(seen > 0 || inputs.is_empty(), "{}: no output reacts to any input", id(md));
     }
 }
+
+#[test]
+fn hostile_lengths_and_strings_are_errors_naming_the_function() {
+    for fmu in every_fmu() {
+        let md = &fmu.description;
+        let (i, log) = fmu.instantiate("lengths", kinds(md)[0], fmu.guid());
+        let i = i.unwrap();
+        i.initialize();
+        let f = i.f();
+        let vr = [0u32; 2];
+        let mut out = [0.0f64; 2];
+        // a length of 2^40 with a two-element buffer: refused before anything is read
+        let s = unsafe { (f.get_real)(i.c, vr.as_ptr(), 1 << 40, out.as_mut_ptr()) };
+        assert_eq!(s, ERROR);
+        let msg = log.last_error().unwrap();
+        assert!(msg.contains("fmi2GetReal") && msg.contains("1099511627776"), "{msg}");
+        assert_eq!(i.reset(), OK);
+        i.initialize();
+        // the model has no String variables: fmi2SetString reports under its own name
+        let text = [c"x".as_ptr()];
+        let s = unsafe { (f.set_string)(i.c, vr.as_ptr(), 1, text.as_ptr()) };
+        assert_eq!(s, ERROR);
+        let msg = log.last_error().unwrap();
+        assert!(msg.starts_with("fmi2SetString:"), "{msg}");
+    }
+}

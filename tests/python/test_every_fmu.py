@@ -1,0 +1,72 @@
+"""fmpy checks over every FMU build-fmu built (target/fmu/manifest.json): validate_fmu
+reports no problems, Co-Simulation runs, Model Exchange runs where declared, the outputs
+stay finite, and a wrong GUID is refused. A new FMU is covered once it is in build-fmu's
+list (the manifest is written from that list)."""
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+REPO = Path(__file__).resolve().parents[2]
+TARGET = REPO / os.environ.get("CARGO_TARGET_DIR", "target")
+FMU_DIR = Path(os.environ.get("NIGEL_FMU_DIR", TARGET / "fmu"))
+MANIFEST = json.loads((FMU_DIR / "manifest.json").read_text())
+IDS = [entry["model_identifier"] for entry in MANIFEST]
+
+
+def entry_for(model_identifier):
+    return next(e for e in MANIFEST if e["model_identifier"] == model_identifier)
+
+
+def test_manifest_lists_the_plant_and_every_archive_exists():
+    assert "nigel_plant" in IDS
+    for e in MANIFEST:
+        assert (FMU_DIR / e["fmu"]).is_file(), e
+
+
+@pytest.mark.parametrize("model_identifier", IDS)
+def test_validate_fmu_reports_no_problems(model_identifier):
+    path = FMU_DIR / entry_for(model_identifier)["fmu"]
+    assert validate_fmu(str(path)) == []
+    md = read_model_description(str(path))
+    assert md.guid == entry_for(model_identifier)["guid"]
+    interfaces = entry_for(model_identifier)["interfaces"]
+    assert (md.coSimulation is not None) == ("CoSimulation" in interfaces)
+    assert (md.modelExchange is not None) == ("ModelExchange" in interfaces)
+
+
+@pytest.mark.parametrize(
+    "model_identifier,interface",
+    [(e["model_identifier"], i) for e in MANIFEST for i in e["interfaces"]],
+)
+def test_simulation_runs_with_finite_outputs(model_identifier, interface):
+    path = str(FMU_DIR / entry_for(model_identifier)["fmu"])
+    kwargs = dict(fmi_type=interface, start_time=0.0, stop_time=0.5, output_interval=1e-3)
+    if interface == "CoSimulation":
+        kwargs["step_size"] = 1e-3
+    else:
+        kwargs.update(solver="CVode", relative_tolerance=1e-8)
+    result = simulate_fmu(path, **kwargs)
+    assert len(result) >= 500
+    assert result["time"][-1] == pytest.approx(0.5)
+    for name in result.dtype.names:
+        assert np.all(np.isfinite(result[name].astype(float))), name
+
+
+@pytest.mark.parametrize("model_identifier", IDS)
+def test_wrong_guid_is_refused(model_identifier, tmp_path):
+    path = str(FMU_DIR / entry_for(model_identifier)["fmu"])
+    md = read_model_description(path)
+    unzipdir = extract(path, unzipdir=str(tmp_path / "x"))
+    model_identifier_cs = (md.coSimulation or md.modelExchange).modelIdentifier
+    slave = FMU2Slave(guid="{00000000-0000-0000-0000-000000000000}", unzipDirectory=unzipdir,
+                      modelIdentifier=model_identifier_cs, instanceName="wrong")
+    with pytest.raises(Exception):
+        slave.instantiate()

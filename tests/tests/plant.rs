@@ -1,0 +1,263 @@
+//! The plant FMU's physics and hardening through the C ABI: world-frame wind, the
+//! stability-limited Co-Simulation sub-step, hostile serialized states, non-finite
+//! directional derivatives.
+
+use std::ffi::{c_char, c_void};
+use std::ptr::null_mut;
+use std::sync::OnceLock;
+
+use model_description::Causality;
+use nigel_integration_tests::{built_fmu, Fmu, Instance, CO_SIMULATION, ERROR, OK};
+use nigel_vehicle::dynamics::{derivatives_of, idx, stable_rk4_step, Inputs, State, N_STATES};
+use nigel_vehicle::VehicleParams;
+
+fn fmu() -> &'static Fmu {
+    static FMU: OnceLock<Fmu> = OnceLock::new();
+    FMU.get_or_init(|| Fmu::load(&built_fmu("nigel_plant").unwrap()).unwrap())
+}
+
+fn vrs(names: &[&str]) -> Vec<u32> {
+    names.iter().map(|n| fmu().vr(n)).collect()
+}
+
+const BODY: [&str; 6] = ["x", "y", "psi", "v_x", "v_y", "yaw_rate"];
+
+/// Classical RK4 of the body-frame model, the world wind rotated into body axes with the
+/// heading of each stage (written out here, independent of the plant's integrator).
+fn rk4_with_rotated_wind(
+    p: &VehicleParams,
+    s: &State<f64>,
+    u: &Inputs<f64>,
+    (fx, fy): (f64, f64),
+    h: f64,
+) -> State<f64> {
+    let f = |x: &State<f64>| {
+        let psi = x[idx::PSI];
+        let mut body = *u;
+        body.wind_head = -(fx * psi.cos() + fy * psi.sin());
+        body.wind_side = -fx * psi.sin() + fy * psi.cos();
+        derivatives_of(p, x, &body)
+    };
+    let add = |x: &State<f64>, k: &State<f64>, a: f64| -> State<f64> { std::array::from_fn(|j| x[j] + a * k[j]) };
+    let k1 = f(s);
+    let k2 = f(&add(s, &k1, h / 2.0));
+    let k3 = f(&add(s, &k2, h / 2.0));
+    let k4 = f(&add(s, &k3, h));
+    std::array::from_fn(|j| s[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]))
+}
+
+#[test]
+fn world_wind_on_a_car_turning_in_place_is_the_body_wind_rotated_at_every_stage() {
+    let p = VehicleParams::table2();
+    // wheels tangent to the circle about the CG: delta_i = atan(x_i / -y_i)
+    let (xf, xr, half) = (p.l_f, -p.l_r, p.track / 2.0);
+    let delta = [(xf / -half).atan(), (xf / half).atan(), (xr / -half).atan(), (xr / half).atan()];
+    let tau = [-0.02, 0.02, -0.02, 0.02];
+    let wind = (0.3, -0.2);
+    let (i, log) = fmu().instantiate("wind", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    let inputs = vrs(&[
+        "delta_fl", "delta_fr", "delta_rl", "delta_rr", "tau_fl", "tau_fr", "tau_rl", "tau_rr", "wind_x", "wind_y",
+    ]);
+    let mut values = delta.to_vec();
+    values.extend(tau);
+    values.extend([wind.0, wind.1]);
+    assert_eq!(i.set_real(&inputs, &values), OK);
+    assert_eq!(i.set_real(&vrs(&["yaw_rate"]), &[3.0]), OK);
+    i.initialize();
+
+    let mut u = Inputs::<f64>::coasting(0.4);
+    u.delta = delta;
+    u.tau = tau;
+    let mut s = [0.0; N_STATES];
+    s[idx::YAW_RATE] = 3.0;
+    let substep = nigel_plant::DEFAULT_CS_SUBSTEP_MAX.min(stable_rk4_step(&p, &u));
+    let h = 1e-3;
+    let n = nigel_vehicle::dynamics::substeps(h, substep);
+    let body = vrs(&BODY);
+    let mut worst: f64 = 0.0;
+    for k in 0..1500 {
+        assert_eq!(i.do_step(k as f64 * h, h), OK, "{:?}", log.last_error());
+        for _ in 0..n {
+            s = rk4_with_rotated_wind(&p, &s, &u, wind, h / n as f64);
+        }
+        let got = i.get_real(&body).unwrap();
+        for j in 0..6 {
+            worst = worst.max((got[j] - s[j]).abs() / (1.0 + s[j].abs()));
+        }
+    }
+    assert!(worst <= 1e-12, "largest relative difference {worst:e}");
+    // the car turned more than a full circle, so the wind went all the way round the body
+    assert!(s[idx::PSI].abs() > 2.0 * std::f64::consts::PI, "psi = {}", s[idx::PSI]);
+    // and it drifted downwind (world frame), which a body-frame wind would not do
+    assert!(s[idx::X] > 1e-4 && s[idx::Y] < -1e-4, "x = {}, y = {}", s[idx::X], s[idx::Y]);
+}
+
+fn kinetic_energy(i: &Instance) -> f64 {
+    let p = VehicleParams::table2();
+    let v = i.get_real(&vrs(&["v_x", "v_y", "yaw_rate"])).unwrap();
+    0.5 * p.m * (v[0] * v[0] + v[1] * v[1]) + 0.5 * p.i_z * v[2] * v[2]
+}
+
+#[test]
+fn coasting_never_gains_energy_at_the_highest_friction_even_with_a_long_substep_limit() {
+    // A slow car coasting to rest: inside the fade zone (|v| < v_fade) the tires are
+    // stiffest. Before the stability bound, mu above ~3.5 with the default 0.5 ms sub-step
+    // (or mu above ~1 with a 2 ms one) made it gain energy with fmi2OK.
+    for (mu, substep_max) in [(3.0, 1e-2), (1.0, 2e-3), (3.0, 5e-4), (0.4, 1e-2)] {
+        let (i, log) = fmu().instantiate("coast", CO_SIMULATION, fmu().guid());
+        let i = i.unwrap();
+        let names = ["mu_fl", "mu_fr", "mu_rl", "mu_rr", "v_x", "v_y", "yaw_rate", "cs_substep_max"];
+        assert_eq!(i.set_real(&vrs(&names), &[mu, mu, mu, mu, 0.0, 0.015, 0.3, substep_max]), OK);
+        i.initialize();
+        let mut energy = kinetic_energy(&i);
+        let start = energy;
+        for k in 0..2000 {
+            assert_eq!(i.do_step(k as f64 * 1e-3, 1e-3), OK, "{:?}", log.last_error());
+            let e = kinetic_energy(&i);
+            assert!(
+                e <= energy * (1.0 + 1e-12),
+                "mu {mu}, cs_substep_max {substep_max}: energy {energy} -> {e} at step {k}"
+            );
+            energy = e;
+        }
+        assert!(energy < 0.5 * start, "mu {mu}: the sliding is damped ({start} -> {energy})");
+    }
+    // friction above the declared physical maximum is refused
+    let (i, log) = fmu().instantiate("mu", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    assert_eq!(i.set_real(&vrs(&["mu_fl"]), &[3.5]), ERROR);
+    assert!(log.last_error().unwrap().contains("mu_fl = 3.5 refused: above its maximum 3"));
+}
+
+/// The saved variables in the order of the serialized state (the layer's rule: parameters,
+/// inputs, continuous states; the plant has no discrete variables).
+fn saved_names() -> Vec<String> {
+    let md = &fmu().description;
+    let states: Vec<u32> = md.states();
+    md.model_variables
+        .iter()
+        .enumerate()
+        .filter(|(k, v)| {
+            matches!(v.causality, Causality::Parameter | Causality::Input) || states.contains(&(*k as u32 + 1))
+        })
+        .map(|(_, v)| v.name.clone())
+        .collect()
+}
+
+#[test]
+fn hostile_serialized_states_are_refused_like_the_setters_would() {
+    let (i, log) = fmu().instantiate("state", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    i.initialize();
+    assert_eq!(i.do_step(0.0, 1e-3), OK);
+    let f = i.f();
+    let mut state: *mut c_void = null_mut();
+    let bytes = unsafe {
+        assert_eq!((f.get_fmu_state)(i.c, &mut state), OK);
+        let mut size = 0;
+        assert_eq!((f.serialized_fmu_state_size)(i.c, state, &mut size), OK);
+        let mut b = vec![0u8; size];
+        assert_eq!((f.serialize_fmu_state)(i.c, state, b.as_mut_ptr() as *mut c_char, size), OK);
+        b
+    };
+    let names = saved_names();
+    let first = bytes.len() - 8 * names.len();
+    let patched = |name: &str, x: f64| {
+        let k = names.iter().position(|n| n == name).unwrap_or_else(|| panic!("{name} not saved"));
+        let mut b = bytes.clone();
+        b[first + 8 * k..first + 8 * k + 8].copy_from_slice(&x.to_le_bytes());
+        b
+    };
+    // the unpatched bytes are accepted
+    let mut ok_state = null_mut();
+    unsafe {
+        assert_eq!((f.deserialize_fmu_state)(i.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut ok_state), OK);
+    }
+    let cases = [
+        ("mu_rl", -0.5, "mu_rl"),
+        ("wind_x", f64::NAN, "wind_x"),
+        ("wind_side", f64::INFINITY, "wind_side"),
+        ("cs_substep_max", f64::INFINITY, "cs_substep_max"),
+        ("servo_time_constant", -1.0, "servo_time_constant"),
+        ("motor_taper", 0.0, "motor_taper"),
+        ("steering_servo", 2.0, "steering_servo"),
+        ("m", -2.68, "m"),
+        ("delta_max", 4.0, "delta_max"),
+    ];
+    for (name, x, expect) in cases {
+        let bad = patched(name, x);
+        let mut s = null_mut();
+        let status = unsafe { (f.deserialize_fmu_state)(i.c, bad.as_ptr() as *const c_char, bad.len(), &mut s) };
+        assert_eq!(status, ERROR, "{name} = {x} accepted");
+        assert!(s.is_null());
+        let msg = log.last_error().unwrap();
+        assert!(msg.contains("fmi2DeSerializeFMUstate") && msg.contains(expect), "{name}: {msg}");
+        assert_eq!(i.reset(), OK);
+    }
+    // an impossible servo parameter is refused by the setter too, with the servo off
+    assert_eq!(i.set_real(&vrs(&["servo_time_constant"]), &[0.0]), ERROR);
+    assert!(log.last_error().unwrap().contains("servo_time_constant"));
+}
+
+#[test]
+fn directional_derivatives_never_hand_out_non_finite_numbers() {
+    let (i, log) = fmu().instantiate("dd", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    assert_eq!(i.set_real(&vrs(&["v_x"]), &[0.3]), OK);
+    i.initialize();
+    let f = i.f();
+    let (unknown, known) = (fmu().vr("der(v_y)"), fmu().vr("v_y"));
+    let mut out = [0.0];
+    // a finite seed gives the finite slope
+    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &known, 1, &1.0, out.as_mut_ptr()) };
+    assert_eq!(s, OK);
+    assert!(out[0] < -10.0 && out[0].is_finite(), "{}", out[0]);
+    // a huge one overflows: refused, not handed out with fmi2OK
+    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &known, 1, &1e308, out.as_mut_ptr()) };
+    assert_eq!(s, ERROR, "a huge seed overflows: {}", out[0]);
+    let msg = log.last_error().unwrap();
+    assert!(msg.contains("fmi2GetDirectionalDerivative") && msg.contains("der(v_y)"), "{msg}");
+    assert_eq!(i.reset(), OK);
+}
+
+#[test]
+fn the_stable_substep_keeps_coasting_dissipative_over_random_vehicles() {
+    use nigel_vehicle::dynamics::rk4_step;
+    // Random vehicles (mass, inertia, stiffness, fade speed, friction up to the maximum),
+    // slow random sliding states (inside the fade zone, where the tires are stiffest):
+    // with the stability-limited step no coasting step may add energy.
+    let mut seed = 0x5eed_u64;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut cases = 0;
+    for _ in 0..300 {
+        let mut p = VehicleParams::table2();
+        p.m *= 0.3 + 2.0 * rnd();
+        p.i_z *= 0.3 + 2.0 * rnd();
+        p.c = [0, 1, 2, 3].map(|_| 22.4768 * (0.2 + 3.0 * rnd()));
+        p.v_fade = 0.005 + 0.05 * rnd();
+        let mut u = Inputs::<f64>::coasting(0.0);
+        u.mu = [0, 1, 2, 3].map(|_| nigel_plant::MU_MAX * rnd());
+        u.delta = [0, 1, 2, 3].map(|_| (rnd() - 0.5) * 3.0);
+        let h = stable_rk4_step(&p, &u);
+        let mut s = [0.0; N_STATES];
+        s[idx::V_X] = (rnd() - 0.5) * 2.0 * p.v_fade;
+        s[idx::V_Y] = (rnd() - 0.5) * 2.0 * p.v_fade;
+        s[idx::YAW_RATE] = (rnd() - 0.5) * 2.0;
+        let energy = |s: &State<f64>| {
+            0.5 * p.m * (s[idx::V_X].powi(2) + s[idx::V_Y].powi(2)) + 0.5 * p.i_z * s[idx::YAW_RATE].powi(2)
+        };
+        let mut e = energy(&s);
+        for k in 0..400 {
+            s = rk4_step(&p, &s, &u, h);
+            let next = energy(&s);
+            assert!(next <= e * (1.0 + 1e-9) + 1e-300, "case {cases}, step {k}: {e} -> {next} (h = {h})");
+            e = next;
+        }
+        cases += 1;
+    }
+    assert_eq!(cases, 300);
+}
