@@ -7,7 +7,7 @@
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
 use crate::me::MeUnit;
-use crate::system::{BaseType, System, Value, VariableRef};
+use crate::system::{is_cs, BaseType, System, Value, VariableRef};
 use model_description::Causality;
 use std::time::{Duration, Instant};
 
@@ -482,8 +482,10 @@ pub fn default_record(system: &System) -> Vec<VariableRef> {
     out
 }
 
-/// Number of steps and the output stride for an experiment, checked.
-fn schedule(e: &Experiment) -> Result<(u64, u64)> {
+/// Number of steps, the output stride, and whether the last step is shorter (the
+/// interval is not a whole number of steps: allowed only when every Co-Simulation
+/// instance has `canHandleVariableCommunicationStepSize`), checked.
+fn schedule(e: &Experiment, system: &System) -> Result<(u64, u64, bool)> {
     let ok = |x: f64| x.is_finite();
     if !(ok(e.start_time) && ok(e.stop_time) && ok(e.step)) || e.step <= 0.0 || e.stop_time < e.start_time {
         return Err(Error::Experiment(format!(
@@ -492,13 +494,18 @@ fn schedule(e: &Experiment) -> Result<(u64, u64)> {
         )));
     }
     let span = (e.stop_time - e.start_time) / e.step;
-    let steps = span.round();
-    if (span - steps).abs() > 1e-9 * span.max(1.0) {
-        return Err(Error::Experiment(format!(
-            "the interval {} s is not a whole number of steps of {} s",
-            e.stop_time - e.start_time,
-            e.step
-        )));
+    let mut steps = span.round();
+    let partial = (span - steps).abs() > 1e-9 * span.max(1.0);
+    if partial {
+        if let Some(fixed) = system.instances.iter().find(|i| is_cs(i) && !i.fmu.can_handle_variable_step()) {
+            return Err(Error::Experiment(format!(
+                "the interval {} s is not a whole number of steps of {} s, and {} cannot take a shorter last step (canHandleVariableCommunicationStepSize is false)",
+                e.stop_time - e.start_time,
+                e.step,
+                fixed.name
+            )));
+        }
+        steps = span.ceil();
     }
     if steps > 1e12 {
         return Err(Error::Experiment(format!("{steps} steps is too many")));
@@ -516,13 +523,13 @@ fn schedule(e: &Experiment) -> Result<(u64, u64)> {
             r.round()
         }
     };
-    Ok((steps as u64, stride as u64))
+    Ok((steps as u64, stride as u64, partial))
 }
 
 /// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
     let wall = Instant::now();
-    let (steps, stride) = schedule(experiment)?;
+    let (steps, stride, partial) = schedule(experiment, system)?;
     let record: Vec<VariableRef> = match &experiment.record {
         None => default_record(system),
         Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
@@ -556,7 +563,7 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut values = vec![0.0; plan.sources.len()];
-    let rows = steps / stride + 1;
+    let rows = steps / stride + 2;
     // reserve for the whole run, up to 64 MiB up front (a huge run grows as it goes)
     let wanted = (rows as usize).saturating_mul(record.len() + 1).min(8 << 20);
     let mut results = Results { names, values: Vec::with_capacity(wanted) };
@@ -608,7 +615,8 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     let h = experiment.step;
     for n in 0..steps {
         let t = t0 + n as f64 * h;
-        let t_next = t0 + (n + 1) as f64 * h;
+        let last = n + 1 == steps;
+        let t_next = if last && partial { experiment.stop_time } else { t0 + (n + 1) as f64 * h };
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         for (i, (inst, unit)) in instances.iter_mut().zip(units.iter_mut()).enumerate() {
             let c = profile.then(Instant::now);
@@ -622,7 +630,7 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             }
         }
         let clk = if profile { Some(&mut clocks[..]) } else { None };
-        let output_point = (n + 1) % stride == 0;
+        let output_point = (n + 1) % stride == 0 || last;
         match (experiment.algorithm, plan.ordered.as_mut()) {
             (Algorithm::Ordered, Some(ops)) => {
                 run_ops(ops, &mut instances, &mut values, clk)?;

@@ -120,7 +120,7 @@ fn connections_are_checked_for_causality_type_and_unit() {
 fn experiment_is_checked() {
     let dir = work_dir("experiment");
     let system = chain(&dir).build();
-    for (stop, step, interval) in [(1.0, 0.3, None), (1.0, 0.0, None), (f64::NAN, 0.1, None), (1.0, 0.1, Some(0.15))] {
+    for (stop, step, interval) in [(1.0, 0.0, None), (f64::NAN, 0.1, None), (1.0, 0.1, Some(0.15))] {
         let mut e = Experiment::new(stop, step);
         e.output_interval = interval;
         assert!(matches!(simulate(&system, &e), Err(Error::Experiment(_))), "{stop} {step} {interval:?}");
@@ -129,6 +129,22 @@ fn experiment_is_checked() {
     e.output_interval = Some(0.5);
     let (r, _) = simulate(&system, &e).unwrap();
     assert_eq!(r.column("time").unwrap(), vec![0.0, 0.5, 1.0]);
+    // not a whole number of steps: these FMUs can take a shorter last step, which ends
+    // exactly at the stop time
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.3)).unwrap();
+    assert_eq!(r.column("time").unwrap(), vec![0.0, 0.3, 0.6, 0.3 * 3.0, 1.0]);
+    assert_eq!(r.column("src.y").unwrap().last(), Some(&1.0));
+    // an FMU that cannot is named
+    let fixed = Model::Gain.model_description().replace(
+        r#"canHandleVariableCommunicationStepSize="true""#,
+        r#"canHandleVariableCommunicationStepSize="false""#,
+    );
+    let mut b = SystemBuilder::new();
+    b.add_instance("rigid", Fmu::load(&build_fmu_with(Model::Gain, &dir, "rigid", &fixed)).unwrap()).unwrap();
+    match simulate(&b.build(), &Experiment::new(1.0, 0.3)) {
+        Err(Error::Experiment(m)) => assert!(m.contains("rigid") && m.contains("canHandleVariable"), "{m}"),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
 }
 
 #[test]
