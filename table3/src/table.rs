@@ -79,7 +79,7 @@ pub struct Options {
     pub maneuvers: Vec<Maneuver>,
     /// The controllers (default the three of Table III).
     pub controllers: Vec<Controller>,
-    /// Keep every run's recorded series (for CSV and plots; about 2.6 MB a run).
+    /// Keep every run's recorded series (for CSV and plots; about 4.3 MB a run).
     pub keep_runs: bool,
 }
 
