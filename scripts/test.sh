@@ -32,3 +32,5 @@ echo "== fmpy cross-checks"
 "$target_dir/venv/bin/python" -m pytest tests/python -q
 echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
+echo "== Table III closed loop as SSP in fmpy"
+"$target_dir/venv/bin/python" -m pytest table3/tests/python -q

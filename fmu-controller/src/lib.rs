@@ -193,21 +193,21 @@ fn build_declaration() -> DeclarationSpec<Var> {
         }
         v.push(p);
     }
-    for i in 0..4 {
-        for j in 0..2 {
+    for (i, w) in WHEEL.iter().enumerate() {
+        for (j, c) in COLUMN.iter().enumerate() {
             let r = vr::K_CUSTOM + (2 * i + j) as u32;
             v.push(
-                VarDecl::real(leak(format!("k_{}_{}", COLUMN[j], WHEEL[i])), r, Var::CustomGain(i, j))
+                VarDecl::real(leak(format!("k_{c}_{w}")), r, Var::CustomGain(i, j))
                     .tunable_parameter(Start::Real(ROBUST[i][j]))
                     .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
                     .describe("custom gain (used when controller = custom; tunable between steps)"),
             );
         }
     }
-    for i in 0..4 {
-        for j in 0..2 {
+    for (i, w) in WHEEL.iter().enumerate() {
+        for (j, c) in COLUMN.iter().enumerate() {
             let r = vr::GAIN_IN_USE + (2 * i + j) as u32;
-            let mut g = VarDecl::real(leak(format!("gain_{}_{}", COLUMN[j], WHEEL[i])), r, Var::GainInUse(i, j))
+            let mut g = VarDecl::real(leak(format!("gain_{c}_{w}")), r, Var::GainInUse(i, j))
                 .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
                 .describe("the gain in use (from controller and the custom gains)");
             g.causality = Causality::CalculatedParameter;
@@ -241,8 +241,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
             ],
         )],
         units: vec![
-            si_unit("rad", 0, 0, 0, 0),
-            si_unit("rad/s", 0, 0, -1, 0),
+            si_unit("rad", 0, 0, 0, 1),
+            si_unit("rad/s", 0, 0, -1, 1),
             si_unit("m/s", 0, 1, -1, 0),
             si_unit("m", 0, 1, 0, 0),
             si_unit("s", 0, 0, 1, 0),
@@ -460,7 +460,7 @@ impl Model for Controller {
         let [k, start_time, saturated, pending] = data else {
             return Err(format!("controller internal data: 4 numbers expected, got {}", data.len()).into());
         };
-        if !(*k >= 0.0 && k.fract() == 0.0 && *k < 9e15) || !start_time.is_finite() || !pending.is_finite() {
+        if !(*k >= 0.0 && k.fract() == 0.0 && *k < 9e15 && start_time.is_finite() && pending.is_finite()) {
             return Err(format!("controller internal data {data:?} refused").into());
         }
         if !(*saturated == 0.0 || *saturated == 1.0) {

@@ -258,8 +258,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
             ),
         ],
         units: vec![
-            si_unit("rad", 0, 0, 0, 0),
-            si_unit("rad/s", 0, 0, -1, 0),
+            si_unit("rad", 0, 0, 0, 1),
+            si_unit("rad/s", 0, 0, -1, 1),
             si_unit("m/s", 0, 1, -1, 0),
             si_unit("m", 0, 1, 0, 0),
             si_unit("s", 0, 0, 1, 0),
@@ -489,7 +489,7 @@ impl Model for TestBench {
         let [k, start_time] = data else {
             return Err(format!("test-bench internal data: 2 numbers expected, got {}", data.len()).into());
         };
-        if !(*k >= 0.0 && k.fract() == 0.0 && *k <= MAX_SAMPLES as f64 + 1.0) || !start_time.is_finite() {
+        if !(*k >= 0.0 && k.fract() == 0.0 && *k <= MAX_SAMPLES as f64 + 1.0 && start_time.is_finite()) {
             return Err(format!("test-bench internal data {data:?} refused").into());
         }
         self.k = *k as u64;

@@ -106,21 +106,14 @@ def test_validate_fmu_reports_no_problems(path):
     assert validate_fmu(str(path)) == []
 
 
-# fmpy's CVode, given a model with no continuous state, integrates a dummy state and calls
-# fmi2SetTime a little past the stop time, which an FMU must refuse once fmi2SetupExperiment
-# declared that stop time (FMI 2.0, 2.1.6): Model Exchange runs here do not declare it.
-ME_OPTIONS = dict(set_stop_time=False)
-
-
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 def test_both_interfaces_run(fmi_type):
-    opts = ME_OPTIONS if fmi_type == "ModelExchange" else {}
     r = simulate_fmu(str(CONTROLLER), fmi_type=fmi_type, stop_time=0.05, output_interval=T,
-                     start_values={"speed": 0.3}, output=["tau_fl", "speed_integral"], **opts)
+                     start_values={"speed": 0.3}, output=["tau_fl", "speed_integral"])
     i = r["speed_integral"]  # e = 0.05 at every sample: I grows by 5e-5 a sample
     assert len(r) >= 50 and np.all(np.diff(i) >= 0) and i[-1] == pytest.approx(0.05 * 0.05, rel=0.03)
     r = simulate_fmu(str(MANEUVER), fmi_type=fmi_type, stop_time=3.0, output_interval=T,
-                     start_values={"maneuver": 3, "duration": 3.0}, output=["delta_ff_fl", "x_ref"], **opts)
+                     start_values={"maneuver": 3, "duration": 3.0}, output=["delta_ff_fl", "x_ref"])
     assert r["delta_ff_fl"][-1] == pytest.approx(A, abs=1e-15) and r["x_ref"][-1] > 0.9
 
 
@@ -256,7 +249,7 @@ def test_model_exchange_outputs_change_exactly_at_the_samples():
     t_in = np.linspace(0.0, 0.02, 2001)
     signal = np.array(list(zip(t_in, 0.1 * np.sin(2 * np.pi * 37 * t_in))), dtype=[("time", float), ("beta", float)])
     r = simulate_fmu(str(CONTROLLER), fmi_type="ModelExchange", stop_time=0.02, output_interval=0.1e-3,
-                     input=signal, record_events=True, output=["delta_fl", "beta"], **ME_OPTIONS)
+                     input=signal, record_events=True, output=["delta_fl", "beta"])
     t, d = r["time"], r["delta_fl"]
     jumps = t[1:][np.diff(d) != 0]
     assert len(jumps) >= 15
@@ -423,3 +416,55 @@ def test_bench_bad_input(bench, capsys):
         s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
     finally:
         s.freeInstance()
+
+
+# ------------------------------------------------------------------------- closed loop of the three FMUs
+
+# (column, maneuver, epsilon of the robust controller) from the independent implementation
+# of maneuvers.md (the self-check table of benchmark/tests/table3.rs), seed 0.
+CLOSED_LOOP_CELLS = [("paper", "lane_change", 0.0420524), ("real", "fishhook", 0.135593)]
+
+
+@pytest.mark.parametrize("fidelity,maneuver,epsilon", CLOSED_LOOP_CELLS)
+def test_closed_loop_of_the_three_fmus_reproduces_table3(ctl, bench, plant, fidelity, maneuver, epsilon):
+    """Plant, test bench and controller FMUs in one Co-Simulation loop (1 ms steps, ordered
+    plant -> bench -> controller -> plant at each communication point, which the declared
+    feedthrough allows): the epsilon of Table III over 30 s equals the independent
+    implementation's to its 6 printed digits."""
+    real = fidelity == "real"
+    b = initialized(bench, "cl_bench", ints={"maneuver": bench.enum("Maneuver", maneuver),
+                                             "fidelity": bench.enum("Fidelity", fidelity)})
+    c = initialized(ctl, "cl_ctl")
+    p = initialized(plant, "cl_plant", reals={"v_x": 0.35},
+                    bools={k: real for k in ("friction_circle", "steering_servo", "motor_speed_limit")})
+    v = lambda fmu, *names: [fmu.vr[n] for n in names]
+    p_out = v(plant, "beta", "yaw_rate", "speed", "x", "y", "psi")
+    b_in = v(bench, "beta", "yaw_rate")
+    b_out = v(bench, *[f"delta_ff_{w}" for w in WHEELS], "beta_ref", "yaw_rate_ref", "speed_ref",
+              "beta_meas", "yaw_rate_meas", "x_ref", "y_ref", "psi_ref",
+              *[f"mu_{w}" for w in WHEELS], "wind_x", "wind_y")
+    c_in = v(ctl, *[f"delta_ff_{w}" for w in WHEELS], "beta_ref", "yaw_rate_ref", "speed_ref", "beta", "yaw_rate", "speed")
+    c_out = v(ctl, *[f"delta_{w}" for w in WHEELS], *[f"tau_{w}" for w in WHEELS])
+    p_in = v(plant, *[f"delta_{w}" for w in WHEELS], *[f"tau_{w}" for w in WHEELS],
+             *[f"mu_{w}" for w in WHEELS], "wind_x", "wind_y")
+    try:
+        n = 30_000
+        sq = np.zeros(3)
+        for k in range(n + 1):
+            beta, yaw_rate, speed, x, y, psi = p.getReal(p_out)
+            b.setReal(b_in, [beta, yaw_rate])
+            o = b.getReal(b_out)
+            if k > 0:
+                sq += (np.array([x, y, psi]) - np.array(o[9:12])) ** 2
+            if k == n:
+                break
+            c.setReal(c_in, o[0:7] + [o[7], o[8], speed])
+            p.setReal(p_in, c.getReal(c_out) + o[12:18])
+            for fmu in (p, b, c):
+                fmu.doStep(currentCommunicationPoint=k * T, communicationStepSize=T)
+        eps = float(np.sqrt(np.sum(sq / n)))
+        print(f"{fidelity} {maneuver} robust: epsilon {eps:.9g} (independent implementation {epsilon})")
+        assert eps == pytest.approx(epsilon, rel=1e-5)
+    finally:
+        for fmu in (p, b, c):
+            fmu.freeInstance()

@@ -1,0 +1,329 @@
+//! The FMU engine: the three `.fmu` archives built by `build-fmu`, imported through the C
+//! ABI by the `nigel_cosim` master and co-simulated with fixed 1 ms steps for 30 s
+//! (`ordered` by default: every output reaches its inputs at the same communication
+//! point along the direct-feedthrough chain plant -> test bench -> controller -> plant).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use nigel_benchmark::{Controller, Fidelity, Maneuver, DEFAULT_SPEED, N_SAMPLES, SAMPLE_PERIOD};
+use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Results, System, SystemBuilder, Value};
+
+use super::{Engine, Job, Run};
+use crate::Error;
+
+/// File names of the plant, the controller and the test bench in `target/fmu/`.
+pub const FMU_FILES: [&str; 3] = ["nigel_plant.fmu", "nigel_controller.fmu", "nigel_maneuver.fmu"];
+
+const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
+
+/// The closed loop of Table III from the three FMUs.
+pub struct FmuEngine {
+    plant: Arc<Fmu>,
+    controller: Arc<Fmu>,
+    maneuver: Arc<Fmu>,
+    maneuver_values: [i32; 6],
+    fidelity_values: [i32; 2],
+    controller_values: [i32; 3],
+    gains: [[[f64; 2]; 4]; 3],
+    /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
+    /// connection by one step).
+    pub algorithm: Algorithm,
+}
+
+/// The folder `build-fmu` writes to: `$CARGO_TARGET_DIR/fmu`, else `<workspace>/target/fmu`.
+pub fn default_fmu_dir() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(t) if Path::new(&t).is_absolute() => PathBuf::from(t).join("fmu"),
+        Some(t) => Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(t).join("fmu"),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fmu"),
+    }
+}
+
+fn load(path: &Path) -> Result<Arc<Fmu>, Error> {
+    if !path.is_file() {
+        return Err(Error::MissingFmu { path: path.to_path_buf() });
+    }
+    Fmu::load(path).map_err(|source| Error::Cosim { context: format!("loading {}", path.display()), source })
+}
+
+/// The items `(name, value)` of the enumeration type of variable `variable` of `fmu`, read
+/// from its `modelDescription.xml`.
+fn enumeration_items(fmu: &Fmu, variable: &str) -> Result<Vec<(String, i32)>, String> {
+    use quick_xml::events::Event;
+    let path = fmu.unpacked_dir().join("modelDescription.xml");
+    let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut reader = quick_xml::Reader::from_str(&xml);
+    let attr = |e: &quick_xml::events::BytesStart, key: &[u8]| -> Option<String> {
+        e.attributes()
+            .flatten()
+            .find(|a| a.key.as_ref() == key)
+            .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
+    };
+    let mut simple_type: Option<String> = None;
+    let mut scalar: Option<String> = None;
+    let mut declared: Option<String> = None;
+    let mut items: Vec<(String, String, i32)> = Vec::new();
+    loop {
+        match reader.read_event() {
+            Err(e) => return Err(format!("{}: {e}", path.display())),
+            Ok(Event::Eof) => break,
+            Ok(Event::Start(e)) | Ok(Event::Empty(e)) => match e.name().as_ref() {
+                b"SimpleType" => simple_type = attr(&e, b"name"),
+                b"Item" => {
+                    let (Some(t), Some(n), Some(v)) = (&simple_type, attr(&e, b"name"), attr(&e, b"value")) else {
+                        continue;
+                    };
+                    let v = v.trim().parse::<i32>().map_err(|_| format!("item {n} of {t} has value {v:?}"))?;
+                    items.push((t.clone(), n, v));
+                }
+                b"ScalarVariable" => scalar = attr(&e, b"name"),
+                b"Enumeration" if scalar.as_deref() == Some(variable) => declared = attr(&e, b"declaredType"),
+                _ => {}
+            },
+            Ok(Event::End(e)) => match e.name().as_ref() {
+                b"SimpleType" => simple_type = None,
+                b"ScalarVariable" => scalar = None,
+                _ => {}
+            },
+            Ok(_) => {}
+        }
+    }
+    let declared = declared.ok_or_else(|| format!("no Enumeration variable {variable:?}"))?;
+    Ok(items.into_iter().filter(|(t, _, _)| *t == declared).map(|(_, n, v)| (n, v)).collect())
+}
+
+/// The value of each name of `names` in the enumeration of `variable`.
+fn enumeration_values<const N: usize>(
+    fmu: &Fmu,
+    file: &str,
+    variable: &str,
+    names: [&str; N],
+) -> Result<[i32; N], Error> {
+    let bad = |reason: String| Error::BadRun { run: format!("{file}: {variable}"), reason };
+    let items = enumeration_items(fmu, variable).map_err(bad)?;
+    let mut out = [0; N];
+    for (o, name) in out.iter_mut().zip(names) {
+        *o = items.iter().find(|(n, _)| n == name).map(|(_, v)| *v).ok_or_else(|| {
+            bad(format!("has no item {name:?} (items: {:?})", items.iter().map(|(n, _)| n).collect::<Vec<_>>()))
+        })?;
+    }
+    Ok(out)
+}
+
+/// The calculated parameters `gain_*` of the controller FMU with `controller = value`,
+/// read after initialization by the master (a run of zero steps).
+fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 2]; 4], Error> {
+    let ctx = |source| Error::Cosim { context: format!("reading the gains of {}", FMU_FILES[1]), source };
+    let mut b = SystemBuilder::new();
+    b.add_instance("controller", fmu.clone()).map_err(ctx)?;
+    b.set("controller.controller", Value::Integer(value)).map_err(ctx)?;
+    let names: Vec<String> =
+        WHEELS.iter().flat_map(|w| ["beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}"))).collect();
+    let experiment = Experiment { record: Some(names.clone()), ..Experiment::new(0.0, SAMPLE_PERIOD) };
+    let (results, _) = simulate(&b.build(), &experiment).map_err(ctx)?;
+    let mut k = [[0.0; 2]; 4];
+    for (i, name) in names.iter().enumerate() {
+        let bare = name.trim_start_matches("controller.");
+        let v = results
+            .column(bare)
+            .and_then(|c| c.first().copied())
+            .ok_or_else(|| Error::BadRun { run: FMU_FILES[1].into(), reason: format!("no value of {name}") })?;
+        k[i / 2][i % 2] = v;
+    }
+    Ok(k)
+}
+
+fn index<T: PartialEq>(all: &[T], x: &T) -> usize {
+    all.iter().position(|a| a == x).unwrap_or(0)
+}
+
+impl FmuEngine {
+    /// Loads `nigel_plant.fmu`, `nigel_controller.fmu` and `nigel_maneuver.fmu` from `dir`.
+    pub fn load_dir(dir: &Path) -> Result<FmuEngine, Error> {
+        FmuEngine::load(&dir.join(FMU_FILES[0]), &dir.join(FMU_FILES[1]), &dir.join(FMU_FILES[2]))
+    }
+
+    /// Loads the three archives from the default folder ([`default_fmu_dir`]).
+    pub fn load_default() -> Result<FmuEngine, Error> {
+        FmuEngine::load_dir(&default_fmu_dir())
+    }
+
+    /// Loads the three archives and resolves the enumeration items it sets.
+    pub fn load(plant: &Path, controller: &Path, maneuver: &Path) -> Result<FmuEngine, Error> {
+        let (p, c, m) = (load(plant)?, load(controller)?, load(maneuver)?);
+        let maneuver_values = enumeration_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
+        let fidelity_values = enumeration_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
+        let controller_values =
+            enumeration_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
+        let mut gains = [[[0.0; 2]; 4]; 3];
+        for (g, value) in gains.iter_mut().zip(controller_values) {
+            *g = controller_gain(&c, value)?;
+        }
+        Ok(FmuEngine {
+            plant: p,
+            controller: c,
+            maneuver: m,
+            maneuver_values,
+            fidelity_values,
+            controller_values,
+            gains,
+            algorithm: Algorithm::Ordered,
+        })
+    }
+
+    /// The gain the controller FMU uses for each controller of Table III (its calculated
+    /// parameters `gain_beta_fl .. gain_yaw_rate_rr` after initialization).
+    pub fn gains(&self) -> [[[f64; 2]; 4]; 3] {
+        self.gains
+    }
+
+    /// The same engine with another communication algorithm.
+    pub fn with_algorithm(mut self, algorithm: Algorithm) -> FmuEngine {
+        self.algorithm = algorithm;
+        self
+    }
+
+    /// The system of one job: three instances `plant`, `controller`, `maneuver`, their
+    /// parameters and the closed-loop connections of the issue-6 contract.
+    pub fn system(&self, job: &Job) -> Result<System, Error> {
+        let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
+        let controller = Controller::TABLE.iter().position(|c| *c == job.controller).ok_or_else(|| {
+            Error::Usage(format!(
+                "the controller FMU runs open_loop, pole_placement and robust, not {}",
+                job.controller
+            ))
+        })?;
+        let seed = i32::try_from(job.seed).map_err(|_| {
+            Error::Usage(format!("seed {} does not fit the test bench's Integer seed (0 ..= {})", job.seed, i32::MAX))
+        })?;
+        let mut b = SystemBuilder::new();
+        b.add_instance("plant", self.plant.clone()).map_err(ctx)?;
+        b.add_instance("controller", self.controller.clone()).map_err(ctx)?;
+        b.add_instance("maneuver", self.maneuver.clone()).map_err(ctx)?;
+        b.set("maneuver.maneuver", Value::Integer(self.maneuver_values[index(&Maneuver::ALL, &job.maneuver)]))
+            .map_err(ctx)?;
+        b.set("maneuver.fidelity", Value::Integer(self.fidelity_values[index(&Fidelity::ALL, &job.fidelity)]))
+            .map_err(ctx)?;
+        b.set("maneuver.seed", Value::Integer(seed)).map_err(ctx)?;
+        if !job.disturbed {
+            for switch in ["friction_variation", "wind", "measurement_noise"] {
+                b.set(&format!("maneuver.{switch}"), Value::Boolean(false)).map_err(ctx)?;
+            }
+        }
+        b.set("controller.controller", Value::Integer(self.controller_values[controller])).map_err(ctx)?;
+        let real = job.fidelity == Fidelity::Real;
+        for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
+            b.set(&format!("plant.{switch}"), Value::Boolean(real)).map_err(ctx)?;
+        }
+        b.set("plant.v_x", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
+        let mut connect = |from: &str, to: &str| b.connect(from, to).map(|_| ()).map_err(ctx);
+        for w in WHEELS {
+            connect(&format!("controller.delta_{w}"), &format!("plant.delta_{w}"))?;
+            connect(&format!("controller.tau_{w}"), &format!("plant.tau_{w}"))?;
+            connect(&format!("maneuver.mu_{w}"), &format!("plant.mu_{w}"))?;
+            connect(&format!("maneuver.delta_ff_{w}"), &format!("controller.delta_ff_{w}"))?;
+        }
+        connect("maneuver.wind_x", "plant.wind_x")?;
+        connect("maneuver.wind_y", "plant.wind_y")?;
+        connect("maneuver.beta_meas", "controller.beta")?;
+        connect("maneuver.yaw_rate_meas", "controller.yaw_rate")?;
+        connect("plant.speed", "controller.speed")?;
+        connect("maneuver.beta_ref", "controller.beta_ref")?;
+        connect("maneuver.yaw_rate_ref", "controller.yaw_rate_ref")?;
+        connect("maneuver.speed_ref", "controller.speed_ref")?;
+        connect("plant.beta", "maneuver.beta")?;
+        connect("plant.yaw_rate", "maneuver.yaw_rate")?;
+        Ok(b.build())
+    }
+
+    /// Writes the closed loop of `job` as an SSP 1.0 archive (`SystemStructure.ssd` and the
+    /// three FMUs; parameters as inline bindings), to run in other tools (fmpy's
+    /// `simulate_ssp`, ecos, libcosim). Its default experiment is 0 .. 30 s.
+    pub fn write_ssp(&self, job: &Job, path: &Path) -> Result<(), Error> {
+        let system = self.system(job)?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(crate::error::io(dir))?;
+        }
+        nigel_cosim::write_ssp(&system, "nigel_closed_loop", Some(N_SAMPLES as f64 * SAMPLE_PERIOD), path)
+            .map_err(|source| Error::Cosim { context: format!("writing {}", path.display()), source })
+    }
+
+    /// The variables a run records.
+    pub fn recorded() -> Vec<String> {
+        let mut v: Vec<String> = ["plant.x", "plant.y", "plant.psi", "plant.beta", "plant.yaw_rate"]
+            .into_iter()
+            .chain([
+                "maneuver.x_ref",
+                "maneuver.y_ref",
+                "maneuver.psi_ref",
+                "maneuver.beta_ref",
+                "maneuver.yaw_rate_ref",
+            ])
+            .map(String::from)
+            .collect();
+        for stem in ["controller.delta", "maneuver.mu"] {
+            v.extend(WHEELS.iter().map(|w| format!("{stem}_{w}")));
+        }
+        v
+    }
+}
+
+fn column(results: &Results, name: &str, job: &Job) -> Result<Vec<f64>, Error> {
+    results
+        .column(name)
+        .ok_or_else(|| Error::BadRun { run: job.label(), reason: format!("no column {name} in the results") })
+}
+
+impl Engine for FmuEngine {
+    fn name(&self) -> String {
+        let alg = match self.algorithm {
+            Algorithm::Ordered => "ordered",
+            Algorithm::Jacobi => "jacobi",
+        };
+        format!("FMUs via nigel_cosim ({alg}, 1 ms)")
+    }
+
+    fn run(&self, job: &Job) -> Result<Run, Error> {
+        self.run_system(&self.system(job)?, job)
+    }
+}
+
+impl FmuEngine {
+    /// Runs `system` (instances `plant`, `controller`, `maneuver` wired for `job`, e.g. an
+    /// SSP read back with `nigel_cosim::read_ssp`) over the benchmark horizon and records it.
+    pub fn run_system(&self, system: &System, job: &Job) -> Result<Run, Error> {
+        let experiment = Experiment {
+            algorithm: self.algorithm,
+            record: Some(FmuEngine::recorded()),
+            ..Experiment::new(N_SAMPLES as f64 * SAMPLE_PERIOD, SAMPLE_PERIOD)
+        };
+        let (results, _summary) =
+            simulate(system, &experiment).map_err(|source| Error::Cosim { context: job.label(), source })?;
+        let col = |name: &str| column(&results, name, job);
+        let n = results.rows().saturating_sub(1);
+        let wheels = |stem: &str| -> Result<Vec<[f64; 4]>, Error> {
+            let c: Vec<Vec<f64>> = WHEELS.iter().map(|w| col(&format!("{stem}_{w}"))).collect::<Result<_, _>>()?;
+            Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
+        };
+        let gain = self.gains[index(&Controller::TABLE, &job.controller)];
+        let run = Run {
+            job: *job,
+            gain,
+            x: col("plant.x")?,
+            y: col("plant.y")?,
+            psi: col("plant.psi")?,
+            beta: col("plant.beta")?,
+            yaw_rate: col("plant.yaw_rate")?,
+            x_ref: col("maneuver.x_ref")?,
+            y_ref: col("maneuver.y_ref")?,
+            psi_ref: col("maneuver.psi_ref")?,
+            beta_ref: col("maneuver.beta_ref")?,
+            yaw_rate_ref: col("maneuver.yaw_rate_ref")?,
+            delta: wheels("controller.delta")?,
+            mu: wheels("maneuver.mu")?,
+        };
+        run.check()?;
+        Ok(run)
+    }
+}

@@ -1,0 +1,153 @@
+//! The table as markdown (ours beside the paper's) and as the JSON of the contract:
+//! `{"seed", "gains": {"robust", "pole_placement"}, "results": {"sim"|"real": {maneuver:
+//! {controller: {"eps", "rmse": [x, y, psi], "eps_state"}}}}, "wall_s"}`.
+
+use std::fmt::Write;
+
+use serde_json::{json, Map, Value};
+
+use crate::{paper, Controller, Table};
+
+fn gain_json(k: &[[f64; 2]; 4]) -> Value {
+    Value::Array(k.iter().map(|row| json!([row[0], row[1]])).collect())
+}
+
+/// The JSON of the contract (keys sorted; numbers in shortest round-trip form).
+pub fn json(table: &Table) -> Value {
+    let mut v = json_without_wall(table);
+    if let Value::Object(m) = &mut v {
+        m.insert("wall_s".into(), json!(table.wall_s));
+    }
+    v
+}
+
+/// [`json`] without `wall_s`: equal for two runs of the same seed, bit for bit.
+pub fn json_without_wall(table: &Table) -> Value {
+    let mut gains = Map::new();
+    for (c, k) in &table.gains {
+        gains.insert(c.name().into(), gain_json(k));
+    }
+    let mut results = Map::new();
+    for f in table.fidelities() {
+        let mut column = Map::new();
+        for m in table.maneuvers() {
+            let mut row = Map::new();
+            for cell in table.cells.iter().filter(|c| c.fidelity == f && c.maneuver == m) {
+                let r = &cell.metric;
+                row.insert(
+                    cell.controller.name().into(),
+                    json!({"eps": r.eps, "rmse": [r.rmse[0], r.rmse[1], r.rmse[2]], "eps_state": r.eps_state}),
+                );
+            }
+            column.insert(m.name().into(), Value::Object(row));
+        }
+        results.insert(f.column().into(), Value::Object(column));
+    }
+    json!({"seed": table.seed, "gains": gains, "results": results})
+}
+
+fn heading(c: Controller) -> &'static str {
+    match c {
+        Controller::OpenLoop => "open-loop",
+        Controller::PolePlacement => "non-robust",
+        Controller::Robust => "robust",
+        Controller::Custom(_) => "custom",
+    }
+}
+
+/// `3.081e-2` (four significant digits; the paper prints three).
+pub fn sci(x: f64) -> String {
+    format!("{x:.3e}")
+}
+
+/// The markdown report: per column Table III (ours and the paper's, the lowest of each
+/// row), the auxiliary `||(RMSE_beta, RMSE_r)||`, and the gains.
+pub fn markdown(table: &Table) -> String {
+    let mut s = String::new();
+    let controllers = table.controllers();
+    let _ = writeln!(
+        s,
+        "Table III, seed {} ({}), epsilon = ||(RMSE_X, RMSE_Y, RMSE_psi)||_2 [m, m, rad]",
+        table.seed, table.engine
+    );
+    let _ = writeln!(s);
+    for f in table.fidelities() {
+        let _ = write!(s, "| {} | ", f.column());
+        for &c in &controllers {
+            let _ = write!(s, "{} | ", heading(c));
+        }
+        let _ = write!(s, "lowest | ");
+        for &c in &controllers {
+            let _ = write!(s, "paper {} | ", heading(c));
+        }
+        let _ = writeln!(s, "paper lowest |");
+        let _ = writeln!(s, "|---|{}", "---:|".repeat(2 * controllers.len() + 2));
+        for m in table.maneuvers() {
+            let _ = write!(s, "| {} | ", m.name());
+            let lowest = table.lowest(f, m);
+            for &c in &controllers {
+                match table.get(f, m, c) {
+                    Some(cell) if Some(c) == lowest => {
+                        let _ = write!(s, "**{}** | ", sci(cell.metric.eps));
+                    }
+                    Some(cell) => {
+                        let _ = write!(s, "{} | ", sci(cell.metric.eps));
+                    }
+                    None => s.push_str("- | "),
+                }
+            }
+            let _ = write!(s, "{} | ", lowest.map_or("-", heading));
+            let mut paper_best: Option<(Controller, f64)> = None;
+            for &c in &controllers {
+                match paper::epsilon(f, m, c) {
+                    Some(e) => {
+                        let _ = write!(s, "{} | ", sci(e));
+                        if paper_best.map_or(true, |(_, b)| e < b) {
+                            paper_best = Some((c, e));
+                        }
+                    }
+                    None => s.push_str("- | "),
+                }
+            }
+            let _ = writeln!(s, "{} |", paper_best.map_or("-", |(c, _)| heading(c)));
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(s, "Auxiliary: ||(RMSE_beta, RMSE_r)||_2 [rad, rad/s] (what the controllers regulate)");
+    let _ = writeln!(s);
+    for f in table.fidelities() {
+        let _ = write!(s, "| {} | ", f.column());
+        for &c in &controllers {
+            let _ = write!(s, "{} | ", heading(c));
+        }
+        let _ = writeln!(s, "lowest |");
+        let _ = writeln!(s, "|---|{}", "---:|".repeat(controllers.len() + 1));
+        for m in table.maneuvers() {
+            let _ = write!(s, "| {} | ", m.name());
+            let cells: Vec<_> = controllers.iter().filter_map(|&c| table.get(f, m, c)).collect();
+            let lowest =
+                cells.iter().min_by(|a, b| a.metric.eps_state.total_cmp(&b.metric.eps_state)).map(|c| c.controller);
+            for &c in &controllers {
+                match table.get(f, m, c) {
+                    Some(cell) if Some(c) == lowest => {
+                        let _ = write!(s, "**{}** | ", sci(cell.metric.eps_state));
+                    }
+                    Some(cell) => {
+                        let _ = write!(s, "{} | ", sci(cell.metric.eps_state));
+                    }
+                    None => s.push_str("- | "),
+                }
+            }
+            let _ = writeln!(s, "{} |", lowest.map_or("-", heading));
+        }
+        let _ = writeln!(s);
+    }
+    for (c, k) in &table.gains {
+        let _ = writeln!(s, "K {} (rows FL, FR, RL, RR; [k_beta, k_yaw_rate]):", c.name());
+        for (w, row) in ["FL", "FR", "RL", "RR"].iter().zip(k) {
+            let _ = writeln!(s, "  {w}: [{:+.6}, {:+.6}]", row[0], row[1]);
+        }
+    }
+    let _ = writeln!(s, "{} runs in {:.3} s wall", table.cells.len(), table.wall_s);
+    s
+}

@@ -1,0 +1,131 @@
+//! The `table3` binary: clear errors for bad input, the JSON contract, CSV and PNG output.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn table3(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_table3")).args(args).output().expect("the binary starts")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn unknown_maneuver_is_a_clear_error() {
+    let o = table3(&["--engine", "in-process", "--maneuver", "drift"]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("unknown maneuver \"drift\"") && e.contains("figure_8"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn unparsable_seed_is_a_clear_error() {
+    for seed in ["abc", "-1", "1.5", "99999999999999999999999"] {
+        let o = table3(&["--engine", "in-process", "--seed", seed]);
+        assert!(!o.status.success(), "{seed}");
+        let e = stderr(&o);
+        assert!(e.contains("--seed") && e.contains(seed), "{seed}: {e}");
+        assert!(!e.contains("panicked"), "{e}");
+    }
+}
+
+#[test]
+fn missing_fmus_are_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = table3(&["--fmu-dir", dir.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("nigel_plant.fmu not found") && e.contains("build-fmu"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn corrupt_fmus_are_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in nigel_table3::engine::FMU_FILES {
+        std::fs::write(dir.path().join(name), b"PK\x03\x04 this is not a zip archive").unwrap();
+    }
+    let o = table3(&["--fmu-dir", dir.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("loading") && e.contains("nigel_plant.fmu"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn json_has_the_contract_shape_and_the_printed_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("t.json");
+    let csv = dir.path().join("csv");
+    let o = table3(&[
+        "--engine",
+        "in-process",
+        "--seed",
+        "5",
+        "--maneuver",
+        "lane_change",
+        "--json",
+        json.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
+    assert_eq!(keys, ["gains", "results", "seed", "wall_s"]);
+    assert_eq!(v["seed"], 5);
+    assert!(v["wall_s"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["gains"]["robust"][2][1].as_f64().unwrap(), nigel_benchmark::gains::ROBUST[2][1]);
+    assert_eq!(v["gains"]["pole_placement"][0][0].as_f64().unwrap(), nigel_benchmark::gains::POLE_PLACEMENT[0][0]);
+    for k in ["robust", "pole_placement"] {
+        let rows = v["gains"][k].as_array().unwrap();
+        assert_eq!(rows.len(), 4);
+        assert!(rows.iter().all(|r| r.as_array().unwrap().len() == 2));
+    }
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    for column in ["sim", "real"] {
+        let row = &v["results"][column]["lane_change"];
+        assert_eq!(row.as_object().unwrap().len(), 3);
+        for c in ["open_loop", "pole_placement", "robust"] {
+            let cell = &row[c];
+            let eps = cell["eps"].as_f64().unwrap();
+            let rmse: Vec<f64> = cell["rmse"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            assert_eq!(rmse.len(), 3);
+            assert!((eps - rmse.iter().map(|x| x * x).sum::<f64>().sqrt()).abs() <= 1e-15 * eps);
+            assert!(cell["eps_state"].as_f64().unwrap() > 0.0);
+            // the markdown prints the same number
+            assert!(stdout.contains(&format!("{eps:.3e}")), "{eps:.3e} not in\n{stdout}");
+        }
+        // one CSV per run, 30,001 rows and a header
+        let text = std::fs::read_to_string(csv.join(format!("{column}_lane_change_robust.csv"))).unwrap();
+        assert_eq!(text.lines().count(), 30_002);
+        assert!(text.starts_with("t,x,y,psi,x_ref"));
+    }
+    assert!(v["results"]["sim"].get("skidpad").is_none());
+}
+
+#[test]
+fn png_figures_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = table3(&["--engine", "in-process", "--maneuver", "straight", "--png", dir.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for name in ["fig7_sim.png", "fig7_real.png", "time_sim_straight.png", "time_real_straight.png"] {
+        let bytes = std::fs::read(dir.path().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name}");
+        let (w, h) = png_size(&bytes);
+        assert!(w >= 1500 && h >= 600, "{name}: {w} x {h}");
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+    assert!(!Path::new(&dir.path().join("time_sim_skidpad.png")).exists());
+}
+
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    (be(16), be(20))
+}

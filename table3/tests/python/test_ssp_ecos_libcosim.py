@@ -1,0 +1,130 @@
+"""The closed loop of Table III exported as SSP (`table3 --ssp`) run by libcosim
+(libcosimpy 0.0.6) and ecos (ecospy 0.7.2) for one job (sim, lane_change, robust), 30 s at
+1 ms. Both delay every connection by one step as our `jacobi` does and apply the SSD's
+inline parameter bindings themselves.
+
+What does not work yet: neither tool sees the FMUs' Enumeration variables (libcosim lists
+no `maneuver`, `fidelity` or `controller` among the variables), so those bindings are
+dropped and the test bench and controller keep their defaults (straight, paper, robust);
+neither applies the binding of `plant.v_x = 0.35`, the start value of an output state
+(initial = exact), so the car starts at rest. Epsilon comes out 2.5626e-2 in both, against
+our 4.1361e-2 (jacobi). The comparison with our runs (within 2 % of `ordered`, 1e-9 of
+`jacobi`) is therefore a strict expected failure until the FMUs take those settings as
+plain Integer / parameter variables; what is asserted now is that libcosim and ecos agree
+with each other to 1e-12 over the 30 000 steps.
+
+Conventions (see cosim/tests/python/test_cosim_ecos_libcosim.py): libcosim's observer reads
+the outputs right after a step, as our master records them; ecos reads after the
+connections are applied, which changes only direct-feedthrough outputs: the pose and the
+reference pose compared here have none."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import target_dir
+
+JOB = "sim/lane_change/robust"
+N = 30_000
+POSE = ["plant.x", "plant.y", "plant.psi", "maneuver.x_ref", "maneuver.y_ref", "maneuver.psi_ref"]
+
+
+def epsilon(v):
+    x, y, psi, x_ref, y_ref, psi_ref = (np.asarray(v[n]) for n in POSE)
+    rmse = [np.sqrt(np.mean((a - b) ** 2)) for a, b in ((x, x_ref), (y, y_ref), (psi, psi_ref))]
+    return float(np.linalg.norm(rmse))
+
+
+@pytest.fixture(scope="module")
+def ssp(table3):
+    p = target_dir() / "ssp" / "nigel_closed_loop.ssp"
+    subprocess.run([str(table3), "--ssp", str(p), "--ssp-job", JOB], check=True, capture_output=True)
+    return p
+
+
+@pytest.fixture(scope="module")
+def ours(table3, tmp_path_factory):
+    d = tmp_path_factory.mktemp("ours")
+    out = {}
+    for alg in ("ordered", "jacobi"):
+        subprocess.run([str(table3), "--quiet", "--algorithm", alg, "--maneuver", "lane_change",
+                        "--json", str(d / f"{alg}.json"), "--csv", str(d / alg)],
+                       check=True, capture_output=True)
+        cells = json.loads((d / f"{alg}.json").read_text())["results"]["sim"]["lane_change"]
+        rows = np.genfromtxt(d / alg / "sim_lane_change_robust.csv", delimiter=",", names=True)
+        out[alg] = (cells["robust"]["eps"], rows)
+    return out
+
+
+def check(name, series, ours):
+    eps = epsilon(series)
+    eps_ordered, _ = ours["ordered"]
+    eps_jacobi, rows = ours["jacobi"]
+    worst = max(float(np.max(np.abs(np.asarray(series[n]) - rows[n.split(".")[1]][1:N + 1]))) for n in POSE)
+    print(f"{name}: epsilon {eps:.12g} (ours jacobi {eps_jacobi:.12g}, ordered {eps_ordered:.12g}); "
+          f"largest pose difference from our jacobi run {worst:.3g}")
+    assert abs(eps - eps_ordered) <= 0.02 * eps_ordered
+    assert abs(eps - eps_jacobi) <= 1e-9 * eps_jacobi
+
+
+@pytest.fixture(scope="module")
+def libcosim(ssp):
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    ex = CosimExecution.from_ssp_file(str(ssp), step_size=1_000_000)  # 1 ms in ns
+    obs = CosimObserver.create_last_value()
+    ex.add_observer(obs)
+    slots = []
+    for name in POSE:
+        inst, var = name.split(".")
+        i = ex.slave_index_from_instance_name(inst)
+        refs = {v.name.decode(): v.reference for v in ex.slave_variables(i)}
+        slots.append((i, refs[var]))
+    series = {n: [] for n in POSE}
+    for _ in range(N):
+        ex.step(1)
+        for name, (i, r) in zip(POSE, slots):
+            series[name].append(obs.last_real_values(i, [r])[0])
+    return series
+
+
+@pytest.fixture(scope="module")
+def ecos(ssp):
+    from ecospy import EcosSimulation
+
+    sim = EcosSimulation(ssp_path=str(ssp), step_size=1e-3)
+    sim.init()
+    series = {n: [] for n in POSE}
+    for _ in range(N):
+        sim.step(1)
+        for name in POSE:
+            series[name].append(sim.get_real(name.replace(".", "::")))
+    sim.terminate()
+    return series
+
+
+def test_libcosim_and_ecos_run_the_exported_loop_alike(libcosim, ecos):
+    for name in POSE:
+        assert len(libcosim[name]) == N and len(ecos[name]) == N
+        assert np.max(np.abs(np.asarray(libcosim[name]) - np.asarray(ecos[name]))) <= 1e-12, name
+    # the car got up to speed and drove (from rest: the v_x binding is not applied)
+    assert libcosim["plant.x"][0] < 1e-5 and libcosim["plant.x"][-1] > 10.0
+    print(f"libcosim and ecos: epsilon {epsilon(libcosim):.12g}, {epsilon(ecos):.12g}")
+
+
+V_X_REASON = ("libcosim and ecos drop the bindings of the Enumeration parameters (maneuver, fidelity, "
+              "controller) and of plant.v_x (an output state's start value)")
+
+
+@pytest.mark.xfail(strict=True, reason=V_X_REASON)
+def test_libcosim_equals_our_runs(libcosim, ours):
+    check("libcosim", libcosim, ours)
+
+
+@pytest.mark.xfail(strict=True, reason=V_X_REASON)
+def test_ecos_equals_our_runs(ecos, ours):
+    check("ecos", ecos, ours)
