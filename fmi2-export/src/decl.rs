@@ -290,6 +290,9 @@ pub fn enumeration_type(name: &str, description: &str, items: &[(&str, i32, &str
 pub struct Declaration<B> {
     pub spec: DeclarationSpec<B>,
     lookup: HashMap<(BaseType, u32), usize>,
+    /// `dense[base type][vr]` = row (or `NO_ROW`), for value references below
+    /// `DENSE_VR_LIMIT`: the lookup of every get/set, without hashing.
+    dense: [Vec<u32>; 3],
     /// Rows of the continuous states, in the order of the state vector (= Derivatives order).
     pub state_rows: Vec<usize>,
     /// Rows of the derivatives, same order.
@@ -299,6 +302,19 @@ pub struct Declaration<B> {
     pub saved_rows: Vec<usize>,
     description: md::ModelDescription,
     xml: String,
+}
+
+/// Value references below this are looked up in a table; larger ones (legal, but rare) in
+/// the hash map.
+const DENSE_VR_LIMIT: u32 = 1 << 16;
+const NO_ROW: u32 = u32::MAX;
+
+fn base_type_slot(base_type: BaseType) -> usize {
+    match base_type {
+        BaseType::Real => 0,
+        BaseType::Integer => 1,
+        BaseType::Boolean => 2,
+    }
 }
 
 /// Log categories every FMU of ours offers.
@@ -521,13 +537,30 @@ impl<B> Declaration<B> {
                         && matches!(v.causality, Causality::Local | Causality::Output))
             })
             .collect();
-        Ok(Declaration { spec, lookup, state_rows, derivative_rows, saved_rows, description, xml })
+        let mut dense: [Vec<u32>; 3] = Default::default();
+        for (&(base_type, vr), &row) in &lookup {
+            if vr < DENSE_VR_LIMIT {
+                let table = &mut dense[base_type_slot(base_type)];
+                if table.len() <= vr as usize {
+                    table.resize(vr as usize + 1, NO_ROW);
+                }
+                table[vr as usize] = row as u32;
+            }
+        }
+        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, description, xml })
     }
 
     /// Row of the variable with this base type and value reference.
     #[inline]
     pub fn row(&self, base_type: BaseType, vr: u32) -> Option<usize> {
-        self.lookup.get(&(base_type, vr)).copied()
+        if vr < DENSE_VR_LIMIT {
+            match self.dense[base_type_slot(base_type)].get(vr as usize) {
+                Some(&row) if row != NO_ROW => Some(row as usize),
+                _ => None,
+            }
+        } else {
+            self.lookup.get(&(base_type, vr)).copied()
+        }
     }
 
     #[inline]
@@ -593,6 +626,22 @@ mod tests {
             VarDecl::real("k", 3, 3).parameter(Start::Real(2.0)),
             VarDecl::boolean("on", 1, 4).parameter(Start::Boolean(true)),
         ]
+    }
+
+    #[test]
+    fn value_references_are_found_per_base_type_below_and_above_the_table_limit() {
+        let mut v = toy();
+        v.push(VarDecl::real("far", DENSE_VR_LIMIT + 7, 5).parameter(Start::Real(1.0)));
+        v.push(VarDecl::integer("n", 5, 6).parameter(Start::Integer(3)));
+        let d = Declaration::new(spec(v)).unwrap();
+        for (row, var) in d.spec.variables.iter().enumerate() {
+            assert_eq!(d.row(var.base_type, var.value_reference), Some(row), "{}", var.name);
+        }
+        assert_eq!(d.row(BaseType::Real, 4), None); // a gap in the table
+        assert_eq!(d.row(BaseType::Real, 6), None); // past the table's end
+        assert_eq!(d.row(BaseType::Boolean, 5), None); // Real 5 and Integer 5 exist, Boolean 5 does not
+        assert_eq!(d.row(BaseType::Real, DENSE_VR_LIMIT + 8), None);
+        assert_eq!(d.row(BaseType::Integer, u32::MAX), None);
     }
 
     #[test]
