@@ -325,7 +325,7 @@ pub struct TestBench {
 impl TestBench {
     fn scenario_now(&self) -> Result<Scenario, String> {
         let d = self.duration;
-        if !(d >= SAMPLE_PERIOD && d <= MAX_DURATION) {
+        if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&d) {
             return Err(format!("duration = {d} refused: must be in [1 ms, {MAX_DURATION} s]"));
         }
         let scenario = Scenario { n_samples: (d / SAMPLE_PERIOD).round() as usize, ..self.scenario };
@@ -422,7 +422,7 @@ impl Model for TestBench {
                 self.scenario.speed_ref = value;
             }
             Var::Duration => {
-                if !(value >= SAMPLE_PERIOD && value <= MAX_DURATION) {
+                if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&value) {
                     return Err(format!("duration = {value} refused: must be in [1 ms, {MAX_DURATION} s]").into());
                 }
                 self.duration = value;
