@@ -21,7 +21,7 @@ use std::sync::OnceLock;
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
     enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate,
-    Initial, InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+    Initial, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
 };
 use nigel_benchmark::control::{FORCE_MAX, KI_SPEED, KP_SPEED};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
@@ -29,6 +29,14 @@ use nigel_benchmark::{ControllerInputs, ControllerOutputs, ControllerSettings, S
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_controller";
+
+/// Most samples the controller runs in Co-Simulation without the importer reading or setting
+/// a value in between (1000 s at 1 ms): a longer run (a 10^9 s `fmi2DoStep`, a sample period of 1e-300 s)
+/// is refused with `fmi2Error` instead of hanging the importer.
+pub const MAX_SAMPLES_UNATTENDED: u64 = 1_000_000;
+
+/// Smallest sample period accepted [s].
+pub const MIN_SAMPLE_PERIOD: f64 = 1e-6;
 
 /// The items of the `controller` enumeration.
 pub mod mode {
@@ -187,7 +195,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
         ),
     ];
     for (name, r, b, start, unit, text) in params {
-        let mut p = VarDecl::real(name, r, b).parameter(Start::Real(start)).unit(unit).describe(text).min(0.0);
+        let min = if b == Var::SamplePeriod { MIN_SAMPLE_PERIOD } else { 0.0 };
+        let mut p = VarDecl::real(name, r, b).parameter(Start::Real(start)).unit(unit).describe(text).min(min);
         if b == Var::SteerLimit {
             p = p.max(core::f64::consts::FRAC_PI_2);
         }
@@ -280,6 +289,9 @@ pub struct Controller {
     k: u64,
     /// Time of sample 0.
     start_time: f64,
+    /// Co-Simulation: samples run since the importer last read or set a value.
+    unattended: u64,
+    interface: Interface,
 }
 
 impl Controller {
@@ -328,7 +340,7 @@ impl Model for Controller {
         })
     }
 
-    fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
+    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         let settings = ControllerSettings::default();
         Ok(Controller {
             inputs: ControllerInputs {
@@ -348,10 +360,13 @@ impl Model for Controller {
             pending_increment: 0.0,
             k: 0,
             start_time: 0.0,
+            unattended: 0,
+            interface: context.interface,
         })
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
+        self.unattended = 0;
         let x = &self.inputs;
         let s = &self.settings;
         Ok(match b {
@@ -379,6 +394,7 @@ impl Model for Controller {
     }
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
+        self.unattended = 0;
         let x = &mut self.inputs;
         let s = &mut self.settings;
         match b {
@@ -394,7 +410,12 @@ impl Model for Controller {
             Var::Torque(i) => self.held.tau[i] = value,
             Var::DriveForce => self.held.force = value,
             Var::SpeedIntegral => self.integral = value,
-            Var::SamplePeriod => Self::set_parameter(&mut s.sample_period, "sample_period", value, true)?,
+            Var::SamplePeriod => {
+                if !(value >= MIN_SAMPLE_PERIOD) {
+                    return Err(format!("sample_period = {value} refused: must be >= {MIN_SAMPLE_PERIOD} s").into());
+                }
+                s.sample_period = value;
+            }
             Var::KpSpeed => Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?,
             Var::KiSpeed => Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?,
             Var::ForceMax => Self::set_parameter(&mut s.force_max, "force_max", value, true)?,
@@ -434,6 +455,16 @@ impl Model for Controller {
     }
 
     fn event_update(&mut self, time: f64) -> ModelResult<EventUpdate> {
+        // in Model Exchange every event is one fmi2NewDiscreteStates call of the importer
+        self.unattended += (self.interface == Interface::CoSimulation) as u64;
+        if self.unattended > MAX_SAMPLES_UNATTENDED {
+            return Err(format!(
+                "more than {MAX_SAMPLES_UNATTENDED} samples (sample_period = {} s) without the importer reading or \
+                 setting a value: the step to beyond t = {time} s is refused",
+                self.settings.sample_period
+            )
+            .into());
+        }
         if self.k == 0 {
             self.start_time = time;
         } else {

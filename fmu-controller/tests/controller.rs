@@ -363,3 +363,24 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     let out = md.model_structure.outputs.iter().find(|u| u.index == index("tau_fl")).unwrap();
     assert_eq!(out.dependencies.as_ref(), Some(&vec![index("speed"), index("speed_ref")]));
 }
+
+#[test]
+fn a_step_of_astronomically_many_samples_is_refused_not_run() {
+    let c = C::cs();
+    c.init();
+    set_inputs(&c, &SETS[0]);
+    // 10^9 s at 1 ms would be 10^12 samples: refused after 10^6 unattended ones
+    assert_eq!(c.step(0.0, 1e9), ERR);
+    assert!(c.last_error().contains("samples"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    // a tiny sample period is refused up front
+    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, 5e-324), ERR);
+    assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
+    c.init();
+    // 300 s in 100 s steps with a read between them is a normal run
+    for k in 0..3 {
+        assert_eq!(c.step(k as f64 * 100.0, 100.0), OK, "{}", c.last_error());
+        assert!(c.real(vr::SPEED_INTEGRAL).is_finite());
+    }
+}

@@ -13,20 +13,50 @@
 // `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
     enumeration_type, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
     InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
 };
-use nigel_benchmark::scenario::MAX_SAMPLES;
 use nigel_benchmark::{
     BenchSample, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE, SAMPLE_PERIOD,
 };
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_maneuver";
+
+/// Longest reference the FMU computes (10 minutes: 600,000 samples, about 50 MB and 1.5 s
+/// at initialization); `duration` above it is refused.
+pub const MAX_DURATION: f64 = 600.0;
+
+/// Samples of the longest reference.
+const MAX_SAMPLES: usize = 600_000;
+
+/// Prepared benchmarks shared by the instances of a process (most recent last): a parameter
+/// sweep or an importer that instantiates many times computes each reference once. Only
+/// references up to 60 s are kept, at most 16 (some 40 MB).
+fn prepared(scenario: Scenario) -> Result<Arc<Benchmark>, String> {
+    static CACHE: Mutex<Vec<Arc<Benchmark>>> = Mutex::new(Vec::new());
+    const KEEP: usize = 16;
+    const KEEP_SAMPLES: usize = 60_000;
+    if let Ok(cache) = CACHE.lock() {
+        if let Some(b) = cache.iter().find(|b| b.scenario == scenario) {
+            return Ok(Arc::clone(b));
+        }
+    }
+    let bench = Arc::new(Benchmark::prepare(scenario).map_err(|e| e.to_string())?);
+    if scenario.n_samples <= KEEP_SAMPLES {
+        if let Ok(mut cache) = CACHE.lock() {
+            if cache.len() >= KEEP {
+                cache.remove(0);
+            }
+            cache.push(Arc::clone(&bench));
+        }
+    }
+    Ok(bench)
+}
 
 /// What a value reference stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -187,7 +217,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         VarDecl::real("duration", vr::DURATION, Var::Duration)
             .parameter(Start::Real(30.0))
             .min(SAMPLE_PERIOD)
-            .max(MAX_SAMPLES as f64 * SAMPLE_PERIOD)
+            .max(MAX_DURATION)
             .unit("s")
             .describe("length of the reference computed at initialization (30 s); a run may not go past it"),
     );
@@ -295,8 +325,8 @@ pub struct TestBench {
 impl TestBench {
     fn scenario_now(&self) -> Result<Scenario, String> {
         let d = self.duration;
-        if !(d >= SAMPLE_PERIOD && d <= MAX_SAMPLES as f64 * SAMPLE_PERIOD) {
-            return Err(format!("duration = {d} refused: must be in [1 ms, 10^4 s]"));
+        if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&d) {
+            return Err(format!("duration = {d} refused: must be in [1 ms, {MAX_DURATION} s]"));
         }
         let scenario = Scenario { n_samples: (d / SAMPLE_PERIOD).round() as usize, ..self.scenario };
         scenario.validate().map_err(|e| e.to_string())?;
@@ -392,8 +422,8 @@ impl Model for TestBench {
                 self.scenario.speed_ref = value;
             }
             Var::Duration => {
-                if !(value >= SAMPLE_PERIOD && value <= MAX_SAMPLES as f64 * SAMPLE_PERIOD) {
-                    return Err(format!("duration = {value} refused: must be in [1 ms, 10^4 s]").into());
+                if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&value) {
+                    return Err(format!("duration = {value} refused: must be in [1 ms, {MAX_DURATION} s]").into());
                 }
                 self.duration = value;
             }
@@ -456,8 +486,7 @@ impl Model for TestBench {
         if self.bench.as_ref().is_some_and(|b| b.scenario == scenario) {
             return Ok(());
         }
-        let bench = Benchmark::prepare(scenario).map_err(|e| e.to_string())?;
-        self.bench = Some(Arc::new(bench));
+        self.bench = Some(prepared(scenario)?);
         Ok(())
     }
 

@@ -205,6 +205,15 @@ fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     assert_eq!(b.set_real(vr::DURATION, -1.0), ERR);
     assert!(b.last_error().contains("duration"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::DURATION, 1e308), ERR, "longer than the 600 s a reference may cover");
+    assert!(b.last_error().contains("duration"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    // a step far past the reference is refused, not run
+    assert_eq!(b.set_real(vr::DURATION, 0.5), OK);
+    b.init();
+    assert_eq!(b.step(0.0, 1e9), ERR);
+    assert!(b.last_error().contains("duration"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
     assert_eq!(b.set_real(vr::DURATION, 0.01), OK);
     b.init();
     assert_eq!(b.int(vr::MANEUVER), 1);

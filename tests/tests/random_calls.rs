@@ -116,7 +116,8 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
                 }
             };
-            let mut reals_out = vec![f64::NAN; n.max(p.nx)];
+            // at least one slot: fmi2GetRealStatus writes one value (an FMU may have nx = 0)
+            let mut reals_out = vec![f64::NAN; n.max(p.nx).max(1)];
             let mut check_reals: Option<usize> = None;
             let mut new_time = None;
             let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
