@@ -232,7 +232,11 @@ pub struct ClosedLoopRun {
 }
 
 /// How many references [`Benchmark::prepare`] keeps (about 2.6 MB each for 30 s).
-pub const REFERENCE_CACHE_SIZE: usize = 12;
+pub const REFERENCE_CACHE_SIZE: usize = 16;
+
+/// Only references of at most this many samples (60 s) are kept, so the cache stays
+/// below some 80 MB.
+pub const REFERENCE_CACHE_MAX_SAMPLES: usize = 60_000;
 
 /// What a reference depends on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -310,7 +314,9 @@ impl Benchmark {
             _ => Vec::new(),
         };
         let bench = Self::prepare_with_switches(scenario, switches)?;
-        reference_cache().store(key, &bench.reference);
+        if bench.scenario.n_samples <= REFERENCE_CACHE_MAX_SAMPLES {
+            reference_cache().store(key, &bench.reference);
+        }
         Ok(bench)
     }
 

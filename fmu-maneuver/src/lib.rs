@@ -13,7 +13,7 @@
 // `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
@@ -33,30 +33,6 @@ pub const MAX_DURATION: f64 = 600.0;
 
 /// Samples of the longest reference.
 const MAX_SAMPLES: usize = 600_000;
-
-/// Prepared benchmarks shared by the instances of a process (most recent last): a parameter
-/// sweep or an importer that instantiates many times computes each reference once. Only
-/// references up to 60 s are kept, at most 16 (some 40 MB).
-fn prepared(scenario: Scenario) -> Result<Arc<Benchmark>, String> {
-    static CACHE: Mutex<Vec<Arc<Benchmark>>> = Mutex::new(Vec::new());
-    const KEEP: usize = 16;
-    const KEEP_SAMPLES: usize = 60_000;
-    if let Ok(cache) = CACHE.lock() {
-        if let Some(b) = cache.iter().find(|b| b.scenario == scenario) {
-            return Ok(Arc::clone(b));
-        }
-    }
-    let bench = Arc::new(Benchmark::prepare(scenario).map_err(|e| e.to_string())?);
-    if scenario.n_samples <= KEEP_SAMPLES {
-        if let Ok(mut cache) = CACHE.lock() {
-            if cache.len() >= KEEP {
-                cache.remove(0);
-            }
-            cache.push(Arc::clone(&bench));
-        }
-    }
-    Ok(bench)
-}
 
 /// What a value reference stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -486,7 +462,9 @@ impl Model for TestBench {
         if self.bench.as_ref().is_some_and(|b| b.scenario == scenario) {
             return Ok(());
         }
-        self.bench = Some(prepared(scenario)?);
+        // `Benchmark::prepare` keeps the recent references for the process (they depend on
+        // neither the seed nor the switches): many instances compute each one once.
+        self.bench = Some(Arc::new(Benchmark::prepare(scenario).map_err(|e| e.to_string())?));
         Ok(())
     }
 
