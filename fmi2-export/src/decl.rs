@@ -593,6 +593,13 @@ impl<B> Declaration<B> {
     }
 }
 
+/// A variable name built at run time (`format!("delta_{wheel}")`) for a declaration, which
+/// holds `&'static str`: declarations are built once per process (in a `OnceLock`), so the
+/// few hundred bytes are kept for its life on purpose.
+pub fn declared_name(name: String) -> &'static str {
+    Box::leak(name.into_boxed_str())
+}
+
 /// A unit with base-unit exponents `[kg, m, s, rad]`.
 pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
     md::Unit {

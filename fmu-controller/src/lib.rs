@@ -20,8 +20,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate,
-    Initial, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+    declared_name, enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies,
+    EventUpdate, Initial, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
 };
 use nigel_benchmark::control::{FORCE_MAX, KI_SPEED, KP_SPEED};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
@@ -110,11 +110,6 @@ pub mod vr {
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 const COLUMN: [&str; 2] = ["beta", "yaw_rate"];
 
-fn leak(s: String) -> &'static str {
-    // Names built once for the process-wide declaration (a few hundred bytes in all).
-    Box::leak(s.into_boxed_str())
-}
-
 fn build_declaration() -> DeclarationSpec<Var> {
     let mut v: Vec<VarDecl<Var>> = vec![
         VarDecl::real("beta", vr::BETA, Var::Beta)
@@ -144,7 +139,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     ];
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            VarDecl::real(leak(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
+            VarDecl::real(declared_name(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
                 .input(Start::Real(0.0))
                 .unit("rad")
                 .describe("feed-forward steering (the maneuver's program)"),
@@ -153,7 +148,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     let steer_deps = |i: u32| vec![vr::BETA, vr::YAW_RATE, vr::BETA_REF, vr::YAW_RATE_REF, vr::DELTA_FF + i];
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            VarDecl::real(leak(format!("delta_{w}")), vr::DELTA + i as u32, Var::Steer(i))
+            VarDecl::real(declared_name(format!("delta_{w}")), vr::DELTA + i as u32, Var::Steer(i))
                 .discrete_output(Dependencies::On(steer_deps(i as u32)))
                 .unit("rad")
                 .describe("steering command delta_ff + K (x - x_ref), clamped to +-delta_max; held over a sample"),
@@ -161,7 +156,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     }
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            VarDecl::real(leak(format!("tau_{w}")), vr::TAU + i as u32, Var::Torque(i))
+            VarDecl::real(declared_name(format!("tau_{w}")), vr::TAU + i as u32, Var::Torque(i))
                 .discrete_output(Dependencies::On(vec![vr::SPEED, vr::SPEED_REF]))
                 .unit("N.m")
                 .describe("drive torque F r_wheel / 4; held over a sample"),
@@ -206,7 +201,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         for (j, c) in COLUMN.iter().enumerate() {
             let r = vr::K_CUSTOM + (2 * i + j) as u32;
             v.push(
-                VarDecl::real(leak(format!("k_{c}_{w}")), r, Var::CustomGain(i, j))
+                VarDecl::real(declared_name(format!("k_{c}_{w}")), r, Var::CustomGain(i, j))
                     .tunable_parameter(Start::Real(ROBUST[i][j]))
                     .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
                     .describe("custom gain (used when controller = custom; tunable between steps)"),
@@ -216,7 +211,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     for (i, w) in WHEEL.iter().enumerate() {
         for (j, c) in COLUMN.iter().enumerate() {
             let r = vr::GAIN_IN_USE + (2 * i + j) as u32;
-            let mut g = VarDecl::real(leak(format!("gain_{c}_{w}")), r, Var::GainInUse(i, j))
+            let mut g = VarDecl::real(declared_name(format!("gain_{c}_{w}")), r, Var::GainInUse(i, j))
                 .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
                 .describe("the gain in use (from controller and the custom gains)");
             g.causality = Causality::CalculatedParameter;

@@ -17,7 +17,7 @@ use std::sync::{Arc, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    enumeration_type, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
+    declared_name, enumeration_type, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
     InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
 };
 use nigel_benchmark::{
@@ -96,11 +96,6 @@ pub mod vr {
 
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 
-fn leak(s: String) -> &'static str {
-    // Names built once for the process-wide declaration (a few hundred bytes in all).
-    Box::leak(s.into_boxed_str())
-}
-
 /// Enumeration value (1-based) of a maneuver, in the order of [`Maneuver::ALL`].
 pub fn maneuver_value(m: Maneuver) -> i32 {
     Maneuver::ALL.iter().position(|&x| x == m).map_or(0, |i| i as i32 + 1)
@@ -125,7 +120,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     ];
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            VarDecl::real(leak(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
+            VarDecl::real(declared_name(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
                 .discrete_output(none())
                 .unit("rad")
                 .describe("the maneuver's steering program (front +f, rear -f)"),
@@ -144,7 +139,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     }
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            VarDecl::real(leak(format!("mu_{w}")), vr::MU + i as u32, Var::Friction(i))
+            VarDecl::real(declared_name(format!("mu_{w}")), vr::MU + i as u32, Var::Friction(i))
                 .discrete_output(none())
                 .describe("road friction 0.35 sin(2 pi f theta - phi_i) + 0.55 + noise (0.4 when off)"),
         );

@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
 use fmi2_export::{
-    si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model,
-    ModelError, ModelResult, Start, VarDecl,
+    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces,
+    Model, ModelError, ModelResult, Start, VarDecl,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
@@ -138,11 +138,6 @@ pub mod vr {
     pub const MOTOR_SPEED_LIMIT: u32 = 2;
 }
 
-fn leak(s: String) -> &'static str {
-    // Names built once for the process-wide declaration (a few hundred bytes in all).
-    Box::leak(s.into_boxed_str())
-}
-
 fn state_vr(i: usize) -> u32 {
     vr::STATE + i as u32
 }
@@ -181,7 +176,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     // inputs
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            real(leak(format!("delta_{w}")), vr::STEER + i as u32, PlantVar::Input(Input::Steer(i)))
+            real(declared_name(format!("delta_{w}")), vr::STEER + i as u32, PlantVar::Input(Input::Steer(i)))
                 .input(Start::Real(0.0))
                 .unit("rad")
                 .describe("steering command, clamped to [-delta_max, delta_max]"),
@@ -189,7 +184,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     }
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            real(leak(format!("tau_{w}")), vr::TORQUE + i as u32, PlantVar::Input(Input::Torque(i)))
+            real(declared_name(format!("tau_{w}")), vr::TORQUE + i as u32, PlantVar::Input(Input::Torque(i)))
                 .input(Start::Real(0.0))
                 .unit("N.m")
                 .describe("drive torque at the wheel"),
@@ -197,7 +192,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     }
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
-            real(leak(format!("mu_{w}")), vr::FRICTION + i as u32, PlantVar::Input(Input::Friction(i)))
+            real(declared_name(format!("mu_{w}")), vr::FRICTION + i as u32, PlantVar::Input(Input::Friction(i)))
                 .input(Start::Real(0.4))
                 .min(0.0)
                 .max(MU_MAX)
@@ -279,7 +274,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     for (make, base, stem, unit, text) in per_wheel {
         for (i, w) in WHEEL.iter().enumerate() {
             v.push(
-                real(leak(format!("{stem}_{w}")), base + i as u32, PlantVar::Output(make(i)))
+                real(declared_name(format!("{stem}_{w}")), base + i as u32, PlantVar::Output(make(i)))
                     .output(Dependencies::On(wheel_knowns(make, i)))
                     .unit(unit)
                     .describe(text),
