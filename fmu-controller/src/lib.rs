@@ -20,8 +20,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies,
-    EventUpdate, Initial, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+    declared_name, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate, Initial,
+    InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
 };
 use nigel_benchmark::control::{FORCE_MAX, KI_SPEED, KP_SPEED};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
@@ -38,7 +38,9 @@ pub const MAX_SAMPLES_UNATTENDED: u64 = 1_000_000;
 /// Smallest sample period accepted [s].
 pub const MIN_SAMPLE_PERIOD: f64 = 1e-6;
 
-/// The items of the `controller` enumeration.
+/// The values of the Integer parameter `controller` (1-based; the list is in the
+/// variable's description and the FMU documentation). A plain Integer, not an FMI
+/// Enumeration, so that every importer (libcosim and ecos ignore Enumerations) can set it.
 pub mod mode {
     /// `K = 0`: the steering is the feed-forward alone.
     pub const OPEN_LOOP: i32 = 1;
@@ -103,9 +105,15 @@ pub mod vr {
     pub const K_CUSTOM: u32 = 40;
     /// `gain_beta_fl, gain_yaw_rate_fl, ...`: 50..58, the gain in use.
     pub const GAIN_IN_USE: u32 = 50;
-    /// Integer (Enumeration) value reference of `controller`.
+    /// Integer value reference of `controller`.
     pub const CONTROLLER: u32 = 0;
 }
+
+/// The description of `controller`: its values and what each selects.
+pub const CONTROLLER_ITEMS: &str =
+    "which steering feedback: 1 open_loop (K = 0, the feed-forward alone), 2 pole_placement \
+     (non-robust baseline, Re(s) < -2 at mu = 0.4), 3 robust (mixed H2/H-inf gain, the default), 4 custom (the \
+     tunable gains k_beta_* / k_yaw_rate_*)";
 
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 const COLUMN: [&str; 2] = ["beta", "yaw_rate"];
@@ -221,9 +229,11 @@ fn build_declaration() -> DeclarationSpec<Var> {
         }
     }
     v.push(
-        VarDecl::enumeration("controller", vr::CONTROLLER, "Controller", Var::Controller)
+        VarDecl::integer("controller", vr::CONTROLLER, Var::Controller)
             .parameter(Start::Integer(mode::ROBUST))
-            .describe("which steering feedback"),
+            .min(f64::from(mode::OPEN_LOOP))
+            .max(f64::from(mode::CUSTOM))
+            .describe(CONTROLLER_ITEMS),
     );
     DeclarationSpec {
         model_name: "nigel_controller",
@@ -234,16 +244,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        enumerations: vec![enumeration_type(
-            "Controller",
-            "steering feedback",
-            &[
-                ("open_loop", mode::OPEN_LOOP, "K = 0: the feed-forward alone"),
-                ("pole_placement", mode::POLE_PLACEMENT, "non-robust baseline, Re(s) < -2 at mu = 0.4"),
-                ("robust", mode::ROBUST, "robust mixed H2/H-inf gain (paper variant, 4WD4WS, Pareto point)"),
-                ("custom", mode::CUSTOM, "the tunable gains k_beta_* / k_yaw_rate_*"),
-            ],
-        )],
+        enumerations: Vec::new(),
         units: vec![
             si_unit("rad", 0, 0, 0, 1),
             si_unit("rad/s", 0, 0, -1, 1),
@@ -384,7 +385,7 @@ impl Model for Controller {
             Var::SteerLimit => s.delta_max,
             Var::CustomGain(i, j) => self.custom[i][j],
             Var::GainInUse(i, j) => self.gain_in_use()[i][j],
-            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+            Var::Controller => return Err("controller is an Integer, not a Real".into()),
         })
     }
 
@@ -418,7 +419,7 @@ impl Model for Controller {
             Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
             Var::CustomGain(i, j) => self.custom[i][j] = value,
             Var::GainInUse(..) => return Err("the gains in use are calculated".into()),
-            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+            Var::Controller => return Err("controller is an Integer, not a Real".into()),
         }
         Ok(())
     }
@@ -512,10 +513,11 @@ e = speed_ref - speed,   F = kp_speed e + ki_speed I
 if |F| > force_max:  F = +-force_max and I is frozen,   else  I := I + e sample_period  (at the next sample)
 tau_i = F r_wheel / 4
 </pre>
-<p><code>controller</code> selects K: <code>open_loop</code> (K = 0), <code>pole_placement</code> (the non-robust
-baseline, Re(s) &lt; -2 at mu = 0.4), <code>robust</code> (the mixed H2/H-inf gain of the paper variant, 4WD4WS,
-Pareto point; default) or <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>, which
-start at the robust gain and may change between steps). The gain in use is readable as <code>gain_*</code>.
+<p>The Integer parameter <code>controller</code> (1 .. 4; a plain Integer rather than an FMI Enumeration, so
+that every importer can set it) selects K: 1 <code>open_loop</code> (K = 0), 2 <code>pole_placement</code> (the
+non-robust baseline, Re(s) &lt; -2 at mu = 0.4), 3 <code>robust</code> (the mixed H2/H-inf gain of the paper variant,
+4WD4WS, Pareto point; default) or 4 <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>,
+which start at the robust gain and may change between steps). The gain in use is readable as <code>gain_*</code>.
 The robust and pole-placement gains are baked from the synthesis crate
 (<code>cargo run --release -p nigel-synthesis --bin bake-gains</code>).</p>
 <h2>Sampling</h2>

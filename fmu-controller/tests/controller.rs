@@ -384,3 +384,37 @@ fn a_step_of_astronomically_many_samples_is_refused_not_run() {
         assert!(c.real(vr::SPEED_INTEGRAL).is_finite());
     }
 }
+
+/// The switch is a plain Integer parameter (libcosim and ecos do not see FMI Enumerations):
+/// declared min/max 1 .. 4, its values listed in its description, the values unchanged
+/// (1-based, as the Enumeration had them), and no type definition left behind.
+#[test]
+fn controller_switch_is_an_integer_parameter_listing_its_values() {
+    use fmi2_export::model_description::{Causality, VariableType};
+    use fmi2_export::Model;
+    let md = Controller::declaration().model_description();
+    let v = md.variable("controller").expect("controller is declared");
+    assert_eq!(v.causality, Causality::Parameter);
+    assert_eq!(v.value_reference, vr::CONTROLLER);
+    assert_eq!(v.variable_type, VariableType::Integer { start: Some(3), min: Some(1), max: Some(4) });
+    let text = v.description.as_deref().unwrap_or("");
+    for (value, name) in [(1, "open_loop"), (2, "pole_placement"), (3, "robust"), (4, "custom")] {
+        assert!(text.contains(&format!("{value} {name} (")), "{name} = {value} missing from {text:?}");
+    }
+    assert_eq!((mode::OPEN_LOOP, mode::POLE_PLACEMENT, mode::ROBUST, mode::CUSTOM), (1, 2, 3, 4));
+    assert!(md.type_definitions.is_empty());
+    let xml = Controller::declaration().xml();
+    assert!(!xml.contains("Enumeration"), "no Enumeration left in the description");
+    // the bounds are enforced: 0 and 5 refused naming the variable, 1 .. 4 accepted
+    for bad in [0, 5] {
+        let c = C::cs();
+        assert_eq!(c.set_int(vr::CONTROLLER, bad), ERR);
+        assert!(c.last_error().contains("controller"), "{}", c.last_error());
+    }
+    for good in 1..=4 {
+        let c = C::cs();
+        assert_eq!(c.set_int(vr::CONTROLLER, good), OK);
+        c.init();
+        assert_eq!(c.int(vr::CONTROLLER), good);
+    }
+}

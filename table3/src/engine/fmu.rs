@@ -47,66 +47,48 @@ fn load(path: &Path) -> Result<Arc<Fmu>, Error> {
     Fmu::load(path).map_err(|source| Error::Cosim { context: format!("loading {}", path.display()), source })
 }
 
-/// The items `(name, value)` of the enumeration type of variable `variable` of `fmu`, read
-/// from its `modelDescription.xml`.
-fn enumeration_items(fmu: &Fmu, variable: &str) -> Result<Vec<(String, i32)>, String> {
-    use quick_xml::events::Event;
-    let path = fmu.unpacked_dir().join("modelDescription.xml");
-    let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut reader = quick_xml::Reader::from_str(&xml);
-    let attr = |e: &quick_xml::events::BytesStart, key: &[u8]| -> Option<String> {
-        e.attributes()
-            .flatten()
-            .find(|a| a.key.as_ref() == key)
-            .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
-    };
-    let mut simple_type: Option<String> = None;
-    let mut scalar: Option<String> = None;
-    let mut declared: Option<String> = None;
-    let mut items: Vec<(String, String, i32)> = Vec::new();
-    loop {
-        match reader.read_event() {
-            Err(e) => return Err(format!("{}: {e}", path.display())),
-            Ok(Event::Eof) => break,
-            Ok(Event::Start(e)) | Ok(Event::Empty(e)) => match e.name().as_ref() {
-                b"SimpleType" => simple_type = attr(&e, b"name"),
-                b"Item" => {
-                    let (Some(t), Some(n), Some(v)) = (&simple_type, attr(&e, b"name"), attr(&e, b"value")) else {
-                        continue;
-                    };
-                    let v = v.trim().parse::<i32>().map_err(|_| format!("item {n} of {t} has value {v:?}"))?;
-                    items.push((t.clone(), n, v));
-                }
-                b"ScalarVariable" => scalar = attr(&e, b"name"),
-                b"Enumeration" if scalar.as_deref() == Some(variable) => declared = attr(&e, b"declaredType"),
-                _ => {}
-            },
-            Ok(Event::End(e)) => match e.name().as_ref() {
-                b"SimpleType" => simple_type = None,
-                b"ScalarVariable" => scalar = None,
-                _ => {}
-            },
-            Ok(_) => {}
-        }
-    }
-    let declared = declared.ok_or_else(|| format!("no Enumeration variable {variable:?}"))?;
-    Ok(items.into_iter().filter(|(t, _, _)| *t == declared).map(|(_, n, v)| (n, v)).collect())
-}
-
-/// The value of each name of `names` in the enumeration of `variable`.
-fn enumeration_values<const N: usize>(
-    fmu: &Fmu,
-    file: &str,
-    variable: &str,
-    names: [&str; N],
-) -> Result<[i32; N], Error> {
+/// The value of each name of `names` for the switch `variable` of `fmu`.
+///
+/// Our FMUs declare their switches (`maneuver`, `fidelity`, `controller`) as plain Integer
+/// parameters whose values are the 1-based positions of `names` (the contract written in
+/// each variable's description and the FMU documentation): the declared `min`/`max` must
+/// cover them. An FMU that declares the switch as an Enumeration (our FMUs before the
+/// switches became Integers, or a user's own FMU) is read by item name instead.
+fn switch_values<const N: usize>(fmu: &Fmu, file: &str, variable: &str, names: [&str; N]) -> Result<[i32; N], Error> {
+    use model_description::VariableType;
     let bad = |reason: String| Error::BadRun { run: format!("{file}: {variable}"), reason };
-    let items = enumeration_items(fmu, variable).map_err(bad)?;
+    let md = fmu.description();
+    let v = md.variable(variable).ok_or_else(|| bad("no such variable".into()))?;
     let mut out = [0; N];
-    for (o, name) in out.iter_mut().zip(names) {
-        *o = items.iter().find(|(n, _)| n == name).map(|(_, v)| *v).ok_or_else(|| {
-            bad(format!("has no item {name:?} (items: {:?})", items.iter().map(|(n, _)| n).collect::<Vec<_>>()))
-        })?;
+    match &v.variable_type {
+        VariableType::Integer { min, max, .. } => {
+            let (lo, hi) = (min.unwrap_or(i32::MIN), max.unwrap_or(i32::MAX));
+            if lo > 1 || hi < N as i32 {
+                return Err(bad(format!(
+                    "declared in {lo} ..= {hi}, but the values of {names:?} are 1 ..= {N}: not the switch this \
+                     engine sets"
+                )));
+            }
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = k as i32 + 1;
+            }
+        }
+        VariableType::Enumeration { declared_type, .. } => {
+            let t = md
+                .type_definitions
+                .iter()
+                .find(|t| &t.name == declared_type)
+                .ok_or_else(|| bad(format!("enumeration type {declared_type:?} is not defined")))?;
+            for (o, name) in out.iter_mut().zip(names) {
+                *o = t.items.iter().find(|i| i.name == name).map(|i| i.value).ok_or_else(|| {
+                    bad(format!(
+                        "has no item {name:?} (items: {:?})",
+                        t.items.iter().map(|i| i.name.as_str()).collect::<Vec<_>>()
+                    ))
+                })?;
+            }
+        }
+        other => return Err(bad(format!("is a {}, not an Integer", other.type_name()))),
     }
     Ok(out)
 }
@@ -149,13 +131,12 @@ impl FmuEngine {
         FmuEngine::load_dir(&default_fmu_dir())
     }
 
-    /// Loads the three archives and resolves the enumeration items it sets.
+    /// Loads the three archives and resolves the values of the switches it sets.
     pub fn load(plant: &Path, controller: &Path, maneuver: &Path) -> Result<FmuEngine, Error> {
         let (p, c, m) = (load(plant)?, load(controller)?, load(maneuver)?);
-        let maneuver_values = enumeration_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
-        let fidelity_values = enumeration_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
-        let controller_values =
-            enumeration_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
+        let maneuver_values = switch_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
+        let fidelity_values = switch_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
+        let controller_values = switch_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
         let mut gains = [[[0.0; 2]; 4]; 3];
         for (g, value) in gains.iter_mut().zip(controller_values) {
             *g = controller_gain(&c, value)?;
@@ -216,7 +197,9 @@ impl FmuEngine {
         for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
             b.set(&format!("plant.{switch}"), Value::Boolean(real)).map_err(ctx)?;
         }
-        b.set("plant.v_x", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
+        // the initial speed is a parameter (the state v_x is calculated from it), so that
+        // every importer applies it from an SSP's parameter bindings
+        b.set("plant.v_x_start", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
         let mut connect = |from: &str, to: &str| b.connect(from, to).map(|_| ()).map_err(ctx);
         for w in WHEELS {
             connect(&format!("controller.delta_{w}"), &format!("plant.delta_{w}"))?;
