@@ -343,3 +343,32 @@ fn initial_state_comes_from_the_start_parameters() {
 fn fmu_plant_substep(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
     nigel_plant::DEFAULT_CS_SUBSTEP_MAX.min(stable_rk4_step(p, u))
 }
+
+/// The InitialUnknowns depend only on what is known at initialization (FMI 2.0 section
+/// 2.2.8: inputs and variables with initial="exact"): the calculated body states on their
+/// `*_start` parameters, not on themselves; the derivatives not on the calculated states.
+#[test]
+fn initial_unknowns_depend_only_on_initialization_knowns() {
+    let md = &fmu().description;
+    let var = |index: u32| &md.model_variables[index as usize - 1];
+    let index_of = |name: &str| md.model_variables.iter().position(|v| v.name == name).unwrap() as u32 + 1;
+    assert!(!md.model_structure.initial_unknowns.is_empty());
+    for u in &md.model_structure.initial_unknowns {
+        let deps = u.dependencies.as_ref().expect("declared dependencies");
+        for &d in deps {
+            let k = var(d);
+            assert!(
+                k.causality == Causality::Input || k.effective_initial() == Some(model_description::Initial::Exact),
+                "{} depends on {} at initialization",
+                var(u.index).name,
+                k.name
+            );
+        }
+    }
+    for state in BODY {
+        let u = md.model_structure.initial_unknowns.iter().find(|u| u.index == index_of(state)).unwrap();
+        let deps = u.dependencies.as_ref().unwrap();
+        assert!(deps.contains(&index_of(&format!("{state}_start"))), "{state}");
+        assert!(!deps.contains(&index_of(state)), "{state} on itself");
+    }
+}
