@@ -178,7 +178,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     }
     for (i, (name, unit)) in POSE_NAMES.iter().zip(POSE_UNITS).enumerate() {
         v.push(
-            VarDecl::real(*name, vr::POSE + i as u32, Var::Pose(i))
+            VarDecl::real(name, vr::POSE + i as u32, Var::Pose(i))
                 .input(Start::Real(0.0))
                 .unit(unit)
                 .describe("measured pose (world frame; heading may be unwrapped), read by robust_tracking only"),
