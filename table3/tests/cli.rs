@@ -23,6 +23,22 @@ fn unknown_maneuver_is_a_clear_error() {
 }
 
 #[test]
+fn controllers_can_be_chosen_and_unknown_ones_are_a_clear_error() {
+    let o = table3(&["--engine", "in-process", "--controller", "lqr"]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("unknown controller \"lqr\"") && e.contains("robust_tracking"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("t.json");
+    let args = ["--engine", "in-process", "--maneuver", "straight", "--controller", "robust_tracking"];
+    let o = table3(&[&args[..], &["--controller", "open_loop", "--json", json.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = v["results"]["real"]["straight"].as_object().unwrap();
+    assert_eq!(row.keys().collect::<Vec<_>>(), ["open_loop", "robust_tracking"]);
+}
+
+#[test]
 fn unparsable_seed_is_a_clear_error() {
     for seed in ["abc", "-1", "1.5", "99999999999999999999999"] {
         let o = table3(&["--engine", "in-process", "--seed", seed]);

@@ -13,7 +13,9 @@ use std::time::Instant;
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nigel_table3::engine::default_fmu_dir;
-use nigel_table3::{csv, plot, report, run_table_with, Engine, Error, FmuEngine, InProcess, Maneuver, Options};
+use nigel_table3::{
+    csv, plot, report, run_table_with, Controller, Engine, Error, FmuEngine, InProcess, Maneuver, Options,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum EngineKind {
@@ -56,6 +58,10 @@ struct Args {
     /// Only these maneuvers (repeat; default all six).
     #[arg(long = "maneuver", value_name = "NAME", value_parser = parse_maneuver)]
     maneuvers: Vec<Maneuver>,
+    /// Only these controllers (repeat; default all four: open_loop, pole_placement, robust,
+    /// robust_tracking).
+    #[arg(long = "controller", value_name = "NAME", value_parser = parse_controller)]
+    controllers: Vec<Controller>,
     /// What runs the closed loops.
     #[arg(long, value_enum, default_value_t = EngineKind::Fmu)]
     engine: EngineKind,
@@ -90,6 +96,13 @@ fn parse_seeds(s: &str) -> Result<(u64, u64), String> {
         return Err(format!("{s:?}: at most 1000 seeds"));
     }
     Ok((a, b))
+}
+
+fn parse_controller(s: &str) -> Result<Controller, String> {
+    nigel_table3::CONTROLLERS.into_iter().find(|c| c.name() == s).ok_or_else(|| {
+        let names: Vec<&str> = nigel_table3::CONTROLLERS.iter().map(|c| c.name()).collect();
+        format!("unknown controller {s:?} (one of {})", names.join(", "))
+    })
 }
 
 fn parse_maneuver(s: &str) -> Result<Maneuver, String> {
@@ -139,6 +152,9 @@ fn run(args: &Args) -> Result<(), Error> {
     options.threads = args.threads;
     if !args.maneuvers.is_empty() {
         options.maneuvers = Maneuver::ALL.into_iter().filter(|m| args.maneuvers.contains(m)).collect();
+    }
+    if !args.controllers.is_empty() {
+        options.controllers = nigel_table3::CONTROLLERS.into_iter().filter(|c| args.controllers.contains(c)).collect();
     }
     options.keep_runs = args.png.is_some() || args.csv.is_some();
     if let Some(repeats) = args.bench {
