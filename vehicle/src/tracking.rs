@@ -133,14 +133,8 @@ pub fn pose_errors<T: Scalar>(x: T, y: T, psi: T, x_ref: T, y_ref: T, psi_ref: T
 
 /// The errors of `car` relative to `reference` (plant state vectors, [`crate::State`]).
 pub fn tracking_errors<T: Scalar>(car: &State<T>, reference: &State<T>) -> TrackingErrors<T> {
-    let (along, lateral, heading) = pose_errors(
-        car[idx::X],
-        car[idx::Y],
-        car[idx::PSI],
-        reference[idx::X],
-        reference[idx::Y],
-        reference[idx::PSI],
-    );
+    let (along, lateral, heading) =
+        pose_errors(car[idx::X], car[idx::Y], car[idx::PSI], reference[idx::X], reference[idx::Y], reference[idx::PSI]);
     let beta = car[idx::V_Y].atan2(car[idx::V_X]);
     let beta_ref = reference[idx::V_Y].atan2(reference[idx::V_X]);
     TrackingErrors {
