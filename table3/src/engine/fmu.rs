@@ -2,6 +2,8 @@
 //! ABI by the `nigel_cosim` master and co-simulated with fixed 1 ms steps for 30 s
 //! (`ordered` by default: every output reaches its inputs at the same communication
 //! point along the direct-feedthrough chain plant -> test bench -> controller -> plant).
+//! The controller gets the pose too (plant `x, y, psi`, test bench `x_ref, y_ref,
+//! psi_ref`), for every controller; only `robust_tracking` reads it.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,8 +26,8 @@ pub struct FmuEngine {
     maneuver: Arc<Fmu>,
     maneuver_values: [i32; 6],
     fidelity_values: [i32; 2],
-    controller_values: [i32; 3],
-    gains: [[[f64; 2]; 4]; 3],
+    controller_values: [i32; 4],
+    gains: [[[f64; 4]; 4]; 4],
     /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
     /// connection by one step).
     pub algorithm: Algorithm,
@@ -93,25 +95,28 @@ fn switch_values<const N: usize>(fmu: &Fmu, file: &str, variable: &str, names: [
     Ok(out)
 }
 
-/// The calculated parameters `gain_*` of the controller FMU with `controller = value`,
-/// read after initialization by the master (a run of zero steps).
-fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 2]; 4], Error> {
+/// The calculated parameters `gain_*` of the controller FMU with `controller = value`
+/// (columns `e_y, e_psi, beta, yaw_rate`), read after initialization by the master (a run
+/// of zero steps).
+fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 4]; 4], Error> {
     let ctx = |source| Error::Cosim { context: format!("reading the gains of {}", FMU_FILES[1]), source };
     let mut b = SystemBuilder::new();
     b.add_instance("controller", fmu.clone()).map_err(ctx)?;
     b.set("controller.controller", Value::Integer(value)).map_err(ctx)?;
-    let names: Vec<String> =
-        WHEELS.iter().flat_map(|w| ["beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}"))).collect();
+    let names: Vec<String> = WHEELS
+        .iter()
+        .flat_map(|w| ["e_y", "e_psi", "beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}")))
+        .collect();
     let experiment = Experiment { record: Some(names.clone()), ..Experiment::new(0.0, SAMPLE_PERIOD) };
     let (results, _) = simulate(&b.build(), &experiment).map_err(ctx)?;
-    let mut k = [[0.0; 2]; 4];
+    let mut k = [[0.0; 4]; 4];
     for (i, name) in names.iter().enumerate() {
         let bare = name.trim_start_matches("controller.");
         let v = results
             .column(bare)
             .and_then(|c| c.first().copied())
             .ok_or_else(|| Error::BadRun { run: FMU_FILES[1].into(), reason: format!("no value of {name}") })?;
-        k[i / 2][i % 2] = v;
+        k[i / 4][i % 4] = v;
     }
     Ok(k)
 }
@@ -136,8 +141,9 @@ impl FmuEngine {
         let (p, c, m) = (load(plant)?, load(controller)?, load(maneuver)?);
         let maneuver_values = switch_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
         let fidelity_values = switch_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
-        let controller_values = switch_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
-        let mut gains = [[[0.0; 2]; 4]; 3];
+        let controller_values =
+            switch_values(&c, FMU_FILES[1], "controller", Controller::WITH_TRACKING.map(|x| x.name()))?;
+        let mut gains = [[[0.0; 4]; 4]; 4];
         for (g, value) in gains.iter_mut().zip(controller_values) {
             *g = controller_gain(&c, value)?;
         }
@@ -153,9 +159,9 @@ impl FmuEngine {
         })
     }
 
-    /// The gain the controller FMU uses for each controller of Table III (its calculated
-    /// parameters `gain_beta_fl .. gain_yaw_rate_rr` after initialization).
-    pub fn gains(&self) -> [[[f64; 2]; 4]; 3] {
+    /// The gain the controller FMU uses for each controller of [`Controller::WITH_TRACKING`]
+    /// (its calculated parameters `gain_e_y_fl .. gain_yaw_rate_rr` after initialization).
+    pub fn gains(&self) -> [[[f64; 4]; 4]; 4] {
         self.gains
     }
 
@@ -169,9 +175,9 @@ impl FmuEngine {
     /// parameters and the closed-loop connections of the issue-6 contract.
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
-        let controller = Controller::TABLE.iter().position(|c| *c == job.controller).ok_or_else(|| {
+        let controller = Controller::WITH_TRACKING.iter().position(|c| *c == job.controller).ok_or_else(|| {
             Error::Usage(format!(
-                "the controller FMU runs open_loop, pole_placement and robust, not {}",
+                "the controller FMU runs open_loop, pole_placement, robust and robust_tracking, not {}",
                 job.controller
             ))
         })?;
@@ -217,6 +223,10 @@ impl FmuEngine {
         connect("maneuver.speed_ref", "controller.speed_ref")?;
         connect("plant.beta", "maneuver.beta")?;
         connect("plant.yaw_rate", "maneuver.yaw_rate")?;
+        for pose in ["x", "y", "psi"] {
+            connect(&format!("plant.{pose}"), &format!("controller.{pose}"))?;
+            connect(&format!("maneuver.{pose}_ref"), &format!("controller.{pose}_ref"))?;
+        }
         Ok(b.build())
     }
 
@@ -289,7 +299,7 @@ impl FmuEngine {
             let c: Vec<Vec<f64>> = WHEELS.iter().map(|w| col(&format!("{stem}_{w}"))).collect::<Result<_, _>>()?;
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
-        let gain = self.gains[index(&Controller::TABLE, &job.controller)];
+        let gain = self.gains[index(&Controller::WITH_TRACKING, &job.controller)];
         let run = Run {
             job: *job,
             gain,
