@@ -305,7 +305,7 @@ mod tests {
         ));
         assert!(plant.contains("<h2>Initial state</h2>"));
         let controller = &all.iter().find(|t| t.model_identifier == "nigel_controller").unwrap().documentation;
-        assert!(controller.contains("<td><code>controller</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 4</td><td>3</td><td>which steering feedback: 1 open_loop"), "{controller}");
+        assert!(controller.contains("<td><code>controller</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 5</td><td>3</td><td>which steering feedback: 1 open_loop"), "{controller}");
         let bench = &all.iter().find(|t| t.model_identifier == "nigel_maneuver").unwrap().documentation;
         assert!(bench.contains("<td><code>maneuver</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 6</td><td>1</td><td>the maneuver: 1 straight"));
         assert!(bench.contains(
