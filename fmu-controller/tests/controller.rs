@@ -371,10 +371,18 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     expect.extend(["x_ref", "y_ref", "psi_ref"].map(index));
     expect.sort();
     assert_eq!(out.dependencies.as_ref(), Some(&expect));
-    // robust_tracking is the last item of the Controller type (existing values unchanged)
-    let t = md.type_definitions.iter().find(|t| t.name == "Controller").expect("a Controller type");
-    let items: Vec<(&str, i32)> = t.items.iter().map(|i| (i.name.as_str(), i.value)).collect();
-    assert_eq!(items, [("open_loop", 1), ("pole_placement", 2), ("robust", 3), ("custom", 4), ("robust_tracking", 5)]);
+    // controller is an Integer 1 ..= 5, robust_tracking the last value (the others unchanged),
+    // every value named in its description
+    let v = md.model_variables.iter().find(|v| v.name == "controller").unwrap();
+    let fmi2_export::model_description::VariableType::Integer { start, min, max, .. } = &v.variable_type else {
+        panic!("controller is {:?}", v.variable_type)
+    };
+    assert_eq!((*start, *min, *max), (Some(mode::ROBUST), Some(1), Some(mode::ROBUST_TRACKING)));
+    assert_eq!(mode::ROBUST_TRACKING, 5);
+    let text = v.description.as_deref().unwrap_or_default();
+    for item in ["1 open_loop", "2 pole_placement", "3 robust", "4 custom", "5 robust_tracking"] {
+        assert!(text.contains(item), "{item} not in {text:?}");
+    }
 }
 
 /// The tracking law written out by hand from its definition (issue 9), independent of
@@ -490,7 +498,8 @@ fn controller_switch_is_an_integer_parameter_listing_its_values() {
     assert_eq!(v.value_reference, vr::CONTROLLER);
     assert_eq!(v.variable_type, VariableType::Integer { start: Some(3), min: Some(1), max: Some(5) });
     let text = v.description.as_deref().unwrap_or("");
-    for (value, name) in [(1, "open_loop"), (2, "pole_placement"), (3, "robust"), (4, "custom"), (5, "robust_tracking")] {
+    for (value, name) in [(1, "open_loop"), (2, "pole_placement"), (3, "robust"), (4, "custom"), (5, "robust_tracking")]
+    {
         assert!(text.contains(&format!("{value} {name} (")), "{name} = {value} missing from {text:?}");
     }
     assert_eq!(

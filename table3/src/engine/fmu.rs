@@ -141,8 +141,15 @@ impl FmuEngine {
         let (p, c, m) = (load(plant)?, load(controller)?, load(maneuver)?);
         let maneuver_values = switch_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
         let fidelity_values = switch_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
-        let controller_values =
-            switch_values(&c, FMU_FILES[1], "controller", Controller::WITH_TRACKING.map(|x| x.name()))?;
+        // the controller FMU's values are the positions in its whole list, `custom` (4)
+        // included: robust_tracking is 5, not the 4th of the controllers run here
+        let all = switch_values(
+            &c,
+            FMU_FILES[1],
+            "controller",
+            ["open_loop", "pole_placement", "robust", "custom", "robust_tracking"],
+        )?;
+        let controller_values = [all[0], all[1], all[2], all[4]];
         let mut gains = [[[0.0; 4]; 4]; 4];
         for (g, value) in gains.iter_mut().zip(controller_values) {
             *g = controller_gain(&c, value)?;
