@@ -300,8 +300,24 @@ pub struct Declaration<B> {
     /// Rows saved with the FMU state, in declaration order: parameters, inputs,
     /// continuous states and discrete variables (locals and outputs).
     pub saved_rows: Vec<usize>,
+    /// Per row, what `fmi2Set*` checks, precomputed ([`SetAccess`]).
+    set_access: Vec<SetAccess>,
     description: md::ModelDescription,
     xml: String,
+}
+
+/// The checks of `fmi2Set*` for one variable as tables: a value inside them is accepted
+/// without running the full checks (which run, and give the reason, for anything else).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SetAccess {
+    /// Bit `Machine::bit()` set: the variable may be set in that state.
+    pub settable_in: u16,
+    /// Not an Enumeration (whose values must also be items).
+    pub plain: bool,
+    /// The declared minimum, else the most negative finite f64.
+    pub lowest: f64,
+    /// The declared maximum, else the largest finite f64.
+    pub highest: f64,
 }
 
 /// Value references below this are looked up in a table; larger ones (legal, but rare) in
@@ -547,7 +563,20 @@ impl<B> Declaration<B> {
                 table[vr as usize] = row as u32;
             }
         }
-        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, description, xml })
+        let set_access = spec
+            .variables
+            .iter()
+            .map(|v| SetAccess {
+                settable_in: crate::states::Machine::ALL
+                    .into_iter()
+                    .filter(|&m| crate::instance::settable_in(v, m).is_ok())
+                    .fold(0, |mask, m| mask | m.bit()),
+                plain: v.declared_type.is_none(),
+                lowest: v.min.unwrap_or(f64::MIN),
+                highest: v.max.unwrap_or(f64::MAX),
+            })
+            .collect();
+        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, set_access, description, xml })
     }
 
     /// Row of the variable with this base type and value reference.
@@ -561,6 +590,11 @@ impl<B> Declaration<B> {
         } else {
             self.lookup.get(&(base_type, vr)).copied()
         }
+    }
+
+    #[inline]
+    pub(crate) fn set_access(&self, row: usize) -> SetAccess {
+        self.set_access[row]
     }
 
     #[inline]

@@ -150,6 +150,8 @@ impl Logger {
 
     /// Whether a warning was logged since the last call; clears the flag.
     pub(crate) fn take_warned(&self) -> bool {
-        self.shared.warned.swap(false, Ordering::Relaxed)
+        // a plain load first: the flag is almost always clear, and a swap is a locked
+        // read-modify-write at every fmi2 call
+        self.shared.warned.load(Ordering::Relaxed) && self.shared.warned.swap(false, Ordering::Relaxed)
     }
 }

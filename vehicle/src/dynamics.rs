@@ -115,6 +115,35 @@ pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> St
     st
 }
 
+/// Whether `hypot(f_drive, f_lat) <= cap` certainly holds, decided without the square
+/// root: `f_drive^2 + f_lat^2 < cap^2 (1 - 1e-12)`. The squares carry a relative error of a
+/// few units in the last place, far inside the 1e-12 margin, so `true` implies that the
+/// computed `hypot` is not above `cap` either and the friction circle would change nothing;
+/// `false` (near the circle, outside it, NaN, or magnitudes below 1e-100 or above 1e150
+/// where the squares could underflow or overflow) leaves the decision to the exact `hypot`
+/// test. Only the cost changes: the results are bit for bit those of the `hypot` test alone.
+#[inline(always)]
+fn inside_friction_circle(f_drive: f64, f_lat: f64, cap: f64) -> bool {
+    const LOWEST: f64 = 1e-100;
+    const HIGHEST: f64 = 1e150;
+    (LOWEST..HIGHEST).contains(&cap)
+        && f_drive.abs() < HIGHEST
+        && f_lat.abs() < HIGHEST
+        && f_drive * f_drive + f_lat * f_lat < cap * cap * (1.0 - 1e-12)
+}
+
+/// Body slip angle `atan2(v_y, v_x)` [rad] of a state (an output of [`evaluate`]).
+#[inline]
+pub fn body_slip_angle<T: Scalar>(s: &State<T>) -> T {
+    s[idx::V_Y].atan2(s[idx::V_X])
+}
+
+/// Speed `hypot(v_x, v_y)` [m/s] of a state (an output of [`evaluate`]).
+#[inline]
+pub fn speed_of<T: Scalar>(s: &State<T>) -> T {
+    s[idx::V_X].hypot(s[idx::V_Y])
+}
+
 /// Derivatives and per-wheel quantities, without the body outputs (the hot path).
 struct Core<T> {
     derivatives: State<T>,
@@ -163,7 +192,7 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
             let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
             f_drive = f_drive * scale;
         }
-        if p.friction_circle {
+        if p.friction_circle && !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
             let h = f_drive.hypot(f_lat);
             if h.value() > cap.value() && h.value() > 0.0 {
                 let k = cap / h;
@@ -199,11 +228,10 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
 pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
     let st = steering(p, s, u);
     let c = core(p, s, u, &st);
-    let (v_x, v_y) = (s[idx::V_X], s[idx::V_Y]);
     Evaluation {
         derivatives: c.derivatives,
-        beta: v_y.atan2(v_x),
-        speed: v_x.hypot(v_y),
+        beta: body_slip_angle(s),
+        speed: speed_of(s),
         lateral_accel: c.lateral_force / p.m,
         slip_angle: c.slip_angle,
         force_lat: c.force_lat,
