@@ -300,10 +300,18 @@ pub struct Declaration<B> {
     /// Rows saved with the FMU state, in declaration order: parameters, inputs,
     /// continuous states and discrete variables (locals and outputs).
     pub saved_rows: Vec<usize>,
-    /// Per row, what `fmi2Set*` checks, precomputed ([`SetAccess`]).
-    set_access: Vec<SetAccess>,
+    /// Per row, the binding and what `fmi2Set*` checks, in one compact table (the per-value
+    /// path of `fmi2Get*`/`fmi2Set*` reads this, not the whole [`VarDecl`]).
+    hot: Vec<HotRow<B>>,
     description: md::ModelDescription,
     xml: String,
+}
+
+/// One row of [`Declaration`]'s compact table: the model's binding and the set checks.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HotRow<B> {
+    pub binding: B,
+    pub access: SetAccess,
 }
 
 /// The checks of `fmi2Set*` for one variable as tables: a value inside them is accepted
@@ -341,7 +349,7 @@ pub const LOG_CATEGORIES: [(&str, &str); 4] = [
     ("logCalls", "Every fmi2 call"),
 ];
 
-impl<B> Declaration<B> {
+impl<B: Copy> Declaration<B> {
     /// Checks the spec (unique names and value references, derivatives refer to Real states,
     /// dependencies refer to declared Reals), builds the lookup tables and generates the
     /// description, then runs the modelDescription validator over it.
@@ -563,22 +571,27 @@ impl<B> Declaration<B> {
                 table[vr as usize] = row as u32;
             }
         }
-        let set_access = spec
+        let hot = spec
             .variables
             .iter()
-            .map(|v| SetAccess {
-                settable_in: crate::states::Machine::ALL
-                    .into_iter()
-                    .filter(|&m| crate::instance::settable_in(v, m).is_ok())
-                    .fold(0, |mask, m| mask | m.bit()),
-                plain: v.declared_type.is_none(),
-                lowest: v.min.unwrap_or(f64::MIN),
-                highest: v.max.unwrap_or(f64::MAX),
+            .map(|v| HotRow {
+                binding: v.binding,
+                access: SetAccess {
+                    settable_in: crate::states::Machine::ALL
+                        .into_iter()
+                        .filter(|&m| crate::instance::settable_in(v, m).is_ok())
+                        .fold(0, |mask, m| mask | m.bit()),
+                    plain: v.declared_type.is_none(),
+                    lowest: v.min.unwrap_or(f64::MIN),
+                    highest: v.max.unwrap_or(f64::MAX),
+                },
             })
             .collect();
-        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, set_access, description, xml })
+        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, hot, description, xml })
     }
+}
 
+impl<B> Declaration<B> {
     /// Row of the variable with this base type and value reference.
     #[inline]
     pub fn row(&self, base_type: BaseType, vr: u32) -> Option<usize> {
@@ -593,8 +606,8 @@ impl<B> Declaration<B> {
     }
 
     #[inline]
-    pub(crate) fn set_access(&self, row: usize) -> SetAccess {
-        self.set_access[row]
+    pub(crate) fn hot(&self, row: usize) -> &HotRow<B> {
+        &self.hot[row]
     }
 
     #[inline]

@@ -288,7 +288,7 @@ impl<M: Model> Instance<M> {
         self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Real, vr)?;
-            let x = self.core.model.get_real(d.variable(row).binding)?;
+            let x = self.core.model.get_real(d.hot(row).binding)?;
             if !x.is_finite() {
                 return Self::not_finite(row, x);
             }
@@ -321,7 +321,7 @@ impl<M: Model> Instance<M> {
         self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Integer, vr)?;
-            *o = self.core.model.get_integer(d.variable(row).binding)?;
+            *o = self.core.model.get_integer(d.hot(row).binding)?;
         }
         Ok(())
     }
@@ -332,7 +332,7 @@ impl<M: Model> Instance<M> {
         self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Boolean, vr)?;
-            *o = self.core.model.get_boolean(d.variable(row).binding)?;
+            *o = self.core.model.get_boolean(d.hot(row).binding)?;
         }
         Ok(())
     }
@@ -373,7 +373,7 @@ impl<M: Model> Instance<M> {
             let row = Self::row_in(d, base_type, vr)?;
             // the common case from precomputed tables; the full checks (which give the
             // reason) only when these do not accept at once
-            let access = d.set_access(row);
+            let access = d.hot(row).access;
             if access.settable_in & machine_bit == 0 {
                 self.settable(row)?;
             }
@@ -385,9 +385,10 @@ impl<M: Model> Instance<M> {
         self.unsettle_events();
         let backup = self.core.model.clone();
         for (&vr, &value) in vrs.iter().zip(values) {
-            let v = d.variable(Self::row_in(d, base_type, vr)?);
-            if let Err(e) = apply(&mut self.core.model, v.binding, value) {
+            let row = Self::row_in(d, base_type, vr)?;
+            if let Err(e) = apply(&mut self.core.model, d.hot(row).binding, value) {
                 self.core.model = backup;
+                let v = d.variable(row);
                 return Err(match e {
                     ModelError::Error(m) => ModelError::Error(format!("{}: {m}", v.name)),
                     ModelError::Discard(m) => ModelError::Discard(format!("{}: {m}", v.name)),
