@@ -698,6 +698,71 @@ mod tests {
         assert_eq!(d.row(BaseType::Integer, u32::MAX), None);
     }
 
+    /// The precomputed set checks accept a value only where the full checks do (which
+    /// give the reason for everything else), and the settable mask is the full rule in
+    /// every instance state: the fast path of `fmi2Set*` changes no outcome.
+    #[test]
+    fn precomputed_set_checks_agree_with_the_full_checks() {
+        use crate::instance::{check_value_in, settable_in};
+        use crate::states::Machine;
+        let mut v = toy();
+        v.push(VarDecl::real("bounded", 7, 5).tunable_parameter(Start::Real(0.5)).min(-1.0).max(2.0));
+        v.push(VarDecl::real("above", 8, 6).input(Start::Real(0.0)).min(0.0));
+        v.push(VarDecl::integer("n", 5, 7).parameter(Start::Integer(3)).min(0.0));
+        v.push(VarDecl::enumeration("mode", 6, "Mode", 8).parameter(Start::Integer(1)));
+        v.push(VarDecl::real("y", 9, 9).output(Dependencies::On(vec![5])));
+        let mut s = spec(v);
+        s.enumerations = vec![enumeration_type("Mode", "", &[("a", 1, ""), ("b", 2, ""), ("c", 4, "")])];
+        let d = Declaration::new(s).unwrap();
+        let tiny = f64::MIN_POSITIVE;
+        let values = [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+            0.0,
+            -0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+            -1.0,
+            f64::from_bits(2.0f64.to_bits() + 1),
+            f64::from_bits((-1.0f64).to_bits() + 1),
+            -tiny,
+            tiny,
+            0.5,
+            1e300,
+            -1e300,
+        ];
+        let mut fast_accepted = 0;
+        for row in 0..d.spec.variables.len() {
+            let hot = d.hot(row);
+            assert_eq!(hot.binding, d.variable(row).binding);
+            for m in Machine::ALL {
+                let full = settable_in(d.variable(row), m).is_ok();
+                assert_eq!(hot.access.settable_in & m.bit() != 0, full, "{} in {m:?}", d.variable(row).name);
+            }
+            for x in values {
+                let a = hot.access;
+                if a.plain && x >= a.lowest && x <= a.highest {
+                    fast_accepted += 1;
+                    assert_eq!(check_value_in(&d, row, x), Ok(()), "{} = {x}", d.variable(row).name);
+                }
+            }
+            // what the full checks refuse, the fast path refuses too (it then runs them)
+            for x in values.into_iter().filter(|&x| check_value_in(&d, row, x).is_err()) {
+                let a = hot.access;
+                assert!(!(a.plain && x >= a.lowest && x <= a.highest), "{} = {x}", d.variable(row).name);
+            }
+        }
+        assert!(fast_accepted > 50, "{fast_accepted}");
+        // the enumeration never takes the fast path: its items are checked in full
+        assert!(!d.hot(d.row(BaseType::Integer, 6).unwrap()).access.plain);
+        assert!(check_value_in(&d, d.row(BaseType::Integer, 6).unwrap(), 3.0).is_err());
+    }
+
     #[test]
     fn structure_is_derived_with_one_based_indices() {
         let d = Declaration::new(spec(toy())).unwrap();

@@ -339,23 +339,7 @@ impl<M: Model> Instance<M> {
 
     /// Whether `value` fits variable `row` (min/max of the declaration, enumeration items).
     fn check_value(row: usize, value: f64) -> Result<(), String> {
-        let v = decl::<M>().variable(row);
-        if !value.is_finite() {
-            return Err(format!("{} = {value} refused: not a finite number", v.name));
-        }
-        if let Some(e) = decl::<M>().enumeration_of(row) {
-            if e.item(value as i32).is_none() {
-                let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
-                return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
-            }
-        }
-        if let Some(min) = v.min.filter(|&m| value < m) {
-            return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
-        }
-        if let Some(max) = v.max.filter(|&m| value > m) {
-            return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
-        }
-        Ok(())
+        check_value_in(decl::<M>(), row, value)
     }
 
     /// Sets all or nothing: every value reference, permission and value is checked first,
@@ -806,4 +790,26 @@ pub(crate) fn settable_in<B>(v: &VarDecl<B>, machine: Machine) -> Result<(), Str
         }
         _ => why(&format!("in {machine:?}")),
     }
+}
+
+/// Whether `value` fits variable `row` of declaration `d` (finite, min/max, enumeration
+/// items); the reason when not.
+pub(crate) fn check_value_in<B>(d: &Declaration<B>, row: usize, value: f64) -> Result<(), String> {
+    let v = d.variable(row);
+    if !value.is_finite() {
+        return Err(format!("{} = {value} refused: not a finite number", v.name));
+    }
+    if let Some(e) = d.enumeration_of(row) {
+        if e.item(value as i32).is_none() {
+            let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
+            return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
+        }
+    }
+    if let Some(min) = v.min.filter(|&m| value < m) {
+        return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
+    }
+    if let Some(max) = v.max.filter(|&m| value > m) {
+        return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
+    }
+    Ok(())
 }

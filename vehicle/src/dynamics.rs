@@ -374,3 +374,75 @@ pub fn straight_running(v: f64) -> State<f64> {
     s[idx::V_X] = v;
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SplitMix64, for reproducible test points.
+    fn next(state: &mut u64) -> f64 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The shortcut decides "inside" only where the exact test (`hypot > cap`) would not
+    /// scale the forces: so the right-hand side is bit for bit the one without it. Points
+    /// on, just inside and just outside the circle at every scale, signs, zeros, subnormal,
+    /// huge and non-finite values.
+    #[test]
+    fn friction_circle_shortcut_only_skips_what_the_hypot_test_would_skip() {
+        let mut seed = 7u64;
+        let (mut shortcut, mut near_and_inside) = (0usize, 0usize);
+        let mut check = |a: f64, b: f64, cap: f64| {
+            if inside_friction_circle(a, b, cap) {
+                assert!(a.hypot(b) <= cap, "a = {a:e}, b = {b:e}, cap = {cap:e}");
+                shortcut += 1;
+            }
+        };
+        for scale in [1e-300, 1e-160, 1e-100, 1e-20, 1e-3, 1.0, 9.81, 1e3, 1e20, 1e149, 1e151, 1e300] {
+            for _ in 0..20_000 {
+                let cap = scale * (0.5 + next(&mut seed));
+                let angle = 2.0 * core::f64::consts::PI * next(&mut seed);
+                // radius from 0.9 to 1.1 of the cap, denser within 1e-9 of the circle
+                let rel = if next(&mut seed) < 0.5 {
+                    0.9 + 0.2 * next(&mut seed)
+                } else {
+                    1.0 + 1e-9 * (2.0 * next(&mut seed) - 1.0) * 10f64.powi(-(next(&mut seed) * 7.0) as i32)
+                };
+                let (a, b) = (cap * rel * angle.cos(), cap * rel * angle.sin());
+                check(a, b, cap);
+                check(-a, b, cap);
+                check(a, -b, cap);
+                check(b, a, cap);
+                if rel < 1.0 - 1e-11 && (1e-100..1e149).contains(&cap) && inside_friction_circle(a, b, cap) {
+                    near_and_inside += 1;
+                }
+            }
+        }
+        for (a, b, cap) in [
+            (1.0, 0.0, 1.0),
+            (0.0, 1.0, 1.0),
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, 1.0),
+            (f64::MIN_POSITIVE / 4.0, 0.0, f64::MIN_POSITIVE / 8.0),
+            (f64::NAN, 0.0, 1.0),
+            (0.0, f64::INFINITY, 1.0),
+            (1e200, 1e200, 1e201),
+            (1.0, 1.0, f64::INFINITY),
+            (1.0, 1.0, f64::NAN),
+            (-3.0, 4.0, 5.0),
+            (-3.0, 4.0, 5.0 * (1.0 + 1e-13)),
+        ] {
+            check(a, b, cap);
+        }
+        // it does take the shortcut where the forces are well inside the circle
+        assert!(shortcut > 200_000, "{shortcut}");
+        assert!(near_and_inside > 30_000, "{near_and_inside}");
+        assert!(!inside_friction_circle(3.0, 4.0, 5.0), "on the circle: the exact test decides");
+        assert!(!inside_friction_circle(f64::NAN, 0.0, 1.0));
+        assert!(inside_friction_circle(3.0, 4.0, 5.0 * (1.0 + 1e-11)));
+    }
+}
