@@ -144,6 +144,22 @@ pub fn speed_of<T: Scalar>(s: &State<T>) -> T {
     s[idx::V_X].hypot(s[idx::V_Y])
 }
 
+/// The tire force limit `cap_i = mu_i N_i` and the drive force `clamp(tau_i / r_wheel, +-cap_i)`
+/// before the motor taper and the friction circle: functions of the parameters and inputs
+/// only, so an integrator holding the inputs over a step computes them once per step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct WheelDrive<T> {
+    cap: [T; 4],
+    drive: [T; 4],
+}
+
+#[inline(always)]
+fn wheel_drive<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> WheelDrive<T> {
+    let loads = p.normal_loads();
+    let cap: [T; 4] = core::array::from_fn(|i| u.mu[i] * loads[i]);
+    WheelDrive { cap, drive: core::array::from_fn(|i| (u.tau[i] / p.r_wheel).clamp_s(-cap[i], cap[i])) }
+}
+
 /// Derivatives and per-wheel quantities, without the body outputs (the hot path).
 struct Core<T> {
     derivatives: State<T>,
@@ -154,7 +170,7 @@ struct Core<T> {
 }
 
 #[inline(always)]
-fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>) -> Core<T> {
+fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>, wd: &WheelDrive<T>) -> Core<T> {
     let zero = T::constant(0.0);
     let one = T::constant(1.0);
     let v_x = s[idx::V_X];
@@ -162,7 +178,6 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let r = s[idx::YAW_RATE];
     let psi = s[idx::PSI];
     let pos = p.wheel_positions();
-    let loads = p.normal_loads();
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
@@ -186,8 +201,8 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
         let fade = if speed_sq.value() < v_fade_sq { speed_sq.sqrt() / p.v_fade } else { one };
         let mu = u.mu[i];
         let mut f_lat = mu * alpha * p.c[i] * fade;
-        let cap = mu * loads[i];
-        let mut f_drive = (u.tau[i] / p.r_wheel).clamp_s(-cap, cap);
+        let cap = wd.cap[i];
+        let mut f_drive = wd.drive[i];
         if p.motor_speed_limit && f_drive.value() > 0.0 {
             let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
             f_drive = f_drive * scale;
@@ -227,7 +242,7 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
 /// The model at one point: derivatives and all outputs.
 pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
     let st = steering(p, s, u);
-    let c = core(p, s, u, &st);
+    let c = core(p, s, u, &st, &wheel_drive(p, u));
     Evaluation {
         derivatives: c.derivatives,
         beta: body_slip_angle(s),
@@ -243,27 +258,40 @@ pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Ev
 /// Only the derivatives (the hot path of integrators).
 #[inline]
 pub fn derivatives_of(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
-    core(p, s, u, &steering(p, s, u)).derivatives
+    core(p, s, u, &steering(p, s, u), &wheel_drive(p, u)).derivatives
 }
 
 /// The derivatives with the steering given (valid while it does not depend on the state,
-/// i.e. with the servo off).
+/// i.e. with the servo off) and the wheel drive given (always valid with the inputs held).
 #[inline]
-fn derivatives_steered(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, st: &Steering<f64>) -> State<f64> {
-    core(p, s, u, st).derivatives
+fn derivatives_steered(
+    p: &VehicleParams,
+    s: &State<f64>,
+    u: &Inputs<f64>,
+    st: &Steering<f64>,
+    wd: &WheelDrive<f64>,
+) -> State<f64> {
+    core(p, s, u, st, wd).derivatives
 }
 
 /// One classical Runge-Kutta step of size `h` with inputs held constant.
 pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
     let held = (!p.steering_servo).then(|| steering(p, s, u));
-    rk4(p, s, u, h, held.as_ref())
+    rk4(p, s, u, h, held.as_ref(), &wheel_drive(p, u))
 }
 
 #[inline]
-fn rk4(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, held: Option<&Steering<f64>>) -> State<f64> {
+fn rk4(
+    p: &VehicleParams,
+    s: &State<f64>,
+    u: &Inputs<f64>,
+    h: f64,
+    held: Option<&Steering<f64>>,
+    wd: &WheelDrive<f64>,
+) -> State<f64> {
     let f = |x: &State<f64>| match held {
-        Some(st) => derivatives_steered(p, x, u, st),
-        None => derivatives_of(p, x, u),
+        Some(st) => derivatives_steered(p, x, u, st, wd),
+        None => derivatives_steered(p, x, u, &steering(p, x, u), wd),
     };
     let add = |a: &State<f64>, k: &State<f64>, c: f64| {
         let mut o = *a;
@@ -338,14 +366,16 @@ pub fn stable_rk4_step(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
 }
 
 /// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`, inputs held.
-/// With the servo off the steering trigonometry is computed once for the whole interval.
+/// With the servo off the steering trigonometry is computed once for the whole interval;
+/// the tire force limits and drive forces always are (they depend on the inputs only).
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
     let n = substeps(h, max_step);
     let dt = h / n as f64;
     let held = (!p.steering_servo).then(|| steering(p, s, u));
+    let wd = wheel_drive(p, u);
     let mut x = *s;
     for _ in 0..n {
-        x = rk4(p, &x, u, dt, held.as_ref());
+        x = rk4(p, &x, u, dt, held.as_ref(), &wd);
         flush_negligible(&mut x);
     }
     x
