@@ -212,14 +212,14 @@ fn cached_references_equal_fresh_ones() {
     ] {
         let mut first = Scenario::new(maneuver, fidelity);
         first.seed = 3;
-        let a = Benchmark::prepare(first.clone()).unwrap();
+        let a = Benchmark::prepare(first).unwrap();
         let mut second = Scenario::new(maneuver, fidelity);
         second.seed = 11;
         second.wind = false;
         // from the cache, also when two threads ask at once
         let (b, c) = std::thread::scope(|t| {
-            let h = t.spawn(|| Benchmark::prepare(second.clone()).unwrap());
-            (Benchmark::prepare(second.clone()).unwrap(), h.join().unwrap())
+            let h = t.spawn(|| Benchmark::prepare(second).unwrap());
+            (Benchmark::prepare(second).unwrap(), h.join().unwrap())
         });
         assert_eq!(a.reference, b.reference);
         assert_eq!(c.reference, b.reference);
@@ -228,14 +228,14 @@ fn cached_references_equal_fresh_ones() {
             Maneuver::Figure8 => figure8_switches(second.steer_amplitude, second.speed_ref, second.n_samples).unwrap(),
             _ => Vec::new(),
         };
-        let fresh = Benchmark::prepare_with_switches(second.clone(), switches).unwrap();
+        let fresh = Benchmark::prepare_with_switches(second, switches).unwrap();
         assert_eq!(fresh.reference, b.reference);
         // a different amplitude is a different reference
-        let mut other = second.clone();
+        let mut other = second;
         other.steer_amplitude *= 0.5;
         assert_ne!(Benchmark::prepare(other).unwrap().reference.trajectory, b.reference.trajectory);
         // and a bad scenario is refused even though a reference for its key may be cached
-        let mut bad = second.clone();
+        let mut bad = second;
         bad.speed_ref = f64::NAN;
         assert!(Benchmark::prepare(bad).is_err());
     }

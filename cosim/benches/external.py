@@ -1,12 +1,12 @@
 """The plant FMU, 30 s at 1 ms, run by fmpy, ecos (ecospy) and libcosim (libcosimpy),
 each timed around its run call only (best of 3). Called by `cargo bench -p nigel-cosim`
 with COSIM_BENCH_PYTHON set; arguments: the plant .fmu and the one-plant .ssp the bench
-wrote (start values v_x = 0.35, delta_fl = 0.2 as inline parameter bindings)."""
+wrote (start values v_x_start = 0.35, delta_fl = 0.2 as inline parameter bindings)."""
 import sys
 import time
 
 fmu, ssp = sys.argv[1], sys.argv[2]
-START = {"v_x": 0.35, "delta_fl": 0.2}
+START = {"v_x_start": 0.35, "delta_fl": 0.2}
 STEPS = 30000
 
 

@@ -69,7 +69,7 @@ fn main() {
     let steps = 30_000.0;
     let mut system = SystemBuilder::new();
     system.add_instance("plant", fmu.clone()).unwrap();
-    system.set_text("plant.v_x", "0.35").unwrap();
+    system.set_text("plant.v_x_start", "0.35").unwrap();
     system.set_text("plant.delta_fl", "0.2").unwrap();
     let system: System = system.build();
     let run = |record: Option<Vec<String>>| {
@@ -86,7 +86,7 @@ fn main() {
     // the floor: the same fmi2DoStep calls in a bare loop
     let bare = best_of(5, || {
         let mut inst = Instance::new(&fmu, "bare").unwrap();
-        let vx = fmu.description().real_value_reference("v_x").unwrap();
+        let vx = fmu.description().real_value_reference("v_x_start").unwrap();
         let d = fmu.description().real_value_reference("delta_fl").unwrap();
         inst.setup_experiment(None, 0.0, Some(30.0)).unwrap();
         inst.set_real(&[vx, d], &[0.35, 0.2]).unwrap();
@@ -109,7 +109,7 @@ fn main() {
         .collect();
     let bare_get = best_of(5, || {
         let mut inst = Instance::new(&fmu, "bare").unwrap();
-        let vx = fmu.description().real_value_reference("v_x").unwrap();
+        let vx = fmu.description().real_value_reference("v_x_start").unwrap();
         let d = fmu.description().real_value_reference("delta_fl").unwrap();
         inst.setup_experiment(None, 0.0, Some(30.0)).unwrap();
         inst.set_real(&[vx, d], &[0.35, 0.2]).unwrap();
