@@ -155,13 +155,25 @@ fn run_loop(
 /// sample after its closest approach to the origin once it has turned `3 pi/2` since the
 /// last flip. Computed once and replayed everywhere.
 pub fn figure8_switches(amplitude: f64, speed_ref: f64, n_samples: usize) -> Result<Vec<usize>, SettingError> {
+    Ok(figure8_nominal_run(amplitude, speed_ref, n_samples)?.0)
+}
+
+/// The run behind [`figure8_switches`]: the table and the nominal car's trajectory. That
+/// trajectory is the paper-fidelity figure-8 reference itself: the reference run replays
+/// the same steering (`figure8_sign(switches, k) * a` at every sample) on the same plant
+/// with the same loop, so it reproduces it bit for bit and need not be run again.
+fn figure8_nominal_run(
+    amplitude: f64,
+    speed_ref: f64,
+    n_samples: usize,
+) -> Result<(Vec<usize>, Trajectory), SettingError> {
     let mut scenario = Scenario::new(Maneuver::Figure8, Fidelity::Paper).undisturbed();
     scenario.steer_amplitude = amplitude;
     scenario.speed_ref = speed_ref;
     scenario.n_samples = n_samples;
     scenario.validate()?;
     let mut switches = Vec::new();
-    run_loop(
+    let trajectory = run_loop(
         &Fidelity::Paper.params(),
         Steer::Figure8Online { amplitude, switches: &mut switches },
         &Disturbances::none(),
@@ -170,7 +182,7 @@ pub fn figure8_switches(amplitude: f64, speed_ref: f64, n_samples: usize) -> Res
         speed_ref,
         n_samples,
     )?;
-    Ok(switches)
+    Ok((switches, trajectory))
 }
 
 /// The reference of a column: the open-loop run (`K = 0`, same speed loop) of the column's
@@ -270,24 +282,38 @@ impl ReferenceKey {
     }
 }
 
-/// The most recently computed references, newest last.
-struct ReferenceCache(std::sync::Mutex<Vec<(ReferenceKey, Arc<Reference>)>>);
+/// One reference of the cache: empty while (or if) it is being computed. Its own lock
+/// makes a second thread asking for the same reference wait for the first one's result
+/// instead of computing it again (the runs of Table III come in threes per reference).
+type ReferenceSlot = Arc<std::sync::Mutex<Option<Arc<Reference>>>>;
+
+/// The most recently used references, newest last.
+struct ReferenceCache(std::sync::Mutex<Vec<(ReferenceKey, ReferenceSlot)>>);
 
 impl ReferenceCache {
-    fn lookup(&self, key: &ReferenceKey) -> Option<Reference> {
-        let entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        entries.iter().find(|(k, _)| k == key).map(|(_, r)| Reference::clone(r))
-    }
-
-    fn store(&self, key: ReferenceKey, reference: &Reference) {
+    /// The slot of `key`, made (empty) if there is none; the oldest slot goes when the
+    /// cache is full.
+    fn slot(&self, key: ReferenceKey) -> ReferenceSlot {
         let mut entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if entries.iter().any(|(k, _)| *k == key) {
-            return;
+        if let Some((_, slot)) = entries.iter().find(|(k, _)| *k == key) {
+            return slot.clone();
         }
         if entries.len() >= REFERENCE_CACHE_SIZE {
             entries.remove(0);
         }
-        entries.push((key, Arc::new(reference.clone())));
+        let slot = ReferenceSlot::default();
+        entries.push((key, slot.clone()));
+        slot
+    }
+
+    /// The reference of `key` if it is there and not being computed (never waits).
+    fn peek(&self, key: ReferenceKey) -> Option<Arc<Reference>> {
+        let slot = {
+            let entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            entries.iter().find(|(k, _)| *k == key)?.1.clone()
+        };
+        let cached = slot.try_lock().ok()?;
+        cached.clone()
     }
 }
 
@@ -315,19 +341,43 @@ impl Benchmark {
     /// 36 runs of Table III, or many instances of the test-bench FMU, compute 12 of them.
     pub fn prepare(scenario: Scenario) -> Result<Benchmark, SettingError> {
         scenario.validate()?;
-        let key = ReferenceKey::of(&scenario);
-        if let Some(reference) = reference_cache().lookup(&key) {
-            return Ok(Benchmark { scenario, reference });
+        if scenario.n_samples > REFERENCE_CACHE_MAX_SAMPLES {
+            return Self::prepare_uncached(scenario);
         }
-        let switches = match scenario.maneuver {
-            Maneuver::Figure8 => figure8_switches(scenario.steer_amplitude, scenario.speed_ref, scenario.n_samples)?,
-            _ => Vec::new(),
-        };
-        let bench = Self::prepare_with_switches(scenario, switches)?;
-        if bench.scenario.n_samples <= REFERENCE_CACHE_MAX_SAMPLES {
-            reference_cache().store(key, &bench.reference);
+        let slot = reference_cache().slot(ReferenceKey::of(&scenario));
+        // held while computing: a concurrent request for the same reference waits for it
+        let mut cached = slot.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some(reference) = cached.as_ref() {
+            return Ok(Benchmark { scenario, reference: Reference::clone(reference) });
         }
+        let bench = Self::prepare_uncached(scenario)?;
+        *cached = Some(Arc::new(bench.reference.clone()));
         Ok(bench)
+    }
+
+    /// [`Benchmark::prepare`] without the cache. The paper-fidelity figure-8 reference is
+    /// the trajectory of the run that finds its switching table ([`figure8_nominal_run`]);
+    /// the real-fidelity one takes its table from that reference when it is cached.
+    fn prepare_uncached(scenario: Scenario) -> Result<Benchmark, SettingError> {
+        if scenario.maneuver != Maneuver::Figure8 {
+            return Self::prepare_with_switches(scenario, Vec::new());
+        }
+        let (amplitude, speed, n) = (scenario.steer_amplitude, scenario.speed_ref, scenario.n_samples);
+        match scenario.fidelity {
+            Fidelity::Paper => {
+                let (switches, trajectory) = figure8_nominal_run(amplitude, speed, n)?;
+                let program = Program::new(scenario.maneuver, amplitude, switches);
+                Ok(Benchmark { scenario, reference: Reference { program, trajectory } })
+            }
+            Fidelity::Real => {
+                let paper = ReferenceKey { fidelity: Fidelity::Paper, ..ReferenceKey::of(&scenario) };
+                let switches = match reference_cache().peek(paper) {
+                    Some(nominal) => nominal.program.switches.clone(),
+                    None => figure8_nominal_run(amplitude, speed, n)?.0,
+                };
+                Self::prepare_with_switches(scenario, switches)
+            }
+        }
     }
 
     /// As [`Benchmark::prepare`] with a figure-8 table given (e.g. shared between columns).

@@ -300,8 +300,32 @@ pub struct Declaration<B> {
     /// Rows saved with the FMU state, in declaration order: parameters, inputs,
     /// continuous states and discrete variables (locals and outputs).
     pub saved_rows: Vec<usize>,
+    /// Per row, the binding and what `fmi2Set*` checks, in one compact table (the per-value
+    /// path of `fmi2Get*`/`fmi2Set*` reads this, not the whole [`VarDecl`]).
+    hot: Vec<HotRow<B>>,
     description: md::ModelDescription,
     xml: String,
+}
+
+/// One row of [`Declaration`]'s compact table: the model's binding and the set checks.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HotRow<B> {
+    pub binding: B,
+    pub access: SetAccess,
+}
+
+/// The checks of `fmi2Set*` for one variable as tables: a value inside them is accepted
+/// without running the full checks (which run, and give the reason, for anything else).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SetAccess {
+    /// Bit `Machine::bit()` set: the variable may be set in that state.
+    pub settable_in: u16,
+    /// Not an Enumeration (whose values must also be items).
+    pub plain: bool,
+    /// The declared minimum, else the most negative finite f64.
+    pub lowest: f64,
+    /// The declared maximum, else the largest finite f64.
+    pub highest: f64,
 }
 
 /// Value references below this are looked up in a table; larger ones (legal, but rare) in
@@ -325,7 +349,7 @@ pub const LOG_CATEGORIES: [(&str, &str); 4] = [
     ("logCalls", "Every fmi2 call"),
 ];
 
-impl<B> Declaration<B> {
+impl<B: Copy> Declaration<B> {
     /// Checks the spec (unique names and value references, derivatives refer to Real states,
     /// dependencies refer to declared Reals), builds the lookup tables and generates the
     /// description, then runs the modelDescription validator over it.
@@ -554,9 +578,27 @@ impl<B> Declaration<B> {
                 table[vr as usize] = row as u32;
             }
         }
-        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, description, xml })
+        let hot = spec
+            .variables
+            .iter()
+            .map(|v| HotRow {
+                binding: v.binding,
+                access: SetAccess {
+                    settable_in: crate::states::Machine::ALL
+                        .into_iter()
+                        .filter(|&m| crate::instance::settable_in(v, m).is_ok())
+                        .fold(0, |mask, m| mask | m.bit()),
+                    plain: v.declared_type.is_none(),
+                    lowest: v.min.unwrap_or(f64::MIN),
+                    highest: v.max.unwrap_or(f64::MAX),
+                },
+            })
+            .collect();
+        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, hot, description, xml })
     }
+}
 
+impl<B> Declaration<B> {
     /// Row of the variable with this base type and value reference.
     #[inline]
     pub fn row(&self, base_type: BaseType, vr: u32) -> Option<usize> {
@@ -568,6 +610,11 @@ impl<B> Declaration<B> {
         } else {
             self.lookup.get(&(base_type, vr)).copied()
         }
+    }
+
+    #[inline]
+    pub(crate) fn hot(&self, row: usize) -> &HotRow<B> {
+        &self.hot[row]
     }
 
     #[inline]
@@ -656,6 +703,71 @@ mod tests {
         assert_eq!(d.row(BaseType::Boolean, 5), None); // Real 5 and Integer 5 exist, Boolean 5 does not
         assert_eq!(d.row(BaseType::Real, DENSE_VR_LIMIT + 8), None);
         assert_eq!(d.row(BaseType::Integer, u32::MAX), None);
+    }
+
+    /// The precomputed set checks accept a value only where the full checks do (which
+    /// give the reason for everything else), and the settable mask is the full rule in
+    /// every instance state: the fast path of `fmi2Set*` changes no outcome.
+    #[test]
+    fn precomputed_set_checks_agree_with_the_full_checks() {
+        use crate::instance::{check_value_in, settable_in};
+        use crate::states::Machine;
+        let mut v = toy();
+        v.push(VarDecl::real("bounded", 7, 5).tunable_parameter(Start::Real(0.5)).min(-1.0).max(2.0));
+        v.push(VarDecl::real("above", 8, 6).input(Start::Real(0.0)).min(0.0));
+        v.push(VarDecl::integer("n", 5, 7).parameter(Start::Integer(3)).min(0.0));
+        v.push(VarDecl::enumeration("mode", 6, "Mode", 8).parameter(Start::Integer(1)));
+        v.push(VarDecl::real("y", 9, 9).output(Dependencies::On(vec![5])));
+        let mut s = spec(v);
+        s.enumerations = vec![enumeration_type("Mode", "", &[("a", 1, ""), ("b", 2, ""), ("c", 4, "")])];
+        let d = Declaration::new(s).unwrap();
+        let tiny = f64::MIN_POSITIVE;
+        let values = [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+            0.0,
+            -0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+            -1.0,
+            f64::from_bits(2.0f64.to_bits() + 1),
+            f64::from_bits((-1.0f64).to_bits() + 1),
+            -tiny,
+            tiny,
+            0.5,
+            1e300,
+            -1e300,
+        ];
+        let mut fast_accepted = 0;
+        for row in 0..d.spec.variables.len() {
+            let hot = d.hot(row);
+            assert_eq!(hot.binding, d.variable(row).binding);
+            for m in Machine::ALL {
+                let full = settable_in(d.variable(row), m).is_ok();
+                assert_eq!(hot.access.settable_in & m.bit() != 0, full, "{} in {m:?}", d.variable(row).name);
+            }
+            for x in values {
+                let a = hot.access;
+                if a.plain && x >= a.lowest && x <= a.highest {
+                    fast_accepted += 1;
+                    assert_eq!(check_value_in(&d, row, x), Ok(()), "{} = {x}", d.variable(row).name);
+                }
+            }
+            // what the full checks refuse, the fast path refuses too (it then runs them)
+            for x in values.into_iter().filter(|&x| check_value_in(&d, row, x).is_err()) {
+                let a = hot.access;
+                assert!(!(a.plain && x >= a.lowest && x <= a.highest), "{} = {x}", d.variable(row).name);
+            }
+        }
+        assert!(fast_accepted > 50, "{fast_accepted}");
+        // the enumeration never takes the fast path: its items are checked in full
+        assert!(!d.hot(d.row(BaseType::Integer, 6).unwrap()).access.plain);
+        assert!(check_value_in(&d, d.row(BaseType::Integer, 6).unwrap(), 3.0).is_err());
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! variable access checks, time events and FMU state handling. The C ABI in
 //! [`crate::abi`] only translates pointers to slices.
 
-use crate::decl::{BaseType, Causality, Declaration, Initial, Start, Variability};
+use crate::decl::{BaseType, Causality, Declaration, Initial, Start, VarDecl, Variability};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 pub use crate::states::{Function, Machine, Scope};
 
@@ -29,8 +29,9 @@ pub struct Core<M> {
     pub model: M,
     /// Co-Simulation: the model (and its next event) before the events at the current
     /// time were run (lazily, at the first read or step). Setting an input afterwards
-    /// restores it, so the events see the inputs of their own time instant.
-    pre_event: Option<Box<(M, Option<f64>)>>,
+    /// restores it, so the events see the inputs of their own time instant. Held inline
+    /// (not boxed): a sampled model takes this copy at every communication point.
+    pre_event: Option<(M, Option<f64>)>,
 }
 
 /// A saved FMU state (`fmi2FMUstate`).
@@ -196,48 +197,33 @@ impl<M: Model> Instance<M> {
     /// Whether variable `row` may be set in the current state (FMI 2.0 section 2.2.7 and
     /// the state tables); the reason when not.
     fn settable(&self, row: usize) -> Result<(), String> {
-        let v = decl::<M>().variable(row);
-        let why = |reason: &str| Err(format!("{} cannot be set {reason}", v.name));
-        if v.variability == Variability::Constant {
-            return why("(a constant)");
-        }
-        if matches!(v.causality, Causality::Independent | Causality::CalculatedParameter) {
-            return why("(calculated)");
-        }
-        let has_start = matches!(v.initial, Some(Initial::Exact) | Some(Initial::Approx));
-        let machine = self.core.machine;
-        match machine {
-            Machine::Instantiated | Machine::InitializationMode => {
-                if has_start || v.causality == Causality::Input {
-                    Ok(())
-                } else {
-                    why("(no start value: it is calculated)")
-                }
-            }
-            Machine::StepComplete | Machine::EventMode => match (v.causality, v.variability) {
-                (Causality::Input, _) | (Causality::Parameter, Variability::Tunable) => Ok(()),
-                (Causality::Parameter, _) => why("after initialization (a fixed parameter; only tunable ones can)"),
-                _ => why(&format!("in {machine:?} (only inputs and tunable parameters)")),
-            },
-            Machine::ContinuousTimeMode => {
-                if v.causality == Causality::Input && v.variability == Variability::Continuous {
-                    Ok(())
-                } else {
-                    why("in ContinuousTimeMode (only continuous inputs)")
-                }
-            }
-            _ => why(&format!("in {machine:?}")),
+        settable_in(decl::<M>().variable(row), self.core.machine)
+    }
+
+    /// The row of value reference `vr` of `base_type` in declaration `d` (fetched once per call).
+    #[inline(always)]
+    fn row_in(d: &Declaration<M::Binding>, base_type: BaseType, vr: u32) -> OpResult<usize> {
+        match d.row(base_type, vr) {
+            Some(row) => Ok(row),
+            None => Self::unknown_value_reference(base_type, vr),
         }
     }
 
-    fn rows(&self, base_type: BaseType, vrs: &[u32]) -> OpResult<Vec<usize>> {
-        vrs.iter()
-            .map(|&vr| {
-                decl::<M>()
-                    .row(base_type, vr)
-                    .ok_or_else(|| format!("unknown {base_type:?} value reference {vr}").into())
-            })
-            .collect()
+    #[cold]
+    #[inline(never)]
+    fn unknown_value_reference(base_type: BaseType, vr: u32) -> OpResult<usize> {
+        err(format!("unknown {base_type:?} value reference {vr}"))
+    }
+
+    /// Refuses the whole call if one value reference is unknown (before anything is read
+    /// or changed). The rows are looked up again where they are used: a table lookup is
+    /// cheaper than a vector allocated per call.
+    #[inline(always)]
+    fn check_rows(d: &Declaration<M::Binding>, base_type: BaseType, vrs: &[u32]) -> OpResult {
+        for &vr in vrs {
+            Self::row_in(d, base_type, vr)?;
+        }
+        Ok(())
     }
 
     /// Co-Simulation: runs the events due at the current time (lazily, so that they see
@@ -249,7 +235,7 @@ impl<M: Model> Instance<M> {
         let now = self.core.time;
         if matches!(self.core.next_event, Some(te) if te <= now + time_eps(now)) {
             if self.core.pre_event.is_none() {
-                self.core.pre_event = Some(Box::new((self.core.model.clone(), self.core.next_event)));
+                self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
             }
             self.run_events_at(now)?;
         }
@@ -258,8 +244,7 @@ impl<M: Model> Instance<M> {
 
     /// Before a set in Co-Simulation: undo the events run lazily at this instant.
     fn unsettle_events(&mut self) {
-        if let Some(pre) = self.core.pre_event.take() {
-            let (model, next) = *pre;
+        if let Some((model, next)) = self.core.pre_event.take() {
             self.core.model = model;
             self.core.next_event = next;
         }
@@ -298,10 +283,16 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
-        let rows = self.rows(BaseType::Real, vrs)?;
+        let d = decl::<M>();
+        Self::check_rows(d, BaseType::Real, vrs)?;
         self.settle_events()?;
-        for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.finite_real(row)?;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let x = self.core.model.get_real(d.hot(row).binding)?;
+            if !x.is_finite() {
+                return Self::not_finite(row, x);
+            }
+            *o = x;
         }
         Ok(())
     }
@@ -309,52 +300,46 @@ impl<M: Model> Instance<M> {
     /// A Real of the model, refusing a non-finite result (an overflowed state, say)
     /// rather than handing NaN or Inf to the importer's solver.
     fn finite_real(&mut self, row: usize) -> OpResult<f64> {
-        let v = decl::<M>().variable(row);
-        let x = self.core.model.get_real(v.binding)?;
+        let x = self.core.model.get_real(decl::<M>().variable(row).binding)?;
         if x.is_finite() {
             Ok(x)
         } else {
-            err(format!("{} evaluated to {x} (the state or inputs are out of the model's range)", v.name))
+            Self::not_finite(row, x)
         }
     }
 
+    #[cold]
+    #[inline(never)]
+    fn not_finite<T>(row: usize, x: f64) -> OpResult<T> {
+        let name = decl::<M>().variable(row).name;
+        err(format!("{name} evaluated to {x} (the state or inputs are out of the model's range)"))
+    }
+
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
-        let rows = self.rows(BaseType::Integer, vrs)?;
+        let d = decl::<M>();
+        Self::check_rows(d, BaseType::Integer, vrs)?;
         self.settle_events()?;
-        for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.core.model.get_integer(decl::<M>().variable(row).binding)?;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let row = Self::row_in(d, BaseType::Integer, vr)?;
+            *o = self.core.model.get_integer(d.hot(row).binding)?;
         }
         Ok(())
     }
 
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
-        let rows = self.rows(BaseType::Boolean, vrs)?;
+        let d = decl::<M>();
+        Self::check_rows(d, BaseType::Boolean, vrs)?;
         self.settle_events()?;
-        for (o, row) in out.iter_mut().zip(rows) {
-            *o = self.core.model.get_boolean(decl::<M>().variable(row).binding)?;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let row = Self::row_in(d, BaseType::Boolean, vr)?;
+            *o = self.core.model.get_boolean(d.hot(row).binding)?;
         }
         Ok(())
     }
 
     /// Whether `value` fits variable `row` (min/max of the declaration, enumeration items).
     fn check_value(row: usize, value: f64) -> Result<(), String> {
-        let v = decl::<M>().variable(row);
-        if !value.is_finite() {
-            return Err(format!("{} = {value} refused: not a finite number", v.name));
-        }
-        if let Some(e) = decl::<M>().enumeration_of(row) {
-            if e.item(value as i32).is_none() {
-                let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
-                return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
-            }
-        }
-        if let Some(min) = v.min.filter(|&m| value < m) {
-            return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
-        }
-        if let Some(max) = v.max.filter(|&m| value > m) {
-            return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
-        }
-        Ok(())
+        check_value_in(decl::<M>(), row, value)
     }
 
     /// Sets all or nothing: every value reference, permission and value is checked first,
@@ -366,17 +351,28 @@ impl<M: Model> Instance<M> {
         values: &[T],
         mut apply: impl FnMut(&mut M, M::Binding, T) -> OpResult,
     ) -> OpResult {
-        let rows = self.rows(base_type, vrs)?;
-        for (&row, &value) in rows.iter().zip(values) {
-            self.settable(row)?;
-            Self::check_value(row, value.into())?;
+        let d = decl::<M>();
+        let machine_bit = self.core.machine.bit();
+        for (&vr, &value) in vrs.iter().zip(values) {
+            let row = Self::row_in(d, base_type, vr)?;
+            // the common case from precomputed tables; the full checks (which give the
+            // reason) only when these do not accept at once
+            let access = d.hot(row).access;
+            if access.settable_in & machine_bit == 0 {
+                self.settable(row)?;
+            }
+            let x: f64 = value.into();
+            if !(access.plain && x >= access.lowest && x <= access.highest) {
+                Self::check_value(row, x)?;
+            }
         }
         self.unsettle_events();
         let backup = self.core.model.clone();
-        for (&row, &value) in rows.iter().zip(values) {
-            let v = decl::<M>().variable(row);
-            if let Err(e) = apply(&mut self.core.model, v.binding, value) {
+        for (&vr, &value) in vrs.iter().zip(values) {
+            let row = Self::row_in(d, base_type, vr)?;
+            if let Err(e) = apply(&mut self.core.model, d.hot(row).binding, value) {
                 self.core.model = backup;
+                let v = d.variable(row);
                 return Err(match e {
                     ModelError::Error(m) => ModelError::Error(format!("{}: {m}", v.name)),
                     ModelError::Discard(m) => ModelError::Discard(format!("{}: {m}", v.name)),
@@ -758,4 +754,62 @@ impl From<BoolAsF64> for f64 {
     fn from(b: BoolAsF64) -> f64 {
         b.0 as u8 as f64
     }
+}
+
+/// Whether variable `v` may be set in instance state `machine` (FMI 2.0 section 2.2.7 and
+/// the state tables); the reason when not. [`Declaration`] keeps the answer for every state
+/// as a bit mask, the fast path of `fmi2Set*`.
+pub(crate) fn settable_in<B>(v: &VarDecl<B>, machine: Machine) -> Result<(), String> {
+    let why = |reason: &str| Err(format!("{} cannot be set {reason}", v.name));
+    if v.variability == Variability::Constant {
+        return why("(a constant)");
+    }
+    if matches!(v.causality, Causality::Independent | Causality::CalculatedParameter) {
+        return why("(calculated)");
+    }
+    let has_start = matches!(v.initial, Some(Initial::Exact) | Some(Initial::Approx));
+    match machine {
+        Machine::Instantiated | Machine::InitializationMode => {
+            if has_start || v.causality == Causality::Input {
+                Ok(())
+            } else {
+                why("(no start value: it is calculated)")
+            }
+        }
+        Machine::StepComplete | Machine::EventMode => match (v.causality, v.variability) {
+            (Causality::Input, _) | (Causality::Parameter, Variability::Tunable) => Ok(()),
+            (Causality::Parameter, _) => why("after initialization (a fixed parameter; only tunable ones can)"),
+            _ => why(&format!("in {machine:?} (only inputs and tunable parameters)")),
+        },
+        Machine::ContinuousTimeMode => {
+            if v.causality == Causality::Input && v.variability == Variability::Continuous {
+                Ok(())
+            } else {
+                why("in ContinuousTimeMode (only continuous inputs)")
+            }
+        }
+        _ => why(&format!("in {machine:?}")),
+    }
+}
+
+/// Whether `value` fits variable `row` of declaration `d` (finite, min/max, enumeration
+/// items); the reason when not.
+pub(crate) fn check_value_in<B>(d: &Declaration<B>, row: usize, value: f64) -> Result<(), String> {
+    let v = d.variable(row);
+    if !value.is_finite() {
+        return Err(format!("{} = {value} refused: not a finite number", v.name));
+    }
+    if let Some(e) = d.enumeration_of(row) {
+        if e.item(value as i32).is_none() {
+            let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
+            return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
+        }
+    }
+    if let Some(min) = v.min.filter(|&m| value < m) {
+        return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
+    }
+    if let Some(max) = v.max.filter(|&m| value > m) {
+        return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
+    }
+    Ok(())
 }

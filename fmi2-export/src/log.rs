@@ -89,6 +89,7 @@ impl Logger {
     }
 
     /// Whether messages of `category` reach the importer (errors always do).
+    #[inline]
     pub fn enabled(&self, category: LogCategory) -> bool {
         category == LogCategory::Error
             || (self.shared.logging_on.load(Ordering::Relaxed)
@@ -125,11 +126,19 @@ impl Logger {
         self.emit(Fmi2Status::Ok, LogCategory::Events, message);
     }
 
+    /// Inline: the check runs at every fmi2 call (the `logCalls` message), the call to the
+    /// importer only when the category is on.
+    #[inline]
     pub(crate) fn emit(&self, status: Fmi2Status, category: LogCategory, message: &str) {
         // Errors and discards always reach the importer: they explain a status.
         if !self.enabled(category) && status < Fmi2Status::Discard {
             return;
         }
+        self.emit_now(status, category, message);
+    }
+
+    #[inline(never)]
+    fn emit_now(&self, status: Fmi2Status, category: LogCategory, message: &str) {
         let Some(callbacks) = &self.shared.callbacks else { return };
         if let Some(logger) = callbacks.logger {
             let category = c_text(category.name());
@@ -150,6 +159,8 @@ impl Logger {
 
     /// Whether a warning was logged since the last call; clears the flag.
     pub(crate) fn take_warned(&self) -> bool {
-        self.shared.warned.swap(false, Ordering::Relaxed)
+        // a plain load first: the flag is almost always clear, and a swap is a locked
+        // read-modify-write at every fmi2 call
+        self.shared.warned.load(Ordering::Relaxed) && self.shared.warned.swap(false, Ordering::Relaxed)
     }
 }

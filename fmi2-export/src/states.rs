@@ -40,7 +40,7 @@ impl Machine {
         Machine::ALL.into_iter().find(|m| m.code() == c)
     }
 
-    const fn bit(self) -> u16 {
+    pub(crate) const fn bit(self) -> u16 {
         1 << self as u16
     }
 }

@@ -555,6 +555,10 @@ impl Model for Plant {
             PlantVar::State(i) => self.state[i],
             PlantVar::StateStart(i) => self.state_start[i],
             PlantVar::Derivative(i) => self.evaluation().derivatives[i],
+            // the body outputs depend on the state alone: computed as `evaluate` does, without
+            // the whole right-hand side (a master reads them at every communication point)
+            PlantVar::Output(Output::Beta) => nigel_vehicle::dynamics::body_slip_angle(&self.state),
+            PlantVar::Output(Output::Speed) => nigel_vehicle::dynamics::speed_of(&self.state),
             PlantVar::Output(o) => output_of(self.evaluation(), o),
             PlantVar::Switch(_) => return Err("a Boolean, not a Real".into()),
         })

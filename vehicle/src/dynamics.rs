@@ -115,6 +115,51 @@ pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> St
     st
 }
 
+/// Whether `hypot(f_drive, f_lat) <= cap` certainly holds, decided without the square
+/// root: `f_drive^2 + f_lat^2 < cap^2 (1 - 1e-12)`. The squares carry a relative error of a
+/// few units in the last place, far inside the 1e-12 margin, so `true` implies that the
+/// computed `hypot` is not above `cap` either and the friction circle would change nothing;
+/// `false` (near the circle, outside it, NaN, or magnitudes below 1e-100 or above 1e150
+/// where the squares could underflow or overflow) leaves the decision to the exact `hypot`
+/// test. Only the cost changes: the results are bit for bit those of the `hypot` test alone.
+#[inline(always)]
+fn inside_friction_circle(f_drive: f64, f_lat: f64, cap: f64) -> bool {
+    const LOWEST: f64 = 1e-100;
+    const HIGHEST: f64 = 1e150;
+    (LOWEST..HIGHEST).contains(&cap)
+        && f_drive.abs() < HIGHEST
+        && f_lat.abs() < HIGHEST
+        && f_drive * f_drive + f_lat * f_lat < cap * cap * (1.0 - 1e-12)
+}
+
+/// Body slip angle `atan2(v_y, v_x)` [rad] of a state (an output of [`evaluate`]).
+#[inline]
+pub fn body_slip_angle<T: Scalar>(s: &State<T>) -> T {
+    s[idx::V_Y].atan2(s[idx::V_X])
+}
+
+/// Speed `hypot(v_x, v_y)` [m/s] of a state (an output of [`evaluate`]).
+#[inline]
+pub fn speed_of<T: Scalar>(s: &State<T>) -> T {
+    s[idx::V_X].hypot(s[idx::V_Y])
+}
+
+/// The tire force limit `cap_i = mu_i N_i` and the drive force `clamp(tau_i / r_wheel, +-cap_i)`
+/// before the motor taper and the friction circle: functions of the parameters and inputs
+/// only, so an integrator holding the inputs over a step computes them once per step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct WheelDrive<T> {
+    cap: [T; 4],
+    drive: [T; 4],
+}
+
+#[inline(always)]
+fn wheel_drive<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> WheelDrive<T> {
+    let loads = p.normal_loads();
+    let cap: [T; 4] = core::array::from_fn(|i| u.mu[i] * loads[i]);
+    WheelDrive { cap, drive: core::array::from_fn(|i| (u.tau[i] / p.r_wheel).clamp_s(-cap[i], cap[i])) }
+}
+
 /// Derivatives and per-wheel quantities, without the body outputs (the hot path).
 struct Core<T> {
     derivatives: State<T>,
@@ -125,7 +170,7 @@ struct Core<T> {
 }
 
 #[inline(always)]
-fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>) -> Core<T> {
+fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>, wd: &WheelDrive<T>) -> Core<T> {
     let zero = T::constant(0.0);
     let one = T::constant(1.0);
     let v_x = s[idx::V_X];
@@ -133,7 +178,6 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let r = s[idx::YAW_RATE];
     let psi = s[idx::PSI];
     let pos = p.wheel_positions();
-    let loads = p.normal_loads();
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
@@ -157,13 +201,13 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
         let fade = if speed_sq.value() < v_fade_sq { speed_sq.sqrt() / p.v_fade } else { one };
         let mu = u.mu[i];
         let mut f_lat = mu * alpha * p.c[i] * fade;
-        let cap = mu * loads[i];
-        let mut f_drive = (u.tau[i] / p.r_wheel).clamp_s(-cap, cap);
+        let cap = wd.cap[i];
+        let mut f_drive = wd.drive[i];
         if p.motor_speed_limit && f_drive.value() > 0.0 {
             let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
             f_drive = f_drive * scale;
         }
-        if p.friction_circle {
+        if p.friction_circle && !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
             let h = f_drive.hypot(f_lat);
             if h.value() > cap.value() && h.value() > 0.0 {
                 let k = cap / h;
@@ -198,12 +242,11 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
 /// The model at one point: derivatives and all outputs.
 pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
     let st = steering(p, s, u);
-    let c = core(p, s, u, &st);
-    let (v_x, v_y) = (s[idx::V_X], s[idx::V_Y]);
+    let c = core(p, s, u, &st, &wheel_drive(p, u));
     Evaluation {
         derivatives: c.derivatives,
-        beta: v_y.atan2(v_x),
-        speed: v_x.hypot(v_y),
+        beta: body_slip_angle(s),
+        speed: speed_of(s),
         lateral_accel: c.lateral_force / p.m,
         slip_angle: c.slip_angle,
         force_lat: c.force_lat,
@@ -215,27 +258,40 @@ pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Ev
 /// Only the derivatives (the hot path of integrators).
 #[inline]
 pub fn derivatives_of(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> State<f64> {
-    core(p, s, u, &steering(p, s, u)).derivatives
+    core(p, s, u, &steering(p, s, u), &wheel_drive(p, u)).derivatives
 }
 
 /// The derivatives with the steering given (valid while it does not depend on the state,
-/// i.e. with the servo off).
+/// i.e. with the servo off) and the wheel drive given (always valid with the inputs held).
 #[inline]
-fn derivatives_steered(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, st: &Steering<f64>) -> State<f64> {
-    core(p, s, u, st).derivatives
+fn derivatives_steered(
+    p: &VehicleParams,
+    s: &State<f64>,
+    u: &Inputs<f64>,
+    st: &Steering<f64>,
+    wd: &WheelDrive<f64>,
+) -> State<f64> {
+    core(p, s, u, st, wd).derivatives
 }
 
 /// One classical Runge-Kutta step of size `h` with inputs held constant.
 pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
     let held = (!p.steering_servo).then(|| steering(p, s, u));
-    rk4(p, s, u, h, held.as_ref())
+    rk4(p, s, u, h, held.as_ref(), &wheel_drive(p, u))
 }
 
 #[inline]
-fn rk4(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, held: Option<&Steering<f64>>) -> State<f64> {
+fn rk4(
+    p: &VehicleParams,
+    s: &State<f64>,
+    u: &Inputs<f64>,
+    h: f64,
+    held: Option<&Steering<f64>>,
+    wd: &WheelDrive<f64>,
+) -> State<f64> {
     let f = |x: &State<f64>| match held {
-        Some(st) => derivatives_steered(p, x, u, st),
-        None => derivatives_of(p, x, u),
+        Some(st) => derivatives_steered(p, x, u, st, wd),
+        None => derivatives_steered(p, x, u, &steering(p, x, u), wd),
     };
     let add = |a: &State<f64>, k: &State<f64>, c: f64| {
         let mut o = *a;
@@ -310,14 +366,16 @@ pub fn stable_rk4_step(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
 }
 
 /// Integrates over `[0, h]` with RK4 sub-steps no longer than `max_step`, inputs held.
-/// With the servo off the steering trigonometry is computed once for the whole interval.
+/// With the servo off the steering trigonometry is computed once for the whole interval;
+/// the tire force limits and drive forces always are (they depend on the inputs only).
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
     let n = substeps(h, max_step);
     let dt = h / n as f64;
     let held = (!p.steering_servo).then(|| steering(p, s, u));
+    let wd = wheel_drive(p, u);
     let mut x = *s;
     for _ in 0..n {
-        x = rk4(p, &x, u, dt, held.as_ref());
+        x = rk4(p, &x, u, dt, held.as_ref(), &wd);
         flush_negligible(&mut x);
     }
     x
@@ -345,4 +403,76 @@ pub fn straight_running(v: f64) -> State<f64> {
     let mut s = [0.0; N_STATES];
     s[idx::V_X] = v;
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// SplitMix64, for reproducible test points.
+    fn next(state: &mut u64) -> f64 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The shortcut decides "inside" only where the exact test (`hypot > cap`) would not
+    /// scale the forces: so the right-hand side is bit for bit the one without it. Points
+    /// on, just inside and just outside the circle at every scale, signs, zeros, subnormal,
+    /// huge and non-finite values.
+    #[test]
+    fn friction_circle_shortcut_only_skips_what_the_hypot_test_would_skip() {
+        let mut seed = 7u64;
+        let (mut shortcut, mut near_and_inside) = (0usize, 0usize);
+        let mut check = |a: f64, b: f64, cap: f64| {
+            if inside_friction_circle(a, b, cap) {
+                assert!(a.hypot(b) <= cap, "a = {a:e}, b = {b:e}, cap = {cap:e}");
+                shortcut += 1;
+            }
+        };
+        for scale in [1e-300, 1e-160, 1e-100, 1e-20, 1e-3, 1.0, 9.81, 1e3, 1e20, 1e149, 1e151, 1e300] {
+            for _ in 0..20_000 {
+                let cap = scale * (0.5 + next(&mut seed));
+                let angle = 2.0 * core::f64::consts::PI * next(&mut seed);
+                // radius from 0.9 to 1.1 of the cap, denser within 1e-9 of the circle
+                let rel = if next(&mut seed) < 0.5 {
+                    0.9 + 0.2 * next(&mut seed)
+                } else {
+                    1.0 + 1e-9 * (2.0 * next(&mut seed) - 1.0) * 10f64.powi(-(next(&mut seed) * 7.0) as i32)
+                };
+                let (a, b) = (cap * rel * angle.cos(), cap * rel * angle.sin());
+                check(a, b, cap);
+                check(-a, b, cap);
+                check(a, -b, cap);
+                check(b, a, cap);
+                if rel < 1.0 - 1e-11 && (1e-100..1e149).contains(&cap) && inside_friction_circle(a, b, cap) {
+                    near_and_inside += 1;
+                }
+            }
+        }
+        for (a, b, cap) in [
+            (1.0, 0.0, 1.0),
+            (0.0, 1.0, 1.0),
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, 1.0),
+            (f64::MIN_POSITIVE / 4.0, 0.0, f64::MIN_POSITIVE / 8.0),
+            (f64::NAN, 0.0, 1.0),
+            (0.0, f64::INFINITY, 1.0),
+            (1e200, 1e200, 1e201),
+            (1.0, 1.0, f64::INFINITY),
+            (1.0, 1.0, f64::NAN),
+            (-3.0, 4.0, 5.0),
+            (-3.0, 4.0, 5.0 * (1.0 + 1e-13)),
+        ] {
+            check(a, b, cap);
+        }
+        // it does take the shortcut where the forces are well inside the circle
+        assert!(shortcut > 200_000, "{shortcut}");
+        assert!(near_and_inside > 30_000, "{near_and_inside}");
+        assert!(!inside_friction_circle(3.0, 4.0, 5.0), "on the circle: the exact test decides");
+        assert!(!inside_friction_circle(f64::NAN, 0.0, 1.0));
+        assert!(inside_friction_circle(3.0, 4.0, 5.0 * (1.0 + 1e-11)));
+    }
 }

@@ -269,10 +269,29 @@ impl FmuEngine {
     }
 }
 
-fn column(results: &Results, name: &str, job: &Job) -> Result<Vec<f64>, Error> {
-    results
-        .column(name)
-        .ok_or_else(|| Error::BadRun { run: job.label(), reason: format!("no column {name} in the results") })
+/// The columns `names` of `results` (as [`Results::column`] gives them), read in one pass
+/// over the rows: one column at a time would walk the whole row-major table once per
+/// column.
+fn columns(results: &Results, names: &[String], job: &Job) -> Result<Vec<Vec<f64>>, Error> {
+    let index = names
+        .iter()
+        .map(|name| {
+            let j = results.names.iter().position(|n| n == name).ok_or_else(|| Error::BadRun {
+                run: job.label(),
+                reason: format!("no column {name} in the results"),
+            })?;
+            Ok(j + 1)
+        })
+        .collect::<Result<Vec<usize>, Error>>()?;
+    let rows = results.rows();
+    let mut columns: Vec<Vec<f64>> = names.iter().map(|_| Vec::with_capacity(rows)).collect();
+    for k in 0..rows {
+        let row = results.row(k);
+        for (column, &j) in columns.iter_mut().zip(&index) {
+            column.push(row[j]);
+        }
+    }
+    Ok(columns)
 }
 
 impl Engine for FmuEngine {
@@ -293,35 +312,53 @@ impl FmuEngine {
     /// Runs `system` (instances `plant`, `controller`, `maneuver` wired for `job`, e.g. an
     /// SSP read back with `nigel_cosim::read_ssp`) over the benchmark horizon and records it.
     pub fn run_system(&self, system: &System, job: &Job) -> Result<Run, Error> {
+        let recorded = FmuEngine::recorded();
         let experiment = Experiment {
             algorithm: self.algorithm,
-            record: Some(FmuEngine::recorded()),
+            record: Some(recorded.clone()),
             ..Experiment::new(N_SAMPLES as f64 * SAMPLE_PERIOD, SAMPLE_PERIOD)
         };
         let (results, _summary) =
             simulate(system, &experiment).map_err(|source| Error::Cosim { context: job.label(), source })?;
-        let col = |name: &str| column(&results, name, job);
+        let mut all = columns(&results, &recorded, job)?;
+        let mut col = |name: &str| -> Result<Vec<f64>, Error> {
+            let i = recorded
+                .iter()
+                .position(|r| r == name)
+                .ok_or_else(|| Error::BadRun { run: job.label(), reason: format!("{name} is not recorded") })?;
+            Ok(std::mem::take(&mut all[i]))
+        };
         let n = results.rows().saturating_sub(1);
-        let wheels = |stem: &str| -> Result<Vec<[f64; 4]>, Error> {
+        let (x, y, psi, beta, yaw_rate) =
+            (col("plant.x")?, col("plant.y")?, col("plant.psi")?, col("plant.beta")?, col("plant.yaw_rate")?);
+        let (x_ref, y_ref, psi_ref, beta_ref, yaw_rate_ref) = (
+            col("maneuver.x_ref")?,
+            col("maneuver.y_ref")?,
+            col("maneuver.psi_ref")?,
+            col("maneuver.beta_ref")?,
+            col("maneuver.yaw_rate_ref")?,
+        );
+        let mut wheels = |stem: &str| -> Result<Vec<[f64; 4]>, Error> {
             let c: Vec<Vec<f64>> = WHEELS.iter().map(|w| col(&format!("{stem}_{w}"))).collect::<Result<_, _>>()?;
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
+        let (delta, mu) = (wheels("controller.delta")?, wheels("maneuver.mu")?);
         let gain = self.gains[index(&Controller::WITH_TRACKING, &job.controller)];
         let run = Run {
             job: *job,
             gain,
-            x: col("plant.x")?,
-            y: col("plant.y")?,
-            psi: col("plant.psi")?,
-            beta: col("plant.beta")?,
-            yaw_rate: col("plant.yaw_rate")?,
-            x_ref: col("maneuver.x_ref")?,
-            y_ref: col("maneuver.y_ref")?,
-            psi_ref: col("maneuver.psi_ref")?,
-            beta_ref: col("maneuver.beta_ref")?,
-            yaw_rate_ref: col("maneuver.yaw_rate_ref")?,
-            delta: wheels("controller.delta")?,
-            mu: wheels("maneuver.mu")?,
+            x,
+            y,
+            psi,
+            beta,
+            yaw_rate,
+            x_ref,
+            y_ref,
+            psi_ref,
+            beta_ref,
+            yaw_rate_ref,
+            delta,
+            mu,
         };
         run.check()?;
         Ok(run)
