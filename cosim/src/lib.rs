@@ -22,6 +22,7 @@
 pub mod error;
 pub mod fmu;
 pub mod me;
+mod parallel;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
