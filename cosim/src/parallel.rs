@@ -10,6 +10,10 @@
 //! called by one thread at a time, always with the same sequence of calls as in one
 //! thread, so the results are identical to the serial run.
 //!
+//! The pool runs only while it pays: after its first 1000 steps it is compared with the
+//! wall time per step measured in one thread over the calibration steps, and stops if it
+//! is slower (the summary's `parallel_steps` says how many steps it ran).
+//!
 //! Threads wait for the next step by spinning briefly (a step of a few microseconds is
 //! shorter than putting a thread to sleep and waking it again), then park; the thread
 //! that makes them ready unparks them, which costs one atomic operation when they are
@@ -98,98 +102,118 @@ fn partition(mut lanes: Vec<Lane>, threads: usize) -> Vec<Vec<Lane>> {
     groups
 }
 
-/// Runs the `jacobi` steps `steps` with `threads` threads (at least 2, at most the number
-/// of lanes). `args(n)` gives step `n`; `row(n, values)` is called after each step with
-/// all outputs in their slots. Returns the lanes in their original order. The first error
-/// (lowest instance index) of a step ends the run.
-pub(crate) fn run(
-    lanes: Vec<Lane>,
-    values: &mut Vec<f64>,
-    threads: usize,
-    steps: Range<u64>,
-    args: &dyn Fn(u64) -> StepArgs,
-    row: &mut dyn FnMut(u64, &[f64]),
-    solver: Solver,
-) -> Result<Vec<Lane>> {
-    let threads = threads.clamp(1, lanes.len().max(1));
-    let shared = Shared {
-        groups: partition(lanes, threads).into_iter().map(Mutex::new).collect(),
-        values: RwLock::new(std::mem::take(values)),
-        args: Mutex::new(StepArgs::default()),
-        epoch: AtomicU64::new(0),
-        done: AtomicUsize::new(0),
-        stop: AtomicBool::new(false),
-        panicked: AtomicBool::new(false),
-    };
-    let main = std::thread::current();
-    let result = std::thread::scope(|scope| {
-        let mut workers = Vec::with_capacity(threads - 1);
-        for g in 1..threads {
-            let shared = &shared;
-            let main = main.clone();
-            let handle = scope.spawn(move || {
-                let mut seen = 0;
-                loop {
-                    wait_until(|| shared.epoch.load(Ordering::Acquire) != seen);
-                    seen = shared.epoch.load(Ordering::Acquire);
-                    if shared.stop.load(Ordering::Acquire) {
-                        return;
+/// Steps in the pool before it is compared with one thread.
+const PROBE_STEPS: u64 = 1000;
+
+/// A pool for one run.
+pub(crate) struct Pool {
+    /// Threads, the calling one included (at least 2, at most the number of lanes).
+    pub(crate) threads: usize,
+    pub(crate) solver: Solver,
+    /// Wall time of one step in one thread (measured): after [`PROBE_STEPS`] steps
+    /// slower than this, the pool stops and the caller goes on in one thread.
+    pub(crate) serial_step: std::time::Duration,
+}
+
+impl Pool {
+    /// Runs the `jacobi` steps `steps`. `args(n)` gives step `n`; `row(n, values)` is called
+    /// after each step with all outputs in their slots. Returns the lanes in their original
+    /// order and the first step not run (the end of `steps` unless the pool was slower than
+    /// one thread). The first error (lowest instance index) of a step ends the run.
+    pub(crate) fn run(
+        &self,
+        lanes: Vec<Lane>,
+        values: &mut Vec<f64>,
+        steps: Range<u64>,
+        args: &dyn Fn(u64) -> StepArgs,
+        row: &mut dyn FnMut(u64, &[f64]),
+    ) -> Result<(Vec<Lane>, u64)> {
+        let solver = self.solver;
+        let threads = self.threads.clamp(1, lanes.len().max(1));
+        let shared = Shared {
+            groups: partition(lanes, threads).into_iter().map(Mutex::new).collect(),
+            values: RwLock::new(std::mem::take(values)),
+            args: Mutex::new(StepArgs::default()),
+            epoch: AtomicU64::new(0),
+            done: AtomicUsize::new(0),
+            stop: AtomicBool::new(false),
+            panicked: AtomicBool::new(false),
+        };
+        let main = std::thread::current();
+        let result = std::thread::scope(|scope| {
+            let mut workers = Vec::with_capacity(threads - 1);
+            for g in 1..threads {
+                let shared = &shared;
+                let main = main.clone();
+                let handle = scope.spawn(move || {
+                    let mut seen = 0;
+                    loop {
+                        wait_until(|| shared.epoch.load(Ordering::Acquire) != seen);
+                        seen = shared.epoch.load(Ordering::Acquire);
+                        if shared.stop.load(Ordering::Acquire) {
+                            return;
+                        }
+                        work(shared, g, solver);
+                        shared.done.fetch_add(1, Ordering::AcqRel);
+                        main.unpark();
                     }
-                    work(shared, g, solver);
-                    shared.done.fetch_add(1, Ordering::AcqRel);
-                    main.unpark();
-                }
-            });
-            workers.push(handle.thread().clone());
-        }
-        let drive = || -> Result<()> {
-            for n in steps {
-                let a = args(n);
-                *lock(&shared.args) = a;
-                shared.done.store(0, Ordering::Release);
-                shared.epoch.fetch_add(1, Ordering::AcqRel);
-                for w in &workers {
-                    w.unpark();
-                }
-                work(&shared, 0, solver);
-                wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
-                if shared.panicked.load(Ordering::Acquire) {
-                    return Err(Error::Experiment("a thread stepping the instances panicked".into()));
-                }
-                let mut values = shared.values.write().unwrap_or_else(|e| e.into_inner());
-                let mut first: Option<(usize, Error)> = None;
-                for g in &shared.groups {
-                    for lane in lock(g).iter_mut() {
-                        if let Some(e) = lane.error.take() {
-                            if first.as_ref().is_none_or(|(i, _)| lane.index < *i) {
-                                first = Some((lane.index, e));
+                });
+                workers.push(handle.thread().clone());
+            }
+            let mut drive = || -> Result<u64> {
+                let start = std::time::Instant::now();
+                let first = steps.start;
+                for n in steps.clone() {
+                    if n == first + PROBE_STEPS && start.elapsed() > self.serial_step * PROBE_STEPS as u32 {
+                        return Ok(n); // slower than one thread: the caller goes on alone
+                    }
+                    let a = args(n);
+                    *lock(&shared.args) = a;
+                    shared.done.store(0, Ordering::Release);
+                    shared.epoch.fetch_add(1, Ordering::AcqRel);
+                    for w in &workers {
+                        w.unpark();
+                    }
+                    work(&shared, 0, solver);
+                    wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
+                    if shared.panicked.load(Ordering::Acquire) {
+                        return Err(Error::Experiment("a thread stepping the instances panicked".into()));
+                    }
+                    let mut values = shared.values.write().unwrap_or_else(|e| e.into_inner());
+                    let mut first: Option<(usize, Error)> = None;
+                    for g in &shared.groups {
+                        for lane in lock(g).iter_mut() {
+                            if let Some(e) = lane.error.take() {
+                                if first.as_ref().is_none_or(|(i, _)| lane.index < *i) {
+                                    first = Some((lane.index, e));
+                                }
                             }
                         }
                     }
-                }
-                if let Some((_, e)) = first {
-                    return Err(e);
-                }
-                for g in &shared.groups {
-                    for lane in lock(g).iter() {
-                        lane.scatter(&mut values, a.output_point);
+                    if let Some((_, e)) = first {
+                        return Err(e);
                     }
+                    for g in &shared.groups {
+                        for lane in lock(g).iter() {
+                            lane.scatter(&mut values, a.output_point);
+                        }
+                    }
+                    row(n, &values);
                 }
-                row(n, &values);
+                Ok(steps.end)
+            };
+            let result = drive();
+            shared.stop.store(true, Ordering::Release);
+            shared.epoch.fetch_add(1, Ordering::AcqRel);
+            for w in &workers {
+                w.unpark();
             }
-            Ok(())
-        };
-        let result = drive();
-        shared.stop.store(true, Ordering::Release);
-        shared.epoch.fetch_add(1, Ordering::AcqRel);
-        for w in &workers {
-            w.unpark();
-        }
-        result
-    });
-    *values = shared.values.into_inner().unwrap_or_else(|e| e.into_inner());
-    let mut lanes: Vec<Lane> =
-        shared.groups.into_iter().flat_map(|g| g.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
-    lanes.sort_by_key(|l| l.index);
-    result.map(|()| lanes)
+            result
+        });
+        *values = shared.values.into_inner().unwrap_or_else(|e| e.into_inner());
+        let mut lanes: Vec<Lane> =
+            shared.groups.into_iter().flat_map(|g| g.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
+        lanes.sort_by_key(|l| l.index);
+        result.map(|next| (lanes, next))
+    }
 }

@@ -166,6 +166,8 @@ pub struct Summary {
     pub integrator_steps: (u64, u64),
     /// Steps redone in halves after an fmi2Discard.
     pub discard_retries: u64,
+    /// `jacobi` steps run with the instances spread over threads (0 in one thread).
+    pub parallel_steps: u64,
 }
 
 impl Summary {
@@ -176,6 +178,7 @@ impl Summary {
             "events": self.events.len(),
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
             "discard_retries": self.discard_retries,
+            "parallel_steps": self.parallel_steps,
             "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
@@ -378,13 +381,31 @@ fn ordered_nodes(system: &System, connected_outputs: &[VariableRef]) -> Result<V
         |k: usize| if k < n_out { connected_outputs[k].instance } else { system.connections[k - n_out].to.instance };
     let mut ready: Vec<usize> = (0..n).filter(|k| indegree[*k] == 0).collect();
     let mut order = Vec::with_capacity(n);
+    // inputs of each instance not yet in the order: an instance's inputs are best set in
+    // one call, once all of them are ready
+    let mut pending_inputs = vec![0usize; system.instances.len()];
+    for c in &system.connections {
+        pending_inputs[c.to.instance] += 1;
+    }
     let mut last: Option<(usize, bool)> = None;
     while !ready.is_empty() {
-        // prefer the same instance and kind as the last node: fewer, larger batches
-        let pick = last
-            .and_then(|(i, is_out)| ready.iter().position(|k| node_instance(*k) == i && (*k < n_out) == is_out))
+        // fewest calls: the same instance and kind as the last node (one batch), then
+        // outputs (reading them sets nothing), then an instance whose inputs are all ready
+        let is_out = |k: &usize| *k < n_out;
+        let same = |k: &usize| last.is_some_and(|(i, o)| node_instance(*k) == i && is_out(k) == o);
+        let ready_inputs = |i: usize| ready.iter().filter(|k| !is_out(k) && node_instance(**k) == i).count();
+        let complete = |k: &usize| !is_out(k) && ready_inputs(node_instance(*k)) == pending_inputs[node_instance(*k)];
+        let pick = ready
+            .iter()
+            .position(same)
+            .or_else(|| ready.iter().position(is_out))
+            .or_else(|| ready.iter().position(complete))
+            .or_else(|| (0..ready.len()).max_by_key(|p| (ready_inputs(node_instance(ready[*p])), usize::MAX - p)))
             .unwrap_or(0);
         let k = ready.swap_remove(pick);
+        if k >= n_out {
+            pending_inputs[node_instance(k)] -= 1;
+        }
         last = Some((node_instance(k), k < n_out));
         order.push(k);
         for &e in &edges[k] {
@@ -841,6 +862,7 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
 
     let profile = experiment.profile;
     let mut profiler = Profiler::new(lanes.len());
+    let mut parallel_steps = 0u64;
     let h = experiment.step;
     let solver = experiment.solver;
     let point = |n: u64| {
@@ -880,10 +902,12 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             // step, the step, its outputs; then all outputs into their slots
             let threads = experiment.threads.min(lanes.len());
             let mut first = 0;
+            // the pool stops when it is slower than one thread (see parallel.rs)
             if threads > 1 {
                 // a few steps in one thread to measure each instance's cost, then the
                 // instances spread over the threads by that cost
                 let calibration = steps.min(CALIBRATION_STEPS);
+                let calibration_start = Instant::now();
                 for n in 0..calibration {
                     let (t, t_next, output_point) = point(n);
                     let a = StepArgs { set_inputs: n > 0, t, t_next, output_point, profile: true };
@@ -898,6 +922,7 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
                     }
                 }
                 first = calibration;
+                let serial_step = calibration_start.elapsed() / calibration.max(1) as u32;
                 if first < steps {
                     let mut step_rows = |n: u64, values: &[f64]| {
                         let (_, t_next, output_point) = point(n);
@@ -909,9 +934,11 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
                         let (t, t_next, output_point) = point(n);
                         StepArgs { set_inputs: n > 0, t, t_next, output_point, profile }
                     };
-                    lanes =
-                        crate::parallel::run(lanes, &mut values, threads, first..steps, &args, &mut step_rows, solver)?;
-                    first = steps;
+                    let pool = crate::parallel::Pool { threads, solver, serial_step };
+                    let (back, next) = pool.run(lanes, &mut values, first..steps, &args, &mut step_rows)?;
+                    lanes = back;
+                    parallel_steps = next - first;
+                    first = next;
                 }
             }
             for n in first..steps {
@@ -940,7 +967,7 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             }
         }
     }
-    let mut summary = Summary { steps, wall_time: Duration::ZERO, ..Summary::default() };
+    let mut summary = Summary { steps, parallel_steps, wall_time: Duration::ZERO, ..Summary::default() };
     for lane in lanes.iter_mut() {
         summary.discard_retries += lane.retries;
         if let Some(state) = lane.saved.take() {
@@ -967,8 +994,9 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
 }
 
 /// Steps run in one thread before the instances are spread over threads by their
-/// measured cost.
-const CALIBRATION_STEPS: u64 = 20;
+/// measured cost (and the time of one step in one thread taken as the mark the pool must
+/// beat).
+const CALIBRATION_STEPS: u64 = 200;
 
 /// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
 /// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.

@@ -22,22 +22,26 @@ fn wide(dir: &std::path::Path, chains: usize) -> nigel_cosim::System {
     b.build()
 }
 
-fn run_threads(system: &nigel_cosim::System, threads: usize, stop: f64, step: f64) -> Results {
+/// The results and the number of steps the thread pool ran.
+fn run_threads(system: &nigel_cosim::System, threads: usize, stop: f64, step: f64) -> (Results, u64) {
     let mut e = Experiment::new(stop, step);
     e.algorithm = Algorithm::Jacobi;
     e.threads = threads;
-    simulate(system, &e).unwrap().0
+    let (r, s) = simulate(system, &e).unwrap();
+    (r, s.parallel_steps)
 }
 
 #[test]
 fn threads_give_the_serial_numbers_bit_for_bit_and_the_derived_values() {
     let dir = work_dir("parallel-wide");
     let system = wide(&dir, 10);
-    // 200 steps: the first 20 calibrate in one thread, the rest run in the pool
-    let serial = run_threads(&system, 1, 2.0, 0.01);
-    assert_eq!(serial.rows(), 201);
+    // 2000 steps: the first 200 calibrate in one thread, then the pool runs at least
+    // 1000 (it goes on only if it is faster than one thread)
+    let (serial, pooled) = run_threads(&system, 1, 2.0, 1e-3);
+    assert_eq!((serial.rows(), pooled), (2001, 0));
     for threads in [2, 3, 7, 64] {
-        let parallel = run_threads(&system, threads, 2.0, 0.01);
+        let (parallel, pooled) = run_threads(&system, threads, 2.0, 1e-3);
+        assert!((1000..=1800).contains(&pooled), "threads {threads}: {pooled} steps in the pool");
         assert_eq!(parallel.names, serial.names);
         assert_eq!(parallel.values.len(), serial.values.len());
         for (k, (a, b)) in serial.values.iter().zip(&parallel.values).enumerate() {
@@ -68,9 +72,9 @@ fn the_closed_loop_in_two_threads_equals_one_thread() {
     let ssp = common::plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
     assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
     let system = nigel_cosim::read_ssp(&ssp, &Default::default()).unwrap().system;
-    let serial = run_threads(&system, 1, 1.0, 1e-3);
-    let parallel = run_threads(&system, 2, 1.0, 1e-3);
-    assert_eq!(serial.rows(), 1001);
+    let (serial, _) = run_threads(&system, 1, 1.0, 1e-3);
+    let (parallel, pooled) = run_threads(&system, 2, 1.0, 1e-3);
+    assert_eq!((serial.rows(), pooled), (1001, 800)); // 200 calibration steps, then the pool
     assert_eq!(serial.names, parallel.names);
     let moved = serial.column("plant.x").unwrap();
     assert!(moved[1000] > 0.1, "the car moves: x(1 s) = {}", moved[1000]);
@@ -89,14 +93,14 @@ fn an_error_in_a_worker_thread_is_typed_as_in_one_thread() {
         b.add_instance("a", src.clone()).unwrap();
         b.add_instance("b", src.clone()).unwrap();
         b.add_instance("bad", faulty.clone()).unwrap();
-        b.set("bad.fail_time", Value::Real(0.5)).unwrap();
-        let mut e = Experiment::new(1.0, 0.01);
+        b.set("bad.fail_time", Value::Real(0.5)).unwrap(); // step 500: in the pool
+        let mut e = Experiment::new(1.0, 1e-3);
         e.threads = threads;
         match simulate(&b.build(), &e) {
             Err(Error::Fmi { instance, function, status, time, log }) => {
                 assert_eq!((instance.as_str(), function, status), ("bad", "fmi2DoStep", Status::Error));
-                // t_50 = 50 h: the first communication point at or after 0.5
-                assert_eq!(time, Some(50.0 * 0.01), "threads {threads}");
+                // t_500 = 500 h: the first communication point at or after 0.5
+                assert_eq!(time, Some(500.0 * 1e-3), "threads {threads}");
                 assert!(log.contains("failing on purpose"), "{log}");
             }
             other => panic!("threads {threads}: expected fmi2DoStep Error, got {other:?}"),
