@@ -201,7 +201,7 @@ fn main() {
     let dir = target().join("cosim-bench");
     std::fs::create_dir_all(&dir).unwrap();
     let gain = Fmu::load(&c_gain(&dir, "gain", &[])).unwrap();
-    let heavy = Fmu::load(&c_gain(&dir, "gain_work", &["-DWORK=4000"])).unwrap();
+    let heavy = Fmu::load(&c_gain(&dir, "gain_work", &["-DWORK=400"])).unwrap();
     let n = 10;
     let mut b = SystemBuilder::new();
     for i in 0..n {
@@ -220,7 +220,7 @@ fn main() {
         );
     }
     // threads: the same chains, trivial and heavier
-    for (what, fmu) in [("trivial", &gain), ("heavier (WORK=4000)", &heavy)] {
+    for (what, fmu) in [("trivial", &gain), ("heavier (WORK=400)", &heavy)] {
         let mut b = SystemBuilder::new();
         for i in 0..n {
             b.add_instance(&format!("g{i}"), fmu.clone()).unwrap();

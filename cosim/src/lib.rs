@@ -19,6 +19,7 @@
 
 #![warn(missing_docs)]
 
+mod coupled;
 pub mod error;
 pub mod fmu;
 pub mod me;

@@ -195,8 +195,8 @@ enum OpKind {
 
 /// One batched fmi2Get/fmi2Set call of one instance and one base type.
 #[derive(Debug)]
-struct Op {
-    instance: usize,
+pub(crate) struct Op {
+    pub(crate) instance: usize,
     kind: OpKind,
     base_type: BaseType,
     vrs: Vec<u32>,
@@ -220,7 +220,7 @@ impl Op {
     }
 
     #[inline]
-    fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
+    pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
         match self.kind {
             OpKind::Get => {
                 self.fetch(inst)?;
@@ -232,6 +232,16 @@ impl Op {
             }
         }
         Ok(())
+    }
+
+    /// Whether the op sets inputs.
+    pub(crate) fn is_set(&self) -> bool {
+        self.kind == OpKind::Set
+    }
+
+    /// The value slots the op reads (set) or writes (get).
+    pub(crate) fn slots(&self) -> &[usize] {
+        &self.slots
     }
 
     /// Get: the fmi2Get call into the op's own buffer.
@@ -491,35 +501,36 @@ impl Plan {
             jacobi_gets_rec.push(gets_rec);
             jacobi_sets.push(sets);
         }
-        let ordered = match ordered_nodes(system, &connected_outputs) {
-            Ok(nodes) => {
-                let mut ops = Vec::new();
-                for (is_output, k) in nodes {
-                    if is_output {
-                        let r = &connected_outputs[k];
-                        let slot = sources.iter().position(|s| s == r).unwrap_or(0);
-                        emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
-                    } else {
-                        let c = &system.connections[k];
-                        let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
-                        emit(
-                            &mut ops,
-                            c.to.instance,
-                            OpKind::Set,
-                            c.to.base_type,
-                            c.to.value_reference,
-                            slot,
-                            (c.gain, c.offset),
-                        );
-                    }
-                }
-                Some(ops)
-            }
+        let ordered = match ordered_ops(system, &sources, &connected_outputs) {
+            Ok(ops) => Some(ops),
             Err(e) if algorithm == Algorithm::Ordered => return Err(e),
             Err(_) => None,
         };
         Ok(Plan { sources, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
     }
+}
+
+/// The batched gets and sets that carry every connection of `system` in topological
+/// order (slots: positions in `sources`), or the algebraic loop by name.
+pub(crate) fn ordered_ops(
+    system: &System,
+    sources: &[VariableRef],
+    connected_outputs: &[VariableRef],
+) -> Result<Vec<Op>> {
+    let nodes = ordered_nodes(system, connected_outputs)?;
+    let mut ops = Vec::new();
+    for (is_output, k) in nodes {
+        if is_output {
+            let r = &connected_outputs[k];
+            let slot = sources.iter().position(|s| s == r).unwrap_or(0);
+            emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
+        } else {
+            let c = &system.connections[k];
+            let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+            emit(&mut ops, c.to.instance, OpKind::Set, c.to.base_type, c.to.value_reference, slot, (c.gain, c.offset));
+        }
+    }
+    Ok(ops)
 }
 
 /// Time spent in each instance's calls, one clock read per call boundary: the time from
@@ -538,6 +549,16 @@ impl Profiler {
     fn restart(&mut self) {
         self.last = Instant::now();
     }
+    /// Charges the time since the last mark evenly to `instances` (a coupled group).
+    fn charge_shared(&mut self, instances: &[usize]) {
+        let now = Instant::now();
+        let share = (now - self.last) / instances.len().max(1) as u32;
+        for &i in instances {
+            self.spent[i] += share;
+        }
+        self.last = now;
+    }
+
     #[inline]
     fn charge(&mut self, instance: usize) {
         let now = Instant::now();
@@ -565,7 +586,7 @@ fn run_ops(ops: &mut [Op], lanes: &mut [Lane], values: &mut [f64], mut profiler:
 pub(crate) struct Lane {
     pub(crate) index: usize,
     pub(crate) inst: Instance,
-    unit: Option<MeUnit>,
+    pub(crate) unit: Option<MeUnit>,
     saved: Option<crate::fmu::FmuState>,
     gets: Vec<Op>,
     gets_rec: Vec<Op>,
@@ -610,19 +631,33 @@ impl Lane {
     #[inline]
     pub(crate) fn jacobi_step(&mut self, values: &[f64], a: StepArgs, solver: crate::me::Solver) -> Result<()> {
         let start = a.profile.then(Instant::now);
+        self.jacobi_inputs(values, a)?;
+        self.advance(solver, a.t, a.t_next)?;
+        self.jacobi_outputs(a)?;
+        if let Some(start) = start {
+            self.spent += start.elapsed();
+        }
+        Ok(())
+    }
+
+    /// The first part of a `jacobi` step: the inputs (unless the first step).
+    #[inline]
+    fn jacobi_inputs(&mut self, values: &[f64], a: StepArgs) -> Result<()> {
         if a.set_inputs {
             for op in self.sets.iter_mut() {
                 op.gather(values);
                 op.apply(&mut self.inst)?;
             }
         }
-        self.advance(solver, a.t, a.t_next)?;
+        Ok(())
+    }
+
+    /// The last part of a `jacobi` step: the outputs fetched.
+    #[inline]
+    fn jacobi_outputs(&mut self, a: StepArgs) -> Result<()> {
         let gets = if a.output_point { &mut self.gets_rec } else { &mut self.gets };
         for op in gets.iter_mut() {
             op.fetch(&mut self.inst)?;
-        }
-        if let Some(start) = start {
-            self.spent += start.elapsed();
         }
         Ok(())
     }
@@ -754,6 +789,8 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         });
     }
     let mut plan = Plan::new(system, &record, experiment.algorithm)?;
+    // Model Exchange instances connected to each other are integrated together
+    let mut group = crate::coupled::MeGroup::of(system)?;
     let record_slots: Vec<usize> =
         record.iter().map(|r| plan.sources.iter().position(|s| s == r).unwrap_or(0)).collect();
     // all recorded variables, one get per instance and type (for the first row)
@@ -844,9 +881,15 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     for lane in lanes.iter_mut() {
         lane.inst.exit_initialization_mode()?;
         lane.unit = match lane.inst.fmu().interface() {
+            Interface::ModelExchange if group.as_ref().is_some_and(|g| g.contains(lane.index)) => {
+                Some(MeUnit::new(&lane.inst))
+            }
             Interface::ModelExchange => Some(MeUnit::initialize(&mut lane.inst)?),
             Interface::CoSimulation => None,
         };
+    }
+    if let Some(g) = group.as_mut() {
+        g.iterate(&mut lanes, t0)?; // the initial event iteration of the coupled ones, together
     }
     for lane in lanes.iter_mut() {
         let fmu = lane.inst.fmu();
@@ -885,9 +928,18 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
                     p.restart();
                 }
                 for lane in lanes.iter_mut() {
+                    if group.as_ref().is_some_and(|g| g.contains(lane.index)) {
+                        continue;
+                    }
                     lane.advance(solver, t, t_next)?;
                     if let Some(p) = prof.as_deref_mut() {
                         p.charge(lane.index);
+                    }
+                }
+                if let Some(g) = group.as_mut() {
+                    g.advance(&mut lanes, solver, t, t_next)?;
+                    if let Some(p) = prof.as_deref_mut() {
+                        p.charge_shared(&g.members);
                     }
                 }
                 run_ops(ops, &mut lanes, &mut values, prof)?;
@@ -900,7 +952,8 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         _ => {
             // jacobi: per instance (in parallel when asked) inputs from the previous
             // step, the step, its outputs; then all outputs into their slots
-            let threads = experiment.threads.min(lanes.len());
+            // a coupled Model Exchange group steps as one: no threads then
+            let threads = if group.is_some() { 1 } else { experiment.threads.min(lanes.len()) };
             let mut first = 0;
             // the pool stops when it is slower than one thread (see parallel.rs)
             if threads > 1 {
@@ -944,8 +997,33 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             for n in first..steps {
                 let (t, t_next, output_point) = point(n);
                 let a = StepArgs { set_inputs: n > 0, t, t_next, output_point, profile };
-                for lane in lanes.iter_mut() {
-                    lane.jacobi_step(&values, a, solver)?;
+                match group.as_mut() {
+                    None => {
+                        for lane in lanes.iter_mut() {
+                            lane.jacobi_step(&values, a, solver)?;
+                        }
+                    }
+                    Some(g) => {
+                        // the group's members: all inputs, the steps together, all outputs
+                        for lane in lanes.iter_mut() {
+                            if g.contains(lane.index) {
+                                lane.jacobi_inputs(&values, a)?;
+                            } else {
+                                lane.jacobi_step(&values, a, solver)?;
+                            }
+                        }
+                        let start = profile.then(Instant::now);
+                        g.advance(&mut lanes, solver, t, t_next)?;
+                        if let Some(start) = start {
+                            let share = start.elapsed() / g.members.len().max(1) as u32;
+                            for &m in g.members.iter() {
+                                lanes[m].spent += share;
+                            }
+                        }
+                        for &m in g.members.iter() {
+                            lanes[m].jacobi_outputs(a)?;
+                        }
+                    }
                 }
                 for lane in lanes.iter() {
                     lane.scatter(&mut values, output_point);
