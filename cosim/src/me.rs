@@ -4,7 +4,9 @@
 //!
 //! Over a communication step the FMU's inputs are held (as for a Co-Simulation FMU),
 //! so an ME instance takes part in `jacobi` and `ordered` systems like a CS one; its
-//! events are handled (event iteration to a fixed point) inside its own step.
+//! events are handled (event iteration to a fixed point) inside its own step, unless it
+//! is connected to another ME instance: then all ME instances advance together and
+//! iterate their events together (`coupled.rs`).
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
