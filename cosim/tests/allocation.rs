@@ -3,7 +3,7 @@
 //! the C test FMUs allocate only when instantiated, with calloc, outside this count).
 
 mod common;
-use common::{build_fmu, work_dir, Model};
+use common::{build_ball, build_fmu, build_latch, work_dir, Model};
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, SystemBuilder};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -72,6 +72,36 @@ fn the_step_loop_allocates_nothing() {
                 "{algorithm:?}, {threads} threads, record {record:?}, interval {interval:?}, profile {profile}: \
                  {short} allocations for 300 steps, {long} for 6000"
             );
+        }
+    }
+}
+
+#[test]
+fn coupled_model_exchange_steps_allocate_nothing_between_events() {
+    // the ball and the counter fed by its velocity, integrated together: runs of 300 and
+    // 6000 steps of 10 us end before the first bounce (0.45 s), so no event happens
+    let dir = work_dir("allocation-me");
+    let mut b = SystemBuilder::new();
+    b.add_instance("ball", Fmu::load(&build_ball(&dir)).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(&build_latch(&dir)).unwrap()).unwrap();
+    b.connect("ball.v", "counter.u").unwrap();
+    let system = b.build();
+    for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
+        for solver in
+            [nigel_cosim::Solver::Rk4 { max_step: None }, nigel_cosim::Solver::Dopri5 { rtol: 1e-8, atol: 1e-10 }]
+        {
+            let count = |steps: u32| {
+                let mut e = Experiment::new(f64::from(steps) * 1e-5, 1e-5);
+                e.algorithm = algorithm;
+                e.solver = solver;
+                let before = ALLOCATIONS.load(Ordering::Relaxed);
+                let (results, summary) = simulate(&system, &e).unwrap();
+                let after = ALLOCATIONS.load(Ordering::Relaxed);
+                assert!(summary.events.is_empty() && results.rows() == steps as usize + 1);
+                after - before
+            };
+            let (short, long) = (count(300), count(6000));
+            assert_eq!(short, long, "{algorithm:?} {solver:?}: {short} allocations for 300 steps, {long} for 6000");
         }
     }
 }
