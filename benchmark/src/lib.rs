@@ -7,7 +7,8 @@
 //! * [`scenario`]: [`Maneuver`], [`Fidelity`] (the "sim" / "real" columns), the steering
 //!   [`Program`] per sample, [`Disturbances`] per sample (friction, wind, measurement noise).
 //! * [`control`]: the sampled law `delta = delta_ff + K (x - x_ref)` with the speed-hold PI,
-//!   [`SampledController`]; the baked gains in [`gains`].
+//!   [`SampledController`]; beyond the paper, the robust tracking law on the pose errors with
+//!   the along-track speed correction ([`Controller::RobustTracking`]); the baked gains in [`gains`].
 //! * [`run`]: the figure-8 switching table, the reference, closed-loop runs and the metric.
 //!
 //! ```no_run

@@ -114,9 +114,13 @@ fn run_loop(
             }
         };
         let (beta_meas, yaw_rate_meas) = disturbances.measure(k, beta, yaw_rate);
-        let (beta_ref, yaw_rate_ref) = match reference {
-            Some(r) => (r.trajectory.beta[k], r.trajectory.yaw_rate[k]),
-            None => (beta_meas, yaw_rate_meas),
+        let (x, y, psi) = (traj.x[k], traj.y[k], traj.psi[k]);
+        let (beta_ref, yaw_rate_ref, x_ref, y_ref, psi_ref) = match reference {
+            Some(r) => {
+                let t = &r.trajectory;
+                (t.beta[k], t.yaw_rate[k], t.x[k], t.y[k], t.psi[k])
+            }
+            None => (beta_meas, yaw_rate_meas, x, y, psi),
         };
         let out = controller.step(&ControllerInputs {
             beta: beta_meas,
@@ -126,6 +130,12 @@ fn run_loop(
             yaw_rate_ref,
             speed_ref,
             delta_ff,
+            x,
+            y,
+            psi,
+            x_ref,
+            y_ref,
+            psi_ref,
         });
         let mut u = Inputs::<f64>::coasting(0.0);
         u.delta = out.delta;
@@ -341,12 +351,13 @@ impl Benchmark {
         &self.reference.program
     }
 
-    /// A closed-loop run with the default speed loop and `controller`'s gain.
+    /// A closed-loop run with `controller`'s settings ([`Controller::settings`]: its gains,
+    /// the speed loop of maneuvers.md, and for the tracking controller the along-track loop).
     pub fn run(&self, controller: Controller) -> Result<ClosedLoopRun, SettingError> {
-        self.run_with(controller, ControllerSettings::with_gain(controller.gain()))
+        self.run_with(controller, controller.settings())
     }
 
-    /// A closed-loop run with any settings (the gain in `settings` is the one used).
+    /// A closed-loop run with any settings (the gains in `settings` are the ones used).
     pub fn run_with(
         &self,
         controller: Controller,

@@ -206,25 +206,25 @@ fn cached_references_equal_fresh_ones() {
     for (maneuver, fidelity) in [(Maneuver::Figure8, Fidelity::Real), (Maneuver::Skidpad, Fidelity::Paper)] {
         let mut first = Scenario::new(maneuver, fidelity);
         first.seed = 3;
-        let a = Benchmark::prepare(first.clone()).unwrap();
+        let a = Benchmark::prepare(first).unwrap();
         let mut second = Scenario::new(maneuver, fidelity);
         second.seed = 11;
         second.wind = false;
-        let b = Benchmark::prepare(second.clone()).unwrap(); // from the cache
+        let b = Benchmark::prepare(second).unwrap(); // from the cache
         assert_eq!(a.reference, b.reference);
         assert_eq!(b.scenario, second);
         let switches = match maneuver {
             Maneuver::Figure8 => figure8_switches(second.steer_amplitude, second.speed_ref, second.n_samples).unwrap(),
             _ => Vec::new(),
         };
-        let fresh = Benchmark::prepare_with_switches(second.clone(), switches).unwrap();
+        let fresh = Benchmark::prepare_with_switches(second, switches).unwrap();
         assert_eq!(fresh.reference, b.reference);
         // a different amplitude is a different reference
-        let mut other = second.clone();
+        let mut other = second;
         other.steer_amplitude *= 0.5;
         assert_ne!(Benchmark::prepare(other).unwrap().reference.trajectory, b.reference.trajectory);
         // and a bad scenario is refused even though a reference for its key may be cached
-        let mut bad = second.clone();
+        let mut bad = second;
         bad.speed_ref = f64::NAN;
         assert!(Benchmark::prepare(bad).is_err());
     }

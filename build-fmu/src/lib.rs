@@ -100,7 +100,14 @@ dX/dt = v_x cos(psi) - v_y sin(psi),  dY/dt = v_x sin(psi) + v_y cos(psi),  dpsi
 switches add a friction circle (hypot(F_d, F_y) &lt;= mu N), a first-order rate-limited steering
 servo, and a drive-motor speed limit. Co-Simulation integrates with classical RK4 sub-steps no
 longer than <code>cs_substep_max</code>; Model Exchange exposes the 10 states to the importer's
-integrator. Linearised at straight running this model is Eq. 2.2 of the paper.</p>"#;
+integrator. Linearised at straight running this model is Eq. 2.2 of the paper.</p>
+<h2>Initial state</h2>
+<p>The body states <code>x, y, psi, v_x, v_y, yaw_rate</code> are <code>initial="calculated"</code>: each equals its
+fixed parameter <code>x_start, y_start, psi_start, v_x_start, v_y_start, yaw_rate_start</code> (default 0, at rest at
+the origin) until the integration moves it. Give the initial condition through those parameters (for example
+<code>v_x_start = 0.35</code> for the benchmark's speed): an SSP parameter binding reaches a parameter in every
+importer (libcosim applies bindings to parameters and inputs only), and setting a calculated state is refused.
+The servo angles start at 0.</p>"#;
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
@@ -132,7 +139,15 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
             VariableType::Real { unit, start, .. } => {
                 (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default())
             }
-            VariableType::Integer { start, .. } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
+            VariableType::Integer { start, min, max } => {
+                // a switch: its range (the values are listed in its description)
+                let range = match (min, max) {
+                    (Some(lo), Some(hi)) => format!("{lo} .. {hi}"),
+                    (Some(lo), None) => format!(">= {lo}"),
+                    _ => String::new(),
+                };
+                (range, start.map(|s| s.to_string()).unwrap_or_default())
+            }
             VariableType::Enumeration { declared_type, start, .. } => {
                 let items = md
                     .type_definitions
@@ -144,6 +159,10 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
             }
             VariableType::Boolean { start } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
             VariableType::String { start } => (String::new(), start.clone().unwrap_or_default()),
+        };
+        let start = match (start.is_empty(), v.initial) {
+            (true, Some(fmi2_export::model_description::Initial::Calculated)) => "(calculated)".to_string(),
+            _ => start,
         };
         let _ = writeln!(
             html,
@@ -273,6 +292,25 @@ mod tests {
             assert!(doc.contains(&format!("<code>{}</code>", escape(&v.name))), "{} missing", v.name);
         }
         assert!(doc.contains("<td>N.m</td>") && doc.contains("<td>rad</td>"));
+    }
+
+    #[test]
+    fn documentation_shows_calculated_states_and_the_switches_ranges() {
+        let all = targets();
+        let plant = &all.iter().find(|t| t.model_identifier == "nigel_plant").unwrap().documentation;
+        // v_x: calculated from v_x_start, which is a parameter starting at 0
+        assert!(plant.contains("<tr><td><code>v_x</code></td><td>3</td><td>Output</td><td>Continuous</td><td>m/s</td><td>(calculated)</td>"), "{plant}");
+        assert!(plant.contains(
+            "<tr><td><code>v_x_start</code></td><td>63</td><td>Parameter</td><td>Fixed</td><td>m/s</td><td>0</td>"
+        ));
+        assert!(plant.contains("<h2>Initial state</h2>"));
+        let controller = &all.iter().find(|t| t.model_identifier == "nigel_controller").unwrap().documentation;
+        assert!(controller.contains("<td><code>controller</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 4</td><td>3</td><td>which steering feedback: 1 open_loop"), "{controller}");
+        let bench = &all.iter().find(|t| t.model_identifier == "nigel_maneuver").unwrap().documentation;
+        assert!(bench.contains("<td><code>maneuver</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 6</td><td>1</td><td>the maneuver: 1 straight"));
+        assert!(bench.contains(
+            "<td><code>fidelity</code></td><td>1</td><td>Parameter</td><td>Fixed</td><td>1 .. 2</td><td>1</td>"
+        ));
     }
 
     /// `[lib] name` of the package in the workspace, read from its Cargo.toml.

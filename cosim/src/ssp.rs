@@ -431,9 +431,16 @@ fn num(v: f64) -> String {
     s
 }
 
+/// The name of the ParameterSet that holds the start values in an SSP written by [`write_ssp`].
+pub const SSP_PARAMETER_SET: &str = "initialValues";
+
 /// Writes `system` as an SSP 1.0 archive: `SystemStructure.ssd` plus each FMU archive
 /// under `resources/` (one copy per distinct FMU), start values as inline parameter
 /// bindings, connections with their linear transformations.
+///
+/// Every component's bindings are one ParameterSet named [`SSP_PARAMETER_SET`]: libcosim
+/// applies each component's first set by default, ecos applies the sets of the one name
+/// given to its `init` (and none without a name), so one name serves both.
 pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
     let io = |source| Error::Io { path: path.to_path_buf(), source };
     // FMU files, one per distinct source
@@ -495,7 +502,7 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
             x.push_str("        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n            <ssd:ParameterValues>\n");
             x.push_str(&format!(
                 "              <ssv:ParameterSet version=\"1.0\" name=\"{}\">\n                <ssv:Parameters>\n",
-                esc(&spec.name)
+                SSP_PARAMETER_SET
             ));
             for (index, value) in &spec.start_values {
                 let vname = &md.model_variables[*index].name;

@@ -209,6 +209,16 @@ impl System {
     }
 }
 
+/// The value `k` a description lists as "k name" ("which steering feedback: 1 open_loop
+/// (K = 0), 2 pole_placement (...), 3 robust (...)"), for a name given where an Integer is due.
+fn listed_value(description: &str, name: &str) -> Option<i32> {
+    let words: Vec<&str> = description
+        .split(|c: char| c.is_whitespace() || matches!(c, ',' | ':' | ';'))
+        .filter(|w| !w.is_empty())
+        .collect();
+    words.windows(2).find(|w| w[1] == name).and_then(|w| w[0].parse().ok())
+}
+
 fn base_unit<'a>(md: &'a ModelDescription, unit: &str) -> Option<&'a BaseUnit> {
     md.unit_definitions.iter().find(|u| u.name == unit).and_then(|u| u.base_unit.as_ref())
 }
@@ -306,7 +316,14 @@ impl SystemBuilder {
         let value = Value::parse(r.base_type, text).map_err(|reason| Error::InvalidValue {
             variable: variable.into(),
             value: text.into(),
-            reason,
+            reason: match (r.base_type, self.system.variable(&r).description.as_deref()) {
+                // a switch whose values are listed in its description ("1 open_loop (...), 2 ...")
+                (BaseType::Integer, Some(d)) => match listed_value(d, text.trim()) {
+                    Some(k) => format!("{reason}; {text:?} is value {k} of this Integer: set {variable}={k}"),
+                    None => format!("{reason} (its description: {d})"),
+                },
+                _ => reason,
+            },
         })?;
         self.set(variable, value)
     }

@@ -27,7 +27,7 @@ fn cycle(plant: &std::path::Path, source: &std::path::Path, gain: &std::path::Pa
     b.connect("src.y", "k.u").unwrap();
     b.connect("k.y", "plant.mu_fl").unwrap(); // unitless input: no unit check
     b.set_text("k.k", "0.1").unwrap();
-    b.set_text("plant.v_x", "0.3").unwrap();
+    b.set_text("plant.v_x_start", "0.3").unwrap();
     let mut e = Experiment::new(0.05, 1e-3);
     e.algorithm = Algorithm::Ordered;
     e.record = Some(vec!["plant.mu_fl".into(), "plant.x".into()]);

@@ -14,7 +14,9 @@ fn plant(interface: Interface) -> std::sync::Arc<Fmu> {
 fn plant_run(interface: Interface, solver: Solver) -> nigel_cosim::Results {
     let mut b = SystemBuilder::new();
     b.add_instance("p", plant(interface)).unwrap();
-    for (k, v) in [("v_x", "0.35"), ("delta_fl", "0.2"), ("delta_fr", "0.2"), ("tau_rl", "0.02"), ("mu_rr", "0.3")] {
+    for (k, v) in
+        [("v_x_start", "0.35"), ("delta_fl", "0.2"), ("delta_fr", "0.2"), ("tau_rl", "0.02"), ("mu_rr", "0.3")]
+    {
         b.set_text(&format!("p.{k}"), v).unwrap();
     }
     let mut e = Experiment::new(2.0, 1e-3);
@@ -111,7 +113,7 @@ fn mixed_co_simulation_and_model_exchange_system() {
     b.connect("src.y", "p.mu_fl").unwrap();
     b.connect("src.y", "q.mu_fl").unwrap();
     for p in ["p", "q"] {
-        b.set_text(&format!("{p}.v_x"), "0.3").unwrap();
+        b.set_text(&format!("{p}.v_x_start"), "0.3").unwrap();
         b.set_text(&format!("{p}.delta_fl"), "0.1").unwrap();
     }
     let mut e = Experiment::new(0.5, 1e-3);

@@ -398,9 +398,16 @@ impl<B> Declaration<B> {
                 || v.causality == Causality::CalculatedParameter
                 || ((is_state(row) || is_derivative(row)) && approx_or_calc);
             if listed {
-                // At initialization the knowns are the declared ones plus every variable
-                // with initial="exact" that is a parameter (their start values count too).
+                // At initialization the knowns are the inputs and the variables with
+                // initial="exact" (FMI 2.0 section 2.2.8): a declared dependency on a state
+                // that is itself calculated (from parameters) is not one, and is covered by
+                // every exact parameter, which is added.
+                let init_known = |index: &u32| {
+                    let k = &spec.variables[*index as usize - 1];
+                    k.causality == Causality::Input || k.initial == Some(Initial::Exact)
+                };
                 let dependencies = deps(v)?.map(|mut d| {
+                    d.retain(init_known);
                     d.extend(
                         spec.variables
                             .iter()

@@ -2,6 +2,15 @@
 //! [`nigel_benchmark::SampledController`], behind the shared FMI 2.0 layer. This file is
 //! only the binding: the declaration of the variables and a small [`Model`] impl.
 //!
+//! Beyond the paper (issue 9), `controller = robust_tracking` (the last item, 5) feeds back
+//! the pose too: the inputs `x, y, psi` (the measured pose, e.g. the plant's outputs) and
+//! `x_ref, y_ref, psi_ref` (the test bench's reference pose) give the tracking errors of
+//! `nigel_vehicle::tracking` (heading difference wrapped to `(-pi, pi]`, so unwrapped
+//! headings are fine), the steering is `delta = delta_ff + K_track [e_y, e_psi, beta -
+//! beta_ref, yaw_rate - yaw_rate_ref]` and the along-track error corrects the speed command
+//! (`k_along_track`, `along_track_speed_max`; see `nigel_benchmark::control`). The other
+//! modes never read the pose inputs.
+//!
 //! Sampled data: at every sample instant `t_k = t_start + k sample_period` the layer calls
 //! [`Model::event_update`] (a time event in Model Exchange; inside `fmi2DoStep`, or lazily at
 //! the first read or step after the importer set the inputs of that instant, in
@@ -20,11 +29,11 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, enumeration_type, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies,
-    EventUpdate, Initial, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+    declared_name, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate, Initial,
+    InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
 };
-use nigel_benchmark::control::{FORCE_MAX, KI_SPEED, KP_SPEED};
-use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
+use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
+use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
 use nigel_benchmark::{ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
@@ -38,7 +47,9 @@ pub const MAX_SAMPLES_UNATTENDED: u64 = 1_000_000;
 /// Smallest sample period accepted [s].
 pub const MIN_SAMPLE_PERIOD: f64 = 1e-6;
 
-/// The items of the `controller` enumeration.
+/// The values of the Integer parameter `controller` (1-based; the list is in the
+/// variable's description and the FMU documentation). A plain Integer, not an FMI
+/// Enumeration, so that every importer (libcosim and ecos ignore Enumerations) can set it.
 pub mod mode {
     /// `K = 0`: the steering is the feed-forward alone.
     pub const OPEN_LOOP: i32 = 1;
@@ -48,6 +59,9 @@ pub mod mode {
     pub const ROBUST: i32 = 3;
     /// The tunable gains `k_beta_* / k_yaw_rate_*`.
     pub const CUSTOM: i32 = 4;
+    /// Beyond the paper: the robust tracking gain `K_track` on the pose and state errors,
+    /// with the along-track speed correction.
+    pub const ROBUST_TRACKING: i32 = 5;
 }
 
 /// What a value reference stands for.
@@ -74,6 +88,14 @@ pub enum Var {
     CustomGain(usize, usize),
     /// The gain in use (calculated parameter), wheel `i`, column `j`.
     GainInUse(usize, usize),
+    /// The pose gain in use (calculated parameter), wheel `i`, column `j` (0 = e_y, 1 = e_psi).
+    PoseGainInUse(usize, usize),
+    /// Measured pose input: 0 = x, 1 = y, 2 = psi.
+    Pose(usize),
+    /// Reference pose input: 0 = x_ref, 1 = y_ref, 2 = psi_ref.
+    PoseRef(usize),
+    AlongTrackGain,
+    AlongTrackSpeedMax,
     Controller,
 }
 
@@ -103,12 +125,30 @@ pub mod vr {
     pub const K_CUSTOM: u32 = 40;
     /// `gain_beta_fl, gain_yaw_rate_fl, ...`: 50..58, the gain in use.
     pub const GAIN_IN_USE: u32 = 50;
-    /// Integer (Enumeration) value reference of `controller`.
+    /// `x, y, psi`: 60..63, the measured pose.
+    pub const POSE: u32 = 60;
+    /// `x_ref, y_ref, psi_ref`: 63..66, the reference pose.
+    pub const POSE_REF: u32 = 63;
+    pub const K_ALONG_TRACK: u32 = 36;
+    pub const ALONG_TRACK_SPEED_MAX: u32 = 37;
+    /// `gain_e_y_fl, gain_e_psi_fl, ...`: 70..78, the pose gain in use.
+    pub const POSE_GAIN_IN_USE: u32 = 70;
+    /// Integer value reference of `controller`.
     pub const CONTROLLER: u32 = 0;
 }
 
+/// The description of `controller`: its values and what each selects.
+pub const CONTROLLER_ITEMS: &str =
+    "which steering feedback: 1 open_loop (K = 0, the feed-forward alone), 2 pole_placement \
+     (non-robust baseline, Re(s) < -2 at mu = 0.4), 3 robust (mixed H2/H-inf gain, the default), 4 custom (the \
+     tunable gains k_beta_* / k_yaw_rate_*), 5 robust_tracking (beyond the paper: the robust tracking gain K_track \
+     on the pose errors and the along-track speed correction; reads the pose inputs)";
+
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 const COLUMN: [&str; 2] = ["beta", "yaw_rate"];
+const POSE_COLUMN: [&str; 2] = ["e_y", "e_psi"];
+const POSE_NAMES: [&str; 3] = ["x", "y", "psi"];
+const POSE_UNITS: [&str; 3] = ["m", "m", "rad"];
 
 fn build_declaration() -> DeclarationSpec<Var> {
     let mut v: Vec<VarDecl<Var>> = vec![
@@ -145,26 +185,56 @@ fn build_declaration() -> DeclarationSpec<Var> {
                 .describe("feed-forward steering (the maneuver's program)"),
         );
     }
-    let steer_deps = |i: u32| vec![vr::BETA, vr::YAW_RATE, vr::BETA_REF, vr::YAW_RATE_REF, vr::DELTA_FF + i];
+    for (i, (name, unit)) in POSE_NAMES.iter().zip(POSE_UNITS).enumerate() {
+        v.push(
+            VarDecl::real(name, vr::POSE + i as u32, Var::Pose(i))
+                .input(Start::Real(0.0))
+                .unit(unit)
+                .describe("measured pose (world frame; heading may be unwrapped), read by robust_tracking only"),
+        );
+        v.push(
+            VarDecl::real(declared_name(format!("{name}_ref")), vr::POSE_REF + i as u32, Var::PoseRef(i))
+                .input(Start::Real(0.0))
+                .unit(unit)
+                .describe("reference pose (the test bench's x_ref, y_ref, psi_ref), read by robust_tracking only"),
+        );
+    }
+    let pose_inputs: Vec<u32> = (0..3).flat_map(|i| [vr::POSE + i, vr::POSE_REF + i]).collect();
+    let steer_deps = |i: u32| {
+        let mut d = vec![vr::BETA, vr::YAW_RATE, vr::BETA_REF, vr::YAW_RATE_REF, vr::DELTA_FF + i];
+        d.extend(&pose_inputs);
+        d.sort_unstable();
+        d
+    };
+    // the along-track error reads x, y and the reference pose (not psi)
+    let speed_deps = {
+        let mut d =
+            vec![vr::SPEED, vr::SPEED_REF, vr::POSE, vr::POSE + 1, vr::POSE_REF, vr::POSE_REF + 1, vr::POSE_REF + 2];
+        d.sort_unstable();
+        d
+    };
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
             VarDecl::real(declared_name(format!("delta_{w}")), vr::DELTA + i as u32, Var::Steer(i))
                 .discrete_output(Dependencies::On(steer_deps(i as u32)))
                 .unit("rad")
-                .describe("steering command delta_ff + K (x - x_ref), clamped to +-delta_max; held over a sample"),
+                .describe(
+                    "steering command delta_ff + K (x - x_ref) (robust_tracking: delta_ff + K_track e), clamped to \
+                     +-delta_max; held over a sample",
+                ),
         );
     }
     for (i, w) in WHEEL.iter().enumerate() {
         v.push(
             VarDecl::real(declared_name(format!("tau_{w}")), vr::TAU + i as u32, Var::Torque(i))
-                .discrete_output(Dependencies::On(vec![vr::SPEED, vr::SPEED_REF]))
+                .discrete_output(Dependencies::On(speed_deps.clone()))
                 .unit("N.m")
                 .describe("drive torque F r_wheel / 4; held over a sample"),
         );
     }
     v.push(
         VarDecl::real("drive_force", vr::DRIVE_FORCE, Var::DriveForce)
-            .discrete_output(Dependencies::On(vec![vr::SPEED, vr::SPEED_REF]))
+            .discrete_output(Dependencies::On(speed_deps.clone()))
             .unit("N")
             .describe("total drive force F = kp e + ki I, |F| <= force_max"),
     );
@@ -174,7 +244,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .unit("m")
             .describe("speed-error integrator I (frozen while F saturates)"),
     );
-    let params: [(&'static str, u32, Var, f64, &'static str, &'static str); 6] = [
+    let params: [(&'static str, u32, Var, f64, &'static str, &'static str); 8] = [
         ("sample_period", vr::SAMPLE_PERIOD, Var::SamplePeriod, 1e-3, "s", "sample period of the law"),
         ("kp_speed", vr::KP_SPEED, Var::KpSpeed, KP_SPEED, "N.s/m", "speed PI proportional gain"),
         ("ki_speed", vr::KI_SPEED, Var::KiSpeed, KI_SPEED, "N/m", "speed PI integral gain"),
@@ -187,6 +257,22 @@ fn build_declaration() -> DeclarationSpec<Var> {
             core::f64::consts::FRAC_PI_2,
             "rad",
             "steering clamp (the plant's limit)",
+        ),
+        (
+            "k_along_track",
+            vr::K_ALONG_TRACK,
+            Var::AlongTrackGain,
+            K_ALONG_TRACK,
+            "1/s",
+            "robust_tracking: speed command correction per metre of along-track error",
+        ),
+        (
+            "along_track_speed_max",
+            vr::ALONG_TRACK_SPEED_MAX,
+            Var::AlongTrackSpeedMax,
+            ALONG_TRACK_SPEED_MAX,
+            "m/s",
+            "robust_tracking: largest along-track speed correction",
         ),
     ];
     for (name, r, b, start, unit, text) in params {
@@ -220,30 +306,35 @@ fn build_declaration() -> DeclarationSpec<Var> {
             v.push(g);
         }
     }
+    for (i, w) in WHEEL.iter().enumerate() {
+        for (j, c) in POSE_COLUMN.iter().enumerate() {
+            let r = vr::POSE_GAIN_IN_USE + (2 * i + j) as u32;
+            let mut g = VarDecl::real(declared_name(format!("gain_{c}_{w}")), r, Var::PoseGainInUse(i, j))
+                .unit(if j == 0 { "rad/m" } else { "rad/rad" })
+                .describe("the pose gain in use (K_track's e_y, e_psi columns with robust_tracking, else 0)");
+            g.causality = Causality::CalculatedParameter;
+            g.variability = Variability::Tunable;
+            g.initial = Some(Initial::Calculated);
+            v.push(g);
+        }
+    }
     v.push(
-        VarDecl::enumeration("controller", vr::CONTROLLER, "Controller", Var::Controller)
+        VarDecl::integer("controller", vr::CONTROLLER, Var::Controller)
             .parameter(Start::Integer(mode::ROBUST))
-            .describe("which steering feedback"),
+            .min(f64::from(mode::OPEN_LOOP))
+            .max(f64::from(mode::ROBUST_TRACKING))
+            .describe(CONTROLLER_ITEMS),
     );
     DeclarationSpec {
         model_name: "nigel_controller",
         model_identifier: MODEL_IDENTIFIER,
         description: "Nigel's sampled controller: delta = delta_ff + K ([beta, yaw_rate] - ref) clamped to \
                       +-delta_max, and the speed-hold PI with anti-windup (maneuvers.md); robust gain baked \
-                      from the synthesis",
+                      from the synthesis; robust_tracking adds pose feedback and the along-track correction",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        enumerations: vec![enumeration_type(
-            "Controller",
-            "steering feedback",
-            &[
-                ("open_loop", mode::OPEN_LOOP, "K = 0: the feed-forward alone"),
-                ("pole_placement", mode::POLE_PLACEMENT, "non-robust baseline, Re(s) < -2 at mu = 0.4"),
-                ("robust", mode::ROBUST, "robust mixed H2/H-inf gain (paper variant, 4WD4WS, Pareto point)"),
-                ("custom", mode::CUSTOM, "the tunable gains k_beta_* / k_yaw_rate_*"),
-            ],
-        )],
+        enumerations: Vec::new(),
         units: vec![
             si_unit("rad", 0, 0, 0, 1),
             si_unit("rad/s", 0, 0, -1, 1),
@@ -256,6 +347,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
             si_unit("N/m", 1, 0, -2, 0),
             si_unit("rad/rad", 0, 0, 0, 0),
             si_unit("rad.s/rad", 0, 0, 1, 0),
+            si_unit("rad/m", 0, -1, 0, 1),
+            si_unit("1/s", 0, 0, -1, 0),
         ],
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
@@ -290,18 +383,36 @@ pub struct Controller {
 }
 
 impl Controller {
-    /// The gain the `controller` parameter selects.
+    /// The gain on `[beta - beta_ref, yaw_rate - yaw_rate_ref]` the `controller` parameter
+    /// selects (for `robust_tracking` the last two columns of `K_track`).
     pub fn gain_in_use(&self) -> [[f64; 2]; 4] {
         match self.mode {
             mode::OPEN_LOOP => [[0.0; 2]; 4],
             mode::POLE_PLACEMENT => POLE_PLACEMENT,
             mode::CUSTOM => self.custom,
+            mode::ROBUST_TRACKING => ROBUST_TRACKING.map(|row| [row[2], row[3]]),
             _ => ROBUST,
         }
     }
 
+    /// The gain on `[e_y, e_psi]` the `controller` parameter selects (zero but for
+    /// `robust_tracking`: the first two columns of `K_track`).
+    pub fn pose_gain_in_use(&self) -> [[f64; 2]; 4] {
+        match self.mode {
+            mode::ROBUST_TRACKING => ROBUST_TRACKING.map(|row| [row[0], row[1]]),
+            _ => [[0.0; 2]; 4],
+        }
+    }
+
     fn law(&self) -> Result<SampledController, String> {
-        let settings = ControllerSettings { gain: self.gain_in_use(), ..self.settings };
+        let tracking = self.mode == mode::ROBUST_TRACKING;
+        let settings = ControllerSettings {
+            gain: self.gain_in_use(),
+            pose_gain: self.pose_gain_in_use(),
+            // the along-track loop belongs to the tracking controller; the paper's run the PI of maneuvers.md
+            k_along_track: if tracking { self.settings.k_along_track } else { 0.0 },
+            ..self.settings
+        };
         let mut c = SampledController::new(settings).map_err(|e| e.to_string())?;
         c.set_integral(self.integral);
         Ok(c)
@@ -336,7 +447,7 @@ impl Model for Controller {
     }
 
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
-        let settings = ControllerSettings::default();
+        let settings = ControllerSettings { k_along_track: K_ALONG_TRACK, ..ControllerSettings::default() };
         Ok(Controller {
             inputs: ControllerInputs {
                 beta: 0.0,
@@ -346,6 +457,12 @@ impl Model for Controller {
                 yaw_rate_ref: 0.0,
                 speed_ref: 0.0,
                 delta_ff: [0.0; 4],
+                x: 0.0,
+                y: 0.0,
+                psi: 0.0,
+                x_ref: 0.0,
+                y_ref: 0.0,
+                psi_ref: 0.0,
             },
             settings,
             custom: ROBUST,
@@ -384,7 +501,12 @@ impl Model for Controller {
             Var::SteerLimit => s.delta_max,
             Var::CustomGain(i, j) => self.custom[i][j],
             Var::GainInUse(i, j) => self.gain_in_use()[i][j],
-            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+            Var::PoseGainInUse(i, j) => self.pose_gain_in_use()[i][j],
+            Var::Pose(i) => [x.x, x.y, x.psi][i],
+            Var::PoseRef(i) => [x.x_ref, x.y_ref, x.psi_ref][i],
+            Var::AlongTrackGain => s.k_along_track,
+            Var::AlongTrackSpeedMax => s.along_track_speed_max,
+            Var::Controller => return Err("controller is an Integer, not a Real".into()),
         })
     }
 
@@ -417,8 +539,26 @@ impl Model for Controller {
             Var::WheelRadius => Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?,
             Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
             Var::CustomGain(i, j) => self.custom[i][j] = value,
-            Var::GainInUse(..) => return Err("the gains in use are calculated".into()),
-            Var::Controller => return Err("controller is an Enumeration, not a Real".into()),
+            Var::GainInUse(..) | Var::PoseGainInUse(..) => return Err("the gains in use are calculated".into()),
+            Var::Pose(0) => x.x = value,
+            Var::Pose(1) => x.y = value,
+            Var::Pose(_) => x.psi = value,
+            Var::PoseRef(0) => x.x_ref = value,
+            Var::PoseRef(1) => x.y_ref = value,
+            Var::PoseRef(_) => x.psi_ref = value,
+            Var::AlongTrackGain => {
+                if !(value >= 0.0) {
+                    return Err(format!("k_along_track = {value} refused: must be >= 0").into());
+                }
+                s.k_along_track = value;
+            }
+            Var::AlongTrackSpeedMax => {
+                if !(value >= 0.0) {
+                    return Err(format!("along_track_speed_max = {value} refused: must be >= 0").into());
+                }
+                s.along_track_speed_max = value;
+            }
+            Var::Controller => return Err("controller is an Integer, not a Real".into()),
         }
         Ok(())
     }
@@ -432,11 +572,11 @@ impl Model for Controller {
 
     fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
         match b {
-            Var::Controller if (mode::OPEN_LOOP..=mode::CUSTOM).contains(&value) => {
+            Var::Controller if (mode::OPEN_LOOP..=mode::ROBUST_TRACKING).contains(&value) => {
                 self.mode = value;
                 Ok(())
             }
-            Var::Controller => Err(format!("controller = {value} refused: not one of 1..4").into()),
+            Var::Controller => Err(format!("controller = {value} refused: not one of 1..5").into()),
             _ => Err(format!("{b:?} is not an Integer").into()),
         }
     }
@@ -512,12 +652,26 @@ e = speed_ref - speed,   F = kp_speed e + ki_speed I
 if |F| > force_max:  F = +-force_max and I is frozen,   else  I := I + e sample_period  (at the next sample)
 tau_i = F r_wheel / 4
 </pre>
-<p><code>controller</code> selects K: <code>open_loop</code> (K = 0), <code>pole_placement</code> (the non-robust
-baseline, Re(s) &lt; -2 at mu = 0.4), <code>robust</code> (the mixed H2/H-inf gain of the paper variant, 4WD4WS,
-Pareto point; default) or <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>, which
-start at the robust gain and may change between steps). The gain in use is readable as <code>gain_*</code>.
+<p>The Integer parameter <code>controller</code> (1 .. 5; a plain Integer rather than an FMI Enumeration, so
+that every importer can set it) selects K: 1 <code>open_loop</code> (K = 0), 2 <code>pole_placement</code> (the
+non-robust baseline, Re(s) &lt; -2 at mu = 0.4), 3 <code>robust</code> (the mixed H2/H-inf gain of the paper variant,
+4WD4WS, Pareto point; default), 4 <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>,
+which start at the robust gain and may change between steps) or 5 <code>robust_tracking</code> (below). The gain in use is readable as <code>gain_*</code>.
 The robust and pole-placement gains are baked from the synthesis crate
 (<code>cargo run --release -p nigel-synthesis --bin bake-gains</code>).</p>
+<h2>Robust tracking (controller = 5, robust_tracking, beyond the paper)</h2>
+<pre>
+e_x   =  cos(psi_ref) (x - x_ref) + sin(psi_ref) (y - y_ref)      along-track error, + = ahead
+e_y   = -sin(psi_ref) (x - x_ref) + cos(psi_ref) (y - y_ref)      lateral error, + = left of the reference
+e_psi = psi - psi_ref wrapped to (-pi, pi]
+delta_i = clamp(delta_ff_i + K_track,i [e_y, e_psi, beta - beta_ref, yaw_rate - yaw_rate_ref], -delta_max, delta_max)
+speed_command = speed_ref - clamp(k_along_track e_x, -along_track_speed_max, along_track_speed_max)
+e = speed_command - speed   (the PI above otherwise unchanged)
+</pre>
+<p>K_track is the robust mixed H2/H-inf tracking gain (issue 9: the same 16-vertex friction polytope, D-stability
+Re(s) &lt; -0.5 and a 135-degree sector), readable as <code>gain_e_y_*</code>, <code>gain_e_psi_*</code>,
+<code>gain_beta_*</code>, <code>gain_yaw_rate_*</code>. Connect <code>x, y, psi</code> to the plant's pose and
+<code>x_ref, y_ref, psi_ref</code> to the test bench's reference pose; the other modes ignore them.</p>
 <h2>Sampling</h2>
 <p>The law runs at t_k = t_start + k sample_period on the inputs at t_k; the outputs are held until t_(k+1).
 The outputs depend directly on the inputs: an importer that sets the inputs at t_k and reads the outputs before

@@ -12,7 +12,7 @@ mod common;
 use std::f64::consts::FRAC_PI_2;
 
 use common::{Fmu, ERR, OK};
-use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST};
+use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
 use nigel_controller::{mode, vr, Controller};
 
 type C = Fmu<Controller>;
@@ -321,6 +321,9 @@ fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     assert_eq!(c.set_int(vr::CONTROLLER, 7), ERR);
     assert!(c.last_error().contains("controller"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
+    assert_eq!(c.set_int(vr::CONTROLLER, 6), ERR);
+    assert!(c.last_error().contains("controller"), "{}", c.last_error());
+    assert_eq!(c.reset(), OK);
     // a negative sample period
     assert_eq!(c.set_real(vr::SAMPLE_PERIOD, -1e-3), ERR);
     assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
@@ -356,12 +359,101 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     assert!(md.model_exchange.is_some() && md.co_simulation.is_some());
     let index = |n: &str| md.model_variables.iter().position(|v| v.name == n).unwrap() as u32 + 1;
     let out = md.model_structure.outputs.iter().find(|u| u.index == index("delta_rl")).unwrap();
+    let pose = ["x", "y", "psi", "x_ref", "y_ref", "psi_ref"].map(index);
     let mut expect =
         vec![index("beta"), index("yaw_rate"), index("beta_ref"), index("yaw_rate_ref"), index("delta_ff_rl")];
+    expect.extend(pose);
     expect.sort();
     assert_eq!(out.dependencies.as_ref(), Some(&expect));
+    // the speed loop: the along-track error reads x, y and the whole reference pose, not psi
     let out = md.model_structure.outputs.iter().find(|u| u.index == index("tau_fl")).unwrap();
-    assert_eq!(out.dependencies.as_ref(), Some(&vec![index("speed"), index("speed_ref")]));
+    let mut expect = vec![index("speed"), index("speed_ref"), index("x"), index("y")];
+    expect.extend(["x_ref", "y_ref", "psi_ref"].map(index));
+    expect.sort();
+    assert_eq!(out.dependencies.as_ref(), Some(&expect));
+    // robust_tracking is the last item of the Controller type (existing values unchanged)
+    let t = md.type_definitions.iter().find(|t| t.name == "Controller").expect("a Controller type");
+    let items: Vec<(&str, i32)> = t.items.iter().map(|i| (i.name.as_str(), i.value)).collect();
+    assert_eq!(items, [("open_loop", 1), ("pole_placement", 2), ("robust", 3), ("custom", 4), ("robust_tracking", 5)]);
+}
+
+/// The tracking law written out by hand from its definition (issue 9), independent of
+/// nigel_vehicle's and nigel_benchmark's code: the errors in the reference's frame.
+fn tracking_by_hand(x: &In, pose: [f64; 6], integral: f64) -> ([f64; 4], f64) {
+    let [px, py, psi, x_ref, y_ref, psi_ref] = pose;
+    let (dx, dy) = (px - x_ref, py - y_ref);
+    let e_x = psi_ref.cos() * dx + psi_ref.sin() * dy;
+    let e_y = -psi_ref.sin() * dx + psi_ref.cos() * dy;
+    let mut e_psi = (psi - psi_ref) % std::f64::consts::TAU;
+    if e_psi > std::f64::consts::PI {
+        e_psi -= std::f64::consts::TAU;
+    } else if e_psi <= -std::f64::consts::PI {
+        e_psi += std::f64::consts::TAU;
+    }
+    let e = [e_y, e_psi, x.beta - x.beta_ref, x.yaw_rate - x.yaw_rate_ref];
+    let k = ROBUST_TRACKING;
+    let delta = std::array::from_fn(|i| {
+        let d = x.ff[i] + (0..4).map(|j| k[i][j] * e[j]).sum::<f64>();
+        d.max(-FRAC_PI_2).min(FRAC_PI_2)
+    });
+    let speed_command = x.speed_ref - (1.0 * e_x).max(-0.1).min(0.1);
+    let f = 53.6 * (speed_command - x.speed) + 268.0 * integral;
+    (delta, f.max(-20.0).min(20.0))
+}
+
+#[test]
+fn robust_tracking_feeds_back_the_pose_and_corrects_the_speed() {
+    let c = C::cs();
+    assert_eq!(c.setup(), OK);
+    assert_eq!(c.enter_init(), OK);
+    assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST_TRACKING), OK, "{}", c.last_error());
+    assert_eq!(c.exit_init(), OK, "{}", c.last_error());
+    for i in 0..4 {
+        let gains = [vr::POSE_GAIN_IN_USE, vr::POSE_GAIN_IN_USE + 1, vr::GAIN_IN_USE, vr::GAIN_IN_USE + 1];
+        let got: Vec<f64> = gains.iter().map(|&g| c.real(g + 2 * i as u32)).collect();
+        assert_eq!(got, ROBUST_TRACKING[i].to_vec(), "wheel {i}");
+    }
+    // poses: the reference at 30 deg, the car left, behind and turned; unwrapped headings a
+    // few turns apart; the car ahead by more than the clamp; headings across +-pi
+    let poses = [
+        [1.0, 2.05, 0.6, 1.03, 2.0, 30f64.to_radians()],
+        [5.0, -1.0, 0.2 + 4.0 * std::f64::consts::PI, 5.01, -1.0, 0.1],
+        [3.0, 0.0, 0.0, 2.5, 0.0, 0.0],
+        [0.0, 0.0, 3.1, 0.0, 0.01, -3.1],
+    ];
+    let mut integral = 0.0;
+    let mut t = 0.0;
+    for (x, pose) in SETS.iter().zip(poses) {
+        set_inputs(&c, x);
+        for (r, v) in [vr::POSE, vr::POSE + 1, vr::POSE + 2, vr::POSE_REF, vr::POSE_REF + 1, vr::POSE_REF + 2]
+            .into_iter()
+            .zip(pose)
+        {
+            assert_eq!(c.set_real(r, v), OK, "{}", c.last_error());
+        }
+        let (delta, force) = tracking_by_hand(x, pose, integral);
+        let got = deltas(&c);
+        for i in 0..4 {
+            assert!(close(got[i], delta[i]), "{pose:?} wheel {i}: {} vs {}", got[i], delta[i]);
+        }
+        assert!(close(c.real(vr::DRIVE_FORCE), force), "{} vs {force}", c.real(vr::DRIVE_FORCE));
+        assert_eq!(c.step(t, T), OK);
+        t += T;
+        if force.abs() < 20.0 {
+            integral += force_error(force, integral) * T;
+        }
+        assert!(close(c.real(vr::SPEED_INTEGRAL), integral), "{} vs {integral}", c.real(vr::SPEED_INTEGRAL));
+    }
+    // a lateral offset to the left steers the front wheels right
+    assert!(tracking_by_hand(&SETS[2], [0.0, 0.02, 0.0, 0.0, 0.0, 0.0], 0.0).0[0] < SETS[2].ff[0]);
+    // the along-track loop's parameters are checked
+    assert_eq!(c.set_real(vr::K_ALONG_TRACK, -1.0), ERR);
+    assert!(c.last_error().contains("k_along_track"), "{}", c.last_error());
+}
+
+/// The speed error `e` behind a force `kp e + ki I` (undoes the PI for the integrator's step).
+fn force_error(force: f64, integral: f64) -> f64 {
+    (force - 268.0 * integral) / 53.6
 }
 
 #[test]
@@ -382,5 +474,42 @@ fn a_step_of_astronomically_many_samples_is_refused_not_run() {
     for k in 0..3 {
         assert_eq!(c.step(k as f64 * 100.0, 100.0), OK, "{}", c.last_error());
         assert!(c.real(vr::SPEED_INTEGRAL).is_finite());
+    }
+}
+
+/// The switch is a plain Integer parameter (libcosim and ecos do not see FMI Enumerations):
+/// declared min/max 1 .. 5, its values listed in its description, the values unchanged
+/// (1-based, as the Enumeration had them), and no type definition left behind.
+#[test]
+fn controller_switch_is_an_integer_parameter_listing_its_values() {
+    use fmi2_export::model_description::{Causality, VariableType};
+    use fmi2_export::Model;
+    let md = Controller::declaration().model_description();
+    let v = md.variable("controller").expect("controller is declared");
+    assert_eq!(v.causality, Causality::Parameter);
+    assert_eq!(v.value_reference, vr::CONTROLLER);
+    assert_eq!(v.variable_type, VariableType::Integer { start: Some(3), min: Some(1), max: Some(5) });
+    let text = v.description.as_deref().unwrap_or("");
+    for (value, name) in [(1, "open_loop"), (2, "pole_placement"), (3, "robust"), (4, "custom"), (5, "robust_tracking")] {
+        assert!(text.contains(&format!("{value} {name} (")), "{name} = {value} missing from {text:?}");
+    }
+    assert_eq!(
+        (mode::OPEN_LOOP, mode::POLE_PLACEMENT, mode::ROBUST, mode::CUSTOM, mode::ROBUST_TRACKING),
+        (1, 2, 3, 4, 5)
+    );
+    assert!(md.type_definitions.is_empty());
+    let xml = Controller::declaration().xml();
+    assert!(!xml.contains("Enumeration"), "no Enumeration left in the description");
+    // the bounds are enforced: 0 and 6 refused naming the variable, 1 .. 5 accepted
+    for bad in [0, 6] {
+        let c = C::cs();
+        assert_eq!(c.set_int(vr::CONTROLLER, bad), ERR);
+        assert!(c.last_error().contains("controller"), "{}", c.last_error());
+    }
+    for good in 1..=5 {
+        let c = C::cs();
+        assert_eq!(c.set_int(vr::CONTROLLER, good), OK);
+        c.init();
+        assert_eq!(c.int(vr::CONTROLLER), good);
     }
 }

@@ -17,8 +17,8 @@ use std::sync::{Arc, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, enumeration_type, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
-    InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
+    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate, InstantiateContext,
+    Interfaces, Model, ModelResult, Start, VarDecl,
 };
 use nigel_benchmark::{
     BenchSample, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE, SAMPLE_PERIOD,
@@ -83,7 +83,8 @@ pub mod vr {
     pub const STEER_AMPLITUDE: u32 = 30;
     pub const SPEED_TARGET: u32 = 31;
     pub const DURATION: u32 = 32;
-    /// Integer (Enumeration) value references.
+    /// Integer value references (`maneuver` and `fidelity` take the 1-based values of
+    /// [`super::maneuver_value`] and [`super::fidelity_value`]).
     pub const MANEUVER: u32 = 0;
     pub const FIDELITY: u32 = 1;
     /// Integer.
@@ -96,14 +97,51 @@ pub mod vr {
 
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 
-/// Enumeration value (1-based) of a maneuver, in the order of [`Maneuver::ALL`].
+/// Value (1-based) of the Integer parameter `maneuver` for a maneuver, in the order of
+/// [`Maneuver::ALL`]: 1 straight, 2 lane_change, 3 skidpad, 4 fishhook, 5 slalom, 6 figure_8.
+/// The switches are plain Integers, not FMI Enumerations, so that every importer (libcosim
+/// and ecos ignore Enumerations) can set them; the list is in the variable's description.
 pub fn maneuver_value(m: Maneuver) -> i32 {
     Maneuver::ALL.iter().position(|&x| x == m).map_or(0, |i| i as i32 + 1)
 }
 
-/// Enumeration value (1-based) of a fidelity: paper 1, real 2.
+/// Value (1-based) of the Integer parameter `fidelity`: paper 1, real 2.
 pub fn fidelity_value(f: Fidelity) -> i32 {
     Fidelity::ALL.iter().position(|&x| x == f).map_or(0, |i| i as i32 + 1)
+}
+
+/// What a maneuver's steering program is (for the description of `maneuver`).
+fn program(m: Maneuver) -> &'static str {
+    match m {
+        Maneuver::Straight => "no steering",
+        Maneuver::LaneChange => "impulse at 14.8 s",
+        Maneuver::Skidpad => "step 2.5 .. 27.5 s",
+        Maneuver::Fishhook => "ramp 2.5 .. 25 s, hold to 27.5 s",
+        Maneuver::Slalom => "sine 2.5 .. 27.5 s, 15 periods",
+        Maneuver::Figure8 => "square wave switched at the nominal car's closest approach to the origin",
+    }
+}
+
+/// The description of `maneuver`: "the maneuver: 1 straight (no steering), 2 lane_change (...), ...".
+fn maneuver_items() -> &'static str {
+    let items: Vec<String> =
+        Maneuver::ALL.iter().map(|&m| format!("{} {} ({})", maneuver_value(m), m.name(), program(m))).collect();
+    declared_name(format!("the maneuver: {}", items.join(", ")))
+}
+
+/// The description of `fidelity`: "... 1 paper (...), 2 real (...)".
+fn fidelity_items() -> &'static str {
+    let items: Vec<String> = Fidelity::ALL
+        .iter()
+        .map(|&f| {
+            let text = match f {
+                Fidelity::Paper => "Table II, true measurements: the sim column",
+                Fidelity::Real => "friction circle, servo, motor limit; noisy measurements",
+            };
+            format!("{} {} ({text})", fidelity_value(f), f.name())
+        })
+        .collect();
+    declared_name(format!("the reference plant and the measurement noise: {}", items.join(", ")))
 }
 
 fn build_declaration() -> DeclarationSpec<Var> {
@@ -193,14 +231,18 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .describe("length of the reference computed at initialization (30 s); a run may not go past it"),
     );
     v.push(
-        VarDecl::enumeration("maneuver", vr::MANEUVER, "Maneuver", Var::Maneuver)
+        VarDecl::integer("maneuver", vr::MANEUVER, Var::Maneuver)
             .parameter(Start::Integer(maneuver_value(Maneuver::Straight)))
-            .describe("the maneuver"),
+            .min(1.0)
+            .max(Maneuver::ALL.len() as f64)
+            .describe(maneuver_items()),
     );
     v.push(
-        VarDecl::enumeration("fidelity", vr::FIDELITY, "Fidelity", Var::Fidelity)
+        VarDecl::integer("fidelity", vr::FIDELITY, Var::Fidelity)
             .parameter(Start::Integer(fidelity_value(Fidelity::Paper)))
-            .describe("the reference plant, and measurement noise (real) or none (paper)"),
+            .min(1.0)
+            .max(Fidelity::ALL.len() as f64)
+            .describe(fidelity_items()),
     );
     v.push(
         VarDecl::integer("seed", vr::SEED, Var::Seed)
@@ -221,20 +263,6 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .parameter(Start::Boolean(true))
             .describe("Gaussian noise on beta_meas, yaw_rate_meas (real fidelity only)"),
     );
-    let items: Vec<(&str, i32, &str)> = Maneuver::ALL
-        .iter()
-        .map(|&m| {
-            let text = match m {
-                Maneuver::Straight => "no steering",
-                Maneuver::LaneChange => "impulse at 14.8 s",
-                Maneuver::Skidpad => "step 2.5 .. 27.5 s",
-                Maneuver::Fishhook => "ramp 2.5 .. 25 s, hold to 27.5 s",
-                Maneuver::Slalom => "sine 2.5 .. 27.5 s, 15 periods",
-                Maneuver::Figure8 => "square wave, switched at the nominal car's closest approach to the origin",
-            };
-            (m.name(), maneuver_value(m), text)
-        })
-        .collect();
     DeclarationSpec {
         model_name: "nigel_maneuver",
         model_identifier: MODEL_IDENTIFIER,
@@ -243,21 +271,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        enumerations: vec![
-            enumeration_type("Maneuver", "maneuvers of Table III", &items),
-            enumeration_type(
-                "Fidelity",
-                "plant of the reference and measurement noise",
-                &[
-                    (Fidelity::Paper.name(), fidelity_value(Fidelity::Paper), "Table II, true measurements (sim)"),
-                    (
-                        Fidelity::Real.name(),
-                        fidelity_value(Fidelity::Real),
-                        "friction circle, servo, motor limit; noisy measurements",
-                    ),
-                ],
-            ),
-        ],
+        enumerations: Vec::new(),
         units: vec![
             si_unit("rad", 0, 0, 0, 1),
             si_unit("rad/s", 0, 0, -1, 1),
@@ -507,6 +521,9 @@ fmi2_export::export_fmi2!(TestBench);
 pub const DOCUMENTATION: &str = r#"<h2>Benchmark (shared/spec/maneuvers.md)</h2>
 <p>Samples k = 0, 1, ... at t_k = t_start + k 1 ms; every output is held over [t_k, t_k + 1 ms).
 Steering programs (front +f, rear -f), a = <code>steer_amplitude</code> (30 deg):</p>
+<p>The switches <code>maneuver</code> and <code>fidelity</code> are plain Integer parameters (not FMI
+Enumerations, so that every importer can set them): <code>maneuver</code> 1 straight, 2 lane_change, 3 skidpad,
+4 fishhook, 5 slalom, 6 figure_8; <code>fidelity</code> 1 paper (the sim column), 2 real.</p>
 <pre>
 straight     0
 lane_change  [14.8, 15.0) s: +a;  [15.0, 15.2) s: -a

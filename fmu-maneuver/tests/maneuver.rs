@@ -219,3 +219,41 @@ fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     assert_eq!(b.int(vr::MANEUVER), 1);
     assert_eq!(b.step(0.0, 0.01), OK);
 }
+
+/// `maneuver` and `fidelity` are plain Integer parameters (libcosim and ecos do not see FMI
+/// Enumerations): declared min/max, their values (1-based, unchanged) listed in their
+/// descriptions, no type definitions left behind.
+#[test]
+fn switches_are_integer_parameters_listing_their_values() {
+    use fmi2_export::model_description::{Causality, VariableType};
+    use fmi2_export::Model;
+    let md = TestBench::declaration().model_description();
+    let names = ["straight", "lane_change", "skidpad", "fishhook", "slalom", "figure_8"];
+    let cases: [(&str, u32, i32, &[&str]); 2] =
+        [("maneuver", vr::MANEUVER, 1, &names), ("fidelity", vr::FIDELITY, 1, &["paper", "real"])];
+    for (name, r, start, items) in cases {
+        let v = md.variable(name).unwrap();
+        assert_eq!((v.causality, v.value_reference), (Causality::Parameter, r));
+        let max = items.len() as i32;
+        assert_eq!(
+            v.variable_type,
+            VariableType::Integer { start: Some(start), min: Some(1), max: Some(max) },
+            "{name}"
+        );
+        let text = v.description.as_deref().unwrap_or("");
+        for (k, item) in items.iter().enumerate() {
+            assert!(text.contains(&format!("{} {item} (", k + 1)), "{item} = {} missing from {text:?}", k + 1);
+        }
+        for bad in [0, max + 1] {
+            let b = B::cs();
+            assert_eq!(b.set_int(r, bad), ERR);
+            assert!(b.last_error().contains(name), "{}", b.last_error());
+        }
+    }
+    for (k, m) in Maneuver::ALL.iter().enumerate() {
+        assert_eq!((m.name(), maneuver_value(*m)), (names[k], k as i32 + 1));
+    }
+    assert_eq!((fidelity_value(Fidelity::Paper), fidelity_value(Fidelity::Real)), (1, 2));
+    assert!(md.type_definitions.is_empty());
+    assert!(!TestBench::declaration().xml().contains("Enumeration"));
+}

@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
 use fmi2_export::{
-    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces,
-    Model, ModelError, ModelResult, Start, VarDecl,
+    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Initial, InstantiateContext,
+    Interfaces, Model, ModelError, ModelResult, Start, VarDecl,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
@@ -94,12 +94,32 @@ pub enum PlantVar {
     State(usize),
     /// Time derivative of state `i`.
     Derivative(usize),
+    /// Initial value of body state `i` (`x_start .. yaw_rate_start`): a fixed parameter, the
+    /// state's start (the state itself is `initial="calculated"` from it).
+    StateStart(usize),
     Output(Output),
 }
 
 const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 const STATE_NAMES: [&str; N_STATES] =
     ["x", "y", "psi", "v_x", "v_y", "yaw_rate", "servo_angle_fl", "servo_angle_fr", "servo_angle_rl", "servo_angle_rr"];
+/// The body states `x .. yaw_rate`, whose initial values are the parameters `*_start`.
+pub const N_BODY_STATES: usize = 6;
+const START_NAMES: [&str; N_BODY_STATES] =
+    ["x_start", "y_start", "psi_start", "v_x_start", "v_y_start", "yaw_rate_start"];
+/// Unit, unit of the derivative, description.
+const STATE_INFO: [(&str, &str, &str); N_STATES] = [
+    ("m", "m/s", "global position X of the CG"),
+    ("m", "m/s", "global position Y of the CG"),
+    ("rad", "rad/s", "yaw angle, counter-clockwise positive"),
+    ("m/s", "m/s2", "longitudinal velocity (body frame)"),
+    ("m/s", "m/s2", "lateral velocity (body frame)"),
+    ("rad/s", "rad/s2", "yaw rate"),
+    ("rad", "rad/s", "steering servo angle FL (a state only when steering_servo is on)"),
+    ("rad", "rad/s", "steering servo angle FR"),
+    ("rad", "rad/s", "steering servo angle RL"),
+    ("rad", "rad/s", "steering servo angle RR"),
+];
 const DER_NAMES: [&str; N_STATES] = [
     "der(x)",
     "der(y)",
@@ -131,6 +151,8 @@ pub mod vr {
     pub const FORCE_LAT: u32 = 47;
     pub const FORCE_DRIVE: u32 = 51;
     pub const STEER_APPLIED: u32 = 55;
+    /// `x_start, y_start, psi_start, v_x_start, v_y_start, yaw_rate_start`: 60..66.
+    pub const STATE_START: u32 = 60;
     pub const PARAM: u32 = 100;
     /// Boolean value references.
     pub const FRICTION_CIRCLE: u32 = 0;
@@ -224,24 +246,27 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             .describe("wind force along world +Y at the geometric centre, rotated with the instantaneous psi"),
     );
 
-    // states (the first six are outputs too) and their derivatives
-    let state_info: [(&str, &str, &str); N_STATES] = [
-        ("m", "m/s", "global position X of the CG"),
-        ("m", "m/s", "global position Y of the CG"),
-        ("rad", "rad/s", "yaw angle, counter-clockwise positive"),
-        ("m/s", "m/s2", "longitudinal velocity (body frame)"),
-        ("m/s", "m/s2", "lateral velocity (body frame)"),
-        ("rad/s", "rad/s2", "yaw rate"),
-        ("rad", "rad/s", "steering servo angle FL (a state only when steering_servo is on)"),
-        ("rad", "rad/s", "steering servo angle FR"),
-        ("rad", "rad/s", "steering servo angle RL"),
-        ("rad", "rad/s", "steering servo angle RR"),
-    ];
-    for i in 0..N_STATES {
-        let (unit, _, text) = state_info[i];
+    // initial state of the body: parameters, declared before the states so that restoring
+    // a serialized FMU state sets them first and the saved states after them
+    for i in 0..N_BODY_STATES {
+        let (unit, _, text) = STATE_INFO[i];
         v.push(
-            real(STATE_NAMES[i], state_vr(i), PlantVar::State(i)).state(0.0, i < idx::SERVO).unit(unit).describe(text),
+            real(START_NAMES[i], vr::STATE_START + i as u32, PlantVar::StateStart(i))
+                .parameter(Start::Real(0.0))
+                .unit(unit)
+                .describe(declared_name(format!("initial value of {} ({text})", STATE_NAMES[i]))),
         );
+    }
+
+    // states (the first six are outputs too, their start values calculated from the
+    // parameters *_start) and their derivatives
+    for i in 0..N_STATES {
+        let (unit, _, text) = STATE_INFO[i];
+        let mut state = real(STATE_NAMES[i], state_vr(i), PlantVar::State(i)).state(0.0, i < idx::SERVO);
+        if i < N_BODY_STATES {
+            state = state.start_value(Start::None, Initial::Calculated);
+        }
+        v.push(state.unit(unit).describe(text));
     }
 
     // outputs
@@ -293,7 +318,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         v.push(
             real(DER_NAMES[i], vr::DERIVATIVE + i as u32, PlantVar::Derivative(i))
                 .derivative(state_vr(i), Dependencies::On(deps))
-                .unit(state_info[i].1),
+                .unit(STATE_INFO[i].1),
         );
     }
 
@@ -411,6 +436,8 @@ pub struct Plant {
     pub params: VehicleParams,
     pub inputs: Inputs<f64>,
     pub state: State<f64>,
+    /// The parameters `x_start .. yaw_rate_start`: the initial body state.
+    pub state_start: [f64; N_BODY_STATES],
     pub cs_substep_max: f64,
     cache: Option<Evaluation<f64>>,
 }
@@ -421,6 +448,7 @@ impl Default for Plant {
             params: VehicleParams::table2(),
             inputs: Inputs::coasting(0.4),
             state: [0.0; N_STATES],
+            state_start: [0.0; N_BODY_STATES],
             cs_substep_max: DEFAULT_CS_SUBSTEP_MAX,
             cache: None,
         }
@@ -525,6 +553,7 @@ impl Model for Plant {
             PlantVar::Param(p) => *param_slot(&mut self.params, p).ok_or("no such parameter")?,
             PlantVar::Input(i) => *input_slot(&mut self.inputs, i),
             PlantVar::State(i) => self.state[i],
+            PlantVar::StateStart(i) => self.state_start[i],
             PlantVar::Derivative(i) => self.evaluation().derivatives[i],
             PlantVar::Output(o) => output_of(self.evaluation(), o),
             PlantVar::Switch(_) => return Err("a Boolean, not a Real".into()),
@@ -550,6 +579,12 @@ impl Model for Plant {
             }
             PlantVar::Input(i) => *input_slot(&mut self.inputs, i) = value,
             PlantVar::State(i) => self.state[i] = value,
+            // a fixed parameter: set only before initialization ends (and when an FMU state is
+            // restored, before the saved states), so the calculated state follows it
+            PlantVar::StateStart(i) => {
+                self.state_start[i] = value;
+                self.state[i] = value;
+            }
             PlantVar::Derivative(_) | PlantVar::Output(_) => return Err("a calculated variable cannot be set".into()),
             PlantVar::Switch(_) => return Err("a Boolean, not a Real".into()),
         }

@@ -239,3 +239,16 @@ fn cli_writes_the_tracking_json_and_refuses_what_does_not_apply() {
         assert_eq!(out.status.code(), Some(2), "{bad:?}");
     }
 }
+
+#[test]
+fn the_baked_tracking_gain_equals_this_fresh_synthesis() {
+    // benchmark/src/gains.rs (what the controller FMU and the benchmark run) against the
+    // design verified above; regenerate with `cargo run --release -p nigel-synthesis --bin bake-gains`
+    let baked = nigel_benchmark::gains::ROBUST_TRACKING;
+    let fresh = design().k_track;
+    let worst = (0..4).flat_map(|i| (0..4).map(move |j| (i, j))).map(|(i, j)| (fresh[i][j] - baked[i][j]).abs());
+    let worst = worst.fold(0.0f64, f64::max);
+    assert!(worst <= 1e-9, "K_track differs from the synthesis by {worst:e}: run bake-gains\n{fresh:?}");
+    // the figures of notes/issue9.md and the README, to 4 decimals
+    assert!((baked[0][0] - -5.2723).abs() < 5e-5 && (baked[2][1] - 0.7945).abs() < 5e-5, "{baked:?}");
+}

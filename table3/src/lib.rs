@@ -8,10 +8,15 @@
 //!   implementation the FMU run must reproduce.
 //! * [`metric`]: the metric of maneuvers.md, computed here from the recorded pose and the
 //!   test bench's reference outputs (not taken from either engine).
-//! * [`table`]: the 36 runs of one seed in parallel, [`Table`]; [`paper`] holds the
+//! * [`table`]: the 48 runs of one seed (2 columns, 6 maneuvers, 4 controllers) in parallel, [`Table`]; [`paper`] holds the
 //!   paper's Table III for comparison.
 //! * [`report`]: the markdown table and the JSON of the contract; [`csv`] and [`plot`]
 //!   (the Fig. 7 PNGs) write the recorded runs.
+//! * [`study`]: several seeds, `robust_tracking` against `robust` cell by cell (issue 9).
+//!
+//! Beyond the paper's three controllers, every table has a fourth column,
+//! `robust_tracking` (issue 9): the robust path-tracking gain with pose feedback and the
+//! along-track speed correction (`nigel_benchmark::control`).
 //!
 //! ```no_run
 //! use nigel_table3::{FmuEngine, Options, run_table};
@@ -30,19 +35,22 @@ pub mod metric;
 pub mod paper;
 pub mod plot;
 pub mod report;
+pub mod study;
 pub mod table;
 
 pub use engine::{Engine, FmuEngine, InProcess, Job, Run};
 pub use error::Error;
 pub use metric::Metric;
+pub use study::Study;
 pub use table::{run_table, run_table_with, Cell, Options, Table, TableRun};
 
 pub use nigel_benchmark::{Controller, Fidelity, Maneuver};
 
-/// The controllers of Table III in its column order.
-pub const CONTROLLERS: [Controller; 3] = Controller::TABLE;
+/// The controllers of our Table III in its column order: the paper's three and, beyond
+/// the paper (issue 9), `robust_tracking`.
+pub const CONTROLLERS: [Controller; 4] = Controller::WITH_TRACKING;
 
-/// `open_loop`, `pole_placement`, `robust` (the JSON and FMU names).
+/// `open_loop`, `pole_placement`, `robust`, `robust_tracking` (the JSON and FMU names).
 pub fn controller_name(c: Controller) -> &'static str {
     c.name()
 }
@@ -55,7 +63,7 @@ pub fn parse_job(text: &str, seed: u64) -> Result<Job, Error> {
     let [column, maneuver, controller] = parts[..] else { return Err(bad()) };
     let fidelity = Fidelity::ALL.into_iter().find(|f| f.column() == column).ok_or_else(bad)?;
     let maneuver = parse_maneuver(maneuver)?;
-    let controller = Controller::TABLE.into_iter().find(|c| c.name() == controller).ok_or_else(bad)?;
+    let controller = CONTROLLERS.into_iter().find(|c| c.name() == controller).ok_or_else(bad)?;
     Ok(Job::new(seed, fidelity, maneuver, controller))
 }
 

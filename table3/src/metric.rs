@@ -16,6 +16,9 @@ pub struct Metric {
     pub rmse_state: [f64; 2],
     /// `||rmse_state||_2`.
     pub eps_state: f64,
+    /// The largest steering command `|delta_i|` of the run, any wheel [rad] (against the
+    /// plant's limit `delta_max = pi/2`).
+    pub max_delta: f64,
 }
 
 /// Root mean square of `a[k] - b[k]` over `k = 1 ..= n` (0 for `n = 0`).
@@ -41,6 +44,7 @@ impl Metric {
         let n = run.n_samples();
         let rmse = [rmse(&run.x, &run.x_ref, n), rmse(&run.y, &run.y_ref, n), rmse(&run.psi, &run.psi_ref, n)];
         let rmse_state = [self::rmse(&run.beta, &run.beta_ref, n), self::rmse(&run.yaw_rate, &run.yaw_rate_ref, n)];
-        Metric { rmse, eps: norm(&rmse), rmse_state, eps_state: norm(&rmse_state) }
+        let max_delta = run.delta.iter().flatten().fold(0.0f64, |m, d| m.max(d.abs()));
+        Metric { rmse, eps: norm(&rmse), rmse_state, eps_state: norm(&rmse_state), max_delta }
     }
 }

@@ -38,6 +38,7 @@ pub fn color(c: Controller) -> RGBColor {
         Controller::PolePlacement => RGBColor(0, 114, 178),
         Controller::Robust => RGBColor(0, 158, 115),
         Controller::Custom(_) => RGBColor(120, 120, 120),
+        Controller::RobustTracking => RGBColor(204, 121, 167),
     }
 }
 
@@ -47,6 +48,7 @@ fn label(c: Controller) -> &'static str {
         Controller::PolePlacement => "non-robust (pole placement)",
         Controller::Robust => "robust",
         Controller::Custom(_) => "custom",
+        Controller::RobustTracking => "robust tracking (pose feedback)",
     }
 }
 
@@ -150,7 +152,7 @@ pub fn xy_figure(runs: &[Run], fidelity: Fidelity, path: &Path) -> Result<(), Er
     let root = BitMapBackend::new(path, (1800, 90 + 555 * rows as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(&err)?;
     let title = format!(
-        "Fig. 7 ({} column, seed {}): paths of the reference and the three controllers",
+        "Fig. 7 ({} column, seed {}): paths of the reference and the controllers",
         fidelity.column(),
         runs.first().map_or(0, |r| r.job.seed)
     );

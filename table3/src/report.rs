@@ -1,6 +1,8 @@
 //! The table as markdown (ours beside the paper's) and as the JSON of the contract:
-//! `{"seed", "gains": {"robust", "pole_placement"}, "results": {"sim"|"real": {maneuver:
-//! {controller: {"eps", "rmse": [x, y, psi], "eps_state"}}}}, "wall_s"}`.
+//! `{"seed", "gains": {"robust", "pole_placement", "robust_tracking"}, "results": {"sim"|"real":
+//! {maneuver: {controller: {"eps", "rmse": [x, y, psi], "eps_state", "max_delta"}}}}, "wall_s"}`.
+//! The paper's gains are 4x2 (columns beta, yaw_rate), `robust_tracking`'s `K_track` 4x4
+//! (columns e_y, e_psi, beta - beta_ref, yaw_rate - yaw_rate_ref); rows FL, FR, RL, RR.
 
 use std::fmt::Write;
 
@@ -8,8 +10,15 @@ use serde_json::{json, Map, Value};
 
 use crate::{paper, Controller, Table};
 
-fn gain_json(k: &[[f64; 2]; 4]) -> Value {
-    Value::Array(k.iter().map(|row| json!([row[0], row[1]])).collect())
+/// The gain as printed: the paper's controllers their `[beta, yaw_rate]` columns, the
+/// tracking controller all four.
+fn gain_columns(c: Controller, k: &[[f64; 4]; 4]) -> Vec<Vec<f64>> {
+    let from = if c.uses_pose() { 0 } else { 2 };
+    k.iter().map(|row| row[from..].to_vec()).collect()
+}
+
+fn gain_json(c: Controller, k: &[[f64; 4]; 4]) -> Value {
+    json!(gain_columns(c, k))
 }
 
 /// The JSON of the contract (keys sorted; numbers in shortest round-trip form).
@@ -25,7 +34,7 @@ pub fn json(table: &Table) -> Value {
 pub fn json_without_wall(table: &Table) -> Value {
     let mut gains = Map::new();
     for (c, k) in &table.gains {
-        gains.insert(c.name().into(), gain_json(k));
+        gains.insert(c.name().into(), gain_json(*c, k));
     }
     let mut results = Map::new();
     for f in table.fidelities() {
@@ -36,7 +45,12 @@ pub fn json_without_wall(table: &Table) -> Value {
                 let r = &cell.metric;
                 row.insert(
                     cell.controller.name().into(),
-                    json!({"eps": r.eps, "rmse": [r.rmse[0], r.rmse[1], r.rmse[2]], "eps_state": r.eps_state}),
+                    json!({
+                        "eps": r.eps,
+                        "rmse": [r.rmse[0], r.rmse[1], r.rmse[2]],
+                        "eps_state": r.eps_state,
+                        "max_delta": r.max_delta,
+                    }),
                 );
             }
             column.insert(m.name().into(), Value::Object(row));
@@ -52,6 +66,7 @@ fn heading(c: Controller) -> &'static str {
         Controller::PolePlacement => "non-robust",
         Controller::Robust => "robust",
         Controller::Custom(_) => "custom",
+        Controller::RobustTracking => "robust tracking",
     }
 }
 
@@ -65,6 +80,8 @@ pub fn sci(x: f64) -> String {
 pub fn markdown(table: &Table) -> String {
     let mut s = String::new();
     let controllers = table.controllers();
+    // the paper has only its three controllers
+    let paper: Vec<Controller> = controllers.iter().copied().filter(|c| Controller::TABLE.contains(c)).collect();
     let _ = writeln!(
         s,
         "Table III, seed {} ({}), epsilon = ||(RMSE_X, RMSE_Y, RMSE_psi)||_2 [m, m, rad]",
@@ -77,11 +94,11 @@ pub fn markdown(table: &Table) -> String {
             let _ = write!(s, "{} | ", heading(c));
         }
         let _ = write!(s, "lowest | ");
-        for &c in &controllers {
+        for &c in &paper {
             let _ = write!(s, "paper {} | ", heading(c));
         }
         let _ = writeln!(s, "paper lowest |");
-        let _ = writeln!(s, "|---|{}", "---:|".repeat(2 * controllers.len() + 2));
+        let _ = writeln!(s, "|---|{}", "---:|".repeat(controllers.len() + paper.len() + 2));
         for m in table.maneuvers() {
             let _ = write!(s, "| {} | ", m.name());
             let lowest = table.lowest(f, m);
@@ -98,7 +115,7 @@ pub fn markdown(table: &Table) -> String {
             }
             let _ = write!(s, "{} | ", lowest.map_or("-", heading));
             let mut paper_best: Option<(Controller, f64)> = None;
-            for &c in &controllers {
+            for &c in &paper {
                 match paper::epsilon(f, m, c) {
                     Some(e) => {
                         let _ = write!(s, "{} | ", sci(e));
@@ -142,10 +159,19 @@ pub fn markdown(table: &Table) -> String {
         }
         let _ = writeln!(s);
     }
+    let _ = write!(s, "Largest steering command |delta| over the runs [rad] (limit delta_max = pi/2 = 1.5708):");
+    for &c in &controllers {
+        let m = table.cells.iter().filter(|x| x.controller == c).fold(0.0f64, |m, x| m.max(x.metric.max_delta));
+        let _ = write!(s, " {} {m:.4};", c.name());
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(s);
     for (c, k) in &table.gains {
-        let _ = writeln!(s, "K {} (rows FL, FR, RL, RR; [k_beta, k_yaw_rate]):", c.name());
+        let columns = if c.uses_pose() { "[k_e_y, k_e_psi, k_beta, k_yaw_rate]" } else { "[k_beta, k_yaw_rate]" };
+        let _ = writeln!(s, "K {} (rows FL, FR, RL, RR; {columns}):", c.name());
         for (w, row) in ["FL", "FR", "RL", "RR"].iter().zip(k) {
-            let _ = writeln!(s, "  {w}: [{:+.6}, {:+.6}]", row[0], row[1]);
+            let text: Vec<String> = gain_columns(*c, &[*row; 4])[0].iter().map(|v| format!("{v:+.6}")).collect();
+            let _ = writeln!(s, "  {w}: [{}]", text.join(", "));
         }
     }
     let _ = writeln!(s, "{} runs in {:.3} s wall", table.cells.len(), table.wall_s);

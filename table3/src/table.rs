@@ -27,8 +27,9 @@ pub struct Table {
     pub seed: u64,
     /// What ran it ([`Engine::name`]).
     pub engine: String,
-    /// The gains the controllers used, read back from the runs (`pole_placement`, `robust`).
-    pub gains: Vec<(Controller, [[f64; 2]; 4])>,
+    /// The gains the controllers used, read back from the runs (`pole_placement`, `robust`,
+    /// `robust_tracking`; columns `[e_y, e_psi, beta, yaw_rate]`, see [`Run::gain`]).
+    pub gains: Vec<(Controller, [[f64; 4]; 4])>,
     /// The cells in the order column, maneuver, controller.
     pub cells: Vec<Cell>,
     /// Wall time of the whole table [s].
@@ -62,7 +63,7 @@ impl Table {
 
     /// The controllers present, in table order.
     pub fn controllers(&self) -> Vec<Controller> {
-        Controller::TABLE.into_iter().filter(|k| self.cells.iter().any(|c| c.controller == *k)).collect()
+        crate::CONTROLLERS.into_iter().filter(|k| self.cells.iter().any(|c| c.controller == *k)).collect()
     }
 }
 
@@ -77,7 +78,7 @@ pub struct Options {
     pub fidelities: Vec<Fidelity>,
     /// The rows (default all six).
     pub maneuvers: Vec<Maneuver>,
-    /// The controllers (default the three of Table III).
+    /// The controllers (default the paper's three and `robust_tracking`).
     pub controllers: Vec<Controller>,
     /// Keep every run's recorded series (for CSV and plots; about 4.3 MB a run).
     pub keep_runs: bool,
@@ -91,7 +92,7 @@ impl Options {
             threads: 0,
             fidelities: Fidelity::ALL.to_vec(),
             maneuvers: Maneuver::ALL.to_vec(),
-            controllers: Controller::TABLE.to_vec(),
+            controllers: crate::CONTROLLERS.to_vec(),
             keep_runs: false,
         }
     }
@@ -135,7 +136,7 @@ pub fn run_table_with(engine: &dyn Engine, options: &Options, done: &(dyn Fn(&Jo
         .build()
         .map_err(|e| Error::Usage(format!("cannot start {} worker threads: {e}", options.threads)))?;
     let jobs = options.jobs();
-    let results: Vec<(Cell, [[f64; 2]; 4], Option<Run>)> = pool.install(|| {
+    let results: Vec<(Cell, [[f64; 4]; 4], Option<Run>)> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
                 let run = engine.run(job)?;
@@ -151,7 +152,7 @@ pub fn run_table_with(engine: &dyn Engine, options: &Options, done: &(dyn Fn(&Jo
             })
             .collect::<Result<_, Error>>()
     })?;
-    let mut gains: Vec<(Controller, [[f64; 2]; 4])> = Vec::new();
+    let mut gains: Vec<(Controller, [[f64; 4]; 4])> = Vec::new();
     for (cell, gain, _) in &results {
         if cell.controller == Controller::OpenLoop {
             continue;
@@ -167,7 +168,7 @@ pub fn run_table_with(engine: &dyn Engine, options: &Options, done: &(dyn Fn(&Jo
             }
         }
     }
-    gains.sort_by_key(|(c, _)| Controller::TABLE.iter().position(|x| x == c));
+    gains.sort_by_key(|(c, _)| crate::CONTROLLERS.iter().position(|x| x == c));
     let mut cells = Vec::with_capacity(results.len());
     let mut runs = Vec::new();
     for (cell, _, run) in results {

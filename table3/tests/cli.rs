@@ -23,6 +23,22 @@ fn unknown_maneuver_is_a_clear_error() {
 }
 
 #[test]
+fn controllers_can_be_chosen_and_unknown_ones_are_a_clear_error() {
+    let o = table3(&["--engine", "in-process", "--controller", "lqr"]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("unknown controller \"lqr\"") && e.contains("robust_tracking"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("t.json");
+    let args = ["--engine", "in-process", "--maneuver", "straight", "--controller", "robust_tracking"];
+    let o = table3(&[&args[..], &["--controller", "open_loop", "--json", json.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = v["results"]["real"]["straight"].as_object().unwrap();
+    assert_eq!(row.keys().collect::<Vec<_>>(), ["open_loop", "robust_tracking"]);
+}
+
+#[test]
 fn unparsable_seed_is_a_clear_error() {
     for seed in ["abc", "-1", "1.5", "99999999999999999999999"] {
         let o = table3(&["--engine", "in-process", "--seed", seed]);
@@ -83,22 +99,28 @@ fn json_has_the_contract_shape_and_the_printed_numbers() {
     assert!(v["wall_s"].as_f64().unwrap() > 0.0);
     assert_eq!(v["gains"]["robust"][2][1].as_f64().unwrap(), nigel_benchmark::gains::ROBUST[2][1]);
     assert_eq!(v["gains"]["pole_placement"][0][0].as_f64().unwrap(), nigel_benchmark::gains::POLE_PLACEMENT[0][0]);
-    for k in ["robust", "pole_placement"] {
+    for (k, columns) in [("robust", 2), ("pole_placement", 2), ("robust_tracking", 4)] {
         let rows = v["gains"][k].as_array().unwrap();
         assert_eq!(rows.len(), 4);
-        assert!(rows.iter().all(|r| r.as_array().unwrap().len() == 2));
+        assert!(rows.iter().all(|r| r.as_array().unwrap().len() == columns), "{k}");
     }
+    assert_eq!(v["gains"]["robust_tracking"][0][0].as_f64().unwrap(), nigel_benchmark::gains::ROBUST_TRACKING[0][0]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     for column in ["sim", "real"] {
         let row = &v["results"][column]["lane_change"];
-        assert_eq!(row.as_object().unwrap().len(), 3);
-        for c in ["open_loop", "pole_placement", "robust"] {
+        assert_eq!(row.as_object().unwrap().len(), 4);
+        for c in ["open_loop", "pole_placement", "robust", "robust_tracking"] {
             let cell = &row[c];
             let eps = cell["eps"].as_f64().unwrap();
             let rmse: Vec<f64> = cell["rmse"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
             assert_eq!(rmse.len(), 3);
             assert!((eps - rmse.iter().map(|x| x * x).sum::<f64>().sqrt()).abs() <= 1e-15 * eps);
             assert!(cell["eps_state"].as_f64().unwrap() > 0.0);
+            let max_delta = cell["max_delta"].as_f64().unwrap();
+            assert!(max_delta > 0.0 && max_delta < std::f64::consts::FRAC_PI_2, "{c}: {max_delta}");
+            if c == "open_loop" {
+                assert_eq!(max_delta, std::f64::consts::PI / 6.0, "the program's amplitude");
+            }
             // the markdown prints the same number
             assert!(stdout.contains(&format!("{eps:.3e}")), "{eps:.3e} not in\n{stdout}");
         }
@@ -108,6 +130,33 @@ fn json_has_the_contract_shape_and_the_printed_numbers() {
         assert!(text.starts_with("t,x,y,psi,x_ref"));
     }
     assert!(v["results"]["sim"].get("skidpad").is_none());
+}
+
+#[test]
+fn seeds_study_prints_the_ratio_of_every_cell_and_seed() {
+    let o = table3(&["--engine", "in-process", "--maneuver", "straight", "--seeds", "2..3", "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("eps(robust_tracking) / eps(robust) per cell, seeds 2, 3"), "{out}");
+    assert!(out.contains("| sim | straight |") && out.contains("| real | straight |"), "{out}");
+    assert!(out.contains("in all 2 rows of all 2 seeds"), "{out}");
+    assert!(out.contains("Largest steering command") && out.contains("robust_tracking 0."), "{out}");
+    // the ratio printed is the one of the two tables run separately
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("t.json");
+    let args = ["--engine", "in-process", "--maneuver", "straight", "--seed", "3", "--json"];
+    let o = table3(&[&args[..], &[json.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let cell = |c: &str| v["results"]["sim"]["straight"][c]["eps"].as_f64().unwrap();
+    let ratio = format!(" {:.3} |", cell("robust_tracking") / cell("robust"));
+    let row = out.lines().find(|l| l.starts_with("| sim | straight |")).unwrap();
+    assert_eq!(row.split('|').nth(4).map(|x| format!("{x}|")), Some(ratio), "{row}");
+    for bad in ["9..2", "a..b", "5", "0..5000"] {
+        let o = table3(&["--engine", "in-process", "--seeds", bad]);
+        assert!(!o.status.success(), "{bad}");
+        assert!(stderr(&o).contains("--seeds"), "{bad}: {}", stderr(&o));
+    }
 }
 
 #[test]

@@ -55,6 +55,11 @@ fn self_check_24_cells_through_the_fmus() {
 }
 
 #[test]
+fn robust_tracking_is_lowest_in_all_12_rows_through_the_fmus() {
+    common::assert_tracking_lowest(table_seed0());
+}
+
+#[test]
 fn fmu_table_equals_the_in_process_table() {
     let fmu = table_seed0();
     let inp = run_table(&InProcess::new(), &Options::new(0)).unwrap().table;
@@ -68,7 +73,7 @@ fn fmu_table_equals_the_in_process_table() {
         // differences; 1e-11 leaves room over the 1e-12 seen
         assert!(rel <= 1e-11, "{:?} {} {}: {} vs {}", a.fidelity, a.maneuver, a.controller, a.metric.eps, b.metric.eps);
     }
-    eprintln!("FMU vs in-process: worst relative epsilon difference {worst:.2e} over 36 cells");
+    eprintln!("FMU vs in-process: worst relative epsilon difference {worst:.2e} over {} cells", fmu.cells.len());
 }
 
 #[test]
@@ -78,13 +83,14 @@ fn fmu_runs_follow_the_in_process_runs_sample_by_sample() {
         (Fidelity::Paper, Maneuver::Figure8, Controller::Robust),
         (Fidelity::Real, Maneuver::Slalom, Controller::PolePlacement),
         (Fidelity::Real, Maneuver::LaneChange, Controller::OpenLoop),
+        (Fidelity::Real, Maneuver::Skidpad, Controller::RobustTracking),
     ] {
         let job = Job::new(11, f, m, c);
         let (a, b) = (engine().run(&job).unwrap(), inp.run(&job).unwrap());
         let d = max_difference(&a, &b);
         eprintln!("{}: largest difference of any recorded series {d:.2e}", job.label());
         assert!(d <= 1e-11, "{}: {d}", job.label());
-        assert_eq!(a.gain, c.gain());
+        assert_eq!(a.gain, c.feedback_gain());
     }
 }
 
@@ -95,6 +101,7 @@ fn fmu_runs_equal_a_loop_on_the_masters_time_grid_bit_for_bit() {
     for (f, m, c) in [
         (Fidelity::Paper, Maneuver::Figure8, Controller::Robust),
         (Fidelity::Real, Maneuver::Slalom, Controller::PolePlacement),
+        (Fidelity::Paper, Maneuver::Figure8, Controller::RobustTracking),
     ] {
         let job = Job::new(11, f, m, c);
         let (a, b) = (engine().run(&job).unwrap(), replica::run_on_master_grid(&job));
@@ -110,7 +117,7 @@ fn undisturbed_straight_stays_on_the_reference_through_the_fmus() {
     // reference is computed inside the test bench on exact 1 ms steps): 1e-12 relative to
     // the 10.5 m driven.
     for f in Fidelity::ALL {
-        for c in Controller::TABLE {
+        for c in Controller::WITH_TRACKING {
             let job = Job { disturbed: false, ..Job::new(0, f, Maneuver::Straight, c) };
             let run = engine().run(&job).unwrap();
             let m = Metric::of(&run);
@@ -156,7 +163,8 @@ fn the_exported_ssp_runs_in_our_master_exactly_like_the_system_it_came_from() {
     let ssp = nigel_cosim::read_ssp(&path, &nigel_cosim::ImportOptions::default()).unwrap();
     assert_eq!(ssp.default_start_stop, (Some(0.0), Some(30.0)));
     assert_eq!(ssp.system.instances.len(), 3);
-    assert_eq!(ssp.system.connections.len(), 26);
+    // 26 of the paper's loop and the 6 pose inputs of the controller
+    assert_eq!(ssp.system.connections.len(), 32);
     let jacobi = FmuEngine::load_default().unwrap().with_algorithm(nigel_cosim::Algorithm::Jacobi);
     let from_ssp = jacobi.run_system(&ssp.system, &job).unwrap();
     let direct = jacobi.run(&job).unwrap();

@@ -20,15 +20,22 @@ fn self_check_24_cells() {
 }
 
 #[test]
+fn robust_tracking_is_lowest_in_all_12_rows() {
+    common::assert_tracking_lowest(table_seed0());
+}
+
+#[test]
 fn the_table_has_every_cell_and_the_baked_gains() {
     let t = table_seed0();
-    assert_eq!(t.cells.len(), 36);
+    assert_eq!(t.cells.len(), 48);
     assert_eq!(t.seed, 0);
+    let paper = |k: [[f64; 2]; 4]| k.map(|row| [0.0, 0.0, row[0], row[1]]);
     assert_eq!(
         t.gains,
         vec![
-            (Controller::PolePlacement, nigel_benchmark::gains::POLE_PLACEMENT),
-            (Controller::Robust, nigel_benchmark::gains::ROBUST)
+            (Controller::PolePlacement, paper(nigel_benchmark::gains::POLE_PLACEMENT)),
+            (Controller::Robust, paper(nigel_benchmark::gains::ROBUST)),
+            (Controller::RobustTracking, nigel_benchmark::gains::ROBUST_TRACKING),
         ]
     );
     for c in &t.cells {
@@ -45,6 +52,7 @@ fn metric_equals_nigel_benchmarks_own() {
     for (f, m, c) in [
         (Fidelity::Paper, Maneuver::Slalom, Controller::Robust),
         (Fidelity::Real, Maneuver::Figure8, Controller::PolePlacement),
+        (Fidelity::Real, Maneuver::Fishhook, Controller::RobustTracking),
     ] {
         let run = InProcess::new().run(&Job::new(3, f, m, c)).unwrap();
         let ours = Metric::of(&run);
@@ -69,7 +77,7 @@ fn metric_equals_nigel_benchmarks_own() {
 fn undisturbed_straight_stays_on_the_reference() {
     let engine = InProcess::new();
     for f in Fidelity::ALL {
-        for c in Controller::TABLE {
+        for c in Controller::WITH_TRACKING {
             let job = Job { disturbed: false, ..Job::new(0, f, Maneuver::Straight, c) };
             let run = engine.run(&job).unwrap();
             let m = Metric::of(&run);

@@ -70,3 +70,49 @@ def test_wrong_guid_is_refused(model_identifier, tmp_path):
                       modelIdentifier=model_identifier_cs, instanceName="wrong")
     with pytest.raises(Exception):
         slave.instantiate()
+
+
+@pytest.mark.parametrize("model_identifier", IDS)
+def test_no_enumeration_variables(model_identifier):
+    """libcosim and ecos do not see FMI 2.0 Enumeration variables: every switch of our FMUs is
+    a plain Integer with declared min/max and its values listed in its description."""
+    md = read_model_description(str(FMU_DIR / entry_for(model_identifier)["fmu"]))
+    assert md.typeDefinitions == [] or all(t.type != "Enumeration" for t in md.typeDefinitions)
+    for v in md.modelVariables:
+        assert v.type != "Enumeration", v.name
+        if v.type == "Integer" and v.causality == "parameter" and v.name != "seed":
+            assert v.min is not None and v.max is not None, v.name
+            for k in range(int(v.min), int(v.max) + 1):
+                assert f"{k} " in (v.description or ""), f"{v.name}: value {k} not described"
+
+
+def test_closed_loop_ssp_binds_only_what_every_importer_applies():
+    """The bindings of target/ssp/nigel_closed_loop.ssp (written by build-fmu) are what libcosim,
+    ecos and our master all apply: parameters or inputs (libcosim drops a binding of anything
+    else), of the variable's own type (no Enumeration), in one ParameterSet name shared by every
+    component (ecos applies the sets of the one name given to init)."""
+    import shutil
+    from fmpy.ssp.ssd import find_components, read_ssd
+
+    ssp = TARGET / "ssp" / "nigel_closed_loop.ssp"
+    ssd = read_ssd(str(ssp))
+    names = set()
+    bound = {}
+    unzipped = extract(str(ssp))
+    try:
+        for c in find_components(ssd.system):
+            md = read_model_description(os.path.join(unzipped, c.source))
+            variables = {v.name: v for v in md.modelVariables}
+            for binding in c.parameterBindings:
+                for values in binding.parameterValues:
+                    names.add(values.name)
+                    for p in values.parameters:
+                        v = variables[p.name]
+                        assert v.causality in ("parameter", "input"), (c.name, p.name, v.causality)
+                        assert p.type == v.type, (c.name, p.name, p.type, v.type)
+                        bound[f"{c.name}.{p.name}"] = p.value
+    finally:
+        shutil.rmtree(unzipped, ignore_errors=True)
+    assert names == {"initialValues"}
+    assert float(bound["plant.v_x_start"]) == 0.35
+    assert int(bound["maneuver.maneuver"]) == 2 and int(bound["controller.controller"]) == 3

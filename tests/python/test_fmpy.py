@@ -283,12 +283,12 @@ def runs(fmu_path):
     out += [f"force_lat_{w}" for w in WHEELS] + [f"delta_applied_{w}" for w in WHEELS]
     cs = simulate_fmu(
         fmu_path, fmi_type="CoSimulation", start_time=0.0, stop_time=STOP, step_size=DT,
-        output_interval=DT, start_values={"v_x": V0}, input=signal, output=out,
+        output_interval=DT, start_values={"v_x_start": V0}, input=signal, output=out,
     )
     me = simulate_fmu(
         fmu_path, fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
         start_time=0.0, stop_time=STOP, output_interval=DT, record_events=True,
-        start_values={"v_x": V0}, input=signal, output=out,
+        start_values={"v_x_start": V0}, input=signal, output=out,
     )
     ref = Reference().simulate([0.0, 0.0, 0.0, V0, 0.0, 0.0])
     return cs, me, reference_table(ref)
@@ -332,8 +332,11 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
     units = ["m", "m", "rad", "m/s", "m/s", "rad/s", "rad", "rad", "rad", "rad"]
     der_units = ["m/s", "m/s", "rad/s", "m/s2", "m/s2", "rad/s2", "rad/s", "rad/s", "rad/s", "rad/s"]
     for i, name in enumerate(BODY_STATES + SERVO_STATES):
-        expected[name] = (i, "Real", "output" if i < 6 else "local", units[i], 0.0)
+        # the body states are calculated from the parameters *_start (no start value of their own)
+        expected[name] = (i, "Real", "output" if i < 6 else "local", units[i], None if i < 6 else 0.0)
         expected[f"der({name})"] = (10 + i, "Real", "local", der_units[i], None)
+    for i, name in enumerate(BODY_STATES):
+        expected[f"{name}_start"] = (60 + i, "Real", "parameter", units[i], 0.0)
     expected["beta"] = (40, "Real", "output", "rad", None)
     expected["speed"] = (41, "Real", "output", "m/s", None)
     expected["lateral_accel"] = (42, "Real", "output", "m/s2", None)
@@ -371,6 +374,7 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
     assert got["mu_fl"].max is not None and float(got["mu_fl"].max) == 3.0, "a physical maximum of friction"
     for i, name in enumerate(BODY_STATES + SERVO_STATES):
         assert got[f"der({name})"].derivative is got[name]
+        assert got[name].initial == ("calculated" if i < 6 else "exact"), name
     assert [d.variable.name for d in md.derivatives] == [f"der({n})" for n in BODY_STATES + SERVO_STATES]
     assert [o.variable.name for o in md.outputs] == [n for n, e in expected.items() if e[2] == "output"]
     assert md.numberOfContinuousStates == 10 and md.numberOfEventIndicators == 0
@@ -523,7 +527,7 @@ def test_fmu_state_get_set_and_serialize(md, unzipdir, vr):
         return np.array(rows)
 
     # the steering servo on in "a" only: parameters must travel in the state as well
-    a = initialized_slave(md, unzipdir, vr, "a", start={"v_x": V0}, switches=["steering_servo"])
+    a = initialized_slave(md, unzipdir, vr, "a", start={"v_x_start": V0}, switches=["steering_servo"])
     b = None
     try:
         a.setReal(steer, [0.2, 0.2, -0.2, -0.2])
@@ -706,7 +710,7 @@ def test_wrong_guid_is_refused(md, unzipdir, capsys):
 
 
 def test_do_step_after_terminate_is_refused(md, unzipdir, vr):
-    fmu = initialized_slave(md, unzipdir, vr, "terminated", start={"v_x": V0})
+    fmu = initialized_slave(md, unzipdir, vr, "terminated", start={"v_x_start": V0})
     try:
         fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=DT)
         fmu.terminate()
@@ -718,7 +722,7 @@ def test_do_step_after_terminate_is_refused(md, unzipdir, vr):
 
 
 def test_nan_input_is_refused(md, unzipdir, vr):
-    fmu = initialized_slave(md, unzipdir, vr, "nan", start={"v_x": V0})
+    fmu = initialized_slave(md, unzipdir, vr, "nan", start={"v_x_start": V0})
     try:
         fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=DT)
         fmu.setReal([vr["delta_fl"]], [0.1])
@@ -754,7 +758,7 @@ SSD = """<?xml version="1.0" encoding="UTF-8"?>
         <ssd:ParameterValues>
           <ssv:ParameterSet version="1.0" name="start">
             <ssv:Parameters>
-              <ssv:Parameter name="plant.v_x"><ssv:Real value="0.35"/></ssv:Parameter>
+              <ssv:Parameter name="plant.v_x_start"><ssv:Real value="0.35"/></ssv:Parameter>
               <ssv:Parameter name="plant.mu_rr"><ssv:Real value="0.3"/></ssv:Parameter>
               <ssv:Parameter name="plant.I_z"><ssv:Real value="0.025"/></ssv:Parameter>
             </ssv:Parameters>
@@ -782,7 +786,7 @@ SSD = """<?xml version="1.0" encoding="UTF-8"?>
 
 def test_ssp_with_the_plant_matches_the_direct_cs_run(fmu_path, tmp_path):
     """A one-component SSP (the plant as a CS FMU; two steering signals from system inputs;
-    a state start (v_x), an input start (mu_rr) and a parameter (I_z) from the SSD's
+    a parameter of the initial state (v_x_start), an input start (mu_rr) and a parameter (I_z) from the SSD's
     ParameterValues) through
     fmpy.ssp.simulation.simulate_ssp, against simulate_fmu on the same FMU.
 
@@ -811,7 +815,7 @@ def test_ssp_with_the_plant_matches_the_direct_cs_run(fmu_path, tmp_path):
     (binding,) = ssd.system.parameterBindings
     (parameter_set,) = binding.parameterValues
     assert [(p.name, float(p.value)) for p in parameter_set.parameters] == [
-        ("plant.v_x", 0.35), ("plant.mu_rr", 0.3), ("plant.I_z", 0.025)]
+        ("plant.v_x_start", 0.35), ("plant.mu_rr", 0.3), ("plant.I_z", 0.025)]
 
     t_on = 0.5  # the system input switches at 0.5 s (threshold half a step early: fmpy sums time += step)
     stop = 1.0
@@ -832,7 +836,7 @@ def test_ssp_with_the_plant_matches_the_direct_cs_run(fmu_path, tmp_path):
     def direct_run(t_switch):
         return simulate_fmu(
             fmu_path, fmi_type="CoSimulation", start_time=0.0, stop_time=stop + 2 * DT, step_size=DT,
-            output_interval=DT, start_values={"v_x": 0.35, "I_z": 0.025},
+            output_interval=DT, start_values={"v_x_start": 0.35, "I_z": 0.025},
             input=fmpy_input_signal([(t_switch, steer)], stop + 2 * DT, base=fmu_defaults), output=outputs,
         )
 
@@ -845,11 +849,11 @@ def test_ssp_with_the_plant_matches_the_direct_cs_run(fmu_path, tmp_path):
     # can change the FMU's number of internal RK4 sub-steps; the effect is ~1e-12
     assert max(diff.values()) <= 1e-9, diff
     assert abs(ssp_cols["yaw_rate"][-1]) > 0.3  # the steering went through the connections
-    assert abs(ssp_cols["v_x"][0] - 0.35) < 1e-3  # v_x = 0.35 from the ParameterValues
+    assert abs(ssp_cols["v_x"][0] - 0.35) < 1e-3  # v_x_start = 0.35 from the ParameterValues
     # mu_rr and I_z from the ParameterValues matter: the run with the FMU's defaults differs
     plain = simulate_fmu(
         fmu_path, fmi_type="CoSimulation", start_time=0.0, stop_time=stop + 2 * DT, step_size=DT,
-        output_interval=DT, start_values={"v_x": 0.35},
+        output_interval=DT, start_values={"v_x_start": 0.35},
         input=fmpy_input_signal([(t_on + DT, steer)], stop + 2 * DT, base=dict(fmu_defaults, mu_rr=0.4)),
         output=outputs,
     )

@@ -63,7 +63,7 @@ fn world_wind_on_a_car_turning_in_place_is_the_body_wind_rotated_at_every_stage(
     values.extend(tau);
     values.extend([wind.0, wind.1]);
     assert_eq!(i.set_real(&inputs, &values), OK);
-    assert_eq!(i.set_real(&vrs(&["yaw_rate"]), &[3.0]), OK);
+    assert_eq!(i.set_real(&vrs(&["yaw_rate_start"]), &[3.0]), OK);
     i.initialize();
 
     let mut u = Inputs::<f64>::coasting(0.4);
@@ -108,7 +108,7 @@ fn coasting_never_gains_energy_at_the_highest_friction_even_with_a_long_substep_
     for (mu, substep_max) in [(3.0, 1e-2), (1.0, 2e-3), (3.0, 5e-4), (0.4, 1e-2)] {
         let (i, log) = fmu().instantiate("coast", CO_SIMULATION, fmu().guid());
         let i = i.unwrap();
-        let names = ["mu_fl", "mu_fr", "mu_rl", "mu_rr", "v_x", "v_y", "yaw_rate", "cs_substep_max"];
+        let names = ["mu_fl", "mu_fr", "mu_rl", "mu_rr", "v_x_start", "v_y_start", "yaw_rate_start", "cs_substep_max"];
         assert_eq!(i.set_real(&vrs(&names), &[mu, mu, mu, mu, 0.0, 0.015, 0.3, substep_max]), OK);
         i.initialize();
         let mut energy = kinetic_energy(&i);
@@ -205,7 +205,7 @@ fn hostile_serialized_states_are_refused_like_the_setters_would() {
 fn directional_derivatives_never_hand_out_non_finite_numbers() {
     let (i, log) = fmu().instantiate("dd", CO_SIMULATION, fmu().guid());
     let i = i.unwrap();
-    assert_eq!(i.set_real(&vrs(&["v_x"]), &[0.3]), OK);
+    assert_eq!(i.set_real(&vrs(&["v_x_start"]), &[0.3]), OK);
     i.initialize();
     let f = i.f();
     let (unknown, known) = (fmu().vr("der(v_y)"), fmu().vr("v_y"));
@@ -261,4 +261,114 @@ fn the_stable_substep_keeps_coasting_dissipative_over_random_vehicles() {
         cases += 1;
     }
     assert_eq!(cases, 300);
+}
+
+/// The initial body state is given by the fixed parameters `x_start .. yaw_rate_start` (a
+/// binding of an SSP applies to parameters and inputs only, in libcosim); the states are
+/// outputs with `initial="calculated"`: not settable before initialization, equal to their
+/// `*_start` from instantiation on, free to move after it, restored from a saved FMU state
+/// (not from the start parameters).
+#[test]
+fn initial_state_comes_from_the_start_parameters() {
+    use model_description::{Initial, VariableType};
+    let md = &fmu().description;
+    let starts: Vec<String> = BODY.iter().map(|n| format!("{n}_start")).collect();
+    for (state, start) in BODY.iter().zip(&starts) {
+        let s = md.variable(state).unwrap();
+        assert_eq!((s.causality, s.initial), (Causality::Output, Some(Initial::Calculated)), "{state}");
+        assert!(matches!(s.variable_type, VariableType::Real { start: None, .. }), "{state} has no start value");
+        let p = md.variable(start).unwrap();
+        assert_eq!((p.causality, p.initial), (Causality::Parameter, Some(Initial::Exact)), "{start}");
+        assert!(matches!(p.variable_type, VariableType::Real { start: Some(0.0), .. }), "{start} starts at 0");
+        assert_eq!(p.variable_type.unit(), s.variable_type.unit(), "{start} has the unit of {state}");
+    }
+    let values = [1.5, -2.0, 0.3, 0.35, 0.01, -0.2];
+    let starts: Vec<&str> = starts.iter().map(String::as_str).collect();
+    let (i, log) = fmu().instantiate("starts", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    // the state itself is calculated: refused, naming it
+    assert_eq!(i.set_real(&vrs(&["v_x"]), &[0.35]), ERROR);
+    assert!(log.last_error().unwrap().contains("v_x"), "{:?}", log.last_error());
+    assert_eq!(i.reset(), OK);
+    assert_eq!(i.set_real(&vrs(&starts), &values), OK);
+    assert_eq!(i.setup(0.0), OK);
+    assert_eq!(i.enter_init(), OK);
+    assert_eq!(i.get_real(&vrs(&BODY)).unwrap(), values, "during initialization");
+    assert_eq!(i.exit_init(), OK);
+    assert_eq!(i.get_real(&vrs(&BODY)).unwrap(), values, "after initialization");
+    // the dynamics from there are the model's from that state, unchanged
+    let p = VehicleParams::table2();
+    let u = Inputs::coasting(0.4);
+    let mut s: State<f64> = [0.0; N_STATES];
+    s[..6].copy_from_slice(&values);
+    for k in 0..100 {
+        assert_eq!(i.do_step(k as f64 * 1e-3, 1e-3), OK);
+        let h = fmu_plant_substep(&p, &u);
+        s = nigel_vehicle::integrate(&p, &s, &u, 1e-3, h);
+    }
+    let body = i.get_real(&vrs(&BODY)).unwrap();
+    assert_eq!(body, s[..6].to_vec(), "the plant's own RK4 from the start state, bit for bit");
+    assert_eq!(i.get_real(&vrs(&starts)).unwrap(), values, "the start parameters stay");
+    // a saved FMU state restores the states, not the start values
+    let f = i.f();
+    let mut saved: *mut c_void = null_mut();
+    unsafe { assert_eq!((f.get_fmu_state)(i.c, &mut saved), OK) };
+    assert_eq!(i.do_step(0.1, 1e-3), OK);
+    unsafe { assert_eq!((f.set_fmu_state)(i.c, saved), OK) };
+    assert_eq!(i.get_real(&vrs(&BODY)).unwrap(), body);
+    let bytes = unsafe {
+        let mut size = 0;
+        assert_eq!((f.serialized_fmu_state_size)(i.c, saved, &mut size), OK);
+        let mut b = vec![0u8; size];
+        assert_eq!((f.serialize_fmu_state)(i.c, saved, b.as_mut_ptr() as *mut c_char, size), OK);
+        assert_eq!((f.free_fmu_state)(i.c, &mut saved), OK);
+        b
+    };
+    let (j, log) = fmu().instantiate("restored", CO_SIMULATION, fmu().guid());
+    let j = j.unwrap();
+    j.initialize();
+    let mut restored: *mut c_void = null_mut();
+    unsafe {
+        assert_eq!((f.deserialize_fmu_state)(j.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut restored), OK);
+        assert_eq!((f.set_fmu_state)(j.c, restored), OK);
+        assert_eq!((f.free_fmu_state)(j.c, &mut restored), OK);
+    }
+    assert_eq!(j.get_real(&vrs(&BODY)).unwrap(), body, "restored into a fresh instance");
+    assert_eq!(j.get_real(&vrs(&starts)).unwrap(), values);
+    // a fixed parameter after initialization: refused, naming it
+    assert_eq!(j.set_real(&vrs(&["v_x_start"]), &[1.0]), ERROR);
+    assert!(log.last_error().unwrap().contains("v_x_start"), "{:?}", log.last_error());
+}
+
+fn fmu_plant_substep(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
+    nigel_plant::DEFAULT_CS_SUBSTEP_MAX.min(stable_rk4_step(p, u))
+}
+
+/// The InitialUnknowns depend only on what is known at initialization (FMI 2.0 section
+/// 2.2.8: inputs and variables with initial="exact"): the calculated body states on their
+/// `*_start` parameters, not on themselves; the derivatives not on the calculated states.
+#[test]
+fn initial_unknowns_depend_only_on_initialization_knowns() {
+    let md = &fmu().description;
+    let var = |index: u32| &md.model_variables[index as usize - 1];
+    let index_of = |name: &str| md.model_variables.iter().position(|v| v.name == name).unwrap() as u32 + 1;
+    assert!(!md.model_structure.initial_unknowns.is_empty());
+    for u in &md.model_structure.initial_unknowns {
+        let deps = u.dependencies.as_ref().expect("declared dependencies");
+        for &d in deps {
+            let k = var(d);
+            assert!(
+                k.causality == Causality::Input || k.effective_initial() == Some(model_description::Initial::Exact),
+                "{} depends on {} at initialization",
+                var(u.index).name,
+                k.name
+            );
+        }
+    }
+    for state in BODY {
+        let u = md.model_structure.initial_unknowns.iter().find(|u| u.index == index_of(state)).unwrap();
+        let deps = u.dependencies.as_ref().unwrap();
+        assert!(deps.contains(&index_of(&format!("{state}_start"))), "{state}");
+        assert!(!deps.contains(&index_of(state)), "{state} on itself");
+    }
 }

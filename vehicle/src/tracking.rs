@@ -121,17 +121,26 @@ fn angle_difference<T: Scalar>(a: T, b: T) -> T {
     }
 }
 
+/// The pose errors `(e_x, e_y, e_psi)` of a car at `(x, y, psi)` relative to a reference
+/// pose `(x_ref, y_ref, psi_ref)` (world frame, headings unwrapped or not): along-track and
+/// lateral error in the reference's frame, heading error wrapped to `(-pi, pi]` (see the
+/// module documentation). What the sampled controller computes from its pose inputs.
+pub fn pose_errors<T: Scalar>(x: T, y: T, psi: T, x_ref: T, y_ref: T, psi_ref: T) -> (T, T, T) {
+    let (sr, cr) = (psi_ref.sin(), psi_ref.cos());
+    let (dx, dy) = (x - x_ref, y - y_ref);
+    (cr * dx + sr * dy, cr * dy - sr * dx, angle_difference(psi, psi_ref))
+}
+
 /// The errors of `car` relative to `reference` (plant state vectors, [`crate::State`]).
 pub fn tracking_errors<T: Scalar>(car: &State<T>, reference: &State<T>) -> TrackingErrors<T> {
-    let (sr, cr) = (reference[idx::PSI].sin(), reference[idx::PSI].cos());
-    let dx = car[idx::X] - reference[idx::X];
-    let dy = car[idx::Y] - reference[idx::Y];
+    let (along, lateral, heading) =
+        pose_errors(car[idx::X], car[idx::Y], car[idx::PSI], reference[idx::X], reference[idx::Y], reference[idx::PSI]);
     let beta = car[idx::V_Y].atan2(car[idx::V_X]);
     let beta_ref = reference[idx::V_Y].atan2(reference[idx::V_X]);
     TrackingErrors {
-        along: cr * dx + sr * dy,
-        lateral: cr * dy - sr * dx,
-        heading: angle_difference(car[idx::PSI], reference[idx::PSI]),
+        along,
+        lateral,
+        heading,
         sideslip: beta - beta_ref,
         yaw_rate: car[idx::YAW_RATE] - reference[idx::YAW_RATE],
     }

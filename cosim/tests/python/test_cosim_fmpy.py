@@ -4,7 +4,7 @@ import subprocess
 import numpy as np
 from fmpy import simulate_fmu
 
-START = {"v_x": 0.35, "delta_fl": 0.2, "delta_fr": 0.2, "mu_rl": 0.3, "wind_side": 0.05, "tau_rl": 0.01}
+START = {"v_x_start": 0.35, "delta_fl": 0.2, "delta_fr": 0.2, "mu_rl": 0.3, "wind_side": 0.05, "tau_rl": 0.01}
 
 
 def run_cosim(cosim, fmu, out, *extra):
@@ -31,10 +31,10 @@ def test_single_fmu_co_simulation_equals_fmpy(cosim, plant_fmu, tmp_path):
 
 def test_ordered_equals_jacobi_for_one_fmu_and_csv_format(cosim, plant_fmu, tmp_path):
     a = run_cosim(cosim, plant_fmu, tmp_path / "a.csv", "--stop-time", "0.1", "--step", "1e-3",
-                  "--algorithm", "ordered", "--set", "v_x=0.3", "--record", "v_x", "--record", "x",
+                  "--algorithm", "ordered", "--set", "v_x_start=0.3", "--record", "v_x", "--record", "x",
                   "--output-interval", "0.01")
     b = run_cosim(cosim, plant_fmu, tmp_path / "b.csv", "--stop-time", "0.1", "--step", "1e-3",
-                  "--algorithm", "jacobi", "--set", "v_x=0.3", "--record", "v_x", "--record", "x",
+                  "--algorithm", "jacobi", "--set", "v_x_start=0.3", "--record", "v_x", "--record", "x",
                   "--output-interval", "0.01")
     assert a.dtype.names == ("time", "v_x", "x")
     assert len(a) == 11

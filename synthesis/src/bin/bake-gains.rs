@@ -5,10 +5,13 @@
 //! cargo run --release -p nigel-synthesis --bin bake-gains            # rewrite benchmark/src/gains.rs
 //! cargo run --release -p nigel-synthesis --bin bake-gains -- OUT.rs  # write elsewhere
 //! ```
-//! Baked: the robust gain (paper variant, 4WD4WS, the Pareto point nearest the origin)
-//! and the pole-placement baseline (`Re(s) < -2` at `mu_i = 0.4`, same polytope). The test
-//! `synthesis/tests/baked_gains.rs` re-runs the synthesis and fails if the committed file
-//! differs from it by more than 1e-9, so the file cannot drift from the synthesis.
+//! Baked: the robust gain (paper variant, 4WD4WS, the Pareto point nearest the origin),
+//! the pole-placement baseline (`Re(s) < -2` at `mu_i = 0.4`, same polytope) and the robust
+//! tracking gain `K_track` (issue 9: [`nigel_synthesis::tracking::design_tracking`] with the
+//! default design and region). The tests `synthesis/tests/baked_gains.rs` (the paper's two)
+//! and `synthesis/tests/tracking.rs` (`K_track`, reusing the design that file verifies)
+//! re-run the synthesis and fail if the committed file differs from it by more than 1e-9,
+//! so the file cannot drift from the synthesis.
 //!
 //! Exit codes: 0 written, 1 synthesis failed, 2 bad command line or I/O error.
 
@@ -16,8 +19,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use nalgebra::DMatrix;
+use nigel_synthesis::tracking::{design_tracking, tracking_region};
 use nigel_synthesis::{
     pareto_sweep, pole_placement_baseline, Architecture, PlantSpec, PoleRegion, SweepOptions, SynthesisOptions,
+    TrackingSpec, VerifyOptions,
 };
 
 fn rows(k: &DMatrix<f64>) -> Result<[[f64; 2]; 4], String> {
@@ -38,6 +43,16 @@ fn matrix_literal(k: &[[f64; 2]; 4]) -> String {
     s
 }
 
+fn tracking_literal(k: &[[f64; 4]; 4]) -> String {
+    let wheel = ["FL", "FR", "RL", "RR"];
+    let mut s = String::from("[\n");
+    for (row, name) in k.iter().zip(wheel) {
+        s.push_str(&format!("    [{:?}, {:?}, {:?}, {:?}], // {name}\n", row[0], row[1], row[2], row[3]));
+    }
+    s.push(']');
+    s
+}
+
 fn generate() -> Result<String, String> {
     let spec = PlantSpec::paper(Architecture::FourWheelSteering);
     let poly = spec.polytope().map_err(|e| e.to_string())?;
@@ -50,6 +65,13 @@ fn generate() -> Result<String, String> {
     let baseline = pole_placement_baseline(&poly, 0.4, -2.0, &opts).map_err(|e| format!("baseline: {e}"))?;
     let pole = rows(&baseline.design.gain)?;
     let nu = chosen.nu().unwrap_or(f64::NAN);
+    let tracking =
+        design_tracking(&TrackingSpec::default_design(), &tracking_region(), &opts, &VerifyOptions::default(), 0, None)
+            .map_err(|e| format!("tracking design: {e}"))?;
+    if !tracking.verification.passed() {
+        return Err("the tracking design failed its verification".into());
+    }
+    let tracking_point = tracking.sweep.chosen_point();
     Ok(format!(
         "//! Controller gains baked from the robust synthesis. GENERATED, do not edit: regenerate with\n\
          //! `cargo run --release -p nigel-synthesis --bin bake-gains`\n\
@@ -64,7 +86,15 @@ fn generate() -> Result<String, String> {
          /// Non-robust baseline: pole placement `Re(s) < {alpha:?}` on the nominal model `mu_i = {mu:?}` (same\n\
          /// plant as `ROBUST`); stabilises all 16 friction vertices: {stab}\n\
          /// (largest closed-loop real part over them {re:?}).\n\
-         pub const POLE_PLACEMENT: [[f64; 2]; 4] = {pole};\n",
+         pub const POLE_PLACEMENT: [[f64; 2]; 4] = {pole};\n\n\
+         /// Robust tracking gain `K_track` (issue 9): mixed H2/H-inf with D-stability on the tracking\n\
+         /// error model (Table II, physical disturbance column, v = 0.35 m/s, mu in [0.1, 1.0]),\n\
+         /// weights z = [50 e_y; 10 e_psi; 10 u], region Re(s) < -0.5 and the 135-degree sector;\n\
+         /// Pareto point k = {tk}, H-inf bound g = {tg:?}, H2 bound nu = {tnu:?}\n\
+         /// (gamma* = {tgs:?}); verified (poles, H-inf, H2).\n\
+         /// Convention: `delta = delta_ff + K_track e`, `e = [e_y, e_psi, beta - beta_ref, yaw_rate - yaw_rate_ref]`\n\
+         /// (`nigel_vehicle::tracking`), rows FL, FR, RL, RR.\n\
+         pub const ROBUST_TRACKING: [[f64; 4]; 4] = {track};\n",
         k = chosen.k,
         g = chosen.g,
         gs = sweep.gamma_star(),
@@ -74,6 +104,11 @@ fn generate() -> Result<String, String> {
         stab = baseline.stabilises_all_vertices,
         re = baseline.max_real_part_over_vertices,
         pole = matrix_literal(&pole),
+        tk = tracking_point.k,
+        tg = tracking.gamma,
+        tnu = tracking.nu,
+        tgs = tracking.sweep.gamma_star(),
+        track = tracking_literal(&tracking.k_track),
     ))
 }
 

@@ -2,6 +2,8 @@
 //! by the master (`ordered`, 1 ms, 30 s), or in process as a cross-check.
 //!
 //! `table3 [--seed N] [--json PATH] [--png DIR] [--csv DIR] [--threads N]`
+//! `table3 --seeds 0..9 [--engine in-process]`: the seed study of issue 9 (the ratio
+//! `eps(robust_tracking) / eps(robust)` per cell and seed, the largest steering command).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -11,7 +13,9 @@ use std::time::Instant;
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nigel_table3::engine::default_fmu_dir;
-use nigel_table3::{csv, plot, report, run_table_with, Engine, Error, FmuEngine, InProcess, Maneuver, Options};
+use nigel_table3::{
+    csv, plot, report, run_table_with, Controller, Engine, Error, FmuEngine, InProcess, Maneuver, Options,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum EngineKind {
@@ -34,6 +38,11 @@ struct Args {
     /// Noise seed (0 ..= 2147483647 for the FMU engine: the test bench's seed is an Integer).
     #[arg(long, default_value_t = 0, value_name = "N", allow_hyphen_values = true)]
     seed: u64,
+    /// Run the whole table for every seed of A..B (both included, e.g. 0..9) and print the
+    /// study: eps(robust_tracking) / eps(robust) per cell and seed, whether robust_tracking
+    /// is lowest everywhere, the largest steering command. Replaces --seed.
+    #[arg(long, value_name = "A..B", value_parser = parse_seeds, conflicts_with_all = ["seed", "json", "png", "csv", "bench", "ssp"])]
+    seeds: Option<(u64, u64)>,
     /// Write the table as JSON.
     #[arg(long, value_name = "PATH")]
     json: Option<PathBuf>,
@@ -49,6 +58,10 @@ struct Args {
     /// Only these maneuvers (repeat; default all six).
     #[arg(long = "maneuver", value_name = "NAME", value_parser = parse_maneuver)]
     maneuvers: Vec<Maneuver>,
+    /// Only these controllers (repeat; default all four: open_loop, pole_placement, robust,
+    /// robust_tracking).
+    #[arg(long = "controller", value_name = "NAME", value_parser = parse_controller)]
+    controllers: Vec<Controller>,
     /// What runs the closed loops.
     #[arg(long, value_enum, default_value_t = EngineKind::Fmu)]
     engine: EngineKind,
@@ -70,6 +83,26 @@ struct Args {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+fn parse_seeds(s: &str) -> Result<(u64, u64), String> {
+    let bad = || format!("{s:?} is not a seed range A..B (both included, e.g. 0..9)");
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u64, u64) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    if a > b {
+        return Err(format!("{s:?}: the first seed is after the last"));
+    }
+    if b - a >= 1000 {
+        return Err(format!("{s:?}: at most 1000 seeds"));
+    }
+    Ok((a, b))
+}
+
+fn parse_controller(s: &str) -> Result<Controller, String> {
+    nigel_table3::CONTROLLERS.into_iter().find(|c| c.name() == s).ok_or_else(|| {
+        let names: Vec<&str> = nigel_table3::CONTROLLERS.iter().map(|c| c.name()).collect();
+        format!("unknown controller {s:?} (one of {})", names.join(", "))
+    })
 }
 
 fn parse_maneuver(s: &str) -> Result<Maneuver, String> {
@@ -120,9 +153,15 @@ fn run(args: &Args) -> Result<(), Error> {
     if !args.maneuvers.is_empty() {
         options.maneuvers = Maneuver::ALL.into_iter().filter(|m| args.maneuvers.contains(m)).collect();
     }
+    if !args.controllers.is_empty() {
+        options.controllers = nigel_table3::CONTROLLERS.into_iter().filter(|c| args.controllers.contains(c)).collect();
+    }
     options.keep_runs = args.png.is_some() || args.csv.is_some();
     if let Some(repeats) = args.bench {
         return bench(engine.as_ref(), &options, repeats.max(1));
+    }
+    if let Some((first, last)) = args.seeds {
+        return study(engine.as_ref(), &options, first, last, args.quiet);
     }
     let jobs = options.jobs().len() as u64;
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
@@ -153,6 +192,23 @@ fn run(args: &Args) -> Result<(), Error> {
         let files = plot::write_all(&out.runs, dir)?;
         eprintln!("wrote {} PNG files into {} ({:.2} s)", files.len(), dir.display(), t.elapsed().as_secs_f64());
     }
+    Ok(())
+}
+
+fn study(engine: &dyn Engine, options: &Options, first: u64, last: u64, quiet: bool) -> Result<(), Error> {
+    let mut tables = Vec::new();
+    let t = Instant::now();
+    for seed in first..=last {
+        let out = nigel_table3::run_table(engine, &Options { seed, ..options.clone() })?;
+        if !quiet {
+            eprintln!("seed {seed}: {} runs, {:.1} s", out.table.cells.len(), out.table.wall_s);
+        }
+        tables.push(out.table);
+    }
+    let study = nigel_table3::Study::of(&tables)
+        .ok_or_else(|| Error::Usage("the study needs the robust and robust_tracking controllers".into()))?;
+    println!("{} ({:.1} s)", engine.name(), t.elapsed().as_secs_f64());
+    print!("{}", study.markdown());
     Ok(())
 }
 

@@ -2,6 +2,8 @@
 //! ABI by the `nigel_cosim` master and co-simulated with fixed 1 ms steps for 30 s
 //! (`ordered` by default: every output reaches its inputs at the same communication
 //! point along the direct-feedthrough chain plant -> test bench -> controller -> plant).
+//! The controller gets the pose too (plant `x, y, psi`, test bench `x_ref, y_ref,
+//! psi_ref`), for every controller; only `robust_tracking` reads it.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,8 +26,8 @@ pub struct FmuEngine {
     maneuver: Arc<Fmu>,
     maneuver_values: [i32; 6],
     fidelity_values: [i32; 2],
-    controller_values: [i32; 3],
-    gains: [[[f64; 2]; 4]; 3],
+    controller_values: [i32; 4],
+    gains: [[[f64; 4]; 4]; 4],
     /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
     /// connection by one step).
     pub algorithm: Algorithm,
@@ -47,89 +49,74 @@ fn load(path: &Path) -> Result<Arc<Fmu>, Error> {
     Fmu::load(path).map_err(|source| Error::Cosim { context: format!("loading {}", path.display()), source })
 }
 
-/// The items `(name, value)` of the enumeration type of variable `variable` of `fmu`, read
-/// from its `modelDescription.xml`.
-fn enumeration_items(fmu: &Fmu, variable: &str) -> Result<Vec<(String, i32)>, String> {
-    use quick_xml::events::Event;
-    let path = fmu.unpacked_dir().join("modelDescription.xml");
-    let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut reader = quick_xml::Reader::from_str(&xml);
-    let attr = |e: &quick_xml::events::BytesStart, key: &[u8]| -> Option<String> {
-        e.attributes()
-            .flatten()
-            .find(|a| a.key.as_ref() == key)
-            .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
-    };
-    let mut simple_type: Option<String> = None;
-    let mut scalar: Option<String> = None;
-    let mut declared: Option<String> = None;
-    let mut items: Vec<(String, String, i32)> = Vec::new();
-    loop {
-        match reader.read_event() {
-            Err(e) => return Err(format!("{}: {e}", path.display())),
-            Ok(Event::Eof) => break,
-            Ok(Event::Start(e)) | Ok(Event::Empty(e)) => match e.name().as_ref() {
-                b"SimpleType" => simple_type = attr(&e, b"name"),
-                b"Item" => {
-                    let (Some(t), Some(n), Some(v)) = (&simple_type, attr(&e, b"name"), attr(&e, b"value")) else {
-                        continue;
-                    };
-                    let v = v.trim().parse::<i32>().map_err(|_| format!("item {n} of {t} has value {v:?}"))?;
-                    items.push((t.clone(), n, v));
-                }
-                b"ScalarVariable" => scalar = attr(&e, b"name"),
-                b"Enumeration" if scalar.as_deref() == Some(variable) => declared = attr(&e, b"declaredType"),
-                _ => {}
-            },
-            Ok(Event::End(e)) => match e.name().as_ref() {
-                b"SimpleType" => simple_type = None,
-                b"ScalarVariable" => scalar = None,
-                _ => {}
-            },
-            Ok(_) => {}
-        }
-    }
-    let declared = declared.ok_or_else(|| format!("no Enumeration variable {variable:?}"))?;
-    Ok(items.into_iter().filter(|(t, _, _)| *t == declared).map(|(_, n, v)| (n, v)).collect())
-}
-
-/// The value of each name of `names` in the enumeration of `variable`.
-fn enumeration_values<const N: usize>(
-    fmu: &Fmu,
-    file: &str,
-    variable: &str,
-    names: [&str; N],
-) -> Result<[i32; N], Error> {
+/// The value of each name of `names` for the switch `variable` of `fmu`.
+///
+/// Our FMUs declare their switches (`maneuver`, `fidelity`, `controller`) as plain Integer
+/// parameters whose values are the 1-based positions of `names` (the contract written in
+/// each variable's description and the FMU documentation): the declared `min`/`max` must
+/// cover them. An FMU that declares the switch as an Enumeration (our FMUs before the
+/// switches became Integers, or a user's own FMU) is read by item name instead.
+fn switch_values<const N: usize>(fmu: &Fmu, file: &str, variable: &str, names: [&str; N]) -> Result<[i32; N], Error> {
+    use model_description::VariableType;
     let bad = |reason: String| Error::BadRun { run: format!("{file}: {variable}"), reason };
-    let items = enumeration_items(fmu, variable).map_err(bad)?;
+    let md = fmu.description();
+    let v = md.variable(variable).ok_or_else(|| bad("no such variable".into()))?;
     let mut out = [0; N];
-    for (o, name) in out.iter_mut().zip(names) {
-        *o = items.iter().find(|(n, _)| n == name).map(|(_, v)| *v).ok_or_else(|| {
-            bad(format!("has no item {name:?} (items: {:?})", items.iter().map(|(n, _)| n).collect::<Vec<_>>()))
-        })?;
+    match &v.variable_type {
+        VariableType::Integer { min, max, .. } => {
+            let (lo, hi) = (min.unwrap_or(i32::MIN), max.unwrap_or(i32::MAX));
+            if lo > 1 || hi < N as i32 {
+                return Err(bad(format!(
+                    "declared in {lo} ..= {hi}, but the values of {names:?} are 1 ..= {N}: not the switch this \
+                     engine sets"
+                )));
+            }
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = k as i32 + 1;
+            }
+        }
+        VariableType::Enumeration { declared_type, .. } => {
+            let t = md
+                .type_definitions
+                .iter()
+                .find(|t| &t.name == declared_type)
+                .ok_or_else(|| bad(format!("enumeration type {declared_type:?} is not defined")))?;
+            for (o, name) in out.iter_mut().zip(names) {
+                *o = t.items.iter().find(|i| i.name == name).map(|i| i.value).ok_or_else(|| {
+                    bad(format!(
+                        "has no item {name:?} (items: {:?})",
+                        t.items.iter().map(|i| i.name.as_str()).collect::<Vec<_>>()
+                    ))
+                })?;
+            }
+        }
+        other => return Err(bad(format!("is a {}, not an Integer", other.type_name()))),
     }
     Ok(out)
 }
 
-/// The calculated parameters `gain_*` of the controller FMU with `controller = value`,
-/// read after initialization by the master (a run of zero steps).
-fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 2]; 4], Error> {
+/// The calculated parameters `gain_*` of the controller FMU with `controller = value`
+/// (columns `e_y, e_psi, beta, yaw_rate`), read after initialization by the master (a run
+/// of zero steps).
+fn controller_gain(fmu: &Arc<Fmu>, value: i32) -> Result<[[f64; 4]; 4], Error> {
     let ctx = |source| Error::Cosim { context: format!("reading the gains of {}", FMU_FILES[1]), source };
     let mut b = SystemBuilder::new();
     b.add_instance("controller", fmu.clone()).map_err(ctx)?;
     b.set("controller.controller", Value::Integer(value)).map_err(ctx)?;
-    let names: Vec<String> =
-        WHEELS.iter().flat_map(|w| ["beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}"))).collect();
+    let names: Vec<String> = WHEELS
+        .iter()
+        .flat_map(|w| ["e_y", "e_psi", "beta", "yaw_rate"].map(|c| format!("controller.gain_{c}_{w}")))
+        .collect();
     let experiment = Experiment { record: Some(names.clone()), ..Experiment::new(0.0, SAMPLE_PERIOD) };
     let (results, _) = simulate(&b.build(), &experiment).map_err(ctx)?;
-    let mut k = [[0.0; 2]; 4];
+    let mut k = [[0.0; 4]; 4];
     for (i, name) in names.iter().enumerate() {
         let bare = name.trim_start_matches("controller.");
         let v = results
             .column(bare)
             .and_then(|c| c.first().copied())
             .ok_or_else(|| Error::BadRun { run: FMU_FILES[1].into(), reason: format!("no value of {name}") })?;
-        k[i / 2][i % 2] = v;
+        k[i / 4][i % 4] = v;
     }
     Ok(k)
 }
@@ -149,14 +136,14 @@ impl FmuEngine {
         FmuEngine::load_dir(&default_fmu_dir())
     }
 
-    /// Loads the three archives and resolves the enumeration items it sets.
+    /// Loads the three archives and resolves the values of the switches it sets.
     pub fn load(plant: &Path, controller: &Path, maneuver: &Path) -> Result<FmuEngine, Error> {
         let (p, c, m) = (load(plant)?, load(controller)?, load(maneuver)?);
-        let maneuver_values = enumeration_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
-        let fidelity_values = enumeration_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
+        let maneuver_values = switch_values(&m, FMU_FILES[2], "maneuver", Maneuver::ALL.map(|x| x.name()))?;
+        let fidelity_values = switch_values(&m, FMU_FILES[2], "fidelity", Fidelity::ALL.map(|x| x.name()))?;
         let controller_values =
-            enumeration_values(&c, FMU_FILES[1], "controller", Controller::TABLE.map(|x| x.name()))?;
-        let mut gains = [[[0.0; 2]; 4]; 3];
+            switch_values(&c, FMU_FILES[1], "controller", Controller::WITH_TRACKING.map(|x| x.name()))?;
+        let mut gains = [[[0.0; 4]; 4]; 4];
         for (g, value) in gains.iter_mut().zip(controller_values) {
             *g = controller_gain(&c, value)?;
         }
@@ -172,9 +159,9 @@ impl FmuEngine {
         })
     }
 
-    /// The gain the controller FMU uses for each controller of Table III (its calculated
-    /// parameters `gain_beta_fl .. gain_yaw_rate_rr` after initialization).
-    pub fn gains(&self) -> [[[f64; 2]; 4]; 3] {
+    /// The gain the controller FMU uses for each controller of [`Controller::WITH_TRACKING`]
+    /// (its calculated parameters `gain_e_y_fl .. gain_yaw_rate_rr` after initialization).
+    pub fn gains(&self) -> [[[f64; 4]; 4]; 4] {
         self.gains
     }
 
@@ -188,9 +175,9 @@ impl FmuEngine {
     /// parameters and the closed-loop connections of the issue-6 contract.
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
-        let controller = Controller::TABLE.iter().position(|c| *c == job.controller).ok_or_else(|| {
+        let controller = Controller::WITH_TRACKING.iter().position(|c| *c == job.controller).ok_or_else(|| {
             Error::Usage(format!(
-                "the controller FMU runs open_loop, pole_placement and robust, not {}",
+                "the controller FMU runs open_loop, pole_placement, robust and robust_tracking, not {}",
                 job.controller
             ))
         })?;
@@ -216,7 +203,9 @@ impl FmuEngine {
         for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
             b.set(&format!("plant.{switch}"), Value::Boolean(real)).map_err(ctx)?;
         }
-        b.set("plant.v_x", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
+        // the initial speed is a parameter (the state v_x is calculated from it), so that
+        // every importer applies it from an SSP's parameter bindings
+        b.set("plant.v_x_start", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
         let mut connect = |from: &str, to: &str| b.connect(from, to).map(|_| ()).map_err(ctx);
         for w in WHEELS {
             connect(&format!("controller.delta_{w}"), &format!("plant.delta_{w}"))?;
@@ -234,6 +223,10 @@ impl FmuEngine {
         connect("maneuver.speed_ref", "controller.speed_ref")?;
         connect("plant.beta", "maneuver.beta")?;
         connect("plant.yaw_rate", "maneuver.yaw_rate")?;
+        for pose in ["x", "y", "psi"] {
+            connect(&format!("plant.{pose}"), &format!("controller.{pose}"))?;
+            connect(&format!("maneuver.{pose}_ref"), &format!("controller.{pose}_ref"))?;
+        }
         Ok(b.build())
     }
 
@@ -306,7 +299,7 @@ impl FmuEngine {
             let c: Vec<Vec<f64>> = WHEELS.iter().map(|w| col(&format!("{stem}_{w}"))).collect::<Result<_, _>>()?;
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
-        let gain = self.gains[index(&Controller::TABLE, &job.controller)];
+        let gain = self.gains[index(&Controller::WITH_TRACKING, &job.controller)];
         let run = Run {
             job: *job,
             gain,

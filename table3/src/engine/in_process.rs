@@ -66,7 +66,7 @@ impl Engine for InProcess {
         let n = t.n_samples();
         let run = Run {
             job: *job,
-            gain: job.controller.gain(),
+            gain: job.controller.feedback_gain(),
             x: t.x,
             y: t.y,
             psi: t.psi,

@@ -47,8 +47,10 @@ impl Job {
 pub struct Run {
     /// What ran.
     pub job: Job,
-    /// The gain the controller used (rows FL, FR, RL, RR; columns beta, yaw_rate).
-    pub gain: [[f64; 2]; 4],
+    /// The feedback gain the controller used (rows FL, FR, RL, RR; columns `[e_y, e_psi,
+    /// beta - beta_ref, yaw_rate - yaw_rate_ref]`; the pose columns are zero for the paper's
+    /// three controllers).
+    pub gain: [[f64; 4]; 4],
     /// World X of the car [m].
     pub x: Vec<f64>,
     /// World Y of the car [m].

@@ -45,3 +45,29 @@ pub fn assert_self_check(table: &Table) {
     }
     eprintln!("self-check: worst relative difference sim {:.2e}, real {:.2e}", worst[0], worst[1]);
 }
+
+/// Issue 9's goal on one table: `robust_tracking` has the lowest epsilon of the four
+/// controllers in all 12 rows, and its steering stays inside `delta_max`, like every run's.
+pub fn assert_tracking_lowest(table: &Table) {
+    let mut rows = 0;
+    for f in Fidelity::ALL {
+        for m in Maneuver::ALL {
+            let eps = |c| table.get(f, m, c).unwrap_or_else(|| panic!("no cell {f:?} {m} {c}")).metric.eps;
+            let tracking = eps(Controller::RobustTracking);
+            for c in Controller::TABLE {
+                assert!(tracking < eps(c), "{} {m}: robust_tracking {tracking} >= {c} {}", f.column(), eps(c));
+            }
+            assert_eq!(table.lowest(f, m), Some(Controller::RobustTracking));
+            eprintln!(
+                "{} {m}: eps(robust_tracking) / eps(robust) = {:.3}",
+                f.column(),
+                tracking / eps(Controller::Robust)
+            );
+            rows += 1;
+        }
+    }
+    assert_eq!(rows, 12);
+    for c in &table.cells {
+        assert!(c.metric.max_delta < core::f64::consts::FRAC_PI_2, "{c:?}");
+    }
+}

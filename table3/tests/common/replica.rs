@@ -4,7 +4,6 @@
 //! not over exactly 1 ms, with the plant FMU's sub-step rule. It explains the last bits
 //! between the FMU run and the in-process run.
 
-use nigel_benchmark::control::ControllerSettings;
 use nigel_benchmark::{Benchmark, ControllerInputs, SampledController, Scenario, SAMPLE_PERIOD};
 use nigel_table3::{Job, Run};
 use nigel_vehicle::dynamics::{idx, stable_rk4_step};
@@ -21,11 +20,11 @@ pub fn run_on_master_grid(job: &Job) -> Run {
     let d = scenario.disturbances();
     let r = &bench.reference.trajectory;
     let n = scenario.n_samples;
-    let mut controller = SampledController::new(ControllerSettings::with_gain(job.controller.gain())).unwrap();
+    let mut controller = SampledController::new(job.controller.settings()).unwrap();
     let mut s = straight_running(scenario.speed_ref);
     let mut run = Run {
         job: *job,
-        gain: job.controller.gain(),
+        gain: job.controller.feedback_gain(),
         x: vec![],
         y: vec![],
         psi: vec![],
@@ -59,6 +58,12 @@ pub fn run_on_master_grid(job: &Job) -> Run {
             yaw_rate_ref: r.yaw_rate[k],
             speed_ref: scenario.speed_ref,
             delta_ff: bench.program().steering(k),
+            x: s[idx::X],
+            y: s[idx::Y],
+            psi: s[idx::PSI],
+            x_ref: r.x[k],
+            y_ref: r.y[k],
+            psi_ref: r.psi[k],
         });
         let mut u = Inputs::<f64>::coasting(0.0);
         u.delta = out.delta;
