@@ -1,19 +1,26 @@
-//! `cargo bench -p nigel-cosim`: the master's speed.
+//! `cargo bench -p nigel-cosim`: the master's speed (best of 5 runs each).
 //!
-//! 1. the plant alone, 30 s at 1 ms, through the master (CS, jacobi), recording nothing
-//!    and recording all 25 outputs every step; the plant's own `fmi2DoStep` called
-//!    directly in a bare loop for the floor;
-//! 2. the master's overhead per FMU per step with a trivial FMU (C `gain`, 10 instances in
-//!    a chain, 30,000 steps), ordered and jacobi;
-//! 3. if `COSIM_BENCH_PYTHON` names a Python with fmpy (and optionally ecospy /
-//!    libcosimpy), the same plant run by those tools (`cosim/benches/external.py`).
-//!
-//! Prints one line per measurement (best of 5 runs).
+//! 1. The three-FMU closed loop `target/ssp/nigel_closed_loop.ssp`, 30 s at 1 ms (30,000
+//!    steps): the floor (the plant's own `fmi2DoStep` in a bare loop, then all three FMUs'
+//!    in a bare loop with no data exchanged); the master in `ordered` and `jacobi`,
+//!    recording nothing and recording all 52 outputs every step, `jacobi` in 1 and 2
+//!    threads, `ordered` with the per-FMU profile; each with its epsilon (the paper's
+//!    tracking metric over the 30,000 samples) and final pose, so that readers see every
+//!    tool ran the same thing.
+//! 2. With `COSIM_BENCH_PYTHON` naming the Python of `scripts/python-env.sh`: the same
+//!    `.ssp` run by ecos (ecospy), libcosim (libcosimpy) and fmpy `simulate_ssp`
+//!    (`cosim/benches/external.py`), in the same run.
+//! 3. The master's overhead per FMU per step: 10 trivial C FMUs in a chain.
+//! 4. Threads: 10 C FMUs side by side, trivial and heavier (`-DWORK`), `jacobi` in 1 and
+//!    2 threads.
 
-use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, System, SystemBuilder};
+use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, Results, System, SystemBuilder};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
+
+const STEPS: f64 = 30_000.0;
+const POSE: [&str; 6] = ["plant.x", "plant.y", "plant.psi", "maneuver.x_ref", "maneuver.y_ref", "maneuver.psi_ref"];
 
 fn target() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
@@ -25,11 +32,33 @@ fn best_of<F: FnMut() -> Duration>(n: usize, mut f: F) -> Duration {
     (0..n).map(|_| f()).min().unwrap_or_default()
 }
 
-fn trivial_fmu(dir: &Path) -> PathBuf {
+fn line(what: &str, d: Duration, note: &str) {
+    println!("{what:<58}: {:8.1} ms  ({:6.2} us/step) {note}", d.as_secs_f64() * 1e3, d.as_secs_f64() * 1e6 / STEPS);
+}
+
+/// The paper's epsilon: the norm of the RMS errors of x, y, psi against the reference
+/// over samples 1..=30000 (as `table3` computes it).
+fn epsilon(r: &Results) -> f64 {
+    let col = |n: &str| r.column(n).unwrap_or_else(|| panic!("{n} not recorded"));
+    let c: Vec<Vec<f64>> = POSE.iter().map(|n| col(n)[1..].to_vec()).collect();
+    let rms =
+        |a: &[f64], b: &[f64]| (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len() as f64).sqrt();
+    let e = [rms(&c[0], &c[3]), rms(&c[1], &c[4]), rms(&c[2], &c[5])];
+    (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+}
+
+fn pose(r: &Results) -> String {
+    let last = |n: &str| *r.column(n).unwrap().last().unwrap();
+    format!("x {:.9} y {:.9} psi {:.9}", last("plant.x"), last("plant.y"), last("plant.psi"))
+}
+
+/// The C test model (tests/cfmu/models.c) `gain`, compiled with `flags`, as an FMU.
+fn c_gain(dir: &Path, name: &str, flags: &[&str]) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/models.c");
-    let so = dir.join("gain.so");
+    let so = dir.join(format!("{name}.so"));
     let ok = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-DMODEL=2"])
+        .args(flags)
         .arg(&src)
         .arg("-o")
         .arg(&so)
@@ -47,7 +76,7 @@ fn trivial_fmu(dir: &Path) -> PathBuf {
   </ModelVariables>
   <ModelStructure><Outputs><Unknown index="2" dependencies="1"/></Outputs></ModelStructure>
 </fmiModelDescription>"#;
-    let fmu = dir.join("gain.fmu");
+    let fmu = dir.join(format!("{name}.fmu"));
     let mut zip = zip::ZipWriter::new(std::fs::File::create(&fmu).unwrap());
     let o = zip::write::SimpleFileOptions::default();
     use std::io::Write;
@@ -59,98 +88,120 @@ fn trivial_fmu(dir: &Path) -> PathBuf {
     fmu
 }
 
+/// The instances of `system` initialized with its start values, inputs left at them.
+fn bare_instances(system: &System, only: Option<&str>) -> Vec<Instance> {
+    let mut out = Vec::new();
+    for spec in system.instances.iter().filter(|s| only.is_none_or(|o| s.name == o)) {
+        let mut inst = Instance::new(&spec.fmu, &spec.name).unwrap();
+        inst.setup_experiment(None, 0.0, Some(30.0)).unwrap();
+        nigel_cosim::simulate::apply_start_values(&mut inst, spec).unwrap();
+        inst.enter_initialization_mode().unwrap();
+        inst.exit_initialization_mode().unwrap();
+        out.push(inst);
+    }
+    out
+}
+
+fn bare_loop(system: &System, only: Option<&str>) -> Duration {
+    best_of(5, || {
+        let mut instances = bare_instances(system, only);
+        let t = Instant::now();
+        for n in 0..30_000u32 {
+            let t0 = f64::from(n) * 1e-3;
+            for inst in instances.iter_mut() {
+                inst.do_step(t0, f64::from(n + 1) * 1e-3 - t0).unwrap();
+            }
+        }
+        t.elapsed()
+    })
+}
+
+fn run_master(
+    system: &System,
+    algorithm: Algorithm,
+    threads: usize,
+    record: Option<Vec<String>>,
+    profile: bool,
+) -> Duration {
+    best_of(5, || {
+        let mut e = Experiment::new(30.0, 1e-3);
+        e.algorithm = algorithm;
+        e.threads = threads;
+        e.record = record.clone();
+        e.profile = profile;
+        let t = Instant::now();
+        simulate(system, &e).unwrap();
+        t.elapsed()
+    })
+}
+
 fn main() {
-    let plant = target().join("fmu").join("nigel_plant.fmu");
-    if !plant.is_file() {
-        eprintln!("{} missing: run `cargo run --release -p build-fmu` first", plant.display());
+    let ssp = target().join("ssp").join("nigel_closed_loop.ssp");
+    if !ssp.is_file() {
+        eprintln!("{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
         std::process::exit(1);
     }
-    let fmu = Fmu::load(&plant).unwrap();
-    let steps = 30_000.0;
-    let mut system = SystemBuilder::new();
-    system.add_instance("plant", fmu.clone()).unwrap();
-    system.set_text("plant.v_x_start", "0.35").unwrap();
-    system.set_text("plant.delta_fl", "0.2").unwrap();
-    let system: System = system.build();
-    let run = |record: Option<Vec<String>>| {
-        best_of(5, || {
-            let mut e = Experiment::new(30.0, 1e-3);
-            e.record = record.clone();
-            let t = Instant::now();
-            simulate(&system, &e).unwrap();
-            t.elapsed()
-        })
-    };
-    let none = run(Some(vec![]));
-    let all = run(None);
-    // the floor: the same fmi2DoStep calls in a bare loop
-    let bare = best_of(5, || {
-        let mut inst = Instance::new(&fmu, "bare").unwrap();
-        let vx = fmu.description().real_value_reference("v_x_start").unwrap();
-        let d = fmu.description().real_value_reference("delta_fl").unwrap();
-        inst.setup_experiment(None, 0.0, Some(30.0)).unwrap();
-        inst.set_real(&[vx, d], &[0.35, 0.2]).unwrap();
-        inst.enter_initialization_mode().unwrap();
-        inst.exit_initialization_mode().unwrap();
-        let t = Instant::now();
-        for n in 0..30_000u32 {
-            let t0 = f64::from(n) * 1e-3;
-            inst.do_step(t0, f64::from(n + 1) * 1e-3 - t0).unwrap();
+    let closed = nigel_cosim::read_ssp(&ssp, &Default::default()).unwrap();
+    let system = &closed.system;
+    println!(
+        "closed loop {} ({} instances, {} connections), 30 s at 1 ms:",
+        ssp.display(),
+        system.instances.len(),
+        system.connections.len()
+    );
+    line("floor: the plant's own fmi2DoStep, bare loop", bare_loop(system, Some("plant")), "");
+    line("floor: the three FMUs' fmi2DoStep, bare loop, no exchange", bare_loop(system, None), "");
+    let pose_names: Vec<String> = POSE.iter().map(|s| s.to_string()).collect();
+    for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
+        let mut e = Experiment::new(30.0, 1e-3);
+        e.algorithm = algorithm;
+        e.record = Some(pose_names.clone());
+        let (r, _) = simulate(system, &e).unwrap();
+        let note = format!("epsilon {:.12} | {}", epsilon(&r), pose(&r));
+        let name = format!("{algorithm:?}").to_lowercase();
+        line(
+            &format!("master {name}, recording nothing"),
+            run_master(system, algorithm, 1, Some(vec![]), false),
+            &note,
+        );
+        line(
+            &format!("master {name}, all 52 outputs recorded every step"),
+            run_master(system, algorithm, 1, None, false),
+            "",
+        );
+        if algorithm == Algorithm::Ordered {
+            line(
+                "master ordered, all recorded, per-FMU profile (--summary)",
+                run_master(system, algorithm, 1, None, true),
+                "",
+            );
+        } else {
+            line(
+                "master jacobi, 2 threads, recording nothing",
+                run_master(system, algorithm, 2, Some(vec![]), false),
+                "",
+            );
+            line("master jacobi, 2 threads, all recorded", run_master(system, algorithm, 2, None, false), "");
         }
-        t.elapsed()
-    });
-    // the floor with the 25 outputs read after every step (one fmi2GetReal)
-    let outputs: Vec<u32> = fmu
-        .description()
-        .model_variables
-        .iter()
-        .filter(|v| v.causality == model_description::Causality::Output)
-        .map(|v| v.value_reference)
-        .collect();
-    let bare_get = best_of(5, || {
-        let mut inst = Instance::new(&fmu, "bare").unwrap();
-        let vx = fmu.description().real_value_reference("v_x_start").unwrap();
-        let d = fmu.description().real_value_reference("delta_fl").unwrap();
-        inst.setup_experiment(None, 0.0, Some(30.0)).unwrap();
-        inst.set_real(&[vx, d], &[0.35, 0.2]).unwrap();
-        inst.enter_initialization_mode().unwrap();
-        inst.exit_initialization_mode().unwrap();
-        let mut values = vec![0.0; outputs.len()];
-        let t = Instant::now();
-        for n in 0..30_000u32 {
-            let t0 = f64::from(n) * 1e-3;
-            inst.do_step(t0, f64::from(n + 1) * 1e-3 - t0).unwrap();
-            inst.get_real(&outputs, &mut values).unwrap();
+    }
+
+    if let Some(python) = std::env::var_os("COSIM_BENCH_PYTHON") {
+        // relative to the workspace root (cargo runs benches in the package folder)
+        let python = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(python);
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/external.py");
+        let status = Command::new(python).arg(script).arg(&ssp).status();
+        if !status.map(|s| s.success()).unwrap_or(false) {
+            eprintln!("external tools: the Python script failed");
         }
-        t.elapsed()
-    });
-    let us = |d: Duration| d.as_secs_f64() * 1e6 / steps;
-    println!(
-        "plant 30 s at 1 ms, bare fmi2DoStep loop       : {:8.1} ms  ({:.3} us/step)",
-        bare.as_secs_f64() * 1e3,
-        us(bare)
-    );
-    println!(
-        "plant 30 s at 1 ms, bare loop + 1 fmi2GetReal of the {} outputs: {:8.1} ms  ({:.3} us/step)",
-        outputs.len(),
-        bare_get.as_secs_f64() * 1e3,
-        us(bare_get)
-    );
-    println!(
-        "plant 30 s at 1 ms, master, recording nothing   : {:8.1} ms  ({:.3} us/step)",
-        none.as_secs_f64() * 1e3,
-        us(none)
-    );
-    println!(
-        "plant 30 s at 1 ms, master, 25 outputs recorded : {:8.1} ms  ({:.3} us/step)",
-        all.as_secs_f64() * 1e3,
-        us(all)
-    );
+    } else {
+        println!("(set COSIM_BENCH_PYTHON=target/venv/bin/python for ecos, libcosim and fmpy on the same .ssp)");
+    }
 
     // overhead per FMU per step: a chain of trivial FMUs
     let dir = target().join("cosim-bench");
     std::fs::create_dir_all(&dir).unwrap();
-    let gain = Fmu::load(&trivial_fmu(&dir)).unwrap();
+    let gain = Fmu::load(&c_gain(&dir, "gain", &[])).unwrap();
+    let heavy = Fmu::load(&c_gain(&dir, "gain_work", &["-DWORK=400"])).unwrap();
     let n = 10;
     let mut b = SystemBuilder::new();
     for i in 0..n {
@@ -161,32 +212,30 @@ fn main() {
     }
     let chain = b.build();
     for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
-        let d = best_of(5, || {
-            let mut e = Experiment::new(30.0, 1e-3);
-            e.algorithm = algorithm;
-            e.record = Some(vec![]);
-            let t = Instant::now();
-            simulate(&chain, &e).unwrap();
-            t.elapsed()
-        });
+        let d = run_master(&chain, algorithm, 1, Some(vec![]), false);
         println!(
             "trivial FMU x {n} in a chain, 30,000 steps, {algorithm:?}: {:8.1} ms  ({:.1} ns per FMU per step, incl. 1 get + 1 set per connection)",
             d.as_secs_f64() * 1e3,
-            d.as_secs_f64() * 1e9 / (steps * n as f64)
+            d.as_secs_f64() * 1e9 / (STEPS * n as f64)
         );
     }
-
-    if let Some(python) = std::env::var_os("COSIM_BENCH_PYTHON") {
-        // relative to the workspace root (cargo runs benches in the package folder)
-        let python = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(python);
-        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/external.py");
-        let ssp = dir.join("plant.ssp");
-        nigel_cosim::write_ssp(&system, "plant", Some(30.0), &ssp).unwrap();
-        let status = Command::new(python).arg(script).arg(&plant).arg(&ssp).status();
-        if !status.map(|s| s.success()).unwrap_or(false) {
-            eprintln!("external tools: the Python script failed");
+    // threads: the same chains, trivial and heavier
+    for (what, fmu) in [("trivial", &gain), ("heavier (WORK=400)", &heavy)] {
+        let mut b = SystemBuilder::new();
+        for i in 0..n {
+            b.add_instance(&format!("g{i}"), fmu.clone()).unwrap();
+            if i > 0 {
+                b.connect(&format!("g{}.y", i - 1), &format!("g{i}.u")).unwrap();
+            }
         }
-    } else {
-        println!("(set COSIM_BENCH_PYTHON=target/venv/bin/python for fmpy / ecos / libcosim on the same FMU)");
+        let chain = b.build();
+        let one = run_master(&chain, Algorithm::Jacobi, 1, Some(vec![]), false);
+        let two = run_master(&chain, Algorithm::Jacobi, 2, Some(vec![]), false);
+        println!(
+            "{what} FMU x {n}, jacobi, 30,000 steps: 1 thread {:8.1} ms, 2 threads {:8.1} ms ({:.2}x)",
+            one.as_secs_f64() * 1e3,
+            two.as_secs_f64() * 1e3,
+            one.as_secs_f64() / two.as_secs_f64()
+        );
     }
 }

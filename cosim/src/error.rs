@@ -185,6 +185,17 @@ pub enum Error {
         /// The variables on the loop, `instance.variable`, in order.
         variables: Vec<String>,
     },
+    /// The event iteration of coupled Model Exchange instances found no fixed point: after
+    /// `rounds` rounds of `fmi2NewDiscreteStates` and propagation, `instances` still asked
+    /// for another iteration or had their inputs changed.
+    EventIteration {
+        /// The event time, s.
+        time: f64,
+        /// Rounds done.
+        rounds: usize,
+        /// The instances still not settled.
+        instances: Vec<String>,
+    },
     /// The experiment is not simulable as given (times, step, output interval).
     Experiment(String),
     /// An SSP file is malformed or uses a part this master does not support.
@@ -236,6 +247,11 @@ impl fmt::Display for Error {
             Error::AlgebraicLoop { variables } => {
                 write!(f, "algebraic loop (direct feedthrough cycle): {}", variables.join(" -> "))
             }
+            Error::EventIteration { time, rounds, instances } => write!(
+                f,
+                "the event iteration at t = {time} s did not converge in {rounds} rounds: {} still changing",
+                instances.join(", ")
+            ),
             Error::Experiment(m) => write!(f, "experiment: {m}"),
             Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
         }

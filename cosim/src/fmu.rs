@@ -459,6 +459,10 @@ impl InstanceState {
 #[derive(Debug)]
 pub struct FmuState(*mut c_void);
 
+// SAFETY: a saved state is only passed back to the instance it came from, which is
+// itself never called concurrently (see `Instance`); it moves between threads with it.
+unsafe impl Send for FmuState {}
+
 /// One instance of an FMU. Every call returns `Ok` for fmi2OK and fmi2Warning (the
 /// warning stays in the log), else a typed [`Error::Fmi`] with the FMU's last messages.
 /// Dropping it terminates it (unless it errored or is not initialized) and frees it

@@ -5,8 +5,12 @@
 //!   [`Instance`] wraps every fmi2 call in a typed [`Result`].
 //! - [`SystemBuilder`] makes a [`System`] of instances, start values and connections
 //!   checked for type, causality and unit.
-//! - [`simulate`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
-//!   [`Algorithm::Ordered`], time `t0 + n h`, into [`Results`] (CSV as fmpy writes it).
+//! - [`simulate()`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
+//!   [`Algorithm::Ordered`], time `t0 + n h`, into [`Results`] (CSV as fmpy writes it);
+//!   `jacobi` optionally with the instances in several threads ([`Experiment::threads`],
+//!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
+//!   those connected to each other advancing together with one event iteration across
+//!   them ([`Error::EventIteration`] when it has no fixed point).
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
@@ -19,9 +23,11 @@
 
 #![warn(missing_docs)]
 
+mod coupled;
 pub mod error;
 pub mod fmu;
 pub mod me;
+mod parallel;
 pub mod simulate;
 pub mod ssp;
 pub mod system;

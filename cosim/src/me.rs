@@ -4,7 +4,9 @@
 //!
 //! Over a communication step the FMU's inputs are held (as for a Co-Simulation FMU),
 //! so an ME instance takes part in `jacobi` and `ordered` systems like a CS one; its
-//! events are handled (event iteration to a fixed point) inside its own step.
+//! events are handled (event iteration to a fixed point) inside its own step, unless it
+//! is connected to another ME instance: then all ME instances advance together and
+//! iterate their events together (`coupled.rs`).
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
@@ -52,14 +54,14 @@ pub struct Event {
 /// Integration state of one ME instance; buffers allocated once.
 #[derive(Debug)]
 pub struct MeUnit {
-    x: Vec<f64>,
-    x0: Vec<f64>,
-    xt: Vec<f64>,
+    pub(crate) x: Vec<f64>,
+    pub(crate) x0: Vec<f64>,
+    pub(crate) xt: Vec<f64>,
     k: [Vec<f64>; 7],
-    z0: Vec<f64>,
-    z: Vec<f64>,
-    next_time_event: Option<f64>,
-    h_adaptive: f64,
+    pub(crate) z0: Vec<f64>,
+    pub(crate) z: Vec<f64>,
+    pub(crate) next_time_event: Option<f64>,
+    pub(crate) h_adaptive: f64,
     /// Events so far.
     pub events: Vec<Event>,
     /// Accepted internal steps.
@@ -92,10 +94,18 @@ impl MeUnit {
     /// After `fmi2ExitInitializationMode` (the instance is in event mode): event
     /// iteration, continuous-time mode, initial states and indicators.
     pub fn initialize(inst: &mut Instance) -> Result<MeUnit> {
+        let mut unit = MeUnit::new(inst);
+        event_iteration(inst, &mut unit)?;
+        Ok(unit)
+    }
+
+    /// The integration state of `inst`, before any event iteration (the instance stays in
+    /// event mode).
+    pub(crate) fn new(inst: &Instance) -> MeUnit {
         let md = inst.fmu().description();
         let n = md.states().len();
         let m = md.number_of_event_indicators as usize;
-        let mut unit = MeUnit {
+        MeUnit {
             x: vec![0.0; n],
             x0: vec![0.0; n],
             xt: vec![0.0; n],
@@ -108,19 +118,31 @@ impl MeUnit {
             steps: 0,
             rejected: 0,
             terminated: false,
-        };
-        event_iteration(inst, &mut unit)?;
-        Ok(unit)
+        }
     }
 
-    fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
+    /// The start of a step at `t`: x0 = x and the derivatives there (k1).
+    pub(crate) fn begin_step(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
+        self.x0.copy_from_slice(&self.x);
+        let (x0, k) = (&self.x0, &mut self.k[0]);
+        Self::derivatives(inst, t, x0, k)
+    }
+
+    /// After an event iteration that ended in continuous-time mode: the states and event
+    /// indicators as the FMU now has them.
+    pub(crate) fn resume(&mut self, inst: &mut Instance) -> Result<()> {
+        inst.get_continuous_states(&mut self.x)?;
+        inst.get_event_indicators(&mut self.z0)
+    }
+
+    pub(crate) fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
         inst.set_time(t)?;
         inst.set_continuous_states(x)?;
         inst.get_derivatives(dx)
     }
 
     /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).
-    fn rk4(&mut self, inst: &mut Instance, t: f64, h: f64) -> Result<()> {
+    pub(crate) fn rk4(&mut self, inst: &mut Instance, t: f64, h: f64) -> Result<()> {
         let n = self.x0.len();
         let [k1, k2, k3, k4, ..] = &mut self.k;
         for j in 0..n {
@@ -143,7 +165,7 @@ impl MeUnit {
 
     /// One Dormand-Prince step of size `h` from (t, x0) into `xt` (k1 given in k[0]);
     /// returns the scaled error norm (<= 1: accept). k[6] holds f(t+h, xt) afterwards.
-    fn dopri(&mut self, inst: &mut Instance, t: f64, h: f64, rtol: f64, atol: f64) -> Result<f64> {
+    pub(crate) fn dopri(&mut self, inst: &mut Instance, t: f64, h: f64, rtol: f64, atol: f64) -> Result<f64> {
         const C: [f64; 6] = [1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
         const A: [[f64; 6]; 6] = [
             [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -182,7 +204,7 @@ impl MeUnit {
         Ok(err)
     }
 
-    fn one_step(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<()> {
+    pub(crate) fn one_step(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<()> {
         match solver {
             Solver::Rk4 { .. } => self.rk4(inst, t, h),
             Solver::Dopri5 { rtol, atol } => self.dopri(inst, t, h, rtol, atol).map(|_| ()),
@@ -190,14 +212,56 @@ impl MeUnit {
     }
 
     /// Event indicators at (t, xt) into `z`.
-    fn indicators_at(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
+    pub(crate) fn indicators_at(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
         inst.set_time(t)?;
         inst.set_continuous_states(&self.xt)?;
         inst.get_event_indicators(&mut self.z)
     }
 
-    fn crossed(z0: &[f64], z: &[f64]) -> bool {
+    pub(crate) fn crossed(z0: &[f64], z: &[f64]) -> bool {
         z0.iter().zip(z).any(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0))
+    }
+
+    /// A step of `h` from (t, x0) crossed an event indicator (`z0` to `z`): the offset
+    /// `hi` just after the first crossing, found by the Illinois method on the step size
+    /// (re-integrating from (t, x0)) to [`EVENT_TIME_TOLERANCE`].
+    pub(crate) fn locate_crossing(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<f64> {
+        let (mut lo, mut hi) = (0.0, h);
+        let zi = self
+            .z0
+            .iter()
+            .zip(&self.z)
+            .position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0))
+            .unwrap_or(0);
+        let (mut f_lo, mut f_hi) = (self.z0[zi], self.z[zi]);
+        let mut side = 0i32;
+        let mut iterations = 0;
+        while hi - lo > EVENT_TIME_TOLERANCE && iterations < 200 {
+            iterations += 1;
+            let mut s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+            if !(s > lo && s < hi && s.is_finite()) {
+                s = 0.5 * (lo + hi);
+            }
+            self.one_step(inst, solver, t, s)?;
+            self.indicators_at(inst, t + s)?;
+            // any indicator crossing in (0, s]?
+            if Self::crossed(&self.z0, &self.z) {
+                hi = s;
+                f_hi = self.z[zi];
+                if side == 1 {
+                    f_lo *= 0.5;
+                }
+                side = 1;
+            } else {
+                lo = s;
+                f_lo = self.z[zi];
+                if side == -1 {
+                    f_hi *= 0.5;
+                }
+                side = -1;
+            }
+        }
+        Ok(hi)
     }
 
     /// Integrates from `t` to `t_end` with the inputs as set, handling events.
@@ -266,42 +330,7 @@ impl MeUnit {
             let t_new = if (t + h - target).abs() <= eps { target } else { t + h };
             self.indicators_at(inst, t_new)?;
             if Self::crossed(&self.z0, &self.z) {
-                // state event: Illinois on the step size, re-integrating from (t, x0)
-                let (mut lo, mut hi) = (0.0, t_new - t);
-                let zi = self
-                    .z0
-                    .iter()
-                    .zip(&self.z)
-                    .position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0))
-                    .unwrap_or(0);
-                let (mut f_lo, mut f_hi) = (self.z0[zi], self.z[zi]);
-                let mut side = 0i32;
-                let mut iterations = 0;
-                while hi - lo > EVENT_TIME_TOLERANCE && iterations < 200 {
-                    iterations += 1;
-                    let mut s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-                    if !(s > lo && s < hi && s.is_finite()) {
-                        s = 0.5 * (lo + hi);
-                    }
-                    self.one_step(inst, solver, t, s)?;
-                    self.indicators_at(inst, t + s)?;
-                    // any indicator crossing in (0, s]?
-                    if Self::crossed(&self.z0, &self.z) {
-                        hi = s;
-                        f_hi = self.z[zi];
-                        if side == 1 {
-                            f_lo *= 0.5;
-                        }
-                        side = 1;
-                    } else {
-                        lo = s;
-                        f_lo = self.z[zi];
-                        if side == -1 {
-                            f_hi *= 0.5;
-                        }
-                        side = -1;
-                    }
-                }
+                let hi = self.locate_crossing(inst, solver, t, t_new - t)?;
                 // the event is handled just after the crossing, at t + hi
                 self.one_step(inst, solver, t, hi)?;
                 let te = t + hi;

@@ -48,8 +48,12 @@ pub struct Experiment {
     pub output_interval: Option<f64>,
     /// Variables to record (`instance.variable`); `None`: every output of every instance.
     pub record: Option<Vec<String>>,
-    /// Measure the time spent in each FMU (two clock reads per call).
+    /// Measure the time spent in each FMU (one clock read per call boundary).
     pub profile: bool,
+    /// Threads stepping the instances of a `jacobi` system (1: all in the calling
+    /// thread). Each instance is called by one thread at a time; the results are the
+    /// same for any number. `ordered` always runs in one thread.
+    pub threads: usize,
     /// Called with the fraction done (0..=1) at each output point.
     pub progress: Option<fn(f64)>,
     /// Integration method of Model Exchange instances.
@@ -72,6 +76,7 @@ impl Experiment {
             output_interval: None,
             record: None,
             profile: false,
+            threads: 1,
             progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
@@ -161,6 +166,8 @@ pub struct Summary {
     pub integrator_steps: (u64, u64),
     /// Steps redone in halves after an fmi2Discard.
     pub discard_retries: u64,
+    /// `jacobi` steps run with the instances spread over threads (0 in one thread).
+    pub parallel_steps: u64,
 }
 
 impl Summary {
@@ -171,6 +178,7 @@ impl Summary {
             "events": self.events.len(),
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
             "discard_retries": self.discard_retries,
+            "parallel_steps": self.parallel_steps,
             "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
@@ -187,8 +195,8 @@ enum OpKind {
 
 /// One batched fmi2Get/fmi2Set call of one instance and one base type.
 #[derive(Debug)]
-struct Op {
-    instance: usize,
+pub(crate) struct Op {
+    pub(crate) instance: usize,
     kind: OpKind,
     base_type: BaseType,
     vrs: Vec<u32>,
@@ -212,47 +220,96 @@ impl Op {
     }
 
     #[inline]
-    fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
-        match (self.kind, self.base_type) {
-            (OpKind::Get, BaseType::Real) => {
-                inst.get_real(&self.vrs, &mut self.reals)?;
+    pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
+        match self.kind {
+            OpKind::Get => {
+                self.fetch(inst)?;
+                self.scatter(values);
+            }
+            OpKind::Set => {
+                self.gather(values);
+                self.apply(inst)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the op sets inputs.
+    pub(crate) fn is_set(&self) -> bool {
+        self.kind == OpKind::Set
+    }
+
+    /// The value slots the op reads (set) or writes (get).
+    pub(crate) fn slots(&self) -> &[usize] {
+        &self.slots
+    }
+
+    /// Get: the fmi2Get call into the op's own buffer.
+    #[inline]
+    fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
+        match self.base_type {
+            BaseType::Real => inst.get_real(&self.vrs, &mut self.reals),
+            BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints),
+            BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints),
+            BaseType::String => Ok(()),
+        }
+    }
+
+    /// Get: the fetched values into their slots.
+    #[inline]
+    fn scatter(&self, values: &mut [f64]) {
+        match self.base_type {
+            BaseType::Real => {
                 for (s, v) in self.slots.iter().zip(&self.reals) {
                     values[*s] = *v;
                 }
             }
-            (OpKind::Get, BaseType::Integer) => {
-                inst.get_integer(&self.vrs, &mut self.ints)?;
+            BaseType::Integer => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = f64::from(*v);
                 }
             }
-            (OpKind::Get, BaseType::Boolean) => {
-                inst.get_boolean(&self.vrs, &mut self.ints)?;
+            BaseType::Boolean => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = if *v != 0 { 1.0 } else { 0.0 };
                 }
             }
-            (OpKind::Set, BaseType::Real) => {
+            BaseType::String => {}
+        }
+    }
+
+    /// Set: the source slots, transformed, into the op's buffer.
+    #[inline]
+    fn gather(&mut self, values: &[f64]) {
+        match self.base_type {
+            BaseType::Real => {
                 for ((r, s), (g, o)) in self.reals.iter_mut().zip(&self.slots).zip(&self.gains) {
                     *r = g * values[*s] + o;
                 }
-                inst.set_real(&self.vrs, &self.reals)?;
             }
-            (OpKind::Set, BaseType::Integer) => {
+            BaseType::Integer => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = values[*s] as i32;
                 }
-                inst.set_integer(&self.vrs, &self.ints)?;
             }
-            (OpKind::Set, BaseType::Boolean) => {
+            BaseType::Boolean => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = (values[*s] != 0.0) as i32;
                 }
-                inst.set_boolean(&self.vrs, &self.ints)?;
             }
-            (_, BaseType::String) => {}
+            BaseType::String => {}
         }
-        Ok(())
+    }
+
+    /// Set: the fmi2Set call from the op's buffer.
+    #[inline]
+    fn apply(&mut self, inst: &mut Instance) -> Result<()> {
+        match self.base_type {
+            BaseType::Real => inst.set_real(&self.vrs, &self.reals),
+            BaseType::Integer => inst.set_integer(&self.vrs, &self.ints),
+            BaseType::Boolean => inst.set_boolean(&self.vrs, &self.ints),
+            BaseType::String => Ok(()),
+        }
     }
 }
 
@@ -274,15 +331,20 @@ fn emit(ops: &mut Vec<Op>, instance: usize, kind: OpKind, ty: BaseType, vr: u32,
 }
 
 /// The communication plan of a system: slots for every connected output and recorded
-/// variable, and the ordered list of batched calls.
+/// variable, and the batched calls.
 #[derive(Debug)]
 struct Plan {
-    /// Slot of each source variable, indexed like `sources`.
+    /// The variable behind each slot of the value buffer.
     sources: Vec<VariableRef>,
-    /// (instance, kind, type) node list for ordered propagation, as ops.
+    /// `ordered`: the batched calls in topological order (None: the graph has a loop).
     ordered: Option<Vec<Op>>,
-    jacobi_gets: Vec<Op>,
-    jacobi_sets: Vec<Op>,
+    /// `jacobi`, per instance: one get per type of its connected outputs.
+    jacobi_gets: Vec<Vec<Op>>,
+    /// `jacobi`, per instance: one get per type of its connected outputs and recorded
+    /// variables (used at output points instead of `jacobi_gets`).
+    jacobi_gets_rec: Vec<Vec<Op>>,
+    /// `jacobi`, per instance: one set per type of its connected inputs.
+    jacobi_sets: Vec<Vec<Op>>,
 }
 
 fn slot_of(sources: &mut Vec<VariableRef>, r: &VariableRef) -> usize {
@@ -329,13 +391,31 @@ fn ordered_nodes(system: &System, connected_outputs: &[VariableRef]) -> Result<V
         |k: usize| if k < n_out { connected_outputs[k].instance } else { system.connections[k - n_out].to.instance };
     let mut ready: Vec<usize> = (0..n).filter(|k| indegree[*k] == 0).collect();
     let mut order = Vec::with_capacity(n);
+    // inputs of each instance not yet in the order: an instance's inputs are best set in
+    // one call, once all of them are ready
+    let mut pending_inputs = vec![0usize; system.instances.len()];
+    for c in &system.connections {
+        pending_inputs[c.to.instance] += 1;
+    }
     let mut last: Option<(usize, bool)> = None;
     while !ready.is_empty() {
-        // prefer the same instance and kind as the last node: fewer, larger batches
-        let pick = last
-            .and_then(|(i, is_out)| ready.iter().position(|k| node_instance(*k) == i && (*k < n_out) == is_out))
+        // fewest calls: the same instance and kind as the last node (one batch), then
+        // outputs (reading them sets nothing), then an instance whose inputs are all ready
+        let is_out = |k: &usize| *k < n_out;
+        let same = |k: &usize| last.is_some_and(|(i, o)| node_instance(*k) == i && is_out(k) == o);
+        let ready_inputs = |i: usize| ready.iter().filter(|k| !is_out(k) && node_instance(**k) == i).count();
+        let complete = |k: &usize| !is_out(k) && ready_inputs(node_instance(*k)) == pending_inputs[node_instance(*k)];
+        let pick = ready
+            .iter()
+            .position(same)
+            .or_else(|| ready.iter().position(is_out))
+            .or_else(|| ready.iter().position(complete))
+            .or_else(|| (0..ready.len()).max_by_key(|p| (ready_inputs(node_instance(ready[*p])), usize::MAX - p)))
             .unwrap_or(0);
         let k = ready.swap_remove(pick);
+        if k >= n_out {
+            pending_inputs[node_instance(k)] -= 1;
+        }
         last = Some((node_instance(k), k < n_out));
         order.push(k);
         for &e in &edges[k] {
@@ -384,21 +464,29 @@ impl Plan {
         for r in record {
             slot_of(&mut sources, r);
         }
-        // jacobi: per instance and type one get of its connected outputs and recorded
-        // variables, then per instance and type one set of its connected inputs
-        let mut jacobi_gets = Vec::new();
-        let mut jacobi_sets = Vec::new();
-        for i in 0..system.instances.len() {
+        // jacobi: per instance and type one get of its connected outputs (and one with the
+        // recorded variables too, for output points), then one set of its connected inputs
+        let n = system.instances.len();
+        let (mut jacobi_gets, mut jacobi_gets_rec, mut jacobi_sets) =
+            (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let (mut gets, mut gets_rec, mut sets) = (Vec::new(), Vec::new(), Vec::new());
             for ty in [BaseType::Real, BaseType::Integer, BaseType::Boolean] {
                 let mut get = Op::new(i, OpKind::Get, ty);
-                // only the connected outputs: recorded variables are read at output points
+                let mut get_rec = Op::new(i, OpKind::Get, ty);
                 for (k, s) in sources.iter().enumerate() {
-                    if s.instance == i && s.base_type == ty && connected_outputs.contains(s) {
-                        get.push(s.value_reference, k, (1.0, 0.0));
+                    if s.instance == i && s.base_type == ty {
+                        if connected_outputs.contains(s) {
+                            get.push(s.value_reference, k, (1.0, 0.0));
+                        }
+                        get_rec.push(s.value_reference, k, (1.0, 0.0));
                     }
                 }
                 if !get.vrs.is_empty() {
-                    jacobi_gets.push(get);
+                    gets.push(get);
+                }
+                if !get_rec.vrs.is_empty() {
+                    gets_rec.push(get_rec);
                 }
                 let mut set = Op::new(i, OpKind::Set, ty);
                 for c in system.connections.iter().filter(|c| c.to.instance == i && c.to.base_type == ty) {
@@ -406,62 +494,191 @@ impl Plan {
                     set.push(c.to.value_reference, slot, (c.gain, c.offset));
                 }
                 if !set.vrs.is_empty() {
-                    jacobi_sets.push(set);
+                    sets.push(set);
                 }
             }
+            jacobi_gets.push(gets);
+            jacobi_gets_rec.push(gets_rec);
+            jacobi_sets.push(sets);
         }
-        let ordered = match ordered_nodes(system, &connected_outputs) {
-            Ok(nodes) => {
-                let mut ops = Vec::new();
-                for (is_output, k) in nodes {
-                    if is_output {
-                        let r = &connected_outputs[k];
-                        let slot = sources.iter().position(|s| s == r).unwrap_or(0);
-                        emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
-                    } else {
-                        let c = &system.connections[k];
-                        let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
-                        emit(
-                            &mut ops,
-                            c.to.instance,
-                            OpKind::Set,
-                            c.to.base_type,
-                            c.to.value_reference,
-                            slot,
-                            (c.gain, c.offset),
-                        );
-                    }
-                }
-                Some(ops)
-            }
+        let ordered = match ordered_ops(system, &sources, &connected_outputs) {
+            Ok(ops) => Some(ops),
             Err(e) if algorithm == Algorithm::Ordered => return Err(e),
             Err(_) => None,
         };
-        Ok(Plan { sources, ordered, jacobi_gets, jacobi_sets })
+        Ok(Plan { sources, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
     }
 }
 
-fn run_ops(
-    ops: &mut [Op],
-    instances: &mut [Instance],
-    values: &mut [f64],
-    clocks: Option<&mut [Duration]>,
-) -> Result<()> {
-    match clocks {
-        None => {
-            for op in ops.iter_mut() {
-                op.run(&mut instances[op.instance], values)?;
-            }
+/// The batched gets and sets that carry every connection of `system` in topological
+/// order (slots: positions in `sources`), or the algebraic loop by name.
+pub(crate) fn ordered_ops(
+    system: &System,
+    sources: &[VariableRef],
+    connected_outputs: &[VariableRef],
+) -> Result<Vec<Op>> {
+    let nodes = ordered_nodes(system, connected_outputs)?;
+    let mut ops = Vec::new();
+    for (is_output, k) in nodes {
+        if is_output {
+            let r = &connected_outputs[k];
+            let slot = sources.iter().position(|s| s == r).unwrap_or(0);
+            emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
+        } else {
+            let c = &system.connections[k];
+            let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+            emit(&mut ops, c.to.instance, OpKind::Set, c.to.base_type, c.to.value_reference, slot, (c.gain, c.offset));
         }
-        Some(clocks) => {
-            for op in ops.iter_mut() {
-                let t = Instant::now();
-                op.run(&mut instances[op.instance], values)?;
-                clocks[op.instance] += t.elapsed();
-            }
+    }
+    Ok(ops)
+}
+
+/// Time spent in each instance's calls, one clock read per call boundary: the time from
+/// the previous mark to the end of a call is charged to that call's instance (the
+/// master's marshalling of the call's arguments included).
+struct Profiler {
+    last: Instant,
+    spent: Vec<Duration>,
+}
+
+impl Profiler {
+    fn new(n: usize) -> Profiler {
+        Profiler { last: Instant::now(), spent: vec![Duration::ZERO; n] }
+    }
+    #[inline]
+    fn restart(&mut self) {
+        self.last = Instant::now();
+    }
+    /// Charges the time since the last mark evenly to `instances` (a coupled group).
+    fn charge_shared(&mut self, instances: &[usize]) {
+        let now = Instant::now();
+        let share = (now - self.last) / instances.len().max(1) as u32;
+        for &i in instances {
+            self.spent[i] += share;
+        }
+        self.last = now;
+    }
+
+    #[inline]
+    fn charge(&mut self, instance: usize) {
+        let now = Instant::now();
+        self.spent[instance] += now - self.last;
+        self.last = now;
+    }
+}
+
+fn run_ops(ops: &mut [Op], lanes: &mut [Lane], values: &mut [f64], mut profiler: Option<&mut Profiler>) -> Result<()> {
+    if let Some(p) = profiler.as_deref_mut() {
+        p.restart();
+    }
+    for op in ops.iter_mut() {
+        op.run(&mut lanes[op.instance].inst, values)?;
+        if let Some(p) = profiler.as_deref_mut() {
+            p.charge(op.instance);
         }
     }
     Ok(())
+}
+
+/// One instance with everything its steps need: its integrator (Model Exchange), its
+/// saved state (Discard retry) and, for `jacobi`, its own batched gets and sets. A lane
+/// is stepped by one thread at a time.
+pub(crate) struct Lane {
+    pub(crate) index: usize,
+    pub(crate) inst: Instance,
+    pub(crate) unit: Option<MeUnit>,
+    saved: Option<crate::fmu::FmuState>,
+    gets: Vec<Op>,
+    gets_rec: Vec<Op>,
+    sets: Vec<Op>,
+    /// Time in this lane's calls (when profiling in parallel).
+    pub(crate) spent: Duration,
+    retries: u64,
+    /// The first error of this lane's last step.
+    pub(crate) error: Option<Error>,
+}
+
+/// What every lane does in one `jacobi` step.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct StepArgs {
+    /// Set the inputs (from the values of the previous step) before stepping.
+    pub(crate) set_inputs: bool,
+    pub(crate) t: f64,
+    pub(crate) t_next: f64,
+    /// Read the recorded variables too.
+    pub(crate) output_point: bool,
+    pub(crate) profile: bool,
+}
+
+impl Lane {
+    /// `do_step` (or the integrator over the step), with the Discard retry if enabled.
+    #[inline]
+    fn advance(&mut self, solver: crate::me::Solver, t: f64, t_next: f64) -> Result<()> {
+        let dt = t_next - t; // as fmpy: the step is the difference of the two points
+        match (&mut self.unit, &mut self.saved) {
+            (Some(unit), _) => unit.advance(&mut self.inst, solver, t, t_next),
+            (None, None) => self.inst.do_step(t, dt),
+            (None, Some(state)) => {
+                self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
+                Ok(())
+            }
+        }
+    }
+
+    /// One `jacobi` step of this instance: its inputs set from `values` (the outputs of
+    /// the previous step), the step, its outputs fetched into its get buffers. The call
+    /// sequence of an instance is the same whichever thread runs it.
+    #[inline]
+    pub(crate) fn jacobi_step(&mut self, values: &[f64], a: StepArgs, solver: crate::me::Solver) -> Result<()> {
+        let start = a.profile.then(Instant::now);
+        self.jacobi_inputs(values, a)?;
+        self.advance(solver, a.t, a.t_next)?;
+        self.jacobi_outputs(a)?;
+        if let Some(start) = start {
+            self.spent += start.elapsed();
+        }
+        Ok(())
+    }
+
+    /// The first part of a `jacobi` step: the inputs (unless the first step).
+    #[inline]
+    fn jacobi_inputs(&mut self, values: &[f64], a: StepArgs) -> Result<()> {
+        if a.set_inputs {
+            for op in self.sets.iter_mut() {
+                op.gather(values);
+                op.apply(&mut self.inst)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The last part of a `jacobi` step: the outputs fetched.
+    #[inline]
+    fn jacobi_outputs(&mut self, a: StepArgs) -> Result<()> {
+        let gets = if a.output_point { &mut self.gets_rec } else { &mut self.gets };
+        for op in gets.iter_mut() {
+            op.fetch(&mut self.inst)?;
+        }
+        Ok(())
+    }
+
+    /// The outputs fetched by the last [`Lane::jacobi_step`] into their slots.
+    #[inline]
+    pub(crate) fn scatter(&self, values: &mut [f64], output_point: bool) {
+        let gets = if output_point { &self.gets_rec } else { &self.gets };
+        for op in gets {
+            op.scatter(values);
+        }
+    }
+
+    /// The inputs set from `values` (after the last step, as the serial order does).
+    fn set_inputs(&mut self, values: &[f64]) -> Result<()> {
+        for op in self.sets.iter_mut() {
+            op.gather(values);
+            op.apply(&mut self.inst)?;
+        }
+        Ok(())
+    }
 }
 
 /// The variables recorded by default: every output of every instance.
@@ -526,10 +743,40 @@ fn schedule(e: &Experiment, system: &System) -> Result<(u64, u64, bool)> {
     Ok((steps as u64, stride as u64, partial))
 }
 
+/// Refuses a system with two instances of an FMU that declares
+/// `canBeInstantiatedOnlyOncePerProcess`.
+fn check_single_instance(system: &System) -> Result<()> {
+    for (k, spec) in system.instances.iter().enumerate() {
+        let md = spec.fmu.description();
+        let once = match spec.fmu.interface() {
+            Interface::CoSimulation => {
+                md.co_simulation.as_ref().is_some_and(|c| c.can_be_instantiated_only_once_per_process)
+            }
+            Interface::ModelExchange => {
+                md.model_exchange.as_ref().is_some_and(|m| m.can_be_instantiated_only_once_per_process)
+            }
+        };
+        if !once {
+            continue;
+        }
+        if let Some(other) = system.instances[k + 1..].iter().find(|o| o.fmu.description().guid == md.guid) {
+            return Err(Error::Experiment(format!(
+                "{} and {} are instances of {} (GUID {}), which can be instantiated only once per process (canBeInstantiatedOnlyOncePerProcess)",
+                spec.name, other.name, md.model_name, md.guid
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
     let wall = Instant::now();
     let (steps, stride, partial) = schedule(experiment, system)?;
+    check_single_instance(system)?;
+    if experiment.threads == 0 {
+        return Err(Error::Experiment("threads must be at least 1".into()));
+    }
     let record: Vec<VariableRef> = match &experiment.record {
         None => default_record(system),
         Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
@@ -542,22 +789,46 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         });
     }
     let mut plan = Plan::new(system, &record, experiment.algorithm)?;
+    // Model Exchange instances connected to each other are integrated together
+    let mut group = crate::coupled::MeGroup::of(system)?;
     let record_slots: Vec<usize> =
         record.iter().map(|r| plan.sources.iter().position(|s| s == r).unwrap_or(0)).collect();
-    let mut record_gets: Vec<Op> = Vec::new();
-    for r in &record {
-        let slot = plan.sources.iter().position(|s| s == r).unwrap_or(0);
-        emit(&mut record_gets, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
-    }
-    // merge the record gets per instance and type
-    record_gets.sort_by_key(|op| (op.instance, op.base_type));
-    let mut merged: Vec<Op> = Vec::new();
-    for op in record_gets {
-        for k in 0..op.vrs.len() {
-            emit(&mut merged, op.instance, OpKind::Get, op.base_type, op.vrs[k], op.slots[k], (1.0, 0.0));
+    // all recorded variables, one get per instance and type (for the first row)
+    let merged_record_gets = |record: &[VariableRef]| {
+        let mut sorted: Vec<&VariableRef> = record.iter().collect();
+        sorted.sort_by_key(|r| (r.instance, r.base_type));
+        let mut ops: Vec<Op> = Vec::new();
+        for r in sorted {
+            let slot = plan.sources.iter().position(|s| s == r).unwrap_or(0);
+            emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
         }
-    }
-    let mut record_gets = merged;
+        ops
+    };
+    let mut record_gets = merged_record_gets(&record);
+    // ordered: a recorded variable that the propagation reads after the last set of its
+    // instance is already current in its slot; only the others are read at output points
+    let mut record_gets_ordered = match &plan.ordered {
+        Some(ops) => {
+            let mut last_set = vec![None; system.instances.len()];
+            for (k, op) in ops.iter().enumerate() {
+                if op.kind == OpKind::Set {
+                    last_set[op.instance] = Some(k);
+                }
+            }
+            let fresh = |slot: usize| {
+                ops.iter().enumerate().any(|(k, op)| {
+                    op.kind == OpKind::Get && last_set[op.instance].is_none_or(|l| k > l) && op.slots.contains(&slot)
+                })
+            };
+            let stale: Vec<VariableRef> = record
+                .iter()
+                .filter(|r| !fresh(plan.sources.iter().position(|s| s == *r).unwrap_or(0)))
+                .cloned()
+                .collect();
+            merged_record_gets(&stale)
+        }
+        None => Vec::new(),
+    };
 
     let single = system.instances.len() == 1;
     let names: Vec<String> =
@@ -569,116 +840,241 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     let mut results = Results { names, values: Vec::with_capacity(wanted) };
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
-    let mut instances: Vec<Instance> = Vec::with_capacity(system.instances.len());
-    for spec in &system.instances {
-        instances.push(Instance::new(&spec.fmu, &spec.name)?);
+    let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
+    for (index, spec) in system.instances.iter().enumerate() {
+        lanes.push(Lane {
+            index,
+            inst: Instance::new(&spec.fmu, &spec.name)?,
+            unit: None,
+            saved: None,
+            gets: std::mem::take(&mut plan.jacobi_gets[index]),
+            gets_rec: std::mem::take(&mut plan.jacobi_gets_rec[index]),
+            sets: std::mem::take(&mut plan.jacobi_sets[index]),
+            spent: Duration::ZERO,
+            retries: 0,
+            error: None,
+        });
     }
     let t0 = experiment.start_time;
-    for (inst, spec) in instances.iter_mut().zip(&system.instances) {
-        inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
-        apply_start_values(inst, spec)?;
-        inst.enter_initialization_mode()?;
+    for (lane, spec) in lanes.iter_mut().zip(&system.instances) {
+        lane.inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
+        apply_start_values(&mut lane.inst, spec)?;
+        lane.inst.enter_initialization_mode()?;
     }
-    let propagate_initial = |plan: &mut Plan, instances: &mut [Instance], values: &mut [f64]| -> Result<()> {
+    let propagate_initial = |plan: &mut Plan, lanes: &mut [Lane], values: &mut [f64]| -> Result<()> {
         match plan.ordered.as_mut() {
-            Some(ops) => run_ops(ops, instances, values, None),
+            Some(ops) => run_ops(ops, lanes, values, None),
             None => {
-                run_ops(&mut plan.jacobi_gets, instances, values, None)?;
-                run_ops(&mut plan.jacobi_sets, instances, values, None)
+                for lane in lanes.iter_mut() {
+                    for op in lane.gets.iter_mut() {
+                        op.run(&mut lane.inst, values)?;
+                    }
+                }
+                for lane in lanes.iter_mut() {
+                    lane.set_inputs(values)?;
+                }
+                Ok(())
             }
         }
     };
-    propagate_initial(&mut plan, &mut instances, &mut values)?;
-    let mut units: Vec<Option<MeUnit>> = Vec::with_capacity(instances.len());
-    for inst in instances.iter_mut() {
-        inst.exit_initialization_mode()?;
-        units.push(match inst.fmu().interface() {
-            Interface::ModelExchange => Some(MeUnit::initialize(inst)?),
+    propagate_initial(&mut plan, &mut lanes, &mut values)?;
+    for lane in lanes.iter_mut() {
+        lane.inst.exit_initialization_mode()?;
+        lane.unit = match lane.inst.fmu().interface() {
+            Interface::ModelExchange if group.as_ref().is_some_and(|g| g.contains(lane.index)) => {
+                Some(MeUnit::new(&lane.inst))
+            }
+            Interface::ModelExchange => Some(MeUnit::initialize(&mut lane.inst)?),
             Interface::CoSimulation => None,
-        });
+        };
     }
-    let solver = experiment.solver;
-    let mut saved: Vec<Option<crate::fmu::FmuState>> = Vec::with_capacity(instances.len());
-    for inst in instances.iter_mut() {
-        let capable = inst.fmu().interface() == Interface::CoSimulation
-            && inst.fmu().can_get_and_set_state()
-            && inst.fmu().can_handle_variable_step();
-        saved.push(if experiment.retry_discard && capable { Some(inst.get_state()?) } else { None });
+    if let Some(g) = group.as_mut() {
+        g.iterate(&mut lanes, t0)?; // the initial event iteration of the coupled ones, together
     }
-    let mut retries = 0u64;
-    propagate_initial(&mut plan, &mut instances, &mut values)?;
-    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+    for lane in lanes.iter_mut() {
+        let fmu = lane.inst.fmu();
+        let capable =
+            fmu.interface() == Interface::CoSimulation && fmu.can_get_and_set_state() && fmu.can_handle_variable_step();
+        if experiment.retry_discard && capable {
+            lane.saved = Some(lane.inst.get_state()?);
+        }
+    }
+    propagate_initial(&mut plan, &mut lanes, &mut values)?;
+    run_ops(&mut record_gets, &mut lanes, &mut values, None)?;
     push_row(&mut results, t0, &values, &record_slots);
 
-    let mut clocks = vec![Duration::ZERO; instances.len()];
     let profile = experiment.profile;
+    let mut profiler = Profiler::new(lanes.len());
+    let mut parallel_steps = 0u64;
     let h = experiment.step;
-    for n in 0..steps {
-        let t = t0 + n as f64 * h;
+    let solver = experiment.solver;
+    let point = |n: u64| {
         let last = n + 1 == steps;
         let t_next = if last && partial { experiment.stop_time } else { t0 + (n + 1) as f64 * h };
-        let dt = t_next - t; // as fmpy: the step is the difference of the two points
-        for (i, (inst, unit)) in instances.iter_mut().zip(units.iter_mut()).enumerate() {
-            let c = profile.then(Instant::now);
-            match (unit, &mut saved[i]) {
-                (Some(unit), _) => unit.advance(inst, solver, t, t_next)?,
-                (None, None) => inst.do_step(t, dt)?,
-                (None, Some(state)) => retries += step_with_retry(inst, state, t, dt, 0)?,
-            }
-            if let Some(c) = c {
-                clocks[i] += c.elapsed();
-            }
+        (t0 + n as f64 * h, t_next, (n + 1).is_multiple_of(stride) || last)
+    };
+    let row = |results: &mut Results, n: u64, t_next: f64, values: &[f64]| {
+        push_row(results, t_next, values, &record_slots);
+        if let Some(p) = experiment.progress {
+            p((n + 1) as f64 / steps as f64);
         }
-        let clk = if profile { Some(&mut clocks[..]) } else { None };
-        let output_point = (n + 1) % stride == 0 || last;
-        match (experiment.algorithm, plan.ordered.as_mut()) {
-            (Algorithm::Ordered, Some(ops)) => {
-                run_ops(ops, &mut instances, &mut values, clk)?;
+    };
+    match (experiment.algorithm, plan.ordered.as_mut()) {
+        (Algorithm::Ordered, Some(ops)) => {
+            for n in 0..steps {
+                let (t, t_next, output_point) = point(n);
+                let mut prof = profile.then_some(&mut profiler);
+                if let Some(p) = prof.as_deref_mut() {
+                    p.restart();
+                }
+                for lane in lanes.iter_mut() {
+                    if group.as_ref().is_some_and(|g| g.contains(lane.index)) {
+                        continue;
+                    }
+                    lane.advance(solver, t, t_next)?;
+                    if let Some(p) = prof.as_deref_mut() {
+                        p.charge(lane.index);
+                    }
+                }
+                if let Some(g) = group.as_mut() {
+                    g.advance(&mut lanes, solver, t, t_next)?;
+                    if let Some(p) = prof.as_deref_mut() {
+                        p.charge_shared(&g.members);
+                    }
+                }
+                run_ops(ops, &mut lanes, &mut values, prof)?;
                 if output_point {
-                    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+                    run_ops(&mut record_gets_ordered, &mut lanes, &mut values, None)?;
+                    row(&mut results, n, t_next, &values);
                 }
             }
-            _ => {
-                // outputs (and recorded values) right after the step, then the inputs
-                if output_point {
-                    run_ops(&mut record_gets, &mut instances, &mut values, None)?;
+        }
+        _ => {
+            // jacobi: per instance (in parallel when asked) inputs from the previous
+            // step, the step, its outputs; then all outputs into their slots
+            // a coupled Model Exchange group steps as one: no threads then
+            let threads = if group.is_some() { 1 } else { experiment.threads.min(lanes.len()) };
+            let mut first = 0;
+            // the pool stops when it is slower than one thread (see parallel.rs)
+            if threads > 1 {
+                // a few steps in one thread to measure each instance's cost, then the
+                // instances spread over the threads by that cost
+                let calibration = steps.min(CALIBRATION_STEPS);
+                let calibration_start = Instant::now();
+                for n in 0..calibration {
+                    let (t, t_next, output_point) = point(n);
+                    let a = StepArgs { set_inputs: n > 0, t, t_next, output_point, profile: true };
+                    for lane in lanes.iter_mut() {
+                        lane.jacobi_step(&values, a, solver)?;
+                    }
+                    for lane in lanes.iter() {
+                        lane.scatter(&mut values, output_point);
+                    }
+                    if output_point {
+                        row(&mut results, n, t_next, &values);
+                    }
                 }
-                let mut clk = clk;
-                run_ops(&mut plan.jacobi_gets, &mut instances, &mut values, clk.as_deref_mut())?;
-                run_ops(&mut plan.jacobi_sets, &mut instances, &mut values, clk)?;
+                first = calibration;
+                let serial_step = calibration_start.elapsed() / calibration.max(1) as u32;
+                if first < steps {
+                    let mut step_rows = |n: u64, values: &[f64]| {
+                        let (_, t_next, output_point) = point(n);
+                        if output_point {
+                            row(&mut results, n, t_next, values);
+                        }
+                    };
+                    let args = |n: u64| {
+                        let (t, t_next, output_point) = point(n);
+                        StepArgs { set_inputs: n > 0, t, t_next, output_point, profile }
+                    };
+                    let pool = crate::parallel::Pool { threads, solver, serial_step };
+                    let (back, next) = pool.run(lanes, &mut values, first..steps, &args, &mut step_rows)?;
+                    lanes = back;
+                    parallel_steps = next - first;
+                    first = next;
+                }
+            }
+            for n in first..steps {
+                let (t, t_next, output_point) = point(n);
+                let a = StepArgs { set_inputs: n > 0, t, t_next, output_point, profile };
+                match group.as_mut() {
+                    None => {
+                        for lane in lanes.iter_mut() {
+                            lane.jacobi_step(&values, a, solver)?;
+                        }
+                    }
+                    Some(g) => {
+                        // the group's members: all inputs, the steps together, all outputs
+                        for lane in lanes.iter_mut() {
+                            if g.contains(lane.index) {
+                                lane.jacobi_inputs(&values, a)?;
+                            } else {
+                                lane.jacobi_step(&values, a, solver)?;
+                            }
+                        }
+                        let start = profile.then(Instant::now);
+                        g.advance(&mut lanes, solver, t, t_next)?;
+                        if let Some(start) = start {
+                            let share = start.elapsed() / g.members.len().max(1) as u32;
+                            for &m in g.members.iter() {
+                                lanes[m].spent += share;
+                            }
+                        }
+                        for &m in g.members.iter() {
+                            lanes[m].jacobi_outputs(a)?;
+                        }
+                    }
+                }
+                for lane in lanes.iter() {
+                    lane.scatter(&mut values, output_point);
+                }
+                if output_point {
+                    row(&mut results, n, t_next, &values);
+                }
+            }
+            // the inputs of the last point, as after every other step
+            if steps > 0 {
+                for lane in lanes.iter_mut() {
+                    lane.set_inputs(&values)?;
+                }
+            }
+            if profile {
+                for lane in lanes.iter() {
+                    profiler.spent[lane.index] += lane.spent;
+                }
             }
         }
-        if output_point {
-            push_row(&mut results, t_next, &values, &record_slots);
-            if let Some(p) = experiment.progress {
-                p((n + 1) as f64 / steps as f64);
-            }
+    }
+    let mut summary = Summary { steps, parallel_steps, wall_time: Duration::ZERO, ..Summary::default() };
+    for lane in lanes.iter_mut() {
+        summary.discard_retries += lane.retries;
+        if let Some(state) = lane.saved.take() {
+            lane.inst.free_state(state)?;
+        }
+        if let Some(unit) = lane.unit.take() {
+            summary.integrator_steps.0 += unit.steps;
+            summary.integrator_steps.1 += unit.rejected;
+            summary.events.extend(unit.events);
         }
     }
-    let mut summary = Summary { steps, wall_time: Duration::ZERO, discard_retries: retries, ..Summary::default() };
-    for (inst, state) in instances.iter_mut().zip(saved) {
-        if let Some(state) = state {
-            inst.free_state(state)?;
-        }
-    }
-    for unit in units.into_iter().flatten() {
-        summary.integrator_steps.0 += unit.steps;
-        summary.integrator_steps.1 += unit.rejected;
-        summary.events.extend(unit.events);
-    }
-    for inst in instances.iter_mut() {
-        inst.terminate()?;
-        for rec in inst.take_log() {
+    for lane in lanes.iter_mut() {
+        lane.inst.terminate()?;
+        for rec in lane.inst.take_log() {
             if rec.status != crate::error::Status::Ok {
-                summary.warnings.push((inst.name().to_string(), rec.message));
+                summary.warnings.push((lane.inst.name().to_string(), rec.message));
             }
         }
     }
-    drop(instances);
-    summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(clocks).collect();
+    drop(lanes);
+    summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
     summary.wall_time = wall.elapsed();
     Ok((results, summary))
 }
+
+/// Steps run in one thread before the instances are spread over threads by their
+/// measured cost (and the time of one step in one thread taken as the mark the pool must
+/// beat).
+const CALIBRATION_STEPS: u64 = 200;
 
 /// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
 /// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.

@@ -4,7 +4,8 @@
  *   3 integrator: input u, output x, x' = u (exact for inputs held over a step)
  *   4 faulty:     output y = t; from t >= fail_time doStep returns `mode` (3 Error, 2 Discard)
  * Value references: Reals 0.. in the order listed in each modelDescription.xml.
- * Built with -DOMIT_DOSTEP the library lacks fmi2DoStep. */
+ * Built with -DOMIT_DOSTEP the library lacks fmi2DoStep; with -DWORK=N each fmi2DoStep also
+ * does N rounds of floating-point work (a heavier FMU for the thread benchmarks). */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -115,6 +116,13 @@ EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], 
 #ifndef OMIT_DOSTEP
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior) {
     Model *m = c;
+#ifdef WORK
+    {
+        volatile double acc = 0.0;
+        int k;
+        for (k = 0; k < WORK; k++) acc = acc * 0.999 + (double)k * h;
+    }
+#endif
 #if MODEL == 3
     m->r[1] += m->r[0] * h;
 #elif MODEL == 4

@@ -216,3 +216,42 @@ pub fn build_ball(dir: &Path) -> PathBuf {
     );
     fmu
 }
+
+/// The discrete latch (tests/cfmu/latch.c), Model Exchange only, as `<dir>/latch.fmu`.
+pub fn build_latch(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/latch.c");
+    let so = dir.join("latch.so");
+    let status = Command::new("cc")
+        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
+        .arg(&src)
+        .arg("-o")
+        .arg(&so)
+        .status()
+        .expect("run cc");
+    assert!(status.success());
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="latch" guid="{latch}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="latch"/>
+  <ModelVariables>
+    <ScalarVariable name="u" valueReference="0" causality="input"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output" variability="discrete" initial="exact"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="count" valueReference="2" causality="output" variability="discrete" initial="exact"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="t_last" valueReference="3" causality="output" variability="discrete" initial="exact"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="mode" valueReference="4" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="t_event" valueReference="5" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="2" dependencies=""/><Unknown index="3" dependencies=""/><Unknown index="4" dependencies=""/></Outputs>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    let fmu = dir.join("latch.fmu");
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", xml.as_bytes().to_vec()),
+            ("binaries/linux64/latch.so", std::fs::read(&so).unwrap()),
+        ],
+    );
+    fmu
+}

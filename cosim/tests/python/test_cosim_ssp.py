@@ -59,3 +59,21 @@ def test_cosim_info_lists_the_ssp(cosim, exported_ssp):
     r = subprocess.run([str(cosim), "info", str(exported_ssp)], capture_output=True, text=True, check=True)
     assert "4 instances, 3 connections" in r.stdout
     assert "amp.y [m] -> plant.mu_fl [-]" in r.stdout
+
+
+def test_threads_option_gives_the_same_csv_and_says_how_many_steps_ran_in_the_pool(cosim, exported_ssp, tmp_path):
+    import json
+    outs = []
+    for threads in (1, 2):
+        out, summary = tmp_path / f"t{threads}.csv", tmp_path / f"t{threads}.json"
+        subprocess.run([str(cosim), "run", str(exported_ssp), "--stop-time", "1.5", "--step", "1e-3",
+                        "--algorithm", "jacobi", "--threads", str(threads), "--output", str(out),
+                        "--summary", str(summary)], check=True, capture_output=True)
+        outs.append(out.read_bytes())
+        pooled = json.loads(summary.read_text())["parallel_steps"]
+        # 200 calibration steps in one thread, then at least the pool's 1000 probe steps
+        assert pooled == 0 if threads == 1 else 1000 <= pooled <= 1300, (threads, pooled)
+    assert outs[0] == outs[1]
+    r = subprocess.run([str(cosim), "run", str(exported_ssp), "--stop-time", "0.1", "--threads", "0"],
+                       capture_output=True, text=True)
+    assert r.returncode != 0 and "--threads must be at least 1" in r.stderr

@@ -1,0 +1,313 @@
+//! Model Exchange instances coupled by connections, integrated together so that an event
+//! of any of them is an event of all (FMI 2.0 section 3.2.3, for a system of FMUs).
+//!
+//! Over a communication step the members advance in lockstep: one common internal step
+//! (RK4 with the same sub-steps; Dormand-Prince with the smallest step any member asks
+//! for, rejected if any member's error is too large), each member's event indicators
+//! checked after it. The earliest event of any member (a time event, the first state
+//! event crossing located by the Illinois method, a step event) ends the step of all:
+//! every member is integrated to that time and enters event mode; then, until a fixed
+//! point, outputs are carried through the connections between members in topological
+//! order and every member calls `fmi2NewDiscreteStates`. The iteration ends when no
+//! member asks for another one and no input changed in the last propagation; after
+//! [`MAX_EVENT_ROUNDS`] rounds it stops with [`Error::EventIteration`] naming the members
+//! still changing. Then every member enters continuous-time mode.
+//!
+//! Between events the members' inputs are held, as for any instance over a
+//! communication step; the connections from and to Co-Simulation instances are carried at
+//! communication points only.
+
+use crate::error::{Error, Result};
+use crate::fmu::Interface;
+use crate::me::{Event, Solver, EVENT_TIME_TOLERANCE};
+use crate::simulate::{ordered_ops, Lane, Op};
+use crate::system::{Connection, System, VariableRef};
+
+/// Rounds of the event iteration before it is declared not converging.
+pub const MAX_EVENT_ROUNDS: usize = 100;
+
+/// The Model Exchange instances of a system with at least one connection between two of them.
+pub(crate) struct MeGroup {
+    /// Lane (instance) indices of the members: every Model Exchange instance.
+    pub(crate) members: std::sync::Arc<[usize]>,
+    /// The connections between members, in topological order.
+    ops: Vec<Op>,
+    values: Vec<f64>,
+    before: Vec<f64>,
+}
+
+impl MeGroup {
+    /// The group of `system`, if two of its Model Exchange instances are connected.
+    pub(crate) fn of(system: &System) -> Result<Option<MeGroup>> {
+        let me = |i: usize| system.instances[i].fmu.interface() == Interface::ModelExchange;
+        let links: Vec<Connection> =
+            system.connections.iter().filter(|c| me(c.from.instance) && me(c.to.instance)).cloned().collect();
+        if links.is_empty() {
+            return Ok(None);
+        }
+        let members: std::sync::Arc<[usize]> = (0..system.instances.len()).filter(|i| me(*i)).collect();
+        let sub = System { instances: system.instances.clone(), connections: links };
+        let mut sources: Vec<VariableRef> = Vec::new();
+        for c in &sub.connections {
+            if !sources.contains(&c.from) {
+                sources.push(c.from.clone());
+            }
+        }
+        let ops = ordered_ops(&sub, &sources, &sources)?;
+        let n = sources.len();
+        Ok(Some(MeGroup { members, ops, values: vec![0.0; n], before: vec![0.0; n] }))
+    }
+
+    /// Whether lane `i` is a member.
+    pub(crate) fn contains(&self, i: usize) -> bool {
+        self.members.contains(&i)
+    }
+
+    /// Carries the members' connections; returns whether any carried value changed since
+    /// the last propagation, and appends the members whose inputs changed to `changed`.
+    fn propagate(&mut self, lanes: &mut [Lane], changed: &mut Vec<usize>) -> Result<bool> {
+        self.before.copy_from_slice(&self.values);
+        for op in self.ops.iter_mut() {
+            op.run(&mut lanes[op.instance].inst, &mut self.values)?;
+        }
+        let mut any = false;
+        for op in &self.ops {
+            if op.is_set() && op.slots().iter().any(|s| self.values[*s].to_bits() != self.before[*s].to_bits()) {
+                any = true;
+                if !changed.contains(&op.instance) {
+                    changed.push(op.instance);
+                }
+            }
+        }
+        Ok(any)
+    }
+
+    /// The event iteration of all members, which are in event mode at `time`; ends with
+    /// all of them in continuous-time mode, their states and indicators read again.
+    pub(crate) fn iterate(&mut self, lanes: &mut [Lane], time: f64) -> Result<()> {
+        let mut unsettled = Vec::new();
+        // the members unsettled in the last rounds (an oscillation alternates them)
+        let mut recent: Vec<usize> = Vec::new();
+        self.propagate(lanes, &mut unsettled)?;
+        for round in 0..MAX_EVENT_ROUNDS {
+            unsettled.clear();
+            for &m in self.members.iter() {
+                let lane = &mut lanes[m];
+                let Some(unit) = lane.unit.as_mut() else { continue };
+                let info = lane.inst.new_discrete_states()?;
+                if info.terminate_simulation != 0 {
+                    unit.terminated = true;
+                }
+                unit.next_time_event = (info.next_event_time_defined != 0).then_some(info.next_event_time);
+                if info.new_discrete_states_needed != 0 {
+                    unsettled.push(m);
+                }
+            }
+            let changed = self.propagate(lanes, &mut unsettled)?;
+            if round + 10 >= MAX_EVENT_ROUNDS {
+                for m in &unsettled {
+                    if !recent.contains(m) {
+                        recent.push(*m);
+                    }
+                }
+            }
+            if unsettled.is_empty() && !changed {
+                for &m in self.members.iter() {
+                    let lane = &mut lanes[m];
+                    let Some(unit) = lane.unit.as_mut() else { continue };
+                    lane.inst.enter_continuous_time_mode()?;
+                    unit.resume(&mut lane.inst)?;
+                }
+                return Ok(());
+            }
+        }
+        recent.sort_unstable();
+        Err(Error::EventIteration {
+            time,
+            rounds: MAX_EVENT_ROUNDS,
+            instances: recent.iter().map(|m| lanes[*m].inst.name().to_string()).collect(),
+        })
+    }
+
+    /// An event at `time` caused by `who` (recorded as `kind`): all members enter event
+    /// mode and iterate together.
+    fn event(&mut self, lanes: &mut [Lane], time: f64, kind: &'static str, who: &[usize]) -> Result<()> {
+        for &m in self.members.iter() {
+            lanes[m].inst.enter_event_mode()?;
+        }
+        for &m in who {
+            let lane = &mut lanes[m];
+            if let Some(unit) = lane.unit.as_mut() {
+                unit.events.push(Event { instance: lane.inst.name().to_string(), time, kind });
+            }
+        }
+        self.iterate(lanes, time)
+    }
+
+    /// Integrates all members from `t` to `t_end` together, their inputs held between
+    /// events.
+    pub(crate) fn advance(&mut self, lanes: &mut [Lane], solver: Solver, t: f64, t_end: f64) -> Result<()> {
+        let mut t = t;
+        let span = t_end - t;
+        let eps = 1e-13 * t_end.abs().max(1.0);
+        let members = self.members.clone();
+        let members: &[usize] = &members;
+        for &m in members {
+            if let Some(u) = lanes[m].unit.as_mut() {
+                if u.h_adaptive <= 0.0 {
+                    u.h_adaptive = span * 0.1;
+                }
+            }
+        }
+        let next_time_event = |lanes: &[Lane], m: usize| lanes[m].unit.as_ref().and_then(|u| u.next_time_event);
+        loop {
+            if t >= t_end - eps || members.iter().any(|m| lanes[*m].unit.as_ref().is_some_and(|u| u.terminated)) {
+                return Ok(());
+            }
+            // time events due now
+            let due: Vec<usize> = members
+                .iter()
+                .copied()
+                .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps))
+                .collect();
+            if !due.is_empty() {
+                self.event(lanes, t, "time", &due)?;
+                if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
+                    return Err(Error::Experiment(format!(
+                        "{}: time event at {t} repeats at the same time",
+                        lanes[*m].inst.name()
+                    )));
+                }
+                continue;
+            }
+            // the end of this stretch: the earliest time event or the end of the step
+            let mut target = t_end;
+            let mut time_event = false;
+            for &m in members {
+                if let Some(te) = next_time_event(lanes, m) {
+                    if te <= t_end + eps && te.max(t) <= target {
+                        target = te.max(t);
+                        time_event = true;
+                    }
+                }
+            }
+            let h_max = target - t;
+            let mut h = match solver {
+                Solver::Rk4 { max_step } => {
+                    let hm = max_step.unwrap_or(span).max(1e-300);
+                    h_max / ((h_max / hm) * (1.0 - 1e-12)).ceil().max(1.0)
+                }
+                Solver::Dopri5 { .. } => {
+                    members.iter().filter_map(|m| lanes[*m].unit.as_ref().map(|u| u.h_adaptive)).fold(h_max, f64::min)
+                }
+            };
+            for &m in members {
+                let lane = &mut lanes[m];
+                if let Some(u) = lane.unit.as_mut() {
+                    u.begin_step(&mut lane.inst, t)?;
+                }
+            }
+            match solver {
+                Solver::Dopri5 { rtol, atol } => loop {
+                    let mut err = 0.0f64;
+                    for &m in members {
+                        let lane = &mut lanes[m];
+                        if let Some(u) = lane.unit.as_mut() {
+                            err = err.max(u.dopri(&mut lane.inst, t, h, rtol, atol)?);
+                        }
+                    }
+                    let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+                    if err <= 1.0 || h <= 1e-14 * t_end.abs().max(1.0) {
+                        for &m in members {
+                            if let Some(u) = lanes[m].unit.as_mut() {
+                                u.h_adaptive = (h * factor).min(span.max(h));
+                            }
+                        }
+                        break;
+                    }
+                    if let Some(u) = lanes[members[0]].unit.as_mut() {
+                        u.rejected += 1;
+                    }
+                    h *= factor.min(0.9);
+                },
+                Solver::Rk4 { .. } => {
+                    for &m in members {
+                        let lane = &mut lanes[m];
+                        if let Some(u) = lane.unit.as_mut() {
+                            u.rk4(&mut lane.inst, t, h)?;
+                        }
+                    }
+                }
+            }
+            let t_new = if (t + h - target).abs() <= eps { target } else { t + h };
+            // state events: the earliest crossing of any member
+            let mut first: Option<f64> = None;
+            let mut crossings: Vec<(usize, f64)> = Vec::new();
+            for &m in members {
+                let lane = &mut lanes[m];
+                let Some(u) = lane.unit.as_mut() else { continue };
+                u.indicators_at(&mut lane.inst, t_new)?;
+                if crate::me::MeUnit::crossed(&u.z0, &u.z) {
+                    let hi = u.locate_crossing(&mut lane.inst, solver, t, t_new - t)?;
+                    crossings.push((m, hi));
+                    first = Some(first.map_or(hi, |f: f64| f.min(hi)));
+                }
+            }
+            if let Some(hi) = first {
+                let te = t + hi;
+                for &m in members {
+                    let lane = &mut lanes[m];
+                    let Some(u) = lane.unit.as_mut() else { continue };
+                    u.one_step(&mut lane.inst, solver, t, hi)?;
+                    lane.inst.set_time(te)?;
+                    lane.inst.set_continuous_states(&u.xt)?;
+                    u.x.copy_from_slice(&u.xt);
+                    u.steps += 1;
+                    lane.inst.completed_integrator_step()?;
+                }
+                let who: Vec<usize> =
+                    crossings.iter().filter(|(_, h)| *h <= hi + EVENT_TIME_TOLERANCE).map(|(m, _)| *m).collect();
+                self.event(lanes, te, "state", &who)?;
+                if let Solver::Dopri5 { .. } = solver {
+                    for &m in members {
+                        if let Some(u) = lanes[m].unit.as_mut() {
+                            u.h_adaptive = u.h_adaptive.min(span * 0.1);
+                        }
+                    }
+                }
+                t = te;
+                continue;
+            }
+            // the step is accepted by every member
+            let mut step_events: Vec<usize> = Vec::new();
+            for &m in members {
+                let lane = &mut lanes[m];
+                let Some(u) = lane.unit.as_mut() else { continue };
+                u.x.copy_from_slice(&u.xt);
+                lane.inst.set_time(t_new)?;
+                lane.inst.set_continuous_states(&u.x)?;
+                u.steps += 1;
+                std::mem::swap(&mut u.z0, &mut u.z);
+                let (step_event, terminate) = lane.inst.completed_integrator_step()?;
+                if terminate {
+                    u.terminated = true;
+                }
+                if step_event {
+                    step_events.push(m);
+                }
+            }
+            t = t_new;
+            let at_time_event = time_event && t >= target - eps;
+            if at_time_event {
+                let due: Vec<usize> = members
+                    .iter()
+                    .copied()
+                    .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps) || step_events.contains(m))
+                    .collect();
+                self.event(lanes, t, "time", &due)?;
+            } else if !step_events.is_empty() {
+                self.event(lanes, t, "step", &step_events)?;
+            }
+        }
+    }
+}

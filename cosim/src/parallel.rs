@@ -1,0 +1,219 @@
+//! `jacobi` with the instances spread over threads.
+//!
+//! A pool lives for one run (`std::thread::scope`): `threads - 1` workers plus the
+//! calling thread, each owning a fixed group of instances ([`Lane`]s) chosen by their
+//! measured cost (longest first, onto the least loaded thread). Per communication step
+//! the calling thread publishes the step (an epoch counter), every thread steps its own
+//! instances (inputs from the previous step's values, the step, outputs fetched into
+//! each instance's buffers), the calling thread waits for all, then writes every
+//! instance's outputs into the value slots and records the row. An instance is only ever
+//! called by one thread at a time, always with the same sequence of calls as in one
+//! thread, so the results are identical to the serial run.
+//!
+//! The pool runs only while it pays: after its first 1000 steps it is compared with the
+//! wall time per step measured in one thread over the calibration steps, and stops if it
+//! is slower (the summary's `parallel_steps` says how many steps it ran).
+//!
+//! Threads wait for the next step by spinning briefly (a step of a few microseconds is
+//! shorter than putting a thread to sleep and waking it again), then park; the thread
+//! that makes them ready unparks them, which costs one atomic operation when they are
+//! not parked. On a machine with no free core the spinning only delays the others, so
+//! it is short.
+
+use crate::error::{Error, Result};
+use crate::me::Solver;
+use crate::simulate::{Lane, StepArgs};
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard, RwLock};
+
+/// Busy-wait before parking (`pause` takes from 10 to 140 cycles depending on the
+/// processor, so the bound is a time, checked every 32 spins).
+const SPIN_TIME: std::time::Duration = std::time::Duration::from_micros(10);
+
+struct Shared {
+    groups: Vec<Mutex<Vec<Lane>>>,
+    values: RwLock<Vec<f64>>,
+    args: Mutex<StepArgs>,
+    epoch: AtomicU64,
+    done: AtomicUsize,
+    stop: AtomicBool,
+    panicked: AtomicBool,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn wait_until(ready: impl Fn() -> bool) {
+    if ready() {
+        return;
+    }
+    let start = std::time::Instant::now();
+    let mut spinning = true;
+    let mut spins = 0u32;
+    while !ready() {
+        if spinning {
+            std::hint::spin_loop();
+            spins += 1;
+            if spins.is_multiple_of(32) && start.elapsed() > SPIN_TIME {
+                spinning = false;
+            }
+        } else {
+            // unparked by the thread that makes us ready; the timeout only bounds a
+            // wake-up lost to a race (park tokens make that rare)
+            std::thread::park_timeout(std::time::Duration::from_millis(1));
+        }
+    }
+}
+
+/// Steps the instances of group `g` once; an error stays in its lane, a panic is flagged.
+fn work(shared: &Shared, g: usize, solver: Solver) {
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let a = *lock(&shared.args);
+        let values = shared.values.read().unwrap_or_else(|e| e.into_inner());
+        let mut lanes = lock(&shared.groups[g]);
+        for lane in lanes.iter_mut() {
+            if let Err(e) = lane.jacobi_step(&values, a, solver) {
+                lane.error = Some(e);
+                break;
+            }
+        }
+    }));
+    if outcome.is_err() {
+        shared.panicked.store(true, Ordering::Release);
+    }
+}
+
+/// Groups of lanes with about equal measured cost (`Lane::spent`), longest first onto
+/// the least loaded group.
+fn partition(mut lanes: Vec<Lane>, threads: usize) -> Vec<Vec<Lane>> {
+    lanes.sort_by(|a, b| b.spent.cmp(&a.spent).then(a.index.cmp(&b.index)));
+    let mut groups: Vec<Vec<Lane>> = (0..threads).map(|_| Vec::new()).collect();
+    let mut load = vec![std::time::Duration::ZERO; threads];
+    for lane in lanes {
+        let g = (0..threads).min_by_key(|g| (load[*g], *g)).unwrap_or(0);
+        load[g] += lane.spent;
+        groups[g].push(lane);
+    }
+    for g in groups.iter_mut() {
+        g.sort_by_key(|l| l.index);
+    }
+    groups
+}
+
+/// Steps in the pool before it is compared with one thread.
+const PROBE_STEPS: u64 = 1000;
+
+/// A pool for one run.
+pub(crate) struct Pool {
+    /// Threads, the calling one included (at least 2, at most the number of lanes).
+    pub(crate) threads: usize,
+    pub(crate) solver: Solver,
+    /// Wall time of one step in one thread (measured): after [`PROBE_STEPS`] steps
+    /// slower than this, the pool stops and the caller goes on in one thread.
+    pub(crate) serial_step: std::time::Duration,
+}
+
+impl Pool {
+    /// Runs the `jacobi` steps `steps`. `args(n)` gives step `n`; `row(n, values)` is called
+    /// after each step with all outputs in their slots. Returns the lanes in their original
+    /// order and the first step not run (the end of `steps` unless the pool was slower than
+    /// one thread). The first error (lowest instance index) of a step ends the run.
+    pub(crate) fn run(
+        &self,
+        lanes: Vec<Lane>,
+        values: &mut Vec<f64>,
+        steps: Range<u64>,
+        args: &dyn Fn(u64) -> StepArgs,
+        row: &mut dyn FnMut(u64, &[f64]),
+    ) -> Result<(Vec<Lane>, u64)> {
+        let solver = self.solver;
+        let threads = self.threads.clamp(1, lanes.len().max(1));
+        let shared = Shared {
+            groups: partition(lanes, threads).into_iter().map(Mutex::new).collect(),
+            values: RwLock::new(std::mem::take(values)),
+            args: Mutex::new(StepArgs::default()),
+            epoch: AtomicU64::new(0),
+            done: AtomicUsize::new(0),
+            stop: AtomicBool::new(false),
+            panicked: AtomicBool::new(false),
+        };
+        let main = std::thread::current();
+        let result = std::thread::scope(|scope| {
+            let mut workers = Vec::with_capacity(threads - 1);
+            for g in 1..threads {
+                let shared = &shared;
+                let main = main.clone();
+                let handle = scope.spawn(move || {
+                    let mut seen = 0;
+                    loop {
+                        wait_until(|| shared.epoch.load(Ordering::Acquire) != seen);
+                        seen = shared.epoch.load(Ordering::Acquire);
+                        if shared.stop.load(Ordering::Acquire) {
+                            return;
+                        }
+                        work(shared, g, solver);
+                        shared.done.fetch_add(1, Ordering::AcqRel);
+                        main.unpark();
+                    }
+                });
+                workers.push(handle.thread().clone());
+            }
+            let mut drive = || -> Result<u64> {
+                let start = std::time::Instant::now();
+                let first = steps.start;
+                for n in steps.clone() {
+                    if n == first + PROBE_STEPS && start.elapsed() > self.serial_step * PROBE_STEPS as u32 {
+                        return Ok(n); // slower than one thread: the caller goes on alone
+                    }
+                    let a = args(n);
+                    *lock(&shared.args) = a;
+                    shared.done.store(0, Ordering::Release);
+                    shared.epoch.fetch_add(1, Ordering::AcqRel);
+                    for w in &workers {
+                        w.unpark();
+                    }
+                    work(&shared, 0, solver);
+                    wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
+                    if shared.panicked.load(Ordering::Acquire) {
+                        return Err(Error::Experiment("a thread stepping the instances panicked".into()));
+                    }
+                    let mut values = shared.values.write().unwrap_or_else(|e| e.into_inner());
+                    let mut first: Option<(usize, Error)> = None;
+                    for g in &shared.groups {
+                        for lane in lock(g).iter_mut() {
+                            if let Some(e) = lane.error.take() {
+                                if first.as_ref().is_none_or(|(i, _)| lane.index < *i) {
+                                    first = Some((lane.index, e));
+                                }
+                            }
+                        }
+                    }
+                    if let Some((_, e)) = first {
+                        return Err(e);
+                    }
+                    for g in &shared.groups {
+                        for lane in lock(g).iter() {
+                            lane.scatter(&mut values, a.output_point);
+                        }
+                    }
+                    row(n, &values);
+                }
+                Ok(steps.end)
+            };
+            let result = drive();
+            shared.stop.store(true, Ordering::Release);
+            shared.epoch.fetch_add(1, Ordering::AcqRel);
+            for w in &workers {
+                w.unpark();
+            }
+            result
+        });
+        *values = shared.values.into_inner().unwrap_or_else(|e| e.into_inner());
+        let mut lanes: Vec<Lane> =
+            shared.groups.into_iter().flat_map(|g| g.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
+        lanes.sort_by_key(|l| l.index);
+        result.map(|next| (lanes, next))
+    }
+}

@@ -1,0 +1,138 @@
+/* A discrete FMI 2.0 Model Exchange FMU with no continuous state, for event iteration
+ * across coupled FMUs. Reals (value references): 0 u (input), 1 y (output, discrete),
+ * 2 count (output), 3 t_last (output), 4 mode (parameter), 5 t_event (parameter).
+ *   mode 0, counter: at each event iteration, if u > 0 and the u of its previous event
+ *           iteration was <= 0, count += 1 and t_last = the time; y = count. It never
+ *           asks for another iteration itself: it only sees a new u if the master
+ *           propagates it within the event.
+ *   mode 1, follower: once its time event at t_event has come, y = u at each event
+ *           iteration (before, y holds).
+ *   mode 2, inverter: at each event iteration y = 1 - u.
+ * A follower and an inverter in a loop have no fixed point once the follower follows.
+ * A time event at t_event (if > 0). Its outputs do not depend on its input directly
+ * (they change only in event mode). */
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef int fmi2Status;
+typedef unsigned int fmi2ValueReference;
+typedef struct {
+    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void *stepFinished;
+    void *componentEnvironment;
+} fmi2CallbackFunctions;
+typedef struct {
+    int newDiscreteStatesNeeded, terminateSimulation, nominalsOfContinuousStatesChanged,
+        valuesOfContinuousStatesChanged, nextEventTimeDefined;
+    double nextEventTime;
+} fmi2EventInfo;
+
+#define NR 6
+typedef struct {
+    double r[NR];
+    double time, u_prev;
+    int fired;
+} Latch;
+
+#define EXPORT __attribute__((visibility("default")))
+#define ERR 3
+
+static void defaults(Latch *l) { memset(l, 0, sizeof *l); }
+
+EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cat[]) { return 0; }
+EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
+                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
+    Latch *l;
+    if (!cb || !cb->logger || type != 0) return NULL;
+    l = calloc(1, sizeof *l);
+    defaults(l);
+    return l;
+}
+EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
+    ((Latch *)c)->time = t0;
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    Latch *l = c;
+    l->u_prev = l->r[0];
+    return 0;
+}
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
+    Latch *l = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= NR) return ERR;
+        v[i] = l->r[vr[i]];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
+    Latch *l = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= NR) return ERR;
+        l->r[vr[i]] = v[i];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? ERR : 0; }
+
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    Latch *l = c;
+    double u = l->r[0];
+    memset(info, 0, sizeof *info);
+    if (l->r[5] > 0.0 && l->time >= l->r[5]) l->fired = 1;
+    if (l->r[4] == 1.0) {
+        if (l->fired) l->r[1] = u;
+    } else if (l->r[4] == 2.0) {
+        l->r[1] = 1.0 - u;
+    } else {
+        if (u > 0.0 && l->u_prev <= 0.0) {
+            l->r[2] += 1.0;
+            l->r[3] = l->time;
+        }
+        l->r[1] = l->r[2];
+    }
+    l->u_prev = u;
+    if (l->r[5] > 0.0 && !l->fired) {
+        info->nextEventTimeDefined = 1;
+        info->nextEventTime = l->r[5];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
+    *enterEventMode = 0;
+    *terminate = 0;
+    return 0;
+}
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Latch *)c)->time = t; return 0; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return ERR; }
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) { return ERR; }
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { return ERR; }
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return ERR; }
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return ERR; }
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return ERR; }
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                               const fmi2ValueReference z[], size_t nz, const double dv[],
+                                               double dz[]) { return ERR; }
