@@ -45,7 +45,7 @@ fn cases() -> Vec<Case> {
         (
             "nigel_plant",
             vec![
-                ("v_x", "0.35"),
+                ("v_x_start", "0.35"),
                 ("delta_fl", "0.2"),
                 ("delta_fr", "0.25"),
                 ("delta_rl", "-0.1"),
