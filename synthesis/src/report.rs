@@ -8,8 +8,8 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::design::{
-    min_h2, min_hinf, pareto_sweep, pole_placement_baseline, weighted, Design, SweepOptions, SweepProgress,
-    SynthesisError, SynthesisOptions,
+    min_h2, min_hinf, pareto_sweep, pole_placement_baseline, weighted, Design, ParetoSweep, SweepOptions,
+    SweepProgress, SynthesisError, SynthesisOptions,
 };
 use crate::lmi::SolverStats;
 use crate::plant::{Architecture, PlantSpec, TrackingSpec, TrackingWeights};
@@ -18,7 +18,7 @@ use crate::tracking::{
     design_tracking, offset_recovery, servo_loop_max_real_part, tracking_region, wind_step, ResponsePeaks,
     TrackingDesign,
 };
-use crate::verify::{verify_design, PointCheck, VerifyOptions};
+use crate::verify::{verify_design, PointCheck, VerificationReport, VerifyOptions};
 
 /// Wheel names in the order of the rows of the full 4x2 gain.
 pub const WHEEL_NAMES: [&str; 4] = ["FL", "FR", "RL", "RR"];
@@ -328,21 +328,7 @@ pub fn run(
             let sweep = pareto_sweep(&poly, &req.region, &req.sweep, &req.options, progress)?;
             gamma_star = Some(sweep.gamma_star());
             gamma_star_stats = Some(sweep.hinf_optimum.stats.clone());
-            all_stats.push(sweep.hinf_optimum.stats.clone());
-            for p in &sweep.points {
-                let stats = p.result.as_ref().ok().map(|d| d.stats.clone());
-                if let Some(s) = &stats {
-                    all_stats.push(s.clone());
-                }
-                pareto.push(ParetoEntry {
-                    k: p.k,
-                    g: p.g,
-                    nu: p.nu(),
-                    distance: p.distance(),
-                    error: p.result.as_ref().err().map(|e| e.to_string()),
-                    solver: stats,
-                });
-            }
+            pareto = pareto_entries(&sweep, &mut all_stats);
             let c = sweep.chosen_point();
             chosen = ChosenPoint { k: Some(c.k), g: Some(c.g), nu: c.nu() };
             sweep
@@ -389,30 +375,13 @@ pub fn run(
     let t1 = Instant::now();
     let v = verify_design(&poly, &region, &design.gain, design.gamma, design.nu, &req.verify);
     let verification_s = t1.elapsed().as_secs_f64();
-    let all: Vec<&PointCheck> = v.vertices.iter().chain(v.interior.iter()).collect();
     let spec = &req.spec;
     let x = &design.lyapunov;
-    let max_violation = all_stats.iter().map(|s| s.max_constraint_violation).fold(0.0, f64::max);
     Ok(SynthesisReport {
         tool: "nigel-synthesis",
         version: env!("CARGO_PKG_VERSION"),
         objective: req.objective.name(),
-        plant: PlantReport {
-            architecture: spec.architecture,
-            d2: spec.disturbance.name(),
-            speed: spec.speed,
-            mu_min: spec.mu_min,
-            mu_max: spec.mu_max,
-            m: spec.params.m,
-            i_z: spec.params.i_z,
-            l_f: spec.params.l_f,
-            l_r: spec.params.l_r,
-            track: spec.params.track,
-            cornering_stiffness: spec.params.c,
-            bw: [poly.bw[(0, 0)], poly.bw[(1, 0)]],
-            n_vertices: poly.vertices.len(),
-            steered_wheels: spec.architecture.steered_wheels().iter().map(|&w| WHEEL_NAMES[w]).collect(),
-        },
+        plant: PlantReport::new(spec, [poly.bw[(0, 0)], poly.bw[(1, 0)]], poly.vertices.len()),
         region: region.parts.clone(),
         region_description: region.describe(),
         margin: req.options.margin,
@@ -425,17 +394,84 @@ pub fn run(
         k_columns: ["beta", "r"],
         x: [[x[(0, 0)], x[(0, 1)]], [x[(1, 0)], x[(1, 1)]]],
         vertices: v.vertices.clone(),
-        actual: ActualNorms {
+        actual: ActualNorms::of(&v),
+        verification: VerificationSummary::of(&v, req.verify.seed),
+        solver: SolverSummary::of(&all_stats, gamma_star_stats, &design.stats, req.options.margin),
+        timings: Timings { design_s, verification_s, total_s: t0.elapsed().as_secs_f64() },
+        baseline,
+    })
+}
+
+impl PlantReport {
+    /// The design model `spec` with its disturbance column `bw = [d1, d2]`.
+    fn new(spec: &PlantSpec, bw: [f64; 2], n_vertices: usize) -> PlantReport {
+        PlantReport {
+            architecture: spec.architecture,
+            d2: spec.disturbance.name(),
+            speed: spec.speed,
+            mu_min: spec.mu_min,
+            mu_max: spec.mu_max,
+            m: spec.params.m,
+            i_z: spec.params.i_z,
+            l_f: spec.params.l_f,
+            l_r: spec.params.l_r,
+            track: spec.params.track,
+            cornering_stiffness: spec.params.c,
+            bw,
+            n_vertices,
+            steered_wheels: spec.architecture.steered_wheels().iter().map(|&w| WHEEL_NAMES[w]).collect(),
+        }
+    }
+
+    fn architecture_name(&self) -> &'static str {
+        self.architecture.name()
+    }
+}
+
+/// The grid of a Pareto sweep as the report lists it; appends the statistics of every
+/// solve (the `gamma*` solve first, then each solved grid point) to `all_stats`.
+fn pareto_entries(sweep: &ParetoSweep, all_stats: &mut Vec<SolverStats>) -> Vec<ParetoEntry> {
+    all_stats.push(sweep.hinf_optimum.stats.clone());
+    sweep
+        .points
+        .iter()
+        .map(|p| {
+            let stats = p.result.as_ref().ok().map(|d| d.stats.clone());
+            all_stats.extend(stats.iter().cloned());
+            ParetoEntry {
+                k: p.k,
+                g: p.g,
+                nu: p.nu(),
+                distance: p.distance(),
+                error: p.result.as_ref().err().map(|e| e.to_string()),
+                solver: stats,
+            }
+        })
+        .collect()
+}
+
+impl ActualNorms {
+    /// The certified bounds and worst actual norms of a verification (vertices and
+    /// interior points).
+    fn of(v: &VerificationReport) -> ActualNorms {
+        let all = || v.vertices.iter().chain(v.interior.iter());
+        ActualNorms {
             hinf_bound: v.gamma_bound,
             hinf_worst: v.worst_hinf,
-            hinf_worst_sweep: all.iter().map(|p| p.hinf_sweep).fold(0.0, f64::max),
+            hinf_worst_sweep: all().map(|p| p.hinf_sweep).fold(0.0, f64::max),
             h2_bound: v.nu_bound,
             h2_worst: v.worst_h2,
-            h2_worst_integrated: all.iter().map(|p| p.h2_integrated).fold(0.0, f64::max),
+            h2_worst_integrated: all().map(|p| p.h2_integrated).fold(0.0, f64::max),
             hinf_methods_rel_diff: v.hinf_methods_rel_diff,
             h2_methods_rel_diff: v.h2_methods_rel_diff,
-        },
-        verification: VerificationSummary {
+        }
+    }
+}
+
+impl VerificationSummary {
+    /// The verdicts of a verification whose interior points came from `seed`.
+    fn of(v: &VerificationReport, seed: u64) -> VerificationSummary {
+        VerificationSummary {
             passed: v.passed(),
             all_stable: v.all_stable,
             poles_in_region: v.poles_in_region,
@@ -444,27 +480,125 @@ pub fn run(
             worst_region_margin: v.worst_region_margin,
             max_real_part: v.max_real_part,
             interior_points: v.interior.len(),
-            seed: req.verify.seed,
-        },
-        solver: SolverSummary {
+            seed,
+        }
+    }
+}
+
+impl SolverSummary {
+    /// Totals over `all_stats`; `margin` is the strictness margin the LMIs were posed with.
+    fn of(
+        all_stats: &[SolverStats],
+        gamma_star: Option<SolverStats>,
+        design: &SolverStats,
+        margin: f64,
+    ) -> SolverSummary {
+        let max_violation = all_stats.iter().map(|s| s.max_constraint_violation).fold(0.0, f64::max);
+        let mut statuses: Vec<String> = all_stats.iter().map(|s| s.status.clone()).collect();
+        statuses.sort();
+        statuses.dedup();
+        SolverSummary {
             solver: "clarabel 0.11",
             n_solves: all_stats.len(),
             total_iterations: all_stats.iter().map(|s| s.iterations as u64).sum(),
             total_solve_time_s: all_stats.iter().map(|s| s.solve_time_s).sum(),
-            statuses: {
-                let mut s: Vec<String> = all_stats.iter().map(|s| s.status.clone()).collect();
-                s.sort();
-                s.dedup();
-                s
-            },
-            gamma_star: gamma_star_stats,
-            design: design.stats.clone(),
+            statuses,
+            gamma_star,
+            design: design.clone(),
             max_constraint_violation: max_violation,
-            strict_lmis_hold: max_violation < req.options.margin,
-        },
-        timings: Timings { design_s, verification_s, total_s: t0.elapsed().as_secs_f64() },
-        baseline,
-    })
+            strict_lmis_hold: max_violation < margin,
+        }
+    }
+}
+
+/// The Pareto grid table, the chosen point marked.
+fn write_pareto(s: &mut String, pareto: &[ParetoEntry], chosen: Option<usize>) {
+    let _ = writeln!(s, "\n   k        g        nu   sqrt(g^2+nu^2)  iters");
+    for e in pareto {
+        let mark = if Some(e.k) == chosen { "  <- chosen" } else { "" };
+        match &e.error {
+            None => {
+                let _ = writeln!(
+                    s,
+                    "  {:2}  {:.5}  {:.5}  {:.6}        {:3}{mark}",
+                    e.k,
+                    e.g,
+                    e.nu.unwrap_or(f64::NAN),
+                    e.distance.unwrap_or(f64::NAN),
+                    e.solver.as_ref().map_or(0, |s| s.iterations)
+                );
+            }
+            Some(err) => {
+                let _ = writeln!(s, "  {:2}  {:.5}  failed: {err}", e.k, e.g);
+            }
+        }
+    }
+}
+
+/// `chosen: k = .., g = .., nu = ..`.
+fn write_chosen(s: &mut String, c: &ChosenPoint) {
+    let _ = writeln!(
+        s,
+        "\nchosen: k = {}, g = {}, nu = {}",
+        c.k.map_or("-".to_string(), |k| k.to_string()),
+        opt(c.g, 5),
+        opt(c.nu, 5)
+    );
+}
+
+/// The verdict, the H-inf and H2 norms against their bounds and the poles (against the
+/// region unless `region_imposed` is false).
+fn write_verification(s: &mut String, a: &ActualNorms, v: &VerificationSummary, region_imposed: bool) {
+    let _ = writeln!(
+        s,
+        "\nverification (16 vertices + {} interior points, seed {:#x}): {}",
+        v.interior_points,
+        v.seed,
+        if v.passed { "PASSED" } else { "FAILED" }
+    );
+    let _ = writeln!(
+        s,
+        "  H-inf: certified bound {}, actual worst {:.6} (Hamiltonian) / {:.6} (frequency sweep), rel. diff {:.1e}{}",
+        opt(a.hinf_bound, 6),
+        a.hinf_worst,
+        a.hinf_worst_sweep,
+        a.hinf_methods_rel_diff,
+        if v.hinf_within_bound { "" } else { "  EXCEEDS BOUND" }
+    );
+    let _ = writeln!(
+        s,
+        "  H2:    certified bound {}, actual worst {:.6} (Lyapunov) / {:.6} (Gramian integration), rel. diff {:.1e}{}",
+        opt(a.h2_bound, 6),
+        a.h2_worst,
+        a.h2_worst_integrated,
+        a.h2_methods_rel_diff,
+        if v.h2_within_bound { "" } else { "  EXCEEDS BOUND" }
+    );
+    if region_imposed {
+        let _ = writeln!(
+            s,
+            "  poles: max real part {:.4}, smallest margin inside the region {:.4}{}",
+            v.max_real_part,
+            v.worst_region_margin,
+            if v.poles_in_region { "" } else { "  OUTSIDE THE REGION" }
+        );
+    } else {
+        let _ = writeln!(s, "  poles: max real part {:.4} (no pole region imposed)", v.max_real_part);
+    }
+}
+
+/// The solver totals line.
+fn write_solver(s: &mut String, r: &SolverSummary) {
+    let _ = writeln!(
+        s,
+        "\nsolver: {} solves, {} iterations, {:.3} s in clarabel, statuses {:?}, max constraint violation {:.1e} ({})",
+        r.n_solves,
+        r.total_iterations,
+        r.total_solve_time_s,
+        r.statuses,
+        r.max_constraint_violation,
+        if r.strict_lmis_hold { "< margin: the strict LMIs hold" } else { "NOT below the margin" }
+    );
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
@@ -494,76 +628,14 @@ pub fn render_text(r: &SynthesisReport) -> String {
         let _ = writeln!(s, "gamma* = {g:.6}");
     }
     if !r.pareto.is_empty() {
-        let _ = writeln!(s, "\n   k        g        nu   sqrt(g^2+nu^2)  iters");
-        for e in &r.pareto {
-            let mark = if Some(e.k) == r.chosen.k { "  <- chosen" } else { "" };
-            match &e.error {
-                None => {
-                    let _ = writeln!(
-                        s,
-                        "  {:2}  {:.5}  {:.5}  {:.6}        {:3}{mark}",
-                        e.k,
-                        e.g,
-                        e.nu.unwrap_or(f64::NAN),
-                        e.distance.unwrap_or(f64::NAN),
-                        e.solver.as_ref().map_or(0, |s| s.iterations)
-                    );
-                }
-                Some(err) => {
-                    let _ = writeln!(s, "  {:2}  {:.5}  failed: {err}", e.k, e.g);
-                }
-            }
-        }
+        write_pareto(&mut s, &r.pareto, r.chosen.k);
     }
-    let _ = writeln!(
-        s,
-        "\nchosen: k = {}, g = {}, nu = {}",
-        r.chosen.k.map_or("-".to_string(), |k| k.to_string()),
-        opt(r.chosen.g, 5),
-        opt(r.chosen.nu, 5)
-    );
+    write_chosen(&mut s, &r.chosen);
     let _ = writeln!(s, "\nK (u = K [beta; r]):        beta           r");
     for (name, row) in r.k_rows.iter().zip(&r.k) {
         let _ = writeln!(s, "  {name}               {:>12.6} {:>12.6}", row[0], row[1]);
     }
-    let a = &r.actual;
-    let v = &r.verification;
-    let _ = writeln!(
-        s,
-        "\nverification (16 vertices + {} interior points, seed {:#x}): {}",
-        v.interior_points,
-        v.seed,
-        if v.passed { "PASSED" } else { "FAILED" }
-    );
-    let _ = writeln!(
-        s,
-        "  H-inf: certified bound {}, actual worst {:.6} (Hamiltonian) / {:.6} (frequency sweep), rel. diff {:.1e}{}",
-        opt(a.hinf_bound, 6),
-        a.hinf_worst,
-        a.hinf_worst_sweep,
-        a.hinf_methods_rel_diff,
-        if v.hinf_within_bound { "" } else { "  EXCEEDS BOUND" }
-    );
-    let _ = writeln!(
-        s,
-        "  H2:    certified bound {}, actual worst {:.6} (Lyapunov) / {:.6} (Gramian integration), rel. diff {:.1e}{}",
-        opt(a.h2_bound, 6),
-        a.h2_worst,
-        a.h2_worst_integrated,
-        a.h2_methods_rel_diff,
-        if v.h2_within_bound { "" } else { "  EXCEEDS BOUND" }
-    );
-    if r.region.is_empty() {
-        let _ = writeln!(s, "  poles: max real part {:.4} (no pole region imposed)", v.max_real_part);
-    } else {
-        let _ = writeln!(
-            s,
-            "  poles: max real part {:.4}, smallest margin inside the region {:.4}{}",
-            v.max_real_part,
-            v.worst_region_margin,
-            if v.poles_in_region { "" } else { "  OUTSIDE THE REGION" }
-        );
-    }
+    write_verification(&mut s, &r.actual, &r.verification, !r.region.is_empty());
     if let Some(b) = &r.baseline {
         let _ = writeln!(
             s,
@@ -574,28 +646,13 @@ pub fn render_text(r: &SynthesisReport) -> String {
             b.max_real_part_over_vertices
         );
     }
-    let _ = writeln!(
-        s,
-        "\nsolver: {} solves, {} iterations, {:.3} s in clarabel, statuses {:?}, max constraint violation {:.1e} ({})",
-        r.solver.n_solves,
-        r.solver.total_iterations,
-        r.solver.total_solve_time_s,
-        r.solver.statuses,
-        r.solver.max_constraint_violation,
-        if r.solver.strict_lmis_hold { "< margin: the strict LMIs hold" } else { "NOT below the margin" }
-    );
+    write_solver(&mut s, &r.solver);
     let _ = writeln!(
         s,
         "time: design {:.3} s, verification {:.3} s, total {:.3} s",
         r.timings.design_s, r.timings.verification_s, r.timings.total_s
     );
     s
-}
-
-impl PlantReport {
-    fn architecture_name(&self) -> &'static str {
-        self.architecture.name()
-    }
 }
 
 /// A tracking-design request (the `synthesize --model tracking` run).
@@ -755,47 +812,16 @@ pub fn tracking_report(
         servo_loop_max_real_part: servo_loop_max_real_part(&poly, gain, req.spec.plant.params.servo_time_constant),
     };
     let verification_s = t1.elapsed().as_secs_f64();
-    let mut all_stats = vec![d.sweep.hinf_optimum.stats.clone()];
-    let mut pareto = Vec::new();
-    for p in &d.sweep.points {
-        let stats = p.result.as_ref().ok().map(|d| d.stats.clone());
-        if let Some(s) = &stats {
-            all_stats.push(s.clone());
-        }
-        pareto.push(ParetoEntry {
-            k: p.k,
-            g: p.g,
-            nu: p.nu(),
-            distance: p.distance(),
-            error: p.result.as_ref().err().map(|e| e.to_string()),
-            solver: stats,
-        });
-    }
-    let all: Vec<&PointCheck> = v.vertices.iter().chain(v.interior.iter()).collect();
+    let mut all_stats = Vec::new();
+    let pareto = pareto_entries(&d.sweep, &mut all_stats);
     let spec = &req.spec.plant;
-    let max_violation = all_stats.iter().map(|s| s.max_constraint_violation).fold(0.0, f64::max);
     let x = &chosen_design.lyapunov;
     Ok(TrackingReport {
         tool: "nigel-synthesis",
         version: env!("CARGO_PKG_VERSION"),
         model: "tracking",
         objective: "pareto",
-        plant: PlantReport {
-            architecture: spec.architecture,
-            d2: spec.disturbance.name(),
-            speed: spec.speed,
-            mu_min: spec.mu_min,
-            mu_max: spec.mu_max,
-            m: spec.params.m,
-            i_z: spec.params.i_z,
-            l_f: spec.params.l_f,
-            l_r: spec.params.l_r,
-            track: spec.params.track,
-            cornering_stiffness: spec.params.c,
-            bw: [poly.bw[(2, 0)], poly.bw[(3, 0)]],
-            n_vertices: poly.vertices.len(),
-            steered_wheels: spec.architecture.steered_wheels().iter().map(|&w| WHEEL_NAMES[w]).collect(),
-        },
+        plant: PlantReport::new(spec, [poly.bw[(2, 0)], poly.bw[(3, 0)]], poly.vertices.len()),
         bw_tracking: [poly.bw[(0, 0)], poly.bw[(1, 0)], poly.bw[(2, 0)], poly.bw[(3, 0)]],
         weights: req.spec.weights,
         control_law: TRACKING_CONTROL_LAW,
@@ -814,44 +840,15 @@ pub fn tracking_report(
         k_columns: nigel_vehicle::TRACKING_STATE_NAMES,
         x: (0..x.nrows()).map(|i| (0..x.ncols()).map(|j| x[(i, j)]).collect()).collect(),
         vertices: v.vertices.clone(),
-        actual: ActualNorms {
-            hinf_bound: v.gamma_bound,
-            hinf_worst: v.worst_hinf,
-            hinf_worst_sweep: all.iter().map(|p| p.hinf_sweep).fold(0.0, f64::max),
-            h2_bound: v.nu_bound,
-            h2_worst: v.worst_h2,
-            h2_worst_integrated: all.iter().map(|p| p.h2_integrated).fold(0.0, f64::max),
-            hinf_methods_rel_diff: v.hinf_methods_rel_diff,
-            h2_methods_rel_diff: v.h2_methods_rel_diff,
-        },
-        verification: VerificationSummary {
-            passed: v.passed(),
-            all_stable: v.all_stable,
-            poles_in_region: v.poles_in_region,
-            hinf_within_bound: v.hinf_within_bound,
-            h2_within_bound: v.h2_within_bound,
-            worst_region_margin: v.worst_region_margin,
-            max_real_part: v.max_real_part,
-            interior_points: v.interior.len(),
-            seed: req.verify.seed,
-        },
+        actual: ActualNorms::of(v),
+        verification: VerificationSummary::of(v, req.verify.seed),
         study,
-        solver: SolverSummary {
-            solver: "clarabel 0.11",
-            n_solves: all_stats.len(),
-            total_iterations: all_stats.iter().map(|s| s.iterations as u64).sum(),
-            total_solve_time_s: all_stats.iter().map(|s| s.solve_time_s).sum(),
-            statuses: {
-                let mut s: Vec<String> = all_stats.iter().map(|s| s.status.clone()).collect();
-                s.sort();
-                s.dedup();
-                s
-            },
-            gamma_star: Some(d.sweep.hinf_optimum.stats.clone()),
-            design: chosen_design.stats.clone(),
-            max_constraint_violation: max_violation,
-            strict_lmis_hold: max_violation < req.options.margin,
-        },
+        solver: SolverSummary::of(
+            &all_stats,
+            Some(d.sweep.hinf_optimum.stats.clone()),
+            &chosen_design.stats,
+            req.options.margin,
+        ),
         design_max_constraint_violation: chosen_design.stats.max_constraint_violation,
         design_strict_lmis_hold: chosen_design.stats.max_constraint_violation < req.options.margin,
         timings: Timings { design_s, verification_s, total_s: design_s + verification_s },
@@ -889,72 +886,14 @@ pub fn render_tracking_text(r: &TrackingReport) -> String {
     let _ = writeln!(s, "pole region: {}", r.region_description);
     let _ = writeln!(s, "strictness margin eps = {:e}; gamma = {}", r.margin, r.gamma_meaning);
     let _ = writeln!(s, "gamma* = {:.6}", r.gamma_star);
-    let _ = writeln!(s, "\n   k        g        nu   sqrt(g^2+nu^2)  iters");
-    for e in &r.pareto {
-        let mark = if Some(e.k) == r.chosen.k { "  <- chosen" } else { "" };
-        match &e.error {
-            None => {
-                let _ = writeln!(
-                    s,
-                    "  {:2}  {:.5}  {:.5}  {:.6}        {:3}{mark}",
-                    e.k,
-                    e.g,
-                    e.nu.unwrap_or(f64::NAN),
-                    e.distance.unwrap_or(f64::NAN),
-                    e.solver.as_ref().map_or(0, |s| s.iterations)
-                );
-            }
-            Some(err) => {
-                let _ = writeln!(s, "  {:2}  {:.5}  failed: {err}", e.k, e.g);
-            }
-        }
-    }
-    let _ = writeln!(
-        s,
-        "\nchosen: k = {}, g = {}, nu = {}",
-        r.chosen.k.map_or("-".to_string(), |k| k.to_string()),
-        opt(r.chosen.g, 5),
-        opt(r.chosen.nu, 5)
-    );
+    write_pareto(&mut s, &r.pareto, r.chosen.k);
+    write_chosen(&mut s, &r.chosen);
     let _ = writeln!(s, "\nK_track (delta = delta_ff + K e):  e_y [rad/m]  e_psi [-]  e_beta [-]  e_r [s]");
     for (name, row) in r.k_rows.iter().zip(&r.k) {
         let _ = writeln!(s, "  {name}  {:>12.6} {:>12.6} {:>12.6} {:>12.6}", row[0], row[1], row[2], row[3]);
     }
     let _ = writeln!(s, "  signs: {}", r.sign_conventions);
-    let a = &r.actual;
-    let v = &r.verification;
-    let _ = writeln!(
-        s,
-        "\nverification (16 vertices + {} interior points, seed {:#x}): {}",
-        v.interior_points,
-        v.seed,
-        if v.passed { "PASSED" } else { "FAILED" }
-    );
-    let _ = writeln!(
-        s,
-        "  H-inf: certified bound {}, actual worst {:.6} (Hamiltonian) / {:.6} (frequency sweep), rel. diff {:.1e}{}",
-        opt(a.hinf_bound, 6),
-        a.hinf_worst,
-        a.hinf_worst_sweep,
-        a.hinf_methods_rel_diff,
-        if v.hinf_within_bound { "" } else { "  EXCEEDS BOUND" }
-    );
-    let _ = writeln!(
-        s,
-        "  H2:    certified bound {}, actual worst {:.6} (Lyapunov) / {:.6} (Gramian integration), rel. diff {:.1e}{}",
-        opt(a.h2_bound, 6),
-        a.h2_worst,
-        a.h2_worst_integrated,
-        a.h2_methods_rel_diff,
-        if v.h2_within_bound { "" } else { "  EXCEEDS BOUND" }
-    );
-    let _ = writeln!(
-        s,
-        "  poles: max real part {:.4}, smallest margin inside the region {:.4}{}",
-        v.max_real_part,
-        v.worst_region_margin,
-        if v.poles_in_region { "" } else { "  OUTSIDE THE REGION" }
-    );
+    write_verification(&mut s, &r.actual, &r.verification, !r.region.is_empty());
     let st = &r.study;
     let _ = writeln!(
         s,
@@ -980,16 +919,7 @@ pub fn render_tracking_text(r: &TrackingReport) -> String {
         "  with the {} s steering servo in the loop: max real part {:.4}",
         st.servo_time_constant, st.servo_loop_max_real_part
     );
-    let _ = writeln!(
-        s,
-        "\nsolver: {} solves, {} iterations, {:.3} s in clarabel, statuses {:?}, max constraint violation {:.1e} ({})",
-        r.solver.n_solves,
-        r.solver.total_iterations,
-        r.solver.total_solve_time_s,
-        r.solver.statuses,
-        r.solver.max_constraint_violation,
-        if r.solver.strict_lmis_hold { "< margin: the strict LMIs hold" } else { "NOT below the margin" }
-    );
+    write_solver(&mut s, &r.solver);
     let _ = writeln!(
         s,
         "chosen design: max constraint violation {:.1e} ({})",
