@@ -271,6 +271,19 @@ def test_model_exchange_outputs_change_exactly_at_the_samples():
         assert after == pytest.approx(k_beta_fl * 0.1 * math.sin(2 * math.pi * 37 * tj), rel=1e-6, abs=1e-12)
 
 
+def assert_each_refused(s, cases, capsys):
+    """Each `(name, call)` of `cases` fails with fmi2Error and a log line naming `name`;
+    the instance is reset after each, so the next case starts from instantiated."""
+    for name, call in cases:
+        capsys.readouterr()
+        with pytest.raises(FMICallException) as e:
+            call(s)
+        assert e.value.status == fmi2Error
+        log = capsys.readouterr().out
+        assert name in log, log
+        s.reset()
+
+
 def test_controller_bad_input(ctl, capsys):
     cases = [
         ("controller", lambda s: s.setInteger([ctl.vr["controller"]], [7])),
@@ -279,14 +292,7 @@ def test_controller_bad_input(ctl, capsys):
     ]
     s = ctl.slave("bad")
     try:
-        for name, call in cases:
-            capsys.readouterr()
-            with pytest.raises(FMICallException) as e:
-                call(s)
-            assert e.value.status == fmi2Error
-            log = capsys.readouterr().out
-            assert name in log, log
-            s.reset()
+        assert_each_refused(s, cases, capsys)
         s.setupExperiment(startTime=0.0)
         s.enterInitializationMode()
         s.exitInitializationMode()
@@ -411,14 +417,7 @@ def test_bench_bad_input(bench, capsys):
     ]
     s = bench.slave("bad")
     try:
-        for name, call in cases:
-            capsys.readouterr()
-            with pytest.raises(FMICallException) as e:
-                call(s)
-            assert e.value.status == fmi2Error
-            log = capsys.readouterr().out
-            assert name in log, log
-            s.reset()
+        assert_each_refused(s, cases, capsys)
         s.setupExperiment(startTime=0.0)
         s.setReal([bench.vr["duration"]], [0.01])
         s.enterInitializationMode()
