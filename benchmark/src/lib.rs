@@ -48,9 +48,10 @@ pub mod scenario;
 
 pub use control::{Controller, ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
 pub use run::{
-    figure8_switches, table3, BenchSample, Benchmark, ClosedLoopRun, Metric, Reference, TableCell, Trajectory,
+    figure8_switches, table3, BenchSample, BenchSampler, Benchmark, ClosedLoopRun, Metric, Reference, TableCell,
+    Trajectory,
 };
 pub use scenario::{
-    Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
-    N_SAMPLES, SAMPLE_PERIOD,
+    DisturbanceSequence, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, DEFAULT_SPEED,
+    DEFAULT_STEER_AMPLITUDE, N_SAMPLES, SAMPLE_PERIOD,
 };

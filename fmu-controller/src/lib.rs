@@ -380,6 +380,33 @@ pub struct Controller {
     /// Co-Simulation: samples run since the importer last read or set a value.
     unattended: u64,
     interface: Interface,
+    /// The law of `settings`, `custom` and `mode` once validated (its integrator is not
+    /// used): a sample does not validate the settings again. Emptied by every setter of a
+    /// parameter or of the `controller` switch.
+    validated: Option<SampledController>,
+}
+
+impl Var {
+    /// Whether the variable is a signal of the law (an input, a held output, the
+    /// integrator): setting it leaves the settings as they are.
+    fn is_signal(&self) -> bool {
+        matches!(
+            self,
+            Var::Beta
+                | Var::YawRate
+                | Var::Speed
+                | Var::BetaRef
+                | Var::YawRateRef
+                | Var::SpeedRef
+                | Var::SteerFeedForward(_)
+                | Var::Steer(_)
+                | Var::Torque(_)
+                | Var::DriveForce
+                | Var::SpeedIntegral
+                | Var::Pose(_)
+                | Var::PoseRef(_)
+        )
+    }
 }
 
 impl Controller {
@@ -404,7 +431,23 @@ impl Controller {
         }
     }
 
-    fn law(&self) -> Result<SampledController, String> {
+    /// The law with the settings in use and the integrator `I`; the settings are validated
+    /// once after they change.
+    fn law(&mut self) -> Result<SampledController, String> {
+        let mut c = match self.validated {
+            Some(c) => c,
+            None => {
+                let c = self.validate_law()?;
+                self.validated = Some(c);
+                c
+            }
+        };
+        c.set_integral(self.integral);
+        Ok(c)
+    }
+
+    /// The settings in use (the gains the `controller` switch selects), validated.
+    fn validate_law(&self) -> Result<SampledController, String> {
         let tracking = self.mode == mode::ROBUST_TRACKING;
         let settings = ControllerSettings {
             gain: self.gain_in_use(),
@@ -413,18 +456,66 @@ impl Controller {
             k_along_track: if tracking { self.settings.k_along_track } else { 0.0 },
             ..self.settings
         };
-        let mut c = SampledController::new(settings).map_err(|e| e.to_string())?;
-        c.set_integral(self.integral);
-        Ok(c)
+        SampledController::new(settings).map_err(|e| e.to_string())
     }
 
     /// The outputs an importer reads: the held sample, or before the first sample the law
     /// on the current inputs (what the initial event will latch).
-    fn outputs(&self) -> ModelResult<ControllerOutputs> {
+    fn outputs(&mut self) -> ModelResult<ControllerOutputs> {
         if self.k > 0 {
             return Ok(self.held);
         }
         Ok(self.law()?.outputs(&self.inputs))
+    }
+
+    /// The value of `b` with the outputs `o`; `None` if `b` is not a Real.
+    #[inline(always)]
+    fn value(&self, o: &ControllerOutputs, b: Var) -> Option<f64> {
+        let x = &self.inputs;
+        let s = &self.settings;
+        Some(match b {
+            Var::Beta => x.beta,
+            Var::YawRate => x.yaw_rate,
+            Var::Speed => x.speed,
+            Var::BetaRef => x.beta_ref,
+            Var::YawRateRef => x.yaw_rate_ref,
+            Var::SpeedRef => x.speed_ref,
+            Var::SteerFeedForward(i) => x.delta_ff[i],
+            Var::Steer(i) => o.delta[i],
+            Var::Torque(i) => o.tau[i],
+            Var::DriveForce => o.force,
+            Var::SpeedIntegral => self.integral,
+            Var::SamplePeriod => s.sample_period,
+            Var::KpSpeed => s.kp_speed,
+            Var::KiSpeed => s.ki_speed,
+            Var::ForceMax => s.force_max,
+            Var::WheelRadius => s.r_wheel,
+            Var::SteerLimit => s.delta_max,
+            Var::CustomGain(i, j) => self.custom[i][j],
+            Var::GainInUse(i, j) => self.gain_in_use()[i][j],
+            Var::PoseGainInUse(i, j) => self.pose_gain_in_use()[i][j],
+            Var::Pose(i) => [x.x, x.y, x.psi][i],
+            Var::PoseRef(i) => [x.x_ref, x.y_ref, x.psi_ref][i],
+            Var::AlongTrackGain => s.k_along_track,
+            Var::AlongTrackSpeedMax => s.along_track_speed_max,
+            Var::Controller => return None,
+        })
+    }
+
+    /// `get_real` off its fast path: before the first sample (the law on the current
+    /// inputs, what the initial event will latch) and for a variable that is not a Real.
+    #[cold]
+    #[inline(never)]
+    fn get_real_before_first_sample(&mut self, b: Var) -> ModelResult<f64> {
+        if b == Var::Controller {
+            return Err("controller is an Integer, not a Real".into());
+        }
+        let outputs = match b {
+            // only the outputs of the law need it (a parameter reads without valid settings)
+            Var::Steer(_) | Var::Torque(_) | Var::DriveForce => self.outputs()?,
+            _ => self.held,
+        };
+        self.value(&outputs, b).ok_or_else(|| format!("{b:?} is not a Real").into())
     }
 
     fn set_parameter(slot: &mut f64, name: &str, value: f64, positive: bool) -> ModelResult {
@@ -474,44 +565,26 @@ impl Model for Controller {
             start_time: 0.0,
             unattended: 0,
             interface: context.interface,
+            validated: None,
         })
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
         self.unattended = 0;
-        let x = &self.inputs;
-        let s = &self.settings;
-        Ok(match b {
-            Var::Beta => x.beta,
-            Var::YawRate => x.yaw_rate,
-            Var::Speed => x.speed,
-            Var::BetaRef => x.beta_ref,
-            Var::YawRateRef => x.yaw_rate_ref,
-            Var::SpeedRef => x.speed_ref,
-            Var::SteerFeedForward(i) => x.delta_ff[i],
-            Var::Steer(i) => self.outputs()?.delta[i],
-            Var::Torque(i) => self.outputs()?.tau[i],
-            Var::DriveForce => self.outputs()?.force,
-            Var::SpeedIntegral => self.integral,
-            Var::SamplePeriod => s.sample_period,
-            Var::KpSpeed => s.kp_speed,
-            Var::KiSpeed => s.ki_speed,
-            Var::ForceMax => s.force_max,
-            Var::WheelRadius => s.r_wheel,
-            Var::SteerLimit => s.delta_max,
-            Var::CustomGain(i, j) => self.custom[i][j],
-            Var::GainInUse(i, j) => self.gain_in_use()[i][j],
-            Var::PoseGainInUse(i, j) => self.pose_gain_in_use()[i][j],
-            Var::Pose(i) => [x.x, x.y, x.psi][i],
-            Var::PoseRef(i) => [x.x_ref, x.y_ref, x.psi_ref][i],
-            Var::AlongTrackGain => s.k_along_track,
-            Var::AlongTrackSpeedMax => s.along_track_speed_max,
-            Var::Controller => return Err("controller is an Integer, not a Real".into()),
-        })
+        // an importer reads the held outputs at every sample: that path is a lookup
+        if self.k > 0 {
+            if let Some(value) = self.value(&self.held, b) {
+                return Ok(value);
+            }
+        }
+        self.get_real_before_first_sample(b)
     }
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
         self.unattended = 0;
+        if !b.is_signal() {
+            self.validated = None;
+        }
         let x = &mut self.inputs;
         let s = &mut self.settings;
         match b {
@@ -571,6 +644,7 @@ impl Model for Controller {
     }
 
     fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
+        self.validated = None;
         match b {
             Var::Controller if (mode::OPEN_LOOP..=mode::ROBUST_TRACKING).contains(&value) => {
                 self.mode = value;
@@ -607,8 +681,7 @@ impl Model for Controller {
             self.integral += self.pending_increment;
         }
         let law = self.law()?;
-        self.held = law.outputs(&self.inputs);
-        self.pending_increment = law.increment(&self.inputs);
+        (self.held, self.pending_increment) = law.outputs_and_increment(&self.inputs);
         self.k += 1;
         // sample instants from the start time and an integer count: no drift
         let next = self.start_time + self.k as f64 * self.settings.sample_period;

@@ -255,6 +255,20 @@ fn custom_gains_can_change_between_steps() {
     let after = deltas(&c);
     assert!(close(after[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", after[0], by_hand(&k, &x, 0.0).0[0]);
     assert_eq!(after[1..], before[1..]);
+    // the settings are validated once per change, not per sample: a second change later
+    // takes effect too, and the gain stays put over the samples in between
+    assert_eq!(c.step(T, T), OK);
+    assert!(close(deltas(&c)[0], by_hand(&k, &x, 0.0).0[0]));
+    k[0] = [-0.5, 0.25];
+    assert_eq!(c.set_real(vr::K_CUSTOM, -0.5), OK);
+    assert_eq!(c.set_real(vr::K_CUSTOM + 1, 0.25), OK);
+    assert_eq!(c.step(2.0 * T, T), OK);
+    let again = deltas(&c);
+    assert!(close(again[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", again[0], by_hand(&k, &x, 0.0).0[0]);
+    assert_eq!(again[1..], before[1..]);
+    // a gain the layer lets through but the law refuses (not finite) is still refused
+    assert_eq!(c.set_real(vr::K_CUSTOM, f64::INFINITY), ERR);
+    assert!(c.last_error().contains("k_beta_fl"), "{}", c.last_error());
     // a fixed parameter cannot change after initialization
     assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST), ERR);
 }
