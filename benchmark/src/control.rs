@@ -434,26 +434,17 @@ impl SampledController {
     }
 }
 
+/// The inputs the tests start from, shared with the integration tests.
+#[cfg(test)]
+#[path = "../tests/common/inputs.rs"]
+mod test_inputs;
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn inputs() -> ControllerInputs {
-        ControllerInputs {
-            beta: 0.02,
-            yaw_rate: -0.1,
-            speed: 0.3,
-            beta_ref: 0.01,
-            yaw_rate_ref: 0.05,
-            speed_ref: 0.35,
-            delta_ff: [0.1, 0.1, -0.1, -0.1],
-            x: 0.0,
-            y: 0.0,
-            psi: 0.0,
-            x_ref: 0.0,
-            y_ref: 0.0,
-            psi_ref: 0.0,
-        }
+        super::test_inputs::off_reference()
     }
 
     #[test]
