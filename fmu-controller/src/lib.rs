@@ -382,31 +382,8 @@ pub struct Controller {
     interface: Interface,
     /// The law of `settings`, `custom` and `mode` once validated (its integrator is not
     /// used): a sample does not validate the settings again. Emptied by every setter of a
-    /// parameter or of the `controller` switch.
+    /// parameter (`set_real`'s parameter arms) and of the `controller` switch.
     validated: Option<SampledController>,
-}
-
-impl Var {
-    /// Whether the variable is a signal of the law (an input, a held output, the
-    /// integrator): setting it leaves the settings as they are.
-    fn is_signal(&self) -> bool {
-        matches!(
-            self,
-            Var::Beta
-                | Var::YawRate
-                | Var::Speed
-                | Var::BetaRef
-                | Var::YawRateRef
-                | Var::SpeedRef
-                | Var::SteerFeedForward(_)
-                | Var::Steer(_)
-                | Var::Torque(_)
-                | Var::DriveForce
-                | Var::SpeedIntegral
-                | Var::Pose(_)
-                | Var::PoseRef(_)
-        )
-    }
 }
 
 impl Controller {
@@ -582,9 +559,6 @@ impl Model for Controller {
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
         self.unattended = 0;
-        if !b.is_signal() {
-            self.validated = None;
-        }
         let x = &mut self.inputs;
         let s = &mut self.settings;
         match b {
@@ -600,18 +574,38 @@ impl Model for Controller {
             Var::Torque(i) => self.held.tau[i] = value,
             Var::DriveForce => self.held.force = value,
             Var::SpeedIntegral => self.integral = value,
+            // a parameter: the law is validated again at its next use
             Var::SamplePeriod => {
+                self.validated = None;
                 if !(value >= MIN_SAMPLE_PERIOD) {
                     return Err(format!("sample_period = {value} refused: must be >= {MIN_SAMPLE_PERIOD} s").into());
                 }
                 s.sample_period = value;
             }
-            Var::KpSpeed => Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?,
-            Var::KiSpeed => Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?,
-            Var::ForceMax => Self::set_parameter(&mut s.force_max, "force_max", value, true)?,
-            Var::WheelRadius => Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?,
-            Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
-            Var::CustomGain(i, j) => self.custom[i][j] = value,
+            Var::KpSpeed => {
+                self.validated = None;
+                Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?
+            }
+            Var::KiSpeed => {
+                self.validated = None;
+                Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?
+            }
+            Var::ForceMax => {
+                self.validated = None;
+                Self::set_parameter(&mut s.force_max, "force_max", value, true)?
+            }
+            Var::WheelRadius => {
+                self.validated = None;
+                Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?
+            }
+            Var::SteerLimit => {
+                self.validated = None;
+                Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?
+            }
+            Var::CustomGain(i, j) => {
+                self.validated = None;
+                self.custom[i][j] = value;
+            }
             Var::GainInUse(..) | Var::PoseGainInUse(..) => return Err("the gains in use are calculated".into()),
             Var::Pose(0) => x.x = value,
             Var::Pose(1) => x.y = value,
@@ -620,12 +614,14 @@ impl Model for Controller {
             Var::PoseRef(1) => x.y_ref = value,
             Var::PoseRef(_) => x.psi_ref = value,
             Var::AlongTrackGain => {
+                self.validated = None;
                 if !(value >= 0.0) {
                     return Err(format!("k_along_track = {value} refused: must be >= 0").into());
                 }
                 s.k_along_track = value;
             }
             Var::AlongTrackSpeedMax => {
+                self.validated = None;
                 if !(value >= 0.0) {
                     return Err(format!("along_track_speed_max = {value} refused: must be >= 0").into());
                 }

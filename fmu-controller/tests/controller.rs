@@ -536,3 +536,29 @@ fn controller_switch_is_an_integer_parameter_listing_its_values() {
         assert_eq!(c.int(vr::CONTROLLER), good);
     }
 }
+
+/// The law is validated once and kept until a parameter changes: in initialization mode an
+/// importer may read the outputs (which runs the law), then set a parameter and the
+/// controller switch, and the outputs follow every change.
+#[test]
+fn outputs_follow_parameters_set_after_a_read() {
+    let c = C::cs();
+    assert_eq!(c.setup(), OK);
+    assert_eq!(c.enter_init(), OK);
+    let x = SETS[0];
+    set_inputs(&c, &x);
+    // robust: e = 0.01, F = 53.6 e
+    assert!(close(c.real(vr::DRIVE_FORCE), 53.6 * 0.01));
+    assert!(close(deltas(&c)[0], by_hand(&ROBUST, &x, 0.0).0[0]));
+    assert_eq!(c.set_real(vr::KP_SPEED, 100.0), OK);
+    assert!(close(c.real(vr::DRIVE_FORCE), 100.0 * 0.01), "{}", c.real(vr::DRIVE_FORCE));
+    assert_eq!(c.set_real(vr::R_WHEEL, 0.05), OK);
+    assert!(close(taus(&c)[0], 100.0 * 0.01 * 0.05 / 4.0), "{:?}", taus(&c));
+    assert_eq!(c.set_int(vr::CONTROLLER, mode::POLE_PLACEMENT), OK);
+    assert!(close(deltas(&c)[0], by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]));
+    assert_eq!(c.set_real(vr::DELTA_MAX, 0.05), OK);
+    assert_eq!(deltas(&c)[0], 0.05f64.min(by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]).max(-0.05));
+    assert_eq!(c.exit_init(), OK);
+    assert_eq!(c.step(0.0, T), OK);
+    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
+}
