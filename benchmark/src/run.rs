@@ -295,12 +295,15 @@ type ReferenceSlot = Arc<std::sync::Mutex<Option<Arc<Reference>>>>;
 struct ReferenceCache(std::sync::Mutex<Vec<(ReferenceKey, ReferenceSlot)>>);
 
 impl ReferenceCache {
-    /// The slot of `key`, made (empty) if there is none; the oldest slot goes when the
-    /// cache is full.
+    /// The slot of `key` (now the most recently used), made (empty) if there is none; the
+    /// least recently used slot goes when the cache is full.
     fn slot(&self, key: ReferenceKey) -> ReferenceSlot {
         let mut entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if let Some((_, slot)) = entries.iter().find(|(k, _)| *k == key) {
-            return slot.clone();
+        if let Some(i) = entries.iter().position(|(k, _)| *k == key) {
+            let entry = entries.remove(i);
+            let slot = entry.1.clone();
+            entries.push(entry);
+            return slot;
         }
         if entries.len() >= REFERENCE_CACHE_SIZE {
             entries.remove(0);
