@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use nigel_benchmark::{table3, Benchmark, Controller, Fidelity, Maneuver, Scenario};
+use nigel_benchmark::{table3, BenchSampler, Benchmark, Controller, Fidelity, Maneuver, Scenario, N_SAMPLES};
 
 fn median_seconds(repeats: usize, mut f: impl FnMut()) -> f64 {
     let mut t: Vec<f64> = (0..repeats)
@@ -35,6 +35,27 @@ fn main() {
             run / 30_000.0 * 1e6
         );
     }
+    // the test bench's per-sample outputs: the formulas at every sample (Benchmark::sample)
+    // against the per-seed disturbance table (BenchSampler::sample, what the FMU runs)
+    let scenario = Scenario::new(Maneuver::Slalom, Fidelity::Real);
+    let bench = Benchmark::prepare(scenario).unwrap();
+    let sampler = BenchSampler::prepare(scenario).unwrap();
+    let sweep = |f: &dyn Fn(usize) -> f64| {
+        median_seconds(9, || {
+            let mut acc = 0.0;
+            for k in 0..=N_SAMPLES {
+                acc += f(k);
+            }
+            std::hint::black_box(acc);
+        })
+    };
+    let formulas = sweep(&|k| bench.sample(k, 0.01, 0.1).map_or(0.0, |s| s.mu[0] + s.beta_meas));
+    let table = sweep(&|k| sampler.sample(k, 0.01, 0.1).map_or(0.0, |s| s.mu[0] + s.beta_meas));
+    println!(
+        "test-bench samples (real slalom, 30,001): formulas {:.1} ns a sample, disturbance table {:.1} ns a sample",
+        formulas / (N_SAMPLES + 1) as f64 * 1e9,
+        table / (N_SAMPLES + 1) as f64 * 1e9
+    );
     let one = median_seconds(3, || {
         std::hint::black_box(table3(0, &Controller::TABLE, 1).unwrap());
     });

@@ -410,6 +410,15 @@ impl SampledController {
         }
     }
 
+    /// [`SampledController::outputs`] and [`SampledController::increment`] in one pass
+    /// (the speed error and the force once).
+    pub fn outputs_and_increment(&self, x: &ControllerInputs) -> (ControllerOutputs, f64) {
+        let out = self.outputs(x);
+        let increment =
+            if out.saturated { 0.0 } else { (self.speed_command(x) - x.speed) * self.settings.sample_period };
+        (out, increment)
+    }
+
     /// Moves the integrator past the current sample: `I += e T` unless the force saturates.
     pub fn advance(&mut self, x: &ControllerInputs) {
         self.integral += self.increment(x);
@@ -425,26 +434,17 @@ impl SampledController {
     }
 }
 
+/// The inputs the tests start from, shared with the integration tests.
+#[cfg(test)]
+#[path = "../tests/common/inputs.rs"]
+mod test_inputs;
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn inputs() -> ControllerInputs {
-        ControllerInputs {
-            beta: 0.02,
-            yaw_rate: -0.1,
-            speed: 0.3,
-            beta_ref: 0.01,
-            yaw_rate_ref: 0.05,
-            speed_ref: 0.35,
-            delta_ff: [0.1, 0.1, -0.1, -0.1],
-            x: 0.0,
-            y: 0.0,
-            psi: 0.0,
-            x_ref: 0.0,
-            y_ref: 0.0,
-            psi_ref: 0.0,
-        }
+        super::test_inputs::off_reference()
     }
 
     #[test]
@@ -526,6 +526,19 @@ mod tests {
         assert_eq!(s.pose_gain[0], [gains::ROBUST_TRACKING[0][0], gains::ROBUST_TRACKING[0][1]]);
         assert_eq!(s.k_along_track, K_ALONG_TRACK);
         assert_eq!(Controller::Robust.feedback_gain()[0], [0.0, 0.0, gains::ROBUST[0][0], gains::ROBUST[0][1]]);
+    }
+
+    #[test]
+    fn outputs_and_increment_in_one_pass() {
+        let c = SampledController::new(ControllerSettings::tracking(gains::ROBUST_TRACKING)).unwrap();
+        let mut x = ControllerInputs { x: 0.3, y: -0.1, psi: 0.2, ..inputs() };
+        // e = 0.35 - 0.3 (+ the along-track correction): not saturated, I += e T
+        let (out, inc) = c.outputs_and_increment(&x);
+        assert_eq!((out, inc), (c.outputs(&x), c.increment(&x)));
+        assert!(!out.saturated && inc != 0.0);
+        x.speed = -5.0; // F far beyond 20 N: saturated, the integrator frozen
+        let (out, inc) = c.outputs_and_increment(&x);
+        assert!(out.saturated && inc == 0.0 && c.increment(&x) == 0.0);
     }
 
     #[test]

@@ -5,11 +5,15 @@
 //!
 //! * [`noise`]: counter-based SplitMix64 `u(seed, stream, k)` and Box-Muller `g(seed, stream, k)`.
 //! * [`scenario`]: [`Maneuver`], [`Fidelity`] (the "sim" / "real" columns), the steering
-//!   [`Program`] per sample, [`Disturbances`] per sample (friction, wind, measurement noise).
+//!   [`Program`] per sample, [`Disturbances`] per sample (friction, wind, measurement noise),
+//!   and [`DisturbanceSequence`]: the same numbers from a table computed once per seed and
+//!   process (Table III runs 36 closed loops on one seed).
 //! * [`control`]: the sampled law `delta = delta_ff + K (x - x_ref)` with the speed-hold PI,
 //!   [`SampledController`]; beyond the paper, the robust tracking law on the pose errors with
 //!   the along-track speed correction ([`Controller::RobustTracking`]); the baked gains in [`gains`].
-//! * [`run`]: the figure-8 switching table, the reference, closed-loop runs and the metric.
+//! * [`run`]: the figure-8 switching table, the reference (kept per process:
+//!   [`Benchmark::shared_reference`]), closed-loop runs and the metric; [`BenchSampler`], the
+//!   test bench's outputs sample by sample (what the test-bench FMU runs).
 //!
 //! ```no_run
 //! use nigel_benchmark::{Benchmark, Controller, Fidelity, Maneuver, Scenario};
@@ -48,9 +52,10 @@ pub mod scenario;
 
 pub use control::{Controller, ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
 pub use run::{
-    figure8_switches, table3, BenchSample, Benchmark, ClosedLoopRun, Metric, Reference, TableCell, Trajectory,
+    figure8_switches, table3, BenchSample, BenchSampler, Benchmark, ClosedLoopRun, Metric, Reference, TableCell,
+    Trajectory,
 };
 pub use scenario::{
-    Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
-    N_SAMPLES, SAMPLE_PERIOD,
+    DisturbanceSequence, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, DEFAULT_SPEED,
+    DEFAULT_STEER_AMPLITUDE, N_SAMPLES, SAMPLE_PERIOD,
 };

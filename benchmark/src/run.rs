@@ -9,7 +9,9 @@ use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{integrate, straight_running, Inputs, State, VehicleParams};
 
 use crate::control::{Controller, ControllerInputs, ControllerSettings, SampledController};
-use crate::scenario::{Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, SAMPLE_PERIOD};
+use crate::scenario::{
+    DisturbanceSequence, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, SAMPLE_PERIOD,
+};
 
 /// Largest RK4 sub-step inside a sample (two per 1 ms sample) [s].
 pub const SUBSTEP: f64 = 0.5e-3;
@@ -91,6 +93,8 @@ fn run_loop(
 ) -> Result<Trajectory, SettingError> {
     params.validate().map_err(|e| SettingError { name: e.name, value: e.value, reason: e.reason })?;
     let mut controller = SampledController::new(settings)?;
+    // the seed's disturbances from the process-wide table (the same numbers as the formulas)
+    let disturbances = DisturbanceSequence::new(*disturbances, n);
     let mut s = straight_running(speed_ref);
     let mut traj = Trajectory::with_capacity(n);
     traj.record(&s);
@@ -291,12 +295,15 @@ type ReferenceSlot = Arc<std::sync::Mutex<Option<Arc<Reference>>>>;
 struct ReferenceCache(std::sync::Mutex<Vec<(ReferenceKey, ReferenceSlot)>>);
 
 impl ReferenceCache {
-    /// The slot of `key`, made (empty) if there is none; the oldest slot goes when the
-    /// cache is full.
+    /// The slot of `key` (now the most recently used), made (empty) if there is none; the
+    /// least recently used slot goes when the cache is full.
     fn slot(&self, key: ReferenceKey) -> ReferenceSlot {
         let mut entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if let Some((_, slot)) = entries.iter().find(|(k, _)| *k == key) {
-            return slot.clone();
+        if let Some(i) = entries.iter().position(|(k, _)| *k == key) {
+            let entry = entries.remove(i);
+            let slot = entry.1.clone();
+            entries.push(entry);
+            return slot;
         }
         if entries.len() >= REFERENCE_CACHE_SIZE {
             entries.remove(0);
@@ -304,16 +311,6 @@ impl ReferenceCache {
         let slot = ReferenceSlot::default();
         entries.push((key, slot.clone()));
         slot
-    }
-
-    /// The reference of `key` if it is there and not being computed (never waits).
-    fn peek(&self, key: ReferenceKey) -> Option<Arc<Reference>> {
-        let slot = {
-            let entries = self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-            entries.iter().find(|(k, _)| *k == key)?.1.clone()
-        };
-        let cached = slot.try_lock().ok()?;
-        cached.clone()
     }
 }
 
@@ -340,24 +337,32 @@ impl Benchmark {
     /// the process and handed out again (bit-identical, they are the same numbers), so that
     /// 36 runs of Table III, or many instances of the test-bench FMU, compute 12 of them.
     pub fn prepare(scenario: Scenario) -> Result<Benchmark, SettingError> {
+        Ok(Benchmark { scenario, reference: Reference::clone(&*Self::shared_reference(scenario)?) })
+    }
+
+    /// The reference of [`Benchmark::prepare`] without a copy: the one the process cache
+    /// holds (computed first if need be; a thread asking for a reference another thread is
+    /// computing waits for that one instead of computing it again).
+    pub fn shared_reference(scenario: Scenario) -> Result<Arc<Reference>, SettingError> {
         scenario.validate()?;
         if scenario.n_samples > REFERENCE_CACHE_MAX_SAMPLES {
-            return Self::prepare_uncached(scenario);
+            return Ok(Arc::new(Self::prepare_uncached(scenario)?.reference));
         }
         let slot = reference_cache().slot(ReferenceKey::of(&scenario));
         // held while computing: a concurrent request for the same reference waits for it
         let mut cached = slot.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         if let Some(reference) = cached.as_ref() {
-            return Ok(Benchmark { scenario, reference: Reference::clone(reference) });
+            return Ok(reference.clone());
         }
-        let bench = Self::prepare_uncached(scenario)?;
-        *cached = Some(Arc::new(bench.reference.clone()));
-        Ok(bench)
+        let reference = Arc::new(Self::prepare_uncached(scenario)?.reference);
+        *cached = Some(reference.clone());
+        Ok(reference)
     }
 
     /// [`Benchmark::prepare`] without the cache. The paper-fidelity figure-8 reference is
     /// the trajectory of the run that finds its switching table ([`figure8_nominal_run`]);
-    /// the real-fidelity one takes its table from that reference when it is cached.
+    /// the real-fidelity one takes its table from that reference, through the cache (so
+    /// that it is computed once, and waited for if another thread is computing it).
     fn prepare_uncached(scenario: Scenario) -> Result<Benchmark, SettingError> {
         if scenario.maneuver != Maneuver::Figure8 {
             return Self::prepare_with_switches(scenario, Vec::new());
@@ -370,11 +375,8 @@ impl Benchmark {
                 Ok(Benchmark { scenario, reference: Reference { program, trajectory } })
             }
             Fidelity::Real => {
-                let paper = ReferenceKey { fidelity: Fidelity::Paper, ..ReferenceKey::of(&scenario) };
-                let switches = match reference_cache().peek(paper) {
-                    Some(nominal) => nominal.program.switches.clone(),
-                    None => figure8_nominal_run(amplitude, speed, n)?.0,
-                };
+                let paper = Scenario { fidelity: Fidelity::Paper, ..scenario };
+                let switches = Self::shared_reference(paper)?.program.switches.clone();
                 Self::prepare_with_switches(scenario, switches)
             }
         }
@@ -495,6 +497,66 @@ impl Benchmark {
             return None;
         }
         let d = self.scenario.disturbances();
+        let (beta_meas, yaw_rate_meas) = d.measure(k, beta, yaw_rate);
+        Some(BenchSample {
+            delta_ff: self.reference.program.steering(k),
+            beta_ref: r.beta[k],
+            yaw_rate_ref: r.yaw_rate[k],
+            speed_ref: self.scenario.speed_ref,
+            x_ref: r.x[k],
+            y_ref: r.y[k],
+            psi_ref: r.psi[k],
+            mu: d.friction(k),
+            wind_x: 0.0,
+            wind_y: d.wind_y(k),
+            beta_meas,
+            yaw_rate_meas,
+        })
+    }
+}
+
+/// A benchmark as the test bench plays it, sample by sample: the reference shared with the
+/// process cache ([`Benchmark::shared_reference`], no copy) and the disturbances read from
+/// the seed's table ([`DisturbanceSequence`]). [`BenchSampler::sample`] is exactly (bit for
+/// bit) [`Benchmark::sample`], without drawing the noise again at every sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchSampler {
+    scenario: Scenario,
+    reference: Arc<Reference>,
+    disturbances: DisturbanceSequence,
+}
+
+impl BenchSampler {
+    /// Validates the scenario and takes its reference (computed if need be, see
+    /// [`Benchmark::prepare`]) and its disturbance table.
+    pub fn prepare(scenario: Scenario) -> Result<BenchSampler, SettingError> {
+        let reference = Benchmark::shared_reference(scenario)?;
+        let disturbances = DisturbanceSequence::new(scenario.disturbances(), scenario.n_samples);
+        Ok(BenchSampler { scenario, reference, disturbances })
+    }
+
+    /// The scenario.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// The column's reference and program.
+    pub fn reference(&self) -> &Reference {
+        &self.reference
+    }
+
+    /// [`Benchmark::horizon`].
+    pub fn horizon(&self) -> usize {
+        self.reference.trajectory.n_samples()
+    }
+
+    /// [`Benchmark::sample`].
+    pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
+        let r = &self.reference.trajectory;
+        if k > self.horizon() {
+            return None;
+        }
+        let d = &self.disturbances;
         let (beta_meas, yaw_rate_meas) = d.measure(k, beta, yaw_rate);
         Some(BenchSample {
             delta_ff: self.reference.program.steering(k),

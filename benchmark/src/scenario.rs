@@ -330,3 +330,235 @@ impl Disturbances {
         (beta + 0.005 * g(self.seed, STREAM_BETA, k as u64), yaw_rate + 0.01 * g(self.seed, STREAM_YAW_RATE, k as u64))
     }
 }
+
+/// How many seeds' disturbance tables [`DisturbanceSequence::new`] keeps for the process.
+pub const DISTURBANCE_CACHE_SIZE: usize = 4;
+
+/// Samples a disturbance table covers at most (60 s): about 3.4 MB a seed, so the cache
+/// stays below some 14 MB. Samples beyond it come from the formulas.
+pub const DISTURBANCE_TABLE_MAX_SAMPLES: usize = 60_001;
+
+/// One sample of the seed's disturbance streams, every switch on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct DisturbanceRow {
+    /// [`Disturbances::friction`] with the variation on.
+    mu: [f64; 4],
+    /// [`Disturbances::wind_y`] with the wind on.
+    wind_y: f64,
+    /// `g(seed, 5, k)` and `g(seed, 6, k)`, the measurement noise before its scale.
+    noise: [f64; 2],
+}
+
+/// Every disturbance of one seed for the samples `0 .. rows.len()`, every switch on.
+#[derive(Debug, PartialEq)]
+struct DisturbanceTable {
+    seed: u64,
+    rows: Vec<DisturbanceRow>,
+}
+
+impl DisturbanceTable {
+    fn compute(seed: u64, len: usize) -> Self {
+        let on = Disturbances { seed, friction_variation: true, wind: true, measurement_noise: true };
+        let rows = (0..len)
+            .map(|k| DisturbanceRow {
+                mu: on.friction(k),
+                wind_y: on.wind_y(k),
+                noise: [g(seed, STREAM_BETA, k as u64), g(seed, STREAM_YAW_RATE, k as u64)],
+            })
+            .collect();
+        DisturbanceTable { seed, rows }
+    }
+}
+
+/// One table of the cache: empty while (or if) it is being computed; its own lock makes a
+/// second thread asking for the same seed wait for the first one's table.
+type DisturbanceSlot = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<DisturbanceTable>>>>;
+
+/// The most recently used tables, newest last, keyed by `(seed, len)`.
+type DisturbanceCache = std::sync::Mutex<Vec<((u64, usize), DisturbanceSlot)>>;
+
+fn disturbance_cache() -> &'static DisturbanceCache {
+    static CACHE: std::sync::OnceLock<DisturbanceCache> = std::sync::OnceLock::new();
+    CACHE.get_or_init(|| std::sync::Mutex::new(Vec::new()))
+}
+
+/// The table of `seed` over `len` samples, from the cache or computed (and kept).
+fn disturbance_table(seed: u64, len: usize) -> std::sync::Arc<DisturbanceTable> {
+    let key = (seed, len);
+    let slot = {
+        let mut entries = disturbance_cache().lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        match entries.iter().position(|(k, _)| *k == key) {
+            Some(i) => {
+                // most recently used last
+                let entry = entries.remove(i);
+                let slot = entry.1.clone();
+                entries.push(entry);
+                slot
+            }
+            None => {
+                if entries.len() >= DISTURBANCE_CACHE_SIZE {
+                    entries.remove(0);
+                }
+                let slot = DisturbanceSlot::default();
+                entries.push((key, slot.clone()));
+                slot
+            }
+        }
+    };
+    // held while computing: a concurrent request for the same table waits for it
+    let mut cached = slot.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    cached.get_or_insert_with(|| std::sync::Arc::new(DisturbanceTable::compute(seed, len))).clone()
+}
+
+/// The disturbances of a run read from a table computed once per seed and process
+/// (Table III runs 3 or 4 controllers on 6 maneuvers and 2 columns with the same seed, and
+/// every sample draws 4 sines, 2 logarithms, 2 cosines and 9 hashes). Every value is
+/// exactly (bit for bit) what the per-sample formulas of [`Disturbances`] give: the table
+/// holds those formulas' own results, and samples beyond it are computed by them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DisturbanceSequence {
+    disturbances: Disturbances,
+    /// `None` with every switch off (nothing to look up).
+    table: Option<std::sync::Arc<DisturbanceTable>>,
+}
+
+impl DisturbanceSequence {
+    /// The disturbances `d` of a run of `n_samples` samples: the table covers the samples
+    /// `0 ..= n_samples` (the last one is what a test bench holds at the end), at most
+    /// [`DISTURBANCE_TABLE_MAX_SAMPLES`]; any other sample comes from the formulas.
+    pub fn new(d: Disturbances, n_samples: usize) -> Self {
+        let any = d.friction_variation || d.wind || d.measurement_noise;
+        let len = n_samples.saturating_add(1).min(DISTURBANCE_TABLE_MAX_SAMPLES);
+        let table = any.then(|| disturbance_table(d.seed, len));
+        DisturbanceSequence { disturbances: d, table }
+    }
+
+    /// The switches and the seed.
+    pub fn disturbances(&self) -> &Disturbances {
+        &self.disturbances
+    }
+
+    #[inline]
+    fn row(&self, k: usize) -> Option<&DisturbanceRow> {
+        self.table.as_ref()?.rows.get(k)
+    }
+
+    /// [`Disturbances::friction`] at sample `k`.
+    #[inline]
+    pub fn friction(&self, k: usize) -> [f64; 4] {
+        if !self.disturbances.friction_variation {
+            return [MU_NOMINAL; 4];
+        }
+        match self.row(k) {
+            Some(row) => row.mu,
+            None => self.disturbances.friction(k),
+        }
+    }
+
+    /// [`Disturbances::wind_y`] at sample `k` [N].
+    #[inline]
+    pub fn wind_y(&self, k: usize) -> f64 {
+        if !self.disturbances.wind {
+            return 0.0;
+        }
+        match self.row(k) {
+            Some(row) => row.wind_y,
+            None => self.disturbances.wind_y(k),
+        }
+    }
+
+    /// [`Disturbances::measure`] at sample `k`.
+    #[inline]
+    pub fn measure(&self, k: usize, beta: f64, yaw_rate: f64) -> (f64, f64) {
+        if !self.disturbances.measurement_noise {
+            return (beta, yaw_rate);
+        }
+        match self.row(k) {
+            // the same expression as `Disturbances::measure`, on the same Gaussians
+            Some(row) => (beta + 0.005 * row.noise[0], yaw_rate + 0.01 * row.noise[1]),
+            None => self.disturbances.measure(k, beta, yaw_rate),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bits(x: [f64; 4]) -> [u64; 4] {
+        x.map(f64::to_bits)
+    }
+
+    /// The table holds the formulas' own numbers: every sample, every switch combination,
+    /// bit for bit, and past the table's end the formulas themselves.
+    #[test]
+    fn disturbance_sequence_is_the_formulas_bit_for_bit() {
+        for seed in [0, 7, (1 << 40) + 3] {
+            for switches in 0..8u8 {
+                let d = Disturbances {
+                    seed,
+                    friction_variation: switches & 1 != 0,
+                    wind: switches & 2 != 0,
+                    measurement_noise: switches & 4 != 0,
+                };
+                let n = 2_000;
+                let seq = DisturbanceSequence::new(d, n);
+                assert_eq!(seq.disturbances(), &d);
+                // beyond the table (n + 1 samples) too
+                for k in (0..=n + 50).chain([N_SAMPLES, 10 * N_SAMPLES]) {
+                    assert_eq!(bits(seq.friction(k)), bits(d.friction(k)), "seed {seed} switches {switches} k {k}");
+                    assert_eq!(seq.wind_y(k).to_bits(), d.wind_y(k).to_bits(), "k {k}");
+                    let (beta, yaw_rate) = (0.01 * k as f64 - 3.0, -0.2);
+                    let (a, b) = (seq.measure(k, beta, yaw_rate), d.measure(k, beta, yaw_rate));
+                    assert_eq!((a.0.to_bits(), a.1.to_bits()), (b.0.to_bits(), b.1.to_bits()), "k {k}");
+                }
+            }
+        }
+    }
+
+    /// A whole 30 s run of the default scenario: the table against the formulas (and the
+    /// friction against an independent writing of maneuvers.md's formula).
+    #[test]
+    fn disturbance_table_of_a_whole_run() {
+        let d = Scenario::new(Maneuver::Slalom, Fidelity::Real).disturbances();
+        let seq = DisturbanceSequence::new(d, N_SAMPLES);
+        for k in 0..=N_SAMPLES {
+            assert_eq!(bits(seq.friction(k)), bits(d.friction(k)), "k {k}");
+            assert_eq!(seq.wind_y(k).to_bits(), d.wind_y(k).to_bits(), "k {k}");
+            assert_eq!(seq.measure(k, 0.1, 0.2), d.measure(k, 0.1, 0.2), "k {k}");
+        }
+        // maneuvers.md at t = 12.345 s, wheel RL (phase pi): 0.35 sin(2 pi 12 theta - pi) + 0.55 + 0.1 u - 0.05
+        let k = 12_345;
+        let theta = 2.0 * PI * 12.345 / 30.0;
+        let by_hand = 0.35 * (24.0 * PI * theta - PI).sin() + 0.5 + 0.1 * u(0, 2, k as u64);
+        assert!((seq.friction(k)[2] - by_hand).abs() < 1e-12, "{} vs {by_hand}", seq.friction(k)[2]);
+    }
+
+    /// The process keeps at most `DISTURBANCE_CACHE_SIZE` tables, hands out the same one
+    /// to every run of a seed, and two threads asking at once get one table.
+    #[test]
+    fn disturbance_cache_is_shared_and_bounded() {
+        let d = |seed| Disturbances {
+            seed: 1_000 + seed,
+            ..Scenario::new(Maneuver::Straight, Fidelity::Real).disturbances()
+        };
+        let (a, b) = std::thread::scope(|s| {
+            let a = s.spawn(|| DisturbanceSequence::new(d(0), 500));
+            let b = s.spawn(|| DisturbanceSequence::new(d(0), 500));
+            (a.join().unwrap(), b.join().unwrap())
+        });
+        let (ta, tb) = (a.table.unwrap(), b.table.unwrap());
+        assert!(std::sync::Arc::ptr_eq(&ta, &tb), "one table for one seed");
+        assert_eq!((ta.seed, ta.rows.len()), (1_000, 501));
+        for seed in 1..=2 * DISTURBANCE_CACHE_SIZE as u64 {
+            DisturbanceSequence::new(d(seed), 500);
+        }
+        assert!(disturbance_cache().lock().unwrap().len() <= DISTURBANCE_CACHE_SIZE);
+        // nothing to look up with every switch off; a long run keeps a bounded table
+        assert!(DisturbanceSequence::new(Disturbances::none(), N_SAMPLES).table.is_none());
+        let long = DisturbanceSequence::new(d(99), 100 * N_SAMPLES);
+        assert_eq!(long.table.as_ref().unwrap().rows.len(), DISTURBANCE_TABLE_MAX_SAMPLES);
+        let k = 3 * DISTURBANCE_TABLE_MAX_SAMPLES;
+        assert_eq!(bits(long.friction(k)), bits(d(99).friction(k)));
+    }
+}

@@ -3,6 +3,11 @@
 //! argument in `control.rs`, without overshoot, and the commanded speed stays inside its
 //! clamp however far behind the car starts.
 
+mod common {
+    pub use nigel_benchmark::ControllerInputs;
+    pub mod inputs;
+}
+
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
 use nigel_benchmark::{Controller, ControllerInputs, SampledController, DEFAULT_SPEED, SAMPLE_PERIOD};
 use nigel_vehicle::dynamics::idx;
@@ -126,21 +131,7 @@ fn the_paper_controllers_ignore_the_pose() {
     // the pose inputs change nothing for open loop, pole placement and robust
     for c in Controller::TABLE {
         let ctl = SampledController::new(c.settings()).unwrap();
-        let x = ControllerInputs {
-            beta: 0.02,
-            yaw_rate: -0.1,
-            speed: 0.3,
-            beta_ref: 0.01,
-            yaw_rate_ref: 0.05,
-            speed_ref: 0.35,
-            delta_ff: [0.1, 0.1, -0.1, -0.1],
-            x: 0.0,
-            y: 0.0,
-            psi: 0.0,
-            x_ref: 0.0,
-            y_ref: 0.0,
-            psi_ref: 0.0,
-        };
+        let x = common::inputs::off_reference();
         let moved = ControllerInputs { x: 3.0, y: -1.0, psi: 2.0, x_ref: 1.0, ..x };
         assert_eq!(ctl.outputs(&x), ctl.outputs(&moved), "{c}");
         assert_eq!(ctl.increment(&x), ctl.increment(&moved), "{c}");

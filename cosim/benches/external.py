@@ -4,24 +4,20 @@ and libcosim best of 3, fmpy once: it takes about a minute), then what it comput
 final pose and the paper's epsilon over the 30,000 samples (read in a second, untimed run
 for ecos and libcosim, which record nothing in the timed one). Called by
 `cargo bench -p nigel-cosim` with COSIM_BENCH_PYTHON set; argument: the .ssp."""
+import pathlib
 import sys
 import time
 
-import numpy as np
+# the drivers and epsilon are shared with the cross-checks (cosim/tests/python)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "python"))
+from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series  # noqa: E402
 
 ssp = sys.argv[1]
 N = 30000
-POSE = ["plant.x", "plant.y", "plant.psi", "maneuver.x_ref", "maneuver.y_ref", "maneuver.psi_ref"]
 
 
 def best(f, n=3):
     return min(f() for _ in range(n))
-
-
-def epsilon(series):
-    x, y, psi, x_ref, y_ref, psi_ref = (np.asarray(series[n]) for n in POSE)
-    rms = [np.sqrt(np.mean((a - b) ** 2)) for a, b in ((x, x_ref), (y, y_ref), (psi, psi_ref))]
-    return float(np.linalg.norm(rms))
 
 
 def report(tool, seconds, series, note=""):
@@ -42,24 +38,14 @@ try:
         sim.terminate()
         return dt
 
-    def ecos_series():
-        sim = EcosSimulation(ssp_path=ssp, step_size=1e-3)
-        sim.init(parameter_set="initialValues")
-        series = {n: [] for n in POSE}
-        for _ in range(N):
-            sim.step(1)
-            for name in POSE:
-                series[name].append(sim.get_real(name.replace(".", "::")))
-        sim.terminate()
-        return series
-    report("ecos (ecospy 0.7.2), step(30000)", best(ecos_timed), ecos_series())
+    report("ecos (ecospy 0.7.2), step(30000)", best(ecos_timed),
+           ecos_series(ssp, 1e-3, N, POSE, parameter_set="initialValues"))
 except Exception as e:  # a missing tool is reported, not fatal
     print("ecos:", repr(e))
 
 try:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import log_output_level, CosimLogLevel
-    from libcosimpy.CosimObserver import CosimObserver
 
     log_output_level(CosimLogLevel.ERROR)
 
@@ -69,23 +55,8 @@ try:
         ex.simulate_until(30_000_000_000)
         return time.perf_counter() - t
 
-    def libcosim_series():
-        ex = CosimExecution.from_ssp_file(ssp, step_size=1_000_000)
-        obs = CosimObserver.create_last_value()
-        ex.add_observer(obs)
-        slots = []
-        for name in POSE:
-            inst, var = name.split(".")
-            i = ex.slave_index_from_instance_name(inst)
-            refs = {v.name.decode(): v.reference for v in ex.slave_variables(i)}
-            slots.append((i, refs[var]))
-        series = {n: [] for n in POSE}
-        for _ in range(N):
-            ex.step(1)
-            for name, (i, r) in zip(POSE, slots):
-                series[name].append(obs.last_real_values(i, [r])[0])
-        return series
-    report("libcosim (libcosimpy 0.0.6), simulate_until(30 s)", best(libcosim_timed), libcosim_series())
+    report("libcosim (libcosimpy 0.0.6), simulate_until(30 s)", best(libcosim_timed),
+           libcosim_series(ssp, 1_000_000, N, POSE))
 except Exception as e:
     print("libcosim:", repr(e))
 

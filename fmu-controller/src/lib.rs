@@ -380,6 +380,10 @@ pub struct Controller {
     /// Co-Simulation: samples run since the importer last read or set a value.
     unattended: u64,
     interface: Interface,
+    /// The law of `settings`, `custom` and `mode` once validated (its integrator is not
+    /// used): a sample does not validate the settings again. Emptied by every setter of a
+    /// parameter (`set_real`'s parameter arms) and of the `controller` switch.
+    validated: Option<SampledController>,
 }
 
 impl Controller {
@@ -404,7 +408,23 @@ impl Controller {
         }
     }
 
-    fn law(&self) -> Result<SampledController, String> {
+    /// The law with the settings in use and the integrator `I`; the settings are validated
+    /// once after they change.
+    fn law(&mut self) -> Result<SampledController, String> {
+        let mut c = match self.validated {
+            Some(c) => c,
+            None => {
+                let c = self.validate_law()?;
+                self.validated = Some(c);
+                c
+            }
+        };
+        c.set_integral(self.integral);
+        Ok(c)
+    }
+
+    /// The settings in use (the gains the `controller` switch selects), validated.
+    fn validate_law(&self) -> Result<SampledController, String> {
         let tracking = self.mode == mode::ROBUST_TRACKING;
         let settings = ControllerSettings {
             gain: self.gain_in_use(),
@@ -413,18 +433,66 @@ impl Controller {
             k_along_track: if tracking { self.settings.k_along_track } else { 0.0 },
             ..self.settings
         };
-        let mut c = SampledController::new(settings).map_err(|e| e.to_string())?;
-        c.set_integral(self.integral);
-        Ok(c)
+        SampledController::new(settings).map_err(|e| e.to_string())
     }
 
     /// The outputs an importer reads: the held sample, or before the first sample the law
     /// on the current inputs (what the initial event will latch).
-    fn outputs(&self) -> ModelResult<ControllerOutputs> {
+    fn outputs(&mut self) -> ModelResult<ControllerOutputs> {
         if self.k > 0 {
             return Ok(self.held);
         }
         Ok(self.law()?.outputs(&self.inputs))
+    }
+
+    /// The value of `b` with the outputs `o`; `None` if `b` is not a Real.
+    #[inline(always)]
+    fn value(&self, o: &ControllerOutputs, b: Var) -> Option<f64> {
+        let x = &self.inputs;
+        let s = &self.settings;
+        Some(match b {
+            Var::Beta => x.beta,
+            Var::YawRate => x.yaw_rate,
+            Var::Speed => x.speed,
+            Var::BetaRef => x.beta_ref,
+            Var::YawRateRef => x.yaw_rate_ref,
+            Var::SpeedRef => x.speed_ref,
+            Var::SteerFeedForward(i) => x.delta_ff[i],
+            Var::Steer(i) => o.delta[i],
+            Var::Torque(i) => o.tau[i],
+            Var::DriveForce => o.force,
+            Var::SpeedIntegral => self.integral,
+            Var::SamplePeriod => s.sample_period,
+            Var::KpSpeed => s.kp_speed,
+            Var::KiSpeed => s.ki_speed,
+            Var::ForceMax => s.force_max,
+            Var::WheelRadius => s.r_wheel,
+            Var::SteerLimit => s.delta_max,
+            Var::CustomGain(i, j) => self.custom[i][j],
+            Var::GainInUse(i, j) => self.gain_in_use()[i][j],
+            Var::PoseGainInUse(i, j) => self.pose_gain_in_use()[i][j],
+            Var::Pose(i) => [x.x, x.y, x.psi][i],
+            Var::PoseRef(i) => [x.x_ref, x.y_ref, x.psi_ref][i],
+            Var::AlongTrackGain => s.k_along_track,
+            Var::AlongTrackSpeedMax => s.along_track_speed_max,
+            Var::Controller => return None,
+        })
+    }
+
+    /// `get_real` off its fast path: before the first sample (the law on the current
+    /// inputs, what the initial event will latch) and for a variable that is not a Real.
+    #[cold]
+    #[inline(never)]
+    fn get_real_before_first_sample(&mut self, b: Var) -> ModelResult<f64> {
+        if b == Var::Controller {
+            return Err("controller is an Integer, not a Real".into());
+        }
+        let outputs = match b {
+            // only the outputs of the law need it (a parameter reads without valid settings)
+            Var::Steer(_) | Var::Torque(_) | Var::DriveForce => self.outputs()?,
+            _ => self.held,
+        };
+        self.value(&outputs, b).ok_or_else(|| format!("{b:?} is not a Real").into())
     }
 
     fn set_parameter(slot: &mut f64, name: &str, value: f64, positive: bool) -> ModelResult {
@@ -474,40 +542,19 @@ impl Model for Controller {
             start_time: 0.0,
             unattended: 0,
             interface: context.interface,
+            validated: None,
         })
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
         self.unattended = 0;
-        let x = &self.inputs;
-        let s = &self.settings;
-        Ok(match b {
-            Var::Beta => x.beta,
-            Var::YawRate => x.yaw_rate,
-            Var::Speed => x.speed,
-            Var::BetaRef => x.beta_ref,
-            Var::YawRateRef => x.yaw_rate_ref,
-            Var::SpeedRef => x.speed_ref,
-            Var::SteerFeedForward(i) => x.delta_ff[i],
-            Var::Steer(i) => self.outputs()?.delta[i],
-            Var::Torque(i) => self.outputs()?.tau[i],
-            Var::DriveForce => self.outputs()?.force,
-            Var::SpeedIntegral => self.integral,
-            Var::SamplePeriod => s.sample_period,
-            Var::KpSpeed => s.kp_speed,
-            Var::KiSpeed => s.ki_speed,
-            Var::ForceMax => s.force_max,
-            Var::WheelRadius => s.r_wheel,
-            Var::SteerLimit => s.delta_max,
-            Var::CustomGain(i, j) => self.custom[i][j],
-            Var::GainInUse(i, j) => self.gain_in_use()[i][j],
-            Var::PoseGainInUse(i, j) => self.pose_gain_in_use()[i][j],
-            Var::Pose(i) => [x.x, x.y, x.psi][i],
-            Var::PoseRef(i) => [x.x_ref, x.y_ref, x.psi_ref][i],
-            Var::AlongTrackGain => s.k_along_track,
-            Var::AlongTrackSpeedMax => s.along_track_speed_max,
-            Var::Controller => return Err("controller is an Integer, not a Real".into()),
-        })
+        // an importer reads the held outputs at every sample: that path is a lookup
+        if self.k > 0 {
+            if let Some(value) = self.value(&self.held, b) {
+                return Ok(value);
+            }
+        }
+        self.get_real_before_first_sample(b)
     }
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
@@ -527,18 +574,38 @@ impl Model for Controller {
             Var::Torque(i) => self.held.tau[i] = value,
             Var::DriveForce => self.held.force = value,
             Var::SpeedIntegral => self.integral = value,
+            // a parameter: the law is validated again at its next use
             Var::SamplePeriod => {
+                self.validated = None;
                 if !(value >= MIN_SAMPLE_PERIOD) {
                     return Err(format!("sample_period = {value} refused: must be >= {MIN_SAMPLE_PERIOD} s").into());
                 }
                 s.sample_period = value;
             }
-            Var::KpSpeed => Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?,
-            Var::KiSpeed => Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?,
-            Var::ForceMax => Self::set_parameter(&mut s.force_max, "force_max", value, true)?,
-            Var::WheelRadius => Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?,
-            Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
-            Var::CustomGain(i, j) => self.custom[i][j] = value,
+            Var::KpSpeed => {
+                self.validated = None;
+                Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?
+            }
+            Var::KiSpeed => {
+                self.validated = None;
+                Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?
+            }
+            Var::ForceMax => {
+                self.validated = None;
+                Self::set_parameter(&mut s.force_max, "force_max", value, true)?
+            }
+            Var::WheelRadius => {
+                self.validated = None;
+                Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?
+            }
+            Var::SteerLimit => {
+                self.validated = None;
+                Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?
+            }
+            Var::CustomGain(i, j) => {
+                self.validated = None;
+                self.custom[i][j] = value;
+            }
             Var::GainInUse(..) | Var::PoseGainInUse(..) => return Err("the gains in use are calculated".into()),
             Var::Pose(0) => x.x = value,
             Var::Pose(1) => x.y = value,
@@ -547,12 +614,14 @@ impl Model for Controller {
             Var::PoseRef(1) => x.y_ref = value,
             Var::PoseRef(_) => x.psi_ref = value,
             Var::AlongTrackGain => {
+                self.validated = None;
                 if !(value >= 0.0) {
                     return Err(format!("k_along_track = {value} refused: must be >= 0").into());
                 }
                 s.k_along_track = value;
             }
             Var::AlongTrackSpeedMax => {
+                self.validated = None;
                 if !(value >= 0.0) {
                     return Err(format!("along_track_speed_max = {value} refused: must be >= 0").into());
                 }
@@ -571,6 +640,7 @@ impl Model for Controller {
     }
 
     fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
+        self.validated = None;
         match b {
             Var::Controller if (mode::OPEN_LOOP..=mode::ROBUST_TRACKING).contains(&value) => {
                 self.mode = value;
@@ -607,8 +677,7 @@ impl Model for Controller {
             self.integral += self.pending_increment;
         }
         let law = self.law()?;
-        self.held = law.outputs(&self.inputs);
-        self.pending_increment = law.increment(&self.inputs);
+        (self.held, self.pending_increment) = law.outputs_and_increment(&self.inputs);
         self.k += 1;
         // sample instants from the start time and an integer count: no drift
         let next = self.start_time + self.k as f64 * self.settings.sample_period;

@@ -255,6 +255,20 @@ fn custom_gains_can_change_between_steps() {
     let after = deltas(&c);
     assert!(close(after[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", after[0], by_hand(&k, &x, 0.0).0[0]);
     assert_eq!(after[1..], before[1..]);
+    // the settings are validated once per change, not per sample: a second change later
+    // takes effect too, and the gain stays put over the samples in between
+    assert_eq!(c.step(T, T), OK);
+    assert!(close(deltas(&c)[0], by_hand(&k, &x, 0.0).0[0]));
+    k[0] = [-0.5, 0.25];
+    assert_eq!(c.set_real(vr::K_CUSTOM, -0.5), OK);
+    assert_eq!(c.set_real(vr::K_CUSTOM + 1, 0.25), OK);
+    assert_eq!(c.step(2.0 * T, T), OK);
+    let again = deltas(&c);
+    assert!(close(again[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", again[0], by_hand(&k, &x, 0.0).0[0]);
+    assert_eq!(again[1..], before[1..]);
+    // a gain the layer lets through but the law refuses (not finite) is still refused
+    assert_eq!(c.set_real(vr::K_CUSTOM, f64::INFINITY), ERR);
+    assert!(c.last_error().contains("k_beta_fl"), "{}", c.last_error());
     // a fixed parameter cannot change after initialization
     assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST), ERR);
 }
@@ -521,4 +535,30 @@ fn controller_switch_is_an_integer_parameter_listing_its_values() {
         c.init();
         assert_eq!(c.int(vr::CONTROLLER), good);
     }
+}
+
+/// The law is validated once and kept until a parameter changes: in initialization mode an
+/// importer may read the outputs (which runs the law), then set a parameter and the
+/// controller switch, and the outputs follow every change.
+#[test]
+fn outputs_follow_parameters_set_after_a_read() {
+    let c = C::cs();
+    assert_eq!(c.setup(), OK);
+    assert_eq!(c.enter_init(), OK);
+    let x = SETS[0];
+    set_inputs(&c, &x);
+    // robust: e = 0.01, F = 53.6 e
+    assert!(close(c.real(vr::DRIVE_FORCE), 53.6 * 0.01));
+    assert!(close(deltas(&c)[0], by_hand(&ROBUST, &x, 0.0).0[0]));
+    assert_eq!(c.set_real(vr::KP_SPEED, 100.0), OK);
+    assert!(close(c.real(vr::DRIVE_FORCE), 100.0 * 0.01), "{}", c.real(vr::DRIVE_FORCE));
+    assert_eq!(c.set_real(vr::R_WHEEL, 0.05), OK);
+    assert!(close(taus(&c)[0], 100.0 * 0.01 * 0.05 / 4.0), "{:?}", taus(&c));
+    assert_eq!(c.set_int(vr::CONTROLLER, mode::POLE_PLACEMENT), OK);
+    assert!(close(deltas(&c)[0], by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]));
+    assert_eq!(c.set_real(vr::DELTA_MAX, 0.05), OK);
+    assert_eq!(deltas(&c)[0], 0.05f64.min(by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]).max(-0.05));
+    assert_eq!(c.exit_init(), OK);
+    assert_eq!(c.step(0.0, T), OK);
+    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
 }

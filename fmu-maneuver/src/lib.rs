@@ -21,7 +21,8 @@ use fmi2_export::{
     Interfaces, Model, ModelResult, Start, VarDecl,
 };
 use nigel_benchmark::{
-    BenchSample, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE, SAMPLE_PERIOD,
+    BenchSample, BenchSampler, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
+    SAMPLE_PERIOD,
 };
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
@@ -297,8 +298,9 @@ pub struct TestBench {
     duration: f64,
     beta: f64,
     yaw_rate: f64,
-    /// Computed at the end of initialization (shared by FMU-state copies).
-    bench: Option<Arc<Benchmark>>,
+    /// Computed at the end of initialization (shared by FMU-state copies; the reference and
+    /// the disturbance table are shared with the process cache).
+    bench: Option<Arc<BenchSampler>>,
     /// The outputs of the last sample, held until the next one.
     held: BenchSample,
     /// Samples run so far (the next sample is `k`).
@@ -325,6 +327,39 @@ impl TestBench {
             return self.held;
         }
         Benchmark::initial_sample(&self.scenario, self.beta, self.yaw_rate)
+    }
+
+    /// The value of `b` with the outputs `o`; `None` if `b` is not a Real.
+    #[inline(always)]
+    fn value(&self, o: &BenchSample, b: Var) -> Option<f64> {
+        Some(match b {
+            Var::Beta => self.beta,
+            Var::YawRate => self.yaw_rate,
+            Var::SteerFeedForward(i) => o.delta_ff[i],
+            Var::BetaRef => o.beta_ref,
+            Var::YawRateRef => o.yaw_rate_ref,
+            Var::SpeedRef => o.speed_ref,
+            Var::XRef => o.x_ref,
+            Var::YRef => o.y_ref,
+            Var::PsiRef => o.psi_ref,
+            Var::Friction(i) => o.mu[i],
+            Var::WindX => o.wind_x,
+            Var::WindY => o.wind_y,
+            Var::BetaMeas => o.beta_meas,
+            Var::YawRateMeas => o.yaw_rate_meas,
+            Var::SteerAmplitude => self.scenario.steer_amplitude,
+            Var::SpeedTarget => self.scenario.speed_ref,
+            Var::Duration => self.duration,
+            _ => return None,
+        })
+    }
+
+    /// `get_real` off its fast path: before the first sample (what the initial event will
+    /// latch) and for a variable that is not a Real.
+    #[cold]
+    #[inline(never)]
+    fn get_real_before_first_sample(&self, b: Var) -> ModelResult<f64> {
+        self.value(&self.outputs(), b).ok_or_else(|| format!("{b:?} is not a Real").into())
     }
 }
 
@@ -353,34 +388,13 @@ impl Model for TestBench {
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
-        // the held sample by reference (an importer reads some 20 outputs at every sample)
-        let initial;
-        let o = if self.k > 0 {
-            &self.held
-        } else {
-            initial = self.outputs();
-            &initial
-        };
-        Ok(match b {
-            Var::Beta => self.beta,
-            Var::YawRate => self.yaw_rate,
-            Var::SteerFeedForward(i) => o.delta_ff[i],
-            Var::BetaRef => o.beta_ref,
-            Var::YawRateRef => o.yaw_rate_ref,
-            Var::SpeedRef => o.speed_ref,
-            Var::XRef => o.x_ref,
-            Var::YRef => o.y_ref,
-            Var::PsiRef => o.psi_ref,
-            Var::Friction(i) => o.mu[i],
-            Var::WindX => o.wind_x,
-            Var::WindY => o.wind_y,
-            Var::BetaMeas => o.beta_meas,
-            Var::YawRateMeas => o.yaw_rate_meas,
-            Var::SteerAmplitude => self.scenario.steer_amplitude,
-            Var::SpeedTarget => self.scenario.speed_ref,
-            Var::Duration => self.duration,
-            _ => return Err(format!("{b:?} is not a Real").into()),
-        })
+        // an importer reads some 20 held outputs at every sample: that path is a lookup
+        if self.k > 0 {
+            if let Some(value) = self.value(&self.held, b) {
+                return Ok(value);
+            }
+        }
+        self.get_real_before_first_sample(b)
     }
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
@@ -475,12 +489,12 @@ impl Model for TestBench {
     /// Computes the reference (and the figure-8 table) unless it is there for these parameters.
     fn exit_initialization(&mut self) -> ModelResult {
         let scenario = self.scenario_now()?;
-        if self.bench.as_ref().is_some_and(|b| b.scenario == scenario) {
+        if self.bench.as_ref().is_some_and(|b| *b.scenario() == scenario) {
             return Ok(());
         }
-        // `Benchmark::prepare` keeps the recent references for the process (they depend on
-        // neither the seed nor the switches): many instances compute each one once.
-        self.bench = Some(Arc::new(Benchmark::prepare(scenario).map_err(|e| e.to_string())?));
+        // the process keeps the recent references (they depend on neither the seed nor the
+        // switches) and the disturbance tables per seed: many instances compute each once
+        self.bench = Some(Arc::new(BenchSampler::prepare(scenario).map_err(|e| e.to_string())?));
         Ok(())
     }
 

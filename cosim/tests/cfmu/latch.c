@@ -11,24 +11,8 @@
  * A follower and an inverter in a loop have no fixed point once the follower follows.
  * A time event at t_event (if > 0). Its outputs do not depend on its input directly
  * (they change only in event mode). */
-#include <stdlib.h>
-#include <string.h>
-
-typedef void *fmi2Component;
-typedef int fmi2Status;
-typedef unsigned int fmi2ValueReference;
-typedef struct {
-    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
-    void *(*allocateMemory)(size_t, size_t);
-    void (*freeMemory)(void *);
-    void *stepFinished;
-    void *componentEnvironment;
-} fmi2CallbackFunctions;
-typedef struct {
-    int newDiscreteStatesNeeded, terminateSimulation, nominalsOfContinuousStatesChanged,
-        valuesOfContinuousStatesChanged, nextEventTimeDefined;
-    double nextEventTime;
-} fmi2EventInfo;
+#define FMI2_TEST_NO_FMU_STATE
+#include "fmi2_test.h"
 
 #define NR 6
 typedef struct {
@@ -37,14 +21,8 @@ typedef struct {
     int fired;
 } Latch;
 
-#define EXPORT __attribute__((visibility("default")))
-#define ERR 3
-
 static void defaults(Latch *l) { memset(l, 0, sizeof *l); }
 
-EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
-EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
-EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cat[]) { return 0; }
 EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
                                      const fmi2CallbackFunctions *cb, int visible, int logging) {
     Latch *l;
@@ -84,12 +62,6 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? ERR : 0; }
 
 EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
@@ -127,12 +99,3 @@ EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n)
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return n ? ERR : 0; }
 EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return ERR; }
-EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) { return ERR; }
-EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { return ERR; }
-EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return ERR; }
-EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return ERR; }
-EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return ERR; }
-EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
-                                               const fmi2ValueReference z[], size_t nz, const double dv[],
-                                               double dz[]) { return ERR; }

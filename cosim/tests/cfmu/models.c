@@ -8,19 +8,8 @@
  * does N rounds of floating-point work (a heavier FMU for the thread benchmarks). */
 #include <stdarg.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
-typedef void *fmi2Component;
-typedef int fmi2Status;
-typedef unsigned int fmi2ValueReference;
-typedef struct {
-    void (*logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
-    void *(*allocateMemory)(size_t, size_t);
-    void (*freeMemory)(void *);
-    void *stepFinished;
-    void *componentEnvironment;
-} fmi2CallbackFunctions;
+#define FMI2_TEST_NO_MODEL_EXCHANGE
+#include "fmi2_test.h"
 
 #define NR 8
 typedef struct {
@@ -29,8 +18,6 @@ typedef struct {
     fmi2CallbackFunctions cb;
     char name[64];
 } Model;
-
-#define EXPORT __attribute__((visibility("default")))
 
 static void log_msg(Model *m, fmi2Status s, const char *msg) {
     if (m->cb.logger) m->cb.logger(m->cb.componentEnvironment, m->name, s, "log", "%s", msg);
@@ -58,10 +45,6 @@ static void outputs(Model *m) {
     m->r[0] = m->time;
 #endif
 }
-
-EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
-EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
-EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, int on, size_t n, const char *const cat[]) { return 0; }
 
 EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
                                      const fmi2CallbackFunctions *cb, int visible, int logging) {
@@ -106,12 +89,6 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? 3 : 0; }
-EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? 3 : 0; }
-EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, int v[]) { return n ? 3 : 0; }
-EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const int v[]) { return n ? 3 : 0; }
-EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? 3 : 0; }
-EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? 3 : 0; }
 
 #ifndef OMIT_DOSTEP
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior) {
@@ -149,7 +126,7 @@ EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { *v = 0;
 EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return 3; }
 
 /* FMU state: a copy of the instance. The remaining functions of the 44 (importers such as
- * fmpy resolve all of them): no serialization, derivatives or Model Exchange: fmi2Error. */
+ * fmpy resolve all of them) are fmi2_test.h's: no serialization, derivatives or Model Exchange. */
 EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) {
     if (!*s) *s = malloc(sizeof(Model));
     memcpy(*s, c, sizeof(Model));
@@ -163,23 +140,3 @@ EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, void *s) {
     return 0;
 }
 EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, void **s) { free(*s); *s = NULL; return 0; }
-EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return 3; }
-EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return 3; }
-EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return 3; }
-EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
-                                               const fmi2ValueReference z[], size_t nz, const double dv[],
-                                               double dz[]) { return 3; }
-EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                              const int order[], const double v[]) { return 3; }
-EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                               const int order[], double v[]) { return 3; }
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 3; }
-EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, void *info) { return 3; }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 3; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int a, int *b, int *d) { return 3; }
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { return 3; }
-EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return 3; }
-EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return 3; }
-EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return 3; }
-EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return 3; }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return 3; }

@@ -11,6 +11,7 @@ import subprocess
 import numpy as np
 import pytest
 
+from closed_loop_tools import ecos_series, libcosim_series
 from test_cosim_ssp import exported_ssp  # noqa: F401  (the fixture)
 
 STOP, H, N = 1.0, 0.01, 100
@@ -27,42 +28,17 @@ def ours(cosim, exported_ssp, tmp_path_factory):  # noqa: F811
 
 
 def test_libcosim_agrees_at_every_step(ours, exported_ssp):  # noqa: F811
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    ex = CosimExecution.from_ssp_file(str(exported_ssp), step_size=int(H * 1e9))  # time in ns
-    obs = CosimObserver.create_last_value()
-    ex.add_observer(obs)
-    names = RECORDED
-    slots = []
-    for name in names:
-        inst, var = name.split(".")
-        i = ex.slave_index_from_instance_name(inst)
-        refs = {v.name.decode(): v.reference for v in ex.slave_variables(i)}
-        slots.append((i, refs[var]))
-    worst = 0.0
-    for n in range(1, N + 1):
-        ex.step(1)
-        for name, (i, r) in zip(names, slots):
-            theirs = obs.last_real_values(i, [r])[0]
-            worst = max(worst, abs(theirs - ours[name][n]))
+    theirs = libcosim_series(exported_ssp, int(H * 1e9), N, RECORDED)  # time in ns
+    worst = max(abs(theirs[name][n - 1] - ours[name][n]) for name in RECORDED for n in range(1, N + 1))
     assert worst <= 1e-12, worst
     assert ours["int.x"][N] > 0.9
 
 
 def test_ecos_agrees_on_states_and_outputs_without_feedthrough(ours, exported_ssp):  # noqa: F811
-    from ecospy import EcosSimulation
-
-    sim = EcosSimulation(ssp_path=str(exported_ssp), step_size=H)
-    sim.init()
-    worst = 0.0
-    for n in range(1, N + 1):
-        sim.step(1)
-        for name in ["src.y", "int.x", "plant.x"]:
-            worst = max(worst, abs(sim.get_real(name.replace(".", "::")) - ours[name][n]))
-        # feedthrough output read after the new input: 2 src.y(t_n), our ordered value
-        assert abs(sim.get_real("amp::y") - 2 * ours["src.y"][n]) <= 1e-12
-    sim.terminate()
+    theirs = ecos_series(exported_ssp, H, N, ["src.y", "int.x", "plant.x", "amp.y"])
+    worst = max(abs(theirs[name][n - 1] - ours[name][n])
+                for name in ["src.y", "int.x", "plant.x"] for n in range(1, N + 1))
     assert worst <= 1e-12, worst
+    for n in range(1, N + 1):
+        # feedthrough output read after the new input: 2 src.y(t_n), our ordered value
+        assert abs(theirs["amp.y"][n - 1] - 2 * ours["src.y"][n]) <= 1e-12

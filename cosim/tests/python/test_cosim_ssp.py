@@ -16,7 +16,7 @@ import zipfile
 import os
 import fmpy.ssp
 
-from conftest import REPO, target_dir
+from closed_loop_tools import REPO, target_dir
 
 
 @pytest.fixture(scope="module")

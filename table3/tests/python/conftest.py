@@ -1,24 +1,8 @@
-import os
+# The fixtures and helpers are shared with the master's cross-checks: cosim/tests/python
+# (fixtures.py, closed_loop_tools.py), put on the import path here.
 import pathlib
-import subprocess
+import sys
 
-import pytest
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[3] / "cosim" / "tests" / "python"))
 
-REPO = pathlib.Path(__file__).resolve().parents[3]
-
-
-def target_dir():
-    t = os.environ.get("CARGO_TARGET_DIR")
-    if t:
-        p = pathlib.Path(t)
-        return p if p.is_absolute() else REPO / p
-    return REPO / "target"
-
-
-@pytest.fixture(scope="session")
-def table3():
-    """Path of the release `table3` binary (built by `cargo test --release --workspace`)."""
-    exe = target_dir() / "release" / "table3"
-    if not exe.exists():
-        subprocess.run(["cargo", "build", "--release", "-q", "-p", "nigel-table3"], cwd=REPO, check=True)
-    return exe
+from fixtures import cosim, plant_fmu, table3  # noqa: E402, F401

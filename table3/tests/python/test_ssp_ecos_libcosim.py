@@ -29,17 +29,10 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import target_dir
+from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series, target_dir
 
 JOB = "sim/lane_change/robust"
 N = 30_000
-POSE = ["plant.x", "plant.y", "plant.psi", "maneuver.x_ref", "maneuver.y_ref", "maneuver.psi_ref"]
-
-
-def epsilon(v):
-    x, y, psi, x_ref, y_ref, psi_ref = (np.asarray(v[n]) for n in POSE)
-    rmse = [np.sqrt(np.mean((a - b) ** 2)) for a, b in ((x, x_ref), (y, y_ref), (psi, psi_ref))]
-    return float(np.linalg.norm(rmse))
 
 
 @pytest.fixture(scope="module")
@@ -78,42 +71,13 @@ def check(name, series, ours):
 
 @pytest.fixture(scope="module")
 def libcosim(ssp):
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    ex = CosimExecution.from_ssp_file(str(ssp), step_size=1_000_000)  # 1 ms in ns
-    obs = CosimObserver.create_last_value()
-    ex.add_observer(obs)
-    slots = []
-    for name in POSE:
-        inst, var = name.split(".")
-        i = ex.slave_index_from_instance_name(inst)
-        refs = {v.name.decode(): v.reference for v in ex.slave_variables(i)}
-        slots.append((i, refs[var]))
-    series = {n: [] for n in POSE}
-    for _ in range(N):
-        ex.step(1)
-        for name, (i, r) in zip(POSE, slots):
-            series[name].append(obs.last_real_values(i, [r])[0])
-    return series
+    return libcosim_series(ssp, 1_000_000, N, POSE)  # 1 ms in ns
 
 
 @pytest.fixture(scope="module")
 def ecos(ssp):
-    from ecospy import EcosSimulation
-
-    sim = EcosSimulation(ssp_path=str(ssp), step_size=1e-3)
     # ecos applies the bindings of the one ParameterSet named here (none without a name)
-    sim.init(parameter_set="initialValues")
-    series = {n: [] for n in POSE}
-    for _ in range(N):
-        sim.step(1)
-        for name in POSE:
-            series[name].append(sim.get_real(name.replace(".", "::")))
-    sim.terminate()
-    return series
+    return ecos_series(ssp, 1e-3, N, POSE, parameter_set="initialValues")
 
 
 def test_libcosim_and_ecos_run_the_exported_loop_alike(libcosim, ecos):

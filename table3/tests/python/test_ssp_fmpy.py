@@ -31,7 +31,7 @@ import fmpy.ssp.simulation as fmpy_ssp
 from fmpy.ssp.simulation import find_components, simulate_ssp
 from fmpy.ssp.ssd import Parameter, ParameterSet, get_connections, read_ssd
 
-from conftest import target_dir
+from closed_loop_tools import target_dir
 
 JOB = "sim/lane_change/robust"
 

@@ -7,17 +7,9 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import REPO, target_dir
+from closed_loop_tools import target_dir
 
 SSP_JOB = "sim/lane_change/robust"
-
-
-@pytest.fixture(scope="module")
-def cosim():
-    exe = target_dir() / "release" / "cosim"
-    if not exe.exists():
-        subprocess.run(["cargo", "build", "--release", "-q", "-p", "nigel-cosim"], cwd=REPO, check=True)
-    return exe
 
 
 @pytest.fixture(scope="module")
