@@ -13,6 +13,10 @@ pub type OpResult<T = ()> = Result<T, ModelError>;
 /// keeps asking for another iteration, or keeps scheduling events at the same time).
 pub const MAX_EVENT_ITERATIONS: usize = 1000;
 
+/// Values of one `fmi2Set*` call whose earlier values are kept for the way back without
+/// copying the model (a longer call copies the model once, at its 33rd value).
+const SET_UNDO_CAPACITY: usize = 32;
+
 /// The part of an instance a saved FMU state holds (never the callbacks).
 #[derive(Clone)]
 pub struct Core<M> {
@@ -342,13 +346,18 @@ impl<M: Model> Instance<M> {
         check_value_in(decl::<M>(), row, value)
     }
 
-    /// Sets all or nothing: every value reference, permission and value is checked first,
-    /// and if the model refuses one value the earlier ones are rolled back.
+    /// Sets all or nothing: every value reference, permission and value is checked first
+    /// (from the declaration's tables), then the values are applied in order. If the model
+    /// refuses one, the values this call set before it are put back, newest first, with
+    /// the values their getters returned before the call (the contract of
+    /// [`Model::set_real`]): the model is as before the call. No copy of the model is made
+    /// unless a getter fails (then from that value on the call keeps a copy to go back to).
     fn set_values<T: Copy + Into<f64>>(
         &mut self,
         base_type: BaseType,
         vrs: &[u32],
         values: &[T],
+        mut read: impl FnMut(&mut M, M::Binding) -> OpResult<T>,
         mut apply: impl FnMut(&mut M, M::Binding, T) -> OpResult,
     ) -> OpResult {
         let d = decl::<M>();
@@ -367,32 +376,76 @@ impl<M: Model> Instance<M> {
             }
         }
         self.unsettle_events();
-        let backup = self.core.model.clone();
-        for (&vr, &value) in vrs.iter().zip(values) {
-            let row = Self::row_in(d, base_type, vr)?;
-            if let Err(e) = apply(&mut self.core.model, d.hot(row).binding, value) {
-                self.core.model = backup;
-                let v = d.variable(row);
-                return Err(match e {
-                    ModelError::Error(m) => ModelError::Error(format!("{}: {m}", v.name)),
-                    ModelError::Discard(m) => ModelError::Discard(format!("{}: {m}", v.name)),
-                });
+        let n = vrs.len().min(values.len());
+        let Some(&first) = values.first() else { return Ok(()) };
+        // the earlier values, for the way back (one value needs none: a refused set
+        // leaves the model unchanged)
+        let mut earlier = [first; SET_UNDO_CAPACITY];
+        // from this index on, the way back is a copy of the model (when a getter failed or
+        // the call is longer than `earlier`)
+        let mut copy: Option<(usize, M)> = None;
+        for k in 0..n {
+            let row = Self::row_in(d, base_type, vrs[k])?;
+            let binding = d.hot(row).binding;
+            if n > 1 && copy.is_none() {
+                match (k < SET_UNDO_CAPACITY).then(|| read(&mut self.core.model, binding)) {
+                    Some(Ok(old)) => earlier[k] = old,
+                    _ => copy = Some((k, self.core.model.clone())),
+                }
+            }
+            if let Err(e) = apply(&mut self.core.model, binding, values[k]) {
+                let e = Self::named(row, e);
+                let undo_to = match copy.take() {
+                    Some((from, model)) => {
+                        self.core.model = model;
+                        from
+                    }
+                    None => k,
+                };
+                for j in (0..undo_to).rev() {
+                    let row = Self::row_in(d, base_type, vrs[j])?;
+                    if let Err(undo) = apply(&mut self.core.model, d.hot(row).binding, earlier[j]) {
+                        return err(format!(
+                            "{}; putting back {} failed too ({undo}): the model broke the setter contract",
+                            e.message(),
+                            d.variable(row).name
+                        ));
+                    }
+                }
+                return Err(e);
             }
         }
         Ok(())
     }
 
+    /// A model's refusal, with the variable's name in front.
+    #[cold]
+    #[inline(never)]
+    fn named(row: usize, e: ModelError) -> ModelError {
+        let name = decl::<M>().variable(row).name;
+        match e {
+            ModelError::Error(m) => ModelError::Error(format!("{name}: {m}")),
+            ModelError::Discard(m) => ModelError::Discard(format!("{name}: {m}")),
+        }
+    }
+
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> OpResult {
-        self.set_values(BaseType::Real, vrs, values, |m, b, x| m.set_real(b, x))
+        self.set_values(BaseType::Real, vrs, values, |m, b| m.get_real(b), |m, b, x| m.set_real(b, x))
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> OpResult {
-        self.set_values(BaseType::Integer, vrs, values, |m, b, x| m.set_integer(b, x))
+        self.set_values(BaseType::Integer, vrs, values, |m, b| m.get_integer(b), |m, b, x| m.set_integer(b, x))
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> OpResult {
         let as_f64: Vec<BoolAsF64> = values.iter().map(|&b| BoolAsF64(b)).collect();
-        self.set_values(BaseType::Boolean, vrs, &as_f64, |m, b, x| m.set_boolean(b, x.0))
+        self.set_values(
+            BaseType::Boolean,
+            vrs,
+            &as_f64,
+            |m, b| m.get_boolean(b).map(BoolAsF64),
+            |m, b, x| m.set_boolean(b, x.0),
+        )
     }
 
     // ---------------------------------------------------------------- Co-Simulation

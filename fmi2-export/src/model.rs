@@ -117,6 +117,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self>;
 
     fn get_real(&mut self, binding: Self::Binding) -> ModelResult<f64>;
+
+    /// Sets one variable. The contract of every setter (`set_real`, `set_integer`,
+    /// `set_boolean`), on which the layer's all-or-nothing `fmi2Set*` rests (it makes no
+    /// copy of the model per call):
+    /// - a setter that returns `Err` leaves the model unchanged;
+    /// - a setter changes its variable and at most what is calculated from it (a state
+    ///   from its start parameter, a cache), so that setting a settable variable back to
+    ///   the value its getter returned before undoes the set.
+    ///
+    /// When the model refuses the k-th value of a call, the layer puts values 1 .. k-1
+    /// back that way, newest first (states the model accepted on the way in).
     fn set_real(&mut self, binding: Self::Binding, value: f64) -> ModelResult;
 
     /// Integers and Enumerations.
