@@ -45,6 +45,11 @@ pub type SavedState<M> = Core<M>;
 pub struct Instance<M: Model> {
     pub context: InstantiateContext,
     pub core: Core<M>,
+    /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
+    /// through (0 for another interface's function or a capability the model did not
+    /// declare): the gate of every call as one table lookup; the reasons come from the
+    /// full checks, run only when the table says no.
+    allowed: [u16; Function::ALL.len()],
 }
 
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
@@ -69,7 +74,9 @@ impl<M: Model> Instance<M> {
     /// A new instance with every declared start value applied.
     pub fn new(context: InstantiateContext) -> OpResult<Self> {
         let model = Self::fresh_model(&context)?;
+        let allowed = Function::ALL.map(|f| Self::allowed_states(context.interface, f));
         Ok(Instance {
+            allowed,
             context,
             core: Core {
                 machine: Machine::Instantiated,
@@ -112,8 +119,37 @@ impl<M: Model> Instance<M> {
 
     /// The one gate every call passes: the function belongs to this instance's interface,
     /// the model opted in to it, and the standard allows it in the current state.
+    #[inline]
     pub fn check_call(&self, function: Function) -> OpResult {
-        let interface = self.context.interface;
+        if self.allowed[function as usize] & self.core.machine.bit() != 0 {
+            Ok(())
+        } else {
+            self.refuse_call(function)
+        }
+    }
+
+    /// The states in which `function` passes [`Instance::check_call`] for `interface`.
+    fn allowed_states(interface: Interface, function: Function) -> u16 {
+        Machine::ALL
+            .into_iter()
+            .filter(|&m| Self::call_allowed(interface, function, m).is_ok())
+            .fold(0, |mask, m| mask | m.bit())
+    }
+
+    /// Why `function` is refused now (the table of [`Instance::check_call`] said so).
+    #[cold]
+    #[inline(never)]
+    fn refuse_call(&self, function: Function) -> OpResult {
+        Self::call_allowed(self.context.interface, function, self.core.machine)?;
+        err(format!(
+            "{} refused in state {:?} (internal: the call table and the rules disagree)",
+            function.name(),
+            self.core.machine
+        ))
+    }
+
+    /// The full rules of [`Instance::check_call`], with the reason.
+    fn call_allowed(interface: Interface, function: Function, machine: Machine) -> OpResult {
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
                 return err(format!("not available: this instance was created for {interface:?}"));
@@ -135,8 +171,8 @@ impl<M: Model> Instance<M> {
                 decl::<M>().spec.model_identifier
             ));
         }
-        if !function.allowed_in(self.core.machine) {
-            return err(format!("not allowed in state {:?}", self.core.machine));
+        if !function.allowed_in(machine) {
+            return err(format!("not allowed in state {machine:?}"));
         }
         Ok(())
     }
@@ -232,18 +268,26 @@ impl<M: Model> Instance<M> {
 
     /// Co-Simulation: runs the events due at the current time (lazily, so that they see
     /// the inputs set for this instant), remembering the model from before them.
+    /// The check is inline (nothing is due at almost every read); the events are not.
+    #[inline]
     fn settle_events(&mut self) -> OpResult {
         if self.context.interface != Interface::CoSimulation || self.core.machine != Machine::StepComplete {
             return Ok(());
         }
         let now = self.core.time;
         if matches!(self.core.next_event, Some(te) if te <= now + time_eps(now)) {
-            if self.core.pre_event.is_none() {
-                self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
-            }
-            self.run_events_at(now)?;
+            self.run_due_events(now)
+        } else {
+            Ok(())
         }
-        Ok(())
+    }
+
+    #[inline(never)]
+    fn run_due_events(&mut self, now: f64) -> OpResult {
+        if self.core.pre_event.is_none() {
+            self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
+        }
+        self.run_events_at(now)
     }
 
     /// Before a set in Co-Simulation: undo the events run lazily at this instant.
