@@ -395,7 +395,9 @@ impl<M: Model> Instance<M> {
     /// refuses one, the values this call set before it are put back, newest first, with
     /// the values their getters returned before the call (the contract of
     /// [`Model::set_real`]): the model is as before the call. No copy of the model is made
-    /// unless a getter fails (then from that value on the call keeps a copy to go back to).
+    /// unless a getter fails (then from that value on the call keeps a copy to go back to);
+    /// no earlier value is kept when the model refuses none of the call's variables
+    /// ([`Model::setter_may_refuse`]).
     fn set_values<T: Copy + Into<f64>>(
         &mut self,
         base_type: BaseType,
@@ -406,11 +408,14 @@ impl<M: Model> Instance<M> {
     ) -> OpResult {
         let d = decl::<M>();
         let machine_bit = self.core.machine.bit();
+        let mut may_refuse = false;
         for (&vr, &value) in vrs.iter().zip(values) {
             let row = Self::row_in(d, base_type, vr)?;
             // the common case from precomputed tables; the full checks (which give the
             // reason) only when these do not accept at once
-            let access = d.hot(row).access;
+            let hot = d.hot(row);
+            may_refuse |= M::setter_may_refuse(hot.binding);
+            let access = hot.access;
             if access.settable_in & machine_bit == 0 {
                 self.settable(row)?;
             }
@@ -421,6 +426,15 @@ impl<M: Model> Instance<M> {
         }
         self.unsettle_events();
         let n = vrs.len().min(values.len());
+        if !may_refuse || n == 1 {
+            // nothing to put back: the model refuses none of these (or only this one value,
+            // which then leaves it unchanged)
+            for (&vr, &value) in vrs.iter().zip(values) {
+                let row = Self::row_in(d, base_type, vr)?;
+                apply(&mut self.core.model, d.hot(row).binding, value).map_err(|e| Self::named(row, e))?;
+            }
+            return Ok(());
+        }
         let Some(&first) = values.first() else { return Ok(()) };
         // the earlier values, for the way back (one value needs none: a refused set
         // leaves the model unchanged)

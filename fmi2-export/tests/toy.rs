@@ -179,6 +179,11 @@ impl Model for Toy {
         Ok(())
     }
 
+    /// The input has no check of its own (gain and acc have).
+    fn setter_may_refuse(b: V) -> bool {
+        b != V::U
+    }
+
     fn get_integer(&mut self, b: V) -> ModelResult<i32> {
         Ok(match b {
             V::Mode => self.mode,
@@ -988,6 +993,9 @@ fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
     assert_eq!(set(&vrs, &xs), Fmi2Status::Discard);
     assert_eq!(clones(), copies + 1, "one copy, at the 33rd value");
     assert_eq!((f.real(vr::U), f.real(vr::ACC), f.real(vr::GAIN)), before);
+    // a call of inputs only (which the model never refuses) keeps nothing and applies
+    assert_eq!(set(&[vr::U, vr::U], &[0.75, 0.5]), OK);
+    assert_eq!(clones(), copies + 1);
     // the instance goes on as if the refused calls never happened
     unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
     assert_eq!(set(&[vr::U, vr::GAIN], &[1.0, 3.0]), OK);
