@@ -2,7 +2,7 @@
 //! variable access checks, time events and FMU state handling. The C ABI in
 //! [`crate::abi`] only translates pointers to slices.
 
-use crate::decl::{BaseType, Causality, Declaration, Initial, Start, VarDecl, Variability};
+use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, VarDecl, Variability};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 pub use crate::states::{Function, Machine, Scope};
 
@@ -41,6 +41,56 @@ pub struct Core<M> {
 /// A saved FMU state (`fmi2FMUstate`).
 pub type SavedState<M> = Core<M>;
 
+/// The value references of the last `fmi2GetReal` or `fmi2SetReal` call and their rows
+/// of the declaration: a master sends the same arrays at every communication point, so
+/// the lookups run once per array, not once per value and call. Only the lookups are
+/// kept: every check still runs on every value of every call.
+struct CallMemo<B> {
+    vrs: Vec<u32>,
+    rows: Vec<MemoRow<B>>,
+    /// Whether the model may refuse one of them ([`Model::setter_may_refuse`]).
+    may_refuse: bool,
+}
+
+#[derive(Clone, Copy)]
+struct MemoRow<B> {
+    row: usize,
+    hot: HotRow<B>,
+}
+
+/// Longest call whose lookups are kept (the memo is allocated once, with the instance).
+const MEMO_CAPACITY: usize = 64;
+
+impl<B: Copy> CallMemo<B> {
+    fn new() -> Self {
+        CallMemo { vrs: Vec::with_capacity(MEMO_CAPACITY), rows: Vec::with_capacity(MEMO_CAPACITY), may_refuse: true }
+    }
+
+    #[inline]
+    fn matches(&self, vrs: &[u32]) -> bool {
+        !self.vrs.is_empty() && self.vrs.as_slice() == vrs
+    }
+
+    /// Keeps the lookups of `vrs` (all known Reals: the caller checked).
+    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
+        self.vrs.clear();
+        self.rows.clear();
+        if vrs.len() > MEMO_CAPACITY {
+            return;
+        }
+        for &vr in vrs {
+            let Some(row) = d.row(BaseType::Real, vr) else {
+                self.vrs.clear();
+                self.rows.clear();
+                return;
+            };
+            self.rows.push(MemoRow { row, hot: *d.hot(row) });
+        }
+        self.vrs.extend_from_slice(vrs);
+        self.may_refuse = self.rows.iter().any(|r| may_refuse(r.hot.binding));
+    }
+}
+
 /// One instance of model `M`.
 pub struct Instance<M: Model> {
     pub context: InstantiateContext,
@@ -50,6 +100,8 @@ pub struct Instance<M: Model> {
     /// declare): the gate of every call as one table lookup; the reasons come from the
     /// full checks, run only when the table says no.
     allowed: [u16; Function::ALL.len()],
+    get_memo: CallMemo<M::Binding>,
+    set_memo: CallMemo<M::Binding>,
 }
 
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
@@ -77,6 +129,8 @@ impl<M: Model> Instance<M> {
         let allowed = Function::ALL.map(|f| Self::allowed_states(context.interface, f));
         Ok(Instance {
             allowed,
+            get_memo: CallMemo::new(),
+            set_memo: CallMemo::new(),
             context,
             core: Core {
                 machine: Machine::Instantiated,
@@ -234,12 +288,6 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// Whether variable `row` may be set in the current state (FMI 2.0 section 2.2.7 and
-    /// the state tables); the reason when not.
-    fn settable(&self, row: usize) -> Result<(), String> {
-        settable_in(decl::<M>().variable(row), self.core.machine)
-    }
-
     /// The row of value reference `vr` of `base_type` in declaration `d` (fetched once per call).
     #[inline(always)]
     fn row_in(d: &Declaration<M::Binding>, base_type: BaseType, vr: u32) -> OpResult<usize> {
@@ -332,7 +380,20 @@ impl<M: Model> Instance<M> {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
+        if self.get_memo.matches(vrs) {
+            // the same value references as the last call: their rows are known
+            self.settle_events()?;
+            for (o, r) in out.iter_mut().zip(&self.get_memo.rows) {
+                let x = self.core.model.get_real(r.hot.binding)?;
+                if !x.is_finite() {
+                    return Self::not_finite(r.row, x);
+                }
+                *o = x;
+            }
+            return Ok(());
+        }
         Self::check_rows(d, BaseType::Real, vrs)?;
+        self.get_memo.fill(d, vrs, |_| true);
         self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Real, vr)?;
@@ -408,27 +469,37 @@ impl<M: Model> Instance<M> {
     ) -> OpResult {
         let d = decl::<M>();
         let machine_bit = self.core.machine.bit();
-        let mut may_refuse = false;
-        for (&vr, &value) in vrs.iter().zip(values) {
-            let row = Self::row_in(d, base_type, vr)?;
-            // the common case from precomputed tables; the full checks (which give the
-            // reason) only when these do not accept at once
-            let hot = d.hot(row);
-            may_refuse |= M::setter_may_refuse(hot.binding);
-            let access = hot.access;
-            if access.settable_in & machine_bit == 0 {
-                self.settable(row)?;
-            }
-            let x: f64 = value.into();
-            if !(access.plain && x >= access.lowest && x <= access.highest) {
-                Self::check_value(row, x)?;
-            }
-        }
-        self.unsettle_events();
         let n = vrs.len().min(values.len());
+        // the same Real value references as the last call: their rows are known
+        let memo = base_type == BaseType::Real && self.set_memo.matches(vrs);
+        let may_refuse = if memo {
+            for (r, &value) in self.set_memo.rows.iter().zip(values) {
+                Self::check_set(r.row, r.hot.access, machine_bit, value.into(), self.core.machine)?;
+            }
+            self.set_memo.may_refuse
+        } else {
+            let mut may_refuse = false;
+            for (&vr, &value) in vrs.iter().zip(values) {
+                let row = Self::row_in(d, base_type, vr)?;
+                let hot = d.hot(row);
+                may_refuse |= M::setter_may_refuse(hot.binding);
+                Self::check_set(row, hot.access, machine_bit, value.into(), self.core.machine)?;
+            }
+            if base_type == BaseType::Real {
+                self.set_memo.fill(d, vrs, M::setter_may_refuse);
+            }
+            may_refuse
+        };
+        self.unsettle_events();
         if !may_refuse || n == 1 {
             // nothing to put back: the model refuses none of these (or only this one value,
             // which then leaves it unchanged)
+            if memo {
+                for (r, &value) in self.set_memo.rows.iter().zip(values) {
+                    apply(&mut self.core.model, r.hot.binding, value).map_err(|e| Self::named(r.row, e))?;
+                }
+                return Ok(());
+            }
             for (&vr, &value) in vrs.iter().zip(values) {
                 let row = Self::row_in(d, base_type, vr)?;
                 apply(&mut self.core.model, d.hot(row).binding, value).map_err(|e| Self::named(row, e))?;
@@ -472,6 +543,19 @@ impl<M: Model> Instance<M> {
                 }
                 return Err(e);
             }
+        }
+        Ok(())
+    }
+
+    /// The checks of one value of `fmi2Set*`: the common case from the precomputed tables,
+    /// the full checks (which give the reason) only when these do not accept at once.
+    #[inline(always)]
+    fn check_set(row: usize, access: SetAccess, machine_bit: u16, x: f64, machine: Machine) -> OpResult {
+        if access.settable_in & machine_bit == 0 {
+            settable_in(decl::<M>().variable(row), machine)?;
+        }
+        if !(access.plain && x >= access.lowest && x <= access.highest) {
+            Self::check_value(row, x)?;
         }
         Ok(())
     }

@@ -1011,3 +1011,40 @@ fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
     assert_eq!((g.real(vr::U), g.real(vr::GAIN), g.real(vr::ACC)), (0.0, 2.0, 0.0));
     assert_eq!(g.step(0.0, 0.05), ERR);
 }
+
+/// The layer keeps the lookups of the last `fmi2GetReal`/`fmi2SetReal` arrays (a master
+/// sends the same ones every step): every check still runs on every value of a repeated
+/// array, in the instance's current state.
+#[test]
+fn repeated_value_reference_arrays_are_checked_every_time() {
+    let f = Fmu::<Toy>::cs();
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    let set = |vrs: &[u32], xs: &[f64]| unsafe { abi::set_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr()) };
+    let get = |vrs: &[u32]| {
+        let mut out = vec![f64::NAN; vrs.len()];
+        let s = unsafe { abi::get_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        (s, out)
+    };
+    let vrs = [vr::U, vr::PERIOD, vr::GAIN];
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), OK);
+    assert_eq!(set(&vrs, &[2.0, 0.1, 4.0]), OK);
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    // out of bounds the second time round: refused naming the variable, nothing applied
+    assert_eq!(set(&vrs, &[3.0, 0.1, -1.0]), ERR);
+    assert!(f.last_error().contains("gain = -1 refused: below its minimum 0"), "{}", f.last_error());
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    assert_eq!(f.reset(), OK);
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), OK);
+    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
+    // the same array after initialization: the fixed parameter is refused now
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), ERR);
+    assert!(f.last_error().contains("sample_period cannot be set after initialization"), "{}", f.last_error());
+    assert_eq!(f.reset(), OK);
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    // a known array then one with an unknown value reference at the end
+    assert_eq!(get(&[vr::U, vr::GAIN]).0, OK);
+    assert_eq!(get(&[vr::U, 99]).0, ERR);
+    assert!(f.last_error().contains("unknown Real value reference 99"), "{}", f.last_error());
+}

@@ -167,7 +167,7 @@ mod tests {
     /// it sits (the branch-free pass must not miss one at either end).
     #[test]
     fn check_finds_the_first_non_finite_value_with_its_time() {
-        assert_eq!(run(100).check(), Ok(()));
+        assert!(run(100).check().is_ok());
         for k in [0, 37, 100] {
             let mut r = run(100);
             r.psi_ref[k] = f64::NAN;
