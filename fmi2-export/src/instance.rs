@@ -60,6 +60,33 @@ struct MemoRow<B> {
 
 /// Longest call whose lookups are kept (the memo is allocated once, with the instance).
 const MEMO_CAPACITY: usize = 64;
+/// Arrays kept per direction (a master reads an instance's connected outputs and its
+/// recorded variables in two calls, say).
+const MEMO_ARRAYS: usize = 4;
+
+/// The last [`MEMO_ARRAYS`] arrays, the oldest replaced first.
+struct CallMemos<B> {
+    arrays: [CallMemo<B>; MEMO_ARRAYS],
+    next: usize,
+}
+
+impl<B: Copy> CallMemos<B> {
+    fn new() -> Self {
+        CallMemos { arrays: std::array::from_fn(|_| CallMemo::new()), next: 0 }
+    }
+
+    /// The kept array equal to `vrs`.
+    #[inline]
+    fn find(&self, vrs: &[u32]) -> Option<usize> {
+        self.arrays.iter().position(|m| m.matches(vrs))
+    }
+
+    /// Keeps the lookups of `vrs` in place of the oldest.
+    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
+        self.arrays[self.next].fill(d, vrs, may_refuse);
+        self.next = (self.next + 1) % MEMO_ARRAYS;
+    }
+}
 
 impl<B: Copy> CallMemo<B> {
     fn new() -> Self {
@@ -100,8 +127,8 @@ pub struct Instance<M: Model> {
     /// declare): the gate of every call as one table lookup; the reasons come from the
     /// full checks, run only when the table says no.
     allowed: [u16; Function::ALL.len()],
-    get_memo: CallMemo<M::Binding>,
-    set_memo: CallMemo<M::Binding>,
+    get_memo: CallMemos<M::Binding>,
+    set_memo: CallMemos<M::Binding>,
 }
 
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
@@ -129,8 +156,8 @@ impl<M: Model> Instance<M> {
         let allowed = Function::ALL.map(|f| Self::allowed_states(context.interface, f));
         Ok(Instance {
             allowed,
-            get_memo: CallMemo::new(),
-            set_memo: CallMemo::new(),
+            get_memo: CallMemos::new(),
+            set_memo: CallMemos::new(),
             context,
             core: Core {
                 machine: Machine::Instantiated,
@@ -380,10 +407,10 @@ impl<M: Model> Instance<M> {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
-        if self.get_memo.matches(vrs) {
-            // the same value references as the last call: their rows are known
+        if let Some(m) = self.get_memo.find(vrs) {
+            // the same value references as a recent call: their rows are known
             self.settle_events()?;
-            for (o, r) in out.iter_mut().zip(&self.get_memo.rows) {
+            for (o, r) in out.iter_mut().zip(&self.get_memo.arrays[m].rows) {
                 let x = self.core.model.get_real(r.hot.binding)?;
                 if !x.is_finite() {
                     return Self::not_finite(r.row, x);
@@ -470,13 +497,13 @@ impl<M: Model> Instance<M> {
         let d = decl::<M>();
         let machine_bit = self.core.machine.bit();
         let n = vrs.len().min(values.len());
-        // the same Real value references as the last call: their rows are known
-        let memo = base_type == BaseType::Real && self.set_memo.matches(vrs);
-        let may_refuse = if memo {
-            for (r, &value) in self.set_memo.rows.iter().zip(values) {
+        // the same Real value references as a recent call: their rows are known
+        let memo = if base_type == BaseType::Real { self.set_memo.find(vrs) } else { None };
+        let may_refuse = if let Some(m) = memo {
+            for (r, &value) in self.set_memo.arrays[m].rows.iter().zip(values) {
                 Self::check_set(r.row, r.hot.access, machine_bit, value.into(), self.core.machine)?;
             }
-            self.set_memo.may_refuse
+            self.set_memo.arrays[m].may_refuse
         } else {
             let mut may_refuse = false;
             for (&vr, &value) in vrs.iter().zip(values) {
@@ -494,8 +521,8 @@ impl<M: Model> Instance<M> {
         if !may_refuse || n == 1 {
             // nothing to put back: the model refuses none of these (or only this one value,
             // which then leaves it unchanged)
-            if memo {
-                for (r, &value) in self.set_memo.rows.iter().zip(values) {
+            if let Some(m) = memo {
+                for (r, &value) in self.set_memo.arrays[m].rows.iter().zip(values) {
                     apply(&mut self.core.model, r.hot.binding, value).map_err(|e| Self::named(r.row, e))?;
                 }
                 return Ok(());
