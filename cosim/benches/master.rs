@@ -13,6 +13,11 @@
 //! 3. The master's overhead per FMU per step: 10 trivial C FMUs in a chain.
 //! 4. Threads: 10 C FMUs side by side, trivial and heavier (`-DWORK`), `jacobi` in 1 and
 //!    2 threads.
+//! 5. The FMI layer per value: `fmi2GetReal` of all Real outputs and `fmi2SetReal` of all
+//!    Real inputs of each of our three FMUs, one call per batch, in ns per value and per
+//!    call (the master's buffers, `nigel_cosim::Instance`, the C ABI, the layer's checks
+//!    and the model's getter/setter); and the master's own cost per step: `ordered`
+//!    recording nothing minus the bare loop of the three `fmi2DoStep`s.
 
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, Results, System, SystemBuilder};
 use std::path::{Path, PathBuf};
@@ -150,7 +155,8 @@ fn main() {
         system.connections.len()
     );
     line("floor: the plant's own fmi2DoStep, bare loop", bare_loop(system, Some("plant")), "");
-    line("floor: the three FMUs' fmi2DoStep, bare loop, no exchange", bare_loop(system, None), "");
+    let floor_three = bare_loop(system, None);
+    line("floor: the three FMUs' fmi2DoStep, bare loop, no exchange", floor_three, "");
     let pose_names: Vec<String> = POSE.iter().map(|s| s.to_string()).collect();
     for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
         let mut e = Experiment::new(30.0, 1e-3);
@@ -159,11 +165,15 @@ fn main() {
         let (r, _) = simulate(system, &e).unwrap();
         let note = format!("epsilon {:.12} | {}", epsilon(&r), pose(&r));
         let name = format!("{algorithm:?}").to_lowercase();
-        line(
-            &format!("master {name}, recording nothing"),
-            run_master(system, algorithm, 1, Some(vec![]), false),
-            &note,
-        );
+        let nothing = run_master(system, algorithm, 1, Some(vec![]), false);
+        line(&format!("master {name}, recording nothing"), nothing, &note);
+        if algorithm == Algorithm::Ordered {
+            line(
+                "  exchange cost: ordered (recording nothing) - bare loop",
+                nothing.saturating_sub(floor_three),
+                "(the gets, sets and the master's own work per step)",
+            );
+        }
         line(
             &format!("master {name}, all 52 outputs recorded every step"),
             run_master(system, algorithm, 1, None, false),
@@ -196,6 +206,8 @@ fn main() {
     } else {
         println!("(set COSIM_BENCH_PYTHON=target/venv/bin/python for ecos, libcosim and fmpy on the same .ssp)");
     }
+
+    per_value(system);
 
     // overhead per FMU per step: a chain of trivial FMUs
     let dir = target().join("cosim-bench");
@@ -236,6 +248,49 @@ fn main() {
             one.as_secs_f64() * 1e3,
             two.as_secs_f64() * 1e3,
             one.as_secs_f64() / two.as_secs_f64()
+        );
+    }
+}
+
+/// Section 5: `fmi2GetReal` of every Real output and `fmi2SetReal` of every Real input of
+/// each instance (the inputs set to the values read back, which every FMU accepts), best
+/// of 5 rounds of 20,000 calls.
+fn per_value(system: &System) {
+    use model_description::Causality;
+    const CALLS: u32 = 20_000;
+    for spec in &system.instances {
+        let mut inst = bare_instances(system, Some(&spec.name)).pop().unwrap();
+        let md = spec.fmu.description();
+        let vrs = |c: Causality| -> Vec<u32> {
+            md.model_variables.iter().filter(|v| v.causality == c && v.is_real()).map(|v| v.value_reference).collect()
+        };
+        let (outputs, inputs) = (vrs(Causality::Output), vrs(Causality::Input));
+        let mut out = vec![0.0; outputs.len()];
+        let mut input_values = vec![0.0; inputs.len()];
+        inst.get_real(&inputs, &mut input_values).unwrap();
+        inst.get_real(&outputs, &mut out).unwrap(); // the initial event, once
+        let get = best_of(5, || {
+            let t = Instant::now();
+            for _ in 0..CALLS {
+                inst.get_real(&outputs, &mut out).unwrap();
+            }
+            t.elapsed()
+        });
+        let set = best_of(5, || {
+            let t = Instant::now();
+            for _ in 0..CALLS {
+                inst.set_real(&inputs, &input_values).unwrap();
+            }
+            t.elapsed()
+        });
+        let ns = |d: Duration, n: usize| {
+            (d.as_secs_f64() * 1e9 / f64::from(CALLS), d.as_secs_f64() * 1e9 / (f64::from(CALLS) * n.max(1) as f64))
+        };
+        let (g_call, g_value) = ns(get, outputs.len());
+        let (s_call, s_value) = ns(set, inputs.len());
+        println!(
+            "{:<10} fmi2GetReal of {:2} outputs: {:7.1} ns/call {:5.1} ns/value | fmi2SetReal of {:2} inputs: {:7.1} ns/call {:5.1} ns/value",
+            spec.name, outputs.len(), g_call, g_value, inputs.len(), s_call, s_value
         );
     }
 }

@@ -205,13 +205,31 @@ pub(crate) struct Op {
     gains: Vec<(f64, f64)>,
     reals: Vec<f64>,
     ints: Vec<i32>,
+    /// A get of Reals whose slots are consecutive, from this one: fetched straight into
+    /// the value buffer, with no copy through the op's own.
+    direct: Option<usize>,
 }
 
 impl Op {
     fn new(instance: usize, kind: OpKind, base_type: BaseType) -> Op {
-        Op { instance, kind, base_type, vrs: vec![], slots: vec![], gains: vec![], reals: vec![], ints: vec![] }
+        Op {
+            instance,
+            kind,
+            base_type,
+            vrs: vec![],
+            slots: vec![],
+            gains: vec![],
+            reals: vec![],
+            ints: vec![],
+            direct: None,
+        }
     }
     fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64)) {
+        self.direct = match (self.kind, self.base_type, self.slots.first()) {
+            (OpKind::Get, BaseType::Real, None) => Some(slot),
+            (_, _, Some(&first)) if self.direct == Some(first) && slot == first + self.slots.len() => Some(first),
+            _ => None,
+        };
         self.vrs.push(vr);
         self.slots.push(slot);
         self.gains.push(gain);
@@ -222,10 +240,13 @@ impl Op {
     #[inline]
     pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
         match self.kind {
-            OpKind::Get => {
-                self.fetch(inst)?;
-                self.scatter(values);
-            }
+            OpKind::Get => match self.direct {
+                Some(first) => inst.get_real(&self.vrs, &mut values[first..first + self.vrs.len()])?,
+                None => {
+                    self.fetch(inst)?;
+                    self.scatter(values);
+                }
+            },
             OpKind::Set => {
                 self.gather(values);
                 self.apply(inst)?;
@@ -463,6 +484,23 @@ impl Plan {
         }
         for r in record {
             slot_of(&mut sources, r);
+        }
+        // slots in the order the propagation reads them, then the recorded-only variables
+        // by instance and type: every get of the `ordered` plan then fills consecutive
+        // slots, straight from its fmi2GetReal (`Op::direct`)
+        if let Ok(ops) = ordered_ops(system, &sources, &connected_outputs) {
+            let mut order: Vec<usize> = Vec::with_capacity(sources.len());
+            for op in ops.iter().filter(|op| op.kind == OpKind::Get) {
+                for &slot in &op.slots {
+                    if !order.contains(&slot) {
+                        order.push(slot);
+                    }
+                }
+            }
+            let mut rest: Vec<usize> = (0..sources.len()).filter(|k| !order.contains(k)).collect();
+            rest.sort_by_key(|&k| (sources[k].instance, sources[k].base_type));
+            order.extend(rest);
+            sources = order.into_iter().map(|k| sources[k].clone()).collect();
         }
         // jacobi: per instance and type one get of its connected outputs (and one with the
         // recorded variables too, for output points), then one set of its connected inputs

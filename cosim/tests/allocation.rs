@@ -28,11 +28,16 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// The count is process-wide: the tests of this file run one at a time, or one would
+/// count the other's allocations (the harness runs tests on parallel threads).
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// (algorithm, threads, recorded variables, output interval)
 type Case = (Algorithm, usize, Option<Vec<String>>, Option<f64>);
 
 #[test]
 fn the_step_loop_allocates_nothing() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = work_dir("allocation");
     let mut b = SystemBuilder::new();
     b.add_instance("src", Fmu::load(&build_fmu(Model::Source, &dir, &[])).unwrap()).unwrap();
@@ -78,6 +83,7 @@ fn the_step_loop_allocates_nothing() {
 
 #[test]
 fn coupled_model_exchange_steps_allocate_nothing_between_events() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     // the ball and the counter fed by its velocity, integrated together: runs of 300 and
     // 6000 steps of 10 us end before the first bounce (0.45 s), so no event happens
     let dir = work_dir("allocation-me");

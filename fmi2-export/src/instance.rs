@@ -2,7 +2,7 @@
 //! variable access checks, time events and FMU state handling. The C ABI in
 //! [`crate::abi`] only translates pointers to slices.
 
-use crate::decl::{BaseType, Causality, Declaration, Initial, Start, VarDecl, Variability};
+use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, VarDecl, Variability};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 pub use crate::states::{Function, Machine, Scope};
 
@@ -12,6 +12,10 @@ pub type OpResult<T = ()> = Result<T, ModelError>;
 /// Most event iterations at one time instant before the layer gives up (a model that
 /// keeps asking for another iteration, or keeps scheduling events at the same time).
 pub const MAX_EVENT_ITERATIONS: usize = 1000;
+
+/// Values of one `fmi2Set*` call whose earlier values are kept for the way back without
+/// copying the model (a longer call copies the model once, at its 33rd value).
+const SET_UNDO_CAPACITY: usize = 32;
 
 /// The part of an instance a saved FMU state holds (never the callbacks).
 #[derive(Clone)]
@@ -37,10 +41,94 @@ pub struct Core<M> {
 /// A saved FMU state (`fmi2FMUstate`).
 pub type SavedState<M> = Core<M>;
 
+/// The value references of the last `fmi2GetReal` or `fmi2SetReal` call and their rows
+/// of the declaration: a master sends the same arrays at every communication point, so
+/// the lookups run once per array, not once per value and call. Only the lookups are
+/// kept: every check still runs on every value of every call.
+struct CallMemo<B> {
+    vrs: Vec<u32>,
+    rows: Vec<MemoRow<B>>,
+    /// Whether the model may refuse one of them ([`Model::setter_may_refuse`]).
+    may_refuse: bool,
+}
+
+#[derive(Clone, Copy)]
+struct MemoRow<B> {
+    row: usize,
+    hot: HotRow<B>,
+}
+
+/// Longest call whose lookups are kept (the memo is allocated once, with the instance).
+const MEMO_CAPACITY: usize = 64;
+/// Arrays kept per direction (a master reads an instance's connected outputs and its
+/// recorded variables in two calls, say).
+const MEMO_ARRAYS: usize = 4;
+
+/// The last [`MEMO_ARRAYS`] arrays, the oldest replaced first.
+struct CallMemos<B> {
+    arrays: [CallMemo<B>; MEMO_ARRAYS],
+    next: usize,
+}
+
+impl<B: Copy> CallMemos<B> {
+    fn new() -> Self {
+        CallMemos { arrays: std::array::from_fn(|_| CallMemo::new()), next: 0 }
+    }
+
+    /// The kept array equal to `vrs`.
+    #[inline]
+    fn find(&self, vrs: &[u32]) -> Option<usize> {
+        self.arrays.iter().position(|m| m.matches(vrs))
+    }
+
+    /// Keeps the lookups of `vrs` in place of the oldest.
+    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
+        self.arrays[self.next].fill(d, vrs, may_refuse);
+        self.next = (self.next + 1) % MEMO_ARRAYS;
+    }
+}
+
+impl<B: Copy> CallMemo<B> {
+    fn new() -> Self {
+        CallMemo { vrs: Vec::with_capacity(MEMO_CAPACITY), rows: Vec::with_capacity(MEMO_CAPACITY), may_refuse: true }
+    }
+
+    #[inline]
+    fn matches(&self, vrs: &[u32]) -> bool {
+        !self.vrs.is_empty() && self.vrs.as_slice() == vrs
+    }
+
+    /// Keeps the lookups of `vrs` (all known Reals: the caller checked).
+    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
+        self.vrs.clear();
+        self.rows.clear();
+        if vrs.len() > MEMO_CAPACITY {
+            return;
+        }
+        for &vr in vrs {
+            let Some(row) = d.row(BaseType::Real, vr) else {
+                self.vrs.clear();
+                self.rows.clear();
+                return;
+            };
+            self.rows.push(MemoRow { row, hot: *d.hot(row) });
+        }
+        self.vrs.extend_from_slice(vrs);
+        self.may_refuse = self.rows.iter().any(|r| may_refuse(r.hot.binding));
+    }
+}
+
 /// One instance of model `M`.
 pub struct Instance<M: Model> {
     pub context: InstantiateContext,
     pub core: Core<M>,
+    /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
+    /// through (0 for another interface's function or a capability the model did not
+    /// declare): the gate of every call as one table lookup; the reasons come from the
+    /// full checks, run only when the table says no.
+    allowed: [u16; Function::ALL.len()],
+    get_memo: CallMemos<M::Binding>,
+    set_memo: CallMemos<M::Binding>,
 }
 
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
@@ -65,7 +153,11 @@ impl<M: Model> Instance<M> {
     /// A new instance with every declared start value applied.
     pub fn new(context: InstantiateContext) -> OpResult<Self> {
         let model = Self::fresh_model(&context)?;
+        let allowed = Function::ALL.map(|f| Self::allowed_states(context.interface, f));
         Ok(Instance {
+            allowed,
+            get_memo: CallMemos::new(),
+            set_memo: CallMemos::new(),
             context,
             core: Core {
                 machine: Machine::Instantiated,
@@ -108,8 +200,37 @@ impl<M: Model> Instance<M> {
 
     /// The one gate every call passes: the function belongs to this instance's interface,
     /// the model opted in to it, and the standard allows it in the current state.
+    #[inline]
     pub fn check_call(&self, function: Function) -> OpResult {
-        let interface = self.context.interface;
+        if self.allowed[function as usize] & self.core.machine.bit() != 0 {
+            Ok(())
+        } else {
+            self.refuse_call(function)
+        }
+    }
+
+    /// The states in which `function` passes [`Instance::check_call`] for `interface`.
+    fn allowed_states(interface: Interface, function: Function) -> u16 {
+        Machine::ALL
+            .into_iter()
+            .filter(|&m| Self::call_allowed(interface, function, m).is_ok())
+            .fold(0, |mask, m| mask | m.bit())
+    }
+
+    /// Why `function` is refused now (the table of [`Instance::check_call`] said so).
+    #[cold]
+    #[inline(never)]
+    fn refuse_call(&self, function: Function) -> OpResult {
+        Self::call_allowed(self.context.interface, function, self.core.machine)?;
+        err(format!(
+            "{} refused in state {:?} (internal: the call table and the rules disagree)",
+            function.name(),
+            self.core.machine
+        ))
+    }
+
+    /// The full rules of [`Instance::check_call`], with the reason.
+    fn call_allowed(interface: Interface, function: Function, machine: Machine) -> OpResult {
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
                 return err(format!("not available: this instance was created for {interface:?}"));
@@ -131,8 +252,8 @@ impl<M: Model> Instance<M> {
                 decl::<M>().spec.model_identifier
             ));
         }
-        if !function.allowed_in(self.core.machine) {
-            return err(format!("not allowed in state {:?}", self.core.machine));
+        if !function.allowed_in(machine) {
+            return err(format!("not allowed in state {machine:?}"));
         }
         Ok(())
     }
@@ -194,12 +315,6 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// Whether variable `row` may be set in the current state (FMI 2.0 section 2.2.7 and
-    /// the state tables); the reason when not.
-    fn settable(&self, row: usize) -> Result<(), String> {
-        settable_in(decl::<M>().variable(row), self.core.machine)
-    }
-
     /// The row of value reference `vr` of `base_type` in declaration `d` (fetched once per call).
     #[inline(always)]
     fn row_in(d: &Declaration<M::Binding>, base_type: BaseType, vr: u32) -> OpResult<usize> {
@@ -228,18 +343,26 @@ impl<M: Model> Instance<M> {
 
     /// Co-Simulation: runs the events due at the current time (lazily, so that they see
     /// the inputs set for this instant), remembering the model from before them.
+    /// The check is inline (nothing is due at almost every read); the events are not.
+    #[inline]
     fn settle_events(&mut self) -> OpResult {
         if self.context.interface != Interface::CoSimulation || self.core.machine != Machine::StepComplete {
             return Ok(());
         }
         let now = self.core.time;
         if matches!(self.core.next_event, Some(te) if te <= now + time_eps(now)) {
-            if self.core.pre_event.is_none() {
-                self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
-            }
-            self.run_events_at(now)?;
+            self.run_due_events(now)
+        } else {
+            Ok(())
         }
-        Ok(())
+    }
+
+    #[inline(never)]
+    fn run_due_events(&mut self, now: f64) -> OpResult {
+        if self.core.pre_event.is_none() {
+            self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
+        }
+        self.run_events_at(now)
     }
 
     /// Before a set in Co-Simulation: undo the events run lazily at this instant.
@@ -284,7 +407,20 @@ impl<M: Model> Instance<M> {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
+        if let Some(m) = self.get_memo.find(vrs) {
+            // the same value references as a recent call: their rows are known
+            self.settle_events()?;
+            for (o, r) in out.iter_mut().zip(&self.get_memo.arrays[m].rows) {
+                let x = self.core.model.get_real(r.hot.binding)?;
+                if !x.is_finite() {
+                    return Self::not_finite(r.row, x);
+                }
+                *o = x;
+            }
+            return Ok(());
+        }
         Self::check_rows(d, BaseType::Real, vrs)?;
+        self.get_memo.fill(d, vrs, |_| true);
         self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Real, vr)?;
@@ -342,57 +478,143 @@ impl<M: Model> Instance<M> {
         check_value_in(decl::<M>(), row, value)
     }
 
-    /// Sets all or nothing: every value reference, permission and value is checked first,
-    /// and if the model refuses one value the earlier ones are rolled back.
+    /// Sets all or nothing: every value reference, permission and value is checked first
+    /// (from the declaration's tables), then the values are applied in order. If the model
+    /// refuses one, the values this call set before it are put back, newest first, with
+    /// the values their getters returned before the call (the contract of
+    /// [`Model::set_real`]): the model is as before the call. No copy of the model is made
+    /// unless a getter fails (then from that value on the call keeps a copy to go back to);
+    /// no earlier value is kept when the model refuses none of the call's variables
+    /// ([`Model::setter_may_refuse`]).
     fn set_values<T: Copy + Into<f64>>(
         &mut self,
         base_type: BaseType,
         vrs: &[u32],
         values: &[T],
+        mut read: impl FnMut(&mut M, M::Binding) -> OpResult<T>,
         mut apply: impl FnMut(&mut M, M::Binding, T) -> OpResult,
     ) -> OpResult {
         let d = decl::<M>();
         let machine_bit = self.core.machine.bit();
-        for (&vr, &value) in vrs.iter().zip(values) {
-            let row = Self::row_in(d, base_type, vr)?;
-            // the common case from precomputed tables; the full checks (which give the
-            // reason) only when these do not accept at once
-            let access = d.hot(row).access;
-            if access.settable_in & machine_bit == 0 {
-                self.settable(row)?;
+        let n = vrs.len().min(values.len());
+        // the same Real value references as a recent call: their rows are known
+        let memo = if base_type == BaseType::Real { self.set_memo.find(vrs) } else { None };
+        let may_refuse = if let Some(m) = memo {
+            for (r, &value) in self.set_memo.arrays[m].rows.iter().zip(values) {
+                Self::check_set(r.row, r.hot.access, machine_bit, value.into(), self.core.machine)?;
             }
-            let x: f64 = value.into();
-            if !(access.plain && x >= access.lowest && x <= access.highest) {
-                Self::check_value(row, x)?;
+            self.set_memo.arrays[m].may_refuse
+        } else {
+            let mut may_refuse = false;
+            for (&vr, &value) in vrs.iter().zip(values) {
+                let row = Self::row_in(d, base_type, vr)?;
+                let hot = d.hot(row);
+                may_refuse |= M::setter_may_refuse(hot.binding);
+                Self::check_set(row, hot.access, machine_bit, value.into(), self.core.machine)?;
             }
-        }
+            if base_type == BaseType::Real {
+                self.set_memo.fill(d, vrs, M::setter_may_refuse);
+            }
+            may_refuse
+        };
         self.unsettle_events();
-        let backup = self.core.model.clone();
-        for (&vr, &value) in vrs.iter().zip(values) {
-            let row = Self::row_in(d, base_type, vr)?;
-            if let Err(e) = apply(&mut self.core.model, d.hot(row).binding, value) {
-                self.core.model = backup;
-                let v = d.variable(row);
-                return Err(match e {
-                    ModelError::Error(m) => ModelError::Error(format!("{}: {m}", v.name)),
-                    ModelError::Discard(m) => ModelError::Discard(format!("{}: {m}", v.name)),
-                });
+        if !may_refuse || n == 1 {
+            // nothing to put back: the model refuses none of these (or only this one value,
+            // which then leaves it unchanged)
+            if let Some(m) = memo {
+                for (r, &value) in self.set_memo.arrays[m].rows.iter().zip(values) {
+                    apply(&mut self.core.model, r.hot.binding, value).map_err(|e| Self::named(r.row, e))?;
+                }
+                return Ok(());
+            }
+            for (&vr, &value) in vrs.iter().zip(values) {
+                let row = Self::row_in(d, base_type, vr)?;
+                apply(&mut self.core.model, d.hot(row).binding, value).map_err(|e| Self::named(row, e))?;
+            }
+            return Ok(());
+        }
+        let Some(&first) = values.first() else { return Ok(()) };
+        // the earlier values, for the way back (one value needs none: a refused set
+        // leaves the model unchanged)
+        let mut earlier = [first; SET_UNDO_CAPACITY];
+        // from this index on, the way back is a copy of the model (when a getter failed or
+        // the call is longer than `earlier`)
+        let mut copy: Option<(usize, M)> = None;
+        for k in 0..n {
+            let row = Self::row_in(d, base_type, vrs[k])?;
+            let binding = d.hot(row).binding;
+            if n > 1 && copy.is_none() {
+                match (k < SET_UNDO_CAPACITY).then(|| read(&mut self.core.model, binding)) {
+                    Some(Ok(old)) => earlier[k] = old,
+                    _ => copy = Some((k, self.core.model.clone())),
+                }
+            }
+            if let Err(e) = apply(&mut self.core.model, binding, values[k]) {
+                let e = Self::named(row, e);
+                let undo_to = match copy.take() {
+                    Some((from, model)) => {
+                        self.core.model = model;
+                        from
+                    }
+                    None => k,
+                };
+                for j in (0..undo_to).rev() {
+                    let row = Self::row_in(d, base_type, vrs[j])?;
+                    if let Err(undo) = apply(&mut self.core.model, d.hot(row).binding, earlier[j]) {
+                        return err(format!(
+                            "{}; putting back {} failed too ({undo}): the model broke the setter contract",
+                            e.message(),
+                            d.variable(row).name
+                        ));
+                    }
+                }
+                return Err(e);
             }
         }
         Ok(())
     }
 
+    /// The checks of one value of `fmi2Set*`: the common case from the precomputed tables,
+    /// the full checks (which give the reason) only when these do not accept at once.
+    #[inline(always)]
+    fn check_set(row: usize, access: SetAccess, machine_bit: u16, x: f64, machine: Machine) -> OpResult {
+        if access.settable_in & machine_bit == 0 {
+            settable_in(decl::<M>().variable(row), machine)?;
+        }
+        if !(access.plain && x >= access.lowest && x <= access.highest) {
+            Self::check_value(row, x)?;
+        }
+        Ok(())
+    }
+
+    /// A model's refusal, with the variable's name in front.
+    #[cold]
+    #[inline(never)]
+    fn named(row: usize, e: ModelError) -> ModelError {
+        let name = decl::<M>().variable(row).name;
+        match e {
+            ModelError::Error(m) => ModelError::Error(format!("{name}: {m}")),
+            ModelError::Discard(m) => ModelError::Discard(format!("{name}: {m}")),
+        }
+    }
+
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> OpResult {
-        self.set_values(BaseType::Real, vrs, values, |m, b, x| m.set_real(b, x))
+        self.set_values(BaseType::Real, vrs, values, |m, b| m.get_real(b), |m, b, x| m.set_real(b, x))
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> OpResult {
-        self.set_values(BaseType::Integer, vrs, values, |m, b, x| m.set_integer(b, x))
+        self.set_values(BaseType::Integer, vrs, values, |m, b| m.get_integer(b), |m, b, x| m.set_integer(b, x))
     }
 
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[bool]) -> OpResult {
         let as_f64: Vec<BoolAsF64> = values.iter().map(|&b| BoolAsF64(b)).collect();
-        self.set_values(BaseType::Boolean, vrs, &as_f64, |m, b, x| m.set_boolean(b, x.0))
+        self.set_values(
+            BaseType::Boolean,
+            vrs,
+            &as_f64,
+            |m, b| m.get_boolean(b).map(BoolAsF64),
+            |m, b, x| m.set_boolean(b, x.0),
+        )
     }
 
     // ---------------------------------------------------------------- Co-Simulation

@@ -117,7 +117,30 @@ pub trait Model: Clone + Send + Sized + 'static {
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self>;
 
     fn get_real(&mut self, binding: Self::Binding) -> ModelResult<f64>;
+
+    /// Sets one variable. The contract of every setter (`set_real`, `set_integer`,
+    /// `set_boolean`), on which the layer's all-or-nothing `fmi2Set*` rests (it makes no
+    /// copy of the model per call):
+    /// - a setter that returns `Err` leaves the model unchanged;
+    /// - a setter changes its variable and at most what is calculated from it (a state
+    ///   from its start parameter, a cache), so that setting a settable variable back to
+    ///   the value its getter returned before undoes the set.
+    ///
+    /// When the model refuses the k-th value of a call, the layer puts values 1 .. k-1
+    /// back that way, newest first (states the model accepted on the way in). A call
+    /// whose variables the model never refuses ([`Model::setter_may_refuse`]) keeps no
+    /// earlier values at all.
     fn set_real(&mut self, binding: Self::Binding, value: f64) -> ModelResult;
+
+    /// Whether a setter of `binding` can refuse a value that passed the layer's checks
+    /// (known value reference, base type, settable in the current state, finite, declared
+    /// min/max, enumeration items). Answer `false` only where the setter has no check of
+    /// its own beyond those (an input without a model-side range, a state): `fmi2Set*` of
+    /// such variables only then skips keeping their earlier values for the way back, which
+    /// is the all-or-nothing rule's whole cost on the hot path. Default: `true` (safe).
+    fn setter_may_refuse(_binding: Self::Binding) -> bool {
+        true
+    }
 
     /// Integers and Enumerations.
     fn get_integer(&mut self, binding: Self::Binding) -> ModelResult<i32> {

@@ -42,6 +42,12 @@ const STOP_AT_3: i32 = 3;
 thread_local! {
     /// Live toy models of this thread (every test runs on its own thread).
     static LIVE: RefCell<i64> = const { RefCell::new(0) };
+    /// Copies of toy models made on this thread.
+    static CLONES: RefCell<i64> = const { RefCell::new(0) };
+}
+
+fn clones() -> i64 {
+    CLONES.with(|l| *l.borrow())
 }
 
 fn live() -> i64 {
@@ -69,6 +75,7 @@ struct Toy {
 impl Clone for Toy {
     fn clone(&self) -> Self {
         LIVE.with(|l| *l.borrow_mut() += 1);
+        CLONES.with(|l| *l.borrow_mut() += 1);
         Toy { logger: self.logger.clone(), ..*self }
     }
 }
@@ -157,6 +164,11 @@ impl Model for Toy {
 
     fn set_real(&mut self, b: V, x: f64) -> ModelResult {
         match b {
+            // refusals of the model itself (the layer's checks pass these values)
+            V::Gain if x == 13.0 => {
+                return Err(ModelError::Discard("gain = 13 refused: the toy is superstitious".into()))
+            }
+            V::Acc if x > 1e9 => return Err(format!("acc = {x} refused: beyond the toy's accumulator").into()),
             V::U => self.u = x,
             V::Gain => self.gain = x,
             V::Period => self.period = x,
@@ -165,6 +177,11 @@ impl Model for Toy {
             _ => return Err("not a Real".into()),
         }
         Ok(())
+    }
+
+    /// The input has no check of its own (gain and acc have).
+    fn setter_may_refuse(b: V) -> bool {
+        b != V::U
     }
 
     fn get_integer(&mut self, b: V) -> ModelResult<i32> {
@@ -948,4 +965,86 @@ fn a_model_can_ask_to_end_the_simulation() {
         }
         assert_eq!(abi::terminate::<Toy>(g.c), OK);
     }
+}
+
+/// `fmi2SetReal` is all or nothing without copying the model: a batch whose 3rd value the
+/// model refuses leaves the first two unchanged (Discard: the instance goes on; Error: the
+/// values read in the error state are the earlier ones), also when the call is longer
+/// than the layer's undo buffer (then it copies the model once).
+#[test]
+fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
+    let f = Fmu::<Toy>::cs();
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    let set = |vrs: &[u32], xs: &[f64]| unsafe { abi::set_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr()) };
+    assert_eq!(set(&[vr::U, vr::ACC], &[0.5, 0.25]), OK);
+    let before = (f.real(vr::U), f.real(vr::ACC), f.real(vr::GAIN));
+    assert_eq!(before, (0.5, 0.25, 2.0));
+    let copies = clones();
+    assert_eq!(set(&[vr::U, vr::ACC, vr::GAIN], &[5.0, 7.0, 13.0]), Fmi2Status::Discard);
+    assert_eq!(clones(), copies, "no copy of the model for a short call");
+    let e = f.last_error();
+    assert!(e.contains("fmi2SetReal") && e.contains("gain") && e.contains("superstitious"), "{e}");
+    assert_eq!((f.real(vr::U), f.real(vr::ACC), f.real(vr::GAIN)), before);
+    // the same variables several times, longer than the undo buffer: back to the values before
+    let mut vrs: Vec<u32> = (0..39).map(|k| if k % 2 == 0 { vr::U } else { vr::ACC }).collect();
+    let mut xs: Vec<f64> = (0..39).map(|k| k as f64 + 10.0).collect();
+    vrs.push(vr::GAIN);
+    xs.push(13.0);
+    assert_eq!(set(&vrs, &xs), Fmi2Status::Discard);
+    assert_eq!(clones(), copies + 1, "one copy, at the 33rd value");
+    assert_eq!((f.real(vr::U), f.real(vr::ACC), f.real(vr::GAIN)), before);
+    // a call of inputs only (which the model never refuses) keeps nothing and applies
+    assert_eq!(set(&[vr::U, vr::U], &[0.75, 0.5]), OK);
+    assert_eq!(clones(), copies + 1);
+    // the instance goes on as if the refused calls never happened
+    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
+    assert_eq!(set(&[vr::U, vr::GAIN], &[1.0, 3.0]), OK);
+    assert_eq!(f.step(0.0, 0.05), OK);
+    assert_eq!(f.real(vr::Y), 3.0 + 0.25); // gain 3 u 1 + acc 0.25
+                                           // an Error refusal: the error state, whose diagnostic reads show the earlier values
+    let g = Fmu::<Toy>::cs();
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK) };
+    let (vrs, xs) = ([vr::U, vr::GAIN, vr::ACC], [9.0, 4.0, 2e9]);
+    assert_eq!(unsafe { abi::set_real::<Toy>(g.c, vrs.as_ptr(), 3, xs.as_ptr()) }, ERR);
+    let e = g.last_error();
+    assert!(e.contains("acc") && e.contains("beyond the toy's accumulator"), "{e}");
+    assert_eq!((g.real(vr::U), g.real(vr::GAIN), g.real(vr::ACC)), (0.0, 2.0, 0.0));
+    assert_eq!(g.step(0.0, 0.05), ERR);
+}
+
+/// The layer keeps the lookups of the last `fmi2GetReal`/`fmi2SetReal` arrays (a master
+/// sends the same ones every step): every check still runs on every value of a repeated
+/// array, in the instance's current state.
+#[test]
+fn repeated_value_reference_arrays_are_checked_every_time() {
+    let f = Fmu::<Toy>::cs();
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    let set = |vrs: &[u32], xs: &[f64]| unsafe { abi::set_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr()) };
+    let get = |vrs: &[u32]| {
+        let mut out = vec![f64::NAN; vrs.len()];
+        let s = unsafe { abi::get_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        (s, out)
+    };
+    let vrs = [vr::U, vr::PERIOD, vr::GAIN];
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), OK);
+    assert_eq!(set(&vrs, &[2.0, 0.1, 4.0]), OK);
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    // out of bounds the second time round: refused naming the variable, nothing applied
+    assert_eq!(set(&vrs, &[3.0, 0.1, -1.0]), ERR);
+    assert!(f.last_error().contains("gain = -1 refused: below its minimum 0"), "{}", f.last_error());
+    assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
+    assert_eq!(f.reset(), OK);
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), OK);
+    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
+    // the same array after initialization: the fixed parameter is refused now
+    assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), ERR);
+    assert!(f.last_error().contains("sample_period cannot be set after initialization"), "{}", f.last_error());
+    assert_eq!(f.reset(), OK);
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    // a known array then one with an unknown value reference at the end
+    assert_eq!(get(&[vr::U, vr::GAIN]).0, OK);
+    assert_eq!(get(&[vr::U, 99]).0, ERR);
+    assert!(f.last_error().contains("unknown Real value reference 99"), "{}", f.last_error());
 }

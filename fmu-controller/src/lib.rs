@@ -632,6 +632,22 @@ impl Model for Controller {
         Ok(())
     }
 
+    /// The inputs have no check of their own.
+    fn setter_may_refuse(b: Var) -> bool {
+        !matches!(
+            b,
+            Var::Beta
+                | Var::YawRate
+                | Var::Speed
+                | Var::BetaRef
+                | Var::YawRateRef
+                | Var::SpeedRef
+                | Var::SteerFeedForward(_)
+                | Var::Pose(_)
+                | Var::PoseRef(_)
+        )
+    }
+
     fn get_integer(&mut self, b: Var) -> ModelResult<i32> {
         match b {
             Var::Controller => Ok(self.mode),

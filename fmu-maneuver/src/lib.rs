@@ -438,6 +438,11 @@ impl Model for TestBench {
         Ok(())
     }
 
+    /// The inputs have no check of their own.
+    fn setter_may_refuse(b: Var) -> bool {
+        !matches!(b, Var::Beta | Var::YawRate)
+    }
+
     fn get_integer(&mut self, b: Var) -> ModelResult<i32> {
         match b {
             Var::Maneuver => Ok(maneuver_value(self.scenario.maneuver)),

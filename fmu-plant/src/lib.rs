@@ -596,6 +596,12 @@ impl Model for Plant {
         Ok(())
     }
 
+    /// The inputs (friction only within its declared 0 .. MU_MAX, which the layer checks
+    /// first) and the states have no check of their own.
+    fn setter_may_refuse(b: PlantVar) -> bool {
+        !matches!(b, PlantVar::Input(_) | PlantVar::State(_))
+    }
+
     fn get_boolean(&mut self, b: PlantVar) -> ModelResult<bool> {
         match b {
             PlantVar::Switch(s) => Ok(*switch_slot(&mut self.params, s)),

@@ -324,3 +324,50 @@ fn hostile_lengths_and_strings_are_errors_naming_the_function() {
         assert!(msg.starts_with("fmi2SetString:"), "{msg}");
     }
 }
+
+/// Our models declare (`Model::setter_may_refuse`) that their inputs have no check beyond
+/// the layer's, so `fmi2SetReal` of inputs keeps no earlier values for the way back: every
+/// value inside an input's declared bounds must then be accepted, in one batch of all
+/// inputs (in initialization mode), and read back unchanged.
+#[test]
+fn every_real_input_accepts_every_value_inside_its_declared_bounds() {
+    for fmu in every_fmu() {
+        let md = &fmu.description;
+        let inputs: Vec<(String, u32, f64, f64)> = md
+            .model_variables
+            .iter()
+            .filter(|v| v.causality == Causality::Input)
+            .filter_map(|v| match &v.variable_type {
+                VariableType::Real { min, max, .. } => {
+                    Some((v.name.clone(), v.value_reference, min.unwrap_or(-1e300), max.unwrap_or(1e300)))
+                }
+                _ => None,
+            })
+            .collect();
+        assert!(!inputs.is_empty(), "{}", id(md));
+        let vrs: Vec<u32> = inputs.iter().map(|x| x.1).collect();
+        let picks = |k: usize| -> Vec<f64> {
+            inputs
+                .iter()
+                .map(|(_, _, lo, hi)| match k {
+                    0 => *lo,
+                    1 => *hi,
+                    2 => 0.0f64.clamp(*lo, *hi),
+                    3 => (-f64::MIN_POSITIVE).clamp(*lo, *hi),
+                    _ => 0.5 * lo + 0.5 * hi,
+                })
+                .collect()
+        };
+        let (i, log) = fmu.instantiate("inputs", CO_SIMULATION.min(kinds(md)[0]), fmu.guid());
+        let i = i.unwrap();
+        assert_eq!(i.enter_init(), OK);
+        for k in 0..5 {
+            let values = picks(k);
+            assert_eq!(i.set_real(&vrs, &values), OK, "{} pick {k}: {:?}", id(md), log.last_error());
+            let back = i.get_real(&vrs).unwrap();
+            for ((name, ..), (x, y)) in inputs.iter().zip(values.iter().zip(&back)) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{}: {name}", id(md));
+            }
+        }
+    }
+}

@@ -112,7 +112,9 @@ impl Run {
             if s.len() != n + 1 {
                 return bad(format!("{name} has {} samples, x has {}", s.len(), n + 1));
             }
-            if let Some(k) = s.iter().position(|v| !v.is_finite()) {
+            // all finite: one branch-free pass (vectorized); where not, found afterwards
+            if !s.iter().fold(true, |ok, v| ok & v.is_finite()) {
+                let k = s.iter().position(|v| !v.is_finite()).unwrap_or(0);
                 return bad(format!("{name} is {} at t = {} s", s[k], Run::time(k)));
             }
         }
@@ -120,7 +122,8 @@ impl Run {
             if s.len() != n {
                 return bad(format!("{name} has {} samples, expected {n}", s.len()));
             }
-            if let Some(k) = s.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
+            if !s.iter().flatten().fold(true, |ok, x| ok & x.is_finite()) {
+                let k = s.iter().position(|v| v.iter().any(|x| !x.is_finite())).unwrap_or(0);
                 return bad(format!("{name} is {:?} at t = {} s", s[k], Run::time(k)));
             }
         }
@@ -134,4 +137,51 @@ pub trait Engine: Sync {
     fn name(&self) -> String;
     /// Runs one job over the whole benchmark horizon (30 s).
     fn run(&self, job: &Job) -> Result<Run, Error>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(n: usize) -> Run {
+        let s = |k: f64| (0..=n).map(|i| k * i as f64).collect::<Vec<f64>>();
+        Run {
+            job: Job::new(0, Fidelity::Paper, Maneuver::Straight, Controller::Robust),
+            gain: [[0.0; 4]; 4],
+            x: s(1.0),
+            y: s(2.0),
+            psi: s(3.0),
+            beta: s(4.0),
+            yaw_rate: s(5.0),
+            x_ref: s(6.0),
+            y_ref: s(7.0),
+            psi_ref: s(8.0),
+            beta_ref: s(9.0),
+            yaw_rate_ref: s(10.0),
+            delta: vec![[0.1; 4]; n],
+            mu: vec![[0.4; 4]; n],
+        }
+    }
+
+    /// The finiteness check names the series, the first bad value and its time, wherever
+    /// it sits (the branch-free pass must not miss one at either end).
+    #[test]
+    fn check_finds_the_first_non_finite_value_with_its_time() {
+        assert!(run(100).check().is_ok());
+        for k in [0, 37, 100] {
+            let mut r = run(100);
+            r.psi_ref[k] = f64::NAN;
+            r.psi_ref[100 - k / 2] = f64::INFINITY;
+            let first = k.min(100 - k / 2);
+            let e = r.check().unwrap_err().to_string();
+            assert!(e.contains("psi_ref is") && e.contains(&format!("at t = {} s", Run::time(first))), "{k}: {e}");
+        }
+        let mut r = run(100);
+        r.mu[63][2] = f64::NEG_INFINITY;
+        let e = r.check().unwrap_err().to_string();
+        assert!(e.contains("mu is [0.4, 0.4, -inf, 0.4]") && e.contains(&format!("at t = {} s", Run::time(63))), "{e}");
+        let mut r = run(100);
+        r.delta.pop();
+        assert!(r.check().unwrap_err().to_string().contains("delta has 99 samples, expected 100"));
+    }
 }
