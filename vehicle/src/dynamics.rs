@@ -109,9 +109,8 @@ pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> St
         } else {
             cmd
         };
-        st.sin[i] = st.delta[i].sin();
-        st.cos[i] = st.delta[i].cos();
     }
+    (st.sin, st.cos) = T::sin_cos4(st.delta);
     st
 }
 
@@ -181,30 +180,39 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
-    let mut slip_angle = [zero; 4];
     let mut force_lat = [zero; 4];
     let mut force_drive = [zero; 4];
     let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+
+    // wheel-centre velocities, body frame (u, w) and wheel frame (v_lon, v_lat); the slip
+    // angles of the four wheels are then computed together (one vectorizable atan2)
+    let mut v_lon = [zero; 4];
+    let mut v_lat = [zero; 4];
+    let mut speed_sq = [zero; 4];
+    for i in 0..4 {
+        let (xi, yi) = pos[i];
+        let (sd, cd) = (st.sin[i], st.cos[i]);
+        let ui = v_x - r * yi;
+        let wi = v_y + r * xi;
+        v_lon[i] = ui * cd + wi * sd;
+        v_lat[i] = wi * cd - ui * sd;
+        speed_sq[i] = ui * ui + wi * wi;
+    }
+    let slip_angle: [T; 4] = core::array::from_fn(|i| -v_lat[i].atan2(v_lon[i].abs()));
 
     for i in 0..4 {
         let (xi, yi) = pos[i];
         let (sd, cd) = (st.sin[i], st.cos[i]);
         der[idx::SERVO + i] = st.servo_rate[i];
-        // wheel-centre velocity, body frame and wheel frame
-        let ui = v_x - r * yi;
-        let wi = v_y + r * xi;
-        let v_lon = ui * cd + wi * sd;
-        let v_lat = wi * cd - ui * sd;
-        let alpha = -v_lat.atan2(v_lon.abs());
+        let alpha = slip_angle[i];
         // min(1, |(u, w)| / v_fade), with the square root only inside the fade zone
-        let speed_sq = ui * ui + wi * wi;
-        let fade = if speed_sq.value() < v_fade_sq { speed_sq.sqrt() / p.v_fade } else { one };
+        let fade = if speed_sq[i].value() < v_fade_sq { speed_sq[i].sqrt() / p.v_fade } else { one };
         let mu = u.mu[i];
         let mut f_lat = mu * alpha * p.c[i] * fade;
         let cap = wd.cap[i];
         let mut f_drive = wd.drive[i];
         if p.motor_speed_limit && f_drive.value() > 0.0 {
-            let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
+            let scale = ((T::constant(p.wheel_speed_max) - v_lon[i]) / p.motor_taper).clamp_s(zero, one);
             f_drive = f_drive * scale;
         }
         if p.friction_circle && !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
@@ -220,11 +228,10 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
         fx_sum = fx_sum + fx;
         fy_sum = fy_sum + fy;
         mz = mz + fy * xi - fx * yi;
-        slip_angle[i] = alpha;
         force_lat[i] = f_lat;
         force_drive[i] = f_drive;
     }
-    let (sp, cp) = (psi.sin(), psi.cos());
+    let (sp, cp) = psi.sin_cos();
     // world-frame wind (wind_x, wind_y) in body axes: forward = x cos + y sin, left = -x sin + y cos
     let wind_head = u.wind_head - (u.wind_x * cp + u.wind_y * sp);
     let wind_side = u.wind_side + (u.wind_y * cp - u.wind_x * sp);

@@ -3,6 +3,8 @@
 
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
+use crate::fastmath;
+
 /// The operations the vehicle right-hand side needs.
 ///
 /// Comparisons (`value()`) decide branches (clamps, fades); the branch taken is then
@@ -23,6 +25,15 @@ pub trait Scalar:
     fn value(self) -> f64;
     fn sin(self) -> Self;
     fn cos(self) -> Self;
+    /// `(sin, cos)` at once.
+    fn sin_cos(self) -> (Self, Self) {
+        (self.sin(), self.cos())
+    }
+    /// [`Scalar::sin_cos`] of four values (the four wheels), the same results lane by lane.
+    fn sin_cos4(v: [Self; 4]) -> ([Self; 4], [Self; 4]) {
+        let p = v.map(Self::sin_cos);
+        (p.map(|q| q.0), p.map(|q| q.1))
+    }
     fn abs(self) -> Self;
     /// Square root, with derivative 0 at 0 (where it is infinite).
     fn sqrt(self) -> Self;
@@ -50,6 +61,9 @@ pub trait Scalar:
     }
 }
 
+/// The `f64` functions are those of [`fastmath`] (within 2 ulp of glibc, the same bits on
+/// every CPU), so that the right-hand side, its outputs and its dual-number derivatives all
+/// use one and the same function.
 impl Scalar for f64 {
     #[inline]
     fn constant(v: f64) -> Self {
@@ -61,11 +75,19 @@ impl Scalar for f64 {
     }
     #[inline]
     fn sin(self) -> Self {
-        f64::sin(self)
+        fastmath::sin_cos(self).0
     }
     #[inline]
     fn cos(self) -> Self {
-        f64::cos(self)
+        fastmath::sin_cos(self).1
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        fastmath::sin_cos(self)
+    }
+    #[inline(always)]
+    fn sin_cos4(v: [Self; 4]) -> ([Self; 4], [Self; 4]) {
+        fastmath::sin_cos4(v)
     }
     #[inline]
     fn abs(self) -> Self {
@@ -75,9 +97,9 @@ impl Scalar for f64 {
     fn sqrt(self) -> Self {
         f64::sqrt(self)
     }
-    #[inline]
+    #[inline(always)]
     fn atan2(self, x: Self) -> Self {
-        f64::atan2(self, x)
+        fastmath::atan2(self, x)
     }
     #[inline]
     fn hypot(self, y: Self) -> Self {
@@ -173,11 +195,18 @@ impl Scalar for Dual {
     }
     #[inline]
     fn sin(self) -> Self {
-        Dual::new(self.v.sin(), self.d * self.v.cos())
+        let (s, c) = fastmath::sin_cos(self.v);
+        Dual::new(s, self.d * c)
     }
     #[inline]
     fn cos(self) -> Self {
-        Dual::new(self.v.cos(), -self.d * self.v.sin())
+        let (s, c) = fastmath::sin_cos(self.v);
+        Dual::new(c, -self.d * s)
+    }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = fastmath::sin_cos(self.v);
+        (Dual::new(s, self.d * c), Dual::new(c, -self.d * s))
     }
     #[inline]
     fn abs(self) -> Self {
@@ -196,7 +225,7 @@ impl Scalar for Dual {
     fn atan2(self, x: Self) -> Self {
         let r2 = self.v * self.v + x.v * x.v;
         let d = if r2 > 0.0 { (x.v * self.d - self.v * x.d) / r2 } else { 0.0 };
-        Dual::new(self.v.atan2(x.v), d)
+        Dual::new(fastmath::atan2(self.v, x.v), d)
     }
     #[inline]
     fn hypot(self, y: Self) -> Self {
