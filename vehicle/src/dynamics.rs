@@ -180,12 +180,12 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
-    let mut force_lat = [zero; 4];
-    let mut force_drive = [zero; 4];
-    let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+    for i in 0..4 {
+        der[idx::SERVO + i] = st.servo_rate[i];
+    }
 
-    // wheel-centre velocities, body frame (u, w) and wheel frame (v_lon, v_lat); the slip
-    // angles of the four wheels are then computed together (one vectorizable atan2)
+    // wheel-centre velocities, body frame (u, w) and wheel frame (v_lon, v_lat); the four
+    // wheels go through each stage together (straight-line code the compiler vectorizes)
     let mut v_lon = [zero; 4];
     let mut v_lat = [zero; 4];
     let mut speed_sq = [zero; 4];
@@ -198,38 +198,43 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
         v_lat[i] = wi * cd - ui * sd;
         speed_sq[i] = ui * ui + wi * wi;
     }
-    let slip_angle: [T; 4] = core::array::from_fn(|i| -v_lat[i].atan2(v_lon[i].abs()));
-
-    for i in 0..4 {
-        let (xi, yi) = pos[i];
-        let (sd, cd) = (st.sin[i], st.cos[i]);
-        der[idx::SERVO + i] = st.servo_rate[i];
-        let alpha = slip_angle[i];
-        // min(1, |(u, w)| / v_fade), with the square root only inside the fade zone
+    let slip_angle = T::atan2x4(v_lat, v_lon.map(T::abs)).map(|a| -a);
+    // lateral force mu alpha C min(1, |(u, w)| / v_fade), the square root only inside the fade zone
+    let mut force_lat: [T; 4] = core::array::from_fn(|i| {
         let fade = if speed_sq[i].value() < v_fade_sq { speed_sq[i].sqrt() / p.v_fade } else { one };
-        let mu = u.mu[i];
-        let mut f_lat = mu * alpha * p.c[i] * fade;
-        let cap = wd.cap[i];
-        let mut f_drive = wd.drive[i];
-        if p.motor_speed_limit && f_drive.value() > 0.0 {
-            let scale = ((T::constant(p.wheel_speed_max) - v_lon[i]) / p.motor_taper).clamp_s(zero, one);
-            f_drive = f_drive * scale;
-        }
-        if p.friction_circle && !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
-            let h = f_drive.hypot(f_lat);
-            if h.value() > cap.value() && h.value() > 0.0 {
-                let k = cap / h;
-                f_drive = f_drive * k;
-                f_lat = f_lat * k;
+        u.mu[i] * slip_angle[i] * p.c[i] * fade
+    });
+    let mut force_drive = wd.drive;
+    if p.motor_speed_limit {
+        for i in 0..4 {
+            if force_drive[i].value() > 0.0 {
+                let scale = ((T::constant(p.wheel_speed_max) - v_lon[i]) / p.motor_taper).clamp_s(zero, one);
+                force_drive[i] = force_drive[i] * scale;
             }
         }
-        let fx = f_drive * cd - f_lat * sd;
-        let fy = f_drive * sd + f_lat * cd;
-        fx_sum = fx_sum + fx;
-        fy_sum = fy_sum + fy;
-        mz = mz + fy * xi - fx * yi;
-        force_lat[i] = f_lat;
-        force_drive[i] = f_drive;
+    }
+    if p.friction_circle {
+        for i in 0..4 {
+            let (f_drive, f_lat, cap) = (force_drive[i], force_lat[i], wd.cap[i]);
+            if !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
+                let h = f_drive.hypot(f_lat);
+                if h.value() > cap.value() && h.value() > 0.0 {
+                    let k = cap / h;
+                    force_drive[i] = f_drive * k;
+                    force_lat[i] = f_lat * k;
+                }
+            }
+        }
+    }
+    // wheel-frame forces into body axes, summed in wheel order
+    let fx: [T; 4] = core::array::from_fn(|i| force_drive[i] * st.cos[i] - force_lat[i] * st.sin[i]);
+    let fy: [T; 4] = core::array::from_fn(|i| force_drive[i] * st.sin[i] + force_lat[i] * st.cos[i]);
+    let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+    for i in 0..4 {
+        let (xi, yi) = pos[i];
+        fx_sum = fx_sum + fx[i];
+        fy_sum = fy_sum + fy[i];
+        mz = mz + fy[i] * xi - fx[i] * yi;
     }
     let (sp, cp) = psi.sin_cos();
     // world-frame wind (wind_x, wind_y) in body axes: forward = x cos + y sin, left = -x sin + y cos

@@ -46,13 +46,39 @@ fn select(c: bool, a: f64, b: f64) -> f64 {
 
 /// `atan2(y, x)` [rad] in `[-pi, pi]`, with the IEEE-754 special values of C's `atan2`
 /// (signed zeros, infinities, NaN). Within 2 ulp of glibc's (tested).
-///
-/// With `a = min(|y|, |x|)`, `b = max(|y|, |x|)`, `t = a / b` in `[0, 1]`, or `(a - b) / (a + b)`
-/// (one division, no double rounding) around `pi/4` when `a > tan(pi/8) b`; then
-/// `atan(t) = t + t z h(z)` and the octant is restored by `k pi/4 +- atan(t)`, `k = 0 ..= 4`,
-/// with `pi/4` carried in two parts.
 #[inline(always)]
 pub fn atan2(y: f64, x: f64) -> f64 {
+    if is_plain(y, x) {
+        atan2_plain(y, x)
+    } else {
+        atan2_special(y, x)
+    }
+}
+
+/// At or above this `|y| + |x|` (and at 0, infinity, NaN) [`atan2_special`] takes over.
+const ATAN2_PLAIN_MAX: f64 = 1e300;
+
+/// `0 < |y| + |x| < ATAN2_PLAIN_MAX`: neither is NaN or infinite, not both are zero, and
+/// `a + b` in [`atan2_octant`] cannot overflow.
+#[inline(always)]
+fn is_plain(y: f64, x: f64) -> bool {
+    let sum = y.abs() + x.abs();
+    (sum > 0.0) & (sum < ATAN2_PLAIN_MAX)
+}
+
+/// [`atan2`] where [`is_plain`] (no zero division, no overflow of `a + b`, no infinity, no
+/// NaN): the common case, without a branch.
+#[inline(always)]
+fn atan2_plain(y: f64, x: f64) -> f64 {
+    let (ay, ax) = (y.abs(), x.abs());
+    let swap = ay > ax;
+    let (a, b) = (select(swap, ax, ay), select(swap, ay, ax));
+    atan2_octant(y, x, swap, a, b, false)
+}
+
+/// [`atan2`] of zeros, infinities, NaN and arguments near `f64::MAX`.
+#[inline(never)]
+fn atan2_special(y: f64, x: f64) -> f64 {
     let (ay, ax) = (y.abs(), x.abs());
     let swap = ay > ax;
     let (mut a, mut b) = (select(swap, ax, ay), select(swap, ay, ax));
@@ -61,14 +87,23 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     a = select(both_infinite, 1.0, a);
     b = select(both_infinite, 1.0, b);
     // a + b would overflow near f64::MAX: halve both (exact at that size)
-    let scale = select(b > 1e300, 0.5, 1.0);
-    let (a, b) = (a * scale, b * scale);
+    let scale = select(b > ATAN2_PLAIN_MAX, 0.5, 1.0);
+    atan2_octant(y, x, swap, a * scale, b * scale, true)
+}
+
+/// `atan2` from `0 <= a <= b` (`|y|, |x|` in some order, `swap` when `a = |x|`).
+///
+/// `t = a / b` in `[0, 1]`, or `(a - b) / (a + b)` (one division, no double rounding)
+/// around `pi/4` when `a > tan(pi/8) b`; then `atan(t) = t + t z h(z)` and the octant is
+/// restored by `k pi/4 +- atan(t)`, `k = 0 ..= 4`, with `pi/4` carried in two parts.
+#[inline(always)]
+fn atan2_octant(y: f64, x: f64, swap: bool, a: f64, b: f64, zero_possible: bool) -> f64 {
     let mid = a > TAN_PI_8 * b;
     let num = select(mid, a - b, a);
     let den = select(mid, a + b, b);
     // den = 0 only for x = y = 0 (t = 0, the signs of x and y then give +-0 or +-pi) or a
     // NaN y with x = 0 (t = NaN)
-    let t = select(den == 0.0, num, num / den);
+    let t = if zero_possible { select(den == 0.0, num, num / den) } else { num / den };
     let z = t * t;
     let mut p = ATAN[10];
     for &c in ATAN[..10].iter().rev() {
@@ -88,7 +123,12 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 /// the same results bit for bit, laid out for the compiler to vectorize.
 #[inline(always)]
 pub fn atan2x4(y: [f64; 4], x: [f64; 4]) -> [f64; 4] {
-    [atan2(y[0], x[0]), atan2(y[1], x[1]), atan2(y[2], x[2]), atan2(y[3], x[3])]
+    // `&`, not `&&`: four compares and no branch but one
+    if is_plain(y[0], x[0]) & is_plain(y[1], x[1]) & is_plain(y[2], x[2]) & is_plain(y[3], x[3]) {
+        core::array::from_fn(|i| atan2_plain(y[i], x[i]))
+    } else {
+        core::array::from_fn(|i| atan2(y[i], x[i]))
+    }
 }
 
 /// `S(z) = (sin(sqrt z) / sqrt z - 1) / z` on `0 <= z <= (pi/4)^2`, powers `z^0 .. z^6`.
@@ -132,7 +172,14 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() <= SIN_COS_FAST_MAX) {
         return (x.sin(), x.cos());
     }
-    sin_cos_reduced(x)
+    let (sin_r, cos_r, k) = sin_cos_octant(x);
+    // one argument: a branch on the quadrant is cheaper than selects (same values)
+    match (k as i32) & 3 {
+        0 => (sin_r, cos_r),
+        1 => (cos_r, -sin_r),
+        2 => (-sin_r, -cos_r),
+        _ => (-cos_r, sin_r),
+    }
 }
 
 /// [`sin_cos`] of four arguments at once (the four steering angles): the same operations
@@ -140,7 +187,8 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 /// fast range so that the compiler vectorizes them.
 #[inline(always)]
 pub fn sin_cos4(x: [f64; 4]) -> ([f64; 4], [f64; 4]) {
-    if x.iter().all(|v| v.abs() <= SIN_COS_FAST_MAX) {
+    let fast = |v: f64| v.abs() <= SIN_COS_FAST_MAX;
+    if fast(x[0]) & fast(x[1]) & fast(x[2]) & fast(x[3]) {
         let mut s = [0.0; 4];
         let mut c = [0.0; 4];
         for i in 0..4 {
@@ -156,6 +204,19 @@ pub fn sin_cos4(x: [f64; 4]) -> ([f64; 4], [f64; 4]) {
 /// [`sin_cos`] for `|x| <= SIN_COS_FAST_MAX`, without a branch.
 #[inline(always)]
 fn sin_cos_reduced(x: f64) -> (f64, f64) {
+    let (sin_r, cos_r, k) = sin_cos_octant(x);
+    // quadrant k mod 4 (|k| < 2^17 fits an i32; two's complement gives the right residue
+    // for negative k): odd swaps sin and cos, then sin is negated in quadrants 2, 3 and cos
+    // in quadrants 1, 2
+    let q = k as i32;
+    let swap = q & 1 != 0;
+    let (s0, c0) = (select(swap, cos_r, sin_r), select(swap, sin_r, cos_r));
+    (select(q & 2 != 0, -s0, s0), select((q + 1) & 2 != 0, -c0, c0))
+}
+
+/// `(sin r, cos r, k)` with `r = x - k pi/2`, `|r| <= pi/4`, for `|x| <= SIN_COS_FAST_MAX`.
+#[inline(always)]
+fn sin_cos_octant(x: f64) -> (f64, f64, f64) {
     let k = (x * FRAC_2_PI + ROUND_MAGIC) - ROUND_MAGIC;
     let r = (((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3) - k * PIO2_4;
     let z = r * r;
@@ -172,13 +233,7 @@ fn sin_cos_reduced(x: f64) -> (f64, f64) {
     let half_z = 0.5 * z;
     let w = 1.0 - half_z;
     let cos_r = w + (((1.0 - w) - half_z) + z * (z * pc));
-    // quadrant k mod 4 (|k| < 2^17 fits an i32; two's complement gives the right residue
-    // for negative k): odd swaps sin and cos, then sin is negated in quadrants 2, 3 and cos
-    // in quadrants 1, 2
-    let q = k as i32;
-    let swap = q & 1 != 0;
-    let (s0, c0) = (select(swap, cos_r, sin_r), select(swap, sin_r, cos_r));
-    (select(q & 2 != 0, -s0, s0), select((q + 1) & 2 != 0, -c0, c0))
+    (sin_r, cos_r, k)
 }
 
 #[cfg(test)]
@@ -301,12 +356,18 @@ mod tests {
     #[test]
     fn atan2x4_is_atan2_lane_by_lane() {
         let mut seed = 3u64;
-        for _ in 0..10_000 {
-            let y: [f64; 4] = core::array::from_fn(|_| any_magnitude(&mut seed, -30, 30));
-            let x: [f64; 4] = core::array::from_fn(|_| any_magnitude(&mut seed, -30, 30));
+        let special = [0.0, -0.0, f64::INFINITY, -f64::INFINITY, f64::NAN, 1e301, -f64::MAX, 5e-324];
+        for n in 0..20_000 {
+            let mut y: [f64; 4] = core::array::from_fn(|_| any_magnitude(&mut seed, -30, 30));
+            let mut x: [f64; 4] = core::array::from_fn(|_| any_magnitude(&mut seed, -30, 30));
+            // some with a special lane (zero, infinite, NaN, huge): the lanes take two paths
+            if n % 5 == 0 {
+                y[n % 4] = special[(n / 5) % 8];
+                x[(n / 3) % 4] = special[(n / 40) % 8];
+            }
             let v = atan2x4(y, x);
             for i in 0..4 {
-                assert_eq!(v[i].to_bits(), atan2(y[i], x[i]).to_bits());
+                assert_eq!(v[i].to_bits(), atan2(y[i], x[i]).to_bits(), "atan2({}, {})", y[i], x[i]);
             }
         }
     }

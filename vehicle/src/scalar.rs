@@ -39,6 +39,10 @@ pub trait Scalar:
     fn sqrt(self) -> Self;
     /// `atan2(self, x)`, with derivative 0 at the origin (where it is undefined).
     fn atan2(self, x: Self) -> Self;
+    /// [`Scalar::atan2`] of four pairs (the four wheels), the same results lane by lane.
+    fn atan2x4(y: [Self; 4], x: [Self; 4]) -> [Self; 4] {
+        core::array::from_fn(|i| y[i].atan2(x[i]))
+    }
     /// `sqrt(self^2 + y^2)`, with derivative 0 at the origin.
     fn hypot(self, y: Self) -> Self;
 
@@ -100,6 +104,10 @@ impl Scalar for f64 {
     #[inline(always)]
     fn atan2(self, x: Self) -> Self {
         fastmath::atan2(self, x)
+    }
+    #[inline(always)]
+    fn atan2x4(y: [Self; 4], x: [Self; 4]) -> [Self; 4] {
+        fastmath::atan2x4(y, x)
     }
     #[inline]
     fn hypot(self, y: Self) -> Self {
