@@ -180,9 +180,7 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
-    for i in 0..4 {
-        der[idx::SERVO + i] = st.servo_rate[i];
-    }
+    der[idx::SERVO..].copy_from_slice(&st.servo_rate);
 
     // wheel-centre velocities, body frame (u, w) and wheel frame (v_lon, v_lat); the four
     // wheels go through each stage together (straight-line code the compiler vectorizes)

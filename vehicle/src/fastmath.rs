@@ -172,9 +172,9 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() <= SIN_COS_FAST_MAX) {
         return (x.sin(), x.cos());
     }
-    let (sin_r, cos_r, k) = sin_cos_octant(x);
+    let (sin_r, cos_r, q) = sin_cos_octant(x);
     // one argument: a branch on the quadrant is cheaper than selects (same values)
-    match (k as i32) & 3 {
+    match q & 3 {
         0 => (sin_r, cos_r),
         1 => (cos_r, -sin_r),
         2 => (-sin_r, -cos_r),
@@ -204,20 +204,25 @@ pub fn sin_cos4(x: [f64; 4]) -> ([f64; 4], [f64; 4]) {
 /// [`sin_cos`] for `|x| <= SIN_COS_FAST_MAX`, without a branch.
 #[inline(always)]
 fn sin_cos_reduced(x: f64) -> (f64, f64) {
-    let (sin_r, cos_r, k) = sin_cos_octant(x);
-    // quadrant k mod 4 (|k| < 2^17 fits an i32; two's complement gives the right residue
-    // for negative k): odd swaps sin and cos, then sin is negated in quadrants 2, 3 and cos
-    // in quadrants 1, 2
-    let q = k as i32;
-    let swap = q & 1 != 0;
-    let (s0, c0) = (select(swap, cos_r, sin_r), select(swap, sin_r, cos_r));
-    (select(q & 2 != 0, -s0, s0), select((q + 1) & 2 != 0, -c0, c0))
+    let (sin_r, cos_r, q) = sin_cos_octant(x);
+    // quadrant q = k mod 4: odd swaps sin and cos, then sin is negated in quadrants 2, 3
+    // and cos in quadrants 1, 2 (bit operations: 64-bit lanes the compiler vectorizes)
+    let swap = 0u64.wrapping_sub(q & 1);
+    let (sb, cb) = (sin_r.to_bits(), cos_r.to_bits());
+    let s0 = (cb & swap) | (sb & !swap);
+    let c0 = (sb & swap) | (cb & !swap);
+    (f64::from_bits(s0 ^ ((q & 2) << 62)), f64::from_bits(c0 ^ (((q + 1) & 2) << 62)))
 }
 
-/// `(sin r, cos r, k)` with `r = x - k pi/2`, `|r| <= pi/4`, for `|x| <= SIN_COS_FAST_MAX`.
+/// `(sin r, cos r, q)` with `r = x - k pi/2`, `|r| <= pi/4`, for `|x| <= SIN_COS_FAST_MAX`,
+/// and `q = k mod 4` in its two lowest bits.
 #[inline(always)]
-fn sin_cos_octant(x: f64) -> (f64, f64, f64) {
-    let k = (x * FRAC_2_PI + ROUND_MAGIC) - ROUND_MAGIC;
+fn sin_cos_octant(x: f64) -> (f64, f64, u64) {
+    let shifted = x * FRAC_2_PI + ROUND_MAGIC;
+    // shifted = 1.5 2^52 + k: its significand field holds 2^51 + k, so its lowest bits are
+    // those of k (two's complement for negative k)
+    let q = shifted.to_bits();
+    let k = shifted - ROUND_MAGIC;
     let r = (((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3) - k * PIO2_4;
     let z = r * r;
     let mut ps = SIN[6];
@@ -233,7 +238,7 @@ fn sin_cos_octant(x: f64) -> (f64, f64, f64) {
     let half_z = 0.5 * z;
     let w = 1.0 - half_z;
     let cos_r = w + (((1.0 - w) - half_z) + z * (z * pc));
-    (sin_r, cos_r, k)
+    (sin_r, cos_r, q)
 }
 
 #[cfg(test)]
