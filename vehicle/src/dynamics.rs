@@ -96,19 +96,28 @@ pub struct Steering<T> {
 
 /// The steering actually applied at this state and input.
 pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Steering<T> {
-    let zero = T::constant(0.0);
+    steering_commanded(p, s, &clamped_commands(p, u))
+}
+
+/// The steering commands clamped to `+-delta_max` (inputs only: once per held step).
+#[inline(always)]
+fn clamped_commands<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> [T; 4] {
     let dmax = T::constant(p.delta_max);
-    let mut st = Steering { delta: [zero; 4], sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
-    for i in 0..4 {
-        let cmd = u.delta[i].clamp_s(-dmax, dmax);
-        st.delta[i] = if p.steering_servo {
+    u.delta.map(|d| d.clamp_s(-dmax, dmax))
+}
+
+/// [`steering`] from the clamped commands.
+#[inline(always)]
+fn steering_commanded<T: Scalar>(p: &VehicleParams, s: &State<T>, cmd: &[T; 4]) -> Steering<T> {
+    let zero = T::constant(0.0);
+    let mut st = Steering { delta: *cmd, sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
+    if p.steering_servo {
+        let rate = T::constant(p.servo_rate_max);
+        for i in 0..4 {
             let sv = s[idx::SERVO + i];
-            let rate = T::constant(p.servo_rate_max);
-            st.servo_rate[i] = ((cmd - sv) / p.servo_time_constant).clamp_s(-rate, rate);
-            sv
-        } else {
-            cmd
-        };
+            st.servo_rate[i] = ((cmd[i] - sv) / p.servo_time_constant).clamp_s(-rate, rate);
+            st.delta[i] = sv;
+        }
     }
     (st.sin, st.cos) = T::sin_cos4(st.delta);
     st
@@ -286,8 +295,26 @@ fn derivatives_steered(
 
 /// One classical Runge-Kutta step of size `h` with inputs held constant.
 pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
-    let held = (!p.steering_servo).then(|| steering(p, s, u));
-    rk4(p, s, u, h, held.as_ref(), &wheel_drive(p, u))
+    rk4(p, s, u, h, &HeldSteering::new(p, s, u), &wheel_drive(p, u))
+}
+
+/// What of the steering is constant while the inputs are held: all of it with the servo
+/// off (it depends on the inputs only), the clamped commands with the servo on.
+enum HeldSteering {
+    Fixed(Steering<f64>),
+    Servo([f64; 4]),
+}
+
+impl HeldSteering {
+    #[inline(always)]
+    fn new(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> Self {
+        let cmd = clamped_commands(p, u);
+        if p.steering_servo {
+            HeldSteering::Servo(cmd)
+        } else {
+            HeldSteering::Fixed(steering_commanded(p, s, &cmd))
+        }
+    }
 }
 
 #[inline]
@@ -296,12 +323,12 @@ fn rk4(
     s: &State<f64>,
     u: &Inputs<f64>,
     h: f64,
-    held: Option<&Steering<f64>>,
+    held: &HeldSteering,
     wd: &WheelDrive<f64>,
 ) -> State<f64> {
     let f = |x: &State<f64>| match held {
-        Some(st) => derivatives_steered(p, x, u, st, wd),
-        None => derivatives_steered(p, x, u, &steering(p, x, u), wd),
+        HeldSteering::Fixed(st) => derivatives_steered(p, x, u, st, wd),
+        HeldSteering::Servo(cmd) => derivatives_steered(p, x, u, &steering_commanded(p, x, cmd), wd),
     };
     let add = |a: &State<f64>, k: &State<f64>, c: f64| {
         let mut o = *a;
@@ -381,11 +408,11 @@ pub fn stable_rk4_step(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
     let n = substeps(h, max_step);
     let dt = h / n as f64;
-    let held = (!p.steering_servo).then(|| steering(p, s, u));
+    let held = HeldSteering::new(p, s, u);
     let wd = wheel_drive(p, u);
     let mut x = *s;
     for _ in 0..n {
-        x = rk4(p, &x, u, dt, held.as_ref(), &wd);
+        x = rk4(p, &x, u, dt, &held, &wd);
         flush_negligible(&mut x);
     }
     x
