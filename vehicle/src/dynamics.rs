@@ -354,7 +354,17 @@ fn rk4(
 /// that accumulate time produce) from costing one more sub-step. Callers facing untrusted
 /// `h` and `max_step` check this count before integrating (it can be astronomically large).
 pub fn substeps(h: f64, max_step: f64) -> usize {
-    (h / max_step - 1e-9).ceil().max(1.0) as usize
+    let q = h / max_step - 1e-9;
+    // ceil(q) without a call: baseline x86-64 has no rounding instruction, and `f64::ceil`
+    // costs a libm call per step. Exact for 0 <= q < 2^52 (the truncation is exact there);
+    // anything else (negative, huge, infinite, NaN) takes `ceil` itself.
+    if (0.0..4503599627370496.0).contains(&q) {
+        let truncated = q as u64;
+        let up = truncated + u64::from((truncated as f64) < q);
+        up.max(1) as usize
+    } else {
+        q.ceil().max(1.0) as usize
+    }
 }
 
 /// Real-axis stability limit of classical RK4: `|h lambda| <= 2.785` for a real negative
@@ -453,6 +463,44 @@ mod tests {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The call-free `ceil` of [`substeps`] is `ceil` exactly: at and around integers, on
+    /// both sides of 2^52, for tiny, negative and non-finite ratios.
+    #[test]
+    fn substeps_equals_the_ceil_formula() {
+        let reference = |h: f64, max_step: f64| (h / max_step - 1e-9).ceil().max(1.0) as usize;
+        let mut seed = 17u64;
+        let mut cases: Vec<(f64, f64)> = vec![
+            (1e-3, 5e-4),
+            (1e-3 + 1e-18, 5e-4),
+            (1e-3 * (1.0 + 1e-12), 5e-4),
+            (1e-3, 1e-3),
+            (0.0, 1e-3),
+            (-1.0, 1e-3),
+            (1e-300, 1.0),
+            (1.0, 1e-300),
+            (f64::INFINITY, 1.0),
+            (f64::NAN, 1.0),
+            (4503599627370496.0, 1.0),
+            (4503599627370495.5, 1.0),
+            (9007199254740993.0, 1.0),
+            (1e20, 1.0),
+        ];
+        for _ in 0..200_000 {
+            let max_step = 10f64.powf(-6.0 * next(&mut seed)) * 1e-3;
+            let k = (next(&mut seed) * 1e4).floor();
+            // multiples of max_step, a few ulps either side, and arbitrary ratios
+            let h = match (next(&mut seed) * 3.0) as u32 {
+                0 => k * max_step,
+                1 => k * max_step * (1.0 + (next(&mut seed) - 0.5) * 1e-12),
+                _ => next(&mut seed) * 1e4 * max_step,
+            };
+            cases.push((h, max_step));
+        }
+        for (h, max_step) in cases {
+            assert_eq!(substeps(h, max_step), reference(h, max_step), "h = {h:e}, max_step = {max_step:e}");
+        }
     }
 
     /// The shortcut decides "inside" only where the exact test (`hypot > cap`) would not
