@@ -317,6 +317,8 @@ impl HeldSteering {
     }
 }
 
+/// One classical RK4 step with the inputs held, for the held steering: one monomorphic
+/// [`rk4_with`] per case, so each inlines its right-hand side.
 #[inline]
 fn rk4(
     p: &VehicleParams,
@@ -326,24 +328,42 @@ fn rk4(
     held: &HeldSteering,
     wd: &WheelDrive<f64>,
 ) -> State<f64> {
-    let f = |x: &State<f64>| match held {
-        HeldSteering::Fixed(st) => derivatives_steered(p, x, u, st, wd),
-        HeldSteering::Servo(cmd) => derivatives_steered(p, x, u, &steering_commanded(p, x, cmd), wd),
-    };
-    let add = |a: &State<f64>, k: &State<f64>, c: f64| {
-        let mut o = *a;
-        for j in 0..N_STATES {
-            o[j] += c * k[j];
+    match held {
+        HeldSteering::Fixed(st) => rk4_with(s, h, |x| derivatives_steered(p, x, u, st, wd)),
+        HeldSteering::Servo(cmd) => {
+            rk4_with(s, h, |x| derivatives_steered(p, x, u, &steering_commanded(p, x, cmd), wd))
         }
-        o
-    };
-    let k1 = f(s);
-    let k2 = f(&add(s, &k1, 0.5 * h));
-    let k3 = f(&add(s, &k2, 0.5 * h));
-    let k4 = f(&add(s, &k3, h));
+    }
+}
+
+/// Classical RK4 of `f` over `h`: `s + h/6 (k1 + 2 k2 + 2 k3 + k4)`, the sum accumulated
+/// in that order as the stages come (the same operations as the textbook form, so the same
+/// bits), the stages in a loop so that `f` has one call site.
+#[inline(always)]
+fn rk4_with(s: &State<f64>, h: f64, f: impl Fn(&State<f64>) -> State<f64>) -> State<f64> {
+    let mut sum = [0.0; N_STATES];
+    let mut x = *s;
+    for stage in 0..4 {
+        let k = f(&x);
+        if stage == 0 {
+            sum = k;
+        } else {
+            let weight = if stage == 3 { 1.0 } else { 2.0 };
+            for j in 0..N_STATES {
+                sum[j] += weight * k[j];
+            }
+        }
+        if stage < 3 {
+            let c = if stage < 2 { 0.5 * h } else { h };
+            x = *s;
+            for j in 0..N_STATES {
+                x[j] += c * k[j];
+            }
+        }
+    }
     let mut o = *s;
     for j in 0..N_STATES {
-        o[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        o[j] += h / 6.0 * sum[j];
     }
     o
 }
@@ -463,6 +483,50 @@ mod tests {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// `rk4_step` (held steering, stages in a loop, the sum accumulated as they come) is bit
+    /// for bit the textbook RK4 of `derivatives_of`, in both fidelities.
+    #[test]
+    fn rk4_step_is_the_textbook_rk4_bit_for_bit() {
+        let seed = core::cell::Cell::new(23u64);
+        let uniform = || {
+            let mut v = seed.get();
+            let x = next(&mut v);
+            seed.set(v);
+            x
+        };
+        let r = |scale: f64| scale * (2.0 * uniform() - 1.0);
+        for p in [VehicleParams::table2(), VehicleParams::real_fidelity()] {
+            for _ in 0..2_000 {
+                let mut s = [0.0; N_STATES];
+                s[idx::X] = r(5.0);
+                s[idx::Y] = r(5.0);
+                s[idx::PSI] = r(20.0);
+                s[idx::V_X] = r(1.0);
+                s[idx::V_Y] = r(0.3);
+                s[idx::YAW_RATE] = r(3.0);
+                for i in 0..4 {
+                    s[idx::SERVO + i] = r(1.6);
+                }
+                let mut u = Inputs::coasting(0.2 + uniform());
+                u.delta = [r(2.0), r(2.0), r(2.0), r(2.0)];
+                u.tau = [r(0.05), r(0.05), r(0.05), r(0.05)];
+                u.wind_x = r(0.5);
+                u.wind_side = r(0.5);
+                let h = 1e-4 + 1e-3 * uniform();
+                let f = |x: &State<f64>| derivatives_of(&p, x, &u);
+                let add = |k: &State<f64>, c: f64| core::array::from_fn::<f64, N_STATES, _>(|j| s[j] + c * k[j]);
+                let k1 = f(&s);
+                let k2 = f(&add(&k1, 0.5 * h));
+                let k3 = f(&add(&k2, 0.5 * h));
+                let k4 = f(&add(&k3, h));
+                let want: State<f64> =
+                    core::array::from_fn(|j| s[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]));
+                let got = rk4_step(&p, &s, &u, h);
+                assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "{s:?} {u:?}");
+            }
+        }
     }
 
     /// The call-free `ceil` of [`substeps`] is `ceil` exactly: at and around integers, on
