@@ -8,7 +8,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::abi;
 use fmi2_export::ffi::{Fmi2CallbackFunctions, Fmi2CallbackLogger, Fmi2Status};
 use fmi2_export::Model;
-use nigel_plant::Plant;
+use nigel_plant::{vr, Plant};
 use nigel_vehicle::{derivatives_of, Inputs, VehicleParams};
 
 unsafe extern "C" fn silent(_: *mut c_void, _: *const c_char, _: c_int, _: *const c_char, _: *const c_char) {}
@@ -28,10 +28,10 @@ fn component(kind: c_int) -> *mut c_void {
     let c =
         unsafe { abi::instantiate::<Plant>(c"bench".as_ptr(), kind, guid.as_ptr(), std::ptr::null(), callbacks, 0, 0) };
     assert!(!c.is_null());
-    let vr = [3u32, 20, 21, 22, 23];
+    let refs = [vr::STATE_START + 3, 20, 21, 22, 23]; // v_x_start, delta_fl .. delta_rr
     let values = [0.35, 0.2, 0.2, -0.2, -0.2];
     unsafe {
-        assert_eq!(abi::set_real::<Plant>(c, vr.as_ptr(), vr.len(), values.as_ptr()), Fmi2Status::Ok);
+        assert_eq!(abi::set_real::<Plant>(c, refs.as_ptr(), refs.len(), values.as_ptr()), Fmi2Status::Ok);
         assert_eq!(abi::setup_experiment::<Plant>(c, 0, 0.0, 0.0, 0, 0.0), Fmi2Status::Ok);
         assert_eq!(abi::enter_initialization_mode::<Plant>(c), Fmi2Status::Ok);
         assert_eq!(abi::exit_initialization_mode::<Plant>(c), Fmi2Status::Ok);

@@ -96,22 +96,30 @@ pub struct Steering<T> {
 
 /// The steering actually applied at this state and input.
 pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Steering<T> {
-    let zero = T::constant(0.0);
+    steering_commanded(p, s, &clamped_commands(p, u))
+}
+
+/// The steering commands clamped to `+-delta_max` (inputs only: once per held step).
+#[inline(always)]
+fn clamped_commands<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> [T; 4] {
     let dmax = T::constant(p.delta_max);
-    let mut st = Steering { delta: [zero; 4], sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
-    for i in 0..4 {
-        let cmd = u.delta[i].clamp_s(-dmax, dmax);
-        st.delta[i] = if p.steering_servo {
+    u.delta.map(|d| d.clamp_s(-dmax, dmax))
+}
+
+/// [`steering`] from the clamped commands.
+#[inline(always)]
+fn steering_commanded<T: Scalar>(p: &VehicleParams, s: &State<T>, cmd: &[T; 4]) -> Steering<T> {
+    let zero = T::constant(0.0);
+    let mut st = Steering { delta: *cmd, sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
+    if p.steering_servo {
+        let rate = T::constant(p.servo_rate_max);
+        for i in 0..4 {
             let sv = s[idx::SERVO + i];
-            let rate = T::constant(p.servo_rate_max);
-            st.servo_rate[i] = ((cmd - sv) / p.servo_time_constant).clamp_s(-rate, rate);
-            sv
-        } else {
-            cmd
-        };
-        st.sin[i] = st.delta[i].sin();
-        st.cos[i] = st.delta[i].cos();
+            st.servo_rate[i] = ((cmd[i] - sv) / p.servo_time_constant).clamp_s(-rate, rate);
+            st.delta[i] = sv;
+        }
     }
+    (st.sin, st.cos) = T::sin_cos4(st.delta);
     st
 }
 
@@ -181,50 +189,61 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let v_fade_sq = p.v_fade * p.v_fade;
 
     let mut der = [zero; N_STATES];
-    let mut slip_angle = [zero; 4];
-    let mut force_lat = [zero; 4];
-    let mut force_drive = [zero; 4];
-    let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+    der[idx::SERVO..].copy_from_slice(&st.servo_rate);
 
+    // wheel-centre velocities, body frame (u, w) and wheel frame (v_lon, v_lat); the four
+    // wheels go through each stage together (straight-line code the compiler vectorizes)
+    let mut v_lon = [zero; 4];
+    let mut v_lat = [zero; 4];
+    let mut speed_sq = [zero; 4];
     for i in 0..4 {
         let (xi, yi) = pos[i];
         let (sd, cd) = (st.sin[i], st.cos[i]);
-        der[idx::SERVO + i] = st.servo_rate[i];
-        // wheel-centre velocity, body frame and wheel frame
         let ui = v_x - r * yi;
         let wi = v_y + r * xi;
-        let v_lon = ui * cd + wi * sd;
-        let v_lat = wi * cd - ui * sd;
-        let alpha = -v_lat.atan2(v_lon.abs());
-        // min(1, |(u, w)| / v_fade), with the square root only inside the fade zone
-        let speed_sq = ui * ui + wi * wi;
-        let fade = if speed_sq.value() < v_fade_sq { speed_sq.sqrt() / p.v_fade } else { one };
-        let mu = u.mu[i];
-        let mut f_lat = mu * alpha * p.c[i] * fade;
-        let cap = wd.cap[i];
-        let mut f_drive = wd.drive[i];
-        if p.motor_speed_limit && f_drive.value() > 0.0 {
-            let scale = ((T::constant(p.wheel_speed_max) - v_lon) / p.motor_taper).clamp_s(zero, one);
-            f_drive = f_drive * scale;
-        }
-        if p.friction_circle && !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
-            let h = f_drive.hypot(f_lat);
-            if h.value() > cap.value() && h.value() > 0.0 {
-                let k = cap / h;
-                f_drive = f_drive * k;
-                f_lat = f_lat * k;
+        v_lon[i] = ui * cd + wi * sd;
+        v_lat[i] = wi * cd - ui * sd;
+        speed_sq[i] = ui * ui + wi * wi;
+    }
+    let slip_angle = T::atan2x4(v_lat, v_lon.map(T::abs)).map(|a| -a);
+    // lateral force mu alpha C min(1, |(u, w)| / v_fade), the square root only inside the fade zone
+    let mut force_lat: [T; 4] = core::array::from_fn(|i| {
+        let fade = if speed_sq[i].value() < v_fade_sq { speed_sq[i].sqrt() / p.v_fade } else { one };
+        u.mu[i] * slip_angle[i] * p.c[i] * fade
+    });
+    let mut force_drive = wd.drive;
+    if p.motor_speed_limit {
+        for i in 0..4 {
+            if force_drive[i].value() > 0.0 {
+                let scale = ((T::constant(p.wheel_speed_max) - v_lon[i]) / p.motor_taper).clamp_s(zero, one);
+                force_drive[i] = force_drive[i] * scale;
             }
         }
-        let fx = f_drive * cd - f_lat * sd;
-        let fy = f_drive * sd + f_lat * cd;
-        fx_sum = fx_sum + fx;
-        fy_sum = fy_sum + fy;
-        mz = mz + fy * xi - fx * yi;
-        slip_angle[i] = alpha;
-        force_lat[i] = f_lat;
-        force_drive[i] = f_drive;
     }
-    let (sp, cp) = (psi.sin(), psi.cos());
+    if p.friction_circle {
+        for i in 0..4 {
+            let (f_drive, f_lat, cap) = (force_drive[i], force_lat[i], wd.cap[i]);
+            if !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
+                let h = f_drive.hypot(f_lat);
+                if h.value() > cap.value() && h.value() > 0.0 {
+                    let k = cap / h;
+                    force_drive[i] = f_drive * k;
+                    force_lat[i] = f_lat * k;
+                }
+            }
+        }
+    }
+    // wheel-frame forces into body axes, summed in wheel order
+    let fx: [T; 4] = core::array::from_fn(|i| force_drive[i] * st.cos[i] - force_lat[i] * st.sin[i]);
+    let fy: [T; 4] = core::array::from_fn(|i| force_drive[i] * st.sin[i] + force_lat[i] * st.cos[i]);
+    let (mut fx_sum, mut fy_sum, mut mz) = (zero, zero, zero);
+    for i in 0..4 {
+        let (xi, yi) = pos[i];
+        fx_sum = fx_sum + fx[i];
+        fy_sum = fy_sum + fy[i];
+        mz = mz + fy[i] * xi - fx[i] * yi;
+    }
+    let (sp, cp) = psi.sin_cos();
     // world-frame wind (wind_x, wind_y) in body axes: forward = x cos + y sin, left = -x sin + y cos
     let wind_head = u.wind_head - (u.wind_x * cp + u.wind_y * sp);
     let wind_side = u.wind_side + (u.wind_y * cp - u.wind_x * sp);
@@ -276,37 +295,75 @@ fn derivatives_steered(
 
 /// One classical Runge-Kutta step of size `h` with inputs held constant.
 pub fn rk4_step(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64) -> State<f64> {
-    let held = (!p.steering_servo).then(|| steering(p, s, u));
-    rk4(p, s, u, h, held.as_ref(), &wheel_drive(p, u))
+    rk4(p, s, u, h, &HeldSteering::new(p, s, u), &wheel_drive(p, u))
 }
 
+/// What of the steering is constant while the inputs are held: all of it with the servo
+/// off (it depends on the inputs only), the clamped commands with the servo on.
+enum HeldSteering {
+    Fixed(Steering<f64>),
+    Servo([f64; 4]),
+}
+
+impl HeldSteering {
+    #[inline(always)]
+    fn new(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>) -> Self {
+        let cmd = clamped_commands(p, u);
+        if p.steering_servo {
+            HeldSteering::Servo(cmd)
+        } else {
+            HeldSteering::Fixed(steering_commanded(p, s, &cmd))
+        }
+    }
+}
+
+/// One classical RK4 step with the inputs held, for the held steering: one monomorphic
+/// [`rk4_with`] per case, so each inlines its right-hand side.
 #[inline]
 fn rk4(
     p: &VehicleParams,
     s: &State<f64>,
     u: &Inputs<f64>,
     h: f64,
-    held: Option<&Steering<f64>>,
+    held: &HeldSteering,
     wd: &WheelDrive<f64>,
 ) -> State<f64> {
-    let f = |x: &State<f64>| match held {
-        Some(st) => derivatives_steered(p, x, u, st, wd),
-        None => derivatives_steered(p, x, u, &steering(p, x, u), wd),
-    };
-    let add = |a: &State<f64>, k: &State<f64>, c: f64| {
-        let mut o = *a;
-        for j in 0..N_STATES {
-            o[j] += c * k[j];
+    match held {
+        HeldSteering::Fixed(st) => rk4_with(s, h, |x| derivatives_steered(p, x, u, st, wd)),
+        HeldSteering::Servo(cmd) => {
+            rk4_with(s, h, |x| derivatives_steered(p, x, u, &steering_commanded(p, x, cmd), wd))
         }
-        o
-    };
-    let k1 = f(s);
-    let k2 = f(&add(s, &k1, 0.5 * h));
-    let k3 = f(&add(s, &k2, 0.5 * h));
-    let k4 = f(&add(s, &k3, h));
+    }
+}
+
+/// Classical RK4 of `f` over `h`: `s + h/6 (k1 + 2 k2 + 2 k3 + k4)`, the sum accumulated
+/// in that order as the stages come (the same operations as the textbook form, so the same
+/// bits), the stages in a loop so that `f` has one call site.
+#[inline(always)]
+fn rk4_with(s: &State<f64>, h: f64, f: impl Fn(&State<f64>) -> State<f64>) -> State<f64> {
+    let mut sum = [0.0; N_STATES];
+    let mut x = *s;
+    for stage in 0..4 {
+        let k = f(&x);
+        if stage == 0 {
+            sum = k;
+        } else {
+            let weight = if stage == 3 { 1.0 } else { 2.0 };
+            for j in 0..N_STATES {
+                sum[j] += weight * k[j];
+            }
+        }
+        if stage < 3 {
+            let c = if stage < 2 { 0.5 * h } else { h };
+            x = *s;
+            for j in 0..N_STATES {
+                x[j] += c * k[j];
+            }
+        }
+    }
     let mut o = *s;
     for j in 0..N_STATES {
-        o[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        o[j] += h / 6.0 * sum[j];
     }
     o
 }
@@ -317,7 +374,17 @@ fn rk4(
 /// that accumulate time produce) from costing one more sub-step. Callers facing untrusted
 /// `h` and `max_step` check this count before integrating (it can be astronomically large).
 pub fn substeps(h: f64, max_step: f64) -> usize {
-    (h / max_step - 1e-9).ceil().max(1.0) as usize
+    let q = h / max_step - 1e-9;
+    // ceil(q) without a call: baseline x86-64 has no rounding instruction, and `f64::ceil`
+    // costs a libm call per step. Exact for 0 <= q < 2^52 (the truncation is exact there);
+    // anything else (negative, huge, infinite, NaN) takes `ceil` itself.
+    if (0.0..4503599627370496.0).contains(&q) {
+        let truncated = q as u64;
+        let up = truncated + u64::from((truncated as f64) < q);
+        up.max(1) as usize
+    } else {
+        q.ceil().max(1.0) as usize
+    }
 }
 
 /// Real-axis stability limit of classical RK4: `|h lambda| <= 2.785` for a real negative
@@ -371,11 +438,11 @@ pub fn stable_rk4_step(p: &VehicleParams, u: &Inputs<f64>) -> f64 {
 pub fn integrate(p: &VehicleParams, s: &State<f64>, u: &Inputs<f64>, h: f64, max_step: f64) -> State<f64> {
     let n = substeps(h, max_step);
     let dt = h / n as f64;
-    let held = (!p.steering_servo).then(|| steering(p, s, u));
+    let held = HeldSteering::new(p, s, u);
     let wd = wheel_drive(p, u);
     let mut x = *s;
     for _ in 0..n {
-        x = rk4(p, &x, u, dt, held.as_ref(), &wd);
+        x = rk4(p, &x, u, dt, &held, &wd);
         flush_negligible(&mut x);
     }
     x
@@ -416,6 +483,88 @@ mod tests {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// `rk4_step` (held steering, stages in a loop, the sum accumulated as they come) is bit
+    /// for bit the textbook RK4 of `derivatives_of`, in both fidelities.
+    #[test]
+    fn rk4_step_is_the_textbook_rk4_bit_for_bit() {
+        let seed = core::cell::Cell::new(23u64);
+        let uniform = || {
+            let mut v = seed.get();
+            let x = next(&mut v);
+            seed.set(v);
+            x
+        };
+        let r = |scale: f64| scale * (2.0 * uniform() - 1.0);
+        for p in [VehicleParams::table2(), VehicleParams::real_fidelity()] {
+            for _ in 0..2_000 {
+                let mut s = [0.0; N_STATES];
+                s[idx::X] = r(5.0);
+                s[idx::Y] = r(5.0);
+                s[idx::PSI] = r(20.0);
+                s[idx::V_X] = r(1.0);
+                s[idx::V_Y] = r(0.3);
+                s[idx::YAW_RATE] = r(3.0);
+                for i in 0..4 {
+                    s[idx::SERVO + i] = r(1.6);
+                }
+                let mut u = Inputs::coasting(0.2 + uniform());
+                u.delta = [r(2.0), r(2.0), r(2.0), r(2.0)];
+                u.tau = [r(0.05), r(0.05), r(0.05), r(0.05)];
+                u.wind_x = r(0.5);
+                u.wind_side = r(0.5);
+                let h = 1e-4 + 1e-3 * uniform();
+                let f = |x: &State<f64>| derivatives_of(&p, x, &u);
+                let add = |k: &State<f64>, c: f64| core::array::from_fn::<f64, N_STATES, _>(|j| s[j] + c * k[j]);
+                let k1 = f(&s);
+                let k2 = f(&add(&k1, 0.5 * h));
+                let k3 = f(&add(&k2, 0.5 * h));
+                let k4 = f(&add(&k3, h));
+                let want: State<f64> =
+                    core::array::from_fn(|j| s[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]));
+                let got = rk4_step(&p, &s, &u, h);
+                assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "{s:?} {u:?}");
+            }
+        }
+    }
+
+    /// The call-free `ceil` of [`substeps`] is `ceil` exactly: at and around integers, on
+    /// both sides of 2^52, for tiny, negative and non-finite ratios.
+    #[test]
+    fn substeps_equals_the_ceil_formula() {
+        let reference = |h: f64, max_step: f64| (h / max_step - 1e-9).ceil().max(1.0) as usize;
+        let mut seed = 17u64;
+        let mut cases: Vec<(f64, f64)> = vec![
+            (1e-3, 5e-4),
+            (1e-3 + 1e-18, 5e-4),
+            (1e-3 * (1.0 + 1e-12), 5e-4),
+            (1e-3, 1e-3),
+            (0.0, 1e-3),
+            (-1.0, 1e-3),
+            (1e-300, 1.0),
+            (1.0, 1e-300),
+            (f64::INFINITY, 1.0),
+            (f64::NAN, 1.0),
+            (4503599627370496.0, 1.0),
+            (4503599627370495.5, 1.0),
+            (9007199254740993.0, 1.0),
+            (1e20, 1.0),
+        ];
+        for _ in 0..200_000 {
+            let max_step = 10f64.powf(-6.0 * next(&mut seed)) * 1e-3;
+            let k = (next(&mut seed) * 1e4).floor();
+            // multiples of max_step, a few ulps either side, and arbitrary ratios
+            let h = match (next(&mut seed) * 3.0) as u32 {
+                0 => k * max_step,
+                1 => k * max_step * (1.0 + (next(&mut seed) - 0.5) * 1e-12),
+                _ => next(&mut seed) * 1e4 * max_step,
+            };
+            cases.push((h, max_step));
+        }
+        for (h, max_step) in cases {
+            assert_eq!(substeps(h, max_step), reference(h, max_step), "h = {h:e}, max_step = {max_step:e}");
+        }
     }
 
     /// The shortcut decides "inside" only where the exact test (`hypot > cap`) would not

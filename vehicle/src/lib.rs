@@ -9,6 +9,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod dynamics;
+pub mod fastmath;
 pub mod linear;
 pub mod params;
 pub mod scalar;
