@@ -204,6 +204,15 @@ impl<B> VarDecl<B> {
         self
     }
 
+    /// `causality="calculatedParameter" variability="tunable" initial="calculated"`: a
+    /// value the model computes from the parameters (recomputed when a tunable one changes).
+    pub fn calculated_parameter(mut self) -> Self {
+        self.causality = Causality::CalculatedParameter;
+        self.variability = Variability::Tunable;
+        self.initial = Some(Initial::Calculated);
+        self
+    }
+
     /// A calculated continuous output.
     pub fn output(mut self, dependencies: Dependencies) -> Self {
         self.causality = Causality::Output;
@@ -654,6 +663,48 @@ pub fn declared_name(name: String) -> &'static str {
     Box::leak(name.into_boxed_str())
 }
 
+/// The wheels, in the order of every per-wheel array of the models (front-left,
+/// front-right, rear-left, rear-right): the suffixes of the per-wheel variable names.
+pub const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
+
+/// A family of 4 per-wheel variables `{stem}_fl .. {stem}_rr` (in [`WHEELS`] order), with
+/// value references `base .. base + 3` and bindings `binding(i)`; `build(variable, i)`
+/// applies the builder chain to the Real variable of wheel `i`.
+///
+/// `per_wheel("tau", vr::TAU, Var::Torque, |v, _| v.input(Start::Real(0.0)).unit("N.m"))`
+/// declares `tau_fl` (vr `TAU`, `Var::Torque(0)`) .. `tau_rr` (vr `TAU + 3`, `Var::Torque(3)`).
+pub fn per_wheel<B>(
+    stem: &str,
+    base: u32,
+    binding: impl Fn(usize) -> B,
+    build: impl Fn(VarDecl<B>, usize) -> VarDecl<B>,
+) -> Vec<VarDecl<B>> {
+    per_wheel_columns(&[stem], base, |i, _| binding(i), |v, i, _| build(v, i))
+}
+
+/// Per-wheel families stored wheel-major, e.g. a gain matrix with a row per wheel and a
+/// column per `stems[j]`: for each wheel `i` (in [`WHEELS`] order), for each column `j`,
+/// the Real variable `{stems[j]}_{WHEELS[i]}` with value reference
+/// `base + stems.len() * i + j` and binding `binding(i, j)`, built by `build(variable, i, j)`.
+/// With one stem it is [`per_wheel`].
+pub fn per_wheel_columns<B>(
+    stems: &[&str],
+    base: u32,
+    binding: impl Fn(usize, usize) -> B,
+    build: impl Fn(VarDecl<B>, usize, usize) -> VarDecl<B>,
+) -> Vec<VarDecl<B>> {
+    let columns = stems.len();
+    WHEELS
+        .iter()
+        .enumerate()
+        .flat_map(|(i, wheel)| stems.iter().enumerate().map(move |(j, stem)| (i, j, *wheel, *stem)))
+        .map(|(i, j, wheel, stem)| {
+            let name = declared_name(format!("{stem}_{wheel}"));
+            build(VarDecl::real(name, base + (columns * i + j) as u32, binding(i, j)), i, j)
+        })
+        .collect()
+}
+
 /// A unit with base-unit exponents `[kg, m, s, rad]`.
 pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
     md::Unit {
@@ -785,6 +836,68 @@ mod tests {
         assert_eq!(d.row(BaseType::Real, 4), None);
         assert_eq!(md.guid, md.content_guid());
         assert!(d.xml().contains(&md.guid));
+    }
+
+    #[test]
+    fn per_wheel_families_have_the_wheel_names_consecutive_references_and_the_chain() {
+        let torques = per_wheel("tau", 20, |i| 100 + i as u8, |v, i| v.input(Start::Real(i as f64)).unit("N.m"));
+        let names: Vec<&str> = torques.iter().map(|v| v.name).collect();
+        assert_eq!(names, ["tau_fl", "tau_fr", "tau_rl", "tau_rr"]);
+        let vrs: Vec<u32> = torques.iter().map(|v| v.value_reference).collect();
+        assert_eq!(vrs, [20, 21, 22, 23]);
+        let bindings: Vec<u8> = torques.iter().map(|v| v.binding).collect();
+        assert_eq!(bindings, [100, 101, 102, 103]);
+        for (i, v) in torques.iter().enumerate() {
+            assert_eq!(
+                (v.base_type, v.causality, v.variability),
+                (BaseType::Real, Causality::Input, Variability::Continuous)
+            );
+            assert_eq!((v.start, v.unit, v.initial), (Start::Real(i as f64), Some("N.m"), None));
+        }
+
+        // wheel-major matrix: k_a_fl, k_b_fl, k_a_fr, ... at base + 2 i + j
+        let gains = per_wheel_columns(
+            &["k_a", "k_b"],
+            40,
+            |i, j| (10 * i + j) as u8,
+            |v, i, j| v.tunable_parameter(Start::Real((10 * i + j) as f64)),
+        );
+        let rows: Vec<(&str, u32, u8)> = gains.iter().map(|v| (v.name, v.value_reference, v.binding)).collect();
+        assert_eq!(
+            rows,
+            [
+                ("k_a_fl", 40, 0),
+                ("k_b_fl", 41, 1),
+                ("k_a_fr", 42, 10),
+                ("k_b_fr", 43, 11),
+                ("k_a_rl", 44, 20),
+                ("k_b_rl", 45, 21),
+                ("k_a_rr", 46, 30),
+                ("k_b_rr", 47, 31),
+            ]
+        );
+        assert!(gains
+            .iter()
+            .all(|v| v.variability == Variability::Tunable && v.start == Start::Real(v.binding as f64)));
+
+        // a declaration of them is valid, and each is found by its value reference
+        let mut v = toy();
+        v.extend(torques);
+        v.extend(gains);
+        v.push(VarDecl::real("g", 50, 200).calculated_parameter());
+        let mut s = spec(v);
+        s.units.push(si_unit("N.m", 1, 2, -2, 0));
+        let d = Declaration::new(s).unwrap();
+        assert_eq!(d.variable(d.row(BaseType::Real, 23).unwrap()).name, "tau_rr");
+        assert_eq!(d.variable(d.row(BaseType::Real, 45).unwrap()).name, "k_b_rl");
+        let g = d.variable(d.row(BaseType::Real, 50).unwrap());
+        assert_eq!(
+            (g.causality, g.variability, g.initial),
+            (Causality::CalculatedParameter, Variability::Tunable, Some(Initial::Calculated))
+        );
+        // a calculated parameter is an InitialUnknown
+        let g_index = d.row(BaseType::Real, 50).unwrap() as u32 + 1;
+        assert!(d.model_description().model_structure.initial_unknowns.iter().any(|u| u.index == g_index));
     }
 
     #[test]

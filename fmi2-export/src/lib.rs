@@ -127,8 +127,8 @@ pub mod states;
 pub mod uri;
 
 pub use decl::{
-    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec,
-    Dependencies, Initial, Interfaces, Start, VarDecl, Variability,
+    declared_name, enumeration_type, per_wheel, per_wheel_columns, si_unit, BaseType, Capabilities, Causality,
+    Declaration, DeclarationSpec, Dependencies, Initial, Interfaces, Start, VarDecl, Variability, WHEELS,
 };
 pub use instance::Instance;
 pub use log::{LogCategory, Logger};

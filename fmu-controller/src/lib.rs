@@ -29,8 +29,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, si_unit, Capabilities, Causality, Declaration, DeclarationSpec, Dependencies, EventUpdate, Initial,
-    InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl, Variability,
+    declared_name, per_wheel, per_wheel_columns, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies,
+    EventUpdate, InstantiateContext, Interface, Interfaces, Model, ModelResult, Start, VarDecl,
 };
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
@@ -144,9 +144,6 @@ pub const CONTROLLER_ITEMS: &str =
      tunable gains k_beta_* / k_yaw_rate_*), 5 robust_tracking (beyond the paper: the robust tracking gain K_track \
      on the pose errors and the along-track speed correction; reads the pose inputs)";
 
-const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
-const COLUMN: [&str; 2] = ["beta", "yaw_rate"];
-const POSE_COLUMN: [&str; 2] = ["e_y", "e_psi"];
 const POSE_NAMES: [&str; 3] = ["x", "y", "psi"];
 const POSE_UNITS: [&str; 3] = ["m", "m", "rad"];
 
@@ -177,14 +174,9 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .unit("m/s")
             .describe("speed the PI holds"),
     ];
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            VarDecl::real(declared_name(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
-                .input(Start::Real(0.0))
-                .unit("rad")
-                .describe("feed-forward steering (the maneuver's program)"),
-        );
-    }
+    v.extend(per_wheel("delta_ff", vr::DELTA_FF, Var::SteerFeedForward, |d, _| {
+        d.input(Start::Real(0.0)).unit("rad").describe("feed-forward steering (the maneuver's program)")
+    }));
     for (i, (name, unit)) in POSE_NAMES.iter().zip(POSE_UNITS).enumerate() {
         v.push(
             VarDecl::real(name, vr::POSE + i as u32, Var::Pose(i))
@@ -213,25 +205,17 @@ fn build_declaration() -> DeclarationSpec<Var> {
         d.sort_unstable();
         d
     };
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            VarDecl::real(declared_name(format!("delta_{w}")), vr::DELTA + i as u32, Var::Steer(i))
-                .discrete_output(Dependencies::On(steer_deps(i as u32)))
-                .unit("rad")
-                .describe(
-                    "steering command delta_ff + K (x - x_ref) (robust_tracking: delta_ff + K_track e), clamped to \
-                     +-delta_max; held over a sample",
-                ),
-        );
-    }
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            VarDecl::real(declared_name(format!("tau_{w}")), vr::TAU + i as u32, Var::Torque(i))
-                .discrete_output(Dependencies::On(speed_deps.clone()))
-                .unit("N.m")
-                .describe("drive torque F r_wheel / 4; held over a sample"),
-        );
-    }
+    v.extend(per_wheel("delta", vr::DELTA, Var::Steer, |d, i| {
+        d.discrete_output(Dependencies::On(steer_deps(i as u32))).unit("rad").describe(
+            "steering command delta_ff + K (x - x_ref) (robust_tracking: delta_ff + K_track e), clamped to \
+             +-delta_max; held over a sample",
+        )
+    }));
+    v.extend(per_wheel("tau", vr::TAU, Var::Torque, |d, _| {
+        d.discrete_output(Dependencies::On(speed_deps.clone()))
+            .unit("N.m")
+            .describe("drive torque F r_wheel / 4; held over a sample")
+    }));
     v.push(
         VarDecl::real("drive_force", vr::DRIVE_FORCE, Var::DriveForce)
             .discrete_output(Dependencies::On(speed_deps.clone()))
@@ -283,41 +267,22 @@ fn build_declaration() -> DeclarationSpec<Var> {
         }
         v.push(p);
     }
-    for (i, w) in WHEEL.iter().enumerate() {
-        for (j, c) in COLUMN.iter().enumerate() {
-            let r = vr::K_CUSTOM + (2 * i + j) as u32;
-            v.push(
-                VarDecl::real(declared_name(format!("k_{c}_{w}")), r, Var::CustomGain(i, j))
-                    .tunable_parameter(Start::Real(ROBUST[i][j]))
-                    .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
-                    .describe("custom gain (used when controller = custom; tunable between steps)"),
-            );
-        }
-    }
-    for (i, w) in WHEEL.iter().enumerate() {
-        for (j, c) in COLUMN.iter().enumerate() {
-            let r = vr::GAIN_IN_USE + (2 * i + j) as u32;
-            let mut g = VarDecl::real(declared_name(format!("gain_{c}_{w}")), r, Var::GainInUse(i, j))
-                .unit(if j == 0 { "rad/rad" } else { "rad.s/rad" })
-                .describe("the gain in use (from controller and the custom gains)");
-            g.causality = Causality::CalculatedParameter;
-            g.variability = Variability::Tunable;
-            g.initial = Some(Initial::Calculated);
-            v.push(g);
-        }
-    }
-    for (i, w) in WHEEL.iter().enumerate() {
-        for (j, c) in POSE_COLUMN.iter().enumerate() {
-            let r = vr::POSE_GAIN_IN_USE + (2 * i + j) as u32;
-            let mut g = VarDecl::real(declared_name(format!("gain_{c}_{w}")), r, Var::PoseGainInUse(i, j))
-                .unit(if j == 0 { "rad/m" } else { "rad/rad" })
-                .describe("the pose gain in use (K_track's e_y, e_psi columns with robust_tracking, else 0)");
-            g.causality = Causality::CalculatedParameter;
-            g.variability = Variability::Tunable;
-            g.initial = Some(Initial::Calculated);
-            v.push(g);
-        }
-    }
+    // the gains: a row per wheel, a column per state (beta, yaw_rate) or pose error (e_y, e_psi)
+    const GAIN_UNITS: [&str; 2] = ["rad/rad", "rad.s/rad"];
+    const POSE_GAIN_UNITS: [&str; 2] = ["rad/m", "rad/rad"];
+    v.extend(per_wheel_columns(&["k_beta", "k_yaw_rate"], vr::K_CUSTOM, Var::CustomGain, |d, i, j| {
+        d.tunable_parameter(Start::Real(ROBUST[i][j]))
+            .unit(GAIN_UNITS[j])
+            .describe("custom gain (used when controller = custom; tunable between steps)")
+    }));
+    v.extend(per_wheel_columns(&["gain_beta", "gain_yaw_rate"], vr::GAIN_IN_USE, Var::GainInUse, |d, _, j| {
+        d.calculated_parameter().unit(GAIN_UNITS[j]).describe("the gain in use (from controller and the custom gains)")
+    }));
+    v.extend(per_wheel_columns(&["gain_e_y", "gain_e_psi"], vr::POSE_GAIN_IN_USE, Var::PoseGainInUse, |d, _, j| {
+        d.calculated_parameter()
+            .unit(POSE_GAIN_UNITS[j])
+            .describe("the pose gain in use (K_track's e_y, e_psi columns with robust_tracking, else 0)")
+    }));
     v.push(
         VarDecl::integer("controller", vr::CONTROLLER, Var::Controller)
             .parameter(Start::Integer(mode::ROBUST))

@@ -17,8 +17,8 @@ use std::sync::{Arc, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate, InstantiateContext,
-    Interfaces, Model, ModelResult, Start, VarDecl,
+    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
+    InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
 };
 use nigel_benchmark::{
     BenchSample, BenchSampler, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
@@ -96,8 +96,6 @@ pub mod vr {
     pub const MEASUREMENT_NOISE: u32 = 2;
 }
 
-const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
-
 /// Value (1-based) of the Integer parameter `maneuver` for a maneuver, in the order of
 /// [`Maneuver::ALL`]: 1 straight, 2 lane_change, 3 skidpad, 4 fishhook, 5 slalom, 6 figure_8.
 /// The switches are plain Integers, not FMI Enumerations, so that every importer (libcosim
@@ -157,14 +155,9 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .unit("rad/s")
             .describe("the plant's true yaw rate"),
     ];
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            VarDecl::real(declared_name(format!("delta_ff_{w}")), vr::DELTA_FF + i as u32, Var::SteerFeedForward(i))
-                .discrete_output(none())
-                .unit("rad")
-                .describe("the maneuver's steering program (front +f, rear -f)"),
-        );
-    }
+    v.extend(per_wheel("delta_ff", vr::DELTA_FF, Var::SteerFeedForward, |d, _| {
+        d.discrete_output(none()).unit("rad").describe("the maneuver's steering program (front +f, rear -f)")
+    }));
     let outputs: [(&'static str, u32, Var, &'static str, &'static str); 6] = [
         ("beta_ref", vr::BETA_REF, Var::BetaRef, "rad", "reference body slip angle"),
         ("yaw_rate_ref", vr::YAW_RATE_REF, Var::YawRateRef, "rad/s", "reference yaw rate"),
@@ -176,13 +169,9 @@ fn build_declaration() -> DeclarationSpec<Var> {
     for (name, r, b, unit, text) in outputs {
         v.push(VarDecl::real(name, r, b).discrete_output(none()).unit(unit).describe(text));
     }
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            VarDecl::real(declared_name(format!("mu_{w}")), vr::MU + i as u32, Var::Friction(i))
-                .discrete_output(none())
-                .describe("road friction 0.35 sin(2 pi f theta - phi_i) + 0.55 + noise (0.4 when off)"),
-        );
-    }
+    v.extend(per_wheel("mu", vr::MU, Var::Friction, |d, _| {
+        d.discrete_output(none()).describe("road friction 0.35 sin(2 pi f theta - phi_i) + 0.55 + noise (0.4 when off)")
+    }));
     v.push(
         VarDecl::real("wind_x", vr::WIND_X, Var::WindX)
             .discrete_output(none())

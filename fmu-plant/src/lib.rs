@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
 use fmi2_export::{
-    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Initial, InstantiateContext,
-    Interfaces, Model, ModelError, ModelResult, Start, VarDecl,
+    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Initial,
+    InstantiateContext, Interfaces, Model, ModelError, ModelResult, Start, VarDecl, WHEELS,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
@@ -100,7 +100,6 @@ pub enum PlantVar {
     Output(Output),
 }
 
-const WHEEL: [&str; 4] = ["fl", "fr", "rl", "rr"];
 const STATE_NAMES: [&str; N_STATES] =
     ["x", "y", "psi", "v_x", "v_y", "yaw_rate", "servo_angle_fl", "servo_angle_fr", "servo_angle_rl", "servo_angle_rr"];
 /// The body states `x .. yaw_rate`, whose initial values are the parameters `*_start`.
@@ -196,31 +195,24 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
     let real = |name: &'static str, vr: u32, b: PlantVar| VarDecl::real(name, vr, b);
 
     // inputs
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            real(declared_name(format!("delta_{w}")), vr::STEER + i as u32, PlantVar::Input(Input::Steer(i)))
-                .input(Start::Real(0.0))
-                .unit("rad")
-                .describe("steering command, clamped to [-delta_max, delta_max]"),
-        );
-    }
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            real(declared_name(format!("tau_{w}")), vr::TORQUE + i as u32, PlantVar::Input(Input::Torque(i)))
-                .input(Start::Real(0.0))
-                .unit("N.m")
-                .describe("drive torque at the wheel"),
-        );
-    }
-    for (i, w) in WHEEL.iter().enumerate() {
-        v.push(
-            real(declared_name(format!("mu_{w}")), vr::FRICTION + i as u32, PlantVar::Input(Input::Friction(i)))
-                .input(Start::Real(0.4))
-                .min(0.0)
-                .max(MU_MAX)
-                .describe("road-tire friction coefficient, 0 .. 3"),
-        );
-    }
+    v.extend(per_wheel(
+        "delta",
+        vr::STEER,
+        |i| PlantVar::Input(Input::Steer(i)),
+        |d, _| d.input(Start::Real(0.0)).unit("rad").describe("steering command, clamped to [-delta_max, delta_max]"),
+    ));
+    v.extend(per_wheel(
+        "tau",
+        vr::TORQUE,
+        |i| PlantVar::Input(Input::Torque(i)),
+        |d, _| d.input(Start::Real(0.0)).unit("N.m").describe("drive torque at the wheel"),
+    ));
+    v.extend(per_wheel(
+        "mu",
+        vr::FRICTION,
+        |i| PlantVar::Input(Input::Friction(i)),
+        |d, _| d.input(Start::Real(0.4)).min(0.0).max(MU_MAX).describe("road-tire friction coefficient, 0 .. 3"),
+    ));
     v.push(
         real("wind_head", vr::WIND_HEAD, PlantVar::Input(Input::WindHead))
             .input(Start::Real(0.0))
@@ -290,21 +282,19 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             .describe("body-frame lateral acceleration dv_y/dt + r v_x"),
     );
     type Per = (fn(usize) -> Output, u32, &'static str, &'static str, &'static str);
-    let per_wheel: [Per; 4] = [
+    let per_wheel_outputs: [Per; 4] = [
         (Output::SlipAngle, vr::SLIP_ANGLE, "slip_angle", "rad", "tire slip angle"),
         (Output::ForceLat, vr::FORCE_LAT, "force_lat", "N", "lateral tire force (wheel frame)"),
         (Output::ForceDrive, vr::FORCE_DRIVE, "force_drive", "N", "drive force (wheel frame), capped by friction"),
         (Output::SteerApplied, vr::STEER_APPLIED, "delta_applied", "rad", "steering angle actually applied"),
     ];
-    for (make, base, stem, unit, text) in per_wheel {
-        for (i, w) in WHEEL.iter().enumerate() {
-            v.push(
-                real(declared_name(format!("{stem}_{w}")), base + i as u32, PlantVar::Output(make(i)))
-                    .output(Dependencies::On(wheel_knowns(make, i)))
-                    .unit(unit)
-                    .describe(text),
-            );
-        }
+    for (make, base, stem, unit, text) in per_wheel_outputs {
+        v.extend(per_wheel(
+            stem,
+            base,
+            |i| PlantVar::Output(make(i)),
+            |d, i| d.output(Dependencies::On(wheel_knowns(make, i))).unit(unit).describe(text),
+        ));
     }
 
     for i in 0..N_STATES {
@@ -579,7 +569,7 @@ impl Model for Plant {
                 self.params = candidate;
             }
             PlantVar::Input(Input::Friction(i)) if !(0.0..=MU_MAX).contains(&value) => {
-                return Err(format!("mu_{} = {value} refused: friction must be in [0, {MU_MAX}]", WHEEL[i]).into());
+                return Err(format!("mu_{} = {value} refused: friction must be in [0, {MU_MAX}]", WHEELS[i]).into());
             }
             PlantVar::Input(i) => *input_slot(&mut self.inputs, i) = value,
             PlantVar::State(i) => self.state[i] = value,
@@ -622,7 +612,7 @@ impl Model for Plant {
     fn exit_initialization(&mut self) -> ModelResult {
         validate_all(&self.params)?;
         if let Some(i) = self.inputs.mu.iter().position(|m| !(0.0..=MU_MAX).contains(m)) {
-            return Err(format!("mu_{} = {} must be in [0, {MU_MAX}]", WHEEL[i], self.inputs.mu[i]).into());
+            return Err(format!("mu_{} = {} must be in [0, {MU_MAX}]", WHEELS[i], self.inputs.mu[i]).into());
         }
         if !(self.cs_substep_max > 0.0 && self.cs_substep_max.is_finite()) {
             return Err(format!("cs_substep_max = {} must be finite and > 0", self.cs_substep_max).into());
