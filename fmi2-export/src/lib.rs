@@ -15,7 +15,9 @@
 //!    exported only with it, so several FMU crates can be linked into one test binary).
 //! 2. A binding enum (what each value reference stands for) and the declaration: every
 //!    variable once, with causality, start value, unit, min/max, dependencies. Enumerations
-//!    are Integers with a named type ([`VarDecl::enumeration`], [`enumeration_type`]);
+//!    are Integers with a named type ([`VarDecl::enumeration`], [`enumeration_type`]); a
+//!    family of 4 per-wheel variables `{stem}_fl .. {stem}_rr` ([`WHEELS`]) is one call of
+//!    [`per_wheel`] (a row per wheel and a column per stem: [`per_wheel_columns`]);
 //!    capabilities (directional derivatives, FMU state, serialization) are opt-in in
 //!    [`Capabilities`]; interfaces in [`Interfaces`].
 //! 3. `impl Model`: [`Model::declaration`], [`Model::instantiate`], get/set by binding.

@@ -682,3 +682,36 @@ impl Model for Plant {
 
 #[cfg(feature = "fmi-export")]
 fmi2_export::export_fmi2!(Plant);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_export::BaseType;
+
+    /// The layer's wheel names (the suffixes of every per-wheel variable) are the vehicle
+    /// model's wheel order: `mu_rl` is the friction the physics applies to wheel 2.
+    #[test]
+    fn per_wheel_variables_follow_the_vehicle_wheel_order() {
+        assert_eq!(WHEELS, nigel_vehicle::WHEELS);
+        let d = Plant::declaration();
+        let named = |name: &str| d.spec.variables.iter().find(|v| v.name == name).unwrap_or_else(|| panic!("{name}"));
+        for (i, w) in WHEELS.iter().enumerate() {
+            let families: [(&str, u32, PlantVar); 7] = [
+                ("delta", vr::STEER, PlantVar::Input(Input::Steer(i))),
+                ("tau", vr::TORQUE, PlantVar::Input(Input::Torque(i))),
+                ("mu", vr::FRICTION, PlantVar::Input(Input::Friction(i))),
+                ("slip_angle", vr::SLIP_ANGLE, PlantVar::Output(Output::SlipAngle(i))),
+                ("force_lat", vr::FORCE_LAT, PlantVar::Output(Output::ForceLat(i))),
+                ("force_drive", vr::FORCE_DRIVE, PlantVar::Output(Output::ForceDrive(i))),
+                ("delta_applied", vr::STEER_APPLIED, PlantVar::Output(Output::SteerApplied(i))),
+            ];
+            for (stem, base, binding) in families {
+                let v = named(&format!("{stem}_{w}"));
+                assert_eq!((v.value_reference, v.binding), (base + i as u32, binding), "{}", v.name);
+                assert_eq!(d.row(BaseType::Real, base + i as u32).map(|row| d.variable(row).name), Some(v.name));
+            }
+            // the servo state of wheel i is named after the same wheel
+            assert_eq!(named(&format!("servo_angle_{w}")).binding, PlantVar::State(idx::SERVO + i));
+        }
+    }
+}
