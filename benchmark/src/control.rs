@@ -256,7 +256,7 @@ impl ControllerSettings {
 }
 
 /// What the law reads at a sample instant.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ControllerInputs {
     /// Measured body slip angle [rad].
     pub beta: f64,

@@ -492,26 +492,8 @@ impl Benchmark {
     /// The test bench at sample `k` given the plant's true `beta` and `yaw_rate` there;
     /// `None` beyond the reference ([`Benchmark::horizon`]).
     pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
-        let r = &self.reference.trajectory;
-        if k > self.horizon() {
-            return None;
-        }
         let d = self.scenario.disturbances();
-        let (beta_meas, yaw_rate_meas) = d.measure(k, beta, yaw_rate);
-        Some(BenchSample {
-            delta_ff: self.reference.program.steering(k),
-            beta_ref: r.beta[k],
-            yaw_rate_ref: r.yaw_rate[k],
-            speed_ref: self.scenario.speed_ref,
-            x_ref: r.x[k],
-            y_ref: r.y[k],
-            psi_ref: r.psi[k],
-            mu: d.friction(k),
-            wind_x: 0.0,
-            wind_y: d.wind_y(k),
-            beta_meas,
-            yaw_rate_meas,
-        })
+        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind_y(k), d.measure(k, beta, yaw_rate))
     }
 }
 
@@ -552,27 +534,41 @@ impl BenchSampler {
 
     /// [`Benchmark::sample`].
     pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
-        let r = &self.reference.trajectory;
-        if k > self.horizon() {
-            return None;
-        }
         let d = &self.disturbances;
-        let (beta_meas, yaw_rate_meas) = d.measure(k, beta, yaw_rate);
-        Some(BenchSample {
-            delta_ff: self.reference.program.steering(k),
-            beta_ref: r.beta[k],
-            yaw_rate_ref: r.yaw_rate[k],
-            speed_ref: self.scenario.speed_ref,
-            x_ref: r.x[k],
-            y_ref: r.y[k],
-            psi_ref: r.psi[k],
-            mu: d.friction(k),
-            wind_x: 0.0,
-            wind_y: d.wind_y(k),
-            beta_meas,
-            yaw_rate_meas,
-        })
+        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind_y(k), d.measure(k, beta, yaw_rate))
     }
+}
+
+/// The test bench's outputs at sample `k` of `scenario` (`None` past the reference's end):
+/// the program's steering and the reference, with the sample's disturbances (friction
+/// `mu`, wind `wind_y`, the measured `(beta, yaw_rate)`) as given.
+#[inline]
+fn bench_sample(
+    scenario: &Scenario,
+    reference: &Reference,
+    k: usize,
+    mu: [f64; 4],
+    wind_y: f64,
+    (beta_meas, yaw_rate_meas): (f64, f64),
+) -> Option<BenchSample> {
+    let r = &reference.trajectory;
+    if k > r.n_samples() {
+        return None;
+    }
+    Some(BenchSample {
+        delta_ff: reference.program.steering(k),
+        beta_ref: r.beta[k],
+        yaw_rate_ref: r.yaw_rate[k],
+        speed_ref: scenario.speed_ref,
+        x_ref: r.x[k],
+        y_ref: r.y[k],
+        psi_ref: r.psi[k],
+        mu,
+        wind_x: 0.0,
+        wind_y,
+        beta_meas,
+        yaw_rate_meas,
+    })
 }
 
 /// One cell of Table III.

@@ -352,6 +352,42 @@ pub struct Controller {
 }
 
 impl Controller {
+    /// `set_real` of a Real parameter (the settings the law is validated against, and the
+    /// custom gains); the model is unchanged when the value is refused.
+    fn set_real_parameter(&mut self, b: Var, value: f64) -> ModelResult {
+        let s = &mut self.settings;
+        match b {
+            Var::SamplePeriod => {
+                if !(value >= MIN_SAMPLE_PERIOD) {
+                    return Err(format!("sample_period = {value} refused: must be >= {MIN_SAMPLE_PERIOD} s").into());
+                }
+                s.sample_period = value;
+            }
+            Var::KpSpeed => Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?,
+            Var::KiSpeed => Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?,
+            Var::ForceMax => Self::set_parameter(&mut s.force_max, "force_max", value, true)?,
+            Var::WheelRadius => Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?,
+            Var::SteerLimit => Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?,
+            Var::AlongTrackGain => {
+                if !(value >= 0.0) {
+                    return Err(format!("k_along_track = {value} refused: must be >= 0").into());
+                }
+                s.k_along_track = value;
+            }
+            Var::AlongTrackSpeedMax => {
+                if !(value >= 0.0) {
+                    return Err(format!("along_track_speed_max = {value} refused: must be >= 0").into());
+                }
+                s.along_track_speed_max = value;
+            }
+            Var::CustomGain(i, j) => self.custom[i][j] = value,
+            Var::GainInUse(..) | Var::PoseGainInUse(..) => return Err("the gains in use are calculated".into()),
+            Var::Controller => return Err("controller is an Integer, not a Real".into()),
+            _ => return Err(format!("{b:?} is not a Real parameter").into()),
+        }
+        Ok(())
+    }
+
     /// The gain on `[beta - beta_ref, yaw_rate - yaw_rate_ref]` the `controller` parameter
     /// selects (for `robust_tracking` the last two columns of `K_track`).
     pub fn gain_in_use(&self) -> [[f64; 2]; 4] {
@@ -482,21 +518,8 @@ impl Model for Controller {
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         let settings = ControllerSettings { k_along_track: K_ALONG_TRACK, ..ControllerSettings::default() };
         Ok(Controller {
-            inputs: ControllerInputs {
-                beta: 0.0,
-                yaw_rate: 0.0,
-                speed: 0.0,
-                beta_ref: 0.0,
-                yaw_rate_ref: 0.0,
-                speed_ref: 0.0,
-                delta_ff: [0.0; 4],
-                x: 0.0,
-                y: 0.0,
-                psi: 0.0,
-                x_ref: 0.0,
-                y_ref: 0.0,
-                psi_ref: 0.0,
-            },
+            // every input 0 until the layer applies the declared start values
+            inputs: ControllerInputs::default(),
             settings,
             custom: ROBUST,
             mode: mode::ROBUST,
@@ -523,9 +546,7 @@ impl Model for Controller {
     }
 
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
-        self.unattended = 0;
         let x = &mut self.inputs;
-        let s = &mut self.settings;
         match b {
             Var::Beta => x.beta = value,
             Var::YawRate => x.yaw_rate = value,
@@ -534,66 +555,25 @@ impl Model for Controller {
             Var::YawRateRef => x.yaw_rate_ref = value,
             Var::SpeedRef => x.speed_ref = value,
             Var::SteerFeedForward(i) => x.delta_ff[i] = value,
-            // held outputs come back through here when an FMU state is restored
-            Var::Steer(i) => self.held.delta[i] = value,
-            Var::Torque(i) => self.held.tau[i] = value,
-            Var::DriveForce => self.held.force = value,
-            Var::SpeedIntegral => self.integral = value,
-            // a parameter: the law is validated again at its next use
-            Var::SamplePeriod => {
-                self.validated = None;
-                if !(value >= MIN_SAMPLE_PERIOD) {
-                    return Err(format!("sample_period = {value} refused: must be >= {MIN_SAMPLE_PERIOD} s").into());
-                }
-                s.sample_period = value;
-            }
-            Var::KpSpeed => {
-                self.validated = None;
-                Self::set_parameter(&mut s.kp_speed, "kp_speed", value, false)?
-            }
-            Var::KiSpeed => {
-                self.validated = None;
-                Self::set_parameter(&mut s.ki_speed, "ki_speed", value, false)?
-            }
-            Var::ForceMax => {
-                self.validated = None;
-                Self::set_parameter(&mut s.force_max, "force_max", value, true)?
-            }
-            Var::WheelRadius => {
-                self.validated = None;
-                Self::set_parameter(&mut s.r_wheel, "r_wheel", value, true)?
-            }
-            Var::SteerLimit => {
-                self.validated = None;
-                Self::set_parameter(&mut s.delta_max, "delta_max", value, true)?
-            }
-            Var::CustomGain(i, j) => {
-                self.validated = None;
-                self.custom[i][j] = value;
-            }
-            Var::GainInUse(..) | Var::PoseGainInUse(..) => return Err("the gains in use are calculated".into()),
             Var::Pose(0) => x.x = value,
             Var::Pose(1) => x.y = value,
             Var::Pose(_) => x.psi = value,
             Var::PoseRef(0) => x.x_ref = value,
             Var::PoseRef(1) => x.y_ref = value,
             Var::PoseRef(_) => x.psi_ref = value,
-            Var::AlongTrackGain => {
+            // held outputs come back through here when an FMU state is restored
+            Var::Steer(i) => self.held.delta[i] = value,
+            Var::Torque(i) => self.held.tau[i] = value,
+            Var::DriveForce => self.held.force = value,
+            Var::SpeedIntegral => self.integral = value,
+            // a parameter: the law is validated again at its next use
+            _ => {
+                self.set_real_parameter(b, value)?;
                 self.validated = None;
-                if !(value >= 0.0) {
-                    return Err(format!("k_along_track = {value} refused: must be >= 0").into());
-                }
-                s.k_along_track = value;
             }
-            Var::AlongTrackSpeedMax => {
-                self.validated = None;
-                if !(value >= 0.0) {
-                    return Err(format!("along_track_speed_max = {value} refused: must be >= 0").into());
-                }
-                s.along_track_speed_max = value;
-            }
-            Var::Controller => return Err("controller is an Integer, not a Real".into()),
         }
+        // only an accepted set counts as the importer attending (a refused one changes nothing)
+        self.unattended = 0;
         Ok(())
     }
 

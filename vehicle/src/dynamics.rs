@@ -476,14 +476,7 @@ pub fn straight_running(v: f64) -> State<f64> {
 mod tests {
     use super::*;
 
-    /// SplitMix64, for reproducible test points.
-    fn next(state: &mut u64) -> f64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::test_rng::next_unit as next;
 
     /// `rk4_step` (held steering, stages in a loop, the sum accumulated as they come) is bit
     /// for bit the textbook RK4 of `derivatives_of`, in both fidelities.

@@ -245,17 +245,7 @@ fn sin_cos_octant(x: f64) -> (f64, f64, u64) {
 mod tests {
     use super::*;
 
-    /// SplitMix64.
-    fn next(state: &mut u64) -> u64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(state: &mut u64) -> f64 {
-        (next(state) >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::test_rng::{next_u64 as next, next_unit as uniform};
 
     /// Distance in units in the last place, through the ordered integer images of the
     /// values (so across a power of two it counts the representable numbers in between).

@@ -13,6 +13,8 @@ pub mod fastmath;
 pub mod linear;
 pub mod params;
 pub mod scalar;
+#[cfg(test)]
+mod test_rng;
 pub mod tracking;
 
 pub use dynamics::{
