@@ -327,8 +327,20 @@ impl Disturbances {
         if !self.measurement_noise {
             return (beta, yaw_rate);
         }
-        (beta + 0.005 * g(self.seed, STREAM_BETA, k as u64), yaw_rate + 0.01 * g(self.seed, STREAM_YAW_RATE, k as u64))
+        with_noise(beta, yaw_rate, measurement_noise(self.seed, k))
     }
+}
+
+/// The unscaled measurement noise of sample `k`: `g(seed, 5, k)`, `g(seed, 6, k)`.
+#[inline]
+fn measurement_noise(seed: u64, k: usize) -> [f64; 2] {
+    [g(seed, STREAM_BETA, k as u64), g(seed, STREAM_YAW_RATE, k as u64)]
+}
+
+/// `(beta + 0.005 noise_0, r + 0.01 noise_1)`: what the controller measures.
+#[inline]
+fn with_noise(beta: f64, yaw_rate: f64, noise: [f64; 2]) -> (f64, f64) {
+    (beta + 0.005 * noise[0], yaw_rate + 0.01 * noise[1])
 }
 
 /// How many seeds' disturbance tables [`DisturbanceSequence::new`] keeps for the process.
@@ -360,11 +372,7 @@ impl DisturbanceTable {
     fn compute(seed: u64, len: usize) -> Self {
         let on = Disturbances { seed, friction_variation: true, wind: true, measurement_noise: true };
         let rows = (0..len)
-            .map(|k| DisturbanceRow {
-                mu: on.friction(k),
-                wind_y: on.wind_y(k),
-                noise: [g(seed, STREAM_BETA, k as u64), g(seed, STREAM_YAW_RATE, k as u64)],
-            })
+            .map(|k| DisturbanceRow { mu: on.friction(k), wind_y: on.wind_y(k), noise: measurement_noise(seed, k) })
             .collect();
         DisturbanceTable { seed, rows }
     }
@@ -474,8 +482,7 @@ impl DisturbanceSequence {
             return (beta, yaw_rate);
         }
         match self.row(k) {
-            // the same expression as `Disturbances::measure`, on the same Gaussians
-            Some(row) => (beta + 0.005 * row.noise[0], yaw_rate + 0.01 * row.noise[1]),
+            Some(row) => with_noise(beta, yaw_rate, row.noise),
             None => self.disturbances.measure(k, beta, yaw_rate),
         }
     }

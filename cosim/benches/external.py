@@ -10,7 +10,7 @@ import time
 
 # the drivers and epsilon are shared with the cross-checks (cosim/tests/python)
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "python"))
-from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series  # noqa: E402
+from closed_loop_tools import POSE, bound_parameters, ecos_series, epsilon, libcosim_series  # noqa: E402
 
 ssp = sys.argv[1]
 N = 30000
@@ -61,23 +61,9 @@ except Exception as e:
     print("libcosim:", repr(e))
 
 try:
-    from fmpy.ssp.simulation import find_components, simulate_ssp
-    from fmpy.ssp.ssd import Parameter, ParameterSet, read_ssd
+    from fmpy.ssp.simulation import simulate_ssp
 
-    # fmpy applies no SSD bindings itself: they are passed as a typed parameter set
-    params = []
-    for c in find_components(read_ssd(ssp).system):
-        for binding in c.parameterBindings:
-            for values in binding.parameterValues:
-                for p in values.parameters:
-                    if p.type == "Boolean":
-                        v = str(p.value).strip().lower() in ("true", "1")
-                    elif p.type in ("Integer", "Enumeration"):
-                        v = int(p.value)
-                    else:
-                        v = float(p.value)
-                    params.append(Parameter(name=f"{c.name}.{p.name}", type=p.type, value=v))
-    ps = ParameterSet(name="bindings", parameters=params)
+    ps = bound_parameters(ssp)
     t = time.perf_counter()
     r = simulate_ssp(ssp, stop_time=30.0, step_size=1e-3, parameter_set=ps)
     dt = time.perf_counter() - t

@@ -33,6 +33,18 @@ fn target() -> PathBuf {
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"))
 }
 
+/// `n` instances `g0 .. g(n-1)` of `fmu`, each output `y` feeding the next one's input `u`.
+fn chain_of(fmu: &std::sync::Arc<Fmu>, n: usize) -> System {
+    let mut b = SystemBuilder::new();
+    for i in 0..n {
+        b.add_instance(&format!("g{i}"), fmu.clone()).unwrap();
+        if i > 0 {
+            b.connect(&format!("g{}.y", i - 1), &format!("g{i}.u")).unwrap();
+        }
+    }
+    b.build()
+}
+
 fn best_of<F: FnMut() -> Duration>(n: usize, mut f: F) -> Duration {
     (0..n).map(|_| f()).min().unwrap_or_default()
 }
@@ -215,14 +227,7 @@ fn main() {
     let gain = Fmu::load(&c_gain(&dir, "gain", &[])).unwrap();
     let heavy = Fmu::load(&c_gain(&dir, "gain_work", &["-DWORK=400"])).unwrap();
     let n = 10;
-    let mut b = SystemBuilder::new();
-    for i in 0..n {
-        b.add_instance(&format!("g{i}"), gain.clone()).unwrap();
-        if i > 0 {
-            b.connect(&format!("g{}.y", i - 1), &format!("g{i}.u")).unwrap();
-        }
-    }
-    let chain = b.build();
+    let chain = chain_of(&gain, n);
     for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
         let d = run_master(&chain, algorithm, 1, Some(vec![]), false);
         println!(
@@ -233,14 +238,7 @@ fn main() {
     }
     // threads: the same chains, trivial and heavier
     for (what, fmu) in [("trivial", &gain), ("heavier (WORK=400)", &heavy)] {
-        let mut b = SystemBuilder::new();
-        for i in 0..n {
-            b.add_instance(&format!("g{i}"), fmu.clone()).unwrap();
-            if i > 0 {
-                b.connect(&format!("g{}.y", i - 1), &format!("g{i}.u")).unwrap();
-            }
-        }
-        let chain = b.build();
+        let chain = chain_of(fmu, n);
         let one = run_master(&chain, Algorithm::Jacobi, 1, Some(vec![]), false);
         let two = run_master(&chain, Algorithm::Jacobi, 2, Some(vec![]), false);
         println!(

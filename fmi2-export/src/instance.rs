@@ -533,9 +533,8 @@ impl<M: Model> Instance<M> {
             }
             return Ok(());
         }
+        // here n >= 2 and some value may be refused: the earlier values, for the way back
         let Some(&first) = values.first() else { return Ok(()) };
-        // the earlier values, for the way back (one value needs none: a refused set
-        // leaves the model unchanged)
         let mut earlier = [first; SET_UNDO_CAPACITY];
         // from this index on, the way back is a copy of the model (when a getter failed or
         // the call is longer than `earlier`)
@@ -543,7 +542,7 @@ impl<M: Model> Instance<M> {
         for k in 0..n {
             let row = Self::row_in(d, base_type, vrs[k])?;
             let binding = d.hot(row).binding;
-            if n > 1 && copy.is_none() {
+            if copy.is_none() {
                 match (k < SET_UNDO_CAPACITY).then(|| read(&mut self.core.model, binding)) {
                     Some(Ok(old)) => earlier[k] = old,
                     _ => copy = Some((k, self.core.model.clone())),

@@ -100,6 +100,19 @@ fn fmi_rs_load(id: &str) -> fmi_rs::fmi2::builder::FMU2Builder {
     fmi_rs::fmi2::builder::FMU2Builder::new(&archive(id)).unwrap_or_else(|e| panic!("{id}: fmi-rs: {e}"))
 }
 
+/// The archive's modelDescription as fmi-rs's simulators take it, and a recorder of every
+/// output (fmi-rs's own `Trajectories`).
+fn description_and_recorder(builder: &fmi_rs::fmi2::builder::FMU2Builder) -> (Arc<RsModelDescription>, Arc<Recorder>) {
+    let md = Arc::new(
+        fmi_rs::model_description::fmi2::ModelDescription::from_path(
+            &builder.unzipdir.path().join("modelDescription.xml"),
+        )
+        .unwrap(),
+    );
+    let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), output_indices(&md))));
+    (md, recorder)
+}
+
 fn problems(md: &RsModelDescription) -> Vec<String> {
     md.validate().into_iter().map(|p| p.message).collect()
 }
@@ -223,13 +236,7 @@ fn co_simulation_through_fmi_rs_equals_nigel_cosim_bit_for_bit() {
     for (id, starts, stop) in cases() {
         // fmi-rs: its unzip, its driver, its recorder
         let builder = fmi_rs_load(id);
-        let md = Arc::new(
-            fmi_rs::model_description::fmi2::ModelDescription::from_path(
-                &builder.unzipdir.path().join("modelDescription.xml"),
-            )
-            .unwrap(),
-        );
-        let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), output_indices(&md))));
+        let (md, recorder) = description_and_recorder(&builder);
         fmi_rs::sim::fmi2::cs::simulate(&settings(&builder, md.clone(), &starts, stop), None, recorder.clone())
             .unwrap_or_else(|e| panic!("{id}: fmi-rs simulate: {e}"));
         let trajectories = Arc::into_inner(recorder).unwrap().into_trajectories();
@@ -261,13 +268,7 @@ fn model_exchange_through_fmi_rs_euler_equals_euler_over_nigel_cosim() {
 
     // fmi-rs: Model Exchange driver, forward Euler with h = STEP
     let builder = fmi_rs_load(id);
-    let md = Arc::new(
-        fmi_rs::model_description::fmi2::ModelDescription::from_path(
-            &builder.unzipdir.path().join("modelDescription.xml"),
-        )
-        .unwrap(),
-    );
-    let recorder = Arc::new(Recorder::new(Trajectories::new(md.clone(), output_indices(&md))));
+    let (md, recorder) = description_and_recorder(&builder);
     fmi_rs::sim::fmi2::me::simulate(
         &settings(&builder, md.clone(), &starts, stop),
         &ForwardEulerFactory { fixed_step_size: STEP },

@@ -178,18 +178,31 @@ pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> P
     fmu
 }
 
-/// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
-pub fn build_ball(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/ball.c");
-    let so = dir.join("ball.so");
+/// Compiles `tests/cfmu/<id>.c` and packs it with `xml` as `<dir>/<id>.fmu`.
+fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cfmu/{id}.c"));
+    let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
-        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden"])
+        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
         .arg(&src)
         .arg("-o")
         .arg(&so)
         .status()
         .expect("run cc");
-    assert!(status.success());
+    assert!(status.success(), "cc failed for {}", src.display());
+    let fmu = dir.join(format!("{id}.fmu"));
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", xml.as_bytes().to_vec()),
+            (&format!("binaries/linux64/{id}.so"), std::fs::read(&so).unwrap()),
+        ],
+    );
+    fmu
+}
+
+/// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
+pub fn build_ball(dir: &Path) -> PathBuf {
     let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="ball" guid="{ball}" numberOfEventIndicators="1">
   <ModelExchange modelIdentifier="ball"/>
@@ -209,26 +222,11 @@ pub fn build_ball(dir: &Path) -> PathBuf {
   </ModelStructure>
 </fmiModelDescription>
 "#;
-    let fmu = dir.join("ball.fmu");
-    zip_entries(
-        &fmu,
-        &[("modelDescription.xml", xml.as_bytes().to_vec()), ("binaries/linux64/ball.so", std::fs::read(&so).unwrap())],
-    );
-    fmu
+    build_single_c_fmu(dir, "ball", xml)
 }
 
 /// The discrete latch (tests/cfmu/latch.c), Model Exchange only, as `<dir>/latch.fmu`.
 pub fn build_latch(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/latch.c");
-    let so = dir.join("latch.so");
-    let status = Command::new("cc")
-        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
-        .arg(&src)
-        .arg("-o")
-        .arg(&so)
-        .status()
-        .expect("run cc");
-    assert!(status.success());
     let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="latch" guid="{latch}" numberOfEventIndicators="0">
   <ModelExchange modelIdentifier="latch"/>
@@ -245,13 +243,5 @@ pub fn build_latch(dir: &Path) -> PathBuf {
   </ModelStructure>
 </fmiModelDescription>
 "#;
-    let fmu = dir.join("latch.fmu");
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            ("binaries/linux64/latch.so", std::fs::read(&so).unwrap()),
-        ],
-    );
-    fmu
+    build_single_c_fmu(dir, "latch", xml)
 }

@@ -84,3 +84,24 @@ def ecos_series(ssp, step_size, steps, names, parameter_set=None):
             series[name].append(sim.get_real(name.replace(".", "::")))
     sim.terminate()
     return series
+
+
+def bound_parameters(path):
+    """The SSD's inline parameter bindings as one typed fmpy ParameterSet (`component.variable`):
+    fmpy's `simulate_ssp` applies no SSD bindings itself."""
+    from fmpy.ssp.simulation import find_components
+    from fmpy.ssp.ssd import Parameter, ParameterSet, read_ssd
+
+    params = []
+    for c in find_components(read_ssd(str(path)).system):
+        for binding in c.parameterBindings:
+            for values in binding.parameterValues:
+                for p in values.parameters:
+                    if p.type == "Boolean":
+                        v = str(p.value).strip().lower() in ("true", "1")
+                    elif p.type in ("Integer", "Enumeration"):
+                        v = int(p.value)
+                    else:
+                        v = float(p.value)
+                    params.append(Parameter(name=f"{c.name}.{p.name}", type=p.type, value=v))
+    return ParameterSet(name="bindings", parameters=params)

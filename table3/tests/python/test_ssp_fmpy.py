@@ -29,9 +29,9 @@ import types
 
 import fmpy.ssp.simulation as fmpy_ssp
 from fmpy.ssp.simulation import find_components, simulate_ssp
-from fmpy.ssp.ssd import Parameter, ParameterSet, get_connections, read_ssd
+from fmpy.ssp.ssd import get_connections, read_ssd
 
-from closed_loop_tools import target_dir
+from closed_loop_tools import bound_parameters, target_dir
 
 JOB = "sim/lane_change/robust"
 
@@ -53,23 +53,6 @@ def ours(table3, tmp_path_factory):
         rows = np.genfromtxt(d / alg / "sim_lane_change_robust.csv", delimiter=",", names=True)
         out[alg] = (cells["robust"]["eps"], rows)
     return out
-
-
-def bound_parameters(path):
-    """The SSD's inline parameter bindings as one typed ParameterSet (`component.variable`)."""
-    params = []
-    for c in find_components(read_ssd(str(path)).system):
-        for binding in c.parameterBindings:
-            for values in binding.parameterValues:
-                for p in values.parameters:
-                    if p.type == "Boolean":
-                        v = str(p.value).strip().lower() in ("true", "1")
-                    elif p.type in ("Integer", "Enumeration"):
-                        v = int(p.value)
-                    else:
-                        v = float(p.value)
-                    params.append(Parameter(name=f"{c.name}.{p.name}", type=p.type, value=v))
-    return ParameterSet(name="bindings", parameters=params)
 
 
 @pytest.fixture(scope="module")
