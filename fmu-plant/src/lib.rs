@@ -18,6 +18,9 @@ use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehiclePa
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
 
+/// The equations and the initial state, for `documentation/index.html`.
+pub const DOCUMENTATION: &str = include_str!("documentation.html");
+
 /// Largest number of RK4 sub-steps one `fmi2DoStep` may take (about 10 s of computing);
 /// a longer step is refused instead of hanging the importer.
 pub const MAX_SUBSTEPS_PER_STEP: usize = 10_000_000;
