@@ -23,11 +23,9 @@
 
 #![warn(missing_docs)]
 
-mod coupled;
 pub mod error;
 pub mod fmu;
 pub mod me;
-mod parallel;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
