@@ -2,7 +2,7 @@
 //! [`nigel_benchmark::SampledController`], behind the shared FMI 2.0 layer. This file is
 //! only the binding: the declaration of the variables and a small [`Model`] impl.
 //!
-//! Beyond the paper (issue 9), `controller = robust_tracking` (the last item, 5) feeds back
+//! Beyond the paper, `controller = robust_tracking` (the last item, 5) feeds back
 //! the pose too: the inputs `x, y, psi` (the measured pose, e.g. the plant's outputs) and
 //! `x_ref, y_ref, psi_ref` (the test bench's reference pose) give the tracking errors of
 //! `nigel_vehicle::tracking` (heading difference wrapped to `(-pi, pi]`, so unwrapped

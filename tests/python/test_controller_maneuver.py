@@ -431,7 +431,7 @@ def test_bench_bad_input(bench, capsys):
 
 # (column, maneuver, controller, epsilon) seed 0: the robust controller's from the
 # independent implementation of docs/benchmark.md (the self-check table of
-# benchmark/tests/table3.rs); robust_tracking's (issue 9, pose feedback; None here) computed
+# benchmark/tests/table3.rs); robust_tracking's (pose feedback; None here) computed
 # when the test runs by nigel_benchmark in process (`table3 --engine in-process`), which this
 # loop, written here without our master, must reproduce through the FMUs' pose inputs.
 CLOSED_LOOP_CELLS = [

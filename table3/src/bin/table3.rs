@@ -2,7 +2,7 @@
 //! by the master (`ordered`, 1 ms, 30 s), or in process as a cross-check.
 //!
 //! `table3 [--seed N] [--json PATH] [--png DIR] [--csv DIR] [--threads N]`
-//! `table3 --seeds 0..9 [--engine in-process]`: the seed study of issue 9 (the ratio
+//! `table3 --seeds 0..9 [--engine in-process]`: the seed study (the ratio
 //! `eps(robust_tracking) / eps(robust)` per cell and seed, the largest steering command).
 
 use std::io::IsTerminal;

@@ -182,7 +182,7 @@ impl FmuEngine {
     }
 
     /// The system of one job: three instances `plant`, `controller`, `maneuver`, their
-    /// parameters and the closed-loop connections of the issue-6 contract.
+    /// parameters and the closed-loop connections (docs/closed-loop.svg).
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
         // the controller FMU's switch value; a custom gain runs as `custom` with its k_* set
