@@ -164,7 +164,7 @@ def test_robust_gain_is_the_synthesis_one(ctl):
     s = initialized(ctl)
     try:
         k = gains_in_use(s, ctl)
-        readme = [[-0.16066, -0.31042], [-0.16066, -0.31042], [-0.14798, 0.40928], [-0.14798, 0.40928]]
+        readme = [[-0.16067, -0.31042], [-0.16067, -0.31042], [-0.14797, 0.40928], [-0.14797, 0.40928]]
         assert np.allclose(k, readme, atol=5e-6), k
     finally:
         s.freeInstance()
