@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use crate::decl::Declaration;
 use crate::log::Logger;
+use crate::sampled::SampleEnd;
 
 /// What the model learns at instantiation.
 #[derive(Clone, Debug)]
@@ -168,6 +169,27 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// sample instant. Default: no events.
     fn event_update(&mut self, _time: f64) -> ModelResult<EventUpdate> {
         Ok(EventUpdate::default())
+    }
+
+    /// A sampled model's period [s] ([`crate::sampled`]): the layer then keeps the sample
+    /// clock and calls [`Model::sample`] instead of [`Model::event_update`]. Read when
+    /// initialization ends (a period parameter is fixed from then on). Default: not sampled.
+    fn sample_period(&self) -> Option<f64> {
+        None
+    }
+
+    /// The last sample of a sampled model, if it has one (a reference of finite length).
+    fn sample_end(&self) -> Option<SampleEnd> {
+        None
+    }
+
+    /// Sample `k` at `time` = start + k period, with the inputs and tunable parameters of
+    /// that instant: compute and latch the held outputs. Before sample 0 has run, the
+    /// layer answers reads of the discrete outputs by running sample 0 on a copy of the
+    /// model (in Initialization Mode too: `sample(0, ..)` must then work with the
+    /// parameters alone).
+    fn sample(&mut self, _k: u64, _time: f64) -> ModelResult {
+        Ok(())
     }
 
     /// Co-Simulation: advance the continuous states from `time` by `step` with inputs held.
