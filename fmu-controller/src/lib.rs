@@ -202,10 +202,19 @@ fn build_declaration() -> DeclarationSpec<Var> {
         d.sort_unstable();
         d
     };
-    // the along-track error reads x, y and the reference pose (not psi)
+    // the along-track error reads x, y and the reference pose (not psi); the PI its integrator
+    // (a known in Initialization Mode only: the layer keeps it out of the Outputs list)
     let speed_deps = {
-        let mut d =
-            vec![vr::SPEED, vr::SPEED_REF, vr::POSE, vr::POSE + 1, vr::POSE_REF, vr::POSE_REF + 1, vr::POSE_REF + 2];
+        let mut d = vec![
+            vr::SPEED,
+            vr::SPEED_REF,
+            vr::POSE,
+            vr::POSE + 1,
+            vr::POSE_REF,
+            vr::POSE_REF + 1,
+            vr::POSE_REF + 2,
+            vr::SPEED_INTEGRAL,
+        ];
         d.sort_unstable();
         d
     };
