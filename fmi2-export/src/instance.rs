@@ -954,6 +954,44 @@ impl<M: Model> Instance<M> {
                 .map(|r| decl::<M>().variable(r).binding)
                 .ok_or_else(|| format!("unknown Real value reference {vr}").into())
         };
+        let d = decl::<M>();
+        let initialization = self.core.machine == Machine::InitializationMode;
+        for &vr in knowns {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let v = d.variable(row);
+            // the knowns of FMI 2.0 section 2.2.8: inputs and continuous states, and in
+            // Initialization Mode the variables with initial="exact" (a state calculated
+            // from its start value stays a known there too: its partials are defined)
+            let known = v.causality == Causality::Input
+                || d.state_rows.contains(&row)
+                || (initialization && v.initial == Some(Initial::Exact));
+            if !known {
+                return err(format!(
+                    "known {} is not an input, a continuous state or (in Initialization Mode) exact",
+                    v.name
+                ));
+            }
+            if !M::provides_derivative_with_respect_to(v.binding, initialization) {
+                return err(format!(
+                    "derivatives with respect to {} are not provided ({} in Initialization Mode)",
+                    v.name,
+                    if initialization {
+                        "only inputs, continuous states and their start values"
+                    } else {
+                        "only inputs and continuous states"
+                    }
+                ));
+            }
+        }
+        for &vr in unknowns {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let v = d.variable(row);
+            let unknown =
+                v.causality == Causality::Output || d.state_rows.contains(&row) || d.derivative_rows.contains(&row);
+            if !unknown {
+                return err(format!("unknown {} is not an output, a continuous state or a derivative", v.name));
+            }
+        }
         let u: Vec<_> = unknowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
         let k: Vec<_> = knowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
         self.core.model.directional_derivative(&u, &k, dv_known, out)?;

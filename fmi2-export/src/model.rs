@@ -207,8 +207,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Model Exchange: the importer's time (for time-dependent models).
     fn set_time(&mut self, _time: f64) {}
 
+    /// Whether [`Model::directional_derivative`] takes `known` as a known (the layer has
+    /// checked that it is one of the current mode: an input, a continuous state, or in
+    /// Initialization Mode a variable with `initial="exact"`); if not, the layer refuses the
+    /// call naming the variable. Default: every known.
+    fn provides_derivative_with_respect_to(_known: Self::Binding, _initialization: bool) -> bool {
+        true
+    }
+
     /// Exact directional derivative `dv_unknown = J dv_known`, J = d unknowns / d knowns.
-    /// Called only when the declaration opts in to `directional_derivatives`.
+    /// Called only when the declaration opts in to `directional_derivatives`, with knowns
+    /// and unknowns the layer checked (see [`Model::provides_derivative_with_respect_to`]).
     fn directional_derivative(
         &mut self,
         _unknowns: &[Self::Binding],
