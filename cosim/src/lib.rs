@@ -25,13 +25,15 @@
 
 pub mod error;
 pub mod fmu;
+pub mod isolate;
 pub mod me;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
 pub mod unpack;
 
-pub use error::{Error, Result, Status};
+pub use error::{Error, HostEnd, Result, Status};
+pub use isolate::Isolation;
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use me::{Event, Solver};
 pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};
