@@ -23,12 +23,14 @@
 
 #![warn(missing_docs)]
 
+mod elf;
 pub mod error;
 pub mod fmu;
 pub mod isolate;
 pub mod me;
 pub mod simulate;
 pub mod ssp;
+pub(crate) mod suggest;
 pub mod system;
 pub mod unpack;
 
