@@ -93,6 +93,7 @@ struct RunArgs {
 }
 
 fn main() -> ExitCode {
+    nigel_cosim::unpack::remove_on_signals();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
