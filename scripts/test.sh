@@ -28,6 +28,8 @@ export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 echo "== Rust tests"
 cargo test --release --workspace
+echo "== synthesis tests under two more OpenBLAS kernels"
+bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"
 "$target_dir/venv/bin/python" -m pytest tests/python -q
 echo "== co-simulation master cross-checks"
