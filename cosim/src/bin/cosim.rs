@@ -80,6 +80,11 @@ struct RunArgs {
     /// Start value or parameter: instance.variable=value (or variable=value for one FMU).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
+    /// Run the closed loop's `controller` instance with one's own gain: a `synthesize --json`
+    /// report (its "K", rows FL, FR, RL, RR, columns beta, r). Sets `controller.controller=4`
+    /// (custom) and `controller.k_beta_*`, `controller.k_yaw_rate_*`; `--set` applies after it.
+    #[arg(long, value_name = "K.json")]
+    gains: Option<PathBuf>,
     /// Variables to record (default: all outputs), repeatable.
     #[arg(long = "record", value_name = "NAME")]
     record: Vec<String>,
@@ -130,6 +135,20 @@ fn progress(fraction: f64) {
     }
 }
 
+/// The `--set`s that run the controller FMU of the closed loop with the gain of a
+/// `synthesize --json` report: `controller = 4` (custom) and the eight `k_*` parameters.
+fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let k = nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
+    let mut sets = vec![("controller.controller".to_string(), "4".to_string())];
+    for (row, wheel) in k.iter().zip(["fl", "fr", "rl", "rr"]) {
+        // `{:?}` prints the shortest decimal that reads back to the same f64
+        sets.push((format!("controller.k_beta_{wheel}"), format!("{:?}", row[0])));
+        sets.push((format!("controller.k_yaw_rate_{wheel}"), format!("{:?}", row[1])));
+    }
+    Ok(sets)
+}
+
 fn run(args: RunArgs) -> Result<(), Error> {
     let interface = match args.interface.as_deref() {
         None => None,
@@ -150,6 +169,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         builder.add_instance(SINGLE, fmu)?;
         (builder, default.stop_time, default.step_size, true, None)
     };
+    if let Some(path) = &args.gains {
+        for (name, value) in custom_gain_settings(path)? {
+            builder.set_text(&name, &value)?;
+        }
+    }
     for s in &args.set {
         let (name, value) =
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
