@@ -36,3 +36,5 @@ echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
 echo "== Table III closed loop as SSP in fmpy"
 "$target_dir/venv/bin/python" -m pytest table3/tests/python -q
+echo "== examples (each prints what its header says; checked against table3)"
+"$target_dir/venv/bin/python" -m pytest examples -q

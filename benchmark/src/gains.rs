@@ -26,7 +26,7 @@ pub const POLE_PLACEMENT: [[f64; 2]; 4] = [
     [0.5549146485747638, -0.07206728388483528], // RR
 ];
 
-/// Robust tracking gain `K_track` (issue 9): mixed H2/H-inf with D-stability on the tracking
+/// Robust tracking gain `K_track`: mixed H2/H-inf with D-stability on the tracking
 /// error model (Table II, physical disturbance column, v = 0.35 m/s, mu in [0.1, 1.0]),
 /// weights z = [50 e_y; 10 e_psi; 10 u], region Re(s) < -0.5 and the 135-degree sector;
 /// Pareto point k = 12, H-inf bound g = 2.227808578571624, H2 bound nu = 3.343235155985476

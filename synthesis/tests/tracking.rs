@@ -1,4 +1,4 @@
-//! The robust tracking design (issue 9): the design model against the vehicle crate's
+//! The robust tracking design: the design model against the vehicle crate's
 //! linearization, the synthesized gain verified without trusting the solver, the sign
 //! conventions on the nonlinear car, and the CLI's JSON.
 

@@ -7,7 +7,7 @@
 //! ```
 //! Baked: the robust gain (paper variant, 4WD4WS, the Pareto point nearest the origin),
 //! the pole-placement baseline (`Re(s) < -2` at `mu_i = 0.4`, same polytope) and the robust
-//! tracking gain `K_track` (issue 9: [`nigel_synthesis::tracking::design_tracking`] with the
+//! tracking gain `K_track` ([`nigel_synthesis::tracking::design_tracking`] with the
 //! default design and region). The tests `synthesis/tests/baked_gains.rs` (the paper's two)
 //! and `synthesis/tests/tracking.rs` (`K_track`, reusing the design that file verifies)
 //! re-run the synthesis and fail if the committed file differs from it by more than the
@@ -90,7 +90,7 @@ fn generate() -> Result<String, String> {
          /// plant as `ROBUST`); stabilises all 16 friction vertices: {stab}\n\
          /// (largest closed-loop real part over them {re:?}).\n\
          pub const POLE_PLACEMENT: [[f64; 2]; 4] = {pole};\n\n\
-         /// Robust tracking gain `K_track` (issue 9): mixed H2/H-inf with D-stability on the tracking\n\
+         /// Robust tracking gain `K_track`: mixed H2/H-inf with D-stability on the tracking\n\
          /// error model (Table II, physical disturbance column, v = 0.35 m/s, mu in [0.1, 1.0]),\n\
          /// weights z = [50 e_y; 10 e_psi; 10 u], region Re(s) < -0.5 and the 135-degree sector;\n\
          /// Pareto point k = {tk}, H-inf bound g = {tg:?}, H2 bound nu = {tnu:?}\n\

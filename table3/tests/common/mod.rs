@@ -57,7 +57,7 @@ pub fn assert_self_check(table: &Table) {
     eprintln!("self-check: worst relative difference sim {:.2e}, real {:.2e}", worst[0], worst[1]);
 }
 
-/// Issue 9's goal on one table: `robust_tracking` has the lowest epsilon of the four
+/// The tracking controller's claim on one table: `robust_tracking` has the lowest epsilon of the four
 /// controllers in all 12 rows, and its steering stays inside `delta_max`, like every run's.
 pub fn assert_tracking_lowest(table: &Table) {
     let mut rows = 0;
