@@ -171,6 +171,24 @@ pub enum Error {
         instance: String,
         /// The variable.
         variable: String,
+        /// The closest names the instance has (at most 3).
+        closest: Vec<String>,
+    },
+    /// An instance name is unknown in the system.
+    UnknownInstance {
+        /// The name as given.
+        name: String,
+        /// The instances of the system.
+        instances: Vec<String>,
+    },
+    /// A variable name without the instance it belongs to, in a system of several.
+    NoInstance {
+        /// The name as given.
+        name: String,
+        /// The instances of the system.
+        instances: Vec<String>,
+        /// `instance.variable` names that end in the name given.
+        candidates: Vec<String>,
     },
     /// A value cannot be given to a variable (wrong type, unparsable, wrong causality).
     InvalidValue {
@@ -282,7 +300,30 @@ impl fmt::Display for Error {
                 write!(f, "{instance}: {function} is not allowed in state {state}")
             }
             Error::Instance { name, reason } => write!(f, "instance {name:?}: {reason}"),
-            Error::UnknownVariable { instance, variable } => write!(f, "{instance} has no variable {variable:?}"),
+            Error::UnknownVariable { instance, variable, closest } => {
+                write!(f, "instance {instance:?} has no variable {variable:?}")?;
+                if !closest.is_empty() {
+                    let q: Vec<String> = closest.iter().map(|c| format!("{c:?}")).collect();
+                    write!(f, "; did you mean {}?", q.join(" or "))?;
+                }
+                f.write_str(" (`cosim info` lists the variables)")
+            }
+            Error::UnknownInstance { name, instances } => {
+                write!(f, "the system has no instance {name:?}")?;
+                let close = crate::suggest::closest(name, instances.iter().map(String::as_str));
+                if let Some(c) = close.first() {
+                    write!(f, "; did you mean {c:?}?")?;
+                }
+                write!(f, " (its instances: {})", instances.join(", "))
+            }
+            Error::NoInstance { name, instances, candidates } => {
+                write!(f, "{name:?} names no instance: in a system, variables are named instance.variable")?;
+                match candidates.as_slice() {
+                    [] => write!(f, " (its instances: {})", instances.join(", ")),
+                    [one] => write!(f, "; did you mean {one:?}?"),
+                    many => write!(f, "; {name:?} is in {}", many.join(", ")),
+                }
+            }
             Error::InvalidValue { variable, value, reason } => write!(f, "{variable} = {value:?}: {reason}"),
             Error::Connection { from, to, reason } => write!(f, "connection {from} -> {to}: {reason}"),
             Error::AlgebraicLoop { variables } => {

@@ -106,6 +106,14 @@ pub struct SspSystem {
     _dir: Option<tempfile::TempDir>,
 }
 
+impl SspSystem {
+    /// Where an FMU of the system is inside the `.ssp` archive (`resources/x.fmu`), for
+    /// FMUs unpacked from it; `None` for a bare `.ssd`, whose FMU paths are real files.
+    pub fn path_in_archive<'a>(&self, fmu_path: &'a Path) -> Option<&'a Path> {
+        self._dir.as_ref().and_then(|d| fmu_path.strip_prefix(d.path()).ok())
+    }
+}
+
 /// One endpoint in the SSD before flattening: an FMU variable or a system connector.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 enum Node {

@@ -293,3 +293,113 @@ fn a_parameter_file_whose_root_is_not_a_parameter_set_is_refused() {
         other => panic!("accepted: {:?}", other.is_ok()),
     }
 }
+
+#[test]
+fn the_algebraic_loop_error_names_only_the_loop() {
+    // a.y feeds c (a tail: c -> d depends on the loop but is not on it) and the loop a <-> b
+    let dir = work_dir("loop-members");
+    let gain = Fmu::load(&build_fmu(Model::Gain, &dir, &[])).unwrap();
+    let mut b = nigel_cosim::SystemBuilder::new();
+    for name in ["a", "b", "c", "d"] {
+        b.add_instance(name, gain.clone()).unwrap();
+    }
+    b.connect("a.y", "c.u").unwrap();
+    b.connect("c.y", "d.u").unwrap();
+    b.connect("a.y", "b.u").unwrap();
+    b.connect("b.y", "a.u").unwrap();
+    let mut e = nigel_cosim::Experiment::new(1.0, 0.5);
+    e.algorithm = nigel_cosim::Algorithm::Ordered;
+    match nigel_cosim::simulate(&b.build(), &e) {
+        Err(Error::AlgebraicLoop { variables }) => {
+            let mut members = variables.clone();
+            assert_eq!(members.first(), members.last(), "closed: {variables:?}");
+            members.pop();
+            members.sort();
+            assert_eq!(members, ["a.u", "a.y", "b.u", "b.y"], "{variables:?}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}
+
+fn cosim(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn an_exact_variable_name_wins_over_the_instance_prefix() {
+    let dir = work_dir("exact-name");
+    // the source's slope is called "model.slope": `--set model.slope=3` is that variable
+    let xml = Model::Source.model_description().replace(r#"name="slope""#, r#"name="model.slope""#);
+    let fmu = build_fmu_with(Model::Source, &dir, "dotted", &xml);
+    let csv = dir.join("out.csv");
+    let (ok, _, err) = cosim(&[
+        "run",
+        fmu.to_str().unwrap(),
+        "--set",
+        "model.slope=3",
+        "--stop-time",
+        "1",
+        "--step",
+        "0.5",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "\"time\",\"y\"\n0,0\n0.5,1.5\n1,3\n");
+}
+
+#[test]
+fn messages_say_what_is_wrong_in_plain_words_with_suggestions() {
+    let plant = plant_fmu();
+    let p = plant.to_str().unwrap();
+    let run = |set: &str| {
+        let (ok, _, err) = cosim(&["run", p, "--stop-time", "0.01", "--set", set]);
+        assert!(!ok, "{set} accepted");
+        err.trim().to_string()
+    };
+    assert_eq!(
+        run("v_x_strat=0.35"),
+        "cosim: instance \"model\" has no variable \"v_x_strat\"; did you mean \"v_x_start\" or \"v_y_start\" or \"v_x\"? (`cosim info` lists the variables)"
+    );
+    assert_eq!(
+        run("v_x=0.35"),
+        "cosim: model.v_x = \"0.35\": a continuous output variable without a start value is calculated by the FMU and cannot be set; its initial value is set by the parameter \"v_x_start\""
+    );
+    assert_eq!(run("friction_circle=yes"), "cosim: model.friction_circle = \"yes\": not a Boolean (true, false, 1, 0)");
+    // written by `cargo run --release -p build-fmu` with the FMUs
+    let ssp = plant.parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop.ssp");
+    assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
+    {
+        let s = ssp.to_str().unwrap();
+        let run = |set: &str| cosim(&["run", s, "--stop-time", "0.01", "--set", set]).2.trim().to_string();
+        assert_eq!(
+            run("v_x_start=1"),
+            "cosim: \"v_x_start\" names no instance: in a system, variables are named instance.variable; did you mean \"plant.v_x_start\"?"
+        );
+        assert_eq!(
+            run("plnt.v_x_start=1"),
+            "cosim: the system has no instance \"plnt\"; did you mean \"plant\"? (its instances: plant, controller, maneuver)"
+        );
+        let (ok, out, err) = cosim(&["info", s]);
+        assert!(ok, "{err}");
+        assert!(
+            out.contains(&format!("instance plant                resources/nigel_plant.fmu in {s} (CoSimulation)")),
+            "{out}"
+        );
+        assert!(out.contains("  start v_x_start = 0.35 m/s\n"), "{out}");
+        assert!(!out.contains("nigel-cosim-") && !out.contains("Real(") && !out.contains("Boolean("), "{out}");
+    }
+    let (ok, out, err) = cosim(&["info", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("default experiment: start 0 s, stop 10 s, step 0.001 s, tolerance 1e-8\n"), "{out}");
+    let mu = out.lines().find(|l| l.starts_with("mu_fl ")).unwrap();
+    let words: Vec<&str> = mu.split_whitespace().collect();
+    assert_eq!(words[..9], ["mu_fl", "input", "continuous", "Real", "-", "0.4", "0", "..", "3"], "{mu}");
+    assert!(mu.ends_with("road-tire friction coefficient, 0 .. 3"), "{mu}");
+    assert!(!out.contains("Some(") && !out.contains("None"), "{out}");
+}
