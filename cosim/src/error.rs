@@ -149,6 +149,20 @@ pub enum Error {
         /// The last messages the FMU logged.
         log: String,
     },
+    /// An FMU returned a NaN or infinite Real with fmi2OK (refused where it came from,
+    /// before it reaches another FMU or the results).
+    NonFinite {
+        /// The instance.
+        instance: String,
+        /// The FMU file.
+        fmu: PathBuf,
+        /// The variable.
+        variable: String,
+        /// The value (NaN, inf or -inf).
+        value: f64,
+        /// The simulation time of the value, s.
+        time: f64,
+    },
     /// A call made in a state where the standard forbids it (a bug of the caller).
     IllegalCall {
         /// The instance name.
@@ -296,6 +310,12 @@ impl fmt::Display for Error {
                 }
                 f.write_str(&tail(log))
             }
+            Error::NonFinite { instance, fmu, variable, value, time } => write!(
+                f,
+                "{instance} ({}): {variable} = {value} at t = {time} s, returned with fmi2OK by fmi2GetReal \
+                 (a non-finite value; --allow-non-finite passes such values on)",
+                fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+            ),
             Error::IllegalCall { instance, function, state } => {
                 write!(f, "{instance}: {function} is not allowed in state {state}")
             }

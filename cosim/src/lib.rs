@@ -27,6 +27,7 @@ mod coupled;
 mod elf;
 pub mod error;
 pub mod fmu;
+pub mod mat;
 pub mod me;
 mod parallel;
 pub mod simulate;

@@ -266,7 +266,9 @@ impl Flattener<'_> {
             Some(f) => f.clone(),
             None => {
                 let mut options = self.options.clone();
+                // the interface asked for by the importer wins over the SSD's choice
                 match el.attr("implementation") {
+                    _ if options.interface.is_some() => {}
                     Some("ModelExchange") => options.interface = Some(crate::Interface::ModelExchange),
                     Some("CoSimulation") => options.interface = Some(crate::Interface::CoSimulation),
                     _ => {}

@@ -403,3 +403,80 @@ fn messages_say_what_is_wrong_in_plain_words_with_suggestions() {
     assert!(mu.ends_with("road-tire friction coefficient, 0 .. 3"), "{mu}");
     assert!(!out.contains("Some(") && !out.contains("None"), "{out}");
 }
+
+#[test]
+fn non_finite_outputs_are_refused_at_their_source() {
+    let dir = work_dir("non-finite");
+    let hostile = build_hostile(&dir);
+    let gain = Fmu::load(&build_fmu(Model::Gain, &dir, &[])).unwrap();
+    for (bad, shown) in [("0", "NaN"), ("1", "inf"), ("2", "-inf")] {
+        let mut b = nigel_cosim::SystemBuilder::new();
+        b.add_instance("h", Fmu::load(&hostile).unwrap()).unwrap();
+        b.add_instance("g", gain.clone()).unwrap();
+        b.connect("h.y", "g.u").unwrap();
+        b.set_text("h.bad", bad).unwrap();
+        let system = b.build();
+        for algorithm in [nigel_cosim::Algorithm::Ordered, nigel_cosim::Algorithm::Jacobi] {
+            let mut e = nigel_cosim::Experiment::new(1.0, 0.125);
+            e.algorithm = algorithm;
+            match nigel_cosim::simulate(&system, &e) {
+                Err(err @ Error::NonFinite { .. }) => {
+                    let Error::NonFinite { instance, variable, value, time, .. } = &err else { unreachable!() };
+                    // y turns bad at t_bad = 0.5 s, a communication point (4 steps of 1/8 s: exact)
+                    assert_eq!((instance.as_str(), variable.as_str(), *time), ("h", "y", 0.5), "{algorithm:?}");
+                    assert_eq!(value.to_string(), shown);
+                    let text = err.to_string();
+                    assert!(text.starts_with(&format!("h (hostile.fmu): y = {shown} at t = 0.5 s")), "{text}");
+                }
+                other => panic!("{algorithm:?} {bad}: {:?}", other.map(|(r, _)| r.column("g.y"))),
+            }
+        }
+    }
+    // allowed: passed on and recorded
+    let options = ImportOptions { allow_non_finite: true, ..ImportOptions::default() };
+    let mut b = nigel_cosim::SystemBuilder::new();
+    b.add_instance("h", Fmu::load_with(&hostile, &options).unwrap()).unwrap();
+    let (r, _) = nigel_cosim::simulate(&b.build(), &nigel_cosim::Experiment::new(1.0, 0.125)).unwrap();
+    let y = r.column("y").unwrap();
+    assert_eq!(y[..4], [0.0, 0.125, 0.25, 0.375]);
+    assert!(y[4..].iter().all(|v| v.is_nan()), "{y:?}");
+}
+
+#[test]
+fn the_cli_refuses_runs_it_cannot_mean_and_warns_of_long_steps() {
+    let plant = plant_fmu();
+    let p = plant.to_str().unwrap();
+    let dir = work_dir("cli-checks");
+    for (args, needle) in [
+        (vec!["--stop-time", "0"], "the stop time 0 s must be after the start time 0 s"),
+        (vec!["--step", "2", "--stop-time", "1"], "the step 2 s is longer than the run (1 s from 0 to 1 s)"),
+        (vec!["--output", "out.txt"], "--output out.txt: the file name must end in .csv"),
+    ] {
+        let mut all = vec!["run", p];
+        all.extend(args.iter().copied());
+        let (ok, _, err) = cosim(&all);
+        assert!(!ok && err.contains(needle), "{args:?}: {err}");
+    }
+    let (ok, _, err) = cosim(&["run", p, "--stop-time", "0.01"]);
+    assert!(ok && err.contains("note: no --output or --summary given"), "{err}");
+    let ssp = plant.parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop.ssp");
+    let s = ssp.to_str().unwrap();
+    let summary = dir.join("s.json");
+    let (ok, _, err) =
+        cosim(&["run", s, "--step", "0.1", "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: controller (nigel_controller.fmu) runs every 0.001 s (its parameter sample_period), but the communication step is 0.1 s"),
+        "{err}"
+    );
+    let (_, _, err) = cosim(&["run", s, "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);
+    assert!(!err.contains("warning"), "{err}");
+    // --interface applies to the FMUs of a system: Model Exchange is integrated by the master
+    let (ok, _, err) =
+        cosim(&["run", s, "--interface", "me", "--stop-time", "0.01", "--summary", summary.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    // RK4 at the communication step: one accepted integrator step per FMU and step
+    let steps = json["integrator_steps"]["accepted"].as_u64().unwrap_or(0);
+    assert!(steps >= 10, "{json}");
+}

@@ -95,9 +95,13 @@ struct RunArgs {
     /// get/set their state and vary their step).
     #[arg(long)]
     retry_discard: bool,
-    /// CSV file of the results (fmpy's format).
+    /// Results file: .csv (fmpy's CSV) or .mat (MAT v4 as Dymola and OpenModelica write it).
     #[arg(long, short)]
     output: Option<PathBuf>,
+    /// Pass on NaN and infinite outputs that FMUs return with fmi2OK (default: an error
+    /// naming the FMU and the variable).
+    #[arg(long)]
+    allow_non_finite: bool,
     /// Output interval, s (a whole multiple of the step; default: every step).
     #[arg(long)]
     output_interval: Option<f64>,
@@ -165,10 +169,15 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
+    let format = match &args.output {
+        None => None,
+        Some(p) => Some(OutputFormat::of(p)?),
+    };
     let limits = args.limits.limits();
-    let options = ImportOptions { interface, limits };
+    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
-        let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions { limits, ..ImportOptions::default() })?;
+        // --interface applies to every FMU of the system (one without it is refused by name)
+        let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
         let builder = SystemBuilder::from_system(ssp.system.clone());
         (builder, ssp.default_start_stop.1, None, None, Some(ssp))
     } else {
@@ -188,6 +197,16 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let mut experiment =
         Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
+    check_times(&experiment)?;
+    for warning in sample_period_warnings(&system, experiment.step) {
+        eprintln!("cosim: warning: {warning}");
+    }
+    if args.output.is_none() && args.summary.is_none() {
+        eprintln!(
+            "cosim: note: no --output or --summary given: the run is checked but its results are not kept \
+             (add --output out.csv or --output out.mat)"
+        );
+    }
     experiment.algorithm = algorithm;
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
@@ -218,8 +237,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
         std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
     };
-    if let Some(path) = &args.output {
-        write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?;
+    if let (Some(path), Some(format)) = (&args.output, format) {
+        match format {
+            OutputFormat::Csv => write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?,
+            OutputFormat::Mat => {
+                let descriptions = column_descriptions(&system, &results);
+                write(path, &|f| results.write_mat(std::io::BufWriter::new(f), &descriptions))?
+            }
+        }
     }
     let json = serde_json::to_string_pretty(&summary.to_json()).unwrap_or_default();
     match &args.summary {
@@ -231,6 +256,96 @@ fn run(args: RunArgs) -> Result<(), Error> {
         eprintln!("cosim: warning from {instance}: {message}");
     }
     Ok(())
+}
+
+#[derive(Clone, Copy)]
+enum OutputFormat {
+    Csv,
+    Mat,
+}
+
+impl OutputFormat {
+    /// By the file's extension; anything but .csv and .mat is refused before the run.
+    fn of(path: &Path) -> Result<OutputFormat, Error> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("csv") => Ok(OutputFormat::Csv),
+            Some("mat") => Ok(OutputFormat::Mat),
+            _ => Err(Error::Experiment(format!(
+                "--output {}: the file name must end in .csv (fmpy's CSV) or .mat (MAT v4, as Dymola writes it)",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// The variable descriptions of the result columns, for the MAT file.
+fn column_descriptions(system: &System, results: &nigel_cosim::Results) -> Vec<String> {
+    let single = system.instances.len() == 1;
+    results
+        .names
+        .iter()
+        .map(|n| {
+            let full = if single { format!("{SINGLE}.{n}") } else { n.clone() };
+            system.resolve(&full).ok().and_then(|r| system.variable(&r).description.clone()).unwrap_or_default()
+        })
+        .collect()
+}
+
+/// Times a run cannot mean: refused before anything is loaded into an FMU.
+fn check_times(e: &Experiment) -> Result<(), Error> {
+    let span = e.stop_time - e.start_time;
+    if !(span > 0.0) {
+        return Err(Error::Experiment(format!(
+            "the stop time {} s must be after the start time {} s (--stop-time, --start-time)",
+            e.stop_time, e.start_time
+        )));
+    }
+    if e.step > span {
+        return Err(Error::Experiment(format!(
+            "the step {} s is longer than the run ({span} s from {} to {} s): choose a --step of at most {span}",
+            e.step, e.start_time, e.stop_time
+        )));
+    }
+    Ok(())
+}
+
+/// A warning for every FMU whose declared sample period (a parameter `sample_period`,
+/// else its DefaultExperiment stepSize) is shorter than the communication step: its
+/// inputs are then held and its outputs read less often than it is meant to run.
+fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
+    let mut out = Vec::new();
+    for spec in &system.instances {
+        let md = spec.fmu.description();
+        let parameter = md.model_variables.iter().enumerate().find(|(_, v)| {
+            v.name == "sample_period" && v.causality == model_description::Causality::Parameter && v.is_real()
+        });
+        let from_parameter = parameter.and_then(|(index, v)| {
+            let set = spec.start_values.iter().find(|(i, _)| *i == index).and_then(|(_, value)| match value {
+                nigel_cosim::Value::Real(x) => Some(*x),
+                _ => None,
+            });
+            let start = match v.variable_type {
+                model_description::VariableType::Real { start, .. } => start,
+                _ => None,
+            };
+            set.or(start).map(|p| (p, "its parameter sample_period"))
+        });
+        let declared = from_parameter.or_else(|| {
+            md.default_experiment.as_ref().and_then(|d| d.step_size).map(|p| (p, "its DefaultExperiment stepSize"))
+        });
+        if let Some((period, source)) = declared {
+            // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
+            if period > 0.0 && step > period * (1.0 + 1e-9) {
+                out.push(format!(
+                    "{} ({}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
+                     are held and its outputs read only every {step} s (use --step {period})",
+                    spec.name,
+                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+                ));
+            }
+        }
+    }
+    out
 }
 
 fn is_ssp(path: &Path) -> bool {
