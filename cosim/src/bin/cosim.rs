@@ -98,6 +98,11 @@ struct RunArgs {
     /// Results file: .csv (fmpy's CSV) or .mat (MAT v4 as Dymola and OpenModelica write it).
     #[arg(long, short)]
     output: Option<PathBuf>,
+    /// Input signals over time: a CSV file in fmpy's input format (a time column first,
+    /// then one column per input, named as in --set); Reals interpolated linearly between
+    /// rows unless discrete, others held from the last row at or before the time.
+    #[arg(long, value_name = "FILE.csv")]
+    input: Option<PathBuf>,
     /// Pass on NaN and infinite outputs that FMUs return with fmi2OK (default: an error
     /// naming the FMU and the variable).
     #[arg(long)]
@@ -201,12 +206,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     for warning in sample_period_warnings(&system, experiment.step) {
         eprintln!("cosim: warning: {warning}");
     }
-    if args.output.is_none() && args.summary.is_none() {
-        eprintln!(
-            "cosim: note: no --output or --summary given: the run is checked but its results are not kept \
-             (add --output out.csv or --output out.mat)"
-        );
-    }
+
     experiment.algorithm = algorithm;
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
@@ -218,6 +218,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()));
+    }
+    if let Some(path) = &args.input {
+        experiment.input = Some(std::sync::Arc::new(nigel_cosim::InputTable::read_csv(path)?));
     }
     experiment.output_interval = args.output_interval;
     experiment.retry_discard = args.retry_discard;
@@ -234,6 +237,12 @@ fn run(args: RunArgs) -> Result<(), Error> {
         experiment.progress = Some(progress);
     }
     let (results, summary) = simulate(&system, &experiment)?;
+    if args.output.is_none() && args.summary.is_none() {
+        eprintln!(
+            "cosim: note: no --output or --summary given: the run completed but its results were not kept \
+             (add --output out.csv or --output out.mat)"
+        );
+    }
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
         std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
     };

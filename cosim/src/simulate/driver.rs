@@ -75,6 +75,12 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
         _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
         _ => Box::new(Jacobi),
     };
+    if let Some(table) = &experiment.input {
+        if experiment.threads > 1 {
+            return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
+        }
+        algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table)?);
+    }
     let single = system.instances.len() == 1;
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
@@ -150,8 +156,12 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             profiler.spent[lane.index] += lane.spent;
         }
     }
-    let mut summary =
-        Summary { steps: clock.steps, parallel_steps: core.parallel_steps, wall_time: Duration::ZERO, ..Summary::default() };
+    let mut summary = Summary {
+        steps: clock.steps,
+        parallel_steps: core.parallel_steps,
+        wall_time: Duration::ZERO,
+        ..Summary::default()
+    };
     for lane in core.lanes.iter_mut() {
         summary.discard_retries += lane.retries;
         if let Some(state) = lane.saved.take() {

@@ -55,6 +55,9 @@ pub struct Experiment {
     /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
     /// stops the run with [`Error::Fmi`].
     pub retry_discard: bool,
+    /// Input signals over time (fmpy's `input=`), applied before every communication
+    /// step; the variables they drive must not be connected.
+    pub input: Option<std::sync::Arc<crate::simulate::InputTable>>,
 }
 
 impl Experiment {
@@ -72,6 +75,7 @@ impl Experiment {
             progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
+            input: None,
         }
     }
 }
