@@ -303,7 +303,7 @@ fn column_descriptions(system: &System, results: &nigel_cosim::Results) -> Vec<S
 /// Times a run cannot mean: refused before anything is loaded into an FMU.
 fn check_times(e: &Experiment) -> Result<(), Error> {
     let span = e.stop_time - e.start_time;
-    if !(span > 0.0) {
+    if span.is_nan() || span <= 0.0 {
         return Err(Error::Experiment(format!(
             "the stop time {} s must be after the start time {} s (--stop-time, --start-time)",
             e.stop_time, e.start_time

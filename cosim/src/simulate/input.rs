@@ -40,11 +40,11 @@ impl InputTable {
         if names.len() != columns.len() {
             return Err(bad(format!("{} names for {} columns", names.len(), columns.len())));
         }
-        if let Some(k) = time.windows(2).position(|w| !(w[1] >= w[0])) {
-            return Err(bad(format!("time goes back from {} to {} s at row {}", time[k], time[k + 1], k + 2)));
-        }
         if let Some(t) = time.iter().find(|t| !t.is_finite()) {
             return Err(bad(format!("time {t} is not finite")));
+        }
+        if let Some(k) = time.windows(2).position(|w| w[1] < w[0]) {
+            return Err(bad(format!("time goes back from {} to {} s at row {}", time[k], time[k + 1], k + 2)));
         }
         for (name, c) in names.iter().zip(&columns) {
             if c.len() != time.len() {
