@@ -308,7 +308,7 @@ fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloadin
 pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<ModelDescription> {
     let path = dir.join("modelDescription.xml");
     let xml =
-        crate::unpack::read_xml_text(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
+        crate::unpack::read_text_file(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
             Error::Io { source: e, .. } => {
                 Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") }
             }

@@ -323,14 +323,15 @@ impl Flattener<'_> {
             let set = match (b.attr("source"), b.child("ParameterValues")) {
                 (Some(src), _) => {
                     let file = self.resource(src)?;
-                    let text = crate::unpack::read_xml_text(&file, src, self.options.limits.max_xml_bytes).map_err(
-                        |e| match e {
-                            Error::Io { source, .. } => {
-                                self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
+                    let text =
+                        crate::unpack::read_text_file(&file, src, self.options.limits.max_xml_bytes).map_err(|e| {
+                            match e {
+                                Error::Io { source, .. } => {
+                                    self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
+                                }
+                                other => other,
                             }
-                            other => other,
-                        },
-                    )?;
+                        })?;
                     let set = parse_xml(&text, &file)?;
                     if set.name != "ParameterSet" {
                         return Err(self.err(format!(
@@ -430,7 +431,7 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         (Some(dir), root, ssd)
     };
     let text =
-        crate::unpack::read_xml_text(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
+        crate::unpack::read_text_file(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
             match e {
                 Error::Io { source, .. } if !is_ssd => Error::Ssp {
                     path: path.to_path_buf(),

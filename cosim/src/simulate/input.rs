@@ -60,7 +60,7 @@ impl InputTable {
     /// Reads a CSV file in fmpy's format: a header of names (quoted or not, the first
     /// being the time column), then rows of numbers separated by commas.
     pub fn read_csv(path: &Path) -> Result<InputTable> {
-        let text = crate::unpack::read_xml_text(path, "the input file", 1 << 30)?;
+        let text = crate::unpack::read_text_file(path, "the input file", 1 << 30)?;
         let bad = |line: usize, m: String| Error::Experiment(format!("{}:{line}: {m}", path.display()));
         let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
         let (_, header) = lines.next().ok_or_else(|| bad(1, "empty file, expected a header of names".into()))?;
