@@ -26,6 +26,7 @@
 mod elf;
 pub mod error;
 pub mod fmu;
+pub mod isolate;
 pub mod mat;
 pub mod me;
 pub mod simulate;
@@ -34,8 +35,9 @@ pub(crate) mod suggest;
 pub mod system;
 pub mod unpack;
 
-pub use error::{Error, Result, Status};
+pub use error::{Error, HostEnd, Result, Status};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
+pub use isolate::Isolation;
 pub use me::{Event, Solver};
 pub use simulate::{simulate, Algorithm, Experiment, InputTable, Results, Summary};
 pub use ssp::{read_ssp, write_ssp, SspSystem};
