@@ -184,11 +184,7 @@ fn isolation(system: &System) {
         line(
             &format!("master {name}, recording nothing, in process"),
             a,
-            &format!(
-                "(5 runs alternated with --isolate: {:.1} .. {:.1} ms)",
-                a.as_secs_f64() * 1e3,
-                worst(&times[0]).as_secs_f64() * 1e3
-            ),
+            &format!("(5 runs alternated with --isolate: {:.1} .. {:.1} ms)", a.as_secs_f64() * 1e3, worst(&times[0]).as_secs_f64() * 1e3),
         );
         line(
             &format!("master {name}, recording nothing, --isolate"),

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 /// Spin before sleeping while waiting for the host (the host of a 1 us `fmi2DoStep`
 /// answers within it; a longer call puts the master to sleep).
-const MASTER_SPIN: Duration = Duration::from_micros(5);
+const MASTER_SPIN: Duration = Duration::from_micros(50);
 /// How often a sleeping master checks the host and the time limits.
 const CHECK_SLICE: Duration = Duration::from_millis(10);
 /// fmi2Fatal: what the proxy returns for a call the host did not answer.
@@ -153,7 +153,7 @@ impl Channel {
             last_records: Vec::new(),
         };
         std::mem::forget(child); // reaped by waitpid in `reap`
-                                 // the host answers a first empty call once it has loaded the library
+        // the host answers a first empty call once it has loaded the library
         let status = channel.call(Op::Flush);
         if status != 0 {
             return Err(match &channel.failure {
@@ -272,18 +272,16 @@ impl Channel {
         // SAFETY: the header lives as long as self (see `header`).
         let hdr = unsafe { &*h };
         publish(&hdr.request, seq, &hdr.host_sleeping);
-        let outcome =
-            wait_for(&hdr.response, seq.wrapping_sub(1), &hdr.master_sleeping, MASTER_SPIN, CHECK_SLICE, || {
-                self.check(start)
-            });
+        let outcome = wait_for(&hdr.response, seq.wrapping_sub(1), &hdr.master_sleeping, MASTER_SPIN, CHECK_SLICE, || {
+            self.check(start)
+        });
         // the response may be stale only if it was never written (the host died)
         if let Err(end) = outcome {
             self.failure = Some(end);
             return FATAL;
         }
         if hdr.response.load(Ordering::Acquire) != seq {
-            self.failure =
-                Some(HostEnd::Failed(format!("answer {} to call {seq}", hdr.response.load(Ordering::Acquire))));
+            self.failure = Some(HostEnd::Failed(format!("answer {} to call {seq}", hdr.response.load(Ordering::Acquire))));
             return FATAL;
         }
         self.read_log();

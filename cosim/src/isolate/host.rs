@@ -12,7 +12,7 @@ use std::time::Duration;
 
 /// The host spins this long for the next call before sleeping (the master's other
 /// instances take about a microsecond each between two calls to this one).
-const HOST_SPIN: Duration = Duration::from_micros(5);
+const HOST_SPIN: Duration = Duration::from_micros(30);
 
 struct Region {
     base: *mut u8,
@@ -43,8 +43,9 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
         return 2;
     };
     // SAFETY: maps the descriptor the master passed, of the size it made it.
-    let base =
-        unsafe { libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0) };
+    let base = unsafe {
+        libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0)
+    };
     if base == libc::MAP_FAILED {
         eprintln!("cosim-host: mmap: {}", std::io::Error::last_os_error());
         return 2;
@@ -262,9 +263,7 @@ impl Host {
                         0
                     }
                 }
-                Op::SetupExperiment => {
-                    (f.setup_experiment)(c, h.i[0] as c_int, h.f[0], h.f[1], h.i[1] as c_int, h.f[2])
-                }
+                Op::SetupExperiment => (f.setup_experiment)(c, h.i[0] as c_int, h.f[0], h.f[1], h.i[1] as c_int, h.f[2]),
                 Op::EnterInitializationMode => (f.enter_initialization_mode)(c),
                 Op::ExitInitializationMode => (f.exit_initialization_mode)(c),
                 Op::Terminate => (f.terminate)(c),

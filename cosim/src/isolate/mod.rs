@@ -269,8 +269,7 @@ pub(crate) fn wait_for<E>(
             sleeping.store(0, Ordering::SeqCst);
             return Ok(());
         }
-        let ts =
-            libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
+        let ts = libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
         // SAFETY: `word` is a live u32 in shared memory; FUTEX_WAIT (not private: the
         // region is shared between processes) returns when woken, on timeout or at once
         // if the word is no longer `old`.

@@ -65,7 +65,8 @@ unsafe extern "C" fn instantiate(
 
 /// `fmi2Instantiate` in the host of `channel`; the fmi2 status.
 pub(crate) fn instantiate_in(channel: &mut Channel, name: &CStr, fmi_type: c_int, guid: &CStr, uri: &CStr) -> i32 {
-    let bytes: Vec<u8> = [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
+    let bytes: Vec<u8> =
+        [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
     if !fits(channel, bytes.len()) {
         return 3;
     }
@@ -79,14 +80,7 @@ unsafe extern "C" fn free_instance(c: Component) {
     let _ = ch(c).call(Op::Free);
 }
 
-unsafe extern "C" fn setup_experiment(
-    c: Component,
-    tol_defined: c_int,
-    tol: f64,
-    start: f64,
-    stop_defined: c_int,
-    stop: f64,
-) -> c_int {
+unsafe extern "C" fn setup_experiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
     let channel = ch(c);
     let h = channel.header();
     h.i = [tol_defined as i64, stop_defined as i64, 0, 0];
@@ -288,12 +282,7 @@ unsafe extern "C" fn new_discrete_states(c: Component, info: *mut EventInfo) -> 
     r
 }
 
-unsafe extern "C" fn completed_integrator_step(
-    c: Component,
-    no_set_prior: c_int,
-    event: *mut c_int,
-    terminate: *mut c_int,
-) -> c_int {
+unsafe extern "C" fn completed_integrator_step(c: Component, no_set_prior: c_int, event: *mut c_int, terminate: *mut c_int) -> c_int {
     let channel = ch(c);
     channel.header().i = [no_set_prior as i64, 0, 0, 0];
     let r = channel.call(Op::CompletedIntegratorStep);
@@ -379,19 +368,13 @@ pub(crate) fn table(real: &Functions) -> Functions {
         get_real_status: real.get_real_status.is_some().then_some(get_real_status as _),
         enter_event_mode: real.enter_event_mode.is_some().then_some(enter_event_mode as _),
         new_discrete_states: real.new_discrete_states.is_some().then_some(new_discrete_states as _),
-        enter_continuous_time_mode: real
-            .enter_continuous_time_mode
-            .is_some()
-            .then_some(enter_continuous_time_mode as _),
+        enter_continuous_time_mode: real.enter_continuous_time_mode.is_some().then_some(enter_continuous_time_mode as _),
         completed_integrator_step: real.completed_integrator_step.is_some().then_some(completed_integrator_step as _),
         set_time: real.set_time.is_some().then_some(set_time as _),
         set_continuous_states: real.set_continuous_states.is_some().then_some(set_continuous_states as _),
         get_derivatives: real.get_derivatives.is_some().then_some(get_derivatives as _),
         get_event_indicators: real.get_event_indicators.is_some().then_some(get_event_indicators as _),
         get_continuous_states: real.get_continuous_states.is_some().then_some(get_continuous_states as _),
-        get_nominals_of_continuous_states: real
-            .get_nominals_of_continuous_states
-            .is_some()
-            .then_some(get_nominals as _),
+        get_nominals_of_continuous_states: real.get_nominals_of_continuous_states.is_some().then_some(get_nominals as _),
     }
 }
