@@ -11,6 +11,8 @@
 //!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
 //!   those connected to each other advancing together with one event iteration across
 //!   them ([`Error::EventIteration`] when it has no fixed point).
+//! - [`InputTable`]: input signals over time (fmpy's `input=`), [`Experiment::input`];
+//!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
 //! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
 //!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
 //!   ([`simulate::simulate_recorded`]).
