@@ -572,38 +572,4 @@ impl Model for Controller {
 fmi2_export::export_fmi2!(Controller);
 
 /// The law and its timing, for `documentation/index.html`.
-pub const DOCUMENTATION: &str = r#"<h2>Law (docs/benchmark.md)</h2>
-<pre>
-x = [beta, yaw_rate],  x_ref = [beta_ref, yaw_rate_ref]
-delta_i = clamp(delta_ff_i + K_i (x - x_ref), -delta_max, delta_max)      (rows i = FL, FR, RL, RR)
-e = speed_ref - speed,   F = kp_speed e + ki_speed I
-if |F| > force_max:  F = +-force_max and I is frozen,   else  I := I + e sample_period  (at the next sample)
-tau_i = F r_wheel / 4
-</pre>
-<p>The Integer parameter <code>controller</code> (1 .. 5; a plain Integer rather than an FMI Enumeration, so
-that every importer can set it) selects K: 1 <code>open_loop</code> (K = 0), 2 <code>pole_placement</code> (the
-non-robust baseline, Re(s) &lt; -2 at mu = 0.4), 3 <code>robust</code> (the mixed H2/H-inf gain of the paper variant,
-4WD4WS, Pareto point; default), 4 <code>custom</code> (the tunable <code>k_beta_*</code>, <code>k_yaw_rate_*</code>,
-which start at the robust gain and may change between steps) or 5 <code>robust_tracking</code> (below). The gain in use is readable as <code>gain_*</code>.
-The robust and pole-placement gains are baked from the synthesis crate
-(<code>cargo run --release -p nigel-synthesis --bin bake-gains</code>).</p>
-<h2>Robust tracking (controller = 5, robust_tracking, beyond the paper)</h2>
-<pre>
-e_x   =  cos(psi_ref) (x - x_ref) + sin(psi_ref) (y - y_ref)      along-track error, + = ahead
-e_y   = -sin(psi_ref) (x - x_ref) + cos(psi_ref) (y - y_ref)      lateral error, + = left of the reference
-e_psi = psi - psi_ref wrapped to (-pi, pi]
-delta_i = clamp(delta_ff_i + K_track,i [e_y, e_psi, beta - beta_ref, yaw_rate - yaw_rate_ref], -delta_max, delta_max)
-speed_command = speed_ref - clamp(k_along_track e_x, -along_track_speed_max, along_track_speed_max)
-e = speed_command - speed   (the PI above otherwise unchanged)
-</pre>
-<p>K_track is the robust mixed H2/H-inf tracking gain (issue 9: the same 16-vertex friction polytope, D-stability
-Re(s) &lt; -0.5 and a 135-degree sector), readable as <code>gain_e_y_*</code>, <code>gain_e_psi_*</code>,
-<code>gain_beta_*</code>, <code>gain_yaw_rate_*</code>. Connect <code>x, y, psi</code> to the plant's pose and
-<code>x_ref, y_ref, psi_ref</code> to the test bench's reference pose; the other modes ignore them.</p>
-<h2>Sampling</h2>
-<p>The law runs at t_k = t_start + k sample_period on the inputs at t_k; the outputs are held until t_(k+1).
-The outputs depend directly on the inputs: an importer that sets the inputs at t_k and reads the outputs before
-<code>fmi2DoStep</code> gets the law applied to them. <code>speed_integral</code> read at t_k is the I used there;
-it takes the step of sample k when time moves past t_k. A Co-Simulation step spanning several samples runs them in
-order (one 10 ms step equals ten 1 ms steps with the same inputs, bit for bit); in Model Exchange the samples are
-time events.</p>"#;
+pub const DOCUMENTATION: &str = include_str!("documentation.html");

@@ -400,7 +400,7 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     }
 }
 
-/// The tracking law written out by hand from its definition (issue 9), independent of
+/// The tracking law written out by hand from its definition, independent of
 /// nigel_vehicle's and nigel_benchmark's code: the errors in the reference's frame.
 fn tracking_by_hand(x: &In, pose: [f64; 6], integral: f64) -> ([f64; 4], f64) {
     let [px, py, psi, x_ref, y_ref, psi_ref] = pose;

@@ -449,32 +449,4 @@ impl Model for TestBench {
 fmi2_export::export_fmi2!(TestBench);
 
 /// What the test bench computes, for `documentation/index.html`.
-pub const DOCUMENTATION: &str = r#"<h2>Benchmark (docs/benchmark.md)</h2>
-<p>Samples k = 0, 1, ... at t_k = t_start + k 1 ms; every output is held over [t_k, t_k + 1 ms).
-Steering programs (front +f, rear -f), a = <code>steer_amplitude</code> (30 deg):</p>
-<p>The switches <code>maneuver</code> and <code>fidelity</code> are plain Integer parameters (not FMI
-Enumerations, so that every importer can set them): <code>maneuver</code> 1 straight, 2 lane_change, 3 skidpad,
-4 fishhook, 5 slalom, 6 figure_8; <code>fidelity</code> 1 paper (the sim column), 2 real.</p>
-<pre>
-straight     0
-lane_change  [14.8, 15.0) s: +a;  [15.0, 15.2) s: -a
-skidpad      [2.5, 27.5) s: +a
-fishhook     [2.5, 25.0) s: a (t - 2.5)/22.5;  [25.0, 27.5) s: a
-slalom       [2.5, 27.5) s: a cos(30 pi (t - 2.5)/25)
-figure_8     +-a from t = 0, the sign flipping one sample after the nominal paper-fidelity car's closest
-             approach to the origin once it has turned 3 pi/2 (first flips at samples 3144, 6267, 9390)
-</pre>
-<pre>
-mu_i   = 0.35 sin(2 pi 12 theta_k - phi_i) + 0.55 + 0.1 u(seed, i, k) - 0.05,  theta_k = 2 pi t_k / 30 s,
-         phi = (0, pi/2, pi, 3 pi/2)                       (0.4 with friction_variation off)
-wind_y = 0.25 [t_k >= 1 s] + 0.025 u(seed, 4, k)  [N, world frame]   (0 with wind off); wind_x = 0
-beta_meas     = beta     + 0.005 g(seed, 5, k)    (real fidelity with measurement_noise on; else beta)
-yaw_rate_meas = yaw_rate + 0.01  g(seed, 6, k)
-u(seed, s, k) = (mix(((seed &lt;&lt; 8) | s) + (k + 1) 0x9E3779B97F4A7C15) &gt;&gt; 11) 2^-53   (SplitMix64 finaliser)
-g(seed, s, k) = sqrt(-2 ln(1 - u(seed, s, 2k))) cos(2 pi u(seed, s, 2k + 1))
-</pre>
-<p>The reference (<code>beta_ref, yaw_rate_ref, x_ref, y_ref, psi_ref</code>) is computed at the end of
-initialization: the open-loop run (K = 0) of the chosen fidelity's plant (nigel-vehicle, RK4 with two 0.5 ms
-sub-steps per sample) from the origin at <code>speed_target</code>, with the speed PI of the controller FMU
-(kp 53.6, ki 268, |F| &lt;= 20 N), mu = 0.4, no wind, no noise, over <code>duration</code> seconds. A run may not go
-past <code>duration</code>. <code>speed_ref</code> outputs <code>speed_target</code>.</p>"#;
+pub const DOCUMENTATION: &str = include_str!("documentation.html");

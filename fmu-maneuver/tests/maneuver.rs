@@ -27,15 +27,21 @@ fn bench(m: Maneuver, f: Fidelity, duration: f64) -> B {
 }
 
 #[test]
-fn spec_vectors_bit_exact() {
+fn spec_vectors_at_the_first_samples() {
     let b = bench(Maneuver::Straight, Fidelity::Real, 1.5);
     // k = 0: mu_fl, and beta_meas with beta = 0 is 0.005 g(0, 5, 0)
+    // MU at k = 0 is arithmetic on a SplitMix64 uniform (sin(0) = 0): bit-exact anywhere; the
+    // noise g goes through the platform libm's ln and cos, so it is compared with this process's
+    // g bit for bit and with the spec's glibc vector to 1e-15 relative (benchmark/src/noise.rs)
     assert_eq!(b.real(vr::MU), 0.5883310808213643);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * 0.014334745996352224);
+    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * g(0, 5, 0));
+    assert!((g(0, 5, 0) - 0.014334745996352224).abs() <= 1e-15 * 0.014334745996352224);
     assert_eq!(b.real(vr::YAW_RATE_MEAS), 0.01 * g(0, 6, 0));
     assert_eq!(b.step(0.0, T), OK);
-    assert_eq!(b.real(vr::MU), 0.5486795484644006);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * 0.5906209568869251);
+    // k = 1: the friction's sin and the noise's ln, cos are the platform libm's (within 1 ulp
+    // of correctly rounded): 1e-15 is over 10 ulp of mu and of 0.005 g
+    assert!((b.real(vr::MU) - 0.5486795484644006).abs() < 1e-15, "{}", b.real(vr::MU));
+    assert!((b.real(vr::BETA_MEAS) - 0.005 * 0.5906209568869251).abs() < 1e-17, "{}", b.real(vr::BETA_MEAS));
     assert_eq!(b.step(T, 998.0 * T), OK);
     assert_eq!(b.real(vr::WIND_Y), 0.007915537544713306, "k = 999");
     assert_eq!(b.step(999.0 * T, T), OK);

@@ -18,6 +18,9 @@ use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehiclePa
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
 
+/// The equations and the initial state, for `documentation/index.html`.
+pub const DOCUMENTATION: &str = include_str!("documentation.html");
+
 /// Largest number of RK4 sub-steps one `fmi2DoStep` may take (about 0.5 s of computing at
 /// some 0.5 us a sub-step); a longer step is refused before it starts (`fmi2Discard`)
 /// instead of keeping the importer.
