@@ -489,10 +489,14 @@ impl Model for Controller {
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
+        // the held outputs an importer reads at every sample: a field
+        if let Some(x) = self.slot(b) {
+            return Ok(*x);
+        }
         match b {
             Var::GainInUse(i, j) => Ok(self.gain_in_use()[i][j]),
             Var::PoseGainInUse(i, j) => Ok(self.pose_gain_in_use()[i][j]),
-            _ => self.slot(b).map(|x| *x).ok_or_else(|| "controller is an Integer, not a Real".into()),
+            _ => Err("controller is an Integer, not a Real".into()),
         }
     }
 
