@@ -77,3 +77,24 @@ fn main() {
         std::process::exit(1);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_controller_component_gets_the_own_fmu_and_loses_only_its_parameter_binding() {
+        let ssd = "<a><ssd:Component name=\"plant\" source=\"resources/nigel_plant.fmu\"><ssd:ParameterBindings>p\
+                   </ssd:ParameterBindings></ssd:Component><ssd:Component name=\"controller\" \
+                   source=\"resources/nigel_controller.fmu\"><c/><ssd:ParameterBindings>k</ssd:ParameterBindings>\
+                   </ssd:Component></a>";
+        let own = own_component(ssd).unwrap();
+        assert_eq!(
+            own,
+            "<a><ssd:Component name=\"plant\" source=\"resources/nigel_plant.fmu\"><ssd:ParameterBindings>p\
+             </ssd:ParameterBindings></ssd:Component><ssd:Component name=\"controller\" \
+             source=\"resources/own_controller.fmu\"><c/></ssd:Component></a>"
+        );
+        assert!(own_component("<a/>").unwrap_err().contains("no component"));
+    }
+}
