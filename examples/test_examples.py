@@ -77,3 +77,51 @@ def test_d_cosim_as_a_library(table3_sim_lane_change):
         eps = number(rf"{name}\s+epsilon (\S+)", r.stdout)
         want = table3_sim_lane_change[name]["eps"]
         assert abs(eps - want) <= REL * want, (name, eps, want)
+
+
+def test_c_own_controller_fmu_in_the_ssp(table3_sim_lane_change, tmp_path):
+    import numpy as np
+    r = subprocess.run(["bash", str(REPO / "examples" / "own_controller.sh"), str(tmp_path)],
+                       capture_output=True, text=True, check=True)
+    eps = number(r"own controller epsilon (\S+)", r.stdout)
+    csv = tmp_path / "cosim.csv"
+    names = [n.strip('"') for n in csv.read_text().splitlines()[0].split(",")]
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    col = {n: data[:, i] for i, n in enumerate(names)}
+    # epsilon as docs/benchmark.md defines it, from the CSV: RMSE of x, y, psi over t = 1 ms .. 30 s
+    after = col["time"] > 0
+    rmse = [np.sqrt(np.mean((col[f"plant.{q}"][after] - col[f"maneuver.{q}_ref"][after]) ** 2))
+            for q in ("x", "y", "psi")]
+    want = float(np.linalg.norm(rmse))
+    assert abs(eps - want) <= REL * want, (eps, want)
+    # the master ran our P law: every recorded command is the law of the inputs recorded with it
+    # (k_yaw_rate = 0.3 rad.s/rad, kp_speed = 53.6 N.s/m, force_max = 20 N; one product and one
+    # sum in double precision, so 1e-12 rad / N is far above the rounding on any machine)
+    e_r = col["controller.yaw_rate_ref"] - col["controller.yaw_rate"]
+    assert np.max(np.abs(col["controller.delta_fl"] - (col["controller.delta_ff_fl"] + 0.3 * e_r))) < 1e-12
+    assert np.max(np.abs(col["controller.delta_rl"] - (col["controller.delta_ff_rl"] - 0.3 * e_r))) < 1e-12
+    force = np.clip(53.6 * (col["controller.speed_ref"] - col["controller.speed"]), -20.0, 20.0)
+    assert np.max(np.abs(col["controller.drive_force"] - force)) < 1e-12
+    assert np.max(np.abs(e_r)) > 1e-3  # the feedback acted
+    # a different controller gives a different result than ours, robust or none
+    for name in ("robust", "open_loop"):
+        other = table3_sim_lane_change[name]["eps"]
+        assert abs(eps - other) > 1e-3 * other, (name, eps, other)
+
+
+def test_c_own_controller_fmu_in_fmpy():
+    """The packaged FMU alone in fmpy (an independent importer) with constant inputs."""
+    from fmpy import simulate_fmu
+    fmu = target_dir() / "fmu" / "own_controller.fmu"
+    subprocess.run(["cargo", "run", "--release", "--quiet", "-p", "own-controller"], cwd=REPO, check=True,
+                   capture_output=True)
+    inputs = {"yaw_rate": 0.05, "yaw_rate_ref": 0.15, "speed": 0.35, "speed_ref": 0.5, "delta_ff_fl": 0.02}
+    res = simulate_fmu(str(fmu), stop_time=0.01, output_interval=1e-3, start_values=inputs,
+                       output=["delta_fl", "delta_rl", "drive_force", "tau_fr"])
+    last = res[-1]
+    # 0.02 + 0.3 (0.15 - 0.05); -0.3 (0.15 - 0.05); 53.6 (0.5 - 0.35) N; F 0.0325 m / 4
+    # (a few double operations: 1e-12 is far above their rounding)
+    assert abs(last["delta_fl"] - 0.05) < 1e-12
+    assert abs(last["delta_rl"] + 0.03) < 1e-12
+    assert abs(last["drive_force"] - 8.04) < 1e-12
+    assert abs(last["tau_fr"] - 8.04 * 0.0325 / 4) < 1e-12

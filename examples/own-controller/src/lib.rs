@@ -1,0 +1,224 @@
+//! One's own steering controller as an FMI 2.0 Co-Simulation FMU (`own_controller`): the
+//! smallest credible replacement of `nigel_controller` in the closed loop. Every input and
+//! output the closed-loop SSP connects is declared with the same name, causality and unit,
+//! so the SSP's connections fit unchanged; the pose inputs are accepted and not read.
+//!
+//! Sampled every `T = 1 ms` at `t_k = k T` (the layer keeps the clock), outputs held:
+//! - steering: `delta_i = delta_ff_i + s_i k_yaw_rate (yaw_rate_ref - yaw_rate)`, with
+//!   `s_i = +1` for the front wheels and `-1` for the rear ones (more yaw rate wanted: the
+//!   front wheels steer into the turn, the rear ones against it), clamped to `+-delta_max`;
+//! - drive: `F = clamp(kp_speed (speed_ref - speed), -force_max, force_max)`, the torque of
+//!   each wheel `tau_i = F r_wheel / 4`.
+
+use std::sync::OnceLock;
+
+use fmi2_export::model_description::DefaultExperiment;
+use fmi2_export::{
+    per_wheel, si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, ModelResult,
+    Start, VarDecl,
+};
+
+/// The sample period of the law [s].
+pub const SAMPLE_PERIOD: f64 = 1e-3;
+
+/// What a value reference stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Var {
+    /// Inputs, in the order of [`INPUTS`].
+    Input(usize),
+    /// `delta_ff_fl .. delta_ff_rr`.
+    SteerFeedForward(usize),
+    /// `delta_fl .. delta_rr`.
+    Steer(usize),
+    /// `tau_fl .. tau_rr`.
+    Torque(usize),
+    DriveForce,
+    /// Parameters, in the order of [`PARAMETERS`].
+    Parameter(usize),
+}
+
+/// The scalar inputs `(name, unit, start)`: value references 0.. in this order.
+pub const INPUTS: [(&str, &str, f64); 12] = [
+    ("beta", "rad", 0.0),
+    ("yaw_rate", "rad/s", 0.0),
+    ("speed", "m/s", 0.35),
+    ("beta_ref", "rad", 0.0),
+    ("yaw_rate_ref", "rad/s", 0.0),
+    ("speed_ref", "m/s", 0.35),
+    ("x", "m", 0.0),
+    ("x_ref", "m", 0.0),
+    ("y", "m", 0.0),
+    ("y_ref", "m", 0.0),
+    ("psi", "rad", 0.0),
+    ("psi_ref", "rad", 0.0),
+];
+const YAW_RATE: usize = 1;
+const SPEED: usize = 2;
+const YAW_RATE_REF: usize = 4;
+const SPEED_REF: usize = 5;
+
+/// The parameters `(name, unit, start, min, max, description)`: value references 30.. in this order.
+pub const PARAMETERS: [(&str, &str, f64, f64, f64, &str); 5] = [
+    ("k_yaw_rate", "rad.s/rad", 0.3, 0.0, 10.0, "steering per yaw-rate error (front +, rear -)"),
+    ("kp_speed", "N.s/m", 53.6, 0.0, 1e4, "drive force per speed error"),
+    ("force_max", "N", 20.0, 1e-3, 1e3, "largest total drive force"),
+    ("r_wheel", "m", 0.0325, 1e-3, 1.0, "wheel radius (force to torque)"),
+    ("delta_max", "rad", core::f64::consts::FRAC_PI_2, 1e-3, core::f64::consts::FRAC_PI_2, "steering clamp"),
+];
+const K_YAW_RATE: usize = 0;
+const KP_SPEED: usize = 1;
+const FORCE_MAX: usize = 2;
+const R_WHEEL: usize = 3;
+const DELTA_MAX: usize = 4;
+
+const VR_DELTA_FF: u32 = 12;
+const VR_DELTA: u32 = 20;
+const VR_TAU: u32 = 24;
+const VR_DRIVE_FORCE: u32 = 28;
+const VR_PARAMETERS: u32 = 30;
+
+fn build_declaration() -> DeclarationSpec<Var> {
+    let mut v: Vec<VarDecl<Var>> = INPUTS
+        .iter()
+        .enumerate()
+        .map(|(i, (name, unit, start))| {
+            VarDecl::real(name, i as u32, Var::Input(i)).input(Start::Real(*start)).unit(unit)
+        })
+        .collect();
+    v.extend(per_wheel("delta_ff", VR_DELTA_FF, Var::SteerFeedForward, |d, _| {
+        d.input(Start::Real(0.0)).unit("rad").describe("feed-forward steering")
+    }));
+    v.extend(per_wheel("delta", VR_DELTA, Var::Steer, |d, i| {
+        d.discrete_output(Dependencies::On(vec![YAW_RATE as u32, YAW_RATE_REF as u32, VR_DELTA_FF + i as u32]))
+            .unit("rad")
+            .describe("delta_ff + s k_yaw_rate (yaw_rate_ref - yaw_rate), s = +1 front, -1 rear")
+    }));
+    let speed_deps = || Dependencies::On(vec![SPEED as u32, SPEED_REF as u32]);
+    v.extend(per_wheel("tau", VR_TAU, Var::Torque, |d, _| {
+        d.discrete_output(speed_deps()).unit("N.m").describe("drive torque F r_wheel / 4")
+    }));
+    v.push(
+        VarDecl::real("drive_force", VR_DRIVE_FORCE, Var::DriveForce)
+            .discrete_output(speed_deps())
+            .unit("N")
+            .describe("F = kp_speed (speed_ref - speed), |F| <= force_max"),
+    );
+    for (j, (name, unit, start, min, max, text)) in PARAMETERS.iter().enumerate() {
+        v.push(
+            VarDecl::real(name, VR_PARAMETERS + j as u32, Var::Parameter(j))
+                .parameter(Start::Real(*start))
+                .unit(unit)
+                .min(*min)
+                .max(*max)
+                .describe(text),
+        );
+    }
+    DeclarationSpec {
+        model_name: "own_controller",
+        model_identifier: "own_controller",
+        description: "A user's own sampled (1 ms) steering controller: P on the yaw rate, P on the speed",
+        version: env!("CARGO_PKG_VERSION"),
+        interfaces: Interfaces { model_exchange: false, co_simulation: true },
+        units: vec![
+            si_unit("rad", 0, 0, 0, 1),
+            si_unit("rad/s", 0, 0, -1, 1),
+            si_unit("m/s", 0, 1, -1, 0),
+            si_unit("m", 0, 1, 0, 0),
+            si_unit("N", 1, 1, -2, 0),
+            si_unit("N.m", 1, 2, -2, 0),
+            si_unit("N.s/m", 1, 0, -1, 0),
+            si_unit("rad.s/rad", 0, 0, 1, 0),
+        ],
+        default_experiment: Some(DefaultExperiment {
+            start_time: Some(0.0),
+            stop_time: Some(30.0),
+            tolerance: None,
+            step_size: Some(SAMPLE_PERIOD),
+        }),
+        variables: v,
+        ..Default::default()
+    }
+}
+
+/// The controller instance: its inputs, parameters and held outputs.
+#[derive(Clone, Debug)]
+pub struct OwnController {
+    inputs: [f64; INPUTS.len()],
+    delta_ff: [f64; 4],
+    parameters: [f64; PARAMETERS.len()],
+    delta: [f64; 4],
+    tau: [f64; 4],
+    drive_force: f64,
+}
+
+impl OwnController {
+    /// The law on the current inputs: `(delta, F)`.
+    pub fn law(&self) -> ([f64; 4], f64) {
+        let p = &self.parameters;
+        let yaw_rate_error = self.inputs[YAW_RATE_REF] - self.inputs[YAW_RATE];
+        let side = [1.0, 1.0, -1.0, -1.0];
+        let delta = core::array::from_fn(|i| {
+            (self.delta_ff[i] + side[i] * p[K_YAW_RATE] * yaw_rate_error).clamp(-p[DELTA_MAX], p[DELTA_MAX])
+        });
+        let force = (p[KP_SPEED] * (self.inputs[SPEED_REF] - self.inputs[SPEED])).clamp(-p[FORCE_MAX], p[FORCE_MAX]);
+        (delta, force)
+    }
+}
+
+impl Model for OwnController {
+    type Binding = Var;
+
+    fn declaration() -> &'static Declaration<Var> {
+        static D: OnceLock<Declaration<Var>> = OnceLock::new();
+        D.get_or_init(|| Declaration::new(build_declaration()).expect("the declaration is valid"))
+    }
+
+    fn instantiate(_: &InstantiateContext) -> ModelResult<Self> {
+        Ok(OwnController {
+            inputs: INPUTS.map(|(_, _, start)| start),
+            delta_ff: [0.0; 4],
+            parameters: PARAMETERS.map(|(_, _, start, ..)| start),
+            delta: [0.0; 4],
+            tau: [0.0; 4],
+            drive_force: 0.0,
+        })
+    }
+
+    fn get_real(&mut self, b: Var) -> ModelResult<f64> {
+        Ok(match b {
+            Var::Input(i) => self.inputs[i],
+            Var::SteerFeedForward(i) => self.delta_ff[i],
+            Var::Steer(i) => self.delta[i],
+            Var::Torque(i) => self.tau[i],
+            Var::DriveForce => self.drive_force,
+            Var::Parameter(j) => self.parameters[j],
+        })
+    }
+
+    fn set_real(&mut self, b: Var, x: f64) -> ModelResult {
+        match b {
+            Var::Input(i) => self.inputs[i] = x,
+            Var::SteerFeedForward(i) => self.delta_ff[i] = x,
+            Var::Steer(i) => self.delta[i] = x,
+            Var::Torque(i) => self.tau[i] = x,
+            Var::DriveForce => self.drive_force = x,
+            Var::Parameter(j) => self.parameters[j] = x,
+        }
+        Ok(())
+    }
+
+    fn sample_period(&self) -> Option<f64> {
+        Some(SAMPLE_PERIOD)
+    }
+
+    fn sample(&mut self, _k: u64, _time: f64) -> ModelResult {
+        let (delta, force) = self.law();
+        self.delta = delta;
+        self.drive_force = force;
+        self.tau = [force * self.parameters[R_WHEEL] / 4.0; 4];
+        Ok(())
+    }
+}
+
+#[cfg(feature = "fmi-export")]
+fmi2_export::export_fmi2!(OwnController);
