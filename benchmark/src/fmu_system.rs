@@ -50,8 +50,9 @@ pub struct FmuSystem {
 /// the noise `seed`, and `disturbed` (friction variation, wind, measurement noise as in the
 /// benchmark; `false` turns all three off).
 ///
-/// Fails for [`Controller::Custom`] (its gains are the controller FMU's tunable parameters,
-/// which no job sets here) and for a seed beyond the test bench's Integer range.
+/// [`Controller::Custom`] runs as the controller FMU's `custom` with its gain in the
+/// tunable parameters `k_beta_<wheel>`, `k_yaw_rate_<wheel>`. Fails for a seed beyond the
+/// test bench's Integer range.
 pub fn closed_loop(
     fidelity: Fidelity,
     maneuver: Maneuver,
@@ -59,9 +60,6 @@ pub fn closed_loop(
     seed: u64,
     disturbed: bool,
 ) -> Result<FmuSystem, String> {
-    if matches!(controller, Controller::Custom(_)) {
-        return Err("a custom gain is set through the controller FMU's k_* parameters, not as a job".into());
-    }
     let seed = i32::try_from(seed)
         .map_err(|_| format!("seed {seed} does not fit the test bench's Integer seed (0 ..= {})", i32::MAX))?;
     let position = |names: &[&str], name: &str| names.iter().position(|n| *n == name).map_or(0, |k| k as i32 + 1);
@@ -79,6 +77,12 @@ pub fn closed_loop(
     }
     parameters
         .push(("controller.controller".into(), StartValue::Integer(position(&CONTROLLER_SWITCH, controller.name()))));
+    if let Controller::Custom(k) = controller {
+        for (row, w) in k.iter().zip(WHEELS) {
+            parameters.push((format!("controller.k_beta_{w}"), StartValue::Real(row[0])));
+            parameters.push((format!("controller.k_yaw_rate_{w}"), StartValue::Real(row[1])));
+        }
+    }
     let real = fidelity == Fidelity::Real;
     for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
         parameters.push((format!("plant.{switch}"), StartValue::Boolean(real)));
@@ -152,7 +156,12 @@ mod tests {
         assert_eq!(get("maneuver.seed"), Some(StartValue::Integer(7)));
         assert_eq!(get("maneuver.measurement_noise"), Some(StartValue::Boolean(false)));
         assert_eq!(get("plant.friction_circle"), Some(StartValue::Boolean(true)));
-        assert!(closed_loop(Fidelity::Paper, Maneuver::Straight, Controller::Custom([[0.0; 2]; 4]), 0, true).is_err());
+        let k = [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]];
+        let c = closed_loop(Fidelity::Paper, Maneuver::Straight, Controller::Custom(k), 0, true).unwrap();
+        let get = |name: &str| c.parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+        assert_eq!(get("controller.controller"), Some(StartValue::Integer(4)));
+        assert_eq!(get("controller.k_beta_rl"), Some(StartValue::Real(0.5)));
+        assert_eq!(get("controller.k_yaw_rate_rr"), Some(StartValue::Real(0.8)));
         let e = closed_loop(Fidelity::Paper, Maneuver::Straight, Controller::Robust, 1 << 31, true).unwrap_err();
         assert!(e.contains("2147483648"), "{e}");
     }

@@ -23,17 +23,19 @@
 
 #![warn(missing_docs)]
 
-mod coupled;
+mod elf;
 pub mod error;
 pub mod fmu;
+pub mod isolate;
 pub mod me;
-mod parallel;
 pub mod simulate;
 pub mod ssp;
+pub(crate) mod suggest;
 pub mod system;
 pub mod unpack;
 
-pub use error::{Error, Result, Status};
+pub use error::{Error, HostEnd, Result, Status};
+pub use isolate::Isolation;
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use me::{Event, Solver};
 pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};

@@ -1,21 +1,21 @@
 //! Table III and Fig. 7 of the paper (Section V) from the three FMUs, as pinned down in
-//! `shared/spec/maneuvers.md`.
+//! `docs/benchmark.md`.
 //!
 //! * [`engine`]: what runs one closed loop. [`Engine`] has two implementations:
 //!   [`FmuEngine`] co-simulates the archives `nigel_plant.fmu`, `nigel_controller.fmu`
 //!   and `nigel_maneuver.fmu` with the `nigel_cosim` master (`ordered`, 1 ms, 30 s,
 //!   through the C ABI), and [`InProcess`] runs `nigel_benchmark`'s loop, the independent
 //!   implementation the FMU run must reproduce.
-//! * [`metric`]: the metric of maneuvers.md, computed here from the recorded pose and the
+//! * [`metric`]: the metric of docs/benchmark.md, computed here from the recorded pose and the
 //!   test bench's reference outputs (not taken from either engine).
 //! * [`table`]: the 48 runs of one seed (2 columns, 6 maneuvers, 4 controllers) in parallel, [`Table`]; [`paper`] holds the
 //!   paper's Table III for comparison.
 //! * [`report`]: the markdown table and the JSON of the contract; [`csv`] and [`plot`]
 //!   (the Fig. 7 PNGs) write the recorded runs.
-//! * [`study`]: several seeds, `robust_tracking` against `robust` cell by cell (issue 9).
+//! * [`study`]: several seeds, `robust_tracking` against `robust` cell by cell.
 //!
 //! Beyond the paper's three controllers, every table has a fourth column,
-//! `robust_tracking` (issue 9): the robust path-tracking gain with pose feedback and the
+//! `robust_tracking`: the robust path-tracking gain with pose feedback and the
 //! along-track speed correction (`nigel_benchmark::control`).
 //!
 //! ```no_run
@@ -47,7 +47,7 @@ pub use table::{run_table, run_table_with, Cell, Options, Table, TableRun};
 pub use nigel_benchmark::{Controller, Fidelity, Maneuver};
 
 /// The controllers of our Table III in its column order: the paper's three and, beyond
-/// the paper (issue 9), `robust_tracking`.
+/// the paper, `robust_tracking`.
 pub const CONTROLLERS: [Controller; 4] = Controller::WITH_TRACKING;
 
 /// `open_loop`, `pole_placement`, `robust`, `robust_tracking` (the JSON and FMU names).

@@ -28,6 +28,8 @@ pub struct FmuEngine {
     maneuver_values: [i32; 6],
     fidelity_values: [i32; 2],
     controller_values: [i32; 4],
+    /// The controller FMU's value of `custom` (the tunable `k_*` gain).
+    custom_value: i32,
     gains: [[[f64; 4]; 4]; 4],
     /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
     /// connection by one step).
@@ -162,6 +164,7 @@ impl FmuEngine {
             maneuver_values,
             fidelity_values,
             controller_values,
+            custom_value: all[3],
             gains,
             algorithm: Algorithm::Ordered,
         })
@@ -181,15 +184,22 @@ impl FmuEngine {
 
     /// The system of one job: three instances `plant`, `controller`, `maneuver`, their
     /// parameters and the closed-loop connections, as [`nigel_benchmark::fmu_system`]
-    /// describes them; the switches take the values read from these FMUs' declarations.
+    /// describes them (docs/closed-loop.svg); the switches take the values read from these
+    /// FMUs' declarations.
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
-        let controller = Controller::WITH_TRACKING.iter().position(|c| *c == job.controller).ok_or_else(|| {
-            Error::Usage(format!(
-                "the controller FMU runs open_loop, pole_placement, robust and robust_tracking, not {}",
-                job.controller
-            ))
-        })?;
+        // the controller FMU's switch value; a custom gain runs as `custom` with its k_* set
+        let controller_value = match job.controller {
+            Controller::Custom(_) => self.custom_value,
+            c => {
+                let i = Controller::WITH_TRACKING.iter().position(|x| *x == c).ok_or_else(|| {
+                    Error::Usage(format!(
+                        "the controller FMU runs open_loop, pole_placement, robust, robust_tracking and custom gains, not {c}"
+                    ))
+                })?;
+                self.controller_values[i]
+            }
+        };
         let description = fmu_system::closed_loop(job.fidelity, job.maneuver, job.controller, job.seed, job.disturbed)
             .map_err(Error::Usage)?;
         let mut b = SystemBuilder::new();
@@ -200,7 +210,7 @@ impl FmuEngine {
             let value = match (name.as_str(), *value) {
                 ("maneuver.maneuver", _) => Value::Integer(self.maneuver_values[index(&Maneuver::ALL, &job.maneuver)]),
                 ("maneuver.fidelity", _) => Value::Integer(self.fidelity_values[index(&Fidelity::ALL, &job.fidelity)]),
-                ("controller.controller", _) => Value::Integer(self.controller_values[controller]),
+                ("controller.controller", _) => Value::Integer(controller_value),
                 (_, StartValue::Real(x)) => Value::Real(x),
                 (_, StartValue::Integer(n)) => Value::Integer(n),
                 (_, StartValue::Boolean(v)) => Value::Boolean(v),
@@ -319,7 +329,11 @@ impl FmuEngine {
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
         let (delta, mu) = (wheels("controller.delta")?, wheels("maneuver.mu")?);
-        let gain = self.gains[index(&Controller::WITH_TRACKING, &job.controller)];
+        let gain = match job.controller {
+            // the custom gain is the one set above (the FMU applies k_* as given)
+            Controller::Custom(_) => job.controller.feedback_gain(),
+            c => self.gains[index(&Controller::WITH_TRACKING, &c)],
+        };
         let run = Run {
             job: *job,
             gain,

@@ -1,0 +1,211 @@
+//! `campaign`: run, shard, submit to Slurm, merge and report a campaign of co-simulations.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use nigel_campaign::report::Report;
+use nigel_campaign::run::{parse_shard, Options, Worker};
+use nigel_campaign::spec::Spec;
+use nigel_campaign::{merge, slurm, Error};
+
+#[derive(Parser)]
+#[command(name = "campaign", version, about = "Campaigns of co-simulations from one TOML description")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the campaign (or a shard of it, or one run) into DIR.
+    Run {
+        /// The description (TOML).
+        spec: PathBuf,
+        /// The output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Only shard I of N (0 <= I < N; contiguous blocks of runs).
+        #[arg(long)]
+        shard: Option<String>,
+        /// Run only the runs the output does not hold yet.
+        #[arg(long)]
+        resume: bool,
+        /// Run only run RUN, recording every output into DIR/run-RUN.csv, and print its row.
+        #[arg(long)]
+        only: Option<u64>,
+    },
+    /// Write the sbatch job-array script DIR/campaign.sbatch (and with --submit, submit it,
+    /// wait for it and merge).
+    Slurm {
+        /// The description (TOML).
+        spec: PathBuf,
+        /// The output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Array tasks (shards).
+        #[arg(long)]
+        tasks: u64,
+        /// Submit with sbatch, wait by polling squeue, then merge.
+        #[arg(long)]
+        submit: bool,
+        /// Slurm partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// CPUs (threads) per task.
+        #[arg(long, default_value_t = 1)]
+        cpus_per_task: u64,
+    },
+    /// Check that the shards in DIR hold every run exactly once and write DIR/results.csv.
+    Merge {
+        /// The output folder.
+        dir: PathBuf,
+    },
+    /// Per group count, mean, median, p95 and worst of each metric (markdown on standard
+    /// output, DIR/report.json); with --png, the figures.
+    Report {
+        /// The output folder.
+        dir: PathBuf,
+        /// Group by these varied columns.
+        #[arg(long, num_args = 1..)]
+        by: Vec<String>,
+        /// Write the PNG figures into this folder.
+        #[arg(long)]
+        png: Option<PathBuf>,
+        /// The metric of the figures and of the worst runs (default: the first).
+        #[arg(long)]
+        metric: Option<String>,
+        /// How many worst runs to list.
+        #[arg(long, default_value_t = 10)]
+        worst: usize,
+    },
+}
+
+/// The description recorded in DIR/campaign.json.
+fn spec_of_dir(dir: &std::path::Path) -> Result<Spec, Error> {
+    let path = dir.join("campaign.json");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| Error::Usage(format!("{}: {e} (not a campaign output folder)", path.display())))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| Error::Usage(format!("{}: {e}", path.display())))?;
+    let desc = v["description"].as_str().ok_or_else(|| Error::Usage(format!("{}: no description", path.display())))?;
+    Spec::load(desc.as_ref())
+}
+
+fn main_inner() -> Result<(), Error> {
+    match Cli::parse().command {
+        Command::Run { spec, out, threads, shard, resume, only } => {
+            let spec = Spec::load(&spec)?;
+            if let Some(i) = only {
+                if i >= spec.runs() {
+                    return Err(Error::Usage(format!("--only {i}: the campaign has runs 0 .. {}", spec.runs() - 1)));
+                }
+                std::fs::create_dir_all(&out).map_err(|e| Error::Io(format!("{}: {e}", out.display())))?;
+                let worker = Worker::new(&spec)?;
+                let row = worker.run(i);
+                let header = spec.header();
+                let line = row.line();
+                for (h, v) in header.iter().zip(line.trim_end().split(',')) {
+                    println!("{h:>24} = {v}");
+                }
+                if !row.message.is_empty() {
+                    println!("{:>24} : {}", "message", row.message);
+                }
+                let path = out.join(format!("run-{i}.csv"));
+                let recorded = worker.run_recorded(i).map_err(|e| Error::Usage(format!("run {i}: {e}")))?;
+                let f = std::fs::File::create(&path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+                recorded
+                    .write_csv(std::io::BufWriter::new(f))
+                    .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+                eprintln!("every output of run {i}: {}", path.display());
+                return Ok(());
+            }
+            let shard = shard.as_deref().map(parse_shard).transpose()?;
+            let options = Options { out, threads, shard, resume, progress: true };
+            let done = nigel_campaign::run::run(&spec, &options)?;
+            eprintln!(
+                "{} runs in {:.1} s on {} threads ({:.0} runs/min), {} failed, {} already done: {}",
+                done.ran,
+                done.wall.as_secs_f64(),
+                done.threads,
+                done.ran as f64 / done.wall.as_secs_f64().max(1e-9) * 60.0,
+                done.failed,
+                done.kept,
+                done.rows.display()
+            );
+            Ok(())
+        }
+        Command::Slurm { spec, out, tasks, submit, partition, cpus_per_task } => {
+            let spec = Spec::load(&spec)?;
+            let program = std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?;
+            let array = slurm::Array { out: out.clone(), tasks, partition, cpus_per_task, program };
+            let script = slurm::write(&spec, &array)?;
+            eprintln!("{} ({} runs in {tasks} tasks)", script.display(), spec.runs());
+            if !submit {
+                println!("sbatch {}", script.display());
+                return Ok(());
+            }
+            let job = slurm::submit(&script)?;
+            eprintln!("submitted job {job}");
+            let waited = slurm::wait(&job, |_| {})?;
+            let states = slurm::task_states(&job).unwrap_or_default();
+            let bad: Vec<String> =
+                states.iter().filter(|(_, s)| s != "COMPLETED").map(|(t, s)| format!("task {t} {s}")).collect();
+            eprintln!(
+                "job {job} left the queue after {:.1} s{}",
+                waited.as_secs_f64(),
+                if bad.is_empty() { String::new() } else { format!(" ({})", bad.join(", ")) }
+            );
+            let m = merge::merge(&out, &spec)?;
+            eprintln!(
+                "merged {} shards: {} runs, {} failed: {}",
+                m.shards,
+                m.runs,
+                m.failed,
+                out.join("results.csv").display()
+            );
+            Ok(())
+        }
+        Command::Merge { dir } => {
+            let spec = spec_of_dir(&dir)?;
+            let m = merge::merge(&dir, &spec)?;
+            eprintln!(
+                "merged {} shards: {} runs, {} failed: {}",
+                m.shards,
+                m.runs,
+                m.failed,
+                dir.join("results.csv").display()
+            );
+            Ok(())
+        }
+        Command::Report { dir, by, png, metric, worst } => {
+            let spec = spec_of_dir(&dir)?;
+            let report = Report::load(spec, &dir, &by)?;
+            let m = report.metric(metric.as_deref())?;
+            print!("{}", report.markdown(m, worst));
+            let path = dir.join("report.json");
+            let text = serde_json::to_string_pretty(&report.json(m, worst)).expect("JSON of plain values");
+            std::fs::write(&path, text + "\n").map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+            eprintln!("{}", path.display());
+            if let Some(d) = png {
+                for p in report.pngs(m, &d)? {
+                    eprintln!("{}", p.display());
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match main_inner() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("campaign: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

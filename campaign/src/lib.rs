@@ -1,0 +1,58 @@
+//! `nigel_campaign`: thousands of co-simulations from one TOML description.
+//!
+//! - [`spec`]: the description (system, experiment, grid, named cases, random draws,
+//!   metrics), checked against the system's variables (type, declared min / max).
+//! - [`rng`]: run `i`'s random values from `(seed, column, i)` only.
+//! - [`metric`]: per-run metrics over `t_1 .. t_N`, accumulated point by point.
+//! - [`run`]: the runs of a block on N threads, each thread loading the system once;
+//!   rows written as they finish; failed runs are rows with their status and message.
+//! - [`results`]: the output folder's files; [`merge`] joins shards; [`slurm`] writes and
+//!   submits the job array; [`report`] summarises (markdown, JSON, PNG).
+//!
+//! ```no_run
+//! use nigel_campaign::{spec::Spec, run::{run, Options}};
+//! let spec = Spec::load("campaigns/example.toml".as_ref())?;
+//! let done = run(&spec, &Options::new("out".into()))?;
+//! println!("{} runs, {} failed", done.ran, done.failed);
+//! # Ok::<(), nigel_campaign::Error>(())
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod merge;
+pub mod metric;
+pub mod report;
+pub mod results;
+pub mod rng;
+pub mod run;
+pub mod slurm;
+pub mod spec;
+
+/// What can go wrong, each a one-line message naming the culprit.
+#[derive(Debug)]
+pub enum Error {
+    /// The description is malformed or does not fit the system.
+    Spec(String),
+    /// A command-line or folder problem.
+    Usage(String),
+    /// A shard is missing, foreign or overlaps another.
+    Merge(String),
+    /// Reading or writing a file.
+    Io(String),
+    /// Slurm refused or failed.
+    Slurm(String),
+    /// Drawing a figure.
+    Plot(String),
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Spec(m) | Error::Usage(m) | Error::Merge(m) | Error::Io(m) | Error::Slurm(m) | Error::Plot(m) => {
+                f.write_str(m)
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {}
