@@ -11,6 +11,9 @@
 //!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
 //!   those connected to each other advancing together with one event iteration across
 //!   them ([`Error::EventIteration`] when it has no fixed point).
+//! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
+//!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
+//!   ([`simulate::simulate_recorded`]).
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};

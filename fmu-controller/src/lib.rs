@@ -220,8 +220,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
     };
     v.extend(per_wheel("delta", vr::DELTA, Var::Steer, |d, i| {
         d.discrete_output(Dependencies::On(steer_deps(i as u32))).unit("rad").describe(
-            "steering command delta_ff + K (x - x_ref) (robust_tracking: delta_ff + K_track e), clamped to \
-             +-delta_max; held over a sample",
+            "steering command delta_ff + K (q - q_ref), q = [beta, yaw_rate] (robust_tracking: \
+             delta_ff + K_track e), clamped to +-delta_max; held over a sample",
         )
     }));
     v.extend(per_wheel("tau", vr::TAU, Var::Torque, |d, _| {
