@@ -11,6 +11,8 @@
 //! * [`control`]: the sampled law `delta = delta_ff + K (x - x_ref)` with the speed-hold PI,
 //!   [`SampledController`]; beyond the paper, the robust tracking law on the pose errors with
 //!   the along-track speed correction ([`Controller::RobustTracking`]); the baked gains in [`gains`].
+//! * [`fmu_system`]: the closed loop as the three FMUs' instances, parameters and connections
+//!   (what build-fmu writes as SSP and nigel-table3 co-simulates).
 //! * [`run`]: the figure-8 switching table, the reference (kept per process:
 //!   [`Benchmark::shared_reference`]), closed-loop runs and the metric; [`BenchSampler`], the
 //!   test bench's outputs sample by sample (what the test-bench FMU runs).
@@ -45,6 +47,7 @@
 #![warn(missing_docs)]
 
 pub mod control;
+pub mod fmu_system;
 pub mod gain_file;
 pub mod gains;
 pub mod noise;

@@ -65,11 +65,9 @@ mod tests {
     /// machine and is still far below the 2^-53 steps of the uniforms that feed `g`.
     #[test]
     fn gaussian_vectors() {
-        for (got, want) in [
-            (g(0, 5, 0), 0.014334745996352224),
-            (g(0, 5, 1), 0.5906209568869251),
-            (g(3, 6, 100), -0.5936807237213725),
-        ] {
+        for (got, want) in
+            [(g(0, 5, 0), 0.014334745996352224), (g(0, 5, 1), 0.5906209568869251), (g(3, 6, 100), -0.5936807237213725)]
+        {
             assert!((got - want).abs() <= 1e-15 * want.abs(), "{got:e} vs {want:e}");
         }
     }

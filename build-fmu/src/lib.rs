@@ -1,5 +1,8 @@
 //! Packaging of FMUs: the archive layout importers expect, generated from the models'
-//! declarations, written deterministically (fixed order, timestamps and permissions).
+//! declarations, written deterministically (fixed order, timestamps and permissions), with
+//! one library per [`Platform`] in each archive.
+
+pub mod platform;
 
 use std::fmt::Write as _;
 use std::io::{Cursor, Write};
@@ -9,6 +12,8 @@ use std::process::Command;
 use fmi2_export::model_description::{ModelDescription, VariableType};
 use fmi2_export::{Declaration, Model};
 use zip::write::SimpleFileOptions;
+
+pub use platform::Platform;
 
 /// One FMU this workspace ships. Everything but the package name comes from the model's
 /// declaration (identifier, interfaces, variables, documentation).
@@ -60,24 +65,97 @@ pub fn targets() -> Vec<FmuTarget> {
 }
 
 /// `manifest.json` written next to the archives (and printed by `build-fmu --list`): one
-/// object per FMU with its model identifier, package, archive file name and interfaces,
-/// so that tests iterate over exactly what was built.
-pub fn manifest(targets: &[FmuTarget]) -> String {
-    let entries: Vec<String> = targets
+/// object per FMU with its model identifier, package, archive file name, interfaces and the
+/// platforms its archive carries (each with its library, minimum OS, C library and how it is
+/// tested), so that tests iterate over exactly what was built.
+pub fn manifest(targets: &[FmuTarget], platforms: &[PlatformBuild]) -> String {
+    let entries: Vec<serde_json::Value> = targets
         .iter()
         .map(|t| {
-            let interfaces: Vec<String> = t.interfaces().iter().map(|i| format!("\"{i}\"")).collect();
-            format!(
-                "  {{\"model_identifier\": \"{id}\", \"package\": \"{package}\", \"fmu\": \"{id}.fmu\", \
-                 \"guid\": \"{guid}\", \"interfaces\": [{interfaces}]}}",
-                id = t.model_identifier,
-                package = t.package,
-                guid = t.description.guid,
-                interfaces = interfaces.join(", "),
-            )
+            serde_json::json!({
+                "model_identifier": t.model_identifier,
+                "package": t.package,
+                "fmu": format!("{}.fmu", t.model_identifier),
+                "guid": t.description.guid,
+                "interfaces": t.interfaces(),
+                "platforms": platforms.iter().map(|p| serde_json::json!({
+                    "folder": p.platform.folder(),
+                    "library": format!("binaries/{}/{}", p.platform.folder(), p.platform.library_file(&t.model_identifier)),
+                    "minimum_os": p.minimum_os,
+                    "c_library": p.c_library,
+                    "tested": p.platform.tested(),
+                })).collect::<Vec<_>>(),
+            })
         })
         .collect();
-    format!("[\n{}\n]\n", entries.join(",\n"))
+    let mut text = serde_json::to_string_pretty(&entries).unwrap_or_default();
+    text.push('\n');
+    text
+}
+
+/// What one platform of an archive needs and how it was built: the [`Platform`]'s own text,
+/// except on linux64 without the cross tools, where the library is the build machine's and
+/// its glibc requirement is read from the library itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlatformBuild {
+    /// The platform.
+    pub platform: Platform,
+    /// What the library needs on the user's machine.
+    pub minimum_os: String,
+    /// The C library it links against.
+    pub c_library: String,
+}
+
+impl PlatformBuild {
+    /// The platform as [`Platform::build`] builds it with its cross toolchain.
+    pub fn of(platform: Platform) -> PlatformBuild {
+        PlatformBuild {
+            platform,
+            minimum_os: platform.minimum_os().to_string(),
+            c_library: platform.c_library().to_string(),
+        }
+    }
+}
+
+/// The highest `GLIBC_2.N` symbol version an ELF library names (its version-needed
+/// strings), as `(2, N)`; `None` when it names none.
+pub fn glibc_requirement(library: &[u8]) -> Option<(u32, u32)> {
+    let needle = b"GLIBC_2.";
+    let mut best = None;
+    let mut i = 0;
+    while let Some(pos) = library[i..].windows(needle.len()).position(|w| w == needle) {
+        let start = i + pos + needle.len();
+        let digits: String = library[start..].iter().take_while(|b| b.is_ascii_digit()).map(|&b| b as char).collect();
+        if let Ok(minor) = digits.parse::<u32>() {
+            best = best.max(Some((2, minor)));
+        }
+        i = start;
+    }
+    best
+}
+
+/// The platforms' part of `documentation/index.html`: a table of the platforms the archive
+/// carries, inserted before the end of the body.
+pub fn with_platform_table(documentation: &str, model_identifier: &str, platforms: &[PlatformBuild]) -> String {
+    let mut table = String::from(
+        "<h2>Platforms</h2>\n<table>\n<tr><th>folder</th><th>library</th><th>needs</th><th>C library</th><th>tested</th></tr>\n",
+    );
+    for p in platforms {
+        let _ = writeln!(
+            table,
+            "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            p.platform.folder(),
+            escape(&p.platform.library_file(model_identifier)),
+            escape(&p.minimum_os),
+            escape(&p.c_library),
+            escape(p.platform.tested()),
+        );
+    }
+    table.push_str("</table>\n");
+    match documentation.rfind("</body>") {
+        Some(i) => format!("{}{table}{}", &documentation[..i], &documentation[i..]),
+        None => format!("{documentation}{table}"),
+    }
 }
 
 /// The closed loop of the three FMUs, drawn into every FMU's documentation.
@@ -186,20 +264,29 @@ impl std::fmt::Display for BuildError {
 
 impl std::error::Error for BuildError {}
 
-/// The archive bytes: `modelDescription.xml`, `binaries/linux64/<id>.so`,
-/// `documentation/index.html`, in that order, with fixed timestamps and modes.
-pub fn archive(xml: &str, library: &[u8], model_identifier: &str, documentation: &str) -> Result<Vec<u8>, BuildError> {
+/// The archive bytes: `modelDescription.xml`, `binaries/<platform>/<id>.<ext>` for each
+/// library (in the order given), `documentation/index.html`, with fixed timestamps and modes.
+pub fn archive(
+    xml: &str,
+    libraries: &[(Platform, &[u8])],
+    model_identifier: &str,
+    documentation: &str,
+) -> Result<Vec<u8>, BuildError> {
     let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
     let options = SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .last_modified_time(zip::DateTime::default())
         .unix_permissions(0o644);
     let err = |e: zip::result::ZipError| BuildError::Zip(e.to_string());
-    let entries: [(String, &[u8], u32); 3] = [
-        ("modelDescription.xml".into(), xml.as_bytes(), 0o644),
-        (format!("binaries/linux64/{model_identifier}.so"), library, 0o755),
-        ("documentation/index.html".into(), documentation.as_bytes(), 0o644),
-    ];
+    let mut entries: Vec<(String, &[u8], u32)> = vec![("modelDescription.xml".into(), xml.as_bytes(), 0o644)];
+    for (platform, bytes) in libraries {
+        entries.push((
+            format!("binaries/{}/{}", platform.folder(), platform.library_file(model_identifier)),
+            bytes,
+            0o755,
+        ));
+    }
+    entries.push(("documentation/index.html".into(), documentation.as_bytes(), 0o644));
     for (name, bytes, mode) in entries {
         zip.start_file(name, options.unix_permissions(mode)).map_err(err)?;
         zip.write_all(bytes).map_err(|e| BuildError::Zip(e.to_string()))?;
@@ -214,40 +301,114 @@ pub fn target_dir() -> PathBuf {
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap_or(Path::new(".")).join("target"))
 }
 
-/// Builds the shared library of `target` (release, with the fmi2 symbols exported)
-/// and returns its path.
-pub fn build_library(target: &FmuTarget) -> Result<PathBuf, BuildError> {
+/// Builds the libraries of every target for linux64 with the workspace's own cargo (no
+/// cross tools: the glibc baseline is the build machine's) and returns their paths.
+pub fn build_host_linux64(targets: &[FmuTarget]) -> Result<Vec<PathBuf>, BuildError> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
-    let status = Command::new(cargo)
-        .args([
-            "build",
-            "--release",
-            "--quiet",
-            "--package",
-            target.package,
-            "--features",
-            "fmi-export",
-            "--manifest-path",
-        ])
-        .arg(&manifest)
-        .status()
-        .map_err(|e| BuildError::Cargo(e.to_string()))?;
-    if !status.success() {
-        return Err(BuildError::Cargo(format!("{} exited with {status}", target.package)));
+    let mut c = Command::new(cargo);
+    c.args(["build", "--release", "--quiet"]);
+    for t in targets {
+        c.args(["--package", t.package]);
     }
-    Ok(target_dir().join("release").join(format!("lib{}.so", target.model_identifier)))
+    let features: Vec<String> = targets.iter().map(|t| format!("{}/fmi-export", t.package)).collect();
+    c.args(["--features", &features.join(","), "--manifest-path"]).arg(&manifest);
+    let status = c.status().map_err(|e| BuildError::Cargo(e.to_string()))?;
+    if !status.success() {
+        return Err(BuildError::Cargo(format!("linux64 (host toolchain): cargo exited with {status}")));
+    }
+    Ok(targets.iter().map(|t| target_dir().join("release").join(format!("lib{}.so", t.model_identifier))).collect())
 }
 
-/// Builds and writes `<out_dir>/<id>.fmu`; returns its path and size.
-pub fn build(target: &FmuTarget, out_dir: &Path) -> Result<(PathBuf, usize), BuildError> {
-    let library_path = build_library(target)?;
-    let library = std::fs::read(&library_path).map_err(|e| BuildError::Io(library_path.clone(), e))?;
-    let bytes = archive(&target.description.to_xml(), &library, &target.model_identifier, &target.documentation)?;
+/// Writes the closed loop `job` of the benchmark (`column/maneuver/controller`, e.g.
+/// `sim/lane_change/robust`, noise seed `seed`) as an SSP 1.0 archive at `ssp_path`: the
+/// instances, parameters and connections of [`nigel_benchmark::fmu_system::closed_loop`]
+/// over the archives in `fmu_dir`, written by `nigel_cosim::write_ssp` (default experiment
+/// 0 .. 30 s).
+pub fn write_closed_loop_ssp(fmu_dir: &Path, job: &str, seed: u64, ssp_path: &Path) -> Result<(), String> {
+    use nigel_benchmark::fmu_system::{closed_loop, StartValue};
+    use nigel_benchmark::{Controller, Fidelity, Maneuver};
+    let bad = || format!("{job:?} is not column/maneuver/controller (e.g. sim/lane_change/robust)");
+    let parts: Vec<&str> = job.split('/').collect();
+    let [column, maneuver, controller] = parts[..] else { return Err(bad()) };
+    let fidelity = Fidelity::ALL.into_iter().find(|f| f.column() == column).ok_or_else(bad)?;
+    let maneuver = Maneuver::from_name(maneuver).ok_or_else(bad)?;
+    let controller = Controller::WITH_TRACKING.into_iter().find(|c| c.name() == controller).ok_or_else(bad)?;
+    let description = closed_loop(fidelity, maneuver, controller, seed, true)?;
+    let mut b = nigel_cosim::SystemBuilder::new();
+    for (instance, model_identifier) in &description.instances {
+        let path = fmu_dir.join(format!("{model_identifier}.fmu"));
+        let fmu = nigel_cosim::Fmu::load(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        b.add_instance(instance, fmu).map_err(|e| e.to_string())?;
+    }
+    for (name, value) in &description.parameters {
+        let value = match *value {
+            StartValue::Real(x) => nigel_cosim::Value::Real(x),
+            StartValue::Integer(n) => nigel_cosim::Value::Integer(n),
+            StartValue::Boolean(v) => nigel_cosim::Value::Boolean(v),
+        };
+        b.set(name, value).map_err(|e| e.to_string())?;
+    }
+    for (from, to) in &description.connections {
+        b.connect(from, to).map_err(|e| e.to_string())?;
+    }
+    if let Some(dir) = ssp_path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    nigel_cosim::write_ssp(&b.build(), "nigel_closed_loop", Some(description.stop_time), ssp_path)
+        .map_err(|e| format!("{}: {e}", ssp_path.display()))
+}
+
+/// Builds every target for every platform of `platforms` and writes `<out_dir>/<id>.fmu`
+/// for each, carrying all those platforms; returns each archive's path and size.
+///
+/// linux64 is built with cargo-zigbuild (glibc 2.17 baseline) when it is installed, else
+/// with the workspace's cargo (the build machine's glibc, read from the libraries and
+/// reported in the returned [`PlatformBuild`]).
+pub fn build_all(
+    targets: &[FmuTarget],
+    platforms: &[Platform],
+    out_dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<(PathBuf, usize)>, Vec<PlatformBuild>), BuildError> {
+    let packages: Vec<&str> = targets.iter().map(|t| t.package).collect();
+    let ids: Vec<&str> = targets.iter().map(|t| t.model_identifier.as_str()).collect();
+    let mut libraries: Vec<(PlatformBuild, Vec<Vec<u8>>)> = Vec::new();
+    for &platform in platforms {
+        let started = std::time::Instant::now();
+        let mut built = PlatformBuild::of(platform);
+        let paths = if platform == Platform::Linux64 && platform.missing_toolchain().is_some() {
+            build_host_linux64(targets)?
+        } else {
+            platform.build(&packages, &ids, &target_dir())?
+        };
+        let mut bytes = Vec::new();
+        for path in &paths {
+            bytes.push(std::fs::read(path).map_err(|e| BuildError::Io(path.clone(), e))?);
+        }
+        if platform == Platform::Linux64 || platform == Platform::Aarch64Linux {
+            let needed = bytes.iter().filter_map(|b| glibc_requirement(b)).max();
+            if let Some((major, minor)) = needed.filter(|&(_, minor)| minor > 17) {
+                built.c_library =
+                    format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
+                built.minimum_os = format!("Linux with glibc {major}.{minor} or later");
+            }
+        }
+        progress(&format!("{}: built in {:.1} s", platform.folder(), started.elapsed().as_secs_f64()));
+        libraries.push((built, bytes));
+    }
+    let builds: Vec<PlatformBuild> = libraries.iter().map(|(b, _)| b.clone()).collect();
     std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
-    let path = out_dir.join(format!("{}.fmu", target.model_identifier));
-    std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
-    Ok((path, bytes.len()))
+    let mut written = Vec::new();
+    for (i, target) in targets.iter().enumerate() {
+        let libs: Vec<(Platform, &[u8])> = libraries.iter().map(|(b, l)| (b.platform, l[i].as_slice())).collect();
+        let documentation = with_platform_table(&target.documentation, &target.model_identifier, &builds);
+        let bytes = archive(&target.description.to_xml(), &libs, &target.model_identifier, &documentation)?;
+        let path = out_dir.join(format!("{}.fmu", target.model_identifier));
+        std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
+        written.push((path, bytes.len()));
+    }
+    Ok((written, builds))
 }
 
 #[cfg(test)]
@@ -259,12 +420,21 @@ mod tests {
         let t = &targets()[0];
         let xml = t.description.to_xml();
         let doc = &t.documentation;
-        let a = archive(&xml, b"\x7fELF fake", &t.model_identifier, doc).unwrap();
-        let b = archive(&xml, b"\x7fELF fake", &t.model_identifier, doc).unwrap();
+        let libs: [(Platform, &[u8]); 2] = [(Platform::Linux64, b"\x7fELF fake"), (Platform::Win64, b"MZ fake")];
+        let a = archive(&xml, &libs, &t.model_identifier, doc).unwrap();
+        let b = archive(&xml, &libs, &t.model_identifier, doc).unwrap();
         assert_eq!(a, b);
         let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
         let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
-        assert_eq!(names, ["modelDescription.xml", "binaries/linux64/nigel_plant.so", "documentation/index.html"]);
+        assert_eq!(
+            names,
+            [
+                "modelDescription.xml",
+                "binaries/linux64/nigel_plant.so",
+                "binaries/win64/nigel_plant.dll",
+                "documentation/index.html"
+            ]
+        );
         let mut text = String::new();
         std::io::Read::read_to_string(&mut z.by_name("modelDescription.xml").unwrap(), &mut text).unwrap();
         assert_eq!(text, xml);
@@ -352,12 +522,55 @@ mod tests {
     }
 
     #[test]
-    fn manifest_lists_every_target_with_its_interfaces() {
+    fn manifest_lists_every_target_with_its_interfaces_and_platforms() {
         let ts = targets();
-        let m = manifest(&ts);
-        for t in &ts {
-            assert!(m.contains(&format!("\"fmu\": \"{}.fmu\"", t.model_identifier)), "{m}");
+        let builds: Vec<PlatformBuild> = Platform::ALL.into_iter().map(PlatformBuild::of).collect();
+        let m = manifest(&ts, &builds);
+        let parsed: serde_json::Value = serde_json::from_str(&m).unwrap();
+        let entries = parsed.as_array().unwrap();
+        assert_eq!(entries.len(), ts.len());
+        for (t, e) in ts.iter().zip(entries) {
+            assert_eq!(e["fmu"], format!("{}.fmu", t.model_identifier));
+            let folders: Vec<&str> =
+                e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap()).collect();
+            assert_eq!(folders, ["linux64", "win64", "aarch64-linux", "darwin64"]);
+            assert_eq!(e["platforms"][1]["library"], format!("binaries/win64/{}.dll", t.model_identifier));
+            assert_eq!(e["platforms"][3]["library"], format!("binaries/darwin64/{}.dylib", t.model_identifier));
         }
-        assert!(m.contains(r#""interfaces": ["CoSimulation", "ModelExchange"]"#), "{m}");
+        assert_eq!(entries[0]["interfaces"], serde_json::json!(["CoSimulation", "ModelExchange"]));
+        // test.sh reads the identifiers with grep
+        assert!(m.contains(r#""model_identifier": "nigel_plant""#), "{m}");
+    }
+
+    #[test]
+    fn glibc_requirement_is_the_highest_version_named() {
+        let lib = b"\x7fELF..libm.so.6\0GLIBC_2.2.5\0hypot\0GLIBC_2.35\0GLIBC_2.17\0GLIBC_PRIVATE\0";
+        assert_eq!(glibc_requirement(lib), Some((2, 35)));
+        assert_eq!(glibc_requirement(b"GLIBC_2.3.4\0GLIBC_2.14"), Some((2, 14)));
+        assert_eq!(glibc_requirement(b"no versions"), None);
+    }
+
+    #[test]
+    fn documentation_gets_one_platform_row_per_platform_before_the_end() {
+        let t = &targets()[1];
+        let builds: Vec<PlatformBuild> = Platform::ALL.into_iter().map(PlatformBuild::of).collect();
+        let doc = with_platform_table(&t.documentation, &t.model_identifier, &builds);
+        assert!(doc.ends_with("</table>\n</body></html>\n"), "{doc}");
+        assert_eq!(doc.matches("<tr><td><code>").count(), t.description.model_variables.len() + 4);
+        assert!(doc.contains(
+            "<tr><td><code>win64</code></td><td><code>nigel_controller.dll</code></td><td>64-bit Windows 10 or later"
+        ));
+        assert!(doc.contains(
+            "<td><code>darwin64</code></td><td><code>nigel_controller.dylib</code></td><td>macOS 11 or later"
+        ));
+        assert!(doc.contains("not executed (no macOS here)"));
+    }
+
+    #[test]
+    fn platform_folders_round_trip() {
+        for p in Platform::ALL {
+            assert_eq!(Platform::from_folder(p.folder()), Some(p));
+        }
+        assert_eq!(Platform::from_folder("win32"), None);
     }
 }

@@ -15,8 +15,25 @@ use crate::{Error, Run};
 
 /// The column names, in order (written quoted).
 pub const COLUMNS: [&str; 19] = [
-    "time", "x", "y", "psi", "x_ref", "y_ref", "psi_ref", "beta", "yaw_rate", "beta_ref", "yaw_rate_ref", "delta_fl",
-    "delta_fr", "delta_rl", "delta_rr", "mu_fl", "mu_fr", "mu_rl", "mu_rr",
+    "time",
+    "x",
+    "y",
+    "psi",
+    "x_ref",
+    "y_ref",
+    "psi_ref",
+    "beta",
+    "yaw_rate",
+    "beta_ref",
+    "yaw_rate_ref",
+    "delta_fl",
+    "delta_fr",
+    "delta_rl",
+    "delta_rr",
+    "mu_fl",
+    "mu_fr",
+    "mu_rl",
+    "mu_rr",
 ];
 
 /// `sim_skidpad_robust.csv`.
@@ -27,11 +44,7 @@ pub fn file_name(run: &Run) -> String {
 
 /// Writes `run` as CSV to `w`.
 pub fn write<W: Write>(run: &Run, mut w: W) -> std::io::Result<()> {
-    writeln!(
-        w,
-        "{}",
-        COLUMNS.iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(",")
-    )?;
+    writeln!(w, "{}", COLUMNS.iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(","))?;
     let n = run.n_samples();
     for k in 0..=n {
         write!(

@@ -124,7 +124,11 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
         (x0, x1) = (cx - scale * pw / 2.0, cx + scale * pw / 2.0);
         (y0, y1) = (cy - scale * ph / 2.0, cy + scale * ph / 2.0);
     }
-    let caption = if equal { maneuver.name().to_string() } else { format!("{} (Y stretched: axes not to scale)", maneuver.name()) };
+    let caption = if equal {
+        maneuver.name().to_string()
+    } else {
+        format!("{} (Y stretched: axes not to scale)", maneuver.name())
+    };
     let mut chart = ChartBuilder::on(area)
         .caption(caption, ("sans-serif", 22))
         .margin(8)
@@ -151,7 +155,7 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
         .map_err(&err)?;
     for r in runs {
         let c = color(r.job.controller);
-                chart.draw_series(LineSeries::new(sampled(n).map(|k| (r.x[k], r.y[k])), c.stroke_width(2))).map_err(&err)?;
+        chart.draw_series(LineSeries::new(sampled(n).map(|k| (r.x[k], r.y[k])), c.stroke_width(2))).map_err(&err)?;
     }
     // direction of travel on the reference: a filled triangle every ARROW_EVERY seconds,
     // pointing along the reference heading (drawn in pixels, so it keeps its shape on

@@ -116,3 +116,23 @@ def test_closed_loop_ssp_binds_only_what_every_importer_applies():
     assert names == {"initialValues"}
     assert float(bound["plant.v_x_start"]) == 0.35
     assert int(bound["maneuver.maneuver"]) == 2 and int(bound["controller.controller"]) == 3
+
+
+@pytest.mark.parametrize("model_identifier", IDS)
+def test_fmpy_finds_the_library_of_every_platform_the_manifest_lists(model_identifier):
+    import zipfile
+
+    from fmpy import supported_platforms
+
+    e = entry_for(model_identifier)
+    path = FMU_DIR / e["fmu"]
+    with zipfile.ZipFile(path) as z:
+        names = set(z.namelist())
+    found = set(supported_platforms(str(path)))
+    folders = [p["folder"] for p in e["platforms"]]
+    assert "linux64" in folders
+    for p in e["platforms"]:
+        assert p["library"] in names, p
+        # fmpy names the FMI 2 platforms; aarch64-linux is FMI 3's folder, which it may not list
+        if p["folder"] in ("linux64", "win64", "darwin64"):
+            assert p["folder"] in found, (p["folder"], found)

@@ -8,7 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use nigel_benchmark::{Controller, Fidelity, Maneuver, DEFAULT_SPEED, N_SAMPLES, SAMPLE_PERIOD};
+use nigel_benchmark::fmu_system::{self, StartValue};
+use nigel_benchmark::{Controller, Fidelity, Maneuver, N_SAMPLES, SAMPLE_PERIOD};
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Results, System, SystemBuilder, Value};
 
 use super::{Engine, Job, Run};
@@ -182,72 +183,42 @@ impl FmuEngine {
     }
 
     /// The system of one job: three instances `plant`, `controller`, `maneuver`, their
-    /// parameters and the closed-loop connections (docs/closed-loop.svg).
+    /// parameters and the closed-loop connections, as [`nigel_benchmark::fmu_system`]
+    /// describes them (docs/closed-loop.svg); the switches take the values read from these
+    /// FMUs' declarations.
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
         // the controller FMU's switch value; a custom gain runs as `custom` with its k_* set
-        let (controller_value, custom) = match job.controller {
-            Controller::Custom(k) => (self.custom_value, Some(k)),
+        let controller_value = match job.controller {
+            Controller::Custom(_) => self.custom_value,
             c => {
                 let i = Controller::WITH_TRACKING.iter().position(|x| *x == c).ok_or_else(|| {
                     Error::Usage(format!(
                         "the controller FMU runs open_loop, pole_placement, robust, robust_tracking and custom gains, not {c}"
                     ))
                 })?;
-                (self.controller_values[i], None)
+                self.controller_values[i]
             }
         };
-        let seed = i32::try_from(job.seed).map_err(|_| {
-            Error::Usage(format!("seed {} does not fit the test bench's Integer seed (0 ..= {})", job.seed, i32::MAX))
-        })?;
+        let description = fmu_system::closed_loop(job.fidelity, job.maneuver, job.controller, job.seed, job.disturbed)
+            .map_err(Error::Usage)?;
         let mut b = SystemBuilder::new();
-        b.add_instance("plant", self.plant.clone()).map_err(ctx)?;
-        b.add_instance("controller", self.controller.clone()).map_err(ctx)?;
-        b.add_instance("maneuver", self.maneuver.clone()).map_err(ctx)?;
-        b.set("maneuver.maneuver", Value::Integer(self.maneuver_values[index(&Maneuver::ALL, &job.maneuver)]))
-            .map_err(ctx)?;
-        b.set("maneuver.fidelity", Value::Integer(self.fidelity_values[index(&Fidelity::ALL, &job.fidelity)]))
-            .map_err(ctx)?;
-        b.set("maneuver.seed", Value::Integer(seed)).map_err(ctx)?;
-        if !job.disturbed {
-            for switch in ["friction_variation", "wind", "measurement_noise"] {
-                b.set(&format!("maneuver.{switch}"), Value::Boolean(false)).map_err(ctx)?;
-            }
+        for (instance, fmu) in description.instances.iter().zip([&self.plant, &self.controller, &self.maneuver]) {
+            b.add_instance(instance.0, fmu.clone()).map_err(ctx)?;
         }
-        b.set("controller.controller", Value::Integer(controller_value)).map_err(ctx)?;
-        if let Some(k) = custom {
-            for (row, w) in k.iter().zip(WHEELS) {
-                b.set(&format!("controller.k_beta_{w}"), Value::Real(row[0])).map_err(ctx)?;
-                b.set(&format!("controller.k_yaw_rate_{w}"), Value::Real(row[1])).map_err(ctx)?;
-            }
+        for (name, value) in &description.parameters {
+            let value = match (name.as_str(), *value) {
+                ("maneuver.maneuver", _) => Value::Integer(self.maneuver_values[index(&Maneuver::ALL, &job.maneuver)]),
+                ("maneuver.fidelity", _) => Value::Integer(self.fidelity_values[index(&Fidelity::ALL, &job.fidelity)]),
+                ("controller.controller", _) => Value::Integer(controller_value),
+                (_, StartValue::Real(x)) => Value::Real(x),
+                (_, StartValue::Integer(n)) => Value::Integer(n),
+                (_, StartValue::Boolean(v)) => Value::Boolean(v),
+            };
+            b.set(name, value).map_err(ctx)?;
         }
-        let real = job.fidelity == Fidelity::Real;
-        for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
-            b.set(&format!("plant.{switch}"), Value::Boolean(real)).map_err(ctx)?;
-        }
-        // the initial speed is a parameter (the state v_x is calculated from it), so that
-        // every importer applies it from an SSP's parameter bindings
-        b.set("plant.v_x_start", Value::Real(DEFAULT_SPEED)).map_err(ctx)?;
-        let mut connect = |from: &str, to: &str| b.connect(from, to).map(|_| ()).map_err(ctx);
-        for w in WHEELS {
-            connect(&format!("controller.delta_{w}"), &format!("plant.delta_{w}"))?;
-            connect(&format!("controller.tau_{w}"), &format!("plant.tau_{w}"))?;
-            connect(&format!("maneuver.mu_{w}"), &format!("plant.mu_{w}"))?;
-            connect(&format!("maneuver.delta_ff_{w}"), &format!("controller.delta_ff_{w}"))?;
-        }
-        connect("maneuver.wind_x", "plant.wind_x")?;
-        connect("maneuver.wind_y", "plant.wind_y")?;
-        connect("maneuver.beta_meas", "controller.beta")?;
-        connect("maneuver.yaw_rate_meas", "controller.yaw_rate")?;
-        connect("plant.speed", "controller.speed")?;
-        connect("maneuver.beta_ref", "controller.beta_ref")?;
-        connect("maneuver.yaw_rate_ref", "controller.yaw_rate_ref")?;
-        connect("maneuver.speed_ref", "controller.speed_ref")?;
-        connect("plant.beta", "maneuver.beta")?;
-        connect("plant.yaw_rate", "maneuver.yaw_rate")?;
-        for pose in ["x", "y", "psi"] {
-            connect(&format!("plant.{pose}"), &format!("controller.{pose}"))?;
-            connect(&format!("maneuver.{pose}_ref"), &format!("controller.{pose}_ref"))?;
+        for (from, to) in &description.connections {
+            b.connect(from, to).map_err(ctx)?;
         }
         Ok(b.build())
     }

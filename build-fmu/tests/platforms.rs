@@ -1,0 +1,523 @@
+//! The archives' libraries on each platform they carry (`target/fmu/*.fmu`, as build-fmu
+//! wrote them; `target/ssp/nigel_closed_loop.ssp` gives the closed loop's wiring):
+//!
+//! - linux64: no symbol version above GLIBC_2.17 (`objdump -T`), 44 fmi2 exports; the C
+//!   importer `tests/c/fmi2_closed_loop.c`, built with gcc, runs the closed loop of plant,
+//!   controller and test bench 30 s at 1 ms (Jacobi), and its CSV equals nigel_cosim's
+//!   Jacobi run of the same SSP bit for bit (two importers, one answer);
+//! - win64: the same C importer built with mingw-w64 runs the DLLs under wine; exports and
+//!   imported DLLs checked;
+//! - aarch64-linux: the same C importer built with aarch64-linux-gnu-gcc runs under
+//!   qemu-user; glibc versions checked;
+//! - darwin64: structural only (no macOS here): both architectures, the 44 `_fmi2*`
+//!   exports, `minos` 11.0, only `/usr/lib/` libraries imported (Mach-O parsed below).
+//!
+//! Each foreign run is compared with the linux64 run column by column (see
+//! [`compare_with_linux64`] for what must be bit-identical and why the rest is not).
+//!
+//! A platform the manifest does not list is reported and skipped, unless
+//! `NIGEL_REQUIRE_PLATFORMS` (`all` or a comma list; scripts/test.sh sets `all`) names it:
+//! then its absence fails the test.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use nigel_cosim::{read_ssp, simulate, Algorithm, Experiment, ImportOptions, System, Value};
+
+const STOP_TIME: f64 = 30.0;
+const STEP: f64 = 1e-3;
+
+fn target_dir() -> PathBuf {
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
+    // absolute and without `..`: the paths go to wine as Z:\... and to qemu
+    dir.canonicalize().unwrap_or(dir)
+}
+
+fn work_dir(name: &str) -> PathBuf {
+    let d = target_dir().join("platform-tests").join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The platform folders of the manifest (the same for every FMU: build-fmu packs each
+/// platform into every archive).
+fn manifest_platforms() -> Vec<String> {
+    let path = target_dir().join("fmu").join("manifest.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (run `cargo run --release -p build-fmu` first)", path.display()));
+    let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let entries = m.as_array().unwrap();
+    let first: Vec<String> =
+        entries[0]["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
+    for e in entries {
+        let these: Vec<String> =
+            e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
+        assert_eq!(these, first, "{}: platforms differ between archives", e["fmu"]);
+    }
+    first
+}
+
+/// True when `folder` is in the archives; false (with a note) when it is not and not required.
+fn built(folder: &str) -> bool {
+    if manifest_platforms().iter().any(|p| p == folder) {
+        return true;
+    }
+    let required = std::env::var("NIGEL_REQUIRE_PLATFORMS").unwrap_or_default();
+    if required == "all" || required.split(',').any(|p| p.trim() == folder) {
+        panic!(
+            "{folder} is required (NIGEL_REQUIRE_PLATFORMS={required}) but target/fmu/manifest.json does not list it"
+        );
+    }
+    eprintln!("{folder} not in the archives: not tested (bash scripts/setup-cross.sh, then build-fmu)");
+    false
+}
+
+const FMUS: [&str; 3] = ["nigel_plant", "nigel_controller", "nigel_maneuver"];
+
+fn extension(folder: &str) -> &'static str {
+    match folder {
+        "win64" => "dll",
+        "darwin64" => "dylib",
+        _ => "so",
+    }
+}
+
+/// Unpacks `binaries/<folder>/<id>.<ext>` of every archive into the test's folder.
+fn libraries(folder: &str) -> Vec<PathBuf> {
+    let dir = work_dir(folder);
+    FMUS.iter()
+        .map(|id| {
+            let archive = target_dir().join("fmu").join(format!("{id}.fmu"));
+            let mut z = zip::ZipArchive::new(std::fs::File::open(&archive).unwrap()).unwrap();
+            let name = format!("binaries/{folder}/{id}.{}", extension(folder));
+            let mut entry = z.by_name(&name).unwrap_or_else(|e| panic!("{}: {name}: {e}", archive.display()));
+            let path = dir.join(format!("{id}.{}", extension(folder)));
+            let mut out = std::fs::File::create(&path).unwrap();
+            std::io::copy(&mut entry, &mut out).unwrap();
+            path
+        })
+        .collect()
+}
+
+fn run(c: &mut Command) -> String {
+    let out = c.output().unwrap_or_else(|e| panic!("{c:?}: {e}"));
+    assert!(out.status.success(), "{c:?}: {}\n{}", out.status, String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn closed_loop_system() -> (System, nigel_cosim::SspSystem) {
+    let ssp = target_dir().join("ssp").join("nigel_closed_loop.ssp");
+    let imported = read_ssp(&ssp, &ImportOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", ssp.display()));
+    (imported.system.clone(), imported)
+}
+
+/// The recorded columns: every Real output of every instance, `instance.name`.
+fn recorded(system: &System) -> Vec<(usize, u32, String)> {
+    let mut v = Vec::new();
+    for (i, inst) in system.instances.iter().enumerate() {
+        for var in &inst.fmu.description().model_variables {
+            let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
+            if real && var.causality == model_description::Causality::Output {
+                v.push((i, var.value_reference, format!("{}.{}", inst.name, var.name)));
+            }
+        }
+    }
+    v
+}
+
+/// The job file of `tests/c/fmi2_closed_loop.c` for `system`, with `library(i)` the path
+/// of instance i's library as the importer must open it.
+fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
+    let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
+    for (i, inst) in system.instances.iter().enumerate() {
+        job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
+    }
+    for inst in &system.instances {
+        let vars = &inst.fmu.description().model_variables;
+        for (index, value) in &inst.start_values {
+            let vr = vars[*index].value_reference;
+            job += &match value {
+                Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
+                Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
+                Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
+                Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
+            };
+        }
+    }
+    for c in &system.connections {
+        job += &format!(
+            "connect {} {} {} {} {:?} {:?}\n",
+            system.instances[c.from.instance].name,
+            c.from.value_reference,
+            system.instances[c.to.instance].name,
+            c.to.value_reference,
+            c.gain,
+            c.offset
+        );
+    }
+    for (i, vr, name) in recorded(system) {
+        job += &format!("record {} {vr} {name}\n", system.instances[i].name);
+    }
+    job
+}
+
+/// A CSV as the C importer writes it: header, then rows.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(|s| s.trim_matches('"').to_string()).collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect()).collect();
+    (header, rows)
+}
+
+const IMPORTER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/fmi2_closed_loop.c");
+
+/// Runs the C importer built by `compiler` on the libraries of `folder`; `runner` prefixes
+/// the command (wine, qemu); `path_of` turns a host path into the one the program opens.
+fn closed_loop(
+    folder: &str,
+    compiler: &[&str],
+    exe_name: &str,
+    runner: &mut dyn FnMut(&Path) -> Command,
+    path_of: &dyn Fn(&Path) -> String,
+) -> (Vec<String>, Vec<Vec<f64>>) {
+    let dir = work_dir(folder);
+    let libs = libraries(folder);
+    let (system, _keep) = closed_loop_system();
+    let index: BTreeMap<String, usize> = FMUS.iter().enumerate().map(|(k, id)| (id.to_string(), k)).collect();
+    let job = job_file(&system, &|i| {
+        let id = &system.instances[i].fmu.description().co_simulation.as_ref().unwrap().model_identifier;
+        path_of(&libs[index[id.as_str()]])
+    });
+    let job_path = dir.join("closed_loop.job");
+    std::fs::write(&job_path, job).unwrap();
+    let exe = dir.join(exe_name);
+    run(Command::new(compiler[0])
+        .args(&compiler[1..])
+        .args(["-std=c99", "-O2", "-Wall", "-Werror", "-o"])
+        .arg(&exe)
+        .arg(IMPORTER));
+    let csv = dir.join("closed_loop.csv");
+    let _ = std::fs::remove_file(&csv);
+    run(runner(&exe).arg(path_of(&job_path)).arg(path_of(&csv)));
+    let (header, rows) = read_csv(&csv);
+    assert_eq!(rows.len(), 30_001, "{folder}: 0 .. 30 s at 1 ms");
+    (header, rows)
+}
+
+fn linux64_run() -> (Vec<String>, Vec<Vec<f64>>) {
+    closed_loop("linux64", &["gcc"], "fmi2_closed_loop", &mut |exe| Command::new(exe), &|p| p.display().to_string())
+}
+
+/// Columns computed with our own arithmetic only (+ - * / and sqrt on doubles, correctly
+/// rounded by IEEE 754 on every platform; Rust contracts no a * b + c into a fused
+/// multiply-add; the tyres' `sin_cos` and `atan2` are the plant's own polynomials,
+/// `nigel_vehicle::fastmath`) and fed by no C library function: bit for bit on every
+/// platform. They are the test bench's open-loop outputs: the steering program (lane
+/// change: +-a on integer sample ranges), the speed reference and the wind (a constant gust
+/// plus scaled SplitMix64 integer noise).
+///
+/// Every other column depends, through the closed loop, on a C library function whose last
+/// bit may differ between glibc on x86-64, mingw-w64 (msvcrt and libmingwex) and glibc's
+/// aarch64 build: the plant's heading rotation `psi.sin_cos()` (`sin`, `cos`), its outputs
+/// `beta = atan2(v_y, v_x)` and `speed = hypot(v_x, v_y)`, and the test bench's friction
+/// `mu = 0.35 sin(...) + ...` (`sin`); in the real column also the friction circle (`hypot`)
+/// and the Box-Muller measurement noise (`ln`, `cos`), which this job (sim) does not run.
+const OWN_ARITHMETIC: [&str; 7] = [
+    "maneuver.delta_ff_fl",
+    "maneuver.delta_ff_fr",
+    "maneuver.delta_ff_rl",
+    "maneuver.delta_ff_rr",
+    "maneuver.speed_ref",
+    "maneuver.wind_x",
+    "maneuver.wind_y",
+];
+
+/// Every column of `other` equals linux64's bit for bit when it is in [`OWN_ARITHMETIC`]
+/// or when the platforms' C libraries agreed, else is within `1e-12` of linux64's relative
+/// to the column's largest magnitude. Returns the columns that differed.
+fn compare_with_linux64(
+    folder: &str,
+    linux: &(Vec<String>, Vec<Vec<f64>>),
+    other: &(Vec<String>, Vec<Vec<f64>>),
+) -> Vec<String> {
+    assert_eq!(linux.0, other.0, "{folder}: columns");
+    let mut differed = Vec::new();
+    for j in 0..linux.0.len() {
+        let scale = linux.1.iter().map(|r| r[j].abs()).fold(0.0, f64::max);
+        let mut worst: f64 = 0.0;
+        let mut identical = true;
+        for (a, b) in linux.1.iter().zip(&other.1) {
+            if a[j].to_bits() != b[j].to_bits() {
+                identical = false;
+                worst = worst.max((a[j] - b[j]).abs());
+            }
+        }
+        let name = &linux.0[j];
+        if OWN_ARITHMETIC.contains(&name.as_str()) || name == "time" {
+            assert!(identical, "{folder}: {name} must equal linux64 bit for bit, differs by up to {worst:e}");
+        }
+        // 1e-12 relative: the C libraries' functions differ by an ulp or so (about 1e-16
+        // relative); the closed loop is stable, so 30 000 steps grow that by orders of
+        // magnitude less than the 1e4 this leaves
+        assert!(worst <= 1e-12 * scale, "{folder}: {name} differs from linux64 by {worst:e}, scale {scale:e}");
+        if !identical {
+            differed.push(format!("{name} (max {:.1e} relative)", worst / scale));
+        }
+    }
+    eprintln!(
+        "{folder}: {} of {} columns bit-identical to linux64; within 1e-12: {}",
+        linux.0.len() - differed.len(),
+        linux.0.len(),
+        differed.join(", ")
+    );
+    differed
+}
+
+/// objdump -T's GLIBC_2.N versions of `lib`, the highest.
+fn highest_glibc(objdump: &str, lib: &Path) -> (u32, u32) {
+    let text = run(Command::new(objdump).arg("-T").arg(lib));
+    let mut best = (0, 0);
+    for word in text.split_whitespace() {
+        let Some(v) = word.trim_matches(|c| c == '(' || c == ')').strip_prefix("GLIBC_") else { continue };
+        let parts: Vec<u32> = v.split('.').filter_map(|x| x.parse().ok()).collect();
+        if parts.len() >= 2 {
+            best = best.max((parts[0], parts[1]));
+        }
+    }
+    best
+}
+
+#[test]
+fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
+    if !built("linux64") {
+        return;
+    }
+    for lib in libraries("linux64") {
+        let v = highest_glibc("objdump", &lib);
+        assert!(v <= (2, 17) && v >= (2, 2), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
+        let n = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib))
+            .lines()
+            .filter(|l| l.contains(" T fmi2"))
+            .count();
+        assert_eq!(n, 44, "{}: fmi2 exports", lib.display());
+    }
+    let c_run = linux64_run();
+    // the same SSP through nigel_cosim's Jacobi master: another importer, the same numbers
+    let (system, _keep) = closed_loop_system();
+    let names: Vec<String> = c_run.0[1..].to_vec();
+    let experiment =
+        Experiment { algorithm: Algorithm::Jacobi, record: Some(names.clone()), ..Experiment::new(STOP_TIME, STEP) };
+    let (results, _) = simulate(&system, &experiment).unwrap();
+    assert_eq!(results.rows(), c_run.1.len());
+    for (k, row) in c_run.1.iter().enumerate() {
+        let theirs = results.row(k);
+        for j in 0..row.len() {
+            let col = if j == 0 { 0 } else { 1 + results.names.iter().position(|n| *n == names[j - 1]).unwrap() };
+            assert_eq!(
+                row[j].to_bits(),
+                theirs[col].to_bits(),
+                "row {k}, {}: C {} nigel_cosim {}",
+                c_run.0[j],
+                row[j],
+                theirs[col]
+            );
+        }
+    }
+}
+
+fn wine_path(p: &Path) -> String {
+    format!("Z:{}", p.display().to_string().replace('/', "\\"))
+}
+
+#[test]
+fn win64_closed_loop_under_wine_matches_linux64() {
+    if !built("win64") {
+        return;
+    }
+    let libs = libraries("win64");
+    for lib in &libs {
+        let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib));
+        let exports = text.lines().filter(|l| l.trim_start().starts_with('[') && l.contains(" fmi2")).count();
+        assert_eq!(exports, 44, "{}: fmi2 exports", lib.display());
+        let dlls: Vec<String> =
+            text.lines().filter_map(|l| l.trim().strip_prefix("DLL Name: ")).map(|s| s.to_lowercase()).collect();
+        let system = [
+            "kernel32.dll",
+            "msvcrt.dll",
+            "ntdll.dll",
+            "bcryptprimitives.dll",
+            "ws2_32.dll",
+            "userenv.dll",
+            "advapi32.dll",
+        ];
+        for d in &dlls {
+            assert!(
+                system.contains(&d.as_str()) || d.starts_with("api-ms-win-"),
+                "{}: imports {d}, not a system DLL",
+                lib.display()
+            );
+        }
+    }
+    let dir = work_dir("win64");
+    // Rust's standard library (1.78 and later) imports ProcessPrng from
+    // bcryptprimitives.dll, which Windows 10 has and wine 8 lacks: a shim next to the
+    // importer forwards it to BCryptGenRandom (test only; nothing of it is in the archive)
+    let shim = dir.join("process_prng_shim.c");
+    std::fs::write(
+        &shim,
+        "#include <windows.h>\n#include <bcrypt.h>\n\
+         __declspec(dllexport) BOOL WINAPI ProcessPrng(PBYTE data, SIZE_T len) {\n\
+         return BCryptGenRandom(NULL, data, (ULONG)len, BCRYPT_USE_SYSTEM_PREFERRED_RNG) == 0;\n}\n",
+    )
+    .unwrap();
+    run(Command::new("x86_64-w64-mingw32-gcc")
+        .args(["-shared", "-O2", "-o"])
+        .arg(dir.join("bcryptprimitives.dll"))
+        .arg(&shim)
+        .arg("-lbcrypt"));
+    let prefix = target_dir().join("wine-prefix");
+    let mut wine = |exe: &Path| {
+        let mut c = Command::new("wine");
+        c.arg(exe)
+            .env("WINEPREFIX", &prefix)
+            .env("WINEDEBUG", "-all")
+            .env("WINEDLLOVERRIDES", "mscoree,mshtml=;bcryptprimitives=n")
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY");
+        c
+    };
+    let win = closed_loop("win64", &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path);
+    compare_with_linux64("win64", &linux64_run(), &win);
+}
+
+#[test]
+fn aarch64_closed_loop_under_qemu_matches_linux64() {
+    if !built("aarch64-linux") {
+        return;
+    }
+    for lib in libraries("aarch64-linux") {
+        let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
+        assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
+    }
+    let mut qemu = |exe: &Path| {
+        let mut c = Command::new("qemu-aarch64");
+        c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
+        c
+    };
+    let arm = closed_loop("aarch64-linux", &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
+        p.display().to_string()
+    });
+    compare_with_linux64("aarch64-linux", &linux64_run(), &arm);
+}
+
+// ---- Mach-O, the little of it the darwin64 checks read --------------------------------
+
+const FAT_MAGIC: u32 = 0xcafe_babe;
+const MH_MAGIC_64: u32 = 0xfeed_facf;
+const CPU_TYPE_X86_64: u32 = 0x0100_0007;
+const CPU_TYPE_ARM64: u32 = 0x0100_000c;
+const LC_SYMTAB: u32 = 0x2;
+const LC_LOAD_DYLIB: u32 = 0xc;
+const LC_BUILD_VERSION: u32 = 0x32;
+const PLATFORM_MACOS: u32 = 1;
+
+struct Slice {
+    cpu: u32,
+    minos: Option<(u32, u32)>,
+    dylibs: Vec<String>,
+    fmi2_exports: Vec<String>,
+}
+
+fn u32_le(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+fn u32_be(b: &[u8], at: usize) -> u32 {
+    u32::from_be_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+fn c_string(b: &[u8], at: usize) -> String {
+    let end = b[at..].iter().position(|&c| c == 0).map_or(b.len(), |e| at + e);
+    String::from_utf8_lossy(&b[at..end]).into_owned()
+}
+
+/// One thin 64-bit little-endian Mach-O image.
+fn parse_slice(b: &[u8]) -> Slice {
+    assert_eq!(u32_le(b, 0), MH_MAGIC_64, "not a 64-bit Mach-O");
+    let cpu = u32_le(b, 4);
+    let ncmds = u32_le(b, 16) as usize;
+    let mut at = 32; // sizeof(mach_header_64)
+    let mut slice = Slice { cpu, minos: None, dylibs: Vec::new(), fmi2_exports: Vec::new() };
+    for _ in 0..ncmds {
+        let (cmd, size) = (u32_le(b, at), u32_le(b, at + 4) as usize);
+        match cmd {
+            LC_BUILD_VERSION => {
+                assert_eq!(u32_le(b, at + 8), PLATFORM_MACOS, "build version platform");
+                let v = u32_le(b, at + 12); // xxxx.yy.zz nibbles
+                slice.minos = Some((v >> 16, (v >> 8) & 0xff));
+            }
+            LC_LOAD_DYLIB => slice.dylibs.push(c_string(b, at + u32_le(b, at + 8) as usize)),
+            LC_SYMTAB => {
+                let (symoff, nsyms, stroff) =
+                    (u32_le(b, at + 8) as usize, u32_le(b, at + 12) as usize, u32_le(b, at + 16) as usize);
+                for k in 0..nsyms {
+                    let e = symoff + 16 * k; // sizeof(nlist_64)
+                    let n_type = b[e + 4];
+                    // N_EXT, and N_TYPE == N_SECT: an exported definition
+                    if n_type & 0x01 != 0 && n_type & 0x0e == 0x0e {
+                        let name = c_string(b, stroff + u32_le(b, e) as usize);
+                        if name.starts_with("_fmi2") {
+                            slice.fmi2_exports.push(name);
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+        at += size;
+    }
+    slice
+}
+
+#[test]
+fn darwin64_is_universal_macos_11_with_the_fmi2_exports_and_system_libraries_only() {
+    if !built("darwin64") {
+        return;
+    }
+    for lib in libraries("darwin64") {
+        let b = std::fs::read(&lib).unwrap();
+        assert_eq!(u32_be(&b, 0), FAT_MAGIC, "{}: not a universal binary", lib.display());
+        let n = u32_be(&b, 4) as usize;
+        let mut cpus = Vec::new();
+        for k in 0..n {
+            let e = 8 + 20 * k; // sizeof(fat_arch), big-endian
+            let (cpu, offset, size) = (u32_be(&b, e), u32_be(&b, e + 8) as usize, u32_be(&b, e + 12) as usize);
+            let slice = parse_slice(&b[offset..offset + size]);
+            assert_eq!(slice.cpu, cpu);
+            assert_eq!(slice.minos, Some((11, 0)), "{} cpu {cpu:#x}: minimum macOS", lib.display());
+            let mut exports = slice.fmi2_exports.clone();
+            exports.sort();
+            exports.dedup();
+            assert_eq!(exports.len(), 44, "{} cpu {cpu:#x}: fmi2 exports {exports:?}", lib.display());
+            assert!(
+                exports.contains(&"_fmi2DoStep".to_string())
+                    && exports.contains(&"_fmi2GetDirectionalDerivative".to_string())
+            );
+            assert!(!slice.dylibs.is_empty());
+            for d in &slice.dylibs {
+                assert!(
+                    d.starts_with("/usr/lib/") || d.starts_with("/System/Library/"),
+                    "{}: imports {d}",
+                    lib.display()
+                );
+            }
+            cpus.push(cpu);
+        }
+        cpus.sort();
+        assert_eq!(cpus, [CPU_TYPE_X86_64, CPU_TYPE_ARM64], "{}: architectures", lib.display());
+    }
+}
