@@ -24,6 +24,7 @@ python="${PYTHON:-python3}"
 # masters the master's cross-checks (cosim/tests/python) compare with; no dependencies.
 # fmu-manipulation-toolbox (fmucontainer: a container FMU with its own C runtime around our
 # FMUs) needs colorama, elementpath and xmlschema.
+# pandas (with python-dateutil, tzdata) reads the campaign's results.csv in its tests.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
@@ -55,6 +56,9 @@ referencing==0.37.0
 rpds-py==2026.9.1
 traitlets==5.16.1
 typing_extensions==4.16.0
+pandas==3.1.1
+python-dateutil==4.0.0
+tzdata==2026.6
 EOF
 )"
 

@@ -34,3 +34,7 @@ echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
 echo "== Table III closed loop as SSP in fmpy"
 "$target_dir/venv/bin/python" -m pytest table3/tests/python -q
+echo "== campaign results in fmpy and pandas"
+"$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
+echo "== campaign on a local Slurm cluster"
+bash scripts/test-campaign-slurm.sh
