@@ -23,8 +23,12 @@ python="${PYTHON:-python3}"
 # ecospy (ecos, needs Debian's libtbb12) and libcosimpy (libcosim) are the co-simulation
 # masters the master's cross-checks (cosim/tests/python) compare with; no dependencies.
 # fmu-manipulation-toolbox (fmucontainer: a container FMU with its own C runtime around our
-# FMUs) needs colorama, elementpath and xmlschema.
-# pandas (with python-dateutil, tzdata) reads the campaign's results.csv in its tests.
+# FMUs) needs colorama, elementpath and xmlschema. matplotlib (with contourpy, cycler, fonttools,
+# kiwisolver, pillow, pyparsing, python-dateutil, tzdata) draws the examples' PNG figures
+# (Agg backend, no display needed). plotly (with narwhals) is fmpy's own plotting backend:
+# fmpy.util.plot_result and `fmpy simulate --show-plot` (a PNG from plotly would need kaleido
+# and a Chrome; HTML and the figure object need neither).
+# pandas (with the python-dateutil and tzdata above) reads the campaign's results.csv in its tests.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
@@ -33,6 +37,17 @@ fmu-manipulation-toolbox==2.0
 colorama==0.4.6
 elementpath==5.1.4
 xmlschema==4.3.2
+matplotlib==3.11.2
+contourpy==1.3.3
+cycler==0.12.1
+fonttools==4.68.0
+kiwisolver==1.5.1
+pillow==13.0.0
+pyparsing==3.3.3
+python-dateutil==4.0.0
+tzdata==2026.6
+plotly==7.1.0
+narwhals==2.29.0
 numpy==2.4.6
 pytest==9.2.0
 lxml==6.1.3
@@ -57,8 +72,6 @@ rpds-py==2026.9.1
 traitlets==5.16.1
 typing_extensions==4.16.0
 pandas==3.1.1
-python-dateutil==4.0.0
-tzdata==2026.6
 EOF
 )"
 
@@ -87,6 +100,6 @@ trap 'rm -f "$req_file"' EXIT
 printf '%s\n' "$requirements" >"$req_file"
 PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-input --quiet -r "$req_file" >&2
 # a smoke check of the pieces the tests use, before the marker says "done"
-"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest, ecospy, libcosimpy' >&2
+"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest, ecospy, libcosimpy, matplotlib, plotly' >&2
 printf '%s\n' "$hash" >"$marker"
 echo "$venv"

@@ -1,4 +1,4 @@
-//! The sampled controller of maneuvers.md: steering feedback on `x = [beta, yaw_rate]`
+//! The sampled controller of docs/benchmark.md: steering feedback on `x = [beta, yaw_rate]`
 //! around the reference plus the speed-hold PI, as one type that the benchmark loop and the
 //! controller FMU both run; and, beyond the paper (issue 9), the robust path-tracking law
 //! with pose feedback and the along-track speed correction.
@@ -24,7 +24,7 @@
 //!
 //! ```text
 //! speed_command = speed_ref - clamp(k_along_track e_x, -along_track_speed_max, +along_track_speed_max)
-//! e = speed_command - speed,   F = kp_speed e + ki_speed I        (the PI of maneuvers.md otherwise unchanged)
+//! e = speed_command - speed,   F = kp_speed e + ki_speed I        (the PI of docs/benchmark.md otherwise unchanged)
 //! ```
 //!
 //! A car behind (`e_x < 0`) is asked to go faster, one ahead slower. Gain from a linear
@@ -40,7 +40,7 @@
 //! clamp [`ALONG_TRACK_SPEED_MAX`] `= 0.1 m/s` (29 % of 0.35 m/s) keeps the commanded speed
 //! inside `0.25 .. 0.45 m/s`, near the speed the tracking gain was designed for, however
 //! far behind the car starts. The paper's three controllers run with `k_along_track = 0`,
-//! i.e. exactly the speed PI of maneuvers.md.
+//! i.e. exactly the speed PI of docs/benchmark.md.
 
 use core::f64::consts::FRAC_PI_2;
 use core::fmt;
@@ -117,7 +117,7 @@ impl Controller {
         matches!(self, Controller::RobustTracking)
     }
 
-    /// The settings of maneuvers.md with this controller's gains (and, for the tracking
+    /// The settings of docs/benchmark.md with this controller's gains (and, for the tracking
     /// controller, the along-track correction [`K_ALONG_TRACK`]).
     pub fn settings(&self) -> ControllerSettings {
         match self {
@@ -152,7 +152,7 @@ pub struct ControllerSettings {
     /// Steering feedback on the pose errors, rows FL, FR, RL, RR, columns `[e_y, e_psi]`
     /// [rad/m, rad/rad] (zero for the paper's controllers).
     pub pose_gain: [[f64; 2]; 4],
-    /// Along-track correction of the speed command [1/s] (0: the speed PI of maneuvers.md).
+    /// Along-track correction of the speed command [1/s] (0: the speed PI of docs/benchmark.md).
     pub k_along_track: f64,
     /// Largest along-track speed correction [m/s].
     pub along_track_speed_max: f64,
@@ -177,7 +177,7 @@ impl Default for ControllerSettings {
 }
 
 impl ControllerSettings {
-    /// The defaults of maneuvers.md with gain `K`.
+    /// The defaults of docs/benchmark.md with gain `K`.
     pub fn with_gain(gain: [[f64; 2]; 4]) -> Self {
         ControllerSettings {
             gain,
@@ -366,7 +366,7 @@ impl SampledController {
                 delta[i] = (x.delta_ff[i] + u).clamp(-s.delta_max, s.delta_max);
             }
         } else {
-            // the paper's law, exactly as maneuvers.md writes it
+            // the paper's law, exactly as docs/benchmark.md writes it
             for i in 0..4 {
                 let cmd = x.delta_ff[i] + (s.gain[i][0] * d_beta + s.gain[i][1] * d_yaw_rate);
                 delta[i] = cmd.clamp(-s.delta_max, s.delta_max);

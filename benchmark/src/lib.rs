@@ -1,5 +1,5 @@
 //! The benchmark of the paper's Section V (Table III), exactly as pinned down in
-//! `shared/spec/maneuvers.md`, as a plain Rust library (no solver, no FFI): the controller
+//! `docs/benchmark.md`, as a plain Rust library (no solver, no FFI): the controller
 //! and test-bench FMUs are thin bindings over it, and it is the in-process cross-check
 //! that a co-simulation of those FMUs with the plant FMU must reproduce.
 //!
@@ -22,7 +22,7 @@
 //! println!("epsilon = {}", run.metric.epsilon);
 //! ```
 //!
-//! # Decisions where maneuvers.md leaves room
+//! # Decisions where docs/benchmark.md leaves room
 //! * Sample boundaries of the programs are integer sample indices (`k in 14_800..15_000`),
 //!   so `t = 14.8 s` is never subject to rounding; the fishhook ramp is `a (t_k - 2.5) / 22.5`,
 //!   the slalom `a cos(30 pi (t_k - 2.5) / 25)` with `t_k - 2.5 = (k - 2500) * 1 ms`.

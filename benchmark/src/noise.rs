@@ -1,4 +1,4 @@
-//! Counter-based SplitMix64 noise (maneuvers.md, "Noise"): every sample of every stream is a
+//! Counter-based SplitMix64 noise (docs/benchmark.md, "Noise"): every sample of every stream is a
 //! pure function of `(seed, stream, k)`, so any implementation, in any order, on any number
 //! of threads, draws the same numbers.
 
@@ -48,7 +48,7 @@ pub fn g(seed: u64, stream: u8, k: u64) -> f64 {
 mod tests {
     use super::*;
 
-    /// Vectors from an independent implementation of maneuvers.md (bit-exact).
+    /// Vectors from an independent implementation of docs/benchmark.md (bit-exact).
     #[test]
     fn uniform_vectors() {
         assert_eq!(u(0, 0, 0), 0.8833108082136426);

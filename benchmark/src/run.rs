@@ -1,4 +1,4 @@
-//! The loop of maneuvers.md in process: the plant (`nigel_vehicle`, RK4 with two 0.5 ms
+//! The loop of docs/benchmark.md in process: the plant (`nigel_vehicle`, RK4 with two 0.5 ms
 //! sub-steps per sample) under the sampled controller with zero-order hold; the nominal
 //! reference run, the figure-8 switching table, closed-loop runs and the metric.
 
@@ -404,7 +404,7 @@ impl Benchmark {
     }
 
     /// A closed-loop run with `controller`'s settings ([`Controller::settings`]: its gains,
-    /// the speed loop of maneuvers.md, and for the tracking controller the along-track loop).
+    /// the speed loop of docs/benchmark.md, and for the tracking controller the along-track loop).
     pub fn run(&self, controller: Controller) -> Result<ClosedLoopRun, SettingError> {
         self.run_with(controller, controller.settings())
     }
@@ -449,7 +449,7 @@ pub struct BenchSample {
     pub psi_ref: f64,
     /// Road friction per wheel [-].
     pub mu: [f64; 4],
-    /// Wind along world X [N] (always 0 in maneuvers.md).
+    /// Wind along world X [N] (always 0 in docs/benchmark.md).
     pub wind_x: f64,
     /// Wind along world Y [N].
     pub wind_y: f64,
@@ -584,7 +584,7 @@ pub struct TableCell {
     pub metric: Metric,
 }
 
-/// Table III of maneuvers.md for one seed: every fidelity, maneuver and controller of
+/// Table III of docs/benchmark.md for one seed: every fidelity, maneuver and controller of
 /// `controllers` (the figure-8 table computed once), on up to `threads` threads (0 = all
 /// cores). Cells come in the order fidelity, maneuver, controller.
 pub fn table3(seed: u64, controllers: &[Controller], threads: usize) -> Result<Vec<TableCell>, SettingError> {

@@ -1,5 +1,5 @@
 //! What one benchmark run is: the maneuver, the column (plant fidelity), the steering
-//! program per sample and the disturbances per sample (maneuvers.md).
+//! program per sample and the disturbances per sample (docs/benchmark.md).
 
 use core::f64::consts::{FRAC_PI_2, PI};
 use core::fmt;
@@ -158,7 +158,7 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// The definition of maneuvers.md: seed 0, every disturbance on, 30 deg, 0.35 m/s, 30 s.
+    /// The definition of docs/benchmark.md: seed 0, every disturbance on, 30 deg, 0.35 m/s, 30 s.
     pub fn new(maneuver: Maneuver, fidelity: Fidelity) -> Self {
         Scenario {
             maneuver,
@@ -524,7 +524,7 @@ mod tests {
     }
 
     /// A whole 30 s run of the default scenario: the table against the formulas (and the
-    /// friction against an independent writing of maneuvers.md's formula).
+    /// friction against an independent writing of docs/benchmark.md's formula).
     #[test]
     fn disturbance_table_of_a_whole_run() {
         let d = Scenario::new(Maneuver::Slalom, Fidelity::Real).disturbances();
@@ -534,7 +534,7 @@ mod tests {
             assert_eq!(seq.wind_y(k).to_bits(), d.wind_y(k).to_bits(), "k {k}");
             assert_eq!(seq.measure(k, 0.1, 0.2), d.measure(k, 0.1, 0.2), "k {k}");
         }
-        // maneuvers.md at t = 12.345 s, wheel RL (phase pi): 0.35 sin(2 pi 12 theta - pi) + 0.55 + 0.1 u - 0.05
+        // docs/benchmark.md at t = 12.345 s, wheel RL (phase pi): 0.35 sin(2 pi 12 theta - pi) + 0.55 + 0.1 u - 0.05
         let k = 12_345;
         let theta = 2.0 * PI * 12.345 / 30.0;
         let by_hand = 0.35 * (24.0 * PI * theta - PI).sin() + 0.5 + 0.1 * u(0, 2, k as u64);

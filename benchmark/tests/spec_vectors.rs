@@ -1,4 +1,4 @@
-//! The test vectors of maneuvers.md from an independent implementation (bit-exact), the
+//! The test vectors of docs/benchmark.md from an independent implementation (bit-exact), the
 //! programs at their edges, and the exactness of an undisturbed closed loop.
 
 use std::f64::consts::PI;

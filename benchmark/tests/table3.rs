@@ -1,4 +1,4 @@
-//! Table III of maneuvers.md against the self-check table of an independent implementation
+//! Table III of docs/benchmark.md against the self-check table of an independent implementation
 //! (seed 0, epsilon): agreement to 1e-4 relative in the sim column and 1e-3 in the real one.
 
 use nigel_benchmark::{table3, Benchmark, Controller, Fidelity, Maneuver, Scenario};

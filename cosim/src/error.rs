@@ -61,6 +61,13 @@ pub enum Error {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A path to read is not a regular file (a folder, FIFO, socket or device).
+    NotRegularFile {
+        /// The path.
+        path: PathBuf,
+        /// What it is instead.
+        kind: String,
+    },
     /// The archive is not a readable zip file.
     Archive {
         /// The archive.
@@ -81,8 +88,11 @@ pub enum Error {
         entry: String,
         /// Declared or counted size (bytes or entries).
         size: u64,
-        /// The limit (raise it in [`crate::UnpackLimits`]).
+        /// The limit.
         limit: u64,
+        /// Which limit: the field of [`crate::UnpackLimits`] that raises it, or "the size
+        /// its header declares" for an entry that inflates to more than that.
+        limit_name: &'static str,
     },
     /// `modelDescription.xml` is missing or malformed.
     ModelDescription {
@@ -211,11 +221,42 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            Error::NotRegularFile { path, kind } => {
+                write!(f, "{}: is {kind}, not a regular file (only files are read)", path.display())
+            }
             Error::Archive { path, reason } => write!(f, "{}: not a readable zip archive: {reason}", path.display()),
             Error::UnsafeEntry { entry, reason } => write!(f, "archive entry {entry:?} refused: {reason}"),
-            Error::ArchiveLimit { entry, size, limit } => {
-                write!(f, "archive entry {entry:?}: {size} exceeds the limit {limit} (raise it in the unpack limits)")
-            }
+            Error::ArchiveLimit { entry, size, limit, limit_name } => match *limit_name {
+                "max_entries" => write!(
+                    f,
+                    "the archive has {size} entries, more than the limit of {limit} (raise it with --max-entries)"
+                ),
+                "max_entry_bytes" => write!(
+                    f,
+                    "archive entry {entry:?} is {size} bytes uncompressed, more than the limit of {limit} \
+                     (raise it with --max-entry-bytes)"
+                ),
+                "max_total_bytes" => write!(
+                    f,
+                    "the archive's entries are {size} bytes uncompressed in all, more than the limit of {limit} \
+                     (raise it with --max-total-bytes)"
+                ),
+                "max_ratio" => write!(
+                    f,
+                    "archive entry {entry:?} inflates {size} times its compressed size, more than the limit of \
+                     {limit} (a zip bomb? raise it with --max-ratio)"
+                ),
+                "max_xml_bytes" => write!(
+                    f,
+                    "{entry} is {size} bytes, more than the limit of {limit} for XML files (raise it with \
+                     --max-xml-bytes)"
+                ),
+                _ => write!(
+                    f,
+                    "archive entry {entry:?} inflates to more than the {limit} bytes its header declares: \
+                     refused at {size} bytes (a corrupt or hostile archive)"
+                ),
+            },
             Error::ModelDescription { path, reason } => {
                 write!(f, "{}: modelDescription.xml: {reason}", path.display())
             }

@@ -288,6 +288,8 @@ fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloadin
     if let Some(lib) = cache.get(&key) {
         return Ok(lib.clone());
     }
+    crate::elf::check_shared_library(&bytes)
+        .map_err(|reason| Error::LoadLibrary { path: shown.to_path_buf(), reason })?;
     // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
     let library = unsafe { libloading::Library::new(so) }.map_err(|e| Error::LoadLibrary {
         path: shown.to_path_buf(),
@@ -298,13 +300,16 @@ fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloadin
     Ok(library)
 }
 
-/// Reads `modelDescription.xml` of an unpacked FMU.
-pub fn read_model_description(dir: &Path, source: &Path) -> Result<ModelDescription> {
+/// Reads `modelDescription.xml` of an unpacked FMU (at most `limits.max_xml_bytes`).
+pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<ModelDescription> {
     let path = dir.join("modelDescription.xml");
-    let xml = std::fs::read(&path)
-        .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") })?;
-    let xml = String::from_utf8(xml)
-        .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: format!("not UTF-8: {e}") })?;
+    let xml =
+        crate::unpack::read_xml_text(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
+            Error::Io { source: e, .. } => {
+                Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") }
+            }
+            other => other,
+        })?;
     ModelDescription::from_xml(&xml)
         .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: e.to_string() })
 }
@@ -331,7 +336,20 @@ impl Fmu {
     /// resolve the functions of the interface.
     pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Arc<Fmu>> {
         let dir = unpack(path, &options.limits)?;
-        let description = read_model_description(dir.path(), path)?;
+        let description = read_model_description(dir.path(), path, &options.limits)?;
+        let mut names = std::collections::HashMap::with_capacity(description.model_variables.len());
+        for (k, v) in description.model_variables.iter().enumerate() {
+            if let Some(first) = names.insert(v.name.as_str(), k + 1) {
+                return Err(Error::ModelDescription {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "variables {first} and {} are both called {:?} (variable names must be unique)",
+                        k + 1,
+                        v.name
+                    ),
+                });
+            }
+        }
         let interface = match options.interface {
             Some(i) => i,
             None if description.co_simulation.is_some() => Interface::CoSimulation,

@@ -23,13 +23,13 @@
 
 #![warn(missing_docs)]
 
-mod coupled;
+mod elf;
 pub mod error;
 pub mod fmu;
 pub mod me;
-mod parallel;
 pub mod simulate;
 pub mod ssp;
+pub(crate) mod suggest;
 pub mod system;
 pub mod unpack;
 

@@ -1,16 +1,16 @@
-//! Model Exchange FMUs integrated by the master: fixed-step RK4 and adaptive
-//! Dormand-Prince 5(4); time events, state events (event indicators changing sign,
-//! located by the Illinois method to [`EVENT_TIME_TOLERANCE`]) and step events.
+//! Model Exchange FMUs integrated by the master: the numerics of one instance, fixed-step
+//! RK4 and adaptive Dormand-Prince 5(4), event indicators and the location of a state
+//! event (an indicator changing sign) by the Illinois method to [`EVENT_TIME_TOLERANCE`].
 //!
 //! Over a communication step the FMU's inputs are held (as for a Co-Simulation FMU),
-//! so an ME instance takes part in `jacobi` and `ordered` systems like a CS one; its
-//! events are handled (event iteration to a fixed point) inside its own step, unless it
-//! is connected to another ME instance: then all ME instances advance together and
-//! iterate their events together (`coupled.rs`).
+//! so an ME instance takes part in `jacobi` and `ordered` systems like a CS one. The
+//! stepping, the time, state and step events and the event iteration are the master's
+//! one integrator of a group of ME instances (`simulate/me_group.rs`): an instance
+//! connected to no other ME instance is a group of one.
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fmu::Instance;
 
 /// Width of the time bracket an event is located to, s.
@@ -72,36 +72,10 @@ pub struct MeUnit {
     pub terminated: bool,
 }
 
-fn event_iteration(inst: &mut Instance, unit: &mut MeUnit) -> Result<()> {
-    // FMI 2.0 section 3.2.3: iterate fmi2NewDiscreteStates until no new discrete states
-    for _ in 0..1000 {
-        let info = inst.new_discrete_states()?;
-        if info.terminate_simulation != 0 {
-            unit.terminated = true;
-        }
-        unit.next_time_event = (info.next_event_time_defined != 0).then_some(info.next_event_time);
-        if info.new_discrete_states_needed == 0 {
-            inst.enter_continuous_time_mode()?;
-            inst.get_continuous_states(&mut unit.x)?;
-            inst.get_event_indicators(&mut unit.z0)?;
-            return Ok(());
-        }
-    }
-    Err(Error::Experiment(format!("{}: event iteration did not converge in 1000 rounds", inst.name())))
-}
-
 impl MeUnit {
-    /// After `fmi2ExitInitializationMode` (the instance is in event mode): event
-    /// iteration, continuous-time mode, initial states and indicators.
-    pub fn initialize(inst: &mut Instance) -> Result<MeUnit> {
-        let mut unit = MeUnit::new(inst);
-        event_iteration(inst, &mut unit)?;
-        Ok(unit)
-    }
-
     /// The integration state of `inst`, before any event iteration (the instance stays in
     /// event mode).
-    pub(crate) fn new(inst: &Instance) -> MeUnit {
+    pub fn new(inst: &Instance) -> MeUnit {
         let md = inst.fmu().description();
         let n = md.states().len();
         let m = md.number_of_event_indicators as usize;
@@ -262,111 +236,5 @@ impl MeUnit {
             }
         }
         Ok(hi)
-    }
-
-    /// Integrates from `t` to `t_end` with the inputs as set, handling events.
-    pub fn advance(&mut self, inst: &mut Instance, solver: Solver, t: f64, t_end: f64) -> Result<()> {
-        let mut t = t;
-        let span = t_end - t;
-        let eps = 1e-13 * t_end.abs().max(1.0);
-        if self.h_adaptive <= 0.0 {
-            self.h_adaptive = span * 0.1;
-        }
-        while t < t_end - eps && !self.terminated {
-            // a time event due now
-            if let Some(te) = self.next_time_event {
-                if te <= t + eps {
-                    inst.enter_event_mode()?;
-                    self.events.push(Event { instance: inst.name().to_string(), time: t, kind: "time" });
-                    event_iteration(inst, self)?;
-                    if self.next_time_event.is_some_and(|n| n <= t + eps) {
-                        return Err(Error::Experiment(format!(
-                            "{}: time event at {te} repeats at the same time",
-                            inst.name()
-                        )));
-                    }
-                    continue;
-                }
-            }
-            // the end of this stretch: the next time event or the end of the step
-            let mut target = t_end;
-            let mut time_event = false;
-            if let Some(te) = self.next_time_event {
-                if te <= t_end + eps {
-                    target = te.max(t);
-                    time_event = true;
-                }
-            }
-            // one internal step
-            let h_max = target - t;
-            let h = match solver {
-                Solver::Rk4 { max_step } => {
-                    let hm = max_step.unwrap_or(span).max(1e-300);
-                    let n = ((h_max / hm) * (1.0 - 1e-12)).ceil().max(1.0);
-                    h_max / n
-                }
-                Solver::Dopri5 { .. } => self.h_adaptive.min(h_max),
-            };
-            self.x0.copy_from_slice(&self.x);
-            {
-                let (x0, k) = (&self.x0, &mut self.k[0]);
-                Self::derivatives(inst, t, x0, k)?;
-            }
-            let mut h = h;
-            if let Solver::Dopri5 { rtol, atol } = solver {
-                loop {
-                    let err = self.dopri(inst, t, h, rtol, atol)?;
-                    let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
-                    if err <= 1.0 || h <= 1e-14 * t_end.abs().max(1.0) {
-                        self.h_adaptive = (h * factor).min(span.max(h));
-                        break;
-                    }
-                    self.rejected += 1;
-                    h *= factor.min(0.9);
-                }
-            } else {
-                self.rk4(inst, t, h)?;
-            }
-            let t_new = if (t + h - target).abs() <= eps { target } else { t + h };
-            self.indicators_at(inst, t_new)?;
-            if Self::crossed(&self.z0, &self.z) {
-                let hi = self.locate_crossing(inst, solver, t, t_new - t)?;
-                // the event is handled just after the crossing, at t + hi
-                self.one_step(inst, solver, t, hi)?;
-                let te = t + hi;
-                inst.set_time(te)?;
-                inst.set_continuous_states(&self.xt)?;
-                self.x.copy_from_slice(&self.xt);
-                self.steps += 1;
-                inst.completed_integrator_step()?;
-                inst.enter_event_mode()?;
-                self.events.push(Event { instance: inst.name().to_string(), time: te, kind: "state" });
-                event_iteration(inst, self)?;
-                if let Solver::Dopri5 { .. } = solver {
-                    self.h_adaptive = self.h_adaptive.min(span * 0.1);
-                }
-                t = te;
-                continue;
-            }
-            // accepted step without state event
-            self.x.copy_from_slice(&self.xt);
-            inst.set_time(t_new)?;
-            inst.set_continuous_states(&self.x)?;
-            self.steps += 1;
-            std::mem::swap(&mut self.z0, &mut self.z);
-            let (step_event, terminate) = inst.completed_integrator_step()?;
-            if terminate {
-                self.terminated = true;
-            }
-            t = t_new;
-            let at_time_event = time_event && t >= target - eps;
-            if step_event || at_time_event {
-                inst.enter_event_mode()?;
-                let kind = if at_time_event { "time" } else { "step" };
-                self.events.push(Event { instance: inst.name().to_string(), time: t, kind });
-                event_iteration(inst, self)?;
-            }
-        }
-        Ok(())
     }
 }

@@ -46,8 +46,17 @@ fn parse_xml(text: &str, path: &Path) -> Result<Element> {
     let open = |e: &quick_xml::events::BytesStart| -> Result<Element> {
         let mut el =
             Element { name: String::from_utf8_lossy(e.local_name().as_ref()).into_owned(), ..Element::default() };
-        for a in e.attributes() {
+        // a hash set for duplicates: quick-xml's own check is quadratic in the attributes
+        let mut keys = std::collections::HashSet::new();
+        for a in e.attributes().with_checks(false) {
             let a = a.map_err(|x| err(format!("malformed XML attribute: {x}")))?;
+            if !keys.insert(a.key.as_ref().to_vec()) {
+                return Err(err(format!(
+                    "attribute {} repeated in <{}>",
+                    String::from_utf8_lossy(a.key.as_ref()),
+                    el.name
+                )));
+            }
             let v = a.unescape_value().map_err(|x| err(format!("malformed XML attribute value: {x}")))?;
             el.attributes.push((String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned(), v.into_owned()));
         }
@@ -111,7 +120,9 @@ struct Flattener<'a> {
     fmus: HashMap<PathBuf, Arc<Fmu>>,
     builder: SystemBuilder,
     /// edges (from, to, factor, offset, suppress_unit_conversion)
-    edges: Vec<(Node, Node, f64, f64, bool)>,
+    edges: Vec<Edge>,
+    /// declared system connectors: (system path, connector name)
+    connectors: std::collections::HashSet<(String, String)>,
     parameters: Vec<(String, String, String)>, // (instance.variable, type, value text)
 }
 
@@ -139,14 +150,23 @@ impl Flattener<'_> {
                 return Err(self.err(format!("system {prefix:?}: {unsupported} are not supported")));
             }
         }
-        let mut element_names: Vec<&str> = Vec::new();
-        if let Some(elements) = el.child("Elements") {
-            for e in &elements.children {
+        if let Some(connectors) = el.child("Connectors") {
+            for c in connectors.all("Connector") {
+                let name = c.attr("name").unwrap_or("");
+                if !self.connectors.insert((prefix.to_string(), name.to_string())) {
+                    return Err(self.err(format!("system {prefix:?}: connector {name:?} is declared twice")));
+                }
+            }
+        }
+        // element name -> whether it is a nested system
+        let mut elements: HashMap<&str, bool> = HashMap::new();
+        if let Some(list) = el.child("Elements") {
+            for e in &list.children {
                 let name = e.attr("name").ok_or_else(|| self.err(format!("an element {} without name", e.name)))?;
-                if name.contains('.') || name.is_empty() || element_names.contains(&name) {
+                if name.contains('.') || name.is_empty() || elements.contains_key(name) {
                     return Err(self.err(format!("element name {name:?}: empty, containing '.' or repeated")));
                 }
-                element_names.push(name);
+                elements.insert(name, e.name == "System");
                 match e.name.as_str() {
                     "Component" => self.component(e, &here(name))?,
                     "System" => self.system(e, &here(name))?,
@@ -159,23 +179,49 @@ impl Flattener<'_> {
         }
         if let Some(connections) = el.child("Connections") {
             for c in connections.all("Connection") {
-                let node = |element: Option<&str>, connector: &str| match element {
-                    Some(e) => {
-                        // a component's variable, or a connector of a nested system
-                        Node::Variable { instance: here(e), variable: connector.to_string() }
-                    }
-                    None => Node::SystemConnector { system: prefix.to_string(), connector: connector.to_string() },
-                };
-                for end in [c.attr("startElement"), c.attr("endElement")].into_iter().flatten() {
-                    if !element_names.contains(&end) {
-                        return Err(
-                            self.err(format!("connection names an unknown element {end:?} of system {prefix:?}"))
-                        );
-                    }
-                }
                 let start =
                     c.attr("startConnector").ok_or_else(|| self.err("Connection without startConnector".into()))?;
                 let end = c.attr("endConnector").ok_or_else(|| self.err("Connection without endConnector".into()))?;
+                let shown = |element: Option<&str>, connector: &str| match element {
+                    Some(e) => format!("{e}.{connector}"),
+                    None => connector.to_string(),
+                };
+                let what = format!(
+                    "connection {} -> {} of system {prefix:?}",
+                    shown(c.attr("startElement"), start),
+                    shown(c.attr("endElement"), end)
+                );
+                // a component's variable, or a connector of this system or of a nested one
+                let node = |element: Option<&str>, connector: &str| -> Result<Node> {
+                    let system = match element {
+                        None => prefix.to_string(),
+                        Some(e) => match elements.get(e) {
+                            None => {
+                                let mut known: Vec<&str> = elements.keys().copied().collect();
+                                known.sort_unstable();
+                                return Err(self.err(format!(
+                                    "{what}: names an unknown element {e:?}{}",
+                                    crate::suggest::did_you_mean(e, known.iter().copied(), "elements")
+                                )));
+                            }
+                            Some(false) => {
+                                return Ok(Node::Variable { instance: here(e), variable: connector.to_string() })
+                            }
+                            Some(true) => here(e),
+                        },
+                    };
+                    if !self.connectors.contains(&(system.clone(), connector.to_string())) {
+                        let mut declared: Vec<&str> =
+                            self.connectors.iter().filter(|(s, _)| *s == system).map(|(_, c)| c.as_str()).collect();
+                        declared.sort_unstable();
+                        return Err(self.err(format!(
+                            "{what}: system {system:?} declares no connector {connector:?}{}",
+                            crate::suggest::did_you_mean(connector, declared.iter().copied(), "its connectors")
+                        )));
+                    }
+                    Ok(Node::SystemConnector { system, connector: connector.to_string() })
+                };
+                let (from, to) = (node(c.attr("startElement"), start)?, node(c.attr("endElement"), end)?);
                 let (mut factor, mut offset) = (1.0, 0.0);
                 for t in &c.children {
                     match t.name.as_str() {
@@ -191,23 +237,11 @@ impl Flattener<'_> {
                             offset = num("offset", 0.0)?;
                         }
                         "ConnectionGeometry" | "Annotations" => {}
-                        other => {
-                            return Err(self.err(format!(
-                                "connection {}.{start} -> {}.{end}: {other} is not supported",
-                                c.attr("startElement").unwrap_or(""),
-                                c.attr("endElement").unwrap_or("")
-                            )))
-                        }
+                        other => return Err(self.err(format!("{what}: {other} is not supported"))),
                     }
                 }
                 let suppress = c.attr("suppressUnitConversion") == Some("true");
-                self.edges.push((
-                    node(c.attr("startElement"), start),
-                    node(c.attr("endElement"), end),
-                    factor,
-                    offset,
-                    suppress,
-                ));
+                self.edges.push((from, to, factor, offset, suppress));
             }
         }
         Ok(())
@@ -279,9 +313,23 @@ impl Flattener<'_> {
             let set = match (b.attr("source"), b.child("ParameterValues")) {
                 (Some(src), _) => {
                     let file = self.resource(src)?;
-                    let text = std::fs::read_to_string(&file)
-                        .map_err(|e| self.err(format!("{owner:?}: parameter file {src:?}: {e}")))?;
-                    parse_xml(&text, &file)?
+                    let text = crate::unpack::read_xml_text(&file, src, self.options.limits.max_xml_bytes).map_err(
+                        |e| match e {
+                            Error::Io { source, .. } => {
+                                self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
+                            }
+                            other => other,
+                        },
+                    )?;
+                    let set = parse_xml(&text, &file)?;
+                    if set.name != "ParameterSet" {
+                        return Err(self.err(format!(
+                            "{owner:?}: parameter file {src:?} has the root element <{}>, not <ParameterSet> \
+                             (an SSP 1.0 .ssv file)",
+                            set.name
+                        )));
+                    }
+                    set
                 }
                 (None, Some(values)) => values
                     .child("ParameterSet")
@@ -318,6 +366,47 @@ impl Flattener<'_> {
     }
 }
 
+/// A system connector's source: the FMU output (or None: an unconnected system input)
+/// and the composed (factor, offset, suppress unit conversion).
+type Trace<'n> = (Option<&'n Node>, f64, f64, bool);
+
+type Edge = (Node, Node, f64, f64, bool);
+
+/// Traces `start` back through system connectors to an FMU output: walks back to a
+/// variable, an unfed connector or one traced before, then remembers the trace of every
+/// connector on the way.
+fn trace<'e>(
+    start: &'e Node,
+    edges: &'e [Edge],
+    feeding: &HashMap<&'e Node, usize>,
+    traced: &mut HashMap<&'e Node, Trace<'e>>,
+) -> std::result::Result<Trace<'e>, String> {
+    let mut path: Vec<&Node> = Vec::new();
+    let mut node = start;
+    let base: Trace = loop {
+        if let Node::Variable { .. } = node {
+            break (Some(node), 1.0, 0.0, false);
+        }
+        if let Some(t) = traced.get(node) {
+            break *t;
+        }
+        let Some(&k) = feeding.get(node) else { break (None, 1.0, 0.0, false) };
+        if path.len() > edges.len() {
+            return Err("connections through system connectors form a cycle".into());
+        }
+        path.push(node);
+        node = &edges[k].0;
+    };
+    let mut t = base;
+    for n in path.into_iter().rev() {
+        let (_, _, k2, o2, s2) = &edges[feeding[n]];
+        // connector = k2 * source + o2, source = t.1 x + t.2
+        t = (t.0, k2 * t.1, k2 * t.2 + o2, t.3 | s2);
+        traced.insert(n, t);
+    }
+    Ok(t)
+}
+
 /// Reads an `.ssp` archive or a bare `.ssd` file (FMU sources relative to its folder).
 pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     let is_ssd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssd"));
@@ -330,10 +419,16 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         let ssd = root.join("SystemStructure.ssd");
         (Some(dir), root, ssd)
     };
-    let text = std::fs::read_to_string(&ssd_path).map_err(|e| Error::Ssp {
-        path: path.to_path_buf(),
-        reason: format!("cannot read SystemStructure.ssd: {e}"),
-    })?;
+    let text =
+        crate::unpack::read_xml_text(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
+            match e {
+                Error::Io { source, .. } if !is_ssd => Error::Ssp {
+                    path: path.to_path_buf(),
+                    reason: format!("cannot read SystemStructure.ssd: {source}"),
+                },
+                other => other,
+            }
+        })?;
     let doc = parse_xml(&text, path)?;
     if doc.name != "SystemStructureDescription" {
         return Err(Error::Ssp {
@@ -348,45 +443,34 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         fmus: HashMap::new(),
         builder: SystemBuilder::new(),
         edges: Vec::new(),
+        connectors: Default::default(),
         parameters: Vec::new(),
     };
     let system_el = doc.child("System").ok_or_else(|| f.err("no System".into()))?;
     f.system(system_el, "")?;
     // follow connections through system connectors: every edge ending at an FMU input
-    // is traced back to an FMU output, composing the linear transformations
-    let instances: Vec<String> = f.builder.system().instances.iter().map(|i| i.name.clone()).collect();
-    let is_instance = |n: &Node| matches!(n, Node::Variable { instance, .. } if instances.contains(instance));
-    // a Variable node naming a nested system is that system's connector
-    let normalize = |n: &Node| match n {
-        Node::Variable { instance, variable } if !instances.contains(instance) => {
-            Node::SystemConnector { system: instance.clone(), connector: variable.clone() }
-        }
-        other => other.clone(),
-    };
-    let edges: Vec<(Node, Node, f64, f64, bool)> =
-        f.edges.iter().map(|(a, b, k, o, s)| (normalize(a), normalize(b), *k, *o, *s)).collect();
-    for (a, b, k, o, s) in &edges {
-        if !is_instance(b) {
-            continue;
-        }
-        let (mut src, mut factor, mut offset, mut suppress) = (a.clone(), *k, *o, *s);
-        let mut hops = 0;
-        while !is_instance(&src) {
-            let Some((a2, _, k2, o2, s2)) = edges.iter().find(|(_, b2, ..)| *b2 == src) else { break };
-            // to = k (k2 x + o2) + o
-            offset += factor * o2;
-            factor *= k2;
-            suppress |= s2;
-            src = a2.clone();
-            hops += 1;
-            if hops > edges.len() {
-                return Err(f.err("connections through system connectors form a cycle".into()));
+    // is traced back to an FMU output, composing the linear transformations. Each system
+    // connector is fed by at most one edge (a map from it to that edge), and a connector's
+    // trace is remembered, so the whole is linear in the number of connections.
+    let edges = std::mem::take(&mut f.edges);
+    let mut feeding: HashMap<&Node, usize> = HashMap::new();
+    for (k, (_, to, ..)) in edges.iter().enumerate() {
+        if let Node::SystemConnector { system, connector } = to {
+            if feeding.insert(to, k).is_some() {
+                return Err(f.err(format!("system {system:?}: connector {connector:?} is fed by two connections")));
             }
         }
-        let (Node::Variable { instance: ai, variable: av }, Node::Variable { instance: bi, variable: bv }) = (&src, b)
-        else {
+    }
+    let mut traced: HashMap<&Node, Trace> = HashMap::new();
+    for (a, b, k, o, s) in &edges {
+        let Node::Variable { instance: bi, variable: bv } = b else { continue };
+        let (src, factor0, offset0, suppress0) =
+            trace(a, &edges, &feeding, &mut traced).map_err(|reason| f.err(reason))?;
+        let Some(Node::Variable { instance: ai, variable: av }) = src else {
             continue; // fed by an unconnected system input: left at its start value
         };
+        // to = k (factor0 x + offset0) + o
+        let (factor, offset, suppress) = (k * factor0, k * offset0 + o, suppress0 | s);
         let from = format!("{ai}.{av}");
         let to = format!("{bi}.{bv}");
         let linear = if factor == 1.0 && offset == 0.0 { None } else { Some((factor, offset)) };

@@ -1,9 +1,12 @@
 //! Safe unpacking of `.fmu` / `.ssp` archives into a private temporary folder.
 //!
 //! Refused: names that escape the folder (`..`, absolute paths, drive letters, NUL),
-//! symbolic links, duplicate names, and archive bombs (too many entries, an entry or
-//! the total larger than the limits; the actual bytes are counted too, so a lying
-//! header does not help). On any error the partly written folder is removed.
+//! symbolic links, duplicate names, and archive bombs: too many entries, an entry or the
+//! total larger than the limits, an entry that inflates more than `max_ratio` times its
+//! compressed size. Every limit is checked on the sizes the headers declare before
+//! anything is written; while inflating, an entry that yields more bytes than its header
+//! declares is refused at once (so a lying header gets at most one buffer of 64 KiB past
+//! its declared size written). On any error the partly written folder is removed.
 
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
@@ -18,12 +21,32 @@ pub struct UnpackLimits {
     pub max_entry_bytes: u64,
     /// Largest uncompressed size of all entries together, bytes.
     pub max_total_bytes: u64,
+    /// Largest ratio of uncompressed to compressed size of an entry, for entries larger
+    /// than [`UnpackLimits::RATIO_FREE_BYTES`] (below that a high ratio costs nothing).
+    pub max_ratio: u64,
+    /// Largest `modelDescription.xml` (or `SystemStructure.ssd`, `.ssv`) read, bytes:
+    /// reading holds the text and its element tree in memory, about 12 times its size.
+    pub max_xml_bytes: u64,
+}
+
+impl UnpackLimits {
+    /// Entries up to this uncompressed size are not checked for their ratio (1 MiB).
+    pub const RATIO_FREE_BYTES: u64 = 1 << 20;
 }
 
 impl Default for UnpackLimits {
-    /// 10,000 entries, 1 GiB per entry, 4 GiB in all.
+    /// 10,000 entries, 256 MiB per entry, 1 GiB in all, ratio 100, XML 64 MiB. FMUs are
+    /// far below these: our plant is 1.0 MB in 3 entries at ratios 2.4 (the library) to
+    /// 8.6 (the XML); text compresses about 10:1, machine code 2-3:1, while a zip bomb of
+    /// zeros compresses 1000:1.
     fn default() -> Self {
-        UnpackLimits { max_entries: 10_000, max_entry_bytes: 1 << 30, max_total_bytes: 4 << 30 }
+        UnpackLimits {
+            max_entries: 10_000,
+            max_entry_bytes: 256 << 20,
+            max_total_bytes: 1 << 30,
+            max_ratio: 100,
+            max_xml_bytes: 64 << 20,
+        }
     }
 }
 
@@ -60,6 +83,67 @@ pub fn safe_relative_path(name: &str) -> std::result::Result<PathBuf, &'static s
     Ok(out)
 }
 
+/// Opens `path` for reading if it is a regular file (a FIFO, device or folder is refused
+/// without opening it: opening a FIFO would wait for a writer). Non-blocking open, so
+/// that a file swapped for a FIFO after the check does not block either.
+pub fn open_regular(path: &Path) -> Result<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    let not_regular = |kind: &str| Error::NotRegularFile { path: path.to_path_buf(), kind: kind.to_string() };
+    let kind = |m: &std::fs::Metadata| {
+        use std::os::unix::fs::FileTypeExt;
+        let t = m.file_type();
+        if t.is_dir() {
+            "a folder"
+        } else if t.is_fifo() {
+            "a FIFO (named pipe)"
+        } else if t.is_socket() {
+            "a socket"
+        } else if t.is_block_device() || t.is_char_device() {
+            "a device"
+        } else {
+            "not a regular file"
+        }
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(kind(&meta)));
+    }
+    const O_NONBLOCK: i32 = 0o4000; // Linux
+    let file = std::fs::OpenOptions::new().read(true).custom_flags(O_NONBLOCK).open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(kind(&meta)));
+    }
+    Ok(file)
+}
+
+/// Reads the XML text file `path` (a regular file of at most `limit` bytes, checked
+/// before reading); `shown` names it in errors.
+pub fn read_xml_text(path: &Path, shown: &str, limit: u64) -> Result<String> {
+    use std::io::Read;
+    let file = open_regular(path)?;
+    let size = file.metadata().map_err(|source| Error::Io { path: path.to_path_buf(), source })?.len();
+    if size > limit {
+        return Err(Error::ArchiveLimit { entry: shown.to_string(), size, limit, limit_name: "max_xml_bytes" });
+    }
+    let mut bytes = Vec::with_capacity(size as usize);
+    // `take`: a file grown since the check is still held to the limit
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    if bytes.len() as u64 > limit {
+        return Err(Error::ArchiveLimit {
+            entry: shown.to_string(),
+            size: bytes.len() as u64,
+            limit,
+            limit_name: "max_xml_bytes",
+        });
+    }
+    String::from_utf8(bytes).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("{shown} is not UTF-8 text: {e}")),
+    })
+}
+
 /// Unpacks `archive` into a fresh private temporary folder (removed when dropped).
 pub fn unpack(archive: &Path, limits: &UnpackLimits) -> Result<tempfile::TempDir> {
     let dir = tempfile::Builder::new()
@@ -71,7 +155,7 @@ pub fn unpack(archive: &Path, limits: &UnpackLimits) -> Result<tempfile::TempDir
 }
 
 fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()> {
-    let file = std::fs::File::open(archive).map_err(|source| Error::Io { path: archive.to_path_buf(), source })?;
+    let file = open_regular(archive)?;
     let bad = |e: zip::result::ZipError| Error::Archive { path: archive.to_path_buf(), reason: e.to_string() };
     let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file)).map_err(bad)?;
     let count = zip.len() as u64;
@@ -80,6 +164,7 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
             entry: "<number of entries>".into(),
             size: count,
             limit: limits.max_entries,
+            limit_name: "max_entries",
         });
     }
     // check every header before writing anything
@@ -94,7 +179,22 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
             }
         }
         if entry.size() > limits.max_entry_bytes {
-            return Err(Error::ArchiveLimit { entry: name, size: entry.size(), limit: limits.max_entry_bytes });
+            return Err(Error::ArchiveLimit {
+                entry: name,
+                size: entry.size(),
+                limit: limits.max_entry_bytes,
+                limit_name: "max_entry_bytes",
+            });
+        }
+        if entry.size() > UnpackLimits::RATIO_FREE_BYTES
+            && entry.size() / entry.compressed_size().max(1) >= limits.max_ratio
+        {
+            return Err(Error::ArchiveLimit {
+                entry: name,
+                size: entry.size() / entry.compressed_size().max(1),
+                limit: limits.max_ratio,
+                limit_name: "max_ratio",
+            });
         }
         declared_total = declared_total.saturating_add(entry.size());
         if declared_total > limits.max_total_bytes {
@@ -102,10 +202,10 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
                 entry: "<total>".into(),
                 size: declared_total,
                 limit: limits.max_total_bytes,
+                limit_name: "max_total_bytes",
             });
         }
     }
-    let mut total = 0u64;
     let mut buffer = vec![0u8; 64 * 1024];
     for i in 0..zip.len() {
         let mut entry = zip.by_index(i).map_err(bad)?;
@@ -131,6 +231,7 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
                 _ => Error::Io { path: target.clone(), source },
             }
         })?;
+        let declared = entry.size();
         let mut written = 0u64;
         loop {
             let n = entry
@@ -140,15 +241,14 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
                 break;
             }
             written += n as u64;
-            total += n as u64;
-            if written > limits.max_entry_bytes {
-                return Err(Error::ArchiveLimit { entry: name, size: written, limit: limits.max_entry_bytes });
-            }
-            if total > limits.max_total_bytes {
+            // the declared sizes passed every limit above: holding each entry to its
+            // declared size holds the archive to all of them
+            if written > declared {
                 return Err(Error::ArchiveLimit {
-                    entry: "<total>".into(),
-                    size: total,
-                    limit: limits.max_total_bytes,
+                    entry: name,
+                    size: written,
+                    limit: declared,
+                    limit_name: "the size its header declares",
                 });
             }
             out.write_all(&buffer[..n]).map_err(io(&target))?;

@@ -109,3 +109,24 @@ fn an_event_iteration_without_a_fixed_point_names_the_fmus() {
         other => panic!("expected a non-converging event iteration, got {other:?}"),
     }
 }
+
+/// A Model Exchange FMU on its own is a group of one of the same integrator: its event
+/// iteration has the same limit and the same error as a coupled group's.
+#[test]
+fn single_me_instance_event_iteration_has_the_group_limit_and_error() {
+    let dir = work_dir("restless");
+    let latch = Fmu::load(&build_latch(&dir)).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("restless", latch).unwrap();
+    b.set("restless.mode", Value::Real(3.0)).unwrap();
+    b.set("restless.t_event", Value::Real(0.25)).unwrap();
+    let system = b.build();
+    match simulate(&system, &Experiment::new(1.0, 0.1)) {
+        Err(Error::EventIteration { time, rounds, instances }) => {
+            assert_eq!((time, rounds), (0.25, nigel_cosim::simulate::MAX_EVENT_ROUNDS));
+            assert_eq!(rounds, 100);
+            assert_eq!(instances, ["restless"]);
+        }
+        other => panic!("expected a non-converging event iteration, got {other:?}"),
+    }
+}

@@ -1,4 +1,4 @@
-//! The controller FMU (`nigel_controller`): the sampled law of maneuvers.md,
+//! The controller FMU (`nigel_controller`): the sampled law of docs/benchmark.md,
 //! [`nigel_benchmark::SampledController`], behind the shared FMI 2.0 layer. This file is
 //! only the binding: the declaration of the variables and a small [`Model`] impl.
 //!
@@ -294,7 +294,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         model_name: "nigel_controller",
         model_identifier: MODEL_IDENTIFIER,
         description: "Nigel's sampled controller: delta = delta_ff + K ([beta, yaw_rate] - ref) clamped to \
-                      +-delta_max, and the speed-hold PI with anti-windup (maneuvers.md); robust gain baked \
+                      +-delta_max, and the speed-hold PI with anti-windup (docs/benchmark.md); robust gain baked \
                       from the synthesis; robust_tracking adds pose feedback and the along-track correction",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
@@ -430,7 +430,7 @@ impl Controller {
         let settings = ControllerSettings {
             gain: self.gain_in_use(),
             pose_gain: self.pose_gain_in_use(),
-            // the along-track loop belongs to the tracking controller; the paper's run the PI of maneuvers.md
+            // the along-track loop belongs to the tracking controller; the paper's run the PI of docs/benchmark.md
             k_along_track: if tracking { self.settings.k_along_track } else { 0.0 },
             ..self.settings
         };
@@ -674,7 +674,7 @@ impl Model for Controller {
 fmi2_export::export_fmi2!(Controller);
 
 /// The law and its timing, for `documentation/index.html`.
-pub const DOCUMENTATION: &str = r#"<h2>Law (shared/spec/maneuvers.md)</h2>
+pub const DOCUMENTATION: &str = r#"<h2>Law (docs/benchmark.md)</h2>
 <pre>
 x = [beta, yaw_rate],  x_ref = [beta_ref, yaw_rate_ref]
 delta_i = clamp(delta_ff_i + K_i (x - x_ref), -delta_max, delta_max)      (rows i = FL, FR, RL, RR)

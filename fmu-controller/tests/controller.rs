@@ -88,7 +88,7 @@ fn taus(c: &C) -> [f64; 4] {
     std::array::from_fn(|i| c.real(vr::TAU + i as u32))
 }
 
-/// The law written out by hand (maneuvers.md), independent of nigel_benchmark's code.
+/// The law written out by hand (docs/benchmark.md), independent of nigel_benchmark's code.
 fn by_hand(k: &[[f64; 2]; 4], x: &In, integral: f64) -> ([f64; 4], f64) {
     let delta = std::array::from_fn(|i| {
         let d = x.ff[i] + k[i][0] * (x.beta - x.beta_ref) + k[i][1] * (x.yaw_rate - x.yaw_rate_ref);

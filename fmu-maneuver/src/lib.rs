@@ -1,4 +1,4 @@
-//! The test-bench FMU (`nigel_maneuver`): the benchmark of maneuvers.md,
+//! The test-bench FMU (`nigel_maneuver`): the benchmark of docs/benchmark.md,
 //! [`nigel_benchmark::Benchmark`], behind the shared FMI 2.0 layer. This file is only the
 //! binding: the declaration of the variables and a small [`Model`] impl.
 //!
@@ -176,7 +176,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
         VarDecl::real("wind_x", vr::WIND_X, Var::WindX)
             .discrete_output(none())
             .unit("N")
-            .describe("wind force along world X (zero in maneuvers.md)"),
+            .describe("wind force along world X (zero in docs/benchmark.md)"),
     );
     v.push(
         VarDecl::real("wind_y", vr::WIND_Y, Var::WindY)
@@ -256,7 +256,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     DeclarationSpec {
         model_name: "nigel_maneuver",
         model_identifier: MODEL_IDENTIFIER,
-        description: "Benchmark test bench of maneuvers.md: steering programs, reference (nominal open-loop run), \
+        description: "Benchmark test bench of docs/benchmark.md: steering programs, reference (nominal open-loop run), \
                       friction and wind disturbances, measurement noise (counter-based SplitMix64)",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
@@ -533,7 +533,7 @@ impl Model for TestBench {
 fmi2_export::export_fmi2!(TestBench);
 
 /// What the test bench computes, for `documentation/index.html`.
-pub const DOCUMENTATION: &str = r#"<h2>Benchmark (shared/spec/maneuvers.md)</h2>
+pub const DOCUMENTATION: &str = r#"<h2>Benchmark (docs/benchmark.md)</h2>
 <p>Samples k = 0, 1, ... at t_k = t_start + k 1 ms; every output is held over [t_k, t_k + 1 ms).
 Steering programs (front +f, rear -f), a = <code>steer_amplitude</code> (30 deg):</p>
 <p>The switches <code>maneuver</code> and <code>fidelity</code> are plain Integer parameters (not FMI

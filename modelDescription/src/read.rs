@@ -221,9 +221,15 @@ fn tag_start(src: &str, from: usize) -> usize {
 fn make_node(src: &str, reader: &Reader<&[u8]>, e: &BytesStart<'_>, pos: usize) -> Result<Node, ReadError> {
     let name = std::str::from_utf8(e.name().as_ref()).map_err(|err| xml_err(src, err, pos as u64))?.to_string();
     let mut attrs = Vec::new();
-    for a in e.attributes() {
+    // quick-xml's own duplicate check compares each attribute with all before it
+    // (quadratic: 160,000 attributes took 21 s); a hash set does it in linear time
+    let mut keys = std::collections::HashSet::new();
+    for a in e.attributes().with_checks(false) {
         let a = a.map_err(|err| xml_err(src, err, pos as u64))?;
         let key = std::str::from_utf8(a.key.as_ref()).map_err(|err| xml_err(src, err, pos as u64))?;
+        if !keys.insert(key.to_string()) {
+            return Err(xml_err(src, format!("attribute {key} repeated in <{name}>"), pos as u64));
+        }
         let value = a
             .decode_and_unescape_value(reader.decoder())
             .map_err(|err| xml_err(src, format!("attribute {key} of <{name}>: {err}"), pos as u64))?;

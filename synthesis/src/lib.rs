@@ -2,7 +2,7 @@
 //!
 //! Mixed H2/H-inf state feedback with D-stability over the 16-vertex friction polytope,
 //! solved as semidefinite programs with clarabel, and verified without trusting the
-//! solver. See `shared/spec/robust-synthesis.md` for the contract.
+//! solver. See `docs/synthesis.md` for the contract.
 //!
 //! * [`plant`]: the polytopic design model, built from [`nigel_vehicle::VehicleParams`].
 //! * [`region`]: pole regions (half-plane, sector, disk, intersections) as data.

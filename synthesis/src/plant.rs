@@ -45,7 +45,7 @@ impl Architecture {
     }
 }
 
-/// Which disturbance column and geometry (see `shared/spec/robust-synthesis.md`).
+/// Which disturbance column and geometry (see `docs/synthesis.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum DisturbanceVariant {
     /// The paper's synthesis: `d2 = (l_f - l_r)/2` as printed in Eq. 2.2 and the geometry

@@ -46,7 +46,7 @@
 //! neither the study nor the choice uses the maneuvers, friction or noise realisations.
 //! Every design of the study was verified (poles, H-inf, H2 within their bounds).
 //!
-//! On the benchmark maneuvers of `shared/spec/maneuvers.md` (implemented once, in
+//! On the benchmark maneuvers of `docs/benchmark.md` (implemented once, in
 //! `nigel-benchmark`, where the controller also gets the along-track speed correction) the
 //! gain is the controller FMU's `robust_tracking` mode; Table III's fourth column and the
 //! seed study (`table3 --seeds 0..9`) give, over seeds 0..9 and both columns, epsilon

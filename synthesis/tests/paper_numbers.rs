@@ -1,4 +1,4 @@
-//! The published numbers (paper variant) and the known facts of `robust-synthesis.md`,
+//! The published numbers (paper variant) and the known facts of `docs/synthesis.md`,
 //! each design verified without trusting the solver.
 
 use std::sync::OnceLock;
@@ -132,7 +132,7 @@ fn ackermann_chosen_point_matches_the_paper() {
 
 #[test]
 fn table2_geometry_with_the_printed_d2() {
-    // robust-synthesis.md: with Table II's l_r = 0.07929, gamma* = 0.11747 (Ackermann 0.17057)
+    // docs/synthesis.md: with Table II's l_r = 0.07929, gamma* = 0.11747 (Ackermann 0.17057)
     for (arch, expect) in [(Architecture::FourWheelSteering, 0.11747), (Architecture::Ackermann, 0.17057)] {
         let spec = PlantSpec { params: VehicleParams::table2(), ..PlantSpec::paper(arch) };
         let poly = spec.polytope().unwrap();

@@ -1,12 +1,12 @@
 //! Table III and Fig. 7 of the paper (Section V) from the three FMUs, as pinned down in
-//! `shared/spec/maneuvers.md`.
+//! `docs/benchmark.md`.
 //!
 //! * [`engine`]: what runs one closed loop. [`Engine`] has two implementations:
 //!   [`FmuEngine`] co-simulates the archives `nigel_plant.fmu`, `nigel_controller.fmu`
 //!   and `nigel_maneuver.fmu` with the `nigel_cosim` master (`ordered`, 1 ms, 30 s,
 //!   through the C ABI), and [`InProcess`] runs `nigel_benchmark`'s loop, the independent
 //!   implementation the FMU run must reproduce.
-//! * [`metric`]: the metric of maneuvers.md, computed here from the recorded pose and the
+//! * [`metric`]: the metric of docs/benchmark.md, computed here from the recorded pose and the
 //!   test bench's reference outputs (not taken from either engine).
 //! * [`table`]: the 48 runs of one seed (2 columns, 6 maneuvers, 4 controllers) in parallel, [`Table`]; [`paper`] holds the
 //!   paper's Table III for comparison.

@@ -1,4 +1,4 @@
-//! The metric of maneuvers.md, from what a run recorded: RMSE of the true X, Y and the
+//! The metric of docs/benchmark.md, from what a run recorded: RMSE of the true X, Y and the
 //! unwrapped heading against the test bench's reference pose over the samples
 //! `t = 1 ms .. 30 s` (`k = 1 ..= n`), `epsilon` their 2-norm; and the auxiliary
 //! `||(RMSE_beta, RMSE_r)||` of the quantities the controller regulates.

@@ -1,4 +1,4 @@
-//! The paper's Table III (epsilon; as printed, reproduced in maneuvers.md), for comparison.
+//! The paper's Table III (epsilon; as printed, reproduced in docs/benchmark.md), for comparison.
 
 use nigel_benchmark::{Controller, Fidelity, Maneuver};
 

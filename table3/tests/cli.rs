@@ -124,10 +124,16 @@ fn json_has_the_contract_shape_and_the_printed_numbers() {
             // the markdown prints the same number
             assert!(stdout.contains(&format!("{eps:.3e}")), "{eps:.3e} not in\n{stdout}");
         }
-        // one CSV per run, 30,001 rows and a header
+        // one CSV per run in fmpy's format: a quoted header with "time" first, 30,001 rows,
+        // 19 numbers in every row (the last one too)
         let text = std::fs::read_to_string(csv.join(format!("{column}_lane_change_robust.csv"))).unwrap();
         assert_eq!(text.lines().count(), 30_002);
-        assert!(text.starts_with("t,x,y,psi,x_ref"));
+        assert!(text.starts_with("\"time\",\"x\",\"y\",\"psi\",\"x_ref\""), "{}", &text[..80]);
+        for line in text.lines().skip(1) {
+            let fields: Vec<&str> = line.split(',').collect();
+            assert_eq!(fields.len(), 19, "{line}");
+            assert!(fields.iter().all(|f| f.parse::<f64>().is_ok_and(f64::is_finite)), "{line}");
+        }
     }
     assert!(v["results"]["sim"].get("skidpad").is_none());
 }

@@ -1,5 +1,5 @@
 """fmpy checks of the controller FMU (nigel_controller.fmu) and the test-bench FMU
-(nigel_maneuver.fmu), with independent Python arithmetic of shared/spec/maneuvers.md.
+(nigel_maneuver.fmu), with independent Python arithmetic of docs/benchmark.md.
 
 What is checked, and against what:
 - validate_fmu (fmpy's own rules) reports no problems; Co-Simulation and Model Exchange run.
@@ -146,7 +146,7 @@ def set_controller_inputs(s, fmu, x):
 
 
 def law(gain, x, integral):
-    """maneuvers.md written out: steering with clamp, speed PI with the force clip."""
+    """docs/benchmark.md written out: steering with clamp, speed PI with the force clip."""
     delta = []
     for i in range(4):
         d = x["ff"][i] + gain[i][0] * (x["beta"] - x["beta_ref"]) + gain[i][1] * (x["yaw_rate"] - x["yaw_rate_ref"])
@@ -308,7 +308,7 @@ MASK = (1 << 64) - 1
 
 
 def splitmix_u(seed, stream, k):
-    """maneuvers.md's counter-based SplitMix64, written out independently."""
+    """docs/benchmark.md's counter-based SplitMix64, written out independently."""
     z = ((((seed << 8) | stream) + (k + 1) * 0x9E3779B97F4A7C15)) & MASK
     z ^= z >> 30
     z = (z * 0xBF58476D1CE4E5B9) & MASK
@@ -430,7 +430,7 @@ def test_bench_bad_input(bench, capsys):
 # ------------------------------------------------------------------------- closed loop of the three FMUs
 
 # (column, maneuver, controller, epsilon) seed 0: the robust controller's from the
-# independent implementation of maneuvers.md (the self-check table of
+# independent implementation of docs/benchmark.md (the self-check table of
 # benchmark/tests/table3.rs); robust_tracking's (issue 9, pose feedback; None here) computed
 # when the test runs by nigel_benchmark in process (`table3 --engine in-process`), which this
 # loop, written here without our master, must reproduce through the FMUs' pose inputs.

@@ -3,7 +3,7 @@
 fmpy (0.3.x, an importer we did not write) loads, validates, simulates and probes the plant
 FMU; the numbers are compared with each other (Co-Simulation vs. Model Exchange), with an
 independent reference written here in plain Python straight from
-shared/spec/vehicle-model.md, and with the interface the plant declares in
+docs/vehicle-model.md, and with the interface the plant declares in
 fmu-plant/src/lib.rs.
 
 The FMU is taken from $NIGEL_FMU_DIR (default $CARGO_TARGET_DIR/fmu, else <repo>/target/fmu,
@@ -104,7 +104,7 @@ def fmpy_input_signal(changes=CHANGES, stop=STOP, base=BASE):
 
 
 # ---------------------------------------------------------------------------------------
-# Independent reference: vehicle-model.md in plain Python (math on floats), fixed RK4.
+# Independent reference: docs/vehicle-model.md in plain Python (math on floats), fixed RK4.
 # ---------------------------------------------------------------------------------------
 TABLE2 = dict(
     m=2.68, I_z=0.01944, l_f=0.06226, l_r=0.07929, track=0.14724, r_wheel=0.0325,
@@ -114,7 +114,7 @@ TABLE2 = dict(
 
 
 class Reference:
-    """The right-hand side of vehicle-model.md ("paper" fidelity, plus the three "real"
+    """The right-hand side of docs/vehicle-model.md ("paper" fidelity, plus the three "real"
     options for the derivative spot checks). State: X, Y, psi, v_x, v_y, r, then the four
     servo angles (used only with the servo on)."""
 
@@ -167,7 +167,7 @@ class Reference:
             fx_sum += fx
             fy_sum += fy
             mz += xi * fy - yi * fx
-        # world-frame wind in body axes at this stage's heading (maneuvers.md)
+        # world-frame wind in body axes at this stage's heading (docs/benchmark.md)
         wx, wy = u.get("wind_x", 0.0), u.get("wind_y", 0.0)
         head = u["wind_head"] - (wx * math.cos(psi) + wy * math.sin(psi))
         side = u["wind_side"] + (wy * math.cos(psi) - wx * math.sin(psi))

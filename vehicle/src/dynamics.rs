@@ -1,4 +1,4 @@
-//! The nonlinear right-hand side (`../shared/spec/vehicle-model.md`), generic over [`Scalar`].
+//! The nonlinear right-hand side (`docs/vehicle-model.md`), generic over [`Scalar`].
 
 use crate::params::VehicleParams;
 use crate::scalar::Scalar;

@@ -4,7 +4,7 @@ use nalgebra::{Matrix2, Matrix2x4, Vector2};
 
 use crate::params::VehicleParams;
 
-/// Which disturbance column `[d1; d2]` to use (see `robust-synthesis.md`).
+/// Which disturbance column `[d1; d2]` to use (see `docs/synthesis.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DisturbanceColumn {
     /// `d2 = (l_f - l_r)/2` as printed in Eq. 2.2 (reproduces the published numbers).

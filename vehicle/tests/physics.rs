@@ -48,7 +48,7 @@ fn nonlinear_jacobian(p: &VehicleParams, mu: [f64; 4], v: f64) -> (Matrix2<f64>,
 
 #[test]
 fn closed_form_matches_the_numbers_in_the_spec() {
-    // vehicle-model.md: mu = 0.4, v = 0.35
+    // docs/vehicle-model.md: mu = 0.4, v = 0.35
     let lm = linear_model(&VehicleParams::table2(), [0.4; 4], 0.35);
     let expected_a = [[-38.3400, -0.06724], [15.7523, -26.8591]];
     for r in 0..2 {

@@ -8,6 +8,8 @@
  *   mode 1, follower: once its time event at t_event has come, y = u at each event
  *           iteration (before, y holds).
  *   mode 2, inverter: at each event iteration y = 1 - u.
+ *   mode 3, restless: once its time event at t_event has come, y += 1 at each event
+ *           iteration and it always asks for another one (no fixed point on its own).
  * A follower and an inverter in a loop have no fixed point once the follower follows.
  * A time event at t_event (if > 0). Its outputs do not depend on its input directly
  * (they change only in event mode). */
@@ -73,6 +75,11 @@ EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
         if (l->fired) l->r[1] = u;
     } else if (l->r[4] == 2.0) {
         l->r[1] = 1.0 - u;
+    } else if (l->r[4] == 3.0) {
+        if (l->fired) {
+            l->r[1] += 1.0;
+            info->newDiscreteStatesNeeded = 1;
+        }
     } else {
         if (u > 0.0 && l->u_prev <= 0.0) {
             l->r[2] += 1.0;

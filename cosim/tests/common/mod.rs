@@ -201,6 +201,23 @@ fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
     fmu
 }
 
+/// The misbehaving FMU (tests/cfmu/hostile.c): hostile log formats at instantiation,
+/// output `y` NaN / Inf with fmi2OK from `t_bad` on; as `<dir>/hostile.fmu`.
+pub fn build_hostile(dir: &Path) -> PathBuf {
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="hostile" guid="{hostile}" numberOfEventIndicators="0">
+  <CoSimulation modelIdentifier="hostile" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
+    <ScalarVariable name="t_bad" valueReference="1" causality="parameter" variability="fixed"><Real start="0.5"/></ScalarVariable>
+    <ScalarVariable name="bad" valueReference="2" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#;
+    build_single_c_fmu(dir, "hostile", xml)
+}
+
 /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
 pub fn build_ball(dir: &Path) -> PathBuf {
     let xml = r#"<?xml version="1.0" encoding="UTF-8"?>

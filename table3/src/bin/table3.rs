@@ -31,7 +31,7 @@ enum AlgorithmArg {
     Jacobi,
 }
 
-/// Table III and Fig. 7 (maneuvers.md) for one seed.
+/// Table III and Fig. 7 (docs/benchmark.md) for one seed.
 #[derive(Parser, Debug)]
 #[command(name = "table3", version)]
 struct Args {

@@ -22,7 +22,7 @@ pub struct Job {
     pub maneuver: Maneuver,
     /// The controller.
     pub controller: Controller,
-    /// Friction variation, wind and measurement noise as in maneuvers.md (`true`), or all
+    /// Friction variation, wind and measurement noise as in docs/benchmark.md (`true`), or all
     /// off (`false`: mu = 0.4, no wind, no noise; the run must then stay on its reference
     /// when `controller` is open loop).
     pub disturbed: bool,

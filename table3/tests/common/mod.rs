@@ -1,5 +1,5 @@
 //! Shared by the integration tests: the self-check table of the issue (an independent
-//! implementation of maneuvers.md, seed 0) and cached tables.
+//! implementation of docs/benchmark.md, seed 0) and cached tables.
 #![allow(dead_code)]
 
 use nigel_table3::{Controller, Fidelity, Maneuver, Table};

@@ -1,4 +1,4 @@
-//! The loop of maneuvers.md once more, written here from nigel_benchmark's and
+//! The loop of docs/benchmark.md once more, written here from nigel_benchmark's and
 //! nigel_vehicle's public pieces, with one difference from nigel_benchmark's: the plant
 //! is stepped over `t_(k+1) - t_k` with `t_k = k * 1 ms` (as the master does, like fmpy),
 //! not over exactly 1 ms, with the plant FMU's sub-step rule. It explains the last bits

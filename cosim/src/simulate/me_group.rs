@@ -1,5 +1,7 @@
-//! Model Exchange instances coupled by connections, integrated together so that an event
-//! of any of them is an event of all (FMI 2.0 section 3.2.3, for a system of FMUs).
+//! The one Model Exchange integrator of the master: a group of ME instances integrated
+//! together, so that an event of any of them is an event of all (FMI 2.0 section 3.2.3,
+//! for a system of FMUs). An ME instance connected to no other ME instance is a group of
+//! one; the ME instances connected to each other form one group.
 //!
 //! Over a communication step the members advance in lockstep: one common internal step
 //! (RK4 with the same sub-steps; Dormand-Prince with the smallest step any member asks
@@ -18,17 +20,41 @@
 //! communication points only.
 
 use crate::error::{Error, Result};
-use crate::fmu::Interface;
-use crate::me::{Event, Solver, EVENT_TIME_TOLERANCE};
-use crate::simulate::{ordered_ops, Lane, Op};
+use crate::fmu::{Instance, Interface};
+use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
+use crate::simulate::plan::{ordered_ops, Instances, Op};
 use crate::system::{Connection, System, VariableRef};
+
+/// Access to the members of a group: each one's instance and integration state.
+pub(crate) trait Members: Instances {
+    /// Member `m` (an instance index of the system), if it has its integration state.
+    fn member(&mut self, m: usize) -> Option<(&mut Instance, &mut MeUnit)>;
+}
+
+/// One ME instance on its own: the members of its group of one.
+pub(crate) struct Solo<'a> {
+    pub(crate) inst: &'a mut Instance,
+    pub(crate) unit: &'a mut MeUnit,
+}
+
+impl Instances for Solo<'_> {
+    fn instance(&mut self, _: usize) -> &mut Instance {
+        self.inst
+    }
+}
+
+impl Members for Solo<'_> {
+    fn member(&mut self, _: usize) -> Option<(&mut Instance, &mut MeUnit)> {
+        Some((&mut *self.inst, &mut *self.unit))
+    }
+}
 
 /// Rounds of the event iteration before it is declared not converging.
 pub const MAX_EVENT_ROUNDS: usize = 100;
 
-/// The Model Exchange instances of a system with at least one connection between two of them.
+/// Model Exchange instances integrated together.
 pub(crate) struct MeGroup {
-    /// Lane (instance) indices of the members: every Model Exchange instance.
+    /// Instance indices of the members.
     pub(crate) members: std::sync::Arc<[usize]>,
     /// The connections between members, in topological order.
     ops: Vec<Op>,
@@ -37,8 +63,14 @@ pub(crate) struct MeGroup {
 }
 
 impl MeGroup {
-    /// The group of `system`, if two of its Model Exchange instances are connected.
-    pub(crate) fn of(system: &System) -> Result<Option<MeGroup>> {
+    /// The group of one: instance `index` on its own.
+    pub(crate) fn solo(index: usize) -> MeGroup {
+        MeGroup { members: std::sync::Arc::new([index]), ops: Vec::new(), values: Vec::new(), before: Vec::new() }
+    }
+
+    /// The coupled group of `system`: all its Model Exchange instances, if two of them
+    /// are connected.
+    pub(crate) fn coupled(system: &System) -> Result<Option<MeGroup>> {
         let me = |i: usize| system.instances[i].fmu.interface() == Interface::ModelExchange;
         let links: Vec<Connection> =
             system.connections.iter().filter(|c| me(c.from.instance) && me(c.to.instance)).cloned().collect();
@@ -65,10 +97,10 @@ impl MeGroup {
 
     /// Carries the members' connections; returns whether any carried value changed since
     /// the last propagation, and appends the members whose inputs changed to `changed`.
-    fn propagate(&mut self, lanes: &mut [Lane], changed: &mut Vec<usize>) -> Result<bool> {
+    fn propagate<L: Members + ?Sized>(&mut self, lanes: &mut L, changed: &mut Vec<usize>) -> Result<bool> {
         self.before.copy_from_slice(&self.values);
         for op in self.ops.iter_mut() {
-            op.run(&mut lanes[op.instance].inst, &mut self.values)?;
+            op.run(lanes.instance(op.instance), &mut self.values)?;
         }
         let mut any = false;
         for op in &self.ops {
@@ -84,7 +116,7 @@ impl MeGroup {
 
     /// The event iteration of all members, which are in event mode at `time`; ends with
     /// all of them in continuous-time mode, their states and indicators read again.
-    pub(crate) fn iterate(&mut self, lanes: &mut [Lane], time: f64) -> Result<()> {
+    pub(crate) fn iterate<L: Members + ?Sized>(&mut self, lanes: &mut L, time: f64) -> Result<()> {
         let mut unsettled = Vec::new();
         // the members unsettled in the last rounds (an oscillation alternates them)
         let mut recent: Vec<usize> = Vec::new();
@@ -92,9 +124,8 @@ impl MeGroup {
         for round in 0..MAX_EVENT_ROUNDS {
             unsettled.clear();
             for &m in self.members.iter() {
-                let lane = &mut lanes[m];
-                let Some(unit) = lane.unit.as_mut() else { continue };
-                let info = lane.inst.new_discrete_states()?;
+                let Some((inst, unit)) = lanes.member(m) else { continue };
+                let info = inst.new_discrete_states()?;
                 if info.terminate_simulation != 0 {
                     unit.terminated = true;
                 }
@@ -113,10 +144,9 @@ impl MeGroup {
             }
             if unsettled.is_empty() && !changed {
                 for &m in self.members.iter() {
-                    let lane = &mut lanes[m];
-                    let Some(unit) = lane.unit.as_mut() else { continue };
-                    lane.inst.enter_continuous_time_mode()?;
-                    unit.resume(&mut lane.inst)?;
+                    let Some((inst, unit)) = lanes.member(m) else { continue };
+                    inst.enter_continuous_time_mode()?;
+                    unit.resume(inst)?;
                 }
                 return Ok(());
             }
@@ -125,20 +155,19 @@ impl MeGroup {
         Err(Error::EventIteration {
             time,
             rounds: MAX_EVENT_ROUNDS,
-            instances: recent.iter().map(|m| lanes[*m].inst.name().to_string()).collect(),
+            instances: recent.iter().map(|m| lanes.instance(*m).name().to_string()).collect(),
         })
     }
 
     /// An event at `time` caused by `who` (recorded as `kind`): all members enter event
     /// mode and iterate together.
-    fn event(&mut self, lanes: &mut [Lane], time: f64, kind: &'static str, who: &[usize]) -> Result<()> {
+    fn event<L: Members + ?Sized>(&mut self, lanes: &mut L, time: f64, kind: &'static str, who: &[usize]) -> Result<()> {
         for &m in self.members.iter() {
-            lanes[m].inst.enter_event_mode()?;
+            lanes.instance(m).enter_event_mode()?;
         }
         for &m in who {
-            let lane = &mut lanes[m];
-            if let Some(unit) = lane.unit.as_mut() {
-                unit.events.push(Event { instance: lane.inst.name().to_string(), time, kind });
+            if let Some((inst, unit)) = lanes.member(m) {
+                unit.events.push(Event { instance: inst.name().to_string(), time, kind });
             }
         }
         self.iterate(lanes, time)
@@ -146,22 +175,22 @@ impl MeGroup {
 
     /// Integrates all members from `t` to `t_end` together, their inputs held between
     /// events.
-    pub(crate) fn advance(&mut self, lanes: &mut [Lane], solver: Solver, t: f64, t_end: f64) -> Result<()> {
+    pub(crate) fn advance<L: Members + ?Sized>(&mut self, lanes: &mut L, solver: Solver, t: f64, t_end: f64) -> Result<()> {
         let mut t = t;
         let span = t_end - t;
         let eps = 1e-13 * t_end.abs().max(1.0);
         let members = self.members.clone();
         let members: &[usize] = &members;
         for &m in members {
-            if let Some(u) = lanes[m].unit.as_mut() {
+            if let Some((_, u)) = lanes.member(m) {
                 if u.h_adaptive <= 0.0 {
                     u.h_adaptive = span * 0.1;
                 }
             }
         }
-        let next_time_event = |lanes: &[Lane], m: usize| lanes[m].unit.as_ref().and_then(|u| u.next_time_event);
+        let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
         loop {
-            if t >= t_end - eps || members.iter().any(|m| lanes[*m].unit.as_ref().is_some_and(|u| u.terminated)) {
+            if t >= t_end - eps || members.iter().any(|m| lanes.member(*m).is_some_and(|(_, u)| u.terminated)) {
                 return Ok(());
             }
             // time events due now
@@ -175,7 +204,7 @@ impl MeGroup {
                 if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
                     return Err(Error::Experiment(format!(
                         "{}: time event at {t} repeats at the same time",
-                        lanes[*m].inst.name()
+                        lanes.instance(*m).name()
                     )));
                 }
                 continue;
@@ -198,43 +227,40 @@ impl MeGroup {
                     h_max / ((h_max / hm) * (1.0 - 1e-12)).ceil().max(1.0)
                 }
                 Solver::Dopri5 { .. } => {
-                    members.iter().filter_map(|m| lanes[*m].unit.as_ref().map(|u| u.h_adaptive)).fold(h_max, f64::min)
+                    members.iter().filter_map(|m| lanes.member(*m).map(|(_, u)| u.h_adaptive)).fold(h_max, f64::min)
                 }
             };
             for &m in members {
-                let lane = &mut lanes[m];
-                if let Some(u) = lane.unit.as_mut() {
-                    u.begin_step(&mut lane.inst, t)?;
+                if let Some((inst, u)) = lanes.member(m) {
+                    u.begin_step(inst, t)?;
                 }
             }
             match solver {
                 Solver::Dopri5 { rtol, atol } => loop {
                     let mut err = 0.0f64;
                     for &m in members {
-                        let lane = &mut lanes[m];
-                        if let Some(u) = lane.unit.as_mut() {
-                            err = err.max(u.dopri(&mut lane.inst, t, h, rtol, atol)?);
+                        if let Some((inst, u)) = lanes.member(m) {
+                            err = err.max(u.dopri(inst, t, h, rtol, atol)?);
                         }
                     }
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     if err <= 1.0 || h <= 1e-14 * t_end.abs().max(1.0) {
                         for &m in members {
-                            if let Some(u) = lanes[m].unit.as_mut() {
+                            if let Some((_, u)) = lanes.member(m) {
                                 u.h_adaptive = (h * factor).min(span.max(h));
                             }
                         }
                         break;
                     }
-                    if let Some(u) = lanes[members[0]].unit.as_mut() {
+                    if let Some((_, u)) = lanes.member(members[0]) {
                         u.rejected += 1;
                     }
                     h *= factor.min(0.9);
                 },
                 Solver::Rk4 { .. } => {
                     for &m in members {
-                        let lane = &mut lanes[m];
-                        if let Some(u) = lane.unit.as_mut() {
-                            u.rk4(&mut lane.inst, t, h)?;
+                        if let Some((inst, u)) = lanes.member(m) {
+                            u.rk4(inst, t, h)?;
                         }
                     }
                 }
@@ -244,11 +270,10 @@ impl MeGroup {
             let mut first: Option<f64> = None;
             let mut crossings: Vec<(usize, f64)> = Vec::new();
             for &m in members {
-                let lane = &mut lanes[m];
-                let Some(u) = lane.unit.as_mut() else { continue };
-                u.indicators_at(&mut lane.inst, t_new)?;
-                if crate::me::MeUnit::crossed(&u.z0, &u.z) {
-                    let hi = u.locate_crossing(&mut lane.inst, solver, t, t_new - t)?;
+                let Some((inst, u)) = lanes.member(m) else { continue };
+                u.indicators_at(inst, t_new)?;
+                if MeUnit::crossed(&u.z0, &u.z) {
+                    let hi = u.locate_crossing(inst, solver, t, t_new - t)?;
                     crossings.push((m, hi));
                     first = Some(first.map_or(hi, |f: f64| f.min(hi)));
                 }
@@ -256,21 +281,20 @@ impl MeGroup {
             if let Some(hi) = first {
                 let te = t + hi;
                 for &m in members {
-                    let lane = &mut lanes[m];
-                    let Some(u) = lane.unit.as_mut() else { continue };
-                    u.one_step(&mut lane.inst, solver, t, hi)?;
-                    lane.inst.set_time(te)?;
-                    lane.inst.set_continuous_states(&u.xt)?;
+                    let Some((inst, u)) = lanes.member(m) else { continue };
+                    u.one_step(inst, solver, t, hi)?;
+                    inst.set_time(te)?;
+                    inst.set_continuous_states(&u.xt)?;
                     u.x.copy_from_slice(&u.xt);
                     u.steps += 1;
-                    lane.inst.completed_integrator_step()?;
+                    inst.completed_integrator_step()?;
                 }
                 let who: Vec<usize> =
                     crossings.iter().filter(|(_, h)| *h <= hi + EVENT_TIME_TOLERANCE).map(|(m, _)| *m).collect();
                 self.event(lanes, te, "state", &who)?;
                 if let Solver::Dopri5 { .. } = solver {
                     for &m in members {
-                        if let Some(u) = lanes[m].unit.as_mut() {
+                        if let Some((_, u)) = lanes.member(m) {
                             u.h_adaptive = u.h_adaptive.min(span * 0.1);
                         }
                     }
@@ -281,14 +305,13 @@ impl MeGroup {
             // the step is accepted by every member
             let mut step_events: Vec<usize> = Vec::new();
             for &m in members {
-                let lane = &mut lanes[m];
-                let Some(u) = lane.unit.as_mut() else { continue };
+                let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&u.xt);
-                lane.inst.set_time(t_new)?;
-                lane.inst.set_continuous_states(&u.x)?;
+                inst.set_time(t_new)?;
+                inst.set_continuous_states(&u.x)?;
                 u.steps += 1;
                 std::mem::swap(&mut u.z0, &mut u.z);
-                let (step_event, terminate) = lane.inst.completed_integrator_step()?;
+                let (step_event, terminate) = inst.completed_integrator_step()?;
                 if terminate {
                     u.terminated = true;
                 }

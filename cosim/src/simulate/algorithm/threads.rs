@@ -1,5 +1,8 @@
 //! `jacobi` with the instances spread over threads.
 //!
+//! The first [`CALIBRATION_STEPS`] steps run in one thread and measure each instance's
+//! time; the instances are then spread over the threads.
+//!
 //! A pool lives for one run (`std::thread::scope`): `threads - 1` workers plus the
 //! calling thread, each owning a fixed group of instances ([`Lane`]s) chosen by their
 //! measured cost (longest first, onto the least loaded thread). Per communication step
@@ -20,9 +23,12 @@
 //! not parked. On a machine with no free core the spinning only delays the others, so
 //! it is short.
 
+use super::{Communication, Core, Jacobi};
 use crate::error::{Error, Result};
 use crate::me::Solver;
-use crate::simulate::{Lane, StepArgs};
+use crate::simulate::clock::{Clock, Point};
+use crate::simulate::lane::Lane;
+use crate::simulate::observer::{Observers, Profiler};
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard, RwLock};
@@ -34,7 +40,7 @@ const SPIN_TIME: std::time::Duration = std::time::Duration::from_micros(10);
 struct Shared {
     groups: Vec<Mutex<Vec<Lane>>>,
     values: RwLock<Vec<f64>>,
-    args: Mutex<StepArgs>,
+    args: Mutex<Point>,
     epoch: AtomicU64,
     done: AtomicUsize,
     stop: AtomicBool,
@@ -68,13 +74,13 @@ fn wait_until(ready: impl Fn() -> bool) {
 }
 
 /// Steps the instances of group `g` once; an error stays in its lane, a panic is flagged.
-fn work(shared: &Shared, g: usize, solver: Solver) {
+fn work(shared: &Shared, g: usize, solver: Solver, profile: bool) {
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let a = *lock(&shared.args);
         let values = shared.values.read().unwrap_or_else(|e| e.into_inner());
         let mut lanes = lock(&shared.groups[g]);
         for lane in lanes.iter_mut() {
-            if let Err(e) = lane.jacobi_step(&values, a, solver) {
+            if let Err(e) = lane.jacobi_step(&values, a, profile, solver) {
                 lane.error = Some(e);
                 break;
             }
@@ -106,34 +112,37 @@ fn partition(mut lanes: Vec<Lane>, threads: usize) -> Vec<Vec<Lane>> {
 const PROBE_STEPS: u64 = 1000;
 
 /// A pool for one run.
-pub(crate) struct Pool {
+struct Pool {
     /// Threads, the calling one included (at least 2, at most the number of lanes).
-    pub(crate) threads: usize,
-    pub(crate) solver: Solver,
+    threads: usize,
+    solver: Solver,
+    /// Lanes measure the time of their calls.
+    profile: bool,
     /// Wall time of one step in one thread (measured): after [`PROBE_STEPS`] steps
     /// slower than this, the pool stops and the caller goes on in one thread.
-    pub(crate) serial_step: std::time::Duration,
+    serial_step: std::time::Duration,
 }
 
 impl Pool {
-    /// Runs the `jacobi` steps `steps`. `args(n)` gives step `n`; `row(n, values)` is called
-    /// after each step with all outputs in their slots. Returns the lanes in their original
-    /// order and the first step not run (the end of `steps` unless the pool was slower than
-    /// one thread). The first error (lowest instance index) of a step ends the run.
-    pub(crate) fn run(
+    /// Runs the `jacobi` steps `steps` of `clock`; the observers are told after each step
+    /// with all outputs in their slots. Returns the lanes in their original order and the
+    /// first step not run (the end of `steps` unless the pool was slower than one thread).
+    /// The first error (lowest instance index) of a step ends the run.
+    fn run(
         &self,
         lanes: Vec<Lane>,
         values: &mut Vec<f64>,
+        clock: &Clock,
         steps: Range<u64>,
-        args: &dyn Fn(u64) -> StepArgs,
-        row: &mut dyn FnMut(u64, &[f64]),
+        observers: &mut Observers,
     ) -> Result<(Vec<Lane>, u64)> {
         let solver = self.solver;
+        let profile = self.profile;
         let threads = self.threads.clamp(1, lanes.len().max(1));
         let shared = Shared {
             groups: partition(lanes, threads).into_iter().map(Mutex::new).collect(),
             values: RwLock::new(std::mem::take(values)),
-            args: Mutex::new(StepArgs::default()),
+            args: Mutex::new(Point::default()),
             epoch: AtomicU64::new(0),
             done: AtomicUsize::new(0),
             stop: AtomicBool::new(false),
@@ -153,7 +162,7 @@ impl Pool {
                         if shared.stop.load(Ordering::Acquire) {
                             return;
                         }
-                        work(shared, g, solver);
+                        work(shared, g, solver, profile);
                         shared.done.fetch_add(1, Ordering::AcqRel);
                         main.unpark();
                     }
@@ -167,14 +176,14 @@ impl Pool {
                     if n == first + PROBE_STEPS && start.elapsed() > self.serial_step * PROBE_STEPS as u32 {
                         return Ok(n); // slower than one thread: the caller goes on alone
                     }
-                    let a = args(n);
+                    let a = clock.point(n);
                     *lock(&shared.args) = a;
                     shared.done.store(0, Ordering::Release);
                     shared.epoch.fetch_add(1, Ordering::AcqRel);
                     for w in &workers {
                         w.unpark();
                     }
-                    work(&shared, 0, solver);
+                    work(&shared, 0, solver, profile);
                     wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
                     if shared.panicked.load(Ordering::Acquire) {
                         return Err(Error::Experiment("a thread stepping the instances panicked".into()));
@@ -198,7 +207,7 @@ impl Pool {
                             lane.scatter(&mut values, a.output_point);
                         }
                     }
-                    row(n, &values);
+                    observers.step_complete(&a, &values);
                 }
                 Ok(steps.end)
             };
@@ -215,5 +224,64 @@ impl Pool {
             shared.groups.into_iter().flat_map(|g| g.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
         lanes.sort_by_key(|l| l.index);
         result.map(|next| (lanes, next))
+    }
+}
+
+/// Steps run in one thread before the instances are spread over threads by their
+/// measured cost (and the time of one step in one thread taken as the mark the pool must
+/// beat).
+const CALIBRATION_STEPS: u64 = 200;
+
+/// `jacobi` with the instances in `threads` threads (the calling one included); a system
+/// with a coupled Model Exchange group runs in one thread.
+pub(crate) struct ThreadedJacobi {
+    pub(crate) threads: usize,
+}
+
+impl Communication for ThreadedJacobi {
+    fn propagate(&mut self, core: &mut Core) -> Result<()> {
+        Jacobi.propagate(core)
+    }
+
+    fn step(&mut self, core: &mut Core, p: Point, calls: Option<&mut Profiler>) -> Result<()> {
+        Jacobi.step(core, p, calls)
+    }
+
+    fn finish(&mut self, core: &mut Core) -> Result<()> {
+        Jacobi.finish(core)
+    }
+
+    fn run(&mut self, core: &mut Core, observers: &mut Observers) -> Result<()> {
+        let threads = if core.group.is_some() { 1 } else { self.threads.min(core.lanes.len()) };
+        let steps = core.clock.steps;
+        let mut first = 0;
+        if threads > 1 {
+            // a few steps in one thread to measure each instance's cost, then the
+            // instances spread over the threads by that cost
+            let calibration = steps.min(CALIBRATION_STEPS);
+            let calibration_start = std::time::Instant::now();
+            for n in 0..calibration {
+                let p = core.clock.point(n);
+                Jacobi::step_lanes(core, p, true)?;
+                observers.step_complete(&p, &core.values);
+            }
+            first = calibration;
+            let serial_step = calibration_start.elapsed() / calibration.max(1) as u32;
+            if first < steps {
+                let pool = Pool { threads, solver: core.solver, profile: core.profile, serial_step };
+                let lanes = std::mem::take(&mut core.lanes);
+                let clock = core.clock;
+                let (back, next) = pool.run(lanes, &mut core.values, &clock, first..steps, observers)?;
+                core.lanes = back;
+                core.parallel_steps = next - first;
+                first = next;
+            }
+        }
+        for n in first..steps {
+            let p = core.clock.point(n);
+            Jacobi.step(core, p, None)?;
+            observers.step_complete(&p, &core.values);
+        }
+        self.finish(core)
     }
 }

@@ -1,0 +1,50 @@
+//! `ordered`: after the step, outputs flow in the topological order of the variable graph
+//! (connections and direct feedthrough), so an input sees its source at the same
+//! communication point.
+
+use super::{Communication, Core};
+use crate::error::Result;
+use crate::simulate::clock::Point;
+use crate::simulate::observer::Profiler;
+use crate::simulate::plan::{run_ops, Op};
+
+/// The `ordered` algorithm: the plan's calls in topological order.
+pub(crate) struct Ordered {
+    /// The batched calls carrying every connection, in topological order.
+    pub(crate) ops: Vec<Op>,
+    /// The gets of the recorded variables the propagation does not leave current.
+    pub(crate) record_gets: Vec<Op>,
+}
+
+impl Communication for Ordered {
+    fn propagate(&mut self, core: &mut Core) -> Result<()> {
+        run_ops(&mut self.ops, core.lanes.as_mut_slice(), &mut core.values, None)
+    }
+
+    #[inline]
+    fn step(&mut self, core: &mut Core, p: Point, mut calls: Option<&mut Profiler>) -> Result<()> {
+        if let Some(c) = calls.as_deref_mut() {
+            c.restart();
+        }
+        for lane in core.lanes.iter_mut() {
+            if lane.in_group() {
+                continue;
+            }
+            lane.advance(core.solver, p.t, p.t_next)?;
+            if let Some(c) = calls.as_deref_mut() {
+                c.charge(lane.index);
+            }
+        }
+        if let Some(g) = core.group.as_mut() {
+            g.advance(core.lanes.as_mut_slice(), core.solver, p.t, p.t_next)?;
+            if let Some(c) = calls.as_deref_mut() {
+                c.charge_shared(&g.members);
+            }
+        }
+        run_ops(&mut self.ops, core.lanes.as_mut_slice(), &mut core.values, calls)?;
+        if p.output_point {
+            run_ops(&mut self.record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+        }
+        Ok(())
+    }
+}

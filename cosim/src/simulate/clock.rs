@@ -1,0 +1,105 @@
+//! The time base of a run: communication point `n` is at `t0 + n h`, computed from the
+//! integer step count (no time is accumulated), and the last step ends exactly at the
+//! stop time when the interval is not a whole number of steps.
+
+use crate::error::{Error, Result};
+use crate::simulate::types::Experiment;
+use crate::system::{is_cs, System};
+
+/// One communication step: from `t` to `t_next`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Point {
+    /// Step number from the start (0-based).
+    pub(crate) n: u64,
+    /// Start of the step, s.
+    pub(crate) t: f64,
+    /// End of the step, s.
+    pub(crate) t_next: f64,
+    /// A row is recorded at `t_next`.
+    pub(crate) output_point: bool,
+}
+
+/// The communication points of a run.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Clock {
+    /// Start time, s.
+    pub(crate) t0: f64,
+    /// Communication step, s.
+    pub(crate) h: f64,
+    /// Stop time, s.
+    pub(crate) stop: f64,
+    /// Number of communication steps.
+    pub(crate) steps: u64,
+    /// A row every `stride` steps (and at the last).
+    pub(crate) stride: u64,
+    /// The last step is shorter than `h` and ends at `stop`.
+    partial: bool,
+}
+
+impl Clock {
+    /// Step `n` of the run.
+    #[inline]
+    pub(crate) fn point(&self, n: u64) -> Point {
+        let last = n + 1 == self.steps;
+        let t_next = if last && self.partial { self.stop } else { self.t0 + (n + 1) as f64 * self.h };
+        Point { n, t: self.t0 + n as f64 * self.h, t_next, output_point: (n + 1).is_multiple_of(self.stride) || last }
+    }
+
+    /// Rows a run records (the initial one included).
+    pub(crate) fn rows(&self) -> u64 {
+        self.steps / self.stride + 2
+    }
+
+    /// The points of experiment `e`: the number of steps, the output stride, and whether
+    /// the last step is shorter (the interval is not a whole number of steps: allowed only
+    /// when every Co-Simulation instance has `canHandleVariableCommunicationStepSize`),
+    /// checked.
+    pub(crate) fn new(e: &Experiment, system: &System) -> Result<Clock> {
+        let ok = |x: f64| x.is_finite();
+        if !(ok(e.start_time) && ok(e.stop_time) && ok(e.step)) || e.step <= 0.0 || e.stop_time < e.start_time {
+            return Err(Error::Experiment(format!(
+                "need finite times with stop >= start and step > 0 (start {}, stop {}, step {})",
+                e.start_time, e.stop_time, e.step
+            )));
+        }
+        let span = (e.stop_time - e.start_time) / e.step;
+        let mut steps = span.round();
+        let partial = (span - steps).abs() > 1e-9 * span.max(1.0);
+        if partial {
+            if let Some(fixed) = system.instances.iter().find(|i| is_cs(i) && !i.fmu.can_handle_variable_step()) {
+                return Err(Error::Experiment(format!(
+                    "the interval {} s is not a whole number of steps of {} s, and {} cannot take a shorter last step (canHandleVariableCommunicationStepSize is false)",
+                    e.stop_time - e.start_time,
+                    e.step,
+                    fixed.name
+                )));
+            }
+            steps = span.ceil();
+        }
+        if steps > 1e12 {
+            return Err(Error::Experiment(format!("{steps} steps is too many")));
+        }
+        let stride = match e.output_interval {
+            None => 1.0,
+            Some(d) => {
+                let r = d / e.step;
+                if !(d.is_finite() && d > 0.0) || (r - r.round()).abs() > 1e-9 * r.max(1.0) || r.round() < 1.0 {
+                    return Err(Error::Experiment(format!(
+                        "the output interval {d} s must be a whole multiple of the step {} s",
+                        e.step
+                    )));
+                }
+                r.round()
+            }
+        };
+        Ok(Clock {
+            t0: e.start_time,
+            h: e.step,
+            stop: e.stop_time,
+            steps: steps as u64,
+            stride: stride as u64,
+            partial,
+        })
+    }
+
+}

@@ -1,0 +1,178 @@
+//! The driver of a run: checks, the plan, instantiation and initialization (FMI 2.0
+//! section 4.2.4), then the steps handed to the algorithm with the observers attached,
+//! then the summary and termination.
+
+use crate::error::{Error, Result};
+use crate::fmu::{Instance, Interface};
+use crate::me::MeUnit;
+use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
+use crate::simulate::clock::Clock;
+use crate::simulate::lane::{apply_start_values, Lane};
+use crate::simulate::me_group::MeGroup;
+use crate::simulate::observer::{Observer, Observers, Profiler, Recorder};
+use crate::simulate::plan::{default_record, run_ops, Plan};
+use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
+use crate::system::{BaseType, System, VariableRef};
+use std::time::{Duration, Instant};
+
+/// Refuses a system with two instances of an FMU that declares
+/// `canBeInstantiatedOnlyOncePerProcess`.
+fn check_single_instance(system: &System) -> Result<()> {
+    for (k, spec) in system.instances.iter().enumerate() {
+        let md = spec.fmu.description();
+        let once = match spec.fmu.interface() {
+            Interface::CoSimulation => {
+                md.co_simulation.as_ref().is_some_and(|c| c.can_be_instantiated_only_once_per_process)
+            }
+            Interface::ModelExchange => {
+                md.model_exchange.as_ref().is_some_and(|m| m.can_be_instantiated_only_once_per_process)
+            }
+        };
+        if !once {
+            continue;
+        }
+        if let Some(other) = system.instances[k + 1..].iter().find(|o| o.fmu.description().guid == md.guid) {
+            return Err(Error::Experiment(format!(
+                "{} and {} are instances of {} (GUID {}), which can be instantiated only once per process (canBeInstantiatedOnlyOncePerProcess)",
+                spec.name, other.name, md.model_name, md.guid
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
+pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
+    let wall = Instant::now();
+    let clock = Clock::new(experiment, system)?;
+    check_single_instance(system)?;
+    if experiment.threads == 0 {
+        return Err(Error::Experiment("threads must be at least 1".into()));
+    }
+    let record: Vec<VariableRef> = match &experiment.record {
+        None => default_record(system),
+        Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
+    };
+    if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
+        return Err(Error::InvalidValue {
+            variable: system.name_of(r),
+            value: String::new(),
+            reason: "String variables cannot be recorded in CSV".into(),
+        });
+    }
+    let mut plan = Plan::new(system, &record, experiment.algorithm)?;
+    // Model Exchange instances connected to each other are integrated together
+    let group = MeGroup::coupled(system)?;
+    let record_slots: Vec<usize> = record.iter().map(|r| plan.slot(r)).collect();
+    // all recorded variables, one get per instance and type (for the first row)
+    let mut record_gets = plan.record_gets(&record);
+    let mut algorithm: Box<dyn Communication> = match (experiment.algorithm, plan.ordered.take()) {
+        (Algorithm::Ordered, Some(ops)) => {
+            plan.ordered = Some(ops);
+            let record_gets = plan.ordered_record_gets(&record);
+            Box::new(Ordered { ops: plan.ordered.take().unwrap_or_default(), record_gets })
+        }
+        _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
+        _ => Box::new(Jacobi),
+    };
+    let single = system.instances.len() == 1;
+    let names: Vec<String> =
+        record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
+    let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress);
+
+    // instantiate and initialize (FMI 2.0 section 4.2.4)
+    let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
+    for (index, spec) in system.instances.iter().enumerate() {
+        lanes.push(Lane::new(
+            index,
+            Instance::new(&spec.fmu, &spec.name)?,
+            std::mem::take(&mut plan.jacobi_gets[index]),
+            std::mem::take(&mut plan.jacobi_gets_rec[index]),
+            std::mem::take(&mut plan.jacobi_sets[index]),
+        ));
+    }
+    let mut core = Core {
+        lanes,
+        values: vec![0.0; plan.sources.len()],
+        group,
+        solver: experiment.solver,
+        clock,
+        profile: experiment.profile,
+        parallel_steps: 0,
+    };
+    let t0 = clock.t0;
+    for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
+        lane.inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
+        apply_start_values(&mut lane.inst, spec)?;
+        lane.inst.enter_initialization_mode()?;
+    }
+    algorithm.propagate(&mut core)?;
+    for lane in core.lanes.iter_mut() {
+        lane.inst.exit_initialization_mode()?;
+        if lane.inst.fmu().interface() == Interface::ModelExchange {
+            lane.unit = Some(MeUnit::new(&lane.inst));
+            if !core.group.as_ref().is_some_and(|g| g.contains(lane.index)) {
+                lane.solo = Some(MeGroup::solo(lane.index));
+            }
+        }
+    }
+    // the initial event iteration of every Model Exchange group
+    for lane in core.lanes.iter_mut() {
+        if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
+            solo.iterate(&mut crate::simulate::me_group::Solo { inst: &mut lane.inst, unit }, t0)?;
+        }
+    }
+    if let Some(g) = core.group.as_mut() {
+        g.iterate(core.lanes.as_mut_slice(), t0)?;
+    }
+    for lane in core.lanes.iter_mut() {
+        let fmu = lane.inst.fmu();
+        let capable =
+            fmu.interface() == Interface::CoSimulation && fmu.can_get_and_set_state() && fmu.can_handle_variable_step();
+        if experiment.retry_discard && capable {
+            lane.saved = Some(lane.inst.get_state()?);
+        }
+    }
+    algorithm.propagate(&mut core)?;
+    run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+    recorder.push_row(t0, &core.values);
+
+    let mut profiler = Profiler::new(core.lanes.len());
+    {
+        let mut observers = Observers {
+            list: vec![&mut recorder as &mut dyn Observer],
+            calls: experiment.profile.then_some(&mut profiler),
+        };
+        algorithm.run(&mut core, &mut observers)?;
+    }
+    if experiment.profile {
+        for lane in core.lanes.iter() {
+            profiler.spent[lane.index] += lane.spent;
+        }
+    }
+    let mut summary =
+        Summary { steps: clock.steps, parallel_steps: core.parallel_steps, wall_time: Duration::ZERO, ..Summary::default() };
+    for lane in core.lanes.iter_mut() {
+        summary.discard_retries += lane.retries;
+        if let Some(state) = lane.saved.take() {
+            lane.inst.free_state(state)?;
+        }
+        if let Some(unit) = lane.unit.take() {
+            summary.integrator_steps.0 += unit.steps;
+            summary.integrator_steps.1 += unit.rejected;
+            summary.events.extend(unit.events);
+        }
+    }
+    for lane in core.lanes.iter_mut() {
+        lane.inst.terminate()?;
+        for rec in lane.inst.take_log() {
+            if rec.status != crate::error::Status::Ok {
+                summary.warnings.push((lane.inst.name().to_string(), rec.message));
+            }
+        }
+    }
+    drop(core);
+    summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
+    summary.wall_time = wall.elapsed();
+    Ok((recorder.results, summary))
+}

@@ -1,0 +1,183 @@
+//! A lane: one instance with everything its steps need, stepped by one thread at a time.
+
+use crate::error::{Error, Result};
+use crate::fmu::{FmuState, Instance};
+use crate::me::{MeUnit, Solver};
+use crate::simulate::clock::Point;
+use crate::simulate::me_group::{MeGroup, Members, Solo};
+use crate::simulate::plan::{Instances, Op};
+use crate::system::{InstanceSpec, Value};
+use std::time::{Duration, Instant};
+
+/// One instance with its integrator (Model Exchange), its saved state (Discard retry)
+/// and, for `jacobi`, its own batched gets and sets.
+pub(crate) struct Lane {
+    /// Index of the instance in the system.
+    pub(crate) index: usize,
+    pub(crate) inst: Instance,
+    /// Model Exchange: the integration state.
+    pub(crate) unit: Option<MeUnit>,
+    /// Model Exchange, connected to no other ME instance: its group of one (a member of
+    /// the coupled group is advanced by that group).
+    pub(crate) solo: Option<MeGroup>,
+    pub(crate) saved: Option<FmuState>,
+    pub(crate) gets: Vec<Op>,
+    pub(crate) gets_rec: Vec<Op>,
+    pub(crate) sets: Vec<Op>,
+    /// Time in this lane's calls (`jacobi` when profiling).
+    pub(crate) spent: Duration,
+    pub(crate) retries: u64,
+    /// The first error of this lane's last step (when stepped in a thread).
+    pub(crate) error: Option<Error>,
+}
+
+impl Instances for [Lane] {
+    #[inline]
+    fn instance(&mut self, i: usize) -> &mut Instance {
+        &mut self[i].inst
+    }
+}
+
+impl Members for [Lane] {
+    #[inline]
+    fn member(&mut self, m: usize) -> Option<(&mut Instance, &mut MeUnit)> {
+        let lane = &mut self[m];
+        lane.unit.as_mut().map(|u| (&mut lane.inst, u))
+    }
+}
+
+impl Lane {
+    /// A lane for `inst`, the instance `index` of the system, with its `jacobi` calls.
+    pub(crate) fn new(index: usize, inst: Instance, gets: Vec<Op>, gets_rec: Vec<Op>, sets: Vec<Op>) -> Lane {
+        Lane {
+            index,
+            inst,
+            unit: None,
+            solo: None,
+            saved: None,
+            gets,
+            gets_rec,
+            sets,
+            spent: Duration::ZERO,
+            retries: 0,
+            error: None,
+        }
+    }
+
+    /// A member of the coupled Model Exchange group (advanced by the group, not alone).
+    #[inline]
+    pub(crate) fn in_group(&self) -> bool {
+        self.unit.is_some() && self.solo.is_none()
+    }
+
+    /// `do_step` (or the integrator of its group of one over the step), with the Discard
+    /// retry if enabled. A member of the coupled Model Exchange group is not advanced here.
+    #[inline]
+    pub(crate) fn advance(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
+        let dt = t_next - t; // as fmpy: the step is the difference of the two points
+        match (&mut self.unit, &mut self.saved) {
+            (None, None) => self.inst.do_step(t, dt),
+            (None, Some(state)) => {
+                self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
+                Ok(())
+            }
+            (Some(unit), _) => match self.solo.as_mut() {
+                Some(group) => group.advance(&mut Solo { inst: &mut self.inst, unit }, solver, t, t_next),
+                None => Ok(()),
+            },
+        }
+    }
+
+    /// One `jacobi` step of this instance: its inputs set from `values` (the outputs of
+    /// the previous step), the step, its outputs fetched into its get buffers. The call
+    /// sequence of an instance is the same whichever thread runs it.
+    #[inline]
+    pub(crate) fn jacobi_step(&mut self, values: &[f64], p: Point, profile: bool, solver: Solver) -> Result<()> {
+        let start = profile.then(Instant::now);
+        self.jacobi_inputs(values, p)?;
+        self.advance(solver, p.t, p.t_next)?;
+        self.jacobi_outputs(p)?;
+        if let Some(start) = start {
+            self.spent += start.elapsed();
+        }
+        Ok(())
+    }
+
+    /// The first part of a `jacobi` step: the inputs (unless the first step).
+    #[inline]
+    pub(crate) fn jacobi_inputs(&mut self, values: &[f64], p: Point) -> Result<()> {
+        if p.n > 0 {
+            self.set_inputs(values)?;
+        }
+        Ok(())
+    }
+
+    /// The last part of a `jacobi` step: the outputs fetched.
+    #[inline]
+    pub(crate) fn jacobi_outputs(&mut self, p: Point) -> Result<()> {
+        let gets = if p.output_point { &mut self.gets_rec } else { &mut self.gets };
+        for op in gets.iter_mut() {
+            op.fetch(&mut self.inst)?;
+        }
+        Ok(())
+    }
+
+    /// The outputs fetched by the last [`Lane::jacobi_step`] into their slots.
+    #[inline]
+    pub(crate) fn scatter(&self, values: &mut [f64], output_point: bool) {
+        let gets = if output_point { &self.gets_rec } else { &self.gets };
+        for op in gets {
+            op.scatter(values);
+        }
+    }
+
+    /// The outputs of this lane's `jacobi` gets read from the instance into `values`.
+    pub(crate) fn get_outputs(&mut self, values: &mut [f64]) -> Result<()> {
+        for op in self.gets.iter_mut() {
+            op.run(&mut self.inst, values)?;
+        }
+        Ok(())
+    }
+
+    /// The inputs set from `values`.
+    #[inline]
+    pub(crate) fn set_inputs(&mut self, values: &[f64]) -> Result<()> {
+        for op in self.sets.iter_mut() {
+            op.gather(values);
+            op.apply(&mut self.inst)?;
+        }
+        Ok(())
+    }
+}
+
+/// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
+/// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.
+fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
+    inst.update_state(state)?;
+    match inst.do_step(t, dt) {
+        Ok(()) => Ok(0),
+        Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
+            inst.set_state(state)?;
+            let half = 0.5 * dt;
+            let a = step_with_retry(inst, state, t, half, depth + 1)?;
+            let b = step_with_retry(inst, state, t + half, dt - half, depth + 1)?;
+            Ok(1 + a + b)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Sets the start values of an instance (before initialization mode), one call each.
+pub fn apply_start_values(inst: &mut Instance, spec: &InstanceSpec) -> Result<()> {
+    let md = spec.fmu.description();
+    for (index, value) in &spec.start_values {
+        let vr = md.model_variables[*index].value_reference;
+        match value {
+            Value::Real(x) => inst.set_real(&[vr], &[*x])?,
+            Value::Integer(x) => inst.set_integer(&[vr], &[*x])?,
+            Value::Boolean(x) => inst.set_boolean(&[vr], &[*x as i32])?,
+            Value::String(s) => inst.set_string(vr, s)?,
+        }
+    }
+    Ok(())
+}

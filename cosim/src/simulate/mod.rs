@@ -1,0 +1,34 @@
+//! Fixed-step Co-Simulation of a [`System`](crate::System): initialization per the
+//! standard, `jacobi` and `ordered` communication, results at output points. Time is
+//! `t0 + n h`.
+//!
+//! Before the loop everything is resolved to value references and buffer slots: the
+//! loop does not allocate and looks nothing up by name.
+//!
+//! The modules, each using only those above it:
+//! - `types`: the public types ([`Experiment`], [`Algorithm`], [`Results`], [`Summary`]);
+//! - `clock`: the time base, communication point `n` at `t0 + n h`;
+//! - `plan`: the value slots and the batched fmi2Get/fmi2Set calls;
+//! - `me_group`: the Model Exchange integrator of a group of ME instances (a group of
+//!   one for an ME instance on its own);
+//! - `lane`: one instance with its calls and integrator;
+//! - `observer`: what is told after every step (the recorder, the profiler);
+//! - `algorithm`: `jacobi`, `ordered` and `jacobi` in threads, each one file behind one
+//!   trait;
+//! - `driver`: [`simulate()`].
+
+mod algorithm;
+mod clock;
+mod driver;
+mod lane;
+mod me_group;
+mod observer;
+mod plan;
+mod types;
+
+pub use driver::simulate;
+pub use lane::apply_start_values;
+pub use plan::default_record;
+pub use types::{push_number, Algorithm, Experiment, Results, Summary};
+
+pub use me_group::MAX_EVENT_ROUNDS;

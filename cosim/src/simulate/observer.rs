@@ -1,0 +1,117 @@
+//! Observers of a run (libcosim's pattern): the algorithms step the instances and tell the
+//! observers after every communication step; what is recorded and how long each FMU took
+//! is theirs, not the loop's.
+//!
+//! - [`Recorder`]: the rows of the results at output points, and the progress callback.
+//! - [`Profiler`]: the time spent in each instance's calls, one clock read per call
+//!   boundary; the algorithms tell it after each call (it is attached only when asked
+//!   for, so an unprofiled run reads no clock).
+
+use crate::simulate::clock::Point;
+use crate::simulate::types::Results;
+use std::time::{Duration, Instant};
+
+/// Told after every communication step, with all values of the plan current at output
+/// points.
+pub(crate) trait Observer {
+    /// Step `point.n` ended at `point.t_next`; `values` is the value buffer of the plan.
+    fn step_complete(&mut self, point: &Point, values: &[f64]);
+}
+
+/// The rows of the results: time and the recorded slots at every output point.
+pub(crate) struct Recorder {
+    pub(crate) results: Results,
+    slots: Vec<usize>,
+    steps: u64,
+    progress: Option<fn(f64)>,
+}
+
+impl Recorder {
+    /// A recorder of the slots `slots` under the column names `names`, with room reserved
+    /// for `rows` rows (up to 64 MiB up front: a huge run grows as it goes).
+    pub(crate) fn new(names: Vec<String>, slots: Vec<usize>, rows: u64, steps: u64, progress: Option<fn(f64)>) -> Self {
+        let wanted = (rows as usize).saturating_mul(slots.len() + 1).min(8 << 20);
+        Recorder { results: Results { names, values: Vec::with_capacity(wanted) }, slots, steps, progress }
+    }
+
+    /// The row at time `t`.
+    #[inline]
+    pub(crate) fn push_row(&mut self, t: f64, values: &[f64]) {
+        self.results.values.push(t);
+        self.results.values.extend(self.slots.iter().map(|s| values[*s]));
+    }
+}
+
+impl Observer for Recorder {
+    #[inline]
+    fn step_complete(&mut self, point: &Point, values: &[f64]) {
+        if point.output_point {
+            self.push_row(point.t_next, values);
+            if let Some(p) = self.progress {
+                p((point.n + 1) as f64 / self.steps as f64);
+            }
+        }
+    }
+}
+
+/// Time spent in each instance's calls, one clock read per call boundary: the time from
+/// the previous mark to the end of a call is charged to that call's instance (the
+/// master's marshalling of the call's arguments included). Lanes stepped in threads
+/// measure their own time ([`crate::simulate::lane::Lane::spent`]), added at the end.
+pub(crate) struct Profiler {
+    last: Instant,
+    pub(crate) spent: Vec<Duration>,
+}
+
+impl Profiler {
+    pub(crate) fn new(n: usize) -> Profiler {
+        Profiler { last: Instant::now(), spent: vec![Duration::ZERO; n] }
+    }
+
+    /// Starts a stretch of calls.
+    #[inline]
+    pub(crate) fn restart(&mut self) {
+        self.last = Instant::now();
+    }
+
+    /// Charges the time since the last mark evenly to `instances` (a coupled group).
+    pub(crate) fn charge_shared(&mut self, instances: &[usize]) {
+        let now = Instant::now();
+        let share = (now - self.last) / instances.len().max(1) as u32;
+        for &i in instances {
+            self.spent[i] += share;
+        }
+        self.last = now;
+    }
+
+    /// Charges the time since the last mark to `instance`.
+    #[inline]
+    pub(crate) fn charge(&mut self, instance: usize) {
+        let now = Instant::now();
+        self.spent[instance] += now - self.last;
+        self.last = now;
+    }
+}
+
+/// The observers of one run: told in order after every step.
+pub(crate) struct Observers<'a> {
+    pub(crate) list: Vec<&'a mut dyn Observer>,
+    /// The per-call profiler, when asked for.
+    pub(crate) calls: Option<&'a mut Profiler>,
+}
+
+impl Observers<'_> {
+    /// Tells every observer that the step of `point` is complete.
+    #[inline]
+    pub(crate) fn step_complete(&mut self, point: &Point, values: &[f64]) {
+        for o in self.list.iter_mut() {
+            o.step_complete(point, values);
+        }
+    }
+
+    /// The profiler, if attached (reborrowed for one stretch of calls).
+    #[inline]
+    pub(crate) fn calls(&mut self) -> Option<&mut Profiler> {
+        self.calls.as_deref_mut()
+    }
+}

@@ -1,0 +1,180 @@
+//! The public types of a run: what to simulate ([`Experiment`], [`Algorithm`]) and what
+//! comes back ([`Results`], [`Summary`]).
+
+use std::time::Duration;
+
+/// How connections are updated at communication points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Algorithm {
+    /// Every connection delayed by one step (all outputs read, then all inputs set), as
+    /// fmpy `simulate_ssp`, libcosim and ecos do.
+    Jacobi,
+    /// Outputs flow along direct-feedthrough chains in topological order, so an input sees
+    /// its source at the same communication point; algebraic loops are refused by name.
+    Ordered,
+}
+
+impl std::str::FromStr for Algorithm {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "jacobi" => Ok(Algorithm::Jacobi),
+            "ordered" => Ok(Algorithm::Ordered),
+            _ => Err(format!("unknown algorithm {s:?} (jacobi, ordered)")),
+        }
+    }
+}
+
+/// What to simulate.
+#[derive(Clone, Debug)]
+pub struct Experiment {
+    /// Start time t0, s.
+    pub start_time: f64,
+    /// Stop time, s.
+    pub stop_time: f64,
+    /// Communication step h, s.
+    pub step: f64,
+    /// Algorithm.
+    pub algorithm: Algorithm,
+    /// Output interval (a whole multiple of `step`); `None`: every step.
+    pub output_interval: Option<f64>,
+    /// Variables to record (`instance.variable`); `None`: every output of every instance.
+    pub record: Option<Vec<String>>,
+    /// Measure the time spent in each FMU (one clock read per call boundary).
+    pub profile: bool,
+    /// Threads stepping the instances of a `jacobi` system (1: all in the calling
+    /// thread). Each instance is called by one thread at a time; the results are the
+    /// same for any number. `ordered` always runs in one thread.
+    pub threads: usize,
+    /// Called with the fraction done (0..=1) at each output point.
+    pub progress: Option<fn(f64)>,
+    /// Integration method of Model Exchange instances.
+    pub solver: crate::me::Solver,
+    /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
+    /// handle variable steps: restore the state and retry in halves (at most 2^10
+    /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
+    /// stops the run with [`Error::Fmi`].
+    pub retry_discard: bool,
+}
+
+impl Experiment {
+    /// `stop_time` with step `h` from 0, jacobi, every step recorded.
+    pub fn new(stop_time: f64, step: f64) -> Experiment {
+        Experiment {
+            start_time: 0.0,
+            stop_time,
+            step,
+            algorithm: Algorithm::Jacobi,
+            output_interval: None,
+            record: None,
+            profile: false,
+            threads: 1,
+            progress: None,
+            solver: crate::me::Solver::default(),
+            retry_discard: false,
+        }
+    }
+}
+
+/// Results: one row per output point, `time` first.
+#[derive(Clone, Debug, Default)]
+pub struct Results {
+    /// Column names after `time` (`instance.variable`, or the bare name for a one-instance system).
+    pub names: Vec<String>,
+    /// Row-major values: `time, v1, v2, ...` per row.
+    pub values: Vec<f64>,
+}
+
+impl Results {
+    /// Number of columns including time.
+    pub fn width(&self) -> usize {
+        self.names.len() + 1
+    }
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.values.len() / self.width()
+    }
+    /// Row `k` (time first).
+    pub fn row(&self, k: usize) -> &[f64] {
+        &self.values[k * self.width()..(k + 1) * self.width()]
+    }
+    /// The column called `name` (`"time"` for time).
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let j = if name == "time" { 0 } else { self.names.iter().position(|n| n == name)? + 1 };
+        Some((0..self.rows()).map(|k| self.row(k)[j]).collect())
+    }
+
+    /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
+    /// in the shortest form that reads back to the same f64.
+    pub fn write_csv<W: std::io::Write>(&self, mut w: W) -> std::io::Result<()> {
+        let mut line = String::from("\"time\"");
+        for n in &self.names {
+            line.push_str(",\"");
+            line.push_str(&n.replace('"', "\"\""));
+            line.push('"');
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
+        for k in 0..self.rows() {
+            line.clear();
+            for (j, v) in self.row(k).iter().enumerate() {
+                if j > 0 {
+                    line.push(',');
+                }
+                push_number(&mut line, *v);
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes())?;
+        }
+        w.flush()
+    }
+}
+
+/// Shortest round-trip text of `v` (exponent form for very small or large magnitudes).
+pub fn push_number(out: &mut String, v: f64) {
+    use std::fmt::Write;
+    let a = v.abs();
+    if v == 0.0 || (1e-5..1e16).contains(&a) || !v.is_finite() {
+        let _ = write!(out, "{v}");
+    } else {
+        let _ = write!(out, "{v:e}");
+    }
+}
+
+/// A JSON-able run summary.
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    /// Communication steps taken.
+    pub steps: u64,
+    /// Wall time of initialization + loop.
+    pub wall_time: Duration,
+    /// Per instance: name and time spent in its fmi2 calls (zero unless profiling).
+    pub instance_time: Vec<(String, Duration)>,
+    /// Warnings the FMUs logged (instance, message).
+    pub warnings: Vec<(String, String)>,
+    /// Events of Model Exchange instances.
+    pub events: Vec<crate::me::Event>,
+    /// Internal integrator steps of Model Exchange instances (accepted, rejected).
+    pub integrator_steps: (u64, u64),
+    /// Steps redone in halves after an fmi2Discard.
+    pub discard_retries: u64,
+    /// `jacobi` steps run with the instances spread over threads (0 in one thread).
+    pub parallel_steps: u64,
+}
+
+impl Summary {
+    /// As a JSON value.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "steps": self.steps,
+            "events": self.events.len(),
+            "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
+            "discard_retries": self.discard_retries,
+            "parallel_steps": self.parallel_steps,
+            "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
+            "wall_time_s": self.wall_time.as_secs_f64(),
+            "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
+            "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
+        })
+    }
+}
