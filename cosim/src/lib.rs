@@ -36,7 +36,7 @@ pub mod unpack;
 pub use error::{Error, Result, Status};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use me::{Event, Solver};
-pub use simulate::{simulate, Algorithm, Experiment, Results, Summary};
+pub use simulate::{simulate, simulate_with, Algorithm, Experiment, InstancePool, Results, RowSink, Summary};
 pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};
 pub use unpack::UnpackLimits;

@@ -43,6 +43,20 @@ fn check_single_instance(system: &System) -> Result<()> {
 
 /// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
+    simulate_with(system, experiment, None, None)
+}
+
+/// [`simulate()`] taking its instances from `pool` (each reset with `fmi2Reset` instead
+/// of instantiated again; put back after a run that ends without error) and, with a
+/// `sink`, handing each row (time and the recorded values) to it instead of keeping it:
+/// the [`Results`] then have the column names and no rows. For many runs of one system
+/// (parameter studies): no new instantiation per run, no recording held in memory.
+pub fn simulate_with<'s>(
+    system: &System,
+    experiment: &Experiment,
+    mut pool: Option<&mut InstancePool>,
+    sink: Option<&'s mut RowSink<'s>>,
+) -> Result<(Results, Summary)> {
     let wall = Instant::now();
     let clock = Clock::new(experiment, system)?;
     check_single_instance(system)?;
@@ -78,14 +92,21 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
     let single = system.instances.len() == 1;
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
-    let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress);
+    let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress, sink);
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
     let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
     for (index, spec) in system.instances.iter().enumerate() {
+        let inst = match pool.as_deref_mut().and_then(|p| p.take(index, spec)) {
+            Some(mut inst) => {
+                inst.reset()?;
+                inst
+            }
+            None => Instance::new(&spec.fmu, &spec.name)?,
+        };
         lanes.push(Lane::new(
             index,
-            Instance::new(&spec.fmu, &spec.name)?,
+            inst,
             std::mem::take(&mut plan.jacobi_gets[index]),
             std::mem::take(&mut plan.jacobi_gets_rec[index]),
             std::mem::take(&mut plan.jacobi_sets[index]),
@@ -150,8 +171,12 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             profiler.spent[lane.index] += lane.spent;
         }
     }
-    let mut summary =
-        Summary { steps: clock.steps, parallel_steps: core.parallel_steps, wall_time: Duration::ZERO, ..Summary::default() };
+    let mut summary = Summary {
+        steps: clock.steps,
+        parallel_steps: core.parallel_steps,
+        wall_time: Duration::ZERO,
+        ..Summary::default()
+    };
     for lane in core.lanes.iter_mut() {
         summary.discard_retries += lane.retries;
         if let Some(state) = lane.saved.take() {
@@ -171,8 +196,53 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
             }
         }
     }
+    if let Some(pool) = pool {
+        for lane in std::mem::take(&mut core.lanes) {
+            pool.put(lane.index, lane.inst);
+        }
+    }
     drop(core);
     summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
     summary.wall_time = wall.elapsed();
     Ok((recorder.results, summary))
+}
+
+/// Where [`simulate_with`] hands each row: the time and the recorded values, in the order
+/// of [`Experiment::record`](crate::Experiment::record).
+pub type RowSink<'s> = dyn FnMut(f64, &[f64]) + 's;
+
+/// Instances kept between runs of one system by [`simulate_with`]: the instance of each
+/// position, reused only for the same FMU (the same loaded archive) and name.
+#[derive(Default)]
+pub struct InstancePool {
+    slots: Vec<Option<Instance>>,
+}
+
+impl InstancePool {
+    /// An empty pool.
+    pub fn new() -> InstancePool {
+        InstancePool::default()
+    }
+
+    /// Instances held.
+    pub fn len(&self) -> usize {
+        self.slots.iter().flatten().count()
+    }
+
+    /// Whether the pool holds no instance.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn take(&mut self, index: usize, spec: &crate::system::InstanceSpec) -> Option<Instance> {
+        let inst = self.slots.get_mut(index)?.take()?;
+        (std::sync::Arc::ptr_eq(inst.fmu(), &spec.fmu) && inst.name() == spec.name).then_some(inst)
+    }
+
+    fn put(&mut self, index: usize, inst: Instance) {
+        if self.slots.len() <= index {
+            self.slots.resize_with(index + 1, || None);
+        }
+        self.slots[index] = Some(inst);
+    }
 }

@@ -26,7 +26,7 @@ mod observer;
 mod plan;
 mod types;
 
-pub use driver::simulate;
+pub use driver::{simulate, simulate_with, InstancePool, RowSink};
 pub use lane::apply_start_values;
 pub use plan::default_record;
 pub use types::{push_number, Algorithm, Experiment, Results, Summary};
