@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use nigel_cosim::{simulate, Experiment, Results, System};
+use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
 use crate::metric::Accumulators;
 use crate::results::{self, Appender, Row, Target, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
@@ -53,6 +53,9 @@ pub struct Done {
     pub threads: usize,
     /// The rows file written.
     pub rows: PathBuf,
+    /// Summed over the runs: time inside the co-simulation, and in the whole run (values,
+    /// system, co-simulation, metrics); their difference is the per-run overhead.
+    pub timing: (Duration, Duration),
 }
 
 /// Parses `I/N` (`0 <= I < N`).
@@ -88,22 +91,18 @@ pub fn metric_variables(spec: &Spec) -> Vec<String> {
     vars
 }
 
-/// The metrics of a run's results (columns `record`): every row after the first, i.e. the
-/// communication points `t_1 .. t_N`.
-pub fn metrics_of(spec: &Spec, results: &Results, record: &[String]) -> Vec<f64> {
-    let mut acc = Accumulators::new(spec.metrics.iter().map(|(_, m)| m), record);
-    for k in 1..results.rows() {
-        acc.push(&results.row(k)[1..]);
-    }
-    acc.values()
-}
-
-/// A loaded system and what a run needs, reused for every run of one thread.
+/// A loaded system and what a run needs, reused for every run of one thread: the
+/// instances go back into a pool after each run and are reset with `fmi2Reset` for the
+/// next ([`nigel_cosim::simulate_with`]); the metrics take each row as it comes.
 pub struct Worker<'a> {
     spec: &'a Spec,
     base: System,
     record: Vec<String>,
     experiment: Experiment,
+    pool: InstancePool,
+    /// Time inside the co-simulation (`simulate_with`, its reset / instantiation and
+    /// initialization included) and in all of [`Worker::run`], summed over the runs.
+    pub timing: (Duration, Duration),
 }
 
 impl<'a> Worker<'a> {
@@ -112,7 +111,7 @@ impl<'a> Worker<'a> {
         let base = load_system(&spec.system).map_err(Error::Spec)?;
         let record = metric_variables(spec);
         let experiment = experiment(spec, record.clone());
-        Ok(Worker { spec, base, record, experiment })
+        Ok(Worker { spec, base, record, experiment, pool: InstancePool::new(), timing: Default::default() })
     }
 
     /// The system of run `values`.
@@ -121,13 +120,27 @@ impl<'a> Worker<'a> {
     }
 
     /// Runs one run; a failure or a panic is a row with its status and message.
-    pub fn run(&self, i: u64) -> Row {
+    pub fn run(&mut self, i: u64) -> Row {
+        let start = Instant::now();
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
+        let mut inside = Duration::ZERO;
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Vec<f64>, String> {
-            let system = self.system(&values)?;
-            let (results, _) = simulate(&system, &self.experiment).map_err(|e| e.to_string())?;
-            Ok(metrics_of(self.spec, &results, &self.record))
+            let system = self.spec.system_of(&self.base, &values)?;
+            let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
+            // every row after the first: the communication points t_1 .. t_N
+            let mut first = true;
+            let mut sink = |_t: f64, row: &[f64]| {
+                if first {
+                    first = false;
+                } else {
+                    acc.push(row);
+                }
+            };
+            let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
+                .map_err(|e| e.to_string())?;
+            inside = summary.wall_time;
+            Ok(acc.values())
         }));
         let (status, message, metrics) = match outcome {
             Ok(Ok(m)) => (STATUS_OK, String::new(), m),
@@ -143,6 +156,8 @@ impl<'a> Worker<'a> {
         };
         let mut v = values.numbers;
         v.extend(metrics);
+        self.timing.0 += inside;
+        self.timing.1 += start.elapsed();
         Row { run: i, status, message, values: v }
     }
 
@@ -207,15 +222,16 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     };
     let next = AtomicU64::new(0);
     let (tx, rx) = mpsc::channel::<Result<Row, Error>>();
+    let timing = std::sync::Mutex::new((Duration::ZERO, Duration::ZERO));
     let mut done = Done { threads, kept: have.len() as u64, rows: target.rows.clone(), ..Done::default() };
     let mut rows = have;
     let mut write_error = None;
     std::thread::scope(|scope| {
         for _ in 0..threads {
             let tx = tx.clone();
-            let (todo, next) = (&todo, &next);
+            let (todo, next, timing) = (&todo, &next, &timing);
             scope.spawn(move || {
-                let worker = match Worker::new(spec) {
+                let mut worker = match Worker::new(spec) {
                     Ok(w) => w,
                     Err(e) => {
                         let _ = tx.send(Err(e));
@@ -229,6 +245,9 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
                         break;
                     }
                 }
+                let mut t = timing.lock().unwrap_or_else(|p| p.into_inner());
+                t.0 += worker.timing.0;
+                t.1 += worker.timing.1;
             });
         }
         drop(tx);
@@ -262,5 +281,6 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     drop(appender);
     results::write_sorted(&target, spec, &mut rows)?;
     done.wall = start.elapsed();
+    done.timing = timing.into_inner().unwrap_or_else(|p| p.into_inner());
     Ok(done)
 }

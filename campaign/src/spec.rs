@@ -441,7 +441,8 @@ impl Spec {
     pub fn parse(path: &Path, text: &str) -> Result<(Spec, System), Error> {
         let bad = |m: String| Error::Spec(format!("{}: {m}", path.display()));
         let doc: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-            bad(e.message().trim().replace('\n', "; ") + &e.span().map_or(String::new(), |s| format!(" (at byte {})", s.start)))
+            bad(e.message().trim().replace('\n', "; ")
+                + &e.span().map_or(String::new(), |s| format!(" (at byte {})", s.start)))
         })?;
         let get_f = |k: &str| -> Result<f64, Error> {
             doc.get(k).ok_or_else(|| bad(format!("missing {k}"))).and_then(|v| number(v, k).map_err(bad))

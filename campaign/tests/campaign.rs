@@ -33,7 +33,10 @@ const CAMPAIGN: &str = env!("CARGO_BIN_EXE_campaign");
 fn small(dir: &Path, stop: f64, samples: u64) -> PathBuf {
     let text = std::fs::read_to_string(root().join("campaigns/example.toml")).unwrap();
     let text = text
-        .replace("system = \"target/ssp/nigel_closed_loop.ssp\"", &format!("system = {:?}", ssp().display().to_string()))
+        .replace(
+            "system = \"target/ssp/nigel_closed_loop.ssp\"",
+            &format!("system = {:?}", ssp().display().to_string()),
+        )
         .replace("stop_time = 30.0", &format!("stop_time = {stop:?}"))
         .replace("samples = 20 ", &format!("samples = {samples} "));
     let path = dir.join("small.toml");
@@ -51,11 +54,22 @@ fn the_example_is_accepted_as_written_and_its_first_run_runs() {
     std::env::set_current_dir(root()).unwrap();
     let spec = Spec::load("campaigns/example.toml".as_ref()).unwrap();
     assert_eq!(spec.runs(), 2 * 2 * 20);
-    assert_eq!(spec.header(), [
-        "run", "status", "message", "maneuver.maneuver", "controller.controller", "maneuver.seed", "plant.m", "epsilon",
-        "y_final", "max_delta"
-    ]);
-    let worker = Worker::new(&spec).unwrap();
+    assert_eq!(
+        spec.header(),
+        [
+            "run",
+            "status",
+            "message",
+            "maneuver.maneuver",
+            "controller.controller",
+            "maneuver.seed",
+            "plant.m",
+            "epsilon",
+            "y_final",
+            "max_delta"
+        ]
+    );
+    let mut worker = Worker::new(&spec).unwrap();
     let row = worker.run(0);
     assert_eq!((row.status, row.message.as_str()), (STATUS_OK, ""));
     // run 0: maneuver 2, controller 1 (open loop); its draws inside their ranges
@@ -122,8 +136,14 @@ fn resume_after_a_killed_run_completes_it() {
     let local = dir.path().join("local");
     run(&spec, &quiet(&local)).unwrap();
     let out = dir.path().join("killed");
-    let mut child =
-        Command::new(CAMPAIGN).arg("run").arg(&spec_path).arg("--out").arg(&out).args(["--threads", "1"]).spawn().unwrap();
+    let mut child = Command::new(CAMPAIGN)
+        .arg("run")
+        .arg(&spec_path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--threads", "1"])
+        .spawn()
+        .unwrap();
     let rows = out.join("results.csv");
     let count = || std::fs::read_to_string(&rows).map_or(0, |t| t.lines().count().saturating_sub(1));
     while count() < 3 {
@@ -156,7 +176,7 @@ fn read_cosim_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 fn metrics_equal_those_of_cosim_runs_csv() {
     let dir = tempfile::tempdir().unwrap();
     let spec = Spec::load(&small(dir.path(), 4.0, 3)).unwrap();
-    let worker = Worker::new(&spec).unwrap();
+    let mut worker = Worker::new(&spec).unwrap();
     let cosim = target_dir().join("release").join("cosim");
     assert!(cosim.exists(), "{} (cargo build --release -p nigel-cosim)", cosim.display());
     for i in [1u64, 10] {
@@ -164,7 +184,10 @@ fn metrics_equal_those_of_cosim_runs_csv() {
         let values = spec.values(i);
         let csv = dir.path().join(format!("cosim-{i}.csv"));
         let mut cmd = Command::new(&cosim);
-        cmd.arg("run").arg(ssp()).args(["--stop-time", "4", "--step", "1e-3", "--algorithm", "ordered", "--output"]).arg(&csv);
+        cmd.arg("run")
+            .arg(ssp())
+            .args(["--stop-time", "4", "--step", "1e-3", "--algorithm", "ordered", "--output"])
+            .arg(&csv);
         for (var, x) in &values.assignments {
             let text = match x {
                 nigel_campaign::spec::Scalar::Real(v) => format!("{v:?}"),
@@ -199,7 +222,7 @@ fn metrics_equal_those_of_cosim_runs_csv() {
 
 #[test]
 fn epsilon_equals_table3_for_the_same_seed_maneuver_and_controller() {
-    use nigel_table3::{Controller, Engine, FmuEngine, Fidelity, Job, Maneuver, Metric};
+    use nigel_table3::{Controller, Engine, Fidelity, FmuEngine, Job, Maneuver, Metric};
     let dir = tempfile::tempdir().unwrap();
     let engine = FmuEngine::load_dir(&target_dir().join("fmu")).unwrap();
     // the description's variables as table3 sets them: maneuver 2 = lane_change,
@@ -221,7 +244,7 @@ max_delta = "max_abs(controller.delta_fl)"
     let path = dir.path().join("eps.toml");
     std::fs::write(&path, text).unwrap();
     let spec = Spec::load(&path).unwrap();
-    let worker = Worker::new(&spec).unwrap();
+    let mut worker = Worker::new(&spec).unwrap();
     for (i, (maneuver, controller, seed)) in [
         (Maneuver::LaneChange, Controller::Robust, 0),
         (Maneuver::LaneChange, Controller::Robust, 7),
@@ -254,8 +277,14 @@ fn bad_input_is_a_one_line_error_naming_the_culprit() {
     let cases = [
         ("[random]\n\"plant.mass\" = { uniform = [2.4, 3.0] }\n", "unknown variable plant.mass"),
         ("[grid]\n\"maneuver.maneuver\" = [2, 7]\n", "7 is outside maneuver.maneuver's declared range [1, 6]"),
-        ("[random]\n\"maneuver.speed_target\" = { uniform = [0.2, 12.0] }\n", "[0.2, 12] is outside maneuver.speed_target's declared range [0, 10]"),
-        ("[random]\n\"maneuver.seed\" = { uniform = [0, 10] }\n", "maneuver.seed is Integer, uniform (Real draws) cannot set it"),
+        (
+            "[random]\n\"maneuver.speed_target\" = { uniform = [0.2, 12.0] }\n",
+            "[0.2, 12] is outside maneuver.speed_target's declared range [0, 10]",
+        ),
+        (
+            "[random]\n\"maneuver.seed\" = { uniform = [0, 10] }\n",
+            "maneuver.seed is Integer, uniform (Real draws) cannot set it",
+        ),
         ("[grid]\n\"plant.friction_circle\" = [1.5]\n", "plant.friction_circle is Boolean but the value is 1.5 (Real)"),
         ("[grid]\n\"maneuver.maneuver\" = [2.5]\n", "maneuver.maneuver is Integer but the value is 2.5 (Real)"),
         ("[metrics]\ne = \"rms_diff(plant.x maneuver.x_ref)\"\n", "[metrics] \"e\": malformed expression"),
@@ -285,7 +314,8 @@ fn bad_input_is_a_one_line_error_naming_the_culprit() {
     assert!(e.contains("shard 1/3") && e.contains("--resume"), "{e}");
     // a shard of another description (another seed) copied in
     let other_path = d.join("other.toml");
-    std::fs::write(&other_path, std::fs::read_to_string(&spec_path).unwrap().replace("seed = 1 ", "seed = 9 ")).unwrap();
+    std::fs::write(&other_path, std::fs::read_to_string(&spec_path).unwrap().replace("seed = 1 ", "seed = 9 "))
+        .unwrap();
     let other = Spec::load(&other_path).unwrap();
     let other_out = d.join("other");
     run(&other, &Options { shard: Some((1, 3)), ..quiet(&other_out) }).unwrap();

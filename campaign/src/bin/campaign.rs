@@ -104,7 +104,7 @@ fn main_inner() -> Result<(), Error> {
                     return Err(Error::Usage(format!("--only {i}: the campaign has runs 0 .. {}", spec.runs() - 1)));
                 }
                 std::fs::create_dir_all(&out).map_err(|e| Error::Io(format!("{}: {e}", out.display())))?;
-                let worker = Worker::new(&spec)?;
+                let mut worker = Worker::new(&spec)?;
                 let row = worker.run(i);
                 let header = spec.header();
                 let line = row.line();
@@ -126,12 +126,15 @@ fn main_inner() -> Result<(), Error> {
             let shard = shard.as_deref().map(parse_shard).transpose()?;
             let options = Options { out, threads, shard, resume, progress: true };
             let done = nigel_campaign::run::run(&spec, &options)?;
+            let (inside, total) = (done.timing.0.as_secs_f64(), done.timing.1.as_secs_f64());
             eprintln!(
-                "{} runs in {:.1} s on {} threads ({:.0} runs/min), {} failed, {} already done: {}",
+                "{} runs in {:.1} s on {} threads ({:.0} runs/min; {:.1} ms a run, of it {:.2} % outside the co-simulation), {} failed, {} already done: {}",
                 done.ran,
                 done.wall.as_secs_f64(),
                 done.threads,
                 done.ran as f64 / done.wall.as_secs_f64().max(1e-9) * 60.0,
+                1e3 * total / done.ran.max(1) as f64,
+                100.0 * (total - inside) / total.max(1e-12),
                 done.failed,
                 done.kept,
                 done.rows.display()
