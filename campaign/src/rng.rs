@@ -1,5 +1,5 @@
-//! Counter-based draws: every random value of run `i` in column `name` is a pure function
-//! of `(seed, name, i)`, built on the test bench's SplitMix64 finaliser
+//! Counter-based draws: every random value of sample `s` in column `name` is a pure function
+//! of `(seed, name, s)`, built on the test bench's SplitMix64 finaliser
 //! ([`nigel_benchmark::noise::mix`]), so no generator state is carried between runs.
 
 use nigel_benchmark::noise::{mix, GOLDEN};
@@ -20,7 +20,7 @@ pub fn uniform01(seed: u64, name: &str, run: u64, k: u64) -> f64 {
     (mix(key.wrapping_add(counter.wrapping_mul(GOLDEN))) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
-/// The value of `dist` for run `run` in column `name`.
+/// The value of `dist` for sample `run` (the run's sample index) in column `name`.
 pub fn draw(dist: &Distribution, seed: u64, name: &str, run: u64) -> Scalar {
     let u = |k: u64| uniform01(seed, name, run, k);
     match dist {

@@ -200,7 +200,10 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     }
     let mut present = std::collections::HashSet::new();
     have.retain(|r| range.contains(&r.run) && present.insert(r.run));
-    let todo: Vec<u64> = range.clone().filter(|i| !present.contains(i)).collect();
+    let mut todo: Vec<u64> = range.clone().filter(|i| !present.contains(i)).collect();
+    // started sample by sample across the grid points: a campaign stopped half-way holds
+    // as many samples of every grid point (the rows are sorted by run at the end)
+    todo.sort_by_key(|i| (i % spec.samples, i / spec.samples));
     let threads = options
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))

@@ -4,7 +4,9 @@
 //! Runs are numbered `0 .. grid points x samples`: run `i` is grid point `i / samples`
 //! (the grid's first key varies slowest, its last fastest, as nested loops in the order
 //! written) and sample `i % samples`; its random values are drawn from `(seed, column,
-//! i)` only ([`crate::rng`]), so they never depend on threads, shards or order.
+//! i % samples)` only ([`crate::rng`]), so they never depend on threads, shards or order.
+//! Every grid point gets the same draws for its sample `s` (common random numbers): two
+//! controllers, say, meet the same masses, speeds and seeds, and are compared run by run.
 
 use std::path::{Path, PathBuf};
 
@@ -632,7 +634,7 @@ impl Spec {
                     assignments.extend(cases[grid_index[k]].1.iter().cloned());
                 }
                 Domain::Random(d) => {
-                    let x = rng::draw(d, self.seed, &c.name, i);
+                    let x = rng::draw(d, self.seed, &c.name, i % self.samples);
                     numbers.push(x.number());
                     assignments.extend(c.targets.iter().map(|t| (t.clone(), x.clone())));
                 }

@@ -81,6 +81,10 @@ enum Command {
         /// How many worst runs to list.
         #[arg(long, default_value_t = 10)]
         worst: usize,
+        /// Compare the values of this column run by run (same other grid values, same
+        /// draws): P(metric of A < metric of B) per group of the other --by columns.
+        #[arg(long)]
+        pair: Option<String>,
     },
 }
 
@@ -184,13 +188,22 @@ fn main_inner() -> Result<(), Error> {
             );
             Ok(())
         }
-        Command::Report { dir, by, png, metric, worst } => {
+        Command::Report { dir, by, png, metric, worst, pair } => {
             let spec = spec_of_dir(&dir)?;
             let report = Report::load(spec, &dir, &by)?;
             let m = report.metric(metric.as_deref())?;
             print!("{}", report.markdown(m, worst));
+            let mut json = report.json(m, worst);
+            if let Some(column) = pair {
+                let pairings = report.pairings(&column, &by, m)?;
+                print!("{}", report.pairings_markdown(&pairings, &report.spec.metrics[m].0));
+                json["pairs"] = pairings
+                    .iter()
+                    .map(|p| serde_json::json!({"group": p.group, "a": p.a, "b": p.b, "pairs": p.pairs, "p_less": p.p_less, "p_more": p.p_more, "median_ratio": p.median_ratio}))
+                    .collect();
+            }
             let path = dir.join("report.json");
-            let text = serde_json::to_string_pretty(&report.json(m, worst)).expect("JSON of plain values");
+            let text = serde_json::to_string_pretty(&json).expect("JSON of plain values");
             std::fs::write(&path, text + "\n").map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
             eprintln!("{}", path.display());
             if let Some(d) = png {
