@@ -4,7 +4,8 @@
 //!    initialize, 30,000 steps, terminate, free);
 //! 2. a campaign worker's run of the example's description (its start values set,
 //!    instances reset with fmi2Reset instead of instantiated, three metrics streamed);
-//! 3. the same worker with its pool emptied before each run (a fresh instantiation).
+//! 3. the same worker made again before each run (the `.ssp` unpacked and instantiated).
+//!
 //! Rounds alternate the three; the table gives each one's best and median per run and the
 //! spread (max / min) over the rounds. Run: `cargo bench -p nigel-campaign`.
 

@@ -54,7 +54,8 @@ pub enum Distribution {
     /// Uniform on `[low, high)`.
     Uniform(f64, f64),
     /// Normal with mean and standard deviation, optionally truncated to `[min, max]`
-    /// (rejection: the draw is repeated with the next counter until it falls inside).
+    /// (rejection: the draw is repeated with the next counter until it falls inside; at least
+    /// 1 % of the distribution must lie inside).
     Normal {
         /// Mean.
         mean: f64,
@@ -236,9 +237,9 @@ fn distribution(key: &str, v: &toml::Value) -> Result<(Distribution, Vec<String>
                     return Err(format!("{what} normal: min {a} must be below max {b}"));
                 }
             }
-            // the rejection loop must find a value: at least 1e-6 of the mass inside
+            // the rejection loop must find a value: at least 1 % of the mass inside
             let p = normal_mass(*mean, *std, min, max);
-            if p < 1e-6 {
+            if p < 0.01 {
                 return Err(format!("{what} normal: [min, max] holds only {p:.1e} of the distribution"));
             }
             *lo = min;
