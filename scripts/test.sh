@@ -28,12 +28,16 @@ export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 echo "== Rust tests"
 cargo test --release --workspace
+echo "== synthesis tests under two more OpenBLAS kernels"
+bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"
 "$target_dir/venv/bin/python" -m pytest tests/python -q
 echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
 echo "== Table III closed loop as SSP in fmpy"
 "$target_dir/venv/bin/python" -m pytest table3/tests/python -q
+echo "== examples (each prints what its header says; checked against table3)"
+"$target_dir/venv/bin/python" -m pytest examples -q
 echo "== campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
 echo "== campaign on a local Slurm cluster"

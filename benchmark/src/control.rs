@@ -1,6 +1,6 @@
 //! The sampled controller of docs/benchmark.md: steering feedback on `x = [beta, yaw_rate]`
 //! around the reference plus the speed-hold PI, as one type that the benchmark loop and the
-//! controller FMU both run; and, beyond the paper (issue 9), the robust path-tracking law
+//! controller FMU both run; and, beyond the paper, the robust path-tracking law
 //! with pose feedback and the along-track speed correction.
 //!
 //! # Robust tracking (`Controller::RobustTracking`)
@@ -17,7 +17,7 @@
 //! convention: `u = delta - delta_ff = K_track e`). The headings may be unwrapped (the plant
 //! and the test bench integrate them); only their difference is wrapped.
 //!
-//! # Along-track correction (issue 9, item 3)
+//! # Along-track correction
 //!
 //! The lateral law cannot remove the along-track error `e_x` (positive: the car is *ahead*
 //! of the reference car, along the reference heading). A loop on top of the speed PI does:
@@ -72,7 +72,7 @@ pub enum Controller {
     Robust,
     /// Any gain (rows FL, FR, RL, RR; columns beta, yaw_rate).
     Custom([[f64; 2]; 4]),
-    /// Beyond the paper (issue 9): the robust tracking gain [`gains::ROBUST_TRACKING`] on
+    /// Beyond the paper: the robust tracking gain [`gains::ROBUST_TRACKING`] on
     /// `[e_y, e_psi, beta - beta_ref, r - r_ref]` with the along-track speed correction.
     RobustTracking,
 }

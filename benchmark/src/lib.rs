@@ -45,6 +45,7 @@
 #![warn(missing_docs)]
 
 pub mod control;
+pub mod gain_file;
 pub mod gains;
 pub mod noise;
 pub mod run;

@@ -1,4 +1,4 @@
-//! The along-track correction of the robust tracking controller (issue 9, item 3): a car
+//! The along-track correction of the robust tracking controller: a car
 //! started behind its reference car catches up with the time constant of the linear
 //! argument in `control.rs`, without overshoot, and the commanded speed stays inside its
 //! clamp however far behind the car starts.

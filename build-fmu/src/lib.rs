@@ -53,7 +53,7 @@ impl FmuTarget {
 /// Everything `build-fmu` builds: a new FMU is one entry here.
 pub fn targets() -> Vec<FmuTarget> {
     vec![
-        FmuTarget::of::<nigel_plant::Plant>("fmu-plant", PLANT_EQUATIONS),
+        FmuTarget::of::<nigel_plant::Plant>("fmu-plant", nigel_plant::DOCUMENTATION),
         FmuTarget::of::<nigel_controller::Controller>("fmu-controller", nigel_controller::DOCUMENTATION),
         FmuTarget::of::<nigel_maneuver::TestBench>("fmu-maneuver", nigel_maneuver::DOCUMENTATION),
     ]
@@ -80,34 +80,8 @@ pub fn manifest(targets: &[FmuTarget]) -> String {
     format!("[\n{}\n]\n", entries.join(",\n"))
 }
 
-const PLANT_EQUATIONS: &str = r#"<p>For each wheel i (order FL, FR, RL, RR) at (x_i, y_i) from the CG, with the steer
-delta_i clamped to [-delta_max, delta_max] (or the servo angle, when the servo is on):</p>
-<pre>
-u_i = v_x - r y_i,  w_i = v_y + r x_i
-v_lon,i = u_i cos(delta_i) + w_i sin(delta_i),   v_lat,i = -u_i sin(delta_i) + w_i cos(delta_i)
-alpha_i = -atan2(v_lat,i, |v_lon,i|)
-F_y,i = mu_i C_i alpha_i min(1, |(u_i, w_i)| / v_fade)
-F_d,i = clamp(tau_i / r_wheel, -mu_i N_i, mu_i N_i)
-F_x,i = F_d,i cos(delta_i) - F_y,i sin(delta_i),   F_yb,i = F_d,i sin(delta_i) + F_y,i cos(delta_i)
-
-M_z     = sum_i (x_i F_yb,i - y_i F_x,i) + x_c F_sw,     x_c = (l_f - l_r)/2
-dv_x/dt = (sum_i F_x,i - F_hw)/m + r v_y
-dv_y/dt = (sum_i F_yb,i + F_sw)/m - r v_x
-dr/dt   = M_z / I_z
-dX/dt = v_x cos(psi) - v_y sin(psi),  dY/dt = v_x sin(psi) + v_y cos(psi),  dpsi/dt = r
-</pre>
-<p>Static normal loads N_front = m g l_r / (2 l), N_rear = m g l_f / (2 l). The "real" fidelity
-switches add a friction circle (hypot(F_d, F_y) &lt;= mu N), a first-order rate-limited steering
-servo, and a drive-motor speed limit. Co-Simulation integrates with classical RK4 sub-steps no
-longer than <code>cs_substep_max</code>; Model Exchange exposes the 10 states to the importer's
-integrator. Linearised at straight running this model is Eq. 2.2 of the paper.</p>
-<h2>Initial state</h2>
-<p>The body states <code>x, y, psi, v_x, v_y, yaw_rate</code> are <code>initial="calculated"</code>: each equals its
-fixed parameter <code>x_start, y_start, psi_start, v_x_start, v_y_start, yaw_rate_start</code> (default 0, at rest at
-the origin) until the integration moves it. Give the initial condition through those parameters (for example
-<code>v_x_start = 0.35</code> for the benchmark's speed): an SSP parameter binding reaches a parameter in every
-importer (libcosim applies bindings to parameters and inputs only), and setting a calculated state is refused.
-The servo angles start at 0.</p>"#;
+/// The closed loop of the three FMUs, drawn into every FMU's documentation.
+const CLOSED_LOOP_SVG: &str = include_str!("../../docs/closed-loop.svg");
 
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
@@ -124,7 +98,7 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
          td,th{{border:1px solid #ccc;padding:2px 6px;text-align:left}}</style></head><body>\n\
          <h1>{name}</h1>\n<p>{desc}</p>\n<p>FMI 2.0, {interfaces}. GUID <code>{guid}</code>. \
          All quantities SI, angles in rad.</p>\n<h2>Variables</h2>\n<table>\n\
-         <tr><th>name</th><th>vr</th><th>causality</th><th>variability</th><th>unit</th><th>start</th><th>description</th></tr>\n",
+         <tr><th>name</th><th>vr</th><th>causality</th><th>variability</th><th>unit</th><th>range</th><th>start</th><th>description</th></tr>\n",
         name = escape(&md.model_name),
         desc = escape(md.description.as_deref().unwrap_or("")),
         guid = escape(&md.guid),
@@ -135,19 +109,24 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
         },
     );
     for v in &md.model_variables {
-        let (unit, start) = match &v.variable_type {
-            VariableType::Real { unit, start, .. } => {
-                (unit.clone().unwrap_or_default(), start.map(|s| s.to_string()).unwrap_or_default())
+        // the unit column holds units only; the declared range (and an Integer switch's
+        // values, listed in its description) goes to the range column
+        let range_of = |min: Option<String>, max: Option<String>| match (min, max) {
+            (Some(lo), Some(hi)) => format!("{lo} .. {hi}"),
+            (Some(lo), None) => format!(">= {lo}"),
+            (None, Some(hi)) => format!("<= {hi}"),
+            (None, None) => String::new(),
+        };
+        let (unit, range, start) = match &v.variable_type {
+            VariableType::Real { unit, start, min, max, .. } => {
+                let finite = |v: &Option<f64>| v.filter(|x| x.is_finite()).map(|x| x.to_string());
+                (unit.clone().unwrap_or_default(), range_of(finite(min), finite(max)), start.map(|s| s.to_string()).unwrap_or_default())
             }
-            VariableType::Integer { start, min, max } => {
-                // a switch: its range (the values are listed in its description)
-                let range = match (min, max) {
-                    (Some(lo), Some(hi)) => format!("{lo} .. {hi}"),
-                    (Some(lo), None) => format!(">= {lo}"),
-                    _ => String::new(),
-                };
-                (range, start.map(|s| s.to_string()).unwrap_or_default())
-            }
+            VariableType::Integer { start, min, max } => (
+                String::new(),
+                range_of(min.map(|m| m.to_string()), max.map(|m| m.to_string())),
+                start.map(|s| s.to_string()).unwrap_or_default(),
+            ),
             VariableType::Enumeration { declared_type, start, .. } => {
                 let items = md
                     .type_definitions
@@ -155,10 +134,12 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
                     .find(|t| &t.name == declared_type)
                     .map(|t| t.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect::<Vec<_>>().join(", "))
                     .unwrap_or_default();
-                (format!("{declared_type}: {items}"), start.map(|s| s.to_string()).unwrap_or_default())
+                (String::new(), format!("{declared_type}: {items}"), start.map(|s| s.to_string()).unwrap_or_default())
             }
-            VariableType::Boolean { start } => (String::new(), start.map(|s| s.to_string()).unwrap_or_default()),
-            VariableType::String { start } => (String::new(), start.clone().unwrap_or_default()),
+            VariableType::Boolean { start } => {
+                (String::new(), String::new(), start.map(|s| s.to_string()).unwrap_or_default())
+            }
+            VariableType::String { start } => (String::new(), String::new(), start.clone().unwrap_or_default()),
         };
         let start = match (start.is_empty(), v.initial) {
             (true, Some(fmi2_export::model_description::Initial::Calculated)) => "(calculated)".to_string(),
@@ -166,17 +147,22 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
         };
         let _ = writeln!(
             html,
-            "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&v.name),
             v.value_reference,
             v.causality,
             v.variability,
             escape(&unit),
+            escape(&range),
             escape(&start),
             escape(v.description.as_deref().unwrap_or("")),
         );
     }
-    let _ = write!(html, "</table>\n<h2>Equations</h2>\n{equations}\n</body></html>\n");
+    let _ = write!(
+        html,
+        "</table>\n{equations}\n<h2>The closed loop</h2>\n<p>How the three FMUs of nigel-fmi (plant, controller, \
+         test bench) are connected in the benchmark.</p>\n{CLOSED_LOOP_SVG}\n</body></html>\n"
+    );
     html
 }
 
@@ -299,17 +285,17 @@ mod tests {
         let all = targets();
         let plant = &all.iter().find(|t| t.model_identifier == "nigel_plant").unwrap().documentation;
         // v_x: calculated from v_x_start, which is a parameter starting at 0
-        assert!(plant.contains("<tr><td><code>v_x</code></td><td>3</td><td>Output</td><td>Continuous</td><td>m/s</td><td>(calculated)</td>"), "{plant}");
+        assert!(plant.contains("<tr><td><code>v_x</code></td><td>3</td><td>Output</td><td>Continuous</td><td>m/s</td><td></td><td>(calculated)</td>"), "{plant}");
         assert!(plant.contains(
-            "<tr><td><code>v_x_start</code></td><td>63</td><td>Parameter</td><td>Fixed</td><td>m/s</td><td>0</td>"
+            "<tr><td><code>v_x_start</code></td><td>63</td><td>Parameter</td><td>Fixed</td><td>m/s</td><td></td><td>0</td>"
         ));
         assert!(plant.contains("<h2>Initial state</h2>"));
         let controller = &all.iter().find(|t| t.model_identifier == "nigel_controller").unwrap().documentation;
-        assert!(controller.contains("<td><code>controller</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 5</td><td>3</td><td>which steering feedback: 1 open_loop"), "{controller}");
+        assert!(controller.contains("<td><code>controller</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td></td><td>1 .. 5</td><td>3</td><td>which steering feedback: 1 open_loop"), "{controller}");
         let bench = &all.iter().find(|t| t.model_identifier == "nigel_maneuver").unwrap().documentation;
-        assert!(bench.contains("<td><code>maneuver</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td>1 .. 6</td><td>1</td><td>the maneuver: 1 straight"));
+        assert!(bench.contains("<td><code>maneuver</code></td><td>0</td><td>Parameter</td><td>Fixed</td><td></td><td>1 .. 6</td><td>1</td><td>the maneuver: 1 straight"));
         assert!(bench.contains(
-            "<td><code>fidelity</code></td><td>1</td><td>Parameter</td><td>Fixed</td><td>1 .. 2</td><td>1</td>"
+            "<td><code>fidelity</code></td><td>1</td><td>Parameter</td><td>Fixed</td><td></td><td>1 .. 2</td><td>1</td>"
         ));
     }
 

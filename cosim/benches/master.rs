@@ -152,6 +152,53 @@ fn run_master(
     })
 }
 
+/// The closed loop in process and with every FMU in its own host process (`--isolate`),
+/// `jacobi` and `ordered` recording nothing, the two alternated 5 times (best and spread
+/// of each); the isolation cost per FMU per step is the difference over 3 FMUs x 30,000
+/// steps.
+fn isolation(system: &System) {
+    let host = target().join("release").join("cosim-host");
+    if !host.is_file() {
+        println!("isolation: {} missing (cargo build --release -p nigel-cosim)", host.display());
+        return;
+    }
+    for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+        let mut times = [Vec::new(), Vec::new()];
+        for _ in 0..5 {
+            for (k, isolate) in [false, true].into_iter().enumerate() {
+                let mut e = Experiment::new(30.0, 1e-3);
+                e.algorithm = algorithm;
+                e.record = Some(vec![]);
+                if isolate {
+                    e.isolation = Some(nigel_cosim::Isolation { host: Some(host.clone()), ..Default::default() });
+                }
+                let t = Instant::now();
+                simulate(system, &e).unwrap();
+                times[k].push(t.elapsed());
+            }
+        }
+        let best = |v: &[Duration]| v.iter().min().copied().unwrap_or_default();
+        let worst = |v: &[Duration]| v.iter().max().copied().unwrap_or_default();
+        let (a, b) = (best(&times[0]), best(&times[1]));
+        let name = format!("{algorithm:?}").to_lowercase();
+        line(
+            &format!("master {name}, recording nothing, in process"),
+            a,
+            &format!("(5 runs alternated with --isolate: {:.1} .. {:.1} ms)", a.as_secs_f64() * 1e3, worst(&times[0]).as_secs_f64() * 1e3),
+        );
+        line(
+            &format!("master {name}, recording nothing, --isolate"),
+            b,
+            &format!(
+                "({:.1} .. {:.1} ms; isolation cost {:.2} us per FMU per step)",
+                b.as_secs_f64() * 1e3,
+                worst(&times[1]).as_secs_f64() * 1e3,
+                (b.saturating_sub(a)).as_secs_f64() * 1e6 / (STEPS * system.instances.len() as f64)
+            ),
+        );
+    }
+}
+
 fn main() {
     let ssp = target().join("ssp").join("nigel_closed_loop.ssp");
     if !ssp.is_file() {
@@ -160,6 +207,10 @@ fn main() {
     }
     let closed = nigel_cosim::read_ssp(&ssp, &Default::default()).unwrap();
     let system = &closed.system;
+    if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "isolation") {
+        isolation(system);
+        return;
+    }
     println!(
         "closed loop {} ({} instances, {} connections), 30 s at 1 ms:",
         ssp.display(),
@@ -218,6 +269,8 @@ fn main() {
     } else {
         println!("(set COSIM_BENCH_PYTHON=target/venv/bin/python for ecos, libcosim and fmpy on the same .ssp)");
     }
+
+    isolation(system);
 
     per_value(system);
 

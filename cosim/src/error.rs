@@ -35,6 +35,19 @@ impl Status {
             other => Status::Invalid(other),
         }
     }
+
+    /// The C integer.
+    pub fn to_raw(self) -> i32 {
+        match self {
+            Status::Ok => 0,
+            Status::Warning => 1,
+            Status::Discard => 2,
+            Status::Error => 3,
+            Status::Fatal => 4,
+            Status::Pending => 5,
+            Status::Invalid(v) => v,
+        }
+    }
 }
 
 impl fmt::Display for Status {
@@ -206,6 +219,38 @@ pub enum Error {
         /// The instances still not settled.
         instances: Vec<String>,
     },
+    /// An FMU ended the simulation itself, as FMI 2 lets it: in Co-Simulation
+    /// `fmi2DoStep` returned fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)` true,
+    /// in Model Exchange `terminateSimulation` was set. [`crate::simulate()`] ends the run
+    /// there and returns its results (with [`crate::Summary::ended_by`]); the step
+    /// functions return this variant to it.
+    Terminated {
+        /// The instance that ended the run.
+        instance: String,
+        /// The time the run ends at, s (CS: `fmi2LastSuccessfulTime`; ME: the event).
+        time: f64,
+        /// How the FMU said so.
+        reason: &'static str,
+    },
+    /// The host process of an isolated instance ended or was killed while the master
+    /// waited for a call: the FMU crashed (a signal), exited, or overran a time limit.
+    Host {
+        /// The instance.
+        instance: String,
+        /// The fmi2 function the host was running.
+        function: &'static str,
+        /// The simulation time of the call (or of the instance's last timed call), s.
+        time: f64,
+        /// How the host ended.
+        cause: HostEnd,
+    },
+    /// The whole run took longer than its time limit (`--timeout`); checked between steps.
+    Timeout {
+        /// The limit.
+        limit: std::time::Duration,
+        /// The simulation time reached, s.
+        time: f64,
+    },
     /// The experiment is not simulable as given (times, step, output interval).
     Experiment(String),
     /// An SSP file is malformed or uses a part this master does not support.
@@ -215,6 +260,59 @@ pub enum Error {
         /// What is wrong or unsupported, named.
         reason: String,
     },
+}
+
+/// How the host process of an isolated instance ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum HostEnd {
+    /// Killed by a signal (its number), e.g. 11 SIGSEGV, 6 SIGABRT.
+    Signal(i32),
+    /// Exited by itself with this code (the FMU called `exit`).
+    Exit(i32),
+    /// Killed by the master: the call took longer than this (`--timeout-call`).
+    CallTimeout(std::time::Duration),
+    /// Killed by the master: the run's time limit (`--timeout`) passed during the call.
+    RunTimeout(std::time::Duration),
+    /// The host could not be started or broke the protocol.
+    Failed(String),
+}
+
+/// The name of signal `n` (as `kill -l` prints it).
+pub fn signal_name(n: i32) -> &'static str {
+    match n {
+        1 => "SIGHUP",
+        2 => "SIGINT",
+        3 => "SIGQUIT",
+        4 => "SIGILL",
+        5 => "SIGTRAP",
+        6 => "SIGABRT",
+        7 => "SIGBUS",
+        8 => "SIGFPE",
+        9 => "SIGKILL",
+        11 => "SIGSEGV",
+        13 => "SIGPIPE",
+        15 => "SIGTERM",
+        24 => "SIGXCPU",
+        25 => "SIGXFSZ",
+        31 => "SIGSYS",
+        _ => "signal",
+    }
+}
+
+impl fmt::Display for HostEnd {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            HostEnd::Signal(n) => write!(f, "was killed by signal {n} ({})", signal_name(*n)),
+            HostEnd::Exit(c) => write!(f, "exited with code {c}"),
+            HostEnd::CallTimeout(d) => {
+                write!(f, "was killed: the call took longer than {} s (--timeout-call)", d.as_secs_f64())
+            }
+            HostEnd::RunTimeout(d) => {
+                write!(f, "was killed: the run's time limit of {} s passed (--timeout)", d.as_secs_f64())
+            }
+            HostEnd::Failed(m) => write!(f, "failed: {m}"),
+        }
+    }
 }
 
 impl fmt::Display for Error {
@@ -293,6 +391,15 @@ impl fmt::Display for Error {
                 "the event iteration at t = {time} s did not converge in {rounds} rounds: {} still changing",
                 instances.join(", ")
             ),
+            Error::Terminated { instance, time, reason } => {
+                write!(f, "{instance} ended the simulation at t = {time} s ({reason})")
+            }
+            Error::Host { instance, function, time, cause } => {
+                write!(f, "{instance}: the FMU's host process {cause} during {function} at t = {time} s")
+            }
+            Error::Timeout { limit, time } => {
+                write!(f, "the run exceeded its time limit of {} s (--timeout) at t = {time} s", limit.as_secs_f64())
+            }
             Error::Experiment(m) => write!(f, "experiment: {m}"),
             Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
         }

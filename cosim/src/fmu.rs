@@ -78,6 +78,17 @@ unsafe extern "C" fn release(p: *mut c_void) {
     free(p)
 }
 
+/// The callbacks of an instance whose messages go to `log` (the C shim formats them).
+pub(crate) fn callbacks_for(log: &LogSink) -> Box<CallbackFunctions> {
+    Box::new(CallbackFunctions {
+        logger: nigel_cosim_logger,
+        allocate_memory: allocate,
+        free_memory: release,
+        step_finished: None,
+        component_environment: log as *const LogSink as *mut c_void,
+    })
+}
+
 /// One message an FMU logged.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogRecord {
@@ -102,6 +113,16 @@ impl LogSink {
     /// Takes the kept messages.
     pub fn take(&self) -> Vec<LogRecord> {
         self.records.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
+    }
+
+    /// Keeps `record` (the oldest dropped beyond the capacity).
+    pub(crate) fn push(&self, record: LogRecord) {
+        if let Ok(mut r) = self.records.lock() {
+            if r.len() == LogSink::CAPACITY {
+                r.pop_front();
+            }
+            r.push_back(record);
+        }
     }
 
     /// The last messages at Warning or worse, joined, for an error message.
@@ -161,7 +182,7 @@ macro_rules! fmi2_table {
         impl Functions {
             /// # Safety
             /// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
-            unsafe fn load(lib: &libloading::Library, path: &Path) -> Result<Functions> {
+            pub(crate) unsafe fn load(lib: &libloading::Library, path: &Path) -> Result<Functions> {
                 Ok(Functions {
                     $($rf: *lib.get::<unsafe extern "C" fn($($ra),*) $(-> $rr)?>(concat!($rs, "\0").as_bytes())
                         .map_err(|_| Error::MissingSymbol { path: path.to_path_buf(), symbol: $rs })?,)*
@@ -261,7 +282,12 @@ pub struct Fmu {
     interface: Interface,
     source: PathBuf,
     resource_uri: CString,
-    dir: tempfile::TempDir,
+    /// The unpacked folder: owned, or that of the FMU this is the isolated view of.
+    dir: Option<tempfile::TempDir>,
+    /// Isolated view: the FMU whose library runs in host processes.
+    isolated_from: Option<Arc<Fmu>>,
+    /// The library inside the unpacked folder.
+    library_path: PathBuf,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -279,7 +305,7 @@ impl std::fmt::Debug for Fmu {
 static LIBRARIES: std::sync::OnceLock<Mutex<std::collections::HashMap<[u8; 32], Arc<libloading::Library>>>> =
     std::sync::OnceLock::new();
 
-fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloading::Library>> {
+pub(crate) fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloading::Library>> {
     use sha2::Digest;
     let bytes = std::fs::read(so).map_err(|source| Error::Io { path: shown.to_path_buf(), source })?;
     let key: [u8; 32] = sha2::Sha256::digest(&bytes).into();
@@ -397,8 +423,34 @@ impl Fmu {
             interface,
             source: path.to_path_buf(),
             resource_uri,
-            dir,
+            dir: Some(dir),
+            isolated_from: None,
+            library_path: so,
         }))
+    }
+
+    /// The same FMU with its instances in host processes: a function table that carries
+    /// every call to the instance's host (see `isolate`).
+    pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
+        if self.isolated_from.is_some() {
+            return self.clone();
+        }
+        Arc::new(Fmu {
+            functions: crate::isolate::proxy::table(&self.functions),
+            _library: self._library.clone(),
+            description: self.description.clone(),
+            interface: self.interface,
+            source: self.source.clone(),
+            resource_uri: self.resource_uri.clone(),
+            dir: None,
+            isolated_from: Some(self.clone()),
+            library_path: self.library_path.clone(),
+        })
+    }
+
+    /// Whether instances of this FMU run in host processes.
+    pub fn is_isolated(&self) -> bool {
+        self.isolated_from.is_some()
     }
 
     /// The model description.
@@ -418,7 +470,11 @@ impl Fmu {
 
     /// The private folder it is unpacked in (removed when the last `Arc` is dropped).
     pub fn unpacked_dir(&self) -> &Path {
-        self.dir.path()
+        match (&self.dir, &self.isolated_from) {
+            (Some(d), _) => d.path(),
+            (None, Some(f)) => f.unpacked_dir(),
+            (None, None) => Path::new(""),
+        }
     }
 
     /// `canHandleVariableCommunicationStepSize` (false for Model Exchange).
@@ -494,6 +550,8 @@ pub struct Instance {
     _callbacks: Box<CallbackFunctions>,
     saved: Vec<*mut c_void>,
     fmu: Arc<Fmu>,
+    /// Isolated: the host process the calls go to (the component is its address).
+    host: Option<Box<crate::isolate::channel::Channel>>,
 }
 
 // SAFETY: an FMI 2.0 instance may be used from any thread as long as calls to it are not
@@ -554,6 +612,74 @@ impl Instance {
             _callbacks: callbacks,
             saved: Vec::new(),
             fmu: fmu.clone(),
+            host: None,
+        })
+    }
+
+    /// `fmi2Instantiate` in a host process of its own (`isolation` names the host binary
+    /// and the per-call time limit; `run_deadline`: the run's deadline and its limit).
+    pub fn new_isolated(
+        fmu: &Arc<Fmu>,
+        name: &str,
+        isolation: &crate::isolate::Isolation,
+        run_deadline: Option<(std::time::Instant, std::time::Duration)>,
+    ) -> Result<Instance> {
+        use crate::error::HostEnd;
+        let fmu = fmu.isolated();
+        let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
+        let guid = CString::new(fmu.description.guid.as_str())
+            .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
+        let failed = |m: String| Error::Host {
+            instance: name.into(),
+            function: "fmi2Instantiate",
+            time: 0.0,
+            cause: HostEnd::Failed(m),
+        };
+        let host = crate::isolate::channel::find_host(isolation.host.as_deref()).map_err(failed)?;
+        let variables = fmu.description.model_variables.len();
+        let mut channel = Box::new(
+            crate::isolate::channel::Channel::start(
+                &host,
+                &fmu.library_path,
+                variables,
+                isolation.call_timeout,
+                run_deadline,
+            )
+            .map_err(failed)?,
+        );
+        let log = Box::<LogSink>::default();
+        channel.log = &*log as *const LogSink;
+        let status = crate::isolate::proxy::instantiate_in(
+            &mut channel,
+            &name_c,
+            fmu.interface.fmi_type(),
+            &guid,
+            &fmu.resource_uri,
+        );
+        if status != 0 {
+            if let Some(cause) = channel.failure.clone() {
+                return Err(Error::Host { instance: name.into(), function: "fmi2Instantiate", time: 0.0, cause });
+            }
+            return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
+        }
+        let callbacks = Box::new(CallbackFunctions {
+            logger: nigel_cosim_logger,
+            allocate_memory: allocate,
+            free_memory: release,
+            step_finished: None,
+            component_environment: &*log as *const LogSink as *mut c_void,
+        });
+        let component = &mut *channel as *mut crate::isolate::channel::Channel as *mut c_void;
+        Ok(Instance {
+            component,
+            state: InstanceState::Instantiated,
+            name: name.into(),
+            _name_c: name_c,
+            log,
+            _callbacks: callbacks,
+            saved: Vec::new(),
+            fmu,
+            host: Some(channel),
         })
     }
 
@@ -593,6 +719,10 @@ impl Instance {
             Status::Discard => {}
             Status::Error | Status::Pending | Status::Invalid(_) => self.state = InstanceState::Errored,
             Status::Fatal => self.state = InstanceState::Fatal,
+        }
+        if let Some(cause) = self.host.as_ref().and_then(|h| h.failure.clone()) {
+            let time = time.unwrap_or(self.host.as_ref().map_or(0.0, |h| h.last_time));
+            return Err(Error::Host { instance: self.name.clone(), function, time, cause });
         }
         Err(Error::Fmi { instance: self.name.clone(), function, status, time, log: self.log.recent_problems() })
     }

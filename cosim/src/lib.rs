@@ -26,6 +26,7 @@
 mod elf;
 pub mod error;
 pub mod fmu;
+pub mod isolate;
 pub mod me;
 pub mod simulate;
 pub mod ssp;
@@ -33,7 +34,8 @@ pub(crate) mod suggest;
 pub mod system;
 pub mod unpack;
 
-pub use error::{Error, Result, Status};
+pub use error::{Error, HostEnd, Result, Status};
+pub use isolate::Isolation;
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use me::{Event, Solver};
 pub use simulate::{simulate, simulate_with, Algorithm, Experiment, InstancePool, Results, RowSink, Summary};

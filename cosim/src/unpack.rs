@@ -144,14 +144,59 @@ pub fn read_xml_text(path: &Path, shown: &str, limit: u64) -> Result<String> {
     })
 }
 
-/// Unpacks `archive` into a fresh private temporary folder (removed when dropped).
+/// Unpacks `archive` into a fresh private temporary folder (removed when dropped, or by
+/// [`remove_on_signals`] when the process is interrupted).
 pub fn unpack(archive: &Path, limits: &UnpackLimits) -> Result<tempfile::TempDir> {
     let dir = tempfile::Builder::new()
         .prefix("nigel-cosim-")
         .tempdir()
         .map_err(|source| Error::Io { path: std::env::temp_dir(), source })?;
+    register(dir.path());
     unpack_into(archive, dir.path(), limits)?; // on error `dir` is dropped, so removed
     Ok(dir)
+}
+
+/// The temporary folders this process made (those already removed are pruned as new
+/// ones come).
+static MADE: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register(dir: &Path) {
+    let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
+    made.retain(|p| p.exists());
+    made.push(dir.to_path_buf());
+}
+
+/// Removes the temporary folders of this process when it gets SIGINT, SIGTERM or SIGHUP,
+/// then exits with 128 + the signal's number (as a shell reports it). Call it first in
+/// `main`, before any thread starts: it blocks those signals in the calling thread (and so
+/// in every thread and child started after) and waits for them in a thread of its own.
+pub fn remove_on_signals() {
+    // SAFETY: plain libc calls on a local signal set.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
+            let mut signal: libc::c_int = 0;
+            if libc::sigwait(&set, &mut signal) == 0 {
+                let made = MADE.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                for dir in made {
+                    let _ = std::fs::remove_dir_all(dir);
+                }
+                eprintln!(
+                    "cosim: stopped by {}; temporary folders removed",
+                    crate::error::signal_name(signal)
+                );
+                // host processes end with the master (PR_SET_PDEATHSIG)
+                libc::_exit(128 + signal);
+            }
+        });
+    }
 }
 
 fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()> {

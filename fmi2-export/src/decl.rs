@@ -403,12 +403,26 @@ impl<B: Copy> Declaration<B> {
                     }),
             }
         };
+        // One dependency declaration per unknown, over everything its value is computed from;
+        // each list of the ModelStructure keeps the knowns of its own modes (FMI 2.0 section
+        // 2.2.8): after initialization the inputs and the continuous states (a discrete
+        // state is no known there), at initialization the inputs and the exact variables.
+        let later_known = |index: &u32| {
+            let row = *index as usize - 1;
+            spec.variables[row].causality == Causality::Input || state_rows.contains(&row)
+        };
+        let later_deps = |v: &VarDecl<B>| -> Result<Option<Vec<u32>>, String> {
+            Ok(deps(v)?.map(|mut d| {
+                d.retain(later_known);
+                d
+            }))
+        };
         let mut structure = md::ModelStructure::default();
         for (row, v) in spec.variables.iter().enumerate() {
             if v.causality == Causality::Output {
                 structure.outputs.push(md::Unknown {
                     index: index(row),
-                    dependencies: deps(v)?,
+                    dependencies: later_deps(v)?,
                     dependencies_kind: None,
                 });
             }
@@ -417,7 +431,7 @@ impl<B: Copy> Declaration<B> {
             let v = &spec.variables[row];
             structure.derivatives.push(md::Unknown {
                 index: index(row),
-                dependencies: deps(v)?,
+                dependencies: later_deps(v)?,
                 dependencies_kind: None,
             });
         }

@@ -4,6 +4,7 @@
 
 use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, VarDecl, Variability};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
+use crate::sampled::{instant_tolerance, SampleClock, MAX_SAMPLES_PER_STEP};
 pub use crate::states::{Function, Machine, Scope};
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
@@ -31,11 +32,44 @@ pub struct Core<M> {
     /// The model asked to end the simulation (`fmi2GetBooleanStatus(fmi2Terminated)`).
     pub terminate_requested: bool,
     pub model: M,
-    /// Co-Simulation: the model (and its next event) before the events at the current
-    /// time were run (lazily, at the first read or step). Setting an input afterwards
-    /// restores it, so the events see the inputs of their own time instant. Held inline
-    /// (not boxed): a sampled model takes this copy at every communication point.
-    pre_event: Option<(M, Option<f64>)>,
+    /// A sampled model's clock, from the end of initialization on.
+    pub clock: Option<SampleClock>,
+    /// A sampled model before its sample 0: reads of its discrete outputs run sample 0
+    /// on a copy of the model.
+    pub presample: bool,
+    /// Co-Simulation: the instance before the events at the current time were run
+    /// (lazily, at the first read or step). Setting an input afterwards restores it, so
+    /// the events see the inputs of their own time instant. Held inline (not boxed): a
+    /// sampled model takes this copy at every communication point.
+    pre_event: Option<PreEvent<M>>,
+}
+
+/// What the events at one instant change, kept to undo them ([`Core`]'s `pre_event`).
+#[derive(Clone)]
+struct PreEvent<M> {
+    model: M,
+    next_event: Option<f64>,
+    clock: Option<SampleClock>,
+    presample: bool,
+    terminate_requested: bool,
+}
+
+impl<M: Model> Core<M> {
+    fn new(model: M) -> Self {
+        let presample = model.sample_period().is_some();
+        Core {
+            machine: Machine::Instantiated,
+            time: 0.0,
+            stop_time: None,
+            next_event: None,
+            iteration_pending: false,
+            terminate_requested: false,
+            model,
+            clock: None,
+            presample,
+            pre_event: None,
+        }
+    }
 }
 
 /// A saved FMU state (`fmi2FMUstate`).
@@ -132,9 +166,9 @@ pub struct Instance<M: Model> {
 }
 
 const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
-const SERIAL_VERSION: u32 = 2;
+const SERIAL_VERSION: u32 = 3;
 /// Numbers of the layer ahead of the model's in a serialized state.
-const SERIAL_HEADER_NUMBERS: usize = 7;
+const SERIAL_HEADER_NUMBERS: usize = 12;
 
 fn decl<M: Model>() -> &'static Declaration<M::Binding> {
     M::declaration()
@@ -144,9 +178,9 @@ fn err<T>(message: impl Into<String>) -> OpResult<T> {
     Err(ModelError::Error(message.into()))
 }
 
-/// Time tolerance for "this event is now": relative 1e-12 of the time scale.
+/// Time tolerance for "this event is now" ([`instant_tolerance`]).
 fn time_eps(t: f64) -> f64 {
-    1e-12 * t.abs().max(1.0)
+    instant_tolerance(t)
 }
 
 impl<M: Model> Instance<M> {
@@ -159,16 +193,7 @@ impl<M: Model> Instance<M> {
             get_memo: CallMemos::new(),
             set_memo: CallMemos::new(),
             context,
-            core: Core {
-                machine: Machine::Instantiated,
-                time: 0.0,
-                stop_time: None,
-                next_event: None,
-                iteration_pending: false,
-                terminate_requested: false,
-                model,
-                pre_event: None,
-            },
+            core: Core::new(model),
         })
     }
 
@@ -272,9 +297,28 @@ impl<M: Model> Instance<M> {
                 return err(format!("tolerance {tol} must be finite and > 0"));
             }
         }
+        if let Some(stop) = stop_time {
+            self.check_stop_within_samples(start_time, stop)?;
+        }
         self.core.time = start_time;
         self.core.stop_time = stop_time;
         self.core.model.set_time(start_time);
+        Ok(())
+    }
+
+    /// A sampled model with a last sample: `stop` must not be past it.
+    fn check_stop_within_samples(&self, start: f64, stop: f64) -> OpResult {
+        let model = &self.core.model;
+        let (Some(period), Some(end)) = (model.sample_period(), model.sample_end()) else { return Ok(()) };
+        let clock = SampleClock { start, period, next: 0, end: Some(end) };
+        let end_time = clock.end_time().unwrap_or(start);
+        if stop > end_time + time_eps(end_time) {
+            return err(format!(
+                "stopTime = {stop} s is past the model's last sample at t = {end_time} s \
+                 (sample {} of {period} s from startTime = {start} s, set by {})",
+                end.last, end.variable
+            ));
+        }
         Ok(())
     }
 
@@ -285,12 +329,26 @@ impl<M: Model> Instance<M> {
 
     pub fn exit_initialization_mode(&mut self) -> OpResult {
         self.core.model.exit_initialization()?;
+        let start = self.core.time;
+        if let Some(period) = self.core.model.sample_period() {
+            if !(period > 0.0 && period.is_finite()) {
+                return err(format!("the sample period {period} s is not finite and > 0"));
+            }
+            let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
+            clock.check_resolution(start)?;
+            if let Some(stop) = self.core.stop_time {
+                self.check_stop_within_samples(start, stop)?;
+                clock.check_resolution(stop)?;
+            }
+            self.core.clock = Some(clock);
+            self.core.presample = true;
+        }
         self.core.machine = match self.context.interface {
             Interface::CoSimulation => Machine::StepComplete,
             Interface::ModelExchange => Machine::EventMode,
         };
         // the initial event, at the start time
-        self.core.next_event = Some(self.core.time);
+        self.core.next_event = Some(start);
         Ok(())
     }
 
@@ -302,16 +360,7 @@ impl<M: Model> Instance<M> {
     /// Back to `Instantiated` with the start values, keeping name, interface and callbacks.
     pub fn reset(&mut self) -> OpResult {
         let model = Self::fresh_model(&self.context)?;
-        self.core = Core {
-            machine: Machine::Instantiated,
-            time: 0.0,
-            stop_time: None,
-            next_event: None,
-            iteration_pending: false,
-            terminate_requested: false,
-            model,
-            pre_event: None,
-        };
+        self.core = Core::new(model);
         Ok(())
     }
 
@@ -360,16 +409,26 @@ impl<M: Model> Instance<M> {
     #[inline(never)]
     fn run_due_events(&mut self, now: f64) -> OpResult {
         if self.core.pre_event.is_none() {
-            self.core.pre_event = Some((self.core.model.clone(), self.core.next_event));
+            let c = &self.core;
+            self.core.pre_event = Some(PreEvent {
+                model: c.model.clone(),
+                next_event: c.next_event,
+                clock: c.clock,
+                presample: c.presample,
+                terminate_requested: c.terminate_requested,
+            });
         }
         self.run_events_at(now)
     }
 
     /// Before a set in Co-Simulation: undo the events run lazily at this instant.
     fn unsettle_events(&mut self) {
-        if let Some((model, next)) = self.core.pre_event.take() {
-            self.core.model = model;
-            self.core.next_event = next;
+        if let Some(pre) = self.core.pre_event.take() {
+            self.core.model = pre.model;
+            self.core.next_event = pre.next_event;
+            self.core.clock = pre.clock;
+            self.core.presample = pre.presample;
+            self.core.terminate_requested = pre.terminate_requested;
         }
     }
 
@@ -380,6 +439,10 @@ impl<M: Model> Instance<M> {
             let update = self.event_update(time)?;
             if update.terminate_simulation {
                 self.core.terminate_requested = true;
+                if self.core.clock.is_some() {
+                    // the end of the samples: the last values stand; the next step is refused
+                    return Ok(());
+                }
                 return Err(ModelError::Discard(format!("the model asked to terminate the simulation at t = {time}")));
             }
             let due = matches!(self.core.next_event, Some(te) if te <= time + time_eps(time));
@@ -393,6 +456,9 @@ impl<M: Model> Instance<M> {
     /// One call of the model's event update, with its next event time checked.
     fn event_update(&mut self, time: f64) -> OpResult<EventUpdate> {
         self.core.model.set_time(time);
+        if let Some(mut clock) = self.core.clock {
+            return self.sample(&mut clock, time);
+        }
         let update = self.core.model.event_update(time)?;
         if let Some(te) = update.next_event_time {
             if !te.is_finite() || !(te > time) {
@@ -405,11 +471,62 @@ impl<M: Model> Instance<M> {
         Ok(update)
     }
 
+    /// The event of a sampled model at `time` = its next sample (or the end of its samples).
+    fn sample(&mut self, clock: &mut SampleClock, time: f64) -> OpResult<EventUpdate> {
+        self.core.iteration_pending = false;
+        if !clock.has_next() {
+            return err(format!("no sample after sample {} at t = {time} s", clock.next));
+        }
+        self.core.model.sample(clock.next, time)?;
+        clock.next += 1;
+        self.core.clock = Some(*clock);
+        self.core.presample = false;
+        self.core.next_event = clock.next_event();
+        // after the last sample: the end of the simulation
+        let terminate_simulation = self.core.next_event.is_none();
+        self.core.terminate_requested |= terminate_simulation;
+        Ok(EventUpdate { next_event_time: self.core.next_event, terminate_simulation, ..Default::default() })
+    }
+
+    /// Reads before sample 0 of a sampled model: the discrete outputs from what sample 0
+    /// will latch (run on a copy), everything else from the model.
+    #[cold]
+    #[inline(never)]
+    fn get_real_presample(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
+        let d = decl::<M>();
+        Self::check_rows(d, BaseType::Real, vrs)?;
+        let mut sampled: Option<M> = None;
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let v = d.variable(row);
+            let latched = v.variability == Variability::Discrete && v.initial == Some(Initial::Calculated);
+            let model = if latched {
+                if sampled.is_none() {
+                    let mut copy = self.core.model.clone();
+                    copy.sample(0, self.core.time)?;
+                    sampled = Some(copy);
+                }
+                sampled.as_mut().unwrap_or(&mut self.core.model)
+            } else {
+                &mut self.core.model
+            };
+            let x = model.get_real(v.binding)?;
+            if !x.is_finite() {
+                return Self::not_finite(row, x);
+            }
+            *o = x;
+        }
+        Ok(())
+    }
+
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
+        self.settle_events()?;
+        if self.core.presample {
+            return self.get_real_presample(vrs, out);
+        }
         if let Some(m) = self.get_memo.find(vrs) {
             // the same value references as a recent call: their rows are known
-            self.settle_events()?;
             for (o, r) in out.iter_mut().zip(&self.get_memo.arrays[m].rows) {
                 let x = self.core.model.get_real(r.hot.binding)?;
                 if !x.is_finite() {
@@ -421,7 +538,6 @@ impl<M: Model> Instance<M> {
         }
         Self::check_rows(d, BaseType::Real, vrs)?;
         self.get_memo.fill(d, vrs, |_| true);
-        self.settle_events()?;
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Real, vr)?;
             let x = self.core.model.get_real(d.hot(row).binding)?;
@@ -621,25 +737,48 @@ impl<M: Model> Instance<M> {
     /// `fmi2DoStep`: the model's time events inside the step run in order at their time
     /// (those at the step's start with the inputs just set); the continuous part is
     /// integrated between them; events exactly at the step's end wait for the next
-    /// read or step (so that they see the inputs of that instant).
+    /// read or step (so that they see the inputs of that instant). The step starts at the
+    /// importer's `currentCommunicationPoint` and ends at `currentCommunicationPoint +
+    /// communicationStepSize` exactly (FMI 2.0 section 4.2.2), so the FMU's time is the
+    /// importer's and `fmi2LastSuccessfulTime` its arithmetic.
     pub fn do_step(&mut self, current_time: f64, step: f64) -> OpResult {
         if !(step > 0.0) || !step.is_finite() {
-            return err(format!("communicationStepSize {step} must be finite and > 0"));
+            return err(format!("communicationStepSize = {step} s refused: must be finite and > 0"));
         }
         let now = self.core.time;
-        if !current_time.is_finite() || (current_time - now).abs() > 1e-9 * now.abs().max(1.0) {
+        if !current_time.is_finite() || (current_time - now).abs() > time_eps(now) {
             return err(format!(
-                "currentCommunicationPoint {current_time} is not the end of the previous step ({now})"
+                "currentCommunicationPoint = {current_time} s is not the end of the previous step ({now} s)"
             ));
         }
-        let end = now + step;
+        let end = current_time + step;
         if let Some(stop) = self.core.stop_time {
             if end > stop + time_eps(stop) {
-                return err(format!("the step would end at {end}, after the stopTime {stop} of fmi2SetupExperiment"));
+                return err(format!(
+                    "the step would end at {end} s, after the stopTime {stop} s of fmi2SetupExperiment"
+                ));
             }
         }
+        if let Some(clock) = self.core.clock {
+            // refused before any work: too many samples, or a time that cannot hold the grid
+            // a model with a last sample stops there
+            let until = clock.end_time().map_or(end, |t_end| end.min(t_end));
+            let samples = (until - clock.time_of(clock.next)) / clock.period;
+            if samples > MAX_SAMPLES_PER_STEP {
+                return Err(ModelError::Discard(format!(
+                    "the step of {step} s would run {samples:.0} samples of {} s, more than the {MAX_SAMPLES_PER_STEP} \
+                     one fmi2DoStep may run: take shorter steps",
+                    clock.period
+                )));
+            }
+            clock.check_resolution(end).map_err(ModelError::Discard)?;
+        }
+        self.core.time = current_time;
         self.settle_events()?;
         self.core.pre_event = None;
+        if self.core.terminate_requested && self.core.clock.is_some() {
+            return Err(self.past_the_samples());
+        }
         loop {
             match self.core.next_event {
                 Some(te) if te < end - time_eps(end) => {
@@ -649,11 +788,14 @@ impl<M: Model> Instance<M> {
                         self.core.time = te;
                     }
                     self.run_events_at(te)?;
+                    if self.core.terminate_requested && self.core.clock.is_some() {
+                        return Err(self.past_the_samples());
+                    }
                 }
                 _ => {
                     let t = self.core.time;
                     // without an event inside, exactly the importer's step size
-                    let rest = if t == now { step } else { end - t };
+                    let rest = if t == current_time { step } else { end - t };
                     if rest > 0.0 {
                         self.core.model.do_step(t, rest)?;
                     }
@@ -662,6 +804,25 @@ impl<M: Model> Instance<M> {
                 }
             }
         }
+    }
+
+    /// The `fmi2Discard` of a step past a sampled model's last sample (the instance is at
+    /// the end of its samples: `fmi2LastSuccessfulTime`).
+    #[cold]
+    fn past_the_samples(&self) -> ModelError {
+        let what = match self.core.model.sample_end() {
+            Some(e) => format!(
+                "sample {} of {} s is the last, set by {}",
+                e.last,
+                self.core.clock.map_or(0.0, |c| c.period),
+                e.variable
+            ),
+            None => "the model's last sample".to_string(),
+        };
+        ModelError::Discard(format!(
+            "the simulation ends at t = {} s ({what}): fmi2Terminated is true, fmi2LastSuccessfulTime is that time",
+            self.core.time
+        ))
     }
 
     // ---------------------------------------------------------------- Model Exchange
@@ -705,7 +866,11 @@ impl<M: Model> Instance<M> {
             let update = self.event_update(now)?;
             Ok(update)
         } else {
-            Ok(EventUpdate { next_event_time: self.core.next_event, ..Default::default() })
+            Ok(EventUpdate {
+                next_event_time: self.core.next_event,
+                terminate_simulation: self.core.terminate_requested,
+                ..Default::default()
+            })
         }
     }
 
@@ -789,6 +954,44 @@ impl<M: Model> Instance<M> {
                 .map(|r| decl::<M>().variable(r).binding)
                 .ok_or_else(|| format!("unknown Real value reference {vr}").into())
         };
+        let d = decl::<M>();
+        let initialization = self.core.machine == Machine::InitializationMode;
+        for &vr in knowns {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let v = d.variable(row);
+            // the knowns of FMI 2.0 section 2.2.8: inputs and continuous states, and in
+            // Initialization Mode the variables with initial="exact" (a state calculated
+            // from its start value stays a known there too: its partials are defined)
+            let known = v.causality == Causality::Input
+                || d.state_rows.contains(&row)
+                || (initialization && v.initial == Some(Initial::Exact));
+            if !known {
+                return err(format!(
+                    "known {} is not an input, a continuous state or (in Initialization Mode) exact",
+                    v.name
+                ));
+            }
+            if !M::provides_derivative_with_respect_to(v.binding, initialization) {
+                return err(format!(
+                    "derivatives with respect to {} are not provided ({} in Initialization Mode)",
+                    v.name,
+                    if initialization {
+                        "only inputs, continuous states and their start values"
+                    } else {
+                        "only inputs and continuous states"
+                    }
+                ));
+            }
+        }
+        for &vr in unknowns {
+            let row = Self::row_in(d, BaseType::Real, vr)?;
+            let v = d.variable(row);
+            let unknown =
+                v.causality == Causality::Output || d.state_rows.contains(&row) || d.derivative_rows.contains(&row);
+            if !unknown {
+                return err(format!("unknown {} is not an output, a continuous state or a derivative", v.name));
+            }
+        }
         let u: Vec<_> = unknowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
         let k: Vec<_> = knowns.iter().map(|&vr| binding(vr)).collect::<OpResult<_>>()?;
         self.core.model.directional_derivative(&u, &k, dv_known, out)?;
@@ -841,9 +1044,9 @@ impl<M: Model> Instance<M> {
     /// little-endian f64. Events run lazily at the current time are saved as not run.
     pub fn serialize(state: &SavedState<M>) -> OpResult<Vec<u8>> {
         let guid = decl::<M>().guid().as_bytes();
-        let (mut model, next_event) = match &state.pre_event {
-            Some(pre) => (pre.0.clone(), pre.1),
-            None => (state.model.clone(), state.next_event),
+        let (mut model, next_event, clock, presample) = match &state.pre_event {
+            Some(pre) => (pre.model.clone(), pre.next_event, pre.clock, pre.presample),
+            None => (state.model.clone(), state.next_event, state.clock, state.presample),
         };
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         let mut numbers = vec![
@@ -854,6 +1057,11 @@ impl<M: Model> Instance<M> {
             flag(next_event.is_some()),
             next_event.unwrap_or(0.0),
             flag(state.iteration_pending),
+            flag(clock.is_some()),
+            clock.map_or(0.0, |c| c.start),
+            clock.map_or(0.0, |c| c.period),
+            clock.map_or(0.0, |c| c.next as f64),
+            flag(presample),
         ];
         for &row in Self::saved_rows() {
             let v = decl::<M>().variable(row);
@@ -933,6 +1141,9 @@ impl<M: Model> Instance<M> {
         if next_event.is_some_and(|t| !t.is_finite() || t < time - time_eps(time)) {
             return err("serialized state has a next event time that is non-finite or past");
         }
+        let has_clock = flag(numbers[7], "sample clock")?;
+        let (clock_start, period, next_sample) = (numbers[8], numbers[9], numbers[10]);
+        let presample = flag(numbers[11], "before the first sample")?;
         let mut model = Self::fresh_model(&self.context)?;
         let values = &numbers[SERIAL_HEADER_NUMBERS..SERIAL_HEADER_NUMBERS + saved];
         for (&row, &x) in Self::saved_rows().iter().zip(values) {
@@ -951,19 +1162,100 @@ impl<M: Model> Instance<M> {
             r.map_err(|e| format!("serialized state: {}: {e}", v.name))?;
         }
         model.load_internal(&numbers[SERIAL_HEADER_NUMBERS + saved..])?;
-        if !matches!(machine, Machine::Instantiated | Machine::InitializationMode) {
+        let initialized = !matches!(machine, Machine::Instantiated | Machine::InitializationMode);
+        if initialized {
             model.exit_initialization().map_err(|e| format!("serialized state: {e}"))?;
         }
+        let clock = if has_clock {
+            Some(SampleClock { start: clock_start, period, next: 0, end: model.sample_end() })
+        } else {
+            None
+        };
+        let clock = Self::consistent_clock(&model, initialized, clock, next_sample, time, next_event, presample)
+            .map_err(|e| ModelError::Error(format!("serialized state: {e}")))?;
         Ok(Core {
             machine,
             time,
             stop_time,
             next_event,
             iteration_pending,
-            terminate_requested: false,
+            terminate_requested: clock.is_some_and(|c| !c.has_next()),
             model,
+            clock,
+            presample,
             pre_event: None,
         })
+    }
+
+    /// A loaded sample clock agrees with the model and the instance: the model is sampled
+    /// exactly when the state has a clock past initialization, with the period of its
+    /// parameters; the sample count is an integer within the model's samples; the time
+    /// lies between the last sample run and the next; the next event is the next sample
+    /// (or the end of the samples) to the bit; "before the first sample" is "no sample run".
+    fn consistent_clock(
+        model: &M,
+        initialized: bool,
+        clock: Option<SampleClock>,
+        next_sample: f64,
+        time: f64,
+        next_event: Option<f64>,
+        presample: bool,
+    ) -> Result<Option<SampleClock>, String> {
+        let period = model.sample_period();
+        let Some(mut clock) = clock else {
+            if initialized && period.is_some() {
+                return Err("a sampled model past initialization without its sample clock".into());
+            }
+            if presample != (period.is_some()) {
+                return Err(format!("the before-first-sample flag {presample} disagrees with the model"));
+            }
+            return Ok(None);
+        };
+        if !initialized {
+            return Err("a sample clock before initialization ended".into());
+        }
+        if period != Some(clock.period) {
+            return Err(format!(
+                "the sample clock's period {} s disagrees with the model's {period:?} s",
+                clock.period
+            ));
+        }
+        if !(clock.start.is_finite() && next_sample >= 0.0 && next_sample.fract() == 0.0 && next_sample < 9e15) {
+            return Err(format!(
+                "the sample clock (start {} s, sample {next_sample}) is not a finite start and a sample count",
+                clock.start
+            ));
+        }
+        clock.next = next_sample as u64;
+        if let Some(end) = clock.end {
+            if clock.next > end.last + 1 {
+                return Err(format!(
+                    "sample {} is past the model's last sample {} (set by {})",
+                    clock.next, end.last, end.variable
+                ));
+            }
+        }
+        if presample != (clock.next == 0) {
+            return Err(format!("the before-first-sample flag {presample} disagrees with sample count {}", clock.next));
+        }
+        let (earliest, latest) = match clock.next {
+            0 => (clock.start, clock.start),
+            k => (clock.time_of(k - 1), clock.time_of(k)),
+        };
+        if !(time >= earliest - time_eps(earliest) && time <= latest + time_eps(latest)) {
+            return Err(format!(
+                "time {time} s is not between the last sample run and the next ({earliest} s .. {latest} s, sample {})",
+                clock.next
+            ));
+        }
+        let expected = clock.next_event();
+        if next_event.map(f64::to_bits) != expected.map(f64::to_bits) {
+            return Err(format!(
+                "the next event time {next_event:?} s disagrees with the sample clock: sample {} is due at {:?} s",
+                clock.next, expected
+            ));
+        }
+        Ok(Some(clock))
     }
 }
 

@@ -21,9 +21,13 @@
 //!    capabilities (directional derivatives, FMU state, serialization) are opt-in in
 //!    [`Capabilities`]; interfaces in [`Interfaces`].
 //! 3. `impl Model`: [`Model::declaration`], [`Model::instantiate`], get/set by binding.
-//!    A sampled (discrete-time) model adds [`Model::event_update`]: it is called at the
-//!    initial event (the start time) and whenever the `next_event_time` it returned is
-//!    reached; it computes the sample and returns the next sample time. That is all:
+//!    A sampled (discrete-time) model answers [`Model::sample_period`] and implements
+//!    [`Model::sample`] (latch the outputs of sample `k`); the layer keeps the clock
+//!    ([`sampled`]: `t_k = start + k period` counted as integers, exact at any start time,
+//!    the reads before sample 0, the clock's part of the FMU state, checked when loaded) and
+//!    [`Model::sample_end`] ends the run the FMI way at a last sample. A model with other
+//!    time events implements [`Model::event_update`]: it is called at the initial event
+//!    (the start time) and whenever the `next_event_time` it returned is reached. Either way:
 //!    - Model Exchange: `fmi2NewDiscreteStates` calls it and reports
 //!      `nextEventTimeDefined`/`nextEventTime`; `newDiscreteStatesNeeded` iterates;
 //!    - Co-Simulation: `fmi2DoStep` runs the events inside the step in order (a model
@@ -125,6 +129,7 @@ pub mod ffi;
 pub mod instance;
 pub mod log;
 pub mod model;
+pub mod sampled;
 pub mod states;
 pub mod uri;
 
@@ -136,6 +141,7 @@ pub use instance::Instance;
 pub use log::{LogCategory, Logger};
 pub use model::{EventUpdate, InstantiateContext, Interface, Model, ModelError, ModelResult};
 pub use model_description;
+pub use sampled::{SampleClock, SampleEnd};
 pub use states::{Function, Machine};
 
 /// Exports the 44 FMI 2.0 functions for model type `$model` from the calling crate

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use crate::decl::Declaration;
 use crate::log::Logger;
+use crate::sampled::SampleEnd;
 
 /// What the model learns at instantiation.
 #[derive(Clone, Debug)]
@@ -170,6 +171,27 @@ pub trait Model: Clone + Send + Sized + 'static {
         Ok(EventUpdate::default())
     }
 
+    /// A sampled model's period [s] ([`crate::sampled`]): the layer then keeps the sample
+    /// clock and calls [`Model::sample`] instead of [`Model::event_update`]. Read when
+    /// initialization ends (a period parameter is fixed from then on). Default: not sampled.
+    fn sample_period(&self) -> Option<f64> {
+        None
+    }
+
+    /// The last sample of a sampled model, if it has one (a reference of finite length).
+    fn sample_end(&self) -> Option<SampleEnd> {
+        None
+    }
+
+    /// Sample `k` at `time` = start + k period, with the inputs and tunable parameters of
+    /// that instant: compute and latch the held outputs. Before sample 0 has run, the
+    /// layer answers reads of the discrete outputs by running sample 0 on a copy of the
+    /// model (in Initialization Mode too: `sample(0, ..)` must then work with the
+    /// parameters alone).
+    fn sample(&mut self, _k: u64, _time: f64) -> ModelResult {
+        Ok(())
+    }
+
     /// Co-Simulation: advance the continuous states from `time` by `step` with inputs held.
     /// The layer has already split the communication step at the time events, so there
     /// is no event strictly inside `(time, time + step)`. The default serves models
@@ -185,8 +207,17 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// Model Exchange: the importer's time (for time-dependent models).
     fn set_time(&mut self, _time: f64) {}
 
+    /// Whether [`Model::directional_derivative`] takes `known` as a known (the layer has
+    /// checked that it is one of the current mode: an input, a continuous state, or in
+    /// Initialization Mode a variable with `initial="exact"`); if not, the layer refuses the
+    /// call naming the variable. Default: every known.
+    fn provides_derivative_with_respect_to(_known: Self::Binding, _initialization: bool) -> bool {
+        true
+    }
+
     /// Exact directional derivative `dv_unknown = J dv_known`, J = d unknowns / d knowns.
-    /// Called only when the declaration opts in to `directional_derivatives`.
+    /// Called only when the declaration opts in to `directional_derivatives`, with knowns
+    /// and unknowns the layer checked (see [`Model::provides_derivative_with_respect_to`]).
     fn directional_derivative(
         &mut self,
         _unknowns: &[Self::Binding],

@@ -906,9 +906,9 @@ fn a_model_can_override_the_fmu_state_format() {
         assert_eq!(abi::serialize_fmu_state::<Own>(f.c, s, b.as_mut_ptr() as *mut c_char, size), OK);
         b
     };
-    // the layer's 7 numbers and the model's own 7, no declared variables
+    // the layer's 12 numbers (the sample clock among them) and the model's own 7, no declared variables
     let guid = Own::declaration().guid().len();
-    assert_eq!(bytes.len(), 8 + 4 + 4 + guid + 8 + 8 * (7 + 7));
+    assert_eq!(bytes.len(), 8 + 4 + 4 + guid + 8 + 8 * (12 + 7));
     let g = Fmu::<Own>::cs();
     let mut copy: fmi2FMUstate = null_mut();
     unsafe {

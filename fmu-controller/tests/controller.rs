@@ -11,7 +11,8 @@ mod common;
 
 use std::f64::consts::FRAC_PI_2;
 
-use common::{Fmu, ERR, OK};
+use common::{Fmu, DISCARD, ERR, OK};
+use fmi2_export::Model;
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
 use nigel_controller::{mode, vr, Controller};
 
@@ -399,7 +400,7 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     }
 }
 
-/// The tracking law written out by hand from its definition (issue 9), independent of
+/// The tracking law written out by hand from its definition, independent of
 /// nigel_vehicle's and nigel_benchmark's code: the errors in the reference's frame.
 fn tracking_by_hand(x: &In, pose: [f64; 6], integral: f64) -> ([f64; 4], f64) {
     let [px, py, psi, x_ref, y_ref, psi_ref] = pose;
@@ -483,9 +484,10 @@ fn a_step_of_astronomically_many_samples_is_refused_not_run() {
     let c = C::cs();
     c.init();
     set_inputs(&c, &SETS[0]);
-    // 10^9 s at 1 ms would be 10^12 samples: refused after 10^6 unattended ones
-    assert_eq!(c.step(0.0, 1e9), ERR);
-    assert!(c.last_error().contains("samples"), "{}", c.last_error());
+    // 10^9 s at 1 ms would be 10^12 samples: refused before any work, nothing changed
+    assert_eq!(c.step(0.0, 1e9), DISCARD);
+    assert!(c.last_message().contains("1000000000000 samples"), "{}", c.last_message());
+    assert_eq!(c.last_successful_time(), 0.0);
     assert_eq!(c.reset(), OK);
     // a tiny sample period is refused up front
     assert_eq!(c.set_real(vr::SAMPLE_PERIOD, 5e-324), ERR);
@@ -561,4 +563,150 @@ fn outputs_follow_parameters_set_after_a_read() {
     assert_eq!(c.exit_init(), OK);
     assert_eq!(c.step(0.0, T), OK);
     assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
+}
+
+/// The outputs and the integrator of a Co-Simulation run from `start` with steps of `h`
+/// (the master's communication points `start + n h`, one rounding each), the inputs
+/// changing at every 1 ms sample instant.
+fn run_from(start: f64, h: f64, samples: usize) -> Vec<[f64; 6]> {
+    let c = C::cs();
+    c.init_at(start);
+    let per_step = (h / T).round() as usize;
+    let mut rows = Vec::new();
+    for n in 0..samples / per_step {
+        set_inputs(&c, &SETS[n % 3]);
+        let d = deltas(&c);
+        rows.push([d[0], d[3], c.real(vr::TAU), c.real(vr::DRIVE_FORCE), c.real(vr::SPEED_INTEGRAL), n as f64]);
+        assert_eq!(c.step(start + n as f64 * h, h), OK, "start {start}: {}", c.last_error());
+    }
+    rows
+}
+
+/// Samples are counted as integers from the start time and communication points compared
+/// on the scale of an f64 at that time, never of 1e-12 |t| (1.7 ms at 1.7e9 s, more than a
+/// period): a run started at a Unix time gives the run started at 0, bit for bit, in 1 ms
+/// steps and in 10 ms steps (ten samples inside each); 1e12 s still resolves 1 ms to
+/// 1.2e-4 s. The inputs change every step, so a sample run early or late shows.
+#[test]
+fn large_start_times_give_the_same_run_bit_for_bit() {
+    for h in [T, 10.0 * T] {
+        let at_zero = run_from(0.0, h, 600);
+        assert!(at_zero.windows(2).any(|w| w[0][0] != w[1][0]), "the steering changes from step to step");
+        for start in [1e6, 1.7e9, 1e12] {
+            assert_eq!(run_from(start, h, 600), at_zero, "start time {start} s, steps of {h} s");
+        }
+    }
+}
+
+/// A start time at which an f64 cannot resolve the sample period is refused when
+/// initialization ends, with the reason, instead of running samples at the wrong time.
+#[test]
+fn a_start_time_that_cannot_hold_the_sample_grid_is_refused() {
+    let c = C::cs();
+    assert_eq!(c.setup_at(1e14, None), OK);
+    assert_eq!(c.enter_init(), OK);
+    assert_eq!(c.exit_init(), ERR);
+    assert!(c.last_error().contains("cannot resolve the sample period 0.001 s"), "{}", c.last_error());
+}
+
+/// Co-Simulation time is the importer's: each step ends at currentCommunicationPoint +
+/// communicationStepSize to the bit, and fmi2LastSuccessfulTime reports it, whether the
+/// master accumulates `t += h` or computes `n h` (which differ by rounding after a few
+/// steps of 0.1 ms, by 1e-12 s and more after 10^4).
+#[test]
+fn co_simulation_time_is_the_communication_point_plus_the_step() {
+    let h = 1e-4;
+    let c = C::cs();
+    c.init();
+    let mut accumulated = 0.0;
+    let mut differed = 0;
+    for n in 0..20_000u32 {
+        // alternate the two masters' arithmetic
+        let t = if n % 2 == 0 { accumulated } else { f64::from(n) * h };
+        differed += (t != f64::from(n) * h || accumulated != f64::from(n) * h) as u32;
+        assert_eq!(c.step(t, h), OK, "{}", c.last_error());
+        assert_eq!(c.last_successful_time().to_bits(), (t + h).to_bits(), "step {n} from {t}");
+        accumulated = t + h;
+    }
+    assert!(differed > 1000, "the two arithmetics differ often: {differed}");
+    // a communication point off by more than the f64 resolution (plus 1 ns) is refused
+    let now = c.last_successful_time();
+    assert_eq!(c.step(now + 1e-6, h), ERR);
+    assert!(c.last_error().contains("currentCommunicationPoint"), "{}", c.last_error());
+}
+
+/// Every parameter has a physically meaningful range in the description, refused at the
+/// set with the function, the variable and the bound: no value the law cannot use (a
+/// wheel radius of 1e308 m gave an infinite torque at the next read).
+#[test]
+fn parameters_out_of_their_range_are_refused_at_the_set() {
+    let xml = Controller::declaration().xml();
+    for name in [
+        "sample_period",
+        "kp_speed",
+        "ki_speed",
+        "force_max",
+        "r_wheel",
+        "delta_max",
+        "k_along_track",
+        "along_track_speed_max",
+        "k_beta_fl",
+        "k_yaw_rate_rr",
+    ] {
+        let at = xml.find(&format!("name=\"{name}\"")).unwrap_or_else(|| panic!("{name} declared"));
+        let real = &xml[at..at + xml[at..].find("/>").unwrap()];
+        assert!(real.contains("min=\"") && real.contains("max=\""), "{name}: {real}");
+    }
+    for (r, bad, name) in [
+        (vr::R_WHEEL, 1e308, "r_wheel"),
+        (vr::SAMPLE_PERIOD, 1e308, "sample_period"),
+        (vr::DELTA_MAX, 5e-324, "delta_max"),
+        (vr::FORCE_MAX, 0.0, "force_max"),
+        (vr::K_CUSTOM, -1e6, "k_beta_fl"),
+    ] {
+        let c = C::cs();
+        assert_eq!(c.set_real(r, bad), ERR, "{name} = {bad}");
+        let e = c.last_error();
+        assert!(e.starts_with("fmi2SetReal: ") && e.contains(name) && e.contains("refused"), "{e}");
+        assert!(!e.contains("Var::") && !e.contains("Real("), "no Rust debug text: {e}");
+    }
+}
+
+/// A serialized state whose sample clock disagrees with its time or its next event is
+/// refused naming what disagrees (a sample index of 20000 at t = 6 ms, a next event at
+/// 1e300 s), where the unchanged state restores; an FMU state carries the clock exactly.
+#[test]
+fn an_inconsistent_sample_clock_in_a_state_is_refused() {
+    let c = C::cs();
+    c.init();
+    for n in 0..6 {
+        set_inputs(&c, &SETS[n % 3]);
+        assert_eq!(c.step(n as f64 * T, T), OK);
+    }
+    let _ = c.real(vr::DELTA); // runs the sample at 6 ms lazily
+    let bytes = c.serialized_state();
+    let guid = Controller::declaration().guid().len();
+    let at = |i: usize| 8 + 4 + 4 + guid + 8 + 8 * i;
+    let number = |b: &[u8], i: usize| f64::from_le_bytes(b[at(i)..at(i) + 8].try_into().unwrap());
+    // the layer's numbers: 1 time, 5 next event, 8 clock start, 9 period, 10 next sample
+    assert_eq!((number(&bytes, 1), number(&bytes, 10)), (6.0 * T, 6.0));
+    let g = C::cs();
+    assert_eq!(g.restore_serialized(&bytes), OK, "{}", g.last_error());
+    assert_eq!(g.real(vr::DELTA), c.real(vr::DELTA));
+    for (i, value, what) in [
+        (10, 20_000.0, "sample"),
+        (10, 2.5, "sample"),
+        (5, 1e300, "next event"),
+        (1, 0.5, "time"),
+        (8, 1e-3, "time"),
+        (9, 2e-3, "period"),
+        (11, 1.0, "before-first-sample"),
+    ] {
+        let mut b = bytes.clone();
+        b[at(i)..at(i) + 8].copy_from_slice(&f64::to_le_bytes(value));
+        let g = C::cs();
+        assert_eq!(g.restore_serialized(&b), ERR, "number {i} = {value}");
+        let e = g.last_error();
+        assert!(e.contains("fmi2DeSerializeFMUstate") && e.contains(what), "number {i} = {value}: {e}");
+    }
 }

@@ -5,9 +5,12 @@
 //! At the end of initialization the FMU computes, from `nigel-vehicle`, the reference of
 //! the chosen fidelity (the nominal open-loop run with the speed loop, 1 ms samples, for
 //! `duration` seconds) and, for the figure-8, the switching table from the nominal
-//! paper-fidelity run. Then at every sample instant `t_k = t_start + k 1 ms` (a time event;
-//! inside `fmi2DoStep` in Co-Simulation) it latches the outputs of sample `k` and holds
-//! them until `t_(k+1)`. `beta_meas` and `yaw_rate_meas` depend directly on the inputs
+//! paper-fidelity run. Then at every sample instant `t_k = t_start + k 1 ms` (the layer's
+//! sample clock, [`fmi2_export::sampled`]: a time event; inside `fmi2DoStep` in
+//! Co-Simulation) it latches the outputs of sample `k` and holds them until `t_(k+1)`. The
+//! last sample is at `t = duration`: there the simulation ends (Model Exchange
+//! `terminateSimulation`; a Co-Simulation step past it `fmi2Discard` with `fmi2Terminated`),
+//! and a stop time past it is refused. `beta_meas` and `yaw_rate_meas` depend directly on the inputs
 //! `beta` and `yaw_rate` (declared in the ModelStructure); everything else on `k` alone.
 
 // `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
@@ -17,8 +20,8 @@ use std::sync::{Arc, OnceLock};
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, EventUpdate,
-    InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
+    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext,
+    Interfaces, Model, ModelResult, SampleEnd, Start, VarDecl,
 };
 use nigel_benchmark::{
     BenchSample, BenchSampler, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
@@ -32,8 +35,8 @@ pub const MODEL_IDENTIFIER: &str = "nigel_maneuver";
 /// at initialization); `duration` above it is refused.
 pub const MAX_DURATION: f64 = 600.0;
 
-/// Samples of the longest reference.
-const MAX_SAMPLES: usize = 600_000;
+/// Slowest `speed_target` [m/s]: the reference and its speed loop need the car moving.
+pub const MIN_SPEED_TARGET: f64 = 0.01;
 
 /// What a value reference stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -207,7 +210,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
     v.push(
         VarDecl::real("speed_target", vr::SPEED_TARGET, Var::SpeedTarget)
             .parameter(Start::Real(DEFAULT_SPEED))
-            .min(0.0)
+            .min(MIN_SPEED_TARGET)
             .max(10.0)
             .unit("m/s")
             .describe("speed the reference holds and the output speed_ref gives (start speed of the reference)"),
@@ -292,65 +295,49 @@ pub struct TestBench {
     bench: Option<Arc<BenchSampler>>,
     /// The outputs of the last sample, held until the next one.
     held: BenchSample,
-    /// Samples run so far (the next sample is `k`).
-    k: u64,
-    /// Time of sample 0.
-    start_time: f64,
 }
 
 impl TestBench {
+    /// The scenario of the parameters (`duration` in whole samples; its range is declared).
     fn scenario_now(&self) -> Result<Scenario, String> {
-        let d = self.duration;
-        if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&d) {
-            return Err(format!("duration = {d} refused: must be in [1 ms, {MAX_DURATION} s]"));
-        }
-        let scenario = Scenario { n_samples: (d / SAMPLE_PERIOD).round() as usize, ..self.scenario };
+        let scenario = Scenario { n_samples: self.last_sample() as usize, ..self.scenario };
         scenario.validate().map_err(|e| e.to_string())?;
         Ok(scenario)
     }
 
-    /// The outputs an importer reads: the held sample, or before the first sample what
-    /// the initial event will latch.
-    fn outputs(&self) -> BenchSample {
-        if self.k > 0 {
-            return self.held;
-        }
-        Benchmark::initial_sample(&self.scenario, self.beta, self.yaw_rate)
+    /// The sample at `t = duration`: the reference covers samples `0 ..= last`.
+    fn last_sample(&self) -> u64 {
+        (self.duration / SAMPLE_PERIOD).round() as u64
     }
 
-    /// The value of `b` with the outputs `o`; `None` if `b` is not a Real.
+    /// The slot of Real variable `b` (`None` for the other base types).
     #[inline(always)]
-    fn value(&self, o: &BenchSample, b: Var) -> Option<f64> {
+    fn slot(&mut self, b: Var) -> Option<&mut f64> {
+        let o = &mut self.held;
         Some(match b {
-            Var::Beta => self.beta,
-            Var::YawRate => self.yaw_rate,
-            Var::SteerFeedForward(i) => o.delta_ff[i],
-            Var::BetaRef => o.beta_ref,
-            Var::YawRateRef => o.yaw_rate_ref,
-            Var::SpeedRef => o.speed_ref,
-            Var::XRef => o.x_ref,
-            Var::YRef => o.y_ref,
-            Var::PsiRef => o.psi_ref,
-            Var::Friction(i) => o.mu[i],
-            Var::WindX => o.wind_x,
-            Var::WindY => o.wind_y,
-            Var::BetaMeas => o.beta_meas,
-            Var::YawRateMeas => o.yaw_rate_meas,
-            Var::SteerAmplitude => self.scenario.steer_amplitude,
-            Var::SpeedTarget => self.scenario.speed_ref,
-            Var::Duration => self.duration,
+            Var::Beta => &mut self.beta,
+            Var::YawRate => &mut self.yaw_rate,
+            Var::SteerFeedForward(i) => &mut o.delta_ff[i],
+            Var::BetaRef => &mut o.beta_ref,
+            Var::YawRateRef => &mut o.yaw_rate_ref,
+            Var::SpeedRef => &mut o.speed_ref,
+            Var::XRef => &mut o.x_ref,
+            Var::YRef => &mut o.y_ref,
+            Var::PsiRef => &mut o.psi_ref,
+            Var::Friction(i) => &mut o.mu[i],
+            Var::WindX => &mut o.wind_x,
+            Var::WindY => &mut o.wind_y,
+            Var::BetaMeas => &mut o.beta_meas,
+            Var::YawRateMeas => &mut o.yaw_rate_meas,
+            Var::SteerAmplitude => &mut self.scenario.steer_amplitude,
+            Var::SpeedTarget => &mut self.scenario.speed_ref,
+            Var::Duration => &mut self.duration,
             _ => return None,
         })
     }
-
-    /// `get_real` off its fast path: before the first sample (what the initial event will
-    /// latch) and for a variable that is not a Real.
-    #[cold]
-    #[inline(never)]
-    fn get_real_before_first_sample(&self, b: Var) -> ModelResult<f64> {
-        self.value(&self.outputs(), b).ok_or_else(|| format!("{b:?} is not a Real").into())
-    }
 }
+
+const NOT_A_REAL: &str = "not a Real variable";
 
 impl Model for TestBench {
     type Binding = Var;
@@ -371,111 +358,57 @@ impl Model for TestBench {
             yaw_rate: 0.0,
             bench: None,
             held: Benchmark::initial_sample(&scenario, 0.0, 0.0),
-            k: 0,
-            start_time: 0.0,
         })
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
-        // an importer reads some 20 held outputs at every sample: that path is a lookup
-        if self.k > 0 {
-            if let Some(value) = self.value(&self.held, b) {
-                return Ok(value);
-            }
-        }
-        self.get_real_before_first_sample(b)
+        self.slot(b).map(|x| *x).ok_or_else(|| NOT_A_REAL.into())
     }
 
+    /// The declaration's ranges are the only checks.
     fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
-        let h = &mut self.held;
-        match b {
-            Var::Beta => self.beta = value,
-            Var::YawRate => self.yaw_rate = value,
-            // held outputs come back through here when an FMU state is restored
-            Var::SteerFeedForward(i) => h.delta_ff[i] = value,
-            Var::BetaRef => h.beta_ref = value,
-            Var::YawRateRef => h.yaw_rate_ref = value,
-            Var::SpeedRef => h.speed_ref = value,
-            Var::XRef => h.x_ref = value,
-            Var::YRef => h.y_ref = value,
-            Var::PsiRef => h.psi_ref = value,
-            Var::Friction(i) => h.mu[i] = value,
-            Var::WindX => h.wind_x = value,
-            Var::WindY => h.wind_y = value,
-            Var::BetaMeas => h.beta_meas = value,
-            Var::YawRateMeas => h.yaw_rate_meas = value,
-            Var::SteerAmplitude => {
-                if !(0.0..=core::f64::consts::FRAC_PI_2).contains(&value) {
-                    return Err(format!("steer_amplitude = {value} refused: must be in [0, pi/2] rad").into());
-                }
-                self.scenario.steer_amplitude = value;
-            }
-            Var::SpeedTarget => {
-                if !(value > 0.0 && value <= 10.0) {
-                    return Err(format!("speed_target = {value} refused: must be in (0, 10] m/s").into());
-                }
-                self.scenario.speed_ref = value;
-            }
-            Var::Duration => {
-                if !(SAMPLE_PERIOD..=MAX_DURATION).contains(&value) {
-                    return Err(format!("duration = {value} refused: must be in [1 ms, {MAX_DURATION} s]").into());
-                }
-                self.duration = value;
-            }
-            _ => return Err(format!("{b:?} is not a Real").into()),
-        }
+        *self.slot(b).ok_or(NOT_A_REAL)? = value;
         Ok(())
     }
 
-    /// The inputs have no check of their own.
     fn setter_may_refuse(b: Var) -> bool {
-        !matches!(b, Var::Beta | Var::YawRate)
+        matches!(b, Var::Maneuver | Var::Fidelity | Var::Seed)
     }
 
     fn get_integer(&mut self, b: Var) -> ModelResult<i32> {
         match b {
             Var::Maneuver => Ok(maneuver_value(self.scenario.maneuver)),
             Var::Fidelity => Ok(fidelity_value(self.scenario.fidelity)),
-            Var::Seed => Ok(self.scenario.seed as i32),
-            _ => Err(format!("{b:?} is not an Integer").into()),
+            _ => Ok(self.scenario.seed as i32),
         }
     }
 
+    /// The declared ranges (1 .. the number of items, seed >= 0) make each conversion exact.
     fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
+        let index = usize::try_from(value - 1).unwrap_or(0);
         match b {
-            Var::Maneuver => {
-                let m = usize::try_from(value - 1).ok().and_then(|i| Maneuver::ALL.get(i));
-                self.scenario.maneuver =
-                    *m.ok_or_else(|| format!("maneuver = {value} refused: not one of 1..{}", Maneuver::ALL.len()))?;
-            }
-            Var::Fidelity => {
-                let f = usize::try_from(value - 1).ok().and_then(|i| Fidelity::ALL.get(i));
-                self.scenario.fidelity = *f.ok_or_else(|| format!("fidelity = {value} refused: not one of 1..2"))?;
-            }
-            Var::Seed => {
-                self.scenario.seed =
-                    u64::try_from(value).map_err(|_| format!("seed = {value} refused: must be >= 0"))?;
-            }
-            _ => return Err(format!("{b:?} is not an Integer").into()),
+            Var::Maneuver => self.scenario.maneuver = *Maneuver::ALL.get(index).ok_or("not a maneuver")?,
+            Var::Fidelity => self.scenario.fidelity = *Fidelity::ALL.get(index).ok_or("not a fidelity")?,
+            _ => self.scenario.seed = u64::try_from(value).map_err(|_| "a seed is >= 0")?,
         }
         Ok(())
     }
 
     fn get_boolean(&mut self, b: Var) -> ModelResult<bool> {
-        match b {
-            Var::FrictionVariation => Ok(self.scenario.friction_variation),
-            Var::Wind => Ok(self.scenario.wind),
-            Var::MeasurementNoise => Ok(self.scenario.measurement_noise),
-            _ => Err(format!("{b:?} is not a Boolean").into()),
-        }
+        let s = &self.scenario;
+        Ok(match b {
+            Var::FrictionVariation => s.friction_variation,
+            Var::Wind => s.wind,
+            _ => s.measurement_noise,
+        })
     }
 
     fn set_boolean(&mut self, b: Var, value: bool) -> ModelResult {
+        let s = &mut self.scenario;
         match b {
-            Var::FrictionVariation => self.scenario.friction_variation = value,
-            Var::Wind => self.scenario.wind = value,
-            Var::MeasurementNoise => self.scenario.measurement_noise = value,
-            _ => return Err(format!("{b:?} is not a Boolean").into()),
+            Var::FrictionVariation => s.friction_variation = value,
+            Var::Wind => s.wind = value,
+            _ => s.measurement_noise = value,
         }
         Ok(())
     }
@@ -492,39 +425,22 @@ impl Model for TestBench {
         Ok(())
     }
 
-    fn event_update(&mut self, time: f64) -> ModelResult<EventUpdate> {
-        let Some(bench) = self.bench.as_ref() else {
-            return Err("the reference was not computed (initialization did not end)".into());
-        };
-        if self.k == 0 {
-            self.start_time = time;
-        }
-        let k = self.k as usize;
-        self.held = bench.sample(k, self.beta, self.yaw_rate).ok_or_else(|| {
-            format!(
-                "t = {time} s is past the benchmark's end: the reference covers {} s (parameter duration)",
-                self.duration
-            )
-        })?;
-        self.k += 1;
-        // sample instants from the start time and an integer count: no drift
-        Ok(EventUpdate::next_at(self.start_time + self.k as f64 * SAMPLE_PERIOD))
+    fn sample_period(&self) -> Option<f64> {
+        Some(SAMPLE_PERIOD)
     }
 
-    fn save_internal(&self, out: &mut Vec<f64>) {
-        out.push(self.k as f64);
-        out.push(self.start_time);
+    fn sample_end(&self) -> Option<SampleEnd> {
+        Some(SampleEnd { last: self.last_sample(), variable: "duration" })
     }
 
-    fn load_internal(&mut self, data: &[f64]) -> ModelResult {
-        let [k, start_time] = data else {
-            return Err(format!("test-bench internal data: 2 numbers expected, got {}", data.len()).into());
+    /// The outputs of sample `k`; before the reference exists (Initialization Mode) sample 0
+    /// is the benchmark's initial sample.
+    fn sample(&mut self, k: u64, _time: f64) -> ModelResult {
+        self.held = match &self.bench {
+            Some(bench) => bench.sample(k as usize, self.beta, self.yaw_rate).ok_or("past the reference's end")?,
+            None if k == 0 => Benchmark::initial_sample(&self.scenario, self.beta, self.yaw_rate),
+            None => return Err("the reference was not computed (initialization did not end)".into()),
         };
-        if !(*k >= 0.0 && k.fract() == 0.0 && *k <= MAX_SAMPLES as f64 + 1.0 && start_time.is_finite()) {
-            return Err(format!("test-bench internal data {data:?} refused").into());
-        }
-        self.k = *k as u64;
-        self.start_time = *start_time;
         Ok(())
     }
 }
@@ -533,32 +449,4 @@ impl Model for TestBench {
 fmi2_export::export_fmi2!(TestBench);
 
 /// What the test bench computes, for `documentation/index.html`.
-pub const DOCUMENTATION: &str = r#"<h2>Benchmark (docs/benchmark.md)</h2>
-<p>Samples k = 0, 1, ... at t_k = t_start + k 1 ms; every output is held over [t_k, t_k + 1 ms).
-Steering programs (front +f, rear -f), a = <code>steer_amplitude</code> (30 deg):</p>
-<p>The switches <code>maneuver</code> and <code>fidelity</code> are plain Integer parameters (not FMI
-Enumerations, so that every importer can set them): <code>maneuver</code> 1 straight, 2 lane_change, 3 skidpad,
-4 fishhook, 5 slalom, 6 figure_8; <code>fidelity</code> 1 paper (the sim column), 2 real.</p>
-<pre>
-straight     0
-lane_change  [14.8, 15.0) s: +a;  [15.0, 15.2) s: -a
-skidpad      [2.5, 27.5) s: +a
-fishhook     [2.5, 25.0) s: a (t - 2.5)/22.5;  [25.0, 27.5) s: a
-slalom       [2.5, 27.5) s: a cos(30 pi (t - 2.5)/25)
-figure_8     +-a from t = 0, the sign flipping one sample after the nominal paper-fidelity car's closest
-             approach to the origin once it has turned 3 pi/2 (first flips at samples 3144, 6267, 9390)
-</pre>
-<pre>
-mu_i   = 0.35 sin(2 pi 12 theta_k - phi_i) + 0.55 + 0.1 u(seed, i, k) - 0.05,  theta_k = 2 pi t_k / 30 s,
-         phi = (0, pi/2, pi, 3 pi/2)                       (0.4 with friction_variation off)
-wind_y = 0.25 [t_k >= 1 s] + 0.025 u(seed, 4, k)  [N, world frame]   (0 with wind off); wind_x = 0
-beta_meas     = beta     + 0.005 g(seed, 5, k)    (real fidelity with measurement_noise on; else beta)
-yaw_rate_meas = yaw_rate + 0.01  g(seed, 6, k)
-u(seed, s, k) = (mix(((seed &lt;&lt; 8) | s) + (k + 1) 0x9E3779B97F4A7C15) &gt;&gt; 11) 2^-53   (SplitMix64 finaliser)
-g(seed, s, k) = sqrt(-2 ln(1 - u(seed, s, 2k))) cos(2 pi u(seed, s, 2k + 1))
-</pre>
-<p>The reference (<code>beta_ref, yaw_rate_ref, x_ref, y_ref, psi_ref</code>) is computed at the end of
-initialization: the open-loop run (K = 0) of the chosen fidelity's plant (nigel-vehicle, RK4 with two 0.5 ms
-sub-steps per sample) from the origin at <code>speed_target</code>, with the speed PI of the controller FMU
-(kp 53.6, ki 268, |F| &lt;= 20 N), mu = 0.4, no wind, no noise, over <code>duration</code> seconds. A run may not go
-past <code>duration</code>. <code>speed_ref</code> outputs <code>speed_target</code>.</p>"#;
+pub const DOCUMENTATION: &str = include_str!("documentation.html");

@@ -18,9 +18,35 @@ use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehiclePa
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
 
-/// Largest number of RK4 sub-steps one `fmi2DoStep` may take (about 10 s of computing);
-/// a longer step is refused instead of hanging the importer.
-pub const MAX_SUBSTEPS_PER_STEP: usize = 10_000_000;
+/// The equations and the initial state, for `documentation/index.html`.
+pub const DOCUMENTATION: &str = include_str!("documentation.html");
+
+/// Largest number of RK4 sub-steps one `fmi2DoStep` may take (about 0.5 s of computing at
+/// some 0.5 us a sub-step); a longer step is refused before it starts (`fmi2Discard`)
+/// instead of keeping the importer.
+pub const MAX_SUBSTEPS_PER_STEP: usize = 1_000_000;
+
+/// The declared range of a parameter: what a 1:14 to full-size car, on Earth-like gravity,
+/// can have (the defaults are the 2.68 kg Nigel). The bounds also keep the tires'
+/// stability step, and so the work of a step, bounded.
+fn parameter_range(p: Param) -> (f64, f64) {
+    match p {
+        Param::Mass => (0.1, 5000.0),
+        Param::YawInertia => (1e-4, 1e4),
+        Param::CgToFront | Param::CgToRear => (5e-3, 5.0),
+        Param::Track => (0.01, 3.0),
+        Param::WheelRadius => (5e-3, 1.0),
+        Param::CorneringStiffness(_) => (0.1, 1e6),
+        Param::Gravity => (1.0, 30.0),
+        Param::FadeSpeed => (1e-3, 1.0),
+        Param::SteerLimit => (1e-3, std::f64::consts::FRAC_PI_2),
+        Param::ServoTimeConstant => (1e-3, 1.0),
+        Param::ServoRateMax => (0.01, 100.0),
+        Param::WheelSpeedMax => (0.01, 100.0),
+        Param::MotorTaper => (1e-3, 10.0),
+        Param::CsSubstepMax => (1e-6, 0.1),
+    }
+}
 
 /// Default upper bound of the internal RK4 sub-step in Co-Simulation [s]. The sub-step
 /// actually taken is also bounded by the tires' stability limit
@@ -358,14 +384,15 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         ),
     ];
     for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
-        let mut var = real(name, vr::PARAM + k as u32, PlantVar::Param(p))
-            .parameter(Start::Real(start))
-            .unit(unit)
-            .describe(text);
-        if p == Param::SteerLimit {
-            var = var.max(std::f64::consts::FRAC_PI_2);
-        }
-        v.push(var);
+        let (min, max) = parameter_range(p);
+        v.push(
+            real(name, vr::PARAM + k as u32, PlantVar::Param(p))
+                .parameter(Start::Real(start))
+                .unit(unit)
+                .describe(text)
+                .min(min)
+                .max(max),
+        );
     }
     let switches = [
         (
@@ -556,12 +583,8 @@ impl Model for Plant {
 
     fn set_real(&mut self, b: PlantVar, value: f64) -> ModelResult {
         match b {
-            PlantVar::Param(Param::CsSubstepMax) => {
-                if !(value > 0.0) || !value.is_finite() {
-                    return Err(format!("cs_substep_max = {value} must be finite and > 0").into());
-                }
-                self.cs_substep_max = value;
-            }
+            // its range is declared; nothing else depends on it
+            PlantVar::Param(Param::CsSubstepMax) => self.cs_substep_max = value,
             PlantVar::Param(p) => {
                 let mut candidate = self.params;
                 *param_slot(&mut candidate, p).ok_or("no such parameter")? = value;
@@ -595,12 +618,12 @@ impl Model for Plant {
     fn get_boolean(&mut self, b: PlantVar) -> ModelResult<bool> {
         match b {
             PlantVar::Switch(s) => Ok(*switch_slot(&mut self.params, s)),
-            _ => Err(format!("{b:?} is not a Boolean").into()),
+            _ => Err("not a Boolean variable".into()),
         }
     }
 
     fn set_boolean(&mut self, b: PlantVar, value: bool) -> ModelResult {
-        let PlantVar::Switch(s) = b else { return Err(format!("{b:?} is not a Boolean").into()) };
+        let PlantVar::Switch(s) = b else { return Err("not a Boolean variable".into()) };
         let mut candidate = self.params;
         *switch_slot(&mut candidate, s) = value;
         validate_all(&candidate)?;
@@ -613,9 +636,6 @@ impl Model for Plant {
         validate_all(&self.params)?;
         if let Some(i) = self.inputs.mu.iter().position(|m| !(0.0..=MU_MAX).contains(m)) {
             return Err(format!("mu_{} = {} must be in [0, {MU_MAX}]", WHEELS[i], self.inputs.mu[i]).into());
-        }
-        if !(self.cs_substep_max > 0.0 && self.cs_substep_max.is_finite()) {
-            return Err(format!("cs_substep_max = {} must be finite and > 0", self.cs_substep_max).into());
         }
         Ok(())
     }
@@ -640,6 +660,16 @@ impl Model for Plant {
         Ok(())
     }
 
+    /// The inputs and states; in Initialization Mode also the states' start values (the
+    /// states are their start values there), not the parameters.
+    fn provides_derivative_with_respect_to(known: PlantVar, initialization: bool) -> bool {
+        match known {
+            PlantVar::Input(_) | PlantVar::State(_) => true,
+            PlantVar::StateStart(_) => initialization,
+            _ => false,
+        }
+    }
+
     fn directional_derivative(
         &mut self,
         unknowns: &[PlantVar],
@@ -660,9 +690,10 @@ impl Model for Plant {
         };
         for (&k, &dv) in knowns.iter().zip(dv_known) {
             match k {
-                PlantVar::State(i) => s[i].d += dv,
+                // in Initialization Mode a state is its start value
+                PlantVar::State(i) | PlantVar::StateStart(i) => s[i].d += dv,
                 PlantVar::Input(i) => input_slot(&mut ud, i).d += dv,
-                other => return Err(format!("{other:?} is not a known (only states and inputs are)").into()),
+                _ => return Err("a known the layer let through is not a state or an input".into()),
             }
         }
         let e = evaluate(&self.params, &s, &ud);
@@ -671,9 +702,7 @@ impl Model for Plant {
                 PlantVar::Derivative(i) => e.derivatives[i].d,
                 PlantVar::Output(w) => output_of(&e, w).d,
                 PlantVar::State(i) => s[i].d,
-                other => {
-                    return Err(format!("{other:?} is not an unknown (only derivatives, outputs and states are)").into())
-                }
+                _ => return Err("an unknown the layer let through is not a derivative, output or state".into()),
             };
         }
         Ok(())

@@ -18,6 +18,26 @@
 //! **Strictness margin.** Every strict inequality `F < 0` (and `X > 0`) is imposed as
 //! `F <= -eps I` with the absolute margin [`SynthesisOptions::margin`], default
 //! `eps = 1e-7` (see [`DEFAULT_MARGIN`]).
+//!
+//! **Mirror symmetry.** The car is its own mirror image: reflecting it in its longitudinal
+//! axis swaps FL with FR and RL with RR (their friction coefficients and steering inputs) and
+//! flips the sign of every state (`beta`, `r`, and the tracking errors `e_y`, `e_psi`), of
+//! every steering angle and of the lateral disturbance force. With `T = -I` on the states,
+//! `P` the wheel swap on the inputs and `sigma` the vertex swap, the vertices satisfy
+//! `A_sigma(j) = A_j` and `B_sigma(j) = B_j P`, and the performance outputs map by the
+//! orthogonal `-P_z` (`P` on the input part of `z`). So if `(X, Y, gamma^2, Q)` satisfies
+//! every LMI, `(T X T', -P Y T', gamma^2, P_z Q P_z') = (X, P Y, gamma^2, P_z Q P_z')`
+//! satisfies them too (each LMI at vertex `j` is congruent, by an orthogonal matrix, to the
+//! same LMI at vertex `sigma(j)`, margins included), with the same objective. The LMIs are
+//! convex, so the average `(X, (Y + P Y)/2, ...)` is feasible and optimal as well: an optimum
+//! with `Y = P Y` exists, and imposing `Y = P Y` on the variables (one row of `Y` per mirror
+//! pair of wheels) loses nothing. It removes a direction in which the optimum is flat, where
+//! without it the solver's last digits (about 1e-6 in `K`) follow the BLAS kernel's rounding.
+//! `K = Y X^-1` then has equal rows for FL and FR and for RL and RR by construction.
+//! The symmetry is imposed only when [`mirror_pairs`] finds it in the vertices given
+//! (a car with different left and right tires is solved in full), it can be turned off
+//! with [`SynthesisOptions::mirror_symmetry`], and the pole-placement baseline, a feasibility
+//! problem whose answer is wherever the solver stops, keeps its full problem.
 
 use std::fmt;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -41,11 +61,14 @@ pub struct SynthesisOptions {
     pub margin: f64,
     /// Solver settings.
     pub solver: SolverSettings,
+    /// Impose the car's mirror symmetry on `Y` when the vertices have it (see the module
+    /// documentation); `false` solves over every `Y`.
+    pub mirror_symmetry: bool,
 }
 
 impl Default for SynthesisOptions {
     fn default() -> Self {
-        SynthesisOptions { margin: DEFAULT_MARGIN, solver: SolverSettings::default() }
+        SynthesisOptions { margin: DEFAULT_MARGIN, solver: SolverSettings::default(), mirror_symmetry: true }
     }
 }
 
@@ -121,6 +144,9 @@ pub struct Design {
     pub gamma: Option<f64>,
     /// Certified bound on the H2 norm `w -> z` over the polytope, if constrained.
     pub nu: Option<f64>,
+    /// Whether the mirror symmetry was imposed, so that the rows of mirror wheels of `gain`
+    /// are equal by construction.
+    pub mirror_symmetric: bool,
     /// What the solver reported.
     pub stats: SolverStats,
 }
@@ -139,7 +165,12 @@ enum HinfTerm {
 struct Built {
     problem: LmiProblem,
     x: SymVar,
-    y: MatVar,
+    /// The free rows of `Y`: one per mirror pair of inputs when the symmetry is imposed,
+    /// else one per input.
+    y_free: MatVar,
+    /// `Y = expand * y_free` (n_inputs x rows of `y_free`): a 0/1 matrix that copies each
+    /// pair's row to both of its inputs, or the identity.
+    expand: DMatrix<f64>,
     gamma_sq: Option<crate::lmi::ScalarVar>,
     q: Option<SymVar>,
 }
@@ -151,6 +182,51 @@ fn check_inputs(poly: &Polytope, region: &PoleRegion, opts: &SynthesisOptions) -
         return Err(SynthesisError::Invalid(format!("margin {} must be finite and >= 0", opts.margin)));
     }
     Ok(())
+}
+
+/// Relative tolerance of the mirror-symmetry check on the vertex matrices. They are computed
+/// by the same code from swapped friction vectors, so mirror entries agree up to the rounding
+/// of a sum of four products taken in another order (a few ulp, about 1e-15 relative); 1e-12
+/// accepts that on any machine and refuses any physical left/right difference, which is at
+/// least a part in a thousand for a real car's parameters.
+const MIRROR_TOLERANCE: f64 = 1e-12;
+
+/// The mirror pairs of the inputs, when the car's mirror symmetry maps `vertices` onto
+/// themselves (see the module documentation): for every vertex `j` there is a vertex
+/// `sigma(j)` with the left and right friction coefficients swapped, `A_sigma(j) = A_j` and
+/// `B_sigma(j) = B_j P` (`P` swaps the columns of FL and FR and of RL and RR), and the
+/// performance outputs `z = C x + D_u u` satisfy `P_z C = C` and `P_z D_u = D_u P` (`P_z`
+/// swaps the outputs that weigh mirror inputs). Returns the input index pairs `(left, right)`,
+/// or `None` when any of this fails.
+pub fn mirror_pairs(poly: &Polytope, vertices: &[Vertex]) -> Option<Vec<(usize, usize)>> {
+    let wheels = poly.spec.architecture.steered_wheels();
+    let m = wheels.len();
+    // wheel order FL, FR, RL, RR: the mirror of wheel w is w ^ 1
+    let partner: Option<Vec<usize>> = wheels.iter().map(|&w| wheels.iter().position(|&v| v == w ^ 1)).collect();
+    let partner = partner?;
+    let perm = DMatrix::from_fn(m, m, |i, j| if partner[j] == i { 1.0 } else { 0.0 });
+    let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| {
+        a.shape() == b.shape() && (a - b).amax() <= MIRROR_TOLERANCE * a.amax().max(b.amax()).max(f64::MIN_POSITIVE)
+    };
+    for v in vertices {
+        let mirrored_mu = [v.mu[1], v.mu[0], v.mu[3], v.mu[2]];
+        let image = vertices.iter().find(|u| u.mu == mirrored_mu)?;
+        if !(close(&image.a, &v.a) && close(&image.b, &(&v.b * &perm))) {
+            return None;
+        }
+    }
+    let (c, d_u) = (poly.c(), poly.d_u());
+    let nz = c.nrows();
+    if nz < m {
+        return None;
+    }
+    // P_z: the identity on the state part of z, P on its last m rows (the weighted inputs)
+    let mut perm_z = DMatrix::identity(nz, nz);
+    perm_z.view_mut((nz - m, nz - m), (m, m)).copy_from(&perm);
+    if !(close(&(&perm_z * &c), &c) && close(&(&perm_z * &d_u), &(&d_u * &perm))) {
+        return None;
+    }
+    Some((0..m).filter(|&i| i < partner[i]).map(|i| (i, partner[i])).collect())
 }
 
 /// `L ⊗ X + M ⊗ N + M' ⊗ N'` for one region part.
@@ -172,9 +248,21 @@ fn build(
     let (n, m, nz) = (poly.n_states(), poly.n_inputs(), poly.n_outputs());
     let mut p = LmiProblem::new();
     let x = p.symmetric(n);
-    let y = p.full(m, n);
+    let pairs = if opts.mirror_symmetry { mirror_pairs(poly, vertices) } else { None };
+    let expand = match &pairs {
+        Some(pairs) => {
+            let mut e = DMatrix::zeros(m, pairs.len());
+            for (row, &(left, right)) in pairs.iter().enumerate() {
+                e[(left, row)] = 1.0;
+                e[(right, row)] = 1.0;
+            }
+            e
+        }
+        None => DMatrix::identity(m, m),
+    };
+    let y_free = p.full(expand.ncols(), n);
     let xe = x.expr();
-    let ye = y.expr();
+    let ye = y_free.expr().premul(&expand);
     p.positive_definite("X > 0", xe.clone(), eps)?;
     let bw = AffineExpr::constant(poly.bw.clone());
     let nw = poly.bw.ncols();
@@ -219,18 +307,26 @@ fn build(
     } else {
         None
     };
-    Ok(Built { problem: p, x, y, gamma_sq, q })
+    Ok(Built { problem: p, x, y_free, expand, gamma_sq, q })
 }
 
+/// `K = Y X^-1`, computed as `expand (Y_free X^-1)` so that mirror rows are equal bit for bit.
 fn extract(built: &Built, sol: &crate::lmi::LmiSolution) -> Result<(DMatrix<f64>, DMatrix<f64>), SynthesisError> {
     let x = sol.sym(built.x);
-    let y = sol.mat(built.y);
+    let y_free = sol.mat(built.y_free);
     let xinv = x.clone().try_inverse().ok_or(SynthesisError::SingularLyapunov)?;
-    let k = &y * xinv;
+    // a 0/1 matrix with one 1 per row times a finite matrix copies rows exactly (1 a + 0 b = a)
+    let k = &built.expand * (&y_free * xinv);
     if !k.iter().all(|v| v.is_finite()) {
         return Err(SynthesisError::SingularLyapunov);
     }
     Ok((k, x))
+}
+
+impl Built {
+    fn mirror_symmetric(&self) -> bool {
+        self.expand.ncols() < self.expand.nrows()
+    }
 }
 
 /// `gamma* = min gamma` subject to D-stability and the H-inf LMIs at every vertex.
@@ -242,7 +338,7 @@ pub fn min_hinf(poly: &Polytope, region: &PoleRegion, opts: &SynthesisOptions) -
     let sol = b.problem.solve(&opts.solver)?;
     let (gain, lyapunov) = extract(&b, &sol)?;
     let gamma = sol.scalar(s).max(0.0).sqrt();
-    Ok(Design { gain, lyapunov, gamma: Some(gamma), nu: None, stats: sol.stats })
+    Ok(Design { gain, lyapunov, gamma: Some(gamma), nu: None, mirror_symmetric: b.mirror_symmetric(), stats: sol.stats })
 }
 
 /// `min nu` subject to D-stability, the H2 LMIs and, if `hinf_bound` is given, the H-inf
@@ -266,7 +362,7 @@ pub fn min_h2(
     let sol = b.problem.solve(&opts.solver)?;
     let (gain, lyapunov) = extract(&b, &sol)?;
     let nu = sol.eval(&q.expr().trace())[(0, 0)].max(0.0).sqrt();
-    Ok(Design { gain, lyapunov, gamma: hinf_bound, nu: Some(nu), stats: sol.stats })
+    Ok(Design { gain, lyapunov, gamma: hinf_bound, nu: Some(nu), mirror_symmetric: b.mirror_symmetric(), stats: sol.stats })
 }
 
 /// `min a gamma^2 + b nu^2` subject to D-stability, the H-inf and the H2 LMIs.
@@ -294,7 +390,14 @@ pub fn weighted(
     let (gain, lyapunov) = extract(&b, &sol)?;
     let gamma = sol.scalar(s).max(0.0).sqrt();
     let nu = sol.eval(&q.expr().trace())[(0, 0)].max(0.0).sqrt();
-    Ok(Design { gain, lyapunov, gamma: Some(gamma), nu: Some(nu), stats: sol.stats })
+    Ok(Design {
+        gain,
+        lyapunov,
+        gamma: Some(gamma),
+        nu: Some(nu),
+        mirror_symmetric: b.mirror_symmetric(),
+        stats: sol.stats,
+    })
 }
 
 /// The grid of the authors' Pareto sweep.
@@ -524,7 +627,11 @@ pub fn pole_placement_baseline(
     let region = PoleRegion { parts: vec![Region::half_plane(alpha)] };
     region.validate()?;
     let nominal = poly.at([mu_nominal; 4]);
-    let mut b = build(poly, std::slice::from_ref(&nominal), &region, HinfTerm::None, false, opts)?;
+    // A feasibility problem: its answer is the solver's interior point, not an optimum, so
+    // restricting the variables would move it; the full problem is kept (the symmetric data
+    // give mirror rows equal to the last bit on every OpenBLAS kernel measured).
+    let full = SynthesisOptions { mirror_symmetry: false, ..opts.clone() };
+    let mut b = build(poly, std::slice::from_ref(&nominal), &region, HinfTerm::None, false, &full)?;
     let n = poly.n_states();
     b.problem.positive_definite("X >= I", &b.x.expr() - &AffineExpr::identity(n, 1.0), 0.0)?;
     let sol = b.problem.solve(&opts.solver)?;
@@ -535,7 +642,7 @@ pub fn pole_placement_baseline(
         .map(|v| crate::verify::ClosedLoop::new(v, &poly.bw, &gain).max_real_part())
         .fold(f64::NEG_INFINITY, f64::max);
     Ok(Baseline {
-        design: Design { gain, lyapunov, gamma: None, nu: None, stats: sol.stats },
+        design: Design { gain, lyapunov, gamma: None, nu: None, mirror_symmetric: b.mirror_symmetric(), stats: sol.stats },
         mu_nominal,
         alpha,
         max_real_part_over_vertices: max_re,

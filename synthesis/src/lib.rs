@@ -12,7 +12,7 @@
 //! * [`verify`]: closed-loop poles, H-inf and H2 norms computed from `K` alone, two ways each.
 //! * [`report`]: the serialisable summary the `synthesize` CLI prints and writes.
 //! * [`plot`]: the SVG figure (Pareto curve and pole map).
-//! * [`tracking`]: the robust path-tracking design (issue 9) on the 4-state tracking error
+//! * [`tracking`]: the robust path-tracking design on the 4-state tracking error
 //!   model of [`nigel_vehicle::tracking`], and its linear closed-loop study.
 //!
 //! Conventions: `gamma` is always the bound on the induced L2 gain (not its square);
@@ -33,7 +33,7 @@ pub mod tracking;
 pub mod verify;
 
 pub use design::{
-    min_h2, min_hinf, pareto_sweep, pole_placement_baseline, weighted, Baseline, Design, ParetoPoint, ParetoSweep,
+    min_h2, min_hinf, mirror_pairs, pareto_sweep, pole_placement_baseline, weighted, Baseline, Design, ParetoPoint, ParetoSweep,
     SweepOptions, SweepProgress, SynthesisError, SynthesisOptions, DEFAULT_MARGIN,
 };
 pub use lmi::{SolveError, SolverSettings, SolverStats};

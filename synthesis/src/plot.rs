@@ -1,5 +1,8 @@
 //! A hand-written SVG figure of a [`SynthesisReport`]: the Pareto curve with the chosen
-//! point (left) and the closed-loop poles of the 16 vertices with the pole region (right).
+//! point (left), the closed-loop poles of the 16 vertices with the pole region (middle), and
+//! the same region zoomed to the origin, where its half-plane boundary (`Re(s) < -0.1` in the
+//! paper) and the sector's apex are (right). [`render_png`] rasterises the SVG with the
+//! bundled DejaVu Sans (no system font needed).
 
 use std::fmt::Write as _;
 
@@ -7,8 +10,8 @@ use crate::region::Region;
 use crate::report::{ChosenPoint, ParetoEntry, PlantReport, SynthesisReport, TrackingReport, VerificationSummary};
 use crate::verify::PointCheck;
 
-const W: f64 = 1100.0;
-const H: f64 = 480.0;
+const W: f64 = 1560.0;
+const H: f64 = 540.0;
 
 struct Frame {
     x0: f64,
@@ -48,6 +51,8 @@ fn nice_step(range: f64, target: usize) -> f64 {
 
 fn fmt_tick(v: f64, step: f64) -> String {
     let digits = (-step.log10().floor()).max(0.0) as usize;
+    // a tick that rounds to zero is "0", never "-0.0"
+    let v = if v.abs() < 0.5 * step { 0.0 } else { v };
     format!("{v:.digits$}")
 }
 
@@ -208,7 +213,7 @@ fn render(r: &PlotView) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif">"##
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="DejaVu Sans, sans-serif">"##
     );
     let _ = writeln!(s, r##"<rect width="{W}" height="{H}" fill="#fafafa"/>"##);
     let _ = writeln!(
@@ -237,7 +242,7 @@ fn render(r: &PlotView) -> String {
         }
     }
     let all: Vec<(f64, f64)> = pts.iter().copied().chain(chosen).chain(refs.iter().map(|r| (r.0, r.1))).collect();
-    let left = Frame { x0: 80.0, y0: 60.0, w: 420.0, h: 360.0, xmin: 0.0, xmax: 1.0, ymin: 0.0, ymax: 1.0 };
+    let left = Frame { x0: 80.0, y0: 60.0, w: 400.0, h: 380.0, xmin: 0.0, xmax: 1.0, ymin: 0.0, ymax: 1.0 };
     if all.is_empty() {
         axes(&mut s, &left, "Pareto curve (not computed for this objective)", "g (H-inf bound)", "nu (H2 bound)");
     } else {
@@ -248,7 +253,7 @@ fn render(r: &PlotView) -> String {
         let padx = ((gmax - gmin) * 0.06).max(0.01);
         let pady = ((nmax - nmin) * 0.06).max(0.01);
         let f = Frame { xmin: gmin - padx, xmax: gmax + padx, ymin: nmin - pady, ymax: nmax + pady, ..left };
-        axes(&mut s, &f, "Pareto curve: min nu subject to gamma ≤ g", "g (bound on the L2 gain)", "nu (H2 bound)");
+        axes(&mut s, &f, "Pareto curve: min nu subject to gamma ≤ g", "g (bound on the L2 gain from F_w to z)", "nu (H2 bound)");
         if let Some(gs) = r.gamma_star {
             if gs >= f.xmin && gs <= f.xmax {
                 let x = f.px(gs);
@@ -274,13 +279,15 @@ fn render(r: &PlotView) -> String {
             let _ = writeln!(s, r##"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="#1f77b4"/>"##, f.px(p.0), f.py(p.1));
         }
         for (g, nu, label) in &refs {
+            // the label on the side of the marker with room for it, inside the axes
+            // below and right of the marker: under the falling curve, inside the axes
+            let (x, anchor) = if f.x0 + f.w - f.px(*g) > 140.0 { (f.px(*g) + 6.0, "start") } else { (f.px(*g) - 6.0, "end") };
+            let y = (f.py(*nu) + 34.0).min(f.y0 + f.h - 6.0);
             let _ = writeln!(
                 s,
-                r##"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="none" stroke="#2ca02c" stroke-width="1.5"/><text x="{:.1}" y="{:.1}" font-size="11" fill="#2ca02c" text-anchor="end">{label}</text>"##,
+                r##"<rect x="{:.1}" y="{:.1}" width="9" height="9" fill="none" stroke="#2ca02c" stroke-width="1.5"/><text x="{x:.1}" y="{y:.1}" font-size="11" fill="#2ca02c" text-anchor="{anchor}">{label}</text>"##,
                 f.px(*g) - 4.5,
                 f.py(*nu) - 4.5,
-                f.px(*g) - 8.0,
-                f.py(*nu) + 20.0
             );
         }
         if let Some((g, nu)) = chosen {
@@ -288,13 +295,14 @@ fn render(r: &PlotView) -> String {
                 Some(k) => format!("chosen k = {k}: ({g:.4}, {nu:.4})"),
                 None => format!("design ({g:.4}, {nu:.4})"),
             };
+            let (x, anchor) =
+                if f.x0 + f.w - f.px(g) > 200.0 { (f.px(g) + 10.0, "start") } else { (f.px(g) - 10.0, "end") };
+            let y = (f.py(nu) - 22.0).max(f.y0 + 14.0);
             let _ = writeln!(
                 s,
-                r##"<circle cx="{:.1}" cy="{:.1}" r="6" fill="none" stroke="#d62728" stroke-width="2"/><text x="{:.1}" y="{:.1}" font-size="12" fill="#d62728">{label}</text>"##,
+                r##"<circle cx="{:.1}" cy="{:.1}" r="6" fill="none" stroke="#d62728" stroke-width="2"/><text x="{x:.1}" y="{y:.1}" font-size="12" fill="#d62728" text-anchor="{anchor}">{label}</text>"##,
                 f.px(g),
                 f.py(nu),
-                f.px(g) + 10.0,
-                f.py(nu) - 22.0
             );
         }
     }
@@ -321,10 +329,77 @@ fn render(r: &PlotView) -> String {
     xmin -= 0.08 * span;
     xmax += 0.12 * span;
     let yabs = yabs.max(0.45 * (xmax - xmin)) * 1.05;
-    let f = Frame { x0: 600.0, y0: 60.0, w: 460.0, h: 360.0, xmin, xmax, ymin: -yabs, ymax: yabs };
-    axes(&mut s, &f, "Closed-loop poles at the 16 vertices", "Re(s)", "Im(s)");
-    let region_poly = region_polygon(r.region, &f);
-    if region_poly.len() >= 3 && !r.region.is_empty() {
+    let f = Frame { x0: 590.0, y0: 60.0, w: 420.0, h: 380.0, xmin, xmax, ymin: -yabs, ymax: yabs };
+    pole_panel(&mut s, &f, "Closed-loop poles at the 16 vertices", &poles, r.region);
+    // the zoom: the half-plane boundary and the sector's apex, at a scale where they show
+    let alpha = r.region.iter().find_map(|p| if let Region::HalfPlane { alpha } = p { Some(*alpha) } else { None });
+    let reach = alpha.map_or(1.0, |a| (12.0 * a.abs()).max(0.5));
+    let zoom = Frame {
+        x0: 1100.0,
+        y0: 60.0,
+        w: 420.0,
+        h: 380.0,
+        xmin: -reach,
+        xmax: 0.25 * reach,
+        ymin: -0.45 * reach * 380.0 / 420.0 * 1.25,
+        ymax: 0.45 * reach * 380.0 / 420.0 * 1.25,
+    };
+    pole_panel(&mut s, &zoom, "The region near the origin (zoom)", &poles, r.region);
+    if let Some(a) = alpha {
+        let x = zoom.px(a);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#2ca02c" stroke-width="2" stroke-dasharray="6 3"/><text x="{:.1}" y="{:.1}" font-size="12" fill="#2ca02c" text-anchor="end">Re(s) = {a} 1/s</text>"##,
+            zoom.y0,
+            zoom.y0 + zoom.h,
+            x - 5.0,
+            zoom.y0 + 18.0
+        );
+    }
+    let nearest = poles.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max);
+    let in_view = poles.iter().filter(|p| p[0] >= zoom.xmin && p[1].abs() <= zoom.ymax).count();
+    let note = if in_view == 0 && nearest.is_finite() {
+        format!("no pole in this view: the slowest is at Re(s) = {nearest:.2} 1/s")
+    } else {
+        format!("{in_view} poles in this view; the slowest at Re(s) = {nearest:.2} 1/s")
+    };
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.1}" y="{:.1}" font-size="11" fill="#333">{}</text>"##,
+        zoom.x0 + 8.0,
+        zoom.y0 + zoom.h - 10.0,
+        xml_escape(&note)
+    );
+    // legend under the axes, clear of the data
+    let legend =
+        if r.region.is_empty() { "no pole region".to_string() } else { format!("region: {}", r.region_description) };
+    let ly = f.y0 + f.h + 62.0;
+    let _ = writeln!(
+        s,
+        r##"<rect x="{:.1}" y="{:.1}" width="16" height="10" fill="#2ca02c" fill-opacity="0.13" stroke="#2ca02c"/><text x="{:.1}" y="{:.1}" font-size="12" fill="#2ca02c">{} (shaded)</text>"##,
+        f.x0,
+        ly - 9.0,
+        f.x0 + 22.0,
+        ly,
+        xml_escape(&legend),
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.1}" y="{:.1}" font-size="12" fill="#d62728">x closed-loop poles of the 16 friction vertices (worst distance inside the region {:.3} 1/s)</text>"##,
+        f.x0,
+        ly + 18.0,
+        r.verification.worst_region_margin
+    );
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// One pole map: the region shaded, the axes through the origin, the poles as crosses
+/// (those outside the view left out).
+fn pole_panel(s: &mut String, f: &Frame, title: &str, poles: &[[f64; 2]], region: &[Region]) {
+    axes(s, f, title, "Re(s) [1/s]", "Im(s) [rad/s]");
+    let region_poly = region_polygon(region, f);
+    if region_poly.len() >= 3 && !region.is_empty() {
         let pts: Vec<String> = region_poly.iter().map(|p| format!("{:.1},{:.1}", f.px(p.0), f.py(p.1))).collect();
         let _ = writeln!(
             s,
@@ -332,7 +407,6 @@ fn render(r: &PlotView) -> String {
             pts.join(" ")
         );
     }
-    // axes through the origin
     if f.xmin < 0.0 && f.xmax > 0.0 {
         let _ = writeln!(
             s,
@@ -342,14 +416,8 @@ fn render(r: &PlotView) -> String {
             f.y0 + f.h
         );
     }
-    let _ = writeln!(
-        s,
-        r##"<line x1="{0:.1}" y1="{1:.1}" x2="{2:.1}" y2="{1:.1}" stroke="#555"/>"##,
-        f.x0,
-        f.py(0.0),
-        f.x0 + f.w
-    );
-    for p in &poles {
+    let _ = writeln!(s, r##"<line x1="{0:.1}" y1="{1:.1}" x2="{2:.1}" y2="{1:.1}" stroke="#555"/>"##, f.x0, f.py(0.0), f.x0 + f.w);
+    for p in poles.iter().filter(|p| p[0] >= f.xmin && p[0] <= f.xmax && p[1] >= f.ymin && p[1] <= f.ymax) {
         let (x, y) = (f.px(p[0]), f.py(p[1]));
         let _ = writeln!(
             s,
@@ -364,23 +432,20 @@ fn render(r: &PlotView) -> String {
             y - 4.0
         );
     }
-    let legend =
-        if r.region.is_empty() { "no pole region".to_string() } else { format!("region: {}", r.region_description) };
-    let _ = writeln!(
-        s,
-        r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="36" fill="white" fill-opacity="0.85"/><text x="{:.1}" y="{:.1}" font-size="11" fill="#2ca02c">{}</text><text x="{:.1}" y="{:.1}" font-size="11" fill="#d62728">x closed-loop poles (worst margin {:.3})</text>"##,
-        f.x0 + 1.0,
-        f.y0 + 1.0,
-        ((legend.len().max(40) as f64) * 6.2 + 10.0).min(f.w - 2.0),
-        f.x0 + 6.0,
-        f.y0 + 16.0,
-        xml_escape(&legend),
-        f.x0 + 6.0,
-        f.y0 + 32.0,
-        r.verification.worst_region_margin
-    );
-    let _ = writeln!(s, "</svg>");
-    s
+}
+
+static FONT: &[u8] = include_bytes!("../../table3/assets/DejaVuSans.ttf");
+
+/// Rasterises an SVG of this module to PNG (`scale` pixels per SVG unit), with the bundled
+/// DejaVu Sans as the only font, so the PNG looks the same on every machine.
+pub fn render_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
+    let mut options = resvg::usvg::Options { font_family: "DejaVu Sans".into(), ..Default::default() };
+    options.fontdb_mut().load_font_data(FONT.to_vec());
+    let tree = resvg::usvg::Tree::from_str(svg, &options).map_err(|e| format!("SVG: {e}"))?;
+    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty figure")?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("figure too large")?;
+    resvg::render(&tree, resvg::tiny_skia::Transform::from_scale(scale, scale), &mut pixmap.as_mut());
+    pixmap.encode_png().map_err(|e| format!("PNG: {e}"))
 }
 
 fn xml_escape(s: &str) -> String {

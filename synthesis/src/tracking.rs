@@ -1,4 +1,4 @@
-//! The robust tracking design (issue 9): mixed H2/H-inf state feedback with D-stability on
+//! The robust tracking design: mixed H2/H-inf state feedback with D-stability on
 //! the tracking error model, over the same 16-vertex friction polytope as the paper's design.
 //!
 //! # Model

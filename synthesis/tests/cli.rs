@@ -94,9 +94,16 @@ fn paper_pareto_json_and_plot() {
     assert_eq!(r["plant"]["d2"], "paper");
     assert_eq!(r["region"].as_array().unwrap().len(), 2);
 
+    let png = std::fs::read(svg.with_extension("png")).unwrap();
     let svg = std::fs::read_to_string(&svg).unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.contains("<polyline") && svg.contains("chosen k = ") && svg.contains("<polygon"));
+    // the zoom shows the half-plane boundary; the axes carry units
+    assert!(svg.contains("Re(s) = -0.1 1/s") && svg.contains("Re(s) [1/s]") && svg.contains("Im(s) [rad/s]"));
+    // the PNG next to it: 2 pixels per SVG unit (the IHDR chunk's width and height)
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let (w, h) = (u32::from_be_bytes(png[16..20].try_into().unwrap()), u32::from_be_bytes(png[20..24].try_into().unwrap()));
+    assert_eq!((w, h), (3120, 1080));
     let _ = std::fs::remove_file(json);
 }
 

@@ -1,4 +1,4 @@
-//! The robust tracking design (issue 9): the design model against the vehicle crate's
+//! The robust tracking design: the design model against the vehicle crate's
 //! linearization, the synthesized gain verified without trusting the solver, the sign
 //! conventions on the nonlinear car, and the CLI's JSON.
 
@@ -248,7 +248,13 @@ fn the_baked_tracking_gain_equals_this_fresh_synthesis() {
     let fresh = design().k_track;
     let worst = (0..4).flat_map(|i| (0..4).map(move |j| (i, j))).map(|(i, j)| (fresh[i][j] - baked[i][j]).abs());
     let worst = worst.fold(0.0f64, f64::max);
-    assert!(worst <= 1e-9, "K_track differs from the synthesis by {worst:e}: run bake-gains\n{fresh:?}");
-    // the figures of notes/issue9.md and the README, to 4 decimals
-    assert!((baked[0][0] - -5.2723).abs() < 5e-5 && (baked[2][1] - 0.7945).abs() < 5e-5, "{baked:?}");
+    // The tracking LMIs are scaled up by the output weights (50 /m, 10 /rad), so clarabel's
+    // 1e-8 feasibility residual, relative to the data's norm, leaves gamma* reproducible only
+    // to about 1.1e-6 (relative) from kernel to kernel, and the chosen grid point
+    // g = 1.6 gamma* moves with it. With the mirror symmetry imposed, K_track differs between
+    // OPENBLAS_CORETYPE Haswell (= Zen), Sandybridge and SkylakeX by at most 2.0e-6; 2e-5 is
+    // 10 times that and 4 orders below the gain's change to the next grid point (0.15).
+    assert!(worst <= 2e-5, "K_track differs from the synthesis by {worst:e}: run bake-gains\n{fresh:?}");
+    // the README's figures, to 4 decimals
+    assert!((baked[0][0] - -5.2724).abs() < 5e-5 && (baked[2][1] - 0.7945).abs() < 5e-5, "{baked:?}");
 }

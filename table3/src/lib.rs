@@ -12,10 +12,10 @@
 //!   paper's Table III for comparison.
 //! * [`report`]: the markdown table and the JSON of the contract; [`csv`] and [`plot`]
 //!   (the Fig. 7 PNGs) write the recorded runs.
-//! * [`study`]: several seeds, `robust_tracking` against `robust` cell by cell (issue 9).
+//! * [`study`]: several seeds, `robust_tracking` against `robust` cell by cell.
 //!
 //! Beyond the paper's three controllers, every table has a fourth column,
-//! `robust_tracking` (issue 9): the robust path-tracking gain with pose feedback and the
+//! `robust_tracking`: the robust path-tracking gain with pose feedback and the
 //! along-track speed correction (`nigel_benchmark::control`).
 //!
 //! ```no_run
@@ -47,7 +47,7 @@ pub use table::{run_table, run_table_with, Cell, Options, Table, TableRun};
 pub use nigel_benchmark::{Controller, Fidelity, Maneuver};
 
 /// The controllers of our Table III in its column order: the paper's three and, beyond
-/// the paper (issue 9), `robust_tracking`.
+/// the paper, `robust_tracking`.
 pub const CONTROLLERS: [Controller; 4] = Controller::WITH_TRACKING;
 
 /// `open_loop`, `pole_placement`, `robust`, `robust_tracking` (the JSON and FMU names).

@@ -1,7 +1,7 @@
-//! The paper's Fig. 7 as PNG: per column, the XY paths of the reference and the three
+//! The paper's Fig. 7 as PNG: per column, the XY paths of the reference and the
 //! controllers for every maneuver (`fig7_sim.png`, `fig7_real.png`), and per column and
 //! maneuver the time plots of beta, yaw rate, the front-left and rear-left steering
-//! commands and the friction (`time_sim_skidpad.png`, ...). Text is drawn with the bundled
+//! commands per controller, and the friction (`time_sim_skidpad.png`, ...). Text is drawn with the bundled
 //! DejaVu Sans (no system font needed).
 
 use std::path::{Path, PathBuf};
@@ -27,7 +27,6 @@ fn register_font() -> Result<(), String> {
 /// Points kept per series: every `STRIDE`-th sample (10 ms; 3001 points for 30 s).
 pub const STRIDE: usize = 10;
 
-const REFERENCE: RGBColor = RGBColor(0, 0, 0);
 const WHEEL_COLORS: [RGBColor; 4] =
     [RGBColor(213, 94, 0), RGBColor(0, 114, 178), RGBColor(0, 158, 115), RGBColor(204, 121, 167)];
 
@@ -86,8 +85,27 @@ fn sampled(n: usize) -> impl Iterator<Item = usize> + Clone {
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
-/// Draws one XY panel: equal scale on both axes unless that would squash the paths to a
-/// line (straight, lane change, slalom), then Y is stretched and the caption says so.
+/// The reference band: wide and light, drawn first, so that a controller on the reference
+/// (robust tracking) stays visible on top of it.
+const REFERENCE_BAND: RGBColor = RGBColor(210, 210, 210);
+/// Degrees per radian (the time plots show angles in degrees).
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+/// Seconds between the direction arrows on the reference.
+const ARROW_EVERY: f64 = 5.0;
+
+/// What the reference is, for the captions.
+const REFERENCE_CAPTION: &str =
+    "reference (grey band): the open-loop run of the same plant and program without disturbances (mu = 0.4, no wind, no noise)";
+
+/// The last sample's time [s]: the axis end of every time plot.
+fn duration(run: &Run) -> f64 {
+    Run::time(run.n_samples())
+}
+
+/// Draws one XY panel. Equal scale on both axes unless that would leave most of the panel
+/// empty (straight, lane change, slalom): then Y is stretched and the caption says so. The
+/// reference is a grey band under the paths, with a start marker and arrows every 5 s in the
+/// direction of travel.
 fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Result<(), Error> {
     let err = plot_err(path);
     let Some(first) = runs.first() else { return Ok(()) };
@@ -99,14 +117,14 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
     let (w, h) = area.dim_in_pixel();
     let (pw, ph) = ((w as f64 - 75.0).max(10.0), (h as f64 - 80.0).max(10.0));
     let (sx, sy) = ((x1 - x0) / pw, (y1 - y0) / ph);
-    let equal = sx.max(sy) / sx.min(sy) < 6.0;
+    let equal = sx.max(sy) / sx.min(sy) < 1.85;
     if equal {
         let scale = sx.max(sy);
         let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
         (x0, x1) = (cx - scale * pw / 2.0, cx + scale * pw / 2.0);
         (y0, y1) = (cy - scale * ph / 2.0, cy + scale * ph / 2.0);
     }
-    let caption = if equal { maneuver.name().to_string() } else { format!("{} (axes not to scale)", maneuver.name()) };
+    let caption = if equal { maneuver.name().to_string() } else { format!("{} (Y stretched: axes not to scale)", maneuver.name()) };
     let mut chart = ChartBuilder::on(area)
         .caption(caption, ("sans-serif", 22))
         .margin(8)
@@ -125,18 +143,52 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
         .y_label_formatter(&tick)
         .draw()
         .map_err(&err)?;
-    for r in runs {
-        let c = color(r.job.controller);
-        chart.draw_series(LineSeries::new(sampled(n).map(|k| (r.x[k], r.y[k])), c.stroke_width(2))).map_err(&err)?;
-    }
     chart
-        .draw_series(DashedLineSeries::new(
+        .draw_series(LineSeries::new(
             sampled(n).map(|k| (first.x_ref[k], first.y_ref[k])),
-            6,
-            4,
-            REFERENCE.stroke_width(2),
+            REFERENCE_BAND.stroke_width(7),
         ))
         .map_err(&err)?;
+    for r in runs {
+        let c = color(r.job.controller);
+                chart.draw_series(LineSeries::new(sampled(n).map(|k| (r.x[k], r.y[k])), c.stroke_width(2))).map_err(&err)?;
+    }
+    // direction of travel on the reference: a filled triangle every ARROW_EVERY seconds,
+    // pointing along the reference heading (drawn in pixels, so it keeps its shape on
+    // stretched axes)
+    let every = (ARROW_EVERY / Run::time(1)).round() as usize;
+    let to_px = |x: f64, y: f64| chart.backend_coord(&(x, y));
+    let (c00, c11) = (to_px(x0, y0), to_px(x1, y1));
+    let px_per_m = ((c11.0 - c00.0) as f64 / (x1 - x0), (c11.1 - c00.1) as f64 / (y1 - y0));
+    let mut arrows = Vec::new();
+    for k in (every..n).step_by(every) {
+        // the heading psi_ref mapped through the (linear) axes: pixels per metre from the
+        // corners (points outside the axes would be clamped)
+        let h = first.psi_ref[k];
+        let (dx, dy) = (h.cos() * px_per_m.0, h.sin() * px_per_m.1);
+        let len = dx.hypot(dy);
+        if len < 1e-9 {
+            continue;
+        }
+        let (ux, uy) = (dx / len, dy / len);
+        let tip = to_px(first.x_ref[k], first.y_ref[k]);
+        let (tx, ty) = (tip.0 as f64 + 7.0 * ux, tip.1 as f64 + 7.0 * uy);
+        let back = (tx - 14.0 * ux, ty - 14.0 * uy);
+        let p = |sx: f64| ((back.0 - sx * 6.0 * uy) as i32, (back.1 + sx * 6.0 * ux) as i32);
+        arrows.push(vec![(tx as i32, ty as i32), p(1.0), p(-1.0)]);
+    }
+    let start = to_px(first.x_ref[0], first.y_ref[0]);
+    let plot_area = chart.plotting_area().strip_coord_spec();
+    // backend_coord is in the whole image's pixels, the plotting area draws in its own
+    let base = plot_area.get_base_pixel();
+    let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+    let start = local(start);
+    let arrows: Vec<Vec<(i32, i32)>> = arrows.into_iter().map(|a| a.into_iter().map(local).collect()).collect();
+    for a in arrows {
+        plot_area.draw(&Polygon::new(a, BLACK.filled())).map_err(&err)?;
+    }
+    plot_area.draw(&Circle::new(start, 6, BLACK.filled())).map_err(&err)?;
+    plot_area.draw(&Circle::new(start, 3, WHITE.filled())).map_err(&err)?;
     Ok(())
 }
 
@@ -149,17 +201,26 @@ pub fn xy_figure(runs: &[Run], fidelity: Fidelity, path: &Path) -> Result<(), Er
         .filter(|m| runs.iter().any(|r| r.job.fidelity == fidelity && r.job.maneuver == *m))
         .collect();
     let (rows, cols) = if maneuvers.len() <= 3 { (1, maneuvers.len().max(1)) } else { (2, 3) };
-    let root = BitMapBackend::new(path, (1800, 90 + 555 * rows as u32)).into_drawing_area();
+    let root = BitMapBackend::new(path, (1800, 150 + 555 * rows as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(&err)?;
     let title = format!(
-        "Fig. 7 ({} column, seed {}): paths of the reference and the controllers",
+        "Fig. 7 ({} column, seed {}): paths X, Y of the car's centre of gravity under each controller",
         fidelity.column(),
         runs.first().map_or(0, |r| r.job.seed)
     );
     let root = root.titled(&title, ("sans-serif", 28)).map_err(&err)?;
-    let (top, body) = root.split_vertically(36);
+    let (top, body) = root.split_vertically(96);
+    let (legend, notes) = top.split_vertically(36);
     let column: Vec<&Run> = runs.iter().filter(|r| r.job.fidelity == fidelity).collect();
-    legend_strip(&top, &controller_legend(&column), path)?;
+    legend_strip(&legend, &controller_legend(&column), path)?;
+    caption_lines(
+        &notes,
+        &[
+            REFERENCE_CAPTION,
+            "ring: start at the origin; triangles: direction of travel on the reference, every 5 s; 30 s per run, the same disturbances for every controller",
+        ],
+        path,
+    )?;
     let panels = body.split_evenly((rows, cols));
     for (panel, &m) in panels.iter().zip(&maneuvers) {
         let rs = runs_of(runs, fidelity, m);
@@ -169,14 +230,30 @@ pub fn xy_figure(runs: &[Run], fidelity: Fidelity, path: &Path) -> Result<(), Er
     Ok(())
 }
 
+/// Centered lines of caption text.
+fn caption_lines(area: &Area, lines: &[&str], path: &Path) -> Result<(), Error> {
+    let err = plot_err(path);
+    let (w, h) = area.dim_in_pixel();
+    let style = TextStyle::from(("sans-serif", 16).into_font());
+    let step = h as i32 / lines.len().max(1) as i32;
+    for (i, line) in lines.iter().enumerate() {
+        let tw = area.estimate_text_size(line, &style).map_or(8 * line.len() as i32, |s| s.0 as i32);
+        area.draw(&Text::new(line.to_string(), ((w as i32 - tw).max(0) / 2, i as i32 * step + 2), style.clone()))
+            .map_err(&err)?;
+    }
+    Ok(())
+}
+
 struct Series {
     label: String,
     color: RGBColor,
-    dashed: bool,
+    /// Line width in pixels.
+    width: u32,
     points: Vec<(f64, f64)>,
 }
 
-/// A legend row across the top of a figure: a line sample and the label of each entry.
+/// A legend row across the top of a figure: a line sample and the label of each entry
+/// (`band`: the reference's wide grey band).
 fn legend_strip(area: &Area, entries: &[(&str, RGBColor, bool)], path: &Path) -> Result<(), Error> {
     let err = plot_err(path);
     let (w, h) = area.dim_in_pixel();
@@ -187,15 +264,9 @@ fn legend_strip(area: &Area, entries: &[(&str, RGBColor, bool)], path: &Path) ->
         .map(|(l, _, _)| 40 + area.estimate_text_size(l, &style).map_or(8 * l.len() as i32, |s| s.0 as i32) + 30)
         .collect();
     let mut x = (w as i32 - widths.iter().sum::<i32>()).max(0) / 2;
-    for ((label, c, dashed), wd) in entries.iter().zip(widths) {
-        if *dashed {
-            for k in 0..4 {
-                let x0 = x + k * 9;
-                area.draw(&PathElement::new(vec![(x0, y), (x0 + 5, y)], c.stroke_width(3))).map_err(&err)?;
-            }
-        } else {
-            area.draw(&PathElement::new(vec![(x, y), (x + 32, y)], c.stroke_width(3))).map_err(&err)?;
-        }
+    for ((label, c, band), wd) in entries.iter().zip(widths) {
+        let width = if *band { 7 } else { 3 };
+        area.draw(&PathElement::new(vec![(x, y), (x + 32, y)], c.stroke_width(width))).map_err(&err)?;
         area.draw(&Text::new(label.to_string(), (x + 40, y - 9), style.clone())).map_err(&err)?;
         x += wd;
     }
@@ -209,33 +280,40 @@ fn controller_legend(runs: &[&Run]) -> Vec<(&'static str, RGBColor, bool)> {
             v.push((label(c), color(c), false));
         }
     }
-    v.push(("reference", REFERENCE, true));
+    if let Some(r) = runs.iter().find(|r| matches!(r.job.controller, Controller::Custom(_))) {
+        v.push((label(r.job.controller), color(r.job.controller), false));
+    }
+    v.push(("reference", REFERENCE_BAND, true));
     v
 }
 
+/// One time panel over `[0, t_end]` with the y range `ys` (shared along a row), ticks every
+/// 5 s up to and including `t_end`.
 fn time_panel(
     area: &Area,
     title: &str,
     y_desc: &str,
     series: &[Series],
-    legend: bool,
+    t_end: f64,
+    ys: (f64, f64),
     path: &Path,
 ) -> Result<(), Error> {
     let err = plot_err(path);
-    let t0 = series.iter().flat_map(|s| s.points.first().map(|p| p.0)).fold(f64::INFINITY, f64::min).min(0.0);
-    let t1 = series.iter().flat_map(|s| s.points.last().map(|p| p.0)).fold(0.0, f64::max).max(1e-3);
-    let (y0, y1) = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    let t_end = t_end.max(1e-3);
     let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
+        .caption(title, ("sans-serif", 17))
         .margin(6)
+        .margin_right(14)
         .x_label_area_size(34)
-        .y_label_area_size(62)
-        .build_cartesian_2d(t0..t1, y0..y1)
+        .y_label_area_size(58)
+        .build_cartesian_2d(0.0..t_end, ys.0..ys.1)
         .map_err(&err)?;
+    let ticks = (t_end / 5.0).floor() as usize + 1;
     chart
         .configure_mesh()
         .x_desc("t [s]")
         .y_desc(y_desc)
+        .x_labels(ticks.max(2))
         .label_style(("sans-serif", 13))
         .axis_desc_style(("sans-serif", 14))
         .light_line_style(WHITE.mix(0.0))
@@ -244,116 +322,130 @@ fn time_panel(
         .draw()
         .map_err(&err)?;
     for s in series {
-        let c = s.color;
-        let style = c.stroke_width(if s.dashed { 2 } else { 1 });
-        let anno = if s.dashed {
-            chart.draw_series(DashedLineSeries::new(s.points.iter().copied(), 6, 4, style)).map_err(&err)?
-        } else {
-            chart.draw_series(LineSeries::new(s.points.iter().copied(), style)).map_err(&err)?
-        };
-        if legend {
-            anno.label(s.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 22, y)], c.stroke_width(3)));
-        }
-    }
-    if legend {
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(&err)?;
+        chart.draw_series(LineSeries::new(s.points.iter().copied(), s.color.stroke_width(s.width))).map_err(&err)?;
     }
     Ok(())
 }
 
-/// The time plots of one column and maneuver: beta, yaw rate (reference and each
-/// controller), front-left and rear-left steering commands, and the friction per wheel.
+/// The time plots of one column and maneuver as small multiples: one column of panels per
+/// controller (beta, yaw rate, front-left and rear-left steering command, each over the
+/// reference, the y range shared along a row), and the friction of the four wheels over
+/// the whole run below.
 pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &Path) -> Result<(), Error> {
     register_font().map_err(plot_err(path))?;
     let err = plot_err(path);
     let rs = runs_of(runs, fidelity, maneuver);
     let Some(first) = rs.first() else { return Ok(()) };
     let n = first.n_samples();
-    let deg = 180.0 / std::f64::consts::PI;
-    let state = |get: &dyn Fn(&Run, usize) -> f64, get_ref: &dyn Fn(&Run, usize) -> f64| {
-        let mut v: Vec<Series> = rs
-            .iter()
-            .map(|r| Series {
-                label: label(r.job.controller).into(),
-                color: color(r.job.controller),
-                dashed: false,
-                points: sampled(n).map(|k| (Run::time(k), get(r, k))).collect(),
-            })
-            .collect();
+    let t_end = duration(first);
+    let deg = DEG;
+    let reference_program = |wheel: usize| -> Vec<(f64, f64)> {
+        // the reference run's command is the program itself (open loop, K = 0)
+        match rs.iter().find(|r| r.job.controller == Controller::OpenLoop) {
+            Some(r) => sampled(n - 1).map(|k| (Run::time(k), r.delta[k][wheel] * deg)).collect(),
+            None => Vec::new(),
+        }
+    };
+    type Getter = dyn Fn(&Run, usize) -> f64;
+    let quantity = |r: &Run, get: &Getter, get_ref: Option<&Getter>| -> Vec<Series> {
+        let mut v = Vec::new();
+        if let Some(g) = get_ref {
+            v.push(Series {
+                label: "reference".into(),
+                color: REFERENCE_BAND,
+                width: 5,
+                points: sampled(n).map(|k| (Run::time(k), g(first, k))).collect(),
+            });
+        }
         v.push(Series {
-            label: "reference".into(),
-            color: REFERENCE,
-            dashed: true,
-            points: sampled(n).map(|k| (Run::time(k), get_ref(first, k))).collect(),
+            label: label(r.job.controller).into(),
+            color: color(r.job.controller),
+            width: 1,
+            points: sampled(n).map(|k| (Run::time(k), get(r, k))).collect(),
         });
         v
     };
-    let steer = |wheel: usize| -> Vec<Series> {
+    let beta: Vec<Vec<Series>> =
+        rs.iter().map(|r| quantity(r, &|r, k| r.beta[k] * DEG, Some(&|r, k| r.beta_ref[k] * DEG))).collect();
+    let yaw: Vec<Vec<Series>> =
+        rs.iter().map(|r| quantity(r, &|r, k| r.yaw_rate[k] * DEG, Some(&|r, k| r.yaw_rate_ref[k] * DEG))).collect();
+    let steer = |wheel: usize| -> Vec<Vec<Series>> {
         rs.iter()
-            .map(|r| Series {
-                label: label(r.job.controller).into(),
-                color: color(r.job.controller),
-                dashed: false,
-                points: sampled(n - 1).map(|k| (Run::time(k), r.delta[k][wheel] * deg)).collect(),
+            .map(|r| {
+                let mut v = vec![Series {
+                    label: "program".into(),
+                    color: REFERENCE_BAND,
+                    width: 5,
+                    points: reference_program(wheel),
+                }];
+                v.push(Series {
+                    label: label(r.job.controller).into(),
+                    color: color(r.job.controller),
+                    width: 1,
+                    points: sampled(n - 1).map(|k| (Run::time(k), r.delta[k][wheel] * deg)).collect(),
+                });
+                v
             })
             .collect()
     };
-    // the friction has 75 periods in 30 s: show the first 3 s
-    let mu_n = (n - 1).min(3000);
+    let (front, rear) = (steer(0), steer(2));
+    let row_range = |row: &[Vec<Series>]| range(row.iter().flatten().flat_map(|s| s.points.iter().map(|p| p.1)));
+    let cols = rs.len();
+    let root = BitMapBackend::new(path, (560 * cols as u32 + 40, 1560)).into_drawing_area();
+    root.fill(&WHITE).map_err(&err)?;
+    let title = format!(
+        "{} column, {}: states and steering commands per controller, and the road friction (seed {})",
+        fidelity.column(),
+        maneuver.name(),
+        first.job.seed
+    );
+    let root = root.titled(&title, ("sans-serif", 24)).map_err(&err)?;
+    let (top, body) = root.split_vertically(70);
+    let (legend, notes) = top.split_vertically(36);
+    legend_strip(&legend, &controller_legend(&rs), path)?;
+    caption_lines(
+        &notes,
+        &[&format!(
+            "{REFERENCE_CAPTION}; under the steering commands: the program (the open-loop command). Angles in degrees."
+        )],
+        path,
+    )?;
+    let (grid, bottom) = body.split_vertically(4 * 292);
+    let panels = grid.split_evenly((4, cols));
+    let rows: [(&str, &str, &[Vec<Series>]); 4] = [
+        ("body slip angle beta", "beta [deg]", &beta),
+        ("yaw rate r", "r [deg/s]", &yaw),
+        ("steering command, front left", "delta_FL [deg]", &front),
+        ("steering command, rear left", "delta_RL [deg]", &rear),
+    ];
+    for (i, (what, y_desc, row)) in rows.iter().enumerate() {
+        let ys = row_range(row);
+        for (j, series) in row.iter().enumerate() {
+            let title = format!("{}: {what}", label(rs[j].job.controller));
+            time_panel(&panels[i * cols + j], &title, y_desc, series, t_end, ys, path)?;
+        }
+    }
     let mu: Vec<Series> = ["FL", "FR", "RL", "RR"]
         .iter()
         .enumerate()
         .map(|(i, w)| Series {
             label: format!("mu {w}"),
             color: WHEEL_COLORS[i],
-            dashed: false,
-            points: (0..mu_n).step_by(2).map(|k| (Run::time(k), first.mu[k][i])).collect(),
+            width: 1,
+            points: sampled(n - 1).map(|k| (Run::time(k), first.mu[k][i])).collect(),
         })
         .collect();
-    let root = BitMapBackend::new(path, (1500, 1600)).into_drawing_area();
-    root.fill(&WHITE).map_err(&err)?;
-    let title = format!(
-        "{} column, {}: states, commands and friction (seed {})",
-        fidelity.column(),
-        maneuver.name(),
-        first.job.seed
-    );
-    let root = root.titled(&title, ("sans-serif", 24)).map_err(&err)?;
-    let (top, body) = root.split_vertically(32);
-    legend_strip(&top, &controller_legend(&rs), path)?;
-    let panels = body.split_evenly((5, 1));
+    let (mu_legend, mu_area) = bottom.split_vertically(30);
+    let entries: Vec<(&str, RGBColor, bool)> = mu.iter().map(|s| (s.label.as_str(), s.color, false)).collect();
+    legend_strip(&mu_legend, &entries, path)?;
+    let ys = range(mu.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
     time_panel(
-        &panels[0],
-        "body slip angle beta",
-        "beta [deg]",
-        &state(&|r, k| r.beta[k] * deg, &|r, k| r.beta_ref[k] * deg),
-        false,
-        path,
-    )?;
-    time_panel(
-        &panels[1],
-        "yaw rate r",
-        "r [deg/s]",
-        &state(&|r, k| r.yaw_rate[k] * deg, &|r, k| r.yaw_rate_ref[k] * deg),
-        false,
-        path,
-    )?;
-    time_panel(&panels[2], "steering command, front left", "delta_FL [deg]", &steer(0), false, path)?;
-    time_panel(&panels[3], "steering command, rear left", "delta_RL [deg]", &steer(2), false, path)?;
-    time_panel(
-        &panels[4],
-        "road friction per wheel, first 3 s of 30 (the same for every controller)",
-        "mu [-]",
+        &mu_area,
+        "road friction per wheel, the whole run (the same for every controller; 12 x 2 pi of variation: 75 periods)",
+        "mu [1]",
         &mu,
-        true,
+        t_end,
+        ys,
         path,
     )?;
     root.present().map_err(&err)?;

@@ -1,4 +1,4 @@
-//! The seed study of issue 9: for several seeds, how the robust tracking controller
+//! The seed study: for several seeds, how the robust tracking controller
 //! compares with the paper's robust controller cell by cell (`eps(robust_tracking) /
 //! eps(robust)`), whether it is the lowest of all the controllers run in every row, and
 //! the largest steering command over every run (against `delta_max`).

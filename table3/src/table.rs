@@ -63,7 +63,15 @@ impl Table {
 
     /// The controllers present, in table order.
     pub fn controllers(&self) -> Vec<Controller> {
-        crate::CONTROLLERS.into_iter().filter(|k| self.cells.iter().any(|c| c.controller == *k)).collect()
+        let mut v: Vec<Controller> =
+            crate::CONTROLLERS.into_iter().filter(|k| self.cells.iter().any(|c| c.controller == *k)).collect();
+        // custom gains after the named controllers, in the order they ran
+        for c in &self.cells {
+            if matches!(c.controller, Controller::Custom(_)) && !v.contains(&c.controller) {
+                v.push(c.controller);
+            }
+        }
+        v
     }
 }
 
@@ -168,7 +176,7 @@ pub fn run_table_with(engine: &dyn Engine, options: &Options, done: &(dyn Fn(&Jo
             }
         }
     }
-    gains.sort_by_key(|(c, _)| crate::CONTROLLERS.iter().position(|x| x == c));
+    gains.sort_by_key(|(c, _)| crate::CONTROLLERS.iter().position(|x| x == c).unwrap_or(usize::MAX));
     let mut cells = Vec::with_capacity(results.len());
     let mut runs = Vec::new();
     for (cell, _, run) in results {

@@ -117,9 +117,17 @@ fn illegal_call_orders_are_refused_and_only_reset_recovers() {
     assert_eq!(i.do_step(0.0, 1e9), DISCARD, "a step that would take 2e12 sub-steps is discarded, not run");
     assert!(log.last_error().unwrap().contains("take shorter communication steps"));
     assert_eq!(i.reset(), OK);
-    assert_eq!(i.set_real(&[fmu().vr("cs_substep_max")], &[1e-300]), OK);
+    // a vanishing sub-step is refused at the set (its declared minimum is 1 us) ...
+    assert_eq!(i.set_real(&[fmu().vr("cs_substep_max")], &[1e-300]), ERROR);
+    let e = log.last_error().unwrap();
+    assert!(e.contains("fmi2SetReal") && e.contains("cs_substep_max") && e.contains("below its minimum"), "{e}");
+    assert_eq!(i.reset(), OK);
+    // ... and at the smallest one, a step of more than 10^6 sub-steps is discarded before it starts
+    assert_eq!(i.set_real(&[fmu().vr("cs_substep_max")], &[1e-6]), OK);
     i.initialize();
-    assert_eq!(i.do_step(0.0, 1e-3), DISCARD, "a vanishing sub-step is discarded, not run");
+    assert_eq!(i.do_step(0.0, 1e-3), OK, "1000 sub-steps");
+    assert_eq!(i.do_step(1e-3, 10.0), DISCARD, "10^7 sub-steps");
+    assert!(log.last_error().unwrap().contains("take shorter communication steps"));
     assert_eq!(i.reset(), OK);
     i.initialize();
     assert_eq!(i.do_step(0.0, 1e-3), OK);

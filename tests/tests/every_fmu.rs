@@ -371,3 +371,134 @@ fn every_real_input_accepts_every_value_inside_its_declared_bounds() {
         }
     }
 }
+
+/// The Real unknowns of one ModelStructure list: (name, value reference, dependencies).
+fn real_unknowns(md: &ModelDescription, list: &[model_description::Unknown]) -> Vec<(String, u32, Option<Vec<u32>>)> {
+    list.iter()
+        .map(|u| (&md.model_variables[u.index as usize - 1], &u.dependencies))
+        .filter(|(v, _)| v.variable_type.type_name() == "Real")
+        .map(|(v, d)| (v.name.clone(), v.value_reference, d.clone()))
+        .collect()
+}
+
+/// 1-based index of variable `name` in ModelVariables.
+fn index_of(md: &ModelDescription, name: &str) -> u32 {
+    md.model_variables.iter().position(|v| v.name == name).map(|p| p as u32 + 1).unwrap()
+}
+
+/// Perturbs one known by `change` (which must also undo it when given `false`), reads the
+/// unknowns before and after, and checks that every unknown that moved lists the known
+/// (or depends on all). Returns how many moved.
+fn check_moved(
+    md: &ModelDescription,
+    what: &str,
+    i: &Instance,
+    unknowns: &[(String, u32, Option<Vec<u32>>)],
+    known: (&str, u32),
+    change: &dyn Fn(bool),
+) -> usize {
+    let vrs: Vec<u32> = unknowns.iter().map(|u| u.1).collect();
+    let before = i.get_real(&vrs).unwrap();
+    change(true);
+    let after = i.get_real(&vrs).unwrap();
+    change(false);
+    assert_eq!(i.get_real(&vrs).unwrap(), before, "{}: {what}: undoing {} restores the unknowns", id(md), known.0);
+    let mut moved = 0;
+    for ((name, _, deps), (b, a)) in unknowns.iter().zip(before.iter().zip(&after)) {
+        if a.to_bits() != b.to_bits() {
+            moved += 1;
+            assert!(
+                !matches!(deps, Some(d) if !d.contains(&known.1)),
+                "{}: {what}: {name} moves with {} ({b} -> {a}) but its dependencies {deps:?} omit index {}",
+                id(md),
+                known.0,
+                known.1
+            );
+        }
+    }
+    moved
+}
+
+/// The ModelStructure's dependencies, checked numerically for every FMU: perturb each known
+/// and see which unknowns move. In Initialization Mode the knowns are the inputs and the
+/// exact variables (FMI 2.0 section 2.2.8: parameters, and exact locals such as the
+/// controller's `speed_integral`) and the unknowns the InitialUnknowns; after it, the
+/// Outputs and Derivatives move only with the inputs and continuous states they list
+/// (Co-Simulation between steps; Model Exchange in continuous-time mode). A moving unknown
+/// whose list omits the known fails; the totals show the check is not vacuous.
+#[test]
+fn model_structure_dependencies_are_the_knowns_that_move_the_unknowns() {
+    for fmu in every_fmu() {
+        let md = &fmu.description;
+        let knowns = settable_reals(md);
+        let ms = &md.model_structure;
+
+        let (i, _log) = fmu.instantiate("deps-init", kinds(md)[0], fmu.guid());
+        let i = i.unwrap();
+        assert_eq!(i.setup(0.0), OK);
+        assert_eq!(i.enter_init(), OK);
+        let initial = real_unknowns(md, &ms.initial_unknowns);
+        let mut moved = 0;
+        for (name, vr, start, other) in &knowns {
+            let set = |on: bool| assert_eq!(i.set_real(&[*vr], &[if on { *other } else { *start }]), OK);
+            moved += check_moved(md, "initialization", &i, &initial, (name, index_of(md, name)), &set);
+        }
+        assert!(moved > 0, "{}: nothing moved in Initialization Mode", id(md));
+
+        let inputs: Vec<_> =
+            knowns.iter().filter(|(n, ..)| md.variable(n).is_some_and(|v| v.causality == Causality::Input)).collect();
+        let outputs = real_unknowns(md, &ms.outputs);
+        let derivatives = real_unknowns(md, &ms.derivatives);
+        if md.co_simulation.is_some() {
+            let (i, _log) = fmu.instantiate("deps-cs", CO_SIMULATION, fmu.guid());
+            let i = i.unwrap();
+            i.initialize();
+            assert_eq!(i.do_step(0.0, 1e-3), OK);
+            for (name, vr, start, other) in &inputs {
+                let set = |on: bool| assert_eq!(i.set_real(&[*vr], &[if on { *other } else { *start }]), OK);
+                check_moved(md, "Co-Simulation", &i, &outputs, (name, index_of(md, name)), &set);
+            }
+        }
+        if md.model_exchange.is_some() {
+            let (i, _log) = fmu.instantiate("deps-me", MODEL_EXCHANGE, fmu.guid());
+            let i = i.unwrap();
+            i.initialize();
+            let mut info = nigel_integration_tests::EventInfo::default();
+            unsafe {
+                assert_eq!((i.f().new_discrete_states)(i.c, &mut info), OK);
+                assert_eq!((i.f().enter_continuous_time_mode)(i.c), OK);
+            }
+            let mut unknowns = outputs.clone();
+            unknowns.extend(derivatives.iter().cloned());
+            let continuous: Vec<_> = inputs
+                .iter()
+                .filter(|(n, ..)| {
+                    md.variable(n).is_some_and(|v| v.variability == model_description::Variability::Continuous)
+                })
+                .collect();
+            for (name, vr, start, other) in continuous {
+                let set = |on: bool| assert_eq!(i.set_real(&[*vr], &[if on { *other } else { *start }]), OK);
+                check_moved(md, "Model Exchange", &i, &unknowns, (name, index_of(md, name)), &set);
+            }
+            let nx = derivatives.len();
+            let mut x = vec![0.0; nx];
+            unsafe { assert_eq!((i.f().get_continuous_states)(i.c, x.as_mut_ptr(), nx), OK) };
+            for (k, d) in ms.derivatives.iter().enumerate() {
+                let Some(VariableType::Real { derivative: Some(state), .. }) =
+                    md.model_variables.get(d.index as usize - 1).map(|v| &v.variable_type)
+                else {
+                    panic!("{}: derivative without its state", id(md))
+                };
+                let state_name = md.model_variables[*state as usize - 1].name.clone();
+                let set = |on: bool| {
+                    let mut y = x.clone();
+                    if on {
+                        y[k] += 1e-3 * (1.0 + y[k].abs());
+                    }
+                    assert_eq!(unsafe { (i.f().set_continuous_states)(i.c, y.as_ptr(), nx) }, OK);
+                };
+                check_moved(md, "Model Exchange", &i, &unknowns, (&state_name, *state), &set);
+            }
+        }
+    }
+}

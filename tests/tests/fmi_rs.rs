@@ -1,4 +1,4 @@
-//! Issue 7's third-party cross-check with `fmi-rs` (crates.io, CATIA-Systems, by fmpy's
+//! A third-party cross-check with `fmi-rs` (crates.io, CATIA-Systems, by fmpy's
 //! authors), over the three built archives in `target/fmu/`:
 //!
 //! 1. fmi-rs parses each modelDescription.xml and its FMI 2.0 validation (its port of

@@ -372,3 +372,55 @@ fn initial_unknowns_depend_only_on_initialization_knowns() {
         assert!(!deps.contains(&index_of(state)), "{state} on itself");
     }
 }
+
+/// In Initialization Mode the exact start values are knowns (FMI 2.0 section 2.2.8): the
+/// directional derivatives with respect to them go through the initial-state calculation
+/// (the state is its start value) and agree with central differences of the InitialUnknowns
+/// (the derivatives, whose dependence on the state is smooth at this point). A parameter,
+/// for which none are provided, is refused naming it, without Rust debug text.
+#[test]
+fn initialization_mode_directional_derivatives_with_respect_to_the_start_values() {
+    let (i, log) = fmu().instantiate("dd-init", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    let f = i.f();
+    let starts = ["v_x_start", "v_y_start", "yaw_rate_start", "psi_start"];
+    let point = [0.35, 0.02, 0.4, 0.3];
+    assert_eq!(i.setup(0.0), OK);
+    assert_eq!(i.enter_init(), OK);
+    assert_eq!(i.set_real(&vrs(&starts), &point), OK);
+    let unknowns = vrs(&["der(x)", "der(y)", "der(v_x)", "der(v_y)", "der(yaw_rate)", "v_y"]);
+    for (k, start) in starts.iter().enumerate() {
+        let known = fmu().vr(start);
+        let mut exact = vec![0.0; unknowns.len()];
+        let s = unsafe {
+            (f.get_directional_derivative)(i.c, unknowns.as_ptr(), unknowns.len(), &known, 1, &1.0, exact.as_mut_ptr())
+        };
+        assert_eq!(s, OK, "{start}: {:?}", log.last_error());
+        // central differences, h = 1e-6: truncation O(h^2 f''') ~ 1e-10 relative on these
+        // smooth terms, rounding O(eps / h) ~ 1e-10; 1e-6 relative (+1e-8 absolute) holds
+        // on any x86-64 libm
+        let h = 1e-6;
+        let at = |x: f64| {
+            let mut p = point;
+            p[k] = x;
+            assert_eq!(i.set_real(&vrs(&starts), &p), OK);
+            i.get_real(&unknowns).unwrap()
+        };
+        let (up, down) = (at(point[k] + h), at(point[k] - h));
+        assert_eq!(i.set_real(&vrs(&starts), &point), OK);
+        let mut nonzero = 0;
+        for (j, e) in exact.iter().enumerate() {
+            let fd = (up[j] - down[j]) / (2.0 * h);
+            assert!((e - fd).abs() <= 1e-6 * fd.abs() + 1e-8, "d unknown {j} / d {start}: {e} vs {fd}");
+            nonzero += (*e != 0.0) as usize;
+        }
+        assert!(nonzero > 0, "{start} moves something");
+    }
+    let (unknown, param) = (fmu().vr("der(v_y)"), fmu().vr("l_f"));
+    let mut out = [0.0];
+    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &param, 1, &1.0, out.as_mut_ptr()) };
+    assert_eq!(s, ERROR);
+    let msg = log.last_error().unwrap();
+    assert!(msg.contains("fmi2GetDirectionalDerivative") && msg.contains("l_f"), "{msg}");
+    assert!(!msg.contains("Param(") && !msg.contains("StateStart("), "{msg}");
+}

@@ -1,4 +1,4 @@
-//! The path-tracking error model (issue 9): the car's errors relative to a *reference car*
+//! The path-tracking error model: the car's errors relative to a *reference car*
 //! that drives the reference path, and their small-error linearization.
 //!
 //! # Definitions (nonlinear, exact)

@@ -1,7 +1,7 @@
 //! `cosim`: run an FMU or a system of FMUs, or list what is in one.
 
 use clap::{Parser, Subcommand};
-use nigel_cosim::{simulate, Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder};
+use nigel_cosim::{Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -53,6 +53,20 @@ struct RunArgs {
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
+    /// The cap on the steps of a run (communication steps, and the Model Exchange
+    /// integrator's internal steps): a run that would take more stops with an error.
+    #[arg(long, default_value_t = nigel_cosim::simulate::DEFAULT_MAX_STEPS)]
+    max_steps: u64,
+    /// Run every FMU in a host process of its own (`cosim-host`): a crash, an exit or a
+    /// hang of an FMU is then an error naming it, with the rows so far written.
+    #[arg(long)]
+    isolate: bool,
+    /// Wall-clock limit of one FMU call, s (needs --isolate: the host is killed).
+    #[arg(long, value_name = "SECONDS")]
+    timeout_call: Option<f64>,
+    /// Wall-clock limit of the whole run, s.
+    #[arg(long, value_name = "SECONDS")]
+    timeout: Option<f64>,
     /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
     /// get/set their state and vary their step).
     #[arg(long)]
@@ -66,6 +80,11 @@ struct RunArgs {
     /// Start value or parameter: instance.variable=value (or variable=value for one FMU).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
+    /// Run the closed loop's `controller` instance with one's own gain: a `synthesize --json`
+    /// report (its "K", rows FL, FR, RL, RR, columns beta, r). Sets `controller.controller=4`
+    /// (custom) and `controller.k_beta_*`, `controller.k_yaw_rate_*`; `--set` applies after it.
+    #[arg(long, value_name = "K.json")]
+    gains: Option<PathBuf>,
     /// Variables to record (default: all outputs), repeatable.
     #[arg(long = "record", value_name = "NAME")]
     record: Vec<String>,
@@ -79,6 +98,7 @@ struct RunArgs {
 }
 
 fn main() -> ExitCode {
+    nigel_cosim::unpack::remove_on_signals();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
@@ -115,6 +135,20 @@ fn progress(fraction: f64) {
     }
 }
 
+/// The `--set`s that run the controller FMU of the closed loop with the gain of a
+/// `synthesize --json` report: `controller = 4` (custom) and the eight `k_*` parameters.
+fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let k = nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
+    let mut sets = vec![("controller.controller".to_string(), "4".to_string())];
+    for (row, wheel) in k.iter().zip(["fl", "fr", "rl", "rr"]) {
+        // `{:?}` prints the shortest decimal that reads back to the same f64
+        sets.push((format!("controller.k_beta_{wheel}"), format!("{:?}", row[0])));
+        sets.push((format!("controller.k_yaw_rate_{wheel}"), format!("{:?}", row[1])));
+    }
+    Ok(sets)
+}
+
 fn run(args: RunArgs) -> Result<(), Error> {
     let interface = match args.interface.as_deref() {
         None => None,
@@ -135,6 +169,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         builder.add_instance(SINGLE, fmu)?;
         (builder, default.stop_time, default.step_size, true, None)
     };
+    if let Some(path) = &args.gains {
+        for (name, value) in custom_gain_settings(path)? {
+            builder.set_text(&name, &value)?;
+        }
+    }
     for s in &args.set {
         let (name, value) =
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
@@ -164,19 +203,49 @@ fn run(args: RunArgs) -> Result<(), Error> {
         return Err(Error::Experiment("--threads must be at least 1".into()));
     }
     experiment.threads = args.threads;
+    experiment.max_steps = args.max_steps;
+    let seconds = |what: &str, s: f64| {
+        std::time::Duration::try_from_secs_f64(s)
+            .ok()
+            .filter(|d| !d.is_zero())
+            .ok_or_else(|| Error::Experiment(format!("{what} {s} must be a positive number of seconds")))
+    };
+    if let Some(s) = args.timeout {
+        experiment.timeout = Some(seconds("--timeout", s)?);
+    }
+    if args.timeout_call.is_some() && !args.isolate {
+        return Err(Error::Experiment(
+            "--timeout-call needs --isolate (a call in this process cannot be stopped; a host process can be killed)"
+                .into(),
+        ));
+    }
+    if args.isolate {
+        experiment.isolation = Some(nigel_cosim::Isolation {
+            instances: None,
+            call_timeout: args.timeout_call.map(|s| seconds("--timeout-call", s)).transpose()?,
+            host: None,
+        });
+    }
     if !args.record.is_empty() {
         experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
     }
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
     }
-    let (results, summary) = simulate(&system, &experiment)?;
+    let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
         std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
     };
+    // the rows recorded so far are written also when the run failed
     if let Some(path) = &args.output {
-        write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?;
+        if outcome.is_ok() || results.rows() > 0 {
+            write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?;
+            if outcome.is_err() {
+                eprintln!("cosim: {} rows up to the last completed step written to {}", results.rows(), path.display());
+            }
+        }
     }
+    let summary = outcome?;
     let json = serde_json::to_string_pretty(&summary.to_json()).unwrap_or_default();
     match &args.summary {
         Some(p) if p.as_os_str() == "-" => println!("{json}"),
@@ -185,6 +254,12 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
     for (instance, message) in &summary.warnings {
         eprintln!("cosim: warning from {instance}: {message}");
+    }
+    if let Some((instance, time, reason)) = &summary.ended_by {
+        eprintln!(
+            "cosim: {instance} ended the simulation at t = {time} s ({reason}); stop time {} s",
+            experiment.stop_time
+        );
     }
     Ok(())
 }

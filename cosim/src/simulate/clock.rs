@@ -6,6 +6,18 @@ use crate::error::{Error, Result};
 use crate::simulate::types::Experiment;
 use crate::system::{is_cs, System};
 
+/// The fraction of a step below which the interval's remainder is no step of its own.
+pub(crate) const WHOLE_STEP_TOLERANCE: f64 = 1e-6;
+
+/// The distance from `x` to the next f64 away from zero (the spacing of times near `x`).
+pub(crate) fn ulp(x: f64) -> f64 {
+    let a = x.abs();
+    if !a.is_finite() {
+        return f64::INFINITY;
+    }
+    f64::from_bits(a.to_bits() + 1) - a
+}
+
 /// One communication step: from `t` to `t_next`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Point {
@@ -62,9 +74,22 @@ impl Clock {
                 e.start_time, e.stop_time, e.step
             )));
         }
-        let span = (e.stop_time - e.start_time) / e.step;
-        let mut steps = span.round();
-        let partial = (span - steps).abs() > 1e-9 * span.max(1.0);
+        // the step must be resolvable by the times of the run
+        let resolution = 2.0 * ulp(e.start_time.abs().max(e.stop_time.abs()));
+        if e.step < 2.0 * resolution {
+            return Err(Error::Experiment(format!(
+                "the step {} s is below the resolution of f64 times near {} s ({resolution:e} s): the points cannot be told apart",
+                e.step,
+                e.start_time.abs().max(e.stop_time.abs())
+            )));
+        }
+        // a whole number n of steps when the point t0 + n h, as computed here, is the stop
+        // time to within a millionth of a step, or to the rounding of the times themselves
+        // (two ulps of the larger time; at |t| = 1e6 s that is 2.3e-10 s): relative to the
+        // step, not to |t|, so a start at 1e6 s or 1e12 s counts the same steps as 0
+        let mut steps = ((e.stop_time - e.start_time) / e.step).round();
+        let gap = (e.start_time + steps * e.step - e.stop_time).abs();
+        let partial = gap > (WHOLE_STEP_TOLERANCE * e.step).max(resolution);
         if partial {
             if let Some(fixed) = system.instances.iter().find(|i| is_cs(i) && !i.fmu.can_handle_variable_step()) {
                 return Err(Error::Experiment(format!(
@@ -74,10 +99,13 @@ impl Clock {
                     fixed.name
                 )));
             }
-            steps = span.ceil();
+            steps = ((e.stop_time - e.start_time) / e.step).ceil();
         }
-        if steps > 1e12 {
-            return Err(Error::Experiment(format!("{steps} steps is too many")));
+        if steps > e.max_steps as f64 {
+            return Err(Error::Experiment(format!(
+                "{steps} communication steps exceed the cap of {} steps of a run (Experiment::max_steps, --max-steps)",
+                e.max_steps
+            )));
         }
         let stride = match e.output_interval {
             None => 1.0,
@@ -101,5 +129,4 @@ impl Clock {
             partial,
         })
     }
-
 }

@@ -4,12 +4,12 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
-use crate::me::MeUnit;
+use crate::me::{MeUnit, Solver};
 use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
 use crate::simulate::clock::Clock;
-use crate::simulate::lane::{apply_start_values, Lane};
+use crate::simulate::lane::{apply_start_values, Lane, DISCARD_TERMINATED};
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Observer, Observers, Profiler, Recorder};
+use crate::simulate::observer::{Deadline, Observer, Observers, Profiler, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Plan};
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
 use crate::system::{BaseType, System, VariableRef};
@@ -41,24 +41,92 @@ fn check_single_instance(system: &System) -> Result<()> {
     Ok(())
 }
 
+/// The smallest relative tolerance of `dopri5`: a hundred machine epsilons (2.2e-14); below
+/// it the error estimate of an f64 step is rounding, and no step size meets it.
+pub(crate) const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
+/// Refuses integrator settings that cannot progress: an RK4 `max_step` so small that the
+/// run's internal steps would exceed its cap (or below the resolution of its times), a
+/// `dopri5` tolerance no f64 step can meet.
+fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
+    if !system.instances.iter().any(|i| i.fmu.interface() == Interface::ModelExchange) {
+        return Ok(());
+    }
+    match e.solver {
+        Solver::Rk4 { max_step: Some(m) } => {
+            let resolution = 2.0 * crate::simulate::clock::ulp(clock.t0.abs().max(clock.stop.abs()));
+            if !(m.is_finite() && m > 0.0) || m < resolution {
+                return Err(Error::Experiment(format!(
+                    "the largest RK4 step {m:e} s must be finite and above the resolution of the run's times ({resolution:e} s)"
+                )));
+            }
+            let per_step = (clock.h / m).ceil().max(1.0);
+            let total = per_step * clock.steps as f64;
+            if total > e.max_steps as f64 {
+                return Err(Error::Experiment(format!(
+                    "the largest RK4 step {m:e} s makes {total:e} internal steps ({per_step:e} per communication step of {} s), over the cap of {} steps of a run (Experiment::max_steps, --max-steps)",
+                    clock.h, e.max_steps
+                )));
+            }
+        }
+        Solver::Rk4 { max_step: None } => {}
+        Solver::Dopri5 { rtol, atol } => {
+            if !(rtol.is_finite() && rtol >= MIN_RTOL) {
+                return Err(Error::Experiment(format!(
+                    "the dopri5 relative tolerance {rtol:e} is below {MIN_RTOL:e} (100 machine epsilons), which no f64 step can meet"
+                )));
+            }
+            if !(atol.is_finite() && atol >= 0.0) {
+                return Err(Error::Experiment(format!("the dopri5 absolute tolerance {atol:e} must be finite and >= 0")));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Instantiates, initializes and runs `system` with fixed-step Co-Simulation.
 pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Summary)> {
-    simulate_with(system, experiment, None, None)
+    let (results, summary) = simulate_recorded(system, experiment);
+    summary.map(|s| (results, s))
+}
+
+/// [`simulate`], with the rows recorded up to the last completed step also when the run
+/// fails (an FMU's error, a crashed host, a time limit): nothing recorded is lost.
+pub fn simulate_recorded(system: &System, experiment: &Experiment) -> (Results, Result<Summary>) {
+    let mut results = Results::default();
+    let summary = run(system, experiment, &mut results, None, None);
+    (results, summary)
 }
 
 /// [`simulate()`] taking its instances from `pool` (each reset with `fmi2Reset` instead
-/// of instantiated again; put back after a run that ends without error) and, with a
-/// `sink`, handing each row (time and the recorded values) to it instead of keeping it:
-/// the [`Results`] then have the column names and no rows. For many runs of one system
-/// (parameter studies): no new instantiation per run, no recording held in memory.
+/// of instantiated again; put back after a run that ends without error; not used for
+/// isolated instances) and, with a `sink`, handing each row (time and the recorded
+/// values) to it instead of keeping it: the [`Results`] then have the column names and no
+/// rows. For many runs of one system (parameter studies): no new instantiation per run,
+/// no recording held in memory.
 pub fn simulate_with<'s>(
     system: &System,
     experiment: &Experiment,
-    mut pool: Option<&mut InstancePool>,
+    pool: Option<&mut InstancePool>,
     sink: Option<&'s mut RowSink<'s>>,
 ) -> Result<(Results, Summary)> {
+    let mut results = Results::default();
+    let pool = if experiment.isolation.is_some() { None } else { pool };
+    let summary = run(system, experiment, &mut results, pool, sink)?;
+    Ok((results, summary))
+}
+
+fn run<'s>(
+    system: &System,
+    experiment: &Experiment,
+    out: &mut Results,
+    mut pool: Option<&mut InstancePool>,
+    sink: Option<&'s mut RowSink<'s>>,
+) -> Result<Summary> {
     let wall = Instant::now();
+    let deadline = experiment.timeout.map(|limit| (wall + limit, limit));
     let clock = Clock::new(experiment, system)?;
+    check_solver(experiment, &clock, system)?;
     check_single_instance(system)?;
     if experiment.threads == 0 {
         return Err(Error::Experiment("threads must be at least 1".into()));
@@ -76,7 +144,7 @@ pub fn simulate_with<'s>(
     }
     let mut plan = Plan::new(system, &record, experiment.algorithm)?;
     // Model Exchange instances connected to each other are integrated together
-    let group = MeGroup::coupled(system)?;
+    let group = MeGroup::coupled(system, experiment.max_steps)?;
     let record_slots: Vec<usize> = record.iter().map(|r| plan.slot(r)).collect();
     // all recorded variables, one get per instance and type (for the first row)
     let mut record_gets = plan.record_gets(&record);
@@ -93,6 +161,7 @@ pub fn simulate_with<'s>(
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress, sink);
+    let outcome = (|| -> Result<Summary> {
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
     let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
@@ -102,7 +171,10 @@ pub fn simulate_with<'s>(
                 inst.reset()?;
                 inst
             }
-            None => Instance::new(&spec.fmu, &spec.name)?,
+            None => match &experiment.isolation {
+                Some(iso) if iso.covers(&spec.name) => Instance::new_isolated(&spec.fmu, &spec.name, iso, deadline)?,
+                _ => Instance::new(&spec.fmu, &spec.name)?,
+            },
         };
         lanes.push(Lane::new(
             index,
@@ -133,7 +205,7 @@ pub fn simulate_with<'s>(
         if lane.inst.fmu().interface() == Interface::ModelExchange {
             lane.unit = Some(MeUnit::new(&lane.inst));
             if !core.group.as_ref().is_some_and(|g| g.contains(lane.index)) {
-                lane.solo = Some(MeGroup::solo(lane.index));
+                lane.solo = Some(MeGroup::solo(lane.index, experiment.max_steps));
             }
         }
     }
@@ -157,14 +229,35 @@ pub fn simulate_with<'s>(
     algorithm.propagate(&mut core)?;
     run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
     recorder.push_row(t0, &core.values);
+    // an FMU may end the run in its initial event iteration
+    let mut ended = core.lanes.iter().find(|l| l.unit.as_ref().is_some_and(|u| u.terminated)).map(|l| {
+        Error::Terminated { instance: l.inst.name().to_string(), time: t0, reason: "terminateSimulation" }
+    });
 
     let mut profiler = Profiler::new(core.lanes.len());
-    {
-        let mut observers = Observers {
-            list: vec![&mut recorder as &mut dyn Observer],
-            calls: experiment.profile.then_some(&mut profiler),
-        };
-        algorithm.run(&mut core, &mut observers)?;
+    if ended.is_none() {
+        let mut limit = deadline.map(|(at, limit)| Deadline { at, limit });
+        let mut list = vec![&mut recorder as &mut dyn Observer];
+        if let Some(d) = limit.as_mut() {
+            list.push(d);
+        }
+        let mut observers = Observers { list, calls: experiment.profile.then_some(&mut profiler) };
+        match algorithm.run(&mut core, &mut observers) {
+            Ok(()) => {}
+            Err(e @ Error::Terminated { .. }) => ended = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    let mut ended_by = None;
+    if let Some(Error::Terminated { instance, time, reason }) = ended {
+        // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
+        // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
+        // row after the last communication point before the event (as fmpy)
+        if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
+            run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+            recorder.push_row(time, &core.values);
+        }
+        ended_by = Some((instance, time, reason));
     }
     if experiment.profile {
         for lane in core.lanes.iter() {
@@ -172,9 +265,10 @@ pub fn simulate_with<'s>(
         }
     }
     let mut summary = Summary {
-        steps: clock.steps,
+        steps: recorder.steps_done(),
         parallel_steps: core.parallel_steps,
         wall_time: Duration::ZERO,
+        ended_by,
         ..Summary::default()
     };
     for lane in core.lanes.iter_mut() {
@@ -204,7 +298,10 @@ pub fn simulate_with<'s>(
     drop(core);
     summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
     summary.wall_time = wall.elapsed();
-    Ok((recorder.results, summary))
+    Ok(summary)
+    })();
+    *out = std::mem::take(&mut recorder.results);
+    outcome
 }
 
 /// Where [`simulate_with`] hands each row: the time and the recorded values, in the order

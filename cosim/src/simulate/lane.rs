@@ -76,7 +76,10 @@ impl Lane {
     pub(crate) fn advance(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         match (&mut self.unit, &mut self.saved) {
-            (None, None) => self.inst.do_step(t, dt),
+            (None, None) => match self.inst.do_step(t, dt) {
+                Ok(()) => Ok(()),
+                Err(e) => Err(ended_or(&mut self.inst, e, t)),
+            },
             (None, Some(state)) => {
                 self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
                 Ok(())
@@ -150,11 +153,27 @@ impl Lane {
     }
 }
 
+/// How the FMU said it ended the run (Co-Simulation).
+pub(crate) const DISCARD_TERMINATED: &str = "fmi2DoStep returned fmi2Discard with fmi2Terminated";
+
+/// The error of a step from `t`: an fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)`
+/// true is the FMU ending the run at `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the
+/// last point it reached, if it cannot say), anything else is `e`.
+#[cold]
+fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
+    if matches!(e, Error::Fmi { status: crate::Status::Discard, .. }) && inst.terminated_status() == Some(true) {
+        let time = inst.last_successful_time().filter(|x| x.is_finite()).unwrap_or(t);
+        return Error::Terminated { instance: inst.name().to_string(), time, reason: DISCARD_TERMINATED };
+    }
+    e
+}
+
 /// `fmi2DoStep` with the state saved first; on fmi2Discard the state is restored and the
-/// step taken as two halves (recursively, at most 10 levels). Returns the number of retries.
+/// step taken as two halves (recursively, at most 10 levels), unless the FMU ended the run
+/// (`fmi2Terminated`). Returns the number of retries.
 fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
     inst.update_state(state)?;
-    match inst.do_step(t, dt) {
+    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e, t)) {
         Ok(()) => Ok(0),
         Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
             inst.set_state(state)?;

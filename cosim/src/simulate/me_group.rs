@@ -60,17 +60,27 @@ pub(crate) struct MeGroup {
     ops: Vec<Op>,
     values: Vec<f64>,
     before: Vec<f64>,
+    /// Internal steps tried (accepted and rejected) so far, and the cap on them.
+    tried: u64,
+    max_steps: u64,
 }
 
 impl MeGroup {
     /// The group of one: instance `index` on its own.
-    pub(crate) fn solo(index: usize) -> MeGroup {
-        MeGroup { members: std::sync::Arc::new([index]), ops: Vec::new(), values: Vec::new(), before: Vec::new() }
+    pub(crate) fn solo(index: usize, max_steps: u64) -> MeGroup {
+        MeGroup {
+            members: std::sync::Arc::new([index]),
+            ops: Vec::new(),
+            values: Vec::new(),
+            before: Vec::new(),
+            tried: 0,
+            max_steps,
+        }
     }
 
     /// The coupled group of `system`: all its Model Exchange instances, if two of them
     /// are connected.
-    pub(crate) fn coupled(system: &System) -> Result<Option<MeGroup>> {
+    pub(crate) fn coupled(system: &System, max_steps: u64) -> Result<Option<MeGroup>> {
         let me = |i: usize| system.instances[i].fmu.interface() == Interface::ModelExchange;
         let links: Vec<Connection> =
             system.connections.iter().filter(|c| me(c.from.instance) && me(c.to.instance)).cloned().collect();
@@ -87,7 +97,7 @@ impl MeGroup {
         }
         let ops = ordered_ops(&sub, &sources, &sources)?;
         let n = sources.len();
-        Ok(Some(MeGroup { members, ops, values: vec![0.0; n], before: vec![0.0; n] }))
+        Ok(Some(MeGroup { members, ops, values: vec![0.0; n], before: vec![0.0; n], tried: 0, max_steps }))
     }
 
     /// Whether lane `i` is a member.
@@ -173,12 +183,43 @@ impl MeGroup {
         self.iterate(lanes, time)
     }
 
+    /// One more internal step tried at `t`; past the cap of the run, the error.
+    #[inline]
+    fn count_step<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64) -> Result<()> {
+        self.tried += 1;
+        if self.tried <= self.max_steps {
+            return Ok(());
+        }
+        let names: Vec<String> = self.members.iter().map(|m| lanes.instance(*m).name().to_string()).collect();
+        Err(Error::Experiment(format!(
+            "the Model Exchange integrator of {} tried more than {} internal steps by t = {t} s (the cap on the steps of a run: Experiment::max_steps, --max-steps)",
+            names.join(", "),
+            self.max_steps
+        )))
+    }
+
+    /// [`Error::Terminated`] at `time` if a member set `terminateSimulation`.
+    pub(crate) fn ended<L: Members + ?Sized>(&self, lanes: &mut L, time: f64) -> Result<()> {
+        for &m in self.members.iter() {
+            if let Some((inst, u)) = lanes.member(m) {
+                if u.terminated {
+                    return Err(Error::Terminated {
+                        instance: inst.name().to_string(),
+                        time,
+                        reason: "terminateSimulation",
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Integrates all members from `t` to `t_end` together, their inputs held between
     /// events.
     pub(crate) fn advance<L: Members + ?Sized>(&mut self, lanes: &mut L, solver: Solver, t: f64, t_end: f64) -> Result<()> {
         let mut t = t;
         let span = t_end - t;
-        let eps = 1e-13 * t_end.abs().max(1.0);
+        let eps = time_slack(t_end, span);
         let members = self.members.clone();
         let members: &[usize] = &members;
         for &m in members {
@@ -190,7 +231,8 @@ impl MeGroup {
         }
         let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
         loop {
-            if t >= t_end - eps || members.iter().any(|m| lanes.member(*m).is_some_and(|(_, u)| u.terminated)) {
+            self.ended(lanes, t)?;
+            if t >= t_end - eps {
                 return Ok(());
             }
             // time events due now
@@ -201,6 +243,7 @@ impl MeGroup {
                 .collect();
             if !due.is_empty() {
                 self.event(lanes, t, "time", &due)?;
+                self.ended(lanes, t)?;
                 if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
                     return Err(Error::Experiment(format!(
                         "{}: time event at {t} repeats at the same time",
@@ -244,7 +287,8 @@ impl MeGroup {
                         }
                     }
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
-                    if err <= 1.0 || h <= 1e-14 * t_end.abs().max(1.0) {
+                    self.count_step(lanes, t)?;
+                    if err <= 1.0 || h <= 0.1 * eps {
                         for &m in members {
                             if let Some((_, u)) = lanes.member(m) {
                                 u.h_adaptive = (h * factor).min(span.max(h));
@@ -258,6 +302,7 @@ impl MeGroup {
                     h *= factor.min(0.9);
                 },
                 Solver::Rk4 { .. } => {
+                    self.count_step(lanes, t)?;
                     for &m in members {
                         if let Some((inst, u)) = lanes.member(m) {
                             u.rk4(inst, t, h)?;
@@ -320,6 +365,7 @@ impl MeGroup {
                 }
             }
             t = t_new;
+            self.ended(lanes, t)?;
             let at_time_event = time_event && t >= target - eps;
             if at_time_event {
                 let due: Vec<usize> = members
@@ -333,4 +379,12 @@ impl MeGroup {
             }
         }
     }
+}
+
+/// Two times closer than this within a communication step of length `span` ending at
+/// `t_end` are the same time: 1e-13 of the time (at most 1e-6 of the step, so that large
+/// times do not swallow the step), and at least two ulps of `t_end` (the rounding of the
+/// times themselves).
+fn time_slack(t_end: f64, span: f64) -> f64 {
+    (1e-13 * t_end.abs().max(1.0)).min(1e-6 * span).max(2.0 * crate::simulate::clock::ulp(t_end))
 }

@@ -26,9 +26,9 @@ mod observer;
 mod plan;
 mod types;
 
-pub use driver::{simulate, simulate_with, InstancePool, RowSink};
+pub use driver::{simulate, simulate_recorded, simulate_with, InstancePool, RowSink};
 pub use lane::apply_start_values;
 pub use plan::default_record;
-pub use types::{push_number, Algorithm, Experiment, Results, Summary};
+pub use types::{push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

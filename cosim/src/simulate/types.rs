@@ -25,6 +25,10 @@ impl std::str::FromStr for Algorithm {
     }
 }
 
+/// The default of [`Experiment::max_steps`]: a thousand million steps (about half an
+/// hour of the closed loop at its speed).
+pub const DEFAULT_MAX_STEPS: u64 = 1_000_000_000;
+
 /// What to simulate.
 #[derive(Clone, Debug)]
 pub struct Experiment {
@@ -55,6 +59,16 @@ pub struct Experiment {
     /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
     /// stops the run with [`Error::Fmi`].
     pub retry_discard: bool,
+    /// The cap on the steps of a run: communication steps, and the internal steps
+    /// (accepted and rejected) of the Model Exchange integrator; a run that would take
+    /// more stops with [`Error::Experiment`] (an adaptive step that shrinks without end
+    /// never hangs the run).
+    pub max_steps: u64,
+    /// Instances in host processes of their own (`None`: all in this process).
+    pub isolation: Option<crate::isolate::Isolation>,
+    /// The wall-clock limit of the whole run ([`Error::Timeout`], or
+    /// [`Error::Host`] when it passes during a call of an isolated instance).
+    pub timeout: Option<Duration>,
 }
 
 impl Experiment {
@@ -72,6 +86,9 @@ impl Experiment {
             progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
+            max_steps: DEFAULT_MAX_STEPS,
+            isolation: None,
+            timeout: None,
         }
     }
 }
@@ -144,7 +161,7 @@ pub fn push_number(out: &mut String, v: f64) {
 /// A JSON-able run summary.
 #[derive(Clone, Debug, Default)]
 pub struct Summary {
-    /// Communication steps taken.
+    /// Communication steps completed.
     pub steps: u64,
     /// Wall time of initialization + loop.
     pub wall_time: Duration,
@@ -160,6 +177,9 @@ pub struct Summary {
     pub discard_retries: u64,
     /// `jacobi` steps run with the instances spread over threads (0 in one thread).
     pub parallel_steps: u64,
+    /// The FMU that ended the run itself (FMI's fmi2Terminated / terminateSimulation):
+    /// its instance, the time the run ended, and how it said so.
+    pub ended_by: Option<(String, f64, &'static str)>,
 }
 
 impl Summary {
@@ -171,6 +191,7 @@ impl Summary {
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
             "discard_retries": self.discard_retries,
             "parallel_steps": self.parallel_steps,
+            "ended_by": self.ended_by.as_ref().map(|(i, t, r)| serde_json::json!({"instance": i, "time": t, "reason": r})),
             "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),

@@ -262,3 +262,15 @@ pub fn build_latch(dir: &Path) -> PathBuf {
 "#;
     build_single_c_fmu(dir, "latch", xml)
 }
+
+/// The self-ending counter (tests/cfmu/stair.c, after the Reference FMU Stair), Model
+/// Exchange and Co-Simulation, as `<dir>/stair.fmu`.
+pub fn build_stair(dir: &Path) -> PathBuf {
+    build_single_c_fmu(dir, "stair", include_str!("../cfmu/stair.xml"))
+}
+
+/// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
+/// exit(0) or a never-returning step at t_crash), as `<dir>/crash.fmu`.
+pub fn build_crash(dir: &Path) -> PathBuf {
+    build_single_c_fmu(dir, "crash", include_str!("../cfmu/crash.xml"))
+}

@@ -31,6 +31,7 @@ unsafe extern "C" fn record(
 
 pub const OK: Fmi2Status = Fmi2Status::Ok;
 pub const ERR: Fmi2Status = Fmi2Status::Error;
+pub const DISCARD: Fmi2Status = Fmi2Status::Discard;
 
 pub struct Fmu<M: Model> {
     pub c: fmi2Component,
@@ -65,8 +66,34 @@ impl<M: Model> Fmu<M> {
     pub fn last_error(&self) -> String {
         self.log.0.borrow().iter().rev().find(|r| r.0 >= 3).map(|r| r.2.clone()).unwrap_or_default()
     }
+    /// The last message logged with status Discard or worse.
+    pub fn last_message(&self) -> String {
+        self.log.0.borrow().iter().rev().find(|r| r.0 >= 2).map(|r| r.2.clone()).unwrap_or_default()
+    }
     pub fn setup(&self) -> Fmi2Status {
         unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, 0, 0.0) }
+    }
+    /// `fmi2SetupExperiment` with a start time and an optional stop time.
+    pub fn setup_at(&self, start: f64, stop: Option<f64>) -> Fmi2Status {
+        unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, start, stop.is_some() as i32, stop.unwrap_or(0.0)) }
+    }
+    /// setup at `start`, enter and exit initialization, all Ok.
+    pub fn init_at(&self, start: f64) {
+        assert_eq!(self.setup_at(start, None), OK, "{}", self.last_error());
+        assert_eq!(self.enter_init(), OK, "{}", self.last_error());
+        assert_eq!(self.exit_init(), OK, "{}", self.last_error());
+    }
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    pub fn last_successful_time(&self) -> f64 {
+        let mut t = f64::NAN;
+        assert_eq!(unsafe { abi::get_real_status::<M>(self.c, 2, &mut t) }, OK, "{}", self.last_error());
+        t
+    }
+    /// `fmi2GetBooleanStatus(fmi2Terminated)`.
+    pub fn terminated(&self) -> bool {
+        let mut b = -1;
+        assert_eq!(unsafe { abi::get_boolean_status::<M>(self.c, 3, &mut b) }, OK, "{}", self.last_error());
+        b == 1
     }
     pub fn enter_init(&self) -> Fmi2Status {
         unsafe { abi::enter_initialization_mode::<M>(self.c) }
@@ -123,6 +150,10 @@ impl<M: Model> Fmu<M> {
     }
     /// One event iteration; the next event time if defined.
     pub fn new_discrete_states(&self) -> Option<f64> {
+        self.event_iteration().0
+    }
+    /// One event iteration: the next event time if defined, and terminateSimulation.
+    pub fn event_iteration(&self) -> (Option<f64>, bool) {
         let mut info = Fmi2EventInfo {
             new_discrete_states_needed: 0,
             terminate_simulation: 0,
@@ -134,7 +165,7 @@ impl<M: Model> Fmu<M> {
         let s = unsafe { abi::new_discrete_states::<M>(self.c, &mut info) };
         assert_eq!(s, OK, "{}", self.last_error());
         assert_eq!(info.new_discrete_states_needed, 0);
-        (info.next_event_time_defined != 0).then_some(info.next_event_time)
+        ((info.next_event_time_defined != 0).then_some(info.next_event_time), info.terminate_simulation != 0)
     }
     /// FMU state round trip through serialization.
     pub fn serialized_state(&self) -> Vec<u8> {

@@ -57,7 +57,7 @@ Verification:
   --seed S                    their seed (default 0x5eed0f4157)
 Output:
   --json PATH                 write the full report as JSON
-  --plot PATH                 write an SVG figure (Pareto curve, pole map)
+  --plot PATH                 write an SVG figure (Pareto curve, pole map, zoom) and its PNG next to it
   --quiet                     no progress lines on stderr
   -h, --help                  this text
 
@@ -353,11 +353,10 @@ fn main() -> ExitCode {
                 }
             }
             if let Some(path) = &cli.plot {
-                if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_svg(&report)) {
-                    eprintln!("synthesize: cannot write {path}: {e}");
+                if let Err(e) = write_figure(path, &nigel_synthesis::plot::render_svg(&report)) {
+                    eprintln!("synthesize: {e}");
                     return ExitCode::from(1);
                 }
-                println!("wrote {path}");
             }
             report.verification.passed
         }
@@ -380,11 +379,10 @@ fn main() -> ExitCode {
                 }
             }
             if let Some(path) = &cli.plot {
-                if let Err(e) = std::fs::write(path, nigel_synthesis::plot::render_tracking_svg(&report)) {
-                    eprintln!("synthesize: cannot write {path}: {e}");
+                if let Err(e) = write_figure(path, &nigel_synthesis::plot::render_tracking_svg(&report)) {
+                    eprintln!("synthesize: {e}");
                     return ExitCode::from(1);
                 }
-                println!("wrote {path}");
             }
             report.verification.passed
         }
@@ -394,4 +392,16 @@ fn main() -> ExitCode {
         return ExitCode::from(3);
     }
     ExitCode::SUCCESS
+}
+
+/// Writes the SVG figure to `path` and its PNG next to it (`k.svg` -> `k.png`, 2 pixels per
+/// SVG unit), and says so.
+fn write_figure(path: &str, svg: &str) -> Result<(), String> {
+    std::fs::write(path, svg).map_err(|e| format!("cannot write {path}: {e}"))?;
+    println!("wrote {path}");
+    let png_path = std::path::Path::new(path).with_extension("png");
+    let png = nigel_synthesis::plot::render_png(svg, 2.0).map_err(|e| format!("{}: {e}", png_path.display()))?;
+    std::fs::write(&png_path, png).map_err(|e| format!("cannot write {}: {e}", png_path.display()))?;
+    println!("wrote {}", png_path.display());
+    Ok(())
 }

@@ -2,7 +2,7 @@
 //! by the master (`ordered`, 1 ms, 30 s), or in process as a cross-check.
 //!
 //! `table3 [--seed N] [--json PATH] [--png DIR] [--csv DIR] [--threads N]`
-//! `table3 --seeds 0..9 [--engine in-process]`: the seed study of issue 9 (the ratio
+//! `table3 --seeds 0..9 [--engine in-process]`: the seed study (the ratio
 //! `eps(robust_tracking) / eps(robust)` per cell and seed, the largest steering command).
 
 use std::io::IsTerminal;
@@ -62,6 +62,10 @@ struct Args {
     /// robust_tracking).
     #[arg(long = "controller", value_name = "NAME", value_parser = parse_controller)]
     controllers: Vec<Controller>,
+    /// Also run one's own gain: a `synthesize --json` report (its "K", rows FL, FR, RL, RR,
+    /// columns beta, r), as the controller `custom` (the controller FMU's tunable k_*).
+    #[arg(long, value_name = "K.json")]
+    gain: Option<PathBuf>,
     /// What runs the closed loops.
     #[arg(long, value_enum, default_value_t = EngineKind::Fmu)]
     engine: EngineKind,
@@ -155,6 +159,11 @@ fn run(args: &Args) -> Result<(), Error> {
     }
     if !args.controllers.is_empty() {
         options.controllers = nigel_table3::CONTROLLERS.into_iter().filter(|c| args.controllers.contains(c)).collect();
+    }
+    if let Some(path) = &args.gain {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+        let k = nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Usage)?;
+        options.controllers.push(Controller::Custom(k));
     }
     options.keep_runs = args.png.is_some() || args.csv.is_some();
     if let Some(repeats) = args.bench {

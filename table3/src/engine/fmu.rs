@@ -27,6 +27,8 @@ pub struct FmuEngine {
     maneuver_values: [i32; 6],
     fidelity_values: [i32; 2],
     controller_values: [i32; 4],
+    /// The controller FMU's value of `custom` (the tunable `k_*` gain).
+    custom_value: i32,
     gains: [[[f64; 4]; 4]; 4],
     /// How the master exchanges values (`Ordered`, the table's; `Jacobi` delays every
     /// connection by one step).
@@ -161,6 +163,7 @@ impl FmuEngine {
             maneuver_values,
             fidelity_values,
             controller_values,
+            custom_value: all[3],
             gains,
             algorithm: Algorithm::Ordered,
         })
@@ -179,15 +182,21 @@ impl FmuEngine {
     }
 
     /// The system of one job: three instances `plant`, `controller`, `maneuver`, their
-    /// parameters and the closed-loop connections of the issue-6 contract.
+    /// parameters and the closed-loop connections (docs/closed-loop.svg).
     pub fn system(&self, job: &Job) -> Result<System, Error> {
         let ctx = |source| Error::Cosim { context: format!("building the system of {}", job.label()), source };
-        let controller = Controller::WITH_TRACKING.iter().position(|c| *c == job.controller).ok_or_else(|| {
-            Error::Usage(format!(
-                "the controller FMU runs open_loop, pole_placement, robust and robust_tracking, not {}",
-                job.controller
-            ))
-        })?;
+        // the controller FMU's switch value; a custom gain runs as `custom` with its k_* set
+        let (controller_value, custom) = match job.controller {
+            Controller::Custom(k) => (self.custom_value, Some(k)),
+            c => {
+                let i = Controller::WITH_TRACKING.iter().position(|x| *x == c).ok_or_else(|| {
+                    Error::Usage(format!(
+                        "the controller FMU runs open_loop, pole_placement, robust, robust_tracking and custom gains, not {c}"
+                    ))
+                })?;
+                (self.controller_values[i], None)
+            }
+        };
         let seed = i32::try_from(job.seed).map_err(|_| {
             Error::Usage(format!("seed {} does not fit the test bench's Integer seed (0 ..= {})", job.seed, i32::MAX))
         })?;
@@ -205,7 +214,13 @@ impl FmuEngine {
                 b.set(&format!("maneuver.{switch}"), Value::Boolean(false)).map_err(ctx)?;
             }
         }
-        b.set("controller.controller", Value::Integer(self.controller_values[controller])).map_err(ctx)?;
+        b.set("controller.controller", Value::Integer(controller_value)).map_err(ctx)?;
+        if let Some(k) = custom {
+            for (row, w) in k.iter().zip(WHEELS) {
+                b.set(&format!("controller.k_beta_{w}"), Value::Real(row[0])).map_err(ctx)?;
+                b.set(&format!("controller.k_yaw_rate_{w}"), Value::Real(row[1])).map_err(ctx)?;
+            }
+        }
         let real = job.fidelity == Fidelity::Real;
         for switch in ["friction_circle", "steering_servo", "motor_speed_limit"] {
             b.set(&format!("plant.{switch}"), Value::Boolean(real)).map_err(ctx)?;
@@ -343,7 +358,11 @@ impl FmuEngine {
             Ok((0..n).map(|k| [c[0][k], c[1][k], c[2][k], c[3][k]]).collect())
         };
         let (delta, mu) = (wheels("controller.delta")?, wheels("maneuver.mu")?);
-        let gain = self.gains[index(&Controller::WITH_TRACKING, &job.controller)];
+        let gain = match job.controller {
+            // the custom gain is the one set above (the FMU applies k_* as given)
+            Controller::Custom(_) => job.controller.feedback_gain(),
+            c => self.gains[index(&Controller::WITH_TRACKING, &c)],
+        };
         let run = Run {
             job: *job,
             gain,

@@ -24,13 +24,24 @@ pub const SELF_CHECK_REAL: [(Maneuver, f64, f64); 6] = [
     (Maneuver::Figure8, 0.650735, 0.42491),
 ];
 
+/// Relative tolerance of the robust cells against the self-check. The self-check's robust gain
+/// is another solution of the same LMIs than the baked `gains::ROBUST` (the optimum is flat in
+/// `K` to about 1e-5; `nigel-benchmark`'s `tests/table3.rs` runs the self-check's own gain
+/// against it to 1e-5), and across the two the robust cells move by up to 2.0e-4 (sim straight
+/// and lane change, measured): 5e-4 holds that, and a change of the definition moves the cells
+/// by percents.
+pub const ROBUST_CELL_TOLERANCE: f64 = 5e-4;
+
 /// Asserts the 24 cells of the self-check against `table` (1e-4 relative in sim, 1e-3 in
-/// real; the self-check prints six significant digits, so 1e-4 is also about its rounding).
+/// real; the self-check prints six significant digits, so 1e-4 is also about its rounding;
+/// the robust cells of the sim column to [`ROBUST_CELL_TOLERANCE`]).
 pub fn assert_self_check(table: &Table) {
     let mut worst: [f64; 2] = [0.0; 2];
     for (f, rows, tol) in [(Fidelity::Paper, SELF_CHECK_SIM, 1e-4), (Fidelity::Real, SELF_CHECK_REAL, 1e-3)] {
         for (m, open, robust) in rows {
-            for (c, expected) in [(Controller::OpenLoop, open), (Controller::Robust, robust)] {
+            for (c, expected, tol) in
+                [(Controller::OpenLoop, open, tol), (Controller::Robust, robust, f64::max(tol, ROBUST_CELL_TOLERANCE))]
+            {
                 let got = table.get(f, m, c).unwrap_or_else(|| panic!("no cell {f:?} {m} {c}")).metric.eps;
                 let rel = (got - expected).abs() / expected;
                 let i = if f == Fidelity::Paper { 0 } else { 1 };
@@ -46,7 +57,7 @@ pub fn assert_self_check(table: &Table) {
     eprintln!("self-check: worst relative difference sim {:.2e}, real {:.2e}", worst[0], worst[1]);
 }
 
-/// Issue 9's goal on one table: `robust_tracking` has the lowest epsilon of the four
+/// The tracking controller's claim on one table: `robust_tracking` has the lowest epsilon of the four
 /// controllers in all 12 rows, and its steering stays inside `delta_max`, like every run's.
 pub fn assert_tracking_lowest(table: &Table) {
     let mut rows = 0;

@@ -7,7 +7,7 @@ through the connections before the first step as we do, and apply the SSD's inli
 bindings themselves, so epsilon equals our `jacobi` run to 1e-9 (measured: to every printed
 digit, the pose to 1e-13) and is within 2 % of `ordered` (the one-step delay).
 
-What it took (issue 8, part 4):
+What it takes:
 - neither tool sees FMI 2.0 Enumeration variables (libcosim lists none): the switches
   `maneuver`, `fidelity` and `controller` are plain Integer parameters now;
 - libcosim applies a binding only to a parameter or an input (ssp_loader.cpp: "Non-input

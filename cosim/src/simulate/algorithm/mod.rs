@@ -56,7 +56,7 @@ pub(crate) trait Communication {
         for n in 0..core.clock.steps {
             let p = core.clock.point(n);
             self.step(core, p, observers.calls())?;
-            observers.step_complete(&p, &core.values);
+            observers.step_complete(&p, &core.values)?;
         }
         self.finish(core)
     }

@@ -126,8 +126,8 @@ struct Pool {
 impl Pool {
     /// Runs the `jacobi` steps `steps` of `clock`; the observers are told after each step
     /// with all outputs in their slots. Returns the lanes in their original order and the
-    /// first step not run (the end of `steps` unless the pool was slower than one thread).
-    /// The first error (lowest instance index) of a step ends the run.
+    /// first step not run (the end of `steps` unless the pool was slower than one thread),
+    /// or the first error (lowest instance index) of a step, which ends the run.
     fn run(
         &self,
         lanes: Vec<Lane>,
@@ -135,7 +135,7 @@ impl Pool {
         clock: &Clock,
         steps: Range<u64>,
         observers: &mut Observers,
-    ) -> Result<(Vec<Lane>, u64)> {
+    ) -> (Vec<Lane>, Result<u64>) {
         let solver = self.solver;
         let profile = self.profile;
         let threads = self.threads.clamp(1, lanes.len().max(1));
@@ -207,7 +207,7 @@ impl Pool {
                             lane.scatter(&mut values, a.output_point);
                         }
                     }
-                    observers.step_complete(&a, &values);
+                    observers.step_complete(&a, &values)?;
                 }
                 Ok(steps.end)
             };
@@ -223,7 +223,7 @@ impl Pool {
         let mut lanes: Vec<Lane> =
             shared.groups.into_iter().flat_map(|g| g.into_inner().unwrap_or_else(|e| e.into_inner())).collect();
         lanes.sort_by_key(|l| l.index);
-        result.map(|next| (lanes, next))
+        (lanes, result)
     }
 }
 
@@ -263,7 +263,7 @@ impl Communication for ThreadedJacobi {
             for n in 0..calibration {
                 let p = core.clock.point(n);
                 Jacobi::step_lanes(core, p, true)?;
-                observers.step_complete(&p, &core.values);
+                observers.step_complete(&p, &core.values)?;
             }
             first = calibration;
             let serial_step = calibration_start.elapsed() / calibration.max(1) as u32;
@@ -271,8 +271,9 @@ impl Communication for ThreadedJacobi {
                 let pool = Pool { threads, solver: core.solver, profile: core.profile, serial_step };
                 let lanes = std::mem::take(&mut core.lanes);
                 let clock = core.clock;
-                let (back, next) = pool.run(lanes, &mut core.values, &clock, first..steps, observers)?;
+                let (back, next) = pool.run(lanes, &mut core.values, &clock, first..steps, observers);
                 core.lanes = back;
+                let next = next?;
                 core.parallel_steps = next - first;
                 first = next;
             }
@@ -280,7 +281,7 @@ impl Communication for ThreadedJacobi {
         for n in first..steps {
             let p = core.clock.point(n);
             Jacobi.step(core, p, None)?;
-            observers.step_complete(&p, &core.values);
+            observers.step_complete(&p, &core.values)?;
         }
         self.finish(core)
     }

@@ -1,0 +1,415 @@
+//! The master's side of one host process: start, calls (one round trip each, sets queued),
+//! liveness and time limits, and the end of the host.
+
+use super::{publish, wait_for, Header, Layout, Op};
+use crate::error::HostEnd;
+use crate::fmu::{LogRecord, LogSink};
+use crate::Status;
+use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+/// Spin before sleeping while waiting for the host (the host of a 1 us `fmi2DoStep`
+/// answers within it; a longer call puts the master to sleep).
+const MASTER_SPIN: Duration = Duration::from_micros(5);
+/// How often a sleeping master checks the host and the time limits.
+const CHECK_SLICE: Duration = Duration::from_millis(10);
+/// fmi2Fatal: what the proxy returns for a call the host did not answer.
+pub(crate) const FATAL: i32 = 4;
+
+/// The host binary: `explicit`, else `NIGEL_COSIM_HOST`, else `cosim-host` next to the
+/// running executable or one folder up (test binaries live in `target/*/deps`).
+pub(crate) fn find_host(explicit: Option<&Path>) -> Result<PathBuf, String> {
+    if let Some(p) = explicit {
+        return Ok(p.to_path_buf());
+    }
+    if let Some(p) = std::env::var_os("NIGEL_COSIM_HOST") {
+        return Ok(PathBuf::from(p));
+    }
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find the running executable: {e}"))?;
+    let mut dir = exe.parent();
+    for _ in 0..2 {
+        let Some(d) = dir else { break };
+        let candidate = d.join("cosim-host");
+        if candidate.is_file() {
+            return Ok(candidate);
+        }
+        dir = d.parent();
+    }
+    Err(format!(
+        "no cosim-host next to {} (build it with `cargo build --release -p nigel-cosim`, or set NIGEL_COSIM_HOST)",
+        exe.display()
+    ))
+}
+
+/// One host process and the region shared with it.
+pub(crate) struct Channel {
+    base: *mut u8,
+    layout: Layout,
+    _fd: OwnedFd,
+    pid: libc::pid_t,
+    /// The host's end, once known (it is then reaped).
+    pub(crate) failure: Option<HostEnd>,
+    reaped: bool,
+    seq: u32,
+    call_timeout: Option<Duration>,
+    run_deadline: Option<(Instant, Duration)>,
+    /// The log the messages of the host's FMU go to (the instance's).
+    pub(crate) log: *const LogSink,
+    /// The simulation time of the last timed call, s.
+    pub(crate) last_time: f64,
+    /// Sets queued for the next call.
+    queued: u32,
+    queued_bytes: usize,
+    /// Where the queued sets came from, for the message of a failure.
+    queued_functions: Vec<&'static str>,
+    /// The Reals the host reads after each step (their references), and whether the
+    /// values in the region are those of the last step.
+    prefetch_vrs: Vec<u32>,
+    prefetch_valid: bool,
+    /// The last call was a step: the next `fmi2GetReal` sets the prefetch.
+    after_step: bool,
+    /// Strings returned by `fmi2GetString`, valid until the next call.
+    pub(crate) strings: Vec<std::ffi::CString>,
+    /// The messages of the last call (also in the instance's log once it has one).
+    last_records: Vec<LogRecord>,
+}
+
+// SAFETY: the region and the host are used only through `&mut self` (one caller at a
+// time), as the instance that owns the channel is.
+unsafe impl Send for Channel {}
+
+impl Channel {
+    /// Starts `host` for the library `library` of an FMU of `variables` variables.
+    pub(crate) fn start(
+        host: &Path,
+        library: &Path,
+        variables: usize,
+        call_timeout: Option<Duration>,
+        run_deadline: Option<(Instant, Duration)>,
+    ) -> Result<Channel, String> {
+        let layout = Layout::for_variables(variables);
+        // SAFETY: plain syscalls; the name is a NUL-terminated literal.
+        let raw = unsafe { libc::memfd_create(c"nigel-cosim-host".as_ptr(), 0) };
+        if raw < 0 {
+            return Err(format!("memfd_create: {}", std::io::Error::last_os_error()));
+        }
+        // SAFETY: `raw` is a fresh descriptor we own.
+        let fd = unsafe { OwnedFd::from_raw_fd(raw) };
+        // SAFETY: a descriptor we own, a size in range.
+        if unsafe { libc::ftruncate(fd.as_raw_fd(), layout.total as libc::off_t) } != 0 {
+            return Err(format!("ftruncate: {}", std::io::Error::last_os_error()));
+        }
+        // SAFETY: maps the whole memfd shared, read-write.
+        let base = unsafe {
+            libc::mmap(
+                std::ptr::null_mut(),
+                layout.total,
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_SHARED,
+                fd.as_raw_fd(),
+                0,
+            )
+        };
+        if base == libc::MAP_FAILED {
+            return Err(format!("mmap: {}", std::io::Error::last_os_error()));
+        }
+        let mut command = std::process::Command::new(host);
+        command
+            .arg(fd.as_raw_fd().to_string())
+            .arg(layout.total.to_string())
+            .arg(library)
+            .stdin(std::process::Stdio::null());
+        // SAFETY: runs in the child between fork and exec: only async-signal-safe calls
+        // (prctl). The host dies with the master.
+        unsafe {
+            use std::os::unix::process::CommandExt;
+            command.pre_exec(|| {
+                libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
+                Ok(())
+            });
+        }
+        let child = command.spawn().map_err(|e| format!("cannot start {}: {e}", host.display()))?;
+        let mut channel = Channel {
+            base: base as *mut u8,
+            layout,
+            _fd: fd,
+            pid: child.id() as libc::pid_t,
+            failure: None,
+            reaped: false,
+            seq: 0,
+            call_timeout,
+            run_deadline,
+            log: std::ptr::null(),
+            last_time: 0.0,
+            queued: 0,
+            queued_bytes: 0,
+            queued_functions: Vec::new(),
+            prefetch_vrs: Vec::new(),
+            prefetch_valid: false,
+            after_step: false,
+            strings: Vec::new(),
+            last_records: Vec::new(),
+        };
+        std::mem::forget(child); // reaped by waitpid in `reap`
+        // the host answers a first empty call once it has loaded the library
+        let status = channel.call(Op::Flush);
+        if status != 0 {
+            return Err(match &channel.failure {
+                Some(f) => format!("the host {f} while loading {}", library.display()),
+                None => format!(
+                    "the host could not load {}: {}",
+                    library.display(),
+                    channel.last_records.iter().map(|r| r.message.as_str()).collect::<Vec<_>>().join("; ")
+                ),
+            });
+        }
+        Ok(channel)
+    }
+
+    #[allow(clippy::mut_from_ref)] // the region is memory the host shares, not a Rust object
+    pub(crate) fn header(&self) -> &mut Header {
+        // SAFETY: the region starts with a Header, is page-aligned and lives as long as
+        // self; the host writes it only while the master waits (the protocol's turns).
+        unsafe { &mut *(self.base as *mut Header) }
+    }
+
+    /// The call's array area.
+    pub(crate) fn data(&mut self) -> &mut [u8] {
+        // SAFETY: within the mapping (see Layout), exclusive while it is the master's turn.
+        unsafe { std::slice::from_raw_parts_mut(self.base.add(self.layout.data), self.layout.data_len) }
+    }
+
+    fn area(&mut self, offset: usize, len: usize) -> &mut [u8] {
+        // SAFETY: within the mapping (see Layout), exclusive while it is the master's turn.
+        unsafe { std::slice::from_raw_parts_mut(self.base.add(offset), len) }
+    }
+
+    /// Queues an `fmi2SetReal/Integer/Boolean` (kind 0/1/2) of `vrs` with the values'
+    /// bytes `bytes`; false if it does not fit (the caller then flushes and retries).
+    pub(crate) fn queue_set(&mut self, kind: u32, function: &'static str, vrs: &[u32], bytes: &[u8]) -> bool {
+        let need = 8 + 4 * vrs.len() + bytes.len();
+        let need = need.div_ceil(8) * 8;
+        if self.queued_bytes + need > self.layout.sets_len {
+            return false;
+        }
+        let at = self.queued_bytes;
+        let (sets, len) = (self.layout.sets, self.layout.sets_len);
+        let area = self.area(sets, len);
+        area[at..at + 4].copy_from_slice(&kind.to_ne_bytes());
+        area[at + 4..at + 8].copy_from_slice(&(vrs.len() as u32).to_ne_bytes());
+        let mut p = at + 8;
+        for vr in vrs {
+            area[p..p + 4].copy_from_slice(&vr.to_ne_bytes());
+            p += 4;
+        }
+        area[p..p + bytes.len()].copy_from_slice(bytes);
+        self.queued_bytes += need;
+        self.queued += 1;
+        self.queued_functions.push(function);
+        self.prefetch_valid = false;
+        self.after_step = false;
+        true
+    }
+
+    /// `fmi2GetReal` of `vrs` answered from the values the host read after the last step.
+    pub(crate) fn prefetched_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> bool {
+        if !(self.prefetch_valid && self.prefetch_vrs == vrs) {
+            return false;
+        }
+        let off = self.layout.prefetch + (4 * vrs.len()).div_ceil(8) * 8;
+        // SAFETY: the host wrote vrs.len() f64 there, 8-aligned, before its answer.
+        let values = unsafe { std::slice::from_raw_parts(self.base.add(off) as *const f64, vrs.len()) };
+        out.copy_from_slice(values);
+        self.prefetch_valid = false;
+        true
+    }
+
+    /// The first `fmi2GetReal` after a step: the Reals the host reads after each step.
+    pub(crate) fn learn_prefetch(&mut self, vrs: &[u32]) {
+        if !self.after_step || 4 * vrs.len() + 8 * vrs.len() + 16 > self.layout.prefetch_len || self.prefetch_vrs == vrs
+        {
+            return;
+        }
+        self.prefetch_vrs.clear();
+        self.prefetch_vrs.extend_from_slice(vrs);
+        let (off, len) = (self.layout.prefetch, self.layout.prefetch_len);
+        let area = self.area(off, len);
+        for (k, vr) in vrs.iter().enumerate() {
+            area[4 * k..4 * k + 4].copy_from_slice(&vr.to_ne_bytes());
+        }
+        self.header().prefetch = vrs.len() as u32;
+    }
+
+    /// One round trip: call `op` (its arguments already in the header and data area),
+    /// with the queued sets first. Returns the fmi2 status, or [`FATAL`] with
+    /// `self.failure` set if the host ended or a time limit passed.
+    pub(crate) fn call(&mut self, op: Op) -> i32 {
+        if self.failure.is_some() {
+            return FATAL;
+        }
+        let was_step = op == Op::DoStep;
+        {
+            let h = self.header();
+            h.op = op as u32;
+            h.log_count = 0;
+            h.log_bytes = 0;
+            h.prefetched = 0;
+        }
+        let queued = self.queued;
+        let queued_bytes = self.queued_bytes;
+        {
+            let h = self.header();
+            h.queued = queued;
+            h.queued_bytes = queued_bytes as u32;
+            h.queued_failed = u32::MAX;
+        }
+        self.seq = self.seq.wrapping_add(1);
+        let seq = self.seq;
+        let start = Instant::now();
+        let h = self.header() as *mut Header;
+        // SAFETY: the header lives as long as self (see `header`).
+        let hdr = unsafe { &*h };
+        publish(&hdr.request, seq, &hdr.host_sleeping);
+        let outcome = wait_for(&hdr.response, seq.wrapping_sub(1), &hdr.master_sleeping, MASTER_SPIN, CHECK_SLICE, || {
+            self.check(start)
+        });
+        // the response may be stale only if it was never written (the host died)
+        if let Err(end) = outcome {
+            self.failure = Some(end);
+            return FATAL;
+        }
+        if hdr.response.load(Ordering::Acquire) != seq {
+            self.failure = Some(HostEnd::Failed(format!("answer {} to call {seq}", hdr.response.load(Ordering::Acquire))));
+            return FATAL;
+        }
+        self.read_log();
+        let mut status = hdr.status;
+        if hdr.queued_failed != u32::MAX {
+            let function = self.queued_functions.get(hdr.queued_failed as usize).copied().unwrap_or("fmi2Set*");
+            status = hdr.queued_status;
+            self.push_log(
+                Status::from_raw(status),
+                format!("{function} (sent with {}) returned {}", op.function(), Status::from_raw(status)),
+            );
+        }
+        self.queued = 0;
+        self.queued_bytes = 0;
+        self.queued_functions.clear();
+        self.prefetch_valid = was_step && hdr.prefetched == 1;
+        self.after_step = was_step && status <= 1;
+        status
+    }
+
+    /// While waiting: the host alive, and the time limits.
+    fn check(&mut self, start: Instant) -> Result<(), HostEnd> {
+        if let Some(end) = self.poll_exit() {
+            return Err(end);
+        }
+        if let Some(limit) = self.call_timeout {
+            if start.elapsed() > limit {
+                self.kill();
+                return Err(HostEnd::CallTimeout(limit));
+            }
+        }
+        if let Some((deadline, limit)) = self.run_deadline {
+            if Instant::now() > deadline {
+                self.kill();
+                return Err(HostEnd::RunTimeout(limit));
+            }
+        }
+        Ok(())
+    }
+
+    /// The host's end if it has ended (reaps it).
+    fn poll_exit(&mut self) -> Option<HostEnd> {
+        if self.reaped {
+            return Some(HostEnd::Failed("the host is gone".into()));
+        }
+        let mut status: libc::c_int = 0;
+        // SAFETY: our own child; WNOHANG does not block.
+        let r = unsafe { libc::waitpid(self.pid, &mut status, libc::WNOHANG) };
+        if r == self.pid {
+            self.reaped = true;
+            if libc::WIFSIGNALED(status) {
+                return Some(HostEnd::Signal(libc::WTERMSIG(status)));
+            }
+            return Some(HostEnd::Exit(libc::WEXITSTATUS(status)));
+        }
+        None
+    }
+
+    fn kill(&mut self) {
+        if !self.reaped {
+            // SAFETY: our own child, not yet reaped (its pid is still ours).
+            unsafe {
+                libc::kill(self.pid, libc::SIGKILL);
+                libc::waitpid(self.pid, std::ptr::null_mut(), 0);
+            }
+            self.reaped = true;
+        }
+    }
+
+    fn push_log(&self, status: Status, message: String) {
+        if self.log.is_null() {
+            return;
+        }
+        // SAFETY: the instance's LogSink outlives its channel (see proxy.rs).
+        let sink = unsafe { &*self.log };
+        sink.push(LogRecord { status, category: "host".into(), message });
+    }
+
+    /// The messages of the call into the instance's log.
+    fn read_log(&mut self) {
+        let (count, bytes) = (self.header().log_count, self.header().log_bytes as usize);
+        self.last_records.clear();
+        if count == 0 {
+            return;
+        }
+        let (off, len) = (self.layout.log, self.layout.log_len);
+        let area = self.area(off, len)[..bytes.min(len)].to_vec();
+        let mut p = 0;
+        for _ in 0..count {
+            if p + 12 > area.len() {
+                break;
+            }
+            let status = i32::from_ne_bytes(area[p..p + 4].try_into().unwrap_or([0; 4]));
+            let cl = u32::from_ne_bytes(area[p + 4..p + 8].try_into().unwrap_or([0; 4])) as usize;
+            let ml = u32::from_ne_bytes(area[p + 8..p + 12].try_into().unwrap_or([0; 4])) as usize;
+            p += 12;
+            if p + cl + ml > area.len() {
+                break;
+            }
+            let category = String::from_utf8_lossy(&area[p..p + cl]).into_owned();
+            let message = String::from_utf8_lossy(&area[p + cl..p + cl + ml]).into_owned();
+            p += cl + ml;
+            let record = LogRecord { status: Status::from_raw(status), category, message };
+            if !self.log.is_null() {
+                // SAFETY: as in push_log.
+                unsafe { &*self.log }.push(record.clone());
+            }
+            self.last_records.push(record);
+        }
+    }
+}
+
+impl Drop for Channel {
+    fn drop(&mut self) {
+        // a host that is still there after fmi2FreeInstance (or never got it) is killed
+        if !self.reaped {
+            let deadline = Instant::now() + Duration::from_millis(200);
+            while Instant::now() < deadline {
+                if self.poll_exit().is_some() {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            self.kill();
+        }
+        // SAFETY: the mapping made in `start`, unmapped once.
+        unsafe {
+            libc::munmap(self.base as *mut libc::c_void, self.layout.total);
+        }
+    }
+}

@@ -1,0 +1,348 @@
+//! The host process of an isolated instance (`cosim-host FD SIZE LIBRARY`): maps the
+//! region the master shares (descriptor `FD`, `SIZE` bytes), loads the FMU's library and
+//! answers the master's calls until `fmi2FreeInstance`, then exits 0. Whatever the FMU
+//! does to this process (a crash, `exit`, a call that never returns) the master sees as
+//! the host's end.
+
+use super::{publish, wait_for, Header, Layout, Op};
+use crate::fmu::{callbacks_for, load_library, EventInfo, Functions, LogSink};
+use std::ffi::{c_char, c_int, c_void, CStr};
+use std::path::Path;
+use std::time::Duration;
+
+/// The host spins this long for the next call before sleeping (the master's other
+/// instances take about a microsecond each between two calls to this one).
+const HOST_SPIN: Duration = Duration::from_micros(5);
+
+struct Region {
+    base: *mut u8,
+    layout: Layout,
+}
+
+impl Region {
+    #[allow(clippy::mut_from_ref)] // the region is memory the master shares, not a Rust object
+    fn header(&self) -> &mut Header {
+        // SAFETY: the mapping starts with the Header; the master does not touch it while
+        // it is the host's turn.
+        unsafe { &mut *(self.base as *mut Header) }
+    }
+    fn at<T>(&self, offset: usize) -> *mut T {
+        // SAFETY: offsets within the mapping (Layout), 8-aligned where f64 are read.
+        unsafe { self.base.add(offset) as *mut T }
+    }
+}
+
+/// Runs the host with the process arguments; returns the exit code.
+pub fn run(args: &[std::ffi::OsString]) -> i32 {
+    let (Some(fd), Some(size), Some(library)) = (args.get(1), args.get(2), args.get(3)) else {
+        eprintln!("cosim-host: started by the master (cosim --isolate), not by hand");
+        return 2;
+    };
+    let (Ok(fd), Ok(size)) = (fd.to_string_lossy().parse::<i32>(), size.to_string_lossy().parse::<usize>()) else {
+        eprintln!("cosim-host: bad arguments");
+        return 2;
+    };
+    // SAFETY: maps the descriptor the master passed, of the size it made it.
+    let base = unsafe {
+        libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0)
+    };
+    if base == libc::MAP_FAILED {
+        eprintln!("cosim-host: mmap: {}", std::io::Error::last_os_error());
+        return 2;
+    }
+    // the layout is a function of the size the master chose
+    let layout = layout_of(size);
+    let region = Region { base: base as *mut u8, layout };
+    let log = Box::<LogSink>::default();
+    let library = Path::new(library);
+    let loaded = load_library(library, library, &library.display().to_string())
+        .and_then(|lib| unsafe { Functions::load(&lib, library) }.map(|f| (lib, f)));
+    let mut seen = 0u32;
+    let (_lib, functions) = match loaded {
+        Ok(x) => x,
+        Err(e) => {
+            // answer the first call with the reason
+            wait_next(&region, &mut seen);
+            write_log_text(&region, 3, &e.to_string());
+            region.header().status = 3;
+            answer(&region, seen);
+            return 0;
+        }
+    };
+    let mut host = Host { f: functions, c: std::ptr::null_mut(), log, _callbacks: None, strings: Vec::new() };
+    loop {
+        wait_next(&region, &mut seen);
+        let h = region.header();
+        h.log_count = 0;
+        h.log_bytes = 0;
+        let op = Op::from_u32(h.op);
+        let mut status = host.queued(&region);
+        let mut free = false;
+        if status <= 1 {
+            status = match op {
+                Some(Op::Flush) => 0,
+                Some(Op::Free) => {
+                    free = true;
+                    host.free();
+                    0
+                }
+                Some(op) => host.call(op, &region),
+                None => 3,
+            };
+        }
+        if op == Some(Op::DoStep) && status <= 1 && h.prefetch > 0 {
+            let n = h.prefetch as usize;
+            let vrs: *const u32 = region.at(layout.prefetch);
+            let values: *mut f64 = region.at(layout.prefetch + (4 * n).div_ceil(8) * 8);
+            // SAFETY: live component; n references and n values inside the prefetch area.
+            let s = unsafe { (host.f.get_real)(host.c, vrs, n, values) };
+            h.prefetched = (s <= 1) as u32;
+        }
+        host.drain_log(&region);
+        h.status = status;
+        answer(&region, seen);
+        if free {
+            return 0;
+        }
+    }
+}
+
+fn layout_of(size: usize) -> Layout {
+    // the master sized the region with Layout::for_variables; find the same layout
+    let mut v = 16;
+    loop {
+        let l = Layout::for_variables(v);
+        if l.total >= size {
+            return l;
+        }
+        v = (v * 2).max(v + 1);
+    }
+}
+
+fn wait_next(region: &Region, seen: &mut u32) {
+    let h = region.header();
+    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, HOST_SPIN, Duration::from_secs(1), || Ok(()));
+    *seen = h.request.load(std::sync::atomic::Ordering::Acquire);
+}
+
+fn answer(region: &Region, seq: u32) {
+    let h = region.header();
+    publish(&h.response, seq, &h.master_sleeping);
+}
+
+fn write_log_text(region: &Region, status: i32, text: &str) {
+    let h = region.header();
+    let l = region.layout;
+    let mut p = h.log_bytes as usize;
+    let (cat, msg) = (b"host".as_slice(), text.as_bytes());
+    if p + 12 + cat.len() + msg.len() > l.log_len {
+        return;
+    }
+    let area: *mut u8 = region.at(l.log);
+    // SAFETY: within the log area (checked above).
+    unsafe {
+        let dst = std::slice::from_raw_parts_mut(area.add(p), 12 + cat.len() + msg.len());
+        dst[0..4].copy_from_slice(&status.to_ne_bytes());
+        dst[4..8].copy_from_slice(&(cat.len() as u32).to_ne_bytes());
+        dst[8..12].copy_from_slice(&(msg.len() as u32).to_ne_bytes());
+        dst[12..12 + cat.len()].copy_from_slice(cat);
+        dst[12 + cat.len()..].copy_from_slice(msg);
+    }
+    p += 12 + cat.len() + msg.len();
+    h.log_bytes = p as u32;
+    h.log_count += 1;
+}
+
+struct Host {
+    f: Functions,
+    c: *mut c_void,
+    log: Box<LogSink>,
+    _callbacks: Option<Box<crate::fmu::CallbackFunctions>>,
+    strings: Vec<std::ffi::CString>,
+}
+
+impl Host {
+    /// The queued sets, in order; the status of the first that failed (the rest skipped).
+    fn queued(&mut self, region: &Region) -> i32 {
+        let h = region.header();
+        let l = region.layout;
+        let mut p = 0usize;
+        for k in 0..h.queued {
+            let base: *mut u8 = region.at(l.sets + p);
+            // SAFETY: the master wrote the record inside the set area (queue_set).
+            let (kind, n) = unsafe { (*(base as *const u32), *(base.add(4) as *const u32) as usize) };
+            let vrs = unsafe { base.add(8) } as *const u32;
+            let values = unsafe { base.add(8 + 4 * n) };
+            // SAFETY: live component; n references and n values of the kind's type.
+            let s = unsafe {
+                match kind {
+                    0 => (self.f.set_real)(self.c, vrs, n, values as *const f64),
+                    1 => (self.f.set_integer)(self.c, vrs, n, values as *const c_int),
+                    _ => (self.f.set_boolean)(self.c, vrs, n, values as *const c_int),
+                }
+            };
+            let width = if kind == 0 { 8 } else { 4 };
+            p += (8 + 4 * n + width * n).div_ceil(8) * 8;
+            if s > 1 {
+                h.queued_failed = k;
+                h.queued_status = s;
+                return s;
+            }
+        }
+        0
+    }
+
+    fn free(&mut self) {
+        if !self.c.is_null() {
+            // SAFETY: the component from fmi2Instantiate, freed once.
+            unsafe { (self.f.free_instance)(self.c) };
+            self.c = std::ptr::null_mut();
+        }
+    }
+
+    fn drain_log(&mut self, region: &Region) {
+        for r in self.log.take() {
+            let status = r.status.to_raw();
+            let h = region.header();
+            let l = region.layout;
+            let mut p = h.log_bytes as usize;
+            let (cat, msg) = (r.category.as_bytes(), r.message.as_bytes());
+            if p + 12 + cat.len() + msg.len() > l.log_len {
+                return;
+            }
+            let area: *mut u8 = region.at(l.log);
+            // SAFETY: within the log area (checked above).
+            unsafe {
+                let dst = std::slice::from_raw_parts_mut(area.add(p), 12 + cat.len() + msg.len());
+                dst[0..4].copy_from_slice(&status.to_ne_bytes());
+                dst[4..8].copy_from_slice(&(cat.len() as u32).to_ne_bytes());
+                dst[8..12].copy_from_slice(&(msg.len() as u32).to_ne_bytes());
+                dst[12..12 + cat.len()].copy_from_slice(cat);
+                dst[12 + cat.len()..].copy_from_slice(msg);
+            }
+            p += 12 + cat.len() + msg.len();
+            h.log_bytes = p as u32;
+            h.log_count += 1;
+        }
+    }
+
+    /// One fmi2 call with its arguments from the region, results into it.
+    fn call(&mut self, op: Op, region: &Region) -> i32 {
+        let h = region.header();
+        let l = region.layout;
+        let n = h.n as usize;
+        let data: *mut u8 = region.at(l.data);
+        let vrs = data as *const u32;
+        let after_vrs = (4 * n).div_ceil(8) * 8;
+        let c = self.c;
+        let f = &self.f;
+        let missing = 3;
+        // SAFETY: every pointer is inside the data area, laid out by the proxy for this
+        // op (proxy.rs); the component is live (the master's state machine orders calls).
+        unsafe {
+            match op {
+                Op::Instantiate => {
+                    let name = CStr::from_ptr(data as *const c_char);
+                    let guid_at = data.add(name.to_bytes().len() + 1);
+                    let guid = CStr::from_ptr(guid_at as *const c_char);
+                    let uri_at = guid_at.add(guid.to_bytes().len() + 1);
+                    let callbacks = callbacks_for(&self.log);
+                    self.c = (f.instantiate)(
+                        name.as_ptr(),
+                        h.i[0] as c_int,
+                        guid.as_ptr(),
+                        uri_at as *const c_char,
+                        &*callbacks,
+                        h.i[1] as c_int,
+                        h.i[2] as c_int,
+                    );
+                    self._callbacks = Some(callbacks);
+                    if self.c.is_null() {
+                        3
+                    } else {
+                        0
+                    }
+                }
+                Op::SetupExperiment => (f.setup_experiment)(c, h.i[0] as c_int, h.f[0], h.f[1], h.i[1] as c_int, h.f[2]),
+                Op::EnterInitializationMode => (f.enter_initialization_mode)(c),
+                Op::ExitInitializationMode => (f.exit_initialization_mode)(c),
+                Op::Terminate => (f.terminate)(c),
+                Op::Reset => f.reset.map_or(missing, |g| g(c)),
+                Op::GetReal => (f.get_real)(c, vrs, n, data.add(after_vrs) as *mut f64),
+                Op::GetInteger => (f.get_integer)(c, vrs, n, data.add(after_vrs) as *mut c_int),
+                Op::GetBoolean => (f.get_boolean)(c, vrs, n, data.add(after_vrs) as *mut c_int),
+                Op::GetString => {
+                    let mut ptrs: Vec<*const c_char> = vec![std::ptr::null(); n];
+                    let s = (f.get_string)(c, vrs, n, ptrs.as_mut_ptr());
+                    let mut p = after_vrs;
+                    for q in ptrs {
+                        let bytes = if q.is_null() { &[][..] } else { CStr::from_ptr(q).to_bytes() };
+                        if p + bytes.len() + 1 > l.data_len {
+                            return 3;
+                        }
+                        std::ptr::copy_nonoverlapping(bytes.as_ptr(), data.add(p), bytes.len());
+                        *data.add(p + bytes.len()) = 0;
+                        p += bytes.len() + 1;
+                    }
+                    s
+                }
+                Op::SetString => {
+                    self.strings.clear();
+                    let mut p = after_vrs;
+                    for _ in 0..n {
+                        let s = CStr::from_ptr(data.add(p) as *const c_char);
+                        p += s.to_bytes().len() + 1;
+                        self.strings.push(s.to_owned());
+                    }
+                    let ptrs: Vec<*const c_char> = self.strings.iter().map(|s| s.as_ptr()).collect();
+                    (f.set_string)(c, vrs, n, ptrs.as_ptr())
+                }
+                Op::DoStep => f.do_step.map_or(missing, |g| g(c, h.f[0], h.f[1], h.i[0] as c_int)),
+                Op::GetFmuState => {
+                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
+                    let r = f.get_fmu_state.map_or(missing, |g| g(c, &mut s));
+                    h.i[0] = s as usize as i64;
+                    r
+                }
+                Op::SetFmuState => f.set_fmu_state.map_or(missing, |g| g(c, h.i[0] as usize as *mut c_void)),
+                Op::FreeFmuState => {
+                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
+                    let r = f.free_fmu_state.map_or(missing, |g| g(c, &mut s));
+                    h.i[0] = s as usize as i64;
+                    r
+                }
+                Op::GetBooleanStatus => {
+                    let mut v: c_int = 0;
+                    let r = f.get_boolean_status.map_or(missing, |g| g(c, h.i[0] as c_int, &mut v));
+                    h.i[1] = v as i64;
+                    r
+                }
+                Op::GetRealStatus => {
+                    let mut v = 0.0;
+                    let r = f.get_real_status.map_or(missing, |g| g(c, h.i[0] as c_int, &mut v));
+                    h.f[0] = v;
+                    r
+                }
+                Op::EnterEventMode => f.enter_event_mode.map_or(missing, |g| g(c)),
+                Op::NewDiscreteStates => f.new_discrete_states.map_or(missing, |g| g(c, data as *mut EventInfo)),
+                Op::EnterContinuousTimeMode => f.enter_continuous_time_mode.map_or(missing, |g| g(c)),
+                Op::CompletedIntegratorStep => {
+                    let (mut a, mut b) = (0, 0);
+                    let r = f.completed_integrator_step.map_or(missing, |g| g(c, h.i[0] as c_int, &mut a, &mut b));
+                    h.i[1] = a as i64;
+                    h.i[2] = b as i64;
+                    r
+                }
+                Op::SetTime => f.set_time.map_or(missing, |g| g(c, h.f[0])),
+                Op::SetContinuousStates => f.set_continuous_states.map_or(missing, |g| g(c, data as *const f64, n)),
+                Op::GetDerivatives => f.get_derivatives.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetEventIndicators => f.get_event_indicators.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetContinuousStates => f.get_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetNominalsOfContinuousStates => {
+                    f.get_nominals_of_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n))
+                }
+                Op::Free | Op::Flush => 0,
+            }
+        }
+    }
+}

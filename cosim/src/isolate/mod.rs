@@ -1,0 +1,296 @@
+//! Isolation: an instance whose FMU runs in its own host process (`cosim-host`), so that
+//! a crash, an `exit`, or a call that never returns ends only the host. The master sees a
+//! typed [`Error::Host`](crate::Error::Host) naming the FMU, the function, the simulation
+//! time and the signal or exit code, and keeps the rows recorded so far.
+//!
+//! The master and the host share one memory region (`memfd_create` + `mmap`): a header
+//! with two sequence numbers (futex words) and the arguments of one call, then the
+//! arrays of the call (value references, values, states), then the messages the FMU
+//! logged during it. A call is one round trip: the master writes the request and bumps
+//! the request number; the host runs the fmi2 function on the real FMU, writes the
+//! results, the status and the log, and sets the response number. Each side spins for a
+//! few microseconds, then sleeps on the futex (woken only if it sleeps). While it waits
+//! the master checks every 10 ms that the host is alive (`waitpid`) and the call's and
+//! the run's time limits; an expired limit kills the host (SIGKILL).
+//!
+//! Setting inputs does not wait: `fmi2Set*` calls are queued in the region and sent with
+//! the next call that needs an answer (as a `jacobi` step's inputs go with its
+//! `fmi2DoStep`); after a step the host also reads the Reals the master read after the
+//! previous step, so that the master's next read of them needs no round trip. A
+//! `jacobi` step of an isolated instance is thus one round trip; an error of a queued set
+//! is reported by the call it went with, its function named in the log.
+//!
+//! The master's side is an [`Instance`](crate::Instance) whose function table is the
+//! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
+//! in-process ones. The host's side is [`host::run`], the whole of `cosim-host`.
+
+pub(crate) mod channel;
+pub mod host;
+pub(crate) mod proxy;
+
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::Duration;
+
+/// Which instances run in their own host process, and the time limit per call.
+#[derive(Clone, Debug, Default)]
+pub struct Isolation {
+    /// The instances to isolate (`None`: every instance).
+    pub instances: Option<Vec<String>>,
+    /// The wall-clock limit of one FMU call; the host is killed when it passes.
+    pub call_timeout: Option<Duration>,
+    /// The host binary (`None`: `cosim-host` next to the running executable, or the
+    /// `NIGEL_COSIM_HOST` environment variable).
+    pub host: Option<std::path::PathBuf>,
+}
+
+impl Isolation {
+    /// Whether instance `name` is isolated.
+    pub fn covers(&self, name: &str) -> bool {
+        self.instances.as_ref().is_none_or(|v| v.iter().any(|n| n == name))
+    }
+}
+
+/// The calls of the protocol.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Op {
+    Instantiate = 1,
+    Free,
+    SetupExperiment,
+    EnterInitializationMode,
+    ExitInitializationMode,
+    Terminate,
+    Reset,
+    GetReal,
+    GetInteger,
+    GetBoolean,
+    GetString,
+    SetString,
+    DoStep,
+    GetFmuState,
+    SetFmuState,
+    FreeFmuState,
+    GetBooleanStatus,
+    GetRealStatus,
+    EnterEventMode,
+    NewDiscreteStates,
+    EnterContinuousTimeMode,
+    CompletedIntegratorStep,
+    SetTime,
+    SetContinuousStates,
+    GetDerivatives,
+    GetEventIndicators,
+    GetContinuousStates,
+    GetNominalsOfContinuousStates,
+    /// Only the queued sets.
+    Flush,
+}
+
+impl Op {
+    pub(crate) fn from_u32(v: u32) -> Option<Op> {
+        use Op::*;
+        const ALL: [Op; 29] = [
+            Instantiate,
+            Free,
+            SetupExperiment,
+            EnterInitializationMode,
+            ExitInitializationMode,
+            Terminate,
+            Reset,
+            GetReal,
+            GetInteger,
+            GetBoolean,
+            GetString,
+            SetString,
+            DoStep,
+            GetFmuState,
+            SetFmuState,
+            FreeFmuState,
+            GetBooleanStatus,
+            GetRealStatus,
+            EnterEventMode,
+            NewDiscreteStates,
+            EnterContinuousTimeMode,
+            CompletedIntegratorStep,
+            SetTime,
+            SetContinuousStates,
+            GetDerivatives,
+            GetEventIndicators,
+            GetContinuousStates,
+            GetNominalsOfContinuousStates,
+            Flush,
+        ];
+        ALL.iter().copied().find(|o| *o as u32 == v)
+    }
+
+    /// The fmi2 function it is.
+    pub(crate) fn function(self) -> &'static str {
+        use Op::*;
+        match self {
+            Instantiate => "fmi2Instantiate",
+            Free => "fmi2FreeInstance",
+            SetupExperiment => "fmi2SetupExperiment",
+            EnterInitializationMode => "fmi2EnterInitializationMode",
+            ExitInitializationMode => "fmi2ExitInitializationMode",
+            Terminate => "fmi2Terminate",
+            Reset => "fmi2Reset",
+            GetReal => "fmi2GetReal",
+            GetInteger => "fmi2GetInteger",
+            GetBoolean => "fmi2GetBoolean",
+            GetString => "fmi2GetString",
+            SetString => "fmi2SetString",
+            DoStep => "fmi2DoStep",
+            GetFmuState => "fmi2GetFMUstate",
+            SetFmuState => "fmi2SetFMUstate",
+            FreeFmuState => "fmi2FreeFMUstate",
+            GetBooleanStatus => "fmi2GetBooleanStatus",
+            GetRealStatus => "fmi2GetRealStatus",
+            EnterEventMode => "fmi2EnterEventMode",
+            NewDiscreteStates => "fmi2NewDiscreteStates",
+            EnterContinuousTimeMode => "fmi2EnterContinuousTimeMode",
+            CompletedIntegratorStep => "fmi2CompletedIntegratorStep",
+            SetTime => "fmi2SetTime",
+            SetContinuousStates => "fmi2SetContinuousStates",
+            GetDerivatives => "fmi2GetDerivatives",
+            GetEventIndicators => "fmi2GetEventIndicators",
+            GetContinuousStates => "fmi2GetContinuousStates",
+            GetNominalsOfContinuousStates => "fmi2GetNominalsOfContinuousStates",
+            Flush => "fmi2Set*",
+        }
+    }
+}
+
+/// The header at the start of the shared region.
+#[repr(C)]
+pub(crate) struct Header {
+    /// Bumped by the master when a request is ready (a futex word).
+    pub(crate) request: AtomicU32,
+    /// Set to the request number by the host when it is answered (a futex word).
+    pub(crate) response: AtomicU32,
+    /// 1 while the host sleeps on `request`.
+    pub(crate) host_sleeping: AtomicU32,
+    /// 1 while the master sleeps on `response`.
+    pub(crate) master_sleeping: AtomicU32,
+    pub(crate) op: u32,
+    /// The fmi2 status of the call.
+    pub(crate) status: i32,
+    /// Queued sets in the set area (count, bytes used).
+    pub(crate) queued: u32,
+    pub(crate) queued_bytes: u32,
+    /// Index of the queued set that failed (u32::MAX: none), and its status.
+    pub(crate) queued_failed: u32,
+    pub(crate) queued_status: i32,
+    /// Reals to read after a successful `fmi2DoStep` (the prefetch), their count; the
+    /// value references are in the prefetch area, the values follow them.
+    pub(crate) prefetch: u32,
+    /// The prefetch was read (1) after the last step.
+    pub(crate) prefetched: u32,
+    /// Array lengths and scalar arguments of the call.
+    pub(crate) n: u64,
+    pub(crate) f: [f64; 4],
+    pub(crate) i: [i64; 4],
+    /// Messages logged during the call, and the bytes they take in the log area.
+    pub(crate) log_count: u32,
+    pub(crate) log_bytes: u32,
+}
+
+/// Layout of the region: the header, the call's arrays, the queued sets, the prefetch,
+/// the log. Sized from the FMU's numbers of variables and states.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Layout {
+    pub(crate) data: usize,
+    pub(crate) data_len: usize,
+    pub(crate) sets: usize,
+    pub(crate) sets_len: usize,
+    pub(crate) prefetch: usize,
+    pub(crate) prefetch_len: usize,
+    pub(crate) log: usize,
+    pub(crate) log_len: usize,
+    pub(crate) total: usize,
+}
+
+impl Layout {
+    /// For an FMU of `variables` variables (bounding any one call's arrays: 12 bytes per
+    /// value with its reference; strings get 64 KiB more).
+    pub(crate) fn for_variables(variables: usize) -> Layout {
+        let page = 4096;
+        let round = |x: usize| x.div_ceil(page) * page;
+        let arrays = round(16 * variables.max(16) + (64 << 10));
+        let data = page;
+        let sets = data + arrays;
+        let prefetch = sets + arrays;
+        let log = prefetch + arrays;
+        let log_len = 256 << 10;
+        Layout {
+            data,
+            data_len: arrays,
+            sets,
+            sets_len: arrays,
+            prefetch,
+            prefetch_len: arrays,
+            log,
+            log_len,
+            total: log + log_len,
+        }
+    }
+}
+
+/// Waits until `word` differs from `old`: spins for `spin`, then sleeps on the futex with
+/// `sleeping` set (the waker wakes only sleepers), at most `slice` at a time; `check` is
+/// called after each slice and may end the wait with its error.
+pub(crate) fn wait_for<E>(
+    word: &AtomicU32,
+    old: u32,
+    sleeping: &AtomicU32,
+    spin: Duration,
+    slice: Duration,
+    mut check: impl FnMut() -> Result<(), E>,
+) -> Result<(), E> {
+    if word.load(Ordering::Acquire) != old {
+        return Ok(());
+    }
+    let start = std::time::Instant::now();
+    let mut spins = 0u32;
+    while start.elapsed() < spin {
+        for _ in 0..64 {
+            std::hint::spin_loop();
+        }
+        if word.load(Ordering::Acquire) != old {
+            return Ok(());
+        }
+        spins += 1;
+        if spins.is_multiple_of(8) {
+            std::thread::yield_now();
+        }
+    }
+    loop {
+        sleeping.store(1, Ordering::SeqCst);
+        if word.load(Ordering::SeqCst) != old {
+            sleeping.store(0, Ordering::SeqCst);
+            return Ok(());
+        }
+        let ts = libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
+        // SAFETY: `word` is a live u32 in shared memory; FUTEX_WAIT (not private: the
+        // region is shared between processes) returns when woken, on timeout or at once
+        // if the word is no longer `old`.
+        unsafe {
+            libc::syscall(libc::SYS_futex, word.as_ptr(), libc::FUTEX_WAIT, old, &ts as *const libc::timespec);
+        }
+        sleeping.store(0, Ordering::SeqCst);
+        if word.load(Ordering::Acquire) != old {
+            return Ok(());
+        }
+        check()?;
+    }
+}
+
+/// Publishes `value` in `word` and wakes the other side if it sleeps on it.
+pub(crate) fn publish(word: &AtomicU32, value: u32, sleeping: &AtomicU32) {
+    word.store(value, Ordering::SeqCst);
+    if sleeping.load(Ordering::SeqCst) != 0 {
+        // SAFETY: `word` is a live u32 in shared memory; wakes every waiter on it.
+        unsafe {
+            libc::syscall(libc::SYS_futex, word.as_ptr(), libc::FUTEX_WAKE, i32::MAX);
+        }
+    }
+}

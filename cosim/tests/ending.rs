@@ -1,0 +1,56 @@
+//! Ending a run the FMI 2 way, with a C FMU after the Reference FMU `Stair` (a counter
+//! 1 .. 10, one more each whole second, that ends the simulation when it reaches 10 at
+//! t = 9 s), run as fmpy and fmusim run it:
+//! - Co-Simulation: `fmi2DoStep` over (8.8, 9.0] returns fmi2Discard with fmi2Terminated
+//!   true and fmi2LastSuccessfulTime 9: the run ends there, with the row at 9 (counter 10);
+//! - Model Exchange: `terminateSimulation` at the time event at 9: the run ends at the
+//!   event, the last row is the communication point before it (8.8, counter 9).
+
+mod common;
+use common::{build_stair, work_dir};
+use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, Interface, System};
+
+fn stair(interface: Interface) -> System {
+    let dir = work_dir(&format!("stair-{}", interface.as_str()));
+    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    System::single("model", Fmu::load_with(&build_stair(&dir), &options).unwrap()).unwrap()
+}
+
+/// Counter at time t: 1 plus the whole seconds up to t (the FMU's definition).
+fn counter_at(t: f64) -> f64 {
+    1.0 + (t + 1e-9).floor()
+}
+
+#[test]
+fn co_simulation_ends_at_the_last_successful_time_with_that_row() {
+    let system = stair(Interface::CoSimulation);
+    let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
+    let time = r.column("time").unwrap();
+    let counter = r.column("counter").unwrap();
+    // rows 0, 0.2, ..., 8.8 (45 communication points), then the row at 9
+    assert_eq!(r.rows(), 46);
+    assert_eq!(*time.last().unwrap(), 9.0);
+    assert_eq!(*counter.last().unwrap(), 10.0);
+    for (t, c) in time.iter().zip(&counter).take(45) {
+        assert_eq!(*c, counter_at(*t), "t = {t}");
+    }
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end), ("model", 9.0));
+    assert!(reason.contains("fmi2Terminated"), "{reason}");
+    assert_eq!(summary.steps, 44, "the step over (8.8, 9.0] did not complete");
+}
+
+#[test]
+fn model_exchange_ends_at_the_event_with_no_row_after_it() {
+    let system = stair(Interface::ModelExchange);
+    let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
+    let time = r.column("time").unwrap();
+    let counter = r.column("counter").unwrap();
+    assert_eq!(r.rows(), 45);
+    assert!((time.last().unwrap() - 8.8).abs() < 1e-12, "{:?}", time.last()); // 44 * 0.2 in f64
+    for (t, c) in time.iter().zip(&counter) {
+        assert_eq!(*c, counter_at(*t), "t = {t}");
+    }
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
+}

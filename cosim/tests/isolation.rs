@@ -1,0 +1,155 @@
+//! Isolation: FMUs in host processes of their own (`--isolate`, `Experiment::isolation`).
+//! A C FMU (tests/cfmu/crash.c) misbehaves in `fmi2DoStep` at t = 0.5 s (steps of 0.1 s):
+//! a segfault, abort, stack overflow, `exit(0)`, a step that never returns. Under
+//! `--isolate` each is a typed error naming the instance, the function, the time and the
+//! signal or exit code; the CSV holds the rows up to the last completed step (0 .. 0.5 s,
+//! y = t); the exit code is non-zero; TMPDIR (a fresh folder per run) is empty after.
+
+mod common;
+use common::{build_crash, plant_fmu, work_dir};
+use nigel_cosim::{
+    read_ssp, simulate, simulate::simulate_recorded, Algorithm, Error, Experiment, Fmu, HostEnd, Isolation,
+    SystemBuilder, Value,
+};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn cosim() -> &'static str {
+    env!("CARGO_BIN_EXE_cosim")
+}
+
+fn isolation() -> Isolation {
+    Isolation { instances: None, call_timeout: None, host: Some(PathBuf::from(env!("CARGO_BIN_EXE_cosim-host"))) }
+}
+
+fn fresh_tmp(dir: &Path, name: &str) -> PathBuf {
+    let t = dir.join(name);
+    let _ = std::fs::remove_dir_all(&t);
+    std::fs::create_dir_all(&t).unwrap();
+    t
+}
+
+/// Runs `cosim run crash.fmu --set mode=M --isolate ...` with its own TMPDIR; returns
+/// (exit code, stderr, CSV rows) and checks that TMPDIR is empty after.
+fn run_crash(test: &str, mode: u32, extra: &[&str]) -> (Option<i32>, String, Vec<(f64, f64)>) {
+    let dir = work_dir(&format!("{test}-{mode}-{}", extra.len()));
+    let fmu = build_crash(&dir);
+    let tmp = fresh_tmp(&dir, &format!("tmp-{mode}-{}", extra.len()));
+    let out = dir.join(format!("out-{mode}-{}.csv", extra.len()));
+    let _ = std::fs::remove_file(&out);
+    let done = Command::new(cosim())
+        .args(["run", fmu.to_str().unwrap(), "--set", &format!("mode={mode}"), "--output", out.to_str().unwrap()])
+        .args(extra)
+        .env("TMPDIR", &tmp)
+        .env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host"))
+        .output()
+        .unwrap();
+    let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().map(|e| e.unwrap().path()).collect();
+    assert!(left.is_empty(), "mode {mode}: left in TMPDIR: {left:?}");
+    let text = std::fs::read_to_string(&out).unwrap_or_default();
+    let rows = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut it = l.split(',').map(|x| x.parse::<f64>().unwrap());
+            (it.next().unwrap(), it.next().unwrap())
+        })
+        .collect();
+    (done.status.code(), String::from_utf8_lossy(&done.stderr).into_owned(), rows)
+}
+
+/// The rows of a run that stopped in the step from 0.5 s: 0, 0.1, ..., 0.5 with y = t.
+fn assert_rows_to_half(rows: &[(f64, f64)], what: &str) {
+    assert_eq!(rows.len(), 6, "{what}: {rows:?}");
+    for (n, (t, y)) in rows.iter().enumerate() {
+        assert_eq!(*t, n as f64 * 0.1, "{what}: row {n}");
+        // y is the FMU's own t + h, the same sum as the master's t0 + n h to one ulp
+        assert!((y - t).abs() <= 1e-15, "{what}: row {n}: y {y} at t {t}");
+    }
+}
+
+#[test]
+fn crashes_under_isolate_are_typed_errors_with_the_rows_so_far() {
+    for (mode, cause) in [
+        (1, vec!["signal 11 (SIGSEGV)"]),
+        (2, vec!["signal 6 (SIGABRT)"]),
+        // a C stack overflow hits the guard page: SIGSEGV (or SIGABRT from a handler)
+        (3, vec!["signal 11 (SIGSEGV)", "signal 6 (SIGABRT)"]),
+        (4, vec!["exited with code 0"]),
+    ] {
+        let (code, stderr, rows) = run_crash("isolation-crash", mode, &["--isolate"]);
+        assert_eq!(code, Some(1), "mode {mode}: {stderr}");
+        assert!(
+            stderr.contains("model: the FMU's host process") && stderr.contains("during fmi2DoStep at t = 0.5 s"),
+            "mode {mode}: {stderr}"
+        );
+        assert!(cause.iter().any(|c| stderr.contains(c)), "mode {mode}: {stderr}");
+        assert_rows_to_half(&rows, &format!("mode {mode}"));
+    }
+}
+
+#[test]
+fn a_step_that_never_returns_is_killed_by_the_call_or_the_run_limit() {
+    let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout-call", "0.5"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("the call took longer than 0.5 s (--timeout-call) during fmi2DoStep at t = 0.5 s"), "{stderr}");
+    assert_rows_to_half(&rows, "call limit");
+    let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout", "1"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("the run's time limit of 1 s passed (--timeout) during fmi2DoStep at t = 0.5 s"), "{stderr}");
+    assert_rows_to_half(&rows, "run limit");
+}
+
+#[test]
+fn timeout_call_needs_isolate_and_in_process_nothing_changes() {
+    let (code, stderr, _) = run_crash("isolation-local", 0, &["--timeout-call", "1"]);
+    assert_eq!(code, Some(1));
+    assert!(stderr.contains("--timeout-call needs --isolate"), "{stderr}");
+    // a well-behaved run, isolated or not: the same 11 rows
+    let (code, _, isolated) = run_crash("isolation-local", 0, &["--isolate"]);
+    assert_eq!(code, Some(0));
+    let (code, _, local) = run_crash("isolation-local", 0, &[]);
+    assert_eq!(code, Some(0));
+    assert_eq!(isolated.len(), 11);
+    assert_eq!(isolated, local);
+}
+
+#[test]
+fn per_instance_isolation_in_the_library_gives_the_typed_error_and_the_rows() {
+    let dir = work_dir("isolation-api");
+    let crash = Fmu::load(&build_crash(&dir)).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("bad", crash.clone()).unwrap();
+    b.add_instance("good", crash).unwrap();
+    b.set("bad.mode", Value::Real(1.0)).unwrap();
+    let system = b.build();
+    let mut e = Experiment::new(1.0, 0.1);
+    e.isolation = Some(Isolation { instances: Some(vec!["bad".into()]), ..isolation() });
+    let (results, outcome) = simulate_recorded(&system, &e);
+    match outcome {
+        Err(Error::Host { instance, function, time, cause }) => {
+            assert_eq!((instance.as_str(), function, time), ("bad", "fmi2DoStep", 0.5));
+            assert_eq!(cause, HostEnd::Signal(11));
+        }
+        other => panic!("expected the host's end, got {other:?}"),
+    }
+    assert_eq!(results.rows(), 6);
+    assert_eq!(results.column("good.y").unwrap(), results.column("time").unwrap());
+}
+
+#[test]
+fn the_isolated_closed_loop_is_bit_identical_to_in_process() {
+    let ssp = plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
+    let system = read_ssp(&ssp, &Default::default()).unwrap().system;
+    for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+        let mut e = Experiment::new(0.3, 1e-3);
+        e.algorithm = algorithm;
+        let (local, _) = simulate(&system, &e).unwrap();
+        e.isolation = Some(isolation());
+        let (isolated, _) = simulate(&system, &e).unwrap();
+        assert_eq!(local.names, isolated.names);
+        assert_eq!(local.rows(), 301);
+        let same = local.values.iter().zip(&isolated.values).all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{algorithm:?}: isolated values differ from in-process");
+    }
+}

@@ -1,0 +1,45 @@
+"""An FMU that ends its own run (tests/cfmu/stair.c, after the Reference FMU Stair: a counter
+1 .. 10 that ends the simulation at t = 9 s) run by the master and by fmpy 0.3.32's
+`simulate_fmu` in both interfaces: the same rows, the same values."""
+import subprocess
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+
+CFMU = Path(__file__).resolve().parent.parent / "cfmu"
+
+
+@pytest.fixture(scope="module")
+def stair_fmu(tmp_path_factory):
+    d = tmp_path_factory.mktemp("stair")
+    so = d / "stair.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", str(CFMU / "stair.c"), "-o", str(so)],
+                   check=True)
+    fmu = d / "stair.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.write(CFMU / "stair.xml", "modelDescription.xml")
+        z.write(so, "binaries/linux64/stair.so")
+    return fmu
+
+
+@pytest.mark.parametrize("interface,fmi_type", [("cs", "CoSimulation"), ("me", "ModelExchange")])
+def test_self_ending_fmu_runs_as_fmpy_runs_it(cosim, stair_fmu, tmp_path, interface, fmi_type):
+    out = tmp_path / "ours.csv"
+    done = subprocess.run([str(cosim), "run", str(stair_fmu), "--interface", interface, "--output", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "model ended the simulation at t = 9 s" in done.stderr, done.stderr
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    # the master records communication points only, not the instants before and after events
+    extra = {"record_events": False} if interface == "me" else {}
+    ref = simulate_fmu(str(stair_fmu), fmi_type=fmi_type, output_interval=0.2, **extra)
+    assert len(ours) == len(ref), (ours["time"][-3:], ref["time"][-3:])
+    # CS: 0 .. 8.8 then the row at fmi2LastSuccessfulTime 9; ME: 0 .. 8.8, none at or after the event
+    assert len(ref) == (46 if interface == "cs" else 45)
+    # both compute the points as start + n * 0.2 (fmpy) or t0 + n h (ours): equal to 1 ulp of 10 s
+    assert np.max(np.abs(ours["time"] - ref["time"])) <= 2e-15
+    assert np.array_equal(ours["counter"], ref["counter"])
+    assert ours["counter"][-1] == (10 if interface == "cs" else 9)
