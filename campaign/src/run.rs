@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
 use crate::metric::Accumulators;
-use crate::results::{self, Appender, Row, Target, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
+use crate::results::{self, Appender, Row, Target, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
 use crate::spec::{load_system, RunValues, Spec};
 use crate::Error;
 
@@ -125,25 +125,31 @@ impl<'a> Worker<'a> {
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
         let mut inside = Duration::ZERO;
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Vec<f64>, String> {
-            let system = self.spec.system_of(&self.base, &values)?;
-            let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
-            // every row after the first: the communication points t_1 .. t_N
-            let mut first = true;
-            let mut sink = |_t: f64, row: &[f64]| {
-                if first {
-                    first = false;
-                } else {
-                    acc.push(row);
-                }
-            };
-            let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
-                .map_err(|e| e.to_string())?;
-            inside = summary.wall_time;
-            Ok(acc.values())
-        }));
+        let outcome =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<(Vec<f64>, Option<String>), String> {
+                let system = self.spec.system_of(&self.base, &values)?;
+                let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
+                // every row after the first: the communication points t_1 .. t_N
+                let mut first = true;
+                let mut sink = |_t: f64, row: &[f64]| {
+                    if first {
+                        first = false;
+                    } else {
+                        acc.push(row);
+                    }
+                };
+                let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
+                    .map_err(|e| e.to_string())?;
+                inside = summary.wall_time;
+                // an FMU that ends the run before the stop time: the metrics cover fewer points
+                let ended = summary.ended_by.map(|(instance, t, reason)| {
+                    format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
+                });
+                Ok((acc.values(), ended))
+            }));
         let (status, message, metrics) = match outcome {
-            Ok(Ok(m)) => (STATUS_OK, String::new(), m),
+            Ok(Ok((m, None))) => (STATUS_OK, String::new(), m),
+            Ok(Ok((m, Some(ended)))) => (STATUS_ENDED, ended, m),
             Ok(Err(e)) => (STATUS_FAILED, e, nan_metrics()),
             Err(p) => {
                 let what = p

@@ -22,7 +22,7 @@ def test_fmpy_and_pandas_read_results(tmp_path):
     spec = tmp_path / "c.toml"
     spec.write_text(
         f'system = "{SSP}"\nstop_time = 0.2\nstep = 1e-3\nsamples = 2\n'
-        '[grid]\n"plant.v_fade" = [0.02, -1.0]\n'
+        '[grid]\n"maneuver.duration" = [30.0, 0.1]\n'
         '[cases.column]\nsim = { "maneuver.fidelity" = 1, "plant.friction_circle" = false }\n'
         'real = { "maneuver.fidelity" = 2, "plant.friction_circle" = true }\n'
         '[random]\n"plant.m" = { uniform = [2.4, 3.0] }\n'
@@ -35,7 +35,7 @@ def test_fmpy_and_pandas_read_results(tmp_path):
     assert len(rows) == 2 * 2 * 2
 
     traj = read_csv(out / "results.csv")
-    assert list(traj.dtype.names) == ["run", "status", "message", "plant.v_fade", "column", "plant.m", "y_final", "speed_mean"]
+    assert list(traj.dtype.names) == ["run", "status", "message", "maneuver.duration", "column", "plant.m", "y_final", "speed_mean"]
     frame = pandas.read_csv(out / "results.csv")
     assert list(frame.columns) == list(traj.dtype.names)
     for k, row in enumerate(rows):
@@ -43,11 +43,11 @@ def test_fmpy_and_pandas_read_results(tmp_path):
             for got in (traj[name][k], frame[name][k]):
                 assert (math.isnan(got) and math.isnan(row[j])) or got == row[j], (k, name)
     failed = frame[frame.status == 1]
-    # v_fade = -1 is refused by the plant: runs 4 .. 7 (the grid's second value)
+    # duration 0.1 s < stop time 0.2 s is refused by the test bench: runs 4 .. 7 (the grid's second value)
     assert list(failed.run) == [4, 5, 6, 7]
     assert failed.y_final.isna().all() and (failed.message == 1).all()
     messages = pandas.read_csv(out / "messages.csv")
     assert list(messages.run) == [4, 5, 6, 7]
-    assert all("v_fade" in m for m in messages.message)
-    # the case column holds the case's index: sim, real alternate fastest within a v_fade
+    assert all("duration" in m for m in messages.message)
+    # the case column holds the case's index: sim, real alternate fastest within a duration
     assert list(frame.column[:4]) == [0, 0, 1, 1]
