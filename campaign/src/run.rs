@@ -75,6 +75,7 @@ pub fn experiment(spec: &Spec, record: Vec<String>) -> Experiment {
     let mut e = Experiment::new(spec.stop_time, spec.step);
     e.algorithm = spec.algorithm;
     e.record = Some(record);
+    e.timeout = spec.timeout;
     e
 }
 

@@ -119,6 +119,9 @@ pub struct Spec {
     pub step: f64,
     /// The master's algorithm.
     pub algorithm: Algorithm,
+    /// Wall-clock limit of one run (`timeout = 10.0`, seconds): a run past it fails with
+    /// its message and the campaign goes on.
+    pub timeout: Option<std::time::Duration>,
     /// The campaign's random seed.
     pub seed: u64,
     /// Random draws per grid point.
@@ -451,11 +454,23 @@ impl Spec {
             doc.get(k).ok_or_else(|| bad(format!("missing {k}"))).and_then(|v| number(v, k).map_err(bad))
         };
         for k in doc.keys() {
-            if !["system", "stop_time", "step", "algorithm", "seed", "samples", "grid", "cases", "random", "metrics"]
-                .contains(&k.as_str())
+            if ![
+                "system",
+                "stop_time",
+                "step",
+                "algorithm",
+                "timeout",
+                "seed",
+                "samples",
+                "grid",
+                "cases",
+                "random",
+                "metrics",
+            ]
+            .contains(&k.as_str())
             {
                 return Err(bad(format!(
-                    "unknown key {k:?} (expected system, stop_time, step, algorithm, seed, samples, grid, cases, random, metrics)"
+                    "unknown key {k:?} (expected system, stop_time, step, algorithm, timeout, seed, samples, grid, cases, random, metrics)"
                 )));
             }
         }
@@ -471,6 +486,16 @@ impl Spec {
             None | Some(Some("ordered")) => Algorithm::Ordered,
             Some(Some("jacobi")) => Algorithm::Jacobi,
             Some(_) => return Err(bad("algorithm: expected \"ordered\" or \"jacobi\"".into())),
+        };
+        let timeout = match doc.get("timeout") {
+            None => None,
+            Some(v) => {
+                let t = number(v, "timeout").map_err(bad)?;
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(bad(format!("timeout: expected seconds > 0, got {t}")));
+                }
+                Some(std::time::Duration::from_secs_f64(t))
+            }
         };
         let uint = |k: &str, default: u64| -> Result<u64, Error> {
             match doc.get(k) {
@@ -540,6 +565,7 @@ impl Spec {
                 stop_time,
                 step,
                 algorithm,
+                timeout,
                 seed,
                 samples,
                 columns,

@@ -362,4 +362,13 @@ fn a_failing_run_is_a_row_and_the_campaign_goes_on() {
     assert!(rows[1].values[1].is_nan() && rows[0].values[1].is_finite());
     let text = std::fs::read_to_string(out.join("results.csv")).unwrap();
     assert!(text.lines().nth(2).unwrap().starts_with("1,1,1,0.02,NaN"), "{text}");
+    // a time limit no run can meet: every run fails with the master's timeout, none is lost
+    let text = std::fs::read_to_string(&path).unwrap().replace("step = 1e-3\n", "step = 1e-3\ntimeout = 1e-9\n");
+    std::fs::write(&path, text).unwrap();
+    let spec = Spec::load(&path).unwrap();
+    let out = dir.path().join("timeout");
+    let done = run(&spec, &quiet(&out)).unwrap();
+    assert_eq!((done.ran, done.failed), (3, 3));
+    let rows = nigel_campaign::results::read_rows(&Target::whole(&out), &spec, false).unwrap();
+    assert!(rows.iter().all(|r| r.status == 1 && r.message.contains("time")), "{:?}", rows[0].message);
 }
