@@ -7,11 +7,11 @@ docs/benchmark.md computed from the run, and a figure written to PNG.
 
 Prints (sim column, lane change, robust controller, seed 0):
 
-    epsilon 4.205241596e-02 (RMSE X 0.0007 m, Y 0.0419 m, psi 0.00383 rad)
+    epsilon 4.204754401e-02 (RMSE X 0.0007 m, Y 0.0419 m, psi 0.00383 rad)
     wrote closed_loop_fmpy.png
 
 The same job in `table3 --maneuver lane_change --controller robust --json t.json` gives
-eps 0.04205241596244...; the test (examples/test_examples.py) holds the two to 1e-9
+eps 0.0420475440138...; the test (examples/test_examples.py) holds the two to 1e-9
 relative (the same FMUs, the same step sizes and order: only the last bits of 30,000 RMSE
 terms may differ). The loop is "ordered": at
 each sample the plant's outputs go to the test bench, the test bench's to the controller,

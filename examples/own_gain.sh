@@ -10,7 +10,7 @@
 # Table II geometry) instead of the printed one. Prints, after the synthesis' own report:
 #   - table3's sim and real lane-change rows with the robust controller and "custom" (the
 #     gain of k.json): sim custom 6.126e-2, real custom 3.549e-2;
-#   - "cosim custom epsilon 6.125942400e-02": the same sim lane-change job run by the master
+#   - "cosim custom epsilon 6.126091740e-02": the same sim lane-change job run by the master
 #     from the SSP with the gain set by --gains, scored here from its CSV.
 # The test (examples/test_examples.py) checks that the two epsilons agree to 1e-9 relative
 # and that both use the gain in k.json.

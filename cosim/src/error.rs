@@ -162,6 +162,20 @@ pub enum Error {
         /// The last messages the FMU logged.
         log: String,
     },
+    /// An FMU returned a NaN or infinite Real with fmi2OK (refused where it came from,
+    /// before it reaches another FMU or the results).
+    NonFinite {
+        /// The instance.
+        instance: String,
+        /// The FMU file.
+        fmu: PathBuf,
+        /// The variable.
+        variable: String,
+        /// The value (NaN, inf or -inf).
+        value: f64,
+        /// The simulation time of the value, s.
+        time: f64,
+    },
     /// A call made in a state where the standard forbids it (a bug of the caller).
     IllegalCall {
         /// The instance name.
@@ -184,6 +198,24 @@ pub enum Error {
         instance: String,
         /// The variable.
         variable: String,
+        /// The closest names the instance has (at most 3).
+        closest: Vec<String>,
+    },
+    /// An instance name is unknown in the system.
+    UnknownInstance {
+        /// The name as given.
+        name: String,
+        /// The instances of the system.
+        instances: Vec<String>,
+    },
+    /// A variable name without the instance it belongs to, in a system of several.
+    NoInstance {
+        /// The name as given.
+        name: String,
+        /// The instances of the system.
+        instances: Vec<String>,
+        /// `instance.variable` names that end in the name given.
+        candidates: Vec<String>,
     },
     /// A value cannot be given to a variable (wrong type, unparsable, wrong causality).
     InvalidValue {
@@ -376,11 +408,40 @@ impl fmt::Display for Error {
                 }
                 f.write_str(&tail(log))
             }
+            Error::NonFinite { instance, fmu, variable, value, time } => write!(
+                f,
+                "{instance} ({}): {variable} = {value} at t = {time} s, returned with fmi2OK by fmi2GetReal \
+                 (a non-finite value; --allow-non-finite passes such values on)",
+                fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+            ),
             Error::IllegalCall { instance, function, state } => {
                 write!(f, "{instance}: {function} is not allowed in state {state}")
             }
             Error::Instance { name, reason } => write!(f, "instance {name:?}: {reason}"),
-            Error::UnknownVariable { instance, variable } => write!(f, "{instance} has no variable {variable:?}"),
+            Error::UnknownVariable { instance, variable, closest } => {
+                write!(f, "instance {instance:?} has no variable {variable:?}")?;
+                if !closest.is_empty() {
+                    let q: Vec<String> = closest.iter().map(|c| format!("{c:?}")).collect();
+                    write!(f, "; did you mean {}?", q.join(" or "))?;
+                }
+                f.write_str(" (`cosim info` lists the variables)")
+            }
+            Error::UnknownInstance { name, instances } => {
+                write!(f, "the system has no instance {name:?}")?;
+                let close = crate::suggest::closest(name, instances.iter().map(String::as_str));
+                if let Some(c) = close.first() {
+                    write!(f, "; did you mean {c:?}?")?;
+                }
+                write!(f, " (its instances: {})", instances.join(", "))
+            }
+            Error::NoInstance { name, instances, candidates } => {
+                write!(f, "{name:?} names no instance: in a system, variables are named instance.variable")?;
+                match candidates.as_slice() {
+                    [] => write!(f, " (its instances: {})", instances.join(", ")),
+                    [one] => write!(f, "; did you mean {one:?}?"),
+                    many => write!(f, "; {name:?} is in {}", many.join(", ")),
+                }
+            }
             Error::InvalidValue { variable, value, reason } => write!(f, "{variable} = {value:?}: {reason}"),
             Error::Connection { from, to, reason } => write!(f, "connection {from} -> {to}: {reason}"),
             Error::AlgebraicLoop { variables } => {

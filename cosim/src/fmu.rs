@@ -271,12 +271,16 @@ pub struct ImportOptions {
     pub limits: UnpackLimits,
     /// The interface; `None`: Co-Simulation if the FMU has it, else Model Exchange.
     pub interface: Option<Interface>,
+    /// Pass on NaN and infinite Reals an FMU returns with fmi2OK (default: refused at
+    /// the source, [`Error::NonFinite`] naming the FMU and the variable).
+    pub allow_non_finite: bool,
 }
 
 /// An imported FMU: its unpacked folder (removed on drop), model description and library.
 /// Share it between instances with `Arc`; it outlives them.
 pub struct Fmu {
     pub(crate) functions: Functions,
+    allow_non_finite: bool,
     _library: Arc<libloading::Library>,
     description: ModelDescription,
     interface: Interface,
@@ -330,7 +334,7 @@ pub(crate) fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Ar
 pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<ModelDescription> {
     let path = dir.join("modelDescription.xml");
     let xml =
-        crate::unpack::read_xml_text(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
+        crate::unpack::read_text_file(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
             Error::Io { source: e, .. } => {
                 Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") }
             }
@@ -418,6 +422,7 @@ impl Fmu {
             .map_err(|_| Error::Experiment("temporary folder path contains NUL".into()))?;
         Ok(Arc::new(Fmu {
             functions,
+            allow_non_finite: options.allow_non_finite,
             _library: library,
             description,
             interface,
@@ -437,6 +442,7 @@ impl Fmu {
         }
         Arc::new(Fmu {
             functions: crate::isolate::proxy::table(&self.functions),
+            allow_non_finite: self.allow_non_finite,
             _library: self._library.clone(),
             description: self.description.clone(),
             interface: self.interface,
@@ -550,6 +556,9 @@ pub struct Instance {
     _callbacks: Box<CallbackFunctions>,
     saved: Vec<*mut c_void>,
     fmu: Arc<Fmu>,
+    /// The time the FMU's values are at (the last setup, step end or `fmi2SetTime`), for
+    /// [`Error::NonFinite`].
+    time: f64,
     /// Isolated: the host process the calls go to (the component is its address).
     host: Option<Box<crate::isolate::channel::Channel>>,
 }
@@ -612,6 +621,7 @@ impl Instance {
             _callbacks: callbacks,
             saved: Vec::new(),
             fmu: fmu.clone(),
+            time: 0.0,
             host: None,
         })
     }
@@ -680,6 +690,7 @@ impl Instance {
             saved: Vec::new(),
             fmu,
             host: Some(channel),
+            time: 0.0,
         })
     }
 
@@ -742,6 +753,7 @@ impl Instance {
         }
         let f = self.fmu.functions.setup_experiment;
         let c = self.component;
+        self.time = start_time;
         call!(
             self,
             "fmi2SetupExperiment",
@@ -796,12 +808,40 @@ impl Instance {
         self.status("fmi2Reset", raw, None)
     }
 
-    /// `fmi2GetReal` of `vrs` into `values` (same length).
+    /// `fmi2GetReal` of `vrs` into `values` (same length). A NaN or infinite value is
+    /// [`Error::NonFinite`] unless the FMU was imported with `allow_non_finite`.
     #[inline]
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_real: one value per value reference");
         let (f, c) = (self.fmu.functions.get_real, self.component);
-        call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+        call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?;
+        // all exponent bits set: Inf or NaN. An OR of integer compares over the values
+        // just read, without a branch per value (the compiler vectorizes it).
+        const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+        let any = values.iter().fold(false, |any, v| any | (v.to_bits() & EXPONENT == EXPONENT));
+        if any && !self.fmu.allow_non_finite {
+            return Err(self.non_finite(vrs, values));
+        }
+        Ok(())
+    }
+
+    #[cold]
+    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Error {
+        let k = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+        let variable = self
+            .fmu
+            .description
+            .model_variables
+            .iter()
+            .find(|v| v.is_real() && v.value_reference == vrs[k])
+            .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
+        Error::NonFinite {
+            instance: self.name.clone(),
+            fmu: self.fmu.source.clone(),
+            variable,
+            value: values[k],
+            time: self.time,
+        }
     }
 
     /// `fmi2SetReal`.
@@ -873,7 +913,9 @@ impl Instance {
     pub fn do_step(&mut self, time: f64, step: f64) -> Result<()> {
         let f = self.optional(self.fmu.functions.do_step, "fmi2DoStep")?;
         let c = self.component;
-        call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))
+        call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))?;
+        self.time = time + step;
+        Ok(())
     }
 
     /// `fmi2GetFMUstate`: saves the current state.
@@ -921,6 +963,7 @@ impl Instance {
     pub fn set_time(&mut self, time: f64) -> Result<()> {
         let f = self.optional(self.fmu.functions.set_time, "fmi2SetTime")?;
         let c = self.component;
+        self.time = time;
         call!(self, "fmi2SetTime", Some(time), f(c, time))
     }
 

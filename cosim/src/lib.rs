@@ -11,6 +11,11 @@
 //!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
 //!   those connected to each other advancing together with one event iteration across
 //!   them ([`Error::EventIteration`] when it has no fixed point).
+//! - [`InputTable`]: input signals over time (fmpy's `input=`), [`Experiment::input`];
+//!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
+//! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
+//!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
+//!   ([`simulate::simulate_recorded`]).
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
@@ -27,6 +32,7 @@ mod elf;
 pub mod error;
 pub mod fmu;
 pub mod isolate;
+pub mod mat;
 pub mod me;
 pub mod simulate;
 pub mod ssp;
@@ -35,10 +41,12 @@ pub mod system;
 pub mod unpack;
 
 pub use error::{Error, HostEnd, Result, Status};
-pub use isolate::Isolation;
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
+pub use isolate::Isolation;
 pub use me::{Event, Solver};
-pub use simulate::{simulate, simulate_with, Algorithm, Experiment, InstancePool, Results, RowSink, Summary};
+pub use simulate::{
+    simulate, simulate_with, Algorithm, Experiment, InputTable, InstancePool, Results, RowSink, Summary,
+};
 pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};
 pub use unpack::UnpackLimits;

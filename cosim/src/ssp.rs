@@ -106,6 +106,14 @@ pub struct SspSystem {
     _dir: Option<tempfile::TempDir>,
 }
 
+impl SspSystem {
+    /// Where an FMU of the system is inside the `.ssp` archive (`resources/x.fmu`), for
+    /// FMUs unpacked from it; `None` for a bare `.ssd`, whose FMU paths are real files.
+    pub fn path_in_archive<'a>(&self, fmu_path: &'a Path) -> Option<&'a Path> {
+        self._dir.as_ref().and_then(|d| fmu_path.strip_prefix(d.path()).ok())
+    }
+}
+
 /// One endpoint in the SSD before flattening: an FMU variable or a system connector.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 enum Node {
@@ -258,7 +266,9 @@ impl Flattener<'_> {
             Some(f) => f.clone(),
             None => {
                 let mut options = self.options.clone();
+                // the interface asked for by the importer wins over the SSD's choice
                 match el.attr("implementation") {
+                    _ if options.interface.is_some() => {}
                     Some("ModelExchange") => options.interface = Some(crate::Interface::ModelExchange),
                     Some("CoSimulation") => options.interface = Some(crate::Interface::CoSimulation),
                     _ => {}
@@ -313,14 +323,15 @@ impl Flattener<'_> {
             let set = match (b.attr("source"), b.child("ParameterValues")) {
                 (Some(src), _) => {
                     let file = self.resource(src)?;
-                    let text = crate::unpack::read_xml_text(&file, src, self.options.limits.max_xml_bytes).map_err(
-                        |e| match e {
-                            Error::Io { source, .. } => {
-                                self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
+                    let text =
+                        crate::unpack::read_text_file(&file, src, self.options.limits.max_xml_bytes).map_err(|e| {
+                            match e {
+                                Error::Io { source, .. } => {
+                                    self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
+                                }
+                                other => other,
                             }
-                            other => other,
-                        },
-                    )?;
+                        })?;
                     let set = parse_xml(&text, &file)?;
                     if set.name != "ParameterSet" {
                         return Err(self.err(format!(
@@ -420,7 +431,7 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         (Some(dir), root, ssd)
     };
     let text =
-        crate::unpack::read_xml_text(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
+        crate::unpack::read_text_file(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
             match e {
                 Error::Io { source, .. } if !is_ssd => Error::Ssp {
                     path: path.to_path_buf(),

@@ -65,7 +65,10 @@ impl Value {
                 .filter(|v| v.is_finite())
                 .map(Value::Real)
                 .ok_or_else(|| "not a finite number".to_string()),
-            BaseType::Integer => t.parse::<i32>().map(Value::Integer).map_err(|e| format!("not an Integer: {e}")),
+            BaseType::Integer => t
+                .parse::<i32>()
+                .map(Value::Integer)
+                .map_err(|_| "not an Integer (a whole number from -2147483648 to 2147483647)".to_string()),
             BaseType::Boolean => match t {
                 "true" | "1" => Ok(Value::Boolean(true)),
                 "false" | "0" => Ok(Value::Boolean(false)),
@@ -80,6 +83,18 @@ impl Value {
             Value::Integer(_) => BaseType::Integer,
             Value::Boolean(_) => BaseType::Boolean,
             Value::String(_) => BaseType::String,
+        }
+    }
+}
+
+impl std::fmt::Display for Value {
+    /// The value as it would be written in `--set` or an `.ssv` file.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Real(x) => write!(f, "{x}"),
+            Value::Integer(k) => write!(f, "{k}"),
+            Value::Boolean(b) => write!(f, "{b}"),
+            Value::String(s) => write!(f, "{s:?}"),
         }
     }
 }
@@ -138,6 +153,8 @@ pub struct System {
 pub struct SystemBuilder {
     system: System,
     names: HashMap<String, usize>,
+    /// (instance, variable index) of the inputs connected so far
+    connected: std::collections::HashSet<(usize, usize)>,
 }
 
 /// Splits `instance.variable` at the first `.`.
@@ -163,22 +180,78 @@ impl System {
         self.instances[i].fmu.description()
     }
 
-    /// Resolves `instance.variable` (instance names of flattened nested systems contain
-    /// `.` themselves: the longest instance name that prefixes `full` wins).
+    /// Resolves `instance.variable`. Instance names of flattened nested systems contain
+    /// `.` themselves, and so may variable names (`body.v_x`): every split of `full` at a
+    /// `.` into an instance and one of its variables is a reading; one reading wins, two
+    /// are refused as ambiguous, none is an error naming the closest names.
     pub fn resolve(&self, full: &str) -> Result<VariableRef> {
-        let best = self
-            .instances
-            .iter()
-            .filter(|i| {
-                full.len() > i.name.len() + 1 && full.starts_with(&i.name) && full.as_bytes()[i.name.len()] == b'.'
-            })
-            .max_by_key(|i| i.name.len());
-        match best {
-            Some(i) => self.resolve_parts(&i.name, &full[i.name.len() + 1..]),
-            None => {
-                let (inst, var) = split_name(full)
-                    .ok_or_else(|| Error::Instance { name: full.into(), reason: "expected instance.variable" })?;
-                self.resolve_parts(inst, var)
+        let mut found: Vec<VariableRef> = Vec::new();
+        let mut longest_instance: Option<(usize, usize)> = None;
+        for (dot, _) in full.match_indices('.') {
+            let Some(i) = self.instance_index(&full[..dot]) else { continue };
+            longest_instance = Some((i, dot));
+            if let Some(r) = self.variable_of(i, &full[dot + 1..]) {
+                found.push(r);
+            }
+        }
+        match (found.len(), longest_instance) {
+            (1, _) => Ok(found.remove(0)),
+            (0, Some((i, dot))) => Err(self.unknown_variable(i, &full[dot + 1..])),
+            (0, None) => Err(self.no_instance(full)),
+            _ => Err(Error::InvalidValue {
+                variable: full.into(),
+                value: String::new(),
+                reason: format!(
+                    "the name is ambiguous: it reads as {}",
+                    found
+                        .iter()
+                        .map(|r| format!(
+                            "variable {:?} of instance {:?}",
+                            self.variable(r).name,
+                            self.instances[r.instance].name
+                        ))
+                        .collect::<Vec<_>>()
+                        .join(" and as ")
+                ),
+            }),
+        }
+    }
+
+    fn variable_of(&self, i: usize, variable: &str) -> Option<VariableRef> {
+        let md = self.description(i);
+        let index = md.model_variables.iter().position(|v| v.name == variable)?;
+        let v = &md.model_variables[index];
+        Some(VariableRef { instance: i, index, value_reference: v.value_reference, base_type: BaseType::of(v) })
+    }
+
+    fn unknown_variable(&self, i: usize, variable: &str) -> Error {
+        let md = self.description(i);
+        let closest = crate::suggest::closest(variable, md.model_variables.iter().map(|v| v.name.as_str()));
+        Error::UnknownVariable {
+            instance: self.instances[i].name.clone(),
+            variable: variable.into(),
+            closest: closest.into_iter().map(String::from).collect(),
+        }
+    }
+
+    fn instance_names(&self) -> Vec<String> {
+        self.instances.iter().map(|i| i.name.clone()).collect()
+    }
+
+    /// The error for a name whose part before the last `.` (or whole) is no instance.
+    fn no_instance(&self, full: &str) -> Error {
+        match full.rsplit_once('.') {
+            Some((instance, _)) if !instance.is_empty() => {
+                Error::UnknownInstance { name: instance.into(), instances: self.instance_names() }
+            }
+            _ => {
+                let candidates = self
+                    .instances
+                    .iter()
+                    .filter(|i| i.fmu.description().variable(full).is_some())
+                    .map(|i| format!("{}.{full}", i.name))
+                    .collect();
+                Error::NoInstance { name: full.into(), instances: self.instance_names(), candidates }
             }
         }
     }
@@ -187,15 +260,8 @@ impl System {
     pub fn resolve_parts(&self, instance: &str, variable: &str) -> Result<VariableRef> {
         let i = self
             .instance_index(instance)
-            .ok_or_else(|| Error::Instance { name: instance.into(), reason: "unknown instance" })?;
-        let md = self.description(i);
-        let index = md
-            .model_variables
-            .iter()
-            .position(|v| v.name == variable)
-            .ok_or_else(|| Error::UnknownVariable { instance: instance.into(), variable: variable.into() })?;
-        let v = &md.model_variables[index];
-        Ok(VariableRef { instance: i, index, value_reference: v.value_reference, base_type: BaseType::of(v) })
+            .ok_or_else(|| Error::UnknownInstance { name: instance.into(), instances: self.instance_names() })?;
+        self.variable_of(i, variable).ok_or_else(|| self.unknown_variable(i, variable))
     }
 
     /// `instance.variable` of a resolved reference.
@@ -207,6 +273,24 @@ impl System {
     pub fn variable(&self, r: &VariableRef) -> &ScalarVariable {
         &self.description(r.instance).model_variables[r.index]
     }
+}
+
+/// The parameter that sets the initial value of the calculated variable `name`: one whose
+/// description says "initial value of NAME" (word for word), else one called `NAME_start`,
+/// `NAME0`, `NAME_0` or `start_NAME`.
+fn start_parameter<'a>(md: &'a ModelDescription, name: &str) -> Option<&'a str> {
+    let params = || md.model_variables.iter().filter(|p| p.causality == Causality::Parameter);
+    let phrase = format!("initial value of {name}");
+    let by_description = params().find(|p| {
+        p.description.as_deref().is_some_and(|d| {
+            d.match_indices(&phrase).any(|(at, _)| {
+                // the name ends there: not "initial value of v_x_dot" for v_x
+                !d[at + phrase.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+            })
+        })
+    });
+    let names = [format!("{name}_start"), format!("{name}0"), format!("{name}_0"), format!("start_{name}")];
+    by_description.or_else(|| params().find(|p| names.contains(&p.name))).map(|p| p.name.as_str())
 }
 
 /// The value `k` a description lists as "k name" ("which steering feedback: 1 open_loop
@@ -257,7 +341,8 @@ impl SystemBuilder {
     /// Continues building an existing system (e.g. one read from an SSP).
     pub fn from_system(system: System) -> SystemBuilder {
         let names = system.instances.iter().enumerate().map(|(i, s)| (s.name.clone(), i)).collect();
-        SystemBuilder { system, names }
+        let connected = system.connections.iter().map(|c| (c.to.instance, c.to.index)).collect();
+        SystemBuilder { system, names, connected }
     }
 
     /// Adds an instance of `fmu` called `name` (unique, non-empty; `.` only between the
@@ -282,8 +367,7 @@ impl SystemBuilder {
     pub fn set(&mut self, variable: &str, value: Value) -> Result<&mut Self> {
         let r = self.system.resolve(variable)?;
         let v = self.system.variable(&r);
-        let bad =
-            |reason: String| Error::InvalidValue { variable: variable.into(), value: format!("{value:?}"), reason };
+        let bad = |reason: String| Error::InvalidValue { variable: variable.into(), value: value.to_string(), reason };
         let value = match (r.base_type, &value) {
             (BaseType::Real, Value::Integer(i)) => Value::Real(f64::from(*i)),
             (t, v) if t == v.base_type() => v.clone(),
@@ -298,11 +382,22 @@ impl SystemBuilder {
             && (matches!(v.causality, Causality::Parameter | Causality::Input)
                 || v.variable_type.has_start() && v.causality != Causality::CalculatedParameter);
         if !settable {
-            return Err(bad(format!(
-                "a {} {} variable without start value cannot be set",
-                v.variability.as_str(),
-                v.causality.as_str()
-            )));
+            let what = if v.variability == Variability::Constant {
+                format!("a constant cannot be set (causality {})", v.causality.as_str())
+            } else if v.causality == Causality::CalculatedParameter {
+                "a calculated parameter is computed by the FMU from other parameters and cannot be set".to_string()
+            } else {
+                format!(
+                    "a {} {} variable without a start value is calculated by the FMU and cannot be set",
+                    v.variability.as_str(),
+                    v.causality.as_str()
+                )
+            };
+            let hint = match start_parameter(self.system.description(r.instance), &v.name) {
+                Some(p) => format!("; its initial value is set by the parameter {p:?}"),
+                None => String::new(),
+            };
+            return Err(bad(format!("{what}{hint}")));
         }
         let spec = &mut self.system.instances[r.instance];
         spec.start_values.retain(|(i, _)| *i != r.index);
@@ -365,7 +460,7 @@ impl SystemBuilder {
         if a.instance == b.instance {
             // legal in FMI, but a direct self-loop through an FMU is rarely meant; allowed
         }
-        if self.system.connections.iter().any(|c| c.to == b) {
+        if self.connected.contains(&(b.instance, b.index)) {
             return Err(err("the input is already connected".into()));
         }
         let (mut gain, mut offset) = (1.0, 0.0);
@@ -383,6 +478,7 @@ impl SystemBuilder {
             }
             (gain, offset) = (f * gain, f * offset + o);
         }
+        self.connected.insert((b.instance, b.index));
         self.system.connections.push(Connection { from: a, to: b, gain, offset, linear_transformation: linear });
         Ok(self)
     }

@@ -118,9 +118,9 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File> {
     Ok(file)
 }
 
-/// Reads the XML text file `path` (a regular file of at most `limit` bytes, checked
+/// Reads the text file `path` (a regular file of at most `limit` bytes, checked
 /// before reading); `shown` names it in errors.
-pub fn read_xml_text(path: &Path, shown: &str, limit: u64) -> Result<String> {
+pub fn read_text_file(path: &Path, shown: &str, limit: u64) -> Result<String> {
     use std::io::Read;
     let file = open_regular(path)?;
     let size = file.metadata().map_err(|source| Error::Io { path: path.to_path_buf(), source })?.len();
@@ -188,10 +188,7 @@ pub fn remove_on_signals() {
                 for dir in made {
                     let _ = std::fs::remove_dir_all(dir);
                 }
-                eprintln!(
-                    "cosim: stopped by {}; temporary folders removed",
-                    crate::error::signal_name(signal)
-                );
+                eprintln!("cosim: stopped by {}; temporary folders removed", crate::error::signal_name(signal));
                 // host processes end with the master (PR_SET_PDEATHSIG)
                 libc::_exit(128 + signal);
             }

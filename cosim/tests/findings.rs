@@ -293,3 +293,190 @@ fn a_parameter_file_whose_root_is_not_a_parameter_set_is_refused() {
         other => panic!("accepted: {:?}", other.is_ok()),
     }
 }
+
+#[test]
+fn the_algebraic_loop_error_names_only_the_loop() {
+    // a.y feeds c (a tail: c -> d depends on the loop but is not on it) and the loop a <-> b
+    let dir = work_dir("loop-members");
+    let gain = Fmu::load(&build_fmu(Model::Gain, &dir, &[])).unwrap();
+    let mut b = nigel_cosim::SystemBuilder::new();
+    for name in ["a", "b", "c", "d"] {
+        b.add_instance(name, gain.clone()).unwrap();
+    }
+    b.connect("a.y", "c.u").unwrap();
+    b.connect("c.y", "d.u").unwrap();
+    b.connect("a.y", "b.u").unwrap();
+    b.connect("b.y", "a.u").unwrap();
+    let mut e = nigel_cosim::Experiment::new(1.0, 0.5);
+    e.algorithm = nigel_cosim::Algorithm::Ordered;
+    match nigel_cosim::simulate(&b.build(), &e) {
+        Err(Error::AlgebraicLoop { variables }) => {
+            let mut members = variables.clone();
+            assert_eq!(members.first(), members.last(), "closed: {variables:?}");
+            members.pop();
+            members.sort();
+            assert_eq!(members, ["a.u", "a.y", "b.u", "b.y"], "{variables:?}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}
+
+fn cosim(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn an_exact_variable_name_wins_over_the_instance_prefix() {
+    let dir = work_dir("exact-name");
+    // the source's slope is called "model.slope": `--set model.slope=3` is that variable
+    let xml = Model::Source.model_description().replace(r#"name="slope""#, r#"name="model.slope""#);
+    let fmu = build_fmu_with(Model::Source, &dir, "dotted", &xml);
+    let csv = dir.join("out.csv");
+    let (ok, _, err) = cosim(&[
+        "run",
+        fmu.to_str().unwrap(),
+        "--set",
+        "model.slope=3",
+        "--stop-time",
+        "1",
+        "--step",
+        "0.5",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "\"time\",\"y\"\n0,0\n0.5,1.5\n1,3\n");
+}
+
+#[test]
+fn messages_say_what_is_wrong_in_plain_words_with_suggestions() {
+    let plant = plant_fmu();
+    let p = plant.to_str().unwrap();
+    let run = |set: &str| {
+        let (ok, _, err) = cosim(&["run", p, "--stop-time", "0.01", "--set", set]);
+        assert!(!ok, "{set} accepted");
+        err.trim().to_string()
+    };
+    assert_eq!(
+        run("v_x_strat=0.35"),
+        "cosim: instance \"model\" has no variable \"v_x_strat\"; did you mean \"v_x_start\" or \"v_y_start\" or \"v_x\"? (`cosim info` lists the variables)"
+    );
+    assert_eq!(
+        run("v_x=0.35"),
+        "cosim: model.v_x = \"0.35\": a continuous output variable without a start value is calculated by the FMU and cannot be set; its initial value is set by the parameter \"v_x_start\""
+    );
+    assert_eq!(run("friction_circle=yes"), "cosim: model.friction_circle = \"yes\": not a Boolean (true, false, 1, 0)");
+    // written by `cargo run --release -p build-fmu` with the FMUs
+    let ssp = plant.parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop.ssp");
+    assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
+    {
+        let s = ssp.to_str().unwrap();
+        let run = |set: &str| cosim(&["run", s, "--stop-time", "0.01", "--set", set]).2.trim().to_string();
+        assert_eq!(
+            run("v_x_start=1"),
+            "cosim: \"v_x_start\" names no instance: in a system, variables are named instance.variable; did you mean \"plant.v_x_start\"?"
+        );
+        assert_eq!(
+            run("plnt.v_x_start=1"),
+            "cosim: the system has no instance \"plnt\"; did you mean \"plant\"? (its instances: plant, controller, maneuver)"
+        );
+        let (ok, out, err) = cosim(&["info", s]);
+        assert!(ok, "{err}");
+        assert!(
+            out.contains(&format!("instance plant                resources/nigel_plant.fmu in {s} (CoSimulation)")),
+            "{out}"
+        );
+        assert!(out.contains("  start v_x_start = 0.35 m/s\n"), "{out}");
+        assert!(!out.contains("nigel-cosim-") && !out.contains("Real(") && !out.contains("Boolean("), "{out}");
+    }
+    let (ok, out, err) = cosim(&["info", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("default experiment: start 0 s, stop 10 s, step 0.001 s, tolerance 1e-8\n"), "{out}");
+    let mu = out.lines().find(|l| l.starts_with("mu_fl ")).unwrap();
+    let words: Vec<&str> = mu.split_whitespace().collect();
+    assert_eq!(words[..9], ["mu_fl", "input", "continuous", "Real", "-", "0.4", "0", "..", "3"], "{mu}");
+    assert!(mu.ends_with("road-tire friction coefficient, 0 .. 3"), "{mu}");
+    assert!(!out.contains("Some(") && !out.contains("None"), "{out}");
+}
+
+#[test]
+fn non_finite_outputs_are_refused_at_their_source() {
+    let dir = work_dir("non-finite");
+    let hostile = build_hostile(&dir);
+    let gain = Fmu::load(&build_fmu(Model::Gain, &dir, &[])).unwrap();
+    for (bad, shown) in [("0", "NaN"), ("1", "inf"), ("2", "-inf")] {
+        let mut b = nigel_cosim::SystemBuilder::new();
+        b.add_instance("h", Fmu::load(&hostile).unwrap()).unwrap();
+        b.add_instance("g", gain.clone()).unwrap();
+        b.connect("h.y", "g.u").unwrap();
+        b.set_text("h.bad", bad).unwrap();
+        let system = b.build();
+        for algorithm in [nigel_cosim::Algorithm::Ordered, nigel_cosim::Algorithm::Jacobi] {
+            let mut e = nigel_cosim::Experiment::new(1.0, 0.125);
+            e.algorithm = algorithm;
+            match nigel_cosim::simulate(&system, &e) {
+                Err(err @ Error::NonFinite { .. }) => {
+                    let Error::NonFinite { instance, variable, value, time, .. } = &err else { unreachable!() };
+                    // y turns bad at t_bad = 0.5 s, a communication point (4 steps of 1/8 s: exact)
+                    assert_eq!((instance.as_str(), variable.as_str(), *time), ("h", "y", 0.5), "{algorithm:?}");
+                    assert_eq!(value.to_string(), shown);
+                    let text = err.to_string();
+                    assert!(text.starts_with(&format!("h (hostile.fmu): y = {shown} at t = 0.5 s")), "{text}");
+                }
+                other => panic!("{algorithm:?} {bad}: {:?}", other.map(|(r, _)| r.column("g.y"))),
+            }
+        }
+    }
+    // allowed: passed on and recorded
+    let options = ImportOptions { allow_non_finite: true, ..ImportOptions::default() };
+    let mut b = nigel_cosim::SystemBuilder::new();
+    b.add_instance("h", Fmu::load_with(&hostile, &options).unwrap()).unwrap();
+    let (r, _) = nigel_cosim::simulate(&b.build(), &nigel_cosim::Experiment::new(1.0, 0.125)).unwrap();
+    let y = r.column("y").unwrap();
+    assert_eq!(y[..4], [0.0, 0.125, 0.25, 0.375]);
+    assert!(y[4..].iter().all(|v| v.is_nan()), "{y:?}");
+}
+
+#[test]
+fn the_cli_refuses_runs_it_cannot_mean_and_warns_of_long_steps() {
+    let plant = plant_fmu();
+    let p = plant.to_str().unwrap();
+    let dir = work_dir("cli-checks");
+    for (args, needle) in [
+        (vec!["--stop-time", "0"], "the stop time 0 s must be after the start time 0 s"),
+        (vec!["--step", "2", "--stop-time", "1"], "the step 2 s is longer than the run (1 s from 0 to 1 s)"),
+        (vec!["--output", "out.txt"], "--output out.txt: the file name must end in .csv"),
+    ] {
+        let mut all = vec!["run", p];
+        all.extend(args.iter().copied());
+        let (ok, _, err) = cosim(&all);
+        assert!(!ok && err.contains(needle), "{args:?}: {err}");
+    }
+    let (ok, _, err) = cosim(&["run", p, "--stop-time", "0.01"]);
+    assert!(ok && err.contains("note: no --output or --summary given"), "{err}");
+    let ssp = plant.parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop.ssp");
+    let s = ssp.to_str().unwrap();
+    let summary = dir.join("s.json");
+    let (ok, _, err) =
+        cosim(&["run", s, "--step", "0.1", "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: controller (nigel_controller.fmu) runs every 0.001 s (its parameter sample_period), but the communication step is 0.1 s"),
+        "{err}"
+    );
+    let (_, _, err) = cosim(&["run", s, "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);
+    assert!(!err.contains("warning"), "{err}");
+    // --interface applies to the FMUs of a system: Model Exchange is integrated by the master
+    let (ok, _, err) =
+        cosim(&["run", s, "--interface", "me", "--stop-time", "0.01", "--summary", summary.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    // RK4 at the communication step: one accepted integrator step per FMU and step
+    let steps = json["integrator_steps"]["accepted"].as_u64().unwrap_or(0);
+    assert!(steps >= 10, "{json}");
+}

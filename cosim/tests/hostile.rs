@@ -71,9 +71,15 @@ fn hostile_inputs_are_refused_by_name_and_leave_nothing_behind() {
     let slip = case("slip", &[("modelDescription.xml", xml.clone()), ("../../escaped.txt", b"x".to_vec())]);
     expect(&slip, d, &|e| matches!(e, Error::UnsafeEntry { entry, .. } if entry == "../../escaped.txt"), "zip slip");
     assert!(!dir.join("escaped.txt").exists() && !tmp.join("escaped.txt").exists());
-    let abs = case("abs", &[("/tmp/nigel-escaped.txt", b"x".to_vec())]);
+    // an absolute entry naming a file of this test's own folder (not a shared path such as /tmp,
+    // which another run or user may hold)
+    let escaped = std::fs::canonicalize(&dir).unwrap().join("abs-escaped.txt");
+    let _ = std::fs::remove_file(&escaped);
+    let escaped_name = escaped.to_string_lossy().into_owned();
+    assert!(escaped.is_absolute(), "{escaped_name}");
+    let abs = case("abs", &[(escaped_name.as_str(), b"x".to_vec())]);
     expect(&abs, d, &|e| matches!(e, Error::UnsafeEntry { reason, .. } if reason.contains("absolute")), "absolute");
-    assert!(!Path::new("/tmp/nigel-escaped.txt").exists());
+    assert!(!escaped.exists());
 
     // a symbolic link entry
     let link = dir.join("link.fmu");

@@ -12,7 +12,7 @@ fn interrupt(signal: i32, extra: &[&str]) {
     let tmp = dir.join("tmp");
     std::fs::create_dir_all(&tmp).unwrap();
     // a run of hours (1e5 s at 1 ms): it is interrupted long before its end
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cosim"))
+    let child = Command::new(env!("CARGO_BIN_EXE_cosim"))
         .args(["run", plant_fmu().to_str().unwrap(), "--stop-time", "100000", "--step", "1e-3", "--record", "x"])
         .args(extra)
         .env("TMPDIR", &tmp)

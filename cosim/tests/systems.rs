@@ -93,7 +93,7 @@ fn connections_are_checked_for_causality_type_and_unit() {
     assert!(err(b.connect("amp.u", "int.u")).contains("not an output"));
     assert!(err(b.connect("src.y", "int.u")).contains("already connected"));
     assert!(err(b.connect("src.nope", "int.u")).contains("no variable \"nope\""));
-    assert!(err(b.connect("zz.y", "int.u")).contains("unknown instance"));
+    assert!(err(b.connect("zz.y", "int.u")).contains("no instance \"zz\""));
     // units: metres into millimetres is a factor 1000; metres into m/s is refused
     let xml_mm =
         Model::Gain.model_description().replace(r#"<Real start="0" unit="m"/>"#, r#"<Real start="0" unit="mm"/>"#);

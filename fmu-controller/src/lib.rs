@@ -220,8 +220,8 @@ fn build_declaration() -> DeclarationSpec<Var> {
     };
     v.extend(per_wheel("delta", vr::DELTA, Var::Steer, |d, i| {
         d.discrete_output(Dependencies::On(steer_deps(i as u32))).unit("rad").describe(
-            "steering command delta_ff + K (x - x_ref) (robust_tracking: delta_ff + K_track e), clamped to \
-             +-delta_max; held over a sample",
+            "steering command delta_ff + K (q - q_ref), q = [beta, yaw_rate] (robust_tracking: \
+             delta_ff + K_track e), clamped to +-delta_max; held over a sample",
         )
     }));
     v.extend(per_wheel("tau", vr::TAU, Var::Torque, |d, _| {
@@ -489,10 +489,14 @@ impl Model for Controller {
     }
 
     fn get_real(&mut self, b: Var) -> ModelResult<f64> {
+        // the held outputs an importer reads at every sample: a field
+        if let Some(x) = self.slot(b) {
+            return Ok(*x);
+        }
         match b {
             Var::GainInUse(i, j) => Ok(self.gain_in_use()[i][j]),
             Var::PoseGainInUse(i, j) => Ok(self.pose_gain_in_use()[i][j]),
-            _ => self.slot(b).map(|x| *x).ok_or_else(|| "controller is an Integer, not a Real".into()),
+            _ => Err("controller is an Integer, not a Real".into()),
         }
     }
 

@@ -252,6 +252,17 @@ def test_custom_gains_change_between_steps(ctl):
         s.freeInstance()
 
 
+def baked_robust_gain():
+    """`ROBUST` of benchmark/src/gains.rs (the gain the controller FMU was built with), rows FL,
+    FR, RL, RR of [k_beta, k_yaw_rate]."""
+    text = (REPO / "benchmark" / "src" / "gains.rs").read_text()
+    block = text.split("pub const ROBUST: [[f64; 2]; 4] = [", 1)[1].split("];", 1)[0]
+    rows = [[float(x) for x in re.findall(r"-?\d+\.\d+(?:e-?\d+)?", line)] for line in block.splitlines()]
+    rows = [r[:2] for r in rows if len(r) >= 2]
+    assert len(rows) == 4, block
+    return rows
+
+
 def test_model_exchange_outputs_change_exactly_at_the_samples():
     """fmpy ME with a smooth input beta(t) = 0.1 sin(2 pi 37 t): the steering (robust gain)
     is piecewise constant and jumps only at multiples of 1 ms, where it takes the law of
@@ -265,7 +276,7 @@ def test_model_exchange_outputs_change_exactly_at_the_samples():
     assert len(jumps) >= 15
     assert np.allclose(jumps, np.round(jumps / T) * T, atol=1e-12), jumps
     # at each jump the new value is the law on beta at that instant (K_fl,beta * beta)
-    k_beta_fl = -0.16065807504986623
+    k_beta_fl = baked_robust_gain()[0][0]
     for tj in jumps:
         after = d[np.where(t == tj)[0][-1]]
         assert after == pytest.approx(k_beta_fl * 0.1 * math.sin(2 * math.pi * 37 * tj), rel=1e-6, abs=1e-12)

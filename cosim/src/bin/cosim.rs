@@ -1,7 +1,7 @@
 //! `cosim`: run an FMU or a system of FMUs, or list what is in one.
 
 use clap::{Parser, Subcommand};
-use nigel_cosim::{Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder};
+use nigel_cosim::{Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder, UnpackLimits};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -22,7 +22,43 @@ enum Command {
     Info {
         /// The .fmu, .ssp or .ssd file.
         model: PathBuf,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
+}
+
+/// Limits of the archives and XML files read; the defaults refuse zip bombs and files
+/// far larger than any FMU, raise them for an archive you trust.
+#[derive(clap::Args)]
+struct LimitArgs {
+    /// Most entries in an archive.
+    #[arg(long, value_name = "N")]
+    max_entries: Option<u64>,
+    /// Largest uncompressed entry of an archive, bytes (default 256 MiB).
+    #[arg(long, value_name = "BYTES")]
+    max_entry_bytes: Option<u64>,
+    /// Largest uncompressed archive in all, bytes (default 1 GiB).
+    #[arg(long, value_name = "BYTES")]
+    max_total_bytes: Option<u64>,
+    /// Largest ratio of uncompressed to compressed size of an entry over 1 MiB (default 100).
+    #[arg(long, value_name = "RATIO")]
+    max_ratio: Option<u64>,
+    /// Largest modelDescription.xml, .ssd or .ssv file, bytes (default 64 MiB).
+    #[arg(long, value_name = "BYTES")]
+    max_xml_bytes: Option<u64>,
+}
+
+impl LimitArgs {
+    fn limits(&self) -> UnpackLimits {
+        let d = UnpackLimits::default();
+        UnpackLimits {
+            max_entries: self.max_entries.unwrap_or(d.max_entries),
+            max_entry_bytes: self.max_entry_bytes.unwrap_or(d.max_entry_bytes),
+            max_total_bytes: self.max_total_bytes.unwrap_or(d.max_total_bytes),
+            max_ratio: self.max_ratio.unwrap_or(d.max_ratio),
+            max_xml_bytes: self.max_xml_bytes.unwrap_or(d.max_xml_bytes),
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -71,9 +107,18 @@ struct RunArgs {
     /// get/set their state and vary their step).
     #[arg(long)]
     retry_discard: bool,
-    /// CSV file of the results (fmpy's format).
+    /// Results file: .csv (fmpy's CSV) or .mat (MAT v4 as Dymola and OpenModelica write it).
     #[arg(long, short)]
     output: Option<PathBuf>,
+    /// Input signals over time: a CSV file in fmpy's input format (a time column first,
+    /// then one column per input, named as in --set); Reals interpolated linearly between
+    /// rows unless discrete, others held from the last row at or before the time.
+    #[arg(long, value_name = "FILE.csv")]
+    input: Option<PathBuf>,
+    /// Pass on NaN and infinite outputs that FMUs return with fmi2OK (default: an error
+    /// naming the FMU and the variable).
+    #[arg(long)]
+    allow_non_finite: bool,
     /// Output interval, s (a whole multiple of the step; default: every step).
     #[arg(long)]
     output_interval: Option<f64>,
@@ -95,6 +140,8 @@ struct RunArgs {
     /// JSON run summary file ("-" for standard output; with the time spent in each FMU).
     #[arg(long)]
     summary: Option<PathBuf>,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 fn main() -> ExitCode {
@@ -102,7 +149,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
-        Command::Info { model } => info(&model),
+        Command::Info { model, limits } => info(&model, &limits.limits()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -115,11 +162,13 @@ fn main() -> ExitCode {
 
 const SINGLE: &str = "model";
 
-fn qualify(name: &str, single: bool) -> String {
-    if single && !name.starts_with(&format!("{SINGLE}.")) {
-        format!("{SINGLE}.{name}")
-    } else {
-        name.to_string()
+/// The system name of `name`: for a single FMU its variable (an exact variable name wins,
+/// so a variable called `model.beta` is not read as `beta` of the instance), else as given.
+fn qualify(name: &str, single: Option<&Fmu>) -> String {
+    match single {
+        Some(fmu) if fmu.description().variable(name).is_some() => format!("{SINGLE}.{name}"),
+        Some(_) if !name.starts_with(&format!("{SINGLE}.")) => format!("{SINGLE}.{name}"),
+        _ => name.to_string(),
     }
 }
 
@@ -139,7 +188,8 @@ fn progress(fraction: f64) {
 /// `synthesize --json` report: `controller = 4` (custom) and the eight `k_*` parameters.
 fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    let k = nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
+    let k =
+        nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
     let mut sets = vec![("controller.controller".to_string(), "4".to_string())];
     for (row, wheel) in k.iter().zip(["fl", "fr", "rl", "rr"]) {
         // `{:?}` prints the shortest decimal that reads back to the same f64
@@ -157,18 +207,25 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
-    let options = ImportOptions { interface, ..ImportOptions::default() };
+    let format = match &args.output {
+        None => None,
+        Some(p) => Some(OutputFormat::of(p)?),
+    };
+    let limits = args.limits.limits();
+    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
-        let ssp = nigel_cosim::read_ssp(&args.model, &ImportOptions::default())?;
+        // --interface applies to every FMU of the system (one without it is refused by name)
+        let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
         let builder = SystemBuilder::from_system(ssp.system.clone());
-        (builder, ssp.default_start_stop.1, None, false, Some(ssp))
+        (builder, ssp.default_start_stop.1, None, None, Some(ssp))
     } else {
         let fmu = Fmu::load_with(&args.model, &options)?;
         let default = fmu.description().default_experiment.clone().unwrap_or_default();
         let mut builder = SystemBuilder::new();
-        builder.add_instance(SINGLE, fmu)?;
-        (builder, default.stop_time, default.step_size, true, None)
+        builder.add_instance(SINGLE, fmu.clone())?;
+        (builder, default.stop_time, default.step_size, Some(fmu), None)
     };
+    let single = single.as_deref();
     if let Some(path) = &args.gains {
         for (name, value) in custom_gain_settings(path)? {
             builder.set_text(&name, &value)?;
@@ -183,6 +240,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let mut experiment =
         Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
+    check_times(&experiment)?;
+    for warning in sample_period_warnings(&system, experiment.step) {
+        eprintln!("cosim: warning: {warning}");
+    }
+
     experiment.algorithm = algorithm;
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
@@ -194,6 +256,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()));
+    }
+    if let Some(path) = &args.input {
+        experiment.input = Some(std::sync::Arc::new(nigel_cosim::InputTable::read_csv(path)?));
     }
     experiment.output_interval = args.output_interval;
     experiment.retry_discard = args.retry_discard;
@@ -233,13 +298,25 @@ fn run(args: RunArgs) -> Result<(), Error> {
         experiment.progress = Some(progress);
     }
     let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
+    if outcome.is_ok() && args.output.is_none() && args.summary.is_none() {
+        eprintln!(
+            "cosim: note: no --output or --summary given: the run completed but its results were not kept \
+             (add --output out.csv or --output out.mat)"
+        );
+    }
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
         std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
     };
     // the rows recorded so far are written also when the run failed
-    if let Some(path) = &args.output {
+    if let (Some(path), Some(format)) = (&args.output, format) {
         if outcome.is_ok() || results.rows() > 0 {
-            write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?;
+            match format {
+                OutputFormat::Csv => write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?,
+                OutputFormat::Mat => {
+                    let descriptions = column_descriptions(&system, &results);
+                    write(path, &|f| results.write_mat(std::io::BufWriter::new(f), &descriptions))?
+                }
+            }
             if outcome.is_err() {
                 eprintln!("cosim: {} rows up to the last completed step written to {}", results.rows(), path.display());
             }
@@ -264,13 +341,103 @@ fn run(args: RunArgs) -> Result<(), Error> {
     Ok(())
 }
 
+#[derive(Clone, Copy)]
+enum OutputFormat {
+    Csv,
+    Mat,
+}
+
+impl OutputFormat {
+    /// By the file's extension; anything but .csv and .mat is refused before the run.
+    fn of(path: &Path) -> Result<OutputFormat, Error> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("csv") => Ok(OutputFormat::Csv),
+            Some("mat") => Ok(OutputFormat::Mat),
+            _ => Err(Error::Experiment(format!(
+                "--output {}: the file name must end in .csv (fmpy's CSV) or .mat (MAT v4, as Dymola writes it)",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// The variable descriptions of the result columns, for the MAT file.
+fn column_descriptions(system: &System, results: &nigel_cosim::Results) -> Vec<String> {
+    let single = system.instances.len() == 1;
+    results
+        .names
+        .iter()
+        .map(|n| {
+            let full = if single { format!("{SINGLE}.{n}") } else { n.clone() };
+            system.resolve(&full).ok().and_then(|r| system.variable(&r).description.clone()).unwrap_or_default()
+        })
+        .collect()
+}
+
+/// Times a run cannot mean: refused before anything is loaded into an FMU.
+fn check_times(e: &Experiment) -> Result<(), Error> {
+    let span = e.stop_time - e.start_time;
+    if span.is_nan() || span <= 0.0 {
+        return Err(Error::Experiment(format!(
+            "the stop time {} s must be after the start time {} s (--stop-time, --start-time)",
+            e.stop_time, e.start_time
+        )));
+    }
+    if e.step > span {
+        return Err(Error::Experiment(format!(
+            "the step {} s is longer than the run ({span} s from {} to {} s): choose a --step of at most {span}",
+            e.step, e.start_time, e.stop_time
+        )));
+    }
+    Ok(())
+}
+
+/// A warning for every FMU whose declared sample period (a parameter `sample_period`,
+/// else its DefaultExperiment stepSize) is shorter than the communication step: its
+/// inputs are then held and its outputs read less often than it is meant to run.
+fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
+    let mut out = Vec::new();
+    for spec in &system.instances {
+        let md = spec.fmu.description();
+        let parameter = md.model_variables.iter().enumerate().find(|(_, v)| {
+            v.name == "sample_period" && v.causality == model_description::Causality::Parameter && v.is_real()
+        });
+        let from_parameter = parameter.and_then(|(index, v)| {
+            let set = spec.start_values.iter().find(|(i, _)| *i == index).and_then(|(_, value)| match value {
+                nigel_cosim::Value::Real(x) => Some(*x),
+                _ => None,
+            });
+            let start = match v.variable_type {
+                model_description::VariableType::Real { start, .. } => start,
+                _ => None,
+            };
+            set.or(start).map(|p| (p, "its parameter sample_period"))
+        });
+        let declared = from_parameter.or_else(|| {
+            md.default_experiment.as_ref().and_then(|d| d.step_size).map(|p| (p, "its DefaultExperiment stepSize"))
+        });
+        if let Some((period, source)) = declared {
+            // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
+            if period > 0.0 && step > period * (1.0 + 1e-9) {
+                out.push(format!(
+                    "{} ({}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
+                     are held and its outputs read only every {step} s (use --step {period})",
+                    spec.name,
+                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+                ));
+            }
+        }
+    }
+    out
+}
+
 fn is_ssp(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
 }
 
-fn info_ssp(path: &Path) -> Result<(), Error> {
+fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     use std::io::Write;
-    let ssp = nigel_cosim::read_ssp(path, &ImportOptions::default())?;
+    let ssp = nigel_cosim::read_ssp(path, &ImportOptions { limits: *limits, ..ImportOptions::default() })?;
     let s = &ssp.system;
     let mut out = std::io::stdout().lock();
     let mut lines = vec![format!(
@@ -279,23 +446,31 @@ fn info_ssp(path: &Path) -> Result<(), Error> {
         s.instances.len(),
         s.connections.len()
     )];
+    if let (start, Some(stop)) = ssp.default_start_stop {
+        lines.push(format!("default experiment: start {} s, stop {stop} s", start.unwrap_or(0.0)));
+    }
     for i in &s.instances {
-        lines.push(format!("instance {:<20} {} ({})", i.name, i.fmu.source().display(), i.fmu.interface().as_str()));
+        // an FMU unpacked from the .ssp is named by its place in the archive (the
+        // temporary copy is gone when this command ends)
+        let source = match ssp.path_in_archive(i.fmu.source()) {
+            Some(inside) => format!("{} in {}", inside.display(), path.display()),
+            None => i.fmu.source().display().to_string(),
+        };
+        lines.push(format!("instance {:<20} {source} ({})", i.name, i.fmu.interface().as_str()));
         for (index, v) in &i.start_values {
-            lines.push(format!("  start {} = {v:?}", i.fmu.description().model_variables[*index].name));
+            let var = &i.fmu.description().model_variables[*index];
+            let unit = var.variable_type.unit().map(|u| format!(" {u}")).unwrap_or_default();
+            lines.push(format!("  start {} = {v}{unit}", var.name));
         }
     }
     for c in &s.connections {
         let unit = |r: &nigel_cosim::VariableRef| s.variable(r).variable_type.unit().unwrap_or("-").to_string();
-        lines.push(format!(
-            "connection {} [{}] -> {} [{}]  (x {} + {})",
-            s.name_of(&c.from),
-            unit(&c.from),
-            s.name_of(&c.to),
-            unit(&c.to),
-            c.gain,
-            c.offset
-        ));
+        let mut line =
+            format!("connection {} [{}] -> {} [{}]", s.name_of(&c.from), unit(&c.from), s.name_of(&c.to), unit(&c.to));
+        if c.gain != 1.0 || c.offset != 0.0 {
+            line.push_str(&format!("  (x {} + {})", c.gain, c.offset));
+        }
+        lines.push(line);
     }
     for l in lines {
         if writeln!(out, "{l}").is_err() {
@@ -305,10 +480,24 @@ fn info_ssp(path: &Path) -> Result<(), Error> {
     Ok(())
 }
 
-fn info(path: &Path) -> Result<(), Error> {
-    if is_ssp(path) {
-        return info_ssp(path);
+/// A number as a user writes it (`1e-3`, `0.35`, `inf`).
+fn plain(x: f64) -> String {
+    if x == f64::INFINITY {
+        "inf".into()
+    } else if x == f64::NEG_INFINITY {
+        "-inf".into()
+    } else if x != 0.0 && (x.abs() < 1e-4 || x.abs() >= 1e15) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
+}
+
+fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
+    if is_ssp(path) {
+        return info_ssp(path, limits);
+    }
+    use model_description::VariableType;
     use std::io::Write;
     // a closed pipe (`cosim info X | head`) ends the listing quietly
     macro_rules! w {
@@ -319,52 +508,75 @@ fn info(path: &Path) -> Result<(), Error> {
         };
     }
     let mut out = std::io::stdout().lock();
-    let fmu = Fmu::load(path)?;
+    let fmu = Fmu::load_with(path, &ImportOptions { limits: *limits, ..ImportOptions::default() })?;
     let md = fmu.description();
     w!(out, "model {} (FMI {}), guid {}", md.model_name, md.fmi_version, md.guid);
-    let cs = md.co_simulation.as_ref().map(|c| c.model_identifier.as_str());
-    let me = md.model_exchange.as_ref().map(|c| c.model_identifier.as_str());
-    w!(
-        out,
-        "interfaces: {}{}",
-        cs.map(|id| format!("CoSimulation ({id}) ")).unwrap_or_default(),
-        me.map(|id| format!("ModelExchange ({id})")).unwrap_or_default()
-    );
+    if let Some(d) = md.description.as_deref().filter(|d| !d.is_empty()) {
+        w!(out, "{d}");
+    }
+    let cs = md.co_simulation.as_ref().map(|c| format!("CoSimulation ({})", c.model_identifier));
+    let me = md.model_exchange.as_ref().map(|c| format!("ModelExchange ({})", c.model_identifier));
+    w!(out, "interfaces: {}", [cs, me].into_iter().flatten().collect::<Vec<_>>().join(", "));
     w!(out, "continuous states: {}, event indicators: {}", md.states().len(), md.number_of_event_indicators);
     if let Some(d) = &md.default_experiment {
-        w!(
-            out,
-            "default experiment: start {:?}, stop {:?}, step {:?}, tolerance {:?}",
-            d.start_time,
-            d.stop_time,
-            d.step_size,
-            d.tolerance
-        );
+        let parts: Vec<String> = [
+            d.start_time.map(|v| format!("start {} s", plain(v))),
+            d.stop_time.map(|v| format!("stop {} s", plain(v))),
+            d.step_size.map(|v| format!("step {} s", plain(v))),
+            d.tolerance.map(|v| format!("tolerance {}", plain(v))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !parts.is_empty() {
+            w!(out, "default experiment: {}", parts.join(", "));
+        }
     }
-    w!(out, "{:<28} {:<20} {:<11} {:<8} {:<10} start", "name", "causality", "variability", "type", "unit");
+    w!(
+        out,
+        "{:<24} {:<19} {:<11} {:<8} {:<8} {:<12} {:<18} description",
+        "name",
+        "causality",
+        "variability",
+        "type",
+        "unit",
+        "start",
+        "min .. max"
+    );
     for v in &md.model_variables {
-        let start = match &v.variable_type {
-            model_description::VariableType::Real { start, .. } => start.map(|x| x.to_string()),
-            model_description::VariableType::Integer { start, .. } => start.map(|x| x.to_string()),
-            model_description::VariableType::Enumeration { start, declared_type, .. } => start.map(|x| {
-                let item = md.type_definitions.iter().find(|t| &t.name == declared_type).and_then(|t| t.item(x));
-                match item {
-                    Some(item) => format!("{x} ({})", item.name),
-                    None => x.to_string(),
-                }
-            }),
-            model_description::VariableType::Boolean { start } => start.map(|x| x.to_string()),
-            model_description::VariableType::String { start } => start.clone(),
+        let range = |min: Option<String>, max: Option<String>| match (min, max) {
+            (None, None) => String::new(),
+            (a, b) => format!("{} .. {}", a.unwrap_or_default(), b.unwrap_or_default()),
+        };
+        let (start, bounds) = match &v.variable_type {
+            VariableType::Real { start, min, max, .. } => (start.map(plain), range(min.map(plain), max.map(plain))),
+            VariableType::Integer { start, min, max } => {
+                (start.map(|x| x.to_string()), range(min.map(|x| x.to_string()), max.map(|x| x.to_string())))
+            }
+            VariableType::Enumeration { start, declared_type, min, max } => (
+                start.map(|x| {
+                    let item = md.type_definitions.iter().find(|t| &t.name == declared_type).and_then(|t| t.item(x));
+                    match item {
+                        Some(item) => format!("{x} ({})", item.name),
+                        None => x.to_string(),
+                    }
+                }),
+                range(min.map(|x| x.to_string()), max.map(|x| x.to_string())),
+            ),
+            VariableType::Boolean { start } => (start.map(|x| x.to_string()), String::new()),
+            VariableType::String { start } => (start.as_ref().map(|x| format!("{x:?}")), String::new()),
         };
         w!(
             out,
-            "{:<28} {:<20} {:<11} {:<8} {:<10} {}",
+            "{:<24} {:<19} {:<11} {:<8} {:<8} {:<12} {:<18} {}",
             v.name,
             v.causality.as_str(),
             v.variability.as_str(),
             v.variable_type.type_name(),
             v.variable_type.unit().unwrap_or("-"),
-            start.unwrap_or_default()
+            start.unwrap_or_else(|| "-".into()),
+            bounds,
+            v.description.as_deref().unwrap_or("")
         );
     }
     Ok(())

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 /// Spin before sleeping while waiting for the host (the host of a 1 us `fmi2DoStep`
 /// answers within it; a longer call puts the master to sleep).
-const MASTER_SPIN: Duration = Duration::from_micros(5);
+const MASTER_SPIN: Duration = Duration::from_micros(50);
 /// How often a sleeping master checks the host and the time limits.
 const CHECK_SLICE: Duration = Duration::from_millis(10);
 /// fmi2Fatal: what the proxy returns for a call the host did not answer.

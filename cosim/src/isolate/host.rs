@@ -12,7 +12,7 @@ use std::time::Duration;
 
 /// The host spins this long for the next call before sleeping (the master's other
 /// instances take about a microsecond each between two calls to this one).
-const HOST_SPIN: Duration = Duration::from_micros(5);
+const HOST_SPIN: Duration = Duration::from_micros(30);
 
 struct Region {
     base: *mut u8,

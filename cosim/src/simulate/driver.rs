@@ -157,6 +157,12 @@ fn run<'s>(
         _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
         _ => Box::new(Jacobi),
     };
+    if let Some(table) = &experiment.input {
+        if experiment.threads > 1 {
+            return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
+        }
+        algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table)?);
+    }
     let single = system.instances.len() == 1;
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();

@@ -15,11 +15,13 @@
 //! - `observer`: what is told after every step (the recorder, the profiler);
 //! - `algorithm`: `jacobi`, `ordered` and `jacobi` in threads, each one file behind one
 //!   trait;
+//! - `input`: input signals over time ([`InputTable`]), applied around the algorithm;
 //! - `driver`: [`simulate()`].
 
 mod algorithm;
 mod clock;
 mod driver;
+mod input;
 mod lane;
 mod me_group;
 mod observer;
@@ -27,6 +29,7 @@ mod plan;
 mod types;
 
 pub use driver::{simulate, simulate_recorded, simulate_with, InstancePool, RowSink};
+pub use input::InputTable;
 pub use lane::apply_start_values;
 pub use plan::default_record;
 pub use types::{push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};

@@ -278,19 +278,29 @@ fn ordered_nodes(system: &System, connected_outputs: &[VariableRef]) -> Result<V
                 system.name_of(&system.connections[k - n_out].to)
             }
         };
-        let mut k = (0..n).find(|k| indegree[*k] > 0).unwrap_or(0);
-        let mut path: Vec<usize> = Vec::new();
-        loop {
-            if let Some(p) = path.iter().position(|x| *x == k) {
-                let cycle: Vec<String> = path[p..].iter().map(|x| name(*x)).chain([name(k)]).collect();
-                return Err(Error::AlgebraicLoop { variables: cycle });
+        // Walk backwards: every node left has a predecessor left (else it would have been
+        // ordered), so the walk closes a cycle; walking forwards could run from the loop
+        // into nodes that merely depend on it.
+        let mut predecessors: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (from, to) in edges.iter().enumerate() {
+            for &t in to {
+                if indegree[from] > 0 {
+                    predecessors[t].push(from);
+                }
             }
-            path.push(k);
-            k = match edges[k].iter().find(|e| indegree[**e] > 0) {
-                Some(e) => *e,
-                None => return Err(Error::AlgebraicLoop { variables: path.iter().map(|x| name(*x)).collect() }),
-            };
         }
+        let mut k = (0..n).find(|k| indegree[*k] > 0).unwrap_or(0);
+        let mut seen = vec![usize::MAX; n];
+        let mut path: Vec<usize> = Vec::new();
+        while seen[k] == usize::MAX {
+            seen[k] = path.len();
+            path.push(k);
+            k = predecessors[k].first().copied().unwrap_or(k);
+        }
+        let mut cycle: Vec<usize> = path[seen[k]..].to_vec();
+        cycle.reverse(); // in the direction the values flow
+        let variables = cycle.iter().chain(cycle.first()).map(|x| name(*x)).collect();
+        return Err(Error::AlgebraicLoop { variables });
     }
     Ok(order.into_iter().map(|k| if k < n_out { (true, k) } else { (false, k - n_out) }).collect())
 }

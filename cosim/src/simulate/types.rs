@@ -59,6 +59,9 @@ pub struct Experiment {
     /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
     /// stops the run with [`Error::Fmi`].
     pub retry_discard: bool,
+    /// Input signals over time (fmpy's `input=`), applied before every communication
+    /// step; the variables they drive must not be connected.
+    pub input: Option<std::sync::Arc<crate::simulate::InputTable>>,
     /// The cap on the steps of a run: communication steps, and the internal steps
     /// (accepted and rejected) of the Model Exchange integrator; a run that would take
     /// more stops with [`Error::Experiment`] (an adaptive step that shrinks without end
@@ -86,6 +89,7 @@ impl Experiment {
             progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
+            input: None,
             max_steps: DEFAULT_MAX_STEPS,
             isolation: None,
             timeout: None,

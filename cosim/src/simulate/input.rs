@@ -1,0 +1,250 @@
+//! Input signals over time, as fmpy's `simulate_fmu(input=...)` takes them: a table with
+//! a time column and one column per input variable. Applied by the master before each
+//! communication step at the step's start time: Real variables that are not discrete
+//! interpolated linearly between rows, the others (discrete Reals, Integers, Booleans)
+//! held from the last row at or before the time; before the first row the first values,
+//! after the last row the last values. Two rows at the same time are a jump: at that time
+//! the later row holds (fmpy's `after_event`), in initialization the earlier one.
+//! Model Exchange instances get the value at the start of each communication step, held
+//! over it (as the master holds connections).
+
+use crate::error::{Error, Result};
+use crate::simulate::algorithm::{Communication, Core};
+use crate::simulate::clock::Point;
+use crate::simulate::observer::Profiler;
+use crate::system::{BaseType, System, VariableRef};
+use model_description::{Causality, Variability};
+use std::path::Path;
+
+/// An input table: times ascending (equal neighbours allowed, a jump), one column of
+/// values per named variable.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputTable {
+    /// Variable names, as `--set` names them (`instance.variable`, or the bare name for a
+    /// one-instance system).
+    pub names: Vec<String>,
+    /// The times, s.
+    pub time: Vec<f64>,
+    /// `columns[j][k]`: variable `j` at `time[k]`.
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl InputTable {
+    /// A table from its parts, checked: times finite and not decreasing, every column as
+    /// long as the time column, values finite.
+    pub fn new(names: Vec<String>, time: Vec<f64>, columns: Vec<Vec<f64>>) -> Result<InputTable> {
+        let bad = |m: String| Error::Experiment(format!("input: {m}"));
+        if time.is_empty() {
+            return Err(bad("the table has no rows".into()));
+        }
+        if names.len() != columns.len() {
+            return Err(bad(format!("{} names for {} columns", names.len(), columns.len())));
+        }
+        if let Some(t) = time.iter().find(|t| !t.is_finite()) {
+            return Err(bad(format!("time {t} is not finite")));
+        }
+        if let Some(k) = time.windows(2).position(|w| w[1] < w[0]) {
+            return Err(bad(format!("time goes back from {} to {} s at row {}", time[k], time[k + 1], k + 2)));
+        }
+        for (name, c) in names.iter().zip(&columns) {
+            if c.len() != time.len() {
+                return Err(bad(format!("column {name:?} has {} values for {} times", c.len(), time.len())));
+            }
+            if let Some(k) = c.iter().position(|v| !v.is_finite()) {
+                return Err(bad(format!("{name} = {} at t = {} s is not finite", c[k], time[k])));
+            }
+        }
+        Ok(InputTable { names, time, columns })
+    }
+
+    /// Reads a CSV file in fmpy's format: a header of names (quoted or not, the first
+    /// being the time column), then rows of numbers separated by commas.
+    pub fn read_csv(path: &Path) -> Result<InputTable> {
+        let text = crate::unpack::read_text_file(path, "the input file", 1 << 30)?;
+        let bad = |line: usize, m: String| Error::Experiment(format!("{}:{line}: {m}", path.display()));
+        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let (_, header) = lines.next().ok_or_else(|| bad(1, "empty file, expected a header of names".into()))?;
+        let cells = |l: &str| -> Vec<String> {
+            l.split(',').map(|c| c.trim().trim_matches('"').replace("\"\"", "\"")).collect()
+        };
+        let names = cells(header);
+        if names.len() < 2 {
+            return Err(bad(1, "expected a time column and at least one input column".into()));
+        }
+        let mut time = Vec::new();
+        let mut columns = vec![Vec::new(); names.len() - 1];
+        for (k, line) in lines {
+            let row = cells(line);
+            if row.len() != names.len() {
+                return Err(bad(k + 1, format!("{} values, the header has {} names", row.len(), names.len())));
+            }
+            let num = |j: usize| {
+                row[j]
+                    .parse::<f64>()
+                    .map_err(|_| bad(k + 1, format!("{:?} (column {:?}) is not a number", row[j], names[j])))
+            };
+            time.push(num(0)?);
+            for (j, c) in columns.iter_mut().enumerate() {
+                c.push(num(j + 1)?);
+            }
+        }
+        InputTable::new(names[1..].to_vec(), time, columns)
+    }
+
+    /// The index `i0` of the first time at or after `t` (numpy's `searchsorted`, left).
+    fn search(&self, t: f64) -> usize {
+        self.time.partition_point(|x| *x < t)
+    }
+
+    /// The value of column `j` at `t`, as fmpy's `Input.interpolate` computes it.
+    pub fn value(&self, j: usize, t: f64, discrete: bool, after_event: bool) -> f64 {
+        let (time, v) = (&self.time, &self.columns[j]);
+        let n = time.len();
+        if n < 2 {
+            return v[0];
+        }
+        let i0 = self.search(t);
+        if i0 == 0 {
+            return v[0];
+        }
+        if i0 == n {
+            return v[n - 1];
+        }
+        if discrete {
+            let mut i = i0 - 1;
+            if after_event {
+                while i + 1 < n && (time[i + 1] < t || isclose(t, time[i + 1])) {
+                    i += 1;
+                }
+            }
+            return v[i];
+        }
+        let mut i0 = i0;
+        if isclose(t, time[i0]) && i0 < n - 1 && isclose(time[i0], time[i0 + 1]) {
+            if after_event {
+                while i0 < n - 1 && isclose(time[i0], time[i0 + 1]) {
+                    i0 += 1;
+                }
+            }
+            return v[i0];
+        }
+        let (t0, t1) = (time[i0 - 1], time[i0]);
+        let w0 = (t1 - t) / (t1 - t0);
+        let w1 = 1.0 - w0;
+        w0 * v[i0 - 1] + w1 * v[i0]
+    }
+}
+
+/// Python's `math.isclose` with its defaults (relative tolerance 1e-9, no absolute one),
+/// which fmpy uses to compare times.
+fn isclose(a: f64, b: f64) -> bool {
+    a == b || (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
+
+/// One column resolved to a variable.
+struct Column {
+    variable: VariableRef,
+    discrete: bool,
+}
+
+/// The inputs of a run, resolved, wrapped around the algorithm.
+pub(crate) struct WithInput {
+    pub(crate) inner: Box<dyn Communication>,
+    table: InputTable,
+    columns: Vec<Column>,
+}
+
+impl WithInput {
+    /// Resolves the table's names in `system` (a bare name in a one-instance system is
+    /// that instance's variable); refuses names that are not inputs (or tunable
+    /// parameters) and inputs a connection already feeds.
+    pub(crate) fn new(inner: Box<dyn Communication>, system: &System, table: &InputTable) -> Result<WithInput> {
+        let mut columns = Vec::new();
+        for name in &table.names {
+            let r = match system.resolve(name) {
+                Ok(r) => r,
+                Err(_) if system.instances.len() == 1 => {
+                    system.resolve(&format!("{}.{name}", system.instances[0].name))?
+                }
+                Err(e) => return Err(e),
+            };
+            let v = system.variable(&r);
+            let bad =
+                |reason: String| Error::InvalidValue { variable: name.clone(), value: "(input column)".into(), reason };
+            if !(v.causality == Causality::Input || v.variability == Variability::Tunable) {
+                return Err(bad(format!(
+                    "a {} variable cannot be driven over time (only inputs and tunable parameters)",
+                    v.causality.as_str()
+                )));
+            }
+            if system.connections.iter().any(|c| c.to == r) {
+                return Err(bad("the input is fed by a connection".into()));
+            }
+            if r.base_type == BaseType::String {
+                return Err(bad("String inputs cannot be read from a table".into()));
+            }
+            let discrete = r.base_type != BaseType::Real
+                || v.variability == Variability::Discrete
+                || v.variability == Variability::Tunable;
+            columns.push(Column { variable: r, discrete });
+        }
+        Ok(WithInput { inner, table: table.clone(), columns })
+    }
+
+    fn apply(&self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
+        for (j, c) in self.columns.iter().enumerate() {
+            let v = self.table.value(j, t, c.discrete, after_event);
+            let inst = &mut core.lanes[c.variable.instance].inst;
+            let vr = [c.variable.value_reference];
+            match c.variable.base_type {
+                BaseType::Real => inst.set_real(&vr, &[v])?,
+                // as fmpy's table cast to fmi2Integer / fmi2Boolean: truncated toward zero
+                BaseType::Integer => inst.set_integer(&vr, &[v as i32])?,
+                BaseType::Boolean => inst.set_boolean(&vr, &[(v as i32 != 0) as i32])?,
+                BaseType::String => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Communication for WithInput {
+    fn propagate(&mut self, core: &mut Core) -> Result<()> {
+        self.apply(core, core.clock.t0, false)?;
+        self.inner.propagate(core)
+    }
+
+    fn step(&mut self, core: &mut Core, p: Point, calls: Option<&mut Profiler>) -> Result<()> {
+        self.apply(core, p.t, true)?;
+        self.inner.step(core, p, calls)
+    }
+
+    fn finish(&mut self, core: &mut Core) -> Result<()> {
+        self.inner.finish(core)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_as_fmpy_interpolates_them() {
+        // a ramp, a jump at t = 1 (two rows), then constant
+        let table =
+            InputTable::new(vec!["u".into()], vec![0.0, 0.5, 1.0, 1.0, 2.0], vec![vec![0.0, 1.0, 1.0, 5.0, 5.0]])
+                .unwrap();
+        let at = |t: f64, discrete: bool, after: bool| table.value(0, t, discrete, after);
+        assert_eq!(at(-1.0, false, true), 0.0); // before the first row: held
+        assert_eq!(at(0.25, false, true), 0.5); // w0 = w1 = 0.5
+        assert_eq!(at(0.5, false, true), 1.0);
+        assert_eq!(at(1.0, false, false), 1.0); // the jump: before
+        assert_eq!(at(1.0, false, true), 5.0); // and after
+        assert_eq!(at(3.0, false, true), 5.0); // after the last row: held
+        assert_eq!(at(0.75, true, true), 1.0); // discrete: the last row at or before
+        assert_eq!(at(0.25, true, true), 0.0);
+        assert_eq!(at(0.5, true, false), 0.0); // at a row, before it applies
+        assert_eq!(at(0.5, true, true), 1.0);
+        assert!(InputTable::new(vec!["u".into()], vec![1.0, 0.5], vec![vec![0.0, 0.0]]).is_err());
+    }
+}
