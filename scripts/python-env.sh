@@ -28,6 +28,7 @@ python="${PYTHON:-python3}"
 # (Agg backend, no display needed). plotly (with narwhals) is fmpy's own plotting backend:
 # fmpy.util.plot_result and `fmpy simulate --show-plot` (a PNG from plotly would need kaleido
 # and a Chrome; HTML and the figure object need neither).
+# pandas (with the python-dateutil and tzdata above) reads the campaign's results.csv in its tests.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
@@ -70,6 +71,7 @@ referencing==0.37.0
 rpds-py==2026.9.1
 traitlets==5.16.1
 typing_extensions==4.16.0
+pandas==3.1.1
 EOF
 )"
 

@@ -35,3 +35,7 @@ echo "== Table III closed loop as SSP in fmpy"
 "$target_dir/venv/bin/python" -m pytest table3/tests/python -q
 echo "== examples (each prints what its header says; checked against table3)"
 "$target_dir/venv/bin/python" -m pytest examples -q
+echo "== campaign results in fmpy and pandas"
+"$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
+echo "== campaign on a local Slurm cluster"
+bash scripts/test-campaign-slurm.sh

@@ -127,10 +127,12 @@ pub fn merge(dir: &Path, spec: &Spec) -> Result<Merged, Error> {
                     .collect();
                 let list: Vec<String> = shards.iter().map(|s| format!("{s}/{c}")).collect();
                 format!(
-                    " (shard {}; rerun: campaign run {} --out {} --shard I/N --resume)",
+                    " (shard {}; complete with: campaign run {} --out {} --shard {} --resume{})",
                     list.join(", "),
                     spec.path.display(),
-                    dir.display()
+                    dir.display(),
+                    list[0],
+                    if list.len() > 1 { ", and likewise for the others" } else { "" }
                 )
             }
             _ => String::new(),

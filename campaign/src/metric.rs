@@ -269,7 +269,7 @@ mod tests {
         let m = Metric::parse("norm(rms_diff(plant.x, maneuver.x_ref), rms(plant.y))").unwrap();
         assert_eq!(m.variables(), ["plant.x", "maneuver.x_ref", "plant.y"]);
         let e = Metric::parse("rms_diff(plant.x maneuver.x_ref)").unwrap_err();
-        assert!(e.contains("expected ',' or ')'") && e.contains("column 17"), "{e}");
+        assert!(e.contains("expected ',' or ')'") && e.contains("column 18"), "{e}");
         assert!(Metric::parse("rmse(plant.x)").unwrap_err().contains("unknown function \"rmse\""));
         assert!(Metric::parse("rms(plant.x, plant.y)").unwrap_err().contains("rms takes 1"));
         assert!(Metric::parse("final(plant.x))").unwrap_err().contains("unexpected text"));

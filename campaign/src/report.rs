@@ -412,6 +412,116 @@ impl Report {
     }
 }
 
+/// A paired comparison: for two values `a`, `b` of one column, the runs that differ only
+/// in that column (the same other grid values and the same sample, hence the same draws).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pairing {
+    /// The group (labels of the other `--by` columns).
+    pub group: String,
+    /// The two values' labels.
+    pub a: String,
+    /// See `a`.
+    pub b: String,
+    /// Pairs where both runs completed.
+    pub pairs: usize,
+    /// Fraction of pairs with metric(a) < metric(b).
+    pub p_less: f64,
+    /// Fraction of pairs with metric(b) < metric(a).
+    pub p_more: f64,
+    /// Median of metric(a) / metric(b).
+    pub median_ratio: f64,
+}
+
+impl Report {
+    /// The paired comparisons of metric `m` between the values of column `name`, per group
+    /// of the `by` columns other than `name`.
+    pub fn pairings(&self, name: &str, by: &[String], m: usize) -> Result<Vec<Pairing>, Error> {
+        let col = column_index(&self.spec, name)?;
+        let by: Vec<usize> = by
+            .iter()
+            .map(|b| column_index(&self.spec, b))
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .filter(|&c| c != col)
+            .collect();
+        let grid: Vec<usize> = (0..self.spec.columns.len())
+            .filter(|&c| c != col && !matches!(self.spec.columns[c].domain, crate::spec::Domain::Random(_)))
+            .collect();
+        let metric = self.spec.columns.len() + m;
+        let values: Vec<f64> = match &self.spec.columns[col].domain {
+            crate::spec::Domain::Grid(v) => v.iter().map(|x| x.number()).collect(),
+            crate::spec::Domain::Cases(c) => (0..c.len()).map(|k| k as f64).collect(),
+            crate::spec::Domain::Random(_) => {
+                return Err(Error::Usage(format!("--pair {name}: a random column has no values to pair")))
+            }
+        };
+        // (group key, pairing key) -> value index -> metric
+        let mut cells: BTreeMap<(Vec<u64>, Vec<u64>), BTreeMap<usize, f64>> = BTreeMap::new();
+        let mut labels: BTreeMap<Vec<u64>, String> = BTreeMap::new();
+        for r in self.rows.iter().filter(|r| r.status == STATUS_OK && r.values[metric].is_finite()) {
+            let gk: Vec<u64> = by.iter().map(|&c| order_key(r.values[c])).collect();
+            labels.entry(gk.clone()).or_insert_with(|| {
+                if by.is_empty() {
+                    "all".into()
+                } else {
+                    by.iter()
+                        .map(|&c| format!("{}={}", self.spec.columns[c].name, label(&self.spec, c, r.values[c])))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                }
+            });
+            let mut pk: Vec<u64> = grid.iter().map(|&c| order_key(r.values[c])).collect();
+            pk.push(r.run % self.spec.samples);
+            let Some(v) = values.iter().position(|x| *x == r.values[col]) else { continue };
+            cells.entry((gk, pk)).or_default().insert(v, r.values[metric]);
+        }
+        let mut out = Vec::new();
+        for (gk, glabel) in &labels {
+            for a in 0..values.len() {
+                for b in a + 1..values.len() {
+                    let mut ratios = Vec::new();
+                    let (mut less, mut more) = (0usize, 0usize);
+                    for ((g, _), m) in cells.range((gk.clone(), Vec::new())..) {
+                        if g != gk {
+                            break;
+                        }
+                        if let (Some(x), Some(y)) = (m.get(&a), m.get(&b)) {
+                            less += usize::from(x < y);
+                            more += usize::from(y < x);
+                            ratios.push(x / y);
+                        }
+                    }
+                    ratios.sort_by(f64::total_cmp);
+                    out.push(Pairing {
+                        group: glabel.clone(),
+                        a: label(&self.spec, col, values[a]),
+                        b: label(&self.spec, col, values[b]),
+                        pairs: ratios.len(),
+                        p_less: less as f64 / ratios.len().max(1) as f64,
+                        p_more: more as f64 / ratios.len().max(1) as f64,
+                        median_ratio: rank(&ratios, 0.5),
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The pairings as a markdown table.
+    pub fn pairings_markdown(&self, pairings: &[Pairing], metric: &str) -> String {
+        let mut s = format!(
+            "## Paired: P({metric} of A < {metric} of B), same draws\n\n| group | A | B | pairs | P(A < B) | P(B < A) | median A/B |\n|---|---|---|---|---|---|---|\n"
+        );
+        for p in pairings {
+            s += &format!(
+                "| {} | {} | {} | {} | {:.3} | {:.3} | {:.3} |\n",
+                p.group, p.a, p.b, p.pairs, p.p_less, p.p_more, p.median_ratio
+            );
+        }
+        s + "\n"
+    }
+}
+
 /// A sort key giving the numeric order of f64 values.
 fn order_key(v: f64) -> u64 {
     let b = v.to_bits();

@@ -5,7 +5,8 @@
 //! - `results.csv`: one row per run, columns `run`, `status`, `message`, each varied
 //!   column, each metric. Every field is a number, so that fmpy's `read_csv` reads it
 //!   as well as pandas: `status` 0 = ok, 1 = the run failed (the FMU or the master
-//!   returned an error, or a value was refused), 2 = the run panicked; `message` 1 when
+//!   returned an error, or a value was refused), 2 = the run panicked, 3 = an FMU ended
+//!   the run before the stop time (metrics over the points it had); `message` 1 when
 //!   the run left a message in `messages.csv` (columns `run`, `status`, `message`, text),
 //!   else 0; a case column holds the case's index (its names are in `campaign.json`);
 //!   Booleans are 0 / 1; numbers in Rust's shortest round-trip form (`NaN` for a metric a
@@ -29,6 +30,9 @@ pub const STATUS_OK: u8 = 0;
 pub const STATUS_FAILED: u8 = 1;
 /// Status of a run that panicked.
 pub const STATUS_PANICKED: u8 = 2;
+/// Status of a run an FMU ended before the stop time (its metrics cover the points up to
+/// then).
+pub const STATUS_ENDED: u8 = 3;
 
 /// One result row.
 #[derive(Clone, Debug, PartialEq)]

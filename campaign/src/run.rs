@@ -9,10 +9,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use nigel_cosim::{simulate, Experiment, Results, System};
+use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
 use crate::metric::Accumulators;
-use crate::results::{self, Appender, Row, Target, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
+use crate::results::{self, Appender, Row, Target, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
 use crate::spec::{load_system, RunValues, Spec};
 use crate::Error;
 
@@ -53,6 +53,9 @@ pub struct Done {
     pub threads: usize,
     /// The rows file written.
     pub rows: PathBuf,
+    /// Summed over the runs: time inside the co-simulation, and in the whole run (values,
+    /// system, co-simulation, metrics); their difference is the per-run overhead.
+    pub timing: (Duration, Duration),
 }
 
 /// Parses `I/N` (`0 <= I < N`).
@@ -72,6 +75,7 @@ pub fn experiment(spec: &Spec, record: Vec<String>) -> Experiment {
     let mut e = Experiment::new(spec.stop_time, spec.step);
     e.algorithm = spec.algorithm;
     e.record = Some(record);
+    e.timeout = spec.timeout;
     e
 }
 
@@ -88,22 +92,18 @@ pub fn metric_variables(spec: &Spec) -> Vec<String> {
     vars
 }
 
-/// The metrics of a run's results (columns `record`): every row after the first, i.e. the
-/// communication points `t_1 .. t_N`.
-pub fn metrics_of(spec: &Spec, results: &Results, record: &[String]) -> Vec<f64> {
-    let mut acc = Accumulators::new(spec.metrics.iter().map(|(_, m)| m), record);
-    for k in 1..results.rows() {
-        acc.push(&results.row(k)[1..]);
-    }
-    acc.values()
-}
-
-/// A loaded system and what a run needs, reused for every run of one thread.
+/// A loaded system and what a run needs, reused for every run of one thread: the
+/// instances go back into a pool after each run and are reset with `fmi2Reset` for the
+/// next ([`nigel_cosim::simulate_with`]); the metrics take each row as it comes.
 pub struct Worker<'a> {
     spec: &'a Spec,
     base: System,
     record: Vec<String>,
     experiment: Experiment,
+    pool: InstancePool,
+    /// Time inside the co-simulation (`simulate_with`, its reset / instantiation and
+    /// initialization included) and in all of [`Worker::run`], summed over the runs.
+    pub timing: (Duration, Duration),
 }
 
 impl<'a> Worker<'a> {
@@ -112,7 +112,7 @@ impl<'a> Worker<'a> {
         let base = load_system(&spec.system).map_err(Error::Spec)?;
         let record = metric_variables(spec);
         let experiment = experiment(spec, record.clone());
-        Ok(Worker { spec, base, record, experiment })
+        Ok(Worker { spec, base, record, experiment, pool: InstancePool::new(), timing: Default::default() })
     }
 
     /// The system of run `values`.
@@ -121,16 +121,36 @@ impl<'a> Worker<'a> {
     }
 
     /// Runs one run; a failure or a panic is a row with its status and message.
-    pub fn run(&self, i: u64) -> Row {
+    pub fn run(&mut self, i: u64) -> Row {
+        let start = Instant::now();
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Vec<f64>, String> {
-            let system = self.system(&values)?;
-            let (results, _) = simulate(&system, &self.experiment).map_err(|e| e.to_string())?;
-            Ok(metrics_of(self.spec, &results, &self.record))
-        }));
+        let mut inside = Duration::ZERO;
+        let outcome =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<(Vec<f64>, Option<String>), String> {
+                let system = self.spec.system_of(&self.base, &values)?;
+                let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
+                // every row after the first: the communication points t_1 .. t_N
+                let mut first = true;
+                let mut sink = |_t: f64, row: &[f64]| {
+                    if first {
+                        first = false;
+                    } else {
+                        acc.push(row);
+                    }
+                };
+                let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
+                    .map_err(|e| e.to_string())?;
+                inside = summary.wall_time;
+                // an FMU that ends the run before the stop time: the metrics cover fewer points
+                let ended = summary.ended_by.map(|(instance, t, reason)| {
+                    format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
+                });
+                Ok((acc.values(), ended))
+            }));
         let (status, message, metrics) = match outcome {
-            Ok(Ok(m)) => (STATUS_OK, String::new(), m),
+            Ok(Ok((m, None))) => (STATUS_OK, String::new(), m),
+            Ok(Ok((m, Some(ended)))) => (STATUS_ENDED, ended, m),
             Ok(Err(e)) => (STATUS_FAILED, e, nan_metrics()),
             Err(p) => {
                 let what = p
@@ -143,6 +163,8 @@ impl<'a> Worker<'a> {
         };
         let mut v = values.numbers;
         v.extend(metrics);
+        self.timing.0 += inside;
+        self.timing.1 += start.elapsed();
         Row { run: i, status, message, values: v }
     }
 
@@ -185,7 +207,10 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     }
     let mut present = std::collections::HashSet::new();
     have.retain(|r| range.contains(&r.run) && present.insert(r.run));
-    let todo: Vec<u64> = range.clone().filter(|i| !present.contains(i)).collect();
+    let mut todo: Vec<u64> = range.clone().filter(|i| !present.contains(i)).collect();
+    // started sample by sample across the grid points: a campaign stopped half-way holds
+    // as many samples of every grid point (the rows are sorted by run at the end)
+    todo.sort_by_key(|i| (i % spec.samples, i / spec.samples));
     let threads = options
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
@@ -207,15 +232,16 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     };
     let next = AtomicU64::new(0);
     let (tx, rx) = mpsc::channel::<Result<Row, Error>>();
+    let timing = std::sync::Mutex::new((Duration::ZERO, Duration::ZERO));
     let mut done = Done { threads, kept: have.len() as u64, rows: target.rows.clone(), ..Done::default() };
     let mut rows = have;
     let mut write_error = None;
     std::thread::scope(|scope| {
         for _ in 0..threads {
             let tx = tx.clone();
-            let (todo, next) = (&todo, &next);
+            let (todo, next, timing) = (&todo, &next, &timing);
             scope.spawn(move || {
-                let worker = match Worker::new(spec) {
+                let mut worker = match Worker::new(spec) {
                     Ok(w) => w,
                     Err(e) => {
                         let _ = tx.send(Err(e));
@@ -229,6 +255,9 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
                         break;
                     }
                 }
+                let mut t = timing.lock().unwrap_or_else(|p| p.into_inner());
+                t.0 += worker.timing.0;
+                t.1 += worker.timing.1;
             });
         }
         drop(tx);
@@ -262,5 +291,6 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     drop(appender);
     results::write_sorted(&target, spec, &mut rows)?;
     done.wall = start.elapsed();
+    done.timing = timing.into_inner().unwrap_or_else(|p| p.into_inner());
     Ok(done)
 }

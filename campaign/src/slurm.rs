@@ -10,6 +10,13 @@ use std::time::{Duration, Instant};
 use crate::spec::Spec;
 use crate::Error;
 
+/// The fewest runs per array task for Slurm's overhead to stay under 5 %: a task's start
+/// and end (allocation, prolog, `campaign` loading the system) measured at 0.6 - 0.9 s of
+/// wall time per task on the single-node cluster of `scripts/slurm-local.sh`, 2 tasks at a
+/// time; a 30 s closed-loop run is about 64 ms of one core, so 1 s is about 15 runs, and
+/// 5 % of a task is 1 s when the task holds 20 x 15 = 300 runs.
+pub const RUNS_PER_TASK_MIN: u64 = 300;
+
 /// What to write and how to submit.
 #[derive(Clone, Debug)]
 pub struct Array {

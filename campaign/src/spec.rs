@@ -4,7 +4,9 @@
 //! Runs are numbered `0 .. grid points x samples`: run `i` is grid point `i / samples`
 //! (the grid's first key varies slowest, its last fastest, as nested loops in the order
 //! written) and sample `i % samples`; its random values are drawn from `(seed, column,
-//! i)` only ([`crate::rng`]), so they never depend on threads, shards or order.
+//! i % samples)` only ([`crate::rng`]), so they never depend on threads, shards or order.
+//! Every grid point gets the same draws for its sample `s` (common random numbers): two
+//! controllers, say, meet the same masses, speeds and seeds, and are compared run by run.
 
 use std::path::{Path, PathBuf};
 
@@ -52,7 +54,8 @@ pub enum Distribution {
     /// Uniform on `[low, high)`.
     Uniform(f64, f64),
     /// Normal with mean and standard deviation, optionally truncated to `[min, max]`
-    /// (rejection: the draw is repeated with the next counter until it falls inside).
+    /// (rejection: the draw is repeated with the next counter until it falls inside; at least
+    /// 1 % of the distribution must lie inside).
     Normal {
         /// Mean.
         mean: f64,
@@ -116,6 +119,9 @@ pub struct Spec {
     pub step: f64,
     /// The master's algorithm.
     pub algorithm: Algorithm,
+    /// Wall-clock limit of one run (`timeout = 10.0`, seconds): a run past it fails with
+    /// its message and the campaign goes on.
+    pub timeout: Option<std::time::Duration>,
     /// The campaign's random seed.
     pub seed: u64,
     /// Random draws per grid point.
@@ -234,9 +240,9 @@ fn distribution(key: &str, v: &toml::Value) -> Result<(Distribution, Vec<String>
                     return Err(format!("{what} normal: min {a} must be below max {b}"));
                 }
             }
-            // the rejection loop must find a value: at least 1e-6 of the mass inside
+            // the rejection loop must find a value: at least 1 % of the mass inside
             let p = normal_mass(*mean, *std, min, max);
-            if p < 1e-6 {
+            if p < 0.01 {
                 return Err(format!("{what} normal: [min, max] holds only {p:.1e} of the distribution"));
             }
             *lo = min;
@@ -441,17 +447,30 @@ impl Spec {
     pub fn parse(path: &Path, text: &str) -> Result<(Spec, System), Error> {
         let bad = |m: String| Error::Spec(format!("{}: {m}", path.display()));
         let doc: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-            bad(e.message().to_string() + &e.span().map_or(String::new(), |s| format!(" (at byte {})", s.start)))
+            bad(e.message().trim().replace('\n', "; ")
+                + &e.span().map_or(String::new(), |s| format!(" (at byte {})", s.start)))
         })?;
         let get_f = |k: &str| -> Result<f64, Error> {
             doc.get(k).ok_or_else(|| bad(format!("missing {k}"))).and_then(|v| number(v, k).map_err(bad))
         };
         for k in doc.keys() {
-            if !["system", "stop_time", "step", "algorithm", "seed", "samples", "grid", "cases", "random", "metrics"]
-                .contains(&k.as_str())
+            if ![
+                "system",
+                "stop_time",
+                "step",
+                "algorithm",
+                "timeout",
+                "seed",
+                "samples",
+                "grid",
+                "cases",
+                "random",
+                "metrics",
+            ]
+            .contains(&k.as_str())
             {
                 return Err(bad(format!(
-                    "unknown key {k:?} (expected system, stop_time, step, algorithm, seed, samples, grid, cases, random, metrics)"
+                    "unknown key {k:?} (expected system, stop_time, step, algorithm, timeout, seed, samples, grid, cases, random, metrics)"
                 )));
             }
         }
@@ -467,6 +486,16 @@ impl Spec {
             None | Some(Some("ordered")) => Algorithm::Ordered,
             Some(Some("jacobi")) => Algorithm::Jacobi,
             Some(_) => return Err(bad("algorithm: expected \"ordered\" or \"jacobi\"".into())),
+        };
+        let timeout = match doc.get("timeout") {
+            None => None,
+            Some(v) => {
+                let t = number(v, "timeout").map_err(bad)?;
+                if !(t.is_finite() && t > 0.0) {
+                    return Err(bad(format!("timeout: expected seconds > 0, got {t}")));
+                }
+                Some(std::time::Duration::from_secs_f64(t))
+            }
         };
         let uint = |k: &str, default: u64| -> Result<u64, Error> {
             match doc.get(k) {
@@ -536,6 +565,7 @@ impl Spec {
                 stop_time,
                 step,
                 algorithm,
+                timeout,
                 seed,
                 samples,
                 columns,
@@ -631,7 +661,7 @@ impl Spec {
                     assignments.extend(cases[grid_index[k]].1.iter().cloned());
                 }
                 Domain::Random(d) => {
-                    let x = rng::draw(d, self.seed, &c.name, i);
+                    let x = rng::draw(d, self.seed, &c.name, i % self.samples);
                     numbers.push(x.number());
                     assignments.extend(c.targets.iter().map(|t| (t.clone(), x.clone())));
                 }

@@ -44,7 +44,9 @@ pub use error::{Error, HostEnd, Result, Status};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
 pub use me::{Event, Solver};
-pub use simulate::{simulate, Algorithm, Experiment, InputTable, Results, Summary};
+pub use simulate::{
+    simulate, simulate_with, Algorithm, Experiment, InputTable, InstancePool, Results, RowSink, Summary,
+};
 pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};
 pub use unpack::UnpackLimits;

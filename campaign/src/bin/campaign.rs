@@ -81,6 +81,10 @@ enum Command {
         /// How many worst runs to list.
         #[arg(long, default_value_t = 10)]
         worst: usize,
+        /// Compare the values of this column run by run (same other grid values, same
+        /// draws): P(metric of A < metric of B) per group of the other --by columns.
+        #[arg(long)]
+        pair: Option<String>,
     },
 }
 
@@ -104,7 +108,7 @@ fn main_inner() -> Result<(), Error> {
                     return Err(Error::Usage(format!("--only {i}: the campaign has runs 0 .. {}", spec.runs() - 1)));
                 }
                 std::fs::create_dir_all(&out).map_err(|e| Error::Io(format!("{}: {e}", out.display())))?;
-                let worker = Worker::new(&spec)?;
+                let mut worker = Worker::new(&spec)?;
                 let row = worker.run(i);
                 let header = spec.header();
                 let line = row.line();
@@ -126,12 +130,15 @@ fn main_inner() -> Result<(), Error> {
             let shard = shard.as_deref().map(parse_shard).transpose()?;
             let options = Options { out, threads, shard, resume, progress: true };
             let done = nigel_campaign::run::run(&spec, &options)?;
+            let (inside, total) = (done.timing.0.as_secs_f64(), done.timing.1.as_secs_f64());
             eprintln!(
-                "{} runs in {:.1} s on {} threads ({:.0} runs/min), {} failed, {} already done: {}",
+                "{} runs in {:.1} s on {} threads ({:.0} runs/min; {:.1} ms a run, of it {:.2} % outside the co-simulation), {} failed, {} already done: {}",
                 done.ran,
                 done.wall.as_secs_f64(),
                 done.threads,
                 done.ran as f64 / done.wall.as_secs_f64().max(1e-9) * 60.0,
+                1e3 * total / done.ran.max(1) as f64,
+                100.0 * (total - inside) / total.max(1e-12),
                 done.failed,
                 done.kept,
                 done.rows.display()
@@ -143,6 +150,13 @@ fn main_inner() -> Result<(), Error> {
             let program = std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?;
             let array = slurm::Array { out: out.clone(), tasks, partition, cpus_per_task, program };
             let script = slurm::write(&spec, &array)?;
+            let per_task = spec.runs().div_ceil(tasks.max(1));
+            if per_task < slurm::RUNS_PER_TASK_MIN {
+                eprintln!(
+                    "campaign: note: {per_task} runs per task; Slurm's start of a task (about 1 s measured on one node, about 15 runs of the 30 s closed loop) is more than 5 % of a task below {} runs",
+                    slurm::RUNS_PER_TASK_MIN
+                );
+            }
             eprintln!("{} ({} runs in {tasks} tasks)", script.display(), spec.runs());
             if !submit {
                 println!("sbatch {}", script.display());
@@ -181,13 +195,22 @@ fn main_inner() -> Result<(), Error> {
             );
             Ok(())
         }
-        Command::Report { dir, by, png, metric, worst } => {
+        Command::Report { dir, by, png, metric, worst, pair } => {
             let spec = spec_of_dir(&dir)?;
             let report = Report::load(spec, &dir, &by)?;
             let m = report.metric(metric.as_deref())?;
             print!("{}", report.markdown(m, worst));
+            let mut json = report.json(m, worst);
+            if let Some(column) = pair {
+                let pairings = report.pairings(&column, &by, m)?;
+                print!("{}", report.pairings_markdown(&pairings, &report.spec.metrics[m].0));
+                json["pairs"] = pairings
+                    .iter()
+                    .map(|p| serde_json::json!({"group": p.group, "a": p.a, "b": p.b, "pairs": p.pairs, "p_less": p.p_less, "p_more": p.p_more, "median_ratio": p.median_ratio}))
+                    .collect();
+            }
             let path = dir.join("report.json");
-            let text = serde_json::to_string_pretty(&report.json(m, worst)).expect("JSON of plain values");
+            let text = serde_json::to_string_pretty(&json).expect("JSON of plain values");
             std::fs::write(&path, text + "\n").map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
             eprintln!("{}", path.display());
             if let Some(d) = png {

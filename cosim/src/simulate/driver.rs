@@ -94,11 +94,35 @@ pub fn simulate(system: &System, experiment: &Experiment) -> Result<(Results, Su
 /// fails (an FMU's error, a crashed host, a time limit): nothing recorded is lost.
 pub fn simulate_recorded(system: &System, experiment: &Experiment) -> (Results, Result<Summary>) {
     let mut results = Results::default();
-    let summary = run(system, experiment, &mut results);
+    let summary = run(system, experiment, &mut results, None, None);
     (results, summary)
 }
 
-fn run(system: &System, experiment: &Experiment, out: &mut Results) -> Result<Summary> {
+/// [`simulate()`] taking its instances from `pool` (each reset with `fmi2Reset` instead
+/// of instantiated again; put back after a run that ends without error; not used for
+/// isolated instances) and, with a `sink`, handing each row (time and the recorded
+/// values) to it instead of keeping it: the [`Results`] then have the column names and no
+/// rows. For many runs of one system (parameter studies): no new instantiation per run,
+/// no recording held in memory.
+pub fn simulate_with<'s>(
+    system: &System,
+    experiment: &Experiment,
+    pool: Option<&mut InstancePool>,
+    sink: Option<&'s mut RowSink<'s>>,
+) -> Result<(Results, Summary)> {
+    let mut results = Results::default();
+    let pool = if experiment.isolation.is_some() { None } else { pool };
+    let summary = run(system, experiment, &mut results, pool, sink)?;
+    Ok((results, summary))
+}
+
+fn run<'s>(
+    system: &System,
+    experiment: &Experiment,
+    out: &mut Results,
+    mut pool: Option<&mut InstancePool>,
+    sink: Option<&'s mut RowSink<'s>>,
+) -> Result<Summary> {
     let wall = Instant::now();
     let deadline = experiment.timeout.map(|limit| (wall + limit, limit));
     let clock = Clock::new(experiment, system)?;
@@ -142,18 +166,25 @@ fn run(system: &System, experiment: &Experiment, out: &mut Results) -> Result<Su
     let single = system.instances.len() == 1;
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
-    let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress);
+    let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress, sink);
     let outcome = (|| -> Result<Summary> {
 
     // instantiate and initialize (FMI 2.0 section 4.2.4)
     let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
     for (index, spec) in system.instances.iter().enumerate() {
-        lanes.push(Lane::new(
-            index,
-            match &experiment.isolation {
+        let inst = match pool.as_deref_mut().and_then(|p| p.take(index, spec)) {
+            Some(mut inst) => {
+                inst.reset()?;
+                inst
+            }
+            None => match &experiment.isolation {
                 Some(iso) if iso.covers(&spec.name) => Instance::new_isolated(&spec.fmu, &spec.name, iso, deadline)?,
                 _ => Instance::new(&spec.fmu, &spec.name)?,
             },
+        };
+        lanes.push(Lane::new(
+            index,
+            inst,
             std::mem::take(&mut plan.jacobi_gets[index]),
             std::mem::take(&mut plan.jacobi_gets_rec[index]),
             std::mem::take(&mut plan.jacobi_sets[index]),
@@ -265,6 +296,11 @@ fn run(system: &System, experiment: &Experiment, out: &mut Results) -> Result<Su
             }
         }
     }
+    if let Some(pool) = pool {
+        for lane in std::mem::take(&mut core.lanes) {
+            pool.put(lane.index, lane.inst);
+        }
+    }
     drop(core);
     summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
     summary.wall_time = wall.elapsed();
@@ -272,4 +308,44 @@ fn run(system: &System, experiment: &Experiment, out: &mut Results) -> Result<Su
     })();
     *out = std::mem::take(&mut recorder.results);
     outcome
+}
+
+/// Where [`simulate_with`] hands each row: the time and the recorded values, in the order
+/// of [`Experiment::record`](crate::Experiment::record).
+pub type RowSink<'s> = dyn FnMut(f64, &[f64]) + 's;
+
+/// Instances kept between runs of one system by [`simulate_with`]: the instance of each
+/// position, reused only for the same FMU (the same loaded archive) and name.
+#[derive(Default)]
+pub struct InstancePool {
+    slots: Vec<Option<Instance>>,
+}
+
+impl InstancePool {
+    /// An empty pool.
+    pub fn new() -> InstancePool {
+        InstancePool::default()
+    }
+
+    /// Instances held.
+    pub fn len(&self) -> usize {
+        self.slots.iter().flatten().count()
+    }
+
+    /// Whether the pool holds no instance.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn take(&mut self, index: usize, spec: &crate::system::InstanceSpec) -> Option<Instance> {
+        let inst = self.slots.get_mut(index)?.take()?;
+        (std::sync::Arc::ptr_eq(inst.fmu(), &spec.fmu) && inst.name() == spec.name).then_some(inst)
+    }
+
+    fn put(&mut self, index: usize, inst: Instance) {
+        if self.slots.len() <= index {
+            self.slots.resize_with(index + 1, || None);
+        }
+        self.slots[index] = Some(inst);
+    }
 }

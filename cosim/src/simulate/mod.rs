@@ -28,7 +28,7 @@ mod observer;
 mod plan;
 mod types;
 
-pub use driver::{simulate, simulate_recorded};
+pub use driver::{simulate, simulate_recorded, simulate_with, InstancePool, RowSink};
 pub use input::InputTable;
 pub use lane::apply_start_values;
 pub use plan::default_record;

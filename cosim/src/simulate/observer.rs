@@ -21,21 +21,44 @@ pub(crate) trait Observer {
 }
 
 /// The rows of the results: time and the recorded slots at every output point.
-pub(crate) struct Recorder {
+/// With a sink ([`crate::simulate::RowSink`]) the rows are handed to it instead of kept.
+pub(crate) struct Recorder<'s> {
     pub(crate) results: Results,
     slots: Vec<usize>,
     steps: u64,
     /// Steps completed so far.
     done: u64,
     progress: Option<fn(f64)>,
+    sink: Option<&'s mut crate::simulate::RowSink<'s>>,
+    row: Vec<f64>,
+    /// The time of the last row.
+    last: Option<f64>,
 }
 
-impl Recorder {
+impl<'s> Recorder<'s> {
     /// A recorder of the slots `slots` under the column names `names`, with room reserved
-    /// for `rows` rows (up to 64 MiB up front: a huge run grows as it goes).
-    pub(crate) fn new(names: Vec<String>, slots: Vec<usize>, rows: u64, steps: u64, progress: Option<fn(f64)>) -> Self {
-        let wanted = (rows as usize).saturating_mul(slots.len() + 1).min(8 << 20);
-        Recorder { results: Results { names, values: Vec::with_capacity(wanted) }, slots, steps, done: 0, progress }
+    /// for `rows` rows (up to 64 MiB up front: a huge run grows as it goes; nothing when
+    /// the rows go to `sink`).
+    pub(crate) fn new(
+        names: Vec<String>,
+        slots: Vec<usize>,
+        rows: u64,
+        steps: u64,
+        progress: Option<fn(f64)>,
+        sink: Option<&'s mut crate::simulate::RowSink<'s>>,
+    ) -> Self {
+        let wanted = if sink.is_some() { 0 } else { (rows as usize).saturating_mul(slots.len() + 1).min(8 << 20) };
+        let row = Vec::with_capacity(slots.len());
+        Recorder {
+            results: Results { names, values: Vec::with_capacity(wanted) },
+            slots,
+            steps,
+            done: 0,
+            progress,
+            sink,
+            row,
+            last: None,
+        }
     }
 
     /// Communication steps completed.
@@ -43,21 +66,30 @@ impl Recorder {
         self.done
     }
 
-    /// The time of the last row.
+    /// The time of the last row (kept or handed to the sink).
     pub(crate) fn last_time(&self) -> Option<f64> {
-        let width = self.slots.len() + 1;
-        self.results.values.len().checked_sub(width).map(|k| self.results.values[k])
+        self.last
     }
 
     /// The row at time `t`.
     #[inline]
     pub(crate) fn push_row(&mut self, t: f64, values: &[f64]) {
-        self.results.values.push(t);
-        self.results.values.extend(self.slots.iter().map(|s| values[*s]));
+        self.last = Some(t);
+        match self.sink.as_deref_mut() {
+            Some(sink) => {
+                self.row.clear();
+                self.row.extend(self.slots.iter().map(|s| values[*s]));
+                sink(t, &self.row);
+            }
+            None => {
+                self.results.values.push(t);
+                self.results.values.extend(self.slots.iter().map(|s| values[*s]));
+            }
+        }
     }
 }
 
-impl Observer for Recorder {
+impl Observer for Recorder<'_> {
     #[inline]
     fn step_complete(&mut self, point: &Point, values: &[f64]) -> Result<()> {
         self.done = point.n + 1;
