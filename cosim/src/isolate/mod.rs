@@ -50,114 +50,67 @@ impl Isolation {
     }
 }
 
-/// The calls of the protocol.
-#[repr(u32)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Op {
-    Instantiate = 1,
-    Free,
-    SetupExperiment,
-    EnterInitializationMode,
-    ExitInitializationMode,
-    Terminate,
-    Reset,
-    GetReal,
-    GetInteger,
-    GetBoolean,
-    GetString,
-    SetString,
-    DoStep,
-    GetFmuState,
-    SetFmuState,
-    FreeFmuState,
-    GetBooleanStatus,
-    GetRealStatus,
-    EnterEventMode,
-    NewDiscreteStates,
-    EnterContinuousTimeMode,
-    CompletedIntegratorStep,
-    SetTime,
-    SetContinuousStates,
-    GetDerivatives,
-    GetEventIndicators,
-    GetContinuousStates,
-    GetNominalsOfContinuousStates,
-    /// Only the queued sets.
-    Flush,
+/// Declares the calls of the protocol once: each variant with the fmi2 function it stands for.
+/// The numbers on the wire are the variants' positions from 1 (0 is never a request).
+macro_rules! protocol_ops {
+    ($first:ident => $first_function:literal, $($(#[$doc:meta])* $op:ident => $function:literal,)*) => {
+        /// The calls of the protocol.
+        #[repr(u32)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub(crate) enum Op {
+            $first = 1,
+            $($(#[$doc])* $op,)*
+        }
+
+        impl Op {
+            const ALL: &'static [Op] = &[Op::$first, $(Op::$op),*];
+
+            pub(crate) fn from_u32(v: u32) -> Option<Op> {
+                Op::ALL.get((v as usize).checked_sub(1)?).copied()
+            }
+
+            /// The fmi2 function it is.
+            pub(crate) fn function(self) -> &'static str {
+                match self {
+                    Op::$first => $first_function,
+                    $(Op::$op => $function,)*
+                }
+            }
+        }
+    };
 }
 
-impl Op {
-    pub(crate) fn from_u32(v: u32) -> Option<Op> {
-        use Op::*;
-        const ALL: [Op; 29] = [
-            Instantiate,
-            Free,
-            SetupExperiment,
-            EnterInitializationMode,
-            ExitInitializationMode,
-            Terminate,
-            Reset,
-            GetReal,
-            GetInteger,
-            GetBoolean,
-            GetString,
-            SetString,
-            DoStep,
-            GetFmuState,
-            SetFmuState,
-            FreeFmuState,
-            GetBooleanStatus,
-            GetRealStatus,
-            EnterEventMode,
-            NewDiscreteStates,
-            EnterContinuousTimeMode,
-            CompletedIntegratorStep,
-            SetTime,
-            SetContinuousStates,
-            GetDerivatives,
-            GetEventIndicators,
-            GetContinuousStates,
-            GetNominalsOfContinuousStates,
-            Flush,
-        ];
-        ALL.iter().copied().find(|o| *o as u32 == v)
-    }
-
-    /// The fmi2 function it is.
-    pub(crate) fn function(self) -> &'static str {
-        use Op::*;
-        match self {
-            Instantiate => "fmi2Instantiate",
-            Free => "fmi2FreeInstance",
-            SetupExperiment => "fmi2SetupExperiment",
-            EnterInitializationMode => "fmi2EnterInitializationMode",
-            ExitInitializationMode => "fmi2ExitInitializationMode",
-            Terminate => "fmi2Terminate",
-            Reset => "fmi2Reset",
-            GetReal => "fmi2GetReal",
-            GetInteger => "fmi2GetInteger",
-            GetBoolean => "fmi2GetBoolean",
-            GetString => "fmi2GetString",
-            SetString => "fmi2SetString",
-            DoStep => "fmi2DoStep",
-            GetFmuState => "fmi2GetFMUstate",
-            SetFmuState => "fmi2SetFMUstate",
-            FreeFmuState => "fmi2FreeFMUstate",
-            GetBooleanStatus => "fmi2GetBooleanStatus",
-            GetRealStatus => "fmi2GetRealStatus",
-            EnterEventMode => "fmi2EnterEventMode",
-            NewDiscreteStates => "fmi2NewDiscreteStates",
-            EnterContinuousTimeMode => "fmi2EnterContinuousTimeMode",
-            CompletedIntegratorStep => "fmi2CompletedIntegratorStep",
-            SetTime => "fmi2SetTime",
-            SetContinuousStates => "fmi2SetContinuousStates",
-            GetDerivatives => "fmi2GetDerivatives",
-            GetEventIndicators => "fmi2GetEventIndicators",
-            GetContinuousStates => "fmi2GetContinuousStates",
-            GetNominalsOfContinuousStates => "fmi2GetNominalsOfContinuousStates",
-            Flush => "fmi2Set*",
-        }
-    }
+protocol_ops! {
+    Instantiate => "fmi2Instantiate",
+    Free => "fmi2FreeInstance",
+    SetupExperiment => "fmi2SetupExperiment",
+    EnterInitializationMode => "fmi2EnterInitializationMode",
+    ExitInitializationMode => "fmi2ExitInitializationMode",
+    Terminate => "fmi2Terminate",
+    Reset => "fmi2Reset",
+    GetReal => "fmi2GetReal",
+    GetInteger => "fmi2GetInteger",
+    GetBoolean => "fmi2GetBoolean",
+    GetString => "fmi2GetString",
+    SetString => "fmi2SetString",
+    DoStep => "fmi2DoStep",
+    GetFmuState => "fmi2GetFMUstate",
+    SetFmuState => "fmi2SetFMUstate",
+    FreeFmuState => "fmi2FreeFMUstate",
+    GetBooleanStatus => "fmi2GetBooleanStatus",
+    GetRealStatus => "fmi2GetRealStatus",
+    EnterEventMode => "fmi2EnterEventMode",
+    NewDiscreteStates => "fmi2NewDiscreteStates",
+    EnterContinuousTimeMode => "fmi2EnterContinuousTimeMode",
+    CompletedIntegratorStep => "fmi2CompletedIntegratorStep",
+    SetTime => "fmi2SetTime",
+    SetContinuousStates => "fmi2SetContinuousStates",
+    GetDerivatives => "fmi2GetDerivatives",
+    GetEventIndicators => "fmi2GetEventIndicators",
+    GetContinuousStates => "fmi2GetContinuousStates",
+    GetNominalsOfContinuousStates => "fmi2GetNominalsOfContinuousStates",
+    /// Only the queued sets.
+    Flush => "fmi2Set*",
 }
 
 /// The header at the start of the shared region.
@@ -292,5 +245,21 @@ pub(crate) fn publish(word: &AtomicU32, value: u32, sleeping: &AtomicU32) {
         unsafe {
             libc::syscall(libc::SYS_futex, word.as_ptr(), libc::FUTEX_WAKE, i32::MAX);
         }
+    }
+}
+
+#[cfg(test)]
+mod protocol_tests {
+    use super::Op;
+
+    #[test]
+    fn wire_numbers_map_back_to_their_calls() {
+        for &op in Op::ALL {
+            assert_eq!(Op::from_u32(op as u32), Some(op));
+        }
+        assert_eq!(Op::from_u32(0), None);
+        assert_eq!(Op::from_u32(Op::ALL.len() as u32 + 1), None);
+        assert_eq!(Op::DoStep.function(), "fmi2DoStep");
+        assert_eq!(Op::Instantiate as u32, 1);
     }
 }
