@@ -15,7 +15,8 @@ echo "== rebuilding from touched sources must give byte-identical archives"
 touch fmu-plant/src/lib.rs fmi2-export/src/abi.rs
 cargo run --release --quiet -p build-fmu -- --platforms all "$target_dir/fmu-rebuild" >/dev/null
 for f in "$target_dir"/fmu/*.fmu; do
-    cmp "$f" "$target_dir/fmu-rebuild/$(basename "$f")" && echo "identical: $(basename "$f")"
+    cmp "$f" "$target_dir/fmu-rebuild/$(basename "$f")" || { echo "rebuilt $(basename "$f") differs" >&2; exit 1; }
+    echo "identical: $(basename "$f")"
 done
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
