@@ -145,7 +145,7 @@ pub struct Scenario {
     pub seed: u64,
     /// Friction sinusoids plus noise on (else `mu_i = 0.4`).
     pub friction_variation: bool,
-    /// Wind along world +Y on (else none).
+    /// Wind along `disturbance_settings.wind_direction` on (else none).
     pub wind: bool,
     /// Measurement noise on beta and r; only the real fidelity measures with noise.
     pub measurement_noise: bool,
@@ -353,7 +353,12 @@ impl DisturbanceSettings {
         let s = self;
         check("friction_amplitude", s.friction_amplitude, s.friction_amplitude >= 0.0, "must be >= 0")?;
         check("friction_noise", s.friction_noise, s.friction_noise >= 0.0, "must be >= 0")?;
-        check("friction_frequency", s.friction_frequency, s.friction_frequency >= 0.0, "must be >= 0")?;
+        check(
+            "friction_frequency",
+            s.friction_frequency,
+            (0.0..=1000.0).contains(&s.friction_frequency),
+            "must be in [0, 1000]",
+        )?;
         for (name, phase) in FRICTION_PHASE_NAMES.into_iter().zip(s.friction_phase) {
             check(name, phase, phase.abs() <= 2.0 * TAU, "must be in [-4 pi, 4 pi] rad")?;
         }
