@@ -359,6 +359,36 @@ pub fn write_closed_loop_ssp(fmu_dir: &Path, job: &str, seed: u64, ssp_path: &Pa
         .map_err(|e| format!("{}: {e}", ssp_path.display()))
 }
 
+/// `built` with the C library and minimum OS the Linux `libraries` really need: when one
+/// names a glibc symbol version above the 2.17 baseline (a build with the host toolchain),
+/// that version.
+fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBuild {
+    let needed = libraries.iter().filter_map(|b| glibc_requirement(b)).max();
+    if let Some((major, minor)) = needed.filter(|&(_, minor)| minor > 17) {
+        built.c_library = format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
+        built.minimum_os = format!("Linux with glibc {major}.{minor} or later");
+    }
+    built
+}
+
+/// Builds one FMU for linux64 with the workspace's own cargo (no cross toolchain needed;
+/// the library needs the build machine's glibc, which its documentation then states) and
+/// writes `<out_dir>/<id>.fmu`; returns its path and size. For an FMU of one's own whose
+/// crate depends on this one: the cross builds of [`build_all`] would build this crate's
+/// own dependencies (the master) for every platform too.
+pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<(PathBuf, usize), BuildError> {
+    let paths = build_host_linux64(std::slice::from_ref(target))?;
+    let library = std::fs::read(&paths[0]).map_err(|e| BuildError::Io(paths[0].clone(), e))?;
+    let built = with_glibc_of(PlatformBuild::of(Platform::Linux64), std::slice::from_ref(&library));
+    let documentation = with_platform_table(&target.documentation, &target.model_identifier, &[built]);
+    let libraries = [(Platform::Linux64, library.as_slice())];
+    let bytes = archive(&target.description.to_xml(), &libraries, &target.model_identifier, &documentation)?;
+    std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
+    let path = out_dir.join(format!("{}.fmu", target.model_identifier));
+    std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
+    Ok((path, bytes.len()))
+}
+
 /// Builds every target for every platform of `platforms` and writes `<out_dir>/<id>.fmu`
 /// for each, carrying all those platforms; returns each archive's path and size.
 ///
@@ -387,12 +417,7 @@ pub fn build_all(
             bytes.push(std::fs::read(path).map_err(|e| BuildError::Io(path.clone(), e))?);
         }
         if platform == Platform::Linux64 || platform == Platform::Aarch64Linux {
-            let needed = bytes.iter().filter_map(|b| glibc_requirement(b)).max();
-            if let Some((major, minor)) = needed.filter(|&(_, minor)| minor > 17) {
-                built.c_library =
-                    format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
-                built.minimum_os = format!("Linux with glibc {major}.{minor} or later");
-            }
+            built = with_glibc_of(built, &bytes);
         }
         progress(&format!("{}: built in {:.1} s", platform.folder(), started.elapsed().as_secs_f64()));
         libraries.push((built, bytes));
