@@ -5,7 +5,7 @@
 //!
 //! * [`noise`]: counter-based SplitMix64 `u(seed, stream, k)` and Box-Muller `g(seed, stream, k)`.
 //! * [`scenario`]: [`Maneuver`], [`Fidelity`] (the "sim" / "real" columns), the steering
-//!   [`Program`] per sample, [`Disturbances`] per sample (friction, wind, measurement noise),
+//!   [`Program`] per sample, [`Disturbances`] per sample (friction, wind, measurement noise; their numbers [`DisturbanceSettings`]),
 //!   and [`DisturbanceSequence`]: the same numbers from a table computed once per seed and
 //!   process (Table III runs 36 closed loops on one seed).
 //! * [`control`]: the sampled law `delta = delta_ff + K (x - x_ref)` with the speed-hold PI,
@@ -60,6 +60,6 @@ pub use run::{
     Trajectory,
 };
 pub use scenario::{
-    DisturbanceSequence, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, DEFAULT_SPEED,
-    DEFAULT_STEER_AMPLITUDE, N_SAMPLES, SAMPLE_PERIOD,
+    DisturbanceSequence, DisturbanceSettings, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError,
+    DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE, MAX_WIND_AMPLITUDE, MU_MAX, N_SAMPLES, SAMPLE_PERIOD,
 };

@@ -145,7 +145,7 @@ fn run_loop(
         u.delta = out.delta;
         u.tau = out.tau;
         u.mu = disturbances.friction(k);
-        u.wind_y = disturbances.wind_y(k);
+        [u.wind_x, u.wind_y] = disturbances.wind(k);
         s = integrate(params, &s, &u, SAMPLE_PERIOD, SUBSTEP);
         traj.delta.push(out.delta);
         traj.tau.push(out.tau[0]);
@@ -482,8 +482,8 @@ impl Benchmark {
             y_ref: 0.0,
             psi_ref: 0.0,
             mu: d.friction(0),
-            wind_x: 0.0,
-            wind_y: d.wind_y(0),
+            wind_x: d.wind(0)[0],
+            wind_y: d.wind(0)[1],
             beta_meas,
             yaw_rate_meas,
         }
@@ -493,7 +493,7 @@ impl Benchmark {
     /// `None` beyond the reference ([`Benchmark::horizon`]).
     pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
         let d = self.scenario.disturbances();
-        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind_y(k), d.measure(k, beta, yaw_rate))
+        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind(k), d.measure(k, beta, yaw_rate))
     }
 }
 
@@ -535,20 +535,20 @@ impl BenchSampler {
     /// [`Benchmark::sample`].
     pub fn sample(&self, k: usize, beta: f64, yaw_rate: f64) -> Option<BenchSample> {
         let d = &self.disturbances;
-        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind_y(k), d.measure(k, beta, yaw_rate))
+        bench_sample(&self.scenario, &self.reference, k, d.friction(k), d.wind(k), d.measure(k, beta, yaw_rate))
     }
 }
 
 /// The test bench's outputs at sample `k` of `scenario` (`None` past the reference's end):
 /// the program's steering and the reference, with the sample's disturbances (friction
-/// `mu`, wind `wind_y`, the measured `(beta, yaw_rate)`) as given.
+/// `mu`, wind `[wind_x, wind_y]`, the measured `(beta, yaw_rate)`) as given.
 #[inline]
 fn bench_sample(
     scenario: &Scenario,
     reference: &Reference,
     k: usize,
     mu: [f64; 4],
-    wind_y: f64,
+    [wind_x, wind_y]: [f64; 2],
     (beta_meas, yaw_rate_meas): (f64, f64),
 ) -> Option<BenchSample> {
     let r = &reference.trajectory;
@@ -564,7 +564,7 @@ fn bench_sample(
         y_ref: r.y[k],
         psi_ref: r.psi[k],
         mu,
-        wind_x: 0.0,
+        wind_x,
         wind_y,
         beta_meas,
         yaw_rate_meas,

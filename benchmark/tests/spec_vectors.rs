@@ -30,10 +30,10 @@ fn friction_vectors_seed_0() {
 #[test]
 fn wind_vectors_seed_0() {
     let d = seed0();
-    assert_eq!(d.wind_y(999), 0.007915537544713306);
-    assert_eq!(d.wind_y(1000), 0.2629350570802014);
+    assert_eq!(d.wind(999), [0.0, 0.007915537544713306]);
+    assert_eq!(d.wind(1000), [0.0, 0.2629350570802014]);
     let off = Disturbances { wind: false, ..d };
-    assert_eq!(off.wind_y(5000), 0.0);
+    assert_eq!(off.wind(5000), [0.0, 0.0]);
 }
 
 #[test]
@@ -180,7 +180,7 @@ fn test_bench_sample_is_the_reference_the_program_and_the_disturbances() {
     assert_eq!(o.delta_ff, [-a, -a, a, a]);
     assert_eq!((o.beta_ref, o.yaw_rate_ref, o.speed_ref), (t.beta[k], t.yaw_rate[k], 0.35));
     assert_eq!((o.x_ref, o.y_ref, o.psi_ref), (t.x[k], t.y[k], t.psi[k]));
-    assert_eq!((o.mu, o.wind_x, o.wind_y), (d.friction(k), 0.0, d.wind_y(k)));
+    assert_eq!((o.mu, [o.wind_x, o.wind_y]), (d.friction(k), d.wind(k)));
     assert_eq!((o.beta_meas, o.yaw_rate_meas), d.measure(k, 0.01, -0.02));
     assert!(o.beta_meas != 0.01, "real fidelity measures with noise");
     assert!(bench.sample(15_100, 0.0, 0.0).is_some());

@@ -18,14 +18,15 @@
 
 use std::sync::{Arc, OnceLock};
 
+use core::f64::consts::TAU;
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
     declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext,
     Interfaces, Model, ModelResult, SampleEnd, Start, VarDecl,
 };
 use nigel_benchmark::{
-    BenchSample, BenchSampler, Benchmark, Fidelity, Maneuver, Scenario, DEFAULT_SPEED, DEFAULT_STEER_AMPLITUDE,
-    SAMPLE_PERIOD,
+    BenchSample, BenchSampler, Benchmark, DisturbanceSettings, Fidelity, Maneuver, Scenario, DEFAULT_SPEED,
+    DEFAULT_STEER_AMPLITUDE, MAX_WIND_AMPLITUDE, MU_MAX, SAMPLE_PERIOD,
 };
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
@@ -64,6 +65,17 @@ pub enum Var {
     FrictionVariation,
     Wind,
     MeasurementNoise,
+    FrictionMean,
+    FrictionAmplitude,
+    FrictionFrequency,
+    FrictionNoise,
+    FrictionPhase(usize),
+    WindAmplitude,
+    WindNoise,
+    WindDirection,
+    WindStart,
+    BetaNoise,
+    YawRateNoise,
 }
 
 /// Value references (Reals unless stated).
@@ -87,6 +99,19 @@ pub mod vr {
     pub const STEER_AMPLITUDE: u32 = 30;
     pub const SPEED_TARGET: u32 = 31;
     pub const DURATION: u32 = 32;
+    /// The disturbance settings ([`nigel_benchmark::DisturbanceSettings`]): 40..54.
+    pub const FRICTION_MEAN: u32 = 40;
+    pub const FRICTION_AMPLITUDE: u32 = 41;
+    pub const FRICTION_FREQUENCY: u32 = 42;
+    pub const FRICTION_NOISE: u32 = 43;
+    /// `friction_phase_fl .. friction_phase_rr`: 44..48.
+    pub const FRICTION_PHASE: u32 = 44;
+    pub const WIND_AMPLITUDE: u32 = 48;
+    pub const WIND_NOISE: u32 = 49;
+    pub const WIND_DIRECTION: u32 = 50;
+    pub const WIND_START: u32 = 51;
+    pub const BETA_NOISE: u32 = 52;
+    pub const YAW_RATE_NOISE: u32 = 53;
     /// Integer value references (`maneuver` and `fidelity` take the 1-based values of
     /// [`super::maneuver_value`] and [`super::fidelity_value`]).
     pub const MANEUVER: u32 = 0;
@@ -173,31 +198,32 @@ fn build_declaration() -> DeclarationSpec<Var> {
         v.push(VarDecl::real(name, r, b).discrete_output(none()).unit(unit).describe(text));
     }
     v.extend(per_wheel("mu", vr::MU, Var::Friction, |d, _| {
-        d.discrete_output(none()).describe("road friction 0.35 sin(2 pi f theta - phi_i) + 0.55 + noise (0.4 when off)")
+        d.discrete_output(none()).describe(
+            "road friction friction_amplitude sin(2 pi friction_frequency theta - friction_phase_i) + friction_mean \
+             + friction_noise (u - 1/2), theta = 2 pi t / 30 s (0.4 when off)",
+        )
     }));
     v.push(
         VarDecl::real("wind_x", vr::WIND_X, Var::WindX)
             .discrete_output(none())
             .unit("N")
-            .describe("wind force along world X (zero in docs/benchmark.md)"),
+            .describe("wind force along world X: cos(wind_direction) F_w (zero with the default direction)"),
     );
-    v.push(
-        VarDecl::real("wind_y", vr::WIND_Y, Var::WindY)
-            .discrete_output(none())
-            .unit("N")
-            .describe("wind force along world Y: 0.25 [t >= 1 s] + 0.025 chi"),
-    );
+    v.push(VarDecl::real("wind_y", vr::WIND_Y, Var::WindY).discrete_output(none()).unit("N").describe(
+        "wind force along world Y: sin(wind_direction) F_w, \
+                 F_w = wind_amplitude ([t >= wind_start] + wind_noise chi)",
+    ));
     v.push(
         VarDecl::real("beta_meas", vr::BETA_MEAS, Var::BetaMeas)
             .discrete_output(Dependencies::On(vec![vr::BETA]))
             .unit("rad")
-            .describe("what the controller measures: beta (+ 0.005 g in the real fidelity)"),
+            .describe("what the controller measures: beta (+ beta_noise g in the real fidelity)"),
     );
     v.push(
         VarDecl::real("yaw_rate_meas", vr::YAW_RATE_MEAS, Var::YawRateMeas)
             .discrete_output(Dependencies::On(vec![vr::YAW_RATE]))
             .unit("rad/s")
-            .describe("what the controller measures: yaw rate (+ 0.01 g in the real fidelity)"),
+            .describe("what the controller measures: yaw rate (+ yaw_rate_noise g in the real fidelity)"),
     );
     v.push(
         VarDecl::real("steer_amplitude", vr::STEER_AMPLITUDE, Var::SteerAmplitude)
@@ -256,10 +282,119 @@ fn build_declaration() -> DeclarationSpec<Var> {
             .parameter(Start::Boolean(true))
             .describe("Gaussian noise on beta_meas, yaw_rate_meas (real fidelity only)"),
     );
+    let defaults = DisturbanceSettings::default();
+    // the disturbance settings: fixed parameters, the paper's values as start values
+    let setting = |name, r, b, start: f64, (min, max): (f64, f64), text| {
+        VarDecl::real(name, r, b).parameter(Start::Real(start)).min(min).max(max).describe(text)
+    };
+    v.push(setting(
+        "friction_mean",
+        vr::FRICTION_MEAN,
+        Var::FrictionMean,
+        defaults.friction_mean,
+        (0.0, MU_MAX),
+        "friction the sinusoid oscillates around (0.55); friction_mean -+ (friction_amplitude + \
+             friction_noise / 2) must stay in [0, 3]",
+    ));
+    v.push(setting(
+        "friction_amplitude",
+        vr::FRICTION_AMPLITUDE,
+        Var::FrictionAmplitude,
+        defaults.friction_amplitude,
+        (0.0, MU_MAX),
+        "amplitude of the friction sinusoid (0.35)",
+    ));
+    v.push(setting(
+        "friction_frequency",
+        vr::FRICTION_FREQUENCY,
+        Var::FrictionFrequency,
+        defaults.friction_frequency,
+        (0.0, 1000.0),
+        "factor f of theta = 2 pi t / 30 s in the sinusoid's argument 2 pi f theta (12: about 75 periods in 30 s)",
+    ));
+    v.push(setting(
+        "friction_noise",
+        vr::FRICTION_NOISE,
+        Var::FrictionNoise,
+        defaults.friction_noise,
+        (0.0, 2.0 * MU_MAX),
+        "width of the uniform friction noise, centred on zero (0.1: -0.05 .. 0.05)",
+    ));
+    v.push(
+        setting(
+            "wind_amplitude",
+            vr::WIND_AMPLITUDE,
+            Var::WindAmplitude,
+            defaults.wind_amplitude,
+            (0.0, MAX_WIND_AMPLITUDE),
+            "wind step from wind_start (0.25 N)",
+        )
+        .unit("N"),
+    );
+    v.push(setting(
+        "wind_noise",
+        vr::WIND_NOISE,
+        Var::WindNoise,
+        defaults.wind_noise,
+        (0.0, 10.0),
+        "uniform wind noise from t = 0, relative to wind_amplitude (0.1)",
+    ));
+    v.push(
+        setting(
+            "wind_direction",
+            vr::WIND_DIRECTION,
+            Var::WindDirection,
+            defaults.wind_direction,
+            (-TAU, TAU),
+            "direction the wind blows towards in the world frame, from +X towards +Y (pi/2: along +Y)",
+        )
+        .unit("rad"),
+    );
+    v.push(
+        setting(
+            "wind_start",
+            vr::WIND_START,
+            Var::WindStart,
+            defaults.wind_start,
+            (0.0, MAX_DURATION),
+            "time the wind step starts, at the nearest 1 ms sample (1 s)",
+        )
+        .unit("s"),
+    );
+    v.push(
+        setting(
+            "beta_noise",
+            vr::BETA_NOISE,
+            Var::BetaNoise,
+            defaults.beta_noise,
+            (0.0, 1.0),
+            "standard deviation of the Gaussian noise on beta_meas (0.005 rad; real fidelity only)",
+        )
+        .unit("rad"),
+    );
+    v.push(
+        setting(
+            "yaw_rate_noise",
+            vr::YAW_RATE_NOISE,
+            Var::YawRateNoise,
+            defaults.yaw_rate_noise,
+            (0.0, 10.0),
+            "standard deviation of the Gaussian noise on yaw_rate_meas (0.01 rad/s; real fidelity only)",
+        )
+        .unit("rad/s"),
+    );
+    v.extend(per_wheel("friction_phase", vr::FRICTION_PHASE, Var::FrictionPhase, |d, i| {
+        d.parameter(Start::Real(defaults.friction_phase[i]))
+            .min(-2.0 * TAU)
+            .max(2.0 * TAU)
+            .unit("rad")
+            .describe("phase of the wheel's friction sinusoid (FL 0, FR pi/2, RL pi, RR 3 pi/2)")
+    }));
     DeclarationSpec {
         model_name: "nigel_maneuver",
         model_identifier: MODEL_IDENTIFIER,
-        description: "Benchmark test bench of docs/benchmark.md: steering programs, reference (nominal open-loop run), \
+        description:
+            "Benchmark test bench of docs/benchmark.md: steering programs, reference (nominal open-loop run), \
                       friction and wind disturbances, measurement noise (counter-based SplitMix64)",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
@@ -314,6 +449,7 @@ impl TestBench {
     #[inline(always)]
     fn slot(&mut self, b: Var) -> Option<&mut f64> {
         let o = &mut self.held;
+        let d = &mut self.scenario.disturbance_settings;
         Some(match b {
             Var::Beta => &mut self.beta,
             Var::YawRate => &mut self.yaw_rate,
@@ -332,6 +468,17 @@ impl TestBench {
             Var::SteerAmplitude => &mut self.scenario.steer_amplitude,
             Var::SpeedTarget => &mut self.scenario.speed_ref,
             Var::Duration => &mut self.duration,
+            Var::FrictionMean => &mut d.friction_mean,
+            Var::FrictionAmplitude => &mut d.friction_amplitude,
+            Var::FrictionFrequency => &mut d.friction_frequency,
+            Var::FrictionNoise => &mut d.friction_noise,
+            Var::FrictionPhase(i) => &mut d.friction_phase[i],
+            Var::WindAmplitude => &mut d.wind_amplitude,
+            Var::WindNoise => &mut d.wind_noise,
+            Var::WindDirection => &mut d.wind_direction,
+            Var::WindStart => &mut d.wind_start,
+            Var::BetaNoise => &mut d.beta_noise,
+            Var::YawRateNoise => &mut d.yaw_rate_noise,
             _ => return None,
         })
     }
@@ -419,8 +566,9 @@ impl Model for TestBench {
         if self.bench.as_ref().is_some_and(|b| *b.scenario() == scenario) {
             return Ok(());
         }
-        // the process keeps the recent references (they depend on neither the seed nor the
-        // switches) and the disturbance tables per seed: many instances compute each once
+        // the process keeps the recent references (they depend on neither the seed, the
+        // switches nor the disturbance settings) and the disturbance tables per seed and
+        // settings: many instances compute each once
         self.bench = Some(Arc::new(BenchSampler::prepare(scenario).map_err(|e| e.to_string())?));
         Ok(())
     }

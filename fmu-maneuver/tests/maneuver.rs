@@ -366,3 +366,100 @@ fn an_inconsistent_test_bench_state_is_refused() {
         assert!(g.last_error().contains(what), "number {i} = {value}: {}", g.last_error());
     }
 }
+
+/// The disturbance settings are parameters starting at the paper's values, and other values
+/// change the outputs as docs/benchmark.md's formulas say.
+#[test]
+fn disturbance_settings_change_the_outputs_as_the_formulas_say() {
+    use nigel_benchmark::noise::u;
+    let defaults = B::cs();
+    assert_eq!(defaults.setup(), OK);
+    assert_eq!(defaults.enter_init(), OK);
+    let starts = [
+        (vr::FRICTION_MEAN, 0.55),
+        (vr::FRICTION_AMPLITUDE, 0.35),
+        (vr::FRICTION_FREQUENCY, 12.0),
+        (vr::FRICTION_NOISE, 0.1),
+        (vr::FRICTION_PHASE, 0.0),
+        (vr::FRICTION_PHASE + 1, PI / 2.0),
+        (vr::FRICTION_PHASE + 2, PI),
+        (vr::FRICTION_PHASE + 3, 1.5 * PI),
+        (vr::WIND_AMPLITUDE, 0.25),
+        (vr::WIND_NOISE, 0.1),
+        (vr::WIND_DIRECTION, PI / 2.0),
+        (vr::WIND_START, 1.0),
+        (vr::BETA_NOISE, 0.005),
+        (vr::YAW_RATE_NOISE, 0.01),
+    ];
+    for (r, start) in starts {
+        assert_eq!(defaults.real(r), start, "value reference {r}");
+    }
+
+    let b = B::cs();
+    let settings = [
+        (vr::FRICTION_MEAN, 0.8),
+        (vr::FRICTION_AMPLITUDE, 0.1),
+        (vr::FRICTION_NOISE, 0.02),
+        (vr::WIND_AMPLITUDE, 0.4),
+        (vr::WIND_DIRECTION, 0.0),
+        (vr::WIND_START, 0.5),
+        (vr::BETA_NOISE, 0.02),
+    ];
+    for (r, value) in settings {
+        assert_eq!(b.set_real(r, value), OK);
+    }
+    assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(Fidelity::Real)), OK);
+    assert_eq!(b.set_int(vr::SEED, 3), OK);
+    assert_eq!(b.set_real(vr::DURATION, 2.0), OK);
+    b.init();
+    let (mut sum, mut n, mut low, mut high) = (0.0, 0, f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..2_000u32 {
+        let t = k as f64 * T;
+        let theta = 2.0 * PI * t / 30.0;
+        for i in 0..4u32 {
+            let mu = b.real(vr::MU + i);
+            let phase = [0.0, PI / 2.0, PI, 1.5 * PI][i as usize];
+            let by_hand = 0.1 * (24.0 * PI * theta - phase).sin() + 0.8 + 0.02 * (u(3, i as u8, k as u64) - 0.5);
+            // the same formula written as w (u - 1/2) instead of w u - w / 2, and (2 pi 12) theta
+            // against 24 pi theta: a few ulp of numbers below 1 (libm's sin within 1 ulp)
+            assert!((mu - by_hand).abs() < 1e-14, "k {k} wheel {i}: {mu} vs {by_hand}");
+            (sum, n, low, high) = (sum + mu, n + 1, low.min(mu), high.max(mu));
+        }
+        // direction 0: the whole wind along world X, exactly none along Y
+        let force = if k >= 500 { 0.4 } else { 0.0 } + 0.1 * 0.4 * u(3, 4, k as u64);
+        assert_eq!((b.real(vr::WIND_X), b.real(vr::WIND_Y)), (force, 0.0), "k {k}");
+        assert_eq!(b.real(vr::BETA_MEAS), 0.02 * g(3, 5, k as u64), "beta = 0, k {k}");
+        assert_eq!(b.step(t, T), OK);
+    }
+    // 2 s hold 5.03 periods of the sinusoid (24 pi^2 / 30 s = 7.9 rad/s): the mean is 0.8 to
+    // within the partial period (0.1 x 0.03 / 5) and the noise's mean (0.02 x 0.29 / sqrt(8000))
+    let mean = sum / n as f64;
+    assert!((mean - 0.8).abs() < 0.01, "mean friction {mean}");
+    assert!(low >= 0.8 - 0.1 - 0.01 && high <= 0.8 + 0.1 + 0.01, "{low} .. {high}");
+    assert!(low < 0.8 - 0.09 && high > 0.8 + 0.09, "the sinusoid's whole swing: {low} .. {high}");
+}
+
+/// Settings out of their declared range are refused by the setter, and a combination that
+/// would make the friction negative at the end of initialization; both name the variable.
+#[test]
+fn disturbance_settings_out_of_range_are_refused_naming_the_variable() {
+    let b = B::cs();
+    assert_eq!(b.set_real(vr::WIND_AMPLITUDE, -0.1), ERR);
+    assert!(b.last_error().contains("wind_amplitude"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::FRICTION_PHASE + 2, f64::NAN), ERR);
+    assert!(b.last_error().contains("friction_phase_rl"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    // 0.3 - 0.35 - 0.05 < 0: each value in its range, the combination not
+    assert_eq!(b.set_real(vr::FRICTION_MEAN, 0.3), OK);
+    assert_eq!(b.setup(), OK);
+    assert_eq!(b.enter_init(), OK);
+    assert_eq!(b.exit_init(), ERR);
+    assert!(b.last_error().contains("friction_mean"), "{}", b.last_error());
+    assert_eq!(b.reset(), OK);
+    assert_eq!(b.set_real(vr::FRICTION_MEAN, 0.7), OK);
+    assert_eq!(b.set_real(vr::FRICTION_AMPLITUDE, 0.25), OK);
+    assert_eq!(b.set_real(vr::DURATION, 0.1), OK);
+    b.init();
+    assert_eq!(b.step(0.0, 0.1), OK);
+}

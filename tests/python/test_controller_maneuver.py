@@ -357,6 +357,34 @@ def test_bench_vectors_bit_exact(bench):
         s.freeInstance()
 
 
+def test_bench_disturbance_parameters_follow_the_formulas(bench):
+    """The disturbance settings declared with the paper's values as start values; other values
+    give docs/benchmark.md's general formulas, written here in Python."""
+    md = {v.name: v for v in bench.md.modelVariables}
+    for name, start, unit in [("friction_mean", 0.55, None), ("friction_amplitude", 0.35, None),
+                              ("wind_amplitude", 0.25, "N"), ("wind_direction", math.pi / 2, "rad"),
+                              ("wind_start", 1.0, "s"), ("friction_phase_rl", math.pi, "rad")]:
+        assert (md[name].causality, md[name].variability) == ("parameter", "fixed")
+        assert float(md[name].start) == start and md[name].unit == unit, name
+    reals = {"friction_mean": 0.8, "friction_amplitude": 0.1, "friction_noise": 0.02,
+             "wind_amplitude": 0.4, "wind_direction": 0.0, "wind_start": 0.5, "duration": 1.0}
+    s = initialized(bench, "settings", reals=reals, ints={"seed": 3})
+    try:
+        for k in range(1000):
+            t = k * T
+            theta = 2 * math.pi * t / 30
+            for i, w in enumerate(WHEELS):
+                phase = (0.0, math.pi / 2, math.pi, 1.5 * math.pi)[i]
+                mu = 0.1 * math.sin(24 * math.pi * theta - phase) + 0.8 + 0.02 * (splitmix_u(3, i, k) - 0.5)
+                # Python's and Rust's association differ by a few ulp of numbers below 1
+                assert abs(get(s, bench, f"mu_{w}")[0] - mu) < 1e-14, (k, w)
+            force = (0.4 if k >= 500 else 0.0) + 0.1 * 0.4 * splitmix_u(3, 4, k)
+            assert get(s, bench, "wind_x", "wind_y") == [force, 0.0], k
+            s.doStep(currentCommunicationPoint=t, communicationStepSize=T)
+    finally:
+        s.freeInstance()
+
+
 def test_figure8_switch_samples(bench):
     r = simulate_fmu(str(MANEUVER), stop_time=9.5, output_interval=T,
                      start_values={"maneuver": bench.value("maneuver", "figure_8"), "duration": 9.5},

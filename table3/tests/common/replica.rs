@@ -69,7 +69,7 @@ pub fn run_on_master_grid(job: &Job) -> Run {
         u.delta = out.delta;
         u.tau = out.tau;
         u.mu = d.friction(k);
-        u.wind_y = d.wind_y(k);
+        [u.wind_x, u.wind_y] = d.wind(k);
         let h = (k + 1) as f64 * SAMPLE_PERIOD - k as f64 * SAMPLE_PERIOD;
         let substep = 0.5e-3_f64.min(stable_rk4_step(&params, &u));
         s = integrate(&params, &s, &u, h, substep);
