@@ -22,7 +22,7 @@ case "$target" in /*) ;; *) target="$repo/$target" ;; esac
 out="${1:-$target/examples/own_controller}"
 mkdir -p "$out"
 cd "$repo"
-cargo build --release --quiet -p own-controller -p nigel-cosim --bin cosim
+cargo build --release --quiet -p own-controller -p nigel-cosim --bin own-controller --bin cosim
 bin="$target/release"
 
 # 1. the FMU and the SSP with it
