@@ -14,9 +14,12 @@ cargo run --release --quiet -p build-fmu -- --platforms all
 echo "== rebuilding from touched sources must give byte-identical archives"
 touch fmu-plant/src/lib.rs fmi2-export/src/abi.rs
 cargo run --release --quiet -p build-fmu -- --platforms all "$target_dir/fmu-rebuild" >/dev/null
-for f in "$target_dir"/fmu/*.fmu; do
-    cmp "$f" "$target_dir/fmu-rebuild/$(basename "$f")" || { echo "rebuilt $(basename "$f") differs" >&2; exit 1; }
-    echo "identical: $(basename "$f")"
+# the FMUs of build-fmu's list (target/fmu may also hold FMUs the examples wrote)
+ids=$(grep -o '"model_identifier": "[^"]*"' "$target_dir/fmu/manifest.json" | cut -d'"' -f4)
+[ -n "$ids" ] || { echo "no FMU in $target_dir/fmu/manifest.json" >&2; exit 1; }
+for id in $ids; do
+    cmp "$target_dir/fmu/$id.fmu" "$target_dir/fmu-rebuild/$id.fmu" || { echo "rebuilt $id.fmu differs" >&2; exit 1; }
+    echo "identical: $id.fmu"
 done
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
