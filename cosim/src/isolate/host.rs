@@ -131,12 +131,17 @@ fn answer(region: &Region, seq: u32) {
 }
 
 fn write_log_text(region: &Region, status: i32, text: &str) {
+    write_log_record(region, status, b"host", text.as_bytes());
+}
+
+/// Appends one log record (status, category, message) to the region's log area; false when
+/// the area is full.
+fn write_log_record(region: &Region, status: i32, cat: &[u8], msg: &[u8]) -> bool {
     let h = region.header();
     let l = region.layout;
     let mut p = h.log_bytes as usize;
-    let (cat, msg) = (b"host".as_slice(), text.as_bytes());
     if p + 12 + cat.len() + msg.len() > l.log_len {
-        return;
+        return false;
     }
     let area: *mut u8 = region.at(l.log);
     // SAFETY: within the log area (checked above).
@@ -151,6 +156,7 @@ fn write_log_text(region: &Region, status: i32, text: &str) {
     p += 12 + cat.len() + msg.len();
     h.log_bytes = p as u32;
     h.log_count += 1;
+    true
 }
 
 struct Host {
@@ -202,27 +208,9 @@ impl Host {
 
     fn drain_log(&mut self, region: &Region) {
         for r in self.log.take() {
-            let status = r.status.to_raw();
-            let h = region.header();
-            let l = region.layout;
-            let mut p = h.log_bytes as usize;
-            let (cat, msg) = (r.category.as_bytes(), r.message.as_bytes());
-            if p + 12 + cat.len() + msg.len() > l.log_len {
+            if !write_log_record(region, r.status.to_raw(), r.category.as_bytes(), r.message.as_bytes()) {
                 return;
             }
-            let area: *mut u8 = region.at(l.log);
-            // SAFETY: within the log area (checked above).
-            unsafe {
-                let dst = std::slice::from_raw_parts_mut(area.add(p), 12 + cat.len() + msg.len());
-                dst[0..4].copy_from_slice(&status.to_ne_bytes());
-                dst[4..8].copy_from_slice(&(cat.len() as u32).to_ne_bytes());
-                dst[8..12].copy_from_slice(&(msg.len() as u32).to_ne_bytes());
-                dst[12..12 + cat.len()].copy_from_slice(cat);
-                dst[12 + cat.len()..].copy_from_slice(msg);
-            }
-            p += 12 + cat.len() + msg.len();
-            h.log_bytes = p as u32;
-            h.log_count += 1;
         }
     }
 
