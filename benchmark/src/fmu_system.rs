@@ -10,6 +10,7 @@
 //! robust_tracking` ([`CONTROLLER_SWITCH`]).
 
 use crate::{Controller, Fidelity, Maneuver, DEFAULT_SPEED, N_SAMPLES, SAMPLE_PERIOD};
+use nigel_vehicle::WHEELS;
 
 /// The instances, `(instance name, model identifier)`, in the order a master adds them.
 pub const INSTANCES: [(&str, &str); 3] =
@@ -17,8 +18,6 @@ pub const INSTANCES: [(&str, &str); 3] =
 
 /// The controller FMU's `controller` switch: the value of each name is its position + 1.
 pub const CONTROLLER_SWITCH: [&str; 5] = ["open_loop", "pole_placement", "robust", "custom", "robust_tracking"];
-
-const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
 
 /// A parameter's value, typed as the FMU declares it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -55,6 +55,8 @@ pub mod run;
 pub mod scenario;
 
 pub use control::{Controller, ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
+/// The wheels (the suffixes of every per-wheel name), in the order of every per-wheel array.
+pub use nigel_vehicle::WHEELS;
 pub use run::{
     figure8_switches, table3, BenchSample, BenchSampler, Benchmark, ClosedLoopRun, Metric, Reference, TableCell,
     Trajectory,

@@ -14,6 +14,14 @@ pub enum BaseType {
     Boolean,
 }
 
+/// A declared variable, as [`crate::Variables`] returned it: what dependencies refer to,
+/// and how a test or an importer addresses it (`fmi2GetReal(value_reference)` for a Real).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct VarHandle {
+    pub base_type: BaseType,
+    pub value_reference: u32,
+}
+
 /// Start value (its variant also fixes the base type).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Start {
@@ -23,6 +31,22 @@ pub enum Start {
     Boolean(bool),
 }
 
+impl From<f64> for Start {
+    fn from(x: f64) -> Self {
+        Start::Real(x)
+    }
+}
+impl From<i32> for Start {
+    fn from(x: i32) -> Self {
+        Start::Integer(x)
+    }
+}
+impl From<bool> for Start {
+    fn from(x: bool) -> Self {
+        Start::Boolean(x)
+    }
+}
+
 /// What an Unknown of the ModelStructure depends on.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Dependencies {
@@ -30,6 +54,39 @@ pub enum Dependencies {
     All,
     /// Value references (of Reals) of the knowns it depends on; empty: none.
     On(Vec<u32>),
+    /// The knowns it depends on, as [`Variables`](crate::Variables) returned them (Reals).
+    Variables(Vec<VarHandle>),
+}
+
+impl From<Vec<VarHandle>> for Dependencies {
+    fn from(on: Vec<VarHandle>) -> Self {
+        Dependencies::Variables(on)
+    }
+}
+impl From<&[VarHandle]> for Dependencies {
+    fn from(on: &[VarHandle]) -> Self {
+        Dependencies::Variables(on.to_vec())
+    }
+}
+impl<const N: usize> From<[VarHandle; N]> for Dependencies {
+    fn from(on: [VarHandle; N]) -> Self {
+        Dependencies::Variables(on.to_vec())
+    }
+}
+
+/// A reference to a Real state: its value reference or its handle.
+pub trait RealReference {
+    fn real_value_reference(&self) -> u32;
+}
+impl RealReference for u32 {
+    fn real_value_reference(&self) -> u32 {
+        *self
+    }
+}
+impl RealReference for VarHandle {
+    fn real_value_reference(&self) -> u32 {
+        self.value_reference
+    }
 }
 
 /// One declared variable, bound to the model's own handle `B` for it.
@@ -54,6 +111,9 @@ pub struct VarDecl<B> {
     /// For an Enumeration (base type Integer): the name of its type in
     /// [`DeclarationSpec::enumerations`].
     pub declared_type: Option<&'static str>,
+    /// The binding's base type is not the variable's (a `bool` field for a Real): a slip
+    /// [`Declaration::new`] refuses.
+    pub(crate) mismatched_accessor: bool,
     pub binding: B,
 }
 
@@ -75,8 +135,57 @@ impl<B> VarDecl<B> {
             derivative_of: None,
             dependencies: Dependencies::All,
             declared_type: None,
+            mismatched_accessor: false,
             binding,
         }
+    }
+
+    /// A variable without its final binding yet (for [`crate::Variables`]).
+    pub(crate) fn unbound(name: &'static str, value_reference: u32, base_type: BaseType, binding: B) -> Self {
+        Self::new(name, value_reference, base_type, binding)
+    }
+
+    /// The same variable with another binding, and the binding it had.
+    pub(crate) fn with_binding<C>(self, binding: C) -> (VarDecl<C>, B) {
+        let VarDecl {
+            name,
+            value_reference,
+            base_type,
+            description,
+            causality,
+            variability,
+            initial,
+            start,
+            unit,
+            min,
+            max,
+            nominal,
+            derivative_of,
+            dependencies,
+            declared_type,
+            mismatched_accessor,
+            binding: old,
+        } = self;
+        let v = VarDecl {
+            name,
+            value_reference,
+            base_type,
+            description,
+            causality,
+            variability,
+            initial,
+            start,
+            unit,
+            min,
+            max,
+            nominal,
+            derivative_of,
+            dependencies,
+            declared_type,
+            mismatched_accessor,
+            binding,
+        };
+        (v, old)
     }
 
     /// A Real variable.
@@ -126,7 +235,8 @@ impl<B> VarDecl<B> {
     }
 
     /// `causality="parameter" variability="fixed" initial="exact"` with a start value.
-    pub fn parameter(mut self, start: Start) -> Self {
+    pub fn parameter(mut self, start: impl Into<Start>) -> Self {
+        let start = start.into();
         self.causality = Causality::Parameter;
         self.variability = Variability::Fixed;
         self.initial = Some(Initial::Exact);
@@ -136,7 +246,7 @@ impl<B> VarDecl<B> {
 
     /// `causality="parameter" variability="tunable" initial="exact"`: settable between
     /// Co-Simulation steps and in Model Exchange event mode too.
-    pub fn tunable_parameter(mut self, start: Start) -> Self {
+    pub fn tunable_parameter(mut self, start: impl Into<Start>) -> Self {
         self = self.parameter(start);
         self.variability = Variability::Tunable;
         self
@@ -144,7 +254,8 @@ impl<B> VarDecl<B> {
 
     /// A discrete state (`causality="local" variability="discrete" initial="exact"`): it
     /// changes only at events; saved with the FMU state through the model's setter.
-    pub fn discrete_state(mut self, start: Start) -> Self {
+    pub fn discrete_state(mut self, start: impl Into<Start>) -> Self {
+        let start = start.into();
         self.causality = Causality::Local;
         self.variability = Variability::Discrete;
         self.initial = Some(Initial::Exact);
@@ -155,7 +266,8 @@ impl<B> VarDecl<B> {
     /// A discrete output (`variability="discrete"`, `initial="calculated"`): held between
     /// events, computed by the model at events; saved with the FMU state through the
     /// model's setter (a held value is not a function of the current inputs).
-    pub fn discrete_output(mut self, dependencies: Dependencies) -> Self {
+    pub fn discrete_output(mut self, dependencies: impl Into<Dependencies>) -> Self {
+        let dependencies = dependencies.into();
         self.causality = Causality::Output;
         self.variability = Variability::Discrete;
         self.initial = Some(Initial::Calculated);
@@ -165,14 +277,15 @@ impl<B> VarDecl<B> {
 
     /// Sets the start value and `initial` (e.g. a discrete output with an exact start
     /// value: `.discrete_output(deps).start_value(Start::Real(0.0), Initial::Exact)`).
-    pub fn start_value(mut self, start: Start, initial: Initial) -> Self {
-        self.start = start;
+    pub fn start_value(mut self, start: impl Into<Start>, initial: Initial) -> Self {
+        self.start = start.into();
         self.initial = Some(initial);
         self
     }
 
     /// `causality="input"` (continuous for Reals, discrete otherwise) with a start value.
-    pub fn input(mut self, start: Start) -> Self {
+    pub fn input(mut self, start: impl Into<Start>) -> Self {
+        let start = start.into();
         self.causality = Causality::Input;
         self.variability =
             if self.base_type == BaseType::Real { Variability::Continuous } else { Variability::Discrete };
@@ -194,8 +307,9 @@ impl<B> VarDecl<B> {
         self
     }
 
-    /// The derivative of the state with value reference `state_vr` (local, calculated).
-    pub fn derivative(mut self, state_vr: u32, dependencies: Dependencies) -> Self {
+    /// The derivative of the state `state` (its handle or Real value reference; local, calculated).
+    pub fn derivative(mut self, state: impl RealReference, dependencies: impl Into<Dependencies>) -> Self {
+        let (state_vr, dependencies) = (state.real_value_reference(), dependencies.into());
         self.causality = Causality::Local;
         self.variability = Variability::Continuous;
         self.initial = Some(Initial::Calculated);
@@ -214,7 +328,8 @@ impl<B> VarDecl<B> {
     }
 
     /// A calculated continuous output.
-    pub fn output(mut self, dependencies: Dependencies) -> Self {
+    pub fn output(mut self, dependencies: impl Into<Dependencies>) -> Self {
+        let dependencies = dependencies.into();
         self.causality = Causality::Output;
         self.variability = Variability::Continuous;
         self.initial = Some(Initial::Calculated);
@@ -375,6 +490,9 @@ impl<B: Copy> Declaration<B> {
             if names.insert(v.name, row).is_some() {
                 return Err(format!("duplicate variable name {}", v.name));
             }
+            if v.mismatched_accessor {
+                return Err(format!("{}: the accessor's value type is not a {:?}", v.name, v.base_type));
+            }
         }
         let real_row = |vr: u32| lookup.get(&(BaseType::Real, vr)).copied();
         let mut state_rows = Vec::new();
@@ -391,16 +509,30 @@ impl<B: Copy> Declaration<B> {
         let deps = |v: &VarDecl<B>| -> Result<Option<Vec<u32>>, String> {
             match &v.dependencies {
                 Dependencies::All => Ok(None),
-                Dependencies::On(vrs) => vrs
-                    .iter()
-                    .map(|&vr| {
-                        real_row(vr).map(index).ok_or_else(|| format!("{}: dependency on unknown Real vr {vr}", v.name))
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-                    .map(|mut d| {
-                        d.sort_unstable();
-                        Some(d)
-                    }),
+                Dependencies::On(_) | Dependencies::Variables(_) => {
+                    let on: Vec<u32> = match &v.dependencies {
+                        Dependencies::Variables(handles) => {
+                            if let Some(h) = handles.iter().find(|h| h.base_type != BaseType::Real) {
+                                return Err(format!("{}: dependency on a {:?}, not a Real", v.name, h.base_type));
+                            }
+                            handles.iter().map(|h| h.value_reference).collect()
+                        }
+                        Dependencies::On(vrs) => vrs.clone(),
+                        Dependencies::All => Vec::new(),
+                    };
+                    on.iter()
+                        .map(|&vr| {
+                            real_row(vr)
+                                .map(index)
+                                .ok_or_else(|| format!("{}: dependency on unknown Real vr {vr}", v.name))
+                        })
+                        .collect::<Result<Vec<_>, _>>()
+                        .map(|mut d| {
+                            d.sort_unstable();
+                            d.dedup();
+                            Some(d)
+                        })
+                }
             }
         };
         // One dependency declaration per unknown, over everything its value is computed from;
@@ -663,6 +795,44 @@ impl<B> Declaration<B> {
         self.state_rows.len()
     }
 
+    /// The value reference of the variable `name` (its base type is the declaration's).
+    pub fn value_reference(&self, name: &str) -> Option<u32> {
+        self.spec.variables.iter().find(|v| v.name == name).map(|v| v.value_reference)
+    }
+
+    /// `name value_reference` per line, in declaration order: the table each FMU pins in a
+    /// checked-in file, so that a change of a value reference shows in review.
+    pub fn value_reference_table(&self) -> String {
+        self.spec.variables.iter().map(|v| format!("{} {}\n", v.name, v.value_reference)).collect()
+    }
+
+    /// Checks [`Declaration::value_reference_table`] against the checked-in file `path`:
+    /// `Err` with both tables when they differ. With `UPDATE_VALUE_REFERENCES=1` in the
+    /// environment it writes the file instead (then review its diff: a changed value
+    /// reference breaks every importer's saved setup that refers to it by number).
+    pub fn check_pinned_value_references(&self, path: &std::path::Path) -> Result<(), String> {
+        let table = self.value_reference_table();
+        if std::env::var_os("UPDATE_VALUE_REFERENCES").is_some_and(|v| v == "1") {
+            return std::fs::write(path, &table).map_err(|e| format!("{}: {e}", path.display()));
+        }
+        let pinned = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        if pinned == table {
+            return Ok(());
+        }
+        let changed: Vec<String> = table
+            .lines()
+            .filter(|line| !pinned.lines().any(|p| p == *line))
+            .map(|line| format!("  now {line}"))
+            .chain(pinned.lines().filter(|p| !table.lines().any(|l| l == *p)).map(|p| format!("  was {p}")))
+            .collect();
+        Err(format!(
+            "the value references of {} differ from {} (UPDATE_VALUE_REFERENCES=1 rewrites it):\n{}",
+            self.spec.model_name,
+            path.display(),
+            changed.join("\n")
+        ))
+    }
+
     /// The enumeration type of variable `row`, if it is an Enumeration.
     pub fn enumeration_of(&self, row: usize) -> Option<&md::EnumerationType> {
         let t = self.variable(row).declared_type?;
@@ -675,48 +845,6 @@ impl<B> Declaration<B> {
 /// few hundred bytes are kept for its life on purpose.
 pub fn declared_name(name: String) -> &'static str {
     Box::leak(name.into_boxed_str())
-}
-
-/// The wheels, in the order of every per-wheel array of the models (front-left,
-/// front-right, rear-left, rear-right): the suffixes of the per-wheel variable names.
-pub const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
-
-/// A family of 4 per-wheel variables `{stem}_fl .. {stem}_rr` (in [`WHEELS`] order), with
-/// value references `base .. base + 3` and bindings `binding(i)`; `build(variable, i)`
-/// applies the builder chain to the Real variable of wheel `i`.
-///
-/// `per_wheel("tau", vr::TAU, Var::Torque, |v, _| v.input(Start::Real(0.0)).unit("N.m"))`
-/// declares `tau_fl` (vr `TAU`, `Var::Torque(0)`) .. `tau_rr` (vr `TAU + 3`, `Var::Torque(3)`).
-pub fn per_wheel<B>(
-    stem: &str,
-    base: u32,
-    binding: impl Fn(usize) -> B,
-    build: impl Fn(VarDecl<B>, usize) -> VarDecl<B>,
-) -> Vec<VarDecl<B>> {
-    per_wheel_columns(&[stem], base, |i, _| binding(i), |v, i, _| build(v, i))
-}
-
-/// Per-wheel families stored wheel-major, e.g. a gain matrix with a row per wheel and a
-/// column per `stems[j]`: for each wheel `i` (in [`WHEELS`] order), for each column `j`,
-/// the Real variable `{stems[j]}_{WHEELS[i]}` with value reference
-/// `base + stems.len() * i + j` and binding `binding(i, j)`, built by `build(variable, i, j)`.
-/// With one stem it is [`per_wheel`].
-pub fn per_wheel_columns<B>(
-    stems: &[&str],
-    base: u32,
-    binding: impl Fn(usize, usize) -> B,
-    build: impl Fn(VarDecl<B>, usize, usize) -> VarDecl<B>,
-) -> Vec<VarDecl<B>> {
-    let columns = stems.len();
-    WHEELS
-        .iter()
-        .enumerate()
-        .flat_map(|(i, wheel)| stems.iter().enumerate().map(move |(j, stem)| (i, j, *wheel, *stem)))
-        .map(|(i, j, wheel, stem)| {
-            let name = declared_name(format!("{stem}_{wheel}"));
-            build(VarDecl::real(name, base + (columns * i + j) as u32, binding(i, j)), i, j)
-        })
-        .collect()
 }
 
 /// A unit with base-unit exponents `[kg, m, s, rad]`.
@@ -850,68 +978,6 @@ mod tests {
         assert_eq!(d.row(BaseType::Real, 4), None);
         assert_eq!(md.guid, md.content_guid());
         assert!(d.xml().contains(&md.guid));
-    }
-
-    #[test]
-    fn per_wheel_families_have_the_wheel_names_consecutive_references_and_the_chain() {
-        let torques = per_wheel("tau", 20, |i| 100 + i as u8, |v, i| v.input(Start::Real(i as f64)).unit("N.m"));
-        let names: Vec<&str> = torques.iter().map(|v| v.name).collect();
-        assert_eq!(names, ["tau_fl", "tau_fr", "tau_rl", "tau_rr"]);
-        let vrs: Vec<u32> = torques.iter().map(|v| v.value_reference).collect();
-        assert_eq!(vrs, [20, 21, 22, 23]);
-        let bindings: Vec<u8> = torques.iter().map(|v| v.binding).collect();
-        assert_eq!(bindings, [100, 101, 102, 103]);
-        for (i, v) in torques.iter().enumerate() {
-            assert_eq!(
-                (v.base_type, v.causality, v.variability),
-                (BaseType::Real, Causality::Input, Variability::Continuous)
-            );
-            assert_eq!((v.start, v.unit, v.initial), (Start::Real(i as f64), Some("N.m"), None));
-        }
-
-        // wheel-major matrix: k_a_fl, k_b_fl, k_a_fr, ... at base + 2 i + j
-        let gains = per_wheel_columns(
-            &["k_a", "k_b"],
-            40,
-            |i, j| (10 * i + j) as u8,
-            |v, i, j| v.tunable_parameter(Start::Real((10 * i + j) as f64)),
-        );
-        let rows: Vec<(&str, u32, u8)> = gains.iter().map(|v| (v.name, v.value_reference, v.binding)).collect();
-        assert_eq!(
-            rows,
-            [
-                ("k_a_fl", 40, 0),
-                ("k_b_fl", 41, 1),
-                ("k_a_fr", 42, 10),
-                ("k_b_fr", 43, 11),
-                ("k_a_rl", 44, 20),
-                ("k_b_rl", 45, 21),
-                ("k_a_rr", 46, 30),
-                ("k_b_rr", 47, 31),
-            ]
-        );
-        assert!(gains
-            .iter()
-            .all(|v| v.variability == Variability::Tunable && v.start == Start::Real(v.binding as f64)));
-
-        // a declaration of them is valid, and each is found by its value reference
-        let mut v = toy();
-        v.extend(torques);
-        v.extend(gains);
-        v.push(VarDecl::real("g", 50, 200).calculated_parameter());
-        let mut s = spec(v);
-        s.units.push(si_unit("N.m", 1, 2, -2, 0));
-        let d = Declaration::new(s).unwrap();
-        assert_eq!(d.variable(d.row(BaseType::Real, 23).unwrap()).name, "tau_rr");
-        assert_eq!(d.variable(d.row(BaseType::Real, 45).unwrap()).name, "k_b_rl");
-        let g = d.variable(d.row(BaseType::Real, 50).unwrap());
-        assert_eq!(
-            (g.causality, g.variability, g.initial),
-            (Causality::CalculatedParameter, Variability::Tunable, Some(Initial::Calculated))
-        );
-        // a calculated parameter is an InitialUnknown
-        let g_index = d.row(BaseType::Real, 50).unwrap() as u32 + 1;
-        assert!(d.model_description().model_structure.initial_unknowns.iter().any(|u| u.index == g_index));
     }
 
     #[test]

@@ -13,14 +13,24 @@
 //! 1. A crate `fmu-xyz` with `[lib] name = "<model identifier>"`,
 //!    `crate-type = ["rlib", "cdylib"]` and a feature `fmi-export = []` (the symbols are
 //!    exported only with it, so several FMU crates can be linked into one test binary).
-//! 2. A binding enum (what each value reference stands for) and the declaration: every
-//!    variable once, with causality, start value, unit, min/max, dependencies. Enumerations
-//!    are Integers with a named type ([`VarDecl::enumeration`], [`enumeration_type`]); a
-//!    family of 4 per-wheel variables `{stem}_fl .. {stem}_rr` ([`WHEELS`]) is one call of
-//!    [`per_wheel`] (a row per wheel and a column per stem: [`per_wheel_columns`]);
-//!    capabilities (directional derivatives, FMU state, serialization) are opt-in in
-//!    [`Capabilities`]; interfaces in [`Interfaces`].
-//! 3. `impl Model`: [`Model::declaration`], [`Model::instantiate`], get/set by binding.
+//! 2. The declaration ([`variables`]): every variable once, with causality, start value,
+//!    unit, min/max, description, and the model field it reads and writes, e.g.
+//!    `v.real("beta").input(0.0).unit("rad").field(|m, _| &mut m.inputs.beta)`, which
+//!    returns the variable's [`VarHandle`]; dependencies (the ModelStructure) are lists of
+//!    those handles. The layer assigns the value references (per base type, in declaration
+//!    order: appending keeps the earlier ones) and each FMU pins them in a checked-in table
+//!    ([`Declaration::check_pinned_value_references`]). A family `{stem}_{suffix}` (the four
+//!    wheels) is one call of [`Variables::family`] (a matrix: [`Variables::family_columns`]);
+//!    a value computed on reading is `.computed(..)`, a setter that checks what the
+//!    declaration cannot say `.get_set(..)`; enumerations are Integers with a named type
+//!    ([`Variables::enumeration`], [`enumeration_type`]); capabilities (directional
+//!    derivatives, FMU state, serialization) are opt-in in [`Capabilities`]; interfaces in
+//!    [`Interfaces`]. A model with special needs (the plant's states, derivatives and
+//!    directional derivatives) keeps its own binding: `.bind(MyBinding::X)` and its own
+//!    `get_real` .. `set_boolean` ([`Access`]).
+//! 3. `impl Model`: [`Model::declaration`] and [`Model::instantiate`]; the getters and
+//!    setters come from the declaration, and [`Model::parameters_changed`] is the one hook
+//!    for a model that caches what it computes from its parameters.
 //!    A sampled (discrete-time) model answers [`Model::sample_period`] and implements
 //!    [`Model::sample`] (latch the outputs of sample `k`); the layer keeps the clock
 //!    ([`sampled`]: `t_k = start + k period` counted as integers, exact at any start time,
@@ -54,23 +64,24 @@
 //! stepFailed; continue with `fmi2SetFMUstate` or `fmi2Reset`); a warning logged through
 //! [`Logger::warning`] makes the call return `fmi2Warning`.
 //!
+//! A toy FMU with three variables, `y_k = gain u(t_k)` sampled every 10 ms:
+//!
 //! ```
 //! use std::sync::OnceLock;
 //! use fmi2_export::*;
 //!
-//! #[derive(Clone, Copy, Debug)]
-//! enum B { U, Gain, Mode, Y }
-//!
 //! #[derive(Clone, Debug, Default)]
-//! struct Sampler { u: f64, gain: f64, mode: i32, y: f64, k: u64 }
-//!
-//! const PERIOD: f64 = 0.01;
+//! struct Sampler { u: f64, gain: f64, y: f64 }
 //!
 //! impl Model for Sampler {
-//!     type Binding = B;
-//!     fn declaration() -> &'static Declaration<B> {
-//!         static D: OnceLock<Declaration<B>> = OnceLock::new();
+//!     type Binding = Field<Sampler>;
+//!     fn declaration() -> &'static Declaration<Field<Sampler>> {
+//!         static D: OnceLock<Declaration<Field<Sampler>>> = OnceLock::new();
 //!         D.get_or_init(|| {
+//!             let mut v = Variables::<Field<Sampler>>::new();
+//!             let u = v.real("u").input(0.0).field(|m, _| &mut m.u);
+//!             v.real("gain").tunable_parameter(1.0).min(0.0).field(|m, _| &mut m.gain);
+//!             v.real("y").discrete_output([u]).describe("gain u at the last sample").field(|m, _| &mut m.y);
 //!             Declaration::new(DeclarationSpec {
 //!                 model_name: "sampler",
 //!                 model_identifier: "sampler",
@@ -78,13 +89,7 @@
 //!                 version: "1",
 //!                 interfaces: Interfaces { model_exchange: true, co_simulation: true },
 //!                 capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, ..Default::default() },
-//!                 enumerations: vec![enumeration_type("Mode", "", &[("on", 1, ""), ("off", 2, "")])],
-//!                 variables: vec![
-//!                     VarDecl::real("u", 0, B::U).input(Start::Real(0.0)),
-//!                     VarDecl::real("gain", 1, B::Gain).tunable_parameter(Start::Real(1.0)).min(0.0),
-//!                     VarDecl::enumeration("mode", 0, "Mode", B::Mode).parameter(Start::Integer(1)),
-//!                     VarDecl::real("y", 2, B::Y).discrete_output(Dependencies::On(vec![0])),
-//!                 ],
+//!                 variables: v.into_vec(),
 //!                 ..Default::default()
 //!             })
 //!             .expect("valid declaration")
@@ -93,31 +98,19 @@
 //!     fn instantiate(_: &InstantiateContext) -> ModelResult<Self> {
 //!         Ok(Sampler::default())
 //!     }
-//!     fn get_real(&mut self, b: B) -> ModelResult<f64> {
-//!         match b { B::U => Ok(self.u), B::Gain => Ok(self.gain), B::Y => Ok(self.y), B::Mode => Err("not a Real".into()) }
+//!     fn sample_period(&self) -> Option<f64> {
+//!         Some(0.01)
 //!     }
-//!     fn set_real(&mut self, b: B, x: f64) -> ModelResult {
-//!         match b { B::U => self.u = x, B::Gain => self.gain = x, B::Y => self.y = x, B::Mode => return Err("not a Real".into()) }
+//!     fn sample(&mut self, _k: u64, _time: f64) -> ModelResult {
+//!         self.y = self.gain * self.u;
 //!         Ok(())
 //!     }
-//!     fn get_integer(&mut self, _: B) -> ModelResult<i32> { Ok(self.mode) }
-//!     fn set_integer(&mut self, _: B, x: i32) -> ModelResult { self.mode = x; Ok(()) }
-//!     fn event_update(&mut self, _time: f64) -> ModelResult<EventUpdate> {
-//!         self.y = if self.mode == 1 { self.gain * self.u } else { 0.0 };
-//!         self.k += 1;
-//!         Ok(EventUpdate::next_at(self.k as f64 * PERIOD))
-//!     }
-//!     fn save_internal(&self, out: &mut Vec<f64>) { out.push(self.k as f64) }
-//!     fn load_internal(&mut self, data: &[f64]) -> ModelResult {
-//!         match data {
-//!             [k] if *k >= 0.0 && k.fract() == 0.0 => { self.k = *k as u64; Ok(()) }
-//!             _ => Err("sample counter expected".into()),
-//!         }
-//!     }
 //! }
-//!
 //! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi2_export::export_fmi2!(Sampler);
-//! assert!(Sampler::declaration().xml().contains(r#"<Enumeration declaredType="Mode" start="1"/>"#));
+//!
+//! let d = Sampler::declaration();
+//! assert_eq!(d.value_reference_table(), "u 0\ngain 1\ny 2\n");
+//! assert!(d.xml().contains(r#"<Unknown index="3" dependencies="1"/>"#), "{}", d.xml());
 //! ```
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
@@ -132,17 +125,19 @@ pub mod model;
 pub mod sampled;
 pub mod states;
 pub mod uri;
+pub mod variables;
 
 pub use decl::{
-    declared_name, enumeration_type, per_wheel, per_wheel_columns, si_unit, BaseType, Capabilities, Causality,
-    Declaration, DeclarationSpec, Dependencies, Initial, Interfaces, Start, VarDecl, Variability, WHEELS,
+    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec,
+    Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use instance::Instance;
 pub use log::{LogCategory, Logger};
-pub use model::{EventUpdate, InstantiateContext, Interface, Model, ModelError, ModelResult};
+pub use model::{Access, EventUpdate, InstantiateContext, Interface, Model, ModelError, ModelResult};
 pub use model_description;
 pub use sampled::{SampleClock, SampleEnd};
 pub use states::{Function, Machine};
+pub use variables::{Accessor, Family, Field, FieldValue, Pending, Variables};
 
 /// Exports the 44 FMI 2.0 functions for model type `$model` from the calling crate
 /// (which should be a `cdylib`). Invoke it once per shared library.

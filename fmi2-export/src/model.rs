@@ -92,6 +92,38 @@ impl EventUpdate {
     }
 }
 
+/// How the layer reads and writes the variable a binding stands for, in model `M`.
+///
+/// The layer's own binding [`crate::Field`] (a variable declared with
+/// [`crate::Variables`] and the model field it reads and writes) implements every method,
+/// so a model declared that way writes no getter or setter at all. A model that keeps its
+/// own binding enum (its `get_real` .. `set_boolean` dispatch on it) implements this trait
+/// with nothing in it: `impl Access<MyModel> for MyBinding {}`.
+pub trait Access<M>: Copy + std::fmt::Debug + Send + Sync + 'static {
+    fn get_real(self, _model: &mut M) -> ModelResult<f64> {
+        Err("not a Real".into())
+    }
+    fn set_real(self, _model: &mut M, _value: f64) -> ModelResult {
+        Err("not a Real".into())
+    }
+    fn get_integer(self, _model: &mut M) -> ModelResult<i32> {
+        Err("not an Integer".into())
+    }
+    fn set_integer(self, _model: &mut M, _value: i32) -> ModelResult {
+        Err("not an Integer".into())
+    }
+    fn get_boolean(self, _model: &mut M) -> ModelResult<bool> {
+        Err("not a Boolean".into())
+    }
+    fn set_boolean(self, _model: &mut M, _value: bool) -> ModelResult {
+        Err("not a Boolean".into())
+    }
+    /// See [`Model::setter_may_refuse`]. Default: `true` (safe).
+    fn may_refuse(self) -> bool {
+        true
+    }
+}
+
 /// A model behind the FMI layer.
 ///
 /// Variables are addressed by the model's own `Binding` (taken from its [`Declaration`]);
@@ -100,15 +132,18 @@ impl EventUpdate {
 /// Enumeration value is one of its items. Errors are [`ModelError`]s: the layer logs them
 /// with the function's name and returns the status.
 ///
-/// Only [`Model::declaration`], [`Model::instantiate`], [`Model::get_real`] and
-/// [`Model::set_real`] are required; everything else has a default:
+/// Only [`Model::declaration`] and [`Model::instantiate`] are required; everything else
+/// has a default:
+/// - the getters and setters go through the binding ([`Access`]): with the layer's
+///   [`crate::Field`] they read and write the fields the declaration names, and a set of a
+///   parameter calls [`Model::parameters_changed`];
 /// - a model without continuous states needs no `do_step`: the layer runs its time events
 ///   ([`Model::event_update`]) inside `fmi2DoStep`;
 /// - FMU state save/load comes from the declaration (every parameter, input, continuous
 ///   and discrete variable through the getters and setters) plus
 ///   [`Model::save_internal`] / [`Model::load_internal`] for data not declared as a variable.
 pub trait Model: Clone + Send + Sized + 'static {
-    type Binding: Copy + std::fmt::Debug + Send + Sync + 'static;
+    type Binding: Access<Self>;
 
     /// The declaration (variables, units, interfaces, capabilities), built once.
     fn declaration() -> &'static Declaration<Self::Binding>;
@@ -117,7 +152,10 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// setters, so the declaration is the one place start values live.
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self>;
 
-    fn get_real(&mut self, binding: Self::Binding) -> ModelResult<f64>;
+    #[inline(always)]
+    fn get_real(&mut self, binding: Self::Binding) -> ModelResult<f64> {
+        binding.get_real(self)
+    }
 
     /// Sets one variable. The contract of every setter (`set_real`, `set_integer`,
     /// `set_boolean`), on which the layer's all-or-nothing `fmi2Set*` rests (it makes no
@@ -131,30 +169,40 @@ pub trait Model: Clone + Send + Sized + 'static {
     /// back that way, newest first (states the model accepted on the way in). A call
     /// whose variables the model never refuses ([`Model::setter_may_refuse`]) keeps no
     /// earlier values at all.
-    fn set_real(&mut self, binding: Self::Binding, value: f64) -> ModelResult;
+    #[inline(always)]
+    fn set_real(&mut self, binding: Self::Binding, value: f64) -> ModelResult {
+        binding.set_real(self, value)
+    }
+
+    /// Called by the layer's [`crate::Field`] binding after a parameter (fixed or tunable)
+    /// was set: the one place a model learns that a parameter changed (to empty a cache of
+    /// what it computed from them). Default: nothing.
+    fn parameters_changed(&mut self) {}
 
     /// Whether a setter of `binding` can refuse a value that passed the layer's checks
     /// (known value reference, base type, settable in the current state, finite, declared
     /// min/max, enumeration items). Answer `false` only where the setter has no check of
     /// its own beyond those (an input without a model-side range, a state): `fmi2Set*` of
     /// such variables only then skips keeping their earlier values for the way back, which
-    /// is the all-or-nothing rule's whole cost on the hot path. Default: `true` (safe).
-    fn setter_may_refuse(_binding: Self::Binding) -> bool {
-        true
+    /// is the all-or-nothing rule's whole cost on the hot path. Default: the binding's
+    /// answer ([`Access::may_refuse`]: a [`crate::Field`] knows it).
+    #[inline(always)]
+    fn setter_may_refuse(binding: Self::Binding) -> bool {
+        binding.may_refuse()
     }
 
     /// Integers and Enumerations.
     fn get_integer(&mut self, binding: Self::Binding) -> ModelResult<i32> {
-        Err(format!("{binding:?} is not an Integer").into())
+        binding.get_integer(self)
     }
-    fn set_integer(&mut self, binding: Self::Binding, _value: i32) -> ModelResult {
-        Err(format!("{binding:?} is not an Integer").into())
+    fn set_integer(&mut self, binding: Self::Binding, value: i32) -> ModelResult {
+        binding.set_integer(self, value)
     }
     fn get_boolean(&mut self, binding: Self::Binding) -> ModelResult<bool> {
-        Err(format!("{binding:?} is not a Boolean").into())
+        binding.get_boolean(self)
     }
-    fn set_boolean(&mut self, binding: Self::Binding, _value: bool) -> ModelResult {
-        Err(format!("{binding:?} is not a Boolean").into())
+    fn set_boolean(&mut self, binding: Self::Binding, value: bool) -> ModelResult {
+        binding.set_boolean(self, value)
     }
 
     /// Checks the parameters as a whole when initialization ends, and after a serialized

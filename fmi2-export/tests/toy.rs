@@ -120,6 +120,9 @@ fn spec(capabilities: Capabilities, interfaces: Interfaces, identifier: &'static
     }
 }
 
+/// The toy dispatches on its own binding.
+impl fmi2_export::Access<Toy> for V {}
+
 impl Model for Toy {
     type Binding = V;
 
@@ -270,6 +273,9 @@ impl Model for Toy {
 #[derive(Clone, Debug)]
 struct Bare(Toy);
 
+/// The toy dispatches on its own binding.
+impl fmi2_export::Access<Bare> for V {}
+
 impl Model for Bare {
     type Binding = V;
     fn declaration() -> &'static Declaration<V> {
@@ -308,6 +314,9 @@ impl Model for Bare {
 /// The toy with its own FMU-state format (the override): only its internal numbers.
 #[derive(Clone, Debug)]
 struct Own(Toy);
+
+/// The toy dispatches on its own binding.
+impl fmi2_export::Access<Own> for V {}
 
 impl Model for Own {
     type Binding = V;

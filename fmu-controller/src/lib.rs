@@ -27,14 +27,15 @@
 
 use std::sync::OnceLock;
 
+use core::f64::consts::FRAC_PI_2;
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, per_wheel, per_wheel_columns, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies,
-    InstantiateContext, Interfaces, Model, ModelResult, Start, VarDecl,
+    si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
+    ModelResult, VarDecl, Variables,
 };
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
-use nigel_benchmark::{ControllerInputs, ControllerOutputs, ControllerSettings, SampledController};
+use nigel_benchmark::{ControllerInputs, ControllerOutputs, ControllerSettings, SampledController, WHEELS};
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_controller";
@@ -64,79 +65,6 @@ pub mod mode {
     pub const ROBUST_TRACKING: i32 = 5;
 }
 
-/// What a value reference stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Var {
-    Beta,
-    YawRate,
-    Speed,
-    BetaRef,
-    YawRateRef,
-    SpeedRef,
-    SteerFeedForward(usize),
-    Steer(usize),
-    Torque(usize),
-    DriveForce,
-    SpeedIntegral,
-    SamplePeriod,
-    KpSpeed,
-    KiSpeed,
-    ForceMax,
-    WheelRadius,
-    SteerLimit,
-    /// Tunable custom gain, wheel `i`, column `j` (0 = beta, 1 = yaw rate).
-    CustomGain(usize, usize),
-    /// The gain in use (calculated parameter), wheel `i`, column `j`.
-    GainInUse(usize, usize),
-    /// The pose gain in use (calculated parameter), wheel `i`, column `j` (0 = e_y, 1 = e_psi).
-    PoseGainInUse(usize, usize),
-    /// Measured pose input: 0 = x, 1 = y, 2 = psi.
-    Pose(usize),
-    /// Reference pose input: 0 = x_ref, 1 = y_ref, 2 = psi_ref.
-    PoseRef(usize),
-    AlongTrackGain,
-    AlongTrackSpeedMax,
-    Controller,
-}
-
-/// Value references (Reals unless stated).
-pub mod vr {
-    pub const BETA: u32 = 0;
-    pub const YAW_RATE: u32 = 1;
-    pub const SPEED: u32 = 2;
-    pub const BETA_REF: u32 = 3;
-    pub const YAW_RATE_REF: u32 = 4;
-    pub const SPEED_REF: u32 = 5;
-    /// `delta_ff_fl .. delta_ff_rr`: 6..10.
-    pub const DELTA_FF: u32 = 6;
-    /// `delta_fl .. delta_rr`: 10..14.
-    pub const DELTA: u32 = 10;
-    /// `tau_fl .. tau_rr`: 14..18.
-    pub const TAU: u32 = 14;
-    pub const DRIVE_FORCE: u32 = 18;
-    pub const SPEED_INTEGRAL: u32 = 20;
-    pub const SAMPLE_PERIOD: u32 = 30;
-    pub const KP_SPEED: u32 = 31;
-    pub const KI_SPEED: u32 = 32;
-    pub const FORCE_MAX: u32 = 33;
-    pub const R_WHEEL: u32 = 34;
-    pub const DELTA_MAX: u32 = 35;
-    /// `k_beta_fl, k_yaw_rate_fl, k_beta_fr, ...`: 40..48 (row-major, wheel then column).
-    pub const K_CUSTOM: u32 = 40;
-    /// `gain_beta_fl, gain_yaw_rate_fl, ...`: 50..58, the gain in use.
-    pub const GAIN_IN_USE: u32 = 50;
-    /// `x, y, psi`: 60..63, the measured pose.
-    pub const POSE: u32 = 60;
-    /// `x_ref, y_ref, psi_ref`: 63..66, the reference pose.
-    pub const POSE_REF: u32 = 63;
-    pub const K_ALONG_TRACK: u32 = 36;
-    pub const ALONG_TRACK_SPEED_MAX: u32 = 37;
-    /// `gain_e_y_fl, gain_e_psi_fl, ...`: 70..78, the pose gain in use.
-    pub const POSE_GAIN_IN_USE: u32 = 70;
-    /// Integer value reference of `controller`.
-    pub const CONTROLLER: u32 = 0;
-}
-
 /// The description of `controller`: its values and what each selects.
 pub const CONTROLLER_ITEMS: &str =
     "which steering feedback: 1 open_loop (K = 0, the feed-forward alone), 2 pole_placement \
@@ -148,176 +76,157 @@ pub const CONTROLLER_ITEMS: &str =
 /// yaw rate): the baked gains are below 1; 100 saturates the steering at 1 mrad of error.
 pub const CUSTOM_GAIN_MAX: f64 = 100.0;
 
-const POSE_NAMES: [&str; 3] = ["x", "y", "psi"];
-const POSE_UNITS: [&str; 3] = ["m", "m", "rad"];
+/// A pose input (world frame), read by `robust_tracking` only.
+fn pose<B>(d: VarDecl<B>, unit: &'static str, measured: bool) -> VarDecl<B> {
+    d.input(0.0).unit(unit).describe(if measured {
+        "measured pose (world frame; heading may be unwrapped), read by robust_tracking only"
+    } else {
+        "reference pose (the test bench's x_ref, y_ref, psi_ref), read by robust_tracking only"
+    })
+}
 
-fn build_declaration() -> DeclarationSpec<Var> {
-    let mut v: Vec<VarDecl<Var>> = vec![
-        VarDecl::real("beta", vr::BETA, Var::Beta)
-            .input(Start::Real(0.0))
-            .unit("rad")
-            .describe("measured body slip angle atan2(v_y, v_x)"),
-        VarDecl::real("yaw_rate", vr::YAW_RATE, Var::YawRate)
-            .input(Start::Real(0.0))
-            .unit("rad/s")
-            .describe("measured yaw rate"),
-        VarDecl::real("speed", vr::SPEED, Var::Speed)
-            .input(Start::Real(0.35))
-            .unit("m/s")
-            .describe("measured speed hypot(v_x, v_y)"),
-        VarDecl::real("beta_ref", vr::BETA_REF, Var::BetaRef)
-            .input(Start::Real(0.0))
-            .unit("rad")
-            .describe("reference body slip angle"),
-        VarDecl::real("yaw_rate_ref", vr::YAW_RATE_REF, Var::YawRateRef)
-            .input(Start::Real(0.0))
-            .unit("rad/s")
-            .describe("reference yaw rate"),
-        VarDecl::real("speed_ref", vr::SPEED_REF, Var::SpeedRef)
-            .input(Start::Real(0.35))
-            .unit("m/s")
-            .describe("speed the PI holds"),
-    ];
-    v.extend(per_wheel("delta_ff", vr::DELTA_FF, Var::SteerFeedForward, |d, _| {
-        d.input(Start::Real(0.0)).unit("rad").describe("feed-forward steering (the maneuver's program)")
-    }));
-    for (i, (name, unit)) in POSE_NAMES.iter().zip(POSE_UNITS).enumerate() {
-        v.push(
-            VarDecl::real(name, vr::POSE + i as u32, Var::Pose(i))
-                .input(Start::Real(0.0))
-                .unit(unit)
-                .describe("measured pose (world frame; heading may be unwrapped), read by robust_tracking only"),
-        );
-        v.push(
-            VarDecl::real(declared_name(format!("{name}_ref")), vr::POSE_REF + i as u32, Var::PoseRef(i))
-                .input(Start::Real(0.0))
-                .unit(unit)
-                .describe("reference pose (the test bench's x_ref, y_ref, psi_ref), read by robust_tracking only"),
-        );
-    }
-    let pose_inputs: Vec<u32> = (0..3).flat_map(|i| [vr::POSE + i, vr::POSE_REF + i]).collect();
-    let steer_deps = |i: u32| {
-        let mut d = vec![vr::BETA, vr::YAW_RATE, vr::BETA_REF, vr::YAW_RATE_REF, vr::DELTA_FF + i];
-        d.extend(&pose_inputs);
-        d.sort_unstable();
-        d
-    };
-    // the along-track error reads x, y and the reference pose (not psi); the PI its integrator
-    // (a known in Initialization Mode only: the layer keeps it out of the Outputs list)
-    let speed_deps = {
-        let mut d = vec![
-            vr::SPEED,
-            vr::SPEED_REF,
-            vr::POSE,
-            vr::POSE + 1,
-            vr::POSE_REF,
-            vr::POSE_REF + 1,
-            vr::POSE_REF + 2,
-            vr::SPEED_INTEGRAL,
-        ];
-        d.sort_unstable();
-        d
-    };
-    v.extend(per_wheel("delta", vr::DELTA, Var::Steer, |d, i| {
-        d.discrete_output(Dependencies::On(steer_deps(i as u32))).unit("rad").describe(
+/// A parameter: name, start, min, max (ranges the law can use: the model checks nothing of
+/// its own), unit, description, field.
+type Parameter = (&'static str, f64, f64, f64, &'static str, &'static str, fn(&mut Controller, usize) -> &mut f64);
+
+fn build_declaration() -> DeclarationSpec<Field<Controller>> {
+    let mut v = Variables::<Field<Controller>>::new();
+    let beta = v
+        .real("beta")
+        .input(0.0)
+        .unit("rad")
+        .describe("measured body slip angle atan2(v_y, v_x)")
+        .field(|m, _| &mut m.inputs.beta);
+    let yaw_rate =
+        v.real("yaw_rate").input(0.0).unit("rad/s").describe("measured yaw rate").field(|m, _| &mut m.inputs.yaw_rate);
+    let speed = v
+        .real("speed")
+        .input(0.35)
+        .unit("m/s")
+        .describe("measured speed hypot(v_x, v_y)")
+        .field(|m, _| &mut m.inputs.speed);
+    let beta_ref = v
+        .real("beta_ref")
+        .input(0.0)
+        .unit("rad")
+        .describe("reference body slip angle")
+        .field(|m, _| &mut m.inputs.beta_ref);
+    let yaw_rate_ref = v
+        .real("yaw_rate_ref")
+        .input(0.0)
+        .unit("rad/s")
+        .describe("reference yaw rate")
+        .field(|m, _| &mut m.inputs.yaw_rate_ref);
+    let speed_ref = v
+        .real("speed_ref")
+        .input(0.35)
+        .unit("m/s")
+        .describe("speed the PI holds")
+        .field(|m, _| &mut m.inputs.speed_ref);
+    let delta_ff = v
+        .family("delta_ff", &WHEELS, |d, _| {
+            d.input(0.0).unit("rad").describe("feed-forward steering (the maneuver's program)")
+        })
+        .field(|m, i| &mut m.inputs.delta_ff[i]);
+    let x = pose(v.real("x"), "m", true).field(|m, _| &mut m.inputs.x);
+    let x_ref = pose(v.real("x_ref"), "m", false).field(|m, _| &mut m.inputs.x_ref);
+    let y = pose(v.real("y"), "m", true).field(|m, _| &mut m.inputs.y);
+    let y_ref = pose(v.real("y_ref"), "m", false).field(|m, _| &mut m.inputs.y_ref);
+    let psi = pose(v.real("psi"), "rad", true).field(|m, _| &mut m.inputs.psi);
+    let psi_ref = pose(v.real("psi_ref"), "rad", false).field(|m, _| &mut m.inputs.psi_ref);
+    let poses = [x, x_ref, y, y_ref, psi, psi_ref];
+    v.family("delta", &WHEELS, |d, i| {
+        let mut on = vec![beta, yaw_rate, beta_ref, yaw_rate_ref, delta_ff[i]];
+        on.extend(poses);
+        d.discrete_output(on).unit("rad").describe(
             "steering command delta_ff + K (q - q_ref), q = [beta, yaw_rate] (robust_tracking: \
              delta_ff + K_track e), clamped to +-delta_max; held over a sample",
         )
-    }));
-    v.extend(per_wheel("tau", vr::TAU, Var::Torque, |d, _| {
-        d.discrete_output(Dependencies::On(speed_deps.clone()))
-            .unit("N.m")
-            .describe("drive torque F r_wheel / 4; held over a sample")
-    }));
-    v.push(
-        VarDecl::real("drive_force", vr::DRIVE_FORCE, Var::DriveForce)
-            .discrete_output(Dependencies::On(speed_deps.clone()))
+    })
+    .field(|m, i| &mut m.held.delta[i]);
+    let mut speed_outputs = v
+        .family("tau", &WHEELS, |d, _| {
+            d.discrete_output(Dependencies::All).unit("N.m").describe("drive torque F r_wheel / 4; held over a sample")
+        })
+        .field(|m, i| &mut m.held.tau[i]);
+    speed_outputs.push(
+        v.real("drive_force")
+            .discrete_output(Dependencies::All)
             .unit("N")
-            .describe("total drive force F = kp e + ki I, |F| <= force_max"),
+            .describe("total drive force F = kp e + ki I, |F| <= force_max")
+            .field(|m, _| &mut m.held.force),
     );
-    v.push(
-        VarDecl::real("speed_integral", vr::SPEED_INTEGRAL, Var::SpeedIntegral)
-            .discrete_state(Start::Real(0.0))
-            .unit("m")
-            .describe("speed-error integrator I (frozen while F saturates)"),
-    );
-    // (name, vr, binding, start, min, max, unit, description): ranges the law can use; the
-    // model checks nothing of its own (the declaration's min/max are refused at the set)
-    type Parameter = (&'static str, u32, Var, f64, f64, f64, &'static str, &'static str);
-    let params: [Parameter; 8] = [
-        (
-            "sample_period",
-            vr::SAMPLE_PERIOD,
-            Var::SamplePeriod,
-            1e-3,
-            MIN_SAMPLE_PERIOD,
-            MAX_SAMPLE_PERIOD,
-            "s",
-            "sample period of the law",
-        ),
-        ("kp_speed", vr::KP_SPEED, Var::KpSpeed, KP_SPEED, 0.0, 1e4, "N.s/m", "speed PI proportional gain"),
-        ("ki_speed", vr::KI_SPEED, Var::KiSpeed, KI_SPEED, 0.0, 1e5, "N/m", "speed PI integral gain"),
-        ("force_max", vr::FORCE_MAX, Var::ForceMax, FORCE_MAX, 1e-3, 1e3, "N", "largest total drive force"),
-        ("r_wheel", vr::R_WHEEL, Var::WheelRadius, 0.0325, 1e-3, 1.0, "m", "wheel radius (force to torque)"),
-        (
-            "delta_max",
-            vr::DELTA_MAX,
-            Var::SteerLimit,
-            core::f64::consts::FRAC_PI_2,
-            1e-3,
-            core::f64::consts::FRAC_PI_2,
-            "rad",
-            "steering clamp (the plant's limit)",
-        ),
+    let speed_integral = v
+        .real("speed_integral")
+        .discrete_state(0.0)
+        .unit("m")
+        .describe("speed-error integrator I (frozen while F saturates)")
+        .field(|m, _| &mut m.integral);
+    // the along-track error reads x, y and the reference pose (not psi); the PI its integrator
+    // (a known in Initialization Mode only: the layer keeps it out of the Outputs list)
+    for output in speed_outputs {
+        v.set_dependencies(output, [speed, speed_ref, x, y, x_ref, y_ref, psi_ref, speed_integral]);
+    }
+    let parameters: [Parameter; 8] = [
+        ("sample_period", 1e-3, MIN_SAMPLE_PERIOD, MAX_SAMPLE_PERIOD, "s", "sample period of the law", |m, _| {
+            &mut m.settings.sample_period
+        }),
+        ("kp_speed", KP_SPEED, 0.0, 1e4, "N.s/m", "speed PI proportional gain", |m, _| &mut m.settings.kp_speed),
+        ("ki_speed", KI_SPEED, 0.0, 1e5, "N/m", "speed PI integral gain", |m, _| &mut m.settings.ki_speed),
+        ("force_max", FORCE_MAX, 1e-3, 1e3, "N", "largest total drive force", |m, _| &mut m.settings.force_max),
+        ("r_wheel", 0.0325, 1e-3, 1.0, "m", "wheel radius (force to torque)", |m, _| &mut m.settings.r_wheel),
+        ("delta_max", FRAC_PI_2, 1e-3, FRAC_PI_2, "rad", "steering clamp (the plant's limit)", |m, _| {
+            &mut m.settings.delta_max
+        }),
         (
             "k_along_track",
-            vr::K_ALONG_TRACK,
-            Var::AlongTrackGain,
             K_ALONG_TRACK,
             0.0,
             100.0,
             "1/s",
             "robust_tracking: speed command correction per metre of along-track error",
+            |m, _| &mut m.settings.k_along_track,
         ),
         (
             "along_track_speed_max",
-            vr::ALONG_TRACK_SPEED_MAX,
-            Var::AlongTrackSpeedMax,
             ALONG_TRACK_SPEED_MAX,
             0.0,
             10.0,
             "m/s",
             "robust_tracking: largest along-track speed correction",
+            |m, _| &mut m.settings.along_track_speed_max,
         ),
     ];
-    for (name, r, b, start, min, max, unit, text) in params {
-        v.push(VarDecl::real(name, r, b).parameter(Start::Real(start)).unit(unit).describe(text).min(min).max(max));
+    for (name, start, min, max, unit, text, field) in parameters {
+        v.real(name).parameter(start).unit(unit).describe(text).min(min).max(max).field(field);
     }
     // the gains: a row per wheel, a column per state (beta, yaw_rate) or pose error (e_y, e_psi)
     const GAIN_UNITS: [&str; 2] = ["rad/rad", "rad.s/rad"];
     const POSE_GAIN_UNITS: [&str; 2] = ["rad/m", "rad/rad"];
-    v.extend(per_wheel_columns(&["k_beta", "k_yaw_rate"], vr::K_CUSTOM, Var::CustomGain, |d, i, j| {
-        d.tunable_parameter(Start::Real(ROBUST[i][j]))
+    v.family_columns(&["k_beta", "k_yaw_rate"], &WHEELS, |d, i, j| {
+        d.tunable_parameter(ROBUST[i][j])
             .min(-CUSTOM_GAIN_MAX)
             .max(CUSTOM_GAIN_MAX)
             .unit(GAIN_UNITS[j])
             .describe("custom gain (used when controller = custom; tunable between steps)")
-    }));
-    v.extend(per_wheel_columns(&["gain_beta", "gain_yaw_rate"], vr::GAIN_IN_USE, Var::GainInUse, |d, _, j| {
+    })
+    .field(|m, k| &mut m.custom.as_flattened_mut()[k]);
+    v.family_columns(&["gain_beta", "gain_yaw_rate"], &WHEELS, |d, _, j| {
         d.calculated_parameter().unit(GAIN_UNITS[j]).describe("the gain in use (from controller and the custom gains)")
-    }));
-    v.extend(per_wheel_columns(&["gain_e_y", "gain_e_psi"], vr::POSE_GAIN_IN_USE, Var::PoseGainInUse, |d, _, j| {
+    })
+    .computed(|m, k| m.gain_in_use().as_flattened()[k]);
+    v.family_columns(&["gain_e_y", "gain_e_psi"], &WHEELS, |d, _, j| {
         d.calculated_parameter()
             .unit(POSE_GAIN_UNITS[j])
             .describe("the pose gain in use (K_track's e_y, e_psi columns with robust_tracking, else 0)")
-    }));
-    v.push(
-        VarDecl::integer("controller", vr::CONTROLLER, Var::Controller)
-            .parameter(Start::Integer(mode::ROBUST))
-            .min(f64::from(mode::OPEN_LOOP))
-            .max(f64::from(mode::ROBUST_TRACKING))
-            .describe(CONTROLLER_ITEMS),
-    );
+    })
+    .computed(|m, k| m.pose_gain_in_use().as_flattened()[k]);
+    v.integer("controller")
+        .parameter(mode::ROBUST)
+        .min(f64::from(mode::OPEN_LOOP))
+        .max(f64::from(mode::ROBUST_TRACKING))
+        .describe(CONTROLLER_ITEMS)
+        .field(|m, _| &mut m.mode);
     DeclarationSpec {
         model_name: "nigel_controller",
         model_identifier: MODEL_IDENTIFIER,
@@ -349,7 +258,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
             tolerance: None,
             step_size: Some(1e-3),
         }),
-        variables: v,
+        variables: v.into_vec(),
     }
 }
 
@@ -411,64 +320,13 @@ impl Controller {
         c.set_integral(self.integral);
         Ok(c)
     }
-
-    /// An input, a held output or the integrator: what the law reads or writes, not its settings.
-    fn is_input_or_held(b: Var) -> bool {
-        matches!(
-            b,
-            Var::Beta
-                | Var::YawRate
-                | Var::Speed
-                | Var::BetaRef
-                | Var::YawRateRef
-                | Var::SpeedRef
-                | Var::SteerFeedForward(_)
-                | Var::Pose(_)
-                | Var::PoseRef(_)
-                | Var::Steer(_)
-                | Var::Torque(_)
-                | Var::DriveForce
-                | Var::SpeedIntegral
-        )
-    }
-
-    /// The slot of Real variable `b` (`None`: a value computed on reading).
-    #[inline(always)]
-    fn slot(&mut self, b: Var) -> Option<&mut f64> {
-        let (x, s, o) = (&mut self.inputs, &mut self.settings, &mut self.held);
-        Some(match b {
-            Var::Beta => &mut x.beta,
-            Var::YawRate => &mut x.yaw_rate,
-            Var::Speed => &mut x.speed,
-            Var::BetaRef => &mut x.beta_ref,
-            Var::YawRateRef => &mut x.yaw_rate_ref,
-            Var::SpeedRef => &mut x.speed_ref,
-            Var::SteerFeedForward(i) => &mut x.delta_ff[i],
-            Var::Pose(i) => [&mut x.x, &mut x.y, &mut x.psi].into_iter().nth(i)?,
-            Var::PoseRef(i) => [&mut x.x_ref, &mut x.y_ref, &mut x.psi_ref].into_iter().nth(i)?,
-            Var::Steer(i) => &mut o.delta[i],
-            Var::Torque(i) => &mut o.tau[i],
-            Var::DriveForce => &mut o.force,
-            Var::SpeedIntegral => &mut self.integral,
-            Var::SamplePeriod => &mut s.sample_period,
-            Var::KpSpeed => &mut s.kp_speed,
-            Var::KiSpeed => &mut s.ki_speed,
-            Var::ForceMax => &mut s.force_max,
-            Var::WheelRadius => &mut s.r_wheel,
-            Var::SteerLimit => &mut s.delta_max,
-            Var::AlongTrackGain => &mut s.k_along_track,
-            Var::AlongTrackSpeedMax => &mut s.along_track_speed_max,
-            Var::CustomGain(i, j) => &mut self.custom[i][j],
-            Var::GainInUse(..) | Var::PoseGainInUse(..) | Var::Controller => return None,
-        })
-    }
 }
 
 impl Model for Controller {
-    type Binding = Var;
+    type Binding = Field<Controller>;
 
-    fn declaration() -> &'static Declaration<Var> {
-        static DECLARATION: OnceLock<Declaration<Var>> = OnceLock::new();
+    fn declaration() -> &'static Declaration<Field<Controller>> {
+        static DECLARATION: OnceLock<Declaration<Field<Controller>>> = OnceLock::new();
         DECLARATION.get_or_init(|| {
             Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("controller declaration is invalid: {e}"))
         })
@@ -488,42 +346,9 @@ impl Model for Controller {
         })
     }
 
-    fn get_real(&mut self, b: Var) -> ModelResult<f64> {
-        // the held outputs an importer reads at every sample: a field
-        if let Some(x) = self.slot(b) {
-            return Ok(*x);
-        }
-        match b {
-            Var::GainInUse(i, j) => Ok(self.gain_in_use()[i][j]),
-            Var::PoseGainInUse(i, j) => Ok(self.pose_gain_in_use()[i][j]),
-            _ => Err("controller is an Integer, not a Real".into()),
-        }
-    }
-
-    /// The declaration's ranges are the only checks; a parameter empties the validated law.
-    fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
-        let slot = self.slot(b).ok_or("the gains in use are calculated and controller is an Integer")?;
-        *slot = value;
-        if !Self::is_input_or_held(b) {
-            self.validated = None;
-        }
-        Ok(())
-    }
-
-    /// Every Real setter accepts what the declaration lets through.
-    fn setter_may_refuse(b: Var) -> bool {
-        matches!(b, Var::GainInUse(..) | Var::PoseGainInUse(..) | Var::Controller)
-    }
-
-    fn get_integer(&mut self, _b: Var) -> ModelResult<i32> {
-        Ok(self.mode)
-    }
-
-    /// `controller` (the only Integer; its range 1..5 is declared).
-    fn set_integer(&mut self, _b: Var, value: i32) -> ModelResult {
+    /// A parameter or the `controller` switch changed: the law is validated again.
+    fn parameters_changed(&mut self) {
         self.validated = None;
-        self.mode = value;
-        Ok(())
     }
 
     fn exit_initialization(&mut self) -> ModelResult {

@@ -14,7 +14,12 @@ use std::f64::consts::FRAC_PI_2;
 use common::{Fmu, DISCARD, ERR, OK};
 use fmi2_export::Model;
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
-use nigel_controller::{mode, vr, Controller};
+use nigel_controller::{mode, Controller};
+
+/// The value reference of the variable `name` (by name, as an importer finds it).
+fn vr(name: &str) -> u32 {
+    Controller::declaration().value_reference(name).unwrap_or_else(|| panic!("no variable {name}"))
+}
 
 type C = Fmu<Controller>;
 
@@ -67,26 +72,26 @@ const SETS: [In; 4] = [
 
 fn set_inputs(c: &C, x: &In) {
     for (r, v) in [
-        (vr::BETA, x.beta),
-        (vr::YAW_RATE, x.yaw_rate),
-        (vr::SPEED, x.speed),
-        (vr::BETA_REF, x.beta_ref),
-        (vr::YAW_RATE_REF, x.yaw_rate_ref),
-        (vr::SPEED_REF, x.speed_ref),
+        (vr("beta"), x.beta),
+        (vr("yaw_rate"), x.yaw_rate),
+        (vr("speed"), x.speed),
+        (vr("beta_ref"), x.beta_ref),
+        (vr("yaw_rate_ref"), x.yaw_rate_ref),
+        (vr("speed_ref"), x.speed_ref),
     ] {
         assert_eq!(c.set_real(r, v), OK, "{}", c.last_error());
     }
     for i in 0..4 {
-        assert_eq!(c.set_real(vr::DELTA_FF + i as u32, x.ff[i]), OK);
+        assert_eq!(c.set_real(vr("delta_ff_fl") + i as u32, x.ff[i]), OK);
     }
 }
 
 fn deltas(c: &C) -> [f64; 4] {
-    std::array::from_fn(|i| c.real(vr::DELTA + i as u32))
+    std::array::from_fn(|i| c.real(vr("delta_fl") + i as u32))
 }
 
 fn taus(c: &C) -> [f64; 4] {
-    std::array::from_fn(|i| c.real(vr::TAU + i as u32))
+    std::array::from_fn(|i| c.real(vr("tau_fl") + i as u32))
 }
 
 /// The law written out by hand (docs/benchmark.md), independent of nigel_benchmark's code.
@@ -114,17 +119,17 @@ fn outputs_are_the_law_in_every_mode() {
             _ => custom,
         };
         let c = C::cs();
-        assert_eq!(c.set_int(vr::CONTROLLER, m), OK);
+        assert_eq!(c.set_int(vr("controller"), m), OK);
         for i in 0..4 {
             for j in 0..2 {
-                assert_eq!(c.set_real(vr::K_CUSTOM + (2 * i + j) as u32, custom[i][j]), OK);
+                assert_eq!(c.set_real(vr("k_beta_fl") + (2 * i + j) as u32, custom[i][j]), OK);
             }
         }
         c.init();
         // the gains in use are readable
         for i in 0..4 {
             for j in 0..2 {
-                assert_eq!(c.real(vr::GAIN_IN_USE + (2 * i + j) as u32), gain[i][j], "mode {m}");
+                assert_eq!(c.real(vr("gain_beta_fl") + (2 * i + j) as u32), gain[i][j], "mode {m}");
             }
         }
         let mut integral = 0.0;
@@ -140,12 +145,12 @@ fn outputs_are_the_law_in_every_mode() {
             for tau in taus(&c) {
                 assert!(close(tau, force * R_WHEEL / 4.0), "mode {m} set {n}: tau {tau} vs F {force}");
             }
-            assert!(close(c.real(vr::DRIVE_FORCE), force));
+            assert!(close(c.real(vr("drive_force")), force));
             assert_eq!(c.step(t, T), OK, "{}", c.last_error());
             if force.abs() < 20.0 {
                 integral += (x.speed_ref - x.speed) * T;
             }
-            assert!(close(c.real(vr::SPEED_INTEGRAL), integral), "{} vs {integral}", c.real(vr::SPEED_INTEGRAL));
+            assert!(close(c.real(vr("speed_integral")), integral), "{} vs {integral}", c.real(vr("speed_integral")));
         }
         // the last set drives the steering into the clamp (the by-hand law clamps too)
         if m != mode::OPEN_LOOP {
@@ -161,32 +166,32 @@ fn force_saturates_and_the_integrator_freezes() {
     let mut x = SETS[2];
     x.speed = 0.0; // e = 0.35: F = 18.76 < 20
     set_inputs(&c, &x);
-    assert!(close(c.real(vr::DRIVE_FORCE), 53.6 * 0.35));
+    assert!(close(c.real(vr("drive_force")), 53.6 * 0.35));
     assert_eq!(c.step(0.0, T), OK);
-    let i1 = c.real(vr::SPEED_INTEGRAL);
+    let i1 = c.real(vr("speed_integral"));
     assert!(close(i1, 0.35e-3));
     // F = 18.76 + 268 * 0.35e-3 = 18.8538, still linear; then 1 m/s short: saturates
     x.speed_ref = 1.0;
     set_inputs(&c, &x);
-    assert_eq!(c.real(vr::DRIVE_FORCE), 20.0);
+    assert_eq!(c.real(vr("drive_force")), 20.0);
     assert_eq!(taus(&c), [20.0 * R_WHEEL / 4.0; 4]);
     for k in 1..50 {
         assert_eq!(c.step(k as f64 * T, T), OK);
-        assert_eq!(c.real(vr::SPEED_INTEGRAL), i1, "frozen while saturated (sample {k})");
+        assert_eq!(c.real(vr("speed_integral")), i1, "frozen while saturated (sample {k})");
     }
     // negative saturation too, still frozen
     x.speed = 3.0;
     set_inputs(&c, &x);
-    assert_eq!(c.real(vr::DRIVE_FORCE), -20.0);
+    assert_eq!(c.real(vr("drive_force")), -20.0);
     assert_eq!(c.step(50.0 * T, T), OK);
-    assert_eq!(c.real(vr::SPEED_INTEGRAL), i1);
+    assert_eq!(c.real(vr("speed_integral")), i1);
     // back in the linear range the integrator runs again
     x.speed = 0.99;
     set_inputs(&c, &x);
-    let f = c.real(vr::DRIVE_FORCE);
+    let f = c.real(vr("drive_force"));
     assert!(close(f, 53.6 * 0.01 + 268.0 * i1), "{f}");
     assert_eq!(c.step(51.0 * T, T), OK);
-    assert!(close(c.real(vr::SPEED_INTEGRAL), i1 + 0.01 * T));
+    assert!(close(c.real(vr("speed_integral")), i1 + 0.01 * T));
 }
 
 #[test]
@@ -208,7 +213,7 @@ fn outputs_follow_inputs_set_at_the_sample_instant_and_hold_between_samples() {
     // at t_1 the new inputs apply
     assert!(close(deltas(&c)[3], by_hand(&ROBUST, &SETS[2], 0.0).0[3]));
     // the integrator moved with the inputs of t_0 (SETS[1]: e = -0.01)
-    assert!(close(c.real(vr::SPEED_INTEGRAL), -0.01 * T));
+    assert!(close(c.real(vr("speed_integral")), -0.01 * T));
 }
 
 #[test]
@@ -216,7 +221,7 @@ fn one_10ms_step_equals_ten_1ms_steps_bit_for_bit() {
     let big = C::cs();
     let small = C::cs();
     for c in [&big, &small] {
-        assert_eq!(c.set_int(vr::CONTROLLER, mode::POLE_PLACEMENT), OK);
+        assert_eq!(c.set_int(vr("controller"), mode::POLE_PLACEMENT), OK);
         c.init();
     }
     let mut t = 0.0;
@@ -229,7 +234,7 @@ fn one_10ms_step_equals_ten_1ms_steps_bit_for_bit() {
         }
         t += 10.0 * T;
         let read = |c: &C| {
-            let mut v = c.reals(&[vr::SPEED_INTEGRAL, vr::DRIVE_FORCE]);
+            let mut v = c.reals(&[vr("speed_integral"), vr("drive_force")]);
             v.extend(deltas(c));
             v.extend(taus(c));
             v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>()
@@ -241,7 +246,7 @@ fn one_10ms_step_equals_ten_1ms_steps_bit_for_bit() {
 #[test]
 fn custom_gains_can_change_between_steps() {
     let c = C::cs();
-    assert_eq!(c.set_int(vr::CONTROLLER, mode::CUSTOM), OK);
+    assert_eq!(c.set_int(vr("controller"), mode::CUSTOM), OK);
     c.init();
     let x = SETS[0];
     set_inputs(&c, &x);
@@ -250,9 +255,9 @@ fn custom_gains_can_change_between_steps() {
     assert_eq!(c.step(0.0, T), OK);
     let mut k = ROBUST;
     k[0] = [2.0, -1.0];
-    assert_eq!(c.set_real(vr::K_CUSTOM, 2.0), OK, "{}", c.last_error());
-    assert_eq!(c.set_real(vr::K_CUSTOM + 1, -1.0), OK);
-    assert_eq!(c.real(vr::GAIN_IN_USE), 2.0);
+    assert_eq!(c.set_real(vr("k_beta_fl"), 2.0), OK, "{}", c.last_error());
+    assert_eq!(c.set_real(vr("k_beta_fl") + 1, -1.0), OK);
+    assert_eq!(c.real(vr("gain_beta_fl")), 2.0);
     let after = deltas(&c);
     assert!(close(after[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", after[0], by_hand(&k, &x, 0.0).0[0]);
     assert_eq!(after[1..], before[1..]);
@@ -261,17 +266,17 @@ fn custom_gains_can_change_between_steps() {
     assert_eq!(c.step(T, T), OK);
     assert!(close(deltas(&c)[0], by_hand(&k, &x, 0.0).0[0]));
     k[0] = [-0.5, 0.25];
-    assert_eq!(c.set_real(vr::K_CUSTOM, -0.5), OK);
-    assert_eq!(c.set_real(vr::K_CUSTOM + 1, 0.25), OK);
+    assert_eq!(c.set_real(vr("k_beta_fl"), -0.5), OK);
+    assert_eq!(c.set_real(vr("k_beta_fl") + 1, 0.25), OK);
     assert_eq!(c.step(2.0 * T, T), OK);
     let again = deltas(&c);
     assert!(close(again[0], by_hand(&k, &x, 0.0).0[0]), "{} vs {}", again[0], by_hand(&k, &x, 0.0).0[0]);
     assert_eq!(again[1..], before[1..]);
     // a gain the layer lets through but the law refuses (not finite) is still refused
-    assert_eq!(c.set_real(vr::K_CUSTOM, f64::INFINITY), ERR);
+    assert_eq!(c.set_real(vr("k_beta_fl"), f64::INFINITY), ERR);
     assert!(c.last_error().contains("k_beta_fl"), "{}", c.last_error());
     // a fixed parameter cannot change after initialization
-    assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST), ERR);
+    assert_eq!(c.set_int(vr("controller"), mode::ROBUST), ERR);
 }
 
 #[test]
@@ -298,7 +303,7 @@ fn model_exchange_samples_are_time_events() {
     let d1 = deltas(&c);
     assert!(close(d1[2], by_hand(&ROBUST, &SETS[1], 0.01 * T).0[2]));
     // at t_1 the integrator holds I_1: one sample of SETS[0] (e = 0.01)
-    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T), "{}", c.real(vr::SPEED_INTEGRAL));
+    assert!(close(c.real(vr("speed_integral")), 0.01 * T), "{}", c.real(vr("speed_integral")));
 }
 
 #[test]
@@ -320,7 +325,7 @@ fn fmu_state_round_trip_reproduces_the_run() {
             assert_eq!(c.step(t, T), OK);
             t += T;
             out.extend(deltas(c).map(f64::to_bits));
-            out.push(c.real(vr::SPEED_INTEGRAL).to_bits());
+            out.push(c.real(vr("speed_integral")).to_bits());
         }
         out
     };
@@ -333,37 +338,37 @@ fn fmu_state_round_trip_reproduces_the_run() {
 fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     let c = C::cs();
     // an out-of-range enumeration
-    assert_eq!(c.set_int(vr::CONTROLLER, 7), ERR);
+    assert_eq!(c.set_int(vr("controller"), 7), ERR);
     assert!(c.last_error().contains("controller"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_int(vr::CONTROLLER, 6), ERR);
+    assert_eq!(c.set_int(vr("controller"), 6), ERR);
     assert!(c.last_error().contains("controller"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
     // a negative sample period
-    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, -1e-3), ERR);
+    assert_eq!(c.set_real(vr("sample_period"), -1e-3), ERR);
     assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
     // zero is refused too (by the model)
-    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, 0.0), ERR);
+    assert_eq!(c.set_real(vr("sample_period"), 0.0), ERR);
     assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
     // NaN gains
-    assert_eq!(c.set_real(vr::K_CUSTOM + 3, f64::NAN), ERR);
+    assert_eq!(c.set_real(vr("k_beta_fl") + 3, f64::NAN), ERR);
     assert!(c.last_error().contains("k_yaw_rate_fr"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_real(vr::BETA, f64::INFINITY), ERR);
+    assert_eq!(c.set_real(vr("beta"), f64::INFINITY), ERR);
     assert!(c.last_error().contains("beta"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_real(vr::DELTA_MAX, 2.0), ERR);
+    assert_eq!(c.set_real(vr("delta_max"), 2.0), ERR);
     assert!(c.last_error().contains("delta_max"), "{}", c.last_error());
     // after reset: the start values and a normal run
     assert_eq!(c.reset(), OK);
     c.init();
-    assert_eq!(c.int(vr::CONTROLLER), mode::ROBUST);
-    assert_eq!(c.real(vr::SAMPLE_PERIOD), T);
+    assert_eq!(c.int(vr("controller")), mode::ROBUST);
+    assert_eq!(c.real(vr("sample_period")), T);
     set_inputs(&c, &SETS[0]);
     assert_eq!(c.step(0.0, T), OK);
-    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
+    assert!(close(c.real(vr("speed_integral")), 0.01 * T));
 }
 
 #[test]
@@ -429,10 +434,10 @@ fn robust_tracking_feeds_back_the_pose_and_corrects_the_speed() {
     let c = C::cs();
     assert_eq!(c.setup(), OK);
     assert_eq!(c.enter_init(), OK);
-    assert_eq!(c.set_int(vr::CONTROLLER, mode::ROBUST_TRACKING), OK, "{}", c.last_error());
+    assert_eq!(c.set_int(vr("controller"), mode::ROBUST_TRACKING), OK, "{}", c.last_error());
     assert_eq!(c.exit_init(), OK, "{}", c.last_error());
     for i in 0..4 {
-        let gains = [vr::POSE_GAIN_IN_USE, vr::POSE_GAIN_IN_USE + 1, vr::GAIN_IN_USE, vr::GAIN_IN_USE + 1];
+        let gains = [vr("gain_e_y_fl"), vr("gain_e_y_fl") + 1, vr("gain_beta_fl"), vr("gain_beta_fl") + 1];
         let got: Vec<f64> = gains.iter().map(|&g| c.real(g + 2 * i as u32)).collect();
         assert_eq!(got, ROBUST_TRACKING[i].to_vec(), "wheel {i}");
     }
@@ -448,10 +453,7 @@ fn robust_tracking_feeds_back_the_pose_and_corrects_the_speed() {
     let mut t = 0.0;
     for (x, pose) in SETS.iter().zip(poses) {
         set_inputs(&c, x);
-        for (r, v) in [vr::POSE, vr::POSE + 1, vr::POSE + 2, vr::POSE_REF, vr::POSE_REF + 1, vr::POSE_REF + 2]
-            .into_iter()
-            .zip(pose)
-        {
+        for (r, v) in [vr("x"), vr("y"), vr("psi"), vr("x_ref"), vr("y_ref"), vr("psi_ref")].into_iter().zip(pose) {
             assert_eq!(c.set_real(r, v), OK, "{}", c.last_error());
         }
         let (delta, force) = tracking_by_hand(x, pose, integral);
@@ -459,18 +461,18 @@ fn robust_tracking_feeds_back_the_pose_and_corrects_the_speed() {
         for i in 0..4 {
             assert!(close(got[i], delta[i]), "{pose:?} wheel {i}: {} vs {}", got[i], delta[i]);
         }
-        assert!(close(c.real(vr::DRIVE_FORCE), force), "{} vs {force}", c.real(vr::DRIVE_FORCE));
+        assert!(close(c.real(vr("drive_force")), force), "{} vs {force}", c.real(vr("drive_force")));
         assert_eq!(c.step(t, T), OK);
         t += T;
         if force.abs() < 20.0 {
             integral += force_error(force, integral) * T;
         }
-        assert!(close(c.real(vr::SPEED_INTEGRAL), integral), "{} vs {integral}", c.real(vr::SPEED_INTEGRAL));
+        assert!(close(c.real(vr("speed_integral")), integral), "{} vs {integral}", c.real(vr("speed_integral")));
     }
     // a lateral offset to the left steers the front wheels right
     assert!(tracking_by_hand(&SETS[2], [0.0, 0.02, 0.0, 0.0, 0.0, 0.0], 0.0).0[0] < SETS[2].ff[0]);
     // the along-track loop's parameters are checked
-    assert_eq!(c.set_real(vr::K_ALONG_TRACK, -1.0), ERR);
+    assert_eq!(c.set_real(vr("k_along_track"), -1.0), ERR);
     assert!(c.last_error().contains("k_along_track"), "{}", c.last_error());
 }
 
@@ -490,14 +492,14 @@ fn a_step_of_astronomically_many_samples_is_refused_not_run() {
     assert_eq!(c.last_successful_time(), 0.0);
     assert_eq!(c.reset(), OK);
     // a tiny sample period is refused up front
-    assert_eq!(c.set_real(vr::SAMPLE_PERIOD, 5e-324), ERR);
+    assert_eq!(c.set_real(vr("sample_period"), 5e-324), ERR);
     assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
     assert_eq!(c.reset(), OK);
     c.init();
     // 300 s in 100 s steps with a read between them is a normal run
     for k in 0..3 {
         assert_eq!(c.step(k as f64 * 100.0, 100.0), OK, "{}", c.last_error());
-        assert!(c.real(vr::SPEED_INTEGRAL).is_finite());
+        assert!(c.real(vr("speed_integral")).is_finite());
     }
 }
 
@@ -511,7 +513,7 @@ fn controller_switch_is_an_integer_parameter_listing_its_values() {
     let md = Controller::declaration().model_description();
     let v = md.variable("controller").expect("controller is declared");
     assert_eq!(v.causality, Causality::Parameter);
-    assert_eq!(v.value_reference, vr::CONTROLLER);
+    assert_eq!(v.value_reference, vr("controller"));
     assert_eq!(v.variable_type, VariableType::Integer { start: Some(3), min: Some(1), max: Some(5) });
     let text = v.description.as_deref().unwrap_or("");
     for (value, name) in [(1, "open_loop"), (2, "pole_placement"), (3, "robust"), (4, "custom"), (5, "robust_tracking")]
@@ -528,14 +530,14 @@ fn controller_switch_is_an_integer_parameter_listing_its_values() {
     // the bounds are enforced: 0 and 6 refused naming the variable, 1 .. 5 accepted
     for bad in [0, 6] {
         let c = C::cs();
-        assert_eq!(c.set_int(vr::CONTROLLER, bad), ERR);
+        assert_eq!(c.set_int(vr("controller"), bad), ERR);
         assert!(c.last_error().contains("controller"), "{}", c.last_error());
     }
     for good in 1..=5 {
         let c = C::cs();
-        assert_eq!(c.set_int(vr::CONTROLLER, good), OK);
+        assert_eq!(c.set_int(vr("controller"), good), OK);
         c.init();
-        assert_eq!(c.int(vr::CONTROLLER), good);
+        assert_eq!(c.int(vr("controller")), good);
     }
 }
 
@@ -550,19 +552,19 @@ fn outputs_follow_parameters_set_after_a_read() {
     let x = SETS[0];
     set_inputs(&c, &x);
     // robust: e = 0.01, F = 53.6 e
-    assert!(close(c.real(vr::DRIVE_FORCE), 53.6 * 0.01));
+    assert!(close(c.real(vr("drive_force")), 53.6 * 0.01));
     assert!(close(deltas(&c)[0], by_hand(&ROBUST, &x, 0.0).0[0]));
-    assert_eq!(c.set_real(vr::KP_SPEED, 100.0), OK);
-    assert!(close(c.real(vr::DRIVE_FORCE), 100.0 * 0.01), "{}", c.real(vr::DRIVE_FORCE));
-    assert_eq!(c.set_real(vr::R_WHEEL, 0.05), OK);
+    assert_eq!(c.set_real(vr("kp_speed"), 100.0), OK);
+    assert!(close(c.real(vr("drive_force")), 100.0 * 0.01), "{}", c.real(vr("drive_force")));
+    assert_eq!(c.set_real(vr("r_wheel"), 0.05), OK);
     assert!(close(taus(&c)[0], 100.0 * 0.01 * 0.05 / 4.0), "{:?}", taus(&c));
-    assert_eq!(c.set_int(vr::CONTROLLER, mode::POLE_PLACEMENT), OK);
+    assert_eq!(c.set_int(vr("controller"), mode::POLE_PLACEMENT), OK);
     assert!(close(deltas(&c)[0], by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]));
-    assert_eq!(c.set_real(vr::DELTA_MAX, 0.05), OK);
+    assert_eq!(c.set_real(vr("delta_max"), 0.05), OK);
     assert_eq!(deltas(&c)[0], 0.05f64.min(by_hand(&POLE_PLACEMENT, &x, 0.0).0[0]).max(-0.05));
     assert_eq!(c.exit_init(), OK);
     assert_eq!(c.step(0.0, T), OK);
-    assert!(close(c.real(vr::SPEED_INTEGRAL), 0.01 * T));
+    assert!(close(c.real(vr("speed_integral")), 0.01 * T));
 }
 
 /// The outputs and the integrator of a Co-Simulation run from `start` with steps of `h`
@@ -576,7 +578,14 @@ fn run_from(start: f64, h: f64, samples: usize) -> Vec<[f64; 6]> {
     for n in 0..samples / per_step {
         set_inputs(&c, &SETS[n % 3]);
         let d = deltas(&c);
-        rows.push([d[0], d[3], c.real(vr::TAU), c.real(vr::DRIVE_FORCE), c.real(vr::SPEED_INTEGRAL), n as f64]);
+        rows.push([
+            d[0],
+            d[3],
+            c.real(vr("tau_fl")),
+            c.real(vr("drive_force")),
+            c.real(vr("speed_integral")),
+            n as f64,
+        ]);
         assert_eq!(c.step(start + n as f64 * h, h), OK, "start {start}: {}", c.last_error());
     }
     rows
@@ -658,11 +667,11 @@ fn parameters_out_of_their_range_are_refused_at_the_set() {
         assert!(real.contains("min=\"") && real.contains("max=\""), "{name}: {real}");
     }
     for (r, bad, name) in [
-        (vr::R_WHEEL, 1e308, "r_wheel"),
-        (vr::SAMPLE_PERIOD, 1e308, "sample_period"),
-        (vr::DELTA_MAX, 5e-324, "delta_max"),
-        (vr::FORCE_MAX, 0.0, "force_max"),
-        (vr::K_CUSTOM, -1e6, "k_beta_fl"),
+        (vr("r_wheel"), 1e308, "r_wheel"),
+        (vr("sample_period"), 1e308, "sample_period"),
+        (vr("delta_max"), 5e-324, "delta_max"),
+        (vr("force_max"), 0.0, "force_max"),
+        (vr("k_beta_fl"), -1e6, "k_beta_fl"),
     ] {
         let c = C::cs();
         assert_eq!(c.set_real(r, bad), ERR, "{name} = {bad}");
@@ -683,7 +692,7 @@ fn an_inconsistent_sample_clock_in_a_state_is_refused() {
         set_inputs(&c, &SETS[n % 3]);
         assert_eq!(c.step(n as f64 * T, T), OK);
     }
-    let _ = c.real(vr::DELTA); // runs the sample at 6 ms lazily
+    let _ = c.real(vr("delta_fl")); // runs the sample at 6 ms lazily
     let bytes = c.serialized_state();
     let guid = Controller::declaration().guid().len();
     let at = |i: usize| 8 + 4 + 4 + guid + 8 + 8 * i;
@@ -692,7 +701,7 @@ fn an_inconsistent_sample_clock_in_a_state_is_refused() {
     assert_eq!((number(&bytes, 1), number(&bytes, 10)), (6.0 * T, 6.0));
     let g = C::cs();
     assert_eq!(g.restore_serialized(&bytes), OK, "{}", g.last_error());
-    assert_eq!(g.real(vr::DELTA), c.real(vr::DELTA));
+    assert_eq!(g.real(vr("delta_fl")), c.real(vr("delta_fl")));
     for (i, value, what) in [
         (10, 20_000.0, "sample"),
         (10, 2.5, "sample"),
@@ -709,4 +718,11 @@ fn an_inconsistent_sample_clock_in_a_state_is_refused() {
         let e = g.last_error();
         assert!(e.contains("fmi2DeSerializeFMUstate") && e.contains(what), "number {i} = {value}: {e}");
     }
+}
+
+/// The value references the layer assigned, pinned: a change shows in review.
+#[test]
+fn value_references_are_the_pinned_ones() {
+    let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
+    Controller::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
 }

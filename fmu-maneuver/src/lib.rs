@@ -18,15 +18,15 @@
 
 use std::sync::{Arc, OnceLock};
 
-use core::f64::consts::TAU;
+use core::f64::consts::{FRAC_PI_2, TAU};
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, InstantiateContext,
-    Interfaces, Model, ModelResult, SampleEnd, Start, VarDecl,
+    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
+    ModelResult, SampleEnd, VarDecl, Variables,
 };
 use nigel_benchmark::{
     BenchSample, BenchSampler, Benchmark, DisturbanceSettings, Fidelity, Maneuver, Scenario, DEFAULT_SPEED,
-    DEFAULT_STEER_AMPLITUDE, MAX_WIND_AMPLITUDE, MU_MAX, SAMPLE_PERIOD,
+    DEFAULT_STEER_AMPLITUDE, MAX_WIND_AMPLITUDE, MU_MAX, SAMPLE_PERIOD, WHEELS,
 };
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
@@ -38,91 +38,6 @@ pub const MAX_DURATION: f64 = 600.0;
 
 /// Slowest `speed_target` [m/s]: the reference and its speed loop need the car moving.
 pub const MIN_SPEED_TARGET: f64 = 0.01;
-
-/// What a value reference stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Var {
-    Beta,
-    YawRate,
-    SteerFeedForward(usize),
-    BetaRef,
-    YawRateRef,
-    SpeedRef,
-    XRef,
-    YRef,
-    PsiRef,
-    Friction(usize),
-    WindX,
-    WindY,
-    BetaMeas,
-    YawRateMeas,
-    SteerAmplitude,
-    SpeedTarget,
-    Duration,
-    Maneuver,
-    Fidelity,
-    Seed,
-    FrictionVariation,
-    Wind,
-    MeasurementNoise,
-    FrictionMean,
-    FrictionAmplitude,
-    FrictionFrequency,
-    FrictionNoise,
-    FrictionPhase(usize),
-    WindAmplitude,
-    WindNoise,
-    WindDirection,
-    WindStart,
-    BetaNoise,
-    YawRateNoise,
-}
-
-/// Value references (Reals unless stated).
-pub mod vr {
-    pub const BETA: u32 = 0;
-    pub const YAW_RATE: u32 = 1;
-    /// `delta_ff_fl .. delta_ff_rr`: 10..14.
-    pub const DELTA_FF: u32 = 10;
-    pub const BETA_REF: u32 = 14;
-    pub const YAW_RATE_REF: u32 = 15;
-    pub const SPEED_REF: u32 = 16;
-    pub const X_REF: u32 = 17;
-    pub const Y_REF: u32 = 18;
-    pub const PSI_REF: u32 = 19;
-    /// `mu_fl .. mu_rr`: 20..24.
-    pub const MU: u32 = 20;
-    pub const WIND_X: u32 = 24;
-    pub const WIND_Y: u32 = 25;
-    pub const BETA_MEAS: u32 = 26;
-    pub const YAW_RATE_MEAS: u32 = 27;
-    pub const STEER_AMPLITUDE: u32 = 30;
-    pub const SPEED_TARGET: u32 = 31;
-    pub const DURATION: u32 = 32;
-    /// The disturbance settings ([`nigel_benchmark::DisturbanceSettings`]): 40..54.
-    pub const FRICTION_MEAN: u32 = 40;
-    pub const FRICTION_AMPLITUDE: u32 = 41;
-    pub const FRICTION_FREQUENCY: u32 = 42;
-    pub const FRICTION_NOISE: u32 = 43;
-    /// `friction_phase_fl .. friction_phase_rr`: 44..48.
-    pub const FRICTION_PHASE: u32 = 44;
-    pub const WIND_AMPLITUDE: u32 = 48;
-    pub const WIND_NOISE: u32 = 49;
-    pub const WIND_DIRECTION: u32 = 50;
-    pub const WIND_START: u32 = 51;
-    pub const BETA_NOISE: u32 = 52;
-    pub const YAW_RATE_NOISE: u32 = 53;
-    /// Integer value references (`maneuver` and `fidelity` take the 1-based values of
-    /// [`super::maneuver_value`] and [`super::fidelity_value`]).
-    pub const MANEUVER: u32 = 0;
-    pub const FIDELITY: u32 = 1;
-    /// Integer.
-    pub const SEED: u32 = 2;
-    /// Boolean value references.
-    pub const FRICTION_VARIATION: u32 = 0;
-    pub const WIND: u32 = 1;
-    pub const MEASUREMENT_NOISE: u32 = 2;
-}
 
 /// Value (1-based) of the Integer parameter `maneuver` for a maneuver, in the order of
 /// [`Maneuver::ALL`]: 1 straight, 2 lane_change, 3 skidpad, 4 fishhook, 5 slalom, 6 figure_8.
@@ -171,225 +86,102 @@ fn fidelity_items() -> &'static str {
     declared_name(format!("the reference plant and the measurement noise: {}", items.join(", ")))
 }
 
-fn build_declaration() -> DeclarationSpec<Var> {
-    let none = || Dependencies::On(vec![]);
-    let mut v: Vec<VarDecl<Var>> = vec![
-        VarDecl::real("beta", vr::BETA, Var::Beta)
-            .input(Start::Real(0.0))
-            .unit("rad")
-            .describe("the plant's true body slip angle"),
-        VarDecl::real("yaw_rate", vr::YAW_RATE, Var::YawRate)
-            .input(Start::Real(0.0))
-            .unit("rad/s")
-            .describe("the plant's true yaw rate"),
-    ];
-    v.extend(per_wheel("delta_ff", vr::DELTA_FF, Var::SteerFeedForward, |d, _| {
-        d.discrete_output(none()).unit("rad").describe("the maneuver's steering program (front +f, rear -f)")
-    }));
-    let outputs: [(&'static str, u32, Var, &'static str, &'static str); 6] = [
-        ("beta_ref", vr::BETA_REF, Var::BetaRef, "rad", "reference body slip angle"),
-        ("yaw_rate_ref", vr::YAW_RATE_REF, Var::YawRateRef, "rad/s", "reference yaw rate"),
-        ("speed_ref", vr::SPEED_REF, Var::SpeedRef, "m/s", "speed to hold (the parameter speed_target)"),
-        ("x_ref", vr::X_REF, Var::XRef, "m", "reference pose: world X"),
-        ("y_ref", vr::Y_REF, Var::YRef, "m", "reference pose: world Y"),
-        ("psi_ref", vr::PSI_REF, Var::PsiRef, "rad", "reference pose: heading (unwrapped)"),
-    ];
-    for (name, r, b, unit, text) in outputs {
-        v.push(VarDecl::real(name, r, b).discrete_output(none()).unit(unit).describe(text));
+/// A held output: name, unit ("" for none), field, description.
+type Held = (&'static str, &'static str, fn(&mut TestBench, usize) -> &mut f64, &'static str);
+/// A Real parameter: name, start, min, max, unit ("" for none), field, description.
+type Parameter = (&'static str, f64, f64, f64, &'static str, fn(&mut TestBench, usize) -> &mut f64, &'static str);
+
+fn with_unit<B>(d: VarDecl<B>, unit: &'static str) -> VarDecl<B> {
+    if unit.is_empty() {
+        d
+    } else {
+        d.unit(unit)
     }
-    v.extend(per_wheel("mu", vr::MU, Var::Friction, |d, _| {
-        d.discrete_output(none()).describe(
-            "road friction friction_amplitude sin(2 pi friction_frequency theta - friction_phase_i) + friction_mean \
-             + friction_noise (u - 1/2), theta = 2 pi t / 30 s (0.4 when off)",
-        )
-    }));
-    v.push(
-        VarDecl::real("wind_x", vr::WIND_X, Var::WindX)
-            .discrete_output(none())
-            .unit("N")
-            .describe("wind force along world X: cos(wind_direction) F_w (zero with the default direction)"),
-    );
-    v.push(VarDecl::real("wind_y", vr::WIND_Y, Var::WindY).discrete_output(none()).unit("N").describe(
-        "wind force along world Y: sin(wind_direction) F_w, \
-                 F_w = wind_amplitude ([t >= wind_start] + wind_noise chi)",
-    ));
-    v.push(
-        VarDecl::real("beta_meas", vr::BETA_MEAS, Var::BetaMeas)
-            .discrete_output(Dependencies::On(vec![vr::BETA]))
-            .unit("rad")
-            .describe("what the controller measures: beta (+ beta_noise g in the real fidelity)"),
-    );
-    v.push(
-        VarDecl::real("yaw_rate_meas", vr::YAW_RATE_MEAS, Var::YawRateMeas)
-            .discrete_output(Dependencies::On(vec![vr::YAW_RATE]))
-            .unit("rad/s")
-            .describe("what the controller measures: yaw rate (+ yaw_rate_noise g in the real fidelity)"),
-    );
-    v.push(
-        VarDecl::real("steer_amplitude", vr::STEER_AMPLITUDE, Var::SteerAmplitude)
-            .parameter(Start::Real(DEFAULT_STEER_AMPLITUDE))
-            .min(0.0)
-            .max(core::f64::consts::FRAC_PI_2)
-            .unit("rad")
-            .describe("amplitude a of the steering programs (30 deg)"),
-    );
-    v.push(
-        VarDecl::real("speed_target", vr::SPEED_TARGET, Var::SpeedTarget)
-            .parameter(Start::Real(DEFAULT_SPEED))
-            .min(MIN_SPEED_TARGET)
-            .max(10.0)
-            .unit("m/s")
-            .describe("speed the reference holds and the output speed_ref gives (start speed of the reference)"),
-    );
-    v.push(
-        VarDecl::real("duration", vr::DURATION, Var::Duration)
-            .parameter(Start::Real(30.0))
-            .min(SAMPLE_PERIOD)
-            .max(MAX_DURATION)
-            .unit("s")
-            .describe("length of the reference computed at initialization (30 s); a run may not go past it"),
-    );
-    v.push(
-        VarDecl::integer("maneuver", vr::MANEUVER, Var::Maneuver)
-            .parameter(Start::Integer(maneuver_value(Maneuver::Straight)))
-            .min(1.0)
-            .max(Maneuver::ALL.len() as f64)
-            .describe(maneuver_items()),
-    );
-    v.push(
-        VarDecl::integer("fidelity", vr::FIDELITY, Var::Fidelity)
-            .parameter(Start::Integer(fidelity_value(Fidelity::Paper)))
-            .min(1.0)
-            .max(Fidelity::ALL.len() as f64)
-            .describe(fidelity_items()),
-    );
-    v.push(
-        VarDecl::integer("seed", vr::SEED, Var::Seed)
-            .parameter(Start::Integer(0))
-            .min(0.0)
-            .describe("seed of every noise stream (counter-based SplitMix64)"),
-    );
-    v.push(
-        VarDecl::boolean("friction_variation", vr::FRICTION_VARIATION, Var::FrictionVariation)
-            .parameter(Start::Boolean(true))
-            .describe("friction sinusoids plus noise (else mu = 0.4)"),
-    );
-    v.push(
-        VarDecl::boolean("wind", vr::WIND, Var::Wind).parameter(Start::Boolean(true)).describe("wind along world +Y"),
-    );
-    v.push(
-        VarDecl::boolean("measurement_noise", vr::MEASUREMENT_NOISE, Var::MeasurementNoise)
-            .parameter(Start::Boolean(true))
-            .describe("Gaussian noise on beta_meas, yaw_rate_meas (real fidelity only)"),
-    );
-    let defaults = DisturbanceSettings::default();
-    // the disturbance settings: fixed parameters, the paper's values as start values
-    let setting = |name, r, b, start: f64, (min, max): (f64, f64), text| {
-        VarDecl::real(name, r, b).parameter(Start::Real(start)).min(min).max(max).describe(text)
-    };
-    v.push(setting(
-        "friction_mean",
-        vr::FRICTION_MEAN,
-        Var::FrictionMean,
-        defaults.friction_mean,
-        (0.0, MU_MAX),
-        "friction the sinusoid oscillates around (0.55); friction_mean -+ (friction_amplitude + \
-             friction_noise / 2) must stay in [0, 3]",
-    ));
-    v.push(setting(
-        "friction_amplitude",
-        vr::FRICTION_AMPLITUDE,
-        Var::FrictionAmplitude,
-        defaults.friction_amplitude,
-        (0.0, MU_MAX),
-        "amplitude of the friction sinusoid (0.35)",
-    ));
-    v.push(setting(
-        "friction_frequency",
-        vr::FRICTION_FREQUENCY,
-        Var::FrictionFrequency,
-        defaults.friction_frequency,
-        (0.0, 1000.0),
-        "factor f of theta = 2 pi t / 30 s in the sinusoid's argument 2 pi f theta (12: about 75 periods in 30 s)",
-    ));
-    v.push(setting(
-        "friction_noise",
-        vr::FRICTION_NOISE,
-        Var::FrictionNoise,
-        defaults.friction_noise,
-        (0.0, 2.0 * MU_MAX),
-        "width of the uniform friction noise, centred on zero (0.1: -0.05 .. 0.05)",
-    ));
-    v.push(
-        setting(
-            "wind_amplitude",
-            vr::WIND_AMPLITUDE,
-            Var::WindAmplitude,
-            defaults.wind_amplitude,
-            (0.0, MAX_WIND_AMPLITUDE),
-            "wind step from wind_start (0.25 N)",
-        )
-        .unit("N"),
-    );
-    v.push(setting(
-        "wind_noise",
-        vr::WIND_NOISE,
-        Var::WindNoise,
-        defaults.wind_noise,
-        (0.0, 10.0),
-        "uniform wind noise from t = 0, relative to wind_amplitude (0.1)",
-    ));
-    v.push(
-        setting(
-            "wind_direction",
-            vr::WIND_DIRECTION,
-            Var::WindDirection,
-            defaults.wind_direction,
-            (-TAU, TAU),
-            "direction the wind blows towards in the world frame, from +X towards +Y (pi/2: along +Y)",
-        )
-        .unit("rad"),
-    );
-    v.push(
-        setting(
-            "wind_start",
-            vr::WIND_START,
-            Var::WindStart,
-            defaults.wind_start,
-            (0.0, MAX_DURATION),
-            "time the wind step starts, at the nearest 1 ms sample (1 s)",
-        )
-        .unit("s"),
-    );
-    v.push(
-        setting(
-            "beta_noise",
-            vr::BETA_NOISE,
-            Var::BetaNoise,
-            defaults.beta_noise,
-            (0.0, 1.0),
-            "standard deviation of the Gaussian noise on beta_meas (0.005 rad; real fidelity only)",
-        )
-        .unit("rad"),
-    );
-    v.push(
-        setting(
-            "yaw_rate_noise",
-            vr::YAW_RATE_NOISE,
-            Var::YawRateNoise,
-            defaults.yaw_rate_noise,
-            (0.0, 10.0),
-            "standard deviation of the Gaussian noise on yaw_rate_meas (0.01 rad/s; real fidelity only)",
-        )
-        .unit("rad/s"),
-    );
-    v.extend(per_wheel("friction_phase", vr::FRICTION_PHASE, Var::FrictionPhase, |d, i| {
-        d.parameter(Start::Real(defaults.friction_phase[i]))
+}
+
+fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
+    let mut v = Variables::<Field<TestBench>>::new();
+    let beta =
+        v.real("beta").input(0.0).unit("rad").describe("the plant's true body slip angle").field(|m, _| &mut m.beta);
+    let yaw_rate =
+        v.real("yaw_rate").input(0.0).unit("rad/s").describe("the plant's true yaw rate").field(|m, _| &mut m.yaw_rate);
+    let steering = "the maneuver's steering program (front +f, rear -f)";
+    v.family("delta_ff", &WHEELS, |d, _| d.discrete_output(vec![]).unit("rad").describe(steering))
+        .field(|m, i| &mut m.held.delta_ff[i]);
+    let friction = "road friction friction_amplitude sin(2 pi friction_frequency theta - friction_phase_i) + \
+                    friction_mean + friction_noise (u - 1/2), theta = 2 pi t / 30 s (0.4 when off)";
+    #[rustfmt::skip]
+    let held: [Held; 10] = [
+        ("beta_ref", "rad", |m, _| &mut m.held.beta_ref, "reference body slip angle"),
+        ("yaw_rate_ref", "rad/s", |m, _| &mut m.held.yaw_rate_ref, "reference yaw rate"),
+        ("speed_ref", "m/s", |m, _| &mut m.held.speed_ref, "speed to hold (the parameter speed_target)"),
+        ("x_ref", "m", |m, _| &mut m.held.x_ref, "reference pose: world X"),
+        ("y_ref", "m", |m, _| &mut m.held.y_ref, "reference pose: world Y"),
+        ("psi_ref", "rad", |m, _| &mut m.held.psi_ref, "reference pose: heading (unwrapped)"),
+        ("wind_x", "N", |m, _| &mut m.held.wind_x,
+            "wind force along world X: cos(wind_direction) F_w (zero with the default direction)"),
+        ("wind_y", "N", |m, _| &mut m.held.wind_y,
+            "wind force along world Y: sin(wind_direction) F_w, F_w = wind_amplitude ([t >= wind_start] + wind_noise chi)"),
+        ("beta_meas", "rad", |m, _| &mut m.held.beta_meas,
+            "what the controller measures: beta (+ beta_noise g in the real fidelity)"),
+        ("yaw_rate_meas", "rad/s", |m, _| &mut m.held.yaw_rate_meas,
+            "what the controller measures: yaw rate (+ yaw_rate_noise g in the real fidelity)"),
+    ];
+    // beta_meas and yaw_rate_meas feed the inputs through; the others depend on the sample alone
+    let feedthrough = [vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![beta], vec![yaw_rate]];
+    for (k, ((name, unit, field, text), on)) in held.into_iter().zip(feedthrough).enumerate() {
+        v.real(name).discrete_output(on).unit(unit).describe(text).field(field);
+        if k == 5 {
+            v.family("mu", &WHEELS, |d, _| d.discrete_output(vec![]).describe(friction))
+                .field(|m, i| &mut m.held.mu[i]);
+        }
+    }
+    let ds = DisturbanceSettings::default();
+    #[rustfmt::skip]
+    let parameters: [Parameter; 13] = [
+        ("steer_amplitude", DEFAULT_STEER_AMPLITUDE, 0.0, FRAC_PI_2, "rad", |m, _| &mut m.scenario.steer_amplitude,
+            "amplitude a of the steering programs (30 deg)"),
+        ("speed_target", DEFAULT_SPEED, MIN_SPEED_TARGET, 10.0, "m/s", |m, _| &mut m.scenario.speed_ref,
+            "speed the reference holds and the output speed_ref gives (start speed of the reference)"),
+        ("duration", 30.0, SAMPLE_PERIOD, MAX_DURATION, "s", |m, _| &mut m.duration,
+            "length of the reference computed at initialization (30 s); a run may not go past it"),
+        // the disturbance settings: the paper's values as start values
+        ("friction_mean", ds.friction_mean, 0.0, MU_MAX, "", |m, _| &mut m.settings().friction_mean,
+            "friction the sinusoid oscillates around (0.55); friction_mean -+ (friction_amplitude + \
+             friction_noise / 2) must stay in [0, 3]"),
+        ("friction_amplitude", ds.friction_amplitude, 0.0, MU_MAX, "", |m, _| &mut m.settings().friction_amplitude,
+            "amplitude of the friction sinusoid (0.35)"),
+        ("friction_frequency", ds.friction_frequency, 0.0, 1000.0, "", |m, _| &mut m.settings().friction_frequency,
+            "factor f of theta = 2 pi t / 30 s in the sinusoid's argument 2 pi f theta (12: about 75 periods in 30 s)"),
+        ("friction_noise", ds.friction_noise, 0.0, 2.0 * MU_MAX, "", |m, _| &mut m.settings().friction_noise,
+            "width of the uniform friction noise, centred on zero (0.1: -0.05 .. 0.05)"),
+        ("wind_amplitude", ds.wind_amplitude, 0.0, MAX_WIND_AMPLITUDE, "N", |m, _| &mut m.settings().wind_amplitude,
+            "wind step from wind_start (0.25 N)"),
+        ("wind_noise", ds.wind_noise, 0.0, 10.0, "", |m, _| &mut m.settings().wind_noise,
+            "uniform wind noise from t = 0, relative to wind_amplitude (0.1)"),
+        ("wind_direction", ds.wind_direction, -TAU, TAU, "rad", |m, _| &mut m.settings().wind_direction,
+            "direction the wind blows towards in the world frame, from +X towards +Y (pi/2: along +Y)"),
+        ("wind_start", ds.wind_start, 0.0, MAX_DURATION, "s", |m, _| &mut m.settings().wind_start,
+            "time the wind step starts, at the nearest 1 ms sample (1 s)"),
+        ("beta_noise", ds.beta_noise, 0.0, 1.0, "rad", |m, _| &mut m.settings().beta_noise,
+            "standard deviation of the Gaussian noise on beta_meas (0.005 rad; real fidelity only)"),
+        ("yaw_rate_noise", ds.yaw_rate_noise, 0.0, 10.0, "rad/s", |m, _| &mut m.settings().yaw_rate_noise,
+            "standard deviation of the Gaussian noise on yaw_rate_meas (0.01 rad/s; real fidelity only)"),
+    ];
+    for (k, (name, start, min, max, unit, field, text)) in parameters.into_iter().enumerate() {
+        if k == 3 {
+            switches(&mut v);
+        }
+        with_unit(v.real(name).parameter(start).min(min).max(max).describe(text), unit).field(field);
+    }
+    v.family("friction_phase", &WHEELS, |d, i| {
+        d.parameter(ds.friction_phase[i])
             .min(-2.0 * TAU)
             .max(2.0 * TAU)
             .unit("rad")
             .describe("phase of the wheel's friction sinusoid (FL 0, FR pi/2, RL pi, RR 3 pi/2)")
-    }));
+    })
+    .field(|m, i| &mut m.settings().friction_phase[i]);
     DeclarationSpec {
         model_name: "nigel_maneuver",
         model_identifier: MODEL_IDENTIFIER,
@@ -414,8 +206,54 @@ fn build_declaration() -> DeclarationSpec<Var> {
             tolerance: None,
             step_size: Some(SAMPLE_PERIOD),
         }),
-        variables: v,
+        variables: v.into_vec(),
     }
+}
+
+/// The Integer and Boolean parameters.
+fn switches(v: &mut Variables<Field<TestBench>>) {
+    // the switches: the declared ranges (1 .. the number of items, seed >= 0) make each
+    // conversion exact, so the setters never refuse what the layer let through
+    v.integer("maneuver")
+        .parameter(maneuver_value(Maneuver::Straight))
+        .min(1.0)
+        .max(Maneuver::ALL.len() as f64)
+        .describe(maneuver_items())
+        .get_set(
+            |m, _| maneuver_value(m.scenario.maneuver),
+            |m, _, x| {
+                m.scenario.maneuver = *Maneuver::ALL.get(x as usize - 1).ok_or("not a maneuver")?;
+                Ok(())
+            },
+        );
+    v.integer("fidelity")
+        .parameter(fidelity_value(Fidelity::Paper))
+        .min(1.0)
+        .max(Fidelity::ALL.len() as f64)
+        .describe(fidelity_items())
+        .get_set(
+            |m, _| fidelity_value(m.scenario.fidelity),
+            |m, _, x| {
+                m.scenario.fidelity = *Fidelity::ALL.get(x as usize - 1).ok_or("not a fidelity")?;
+                Ok(())
+            },
+        );
+    v.integer("seed").parameter(0).min(0.0).describe("seed of every noise stream (counter-based SplitMix64)").get_set(
+        |m, _| m.scenario.seed as i32,
+        |m, _, x| {
+            m.scenario.seed = u64::try_from(x).map_err(|_| "a seed is >= 0")?;
+            Ok(())
+        },
+    );
+    v.boolean("friction_variation")
+        .parameter(true)
+        .describe("friction sinusoids plus noise (else mu = 0.4)")
+        .field(|m, _| &mut m.scenario.friction_variation);
+    v.boolean("wind").parameter(true).describe("wind along world +Y").field(|m, _| &mut m.scenario.wind);
+    v.boolean("measurement_noise")
+        .parameter(true)
+        .describe("Gaussian noise on beta_meas, yaw_rate_meas (real fidelity only)")
+        .field(|m, _| &mut m.scenario.measurement_noise);
 }
 
 /// The test-bench instance.
@@ -440,57 +278,21 @@ impl TestBench {
         Ok(scenario)
     }
 
+    fn settings(&mut self) -> &mut DisturbanceSettings {
+        &mut self.scenario.disturbance_settings
+    }
+
     /// The sample at `t = duration`: the reference covers samples `0 ..= last`.
     fn last_sample(&self) -> u64 {
         (self.duration / SAMPLE_PERIOD).round() as u64
     }
-
-    /// The slot of Real variable `b` (`None` for the other base types).
-    #[inline(always)]
-    fn slot(&mut self, b: Var) -> Option<&mut f64> {
-        let o = &mut self.held;
-        let d = &mut self.scenario.disturbance_settings;
-        Some(match b {
-            Var::Beta => &mut self.beta,
-            Var::YawRate => &mut self.yaw_rate,
-            Var::SteerFeedForward(i) => &mut o.delta_ff[i],
-            Var::BetaRef => &mut o.beta_ref,
-            Var::YawRateRef => &mut o.yaw_rate_ref,
-            Var::SpeedRef => &mut o.speed_ref,
-            Var::XRef => &mut o.x_ref,
-            Var::YRef => &mut o.y_ref,
-            Var::PsiRef => &mut o.psi_ref,
-            Var::Friction(i) => &mut o.mu[i],
-            Var::WindX => &mut o.wind_x,
-            Var::WindY => &mut o.wind_y,
-            Var::BetaMeas => &mut o.beta_meas,
-            Var::YawRateMeas => &mut o.yaw_rate_meas,
-            Var::SteerAmplitude => &mut self.scenario.steer_amplitude,
-            Var::SpeedTarget => &mut self.scenario.speed_ref,
-            Var::Duration => &mut self.duration,
-            Var::FrictionMean => &mut d.friction_mean,
-            Var::FrictionAmplitude => &mut d.friction_amplitude,
-            Var::FrictionFrequency => &mut d.friction_frequency,
-            Var::FrictionNoise => &mut d.friction_noise,
-            Var::FrictionPhase(i) => &mut d.friction_phase[i],
-            Var::WindAmplitude => &mut d.wind_amplitude,
-            Var::WindNoise => &mut d.wind_noise,
-            Var::WindDirection => &mut d.wind_direction,
-            Var::WindStart => &mut d.wind_start,
-            Var::BetaNoise => &mut d.beta_noise,
-            Var::YawRateNoise => &mut d.yaw_rate_noise,
-            _ => return None,
-        })
-    }
 }
 
-const NOT_A_REAL: &str = "not a Real variable";
-
 impl Model for TestBench {
-    type Binding = Var;
+    type Binding = Field<TestBench>;
 
-    fn declaration() -> &'static Declaration<Var> {
-        static DECLARATION: OnceLock<Declaration<Var>> = OnceLock::new();
+    fn declaration() -> &'static Declaration<Field<TestBench>> {
+        static DECLARATION: OnceLock<Declaration<Field<TestBench>>> = OnceLock::new();
         DECLARATION.get_or_init(|| {
             Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("test-bench declaration is invalid: {e}"))
         })
@@ -506,58 +308,6 @@ impl Model for TestBench {
             bench: None,
             held: Benchmark::initial_sample(&scenario, 0.0, 0.0),
         })
-    }
-
-    fn get_real(&mut self, b: Var) -> ModelResult<f64> {
-        self.slot(b).map(|x| *x).ok_or_else(|| NOT_A_REAL.into())
-    }
-
-    /// The declaration's ranges are the only checks.
-    fn set_real(&mut self, b: Var, value: f64) -> ModelResult {
-        *self.slot(b).ok_or(NOT_A_REAL)? = value;
-        Ok(())
-    }
-
-    fn setter_may_refuse(b: Var) -> bool {
-        matches!(b, Var::Maneuver | Var::Fidelity | Var::Seed)
-    }
-
-    fn get_integer(&mut self, b: Var) -> ModelResult<i32> {
-        match b {
-            Var::Maneuver => Ok(maneuver_value(self.scenario.maneuver)),
-            Var::Fidelity => Ok(fidelity_value(self.scenario.fidelity)),
-            _ => Ok(self.scenario.seed as i32),
-        }
-    }
-
-    /// The declared ranges (1 .. the number of items, seed >= 0) make each conversion exact.
-    fn set_integer(&mut self, b: Var, value: i32) -> ModelResult {
-        let index = usize::try_from(value - 1).unwrap_or(0);
-        match b {
-            Var::Maneuver => self.scenario.maneuver = *Maneuver::ALL.get(index).ok_or("not a maneuver")?,
-            Var::Fidelity => self.scenario.fidelity = *Fidelity::ALL.get(index).ok_or("not a fidelity")?,
-            _ => self.scenario.seed = u64::try_from(value).map_err(|_| "a seed is >= 0")?,
-        }
-        Ok(())
-    }
-
-    fn get_boolean(&mut self, b: Var) -> ModelResult<bool> {
-        let s = &self.scenario;
-        Ok(match b {
-            Var::FrictionVariation => s.friction_variation,
-            Var::Wind => s.wind,
-            _ => s.measurement_noise,
-        })
-    }
-
-    fn set_boolean(&mut self, b: Var, value: bool) -> ModelResult {
-        let s = &mut self.scenario;
-        match b {
-            Var::FrictionVariation => s.friction_variation = value,
-            Var::Wind => s.wind = value,
-            _ => s.measurement_noise = value,
-        }
-        Ok(())
     }
 
     /// Computes the reference (and the figure-8 table) unless it is there for these parameters.

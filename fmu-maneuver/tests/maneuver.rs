@@ -12,16 +12,21 @@ use common::{Fmu, DISCARD, ERR, OK};
 use fmi2_export::Model;
 use nigel_benchmark::noise::g;
 use nigel_benchmark::{Benchmark, Fidelity, Maneuver, Scenario};
-use nigel_maneuver::{fidelity_value, maneuver_value, vr, TestBench};
+use nigel_maneuver::{fidelity_value, maneuver_value, TestBench};
+
+/// The value reference of the variable `name` (by name, as an importer finds it).
+fn vr(name: &str) -> u32 {
+    TestBench::declaration().value_reference(name).unwrap_or_else(|| panic!("no variable {name}"))
+}
 
 type B = Fmu<TestBench>;
 const T: f64 = 1e-3;
 
 fn bench(m: Maneuver, f: Fidelity, duration: f64) -> B {
     let b = B::cs();
-    assert_eq!(b.set_int(vr::MANEUVER, maneuver_value(m)), OK);
-    assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(f)), OK);
-    assert_eq!(b.set_real(vr::DURATION, duration), OK);
+    assert_eq!(b.set_int(vr("maneuver"), maneuver_value(m)), OK);
+    assert_eq!(b.set_int(vr("fidelity"), fidelity_value(f)), OK);
+    assert_eq!(b.set_real(vr("duration"), duration), OK);
     b.init();
     b
 }
@@ -33,20 +38,20 @@ fn spec_vectors_at_the_first_samples() {
     // MU at k = 0 is arithmetic on a SplitMix64 uniform (sin(0) = 0): bit-exact anywhere; the
     // noise g goes through the platform libm's ln and cos, so it is compared with this process's
     // g bit for bit and with the spec's glibc vector to 1e-15 relative (benchmark/src/noise.rs)
-    assert_eq!(b.real(vr::MU), 0.5883310808213643);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.005 * g(0, 5, 0));
+    assert_eq!(b.real(vr("mu_fl")), 0.5883310808213643);
+    assert_eq!(b.real(vr("beta_meas")), 0.005 * g(0, 5, 0));
     assert!((g(0, 5, 0) - 0.014334745996352224).abs() <= 1e-15 * 0.014334745996352224);
-    assert_eq!(b.real(vr::YAW_RATE_MEAS), 0.01 * g(0, 6, 0));
+    assert_eq!(b.real(vr("yaw_rate_meas")), 0.01 * g(0, 6, 0));
     assert_eq!(b.step(0.0, T), OK);
     // k = 1: the friction's sin and the noise's ln, cos are the platform libm's (within 1 ulp
     // of correctly rounded): 1e-15 is over 10 ulp of mu and of 0.005 g
-    assert!((b.real(vr::MU) - 0.5486795484644006).abs() < 1e-15, "{}", b.real(vr::MU));
-    assert!((b.real(vr::BETA_MEAS) - 0.005 * 0.5906209568869251).abs() < 1e-17, "{}", b.real(vr::BETA_MEAS));
+    assert!((b.real(vr("mu_fl")) - 0.5486795484644006).abs() < 1e-15, "{}", b.real(vr("mu_fl")));
+    assert!((b.real(vr("beta_meas")) - 0.005 * 0.5906209568869251).abs() < 1e-17, "{}", b.real(vr("beta_meas")));
     assert_eq!(b.step(T, 998.0 * T), OK);
-    assert_eq!(b.real(vr::WIND_Y), 0.007915537544713306, "k = 999");
+    assert_eq!(b.real(vr("wind_y")), 0.007915537544713306, "k = 999");
     assert_eq!(b.step(999.0 * T, T), OK);
-    assert_eq!(b.real(vr::WIND_Y), 0.2629350570802014, "k = 1000");
-    assert_eq!(b.real(vr::WIND_X), 0.0);
+    assert_eq!(b.real(vr("wind_y")), 0.2629350570802014, "k = 1000");
+    assert_eq!(b.real(vr("wind_x")), 0.0);
 }
 
 #[test]
@@ -56,8 +61,8 @@ fn figure8_switches_at_the_spec_samples() {
     let mut sign = 1.0;
     let mut flips = Vec::new();
     for k in 0..9_500u32 {
-        let front = b.real(vr::DELTA_FF);
-        assert_eq!(b.real(vr::DELTA_FF + 2), -front);
+        let front = b.real(vr("delta_ff_fl"));
+        assert_eq!(b.real(vr("delta_ff_fl") + 2), -front);
         if front != sign * a {
             assert_eq!(front, -sign * a, "k = {k}");
             sign = -sign;
@@ -76,15 +81,22 @@ fn reference_and_program_are_the_benchmark_library_s() {
         let r = &lib.reference.trajectory;
         let mut t = 0.0;
         let beta = 0.01;
-        assert_eq!(b.set_real(vr::BETA, beta), OK);
+        assert_eq!(b.set_real(vr("beta"), beta), OK);
         for k in 0..=16_000usize {
             if k % 7 == 0 || (14_790..15_210).contains(&k) {
-                let got = b.reals(&[vr::X_REF, vr::Y_REF, vr::PSI_REF, vr::BETA_REF, vr::YAW_RATE_REF, vr::SPEED_REF]);
+                let got = b.reals(&[
+                    vr("x_ref"),
+                    vr("y_ref"),
+                    vr("psi_ref"),
+                    vr("beta_ref"),
+                    vr("yaw_rate_ref"),
+                    vr("speed_ref"),
+                ]);
                 assert_eq!(got, [r.x[k], r.y[k], r.psi[k], r.beta[k], r.yaw_rate[k], 0.35], "{m} k = {k}");
                 let s = lib.sample(k, beta, 0.0).unwrap();
-                assert_eq!(b.real(vr::DELTA_FF + 1), s.delta_ff[1], "{m} k = {k}");
-                assert_eq!(b.real(vr::MU + 3), s.mu[3]);
-                assert_eq!(b.real(vr::BETA_MEAS), s.beta_meas);
+                assert_eq!(b.real(vr("delta_ff_fl") + 1), s.delta_ff[1], "{m} k = {k}");
+                assert_eq!(b.real(vr("mu_fl") + 3), s.mu[3]);
+                assert_eq!(b.real(vr("beta_meas")), s.beta_meas);
             }
             if k < 16_000 {
                 assert_eq!(b.step(t, T), OK, "{}", b.last_error());
@@ -97,7 +109,7 @@ fn reference_and_program_are_the_benchmark_library_s() {
         assert!(b.last_message().contains("duration"), "{}", b.last_message());
         assert!(b.terminated());
         assert_eq!(b.last_successful_time(), 16.0);
-        assert_eq!(b.real(vr::X_REF), r.x[16_000]);
+        assert_eq!(b.real(vr("x_ref")), r.x[16_000]);
     }
 }
 
@@ -107,7 +119,7 @@ fn every_maneuver_and_fidelity_initializes() {
         for f in Fidelity::ALL {
             let b = bench(m, f, 30.0);
             assert_eq!(b.step(0.0, 10.0 * T), OK, "{m} {f:?}: {}", b.last_error());
-            let x = b.real(vr::X_REF);
+            let x = b.real(vr("x_ref"));
             assert!(x > 0.0033 && x < 0.0036, "{m} {f:?}: x_ref = {x}");
         }
     }
@@ -117,55 +129,58 @@ fn every_maneuver_and_fidelity_initializes() {
 fn measurement_is_fed_through_and_held() {
     let b = bench(Maneuver::Skidpad, Fidelity::Real, 1.0);
     assert_eq!(b.step(0.0, T), OK);
-    assert_eq!(b.set_real(vr::BETA, 0.2), OK);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.2 + 0.005 * g(0, 5, 1), "the input of t_1 at t_1");
-    assert_eq!(b.set_real(vr::BETA, 0.3), OK);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.3 + 0.005 * g(0, 5, 1), "set again at the same instant");
+    assert_eq!(b.set_real(vr("beta"), 0.2), OK);
+    assert_eq!(b.real(vr("beta_meas")), 0.2 + 0.005 * g(0, 5, 1), "the input of t_1 at t_1");
+    assert_eq!(b.set_real(vr("beta"), 0.3), OK);
+    assert_eq!(b.real(vr("beta_meas")), 0.3 + 0.005 * g(0, 5, 1), "set again at the same instant");
     assert_eq!(b.step(T, 0.5 * T), OK);
-    assert_eq!(b.set_real(vr::BETA, -0.3), OK);
-    assert_eq!(b.real(vr::BETA_MEAS), 0.3 + 0.005 * g(0, 5, 1), "held between samples");
+    assert_eq!(b.set_real(vr("beta"), -0.3), OK);
+    assert_eq!(b.real(vr("beta_meas")), 0.3 + 0.005 * g(0, 5, 1), "held between samples");
     // paper fidelity and the noise switch off: the true value
     for (f, noise) in [(Fidelity::Paper, true), (Fidelity::Real, false)] {
         let b = B::cs();
-        assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(f)), OK);
-        assert_eq!(b.set_bool(vr::MEASUREMENT_NOISE, noise), OK);
-        assert_eq!(b.set_real(vr::DURATION, 0.1), OK);
+        assert_eq!(b.set_int(vr("fidelity"), fidelity_value(f)), OK);
+        assert_eq!(b.set_bool(vr("measurement_noise"), noise), OK);
+        assert_eq!(b.set_real(vr("duration"), 0.1), OK);
         b.init();
-        assert_eq!(b.set_real(vr::YAW_RATE, 0.7), OK);
-        assert_eq!(b.real(vr::YAW_RATE_MEAS), 0.7);
+        assert_eq!(b.set_real(vr("yaw_rate"), 0.7), OK);
+        assert_eq!(b.real(vr("yaw_rate_meas")), 0.7);
     }
 }
 
 #[test]
 fn disturbance_switches_and_seed() {
     let b = B::cs();
-    assert_eq!(b.set_bool(vr::FRICTION_VARIATION, false), OK);
-    assert_eq!(b.set_bool(vr::WIND, false), OK);
-    assert_eq!(b.set_int(vr::SEED, 7), OK);
-    assert_eq!(b.set_real(vr::DURATION, 2.0), OK);
+    assert_eq!(b.set_bool(vr("friction_variation"), false), OK);
+    assert_eq!(b.set_bool(vr("wind"), false), OK);
+    assert_eq!(b.set_int(vr("seed"), 7), OK);
+    assert_eq!(b.set_real(vr("duration"), 2.0), OK);
     b.init();
     assert_eq!(b.step(0.0, 1.5), OK);
-    assert_eq!(b.reals(&[vr::MU, vr::MU + 1, vr::MU + 2, vr::MU + 3, vr::WIND_Y]), [0.4, 0.4, 0.4, 0.4, 0.0]);
+    assert_eq!(
+        b.reals(&[vr("mu_fl"), vr("mu_fl") + 1, vr("mu_fl") + 2, vr("mu_fl") + 3, vr("wind_y")]),
+        [0.4, 0.4, 0.4, 0.4, 0.0]
+    );
     let c = B::cs();
-    assert_eq!(c.set_int(vr::SEED, 7), OK);
-    assert_eq!(c.set_real(vr::DURATION, 2.0), OK);
+    assert_eq!(c.set_int(vr("seed"), 7), OK);
+    assert_eq!(c.set_real(vr("duration"), 2.0), OK);
     c.init();
     let expect = 0.55 + 0.1 * nigel_benchmark::noise::u(7, 0, 0) - 0.05; // sin(0) = 0 at k = 0
-    assert!((c.real(vr::MU) - expect).abs() < 1e-15, "{} vs {expect}", c.real(vr::MU));
-    assert!((c.real(vr::MU) - 0.5883310808213643).abs() > 1e-3, "seed 7 is not seed 0");
+    assert!((c.real(vr("mu_fl")) - expect).abs() < 1e-15, "{} vs {expect}", c.real(vr("mu_fl")));
+    assert!((c.real(vr("mu_fl")) - 0.5883310808213643).abs() > 1e-3, "seed 7 is not seed 0");
 }
 
 #[test]
 fn model_exchange_outputs_change_at_the_events() {
     let b = B::me();
-    assert_eq!(b.set_int(vr::MANEUVER, maneuver_value(Maneuver::LaneChange)), OK);
-    assert_eq!(b.set_real(vr::DURATION, 15.0), OK);
+    assert_eq!(b.set_int(vr("maneuver"), maneuver_value(Maneuver::LaneChange)), OK);
+    assert_eq!(b.set_real(vr("duration"), 15.0), OK);
     b.init();
     assert_eq!(b.new_discrete_states(), Some(T));
     assert_eq!(b.enter_continuous_time_mode(), OK);
-    let mu0 = b.real(vr::MU);
+    let mu0 = b.real(vr("mu_fl"));
     assert_eq!(b.set_time(0.7e-3), OK);
-    assert_eq!(b.real(vr::MU), mu0);
+    assert_eq!(b.real(vr("mu_fl")), mu0);
     // to the lane change at 14.8 s event by event
     let mut t = T;
     for k in 1..=14_800u32 {
@@ -176,7 +191,7 @@ fn model_exchange_outputs_change_at_the_events() {
         assert!((next - (k + 1) as f64 * T).abs() < 1e-12);
         t = next;
     }
-    assert_eq!(b.real(vr::DELTA_FF), PI / 6.0);
+    assert_eq!(b.real(vr("delta_ff_fl")), PI / 6.0);
 }
 
 #[test]
@@ -184,7 +199,7 @@ fn fmu_state_round_trip() {
     let b = bench(Maneuver::Fishhook, Fidelity::Real, 3.0);
     assert_eq!(b.step(0.0, 0.5), OK);
     let saved = b.serialized_state();
-    let read = |b: &B| b.reals(&[vr::X_REF, vr::DELTA_FF, vr::MU, vr::BETA_MEAS]);
+    let read = |b: &B| b.reals(&[vr("x_ref"), vr("delta_ff_fl"), vr("mu_fl"), vr("beta_meas")]);
     assert_eq!(b.step(0.5, 2.0), OK);
     let first = read(&b);
     assert_eq!(b.restore_serialized(&saved), OK, "{}", b.last_error());
@@ -195,37 +210,37 @@ fn fmu_state_round_trip() {
 #[test]
 fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     let b = B::cs();
-    assert_eq!(b.set_int(vr::MANEUVER, 7), ERR);
+    assert_eq!(b.set_int(vr("maneuver"), 7), ERR);
     assert!(b.last_error().contains("maneuver"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_int(vr::FIDELITY, 0), ERR);
+    assert_eq!(b.set_int(vr("fidelity"), 0), ERR);
     assert!(b.last_error().contains("fidelity"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_int(vr::SEED, -1), ERR);
+    assert_eq!(b.set_int(vr("seed"), -1), ERR);
     assert!(b.last_error().contains("seed"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::STEER_AMPLITUDE, f64::NAN), ERR);
+    assert_eq!(b.set_real(vr("steer_amplitude"), f64::NAN), ERR);
     assert!(b.last_error().contains("steer_amplitude"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::SPEED_TARGET, 0.0), ERR);
+    assert_eq!(b.set_real(vr("speed_target"), 0.0), ERR);
     assert!(b.last_error().contains("speed_target"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::DURATION, -1.0), ERR);
+    assert_eq!(b.set_real(vr("duration"), -1.0), ERR);
     assert!(b.last_error().contains("duration"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::DURATION, 1e308), ERR, "longer than the 600 s a reference may cover");
+    assert_eq!(b.set_real(vr("duration"), 1e308), ERR, "longer than the 600 s a reference may cover");
     assert!(b.last_error().contains("duration"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
     // a step far past the reference is refused, not run
-    assert_eq!(b.set_real(vr::DURATION, 0.5), OK);
+    assert_eq!(b.set_real(vr("duration"), 0.5), OK);
     b.init();
     assert_eq!(b.step(0.0, 1e9), DISCARD);
     assert!(b.last_message().contains("duration"), "{}", b.last_message());
     assert_eq!(b.last_successful_time(), 0.5);
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::DURATION, 0.01), OK);
+    assert_eq!(b.set_real(vr("duration"), 0.01), OK);
     b.init();
-    assert_eq!(b.int(vr::MANEUVER), 1);
+    assert_eq!(b.int(vr("maneuver")), 1);
     assert_eq!(b.step(0.0, 0.01), OK);
 }
 
@@ -239,7 +254,7 @@ fn switches_are_integer_parameters_listing_their_values() {
     let md = TestBench::declaration().model_description();
     let names = ["straight", "lane_change", "skidpad", "fishhook", "slalom", "figure_8"];
     let cases: [(&str, u32, i32, &[&str]); 2] =
-        [("maneuver", vr::MANEUVER, 1, &names), ("fidelity", vr::FIDELITY, 1, &["paper", "real"])];
+        [("maneuver", vr("maneuver"), 1, &names), ("fidelity", vr("fidelity"), 1, &["paper", "real"])];
     for (name, r, start, items) in cases {
         let v = md.variable(name).unwrap();
         assert_eq!((v.causality, v.value_reference), (Causality::Parameter, r));
@@ -270,13 +285,13 @@ fn switches_are_integer_parameters_listing_their_values() {
 /// The reference outputs of a Co-Simulation run of the lane change from `start`, 1 ms steps.
 fn reference_from(start: f64, steps: usize) -> Vec<[f64; 4]> {
     let b = B::cs();
-    assert_eq!(b.set_int(vr::MANEUVER, maneuver_value(Maneuver::LaneChange)), OK);
-    assert_eq!(b.set_real(vr::DURATION, 1.0), OK);
+    assert_eq!(b.set_int(vr("maneuver"), maneuver_value(Maneuver::LaneChange)), OK);
+    assert_eq!(b.set_real(vr("duration"), 1.0), OK);
     b.init_at(start);
     (0..steps)
         .map(|n| {
-            assert_eq!(b.set_real(vr::BETA, 1e-3 * n as f64), OK);
-            let row = [b.real(vr::X_REF), b.real(vr::PSI_REF), b.real(vr::MU), b.real(vr::BETA_MEAS)];
+            assert_eq!(b.set_real(vr("beta"), 1e-3 * n as f64), OK);
+            let row = [b.real(vr("x_ref")), b.real(vr("psi_ref")), b.real(vr("mu_fl")), b.real(vr("beta_meas"))];
             assert_eq!(b.step(start + n as f64 * T, T), OK, "start {start}: {}", b.last_error());
             row
         })
@@ -303,7 +318,7 @@ fn large_start_times_give_the_same_reference_bit_for_bit() {
 #[test]
 fn the_end_of_the_benchmark_is_announced_the_fmi_way() {
     let me = B::me();
-    assert_eq!(me.set_real(vr::DURATION, 0.01), OK);
+    assert_eq!(me.set_real(vr("duration"), 0.01), OK);
     me.init();
     let mut events = Vec::new();
     let mut t = 0.0;
@@ -321,7 +336,7 @@ fn the_end_of_the_benchmark_is_announced_the_fmi_way() {
     assert_eq!(*events.last().unwrap(), (0.01, None, true));
 
     let cs = B::cs();
-    assert_eq!(cs.set_real(vr::DURATION, 0.01), OK);
+    assert_eq!(cs.set_real(vr("duration"), 0.01), OK);
     cs.init();
     assert_eq!(cs.step(0.0, 0.004), OK);
     assert_eq!(cs.step(0.004, 0.004), OK);
@@ -338,7 +353,7 @@ fn the_end_of_the_benchmark_is_announced_the_fmi_way() {
     let shortened = B::cs();
     assert_eq!(shortened.setup_at(0.0, Some(30.0)), OK);
     assert_eq!(shortened.enter_init(), OK);
-    assert_eq!(shortened.set_real(vr::DURATION, 20.0), OK);
+    assert_eq!(shortened.set_real(vr("duration"), 20.0), OK);
     assert_eq!(shortened.exit_init(), ERR);
     assert!(shortened.last_error().contains("duration"), "{}", shortened.last_error());
 }
@@ -357,7 +372,7 @@ fn an_inconsistent_test_bench_state_is_refused() {
     let at = |i: usize| 8 + 4 + 4 + guid + 8 + 8 * i;
     let g = B::cs();
     assert_eq!(g.restore_serialized(&bytes), OK, "{}", g.last_error());
-    assert_eq!(g.real(vr::X_REF), b.real(vr::X_REF));
+    assert_eq!(g.real(vr("x_ref")), b.real(vr("x_ref")));
     for (i, value, what) in [(5, 1e300, "next event"), (10, 20_000.0, "sample"), (10, 40_000.0, "last sample")] {
         let mut c = bytes.clone();
         c[at(i)..at(i) + 8].copy_from_slice(&f64::to_le_bytes(value));
@@ -376,20 +391,20 @@ fn disturbance_settings_change_the_outputs_as_the_formulas_say() {
     assert_eq!(defaults.setup(), OK);
     assert_eq!(defaults.enter_init(), OK);
     let starts = [
-        (vr::FRICTION_MEAN, 0.55),
-        (vr::FRICTION_AMPLITUDE, 0.35),
-        (vr::FRICTION_FREQUENCY, 12.0),
-        (vr::FRICTION_NOISE, 0.1),
-        (vr::FRICTION_PHASE, 0.0),
-        (vr::FRICTION_PHASE + 1, PI / 2.0),
-        (vr::FRICTION_PHASE + 2, PI),
-        (vr::FRICTION_PHASE + 3, 1.5 * PI),
-        (vr::WIND_AMPLITUDE, 0.25),
-        (vr::WIND_NOISE, 0.1),
-        (vr::WIND_DIRECTION, PI / 2.0),
-        (vr::WIND_START, 1.0),
-        (vr::BETA_NOISE, 0.005),
-        (vr::YAW_RATE_NOISE, 0.01),
+        (vr("friction_mean"), 0.55),
+        (vr("friction_amplitude"), 0.35),
+        (vr("friction_frequency"), 12.0),
+        (vr("friction_noise"), 0.1),
+        (vr("friction_phase_fl"), 0.0),
+        (vr("friction_phase_fl") + 1, PI / 2.0),
+        (vr("friction_phase_fl") + 2, PI),
+        (vr("friction_phase_fl") + 3, 1.5 * PI),
+        (vr("wind_amplitude"), 0.25),
+        (vr("wind_noise"), 0.1),
+        (vr("wind_direction"), PI / 2.0),
+        (vr("wind_start"), 1.0),
+        (vr("beta_noise"), 0.005),
+        (vr("yaw_rate_noise"), 0.01),
     ];
     for (r, start) in starts {
         assert_eq!(defaults.real(r), start, "value reference {r}");
@@ -397,27 +412,27 @@ fn disturbance_settings_change_the_outputs_as_the_formulas_say() {
 
     let b = B::cs();
     let settings = [
-        (vr::FRICTION_MEAN, 0.8),
-        (vr::FRICTION_AMPLITUDE, 0.1),
-        (vr::FRICTION_NOISE, 0.02),
-        (vr::WIND_AMPLITUDE, 0.4),
-        (vr::WIND_DIRECTION, 0.0),
-        (vr::WIND_START, 0.5),
-        (vr::BETA_NOISE, 0.02),
+        (vr("friction_mean"), 0.8),
+        (vr("friction_amplitude"), 0.1),
+        (vr("friction_noise"), 0.02),
+        (vr("wind_amplitude"), 0.4),
+        (vr("wind_direction"), 0.0),
+        (vr("wind_start"), 0.5),
+        (vr("beta_noise"), 0.02),
     ];
     for (r, value) in settings {
         assert_eq!(b.set_real(r, value), OK);
     }
-    assert_eq!(b.set_int(vr::FIDELITY, fidelity_value(Fidelity::Real)), OK);
-    assert_eq!(b.set_int(vr::SEED, 3), OK);
-    assert_eq!(b.set_real(vr::DURATION, 2.0), OK);
+    assert_eq!(b.set_int(vr("fidelity"), fidelity_value(Fidelity::Real)), OK);
+    assert_eq!(b.set_int(vr("seed"), 3), OK);
+    assert_eq!(b.set_real(vr("duration"), 2.0), OK);
     b.init();
     let (mut sum, mut n, mut low, mut high) = (0.0, 0, f64::INFINITY, f64::NEG_INFINITY);
     for k in 0..2_000u32 {
         let t = k as f64 * T;
         let theta = 2.0 * PI * t / 30.0;
         for i in 0..4u32 {
-            let mu = b.real(vr::MU + i);
+            let mu = b.real(vr("mu_fl") + i);
             let phase = [0.0, PI / 2.0, PI, 1.5 * PI][i as usize];
             let by_hand = 0.1 * (24.0 * PI * theta - phase).sin() + 0.8 + 0.02 * (u(3, i as u8, k as u64) - 0.5);
             // the same formula written as w (u - 1/2) instead of w u - w / 2, and (2 pi 12) theta
@@ -427,8 +442,8 @@ fn disturbance_settings_change_the_outputs_as_the_formulas_say() {
         }
         // direction 0: the whole wind along world X, exactly none along Y
         let force = if k >= 500 { 0.4 } else { 0.0 } + 0.1 * 0.4 * u(3, 4, k as u64);
-        assert_eq!((b.real(vr::WIND_X), b.real(vr::WIND_Y)), (force, 0.0), "k {k}");
-        assert_eq!(b.real(vr::BETA_MEAS), 0.02 * g(3, 5, k as u64), "beta = 0, k {k}");
+        assert_eq!((b.real(vr("wind_x")), b.real(vr("wind_y"))), (force, 0.0), "k {k}");
+        assert_eq!(b.real(vr("beta_meas")), 0.02 * g(3, 5, k as u64), "beta = 0, k {k}");
         assert_eq!(b.step(t, T), OK);
     }
     // 2 s hold 5.03 periods of the sinusoid (24 pi^2 / 30 s = 7.9 rad/s): the mean is 0.8 to
@@ -444,22 +459,29 @@ fn disturbance_settings_change_the_outputs_as_the_formulas_say() {
 #[test]
 fn disturbance_settings_out_of_range_are_refused_naming_the_variable() {
     let b = B::cs();
-    assert_eq!(b.set_real(vr::WIND_AMPLITUDE, -0.1), ERR);
+    assert_eq!(b.set_real(vr("wind_amplitude"), -0.1), ERR);
     assert!(b.last_error().contains("wind_amplitude"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::FRICTION_PHASE + 2, f64::NAN), ERR);
+    assert_eq!(b.set_real(vr("friction_phase_fl") + 2, f64::NAN), ERR);
     assert!(b.last_error().contains("friction_phase_rl"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
     // 0.3 - 0.35 - 0.05 < 0: each value in its range, the combination not
-    assert_eq!(b.set_real(vr::FRICTION_MEAN, 0.3), OK);
+    assert_eq!(b.set_real(vr("friction_mean"), 0.3), OK);
     assert_eq!(b.setup(), OK);
     assert_eq!(b.enter_init(), OK);
     assert_eq!(b.exit_init(), ERR);
     assert!(b.last_error().contains("friction_mean"), "{}", b.last_error());
     assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr::FRICTION_MEAN, 0.7), OK);
-    assert_eq!(b.set_real(vr::FRICTION_AMPLITUDE, 0.25), OK);
-    assert_eq!(b.set_real(vr::DURATION, 0.1), OK);
+    assert_eq!(b.set_real(vr("friction_mean"), 0.7), OK);
+    assert_eq!(b.set_real(vr("friction_amplitude"), 0.25), OK);
+    assert_eq!(b.set_real(vr("duration"), 0.1), OK);
     b.init();
     assert_eq!(b.step(0.0, 0.1), OK);
+}
+
+/// The value references the layer assigned, pinned: a change shows in review.
+#[test]
+fn value_references_are_the_pinned_ones() {
+    let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
+    TestBench::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
 }

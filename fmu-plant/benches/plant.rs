@@ -8,7 +8,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::abi;
 use fmi2_export::ffi::{Fmi2CallbackFunctions, Fmi2CallbackLogger, Fmi2Status};
 use fmi2_export::Model;
-use nigel_plant::{vr, Plant};
+use nigel_plant::Plant;
 use nigel_vehicle::{derivatives_of, Inputs, VehicleParams};
 
 unsafe extern "C" fn silent(_: *mut c_void, _: *const c_char, _: c_int, _: *const c_char, _: *const c_char) {}
@@ -28,7 +28,8 @@ fn component(kind: c_int) -> *mut c_void {
     let c =
         unsafe { abi::instantiate::<Plant>(c"bench".as_ptr(), kind, guid.as_ptr(), std::ptr::null(), callbacks, 0, 0) };
     assert!(!c.is_null());
-    let refs = [vr::STATE_START + 3, 20, 21, 22, 23]; // v_x_start, delta_fl .. delta_rr
+    let d = Plant::declaration();
+    let refs = ["v_x_start", "delta_fl", "delta_fr", "delta_rl", "delta_rr"].map(|n| d.value_reference(n).unwrap());
     let values = [0.35, 0.2, 0.2, -0.2, -0.2];
     unsafe {
         assert_eq!(abi::set_real::<Plant>(c, refs.as_ptr(), refs.len(), values.as_ptr()), Fmi2Status::Ok);

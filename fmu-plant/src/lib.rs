@@ -9,11 +9,11 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::{DefaultExperiment, Unit};
 use fmi2_export::{
-    declared_name, per_wheel, si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Initial,
-    InstantiateContext, Interfaces, Model, ModelError, ModelResult, Start, VarDecl, WHEELS,
+    declared_name, si_unit, Access, Capabilities, Declaration, DeclarationSpec, Initial, InstantiateContext,
+    Interfaces, Model, ModelError, ModelResult, Start, VarHandle, Variables,
 };
 use nigel_vehicle::dynamics::idx;
-use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES};
+use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES, WHEELS};
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
@@ -57,7 +57,7 @@ pub const DEFAULT_CS_SUBSTEP_MAX: f64 = 5e-4;
 /// slicks on dry asphalt reach about 2).
 pub const MU_MAX: f64 = 3.0;
 
-/// Real parameters (value references 100 + index).
+/// Real parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Param {
     Mass,
@@ -130,8 +130,6 @@ const STATE_NAMES: [&str; N_STATES] =
     ["x", "y", "psi", "v_x", "v_y", "yaw_rate", "servo_angle_fl", "servo_angle_fr", "servo_angle_rl", "servo_angle_rr"];
 /// The body states `x .. yaw_rate`, whose initial values are the parameters `*_start`.
 pub const N_BODY_STATES: usize = 6;
-const START_NAMES: [&str; N_BODY_STATES] =
-    ["x_start", "y_start", "psi_start", "v_x_start", "v_y_start", "yaw_rate_start"];
 /// Unit, unit of the derivative, description.
 const STATE_INFO: [(&str, &str, &str); N_STATES] = [
     ("m", "m/s", "global position X of the CG"),
@@ -145,197 +143,163 @@ const STATE_INFO: [(&str, &str, &str); N_STATES] = [
     ("rad", "rad/s", "steering servo angle RL"),
     ("rad", "rad/s", "steering servo angle RR"),
 ];
-const DER_NAMES: [&str; N_STATES] = [
-    "der(x)",
-    "der(y)",
-    "der(psi)",
-    "der(v_x)",
-    "der(v_y)",
-    "der(yaw_rate)",
-    "der(servo_angle_fl)",
-    "der(servo_angle_fr)",
-    "der(servo_angle_rl)",
-    "der(servo_angle_rr)",
-];
-
-/// Value references. Grouped by kind; the declaration below is the only table.
-pub mod vr {
-    pub const STATE: u32 = 0; // 0..10
-    pub const DERIVATIVE: u32 = 10; // 10..20
-    pub const STEER: u32 = 20;
-    pub const TORQUE: u32 = 24;
-    pub const FRICTION: u32 = 28;
-    pub const WIND_HEAD: u32 = 32;
-    pub const WIND_SIDE: u32 = 33;
-    pub const WIND_X: u32 = 34;
-    pub const WIND_Y: u32 = 35;
-    pub const BETA: u32 = 40;
-    pub const SPEED: u32 = 41;
-    pub const LATERAL_ACCEL: u32 = 42;
-    pub const SLIP_ANGLE: u32 = 43;
-    pub const FORCE_LAT: u32 = 47;
-    pub const FORCE_DRIVE: u32 = 51;
-    pub const STEER_APPLIED: u32 = 55;
-    /// `x_start, y_start, psi_start, v_x_start, v_y_start, yaw_rate_start`: 60..66.
-    pub const STATE_START: u32 = 60;
-    pub const PARAM: u32 = 100;
-    /// Boolean value references.
-    pub const FRICTION_CIRCLE: u32 = 0;
-    pub const STEERING_SERVO: u32 = 1;
-    pub const MOTOR_SPEED_LIMIT: u32 = 2;
+/// The knowns of the dynamics (states and inputs), as the declaration returned them.
+struct Knowns {
+    states: Vec<VarHandle>,
+    steer: Vec<VarHandle>,
+    torque: Vec<VarHandle>,
+    friction: Vec<VarHandle>,
+    wind_head: VarHandle,
+    wind_side: VarHandle,
+    wind_x: VarHandle,
+    wind_y: VarHandle,
 }
 
-fn state_vr(i: usize) -> u32 {
-    vr::STATE + i as u32
-}
-
-/// Knowns the body dynamics depend on (states and inputs), as value references: all
-/// velocities, servo angles and wheel inputs, the world-frame wind through the heading psi,
-/// and of the body-frame wind the head wind for the longitudinal equation only, the side
-/// wind for the lateral and yaw equations only (it acts at the geometric centre).
-fn body_knowns(longitudinal: bool) -> Vec<u32> {
-    let mut k: Vec<u32> = (idx::V_X..N_STATES).map(state_vr).collect();
-    k.extend((0..4).flat_map(|i| [vr::STEER + i, vr::TORQUE + i, vr::FRICTION + i]));
-    k.extend([if longitudinal { vr::WIND_HEAD } else { vr::WIND_SIDE }, vr::WIND_X, vr::WIND_Y, state_vr(idx::PSI)]);
-    k
-}
-
-/// What a per-wheel output depends on: the applied steering angle is the servo state
-/// (servo on) or the command (servo off); the slip angle adds the body velocities; the
-/// forces add the friction and the torque (the friction circle couples them).
-fn wheel_knowns(output: fn(usize) -> Output, i: usize) -> Vec<u32> {
-    let i32_ = i as u32;
-    let mut k = vec![state_vr(idx::SERVO + i), vr::STEER + i32_];
-    if output(i) != Output::SteerApplied(i) {
-        k.extend([state_vr(idx::V_X), state_vr(idx::V_Y), state_vr(idx::YAW_RATE)]);
+impl Knowns {
+    /// What the body dynamics depend on: all velocities, servo angles and wheel inputs, the
+    /// world-frame wind through the heading psi, and of the body-frame wind the head wind
+    /// for the longitudinal equation only, the side wind for the lateral and yaw equations
+    /// only (it acts at the geometric centre).
+    fn body(&self, longitudinal: bool) -> Vec<VarHandle> {
+        let mut k = self.states[idx::V_X..].to_vec();
+        for i in 0..4 {
+            k.extend([self.steer[i], self.torque[i], self.friction[i]]);
+        }
+        k.extend([
+            if longitudinal { self.wind_head } else { self.wind_side },
+            self.wind_x,
+            self.wind_y,
+            self.states[idx::PSI],
+        ]);
+        k
     }
-    if matches!(output(i), Output::ForceLat(_) | Output::ForceDrive(_)) {
-        k.extend([vr::TORQUE + i32_, vr::FRICTION + i32_]);
+
+    /// What a per-wheel output depends on: the applied steering angle is the servo state
+    /// (servo on) or the command (servo off); the slip angle adds the body velocities; the
+    /// forces add the friction and the torque (the friction circle couples them).
+    fn wheel(&self, output: fn(usize) -> Output, i: usize) -> Vec<VarHandle> {
+        let s = &self.states;
+        let mut k = vec![s[idx::SERVO + i], self.steer[i]];
+        if output(i) != Output::SteerApplied(i) {
+            k.extend([s[idx::V_X], s[idx::V_Y], s[idx::YAW_RATE]]);
+        }
+        if matches!(output(i), Output::ForceLat(_) | Output::ForceDrive(_)) {
+            k.extend([self.torque[i], self.friction[i]]);
+        }
+        k
     }
-    k
 }
 
 fn build_declaration() -> DeclarationSpec<PlantVar> {
     let d = VehicleParams::table2();
-    let mut v: Vec<VarDecl<PlantVar>> = Vec::new();
-    let real = |name: &'static str, vr: u32, b: PlantVar| VarDecl::real(name, vr, b);
+    let mut v = Variables::<PlantVar>::new();
+    let input = PlantVar::Input;
 
     // inputs
-    v.extend(per_wheel(
-        "delta",
-        vr::STEER,
-        |i| PlantVar::Input(Input::Steer(i)),
-        |d, _| d.input(Start::Real(0.0)).unit("rad").describe("steering command, clamped to [-delta_max, delta_max]"),
-    ));
-    v.extend(per_wheel(
-        "tau",
-        vr::TORQUE,
-        |i| PlantVar::Input(Input::Torque(i)),
-        |d, _| d.input(Start::Real(0.0)).unit("N.m").describe("drive torque at the wheel"),
-    ));
-    v.extend(per_wheel(
-        "mu",
-        vr::FRICTION,
-        |i| PlantVar::Input(Input::Friction(i)),
-        |d, _| d.input(Start::Real(0.4)).min(0.0).max(MU_MAX).describe("road-tire friction coefficient, 0 .. 3"),
-    ));
-    v.push(
-        real("wind_head", vr::WIND_HEAD, PlantVar::Input(Input::WindHead))
-            .input(Start::Real(0.0))
-            .unit("N")
-            .describe("head wind force, positive opposes forward motion"),
-    );
-    v.push(
-        real("wind_side", vr::WIND_SIDE, PlantVar::Input(Input::WindSide))
-            .input(Start::Real(0.0))
-            .unit("N")
-            .describe("side wind force toward body +y, at the geometric centre"),
-    );
-    v.push(
-        real("wind_x", vr::WIND_X, PlantVar::Input(Input::WindX))
-            .input(Start::Real(0.0))
-            .unit("N")
-            .describe("wind force along world +X at the geometric centre, rotated with the instantaneous psi"),
-    );
-    v.push(
-        real("wind_y", vr::WIND_Y, PlantVar::Input(Input::WindY))
-            .input(Start::Real(0.0))
-            .unit("N")
-            .describe("wind force along world +Y at the geometric centre, rotated with the instantaneous psi"),
-    );
+    let steer = v
+        .family("delta", &WHEELS, |d, _| {
+            d.input(0.0).unit("rad").describe("steering command, clamped to [-delta_max, delta_max]")
+        })
+        .bind(|i| input(Input::Steer(i)));
+    let torque = v
+        .family("tau", &WHEELS, |d, _| d.input(0.0).unit("N.m").describe("drive torque at the wheel"))
+        .bind(|i| input(Input::Torque(i)));
+    let friction = v
+        .family("mu", &WHEELS, |d, _| {
+            d.input(0.4).min(0.0).max(MU_MAX).describe("road-tire friction coefficient, 0 .. 3")
+        })
+        .bind(|i| input(Input::Friction(i)));
+    let wind_head = v
+        .real("wind_head")
+        .input(0.0)
+        .unit("N")
+        .describe("head wind force, positive opposes forward motion")
+        .bind(input(Input::WindHead));
+    let wind_side = v
+        .real("wind_side")
+        .input(0.0)
+        .unit("N")
+        .describe("side wind force toward body +y, at the geometric centre")
+        .bind(input(Input::WindSide));
+    let wind_x = v
+        .real("wind_x")
+        .input(0.0)
+        .unit("N")
+        .describe("wind force along world +X at the geometric centre, rotated with the instantaneous psi")
+        .bind(input(Input::WindX));
+    let wind_y = v
+        .real("wind_y")
+        .input(0.0)
+        .unit("N")
+        .describe("wind force along world +Y at the geometric centre, rotated with the instantaneous psi")
+        .bind(input(Input::WindY));
 
     // initial state of the body: parameters, declared before the states so that restoring
     // a serialized FMU state sets them first and the saved states after them
-    for i in 0..N_BODY_STATES {
+    for (i, name) in STATE_NAMES.iter().take(N_BODY_STATES).enumerate() {
         let (unit, _, text) = STATE_INFO[i];
-        v.push(
-            real(START_NAMES[i], vr::STATE_START + i as u32, PlantVar::StateStart(i))
-                .parameter(Start::Real(0.0))
-                .unit(unit)
-                .describe(declared_name(format!("initial value of {} ({text})", STATE_NAMES[i]))),
-        );
+        v.real(declared_name(format!("{name}_start")))
+            .parameter(0.0)
+            .unit(unit)
+            .describe(declared_name(format!("initial value of {name} ({text})")))
+            .bind(PlantVar::StateStart(i));
     }
 
     // states (the first six are outputs too, their start values calculated from the
     // parameters *_start) and their derivatives
-    for i in 0..N_STATES {
-        let (unit, _, text) = STATE_INFO[i];
-        let mut state = real(STATE_NAMES[i], state_vr(i), PlantVar::State(i)).state(0.0, i < idx::SERVO);
-        if i < N_BODY_STATES {
-            state = state.start_value(Start::None, Initial::Calculated);
-        }
-        v.push(state.unit(unit).describe(text));
-    }
+    let states: Vec<VarHandle> = (0..N_STATES)
+        .map(|i| {
+            let (unit, _, text) = STATE_INFO[i];
+            let mut state = v.real(STATE_NAMES[i]).state(0.0, i < idx::SERVO);
+            if i < N_BODY_STATES {
+                state = state.start_value(Start::None, Initial::Calculated);
+            }
+            state.unit(unit).describe(text).bind(PlantVar::State(i))
+        })
+        .collect();
+    let k = Knowns { states, steer, torque, friction, wind_head, wind_side, wind_x, wind_y };
 
     // outputs
-    let vel = vec![state_vr(idx::V_X), state_vr(idx::V_Y)];
-    v.push(
-        real("beta", vr::BETA, PlantVar::Output(Output::Beta))
-            .output(Dependencies::On(vel.clone()))
-            .unit("rad")
-            .describe("body slip angle atan2(v_y, v_x)"),
-    );
-    v.push(
-        real("speed", vr::SPEED, PlantVar::Output(Output::Speed))
-            .output(Dependencies::On(vel))
-            .unit("m/s")
-            .describe("hypot(v_x, v_y)"),
-    );
-    v.push(
-        real("lateral_accel", vr::LATERAL_ACCEL, PlantVar::Output(Output::LateralAccel))
-            .output(Dependencies::On(body_knowns(false)))
-            .unit("m/s2")
-            .describe("body-frame lateral acceleration dv_y/dt + r v_x"),
-    );
-    type Per = (fn(usize) -> Output, u32, &'static str, &'static str, &'static str);
+    let s = &k.states;
+    let output = PlantVar::Output;
+    v.real("beta")
+        .output([s[idx::V_X], s[idx::V_Y]])
+        .unit("rad")
+        .describe("body slip angle atan2(v_y, v_x)")
+        .bind(output(Output::Beta));
+    v.real("speed")
+        .output([s[idx::V_X], s[idx::V_Y]])
+        .unit("m/s")
+        .describe("hypot(v_x, v_y)")
+        .bind(output(Output::Speed));
+    v.real("lateral_accel")
+        .output(k.body(false))
+        .unit("m/s2")
+        .describe("body-frame lateral acceleration dv_y/dt + r v_x")
+        .bind(output(Output::LateralAccel));
+    type Per = (fn(usize) -> Output, &'static str, &'static str, &'static str);
     let per_wheel_outputs: [Per; 4] = [
-        (Output::SlipAngle, vr::SLIP_ANGLE, "slip_angle", "rad", "tire slip angle"),
-        (Output::ForceLat, vr::FORCE_LAT, "force_lat", "N", "lateral tire force (wheel frame)"),
-        (Output::ForceDrive, vr::FORCE_DRIVE, "force_drive", "N", "drive force (wheel frame), capped by friction"),
-        (Output::SteerApplied, vr::STEER_APPLIED, "delta_applied", "rad", "steering angle actually applied"),
+        (Output::SlipAngle, "slip_angle", "rad", "tire slip angle"),
+        (Output::ForceLat, "force_lat", "N", "lateral tire force (wheel frame)"),
+        (Output::ForceDrive, "force_drive", "N", "drive force (wheel frame), capped by friction"),
+        (Output::SteerApplied, "delta_applied", "rad", "steering angle actually applied"),
     ];
-    for (make, base, stem, unit, text) in per_wheel_outputs {
-        v.extend(per_wheel(
-            stem,
-            base,
-            |i| PlantVar::Output(make(i)),
-            |d, i| d.output(Dependencies::On(wheel_knowns(make, i))).unit(unit).describe(text),
-        ));
+    for (make, stem, unit, text) in per_wheel_outputs {
+        v.family(stem, &WHEELS, |d, i| d.output(k.wheel(make, i)).unit(unit).describe(text)).bind(|i| output(make(i)));
     }
 
     for i in 0..N_STATES {
         let deps = match i {
-            idx::X | idx::Y => vec![state_vr(idx::PSI), state_vr(idx::V_X), state_vr(idx::V_Y)],
-            idx::PSI => vec![state_vr(idx::YAW_RATE)],
-            idx::V_X => body_knowns(true),
-            idx::V_Y | idx::YAW_RATE => body_knowns(false),
-            servo => vec![state_vr(servo), vr::STEER + (servo - idx::SERVO) as u32],
+            idx::X | idx::Y => vec![s[idx::PSI], s[idx::V_X], s[idx::V_Y]],
+            idx::PSI => vec![s[idx::YAW_RATE]],
+            idx::V_X => k.body(true),
+            idx::V_Y | idx::YAW_RATE => k.body(false),
+            servo => vec![s[servo], k.steer[servo - idx::SERVO]],
         };
-        v.push(
-            real(DER_NAMES[i], vr::DERIVATIVE + i as u32, PlantVar::Derivative(i))
-                .derivative(state_vr(i), Dependencies::On(deps))
-                .unit(STATE_INFO[i].1),
-        );
+        v.real(declared_name(format!("der({})", STATE_NAMES[i])))
+            .derivative(s[i], deps)
+            .unit(STATE_INFO[i].1)
+            .bind(PlantVar::Derivative(i));
     }
 
     // parameters
@@ -383,34 +347,17 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             "Co-Simulation: largest internal RK4 sub-step",
         ),
     ];
-    for (k, (name, p, start, unit, text)) in params.into_iter().enumerate() {
+    for (name, p, start, unit, text) in params {
         let (min, max) = parameter_range(p);
-        v.push(
-            real(name, vr::PARAM + k as u32, PlantVar::Param(p))
-                .parameter(Start::Real(start))
-                .unit(unit)
-                .describe(text)
-                .min(min)
-                .max(max),
-        );
+        v.real(name).parameter(start).unit(unit).describe(text).min(min).max(max).bind(PlantVar::Param(p));
     }
     let switches = [
-        (
-            "friction_circle",
-            Switch::FrictionCircle,
-            vr::FRICTION_CIRCLE,
-            "real fidelity: friction-circle tire, hypot(F_d, F_y) <= mu N",
-        ),
-        (
-            "steering_servo",
-            Switch::SteeringServo,
-            vr::STEERING_SERVO,
-            "real fidelity: first-order rate-limited steering servo",
-        ),
-        ("motor_speed_limit", Switch::MotorSpeedLimit, vr::MOTOR_SPEED_LIMIT, "real fidelity: drive motor speed limit"),
+        (Switch::FrictionCircle, "friction_circle", "real fidelity: friction-circle tire, hypot(F_d, F_y) <= mu N"),
+        (Switch::SteeringServo, "steering_servo", "real fidelity: first-order rate-limited steering servo"),
+        (Switch::MotorSpeedLimit, "motor_speed_limit", "real fidelity: drive motor speed limit"),
     ];
-    for (name, s, r, text) in switches {
-        v.push(VarDecl::boolean(name, r, PlantVar::Switch(s)).parameter(Start::Boolean(false)).describe(text));
+    for (s, name, text) in switches {
+        v.boolean(name).parameter(false).describe(text).bind(PlantVar::Switch(s));
     }
 
     let units: Vec<Unit> = vec![
@@ -443,7 +390,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             tolerance: Some(1e-8),
             step_size: Some(1e-3),
         }),
-        variables: v,
+        variables: v.into_vec(),
     }
 }
 
@@ -549,6 +496,10 @@ impl Plant {
         self.cache = None;
     }
 }
+
+/// The plant dispatches on its own binding (states, derivatives, outputs from one cached
+/// evaluation, directional derivatives by dual numbers).
+impl Access<Plant> for PlantVar {}
 
 impl Model for Plant {
     type Binding = PlantVar;
@@ -717,30 +668,36 @@ mod tests {
     use super::*;
     use fmi2_export::BaseType;
 
-    /// The layer's wheel names (the suffixes of every per-wheel variable) are the vehicle
-    /// model's wheel order: `mu_rl` is the friction the physics applies to wheel 2.
+    /// The wheel names (the suffixes of every per-wheel variable) are the vehicle model's
+    /// wheel order: `mu_rl` is the friction the physics applies to wheel 2.
     #[test]
     fn per_wheel_variables_follow_the_vehicle_wheel_order() {
-        assert_eq!(WHEELS, nigel_vehicle::WHEELS);
         let d = Plant::declaration();
         let named = |name: &str| d.spec.variables.iter().find(|v| v.name == name).unwrap_or_else(|| panic!("{name}"));
-        for (i, w) in WHEELS.iter().enumerate() {
-            let families: [(&str, u32, PlantVar); 7] = [
-                ("delta", vr::STEER, PlantVar::Input(Input::Steer(i))),
-                ("tau", vr::TORQUE, PlantVar::Input(Input::Torque(i))),
-                ("mu", vr::FRICTION, PlantVar::Input(Input::Friction(i))),
-                ("slip_angle", vr::SLIP_ANGLE, PlantVar::Output(Output::SlipAngle(i))),
-                ("force_lat", vr::FORCE_LAT, PlantVar::Output(Output::ForceLat(i))),
-                ("force_drive", vr::FORCE_DRIVE, PlantVar::Output(Output::ForceDrive(i))),
-                ("delta_applied", vr::STEER_APPLIED, PlantVar::Output(Output::SteerApplied(i))),
+        for (i, w) in ["fl", "fr", "rl", "rr"].iter().enumerate() {
+            let families: [(&str, PlantVar); 7] = [
+                ("delta", PlantVar::Input(Input::Steer(i))),
+                ("tau", PlantVar::Input(Input::Torque(i))),
+                ("mu", PlantVar::Input(Input::Friction(i))),
+                ("slip_angle", PlantVar::Output(Output::SlipAngle(i))),
+                ("force_lat", PlantVar::Output(Output::ForceLat(i))),
+                ("force_drive", PlantVar::Output(Output::ForceDrive(i))),
+                ("delta_applied", PlantVar::Output(Output::SteerApplied(i))),
             ];
-            for (stem, base, binding) in families {
+            for (stem, binding) in families {
                 let v = named(&format!("{stem}_{w}"));
-                assert_eq!((v.value_reference, v.binding), (base + i as u32, binding), "{}", v.name);
-                assert_eq!(d.row(BaseType::Real, base + i as u32).map(|row| d.variable(row).name), Some(v.name));
+                assert_eq!(v.binding, binding, "{}", v.name);
+                assert_eq!(d.row(BaseType::Real, v.value_reference).map(|row| d.variable(row).name), Some(v.name));
             }
             // the servo state of wheel i is named after the same wheel
             assert_eq!(named(&format!("servo_angle_{w}")).binding, PlantVar::State(idx::SERVO + i));
         }
+    }
+
+    /// The value references the layer assigned, pinned: a change shows in review.
+    #[test]
+    fn value_references_are_the_pinned_ones() {
+        let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
+        Plant::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
     }
 }

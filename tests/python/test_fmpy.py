@@ -317,32 +317,33 @@ def test_validate_fmu_reports_no_problems(fmu_path):
 
 
 def test_model_description_matches_the_declaration(md, unzipdir, vr):
-    """Every variable fmpy reads has the value reference, causality, unit and start value
-    of the declaration in fmu-plant/src/lib.rs (restated here by hand, from the spec), and
-    the binary's own defaults agree with the XML start values."""
-    expected = {}  # name -> (vr, type, causality, unit, start)
+    """Every variable fmpy reads has the causality, unit and start value of the declaration
+    in fmu-plant/src/lib.rs (restated here by hand, from the spec) and the value reference
+    pinned in fmu-plant/value_references.txt, and the binary's own defaults agree with the
+    XML start values."""
+    expected = {}  # name -> (type, causality, unit, start)
     for i, w in enumerate(WHEELS):
-        expected[f"delta_{w}"] = (20 + i, "Real", "input", "rad", 0.0)
-        expected[f"tau_{w}"] = (24 + i, "Real", "input", "N.m", 0.0)
-        expected[f"mu_{w}"] = (28 + i, "Real", "input", None, 0.4)
-    expected["wind_head"] = (32, "Real", "input", "N", 0.0)
-    expected["wind_side"] = (33, "Real", "input", "N", 0.0)
-    expected["wind_x"] = (34, "Real", "input", "N", 0.0)
-    expected["wind_y"] = (35, "Real", "input", "N", 0.0)
+        expected[f"delta_{w}"] = ("Real", "input", "rad", 0.0)
+        expected[f"tau_{w}"] = ("Real", "input", "N.m", 0.0)
+        expected[f"mu_{w}"] = ("Real", "input", None, 0.4)
+    expected["wind_head"] = ("Real", "input", "N", 0.0)
+    expected["wind_side"] = ("Real", "input", "N", 0.0)
+    expected["wind_x"] = ("Real", "input", "N", 0.0)
+    expected["wind_y"] = ("Real", "input", "N", 0.0)
     units = ["m", "m", "rad", "m/s", "m/s", "rad/s", "rad", "rad", "rad", "rad"]
     der_units = ["m/s", "m/s", "rad/s", "m/s2", "m/s2", "rad/s2", "rad/s", "rad/s", "rad/s", "rad/s"]
     for i, name in enumerate(BODY_STATES + SERVO_STATES):
         # the body states are calculated from the parameters *_start (no start value of their own)
-        expected[name] = (i, "Real", "output" if i < 6 else "local", units[i], None if i < 6 else 0.0)
-        expected[f"der({name})"] = (10 + i, "Real", "local", der_units[i], None)
+        expected[name] = ("Real", "output" if i < 6 else "local", units[i], None if i < 6 else 0.0)
+        expected[f"der({name})"] = ("Real", "local", der_units[i], None)
     for i, name in enumerate(BODY_STATES):
-        expected[f"{name}_start"] = (60 + i, "Real", "parameter", units[i], 0.0)
-    expected["beta"] = (40, "Real", "output", "rad", None)
-    expected["speed"] = (41, "Real", "output", "m/s", None)
-    expected["lateral_accel"] = (42, "Real", "output", "m/s2", None)
-    for base, stem, unit in [(43, "slip_angle", "rad"), (47, "force_lat", "N"), (51, "force_drive", "N"), (55, "delta_applied", "rad")]:
+        expected[f"{name}_start"] = ("Real", "parameter", units[i], 0.0)
+    expected["beta"] = ("Real", "output", "rad", None)
+    expected["speed"] = ("Real", "output", "m/s", None)
+    expected["lateral_accel"] = ("Real", "output", "m/s2", None)
+    for stem, unit in [("slip_angle", "rad"), ("force_lat", "N"), ("force_drive", "N"), ("delta_applied", "rad")]:
         for i, w in enumerate(WHEELS):
-            expected[f"{stem}_{w}"] = (base + i, "Real", "output", unit, None)
+            expected[f"{stem}_{w}"] = ("Real", "output", unit, None)
     params = [
         ("m", "kg", 2.68), ("I_z", "kg.m2", 0.01944), ("l_f", "m", 0.06226), ("l_r", "m", 0.07929),
         ("track", "m", 0.14724), ("r_wheel", "m", 0.0325),
@@ -351,17 +352,19 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
         ("servo_time_constant", "s", 0.03), ("servo_rate_max", "rad/s", 5.51),
         ("wheel_speed_max", "m/s", 0.442), ("motor_taper", "m/s", 0.05), ("cs_substep_max", "s", 5e-4),
     ]
-    for k, (name, unit, start) in enumerate(params):
-        expected[name] = (100 + k, "Real", "parameter", unit, start)
-    for k, name in enumerate(["friction_circle", "steering_servo", "motor_speed_limit"]):
-        expected[name] = (k, "Boolean", "parameter", None, False)
+    for name, unit, start in params:
+        expected[name] = ("Real", "parameter", unit, start)
+    for name in ["friction_circle", "steering_servo", "motor_speed_limit"]:
+        expected[name] = ("Boolean", "parameter", None, False)
 
     got = {v.name: v for v in md.modelVariables}
     assert sorted(got) == sorted(expected), (set(got) ^ set(expected))
     declared_units = {u.name: u for u in md.unitDefinitions}
-    for name, (ref, typ, causality, unit, start) in expected.items():
+    pinned = dict(line.split() for line in (REPO / "fmu-plant/value_references.txt").read_text().splitlines())
+    assert sorted(pinned) == sorted(expected)
+    for name, (typ, causality, unit, start) in expected.items():
         v = got[name]
-        assert (v.valueReference, v.type, v.causality, v.unit) == (ref, typ, causality, unit), name
+        assert (v.valueReference, v.type, v.causality, v.unit) == (int(pinned[name]), typ, causality, unit), name
         if start is None:
             assert v.start is None, name
         elif typ == "Boolean":

@@ -14,30 +14,14 @@ use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    per_wheel, si_unit, Declaration, DeclarationSpec, Dependencies, InstantiateContext, Interfaces, Model, ModelResult,
-    Start, VarDecl,
+    si_unit, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables,
 };
+use nigel_vehicle::WHEELS;
 
 /// The sample period of the law [s].
 pub const SAMPLE_PERIOD: f64 = 1e-3;
 
-/// What a value reference stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Var {
-    /// Inputs, in the order of [`INPUTS`].
-    Input(usize),
-    /// `delta_ff_fl .. delta_ff_rr`.
-    SteerFeedForward(usize),
-    /// `delta_fl .. delta_rr`.
-    Steer(usize),
-    /// `tau_fl .. tau_rr`.
-    Torque(usize),
-    DriveForce,
-    /// Parameters, in the order of [`PARAMETERS`].
-    Parameter(usize),
-}
-
-/// The scalar inputs `(name, unit, start)`: value references 0.. in this order.
+/// The scalar inputs `(name, unit, start)`, kept in `OwnController::inputs` in this order.
 pub const INPUTS: [(&str, &str, f64); 12] = [
     ("beta", "rad", 0.0),
     ("yaw_rate", "rad/s", 0.0),
@@ -57,7 +41,8 @@ const SPEED: usize = 2;
 const YAW_RATE_REF: usize = 4;
 const SPEED_REF: usize = 5;
 
-/// The parameters `(name, unit, start, min, max, description)`: value references 30.. in this order.
+/// The parameters `(name, unit, start, min, max, description)`, kept in
+/// `OwnController::parameters` in this order.
 pub const PARAMETERS: [(&str, &str, f64, f64, f64, &str); 5] = [
     ("k_yaw_rate", "rad.s/rad", 0.3, 0.0, 10.0, "steering per yaw-rate error (front +, rear -)"),
     ("kp_speed", "N.s/m", 53.6, 0.0, 1e4, "drive force per speed error"),
@@ -71,47 +56,39 @@ const FORCE_MAX: usize = 2;
 const R_WHEEL: usize = 3;
 const DELTA_MAX: usize = 4;
 
-const VR_DELTA_FF: u32 = 12;
-const VR_DELTA: u32 = 20;
-const VR_TAU: u32 = 24;
-const VR_DRIVE_FORCE: u32 = 28;
-const VR_PARAMETERS: u32 = 30;
-
-fn build_declaration() -> DeclarationSpec<Var> {
-    let mut v: Vec<VarDecl<Var>> = INPUTS
+fn build_declaration() -> DeclarationSpec<Field<OwnController>> {
+    let mut v = Variables::<Field<OwnController>>::new();
+    let inputs: Vec<_> = INPUTS
         .iter()
         .enumerate()
-        .map(|(i, (name, unit, start))| {
-            VarDecl::real(name, i as u32, Var::Input(i)).input(Start::Real(*start)).unit(unit)
-        })
+        .map(|(i, (name, unit, start))| v.real(name).input(*start).unit(unit).at(i).field(|m, i| &mut m.inputs[i]))
         .collect();
-    v.extend(per_wheel("delta_ff", VR_DELTA_FF, Var::SteerFeedForward, |d, _| {
-        d.input(Start::Real(0.0)).unit("rad").describe("feed-forward steering")
-    }));
-    v.extend(per_wheel("delta", VR_DELTA, Var::Steer, |d, i| {
-        d.discrete_output(Dependencies::On(vec![YAW_RATE as u32, YAW_RATE_REF as u32, VR_DELTA_FF + i as u32]))
+    let delta_ff = v
+        .family("delta_ff", &WHEELS, |d, _| d.input(0.0).unit("rad").describe("feed-forward steering"))
+        .field(|m, i| &mut m.delta_ff[i]);
+    v.family("delta", &WHEELS, |d, i| {
+        d.discrete_output([inputs[YAW_RATE], inputs[YAW_RATE_REF], delta_ff[i]])
             .unit("rad")
             .describe("delta_ff + s k_yaw_rate (yaw_rate_ref - yaw_rate), s = +1 front, -1 rear")
-    }));
-    let speed_deps = || Dependencies::On(vec![SPEED as u32, SPEED_REF as u32]);
-    v.extend(per_wheel("tau", VR_TAU, Var::Torque, |d, _| {
-        d.discrete_output(speed_deps()).unit("N.m").describe("drive torque F r_wheel / 4")
-    }));
-    v.push(
-        VarDecl::real("drive_force", VR_DRIVE_FORCE, Var::DriveForce)
-            .discrete_output(speed_deps())
-            .unit("N")
-            .describe("F = kp_speed (speed_ref - speed), |F| <= force_max"),
-    );
+    })
+    .field(|m, i| &mut m.delta[i]);
+    let speed_inputs = [inputs[SPEED], inputs[SPEED_REF]];
+    v.family("tau", &WHEELS, |d, _| d.discrete_output(speed_inputs).unit("N.m").describe("drive torque F r_wheel / 4"))
+        .field(|m, i| &mut m.tau[i]);
+    v.real("drive_force")
+        .discrete_output(speed_inputs)
+        .unit("N")
+        .describe("F = kp_speed (speed_ref - speed), |F| <= force_max")
+        .field(|m, _| &mut m.drive_force);
     for (j, (name, unit, start, min, max, text)) in PARAMETERS.iter().enumerate() {
-        v.push(
-            VarDecl::real(name, VR_PARAMETERS + j as u32, Var::Parameter(j))
-                .parameter(Start::Real(*start))
-                .unit(unit)
-                .min(*min)
-                .max(*max)
-                .describe(text),
-        );
+        v.real(name)
+            .parameter(*start)
+            .unit(unit)
+            .min(*min)
+            .max(*max)
+            .describe(text)
+            .at(j)
+            .field(|m, j| &mut m.parameters[j]);
     }
     DeclarationSpec {
         model_name: "own_controller",
@@ -135,7 +112,7 @@ fn build_declaration() -> DeclarationSpec<Var> {
             tolerance: None,
             step_size: Some(SAMPLE_PERIOD),
         }),
-        variables: v,
+        variables: v.into_vec(),
         ..Default::default()
     }
 }
@@ -166,10 +143,10 @@ impl OwnController {
 }
 
 impl Model for OwnController {
-    type Binding = Var;
+    type Binding = Field<OwnController>;
 
-    fn declaration() -> &'static Declaration<Var> {
-        static D: OnceLock<Declaration<Var>> = OnceLock::new();
+    fn declaration() -> &'static Declaration<Field<OwnController>> {
+        static D: OnceLock<Declaration<Field<OwnController>>> = OnceLock::new();
         D.get_or_init(|| Declaration::new(build_declaration()).expect("the declaration is valid"))
     }
 
@@ -182,29 +159,6 @@ impl Model for OwnController {
             tau: [0.0; 4],
             drive_force: 0.0,
         })
-    }
-
-    fn get_real(&mut self, b: Var) -> ModelResult<f64> {
-        Ok(match b {
-            Var::Input(i) => self.inputs[i],
-            Var::SteerFeedForward(i) => self.delta_ff[i],
-            Var::Steer(i) => self.delta[i],
-            Var::Torque(i) => self.tau[i],
-            Var::DriveForce => self.drive_force,
-            Var::Parameter(j) => self.parameters[j],
-        })
-    }
-
-    fn set_real(&mut self, b: Var, x: f64) -> ModelResult {
-        match b {
-            Var::Input(i) => self.inputs[i] = x,
-            Var::SteerFeedForward(i) => self.delta_ff[i] = x,
-            Var::Steer(i) => self.delta[i] = x,
-            Var::Torque(i) => self.tau[i] = x,
-            Var::DriveForce => self.drive_force = x,
-            Var::Parameter(j) => self.parameters[j] = x,
-        }
-        Ok(())
     }
 
     fn sample_period(&self) -> Option<f64> {

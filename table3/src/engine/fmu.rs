@@ -14,11 +14,10 @@ use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Results, System, SystemB
 
 use super::{Engine, Job, Run};
 use crate::Error;
+use nigel_benchmark::WHEELS;
 
 /// File names of the plant, the controller and the test bench in `target/fmu/`.
 pub const FMU_FILES: [&str; 3] = ["nigel_plant.fmu", "nigel_controller.fmu", "nigel_maneuver.fmu"];
-
-const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
 
 /// The closed loop of Table III from the three FMUs.
 pub struct FmuEngine {
