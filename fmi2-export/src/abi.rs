@@ -11,10 +11,9 @@ use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use crate::decl::LOG_CATEGORIES;
 use crate::ffi::*;
 use crate::instance::{Function, Instance, Machine, OpResult, SavedState};
-use crate::log::{LogCategory, Logger};
+use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
 use crate::model::{InstantiateContext, Interface, Model, ModelError};
 
 /// Largest `nvr` (or `nx`, `nUnknown`, ...) accepted: far above any sensible request,

@@ -4,6 +4,9 @@
 use std::collections::HashMap;
 
 use model_description as md;
+
+use crate::log::LOG_CATEGORIES;
+use crate::states::{settable_in, Machine};
 pub use model_description::{Causality, Initial, Variability};
 
 /// Base type of a variable.
@@ -465,14 +468,6 @@ fn base_type_slot(base_type: BaseType) -> usize {
     }
 }
 
-/// Log categories every FMU of ours offers.
-pub const LOG_CATEGORIES: [(&str, &str); 4] = [
-    ("logStatusError", "Errors (always logged)"),
-    ("logStatusWarning", "Warnings"),
-    ("logEvents", "Mode changes and events"),
-    ("logCalls", "Every fmi2 call"),
-];
-
 impl<B: Copy> Declaration<B> {
     /// Checks the spec (unique names and value references, derivatives refer to Real states,
     /// dependencies refer to declared Reals), builds the lookup tables and generates the
@@ -739,9 +734,9 @@ impl<B: Copy> Declaration<B> {
             .map(|v| HotRow {
                 binding: v.binding,
                 access: SetAccess {
-                    settable_in: crate::states::Machine::ALL
+                    settable_in: Machine::ALL
                         .into_iter()
-                        .filter(|&m| crate::instance::settable_in(v, m).is_ok())
+                        .filter(|&m| settable_in(v.name, v.causality, v.variability, v.initial, m).is_ok())
                         .fold(0, |mask, m| mask | m.bit()),
                     plain: v.declared_type.is_none(),
                     lowest: v.min.unwrap_or(f64::MIN),
@@ -833,6 +828,28 @@ impl<B> Declaration<B> {
         ))
     }
 
+    /// Whether `value` fits variable `row` of declaration `d` (finite, min/max, enumeration
+    /// items); the reason when not.
+    pub(crate) fn check_value(&self, row: usize, value: f64) -> Result<(), String> {
+        let v = self.variable(row);
+        if !value.is_finite() {
+            return Err(format!("{} = {value} refused: not a finite number", v.name));
+        }
+        if let Some(e) = self.enumeration_of(row) {
+            if e.item(value as i32).is_none() {
+                let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
+                return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
+            }
+        }
+        if let Some(min) = v.min.filter(|&m| value < m) {
+            return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
+        }
+        if let Some(max) = v.max.filter(|&m| value > m) {
+            return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
+        }
+        Ok(())
+    }
+
     /// The enumeration type of variable `row`, if it is an Enumeration.
     pub fn enumeration_of(&self, row: usize) -> Option<&md::EnumerationType> {
         let t = self.variable(row).declared_type?;
@@ -903,8 +920,6 @@ mod tests {
     /// every instance state: the fast path of `fmi2Set*` changes no outcome.
     #[test]
     fn precomputed_set_checks_agree_with_the_full_checks() {
-        use crate::instance::{check_value_in, settable_in};
-        use crate::states::Machine;
         let mut v = toy();
         v.push(VarDecl::real("bounded", 7, 5).tunable_parameter(Start::Real(0.5)).min(-1.0).max(2.0));
         v.push(VarDecl::real("above", 8, 6).input(Start::Real(0.0)).min(0.0));
@@ -941,18 +956,19 @@ mod tests {
             let hot = d.hot(row);
             assert_eq!(hot.binding, d.variable(row).binding);
             for m in Machine::ALL {
-                let full = settable_in(d.variable(row), m).is_ok();
+                let v = d.variable(row);
+                let full = settable_in(v.name, v.causality, v.variability, v.initial, m).is_ok();
                 assert_eq!(hot.access.settable_in & m.bit() != 0, full, "{} in {m:?}", d.variable(row).name);
             }
             for x in values {
                 let a = hot.access;
                 if a.plain && x >= a.lowest && x <= a.highest {
                     fast_accepted += 1;
-                    assert_eq!(check_value_in(&d, row, x), Ok(()), "{} = {x}", d.variable(row).name);
+                    assert_eq!(d.check_value(row, x), Ok(()), "{} = {x}", d.variable(row).name);
                 }
             }
             // what the full checks refuse, the fast path refuses too (it then runs them)
-            for x in values.into_iter().filter(|&x| check_value_in(&d, row, x).is_err()) {
+            for x in values.into_iter().filter(|&x| d.check_value(row, x).is_err()) {
                 let a = hot.access;
                 assert!(!(a.plain && x >= a.lowest && x <= a.highest), "{} = {x}", d.variable(row).name);
             }
@@ -960,7 +976,7 @@ mod tests {
         assert!(fast_accepted > 50, "{fast_accepted}");
         // the enumeration never takes the fast path: its items are checked in full
         assert!(!d.hot(d.row(BaseType::Integer, 6).unwrap()).access.plain);
-        assert!(check_value_in(&d, d.row(BaseType::Integer, 6).unwrap(), 3.0).is_err());
+        assert!(d.check_value(d.row(BaseType::Integer, 6).unwrap(), 3.0).is_err());
     }
 
     #[test]

@@ -2,10 +2,12 @@
 //! variable access checks, time events and FMU state handling. The C ABI in
 //! [`crate::abi`] only translates pointers to slices.
 
-use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, VarDecl, Variability};
+use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, Variability};
+use crate::fmu_state::{self, LayerNumbers};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 use crate::sampled::{instant_tolerance, SampleClock, MAX_SAMPLES_PER_STEP};
 pub use crate::states::{Function, Machine, Scope};
+use crate::states::settable_in;
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
 pub type OpResult<T = ()> = Result<T, ModelError>;
@@ -164,11 +166,6 @@ pub struct Instance<M: Model> {
     get_memo: CallMemos<M::Binding>,
     set_memo: CallMemos<M::Binding>,
 }
-
-const SERIAL_MAGIC: &[u8; 8] = b"NIGELFMU";
-const SERIAL_VERSION: u32 = 3;
-/// Numbers of the layer ahead of the model's in a serialized state.
-const SERIAL_HEADER_NUMBERS: usize = 12;
 
 fn decl<M: Model>() -> &'static Declaration<M::Binding> {
     M::declaration()
@@ -591,7 +588,7 @@ impl<M: Model> Instance<M> {
 
     /// Whether `value` fits variable `row` (min/max of the declaration, enumeration items).
     fn check_value(row: usize, value: f64) -> Result<(), String> {
-        check_value_in(decl::<M>(), row, value)
+        decl::<M>().check_value(row, value)
     }
 
     /// Sets all or nothing: every value reference, permission and value is checked first
@@ -694,7 +691,8 @@ impl<M: Model> Instance<M> {
     #[inline(always)]
     fn check_set(row: usize, access: SetAccess, machine_bit: u16, x: f64, machine: Machine) -> OpResult {
         if access.settable_in & machine_bit == 0 {
-            settable_in(decl::<M>().variable(row), machine)?;
+            let v = decl::<M>().variable(row);
+            settable_in(v.name, v.causality, v.variability, v.initial, machine)?;
         }
         if !(access.plain && x >= access.lowest && x <= access.highest) {
             Self::check_value(row, x)?;
@@ -1038,114 +1036,49 @@ impl<M: Model> Instance<M> {
         }
     }
 
-    /// Bytes of a saved state: magic, version, the GUID (a state belongs to one model),
-    /// then the layer's numbers (machine state, time, stop time, next event), the declared
-    /// variables of [`Declaration::saved_rows`] and the model's internal numbers, all
-    /// little-endian f64. Events run lazily at the current time are saved as not run.
+    /// Bytes of a saved state ([`crate::fmu_state`]): the layer's numbers, the declared
+    /// variables of [`Declaration::saved_rows`] and the model's internal numbers. Events
+    /// run lazily at the current time are saved as not run.
     pub fn serialize(state: &SavedState<M>) -> OpResult<Vec<u8>> {
-        let guid = decl::<M>().guid().as_bytes();
         let (mut model, next_event, clock, presample) = match &state.pre_event {
             Some(pre) => (pre.model.clone(), pre.next_event, pre.clock, pre.presample),
             None => (state.model.clone(), state.next_event, state.clock, state.presample),
         };
-        let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        let mut numbers = vec![
-            state.machine.code(),
-            state.time,
-            flag(state.stop_time.is_some()),
-            state.stop_time.unwrap_or(0.0),
-            flag(next_event.is_some()),
-            next_event.unwrap_or(0.0),
-            flag(state.iteration_pending),
-            flag(clock.is_some()),
-            clock.map_or(0.0, |c| c.start),
-            clock.map_or(0.0, |c| c.period),
-            clock.map_or(0.0, |c| c.next as f64),
-            flag(presample),
-        ];
+        let mut numbers = Vec::new();
+        LayerNumbers {
+            machine: state.machine,
+            time: state.time,
+            stop_time: state.stop_time,
+            next_event,
+            iteration_pending: state.iteration_pending,
+            clock: clock.map(|c| (c.start, c.period, c.next as f64)),
+            presample,
+        }
+        .push_to(&mut numbers);
         for &row in Self::saved_rows() {
             let v = decl::<M>().variable(row);
             numbers.push(match v.base_type {
                 BaseType::Real => model.get_real(v.binding)?,
                 BaseType::Integer => model.get_integer(v.binding)? as f64,
-                BaseType::Boolean => flag(model.get_boolean(v.binding)?),
+                BaseType::Boolean => fmu_state::flag(model.get_boolean(v.binding)?),
             });
         }
         model.save_internal(&mut numbers);
-        let mut out = Vec::with_capacity(8 + 4 + 4 + guid.len() + 8 + numbers.len() * 8);
-        out.extend_from_slice(SERIAL_MAGIC);
-        out.extend_from_slice(&SERIAL_VERSION.to_le_bytes());
-        out.extend_from_slice(&(guid.len() as u32).to_le_bytes());
-        out.extend_from_slice(guid);
-        out.extend_from_slice(&(numbers.len() as u64).to_le_bytes());
-        for x in numbers {
-            out.extend_from_slice(&x.to_le_bytes());
-        }
-        Ok(out)
+        Ok(fmu_state::encode(decl::<M>().guid(), &numbers))
     }
 
     /// Parses bytes from [`Instance::serialize`]; refuses anything else with the reason.
     /// The variables go through the same checks and setters as `fmi2Set*`, and a state
     /// past initialization through the model's `exit_initialization` check.
     pub fn deserialize(&self, bytes: &[u8]) -> OpResult<SavedState<M>> {
-        let mut rest = bytes;
-        let mut take = |n: usize| -> OpResult<&[u8]> {
-            if rest.len() < n {
-                return err(format!("serialized state truncated ({} bytes)", bytes.len()));
-            }
-            let (head, tail) = rest.split_at(n);
-            rest = tail;
-            Ok(head)
-        };
-        if take(8)? != SERIAL_MAGIC {
-            return err("not a serialized FMU state of this layer (bad magic)");
-        }
-        let version = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default());
-        if version != SERIAL_VERSION {
-            return err(format!("serialized state version {version}, expected {SERIAL_VERSION}"));
-        }
-        let guid_len = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default()) as usize;
-        if guid_len > 256 {
-            return err("serialized state has an implausible GUID length");
-        }
-        if take(guid_len)? != decl::<M>().guid().as_bytes() {
-            return err("serialized state belongs to another model (GUID differs)");
-        }
-        let count = u64::from_le_bytes(take(8)?.try_into().unwrap_or_default());
-        let header = 8 + 4 + 4 + guid_len + 8;
         let saved = Self::saved_rows().len();
-        if count.checked_mul(8) != Some((bytes.len() - header) as u64)
-            || (count as usize) < SERIAL_HEADER_NUMBERS + saved
-        {
-            return err("serialized state length does not match its header");
-        }
-        let numbers: Vec<f64> = take(count as usize * 8)?
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
-            .collect();
-        let machine = Machine::from_code(numbers[0]).ok_or("serialized state has an unknown instance state")?;
-        let flag = |x: f64, what: &str| -> OpResult<bool> {
-            if x == 0.0 || x == 1.0 {
-                Ok(x == 1.0)
-            } else {
-                err(format!("serialized {what} flag is {x}, not 0 or 1"))
-            }
-        };
-        let time = numbers[1];
-        let stop_time = flag(numbers[2], "stop time")?.then_some(numbers[3]);
-        let next_event = flag(numbers[4], "next event")?.then_some(numbers[5]);
-        let iteration_pending = flag(numbers[6], "event iteration")?;
-        if !time.is_finite() || stop_time.is_some_and(|s| !s.is_finite() || s < time - time_eps(time)) {
-            return err("serialized state has a non-finite time or a stop time before it");
-        }
-        if next_event.is_some_and(|t| !t.is_finite() || t < time - time_eps(time)) {
-            return err("serialized state has a next event time that is non-finite or past");
-        }
-        let has_clock = flag(numbers[7], "sample clock")?;
-        let (clock_start, period, next_sample) = (numbers[8], numbers[9], numbers[10]);
-        let presample = flag(numbers[11], "before the first sample")?;
+        let numbers = fmu_state::decode(decl::<M>().guid(), bytes, LayerNumbers::COUNT + saved)?;
+        let LayerNumbers { machine, time, stop_time, next_event, iteration_pending, clock, presample } =
+            LayerNumbers::read(&numbers, time_eps)?;
+        let (has_clock, (clock_start, period, next_sample)) = (clock.is_some(), clock.unwrap_or_default());
+        let flag = |x: f64, what: &str| -> OpResult<bool> { Ok(fmu_state::read_flag(x, what)?) };
         let mut model = Self::fresh_model(&self.context)?;
-        let values = &numbers[SERIAL_HEADER_NUMBERS..SERIAL_HEADER_NUMBERS + saved];
+        let values = &numbers[LayerNumbers::COUNT..LayerNumbers::COUNT + saved];
         for (&row, &x) in Self::saved_rows().iter().zip(values) {
             let v = decl::<M>().variable(row);
             Self::check_value(row, x).map_err(|e| format!("serialized state: {e}"))?;
@@ -1161,7 +1094,7 @@ impl<M: Model> Instance<M> {
             };
             r.map_err(|e| format!("serialized state: {}: {e}", v.name))?;
         }
-        model.load_internal(&numbers[SERIAL_HEADER_NUMBERS + saved..])?;
+        model.load_internal(&numbers[LayerNumbers::COUNT + saved..])?;
         let initialized = !matches!(machine, Machine::Instantiated | Machine::InitializationMode);
         if initialized {
             model.exit_initialization().map_err(|e| format!("serialized state: {e}"))?;
@@ -1267,62 +1200,4 @@ impl From<BoolAsF64> for f64 {
     fn from(b: BoolAsF64) -> f64 {
         b.0 as u8 as f64
     }
-}
-
-/// Whether variable `v` may be set in instance state `machine` (FMI 2.0 section 2.2.7 and
-/// the state tables); the reason when not. [`Declaration`] keeps the answer for every state
-/// as a bit mask, the fast path of `fmi2Set*`.
-pub(crate) fn settable_in<B>(v: &VarDecl<B>, machine: Machine) -> Result<(), String> {
-    let why = |reason: &str| Err(format!("{} cannot be set {reason}", v.name));
-    if v.variability == Variability::Constant {
-        return why("(a constant)");
-    }
-    if matches!(v.causality, Causality::Independent | Causality::CalculatedParameter) {
-        return why("(calculated)");
-    }
-    let has_start = matches!(v.initial, Some(Initial::Exact) | Some(Initial::Approx));
-    match machine {
-        Machine::Instantiated | Machine::InitializationMode => {
-            if has_start || v.causality == Causality::Input {
-                Ok(())
-            } else {
-                why("(no start value: it is calculated)")
-            }
-        }
-        Machine::StepComplete | Machine::EventMode => match (v.causality, v.variability) {
-            (Causality::Input, _) | (Causality::Parameter, Variability::Tunable) => Ok(()),
-            (Causality::Parameter, _) => why("after initialization (a fixed parameter; only tunable ones can)"),
-            _ => why(&format!("in {machine:?} (only inputs and tunable parameters)")),
-        },
-        Machine::ContinuousTimeMode => {
-            if v.causality == Causality::Input && v.variability == Variability::Continuous {
-                Ok(())
-            } else {
-                why("in ContinuousTimeMode (only continuous inputs)")
-            }
-        }
-        _ => why(&format!("in {machine:?}")),
-    }
-}
-
-/// Whether `value` fits variable `row` of declaration `d` (finite, min/max, enumeration
-/// items); the reason when not.
-pub(crate) fn check_value_in<B>(d: &Declaration<B>, row: usize, value: f64) -> Result<(), String> {
-    let v = d.variable(row);
-    if !value.is_finite() {
-        return Err(format!("{} = {value} refused: not a finite number", v.name));
-    }
-    if let Some(e) = d.enumeration_of(row) {
-        if e.item(value as i32).is_none() {
-            let items: Vec<String> = e.items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect();
-            return Err(format!("{} = {value} refused: not an item of {} ({})", v.name, e.name, items.join(", ")));
-        }
-    }
-    if let Some(min) = v.min.filter(|&m| value < m) {
-        return Err(format!("{} = {value} refused: below its minimum {min}", v.name));
-    }
-    if let Some(max) = v.max.filter(|&m| value > m) {
-        return Err(format!("{} = {value} refused: above its maximum {max}", v.name));
-    }
-    Ok(())
 }

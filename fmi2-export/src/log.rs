@@ -7,6 +7,14 @@ use std::sync::Arc;
 
 use crate::ffi::{Fmi2CallbackFunctions, Fmi2Status};
 
+/// Log categories every FMU of ours offers.
+pub const LOG_CATEGORIES: [(&str, &str); 4] = [
+    ("logStatusError", "Errors (always logged)"),
+    ("logStatusWarning", "Warnings"),
+    ("logEvents", "Mode changes and events"),
+    ("logCalls", "Every fmi2 call"),
+];
+
 /// The log categories every FMU of ours offers (`<LogCategories>` of the XML).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LogCategory {
@@ -26,7 +34,7 @@ impl LogCategory {
 
     /// The category's name in the XML and in `fmi2SetDebugLogging`.
     pub fn name(self) -> &'static str {
-        crate::decl::LOG_CATEGORIES[self as usize].0
+        LOG_CATEGORIES[self as usize].0
     }
 }
 

@@ -2,6 +2,8 @@
 //! called: the standard's state tables for Model Exchange (section 3.2.3) and
 //! Co-Simulation (section 4.2.4), read row by row.
 
+use model_description::{Causality, Initial, Variability};
+
 /// The FMI 2.0 instance states a synchronous FMU can be in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Machine {
@@ -208,6 +210,48 @@ impl Function {
     /// Whether the standard allows the call in `machine`.
     pub fn allowed_in(self, machine: Machine) -> bool {
         self.allowed_mask() & machine.bit() != 0
+    }
+}
+
+/// Whether variable `v` may be set in instance state `machine` (FMI 2.0 section 2.2.7 and
+/// the state tables); the reason when not. [`Declaration`] keeps the answer for every state
+/// as a bit mask, the fast path of `fmi2Set*`.
+pub(crate) fn settable_in(
+    name: &str,
+    causality: Causality,
+    variability: Variability,
+    initial: Option<Initial>,
+    machine: Machine,
+) -> Result<(), String> {
+    let why = |reason: &str| Err(format!("{name} cannot be set {reason}"));
+    if variability == Variability::Constant {
+        return why("(a constant)");
+    }
+    if matches!(causality, Causality::Independent | Causality::CalculatedParameter) {
+        return why("(calculated)");
+    }
+    let has_start = matches!(initial, Some(Initial::Exact) | Some(Initial::Approx));
+    match machine {
+        Machine::Instantiated | Machine::InitializationMode => {
+            if has_start || causality == Causality::Input {
+                Ok(())
+            } else {
+                why("(no start value: it is calculated)")
+            }
+        }
+        Machine::StepComplete | Machine::EventMode => match (causality, variability) {
+            (Causality::Input, _) | (Causality::Parameter, Variability::Tunable) => Ok(()),
+            (Causality::Parameter, _) => why("after initialization (a fixed parameter; only tunable ones can)"),
+            _ => why(&format!("in {machine:?} (only inputs and tunable parameters)")),
+        },
+        Machine::ContinuousTimeMode => {
+            if causality == Causality::Input && variability == Variability::Continuous {
+                Ok(())
+            } else {
+                why("in ContinuousTimeMode (only continuous inputs)")
+            }
+        }
+        _ => why(&format!("in {machine:?}")),
     }
 }
 
