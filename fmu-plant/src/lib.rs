@@ -28,7 +28,8 @@ pub const MAX_SUBSTEPS_PER_STEP: usize = 1_000_000;
 
 /// The declared range of a parameter: what a 1:14 to full-size car, on Earth-like gravity,
 /// can have (the defaults are the 2.68 kg Nigel). The bounds also keep the tires'
-/// stability step, and so the work of a step, bounded.
+/// stability step, and so the work of a step, bounded. They lie inside the vehicle model's
+/// own checks ([`VehicleParams::validate`], tested), so the setters check nothing more.
 fn parameter_range(p: Param) -> (f64, f64) {
     match p {
         Param::Mass => (0.1, 5000.0),
@@ -536,15 +537,8 @@ impl Model for Plant {
         match b {
             // its range is declared; nothing else depends on it
             PlantVar::Param(Param::CsSubstepMax) => self.cs_substep_max = value,
-            PlantVar::Param(p) => {
-                let mut candidate = self.params;
-                *param_slot(&mut candidate, p).ok_or("no such parameter")? = value;
-                validate_all(&candidate)?;
-                self.params = candidate;
-            }
-            PlantVar::Input(Input::Friction(i)) if !(0.0..=MU_MAX).contains(&value) => {
-                return Err(format!("mu_{} = {value} refused: friction must be in [0, {MU_MAX}]", WHEELS[i]).into());
-            }
+            // the declared ranges lie inside what the vehicle model accepts
+            PlantVar::Param(p) => *param_slot(&mut self.params, p).ok_or("no such parameter")? = value,
             PlantVar::Input(i) => *input_slot(&mut self.inputs, i) = value,
             PlantVar::State(i) => self.state[i] = value,
             // a fixed parameter: set only before initialization ends (and when an FMU state is
@@ -560,10 +554,10 @@ impl Model for Plant {
         Ok(())
     }
 
-    /// The inputs (friction only within its declared 0 .. MU_MAX, which the layer checks
-    /// first) and the states have no check of their own.
+    /// Only the calculated variables refuse (the layer refuses to set them first): the
+    /// declaration's ranges are the only checks of the others.
     fn setter_may_refuse(b: PlantVar) -> bool {
-        !matches!(b, PlantVar::Input(_) | PlantVar::State(_))
+        matches!(b, PlantVar::Derivative(_) | PlantVar::Output(_))
     }
 
     fn get_boolean(&mut self, b: PlantVar) -> ModelResult<bool> {
@@ -575,20 +569,15 @@ impl Model for Plant {
 
     fn set_boolean(&mut self, b: PlantVar, value: bool) -> ModelResult {
         let PlantVar::Switch(s) = b else { return Err("not a Boolean variable".into()) };
-        let mut candidate = self.params;
-        *switch_slot(&mut candidate, s) = value;
-        validate_all(&candidate)?;
-        self.params = candidate;
+        *switch_slot(&mut self.params, s) = value;
         self.changed();
         Ok(())
     }
 
+    /// The vehicle model's own parameter checks, behind the declared ranges (which lie
+    /// inside them, so this refuses nothing the layer let through).
     fn exit_initialization(&mut self) -> ModelResult {
-        validate_all(&self.params)?;
-        if let Some(i) = self.inputs.mu.iter().position(|m| !(0.0..=MU_MAX).contains(m)) {
-            return Err(format!("mu_{} = {} must be in [0, {MU_MAX}]", WHEELS[i], self.inputs.mu[i]).into());
-        }
-        Ok(())
+        Ok(validate_all(&self.params)?)
     }
 
     fn do_step(&mut self, _time: f64, step: f64) -> ModelResult {
@@ -692,6 +681,27 @@ mod tests {
             // the servo state of wheel i is named after the same wheel
             assert_eq!(named(&format!("servo_angle_{w}")).binding, PlantVar::State(idx::SERVO + i));
         }
+    }
+
+    /// Every declared parameter range lies inside what the vehicle model accepts: each
+    /// bound, with the other parameters at their defaults and every feature switched on,
+    /// passes `VehicleParams::validate` (so the setters need no check of their own).
+    #[test]
+    fn declared_parameter_ranges_lie_inside_the_vehicle_checks() {
+        let d = Plant::declaration();
+        let mut checked = 0;
+        for v in &d.spec.variables {
+            let PlantVar::Param(p) = v.binding else { continue };
+            let Some(defaults) = param_slot(&mut VehicleParams::table2(), p).map(|x| *x) else { continue };
+            assert_eq!((v.min, v.max), (Some(parameter_range(p).0), Some(parameter_range(p).1)), "{}", v.name);
+            for bound in [v.min.unwrap(), v.max.unwrap(), defaults] {
+                let mut params = VehicleParams::table2();
+                *param_slot(&mut params, p).unwrap() = bound;
+                assert_eq!(validate_all(&params), Ok(()), "{} = {bound}", v.name);
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 3 * 17);
     }
 
     /// The value references the layer assigned, pinned: a change shows in review.

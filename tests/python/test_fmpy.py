@@ -23,7 +23,6 @@ input-timing convention cannot pass.
 import ctypes
 import math
 import os
-import re
 import zipfile
 from pathlib import Path
 
@@ -40,7 +39,6 @@ REPO = Path(__file__).resolve().parents[2]
 TARGET = REPO / os.environ.get("CARGO_TARGET_DIR", "target")  # an absolute CARGO_TARGET_DIR wins
 FMU_DIR = Path(os.environ.get("NIGEL_FMU_DIR", TARGET / "fmu"))
 FMU = FMU_DIR / "nigel_plant.fmu"
-PLANT_RS = REPO / "fmu-plant" / "src" / "lib.rs"
 
 WHEELS = ("fl", "fr", "rl", "rr")
 BODY_STATES = ("x", "y", "psi", "v_x", "v_y", "yaw_rate")
@@ -379,7 +377,7 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
         assert got[f"der({name})"].derivative is got[name]
         assert got[name].initial == ("calculated" if i < 6 else "exact"), name
     assert [d.variable.name for d in md.derivatives] == [f"der({n})" for n in BODY_STATES + SERVO_STATES]
-    assert [o.variable.name for o in md.outputs] == [n for n, e in expected.items() if e[2] == "output"]
+    assert [o.variable.name for o in md.outputs] == [n for n, e in expected.items() if e[1] == "output"]
     assert md.numberOfContinuousStates == 10 and md.numberOfEventIndicators == 0
     # SI base-unit exponents (kg, m, s, rad) of the units the plant uses
     dims = {"m": (0, 1, 0, 0), "rad": (0, 0, 0, 1), "s": (0, 0, 1, 0), "kg": (1, 0, 0, 0),
@@ -389,23 +387,15 @@ def test_model_description_matches_the_declaration(md, unzipdir, vr):
         bu = declared_units[name].baseUnit
         assert (bu.kg, bu.m, bu.s, bu.rad, bu.factor, bu.offset) == (kg, m, s, rad, 1.0, 0.0), name
 
-    # the value-reference bases in the Rust source agree with this table
-    src = PLANT_RS.read_text()
-    consts = dict((k, int(v)) for k, v in re.findall(r"pub const ([A-Z_]+): u32 = (\d+);", src))
-    assert consts["STATE"] == 0 and consts["DERIVATIVE"] == 10 and consts["STEER"] == 20
-    assert consts["TORQUE"] == 24 and consts["FRICTION"] == 28 and consts["WIND_HEAD"] == 32
-    assert consts["WIND_SIDE"] == 33 and consts["WIND_X"] == 34 and consts["WIND_Y"] == 35 and consts["BETA"] == 40 and consts["SLIP_ANGLE"] == 43
-    assert consts["FORCE_LAT"] == 47 and consts["FORCE_DRIVE"] == 51 and consts["STEER_APPLIED"] == 55
-    assert consts["PARAM"] == 100 and consts["MOTOR_SPEED_LIMIT"] == 2
-
     # what the binary holds at start equals the XML's start values
     fmu = initialized_slave(md, unzipdir, vr, "defaults")
     try:
-        reals = [n for n, e in expected.items() if e[1] == "Real" and e[4] is not None]
+        reals = [n for n, e in expected.items() if e[0] == "Real" and e[3] is not None]
         values = fmu.getReal([vr[n] for n in reals])
         for n, x in zip(reals, values):
-            assert x == pytest.approx(expected[n][4], rel=1e-15, abs=0.0), n
-        assert list(fmu.getBoolean([0, 1, 2])) == [False, False, False]
+            assert x == pytest.approx(expected[n][3], rel=1e-15, abs=0.0), n
+        switches = ["friction_circle", "steering_servo", "motor_speed_limit"]
+        assert list(fmu.getBoolean([vr[n] for n in switches])) == [False, False, False]
     finally:
         fmu.terminate()
         fmu.freeInstance()
@@ -517,7 +507,7 @@ def test_fmu_state_get_set_and_serialize(md, unzipdir, vr):
     """getFMUstate, N steps, setFMUstate, the same N steps: bit-identical; the state carries
     the inputs too. serializeFMUstate -> bytes -> deSerializeFMUstate in a fresh instance
     -> bit-identical continuation. A truncated byte string is refused."""
-    watch = [vr[n] for n in BODY_STATES + SERVO_STATES] + list(range(40, 59))
+    watch = [vr[v.name] for v in md.modelVariables if v.causality == "output" or v.name in SERVO_STATES]
     steer = [vr[f"delta_{w}"] for w in WHEELS]
 
     def run(fmu, k0, n, change_at=None):
@@ -600,9 +590,12 @@ def test_directional_derivatives_match_finite_differences(md, unzipdir, vr, real
         m.enterContinuousTimeMode()
         nx = md.numberOfContinuousStates
         state_vrs = [d.variable.derivative.valueReference for d in md.derivatives]
-        assert state_vrs == list(range(10))
+        assert state_vrs == [vr[n] for n in BODY_STATES + SERVO_STATES]
         der_vrs = [d.variable.valueReference for d in md.derivatives]
-        out_vrs = list(range(40, 59))
+        outputs = ["beta", "speed", "lateral_accel"] + [
+            f"{stem}_{w}" for stem in ["slip_angle", "force_lat", "force_drive", "delta_applied"] for w in WHEELS
+        ]
+        out_vrs = [vr[n] for n in outputs]
         input_vrs = [vr[n] for n in INPUTS]
 
         x = np.array(JAC_STATE, dtype=np.float64)
