@@ -211,6 +211,10 @@ fn main() {
         isolation(system);
         return;
     }
+    if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "per_value") {
+        per_value(system);
+        return;
+    }
     println!(
         "closed loop {} ({} instances, {} connections), 30 s at 1 ms:",
         ssp.display(),
@@ -303,7 +307,7 @@ fn main() {
     }
 }
 
-/// Section 5: `fmi2GetReal` of every Real output and `fmi2SetReal` of every Real input of
+/// Section 5 (alone: `COSIM_BENCH_ONLY=per_value`): `fmi2GetReal` of every Real output and `fmi2SetReal` of every Real input of
 /// each instance (the inputs set to the values read back, which every FMU accepts), best
 /// of 5 rounds of 20,000 calls.
 fn per_value(system: &System) {
