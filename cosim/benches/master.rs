@@ -307,9 +307,9 @@ fn main() {
     }
 }
 
-/// Section 5 (alone: `COSIM_BENCH_ONLY=per_value`): `fmi2GetReal` of every Real output and `fmi2SetReal` of every Real input of
-/// each instance (the inputs set to the values read back, which every FMU accepts), best
-/// of 5 rounds of 20,000 calls.
+/// Section 5 (alone: `COSIM_BENCH_ONLY=per_value`): `fmi2GetReal` of every Real output and
+/// `fmi2SetReal` of every Real input of each instance (the inputs set to the values read
+/// back, which every FMU accepts), best of 5 rounds of 20,000 calls.
 fn per_value(system: &System) {
     use model_description::Causality;
     const CALLS: u32 = 20_000;
