@@ -394,6 +394,15 @@ pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<(Pat
     Ok((path, bytes.len()))
 }
 
+/// What [`build_all`] wrote.
+#[derive(Debug)]
+pub struct Built {
+    /// Each archive's path and size in bytes, in the order of the targets.
+    pub archives: Vec<(PathBuf, usize)>,
+    /// How each platform was built (toolchain, C library baseline).
+    pub platforms: Vec<PlatformBuild>,
+}
+
 /// Builds every target for every platform of `platforms` and writes `<out_dir>/<id>.fmu`
 /// for each, carrying all those platforms; returns each archive's path and size.
 ///
@@ -405,7 +414,7 @@ pub fn build_all(
     platforms: &[Platform],
     out_dir: &Path,
     progress: &mut dyn FnMut(&str),
-) -> Result<(Vec<(PathBuf, usize)>, Vec<PlatformBuild>), BuildError> {
+) -> Result<Built, BuildError> {
     let packages: Vec<&str> = targets.iter().map(|t| t.package).collect();
     let ids: Vec<&str> = targets.iter().map(|t| t.model_identifier.as_str()).collect();
     let mut libraries: Vec<(PlatformBuild, Vec<Vec<u8>>)> = Vec::new();
@@ -438,7 +447,7 @@ pub fn build_all(
         std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
         written.push((path, bytes.len()));
     }
-    Ok((written, builds))
+    Ok(Built { archives: written, platforms: builds })
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@ use fmi2_export::{
 };
 use nigel_vehicle::WHEELS;
 
-/// The sample period of the law [s].
+/// The sample period of the law \[s\].
 pub const SAMPLE_PERIOD: f64 = 1e-3;
 
 /// The scalar inputs `(name, unit, start)`, kept in `OwnController::inputs` in this order.
