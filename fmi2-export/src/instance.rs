@@ -6,8 +6,8 @@ use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, 
 use crate::fmu_state::{self, LayerNumbers};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 use crate::sampled::{instant_tolerance, SampleClock, MAX_SAMPLES_PER_STEP};
-pub use crate::states::{Function, Machine, Scope};
 use crate::states::settable_in;
+pub use crate::states::{Function, Machine, Scope};
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
 pub type OpResult<T = ()> = Result<T, ModelError>;

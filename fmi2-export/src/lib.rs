@@ -116,12 +116,13 @@
 //!
 //! # Modules
 //!
-//! Each uses only those above it (no import circle): [`ffi`] (the C types), [`states`]
+//! Each uses only those before it (no import circle): [`ffi`] (the C types), [`states`]
 //! (the instance states, the allowed-calls table, who may be set when), [`sampled`] (the
-//! sample clock), [`uri`]; [`log`] (categories, the logger); [`fmu_state`] (the byte format
-//! of a serialized FMU state); [`decl`] (the declaration and the generated XML); [`model`]
-//! (the trait a model implements); [`variables`] (declaring each variable once); [`instance`]
-//! (one instance: the FMI semantics over a model); [`abi`] (the C entry points).
+//! sample clock), [`uri`], [`units`] (unit definitions from a unit's name); [`log`]
+//! (categories, the logger); [`fmu_state`] (the byte format of a serialized FMU state);
+//! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
+//! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
+//! the FMI semantics over a model); [`abi`] (the C entry points).
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
