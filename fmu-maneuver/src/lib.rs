@@ -36,6 +36,9 @@ pub const MODEL_IDENTIFIER: &str = "nigel_maneuver";
 /// at initialization); `duration` above it is refused.
 pub const MAX_DURATION: f64 = 600.0;
 
+/// The parameter that ends the benchmark (its last sample is at `t = duration`).
+const DURATION: &str = "duration";
+
 /// Slowest `speed_target` [m/s]: the reference and its speed loop need the car moving.
 pub const MIN_SPEED_TARGET: f64 = 0.01;
 
@@ -129,13 +132,13 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
     ];
     // beta_meas and yaw_rate_meas feed the inputs through; the others depend on the sample alone
     let feedthrough = [vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![beta], vec![yaw_rate]];
-    for (k, ((name, unit, field, text), on)) in held.into_iter().zip(feedthrough).enumerate() {
+    let mut held = held.into_iter().zip(feedthrough);
+    let output = |v: &mut Variables<_>, ((name, unit, field, text), on): (Held, Vec<_>)| {
         v.real(name).discrete_output(on).unit(unit).describe(text).field(field);
-        if k == 5 {
-            v.family("mu", &WHEELS, |d, _| d.discrete_output(vec![]).describe(friction))
-                .field(|m, i| &mut m.held.mu[i]);
-        }
-    }
+    };
+    held.by_ref().take(6).for_each(|row| output(&mut v, row));
+    v.family("mu", &WHEELS, |d, _| d.discrete_output(vec![]).describe(friction)).field(|m, i| &mut m.held.mu[i]);
+    held.for_each(|row| output(&mut v, row));
     let ds = DisturbanceSettings::default();
     #[rustfmt::skip]
     let parameters: [Parameter; 13] = [
@@ -143,7 +146,7 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
             "amplitude a of the steering programs (30 deg)"),
         ("speed_target", DEFAULT_SPEED, MIN_SPEED_TARGET, 10.0, "m/s", |m, _| &mut m.scenario.speed_ref,
             "speed the reference holds and the output speed_ref gives (start speed of the reference)"),
-        ("duration", 30.0, SAMPLE_PERIOD, MAX_DURATION, "s", |m, _| &mut m.duration,
+        (DURATION, 30.0, SAMPLE_PERIOD, MAX_DURATION, "s", |m, _| &mut m.duration,
             "length of the reference computed at initialization (30 s); a run may not go past it"),
         // the disturbance settings: the paper's values as start values
         ("friction_mean", ds.friction_mean, 0.0, MU_MAX, "", |m, _| &mut m.settings().friction_mean,
@@ -168,12 +171,13 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
         ("yaw_rate_noise", ds.yaw_rate_noise, 0.0, 10.0, "rad/s", |m, _| &mut m.settings().yaw_rate_noise,
             "standard deviation of the Gaussian noise on yaw_rate_meas (0.01 rad/s; real fidelity only)"),
     ];
-    for (k, (name, start, min, max, unit, field, text)) in parameters.into_iter().enumerate() {
-        if k == 3 {
-            switches(&mut v);
-        }
+    let parameter = |v: &mut Variables<_>, &(name, start, min, max, unit, field, text): &Parameter| {
         with_unit(v.real(name).parameter(start).min(min).max(max).describe(text), unit).field(field);
-    }
+    };
+    let (scenario, settings) = parameters.split_at(3);
+    scenario.iter().for_each(|row| parameter(&mut v, row));
+    switches(&mut v);
+    settings.iter().for_each(|row| parameter(&mut v, row));
     v.family("friction_phase", &WHEELS, |d, i| {
         d.parameter(ds.friction_phase[i])
             .min(-2.0 * TAU)
@@ -328,7 +332,7 @@ impl Model for TestBench {
     }
 
     fn sample_end(&self) -> Option<SampleEnd> {
-        Some(SampleEnd { last: self.last_sample(), variable: "duration" })
+        Some(SampleEnd { last: self.last_sample(), variable: DURATION })
     }
 
     /// The outputs of sample `k`; before the reference exists (Initialization Mode) sample 0
