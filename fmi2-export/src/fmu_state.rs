@@ -1,6 +1,6 @@
 //! The byte format of a serialized FMU state (`fmi2SerializeFMUstate`): magic, format
 //! version, the model's GUID (a state belongs to one model), the count of numbers, then
-//! the numbers, all little-endian. The numbers are the layer's [`LayerNumbers`] (instance
+//! the numbers, all little-endian. The numbers are the layer's own (instance
 //! state, time, stop time, next event, sample clock), the declared variables the
 //! declaration saves ([`crate::Declaration::saved_rows`]) and the model's own internal
 //! numbers, each an f64 (Integers and Booleans exactly so).

@@ -19,7 +19,7 @@
 //!
 //! Value references: per base type, in declaration order from 0, so that appending a
 //! variable keeps every earlier one. Each FMU pins them in a checked-in table
-//! ([`Declaration::value_reference_table`]) compared by a test, so that a change shows in
+//! ([`crate::Declaration::check_pinned_value_references`]) compared by a test, so that a change shows in
 //! review. Dependencies (the ModelStructure) are given by the [`VarHandle`]s the builder
 //! returned, never by numbers or by repeating names.
 
