@@ -219,7 +219,7 @@ pub trait Model: Clone + Send + Sized + 'static {
         Ok(EventUpdate::default())
     }
 
-    /// A sampled model's period [s] ([`crate::sampled`]): the layer then keeps the sample
+    /// A sampled model's period \[s\] ([`crate::sampled`]): the layer then keeps the sample
     /// clock and calls [`Model::sample`] instead of [`Model::event_update`]. Read when
     /// initialization ends (a period parameter is fixed from then on). Default: not sampled.
     fn sample_period(&self) -> Option<f64> {

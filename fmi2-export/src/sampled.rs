@@ -18,7 +18,7 @@
 //! a stop time past `t_end` is refused at `fmi2SetupExperiment` (and when initialization
 //! ends, for a last sample set after it).
 
-/// Smallest distance between two time instants the layer tells apart [s], besides the
+/// Smallest distance between two time instants the layer tells apart \[s\], besides the
 /// rounding of the times themselves: a master that accumulates `t += h` drifts from the
 /// exact grid by about 1e-11 s after 30 000 steps of 1 ms, far below it; no sample period
 /// of ours is within three orders of magnitude of it (the controller's smallest is 1 us).
@@ -55,7 +55,7 @@ pub struct SampleEnd {
 pub struct SampleClock {
     /// Time of sample 0 (the start time of `fmi2SetupExperiment`).
     pub start: f64,
-    /// Sample period [s].
+    /// Sample period \[s\].
     pub period: f64,
     /// Samples run so far: the next sample is `next`.
     pub next: u64,
