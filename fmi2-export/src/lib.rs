@@ -133,6 +133,7 @@ pub mod sampled;
 pub mod states;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod units;
 pub mod uri;
 
 pub use decl::{
