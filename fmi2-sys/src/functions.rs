@@ -194,4 +194,15 @@ mod tests {
         assert_eq!(SYMBOLS[0].0, "fmi2GetVersion");
         assert_eq!(SYMBOLS[43].0, "fmi2GetNominalsOfContinuousStates");
     }
+
+    /// A shared library that is no FMU: the first core symbol is the error.
+    #[cfg(feature = "import")]
+    #[test]
+    fn a_library_without_the_core_functions_is_refused_naming_the_first() {
+        // SAFETY: the C library's initializers already ran in this process.
+        let libc = unsafe { libloading::Library::new("libc.so.6") }.unwrap();
+        let e = unsafe { Fmi2Functions::load(&libc) }.unwrap_err();
+        assert_eq!(e, MissingSymbol("fmi2GetVersion"));
+        assert_eq!(e.to_string(), "the library does not export fmi2GetVersion");
+    }
 }
