@@ -18,6 +18,9 @@
 //!    call (the master's buffers, `nigel_cosim::Instance`, the C ABI, the layer's checks
 //!    and the model's getter/setter); and the master's own cost per step: `ordered`
 //!    recording nothing minus the bare loop of the three `fmi2DoStep`s.
+//!
+//! `COSIM_BENCH_ONLY=isolation` runs the isolation cost alone, `COSIM_BENCH_ONLY=per_value`
+//! section 5 alone.
 
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, Results, System, SystemBuilder};
 use std::path::{Path, PathBuf};

@@ -376,5 +376,18 @@ pub(crate) fn table(real: &Functions) -> Functions {
         get_event_indicators: real.get_event_indicators.is_some().then_some(get_event_indicators as _),
         get_continuous_states: real.get_continuous_states.is_some().then_some(get_continuous_states as _),
         get_nominals_of_continuous_states: real.get_nominals_of_continuous_states.is_some().then_some(get_nominals as _),
+        // not offered through a host process
+        get_types_platform: None,
+        set_debug_logging: None,
+        serialized_fmu_state_size: None,
+        serialize_fmu_state: None,
+        deserialize_fmu_state: None,
+        get_directional_derivative: None,
+        set_real_input_derivatives: None,
+        get_real_output_derivatives: None,
+        cancel_step: None,
+        get_status: None,
+        get_integer_status: None,
+        get_string_status: None,
     }
 }
