@@ -122,7 +122,8 @@
 //! (categories, the logger); [`fmu_state`] (the byte format of a serialized FMU state);
 //! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
 //! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
-//! the FMI semantics over a model); [`abi`] (the C entry points).
+//! the FMI semantics over a model); [`abi`] (the C entry points); with the feature
+//! `testing`, `testing` (the in-process importer of the FMU crates' tests).
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
