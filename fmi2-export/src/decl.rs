@@ -220,8 +220,10 @@ impl<B> VarDecl<B> {
         self.description = text;
         self
     }
+    /// The unit (declared in [`DeclarationSpec::units`]); `""` is no unit (for tables of
+    /// variables some of which have none).
     pub fn unit(mut self, unit: &'static str) -> Self {
-        self.unit = Some(unit);
+        self.unit = (!unit.is_empty()).then_some(unit);
         self
     }
     pub fn min(mut self, v: f64) -> Self {

@@ -22,7 +22,7 @@ use core::f64::consts::{FRAC_PI_2, TAU};
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
     declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
-    ModelResult, SampleEnd, VarDecl, Variables,
+    ModelResult, SampleEnd, Variables,
 };
 use nigel_benchmark::{
     BenchSample, BenchSampler, Benchmark, DisturbanceSettings, Fidelity, Maneuver, Scenario, DEFAULT_SPEED,
@@ -94,14 +94,6 @@ type Held = (&'static str, &'static str, fn(&mut TestBench, usize) -> &mut f64, 
 /// A Real parameter: name, start, min, max, unit ("" for none), field, description.
 type Parameter = (&'static str, f64, f64, f64, &'static str, fn(&mut TestBench, usize) -> &mut f64, &'static str);
 
-fn with_unit<B>(d: VarDecl<B>, unit: &'static str) -> VarDecl<B> {
-    if unit.is_empty() {
-        d
-    } else {
-        d.unit(unit)
-    }
-}
-
 fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
     let mut v = Variables::<Field<TestBench>>::new();
     let beta =
@@ -172,7 +164,7 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
             "standard deviation of the Gaussian noise on yaw_rate_meas (0.01 rad/s; real fidelity only)"),
     ];
     let parameter = |v: &mut Variables<_>, &(name, start, min, max, unit, field, text): &Parameter| {
-        with_unit(v.real(name).parameter(start).min(min).max(max).describe(text), unit).field(field);
+        v.real(name).parameter(start).min(min).max(max).unit(unit).describe(text).field(field);
     };
     let (scenario, settings) = parameters.split_at(3);
     scenario.iter().for_each(|row| parameter(&mut v, row));
