@@ -654,6 +654,7 @@ impl Instance {
                 variables,
                 isolation.call_timeout,
                 run_deadline,
+                crate::isolate::Spin::of_run(),
             )
             .map_err(failed)?,
         );
@@ -916,6 +917,19 @@ impl Instance {
         call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))?;
         self.time = time + step;
         Ok(())
+    }
+
+    /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
+    /// that the hosts of several instances step at the same time; the next
+    /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
+    /// in process, and when the instance cannot step now (`do_step` then says why).
+    pub(crate) fn post_step(&mut self, time: f64, step: f64) -> bool {
+        let Some(host) = self.host.as_deref_mut() else { return false };
+        if self.state != InstanceState::Running || self.fmu.functions.do_step.is_none() {
+            return false;
+        }
+        crate::isolate::proxy::post_step(host, time, step);
+        true
     }
 
     /// `fmi2GetFMUstate`: saves the current state.

@@ -10,9 +10,6 @@ use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
 
-/// The host spins this long for the next call before sleeping (the master's other
-/// instances take about a microsecond each between two calls to this one).
-const HOST_SPIN: Duration = Duration::from_micros(30);
 
 struct Region {
     base: *mut u8,
@@ -91,12 +88,24 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
             };
         }
         if op == Some(Op::DoStep) && status <= 1 && h.prefetch > 0 {
-            let n = h.prefetch as usize;
-            let vrs: *const u32 = region.at(layout.prefetch);
-            let values: *mut f64 = region.at(layout.prefetch + (4 * n).div_ceil(8) * 8);
-            // SAFETY: live component; n references and n values inside the prefetch area.
-            let s = unsafe { (host.f.get_real)(host.c, vrs, n, values) };
-            h.prefetched = (s <= 1) as u32;
+            // each batch: its count, its references, room for its values (channel::record_len)
+            let mut at = 0usize;
+            let mut ok = true;
+            for _ in 0..h.prefetch {
+                let record: *mut u8 = region.at(layout.prefetch + at);
+                // SAFETY: the master wrote the batch inside the prefetch area (learn_prefetch).
+                let n = unsafe { *(record as *const u32) } as usize;
+                if at + super::channel::record_len(n) > layout.prefetch_len {
+                    ok = false;
+                    break;
+                }
+                let vrs = unsafe { record.add(8) } as *const u32;
+                let values = unsafe { record.add(8 + (4 * n).div_ceil(8) * 8) } as *mut f64;
+                // SAFETY: live component; n references and n values inside the prefetch area.
+                ok &= unsafe { (host.f.get_real)(host.c, vrs, n, values) } <= 1;
+                at += super::channel::record_len(n);
+            }
+            h.prefetched = ok as u32;
         }
         host.drain_log(&region);
         h.status = status;
@@ -121,7 +130,8 @@ fn layout_of(size: usize) -> Layout {
 
 fn wait_next(region: &Region, seen: &mut u32) {
     let h = region.header();
-    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, HOST_SPIN, Duration::from_secs(1), || Ok(()));
+    let spin = Duration::from_nanos(u64::from(h.host_spin_ns));
+    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, spin, h.host_yield_every, Duration::from_secs(1), || Ok(()));
     *seen = h.request.load(std::sync::atomic::Ordering::Acquire);
 }
 

@@ -1,7 +1,7 @@
 //! The function table of an isolated instance: each fmi2 function of the FMI 2.0 C API,
 //! its component being the instance's [`Channel`], carried to the host as one call
 //! (`fmi2Set*` queued for the next one, `fmi2GetReal` after a step answered from the
-//! host's prefetch when it asks for the same Reals).
+//! host's prefetch when it asks for the same Reals as after the previous step).
 
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
@@ -12,10 +12,15 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 
 type Component = *mut c_void;
 
+/// The channel, with any call posted on it answered first (the region is the master's
+/// again).
+///
 /// # Safety
 /// `c` is the address of the live channel of the instance calling (proxy table).
 unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
-    &mut *(c as *mut Channel)
+    let channel = &mut *(c as *mut Channel);
+    channel.settle();
+    channel
 }
 
 fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
@@ -109,7 +114,6 @@ unsafe extern "C" fn get_real(c: Component, vr: *const u32, n: usize, v: *mut f6
     if channel.prefetched_reals(vrs, out) {
         return 0;
     }
-    channel.learn_prefetch(vrs);
     if !fits(channel, 12 * n + 8) {
         return 3;
     }
@@ -226,8 +230,25 @@ unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *cons
     channel.call(Op::SetString)
 }
 
+/// `fmi2DoStep(t, h)` posted to the host (see [`Channel::post`]); `do_step` with the same
+/// arguments collects it.
+pub(crate) fn post_step(channel: &mut Channel, t: f64, h: f64) {
+    channel.settle();
+    let hdr = channel.header();
+    hdr.f = [t, h, 0.0, 0.0];
+    hdr.i = [1, 0, 0, 0];
+    channel.last_time = t;
+    channel.posted_step = Some((t, h));
+    channel.post(Op::DoStep);
+}
+
 unsafe extern "C" fn do_step(c: Component, t: f64, h: f64, no_set_prior: c_int) -> c_int {
-    let channel = ch(c);
+    let channel = &mut *(c as *mut Channel);
+    if channel.is_pending(Op::DoStep) && channel.posted_step == Some((t, h)) && no_set_prior == 1 {
+        channel.posted_step = None;
+        return channel.collect();
+    }
+    channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
     hdr.i = [no_set_prior as i64, 0, 0, 0];
