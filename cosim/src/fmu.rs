@@ -180,6 +180,18 @@ macro_rules! fmi2_table {
             $(pub(crate) $of: Option<unsafe extern "C" fn($($oa),*) $(-> $or)?>,)*
         }
         impl Functions {
+            /// The functions every FMU has.
+            pub(crate) const REQUIRED: &'static [&'static str] = &[$($rs),*];
+
+            /// Whether the table has `symbol` (an fmi2 function name).
+            pub(crate) fn has(&self, symbol: &str) -> bool {
+                match symbol {
+                    $($rs => true,)*
+                    $($os => self.$of.is_some(),)*
+                    _ => false,
+                }
+            }
+
             /// # Safety
             /// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
             pub(crate) unsafe fn load(lib: &libloading::Library, path: &Path) -> Result<Functions> {
@@ -246,23 +258,6 @@ const ME_NEEDS: &[&str] = &[
     "fmi2GetContinuousStates",
 ];
 
-impl Functions {
-    fn has(&self, symbol: &str) -> bool {
-        match symbol {
-            "fmi2DoStep" => self.do_step.is_some(),
-            "fmi2EnterEventMode" => self.enter_event_mode.is_some(),
-            "fmi2NewDiscreteStates" => self.new_discrete_states.is_some(),
-            "fmi2EnterContinuousTimeMode" => self.enter_continuous_time_mode.is_some(),
-            "fmi2CompletedIntegratorStep" => self.completed_integrator_step.is_some(),
-            "fmi2SetTime" => self.set_time.is_some(),
-            "fmi2SetContinuousStates" => self.set_continuous_states.is_some(),
-            "fmi2GetDerivatives" => self.get_derivatives.is_some(),
-            "fmi2GetEventIndicators" => self.get_event_indicators.is_some(),
-            "fmi2GetContinuousStates" => self.get_continuous_states.is_some(),
-            _ => false,
-        }
-    }
-}
 
 /// How to import: unpack limits and the interface to load.
 #[derive(Clone, Debug, Default)]
@@ -274,6 +269,11 @@ pub struct ImportOptions {
     /// Pass on NaN and infinite Reals an FMU returns with fmi2OK (default: refused at
     /// the source, [`Error::NonFinite`] naming the FMU and the variable).
     pub allow_non_finite: bool,
+    /// Do not load the library into this process: its functions are known from its ELF
+    /// symbol table, and its instances can only run in host processes
+    /// ([`Instance::new_isolated`], `Experiment::isolation`), so that not even its
+    /// load-time initializers run here.
+    pub isolated: bool,
 }
 
 /// An imported FMU: its unpacked folder (removed on drop), model description and library.
@@ -281,7 +281,8 @@ pub struct ImportOptions {
 pub struct Fmu {
     pub(crate) functions: Functions,
     allow_non_finite: bool,
-    _library: Arc<libloading::Library>,
+    /// The library loaded in this process (`None`: imported isolated, never loaded here).
+    _library: Option<Arc<libloading::Library>>,
     description: ModelDescription,
     interface: Interface,
     source: PathBuf,
@@ -407,9 +408,24 @@ impl Fmu {
         }
         // errors name the library inside the archive, not the temporary copy
         let shown = path.join(&relative);
-        let library = load_library(&so, &shown, &relative)?;
-        // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
-        let functions = unsafe { Functions::load(&library, &shown)? };
+        let (library, functions) = if options.isolated {
+            // SAFETY (of what is not done): nothing of the library runs in this process
+            let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
+            crate::elf::check_shared_library(&bytes)
+                .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
+            // without section headers every function is taken as present: a missing one
+            // is then the host's error when called
+            let exported = crate::elf::exported_symbols(&bytes);
+            let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
+            if let Some(symbol) = Functions::REQUIRED.iter().find(|s| !present(s)) {
+                return Err(Error::MissingSymbol { path: shown, symbol });
+            }
+            (None, crate::isolate::proxy::table(&present))
+        } else {
+            let library = load_library(&so, &shown, &relative)?;
+            // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
+            (Some(library.clone()), unsafe { Functions::load(&library, &shown)? })
+        };
         let needs = match interface {
             Interface::CoSimulation => CS_NEEDS,
             Interface::ModelExchange => ME_NEEDS,
@@ -437,11 +453,11 @@ impl Fmu {
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
-        if self.isolated_from.is_some() {
+        if self.is_isolated() {
             return self.clone();
         }
         Arc::new(Fmu {
-            functions: crate::isolate::proxy::table(&self.functions),
+            functions: crate::isolate::proxy::table(&|symbol| self.functions.has(symbol)),
             allow_non_finite: self.allow_non_finite,
             _library: self._library.clone(),
             description: self.description.clone(),
@@ -454,9 +470,10 @@ impl Fmu {
         })
     }
 
-    /// Whether instances of this FMU run in host processes.
+    /// Whether instances of this FMU run in host processes (an isolated view, or an FMU
+    /// imported with [`ImportOptions::isolated`]).
     pub fn is_isolated(&self) -> bool {
-        self.isolated_from.is_some()
+        self.isolated_from.is_some() || self._library.is_none()
     }
 
     /// The model description.
@@ -586,6 +603,12 @@ impl Instance {
     /// `fmi2Instantiate` with the FMU's interface, logging off (warnings and errors are
     /// still logged by the FMU and kept).
     pub fn new(fmu: &Arc<Fmu>, name: &str) -> Result<Instance> {
+        if fmu.is_isolated() {
+            return Err(Error::Instance {
+                name: name.into(),
+                reason: "its FMU was imported isolated (its library is not loaded in this process): instantiate it in a host process (Instance::new_isolated, Experiment::isolation)",
+            });
+        }
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
@@ -656,7 +679,12 @@ impl Instance {
                 run_deadline,
                 crate::isolate::Spin::of_run(),
             )
-            .map_err(failed)?,
+            .map_err(|cause| Error::Host {
+                instance: name.into(),
+                function: "fmi2Instantiate (loading the library)",
+                time: 0.0,
+                cause,
+            })?,
         );
         let log = Box::<LogSink>::default();
         channel.log = &*log as *const LogSink;

@@ -95,18 +95,18 @@ impl Channel {
         call_timeout: Option<Duration>,
         run_deadline: Option<(Instant, Duration)>,
         spin: super::Spin,
-    ) -> Result<Channel, String> {
+    ) -> Result<Channel, HostEnd> {
         let layout = Layout::for_variables(variables);
         // SAFETY: plain syscalls; the name is a NUL-terminated literal.
         let raw = unsafe { libc::memfd_create(c"nigel-cosim-host".as_ptr(), 0) };
         if raw < 0 {
-            return Err(format!("memfd_create: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("memfd_create: {}", std::io::Error::last_os_error())));
         }
         // SAFETY: `raw` is a fresh descriptor we own.
         let fd = unsafe { OwnedFd::from_raw_fd(raw) };
         // SAFETY: a descriptor we own, a size in range.
         if unsafe { libc::ftruncate(fd.as_raw_fd(), layout.total as libc::off_t) } != 0 {
-            return Err(format!("ftruncate: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("ftruncate: {}", std::io::Error::last_os_error())));
         }
         // SAFETY: maps the whole memfd shared, read-write.
         let base = unsafe {
@@ -120,7 +120,7 @@ impl Channel {
             )
         };
         if base == libc::MAP_FAILED {
-            return Err(format!("mmap: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("mmap: {}", std::io::Error::last_os_error())));
         }
         // SAFETY: the fresh mapping starts with a zeroed Header; the host is not started yet.
         unsafe {
@@ -143,7 +143,8 @@ impl Channel {
                 Ok(())
             });
         }
-        let child = command.spawn().map_err(|e| format!("cannot start {}: {e}", host.display()))?;
+        let child =
+            command.spawn().map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
         let mut channel = Channel {
             base: base as *mut u8,
             layout,
@@ -171,16 +172,17 @@ impl Channel {
         };
         std::mem::forget(child); // reaped by waitpid in `reap`
         super::LIVE_HOSTS.fetch_add(1, Ordering::Relaxed);
-        // the host answers a first empty call once it has loaded the library
+        // the host answers a first empty call once it has loaded the library (its
+        // load-time initializers ran there: a crash in them is the host's end)
         let status = channel.call(Op::Flush);
         if status != 0 {
             return Err(match &channel.failure {
-                Some(f) => format!("the host {f} while loading {}", library.display()),
-                None => format!(
-                    "the host could not load {}: {}",
+                Some(f) => f.clone(),
+                None => HostEnd::Failed(format!(
+                    "could not load {}: {}",
                     library.display(),
                     channel.last_records.iter().map(|r| r.message.as_str()).collect::<Vec<_>>().join("; ")
-                ),
+                )),
             });
         }
         Ok(channel)

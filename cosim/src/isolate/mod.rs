@@ -46,7 +46,7 @@ pub fn null_round_trips(host: &Path, library: &Path, hosts: usize, n: u32, overl
     let spin = Spin::of_run();
     let mut channels = Vec::new();
     for _ in 0..hosts {
-        channels.push(channel::Channel::start(host, library, 16, None, None, spin)?);
+        channels.push(channel::Channel::start(host, library, 16, None, None, spin).map_err(|e| e.to_string())?);
     }
     let start = Instant::now();
     for _ in 0..n {
