@@ -54,7 +54,7 @@ use crate::scenario::{SettingError, SAMPLE_PERIOD};
 pub const KP_SPEED: f64 = 53.6;
 /// Integral gain of the speed hold [N/m].
 pub const KI_SPEED: f64 = 268.0;
-/// Saturation of the total drive force [N].
+/// Saturation of the total drive force \[N\].
 pub const FORCE_MAX: f64 = 20.0;
 /// Gain of the along-track correction of the robust tracking controller [1/s] (module docs).
 pub const K_ALONG_TRACK: f64 = 1.0;
@@ -160,13 +160,13 @@ pub struct ControllerSettings {
     pub kp_speed: f64,
     /// Speed PI integral gain [N/m].
     pub ki_speed: f64,
-    /// Largest total drive force [N].
+    /// Largest total drive force \[N\].
     pub force_max: f64,
-    /// Wheel radius turning force into torque [m].
+    /// Wheel radius turning force into torque \[m\].
     pub r_wheel: f64,
-    /// Steering clamp [rad] (the plant's limit, pi/2).
+    /// Steering clamp \[rad\] (the plant's limit, pi/2).
     pub delta_max: f64,
-    /// Sample period [s] (1 ms).
+    /// Sample period \[s\] (1 ms).
     pub sample_period: f64,
 }
 
@@ -258,31 +258,31 @@ impl ControllerSettings {
 /// What the law reads at a sample instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ControllerInputs {
-    /// Measured body slip angle [rad].
+    /// Measured body slip angle \[rad\].
     pub beta: f64,
     /// Measured yaw rate [rad/s].
     pub yaw_rate: f64,
     /// Measured speed `hypot(v_x, v_y)` [m/s].
     pub speed: f64,
-    /// Reference body slip angle [rad].
+    /// Reference body slip angle \[rad\].
     pub beta_ref: f64,
     /// Reference yaw rate [rad/s].
     pub yaw_rate_ref: f64,
     /// Speed to hold [m/s].
     pub speed_ref: f64,
-    /// Feed-forward steering (the program) [rad], FL, FR, RL, RR.
+    /// Feed-forward steering (the program) \[rad\], FL, FR, RL, RR.
     pub delta_ff: [f64; 4],
-    /// Measured pose: world X [m] (read only by the tracking law).
+    /// Measured pose: world X \[m\] (read only by the tracking law).
     pub x: f64,
-    /// Measured pose: world Y [m].
+    /// Measured pose: world Y \[m\].
     pub y: f64,
-    /// Measured heading, unwrapped or not [rad].
+    /// Measured heading, unwrapped or not \[rad\].
     pub psi: f64,
-    /// Reference pose: world X [m].
+    /// Reference pose: world X \[m\].
     pub x_ref: f64,
-    /// Reference pose: world Y [m].
+    /// Reference pose: world Y \[m\].
     pub y_ref: f64,
-    /// Reference heading [rad].
+    /// Reference heading \[rad\].
     pub psi_ref: f64,
 }
 
@@ -297,11 +297,11 @@ impl ControllerInputs {
 /// What the law puts out, held until the next sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ControllerOutputs {
-    /// Steering commands [rad], clamped to `+-delta_max`.
+    /// Steering commands \[rad\], clamped to `+-delta_max`.
     pub delta: [f64; 4],
     /// Drive torques `F r_wheel / 4` [N.m].
     pub tau: [f64; 4],
-    /// Total drive force `F` after the clip [N].
+    /// Total drive force `F` after the clip \[N\].
     pub force: f64,
     /// Whether `|kp e + ki I| > force_max` (the integrator is then frozen).
     pub saturated: bool,
@@ -337,7 +337,7 @@ impl SampledController {
         Ok(())
     }
 
-    /// The speed integrator `I` [m].
+    /// The speed integrator `I` \[m\].
     pub fn integral(&self) -> f64 {
         self.integral
     }

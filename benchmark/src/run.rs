@@ -13,25 +13,25 @@ use crate::scenario::{
     DisturbanceSequence, Disturbances, Fidelity, Maneuver, Program, Scenario, SettingError, SAMPLE_PERIOD,
 };
 
-/// Largest RK4 sub-step inside a sample (two per 1 ms sample) [s].
+/// Largest RK4 sub-step inside a sample (two per 1 ms sample) \[s\].
 pub const SUBSTEP: f64 = 0.5e-3;
 
 /// Samples at the start of the trajectory, `t_0 .. t_n` (`n + 1` entries each).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trajectory {
-    /// World X [m].
+    /// World X \[m\].
     pub x: Vec<f64>,
-    /// World Y [m].
+    /// World Y \[m\].
     pub y: Vec<f64>,
-    /// Heading, unwrapped (the integral of the yaw rate) [rad].
+    /// Heading, unwrapped (the integral of the yaw rate) \[rad\].
     pub psi: Vec<f64>,
-    /// True body slip angle `atan2(v_y, v_x)` [rad].
+    /// True body slip angle `atan2(v_y, v_x)` \[rad\].
     pub beta: Vec<f64>,
     /// True yaw rate [rad/s].
     pub yaw_rate: Vec<f64>,
     /// True speed `hypot(v_x, v_y)` [m/s].
     pub speed: Vec<f64>,
-    /// Steering commanded over `[t_k, t_k+1)`, `n` entries [rad].
+    /// Steering commanded over `[t_k, t_k+1)`, `n` entries \[rad\].
     pub delta: Vec<[f64; 4]>,
     /// Torque per wheel over `[t_k, t_k+1)`, `n` entries [N.m].
     pub tau: Vec<f64>,
@@ -66,7 +66,7 @@ impl Trajectory {
         self.x.len().saturating_sub(1)
     }
 
-    /// Time of entry `k` [s].
+    /// Time of entry `k` \[s\].
     pub fn time(k: usize) -> f64 {
         k as f64 * SAMPLE_PERIOD
     }
@@ -202,13 +202,13 @@ pub struct Reference {
 /// Mean-square errors against the reference over the samples `t = 1 ms .. n ms`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Metric {
-    /// RMSE of world X [m].
+    /// RMSE of world X \[m\].
     pub rmse_x: f64,
-    /// RMSE of world Y [m].
+    /// RMSE of world Y \[m\].
     pub rmse_y: f64,
-    /// RMSE of the unwrapped heading [rad].
+    /// RMSE of the unwrapped heading \[rad\].
     pub rmse_psi: f64,
-    /// RMSE of the true beta [rad].
+    /// RMSE of the true beta \[rad\].
     pub rmse_beta: f64,
     /// RMSE of the true yaw rate [rad/s].
     pub rmse_yaw_rate: f64,
@@ -433,27 +433,27 @@ impl Benchmark {
 /// Everything the test bench puts out at sample `k` (held over `[t_k, t_k+1)`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchSample {
-    /// Feed-forward steering, the program [rad], FL, FR, RL, RR.
+    /// Feed-forward steering, the program \[rad\], FL, FR, RL, RR.
     pub delta_ff: [f64; 4],
-    /// Reference body slip angle [rad].
+    /// Reference body slip angle \[rad\].
     pub beta_ref: f64,
     /// Reference yaw rate [rad/s].
     pub yaw_rate_ref: f64,
     /// Speed to hold [m/s].
     pub speed_ref: f64,
-    /// Reference pose: world X [m].
+    /// Reference pose: world X \[m\].
     pub x_ref: f64,
-    /// Reference pose: world Y [m].
+    /// Reference pose: world Y \[m\].
     pub y_ref: f64,
-    /// Reference pose: heading, unwrapped [rad].
+    /// Reference pose: heading, unwrapped \[rad\].
     pub psi_ref: f64,
     /// Road friction per wheel [-].
     pub mu: [f64; 4],
-    /// Wind along world X [N] (always 0 in docs/benchmark.md).
+    /// Wind along world X \[N\] (always 0 in docs/benchmark.md).
     pub wind_x: f64,
-    /// Wind along world Y [N].
+    /// Wind along world Y \[N\].
     pub wind_y: f64,
-    /// What the controller measures: beta [rad].
+    /// What the controller measures: beta \[rad\].
     pub beta_meas: f64,
     /// What the controller measures: yaw rate [rad/s].
     pub yaw_rate_meas: f64,

@@ -8,7 +8,7 @@ use nigel_vehicle::VehicleParams;
 
 use crate::noise::{g, u, STREAM_BETA, STREAM_FRICTION, STREAM_WIND, STREAM_YAW_RATE};
 
-/// The sample period of the benchmark, 1 ms [s].
+/// The sample period of the benchmark, 1 ms \[s\].
 pub const SAMPLE_PERIOD: f64 = 1e-3;
 /// Samples per run: `k = 0 .. 29999`, 30 s.
 pub const N_SAMPLES: usize = 30_000;
@@ -16,7 +16,7 @@ pub const N_SAMPLES: usize = 30_000;
 pub const MAX_SAMPLES: usize = 10_000_000;
 /// The speed the PI holds and the start speed [m/s].
 pub const DEFAULT_SPEED: f64 = 0.35;
-/// Steering amplitude `a` of the programs, 30 deg [rad].
+/// Steering amplitude `a` of the programs, 30 deg \[rad\].
 pub const DEFAULT_STEER_AMPLITUDE: f64 = PI / 6.0;
 /// Nominal friction of the reference run (and of every wheel with the friction variation off).
 pub const MU_NOMINAL: f64 = 0.4;
@@ -151,7 +151,7 @@ pub struct Scenario {
     pub measurement_noise: bool,
     /// The numbers in the disturbance formulas (the paper's by default).
     pub disturbance_settings: DisturbanceSettings,
-    /// Steering amplitude `a` [rad], in `[0, pi/2]`.
+    /// Steering amplitude `a` \[rad\], in `[0, pi/2]`.
     pub steer_amplitude: f64,
     /// Speed held by the PI, and the start speed [m/s].
     pub speed_ref: f64,
@@ -222,7 +222,7 @@ impl Scenario {
 pub struct Program {
     /// The maneuver.
     pub maneuver: Maneuver,
-    /// Amplitude `a` [rad].
+    /// Amplitude `a` \[rad\].
     pub amplitude: f64,
     /// Figure-8 only: the samples at which the sign flips (ascending); empty otherwise.
     pub switches: Vec<usize>,
@@ -234,7 +234,7 @@ impl Program {
         Program { maneuver, amplitude, switches }
     }
 
-    /// The front steering angle at sample `k` (the rear is its negative) [rad].
+    /// The front steering angle at sample `k` (the rear is its negative) \[rad\].
     pub fn front(&self, k: usize) -> f64 {
         let a = self.amplitude;
         // sample boundaries in integer milliseconds: no rounding at 14.8 s or 2.5 s
@@ -262,7 +262,7 @@ impl Program {
         }
     }
 
-    /// `[FL, FR, RL, RR]` at sample `k` [rad].
+    /// `[FL, FR, RL, RR]` at sample `k` \[rad\].
     pub fn steering(&self, k: usize) -> [f64; 4] {
         let f = self.front(k);
         [f, f, -f, -f]
@@ -280,7 +280,7 @@ pub fn figure8_sign(switches: &[usize], k: usize) -> f64 {
 
 /// Largest friction coefficient a disturbance may give (the plant's declared range of `mu`).
 pub const MU_MAX: f64 = 3.0;
-/// Largest wind amplitude accepted [N] (some 10 g of the 2.68 kg car).
+/// Largest wind amplitude accepted \[N\] (some 10 g of the 2.68 kg car).
 pub const MAX_WIND_AMPLITUDE: f64 = 250.0;
 
 /// The numbers in the disturbance formulas of docs/benchmark.md; [`Default`] is the paper's
@@ -297,22 +297,22 @@ pub struct DisturbanceSettings {
     /// `A_mu`, the amplitude of the friction sinusoid (0.35).
     pub friction_amplitude: f64,
     /// `f`, the factor of `theta` in the sinusoid's argument `2 pi f theta` (12: about 75
-    /// periods per 30 s run) [1].
+    /// periods per 30 s run) \[1\].
     pub friction_frequency: f64,
     /// `w_mu`, the width of the uniform friction noise, centred on zero (0.1).
     pub friction_noise: f64,
-    /// `phi_i`, the phase of the sinusoid per wheel FL, FR, RL, RR [rad] (0, pi/2, pi, 3 pi/2).
+    /// `phi_i`, the phase of the sinusoid per wheel FL, FR, RL, RR \[rad\] (0, pi/2, pi, 3 pi/2).
     pub friction_phase: [f64; 4],
-    /// `A_w`, the wind step [N] (0.25).
+    /// `A_w`, the wind step \[N\] (0.25).
     pub wind_amplitude: f64,
     /// `r_w`, the uniform wind noise relative to `A_w`, on from t = 0 (0.1).
     pub wind_noise: f64,
-    /// `dir`, the direction the wind blows towards in the world frame, from +X towards +Y [rad]
+    /// `dir`, the direction the wind blows towards in the world frame, from +X towards +Y \[rad\]
     /// (pi/2: along +Y).
     pub wind_direction: f64,
-    /// When the wind step starts [s] (1 s).
+    /// When the wind step starts \[s\] (1 s).
     pub wind_start: f64,
-    /// `s_beta`, the standard deviation of the noise on the measured beta [rad] (0.005).
+    /// `s_beta`, the standard deviation of the noise on the measured beta \[rad\] (0.005).
     pub beta_noise: f64,
     /// `s_r`, the standard deviation of the noise on the measured yaw rate [rad/s] (0.01).
     pub yaw_rate_noise: f64,
@@ -510,7 +510,7 @@ impl Disturbances {
         gust + s.wind_noise * s.wind_amplitude * u(self.seed, STREAM_WIND, k as u64)
     }
 
-    /// Wind force `[along world X, along world Y]` at sample `k` [N]:
+    /// Wind force `[along world X, along world Y]` at sample `k` \[N\]:
     /// `F_w (cos dir, sin dir)` (by default `(0, F_w)`, exactly).
     pub fn wind(&self, k: usize) -> [f64; 2] {
         if !self.wind {
@@ -675,7 +675,7 @@ impl DisturbanceSequence {
         }
     }
 
-    /// [`Disturbances::wind`] at sample `k` [N].
+    /// [`Disturbances::wind`] at sample `k` \[N\].
     #[inline]
     pub fn wind(&self, k: usize) -> [f64; 2] {
         if !self.disturbances.wind {

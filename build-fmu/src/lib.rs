@@ -198,7 +198,11 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
         let (unit, range, start) = match &v.variable_type {
             VariableType::Real { unit, start, min, max, .. } => {
                 let finite = |v: &Option<f64>| v.filter(|x| x.is_finite()).map(|x| x.to_string());
-                (unit.clone().unwrap_or_default(), range_of(finite(min), finite(max)), start.map(|s| s.to_string()).unwrap_or_default())
+                (
+                    unit.clone().unwrap_or_default(),
+                    range_of(finite(min), finite(max)),
+                    start.map(|s| s.to_string()).unwrap_or_default(),
+                )
             }
             VariableType::Integer { start, min, max } => (
                 String::new(),
@@ -365,7 +369,8 @@ pub fn write_closed_loop_ssp(fmu_dir: &Path, job: &str, seed: u64, ssp_path: &Pa
 fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBuild {
     let needed = libraries.iter().filter_map(|b| glibc_requirement(b)).max();
     if let Some((major, minor)) = needed.filter(|&(_, minor)| minor > 17) {
-        built.c_library = format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
+        built.c_library =
+            format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
         built.minimum_os = format!("Linux with glibc {major}.{minor} or later");
     }
     built
@@ -389,6 +394,15 @@ pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<(Pat
     Ok((path, bytes.len()))
 }
 
+/// What [`build_all`] wrote.
+#[derive(Debug)]
+pub struct Built {
+    /// Each archive's path and size in bytes, in the order of the targets.
+    pub archives: Vec<(PathBuf, usize)>,
+    /// How each platform was built (toolchain, C library baseline).
+    pub platforms: Vec<PlatformBuild>,
+}
+
 /// Builds every target for every platform of `platforms` and writes `<out_dir>/<id>.fmu`
 /// for each, carrying all those platforms; returns each archive's path and size.
 ///
@@ -400,7 +414,7 @@ pub fn build_all(
     platforms: &[Platform],
     out_dir: &Path,
     progress: &mut dyn FnMut(&str),
-) -> Result<(Vec<(PathBuf, usize)>, Vec<PlatformBuild>), BuildError> {
+) -> Result<Built, BuildError> {
     let packages: Vec<&str> = targets.iter().map(|t| t.package).collect();
     let ids: Vec<&str> = targets.iter().map(|t| t.model_identifier.as_str()).collect();
     let mut libraries: Vec<(PlatformBuild, Vec<Vec<u8>>)> = Vec::new();
@@ -433,7 +447,7 @@ pub fn build_all(
         std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
         written.push((path, bytes.len()));
     }
-    Ok((written, builds))
+    Ok(Built { archives: written, platforms: builds })
 }
 
 #[cfg(test)]

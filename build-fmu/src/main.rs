@@ -105,7 +105,7 @@ fn main() -> ExitCode {
     let out_dir = args.out_dir.unwrap_or_else(|| build_fmu::target_dir().join("fmu"));
     let names: Vec<&str> = platforms.iter().map(|p| p.folder()).collect();
     eprintln!("build-fmu: building {} for {}", targets.len(), names.join(", "));
-    let (written, builds) =
+    let build_fmu::Built { archives: written, platforms: builds } =
         match build_fmu::build_all(&targets, &platforms, &out_dir, &mut |m| eprintln!("build-fmu: {m}")) {
             Ok(w) => w,
             Err(e) => {

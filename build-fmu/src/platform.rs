@@ -362,7 +362,8 @@ fn search_path() -> std::ffi::OsString {
     std::env::join_paths(dirs).unwrap_or_default()
 }
 
-/// The first executable called `name` on [`search_path`].
+/// The first executable called `name` in `target/cross-venv/bin` (where setup-cross.sh installs
+/// the PyPI tools), then on `PATH`.
 pub fn find_tool(name: &str) -> Option<PathBuf> {
     std::env::split_paths(&search_path()).map(|d| d.join(name)).find(|p| p.is_file())
 }

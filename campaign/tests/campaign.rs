@@ -374,3 +374,36 @@ fn a_failing_run_is_a_row_and_the_campaign_goes_on() {
     assert!(rows.iter().all(|r| r.status == 1));
     assert!(rows[0].message.contains("time limit") && rows[2].message.contains("time limit"), "{:?}", rows[0].message);
 }
+
+#[test]
+fn only_prints_one_run_by_name_and_writes_its_every_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec_path = small(dir.path(), 1.0, 2);
+    let out = dir.path().join("out");
+    let o = Command::new(CAMPAIGN)
+        .arg("run")
+        .arg(&spec_path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--only", "3"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let lines: Vec<(&str, &str)> = text.lines().map(|l| l.split_once(" = ").unwrap()).collect();
+    // the names right-aligned to one column
+    let column = lines[0].0.len();
+    assert!(lines.iter().all(|(name, _)| name.len() == column), "{text}");
+    let field = |name: &str| lines.iter().find(|(n, _)| n.trim() == name).unwrap_or_else(|| panic!("{name}: {text}")).1;
+    assert_eq!(field("run"), "3");
+    assert_eq!(field("status"), "0 (ok)");
+    // the printed numbers are the worker's row, bit for bit ({} of an f64 round-trips)
+    let spec = Spec::load(&spec_path).unwrap();
+    let row = Worker::new(&spec).unwrap().run(3);
+    for (name, v) in spec.header().iter().skip(3).zip(&row.values) {
+        assert_eq!(field(name).split(' ').next().unwrap().parse::<f64>().unwrap(), *v, "{name}");
+    }
+    let (header, rows) = read_cosim_csv(&out.join("run-3.csv"));
+    assert_eq!(header[0], "time");
+    assert_eq!(rows.len(), 1001, "1 s at 1 ms, both ends");
+}

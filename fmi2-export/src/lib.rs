@@ -131,6 +131,7 @@ pub mod log;
 pub mod model;
 pub mod sampled;
 pub mod states;
+pub mod units;
 pub mod uri;
 
 pub use decl::{

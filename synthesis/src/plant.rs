@@ -209,8 +209,8 @@ impl TrackingWeights {
         Self::from_allowances(0.02, 0.1, 0.1)
     }
 
-    /// The weights `1 / allowance` from the allowed lateral error [m], heading error [rad]
-    /// and steering correction [rad].
+    /// The weights `1 / allowance` from the allowed lateral error \[m\], heading error \[rad\]
+    /// and steering correction \[rad\].
     pub fn from_allowances(lateral: f64, heading: f64, steering: f64) -> Self {
         TrackingWeights { lateral: 1.0 / lateral, heading: 1.0 / heading, steering: 1.0 / steering }
     }

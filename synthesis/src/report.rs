@@ -685,15 +685,15 @@ impl Default for TrackingRequest {
 /// The linear closed-loop figures of the tracking gain at the 16 vertices (worst case).
 #[derive(Clone, Debug, Serialize)]
 pub struct TrackingStudy {
-    /// Step of lateral force (wind) for the first figure [N].
+    /// Step of lateral force (wind) for the first figure \[N\].
     pub wind_step_force: f64,
     /// Response to that step from zero error, 10 s.
     pub wind_step: ResponsePeaks,
-    /// Initial lateral offset of the second figure [m] (2 cm, the study's criterion).
+    /// Initial lateral offset of the second figure \[m\] (2 cm, the study's criterion).
     pub offset: f64,
     /// Recovery from that offset, no wind, 2 s.
     pub offset_recovery: ResponsePeaks,
-    /// Steering servo time constant inserted for the servo check [s].
+    /// Steering servo time constant inserted for the servo check \[s\].
     pub servo_time_constant: f64,
     /// Largest real part of the closed loop with the servo inserted, over the vertices.
     pub servo_loop_max_real_part: f64,

@@ -15,8 +15,8 @@
 //! # Performance outputs (weights)
 //!
 //! `z = [q_y e_y; q_psi e_psi; r_u u]` for both the H-inf and the H2 channel `w -> z`, with
-//! Bryson-style weights ([`TrackingWeights`]): each is the reciprocal of the size that is
-//! "as bad as" the others. [`TrackingWeights::chosen`]: 2 cm lateral, 0.1 rad heading,
+//! Bryson-style weights ([`TrackingWeights`](crate::TrackingWeights)): each is the reciprocal of the size that is
+//! "as bad as" the others. [`TrackingWeights::chosen`](crate::TrackingWeights::chosen): 2 cm lateral, 0.1 rad heading,
 //! 0.1 rad steering correction (`q_y = 50 /m`, `q_psi = 10 /rad`, `r_u = 10 /rad`).
 //!
 //! They come from the study `cargo run --release -p nigel-synthesis --example
@@ -186,13 +186,13 @@ pub fn servo_loop_max_real_part(poly: &Polytope, gain: &DMatrix<f64>, t_s: f64) 
 /// Peaks of a linear closed-loop response (state feedback `u = K e`, no servo).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ResponsePeaks {
-    /// Largest `|e_y|` [m].
+    /// Largest `|e_y|` \[m\].
     pub lateral_peak: f64,
-    /// `e_y` at the end of the run [m].
+    /// `e_y` at the end of the run \[m\].
     pub lateral_final: f64,
-    /// Largest `|e_psi|` [rad].
+    /// Largest `|e_psi|` \[rad\].
     pub heading_peak: f64,
-    /// Largest steering correction `|u_i|` [rad].
+    /// Largest steering correction `|u_i|` \[rad\].
     pub steering_peak: f64,
     /// Largest steering rate `|du_i/dt|` [rad/s].
     pub steering_rate_peak: f64,
@@ -241,13 +241,13 @@ pub fn linear_response(
     peaks
 }
 
-/// The worst peaks over the vertices after a step of lateral force `force` [N] from zero
+/// The worst peaks over the vertices after a step of lateral force `force` \[N\] from zero
 /// error, over `duration` seconds (the last value is the slowest vertex's offset).
 pub fn wind_step(poly: &Polytope, gain: &DMatrix<f64>, force: f64, duration: f64) -> ResponsePeaks {
     worst(poly.vertices.iter().map(|v| linear_response(v, &poly.bw, gain, &[0.0; 4], force, duration, 1e-3)))
 }
 
-/// The worst peaks over the vertices while recovering from a lateral offset `offset` [m]
+/// The worst peaks over the vertices while recovering from a lateral offset `offset` \[m\]
 /// (no wind), over `duration` seconds.
 pub fn offset_recovery(poly: &Polytope, gain: &DMatrix<f64>, offset: f64, duration: f64) -> ResponsePeaks {
     worst(

@@ -16,7 +16,7 @@ pub struct Metric {
     pub rmse_state: [f64; 2],
     /// `||rmse_state||_2`.
     pub eps_state: f64,
-    /// The largest steering command `|delta_i|` of the run, any wheel [rad] (against the
+    /// The largest steering command `|delta_i|` of the run, any wheel \[rad\] (against the
     /// plant's limit `delta_max = pi/2`).
     pub max_delta: f64,
 }

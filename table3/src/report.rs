@@ -30,7 +30,7 @@ pub fn json(table: &Table) -> Value {
     v
 }
 
-/// [`json`] without `wall_s`: equal for two runs of the same seed, bit for bit.
+/// [`json()`] without `wall_s`: equal for two runs of the same seed, bit for bit.
 pub fn json_without_wall(table: &Table) -> Value {
     let mut gains = Map::new();
     for (c, k) in &table.gains {

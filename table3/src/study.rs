@@ -39,7 +39,7 @@ pub struct Study {
     pub seeds: Vec<u64>,
     /// One row per (column, maneuver) present in every table.
     pub rows: Vec<StudyRow>,
-    /// The largest `|delta|` of any run, per controller present [rad].
+    /// The largest `|delta|` of any run, per controller present \[rad\].
     pub max_delta: Vec<(Controller, f64)>,
 }
 

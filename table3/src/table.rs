@@ -32,7 +32,7 @@ pub struct Table {
     pub gains: Vec<(Controller, [[f64; 4]; 4])>,
     /// The cells in the order column, maneuver, controller.
     pub cells: Vec<Cell>,
-    /// Wall time of the whole table [s].
+    /// Wall time of the whole table \[s\].
     pub wall_s: f64,
 }
 

@@ -27,21 +27,21 @@ pub type State<T> = [T; N_STATES];
 /// Inputs of the plant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inputs<T> {
-    /// Steering commands [rad], FL, FR, RL, RR.
+    /// Steering commands \[rad\], FL, FR, RL, RR.
     pub delta: [T; 4],
     /// Drive torques [N.m].
     pub tau: [T; 4],
     /// Road friction coefficients [-].
     pub mu: [T; 4],
-    /// Head wind force [N], positive opposes forward motion.
+    /// Head wind force \[N\], positive opposes forward motion.
     pub wind_head: T,
-    /// Side wind force [N], positive toward body +y, at the geometric centre.
+    /// Side wind force \[N\], positive toward body +y, at the geometric centre.
     pub wind_side: T,
-    /// Wind force along world +X [N], at the geometric centre. Rotated into the body frame
+    /// Wind force along world +X \[N\], at the geometric centre. Rotated into the body frame
     /// with the instantaneous heading inside the right-hand side (every RK4 stage), and
     /// added to `wind_head` / `wind_side`.
     pub wind_x: T,
-    /// Wind force along world +Y [N], at the geometric centre (see `wind_x`).
+    /// Wind force along world +Y \[N\], at the geometric centre (see `wind_x`).
     pub wind_y: T,
 }
 
@@ -65,19 +65,19 @@ impl<T: Scalar> Inputs<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Evaluation<T> {
     pub derivatives: State<T>,
-    /// Body slip angle `atan2(v_y, v_x)` [rad].
+    /// Body slip angle `atan2(v_y, v_x)` \[rad\].
     pub beta: T,
     /// `hypot(v_x, v_y)` [m/s].
     pub speed: T,
     /// Body-frame lateral acceleration `dv_y/dt + r v_x` [m/s2].
     pub lateral_accel: T,
-    /// Tire slip angles alpha_i [rad].
+    /// Tire slip angles alpha_i \[rad\].
     pub slip_angle: [T; 4],
-    /// Lateral tire forces F_y,i in the wheel frame [N].
+    /// Lateral tire forces F_y,i in the wheel frame \[N\].
     pub force_lat: [T; 4],
-    /// Drive forces F_d,i in the wheel frame [N].
+    /// Drive forces F_d,i in the wheel frame \[N\].
     pub force_drive: [T; 4],
-    /// Steering angles actually applied [rad].
+    /// Steering angles actually applied \[rad\].
     pub delta_applied: [T; 4],
 }
 
@@ -140,7 +140,7 @@ fn inside_friction_circle(f_drive: f64, f_lat: f64, cap: f64) -> bool {
         && f_drive * f_drive + f_lat * f_lat < cap * cap * (1.0 - 1e-12)
 }
 
-/// Body slip angle `atan2(v_y, v_x)` [rad] of a state (an output of [`evaluate`]).
+/// Body slip angle `atan2(v_y, v_x)` \[rad\] of a state (an output of [`evaluate`]).
 #[inline]
 pub fn body_slip_angle<T: Scalar>(s: &State<T>) -> T {
     s[idx::V_Y].atan2(s[idx::V_X])

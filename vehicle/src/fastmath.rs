@@ -44,7 +44,7 @@ fn select(c: bool, a: f64, b: f64) -> f64 {
     }
 }
 
-/// `atan2(y, x)` [rad] in `[-pi, pi]`, with the IEEE-754 special values of C's `atan2`
+/// `atan2(y, x)` \[rad\] in `[-pi, pi]`, with the IEEE-754 special values of C's `atan2`
 /// (signed zeros, infinities, NaN). Within 2 ulp of glibc's (tested).
 #[inline(always)]
 pub fn atan2(y: f64, x: f64) -> f64 {

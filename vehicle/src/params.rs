@@ -11,17 +11,17 @@ pub const WHEELS: [&str; 4] = ["fl", "fr", "rl", "rr"];
 /// all values are SI (kg, m, s, rad, N).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VehicleParams {
-    /// Mass m [kg].
+    /// Mass m \[kg\].
     pub m: f64,
     /// Yaw moment of inertia I_z [kg.m2].
     pub i_z: f64,
-    /// CG to front axle l_f [m].
+    /// CG to front axle l_f \[m\].
     pub l_f: f64,
-    /// CG to rear axle l_r [m].
+    /// CG to rear axle l_r \[m\].
     pub l_r: f64,
-    /// Full track width t [m].
+    /// Full track width t \[m\].
     pub track: f64,
-    /// Wheel radius r [m].
+    /// Wheel radius r \[m\].
     pub r_wheel: f64,
     /// Cornering stiffness per wheel C_i [N/rad], order FL, FR, RL, RR.
     pub c: [f64; 4],
@@ -29,13 +29,13 @@ pub struct VehicleParams {
     pub g: f64,
     /// Speed below which tire forces fade to zero [m/s].
     pub v_fade: f64,
-    /// Steering limit [rad].
+    /// Steering limit \[rad\].
     pub delta_max: f64,
     /// "Real" fidelity: friction-circle tire (`hypot(F_d, F_y) <= mu N`).
     pub friction_circle: bool,
     /// "Real" fidelity: first-order steering servo with a rate limit.
     pub steering_servo: bool,
-    /// Servo time constant T_s [s].
+    /// Servo time constant T_s \[s\].
     pub servo_time_constant: f64,
     /// Servo rate limit [rad/s].
     pub servo_rate_max: f64,
@@ -181,7 +181,7 @@ impl VehicleParams {
         [(self.l_f, h), (self.l_f, -h), (-self.l_r, h), (-self.l_r, -h)]
     }
 
-    /// Static normal loads N_i [N].
+    /// Static normal loads N_i \[N\].
     pub fn normal_loads(&self) -> [f64; 4] {
         let l = self.l_f + self.l_r;
         let front = self.m * self.g * self.l_r / (2.0 * l);
@@ -189,7 +189,7 @@ impl VehicleParams {
         [front, front, rear, rear]
     }
 
-    /// Offset of the geometric centre ahead of the CG, `x_c = (l_f - l_r)/2` [m].
+    /// Offset of the geometric centre ahead of the CG, `x_c = (l_f - l_r)/2` \[m\].
     pub fn x_c(&self) -> f64 {
         0.5 * (self.l_f - self.l_r)
     }

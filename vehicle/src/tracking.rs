@@ -41,7 +41,7 @@
 //! Around the reference car running straight at speed `v` (`beta_ref = r_ref = 0`,
 //! `delta_ff = 0`), with `e_x = 0` and the car at the same speed, to first order in `e`,
 //! in the steering correction `u = delta - delta_ff` (FL, FR, RL, RR) and in a lateral
-//! force `w` [N] along the reference's left axis at the geometric centre:
+//! force `w` \[N\] along the reference's left axis at the geometric centre:
 //!
 //! ```text
 //! de_y/dt   = v (e_psi + e_beta)
@@ -90,13 +90,13 @@ pub const TRACKING_STATE_NAMES: [&str; N_TRACKING_STATES] = ["e_y", "e_psi", "be
 /// The errors of a car relative to its reference car (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrackingErrors<T> {
-    /// Along-track error `e_x` [m] (positive: the car is ahead of the reference).
+    /// Along-track error `e_x` \[m\] (positive: the car is ahead of the reference).
     pub along: T,
-    /// Lateral error `e_y` [m] (positive: the car is left of the reference).
+    /// Lateral error `e_y` \[m\] (positive: the car is left of the reference).
     pub lateral: T,
-    /// Heading error `e_psi = psi - psi_ref` [rad], wrapped to `(-pi, pi]`.
+    /// Heading error `e_psi = psi - psi_ref` \[rad\], wrapped to `(-pi, pi]`.
     pub heading: T,
-    /// Sideslip error `beta - beta_ref` [rad].
+    /// Sideslip error `beta - beta_ref` \[rad\].
     pub sideslip: T,
     /// Yaw-rate error `r - r_ref` [rad/s].
     pub yaw_rate: T,
@@ -175,7 +175,7 @@ pub fn tracking_error_rates<T: Scalar>(
 }
 
 /// `e' = A e + B u + d w` for `e = [e_y, e_psi, e_beta, e_r]`, `u` the steering correction
-/// (FL, FR, RL, RR), `w` the lateral force [N] at the geometric centre.
+/// (FL, FR, RL, RR), `w` the lateral force \[N\] at the geometric centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrackingModel {
     /// `A_t(mu)`, 4x4.

@@ -99,6 +99,35 @@ fn spec_of_dir(dir: &std::path::Path) -> Result<Spec, Error> {
     Spec::load(desc.as_ref())
 }
 
+/// One run's row for a reader: a line per column, names aligned, the status in words and the
+/// message in full (the CSV holds only numbers: `status` as a code, `message` as 0 or 1).
+fn describe_row(spec: &Spec, row: &nigel_campaign::results::Row) -> String {
+    let header = spec.header();
+    use nigel_campaign::results::{STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
+    let status = match row.status {
+        STATUS_OK => "ok",
+        STATUS_FAILED => "failed",
+        STATUS_PANICKED => "panicked",
+        STATUS_ENDED => "ended by an FMU before the stop time",
+        _ => "unknown",
+    };
+    let width = header.iter().map(|h| h.len()).max().unwrap_or(0).max("message".len());
+    let mut out = format!("{:>width$} = {}\n{:>width$} = {} ({status})\n", "run", row.run, "status", row.status);
+    if !row.message.is_empty() {
+        out += &format!("{:>width$} = {}\n", "message", row.message);
+    }
+    // the header's first three names are run, status and message; then one per value, the
+    // varied columns first (a case column's value is the case's index: its name is shown)
+    for (i, (h, v)) in header.iter().skip(3).zip(&row.values).enumerate() {
+        let case = spec.columns.get(i).map(|c| c.case_names()).unwrap_or_default();
+        match case.get(*v as usize).filter(|_| v.fract() == 0.0 && *v >= 0.0) {
+            Some(name) => out += &format!("{h:>width$} = {v} ({name})\n"),
+            None => out += &format!("{h:>width$} = {v}\n"),
+        }
+    }
+    out
+}
+
 fn main_inner() -> Result<(), Error> {
     match Cli::parse().command {
         Command::Run { spec, out, threads, shard, resume, only } => {
@@ -110,14 +139,7 @@ fn main_inner() -> Result<(), Error> {
                 std::fs::create_dir_all(&out).map_err(|e| Error::Io(format!("{}: {e}", out.display())))?;
                 let mut worker = Worker::new(&spec)?;
                 let row = worker.run(i);
-                let header = spec.header();
-                let line = row.line();
-                for (h, v) in header.iter().zip(line.trim_end().split(',')) {
-                    println!("{h:>24} = {v}");
-                }
-                if !row.message.is_empty() {
-                    println!("{:>24} : {}", "message", row.message);
-                }
+                print!("{}", describe_row(&spec, &row));
                 let path = out.join(format!("run-{i}.csv"));
                 let recorded = worker.run_recorded(i).map_err(|e| Error::Usage(format!("run {i}: {e}")))?;
                 let f = std::fs::File::create(&path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;

@@ -57,20 +57,20 @@ pub struct Experiment {
     /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
     /// handle variable steps: restore the state and retry in halves (at most 2^10
     /// sub-steps). Costs one `fmi2GetFMUstate` per step of those FMUs. Off: a Discard
-    /// stops the run with [`Error::Fmi`].
+    /// stops the run with [`Error::Fmi`](crate::Error::Fmi).
     pub retry_discard: bool,
     /// Input signals over time (fmpy's `input=`), applied before every communication
     /// step; the variables they drive must not be connected.
     pub input: Option<std::sync::Arc<crate::simulate::InputTable>>,
     /// The cap on the steps of a run: communication steps, and the internal steps
     /// (accepted and rejected) of the Model Exchange integrator; a run that would take
-    /// more stops with [`Error::Experiment`] (an adaptive step that shrinks without end
+    /// more stops with [`Error::Experiment`](crate::Error::Experiment) (an adaptive step that shrinks without end
     /// never hangs the run).
     pub max_steps: u64,
     /// Instances in host processes of their own (`None`: all in this process).
     pub isolation: Option<crate::isolate::Isolation>,
-    /// The wall-clock limit of the whole run ([`Error::Timeout`], or
-    /// [`Error::Host`] when it passes during a call of an isolated instance).
+    /// The wall-clock limit of the whole run ([`Error::Timeout`](crate::Error::Timeout), or
+    /// [`Error::Host`](crate::Error::Host) when it passes during a call of an isolated instance).
     pub timeout: Option<Duration>,
 }
 

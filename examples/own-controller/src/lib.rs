@@ -18,7 +18,7 @@ use fmi2_export::{
     Start, VarDecl,
 };
 
-/// The sample period of the law [s].
+/// The sample period of the law \[s\].
 pub const SAMPLE_PERIOD: f64 = 1e-3;
 
 /// What a value reference stands for.

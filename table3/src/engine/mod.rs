@@ -51,27 +51,27 @@ pub struct Run {
     /// beta - beta_ref, yaw_rate - yaw_rate_ref]`; the pose columns are zero for the paper's
     /// three controllers).
     pub gain: [[f64; 4]; 4],
-    /// World X of the car [m].
+    /// World X of the car \[m\].
     pub x: Vec<f64>,
-    /// World Y of the car [m].
+    /// World Y of the car \[m\].
     pub y: Vec<f64>,
-    /// Heading of the car, unwrapped [rad].
+    /// Heading of the car, unwrapped \[rad\].
     pub psi: Vec<f64>,
-    /// True body slip angle [rad].
+    /// True body slip angle \[rad\].
     pub beta: Vec<f64>,
     /// True yaw rate [rad/s].
     pub yaw_rate: Vec<f64>,
-    /// Reference pose X from the test bench [m].
+    /// Reference pose X from the test bench \[m\].
     pub x_ref: Vec<f64>,
-    /// Reference pose Y [m].
+    /// Reference pose Y \[m\].
     pub y_ref: Vec<f64>,
-    /// Reference heading [rad].
+    /// Reference heading \[rad\].
     pub psi_ref: Vec<f64>,
-    /// Reference body slip angle [rad].
+    /// Reference body slip angle \[rad\].
     pub beta_ref: Vec<f64>,
     /// Reference yaw rate [rad/s].
     pub yaw_rate_ref: Vec<f64>,
-    /// Steering commanded (FL, FR, RL, RR) over `[t_k, t_(k+1))` [rad].
+    /// Steering commanded (FL, FR, RL, RR) over `[t_k, t_(k+1))` \[rad\].
     pub delta: Vec<[f64; 4]>,
     /// Road friction per wheel over `[t_k, t_(k+1))` [-].
     pub mu: Vec<[f64; 4]>,
@@ -83,7 +83,7 @@ impl Run {
         self.x.len().saturating_sub(1)
     }
 
-    /// `t_k` [s].
+    /// `t_k` \[s\].
     pub fn time(k: usize) -> f64 {
         k as f64 * SAMPLE_PERIOD
     }
