@@ -7,10 +7,18 @@
 //! the later row holds (fmpy's `after_event`), in initialization the earlier one.
 //! Model Exchange instances get the value at the start of each communication step, held
 //! over it (as the master holds connections).
+//!
+//! A jump (two rows at one time) and a change of a discrete column are input events.
+//! fmpy's `simulate_fmu` makes one a communication point of its own in Co-Simulation
+//! (when the FMU can vary its step) and a time event in Model Exchange. On a
+//! communication point an event gives the same values here as there (the later row from
+//! that point on); between two points this master would apply it only at the next point,
+//! so a table with an event between points is refused, naming the event and the points
+//! around it.
 
 use crate::error::{Error, Result};
 use crate::simulate::algorithm::{Communication, Core};
-use crate::simulate::clock::Point;
+use crate::simulate::clock::{Clock, Point};
 use crate::simulate::observer::Profiler;
 use crate::system::{BaseType, System, VariableRef};
 use model_description::{Causality, Variability};
@@ -135,6 +143,44 @@ impl InputTable {
     }
 }
 
+/// The input events of a table, as fmpy's `Input.findEvents` finds them: the time of two
+/// rows at one time, and of each row where a discrete column changes; with what it is.
+fn input_events(table: &InputTable, columns: &[Column]) -> Vec<(String, f64)> {
+    let t = &table.time;
+    let mut out = Vec::new();
+    for k in 1..t.len() {
+        if t[k] == t[k - 1] {
+            out.push((format!("the jump (rows {} and {} both at t = {} s)", k + 1, k + 2, t[k]), t[k]));
+        }
+        for (j, c) in columns.iter().enumerate() {
+            if c.discrete && table.columns[j][k] != table.columns[j][k - 1] {
+                out.push((format!("the change of the discrete input {} at t = {} s (row {})", table.names[j], t[k], k + 2), t[k]));
+            }
+        }
+    }
+    out
+}
+
+/// An input event at `t` inside the run must fall on a communication point (see the
+/// module's documentation).
+fn check_on_grid(what: &str, t: f64, clock: &Clock) -> Result<()> {
+    let end = clock.t0 + clock.steps as f64 * clock.h;
+    if !(t > clock.t0 && t < end) || isclose(t, clock.t0) || isclose(t, end) {
+        return Ok(());
+    }
+    let n = ((t - clock.t0) / clock.h).floor();
+    let (before, after) = (clock.t0 + n * clock.h, clock.t0 + (n + 1.0) * clock.h);
+    if isclose(t, before) || isclose(t, after) {
+        return Ok(());
+    }
+    Err(Error::Experiment(format!(
+        "input: {what} falls between the communication points {before} and {after} s (step {} s); fmpy makes \
+         it a communication point (Co-Simulation) or a time event (Model Exchange), this master applies \
+         inputs at communication points only: move the event onto one, or choose a step that has it",
+        clock.h
+    )))
+}
+
 /// Python's `math.isclose` with its defaults (relative tolerance 1e-9, no absolute one),
 /// which fmpy uses to compare times.
 fn isclose(a: f64, b: f64) -> bool {
@@ -158,7 +204,12 @@ impl WithInput {
     /// Resolves the table's names in `system` (a bare name in a one-instance system is
     /// that instance's variable); refuses names that are not inputs (or tunable
     /// parameters) and inputs a connection already feeds.
-    pub(crate) fn new(inner: Box<dyn Communication>, system: &System, table: &InputTable) -> Result<WithInput> {
+    pub(crate) fn new(
+        inner: Box<dyn Communication>,
+        system: &System,
+        table: &InputTable,
+        clock: &Clock,
+    ) -> Result<WithInput> {
         let mut columns = Vec::new();
         for name in &table.names {
             let r = match system.resolve(name) {
@@ -187,6 +238,9 @@ impl WithInput {
                 || v.variability == Variability::Discrete
                 || v.variability == Variability::Tunable;
             columns.push(Column { variable: r, discrete });
+        }
+        for (what, t) in input_events(table, &columns) {
+            check_on_grid(&what, t, clock)?;
         }
         Ok(WithInput { inner, table: table.clone(), columns })
     }
