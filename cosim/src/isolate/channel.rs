@@ -75,8 +75,8 @@ pub(crate) struct Channel {
     last_records: Vec<LogRecord>,
     /// The posted call waiting for its answer, and when it was posted.
     pending: Option<(Op, Instant)>,
-    /// The recent times from a post to its answer seen, averaged (ns), for [`super::Spin`].
-    answer_ns: f64,
+    /// Whether the master's spins for this host have paid lately.
+    gauge: super::SpinGauge,
     /// The arguments (time, step) of the posted `fmi2DoStep`.
     pub(crate) posted_step: Option<(f64, f64)>,
     spin: super::Spin,
@@ -127,6 +127,7 @@ impl Channel {
             let h = &mut *(base as *mut Header);
             h.host_spin_ns = spin.host.as_nanos().min(u128::from(u32::MAX)) as u32;
             h.host_yield_every = spin.yield_every;
+            h.host_adaptive = u32::from(spin.adaptive);
         }
         let mut command = std::process::Command::new(host);
         command
@@ -167,7 +168,7 @@ impl Channel {
             last_records: Vec::new(),
             pending: None,
             posted_step: None,
-            answer_ns: 0.0,
+            gauge: super::SpinGauge::new(),
             spin,
         };
         std::mem::forget(child); // reaped by waitpid in `reap`
@@ -341,21 +342,24 @@ impl Channel {
             return FATAL;
         }
         let seq = self.seq;
-        let spin = match self.spin {
-            s if !s.adaptive => s.master,
-            s if s.cores_to_spare() && self.answer_ns < s.master.as_nanos() as f64 => s.master,
-            _ => Duration::ZERO,
-        };
+        let spin = if self.spin.cores_to_spare() { self.spin.master } else { Duration::ZERO };
         let yield_every = self.spin.yield_every;
+        let adaptive = self.spin.adaptive;
         let h = self.header() as *mut Header;
         // SAFETY: the header lives as long as self (see `header`).
         let hdr = unsafe { &*h };
-        let outcome =
-            wait_for(&hdr.response, seq.wrapping_sub(1), &hdr.master_sleeping, spin, yield_every, CHECK_SLICE, || {
-                self.check(start)
-            });
-        // an average over about the last 8 answers
-        self.answer_ns += (start.elapsed().as_nanos() as f64 - self.answer_ns) / 8.0;
+        let mut gauge = self.gauge;
+        let outcome = wait_for(
+            &hdr.response,
+            seq.wrapping_sub(1),
+            &hdr.master_sleeping,
+            spin,
+            yield_every,
+            adaptive.then_some(&mut gauge),
+            CHECK_SLICE,
+            || self.check(start),
+        );
+        self.gauge = gauge;
         // the response may be stale only if it was never written (the host died)
         if let Err(end) = outcome {
             self.failure = Some(end);

@@ -4,7 +4,7 @@
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::{publish, wait_for, Header, Layout, Op};
+use super::{publish, wait_for, Header, Layout, Op, SpinGauge};
 use crate::fmu::{callbacks_for, load_library, EventInfo, Functions, LogSink};
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
@@ -55,11 +55,12 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     let loaded = load_library(library, library, &library.display().to_string())
         .and_then(|lib| unsafe { Functions::load(&lib, library) }.map(|f| (lib, f)));
     let mut seen = 0u32;
+    let mut gauge = SpinGauge::new();
     let (_lib, functions) = match loaded {
         Ok(x) => x,
         Err(e) => {
             // answer the first call with the reason
-            wait_next(&region, &mut seen);
+            wait_next(&region, &mut seen, &mut gauge);
             write_log_text(&region, 3, &e.to_string());
             region.header().status = 3;
             answer(&region, seen);
@@ -68,7 +69,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     };
     let mut host = Host { f: functions, c: std::ptr::null_mut(), log, _callbacks: None, strings: Vec::new() };
     loop {
-        wait_next(&region, &mut seen);
+        wait_next(&region, &mut seen, &mut gauge);
         let h = region.header();
         h.log_count = 0;
         h.log_bytes = 0;
@@ -128,10 +129,13 @@ fn layout_of(size: usize) -> Layout {
     }
 }
 
-fn wait_next(region: &Region, seen: &mut u32) {
+fn wait_next(region: &Region, seen: &mut u32, gauge: &mut SpinGauge) {
     let h = region.header();
     let spin = Duration::from_nanos(u64::from(h.host_spin_ns));
-    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, spin, h.host_yield_every, Duration::from_secs(1), || Ok(()));
+    let gauge = (h.host_adaptive == 1).then_some(gauge);
+    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, spin, h.host_yield_every, gauge, Duration::from_secs(1), || {
+        Ok(())
+    });
     *seen = h.request.load(std::sync::atomic::Ordering::Acquire);
 }
 

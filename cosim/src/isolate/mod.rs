@@ -172,6 +172,8 @@ pub(crate) struct Header {
     /// first call.
     pub(crate) host_spin_ns: u32,
     pub(crate) host_yield_every: u32,
+    /// 1: the host spins only while spinning pays ([`SpinGauge`]).
+    pub(crate) host_adaptive: u32,
     pub(crate) op: u32,
     /// The fmi2 status of the call.
     pub(crate) status: i32,
@@ -244,11 +246,11 @@ impl Layout {
 /// takes about a microsecond, where a sleep and a futex wake-up take tens (a wake-up in a
 /// VM is an inter-processor interrupt through the hypervisor). With fewer cores than the
 /// master and its hosts, a spinning side holds the core the other side needs, and one
-/// round trip can wait for a scheduler time slice (milliseconds). So with `adaptive`
-/// (the default) both sides spin only while the cores (`available_parallelism`: the
-/// affinity mask and the cgroup's CPU quota) are more than the live hosts, and the
-/// master only while its recent answers came within its spin (an average of the last
-/// few); otherwise each side sleeps at once.
+/// round trip can wait for a scheduler time slice (milliseconds); and a machine busy with
+/// other work preempts the side waited for, so that spinning only burns the core. So with
+/// `adaptive` (the default) both sides spin only while the cores (`available_parallelism`:
+/// the affinity mask and the cgroup's CPU quota) are more than the live hosts, and each
+/// only while its spins have paid lately ([`SpinGauge`]); otherwise it sleeps at once.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Spin {
     pub(crate) master: Duration,
@@ -291,34 +293,81 @@ impl Spin {
     }
 }
 
+/// Whether spinning has paid lately for one waiting side: the share of its recent spins
+/// that saw the answer before they ran out (an average over about 16), and a count that
+/// lets every 64th wait spin anyway, so that a side that stopped spinning notices when
+/// it would pay again.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpinGauge {
+    paid: f32,
+    waits: u32,
+}
+
+impl SpinGauge {
+    pub(crate) const fn new() -> SpinGauge {
+        SpinGauge { paid: 1.0, waits: 0 }
+    }
+
+    /// How long to spin this time, at most `max`.
+    fn budget(&mut self, max: Duration) -> Duration {
+        self.waits = self.waits.wrapping_add(1);
+        if self.paid >= 0.5 || self.waits.is_multiple_of(64) {
+            max
+        } else {
+            Duration::ZERO
+        }
+    }
+
+    fn record(&mut self, paid: bool) {
+        self.paid += (f32::from(u8::from(paid)) - self.paid) / 16.0;
+    }
+}
+
 /// Waits until `word` differs from `old`: spins for `spin` (yielding every `yield_every`
-/// rounds), then sleeps on the futex with `sleeping` set (the waker wakes only
-/// sleepers), at most `slice` at a time; `check` is called after each slice and may end
-/// the wait with its error.
+/// rounds; with a `gauge`, only while spinning pays), then sleeps on the futex with
+/// `sleeping` set (the waker wakes only sleepers), at most `slice` at a time; `check` is
+/// called after each slice and may end the wait with its error.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn wait_for<E>(
     word: &AtomicU32,
     old: u32,
     sleeping: &AtomicU32,
     spin: Duration,
     yield_every: u32,
+    gauge: Option<&mut SpinGauge>,
     slice: Duration,
     mut check: impl FnMut() -> Result<(), E>,
 ) -> Result<(), E> {
     if word.load(Ordering::Acquire) != old {
         return Ok(());
     }
-    let start = std::time::Instant::now();
-    let mut spins = 0u32;
-    while start.elapsed() < spin {
-        for _ in 0..64 {
-            std::hint::spin_loop();
+    let mut gauge = gauge;
+    let spin = match gauge.as_deref_mut() {
+        Some(g) => g.budget(spin),
+        None => spin,
+    };
+    if !spin.is_zero() {
+        let start = std::time::Instant::now();
+        let mut spins = 0u32;
+        let mut paid = false;
+        while start.elapsed() < spin {
+            for _ in 0..64 {
+                std::hint::spin_loop();
+            }
+            if word.load(Ordering::Acquire) != old {
+                paid = true;
+                break;
+            }
+            spins += 1;
+            if yield_every > 0 && spins.is_multiple_of(yield_every) {
+                std::thread::yield_now();
+            }
         }
-        if word.load(Ordering::Acquire) != old {
+        if let Some(g) = gauge {
+            g.record(paid);
+        }
+        if paid {
             return Ok(());
-        }
-        spins += 1;
-        if yield_every > 0 && spins.is_multiple_of(yield_every) {
-            std::thread::yield_now();
         }
     }
     loop {
