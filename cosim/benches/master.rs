@@ -18,6 +18,9 @@
 //!    call (the master's buffers, `nigel_cosim::Instance`, the C ABI, the layer's checks
 //!    and the model's getter/setter); and the master's own cost per step: `ordered`
 //!    recording nothing minus the bare loop of the three `fmi2DoStep`s.
+//! 6. Isolation: the closed loop in process against `--isolate`, alternated (alone with
+//!    `COSIM_BENCH_ONLY=isolation`; `COSIM_BENCH_SPINS` adds fixed ways of waiting); and
+//!    with `COSIM_BENCH_ONLY=round-trips` the floor, null round trips master <-> host.
 
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, Results, System, SystemBuilder};
 use std::path::{Path, PathBuf};
