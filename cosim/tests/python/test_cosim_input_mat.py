@@ -107,24 +107,42 @@ def test_input_jumps_equal_fmpy_in_both_interfaces(cosim, plant_fmu, tmp_path):
     assert abs(ours["psi"][-1]) > 1e-3
 
 
-def test_an_input_jump_between_communication_points_is_refused(cosim, plant_fmu, tmp_path):
-    # fmpy makes a jump between two points a communication point of its own (an extra
-    # row at it); applied at the next point here it would be silently late: refused
+def test_an_input_jump_between_communication_points_splits_the_step_as_fmpy(cosim, plant_fmu, tmp_path):
+    # fmpy makes a jump between two points a communication point of its own (recording a
+    # row there); cosim splits the step there too and records the grid only
     signals = jump_signals(0.5004)
     csv = tmp_path / "offgrid.csv"
     write_input_csv(csv, signals)
-    ref = simulate_fmu(str(plant_fmu), fmi_type="CoSimulation", stop_time=1.0, output_interval=1e-3,
-                       input=signals)
-    assert np.any(np.isclose(ref["time"], 0.5004, rtol=0, atol=1e-12))
-    r = subprocess.run([str(cosim), "run", str(plant_fmu), "--input", str(csv), "--stop-time", "1", "--step", "1e-3"],
-                       capture_output=True, text=True)
-    assert r.returncode != 0
-    assert "the jump (rows 3 and 4 both at t = 0.5004 s) falls between the communication points 0.5 and 0.501 s" \
-        in r.stderr, r.stderr
-    # with a step that has the jump, accepted
-    r = subprocess.run([str(cosim), "run", str(plant_fmu), "--input", str(csv), "--stop-time", "1", "--step", "2e-4",
-                        "--summary", str(tmp_path / "s.json")], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
+    start = {"v_x_start": 0.35}
+    ref = simulate_fmu(str(plant_fmu), fmi_type="CoSimulation", stop_time=1.5, output_interval=1e-3,
+                       start_values=start, input=signals)
+    extra = np.isclose(ref["time"], 0.5004, rtol=0, atol=1e-12)
+    assert extra.sum() == 1 and len(ref) == 1502
+    ref = ref[~extra]
+    out = tmp_path / "cs.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--input", str(csv), "--set", "v_x_start=0.35",
+                    "--stop-time", "1.5", "--step", "1e-3", "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    assert len(ours) == 1501 and np.array_equal(ours["time"], ref["time"])
+    names = [n for n in ref.dtype.names if n != "time"]
+    # the same steps (0.5 -> 0.5004 -> 0.501 s) with the same inputs: the same bits
+    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
+    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
+    # Model Exchange: fmpy's time event at the jump, our integrator stopped there; the
+    # tolerance as in test_input_jumps_equal_fmpy_in_both_interfaces
+    h = 1e-2
+    out = tmp_path / "me.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
+                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", "1.5", "--step", str(h),
+                    "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
+                       stop_time=1.5, output_interval=h, start_values=start, input=signals, record_events=False)
+    assert len(ours) == len(ref) == 151
+    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
+        scale = max(1.0, float(np.max(np.abs(ref[name]))))
+        diff = float(np.max(np.abs(ours[name] - ref[name])))
+        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
 
 
 def read_mat_v4(path):
