@@ -950,7 +950,7 @@ impl Instance {
     /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
     /// that the hosts of several instances step at the same time; the next
     /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
-    /// in process, and when the instance cannot step now (`do_step` then says why).
+    /// in process, and when the instance cannot step in its state (`do_step` then says why).
     pub(crate) fn post_step(&mut self, time: f64, step: f64) -> bool {
         let Some(host) = self.host.as_deref_mut() else { return false };
         if self.state != InstanceState::Running || self.fmu.functions.do_step.is_none() {

@@ -287,7 +287,7 @@ impl Spin {
         }
     }
 
-    /// Whether every host and the master can have a core of their own now.
+    /// Whether the master and every live host can each have a core of their own.
     pub(crate) fn cores_to_spare(&self) -> bool {
         !self.adaptive || cores() > LIVE_HOSTS.load(Ordering::Relaxed)
     }

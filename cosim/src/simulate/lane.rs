@@ -100,8 +100,14 @@ impl Lane {
     /// hosts); [`Lane::advance`] then collects it. False (nothing done) for the others.
     #[inline]
     pub(crate) fn post_step(&mut self, t: f64, t_next: f64) -> bool {
-        self.posted = self.unit.is_none() && self.saved.is_none() && self.inst.post_step(t, t_next - t);
+        self.posted = self.can_post() && self.inst.post_step(t, t_next - t);
         self.posted
+    }
+
+    /// Whether [`Lane::post_step`] hands the step to a host.
+    #[inline]
+    pub(crate) fn can_post(&self) -> bool {
+        self.unit.is_none() && self.saved.is_none() && self.inst.fmu().is_isolated()
     }
 
     /// One `jacobi` step of this instance: its inputs set from `values` (the outputs of

@@ -22,7 +22,7 @@ impl Jacobi {
                 // then step while the master steps the others and collects them in turn
                 let mut first: Option<Error> = None;
                 for lane in core.lanes.iter_mut() {
-                    if !lane.inst.fmu().is_isolated() {
+                    if !lane.can_post() {
                         continue;
                     }
                     if let Err(e) = lane.jacobi_inputs(&core.values, p) {

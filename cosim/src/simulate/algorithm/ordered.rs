@@ -29,7 +29,7 @@ impl Communication for Ordered {
         // the isolated lanes' steps handed to their hosts first, which then step while
         // the master steps the others and collects them in turn
         for lane in core.lanes.iter_mut() {
-            if lane.inst.fmu().is_isolated() {
+            if lane.can_post() {
                 lane.post_step(p.t, p.t_next);
             }
         }
