@@ -21,6 +21,9 @@
 //! 6. Isolation: the closed loop in process against `--isolate`, alternated (alone with
 //!    `COSIM_BENCH_ONLY=isolation`; `COSIM_BENCH_SPINS` adds fixed ways of waiting); and
 //!    with `COSIM_BENCH_ONLY=round-trips` the floor, null round trips master <-> host.
+//!
+//! `COSIM_BENCH_ONLY=isolation` runs the isolation cost alone, `COSIM_BENCH_ONLY=per_value`
+//! section 5 alone.
 
 use nigel_cosim::{simulate, Algorithm, Experiment, Fmu, Instance, Results, System, SystemBuilder};
 use std::path::{Path, PathBuf};
@@ -287,6 +290,10 @@ fn main() {
     }
     if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "isolation") {
         isolation(system);
+        return;
+    }
+    if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "per_value") {
+        per_value(system);
         return;
     }
     println!(

@@ -10,8 +10,10 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-type Component = *mut c_void;
-type RawStatus = c_int;
+use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
+
+type Component = fmi2_sys::fmi2Component;
+type RawStatus = fmi2_sys::fmi2Status;
 
 /// The FMI interface an instance uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,55 +40,20 @@ impl Interface {
     }
 }
 
-#[repr(C)]
-pub(crate) struct CallbackFunctions {
-    logger: unsafe extern "C" fn(),
-    allocate_memory: unsafe extern "C" fn(usize, usize) -> *mut c_void,
-    free_memory: unsafe extern "C" fn(*mut c_void),
-    step_finished: Option<unsafe extern "C" fn(*mut c_void, c_int)>,
-    component_environment: *mut c_void,
-}
+/// `fmi2CallbackFunctions`.
+pub(crate) type CallbackFunctions = fmi2_sys::Fmi2CallbackFunctions;
 
 /// `fmi2EventInfo`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct EventInfo {
-    /// `newDiscreteStatesNeeded`.
-    pub new_discrete_states_needed: c_int,
-    /// `terminateSimulation`.
-    pub terminate_simulation: c_int,
-    /// `nominalsOfContinuousStatesChanged`.
-    pub nominals_of_continuous_states_changed: c_int,
-    /// `valuesOfContinuousStatesChanged`.
-    pub values_of_continuous_states_changed: c_int,
-    /// `nextEventTimeDefined`.
-    pub next_event_time_defined: c_int,
-    /// `nextEventTime`.
-    pub next_event_time: f64,
-}
+pub use fmi2_sys::Fmi2EventInfo as EventInfo;
 
-extern "C" {
-    fn nigel_cosim_logger();
-    fn calloc(n: usize, size: usize) -> *mut c_void;
-    fn free(p: *mut c_void);
-}
+/// The fmi2 functions of a library: the ones every interface needs, the rest optional
+/// (absent when the library lacks them; calling one is then an error naming it).
+pub(crate) use fmi2_sys::Fmi2Functions as Functions;
 
-unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {
-    calloc(n, size)
-}
-unsafe extern "C" fn release(p: *mut c_void) {
-    free(p)
-}
-
-/// The callbacks of an instance whose messages go to `log` (the C shim formats them).
+/// The callbacks of an instance whose messages go to `log` (the logger shim of fmi2-sys
+/// formats them).
 pub(crate) fn callbacks_for(log: &LogSink) -> Box<CallbackFunctions> {
-    Box::new(CallbackFunctions {
-        logger: nigel_cosim_logger,
-        allocate_memory: allocate,
-        free_memory: release,
-        step_finished: None,
-        component_environment: log as *const LogSink as *mut c_void,
-    })
+    Box::new(log.environment.callbacks())
 }
 
 /// One message an FMU logged.
@@ -100,10 +67,35 @@ pub struct LogRecord {
     pub message: String,
 }
 
-/// The last messages of one instance (at most [`LogSink::CAPACITY`]).
+/// The last messages of one instance (at most [`LogSink::CAPACITY`]). Its address is
+/// stable (boxed) while the instance logs to it.
 #[derive(Debug, Default)]
 pub struct LogSink {
-    records: Mutex<VecDeque<LogRecord>>,
+    environment: LogEnvironment<Records>,
+}
+
+#[derive(Debug, Default)]
+struct Records(Mutex<VecDeque<LogRecord>>);
+
+impl LogReceiver for Records {
+    fn receive(&self, m: &LogMessage<'_>) {
+        self.push(LogRecord {
+            status: Status::from_raw(m.status),
+            category: m.category.to_owned(),
+            message: m.message.to_owned(),
+        });
+    }
+}
+
+impl Records {
+    fn push(&self, record: LogRecord) {
+        if let Ok(mut r) = self.0.lock() {
+            if r.len() == LogSink::CAPACITY {
+                r.pop_front();
+            }
+            r.push_back(record);
+        }
+    }
 }
 
 impl LogSink {
@@ -112,136 +104,30 @@ impl LogSink {
 
     /// Takes the kept messages.
     pub fn take(&self) -> Vec<LogRecord> {
-        self.records.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
+        self.environment.0.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
     }
 
     /// Keeps `record` (the oldest dropped beyond the capacity).
     pub(crate) fn push(&self, record: LogRecord) {
-        if let Ok(mut r) = self.records.lock() {
-            if r.len() == LogSink::CAPACITY {
-                r.pop_front();
-            }
-            r.push_back(record);
-        }
+        self.environment.push(record)
     }
 
     /// The last messages at Warning or worse, joined, for an error message.
     fn recent_problems(&self) -> String {
-        let Ok(records) = self.records.lock() else { return String::new() };
+        let Ok(records) = self.environment.0.lock() else { return String::new() };
         let v: Vec<&str> =
             records.iter().rev().filter(|r| r.status != Status::Ok).take(3).map(|r| r.message.as_str()).collect();
         v.into_iter().rev().collect::<Vec<_>>().join("; ")
     }
 }
 
-#[no_mangle]
-unsafe extern "C" fn nigel_cosim_record_log(
-    env: *mut c_void,
-    _instance_name: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    message: *const c_char,
-) {
-    if env.is_null() {
-        return;
-    }
-    let _ = std::panic::catch_unwind(|| {
-        // SAFETY: env is the address of the LogSink the instance owns for its whole life.
-        let sink = unsafe { &*(env as *const LogSink) };
-        let text = |p: *const c_char| {
-            if p.is_null() {
-                String::new()
-            } else {
-                // SAFETY: NUL-terminated strings from the FMU / the C shim's buffer.
-                unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-            }
-        };
-        if let Ok(mut r) = sink.records.lock() {
-            if r.len() == LogSink::CAPACITY {
-                r.pop_front();
-            }
-            r.push_back(LogRecord {
-                status: Status::from_raw(status),
-                category: text(category),
-                message: text(message),
-            });
-        }
-    });
-}
-
-macro_rules! fmi2_table {
-    (required { $($rf:ident : $rs:literal => fn($($ra:ty),*) $(-> $rr:ty)?;)* }
-     optional { $($of:ident : $os:literal => fn($($oa:ty),*) $(-> $or:ty)?;)* }) => {
-        /// The fmi2 functions of a library: the ones every interface needs, the rest optional
-        /// (absent when the library lacks them; calling one is then an error naming it).
-        #[allow(missing_docs, dead_code)]
-        pub(crate) struct Functions {
-            $(pub(crate) $rf: unsafe extern "C" fn($($ra),*) $(-> $rr)?,)*
-            $(pub(crate) $of: Option<unsafe extern "C" fn($($oa),*) $(-> $or)?>,)*
-        }
-        impl Functions {
-            /// The functions every FMU has.
-            pub(crate) const REQUIRED: &'static [&'static str] = &[$($rs),*];
-
-            /// Whether the table has `symbol` (an fmi2 function name).
-            pub(crate) fn has(&self, symbol: &str) -> bool {
-                match symbol {
-                    $($rs => true,)*
-                    $($os => self.$of.is_some(),)*
-                    _ => false,
-                }
-            }
-
-            /// # Safety
-            /// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
-            pub(crate) unsafe fn load(lib: &libloading::Library, path: &Path) -> Result<Functions> {
-                Ok(Functions {
-                    $($rf: *lib.get::<unsafe extern "C" fn($($ra),*) $(-> $rr)?>(concat!($rs, "\0").as_bytes())
-                        .map_err(|_| Error::MissingSymbol { path: path.to_path_buf(), symbol: $rs })?,)*
-                    $($of: lib.get::<unsafe extern "C" fn($($oa),*) $(-> $or)?>(concat!($os, "\0").as_bytes()).ok().map(|s| *s),)*
-                })
-            }
-        }
-    };
-}
-
-fmi2_table! {
-    required {
-        get_version: "fmi2GetVersion" => fn() -> *const c_char;
-        instantiate: "fmi2Instantiate" => fn(*const c_char, c_int, *const c_char, *const c_char, *const CallbackFunctions, c_int, c_int) -> Component;
-        free_instance: "fmi2FreeInstance" => fn(Component);
-        setup_experiment: "fmi2SetupExperiment" => fn(Component, c_int, f64, f64, c_int, f64) -> RawStatus;
-        enter_initialization_mode: "fmi2EnterInitializationMode" => fn(Component) -> RawStatus;
-        exit_initialization_mode: "fmi2ExitInitializationMode" => fn(Component) -> RawStatus;
-        terminate: "fmi2Terminate" => fn(Component) -> RawStatus;
-        get_real: "fmi2GetReal" => fn(Component, *const u32, usize, *mut f64) -> RawStatus;
-        get_integer: "fmi2GetInteger" => fn(Component, *const u32, usize, *mut c_int) -> RawStatus;
-        get_boolean: "fmi2GetBoolean" => fn(Component, *const u32, usize, *mut c_int) -> RawStatus;
-        get_string: "fmi2GetString" => fn(Component, *const u32, usize, *mut *const c_char) -> RawStatus;
-        set_real: "fmi2SetReal" => fn(Component, *const u32, usize, *const f64) -> RawStatus;
-        set_integer: "fmi2SetInteger" => fn(Component, *const u32, usize, *const c_int) -> RawStatus;
-        set_boolean: "fmi2SetBoolean" => fn(Component, *const u32, usize, *const c_int) -> RawStatus;
-        set_string: "fmi2SetString" => fn(Component, *const u32, usize, *const *const c_char) -> RawStatus;
-    }
-    optional {
-        reset: "fmi2Reset" => fn(Component) -> RawStatus;
-        get_fmu_state: "fmi2GetFMUstate" => fn(Component, *mut *mut c_void) -> RawStatus;
-        set_fmu_state: "fmi2SetFMUstate" => fn(Component, *mut c_void) -> RawStatus;
-        free_fmu_state: "fmi2FreeFMUstate" => fn(Component, *mut *mut c_void) -> RawStatus;
-        do_step: "fmi2DoStep" => fn(Component, f64, f64, c_int) -> RawStatus;
-        get_boolean_status: "fmi2GetBooleanStatus" => fn(Component, c_int, *mut c_int) -> RawStatus;
-        get_real_status: "fmi2GetRealStatus" => fn(Component, c_int, *mut f64) -> RawStatus;
-        enter_event_mode: "fmi2EnterEventMode" => fn(Component) -> RawStatus;
-        new_discrete_states: "fmi2NewDiscreteStates" => fn(Component, *mut EventInfo) -> RawStatus;
-        enter_continuous_time_mode: "fmi2EnterContinuousTimeMode" => fn(Component) -> RawStatus;
-        completed_integrator_step: "fmi2CompletedIntegratorStep" => fn(Component, c_int, *mut c_int, *mut c_int) -> RawStatus;
-        set_time: "fmi2SetTime" => fn(Component, f64) -> RawStatus;
-        set_continuous_states: "fmi2SetContinuousStates" => fn(Component, *const f64, usize) -> RawStatus;
-        get_derivatives: "fmi2GetDerivatives" => fn(Component, *mut f64, usize) -> RawStatus;
-        get_event_indicators: "fmi2GetEventIndicators" => fn(Component, *mut f64, usize) -> RawStatus;
-        get_continuous_states: "fmi2GetContinuousStates" => fn(Component, *mut f64, usize) -> RawStatus;
-        get_nominals_of_continuous_states: "fmi2GetNominalsOfContinuousStates" => fn(Component, *mut f64, usize) -> RawStatus;
-    }
+/// Resolves the fmi2 functions of `lib`; a missing required one is an error naming it and
+/// `path`.
+///
+/// # Safety
+/// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
+pub(crate) unsafe fn load_functions(lib: &libloading::Library, path: &Path) -> Result<Functions> {
+    Functions::load(lib).map_err(|missing| Error::MissingSymbol { path: path.to_path_buf(), symbol: missing.0 })
 }
 
 /// The functions each interface needs beyond the common ones (checked at load).
@@ -257,7 +143,6 @@ const ME_NEEDS: &[&str] = &[
     "fmi2GetEventIndicators",
     "fmi2GetContinuousStates",
 ];
-
 
 /// How to import: unpack limits and the interface to load.
 #[derive(Clone, Debug, Default)]
@@ -409,7 +294,7 @@ impl Fmu {
         // errors name the library inside the archive, not the temporary copy
         let shown = path.join(&relative);
         let (library, functions) = if options.isolated {
-            // SAFETY (of what is not done): nothing of the library runs in this process
+            // read and checked only: nothing of the library runs in this process
             let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
             crate::elf::check_shared_library(&bytes)
                 .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
@@ -417,14 +302,15 @@ impl Fmu {
             // is then the host's error when called
             let exported = crate::elf::exported_symbols(&bytes);
             let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
-            if let Some(symbol) = Functions::REQUIRED.iter().find(|s| !present(s)) {
+            // the 15 core functions, which `Fmi2Functions::load` requires, lead SYMBOLS
+            if let Some(symbol) = fmi2_sys::SYMBOLS.iter().take(15).map(|(s, _)| *s).find(|s| !present(s)) {
                 return Err(Error::MissingSymbol { path: shown, symbol });
             }
             (None, crate::isolate::proxy::table(&present))
         } else {
             let library = load_library(&so, &shown, &relative)?;
             // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
-            (Some(library.clone()), unsafe { Functions::load(&library, &shown)? })
+            (Some(library.clone()), unsafe { load_functions(&library, &shown)? })
         };
         let needs = match interface {
             Interface::CoSimulation => CS_NEEDS,
@@ -613,13 +499,7 @@ impl Instance {
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let log = Box::<LogSink>::default();
-        let callbacks = Box::new(CallbackFunctions {
-            logger: nigel_cosim_logger,
-            allocate_memory: allocate,
-            free_memory: release,
-            step_finished: None,
-            component_environment: &*log as *const LogSink as *mut c_void,
-        });
+        let callbacks = callbacks_for(&log);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (fmu.functions.instantiate)(
@@ -701,13 +581,7 @@ impl Instance {
             }
             return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
         }
-        let callbacks = Box::new(CallbackFunctions {
-            logger: nigel_cosim_logger,
-            allocate_memory: allocate,
-            free_memory: release,
-            step_finished: None,
-            component_environment: &*log as *const LogSink as *mut c_void,
-        });
+        let callbacks = callbacks_for(&log);
         let component = &mut *channel as *mut crate::isolate::channel::Channel as *mut c_void;
         Ok(Instance {
             component,

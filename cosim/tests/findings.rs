@@ -195,7 +195,7 @@ fn hostile_log_formats_neither_crash_nor_show_the_masters_memory() {
     let log: Vec<String> = inst.take_log().into_iter().map(|r| r.message).collect();
     assert_eq!(log.len(), 5, "{log:?}");
     assert_eq!(log[0], "[log message not formatted: its format contains %n, which writes to memory] %s%n%n%s");
-    assert_eq!(log[1], "<string in the master's memory>");
+    assert_eq!(log[1], "<string in the importer's memory>");
     assert_eq!(log[2], "<unreadable string>");
     assert_eq!(log[3], "[log message not formatted: its format contains a * width or precision] %*d");
     // what C's printf makes of the same format and arguments

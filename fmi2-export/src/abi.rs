@@ -583,16 +583,8 @@ pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
     with::<M>(c, Function::EnterEventMode, |comp| comp.instance.enter_event_mode())
 }
 
-/// `fmi2EventInfo`.
-#[repr(C)]
-pub struct Fmi2EventInfo {
-    pub new_discrete_states_needed: fmi2Boolean,
-    pub terminate_simulation: fmi2Boolean,
-    pub nominals_of_continuous_states_changed: fmi2Boolean,
-    pub values_of_continuous_states_changed: fmi2Boolean,
-    pub next_event_time_defined: fmi2Boolean,
-    pub next_event_time: f64,
-}
+/// `fmi2EventInfo` (from `fmi2-sys`).
+pub use crate::ffi::Fmi2EventInfo;
 
 pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut Fmi2EventInfo) -> Fmi2Status {
     with::<M>(c, Function::NewDiscreteStates, |comp| {

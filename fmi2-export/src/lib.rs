@@ -131,6 +131,8 @@ pub mod log;
 pub mod model;
 pub mod sampled;
 pub mod states;
+#[cfg(feature = "testing")]
+pub mod testing;
 pub mod units;
 pub mod uri;
 

@@ -12,13 +12,14 @@
 #![allow(clippy::missing_safety_doc)]
 
 use std::cell::RefCell;
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ffi::{c_char, c_int, CString};
 use std::ptr::null_mut;
 use std::sync::OnceLock;
 
 use fmi2_export::abi::{self, Fmi2EventInfo};
 use fmi2_export::ffi::*;
 use fmi2_export::model_description::{Causality, Variability, VariableType};
+use fmi2_export::testing::{self, ERR, OK};
 use fmi2_export::*;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -360,100 +361,32 @@ impl Model for Own {
 // The macro must expand for a model with Integer/Boolean/Enumeration and defaults only.
 export_fmi2!(Toy);
 
-// ------------------------------------------------------------------ a tiny importer
+// ------------------------------------------------------------------ the importer
 
-#[derive(Default)]
-struct Log(RefCell<Vec<(c_int, String, String)>>);
+/// The layer's in-process importer (`fmi2_export::testing`) with the toy tests'
+/// conventions: `last_error` is the last message at Discard or worse, `init` takes the
+/// stop time.
+struct Fmu<M: Model>(testing::Fmu<M>);
 
-/// The importer's logger. FMI's is C-variadic; the layer always passes ("%s", message),
-/// and on x86-64 System V a fixed-argument callee reads those from the same registers.
-unsafe extern "C" fn record(
-    env: *mut c_void,
-    _name: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    _format: *const c_char,
-    message: *const c_char,
-) {
-    let log = &*(env as *const Log);
-    let text = |p: *const c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
-    log.0.borrow_mut().push((status, text(category), text(message)));
+impl<M: Model> std::ops::Deref for Fmu<M> {
+    type Target = testing::Fmu<M>;
+    fn deref(&self) -> &testing::Fmu<M> {
+        &self.0
+    }
 }
-
-struct Fmu<M: Model> {
-    c: fmi2Component,
-    log: Box<Log>,
-    _m: std::marker::PhantomData<M>,
-}
-
-const OK: Fmi2Status = Fmi2Status::Ok;
-const ERR: Fmi2Status = Fmi2Status::Error;
 
 impl<M: Model> Fmu<M> {
-    fn new(kind: c_int) -> Self {
-        let log = Box::<Log>::default();
-        let callbacks = Fmi2CallbackFunctions {
-            // SAFETY: see `record`.
-            logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
-            allocate_memory: None,
-            free_memory: None,
-            step_finished: None,
-            component_environment: &*log as *const Log as *mut c_void,
-        };
-        let name = CString::new("toy1").unwrap();
-        let guid = CString::new(M::declaration().guid()).unwrap();
-        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &callbacks, 0, 1) };
-        assert!(!c.is_null(), "{:?}", log.0.borrow());
-        Fmu { c, log, _m: std::marker::PhantomData }
-    }
     fn cs() -> Self {
-        Self::new(1)
+        Fmu(testing::Fmu::cs())
     }
     fn me() -> Self {
-        Self::new(0)
+        Fmu(testing::Fmu::me())
     }
     fn last_error(&self) -> String {
-        self.log.0.borrow().iter().rev().find(|r| r.0 >= 2).map(|r| r.2.clone()).unwrap_or_default()
+        self.0.last_message()
     }
     fn init(&self, stop: Option<f64>) {
-        unsafe {
-            assert_eq!(
-                abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, stop.is_some() as c_int, stop.unwrap_or(0.0)),
-                OK
-            );
-            assert_eq!(abi::enter_initialization_mode::<M>(self.c), OK);
-            assert_eq!(abi::exit_initialization_mode::<M>(self.c), OK, "{}", self.last_error());
-        }
-    }
-    fn real(&self, vr: u32) -> f64 {
-        let mut x = f64::NAN;
-        let s = unsafe { abi::get_real::<M>(self.c, &vr, 1, &mut x) };
-        assert_eq!(s, OK, "{}", self.last_error());
-        x
-    }
-    fn int(&self, vr: u32) -> i32 {
-        let mut x = -7;
-        let s = unsafe { abi::get_integer::<M>(self.c, &vr, 1, &mut x) };
-        assert_eq!(s, OK, "{}", self.last_error());
-        x
-    }
-    fn set_real(&self, vr: u32, x: f64) -> Fmi2Status {
-        unsafe { abi::set_real::<M>(self.c, &vr, 1, &x) }
-    }
-    fn set_int(&self, vr: u32, x: i32) -> Fmi2Status {
-        unsafe { abi::set_integer::<M>(self.c, &vr, 1, &x) }
-    }
-    fn step(&self, t: f64, h: f64) -> Fmi2Status {
-        unsafe { abi::do_step::<M>(self.c, t, h, 1) }
-    }
-    fn reset(&self) -> Fmi2Status {
-        unsafe { abi::reset::<M>(self.c) }
-    }
-}
-
-impl<M: Model> Drop for Fmu<M> {
-    fn drop(&mut self) {
-        unsafe { abi::free_instance::<M>(self.c) }
+        self.0.init_until(0.0, stop)
     }
 }
 
@@ -781,14 +714,8 @@ fn capabilities_not_declared_are_refused_as_not_supported() {
         assert_eq!(f.reset(), OK);
     }
     // Model Exchange is not offered: instantiation fails with the reason
-    let log = Box::<Log>::default();
-    let callbacks = Fmi2CallbackFunctions {
-        logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
-        allocate_memory: None,
-        free_memory: None,
-        step_finished: None,
-        component_environment: &*log as *const Log as *mut c_void,
-    };
+    let log = testing::Log::environment();
+    let callbacks = log.callbacks();
     let guid = CString::new(Bare::declaration().guid()).unwrap();
     let c = unsafe { abi::instantiate::<Bare>(c"x".as_ptr(), 0, guid.as_ptr(), null_mut(), &callbacks, 0, 0) };
     assert!(c.is_null());

@@ -7,11 +7,9 @@
 // written out independently of nigel_benchmark's code.
 #![allow(clippy::manual_clamp, clippy::needless_range_loop)]
 
-mod common;
-
 use std::f64::consts::FRAC_PI_2;
 
-use common::{Fmu, DISCARD, ERR, OK};
+use fmi2_export::testing::{Fmu, DISCARD, ERR, OK};
 use fmi2_export::Model;
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
 use nigel_controller::{mode, vr, Controller};

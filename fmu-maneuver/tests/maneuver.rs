@@ -3,12 +3,9 @@
 //! fidelity initializes, direct feedthrough of the measurement, Model Exchange time
 //! events, FMU state, and bad input.
 
-#[path = "../../fmu-controller/tests/common/mod.rs"]
-mod common;
-
 use std::f64::consts::PI;
 
-use common::{Fmu, DISCARD, ERR, OK};
+use fmi2_export::testing::{Fmu, DISCARD, ERR, OK};
 use fmi2_export::Model;
 use nigel_benchmark::noise::g;
 use nigel_benchmark::{Benchmark, Fidelity, Maneuver, Scenario};

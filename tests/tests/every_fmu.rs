@@ -121,9 +121,9 @@ fn illegal_call_orders_are_errors_and_reset_recovers() {
             let mut info = nigel_integration_tests::EventInfo::default();
             let early = unsafe {
                 if kind == CO_SIMULATION {
-                    (f.do_step)(i.c, 0.0, 1e-3, 1)
+                    (f.do_step.unwrap())(i.c, 0.0, 1e-3, 1)
                 } else {
-                    (f.new_discrete_states)(i.c, &mut info)
+                    (f.new_discrete_states.unwrap())(i.c, &mut info)
                 }
             };
             assert_eq!(early, ERROR, "{}: step/event before initialization", id(md));
@@ -133,9 +133,9 @@ fn illegal_call_orders_are_errors_and_reset_recovers() {
             // the other interface's functions
             let other = unsafe {
                 if kind == CO_SIMULATION {
-                    (f.enter_continuous_time_mode)(i.c)
+                    (f.enter_continuous_time_mode.unwrap())(i.c)
                 } else {
-                    (f.do_step)(i.c, 0.0, 1e-3, 1)
+                    (f.do_step.unwrap())(i.c, 0.0, 1e-3, 1)
                 }
             };
             assert_eq!(other, ERROR);
@@ -174,9 +174,9 @@ fn nan_and_inf_are_refused_naming_the_variable() {
 
 unsafe fn serialize(i: &Instance, state: *mut c_void) -> Vec<u8> {
     let mut size = 0usize;
-    assert_eq!((i.f().serialized_fmu_state_size)(i.c, state, &mut size), OK);
+    assert_eq!((i.f().serialized_fmu_state_size.unwrap())(i.c, state, &mut size), OK);
     let mut bytes = vec![0u8; size];
-    assert_eq!((i.f().serialize_fmu_state)(i.c, state, bytes.as_mut_ptr() as *mut c_char, size), OK);
+    assert_eq!((i.f().serialize_fmu_state.unwrap())(i.c, state, bytes.as_mut_ptr() as *mut c_char, size), OK);
     bytes
 }
 
@@ -220,13 +220,13 @@ fn fmu_state_round_trip_is_bit_exact() {
         drive(&a, 0.0, 7);
         let mut state = null_mut();
         let bytes = unsafe {
-            assert_eq!((a.f().get_fmu_state)(a.c, &mut state), OK);
+            assert_eq!((a.f().get_fmu_state.unwrap())(a.c, &mut state), OK);
             serialize(&a, state)
         };
         let t1 = 7.0 * step;
         let first = drive(&a, t1, 25);
         // in memory
-        unsafe { assert_eq!((a.f().set_fmu_state)(a.c, state), OK) };
+        unsafe { assert_eq!((a.f().set_fmu_state.unwrap())(a.c, state), OK) };
         assert_eq!(drive(&a, t1, 25), first, "{}: in-memory state", id(md));
         // through bytes, into a fresh instance that was never initialized
         let (b, log) = fmu.instantiate("b", CO_SIMULATION, fmu.guid());
@@ -234,18 +234,18 @@ fn fmu_state_round_trip_is_bit_exact() {
         let mut copy = null_mut();
         unsafe {
             assert_eq!(
-                (b.f().deserialize_fmu_state)(b.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut copy),
+                (b.f().deserialize_fmu_state.unwrap())(b.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut copy),
                 OK,
                 "{:?}",
                 log.last_error()
             );
-            assert_eq!((b.f().set_fmu_state)(b.c, copy), OK);
+            assert_eq!((b.f().set_fmu_state.unwrap())(b.c, copy), OK);
             // and serializing the copy gives the same bytes
             assert_eq!(serialize(&b, copy), bytes);
         }
         assert_eq!(drive(&b, t1, 25), first, "{}: serialized state", id(md));
         // a state of one instance is not accepted by another
-        unsafe { assert_eq!((b.f().set_fmu_state)(b.c, state), ERROR) };
+        unsafe { assert_eq!((b.f().set_fmu_state.unwrap())(b.c, state), ERROR) };
     }
 }
 
@@ -479,8 +479,8 @@ fn model_structure_dependencies_are_the_knowns_that_move_the_unknowns() {
             i.initialize();
             let mut info = nigel_integration_tests::EventInfo::default();
             unsafe {
-                assert_eq!((i.f().new_discrete_states)(i.c, &mut info), OK);
-                assert_eq!((i.f().enter_continuous_time_mode)(i.c), OK);
+                assert_eq!((i.f().new_discrete_states.unwrap())(i.c, &mut info), OK);
+                assert_eq!((i.f().enter_continuous_time_mode.unwrap())(i.c), OK);
             }
             let mut unknowns = outputs.clone();
             unknowns.extend(derivatives.iter().cloned());
@@ -496,7 +496,7 @@ fn model_structure_dependencies_are_the_knowns_that_move_the_unknowns() {
             }
             let nx = derivatives.len();
             let mut x = vec![0.0; nx];
-            unsafe { assert_eq!((i.f().get_continuous_states)(i.c, x.as_mut_ptr(), nx), OK) };
+            unsafe { assert_eq!((i.f().get_continuous_states.unwrap())(i.c, x.as_mut_ptr(), nx), OK) };
             for (k, d) in ms.derivatives.iter().enumerate() {
                 let Some(VariableType::Real { derivative: Some(state), .. }) =
                     md.model_variables.get(d.index as usize - 1).map(|v| &v.variable_type)
@@ -509,7 +509,7 @@ fn model_structure_dependencies_are_the_knowns_that_move_the_unknowns() {
                     if on {
                         y[k] += 1e-3 * (1.0 + y[k].abs());
                     }
-                    assert_eq!(unsafe { (i.f().set_continuous_states)(i.c, y.as_ptr(), nx) }, OK);
+                    assert_eq!(unsafe { (i.f().set_continuous_states.unwrap())(i.c, y.as_ptr(), nx) }, OK);
                 };
                 check_moved(md, "Model Exchange", &i, &unknowns, (&state_name, *state), &set);
             }

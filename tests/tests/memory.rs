@@ -20,8 +20,8 @@ fn ten_thousand_instantiate_free_cycles_do_not_grow_memory() {
         i.initialize();
         assert_eq!(i.do_step(0.0, 1e-3), OK);
         let mut state = null_mut();
-        assert_eq!(unsafe { (i.f().get_fmu_state)(i.c, &mut state) }, OK);
-        assert_eq!(unsafe { (i.f().free_fmu_state)(i.c, &mut state) }, OK);
+        assert_eq!(unsafe { (i.f().get_fmu_state.unwrap())(i.c, &mut state) }, OK);
+        assert_eq!(unsafe { (i.f().free_fmu_state.unwrap())(i.c, &mut state) }, OK);
     };
     for _ in 0..500 {
         cycle();

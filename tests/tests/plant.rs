@@ -155,11 +155,11 @@ fn hostile_serialized_states_are_refused_like_the_setters_would() {
     let f = i.f();
     let mut state: *mut c_void = null_mut();
     let bytes = unsafe {
-        assert_eq!((f.get_fmu_state)(i.c, &mut state), OK);
+        assert_eq!((f.get_fmu_state.unwrap())(i.c, &mut state), OK);
         let mut size = 0;
-        assert_eq!((f.serialized_fmu_state_size)(i.c, state, &mut size), OK);
+        assert_eq!((f.serialized_fmu_state_size.unwrap())(i.c, state, &mut size), OK);
         let mut b = vec![0u8; size];
-        assert_eq!((f.serialize_fmu_state)(i.c, state, b.as_mut_ptr() as *mut c_char, size), OK);
+        assert_eq!((f.serialize_fmu_state.unwrap())(i.c, state, b.as_mut_ptr() as *mut c_char, size), OK);
         b
     };
     let names = saved_names();
@@ -173,7 +173,10 @@ fn hostile_serialized_states_are_refused_like_the_setters_would() {
     // the unpatched bytes are accepted
     let mut ok_state = null_mut();
     unsafe {
-        assert_eq!((f.deserialize_fmu_state)(i.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut ok_state), OK);
+        assert_eq!(
+            (f.deserialize_fmu_state.unwrap())(i.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut ok_state),
+            OK
+        );
     }
     let cases = [
         ("mu_rl", -0.5, "mu_rl"),
@@ -189,7 +192,8 @@ fn hostile_serialized_states_are_refused_like_the_setters_would() {
     for (name, x, expect) in cases {
         let bad = patched(name, x);
         let mut s = null_mut();
-        let status = unsafe { (f.deserialize_fmu_state)(i.c, bad.as_ptr() as *const c_char, bad.len(), &mut s) };
+        let status =
+            unsafe { (f.deserialize_fmu_state.unwrap())(i.c, bad.as_ptr() as *const c_char, bad.len(), &mut s) };
         assert_eq!(status, ERROR, "{name} = {x} accepted");
         assert!(s.is_null());
         let msg = log.last_error().unwrap();
@@ -211,11 +215,11 @@ fn directional_derivatives_never_hand_out_non_finite_numbers() {
     let (unknown, known) = (fmu().vr("der(v_y)"), fmu().vr("v_y"));
     let mut out = [0.0];
     // a finite seed gives the finite slope
-    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &known, 1, &1.0, out.as_mut_ptr()) };
+    let s = unsafe { (f.get_directional_derivative.unwrap())(i.c, &unknown, 1, &known, 1, &1.0, out.as_mut_ptr()) };
     assert_eq!(s, OK);
     assert!(out[0] < -10.0 && out[0].is_finite(), "{}", out[0]);
     // a huge one overflows: refused, not handed out with fmi2OK
-    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &known, 1, &1e308, out.as_mut_ptr()) };
+    let s = unsafe { (f.get_directional_derivative.unwrap())(i.c, &unknown, 1, &known, 1, &1e308, out.as_mut_ptr()) };
     assert_eq!(s, ERROR, "a huge seed overflows: {}", out[0]);
     let msg = log.last_error().unwrap();
     assert!(msg.contains("fmi2GetDirectionalDerivative") && msg.contains("der(v_y)"), "{msg}");
@@ -312,16 +316,16 @@ fn initial_state_comes_from_the_start_parameters() {
     // a saved FMU state restores the states, not the start values
     let f = i.f();
     let mut saved: *mut c_void = null_mut();
-    unsafe { assert_eq!((f.get_fmu_state)(i.c, &mut saved), OK) };
+    unsafe { assert_eq!((f.get_fmu_state.unwrap())(i.c, &mut saved), OK) };
     assert_eq!(i.do_step(0.1, 1e-3), OK);
-    unsafe { assert_eq!((f.set_fmu_state)(i.c, saved), OK) };
+    unsafe { assert_eq!((f.set_fmu_state.unwrap())(i.c, saved), OK) };
     assert_eq!(i.get_real(&vrs(&BODY)).unwrap(), body);
     let bytes = unsafe {
         let mut size = 0;
-        assert_eq!((f.serialized_fmu_state_size)(i.c, saved, &mut size), OK);
+        assert_eq!((f.serialized_fmu_state_size.unwrap())(i.c, saved, &mut size), OK);
         let mut b = vec![0u8; size];
-        assert_eq!((f.serialize_fmu_state)(i.c, saved, b.as_mut_ptr() as *mut c_char, size), OK);
-        assert_eq!((f.free_fmu_state)(i.c, &mut saved), OK);
+        assert_eq!((f.serialize_fmu_state.unwrap())(i.c, saved, b.as_mut_ptr() as *mut c_char, size), OK);
+        assert_eq!((f.free_fmu_state.unwrap())(i.c, &mut saved), OK);
         b
     };
     let (j, log) = fmu().instantiate("restored", CO_SIMULATION, fmu().guid());
@@ -329,9 +333,12 @@ fn initial_state_comes_from_the_start_parameters() {
     j.initialize();
     let mut restored: *mut c_void = null_mut();
     unsafe {
-        assert_eq!((f.deserialize_fmu_state)(j.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut restored), OK);
-        assert_eq!((f.set_fmu_state)(j.c, restored), OK);
-        assert_eq!((f.free_fmu_state)(j.c, &mut restored), OK);
+        assert_eq!(
+            (f.deserialize_fmu_state.unwrap())(j.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut restored),
+            OK
+        );
+        assert_eq!((f.set_fmu_state.unwrap())(j.c, restored), OK);
+        assert_eq!((f.free_fmu_state.unwrap())(j.c, &mut restored), OK);
     }
     assert_eq!(j.get_real(&vrs(&BODY)).unwrap(), body, "restored into a fresh instance");
     assert_eq!(j.get_real(&vrs(&starts)).unwrap(), values);
@@ -393,7 +400,15 @@ fn initialization_mode_directional_derivatives_with_respect_to_the_start_values(
         let known = fmu().vr(start);
         let mut exact = vec![0.0; unknowns.len()];
         let s = unsafe {
-            (f.get_directional_derivative)(i.c, unknowns.as_ptr(), unknowns.len(), &known, 1, &1.0, exact.as_mut_ptr())
+            (f.get_directional_derivative.unwrap())(
+                i.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                &known,
+                1,
+                &1.0,
+                exact.as_mut_ptr(),
+            )
         };
         assert_eq!(s, OK, "{start}: {:?}", log.last_error());
         // central differences, h = 1e-6: truncation O(h^2 f''') ~ 1e-10 relative on these
@@ -418,7 +433,7 @@ fn initialization_mode_directional_derivatives_with_respect_to_the_start_values(
     }
     let (unknown, param) = (fmu().vr("der(v_y)"), fmu().vr("l_f"));
     let mut out = [0.0];
-    let s = unsafe { (f.get_directional_derivative)(i.c, &unknown, 1, &param, 1, &1.0, out.as_mut_ptr()) };
+    let s = unsafe { (f.get_directional_derivative.unwrap())(i.c, &unknown, 1, &param, 1, &1.0, out.as_mut_ptr()) };
     assert_eq!(s, ERROR);
     let msg = log.last_error().unwrap();
     assert!(msg.contains("fmi2GetDirectionalDerivative") && msg.contains("l_f"), "{msg}");

@@ -132,7 +132,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
             let status = unsafe {
                 match function {
                     Function::GetTypesPlatform => {
-                        assert!(!(f.get_types_platform)().is_null());
+                        assert!(!(f.get_types_platform.unwrap())().is_null());
                         continue;
                     }
                     Function::GetVersion => {
@@ -141,7 +141,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     }
                     Function::SetDebugLogging => {
                         let cats = [c"logEvents".as_ptr(), c"noSuchCategory".as_ptr()];
-                        (f.set_debug_logging)(c, 0, rng.below(3), cats.as_ptr())
+                        (f.set_debug_logging.unwrap())(c, 0, rng.below(3), cats.as_ptr())
                     }
                     Function::SetupExperiment => {
                         let start = rng.pick(&[0.0, 0.0, 1.0, f64::NAN, -5.0]);
@@ -162,7 +162,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     Function::EnterInitializationMode => (f.enter_initialization_mode)(c),
                     Function::ExitInitializationMode => (f.exit_initialization_mode)(c),
                     Function::Terminate => (f.terminate)(c),
-                    Function::Reset => (f.reset)(c),
+                    Function::Reset => (f.reset.unwrap())(c),
                     Function::GetReal => {
                         let v = vrs(&mut rng, &p.real);
                         check_reals = Some(n);
@@ -206,7 +206,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     Function::GetFMUstate => {
                         let mut s = if rng.chance(20) && !sh.states.is_empty() { sh.states[0].0 } else { null_mut() };
                         let before = s;
-                        let status = (f.get_fmu_state)(c, &mut s);
+                        let status = (f.get_fmu_state.unwrap())(c, &mut s);
                         if status == OK {
                             if before.is_null() {
                                 sh.states.push((s, sh.machine));
@@ -218,7 +218,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     }
                     Function::SetFMUstate => {
                         let s = state_arg(&mut rng, &sh);
-                        let status = (f.set_fmu_state)(c, s);
+                        let status = (f.set_fmu_state.unwrap())(c, s);
                         if status == OK {
                             restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
                         }
@@ -227,7 +227,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     Function::FreeFMUstate => {
                         let mut s = state_arg(&mut rng, &sh);
                         let before = s;
-                        let status = (f.free_fmu_state)(c, &mut s);
+                        let status = (f.free_fmu_state.unwrap())(c, &mut s);
                         if status == OK && !before.is_null() {
                             assert!(s.is_null());
                             sh.states.retain(|e| e.0 != before);
@@ -237,15 +237,15 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     }
                     Function::SerializedFMUstateSize => {
                         let mut size = 0usize;
-                        (f.serialized_fmu_state_size)(c, state_arg(&mut rng, &sh), &mut size)
+                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
                     }
                     Function::SerializeFMUstate => {
                         let s = state_arg(&mut rng, &sh);
                         let mut size = 0usize;
-                        let _ = (f.serialized_fmu_state_size)(c, s, &mut size);
+                        let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
                         let size = if rng.chance(10) { size / 2 } else { size };
                         let mut buf = vec![0u8; size.min(1 << 20)];
-                        let status = (f.serialize_fmu_state)(c, s, buf.as_mut_ptr() as *mut c_char, buf.len());
+                        let status = (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr() as *mut c_char, buf.len());
                         if status == OK {
                             sh.bytes = buf;
                         }
@@ -261,7 +261,8 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                             bytes = (0..rng.below(200)).map(|_| rng.next() as u8).collect();
                         }
                         let mut s = null_mut();
-                        let status = (f.deserialize_fmu_state)(c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s);
+                        let status =
+                            (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s);
                         if status == OK {
                             sh.states.push((s, None));
                         }
@@ -272,7 +273,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         let known = vrs(&mut rng, &p.real);
                         let seeds: Vec<f64> = (0..n).map(|_| rng.pick(&HOSTILE)).collect();
                         check_reals = Some(n);
-                        (f.get_directional_derivative)(
+                        (f.get_directional_derivative.unwrap())(
                             c,
                             ptr(&unknown),
                             n,
@@ -286,61 +287,61 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         let v = vrs(&mut rng, &p.real);
                         let order = [1 as c_int; 4];
                         let x = [1.0; 4];
-                        (f.set_real_input_derivatives)(c, ptr(&v), n, order.as_ptr(), x.as_ptr())
+                        (f.set_real_input_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), x.as_ptr())
                     }
                     Function::GetRealOutputDerivatives => {
                         let v = vrs(&mut rng, &p.real);
                         let order = [1 as c_int; 4];
                         let mut x = [0.0; 4];
-                        (f.get_real_output_derivatives)(c, ptr(&v), n, order.as_ptr(), x.as_mut_ptr())
+                        (f.get_real_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), x.as_mut_ptr())
                     }
                     Function::DoStep => {
                         let t = time_arg(&mut rng, sh.time);
                         let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
-                        let s = (f.do_step)(c, t, h, 1);
+                        let s = (f.do_step.unwrap())(c, t, h, 1);
                         if s == OK || s == 1 {
                             new_time = Some(t + h);
                         }
                         s
                     }
-                    Function::CancelStep => (f.cancel_step)(c),
+                    Function::CancelStep => (f.cancel_step.unwrap())(c),
                     Function::GetStatus => {
                         let mut v = 0;
-                        (f.get_status)(c, rng.below(5) as c_int, &mut v)
+                        (f.get_status.unwrap())(c, rng.below(5) as c_int, &mut v)
                     }
                     Function::GetRealStatus => {
                         check_reals = Some(1);
-                        (f.get_real_status)(c, rng.below(5) as c_int, reals_out.as_mut_ptr())
+                        (f.get_real_status.unwrap())(c, rng.below(5) as c_int, reals_out.as_mut_ptr())
                     }
                     Function::GetIntegerStatus => {
                         let mut v = 0;
-                        (f.get_integer_status)(c, rng.below(5) as c_int, &mut v)
+                        (f.get_integer_status.unwrap())(c, rng.below(5) as c_int, &mut v)
                     }
                     Function::GetBooleanStatus => {
                         let mut v = 0;
-                        (f.get_boolean_status)(c, rng.below(5) as c_int, &mut v)
+                        (f.get_boolean_status.unwrap())(c, rng.below(5) as c_int, &mut v)
                     }
                     Function::GetStringStatus => {
                         let mut v = null();
-                        (f.get_string_status)(c, rng.below(5) as c_int, &mut v)
+                        (f.get_string_status.unwrap())(c, rng.below(5) as c_int, &mut v)
                     }
-                    Function::EnterEventMode => (f.enter_event_mode)(c),
+                    Function::EnterEventMode => (f.enter_event_mode.unwrap())(c),
                     Function::NewDiscreteStates => {
                         let mut info = EventInfo::default();
-                        let s = (f.new_discrete_states)(c, &mut info);
+                        let s = (f.new_discrete_states.unwrap())(c, &mut info);
                         if s == OK && info.next_event_time_defined != 0 {
                             assert!(info.next_event_time.is_finite());
                         }
                         s
                     }
-                    Function::EnterContinuousTimeMode => (f.enter_continuous_time_mode)(c),
+                    Function::EnterContinuousTimeMode => (f.enter_continuous_time_mode.unwrap())(c),
                     Function::CompletedIntegratorStep => {
                         let (mut a, mut b) = (0, 0);
-                        (f.completed_integrator_step)(c, 1, &mut a, &mut b)
+                        (f.completed_integrator_step.unwrap())(c, 1, &mut a, &mut b)
                     }
                     Function::SetTime => {
                         let t = time_arg(&mut rng, sh.time + 1e-3);
-                        let s = (f.set_time)(c, t);
+                        let s = (f.set_time.unwrap())(c, t);
                         if s == OK || s == 1 {
                             new_time = Some(t);
                         }
@@ -349,7 +350,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     Function::SetContinuousStates => {
                         let nx = if rng.chance(80) { p.nx } else { n };
                         let x: Vec<f64> = (0..nx).map(|_| rng.pick(&HOSTILE)).collect();
-                        (f.set_continuous_states)(c, if null_array { null() } else { x.as_ptr() }, nx)
+                        (f.set_continuous_states.unwrap())(c, if null_array { null() } else { x.as_ptr() }, nx)
                     }
                     Function::GetDerivatives
                     | Function::GetContinuousStates
@@ -359,12 +360,12 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         let out = if null_array { null_mut() } else { reals_out.as_mut_ptr() };
                         check_reals = Some(nx);
                         match function {
-                            Function::GetDerivatives => (f.get_derivatives)(c, out, nx),
-                            Function::GetContinuousStates => (f.get_continuous_states)(c, out, nx),
+                            Function::GetDerivatives => (f.get_derivatives.unwrap())(c, out, nx),
+                            Function::GetContinuousStates => (f.get_continuous_states.unwrap())(c, out, nx),
                             Function::GetNominalsOfContinuousStates => {
-                                (f.get_nominals_of_continuous_states)(c, out, nx)
+                                (f.get_nominals_of_continuous_states.unwrap())(c, out, nx)
                             }
-                            _ => (f.get_event_indicators)(c, out, nx),
+                            _ => (f.get_event_indicators.unwrap())(c, out, nx),
                         }
                     }
                     Function::Instantiate | Function::FreeInstance => unreachable!(),

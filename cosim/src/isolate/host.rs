@@ -5,7 +5,7 @@
 //! the host's end.
 
 use super::{publish, wait_for, Header, Layout, Op, SpinGauge};
-use crate::fmu::{callbacks_for, load_library, EventInfo, Functions, LogSink};
+use crate::fmu::{callbacks_for, load_functions, load_library, EventInfo, Functions, LogSink};
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
@@ -53,7 +53,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     let log = Box::<LogSink>::default();
     let library = Path::new(library);
     let loaded = load_library(library, library, &library.display().to_string())
-        .and_then(|lib| unsafe { Functions::load(&lib, library) }.map(|f| (lib, f)));
+        .and_then(|lib| unsafe { load_functions(&lib, library) }.map(|f| (lib, f)));
     let mut seen = 0u32;
     let mut gauge = SpinGauge::new();
     let (_lib, functions) = match loaded {

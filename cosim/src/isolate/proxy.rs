@@ -398,6 +398,19 @@ pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Functions {
         get_event_indicators: present("fmi2GetEventIndicators").then_some(get_event_indicators as _),
         get_continuous_states: present("fmi2GetContinuousStates").then_some(get_continuous_states as _),
         get_nominals_of_continuous_states: present("fmi2GetNominalsOfContinuousStates").then_some(get_nominals as _),
+        // not offered through a host process
+        get_types_platform: None,
+        set_debug_logging: None,
+        serialized_fmu_state_size: None,
+        serialize_fmu_state: None,
+        deserialize_fmu_state: None,
+        get_directional_derivative: None,
+        set_real_input_derivatives: None,
+        get_real_output_derivatives: None,
+        cancel_step: None,
+        get_status: None,
+        get_integer_status: None,
+        get_string_status: None,
     }
 }
 

@@ -1,60 +1,60 @@
-//! A tiny importer over the layer's C entry points (`fmi2_export::abi`, what the shared
-//! library exports), for the tests of the controller and test-bench FMUs. It records the
-//! log so that tests can check the messages.
-#![allow(dead_code)]
+//! A tiny in-process importer over the layer's C entry points (`fmi2_export::abi`, what
+//! `export_fmi2!` exports from the shared library), for the tests of the layer and of the
+//! FMU crates: it instantiates a model type directly, without building or loading a
+//! library, and records the log (through the logger shim of `fmi2-sys`, as a real importer
+//! receives it) so that tests can check the messages. Behind the feature `testing`, which
+//! the FMU crates enable from their dev-dependencies.
+#![allow(clippy::missing_safety_doc, clippy::new_without_default)]
 
 use std::cell::RefCell;
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ffi::{c_int, CString};
 use std::ptr::null_mut;
 
-use fmi2_export::abi::{self, Fmi2EventInfo};
-use fmi2_export::ffi::*;
-use fmi2_export::Model;
+use crate::abi::{self, Fmi2EventInfo};
+use crate::ffi::*;
+use crate::Model;
+use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
 
-#[derive(Default)]
+/// The log of one instance: (status, category, message), in the order logged.
+#[derive(Debug, Default)]
 pub struct Log(pub RefCell<Vec<(c_int, String, String)>>);
 
-/// The importer's logger. FMI's is C-variadic; the layer always passes ("%s", message),
-/// and on x86-64 System V a fixed-argument callee reads those from the same registers.
-unsafe extern "C" fn record(
-    env: *mut c_void,
-    _name: *const c_char,
-    status: c_int,
-    category: *const c_char,
-    _format: *const c_char,
-    message: *const c_char,
-) {
-    let log = &*(env as *const Log);
-    let text = |p: *const c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
-    log.0.borrow_mut().push((status, text(category), text(message)));
+impl LogReceiver for Log {
+    fn receive(&self, m: &LogMessage<'_>) {
+        self.0.borrow_mut().push((m.status, m.category.to_owned(), m.message.to_owned()));
+    }
+}
+
+impl Log {
+    /// A boxed log to instantiate with ([`LogEnvironment::callbacks`] gives the callbacks).
+    pub fn environment() -> Box<LogEnvironment<Log>> {
+        Box::default()
+    }
 }
 
 pub const OK: Fmi2Status = Fmi2Status::Ok;
 pub const ERR: Fmi2Status = Fmi2Status::Error;
 pub const DISCARD: Fmi2Status = Fmi2Status::Discard;
 
+/// One instance of `M`, freed on drop.
 pub struct Fmu<M: Model> {
     pub c: fmi2Component,
-    pub log: Box<Log>,
+    pub log: Box<LogEnvironment<Log>>,
+    _callbacks: Box<Fmi2CallbackFunctions>,
     _m: std::marker::PhantomData<M>,
 }
 
 impl<M: Model> Fmu<M> {
-    fn new(kind: c_int) -> Self {
-        let log = Box::<Log>::default();
-        let callbacks = Fmi2CallbackFunctions {
-            // SAFETY: see `record`.
-            logger: Some(unsafe { std::mem::transmute::<usize, Fmi2CallbackLogger>(record as *const () as usize) }),
-            allocate_memory: None,
-            free_memory: None,
-            step_finished: None,
-            component_environment: &*log as *const Log as *mut c_void,
-        };
+    /// Instantiates `M` as `kind` (`Fmi2Type` as an int) with logging on; panics with the
+    /// log if the layer refuses.
+    pub fn new(kind: c_int) -> Self {
+        let log = Log::environment();
+        let callbacks = Box::new(log.callbacks());
         let name = CString::new("test").unwrap();
         let guid = CString::new(M::declaration().guid()).unwrap();
-        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &callbacks, 0, 1) };
+        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &*callbacks, 0, 1) };
         assert!(!c.is_null(), "{:?}", log.0.borrow());
-        Fmu { c, log, _m: std::marker::PhantomData }
+        Fmu { c, log, _callbacks: callbacks, _m: std::marker::PhantomData }
     }
     pub fn cs() -> Self {
         Self::new(1)
@@ -73,6 +73,12 @@ impl<M: Model> Fmu<M> {
     pub fn setup(&self) -> Fmi2Status {
         unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, 0, 0.0) }
     }
+    /// setup at `start` with an optional stop time, enter and exit initialization, all Ok.
+    pub fn init_until(&self, start: f64, stop: Option<f64>) {
+        assert_eq!(self.setup_at(start, stop), OK, "{}", self.last_error());
+        assert_eq!(self.enter_init(), OK, "{}", self.last_error());
+        assert_eq!(self.exit_init(), OK, "{}", self.last_error());
+    }
     /// `fmi2SetupExperiment` with a start time and an optional stop time.
     pub fn setup_at(&self, start: f64, stop: Option<f64>) -> Fmi2Status {
         unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, start, stop.is_some() as i32, stop.unwrap_or(0.0)) }
@@ -86,13 +92,23 @@ impl<M: Model> Fmu<M> {
     /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
     pub fn last_successful_time(&self) -> f64 {
         let mut t = f64::NAN;
-        assert_eq!(unsafe { abi::get_real_status::<M>(self.c, 2, &mut t) }, OK, "{}", self.last_error());
+        assert_eq!(
+            unsafe { abi::get_real_status::<M>(self.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t) },
+            OK,
+            "{}",
+            self.last_error()
+        );
         t
     }
     /// `fmi2GetBooleanStatus(fmi2Terminated)`.
     pub fn terminated(&self) -> bool {
         let mut b = -1;
-        assert_eq!(unsafe { abi::get_boolean_status::<M>(self.c, 3, &mut b) }, OK, "{}", self.last_error());
+        assert_eq!(
+            unsafe { abi::get_boolean_status::<M>(self.c, FMI2_TERMINATED, &mut b) },
+            OK,
+            "{}",
+            self.last_error()
+        );
         b == 1
     }
     pub fn enter_init(&self) -> Fmi2Status {
@@ -154,14 +170,7 @@ impl<M: Model> Fmu<M> {
     }
     /// One event iteration: the next event time if defined, and terminateSimulation.
     pub fn event_iteration(&self) -> (Option<f64>, bool) {
-        let mut info = Fmi2EventInfo {
-            new_discrete_states_needed: 0,
-            terminate_simulation: 0,
-            nominals_of_continuous_states_changed: 0,
-            values_of_continuous_states_changed: 0,
-            next_event_time_defined: 0,
-            next_event_time: 0.0,
-        };
+        let mut info = Fmi2EventInfo::default();
         let s = unsafe { abi::new_discrete_states::<M>(self.c, &mut info) };
         assert_eq!(s, OK, "{}", self.last_error());
         assert_eq!(info.new_discrete_states_needed, 0);

@@ -1,5 +1,7 @@
 /* The FMI 2.0 logger callback is C-variadic (printf style); stable Rust cannot define one.
- * This shim formats the message (truncated to 4 KiB) and hands it to the master in Rust.
+ * This shim formats the message (truncated to 4 KiB) and hands it to the importer in Rust:
+ * the component environment points to a `LogEnvironment` (src/logger.rs), whose first
+ * field is the Rust function that receives the formatted message.
  *
  * An FMU's format string is not trusted. C cannot tell how many arguments a variadic call
  * passed, so the format is formatted one conversion at a time, by this shim:
@@ -7,11 +9,11 @@
  *    positional `%1$` arguments is not formatted at all: the message says so and shows
  *    the format text;
  *  - a %s argument is read only if it points into readable memory (checked with
- *    process_vm_readv, which fails instead of faulting) outside the master's own program
+ *    process_vm_readv, which fails instead of faulting) outside the importer's own program
  *    image (its code, constants and static data); otherwise the message shows
- *    "<unreadable string>" or "<string in the master's memory>" in its place. So a %s
+ *    "<unreadable string>" or "<string in the importer's memory>" in its place. So a %s
  *    without an argument (whatever pointer the register or stack slot holds) never crashes
- *    the master and never shows its program's data;
+ *    the importer and never shows its program's data;
  *  - wide strings and characters (%ls, %lc) are not formatted either.
  * Numbers of missing arguments still print whatever the register or stack slot holds: a
  * number, not memory behind it. */
@@ -24,10 +26,11 @@
 #include <sys/uio.h>
 #include <unistd.h>
 
-extern void nigel_cosim_record_log(void *env, const char *instance_name, int status, const char *category,
-                                   const char *message);
+/* The first field of the object the component environment points to. */
+typedef void (*fmi2_sys_receive)(void *env, const char *instance_name, int status, const char *category,
+                                 const char *message);
 
-void nigel_cosim_logger(void *env, const char *instance_name, int status, const char *category,
+void fmi2_sys_logger(void *env, const char *instance_name, int status, const char *category,
                         const char *format, ...);
 
 #define BUFFER 4096
@@ -59,11 +62,11 @@ static long safe_copy_string(const char *p, char *out, size_t cap) {
     return (long)(n < cap ? n : cap);
 }
 
-/* Whether `p` lies in the master's program image (the executable this shim is linked
+/* Whether `p` lies in the importer's program image (the executable this shim is linked
  * into: its code, constants and static data). */
-static int in_master_image(const void *p) {
+static int in_importer_image(const void *p) {
     Dl_info mine, theirs;
-    if (!dladdr((void *)&nigel_cosim_logger, &mine)) return 0;
+    if (!dladdr((void *)&fmi2_sys_logger, &mine)) return 0;
     if (!dladdr(p, &theirs)) return 0;
     return theirs.dli_fbase == mine.dli_fbase;
 }
@@ -164,8 +167,8 @@ static void format_message(char *buf, const char *format, va_list args) {
             char text[BUFFER];
             if (!s) {
                 snprintf(text, sizeof text, "(null)");
-            } else if (in_master_image(s)) {
-                snprintf(text, sizeof text, "<string in the master's memory>");
+            } else if (in_importer_image(s)) {
+                snprintf(text, sizeof text, "<string in the importer's memory>");
             } else if (safe_copy_string(s, text, BUFFER - 1) < 0) {
                 snprintf(text, sizeof text, "<unreadable string>");
             }
@@ -180,7 +183,7 @@ static void format_message(char *buf, const char *format, va_list args) {
     }
 }
 
-void nigel_cosim_logger(void *env, const char *instance_name, int status, const char *category,
+void fmi2_sys_logger(void *env, const char *instance_name, int status, const char *category,
                         const char *format, ...) {
     /* the format, the category and the name are the FMU's pointers too: copied safely */
     char buffer[BUFFER], format_copy[BUFFER], category_copy[256], name_copy[256];
@@ -197,5 +200,8 @@ void nigel_cosim_logger(void *env, const char *instance_name, int status, const 
             va_end(args);
         }
     }
-    nigel_cosim_record_log(env, name_copy, status, category_copy, buffer);
+    if (env) {
+        fmi2_sys_receive receive = *(fmi2_sys_receive *)env;
+        if (receive) receive(env, name_copy, status, category_copy, buffer);
+    }
 }
