@@ -139,12 +139,16 @@ fn resume_after_a_killed_run_completes_it() {
     let local = dir.path().join("local");
     run(&spec, &quiet(&local)).unwrap();
     let out = dir.path().join("killed");
+    // SIGKILL cannot be caught: the unpacked FMUs stay in the child's TMPDIR, the test's own
+    let tmp = dir.path().join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
     let mut child = Command::new(CAMPAIGN)
         .arg("run")
         .arg(&spec_path)
         .arg("--out")
         .arg(&out)
         .args(["--threads", "1"])
+        .env("TMPDIR", &tmp)
         .spawn()
         .unwrap();
     let rows = out.join("results.csv");
@@ -406,4 +410,43 @@ fn only_prints_one_run_by_name_and_writes_its_every_output() {
     let (header, rows) = read_cosim_csv(&out.join("run-3.csv"));
     assert_eq!(header[0], "time");
     assert_eq!(rows.len(), 1001, "1 s at 1 ms, both ends");
+}
+
+#[test]
+fn sigterm_removes_the_unpacked_fmus_and_keeps_the_rows_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec_path = small(dir.path(), 30.0, 10);
+    let out = dir.path().join("stopped");
+    let tmp = dir.path().join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let child = Command::new(CAMPAIGN)
+        .arg("run")
+        .arg(&spec_path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--threads", "1"])
+        .env("TMPDIR", &tmp)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let rows = out.join("results.csv");
+    let count = || std::fs::read_to_string(&rows).map_or(0, |t| t.lines().count().saturating_sub(1));
+    while count() < 2 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(std::fs::read_dir(&tmp).unwrap().count() > 0, "the FMUs are unpacked while the campaign runs");
+    let kill = Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    // 128 + 15, as a shell reports a process ended by SIGTERM
+    assert_eq!(o.status.code(), Some(143), "{stderr}");
+    assert!(stderr.contains("campaign: stopped by SIGTERM; temporary folders removed"), "{stderr}");
+    assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0, "TMPDIR left with unpacked FMUs");
+    // the rows written before the signal are complete lines, and --resume completes the rest
+    let kept = count();
+    assert!(kept >= 2, "{kept}");
+    let spec = Spec::load(&spec_path).unwrap();
+    let done = run(&spec, &Options { resume: true, ..quiet(&out) }).unwrap();
+    assert_eq!(done.kept + done.ran, 40);
 }

@@ -18,6 +18,9 @@
 //!    call (the master's buffers, `nigel_cosim::Instance`, the C ABI, the layer's checks
 //!    and the model's getter/setter); and the master's own cost per step: `ordered`
 //!    recording nothing minus the bare loop of the three `fmi2DoStep`s.
+//! 6. Isolation: the closed loop in process against `--isolate`, alternated (alone with
+//!    `COSIM_BENCH_ONLY=isolation`; `COSIM_BENCH_SPINS` adds fixed ways of waiting); and
+//!    with `COSIM_BENCH_ONLY=round-trips` the floor, null round trips master <-> host.
 //!
 //! `COSIM_BENCH_ONLY=isolation` runs the isolation cost alone, `COSIM_BENCH_ONLY=per_value`
 //! section 5 alone.
@@ -156,49 +159,120 @@ fn run_master(
 }
 
 /// The closed loop in process and with every FMU in its own host process (`--isolate`),
-/// `jacobi` and `ordered` recording nothing, the two alternated 5 times (best and spread
-/// of each); the isolation cost per FMU per step is the difference over 3 FMUs x 30,000
-/// steps.
+/// `jacobi` and `ordered` recording nothing, alternated 5 times (best and spread of each);
+/// the isolation cost per FMU per step is the difference over 3 FMUs x 30,000 steps.
+/// `COSIM_BENCH_SPINS` (`;`-separated `NIGEL_COSIM_SPIN` values, an empty one the
+/// default) runs the isolated side once per way of waiting, all alternated.
 fn isolation(system: &System) {
     let host = target().join("release").join("cosim-host");
     if !host.is_file() {
         println!("isolation: {} missing (cargo build --release -p nigel-cosim)", host.display());
         return;
     }
+    let spins: Vec<String> = std::env::var("COSIM_BENCH_SPINS")
+        .map(|v| v.split(';').map(|s| s.trim().to_string()).collect())
+        .unwrap_or_else(|_| vec![String::new()]);
+    let set_spin = |spin: &str| {
+        if spin.is_empty() {
+            std::env::remove_var("NIGEL_COSIM_SPIN");
+        } else {
+            std::env::set_var("NIGEL_COSIM_SPIN", spin);
+        }
+    };
     for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
-        let mut times = [Vec::new(), Vec::new()];
+        let mut times = vec![Vec::new(); 1 + spins.len()];
         for _ in 0..5 {
-            for (k, isolate) in [false, true].into_iter().enumerate() {
+            for (k, times) in times.iter_mut().enumerate() {
                 let mut e = Experiment::new(30.0, 1e-3);
                 e.algorithm = algorithm;
                 e.record = Some(vec![]);
-                if isolate {
+                if k > 0 {
+                    set_spin(&spins[k - 1]);
                     e.isolation = Some(nigel_cosim::Isolation { host: Some(host.clone()), ..Default::default() });
                 }
                 let t = Instant::now();
                 simulate(system, &e).unwrap();
-                times[k].push(t.elapsed());
+                times.push(t.elapsed());
             }
         }
+        set_spin("");
         let best = |v: &[Duration]| v.iter().min().copied().unwrap_or_default();
         let worst = |v: &[Duration]| v.iter().max().copied().unwrap_or_default();
-        let (a, b) = (best(&times[0]), best(&times[1]));
+        let a = best(&times[0]);
         let name = format!("{algorithm:?}").to_lowercase();
         line(
             &format!("master {name}, recording nothing, in process"),
             a,
             &format!("(5 runs alternated with --isolate: {:.1} .. {:.1} ms)", a.as_secs_f64() * 1e3, worst(&times[0]).as_secs_f64() * 1e3),
         );
-        line(
-            &format!("master {name}, recording nothing, --isolate"),
-            b,
-            &format!(
-                "({:.1} .. {:.1} ms; isolation cost {:.2} us per FMU per step)",
-                b.as_secs_f64() * 1e3,
-                worst(&times[1]).as_secs_f64() * 1e3,
-                (b.saturating_sub(a)).as_secs_f64() * 1e6 / (STEPS * system.instances.len() as f64)
-            ),
-        );
+        for (k, spin) in spins.iter().enumerate() {
+            let b = best(&times[k + 1]);
+            let policy = if spin.is_empty() { String::new() } else { format!(" (spin {spin})") };
+            line(
+                &format!("master {name}, recording nothing, --isolate{policy}"),
+                b,
+                &format!(
+                    "({:.1} .. {:.1} ms; isolation cost {:.2} us per FMU per step)",
+                    b.as_secs_f64() * 1e3,
+                    worst(&times[k + 1]).as_secs_f64() * 1e3,
+                    (b.saturating_sub(a)).as_secs_f64() * 1e6 / (STEPS * system.instances.len() as f64)
+                ),
+            );
+        }
+    }
+}
+
+/// The floor under an isolated step: null round trips (a call the host answers at once)
+/// master <-> host, 10,000 per host, with each way of waiting (`NIGEL_COSIM_SPIN`: master
+/// spin, host spin in us, yield every n spin rounds), to one host, and to three hosts in
+/// turn and overlapped (posted to all, then collected); the policies alternated 3 times,
+/// best and range, in us per round trip. Spinning only is measured with one host alone:
+/// three hosts and the master spinning on two cores wait for the scheduler's time slices
+/// (milliseconds per round trip).
+fn round_trips(system: &System, host: &Path) {
+    let dir = system.instances[0].fmu.unpacked_dir().join("binaries").join("linux64");
+    let Some(library) = std::fs::read_dir(&dir).ok().and_then(|mut d| d.find_map(|e| e.ok().map(|e| e.path()))) else {
+        println!("round trips: no library in {}", dir.display());
+        return;
+    };
+    let policies = [
+        ("spin only", "1000000,1000000,0"),
+        ("futex only", "0,0,0"),
+        ("default", ""),
+    ];
+    let cases = [(1usize, false), (3, false), (3, true)];
+    let n = 10_000u32;
+    let mut times = vec![vec![Vec::new(); cases.len()]; policies.len()];
+    for _ in 0..3 {
+        for (k, (_, policy)) in policies.iter().enumerate() {
+            if policy.is_empty() {
+                std::env::remove_var("NIGEL_COSIM_SPIN");
+            } else {
+                std::env::set_var("NIGEL_COSIM_SPIN", policy);
+            }
+            for (j, &(hosts, overlapped)) in cases.iter().enumerate() {
+                if policy.starts_with("1000000") && hosts > 1 {
+                    continue;
+                }
+                let d = nigel_cosim::isolate::null_round_trips(host, &library, hosts, n, overlapped).unwrap();
+                times[k][j].push(d.as_secs_f64() * 1e6 / f64::from(n) / hosts as f64);
+            }
+        }
+    }
+    std::env::remove_var("NIGEL_COSIM_SPIN");
+    for (k, (name, _)) in policies.iter().enumerate() {
+        for (j, &(hosts, overlapped)) in cases.iter().enumerate() {
+            let v = &times[k][j];
+            if v.is_empty() {
+                continue;
+            }
+            let best = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let worst = v.iter().copied().fold(0.0, f64::max);
+            println!(
+                "null round trip, {name:<10}, {hosts} host(s){:<12}: {best:7.2} us per host ({best:.2} .. {worst:.2})",
+                if overlapped { ", overlapped" } else { "" }
+            );
+        }
     }
 }
 
@@ -210,6 +284,10 @@ fn main() {
     }
     let closed = nigel_cosim::read_ssp(&ssp, &Default::default()).unwrap();
     let system = &closed.system;
+    if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "round-trips") {
+        round_trips(system, &target().join("release").join("cosim-host"));
+        return;
+    }
     if std::env::var_os("COSIM_BENCH_ONLY").is_some_and(|v| v == "isolation") {
         isolation(system);
         return;

@@ -85,6 +85,44 @@ pub fn check_shared_library(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// The names of the symbols `bytes` (a library [`check_shared_library`] accepted) defines
+/// and exports: global or weak, default or protected visibility, from its dynamic symbol
+/// table (`.dynsym`). `None` when the file has no section headers to find it by.
+pub fn exported_symbols(bytes: &[u8]) -> Option<std::collections::HashSet<String>> {
+    let len = bytes.len() as u64;
+    let (shoff, shentsize, shnum) = (u64_at(bytes, 40), u64::from(u16_at(bytes, 58)), u64::from(u16_at(bytes, 60)));
+    if shoff == 0 || shnum == 0 || shentsize < 64 || !within(shoff, shentsize * shnum, len) {
+        return None;
+    }
+    let section = |k: u64| {
+        let h = (shoff + k * shentsize) as usize;
+        // (type, link, offset, size, entry size)
+        (u32_at(bytes, h + 4), u32_at(bytes, h + 40), u64_at(bytes, h + 24), u64_at(bytes, h + 32), u64_at(bytes, h + 56))
+    };
+    let (_, link, offset, size, entsize) = (0..shnum).map(section).find(|s| s.0 == 11)?; // SHT_DYNSYM
+    if u64::from(link) >= shnum || entsize < 24 || !within(offset, size, len) {
+        return None;
+    }
+    let (_, _, str_offset, str_size, _) = section(u64::from(link));
+    if !within(str_offset, str_size, len) {
+        return None;
+    }
+    let strings = &bytes[str_offset as usize..(str_offset + str_size) as usize];
+    let mut out = std::collections::HashSet::new();
+    for k in 1..size / entsize {
+        let e = (offset + k * entsize) as usize;
+        let (name, info, other, shndx) = (u32_at(bytes, e) as usize, bytes[e + 4], bytes[e + 5], u16_at(bytes, e + 6));
+        let (bind, visibility) = (info >> 4, other & 3);
+        // defined (not SHN_UNDEF), STB_GLOBAL or STB_WEAK, STV_DEFAULT or STV_PROTECTED
+        if shndx == 0 || !(bind == 1 || bind == 2) || !(visibility == 0 || visibility == 3) || name >= strings.len() {
+            continue;
+        }
+        let end = strings[name..].iter().position(|b| *b == 0).map_or(strings.len(), |p| name + p);
+        out.insert(String::from_utf8_lossy(&strings[name..end]).into_owned());
+    }
+    Some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,5 +140,26 @@ mod tests {
             assert!(e.contains("past the end of the file"), "{cut}: {e}");
         }
         assert!(check_shared_library(b"not ELF").unwrap_err().contains("not an ELF file"));
+    }
+
+    #[test]
+    fn the_exported_symbols_are_those_the_loader_finds() {
+        // libc's own table, checked against dlsym on the same names
+        let Some(path) = ["/lib/x86_64-linux-gnu/libc.so.6", "/usr/lib/x86_64-linux-gnu/libc.so.6"]
+            .into_iter()
+            .find(|p| std::path::Path::new(p).is_file())
+        else {
+            return;
+        };
+        let bytes = std::fs::read(path).unwrap();
+        let symbols = exported_symbols(&bytes).unwrap();
+        assert!(symbols.len() > 1000, "{} symbols", symbols.len());
+        for name in ["malloc", "printf", "dlopen", "qsort"] {
+            assert!(symbols.contains(name), "{name}");
+            let c = std::ffi::CString::new(name).unwrap();
+            // SAFETY: dlsym on the already-loaded libc, a lookup only
+            assert!(!unsafe { libc::dlsym(libc::RTLD_DEFAULT, c.as_ptr()) }.is_null(), "{name}");
+        }
+        assert!(!symbols.contains("fmi2DoStep"));
     }
 }

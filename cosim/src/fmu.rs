@@ -154,6 +154,11 @@ pub struct ImportOptions {
     /// Pass on NaN and infinite Reals an FMU returns with fmi2OK (default: refused at
     /// the source, [`Error::NonFinite`] naming the FMU and the variable).
     pub allow_non_finite: bool,
+    /// Do not load the library into this process: its functions are known from its ELF
+    /// symbol table, and its instances can only run in host processes
+    /// ([`Instance::new_isolated`], `Experiment::isolation`), so that not even its
+    /// load-time initializers run here.
+    pub isolated: bool,
 }
 
 /// An imported FMU: its unpacked folder (removed on drop), model description and library.
@@ -161,7 +166,8 @@ pub struct ImportOptions {
 pub struct Fmu {
     pub(crate) functions: Functions,
     allow_non_finite: bool,
-    _library: Arc<libloading::Library>,
+    /// The library loaded in this process (`None`: imported isolated, never loaded here).
+    _library: Option<Arc<libloading::Library>>,
     description: ModelDescription,
     interface: Interface,
     source: PathBuf,
@@ -287,9 +293,25 @@ impl Fmu {
         }
         // errors name the library inside the archive, not the temporary copy
         let shown = path.join(&relative);
-        let library = load_library(&so, &shown, &relative)?;
-        // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
-        let functions = unsafe { load_functions(&library, &shown)? };
+        let (library, functions) = if options.isolated {
+            // read and checked only: nothing of the library runs in this process
+            let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
+            crate::elf::check_shared_library(&bytes)
+                .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
+            // without section headers every function is taken as present: a missing one
+            // is then the host's error when called
+            let exported = crate::elf::exported_symbols(&bytes);
+            let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
+            // the 15 core functions, which `Fmi2Functions::load` requires, lead SYMBOLS
+            if let Some(symbol) = fmi2_sys::SYMBOLS.iter().take(15).map(|(s, _)| *s).find(|s| !present(s)) {
+                return Err(Error::MissingSymbol { path: shown, symbol });
+            }
+            (None, crate::isolate::proxy::table(&present))
+        } else {
+            let library = load_library(&so, &shown, &relative)?;
+            // SAFETY: the symbols are declared with the C signatures of the FMI 2.0 headers.
+            (Some(library.clone()), unsafe { load_functions(&library, &shown)? })
+        };
         let needs = match interface {
             Interface::CoSimulation => CS_NEEDS,
             Interface::ModelExchange => ME_NEEDS,
@@ -317,11 +339,11 @@ impl Fmu {
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
-        if self.isolated_from.is_some() {
+        if self.is_isolated() {
             return self.clone();
         }
         Arc::new(Fmu {
-            functions: crate::isolate::proxy::table(&self.functions),
+            functions: crate::isolate::proxy::table(&|symbol| self.functions.has(symbol)),
             allow_non_finite: self.allow_non_finite,
             _library: self._library.clone(),
             description: self.description.clone(),
@@ -334,9 +356,10 @@ impl Fmu {
         })
     }
 
-    /// Whether instances of this FMU run in host processes.
+    /// Whether instances of this FMU run in host processes (an isolated view, or an FMU
+    /// imported with [`ImportOptions::isolated`]).
     pub fn is_isolated(&self) -> bool {
-        self.isolated_from.is_some()
+        self.isolated_from.is_some() || self._library.is_none()
     }
 
     /// The model description.
@@ -466,6 +489,12 @@ impl Instance {
     /// `fmi2Instantiate` with the FMU's interface, logging off (warnings and errors are
     /// still logged by the FMU and kept).
     pub fn new(fmu: &Arc<Fmu>, name: &str) -> Result<Instance> {
+        if fmu.is_isolated() {
+            return Err(Error::Instance {
+                name: name.into(),
+                reason: "its FMU was imported isolated (its library is not loaded in this process): instantiate it in a host process (Instance::new_isolated, Experiment::isolation)",
+            });
+        }
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
@@ -528,8 +557,14 @@ impl Instance {
                 variables,
                 isolation.call_timeout,
                 run_deadline,
+                crate::isolate::Spin::of_run(),
             )
-            .map_err(failed)?,
+            .map_err(|cause| Error::Host {
+                instance: name.into(),
+                function: "fmi2Instantiate (loading the library)",
+                time: 0.0,
+                cause,
+            })?,
         );
         let log = Box::<LogSink>::default();
         channel.log = &*log as *const LogSink;
@@ -784,6 +819,19 @@ impl Instance {
         call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))?;
         self.time = time + step;
         Ok(())
+    }
+
+    /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
+    /// that the hosts of several instances step at the same time; the next
+    /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
+    /// in process, and when the instance cannot step in its state (`do_step` then says why).
+    pub(crate) fn post_step(&mut self, time: f64, step: f64) -> bool {
+        let Some(host) = self.host.as_deref_mut() else { return false };
+        if self.state != InstanceState::Running || self.fmu.functions.do_step.is_none() {
+            return false;
+        }
+        crate::isolate::proxy::post_step(host, time, step);
+        true
     }
 
     /// `fmi2GetFMUstate`: saves the current state.

@@ -171,6 +171,12 @@ fn register(dir: &Path) {
 /// `main`, before any thread starts: it blocks those signals in the calling thread (and so
 /// in every thread and child started after) and waits for them in a thread of its own.
 pub fn remove_on_signals() {
+    // the message names the program that stops (cosim, campaign, table3, a user's own)
+    let program = std::env::args_os()
+        .next()
+        .map(std::path::PathBuf::from)
+        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "cosim".to_string());
     // SAFETY: plain libc calls on a local signal set.
     unsafe {
         let mut set: libc::sigset_t = std::mem::zeroed();
@@ -188,7 +194,7 @@ pub fn remove_on_signals() {
                 for dir in made {
                     let _ = std::fs::remove_dir_all(dir);
                 }
-                eprintln!("cosim: stopped by {}; temporary folders removed", crate::error::signal_name(signal));
+                eprintln!("{program}: stopped by {}; temporary folders removed", crate::error::signal_name(signal));
                 // host processes end with the master (PR_SET_PDEATHSIG)
                 libc::_exit(128 + signal);
             }

@@ -6,10 +6,10 @@
 //! y = t); the exit code is non-zero; TMPDIR (a fresh folder per run) is empty after.
 
 mod common;
-use common::{build_crash, plant_fmu, work_dir};
+use common::{build_crash, build_ctor_crash, plant_fmu, work_dir};
 use nigel_cosim::{
-    read_ssp, simulate, simulate::simulate_recorded, Algorithm, Error, Experiment, Fmu, HostEnd, Isolation,
-    SystemBuilder, Value,
+    read_ssp, simulate, simulate::simulate_recorded, Algorithm, Error, Experiment, Fmu, HostEnd, ImportOptions,
+    Instance, Isolation, SystemBuilder, Value,
 };
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -141,15 +141,117 @@ fn per_instance_isolation_in_the_library_gives_the_typed_error_and_the_rows() {
 fn the_isolated_closed_loop_is_bit_identical_to_in_process() {
     let ssp = plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
     let system = read_ssp(&ssp, &Default::default()).unwrap().system;
+    // every output recorded every step; and two recorded every 6th step, so that the
+    // Reals read after a step alternate between two patterns (the host's prefetch
+    // relearned or not, its batches answered out of turn must not be)
+    let few = Some(vec!["plant.y".to_string(), "controller.delta_fl".to_string()]);
     for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
-        let mut e = Experiment::new(0.3, 1e-3);
-        e.algorithm = algorithm;
-        let (local, _) = simulate(&system, &e).unwrap();
-        e.isolation = Some(isolation());
-        let (isolated, _) = simulate(&system, &e).unwrap();
-        assert_eq!(local.names, isolated.names);
-        assert_eq!(local.rows(), 301);
-        let same = local.values.iter().zip(&isolated.values).all(|(a, b)| a.to_bits() == b.to_bits());
-        assert!(same, "{algorithm:?}: isolated values differ from in-process");
+        for (record, interval, rows) in [(None, None, 301), (few.clone(), Some(6e-3), 51)] {
+            let mut e = Experiment::new(0.3, 1e-3);
+            e.algorithm = algorithm;
+            e.record = record;
+            e.output_interval = interval;
+            let (local, _) = simulate(&system, &e).unwrap();
+            e.isolation = Some(isolation());
+            let (isolated, _) = simulate(&system, &e).unwrap();
+            assert_eq!(local.names, isolated.names);
+            assert_eq!(local.rows(), rows);
+            let same = local.values.iter().zip(&isolated.values).all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "{algorithm:?}, {} columns: isolated values differ from in-process", local.width());
+        }
     }
+}
+
+/// A library that crashes while it is loaded (a load-time initializer writing through a
+/// null pointer, tests/cfmu/ctor.c). Under `--isolate` the master never loads it (the
+/// model description comes from the XML, the functions from the ELF symbol table): the
+/// host that loads it dies, and the run ends with the typed error naming the instance,
+/// `fmi2Instantiate (loading the library)` and SIGSEGV, exit code 1, TMPDIR empty. `cosim
+/// info` reads it without loading it. In process the master itself dies of the signal
+/// in `dlopen`, before any message: what `--isolate` is for.
+#[test]
+fn a_library_that_crashes_while_loading_kills_only_its_host() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = work_dir("isolation-ctor");
+    let fmu = build_ctor_crash(&dir);
+    let run = |tmp: &Path, args: &[&str]| {
+        Command::new(cosim())
+            .args(args)
+            .arg(fmu.to_str().unwrap())
+            .env("TMPDIR", tmp)
+            .env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host"))
+            .output()
+            .unwrap()
+    };
+    let left = |tmp: &Path| std::fs::read_dir(tmp).unwrap().count();
+
+    let tmp = fresh_tmp(&dir, "tmp-isolate");
+    let out = dir.join("ctor.csv");
+    let done = run(&tmp, &["run", "--isolate", "--output", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&done.stderr);
+    assert_eq!(done.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("model: the FMU's host process was killed by signal 11 (SIGSEGV) during fmi2Instantiate (loading the library) at t = 0 s"),
+        "{stderr}"
+    );
+    assert_eq!(left(&tmp), 0);
+
+    let tmp = fresh_tmp(&dir, "tmp-info");
+    let done = run(&tmp, &["info"]);
+    let stdout = String::from_utf8_lossy(&done.stdout);
+    assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    assert!(stdout.contains("model ctor (FMI 2.0)") && stdout.contains("t_crash"), "{stdout}");
+    assert_eq!(left(&tmp), 0);
+
+    let tmp = fresh_tmp(&dir, "tmp-in-process");
+    let done = run(&tmp, &["run"]);
+    assert_eq!(done.status.signal(), Some(libc::SIGSEGV), "in process: {:?}", done.status);
+    assert!(done.stderr.is_empty() && done.stdout.is_empty());
+    // the master died with its unpacked copy of the FMU in TMPDIR
+    assert_eq!(left(&tmp), 1);
+
+    // the library: imported isolated, it cannot be instantiated in process; in a host it
+    // gives the typed error
+    let imported = Fmu::load_with(&fmu, &ImportOptions { isolated: true, ..Default::default() }).unwrap();
+    assert!(imported.is_isolated());
+    match Instance::new(&imported, "ctor") {
+        Err(Error::Instance { name, reason }) => {
+            assert_eq!(name, "ctor");
+            assert!(reason.contains("imported isolated"), "{reason}");
+        }
+        other => panic!("in process: {other:?}"),
+    }
+    match Instance::new_isolated(&imported, "ctor", &isolation(), None) {
+        Err(Error::Host { instance, function, time, cause }) => {
+            assert_eq!((instance.as_str(), function, time), ("ctor", "fmi2Instantiate (loading the library)", 0.0));
+            assert_eq!(cause, HostEnd::Signal(11));
+        }
+        other => panic!("isolated: {other:?}"),
+    }
+}
+
+/// Imported isolated, the functions the master believes an FMU has come from the ELF
+/// symbol table of its library: those of our plant are those the library loaded in
+/// process has, and the isolated import runs the closed-loop's plant as the in-process
+/// one does.
+#[test]
+fn an_isolated_import_knows_the_library_from_its_symbol_table() {
+    let loaded = Fmu::load(&plant_fmu()).unwrap();
+    let isolated = Fmu::load_with(&plant_fmu(), &ImportOptions { isolated: true, ..Default::default() }).unwrap();
+    assert!(!loaded.is_isolated() && isolated.is_isolated());
+    assert_eq!(loaded.can_get_and_set_state(), isolated.can_get_and_set_state());
+    assert_eq!(loaded.can_handle_variable_step(), isolated.can_handle_variable_step());
+    let run = |fmu: std::sync::Arc<Fmu>, isolate: bool| {
+        let mut b = SystemBuilder::new();
+        b.add_instance("plant", fmu).unwrap();
+        let mut e = Experiment::new(0.05, 1e-3);
+        if isolate {
+            e.isolation = Some(isolation());
+        }
+        simulate(&b.build(), &e).unwrap().0
+    };
+    let (a, b) = (run(loaded, false), run(isolated, true));
+    assert_eq!(a.names, b.names);
+    assert_eq!(a.rows(), 51);
+    assert!(a.values.iter().zip(&b.values).all(|(x, y)| x.to_bits() == y.to_bits()));
 }

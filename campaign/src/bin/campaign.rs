@@ -246,6 +246,9 @@ fn main_inner() -> Result<(), Error> {
 }
 
 fn main() -> ExitCode {
+    // SIGINT, SIGTERM (Ctrl-C, scancel) and SIGHUP remove the unpacked FMUs from TMPDIR;
+    // the rows written so far stay, and `--resume` completes the campaign
+    nigel_cosim::unpack::remove_on_signals();
     match main_inner() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

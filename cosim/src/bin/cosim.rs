@@ -212,7 +212,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Some(p) => Some(OutputFormat::of(p)?),
     };
     let limits = args.limits.limits();
-    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite };
+    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated: args.isolate };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
         // --interface applies to every FMU of the system (one without it is refused by name)
         let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
@@ -437,7 +437,7 @@ fn is_ssp(path: &Path) -> bool {
 
 fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     use std::io::Write;
-    let ssp = nigel_cosim::read_ssp(path, &ImportOptions { limits: *limits, ..ImportOptions::default() })?;
+    let ssp = nigel_cosim::read_ssp(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
     let s = &ssp.system;
     let mut out = std::io::stdout().lock();
     let mut lines = vec![format!(
@@ -508,7 +508,7 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         };
     }
     let mut out = std::io::stdout().lock();
-    let fmu = Fmu::load_with(path, &ImportOptions { limits: *limits, ..ImportOptions::default() })?;
+    let fmu = Fmu::load_with(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
     let md = fmu.description();
     w!(out, "model {} (FMI {}), guid {}", md.model_name, md.fmi_version, md.guid);
     if let Some(d) = md.description.as_deref().filter(|d| !d.is_empty()) {

@@ -10,9 +10,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-/// Spin before sleeping while waiting for the host (the host of a 1 us `fmi2DoStep`
-/// answers within it; a longer call puts the master to sleep).
-const MASTER_SPIN: Duration = Duration::from_micros(50);
 /// How often a sleeping master checks the host and the time limits.
 const CHECK_SLICE: Duration = Duration::from_millis(10);
 /// fmi2Fatal: what the proxy returns for a call the host did not answer.
@@ -64,16 +61,25 @@ pub(crate) struct Channel {
     queued_bytes: usize,
     /// Where the queued sets came from, for the message of a failure.
     queued_functions: Vec<&'static str>,
-    /// The Reals the host reads after each step (their references), and whether the
-    /// values in the region are those of the last step.
-    prefetch_vrs: Vec<u32>,
+    /// The batches of Reals the host reads after each step (the references of each, and
+    /// where its record starts in the prefetch area), and whether the values in the
+    /// region are those of the last step.
+    prefetch_batches: Vec<(Vec<u32>, usize)>,
     prefetch_valid: bool,
-    /// The last call was a step: the next `fmi2GetReal` sets the prefetch.
-    after_step: bool,
+    /// The `fmi2GetReal` calls since the last step with nothing else between them (`None`:
+    /// another call came between).
+    gets_since_step: Option<usize>,
     /// Strings returned by `fmi2GetString`, valid until the next call.
     pub(crate) strings: Vec<std::ffi::CString>,
     /// The messages of the last call (also in the instance's log once it has one).
     last_records: Vec<LogRecord>,
+    /// The posted call waiting for its answer, and when it was posted.
+    pending: Option<(Op, Instant)>,
+    /// Whether the master's spins for this host have paid lately.
+    gauge: super::SpinGauge,
+    /// The arguments (time, step) of the posted `fmi2DoStep`.
+    pub(crate) posted_step: Option<(f64, f64)>,
+    spin: super::Spin,
 }
 
 // SAFETY: the region and the host are used only through `&mut self` (one caller at a
@@ -88,18 +94,19 @@ impl Channel {
         variables: usize,
         call_timeout: Option<Duration>,
         run_deadline: Option<(Instant, Duration)>,
-    ) -> Result<Channel, String> {
+        spin: super::Spin,
+    ) -> Result<Channel, HostEnd> {
         let layout = Layout::for_variables(variables);
         // SAFETY: plain syscalls; the name is a NUL-terminated literal.
         let raw = unsafe { libc::memfd_create(c"nigel-cosim-host".as_ptr(), 0) };
         if raw < 0 {
-            return Err(format!("memfd_create: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("memfd_create: {}", std::io::Error::last_os_error())));
         }
         // SAFETY: `raw` is a fresh descriptor we own.
         let fd = unsafe { OwnedFd::from_raw_fd(raw) };
         // SAFETY: a descriptor we own, a size in range.
         if unsafe { libc::ftruncate(fd.as_raw_fd(), layout.total as libc::off_t) } != 0 {
-            return Err(format!("ftruncate: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("ftruncate: {}", std::io::Error::last_os_error())));
         }
         // SAFETY: maps the whole memfd shared, read-write.
         let base = unsafe {
@@ -113,7 +120,14 @@ impl Channel {
             )
         };
         if base == libc::MAP_FAILED {
-            return Err(format!("mmap: {}", std::io::Error::last_os_error()));
+            return Err(HostEnd::Failed(format!("mmap: {}", std::io::Error::last_os_error())));
+        }
+        // SAFETY: the fresh mapping starts with a zeroed Header; the host is not started yet.
+        unsafe {
+            let h = &mut *(base as *mut Header);
+            h.host_spin_ns = spin.host.as_nanos().min(u128::from(u32::MAX)) as u32;
+            h.host_yield_every = spin.yield_every;
+            h.host_adaptive = u32::from(spin.adaptive);
         }
         let mut command = std::process::Command::new(host);
         command
@@ -130,7 +144,8 @@ impl Channel {
                 Ok(())
             });
         }
-        let child = command.spawn().map_err(|e| format!("cannot start {}: {e}", host.display()))?;
+        let child =
+            command.spawn().map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
         let mut channel = Channel {
             base: base as *mut u8,
             layout,
@@ -146,23 +161,29 @@ impl Channel {
             queued: 0,
             queued_bytes: 0,
             queued_functions: Vec::new(),
-            prefetch_vrs: Vec::new(),
+            prefetch_batches: Vec::new(),
             prefetch_valid: false,
-            after_step: false,
+            gets_since_step: None,
             strings: Vec::new(),
             last_records: Vec::new(),
+            pending: None,
+            posted_step: None,
+            gauge: super::SpinGauge::new(),
+            spin,
         };
         std::mem::forget(child); // reaped by waitpid in `reap`
-        // the host answers a first empty call once it has loaded the library
+        super::LIVE_HOSTS.fetch_add(1, Ordering::Relaxed);
+        // the host answers a first empty call once it has loaded the library (its
+        // load-time initializers ran there: a crash in them is the host's end)
         let status = channel.call(Op::Flush);
         if status != 0 {
             return Err(match &channel.failure {
-                Some(f) => format!("the host {f} while loading {}", library.display()),
-                None => format!(
-                    "the host could not load {}: {}",
+                Some(f) => f.clone(),
+                None => HostEnd::Failed(format!(
+                    "could not load {}: {}",
                     library.display(),
                     channel.last_records.iter().map(|r| r.message.as_str()).collect::<Vec<_>>().join("; ")
-                ),
+                )),
             });
         }
         Ok(channel)
@@ -209,72 +230,136 @@ impl Channel {
         self.queued += 1;
         self.queued_functions.push(function);
         self.prefetch_valid = false;
-        self.after_step = false;
+        self.gets_since_step = None;
         true
     }
 
-    /// `fmi2GetReal` of `vrs` answered from the values the host read after the last step.
+    /// `fmi2GetReal` of `vrs` answered from the values the host read after the last step:
+    /// true if this is the k-th `fmi2GetReal` since the step, with nothing else between,
+    /// and the host's k-th batch is these references. Otherwise the batch is learned for
+    /// the next steps (the host then reads it after each step) and false is returned.
     pub(crate) fn prefetched_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> bool {
-        if !(self.prefetch_valid && self.prefetch_vrs == vrs) {
-            return false;
+        let Some(k) = self.gets_since_step else { return false };
+        self.gets_since_step = Some(k + 1);
+        if let Some((batch, at)) = self.prefetch_batches.get(k) {
+            if batch == vrs {
+                if !self.prefetch_valid {
+                    return false;
+                }
+                let off = self.layout.prefetch + at + 8 + (4 * vrs.len()).div_ceil(8) * 8;
+                // SAFETY: the host wrote vrs.len() f64 there, 8-aligned, before its answer.
+                let values = unsafe { std::slice::from_raw_parts(self.base.add(off) as *const f64, vrs.len()) };
+                out.copy_from_slice(values);
+                return true;
+            }
         }
-        let off = self.layout.prefetch + (4 * vrs.len()).div_ceil(8) * 8;
-        // SAFETY: the host wrote vrs.len() f64 there, 8-aligned, before its answer.
-        let values = unsafe { std::slice::from_raw_parts(self.base.add(off) as *const f64, vrs.len()) };
-        out.copy_from_slice(values);
+        self.learn_prefetch(k, vrs);
         self.prefetch_valid = false;
-        true
+        false
     }
 
-    /// The first `fmi2GetReal` after a step: the Reals the host reads after each step.
-    pub(crate) fn learn_prefetch(&mut self, vrs: &[u32]) {
-        if !self.after_step || 4 * vrs.len() + 8 * vrs.len() + 16 > self.layout.prefetch_len || self.prefetch_vrs == vrs
-        {
+    /// The k-th `fmi2GetReal` after a step, `vrs`, becomes the host's k-th batch (those
+    /// after it are dropped), if the prefetch area holds it.
+    fn learn_prefetch(&mut self, k: usize, vrs: &[u32]) {
+        if k > self.prefetch_batches.len() {
             return;
         }
-        self.prefetch_vrs.clear();
-        self.prefetch_vrs.extend_from_slice(vrs);
+        self.prefetch_batches.truncate(k);
+        let at = self.prefetch_batches.last().map_or(0, |(b, at)| at + record_len(b.len()));
+        if at + record_len(vrs.len()) > self.layout.prefetch_len {
+            return;
+        }
         let (off, len) = (self.layout.prefetch, self.layout.prefetch_len);
         let area = self.area(off, len);
-        for (k, vr) in vrs.iter().enumerate() {
-            area[4 * k..4 * k + 4].copy_from_slice(&vr.to_ne_bytes());
+        area[at..at + 4].copy_from_slice(&(vrs.len() as u32).to_ne_bytes());
+        for (j, vr) in vrs.iter().enumerate() {
+            area[at + 8 + 4 * j..at + 12 + 4 * j].copy_from_slice(&vr.to_ne_bytes());
         }
-        self.header().prefetch = vrs.len() as u32;
+        self.prefetch_batches.push((vrs.to_vec(), at));
+        self.header().prefetch = self.prefetch_batches.len() as u32;
     }
 
     /// One round trip: call `op` (its arguments already in the header and data area),
     /// with the queued sets first. Returns the fmi2 status, or [`FATAL`] with
     /// `self.failure` set if the host ended or a time limit passed.
     pub(crate) fn call(&mut self, op: Op) -> i32 {
+        self.post(op);
+        self.collect()
+    }
+
+    /// The first half of [`Channel::call`]: the request of `op` (and the queued sets)
+    /// handed to the host, which starts on it at once; [`Channel::collect`] waits for the
+    /// answer. Between the two the master may post to other hosts, so that they run at
+    /// the same time. A call still pending when another is made is collected first.
+    pub(crate) fn post(&mut self, op: Op) {
+        self.settle();
         if self.failure.is_some() {
-            return FATAL;
+            return;
         }
-        let was_step = op == Op::DoStep;
+        let queued = self.queued;
+        let queued_bytes = self.queued_bytes as u32;
         {
             let h = self.header();
             h.op = op as u32;
             h.log_count = 0;
             h.log_bytes = 0;
             h.prefetched = 0;
-        }
-        let queued = self.queued;
-        let queued_bytes = self.queued_bytes;
-        {
-            let h = self.header();
             h.queued = queued;
-            h.queued_bytes = queued_bytes as u32;
+            h.queued_bytes = queued_bytes;
             h.queued_failed = u32::MAX;
         }
         self.seq = self.seq.wrapping_add(1);
+        self.pending = Some((op, Instant::now()));
+        let host_spin = if self.spin.cores_to_spare() { self.spin.host } else { Duration::ZERO };
+        self.header().host_spin_ns = host_spin.as_nanos().min(u128::from(u32::MAX)) as u32;
+        let hdr = self.header();
+        publish(&hdr.request, self.seq, &hdr.host_sleeping);
+    }
+
+    /// Answers a posted call that nobody collected (before any other use of the region);
+    /// a failure of it goes to the instance's log.
+    pub(crate) fn settle(&mut self) {
+        let Some((op, _)) = self.pending else { return };
+        self.posted_step = None;
+        let status = self.collect();
+        if status > 1 && self.failure.is_none() {
+            self.push_log(Status::from_raw(status), format!("{} returned {}", op.function(), Status::from_raw(status)));
+        }
+    }
+
+    /// Whether a posted call of `op` waits for its answer.
+    pub(crate) fn is_pending(&self, op: Op) -> bool {
+        self.pending.is_some_and(|(p, _)| p == op)
+    }
+
+    /// The answer to the posted call: its fmi2 status, or [`FATAL`] with `self.failure`
+    /// set if the host ended or a time limit passed.
+    pub(crate) fn collect(&mut self) -> i32 {
+        let Some((op, start)) = self.pending.take() else {
+            return if self.failure.is_some() { FATAL } else { 0 };
+        };
+        if self.failure.is_some() {
+            return FATAL;
+        }
         let seq = self.seq;
-        let start = Instant::now();
+        let spin = if self.spin.cores_to_spare() { self.spin.master } else { Duration::ZERO };
+        let yield_every = self.spin.yield_every;
+        let adaptive = self.spin.adaptive;
         let h = self.header() as *mut Header;
         // SAFETY: the header lives as long as self (see `header`).
         let hdr = unsafe { &*h };
-        publish(&hdr.request, seq, &hdr.host_sleeping);
-        let outcome = wait_for(&hdr.response, seq.wrapping_sub(1), &hdr.master_sleeping, MASTER_SPIN, CHECK_SLICE, || {
-            self.check(start)
-        });
+        let mut gauge = self.gauge;
+        let outcome = wait_for(
+            &hdr.response,
+            seq.wrapping_sub(1),
+            &hdr.master_sleeping,
+            spin,
+            yield_every,
+            adaptive.then_some(&mut gauge),
+            CHECK_SLICE,
+            || self.check(start),
+        );
+        self.gauge = gauge;
         // the response may be stale only if it was never written (the host died)
         if let Err(end) = outcome {
             self.failure = Some(end);
@@ -297,8 +382,17 @@ impl Channel {
         self.queued = 0;
         self.queued_bytes = 0;
         self.queued_functions.clear();
-        self.prefetch_valid = was_step && hdr.prefetched == 1;
-        self.after_step = was_step && status <= 1;
+        self.prefetch_valid = match op {
+            Op::DoStep => hdr.prefetched == 1,
+            Op::GetReal => self.prefetch_valid,
+            _ => false,
+        };
+        self.gets_since_step = match op {
+            Op::DoStep => (status <= 1).then_some(0),
+            // a read changes nothing: the count since the step goes on
+            Op::GetReal if status <= 1 => self.gets_since_step,
+            _ => None,
+        };
         status
     }
 
@@ -394,8 +488,15 @@ impl Channel {
     }
 }
 
+/// The bytes of one batch in the prefetch area: its count (and 4 bytes of padding), its
+/// references (padded to 8 bytes), its values.
+pub(crate) fn record_len(n: usize) -> usize {
+    8 + (4 * n).div_ceil(8) * 8 + 8 * n
+}
+
 impl Drop for Channel {
     fn drop(&mut self) {
+        super::LIVE_HOSTS.fetch_sub(1, Ordering::Relaxed);
         // a host that is still there after fmi2FreeInstance (or never got it) is killed
         if !self.reaped {
             let deadline = Instant::now() + Duration::from_millis(200);

@@ -4,15 +4,12 @@
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::{publish, wait_for, Header, Layout, Op};
+use super::{publish, wait_for, Header, Layout, Op, SpinGauge};
 use crate::fmu::{callbacks_for, load_functions, load_library, EventInfo, Functions, LogSink};
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
 
-/// The host spins this long for the next call before sleeping (the master's other
-/// instances take about a microsecond each between two calls to this one).
-const HOST_SPIN: Duration = Duration::from_micros(30);
 
 struct Region {
     base: *mut u8,
@@ -58,11 +55,12 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     let loaded = load_library(library, library, &library.display().to_string())
         .and_then(|lib| unsafe { load_functions(&lib, library) }.map(|f| (lib, f)));
     let mut seen = 0u32;
+    let mut gauge = SpinGauge::new();
     let (_lib, functions) = match loaded {
         Ok(x) => x,
         Err(e) => {
             // answer the first call with the reason
-            wait_next(&region, &mut seen);
+            wait_next(&region, &mut seen, &mut gauge);
             write_log_text(&region, 3, &e.to_string());
             region.header().status = 3;
             answer(&region, seen);
@@ -71,7 +69,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     };
     let mut host = Host { f: functions, c: std::ptr::null_mut(), log, _callbacks: None, strings: Vec::new() };
     loop {
-        wait_next(&region, &mut seen);
+        wait_next(&region, &mut seen, &mut gauge);
         let h = region.header();
         h.log_count = 0;
         h.log_bytes = 0;
@@ -91,12 +89,24 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
             };
         }
         if op == Some(Op::DoStep) && status <= 1 && h.prefetch > 0 {
-            let n = h.prefetch as usize;
-            let vrs: *const u32 = region.at(layout.prefetch);
-            let values: *mut f64 = region.at(layout.prefetch + (4 * n).div_ceil(8) * 8);
-            // SAFETY: live component; n references and n values inside the prefetch area.
-            let s = unsafe { (host.f.get_real)(host.c, vrs, n, values) };
-            h.prefetched = (s <= 1) as u32;
+            // each batch: its count, its references, room for its values (channel::record_len)
+            let mut at = 0usize;
+            let mut ok = true;
+            for _ in 0..h.prefetch {
+                let record: *mut u8 = region.at(layout.prefetch + at);
+                // SAFETY: the master wrote the batch inside the prefetch area (learn_prefetch).
+                let n = unsafe { *(record as *const u32) } as usize;
+                if at + super::channel::record_len(n) > layout.prefetch_len {
+                    ok = false;
+                    break;
+                }
+                let vrs = unsafe { record.add(8) } as *const u32;
+                let values = unsafe { record.add(8 + (4 * n).div_ceil(8) * 8) } as *mut f64;
+                // SAFETY: live component; n references and n values inside the prefetch area.
+                ok &= unsafe { (host.f.get_real)(host.c, vrs, n, values) } <= 1;
+                at += super::channel::record_len(n);
+            }
+            h.prefetched = ok as u32;
         }
         host.drain_log(&region);
         h.status = status;
@@ -119,9 +129,13 @@ fn layout_of(size: usize) -> Layout {
     }
 }
 
-fn wait_next(region: &Region, seen: &mut u32) {
+fn wait_next(region: &Region, seen: &mut u32, gauge: &mut SpinGauge) {
     let h = region.header();
-    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, HOST_SPIN, Duration::from_secs(1), || Ok(()));
+    let spin = Duration::from_nanos(u64::from(h.host_spin_ns));
+    let gauge = (h.host_adaptive == 1).then_some(gauge);
+    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, spin, h.host_yield_every, gauge, Duration::from_secs(1), || {
+        Ok(())
+    });
     *seen = h.request.load(std::sync::atomic::Ordering::Acquire);
 }
 

@@ -8,17 +8,21 @@
 //! arrays of the call (value references, values, states), then the messages the FMU
 //! logged during it. A call is one round trip: the master writes the request and bumps
 //! the request number; the host runs the fmi2 function on the real FMU, writes the
-//! results, the status and the log, and sets the response number. Each side spins for a
-//! few microseconds, then sleeps on the futex (woken only if it sleeps). While it waits
+//! results, the status and the log, and sets the response number. Each side spins while
+//! that pays (see [`Spin`]), then sleeps on the futex (woken only if it sleeps). While it waits
 //! the master checks every 10 ms that the host is alive (`waitpid`) and the call's and
 //! the run's time limits; an expired limit kills the host (SIGKILL).
 //!
 //! Setting inputs does not wait: `fmi2Set*` calls are queued in the region and sent with
 //! the next call that needs an answer (as a `jacobi` step's inputs go with its
-//! `fmi2DoStep`); after a step the host also reads the Reals the master read after the
-//! previous step, so that the master's next read of them needs no round trip. A
-//! `jacobi` step of an isolated instance is thus one round trip; an error of a queued set
-//! is reported by the call it went with, its function named in the log.
+//! `fmi2DoStep`); after a step the host also reads the batches of Reals the master read
+//! after the previous step (before any other call), so that the master's next reads of
+//! them need no round trip. The algorithms post the steps of all isolated instances
+//! first and then collect the answers, so that the hosts step at the same time. A step
+//! of an isolated instance is thus one round trip, overlapped with the others' (in
+//! `ordered`, an instance whose outputs depend on inputs set after the step pays one
+//! more); an error of a queued set is reported by the call it went with, its function
+//! named in the log.
 //!
 //! The master's side is an [`Instance`](crate::Instance) whose function table is the
 //! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
@@ -28,8 +32,47 @@ pub(crate) mod channel;
 pub mod host;
 pub(crate) mod proxy;
 
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::Duration;
+use std::path::Path;
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+/// `n` null round trips (a call the host answers at once) to each of `hosts` host
+/// processes of the FMU library `library`, in turn (`overlapped`: the request posted to
+/// every host, then the answers collected); the time of all. For the isolation bench:
+/// the floor under the cost of an isolated step.
+#[doc(hidden)]
+pub fn null_round_trips(host: &Path, library: &Path, hosts: usize, n: u32, overlapped: bool) -> Result<Duration, String> {
+    let spin = Spin::of_run();
+    let mut channels = Vec::new();
+    for _ in 0..hosts {
+        channels.push(channel::Channel::start(host, library, 16, None, None, spin).map_err(|e| e.to_string())?);
+    }
+    let start = Instant::now();
+    for _ in 0..n {
+        if overlapped {
+            for c in channels.iter_mut() {
+                c.post(Op::Flush);
+            }
+            for c in channels.iter_mut() {
+                if c.collect() != 0 {
+                    return Err(format!("null call failed: {:?}", c.failure));
+                }
+            }
+        } else {
+            for c in channels.iter_mut() {
+                if c.call(Op::Flush) != 0 {
+                    return Err(format!("null call failed: {:?}", c.failure));
+                }
+            }
+        }
+    }
+    let elapsed = start.elapsed();
+    for c in channels.iter_mut() {
+        c.call(Op::Free);
+    }
+    Ok(elapsed)
+}
 
 /// Which instances run in their own host process, and the time limit per call.
 #[derive(Clone, Debug, Default)]
@@ -124,6 +167,13 @@ pub(crate) struct Header {
     pub(crate) host_sleeping: AtomicU32,
     /// 1 while the master sleeps on `response`.
     pub(crate) master_sleeping: AtomicU32,
+    /// How long the host spins for the next request before sleeping, ns, and every how
+    /// many spin rounds it yields the core (0: never); set by the master before the
+    /// first call.
+    pub(crate) host_spin_ns: u32,
+    pub(crate) host_yield_every: u32,
+    /// 1: the host spins only while spinning pays ([`SpinGauge`]).
+    pub(crate) host_adaptive: u32,
     pub(crate) op: u32,
     /// The fmi2 status of the call.
     pub(crate) status: i32,
@@ -133,8 +183,8 @@ pub(crate) struct Header {
     /// Index of the queued set that failed (u32::MAX: none), and its status.
     pub(crate) queued_failed: u32,
     pub(crate) queued_status: i32,
-    /// Reals to read after a successful `fmi2DoStep` (the prefetch), their count; the
-    /// value references are in the prefetch area, the values follow them.
+    /// Batches of Reals to read after a successful `fmi2DoStep` (the prefetch), their
+    /// number; each batch's count, references and values are in the prefetch area.
     pub(crate) prefetch: u32,
     /// The prefetch was read (1) after the last step.
     pub(crate) prefetched: u32,
@@ -188,32 +238,136 @@ impl Layout {
     }
 }
 
-/// Waits until `word` differs from `old`: spins for `spin`, then sleeps on the futex with
+/// How each side waits for the other: spin at most this long (checking the word every 64
+/// pause instructions, yielding the core every `yield_every` rounds, 0: never), then
+/// sleep on the futex.
+///
+/// Spinning pays only when the side waited for has a core of its own: then an answer
+/// takes about a microsecond, where a sleep and a futex wake-up take tens (a wake-up in a
+/// VM is an inter-processor interrupt through the hypervisor). With fewer cores than the
+/// master and its hosts, a spinning side holds the core the other side needs, and one
+/// round trip can wait for a scheduler time slice (milliseconds); and a machine busy with
+/// other work preempts the side waited for, so that spinning only burns the core. So with
+/// `adaptive` (the default) both sides spin only while the cores (`available_parallelism`:
+/// the affinity mask and the cgroup's CPU quota) are more than the live hosts, and each
+/// only while its spins have paid lately ([`SpinGauge`]); otherwise it sleeps at once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Spin {
+    pub(crate) master: Duration,
+    pub(crate) host: Duration,
+    pub(crate) yield_every: u32,
+    pub(crate) adaptive: bool,
+}
+
+/// The host processes alive in this process (the master's), for [`Spin`].
+pub(crate) static LIVE_HOSTS: AtomicUsize = AtomicUsize::new(0);
+
+/// The cores this process may run on.
+pub(crate) fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+impl Spin {
+    /// The policy of a run: adaptive, or fixed by `NIGEL_COSIM_SPIN`
+    /// (`MASTER_US,HOST_US,YIELD_EVERY`, for measuring the ways of waiting side by side).
+    pub(crate) fn of_run() -> Spin {
+        let default =
+            Spin { master: Duration::from_micros(50), host: Duration::from_micros(30), yield_every: 8, adaptive: true };
+        let Some(v) = std::env::var_os("NIGEL_COSIM_SPIN") else { return default };
+        let parts: Vec<u64> = v.to_string_lossy().split(',').filter_map(|x| x.trim().parse().ok()).collect();
+        match parts[..] {
+            [m, h, y] => Spin {
+                master: Duration::from_micros(m),
+                host: Duration::from_micros(h),
+                yield_every: y as u32,
+                adaptive: false,
+            },
+            _ => default,
+        }
+    }
+
+    /// Whether the master and every live host can each have a core of their own.
+    pub(crate) fn cores_to_spare(&self) -> bool {
+        !self.adaptive || cores() > LIVE_HOSTS.load(Ordering::Relaxed)
+    }
+}
+
+/// Whether spinning has paid lately for one waiting side: the share of its recent spins
+/// that saw the answer before they ran out (an average over about 16), and a count that
+/// lets every 64th wait spin anyway, so that a side that stopped spinning notices when
+/// it would pay again.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpinGauge {
+    paid: f32,
+    waits: u32,
+}
+
+impl SpinGauge {
+    pub(crate) const fn new() -> SpinGauge {
+        SpinGauge { paid: 1.0, waits: 0 }
+    }
+
+    /// How long to spin this time, at most `max`.
+    fn budget(&mut self, max: Duration) -> Duration {
+        self.waits = self.waits.wrapping_add(1);
+        if self.paid >= 0.5 || self.waits.is_multiple_of(64) {
+            max
+        } else {
+            Duration::ZERO
+        }
+    }
+
+    fn record(&mut self, paid: bool) {
+        self.paid += (f32::from(u8::from(paid)) - self.paid) / 16.0;
+    }
+}
+
+/// Waits until `word` differs from `old`: spins for `spin` (yielding every `yield_every`
+/// rounds; with a `gauge`, only while spinning pays), then sleeps on the futex with
 /// `sleeping` set (the waker wakes only sleepers), at most `slice` at a time; `check` is
 /// called after each slice and may end the wait with its error.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn wait_for<E>(
     word: &AtomicU32,
     old: u32,
     sleeping: &AtomicU32,
     spin: Duration,
+    yield_every: u32,
+    gauge: Option<&mut SpinGauge>,
     slice: Duration,
     mut check: impl FnMut() -> Result<(), E>,
 ) -> Result<(), E> {
     if word.load(Ordering::Acquire) != old {
         return Ok(());
     }
-    let start = std::time::Instant::now();
-    let mut spins = 0u32;
-    while start.elapsed() < spin {
-        for _ in 0..64 {
-            std::hint::spin_loop();
+    let mut gauge = gauge;
+    let spin = match gauge.as_deref_mut() {
+        Some(g) => g.budget(spin),
+        None => spin,
+    };
+    if !spin.is_zero() {
+        let start = std::time::Instant::now();
+        let mut spins = 0u32;
+        let mut paid = false;
+        while start.elapsed() < spin {
+            for _ in 0..64 {
+                std::hint::spin_loop();
+            }
+            if word.load(Ordering::Acquire) != old {
+                paid = true;
+                break;
+            }
+            spins += 1;
+            if yield_every > 0 && spins.is_multiple_of(yield_every) {
+                std::thread::yield_now();
+            }
         }
-        if word.load(Ordering::Acquire) != old {
+        if let Some(g) = gauge {
+            g.record(paid);
+        }
+        if paid {
             return Ok(());
-        }
-        spins += 1;
-        if spins.is_multiple_of(8) {
-            std::thread::yield_now();
         }
     }
     loop {

@@ -1,7 +1,7 @@
 //! The function table of an isolated instance: each fmi2 function of the FMI 2.0 C API,
 //! its component being the instance's [`Channel`], carried to the host as one call
 //! (`fmi2Set*` queued for the next one, `fmi2GetReal` after a step answered from the
-//! host's prefetch when it asks for the same Reals).
+//! host's prefetch when it asks for the same Reals as after the previous step).
 
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
@@ -12,10 +12,15 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 
 type Component = *mut c_void;
 
+/// The channel, with any call posted on it answered first (the region is the master's
+/// again).
+///
 /// # Safety
 /// `c` is the address of the live channel of the instance calling (proxy table).
 unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
-    &mut *(c as *mut Channel)
+    let channel = &mut *(c as *mut Channel);
+    channel.settle();
+    channel
 }
 
 fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
@@ -109,7 +114,6 @@ unsafe extern "C" fn get_real(c: Component, vr: *const u32, n: usize, v: *mut f6
     if channel.prefetched_reals(vrs, out) {
         return 0;
     }
-    channel.learn_prefetch(vrs);
     if !fits(channel, 12 * n + 8) {
         return 3;
     }
@@ -226,8 +230,25 @@ unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *cons
     channel.call(Op::SetString)
 }
 
+/// `fmi2DoStep(t, h)` posted to the host (see [`Channel::post`]); `do_step` with the same
+/// arguments collects it.
+pub(crate) fn post_step(channel: &mut Channel, t: f64, h: f64) {
+    channel.settle();
+    let hdr = channel.header();
+    hdr.f = [t, h, 0.0, 0.0];
+    hdr.i = [1, 0, 0, 0];
+    channel.last_time = t;
+    channel.posted_step = Some((t, h));
+    channel.post(Op::DoStep);
+}
+
 unsafe extern "C" fn do_step(c: Component, t: f64, h: f64, no_set_prior: c_int) -> c_int {
-    let channel = ch(c);
+    let channel = &mut *(c as *mut Channel);
+    if channel.is_pending(Op::DoStep) && channel.posted_step == Some((t, h)) && no_set_prior == 1 {
+        channel.posted_step = None;
+        return channel.collect();
+    }
+    channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
     hdr.i = [no_set_prior as i64, 0, 0, 0];
@@ -340,9 +361,10 @@ unsafe extern "C" fn get_nominals(c: Component, x: *mut f64, n: usize) -> c_int 
     get_vector(c, x, n, Op::GetNominalsOfContinuousStates)
 }
 
-/// The proxy table for an FMU whose real table is `real` (an optional function is
-/// present where the real one is, so the capabilities stay the FMU's).
-pub(crate) fn table(real: &Functions) -> Functions {
+/// The proxy table for an FMU whose library has the fmi2 functions `present` says it has
+/// (an optional function is in the table where the library has it, so the capabilities
+/// stay the FMU's).
+pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Functions {
     Functions {
         get_version,
         instantiate,
@@ -359,23 +381,23 @@ pub(crate) fn table(real: &Functions) -> Functions {
         set_integer,
         set_boolean,
         set_string,
-        reset: real.reset.is_some().then_some(reset as _),
-        get_fmu_state: real.get_fmu_state.is_some().then_some(get_fmu_state as _),
-        set_fmu_state: real.set_fmu_state.is_some().then_some(set_fmu_state as _),
-        free_fmu_state: real.free_fmu_state.is_some().then_some(free_fmu_state as _),
-        do_step: real.do_step.is_some().then_some(do_step as _),
-        get_boolean_status: real.get_boolean_status.is_some().then_some(get_boolean_status as _),
-        get_real_status: real.get_real_status.is_some().then_some(get_real_status as _),
-        enter_event_mode: real.enter_event_mode.is_some().then_some(enter_event_mode as _),
-        new_discrete_states: real.new_discrete_states.is_some().then_some(new_discrete_states as _),
-        enter_continuous_time_mode: real.enter_continuous_time_mode.is_some().then_some(enter_continuous_time_mode as _),
-        completed_integrator_step: real.completed_integrator_step.is_some().then_some(completed_integrator_step as _),
-        set_time: real.set_time.is_some().then_some(set_time as _),
-        set_continuous_states: real.set_continuous_states.is_some().then_some(set_continuous_states as _),
-        get_derivatives: real.get_derivatives.is_some().then_some(get_derivatives as _),
-        get_event_indicators: real.get_event_indicators.is_some().then_some(get_event_indicators as _),
-        get_continuous_states: real.get_continuous_states.is_some().then_some(get_continuous_states as _),
-        get_nominals_of_continuous_states: real.get_nominals_of_continuous_states.is_some().then_some(get_nominals as _),
+        reset: present("fmi2Reset").then_some(reset as _),
+        get_fmu_state: present("fmi2GetFMUstate").then_some(get_fmu_state as _),
+        set_fmu_state: present("fmi2SetFMUstate").then_some(set_fmu_state as _),
+        free_fmu_state: present("fmi2FreeFMUstate").then_some(free_fmu_state as _),
+        do_step: present("fmi2DoStep").then_some(do_step as _),
+        get_boolean_status: present("fmi2GetBooleanStatus").then_some(get_boolean_status as _),
+        get_real_status: present("fmi2GetRealStatus").then_some(get_real_status as _),
+        enter_event_mode: present("fmi2EnterEventMode").then_some(enter_event_mode as _),
+        new_discrete_states: present("fmi2NewDiscreteStates").then_some(new_discrete_states as _),
+        enter_continuous_time_mode: present("fmi2EnterContinuousTimeMode").then_some(enter_continuous_time_mode as _),
+        completed_integrator_step: present("fmi2CompletedIntegratorStep").then_some(completed_integrator_step as _),
+        set_time: present("fmi2SetTime").then_some(set_time as _),
+        set_continuous_states: present("fmi2SetContinuousStates").then_some(set_continuous_states as _),
+        get_derivatives: present("fmi2GetDerivatives").then_some(get_derivatives as _),
+        get_event_indicators: present("fmi2GetEventIndicators").then_some(get_event_indicators as _),
+        get_continuous_states: present("fmi2GetContinuousStates").then_some(get_continuous_states as _),
+        get_nominals_of_continuous_states: present("fmi2GetNominalsOfContinuousStates").then_some(get_nominals as _),
         // not offered through a host process
         get_types_platform: None,
         set_debug_logging: None,
@@ -389,5 +411,15 @@ pub(crate) fn table(real: &Functions) -> Functions {
         get_status: None,
         get_integer_status: None,
         get_string_status: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_table_has_what_the_library_has() {
+        let t = super::table(&|s| s != "fmi2GetFMUstate" && s != "fmi2SetTime");
+        assert!(t.has("fmi2DoStep") && t.has("fmi2SetFMUstate") && t.has("fmi2GetReal"));
+        assert!(!t.has("fmi2GetFMUstate") && !t.has("fmi2SetTime") && !t.has("fmi2Unknown"));
     }
 }

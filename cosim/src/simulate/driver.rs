@@ -161,7 +161,7 @@ fn run<'s>(
         if experiment.threads > 1 {
             return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
         }
-        algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table)?);
+        algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table, &clock)?);
     }
     let single = system.instances.len() == 1;
     let names: Vec<String> =

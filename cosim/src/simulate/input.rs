@@ -7,10 +7,22 @@
 //! the later row holds (fmpy's `after_event`), in initialization the earlier one.
 //! Model Exchange instances get the value at the start of each communication step, held
 //! over it (as the master holds connections).
+//!
+//! A jump (two rows at one time) and a change of a discrete column are input events.
+//! fmpy's `simulate_fmu` makes one a communication point of its own in Co-Simulation
+//! (when the FMU can vary its step) and a time event in Model Exchange. Here an event on a
+//! communication point applies the later row from that point on, as there; an event
+//! between two points splits the communication step there (the instances step to the
+//! event, the inputs take their values after it, the step goes on to the next point),
+//! which is fmpy's extra communication point, and for a Model Exchange FMU without
+//! discrete states its time event; no row is recorded at the event (fmpy records one
+//! there in Co-Simulation). Splitting needs every Co-Simulation instance to vary its
+//! step (`canHandleVariableCommunicationStepSize`); otherwise an event between points is
+//! refused, naming it and the points around it.
 
 use crate::error::{Error, Result};
 use crate::simulate::algorithm::{Communication, Core};
-use crate::simulate::clock::Point;
+use crate::simulate::clock::{Clock, Point};
 use crate::simulate::observer::Profiler;
 use crate::system::{BaseType, System, VariableRef};
 use model_description::{Causality, Variability};
@@ -135,6 +147,48 @@ impl InputTable {
     }
 }
 
+/// The input events of a table, as fmpy's `Input.findEvents` finds them: the time of two
+/// rows at one time, and of each row where a discrete column changes; with what it is.
+fn input_events(table: &InputTable, columns: &[Column]) -> Vec<(String, f64)> {
+    let t = &table.time;
+    let mut out = Vec::new();
+    for k in 1..t.len() {
+        if t[k] == t[k - 1] {
+            out.push((format!("the jump (rows {} and {} both at t = {} s)", k + 1, k + 2, t[k]), t[k]));
+        }
+        for (j, c) in columns.iter().enumerate() {
+            if c.discrete && table.columns[j][k] != table.columns[j][k - 1] {
+                out.push((format!("the change of the discrete input {} at t = {} s (row {})", table.names[j], t[k], k + 2), t[k]));
+            }
+        }
+    }
+    out
+}
+
+/// Whether an input event at `t` needs no split: outside the run, or on a communication
+/// point (to fmpy's `isclose`).
+fn on_grid(t: f64, clock: &Clock) -> bool {
+    let end = clock.t0 + clock.steps as f64 * clock.h;
+    if !(t > clock.t0 && t < end) || isclose(t, clock.t0) || isclose(t, end) {
+        return true;
+    }
+    let n = ((t - clock.t0) / clock.h).floor();
+    isclose(t, clock.t0 + n * clock.h) || isclose(t, clock.t0 + (n + 1.0) * clock.h)
+}
+
+/// The error for an input event between communication points that cannot split a step
+/// (instance `fixed` cannot vary its step).
+fn off_grid(what: &str, t: f64, clock: &Clock, fixed: &str) -> Error {
+    let n = ((t - clock.t0) / clock.h).floor();
+    let (before, after) = (clock.t0 + n * clock.h, clock.t0 + (n + 1.0) * clock.h);
+    Error::Experiment(format!(
+        "input: {what} falls between the communication points {before} and {after} s (step {} s), and \
+         {fixed} cannot vary its communication step (canHandleVariableCommunicationStepSize) to stop \
+         there: move the event onto a communication point, or choose a step that has it",
+        clock.h
+    ))
+}
+
 /// Python's `math.isclose` with its defaults (relative tolerance 1e-9, no absolute one),
 /// which fmpy uses to compare times.
 fn isclose(a: f64, b: f64) -> bool {
@@ -152,13 +206,22 @@ pub(crate) struct WithInput {
     pub(crate) inner: Box<dyn Communication>,
     table: InputTable,
     columns: Vec<Column>,
+    /// The input events between communication points, ascending: a step is split at each.
+    splits: Vec<f64>,
+    /// The first of `splits` not yet passed.
+    next_split: usize,
 }
 
 impl WithInput {
     /// Resolves the table's names in `system` (a bare name in a one-instance system is
     /// that instance's variable); refuses names that are not inputs (or tunable
     /// parameters) and inputs a connection already feeds.
-    pub(crate) fn new(inner: Box<dyn Communication>, system: &System, table: &InputTable) -> Result<WithInput> {
+    pub(crate) fn new(
+        inner: Box<dyn Communication>,
+        system: &System,
+        table: &InputTable,
+        clock: &Clock,
+    ) -> Result<WithInput> {
         let mut columns = Vec::new();
         for name in &table.names {
             let r = match system.resolve(name) {
@@ -188,7 +251,21 @@ impl WithInput {
                 || v.variability == Variability::Tunable;
             columns.push(Column { variable: r, discrete });
         }
-        Ok(WithInput { inner, table: table.clone(), columns })
+        let fixed_step = system.instances.iter().find(|i| {
+            i.fmu.interface() == crate::fmu::Interface::CoSimulation && !i.fmu.can_handle_variable_step()
+        });
+        let mut splits = Vec::new();
+        for (what, t) in input_events(table, &columns) {
+            if !on_grid(t, clock) {
+                if let Some(i) = fixed_step {
+                    return Err(off_grid(&what, t, clock, &i.name));
+                }
+                splits.push(t);
+            }
+        }
+        splits.sort_by(f64::total_cmp);
+        splits.dedup();
+        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0 })
     }
 
     fn apply(&self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
@@ -214,9 +291,23 @@ impl Communication for WithInput {
         self.inner.propagate(core)
     }
 
-    fn step(&mut self, core: &mut Core, p: Point, calls: Option<&mut Profiler>) -> Result<()> {
+    fn step(&mut self, core: &mut Core, p: Point, mut calls: Option<&mut Profiler>) -> Result<()> {
         self.apply(core, p.t, true)?;
-        self.inner.step(core, p, calls)
+        // the input events inside the step: a stop at each, no row recorded there
+        let mut t = p.t;
+        while let Some(&e) = self.splits.get(self.next_split) {
+            if e >= p.t_next || isclose(e, p.t_next) {
+                break;
+            }
+            self.next_split += 1;
+            if e <= t || isclose(e, t) {
+                continue;
+            }
+            self.inner.step(core, Point { t, t_next: e, output_point: false, ..p }, calls.as_deref_mut())?;
+            self.apply(core, e, true)?;
+            t = e;
+        }
+        self.inner.step(core, Point { t, ..p }, calls)
     }
 
     fn finish(&mut self, core: &mut Core) -> Result<()> {

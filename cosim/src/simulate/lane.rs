@@ -29,6 +29,8 @@ pub(crate) struct Lane {
     pub(crate) retries: u64,
     /// The first error of this lane's last step (when stepped in a thread).
     pub(crate) error: Option<Error>,
+    /// Its step was handed to its host ([`Lane::post_step`]) and waits to be collected.
+    pub(crate) posted: bool,
 }
 
 impl Instances for [Lane] {
@@ -61,6 +63,7 @@ impl Lane {
             spent: Duration::ZERO,
             retries: 0,
             error: None,
+            posted: false,
         }
     }
 
@@ -75,6 +78,7 @@ impl Lane {
     #[inline]
     pub(crate) fn advance(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
+        self.posted = false;
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
@@ -91,13 +95,30 @@ impl Lane {
         }
     }
 
+    /// An isolated Co-Simulation instance without Discard retry: its step from `t` to
+    /// `t_next` handed to its host, which runs it while the master goes on (to the other
+    /// hosts); [`Lane::advance`] then collects it. False (nothing done) for the others.
+    #[inline]
+    pub(crate) fn post_step(&mut self, t: f64, t_next: f64) -> bool {
+        self.posted = self.can_post() && self.inst.post_step(t, t_next - t);
+        self.posted
+    }
+
+    /// Whether [`Lane::post_step`] hands the step to a host.
+    #[inline]
+    pub(crate) fn can_post(&self) -> bool {
+        self.unit.is_none() && self.saved.is_none() && self.inst.fmu().is_isolated()
+    }
+
     /// One `jacobi` step of this instance: its inputs set from `values` (the outputs of
     /// the previous step), the step, its outputs fetched into its get buffers. The call
     /// sequence of an instance is the same whichever thread runs it.
     #[inline]
     pub(crate) fn jacobi_step(&mut self, values: &[f64], p: Point, profile: bool, solver: Solver) -> Result<()> {
         let start = profile.then(Instant::now);
-        self.jacobi_inputs(values, p)?;
+        if !self.posted {
+            self.jacobi_inputs(values, p)?;
+        }
         self.advance(solver, p.t, p.t_next)?;
         self.jacobi_outputs(p)?;
         if let Some(start) = start {

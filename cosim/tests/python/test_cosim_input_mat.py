@@ -46,6 +46,105 @@ def test_input_signals_equal_fmpy(cosim, plant_fmu, tmp_path):
     assert r.returncode != 0 and "cannot be driven over time" in r.stderr, r.stderr
 
 
+def write_input_csv(path, signals):
+    with open(path, "w") as f:
+        f.write(",".join(f'"{n}"' for n in signals.dtype.names) + "\n")
+        for row in signals:
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
+
+
+def jump_signals(t_jump):
+    """Steering that jumps at t_jump (two rows at that time) and again at 1 s, constant
+    between the jumps: with ramps, fmpy's CVode (not restarted at communication points)
+    integrates past each point with the input held from the one before, an approximation
+    of fmpy's own (1.8e-5 m in x here), not the input's."""
+    t = np.array([0.0, t_jump, t_jump, 1.0, 1.0, 2.0])
+    signals = np.zeros(t.size, dtype=[("time", float), ("delta_fl", float), ("delta_fr", float)])
+    signals["time"] = t
+    signals["delta_fl"] = [0.0, 0.0, 0.2, 0.2, -0.1, -0.1]
+    signals["delta_fr"] = [0.0, 0.0, 0.15, 0.15, -0.1, -0.1]
+    return signals
+
+
+def test_input_jumps_equal_fmpy_in_both_interfaces(cosim, plant_fmu, tmp_path):
+    # jumps on communication points: fmpy applies the later row from the jump on, in
+    # Co-Simulation before the step from it, in Model Exchange as a time event there
+    signals = jump_signals(0.5)
+    csv = tmp_path / "jump.csv"
+    write_input_csv(csv, signals)
+    start = {"v_x_start": 0.35}
+    stop = 2.0
+    out = tmp_path / "cs.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--input", str(csv), "--set", "v_x_start=0.35",
+                    "--stop-time", str(stop), "--step", "1e-3", "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    ref = simulate_fmu(str(plant_fmu), fmi_type="CoSimulation", stop_time=stop, output_interval=1e-3,
+                       start_values=start, input=signals)
+    assert len(ours) == len(ref) == 2001 and np.array_equal(ours["time"], ref["time"])
+    names = [n for n in ref.dtype.names if n != "time"]
+    # the same FMU given the same input values before the same steps: the same bits
+    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
+    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
+    # Model Exchange: CVode restarted at each jump (fmpy's time event) against our dopri5,
+    # both to rtol 1e-10 over 2 s; inputs held over each 10 ms step in both (fmpy applies
+    # them at communication points). Each integrator's global error is near 1e-10 of the
+    # state's scale, so 1e-7 of the scale is a thousandfold margin that no libm or BLAS
+    # difference approaches, while the jump applied one step (10 ms) late moves psi by
+    # 4e-3 rad and x by 3e-4 m.
+    h = 1e-2
+    out = tmp_path / "me.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
+                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", str(stop), "--step", str(h),
+                    "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
+                       stop_time=stop, output_interval=h, start_values=start, input=signals, record_events=False)
+    assert len(ours) == len(ref) == 201 and np.allclose(ours["time"], ref["time"], rtol=0, atol=1e-12)
+    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
+        scale = max(1.0, float(np.max(np.abs(ref[name]))))
+        diff = float(np.max(np.abs(ours[name] - ref[name])))
+        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
+    assert abs(ours["psi"][-1]) > 1e-3
+
+
+def test_an_input_jump_between_communication_points_splits_the_step_as_fmpy(cosim, plant_fmu, tmp_path):
+    # fmpy makes a jump between two points a communication point of its own (recording a
+    # row there); cosim splits the step there too and records the grid only
+    signals = jump_signals(0.5004)
+    csv = tmp_path / "offgrid.csv"
+    write_input_csv(csv, signals)
+    start = {"v_x_start": 0.35}
+    ref = simulate_fmu(str(plant_fmu), fmi_type="CoSimulation", stop_time=1.5, output_interval=1e-3,
+                       start_values=start, input=signals)
+    extra = np.isclose(ref["time"], 0.5004, rtol=0, atol=1e-12)
+    assert extra.sum() == 1 and len(ref) == 1502
+    ref = ref[~extra]
+    out = tmp_path / "cs.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--input", str(csv), "--set", "v_x_start=0.35",
+                    "--stop-time", "1.5", "--step", "1e-3", "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    assert len(ours) == 1501 and np.array_equal(ours["time"], ref["time"])
+    names = [n for n in ref.dtype.names if n != "time"]
+    # the same steps (0.5 -> 0.5004 -> 0.501 s) with the same inputs: the same bits
+    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
+    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
+    # Model Exchange: fmpy's time event at the jump, our integrator stopped there; the
+    # tolerance as in test_input_jumps_equal_fmpy_in_both_interfaces
+    h = 1e-2
+    out = tmp_path / "me.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
+                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", "1.5", "--step", str(h),
+                    "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
+                       stop_time=1.5, output_interval=h, start_values=start, input=signals, record_events=False)
+    assert len(ours) == len(ref) == 151
+    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
+        scale = max(1.0, float(np.max(np.abs(ref[name]))))
+        diff = float(np.max(np.abs(ours[name] - ref[name])))
+        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
+
+
 def read_mat_v4(path):
     """The matrices of a MAT v4 file, by the format's definition (MathWorks, "MAT-File
     Format", Level 4): a header of five int32 (type, rows, columns, imaginary, name

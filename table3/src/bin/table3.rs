@@ -114,6 +114,8 @@ fn parse_maneuver(s: &str) -> Result<Maneuver, String> {
 }
 
 fn main() -> ExitCode {
+    // SIGINT, SIGTERM and SIGHUP remove the unpacked FMUs from TMPDIR
+    nigel_cosim::unpack::remove_on_signals();
     let args = Args::parse();
     match run(&args) {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,7 +3,7 @@
 //! step late, as in fmpy `simulate_ssp`, libcosim and ecos.
 
 use super::{Communication, Core};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::simulate::clock::Point;
 use crate::simulate::observer::Profiler;
 use std::time::Instant;
@@ -18,8 +18,30 @@ impl Jacobi {
         let solver = core.solver;
         match core.group.as_mut() {
             None => {
+                // isolated lanes first: their inputs and steps handed to their hosts, which
+                // then step while the master steps the others and collects them in turn
+                let mut first: Option<Error> = None;
                 for lane in core.lanes.iter_mut() {
-                    lane.jacobi_step(&core.values, p, profile, solver)?;
+                    if !lane.can_post() {
+                        continue;
+                    }
+                    if let Err(e) = lane.jacobi_inputs(&core.values, p) {
+                        first = Some(e);
+                        break;
+                    }
+                    lane.post_step(p.t, p.t_next);
+                }
+                // every posted step is collected, even after an error, so that each
+                // instance knows the outcome of its step
+                for lane in core.lanes.iter_mut() {
+                    if lane.posted || first.is_none() {
+                        if let Err(e) = lane.jacobi_step(&core.values, p, profile, solver) {
+                            first.get_or_insert(e);
+                        }
+                    }
+                }
+                if let Some(e) = first {
+                    return Err(e);
                 }
             }
             Some(g) => {

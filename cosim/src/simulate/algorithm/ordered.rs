@@ -3,7 +3,7 @@
 //! communication point.
 
 use super::{Communication, Core};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::simulate::clock::Point;
 use crate::simulate::observer::Profiler;
 use crate::simulate::plan::{run_ops, Op};
@@ -26,14 +26,29 @@ impl Communication for Ordered {
         if let Some(c) = calls.as_deref_mut() {
             c.restart();
         }
+        // the isolated lanes' steps handed to their hosts first, which then step while
+        // the master steps the others and collects them in turn
         for lane in core.lanes.iter_mut() {
-            if lane.in_group() {
+            if lane.can_post() {
+                lane.post_step(p.t, p.t_next);
+            }
+        }
+        // every posted step is collected, even after an error, so that each instance
+        // knows the outcome of its step
+        let mut first: Option<Error> = None;
+        for lane in core.lanes.iter_mut() {
+            if lane.in_group() || !(lane.posted || first.is_none()) {
                 continue;
             }
-            lane.advance(core.solver, p.t, p.t_next)?;
+            if let Err(e) = lane.advance(core.solver, p.t, p.t_next) {
+                first.get_or_insert(e);
+            }
             if let Some(c) = calls.as_deref_mut() {
                 c.charge(lane.index);
             }
+        }
+        if let Some(e) = first {
+            return Err(e);
         }
         if let Some(g) = core.group.as_mut() {
             g.advance(core.lanes.as_mut_slice(), core.solver, p.t, p.t_next)?;
