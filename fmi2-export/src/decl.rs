@@ -220,8 +220,9 @@ impl<B> VarDecl<B> {
         self.description = text;
         self
     }
-    /// The unit (declared in [`DeclarationSpec::units`]); `""` is no unit (for tables of
-    /// variables some of which have none).
+    /// The unit, in Modelica's syntax (its definition derived from the name, or listed in
+    /// [`DeclarationSpec::units`]); `""` is no unit (for tables of variables some of which
+    /// have none).
     pub fn unit(mut self, unit: &'static str) -> Self {
         self.unit = (!unit.is_empty()).then_some(unit);
         self
@@ -374,7 +375,10 @@ pub struct DeclarationSpec<B> {
     pub capabilities: Capabilities,
     /// Enumeration types (`<TypeDefinitions>`), referred to by [`VarDecl::enumeration`].
     pub enumerations: Vec<md::EnumerationType>,
-    /// Units used by the variables (`(name, base unit)`); undeclared units are a build error.
+    /// Unit definitions beyond those the layer derives from the variables' unit names
+    /// ([`crate::units::derived_unit`]: `"N.m"`, `"m/s2"`, `"1/s"` ...); needed only for a
+    /// unit with a prefix or a factor (`"mm"`, `"deg"`). A unit neither listed nor derivable
+    /// is a build error naming the variable.
     pub units: Vec<md::Unit>,
     pub default_experiment: Option<md::DefaultExperiment>,
     pub variables: Vec<VarDecl<B>>,
@@ -690,7 +694,7 @@ impl<B: Copy> Declaration<B> {
             number_of_event_indicators: 0,
             model_exchange: spec.interfaces.model_exchange.then_some(capabilities_me),
             co_simulation: spec.interfaces.co_simulation.then_some(capabilities_cs),
-            unit_definitions: spec.units.clone(),
+            unit_definitions: unit_definitions(&spec)?,
             type_definitions: spec.enumerations.clone(),
             log_categories: LOG_CATEGORIES
                 .iter()
@@ -864,6 +868,20 @@ impl<B> Declaration<B> {
 /// few hundred bytes are kept for its life on purpose.
 pub fn declared_name(name: String) -> &'static str {
     Box::leak(name.into_boxed_str())
+}
+
+/// The `<UnitDefinitions>`: the units the spec lists, then those the variables use in the
+/// order of first use, derived from their names.
+fn unit_definitions<B>(spec: &DeclarationSpec<B>) -> Result<Vec<md::Unit>, String> {
+    let mut units = spec.units.clone();
+    for v in &spec.variables {
+        if let Some(unit) = v.unit {
+            if !units.iter().any(|u| u.name == unit) {
+                units.push(crate::units::derived_unit(unit).map_err(|e| format!("{}: {e}", v.name))?);
+            }
+        }
+    }
+    Ok(units)
 }
 
 /// A unit with base-unit exponents `[kg, m, s, rad]`.

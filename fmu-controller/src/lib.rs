@@ -30,7 +30,7 @@ use std::sync::OnceLock;
 use core::f64::consts::FRAC_PI_2;
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    si_unit, Capabilities, Declaration, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
+    Capabilities, Declaration, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
     ModelResult, VarDecl, Variables,
 };
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
@@ -236,22 +236,6 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        enumerations: Vec::new(),
-        units: vec![
-            si_unit("rad", 0, 0, 0, 1),
-            si_unit("rad/s", 0, 0, -1, 1),
-            si_unit("m/s", 0, 1, -1, 0),
-            si_unit("m", 0, 1, 0, 0),
-            si_unit("s", 0, 0, 1, 0),
-            si_unit("N", 1, 1, -2, 0),
-            si_unit("N.m", 1, 2, -2, 0),
-            si_unit("N.s/m", 1, 0, -1, 0),
-            si_unit("N/m", 1, 0, -2, 0),
-            si_unit("rad/rad", 0, 0, 0, 0),
-            si_unit("rad.s/rad", 0, 0, 1, 0),
-            si_unit("rad/m", 0, -1, 0, 1),
-            si_unit("1/s", 0, 0, -1, 0),
-        ],
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
             stop_time: Some(30.0),
@@ -259,6 +243,7 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
             step_size: Some(1e-3),
         }),
         variables: v.into_vec(),
+        ..Default::default()
     }
 }
 

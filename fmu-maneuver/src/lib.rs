@@ -21,7 +21,7 @@ use std::sync::{Arc, OnceLock};
 use core::f64::consts::{FRAC_PI_2, TAU};
 use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, si_unit, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
+    declared_name, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
     ModelResult, SampleEnd, Variables,
 };
 use nigel_benchmark::{
@@ -187,15 +187,6 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        enumerations: Vec::new(),
-        units: vec![
-            si_unit("rad", 0, 0, 0, 1),
-            si_unit("rad/s", 0, 0, -1, 1),
-            si_unit("m/s", 0, 1, -1, 0),
-            si_unit("m", 0, 1, 0, 0),
-            si_unit("s", 0, 0, 1, 0),
-            si_unit("N", 1, 1, -2, 0),
-        ],
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
             stop_time: Some(30.0),
@@ -203,6 +194,7 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
             step_size: Some(SAMPLE_PERIOD),
         }),
         variables: v.into_vec(),
+        ..Default::default()
     }
 }
 

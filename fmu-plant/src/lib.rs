@@ -7,10 +7,10 @@
 
 use std::sync::OnceLock;
 
-use fmi2_export::model_description::{DefaultExperiment, Unit};
+use fmi2_export::model_description::DefaultExperiment;
 use fmi2_export::{
-    declared_name, si_unit, Access, Capabilities, Declaration, DeclarationSpec, Initial, InstantiateContext,
-    Interfaces, Model, ModelError, ModelResult, Start, VarHandle, Variables,
+    declared_name, Access, Capabilities, Declaration, DeclarationSpec, Initial, InstantiateContext, Interfaces, Model,
+    ModelError, ModelResult, Start, VarHandle, Variables,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES, WHEELS};
@@ -361,20 +361,6 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         v.boolean(name).parameter(false).describe(text).bind(PlantVar::Switch(s));
     }
 
-    let units: Vec<Unit> = vec![
-        si_unit("m", 0, 1, 0, 0),
-        si_unit("rad", 0, 0, 0, 1),
-        si_unit("s", 0, 0, 1, 0),
-        si_unit("kg", 1, 0, 0, 0),
-        si_unit("m/s", 0, 1, -1, 0),
-        si_unit("m/s2", 0, 1, -2, 0),
-        si_unit("rad/s", 0, 0, -1, 1),
-        si_unit("rad/s2", 0, 0, -2, 1),
-        si_unit("N", 1, 1, -2, 0),
-        si_unit("N.m", 1, 2, -2, 0),
-        si_unit("kg.m2", 1, 2, 0, 0),
-        si_unit("N/rad", 1, 1, -2, -1),
-    ];
     DeclarationSpec {
         model_name: "Nigel 4WD4WS plant",
         model_identifier: MODEL_IDENTIFIER,
@@ -383,8 +369,6 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { directional_derivatives: true, fmu_state: true, serialize_fmu_state: true },
-        enumerations: Vec::new(),
-        units,
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
             stop_time: Some(10.0),
@@ -392,6 +376,7 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             step_size: Some(1e-3),
         }),
         variables: v.into_vec(),
+        ..Default::default()
     }
 }
 

@@ -13,9 +13,7 @@
 use std::sync::OnceLock;
 
 use fmi2_export::model_description::DefaultExperiment;
-use fmi2_export::{
-    si_unit, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables,
-};
+use fmi2_export::{Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables};
 use nigel_vehicle::WHEELS;
 
 /// The sample period of the law \[s\].
@@ -96,16 +94,6 @@ fn build_declaration() -> DeclarationSpec<Field<OwnController>> {
         description: "A user's own sampled (1 ms) steering controller: P on the yaw rate, P on the speed",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: false, co_simulation: true },
-        units: vec![
-            si_unit("rad", 0, 0, 0, 1),
-            si_unit("rad/s", 0, 0, -1, 1),
-            si_unit("m/s", 0, 1, -1, 0),
-            si_unit("m", 0, 1, 0, 0),
-            si_unit("N", 1, 1, -2, 0),
-            si_unit("N.m", 1, 2, -2, 0),
-            si_unit("N.s/m", 1, 0, -1, 0),
-            si_unit("rad.s/rad", 0, 0, 1, 0),
-        ],
         default_experiment: Some(DefaultExperiment {
             start_time: Some(0.0),
             stop_time: Some(30.0),
