@@ -203,7 +203,11 @@ fn isolation(system: &System) {
         line(
             &format!("master {name}, recording nothing, in process"),
             a,
-            &format!("(5 runs alternated with --isolate: {:.1} .. {:.1} ms)", a.as_secs_f64() * 1e3, worst(&times[0]).as_secs_f64() * 1e3),
+            &format!(
+                "(5 runs alternated with --isolate: {:.1} .. {:.1} ms)",
+                a.as_secs_f64() * 1e3,
+                worst(&times[0]).as_secs_f64() * 1e3
+            ),
         );
         for (k, spin) in spins.iter().enumerate() {
             let b = best(&times[k + 1]);
@@ -235,11 +239,7 @@ fn round_trips(system: &System, host: &Path) {
         println!("round trips: no library in {}", dir.display());
         return;
     };
-    let policies = [
-        ("spin only", "1000000,1000000,0"),
-        ("futex only", "0,0,0"),
-        ("default", ""),
-    ];
+    let policies = [("spin only", "1000000,1000000,0"), ("futex only", "0,0,0"), ("default", "")];
     let cases = [(1usize, false), (3, false), (3, true)];
     let n = 10_000u32;
     let mut times = vec![vec![Vec::new(); cases.len()]; policies.len()];

@@ -35,9 +35,10 @@ fn epsilon(results: &nigel_cosim::Results) -> Result<f64, String> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args().nth(1).map(PathBuf::from).unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/ssp/nigel_closed_loop.ssp")
-    });
+    let path = std::env::args()
+        .nth(1)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/ssp/nigel_closed_loop.ssp"));
     let ssp = read_ssp(&path, &ImportOptions::default())?;
     let mut experiment = Experiment::new(30.0, 1e-3);
     // the controller sees the plant at t_k: outputs flow along the direct feedthrough

@@ -97,7 +97,13 @@ pub fn exported_symbols(bytes: &[u8]) -> Option<std::collections::HashSet<String
     let section = |k: u64| {
         let h = (shoff + k * shentsize) as usize;
         // (type, link, offset, size, entry size)
-        (u32_at(bytes, h + 4), u32_at(bytes, h + 40), u64_at(bytes, h + 24), u64_at(bytes, h + 32), u64_at(bytes, h + 56))
+        (
+            u32_at(bytes, h + 4),
+            u32_at(bytes, h + 40),
+            u64_at(bytes, h + 24),
+            u64_at(bytes, h + 32),
+            u64_at(bytes, h + 56),
+        )
     };
     let (_, link, offset, size, entsize) = (0..shnum).map(section).find(|s| s.0 == 11)?; // SHT_DYNSYM
     if u64::from(link) >= shnum || entsize < 24 || !within(offset, size, len) {

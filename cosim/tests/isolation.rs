@@ -92,11 +92,17 @@ fn crashes_under_isolate_are_typed_errors_with_the_rows_so_far() {
 fn a_step_that_never_returns_is_killed_by_the_call_or_the_run_limit() {
     let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout-call", "0.5"]);
     assert_eq!(code, Some(1), "{stderr}");
-    assert!(stderr.contains("the call took longer than 0.5 s (--timeout-call) during fmi2DoStep at t = 0.5 s"), "{stderr}");
+    assert!(
+        stderr.contains("the call took longer than 0.5 s (--timeout-call) during fmi2DoStep at t = 0.5 s"),
+        "{stderr}"
+    );
     assert_rows_to_half(&rows, "call limit");
     let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout", "1"]);
     assert_eq!(code, Some(1), "{stderr}");
-    assert!(stderr.contains("the run's time limit of 1 s passed (--timeout) during fmi2DoStep at t = 0.5 s"), "{stderr}");
+    assert!(
+        stderr.contains("the run's time limit of 1 s passed (--timeout) during fmi2DoStep at t = 0.5 s"),
+        "{stderr}"
+    );
     assert_rows_to_half(&rows, "run limit");
 }
 

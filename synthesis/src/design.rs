@@ -338,7 +338,14 @@ pub fn min_hinf(poly: &Polytope, region: &PoleRegion, opts: &SynthesisOptions) -
     let sol = b.problem.solve(&opts.solver)?;
     let (gain, lyapunov) = extract(&b, &sol)?;
     let gamma = sol.scalar(s).max(0.0).sqrt();
-    Ok(Design { gain, lyapunov, gamma: Some(gamma), nu: None, mirror_symmetric: b.mirror_symmetric(), stats: sol.stats })
+    Ok(Design {
+        gain,
+        lyapunov,
+        gamma: Some(gamma),
+        nu: None,
+        mirror_symmetric: b.mirror_symmetric(),
+        stats: sol.stats,
+    })
 }
 
 /// `min nu` subject to D-stability, the H2 LMIs and, if `hinf_bound` is given, the H-inf
@@ -362,7 +369,14 @@ pub fn min_h2(
     let sol = b.problem.solve(&opts.solver)?;
     let (gain, lyapunov) = extract(&b, &sol)?;
     let nu = sol.eval(&q.expr().trace())[(0, 0)].max(0.0).sqrt();
-    Ok(Design { gain, lyapunov, gamma: hinf_bound, nu: Some(nu), mirror_symmetric: b.mirror_symmetric(), stats: sol.stats })
+    Ok(Design {
+        gain,
+        lyapunov,
+        gamma: hinf_bound,
+        nu: Some(nu),
+        mirror_symmetric: b.mirror_symmetric(),
+        stats: sol.stats,
+    })
 }
 
 /// `min a gamma^2 + b nu^2` subject to D-stability, the H-inf and the H2 LMIs.
@@ -642,7 +656,14 @@ pub fn pole_placement_baseline(
         .map(|v| crate::verify::ClosedLoop::new(v, &poly.bw, &gain).max_real_part())
         .fold(f64::NEG_INFINITY, f64::max);
     Ok(Baseline {
-        design: Design { gain, lyapunov, gamma: None, nu: None, mirror_symmetric: b.mirror_symmetric(), stats: sol.stats },
+        design: Design {
+            gain,
+            lyapunov,
+            gamma: None,
+            nu: None,
+            mirror_symmetric: b.mirror_symmetric(),
+            stats: sol.stats,
+        },
         mu_nominal,
         alpha,
         max_real_part_over_vertices: max_re,

@@ -33,8 +33,8 @@ pub mod tracking;
 pub mod verify;
 
 pub use design::{
-    min_h2, min_hinf, mirror_pairs, pareto_sweep, pole_placement_baseline, weighted, Baseline, Design, ParetoPoint, ParetoSweep,
-    SweepOptions, SweepProgress, SynthesisError, SynthesisOptions, DEFAULT_MARGIN,
+    min_h2, min_hinf, mirror_pairs, pareto_sweep, pole_placement_baseline, weighted, Baseline, Design, ParetoPoint,
+    ParetoSweep, SweepOptions, SweepProgress, SynthesisError, SynthesisOptions, DEFAULT_MARGIN,
 };
 pub use lmi::{SolveError, SolverSettings, SolverStats};
 pub use plant::{

@@ -253,7 +253,13 @@ fn render(r: &PlotView) -> String {
         let padx = ((gmax - gmin) * 0.06).max(0.01);
         let pady = ((nmax - nmin) * 0.06).max(0.01);
         let f = Frame { xmin: gmin - padx, xmax: gmax + padx, ymin: nmin - pady, ymax: nmax + pady, ..left };
-        axes(&mut s, &f, "Pareto curve: min nu subject to gamma ≤ g", "g (bound on the L2 gain from F_w to z)", "nu (H2 bound)");
+        axes(
+            &mut s,
+            &f,
+            "Pareto curve: min nu subject to gamma ≤ g",
+            "g (bound on the L2 gain from F_w to z)",
+            "nu (H2 bound)",
+        );
         if let Some(gs) = r.gamma_star {
             if gs >= f.xmin && gs <= f.xmax {
                 let x = f.px(gs);
@@ -281,7 +287,8 @@ fn render(r: &PlotView) -> String {
         for (g, nu, label) in &refs {
             // the label on the side of the marker with room for it, inside the axes
             // below and right of the marker: under the falling curve, inside the axes
-            let (x, anchor) = if f.x0 + f.w - f.px(*g) > 140.0 { (f.px(*g) + 6.0, "start") } else { (f.px(*g) - 6.0, "end") };
+            let (x, anchor) =
+                if f.x0 + f.w - f.px(*g) > 140.0 { (f.px(*g) + 6.0, "start") } else { (f.px(*g) - 6.0, "end") };
             let y = (f.py(*nu) + 34.0).min(f.y0 + f.h - 6.0);
             let _ = writeln!(
                 s,
@@ -416,7 +423,13 @@ fn pole_panel(s: &mut String, f: &Frame, title: &str, poles: &[[f64; 2]], region
             f.y0 + f.h
         );
     }
-    let _ = writeln!(s, r##"<line x1="{0:.1}" y1="{1:.1}" x2="{2:.1}" y2="{1:.1}" stroke="#555"/>"##, f.x0, f.py(0.0), f.x0 + f.w);
+    let _ = writeln!(
+        s,
+        r##"<line x1="{0:.1}" y1="{1:.1}" x2="{2:.1}" y2="{1:.1}" stroke="#555"/>"##,
+        f.x0,
+        f.py(0.0),
+        f.x0 + f.w
+    );
     for p in poles.iter().filter(|p| p[0] >= f.xmin && p[0] <= f.xmax && p[1] >= f.ymin && p[1] <= f.ymax) {
         let (x, y) = (f.px(p[0]), f.py(p[1]));
         let _ = writeln!(

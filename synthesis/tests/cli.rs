@@ -103,7 +103,8 @@ fn paper_pareto_json_and_plot() {
     assert!(svg.contains("Re(s) = -0.1 1/s") && svg.contains("Re(s) [1/s]") && svg.contains("Im(s) [rad/s]"));
     // the PNG next to it: 2 pixels per SVG unit (the IHDR chunk's width and height)
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
-    let (w, h) = (u32::from_be_bytes(png[16..20].try_into().unwrap()), u32::from_be_bytes(png[20..24].try_into().unwrap()));
+    let (w, h) =
+        (u32::from_be_bytes(png[16..20].try_into().unwrap()), u32::from_be_bytes(png[20..24].try_into().unwrap()));
     assert_eq!((w, h), (3120, 1080));
     let _ = std::fs::remove_file(json);
 }

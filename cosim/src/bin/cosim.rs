@@ -437,7 +437,8 @@ fn is_ssp(path: &Path) -> bool {
 
 fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     use std::io::Write;
-    let ssp = nigel_cosim::read_ssp(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
+    let ssp =
+        nigel_cosim::read_ssp(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
     let s = &ssp.system;
     let mut out = std::io::stdout().lock();
     let mut lines = vec![format!(

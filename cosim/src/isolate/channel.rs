@@ -144,8 +144,7 @@ impl Channel {
                 Ok(())
             });
         }
-        let child =
-            command.spawn().map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
+        let child = command.spawn().map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
         let mut channel = Channel {
             base: base as *mut u8,
             layout,
@@ -366,7 +365,8 @@ impl Channel {
             return FATAL;
         }
         if hdr.response.load(Ordering::Acquire) != seq {
-            self.failure = Some(HostEnd::Failed(format!("answer {} to call {seq}", hdr.response.load(Ordering::Acquire))));
+            self.failure =
+                Some(HostEnd::Failed(format!("answer {} to call {seq}", hdr.response.load(Ordering::Acquire))));
             return FATAL;
         }
         self.read_log();

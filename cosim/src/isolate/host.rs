@@ -10,7 +10,6 @@ use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
 
-
 struct Region {
     base: *mut u8,
     layout: Layout,
@@ -40,9 +39,8 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
         return 2;
     };
     // SAFETY: maps the descriptor the master passed, of the size it made it.
-    let base = unsafe {
-        libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0)
-    };
+    let base =
+        unsafe { libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0) };
     if base == libc::MAP_FAILED {
         eprintln!("cosim-host: mmap: {}", std::io::Error::last_os_error());
         return 2;
@@ -133,9 +131,16 @@ fn wait_next(region: &Region, seen: &mut u32, gauge: &mut SpinGauge) {
     let h = region.header();
     let spin = Duration::from_nanos(u64::from(h.host_spin_ns));
     let gauge = (h.host_adaptive == 1).then_some(gauge);
-    let _ = wait_for::<()>(&h.request, *seen, &h.host_sleeping, spin, h.host_yield_every, gauge, Duration::from_secs(1), || {
-        Ok(())
-    });
+    let _ = wait_for::<()>(
+        &h.request,
+        *seen,
+        &h.host_sleeping,
+        spin,
+        h.host_yield_every,
+        gauge,
+        Duration::from_secs(1),
+        || Ok(()),
+    );
     *seen = h.request.load(std::sync::atomic::Ordering::Acquire);
 }
 
@@ -265,7 +270,9 @@ impl Host {
                         0
                     }
                 }
-                Op::SetupExperiment => (f.setup_experiment)(c, h.i[0] as c_int, h.f[0], h.f[1], h.i[1] as c_int, h.f[2]),
+                Op::SetupExperiment => {
+                    (f.setup_experiment)(c, h.i[0] as c_int, h.f[0], h.f[1], h.i[1] as c_int, h.f[2])
+                }
                 Op::EnterInitializationMode => (f.enter_initialization_mode)(c),
                 Op::ExitInitializationMode => (f.exit_initialization_mode)(c),
                 Op::Terminate => (f.terminate)(c),

@@ -42,7 +42,13 @@ use std::time::{Duration, Instant};
 /// every host, then the answers collected); the time of all. For the isolation bench:
 /// the floor under the cost of an isolated step.
 #[doc(hidden)]
-pub fn null_round_trips(host: &Path, library: &Path, hosts: usize, n: u32, overlapped: bool) -> Result<Duration, String> {
+pub fn null_round_trips(
+    host: &Path,
+    library: &Path,
+    hosts: usize,
+    n: u32,
+    overlapped: bool,
+) -> Result<Duration, String> {
     let spin = Spin::of_run();
     let mut channels = Vec::new();
     for _ in 0..hosts {
@@ -376,7 +382,8 @@ pub(crate) fn wait_for<E>(
             sleeping.store(0, Ordering::SeqCst);
             return Ok(());
         }
-        let ts = libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
+        let ts =
+            libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
         // SAFETY: `word` is a live u32 in shared memory; FUTEX_WAIT (not private: the
         // region is shared between processes) returns when woken, on timeout or at once
         // if the word is no longer `old`.

@@ -70,8 +70,7 @@ unsafe extern "C" fn instantiate(
 
 /// `fmi2Instantiate` in the host of `channel`; the fmi2 status.
 pub(crate) fn instantiate_in(channel: &mut Channel, name: &CStr, fmi_type: c_int, guid: &CStr, uri: &CStr) -> i32 {
-    let bytes: Vec<u8> =
-        [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
+    let bytes: Vec<u8> = [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
     if !fits(channel, bytes.len()) {
         return 3;
     }
@@ -85,7 +84,14 @@ unsafe extern "C" fn free_instance(c: Component) {
     let _ = ch(c).call(Op::Free);
 }
 
-unsafe extern "C" fn setup_experiment(c: Component, tol_defined: c_int, tol: f64, start: f64, stop_defined: c_int, stop: f64) -> c_int {
+unsafe extern "C" fn setup_experiment(
+    c: Component,
+    tol_defined: c_int,
+    tol: f64,
+    start: f64,
+    stop_defined: c_int,
+    stop: f64,
+) -> c_int {
     let channel = ch(c);
     let h = channel.header();
     h.i = [tol_defined as i64, stop_defined as i64, 0, 0];
@@ -303,7 +309,12 @@ unsafe extern "C" fn new_discrete_states(c: Component, info: *mut EventInfo) -> 
     r
 }
 
-unsafe extern "C" fn completed_integrator_step(c: Component, no_set_prior: c_int, event: *mut c_int, terminate: *mut c_int) -> c_int {
+unsafe extern "C" fn completed_integrator_step(
+    c: Component,
+    no_set_prior: c_int,
+    event: *mut c_int,
+    terminate: *mut c_int,
+) -> c_int {
     let channel = ch(c);
     channel.header().i = [no_set_prior as i64, 0, 0, 0];
     let r = channel.call(Op::CompletedIntegratorStep);

@@ -77,7 +77,9 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
                 )));
             }
             if !(atol.is_finite() && atol >= 0.0) {
-                return Err(Error::Experiment(format!("the dopri5 absolute tolerance {atol:e} must be finite and >= 0")));
+                return Err(Error::Experiment(format!(
+                    "the dopri5 absolute tolerance {atol:e} must be finite and >= 0"
+                )));
             }
         }
     }
@@ -168,143 +170,145 @@ fn run<'s>(
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress, sink);
     let outcome = (|| -> Result<Summary> {
-
-    // instantiate and initialize (FMI 2.0 section 4.2.4)
-    let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
-    for (index, spec) in system.instances.iter().enumerate() {
-        let inst = match pool.as_deref_mut().and_then(|p| p.take(index, spec)) {
-            Some(mut inst) => {
-                inst.reset()?;
-                inst
-            }
-            None => match &experiment.isolation {
-                Some(iso) if iso.covers(&spec.name) => Instance::new_isolated(&spec.fmu, &spec.name, iso, deadline)?,
-                _ => Instance::new(&spec.fmu, &spec.name)?,
-            },
+        // instantiate and initialize (FMI 2.0 section 4.2.4)
+        let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
+        for (index, spec) in system.instances.iter().enumerate() {
+            let inst = match pool.as_deref_mut().and_then(|p| p.take(index, spec)) {
+                Some(mut inst) => {
+                    inst.reset()?;
+                    inst
+                }
+                None => match &experiment.isolation {
+                    Some(iso) if iso.covers(&spec.name) => {
+                        Instance::new_isolated(&spec.fmu, &spec.name, iso, deadline)?
+                    }
+                    _ => Instance::new(&spec.fmu, &spec.name)?,
+                },
+            };
+            lanes.push(Lane::new(
+                index,
+                inst,
+                std::mem::take(&mut plan.jacobi_gets[index]),
+                std::mem::take(&mut plan.jacobi_gets_rec[index]),
+                std::mem::take(&mut plan.jacobi_sets[index]),
+            ));
+        }
+        let mut core = Core {
+            lanes,
+            values: vec![0.0; plan.sources.len()],
+            group,
+            solver: experiment.solver,
+            clock,
+            profile: experiment.profile,
+            parallel_steps: 0,
         };
-        lanes.push(Lane::new(
-            index,
-            inst,
-            std::mem::take(&mut plan.jacobi_gets[index]),
-            std::mem::take(&mut plan.jacobi_gets_rec[index]),
-            std::mem::take(&mut plan.jacobi_sets[index]),
-        ));
-    }
-    let mut core = Core {
-        lanes,
-        values: vec![0.0; plan.sources.len()],
-        group,
-        solver: experiment.solver,
-        clock,
-        profile: experiment.profile,
-        parallel_steps: 0,
-    };
-    let t0 = clock.t0;
-    for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
-        lane.inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
-        apply_start_values(&mut lane.inst, spec)?;
-        lane.inst.enter_initialization_mode()?;
-    }
-    algorithm.propagate(&mut core)?;
-    for lane in core.lanes.iter_mut() {
-        lane.inst.exit_initialization_mode()?;
-        if lane.inst.fmu().interface() == Interface::ModelExchange {
-            lane.unit = Some(MeUnit::new(&lane.inst));
-            if !core.group.as_ref().is_some_and(|g| g.contains(lane.index)) {
-                lane.solo = Some(MeGroup::solo(lane.index, experiment.max_steps));
+        let t0 = clock.t0;
+        for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
+            lane.inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
+            apply_start_values(&mut lane.inst, spec)?;
+            lane.inst.enter_initialization_mode()?;
+        }
+        algorithm.propagate(&mut core)?;
+        for lane in core.lanes.iter_mut() {
+            lane.inst.exit_initialization_mode()?;
+            if lane.inst.fmu().interface() == Interface::ModelExchange {
+                lane.unit = Some(MeUnit::new(&lane.inst));
+                if !core.group.as_ref().is_some_and(|g| g.contains(lane.index)) {
+                    lane.solo = Some(MeGroup::solo(lane.index, experiment.max_steps));
+                }
             }
         }
-    }
-    // the initial event iteration of every Model Exchange group
-    for lane in core.lanes.iter_mut() {
-        if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
-            solo.iterate(&mut crate::simulate::me_group::Solo { inst: &mut lane.inst, unit }, t0)?;
+        // the initial event iteration of every Model Exchange group
+        for lane in core.lanes.iter_mut() {
+            if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
+                solo.iterate(&mut crate::simulate::me_group::Solo { inst: &mut lane.inst, unit }, t0)?;
+            }
         }
-    }
-    if let Some(g) = core.group.as_mut() {
-        g.iterate(core.lanes.as_mut_slice(), t0)?;
-    }
-    for lane in core.lanes.iter_mut() {
-        let fmu = lane.inst.fmu();
-        let capable =
-            fmu.interface() == Interface::CoSimulation && fmu.can_get_and_set_state() && fmu.can_handle_variable_step();
-        if experiment.retry_discard && capable {
-            lane.saved = Some(lane.inst.get_state()?);
+        if let Some(g) = core.group.as_mut() {
+            g.iterate(core.lanes.as_mut_slice(), t0)?;
         }
-    }
-    algorithm.propagate(&mut core)?;
-    run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
-    recorder.push_row(t0, &core.values);
-    // an FMU may end the run in its initial event iteration
-    let mut ended = core.lanes.iter().find(|l| l.unit.as_ref().is_some_and(|u| u.terminated)).map(|l| {
-        Error::Terminated { instance: l.inst.name().to_string(), time: t0, reason: "terminateSimulation" }
-    });
+        for lane in core.lanes.iter_mut() {
+            let fmu = lane.inst.fmu();
+            let capable = fmu.interface() == Interface::CoSimulation
+                && fmu.can_get_and_set_state()
+                && fmu.can_handle_variable_step();
+            if experiment.retry_discard && capable {
+                lane.saved = Some(lane.inst.get_state()?);
+            }
+        }
+        algorithm.propagate(&mut core)?;
+        run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+        recorder.push_row(t0, &core.values);
+        // an FMU may end the run in its initial event iteration
+        let mut ended = core.lanes.iter().find(|l| l.unit.as_ref().is_some_and(|u| u.terminated)).map(|l| {
+            Error::Terminated { instance: l.inst.name().to_string(), time: t0, reason: "terminateSimulation" }
+        });
 
-    let mut profiler = Profiler::new(core.lanes.len());
-    if ended.is_none() {
-        let mut limit = deadline.map(|(at, limit)| Deadline { at, limit });
-        let mut list = vec![&mut recorder as &mut dyn Observer];
-        if let Some(d) = limit.as_mut() {
-            list.push(d);
-        }
-        let mut observers = Observers { list, calls: experiment.profile.then_some(&mut profiler) };
-        match algorithm.run(&mut core, &mut observers) {
-            Ok(()) => {}
-            Err(e @ Error::Terminated { .. }) => ended = Some(e),
-            Err(e) => return Err(e),
-        }
-    }
-    let mut ended_by = None;
-    if let Some(Error::Terminated { instance, time, reason }) = ended {
-        // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
-        // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
-        // row after the last communication point before the event (as fmpy)
-        if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
-            run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
-            recorder.push_row(time, &core.values);
-        }
-        ended_by = Some((instance, time, reason));
-    }
-    if experiment.profile {
-        for lane in core.lanes.iter() {
-            profiler.spent[lane.index] += lane.spent;
-        }
-    }
-    let mut summary = Summary {
-        steps: recorder.steps_done(),
-        parallel_steps: core.parallel_steps,
-        wall_time: Duration::ZERO,
-        ended_by,
-        ..Summary::default()
-    };
-    for lane in core.lanes.iter_mut() {
-        summary.discard_retries += lane.retries;
-        if let Some(state) = lane.saved.take() {
-            lane.inst.free_state(state)?;
-        }
-        if let Some(unit) = lane.unit.take() {
-            summary.integrator_steps.0 += unit.steps;
-            summary.integrator_steps.1 += unit.rejected;
-            summary.events.extend(unit.events);
-        }
-    }
-    for lane in core.lanes.iter_mut() {
-        lane.inst.terminate()?;
-        for rec in lane.inst.take_log() {
-            if rec.status != crate::error::Status::Ok {
-                summary.warnings.push((lane.inst.name().to_string(), rec.message));
+        let mut profiler = Profiler::new(core.lanes.len());
+        if ended.is_none() {
+            let mut limit = deadline.map(|(at, limit)| Deadline { at, limit });
+            let mut list = vec![&mut recorder as &mut dyn Observer];
+            if let Some(d) = limit.as_mut() {
+                list.push(d);
+            }
+            let mut observers = Observers { list, calls: experiment.profile.then_some(&mut profiler) };
+            match algorithm.run(&mut core, &mut observers) {
+                Ok(()) => {}
+                Err(e @ Error::Terminated { .. }) => ended = Some(e),
+                Err(e) => return Err(e),
             }
         }
-    }
-    if let Some(pool) = pool {
-        for lane in std::mem::take(&mut core.lanes) {
-            pool.put(lane.index, lane.inst);
+        let mut ended_by = None;
+        if let Some(Error::Terminated { instance, time, reason }) = ended {
+            // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
+            // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
+            // row after the last communication point before the event (as fmpy)
+            if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
+                run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+                recorder.push_row(time, &core.values);
+            }
+            ended_by = Some((instance, time, reason));
         }
-    }
-    drop(core);
-    summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
-    summary.wall_time = wall.elapsed();
-    Ok(summary)
+        if experiment.profile {
+            for lane in core.lanes.iter() {
+                profiler.spent[lane.index] += lane.spent;
+            }
+        }
+        let mut summary = Summary {
+            steps: recorder.steps_done(),
+            parallel_steps: core.parallel_steps,
+            wall_time: Duration::ZERO,
+            ended_by,
+            ..Summary::default()
+        };
+        for lane in core.lanes.iter_mut() {
+            summary.discard_retries += lane.retries;
+            if let Some(state) = lane.saved.take() {
+                lane.inst.free_state(state)?;
+            }
+            if let Some(unit) = lane.unit.take() {
+                summary.integrator_steps.0 += unit.steps;
+                summary.integrator_steps.1 += unit.rejected;
+                summary.events.extend(unit.events);
+            }
+        }
+        for lane in core.lanes.iter_mut() {
+            lane.inst.terminate()?;
+            for rec in lane.inst.take_log() {
+                if rec.status != crate::error::Status::Ok {
+                    summary.warnings.push((lane.inst.name().to_string(), rec.message));
+                }
+            }
+        }
+        if let Some(pool) = pool {
+            for lane in std::mem::take(&mut core.lanes) {
+                pool.put(lane.index, lane.inst);
+            }
+        }
+        drop(core);
+        summary.instance_time = system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
+        summary.wall_time = wall.elapsed();
+        Ok(summary)
     })();
     *out = std::mem::take(&mut recorder.results);
     outcome

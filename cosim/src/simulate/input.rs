@@ -158,7 +158,10 @@ fn input_events(table: &InputTable, columns: &[Column]) -> Vec<(String, f64)> {
         }
         for (j, c) in columns.iter().enumerate() {
             if c.discrete && table.columns[j][k] != table.columns[j][k - 1] {
-                out.push((format!("the change of the discrete input {} at t = {} s (row {})", table.names[j], t[k], k + 2), t[k]));
+                out.push((
+                    format!("the change of the discrete input {} at t = {} s (row {})", table.names[j], t[k], k + 2),
+                    t[k],
+                ));
             }
         }
     }
@@ -251,9 +254,10 @@ impl WithInput {
                 || v.variability == Variability::Tunable;
             columns.push(Column { variable: r, discrete });
         }
-        let fixed_step = system.instances.iter().find(|i| {
-            i.fmu.interface() == crate::fmu::Interface::CoSimulation && !i.fmu.can_handle_variable_step()
-        });
+        let fixed_step = system
+            .instances
+            .iter()
+            .find(|i| i.fmu.interface() == crate::fmu::Interface::CoSimulation && !i.fmu.can_handle_variable_step());
         let mut splits = Vec::new();
         for (what, t) in input_events(table, &columns) {
             if !on_grid(t, clock) {

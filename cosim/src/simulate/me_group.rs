@@ -171,7 +171,13 @@ impl MeGroup {
 
     /// An event at `time` caused by `who` (recorded as `kind`): all members enter event
     /// mode and iterate together.
-    fn event<L: Members + ?Sized>(&mut self, lanes: &mut L, time: f64, kind: &'static str, who: &[usize]) -> Result<()> {
+    fn event<L: Members + ?Sized>(
+        &mut self,
+        lanes: &mut L,
+        time: f64,
+        kind: &'static str,
+        who: &[usize],
+    ) -> Result<()> {
         for &m in self.members.iter() {
             lanes.instance(m).enter_event_mode()?;
         }
@@ -216,7 +222,13 @@ impl MeGroup {
 
     /// Integrates all members from `t` to `t_end` together, their inputs held between
     /// events.
-    pub(crate) fn advance<L: Members + ?Sized>(&mut self, lanes: &mut L, solver: Solver, t: f64, t_end: f64) -> Result<()> {
+    pub(crate) fn advance<L: Members + ?Sized>(
+        &mut self,
+        lanes: &mut L,
+        solver: Solver,
+        t: f64,
+        t_end: f64,
+    ) -> Result<()> {
         let mut t = t;
         let span = t_end - t;
         let eps = time_slack(t_end, span);

@@ -204,10 +204,9 @@ fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
 /// The FMU of crash.c whose library segfaults in its load-time initializer
 /// (tests/cfmu/ctor.c), as `<dir>/ctor.fmu`.
 pub fn build_ctor_crash(dir: &Path) -> PathBuf {
-    let xml = include_str!("../cfmu/crash.xml").replace(r#"modelName="crash""#, r#"modelName="ctor""#).replace(
-        r#"modelIdentifier="crash""#,
-        r#"modelIdentifier="ctor""#,
-    );
+    let xml = include_str!("../cfmu/crash.xml")
+        .replace(r#"modelName="crash""#, r#"modelName="ctor""#)
+        .replace(r#"modelIdentifier="crash""#, r#"modelIdentifier="ctor""#);
     build_single_c_fmu(dir, "ctor", &xml)
 }
 
