@@ -17,7 +17,9 @@
 //!    unit, min/max, description, and the model field it reads and writes, e.g.
 //!    `v.real("beta").input(0.0).unit("rad").field(|m, _| &mut m.inputs.beta)`, which
 //!    returns the variable's [`VarHandle`]; dependencies (the ModelStructure) are lists of
-//!    those handles. The layer assigns the value references (per base type, in declaration
+//!    those handles. The unit is written once, on the variable, in Modelica's syntax
+//!    (`"N.m"`, `"m/s2"`): the layer derives its `<UnitDefinitions>` entry from the name
+//!    ([`units`]). The layer assigns the value references (per base type, in declaration
 //!    order: appending keeps the earlier ones) and each FMU pins them in a checked-in table
 //!    ([`Declaration::check_pinned_value_references`]). A family `{stem}_{suffix}` (the four
 //!    wheels) is one call of [`Variables::family`] (a matrix: [`Variables::family_columns`]);
