@@ -131,6 +131,29 @@ fn run_values_depend_only_on_seed_and_run() {
     }
 }
 
+/// `campaign run SPEC --out OUT --threads 1` in the background, with a TMPDIR of its own
+/// (`OUT.tmp`, returned) and standard error piped.
+fn spawn_campaign(spec: &Path, out: &Path) -> (std::process::Child, PathBuf) {
+    let tmp = out.with_extension("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let child = Command::new(CAMPAIGN)
+        .arg("run")
+        .arg(spec)
+        .arg("--out")
+        .arg(out)
+        .args(["--threads", "1"])
+        .env("TMPDIR", &tmp)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    (child, tmp)
+}
+
+/// The rows `results.csv` in `out` holds so far.
+fn rows_in(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("results.csv")).map_or(0, |t| t.lines().count().saturating_sub(1))
+}
+
 #[test]
 fn resume_after_a_killed_run_completes_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,19 +163,9 @@ fn resume_after_a_killed_run_completes_it() {
     run(&spec, &quiet(&local)).unwrap();
     let out = dir.path().join("killed");
     // SIGKILL cannot be caught: the unpacked FMUs stay in the child's TMPDIR, the test's own
-    let tmp = dir.path().join("tmp");
-    std::fs::create_dir(&tmp).unwrap();
-    let mut child = Command::new(CAMPAIGN)
-        .arg("run")
-        .arg(&spec_path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--threads", "1"])
-        .env("TMPDIR", &tmp)
-        .spawn()
-        .unwrap();
+    let (mut child, _tmp) = spawn_campaign(&spec_path, &out);
     let rows = out.join("results.csv");
-    let count = || std::fs::read_to_string(&rows).map_or(0, |t| t.lines().count().saturating_sub(1));
+    let count = || rows_in(&out);
     while count() < 3 {
         assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be killed");
         std::thread::sleep(std::time::Duration::from_millis(5));
@@ -417,20 +430,8 @@ fn sigterm_removes_the_unpacked_fmus_and_keeps_the_rows_written() {
     let dir = tempfile::tempdir().unwrap();
     let spec_path = small(dir.path(), 30.0, 10);
     let out = dir.path().join("stopped");
-    let tmp = dir.path().join("tmp");
-    std::fs::create_dir(&tmp).unwrap();
-    let child = Command::new(CAMPAIGN)
-        .arg("run")
-        .arg(&spec_path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--threads", "1"])
-        .env("TMPDIR", &tmp)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let rows = out.join("results.csv");
-    let count = || std::fs::read_to_string(&rows).map_or(0, |t| t.lines().count().saturating_sub(1));
+    let (child, tmp) = spawn_campaign(&spec_path, &out);
+    let count = || rows_in(&out);
     while count() < 2 {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
