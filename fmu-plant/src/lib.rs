@@ -13,7 +13,7 @@ use fmi2_export::{
     ModelError, ModelResult, Start, VarHandle, Variables,
 };
 use nigel_vehicle::dynamics::idx;
-use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, Scalar, State, VehicleParams, N_STATES, WHEELS};
+use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, ParamScalars, Scalar, State, VehicleParams, N_STATES, WHEELS};
 
 /// The model identifier (file name of the shared library and of the `.fmu`).
 pub const MODEL_IDENTIFIER: &str = "nigel_plant";
@@ -425,6 +425,27 @@ fn param_slot(p: &mut VehicleParams, which: Param) -> Option<&mut f64> {
     })
 }
 
+/// [`param_slot`] of the parameters as scalars of the right-hand side.
+fn param_scalar_slot<T>(p: &mut ParamScalars<T>, which: Param) -> Option<&mut T> {
+    Some(match which {
+        Param::Mass => &mut p.m,
+        Param::YawInertia => &mut p.i_z,
+        Param::CgToFront => &mut p.l_f,
+        Param::CgToRear => &mut p.l_r,
+        Param::Track => &mut p.track,
+        Param::WheelRadius => &mut p.r_wheel,
+        Param::CorneringStiffness(i) => &mut p.c[i],
+        Param::Gravity => &mut p.g,
+        Param::FadeSpeed => &mut p.v_fade,
+        Param::SteerLimit => &mut p.delta_max,
+        Param::ServoTimeConstant => &mut p.servo_time_constant,
+        Param::ServoRateMax => &mut p.servo_rate_max,
+        Param::WheelSpeedMax => &mut p.wheel_speed_max,
+        Param::MotorTaper => &mut p.motor_taper,
+        Param::CsSubstepMax => return None,
+    })
+}
+
 fn switch_slot(p: &mut VehicleParams, which: Switch) -> &mut bool {
     match which {
         Switch::FrictionCircle => &mut p.friction_circle,
@@ -590,7 +611,10 @@ impl Model for Plant {
     fn provides_derivative_with_respect_to(known: PlantVar, initialization: bool) -> bool {
         match known {
             PlantVar::Input(_) | PlantVar::State(_) => true,
-            PlantVar::StateStart(_) => initialization,
+            // in Initialization Mode the knowns with initial="exact": the start values and the
+            // parameters (dual numbers through the right-hand side: the states are their start
+            // values, which no parameter changes)
+            PlantVar::StateStart(_) | PlantVar::Param(_) => initialization,
             _ => false,
         }
     }
@@ -613,15 +637,27 @@ impl Model for Plant {
             wind_x: Dual::constant(u.wind_x),
             wind_y: Dual::constant(u.wind_y),
         };
+        // the parameters as dual numbers only when one is a known (else as constants, the
+        // cheaper evaluation of the Jacobians an ME importer asks for at every step)
+        let mut pd =
+            knowns.iter().any(|k| matches!(k, PlantVar::Param(_))).then(|| ParamScalars::<Dual>::of(&self.params));
         for (&k, &dv) in knowns.iter().zip(dv_known) {
-            match k {
+            match (k, pd.as_mut()) {
                 // in Initialization Mode a state is its start value
-                PlantVar::State(i) | PlantVar::StateStart(i) => s[i].d += dv,
-                PlantVar::Input(i) => input_slot(&mut ud, i).d += dv,
-                _ => return Err("a known the layer let through is not a state or an input".into()),
+                (PlantVar::State(i) | PlantVar::StateStart(i), _) => s[i].d += dv,
+                (PlantVar::Input(i), _) => input_slot(&mut ud, i).d += dv,
+                // cs_substep_max changes no value, only the Co-Simulation step's sub-steps
+                (PlantVar::Param(Param::CsSubstepMax), _) => {}
+                (PlantVar::Param(p), Some(pd)) => {
+                    param_scalar_slot(pd, p).ok_or("a parameter of the right-hand side expected")?.d += dv
+                }
+                _ => return Err("a known the layer let through is not a state, an input or a parameter".into()),
             }
         }
-        let e = evaluate(&self.params, &s, &ud);
+        let e = match &pd {
+            Some(pd) => evaluate(pd, &s, &ud),
+            None => evaluate(&self.params, &s, &ud),
+        };
         for (o, &unknown) in out.iter_mut().zip(unknowns) {
             *o = match unknown {
                 PlantVar::Derivative(i) => e.derivatives[i].d,

@@ -383,8 +383,7 @@ fn initial_unknowns_depend_only_on_initialization_knowns() {
 /// In Initialization Mode the exact start values are knowns (FMI 2.0 section 2.2.8): the
 /// directional derivatives with respect to them go through the initial-state calculation
 /// (the state is its start value) and agree with central differences of the InitialUnknowns
-/// (the derivatives, whose dependence on the state is smooth at this point). A parameter,
-/// for which none are provided, is refused naming it, without Rust debug text.
+/// (the derivatives, whose dependence on the state is smooth at this point).
 #[test]
 fn initialization_mode_directional_derivatives_with_respect_to_the_start_values() {
     let (i, log) = fmu().instantiate("dd-init", CO_SIMULATION, fmu().guid());
@@ -431,6 +430,107 @@ fn initialization_mode_directional_derivatives_with_respect_to_the_start_values(
         }
         assert!(nonzero > 0, "{start} moves something");
     }
+}
+
+/// The other exact knowns of Initialization Mode, the parameters: the directional
+/// derivatives (dual numbers through the right-hand side, the parameters as dual numbers)
+/// agree with central differences for every continuous parameter, with the real-fidelity
+/// switches on (servo, motor limit, friction circle) at a point inside their smooth regions
+/// (the servo at its rate limit, the drive inside the friction circle, the wheels below the
+/// motor taper). After initialization a parameter is no known: refused, naming it.
+#[test]
+fn initialization_mode_directional_derivatives_with_respect_to_the_parameters() {
+    let (i, log) = fmu().instantiate("dd-params", CO_SIMULATION, fmu().guid());
+    let i = i.unwrap();
+    let f = i.f();
+    assert_eq!(i.setup(0.0), OK);
+    assert_eq!(i.enter_init(), OK);
+    assert_eq!(i.set_boolean(&vrs(&["friction_circle", "steering_servo", "motor_speed_limit"]), &[true; 3]), OK);
+    let inputs =
+        ["delta_fl", "delta_fr", "delta_rl", "delta_rr", "tau_fl", "tau_fr", "tau_rl", "tau_rr", "mu_fl", "mu_rr"];
+    let values = [0.2, 0.15, -0.05, 0.0, 0.004, 0.004, 0.003, 0.003, 0.6, 0.5];
+    assert_eq!(i.set_real(&vrs(&inputs), &values), OK);
+    assert_eq!(i.set_real(&vrs(&["v_x_start", "v_y_start", "yaw_rate_start"]), &[0.35, 0.02, 0.4]), OK);
+    // delta_max starts at its maximum pi/2, where p + h would be refused
+    assert_eq!(i.set_real(&vrs(&["delta_max"]), &[1.0]), OK);
+    let parameters = [
+        "m",
+        "I_z",
+        "l_f",
+        "l_r",
+        "track",
+        "r_wheel",
+        "c_fl",
+        "c_fr",
+        "c_rl",
+        "c_rr",
+        "g",
+        "v_fade",
+        "delta_max",
+        "servo_time_constant",
+        "servo_rate_max",
+        "wheel_speed_max",
+        "motor_taper",
+        "cs_substep_max",
+    ];
+    let unknowns = vrs(&[
+        "der(v_x)",
+        "der(v_y)",
+        "der(yaw_rate)",
+        "der(servo_angle_fl)",
+        "lateral_accel",
+        "slip_angle_fl",
+        "force_lat_fl",
+        "force_lat_rr",
+        "force_drive_fl",
+    ]);
+    let mut moved = std::collections::BTreeSet::new();
+    for name in parameters {
+        let known = fmu().vr(name);
+        let p0 = i.get_real(&[known]).unwrap()[0];
+        let mut exact = vec![0.0; unknowns.len()];
+        let s = unsafe {
+            (f.get_directional_derivative.unwrap())(
+                i.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                &known,
+                1,
+                &1.0,
+                exact.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, OK, "{name}: {:?}", log.last_error());
+        // central differences with h = 1e-6 |p|: truncation O(h^2 f''') is about 1e-12 of
+        // the derivative's scale on these smooth terms; rounding is eps |f| / h, at most
+        // 1e-8 here (|f| < 10, |p| > 1e-3): 1e-6 relative plus 1e-7 absolute holds on any
+        // x86-64 libm
+        let h = 1e-6 * p0.abs();
+        let at = |x: f64| {
+            assert_eq!(i.set_real(&[known], &[x]), OK, "{name}");
+            i.get_real(&unknowns).unwrap()
+        };
+        let (up, down) = (at(p0 + h), at(p0 - h));
+        assert_eq!(i.set_real(&[known], &[p0]), OK);
+        for (j, e) in exact.iter().enumerate() {
+            let fd = (up[j] - down[j]) / (2.0 * h);
+            assert!((e - fd).abs() <= 1e-6 * fd.abs() + 1e-7, "d unknown {j} / d {name}: {e} vs {fd}");
+            if *e != 0.0 {
+                moved.insert(name);
+            }
+        }
+    }
+    // the parameters of the terms active at this point move something (the servo runs at
+    // its rate limit: 0.2 rad from its angle 0 is more than servo_rate_max servo_time_constant);
+    // the limits not reached and the integrator's sub-step do not
+    for name in ["m", "I_z", "l_f", "l_r", "track", "r_wheel", "c_fl", "c_rr", "servo_rate_max"] {
+        assert!(moved.contains(name), "{name} moves nothing: {moved:?}");
+    }
+    for name in ["delta_max", "servo_time_constant", "wheel_speed_max", "motor_taper", "cs_substep_max", "g", "v_fade"]
+    {
+        assert!(!moved.contains(name), "{name} moves something: {moved:?}");
+    }
+    assert_eq!(i.exit_init(), OK);
     let (unknown, param) = (fmu().vr("der(v_y)"), fmu().vr("l_f"));
     let mut out = [0.0];
     let s = unsafe { (f.get_directional_derivative.unwrap())(i.c, &unknown, 1, &param, 1, &1.0, out.as_mut_ptr()) };

@@ -3,6 +3,191 @@
 use crate::params::VehicleParams;
 use crate::scalar::Scalar;
 
+/// The parameters as the right-hand side reads them: each continuous one as a scalar `T`,
+/// so that [`evaluate`] differentiates with respect to parameters too (with
+/// [`ParamScalars`] of dual numbers) while [`VehicleParams`] serves every plain evaluation
+/// (its `T::constant` values are the `f64`s themselves, so the `f64` path computes the
+/// same operations on the same numbers).
+pub trait ParamsOf<T: Scalar> {
+    fn m(&self) -> T;
+    fn i_z(&self) -> T;
+    fn r_wheel(&self) -> T;
+    /// Cornering stiffness of wheel `i`.
+    fn c(&self, i: usize) -> T;
+    fn v_fade(&self) -> T;
+    fn delta_max(&self) -> T;
+    fn servo_time_constant(&self) -> T;
+    fn servo_rate_max(&self) -> T;
+    fn wheel_speed_max(&self) -> T;
+    fn motor_taper(&self) -> T;
+    /// Wheel positions `(x_i, y_i)` from the CG, as [`VehicleParams::wheel_positions`].
+    fn wheel_positions(&self) -> [(T, T); 4];
+    /// Static normal loads, as [`VehicleParams::normal_loads`].
+    fn normal_loads(&self) -> [T; 4];
+    /// `x_c`, as [`VehicleParams::x_c`].
+    fn x_c(&self) -> T;
+    /// The fidelity switches (not differentiable).
+    fn switches(&self) -> (bool, bool, bool);
+}
+
+impl<T: Scalar> ParamsOf<T> for VehicleParams {
+    #[inline(always)]
+    fn m(&self) -> T {
+        T::constant(self.m)
+    }
+    #[inline(always)]
+    fn i_z(&self) -> T {
+        T::constant(self.i_z)
+    }
+    #[inline(always)]
+    fn r_wheel(&self) -> T {
+        T::constant(self.r_wheel)
+    }
+    #[inline(always)]
+    fn c(&self, i: usize) -> T {
+        T::constant(self.c[i])
+    }
+    #[inline(always)]
+    fn v_fade(&self) -> T {
+        T::constant(self.v_fade)
+    }
+    #[inline(always)]
+    fn delta_max(&self) -> T {
+        T::constant(self.delta_max)
+    }
+    #[inline(always)]
+    fn servo_time_constant(&self) -> T {
+        T::constant(self.servo_time_constant)
+    }
+    #[inline(always)]
+    fn servo_rate_max(&self) -> T {
+        T::constant(self.servo_rate_max)
+    }
+    #[inline(always)]
+    fn wheel_speed_max(&self) -> T {
+        T::constant(self.wheel_speed_max)
+    }
+    #[inline(always)]
+    fn motor_taper(&self) -> T {
+        T::constant(self.motor_taper)
+    }
+    #[inline(always)]
+    fn wheel_positions(&self) -> [(T, T); 4] {
+        VehicleParams::wheel_positions(self).map(|(x, y)| (T::constant(x), T::constant(y)))
+    }
+    #[inline(always)]
+    fn normal_loads(&self) -> [T; 4] {
+        VehicleParams::normal_loads(self).map(T::constant)
+    }
+    #[inline(always)]
+    fn x_c(&self) -> T {
+        T::constant(VehicleParams::x_c(self))
+    }
+    #[inline(always)]
+    fn switches(&self) -> (bool, bool, bool) {
+        (self.friction_circle, self.steering_servo, self.motor_speed_limit)
+    }
+}
+
+/// [`VehicleParams`] with every continuous parameter a scalar `T` (a dual number to
+/// differentiate with respect to it); the derived quantities are computed with the
+/// operations of [`VehicleParams`]'s methods, in the same order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamScalars<T> {
+    pub m: T,
+    pub i_z: T,
+    pub l_f: T,
+    pub l_r: T,
+    pub track: T,
+    pub r_wheel: T,
+    pub c: [T; 4],
+    pub g: T,
+    pub v_fade: T,
+    pub delta_max: T,
+    pub servo_time_constant: T,
+    pub servo_rate_max: T,
+    pub wheel_speed_max: T,
+    pub motor_taper: T,
+    pub friction_circle: bool,
+    pub steering_servo: bool,
+    pub motor_speed_limit: bool,
+}
+
+impl<T: Scalar> ParamScalars<T> {
+    /// The parameters `p` as constants (derivative parts zero).
+    pub fn of(p: &VehicleParams) -> Self {
+        let k = T::constant;
+        ParamScalars {
+            m: k(p.m),
+            i_z: k(p.i_z),
+            l_f: k(p.l_f),
+            l_r: k(p.l_r),
+            track: k(p.track),
+            r_wheel: k(p.r_wheel),
+            c: p.c.map(k),
+            g: k(p.g),
+            v_fade: k(p.v_fade),
+            delta_max: k(p.delta_max),
+            servo_time_constant: k(p.servo_time_constant),
+            servo_rate_max: k(p.servo_rate_max),
+            wheel_speed_max: k(p.wheel_speed_max),
+            motor_taper: k(p.motor_taper),
+            friction_circle: p.friction_circle,
+            steering_servo: p.steering_servo,
+            motor_speed_limit: p.motor_speed_limit,
+        }
+    }
+}
+
+impl<T: Scalar> ParamsOf<T> for ParamScalars<T> {
+    fn m(&self) -> T {
+        self.m
+    }
+    fn i_z(&self) -> T {
+        self.i_z
+    }
+    fn r_wheel(&self) -> T {
+        self.r_wheel
+    }
+    fn c(&self, i: usize) -> T {
+        self.c[i]
+    }
+    fn v_fade(&self) -> T {
+        self.v_fade
+    }
+    fn delta_max(&self) -> T {
+        self.delta_max
+    }
+    fn servo_time_constant(&self) -> T {
+        self.servo_time_constant
+    }
+    fn servo_rate_max(&self) -> T {
+        self.servo_rate_max
+    }
+    fn wheel_speed_max(&self) -> T {
+        self.wheel_speed_max
+    }
+    fn motor_taper(&self) -> T {
+        self.motor_taper
+    }
+    fn wheel_positions(&self) -> [(T, T); 4] {
+        let h = self.track * 0.5;
+        [(self.l_f, h), (self.l_f, -h), (-self.l_r, h), (-self.l_r, -h)]
+    }
+    fn normal_loads(&self) -> [T; 4] {
+        let l = self.l_f + self.l_r;
+        let front = self.m * self.g * self.l_r / (l * 2.0);
+        let rear = self.m * self.g * self.l_f / (l * 2.0);
+        [front, front, rear, rear]
+    }
+    fn x_c(&self) -> T {
+        (self.l_f - self.l_r) * 0.5
+    }
+    fn switches(&self) -> (bool, bool, bool) {
+        (self.friction_circle, self.steering_servo, self.motor_speed_limit)
+    }
+}
+
 /// Number of continuous states: `x, y, psi, v_x, v_y, yaw_rate` and the four servo angles.
 ///
 /// The servo angles are always states (an FMU has a fixed state vector); with the steering
@@ -95,27 +280,27 @@ pub struct Steering<T> {
 }
 
 /// The steering actually applied at this state and input.
-pub fn steering<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Steering<T> {
+pub fn steering<T: Scalar>(p: &impl ParamsOf<T>, s: &State<T>, u: &Inputs<T>) -> Steering<T> {
     steering_commanded(p, s, &clamped_commands(p, u))
 }
 
 /// The steering commands clamped to `+-delta_max` (inputs only: once per held step).
 #[inline(always)]
-fn clamped_commands<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> [T; 4] {
-    let dmax = T::constant(p.delta_max);
+fn clamped_commands<T: Scalar>(p: &impl ParamsOf<T>, u: &Inputs<T>) -> [T; 4] {
+    let dmax = p.delta_max();
     u.delta.map(|d| d.clamp_s(-dmax, dmax))
 }
 
 /// [`steering`] from the clamped commands.
 #[inline(always)]
-fn steering_commanded<T: Scalar>(p: &VehicleParams, s: &State<T>, cmd: &[T; 4]) -> Steering<T> {
+fn steering_commanded<T: Scalar>(p: &impl ParamsOf<T>, s: &State<T>, cmd: &[T; 4]) -> Steering<T> {
     let zero = T::constant(0.0);
     let mut st = Steering { delta: *cmd, sin: [zero; 4], cos: [zero; 4], servo_rate: [zero; 4] };
-    if p.steering_servo {
-        let rate = T::constant(p.servo_rate_max);
+    if p.switches().1 {
+        let rate = p.servo_rate_max();
         for i in 0..4 {
             let sv = s[idx::SERVO + i];
-            st.servo_rate[i] = ((cmd[i] - sv) / p.servo_time_constant).clamp_s(-rate, rate);
+            st.servo_rate[i] = ((cmd[i] - sv) / p.servo_time_constant()).clamp_s(-rate, rate);
             st.delta[i] = sv;
         }
     }
@@ -162,10 +347,11 @@ struct WheelDrive<T> {
 }
 
 #[inline(always)]
-fn wheel_drive<T: Scalar>(p: &VehicleParams, u: &Inputs<T>) -> WheelDrive<T> {
+fn wheel_drive<T: Scalar>(p: &impl ParamsOf<T>, u: &Inputs<T>) -> WheelDrive<T> {
     let loads = p.normal_loads();
     let cap: [T; 4] = core::array::from_fn(|i| u.mu[i] * loads[i]);
-    WheelDrive { cap, drive: core::array::from_fn(|i| (u.tau[i] / p.r_wheel).clamp_s(-cap[i], cap[i])) }
+    let r_wheel = p.r_wheel();
+    WheelDrive { cap, drive: core::array::from_fn(|i| (u.tau[i] / r_wheel).clamp_s(-cap[i], cap[i])) }
 }
 
 /// Derivatives and per-wheel quantities, without the body outputs (the hot path).
@@ -178,7 +364,8 @@ struct Core<T> {
 }
 
 #[inline(always)]
-fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering<T>, wd: &WheelDrive<T>) -> Core<T> {
+fn core<T: Scalar>(p: &impl ParamsOf<T>, s: &State<T>, u: &Inputs<T>, st: &Steering<T>, wd: &WheelDrive<T>) -> Core<T> {
+    let (friction_circle, _, motor_speed_limit) = p.switches();
     let zero = T::constant(0.0);
     let one = T::constant(1.0);
     let v_x = s[idx::V_X];
@@ -186,7 +373,8 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let r = s[idx::YAW_RATE];
     let psi = s[idx::PSI];
     let pos = p.wheel_positions();
-    let v_fade_sq = p.v_fade * p.v_fade;
+    let v_fade = p.v_fade();
+    let v_fade_sq = (v_fade * v_fade).value();
 
     let mut der = [zero; N_STATES];
     der[idx::SERVO..].copy_from_slice(&st.servo_rate);
@@ -208,19 +396,19 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     let slip_angle = T::atan2x4(v_lat, v_lon.map(T::abs)).map(|a| -a);
     // lateral force mu alpha C min(1, |(u, w)| / v_fade), the square root only inside the fade zone
     let mut force_lat: [T; 4] = core::array::from_fn(|i| {
-        let fade = if speed_sq[i].value() < v_fade_sq { speed_sq[i].sqrt() / p.v_fade } else { one };
-        u.mu[i] * slip_angle[i] * p.c[i] * fade
+        let fade = if speed_sq[i].value() < v_fade_sq { speed_sq[i].sqrt() / v_fade } else { one };
+        u.mu[i] * slip_angle[i] * p.c(i) * fade
     });
     let mut force_drive = wd.drive;
-    if p.motor_speed_limit {
+    if motor_speed_limit {
         for i in 0..4 {
             if force_drive[i].value() > 0.0 {
-                let scale = ((T::constant(p.wheel_speed_max) - v_lon[i]) / p.motor_taper).clamp_s(zero, one);
+                let scale = ((p.wheel_speed_max() - v_lon[i]) / p.motor_taper()).clamp_s(zero, one);
                 force_drive[i] = force_drive[i] * scale;
             }
         }
     }
-    if p.friction_circle {
+    if friction_circle {
         for i in 0..4 {
             let (f_drive, f_lat, cap) = (force_drive[i], force_lat[i], wd.cap[i]);
             if !inside_friction_circle(f_drive.value(), f_lat.value(), cap.value()) {
@@ -252,21 +440,25 @@ fn core<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>, st: &Steering
     der[idx::X] = v_x * cp - v_y * sp;
     der[idx::Y] = v_x * sp + v_y * cp;
     der[idx::PSI] = r;
-    der[idx::V_X] = (fx_sum - wind_head) / p.m + r * v_y;
-    der[idx::V_Y] = lateral_force / p.m - r * v_x;
-    der[idx::YAW_RATE] = mz / p.i_z;
+    let m = p.m();
+    der[idx::V_X] = (fx_sum - wind_head) / m + r * v_y;
+    der[idx::V_Y] = lateral_force / m - r * v_x;
+    der[idx::YAW_RATE] = mz / p.i_z();
     Core { derivatives: der, lateral_force, slip_angle, force_lat, force_drive }
 }
 
 /// The model at one point: derivatives and all outputs.
-pub fn evaluate<T: Scalar>(p: &VehicleParams, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
+///
+/// `p` is a [`VehicleParams`] (the parameters as constants), or [`ParamScalars`] of dual
+/// numbers for derivatives with respect to the parameters.
+pub fn evaluate<T: Scalar>(p: &impl ParamsOf<T>, s: &State<T>, u: &Inputs<T>) -> Evaluation<T> {
     let st = steering(p, s, u);
     let c = core(p, s, u, &st, &wheel_drive(p, u));
     Evaluation {
         derivatives: c.derivatives,
         beta: body_slip_angle(s),
         speed: speed_of(s),
-        lateral_accel: c.lateral_force / p.m,
+        lateral_accel: c.lateral_force / p.m(),
         slip_angle: c.slip_angle,
         force_lat: c.force_lat,
         force_drive: c.force_drive,

@@ -18,8 +18,8 @@ mod test_rng;
 pub mod tracking;
 
 pub use dynamics::{
-    derivatives_of, evaluate, integrate, rk4_step, steering, straight_running, Evaluation, Inputs, State, Steering,
-    N_STATES,
+    derivatives_of, evaluate, integrate, rk4_step, steering, straight_running, Evaluation, Inputs, ParamScalars,
+    ParamsOf, State, Steering, N_STATES,
 };
 pub use linear::{linear_model, DisturbanceColumn, LinearModel};
 pub use params::{ParamError, VehicleParams, WHEELS};
