@@ -405,45 +405,37 @@ impl Default for Plant {
     }
 }
 
+/// The field of parameter `which` in `$params` (a [`VehicleParams`] or [`ParamScalars`]:
+/// the same field names), `None` for `cs_substep_max`, which is the FMU's own.
+macro_rules! param_field {
+    ($params:expr, $which:expr) => {
+        Some(match $which {
+            Param::Mass => &mut $params.m,
+            Param::YawInertia => &mut $params.i_z,
+            Param::CgToFront => &mut $params.l_f,
+            Param::CgToRear => &mut $params.l_r,
+            Param::Track => &mut $params.track,
+            Param::WheelRadius => &mut $params.r_wheel,
+            Param::CorneringStiffness(i) => &mut $params.c[i],
+            Param::Gravity => &mut $params.g,
+            Param::FadeSpeed => &mut $params.v_fade,
+            Param::SteerLimit => &mut $params.delta_max,
+            Param::ServoTimeConstant => &mut $params.servo_time_constant,
+            Param::ServoRateMax => &mut $params.servo_rate_max,
+            Param::WheelSpeedMax => &mut $params.wheel_speed_max,
+            Param::MotorTaper => &mut $params.motor_taper,
+            Param::CsSubstepMax => return None,
+        })
+    };
+}
+
 fn param_slot(p: &mut VehicleParams, which: Param) -> Option<&mut f64> {
-    Some(match which {
-        Param::Mass => &mut p.m,
-        Param::YawInertia => &mut p.i_z,
-        Param::CgToFront => &mut p.l_f,
-        Param::CgToRear => &mut p.l_r,
-        Param::Track => &mut p.track,
-        Param::WheelRadius => &mut p.r_wheel,
-        Param::CorneringStiffness(i) => &mut p.c[i],
-        Param::Gravity => &mut p.g,
-        Param::FadeSpeed => &mut p.v_fade,
-        Param::SteerLimit => &mut p.delta_max,
-        Param::ServoTimeConstant => &mut p.servo_time_constant,
-        Param::ServoRateMax => &mut p.servo_rate_max,
-        Param::WheelSpeedMax => &mut p.wheel_speed_max,
-        Param::MotorTaper => &mut p.motor_taper,
-        Param::CsSubstepMax => return None,
-    })
+    param_field!(p, which)
 }
 
 /// [`param_slot`] of the parameters as scalars of the right-hand side.
 fn param_scalar_slot<T>(p: &mut ParamScalars<T>, which: Param) -> Option<&mut T> {
-    Some(match which {
-        Param::Mass => &mut p.m,
-        Param::YawInertia => &mut p.i_z,
-        Param::CgToFront => &mut p.l_f,
-        Param::CgToRear => &mut p.l_r,
-        Param::Track => &mut p.track,
-        Param::WheelRadius => &mut p.r_wheel,
-        Param::CorneringStiffness(i) => &mut p.c[i],
-        Param::Gravity => &mut p.g,
-        Param::FadeSpeed => &mut p.v_fade,
-        Param::SteerLimit => &mut p.delta_max,
-        Param::ServoTimeConstant => &mut p.servo_time_constant,
-        Param::ServoRateMax => &mut p.servo_rate_max,
-        Param::WheelSpeedMax => &mut p.wheel_speed_max,
-        Param::MotorTaper => &mut p.motor_taper,
-        Param::CsSubstepMax => return None,
-    })
+    param_field!(p, which)
 }
 
 fn switch_slot(p: &mut VehicleParams, which: Switch) -> &mut bool {
