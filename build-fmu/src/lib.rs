@@ -83,8 +83,9 @@ pub fn manifest(targets: &[FmuTarget], platforms: &[PlatformBuild]) -> String {
                     "library": format!("binaries/{}/{}", p.platform.folder(), p.platform.library_file(&t.model_identifier)),
                     "minimum_os": p.minimum_os,
                     "c_library": p.c_library,
-                    "tested": p.platform.tested(),
+                    "tested": p.tested,
                 })).collect::<Vec<_>>(),
+                "not_built": platforms_not_built(platforms),
             })
         })
         .collect();
@@ -104,6 +105,9 @@ pub struct PlatformBuild {
     pub minimum_os: String,
     /// The C library it links against.
     pub c_library: String,
+    /// How libraries built this way are tested ([`Platform::tested`] for the release
+    /// recipe; "not tested" for a build the test command does not make).
+    pub tested: String,
 }
 
 impl PlatformBuild {
@@ -113,8 +117,25 @@ impl PlatformBuild {
             platform,
             minimum_os: platform.minimum_os().to_string(),
             c_library: platform.c_library().to_string(),
+            tested: platform.tested().to_string(),
         }
     }
+}
+
+/// The release platforms an archive of `platforms` lacks, each with why; empty for a
+/// release build (all of [`Platform::ALL`]).
+pub fn platforms_not_built(platforms: &[PlatformBuild]) -> Vec<String> {
+    Platform::ALL
+        .iter()
+        .filter(|p| !platforms.iter().any(|b| b.platform == **p))
+        .map(|p| {
+            format!(
+                "{}: not built (this build asked for fewer platforms; the release archives carry all of {})",
+                p.folder(),
+                Platform::ALL.map(|p| p.folder()).join(", ")
+            )
+        })
+        .collect()
 }
 
 /// The highest `GLIBC_2.N` symbol version an ELF library names (its version-needed
@@ -148,10 +169,18 @@ pub fn with_platform_table(documentation: &str, model_identifier: &str, platform
             escape(&p.platform.library_file(model_identifier)),
             escape(&p.minimum_os),
             escape(&p.c_library),
-            escape(p.platform.tested()),
+            escape(&p.tested),
         );
     }
     table.push_str("</table>\n");
+    let missing = platforms_not_built(platforms);
+    if !missing.is_empty() {
+        table.push_str("<p>This archive is not a release build. It lacks:</p>\n<ul>\n");
+        for m in &missing {
+            let _ = writeln!(table, "<li>{}</li>", escape(m));
+        }
+        table.push_str("</ul>\n");
+    }
     match documentation.rfind("</body>") {
         Some(i) => format!("{}{table}{}", &documentation[..i], &documentation[i..]),
         None => format!("{documentation}{table}"),
@@ -372,6 +401,10 @@ fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBui
         built.c_library =
             format!("glibc {major}.{minor} (the build machine's; symbol versions up to GLIBC_{major}.{minor})");
         built.minimum_os = format!("Linux with glibc {major}.{minor} or later");
+        built.tested = format!(
+            "not tested: built with this machine's toolchain (glibc {major}.{minor}), not with the release recipe \
+             (glibc 2.17 baseline through cargo-zigbuild) whose libraries the test command runs"
+        );
     }
     built
 }

@@ -107,24 +107,25 @@ impl Platform {
         }
     }
 
-    /// How the platform's library is tested by the project's test command.
+    /// How the project's test command (`bash scripts/test.sh`) tests the platform's library
+    /// as this recipe builds it (byte-identical on every build from the same sources).
     pub fn tested(self) -> &'static str {
         match self {
             Platform::Linux64 => {
-                "executed: every test of the workspace, fmpy (validate_fmu, simulations) and the co-simulation \
+                "by the test command, on this recipe's library: executed: every test of the workspace, fmpy (validate_fmu, simulations) and the co-simulation \
                  cross-checks load this library; objdump -T checks the glibc symbol versions; the C FMI \
                  importer build-fmu/tests/c/fmi2_closed_loop.c runs the closed loop (plant, controller, test bench) 30 s at 1 ms as the reference"
             }
             Platform::Win64 => {
-                "executed under wine 8: the C FMI importer build-fmu/tests/c/fmi2_closed_loop.c, built with mingw-w64, runs the closed loop \
+                "by the test command, on this recipe's library: executed under wine 8: the C FMI importer build-fmu/tests/c/fmi2_closed_loop.c, built with mingw-w64, runs the closed loop \
                  30 s at 1 ms and every output is compared with the linux64 run; exports and imported DLLs checked"
             }
             Platform::Aarch64Linux => {
-                "executed under qemu-user: the C FMI importer build-fmu/tests/c/fmi2_closed_loop.c, built with aarch64-linux-gnu-gcc, runs \
+                "by the test command, on this recipe's library: executed under qemu-user: the C FMI importer build-fmu/tests/c/fmi2_closed_loop.c, built with aarch64-linux-gnu-gcc, runs \
                  the closed loop 30 s at 1 ms and every output is compared with the linux64 run"
             }
             Platform::Darwin64 => {
-                "not executed (no macOS here): structural checks only, both architectures present, the 44 fmi2 \
+                "by the test command, on this recipe's library: not executed (no macOS there): structural checks only, both architectures present, the 44 fmi2 \
                  exports, the minimum macOS version and only system libraries imported"
             }
         }

@@ -36,8 +36,13 @@ fn target_dir() -> PathBuf {
     dir.canonicalize().unwrap_or(dir)
 }
 
-fn work_dir(name: &str) -> PathBuf {
-    let d = target_dir().join("platform-tests").join(name);
+/// A scratch folder of one test alone (`target/platform-tests/<test>`): the tests of this
+/// file run in parallel threads, and a library one test has mapped must not be rewritten
+/// by another (that was a SIGBUS, or a half-written CSV read, depending on timing). It is
+/// emptied first, so no file of an earlier run is read.
+fn work_dir(test: &str) -> PathBuf {
+    let d = target_dir().join("platform-tests").join(test);
+    let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -85,9 +90,8 @@ fn extension(folder: &str) -> &'static str {
     }
 }
 
-/// Unpacks `binaries/<folder>/<id>.<ext>` of every archive into the test's folder.
-fn libraries(folder: &str) -> Vec<PathBuf> {
-    let dir = work_dir(folder);
+/// Unpacks `binaries/<folder>/<id>.<ext>` of every archive into `dir`.
+fn libraries(folder: &str, dir: &Path) -> Vec<PathBuf> {
     FMUS.iter()
         .map(|id| {
             let archive = target_dir().join("fmu").join(format!("{id}.fmu"));
@@ -179,13 +183,13 @@ const IMPORTER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/fmi2_closed
 /// the command (wine, qemu); `path_of` turns a host path into the one the program opens.
 fn closed_loop(
     folder: &str,
+    dir: &Path,
     compiler: &[&str],
     exe_name: &str,
     runner: &mut dyn FnMut(&Path) -> Command,
     path_of: &dyn Fn(&Path) -> String,
 ) -> (Vec<String>, Vec<Vec<f64>>) {
-    let dir = work_dir(folder);
-    let libs = libraries(folder);
+    let libs = libraries(folder, dir);
     let (system, _keep) = closed_loop_system();
     let index: BTreeMap<String, usize> = FMUS.iter().enumerate().map(|(k, id)| (id.to_string(), k)).collect();
     let job = job_file(&system, &|i| {
@@ -208,8 +212,18 @@ fn closed_loop(
     (header, rows)
 }
 
-fn linux64_run() -> (Vec<String>, Vec<Vec<f64>>) {
-    closed_loop("linux64", &["gcc"], "fmi2_closed_loop", &mut |exe| Command::new(exe), &|p| p.display().to_string())
+type Table = (Vec<String>, Vec<Vec<f64>>);
+
+/// The linux64 closed loop, the reference of every other platform: run once per test
+/// binary, in its own folder, whichever test asks first (the others wait for it).
+fn linux64_run() -> &'static Table {
+    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = work_dir("linux64-reference");
+        closed_loop("linux64", &dir, &["gcc"], "fmi2_closed_loop", &mut |exe| Command::new(exe), &|p| {
+            p.display().to_string()
+        })
+    })
 }
 
 /// Columns computed with our own arithmetic only (+ - * / and sqrt on doubles, correctly
@@ -296,7 +310,7 @@ fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
     if !built("linux64") {
         return;
     }
-    for lib in libraries("linux64") {
+    for lib in libraries("linux64", &work_dir("linux64-exports")) {
         let v = highest_glibc("objdump", &lib);
         assert!(((2, 2)..=(2, 17)).contains(&v), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
         let n = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib))
@@ -338,7 +352,8 @@ fn win64_closed_loop_under_wine_matches_linux64() {
     if !built("win64") {
         return;
     }
-    let libs = libraries("win64");
+    let dir = work_dir("win64");
+    let libs = libraries("win64", &dir);
     for lib in &libs {
         let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib));
         let exports = text.lines().filter(|l| l.trim_start().starts_with('[') && l.contains(" fmi2")).count();
@@ -362,7 +377,6 @@ fn win64_closed_loop_under_wine_matches_linux64() {
             );
         }
     }
-    let dir = work_dir("win64");
     // Rust's standard library (1.78 and later) imports ProcessPrng from
     // bcryptprimitives.dll, which Windows 10 has and wine 8 lacks: a shim next to the
     // importer forwards it to BCryptGenRandom (test only; nothing of it is in the archive)
@@ -390,8 +404,8 @@ fn win64_closed_loop_under_wine_matches_linux64() {
             .env_remove("WAYLAND_DISPLAY");
         c
     };
-    let win = closed_loop("win64", &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path);
-    compare_with_linux64("win64", &linux64_run(), &win);
+    let win = closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path);
+    compare_with_linux64("win64", linux64_run(), &win);
 }
 
 #[test]
@@ -399,7 +413,8 @@ fn aarch64_closed_loop_under_qemu_matches_linux64() {
     if !built("aarch64-linux") {
         return;
     }
-    for lib in libraries("aarch64-linux") {
+    let dir = work_dir("aarch64-linux");
+    for lib in libraries("aarch64-linux", &dir) {
         let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
         assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
     }
@@ -408,10 +423,10 @@ fn aarch64_closed_loop_under_qemu_matches_linux64() {
         c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
         c
     };
-    let arm = closed_loop("aarch64-linux", &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
+    let arm = closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
         p.display().to_string()
     });
-    compare_with_linux64("aarch64-linux", &linux64_run(), &arm);
+    compare_with_linux64("aarch64-linux", linux64_run(), &arm);
 }
 
 // ---- Mach-O, the little of it the darwin64 checks read --------------------------------
@@ -488,7 +503,7 @@ fn darwin64_is_universal_macos_11_with_the_fmi2_exports_and_system_libraries_onl
     if !built("darwin64") {
         return;
     }
-    for lib in libraries("darwin64") {
+    for lib in libraries("darwin64", &work_dir("darwin64")) {
         let b = std::fs::read(&lib).unwrap();
         assert_eq!(u32_be(&b, 0), FAT_MAGIC, "{}: not a universal binary", lib.display());
         let n = u32_be(&b, 4) as usize;

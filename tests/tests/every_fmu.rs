@@ -26,6 +26,7 @@ fn every_fmu() -> Vec<Fmu> {
                 .unwrap_or_else(|| panic!("manifest.json: unknown platform {}", p["folder"])),
             minimum_os: p["minimum_os"].as_str().unwrap_or_default().to_string(),
             c_library: p["c_library"].as_str().unwrap_or_default().to_string(),
+            tested: p["tested"].as_str().unwrap_or_default().to_string(),
         })
         .collect();
     assert_eq!(manifest, build_fmu::manifest(&targets, &platforms), "target/fmu is stale: rebuild with build-fmu");
