@@ -626,6 +626,30 @@ mod tests {
     }
 
     #[test]
+    fn a_build_with_fewer_platforms_or_this_machines_glibc_says_so() {
+        let targets = targets();
+        let all: Vec<PlatformBuild> = Platform::ALL.into_iter().map(PlatformBuild::of).collect();
+        let release: serde_json::Value = serde_json::from_str(&manifest(&targets, &all)).unwrap();
+        assert_eq!(release[0]["not_built"], serde_json::json!([]));
+        assert!(release[0]["platforms"][0]["tested"].as_str().unwrap().starts_with("by the test command"));
+
+        // linux64 alone, against a glibc 2.35 library: three platforms missing, not tested
+        let host = with_glibc_of(PlatformBuild::of(Platform::Linux64), &[b"GLIBC_2.35\0".to_vec()]);
+        let one: serde_json::Value = serde_json::from_str(&manifest(&targets, std::slice::from_ref(&host))).unwrap();
+        let missing: Vec<&str> = one[0]["not_built"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+        assert_eq!(missing.len(), 3);
+        for (m, folder) in missing.iter().zip(["win64", "aarch64-linux", "darwin64"]) {
+            assert!(m.starts_with(&format!("{folder}: not built")), "{m}");
+        }
+        let p = &one[0]["platforms"][0];
+        assert!(p["tested"].as_str().unwrap().starts_with("not tested"), "{p}");
+        assert_eq!(p["minimum_os"], "Linux with glibc 2.35 or later");
+        let doc = with_platform_table("<html><body></body></html>", "nigel_plant", std::slice::from_ref(&host));
+        assert!(doc.contains("not a release build") && doc.contains("<li>darwin64: not built"), "{doc}");
+        assert!(!with_platform_table("<body></body>", "nigel_plant", &all).contains("not a release build"));
+    }
+
+    #[test]
     fn documentation_gets_one_platform_row_per_platform_before_the_end() {
         let t = &targets()[1];
         let builds: Vec<PlatformBuild> = Platform::ALL.into_iter().map(PlatformBuild::of).collect();
@@ -638,7 +662,7 @@ mod tests {
         assert!(doc.contains(
             "<td><code>darwin64</code></td><td><code>nigel_controller.dylib</code></td><td>macOS 11 or later"
         ));
-        assert!(doc.contains("not executed (no macOS here)"));
+        assert!(doc.contains("not executed (no macOS there)"));
     }
 
     #[test]
