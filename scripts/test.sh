@@ -28,7 +28,7 @@ bash scripts/python-env.sh >/dev/null
 export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 echo "== Rust tests"
-cargo test --release --workspace
+cargo test --release --workspace --no-fail-fast
 echo "== synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"
