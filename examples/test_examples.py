@@ -13,8 +13,10 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "cosim" / "tests" / "python"))
+sys.path.insert(0, str(REPO / "tests" / "python"))
 
 from closed_loop_tools import release_binary, target_dir  # noqa: E402
+from doc_figures import check as doc_check  # noqa: E402
 
 # Same FMUs, same step sizes and order of calls: the runs agree to the rounding of the 30,000
 # squared errors summed in a different order (numpy's pairwise sum, awk's running sum), far
@@ -94,6 +96,8 @@ def test_c_own_controller_fmu_in_the_ssp(table3_sim_lane_change, tmp_path):
             for q in ("x", "y", "psi")]
     want = float(np.linalg.norm(rmse))
     assert abs(eps - want) <= REL * want, (eps, want)
+    doc_check("examples/README.md", "`own controller epsilon {}` for the sim lane change", eps)
+    doc_check("examples/README.md", "lateral position drifts (RMSE_Y {} m of the {})", rmse[1], want)
     # the master ran our P law: every recorded command is the law of the inputs recorded with it
     # (k_yaw_rate = 0.3 rad.s/rad, kp_speed = 53.6 N.s/m, force_max = 20 N; one product and one
     # sum in double precision, so 1e-12 rad / N is far above the rounding on any machine)
