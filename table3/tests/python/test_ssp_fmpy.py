@@ -28,7 +28,7 @@ import pytest
 import types
 
 import fmpy.ssp.simulation as fmpy_ssp
-from doc_figures import check as doc_check
+from doc_figures import check as doc_check, check_at_most as doc_check_at_most
 from fmpy.ssp.simulation import find_components, simulate_ssp
 from fmpy.ssp.ssd import get_connections, read_ssd
 
@@ -179,9 +179,11 @@ def test_fmpy_with_the_initial_outputs_propagated_equals_our_jacobi(ours, fmpy_r
     assert worst <= 1e-9
     assert abs(eps_init - eps_ordered) <= 0.02 * eps_ordered
     rel = abs(eps_init - eps_jacobi) / eps_jacobi
-    doc_check("README.md", "| fmpy, initial outputs propagated | {} | {} | {} % |", eps_init, rel,
+    # rounding (the summation order of fmpy's and our loops): printed as a bound
+    doc_check("README.md", "| fmpy, initial outputs propagated | {} | < {*} | {} % |", eps_init,
               100 * abs(eps_init - eps_ordered) / eps_ordered)
-    doc_check("README.md", "equals our `jacobi` to {}, which proves the explanation", rel)
+    doc_check_at_most("README.md", "| fmpy, initial outputs propagated |{*}| < {} |", rel)
+    doc_check_at_most("README.md", "equals our `jacobi` to {}, which proves the explanation", rel)
     # and the one change is what moved it: plain fmpy is 1e4 times farther from our jacobi
     eps_plain = pose_epsilon(fmpy_run)
     assert abs(eps_plain - eps_jacobi) > 1e3 * max(abs(eps_init - eps_jacobi), 1e-15 * eps_jacobi)
