@@ -54,6 +54,24 @@ def test_python_block_prints_what_its_comment_says(path, line, code, expected):
         f"{path}:{line}: the block prints {got!r}, its comment says {expected!r}"
 
 
+def test_along_track_pole():
+    """The along-track loop's dominant pole (README, controller FMU): the root of
+    s^3 + (kp/m) s^2 + (ki/m + k kp/m) s + k ki/m nearest the origin (benchmark/src/control.rs;
+    benchmark/tests/along_track.rs checks the simulated decay against it)."""
+    from fmpy import read_model_description
+    start = lambda fmu: {v.name: v.start for v in read_model_description(str(target_dir() / "fmu" / fmu)).modelVariables}  # noqa: E731
+    ctl, plant = start("nigel_controller.fmu"), start("nigel_plant.fmu")
+    kp, ki, k = (float(ctl[n]) for n in ("kp_speed", "ki_speed", "k_along_track"))
+    m = float(plant["m"])
+    for name, value in (("kp_speed", kp), ("ki_speed", ki), ("k_along_track", k)):
+        check("README.md", f"`{name}` {{}}", value)
+    poles = np.roots([1, kp / m, ki / m + k * kp / m, k * ki / m])
+    dominant = max(poles, key=lambda p: p.real)
+    assert abs(dominant.imag) < 1e-9, poles  # real: no overshoot
+    check("README.md", "time constant (dominant pole {} /s)", dominant.real)
+    check("README.md", "follows `-0.1 e^({} t)`", dominant.real)
+
+
 # --- the closed-loop SSP in the master ------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -304,9 +322,20 @@ def test_robustness_study_tables_are_its_report():
           "pole placement {}, robust {}, robust tracking {};",
           rep["runs"], ol_r["p_more"], r_rt["p_more"], pp_r["p_more"], eps["open_loop"]["median"],
           eps["pole_placement"]["median"], eps["robust"]["median"], eps["robust_tracking"]["median"])
-    check("README.md", "(epsilon {} at", eps["pole_placement"]["worst"])
-    worst = rep["worst"]
-    assert worst, "the report names the worst runs"
+    worst = {w["run"]: w for w in rep["worst"]}
+    pp, rt = worst[3889], worst[4860]  # the worst pole placement and robust tracking runs
+    assert pp["metrics"]["epsilon"] == eps["pole_placement"]["worst"]
+    assert rt["metrics"]["epsilon"] == eps["robust_tracking"]["worst"]
+    v = pp["values"]
+    check("campaign/README.md", "(run {}, skidpad `sim`, {} m/s, {} kg, {} N/rad, friction mean {}: epsilon {},",
+          pp["run"], v["speed"], v["plant.m"], v["c_tire"], v["maneuver.friction_mean"], pp["metrics"]["epsilon"])
+    check("README.md", "(epsilon {} at {} m/s,", pp["metrics"]["epsilon"], v["speed"])
+    v = rt["values"]
+    check("campaign/README.md", "Its worst run (run {}, skidpad `real`, {} m/s, friction mean {}) saturates the steering "
+          "at 90 deg (`max_delta` {}):", rt["run"], v["speed"], v["maneuver.friction_mean"], rt["metrics"]["max_delta"])
+    check("campaign/README.md", "the car leaves the circle (epsilon {})", rt["metrics"]["epsilon"])
+    assert pp["values"]["maneuver.maneuver"] == rt["values"]["maneuver.maneuver"] == 3  # skidpad
+    assert (pp["values"]["column"], rt["values"]["column"]) == (0, 1)  # sim, real
 
 
 # --- the robust synthesis -------------------------------------------------------------------
