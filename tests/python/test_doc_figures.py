@@ -234,6 +234,17 @@ def test_table3_seed0(table3_seed0):
         for row in rows_of(markdown, column):
             cells = [c.strip() for c in row.strip("|").split("|")]
             paper[(column, cells[0])] = float(cells[8])  # paper robust (after ours, 4, and "lowest")
+    # docs/benchmark.md's copy of the paper's table equals table3's (table3/src/paper.rs)
+    for m in R["sim"]:
+        cols = {}
+        for column in ("sim", "real"):
+            row = next(r for r in rows_of(markdown, column) if r.startswith(f"| {m} | "))
+            cols[column] = [c.strip() for c in row.strip("|").split("|")][6:9]
+        name = m.replace("_", "-")
+        check("docs/benchmark.md", f"| {name} | {{}} / {{}} | {{}} / {{}} | {{}} / {{}} |",
+              *(float(cols[c][i]) for i in range(3) for c in ("sim", "real")))
+    check("docs/benchmark.md", "slightly lower in sim (robust about {}x)",
+          eps("sim", "straight", "robust") / eps("sim", "straight", "open_loop"))
     mag = {k: eps(*k, "robust") / v for k, v in paper.items()}
     others = [v for (f, m), v in mag.items() if m != "straight"]
     sim_ratio = [eps("sim", m, "open_loop") / eps("sim", m, "robust") for m in R["sim"] if m != "straight"]
