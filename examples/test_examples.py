@@ -13,8 +13,10 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "cosim" / "tests" / "python"))
+sys.path.insert(0, str(REPO / "tests" / "python"))
 
 from closed_loop_tools import release_binary, target_dir  # noqa: E402
+from doc_figures import check as doc_check  # noqa: E402
 
 # Same FMUs, same step sizes and order of calls: the runs agree to the rounding of the 30,000
 # squared errors summed in a different order (numpy's pairwise sum, awk's running sum), far
@@ -94,6 +96,18 @@ def test_c_own_controller_fmu_in_the_ssp(table3_sim_lane_change, tmp_path):
             for q in ("x", "y", "psi")]
     want = float(np.linalg.norm(rmse))
     assert abs(eps - want) <= REL * want, (eps, want)
+    doc_check("examples/README.md", "`own controller epsilon {}` for the sim lane change", eps)
+    doc_check("examples/README.md", "lateral position drifts (RMSE_Y {} m of the {})", rmse[1], want)
+    # without the yaw-rate feedback (the same FMU, the gain 0 through the SSP's parameter)
+    quiet = tmp_path / "no_feedback.csv"
+    pose = ["plant.x", "plant.y", "plant.psi", "maneuver.x_ref", "maneuver.y_ref", "maneuver.psi_ref"]
+    subprocess.run([str(release_binary("cosim", "nigel-cosim")), "run", str(target_dir() / "ssp" / "own_controller_closed_loop.ssp"),
+                    "--algorithm", "ordered", "--stop-time", "30", "--step", "1e-3", "--output", str(quiet),
+                    "--set", "controller.k_yaw_rate=0", *(a for n in pose for a in ("--record", n))],
+                   check=True, capture_output=True)
+    q = np.genfromtxt(quiet, delimiter=",", names=True)[1:]  # t_1 .. t_N
+    rms = [np.sqrt(np.mean((q[f"plant{v}"] - q[f"maneuver{v}_ref"]) ** 2)) for v in ("x", "y", "psi")]
+    doc_check("examples/README.md", "`--set controller.k_yaw_rate=0` the same FMU scores {})", float(np.linalg.norm(rms)))
     # the master ran our P law: every recorded command is the law of the inputs recorded with it
     # (k_yaw_rate = 0.3 rad.s/rad, kp_speed = 53.6 N.s/m, force_max = 20 N; one product and one
     # sum in double precision, so 1e-12 rad / N is far above the rounding on any machine)

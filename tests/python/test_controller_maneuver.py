@@ -28,6 +28,8 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, fmi2Error
 from fmpy.validation import validate_fmu
 
+from doc_figures import check as doc_check
+
 REPO = Path(__file__).resolve().parents[2]
 TARGET = REPO / os.environ.get("CARGO_TARGET_DIR", "target")
 FMU_DIR = Path(os.environ.get("NIGEL_FMU_DIR", TARGET / "fmu"))
@@ -393,6 +395,7 @@ def test_figure8_switch_samples(bench):
     # a CS row at t_k is sampled after the step into t_k: it holds sample k
     flips = [int(round(r["time"][i] / T)) for i in range(1, len(d)) if d[i] != d[i - 1]]
     assert flips == [3144, 6267, 9390]
+    doc_check("README.md", "(first flips at samples {}, {}, {})", *flips)
     assert np.all(np.abs(d) == A) and np.all(r["delta_ff_rr"] == -d)
 
 

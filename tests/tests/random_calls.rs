@@ -431,6 +431,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
 #[test]
 fn random_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
     let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES").ok().and_then(|s| s.parse().ok()).unwrap_or(150_000);
+    let mut plant = Vec::new(); // the plant's counts per interface, which README.md prints
     for (k, target) in build_fmu::targets().iter().enumerate() {
         let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
         for kind in [CO_SIMULATION, MODEL_EXCHANGE] {
@@ -454,6 +455,38 @@ fn random_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_n
                 counts[3]
             );
             assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
+            if target.model_identifier == "nigel_plant" {
+                plant.push(counts);
+            }
         }
+    }
+    if sequences == 150_000 {
+        readme_prints_the_plant_counts(&plant);
+    }
+}
+
+/// README.md's figures of the default run (see "Figures in the docs" there): the plant's
+/// calls in millions to the printed two digits, its Discards exactly.
+fn readme_prints_the_plant_counts(plant: &[[usize; 4]]) {
+    let [cs, me] = plant else { panic!("the plant offers CS and ME: {plant:?}") };
+    // "0.41 M OK, 310 Discard, 0.80 M Error": OK and Error in millions, the rare ones counted
+    let text = |c: &[usize; 4]| {
+        let mut parts = vec![format!("{:.2} M OK", c[0] as f64 / 1e6)];
+        parts.extend([(c[1], "Warning"), (c[2], "Discard")].iter().filter(|(n, _)| *n > 0).map(|(n, w)| format!("{n} {w}")));
+        parts.push(format!("{:.2} M Error", c[3] as f64 / 1e6));
+        parts.join(", ")
+    };
+    let total: usize = cs.iter().chain(me.iter()).sum();
+    let expected = [
+        format!("150,000 seeded sequences per interface over all 44 functions with hostile arguments, {:.1} million", total as f64 / 1e6),
+        format!("calls for the plant (CS: {}; ME: {})", text(cs), text(me)),
+        format!("150,000 sequences over all 44 functions per FMU and interface, about {:.1} million calls", cs.iter().sum::<usize>() as f64 / 1e6),
+    ];
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
+    let readme = std::fs::read_to_string(&path).expect("README.md");
+    let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let readme = words(&readme);
+    for e in expected {
+        assert!(readme.contains(&words(&e)), "README.md no longer prints {e:?}: these are the counts now");
     }
 }

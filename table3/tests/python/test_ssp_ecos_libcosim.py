@@ -30,6 +30,13 @@ import numpy as np
 import pytest
 
 from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series, target_dir
+from doc_figures import check as doc_check, check_at_most as doc_check_at_most
+
+# the rows of README.md's SSP table and cosim/README.md's speed table that print these runs
+README_ROW = {"libcosim": "| libcosim (libcosimpy 0.0.6) | {} | < 1e-12 (pose within ",
+              "ecos": "| ecos (ecospy 0.7.2) | {} | < 1e-12 (pose within "}
+COSIM_ROW = {"libcosim": "| libcosim (libcosimpy 0.0.6), same `.ssp`, `simulate_until(30 s)` |{*}| {} | {}, {}, {} |",
+             "ecos": "| ecos (ecospy 0.7.2) on the same `.ssp`, `step(30000)` |{*}| {} | {}, {}, {} |"}
 
 JOB = "sim/lane_change/robust"
 N = 30_000
@@ -67,6 +74,10 @@ def check(name, series, ours):
     assert abs(eps - eps_ordered) >= 1e-3 * eps_ordered, "the one-step delay must show"
     assert abs(eps - eps_jacobi) <= 1e-9 * eps_jacobi
     assert worst <= 1e-9
+    doc_check("README.md", README_ROW[name], eps)
+    # the pose difference is rounding (a few ulps, the tools' own arithmetic): printed as a bound
+    doc_check_at_most("README.md", README_ROW[name].replace("| {} |", "|{*}|") + "{})", worst)
+    doc_check("cosim/README.md", COSIM_ROW[name], eps, *(series[n][-1] for n in POSE[:3]))
 
 
 @pytest.fixture(scope="module")

@@ -28,6 +28,7 @@ import pytest
 import types
 
 import fmpy.ssp.simulation as fmpy_ssp
+from doc_figures import check as doc_check, check_at_most as doc_check_at_most
 from fmpy.ssp.simulation import find_components, simulate_ssp
 from fmpy.ssp.ssd import get_connections, read_ssd
 
@@ -152,6 +153,15 @@ def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fm
     # the whole difference starts in the first step, where fmpy's inputs are still 0
     assert abs(r["plant.y"][0] - rows["y"][1]) > 0.0
     assert abs(eps_fmpy - eps_jacobi) > 1e-7 * eps_jacobi, "the zero start of the connections shows"
+    rel = abs(eps_fmpy - eps_jacobi) / eps_jacobi
+    doc_check("README.md", "| fmpy 0.3.32 `simulate_ssp` | {} | {} | {} % |", eps_fmpy, rel,
+              100 * abs(eps_fmpy - eps_ordered) / eps_ordered)
+    doc_check("README.md", "fmpy's epsilon equals ours to {} relative", rel)
+    doc_check("README.md", "so its first millisecond sees mu = 0 and no wind: {} from `jacobi`", rel)
+    doc_check("cosim/README.md", "fmpy's epsilon is ours (`jacobi`) to {} relative", rel)
+    doc_check("docs/fmi-notes.md", "({} relative in epsilon)", rel)
+    doc_check("cosim/README.md", "| fmpy 0.3.32 `simulate_ssp`, same `.ssp` (records all every step) |{*}| {} | {}, {}, {} |",
+              eps_fmpy, r["plant.x"][-1], r["plant.y"][-1], r["plant.psi"][-1])
 
 
 def test_fmpy_with_the_initial_outputs_propagated_equals_our_jacobi(ours, fmpy_run, fmpy_run_initialized):
@@ -168,6 +178,12 @@ def test_fmpy_with_the_initial_outputs_propagated_equals_our_jacobi(ours, fmpy_r
     assert abs(eps_init - eps_jacobi) <= 1e-9 * eps_jacobi
     assert worst <= 1e-9
     assert abs(eps_init - eps_ordered) <= 0.02 * eps_ordered
+    rel = abs(eps_init - eps_jacobi) / eps_jacobi
+    # rounding (the summation order of fmpy's and our loops): printed as a bound
+    doc_check("README.md", "| fmpy, initial outputs propagated | {} | < {*} | {} % |", eps_init,
+              100 * abs(eps_init - eps_ordered) / eps_ordered)
+    doc_check_at_most("README.md", "| fmpy, initial outputs propagated |{*}| < {} |", rel)
+    doc_check_at_most("README.md", "equals our `jacobi` to {}, which proves the explanation", rel)
     # and the one change is what moved it: plain fmpy is 1e4 times farther from our jacobi
     eps_plain = pose_epsilon(fmpy_run)
     assert abs(eps_plain - eps_jacobi) > 1e3 * max(abs(eps_init - eps_jacobi), 1e-15 * eps_jacobi)
