@@ -30,6 +30,7 @@
 
 mod elf;
 pub mod error;
+pub mod exit_guard;
 pub mod fmu;
 pub mod isolate;
 pub mod mat;
@@ -41,6 +42,7 @@ pub mod system;
 pub mod unpack;
 
 pub use error::{Error, HostEnd, Result, Status};
+pub use exit_guard::{on_exit_inside_call, ExitInsideCall};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
 pub use me::{Event, Solver};
