@@ -15,7 +15,8 @@
 //!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
 //! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
 //!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
-//!   ([`simulate::simulate_recorded`]).
+//!   ([`simulate::simulate_recorded`]); in process, an FMU that calls `exit()` inside a
+//!   call ends the process with status 1, reported with the rows so far ([`exit_guard`]).
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
