@@ -3,7 +3,7 @@
 //! returns a typed [`Result`]. An instance terminates and frees itself on drop.
 
 use crate::error::{Error, Result, Status};
-use crate::unpack::{unpack, UnpackLimits};
+use crate::unpack::{ArchiveSource, UnpackLimits};
 use model_description::ModelDescription;
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
@@ -171,6 +171,8 @@ pub struct Fmu {
     description: ModelDescription,
     interface: Interface,
     source: PathBuf,
+    /// Where the archive is (a file, or an entry of an `.ssp`).
+    origin: ArchiveSource,
     resource_uri: CString,
     /// The unpacked folder: owned, or that of the FMU this is the isolated view of.
     dir: Option<tempfile::TempDir>,
@@ -251,7 +253,16 @@ impl Fmu {
     /// Imports `path`: unpack, read the XML, find and load `binaries/linux64/<id>.so`,
     /// resolve the functions of the interface.
     pub fn load_with(path: &Path, options: &ImportOptions) -> Result<Arc<Fmu>> {
-        let dir = unpack(path, &options.limits)?;
+        Fmu::load_from(&ArchiveSource::File(path.to_path_buf()), options)
+    }
+
+    /// Imports the FMU `origin` (a file, or an entry of an `.ssp` read from it in place):
+    /// only `modelDescription.xml`, `binaries/linux64/` and `resources/` are unpacked.
+    pub fn load_from(origin: &ArchiveSource, options: &ImportOptions) -> Result<Arc<Fmu>> {
+        let shown_path = origin.shown();
+        let path = shown_path.as_path();
+        let unpacked = crate::unpack::unpack_fmu(origin, &options.limits)?;
+        let dir = unpacked.dir;
         let description = read_model_description(dir.path(), path, &options.limits)?;
         let mut names = std::collections::HashMap::with_capacity(description.model_variables.len());
         for (k, v) in description.model_variables.iter().enumerate() {
@@ -285,11 +296,7 @@ impl Fmu {
         let relative = format!("binaries/linux64/{identifier}.so");
         let so = dir.path().join(&relative);
         if !so.is_file() {
-            let mut platforms: Vec<String> = std::fs::read_dir(dir.path().join("binaries"))
-                .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
-                .unwrap_or_default();
-            platforms.sort();
-            return Err(Error::MissingBinary { expected: relative, platforms });
+            return Err(Error::MissingBinary { expected: relative, platforms: unpacked.platforms });
         }
         // errors name the library inside the archive, not the temporary copy
         let shown = path.join(&relative);
@@ -329,6 +336,7 @@ impl Fmu {
             description,
             interface,
             source: path.to_path_buf(),
+            origin: origin.clone(),
             resource_uri,
             dir: Some(dir),
             isolated_from: None,
@@ -349,6 +357,7 @@ impl Fmu {
             description: self.description.clone(),
             interface: self.interface,
             source: self.source.clone(),
+            origin: self.origin.clone(),
             resource_uri: self.resource_uri.clone(),
             dir: None,
             isolated_from: Some(self.clone()),
@@ -372,9 +381,19 @@ impl Fmu {
         self.interface
     }
 
-    /// The archive it came from.
+    /// The archive it came from: its file, or `<ssp>/<entry>` for an FMU of an `.ssp`.
     pub fn source(&self) -> &Path {
         &self.source
+    }
+
+    /// Where the archive is: a file or an entry of an `.ssp`.
+    pub fn origin(&self) -> &ArchiveSource {
+        &self.origin
+    }
+
+    /// The bytes of the archive it came from (read again from the file or the `.ssp`).
+    pub fn archive_bytes(&self) -> Result<Vec<u8>> {
+        self.origin.read_bytes(&UnpackLimits { max_entry_bytes: u64::MAX, ..UnpackLimits::default() })
     }
 
     /// The private folder it is unpacked in (removed when the last `Arc` is dropped).
@@ -479,8 +498,10 @@ impl std::fmt::Debug for Instance {
 macro_rules! call {
     ($self:ident, $name:literal, $time:expr, $f:expr) => {{
         $self.check_callable($name)?;
+        let mark = crate::exit_guard::enter(&$self.name, &$self.fmu, $name, $time.unwrap_or($self.time));
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
+        drop(mark);
         $self.status($name, raw, $time)
     }};
 }
@@ -500,6 +521,7 @@ impl Instance {
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let log = Box::<LogSink>::default();
         let callbacks = callbacks_for(&log);
+        let mark = crate::exit_guard::enter(name, fmu, "fmi2Instantiate", 0.0);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (fmu.functions.instantiate)(
@@ -512,6 +534,7 @@ impl Instance {
                 0,
             )
         };
+        drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
         }
@@ -705,8 +728,10 @@ impl Instance {
             return Err(Error::IllegalCall { instance: self.name.clone(), function: "fmi2Reset", state: "fatal" });
         }
         let f = self.optional(self.fmu.functions.reset, "fmi2Reset")?;
+        let mark = crate::exit_guard::enter(&self.name, &self.fmu, "fmi2Reset", self.time);
         // SAFETY: live component.
         let raw = unsafe { f(self.component) };
+        drop(mark);
         self.state = InstanceState::Instantiated;
         self.status("fmi2Reset", raw, None)
     }
@@ -977,6 +1002,7 @@ impl Drop for Instance {
                 unsafe { free_state(self.component, &mut s) };
             }
         }
+        let _mark = crate::exit_guard::enter(&self.name, &self.fmu, "fmi2FreeInstance", self.time);
         // SAFETY: the component came from fmi2Instantiate and is freed once.
         unsafe { (self.fmu.functions.free_instance)(self.component) };
     }

@@ -15,7 +15,8 @@
 //!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
 //! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
 //!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
-//!   ([`simulate::simulate_recorded`]).
+//!   ([`simulate::simulate_recorded`]); in process, an FMU that calls `exit()` inside a
+//!   call ends the process with status 1, reported with the rows so far ([`exit_guard`]).
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
@@ -30,6 +31,7 @@
 
 mod elf;
 pub mod error;
+pub mod exit_guard;
 pub mod fmu;
 pub mod isolate;
 pub mod mat;
@@ -41,6 +43,7 @@ pub mod system;
 pub mod unpack;
 
 pub use error::{Error, HostEnd, Result, Status};
+pub use exit_guard::{on_exit_inside_call, ExitInsideCall};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
 pub use me::{Event, Solver};

@@ -96,23 +96,27 @@ fn parse_xml(text: &str, path: &Path) -> Result<Element> {
     root.children.pop().ok_or_else(|| err("empty XML document".into()))
 }
 
-/// An SSP system, imported: the flattened [`System`], its default experiment and the
-/// private folder holding the unpacked archive.
+/// An SSP system, imported: the flattened [`System`] and its default experiment. The
+/// FMUs of an `.ssp` are read from it in place (each unpacks only what a run uses).
 pub struct SspSystem {
     /// The flattened system.
     pub system: System,
     /// `DefaultExperiment` start and stop time, if given.
     pub default_start_stop: (Option<f64>, Option<f64>),
-    _dir: Option<tempfile::TempDir>,
+    /// The `.ssp` file (`None` for a bare `.ssd`).
+    archive: Option<PathBuf>,
 }
 
 impl SspSystem {
     /// Where an FMU of the system is inside the `.ssp` archive (`resources/x.fmu`), for
-    /// FMUs unpacked from it; `None` for a bare `.ssd`, whose FMU paths are real files.
+    /// FMUs read from it (their [`Fmu::source`] is `<ssp>/<entry>`); `None` for a bare
+    /// `.ssd`, whose FMU paths are real files.
     pub fn path_in_archive<'a>(&self, fmu_path: &'a Path) -> Option<&'a Path> {
-        self._dir.as_ref().and_then(|d| fmu_path.strip_prefix(d.path()).ok())
+        self.archive.as_ref().and_then(|a| fmu_path.strip_prefix(a).ok())
     }
 }
+
+type Zip = zip::ZipArchive<std::io::BufReader<std::fs::File>>;
 
 /// One endpoint in the SSD before flattening: an FMU variable or a system connector.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -124,6 +128,8 @@ enum Node {
 struct Flattener<'a> {
     root: &'a Path,
     path: &'a Path,
+    /// The `.ssp` and its checked entries (relative path -> entry name); `None` for an `.ssd`.
+    archive: Option<(std::cell::RefCell<Zip>, HashMap<PathBuf, String>)>,
     options: &'a ImportOptions,
     fmus: HashMap<PathBuf, Arc<Fmu>>,
     builder: SystemBuilder,
@@ -141,14 +147,53 @@ impl Flattener<'_> {
         Error::Ssp { path: self.path.to_path_buf(), reason }
     }
 
+    /// The relative path `source` names inside the package.
     fn resource(&self, source: &str) -> Result<PathBuf> {
         let rel = source.strip_prefix("file:").map(|s| s.trim_start_matches("//")).unwrap_or(source);
         if source.contains("://") && !source.starts_with("file:") {
             return Err(self.err(format!("source {source:?}: only files inside the package are supported")));
         }
-        let rel = crate::unpack::safe_relative_path(rel)
-            .map_err(|why| self.err(format!("source {source:?} refused: {why}")))?;
-        Ok(self.root.join(rel))
+        crate::unpack::safe_relative_path(rel).map_err(|why| self.err(format!("source {source:?} refused: {why}")))
+    }
+
+    /// Where the file `rel` of the package is, or why there is none (`what` names the
+    /// component or binding that refers to it, `source` as written).
+    fn locate(&self, rel: &Path, what: &str, source: &str) -> Result<crate::unpack::ArchiveSource> {
+        match &self.archive {
+            Some((_, entries)) => match entries.get(rel) {
+                Some(entry) => {
+                    Ok(crate::unpack::ArchiveSource::Nested { outer: self.path.to_path_buf(), entry: entry.clone() })
+                }
+                None => {
+                    let mut held: Vec<&str> = entries.values().map(String::as_str).collect();
+                    held.sort_unstable();
+                    Err(self.err(format!(
+                        "{what}: its source {source:?} is not in the archive{}",
+                        crate::suggest::did_you_mean(&rel.to_string_lossy(), held.iter().copied(), "its entries")
+                    )))
+                }
+            },
+            None => Ok(crate::unpack::ArchiveSource::File(self.root.join(rel))),
+        }
+    }
+
+    /// The text of the parameter file `rel` (from the archive or next to the `.ssd`).
+    fn read_text(&self, rel: &Path, what: &str, source: &str) -> Result<String> {
+        let limit = self.options.limits.max_xml_bytes;
+        match self.locate(rel, what, source)? {
+            crate::unpack::ArchiveSource::Nested { entry, .. } => {
+                let (zip, _) = self.archive.as_ref().expect("located in the archive");
+                let mut zip = zip.borrow_mut();
+                crate::unpack::read_text_entry(&mut zip, self.path, &entry, limit)?
+                    .ok_or_else(|| self.err(format!("{what}: its source {source:?} is not in the archive")))
+            }
+            crate::unpack::ArchiveSource::File(file) => {
+                crate::unpack::read_text_file(&file, source, limit).map_err(|e| match e {
+                    Error::Io { source: io, .. } => self.err(format!("{what}: {source:?} ({}): {io}", file.display())),
+                    other => other,
+                })
+            }
+        }
     }
 
     fn system(&mut self, el: &Element, prefix: &str) -> Result<()> {
@@ -261,7 +306,10 @@ impl Flattener<'_> {
             return Err(self.err(format!("component {name:?}: type {ty:?} is not supported (only {FMU_TYPE})")));
         }
         let source = el.attr("source").ok_or_else(|| self.err(format!("component {name:?} has no source")))?;
-        let file = self.resource(source)?;
+        let rel = self.resource(source)?;
+        let what = format!("component {name:?}");
+        let origin = self.locate(&rel, &what, source)?;
+        let file = origin.shown();
         let fmu = match self.fmus.get(&file) {
             Some(f) => f.clone(),
             None => {
@@ -273,7 +321,16 @@ impl Flattener<'_> {
                     Some("CoSimulation") => options.interface = Some(crate::Interface::CoSimulation),
                     _ => {}
                 }
-                let f = Fmu::load_with(&file, &options)?;
+                // a missing or unreadable FMU is named by its component and the package
+                let f = Fmu::load_from(&origin, &options).map_err(|e| match e {
+                    Error::Io { path, source: io } => {
+                        self.err(format!("{what}: cannot read its source {source:?} ({}): {io}", path.display()))
+                    }
+                    e @ (Error::Archive { .. } | Error::NotRegularFile { .. } | Error::MissingBinary { .. }) => {
+                        self.err(format!("{what} (source {source:?}): {e}"))
+                    }
+                    other => other,
+                })?;
                 self.fmus.insert(file.clone(), f.clone());
                 f
             }
@@ -322,17 +379,9 @@ impl Flattener<'_> {
             }
             let set = match (b.attr("source"), b.child("ParameterValues")) {
                 (Some(src), _) => {
-                    let file = self.resource(src)?;
-                    let text =
-                        crate::unpack::read_text_file(&file, src, self.options.limits.max_xml_bytes).map_err(|e| {
-                            match e {
-                                Error::Io { source, .. } => {
-                                    self.err(format!("{owner:?}: parameter file {src:?}: {source}"))
-                                }
-                                other => other,
-                            }
-                        })?;
-                    let set = parse_xml(&text, &file)?;
+                    let rel = self.resource(src)?;
+                    let text = self.read_text(&rel, &format!("{owner:?}: parameter file"), src)?;
+                    let set = parse_xml(&text, &self.path.join(&rel))?;
                     if set.name != "ParameterSet" {
                         return Err(self.err(format!(
                             "{owner:?}: parameter file {src:?} has the root element <{}>, not <ParameterSet> \
@@ -421,25 +470,27 @@ fn trace<'e>(
 /// Reads an `.ssp` archive or a bare `.ssd` file (FMU sources relative to its folder).
 pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     let is_ssd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssd"));
-    let (dir, root, ssd_path) = if is_ssd {
-        let root = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        (None, root, path.to_path_buf())
+    let root = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let (archive, text) = if is_ssd {
+        (None, crate::unpack::read_text_file(path, "SystemStructure.ssd", options.limits.max_xml_bytes)?)
     } else {
-        let dir = crate::unpack::unpack(path, &options.limits)?;
-        let root = dir.path().to_path_buf();
-        let ssd = root.join("SystemStructure.ssd");
-        (Some(dir), root, ssd)
-    };
-    let text =
-        crate::unpack::read_text_file(&ssd_path, "SystemStructure.ssd", options.limits.max_xml_bytes).map_err(|e| {
-            match e {
-                Error::Io { source, .. } if !is_ssd => Error::Ssp {
-                    path: path.to_path_buf(),
-                    reason: format!("cannot read SystemStructure.ssd: {source}"),
-                },
-                other => other,
-            }
+        // every header checked first; then only the .ssd, the .ssv files named and the
+        // FMUs are read, straight from the archive
+        let file = crate::unpack::open_regular(path)?;
+        let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file))
+            .map_err(|e| Error::Archive { path: path.to_path_buf(), reason: e.to_string() })?;
+        let entries: HashMap<PathBuf, String> = crate::unpack::check_entries(&mut zip, path, &options.limits)?
+            .into_iter()
+            .map(|e| (e.rel, e.name))
+            .collect();
+        let ssd_name = entries.get(Path::new("SystemStructure.ssd")).cloned().ok_or_else(|| Error::Ssp {
+            path: path.to_path_buf(),
+            reason: "cannot read SystemStructure.ssd: no such entry in the archive".into(),
         })?;
+        let text = crate::unpack::read_text_entry(&mut zip, path, &ssd_name, options.limits.max_xml_bytes)?
+            .unwrap_or_default();
+        (Some((std::cell::RefCell::new(zip), entries)), text)
+    };
     let doc = parse_xml(&text, path)?;
     if doc.name != "SystemStructureDescription" {
         return Err(Error::Ssp {
@@ -450,6 +501,7 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     let mut f = Flattener {
         root: &root,
         path,
+        archive,
         options,
         fmus: HashMap::new(),
         builder: SystemBuilder::new(),
@@ -513,7 +565,8 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
             )
         })
         .unwrap_or((None, None));
-    Ok(SspSystem { system: f.builder.build(), default_start_stop, _dir: dir })
+    let archive = (!is_ssd).then(|| path.to_path_buf());
+    Ok(SspSystem { system: f.builder.build(), default_start_stop, archive })
 }
 
 fn esc(s: &str) -> String {
@@ -651,9 +704,16 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
     let zerr = |e: zip::result::ZipError| Error::Archive { path: path.to_path_buf(), reason: e.to_string() };
     zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
     zip.write_all(x.as_bytes()).map_err(io)?;
+    // the FMUs stored, not deflated: they are compressed archives already (deflate gains
+    // under 1 %), and a stored FMU is read in place by importers that seek (see `unpack`)
+    let stored = options.compression_method(zip::CompressionMethod::Stored);
     for (src, file) in &files {
-        let bytes = std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?;
-        zip.start_file(file.as_str(), options).map_err(zerr)?;
+        let fmu = system.instances.iter().find(|i| i.fmu.source() == src.as_path()).map(|i| &i.fmu);
+        let bytes = match fmu {
+            Some(fmu) => fmu.archive_bytes()?,
+            None => std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?,
+        };
+        zip.start_file(file.as_str(), stored).map_err(zerr)?;
         zip.write_all(&bytes).map_err(io)?;
     }
     zip.finish().map_err(zerr)?;

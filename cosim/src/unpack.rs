@@ -1,5 +1,11 @@
 //! Safe unpacking of `.fmu` / `.ssp` archives into a private temporary folder.
 //!
+//! A run unpacks of an FMU only what it uses ([`unpack_fmu`]: `modelDescription.xml`,
+//! `binaries/linux64/`, `resources/`), so that the libraries of other platforms cost
+//! nothing; an FMU inside an `.ssp` is read straight from it ([`ArchiveSource::Nested`]:
+//! in place when stored, as `write_ssp` stores them, else inflated into memory), never
+//! written to disk as a whole. Every header of every archive is checked as below first.
+//!
 //! Refused: names that escape the folder (`..`, absolute paths, drive letters, NUL),
 //! symbolic links, duplicate names, and archive bombs: too many entries, an entry or the
 //! total larger than the limits, an entry that inflates more than `max_ratio` times its
@@ -147,11 +153,7 @@ pub fn read_text_file(path: &Path, shown: &str, limit: u64) -> Result<String> {
 /// Unpacks `archive` into a fresh private temporary folder (removed when dropped, or by
 /// [`remove_on_signals`] when the process is interrupted).
 pub fn unpack(archive: &Path, limits: &UnpackLimits) -> Result<tempfile::TempDir> {
-    let dir = tempfile::Builder::new()
-        .prefix("nigel-cosim-")
-        .tempdir()
-        .map_err(|source| Error::Io { path: std::env::temp_dir(), source })?;
-    register(dir.path());
+    let dir = fresh_dir()?;
     unpack_into(archive, dir.path(), limits)?; // on error `dir` is dropped, so removed
     Ok(dir)
 }
@@ -164,6 +166,17 @@ fn register(dir: &Path) {
     let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
     made.retain(|p| p.exists());
     made.push(dir.to_path_buf());
+}
+
+/// Removes the temporary folders this process made, without waiting: when another
+/// thread holds the list (it is adding one), nothing is removed. For a process that ends
+/// without unwinding (`_exit`).
+pub(crate) fn remove_temporary_folders_now() {
+    if let Ok(made) = MADE.try_lock() {
+        for dir in made.iter() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
 }
 
 /// Removes the temporary folders of this process when it gets SIGINT, SIGTERM or SIGHUP,
@@ -202,10 +215,169 @@ pub fn remove_on_signals() {
     }
 }
 
-fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()> {
-    let file = open_regular(archive)?;
-    let bad = |e: zip::result::ZipError| Error::Archive { path: archive.to_path_buf(), reason: e.to_string() };
-    let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file)).map_err(bad)?;
+/// Where an archive is: a file, or an entry of an `.ssp` (an FMU in `resources/`), read
+/// straight from the outer archive without writing it to disk.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ArchiveSource {
+    /// An archive file.
+    File(PathBuf),
+    /// The archive stored as entry `entry` of the `.ssp` file `outer`.
+    Nested {
+        /// The `.ssp` file.
+        outer: PathBuf,
+        /// The entry's name in it (`resources/x.fmu`).
+        entry: String,
+    },
+}
+
+impl ArchiveSource {
+    /// The path errors name: the file, or `<outer>/<entry>` (the `.ssp` and the place in it).
+    pub fn shown(&self) -> PathBuf {
+        match self {
+            ArchiveSource::File(p) => p.clone(),
+            ArchiveSource::Nested { outer, entry } => outer.join(entry),
+        }
+    }
+
+    /// The archive's bytes (the file, or the entry read out of the outer archive).
+    pub fn read_bytes(&self, limits: &UnpackLimits) -> Result<Vec<u8>> {
+        let mut bytes = Vec::new();
+        match self.open(limits)? {
+            Reader::File(mut f) => f.read_to_end(&mut bytes),
+            Reader::Window(mut w) => w.read_to_end(&mut bytes),
+            Reader::Memory(c) => return Ok(c.into_inner()),
+        }
+        .map_err(|source| Error::Io { path: self.shown(), source })?;
+        Ok(bytes)
+    }
+
+    fn open(&self, limits: &UnpackLimits) -> Result<Reader> {
+        match self {
+            ArchiveSource::File(p) => Ok(Reader::File(std::io::BufReader::with_capacity(64 * 1024, open_regular(p)?))),
+            ArchiveSource::Nested { outer, entry } => {
+                let mut zip = open_zip(outer)?;
+                let index = zip.index_for_name(entry).ok_or_else(|| Error::Archive {
+                    path: outer.clone(),
+                    reason: format!("no entry {entry:?} in the archive"),
+                })?;
+                let bad = |e: zip::result::ZipError| Error::Archive {
+                    path: outer.clone(),
+                    reason: format!("entry {entry:?}: {e}"),
+                };
+                let raw = zip.by_index_raw(index).map_err(bad)?;
+                if raw.size() > limits.max_entry_bytes {
+                    return Err(Error::ArchiveLimit {
+                        entry: entry.clone(),
+                        size: raw.size(),
+                        limit: limits.max_entry_bytes,
+                        limit_name: "max_entry_bytes",
+                    });
+                }
+                if raw.compression() == zip::CompressionMethod::Stored && !raw.encrypted() {
+                    // stored (as `write_ssp` writes FMUs): read in place, seeking in the outer file
+                    let (start, len) = (raw.data_start(), raw.size());
+                    drop(raw);
+                    let file = zip.into_inner();
+                    return Ok(Reader::Window(Window { file, start, len, pos: 0, at: None }));
+                }
+                drop(raw);
+                // compressed: inflated into memory, held to its declared size
+                let mut e = zip.by_index(index).map_err(bad)?;
+                let declared = e.size();
+                let mut bytes = Vec::with_capacity(declared as usize);
+                (&mut e)
+                    .take(declared + 1)
+                    .read_to_end(&mut bytes)
+                    .map_err(|err| Error::Archive { path: outer.clone(), reason: format!("entry {entry:?}: {err}") })?;
+                if bytes.len() as u64 > declared {
+                    return Err(Error::ArchiveLimit {
+                        entry: entry.clone(),
+                        size: bytes.len() as u64,
+                        limit: declared,
+                        limit_name: "the size its header declares",
+                    });
+                }
+                Ok(Reader::Memory(std::io::Cursor::new(bytes)))
+            }
+        }
+    }
+}
+
+/// An archive opened for reading.
+enum Reader {
+    File(std::io::BufReader<std::fs::File>),
+    Window(Window),
+    Memory(std::io::Cursor<Vec<u8>>),
+}
+
+/// Bytes `start .. start + len` of a file, as a file of their own.
+struct Window {
+    file: std::io::BufReader<std::fs::File>,
+    start: u64,
+    len: u64,
+    pos: u64,
+    /// Where the file is (`None`: unknown); a read there needs no seek, which would
+    /// drop the buffer.
+    at: Option<u64>,
+}
+
+impl Read for Window {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        use std::io::{Seek, SeekFrom};
+        let left = self.len.saturating_sub(self.pos);
+        if left == 0 {
+            return Ok(0);
+        }
+        let n = (buf.len() as u64).min(left) as usize;
+        let want = self.start + self.pos;
+        if self.at != Some(want) {
+            self.at = None;
+            self.file.seek(SeekFrom::Start(want))?;
+        }
+        let got = self.file.read(&mut buf[..n])?;
+        self.pos += got as u64;
+        self.at = Some(want + got as u64);
+        Ok(got)
+    }
+}
+
+impl std::io::Seek for Window {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        use std::io::SeekFrom;
+        let pos = match to {
+            SeekFrom::Start(p) => p as i128,
+            SeekFrom::End(d) => self.len as i128 + d as i128,
+            SeekFrom::Current(d) => self.pos as i128 + d as i128,
+        };
+        if pos < 0 {
+            return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, "seek before the start"));
+        }
+        self.pos = pos as u64;
+        Ok(self.pos)
+    }
+}
+
+fn open_zip(path: &Path) -> Result<zip::ZipArchive<std::io::BufReader<std::fs::File>>> {
+    let file = open_regular(path)?;
+    zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file))
+        .map_err(|e| Error::Archive { path: path.to_path_buf(), reason: e.to_string() })
+}
+
+/// One entry of a checked archive: its index, name and relative path.
+pub(crate) struct Entry {
+    pub(crate) index: usize,
+    pub(crate) name: String,
+    pub(crate) rel: PathBuf,
+}
+
+/// Checks every header of `zip` against `limits` (names, symbolic links, duplicates,
+/// sizes, ratios, the total) before anything is read; returns the entries.
+pub(crate) fn check_entries<R: Read + std::io::Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    shown: &Path,
+    limits: &UnpackLimits,
+) -> Result<Vec<Entry>> {
+    let bad = |e: zip::result::ZipError| Error::Archive { path: shown.to_path_buf(), reason: e.to_string() };
     let count = zip.len() as u64;
     if count > limits.max_entries {
         return Err(Error::ArchiveLimit {
@@ -215,16 +387,21 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
             limit_name: "max_entries",
         });
     }
-    // check every header before writing anything
     let mut declared_total = 0u64;
+    let mut seen = std::collections::HashSet::with_capacity(zip.len());
+    let mut entries = Vec::with_capacity(zip.len());
     for i in 0..zip.len() {
         let entry = zip.by_index_raw(i).map_err(bad)?;
         let name = entry.name().to_string();
-        safe_relative_path(&name).map_err(|reason| Error::UnsafeEntry { entry: name.clone(), reason })?;
+        let rel = safe_relative_path(&name).map_err(|reason| Error::UnsafeEntry { entry: name.clone(), reason })?;
         if let Some(mode) = entry.unix_mode() {
             if mode & 0o170000 == 0o120000 {
                 return Err(Error::UnsafeEntry { entry: name, reason: "symbolic link" });
             }
+        }
+        let is_dir = entry.is_dir() || name.ends_with('/');
+        if !is_dir && !seen.insert(rel.clone()) {
+            return Err(Error::UnsafeEntry { entry: name, reason: "duplicate name in the archive" });
         }
         if entry.size() > limits.max_entry_bytes {
             return Err(Error::ArchiveLimit {
@@ -253,21 +430,117 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
                 limit_name: "max_total_bytes",
             });
         }
+        if !is_dir {
+            entries.push(Entry { index: i, name, rel });
+        }
     }
+    Ok(entries)
+}
+
+/// Reads the text entry `name` of a checked archive (at most `limit` bytes); `Ok(None)`
+/// if there is no such entry.
+pub(crate) fn read_text_entry<R: Read + std::io::Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    shown: &Path,
+    name: &str,
+    limit: u64,
+) -> Result<Option<String>> {
+    let Some(index) = zip.index_for_name(name) else { return Ok(None) };
+    let bad = |e: String| Error::Archive { path: shown.to_path_buf(), reason: format!("entry {name:?}: {e}") };
+    let mut e = zip.by_index(index).map_err(|e| bad(e.to_string()))?;
+    if e.size() > limit {
+        return Err(Error::ArchiveLimit {
+            entry: name.to_string(),
+            size: e.size(),
+            limit,
+            limit_name: "max_xml_bytes",
+        });
+    }
+    let mut bytes = Vec::with_capacity(e.size() as usize);
+    (&mut e).take(limit + 1).read_to_end(&mut bytes).map_err(|e| bad(e.to_string()))?;
+    if bytes.len() as u64 > limit {
+        return Err(Error::ArchiveLimit {
+            entry: name.to_string(),
+            size: bytes.len() as u64,
+            limit,
+            limit_name: "max_xml_bytes",
+        });
+    }
+    String::from_utf8(bytes).map(Some).map_err(|e| bad(format!("not UTF-8 text: {e}")))
+}
+
+/// The entries of an FMU a run in this process uses: `modelDescription.xml`, this
+/// platform's `binaries/linux64/` and `resources/` (other platforms' libraries, the
+/// documentation and sources are not written).
+pub fn used_by_a_run(name: &Path) -> bool {
+    name == Path::new("modelDescription.xml") || name.starts_with("binaries/linux64") || name.starts_with("resources")
+}
+
+/// An FMU unpacked for a run: its private folder and the platforms its archive carries.
+pub struct UnpackedFmu {
+    /// The private folder (removed when dropped).
+    pub dir: tempfile::TempDir,
+    /// The folders under `binaries/` in the archive, sorted.
+    pub platforms: Vec<String>,
+}
+
+/// Unpacks of the FMU `source` only the entries [`used_by_a_run`] into a fresh private
+/// temporary folder, after checking every header of the archive as [`unpack`] does.
+pub fn unpack_fmu(source: &ArchiveSource, limits: &UnpackLimits) -> Result<UnpackedFmu> {
+    let shown = source.shown();
+    let dir = fresh_dir()?;
+    let mut platforms = std::collections::BTreeSet::new();
+    let mut wanted = |e: &Entry| {
+        let mut parts = e.rel.components();
+        if let (Some(first), Some(second), Some(_)) = (parts.next(), parts.next(), parts.next()) {
+            if first.as_os_str() == "binaries" {
+                platforms.insert(second.as_os_str().to_string_lossy().into_owned());
+            }
+        }
+        used_by_a_run(&e.rel)
+    };
+    match source.open(limits)? {
+        Reader::File(r) => extract(r, &shown, dir.path(), limits, &mut wanted)?,
+        Reader::Window(r) => extract(r, &shown, dir.path(), limits, &mut wanted)?,
+        Reader::Memory(r) => extract(r, &shown, dir.path(), limits, &mut wanted)?,
+    }
+    Ok(UnpackedFmu { dir, platforms: platforms.into_iter().collect() })
+}
+
+fn fresh_dir() -> Result<tempfile::TempDir> {
+    let dir = tempfile::Builder::new()
+        .prefix("nigel-cosim-")
+        .tempdir()
+        .map_err(|source| Error::Io { path: std::env::temp_dir(), source })?;
+    register(dir.path());
+    Ok(dir)
+}
+
+fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()> {
+    let file = std::io::BufReader::with_capacity(64 * 1024, open_regular(archive)?);
+    extract(file, archive, dest, limits, &mut |_| true)
+}
+
+/// Checks every header, then writes the entries `wanted` selects into `dest`.
+fn extract<R: Read + std::io::Seek>(
+    reader: R,
+    shown: &Path,
+    dest: &Path,
+    limits: &UnpackLimits,
+    wanted: &mut dyn FnMut(&Entry) -> bool,
+) -> Result<()> {
+    let bad = |e: zip::result::ZipError| Error::Archive { path: shown.to_path_buf(), reason: e.to_string() };
+    let mut zip = zip::ZipArchive::new(reader).map_err(bad)?;
+    let entries = check_entries(&mut zip, shown, limits)?;
     let mut buffer = vec![0u8; 64 * 1024];
-    for i in 0..zip.len() {
-        let mut entry = zip.by_index(i).map_err(bad)?;
-        let name = entry.name().to_string();
-        let rel = safe_relative_path(&name).map_err(|reason| Error::UnsafeEntry { entry: name.clone(), reason })?;
-        let target = dest.join(&rel);
+    for e in entries.iter().filter(|e| wanted(e)) {
+        let mut entry = zip.by_index(e.index).map_err(bad)?;
+        let name = &e.name;
+        let target = dest.join(&e.rel);
         let io = |path: &Path| {
             let path = path.to_path_buf();
             move |source| Error::Io { path, source }
         };
-        if entry.is_dir() || name.ends_with('/') {
-            std::fs::create_dir_all(&target).map_err(io(&target))?;
-            continue;
-        }
         if let Some(parent) = target.parent() {
             std::fs::create_dir_all(parent).map_err(io(parent))?;
         }
@@ -284,7 +557,7 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
         loop {
             let n = entry
                 .read(&mut buffer)
-                .map_err(|e| Error::Archive { path: archive.to_path_buf(), reason: format!("entry {name:?}: {e}") })?;
+                .map_err(|e| Error::Archive { path: shown.to_path_buf(), reason: format!("entry {name:?}: {e}") })?;
             if n == 0 {
                 break;
             }
@@ -293,7 +566,7 @@ fn unpack_into(archive: &Path, dest: &Path, limits: &UnpackLimits) -> Result<()>
             // declared size holds the archive to all of them
             if written > declared {
                 return Err(Error::ArchiveLimit {
-                    entry: name,
+                    entry: name.clone(),
                     size: written,
                     limit: declared,
                     limit_name: "the size its header declares",

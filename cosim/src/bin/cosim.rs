@@ -68,11 +68,11 @@ struct RunArgs {
     /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
     #[arg(long)]
     interface: Option<String>,
-    /// Start time, s.
-    #[arg(long, default_value_t = 0.0)]
+    /// Start time, s (negative times are times like any other).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     start_time: f64,
     /// Stop time, s (default: the FMU's DefaultExperiment, else 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     stop_time: Option<f64>,
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
     #[arg(long)]
@@ -297,6 +297,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
     }
+    report_exit_inside_calls(args.output.clone(), format, &system);
     let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
     if outcome.is_ok() && args.output.is_none() && args.summary.is_none() {
         eprintln!(
@@ -339,6 +340,52 @@ fn run(args: RunArgs) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// An FMU that calls exit() inside a call (in this process) ends `cosim` with status 1,
+/// naming the instance and the call, with the rows so far written to `output`.
+fn report_exit_inside_calls(output: Option<PathBuf>, format: Option<OutputFormat>, system: &System) {
+    // the MAT file's descriptions, by column name (the hook holds no FMU: a held `Arc<Fmu>`
+    // would keep its unpacked folder to the end of the process)
+    let single = system.instances.len() == 1;
+    let descriptions: std::collections::HashMap<String, String> = match format {
+        Some(OutputFormat::Mat) => system
+            .instances
+            .iter()
+            .flat_map(|i| {
+                i.fmu.description().model_variables.iter().map(move |v| {
+                    let name = if single { v.name.clone() } else { format!("{}.{}", i.name, v.name) };
+                    (name, v.description.clone().unwrap_or_default())
+                })
+            })
+            .collect(),
+        _ => Default::default(),
+    };
+    nigel_cosim::on_exit_inside_call(Box::new(move |call, rows| {
+        match call {
+            Some(c) => eprintln!("cosim: {c}"),
+            None => eprintln!("cosim: exit() was called during the run, outside an FMU call of the calling thread"),
+        }
+        let (Some(path), Some(format)) = (&output, format) else { return };
+        let Some(results) = rows.filter(|r| r.rows() > 0) else {
+            eprintln!("cosim: no rows to write to {}", path.display());
+            return;
+        };
+        let written = std::fs::File::create(path).and_then(|f| match format {
+            OutputFormat::Csv => results.write_csv(std::io::BufWriter::new(f)),
+            OutputFormat::Mat => {
+                let d: Vec<String> =
+                    results.names.iter().map(|n| descriptions.get(n).cloned().unwrap_or_default()).collect();
+                results.write_mat(std::io::BufWriter::new(f), &d)
+            }
+        });
+        match written {
+            Ok(()) => {
+                eprintln!("cosim: {} rows up to the last completed step written to {}", results.rows(), path.display())
+            }
+            Err(e) => eprintln!("cosim: {}: {e}", path.display()),
+        }
+    }));
 }
 
 #[derive(Clone, Copy)]
@@ -393,7 +440,7 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
 }
 
 /// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else its DefaultExperiment stepSize) is shorter than the communication step: its
+/// else, for an FMU with discrete states or outputs, its DefaultExperiment stepSize) is shorter than the communication step: its
 /// inputs are then held and its outputs read less often than it is meant to run.
 fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
     let mut out = Vec::new();
@@ -413,8 +460,19 @@ fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
             };
             set.or(start).map(|p| (p, "its parameter sample_period"))
         });
+        // the stepSize is only a suggestion of a continuous model (its integrator runs
+        // within any step); it is a sample period where the FMU has discrete-time values
+        // of its own (discrete states or outputs, which change at its sample instants)
+        let samples = md.model_variables.iter().any(|v| {
+            v.variability == model_description::Variability::Discrete
+                && !matches!(v.causality, model_description::Causality::Input | model_description::Causality::Parameter)
+        });
         let declared = from_parameter.or_else(|| {
-            md.default_experiment.as_ref().and_then(|d| d.step_size).map(|p| (p, "its DefaultExperiment stepSize"))
+            md.default_experiment
+                .as_ref()
+                .and_then(|d| d.step_size)
+                .filter(|_| samples)
+                .map(|p| (p, "its DefaultExperiment stepSize"))
         });
         if let Some((period, source)) = declared {
             // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)

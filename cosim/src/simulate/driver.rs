@@ -169,6 +169,8 @@ fn run<'s>(
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
     let mut recorder = Recorder::new(names, record_slots, clock.rows(), clock.steps, experiment.progress, sink);
+    // an FMU's exit() inside a call during the run reports it with these rows
+    let registered = crate::exit_guard::Registered::new(recorder.shared.clone());
     let outcome = (|| -> Result<Summary> {
         // instantiate and initialize (FMI 2.0 section 4.2.4)
         let mut lanes: Vec<Lane> = Vec::with_capacity(system.instances.len());
@@ -310,7 +312,8 @@ fn run<'s>(
         summary.wall_time = wall.elapsed();
         Ok(summary)
     })();
-    *out = std::mem::take(&mut recorder.results);
+    drop(registered);
+    *out = recorder.take_results();
     outcome
 }
 

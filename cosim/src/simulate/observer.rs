@@ -23,7 +23,9 @@ pub(crate) trait Observer {
 /// The rows of the results: time and the recorded slots at every output point.
 /// With a sink ([`crate::simulate::RowSink`]) the rows are handed to it instead of kept.
 pub(crate) struct Recorder<'s> {
-    pub(crate) results: Results,
+    /// The rows, shared with the handler of an FMU's exit() ([`crate::exit_guard`]):
+    /// locked only while a row is appended (about 20 ns a row).
+    pub(crate) shared: std::sync::Arc<crate::exit_guard::RunRows>,
     slots: Vec<usize>,
     steps: u64,
     /// Steps completed so far.
@@ -50,7 +52,9 @@ impl<'s> Recorder<'s> {
         let wanted = if sink.is_some() { 0 } else { (rows as usize).saturating_mul(slots.len() + 1).min(8 << 20) };
         let row = Vec::with_capacity(slots.len());
         Recorder {
-            results: Results { names, values: Vec::with_capacity(wanted) },
+            shared: std::sync::Arc::new(crate::exit_guard::RunRows {
+                results: std::sync::Mutex::new(Results { names, values: Vec::with_capacity(wanted) }),
+            }),
             slots,
             steps,
             done: 0,
@@ -59,6 +63,11 @@ impl<'s> Recorder<'s> {
             row,
             last: None,
         }
+    }
+
+    /// The rows recorded (taken out).
+    pub(crate) fn take_results(&mut self) -> Results {
+        std::mem::take(&mut *self.shared.results.lock().unwrap_or_else(|e| e.into_inner()))
     }
 
     /// Communication steps completed.
@@ -82,8 +91,9 @@ impl<'s> Recorder<'s> {
                 sink(t, &self.row);
             }
             None => {
-                self.results.values.push(t);
-                self.results.values.extend(self.slots.iter().map(|s| values[*s]));
+                let mut results = self.shared.results.lock().unwrap_or_else(|e| e.into_inner());
+                results.values.push(t);
+                results.values.extend(self.slots.iter().map(|s| values[*s]));
             }
         }
     }

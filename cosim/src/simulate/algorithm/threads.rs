@@ -149,12 +149,14 @@ impl Pool {
             panicked: AtomicBool::new(false),
         };
         let main = std::thread::current();
+        let run = crate::exit_guard::current_run();
         let result = std::thread::scope(|scope| {
             let mut workers = Vec::with_capacity(threads - 1);
             for g in 1..threads {
                 let shared = &shared;
                 let main = main.clone();
                 let handle = scope.spawn(move || {
+                    run.enter();
                     let mut seen = 0;
                     loop {
                         wait_until(|| shared.epoch.load(Ordering::Acquire) != seen);

@@ -1,0 +1,189 @@
+//! An FMU that ends the process with `exit()` inside one of its calls, in process.
+//!
+//! `exit(0)` in `fmi2DoStep` would end the master with status 0 and nothing written: a
+//! failed run that looks like a success. The master registers one `atexit` handler (at
+//! its first run) and marks every call into an FMU (a thread-local: instance, FMU,
+//! function, time; two stores per call). When `exit()` runs while a run is in progress,
+//! the handler reports the instance and the call, hands the rows recorded so far to the
+//! hook the program installed ([`on_exit_inside_call`]; `cosim` writes them to its
+//! `--output`), removes the temporary folders and ends the process with `_exit(1)`.
+//!
+//! Why this is safe enough in an `atexit` handler: handlers run in ordinary context (not
+//! in a signal handler), in the thread that called `exit()`, so allocation and file
+//! writes are allowed. What the handler must not do is wait: other threads keep running
+//! and may hold locks, so the rows are taken with `try_lock` (the recorder holds their
+//! lock only while it appends a row, never during an FMU call) and the list of temporary
+//! folders likewise; a lock that is held means "not written", said so, never a hang. It
+//! ends with `_exit`: calling `exit()` again from a handler is undefined, and the
+//! remaining handlers (the FMU's own destructors, run while the FMU is inside a call)
+//! are better not run. The marker holds pointers to the instance's name and its `Fmu`,
+//! both alive for the whole call it marks; they are read only in the calling thread.
+//! Only the thread-local `Cell`s of `Copy` values are read: they have no destructor, so
+//! glibc's run of thread-local destructors before the handlers leaves them intact.
+
+use crate::fmu::Fmu;
+use crate::simulate::Results;
+use std::cell::Cell;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The call an FMU was in when it called `exit()`.
+#[derive(Clone, Debug)]
+pub struct ExitInsideCall {
+    /// The instance.
+    pub instance: String,
+    /// The FMU's archive ([`Fmu::source`]).
+    pub fmu: PathBuf,
+    /// The FMI function.
+    pub function: &'static str,
+    /// The time the instance was at (the step's start for `fmi2DoStep`), s.
+    pub time: f64,
+}
+
+impl std::fmt::Display for ExitInsideCall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let file = self.fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        write!(
+            f,
+            "{} ({file}) called exit() inside {} at t = {} s, ending the process in the middle of the run",
+            self.instance, self.function, self.time
+        )
+    }
+}
+
+/// What the program does with the rows when an FMU calls `exit()` during a run: given
+/// the call (`None`: `exit()` came from a thread in no FMU call, while a run was in
+/// progress) and the rows recorded so far (`None` when they could not be taken without
+/// waiting, or went to a [`crate::RowSink`]). The process then ends with status 1.
+pub type ExitHook = dyn Fn(Option<&ExitInsideCall>, Option<&Results>) + Send + Sync;
+
+static HOOK: OnceLock<Box<ExitHook>> = OnceLock::new();
+
+/// Installs the hook called when an FMU ends the process with `exit()` during a run in
+/// this process (once per process; a second call returns false and changes nothing).
+/// Without a hook the call is reported on standard error. Either way the process ends
+/// with status 1, not with the status the FMU gave.
+pub fn on_exit_inside_call(hook: Box<ExitHook>) -> bool {
+    HOOK.set(hook).is_ok()
+}
+
+#[derive(Clone, Copy)]
+struct Site {
+    instance: *const str,
+    fmu: *const Fmu,
+    function: &'static str,
+    time: f64,
+}
+
+/// The rows of one run, shared with the handler.
+#[derive(Default)]
+pub(crate) struct RunRows {
+    pub(crate) results: Mutex<Results>,
+}
+
+thread_local! {
+    static CALL: Cell<Option<Site>> = const { Cell::new(None) };
+    static RUN: Cell<*const RunRows> = const { Cell::new(std::ptr::null()) };
+}
+
+/// Runs in progress in this process.
+static ACTIVE: AtomicUsize = AtomicUsize::new(0);
+
+/// The mark of a call in progress; the previous mark comes back when it is dropped.
+pub(crate) struct InCall(Option<Site>);
+
+/// Marks the call `function` of `instance` (of `fmu`) at `time` as in progress in this
+/// thread.
+#[inline]
+pub(crate) fn enter(instance: &str, fmu: &Fmu, function: &'static str, time: f64) -> InCall {
+    let site = Site { instance, fmu, function, time };
+    InCall(CALL.with(|c| c.replace(Some(site))))
+}
+
+impl Drop for InCall {
+    #[inline]
+    fn drop(&mut self) {
+        CALL.with(|c| c.set(self.0));
+    }
+}
+
+/// A run in progress: its rows known to this thread's handler while it lives.
+pub(crate) struct Registered {
+    /// The rows the handler reads, kept alive while the run is registered.
+    _rows: Arc<RunRows>,
+    previous: *const RunRows,
+}
+
+impl Registered {
+    pub(crate) fn new(rows: Arc<RunRows>) -> Registered {
+        static ONCE: std::sync::Once = std::sync::Once::new();
+        // SAFETY: registers a plain `extern "C" fn()` with the C library.
+        ONCE.call_once(|| unsafe {
+            libc::atexit(on_exit);
+        });
+        ACTIVE.fetch_add(1, Ordering::SeqCst);
+        let previous = RUN.with(|r| r.replace(Arc::as_ptr(&rows)));
+        Registered { _rows: rows, previous }
+    }
+}
+
+/// The run this thread is in, for the threads it starts to step its instances
+/// ([`RunHandle::enter`]).
+pub(crate) fn current_run() -> RunHandle {
+    RunHandle(RUN.with(|r| r.get()))
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        RUN.with(|r| r.set(self.previous));
+        ACTIVE.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// The run a worker thread steps instances of (valid while its [`Registered`] lives,
+/// which outlives the run's scoped threads).
+#[derive(Clone, Copy)]
+pub(crate) struct RunHandle(*const RunRows);
+
+// SAFETY: the pointer is only read, through a Mutex, while the run is registered.
+unsafe impl Send for RunHandle {}
+unsafe impl Sync for RunHandle {}
+
+impl RunHandle {
+    /// Makes this thread's exit() report the run's rows.
+    pub(crate) fn enter(self) {
+        RUN.with(|r| r.set(self.0));
+    }
+}
+
+extern "C" fn on_exit() {
+    if ACTIVE.load(Ordering::SeqCst) == 0 {
+        return; // the program ends normally, between runs
+    }
+    let site = CALL.try_with(|c| c.get()).ok().flatten();
+    // SAFETY: the pointers of a mark are alive for the call it marks, and that call is
+    // in progress in this very thread (it is the one calling exit()).
+    let call = site.map(|s| unsafe {
+        ExitInsideCall {
+            instance: (*s.instance).to_string(),
+            fmu: (*s.fmu).source().to_path_buf(),
+            function: s.function,
+            time: s.time,
+        }
+    });
+    let run = RUN.try_with(|r| r.get()).unwrap_or(std::ptr::null());
+    // SAFETY: a registered run's rows outlive its registration, which is in progress.
+    let rows = (!run.is_null()).then(|| unsafe { &*run }).and_then(|r| r.results.try_lock().ok());
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match HOOK.get() {
+        Some(hook) => hook(call.as_ref(), rows.as_deref()),
+        None => match &call {
+            Some(c) => eprintln!("{c}"),
+            None => eprintln!("exit() was called during a run, outside an FMU call of the calling thread"),
+        },
+    }));
+    drop(result);
+    crate::unpack::remove_temporary_folders_now();
+    // SAFETY: ends the process at once, as the handler must (see the module's comment).
+    unsafe { libc::_exit(1) };
+}
