@@ -107,7 +107,7 @@ fn duration(run: &Run) -> f64 {
 pub const WINDOW: f64 = 8.0;
 
 /// The time window the time plots show, inside `[0, t_end]`: from 1 s before the steering
-/// program (`program[k]`, the largest |delta| over the wheels at `t_k`) first reaches its
+/// program (`program[k]`: at `t_k`, the command of the wheel steered the most) first reaches its
 /// largest magnitude (within 1 %), for [`WINDOW`] seconds or until 3 s after the program's
 /// last change if that comes first (at least 4 s): the lane change's impulse and recovery,
 /// the skidpad's step, the end of the fishhook's ramp with its hold and release, the
@@ -370,7 +370,12 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
     // steering is not recorded and the whole run is shown
     let open_loop = rs.iter().find(|r| r.job.controller == Controller::OpenLoop);
     let program: Vec<f64> = open_loop
-        .map(|r| r.delta.iter().map(|d| d.iter().fold(0.0f64, |m, v| m.max(v.abs()))).collect())
+        .map(|r| {
+            // the command of the wheel steered the most (signed, so that a switch shows)
+            let largest = |w: usize| r.delta.iter().fold(0.0f64, |m, d| m.max(d[w].abs()));
+            let w = (0..4).fold(0, |b, w| if largest(w) > largest(b) { w } else { b });
+            r.delta.iter().map(|d| d[w]).collect()
+        })
         .unwrap_or_default();
     let window = focus_window(&program, t_end);
     let in_window = |k: &usize| {
