@@ -247,7 +247,10 @@ impl Report {
 
     /// `controller = robust, maneuver = lane_change` for the columns `by` of a row's values.
     pub fn legend(&self, by: &[usize], values: &[f64]) -> String {
-        by.iter().map(|&c| format!("{} = {}", self.legend_key(c), self.label(c, values[c]))).collect::<Vec<_>>().join(", ")
+        by.iter()
+            .map(|&c| format!("{} = {}", self.legend_key(c), self.label(c, values[c])))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     fn metric_values(&self, rows: &[Row], m: usize) -> Vec<f64> {
@@ -432,7 +435,9 @@ impl Report {
                     let n = v.len() as f64;
                     let pts: Vec<(f64, f64)> = v.iter().enumerate().map(|(k, x)| (*x, (k + 1) as f64 / n)).collect();
                     let color = PALETTE[i % PALETTE.len()];
-                    chart.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2))).map_err(|e| err(&e))?;
+                    chart
+                        .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
                     // a marker at each decile tells the groups apart without colour
                     let deciles: Vec<(f64, f64)> = (1..10)
                         .filter_map(|d| pts.get(((d as f64 / 10.0 * n).ceil() as usize).max(1) - 1).copied())
@@ -480,10 +485,7 @@ impl Report {
             format!("{name} against {} ({} runs{})", self.spec.columns[column].name, ys.len(), y_axis.caption());
         let (root, chart_area) = figure_with_legend(path, &caption, &labels, false).map_err(|e| err(&e))?;
         let mut builder = ChartBuilder::on(&chart_area);
-        builder
-            .margin(16)
-            .x_label_area_size(48)
-            .y_label_area_size(72);
+        builder.margin(16).x_label_area_size(48).y_label_area_size(72);
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
@@ -510,7 +512,9 @@ impl Report {
             }};
         }
         match y_axis {
-            Axis::Log(y0, y1) => draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|e| err(&e))?),
+            Axis::Log(y0, y1) => {
+                draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|e| err(&e))?)
+            }
             Axis::Linear(y0, y1) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| err(&e))?),
         }
         root.present().map_err(|e| err(&e))?;
@@ -777,7 +781,20 @@ fn marker_shape(i: usize, size: i32) -> (Vec<(i32, i32)>, ShapeStyle) {
         2 => vec![(-0.85 * s, -0.85 * s), (0.85 * s, -0.85 * s), (0.85 * s, 0.85 * s), (-0.85 * s, 0.85 * s)],
         3 => {
             let (a, b) = (0.35 * s, 1.1 * s);
-            vec![(-a, -b), (a, -b), (a, -a), (b, -a), (b, a), (a, a), (a, b), (-a, b), (-a, a), (-b, a), (-b, -a), (-a, -a)]
+            vec![
+                (-a, -b),
+                (a, -b),
+                (a, -a),
+                (b, -a),
+                (b, a),
+                (a, a),
+                (a, b),
+                (-a, b),
+                (-a, a),
+                (-b, a),
+                (-b, -a),
+                (-a, -a),
+            ]
         }
         _ => vec![(0.0, -1.2 * s), (1.2 * s, 0.0), (0.0, 1.2 * s), (-1.2 * s, 0.0)],
     };
@@ -824,11 +841,10 @@ mod tests {
         let controller = "which steering feedback: 1 open_loop (K = 0, the feed-forward alone), 2 pole_placement \
                           (non-robust baseline, Re(s) < -2 at mu = 0.4), 3 robust (mixed H2/H-inf gain, the default)";
         let items = items_in_description(controller).unwrap();
-        assert_eq!(items.into_iter().collect::<Vec<_>>(), [
-            (1, "open_loop".to_string()),
-            (2, "pole_placement".to_string()),
-            (3, "robust".to_string())
-        ]);
+        assert_eq!(
+            items.into_iter().collect::<Vec<_>>(),
+            [(1, "open_loop".to_string()), (2, "pole_placement".to_string()), (3, "robust".to_string())]
+        );
         assert_eq!(items_in_description("1 paper, 2 real").unwrap().len(), 2);
         for not in ["the mass of the car", "1 open_loop", "1 a, 1 b", "1 a, two b", "1 a b, 2 c", "1 a (x, 2 b"] {
             assert_eq!(items_in_description(not), None, "{not}");

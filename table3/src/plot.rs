@@ -450,15 +450,22 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
     legend_strip(&legend, &controller_legend(&rs), path)?;
     caption_lines(
         &notes,
-        &[&format!(
+        &[
+            &format!(
             "{REFERENCE_CAPTION}; under the steering commands: the program (the open-loop command). Angles in degrees."
-        ), &format!(
-            "t = {} .. {} s of the {} s run{}",
-            tick(&window.0),
-            tick(&window.1),
-            tick(&t_end),
-            if window == (0.0, t_end) { "" } else { ": from 1 s before the steering program first reaches its largest magnitude (plot::focus_window)" }
-        )],
+        ),
+            &format!(
+                "t = {} .. {} s of the {} s run{}",
+                tick(&window.0),
+                tick(&window.1),
+                tick(&t_end),
+                if window == (0.0, t_end) {
+                    ""
+                } else {
+                    ": from 1 s before the steering program first reaches its largest magnitude (plot::focus_window)"
+                }
+            ),
+        ],
         path,
     )?;
     let (grid, bottom) = body.split_vertically(4 * 292);
@@ -546,14 +553,29 @@ mod tests {
     fn the_window_holds_where_the_program_steers() {
         let a = 0.5;
         // docs/benchmark.md's programs (the parts that set the window)
-        let lane = program(|t| if (14.8..15.0).contains(&t) { a } else if (15.0..15.2).contains(&t) { -a } else { 0.0 });
+        let lane = program(|t| {
+            if (14.8..15.0).contains(&t) {
+                a
+            } else if (15.0..15.2).contains(&t) {
+                -a
+            } else {
+                0.0
+            }
+        });
         let (t0, t1) = focus_window(&lane, 30.0);
         assert!((t0 - 13.8).abs() < 1e-9 && (t1 - 18.2).abs() < 1e-6, "{t0} {t1}");
         let skidpad = program(|t| if (2.5..27.5).contains(&t) { a } else { 0.0 });
         assert_eq!(focus_window(&skidpad, 30.0), (1.5, 1.5 + WINDOW));
         // fishhook: ramp 2.5 .. 25 s, hold to 27.5 s: the window ends at the run's end
-        let fishhook =
-            program(|t| if t < 2.5 || t >= 27.5 { 0.0 } else if t < 25.0 { a * (t - 2.5) / 22.5 } else { a });
+        let fishhook = program(|t| {
+            if t < 2.5 || t >= 27.5 {
+                0.0
+            } else if t < 25.0 {
+                a * (t - 2.5) / 22.5
+            } else {
+                a
+            }
+        });
         let (t0, t1) = focus_window(&fishhook, 30.0);
         assert!((t0 - (30.0 - WINDOW)).abs() < 1e-9 && (t1 - 30.0).abs() < 1e-9, "{t0} {t1}");
         let figure8 = program(|t| if (t / 3.2).floor() as i64 % 2 == 0 { a } else { -a });
