@@ -10,19 +10,71 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 use serde_json::json;
 
+use model_description::VariableType;
+use nigel_cosim::System;
+
 use crate::results::{Row, Target, STATUS_OK};
-use crate::spec::Spec;
+use crate::spec::{Domain, Spec};
 use crate::Error;
 
-/// A column's value as a group label: a case's name, else the number.
-fn label(spec: &Spec, column: usize, v: f64) -> String {
-    let names = spec.columns[column].case_names();
-    if !names.is_empty() {
-        if let Some(n) = names.get(v as usize) {
-            return n.clone();
+/// The names of the values of variable `name` (`instance.variable`) of `system`: an
+/// Enumeration's items, or the items an Integer's description lists as `N name`, the way our
+/// FMUs describe the switches they keep Integer so that every importer can set them
+/// (`which steering feedback: 1 open_loop (...), 2 pole_placement (...), 3 robust ...`).
+/// Empty when the variable has neither.
+pub fn value_names(system: &System, name: &str) -> BTreeMap<i64, String> {
+    let Ok(r) = system.resolve(name) else { return BTreeMap::new() };
+    let v = system.variable(&r);
+    match &v.variable_type {
+        VariableType::Enumeration { declared_type, .. } => system
+            .description(r.instance)
+            .type_definitions
+            .iter()
+            .find(|t| &t.name == declared_type)
+            .map(|t| t.items.iter().map(|i| (i64::from(i.value), i.name.clone())).collect())
+            .unwrap_or_default(),
+        VariableType::Integer { .. } => v.description.as_deref().and_then(items_in_description).unwrap_or_default(),
+        _ => BTreeMap::new(),
+    }
+}
+
+/// The items of a description `[text: ]N name [(note)], N name [(note)], ...`: every part
+/// (split at the commas outside parentheses) an integer, one identifier and an optional note
+/// in parentheses, at least two parts, each value once; `None` for any other text.
+pub fn items_in_description(text: &str) -> Option<BTreeMap<i64, String>> {
+    let list = text.split_once(": ").map_or(text, |(_, l)| l);
+    let mut parts = Vec::new();
+    let (mut depth, mut start) = (0i32, 0usize);
+    for (i, c) in list.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            ',' if depth == 0 => {
+                parts.push(&list[start..i]);
+                start = i + 1;
+            }
+            _ => {}
         }
     }
-    format!("{v}")
+    parts.push(&list[start..]);
+    let mut items = BTreeMap::new();
+    for part in &parts {
+        let part = part.trim();
+        let head = match part.find('(') {
+            Some(k) if part.ends_with(')') => part[..k].trim_end(),
+            Some(_) => return None,
+            None => part,
+        };
+        let mut words = head.split(' ');
+        let (Some(n), Some(id), None) = (words.next(), words.next(), words.next()) else { return None };
+        let n: i64 = n.parse().ok()?;
+        let ident = id.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && id.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !ident || items.insert(n, id.to_string()).is_some() {
+            return None;
+        }
+    }
+    (items.len() >= 2).then_some(items)
 }
 
 /// Statistics of one metric in one group.
@@ -68,19 +120,21 @@ impl Stats {
 /// One group of runs.
 #[derive(Clone, Debug)]
 pub struct Group {
-    /// `column = value` labels.
+    /// Per `--by` column its name and the value's label.
     pub key: Vec<(String, String)>,
+    /// The legend text, `controller = robust, maneuver = lane_change` (see [`Report::legend_key`]).
+    pub legend: String,
     /// The rows.
     pub rows: Vec<Row>,
 }
 
 impl Group {
-    /// `controller=robust, maneuver=2`.
+    /// The legend text (`all` for a report without `--by`).
     pub fn name(&self) -> String {
         if self.key.is_empty() {
             return "all".into();
         }
-        self.key.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(", ")
+        self.legend.clone()
     }
 }
 
@@ -94,6 +148,29 @@ pub struct Report {
     pub rows: Vec<Row>,
     /// The groups.
     pub groups: Vec<Group>,
+    /// Per column the names of its values: a case's name by its index, else the items of
+    /// the enumerated variable it sets ([`value_names`]); empty for a column of numbers.
+    pub value_names: Vec<BTreeMap<i64, String>>,
+}
+
+/// The value names of every column of `spec`: a column of cases by the case index; a column
+/// that sets variables all naming the same items ([`value_names`]) by those items.
+fn column_value_names(spec: &Spec, system: &System) -> Vec<BTreeMap<i64, String>> {
+    spec.columns
+        .iter()
+        .map(|c| match &c.domain {
+            Domain::Cases(cases) => cases.iter().enumerate().map(|(k, (n, _))| (k as i64, n.clone())).collect(),
+            _ => {
+                let mut names = c.targets.iter().map(|t| value_names(system, t));
+                let first = names.next().unwrap_or_default();
+                if names.all(|n| n == first) {
+                    first
+                } else {
+                    BTreeMap::new()
+                }
+            }
+        })
+        .collect()
 }
 
 fn column_index(spec: &Spec, name: &str) -> Result<usize, Error> {
@@ -123,17 +200,57 @@ impl Report {
             return Err(Error::Usage(format!("{}: no results (campaign run first, or campaign merge)", dir.display())));
         }
         let by: Vec<usize> = by.iter().map(|b| column_index(&spec, b)).collect::<Result<_, _>>()?;
+        // the item names come from the system's model descriptions (the description was
+        // checked against the same file: its hash is the folder's)
+        let system = crate::spec::load_system(&spec.system).map_err(Error::Spec)?;
+        let value_names = column_value_names(&spec, &system);
+        let mut report = Report { spec, dir: dir.to_path_buf(), rows: Vec::new(), groups: Vec::new(), value_names };
         let mut groups: BTreeMap<Vec<u64>, Group> = BTreeMap::new();
         for r in &rows {
             // sort by the values' bits of non-negative numbers is not numeric: use total order keys
             let k: Vec<u64> = by.iter().map(|&c| order_key(r.values[c])).collect();
             let g = groups.entry(k).or_insert_with(|| Group {
-                key: by.iter().map(|&c| (spec.columns[c].name.clone(), label(&spec, c, r.values[c]))).collect(),
+                key: by.iter().map(|&c| (report.spec.columns[c].name.clone(), report.label(c, r.values[c]))).collect(),
+                legend: report.legend(&by, &r.values),
                 rows: Vec::new(),
             });
             g.rows.push(r.clone());
         }
-        Ok(Report { spec, dir: dir.to_path_buf(), rows, groups: groups.into_values().collect() })
+        report.rows = rows;
+        report.groups = groups.into_values().collect();
+        Ok(report)
+    }
+
+    /// Column `column`'s value `v` as a label: its name ([`Report::value_names`]), else the number.
+    pub fn label(&self, column: usize, v: f64) -> String {
+        let names = &self.value_names[column];
+        if v.fract() == 0.0 {
+            if let Some(n) = names.get(&(v as i64)) {
+                return n.clone();
+            }
+        }
+        format!("{v}")
+    }
+
+    /// The name a legend gives column `column`: the variable's own name (`controller`) for a
+    /// column named after the one enumerated variable it sets (`controller.controller`),
+    /// which its item names then explain, else the column's name.
+    pub fn legend_key(&self, column: usize) -> String {
+        let c = &self.spec.columns[column];
+        match c.targets.as_slice() {
+            [t] if *t == c.name && !self.value_names[column].is_empty() => {
+                t.split_once('.').map_or(t.as_str(), |(_, v)| v).to_string()
+            }
+            _ => c.name.clone(),
+        }
+    }
+
+    /// `controller = robust, maneuver = lane_change` for the columns `by` of a row's values.
+    pub fn legend(&self, by: &[usize], values: &[f64]) -> String {
+        by.iter()
+            .map(|&c| format!("{} = {}", self.legend_key(c), self.label(c, values[c])))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     fn metric_values(&self, rows: &[Row], m: usize) -> Vec<f64> {
@@ -199,7 +316,7 @@ impl Report {
             .columns
             .iter()
             .enumerate()
-            .map(|(k, c)| format!("{}={}", c.name, label(&self.spec, k, r.values[k])))
+            .map(|(k, c)| format!("{}={}", c.name, self.label(k, r.values[k])))
             .collect::<Vec<_>>()
             .join(", ")
     }
@@ -272,11 +389,10 @@ impl Report {
         Ok(out)
     }
 
-    fn cdf(&self, m: usize, path: &Path) -> Result<(), Error> {
-        let err = |e: &dyn std::fmt::Display| Error::Plot(format!("{}: {e}", path.display()));
-        let name = &self.spec.metrics[m].0;
-        let series: Vec<(String, Vec<f64>)> = self
-            .groups
+    /// The empirical CDF of metric `m` per group: the legend labels and each group's sorted
+    /// finite values, as [`Report::pngs`] draws them.
+    pub fn cdf_series(&self, m: usize) -> Vec<(String, Vec<f64>)> {
+        self.groups
             .iter()
             .map(|g| {
                 let mut v = self.metric_values(&g.rows, m);
@@ -284,16 +400,22 @@ impl Report {
                 v.sort_by(f64::total_cmp);
                 (g.name(), v)
             })
-            .collect();
-        let all: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().copied()).filter(|x| *x > 0.0).collect();
-        let (lo, hi) = bounds(&all);
-        let log = hi / lo > 50.0 && all.len() == series.iter().map(|(_, v)| v.len()).sum::<usize>();
-        let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let caption = format!("empirical CDF of {name} ({} runs)", all.len());
-        let mut builder = ChartBuilder::on(&root);
-        builder.caption(caption, ("sans-serif", 24)).margin(12).x_label_area_size(45).y_label_area_size(60);
-        let style = |i: usize| Palette99::pick(i).stroke_width(2);
+            .collect()
+    }
+
+    fn cdf(&self, m: usize, path: &Path) -> Result<(), Error> {
+        let err = |e: &dyn std::fmt::Display| Error::Plot(format!("{}: {e}", path.display()));
+        let name = &self.spec.metrics[m].0;
+        let series = self.cdf_series(m);
+        let all: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+        let axis = Axis::of(&all);
+        let labels: Vec<String> = series.iter().map(|(g, _)| g.clone()).collect();
+        let caption = format!("empirical CDF of {name} ({} runs{})", all.len(), axis.caption());
+        let (root, chart_area) = figure_with_legend(path, &caption, &labels, true).map_err(|e| err(&e))?;
+        let mut builder = ChartBuilder::on(&chart_area);
+        builder.margin(16).x_label_area_size(48).y_label_area_size(64);
+        // y from -0.03 to 1.03: the curves' ends do not sit on the frame
+        let ys = -0.03..1.03;
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
@@ -302,32 +424,36 @@ impl Report {
                     .x_desc(name.as_str())
                     .y_desc("fraction of runs <= value")
                     .label_style(("sans-serif", 15))
+                    .axis_desc_style(("sans-serif", 16))
+                    .x_label_formatter(&|v: &f64| tick(*v))
+                    .y_label_formatter(&|v: &f64| tick(*v))
+                    .light_line_style(RGBColor(235, 235, 235))
+                    .bold_line_style(RGBColor(200, 200, 200))
                     .draw()
                     .map_err(|e| err(&e))?;
-                for (i, (g, v)) in series.iter().enumerate() {
+                for (i, (_, v)) in series.iter().enumerate() {
                     let n = v.len() as f64;
                     let pts: Vec<(f64, f64)> = v.iter().enumerate().map(|(k, x)| (*x, (k + 1) as f64 / n)).collect();
+                    let color = PALETTE[i % PALETTE.len()];
                     chart
-                        .draw_series(LineSeries::new(pts, style(i)))
-                        .map_err(|e| err(&e))?
-                        .label(g.clone())
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style(i)));
+                        .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+                        .map_err(|e| err(&e))?;
+                    // a marker at each decile tells the groups apart without colour
+                    let deciles: Vec<(f64, f64)> = (1..10)
+                        .filter_map(|d| pts.get(((d as f64 / 10.0 * n).ceil() as usize).max(1) - 1).copied())
+                        .collect();
+                    chart
+                        .draw_series(deciles.into_iter().map(|p| {
+                            let (shape, fill) = marker_shape(i, 5);
+                            EmptyElement::at(p) + Polygon::new(shape, fill)
+                        }))
+                        .map_err(|e| err(&e))?;
                 }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::LowerRight)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 14))
-                    .draw()
-                    .map_err(|e| err(&e))?;
             }};
         }
-        if log {
-            draw!(builder.build_cartesian_2d((lo..hi).log_scale(), 0.0..1.0).map_err(|e| err(&e))?);
-        } else {
-            let (lo, hi) = bounds(&series.iter().flat_map(|(_, v)| v.iter().copied()).collect::<Vec<_>>());
-            draw!(builder.build_cartesian_2d(lo..hi, 0.0..1.0).map_err(|e| err(&e))?);
+        match axis {
+            Axis::Log(lo, hi) => draw!(builder.build_cartesian_2d((lo..hi).log_scale(), ys).map_err(|e| err(&e))?),
+            Axis::Linear(lo, hi) => draw!(builder.build_cartesian_2d(lo..hi, ys).map_err(|e| err(&e))?),
         }
         root.present().map_err(|e| err(&e))?;
         Ok(())
@@ -352,19 +478,14 @@ impl Report {
             .collect();
         let xs: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().map(|p| p.0)).collect();
         let ys: Vec<f64> = series.iter().flat_map(|(_, v)| v.iter().map(|p| p.1)).collect();
-        let (x0, x1) = bounds(&xs);
-        let positive: Vec<f64> = ys.iter().copied().filter(|y| *y > 0.0).collect();
-        let (y0, y1) = bounds(&positive);
-        let log = y1 / y0 > 50.0 && positive.len() == ys.len();
-        let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut builder = ChartBuilder::on(&root);
-        builder
-            .caption(format!("{name} against {}", self.spec.columns[column].name), ("sans-serif", 24))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70);
-        let color = |i: usize| Palette99::pick(i).mix(0.6).filled();
+        let Axis::Linear(x0, x1) = Axis::linear(&xs) else { unreachable!("Axis::linear is linear") };
+        let y_axis = Axis::of(&ys);
+        let labels: Vec<String> = series.iter().map(|(g, _)| g.clone()).collect();
+        let caption =
+            format!("{name} against {} ({} runs{})", self.spec.columns[column].name, ys.len(), y_axis.caption());
+        let (root, chart_area) = figure_with_legend(path, &caption, &labels, false).map_err(|e| err(&e))?;
+        let mut builder = ChartBuilder::on(&chart_area);
+        builder.margin(16).x_label_area_size(48).y_label_area_size(72);
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
@@ -373,30 +494,28 @@ impl Report {
                     .x_desc(self.spec.columns[column].name.as_str())
                     .y_desc(name.as_str())
                     .label_style(("sans-serif", 15))
+                    .axis_desc_style(("sans-serif", 16))
+                    .x_label_formatter(&|v: &f64| tick(*v))
+                    .y_label_formatter(&|v: &f64| tick(*v))
+                    .light_line_style(RGBColor(235, 235, 235))
+                    .bold_line_style(RGBColor(200, 200, 200))
                     .draw()
                     .map_err(|e| err(&e))?;
-                for (i, (g, pts)) in series.iter().enumerate() {
+                for (i, (_, pts)) in series.iter().enumerate() {
                     chart
-                        .draw_series(pts.iter().map(|p| Circle::new(*p, 2, color(i))))
-                        .map_err(|e| err(&e))?
-                        .label(g.clone())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, color(i)));
+                        .draw_series(pts.iter().map(|p| {
+                            let (shape, fill) = marker_shape(i, 3);
+                            EmptyElement::at(*p) + Polygon::new(shape, fill)
+                        }))
+                        .map_err(|e| err(&e))?;
                 }
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 14))
-                    .draw()
-                    .map_err(|e| err(&e))?;
             }};
         }
-        if log {
-            draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|e| err(&e))?);
-        } else {
-            let (y0, y1) = bounds(&ys);
-            draw!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| err(&e))?);
+        match y_axis {
+            Axis::Log(y0, y1) => {
+                draw!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|e| err(&e))?)
+            }
+            Axis::Linear(y0, y1) => draw!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| err(&e))?),
         }
         root.present().map_err(|e| err(&e))?;
         Ok(())
@@ -464,10 +583,7 @@ impl Report {
                 if by.is_empty() {
                     "all".into()
                 } else {
-                    by.iter()
-                        .map(|&c| format!("{}={}", self.spec.columns[c].name, label(&self.spec, c, r.values[c])))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    self.legend(&by, &r.values)
                 }
             });
             let mut pk: Vec<u64> = grid.iter().map(|&c| order_key(r.values[c])).collect();
@@ -494,8 +610,8 @@ impl Report {
                     ratios.sort_by(f64::total_cmp);
                     out.push(Pairing {
                         group: glabel.clone(),
-                        a: label(&self.spec, col, values[a]),
-                        b: label(&self.spec, col, values[b]),
+                        a: self.label(col, values[a]),
+                        b: self.label(col, values[b]),
                         pairs: ratios.len(),
                         p_less: less as f64 / ratios.len().max(1) as f64,
                         p_more: more as f64 / ratios.len().max(1) as f64,
@@ -532,15 +648,157 @@ fn order_key(v: f64) -> u64 {
     }
 }
 
-fn bounds(v: &[f64]) -> (f64, f64) {
-    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
-    if !lo.is_finite() || !hi.is_finite() {
-        return (0.0, 1.0);
+/// A metric axis of a figure and its range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Axis {
+    /// Linear from the first to the second value.
+    Linear(f64, f64),
+    /// Logarithmic from the first to the second value (both positive).
+    Log(f64, f64),
+}
+
+/// More than this ratio of the largest to the smallest value (two decades) draws a log axis.
+pub const LOG_AXIS_RATIO: f64 = 100.0;
+
+/// Share of the span (of the decades on a log axis) left free at each end of an axis, so
+/// that no point sits on the frame.
+pub const AXIS_PAD: f64 = 0.04;
+
+impl Axis {
+    /// The axis of `values` (non-finite ones left out): logarithmic when all are positive
+    /// and span more than two decades ([`LOG_AXIS_RATIO`]), else linear; padded by
+    /// [`AXIS_PAD`] at each end.
+    pub fn of(values: &[f64]) -> Axis {
+        let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+        if lo > 0.0 && hi / lo > LOG_AXIS_RATIO {
+            let pad = AXIS_PAD * (hi / lo).log10();
+            return Axis::Log(lo / 10f64.powf(pad), hi * 10f64.powf(pad));
+        }
+        Axis::linear(&v)
     }
-    if hi <= lo {
-        return (lo - 0.5 * lo.abs().max(1e-3), hi + 0.5 * hi.abs().max(1e-3));
+
+    /// A linear axis over `values` (non-finite ones left out), padded by [`AXIS_PAD`].
+    pub fn linear(values: &[f64]) -> Axis {
+        let (lo, hi) = values
+            .iter()
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+        if !lo.is_finite() {
+            return Axis::Linear(0.0, 1.0);
+        }
+        let pad = if hi > lo { AXIS_PAD * (hi - lo) } else { 0.5 * lo.abs().max(1e-3) };
+        Axis::Linear(lo - pad, hi + pad)
     }
-    (lo, hi)
+
+    /// `, log axis` for a caption.
+    fn caption(&self) -> &'static str {
+        match self {
+            Axis::Log(..) => ", log axis",
+            Axis::Linear(..) => "",
+        }
+    }
+}
+
+/// Tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
+/// powers beyond 1e-4 .. 1e5 as `1e-5`; never `-0`.
+fn tick(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-4..1e5).contains(&a) {
+        let s = format!("{v:.3e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
+        return format!("{m}e{e}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).clamp(0, 8) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Group colours: the Okabe-Ito palette without its yellow (which vanishes on white),
+/// distinguishable with the common colour-vision deficiencies.
+pub const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// A 1000-pixel-wide white figure at `path` titled `title`, with the legend of `labels` (group `i`'s colour
+/// and marker, with a line sample when `line`) in rows of two above the chart, where it hides
+/// no data; returns the whole figure and the chart's area.
+fn figure_with_legend<'a>(
+    path: &'a Path,
+    title: &str,
+    labels: &[String],
+    line: bool,
+) -> Result<(Area<'a>, Area<'a>), DrawingAreaErrorKind<<BitMapBackend<'a> as DrawingBackend>::ErrorType>> {
+    const ROW: u32 = 24;
+    let rows = labels.len().div_ceil(2) as u32;
+    let legend_h = if labels.len() > 1 { rows * ROW + 14 } else { 0 };
+    let root = BitMapBackend::new(path, (1000, 640 + legend_h)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let body = root.titled(title, ("sans-serif", 24))?;
+    let (legend, chart) = body.split_vertically(legend_h);
+    let style = TextStyle::from(("sans-serif", 15).into_font());
+    if labels.len() > 1 {
+        for (i, label) in labels.iter().enumerate() {
+            let (x, y) = (90 + 460 * (i % 2) as i32, 10 + (i / 2) as i32 * ROW as i32 + ROW as i32 / 2);
+            let color = PALETTE[i % PALETTE.len()];
+            if line {
+                legend.draw(&PathElement::new(vec![(x, y), (x + 30, y)], color.stroke_width(2)))?;
+            }
+            let (shape, fill) = marker_shape(i, 5);
+            legend.draw(&(EmptyElement::at((x + 15, y)) + Polygon::new(shape, fill)))?;
+            legend.draw(&Text::new(label.clone(), (x + 40, y - 8), style.clone()))?;
+        }
+    }
+    Ok((root, chart))
+}
+
+/// Group `i`'s marker, `size` pixels across its centre: circle, triangle, square, plus,
+/// diamond in turn (with the colours, 35 groups are told apart); a polygon in pixels around
+/// the point, and its fill.
+fn marker_shape(i: usize, size: i32) -> (Vec<(i32, i32)>, ShapeStyle) {
+    let s = size as f64;
+    let fill = PALETTE[i % PALETTE.len()].mix(0.8).filled();
+    let round = |v: Vec<(f64, f64)>| v.into_iter().map(|(x, y)| (x.round() as i32, y.round() as i32)).collect();
+    let shape = match (i / PALETTE.len() + i) % 5 {
+        0 => (0..16).map(|k| k as f64 * std::f64::consts::PI / 8.0).map(|a| (s * a.cos(), s * a.sin())).collect(),
+        1 => vec![(0.0, -1.2 * s), (1.1 * s, 0.8 * s), (-1.1 * s, 0.8 * s)],
+        2 => vec![(-0.85 * s, -0.85 * s), (0.85 * s, -0.85 * s), (0.85 * s, 0.85 * s), (-0.85 * s, 0.85 * s)],
+        3 => {
+            let (a, b) = (0.35 * s, 1.1 * s);
+            vec![
+                (-a, -b),
+                (a, -b),
+                (a, -a),
+                (b, -a),
+                (b, a),
+                (a, a),
+                (a, b),
+                (-a, b),
+                (-a, a),
+                (-b, a),
+                (-b, -a),
+                (-a, -a),
+            ]
+        }
+        _ => vec![(0.0, -1.2 * s), (1.2 * s, 0.0), (0.0, 1.2 * s), (-1.2 * s, 0.0)],
+    };
+    (round(shape), fill)
 }
 
 fn file_safe(s: &str) -> String {
@@ -555,5 +813,47 @@ fn register_font() -> Result<(), Error> {
         Ok(())
     } else {
         Err(Error::Plot("the bundled DejaVu Sans font is invalid".into()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_axis_is_logarithmic_when_the_values_span_more_than_two_decades() {
+        // 1e-3 .. 1: three decades, padded by 4 % of them (10^0.12) at each end
+        let Axis::Log(lo, hi) = Axis::of(&[1e-3, 0.02, 1.0]) else { panic!("log expected") };
+        assert!((lo - 1e-3 / 10f64.powf(0.12)).abs() < 1e-15 && (hi - 10f64.powf(0.12)).abs() < 1e-12);
+        // exactly two decades, a zero, a negative value: linear, padded by 4 % of the span
+        assert_eq!(Axis::of(&[0.01, 1.0]), Axis::Linear(0.01 - 0.0396, 1.0 + 0.0396));
+        assert!(matches!(Axis::of(&[0.0, 1e-6, 1.0]), Axis::Linear(..)));
+        assert!(matches!(Axis::of(&[-1e-3, 1e-5, 10.0]), Axis::Linear(..)));
+        // non-finite values are left out; nothing left: [0, 1]
+        assert!(matches!(Axis::of(&[f64::NAN, 1e-4, 1.0, f64::INFINITY]), Axis::Log(..)));
+        assert_eq!(Axis::of(&[f64::NAN]), Axis::Linear(0.0, 1.0));
+        // one value: a range around it
+        assert_eq!(Axis::of(&[2.0, 2.0]), Axis::Linear(1.0, 3.0));
+    }
+
+    #[test]
+    fn items_are_read_from_a_description_only_when_every_part_is_one() {
+        let controller = "which steering feedback: 1 open_loop (K = 0, the feed-forward alone), 2 pole_placement \
+                          (non-robust baseline, Re(s) < -2 at mu = 0.4), 3 robust (mixed H2/H-inf gain, the default)";
+        let items = items_in_description(controller).unwrap();
+        assert_eq!(
+            items.into_iter().collect::<Vec<_>>(),
+            [(1, "open_loop".to_string()), (2, "pole_placement".to_string()), (3, "robust".to_string())]
+        );
+        assert_eq!(items_in_description("1 paper, 2 real").unwrap().len(), 2);
+        for not in ["the mass of the car", "1 open_loop", "1 a, 1 b", "1 a, two b", "1 a b, 2 c", "1 a (x, 2 b"] {
+            assert_eq!(items_in_description(not), None, "{not}");
+        }
+    }
+
+    #[test]
+    fn tick_labels_are_short() {
+        let t: Vec<String> = [0.0, 1e-5, 1e-4, 0.001, 0.25, 1.0, 10.0, 2e5, -0.5].iter().map(|v| tick(*v)).collect();
+        assert_eq!(t, ["0", "1e-5", "0.0001", "0.001", "0.25", "1", "10", "2e5", "-0.5"]);
     }
 }

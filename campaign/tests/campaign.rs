@@ -451,3 +451,51 @@ fn sigterm_removes_the_unpacked_fmus_and_keeps_the_rows_written() {
     let done = run(&spec, &Options { resume: true, ..quiet(&out) }).unwrap();
     assert_eq!(done.kept + done.ran, 40);
 }
+
+#[test]
+fn the_report_names_enumerated_values_and_draws_its_figures() {
+    use nigel_campaign::report::{value_names, Axis, Report};
+    let dir = tempfile::tempdir().unwrap();
+    let spec = Spec::load(&small(dir.path(), 0.2, 2)).unwrap();
+    let out = dir.path().join("out");
+    run(&spec, &quiet(&out)).unwrap();
+    // the names come from the controller FMU's and the test bench's model descriptions
+    let system = nigel_campaign::spec::load_system(&ssp()).unwrap();
+    let controller = value_names(&system, "controller.controller");
+    assert_eq!(
+        controller.values().map(String::as_str).collect::<Vec<_>>(),
+        ["open_loop", "pole_placement", "robust", "custom", "robust_tracking"]
+    );
+    assert_eq!(controller.keys().copied().collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
+    assert_eq!(value_names(&system, "maneuver.maneuver").get(&2).map(String::as_str), Some("lane_change"));
+    assert!(value_names(&system, "plant.m").is_empty() && value_names(&system, "maneuver.seed").is_empty());
+    let by = ["maneuver.maneuver".to_string(), "controller.controller".to_string()];
+    let report = Report::load(spec, &out, &by).unwrap();
+    let legends: Vec<String> = report.cdf_series(0).into_iter().map(|(l, _)| l).collect();
+    assert_eq!(
+        legends,
+        [
+            "maneuver = lane_change, controller = open_loop",
+            "maneuver = lane_change, controller = robust",
+            "maneuver = skidpad, controller = open_loop",
+            "maneuver = skidpad, controller = robust"
+        ]
+    );
+    let json = report.json(0, 3);
+    assert_eq!(json["groups"][1]["group"]["controller.controller"], "robust");
+    // the random column of numbers keeps its name and numbers
+    assert_eq!(report.legend_key(2), "maneuver.seed");
+    assert_eq!(report.label(3, 2.5), "2.5");
+    // epsilon over 0.2 s spans less than two decades here: a linear axis, padded
+    let eps: Vec<f64> = report.cdf_series(0).into_iter().flat_map(|(_, v)| v).collect();
+    let (lo, hi) = eps.iter().fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(*x), b.max(*x)));
+    match Axis::of(&eps) {
+        Axis::Log(a, b) => assert!(hi / lo > 100.0 && a < lo && b > hi),
+        Axis::Linear(a, b) => assert!(hi / lo <= 100.0 && a < lo && b > hi),
+    }
+    let pngs = report.pngs(0, &out.join("png")).unwrap();
+    assert_eq!(pngs.len(), 3, "{pngs:?}"); // the CDF and epsilon against the two random columns
+    for p in &pngs {
+        assert_eq!(&std::fs::read(p).unwrap()[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());
+    }
+}

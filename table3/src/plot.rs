@@ -97,9 +97,31 @@ const ARROW_EVERY: f64 = 5.0;
 const REFERENCE_CAPTION: &str =
     "reference (grey band): the open-loop run of the same plant and program without disturbances (mu = 0.4, no wind, no noise)";
 
-/// The last sample's time [s]: the axis end of every time plot.
+/// The last sample's time [s].
 fn duration(run: &Run) -> f64 {
     Run::time(run.n_samples())
+}
+
+/// Length of the time plots' window [s]: the 2.5 Hz friction variation (0.4 s a period)
+/// and the steering transients stay apart at about 70 pixels a second.
+pub const WINDOW: f64 = 8.0;
+
+/// The time window the time plots show, inside `[0, t_end]`: from 1 s before the steering
+/// program (`program[k]`: at `t_k`, the command of the wheel steered the most) first reaches its
+/// largest magnitude (within 1 %), for [`WINDOW`] seconds or until 3 s after the program's
+/// last change if that comes first (at least 4 s): the lane change's impulse and recovery,
+/// the skidpad's step, the end of the fishhook's ramp with its hold and release, the
+/// slalom's first periods, the figure 8's first switches. The whole run when the program
+/// never steers (straight) or the run is shorter than the window.
+pub fn focus_window(program: &[f64], t_end: f64) -> (f64, f64) {
+    let peak = program.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if peak <= 0.0 || t_end <= WINDOW {
+        return (0.0, t_end);
+    }
+    let k = program.iter().position(|v| v.abs() >= 0.99 * peak).unwrap_or(0);
+    let t0 = (Run::time(k) - 1.0).clamp(0.0, t_end - WINDOW);
+    let last = (1..program.len()).rev().find(|&j| program[j] != program[j - 1]).unwrap_or(0);
+    (t0, (t0 + WINDOW).min((Run::time(last) + 3.0).max(t0 + 4.0)))
 }
 
 /// Draws one XY panel. Equal scale on both axes unless that would leave most of the panel
@@ -291,28 +313,29 @@ fn controller_legend(runs: &[&Run]) -> Vec<(&'static str, RGBColor, bool)> {
     v
 }
 
-/// One time panel over `[0, t_end]` with the y range `ys` (shared along a row), ticks every
-/// 5 s up to and including `t_end`.
+/// One time panel over the window `t` with the y range `ys` (shared along a row), a tick
+/// every second (every 5 s on a window longer than 10 s).
 fn time_panel(
     area: &Area,
     title: &str,
     y_desc: &str,
     series: &[Series],
-    t_end: f64,
+    t: (f64, f64),
     ys: (f64, f64),
     path: &Path,
 ) -> Result<(), Error> {
     let err = plot_err(path);
-    let t_end = t_end.max(1e-3);
+    let t = (t.0, t.1.max(t.0 + 1e-3));
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 17))
         .margin(6)
         .margin_right(14)
         .x_label_area_size(34)
         .y_label_area_size(58)
-        .build_cartesian_2d(0.0..t_end, ys.0..ys.1)
+        .build_cartesian_2d(t.0..t.1, ys.0..ys.1)
         .map_err(&err)?;
-    let ticks = (t_end / 5.0).floor() as usize + 1;
+    let every = if t.1 - t.0 > 10.0 { 5.0 } else { 1.0 };
+    let ticks = ((t.1 - t.0) / every).floor() as usize + 1;
     chart
         .configure_mesh()
         .x_desc("t [s]")
@@ -333,8 +356,8 @@ fn time_panel(
 
 /// The time plots of one column and maneuver as small multiples: one column of panels per
 /// controller (beta, yaw rate, front-left and rear-left steering command, each over the
-/// reference, the y range shared along a row), and the friction of the four wheels over
-/// the whole run below.
+/// reference, the y range shared along a row), and the friction of each wheel below (FL, FR
+/// over RL, RR), all over the [`focus_window`] of the maneuver's steering program.
 pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &Path) -> Result<(), Error> {
     register_font().map_err(plot_err(path))?;
     let err = plot_err(path);
@@ -343,9 +366,27 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
     let n = first.n_samples();
     let t_end = duration(first);
     let deg = DEG;
+    // the program: the open-loop run's command (K = 0); without it the reference run's
+    // steering is not recorded and the whole run is shown
+    let open_loop = rs.iter().find(|r| r.job.controller == Controller::OpenLoop);
+    let program: Vec<f64> = open_loop
+        .map(|r| {
+            // the command of the wheel steered the most (signed, so that a switch shows)
+            let largest = |w: usize| r.delta.iter().fold(0.0f64, |m, d| m.max(d[w].abs()));
+            let w = (0..4).fold(0, |b, w| if largest(w) > largest(b) { w } else { b });
+            r.delta.iter().map(|d| d[w]).collect()
+        })
+        .unwrap_or_default();
+    let window = focus_window(&program, t_end);
+    let in_window = |k: &usize| {
+        let t = Run::time(*k);
+        window.0 - 1e-9 <= t && t <= window.1 + 1e-9
+    };
+    // every 2nd sample inside the window (2 ms: 200 points a period of the friction)
+    let sampled = |n: usize| (0..=n).step_by(2).filter(in_window);
     let reference_program = |wheel: usize| -> Vec<(f64, f64)> {
         // the reference run's command is the program itself (open loop, K = 0)
-        match rs.iter().find(|r| r.job.controller == Controller::OpenLoop) {
+        match open_loop {
             Some(r) => sampled(n - 1).map(|k| (Run::time(k), r.delta[k][wheel] * deg)).collect(),
             None => Vec::new(),
         }
@@ -395,7 +436,7 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
     let (front, rear) = (steer(0), steer(2));
     let row_range = |row: &[Vec<Series>]| range(row.iter().flatten().flat_map(|s| s.points.iter().map(|p| p.1)));
     let cols = rs.len();
-    let root = BitMapBackend::new(path, (560 * cols as u32 + 40, 1560)).into_drawing_area();
+    let root = BitMapBackend::new(path, (560 * cols as u32 + 40, 1720)).into_drawing_area();
     root.fill(&WHITE).map_err(&err)?;
     let title = format!(
         "{} column, {}: states and steering commands per controller, and the road friction (seed {})",
@@ -404,14 +445,27 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
         first.job.seed
     );
     let root = root.titled(&title, ("sans-serif", 24)).map_err(&err)?;
-    let (top, body) = root.split_vertically(70);
+    let (top, body) = root.split_vertically(92);
     let (legend, notes) = top.split_vertically(36);
     legend_strip(&legend, &controller_legend(&rs), path)?;
     caption_lines(
         &notes,
-        &[&format!(
+        &[
+            &format!(
             "{REFERENCE_CAPTION}; under the steering commands: the program (the open-loop command). Angles in degrees."
-        )],
+        ),
+            &format!(
+                "t = {} .. {} s of the {} s run{}",
+                tick(&window.0),
+                tick(&window.1),
+                tick(&t_end),
+                if window == (0.0, t_end) {
+                    ""
+                } else {
+                    ": from 1 s before the steering program first reaches its largest magnitude (plot::focus_window)"
+                }
+            ),
+        ],
         path,
     )?;
     let (grid, bottom) = body.split_vertically(4 * 292);
@@ -426,32 +480,30 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
         let ys = row_range(row);
         for (j, series) in row.iter().enumerate() {
             let title = format!("{}: {what}", label(rs[j].job.controller));
-            time_panel(&panels[i * cols + j], &title, y_desc, series, t_end, ys, path)?;
+            time_panel(&panels[i * cols + j], &title, y_desc, series, window, ys, path)?;
         }
     }
-    let mu: Vec<Series> = ["FL", "FR", "RL", "RR"]
-        .iter()
-        .enumerate()
-        .map(|(i, w)| Series {
-            label: format!("mu {w}"),
-            color: WHEEL_COLORS[i],
-            width: 1,
-            points: sampled(n - 1).map(|k| (Run::time(k), first.mu[k][i])).collect(),
-        })
-        .collect();
-    let (mu_legend, mu_area) = bottom.split_vertically(30);
-    let entries: Vec<(&str, RGBColor, bool)> = mu.iter().map(|s| (s.label.as_str(), s.color, false)).collect();
-    legend_strip(&mu_legend, &entries, path)?;
-    let ys = range(mu.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
-    time_panel(
-        &mu_area,
-        "road friction per wheel, the whole run (the same for every controller; 12 x 2 pi of variation: 75 periods)",
-        "mu [1]",
-        &mu,
-        t_end,
-        ys,
+    let (mu_title, mu_grid) = bottom.split_vertically(30);
+    caption_lines(
+        &mu_title,
+        &["road friction per wheel from the test bench (docs/benchmark.md), the same for every controller"],
         path,
     )?;
+    let mu: Vec<Vec<Series>> = (0..4)
+        .map(|i| {
+            vec![Series {
+                label: format!("mu {}", ["FL", "FR", "RL", "RR"][i]),
+                color: WHEEL_COLORS[i],
+                width: 2,
+                points: sampled(n - 1).map(|k| (Run::time(k), first.mu[k][i])).collect(),
+            }]
+        })
+        .collect();
+    let ys = range(mu.iter().flatten().flat_map(|s| s.points.iter().map(|p| p.1)));
+    for (area, series) in mu_grid.split_evenly((2, 2)).iter().zip(&mu) {
+        let title = format!("{} [1]", series[0].label);
+        time_panel(area, &title, "mu [1]", series, window, ys, path)?;
+    }
     root.present().map_err(&err)?;
     Ok(())
 }
@@ -486,4 +538,50 @@ pub fn write_all(runs: &[Run], dir: &Path) -> Result<Vec<PathBuf>, Error> {
             Ok(path)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A program sampled at 1 ms over 30 s from `f(t)`.
+    fn program(f: impl Fn(f64) -> f64) -> Vec<f64> {
+        (0..=30_000).map(|k| f(Run::time(k))).collect()
+    }
+
+    #[test]
+    fn the_window_holds_where_the_program_steers() {
+        let a = 0.5;
+        // docs/benchmark.md's programs (the parts that set the window)
+        let lane = program(|t| {
+            if (14.8..15.0).contains(&t) {
+                a
+            } else if (15.0..15.2).contains(&t) {
+                -a
+            } else {
+                0.0
+            }
+        });
+        let (t0, t1) = focus_window(&lane, 30.0);
+        assert!((t0 - 13.8).abs() < 1e-9 && (t1 - 18.2).abs() < 1e-6, "{t0} {t1}");
+        let skidpad = program(|t| if (2.5..27.5).contains(&t) { a } else { 0.0 });
+        assert_eq!(focus_window(&skidpad, 30.0), (1.5, 1.5 + WINDOW));
+        // fishhook: ramp 2.5 .. 25 s, hold to 27.5 s: the window ends at the run's end
+        let fishhook = program(|t| {
+            if t < 2.5 || t >= 27.5 {
+                0.0
+            } else if t < 25.0 {
+                a * (t - 2.5) / 22.5
+            } else {
+                a
+            }
+        });
+        let (t0, t1) = focus_window(&fishhook, 30.0);
+        assert!((t0 - (30.0 - WINDOW)).abs() < 1e-9 && (t1 - 30.0).abs() < 1e-9, "{t0} {t1}");
+        let figure8 = program(|t| if (t / 3.2).floor() as i64 % 2 == 0 { a } else { -a });
+        assert_eq!(focus_window(&figure8, 30.0), (0.0, WINDOW));
+        let straight = program(|_| 0.0);
+        assert_eq!(focus_window(&straight, 30.0), (0.0, 30.0));
+        assert_eq!(focus_window(&skidpad[..5001], 5.0), (0.0, 5.0));
+    }
 }

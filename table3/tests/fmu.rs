@@ -6,6 +6,7 @@ mod common;
 #[path = "common/replica.rs"]
 mod replica;
 
+use std::path::Path;
 use std::sync::OnceLock;
 
 use nigel_table3::report::json_without_wall;
@@ -172,4 +173,25 @@ fn the_exported_ssp_runs_in_our_master_exactly_like_the_system_it_came_from() {
     // jacobi delays every connection by a step: 3 ms around the loop, 5 % here
     let (e_j, e_o) = (Metric::of(&direct).eps, Metric::of(&engine().run(&job).unwrap()).eps);
     assert!(e_j != e_o && (e_j - e_o).abs() < 0.06 * e_o, "jacobi {e_j}, ordered {e_o}");
+}
+
+/// The time figures the README shows (`table3/figures/time_sim_skidpad.png`,
+/// `time_real_figure_8.png`) are what `table3 --seed 0 --png DIR` draws today, byte for byte
+/// (the runs are bit-identical on this platform and the drawing is deterministic: the font is
+/// bundled). On a change of the figures, regenerate them with that command and copy the two.
+#[test]
+fn the_committed_time_figures_are_what_table3_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("figures");
+    for (fidelity, maneuver) in [(Fidelity::Paper, Maneuver::Skidpad), (Fidelity::Real, Maneuver::Figure8)] {
+        let mut o = Options::new(0);
+        o.fidelities = vec![fidelity];
+        o.maneuvers = vec![maneuver];
+        o.keep_runs = true;
+        let runs = run_table(engine(), &o).unwrap().runs;
+        let name = format!("time_{}_{}.png", fidelity.column(), maneuver.name());
+        nigel_table3::plot::time_figure(&runs, fidelity, maneuver, &dir.path().join(&name)).unwrap();
+        let drawn = std::fs::read(dir.path().join(&name)).unwrap();
+        assert!(drawn == std::fs::read(committed.join(&name)).unwrap(), "{name} differs from table3 --seed 0 --png's");
+    }
 }
