@@ -479,8 +479,10 @@ impl std::fmt::Debug for Instance {
 macro_rules! call {
     ($self:ident, $name:literal, $time:expr, $f:expr) => {{
         $self.check_callable($name)?;
+        let mark = crate::isolate::whole::Mark::call(&$self.name, $name, $time.unwrap_or($self.time));
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
+        drop(mark);
         $self.status($name, raw, $time)
     }};
 }
@@ -500,6 +502,7 @@ impl Instance {
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let log = Box::<LogSink>::default();
         let callbacks = callbacks_for(&log);
+        let mark = crate::isolate::whole::Mark::call(name, "fmi2Instantiate", 0.0);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (fmu.functions.instantiate)(
@@ -512,6 +515,7 @@ impl Instance {
                 0,
             )
         };
+        drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
         }
@@ -705,8 +709,10 @@ impl Instance {
             return Err(Error::IllegalCall { instance: self.name.clone(), function: "fmi2Reset", state: "fatal" });
         }
         let f = self.optional(self.fmu.functions.reset, "fmi2Reset")?;
+        let mark = crate::isolate::whole::Mark::call(&self.name, "fmi2Reset", self.time);
         // SAFETY: live component.
         let raw = unsafe { f(self.component) };
+        drop(mark);
         self.state = InstanceState::Instantiated;
         self.status("fmi2Reset", raw, None)
     }
@@ -977,6 +983,7 @@ impl Drop for Instance {
                 unsafe { free_state(self.component, &mut s) };
             }
         }
+        let _mark = crate::isolate::whole::Mark::call(&self.name, "fmi2FreeInstance", self.time);
         // SAFETY: the component came from fmi2Instantiate and is freed once.
         unsafe { (self.fmu.functions.free_instance)(self.component) };
     }
