@@ -164,19 +164,6 @@ impl<'a> Worker<'a> {
         Worker { spec, base, record, experiment, pool: InstancePool::new(), timing: Default::default() }
     }
 
-    /// The unpacked folders of the loaded FMUs (for removing them after a worker process
-    /// was killed).
-    pub fn folders(&self) -> Vec<PathBuf> {
-        let mut v: Vec<PathBuf> = Vec::new();
-        for i in &self.base.instances {
-            let d = i.fmu.unpacked_dir().to_path_buf();
-            if !d.as_os_str().is_empty() && !v.contains(&d) {
-                v.push(d);
-            }
-        }
-        v
-    }
-
     /// Asks the system whether it can run the description's stop time: run 0's instances
     /// are instantiated, set up with the stop time (`fmi2SetupExperiment`), given run 0's
     /// start values and initialized, then freed (FMI 2.0 lets an FMU refuse a stop time it

@@ -6,7 +6,7 @@
 //!
 //! | parent -> worker | worker -> parent |
 //! |---|---|
-//! | (start) | `ready` then the unpacked folders, tab-separated; or `error MESSAGE` |
+//! | (start) | `ready`, or `error MESSAGE` |
 //! | `check` | `check ok`, or `check refused MESSAGE` ([`Worker::check_stop_time`]) |
 //! | `run I` | `row INSIDE_NS TOTAL_NS` tab the row's CSV line tab its message |
 //!
@@ -18,8 +18,10 @@
 //! own simulation time) it kills the worker (SIGKILL); a worker that ends during a run
 //! (a signal: an FMU's segfault, abort, stack overflow; an exit code: an FMU called `exit`)
 //! or is killed makes that run's row ([`STATUS_CRASHED`], [`STATUS_TIMEOUT`]) with the
-//! reason, the folders it unpacked are removed and a new worker starts. Workers die with
-//! the parent (`PR_SET_PDEATHSIG`, SIGTERM: each removes its unpacked FMUs itself).
+//! reason and a new worker starts. Each worker has a TMPDIR of its own (a fresh folder in
+//! the parent's), removed by the parent when the worker ends however it ends (what a killed
+//! worker unpacked goes with it). Workers die with the parent (`PR_SET_PDEATHSIG`: SIGTERM,
+//! on which a worker removes its TMPDIR itself, [`remove_tmpdir_on_signals`]).
 
 use std::io::{BufRead, Write};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
@@ -34,6 +36,38 @@ use crate::results::{parse_line, Row, STATUS_CRASHED, STATUS_TIMEOUT};
 use crate::run::{Collector, Worker};
 use crate::spec::Spec;
 use crate::Error;
+
+/// The environment variable naming a worker's own TMPDIR (set by the parent).
+pub const WORKER_TMPDIR: &str = "NIGEL_CAMPAIGN_WORKER_TMPDIR";
+
+/// In a worker process (call it first in `main`, before any thread starts, instead of
+/// `nigel_cosim::unpack::remove_on_signals`): on SIGINT, SIGTERM or SIGHUP (the parent's end
+/// arrives as SIGTERM) removes the worker's whole TMPDIR, the folder the parent made for it,
+/// and exits with 128 + the signal.
+pub fn remove_tmpdir_on_signals() {
+    let Some(dir) = std::env::var_os(WORKER_TMPDIR).map(PathBuf::from) else {
+        nigel_cosim::unpack::remove_on_signals();
+        return;
+    };
+    // SAFETY: plain libc calls on a local signal set, as in remove_on_signals.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
+            let mut signal: libc::c_int = 0;
+            if libc::sigwait(&set, &mut signal) == 0 {
+                let _ = std::fs::remove_dir_all(&dir);
+                libc::_exit(128 + signal);
+            }
+        });
+    }
+}
 
 /// Past the description's `timeout`, how long the parent waits before it kills a worker:
 /// the master's own check between steps comes first and names the simulation time.
@@ -74,17 +108,20 @@ pub fn serve(spec_path: &Path, hash: &str) -> i32 {
             Ok((spec, system))
         },
     );
-    let (spec, system) = match loaded {
-        Ok(x) => x,
-        Err(e) => {
-            let _ = writeln!(out, "error {}", field(&e.to_string()));
-            let _ = out.flush();
-            return 1;
-        }
+    let failed = |out: &mut std::io::BufWriter<std::fs::File>, e: Error| {
+        let _ = writeln!(out, "error {}", field(&e.to_string()));
+        let _ = out.flush();
+        1
     };
-    let mut worker = Worker::with_system(&spec, system);
-    let folders: Vec<String> = worker.folders().iter().map(|p| field(&p.display().to_string())).collect();
-    if writeln!(out, "ready\t{}", folders.join("\t")).and_then(|_| out.flush()).is_err() {
+    let spec = match loaded {
+        Ok((spec, _)) => spec,
+        Err(e) => return failed(&mut out, e),
+    };
+    let mut worker = match Worker::new(&spec) {
+        Ok(w) => w,
+        Err(e) => return failed(&mut out, e),
+    };
+    if writeln!(out, "ready").and_then(|_| out.flush()).is_err() {
         return 1;
     }
     let stdin = std::io::stdin();
@@ -131,8 +168,8 @@ struct Slot {
     ready: bool,
     /// The run it is on and when it was handed out.
     busy: Option<(u64, Instant)>,
-    /// The folders its system is unpacked in.
-    folders: Vec<PathBuf>,
+    /// Its TMPDIR (where it unpacks the system), removed when it has ended.
+    tmp: Option<tempfile::TempDir>,
 }
 
 fn start(
@@ -142,8 +179,14 @@ fn start(
     generation: u64,
     tx: &mpsc::Sender<(usize, u64, Said)>,
 ) -> Result<Slot, Error> {
+    let tmp = tempfile::Builder::new()
+        .prefix("nigel-campaign-worker-")
+        .tempdir()
+        .map_err(|e| Error::Io(format!("{}: {e}", std::env::temp_dir().display())))?;
     let mut command = Command::new(program);
     command
+        .env("TMPDIR", tmp.path())
+        .env(WORKER_TMPDIR, tmp.path())
         .arg("worker")
         .arg(std::path::absolute(&spec.path).unwrap_or_else(|_| spec.path.clone()))
         .arg(&spec.hash)
@@ -173,7 +216,7 @@ fn start(
         }
         let _ = tx.send((index, generation, Said::End));
     });
-    Ok(Slot { child, stdin: Some(stdin), generation, ready: false, busy: None, folders: Vec::new() })
+    Ok(Slot { child, stdin: Some(stdin), generation, ready: false, busy: None, tmp: Some(tmp) })
 }
 
 /// Sends one request; a worker that died is seen by its reader's end.
@@ -181,6 +224,22 @@ fn send(slot: &mut Slot, request: &str) {
     if let Some(s) = slot.stdin.as_mut() {
         let _ = writeln!(s, "{request}").and_then(|_| s.flush());
     }
+}
+
+/// Starts workers 1 .. `workers` (worker 0 checked the stop time first).
+fn start_others(
+    program: &Path,
+    spec: &Spec,
+    workers: usize,
+    generations: &mut u64,
+    tx: &mpsc::Sender<(usize, u64, Said)>,
+    slots: &mut Vec<Slot>,
+) -> Result<(), Error> {
+    for j in slots.len()..workers {
+        *generations += 1;
+        slots.push(start(program, spec, j, *generations, tx)?);
+    }
+    Ok(())
 }
 
 /// How a worker process ended, in the words of the master's host processes.
@@ -198,9 +257,7 @@ fn finish(slot: &mut Slot, kill: bool) -> HostEnd {
         let _ = slot.child.kill();
     }
     let end = slot.child.wait().map(end_of).unwrap_or_else(|e| HostEnd::Failed(e.to_string()));
-    for d in slot.folders.drain(..) {
-        let _ = std::fs::remove_dir_all(d);
-    }
+    drop(slot.tmp.take());
     end
 }
 
@@ -242,6 +299,7 @@ pub(crate) fn run_processes(
     let limit = spec.timeout.map(|t| t + GRACE);
     let mut next = 0usize;
     let mut checked = false;
+    let mut check_since: Option<Instant> = None;
     let mut result = Ok(());
     'events: loop {
         // hand out runs to the ready idle workers
@@ -257,9 +315,11 @@ pub(crate) fn run_processes(
             }
         }
         let now = Instant::now();
+        let checking = if checked { None } else { check_since };
         let wait = slots
             .iter()
             .filter_map(|s| Some(s.busy?.1 + limit?))
+            .chain(checking.and_then(|since| Some(since + limit?)))
             .map(|at| at.saturating_duration_since(now))
             .min()
             .unwrap_or(Duration::from_secs(1));
@@ -271,11 +331,11 @@ pub(crate) fn run_processes(
                 match said {
                     Said::Line(line) => {
                         let slot = &mut slots[k];
-                        if let Some(rest) = line.strip_prefix("ready") {
+                        if line == "ready" {
                             slot.ready = true;
-                            slot.folders = rest.split('\t').filter(|f| !f.is_empty()).map(PathBuf::from).collect();
                             if !checked {
                                 send(slot, "check");
+                                check_since = Some(Instant::now());
                             }
                         } else if let Some(answer) = line.strip_prefix("check ") {
                             if let Some(m) = answer.strip_prefix("refused ") {
@@ -288,15 +348,9 @@ pub(crate) fn run_processes(
                                 }
                             }
                             checked = true;
-                            for j in 1..workers {
-                                generations += 1;
-                                match start(program, spec, j, generations, &tx) {
-                                    Ok(s) => slots.push(s),
-                                    Err(e) => {
-                                        result = Err(e);
-                                        break 'events;
-                                    }
-                                }
+                            if let Err(e) = start_others(program, spec, workers, &mut generations, &tx, &mut slots) {
+                                result = Err(e);
+                                break 'events;
                             }
                         } else if let Some(rest) = line.strip_prefix("row ") {
                             let Some((row, timing)) = parse_row(spec, rest) else {
@@ -316,22 +370,33 @@ pub(crate) fn run_processes(
                     }
                     Said::End => {
                         let end = finish(&mut slots[k], false);
-                        let Some((i, _)) = slots[k].busy.take() else {
-                            // ended before it was ready or between runs: not a run's doing
+                        if !slots[k].ready {
+                            // it could not load the system: no run would do better
                             result = Err(Error::Spec(format!(
                                 "a worker process {end} while loading {} (before any run)",
                                 spec.system.display()
                             )));
                             break 'events;
-                        };
-                        let why = match end {
-                            HostEnd::Exit(_) => " (an FMU called exit?)",
-                            _ => "",
-                        };
-                        let message = format!("crashed: the run's worker process {end}{why}; the worker was restarted");
-                        if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default()) {
-                            result = Err(e);
-                            break 'events;
+                        }
+                        if let Some((i, _)) = slots[k].busy.take() {
+                            let why = match end {
+                                HostEnd::Exit(_) => " (an FMU called exit?)",
+                                _ => "",
+                            };
+                            let message =
+                                format!("crashed: the run's worker process {end}{why}; the worker was restarted");
+                            if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default())
+                            {
+                                result = Err(e);
+                                break 'events;
+                            }
+                        } else if !checked {
+                            // it crashed checking the stop time: the runs will say how they end
+                            checked = true;
+                            if let Err(e) = start_others(program, spec, workers, &mut generations, &tx, &mut slots) {
+                                result = Err(e);
+                                break 'events;
+                            }
                         }
                         out.done.restarts += 1;
                         generations += 1;
@@ -347,6 +412,22 @@ pub(crate) fn run_processes(
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 let (Some(limit), Some(timeout)) = (limit, spec.timeout) else { continue };
+                if let (false, Some(since)) = (checked, check_since) {
+                    if since.elapsed() >= limit {
+                        // the check hangs as a run would: the runs will say how they end
+                        finish(&mut slots[0], true);
+                        checked = true;
+                        generations += 1;
+                        let restarted = start(program, spec, 0, generations, &tx).map(|s| slots[0] = s);
+                        if let Err(e) = restarted
+                            .and_then(|_| start_others(program, spec, workers, &mut generations, &tx, &mut slots))
+                        {
+                            result = Err(e);
+                            break 'events;
+                        }
+                        out.done.restarts += 1;
+                    }
+                }
                 for k in 0..slots.len() {
                     let Some((i, since)) = slots[k].busy else { continue };
                     if since.elapsed() < limit {

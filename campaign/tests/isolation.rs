@@ -29,22 +29,29 @@ fn target_dir() -> PathBuf {
 
 /// crash.c compiled with the system `cc` and zipped with crash.xml as `<dir>/crash.fmu`.
 fn build_crash(dir: &Path) -> PathBuf {
+    build_c_fmu(dir, "crash")
+}
+
+/// `<id>.c` of cosim/tests/cfmu (crash.c, or ctor.c: crash.c whose library segfaults while
+/// it is loaded) with crash.xml as `<dir>/<id>.fmu`.
+fn build_c_fmu(dir: &Path, id: &str) -> PathBuf {
     let cfmu = root().join("cosim/tests/cfmu");
-    let so = dir.join("crash.so");
+    let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
-        .arg(cfmu.join("crash.c"))
+        .arg(cfmu.join(format!("{id}.c")))
         .arg("-o")
         .arg(&so)
         .status()
         .expect("run cc");
     assert!(status.success(), "cc failed for crash.c");
-    let fmu = dir.join("crash.fmu");
+    let fmu = dir.join(format!("{id}.fmu"));
+    let xml = std::fs::read_to_string(cfmu.join("crash.xml")).unwrap().replace("\"crash\"", &format!("{id:?}"));
     let mut zip = zip::ZipWriter::new(std::fs::File::create(&fmu).unwrap());
     let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     for (name, bytes) in [
-        ("modelDescription.xml", std::fs::read(cfmu.join("crash.xml")).unwrap()),
-        ("binaries/linux64/crash.so", std::fs::read(&so).unwrap()),
+        ("modelDescription.xml".to_string(), xml.into_bytes()),
+        (format!("binaries/linux64/{id}.so"), std::fs::read(&so).unwrap()),
     ] {
         zip.start_file(name, options).unwrap();
         zip.write_all(&bytes).unwrap();
@@ -186,4 +193,33 @@ fn process_workers_write_the_rows_threads_write() {
     }
     // the rows cross the pipe as text in shortest round-trip form: bit for bit
     assert_eq!(files[0], files[1]);
+}
+
+#[test]
+fn a_library_that_crashes_while_loading_is_one_line_and_not_a_crash_of_the_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = build_c_fmu(dir.path(), "ctor");
+    let path = dir.path().join("ctor.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "system = {:?}\nstop_time = 1.0\nstep = 0.1\n[grid]\n\"model.mode\" = [0.0, 1.0]\n[metrics]\ny = \"final(model.y)\"\n",
+            fmu.display().to_string()
+        ),
+    )
+    .unwrap();
+    // the description is checked without loading the library; the worker that loads it dies
+    let tmp = dir.path().join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let out = dir.path().join("out");
+    let o = campaign(&["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()], &tmp);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    let last = stderr.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with("campaign: a worker process was killed by signal 11 (SIGSEGV) while loading "),
+        "{stderr}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().map(|e| e.unwrap().path()).collect();
+    assert!(left.is_empty(), "left in TMPDIR: {left:?}");
 }

@@ -170,8 +170,8 @@ fn judge(rows: &[nigel_campaign::results::Row], messages: &std::path::Path, allo
     }
 }
 
-fn main_inner() -> Result<Outcome, Error> {
-    match Cli::parse().command {
+fn main_inner(cli: Cli) -> Result<Outcome, Error> {
+    match cli.command {
         Command::Worker { spec, hash } => std::process::exit(nigel_campaign::worker::serve(&spec, &hash)),
         Command::Run { spec, out, threads, shard, resume, only, allow_failures, in_process } => {
             let spec = Spec::load(&spec)?;
@@ -294,8 +294,14 @@ fn merged(dir: &std::path::Path, spec: &Spec, allow_failures: bool) -> Result<Ou
 fn main() -> ExitCode {
     // SIGINT, SIGTERM (Ctrl-C, scancel) and SIGHUP remove the unpacked FMUs from TMPDIR;
     // the rows written so far stay, and `--resume` completes the campaign
-    nigel_cosim::unpack::remove_on_signals();
-    match main_inner() {
+    let cli = Cli::parse();
+    if matches!(cli.command, Command::Worker { .. }) {
+        // a worker process removes the TMPDIR its parent made for it
+        nigel_campaign::worker::remove_tmpdir_on_signals();
+    } else {
+        nigel_cosim::unpack::remove_on_signals();
+    }
+    match main_inner(cli) {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
         Ok(Outcome::RunsFailed) => ExitCode::from(EXIT_RUNS_FAILED),
         Err(e) => {
