@@ -13,8 +13,9 @@
 //! - at the end the outcome: the summary's JSON, or that the run failed (the host printed
 //!   the error itself).
 //!
-//! The parent ([`simulate_in_host`]) waits for the host, kills it when the run's time
-//! limit passes (`--timeout`, checked every 10 ms), and returns the rows written, with
+//! The parent ([`simulate_in_host`]) waits for the host, kills it half a second after the
+//! run's time limit (`--timeout`, checked every 10 ms; the host's own check between steps
+//! comes first), and returns the rows written, with
 //! [`Error::Host`] naming the instance, the call, the time and the signal or exit code
 //! when the host ended without an outcome.
 
@@ -259,7 +260,9 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
         });
     }
     let mut child = command.spawn().map_err(|e| failed(format!("cannot start {}: {e}", program.display())))?;
-    let deadline = experiment.timeout.map(|t| (Instant::now() + t, t));
+    // the host's own check between steps comes first and names the simulation time; past
+    // it by half a second (a call that does not return) the host is killed
+    let deadline = experiment.timeout.map(|t| (Instant::now() + t + Duration::from_millis(500), t));
     let mut killed = None;
     let status = loop {
         match child.try_wait() {
@@ -277,6 +280,7 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
     };
     let names = record_names(system, experiment)?;
     let read = read_region(&fd, names);
+    let simulating = read.is_some();
     let (results, state, folders, summary, mark) = match read {
         Some(r) => r,
         None => (Results { names: record_names(system, experiment)?, values: Vec::new() }, 0, Vec::new(), None, None),
@@ -298,6 +302,12 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
             let (instance, function, time) = match mark {
                 Some((i, f, t, true)) => (i, f, t),
                 Some((i, f, t, false)) => (format!("(the master, after {f} of {i} returned)"), f, t),
+                // the calls are marked with one thread only
+                None if simulating => (
+                    "(an instance)".to_string(),
+                    "an fmi2 call (named with --threads 1 only)".to_string(),
+                    results.rows().checked_sub(1).map_or(0.0, |k| results.row(k)[0]),
+                ),
                 None => ("(the run)".to_string(), "loading the FMUs".to_string(), 0.0),
             };
             let function: &'static str = Box::leak(function.into_boxed_str());
