@@ -209,8 +209,8 @@ impl<'a> Worker<'a> {
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
         let mut inside = Duration::ZERO;
-        let outcome =
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<(Vec<f64>, Option<String>), (String, bool)> {
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+            || -> Result<(Vec<f64>, Option<String>), (String, bool)> {
                 let system = self.spec.system_of(&self.base, &values).map_err(|e| (e, false))?;
                 let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
                 // every row after the first: the communication points t_1 .. t_N
@@ -231,7 +231,8 @@ impl<'a> Worker<'a> {
                     format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
                 });
                 Ok((acc.values(), ended))
-            }));
+            },
+        ));
         let (status, message, metrics) = match outcome {
             Ok(Ok((m, None))) => (STATUS_OK, String::new(), m),
             Ok(Ok((m, Some(ended)))) => (STATUS_ENDED, ended, m),
@@ -342,7 +343,13 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let done = Done { threads, kept: have.len() as u64, file: target.rows.clone(), messages: target.messages.clone(), ..Done::default() };
+    let done = Done {
+        threads,
+        kept: have.len() as u64,
+        file: target.rows.clone(),
+        messages: target.messages.clone(),
+        ..Done::default()
+    };
     let mut out = Collector { appender, target: &target, bar, done, rows: have };
     let refusal = |m: String| -> Result<Option<String>, Error> {
         if options.allow_failures {
@@ -366,14 +373,9 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
                 drop(checker);
                 run_threads(spec, &todo, threads, &mut out)
             }
-            Workers::Processes(program) => crate::worker::run_processes(
-                spec,
-                program,
-                &todo,
-                threads,
-                &mut out,
-                &refusal,
-            ),
+            Workers::Processes(program) => {
+                crate::worker::run_processes(spec, program, &todo, threads, &mut out, &refusal)
+            }
         }
     };
     out.bar.finish_and_clear();

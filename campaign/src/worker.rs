@@ -95,8 +95,8 @@ pub fn serve(spec_path: &Path, hash: &str) -> i32 {
     use std::os::fd::FromRawFd;
     // SAFETY: `proto` is a fresh descriptor owned from here on.
     let mut out = std::io::BufWriter::new(unsafe { std::fs::File::from_raw_fd(proto) });
-    let loaded = Spec::parse(spec_path, &std::fs::read_to_string(spec_path).unwrap_or_default()).and_then(
-        |(spec, system)| {
+    let loaded =
+        Spec::parse(spec_path, &std::fs::read_to_string(spec_path).unwrap_or_default()).and_then(|(spec, system)| {
             if spec.hash != hash {
                 return Err(Error::Spec(format!(
                     "{} changed since the campaign started (hash {} instead of {})",
@@ -106,8 +106,7 @@ pub fn serve(spec_path: &Path, hash: &str) -> i32 {
                 )));
             }
             Ok((spec, system))
-        },
-    );
+        });
     let failed = |out: &mut std::io::BufWriter<std::fs::File>, e: Error| {
         let _ = writeln!(out, "error {}", field(&e.to_string()));
         let _ = out.flush();
@@ -264,7 +263,7 @@ fn finish(slot: &mut Slot, kill: bool) -> HostEnd {
 /// The row of run `i` that did not finish: its values, NaN metrics, the status and reason.
 fn failed_row(spec: &Spec, i: u64, status: u8, message: String) -> Row {
     let mut values = spec.values(i).numbers;
-    values.extend(std::iter::repeat_n(f64::NAN, spec.metrics.len()));
+    values.extend(std::iter::repeat(f64::NAN).take(spec.metrics.len()));
     Row { run: i, status, message, values }
 }
 
@@ -325,7 +324,7 @@ pub(crate) fn run_processes(
             .unwrap_or(Duration::from_secs(1));
         match rx.recv_timeout(wait) {
             Ok((k, generation, said)) => {
-                if slots.get(k).is_none_or(|s| s.generation != generation) {
+                if !slots.get(k).is_some_and(|s| s.generation == generation) {
                     continue; // a worker already ended and replaced
                 }
                 match said {
@@ -385,8 +384,7 @@ pub(crate) fn run_processes(
                             };
                             let message =
                                 format!("crashed: the run's worker process {end}{why}; the worker was restarted");
-                            if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default())
-                            {
+                            if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default()) {
                                 result = Err(e);
                                 break 'events;
                             }
@@ -428,6 +426,8 @@ pub(crate) fn run_processes(
                         out.done.restarts += 1;
                     }
                 }
+                // by index: a slot is replaced in place by the worker started for it
+                #[allow(clippy::needless_range_loop)]
                 for k in 0..slots.len() {
                     let Some((i, since)) = slots[k].busy else { continue };
                     if since.elapsed() < limit {

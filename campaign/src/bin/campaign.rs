@@ -159,7 +159,8 @@ fn judge(rows: &[nigel_campaign::results::Row], messages: &std::path::Path, allo
     match nigel_campaign::results::failure_summary(rows) {
         None => Outcome::Done,
         Some(line) => {
-            let verdict = if allow { "accepted (--allow-failures)" } else { "exit status 3 (--allow-failures to accept)" };
+            let verdict =
+                if allow { "accepted (--allow-failures)" } else { "exit status 3 (--allow-failures to accept)" };
             eprintln!("campaign: {line}; messages in {}; {verdict}", messages.display());
             if allow {
                 Outcome::Done
@@ -286,7 +287,13 @@ fn main_inner(cli: Cli) -> Result<Outcome, Error> {
 /// Merges the shards of `dir` and judges the merged rows.
 fn merged(dir: &std::path::Path, spec: &Spec, allow_failures: bool) -> Result<Outcome, Error> {
     let m = merge::merge(dir, spec)?;
-    eprintln!("merged {} shards: {} runs, {} failed: {}", m.shards, m.runs, m.failed, dir.join("results.csv").display());
+    eprintln!(
+        "merged {} shards: {} runs, {} failed: {}",
+        m.shards,
+        m.runs,
+        m.failed,
+        dir.join("results.csv").display()
+    );
     let rows = nigel_campaign::results::read_rows(&nigel_campaign::results::Target::whole(dir), spec, false)?;
     Ok(judge(&rows, &dir.join("messages.csv"), allow_failures))
 }

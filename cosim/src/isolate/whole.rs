@@ -127,12 +127,8 @@ pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
     region.grow(HEADER + width * 8 * 1024).map_err(Error::Experiment)?;
     let h = region.header();
     h.width.store(width as u64, Ordering::Relaxed);
-    let folders: Vec<String> = system
-        .instances
-        .iter()
-        .map(|i| i.fmu.unpacked_dir().display().to_string())
-        .filter(|d| !d.is_empty())
-        .collect();
+    let folders: Vec<String> =
+        system.instances.iter().map(|i| i.fmu.unpacked_dir().display().to_string()).filter(|d| !d.is_empty()).collect();
     let list = folders.join("\n");
     let n = list.len().min(h.text.len() / 2);
     h.text[..n].copy_from_slice(&list.as_bytes()[..n]);
@@ -240,7 +236,12 @@ pub struct HostRun {
 /// Runs `system` with `experiment` in a host process: this program again, with `args`
 /// (its command line without the program) and [`HOST_VARIABLE`].
 pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::ffi::OsString]) -> Result<HostRun> {
-    let failed = |m: String| Error::Host { instance: "(the run)".into(), function: "starting", time: 0.0, cause: HostEnd::Failed(m) };
+    let failed = |m: String| Error::Host {
+        instance: "(the run)".into(),
+        function: "starting",
+        time: 0.0,
+        cause: HostEnd::Failed(m),
+    };
     // SAFETY: a literal name; no CLOEXEC: the host inherits the descriptor.
     let raw = unsafe { libc::memfd_create(c"nigel-cosim-run".as_ptr(), 0) };
     if raw < 0 {
@@ -391,16 +392,14 @@ fn summary_of(v: &serde_json::Value) -> Summary {
         s.warnings = w
             .iter()
             .map(|x| {
-                (
-                    x["instance"].as_str().unwrap_or("").to_string(),
-                    x["message"].as_str().unwrap_or("").to_string(),
-                )
+                (x["instance"].as_str().unwrap_or("").to_string(), x["message"].as_str().unwrap_or("").to_string())
             })
             .collect();
     }
     if let Some(e) = v["ended_by"].as_object() {
         let reason: &'static str = Box::leak(e["reason"].as_str().unwrap_or("").to_string().into_boxed_str());
-        s.ended_by = Some((e["instance"].as_str().unwrap_or("").to_string(), e["time"].as_f64().unwrap_or(0.0), reason));
+        s.ended_by =
+            Some((e["instance"].as_str().unwrap_or("").to_string(), e["time"].as_f64().unwrap_or(0.0), reason));
     }
     s
 }
