@@ -30,12 +30,17 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+use nigel_cosim::isolate::whole::CallMarker;
 use nigel_cosim::HostEnd;
 
 use crate::results::{parse_line, Row, STATUS_CRASHED, STATUS_TIMEOUT};
 use crate::run::{Collector, Worker};
 use crate::spec::Spec;
 use crate::Error;
+
+/// The environment variable with the descriptor of a worker's call marker
+/// ([`nigel_cosim::isolate::whole::CallMarker`]).
+pub const MARK_FD: &str = "NIGEL_CAMPAIGN_MARK_FD";
 
 /// The environment variable naming a worker's own TMPDIR (set by the parent).
 pub const WORKER_TMPDIR: &str = "NIGEL_CAMPAIGN_WORKER_TMPDIR";
@@ -120,6 +125,12 @@ pub fn serve(spec_path: &Path, hash: &str) -> i32 {
         Ok(w) => w,
         Err(e) => return failed(&mut out, e),
     };
+    // each fmi2 call marked where the parent reads it after a crash (this thread runs them)
+    if let Some(fd) = std::env::var(MARK_FD).ok().and_then(|v| v.parse().ok()) {
+        if let Err(e) = nigel_cosim::isolate::whole::mark_calls(fd) {
+            eprintln!("campaign worker: its calls are not marked: {e}");
+        }
+    }
     if writeln!(out, "ready").and_then(|_| out.flush()).is_err() {
         return 1;
     }
@@ -169,6 +180,19 @@ struct Slot {
     busy: Option<(u64, Instant)>,
     /// Its TMPDIR (where it unpacks the system), removed when it has ended.
     tmp: Option<tempfile::TempDir>,
+    /// Where it marks each fmi2 call (instance, function, time).
+    marker: Option<CallMarker>,
+}
+
+/// Where a worker was when it ended: ` during fmi2DoStep of model at t = 0.5 s`.
+fn where_it_was(slot: &Slot) -> String {
+    match slot.marker.as_ref().and_then(|m| m.last_call()) {
+        Some((instance, function, t, true)) => format!(" during {function} of {instance} at t = {t} s"),
+        Some((instance, function, t, false)) => {
+            format!(" outside the FMUs, after {function} of {instance} returned at t = {t} s")
+        }
+        None => String::new(),
+    }
 }
 
 fn start(
@@ -182,7 +206,13 @@ fn start(
         .prefix("nigel-campaign-worker-")
         .tempdir()
         .map_err(|e| Error::Io(format!("{}: {e}", std::env::temp_dir().display())))?;
+    // a marker is a nicety: without one a crash still names its signal
+    let marker = CallMarker::new().ok();
+    let mark_fd = marker.as_ref().map(|m| m.fd());
     let mut command = Command::new(program);
+    if let Some(fd) = mark_fd {
+        command.env(MARK_FD, fd.to_string());
+    }
     command
         .env("TMPDIR", tmp.path())
         .env(WORKER_TMPDIR, tmp.path())
@@ -195,8 +225,12 @@ fn start(
     // SAFETY: runs in the child between fork and exec: only prctl (async-signal-safe). The
     // worker gets SIGTERM when the parent ends, and removes its unpacked FMUs.
     unsafe {
-        command.pre_exec(|| {
+        command.pre_exec(move || {
             libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
+            // this child alone inherits its marker (fcntl is async-signal-safe)
+            if let Some(fd) = mark_fd {
+                libc::fcntl(fd, libc::F_SETFD, 0);
+            }
             Ok(())
         });
     }
@@ -215,7 +249,7 @@ fn start(
         }
         let _ = tx.send((index, generation, Said::End));
     });
-    Ok(Slot { child, stdin: Some(stdin), generation, ready: false, busy: None, tmp: Some(tmp) })
+    Ok(Slot { child, stdin: Some(stdin), generation, ready: false, busy: None, tmp: Some(tmp), marker })
 }
 
 /// Sends one request; a worker that died is seen by its reader's end.
@@ -382,8 +416,9 @@ pub(crate) fn run_processes(
                                 HostEnd::Exit(_) => " (an FMU called exit?)",
                                 _ => "",
                             };
+                            let at = where_it_was(&slots[k]);
                             let message =
-                                format!("crashed: the run's worker process {end}{why}; the worker was restarted");
+                                format!("crashed: the run's worker process {end}{at}{why}; the worker was restarted");
                             if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default()) {
                                 result = Err(e);
                                 break 'events;
@@ -435,8 +470,17 @@ pub(crate) fn run_processes(
                     }
                     slots[k].busy = None;
                     finish(&mut slots[k], true);
+                    let at = match slots[k].marker.as_ref().and_then(|m| m.last_call()) {
+                        Some((instance, function, t, true)) => {
+                            format!("{function} of {instance} at t = {t} s did not return")
+                        }
+                        Some((instance, function, t, false)) => {
+                            format!("the last call, {function} of {instance} at t = {t} s, had returned")
+                        }
+                        None => "a call did not return".into(),
+                    };
                     let message = format!(
-                        "timeout: the run took longer than the description's timeout of {} s (a call did not return); its worker process was killed and restarted",
+                        "timeout: the run took longer than the description's timeout of {} s ({at}); its worker process was killed and restarted",
                         timeout.as_secs_f64()
                     );
                     if let Err(e) = out.push(failed_row(spec, i, STATUS_TIMEOUT, message), Default::default()) {

@@ -106,10 +106,10 @@ fn crashed_exited_and_hung_runs_are_their_rows_and_every_other_run_completes() {
         assert_eq!(r.values[0], mode as f64, "run {}", r.run);
         let expect = match mode {
             0 => (STATUS_OK, ""),
-            1 => (STATUS_CRASHED, "was killed by signal 11 (SIGSEGV)"),
-            2 => (STATUS_CRASHED, "was killed by signal 6 (SIGABRT)"),
-            4 => (STATUS_CRASHED, "exited with code 0"),
-            5 => (STATUS_TIMEOUT, "timeout of 1 s"),
+            1 => (STATUS_CRASHED, "was killed by signal 11 (SIGSEGV) during fmi2DoStep of model at t = 0.5 s"),
+            2 => (STATUS_CRASHED, "was killed by signal 6 (SIGABRT) during fmi2DoStep of model at t = 0.5 s"),
+            4 => (STATUS_CRASHED, "exited with code 0 during fmi2DoStep of model at t = 0.5 s"),
+            5 => (STATUS_TIMEOUT, "timeout of 1 s (fmi2DoStep of model at t = 0.5 s did not return)"),
             _ => unreachable!(),
         };
         assert_eq!(r.status, expect.0, "run {}: {}", r.run, r.message);

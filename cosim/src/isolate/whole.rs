@@ -60,8 +60,7 @@ struct Header {
 
 /// The host's region, when this process is the host of a whole run.
 static REGION: AtomicPtr<Header> = AtomicPtr::new(std::ptr::null_mut());
-/// The instance name and function last written into the marker (their addresses).
-static LAST_INSTANCE: AtomicUsize = AtomicUsize::new(0);
+/// The function last written into the marker (its address).
 static LAST_FUNCTION: AtomicUsize = AtomicUsize::new(0);
 
 /// Whether this process is the host of a whole run (its parent set [`HOST_VARIABLE`]).
@@ -76,7 +75,8 @@ fn copy_name(dst: &mut [u8; NAME], len: &AtomicU32, s: &str) {
 }
 
 /// Marks an fmi2 call of `instance` in the host's region until dropped (nothing outside a
-/// host, and nothing when the run has several threads: one marker holds one call).
+/// host or a marked process, and nothing when the run has several threads: one marker holds
+/// one call).
 pub(crate) struct Mark(bool);
 
 impl Mark {
@@ -89,9 +89,9 @@ impl Mark {
         // SAFETY: the region stays mapped for the life of the host process; only the
         // simulating thread writes the marker (REGION is set only for one thread).
         let h = unsafe { &mut *p };
-        if LAST_INSTANCE.swap(instance.as_ptr() as usize, Ordering::Relaxed) != instance.as_ptr() as usize {
-            copy_name(&mut h.instance, &h.instance_len, instance);
-        }
+        // the instance's name every time (a freed name's address may come back with another);
+        // the function's only when it changes (a static string)
+        copy_name(&mut h.instance, &h.instance_len, instance);
         if LAST_FUNCTION.swap(function.as_ptr() as usize, Ordering::Relaxed) != function.as_ptr() as usize {
             copy_name(&mut h.function, &h.function_len, function);
         }
@@ -112,6 +112,53 @@ impl Drop for Mark {
             }
         }
     }
+}
+
+/// A region that only holds the call marker, for a process that runs many runs (a
+/// campaign's worker): the parent creates it and hands its descriptor to the process, which
+/// calls [`mark_calls`]; after the process ended, [`CallMarker::last_call`] says what it was
+/// calling.
+pub struct CallMarker {
+    fd: OwnedFd,
+}
+
+impl CallMarker {
+    /// A fresh region (`memfd_create`, close-on-exec: the parent lets one child inherit it).
+    pub fn new() -> std::result::Result<CallMarker, String> {
+        // SAFETY: a literal name; plain syscalls on the fresh descriptor.
+        unsafe {
+            let raw = libc::memfd_create(c"nigel-cosim-mark".as_ptr(), libc::MFD_CLOEXEC);
+            if raw < 0 {
+                return Err(format!("memfd_create: {}", std::io::Error::last_os_error()));
+            }
+            let fd = OwnedFd::from_raw_fd(raw);
+            if libc::ftruncate(fd.as_raw_fd(), HEADER as libc::off_t) != 0 {
+                return Err(format!("ftruncate: {}", std::io::Error::last_os_error()));
+            }
+            Ok(CallMarker { fd })
+        }
+    }
+
+    /// The descriptor to hand to the marked process.
+    pub fn fd(&self) -> i32 {
+        self.fd.as_raw_fd()
+    }
+
+    /// The last fmi2 call the marked process started: the instance, the function, the
+    /// simulation time, and whether it was still in it (`None`: it marked no call).
+    pub fn last_call(&self) -> Option<(String, String, f64, bool)> {
+        read_region(&self.fd, None).and_then(|r| r.4)
+    }
+}
+
+/// In a process handed a [`CallMarker`]'s descriptor: marks each fmi2 call of this process
+/// from now on (call it from the one thread that simulates).
+pub fn mark_calls(fd: i32) -> std::result::Result<(), String> {
+    let mut region = Region { fd, base: std::ptr::null_mut(), len: 0 };
+    region.grow(HEADER)?;
+    region.header().magic = MAGIC;
+    REGION.store(region.base as *mut Header, Ordering::Release);
+    Ok(())
 }
 
 /// The host's side: maps the region of [`HOST_VARIABLE`], simulates with every row
@@ -280,7 +327,7 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
         std::thread::sleep(Duration::from_millis(10));
     };
     let names = record_names(system, experiment)?;
-    let read = read_region(&fd, names);
+    let read = read_region(&fd, Some(names));
     let simulating = read.is_some();
     let (results, state, folders, summary, mark) = match read {
         Some(r) => r,
@@ -329,8 +376,9 @@ fn record_names(system: &System, experiment: &Experiment) -> Result<Vec<String>>
 
 type Read = (Results, u32, Vec<PathBuf>, Option<serde_json::Value>, Option<(String, String, f64, bool)>);
 
-/// The rows, state, folders, summary and marker the host left in the region.
-fn read_region(fd: &OwnedFd, names: Vec<String>) -> Option<Read> {
+/// The rows, state, folders, summary and marker the host left in the region (`names`:
+/// those of the rows; `None`: a region with the marker only).
+fn read_region(fd: &OwnedFd, names: Option<Vec<String>>) -> Option<Read> {
     // SAFETY: fstat and a read-only mapping of the whole memfd, unmapped below.
     unsafe {
         let mut st: libc::stat = std::mem::zeroed();
@@ -349,9 +397,11 @@ fn read_region(fd: &OwnedFd, names: Vec<String>) -> Option<Read> {
             }
             let width = h.width.load(Ordering::Acquire) as usize;
             let rows = (h.rows.load(Ordering::Acquire) as usize).min((len - HEADER) / (8 * width.max(1)));
-            if width != names.len() + 1 {
-                return None;
-            }
+            let names = match names {
+                Some(n) if width == n.len() + 1 => n,
+                Some(_) => return None,
+                None => Vec::new(),
+            };
             let values = std::slice::from_raw_parts((p as *const u8).add(HEADER) as *const f64, rows * width).to_vec();
             let folders_len = (h.folders_len.load(Ordering::Acquire) as usize).min(h.text.len());
             let folders = String::from_utf8_lossy(&h.text[..folders_len])
