@@ -68,9 +68,18 @@ pub fn is_host() -> bool {
     std::env::var_os(HOST_VARIABLE).is_some()
 }
 
+#[inline]
 fn copy_name(dst: &mut [u8; NAME], len: &AtomicU32, s: &str) {
-    let n = s.len().min(NAME);
-    dst[..n].copy_from_slice(&s.as_bytes()[..n]);
+    let b = s.as_bytes();
+    let n = b.len().min(NAME);
+    if n <= 16 {
+        // a short name byte by byte: cheaper than a call of memcpy
+        for (d, c) in dst.iter_mut().zip(&b[..n]) {
+            *d = *c;
+        }
+    } else {
+        dst[..n].copy_from_slice(&b[..n]);
+    }
     len.store(n as u32, Ordering::Relaxed);
 }
 
@@ -92,7 +101,9 @@ impl Mark {
         // the instance's name every time (a freed name's address may come back with another);
         // the function's only when it changes (a static string)
         copy_name(&mut h.instance, &h.instance_len, instance);
-        if LAST_FUNCTION.swap(function.as_ptr() as usize, Ordering::Relaxed) != function.as_ptr() as usize {
+        // plain loads and stores, no locked instruction: one thread writes the marker
+        if LAST_FUNCTION.load(Ordering::Relaxed) != function.as_ptr() as usize {
+            LAST_FUNCTION.store(function.as_ptr() as usize, Ordering::Relaxed);
             copy_name(&mut h.function, &h.function_len, function);
         }
         h.time.store(time.to_bits(), Ordering::Relaxed);
