@@ -160,6 +160,12 @@ pub fn serve(spec_path: &Path, hash: &str) -> i32 {
             break;
         }
     }
+    // its input ended: the parent is done with it, or gone (then this may come before the
+    // SIGTERM of PR_SET_PDEATHSIG): the worker removes its TMPDIR itself either way
+    drop(worker);
+    if let Some(dir) = std::env::var_os(WORKER_TMPDIR) {
+        let _ = std::fs::remove_dir_all(dir);
+    }
     0
 }
 

@@ -185,7 +185,11 @@ fn resume_after_a_killed_run_completes_it() {
     child.wait().unwrap();
     // SIGKILL of the campaign ends its worker processes too (SIGTERM to each, which
     // removes what it unpacked)
-    assert!(tmp_empties(&_tmp), "a worker process outlived the campaign");
+    assert!(
+        tmp_empties(&_tmp),
+        "a worker process outlived the campaign: {:?}",
+        std::fs::read_dir(&_tmp).unwrap().map(|e| e.unwrap().path()).collect::<Vec<_>>()
+    );
     let kept = count();
     assert!((3..40).contains(&kept), "{kept} rows when killed");
     // without --resume the folder is refused, naming what to do
