@@ -4,8 +4,9 @@
 //!   metrics), checked against the system's variables (type, declared min / max).
 //! - [`rng`]: run `i`'s random values from `(seed, column, i)` only.
 //! - [`metric`]: per-run metrics over `t_1 .. t_N`, accumulated point by point.
-//! - [`run`]: the runs of a block on N threads, each thread loading the system once;
-//!   rows written as they finish; failed runs are rows with their status and message.
+//! - [`run`]: the runs of a block on N workers (processes, [`worker`], or threads), each
+//!   loading the system once; rows written as they finish; failed, crashed and timed-out
+//!   runs are rows with their status and message; the stop time checked before the first run.
 //! - [`results`]: the output folder's files; [`merge`] joins shards; [`slurm`] writes and
 //!   submits the job array; [`report`] summarises (markdown, JSON, PNG).
 //!
@@ -27,6 +28,7 @@ pub mod rng;
 pub mod run;
 pub mod slurm;
 pub mod spec;
+pub mod worker;
 
 /// What can go wrong, each a one-line message naming the culprit.
 #[derive(Debug)]

@@ -6,7 +6,8 @@
 //!   column, each metric. Every field is a number, so that fmpy's `read_csv` reads it
 //!   as well as pandas: `status` 0 = ok, 1 = the run failed (the FMU or the master
 //!   returned an error, or a value was refused), 2 = the run panicked, 3 = an FMU ended
-//!   the run before the stop time (metrics over the points it had); `message` 1 when
+//!   the run before the stop time (metrics over the points it had), 4 = the run's worker
+//!   process crashed or exited, 5 = the run passed the description's `timeout`; `message` 1 when
 //!   the run left a message in `messages.csv` (columns `run`, `status`, `message`, text),
 //!   else 0; a case column holds the case's index (its names are in `campaign.json`);
 //!   Booleans are 0 / 1; numbers in Rust's shortest round-trip form (`NaN` for a metric a
@@ -33,13 +34,62 @@ pub const STATUS_PANICKED: u8 = 2;
 /// Status of a run an FMU ended before the stop time (its metrics cover the points up to
 /// then).
 pub const STATUS_ENDED: u8 = 3;
+/// Status of a run whose worker process ended during it: killed by a signal (an FMU's
+/// segfault, abort, stack overflow) or exited (an FMU called `exit`).
+pub const STATUS_CRASHED: u8 = 4;
+/// Status of a run past the description's `timeout`: stopped by the master between two
+/// steps, or its worker process killed while a call did not return.
+pub const STATUS_TIMEOUT: u8 = 5;
+
+/// The status in words.
+pub fn status_name(status: u8) -> &'static str {
+    match status {
+        STATUS_OK => "ok",
+        STATUS_FAILED => "failed",
+        STATUS_PANICKED => "panicked",
+        STATUS_ENDED => "ended by an FMU before the stop time",
+        STATUS_CRASHED => "crashed",
+        STATUS_TIMEOUT => "timed out",
+        _ => "unknown",
+    }
+}
+
+/// The one-line account of the runs that did not complete (`None` when every run did):
+/// `N runs, M failed: ` then the first few by run with their status and message.
+pub fn failure_summary(rows: &[Row]) -> Option<String> {
+    let mut bad: Vec<&Row> = rows.iter().filter(|r| r.status != STATUS_OK).collect();
+    if bad.is_empty() {
+        return None;
+    }
+    bad.sort_by_key(|r| r.run);
+    let shown = 3;
+    let mut parts: Vec<String> = bad
+        .iter()
+        .take(shown)
+        .map(|r| {
+            let m: String = r.message.chars().take(160).collect();
+            let cut = if m.len() < r.message.len() { "..." } else { "" };
+            format!("run {} {} ({m}{cut})", r.run, status_name(r.status))
+        })
+        .collect();
+    if bad.len() > shown {
+        parts.push(format!("and {} more", bad.len() - shown));
+    }
+    let mut by_status = std::collections::BTreeMap::new();
+    for r in &bad {
+        *by_status.entry(status_name(r.status)).or_insert(0u64) += 1;
+    }
+    let counts: Vec<String> = by_status.iter().map(|(s, n)| format!("{n} {s}")).collect();
+    Some(format!("{} runs, {} failed ({}): {}", rows.len(), bad.len(), counts.join(", "), parts.join("; ")))
+}
 
 /// One result row.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
     /// The run's number.
     pub run: u64,
-    /// [`STATUS_OK`], [`STATUS_FAILED`] or [`STATUS_PANICKED`].
+    /// [`STATUS_OK`], [`STATUS_FAILED`], [`STATUS_PANICKED`], [`STATUS_ENDED`],
+    /// [`STATUS_CRASHED`] or [`STATUS_TIMEOUT`].
     pub status: u8,
     /// What went wrong (empty when ok).
     pub message: String,
@@ -184,7 +234,7 @@ impl Target {
 }
 
 /// Parses one results line of `width` fields; `None` if it is not a complete row.
-fn parse_line(line: &str, width: usize) -> Option<(u64, u8, bool, Vec<f64>)> {
+pub(crate) fn parse_line(line: &str, width: usize) -> Option<(u64, u8, bool, Vec<f64>)> {
     let mut it = line.split(',');
     let run = it.next()?.parse().ok()?;
     let status = it.next()?.parse().ok()?;

@@ -1,7 +1,16 @@
-//! Running a block of runs: worker threads, each loading the system once (one unpack of
-//! the `.ssp` and its FMUs per thread; a run instantiates the loaded FMUs again) and
-//! taking the next run number from a shared counter; the calling thread writes each row
-//! as it arrives and draws the progress bar.
+//! Running a block of runs on N workers, each loading the system once (one unpack of the
+//! `.ssp` and its FMUs per worker; its instances reset with `fmi2Reset` between runs) and
+//! taking the next run number as it finishes one; the calling thread writes each row as it
+//! arrives (flushed) and draws the progress bar.
+//!
+//! The workers are processes ([`Workers::Processes`], what `campaign run` uses: a crash,
+//! an `exit` or a hang of an FMU ends only its worker, the run is a row with the reason and
+//! the worker is started again; see [`crate::worker`]) or threads of this process
+//! ([`Workers::Threads`]: no crash boundary).
+//!
+//! Before the first run the description's stop time is put to the system itself
+//! ([`Worker::check_stop_time`]): a stop time every run would fail on (past the test
+//! bench's `duration`) is refused before anything runs.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -12,7 +21,9 @@ use std::time::{Duration, Instant};
 use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
 use crate::metric::Accumulators;
-use crate::results::{self, Appender, Row, Target, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
+use crate::results::{
+    self, Appender, Row, Target, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED, STATUS_TIMEOUT,
+};
 use crate::spec::{load_system, RunValues, Spec};
 use crate::Error;
 
@@ -29,12 +40,37 @@ pub struct Options {
     pub resume: bool,
     /// Show a progress bar (when standard error is a terminal).
     pub progress: bool,
+    /// Threads of this process or worker processes.
+    pub workers: Workers,
+    /// Run even when the system refuses the description's stop time for run 0 (the refusal
+    /// is then in [`Done::stop_time_refused`]): for a campaign that varies what limits it.
+    pub allow_failures: bool,
+}
+
+/// Where the runs run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Workers {
+    /// Threads of the calling process: no crash boundary (a segfault in an FMU ends the
+    /// campaign; a call that never returns holds its thread).
+    Threads,
+    /// Worker processes of this program (`PROGRAM worker SPEC HASH`, [`crate::worker::serve`]),
+    /// each running many runs: a run that crashes, exits or passes the description's
+    /// `timeout` (also inside a call) is a row with the reason, its worker started again.
+    Processes(PathBuf),
 }
 
 impl Options {
-    /// All runs into `out`, all cores, a progress bar on a terminal.
+    /// All runs into `out`, all cores as threads, a progress bar on a terminal.
     pub fn new(out: PathBuf) -> Options {
-        Options { out, threads: None, shard: None, resume: false, progress: true }
+        Options {
+            out,
+            threads: None,
+            shard: None,
+            resume: false,
+            progress: true,
+            workers: Workers::Threads,
+            allow_failures: false,
+        }
     }
 }
 
@@ -47,12 +83,20 @@ pub struct Done {
     pub failed: u64,
     /// Runs already present (with `--resume`).
     pub kept: u64,
+    /// Every row of the target at the end (kept and new), sorted by run.
+    pub rows: Vec<Row>,
+    /// Worker processes started again after a crash or a timeout.
+    pub restarts: u64,
+    /// With [`Options::allow_failures`]: the system's refusal of the stop time for run 0.
+    pub stop_time_refused: Option<String>,
     /// Wall time.
     pub wall: Duration,
     /// Threads used.
     pub threads: usize,
     /// The rows file written.
-    pub rows: PathBuf,
+    pub file: PathBuf,
+    /// Its messages file.
+    pub messages: PathBuf,
     /// Summed over the runs: time inside the co-simulation, and in the whole run (values,
     /// system, co-simulation, metrics); their difference is the per-run overhead.
     pub timing: (Duration, Duration),
@@ -110,9 +154,48 @@ impl<'a> Worker<'a> {
     /// Loads the description's system.
     pub fn new(spec: &'a Spec) -> Result<Worker<'a>, Error> {
         let base = load_system(&spec.system).map_err(Error::Spec)?;
+        Ok(Worker::with_system(spec, base))
+    }
+
+    /// With the description's system already loaded.
+    pub fn with_system(spec: &'a Spec, base: System) -> Worker<'a> {
         let record = metric_variables(spec);
         let experiment = experiment(spec, record.clone());
-        Ok(Worker { spec, base, record, experiment, pool: InstancePool::new(), timing: Default::default() })
+        Worker { spec, base, record, experiment, pool: InstancePool::new(), timing: Default::default() }
+    }
+
+    /// Asks the system whether it can run the description's stop time: run 0's instances
+    /// are instantiated, set up with the stop time (`fmi2SetupExperiment`), given run 0's
+    /// start values and initialized, then freed (FMI 2.0 lets an FMU refuse a stop time it
+    /// cannot reach there; the test bench refuses one past its `duration`). An instance
+    /// that refuses is asked again with the stop time left undefined: only if it then
+    /// accepts is the stop time the cause, and `Err` names the instance and its message
+    /// (a refusal for another reason is left to the run, whose row says it). Inputs keep
+    /// their start values (no connection is propagated), so this is the instances' own
+    /// verdict, not a run.
+    pub fn check_stop_time(&self) -> Result<(), String> {
+        use nigel_cosim::{simulate::apply_start_values, Instance};
+        let Ok(system) = self.spec.system_of(&self.base, &self.spec.values(0)) else { return Ok(()) };
+        let start = self.experiment.start_time;
+        let init = |spec: &nigel_cosim::system::InstanceSpec, stop: Option<f64>| -> Result<(), nigel_cosim::Error> {
+            let mut inst = Instance::new(&spec.fmu, &spec.name)?;
+            inst.setup_experiment(None, start, stop)?;
+            apply_start_values(&mut inst, spec)?;
+            inst.enter_initialization_mode()?;
+            inst.exit_initialization_mode()?;
+            inst.terminate()
+        };
+        for spec in &system.instances {
+            if let Err(e) = init(spec, Some(self.spec.stop_time)) {
+                if init(spec, None).is_ok() {
+                    return Err(format!(
+                        "stop_time = {} s is past what the system can run: {} refuses it with run 0's values ({e})",
+                        self.spec.stop_time, spec.name
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The system of run `values`.
@@ -126,9 +209,9 @@ impl<'a> Worker<'a> {
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
         let mut inside = Duration::ZERO;
-        let outcome =
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<(Vec<f64>, Option<String>), String> {
-                let system = self.spec.system_of(&self.base, &values)?;
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(
+            || -> Result<(Vec<f64>, Option<String>), (String, bool)> {
+                let system = self.spec.system_of(&self.base, &values).map_err(|e| (e, false))?;
                 let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
                 // every row after the first: the communication points t_1 .. t_N
                 let mut first = true;
@@ -139,19 +222,22 @@ impl<'a> Worker<'a> {
                         acc.push(row);
                     }
                 };
+                // the master's time limit (checked between steps) is the run's timeout
                 let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(|e| (e.to_string(), matches!(e, nigel_cosim::Error::Timeout { .. })))?;
                 inside = summary.wall_time;
                 // an FMU that ends the run before the stop time: the metrics cover fewer points
                 let ended = summary.ended_by.map(|(instance, t, reason)| {
                     format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
                 });
                 Ok((acc.values(), ended))
-            }));
+            },
+        ));
         let (status, message, metrics) = match outcome {
             Ok(Ok((m, None))) => (STATUS_OK, String::new(), m),
             Ok(Ok((m, Some(ended)))) => (STATUS_ENDED, ended, m),
-            Ok(Err(e)) => (STATUS_FAILED, e, nan_metrics()),
+            Ok(Err((e, true))) => (STATUS_TIMEOUT, e, nan_metrics()),
+            Ok(Err((e, false))) => (STATUS_FAILED, e, nan_metrics()),
             Err(p) => {
                 let what = p
                     .downcast_ref::<String>()
@@ -174,6 +260,33 @@ impl<'a> Worker<'a> {
         let mut e = self.experiment.clone();
         e.record = None;
         simulate(&system, &e).map(|(r, _)| r).map_err(|e| e.to_string())
+    }
+}
+
+/// Where the rows go as they arrive: the target's files (each row written at once, so a
+/// killed campaign keeps every finished run), the progress bar, the counts.
+pub(crate) struct Collector<'a> {
+    appender: Appender,
+    target: &'a Target,
+    bar: indicatif::ProgressBar,
+    pub(crate) done: Done,
+    rows: Vec<Row>,
+}
+
+impl Collector<'_> {
+    /// Writes one row; `timing`: its time inside the co-simulation and in all of the run.
+    pub(crate) fn push(&mut self, row: Row, timing: (Duration, Duration)) -> Result<(), Error> {
+        self.appender.push(&row).map_err(|e| Error::Io(format!("{}: {e}", self.target.rows.display())))?;
+        self.done.ran += 1;
+        self.done.timing.0 += timing.0;
+        self.done.timing.1 += timing.1;
+        if row.status != STATUS_OK {
+            self.done.failed += 1;
+            self.bar.set_message(format!("{} failed", self.done.failed));
+        }
+        self.bar.inc(1);
+        self.rows.push(row);
+        Ok(())
     }
 }
 
@@ -211,15 +324,15 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     // started sample by sample across the grid points: a campaign stopped half-way holds
     // as many samples of every grid point (the rows are sorted by run at the end)
     todo.sort_by_key(|i| (i % spec.samples, i / spec.samples));
+    if options.threads == Some(0) {
+        return Err(Error::Usage("--threads must be at least 1".into()));
+    }
     let threads = options
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
         .clamp(1, todo.len().max(1));
-    if options.threads == Some(0) {
-        return Err(Error::Usage("--threads must be at least 1".into()));
-    }
     let start = Instant::now();
-    let mut appender = Appender::open(&target, spec)?;
+    let appender = Appender::open(&target, spec)?;
     let bar = if options.progress && std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(todo.len() as u64);
         b.set_style(
@@ -230,16 +343,61 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     } else {
         indicatif::ProgressBar::hidden()
     };
+    let done = Done {
+        threads,
+        kept: have.len() as u64,
+        file: target.rows.clone(),
+        messages: target.messages.clone(),
+        ..Done::default()
+    };
+    let mut out = Collector { appender, target: &target, bar, done, rows: have };
+    let refusal = |m: String| -> Result<Option<String>, Error> {
+        if options.allow_failures {
+            Ok(Some(m))
+        } else {
+            Err(Error::Spec(format!(
+                "{}: {m}; checked before the first run, nothing ran (a shorter stop_time, or --allow-failures to run anyway)",
+                spec.path.display()
+            )))
+        }
+    };
+    let outcome = if todo.is_empty() {
+        Ok(())
+    } else {
+        match &options.workers {
+            Workers::Threads => {
+                let checker = Worker::new(spec)?;
+                if let Err(m) = checker.check_stop_time() {
+                    out.done.stop_time_refused = refusal(m)?;
+                }
+                drop(checker);
+                run_threads(spec, &todo, threads, &mut out)
+            }
+            Workers::Processes(program) => {
+                crate::worker::run_processes(spec, program, &todo, threads, &mut out, &refusal)
+            }
+        }
+    };
+    out.bar.finish_and_clear();
+    outcome?;
+    let Collector { appender, done, mut rows, .. } = out;
+    drop(appender);
+    results::write_sorted(&target, spec, &mut rows)?;
+    let mut done = done;
+    done.rows = rows;
+    done.wall = start.elapsed();
+    Ok(done)
+}
+
+/// The runs `todo` on `threads` threads of this process.
+fn run_threads(spec: &Spec, todo: &[u64], threads: usize, out: &mut Collector) -> Result<(), Error> {
     let next = AtomicU64::new(0);
-    let (tx, rx) = mpsc::channel::<Result<Row, Error>>();
-    let timing = std::sync::Mutex::new((Duration::ZERO, Duration::ZERO));
-    let mut done = Done { threads, kept: have.len() as u64, rows: target.rows.clone(), ..Done::default() };
-    let mut rows = have;
-    let mut write_error = None;
+    let (tx, rx) = mpsc::channel::<Result<(Row, (Duration, Duration)), Error>>();
+    let mut error = None;
     std::thread::scope(|scope| {
         for _ in 0..threads {
             let tx = tx.clone();
-            let (todo, next, timing) = (&todo, &next, &timing);
+            let next = &next;
             scope.spawn(move || {
                 let mut worker = match Worker::new(spec) {
                     Ok(w) => w,
@@ -251,46 +409,23 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed) as usize;
                     let Some(&i) = todo.get(k) else { break };
-                    if tx.send(Ok(worker.run(i))).is_err() {
+                    let before = worker.timing;
+                    let row = worker.run(i);
+                    let timing = (worker.timing.0 - before.0, worker.timing.1 - before.1);
+                    if tx.send(Ok((row, timing))).is_err() {
                         break;
                     }
                 }
-                let mut t = timing.lock().unwrap_or_else(|p| p.into_inner());
-                t.0 += worker.timing.0;
-                t.1 += worker.timing.1;
             });
         }
         drop(tx);
         for msg in rx {
-            match msg {
-                Ok(row) => {
-                    if let Err(e) = appender.push(&row) {
-                        write_error = Some(Error::Io(format!("{}: {e}", target.rows.display())));
-                        next.store(u64::MAX / 2, Ordering::Relaxed);
-                        break;
-                    }
-                    done.ran += 1;
-                    if row.status != STATUS_OK {
-                        done.failed += 1;
-                        bar.set_message(format!("{} failed", done.failed));
-                    }
-                    bar.inc(1);
-                    rows.push(row);
-                }
-                Err(e) => {
-                    write_error.get_or_insert(e);
-                    next.store(u64::MAX / 2, Ordering::Relaxed);
-                }
+            let pushed = msg.and_then(|(row, timing)| out.push(row, timing));
+            if let Err(e) = pushed {
+                error.get_or_insert(e);
+                next.store(u64::MAX / 2, Ordering::Relaxed);
             }
         }
     });
-    bar.finish_and_clear();
-    if let Some(e) = write_error {
-        return Err(e);
-    }
-    drop(appender);
-    results::write_sorted(&target, spec, &mut rows)?;
-    done.wall = start.elapsed();
-    done.timing = timing.into_inner().unwrap_or_else(|p| p.into_inner());
-    Ok(done)
+    error.map_or(Ok(()), Err)
 }

@@ -59,7 +59,7 @@ pub fn script(spec: &Spec, array: &Array) -> String {
     );
     s += &format!("cd {}\n", sh(&abs(Path::new("."))));
     s += &format!(
-        "exec {} run {} --out {} --shard \"$SLURM_ARRAY_TASK_ID/{}\" --resume --threads \"${{SLURM_CPUS_PER_TASK:-1}}\"\n",
+        "exec {} run {} --out {} --shard \"$SLURM_ARRAY_TASK_ID/{}\" --resume --allow-failures --threads \"${{SLURM_CPUS_PER_TASK:-1}}\"\n",
         sh(&abs(&array.program)),
         sh(&abs(&spec.path)),
         sh(&out),

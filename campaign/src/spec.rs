@@ -443,7 +443,8 @@ impl Spec {
         Ok(spec)
     }
 
-    /// Parses `text` (the description at `path`) and loads its system.
+    /// Parses `text` (the description at `path`) and reads its system (the model
+    /// descriptions, no library loaded).
     pub fn parse(path: &Path, text: &str) -> Result<(Spec, System), Error> {
         let bad = |m: String| Error::Spec(format!("{}: {m}", path.display()));
         let doc: toml::Table = text.parse().map_err(|e: toml::de::Error| {
@@ -557,7 +558,9 @@ impl Spec {
         let system_bytes = std::fs::read(&system).map_err(|e| bad(format!("{}: {e}", system.display())))?;
         hasher.update(Sha256::digest(&system_bytes));
         let hash = hex(&hasher.finalize());
-        let loaded = load_system(&system).map_err(bad)?;
+        // only the model descriptions are needed here: the FMUs' libraries are not loaded
+        // (a library that crashes while loading ends a worker process, not the campaign)
+        let loaded = load_system_with(&system, true).map_err(bad)?;
         Ok((
             Spec {
                 path: path.to_path_buf(),
@@ -733,7 +736,14 @@ fn resolve_system(spec: &Path, text: &str) -> Result<PathBuf, String> {
 
 /// Reads an `.ssp` / `.ssd` (or a single `.fmu` as instance `model`).
 pub fn load_system(path: &Path) -> Result<System, String> {
-    let opts = nigel_cosim::ImportOptions::default();
+    load_system_with(path, false)
+}
+
+/// [`load_system`]; `isolated`: without loading the FMUs' libraries (their model
+/// descriptions and the functions their symbol tables list; such a system is checked, not
+/// run in this process).
+pub fn load_system_with(path: &Path, isolated: bool) -> Result<System, String> {
+    let opts = nigel_cosim::ImportOptions { isolated, ..nigel_cosim::ImportOptions::default() };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if ext == "fmu" {
         let fmu = nigel_cosim::Fmu::load_with(path, &opts).map_err(|e| format!("{}: {e}", path.display()))?;

@@ -90,15 +90,19 @@ thread_local! {
 /// Runs in progress in this process.
 static ACTIVE: AtomicUsize = AtomicUsize::new(0);
 
-/// The mark of a call in progress; the previous mark comes back when it is dropped.
-pub(crate) struct InCall(Option<Site>);
+/// The mark of a call in progress; the previous mark comes back when it is dropped. It is
+/// the one marker of an FMU call: read by this process's `atexit` handler, and, inside the
+/// host of `--isolate=run`, also written to the region its parent reads after a crash
+/// ([`crate::isolate::whole`]).
+pub(crate) struct InCall(Option<Site>, #[allow(dead_code)] crate::isolate::whole::Mark);
 
 /// Marks the call `function` of `instance` (of `fmu`) at `time` as in progress in this
 /// thread.
 #[inline]
 pub(crate) fn enter(instance: &str, fmu: &Fmu, function: &'static str, time: f64) -> InCall {
     let site = Site { instance, fmu, function, time };
-    InCall(CALL.with(|c| c.replace(Some(site))))
+    let shared = crate::isolate::whole::Mark::call(instance, function, time);
+    InCall(CALL.with(|c| c.replace(Some(site))), shared)
 }
 
 impl Drop for InCall {

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use nigel_campaign::report::Report;
-use nigel_campaign::run::{parse_shard, Options, Worker};
+use nigel_campaign::run::{parse_shard, Options, Worker, Workers};
 use nigel_campaign::spec::Spec;
 use nigel_campaign::{merge, slurm, Error};
 
@@ -37,6 +37,23 @@ enum Command {
         /// Run only run RUN, recording every output into DIR/run-RUN.csv, and print its row.
         #[arg(long)]
         only: Option<u64>,
+        /// Exit 0 also when runs failed (crashed, timed out, refused), and run even when
+        /// the system refuses the stop time before the first run.
+        #[arg(long)]
+        allow_failures: bool,
+        /// Run the workers as threads of this process instead of worker processes: no
+        /// crash boundary (an FMU's segfault ends the campaign), no timeout inside a call.
+        #[arg(long)]
+        in_process: bool,
+    },
+    /// A worker process of `campaign run` (started by it; speaks its protocol on standard
+    /// input and output).
+    #[command(hide = true)]
+    Worker {
+        /// The description (TOML).
+        spec: PathBuf,
+        /// Its hash, as the parent read it.
+        hash: String,
     },
     /// Write the sbatch job-array script DIR/campaign.sbatch (and with --submit, submit it,
     /// wait for it and merge).
@@ -58,11 +75,17 @@ enum Command {
         /// CPUs (threads) per task.
         #[arg(long, default_value_t = 1)]
         cpus_per_task: u64,
+        /// With --submit: exit 0 also when the merged results hold failed runs.
+        #[arg(long)]
+        allow_failures: bool,
     },
     /// Check that the shards in DIR hold every run exactly once and write DIR/results.csv.
     Merge {
         /// The output folder.
         dir: PathBuf,
+        /// Exit 0 also when the merged results hold failed runs.
+        #[arg(long)]
+        allow_failures: bool,
     },
     /// Per group count, mean, median, p95 and worst of each metric (markdown on standard
     /// output, DIR/report.json); with --png, the figures.
@@ -103,14 +126,7 @@ fn spec_of_dir(dir: &std::path::Path) -> Result<Spec, Error> {
 /// message in full (the CSV holds only numbers: `status` as a code, `message` as 0 or 1).
 fn describe_row(spec: &Spec, row: &nigel_campaign::results::Row) -> String {
     let header = spec.header();
-    use nigel_campaign::results::{STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED};
-    let status = match row.status {
-        STATUS_OK => "ok",
-        STATUS_FAILED => "failed",
-        STATUS_PANICKED => "panicked",
-        STATUS_ENDED => "ended by an FMU before the stop time",
-        _ => "unknown",
-    };
+    let status = nigel_campaign::results::status_name(row.status);
     let width = header.iter().map(|h| h.len()).max().unwrap_or(0).max("message".len());
     let mut out = format!("{:>width$} = {}\n{:>width$} = {} ({status})\n", "run", row.run, "status", row.status);
     if !row.message.is_empty() {
@@ -128,9 +144,37 @@ fn describe_row(spec: &Spec, row: &nigel_campaign::results::Row) -> String {
     out
 }
 
-fn main_inner() -> Result<(), Error> {
-    match Cli::parse().command {
-        Command::Run { spec, out, threads, shard, resume, only } => {
+/// Exit code of a campaign that completed with failed runs (1 is a campaign that could not
+/// run, 2 a command line clap refused).
+const EXIT_RUNS_FAILED: u8 = 3;
+
+/// What a finished command leaves: success, or runs that failed (a one-line summary).
+enum Outcome {
+    Done,
+    RunsFailed,
+}
+
+/// Prints the one-line account of the failed runs; whether they make the exit non-zero.
+fn judge(rows: &[nigel_campaign::results::Row], messages: &std::path::Path, allow: bool) -> Outcome {
+    match nigel_campaign::results::failure_summary(rows) {
+        None => Outcome::Done,
+        Some(line) => {
+            let verdict =
+                if allow { "accepted (--allow-failures)" } else { "exit status 3 (--allow-failures to accept)" };
+            eprintln!("campaign: {line}; messages in {}; {verdict}", messages.display());
+            if allow {
+                Outcome::Done
+            } else {
+                Outcome::RunsFailed
+            }
+        }
+    }
+}
+
+fn main_inner(cli: Cli) -> Result<Outcome, Error> {
+    match cli.command {
+        Command::Worker { spec, hash } => std::process::exit(nigel_campaign::worker::serve(&spec, &hash)),
+        Command::Run { spec, out, threads, shard, resume, only, allow_failures, in_process } => {
             let spec = Spec::load(&spec)?;
             if let Some(i) = only {
                 if i >= spec.runs() {
@@ -147,27 +191,38 @@ fn main_inner() -> Result<(), Error> {
                     .write_csv(std::io::BufWriter::new(f))
                     .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
                 eprintln!("every output of run {i}: {}", path.display());
-                return Ok(());
+                return Ok(Outcome::Done);
             }
             let shard = shard.as_deref().map(parse_shard).transpose()?;
-            let options = Options { out, threads, shard, resume, progress: true };
+            let workers = if in_process {
+                Workers::Threads
+            } else {
+                Workers::Processes(
+                    std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?,
+                )
+            };
+            let options = Options { out, threads, shard, resume, progress: true, workers, allow_failures };
             let done = nigel_campaign::run::run(&spec, &options)?;
+            if let Some(m) = &done.stop_time_refused {
+                eprintln!("campaign: warning: {m} (checked before the first run; run anyway: --allow-failures)");
+            }
             let (inside, total) = (done.timing.0.as_secs_f64(), done.timing.1.as_secs_f64());
             eprintln!(
-                "{} runs in {:.1} s on {} threads ({:.0} runs/min; {:.1} ms a run, of it {:.2} % outside the co-simulation), {} failed, {} already done: {}",
+                "{} runs in {:.1} s on {} {} ({:.0} runs/min; {:.1} ms a run, of it {:.2} % outside the co-simulation), {} failed, {} already done: {}",
                 done.ran,
                 done.wall.as_secs_f64(),
                 done.threads,
+                if in_process { "threads" } else { "worker processes" },
                 done.ran as f64 / done.wall.as_secs_f64().max(1e-9) * 60.0,
                 1e3 * total / done.ran.max(1) as f64,
                 100.0 * (total - inside) / total.max(1e-12),
                 done.failed,
                 done.kept,
-                done.rows.display()
+                done.file.display()
             );
-            Ok(())
+            Ok(judge(&done.rows, &done.messages, allow_failures))
         }
-        Command::Slurm { spec, out, tasks, submit, partition, cpus_per_task } => {
+        Command::Slurm { spec, out, tasks, submit, partition, cpus_per_task, allow_failures } => {
             let spec = Spec::load(&spec)?;
             let program = std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?;
             let array = slurm::Array { out: out.clone(), tasks, partition, cpus_per_task, program };
@@ -182,7 +237,7 @@ fn main_inner() -> Result<(), Error> {
             eprintln!("{} ({} runs in {tasks} tasks)", script.display(), spec.runs());
             if !submit {
                 println!("sbatch {}", script.display());
-                return Ok(());
+                return Ok(Outcome::Done);
             }
             let job = slurm::submit(&script)?;
             eprintln!("submitted job {job}");
@@ -195,27 +250,11 @@ fn main_inner() -> Result<(), Error> {
                 waited.as_secs_f64(),
                 if bad.is_empty() { String::new() } else { format!(" ({})", bad.join(", ")) }
             );
-            let m = merge::merge(&out, &spec)?;
-            eprintln!(
-                "merged {} shards: {} runs, {} failed: {}",
-                m.shards,
-                m.runs,
-                m.failed,
-                out.join("results.csv").display()
-            );
-            Ok(())
+            merged(&out, &spec, allow_failures)
         }
-        Command::Merge { dir } => {
+        Command::Merge { dir, allow_failures } => {
             let spec = spec_of_dir(&dir)?;
-            let m = merge::merge(&dir, &spec)?;
-            eprintln!(
-                "merged {} shards: {} runs, {} failed: {}",
-                m.shards,
-                m.runs,
-                m.failed,
-                dir.join("results.csv").display()
-            );
-            Ok(())
+            merged(&dir, &spec, allow_failures)
         }
         Command::Report { dir, by, png, metric, worst, pair } => {
             let spec = spec_of_dir(&dir)?;
@@ -240,17 +279,38 @@ fn main_inner() -> Result<(), Error> {
                     eprintln!("{}", p.display());
                 }
             }
-            Ok(())
+            Ok(Outcome::Done)
         }
     }
+}
+
+/// Merges the shards of `dir` and judges the merged rows.
+fn merged(dir: &std::path::Path, spec: &Spec, allow_failures: bool) -> Result<Outcome, Error> {
+    let m = merge::merge(dir, spec)?;
+    eprintln!(
+        "merged {} shards: {} runs, {} failed: {}",
+        m.shards,
+        m.runs,
+        m.failed,
+        dir.join("results.csv").display()
+    );
+    let rows = nigel_campaign::results::read_rows(&nigel_campaign::results::Target::whole(dir), spec, false)?;
+    Ok(judge(&rows, &dir.join("messages.csv"), allow_failures))
 }
 
 fn main() -> ExitCode {
     // SIGINT, SIGTERM (Ctrl-C, scancel) and SIGHUP remove the unpacked FMUs from TMPDIR;
     // the rows written so far stay, and `--resume` completes the campaign
-    nigel_cosim::unpack::remove_on_signals();
-    match main_inner() {
-        Ok(()) => ExitCode::SUCCESS,
+    let cli = Cli::parse();
+    if matches!(cli.command, Command::Worker { .. }) {
+        // a worker process removes the TMPDIR its parent made for it
+        nigel_campaign::worker::remove_tmpdir_on_signals();
+    } else {
+        nigel_cosim::unpack::remove_on_signals();
+    }
+    match main_inner(cli) {
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::RunsFailed) => ExitCode::from(EXIT_RUNS_FAILED),
         Err(e) => {
             eprintln!("campaign: {e}");
             ExitCode::FAILURE

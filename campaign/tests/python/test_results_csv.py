@@ -29,7 +29,10 @@ def test_fmpy_and_pandas_read_results(tmp_path):
         '[metrics]\ny_final = "final(plant.y)"\nspeed_mean = "mean(plant.speed)"\n'
     )
     out = tmp_path / "out"
-    subprocess.run([str(CAMPAIGN), "run", str(spec), "--out", str(out)], check=True, capture_output=True)
+    done = subprocess.run([str(CAMPAIGN), "run", str(spec), "--out", str(out)], capture_output=True, text=True)
+    # exit status 3: the campaign completed and runs failed (the four refused below), said in one line
+    assert done.returncode == 3, done.stderr
+    assert "campaign: 8 runs, 4 failed (4 failed): run 4 failed (" in done.stderr, done.stderr
     lines = (out / "results.csv").read_text().splitlines()
     rows = [[float(x) for x in line.split(",")] for line in lines[1:]]
     assert len(rows) == 2 * 2 * 2

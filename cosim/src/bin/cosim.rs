@@ -93,10 +93,13 @@ struct RunArgs {
     /// integrator's internal steps): a run that would take more stops with an error.
     #[arg(long, default_value_t = nigel_cosim::simulate::DEFAULT_MAX_STEPS)]
     max_steps: u64,
-    /// Run every FMU in a host process of its own (`cosim-host`): a crash, an exit or a
-    /// hang of an FMU is then an error naming it, with the rows so far written.
-    #[arg(long)]
-    isolate: bool,
+    /// Crash boundaries: `--isolate` (= `--isolate=fmu`) runs every FMU in a host process
+    /// of its own (`cosim-host`, one round trip per call); `--isolate=run` runs the whole
+    /// run in one host process, the FMUs called in it directly (in-process speed). Either
+    /// way a crash, an exit or a hang (--timeout) of an FMU is an error naming the
+    /// instance, the call, the time and the signal, with the rows so far written.
+    #[arg(long, value_enum, num_args = 0..=1, require_equals = true, default_missing_value = "fmu", value_name = "fmu|run")]
+    isolate: Option<IsolateMode>,
     /// Wall-clock limit of one FMU call, s (needs --isolate: the host is killed).
     #[arg(long, value_name = "SECONDS")]
     timeout_call: Option<f64>,
@@ -142,6 +145,15 @@ struct RunArgs {
     summary: Option<PathBuf>,
     #[command(flatten)]
     limits: LimitArgs,
+}
+
+/// Where `--isolate` draws the crash boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum IsolateMode {
+    /// A host process per FMU.
+    Fmu,
+    /// The whole run in one host process.
+    Run,
 }
 
 fn main() -> ExitCode {
@@ -212,7 +224,10 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Some(p) => Some(OutputFormat::of(p)?),
     };
     let limits = args.limits.limits();
-    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated: args.isolate };
+    // the parent of --isolate=run loads no FMU library (its host does)
+    let host_of_run = nigel_cosim::isolate::whole::is_host();
+    let isolated = args.isolate.is_some() && !host_of_run;
+    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated };
     let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
         // --interface applies to every FMU of the system (one without it is refused by name)
         let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
@@ -241,8 +256,10 @@ fn run(args: RunArgs) -> Result<(), Error> {
         Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
     experiment.start_time = args.start_time;
     check_times(&experiment)?;
-    for warning in sample_period_warnings(&system, experiment.step) {
-        eprintln!("cosim: warning: {warning}");
+    if !host_of_run {
+        for warning in sample_period_warnings(&system, experiment.step) {
+            eprintln!("cosim: warning: {warning}");
+        }
     }
 
     experiment.algorithm = algorithm;
@@ -278,13 +295,13 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if let Some(s) = args.timeout {
         experiment.timeout = Some(seconds("--timeout", s)?);
     }
-    if args.timeout_call.is_some() && !args.isolate {
+    if args.timeout_call.is_some() && args.isolate != Some(IsolateMode::Fmu) {
         return Err(Error::Experiment(
-            "--timeout-call needs --isolate (a call in this process cannot be stopped; a host process can be killed)"
+            "--timeout-call needs --isolate (=fmu: a call in this process cannot be stopped; a host process per FMU can be killed; --isolate=run has --timeout)"
                 .into(),
         ));
     }
-    if args.isolate {
+    if args.isolate == Some(IsolateMode::Fmu) {
         experiment.isolation = Some(nigel_cosim::Isolation {
             instances: None,
             call_timeout: args.timeout_call.map(|s| seconds("--timeout-call", s)).transpose()?,
@@ -297,8 +314,27 @@ fn run(args: RunArgs) -> Result<(), Error> {
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
     }
-    report_exit_inside_calls(args.output.clone(), format, &system);
-    let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
+    // Err(None): the run failed in the host of --isolate=run, which said why itself
+    let mut host_json = None;
+    let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
+        Some(IsolateMode::Run) if host_of_run => {
+            return nigel_cosim::isolate::whole::host_simulate(&system, &experiment);
+        }
+        Some(IsolateMode::Run) => {
+            let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
+            let run = nigel_cosim::isolate::whole::simulate_in_host(&system, &experiment, &argv)?;
+            let outcome = run.outcome.map(|(summary, json)| {
+                host_json = Some(json);
+                summary
+            });
+            (run.results, outcome)
+        }
+        _ => {
+            report_exit_inside_calls(args.output.clone(), format, &system);
+            let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
+            (results, outcome.map_err(Some))
+        }
+    };
     if outcome.is_ok() && args.output.is_none() && args.summary.is_none() {
         eprintln!(
             "cosim: note: no --output or --summary given: the run completed but its results were not kept \
@@ -323,8 +359,12 @@ fn run(args: RunArgs) -> Result<(), Error> {
             }
         }
     }
-    let summary = outcome?;
-    let json = serde_json::to_string_pretty(&summary.to_json()).unwrap_or_default();
+    let summary = match outcome {
+        Ok(s) => s,
+        Err(Some(e)) => return Err(e),
+        Err(None) => std::process::exit(1),
+    };
+    let json = serde_json::to_string_pretty(&host_json.unwrap_or_else(|| summary.to_json())).unwrap_or_default();
     match &args.summary {
         Some(p) if p.as_os_str() == "-" => println!("{json}"),
         Some(p) => write(p, &|mut f| std::io::Write::write_all(&mut f, json.as_bytes()))?,

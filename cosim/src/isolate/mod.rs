@@ -27,10 +27,14 @@
 //! The master's side is an [`Instance`](crate::Instance) whose function table is the
 //! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
 //! in-process ones. The host's side is [`host::run`], the whole of `cosim-host`.
+//!
+//! [`whole`]: the whole run in one host process (`--isolate=run`), the FMUs called in it
+//! directly.
 
 pub(crate) mod channel;
 pub mod host;
 pub(crate) mod proxy;
+pub mod whole;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
