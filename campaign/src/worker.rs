@@ -54,24 +54,9 @@ pub fn remove_tmpdir_on_signals() {
         nigel_cosim::unpack::remove_on_signals();
         return;
     };
-    // SAFETY: plain libc calls on a local signal set, as in remove_on_signals.
-    unsafe {
-        let mut set: libc::sigset_t = std::mem::zeroed();
-        libc::sigemptyset(&mut set);
-        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
-            libc::sigaddset(&mut set, s);
-        }
-        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
-            return;
-        }
-        let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
-            let mut signal: libc::c_int = 0;
-            if libc::sigwait(&set, &mut signal) == 0 {
-                let _ = std::fs::remove_dir_all(&dir);
-                libc::_exit(128 + signal);
-            }
-        });
-    }
+    nigel_cosim::unpack::on_signals(move |_| {
+        let _ = std::fs::remove_dir_all(&dir);
+    });
 }
 
 /// Past the description's `timeout`, how long the parent waits before it kills a worker:

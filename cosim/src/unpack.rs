@@ -190,6 +190,21 @@ pub fn remove_on_signals() {
         .map(std::path::PathBuf::from)
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .unwrap_or_else(|| "cosim".to_string());
+    on_signals(move |signal| {
+        let made = MADE.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        for dir in made {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        eprintln!("{program}: stopped by {}; temporary folders removed", crate::error::signal_name(signal));
+        // host processes end with the master (PR_SET_PDEATHSIG)
+    });
+}
+
+/// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (and so in every thread and child
+/// started after it; call it first in `main`) and waits for them in a thread of its own,
+/// which runs `cleanup` with the signal and exits with 128 + its number. The one signal
+/// waiter of the master's programs ([`remove_on_signals`], a campaign's worker processes).
+pub fn on_signals(cleanup: impl FnOnce(libc::c_int) + Send + 'static) {
     // SAFETY: plain libc calls on a local signal set.
     unsafe {
         let mut set: libc::sigset_t = std::mem::zeroed();
@@ -203,12 +218,7 @@ pub fn remove_on_signals() {
         let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
             let mut signal: libc::c_int = 0;
             if libc::sigwait(&set, &mut signal) == 0 {
-                let made = MADE.lock().unwrap_or_else(|e| e.into_inner()).clone();
-                for dir in made {
-                    let _ = std::fs::remove_dir_all(dir);
-                }
-                eprintln!("{program}: stopped by {}; temporary folders removed", crate::error::signal_name(signal));
-                // host processes end with the master (PR_SET_PDEATHSIG)
+                cleanup(signal);
                 libc::_exit(128 + signal);
             }
         });
