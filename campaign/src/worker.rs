@@ -266,6 +266,23 @@ fn start_others(
     Ok(())
 }
 
+/// Starts a new worker in slot `k` in place of the one that ended or was killed, and counts
+/// the restart.
+fn restart(
+    program: &Path,
+    spec: &Spec,
+    k: usize,
+    generations: &mut u64,
+    restarts: &mut u64,
+    tx: &mpsc::Sender<(usize, u64, Said)>,
+    slots: &mut [Slot],
+) -> Result<(), Error> {
+    *restarts += 1;
+    *generations += 1;
+    slots[k] = start(program, spec, k, *generations, tx)?;
+    Ok(())
+}
+
 /// How a worker process ended, in the words of the master's host processes.
 fn end_of(status: std::process::ExitStatus) -> HostEnd {
     match (status.signal(), status.code()) {
@@ -422,14 +439,11 @@ pub(crate) fn run_processes(
                                 break 'events;
                             }
                         }
-                        out.done.restarts += 1;
-                        generations += 1;
-                        match start(program, spec, k, generations, &tx) {
-                            Ok(s) => slots[k] = s,
-                            Err(e) => {
-                                result = Err(e);
-                                break 'events;
-                            }
+                        let restarted =
+                            restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots);
+                        if let Err(e) = restarted {
+                            result = Err(e);
+                            break 'events;
                         }
                     }
                 }
@@ -441,15 +455,13 @@ pub(crate) fn run_processes(
                         // the check hangs as a run would: the runs will say how they end
                         finish(&mut slots[0], true);
                         checked = true;
-                        generations += 1;
-                        let restarted = start(program, spec, 0, generations, &tx).map(|s| slots[0] = s);
-                        if let Err(e) = restarted
-                            .and_then(|_| start_others(program, spec, workers, &mut generations, &tx, &mut slots))
-                        {
+                        let restarted =
+                            restart(program, spec, 0, &mut generations, &mut out.done.restarts, &tx, &mut slots)
+                                .and_then(|_| start_others(program, spec, workers, &mut generations, &tx, &mut slots));
+                        if let Err(e) = restarted {
                             result = Err(e);
                             break 'events;
                         }
-                        out.done.restarts += 1;
                     }
                 }
                 // by index: a slot is replaced in place by the worker started for it
@@ -478,14 +490,11 @@ pub(crate) fn run_processes(
                         result = Err(e);
                         break 'events;
                     }
-                    out.done.restarts += 1;
-                    generations += 1;
-                    match start(program, spec, k, generations, &tx) {
-                        Ok(s) => slots[k] = s,
-                        Err(e) => {
-                            result = Err(e);
-                            break 'events;
-                        }
+                    let restarted =
+                        restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots);
+                    if let Err(e) = restarted {
+                        result = Err(e);
+                        break 'events;
                     }
                 }
             }

@@ -10,17 +10,8 @@ use nigel_campaign::results::{Target, STATUS_OK};
 use nigel_campaign::run::{run, Options, Worker};
 use nigel_campaign::spec::Spec;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap()
-}
-
-fn target_dir() -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(t) if Path::new(&t).is_absolute() => PathBuf::from(t),
-        Some(t) => root().join(t),
-        None => root().join("target"),
-    }
-}
+mod common;
+use common::{root, target_dir};
 
 fn ssp() -> PathBuf {
     target_dir().join("ssp").join("nigel_closed_loop.ssp")

@@ -15,17 +15,8 @@ use nigel_campaign::spec::Spec;
 
 const CAMPAIGN: &str = env!("CARGO_BIN_EXE_campaign");
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap()
-}
-
-fn target_dir() -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(t) if Path::new(&t).is_absolute() => PathBuf::from(t),
-        Some(t) => root().join(t),
-        None => root().join("target"),
-    }
-}
+mod common;
+use common::{root, target_dir};
 
 /// crash.c compiled with the system `cc` and zipped with crash.xml as `<dir>/crash.fmu`.
 fn build_crash(dir: &Path) -> PathBuf {

@@ -6,7 +6,7 @@
 //! A good run's CSV and summary equal the in-process run's, byte for byte.
 
 mod common;
-use common::{build_crash, work_dir};
+use common::{build_crash, time_and_y, work_dir};
 use std::path::Path;
 use std::process::Command;
 
@@ -55,14 +55,7 @@ fn a_crash_exit_or_hang_ends_only_the_host_and_names_the_call() {
         assert!(stderr.contains("6 rows up to the last completed step written"), "mode {mode}: {stderr}");
         // the rows 0, 0.1, .. 0.5 with y = t (t = n h as the master computes it, and y the
         // time the FMU's last step reached: the same f64 operations)
-        let rows: Vec<(f64, f64)> = csv
-            .lines()
-            .skip(1)
-            .map(|l| {
-                let (t, y) = l.split_once(',').unwrap();
-                (t.parse().unwrap(), y.parse().unwrap())
-            })
-            .collect();
+        let rows = time_and_y(&csv);
         assert_eq!(rows.len(), 6, "mode {mode}: {csv}");
         for (n, (t, y)) in rows.iter().enumerate() {
             assert_eq!(*t, n as f64 * 0.1, "mode {mode}");

@@ -4,7 +4,7 @@
 //! (modelDescription.xml, binaries/linux64/, resources/), straight from the .ssp.
 
 mod common;
-use common::{build_crash, build_fmu, plant_fmu, work_dir, zip_entries, Model};
+use common::{build_crash, build_fmu, plant_fmu, time_and_y, work_dir, zip_entries, Model};
 use nigel_cosim::{read_ssp, Error, Fmu, ImportOptions, SystemBuilder};
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -244,14 +244,7 @@ fn an_fmu_that_calls_exit_inside_a_step_fails_the_run_with_the_rows_so_far() {
     assert!(err.contains("cosim: model (crash.fmu) called exit() inside fmi2DoStep at t = 0.5 s"), "{err}");
     assert!(err.contains(&format!("6 rows up to the last completed step written to {}", csv.display())), "{err}");
     let text = std::fs::read_to_string(&csv).unwrap();
-    let rows: Vec<(f64, f64)> = text
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let (t, y) = l.split_once(',').unwrap();
-            (t.parse().unwrap(), y.parse().unwrap())
-        })
-        .collect();
+    let rows = time_and_y(&text);
     assert_eq!(rows.len(), 6, "{text}");
     for (n, (t, y)) in rows.iter().enumerate() {
         assert_eq!(*t, n as f64 * 0.1, "row {n}");

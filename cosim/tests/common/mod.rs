@@ -283,3 +283,15 @@ pub fn build_stair(dir: &Path) -> PathBuf {
 pub fn build_crash(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "crash", include_str!("../cfmu/crash.xml"))
 }
+
+/// The rows `time,y` of a two-column CSV written by `cosim run` (header skipped).
+#[allow(dead_code)] // not every test binary reads such a CSV
+pub fn time_and_y(csv: &str) -> Vec<(f64, f64)> {
+    csv.lines()
+        .skip(1)
+        .map(|l| {
+            let (t, y) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect()
+}
