@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One's own controller FMU in the loop in place of ours: the crate examples/own-controller
-# (a sampled 1 ms P law on the yaw rate and the speed, ~200 lines on fmi2-export) is packaged
+# (a sampled 1 ms P law on the yaw rate and the speed, ~200 lines on fmi-export) is packaged
 # as target/fmu/own_controller.fmu and put into the closed-loop SSP in place of
 # nigel_controller (target/ssp/own_controller_closed_loop.ssp, same connections); the master
 # runs the sim lane change (seed 0, 30 s, 1 ms) from it.

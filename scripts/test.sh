@@ -12,7 +12,7 @@ target_dir="${CARGO_TARGET_DIR:-target}"
 echo "== building the FMUs (linux64, win64, aarch64-linux, darwin64)"
 cargo run --release --quiet -p build-fmu -- --platforms all
 echo "== rebuilding from touched sources must give byte-identical archives"
-touch fmu-plant/src/lib.rs fmi2-export/src/abi.rs
+touch fmu-plant/src/lib.rs fmi-export/src/abi.rs
 cargo run --release --quiet -p build-fmu -- --platforms all "$target_dir/fmu-rebuild" >/dev/null
 # the FMUs of build-fmu's list (target/fmu may also hold FMUs the examples wrote)
 ids=$(grep -o '"model_identifier": "[^"]*"' "$target_dir/fmu/manifest.json" | cut -d'"' -f4)

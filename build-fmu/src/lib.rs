@@ -9,8 +9,8 @@ use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use fmi2_export::model_description::{ModelDescription, VariableType};
-use fmi2_export::{Declaration, Model};
+use fmi_export::model_description::{ModelDescription, VariableType};
+use fmi_export::{Declaration, Model};
 use zip::write::SimpleFileOptions;
 
 pub use platform::Platform;
@@ -253,7 +253,7 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
             VariableType::String { start } => (String::new(), String::new(), start.clone().unwrap_or_default()),
         };
         let start = match (start.is_empty(), v.initial) {
-            (true, Some(fmi2_export::model_description::Initial::Calculated)) => "(calculated)".to_string(),
+            (true, Some(fmi_export::model_description::Initial::Calculated)) => "(calculated)".to_string(),
             _ => start,
         };
         let _ = writeln!(

@@ -444,7 +444,7 @@ struct Slice {
     cpu: u32,
     minos: Option<(u32, u32)>,
     dylibs: Vec<String>,
-    fmi2_exports: Vec<String>,
+    fmi_exports: Vec<String>,
 }
 
 fn u32_le(b: &[u8], at: usize) -> u32 {
@@ -466,7 +466,7 @@ fn parse_slice(b: &[u8]) -> Slice {
     let cpu = u32_le(b, 4);
     let ncmds = u32_le(b, 16) as usize;
     let mut at = 32; // sizeof(mach_header_64)
-    let mut slice = Slice { cpu, minos: None, dylibs: Vec::new(), fmi2_exports: Vec::new() };
+    let mut slice = Slice { cpu, minos: None, dylibs: Vec::new(), fmi_exports: Vec::new() };
     for _ in 0..ncmds {
         let (cmd, size) = (u32_le(b, at), u32_le(b, at + 4) as usize);
         match cmd {
@@ -486,7 +486,7 @@ fn parse_slice(b: &[u8]) -> Slice {
                     if n_type & 0x01 != 0 && n_type & 0x0e == 0x0e {
                         let name = c_string(b, stroff + u32_le(b, e) as usize);
                         if name.starts_with("_fmi2") {
-                            slice.fmi2_exports.push(name);
+                            slice.fmi_exports.push(name);
                         }
                     }
                 }
@@ -499,7 +499,7 @@ fn parse_slice(b: &[u8]) -> Slice {
 }
 
 #[test]
-fn darwin64_is_universal_macos_11_with_the_fmi2_exports_and_system_libraries_only() {
+fn darwin64_is_universal_macos_11_with_the_fmi_exports_and_system_libraries_only() {
     if !built("darwin64") {
         return;
     }
@@ -514,7 +514,7 @@ fn darwin64_is_universal_macos_11_with_the_fmi2_exports_and_system_libraries_onl
             let slice = parse_slice(&b[offset..offset + size]);
             assert_eq!(slice.cpu, cpu);
             assert_eq!(slice.minos, Some((11, 0)), "{} cpu {cpu:#x}: minimum macOS", lib.display());
-            let mut exports = slice.fmi2_exports.clone();
+            let mut exports = slice.fmi_exports.clone();
             exports.sort();
             exports.dedup();
             assert_eq!(exports.len(), 44, "{} cpu {cpu:#x}: fmi2 exports {exports:?}", lib.display());

@@ -10,10 +10,10 @@ use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
+use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 
-type Component = fmi2_sys::fmi2Component;
-type RawStatus = fmi2_sys::fmi2Status;
+type Component = fmi_sys::fmi2::fmi2Component;
+type RawStatus = fmi_sys::fmi2::fmi2Status;
 
 /// The FMI interface an instance uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,16 +41,16 @@ impl Interface {
 }
 
 /// `fmi2CallbackFunctions`.
-pub(crate) type CallbackFunctions = fmi2_sys::Fmi2CallbackFunctions;
+pub(crate) type CallbackFunctions = fmi_sys::fmi2::Fmi2CallbackFunctions;
 
 /// `fmi2EventInfo`.
-pub use fmi2_sys::Fmi2EventInfo as EventInfo;
+pub use fmi_sys::fmi2::Fmi2EventInfo as EventInfo;
 
 /// The fmi2 functions of a library: the ones every interface needs, the rest optional
 /// (absent when the library lacks them; calling one is then an error naming it).
-pub(crate) use fmi2_sys::Fmi2Functions as Functions;
+pub(crate) use fmi_sys::fmi2::Fmi2Functions as Functions;
 
-/// The callbacks of an instance whose messages go to `log` (the logger shim of fmi2-sys
+/// The callbacks of an instance whose messages go to `log` (the logger shim of fmi-sys
 /// formats them).
 pub(crate) fn callbacks_for(log: &LogSink) -> Box<CallbackFunctions> {
     Box::new(log.environment.callbacks())
@@ -310,7 +310,7 @@ impl Fmu {
             let exported = crate::elf::exported_symbols(&bytes);
             let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
             // the 15 core functions, which `Fmi2Functions::load` requires, lead SYMBOLS
-            if let Some(symbol) = fmi2_sys::SYMBOLS.iter().take(15).map(|(s, _)| *s).find(|s| !present(s)) {
+            if let Some(symbol) = fmi_sys::fmi2::SYMBOLS.iter().take(15).map(|(s, _)| *s).find(|s| !present(s)) {
                 return Err(Error::MissingSymbol { path: shown, symbol });
             }
             (None, crate::isolate::proxy::table(&present))

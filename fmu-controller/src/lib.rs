@@ -11,7 +11,7 @@
 //! (`k_along_track`, `along_track_speed_max`; see `nigel_benchmark::control`). The other
 //! modes never read the pose inputs.
 //!
-//! Sampled data: the layer keeps the sample clock ([`fmi2_export::sampled`]) and at every
+//! Sampled data: the layer keeps the sample clock ([`fmi_export::sampled`]) and at every
 //! sample instant `t_k = t_start + k sample_period` calls [`Model::sample`] (a time event in
 //! Model Exchange; inside `fmi2DoStep`, or lazily at the first read or step after the
 //! importer set the inputs of that instant, in Co-Simulation). There the speed integrator first takes the step of the previous sample
@@ -28,8 +28,8 @@
 use std::sync::OnceLock;
 
 use core::f64::consts::FRAC_PI_2;
-use fmi2_export::model_description::DefaultExperiment;
-use fmi2_export::{
+use fmi_export::model_description::DefaultExperiment;
+use fmi_export::{
     Capabilities, Declaration, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
     ModelResult, VarDecl, Variables,
 };
@@ -379,7 +379,7 @@ impl Model for Controller {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi2_export::export_fmi2!(Controller);
+fmi_export::export_fmi2!(Controller);
 
 /// The law and its timing, for `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("documentation.html");

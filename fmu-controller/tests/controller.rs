@@ -9,8 +9,8 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use fmi2_export::testing::{Fmu, DISCARD, ERR, OK};
-use fmi2_export::Model;
+use fmi_export::testing::{Fmu, DISCARD, ERR, OK};
+use fmi_export::Model;
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};
 use nigel_controller::{mode, Controller};
 
@@ -371,7 +371,7 @@ fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
 
 #[test]
 fn declaration_has_feedthrough_and_the_interfaces() {
-    use fmi2_export::Model;
+    use fmi_export::Model;
     let md = Controller::declaration().model_description();
     assert!(md.validate().is_empty(), "{:?}", md.validate());
     assert!(md.model_exchange.is_some() && md.co_simulation.is_some());
@@ -392,7 +392,7 @@ fn declaration_has_feedthrough_and_the_interfaces() {
     // controller is an Integer 1 ..= 5, robust_tracking the last value (the others unchanged),
     // every value named in its description
     let v = md.model_variables.iter().find(|v| v.name == "controller").unwrap();
-    let fmi2_export::model_description::VariableType::Integer { start, min, max, .. } = &v.variable_type else {
+    let fmi_export::model_description::VariableType::Integer { start, min, max, .. } = &v.variable_type else {
         panic!("controller is {:?}", v.variable_type)
     };
     assert_eq!((*start, *min, *max), (Some(mode::ROBUST), Some(1), Some(mode::ROBUST_TRACKING)));
@@ -506,8 +506,8 @@ fn a_step_of_astronomically_many_samples_is_refused_not_run() {
 /// (1-based, as the Enumeration had them), and no type definition left behind.
 #[test]
 fn controller_switch_is_an_integer_parameter_listing_its_values() {
-    use fmi2_export::model_description::{Causality, VariableType};
-    use fmi2_export::Model;
+    use fmi_export::model_description::{Causality, VariableType};
+    use fmi_export::Model;
     let md = Controller::declaration().model_description();
     let v = md.variable("controller").expect("controller is declared");
     assert_eq!(v.causality, Causality::Parameter);

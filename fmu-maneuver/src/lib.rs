@@ -6,7 +6,7 @@
 //! the chosen fidelity (the nominal open-loop run with the speed loop, 1 ms samples, for
 //! `duration` seconds) and, for the figure-8, the switching table from the nominal
 //! paper-fidelity run. Then at every sample instant `t_k = t_start + k 1 ms` (the layer's
-//! sample clock, [`fmi2_export::sampled`]: a time event; inside `fmi2DoStep` in
+//! sample clock, [`fmi_export::sampled`]: a time event; inside `fmi2DoStep` in
 //! Co-Simulation) it latches the outputs of sample `k` and holds them until `t_(k+1)`. The
 //! last sample is at `t = duration`: there the simulation ends (Model Exchange
 //! `terminateSimulation`; a Co-Simulation step past it `fmi2Discard` with `fmi2Terminated`),
@@ -19,8 +19,8 @@
 use std::sync::{Arc, OnceLock};
 
 use core::f64::consts::{FRAC_PI_2, TAU};
-use fmi2_export::model_description::DefaultExperiment;
-use fmi2_export::{
+use fmi_export::model_description::DefaultExperiment;
+use fmi_export::{
     declared_name, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
     ModelResult, SampleEnd, Variables,
 };
@@ -332,7 +332,7 @@ impl Model for TestBench {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi2_export::export_fmi2!(TestBench);
+fmi_export::export_fmi2!(TestBench);
 
 /// What the test bench computes, for `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("documentation.html");

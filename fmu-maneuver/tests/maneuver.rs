@@ -5,8 +5,8 @@
 
 use std::f64::consts::PI;
 
-use fmi2_export::testing::{Fmu, DISCARD, ERR, OK};
-use fmi2_export::Model;
+use fmi_export::testing::{Fmu, DISCARD, ERR, OK};
+use fmi_export::Model;
 use nigel_benchmark::noise::g;
 use nigel_benchmark::{Benchmark, Fidelity, Maneuver, Scenario};
 use nigel_maneuver::{fidelity_value, maneuver_value, TestBench};
@@ -246,8 +246,8 @@ fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
 /// descriptions, no type definitions left behind.
 #[test]
 fn switches_are_integer_parameters_listing_their_values() {
-    use fmi2_export::model_description::{Causality, VariableType};
-    use fmi2_export::Model;
+    use fmi_export::model_description::{Causality, VariableType};
+    use fmi_export::Model;
     let md = TestBench::declaration().model_description();
     let names = ["straight", "lane_change", "skidpad", "fishhook", "slalom", "figure_8"];
     let cases: [(&str, u32, i32, &[&str]); 2] =

@@ -5,9 +5,9 @@ use std::ffi::{c_char, c_int, c_void, CString};
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use fmi2_export::abi;
-use fmi2_export::ffi::{Fmi2CallbackFunctions, Fmi2CallbackLogger, Fmi2Status};
-use fmi2_export::Model;
+use fmi_export::abi;
+use fmi_export::ffi::{Fmi2CallbackFunctions, Fmi2CallbackLogger, Fmi2Status};
+use fmi_export::Model;
 use nigel_plant::Plant;
 use nigel_vehicle::{derivatives_of, Inputs, VehicleParams};
 

@@ -7,8 +7,8 @@
 
 use std::sync::OnceLock;
 
-use fmi2_export::model_description::DefaultExperiment;
-use fmi2_export::{
+use fmi_export::model_description::DefaultExperiment;
+use fmi_export::{
     declared_name, Access, Capabilities, Declaration, DeclarationSpec, Initial, InstantiateContext, Interfaces, Model,
     ModelError, ModelResult, Start, VarHandle, Variables,
 };
@@ -663,12 +663,12 @@ impl Model for Plant {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi2_export::export_fmi2!(Plant);
+fmi_export::export_fmi2!(Plant);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::BaseType;
+    use fmi_export::BaseType;
 
     /// The wheel names (the suffixes of every per-wheel variable) are the vehicle model's
     /// wheel order: `mu_rl` is the friction the physics applies to wheel 2.

@@ -1,4 +1,4 @@
-//! FMI 2.0 `modelDescription.xml`: types, writer, reader, validation, content GUID.
+//! `modelDescription.xml` of FMI 2.0 (the crate root) and FMI 3.0 ([`fmi3`]): types, writer, reader, validation, content GUID.
 //!
 //! - [`ModelDescription::to_xml`] writes the XML (element order of the XSD, deterministic).
 //! - [`ModelDescription::from_xml`] reads it back (or another tool's), refusing with a
@@ -32,6 +32,7 @@
 #![warn(missing_docs)]
 
 pub mod types;
+pub mod fmi3;
 pub use types::*;
 
 mod guid;

@@ -1,18 +1,18 @@
 //! A minimal FMI 2.0 importer for tests: unpacks a `.fmu`, resolves all 44 `fmi2*`
-//! symbols into the function table of `fmi2-sys` (a missing one is an error, as in
+//! symbols into the function table of `fmi-sys` (a missing one is an error, as in
 //! fmpy), and wraps an instance so tests can call the C ABI, including in the wrong order
-//! on purpose. The log goes through the logger shim of `fmi2-sys`, as in the master.
+//! on purpose. The log goes through the logger shim of `fmi-sys`, as in the master.
 
 use std::ffi::{c_int, CString};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
+use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 
 /// The log of an instance: its callbacks' environment, a [`LogSink`] behind it.
 pub type Log = LogEnvironment<LogSink>;
-pub use fmi2_sys::{
+pub use fmi_sys::fmi2::{
     fmi2Component as Component, fmi2Status as Status, Fmi2EventInfo as EventInfo, Fmi2Functions as Functions,
 };
 pub use model_description::ModelDescription;
@@ -27,7 +27,7 @@ pub const SYMBOLS: [&str; 44] = {
     let mut names = [""; 44];
     let mut k = 0;
     while k < 44 {
-        names[k] = fmi2_sys::SYMBOLS[k].0;
+        names[k] = fmi_sys::fmi2::SYMBOLS[k].0;
         k += 1;
     }
     names
@@ -159,7 +159,7 @@ impl Fmu {
 pub struct Instance<'a> {
     pub fmu: &'a Fmu,
     pub c: Component,
-    _callbacks: Box<fmi2_sys::Fmi2CallbackFunctions>,
+    _callbacks: Box<fmi_sys::fmi2::Fmi2CallbackFunctions>,
 }
 
 pub const MODEL_EXCHANGE: c_int = 0;

@@ -256,16 +256,16 @@ fn every_declared_variable_answers_at_its_value_reference() {
     assert_eq!(i.exit_init(), OK);
     // outputs against the in-process model at the same point
     let mut plant = nigel_plant::Plant::default();
-    use fmi2_export::Model;
+    use fmi_export::Model;
     for v in &md.model_variables {
         if let VariableType::Real { start: Some(_), .. } = v.variable_type {
             let value = i.get_real(&[v.value_reference]).unwrap()[0];
-            let row = nigel_plant::Plant::declaration().row(fmi2_export::BaseType::Real, v.value_reference).unwrap();
+            let row = nigel_plant::Plant::declaration().row(fmi_export::BaseType::Real, v.value_reference).unwrap();
             plant.set_real(nigel_plant::Plant::declaration().variable(row).binding, value).unwrap();
         }
     }
     for v in md.model_variables.iter().filter(|v| v.causality == Causality::Output) {
-        let row = nigel_plant::Plant::declaration().row(fmi2_export::BaseType::Real, v.value_reference).unwrap();
+        let row = nigel_plant::Plant::declaration().row(fmi_export::BaseType::Real, v.value_reference).unwrap();
         let expected = plant.get_real(nigel_plant::Plant::declaration().variable(row).binding).unwrap();
         assert_eq!(i.get_real(&[v.value_reference]).unwrap()[0], expected, "{}", v.name);
     }

@@ -2,7 +2,7 @@
 //! in every state, with hostile arguments (unknown value references, NULL arrays,
 //! NaN/Inf, huge steps, stale and foreign FMU states, corrupted serialized states).
 //! Checked after every call: no crash, a defined status, the allowed-state table of
-//! `fmi2_export::states` respected (a call it forbids returns fmi2Error), and no
+//! `fmi_export::states` respected (a call it forbids returns fmi2Error), and no
 //! non-finite number handed out with fmi2OK.
 //!
 //! `NIGEL_RANDOM_SEQUENCES` sets the number of sequences per FMU and interface
@@ -11,7 +11,7 @@
 use std::ffi::{c_char, c_int, c_void};
 use std::ptr::{null, null_mut};
 
-use fmi2_export::states::{Function, Machine, Scope};
+use fmi_export::states::{Function, Machine, Scope};
 use model_description::ModelDescription;
 use nigel_integration_tests::{built_fmu, EventInfo, Fmu, CO_SIMULATION, DISCARD, ERROR, MODEL_EXCHANGE, OK};
 

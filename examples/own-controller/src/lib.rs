@@ -12,8 +12,8 @@
 
 use std::sync::OnceLock;
 
-use fmi2_export::model_description::DefaultExperiment;
-use fmi2_export::{Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables};
+use fmi_export::model_description::DefaultExperiment;
+use fmi_export::{Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables};
 use nigel_vehicle::WHEELS;
 
 /// The sample period of the law \[s\].
@@ -163,4 +163,4 @@ impl Model for OwnController {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi2_export::export_fmi2!(OwnController);
+fmi_export::export_fmi2!(OwnController);

@@ -1,5 +1,5 @@
 //! Every layer feature on a small sampled toy model, through the layer's C entry points
-//! (`fmi2_export::abi`, what `export_fmi2!` exports): Integer/Boolean/Enumeration,
+//! (`fmi_export::abi`, what `export_fmi2!` exports): Integer/Boolean/Enumeration,
 //! tunable and fixed parameters, time events in Model Exchange and inside `fmi2DoStep`,
 //! event iteration, the default FMU state from the declaration, opt-in capabilities,
 //! Warning/Discard, bad input, stopTime, and the FMU states an instance owns.
@@ -16,11 +16,11 @@ use std::ffi::{c_char, c_int, CString};
 use std::ptr::null_mut;
 use std::sync::OnceLock;
 
-use fmi2_export::abi::{self, Fmi2EventInfo};
-use fmi2_export::ffi::*;
-use fmi2_export::model_description::{Causality, Variability, VariableType};
-use fmi2_export::testing::{self, ERR, OK};
-use fmi2_export::*;
+use fmi_export::abi::{self, Fmi2EventInfo};
+use fmi_export::ffi::*;
+use fmi_export::model_description::{Causality, Variability, VariableType};
+use fmi_export::testing::{self, ERR, OK};
+use fmi_export::*;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum V {
@@ -122,7 +122,7 @@ fn spec(capabilities: Capabilities, interfaces: Interfaces, identifier: &'static
 }
 
 /// The toy dispatches on its own binding.
-impl fmi2_export::Access<Toy> for V {}
+impl fmi_export::Access<Toy> for V {}
 
 impl Model for Toy {
     type Binding = V;
@@ -275,7 +275,7 @@ impl Model for Toy {
 struct Bare(Toy);
 
 /// The toy dispatches on its own binding.
-impl fmi2_export::Access<Bare> for V {}
+impl fmi_export::Access<Bare> for V {}
 
 impl Model for Bare {
     type Binding = V;
@@ -317,7 +317,7 @@ impl Model for Bare {
 struct Own(Toy);
 
 /// The toy dispatches on its own binding.
-impl fmi2_export::Access<Own> for V {}
+impl fmi_export::Access<Own> for V {}
 
 impl Model for Own {
     type Binding = V;
@@ -372,7 +372,7 @@ export_fmi2!(Toy);
 
 // ------------------------------------------------------------------ the importer
 
-/// The layer's in-process importer (`fmi2_export::testing`) with the toy tests'
+/// The layer's in-process importer (`fmi_export::testing`) with the toy tests'
 /// conventions: `last_error` is the last message at Discard or worse, `init` takes the
 /// stop time.
 struct Fmu<M: Model>(testing::Fmu<M>);

@@ -1,7 +1,7 @@
-//! A tiny in-process importer over the layer's C entry points (`fmi2_export::abi`, what
+//! A tiny in-process importer over the layer's C entry points (`fmi_export::abi`, what
 //! `export_fmi2!` exports from the shared library), for the tests of the layer and of the
 //! FMU crates: it instantiates a model type directly, without building or loading a
-//! library, and records the log (through the logger shim of `fmi2-sys`, as a real importer
+//! library, and records the log (through the logger shim of `fmi-sys`, as a real importer
 //! receives it) so that tests can check the messages. Behind the feature `testing`, which
 //! the FMU crates enable from their dev-dependencies.
 #![allow(clippy::missing_safety_doc, clippy::new_without_default)]
@@ -13,7 +13,7 @@ use std::ptr::null_mut;
 use crate::abi::{self, Fmi2EventInfo};
 use crate::ffi::*;
 use crate::Model;
-use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
+use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 
 /// The log of one instance: (status, category, message), in the order logged.
 #[derive(Debug, Default)]

@@ -14,7 +14,7 @@
 //! the Rust function the shim calls, so no Rust symbol is exported by name.
 //!
 //! ```
-//! use fmi2_sys::logger::{LogEnvironment, LogMessage, LogReceiver};
+//! use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 //! use std::sync::Mutex;
 //!
 //! #[derive(Default)]
@@ -33,7 +33,7 @@
 //! assert_eq!(environment.receiver().0.lock().unwrap()[0], "plant [logStatusError] v_x = 0.350");
 //! ```
 
-use crate::*;
+use super::*;
 use std::ffi::{c_char, c_void, CStr};
 
 extern "C" {

@@ -53,7 +53,7 @@
 //!      and discrete states must be settable by binding), plus [`Model::save_internal`] /
 //!      [`Model::load_internal`] for data that is no variable (a sample counter). A loaded
 //!      state goes through the same checks as `fmi2Set*` and `exit_initialization`.
-//! 4. `fmi2_export::export_fmi2!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
+//! 4. `fmi_export::export_fmi2!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
 //!    entry `FmuTarget::of::<MyModel>("fmu-xyz", EQUATIONS_HTML)` in `build-fmu`'s list:
 //!    the identifier, interfaces and documentation come from the declaration, and the
 //!    generic C-ABI and fmpy tests then cover the new FMU.
@@ -70,7 +70,7 @@
 //!
 //! ```
 //! use std::sync::OnceLock;
-//! use fmi2_export::*;
+//! use fmi_export::*;
 //!
 //! #[derive(Clone, Debug, Default)]
 //! struct Sampler { u: f64, gain: f64, y: f64 }
@@ -108,7 +108,7 @@
 //!         Ok(())
 //!     }
 //! }
-//! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi2_export::export_fmi2!(Sampler);
+//! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi_export::export_fmi2!(Sampler);
 //!
 //! let d = Sampler::declaration();
 //! assert_eq!(d.value_reference_table(), "u 0\ngain 1\ny 2\n");

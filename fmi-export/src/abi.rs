@@ -582,7 +582,7 @@ pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
     with::<M>(c, Function::EnterEventMode, |comp| comp.instance.enter_event_mode())
 }
 
-/// `fmi2EventInfo` (from `fmi2-sys`).
+/// `fmi2EventInfo` (from `fmi-sys`).
 pub use crate::ffi::Fmi2EventInfo;
 
 pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut Fmi2EventInfo) -> Fmi2Status {

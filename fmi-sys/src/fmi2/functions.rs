@@ -13,7 +13,7 @@
 //! ([`Fmi2Functions::has`]).
 #![allow(non_snake_case)]
 
-use crate::*;
+use super::*;
 
 /// The part of FMI 2.0 a function belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,7 +45,7 @@ macro_rules! fmi2_functions {
             //! The C type of each function, named as in `fmi2FunctionTypes.h`. The
             //! `fmuType` of `fmi2Instantiate` is a C `int` (an [`Fmi2Type`] value), so that
             //! an importer can pass what its user asked for and hear the FMU refuse it.
-            use crate::*;
+            use super::*;
             use std::ffi::c_int;
             $(#[doc = concat!("`", stringify!($cs), "`.")]
               pub type $cs = unsafe extern "C" fn($($ca),*) $(-> $cr)?;)*

@@ -688,7 +688,7 @@ impl<B: Copy> Declaration<B> {
             version: Some(spec.version.into()),
             copyright: None,
             license: Some("MIT OR Apache-2.0".into()),
-            generation_tool: Some(format!("nigel-fmi fmi2-export {}", env!("CARGO_PKG_VERSION"))),
+            generation_tool: Some(format!("nigel-fmi fmi-export {}", env!("CARGO_PKG_VERSION"))),
             generation_date_and_time: None,
             variable_naming_convention: Some("structured".into()),
             number_of_event_indicators: 0,

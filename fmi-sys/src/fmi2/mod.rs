@@ -14,11 +14,6 @@
 //!   `*` widths, positional arguments, wide strings; a `%s` argument is copied only if it
 //!   points to readable memory outside the importer's program image), and hands the text
 //!   to a Rust [`logger::LogReceiver`].
-//!
-//! The crate is thin on purpose: no state, no FMI state machine (that lives in
-//! `fmi2-export` for the FMUs and in `nigel-cosim` for the master). Everything a C caller
-//! can get wrong stays `unsafe` here; the safe wrappers are the importers' business.
-#![allow(non_camel_case_types)]
 
 use std::ffi::{c_char, c_int, c_uint, c_void};
 
