@@ -283,6 +283,12 @@ pub enum Error {
         /// The simulation time reached, s.
         time: f64,
     },
+    /// The caller asked the run to stop ([`Experiment::cancel`](crate::Experiment::cancel));
+    /// checked between steps.
+    Cancelled {
+        /// The simulation time reached, s.
+        time: f64,
+    },
     /// The experiment is not simulable as given (times, step, output interval).
     Experiment(String),
     /// An SSP file is malformed or uses a part this master does not support.
@@ -461,6 +467,7 @@ impl fmt::Display for Error {
             Error::Timeout { limit, time } => {
                 write!(f, "the run exceeded its time limit of {} s (--timeout) at t = {time} s", limit.as_secs_f64())
             }
+            Error::Cancelled { time } => write!(f, "the run was cancelled at t = {time} s"),
             Error::Experiment(m) => write!(f, "experiment: {m}"),
             Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
         }

@@ -253,6 +253,10 @@ fn run<'s>(
             if let Some(d) = limit.as_mut() {
                 list.push(d);
             }
+            let mut cancel = experiment.cancel.clone().map(crate::simulate::observer::Cancel);
+            if let Some(c) = cancel.as_mut() {
+                list.push(c);
+            }
             let mut observers = Observers { list, calls: experiment.profile.then_some(&mut profiler) };
             match algorithm.run(&mut core, &mut observers) {
                 Ok(()) => {}

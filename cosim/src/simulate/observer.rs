@@ -135,6 +135,20 @@ impl Observer for Deadline {
     }
 }
 
+/// Stops the run when its flag is set ([`Experiment::cancel`](crate::Experiment::cancel)):
+/// one relaxed load per step.
+pub(crate) struct Cancel(pub(crate) std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl Observer for Cancel {
+    #[inline]
+    fn step_complete(&mut self, point: &Point, _values: &[f64]) -> Result<()> {
+        if self.0.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(Error::Cancelled { time: point.t_next });
+        }
+        Ok(())
+    }
+}
+
 /// Time spent in each instance's calls, one clock read per call boundary: the time from
 /// the previous mark to the end of a call is charged to that call's instance (the
 /// master's marshalling of the call's arguments included). Lanes stepped in threads

@@ -72,6 +72,10 @@ pub struct Experiment {
     /// The wall-clock limit of the whole run ([`Error::Timeout`](crate::Error::Timeout), or
     /// [`Error::Host`](crate::Error::Host) when it passes during a call of an isolated instance).
     pub timeout: Option<Duration>,
+    /// Set to true (from any thread) to stop the run between two steps with
+    /// [`Error::Cancelled`](crate::Error::Cancelled), the rows so far kept (a Python caller's
+    /// Ctrl-C).
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Experiment {
@@ -93,6 +97,7 @@ impl Experiment {
             max_steps: DEFAULT_MAX_STEPS,
             isolation: None,
             timeout: None,
+            cancel: None,
         }
     }
 }

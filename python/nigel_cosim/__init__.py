@@ -1,0 +1,344 @@
+"""nigel_cosim: the nigel-fmi co-simulation master from Python, with fmpy's interface.
+
+- :func:`simulate_fmu` runs one FMU with fmpy's keywords and returns fmpy's structured
+  array (``time`` first).
+- :func:`simulate_ssp` runs an SSP system (its parameter bindings applied); fields are
+  named ``instance.variable`` as ``cosim run`` names its CSV columns.
+- :class:`System` loads an FMU or SSP once and runs it many times without unpacking it
+  again (its instances are reset between runs, not re-created).
+- :func:`run_campaign` runs a campaign description (a ``.toml`` path or a dict) and returns
+  its ``results.csv`` as a pandas DataFrame.
+- :func:`write_csv` writes a result as fmpy's ``write_csv`` does.
+
+Runs release the GIL (two Python threads run two simulations at once) and stop on Ctrl-C
+within a fraction of a second with ``KeyboardInterrupt``, their FMUs freed. Every error is a
+:class:`Error` (or one of its subclasses) carrying the master's message.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from . import _native
+from ._native import (
+    CampaignError,
+    Error,
+    ExperimentError,
+    LoadError,
+    RunTimeoutError,
+    SimulationError,
+    VariableError,
+)
+
+__version__ = _native.__version__
+
+__all__ = [
+    "simulate_fmu",
+    "simulate_ssp",
+    "System",
+    "run_campaign",
+    "write_csv",
+    "Error",
+    "LoadError",
+    "VariableError",
+    "SimulationError",
+    "ExperimentError",
+    "RunTimeoutError",
+    "CampaignError",
+]
+
+_DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
+
+# fmpy's names of the integrators, mapped onto the master's (Model Exchange)
+_SOLVERS = {None: "dopri5", "CVode": "dopri5", "dopri5": "dopri5", "rk4": "rk4", "Euler": None}
+
+
+def _auto_interval(t: float) -> float:
+    """fmpy's output interval for a run of length ``t``: 500 to 1000 points (fmpy.util)."""
+    h = 10 ** (np.round(np.log10(t)) - 3)
+    n = t / h
+    if n >= 2500:
+        h *= 5
+    elif n >= 2000:
+        h *= 4
+    elif n >= 1000:
+        h *= 2
+    elif n <= 200:
+        h /= 5
+    elif n <= 250:
+        h /= 4
+    elif n <= 500:
+        h /= 2
+    return float(h)
+
+
+def _text(value: Any) -> str:
+    """A start value as the master parses it (repr round-trips a float exactly)."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return str(value)
+
+
+def _input_table(signals: np.ndarray | None):
+    """fmpy's input (a structured array, time first) as (names, time, columns)."""
+    if signals is None:
+        return None
+    names = signals.dtype.names
+    if not names or len(names) < 2:
+        raise ExperimentError("input: a structured array with a time field first and one field per input")
+    return (
+        list(names[1:]),
+        [float(t) for t in signals[names[0]]],
+        [[float(v) for v in signals[n]] for n in names[1:]],
+    )
+
+
+def _structured(names: Sequence[str], types: Sequence[str], values: np.ndarray) -> np.ndarray:
+    dtype = [("time", np.float64)] + [(n, _DTYPES.get(t, np.float64)) for n, t in zip(names, types)]
+    result = np.empty(values.shape[0], dtype=dtype)
+    result["time"] = values[:, 0]
+    for j, n in enumerate(names):
+        result[n] = values[:, j + 1]
+    return result
+
+
+class System:
+    """An FMU (one instance named ``model``) or an SSP system, loaded and unpacked once.
+
+    Use it as a context manager, or call :meth:`close`, to free its FMUs and remove their
+    unpacked folders::
+
+        with nigel_cosim.System("target/ssp/nigel_closed_loop.ssp") as system:
+            for m in (2.4, 2.7, 3.0):
+                result = system.simulate(stop_time=30.0, step_size=1e-3, start_values={"plant.m": m})
+    """
+
+    def __init__(self, filename: str | os.PathLike, fmi_type: str | None = None):
+        self._native = _native.NativeSystem(os.fspath(filename), fmi_type)
+        self._filename = os.fspath(filename)
+        self._start_values: dict[str, Any] = {}
+        self.last_summary: dict | None = None
+
+    # -- context manager ---------------------------------------------------------------
+    def __enter__(self) -> "System":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Frees the FMUs and removes their unpacked folders."""
+        self._native.close()
+
+    @property
+    def closed(self) -> bool:
+        return self._native.closed
+
+    # -- what it is ----------------------------------------------------------------------
+    @property
+    def interfaces(self) -> list[str]:
+        """The interfaces of a single FMU (``CoSimulation``, ``ModelExchange``)."""
+        return list(self._native.interfaces)
+
+    @property
+    def default_experiment(self) -> dict[str, float | None]:
+        start, stop, step, tolerance = self._native.default_experiment
+        return {"start_time": start, "stop_time": stop, "step_size": step, "tolerance": tolerance}
+
+    def variables(self) -> list[dict[str, Any]]:
+        """Every variable: name, type, causality, variability, start (text), unit, description."""
+        keys = ("name", "type", "causality", "variability", "start", "unit", "description")
+        return [dict(zip(keys, v)) for v in self._native.variables()]
+
+    # -- start values ----------------------------------------------------------------------
+    def set(self, name: str, value: Any) -> None:
+        """Sets a start value or parameter for the following runs (checked at the next run)."""
+        self._start_values[name] = value
+
+    def get(self, name: str) -> Any:
+        """The start value set with :meth:`set`, else the model description's start value."""
+        if name in self._start_values:
+            return self._start_values[name]
+        for v in self._native.variables():
+            if v[0] == name:
+                return v[4]
+        raise VariableError(f"no variable {name!r}")
+
+    # -- runs ------------------------------------------------------------------------------
+    def simulate(
+        self,
+        start_time: float | None = None,
+        stop_time: float | None = None,
+        step_size: float | None = None,
+        output_interval: float | None = None,
+        algorithm: str = "jacobi",
+        start_values: Mapping[str, Any] | None = None,
+        input: np.ndarray | None = None,
+        output: Iterable[str] | None = None,
+        solver: str | None = None,
+        relative_tolerance: float | None = None,
+        timeout: float | None = None,
+        threads: int = 1,
+    ) -> np.ndarray:
+        """One run with the master's semantics: communication step ``step_size`` (default
+        the DefaultExperiment's, else 1 ms), every step recorded unless ``output_interval``
+        (a whole multiple of it) is given; returns a structured array, ``time`` first."""
+        d_start, d_stop, d_step, d_tol = self._native.default_experiment
+        start = float(start_time) if start_time is not None else (d_start if d_start is not None else 0.0)
+        stop = float(stop_time) if stop_time is not None else (d_stop if d_stop is not None else start + 1.0)
+        step = float(step_size) if step_size is not None else (d_step if d_step is not None else 1e-3)
+        tolerance = relative_tolerance if relative_tolerance is not None else d_tol
+        return self._run(start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance, timeout, threads)
+
+    def _run(self, start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance, timeout, threads):
+        if solver not in _SOLVERS:
+            raise ExperimentError(f"unknown solver {solver!r} (CVode, dopri5, rk4)")
+        if _SOLVERS[solver] is None:
+            raise ExperimentError(f"solver {solver!r} is not offered: use 'CVode' (dopri5 here) or 'rk4'")
+        values = dict(self._start_values)
+        values.update(start_values or {})
+        args = {
+            "start_time": start,
+            "stop_time": stop,
+            "step": step,
+            "output_interval": output_interval,
+            "algorithm": algorithm,
+            "start_values": [(k, _text(v)) for k, v in values.items()],
+            "input": _input_table(input),
+            "output": list(output) if output is not None else None,
+            "solver": _SOLVERS[solver],
+            "relative_tolerance": tolerance,
+            "timeout": timeout,
+            "threads": threads,
+        }
+        names, types, array, summary = self._native.simulate(_Args(args))
+        self.last_summary = json.loads(summary) if summary else None
+        return _structured(names, types, array)
+
+
+class _Args:
+    """The attribute view of the run's arguments the native half extracts."""
+
+    def __init__(self, values: dict):
+        self.__dict__.update(values)
+
+
+def simulate_fmu(
+    filename: str | os.PathLike,
+    start_time: float | None = None,
+    stop_time: float | None = None,
+    step_size: float | None = None,
+    output_interval: float | None = None,
+    fmi_type: str | None = None,
+    start_values: Mapping[str, Any] = {},
+    input: np.ndarray | None = None,
+    output: Iterable[str] | None = None,
+    solver: str | None = None,
+    relative_tolerance: float | None = None,
+    timeout: float | None = None,
+) -> np.ndarray:
+    """Simulates an FMU as ``fmpy.simulate_fmu`` does and returns its structured array.
+
+    The keywords mean what they mean in fmpy: ``stop_time`` defaults to the
+    DefaultExperiment's (else start + 1 s); Co-Simulation steps by ``output_interval``
+    (default: the DefaultExperiment's step size, doubled until at most 1000 steps, else
+    fmpy's automatic interval); Model Exchange integrates between output points
+    (``solver='CVode'``, fmpy's default, is this master's dopri5 with
+    ``relative_tolerance``, default 1e-5; ``'rk4'`` a fixed step of ``step_size``).
+    """
+    with System(filename, fmi_type) as system:
+        interface = fmi_type or system.interfaces[0]
+        d = system.default_experiment
+        start = float(start_time) if start_time is not None else (d["start_time"] if d["start_time"] is not None else 0.0)
+        stop = float(stop_time) if stop_time is not None else (d["stop_time"] if d["stop_time"] is not None else start + 1.0)
+        tolerance = relative_tolerance if relative_tolerance is not None else d["tolerance"]
+        total = stop - start
+        if output_interval is None and interface == "CoSimulation" and d["step_size"] is not None:
+            output_interval = float(d["step_size"])
+            while total / output_interval > 1000:
+                output_interval *= 2
+        if output_interval is None:
+            if step_size is None:
+                output_interval = _auto_interval(total) if total > 0 else 1e-3
+            else:
+                output_interval = float(step_size)
+                while total / output_interval > 1000:
+                    output_interval *= 2
+        return system._run(
+            start, stop, float(output_interval), None, "jacobi", start_values, input, output, solver, tolerance, timeout, 1
+        )
+
+
+def simulate_ssp(
+    filename: str | os.PathLike,
+    start_time: float | None = None,
+    stop_time: float | None = None,
+    step_size: float | None = None,
+    output_interval: float | None = None,
+    algorithm: str = "jacobi",
+    start_values: Mapping[str, Any] = {},
+    input: np.ndarray | None = None,
+    output: Iterable[str] | None = None,
+    timeout: float | None = None,
+) -> np.ndarray:
+    """Simulates an SSP system as ``cosim run`` does (its parameter bindings applied);
+    fields are named ``instance.variable``; the same numbers as the command line."""
+    with System(filename) as system:
+        return system.simulate(
+            start_time=start_time,
+            stop_time=stop_time,
+            step_size=step_size,
+            output_interval=output_interval,
+            algorithm=algorithm,
+            start_values=start_values,
+            input=input,
+            output=output,
+            timeout=timeout,
+        )
+
+
+def run_campaign(
+    spec: str | os.PathLike | Mapping[str, Any],
+    out: str | os.PathLike | None = None,
+    threads: int | None = None,
+    shard: tuple[int, int] | None = None,
+    progress: bool = False,
+):
+    """Runs a campaign (``campaign run``'s description: a ``.toml`` path or the same as a
+    dict) into the folder ``out`` (default: a new temporary folder) and returns its
+    ``results.csv`` as a pandas DataFrame (pandas is an optional dependency; without it,
+    a NumPy structured array). ``shard=(i, n)`` runs only block ``i`` of ``n``."""
+    import tempfile
+
+    if out is None:
+        out = tempfile.mkdtemp(prefix="nigel-campaign-")
+    if isinstance(spec, Mapping):
+        path, text = None, json.dumps(spec)
+    else:
+        path, text = os.fspath(spec), None
+    csv, _ran, _failed = _native.run_campaign(path, text, os.fspath(out), threads, shard, progress)
+    try:
+        import pandas
+    except ImportError:
+        return np.genfromtxt(csv, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    return pandas.read_csv(csv)
+
+
+def write_csv(filename: str | os.PathLike, result: np.ndarray, columns: Sequence[str] | None = None) -> None:
+    """Writes a structured result as ``fmpy.util.write_csv`` does: quoted names, ``time``
+    first, one row per point (floats as Python prints them: they read back exactly)."""
+    if columns is not None:
+        result = result[["time"] + list(columns)]
+    names = result.dtype.names
+    with open(filename, "w") as f:
+        f.write(",".join(f'"{n}"' for n in names) + "\n")
+        for row in result:
+            f.write(",".join(str(row[n]) for n in names) + "\n")

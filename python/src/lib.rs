@@ -1,0 +1,425 @@
+//! `nigel_cosim._native`: the Rust half of the Python package `nigel_cosim`.
+//!
+//! A thin layer over the `nigel-cosim` and `nigel-campaign` libraries: it loads an FMU or
+//! an SSP once ([`NativeSystem`]), runs experiments on it with the interpreter's lock
+//! released, and turns the master's errors into the package's exception classes. The
+//! fmpy-compatible keyword handling, the structured arrays and the DataFrame live in the
+//! Python half (`nigel_cosim/__init__.py`), where users can read them.
+//!
+//! A run happens on a worker thread while the calling thread waits without the GIL, waking
+//! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
+//! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
+
+use nigel_cosim::{
+    simulate::simulate_with, Error as CosimError, Experiment, Fmu, ImportOptions, InputTable,
+    InstancePool, Interface, Results, Solver, Summary, System, SystemBuilder,
+};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+create_exception!(nigel_cosim, Error, PyException, "Every error of nigel_cosim, with the master's message.");
+create_exception!(
+    nigel_cosim,
+    LoadError,
+    Error,
+    "An FMU or SSP could not be loaded: a missing or malformed file, a hostile archive, a missing binary."
+);
+create_exception!(
+    nigel_cosim,
+    VariableError,
+    Error,
+    "A variable or instance name that does not exist (with a suggestion), or a value it cannot take."
+);
+create_exception!(
+    nigel_cosim,
+    SimulationError,
+    Error,
+    "The run failed: an FMU returned an error, crashed in its host process, or an event iteration did not converge."
+);
+create_exception!(
+    nigel_cosim,
+    ExperimentError,
+    Error,
+    "The experiment cannot be run as given (times, step, output interval, solver)."
+);
+create_exception!(nigel_cosim, RunTimeoutError, Error, "The run took longer than its `timeout`.");
+create_exception!(nigel_cosim, CampaignError, Error, "A campaign description or its run failed.");
+
+/// The Python exception of a master error.
+fn to_py(e: CosimError) -> PyErr {
+    let message = e.to_string();
+    use CosimError as E;
+    match e {
+        E::Io { .. }
+        | E::NotRegularFile { .. }
+        | E::Archive { .. }
+        | E::UnsafeEntry { .. }
+        | E::ArchiveLimit { .. }
+        | E::ModelDescription { .. }
+        | E::NoInterface { .. }
+        | E::MissingBinary { .. }
+        | E::LoadLibrary { .. }
+        | E::MissingSymbol { .. }
+        | E::Ssp { .. } => LoadError::new_err(message),
+        E::UnknownVariable { .. }
+        | E::UnknownInstance { .. }
+        | E::NoInstance { .. }
+        | E::InvalidValue { .. }
+        | E::Connection { .. } => VariableError::new_err(message),
+        E::Timeout { .. } => RunTimeoutError::new_err(message),
+        E::Experiment(_) => ExperimentError::new_err(message),
+        _ => SimulationError::new_err(message),
+    }
+}
+
+/// An FMU (one instance called `model`) or an SSP system, loaded and unpacked once.
+#[pyclass(module = "nigel_cosim._native", frozen)]
+struct NativeSystem {
+    /// `None` once closed.
+    system: Mutex<Option<System>>,
+    /// Instances kept between runs (reset, not re-instantiated).
+    pool: Mutex<InstancePool>,
+    /// The name of the one instance of a single FMU (`None` for an SSP).
+    single: Option<String>,
+    /// DefaultExperiment: start, stop, step, tolerance.
+    default_experiment: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
+    /// `CoSimulation` / `ModelExchange` of each interface the (single) FMU offers.
+    interfaces: Vec<&'static str>,
+}
+
+const SINGLE: &str = "model";
+
+fn is_ssp(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
+}
+
+fn interface_name(i: Interface) -> &'static str {
+    match i {
+        Interface::CoSimulation => "CoSimulation",
+        Interface::ModelExchange => "ModelExchange",
+    }
+}
+
+/// The arguments of one run, resolved by the Python half.
+#[derive(FromPyObject)]
+struct RunArgs {
+    start_time: f64,
+    stop_time: f64,
+    step: f64,
+    output_interval: Option<f64>,
+    algorithm: String,
+    start_values: Vec<(String, String)>,
+    input: Option<(Vec<String>, Vec<f64>, Vec<Vec<f64>>)>,
+    output: Option<Vec<String>>,
+    solver: String,
+    relative_tolerance: Option<f64>,
+    timeout: Option<f64>,
+    threads: usize,
+}
+
+impl NativeSystem {
+    /// The system name of `name`: for a single FMU, `model.<name>`.
+    fn qualify(&self, name: &str) -> String {
+        match &self.single {
+            Some(instance) => format!("{instance}.{name}"),
+            None => name.to_string(),
+        }
+    }
+
+    fn experiment(&self, args: &RunArgs) -> Result<Experiment, CosimError> {
+        let mut experiment = Experiment::new(args.stop_time, args.step);
+        experiment.start_time = args.start_time;
+        experiment.output_interval = args.output_interval;
+        experiment.algorithm = args.algorithm.parse().map_err(CosimError::Experiment)?;
+        let rtol = args.relative_tolerance.unwrap_or(1e-5);
+        if !(rtol > 0.0 && rtol.is_finite()) {
+            return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
+        }
+        experiment.solver = match args.solver.as_str() {
+            "rk4" => Solver::Rk4 { max_step: None },
+            "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
+            other => {
+                return Err(CosimError::Experiment(format!("unknown solver {other:?} (rk4, dopri5)")));
+            }
+        };
+        if let Some((names, time, columns)) = &args.input {
+            experiment.input = Some(Arc::new(InputTable::new(names.clone(), time.clone(), columns.clone())?));
+        }
+        if let Some(output) = &args.output {
+            experiment.record = Some(output.iter().map(|n| self.qualify(n)).collect());
+        }
+        if let Some(t) = args.timeout {
+            experiment.timeout = Some(
+                Duration::try_from_secs_f64(t)
+                    .ok()
+                    .filter(|d| !d.is_zero())
+                    .ok_or_else(|| CosimError::Experiment(format!("timeout {t} must be a positive number of seconds")))?,
+            );
+        }
+        if args.threads == 0 {
+            return Err(CosimError::Experiment("threads must be at least 1".into()));
+        }
+        experiment.threads = args.threads;
+        Ok(experiment)
+    }
+}
+
+/// The base type name of each recorded column (`Real`, `Integer`, `Boolean`).
+fn column_types(system: &System, results: &Results, single: Option<&str>) -> Vec<&'static str> {
+    results
+        .names
+        .iter()
+        .map(|n| {
+            let full = match single {
+                Some(instance) => format!("{instance}.{n}"),
+                None => n.clone(),
+            };
+            system.resolve(&full).map(|r| r.base_type.as_str()).unwrap_or("Real")
+        })
+        .collect()
+}
+
+/// Runs `f` on a worker thread while this thread waits without the GIL, handling signals
+/// every 100 ms; on a Python exception (Ctrl-C) sets `cancel`, waits for the run to stop
+/// and returns the exception.
+fn interruptible<T: Send>(py: Python<'_>, cancel: &AtomicBool, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    std::thread::scope(|scope| {
+        let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+        // a Receiver is not Sync; the waits below borrow it from the GIL-free closures
+        let done_rx = Mutex::new(done_rx);
+        let worker = scope.spawn(move || {
+            let out = f();
+            let _ = done_tx.send(());
+            out
+        });
+        loop {
+            let finished = py.detach(|| {
+                let rx = done_rx.lock().unwrap_or_else(|p| p.into_inner());
+                rx.recv_timeout(Duration::from_millis(100)).is_ok() || worker.is_finished()
+            });
+            if finished {
+                break;
+            }
+            if let Err(e) = py.check_signals() {
+                cancel.store(true, Ordering::Relaxed);
+                let _ = py.detach(|| worker.join());
+                return Err(e);
+            }
+        }
+        py.detach(|| worker.join()).map_err(|_| SimulationError::new_err("the run panicked (a defect of nigel_cosim)"))
+    })
+}
+
+#[pymethods]
+impl NativeSystem {
+    /// Loads an `.fmu` (as one instance named `model`) or an `.ssp`/`.ssd`.
+    #[new]
+    #[pyo3(signature = (filename, fmi_type=None))]
+    fn new(py: Python<'_>, filename: PathBuf, fmi_type: Option<&str>) -> PyResult<NativeSystem> {
+        let interface = match fmi_type {
+            None => None,
+            Some("CoSimulation") => Some(Interface::CoSimulation),
+            Some("ModelExchange") => Some(Interface::ModelExchange),
+            Some(other) => {
+                return Err(PyValueError::new_err(format!(
+                    "fmi_type must be 'CoSimulation' or 'ModelExchange', not {other:?}"
+                )))
+            }
+        };
+        let options = ImportOptions { interface, ..ImportOptions::default() };
+        py.detach(|| {
+            if is_ssp(&filename) {
+                let ssp = nigel_cosim::read_ssp(&filename, &options)?;
+                let (start, stop) = ssp.default_start_stop;
+                Ok(NativeSystem {
+                    system: Mutex::new(Some(ssp.system)),
+                    pool: Mutex::new(InstancePool::new()),
+                    single: None,
+                    default_experiment: (start, stop, None, None),
+                    interfaces: Vec::new(),
+                })
+            } else {
+                let fmu = Fmu::load_with(&filename, &options)?;
+                let d = fmu.description().default_experiment.clone().unwrap_or_default();
+                let md = fmu.description();
+                let mut interfaces = Vec::new();
+                if md.co_simulation.is_some() {
+                    interfaces.push(interface_name(Interface::CoSimulation));
+                }
+                if md.model_exchange.is_some() {
+                    interfaces.push(interface_name(Interface::ModelExchange));
+                }
+                let interfaces = match interface {
+                    Some(i) => vec![interface_name(i)],
+                    None => interfaces,
+                };
+                let system = System::single(SINGLE, fmu.clone())?;
+                Ok(NativeSystem {
+                    system: Mutex::new(Some(system)),
+                    pool: Mutex::new(InstancePool::new()),
+                    single: Some(SINGLE.to_string()),
+                    default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
+                    interfaces,
+                })
+            }
+        })
+        .map_err(to_py)
+    }
+
+    /// (start, stop, step, tolerance) of the DefaultExperiment, each None when absent.
+    #[getter]
+    fn default_experiment(&self) -> (Option<f64>, Option<f64>, Option<f64>, Option<f64>) {
+        self.default_experiment
+    }
+
+    /// The interfaces a single FMU is run with (`CoSimulation` first), empty for an SSP.
+    #[getter]
+    fn interfaces(&self) -> Vec<&'static str> {
+        self.interfaces.clone()
+    }
+
+    /// One tuple per variable: (name, type, causality, variability, start as text or None,
+    /// unit or None, description or None); names are `instance.variable` for an SSP.
+    fn variables(&self) -> PyResult<Vec<(String, String, String, String, Option<String>, Option<String>, Option<String>)>> {
+        let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
+        let system = guard.as_ref().ok_or_else(|| Error::new_err("the system is closed"))?;
+        let mut out = Vec::new();
+        for spec in &system.instances {
+            let md = spec.fmu.description();
+            for v in &md.model_variables {
+                let name = if self.single.is_some() { v.name.clone() } else { format!("{}.{}", spec.name, v.name) };
+                let start = match &v.variable_type {
+                    model_description::VariableType::Real { start, .. } => start.map(|x| format!("{x:?}")),
+                    model_description::VariableType::Integer { start, .. }
+                    | model_description::VariableType::Enumeration { start, .. } => start.map(|x| x.to_string()),
+                    model_description::VariableType::Boolean { start } => start.map(|x| x.to_string()),
+                    model_description::VariableType::String { start } => start.clone(),
+                };
+                out.push((
+                    name,
+                    v.variable_type.type_name().to_string(),
+                    v.causality.as_str().to_string(),
+                    v.variability.as_str().to_string(),
+                    start,
+                    v.variable_type.unit().map(str::to_string),
+                    v.description.clone(),
+                ));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Runs one experiment; returns (column names, column types, values as a rows x
+    /// (1 + columns) float64 array with time first, the run's summary as JSON text).
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        args: RunArgs,
+    ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String)> {
+        let system = {
+            let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
+            guard.clone().ok_or_else(|| Error::new_err("the system is closed"))?
+        };
+        let mut builder = SystemBuilder::from_system(system);
+        for (name, value) in &args.start_values {
+            builder.set_text(&self.qualify(name), value).map_err(to_py)?;
+        }
+        let system = builder.build();
+        let mut experiment = self.experiment(&args).map_err(to_py)?;
+        let cancel = Arc::new(AtomicBool::new(false));
+        experiment.cancel = Some(cancel.clone());
+        let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
+            let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
+            simulate_with(&system, &experiment, Some(&mut pool), None)
+        })?;
+        let (results, summary) = outcome.map_err(to_py)?;
+        let types = column_types(&system, &results, self.single.as_deref());
+        let (rows, width) = (results.rows(), results.width());
+        let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
+        let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
+        Ok((results.names, types, array.into_any(), json))
+    }
+
+    /// Frees the instances and the FMUs, removing their unpacked folders; the object cannot
+    /// run again.
+    fn close(&self) {
+        *self.pool.lock().unwrap_or_else(|p| p.into_inner()) = InstancePool::new();
+        *self.system.lock().unwrap_or_else(|p| p.into_inner()) = None;
+    }
+
+    /// Whether `close` was called.
+    #[getter]
+    fn closed(&self) -> bool {
+        self.system.lock().unwrap_or_else(|p| p.into_inner()).is_none()
+    }
+}
+
+/// Runs a campaign into `out`: `spec` is the description's `.toml` path, or `spec_json`
+/// the description as JSON text (a dict from Python, relative paths from the current
+/// folder). Returns (results.csv path, runs, failed runs). The runs are threads of this
+/// process (`threads`, default all cores); failed runs are rows with their status.
+#[pyfunction]
+#[pyo3(signature = (spec, spec_json, out, threads=None, shard=None, progress=false))]
+fn run_campaign(
+    py: Python<'_>,
+    spec: Option<PathBuf>,
+    spec_json: Option<String>,
+    out: PathBuf,
+    threads: Option<usize>,
+    shard: Option<(u64, u64)>,
+    progress: bool,
+) -> PyResult<(PathBuf, u64, u64)> {
+    let campaign_error = |e: nigel_campaign::Error| CampaignError::new_err(e.to_string());
+    // a description given as a dict: the same TOML a user would write, in a temporary file
+    let written;
+    let path = match (spec, spec_json) {
+        (Some(path), None) => path,
+        (None, Some(json)) => {
+            let value: serde_json::Value =
+                serde_json::from_str(&json).map_err(|e| CampaignError::new_err(format!("the description: {e}")))?;
+            let table = toml::Table::try_from(value)
+                .map_err(|e| CampaignError::new_err(format!("the description is not a TOML table: {e}")))?;
+            let mut file = tempfile::Builder::new()
+                .prefix("nigel-campaign-")
+                .suffix(".toml")
+                .tempfile_in(".")
+                .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;
+            std::io::Write::write_all(&mut file, table.to_string().as_bytes())
+                .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;
+            written = file;
+            written.path().to_path_buf()
+        }
+        _ => return Err(PyValueError::new_err("give either a description path or a dict")),
+    };
+    let spec = nigel_campaign::spec::Spec::load(&path).map_err(campaign_error)?;
+    let mut options = nigel_campaign::run::Options::new(out.clone());
+    options.threads = threads;
+    options.shard = shard;
+    options.progress = progress;
+    options.allow_failures = true;
+    let cancel = AtomicBool::new(false);
+    let done = interruptible(py, &cancel, || nigel_campaign::run::run(&spec, &options))?.map_err(campaign_error)?;
+    Ok((out.join("results.csv"), done.ran, done.failed))
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<NativeSystem>()?;
+    m.add_function(wrap_pyfunction!(run_campaign, m)?)?;
+    m.add("Error", py.get_type::<Error>())?;
+    m.add("LoadError", py.get_type::<LoadError>())?;
+    m.add("VariableError", py.get_type::<VariableError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add("ExperimentError", py.get_type::<ExperimentError>())?;
+    m.add("RunTimeoutError", py.get_type::<RunTimeoutError>())?;
+    m.add("CampaignError", py.get_type::<CampaignError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
