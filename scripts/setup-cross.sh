@@ -13,6 +13,8 @@
 #   libc6-dev-arm64-cross build the tests' C importer, qemu-user runs it;
 # - darwin64: cargo-zigbuild with -Zbuild-std (rust-web-src) for x86_64 and arm64,
 #   llvm-lipo (llvm-22) joins them into one universal dylib.
+# - the Python wheel (scripts/python-wheel.sh): maturin (PyPI) with the same zig, for
+#   manylinux2014 (glibc 2.17) as the FMUs' linux64 libraries.
 # The PyPI tools go into "$TARGET/cross-venv" (TARGET is $CARGO_TARGET_DIR or <repo>/target).
 # Measured on Debian 12: 87 Debian packages, 2.2 GiB installed, plus 0.44 GiB for the venv;
 # about 3 minutes. A run with everything present takes about a second.
@@ -54,7 +56,7 @@ fi
 
 # The PyPI tools, pinned; a marker holding the pins skips pip when they match.
 venv="$target/cross-venv"
-pins="cargo-zigbuild==0.24.0 ziglang==0.17.0"
+pins="cargo-zigbuild==0.24.0 ziglang==0.17.0 maturin==1.16.0"
 if [ "$(cat "$venv/.pins" 2>/dev/null)" != "$pins" ]; then
     echo "setup-cross: installing $pins into $venv" >&2
     python3 -m venv "$venv"
