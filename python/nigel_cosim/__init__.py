@@ -321,7 +321,7 @@ def run_campaign(
     if out is None:
         out = tempfile.mkdtemp(prefix="nigel-campaign-")
     if isinstance(spec, Mapping):
-        path, text = None, json.dumps(spec)
+        path, text = None, _toml(spec)
     else:
         path, text = os.fspath(spec), None
     csv, _ran, _failed = _native.run_campaign(path, text, os.fspath(out), threads, shard, progress)
@@ -330,6 +330,38 @@ def run_campaign(
     except ImportError:
         return np.genfromtxt(csv, delimiter=",", names=True, dtype=None, encoding="utf-8")
     return pandas.read_csv(csv)
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        v = float(v)
+        if v != v:
+            return "nan"
+        if v in (float("inf"), float("-inf")):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, (str, os.PathLike)):
+        return json.dumps(os.fspath(v))  # a JSON string is a TOML basic string
+    if isinstance(v, Mapping):
+        return "{ " + ", ".join(f"{json.dumps(str(k))} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise CampaignError(f"the description: {v!r} has no TOML form")
+
+
+def _toml(spec: Mapping[str, Any]) -> str:
+    """A campaign description (a dict, in the order given) as the TOML ``campaign run``
+    reads: scalars and lists first, then one table per dict."""
+    lines = [f"{json.dumps(str(k))} = {_toml_value(v)}" for k, v in spec.items() if not isinstance(v, Mapping)]
+    for k, table in spec.items():
+        if isinstance(table, Mapping):
+            lines.append(f"[{json.dumps(str(k))}]")
+            lines += [f"{json.dumps(str(n))} = {_toml_value(v)}" for n, v in table.items()]
+    return "\n".join(lines) + "\n"
 
 
 def write_csv(filename: str | os.PathLike, result: np.ndarray, columns: Sequence[str] | None = None) -> None:

@@ -31,7 +31,7 @@ class NativeSystem:
 
 def run_campaign(
     spec: str | None,
-    spec_json: str | None,
+    spec_text: str | None,
     out: str,
     threads: int | None = None,
     shard: tuple[int, int] | None = None,

@@ -360,16 +360,16 @@ impl NativeSystem {
     }
 }
 
-/// Runs a campaign into `out`: `spec` is the description's `.toml` path, or `spec_json`
-/// the description as JSON text (a dict from Python, relative paths from the current
-/// folder). Returns (results.csv path, runs, failed runs). The runs are threads of this
+/// Runs a campaign into `out`: `spec` is the description's `.toml` path, or `spec_text`
+/// the description's TOML text (a dict from Python, written by the Python half in its
+/// order; relative paths from the current folder). Returns (results.csv path, runs, failed runs). The runs are threads of this
 /// process (`threads`, default all cores); failed runs are rows with their status.
 #[pyfunction]
-#[pyo3(signature = (spec, spec_json, out, threads=None, shard=None, progress=false))]
+#[pyo3(signature = (spec, spec_text, out, threads=None, shard=None, progress=false))]
 fn run_campaign(
     py: Python<'_>,
     spec: Option<PathBuf>,
-    spec_json: Option<String>,
+    spec_text: Option<String>,
     out: PathBuf,
     threads: Option<usize>,
     shard: Option<(u64, u64)>,
@@ -378,19 +378,15 @@ fn run_campaign(
     let campaign_error = |e: nigel_campaign::Error| CampaignError::new_err(e.to_string());
     // a description given as a dict: the same TOML a user would write, in a temporary file
     let written;
-    let path = match (spec, spec_json) {
+    let path = match (spec, spec_text) {
         (Some(path), None) => path,
-        (None, Some(json)) => {
-            let value: serde_json::Value =
-                serde_json::from_str(&json).map_err(|e| CampaignError::new_err(format!("the description: {e}")))?;
-            let table = toml::Table::try_from(value)
-                .map_err(|e| CampaignError::new_err(format!("the description is not a TOML table: {e}")))?;
+        (None, Some(text)) => {
             let mut file = tempfile::Builder::new()
                 .prefix("nigel-campaign-")
                 .suffix(".toml")
                 .tempfile_in(".")
                 .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;
-            std::io::Write::write_all(&mut file, table.to_string().as_bytes())
+            std::io::Write::write_all(&mut file, text.as_bytes())
                 .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;
             written = file;
             written.path().to_path_buf()

@@ -1,0 +1,215 @@
+"""nigel_cosim, the wheel as a user installs it, against fmpy, the `cosim` and `campaign`
+command lines, and itself in threads and under Ctrl-C.
+
+Run by scripts/test-python-package.sh in a fresh venv holding only the wheel and the
+test's own dependencies (fmpy, pandas, pytest)."""
+
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pandas
+import pytest
+
+import nigel_cosim
+
+REPO = Path(__file__).resolve().parents[2]
+TARGET = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
+if not TARGET.is_absolute():
+    TARGET = REPO / TARGET
+FMU = TARGET / "fmu"
+SSP = TARGET / "ssp" / "nigel_closed_loop.ssp"
+BIN = Path(os.environ.get("NIGEL_BIN_DIR", TARGET / "release"))
+COSIM = BIN / "cosim"
+CAMPAIGN = BIN / "campaign"
+
+
+def read_cli_csv(path):
+    """The CLI's CSV (fmpy's format: quoted names, shortest round-trip floats)."""
+    return np.genfromtxt(path, delimiter=",", names=True, deletechars="", dtype=np.float64)
+
+
+@pytest.mark.parametrize("name", ["nigel_plant", "nigel_controller", "nigel_maneuver"])
+def test_simulate_fmu_is_fmpy_bit_for_bit_in_co_simulation(name):
+    # fmpy's defaults (stop time, output interval from the DefaultExperiment) and ours agree
+    ours = nigel_cosim.simulate_fmu(FMU / f"{name}.fmu")
+    theirs = fmpy.simulate_fmu(str(FMU / f"{name}.fmu"))
+    assert ours.dtype.names == theirs.dtype.names
+    assert len(ours) == len(theirs) > 100
+    for field in theirs.dtype.names:
+        assert ours.dtype[field] == theirs.dtype[field], field
+        assert np.array_equal(ours[field], theirs[field]), field
+
+
+def test_simulate_fmu_start_values_output_and_step_as_fmpy():
+    kwargs = dict(stop_time=3.0, output_interval=2e-3, start_values={"m": 2.6, "v_x_start": 1.5}, output=["x", "v_x", "yaw_rate"])
+    ours = nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", **kwargs)
+    theirs = fmpy.simulate_fmu(str(FMU / "nigel_plant.fmu"), **kwargs)
+    assert ours.dtype.names == ("time", "x", "v_x", "yaw_rate") == theirs.dtype.names
+    assert len(ours) == 1501
+    for field in theirs.dtype.names:
+        assert np.array_equal(ours[field], theirs[field]), field
+    # and the start value changed the run (not a run at the defaults)
+    default = nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", stop_time=3.0, output_interval=2e-3, output=["v_x"])
+    assert not np.array_equal(default["v_x"], ours["v_x"])
+
+
+def test_simulate_fmu_input_as_fmpy():
+    # fmpy's input: a structured array, time first; a step of the steering input at 1 s
+    signals = np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 0.2), (3.0, 0.2)], dtype=[("time", float), ("delta_fl", float)])
+    kwargs = dict(stop_time=3.0, input=signals, output=["yaw_rate"], start_values={"v_x_start": 1.5})
+    ours = nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", **kwargs)
+    theirs = fmpy.simulate_fmu(str(FMU / "nigel_plant.fmu"), **kwargs)
+    assert np.max(np.abs(theirs["yaw_rate"])) > 0.1  # the input acted
+    assert np.array_equal(ours["yaw_rate"], theirs["yaw_rate"])
+
+
+def test_simulate_ssp_is_the_command_line_bit_for_bit(tmp_path):
+    csv = tmp_path / "cli.csv"
+    subprocess.run(
+        [COSIM, "run", SSP, "--stop-time", "5", "--step", "1e-3", "--algorithm", "ordered", "--output", csv],
+        check=True,
+        capture_output=True,
+    )
+    cli = read_cli_csv(csv)
+    ours = nigel_cosim.simulate_ssp(SSP, stop_time=5.0, step_size=1e-3, algorithm="ordered")
+    assert ours.dtype.names == cli.dtype.names
+    assert "plant.x" in ours.dtype.names and len(ours) == 5001
+    for field in cli.dtype.names:
+        assert np.array_equal(ours[field].astype(np.float64), cli[field]), field
+
+
+def test_a_system_runs_many_times_from_one_load_as_separate_runs():
+    masses = [2.4, 2.7, 3.0]
+    with nigel_cosim.System(SSP) as system:
+        reused = [
+            system.simulate(stop_time=2.0, step_size=1e-3, start_values={"plant.m": m}, output=["plant.y"])["plant.y"]
+            for m in masses
+        ]
+    assert system.closed
+    with pytest.raises(nigel_cosim.Error, match="closed"):
+        system.simulate(stop_time=1.0)
+    for m, y in zip(masses, reused):
+        fresh = nigel_cosim.simulate_ssp(SSP, stop_time=2.0, step_size=1e-3, start_values={"plant.m": m}, output=["plant.y"])
+        assert np.array_equal(fresh["plant.y"], y)
+    assert not np.array_equal(reused[0], reused[2])
+
+
+def test_errors_carry_the_masters_messages():
+    with pytest.raises(nigel_cosim.VariableError, match='did you mean "m"'):
+        nigel_cosim.simulate_ssp(SSP, stop_time=0.1, start_values={"plant.mm": 3.0})
+    with pytest.raises(nigel_cosim.LoadError, match="no_such.fmu"):
+        nigel_cosim.simulate_fmu("no_such.fmu")
+    with pytest.raises(nigel_cosim.SimulationError, match="m = -1 refused: below its minimum"):
+        nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", stop_time=0.1, start_values={"m": -1.0})
+    with pytest.raises(nigel_cosim.ExperimentError):
+        nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", stop_time=0.1, solver="Euler", fmi_type="ModelExchange")
+    assert issubclass(nigel_cosim.LoadError, nigel_cosim.Error)
+    assert issubclass(nigel_cosim.Error, Exception)
+
+
+def test_runs_release_the_gil_two_threads_overlap():
+    # each thread notes when its run started and ended; with the GIL held for a whole run
+    # the second could not start before the first ended
+    spans = {}
+
+    def run(key):
+        t0 = time.perf_counter()
+        nigel_cosim.simulate_ssp(SSP, stop_time=10.0, step_size=1e-3, output=["plant.x"])
+        spans[key] = (t0, time.perf_counter())
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    (a0, a1), (b0, b1) = spans[0], spans[1]
+    assert a0 < b1 and b0 < a1, spans
+
+
+def test_ctrl_c_raises_keyboard_interrupt_and_leaves_no_folder(tmp_path):
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    script = textwrap.dedent(
+        f"""
+        import sys, time, nigel_cosim
+        print("started", flush=True)
+        try:
+            with nigel_cosim.System({str(FMU / "nigel_plant.fmu")!r}) as system:
+                system.simulate(stop_time=1e6, step_size=1e-3, output=["x"])
+        except KeyboardInterrupt:
+            print("interrupted", time.monotonic(), flush=True)
+            sys.exit(7)
+        """
+    )
+    env = dict(os.environ, TMPDIR=str(scratch))
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(1.0)  # inside the run: loading the SSP takes well under this
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 7, out
+    latency = float(out.split()[1]) - sent
+    # the run stops at its next step and waits at most 100 ms between signal checks; 5 s
+    # only bounds a loaded machine, the latency is printed for the record
+    print(f"KeyboardInterrupt {latency:.3f} s after SIGINT")
+    assert latency < 5.0
+    assert list(scratch.iterdir()) == []
+
+
+def test_run_campaign_returns_the_command_lines_results(tmp_path):
+    spec = {
+        "system": str(SSP),
+        "stop_time": 2.0,
+        "step": 1e-3,
+        "algorithm": "ordered",
+        "seed": 3,
+        "samples": 2,
+        "grid": {"maneuver.maneuver": [2, 3]},
+        "random": {"plant.m": {"uniform": [2.4, 3.0]}},
+        "metrics": {"y_final": "final(plant.y)", "max_delta": "max_abs(controller.delta_fl)"},
+    }
+    toml = tmp_path / "spec.toml"
+    toml.write_text(
+        textwrap.dedent(
+            f"""
+            system = "{SSP}"
+            stop_time = 2.0
+            step = 1e-3
+            algorithm = "ordered"
+            seed = 3
+            samples = 2
+            [grid]
+            "maneuver.maneuver" = [2, 3]
+            [random]
+            "plant.m" = {{ uniform = [2.4, 3.0] }}
+            [metrics]
+            y_final = "final(plant.y)"
+            max_delta = "max_abs(controller.delta_fl)"
+            """
+        )
+    )
+    subprocess.run([CAMPAIGN, "run", toml, "--out", tmp_path / "cli", "--in-process"], check=True, capture_output=True)
+    cli = pandas.read_csv(tmp_path / "cli" / "results.csv")
+    ours = nigel_cosim.run_campaign(spec, out=tmp_path / "py", threads=2)
+    assert list(ours.columns) == list(cli.columns)
+    assert len(ours) == 4
+    pandas.testing.assert_frame_equal(ours.drop(columns=[c for c in ours.columns if "time" in c.lower() and "wall" in c.lower()]),
+                                      cli.drop(columns=[c for c in cli.columns if "time" in c.lower() and "wall" in c.lower()]))
+
+
+def test_write_csv_is_fmpys(tmp_path):
+    result = nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", stop_time=0.5, output=["x", "v_x"])
+    ours, theirs = tmp_path / "ours.csv", tmp_path / "theirs.csv"
+    nigel_cosim.write_csv(ours, result)
+    fmpy.util.write_csv(str(theirs), result)
+    assert ours.read_text() == theirs.read_text()
