@@ -41,5 +41,7 @@ echo "== examples (each prints what its header says; checked against table3)"
 "$target_dir/venv/bin/python" -m pytest examples -q
 echo "== campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
+echo "== the Python package: its wheel in a fresh venv, against fmpy and the command lines"
+bash scripts/test-python-package.sh
 echo "== campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh

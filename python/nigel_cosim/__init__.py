@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
@@ -102,12 +103,14 @@ def _input_table(signals: np.ndarray | None):
 
 
 def _structured(names: Sequence[str], types: Sequence[str], values: np.ndarray) -> np.ndarray:
-    dtype = [("time", np.float64)] + [(n, _DTYPES.get(t, np.float64)) for n, t in zip(names, types)]
-    result = np.empty(values.shape[0], dtype=dtype)
-    result["time"] = values[:, 0]
-    for j, n in enumerate(names):
-        result[n] = values[:, j + 1]
-    return result
+    """fmpy's structured array from the native rows (float64, time first): a view of the
+    rows as float64 fields, cast field by field where a column is Integer or Boolean."""
+    rows = np.ascontiguousarray(values, dtype=np.float64)
+    fields = ["time", *names]
+    as_float = np.dtype([(n, np.float64) for n in fields])
+    result = rows.view(as_float).reshape(rows.shape[0])
+    wanted = np.dtype([("time", np.float64)] + [(n, _DTYPES.get(t, np.float64)) for n, t in zip(names, types)])
+    return result if wanted == as_float else result.astype(wanted)
 
 
 class System:
@@ -313,13 +316,14 @@ def run_campaign(
     progress: bool = False,
 ):
     """Runs a campaign (``campaign run``'s description: a ``.toml`` path or the same as a
-    dict) into the folder ``out`` (default: a new temporary folder) and returns its
+    dict) into the folder ``out`` (default: a temporary folder, removed afterwards) and returns its
     ``results.csv`` as a pandas DataFrame (pandas is an optional dependency; without it,
     a NumPy structured array). ``shard=(i, n)`` runs only block ``i`` of ``n``."""
     import tempfile
 
     if out is None:
-        out = tempfile.mkdtemp(prefix="nigel-campaign-")
+        with tempfile.TemporaryDirectory(prefix="nigel-campaign-") as scratch:
+            return run_campaign(spec, Path(scratch) / "out", threads, shard, progress)
     if isinstance(spec, Mapping):
         path, text = None, _toml(spec)
     else:

@@ -362,7 +362,7 @@ impl NativeSystem {
 
 /// Runs a campaign into `out`: `spec` is the description's `.toml` path, or `spec_text`
 /// the description's TOML text (a dict from Python, written by the Python half in its
-/// order; relative paths from the current folder). Returns (results.csv path, runs, failed runs). The runs are threads of this
+/// order, into a temporary file; relative paths from the current folder, as for a file). Returns (results.csv path, runs, failed runs). The runs are threads of this
 /// process (`threads`, default all cores); failed runs are rows with their status.
 #[pyfunction]
 #[pyo3(signature = (spec, spec_text, out, threads=None, shard=None, progress=false))]
@@ -384,7 +384,7 @@ fn run_campaign(
             let mut file = tempfile::Builder::new()
                 .prefix("nigel-campaign-")
                 .suffix(".toml")
-                .tempfile_in(".")
+                .tempfile()
                 .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;
             std::io::Write::write_all(&mut file, text.as_bytes())
                 .map_err(|e| CampaignError::new_err(format!("writing the description: {e}")))?;

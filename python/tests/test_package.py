@@ -213,3 +213,22 @@ def test_write_csv_is_fmpys(tmp_path):
     nigel_cosim.write_csv(ours, result)
     fmpy.util.write_csv(str(theirs), result)
     assert ours.read_text() == theirs.read_text()
+
+
+def test_the_example_prints_tables_epsilon_and_writes_its_figure(tmp_path):
+    # the same closed loop as examples/closed_loop_fmpy.py prints (fmpy's loop, by hand):
+    # the same FMUs, steps and order, so the same numbers to the rounding of the RMSE sums
+    # and as table3 computes it (the FMUs in the master's own loop): checked at the printed
+    # 10 digits, far coarser than the rounding of 30,000 squared errors summed in another order
+    subprocess.run([BIN / "table3", "--quiet", "--maneuver", "lane_change", "--controller", "robust",
+                    "--json", tmp_path / "t.json"], check=True, capture_output=True)
+    import json
+    want = json.loads((tmp_path / "t.json").read_text())["results"]["sim"]["lane_change"]["robust"]["eps"]
+    png = tmp_path / "python_cosim.png"
+    r = subprocess.run([sys.executable, str(REPO / "examples" / "python_cosim.py"), str(png)],
+                       capture_output=True, text=True, check=True, cwd=REPO)
+    assert f"epsilon {want:.9e} (RMSE" in r.stdout, (want, r.stdout)
+    masses = [float(line.split()[-1]) for line in r.stdout.splitlines() if line.startswith("mass ")]
+    assert len(masses) == 3 and masses[0] < masses[1] < masses[2]  # heavier, larger tracking error
+    assert "campaign: 8 runs" in r.stdout
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
