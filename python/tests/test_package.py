@@ -232,3 +232,33 @@ def test_the_example_prints_tables_epsilon_and_writes_its_figure(tmp_path):
     assert len(masses) == 3 and masses[0] < masses[1] < masses[2]  # heavier, larger tracking error
     assert "campaign: 8 runs" in r.stdout
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def stair_fmu(tmp_path_factory):
+    """A small FMU of our own (cosim/tests/cfmu/stair.c, after the Reference FMU Stair): a
+    counter 1 .. 10 stepped every 1 s that ends the run at t = 9 s."""
+    import zipfile
+
+    cfmu = REPO / "cosim" / "tests" / "cfmu"
+    d = tmp_path_factory.mktemp("stair")
+    so = d / "stair.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", str(cfmu / "stair.c"), "-o", str(so)], check=True)
+    fmu = d / "stair.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.write(cfmu / "stair.xml", "modelDescription.xml")
+        z.write(so, "binaries/linux64/stair.so")
+    return fmu
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"output_interval": 0.1}, {"stop_time": 5.0}])
+def test_simulate_fmu_is_fmpy_on_a_small_fmu_that_ends_its_run(stair_fmu, kwargs):
+    ours = nigel_cosim.simulate_fmu(stair_fmu, **kwargs)
+    theirs = fmpy.simulate_fmu(str(stair_fmu), **kwargs)
+    assert ours.dtype == theirs.dtype
+    # fmpy computes the points as start + n * h, the master as t0 + n h: the same numbers
+    assert np.array_equal(ours["time"], theirs["time"])
+    assert np.array_equal(ours["counter"], theirs["counter"])
+    # the FMU ended the default run at 9 s (the row at its last successful time), else it
+    # ran to the stop time
+    assert ours["time"][-1] == kwargs.get("stop_time", 9.0)
