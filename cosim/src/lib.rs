@@ -48,7 +48,7 @@ pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
 pub use me::{Event, Solver};
 pub use simulate::{
-    simulate, simulate_with, Algorithm, Experiment, InputTable, InstancePool, Results, RowSink, Summary,
+    simulate, simulate_with, Algorithm, Experiment, InputTable, InstancePool, Results, RowSink, SetQueue, Summary,
 };
 pub use ssp::{read_ssp, write_ssp, SspSystem};
 pub use system::{BaseType, Connection, System, SystemBuilder, Value, VariableRef};

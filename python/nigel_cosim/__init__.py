@@ -128,6 +128,9 @@ class System:
         self._native = _native.NativeSystem(os.fspath(filename), fmi_type)
         self._filename = os.fspath(filename)
         self._start_values: dict[str, Any] = {}
+        self._run = None
+        self._step = 1e-3
+        self._output_interval = None
         self.last_summary: dict | None = None
 
     # -- context manager ---------------------------------------------------------------
@@ -138,7 +141,9 @@ class System:
         self.close()
 
     def close(self) -> None:
-        """Frees the FMUs and removes their unpacked folders."""
+        """Ends a stepped run, frees the FMUs and removes their unpacked folders."""
+        self.terminate()
+        self._run = None
         self._native.close()
 
     @property
@@ -161,19 +166,82 @@ class System:
         keys = ("name", "type", "causality", "variability", "start", "unit", "description")
         return [dict(zip(keys, v)) for v in self._native.variables()]
 
-    # -- start values ----------------------------------------------------------------------
+    # -- values ----------------------------------------------------------------------------
     def set(self, name: str, value: Any) -> None:
-        """Sets a start value or parameter for the following runs (checked at the next run)."""
-        self._start_values[name] = value
+        """Before :meth:`initialize` (or between runs): a start value or parameter for the
+        following runs, checked at the next run. During a stepped run: an input or tunable
+        parameter, checked now and applied from the next communication step on."""
+        if self._run is not None and not self._run.finished:
+            self._run.set(name, _text(value))
+        else:
+            self._start_values[name] = value
 
     def get(self, name: str) -> Any:
-        """The start value set with :meth:`set`, else the model description's start value."""
+        """During a stepped run: the recorded value at the current time. Otherwise the start
+        value set with :meth:`set`, else the model description's (as text)."""
+        if self._run is not None:
+            return self._run.get(name)
         if name in self._start_values:
             return self._start_values[name]
         for v in self._native.variables():
             if v[0] == name:
                 return v[4]
         raise VariableError(f"no variable {name!r}")
+
+    # -- a run stepped from here -------------------------------------------------------------
+    def initialize(
+        self,
+        start_time: float | None = None,
+        stop_time: float | None = None,
+        step_size: float | None = None,
+        output_interval: float | None = None,
+        algorithm: str = "jacobi",
+        start_values: Mapping[str, Any] | None = None,
+        input: np.ndarray | None = None,
+        output: Iterable[str] | None = None,
+        solver: str | None = None,
+        relative_tolerance: float | None = None,
+    ) -> float:
+        """Instantiates and initializes a run to be stepped with :meth:`step` and
+        :meth:`step_until` (the same keywords as :meth:`simulate`); returns the start time.
+        :meth:`get` reads the recorded variables (``output``, default every output)."""
+        self.terminate()
+        args = self._args(start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output,
+                          solver, relative_tolerance, None, 1)
+        self._step = args["step"]
+        self._run = self._native.start(_Args(args))
+        return self._run.time
+
+    @property
+    def time(self) -> float:
+        """The time of the stepped run's last row (``nan`` when there is no run)."""
+        return self._run.time if self._run is not None else float("nan")
+
+    def step(self) -> float:
+        """One communication step (one output interval); returns the time reached."""
+        return self.step_until(self.time + (self._output_interval or self._step) * 0.5)
+
+    def step_until(self, time: float) -> float:
+        """Runs on to the first output point at or after ``time`` (at most the stop time);
+        returns the time reached. Ctrl-C stops the run with ``KeyboardInterrupt``."""
+        if self._run is None:
+            raise Error("no run: call initialize first")
+        return self._run.step_until(float(time))
+
+    def results(self) -> np.ndarray:
+        """The stepped run's rows so far (a structured array, ``time`` first)."""
+        if self._run is None:
+            raise Error("no run: call initialize first")
+        return _structured(*self._run.results())
+
+    def terminate(self) -> dict | None:
+        """Ends the stepped run (its instances terminated and freed); its summary, or None
+        when it ended before its stop time."""
+        if self._run is None:
+            return None
+        summary = self._run.terminate()
+        self.last_summary = json.loads(summary) if summary else None
+        return self.last_summary
 
     # -- runs ------------------------------------------------------------------------------
     def simulate(
@@ -194,21 +262,30 @@ class System:
         """One run with the master's semantics: communication step ``step_size`` (default
         the DefaultExperiment's, else 1 ms), every step recorded unless ``output_interval``
         (a whole multiple of it) is given; returns a structured array, ``time`` first."""
+        args = self._args(start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output,
+                          solver, relative_tolerance, timeout, threads)
+        return self._simulate(args)
+
+    def _args(self, start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output, solver,
+              relative_tolerance, timeout, threads):
         d_start, d_stop, d_step, d_tol = self._native.default_experiment
         start = float(start_time) if start_time is not None else (d_start if d_start is not None else 0.0)
         stop = float(stop_time) if stop_time is not None else (d_stop if d_stop is not None else start + 1.0)
         step = float(step_size) if step_size is not None else (d_step if d_step is not None else 1e-3)
         tolerance = relative_tolerance if relative_tolerance is not None else d_tol
-        return self._run(start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance, timeout, threads)
+        self._output_interval = output_interval
+        return self._arguments(start, stop, step, output_interval, algorithm, start_values, input, output, solver,
+                               tolerance, timeout, threads)
 
-    def _run(self, start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance, timeout, threads):
+    def _arguments(self, start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance,
+                   timeout, threads):
         if solver not in _SOLVERS:
             raise ExperimentError(f"unknown solver {solver!r} (CVode, dopri5, rk4)")
         if _SOLVERS[solver] is None:
             raise ExperimentError(f"solver {solver!r} is not offered: use 'CVode' (dopri5 here) or 'rk4'")
         values = dict(self._start_values)
         values.update(start_values or {})
-        args = {
+        return {
             "start_time": start,
             "stop_time": stop,
             "step": step,
@@ -222,6 +299,8 @@ class System:
             "timeout": timeout,
             "threads": threads,
         }
+
+    def _simulate(self, args: dict) -> np.ndarray:
         names, types, array, summary = self._native.simulate(_Args(args))
         self.last_summary = json.loads(summary) if summary else None
         return _structured(names, types, array)
@@ -275,9 +354,9 @@ def simulate_fmu(
                 output_interval = float(step_size)
                 while total / output_interval > 1000:
                     output_interval *= 2
-        return system._run(
-            start, stop, float(output_interval), None, "jacobi", start_values, input, output, solver, tolerance, timeout, 1
-        )
+        args = system._arguments(start, stop, float(output_interval), None, "jacobi", start_values, input, output,
+                                 solver, tolerance, timeout, 1)
+        return system._simulate(args)
 
 
 def simulate_ssp(

@@ -262,3 +262,56 @@ def test_simulate_fmu_is_fmpy_on_a_small_fmu_that_ends_its_run(stair_fmu, kwargs
     # the FMU ended the default run at 9 s (the row at its last successful time), else it
     # ran to the stop time
     assert ours["time"][-1] == kwargs.get("stop_time", 9.0)
+
+
+def test_a_run_stepped_from_python_is_the_run_with_an_input_table():
+    # stepping to 1 s, setting the steering input, stepping on = the input signal's jump at 1 s
+    with nigel_cosim.System(FMU / "nigel_plant.fmu") as system:
+        t0 = system.initialize(stop_time=3.0, step_size=1e-3, start_values={"v_x_start": 1.5}, output=["yaw_rate", "x"])
+        assert t0 == 0.0
+        assert system.step() == 1e-3
+        assert system.step_until(1.0) == 1.0
+        x_at_1 = system.get("x")
+        system.set("delta_fl", 0.2)
+        with pytest.raises(nigel_cosim.VariableError, match="cannot be set during a run"):
+            system.set("m", 3.0)  # a fixed parameter
+        assert system.step_until(5.0) == 3.0  # the stop time at most
+        stepped = system.results()
+        summary = system.terminate()
+    assert summary["steps"] == 3000
+    signals = np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 0.2), (3.0, 0.2)], dtype=[("time", float), ("delta_fl", float)])
+    whole = nigel_cosim.simulate_fmu(FMU / "nigel_plant.fmu", stop_time=3.0, output_interval=1e-3, input=signals,
+                                     start_values={"v_x_start": 1.5}, output=["yaw_rate", "x"])
+    assert len(stepped) == len(whole) == 3001
+    for field in whole.dtype.names:
+        assert np.array_equal(stepped[field], whole[field]), field
+    assert x_at_1 == whole["x"][1000]
+    assert np.max(np.abs(whole["yaw_rate"])) > 0.1
+
+
+def test_ctrl_c_inside_step_until(tmp_path):
+    script = textwrap.dedent(
+        f"""
+        import sys, time, nigel_cosim
+        system = nigel_cosim.System({str(FMU / "nigel_plant.fmu")!r})
+        system.initialize(stop_time=1e6, step_size=1e-3, output=["x"])
+        print("started", flush=True)
+        try:
+            system.step_until(1e6)
+        except KeyboardInterrupt:
+            print("interrupted at", system.time, flush=True)
+            system.close()
+            sys.exit(7)
+        """
+    )
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                         env=dict(os.environ, TMPDIR=str(scratch)))
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(0.5)
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 7, out
+    assert 0 < float(out.split()[-1]) < 1e6
+    assert list(scratch.iterdir()) == []

@@ -165,6 +165,9 @@ fn run<'s>(
         }
         algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table, &clock)?);
     }
+    if let Some(queue) = &experiment.between_steps {
+        algorithm = Box::new(crate::simulate::between::WithSets { inner: algorithm, queue: queue.clone() });
+    }
     let single = system.instances.len() == 1;
     let names: Vec<String> =
         record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();

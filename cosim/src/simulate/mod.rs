@@ -19,6 +19,7 @@
 //! - `driver`: [`simulate()`].
 
 mod algorithm;
+mod between;
 mod clock;
 mod driver;
 mod input;
@@ -28,6 +29,7 @@ mod observer;
 mod plan;
 mod types;
 
+pub use between::SetQueue;
 pub use driver::{simulate, simulate_recorded, simulate_with, InstancePool, RowSink};
 pub use input::InputTable;
 pub use lane::apply_start_values;

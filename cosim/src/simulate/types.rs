@@ -76,6 +76,9 @@ pub struct Experiment {
     /// [`Error::Cancelled`](crate::Error::Cancelled), the rows so far kept (a Python caller's
     /// Ctrl-C).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Values a caller sets while the run is in progress (from another thread, e.g. the
+    /// row sink of a run stepped from outside), applied before the next communication step.
+    pub between_steps: Option<std::sync::Arc<crate::simulate::SetQueue>>,
 }
 
 impl Experiment {
@@ -98,6 +101,7 @@ impl Experiment {
             isolation: None,
             timeout: None,
             cancel: None,
+            between_steps: None,
         }
     }
 }
