@@ -343,12 +343,15 @@ def simulate_fmu(
         stop = float(stop_time) if stop_time is not None else (d["stop_time"] if d["stop_time"] is not None else start + 1.0)
         tolerance = relative_tolerance if relative_tolerance is not None else d["tolerance"]
         total = stop - start
+        # fmpy.simulate_fmu's defaults, in its order
+        if step_size is None and total > 0:
+            step_size = float(10 ** (np.round(np.log10(total)) - 3))
         if output_interval is None and interface == "CoSimulation" and d["step_size"] is not None:
             output_interval = float(d["step_size"])
             while total / output_interval > 1000:
                 output_interval *= 2
         if output_interval is None:
-            if step_size is None:
+            if interface == "CoSimulation" or step_size is None:
                 output_interval = _auto_interval(total) if total > 0 else 1e-3
             else:
                 output_interval = float(step_size)
