@@ -45,6 +45,10 @@ pub struct Options {
     /// Run even when the system refuses the description's stop time for run 0 (the refusal
     /// is then in [`Done::stop_time_refused`]): for a campaign that varies what limits it.
     pub allow_failures: bool,
+    /// Set to true (from any thread) to start no further run (threads only): the runs in
+    /// progress finish and the rows so far are written, as for an interrupted campaign that
+    /// `--resume` completes.
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Where the runs run.
@@ -70,6 +74,7 @@ impl Options {
             progress: true,
             workers: Workers::Threads,
             allow_failures: false,
+            cancel: None,
         }
     }
 }
@@ -371,7 +376,7 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
                     out.done.stop_time_refused = refusal(m)?;
                 }
                 drop(checker);
-                run_threads(spec, &todo, threads, &mut out)
+                run_threads(spec, &todo, threads, options.cancel.as_deref(), &mut out)
             }
             Workers::Processes(program) => {
                 crate::worker::run_processes(spec, program, &todo, threads, &mut out, &refusal)
@@ -389,8 +394,14 @@ pub fn run(spec: &Spec, options: &Options) -> Result<Done, Error> {
     Ok(done)
 }
 
-/// The runs `todo` on `threads` threads of this process.
-fn run_threads(spec: &Spec, todo: &[u64], threads: usize, out: &mut Collector) -> Result<(), Error> {
+/// The runs `todo` on `threads` threads of this process (none started once `cancel` is set).
+fn run_threads(
+    spec: &Spec,
+    todo: &[u64],
+    threads: usize,
+    cancel: Option<&std::sync::atomic::AtomicBool>,
+    out: &mut Collector,
+) -> Result<(), Error> {
     let next = AtomicU64::new(0);
     let (tx, rx) = mpsc::channel::<Result<(Row, (Duration, Duration)), Error>>();
     let mut error = None;
@@ -407,6 +418,9 @@ fn run_threads(spec: &Spec, todo: &[u64], threads: usize, out: &mut Collector) -
                     }
                 };
                 loop {
+                    if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                        break;
+                    }
                     let k = next.fetch_add(1, Ordering::Relaxed) as usize;
                     let Some(&i) = todo.get(k) else { break };
                     let before = worker.timing;

@@ -667,7 +667,10 @@ fn run_campaign(
     options.shard = shard;
     options.progress = progress;
     options.allow_failures = true;
-    let cancel = AtomicBool::new(false);
+    // Ctrl-C: no further run starts; the runs in progress finish and the rows so far are
+    // written to `out` (a later run with the same `out` would resume them)
+    let cancel = Arc::new(AtomicBool::new(false));
+    options.cancel = Some(cancel.clone());
     let done = interruptible(py, &cancel, || nigel_campaign::run::run(&spec, &options))?.map_err(campaign_error)?;
     Ok((out.join("results.csv"), done.ran, done.failed))
 }

@@ -333,3 +333,32 @@ def test_simulate_fmu_in_model_exchange_agrees_with_fmpys_cvode():
     for field in ("x", "y", "psi", "v_x"):
         assert np.max(np.abs(ours[field] - theirs[field])) < 1e-7, field
     assert abs(ours["psi"][-1]) > 0.03  # the vehicle turned (yaw_rate_start): a real trajectory was compared
+
+
+def test_ctrl_c_during_a_campaign_starts_no_further_run(tmp_path):
+    script = textwrap.dedent(
+        f"""
+        import sys, time, nigel_cosim
+        spec = {{"system": {str(SSP)!r}, "stop_time": 2.0, "step": 1e-3, "seed": 1, "samples": 2000,
+                 "random": {{"plant.m": {{"uniform": [2.4, 3.0]}}}}, "metrics": {{"y": "final(plant.y)"}}}}
+        print("started", flush=True)
+        try:
+            nigel_cosim.run_campaign(spec, out={str(tmp_path / "out")!r}, threads=2)
+        except KeyboardInterrupt:
+            print("interrupted", time.monotonic(), flush=True)
+            sys.exit(7)
+        """
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(1.5)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=120)
+    assert p.returncode == 7, out
+    latency = float(out.split()[1]) - sent
+    print(f"KeyboardInterrupt {latency:.3f} s after SIGINT (the runs in progress finish: 2 s each at most)")
+    assert latency < 10.0
+    # the rows of the runs that finished are written, far fewer than the 2000 asked for
+    rows = pandas.read_csv(tmp_path / "out" / "results.csv")
+    assert 0 < len(rows) < 2000
