@@ -9,6 +9,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod write;
+
 pub use crate::{BaseUnit, DefaultExperiment, DependencyKind, Initial, LogCategory, Unit, Variability};
 
 /// `causality` of an FMI 3.0 variable.
