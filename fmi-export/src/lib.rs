@@ -111,7 +111,8 @@
 //! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi_export::export_fmi2!(Sampler);
 //!
 //! let d = Sampler::declaration();
-//! assert_eq!(d.value_reference_table(), "u 0\ngain 1\ny 2\n");
+//! assert_eq!(d.value_reference_table(), "u 0 1\ngain 1 2\ny 2 3\n");
+//! assert!(d.xml3().contains(r#"<Output valueReference="3" dependencies="1"/>"#), "{}", d.xml3());
 //! assert!(d.xml().contains(r#"<Unknown index="3" dependencies="1"/>"#), "{}", d.xml());
 //! ```
 

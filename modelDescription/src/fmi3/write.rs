@@ -3,8 +3,8 @@
 //! ([`crate::format_f64`]).
 
 use super::*;
-use crate::write::{join_u32, Elem, Out};
 use crate::format_f64;
+use crate::write::{join_u32, Elem, Out};
 use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 
@@ -148,7 +148,10 @@ impl ModelDescription {
                 e.attr("maxOutputDerivativeOrder", &cs.max_output_derivative_order.to_string());
             }
             if cs.recommended_intermediate_input_smoothness != 0 {
-                e.attr("recommendedIntermediateInputSmoothness", &cs.recommended_intermediate_input_smoothness.to_string());
+                e.attr(
+                    "recommendedIntermediateInputSmoothness",
+                    &cs.recommended_intermediate_input_smoothness.to_string(),
+                );
             }
             e.flag("providesIntermediateUpdate", cs.provides_intermediate_update)
                 .flag("mightReturnEarlyFromDoStep", cs.might_return_early_from_do_step)
@@ -207,7 +210,8 @@ impl ModelDescription {
             for t in &self.type_definitions {
                 match &t.kind {
                     TypeKind::Float { value_type, quantity, unit, display_unit, min, max, nominal } => {
-                        let mut e = Elem::new(if *value_type == ValueType::Float32 { "Float32Type" } else { "Float64Type" });
+                        let mut e =
+                            Elem::new(if *value_type == ValueType::Float32 { "Float32Type" } else { "Float64Type" });
                         e.attr("name", &t.name)
                             .opt_str("description", &t.description)
                             .opt_str("quantity", quantity)
@@ -380,7 +384,11 @@ mod tests {
             variable_naming_convention: None,
             model_exchange: None,
             co_simulation: Some(CoSimulation {
-                common: InterfaceCommon { model_identifier: "m".into(), provides_adjoint_derivatives: true, ..Default::default() },
+                common: InterfaceCommon {
+                    model_identifier: "m".into(),
+                    provides_adjoint_derivatives: true,
+                    ..Default::default()
+                },
                 can_handle_variable_communication_step_size: true,
                 ..Default::default()
             }),
