@@ -831,6 +831,12 @@ impl<B> Declaration<B> {
         (row < self.spec.variables.len()).then_some(row)
     }
 
+    /// The FMI 3.0 variable of value reference `vr` (`time` for 0).
+    #[inline]
+    pub fn variable3(&self, vr: u32) -> Option<&md::fmi3::Variable> {
+        self.description3.model_variables.get(vr as usize)
+    }
+
     pub fn guid(&self) -> &str {
         &self.description.guid
     }
