@@ -1,6 +1,6 @@
 //! A tiny in-process importer over the layer's C entry points (`fmi_export::abi`, what
-//! `export_fmi!` exports from the shared library), for the tests of the layer and of the
-//! FMU crates: it instantiates a model type directly, without building or loading a
+//! `export_fmi!` exports from the shared library; [`Fmu`] for FMI 2.0, [`Fmu3`] for FMI
+//! 3.0), for the tests of the layer and of the FMU crates: it instantiates a model type directly, without building or loading a
 //! library, and records the log (through the logger shim of `fmi-sys`, as a real importer
 //! receives it) so that tests can check the messages. Behind the feature `testing`, which
 //! the FMU crates enable from their dev-dependencies.
