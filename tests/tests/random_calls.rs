@@ -101,7 +101,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                 ],
                 _ => &[Function::Reset, Function::SetFMUstate],
             };
-            let function = if rng.chance(40) { rng.pick(progress) } else { rng.pick(&Function::ALL) };
+            let function = if rng.chance(40) { rng.pick(progress) } else { rng.pick(&Function::FMI2) };
             if matches!(function, Function::Instantiate | Function::FreeInstance) {
                 continue;
             }
