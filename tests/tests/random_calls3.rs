@@ -95,13 +95,20 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
         let (instance, log) = fmu.instantiate3("random3", co_simulation, fmu.guid());
         let i = instance.expect("instantiate");
         let c = i.c;
-        let mut sh =
-            Shadow { machine: Some(Machine::Instantiated), time: 0.0, states: Vec::new(), freed: Vec::new(), bytes: Vec::new() };
+        let mut sh = Shadow {
+            machine: Some(Machine::Instantiated),
+            time: 0.0,
+            states: Vec::new(),
+            freed: Vec::new(),
+            bytes: Vec::new(),
+        };
         for _ in 0..1 + rng.below(16) {
             let progress: &[Function] = match sh.machine {
                 Some(Machine::Instantiated) => &[Function::Fmi3EnterInitializationMode, Function::Fmi3SetFloat64],
                 Some(Machine::InitializationMode) => &[Function::Fmi3ExitInitializationMode, Function::Fmi3SetFloat64],
-                Some(Machine::StepComplete) => &[Function::Fmi3DoStep, Function::Fmi3SetFloat64, Function::Fmi3GetFMUState],
+                Some(Machine::StepComplete) => {
+                    &[Function::Fmi3DoStep, Function::Fmi3SetFloat64, Function::Fmi3GetFMUState]
+                }
                 Some(Machine::EventMode) => {
                     &[Function::Fmi3UpdateDiscreteStates, Function::Fmi3EnterContinuousTimeMode]
                 }
@@ -208,7 +215,8 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     }
                     Fmi3SetInt64 => {
                         let v = vrs(&mut rng, &p.int64);
-                        let x: Vec<i64> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 1 << 40, i64::MIN])).collect();
+                        let x: Vec<i64> =
+                            (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 1 << 40, i64::MIN])).collect();
                         (f.set_int64.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
                     }
                     Fmi3GetBoolean => {
@@ -373,12 +381,28 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         } else {
                             f.get_adjoint_derivative.unwrap()
                         };
-                        g(c, ptr(&unknown), n, ptr(&known), n, seeds.as_ptr(), n_values, reals_out.as_mut_ptr(), n_values)
+                        g(
+                            c,
+                            ptr(&unknown),
+                            n,
+                            ptr(&known),
+                            n,
+                            seeds.as_ptr(),
+                            n_values,
+                            reals_out.as_mut_ptr(),
+                            n_values,
+                        )
                     }
                     Fmi3EnterConfigurationMode => (f.enter_configuration_mode.unwrap())(c),
                     Fmi3ExitConfigurationMode => (f.exit_configuration_mode.unwrap())(c),
-                    Fmi3GetIntervalDecimal | Fmi3GetIntervalFraction | Fmi3GetShiftDecimal | Fmi3GetShiftFraction
-                    | Fmi3SetIntervalDecimal | Fmi3SetIntervalFraction | Fmi3SetShiftDecimal | Fmi3SetShiftFraction => {
+                    Fmi3GetIntervalDecimal
+                    | Fmi3GetIntervalFraction
+                    | Fmi3GetShiftDecimal
+                    | Fmi3GetShiftFraction
+                    | Fmi3SetIntervalDecimal
+                    | Fmi3SetIntervalFraction
+                    | Fmi3SetShiftDecimal
+                    | Fmi3SetShiftFraction => {
                         let v = vrs(&mut rng, &p.any);
                         let (mut x, mut a, mut b, mut q) = ([0.0; 5], [0u64; 5], [0u64; 5], [0i32; 5]);
                         match function {
@@ -486,7 +510,10 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                 let wrong_interface = function.scope() != Scope::Common && function.scope() != interface_scope;
                 let event_mode_in_cs = co_simulation
                     && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates);
-                if wrong_interface || event_mode_in_cs || function.undeclared_feature().is_some() || !function.allowed_in(m)
+                if wrong_interface
+                    || event_mode_in_cs
+                    || function.undeclared_feature().is_some()
+                    || !function.allowed_in(m)
                 {
                     assert_eq!(status, ERROR, "{function:?} in {m:?} ({})", if co_simulation { "CS" } else { "ME" });
                 }
@@ -564,7 +591,8 @@ fn random_fmi3_call_sequences_respect_the_state_table_and_never_hand_out_non_fin
             if !offered {
                 continue;
             }
-            let counts = run(&fmu, co_simulation, sequences, 0x3C6E_F372_FE94_F82B ^ (k as u64 * 2 + co_simulation as u64));
+            let counts =
+                run(&fmu, co_simulation, sequences, 0x3C6E_F372_FE94_F82B ^ (k as u64 * 2 + co_simulation as u64));
             let total: usize = counts.iter().sum();
             println!(
                 "{} {} (FMI 3.0): {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
