@@ -9,6 +9,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod write;
+
 pub use crate::{BaseUnit, DefaultExperiment, DependencyKind, Initial, LogCategory, Unit, Variability};
 
 /// `causality` of an FMI 3.0 variable.
@@ -344,7 +346,13 @@ pub struct Variable {
 
 impl Variable {
     /// A scalar with only the required attributes set (the others absent or false).
-    pub fn new(name: impl Into<String>, value_reference: u32, value_type: ValueType, causality: Causality, variability: Variability) -> Variable {
+    pub fn new(
+        name: impl Into<String>,
+        value_reference: u32,
+        value_type: ValueType,
+        causality: Causality,
+        variability: Variability,
+    ) -> Variable {
         Variable {
             name: name.into(),
             value_reference,
