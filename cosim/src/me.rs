@@ -105,14 +105,37 @@ impl MeUnit {
     /// After an event iteration that ended in continuous-time mode: the states and event
     /// indicators as the FMU now has them.
     pub(crate) fn resume(&mut self, inst: &mut Instance) -> Result<()> {
-        inst.get_continuous_states(&mut self.x)?;
-        inst.get_event_indicators(&mut self.z0)
+        if !self.x.is_empty() {
+            inst.get_continuous_states(&mut self.x)?;
+        }
+        Self::indicators(inst, &mut self.z0)
     }
 
+    /// The time and the derivatives at (t, x); with no continuous states only the time
+    /// (the state functions are never called with nx = 0: some FMUs refuse it).
     pub(crate) fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
         inst.set_time(t)?;
+        if x.is_empty() {
+            return Ok(());
+        }
         inst.set_continuous_states(x)?;
         inst.get_derivatives(dx)
+    }
+
+    /// `fmi2SetContinuousStates`, not called with no continuous states.
+    pub(crate) fn set_states(inst: &mut Instance, x: &[f64]) -> Result<()> {
+        if x.is_empty() {
+            return Ok(());
+        }
+        inst.set_continuous_states(x)
+    }
+
+    /// `fmi2GetEventIndicators`, not called with no event indicators.
+    pub(crate) fn indicators(inst: &mut Instance, z: &mut [f64]) -> Result<()> {
+        if z.is_empty() {
+            return Ok(());
+        }
+        inst.get_event_indicators(z)
     }
 
     /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).
@@ -188,8 +211,8 @@ impl MeUnit {
     /// Event indicators at (t, xt) into `z`.
     pub(crate) fn indicators_at(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
         inst.set_time(t)?;
-        inst.set_continuous_states(&self.xt)?;
-        inst.get_event_indicators(&mut self.z)
+        Self::set_states(inst, &self.xt)?;
+        Self::indicators(inst, &mut self.z)
     }
 
     pub(crate) fn crossed(z0: &[f64], z: &[f64]) -> bool {

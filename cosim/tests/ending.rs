@@ -4,7 +4,7 @@
 //! - Co-Simulation: `fmi2DoStep` over (8.8, 9.0] returns fmi2Discard with fmi2Terminated
 //!   true and fmi2LastSuccessfulTime 9: the run ends there, with the row at 9 (counter 10);
 //! - Model Exchange: `terminateSimulation` at the time event at 9: the run ends at the
-//!   event, the last row is the communication point before it (8.8, counter 9).
+//!   event, with the row at 9 after its event iteration (counter 10), as in Co-Simulation.
 
 mod common;
 use common::{build_stair, work_dir};
@@ -41,13 +41,16 @@ fn co_simulation_ends_at_the_last_successful_time_with_that_row() {
 }
 
 #[test]
-fn model_exchange_ends_at_the_event_with_no_row_after_it() {
+fn model_exchange_ends_at_the_event_with_the_row_at_the_event() {
     let system = stair(Interface::ModelExchange);
     let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
     let time = r.column("time").unwrap();
     let counter = r.column("counter").unwrap();
-    assert_eq!(r.rows(), 45);
-    assert!((time.last().unwrap() - 8.8).abs() < 1e-12, "{:?}", time.last()); // 44 * 0.2 in f64
+    // rows 0, 0.2, ..., 8.8 (45 communication points), then the row at the event at 9
+    assert_eq!(r.rows(), 46);
+    assert!((time[44] - 8.8).abs() < 1e-12, "{}", time[44]); // 44 * 0.2 in f64
+    assert_eq!(*time.last().unwrap(), 9.0);
+    assert_eq!(*counter.last().unwrap(), 10.0);
     for (t, c) in time.iter().zip(&counter) {
         assert_eq!(*c, counter_at(*t), "t = {t}");
     }

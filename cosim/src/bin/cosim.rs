@@ -480,7 +480,7 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
 }
 
 /// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else, for an FMU with discrete states or outputs, its DefaultExperiment stepSize) is shorter than the communication step: its
+/// else, for an FMU with discrete states or outputs (Model Exchange: outputs), its DefaultExperiment stepSize) is shorter than the communication step: its
 /// inputs are then held and its outputs read less often than it is meant to run.
 fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
     let mut out = Vec::new();
@@ -502,10 +502,19 @@ fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
         });
         // the stepSize is only a suggestion of a continuous model (its integrator runs
         // within any step); it is a sample period where the FMU has discrete-time values
-        // of its own (discrete states or outputs, which change at its sample instants)
+        // of its own, which change at its sample instants: in Co-Simulation discrete
+        // states or outputs; in Model Exchange discrete outputs only (its discrete states
+        // change at its events, which the master's integrator stops at within any
+        // communication step; a model with discrete locals, such as the when-conditions
+        // of a Modelica model, is continuous there)
+        let me = spec.fmu.interface() == nigel_cosim::Interface::ModelExchange;
         let samples = md.model_variables.iter().any(|v| {
             v.variability == model_description::Variability::Discrete
-                && !matches!(v.causality, model_description::Causality::Input | model_description::Causality::Parameter)
+                && match v.causality {
+                    model_description::Causality::Output => true,
+                    model_description::Causality::Input | model_description::Causality::Parameter => false,
+                    _ => !me,
+                }
         });
         let declared = from_parameter.or_else(|| {
             md.default_experiment

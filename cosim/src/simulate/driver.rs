@@ -7,7 +7,7 @@ use crate::fmu::{Instance, Interface};
 use crate::me::{MeUnit, Solver};
 use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
 use crate::simulate::clock::Clock;
-use crate::simulate::lane::{apply_start_values, Lane, DISCARD_TERMINATED};
+use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
 use crate::simulate::observer::{Deadline, Observer, Observers, Profiler, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Plan};
@@ -262,10 +262,11 @@ fn run<'s>(
         }
         let mut ended_by = None;
         if let Some(Error::Terminated { instance, time, reason }) = ended {
-            // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
-            // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
-            // row after the last communication point before the event (as fmpy)
-            if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
+            // the row at the time the run ended, every recorded variable read as its
+            // instance now has it: Co-Simulation at fmi2LastSuccessfulTime (fmpy and fmusim
+            // record it too), Model Exchange at the event that set terminateSimulation,
+            // after its event iteration (fmpy with record_events records it too)
+            if time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
                 run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
                 recorder.push_row(time, &core.values);
             }

@@ -341,7 +341,7 @@ impl MeGroup {
                     let Some((inst, u)) = lanes.member(m) else { continue };
                     u.one_step(inst, solver, t, hi)?;
                     inst.set_time(te)?;
-                    inst.set_continuous_states(&u.xt)?;
+                    MeUnit::set_states(inst, &u.xt)?;
                     u.x.copy_from_slice(&u.xt);
                     u.steps += 1;
                     inst.completed_integrator_step()?;
@@ -365,7 +365,7 @@ impl MeGroup {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&u.xt);
                 inst.set_time(t_new)?;
-                inst.set_continuous_states(&u.x)?;
+                MeUnit::set_states(inst, &u.x)?;
                 u.steps += 1;
                 std::mem::swap(&mut u.z0, &mut u.z);
                 let (step_event, terminate) = inst.completed_integrator_step()?;

@@ -295,3 +295,30 @@ pub fn time_and_y(csv: &str) -> Vec<(f64, f64)> {
         })
         .collect()
 }
+
+/// The model description of the FMU with no states (tests/cfmu/ramp.c); `offset_causality`
+/// of its discrete variable `offset` ("local" as the FMU has it, "output" to test the
+/// sample-period warning).
+pub fn ramp_xml(offset_causality: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="ramp" guid="{{ramp}}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="ramp"/>
+  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.01"/>
+  <ModelVariables>
+    <ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
+    <ScalarVariable name="slope" valueReference="1" causality="parameter" variability="fixed"><Real start="2"/></ScalarVariable>
+    <ScalarVariable name="t_step" valueReference="2" causality="parameter" variability="fixed"><Real start="0.55"/></ScalarVariable>
+    <ScalarVariable name="offset" valueReference="3" causality="{offset_causality}" variability="discrete"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#
+    )
+}
+
+/// The FMU with no continuous states and no event indicators (tests/cfmu/ramp.c), Model
+/// Exchange only, with the model description `xml` ([`ramp_xml`]), as `<dir>/ramp.fmu`.
+pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
+    build_single_c_fmu(dir, "ramp", xml)
+}
