@@ -32,6 +32,16 @@ pub enum Solver {
         /// Absolute tolerance.
         atol: f64,
     },
+    /// Variable-order (1 to 5) variable-step BDF (the NDFs of [`crate::bdf`]) for stiff
+    /// models, with the Jacobian from the FMU's directional derivatives where it provides
+    /// them, else finite differences, both by column groups of its ModelStructure;
+    /// error per state below `atol + rtol |x|`.
+    Bdf {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance.
+        atol: f64,
+    },
 }
 
 impl Default for Solver {
@@ -70,6 +80,8 @@ pub struct MeUnit {
     pub rejected: u64,
     /// The FMU asked to terminate.
     pub terminated: bool,
+    /// The work of the bdf solver of this instance's group (held by its first member).
+    pub stiff: crate::bdf::Work,
 }
 
 impl MeUnit {
@@ -92,6 +104,7 @@ impl MeUnit {
             steps: 0,
             rejected: 0,
             terminated: false,
+            stiff: crate::bdf::Work::default(),
         }
     }
 
@@ -205,6 +218,10 @@ impl MeUnit {
         match solver {
             Solver::Rk4 { .. } => self.rk4(inst, t, h),
             Solver::Dopri5 { rtol, atol } => self.dopri(inst, t, h, rtol, atol).map(|_| ()),
+            // the bdf path locates events on its dense output (simulate/me_group/bdf.rs)
+            Solver::Bdf { .. } => {
+                Err(crate::error::Error::Experiment("internal: a one-step method asked of the bdf solver".into()))
+            }
         }
     }
 

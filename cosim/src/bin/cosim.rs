@@ -80,10 +80,11 @@ struct RunArgs {
     /// ordered or jacobi.
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
-    /// Model Exchange solver: rk4 or dopri5.
+    /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
+    /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 (absolute: rtol / 100).
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
     #[arg(long, default_value_t = 1e-6)]
     rtol: f64,
     /// Largest RK4 step, s (default: the communication step).
@@ -268,8 +269,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
             nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
         }
-        "dopri5" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5)"))),
+        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
+            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
+        }
+        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()));

@@ -322,3 +322,49 @@ pub fn ramp_xml(offset_causality: &str) -> String {
 pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
     build_single_c_fmu(dir, "ramp", xml)
 }
+
+/// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
+/// `<dir>/vdp.fmu`.
+pub fn build_vdp(dir: &Path) -> PathBuf {
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="vdp" guid="{vdp}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="vdp" providesDirectionalDerivative="true"/>
+  <DefaultExperiment startTime="0" stopTime="20"/>
+  <ModelVariables>
+    <ScalarVariable name="x0" valueReference="0" causality="output" initial="exact"><Real start="2"/></ScalarVariable>
+    <ScalarVariable name="der(x0)" valueReference="1"><Real derivative="1"/></ScalarVariable>
+    <ScalarVariable name="x1" valueReference="2" causality="output" initial="exact"><Real start="0"/></ScalarVariable>
+    <ScalarVariable name="der(x1)" valueReference="3"><Real derivative="3"/></ScalarVariable>
+    <ScalarVariable name="mu" valueReference="4" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="directional_calls" valueReference="5"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="1" dependencies=""/><Unknown index="3" dependencies=""/></Outputs>
+    <Derivatives><Unknown index="2" dependencies="3"/><Unknown index="4" dependencies="1 3"/></Derivatives>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    build_single_c_fmu(dir, "vdp", xml)
+}
+
+/// The stiff linear system with a closed-form solution (tests/cfmu/linear.c), Model
+/// Exchange only, as `<dir>/linear.fmu`.
+pub fn build_linear(dir: &Path) -> PathBuf {
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="linear" guid="{linear}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="linear"/>
+  <ModelVariables>
+    <ScalarVariable name="x1" valueReference="0" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="der(x1)" valueReference="1"><Real derivative="1"/></ScalarVariable>
+    <ScalarVariable name="x2" valueReference="2" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="der(x2)" valueReference="3"><Real derivative="3"/></ScalarVariable>
+    <ScalarVariable name="lambda" valueReference="4" causality="parameter" variability="fixed"><Real start="10000"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="1" dependencies=""/><Unknown index="3" dependencies=""/></Outputs>
+    <Derivatives><Unknown index="2" dependencies="1 3"/><Unknown index="4" dependencies="3"/></Derivatives>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    build_single_c_fmu(dir, "linear", xml)
+}
