@@ -130,3 +130,40 @@ fn bdf_finds_the_bouncing_balls_events_where_dopri5_does() {
         assert!((a - b).abs() < 1e-6, "bounce {k}: bdf {a} vs dopri5 {b}");
     }
 }
+
+#[test]
+fn bdf_integrates_a_coupled_model_exchange_group_with_its_events() {
+    // the ball's velocity feeds the discrete counter (tests/cfmu/latch.c, an input: steps
+    // end at every communication point); each bounce is an event of both, counted at its time
+    let dir = work_dir("stiff-coupled");
+    let mut b = SystemBuilder::new();
+    b.add_instance("ball", Fmu::load(&build_ball(&dir)).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(&common::build_latch(&dir)).unwrap()).unwrap();
+    b.connect("ball.v", "counter.u").unwrap();
+    let mut e = Experiment::new(1.5, 0.01);
+    let rtol = 1e-10;
+    e.solver = Solver::Bdf { rtol, atol: rtol / 100.0 };
+    let (r, s) = simulate(&b.build(), &e).unwrap();
+    let g: f64 = 9.81;
+    let t1 = (2.0 / g).sqrt();
+    let exact = [t1, t1 + 2.0 * 0.7 * t1];
+    let state: Vec<f64> = s.events.iter().filter(|e| e.kind == "state").map(|e| e.time).collect();
+    assert_eq!(state.len(), 2, "{:?}", s.events);
+    for (a, b) in state.iter().zip(exact) {
+        // the state error (a few rtol) over the impact speed (>= 3 m/s)
+        assert!((a - b).abs() < 1e-8, "{a} vs {b}");
+    }
+    let (t, count, t_last) =
+        (r.column("time").unwrap(), r.column("counter.count").unwrap(), r.column("counter.t_last").unwrap());
+    for k in 0..t.len() {
+        let (n, last) = if t[k] >= state[1] {
+            (2.0, state[1])
+        } else if t[k] >= state[0] {
+            (1.0, state[0])
+        } else {
+            (0.0, 0.0)
+        };
+        assert_eq!((count[k], t_last[k]), (n, last), "at t = {}", t[k]);
+    }
+    assert!(s.stiff.jacobians > 0, "{:?}", s.stiff);
+}

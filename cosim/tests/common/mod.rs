@@ -229,26 +229,7 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
 
 /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
 pub fn build_ball(dir: &Path) -> PathBuf {
-    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="ball" guid="{ball}" numberOfEventIndicators="1">
-  <ModelExchange modelIdentifier="ball"/>
-  <ModelVariables>
-    <ScalarVariable name="h" valueReference="0" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
-    <ScalarVariable name="v" valueReference="1" causality="output" initial="exact"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="der(h)" valueReference="2"><Real derivative="1"/></ScalarVariable>
-    <ScalarVariable name="der(v)" valueReference="3"><Real derivative="2"/></ScalarVariable>
-    <ScalarVariable name="g" valueReference="4" causality="parameter" variability="fixed"><Real start="9.81"/></ScalarVariable>
-    <ScalarVariable name="e" valueReference="5" causality="parameter" variability="fixed"><Real start="0.7"/></ScalarVariable>
-    <ScalarVariable name="t_kick" valueReference="6" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="kick" valueReference="7" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
-  </ModelVariables>
-  <ModelStructure>
-    <Outputs><Unknown index="1" dependencies=""/><Unknown index="2" dependencies=""/></Outputs>
-    <Derivatives><Unknown index="3" dependencies="2"/><Unknown index="4" dependencies=""/></Derivatives>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
-    build_single_c_fmu(dir, "ball", xml)
+    build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))
 }
 
 /// The discrete latch (tests/cfmu/latch.c), Model Exchange only, as `<dir>/latch.fmu`.
@@ -326,25 +307,7 @@ pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
 /// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
 /// `<dir>/vdp.fmu`.
 pub fn build_vdp(dir: &Path) -> PathBuf {
-    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="vdp" guid="{vdp}" numberOfEventIndicators="0">
-  <ModelExchange modelIdentifier="vdp" providesDirectionalDerivative="true"/>
-  <DefaultExperiment startTime="0" stopTime="20"/>
-  <ModelVariables>
-    <ScalarVariable name="x0" valueReference="0" causality="output" initial="exact"><Real start="2"/></ScalarVariable>
-    <ScalarVariable name="der(x0)" valueReference="1"><Real derivative="1"/></ScalarVariable>
-    <ScalarVariable name="x1" valueReference="2" causality="output" initial="exact"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="der(x1)" valueReference="3"><Real derivative="3"/></ScalarVariable>
-    <ScalarVariable name="mu" valueReference="4" causality="parameter" variability="fixed"><Real start="1"/></ScalarVariable>
-    <ScalarVariable name="directional_calls" valueReference="5"><Real/></ScalarVariable>
-  </ModelVariables>
-  <ModelStructure>
-    <Outputs><Unknown index="1" dependencies=""/><Unknown index="3" dependencies=""/></Outputs>
-    <Derivatives><Unknown index="2" dependencies="3"/><Unknown index="4" dependencies="1 3"/></Derivatives>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
-    build_single_c_fmu(dir, "vdp", xml)
+    build_single_c_fmu(dir, "vdp", include_str!("../cfmu/vdp.xml"))
 }
 
 /// The stiff linear system with a closed-form solution (tests/cfmu/linear.c), Model
