@@ -273,7 +273,7 @@ impl Bdf {
         let n = self.n;
         let newton_tol = (10.0 * f64::EPSILON / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
         loop {
-            let min_step = 10.0 * ulp(self.t.abs().max(t_limit.abs()));
+            let min_step = 10.0 * ulp(self.t);
             if self.h < min_step {
                 return Err(Error::Experiment(format!(
                     "the bdf step at t = {} s fell below {min_step:e} s (the resolution of the time): the Newton iteration or the error test fails at every step size",
@@ -597,9 +597,9 @@ mod tests {
             let e = exact(5.0);
             let end = (bdf.state()[1] - e[1]).abs();
             eprintln!("rtol {rtol:e}: {:?}, worst dense error {worst:e}, end error {end:e}", bdf.work);
-            // a local error per step of rtol |x| accumulates over the steps; the global error
-            // stays within 100 rtol of the states' unit size here (the solution decays)
-            assert!(worst < 100.0 * rtol, "rtol {rtol}: {worst}");
+            // a local error per step of rtol |x| + atol (|x| <= 1) adds up over the steps,
+            // damped by the decaying solution (measured 1.5 to 2.2 rtol): 10 rtol bounds it
+            assert!(worst < 10.0 * rtol, "rtol {rtol}: {worst}");
             // stiff: far fewer steps than 5 s / (2 / 1000) (explicit stability bound)
             assert!(bdf.work.steps < 1000, "{:?}", bdf.work);
         }

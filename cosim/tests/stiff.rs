@@ -167,3 +167,42 @@ fn bdf_integrates_a_coupled_model_exchange_group_with_its_events() {
     }
     assert!(s.stiff.jacobians > 0, "{:?}", s.stiff);
 }
+
+#[test]
+fn cosim_run_solver_bdf_reports_its_work_in_the_summary() {
+    let dir = work_dir("stiff-cli");
+    let fmu = build_vdp(&dir);
+    let (csv, json) = (dir.join("out.csv"), dir.join("summary.json"));
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", fmu.to_str().unwrap(), "--solver", "bdf", "--set", "mu=1000", "--stop-time", "1000"];
+        args.extend_from_slice(&[
+            "--step",
+            "1",
+            "--output",
+            csv.to_str().unwrap(),
+            "--summary",
+            json.to_str().unwrap(),
+        ]);
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(&args).output().unwrap()
+    };
+    let out = run(&[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let work = &summary["bdf"];
+    let (rhs, jacobians, factorizations) =
+        (work["rhs"].as_u64().unwrap(), work["jacobians"].as_u64().unwrap(), work["factorizations"].as_u64().unwrap());
+    let steps = summary["integrator_steps"]["accepted"].as_u64().unwrap();
+    eprintln!("{work} {steps}");
+    // a Newton iteration per step takes at least one right-hand side; a factorization per
+    // Jacobian at least
+    assert!(steps > 0 && rhs >= steps && factorizations >= jacobians && jacobians >= 1, "{work} {steps}");
+    // the row at 1000 s: x0 on its way back after the first transition (near 807 s)
+    let last = std::fs::read_to_string(&csv).unwrap().lines().last().unwrap().to_string();
+    let x0: f64 = last.split(',').nth(1).unwrap().parse().unwrap();
+    assert!(x0 < -1.0 && x0 > -2.1, "{last}");
+    // a tolerance no step can meet is refused before the run
+    let out = run(&["--rtol", "1e-20"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("the bdf relative tolerance 1e-20 is below"));
+}
