@@ -209,7 +209,8 @@ impl Bdf {
         let d2 = norm(&self.psi, &self.scale) / h0;
         let h1 = if d1 <= 1e-15 && d2 <= 1e-15 { (1e-6f64).max(h0 * 1e-3) } else { (0.01 / d1.max(d2)).powf(0.5) };
         self.h = (100.0 * h0).min(h1).min(h_max);
-        if self.h.is_nan() || self.h <= 0.0 {
+        if self.h.is_nan() || self.h <= 0.0 || n == 0 {
+            // no states: nothing to resolve, one step to the limit
             self.h = h_max;
         }
         for row in self.d.iter_mut() {
@@ -286,6 +287,13 @@ impl Bdf {
                 self.change_step(remaining / self.h);
             }
             let t_new = if self.h >= remaining * (1.0 - 1e-12) { t_limit } else { self.t + self.h };
+            if n == 0 {
+                // nothing to solve (and no 0 x 0 factorization)
+                self.work.steps += 1;
+                self.t_old = self.t;
+                self.t = t_new;
+                return Ok(());
+            }
             let order = self.order;
             for i in 0..n {
                 let mut pred = 0.0;

@@ -57,3 +57,23 @@ fn model_exchange_ends_at_the_event_with_the_row_at_the_event() {
     let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
     assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
 }
+
+#[test]
+fn model_exchange_with_bdf_ends_at_the_event_with_the_row_at_the_event() {
+    // no states (the bdf method has nothing to integrate), time events each second
+    let system = stair(Interface::ModelExchange);
+    let mut e = Experiment::new(10.0, 0.2);
+    e.solver = nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    let (r, summary) = simulate(&system, &e).unwrap();
+    let time = r.column("time").unwrap();
+    let counter = r.column("counter").unwrap();
+    assert_eq!(r.rows(), 46);
+    assert_eq!((*time.last().unwrap(), *counter.last().unwrap()), (9.0, 10.0));
+    for (t, c) in time.iter().zip(&counter) {
+        assert_eq!(*c, counter_at(*t), "t = {t}");
+    }
+    let times: Vec<f64> = summary.events.iter().map(|e| e.time).collect();
+    assert_eq!(times, (1..=9).map(f64::from).collect::<Vec<_>>());
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
+}

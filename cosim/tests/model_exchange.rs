@@ -137,7 +137,11 @@ fn an_fmu_with_no_states_runs_without_the_state_functions() {
     // fmi2GetEventIndicators (it has nx = nz = 0): a call of any of them fails the run
     let dir = work_dir("ramp");
     let fmu = Fmu::load(&common::build_ramp(&dir, &common::ramp_xml("local"))).unwrap();
-    for solver in [Solver::Rk4 { max_step: None }, Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 }] {
+    for solver in [
+        Solver::Rk4 { max_step: None },
+        Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 },
+        Solver::Bdf { rtol: 1e-6, atol: 1e-8 },
+    ] {
         let mut b = SystemBuilder::new();
         b.add_instance("ramp", fmu.clone()).unwrap();
         let mut e = Experiment::new(1.0, 0.1);

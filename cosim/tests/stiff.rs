@@ -206,3 +206,20 @@ fn cosim_run_solver_bdf_reports_its_work_in_the_summary() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("the bdf relative tolerance 1e-20 is below"));
 }
+
+#[test]
+fn bdf_ends_a_step_at_a_time_event_and_restarts_there() {
+    // a kick of +2 m/s at t = 0.123 s (not a communication point of the 0.01 s grid)
+    let dir = work_dir("stiff-kick");
+    let fmu = build_ball(&dir);
+    let rtol = 1e-8;
+    let (r, s) =
+        run(&fmu, "ball", &[("t_kick", "0.123"), ("kick", "2")], 0.3, 0.01, Solver::Bdf { rtol, atol: rtol / 100.0 });
+    let time: Vec<f64> = s.events.iter().filter(|e| e.kind == "time").map(|e| e.time).collect();
+    assert_eq!(time, [0.123], "{:?}", s.events);
+    // v' = -g: every BDF order is exact for a linear v (to rounding); h is the parabola
+    // 1 - g t^2 / 2 + 2 (t - 0.123) to the tolerance (order-1 start steps are not exact)
+    let (v, h) = (r.column("v").unwrap(), r.column("h").unwrap());
+    assert!((v[30] - (-9.81 * 0.3 + 2.0)).abs() < 1e-12, "{}", v[30]);
+    assert!((h[30] - (1.0 - 9.81 * 0.09 / 2.0 + 2.0 * (0.3 - 0.123))).abs() < 10.0 * rtol, "{}", h[30]);
+}
