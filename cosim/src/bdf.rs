@@ -42,8 +42,11 @@ pub trait OdeSystem {
 /// The work of the method: what a `--summary` reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Work {
-    /// Right-hand side evaluations by the method (Newton iterations, starting steps).
+    /// Right-hand side evaluations (Newton iterations, starting steps, and those of
+    /// finite-difference Jacobians).
     pub rhs: u64,
+    /// Of `rhs`, those of finite-difference Jacobians (one per column group).
+    pub jacobian_rhs: u64,
     /// Jacobians evaluated.
     pub jacobians: u64,
     /// LU factorizations of `I - c J`.

@@ -223,3 +223,33 @@ fn bdf_ends_a_step_at_a_time_event_and_restarts_there() {
     assert!((v[30] - (-9.81 * 0.3 + 2.0)).abs() < 1e-12, "{}", v[30]);
     assert!((h[30] - (1.0 - 9.81 * 0.09 / 2.0 + 2.0 * (0.3 - 0.123))).abs() < 10.0 * rtol, "{}", h[30]);
 }
+
+#[test]
+fn the_jacobian_from_directional_derivatives_or_differences_one_call_per_column_group() {
+    // van der Pol's columns x0 (row der(x1)) and x1 (rows der(x0), der(x1)) share a row:
+    // two groups, so two calls per Jacobian either way
+    let run_vdp = |fmu: &Path| {
+        let mut b = SystemBuilder::new();
+        b.add_instance("vdp", Fmu::load(fmu).unwrap()).unwrap();
+        b.set_text("vdp.mu", "1000").unwrap();
+        let mut e = Experiment::new(1000.0, 1.0);
+        e.solver = Solver::Bdf { rtol: 1e-7, atol: 1e-9 };
+        e.record = Some(vec!["vdp.x0".into(), "vdp.directional_calls".into(), "vdp.derivative_calls".into()]);
+        simulate(&b.build(), &e).unwrap()
+    };
+    let last = |r: &Results, name: &str| *r.column(name).unwrap().last().unwrap();
+    let (with, s) = run_vdp(&build_vdp(&work_dir("jacobian-directional")));
+    let (without, t) = run_vdp(&common::build_vdp_without_directional_derivatives(&work_dir("jacobian-differences")));
+    eprintln!("directional {:?}\ndifferences {:?}", s.stiff, t.stiff);
+    // the FMU's own counts of its calls equal the summary's
+    assert_eq!(last(&with, "directional_calls"), 2.0 * s.stiff.jacobians as f64);
+    assert_eq!(last(&with, "derivative_calls"), s.stiff.rhs as f64);
+    assert_eq!(s.stiff.jacobian_rhs, 0);
+    assert_eq!(last(&without, "directional_calls"), 0.0);
+    assert_eq!(last(&without, "derivative_calls"), t.stiff.rhs as f64);
+    assert_eq!(t.stiff.jacobian_rhs, 2 * t.stiff.jacobians, "{:?}", t.stiff);
+    // the same solution to the tolerance (the difference Jacobian is only an approximation
+    // of the iteration matrix, not of the solution): x0 at 1000 s
+    let (a, b) = (last(&with, "x0"), last(&without, "x0"));
+    assert!((a - b).abs() < 1e-5, "{a} vs {b}");
+}

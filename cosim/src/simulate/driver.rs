@@ -299,6 +299,7 @@ fn run<'s>(
                 summary.integrator_steps.0 += unit.steps;
                 summary.integrator_steps.1 += unit.rejected;
                 summary.stiff.rhs += unit.stiff.rhs;
+                summary.stiff.jacobian_rhs += unit.stiff.jacobian_rhs;
                 summary.stiff.jacobians += unit.stiff.jacobians;
                 summary.stiff.factorizations += unit.stiff.factorizations;
                 summary.stiff.steps += unit.stiff.steps;

@@ -2,14 +2,15 @@
  *   x0' = x1,  x1' = mu (1 - x0^2) x1 - x0,  x0(0) = 2, x1(0) = 0,
  * with fmi2GetDirectionalDerivative of the state derivatives with respect to the states
  * (the Jacobian [[0, 1], [-2 mu x0 x1 - 1, mu (1 - x0^2)]]), each call counted.
- * Value references: 0 x0, 1 der(x0), 2 x1, 3 der(x1), 4 mu (parameter), 5 directional_calls
- * (local: the calls of fmi2GetDirectionalDerivative so far). */
+ * Value references: 0 x0, 1 der(x0), 2 x1, 3 der(x1), 4 mu (parameter), 5 directional_calls,
+ * 6 derivative_calls (locals: the calls of fmi2GetDirectionalDerivative and of
+ * fmi2GetDerivatives so far). */
 #define FMI2_TEST_NO_FMU_STATE
 #define FMI2_TEST_DIRECTIONAL_DERIVATIVE
 #include "fmi2_test.h"
 
 typedef struct {
-    double r[6];
+    double r[7];
     double time;
 } Vdp;
 
@@ -47,7 +48,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     size_t i;
     derivatives(m);
     for (i = 0; i < n; i++) {
-        if (vr[i] >= 6) return ERR;
+        if (vr[i] >= 7) return ERR;
         v[i] = m->r[vr[i]];
     }
     return 0;
@@ -118,6 +119,7 @@ EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n)
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
     Vdp *m = c;
     if (n != 2) return ERR;
+    m->r[6] += 1.0;
     derivatives(m);
     dx[0] = m->r[1];
     dx[1] = m->r[3];

@@ -331,3 +331,11 @@ pub fn build_linear(dir: &Path) -> PathBuf {
 "#;
     build_single_c_fmu(dir, "linear", xml)
 }
+
+/// [`build_vdp`] with `providesDirectionalDerivative="false"` (the master differences the
+/// right-hand side), as `<dir>/vdp.fmu`.
+pub fn build_vdp_without_directional_derivatives(dir: &Path) -> PathBuf {
+    let xml = include_str!("../cfmu/vdp.xml")
+        .replace(r#"providesDirectionalDerivative="true""#, r#"providesDirectionalDerivative="false""#);
+    build_single_c_fmu(dir, "vdp", &xml)
+}

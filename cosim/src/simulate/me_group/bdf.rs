@@ -208,6 +208,7 @@ impl MeGroup {
         if let Some((_, u)) = lanes.member(self.members[0]) {
             u.stiff = s.bdf.work;
             u.stiff.rhs += s.difference_rhs;
+            u.stiff.jacobian_rhs = s.difference_rhs;
             u.rejected = s.bdf.work.rejected;
         }
         self.stiff = Some(s);
