@@ -68,6 +68,8 @@ pub struct Bdf {
     /// Time of the step before it: the dense output is for [t_old, t].
     pub t_old: f64,
     h: f64,
+    /// The step the method asked for last, before a limit shortened it.
+    h_free: f64,
     order: usize,
     equal_steps: usize,
     /// Backward differences: d[0] = x(t), d[j] the j-th difference at spacing h
@@ -149,6 +151,7 @@ impl Bdf {
             t: 0.0,
             t_old: 0.0,
             h: 0.0,
+            h_free: 0.0,
             order: 1,
             equal_steps: 0,
             d: vec![vec![0.0; n]; MAX_ORDER + 3],
@@ -184,13 +187,25 @@ impl Bdf {
     /// f and a trial Euler step (Hairer, Norsett and Wanner, Solving ODEs I, II.4), at most
     /// `h_max`.
     pub fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, x: &[f64], h_max: f64) -> Result<()> {
+        self.have_jac = false;
+        self.h_free = 0.0;
+        self.begin(sys, t, x, h_max)
+    }
+
+    /// Restarts after an event at (t, x) with order 1, keeping the Jacobian (a new one
+    /// when the Newton iteration fails with it) and trying the step the method last asked
+    /// for (the error test shortens it where the event changed the solution's scale).
+    pub fn restart(&mut self, sys: &mut dyn OdeSystem, t: f64, x: &[f64], h_max: f64) -> Result<()> {
+        self.begin(sys, t, x, h_max)
+    }
+
+    fn begin(&mut self, sys: &mut dyn OdeSystem, t: f64, x: &[f64], h_max: f64) -> Result<()> {
         let n = self.n;
         self.t = t;
         self.t_old = t;
         self.order = 1;
         self.equal_steps = 0;
         self.jac_current = false;
-        self.have_jac = false;
         self.lu = None;
         sys.rhs(t, x, &mut self.f)?;
         self.work.rhs += 1;
@@ -212,6 +227,9 @@ impl Bdf {
         let d2 = norm(&self.psi, &self.scale) / h0;
         let h1 = if d1 <= 1e-15 && d2 <= 1e-15 { (1e-6f64).max(h0 * 1e-3) } else { (0.01 / d1.max(d2)).powf(0.5) };
         self.h = (100.0 * h0).min(h1).min(h_max);
+        if self.h_free > self.h {
+            self.h = self.h_free.min(h_max);
+        }
         if self.h.is_nan() || self.h <= 0.0 || n == 0 {
             // no states: nothing to resolve, one step to the limit
             self.h = h_max;
@@ -286,6 +304,7 @@ impl Bdf {
             }
             // the step ends at t_limit when it would pass it
             let remaining = t_limit - self.t;
+            self.h_free = self.h;
             if self.h > remaining {
                 self.change_step(remaining / self.h);
             }

@@ -5,7 +5,8 @@
 //! accepted step) is located by the Illinois method on the step's dense output to
 //! [`EVENT_TIME_TOLERANCE`], step events come from `fmi2CompletedIntegratorStep`, and
 //! `terminateSimulation` ends the run. After every event the method restarts (order 1)
-//! from the states the event iteration left. A step ends at the end of each
+//! from the states the event iteration left, with the step it last asked for and its
+//! Jacobian (renewed when the Newton iteration fails with it). A step ends at the end of each
 //! communication step (where the members' inputs may change) and the method's history
 //! is kept across it.
 //!
@@ -274,7 +275,11 @@ impl MeGroup {
                             x[offsets[k]..offsets[k + 1]].copy_from_slice(&u.x);
                         }
                     }
-                    bdf.start(&mut sys, t, x, limit - t)?;
+                    if bdf.work.steps == 0 {
+                        bdf.start(&mut sys, t, x, limit - t)?;
+                    } else {
+                        bdf.restart(&mut sys, t, x, limit - t)?;
+                    }
                     *started = true;
                 }
                 let rejected = bdf.work.rejected;
