@@ -939,6 +939,41 @@ impl Instance {
         call!(self, "fmi2GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
     }
 
+    /// Whether the FMU's library has `fmi2GetDirectionalDerivative` (an isolated instance's
+    /// host does not forward it).
+    pub fn has_directional_derivative(&self) -> bool {
+        self.fmu.functions.get_directional_derivative.is_some()
+    }
+
+    /// `fmi2GetDirectionalDerivative` at the instance's current point: `dv_unknown` =
+    /// d(unknowns)/d(knowns) `dv_known` (FMI 2.0 section 2.1.9).
+    pub fn get_directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<()> {
+        assert_eq!(knowns.len(), dv_known.len(), "get_directional_derivative: one seed per known");
+        assert_eq!(unknowns.len(), dv_unknown.len(), "get_directional_derivative: one value per unknown");
+        let f = self.optional(self.fmu.functions.get_directional_derivative, "fmi2GetDirectionalDerivative")?;
+        let c = self.component;
+        call!(
+            self,
+            "fmi2GetDirectionalDerivative",
+            None,
+            f(
+                c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                dv_known.as_ptr(),
+                dv_unknown.as_mut_ptr()
+            )
+        )
+    }
+
     /// `fmi2EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
         let f = self.optional(self.fmu.functions.enter_event_mode, "fmi2EnterEventMode")?;

@@ -29,6 +29,7 @@
 
 #![warn(missing_docs)]
 
+pub mod bdf;
 mod elf;
 pub mod error;
 pub mod exit_guard;

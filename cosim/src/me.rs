@@ -32,6 +32,16 @@ pub enum Solver {
         /// Absolute tolerance.
         atol: f64,
     },
+    /// Variable-order (1 to 5) variable-step BDF (the NDFs of [`crate::bdf`]) for stiff
+    /// models, with the Jacobian from the FMU's directional derivatives where it provides
+    /// them, else finite differences, both by column groups of its ModelStructure;
+    /// error per state below `atol + rtol |x|`.
+    Bdf {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance.
+        atol: f64,
+    },
 }
 
 impl Default for Solver {
@@ -70,6 +80,8 @@ pub struct MeUnit {
     pub rejected: u64,
     /// The FMU asked to terminate.
     pub terminated: bool,
+    /// The work of the bdf solver of this instance's group (held by its first member).
+    pub stiff: crate::bdf::Work,
 }
 
 impl MeUnit {
@@ -92,6 +104,7 @@ impl MeUnit {
             steps: 0,
             rejected: 0,
             terminated: false,
+            stiff: crate::bdf::Work::default(),
         }
     }
 
@@ -105,14 +118,37 @@ impl MeUnit {
     /// After an event iteration that ended in continuous-time mode: the states and event
     /// indicators as the FMU now has them.
     pub(crate) fn resume(&mut self, inst: &mut Instance) -> Result<()> {
-        inst.get_continuous_states(&mut self.x)?;
-        inst.get_event_indicators(&mut self.z0)
+        if !self.x.is_empty() {
+            inst.get_continuous_states(&mut self.x)?;
+        }
+        Self::indicators(inst, &mut self.z0)
     }
 
+    /// The time and the derivatives at (t, x); with no continuous states only the time
+    /// (the state functions are never called with nx = 0: some FMUs refuse it).
     pub(crate) fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
         inst.set_time(t)?;
+        if x.is_empty() {
+            return Ok(());
+        }
         inst.set_continuous_states(x)?;
         inst.get_derivatives(dx)
+    }
+
+    /// `fmi2SetContinuousStates`, not called with no continuous states.
+    pub(crate) fn set_states(inst: &mut Instance, x: &[f64]) -> Result<()> {
+        if x.is_empty() {
+            return Ok(());
+        }
+        inst.set_continuous_states(x)
+    }
+
+    /// `fmi2GetEventIndicators`, not called with no event indicators.
+    pub(crate) fn indicators(inst: &mut Instance, z: &mut [f64]) -> Result<()> {
+        if z.is_empty() {
+            return Ok(());
+        }
+        inst.get_event_indicators(z)
     }
 
     /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).
@@ -182,14 +218,18 @@ impl MeUnit {
         match solver {
             Solver::Rk4 { .. } => self.rk4(inst, t, h),
             Solver::Dopri5 { rtol, atol } => self.dopri(inst, t, h, rtol, atol).map(|_| ()),
+            // the bdf path locates events on its dense output (simulate/me_group/bdf.rs)
+            Solver::Bdf { .. } => {
+                Err(crate::error::Error::Experiment("internal: a one-step method asked of the bdf solver".into()))
+            }
         }
     }
 
     /// Event indicators at (t, xt) into `z`.
     pub(crate) fn indicators_at(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
         inst.set_time(t)?;
-        inst.set_continuous_states(&self.xt)?;
-        inst.get_event_indicators(&mut self.z)
+        Self::set_states(inst, &self.xt)?;
+        Self::indicators(inst, &mut self.z)
     }
 
     pub(crate) fn crossed(z0: &[f64], z: &[f64]) -> bool {

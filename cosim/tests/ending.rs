@@ -4,7 +4,7 @@
 //! - Co-Simulation: `fmi2DoStep` over (8.8, 9.0] returns fmi2Discard with fmi2Terminated
 //!   true and fmi2LastSuccessfulTime 9: the run ends there, with the row at 9 (counter 10);
 //! - Model Exchange: `terminateSimulation` at the time event at 9: the run ends at the
-//!   event, the last row is the communication point before it (8.8, counter 9).
+//!   event, with the row at 9 after its event iteration (counter 10), as in Co-Simulation.
 
 mod common;
 use common::{build_stair, work_dir};
@@ -41,16 +41,39 @@ fn co_simulation_ends_at_the_last_successful_time_with_that_row() {
 }
 
 #[test]
-fn model_exchange_ends_at_the_event_with_no_row_after_it() {
+fn model_exchange_ends_at_the_event_with_the_row_at_the_event() {
     let system = stair(Interface::ModelExchange);
     let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
     let time = r.column("time").unwrap();
     let counter = r.column("counter").unwrap();
-    assert_eq!(r.rows(), 45);
-    assert!((time.last().unwrap() - 8.8).abs() < 1e-12, "{:?}", time.last()); // 44 * 0.2 in f64
+    // rows 0, 0.2, ..., 8.8 (45 communication points), then the row at the event at 9
+    assert_eq!(r.rows(), 46);
+    assert!((time[44] - 8.8).abs() < 1e-12, "{}", time[44]); // 44 * 0.2 in f64
+    assert_eq!(*time.last().unwrap(), 9.0);
+    assert_eq!(*counter.last().unwrap(), 10.0);
     for (t, c) in time.iter().zip(&counter) {
         assert_eq!(*c, counter_at(*t), "t = {t}");
     }
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
+}
+
+#[test]
+fn model_exchange_with_bdf_ends_at_the_event_with_the_row_at_the_event() {
+    // no states (the bdf method has nothing to integrate), time events each second
+    let system = stair(Interface::ModelExchange);
+    let mut e = Experiment::new(10.0, 0.2);
+    e.solver = nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    let (r, summary) = simulate(&system, &e).unwrap();
+    let time = r.column("time").unwrap();
+    let counter = r.column("counter").unwrap();
+    assert_eq!(r.rows(), 46);
+    assert_eq!((*time.last().unwrap(), *counter.last().unwrap()), (9.0, 10.0));
+    for (t, c) in time.iter().zip(&counter) {
+        assert_eq!(*c, counter_at(*t), "t = {t}");
+    }
+    let times: Vec<f64> = summary.events.iter().map(|e| e.time).collect();
+    assert_eq!(times, (1..=9).map(f64::from).collect::<Vec<_>>());
     let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
     assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
 }

@@ -130,3 +130,30 @@ fn mixed_co_simulation_and_model_exchange_system() {
         assert!(x[500].abs() > 1e-4);
     }
 }
+
+#[test]
+fn an_fmu_with_no_states_runs_without_the_state_functions() {
+    // ramp.c refuses fmi2Get/SetContinuousStates, fmi2GetDerivatives and
+    // fmi2GetEventIndicators (it has nx = nz = 0): a call of any of them fails the run
+    let dir = work_dir("ramp");
+    let fmu = Fmu::load(&common::build_ramp(&dir, &common::ramp_xml("local"))).unwrap();
+    for solver in [
+        Solver::Rk4 { max_step: None },
+        Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 },
+        Solver::Bdf { rtol: 1e-6, atol: 1e-8 },
+    ] {
+        let mut b = SystemBuilder::new();
+        b.add_instance("ramp", fmu.clone()).unwrap();
+        let mut e = Experiment::new(1.0, 0.1);
+        e.solver = solver;
+        let (r, s) = simulate(&b.build(), &e).unwrap();
+        assert_eq!(r.rows(), 11, "{solver:?}");
+        // y = 2 t, and 2 t + 1 from the time event at 0.55 s on (the FMU's definition)
+        for (t, y) in r.column("time").unwrap().iter().zip(r.column("y").unwrap()) {
+            let exact = 2.0 * t + if *t >= 0.55 { 1.0 } else { 0.0 };
+            assert!((y - exact).abs() < 1e-14, "{solver:?}: y({t}) = {y} vs {exact}");
+        }
+        let times: Vec<(f64, &str)> = s.events.iter().map(|e| (e.time, e.kind)).collect();
+        assert_eq!(times, [(0.55, "time")], "{solver:?}");
+    }
+}

@@ -228,6 +228,19 @@ fn the_step_warning_is_only_for_fmus_that_sample() {
     // the controller by its sample_period parameter
     let err = run(&fmu_dir.join("nigel_controller.fmu"), &[]);
     assert!(err.contains("runs every 0.001 s (its parameter sample_period)"), "{err}");
+    // a Model Exchange FMU with a discrete local (stepSize 0.01 s) is continuous: no
+    // warning at a step of 0.1 s; the same FMU with that variable an output samples it
+    for (causality, warns) in [("local", false), ("output", true)] {
+        let dir = work_dir(&format!("step-warning-{causality}"));
+        let fmu = common::build_ramp(&dir, &common::ramp_xml(causality));
+        let csv = dir.join("out.csv");
+        let (code, _, err) =
+            cosim(&["run", fmu.to_str().unwrap(), "--step", "0.1", "--output", csv.to_str().unwrap()], None);
+        assert_eq!(code, Some(0), "{err}");
+        let expected = "runs every 0.01 s (its DefaultExperiment stepSize), but the communication step is 0.1 s";
+        assert_eq!(err.contains(expected), warns, "{causality}: {err}");
+        assert_eq!(err.contains("warning"), warns, "{causality}: {err}");
+    }
 }
 
 #[test]

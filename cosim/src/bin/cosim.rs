@@ -80,10 +80,11 @@ struct RunArgs {
     /// ordered or jacobi.
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
-    /// Model Exchange solver: rk4 or dopri5.
+    /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
+    /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 (absolute: rtol / 100).
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
     #[arg(long, default_value_t = 1e-6)]
     rtol: f64,
     /// Largest RK4 step, s (default: the communication step).
@@ -268,8 +269,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
             nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
         }
-        "dopri5" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5)"))),
+        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
+            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
+        }
+        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()));
@@ -480,7 +484,7 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
 }
 
 /// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else, for an FMU with discrete states or outputs, its DefaultExperiment stepSize) is shorter than the communication step: its
+/// else, for an FMU with discrete states or outputs (Model Exchange: outputs), its DefaultExperiment stepSize) is shorter than the communication step: its
 /// inputs are then held and its outputs read less often than it is meant to run.
 fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
     let mut out = Vec::new();
@@ -502,10 +506,19 @@ fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
         });
         // the stepSize is only a suggestion of a continuous model (its integrator runs
         // within any step); it is a sample period where the FMU has discrete-time values
-        // of its own (discrete states or outputs, which change at its sample instants)
+        // of its own, which change at its sample instants: in Co-Simulation discrete
+        // states or outputs; in Model Exchange discrete outputs only (its discrete states
+        // change at its events, which the master's integrator stops at within any
+        // communication step; a model with discrete locals, such as the when-conditions
+        // of a Modelica model, is continuous there)
+        let me = spec.fmu.interface() == nigel_cosim::Interface::ModelExchange;
         let samples = md.model_variables.iter().any(|v| {
             v.variability == model_description::Variability::Discrete
-                && !matches!(v.causality, model_description::Causality::Input | model_description::Causality::Parameter)
+                && match v.causality {
+                    model_description::Causality::Output => true,
+                    model_description::Causality::Input | model_description::Causality::Parameter => false,
+                    _ => !me,
+                }
         });
         let declared = from_parameter.or_else(|| {
             md.default_experiment

@@ -7,7 +7,7 @@ use crate::fmu::{Instance, Interface};
 use crate::me::{MeUnit, Solver};
 use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
 use crate::simulate::clock::Clock;
-use crate::simulate::lane::{apply_start_values, Lane, DISCARD_TERMINATED};
+use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
 use crate::simulate::observer::{Deadline, Observer, Observers, Profiler, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Plan};
@@ -70,15 +70,16 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
             }
         }
         Solver::Rk4 { max_step: None } => {}
-        Solver::Dopri5 { rtol, atol } => {
+        Solver::Dopri5 { rtol, atol } | Solver::Bdf { rtol, atol } => {
+            let name = if matches!(e.solver, Solver::Bdf { .. }) { "bdf" } else { "dopri5" };
             if !(rtol.is_finite() && rtol >= MIN_RTOL) {
                 return Err(Error::Experiment(format!(
-                    "the dopri5 relative tolerance {rtol:e} is below {MIN_RTOL:e} (100 machine epsilons), which no f64 step can meet"
+                    "the {name} relative tolerance {rtol:e} is below {MIN_RTOL:e} (100 machine epsilons), which no f64 step can meet"
                 )));
             }
             if !(atol.is_finite() && atol >= 0.0) {
                 return Err(Error::Experiment(format!(
-                    "the dopri5 absolute tolerance {atol:e} must be finite and >= 0"
+                    "the {name} absolute tolerance {atol:e} must be finite and >= 0"
                 )));
             }
         }
@@ -146,7 +147,10 @@ fn run<'s>(
     }
     let mut plan = Plan::new(system, &record, experiment.algorithm)?;
     // Model Exchange instances connected to each other are integrated together
-    let group = MeGroup::coupled(system, experiment.max_steps)?;
+    let mut group = MeGroup::coupled(system, experiment.max_steps)?;
+    if let Some(g) = group.as_mut() {
+        g.stop_time = experiment.stop_time;
+    }
     let record_slots: Vec<usize> = record.iter().map(|r| plan.slot(r)).collect();
     // all recorded variables, one get per instance and type (for the first row)
     let mut record_gets = plan.record_gets(&record);
@@ -219,7 +223,9 @@ fn run<'s>(
             if lane.inst.fmu().interface() == Interface::ModelExchange {
                 lane.unit = Some(MeUnit::new(&lane.inst));
                 if !core.group.as_ref().is_some_and(|g| g.contains(lane.index)) {
-                    lane.solo = Some(MeGroup::solo(lane.index, experiment.max_steps));
+                    let mut solo = MeGroup::solo(lane.index, experiment.max_steps);
+                    solo.stop_time = experiment.stop_time;
+                    lane.solo = Some(solo);
                 }
             }
         }
@@ -269,10 +275,11 @@ fn run<'s>(
         }
         let mut ended_by = None;
         if let Some(Error::Terminated { instance, time, reason }) = ended {
-            // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
-            // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
-            // row after the last communication point before the event (as fmpy)
-            if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
+            // the row at the time the run ended, every recorded variable read as its
+            // instance now has it: Co-Simulation at fmi2LastSuccessfulTime (fmpy and fmusim
+            // record it too), Model Exchange at the event that set terminateSimulation,
+            // after its event iteration (fmpy with record_events records it too)
+            if time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
                 run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
                 recorder.push_row(time, &core.values);
             }
@@ -298,6 +305,12 @@ fn run<'s>(
             if let Some(unit) = lane.unit.take() {
                 summary.integrator_steps.0 += unit.steps;
                 summary.integrator_steps.1 += unit.rejected;
+                summary.stiff.rhs += unit.stiff.rhs;
+                summary.stiff.jacobian_rhs += unit.stiff.jacobian_rhs;
+                summary.stiff.jacobians += unit.stiff.jacobians;
+                summary.stiff.factorizations += unit.stiff.factorizations;
+                summary.stiff.steps += unit.stiff.steps;
+                summary.stiff.rejected += unit.stiff.rejected;
                 summary.events.extend(unit.events);
             }
         }

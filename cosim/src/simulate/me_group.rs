@@ -25,6 +25,8 @@ use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
 use crate::simulate::plan::{ordered_ops, Instances, Op};
 use crate::system::{Connection, System, VariableRef};
 
+mod bdf;
+
 /// Access to the members of a group: each one's instance and integration state.
 pub(crate) trait Members: Instances {
     /// Member `m` (an instance index of the system), if it has its integration state.
@@ -63,6 +65,11 @@ pub(crate) struct MeGroup {
     /// Internal steps tried (accepted and rejected) so far, and the cap on them.
     tried: u64,
     max_steps: u64,
+    /// The bdf solver's state (its history between communication steps).
+    stiff: Option<Box<bdf::GroupBdf>>,
+    /// The stop time of the run: the bdf solver steps past communication points, not
+    /// past it.
+    pub(crate) stop_time: f64,
 }
 
 impl MeGroup {
@@ -75,6 +82,8 @@ impl MeGroup {
             before: Vec::new(),
             tried: 0,
             max_steps,
+            stiff: None,
+            stop_time: f64::INFINITY,
         }
     }
 
@@ -97,7 +106,16 @@ impl MeGroup {
         }
         let ops = ordered_ops(&sub, &sources, &sources)?;
         let n = sources.len();
-        Ok(Some(MeGroup { members, ops, values: vec![0.0; n], before: vec![0.0; n], tried: 0, max_steps }))
+        Ok(Some(MeGroup {
+            members,
+            ops,
+            values: vec![0.0; n],
+            before: vec![0.0; n],
+            tried: 0,
+            max_steps,
+            stiff: None,
+            stop_time: f64::INFINITY,
+        }))
     }
 
     /// Whether lane `i` is a member.
@@ -229,6 +247,9 @@ impl MeGroup {
         t: f64,
         t_end: f64,
     ) -> Result<()> {
+        if let Solver::Bdf { rtol, atol } = solver {
+            return self.advance_bdf(lanes, rtol, atol, t, t_end);
+        }
         let mut t = t;
         let span = t_end - t;
         let eps = time_slack(t_end, span);
@@ -281,7 +302,7 @@ impl MeGroup {
                     let hm = max_step.unwrap_or(span).max(1e-300);
                     h_max / ((h_max / hm) * (1.0 - 1e-12)).ceil().max(1.0)
                 }
-                Solver::Dopri5 { .. } => {
+                Solver::Dopri5 { .. } | Solver::Bdf { .. } => {
                     members.iter().filter_map(|m| lanes.member(*m).map(|(_, u)| u.h_adaptive)).fold(h_max, f64::min)
                 }
             };
@@ -313,7 +334,7 @@ impl MeGroup {
                     }
                     h *= factor.min(0.9);
                 },
-                Solver::Rk4 { .. } => {
+                Solver::Rk4 { .. } | Solver::Bdf { .. } => {
                     self.count_step(lanes, t)?;
                     for &m in members {
                         if let Some((inst, u)) = lanes.member(m) {
@@ -341,7 +362,7 @@ impl MeGroup {
                     let Some((inst, u)) = lanes.member(m) else { continue };
                     u.one_step(inst, solver, t, hi)?;
                     inst.set_time(te)?;
-                    inst.set_continuous_states(&u.xt)?;
+                    MeUnit::set_states(inst, &u.xt)?;
                     u.x.copy_from_slice(&u.xt);
                     u.steps += 1;
                     inst.completed_integrator_step()?;
@@ -365,7 +386,7 @@ impl MeGroup {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&u.xt);
                 inst.set_time(t_new)?;
-                inst.set_continuous_states(&u.x)?;
+                MeUnit::set_states(inst, &u.x)?;
                 u.steps += 1;
                 std::mem::swap(&mut u.z0, &mut u.z);
                 let (step_event, terminate) = inst.completed_integrator_step()?;

@@ -186,6 +186,9 @@ pub struct Summary {
     pub events: Vec<crate::me::Event>,
     /// Internal integrator steps of Model Exchange instances (accepted, rejected).
     pub integrator_steps: (u64, u64),
+    /// The work of the bdf solver (right-hand sides, Jacobians, factorizations; zero
+    /// with the other solvers).
+    pub stiff: crate::bdf::Work,
     /// Steps redone in halves after an fmi2Discard.
     pub discard_retries: u64,
     /// `jacobi` steps run with the instances spread over threads (0 in one thread).
@@ -206,6 +209,7 @@ impl Summary {
             "parallel_steps": self.parallel_steps,
             "ended_by": self.ended_by.as_ref().map(|(i, t, r)| serde_json::json!({"instance": i, "time": t, "reason": r})),
             "integrator_steps": {"accepted": self.integrator_steps.0, "rejected": self.integrator_steps.1},
+            "bdf": {"rhs": self.stiff.rhs, "jacobian_rhs": self.stiff.jacobian_rhs, "jacobians": self.stiff.jacobians, "factorizations": self.stiff.factorizations},
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),

@@ -45,13 +45,16 @@ EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[],
 EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *v[]) { return n ? ERR : 0; }
 EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const char *const v[]) { return n ? ERR : 0; }
 
-/* No serialization and no directional derivatives. */
+/* No serialization and (unless the file defines FMI2_TEST_DIRECTIONAL_DERIVATIVE and its own
+ * fmi2GetDirectionalDerivative) no directional derivatives. */
 EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, void *s, size_t *n) { return ERR; }
 EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, void *s, char *b, size_t n) { return ERR; }
 EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const char *b, size_t n, void **s) { return ERR; }
+#ifndef FMI2_TEST_DIRECTIONAL_DERIVATIVE
 EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                                const fmi2ValueReference z[], size_t nz, const double dv[],
                                                double dz[]) { return ERR; }
+#endif
 
 #ifdef FMI2_TEST_NO_FMU_STATE
 EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, void **s) { return ERR; }

@@ -229,26 +229,7 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
 
 /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
 pub fn build_ball(dir: &Path) -> PathBuf {
-    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="ball" guid="{ball}" numberOfEventIndicators="1">
-  <ModelExchange modelIdentifier="ball"/>
-  <ModelVariables>
-    <ScalarVariable name="h" valueReference="0" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
-    <ScalarVariable name="v" valueReference="1" causality="output" initial="exact"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="der(h)" valueReference="2"><Real derivative="1"/></ScalarVariable>
-    <ScalarVariable name="der(v)" valueReference="3"><Real derivative="2"/></ScalarVariable>
-    <ScalarVariable name="g" valueReference="4" causality="parameter" variability="fixed"><Real start="9.81"/></ScalarVariable>
-    <ScalarVariable name="e" valueReference="5" causality="parameter" variability="fixed"><Real start="0.7"/></ScalarVariable>
-    <ScalarVariable name="t_kick" valueReference="6" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="kick" valueReference="7" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
-  </ModelVariables>
-  <ModelStructure>
-    <Outputs><Unknown index="1" dependencies=""/><Unknown index="2" dependencies=""/></Outputs>
-    <Derivatives><Unknown index="3" dependencies="2"/><Unknown index="4" dependencies=""/></Derivatives>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
-    build_single_c_fmu(dir, "ball", xml)
+    build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))
 }
 
 /// The discrete latch (tests/cfmu/latch.c), Model Exchange only, as `<dir>/latch.fmu`.
@@ -294,4 +275,67 @@ pub fn time_and_y(csv: &str) -> Vec<(f64, f64)> {
             (t.parse().unwrap(), y.parse().unwrap())
         })
         .collect()
+}
+
+/// The model description of the FMU with no states (tests/cfmu/ramp.c); `offset_causality`
+/// of its discrete variable `offset` ("local" as the FMU has it, "output" to test the
+/// sample-period warning).
+pub fn ramp_xml(offset_causality: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="ramp" guid="{{ramp}}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="ramp"/>
+  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.01"/>
+  <ModelVariables>
+    <ScalarVariable name="y" valueReference="0" causality="output"><Real/></ScalarVariable>
+    <ScalarVariable name="slope" valueReference="1" causality="parameter" variability="fixed"><Real start="2"/></ScalarVariable>
+    <ScalarVariable name="t_step" valueReference="2" causality="parameter" variability="fixed"><Real start="0.55"/></ScalarVariable>
+    <ScalarVariable name="offset" valueReference="3" causality="{offset_causality}" variability="discrete"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#
+    )
+}
+
+/// The FMU with no continuous states and no event indicators (tests/cfmu/ramp.c), Model
+/// Exchange only, with the model description `xml` ([`ramp_xml`]), as `<dir>/ramp.fmu`.
+pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
+    build_single_c_fmu(dir, "ramp", xml)
+}
+
+/// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
+/// `<dir>/vdp.fmu`.
+pub fn build_vdp(dir: &Path) -> PathBuf {
+    build_single_c_fmu(dir, "vdp", include_str!("../cfmu/vdp.xml"))
+}
+
+/// The stiff linear system with a closed-form solution (tests/cfmu/linear.c), Model
+/// Exchange only, as `<dir>/linear.fmu`.
+pub fn build_linear(dir: &Path) -> PathBuf {
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="linear" guid="{linear}" numberOfEventIndicators="0">
+  <ModelExchange modelIdentifier="linear"/>
+  <ModelVariables>
+    <ScalarVariable name="x1" valueReference="0" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="der(x1)" valueReference="1"><Real derivative="1"/></ScalarVariable>
+    <ScalarVariable name="x2" valueReference="2" causality="output" initial="exact"><Real start="1"/></ScalarVariable>
+    <ScalarVariable name="der(x2)" valueReference="3"><Real derivative="3"/></ScalarVariable>
+    <ScalarVariable name="lambda" valueReference="4" causality="parameter" variability="fixed"><Real start="10000"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="1" dependencies=""/><Unknown index="3" dependencies=""/></Outputs>
+    <Derivatives><Unknown index="2" dependencies="1 3"/><Unknown index="4" dependencies="3"/></Derivatives>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    build_single_c_fmu(dir, "linear", xml)
+}
+
+/// [`build_vdp`] with `providesDirectionalDerivative="false"` (the master differences the
+/// right-hand side), as `<dir>/vdp.fmu`.
+pub fn build_vdp_without_directional_derivatives(dir: &Path) -> PathBuf {
+    let xml = include_str!("../cfmu/vdp.xml")
+        .replace(r#"providesDirectionalDerivative="true""#, r#"providesDirectionalDerivative="false""#);
+    build_single_c_fmu(dir, "vdp", &xml)
 }

@@ -1,0 +1,87 @@
+/* An FMI 2.0 Model Exchange FMU with no continuous states and no event indicators, which
+ * refuses (fmi2Error) every call of fmi2GetContinuousStates, fmi2SetContinuousStates,
+ * fmi2GetDerivatives, fmi2GetNominalsOfContinuousStates and fmi2GetEventIndicators, as
+ * some third-party FMUs refuse them with nx = 0 or nz = 0.
+ * Value references: 0 y = slope * time + offset (output, continuous), 1 slope (parameter),
+ * 2 t_step (parameter), 3 offset (local, discrete: 0, then 1 from the time event at
+ * t_step). */
+#define FMI2_TEST_NO_FMU_STATE
+#include "fmi2_test.h"
+
+typedef struct {
+    double slope, t_step, offset, time;
+} Ramp;
+
+static void defaults(Ramp *r) {
+    r->slope = 2.0;
+    r->t_step = 0.55;
+    r->offset = 0.0;
+    r->time = 0.0;
+}
+
+EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
+                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
+    Ramp *r;
+    if (!cb || !cb->logger || type != 0) return NULL;
+    r = calloc(1, sizeof *r);
+    defaults(r);
+    return r;
+}
+EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
+    ((Ramp *)c)->time = t0;
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
+    Ramp *r = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        switch (vr[i]) {
+        case 0: v[i] = r->slope * r->time + r->offset; break;
+        case 1: v[i] = r->slope; break;
+        case 2: v[i] = r->t_step; break;
+        case 3: v[i] = r->offset; break;
+        default: return ERR;
+        }
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
+    Ramp *r = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] == 1) r->slope = v[i];
+        else if (vr[i] == 2) r->t_step = v[i];
+        else return ERR;
+    }
+    return 0;
+}
+
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    Ramp *r = c;
+    memset(info, 0, sizeof *info);
+    if (r->offset == 0.0 && r->time >= r->t_step) r->offset = 1.0;
+    if (r->offset == 0.0) {
+        info->nextEventTimeDefined = 1;
+        info->nextEventTime = r->t_step;
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
+    *enterEventMode = 0;
+    *terminate = 0;
+    return 0;
+}
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Ramp *)c)->time = t; return 0; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return ERR; }
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return ERR; }
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return ERR; }
+EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
+

@@ -1,0 +1,133 @@
+/* Van der Pol oscillator, FMI 2.0 Model Exchange, after the Reference FMU VanDerPol:
+ *   x0' = x1,  x1' = mu (1 - x0^2) x1 - x0,  x0(0) = 2, x1(0) = 0,
+ * with fmi2GetDirectionalDerivative of the state derivatives with respect to the states
+ * (the Jacobian [[0, 1], [-2 mu x0 x1 - 1, mu (1 - x0^2)]]), each call counted.
+ * Value references: 0 x0, 1 der(x0), 2 x1, 3 der(x1), 4 mu (parameter), 5 directional_calls,
+ * 6 derivative_calls (locals: the calls of fmi2GetDirectionalDerivative and of
+ * fmi2GetDerivatives so far). */
+#define FMI2_TEST_NO_FMU_STATE
+#define FMI2_TEST_DIRECTIONAL_DERIVATIVE
+#include "fmi2_test.h"
+
+typedef struct {
+    double r[7];
+    double time;
+} Vdp;
+
+static void defaults(Vdp *v) {
+    memset(v, 0, sizeof *v);
+    v->r[0] = 2.0;
+    v->r[4] = 1.0;
+}
+
+static void derivatives(Vdp *v) {
+    double x0 = v->r[0], x1 = v->r[2], mu = v->r[4];
+    v->r[1] = x1;
+    v->r[3] = mu * (1.0 - x0 * x0) * x1 - x0;
+}
+
+EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
+                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
+    Vdp *v;
+    if (!cb || !cb->logger || type != 0) return NULL;
+    v = calloc(1, sizeof *v);
+    defaults(v);
+    return v;
+}
+EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
+EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
+    ((Vdp *)c)->time = t0;
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
+    Vdp *m = c;
+    size_t i;
+    derivatives(m);
+    for (i = 0; i < n; i++) {
+        if (vr[i] >= 7) return ERR;
+        v[i] = m->r[vr[i]];
+    }
+    return 0;
+}
+EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
+    Vdp *m = c;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (vr[i] != 0 && vr[i] != 2 && vr[i] != 4) return ERR;
+        m->r[vr[i]] = v[i];
+    }
+    return 0;
+}
+
+/* d der(vr_unknown) / d state(vr_known) */
+static int partial(const Vdp *m, fmi2ValueReference unknown, fmi2ValueReference known, double *out) {
+    double x0 = m->r[0], x1 = m->r[2], mu = m->r[4];
+    if (unknown == 1 && known == 0) *out = 0.0;
+    else if (unknown == 1 && known == 2) *out = 1.0;
+    else if (unknown == 3 && known == 0) *out = -2.0 * mu * x0 * x1 - 1.0;
+    else if (unknown == 3 && known == 2) *out = mu * (1.0 - x0 * x0);
+    else return 0;
+    return 1;
+}
+EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                               const fmi2ValueReference z[], size_t nz, const double dv[],
+                                               double dz[]) {
+    Vdp *m = c;
+    size_t i, j;
+    double p;
+    m->r[5] += 1.0;
+    for (i = 0; i < nu; i++) {
+        dz[i] = 0.0;
+        for (j = 0; j < nz; j++) {
+            if (!partial(m, u[i], z[j], &p)) return ERR;
+            dz[i] += p * dv[j];
+        }
+    }
+    return 0;
+}
+
+EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    memset(info, 0, sizeof *info);
+    return 0;
+}
+EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
+EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
+    *enterEventMode = 0;
+    *terminate = 0;
+    return 0;
+}
+EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Vdp *)c)->time = t; return 0; }
+EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
+    Vdp *m = c;
+    if (n != 2) return ERR;
+    m->r[0] = x[0];
+    m->r[2] = x[1];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) {
+    Vdp *m = c;
+    if (n != 2) return ERR;
+    x[0] = m->r[0];
+    x[1] = m->r[2];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
+    Vdp *m = c;
+    if (n != 2) return ERR;
+    m->r[6] += 1.0;
+    derivatives(m);
+    dx[0] = m->r[1];
+    dx[1] = m->r[3];
+    return 0;
+}
+EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
+EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
+    size_t i;
+    for (i = 0; i < n; i++) x[i] = 1.0;
+    return 0;
+}

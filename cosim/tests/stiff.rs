@@ -1,0 +1,280 @@
+//! The bdf solver (`--solver bdf`) on C test FMUs of known solution and against dopri5:
+//! a stiff linear system against its closed form, van der Pol at mu = 1e3 with the FMU's
+//! directional derivatives (one call per column group) against dopri5 at a tight
+//! tolerance, the plant against dopri5, and the bouncing ball's events against dopri5 and
+//! the exact bounce times.
+
+mod common;
+use common::{build_ball, build_linear, build_vdp, plant_fmu, work_dir};
+use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, Interface, Results, Solver, Summary, SystemBuilder};
+use std::path::Path;
+
+fn run(fmu: &Path, name: &str, set: &[(&str, &str)], stop: f64, step: f64, solver: Solver) -> (Results, Summary) {
+    let options = ImportOptions { interface: Some(Interface::ModelExchange), ..ImportOptions::default() };
+    let mut b = SystemBuilder::new();
+    b.add_instance(name, Fmu::load_with(fmu, &options).unwrap()).unwrap();
+    for (k, v) in set {
+        b.set_text(&format!("{name}.{k}"), v).unwrap();
+    }
+    let mut e = Experiment::new(stop, step);
+    e.solver = solver;
+    simulate(&b.build(), &e).unwrap()
+}
+
+#[test]
+fn bdf_on_a_stiff_linear_system_matches_the_closed_form() {
+    let dir = work_dir("stiff-linear");
+    let fmu = build_linear(&dir);
+    let lambda = 1e4;
+    for rtol in [1e-5, 1e-7, 1e-9] {
+        let (r, s) = run(&fmu, "lin", &[], 2.0, 0.01, Solver::Bdf { rtol, atol: rtol / 100.0 });
+        let (t, x1, x2) = (r.column("time").unwrap(), r.column("x1").unwrap(), r.column("x2").unwrap());
+        let mut worst = 0.0f64;
+        for k in 0..t.len() {
+            let e2 = (-t[k]).exp();
+            let e1 = (1.0 - 1.0 / (lambda - 1.0)) * (-lambda * t[k]).exp() + e2 / (lambda - 1.0);
+            worst = worst.max((x1[k] - e1).abs()).max((x2[k] - e2).abs());
+        }
+        eprintln!("rtol {rtol:e}: largest error {worst:e}, {:?}, steps {:?}", s.stiff, s.integrator_steps);
+        // the local error of each step is below rtol |x| + atol (|x| <= 1); over the run the
+        // errors of the decaying solution add to a few rtol: 10 rtol bounds it
+        assert!(worst < 10.0 * rtol, "rtol {rtol}: {worst}");
+        // stiff: an explicit method needs h < 2.8 / lambda (dopri5's stability bound), 7000
+        // steps for 2 s; the bdf steps are set by accuracy
+        assert!(s.integrator_steps.0 < 2000, "{:?}", s.integrator_steps);
+        // no directional derivatives: finite differences (one rhs per colour, 2 colours)
+        assert!(s.stiff.jacobians >= 1 && s.stiff.factorizations >= s.stiff.jacobians, "{:?}", s.stiff);
+        assert!(s.stiff.rhs > s.integrator_steps.0, "{:?}", s.stiff);
+    }
+}
+
+#[test]
+fn bdf_on_van_der_pol_uses_the_fmus_directional_derivatives_and_matches_dopri5() {
+    let dir = work_dir("stiff-vdp");
+    let fmu = build_vdp(&dir);
+    let mu = [("mu", "1000")];
+    let record = |solver: Solver| {
+        let options = ImportOptions { interface: Some(Interface::ModelExchange), ..ImportOptions::default() };
+        let mut b = SystemBuilder::new();
+        b.add_instance("vdp", Fmu::load_with(&fmu, &options).unwrap()).unwrap();
+        b.set_text("vdp.mu", mu[0].1).unwrap();
+        let mut e = Experiment::new(2000.0, 1.0);
+        e.solver = solver;
+        e.record = Some(vec!["vdp.x0".into(), "vdp.x1".into(), "vdp.directional_calls".into()]);
+        simulate(&b.build(), &e).unwrap()
+    };
+    let (bdf, s) = record(Solver::Bdf { rtol: 1e-8, atol: 1e-10 });
+    // the reference: Dormand-Prince at rtol 1e-12, an explicit method unrelated to BDF
+    let (reference, sr) = record(Solver::Dopri5 { rtol: 1e-12, atol: 1e-14 });
+    eprintln!("bdf {:?} {:?}; dopri5 {:?}", s.integrator_steps, s.stiff, sr.integrator_steps);
+    // the Jacobian from the FMU: its two columns share row der(x1), two calls per Jacobian
+    let calls = *bdf.column("directional_calls").unwrap().last().unwrap();
+    assert_eq!(calls, 2.0 * s.stiff.jacobians as f64, "{:?}", s.stiff);
+    assert!(s.stiff.jacobians > 0);
+    // stiff: far fewer steps than the explicit method
+    assert!(s.integrator_steps.0 * 20 < sr.integrator_steps.0, "{:?} vs {:?}", s.integrator_steps, sr.integrator_steps);
+    let (x, y) = (bdf.column("x0").unwrap(), reference.column("x0").unwrap());
+    let worst = x.iter().zip(&y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    eprintln!("x0: largest difference {worst:e}");
+    // the solution crosses two fast transitions (x0 jumps between about +-1 and -+2 within
+    // a few 1/mu s, near 807 s and 1614 s); on the slow branches x0 differs by the
+    // tolerance, and a row after a transition carries the transition's timing difference
+    // times x0's slope there (measured 7e-5): 1e-3 bounds it
+    assert!(worst < 1e-3, "{worst}");
+    // the half period (-3 + 2 ln 2) mu + O(mu^-1/3): x0 changes sign near 807 s
+    let t = bdf.column("time").unwrap();
+    let k = x.iter().position(|v| *v < 0.0).unwrap();
+    assert!((t[k] - 0.5 * (3.0 - 2.0 * 2f64.ln()) * 1000.0).abs() < 5.0, "{}", t[k]);
+}
+
+#[test]
+fn bdf_equals_dopri5_on_the_plant_at_tight_tolerances() {
+    let set = [("v_x_start", "0.35"), ("delta_fl", "0.2"), ("delta_fr", "0.2"), ("tau_rl", "0.02"), ("mu_rr", "0.3")];
+    let (a, _) = run(&plant_fmu(), "p", &set, 2.0, 1e-3, Solver::Dopri5 { rtol: 1e-10, atol: 1e-12 });
+    let (b, s) = run(&plant_fmu(), "p", &set, 2.0, 1e-3, Solver::Bdf { rtol: 1e-10, atol: 1e-12 });
+    assert_eq!(a.names, b.names);
+    let mut worst = 0.0f64;
+    for (x, y) in a.values.iter().zip(&b.values) {
+        worst = worst.max((x - y).abs() / x.abs().max(1.0));
+    }
+    eprintln!("plant bdf vs dopri5: {worst:e}, {:?}", s.stiff);
+    // both with local errors below 1e-10 |x| per step: 2000 communication steps of
+    // several internal steps each add to at most ~1e-6 without damping
+    assert!(worst < 1e-6, "{worst}");
+    assert!(b.column("psi").unwrap()[2000].abs() > 1e-2, "the car turned");
+}
+
+#[test]
+fn bdf_finds_the_bouncing_balls_events_where_dopri5_does() {
+    let dir = work_dir("stiff-ball");
+    let fmu = build_ball(&dir);
+    let g: f64 = 9.81;
+    let t1 = (2.0 / g).sqrt();
+    let state_events = |solver: Solver| -> Vec<f64> {
+        let (_, s) = run(&fmu, "ball", &[], 2.5, 0.01, solver);
+        s.events.iter().filter(|e| e.kind == "state").map(|e| e.time).collect()
+    };
+    let rtol = 1e-8;
+    let bdf = state_events(Solver::Bdf { rtol, atol: rtol / 100.0 });
+    let dp = state_events(Solver::Dopri5 { rtol, atol: rtol / 100.0 });
+    eprintln!("bdf {bdf:?}\ndopri5 {dp:?}");
+    assert_eq!(bdf.len(), dp.len());
+    assert!(bdf.len() >= 8, "{bdf:?}");
+    // the k-th bounce at t1 (1 + 2 e (1 - e^(k-1)) / (1 - e)) (flights of 2 v_k / g, v_k = e^k g t1)
+    let e: f64 = 0.7;
+    for (k, (a, b)) in bdf.iter().zip(&dp).enumerate() {
+        let exact = t1 * (1.0 + 2.0 * e * (1.0 - e.powi(k as i32)) / (1.0 - e));
+        // an event time is off by the state error over the impact speed (v_k = e^k 4.4 m/s):
+        // a global error of 10 rtol over v_8 = 0.25 m/s is 4e-7 s
+        assert!((a - exact).abs() < 1e-6, "bounce {k}: bdf {a} vs {exact}");
+        assert!((a - b).abs() < 1e-6, "bounce {k}: bdf {a} vs dopri5 {b}");
+    }
+}
+
+#[test]
+fn bdf_integrates_a_coupled_model_exchange_group_with_its_events() {
+    // the ball's velocity feeds the discrete counter (tests/cfmu/latch.c, an input: steps
+    // end at every communication point); each bounce is an event of both, counted at its time
+    let dir = work_dir("stiff-coupled");
+    let mut b = SystemBuilder::new();
+    b.add_instance("ball", Fmu::load(&build_ball(&dir)).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(&common::build_latch(&dir)).unwrap()).unwrap();
+    b.connect("ball.v", "counter.u").unwrap();
+    let mut e = Experiment::new(1.5, 0.01);
+    let rtol = 1e-10;
+    e.solver = Solver::Bdf { rtol, atol: rtol / 100.0 };
+    let (r, s) = simulate(&b.build(), &e).unwrap();
+    let g: f64 = 9.81;
+    let t1 = (2.0 / g).sqrt();
+    let exact = [t1, t1 + 2.0 * 0.7 * t1];
+    let state: Vec<f64> = s.events.iter().filter(|e| e.kind == "state").map(|e| e.time).collect();
+    assert_eq!(state.len(), 2, "{:?}", s.events);
+    for (a, b) in state.iter().zip(exact) {
+        // the state error (a few rtol) over the impact speed (>= 3 m/s)
+        assert!((a - b).abs() < 1e-8, "{a} vs {b}");
+    }
+    let (t, count, t_last) =
+        (r.column("time").unwrap(), r.column("counter.count").unwrap(), r.column("counter.t_last").unwrap());
+    for k in 0..t.len() {
+        let (n, last) = if t[k] >= state[1] {
+            (2.0, state[1])
+        } else if t[k] >= state[0] {
+            (1.0, state[0])
+        } else {
+            (0.0, 0.0)
+        };
+        assert_eq!((count[k], t_last[k]), (n, last), "at t = {}", t[k]);
+    }
+    assert!(s.stiff.jacobians > 0, "{:?}", s.stiff);
+}
+
+#[test]
+fn cosim_run_solver_bdf_reports_its_work_in_the_summary() {
+    let dir = work_dir("stiff-cli");
+    let fmu = build_vdp(&dir);
+    let (csv, json) = (dir.join("out.csv"), dir.join("summary.json"));
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", fmu.to_str().unwrap(), "--solver", "bdf", "--set", "mu=1000", "--stop-time", "1000"];
+        args.extend_from_slice(&[
+            "--step",
+            "1",
+            "--output",
+            csv.to_str().unwrap(),
+            "--summary",
+            json.to_str().unwrap(),
+        ]);
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(&args).output().unwrap()
+    };
+    let out = run(&[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let work = &summary["bdf"];
+    let (rhs, jacobians, factorizations) =
+        (work["rhs"].as_u64().unwrap(), work["jacobians"].as_u64().unwrap(), work["factorizations"].as_u64().unwrap());
+    let steps = summary["integrator_steps"]["accepted"].as_u64().unwrap();
+    eprintln!("{work} {steps}");
+    // a Newton iteration per step takes at least one right-hand side; a factorization per
+    // Jacobian at least
+    assert!(steps > 0 && rhs >= steps && factorizations >= jacobians && jacobians >= 1, "{work} {steps}");
+    // the row at 1000 s: x0 on its way back after the first transition (near 807 s)
+    let last = std::fs::read_to_string(&csv).unwrap().lines().last().unwrap().to_string();
+    let x0: f64 = last.split(',').nth(1).unwrap().parse().unwrap();
+    assert!(x0 < -1.0 && x0 > -2.1, "{last}");
+    // a tolerance no step can meet is refused before the run
+    let out = run(&["--rtol", "1e-20"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("the bdf relative tolerance 1e-20 is below"));
+}
+
+#[test]
+fn bdf_ends_a_step_at_a_time_event_and_restarts_there() {
+    // a kick of +2 m/s at t = 0.123 s (not a communication point of the 0.01 s grid)
+    let dir = work_dir("stiff-kick");
+    let fmu = build_ball(&dir);
+    let rtol = 1e-8;
+    let (r, s) =
+        run(&fmu, "ball", &[("t_kick", "0.123"), ("kick", "2")], 0.3, 0.01, Solver::Bdf { rtol, atol: rtol / 100.0 });
+    let time: Vec<f64> = s.events.iter().filter(|e| e.kind == "time").map(|e| e.time).collect();
+    assert_eq!(time, [0.123], "{:?}", s.events);
+    // v' = -g: every BDF order is exact for a linear v (to rounding); h is the parabola
+    // 1 - g t^2 / 2 + 2 (t - 0.123) to the tolerance (order-1 start steps are not exact)
+    let (v, h) = (r.column("v").unwrap(), r.column("h").unwrap());
+    assert!((v[30] - (-9.81 * 0.3 + 2.0)).abs() < 1e-12, "{}", v[30]);
+    assert!((h[30] - (1.0 - 9.81 * 0.09 / 2.0 + 2.0 * (0.3 - 0.123))).abs() < 10.0 * rtol, "{}", h[30]);
+}
+
+#[test]
+fn the_jacobian_from_directional_derivatives_or_differences_one_call_per_column_group() {
+    // van der Pol's columns x0 (row der(x1)) and x1 (rows der(x0), der(x1)) share a row:
+    // two groups, so two calls per Jacobian either way
+    let run_vdp = |fmu: &Path| {
+        let mut b = SystemBuilder::new();
+        b.add_instance("vdp", Fmu::load(fmu).unwrap()).unwrap();
+        b.set_text("vdp.mu", "1000").unwrap();
+        let mut e = Experiment::new(1000.0, 1.0);
+        e.solver = Solver::Bdf { rtol: 1e-7, atol: 1e-9 };
+        e.record = Some(vec!["vdp.x0".into(), "vdp.directional_calls".into(), "vdp.derivative_calls".into()]);
+        simulate(&b.build(), &e).unwrap()
+    };
+    let last = |r: &Results, name: &str| *r.column(name).unwrap().last().unwrap();
+    let (with, s) = run_vdp(&build_vdp(&work_dir("jacobian-directional")));
+    let (without, t) = run_vdp(&common::build_vdp_without_directional_derivatives(&work_dir("jacobian-differences")));
+    eprintln!("directional {:?}\ndifferences {:?}", s.stiff, t.stiff);
+    // the FMU's own counts of its calls equal the summary's
+    assert_eq!(last(&with, "directional_calls"), 2.0 * s.stiff.jacobians as f64);
+    assert_eq!(last(&with, "derivative_calls"), s.stiff.rhs as f64);
+    assert_eq!(s.stiff.jacobian_rhs, 0);
+    assert_eq!(last(&without, "directional_calls"), 0.0);
+    assert_eq!(last(&without, "derivative_calls"), t.stiff.rhs as f64);
+    assert_eq!(t.stiff.jacobian_rhs, 2 * t.stiff.jacobians, "{:?}", t.stiff);
+    // the same solution to the tolerance (the difference Jacobian is only an approximation
+    // of the iteration matrix, not of the solution): x0 at 1000 s
+    let (a, b) = (last(&with, "x0"), last(&without, "x0"));
+    assert!((a - b).abs() < 1e-5, "{a} vs {b}");
+}
+
+#[test]
+fn bdf_runs_the_closed_loop_in_model_exchange_keeping_its_jacobian_across_events() {
+    // plant, controller and maneuver in ME: the sampled controller and maneuver make time
+    // events every 1 ms; the method restarts at each with the Jacobian it has
+    let ssp = plant_fmu().parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop.ssp");
+    let options = ImportOptions { interface: Some(Interface::ModelExchange), ..ImportOptions::default() };
+    let system = nigel_cosim::read_ssp(&ssp, &options).unwrap().system;
+    let run = |solver: Solver| {
+        let mut e = Experiment::new(2.0, 1e-3);
+        e.solver = solver;
+        e.record = Some(vec!["plant.x".into(), "plant.y".into(), "plant.psi".into(), "plant.v_x".into()]);
+        simulate(&system, &e).unwrap()
+    };
+    let (bdf, s) = run(Solver::Bdf { rtol: 1e-8, atol: 1e-10 });
+    let (dp, _) = run(Solver::Dopri5 { rtol: 1e-10, atol: 1e-12 });
+    let worst = bdf.values.iter().zip(&dp.values).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    eprintln!("closed loop bdf vs dopri5: {worst:e}; {:?}, {} events", s.stiff, s.events.len());
+    // some 18000 steps (2000 restarts at order 1), each with a local error below
+    // 1e-8 |x| + 1e-10 (|x| < 3 here): at most ~5e-4 added up, measured 4e-9; 1e-6 is
+    // well above what the error control allows in practice
+    assert!(worst < 1e-6, "{worst}");
+    assert!(s.events.len() >= 2000, "{}", s.events.len());
+    assert!(s.stiff.jacobians * 10 < s.events.len() as u64, "{:?}", s.stiff);
+}
