@@ -54,8 +54,9 @@ __all__ = [
 
 _DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
 
-# fmpy's names of the integrators, mapped onto the master's (Model Exchange)
-_SOLVERS = {None: "dopri5", "CVode": "dopri5", "dopri5": "dopri5", "rk4": "rk4", "Euler": None}
+# fmpy's names of the integrators, mapped onto the master's (Model Exchange): CVode is a
+# variable-order BDF method, as the master's bdf is
+_SOLVERS = {None: "bdf", "CVode": "bdf", "bdf": "bdf", "dopri5": "dopri5", "rk4": "rk4", "Euler": None}
 
 
 def _auto_interval(t: float) -> float:
@@ -280,9 +281,9 @@ class System:
     def _arguments(self, start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance,
                    timeout, threads):
         if solver not in _SOLVERS:
-            raise ExperimentError(f"unknown solver {solver!r} (CVode, dopri5, rk4)")
+            raise ExperimentError(f"unknown solver {solver!r} (CVode, bdf, dopri5, rk4)")
         if _SOLVERS[solver] is None:
-            raise ExperimentError(f"solver {solver!r} is not offered: use 'CVode' (dopri5 here) or 'rk4'")
+            raise ExperimentError(f"solver {solver!r} is not offered: use 'CVode' (bdf here), 'dopri5' or 'rk4'")
         values = dict(self._start_values)
         values.update(start_values or {})
         return {
@@ -333,8 +334,9 @@ def simulate_fmu(
     DefaultExperiment's (else start + 1 s); Co-Simulation steps by ``output_interval``
     (default: the DefaultExperiment's step size, doubled until at most 1000 steps, else
     fmpy's automatic interval); Model Exchange integrates between output points
-    (``solver='CVode'``, fmpy's default, is this master's dopri5 with
-    ``relative_tolerance``, default 1e-5; ``'rk4'`` a fixed step of ``step_size``).
+    (``solver='CVode'``, fmpy's default, is this master's variable-order BDF method with
+    ``relative_tolerance``, default 1e-5, and the FMU's Jacobian; ``'dopri5'`` its explicit
+    Dormand-Prince method; ``'rk4'`` a fixed step of ``step_size``).
     """
     with System(filename, fmi_type) as system:
         interface = fmi_type or system.interfaces[0]

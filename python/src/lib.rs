@@ -146,8 +146,9 @@ impl NativeSystem {
         experiment.solver = match args.solver.as_str() {
             "rk4" => Solver::Rk4 { max_step: None },
             "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
+            "bdf" => Solver::Bdf { rtol, atol: rtol / 100.0 },
             other => {
-                return Err(CosimError::Experiment(format!("unknown solver {other:?} (rk4, dopri5)")));
+                return Err(CosimError::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")));
             }
         };
         if let Some((names, time, columns)) = &args.input {
@@ -393,8 +394,8 @@ impl NativeSystem {
 
 /// What the worker thread of a [`NativeRun`] tells the caller.
 enum RunEvent {
-    /// Paused at this output point.
-    Paused(f64),
+    /// Paused at an output point.
+    Paused,
     /// The run ended: the summary, or why it failed.
     Finished(Result<Summary, CosimError>),
 }
@@ -462,7 +463,7 @@ impl NativeRun {
                     // wait here until asked for a later time (or to stop: the cancel flag ends
                     // the run at its next step)
                     while reached(t, target) && !cancel.load(Ordering::Relaxed) {
-                        let _ = events.send(RunEvent::Paused(t));
+                        let _ = events.send(RunEvent::Paused);
                         match command_rx.recv() {
                             Ok(next) if !next.is_nan() => target = next,
                             _ => cancel.store(true, Ordering::Relaxed),
@@ -511,7 +512,7 @@ impl NativeRun {
         };
         let mut state = self.state.lock().unwrap_or_else(|p| p.into_inner());
         match event {
-            RunEvent::Paused(_) => *state = RunState::Paused,
+            RunEvent::Paused => *state = RunState::Paused,
             RunEvent::Finished(Ok(summary)) => *state = RunState::Finished(Some(summary)),
             RunEvent::Finished(Err(CosimError::Cancelled { .. })) => *state = RunState::Finished(None),
             RunEvent::Finished(Err(e)) => {

@@ -318,8 +318,8 @@ def test_ctrl_c_inside_step_until(tmp_path):
 
 
 def test_simulate_fmu_in_model_exchange_agrees_with_fmpys_cvode():
-    # the same output points (fmpy's defaults: 4 ms over 3 s); CVode (BDF) and the master's
-    # dopri5 both hold the local error below rtol 1e-10 relative, so over 3 s their global
+    # the same output points (fmpy's defaults: 4 ms over 3 s); CVode and the master's BDF
+    # method (solver "CVode" here) both hold the local error below rtol 1e-10 relative, so over 3 s their global
     # errors stay near 1e-9 m / rad / m/s (measured 5e-10); 1e-7 leaves two orders for any
     # machine's rounding
     kwargs = dict(fmi_type="ModelExchange", stop_time=3.0, relative_tolerance=1e-10,
