@@ -516,7 +516,8 @@ pub fn write_closed_loop_ssp(fmu_dir: &Path, job: &str, seed: u64, ssp_path: &Pa
 pub fn write_closed_loop_ssp_fmi3(fmi2_ssp: &Path, fmu_dir: &Path, ssp_path: &Path) -> Result<(), String> {
     use std::io::Read as _;
     let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
-    let mut input = zip::ZipArchive::new(Cursor::new(read(fmi2_ssp)?)).map_err(|e| format!("{}: {e}", fmi2_ssp.display()))?;
+    let mut input =
+        zip::ZipArchive::new(Cursor::new(read(fmi2_ssp)?)).map_err(|e| format!("{}: {e}", fmi2_ssp.display()))?;
     let mut out = zip::ZipWriter::new(Cursor::new(Vec::new()));
     let options = SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
@@ -528,7 +529,10 @@ pub fn write_closed_loop_ssp_fmi3(fmi2_ssp: &Path, fmu_dir: &Path, ssp_path: &Pa
         let (bytes, entry_options) = match name.strip_prefix("resources/").and_then(|f| f.strip_suffix(".fmu")) {
             Some(id) => {
                 // stored, not deflated, as write_ssp stores the FMI 2.0 ones
-                (read(&fmu_dir.join(FmiVersion::Fmi3.archive_path(id)))?, options.compression_method(zip::CompressionMethod::Stored))
+                (
+                    read(&fmu_dir.join(FmiVersion::Fmi3.archive_path(id)))?,
+                    options.compression_method(zip::CompressionMethod::Stored),
+                )
             }
             None => {
                 let mut bytes = Vec::new();
@@ -715,8 +719,11 @@ mod tests {
         // one universal library for both Mac architectures: the same bytes in both folders
         for folder in ["x86_64-darwin", "aarch64-darwin"] {
             let mut bytes = Vec::new();
-            std::io::Read::read_to_end(&mut z.by_name(&format!("binaries/{folder}/nigel_plant.dylib")).unwrap(), &mut bytes)
-                .unwrap();
+            std::io::Read::read_to_end(
+                &mut z.by_name(&format!("binaries/{folder}/nigel_plant.dylib")).unwrap(),
+                &mut bytes,
+            )
+            .unwrap();
             assert_eq!(bytes, b"\xca\xfe\xba\xbe universal");
         }
         let mut doc = String::new();
@@ -732,13 +739,19 @@ mod tests {
             let v3 = t.description3.variable_by_name(&v.name).unwrap();
             assert_eq!(v3.value_reference, row as u32 + 1, "{}", v.name);
             assert!(
-                t.documentation3.contains(&format!("<tr><td><code>{}</code></td><td>{}</td>", escape(&v.name), row + 1)),
+                t.documentation3.contains(&format!(
+                    "<tr><td><code>{}</code></td><td>{}</td>",
+                    escape(&v.name),
+                    row + 1
+                )),
                 "{}",
                 v.name
             );
-            assert!(t
-                .documentation
-                .contains(&format!("<tr><td><code>{}</code></td><td>{}</td>", escape(&v.name), v.value_reference)));
+            assert!(t.documentation.contains(&format!(
+                "<tr><td><code>{}</code></td><td>{}</td>",
+                escape(&v.name),
+                v.value_reference
+            )));
         }
         assert!(t.documentation3.contains(&t.description3.instantiation_token));
         assert!(!t.documentation.contains("FMI 3.0"));

@@ -87,8 +87,7 @@ fn choose(list: &str, this_glibc: bool) -> Result<(Vec<Platform>, Vec<String>), 
         ));
     }
     if chosen.len() < Platform::ALL.len() {
-        let left: Vec<&str> =
-            Platform::ALL.iter().filter(|p| !chosen.contains(p)).map(|p| p.folder()).collect();
+        let left: Vec<&str> = Platform::ALL.iter().filter(|p| !chosen.contains(p)).map(|p| p.folder()).collect();
         notes.push(format!("not a release build: the archives lack {} (the manifest says so)", left.join(", ")));
     }
     Ok((chosen, notes))
