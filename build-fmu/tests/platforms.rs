@@ -83,7 +83,7 @@ fn manifest_platforms3() -> Vec<String> {
     let m: serde_json::Value = serde_json::from_str(&text).unwrap();
     let entries: Vec<&serde_json::Value> = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == "3.0").collect();
     assert_eq!(entries.len(), FMUS.len(), "{}: one FMI 3.0 archive per FMU", path.display());
-    let want: Vec<String> = manifest_platforms().iter().flat_map(|f| fmi3_folders(f)).map(str::to_string).collect();
+    let want: Vec<String> = manifest_platforms().iter().flat_map(|f| fmi3_folders(f)).map(|f| f.to_string()).collect();
     for e in entries {
         let these: Vec<String> =
             e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
