@@ -39,6 +39,8 @@ cargo test --release --workspace --no-fail-fast
 echo "== synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"
+# (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
+# own-controller example's two archives, which it builds with `cargo run -p own-controller`)
 "$target_dir/venv/bin/python" -m pytest tests/python -q
 echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
