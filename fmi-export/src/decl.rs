@@ -1036,7 +1036,14 @@ fn fmi3_description(d2: &md::ModelDescription, caps: Capabilities) -> md::fmi3::
                 },
             })
             .collect(),
-        log_categories: d2.log_categories.clone(),
+        log_categories: d2
+            .log_categories
+            .iter()
+            .map(|c| md::LogCategory {
+                name: c.name.clone(),
+                description: c.description.as_ref().map(|d| d.replace("fmi2", "fmi3")),
+            })
+            .collect(),
         default_experiment: d2.default_experiment.clone(),
         model_variables: variables,
         model_structure: f3::ModelStructure {

@@ -274,11 +274,10 @@ impl<M: Model> Instance<M> {
         if let Some(missing) = function.undeclared_feature() {
             return err(format!("not supported: {missing}"));
         }
-        match (function, interface) {
-            (Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates, Interface::CoSimulation) => {
-                return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
-            }
-            _ => {}
+        if interface == Interface::CoSimulation
+            && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates)
+        {
+            return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
         }
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {

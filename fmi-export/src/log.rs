@@ -14,7 +14,7 @@ pub const LOG_CATEGORIES: [(&str, &str); 4] = [
     ("logStatusError", "Errors (always logged)"),
     ("logStatusWarning", "Warnings"),
     ("logEvents", "Mode changes and events"),
-    ("logCalls", "Every fmi2/fmi3 call"),
+    ("logCalls", "Every fmi2 call"),
 ];
 
 /// The log categories every FMU of ours offers (`<LogCategories>` of the XML).
