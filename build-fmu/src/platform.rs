@@ -150,17 +150,17 @@ impl Platform {
             Platform::Linux64 => {
                 "by the test command, on this recipe's library: executed: fmpy (validate_fmu, Co-Simulation and Model \
                  Exchange against the FMI 2.0 archive) and the C FMI 3.0 importer build-fmu/tests/c/fmi3_closed_loop.c, \
-                 which runs the closed loop (plant, controller, test bench) 30 s at 1 ms and is compared with the FMI 2.0 run"
+                 which runs the closed loop (plant, controller, test bench) 30 s at 1 ms equal to the FMI 2.0 run bit for bit"
             }
             Platform::Win64 => {
                 "by the test command, on this recipe's library: executed under wine 8: the C FMI 3.0 importer \
-                 build-fmu/tests/c/fmi3_closed_loop.c, built with mingw-w64, runs the closed loop 30 s at 1 ms and every \
-                 output is compared with the linux64 FMI 2.0 run"
+                 build-fmu/tests/c/fmi3_closed_loop.c, built with mingw-w64, runs the closed loop 30 s at 1 ms, every \
+                 output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same DLL bit for bit"
             }
             Platform::Aarch64Linux => {
                 "by the test command, on this recipe's library: executed under qemu-user: the C FMI 3.0 importer \
-                 build-fmu/tests/c/fmi3_closed_loop.c, built with aarch64-linux-gnu-gcc, runs the closed loop 30 s at 1 ms \
-                 and every output is compared with the linux64 FMI 2.0 run"
+                 build-fmu/tests/c/fmi3_closed_loop.c, built with aarch64-linux-gnu-gcc, runs the closed loop 30 s at 1 ms, \
+                 every output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same library bit for bit"
             }
             Platform::Darwin64 => {
                 "by the test command, on this recipe's library: not executed (no macOS there): structural checks only, \

@@ -15,10 +15,11 @@
 //! The FMI 3.0 archives (`target/fmu/fmi3/*.fmu`) carry the same library files (checked
 //! byte for byte) in the FMI 3.0 folders; the C FMI 3.0 importer `tests/c/fmi3_closed_loop.c`
 //! (built against fmpy's FMI 3.0 headers) runs the same closed loop through the fmi3
-//! functions: on x86_64-linux natively (equal to the FMI 2.0 run bit for bit: the same
-//! library, the same grid, the same order of calls), on x86_64-windows under wine and on
-//! aarch64-linux under qemu-user (compared with the linux64 FMI 2.0 run as the FMI 2.0
-//! runs are); x86_64-darwin and aarch64-darwin: the fmi3 exports of the universal library.
+//! functions: on x86_64-linux natively, on x86_64-windows under wine and on aarch64-linux
+//! under qemu-user, each compared with the linux64 FMI 2.0 run as the FMI 2.0 runs are, and
+//! equal bit for bit to the FMI 2.0 run of the same platform (the same library, the same
+//! grid, the same order of calls); x86_64-darwin and aarch64-darwin: the fmi3 exports of
+//! the universal library.
 //!
 //! Each foreign run is compared with the linux64 run column by column (see
 //! [`compare_with_linux64`] for what must be bit-identical and why the rest is not).
@@ -578,9 +579,56 @@ fn win64_closed_loop_under_wine_matches_linux64() {
             );
         }
     }
-    let mut wine = wine_runner(&dir);
-    let win = closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path);
-    compare_with_linux64("win64", linux64_run(), &win);
+    compare_with_linux64("win64", linux64_run(), win64_run());
+}
+
+/// The win64 closed loop through the FMI 2.0 importer under wine, run once per test binary
+/// (the FMI 3.0 run of the same DLLs is compared with it).
+fn win64_run() -> &'static Table {
+    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = work_dir("win64-run");
+        let mut wine = wine_runner(&dir);
+        closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path)
+    })
+}
+
+/// The aarch64-linux closed loop through the FMI 2.0 importer under qemu-user, run once per
+/// test binary.
+fn aarch64_run() -> &'static Table {
+    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = work_dir("aarch64-linux-run");
+        closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
+            p.display().to_string()
+        })
+    })
+}
+
+fn qemu(exe: &Path) -> Command {
+    let mut c = Command::new("qemu-aarch64");
+    c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
+    c
+}
+
+/// `fmi3` equals `fmi2` in every column and row to the bit: the same library file on the same
+/// platform, stepped on the same grid with the same calls in the same order, only through the
+/// other C API (whose functions reach the same model code).
+fn assert_same_bits(what: &str, fmi2: &Table, fmi3: &Table) {
+    assert_eq!(fmi3.0, fmi2.0, "{what}: columns");
+    assert_eq!(fmi3.1.len(), fmi2.1.len(), "{what}: rows");
+    for (k, (a, b)) in fmi2.1.iter().zip(&fmi3.1).enumerate() {
+        for j in 0..a.len() {
+            assert_eq!(
+                a[j].to_bits(),
+                b[j].to_bits(),
+                "{what}: row {k}, {}: FMI 2.0 {} FMI 3.0 {}",
+                fmi2.0[j],
+                a[j],
+                b[j]
+            );
+        }
+    }
 }
 
 #[test]
@@ -593,15 +641,7 @@ fn aarch64_closed_loop_under_qemu_matches_linux64() {
         let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
         assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
     }
-    let mut qemu = |exe: &Path| {
-        let mut c = Command::new("qemu-aarch64");
-        c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
-        c
-    };
-    let arm = closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
-        p.display().to_string()
-    });
-    compare_with_linux64("aarch64-linux", linux64_run(), &arm);
+    compare_with_linux64("aarch64-linux", linux64_run(), aarch64_run());
 }
 
 /// The names of the FMI 3.0 functions every library exports (all of them: the FMU answers
@@ -634,15 +674,7 @@ fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
         &mut |exe| Command::new(exe),
         &|p| p.display().to_string(),
     );
-    // the same library file, the same grid and the same order of calls: only the C API
-    // differs, and the fmi3 functions reach the same model code as the fmi2 ones
-    let fmi2 = linux64_run();
-    assert_eq!(fmi3.0, fmi2.0, "columns");
-    for (k, (a, b)) in fmi2.1.iter().zip(&fmi3.1).enumerate() {
-        for j in 0..a.len() {
-            assert_eq!(a[j].to_bits(), b[j].to_bits(), "row {k}, {}: FMI 2.0 {} FMI 3.0 {}", fmi2.0[j], a[j], b[j]);
-        }
-    }
+    assert_same_bits("x86_64-linux", linux64_run(), &fmi3);
 }
 
 #[test]
@@ -675,6 +707,7 @@ fn x86_64_windows_fmi3_closed_loop_under_wine_matches_linux64() {
         &wine_path,
     );
     compare_with_linux64("x86_64-windows (FMI 3.0)", linux64_run(), &win);
+    assert_same_bits("x86_64-windows", win64_run(), &win);
 }
 
 #[test]
@@ -683,11 +716,6 @@ fn aarch64_linux_fmi3_closed_loop_under_qemu_matches_linux64() {
         return;
     }
     let dir = work_dir("aarch64-linux-fmi3");
-    let mut qemu = |exe: &Path| {
-        let mut c = Command::new("qemu-aarch64");
-        c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
-        c
-    };
     let arm = closed_loop_through(
         Abi::Fmi3("aarch64-linux"),
         "aarch64-linux",
@@ -698,6 +726,7 @@ fn aarch64_linux_fmi3_closed_loop_under_qemu_matches_linux64() {
         &|p| p.display().to_string(),
     );
     compare_with_linux64("aarch64-linux (FMI 3.0)", linux64_run(), &arm);
+    assert_same_bits("aarch64-linux", aarch64_run(), &arm);
 }
 
 // ---- Mach-O, the little of it the darwin64 checks read --------------------------------
