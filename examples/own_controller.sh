@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # One's own controller FMU in the loop in place of ours: the crate examples/own-controller
 # (a sampled 1 ms P law on the yaw rate and the speed, ~200 lines on fmi-export) is packaged
-# as target/fmu/own_controller.fmu and put into the closed-loop SSP in place of
+# as target/fmu/own_controller.fmu (and as the FMI 3.0 archive target/fmu/fmi3/own_controller.fmu)
+# and put into the closed-loop SSP in place of
 # nigel_controller (target/ssp/own_controller_closed_loop.ssp, same connections); the master
 # runs the sim lane change (seed 0, 30 s, 1 ms) from it.
 #
 #   cargo run --release -p build-fmu               # target/fmu/*.fmu and target/ssp/nigel_closed_loop.ssp
 #   bash examples/own_controller.sh [OUT_DIR]      # default target/examples/own_controller
 #
-# Prints the paths of the FMU and the SSP, then
+# Prints the paths of the two FMUs and the SSP, then
 #   "own controller epsilon 1.158163341e-01"
 # the lane change's epsilon = ||(RMSE_X, RMSE_Y, RMSE_psi)|| over t = 1 ms .. 30 s
 # (docs/benchmark.md), scored from the master's CSV (OUT_DIR/cosim.csv). Our robust controller

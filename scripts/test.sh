@@ -12,14 +12,21 @@ target_dir="${CARGO_TARGET_DIR:-target}"
 echo "== building the FMUs (linux64, win64, aarch64-linux, darwin64)"
 cargo run --release --quiet -p build-fmu -- --platforms all
 echo "== rebuilding from touched sources must give byte-identical archives"
-touch fmu-plant/src/lib.rs fmi-export/src/abi.rs
+# (the rebuild writes its closed-loop SSPs over target/ssp/: the first ones are kept aside)
+rm -rf "$target_dir/ssp-first" && cp -r "$target_dir/ssp" "$target_dir/ssp-first"
+touch fmu-plant/src/lib.rs fmi-export/src/abi/fmi2.rs fmi-export/src/abi/fmi3.rs
 cargo run --release --quiet -p build-fmu -- --platforms all "$target_dir/fmu-rebuild" >/dev/null
-# the FMUs of build-fmu's list (target/fmu may also hold FMUs the examples wrote)
-ids=$(grep -o '"model_identifier": "[^"]*"' "$target_dir/fmu/manifest.json" | cut -d'"' -f4)
-[ -n "$ids" ] || { echo "no FMU in $target_dir/fmu/manifest.json" >&2; exit 1; }
-for id in $ids; do
-    cmp "$target_dir/fmu/$id.fmu" "$target_dir/fmu-rebuild/$id.fmu" || { echo "rebuilt $id.fmu differs" >&2; exit 1; }
-    echo "identical: $id.fmu"
+# the archives of build-fmu's list, FMI 2.0 (ID.fmu) and FMI 3.0 (fmi3/ID.fmu) (target/fmu
+# may also hold FMUs the examples wrote)
+archives=$(grep -o '"fmu": "[^"]*"' "$target_dir/fmu/manifest.json" | cut -d'"' -f4)
+[ -n "$archives" ] || { echo "no FMU in $target_dir/fmu/manifest.json" >&2; exit 1; }
+for a in $archives; do
+    cmp "$target_dir/fmu/$a" "$target_dir/fmu-rebuild/$a" || { echo "rebuilt $a differs" >&2; exit 1; }
+    echo "identical: $a"
+done
+for ssp in nigel_closed_loop.ssp nigel_closed_loop_fmi3.ssp; do
+    cmp "$target_dir/ssp-first/$ssp" "$target_dir/ssp/$ssp" || { echo "rebuilt $ssp differs" >&2; exit 1; }
+    echo "identical: $ssp"
 done
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
@@ -42,6 +49,8 @@ asan_test fmu-plant fmi3
 echo "== synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"
+# (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
+# own-controller example's two archives, which it builds with `cargo run -p own-controller`)
 "$target_dir/venv/bin/python" -m pytest tests/python -q
 echo "== co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q

@@ -1,6 +1,8 @@
 //! Packaging of FMUs: the archive layout importers expect, generated from the models'
 //! declarations, written deterministically (fixed order, timestamps and permissions), with
-//! one library per [`Platform`] in each archive.
+//! one library per [`Platform`] in each archive. Every FMU is packed twice from the one
+//! declaration and the same library files: an FMI 2.0 archive (`<out>/<id>.fmu`) and an
+//! FMI 3.0 archive (`<out>/fmi3/<id>.fmu`, [`FmiVersion`]).
 
 pub mod platform;
 
@@ -9,6 +11,7 @@ use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use fmi_export::model_description::fmi3::ModelDescription as ModelDescription3;
 use fmi_export::model_description::{ModelDescription, VariableType};
 use fmi_export::{Declaration, Model};
 use zip::write::SimpleFileOptions;
@@ -25,8 +28,12 @@ pub struct FmuTarget {
     pub model_identifier: String,
     /// The generated description (the same declaration the binary dispatches on).
     pub description: &'static ModelDescription,
-    /// Generated `documentation/index.html`.
+    /// The generated FMI 3.0 description of the same declaration.
+    pub description3: &'static ModelDescription3,
+    /// Generated `documentation/index.html` of the FMI 2.0 archive.
     pub documentation: String,
+    /// Generated `documentation/index.html` of the FMI 3.0 archive.
+    pub documentation3: String,
 }
 
 impl FmuTarget {
@@ -38,7 +45,25 @@ impl FmuTarget {
             package,
             model_identifier: declaration.spec.model_identifier.to_string(),
             description: declaration.model_description(),
-            documentation: documentation(declaration, equations),
+            description3: declaration.model_description3(),
+            documentation: documentation(declaration, equations, FmiVersion::Fmi2),
+            documentation3: documentation(declaration, equations, FmiVersion::Fmi3),
+        }
+    }
+
+    /// The archive's `modelDescription.xml` of `version`.
+    pub fn xml(&self, version: FmiVersion) -> String {
+        match version {
+            FmiVersion::Fmi2 => self.description.to_xml(),
+            FmiVersion::Fmi3 => self.description3.to_xml(),
+        }
+    }
+
+    /// The archive's `documentation/index.html` of `version` (without the platform table).
+    pub fn documentation_of(&self, version: FmiVersion) -> &str {
+        match version {
+            FmiVersion::Fmi2 => &self.documentation,
+            FmiVersion::Fmi3 => &self.documentation3,
         }
     }
 
@@ -64,31 +89,84 @@ pub fn targets() -> Vec<FmuTarget> {
     ]
 }
 
+/// The generation of an archive. Both carry the same library files; they differ in
+/// `modelDescription.xml`, in the archive's place and in the names of the platform folders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum FmiVersion {
+    /// FMI 2.0: `<out>/<id>.fmu`, folders `linux64`, `win64`, `aarch64-linux`, `darwin64`.
+    Fmi2,
+    /// FMI 3.0: `<out>/fmi3/<id>.fmu`, folders `x86_64-linux`, `x86_64-windows`,
+    /// `aarch64-linux`, `x86_64-darwin` and `aarch64-darwin`.
+    Fmi3,
+}
+
+impl FmiVersion {
+    /// Both generations, in the manifest's order.
+    pub const ALL: [FmiVersion; 2] = [FmiVersion::Fmi2, FmiVersion::Fmi3];
+
+    /// The `fmiVersion` attribute's value.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FmiVersion::Fmi2 => "2.0",
+            FmiVersion::Fmi3 => "3.0",
+        }
+    }
+
+    /// The archive's path relative to the output folder.
+    pub fn archive_path(self, model_identifier: &str) -> String {
+        match self {
+            FmiVersion::Fmi2 => format!("{model_identifier}.fmu"),
+            FmiVersion::Fmi3 => format!("fmi3/{model_identifier}.fmu"),
+        }
+    }
+
+    /// The platform folders under `binaries/` that carry `platform`'s library.
+    pub fn folders(self, platform: Platform) -> Vec<&'static str> {
+        match self {
+            FmiVersion::Fmi2 => vec![platform.folder()],
+            FmiVersion::Fmi3 => platform.fmi3_folders().to_vec(),
+        }
+    }
+}
+
 /// `manifest.json` written next to the archives (and printed by `build-fmu --list`): one
 /// object per FMU with its model identifier, package, archive file name, interfaces and the
 /// platforms its archive carries (each with its library, minimum OS, C library and how it is
 /// tested), so that tests iterate over exactly what was built.
 pub fn manifest(targets: &[FmuTarget], platforms: &[PlatformBuild]) -> String {
-    let entries: Vec<serde_json::Value> = targets
-        .iter()
-        .map(|t| {
-            serde_json::json!({
+    let mut entries: Vec<serde_json::Value> = Vec::new();
+    for version in FmiVersion::ALL {
+        for t in targets {
+            let platform_entries: Vec<serde_json::Value> = platforms
+                .iter()
+                .flat_map(|p| {
+                    version.folders(p.platform).into_iter().map(move |folder| {
+                        serde_json::json!({
+                            "folder": folder,
+                            "library": format!("binaries/{folder}/{}", p.platform.library_file(&t.model_identifier)),
+                            "minimum_os": p.minimum_os,
+                            "c_library": p.c_library,
+                            "tested": p.tested_in(version),
+                        })
+                    })
+                })
+                .collect();
+            let mut entry = serde_json::json!({
                 "model_identifier": t.model_identifier,
                 "package": t.package,
-                "fmu": format!("{}.fmu", t.model_identifier),
-                "guid": t.description.guid,
-                "interfaces": t.interfaces(),
-                "platforms": platforms.iter().map(|p| serde_json::json!({
-                    "folder": p.platform.folder(),
-                    "library": format!("binaries/{}/{}", p.platform.folder(), p.platform.library_file(&t.model_identifier)),
-                    "minimum_os": p.minimum_os,
-                    "c_library": p.c_library,
-                    "tested": p.tested,
-                })).collect::<Vec<_>>(),
-                "not_built": platforms_not_built(platforms),
-            })
-        })
-        .collect();
+                "fmu": version.archive_path(&t.model_identifier),
+                "fmi_version": version.as_str(),
+            });
+            match version {
+                FmiVersion::Fmi2 => entry["guid"] = t.description.guid.clone().into(),
+                FmiVersion::Fmi3 => entry["instantiation_token"] = t.description3.instantiation_token.clone().into(),
+            }
+            entry["interfaces"] = serde_json::json!(t.interfaces());
+            entry["platforms"] = serde_json::Value::Array(platform_entries);
+            entry["not_built"] = serde_json::json!(platforms_not_built(platforms, version));
+            entries.push(entry);
+        }
+    }
     let mut text = serde_json::to_string_pretty(&entries).unwrap_or_default();
     text.push('\n');
     text
@@ -120,19 +198,29 @@ impl PlatformBuild {
             tested: platform.tested().to_string(),
         }
     }
+
+    /// How the library is tested through the `version` archive: [`Platform::tested_fmi3`]
+    /// for the release recipe's library in the FMI 3.0 archive, else [`PlatformBuild::tested`].
+    pub fn tested_in(&self, version: FmiVersion) -> String {
+        match version {
+            FmiVersion::Fmi3 if self.tested == self.platform.tested() => self.platform.tested_fmi3().to_string(),
+            _ => self.tested.clone(),
+        }
+    }
 }
 
-/// The release platforms an archive of `platforms` lacks, each with why; empty for a
-/// release build (all of [`Platform::ALL`]).
-pub fn platforms_not_built(platforms: &[PlatformBuild]) -> Vec<String> {
+/// The release platform folders a `version` archive of `platforms` lacks, each with why;
+/// empty for a release build (all of [`Platform::ALL`]).
+pub fn platforms_not_built(platforms: &[PlatformBuild], version: FmiVersion) -> Vec<String> {
+    let all: Vec<&str> = Platform::ALL.iter().flat_map(|p| version.folders(*p)).collect();
     Platform::ALL
         .iter()
         .filter(|p| !platforms.iter().any(|b| b.platform == **p))
-        .map(|p| {
+        .flat_map(|p| version.folders(*p))
+        .map(|folder| {
             format!(
-                "{}: not built (this build asked for fewer platforms; the release archives carry all of {})",
-                p.folder(),
-                Platform::ALL.map(|p| p.folder()).join(", ")
+                "{folder}: not built (this build asked for fewer platforms; the release archives carry all of {})",
+                all.join(", ")
             )
         })
         .collect()
@@ -155,25 +243,32 @@ pub fn glibc_requirement(library: &[u8]) -> Option<(u32, u32)> {
     best
 }
 
-/// The platforms' part of `documentation/index.html`: a table of the platforms the archive
-/// carries, inserted before the end of the body.
-pub fn with_platform_table(documentation: &str, model_identifier: &str, platforms: &[PlatformBuild]) -> String {
+/// The platforms' part of `documentation/index.html`: a table of the platform folders the
+/// `version` archive carries, inserted before the end of the body.
+pub fn with_platform_table(
+    documentation: &str,
+    model_identifier: &str,
+    platforms: &[PlatformBuild],
+    version: FmiVersion,
+) -> String {
     let mut table = String::from(
         "<h2>Platforms</h2>\n<table>\n<tr><th>folder</th><th>library</th><th>needs</th><th>C library</th><th>tested</th></tr>\n",
     );
     for p in platforms {
-        let _ = writeln!(
-            table,
-            "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            p.platform.folder(),
-            escape(&p.platform.library_file(model_identifier)),
-            escape(&p.minimum_os),
-            escape(&p.c_library),
-            escape(&p.tested),
-        );
+        for folder in version.folders(p.platform) {
+            let _ = writeln!(
+                table,
+                "<tr><td><code>{}</code></td><td><code>{}</code></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                folder,
+                escape(&p.platform.library_file(model_identifier)),
+                escape(&p.minimum_os),
+                escape(&p.c_library),
+                escape(&p.tested_in(version)),
+            );
+        }
     }
     table.push_str("</table>\n");
-    let missing = platforms_not_built(platforms);
+    let missing = platforms_not_built(platforms, version);
     if !missing.is_empty() {
         table.push_str("<p>This archive is not a release build. It lacks:</p>\n<ul>\n");
         for m in &missing {
@@ -194,28 +289,47 @@ fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-/// `documentation/index.html`: every variable with unit, start value and meaning, then the equations.
-pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String {
+/// `documentation/index.html` of the `version` archive: every variable with its value
+/// reference in that archive, unit, start value and meaning, then the equations.
+pub fn documentation<B>(declaration: &Declaration<B>, equations: &str, version: FmiVersion) -> String {
     let md = declaration.model_description();
+    let (generation, token) = match version {
+        FmiVersion::Fmi2 => ("FMI 2.0".to_string(), format!("GUID <code>{}</code>", escape(&md.guid))),
+        FmiVersion::Fmi3 => (
+            format!(
+                "The FMI 3.0 archive (the FMI 2.0 archive of the same model, with the same library files, is \
+                 <code>{id}.fmu</code> in the folder above <code>fmi3/</code>): FMI 3.0",
+                id = escape(declaration.spec.model_identifier)
+            ),
+            format!(
+                "instantiationToken <code>{}</code> (the FMI 2.0 archive's GUID); the independent variable \
+                 <code>time</code> has value reference 0",
+                escape(&declaration.model_description3().instantiation_token)
+            ),
+        ),
+    };
     let mut html = String::new();
     let _ = write!(
         html,
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\
          <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}\
          td,th{{border:1px solid #ccc;padding:2px 6px;text-align:left}}</style></head><body>\n\
-         <h1>{name}</h1>\n<p>{desc}</p>\n<p>FMI 2.0, {interfaces}. GUID <code>{guid}</code>. \
+         <h1>{name}</h1>\n<p>{desc}</p>\n<p>{generation}, {interfaces}. {token}. \
          All quantities SI, angles in rad.</p>\n<h2>Variables</h2>\n<table>\n\
          <tr><th>name</th><th>vr</th><th>causality</th><th>variability</th><th>unit</th><th>range</th><th>start</th><th>description</th></tr>\n",
         name = escape(&md.model_name),
         desc = escape(md.description.as_deref().unwrap_or("")),
-        guid = escape(&md.guid),
         interfaces = match (md.co_simulation.is_some(), md.model_exchange.is_some()) {
             (true, true) => "Co-Simulation and Model Exchange",
             (true, false) => "Co-Simulation",
             _ => "Model Exchange",
         },
     );
-    for v in &md.model_variables {
+    for (row, v) in md.model_variables.iter().enumerate() {
+        let value_reference = match version {
+            FmiVersion::Fmi2 => v.value_reference,
+            FmiVersion::Fmi3 => Declaration::<B>::value_reference3(row),
+        };
         // the unit column holds units only; the declared range (and an Integer switch's
         // values, listed in its description) goes to the range column
         let range_of = |min: Option<String>, max: Option<String>| match (min, max) {
@@ -260,7 +374,7 @@ pub fn documentation<B>(declaration: &Declaration<B>, equations: &str) -> String
             html,
             "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&v.name),
-            v.value_reference,
+            value_reference,
             v.causality,
             v.variability,
             escape(&unit),
@@ -297,9 +411,12 @@ impl std::fmt::Display for BuildError {
 
 impl std::error::Error for BuildError {}
 
-/// The archive bytes: `modelDescription.xml`, `binaries/<platform>/<id>.<ext>` for each
-/// library (in the order given), `documentation/index.html`, with fixed timestamps and modes.
+/// The `version` archive's bytes: `modelDescription.xml`, `binaries/<folder>/<id>.<ext>` for
+/// each library (in the order given; in FMI 3.0 the darwin64 universal library goes to both
+/// `x86_64-darwin` and `aarch64-darwin`), `documentation/index.html`, with fixed timestamps
+/// and modes.
 pub fn archive(
+    version: FmiVersion,
     xml: &str,
     libraries: &[(Platform, &[u8])],
     model_identifier: &str,
@@ -313,11 +430,9 @@ pub fn archive(
     let err = |e: zip::result::ZipError| BuildError::Zip(e.to_string());
     let mut entries: Vec<(String, &[u8], u32)> = vec![("modelDescription.xml".into(), xml.as_bytes(), 0o644)];
     for (platform, bytes) in libraries {
-        entries.push((
-            format!("binaries/{}/{}", platform.folder(), platform.library_file(model_identifier)),
-            bytes,
-            0o755,
-        ));
+        for folder in version.folders(*platform) {
+            entries.push((format!("binaries/{folder}/{}", platform.library_file(model_identifier)), bytes, 0o755));
+        }
     }
     entries.push(("documentation/index.html".into(), documentation.as_bytes(), 0o644));
     for (name, bytes, mode) in entries {
@@ -392,6 +507,49 @@ pub fn write_closed_loop_ssp(fmu_dir: &Path, job: &str, seed: u64, ssp_path: &Pa
         .map_err(|e| format!("{}: {e}", ssp_path.display()))
 }
 
+/// The closed loop of the FMI 3.0 archives: the SSP `fmi2_ssp` (as [`write_closed_loop_ssp`]
+/// wrote it over the FMI 2.0 archives of `fmu_dir`) with each `resources/<id>.fmu` replaced by
+/// `fmu_dir/fmi3/<id>.fmu`, written to `ssp_path`. The system structure is kept as it is:
+/// both generations have the same variable names, causalities and types (SSP's `Real`,
+/// `Integer`, `Boolean` connectors and parameters are FMI 3.0's `Float64`, `Int32` and
+/// `Boolean`), so the parameter bindings and connections are the same.
+pub fn write_closed_loop_ssp_fmi3(fmi2_ssp: &Path, fmu_dir: &Path, ssp_path: &Path) -> Result<(), String> {
+    use std::io::Read as _;
+    let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
+    let mut input =
+        zip::ZipArchive::new(Cursor::new(read(fmi2_ssp)?)).map_err(|e| format!("{}: {e}", fmi2_ssp.display()))?;
+    let mut out = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    let options = SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .last_modified_time(zip::DateTime::default());
+    let zerr = |e: zip::result::ZipError| format!("{}: {e}", ssp_path.display());
+    for i in 0..input.len() {
+        let mut entry = input.by_index(i).map_err(|e| format!("{}: {e}", fmi2_ssp.display()))?;
+        let name = entry.name().to_string();
+        let (bytes, entry_options) = match name.strip_prefix("resources/").and_then(|f| f.strip_suffix(".fmu")) {
+            Some(id) => {
+                // stored, not deflated, as write_ssp stores the FMI 2.0 ones
+                (
+                    read(&fmu_dir.join(FmiVersion::Fmi3.archive_path(id)))?,
+                    options.compression_method(zip::CompressionMethod::Stored),
+                )
+            }
+            None => {
+                let mut bytes = Vec::new();
+                entry.read_to_end(&mut bytes).map_err(|e| format!("{}: {name}: {e}", fmi2_ssp.display()))?;
+                (bytes, options)
+            }
+        };
+        out.start_file(name, entry_options).map_err(zerr)?;
+        out.write_all(&bytes).map_err(|e| format!("{}: {e}", ssp_path.display()))?;
+    }
+    let bytes = out.finish().map_err(zerr)?.into_inner();
+    if let Some(dir) = ssp_path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(ssp_path, bytes).map_err(|e| format!("{}: {e}", ssp_path.display()))
+}
+
 /// `built` with the C library and minimum OS the Linux `libraries` really need: when one
 /// names a glibc symbol version above the 2.17 baseline (a build with the host toolchain),
 /// that version.
@@ -411,18 +569,37 @@ fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBui
 
 /// Builds one FMU for linux64 with the workspace's own cargo (no cross toolchain needed;
 /// the library needs the build machine's glibc, which its documentation then states) and
-/// writes `<out_dir>/<id>.fmu`; returns its path and size. For an FMU of one's own whose
-/// crate depends on this one: the cross builds of [`build_all`] would build this crate's
-/// own dependencies (the master) for every platform too.
-pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<(PathBuf, usize), BuildError> {
+/// writes `<out_dir>/<id>.fmu` and `<out_dir>/fmi3/<id>.fmu`; returns each archive's path
+/// and size, FMI 2.0 first. For an FMU of one's own whose crate depends on this one: the
+/// cross builds of [`build_all`] would build this crate's own dependencies (the master)
+/// for every platform too.
+pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<Vec<(PathBuf, usize)>, BuildError> {
     let paths = build_host_linux64(std::slice::from_ref(target))?;
     let library = std::fs::read(&paths[0]).map_err(|e| BuildError::Io(paths[0].clone(), e))?;
     let built = with_glibc_of(PlatformBuild::of(Platform::Linux64), std::slice::from_ref(&library));
-    let documentation = with_platform_table(&target.documentation, &target.model_identifier, &[built]);
     let libraries = [(Platform::Linux64, library.as_slice())];
-    let bytes = archive(&target.description.to_xml(), &libraries, &target.model_identifier, &documentation)?;
-    std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
-    let path = out_dir.join(format!("{}.fmu", target.model_identifier));
+    FmiVersion::ALL
+        .into_iter()
+        .map(|version| write_archive(target, version, &libraries, std::slice::from_ref(&built), out_dir))
+        .collect()
+}
+
+/// Writes `target`'s `version` archive of `libraries` (built as `builds` say) under
+/// `out_dir`; returns its path and size.
+fn write_archive(
+    target: &FmuTarget,
+    version: FmiVersion,
+    libraries: &[(Platform, &[u8])],
+    builds: &[PlatformBuild],
+    out_dir: &Path,
+) -> Result<(PathBuf, usize), BuildError> {
+    let documentation =
+        with_platform_table(target.documentation_of(version), &target.model_identifier, builds, version);
+    let bytes = archive(version, &target.xml(version), libraries, &target.model_identifier, &documentation)?;
+    let path = out_dir.join(version.archive_path(&target.model_identifier));
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| BuildError::Io(dir.to_path_buf(), e))?;
+    }
     std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
     Ok((path, bytes.len()))
 }
@@ -430,14 +607,17 @@ pub fn build_for_this_machine(target: &FmuTarget, out_dir: &Path) -> Result<(Pat
 /// What [`build_all`] wrote.
 #[derive(Debug)]
 pub struct Built {
-    /// Each archive's path and size in bytes, in the order of the targets.
+    /// Each FMI 2.0 archive's path and size in bytes, in the order of the targets.
     pub archives: Vec<(PathBuf, usize)>,
+    /// Each FMI 3.0 archive's path and size in bytes, in the order of the targets.
+    pub archives3: Vec<(PathBuf, usize)>,
     /// How each platform was built (toolchain, C library baseline).
     pub platforms: Vec<PlatformBuild>,
 }
 
 /// Builds every target for every platform of `platforms` and writes `<out_dir>/<id>.fmu`
-/// for each, carrying all those platforms; returns each archive's path and size.
+/// and `<out_dir>/fmi3/<id>.fmu` for each, carrying all those platforms; returns each
+/// archive's path and size.
 ///
 /// linux64 is built with cargo-zigbuild (glibc 2.17 baseline) when it is installed, else
 /// with the workspace's cargo (the build machine's glibc, read from the libraries and
@@ -471,16 +651,13 @@ pub fn build_all(
     }
     let builds: Vec<PlatformBuild> = libraries.iter().map(|(b, _)| b.clone()).collect();
     std::fs::create_dir_all(out_dir).map_err(|e| BuildError::Io(out_dir.to_path_buf(), e))?;
-    let mut written = Vec::new();
+    let (mut archives, mut archives3) = (Vec::new(), Vec::new());
     for (i, target) in targets.iter().enumerate() {
         let libs: Vec<(Platform, &[u8])> = libraries.iter().map(|(b, l)| (b.platform, l[i].as_slice())).collect();
-        let documentation = with_platform_table(&target.documentation, &target.model_identifier, &builds);
-        let bytes = archive(&target.description.to_xml(), &libs, &target.model_identifier, &documentation)?;
-        let path = out_dir.join(format!("{}.fmu", target.model_identifier));
-        std::fs::write(&path, &bytes).map_err(|e| BuildError::Io(path.clone(), e))?;
-        written.push((path, bytes.len()));
+        archives.push(write_archive(target, FmiVersion::Fmi2, &libs, &builds, out_dir)?);
+        archives3.push(write_archive(target, FmiVersion::Fmi3, &libs, &builds, out_dir)?);
     }
-    Ok(Built { archives: written, platforms: builds })
+    Ok(Built { archives, archives3, platforms: builds })
 }
 
 #[cfg(test)]
@@ -493,8 +670,8 @@ mod tests {
         let xml = t.description.to_xml();
         let doc = &t.documentation;
         let libs: [(Platform, &[u8]); 2] = [(Platform::Linux64, b"\x7fELF fake"), (Platform::Win64, b"MZ fake")];
-        let a = archive(&xml, &libs, &t.model_identifier, doc).unwrap();
-        let b = archive(&xml, &libs, &t.model_identifier, doc).unwrap();
+        let a = archive(FmiVersion::Fmi2, &xml, &libs, &t.model_identifier, doc).unwrap();
+        let b = archive(FmiVersion::Fmi2, &xml, &libs, &t.model_identifier, doc).unwrap();
         assert_eq!(a, b);
         let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
         let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
@@ -510,6 +687,107 @@ mod tests {
         let mut text = String::new();
         std::io::Read::read_to_string(&mut z.by_name("modelDescription.xml").unwrap(), &mut text).unwrap();
         assert_eq!(text, xml);
+    }
+
+    #[test]
+    fn fmi3_archive_has_the_fmi3_platform_folders_and_description() {
+        let t = &targets()[0];
+        let xml = t.xml(FmiVersion::Fmi3);
+        assert!(xml.contains("fmiVersion=\"3.0\"") && xml.contains(&t.description.guid), "{xml}");
+        let libs: [(Platform, &[u8]); 4] = [
+            (Platform::Linux64, b"\x7fELF x86-64"),
+            (Platform::Win64, b"MZ"),
+            (Platform::Aarch64Linux, b"\x7fELF arm64"),
+            (Platform::Darwin64, b"\xca\xfe\xba\xbe universal"),
+        ];
+        let a = archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap();
+        assert_eq!(a, archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap());
+        let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
+        let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
+        assert_eq!(
+            names,
+            [
+                "modelDescription.xml",
+                "binaries/x86_64-linux/nigel_plant.so",
+                "binaries/x86_64-windows/nigel_plant.dll",
+                "binaries/aarch64-linux/nigel_plant.so",
+                "binaries/x86_64-darwin/nigel_plant.dylib",
+                "binaries/aarch64-darwin/nigel_plant.dylib",
+                "documentation/index.html"
+            ]
+        );
+        // one universal library for both Mac architectures: the same bytes in both folders
+        for folder in ["x86_64-darwin", "aarch64-darwin"] {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(
+                &mut z.by_name(&format!("binaries/{folder}/nigel_plant.dylib")).unwrap(),
+                &mut bytes,
+            )
+            .unwrap();
+            assert_eq!(bytes, b"\xca\xfe\xba\xbe universal");
+        }
+        let mut doc = String::new();
+        std::io::Read::read_to_string(&mut z.by_name("documentation/index.html").unwrap(), &mut doc).unwrap();
+        assert!(doc.contains("The FMI 3.0 archive") && doc.contains("<code>nigel_plant.fmu</code>"), "{doc}");
+    }
+
+    #[test]
+    fn fmi3_documentation_shows_the_fmi3_value_references() {
+        let t = targets().into_iter().find(|t| t.model_identifier == "nigel_plant").unwrap();
+        // row r of the declaration (the FMI 2.0 order) has FMI 3.0 value reference r + 1
+        for (row, v) in t.description.model_variables.iter().enumerate() {
+            let v3 = t.description3.variable_by_name(&v.name).unwrap();
+            assert_eq!(v3.value_reference, row as u32 + 1, "{}", v.name);
+            assert!(
+                t.documentation3.contains(&format!(
+                    "<tr><td><code>{}</code></td><td>{}</td>",
+                    escape(&v.name),
+                    row + 1
+                )),
+                "{}",
+                v.name
+            );
+            assert!(t.documentation.contains(&format!(
+                "<tr><td><code>{}</code></td><td>{}</td>",
+                escape(&v.name),
+                v.value_reference
+            )));
+        }
+        assert!(t.documentation3.contains(&t.description3.instantiation_token));
+        assert!(!t.documentation.contains("FMI 3.0"));
+    }
+
+    #[test]
+    fn fmi3_closed_loop_ssp_is_the_fmi2_one_with_the_fmi3_archives() {
+        use std::io::Read as _;
+        let dir = std::env::temp_dir().join(format!("build-fmu-ssp3-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("fmi3")).unwrap();
+        let ssd = "<ssd:SystemStructureDescription><ssd:Component source=\"resources/nigel_plant.fmu\"/></ssd:SystemStructureDescription>";
+        let mut z = zip::ZipWriter::new(Cursor::new(Vec::new()));
+        z.start_file("SystemStructure.ssd", SimpleFileOptions::default()).unwrap();
+        z.write_all(ssd.as_bytes()).unwrap();
+        z.start_file("resources/nigel_plant.fmu", SimpleFileOptions::default()).unwrap();
+        z.write_all(b"fmi2 archive").unwrap();
+        std::fs::write(dir.join("closed_loop.ssp"), z.finish().unwrap().into_inner()).unwrap();
+        std::fs::write(dir.join("fmi3").join("nigel_plant.fmu"), b"fmi3 archive").unwrap();
+        let out = dir.join("ssp").join("closed_loop_fmi3.ssp");
+        write_closed_loop_ssp_fmi3(&dir.join("closed_loop.ssp"), &dir, &out).unwrap();
+        let first = std::fs::read(&out).unwrap();
+        let mut z = zip::ZipArchive::new(Cursor::new(first.clone())).unwrap();
+        let mut text = String::new();
+        z.by_name("SystemStructure.ssd").unwrap().read_to_string(&mut text).unwrap();
+        assert_eq!(text, ssd);
+        let mut fmu = Vec::new();
+        z.by_name("resources/nigel_plant.fmu").unwrap().read_to_end(&mut fmu).unwrap();
+        assert_eq!(fmu, b"fmi3 archive");
+        // byte-identical when written again; a missing FMI 3.0 archive is an error naming it
+        write_closed_loop_ssp_fmi3(&dir.join("closed_loop.ssp"), &dir, &out).unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), first);
+        std::fs::remove_file(dir.join("fmi3").join("nigel_plant.fmu")).unwrap();
+        let e = write_closed_loop_ssp_fmi3(&dir.join("closed_loop.ssp"), &dir, &out).unwrap_err();
+        assert!(e.contains("fmi3/nigel_plant.fmu"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -603,8 +881,27 @@ mod tests {
         let m = manifest(&ts, &builds);
         let parsed: serde_json::Value = serde_json::from_str(&m).unwrap();
         let entries = parsed.as_array().unwrap();
-        assert_eq!(entries.len(), ts.len());
+        // the FMI 2.0 archives first, then the FMI 3.0 ones
+        assert_eq!(entries.len(), 2 * ts.len());
+        let (entries, entries3) = entries.split_at(ts.len());
+        for (t, e) in ts.iter().zip(entries3) {
+            assert_eq!(e["fmi_version"], "3.0");
+            assert_eq!(e["fmu"], format!("fmi3/{}.fmu", t.model_identifier));
+            assert_eq!(e["instantiation_token"], t.description.guid);
+            assert_eq!(e["interfaces"], serde_json::json!(t.interfaces()));
+            let folders: Vec<&str> =
+                e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap()).collect();
+            assert_eq!(folders, ["x86_64-linux", "x86_64-windows", "aarch64-linux", "x86_64-darwin", "aarch64-darwin"]);
+            assert_eq!(e["platforms"][1]["library"], format!("binaries/x86_64-windows/{}.dll", t.model_identifier));
+            assert_eq!(e["platforms"][4]["library"], format!("binaries/aarch64-darwin/{}.dylib", t.model_identifier));
+            assert!(e["platforms"][1]["tested"].as_str().unwrap().contains("fmi3_closed_loop.c"), "{e}");
+            assert_eq!(e["platforms"][1]["minimum_os"], Platform::Win64.minimum_os());
+            assert_eq!(e["not_built"], serde_json::json!([]));
+        }
         for (t, e) in ts.iter().zip(entries) {
+            assert_eq!(e["fmi_version"], "2.0");
+            assert_eq!(e["guid"], t.description.guid);
+            assert!(e["platforms"][1]["tested"].as_str().unwrap().contains("fmi2_closed_loop.c"), "{e}");
             assert_eq!(e["fmu"], format!("{}.fmu", t.model_identifier));
             let folders: Vec<&str> =
                 e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap()).collect();
@@ -641,20 +938,49 @@ mod tests {
         for (m, folder) in missing.iter().zip(["win64", "aarch64-linux", "darwin64"]) {
             assert!(m.starts_with(&format!("{folder}: not built")), "{m}");
         }
-        let p = &one[0]["platforms"][0];
-        assert!(p["tested"].as_str().unwrap().starts_with("not tested"), "{p}");
-        assert_eq!(p["minimum_os"], "Linux with glibc 2.35 or later");
-        let doc = with_platform_table("<html><body></body></html>", "nigel_plant", std::slice::from_ref(&host));
+        // the FMI 3.0 archive of the same build lacks the same libraries, in its folders
+        let fmi3 = &one[targets.len()];
+        assert_eq!(fmi3["fmi_version"], "3.0");
+        let missing3: Vec<&str> = fmi3["not_built"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+        assert_eq!(missing3.len(), 4);
+        for (m, folder) in missing3.iter().zip(["x86_64-windows", "aarch64-linux", "x86_64-darwin", "aarch64-darwin"]) {
+            assert!(m.starts_with(&format!("{folder}: not built")), "{m}");
+        }
+        for p in [&one[0]["platforms"][0], &fmi3["platforms"][0]] {
+            assert!(p["tested"].as_str().unwrap().starts_with("not tested"), "{p}");
+            assert_eq!(p["minimum_os"], "Linux with glibc 2.35 or later");
+        }
+        assert_eq!(fmi3["platforms"][0]["folder"], "x86_64-linux");
+        let doc = with_platform_table(
+            "<html><body></body></html>",
+            "nigel_plant",
+            std::slice::from_ref(&host),
+            FmiVersion::Fmi2,
+        );
         assert!(doc.contains("not a release build") && doc.contains("<li>darwin64: not built"), "{doc}");
-        assert!(!with_platform_table("<body></body>", "nigel_plant", &all).contains("not a release build"));
+        let doc3 = with_platform_table(
+            "<html><body></body></html>",
+            "nigel_plant",
+            std::slice::from_ref(&host),
+            FmiVersion::Fmi3,
+        );
+        assert!(doc3.contains("<li>aarch64-darwin: not built") && doc3.contains("<code>x86_64-linux</code>"), "{doc3}");
+        for version in FmiVersion::ALL {
+            assert!(!with_platform_table("<body></body>", "nigel_plant", &all, version).contains("not a release build"));
+        }
     }
 
     #[test]
     fn documentation_gets_one_platform_row_per_platform_before_the_end() {
         let t = &targets()[1];
         let builds: Vec<PlatformBuild> = Platform::ALL.into_iter().map(PlatformBuild::of).collect();
-        let doc = with_platform_table(&t.documentation, &t.model_identifier, &builds);
+        let doc = with_platform_table(&t.documentation, &t.model_identifier, &builds, FmiVersion::Fmi2);
         assert!(doc.ends_with("</table>\n</body></html>\n"), "{doc}");
+        let doc3 = with_platform_table(&t.documentation3, &t.model_identifier, &builds, FmiVersion::Fmi3);
+        assert_eq!(doc3.matches("<tr><td><code>").count(), t.description.model_variables.len() + 5);
+        assert!(doc3.contains(
+            "<tr><td><code>aarch64-darwin</code></td><td><code>nigel_controller.dylib</code></td><td>macOS 11 or later"
+        ));
         assert_eq!(doc.matches("<tr><td><code>").count(), t.description.model_variables.len() + 4);
         assert!(doc.contains(
             "<tr><td><code>win64</code></td><td><code>nigel_controller.dll</code></td><td>64-bit Windows 10 or later"

@@ -1,5 +1,6 @@
-//! `build-fmu`: builds every FMU of the workspace into `target/fmu/`, one archive per FMU
-//! with a library for each platform built, and a `manifest.json` listing them.
+//! `build-fmu`: builds every FMU of the workspace into `target/fmu/`, two archives per FMU
+//! with a library for each platform built (FMI 2.0 `target/fmu/<id>.fmu` and FMI 3.0
+//! `target/fmu/fmi3/<id>.fmu`, the same library files), and a `manifest.json` listing them.
 //!
 //! Usage: `cargo run --release -p build-fmu -- [--platforms LIST|all] [--this-glibc] [OUT_DIR]`, `--list`
 //! to print the manifest without building, `--help` for the options.
@@ -8,7 +9,8 @@
 //! archive, `OUT_DIR/../ssp/nigel_closed_loop.ssp` (`target/ssp/` by default): plant,
 //! controller and test bench with every connection, parameters for the sim column,
 //! lane change, robust controller, seed 0 (`table3 --ssp PATH --ssp-job COLUMN/MANEUVER/CONTROLLER`
-//! writes any other job).
+//! writes any other job), and the same closed loop of the FMI 3.0 archives,
+//! `nigel_closed_loop_fmi3.ssp`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -19,9 +21,10 @@ use clap::Parser;
 /// The job the closed-loop SSP is parameterized for.
 const CLOSED_LOOP_JOB: &str = "sim/lane_change/robust";
 
-/// Builds the nigel FMUs (plant, controller, maneuver test bench): one .fmu per model with
-/// a library for each platform, byte-identical on rebuild, plus target/fmu/manifest.json and
-/// the closed loop as target/ssp/nigel_closed_loop.ssp.
+/// Builds the nigel FMUs (plant, controller, maneuver test bench): an FMI 2.0 and an FMI 3.0
+/// .fmu per model (target/fmu/ID.fmu, target/fmu/fmi3/ID.fmu) with a library for each
+/// platform, byte-identical on rebuild, plus target/fmu/manifest.json and the closed loop as
+/// target/ssp/nigel_closed_loop.ssp and target/ssp/nigel_closed_loop_fmi3.ssp.
 #[derive(Parser)]
 #[command(name = "build-fmu")]
 struct Args {
@@ -84,8 +87,7 @@ fn choose(list: &str, this_glibc: bool) -> Result<(Vec<Platform>, Vec<String>), 
         ));
     }
     if chosen.len() < Platform::ALL.len() {
-        let left: Vec<&str> =
-            Platform::ALL.iter().filter(|p| !chosen.contains(p)).map(|p| p.folder()).collect();
+        let left: Vec<&str> = Platform::ALL.iter().filter(|p| !chosen.contains(p)).map(|p| p.folder()).collect();
         notes.push(format!("not a release build: the archives lack {} (the manifest says so)", left.join(", ")));
     }
     Ok((chosen, notes))
@@ -112,7 +114,7 @@ fn main() -> ExitCode {
     let out_dir = args.out_dir.unwrap_or_else(|| build_fmu::target_dir().join("fmu"));
     let names: Vec<&str> = platforms.iter().map(|p| p.folder()).collect();
     eprintln!("build-fmu: building {} for {}", targets.len(), names.join(", "));
-    let build_fmu::Built { archives: written, platforms: builds } =
+    let build_fmu::Built { archives: written, archives3, platforms: builds } =
         match build_fmu::build_all(&targets, &platforms, &out_dir, &mut |m| eprintln!("build-fmu: {m}")) {
             Ok(w) => w,
             Err(e) => {
@@ -132,6 +134,18 @@ fn main() -> ExitCode {
             names.join(" "),
         );
     }
+    for (target, (path, size)) in targets.iter().zip(&archives3) {
+        let md = target.description3;
+        println!(
+            "built {} ({} bytes): FMI 3.0, {} variables, instantiationToken {}, interfaces: {}, platforms: {}",
+            path.display(),
+            size,
+            md.model_variables.len(),
+            md.instantiation_token,
+            target.interfaces().join(" "),
+            platforms.iter().flat_map(|p| p.fmi3_folders()).copied().collect::<Vec<_>>().join(" "),
+        );
+    }
     let manifest_path = out_dir.join("manifest.json");
     if let Err(e) = std::fs::write(&manifest_path, build_fmu::manifest(&targets, &builds)) {
         eprintln!("build-fmu: {}: {e}", manifest_path.display());
@@ -145,6 +159,14 @@ fn main() -> ExitCode {
     let ssp_path = out_dir.parent().unwrap_or(&out_dir).join("ssp").join("nigel_closed_loop.ssp");
     match build_fmu::write_closed_loop_ssp(&out_dir, CLOSED_LOOP_JOB, 0, &ssp_path) {
         Ok(()) => println!("wrote {} ({CLOSED_LOOP_JOB}, seed 0)", ssp_path.display()),
+        Err(e) => {
+            eprintln!("build-fmu: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let ssp3_path = ssp_path.with_file_name("nigel_closed_loop_fmi3.ssp");
+    match build_fmu::write_closed_loop_ssp_fmi3(&ssp_path, &out_dir, &ssp3_path) {
+        Ok(()) => println!("wrote {} (the same closed loop of the FMI 3.0 archives)", ssp3_path.display()),
         Err(e) => {
             eprintln!("build-fmu: {e}");
             return ExitCode::FAILURE;

@@ -66,6 +66,17 @@ impl Platform {
         }
     }
 
+    /// The FMI 3.0 platform folders (`<arch>-<os>`, FMI 3.0 section 2.5.1.1) of this
+    /// platform's library: the darwin64 universal library serves both Mac architectures.
+    pub fn fmi3_folders(self) -> &'static [&'static str] {
+        match self {
+            Platform::Linux64 => &["x86_64-linux"],
+            Platform::Win64 => &["x86_64-windows"],
+            Platform::Aarch64Linux => &["aarch64-linux"],
+            Platform::Darwin64 => &["x86_64-darwin", "aarch64-darwin"],
+        }
+    }
+
     /// The platform of a folder name.
     pub fn from_folder(name: &str) -> Option<Platform> {
         Platform::ALL.into_iter().find(|p| p.folder() == name)
@@ -127,6 +138,33 @@ impl Platform {
             Platform::Darwin64 => {
                 "by the test command, on this recipe's library: not executed (no macOS there): structural checks only, both architectures present, the 44 fmi2 \
                  exports, the minimum macOS version and only system libraries imported"
+            }
+        }
+    }
+
+    /// How the test command tests this platform's library through the FMI 3.0 archive (the
+    /// same file as in the FMI 2.0 archive, [`Platform::tested`], called through its fmi3
+    /// functions).
+    pub fn tested_fmi3(self) -> &'static str {
+        match self {
+            Platform::Linux64 => {
+                "by the test command, on this recipe's library: executed: fmpy (validate_fmu, Co-Simulation and Model \
+                 Exchange against the FMI 2.0 archive) and the C FMI 3.0 importer build-fmu/tests/c/fmi3_closed_loop.c, \
+                 which runs the closed loop (plant, controller, test bench) 30 s at 1 ms equal to the FMI 2.0 run bit for bit"
+            }
+            Platform::Win64 => {
+                "by the test command, on this recipe's library: executed under wine 8: the C FMI 3.0 importer \
+                 build-fmu/tests/c/fmi3_closed_loop.c, built with mingw-w64, runs the closed loop 30 s at 1 ms, every \
+                 output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same DLL bit for bit"
+            }
+            Platform::Aarch64Linux => {
+                "by the test command, on this recipe's library: executed under qemu-user: the C FMI 3.0 importer \
+                 build-fmu/tests/c/fmi3_closed_loop.c, built with aarch64-linux-gnu-gcc, runs the closed loop 30 s at 1 ms, \
+                 every output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same library bit for bit"
+            }
+            Platform::Darwin64 => {
+                "by the test command, on this recipe's library: not executed (no macOS there): structural checks only, \
+                 both architectures present, the fmi3 exports, the minimum macOS version and only system libraries imported"
             }
         }
     }

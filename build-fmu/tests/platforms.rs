@@ -12,6 +12,15 @@
 //! - darwin64: structural only (no macOS here): both architectures, the 44 `_fmi2*`
 //!   exports, `minos` 11.0, only `/usr/lib/` libraries imported (Mach-O parsed below).
 //!
+//! The FMI 3.0 archives (`target/fmu/fmi3/*.fmu`) carry the same library files (checked
+//! byte for byte) in the FMI 3.0 folders; the C FMI 3.0 importer `tests/c/fmi3_closed_loop.c`
+//! (built against fmpy's FMI 3.0 headers) runs the same closed loop through the fmi3
+//! functions: on x86_64-linux natively, on x86_64-windows under wine and on aarch64-linux
+//! under qemu-user, each compared with the linux64 FMI 2.0 run as the FMI 2.0 runs are, and
+//! equal bit for bit to the FMI 2.0 run of the same platform (the same library, the same
+//! grid, the same order of calls); x86_64-darwin and aarch64-darwin: the fmi3 exports of
+//! the universal library.
+//!
 //! Each foreign run is compared with the linux64 run column by column (see
 //! [`compare_with_linux64`] for what must be bit-identical and why the rest is not).
 //!
@@ -54,7 +63,9 @@ fn manifest_platforms() -> Vec<String> {
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e} (run `cargo run --release -p build-fmu` first)", path.display()));
     let m: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let entries = m.as_array().unwrap();
+    // the FMI 2.0 archives' entries; the FMI 3.0 ones name the same libraries by other folders
+    let entries: Vec<&serde_json::Value> = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == "2.0").collect();
+    assert!(!entries.is_empty(), "{}: no FMI 2.0 archive", path.display());
     let first: Vec<String> =
         entries[0]["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
     for e in entries {
@@ -63,6 +74,34 @@ fn manifest_platforms() -> Vec<String> {
         assert_eq!(these, first, "{}: platforms differ between archives", e["fmu"]);
     }
     first
+}
+
+/// The FMI 3.0 archives' platform folders of the manifest, checked to be the FMI 3.0
+/// names of the FMI 2.0 archives' platforms (the same in every archive).
+fn manifest_platforms3() -> Vec<String> {
+    let path = target_dir().join("fmu").join("manifest.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let entries: Vec<&serde_json::Value> = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == "3.0").collect();
+    assert_eq!(entries.len(), FMUS.len(), "{}: one FMI 3.0 archive per FMU", path.display());
+    let want: Vec<String> = manifest_platforms().iter().flat_map(|f| fmi3_folders(f)).map(|f| f.to_string()).collect();
+    for e in entries {
+        let these: Vec<String> =
+            e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
+        assert_eq!(these, want, "{}: FMI 3.0 folders", e["fmu"]);
+    }
+    want
+}
+
+/// The FMI 3.0 folders of an FMI 2.0 platform folder (FMI 3.0 section 2.5.1.1: `<arch>-<os>`).
+fn fmi3_folders(folder: &str) -> &'static [&'static str] {
+    match folder {
+        "linux64" => &["x86_64-linux"],
+        "win64" => &["x86_64-windows"],
+        "aarch64-linux" => &["aarch64-linux"],
+        "darwin64" => &["x86_64-darwin", "aarch64-darwin"],
+        other => panic!("unknown platform folder {other}"),
+    }
 }
 
 /// True when `folder` is in the archives; false (with a note) when it is not and not required.
@@ -104,6 +143,59 @@ fn libraries(folder: &str, dir: &Path) -> Vec<PathBuf> {
             path
         })
         .collect()
+}
+
+/// Unpacks `binaries/<folder3>/<id>.<ext>` of every FMI 3.0 archive into `dir`, each
+/// checked to be the very file the FMI 2.0 archive carries in `folder`.
+fn libraries3(folder: &str, folder3: &str, dir: &Path) -> Vec<PathBuf> {
+    assert!(fmi3_folders(folder).contains(&folder3));
+    assert!(manifest_platforms3().iter().any(|f| f == folder3), "{folder3}: not in the FMI 3.0 archives");
+    let read = |archive: &Path, name: &str| {
+        let mut z = zip::ZipArchive::new(std::fs::File::open(archive).unwrap()).unwrap();
+        let mut entry = z.by_name(name).unwrap_or_else(|e| panic!("{}: {name}: {e}", archive.display()));
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut entry, &mut bytes).unwrap();
+        bytes
+    };
+    FMUS.iter()
+        .map(|id| {
+            let ext = extension(folder);
+            let bytes = read(
+                &target_dir().join("fmu").join("fmi3").join(format!("{id}.fmu")),
+                &format!("binaries/{folder3}/{id}.{ext}"),
+            );
+            let fmi2 =
+                read(&target_dir().join("fmu").join(format!("{id}.fmu")), &format!("binaries/{folder}/{id}.{ext}"));
+            assert!(
+                bytes == fmi2,
+                "{id}: binaries/{folder3} of the FMI 3.0 archive is not binaries/{folder} of the FMI 2.0 one"
+            );
+            let path = dir.join(format!("{id}.{ext}"));
+            std::fs::write(&path, bytes).unwrap();
+            path
+        })
+        .collect()
+}
+
+/// The folder of fmpy's C headers (`fmpy/c-code`, with fmi3FunctionTypes.h), of the Python
+/// the test command set up (`FMPY_PYTHON`, else `target/venv`).
+fn fmi3_headers() -> PathBuf {
+    let python = std::env::var_os("FMPY_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| target_dir().join("venv").join("bin").join("python"));
+    let out = Command::new(&python)
+        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
+        .output()
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e} (bash scripts/python-env.sh sets up fmpy, whose headers the FMI 3.0 importer needs)",
+                python.display()
+            )
+        });
+    assert!(out.status.success(), "{}: no fmpy: {}", python.display(), String::from_utf8_lossy(&out.stderr));
+    let dir = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+    assert!(dir.join("fmi3FunctionTypes.h").is_file(), "{}: no fmi3FunctionTypes.h", dir.display());
+    dir
 }
 
 fn run(c: &mut Command) -> String {
@@ -168,6 +260,52 @@ fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
     job
 }
 
+/// The job file of `tests/c/fmi3_closed_loop.c` for `system`: [`job_file`]'s, with the FMI
+/// 3.0 value references (declaration row r, the index into the FMI 2.0 variables, has value
+/// reference r + 1), the instantiationToken (the FMI 2.0 GUID) and each Integer start value
+/// set as Int32 or, for an enumeration, as Int64.
+fn job_file3(system: &System, library: &dyn Fn(usize) -> String) -> String {
+    let vr3 = |index: usize| index as u32 + 1;
+    let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
+    for (i, inst) in system.instances.iter().enumerate() {
+        job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
+    }
+    for inst in &system.instances {
+        let vars = &inst.fmu.description().model_variables;
+        for (index, value) in &inst.start_values {
+            let vr = vr3(*index);
+            let enumeration = matches!(vars[*index].variable_type, model_description::VariableType::Enumeration { .. });
+            job += &match value {
+                Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
+                Value::Integer(n) if enumeration => format!("enumeration {} {vr} {n}\n", inst.name),
+                Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
+                Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
+                Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
+            };
+        }
+    }
+    for c in &system.connections {
+        job += &format!(
+            "connect {} {} {} {} {:?} {:?}\n",
+            system.instances[c.from.instance].name,
+            vr3(c.from.index),
+            system.instances[c.to.instance].name,
+            vr3(c.to.index),
+            c.gain,
+            c.offset
+        );
+    }
+    for (i, inst) in system.instances.iter().enumerate() {
+        for (index, var) in inst.fmu.description().model_variables.iter().enumerate() {
+            let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
+            if real && var.causality == model_description::Causality::Output {
+                job += &format!("record {} {} {}.{}\n", system.instances[i].name, vr3(index), inst.name, var.name);
+            }
+        }
+    }
+    job
+}
+
 /// A CSV as the C importer writes it: header, then rows.
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -178,6 +316,16 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 }
 
 const IMPORTER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/fmi2_closed_loop.c");
+const IMPORTER3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/c/fmi3_closed_loop.c");
+
+/// Which C API the closed loop goes through.
+#[derive(Clone, Copy, PartialEq)]
+enum Abi {
+    /// `fmi2_closed_loop.c` on the FMI 2.0 archives' libraries of the folder.
+    Fmi2,
+    /// `fmi3_closed_loop.c` on the FMI 3.0 archives' libraries of this FMI 3.0 folder.
+    Fmi3(&'static str),
+}
 
 /// Runs the C importer built by `compiler` on the libraries of `folder`; `runner` prefixes
 /// the command (wine, qemu); `path_of` turns a host path into the one the program opens.
@@ -189,21 +337,43 @@ fn closed_loop(
     runner: &mut dyn FnMut(&Path) -> Command,
     path_of: &dyn Fn(&Path) -> String,
 ) -> (Vec<String>, Vec<Vec<f64>>) {
-    let libs = libraries(folder, dir);
+    closed_loop_through(Abi::Fmi2, folder, dir, compiler, exe_name, runner, path_of)
+}
+
+/// [`closed_loop`] through the C API `abi`.
+fn closed_loop_through(
+    abi: Abi,
+    folder: &str,
+    dir: &Path,
+    compiler: &[&str],
+    exe_name: &str,
+    runner: &mut dyn FnMut(&Path) -> Command,
+    path_of: &dyn Fn(&Path) -> String,
+) -> (Vec<String>, Vec<Vec<f64>>) {
+    let libs = match abi {
+        Abi::Fmi2 => libraries(folder, dir),
+        Abi::Fmi3(folder3) => libraries3(folder, folder3, dir),
+    };
     let (system, _keep) = closed_loop_system();
     let index: BTreeMap<String, usize> = FMUS.iter().enumerate().map(|(k, id)| (id.to_string(), k)).collect();
-    let job = job_file(&system, &|i| {
+    let library = |i: usize| {
         let id = &system.instances[i].fmu.description().co_simulation.as_ref().unwrap().model_identifier;
         path_of(&libs[index[id.as_str()]])
-    });
+    };
+    let job = match abi {
+        Abi::Fmi2 => job_file(&system, &library),
+        Abi::Fmi3(_) => job_file3(&system, &library),
+    };
     let job_path = dir.join("closed_loop.job");
     std::fs::write(&job_path, job).unwrap();
     let exe = dir.join(exe_name);
-    run(Command::new(compiler[0])
-        .args(&compiler[1..])
-        .args(["-std=c99", "-O2", "-Wall", "-Werror", "-o"])
-        .arg(&exe)
-        .arg(IMPORTER));
+    let mut compile = Command::new(compiler[0]);
+    compile.args(&compiler[1..]).args(["-std=c99", "-O2", "-Wall", "-Werror", "-o"]).arg(&exe);
+    match abi {
+        Abi::Fmi2 => compile.arg(IMPORTER),
+        Abi::Fmi3(_) => compile.arg("-I").arg(fmi3_headers()).arg(IMPORTER3),
+    };
+    run(&mut compile);
     let csv = dir.join("closed_loop.csv");
     let _ = std::fs::remove_file(&csv);
     run(runner(&exe).arg(path_of(&job_path)).arg(path_of(&csv)));
@@ -347,6 +517,38 @@ fn wine_path(p: &Path) -> String {
     format!("Z:{}", p.display().to_string().replace('/', "\\"))
 }
 
+/// The command that runs a Windows program under wine in the test's folder `dir`, with
+/// the shim of ProcessPrng next to it.
+fn wine_runner(dir: &Path) -> impl FnMut(&Path) -> Command {
+    // Rust's standard library (1.78 and later) imports ProcessPrng from
+    // bcryptprimitives.dll, which Windows 10 has and wine 8 lacks: a shim next to the
+    // importer forwards it to BCryptGenRandom (test only; nothing of it is in the archive)
+    let shim = dir.join("process_prng_shim.c");
+    std::fs::write(
+        &shim,
+        "#include <windows.h>\n#include <bcrypt.h>\n\
+         __declspec(dllexport) BOOL WINAPI ProcessPrng(PBYTE data, SIZE_T len) {\n\
+         return BCryptGenRandom(NULL, data, (ULONG)len, BCRYPT_USE_SYSTEM_PREFERRED_RNG) == 0;\n}\n",
+    )
+    .unwrap();
+    run(Command::new("x86_64-w64-mingw32-gcc")
+        .args(["-shared", "-O2", "-o"])
+        .arg(dir.join("bcryptprimitives.dll"))
+        .arg(&shim)
+        .arg("-lbcrypt"));
+    let prefix = target_dir().join("wine-prefix");
+    move |exe: &Path| {
+        let mut c = Command::new("wine");
+        c.arg(exe)
+            .env("WINEPREFIX", &prefix)
+            .env("WINEDEBUG", "-all")
+            .env("WINEDLLOVERRIDES", "mscoree,mshtml=;bcryptprimitives=n")
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY");
+        c
+    }
+}
+
 #[test]
 fn win64_closed_loop_under_wine_matches_linux64() {
     if !built("win64") {
@@ -377,35 +579,56 @@ fn win64_closed_loop_under_wine_matches_linux64() {
             );
         }
     }
-    // Rust's standard library (1.78 and later) imports ProcessPrng from
-    // bcryptprimitives.dll, which Windows 10 has and wine 8 lacks: a shim next to the
-    // importer forwards it to BCryptGenRandom (test only; nothing of it is in the archive)
-    let shim = dir.join("process_prng_shim.c");
-    std::fs::write(
-        &shim,
-        "#include <windows.h>\n#include <bcrypt.h>\n\
-         __declspec(dllexport) BOOL WINAPI ProcessPrng(PBYTE data, SIZE_T len) {\n\
-         return BCryptGenRandom(NULL, data, (ULONG)len, BCRYPT_USE_SYSTEM_PREFERRED_RNG) == 0;\n}\n",
-    )
-    .unwrap();
-    run(Command::new("x86_64-w64-mingw32-gcc")
-        .args(["-shared", "-O2", "-o"])
-        .arg(dir.join("bcryptprimitives.dll"))
-        .arg(&shim)
-        .arg("-lbcrypt"));
-    let prefix = target_dir().join("wine-prefix");
-    let mut wine = |exe: &Path| {
-        let mut c = Command::new("wine");
-        c.arg(exe)
-            .env("WINEPREFIX", &prefix)
-            .env("WINEDEBUG", "-all")
-            .env("WINEDLLOVERRIDES", "mscoree,mshtml=;bcryptprimitives=n")
-            .env_remove("DISPLAY")
-            .env_remove("WAYLAND_DISPLAY");
-        c
-    };
-    let win = closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path);
-    compare_with_linux64("win64", linux64_run(), &win);
+    compare_with_linux64("win64", linux64_run(), win64_run());
+}
+
+/// The win64 closed loop through the FMI 2.0 importer under wine, run once per test binary
+/// (the FMI 3.0 run of the same DLLs is compared with it).
+fn win64_run() -> &'static Table {
+    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = work_dir("win64-run");
+        let mut wine = wine_runner(&dir);
+        closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path)
+    })
+}
+
+/// The aarch64-linux closed loop through the FMI 2.0 importer under qemu-user, run once per
+/// test binary.
+fn aarch64_run() -> &'static Table {
+    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = work_dir("aarch64-linux-run");
+        closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
+            p.display().to_string()
+        })
+    })
+}
+
+fn qemu(exe: &Path) -> Command {
+    let mut c = Command::new("qemu-aarch64");
+    c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
+    c
+}
+
+/// `fmi3` equals `fmi2` in every column and row to the bit: the same library file on the same
+/// platform, stepped on the same grid with the same calls in the same order, only through the
+/// other C API (whose functions reach the same model code).
+fn assert_same_bits(what: &str, fmi2: &Table, fmi3: &Table) {
+    assert_eq!(fmi3.0, fmi2.0, "{what}: columns");
+    assert_eq!(fmi3.1.len(), fmi2.1.len(), "{what}: rows");
+    for (k, (a, b)) in fmi2.1.iter().zip(&fmi3.1).enumerate() {
+        for j in 0..a.len() {
+            assert_eq!(
+                a[j].to_bits(),
+                b[j].to_bits(),
+                "{what}: row {k}, {}: FMI 2.0 {} FMI 3.0 {}",
+                fmi2.0[j],
+                a[j],
+                b[j]
+            );
+        }
+    }
 }
 
 #[test]
@@ -418,15 +641,92 @@ fn aarch64_closed_loop_under_qemu_matches_linux64() {
         let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
         assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
     }
-    let mut qemu = |exe: &Path| {
-        let mut c = Command::new("qemu-aarch64");
-        c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
-        c
-    };
-    let arm = closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
-        p.display().to_string()
-    });
-    compare_with_linux64("aarch64-linux", linux64_run(), &arm);
+    compare_with_linux64("aarch64-linux", linux64_run(), aarch64_run());
+}
+
+/// The names of the FMI 3.0 functions every library exports (all of them: the FMU answers
+/// those of a feature it lacks with fmi3Error).
+fn fmi3_symbols() -> Vec<&'static str> {
+    fmi_sys::fmi3::SYMBOLS.iter().map(|(name, _)| *name).collect()
+}
+
+#[test]
+fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
+    if !built("linux64") {
+        return;
+    }
+    let dir = work_dir("x86_64-linux");
+    for lib in libraries3("linux64", "x86_64-linux", &dir) {
+        let text = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib));
+        let mut exports: Vec<&str> =
+            text.lines().filter_map(|l| l.split_whitespace().nth(2)).filter(|n| n.starts_with("fmi3")).collect();
+        exports.sort();
+        let mut want = fmi3_symbols();
+        want.sort();
+        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
+    }
+    let fmi3 = closed_loop_through(
+        Abi::Fmi3("x86_64-linux"),
+        "linux64",
+        &dir,
+        &["gcc"],
+        "fmi3_closed_loop",
+        &mut |exe| Command::new(exe),
+        &|p| p.display().to_string(),
+    );
+    assert_same_bits("x86_64-linux", linux64_run(), &fmi3);
+}
+
+#[test]
+fn x86_64_windows_fmi3_closed_loop_under_wine_matches_linux64() {
+    if !built("win64") {
+        return;
+    }
+    let dir = work_dir("x86_64-windows");
+    for lib in libraries3("win64", "x86_64-windows", &dir) {
+        let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(&lib));
+        let mut exports: Vec<&str> = text
+            .lines()
+            .filter(|l| l.trim_start().starts_with('['))
+            .filter_map(|l| l.split_whitespace().last())
+            .filter(|n| n.starts_with("fmi3"))
+            .collect();
+        exports.sort();
+        let mut want = fmi3_symbols();
+        want.sort();
+        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
+    }
+    let mut wine = wine_runner(&dir);
+    let win = closed_loop_through(
+        Abi::Fmi3("x86_64-windows"),
+        "win64",
+        &dir,
+        &["x86_64-w64-mingw32-gcc"],
+        "fmi3_closed_loop.exe",
+        &mut wine,
+        &wine_path,
+    );
+    compare_with_linux64("x86_64-windows (FMI 3.0)", linux64_run(), &win);
+    assert_same_bits("x86_64-windows", win64_run(), &win);
+}
+
+#[test]
+fn aarch64_linux_fmi3_closed_loop_under_qemu_matches_linux64() {
+    if !built("aarch64-linux") {
+        return;
+    }
+    let dir = work_dir("aarch64-linux-fmi3");
+    let arm = closed_loop_through(
+        Abi::Fmi3("aarch64-linux"),
+        "aarch64-linux",
+        &dir,
+        &["aarch64-linux-gnu-gcc"],
+        "fmi3_closed_loop",
+        &mut qemu,
+        &|p| p.display().to_string(),
+    );
+    compare_with_linux64("aarch64-linux (FMI 3.0)", linux64_run(), &arm);
+    assert_same_bits("aarch64-linux", aarch64_run(), &arm);
 }
 
 // ---- Mach-O, the little of it the darwin64 checks read --------------------------------
@@ -485,7 +785,7 @@ fn parse_slice(b: &[u8]) -> Slice {
                     // N_EXT, and N_TYPE == N_SECT: an exported definition
                     if n_type & 0x01 != 0 && n_type & 0x0e == 0x0e {
                         let name = c_string(b, stroff + u32_le(b, e) as usize);
-                        if name.starts_with("_fmi2") {
+                        if name.starts_with("_fmi2") || name.starts_with("_fmi3") {
                             slice.fmi_exports.push(name);
                         }
                     }
@@ -499,11 +799,19 @@ fn parse_slice(b: &[u8]) -> Slice {
 }
 
 #[test]
-fn darwin64_is_universal_macos_11_with_the_fmi_exports_and_system_libraries_only() {
+fn darwin64_is_universal_macos_11_with_the_fmi2_and_fmi3_exports_and_system_libraries_only() {
     if !built("darwin64") {
         return;
     }
-    for lib in libraries("darwin64", &work_dir("darwin64")) {
+    let dir = work_dir("darwin64");
+    let mut libs = libraries("darwin64", &dir);
+    // the FMI 3.0 archives' x86_64-darwin and aarch64-darwin: the same universal library
+    for folder3 in fmi3_folders("darwin64") {
+        let sub = dir.join(folder3);
+        std::fs::create_dir_all(&sub).unwrap();
+        libs.extend(libraries3("darwin64", folder3, &sub));
+    }
+    for lib in libs {
         let b = std::fs::read(&lib).unwrap();
         assert_eq!(u32_be(&b, 0), FAT_MAGIC, "{}: not a universal binary", lib.display());
         let n = u32_be(&b, 4) as usize;
@@ -517,7 +825,18 @@ fn darwin64_is_universal_macos_11_with_the_fmi_exports_and_system_libraries_only
             let mut exports = slice.fmi_exports.clone();
             exports.sort();
             exports.dedup();
+            let mut fmi3: Vec<String> = exports
+                .iter()
+                .filter_map(|e| e.strip_prefix('_'))
+                .filter(|e| e.starts_with("fmi3"))
+                .map(str::to_string)
+                .collect();
+            exports.retain(|e| e.starts_with("_fmi2"));
             assert_eq!(exports.len(), 44, "{} cpu {cpu:#x}: fmi2 exports {exports:?}", lib.display());
+            fmi3.sort();
+            let mut want3: Vec<String> = fmi3_symbols().iter().map(|s| s.to_string()).collect();
+            want3.sort();
+            assert_eq!(fmi3, want3, "{} cpu {cpu:#x}: fmi3 exports", lib.display());
             assert!(
                 exports.contains(&"_fmi2DoStep".to_string())
                     && exports.contains(&"_fmi2GetDirectionalDerivative".to_string())

@@ -1,4 +1,5 @@
-//! Packages the `own_controller` FMU (`target/fmu/own_controller.fmu`) and writes the
+//! Packages the `own_controller` FMU (`target/fmu/own_controller.fmu`, and its FMI 3.0
+//! archive `target/fmu/fmi3/own_controller.fmu` from the same declaration) and writes the
 //! closed-loop SSP with it in place of `nigel_controller`
 //! (`target/ssp/own_controller_closed_loop.ssp`, from `target/ssp/nigel_closed_loop.ssp`,
 //! which `cargo run --release -p build-fmu` writes). The SSP's connections are kept; the
@@ -58,8 +59,11 @@ fn own_component(ssd: &str) -> Result<String, String> {
 fn run() -> Result<(), String> {
     let target = FmuTarget::of::<OwnController>("own-controller", EQUATIONS);
     let dir = target_dir();
-    let (fmu, _) = build_fmu::build_for_this_machine(&target, &dir.join("fmu")).map_err(|e| e.to_string())?;
-    println!("{}", fmu.display());
+    let archives = build_fmu::build_for_this_machine(&target, &dir.join("fmu")).map_err(|e| e.to_string())?;
+    let fmu = archives[0].0.clone();
+    for (path, _) in &archives {
+        println!("{}", path.display());
+    }
     let closed_loop = dir.join("ssp").join("nigel_closed_loop.ssp");
     let read = |p: &Path| {
         std::fs::read(p).map_err(|e| format!("{}: {e} (run `cargo run --release -p build-fmu`)", p.display()))
