@@ -31,8 +31,8 @@
 
 #![warn(missing_docs)]
 
-pub mod types;
 pub mod fmi3;
+pub mod types;
 pub use types::*;
 
 mod guid;

@@ -9,6 +9,13 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod read;
+pub mod validate;
+
+pub use crate::read::{Position, ReadError};
+pub use read::fmi_version_of;
+pub use validate::{Problem, Rule};
+
 pub use crate::{BaseUnit, DefaultExperiment, DependencyKind, Initial, LogCategory, Unit, Variability};
 
 /// `causality` of an FMI 3.0 variable.
@@ -344,7 +351,13 @@ pub struct Variable {
 
 impl Variable {
     /// A scalar with only the required attributes set (the others absent or false).
-    pub fn new(name: impl Into<String>, value_reference: u32, value_type: ValueType, causality: Causality, variability: Variability) -> Variable {
+    pub fn new(
+        name: impl Into<String>,
+        value_reference: u32,
+        value_type: ValueType,
+        causality: Causality,
+        variability: Variability,
+    ) -> Variable {
         Variable {
             name: name.into(),
             value_reference,
