@@ -6,91 +6,10 @@ use model_description::fmi3::*;
 use model_description::{DependencyKind, Initial, Variability};
 
 /// A bouncing ball (Model Exchange and Co-Simulation; two states, one event indicator).
-const BALL: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="ball" instantiationToken="{1b2e6c1a-0000-4000-8000-000000000001}"
-    description="A ball" generationTool="hand" variableNamingConvention="flat">
-  <ModelExchange modelIdentifier="ball" canGetAndSetFMUState="true" canSerializeFMUState="true" needsCompletedIntegratorStep="false"/>
-  <CoSimulation modelIdentifier="ball" canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true"
-      fixedInternalStepSize="1e-3" hasEventMode="true" mightReturnEarlyFromDoStep="true" maxOutputDerivativeOrder="0"/>
-  <UnitDefinitions>
-    <Unit name="m"><BaseUnit m="1"/></Unit>
-    <Unit name="m/s"><BaseUnit m="1" s="-1"/><DisplayUnit name="km/h" factor="3.6"/></Unit>
-    <Unit name="m/s2"><BaseUnit m="1" s="-2"/></Unit>
-    <Unit name="s"><BaseUnit s="1"/></Unit>
-  </UnitDefinitions>
-  <TypeDefinitions>
-    <Float64Type name="Position" quantity="Length" unit="m"/>
-    <Float64Type name="Velocity" quantity="Velocity" unit="m/s"/>
-  </TypeDefinitions>
-  <LogCategories>
-    <Category name="logEvents" description="Log events"/>
-  </LogCategories>
-  <DefaultExperiment startTime="0" stopTime="3" stepSize="1e-2"/>
-  <ModelVariables>
-    <!-- the independent variable -->
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous" unit="s"/>
-    <Float64 name="h" valueReference="1" causality="output" initial="exact" declaredType="Position" start="1"/>
-    <Float64 name="der(h)" valueReference="2" causality="local" declaredType="Velocity" derivative="1"/>
-    <Float64 name="v" valueReference="3" causality="output" initial="exact" declaredType="Velocity" start="0" reinit="true"/>
-    <Float64 name="der(v)" valueReference="4" unit="m/s2" derivative="3"/>
-    <Float64 name="g" valueReference="5" causality="parameter" variability="fixed" unit="m/s2" start="-9.81"/>
-    <Float64 name="e" valueReference="6" causality="parameter" variability="tunable" start="0.7" min="0.5" max="1"/>
-    <Float64 name="v_min" valueReference="7" variability="constant" declaredType="Velocity" start="0.1"/>
-    <Float64 name="h_indicator" valueReference="8"/>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="1"/>
-    <Output valueReference="3"/>
-    <ContinuousStateDerivative valueReference="2"/>
-    <ContinuousStateDerivative valueReference="4" dependencies="5" dependenciesKind="constant"/>
-    <InitialUnknown valueReference="2" dependencies="3" dependenciesKind="dependent"/>
-    <InitialUnknown valueReference="4" dependencies="5"/>
-    <EventIndicator valueReference="8" dependencies="1"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+const BALL: &str = include_str!("fixtures/fmi3_ball.xml");
 
 /// One variable of every type, scalars and arrays, a structural parameter sizing an array.
-const TYPES: &str = r#"<fmiModelDescription fmiVersion="3.0.2" modelName="types" instantiationToken="t">
-  <CoSimulation modelIdentifier="types"/>
-  <TypeDefinitions>
-    <EnumerationType name="Mode"><Item name="off" value="-1"/><Item name="on" value="4"/></EnumerationType>
-    <Int16Type name="Count" min="0" max="100"/>
-    <BinaryType name="Blob" mimeType="application/octet-stream"/>
-  </TypeDefinitions>
-  <ModelVariables>
-    <Float64 name="time" valueReference="100" causality="independent"/>
-    <Float32 name="f32" valueReference="1" causality="input" start="0.1"/>
-    <Int8 name="i8" valueReference="2" causality="input" start="-128" min="-128" max="127"/>
-    <UInt8 name="u8" valueReference="3" causality="input" start="255"/>
-    <Int16 name="i16" valueReference="4" causality="input" declaredType="Count" start="7"/>
-    <UInt16 name="u16" valueReference="5" causality="input" start="65535"/>
-    <Int32 name="i32" valueReference="6" causality="input" start="-2147483648"/>
-    <UInt32 name="u32" valueReference="7" causality="input" start="4294967295"/>
-    <Int64 name="i64" valueReference="8" causality="input" start="-9223372036854775808"/>
-    <UInt64 name="u64" valueReference="9" causality="input" start="18446744073709551615"/>
-    <Boolean name="b" valueReference="10" causality="input" start="true"/>
-    <String name="s" valueReference="11" causality="input"><Start value="a &amp; b"/></String>
-    <Binary name="bin" valueReference="12" causality="input" declaredType="Blob" maxSize="4"><Start value="00ff10"/></Binary>
-    <Enumeration name="mode" valueReference="13" causality="input" declaredType="Mode" start="4"/>
-    <UInt64 name="n" valueReference="20" causality="structuralParameter" variability="fixed" start="3"/>
-    <Float64 name="y" valueReference="21" causality="output">
-      <Dimension valueReference="20"/>
-    </Float64>
-    <Float64 name="A" valueReference="22" causality="parameter" variability="tunable" start="1 2 3 4 5 6">
-      <Dimension start="2"/><Dimension valueReference="20"/>
-    </Float64>
-    <Boolean name="flags" valueReference="23" causality="parameter" variability="fixed" start="true 0 1">
-      <Dimension start="3"/>
-    </Boolean>
-    <String name="names" valueReference="24" causality="parameter" variability="fixed">
-      <Dimension start="2"/><Start value="x"/><Start value=""/>
-    </String>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="21" dependencies="22 1"/>
-  </ModelStructure>
-</fmiModelDescription>"#;
+const TYPES: &str = include_str!("fixtures/fmi3_types.xml");
 
 fn read(xml: &str) -> ReadError {
     ModelDescription::from_xml(xml).expect_err("must be refused")
@@ -393,7 +312,14 @@ fn validation_of_the_ball_structure() {
     assert_eq!(rules(&md), vec![Rule::Derivative]);
     let mut md = base.clone();
     md.model_structure.continuous_state_derivatives[0].value_reference = 8;
-    assert_eq!(rules(&md), vec![Rule::ContinuousStateDerivatives]);
+    // h_indicator is no derivative; der(h), no longer listed as one, need not be an initial unknown.
+    assert_eq!(rules(&md), vec![Rule::ContinuousStateDerivatives, Rule::InitialUnknowns]);
+    let mut md = base.clone();
+    md.model_structure.initial_unknowns.pop();
+    assert_eq!(rules(&md), vec![Rule::InitialUnknowns], "der(v) (initial calculated) missing");
+    let mut md = base.clone();
+    md.model_structure.initial_unknowns.push(md.model_structure.initial_unknowns[0].clone());
+    assert_eq!(rules(&md), vec![Rule::InitialUnknowns], "listed twice");
     let mut md = base.clone();
     md.model_structure.event_indicators[0].value_reference = 5;
     assert_eq!(rules(&md), vec![Rule::EventIndicators]);

@@ -1,7 +1,7 @@
 //! Checks of an FMI 3.0 [`ModelDescription`] against the rules of the standard importers
 //! enforce (fmpy's `validate`, the FMI 3.0 schema's key constraints, section 2.4).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use super::*;
@@ -60,6 +60,9 @@ pub enum Rule {
     Outputs,
     /// `<ContinuousStateDerivative>` must name variables with a `derivative` attribute.
     ContinuousStateDerivatives,
+    /// `<InitialUnknown>` must list exactly the outputs, continuous states and state
+    /// derivatives with initial approx or calculated, and the calculated parameters.
+    InitialUnknowns,
     /// `<EventIndicator>` must name continuous Float variables.
     EventIndicators,
     /// `dependenciesKind` needs `dependencies` of the same length.
@@ -96,6 +99,7 @@ impl Rule {
             Rule::UnknownValueReference => "unknown-value-reference",
             Rule::Outputs => "outputs",
             Rule::ContinuousStateDerivatives => "continuous-state-derivatives",
+            Rule::InitialUnknowns => "initial-unknowns",
             Rule::EventIndicators => "event-indicators",
             Rule::DependenciesKind => "dependencies-kind",
             Rule::DeclaredType => "declared-type",
@@ -504,6 +508,30 @@ impl ModelDescription {
                 Rule::Outputs,
                 None,
                 format!("<Output> entries are {listed:?}, the causality=output variables are {outputs:?} (in order)"),
+            );
+        }
+        let states: HashSet<u32> = self.states().into_iter().collect();
+        let derivatives: HashSet<u32> = ms.continuous_state_derivatives.iter().map(|u| u.value_reference).collect();
+        let expected: BTreeSet<u32> = self
+            .model_variables
+            .iter()
+            .filter(|v| {
+                let initial = v.initial.or_else(|| Initial::default_for(as_fmi2(v.causality), v.variability));
+                let open = matches!(initial, Some(Initial::Approx | Initial::Calculated));
+                v.causality == Causality::CalculatedParameter
+                    || (open
+                        && (v.causality == Causality::Output
+                            || states.contains(&v.value_reference)
+                            || derivatives.contains(&v.value_reference)))
+            })
+            .map(|v| v.value_reference)
+            .collect();
+        let listed: BTreeSet<u32> = ms.initial_unknowns.iter().map(|u| u.value_reference).collect();
+        if expected != listed || listed.len() != ms.initial_unknowns.len() {
+            push(
+                Rule::InitialUnknowns,
+                None,
+                format!("<InitialUnknown> entries are {listed:?} (once each), expected {expected:?}"),
             );
         }
         problems
