@@ -498,7 +498,7 @@ impl std::fmt::Debug for Instance {
 macro_rules! call {
     ($self:ident, $name:literal, $time:expr, $f:expr) => {{
         $self.check_callable($name)?;
-        let mark = crate::exit_guard::enter(&$self.name, &$self.fmu, $name, $time.unwrap_or($self.time));
+        let mark = crate::call_site::enter(&$self.name, &$self.fmu, $name, $time.unwrap_or($self.time));
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
         drop(mark);
@@ -521,7 +521,7 @@ impl Instance {
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let log = Box::<LogSink>::default();
         let callbacks = callbacks_for(&log);
-        let mark = crate::exit_guard::enter(name, fmu, "fmi2Instantiate", 0.0);
+        let mark = crate::call_site::enter(name, fmu, "fmi2Instantiate", 0.0);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (fmu.functions.instantiate)(
@@ -728,7 +728,7 @@ impl Instance {
             return Err(Error::IllegalCall { instance: self.name.clone(), function: "fmi2Reset", state: "fatal" });
         }
         let f = self.optional(self.fmu.functions.reset, "fmi2Reset")?;
-        let mark = crate::exit_guard::enter(&self.name, &self.fmu, "fmi2Reset", self.time);
+        let mark = crate::call_site::enter(&self.name, &self.fmu, "fmi2Reset", self.time);
         // SAFETY: live component.
         let raw = unsafe { f(self.component) };
         drop(mark);
@@ -850,7 +850,7 @@ impl Instance {
     /// that the hosts of several instances step at the same time; the next
     /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
     /// in process, and when the instance cannot step in its state (`do_step` then says why).
-    pub(crate) fn post_step(&mut self, time: f64, step: f64) -> bool {
+    pub fn post_step(&mut self, time: f64, step: f64) -> bool {
         let Some(host) = self.host.as_deref_mut() else { return false };
         if self.state != InstanceState::Running || self.fmu.functions.do_step.is_none() {
             return false;
@@ -1002,7 +1002,7 @@ impl Drop for Instance {
                 unsafe { free_state(self.component, &mut s) };
             }
         }
-        let _mark = crate::exit_guard::enter(&self.name, &self.fmu, "fmi2FreeInstance", self.time);
+        let _mark = crate::call_site::enter(&self.name, &self.fmu, "fmi2FreeInstance", self.time);
         // SAFETY: the component came from fmi2Instantiate and is freed once.
         unsafe { (self.fmu.functions.free_instance)(self.component) };
     }
