@@ -1,6 +1,8 @@
-//! Import of one FMI 2.0 FMU: unpack, read the model description, load the library,
-//! resolve the functions of the chosen interface; and [`Instance`], whose every fmi2 call
-//! returns a typed [`Result`]. An instance terminates and frees itself on drop.
+//! Import of one FMU, FMI 2.0 or FMI 3.0: unpack, read the model description, load the
+//! library, resolve the functions of the chosen interface; and [`Instance`], whose every
+//! call returns a typed [`Result`], the same calls for both generations (an FMI 3.0 FMU's
+//! scalars as the FMI 2.0-shaped view of [`crate::fmi3`]). An instance terminates and
+//! frees itself on drop.
 
 use crate::error::{Error, Result, Status};
 use crate::unpack::{ArchiveSource, UnpackLimits};
@@ -49,6 +51,14 @@ pub use fmi_sys::fmi2::Fmi2EventInfo as EventInfo;
 /// The fmi2 functions of a library: the ones every interface needs, the rest optional
 /// (absent when the library lacks them; calling one is then an error naming it).
 pub(crate) use fmi_sys::fmi2::Fmi2Functions as Functions;
+
+/// The functions of an FMU: FMI 2.0's table, or FMI 3.0's with the FMU's own description.
+pub(crate) enum Abi {
+    /// FMI 2.0 (in process, or the isolation proxy).
+    Fmi2(Functions),
+    /// FMI 3.0.
+    Fmi3(Box<crate::fmi3::Fmi3Abi>),
+}
 
 /// The callbacks of an instance whose messages go to `log` (the logger shim of fmi-sys
 /// formats them).
@@ -164,7 +174,7 @@ pub struct ImportOptions {
 /// An imported FMU: its unpacked folder (removed on drop), model description and library.
 /// Share it between instances with `Arc`; it outlives them.
 pub struct Fmu {
-    pub(crate) functions: Functions,
+    pub(crate) abi: Abi,
     allow_non_finite: bool,
     /// The library loaded in this process (`None`: imported isolated, never loaded here).
     _library: Option<Arc<libloading::Library>>,
@@ -180,6 +190,8 @@ pub struct Fmu {
     isolated_from: Option<Arc<Fmu>>,
     /// The library inside the unpacked folder.
     library_path: PathBuf,
+    /// FMI 3.0: the variables not in the view (see [`crate::fmi3`]).
+    not_in_view: Vec<String>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -218,19 +230,67 @@ pub(crate) fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Ar
     Ok(library)
 }
 
-/// Reads `modelDescription.xml` of an unpacked FMU (at most `limits.max_xml_bytes`).
-pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<ModelDescription> {
+/// The text of `modelDescription.xml` of an unpacked FMU (at most `limits.max_xml_bytes`).
+fn read_xml(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<String> {
     let path = dir.join("modelDescription.xml");
-    let xml =
-        crate::unpack::read_text_file(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
-            Error::Io { source: e, .. } => {
-                Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") }
-            }
-            other => other,
-        })?;
-    ModelDescription::from_xml(&xml)
+    crate::unpack::read_text_file(&path, "modelDescription.xml", limits.max_xml_bytes).map_err(|e| match e {
+        Error::Io { source: e, .. } => {
+            Error::ModelDescription { path: source.to_path_buf(), reason: format!("cannot read it: {e}") }
+        }
+        other => other,
+    })
+}
+
+/// Reads the FMI 2.0 `modelDescription.xml` of an unpacked FMU (at most
+/// `limits.max_xml_bytes`).
+pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) -> Result<ModelDescription> {
+    ModelDescription::from_xml(&read_xml(dir, source, limits)?)
         .map_err(|e| Error::ModelDescription { path: source.to_path_buf(), reason: e.to_string() })
 }
+
+/// The FMI 3.0 description of the FMU archive `path`, read and checked as
+/// [`Fmu::load`] does, without loading its library; `None` for an FMI 2.0 FMU.
+pub fn read_fmi3_description(
+    path: &Path,
+    limits: &UnpackLimits,
+) -> Result<Option<model_description::fmi3::ModelDescription>> {
+    let unpacked = crate::unpack::unpack_fmu(&ArchiveSource::File(path.to_path_buf()), limits)?;
+    let xml = read_xml(unpacked.dir.path(), path, limits)?;
+    if !model_description::fmi3::fmi_version_of(&xml).is_some_and(|v| v.starts_with("3.")) {
+        return Ok(None);
+    }
+    checked_fmi3(&xml, path).map(Some)
+}
+
+/// Reads an FMI 3.0 description and refuses what [`FMI3_REFUSED`] lists and what the
+/// master does not run.
+fn checked_fmi3(xml: &str, path: &Path) -> Result<model_description::fmi3::ModelDescription> {
+    let refuse = |reason: String| Error::ModelDescription { path: path.to_path_buf(), reason };
+    let md = model_description::fmi3::ModelDescription::from_xml(xml).map_err(|e| refuse(e.to_string()))?;
+    let problems: Vec<String> =
+        md.validate().into_iter().filter(|p| FMI3_REFUSED.contains(&p.rule)).map(|p| p.to_string()).collect();
+    if !problems.is_empty() {
+        return Err(refuse(problems.join("; ")));
+    }
+    if let Some(feature) = crate::fmi3::unsupported_feature(&md) {
+        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
+    }
+    Ok(md)
+}
+
+/// The problems of an FMI 3.0 description that make its import wrong, refused at load.
+const FMI3_REFUSED: &[model_description::fmi3::Rule] = {
+    use model_description::fmi3::Rule as R;
+    &[
+        R::DuplicateName,
+        R::DuplicateValueReference,
+        R::Independent,
+        R::UnknownValueReference,
+        R::Dimension,
+        R::StartCount,
+        R::Derivative,
+    ]
+};
 
 fn file_uri(path: &Path) -> String {
     let mut uri = String::from("file://");
@@ -263,7 +323,12 @@ impl Fmu {
         let path = shown_path.as_path();
         let unpacked = crate::unpack::unpack_fmu(origin, &options.limits)?;
         let dir = unpacked.dir;
-        let description = read_model_description(dir.path(), path, &options.limits)?;
+        let xml = read_xml(dir.path(), path, &options.limits)?;
+        if model_description::fmi3::fmi_version_of(&xml).is_some_and(|v| v.starts_with("3.")) {
+            return Fmu::load_fmi3(origin, options, dir, unpacked.platforms, &xml);
+        }
+        let description = ModelDescription::from_xml(&xml)
+            .map_err(|e| Error::ModelDescription { path: path.to_path_buf(), reason: e.to_string() })?;
         let mut names = std::collections::HashMap::with_capacity(description.model_variables.len());
         for (k, v) in description.model_variables.iter().enumerate() {
             if let Some(first) = names.insert(v.name.as_str(), k + 1) {
@@ -330,7 +395,7 @@ impl Fmu {
         let resource_uri = CString::new(file_uri(&dir.path().join("resources")))
             .map_err(|_| Error::Experiment("temporary folder path contains NUL".into()))?;
         Ok(Arc::new(Fmu {
-            functions,
+            abi: Abi::Fmi2(functions),
             allow_non_finite: options.allow_non_finite,
             _library: library,
             description,
@@ -341,17 +406,123 @@ impl Fmu {
             dir: Some(dir),
             isolated_from: None,
             library_path: so,
+            not_in_view: Vec::new(),
         }))
+    }
+
+    /// The FMI 3.0 part of [`Fmu::load_from`]: `xml` is the archive's description.
+    fn load_fmi3(
+        origin: &ArchiveSource,
+        options: &ImportOptions,
+        dir: tempfile::TempDir,
+        platforms: Vec<String>,
+        xml: &str,
+    ) -> Result<Arc<Fmu>> {
+        let shown_path = origin.shown();
+        let path = shown_path.as_path();
+        let refuse = |reason: String| Error::ModelDescription { path: path.to_path_buf(), reason };
+        let md = checked_fmi3(xml, path)?;
+        if options.isolated {
+            return Err(Error::Unsupported {
+                path: path.to_path_buf(),
+                feature: "FMI 3.0 instances in host processes (--isolate)".into(),
+            });
+        }
+        let (description, enumerations, not_in_view) = crate::fmi3::fmi2_view(&md);
+        let interface = match options.interface {
+            Some(i) => i,
+            None if md.co_simulation.is_some() => Interface::CoSimulation,
+            None => Interface::ModelExchange,
+        };
+        let identifier = match interface {
+            Interface::CoSimulation => md.co_simulation.as_ref().map(|c| c.common.model_identifier.clone()),
+            Interface::ModelExchange => md.model_exchange.as_ref().map(|m| m.common.model_identifier.clone()),
+        }
+        .ok_or(Error::NoInterface { path: path.to_path_buf(), interface: interface.as_str() })?;
+        if !model_description::is_c_identifier(&identifier) {
+            return Err(refuse(format!("modelIdentifier {identifier:?} is not a C identifier")));
+        }
+        let relative = format!("binaries/x86_64-linux/{identifier}.so");
+        let so = dir.path().join(&relative);
+        if !so.is_file() {
+            return Err(Error::MissingBinary { expected: relative, platforms });
+        }
+        let shown = path.join(&relative);
+        let library = load_library(&so, &shown, &relative)?;
+        // SAFETY: the symbols are declared with the C signatures of the FMI 3.0 headers.
+        let functions = unsafe { fmi_sys::fmi3::Fmi3Functions::load(&library) }
+            .map_err(|missing| Error::MissingSymbol { path: shown.clone(), symbol: missing.0 })?;
+        let needs: &[&str] = match interface {
+            Interface::CoSimulation => &["fmi3InstantiateCoSimulation", "fmi3DoStep"],
+            Interface::ModelExchange => &[
+                "fmi3InstantiateModelExchange",
+                "fmi3EnterEventMode",
+                "fmi3UpdateDiscreteStates",
+                "fmi3EnterContinuousTimeMode",
+                "fmi3CompletedIntegratorStep",
+                "fmi3SetTime",
+                "fmi3SetContinuousStates",
+                "fmi3GetContinuousStateDerivatives",
+                "fmi3GetEventIndicators",
+                "fmi3GetContinuousStates",
+            ],
+        };
+        if let Some(symbol) = needs.iter().find(|s| !functions.has(s)) {
+            return Err(Error::MissingSymbol { path: shown, symbol });
+        }
+        let token =
+            CString::new(md.instantiation_token.as_str()).map_err(|_| refuse("NUL in instantiationToken".into()))?;
+        let resource_path = crate::fmi3::resource_path(dir.path())
+            .ok_or_else(|| Error::Experiment("temporary folder path contains NUL".into()))?;
+        Ok(Arc::new(Fmu {
+            abi: Abi::Fmi3(Box::new(crate::fmi3::Fmi3Abi {
+                functions,
+                description: md,
+                enumerations,
+                token,
+                resource_path,
+            })),
+            allow_non_finite: options.allow_non_finite,
+            _library: Some(library),
+            description,
+            interface,
+            source: path.to_path_buf(),
+            origin: origin.clone(),
+            resource_uri: CString::default(),
+            dir: Some(dir),
+            isolated_from: None,
+            library_path: so,
+            not_in_view,
+        }))
+    }
+
+    /// The FMI 3.0 model description (`None` for an FMI 2.0 FMU, whose description is
+    /// [`Fmu::description`]). For an FMI 3.0 FMU, [`Fmu::description`] is the view of it
+    /// the master works with (see [`crate::fmi3`]).
+    pub fn fmi3_description(&self) -> Option<&model_description::fmi3::ModelDescription> {
+        match &self.abi {
+            Abi::Fmi2(_) => None,
+            Abi::Fmi3(a) => Some(&a.description),
+        }
+    }
+
+    /// FMI 3.0: the variables the view leaves out (arrays, Float32, the integer types
+    /// other than Int32, Binary), neither recorded nor settable; empty for FMI 2.0.
+    pub fn not_in_view(&self) -> &[String] {
+        &self.not_in_view
     }
 
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
+        let Abi::Fmi2(functions) = &self.abi else {
+            return self.clone(); // FMI 3.0: refused by Instance::new_isolated
+        };
         if self.is_isolated() {
             return self.clone();
         }
         Arc::new(Fmu {
-            functions: crate::isolate::proxy::table(&|symbol| self.functions.has(symbol)),
+            abi: Abi::Fmi2(crate::isolate::proxy::table(&|symbol| functions.has(symbol))),
             allow_non_finite: self.allow_non_finite,
             _library: self._library.clone(),
             description: self.description.clone(),
@@ -362,6 +533,7 @@ impl Fmu {
             dir: None,
             isolated_from: Some(self.clone()),
             library_path: self.library_path.clone(),
+            not_in_view: Vec::new(),
         })
     }
 
@@ -421,9 +593,13 @@ impl Fmu {
                 self.description.model_exchange.as_ref().is_some_and(|c| c.can_get_and_set_fmu_state)
             }
         };
-        flag && self.functions.get_fmu_state.is_some()
-            && self.functions.set_fmu_state.is_some()
-            && self.functions.free_fmu_state.is_some()
+        flag && match &self.abi {
+            Abi::Fmi2(f) => f.get_fmu_state.is_some() && f.set_fmu_state.is_some() && f.free_fmu_state.is_some(),
+            Abi::Fmi3(a) => {
+                let f = &a.functions;
+                f.get_fmu_state.is_some() && f.set_fmu_state.is_some() && f.free_fmu_state.is_some()
+            }
+        }
     }
 }
 
@@ -483,6 +659,20 @@ pub struct Instance {
     time: f64,
     /// Isolated: the host process the calls go to (the component is its address).
     host: Option<Box<crate::isolate::channel::Channel>>,
+    /// FMI 3.0: what `setup_experiment` was given (tolerance, start, stop), passed on by
+    /// `fmi3EnterInitializationMode`.
+    experiment: (Option<f64>, f64, Option<f64>),
+    /// FMI 3.0: the time `fmi3DoStep` reported `terminateSimulation` at.
+    terminate_requested: Option<f64>,
+    /// FMI 3.0: Booleans as the bytes the ABI has (reused).
+    bytes: Vec<u8>,
+}
+
+/// A function of the FMI 3.0 table, or the error naming it.
+macro_rules! f3 {
+    ($self:ident, $abi:ident, $field:ident, $name:literal) => {
+        $abi.functions.$field.ok_or_else(|| Error::MissingSymbol { path: $self.fmu.source.clone(), symbol: $name })?
+    };
 }
 
 // SAFETY: an FMI 2.0 instance may be used from any thread as long as calls to it are not
@@ -517,14 +707,18 @@ impl Instance {
             });
         }
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
-        let guid = CString::new(fmu.description.guid.as_str())
-            .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let log = Box::<LogSink>::default();
         let callbacks = callbacks_for(&log);
+        let functions = match &fmu.abi {
+            Abi::Fmi2(functions) => functions,
+            Abi::Fmi3(abi) => return Instance::new_fmi3(fmu, abi, name, name_c, log, callbacks),
+        };
+        let guid = CString::new(fmu.description.guid.as_str())
+            .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let mark = crate::call_site::enter(name, fmu, "fmi2Instantiate", 0.0);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
-            (fmu.functions.instantiate)(
+            (functions.instantiate)(
                 name_c.as_ptr(),
                 fmu.interface.fmi_type(),
                 guid.as_ptr(),
@@ -536,9 +730,25 @@ impl Instance {
         };
         drop(mark);
         if component.is_null() {
-            return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
+            return Err(Error::Instantiate {
+                instance: name.into(),
+                function: "fmi2Instantiate",
+                log: log.recent_problems(),
+            });
         }
-        Ok(Instance {
+        Ok(Instance::with(component, name, name_c, log, callbacks, fmu.clone(), None))
+    }
+
+    fn with(
+        component: Component,
+        name: &str,
+        name_c: CString,
+        log: Box<LogSink>,
+        callbacks: Box<CallbackFunctions>,
+        fmu: Arc<Fmu>,
+        host: Option<Box<crate::isolate::channel::Channel>>,
+    ) -> Instance {
+        Instance {
             component,
             state: InstanceState::Instantiated,
             name: name.into(),
@@ -546,10 +756,66 @@ impl Instance {
             log,
             _callbacks: callbacks,
             saved: Vec::new(),
-            fmu: fmu.clone(),
+            fmu,
             time: 0.0,
-            host: None,
-        })
+            host,
+            experiment: (None, 0.0, None),
+            terminate_requested: None,
+            bytes: Vec::new(),
+        }
+    }
+
+    /// `fmi3InstantiateCoSimulation` (early return allowed, no event mode, no
+    /// intermediate update) or `fmi3InstantiateModelExchange`, logging off, the messages
+    /// to the instance's log.
+    fn new_fmi3(
+        fmu: &Arc<Fmu>,
+        abi: &crate::fmi3::Fmi3Abi,
+        name: &str,
+        name_c: CString,
+        log: Box<LogSink>,
+        callbacks: Box<CallbackFunctions>,
+    ) -> Result<Instance> {
+        let environment = &*log as *const LogSink as *mut c_void;
+        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::fmi3::log_message);
+        let missing = |symbol| Error::MissingSymbol { path: fmu.source.clone(), symbol };
+        let (function, component) = match fmu.interface {
+            Interface::CoSimulation => {
+                let f = abi.functions.instantiate_co_simulation.ok_or(missing("fmi3InstantiateCoSimulation"))?;
+                let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateCoSimulation", 0.0);
+                // SAFETY: every pointer is valid for the call; the log outlives the instance.
+                let c = unsafe {
+                    f(
+                        name_c.as_ptr(),
+                        abi.token.as_ptr(),
+                        abi.resource_path.as_ptr(),
+                        0,
+                        0,
+                        0,
+                        1,
+                        std::ptr::null(),
+                        0,
+                        environment,
+                        logger,
+                        None,
+                    )
+                };
+                ("fmi3InstantiateCoSimulation", c)
+            }
+            Interface::ModelExchange => {
+                let f = abi.functions.instantiate_model_exchange.ok_or(missing("fmi3InstantiateModelExchange"))?;
+                let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateModelExchange", 0.0);
+                // SAFETY: as above.
+                let c = unsafe {
+                    f(name_c.as_ptr(), abi.token.as_ptr(), abi.resource_path.as_ptr(), 0, 0, environment, logger)
+                };
+                ("fmi3InstantiateModelExchange", c)
+            }
+        };
+        if component.is_null() {
+            return Err(Error::Instantiate { instance: name.into(), function, log: log.recent_problems() });
+        }
+        Ok(Instance::with(component, name, name_c, log, callbacks, fmu.clone(), None))
     }
 
     /// `fmi2Instantiate` in a host process of its own (`isolation` names the host binary
@@ -561,6 +827,12 @@ impl Instance {
         run_deadline: Option<(std::time::Instant, std::time::Duration)>,
     ) -> Result<Instance> {
         use crate::error::HostEnd;
+        if matches!(fmu.abi, Abi::Fmi3(_)) {
+            return Err(Error::Unsupported {
+                path: fmu.source.clone(),
+                feature: "FMI 3.0 instances in host processes (--isolate)".into(),
+            });
+        }
         let fmu = fmu.isolated();
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
         let guid = CString::new(fmu.description.guid.as_str())
@@ -602,22 +874,15 @@ impl Instance {
             if let Some(cause) = channel.failure.clone() {
                 return Err(Error::Host { instance: name.into(), function: "fmi2Instantiate", time: 0.0, cause });
             }
-            return Err(Error::Instantiate { instance: name.into(), log: log.recent_problems() });
+            return Err(Error::Instantiate {
+                instance: name.into(),
+                function: "fmi2Instantiate",
+                log: log.recent_problems(),
+            });
         }
         let callbacks = callbacks_for(&log);
         let component = &mut *channel as *mut crate::isolate::channel::Channel as *mut c_void;
-        Ok(Instance {
-            component,
-            state: InstanceState::Instantiated,
-            name: name.into(),
-            _name_c: name_c,
-            log,
-            _callbacks: callbacks,
-            saved: Vec::new(),
-            fmu,
-            host: Some(channel),
-            time: 0.0,
-        })
+        Ok(Instance::with(component, name, name_c, log, callbacks, fmu, Some(channel)))
     }
 
     /// The instance name.
@@ -668,18 +933,21 @@ impl Instance {
         f.ok_or_else(|| Error::MissingSymbol { path: self.fmu.source.clone(), symbol: function })
     }
 
-    /// `fmi2SetupExperiment`.
+    /// `fmi2SetupExperiment`; FMI 3.0: kept for `fmi3EnterInitializationMode`.
     pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, stop_time: Option<f64>) -> Result<()> {
+        let function = if self.is_fmi3() { "fmi3EnterInitializationMode" } else { "fmi2SetupExperiment" };
         if self.state != InstanceState::Instantiated {
-            return Err(Error::IllegalCall {
-                instance: self.name.clone(),
-                function: "fmi2SetupExperiment",
-                state: self.state.as_str(),
-            });
+            return Err(Error::IllegalCall { instance: self.name.clone(), function, state: self.state.as_str() });
         }
-        let f = self.fmu.functions.setup_experiment;
-        let c = self.component;
         self.time = start_time;
+        let c = self.component;
+        let f = match &self.fmu.abi {
+            Abi::Fmi2(t) => t.setup_experiment,
+            Abi::Fmi3(_) => {
+                self.experiment = (tolerance, start_time, stop_time);
+                return Ok(());
+            }
+        };
         call!(
             self,
             "fmi2SetupExperiment",
@@ -695,54 +963,116 @@ impl Instance {
         )
     }
 
-    /// `fmi2EnterInitializationMode`.
+    /// Whether the FMU is an FMI 3.0 one.
+    pub fn is_fmi3(&self) -> bool {
+        matches!(self.fmu.abi, Abi::Fmi3(_))
+    }
+
+    /// `fmi2EnterInitializationMode`; FMI 3.0: `fmi3EnterInitializationMode` with the
+    /// experiment of [`Instance::setup_experiment`].
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
-        let (f, c) = (self.fmu.functions.enter_initialization_mode, self.component);
-        call!(self, "fmi2EnterInitializationMode", None, f(c))?;
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.enter_initialization_mode;
+                call!(self, "fmi2EnterInitializationMode", None, f(c))?
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.enter_initialization_mode;
+                let (tolerance, start, stop) = self.experiment;
+                call!(
+                    self,
+                    "fmi3EnterInitializationMode",
+                    Some(start),
+                    f(
+                        c,
+                        tolerance.is_some() as u8,
+                        tolerance.unwrap_or(0.0),
+                        start,
+                        stop.is_some() as u8,
+                        stop.unwrap_or(0.0)
+                    )
+                )?
+            }
+        }
         self.state = InstanceState::Initialization;
         Ok(())
     }
 
-    /// `fmi2ExitInitializationMode`.
+    /// `fmi2ExitInitializationMode` / `fmi3ExitInitializationMode`.
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
-        let (f, c) = (self.fmu.functions.exit_initialization_mode, self.component);
-        call!(self, "fmi2ExitInitializationMode", None, f(c))?;
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.exit_initialization_mode;
+                call!(self, "fmi2ExitInitializationMode", None, f(c))?
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.exit_initialization_mode;
+                call!(self, "fmi3ExitInitializationMode", None, f(c))?
+            }
+        }
         self.state = InstanceState::Running;
         Ok(())
     }
 
-    /// `fmi2Terminate` (only from initialization or running; otherwise nothing to do).
+    /// `fmi2Terminate` / `fmi3Terminate` (only from initialization or running; otherwise
+    /// nothing to do).
     pub fn terminate(&mut self) -> Result<()> {
         if !matches!(self.state, InstanceState::Running | InstanceState::Initialization) {
             return Ok(());
         }
-        let (f, c) = (self.fmu.functions.terminate, self.component);
-        call!(self, "fmi2Terminate", None, f(c))?;
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.terminate;
+                call!(self, "fmi2Terminate", None, f(c))?
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.terminate;
+                call!(self, "fmi3Terminate", None, f(c))?
+            }
+        }
         self.state = InstanceState::Terminated;
         Ok(())
     }
 
-    /// `fmi2Reset`: back to instantiated (also after an fmi2Error).
+    /// `fmi2Reset` / `fmi3Reset`: back to instantiated (also after an error).
     pub fn reset(&mut self) -> Result<()> {
+        let function = if self.is_fmi3() { "fmi3Reset" } else { "fmi2Reset" };
         if self.state == InstanceState::Fatal {
-            return Err(Error::IllegalCall { instance: self.name.clone(), function: "fmi2Reset", state: "fatal" });
+            return Err(Error::IllegalCall { instance: self.name.clone(), function, state: "fatal" });
         }
-        let f = self.optional(self.fmu.functions.reset, "fmi2Reset")?;
-        let mark = crate::call_site::enter(&self.name, &self.fmu, "fmi2Reset", self.time);
-        // SAFETY: live component.
+        let f = match &self.fmu.abi {
+            Abi::Fmi2(t) => self.optional(t.reset, "fmi2Reset")?,
+            Abi::Fmi3(a) => self.optional(a.functions.reset, "fmi3Reset")?,
+        };
+        let mark = crate::call_site::enter(&self.name, &self.fmu, function, self.time);
+        // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.component) };
         drop(mark);
         self.state = InstanceState::Instantiated;
-        self.status("fmi2Reset", raw, None)
+        self.terminate_requested = None;
+        self.status(function, raw, None)
     }
 
-    /// `fmi2GetReal` of `vrs` into `values` (same length). A NaN or infinite value is
-    /// [`Error::NonFinite`] unless the FMU was imported with `allow_non_finite`.
+    /// `fmi2GetReal` / `fmi3GetFloat64` of `vrs` into `values` (same length). A NaN or
+    /// infinite value is [`Error::NonFinite`] unless the FMU was imported with
+    /// `allow_non_finite`.
     #[inline]
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_real: one value per value reference");
-        let (f, c) = (self.fmu.functions.get_real, self.component);
-        call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?;
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.get_real;
+                call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.get_float64;
+                call!(self, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?
+            }
+        }
         // all exponent bits set: Inf or NaN. An OR of integer compares over the values
         // just read, without a branch per value (the compiler vectorizes it).
         const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
@@ -772,51 +1102,173 @@ impl Instance {
         }
     }
 
-    /// `fmi2SetReal`.
+    /// `fmi2SetReal` / `fmi3SetFloat64`.
     #[inline]
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_real: one value per value reference");
-        let (f, c) = (self.fmu.functions.set_real, self.component);
-        call!(self, "fmi2SetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.set_real;
+                call!(self, "fmi2SetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.set_float64;
+                call!(self, "fmi3SetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()))
+            }
+        }
     }
 
-    /// `fmi2GetInteger`.
+    /// Whether some of `vrs` are FMI 3.0 Enumerations (accessed as Int64).
+    fn has_enumerations(&self, vrs: &[u32]) -> bool {
+        match &self.fmu.abi {
+            Abi::Fmi3(a) => !a.enumerations.is_empty() && vrs.iter().any(|vr| a.enumerations.contains(vr)),
+            Abi::Fmi2(_) => false,
+        }
+    }
+
+    /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`.
     #[inline]
     pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_integer: one value per value reference");
-        let (f, c) = (self.fmu.functions.get_integer, self.component);
-        call!(self, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+        let c = self.component;
+        let enumerations = self.has_enumerations(vrs);
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.get_integer;
+                call!(self, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+            }
+            Abi::Fmi3(a) if !enumerations => {
+                let f = f3!(self, a, get_int32, "fmi3GetInt32");
+                call!(self, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))
+            }
+            Abi::Fmi3(_) => {
+                for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                    *value = self.get_integer_fmi3(*vr)?;
+                }
+                Ok(())
+            }
+        }
     }
 
-    /// `fmi2SetInteger`.
+    fn get_integer_fmi3(&mut self, vr: u32) -> Result<i32> {
+        let c = self.component;
+        let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+        if a.enumerations.contains(&vr) {
+            let f = f3!(self, a, get_int64, "fmi3GetInt64");
+            let mut wide = 0i64;
+            call!(self, "fmi3GetInt64", None, f(c, &vr, 1, &mut wide, 1))?;
+            i32::try_from(wide).map_err(|_| Error::Fmi {
+                instance: self.name.clone(),
+                function: "fmi3GetInt64",
+                status: Status::Error,
+                time: Some(self.time),
+                log: format!("Enumeration value {wide} of value reference {vr} is outside the Integer range"),
+            })
+        } else {
+            let f = f3!(self, a, get_int32, "fmi3GetInt32");
+            let mut value = 0i32;
+            call!(self, "fmi3GetInt32", None, f(c, &vr, 1, &mut value, 1))?;
+            Ok(value)
+        }
+    }
+
+    /// `fmi2SetInteger`; FMI 3.0: `fmi3SetInt32`, Enumerations by `fmi3SetInt64`.
     #[inline]
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_integer: one value per value reference");
-        let (f, c) = (self.fmu.functions.set_integer, self.component);
-        call!(self, "fmi2SetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+        let c = self.component;
+        let enumerations = self.has_enumerations(vrs);
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.set_integer;
+                call!(self, "fmi2SetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+            }
+            Abi::Fmi3(a) if !enumerations => {
+                let f = f3!(self, a, set_int32, "fmi3SetInt32");
+                call!(self, "fmi3SetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()))
+            }
+            Abi::Fmi3(a) => {
+                let (set32, set64) = (a.functions.set_int32, a.functions.set_int64);
+                let enums: Vec<bool> = vrs.iter().map(|vr| a.enumerations.contains(vr)).collect();
+                for ((vr, value), is_enum) in vrs.iter().zip(values).zip(enums) {
+                    if is_enum {
+                        let f = self.optional(set64, "fmi3SetInt64")?;
+                        let wide = *value as i64;
+                        call!(self, "fmi3SetInt64", None, f(c, vr, 1, &wide, 1))?;
+                    } else {
+                        let f = self.optional(set32, "fmi3SetInt32")?;
+                        call!(self, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?;
+                    }
+                }
+                Ok(())
+            }
+        }
     }
 
-    /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true).
+    /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true); FMI 3.0:
+    /// `fmi3GetBoolean` (a C `bool`, read as a byte: nonzero is true), as 0 or 1.
     #[inline]
     pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_boolean: one value per value reference");
-        let (f, c) = (self.fmu.functions.get_boolean, self.component);
-        call!(self, "fmi2GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.get_boolean;
+                call!(self, "fmi2GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_boolean, "fmi3GetBoolean");
+                let mut bytes = std::mem::take(&mut self.bytes);
+                bytes.clear();
+                bytes.resize(vrs.len(), 0);
+                let r =
+                    call!(self, "fmi3GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_mut_ptr(), bytes.len()));
+                for (v, b) in values.iter_mut().zip(&bytes) {
+                    *v = (*b != 0) as i32;
+                }
+                self.bytes = bytes;
+                r
+            }
+        }
     }
 
-    /// `fmi2SetBoolean`.
+    /// `fmi2SetBoolean` / `fmi3SetBoolean` (nonzero is true).
     #[inline]
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_boolean: one value per value reference");
-        let (f, c) = (self.fmu.functions.set_boolean, self.component);
-        call!(self, "fmi2SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.set_boolean;
+                call!(self, "fmi2SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, set_boolean, "fmi3SetBoolean");
+                let mut bytes = std::mem::take(&mut self.bytes);
+                bytes.clear();
+                bytes.extend(values.iter().map(|v| (*v != 0) as u8));
+                let r = call!(self, "fmi3SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_ptr(), bytes.len()));
+                self.bytes = bytes;
+                r
+            }
+        }
     }
 
-    /// `fmi2GetString` of one variable (copied).
+    /// `fmi2GetString` / `fmi3GetString` of one variable (copied).
     pub fn get_string(&mut self, vr: u32) -> Result<String> {
         let mut p: *const c_char = std::ptr::null();
-        let (f, c) = (self.fmu.functions.get_string, self.component);
-        call!(self, "fmi2GetString", None, f(c, &vr, 1, &mut p))?;
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.get_string;
+                call!(self, "fmi2GetString", None, f(c, &vr, 1, &mut p))?
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_string, "fmi3GetString");
+                call!(self, "fmi3GetString", None, f(c, &vr, 1, &mut p, 1))?
+            }
+        }
         if p.is_null() {
             return Ok(String::new());
         }
@@ -824,7 +1276,7 @@ impl Instance {
         Ok(unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
     }
 
-    /// `fmi2SetString` of one variable.
+    /// `fmi2SetString` / `fmi3SetString` of one variable.
     pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
         let s = CString::new(value).map_err(|_| Error::InvalidValue {
             variable: format!("{}.<vr {vr}>", self.name),
@@ -832,18 +1284,98 @@ impl Instance {
             reason: "NUL in string".into(),
         })?;
         let p = s.as_ptr();
-        let (f, c) = (self.fmu.functions.set_string, self.component);
-        call!(self, "fmi2SetString", None, f(c, &vr, 1, &p))
+        let c = self.component;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.set_string;
+                call!(self, "fmi2SetString", None, f(c, &vr, 1, &p))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, set_string, "fmi3SetString");
+                call!(self, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
+            }
+        }
     }
 
-    /// `fmi2DoStep` from `time` over `step` (Co-Simulation).
+    /// `fmi2DoStep` / `fmi3DoStep` from `time` over `step` (Co-Simulation).
+    ///
+    /// FMI 3.0: an early return (`earlyReturn` with `lastSuccessfulTime` before the step's
+    /// end) is continued from the time reached until the step's end, so that the caller
+    /// sees the step it asked for; a return that makes no progress is an error naming the
+    /// time. `terminateSimulation` is reported as FMI 2.0 reports it, a Discard with
+    /// [`Instance::terminated_status`] true and [`Instance::last_successful_time`] the time
+    /// reached, which ends the run there.
     #[inline]
     pub fn do_step(&mut self, time: f64, step: f64) -> Result<()> {
-        let f = self.optional(self.fmu.functions.do_step, "fmi2DoStep")?;
         let c = self.component;
+        let f = match &self.fmu.abi {
+            Abi::Fmi2(t) => self.optional(t.do_step, "fmi2DoStep")?,
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, do_step, "fmi3DoStep");
+                return self.do_step_fmi3(f, time, step);
+            }
+        };
         call!(self, "fmi2DoStep", Some(time), f(c, time, step, 1))?;
         self.time = time + step;
         Ok(())
+    }
+
+    fn do_step_fmi3(&mut self, f: fmi_sys::fmi3::functions::types::fmi3DoStepTYPE, time: f64, step: f64) -> Result<()> {
+        let c = self.component;
+        let end = time + step;
+        let mut at = time;
+        // each early return must make progress; a bound on the returns per step besides,
+        // so that an FMU creeping forward by ulps cannot hold the run forever
+        for _ in 0..1000 {
+            let (mut event, mut terminate, mut early, mut reached) = (0u8, 0u8, 0u8, at);
+            call!(
+                self,
+                "fmi3DoStep",
+                Some(at),
+                f(c, at, end - at, 1, &mut event, &mut terminate, &mut early, &mut reached)
+            )?;
+            if terminate != 0 {
+                let reached = if early != 0 && reached.is_finite() { reached } else { end };
+                self.time = reached;
+                self.terminate_requested = Some(reached);
+                return Err(Error::Fmi {
+                    instance: self.name.clone(),
+                    function: "fmi3DoStep",
+                    status: Status::Discard,
+                    time: Some(at),
+                    log: format!("terminateSimulation at t = {reached} s"),
+                });
+            }
+            if early == 0 {
+                self.time = end;
+                return Ok(());
+            }
+            if !(reached > at && reached <= end) {
+                self.state = InstanceState::Errored;
+                return Err(Error::Fmi {
+                    instance: self.name.clone(),
+                    function: "fmi3DoStep",
+                    status: Status::Error,
+                    time: Some(at),
+                    log: format!(
+                        "returned early at lastSuccessfulTime = {reached} s, no progress from {at} s toward the step's end {end} s"
+                    ),
+                });
+            }
+            if reached == end {
+                self.time = end;
+                return Ok(());
+            }
+            at = reached;
+        }
+        self.state = InstanceState::Errored;
+        Err(Error::Fmi {
+            instance: self.name.clone(),
+            function: "fmi3DoStep",
+            status: Status::Error,
+            time: Some(at),
+            log: format!("returned early 1000 times in the step from {time} s to {end} s"),
+        })
     }
 
     /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
@@ -851,30 +1383,47 @@ impl Instance {
     /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
     /// in process, and when the instance cannot step in its state (`do_step` then says why).
     pub fn post_step(&mut self, time: f64, step: f64) -> bool {
+        let has_do_step = matches!(&self.fmu.abi, Abi::Fmi2(t) if t.do_step.is_some());
         let Some(host) = self.host.as_deref_mut() else { return false };
-        if self.state != InstanceState::Running || self.fmu.functions.do_step.is_none() {
+        if self.state != InstanceState::Running || !has_do_step {
             return false;
         }
         crate::isolate::proxy::post_step(host, time, step);
         true
     }
 
-    /// `fmi2GetFMUstate`: saves the current state.
+    /// `fmi2GetFMUstate` / `fmi3GetFMUState`: saves the current state.
     pub fn get_state(&mut self) -> Result<FmuState> {
-        let f = self.optional(self.fmu.functions.get_fmu_state, "fmi2GetFMUstate")?;
         let mut s: *mut c_void = std::ptr::null_mut();
         let c = self.component;
-        call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.get_fmu_state, "fmi2GetFMUstate")?;
+                call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_fmu_state, "fmi3GetFMUState");
+                call!(self, "fmi3GetFMUState", None, f(c, &mut s))?
+            }
+        }
         self.saved.push(s);
         Ok(FmuState(s))
     }
 
-    /// `fmi2GetFMUstate` into an existing state (overwritten).
+    /// `fmi2GetFMUstate` / `fmi3GetFMUState` into an existing state (overwritten).
     pub fn update_state(&mut self, state: &mut FmuState) -> Result<()> {
-        let f = self.optional(self.fmu.functions.get_fmu_state, "fmi2GetFMUstate")?;
         let c = self.component;
         let mut s = state.0;
-        call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.get_fmu_state, "fmi2GetFMUstate")?;
+                call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_fmu_state, "fmi3GetFMUState");
+                call!(self, "fmi3GetFMUState", None, f(c, &mut s))?
+            }
+        }
         if s != state.0 {
             self.saved.retain(|p| *p != state.0);
             self.saved.push(s);
@@ -883,106 +1432,219 @@ impl Instance {
         Ok(())
     }
 
-    /// `fmi2SetFMUstate`: restores a saved state.
+    /// `fmi2SetFMUstate` / `fmi3SetFMUState`: restores a saved state.
     pub fn set_state(&mut self, state: &FmuState) -> Result<()> {
-        let f = self.optional(self.fmu.functions.set_fmu_state, "fmi2SetFMUstate")?;
         let c = self.component;
-        call!(self, "fmi2SetFMUstate", None, f(c, state.0))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.set_fmu_state, "fmi2SetFMUstate")?;
+                call!(self, "fmi2SetFMUstate", None, f(c, state.0))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, set_fmu_state, "fmi3SetFMUState");
+                call!(self, "fmi3SetFMUState", None, f(c, state.0))
+            }
+        }
     }
 
-    /// `fmi2FreeFMUstate`.
+    /// `fmi2FreeFMUstate` / `fmi3FreeFMUState`.
     pub fn free_state(&mut self, state: FmuState) -> Result<()> {
-        let f = self.optional(self.fmu.functions.free_fmu_state, "fmi2FreeFMUstate")?;
         self.saved.retain(|p| *p != state.0);
         let mut s = state.0;
         let c = self.component;
-        call!(self, "fmi2FreeFMUstate", None, f(c, &mut s))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.free_fmu_state, "fmi2FreeFMUstate")?;
+                call!(self, "fmi2FreeFMUstate", None, f(c, &mut s))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, free_fmu_state, "fmi3FreeFMUState");
+                call!(self, "fmi3FreeFMUState", None, f(c, &mut s))
+            }
+        }
     }
 
-    /// `fmi2SetTime` (Model Exchange).
+    /// `fmi2SetTime` / `fmi3SetTime` (Model Exchange).
     #[inline]
     pub fn set_time(&mut self, time: f64) -> Result<()> {
-        let f = self.optional(self.fmu.functions.set_time, "fmi2SetTime")?;
         let c = self.component;
         self.time = time;
-        call!(self, "fmi2SetTime", Some(time), f(c, time))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.set_time, "fmi2SetTime")?;
+                call!(self, "fmi2SetTime", Some(time), f(c, time))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, set_time, "fmi3SetTime");
+                call!(self, "fmi3SetTime", Some(time), f(c, time))
+            }
+        }
     }
 
-    /// `fmi2SetContinuousStates`.
+    /// `fmi2SetContinuousStates` / `fmi3SetContinuousStates`.
     #[inline]
     pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<()> {
-        let f = self.optional(self.fmu.functions.set_continuous_states, "fmi2SetContinuousStates")?;
         let c = self.component;
-        call!(self, "fmi2SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.set_continuous_states, "fmi2SetContinuousStates")?;
+                call!(self, "fmi2SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, set_continuous_states, "fmi3SetContinuousStates");
+                call!(self, "fmi3SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
+            }
+        }
     }
 
-    /// `fmi2GetContinuousStates`.
+    /// `fmi2GetContinuousStates` / `fmi3GetContinuousStates`.
     pub fn get_continuous_states(&mut self, x: &mut [f64]) -> Result<()> {
-        let f = self.optional(self.fmu.functions.get_continuous_states, "fmi2GetContinuousStates")?;
         let c = self.component;
-        call!(self, "fmi2GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.get_continuous_states, "fmi2GetContinuousStates")?;
+                call!(self, "fmi2GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_continuous_states, "fmi3GetContinuousStates");
+                call!(self, "fmi3GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
+            }
+        }
     }
 
-    /// `fmi2GetDerivatives`.
+    /// `fmi2GetDerivatives` / `fmi3GetContinuousStateDerivatives`.
     #[inline]
     pub fn get_derivatives(&mut self, dx: &mut [f64]) -> Result<()> {
-        let f = self.optional(self.fmu.functions.get_derivatives, "fmi2GetDerivatives")?;
         let c = self.component;
-        call!(self, "fmi2GetDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.get_derivatives, "fmi2GetDerivatives")?;
+                call!(self, "fmi2GetDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_continuous_state_derivatives, "fmi3GetContinuousStateDerivatives");
+                call!(self, "fmi3GetContinuousStateDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
+            }
+        }
     }
 
-    /// `fmi2GetEventIndicators`.
+    /// `fmi2GetEventIndicators` / `fmi3GetEventIndicators`.
     #[inline]
     pub fn get_event_indicators(&mut self, z: &mut [f64]) -> Result<()> {
-        let f = self.optional(self.fmu.functions.get_event_indicators, "fmi2GetEventIndicators")?;
         let c = self.component;
-        call!(self, "fmi2GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.get_event_indicators, "fmi2GetEventIndicators")?;
+                call!(self, "fmi2GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, get_event_indicators, "fmi3GetEventIndicators");
+                call!(self, "fmi3GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
+            }
+        }
     }
 
-    /// `fmi2EnterEventMode`.
+    /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
-        let f = self.optional(self.fmu.functions.enter_event_mode, "fmi2EnterEventMode")?;
         let c = self.component;
-        call!(self, "fmi2EnterEventMode", None, f(c))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.enter_event_mode, "fmi2EnterEventMode")?;
+                call!(self, "fmi2EnterEventMode", None, f(c))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, enter_event_mode, "fmi3EnterEventMode");
+                call!(self, "fmi3EnterEventMode", None, f(c))
+            }
+        }
     }
 
-    /// `fmi2NewDiscreteStates`.
+    /// `fmi2NewDiscreteStates`; FMI 3.0: `fmi3UpdateDiscreteStates`, its outputs as the
+    /// FMI 2.0 event info (`discreteStatesNeedUpdate` is `newDiscreteStatesNeeded`).
     pub fn new_discrete_states(&mut self) -> Result<EventInfo> {
-        let f = self.optional(self.fmu.functions.new_discrete_states, "fmi2NewDiscreteStates")?;
         let c = self.component;
         let mut info = EventInfo::default();
-        call!(self, "fmi2NewDiscreteStates", None, f(c, &mut info))?;
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.new_discrete_states, "fmi2NewDiscreteStates")?;
+                call!(self, "fmi2NewDiscreteStates", None, f(c, &mut info))?
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, update_discrete_states, "fmi3UpdateDiscreteStates");
+                let (mut update, mut terminate, mut nominals, mut values, mut defined) = (0u8, 0u8, 0u8, 0u8, 0u8);
+                let mut next = 0.0;
+                call!(
+                    self,
+                    "fmi3UpdateDiscreteStates",
+                    None,
+                    f(c, &mut update, &mut terminate, &mut nominals, &mut values, &mut defined, &mut next)
+                )?;
+                info.new_discrete_states_needed = (update != 0) as c_int;
+                info.terminate_simulation = (terminate != 0) as c_int;
+                info.nominals_of_continuous_states_changed = (nominals != 0) as c_int;
+                info.values_of_continuous_states_changed = (values != 0) as c_int;
+                info.next_event_time_defined = (defined != 0) as c_int;
+                info.next_event_time = next;
+            }
+        }
         Ok(info)
     }
 
-    /// `fmi2EnterContinuousTimeMode`.
+    /// `fmi2EnterContinuousTimeMode` / `fmi3EnterContinuousTimeMode`.
     pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
-        let f = self.optional(self.fmu.functions.enter_continuous_time_mode, "fmi2EnterContinuousTimeMode")?;
         let c = self.component;
-        call!(self, "fmi2EnterContinuousTimeMode", None, f(c))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.enter_continuous_time_mode, "fmi2EnterContinuousTimeMode")?;
+                call!(self, "fmi2EnterContinuousTimeMode", None, f(c))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, enter_continuous_time_mode, "fmi3EnterContinuousTimeMode");
+                call!(self, "fmi3EnterContinuousTimeMode", None, f(c))
+            }
+        }
     }
 
-    /// `fmi2CompletedIntegratorStep`: (enter event mode, terminate simulation).
+    /// `fmi2CompletedIntegratorStep` / `fmi3CompletedIntegratorStep`: (enter event mode,
+    /// terminate simulation).
     pub fn completed_integrator_step(&mut self) -> Result<(bool, bool)> {
-        let f = self.optional(self.fmu.functions.completed_integrator_step, "fmi2CompletedIntegratorStep")?;
         let c = self.component;
-        let (mut event, mut terminate) = (0, 0);
-        call!(self, "fmi2CompletedIntegratorStep", None, f(c, 1, &mut event, &mut terminate))?;
-        Ok((event != 0, terminate != 0))
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = self.optional(t.completed_integrator_step, "fmi2CompletedIntegratorStep")?;
+                let (mut event, mut terminate) = (0, 0);
+                call!(self, "fmi2CompletedIntegratorStep", None, f(c, 1, &mut event, &mut terminate))?;
+                Ok((event != 0, terminate != 0))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!(self, a, completed_integrator_step, "fmi3CompletedIntegratorStep");
+                let (mut event, mut terminate) = (0u8, 0u8);
+                call!(self, "fmi3CompletedIntegratorStep", None, f(c, 1, &mut event, &mut terminate))?;
+                Ok((event != 0, terminate != 0))
+            }
+        }
     }
 
-    /// `fmi2GetBooleanStatus(fmi2Terminated)` after a Discard: whether the FMU wants to stop.
+    /// `fmi2GetBooleanStatus(fmi2Terminated)` after a Discard: whether the FMU wants to
+    /// stop; FMI 3.0: whether the last `fmi3DoStep` said `terminateSimulation`.
     pub fn terminated_status(&mut self) -> Option<bool> {
-        let f = self.fmu.functions.get_boolean_status?;
+        let f = match &self.fmu.abi {
+            Abi::Fmi2(t) => t.get_boolean_status?,
+            Abi::Fmi3(_) => return Some(self.terminate_requested.is_some()),
+        };
         let mut v: c_int = 0;
         // SAFETY: live component, valid out pointer; 3 = fmi2Terminated.
         let raw = unsafe { f(self.component, 3, &mut v) };
         (raw == 0).then_some(v != 0)
     }
 
-    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`; FMI 3.0: the `lastSuccessfulTime` of
+    /// the `fmi3DoStep` that said `terminateSimulation`.
     pub fn last_successful_time(&mut self) -> Option<f64> {
-        let f = self.fmu.functions.get_real_status?;
+        let f = match &self.fmu.abi {
+            Abi::Fmi2(t) => t.get_real_status?,
+            Abi::Fmi3(_) => return self.terminate_requested,
+        };
         let mut v = 0.0;
         // SAFETY: live component, valid out pointer; 2 = fmi2LastSuccessfulTime.
         let raw = unsafe { f(self.component, 2, &mut v) };
@@ -993,17 +1655,22 @@ impl Instance {
 impl Drop for Instance {
     fn drop(&mut self) {
         if self.state == InstanceState::Fatal {
-            return; // the standard: nothing may be called after fmi2Fatal
+            return; // the standard: nothing may be called after a fatal error
         }
         let _ = self.terminate();
-        if let Some(free_state) = self.fmu.functions.free_fmu_state {
+        let (free_state, free_instance, function) = match &self.fmu.abi {
+            Abi::Fmi2(t) => (t.free_fmu_state, t.free_instance, "fmi2FreeInstance"),
+            Abi::Fmi3(a) => (a.functions.free_fmu_state, a.functions.free_instance, "fmi3FreeInstance"),
+        };
+        if let Some(free_state) = free_state {
             for mut s in std::mem::take(&mut self.saved) {
-                // SAFETY: states we obtained from this instance and did not free.
+                // SAFETY: states we obtained from this instance and did not free; both
+                // generations' functions take (instance, *mut state).
                 unsafe { free_state(self.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(&self.name, &self.fmu, "fmi2FreeInstance", self.time);
-        // SAFETY: the component came from fmi2Instantiate and is freed once.
-        unsafe { (self.fmu.functions.free_instance)(self.component) };
+        let _mark = crate::call_site::enter(&self.name, &self.fmu, function, self.time);
+        // SAFETY: the component came from the instantiate call and is freed once.
+        unsafe { free_instance(self.component) };
     }
 }

@@ -17,6 +17,7 @@
 pub mod call_site;
 pub mod elf;
 pub mod error;
+pub mod fmi3;
 pub mod fmu;
 pub mod isolate;
 #[doc(hidden)]

@@ -483,10 +483,14 @@ pub fn read_text_entry<R: Read + std::io::Seek>(
 }
 
 /// The entries of an FMU a run in this process uses: `modelDescription.xml`, this
-/// platform's `binaries/linux64/` and `resources/` (other platforms' libraries, the
-/// documentation and sources are not written).
+/// platform's `binaries/linux64/` (FMI 2.0) or `binaries/x86_64-linux/` (FMI 3.0) and
+/// `resources/` (other platforms' libraries, the documentation and sources are not
+/// written).
 pub fn used_by_a_run(name: &Path) -> bool {
-    name == Path::new("modelDescription.xml") || name.starts_with("binaries/linux64") || name.starts_with("resources")
+    name == Path::new("modelDescription.xml")
+        || name.starts_with("binaries/linux64")
+        || name.starts_with("binaries/x86_64-linux")
+        || name.starts_with("resources")
 }
 
 /// An FMU unpacked for a run: its private folder and the platforms its archive carries.

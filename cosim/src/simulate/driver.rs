@@ -7,7 +7,7 @@ use crate::fmu::{Instance, Interface};
 use crate::me::{MeUnit, Solver};
 use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
 use crate::simulate::clock::Clock;
-use crate::simulate::lane::{apply_start_values, Lane, DISCARD_TERMINATED};
+use crate::simulate::lane::{apply_start_values, Lane, DISCARD_TERMINATED, FMI3_TERMINATED};
 use crate::simulate::me_group::MeGroup;
 use crate::simulate::observer::{Deadline, Observer, Observers, Profiler, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Plan};
@@ -265,7 +265,9 @@ fn run<'s>(
             // Co-Simulation: the row at fmi2LastSuccessfulTime, every recorded variable read
             // as its instance now has it (fmpy and fmusim record it too); Model Exchange: no
             // row after the last communication point before the event (as fmpy)
-            if reason == DISCARD_TERMINATED && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
+            if (reason == DISCARD_TERMINATED || reason == FMI3_TERMINATED)
+                && time > recorder.last_time().unwrap_or(f64::NEG_INFINITY)
+            {
                 run_ops(&mut record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
                 recorder.push_row(time, &core.values);
             }

@@ -40,7 +40,9 @@ pub fn fmi_version_of(xml: &str) -> Option<String> {
                 if e.name().as_ref() != b"fmiModelDescription" {
                     return None;
                 }
-                for a in e.attributes().flatten() {
+                // without quick-xml's duplicate check, quadratic in the attributes (the reader
+                // proper checks them in linear time)
+                for a in e.attributes().with_checks(false).flatten() {
                     if a.key.as_ref() == b"fmiVersion" {
                         return a.unescape_value().ok().map(|v| v.trim().to_string());
                     }
