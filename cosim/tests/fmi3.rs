@@ -389,3 +389,49 @@ with open(sys.argv[2], 'w') as f:
         assert_eq!(row[2], r.column("n").unwrap()[k]);
     }
 }
+
+/// FMI 2.0 and FMI 3.0 instances in one system, connected by names (Real <-> Float64): an
+/// FMI 2.0 source (y = t) feeds the FMI 3.0 counter's u, whose y feeds an FMI 2.0 gain
+/// (y = 2 u). The counter (no direct feedthrough) adds the source's value at the step's
+/// start times h under both algorithms; the gain (direct feedthrough) doubles the counter's
+/// y of the same communication point under `ordered` (the inputs set in topological order)
+/// and of the point before under `jacobi`. Both as built and as written to an SSP and read
+/// back.
+#[test]
+fn fmi2_and_fmi3_instances_in_one_system() {
+    use common::{build_fmu, Model};
+    use nigel_cosim::{read_ssp, write_ssp, Algorithm, ImportOptions};
+    let Some((dir, counter_fmu)) = counter("fmi3-mixed") else { return };
+    let source = build_fmu(Model::Source, &dir, &[]);
+    let gain = build_fmu(Model::Gain, &dir, &[]);
+    let mut b = SystemBuilder::new();
+    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(&counter_fmu).unwrap()).unwrap();
+    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
+    b.connect_unconverted("source.y", "counter.u", None).unwrap();
+    b.connect("counter.y", "gain.u").unwrap();
+    let system = b.build();
+    let ssp = dir.join("mixed.ssp");
+    write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    let from_ssp = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
+    for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
+        let experiment = Experiment { algorithm, ..Experiment::new(1.0, 0.1) };
+        let (r, _) = simulate(&system, &experiment).unwrap();
+        let (rs, _) = simulate(&from_ssp, &experiment).unwrap();
+        assert_eq!((&r.names, &r.values), (&rs.names, &rs.values), "{algorithm:?}: the SSP's run is the system's");
+        let time = r.column("time").unwrap();
+        let ys = r.column("source.y").unwrap();
+        let yc = r.column("counter.y").unwrap();
+        let yg = r.column("gain.y").unwrap();
+        assert_eq!(ys, time, "the FMI 2.0 source: y = t");
+        for k in 1..r.rows() {
+            let h = time[k] - time[k - 1];
+            let g = match algorithm {
+                Algorithm::Ordered => yc[k],
+                _ => yc[k - 1],
+            };
+            assert_eq!(yc[k], yc[k - 1] + 1.0 * ys[k - 1] * h, "{algorithm:?}: counter at t = {}", time[k]);
+            assert_eq!(yg[k], 2.0 * g, "{algorithm:?}: gain at t = {}", time[k]);
+        }
+    }
+}
