@@ -438,6 +438,8 @@ pub struct Declaration<B> {
     hot: Vec<HotRow<B>>,
     description: md::ModelDescription,
     xml: String,
+    description3: md::fmi3::ModelDescription,
+    xml3: String,
 }
 
 /// One row of [`Declaration`]'s compact table: the model's binding and the set checks.
@@ -715,6 +717,8 @@ impl<B: Copy> Declaration<B> {
             ));
         }
         let xml = description.to_xml();
+        let description3 = fmi3_description(&description, spec.capabilities);
+        let xml3 = description3.to_xml();
         let saved_rows = (0..spec.variables.len())
             .filter(|&row| {
                 let v = &spec.variables[row];
@@ -750,7 +754,19 @@ impl<B: Copy> Declaration<B> {
                 },
             })
             .collect();
-        Ok(Declaration { spec, lookup, dense, state_rows, derivative_rows, saved_rows, hot, description, xml })
+        Ok(Declaration {
+            spec,
+            lookup,
+            dense,
+            state_rows,
+            derivative_rows,
+            saved_rows,
+            hot,
+            description,
+            xml,
+            description3,
+            xml3,
+        })
     }
 }
 
@@ -788,6 +804,39 @@ impl<B> Declaration<B> {
         &self.xml
     }
 
+    /// The generated FMI 3.0 description: the same variables (names, causalities,
+    /// variabilities, initial, units, ranges, starts, descriptions) as typed elements,
+    /// `time` at value reference 0 and declaration row `r` at value reference `r + 1`,
+    /// the FMI 2.0 GUID as `instantiationToken`.
+    pub fn model_description3(&self) -> &md::fmi3::ModelDescription {
+        &self.description3
+    }
+
+    /// The generated FMI 3.0 `modelDescription.xml`.
+    pub fn xml3(&self) -> &str {
+        &self.xml3
+    }
+
+    /// The FMI 3.0 value reference of declaration row `row` (`time` is 0).
+    #[inline]
+    pub fn value_reference3(row: usize) -> u32 {
+        row as u32 + 1
+    }
+
+    /// The declaration row of FMI 3.0 value reference `vr` (`None` for `time`, 0, and for
+    /// value references past the variables).
+    #[inline]
+    pub fn row3(&self, vr: u32) -> Option<usize> {
+        let row = (vr as usize).checked_sub(1)?;
+        (row < self.spec.variables.len()).then_some(row)
+    }
+
+    /// The FMI 3.0 variable of value reference `vr` (`time` for 0).
+    #[inline]
+    pub fn variable3(&self, vr: u32) -> Option<&md::fmi3::Variable> {
+        self.description3.model_variables.get(vr as usize)
+    }
+
     pub fn guid(&self) -> &str {
         &self.description.guid
     }
@@ -801,10 +850,16 @@ impl<B> Declaration<B> {
         self.spec.variables.iter().find(|v| v.name == name).map(|v| v.value_reference)
     }
 
-    /// `name value_reference` per line, in declaration order: the table each FMU pins in a
-    /// checked-in file, so that a change of a value reference shows in review.
+    /// `name fmi2_value_reference fmi3_value_reference` per line, in declaration order:
+    /// the table each FMU pins in a checked-in file, so that a change of a value reference
+    /// of either generation shows in review.
     pub fn value_reference_table(&self) -> String {
-        self.spec.variables.iter().map(|v| format!("{} {}\n", v.name, v.value_reference)).collect()
+        self.spec
+            .variables
+            .iter()
+            .enumerate()
+            .map(|(row, v)| format!("{} {} {}\n", v.name, v.value_reference, Self::value_reference3(row)))
+            .collect()
     }
 
     /// Checks [`Declaration::value_reference_table`] against the checked-in file `path`:
@@ -860,6 +915,145 @@ impl<B> Declaration<B> {
     pub fn enumeration_of(&self, row: usize) -> Option<&md::EnumerationType> {
         let t = self.variable(row).declared_type?;
         self.spec.enumerations.iter().find(|e| e.name == t)
+    }
+}
+
+/// The FMI 3.0 description of the same variables as the FMI 2.0 `description` (which the
+/// declaration generated): FMI 2.0's 1-based variable index `i` is FMI 3.0 value
+/// reference `i` (row `i - 1`), so the ModelStructure carries over entry by entry; `time`
+/// is added at value reference 0. Adjoint derivatives come with directional ones (the
+/// layer computes `J^T w` from the columns of `J`).
+fn fmi3_description(d2: &md::ModelDescription, caps: Capabilities) -> md::fmi3::ModelDescription {
+    use md::fmi3 as f3;
+    let common = |model_identifier: &str| f3::InterfaceCommon {
+        model_identifier: model_identifier.to_string(),
+        can_get_and_set_fmu_state: caps.fmu_state,
+        can_serialize_fmu_state: caps.serialize_fmu_state,
+        provides_directional_derivatives: caps.directional_derivatives,
+        provides_adjoint_derivatives: caps.directional_derivatives,
+        ..Default::default()
+    };
+    let mut time =
+        f3::Variable::new("time", 0, f3::ValueType::Float64, f3::Causality::Independent, Variability::Continuous);
+    time.description = Some("Simulation time".into());
+    let mut variables = vec![time];
+    for (row, v) in d2.model_variables.iter().enumerate() {
+        let vr = row as u32 + 1;
+        let (value_type, start, min, max) = match &v.variable_type {
+            md::VariableType::Real { start, min, max, .. } => (
+                f3::ValueType::Float64,
+                start.map(|x| f3::Values::Float(vec![x])),
+                min.map(f3::Bound::Float),
+                max.map(f3::Bound::Float),
+            ),
+            md::VariableType::Integer { start, min, max } => (
+                f3::ValueType::Int32,
+                start.map(|x| f3::Values::Int(vec![x as i128])),
+                min.map(|x| f3::Bound::Int(x as i128)),
+                max.map(|x| f3::Bound::Int(x as i128)),
+            ),
+            md::VariableType::Enumeration { start, min, max, .. } => (
+                f3::ValueType::Enumeration,
+                start.map(|x| f3::Values::Int(vec![x as i128])),
+                min.map(|x| f3::Bound::Int(x as i128)),
+                max.map(|x| f3::Bound::Int(x as i128)),
+            ),
+            md::VariableType::Boolean { start } => {
+                (f3::ValueType::Boolean, start.map(|x| f3::Values::Boolean(vec![x])), None, None)
+            }
+            md::VariableType::String { start } => {
+                (f3::ValueType::String, start.clone().map(|x| f3::Values::String(vec![x])), None, None)
+            }
+        };
+        let mut w =
+            f3::Variable::new(v.name.clone(), vr, value_type, f3::Causality::from_fmi2(v.causality), v.variability);
+        w.description = v.description.clone();
+        w.initial = v.initial;
+        w.start = start;
+        w.min = min;
+        w.max = max;
+        match &v.variable_type {
+            md::VariableType::Real { unit, derivative, nominal, .. } => {
+                w.unit = unit.clone();
+                w.nominal = *nominal;
+                w.derivative = *derivative;
+            }
+            md::VariableType::Enumeration { declared_type, .. } => w.declared_type = Some(declared_type.clone()),
+            _ => {}
+        }
+        variables.push(w);
+    }
+    let unknowns = |list: &[md::Unknown]| -> Vec<f3::Unknown> {
+        list.iter()
+            .map(|u| f3::Unknown {
+                value_reference: u.index,
+                dependencies: u.dependencies.clone(),
+                dependencies_kind: u.dependencies_kind.clone(),
+            })
+            .collect()
+    };
+    let s2 = &d2.model_structure;
+    f3::ModelDescription {
+        fmi_version: "3.0".into(),
+        model_name: d2.model_name.clone(),
+        instantiation_token: d2.guid.clone(),
+        description: d2.description.clone(),
+        author: d2.author.clone(),
+        version: d2.version.clone(),
+        copyright: d2.copyright.clone(),
+        license: d2.license.clone(),
+        generation_tool: d2.generation_tool.clone(),
+        generation_date_and_time: None,
+        variable_naming_convention: d2.variable_naming_convention.clone(),
+        model_exchange: d2
+            .model_exchange
+            .as_ref()
+            .map(|me| f3::ModelExchange { common: common(&me.model_identifier), ..Default::default() }),
+        co_simulation: d2.co_simulation.as_ref().map(|cs| f3::CoSimulation {
+            common: common(&cs.model_identifier),
+            can_handle_variable_communication_step_size: true,
+            ..Default::default()
+        }),
+        scheduled_execution: None,
+        unit_definitions: d2.unit_definitions.clone(),
+        type_definitions: d2
+            .type_definitions
+            .iter()
+            .map(|t| f3::TypeDefinition {
+                name: t.name.clone(),
+                description: t.description.clone(),
+                kind: f3::TypeKind::Enumeration {
+                    quantity: None,
+                    items: t
+                        .items
+                        .iter()
+                        .map(|i| f3::EnumerationItem {
+                            name: i.name.clone(),
+                            value: i.value as i64,
+                            description: i.description.clone(),
+                        })
+                        .collect(),
+                },
+            })
+            .collect(),
+        log_categories: d2
+            .log_categories
+            .iter()
+            .map(|c| md::LogCategory {
+                name: c.name.clone(),
+                description: c.description.as_ref().map(|d| d.replace("fmi2", "fmi3")),
+            })
+            .collect(),
+        default_experiment: d2.default_experiment.clone(),
+        model_variables: variables,
+        model_structure: f3::ModelStructure {
+            outputs: unknowns(&s2.outputs),
+            continuous_state_derivatives: unknowns(&s2.derivatives),
+            clocked_states: Vec::new(),
+            initial_unknowns: unknowns(&s2.initial_unknowns),
+            // the layer's models declare no event indicators (state events)
+            event_indicators: Vec::new(),
+        },
     }
 }
 
@@ -1014,6 +1208,52 @@ mod tests {
         assert_eq!(d.row(BaseType::Real, 4), None);
         assert_eq!(md.guid, md.content_guid());
         assert!(d.xml().contains(&md.guid));
+    }
+
+    /// The FMI 3.0 description of the toy: `time` at 0, row r at r + 1 with the element of
+    /// its base type, the FMI 2.0 GUID as token, the ModelStructure by value reference
+    /// (FMI 2.0 index i = FMI 3.0 value reference i), the same names and causalities.
+    #[test]
+    fn the_fmi3_description_has_the_same_variables_by_value_reference() {
+        use md::fmi3::{Causality as C3, ValueType};
+        let d = Declaration::new(spec(toy())).unwrap();
+        let d2 = d.model_description();
+        let d3 = d.model_description3();
+        assert_eq!(d3.instantiation_token, d2.guid);
+        assert_eq!(d3.model_variables[0].name, "time");
+        assert_eq!(d3.model_variables[0].causality, C3::Independent);
+        assert_eq!(d3.model_variables[0].value_reference, 0);
+        let types: Vec<_> =
+            d3.model_variables.iter().map(|v| (v.name.as_str(), v.value_reference, v.value_type)).collect();
+        assert_eq!(
+            types,
+            [
+                ("time", 0, ValueType::Float64),
+                ("u", 1, ValueType::Float64),
+                ("x", 2, ValueType::Float64),
+                ("der(x)", 3, ValueType::Float64),
+                ("k", 4, ValueType::Float64),
+                ("on", 5, ValueType::Boolean),
+            ]
+        );
+        for (v2, v3) in d2.model_variables.iter().zip(&d3.model_variables[1..]) {
+            assert_eq!(
+                (v3.causality.to_fmi2(), v3.variability, v3.initial),
+                (Some(v2.causality), v2.variability, v2.initial)
+            );
+        }
+        assert_eq!(d3.variable(3).unwrap().derivative, Some(2));
+        assert_eq!(d3.states(), vec![2]);
+        assert_eq!(d3.model_structure.outputs[0].value_reference, 2);
+        assert_eq!(d3.model_structure.outputs[0].dependencies, Some(vec![2]));
+        assert_eq!(d3.model_structure.continuous_state_derivatives[0].dependencies, Some(vec![1]));
+        assert_eq!(d3.model_structure.initial_unknowns[0].dependencies, Some(vec![1, 4, 5]));
+        assert_eq!((d.row3(0), d.row3(1), d.row3(5), d.row3(6)), (None, Some(0), Some(4), None));
+        assert!(
+            d.xml3().contains(r#"<ContinuousStateDerivative valueReference="3" dependencies="1"/>"#),
+            "{}",
+            d.xml3()
+        );
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The C types of the FMI 2.0 API, from `fmi-sys` (the one binding of the workspace),
-//! under the paths the layer and the `export_fmi2!` expansion use.
+//! under the paths the layer and the `export_fmi!` expansion use.
 pub use fmi_sys::fmi2::{
     fmi2Boolean, fmi2Byte, fmi2Char, fmi2Component, fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real,
     fmi2String, fmi2ValueReference, Fmi2CallbackAllocateMemory, Fmi2CallbackFreeMemory, Fmi2CallbackFunctions,

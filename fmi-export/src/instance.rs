@@ -1,13 +1,17 @@
-//! One FMU instance in safe Rust: the FMI 2.0 state machine (one table, [`crate::states`]),
-//! variable access checks, time events and FMU state handling. The C ABI in
-//! [`crate::abi`] only translates pointers to slices.
+//! One FMU instance in safe Rust, the same for both generations of the C API: the state
+//! machine (one table, [`crate::states`]), variable access checks (one variable table, the
+//! [`Declaration`], addressed by FMI 2.0 value references per base type or by FMI 3.0
+//! value references), time events, FMU state handling, directional and adjoint
+//! derivatives. The C ABIs in [`crate::abi`] only translate pointers to slices.
+
+use model_description::fmi3::ValueType as ValueType3;
 
 use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Start, Variability};
 use crate::fmu_state::{self, LayerNumbers};
 use crate::model::{EventUpdate, InstantiateContext, Interface, Model, ModelError};
 use crate::sampled::{instant_tolerance, SampleClock, MAX_SAMPLES_PER_STEP};
 use crate::states::settable_in;
-pub use crate::states::{Function, Machine, Scope};
+pub use crate::states::{Function, Generation, Machine, Scope};
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
 pub type OpResult<T = ()> = Result<T, ModelError>;
@@ -157,6 +161,8 @@ impl<B: Copy> CallMemo<B> {
 /// One instance of model `M`.
 pub struct Instance<M: Model> {
     pub context: InstantiateContext,
+    /// The C API the instance was created by: only its functions pass the gate.
+    pub generation: Generation,
     pub core: Core<M>,
     /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
     /// through (0 for another interface's function or a capability the model did not
@@ -183,10 +189,16 @@ fn time_eps(t: f64) -> f64 {
 impl<M: Model> Instance<M> {
     /// A new instance with every declared start value applied.
     pub fn new(context: InstantiateContext) -> OpResult<Self> {
+        Self::new_for(context, Generation::Fmi2)
+    }
+
+    /// A new instance for the C API of `generation`.
+    pub fn new_for(context: InstantiateContext, generation: Generation) -> OpResult<Self> {
         let model = Self::fresh_model(&context)?;
-        let allowed = Function::ALL.map(|f| Self::allowed_states(context.interface, f));
+        let allowed = Function::ALL.map(|f| Self::allowed_states(generation, context.interface, f));
         Ok(Instance {
             allowed,
+            generation,
             get_memo: CallMemos::new(),
             set_memo: CallMemos::new(),
             context,
@@ -232,10 +244,10 @@ impl<M: Model> Instance<M> {
     }
 
     /// The states in which `function` passes [`Instance::check_call`] for `interface`.
-    fn allowed_states(interface: Interface, function: Function) -> u16 {
+    fn allowed_states(generation: Generation, interface: Interface, function: Function) -> u16 {
         Machine::ALL
             .into_iter()
-            .filter(|&m| Self::call_allowed(interface, function, m).is_ok())
+            .filter(|&m| Self::call_allowed(generation, interface, function, m).is_ok())
             .fold(0, |mask, m| mask | m.bit())
     }
 
@@ -243,7 +255,7 @@ impl<M: Model> Instance<M> {
     #[cold]
     #[inline(never)]
     fn refuse_call(&self, function: Function) -> OpResult {
-        Self::call_allowed(self.context.interface, function, self.core.machine)?;
+        Self::call_allowed(self.generation, self.context.interface, function, self.core.machine)?;
         err(format!(
             "{} refused in state {:?} (internal: the call table and the rules disagree)",
             function.name(),
@@ -252,7 +264,22 @@ impl<M: Model> Instance<M> {
     }
 
     /// The full rules of [`Instance::check_call`], with the reason.
-    fn call_allowed(interface: Interface, function: Function, machine: Machine) -> OpResult {
+    fn call_allowed(generation: Generation, interface: Interface, function: Function, machine: Machine) -> OpResult {
+        if function.generation() != generation {
+            return err(match generation {
+                Generation::Fmi2 => "not available: this instance was created by fmi2Instantiate (FMI 2.0)",
+                Generation::Fmi3 => "not available: this instance was created by an fmi3Instantiate function (FMI 3.0)",
+            });
+        }
+        if let Some(missing) = function.undeclared_feature() {
+            return err(format!("not supported: {missing}"));
+        }
+        match (function, interface) {
+            (Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates, Interface::CoSimulation) => {
+                return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
+            }
+            _ => {}
+        }
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
                 return err(format!("not available: this instance was created for {interface:?}"));
@@ -260,7 +287,7 @@ impl<M: Model> Instance<M> {
             _ => {}
         }
         let caps = decl::<M>().spec.capabilities;
-        let supported = match function {
+        let supported = match function.counterpart().unwrap_or(function) {
             Function::GetFMUstate | Function::SetFMUstate | Function::FreeFMUstate => caps.fmu_state,
             Function::SerializedFMUstateSize | Function::SerializeFMUstate | Function::DeSerializeFMUstate => {
                 caps.serialize_fmu_state
@@ -1002,6 +1029,167 @@ impl<M: Model> Instance<M> {
             ));
         }
         Ok(())
+    }
+
+    /// Adjoint derivatives `out = J^T w` (`out[j] = sum_i w_i dUnknown_i/dKnown_j`) from the
+    /// columns of `J`: one directional derivative per known (`J e_j`, exact as the model's
+    /// directional derivatives are), then the transposed product. Generic: every model with
+    /// directional derivatives has it, in the same modes and with the same checks.
+    pub fn adjoint_derivative(&mut self, unknowns: &[u32], knowns: &[u32], seed: &[f64], out: &mut [f64]) -> OpResult {
+        if let Some(x) = seed.iter().find(|x| !x.is_finite()) {
+            return err(format!("seed contains {x}"));
+        }
+        let mut column = vec![0.0; unknowns.len()];
+        for (o, &known) in out.iter_mut().zip(knowns) {
+            self.directional_derivative(unknowns, &[known], &[1.0], &mut column)?;
+            *o = seed.iter().zip(&column).map(|(w, c)| w * c).sum();
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- FMI 3.0 access
+
+    /// The FMI 2.0 value references (of the base type that `accessed` is in FMI 2.0) of the
+    /// FMI 3.0 value references `vrs`, each checked to be a variable of type `accessed`
+    /// (`function` names the call in the messages). `time` (0) is refused: the callers that
+    /// accept it handle it before.
+    pub fn fmi2_references(&self, vrs: &[u32], accessed: ValueType3) -> OpResult<Vec<u32>> {
+        let d = decl::<M>();
+        vrs.iter()
+            .map(|&vr| {
+                let Some(v) = d.variable3(vr) else {
+                    return err(format!(
+                        "unknown value reference {vr} (the FMU's are 0 ..= {})",
+                        d.spec.variables.len()
+                    ));
+                };
+                if v.value_type != accessed {
+                    return err(format!(
+                        "value reference {vr} is {}, a {} variable, not a {} one",
+                        v.name,
+                        v.value_type.element(),
+                        accessed.element()
+                    ));
+                }
+                match d.row3(vr) {
+                    Some(row) => Ok(d.variable(row).value_reference),
+                    None => err(format!("value reference {vr} is {}, the independent variable", v.name)),
+                }
+            })
+            .collect()
+    }
+
+    /// `fmi3GetFloat64`: the Float64 variables, `time` (value reference 0) included.
+    pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
+        if !vrs.contains(&0) {
+            let vrs2 = self.fmi2_references(vrs, ValueType3::Float64)?;
+            return self.get_real(&vrs2, out);
+        }
+        let vrs2 =
+            self.fmi2_references(&vrs.iter().copied().filter(|&vr| vr != 0).collect::<Vec<_>>(), ValueType3::Float64)?;
+        let mut values = vec![0.0; vrs2.len()];
+        self.get_real(&vrs2, &mut values)?;
+        let mut values = values.into_iter();
+        for (o, &vr) in out.iter_mut().zip(vrs) {
+            *o = if vr == 0 { self.core.time } else { values.next().unwrap_or(f64::NAN) };
+        }
+        Ok(())
+    }
+
+    /// `fmi3SetFloat64` (`time` is refused: it is the independent variable).
+    pub fn set_float64(&mut self, vrs: &[u32], values: &[f64]) -> OpResult {
+        if vrs.contains(&0) {
+            return err("time (value reference 0) cannot be set: it is the independent variable, \
+                 advanced by fmi3DoStep or set by fmi3SetTime");
+        }
+        let vrs2 = self.fmi2_references(vrs, ValueType3::Float64)?;
+        self.set_real(&vrs2, values)
+    }
+
+    /// `fmi3GetInt32` (Integers) or `fmi3GetInt64` (Enumerations).
+    pub fn get_int(&mut self, vrs: &[u32], accessed: ValueType3, out: &mut [i32]) -> OpResult {
+        let vrs2 = self.fmi2_references(vrs, accessed)?;
+        self.get_integer(&vrs2, out)
+    }
+
+    /// `fmi3SetInt32` (Integers) or `fmi3SetInt64` (Enumerations): values outside the
+    /// 32-bit range of the variables are refused before the declaration's checks.
+    pub fn set_int(&mut self, vrs: &[u32], accessed: ValueType3, values: &[i64]) -> OpResult {
+        let vrs2 = self.fmi2_references(vrs, accessed)?;
+        let narrow: Vec<i32> = values
+            .iter()
+            .zip(vrs)
+            .map(|(&x, &vr)| {
+                i32::try_from(x).map_err(|_| {
+                    let name = decl::<M>().variable3(vr).map_or("?", |v| v.name.as_str());
+                    ModelError::from(format!("{name} = {x} refused: outside the 32-bit range of its values"))
+                })
+            })
+            .collect::<OpResult<_>>()?;
+        self.set_integer(&vrs2, &narrow)
+    }
+
+    /// `fmi3GetBoolean`.
+    pub fn get_boolean3(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+        let vrs2 = self.fmi2_references(vrs, ValueType3::Boolean)?;
+        self.get_boolean(&vrs2, out)
+    }
+
+    /// `fmi3SetBoolean`.
+    pub fn set_boolean3(&mut self, vrs: &[u32], values: &[bool]) -> OpResult {
+        let vrs2 = self.fmi2_references(vrs, ValueType3::Boolean)?;
+        self.set_boolean(&vrs2, values)
+    }
+
+    /// The FMI 3.0 value references of the Float64 unknowns or knowns of a derivative
+    /// call, as FMI 2.0 Real value references.
+    pub fn real_references(&self, vrs: &[u32]) -> OpResult<Vec<u32>> {
+        if vrs.contains(&0) {
+            return err("time (value reference 0) is no unknown or known of a partial derivative here");
+        }
+        self.fmi2_references(vrs, ValueType3::Float64)
+    }
+
+    /// Whether the run ends at the current time: the model asked to end it, or a sampled
+    /// model's last sample is due now (it runs at the next read or step).
+    pub fn run_ends(&self) -> bool {
+        let now = self.core.time;
+        self.core.terminate_requested
+            || self.core.clock.is_some_and(|c| c.end_time().is_some_and(|end| end <= now + time_eps(now)))
+    }
+
+    /// `fmi3GetVariableDependencies`: the knowns the unknown `vr` depends on in the current
+    /// state (the `<InitialUnknown>` entry in Initialization Mode, else the `<Output>` or
+    /// `<ContinuousStateDerivative>` entry), as FMI 3.0 value references; an entry without
+    /// `dependencies` depends on every known of the mode (FMI 3.0 section 2.4.8).
+    pub fn variable_dependencies(&self, vr: u32) -> OpResult<Vec<u32>> {
+        let d = decl::<M>();
+        let Some(v) = d.variable3(vr) else { return err(format!("unknown value reference {vr}")) };
+        let s = &d.model_description3().model_structure;
+        let initialization = self.core.machine == Machine::InitializationMode;
+        let entry = if initialization {
+            s.initial_unknowns.iter().find(|u| u.value_reference == vr)
+        } else {
+            s.outputs.iter().chain(&s.continuous_state_derivatives).find(|u| u.value_reference == vr)
+        };
+        let Some(entry) = entry else {
+            return err(format!(
+                "{} (value reference {vr}) is no unknown of the ModelStructure {}",
+                v.name,
+                if initialization { "in Initialization Mode" } else { "after initialization" }
+            ));
+        };
+        Ok(match &entry.dependencies {
+            Some(on) => on.clone(),
+            None => (0..d.spec.variables.len())
+                .filter(|&row| {
+                    let k = d.variable(row);
+                    k.causality == Causality::Input
+                        || if initialization { k.initial == Some(Initial::Exact) } else { d.state_rows.contains(&row) }
+                })
+                .map(Declaration::<M::Binding>::value_reference3)
+                .collect(),
+        })
     }
 
     // ---------------------------------------------------------------- FMU state

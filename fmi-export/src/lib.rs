@@ -2,7 +2,7 @@
 //!
 //! A model implements the safe [`Model`] trait and declares its variables once in a
 //! [`DeclarationSpec`]; this crate owns everything else: the C ABI (all 44 `fmi2*`
-//! functions, exported unmangled by [`export_fmi2!`]), the instance state machine (one
+//! functions, exported unmangled by [`export_fmi!`]), the instance state machine (one
 //! table of allowed states, [`states`]), the GUID check, typed logging through the
 //! importer's callback ([`Logger`]), time events and event iteration, FMU state
 //! get/set/serialize, and the generation of `modelDescription.xml` from the same
@@ -53,7 +53,7 @@
 //!      and discrete states must be settable by binding), plus [`Model::save_internal`] /
 //!      [`Model::load_internal`] for data that is no variable (a sample counter). A loaded
 //!      state goes through the same checks as `fmi2Set*` and `exit_initialization`.
-//! 4. `fmi_export::export_fmi2!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
+//! 4. `fmi_export::export_fmi!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
 //!    entry `FmuTarget::of::<MyModel>("fmu-xyz", EQUATIONS_HTML)` in `build-fmu`'s list:
 //!    the identifier, interfaces and documentation come from the declaration, and the
 //!    generic C-ABI and fmpy tests then cover the new FMU.
@@ -108,10 +108,11 @@
 //!         Ok(())
 //!     }
 //! }
-//! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi_export::export_fmi2!(Sampler);
+//! // in the FMU crate: #[cfg(feature = "fmi-export")] fmi_export::export_fmi!(Sampler);
 //!
 //! let d = Sampler::declaration();
-//! assert_eq!(d.value_reference_table(), "u 0\ngain 1\ny 2\n");
+//! assert_eq!(d.value_reference_table(), "u 0 1\ngain 1 2\ny 2 3\n");
+//! assert!(d.xml3().contains(r#"<Output valueReference="3" dependencies="1"/>"#), "{}", d.xml3());
 //! assert!(d.xml().contains(r#"<Unknown index="3" dependencies="1"/>"#), "{}", d.xml());
 //! ```
 
@@ -149,6 +150,7 @@ pub use decl::{
     declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec,
     Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
+pub use fmi_sys;
 pub use instance::Instance;
 pub use log::{LogCategory, Logger};
 pub use model::{Access, EventUpdate, InstantiateContext, Interface, Model, ModelError, ModelResult};
@@ -157,15 +159,25 @@ pub use sampled::{SampleClock, SampleEnd};
 pub use states::{Function, Machine};
 pub use variables::{Accessor, Family, Field, FieldValue, Pending, Variables};
 
-/// Exports the 44 FMI 2.0 functions for model type `$model` from the calling crate
-/// (which should be a `cdylib`). Invoke it once per shared library.
+/// Exports the 44 FMI 2.0 and the 75 FMI 3.0 functions for model type `$model` from the
+/// calling crate (which should be a `cdylib`): one library serves both generations'
+/// archives. Invoke it once per shared library. Each `fmi3*` symbol is checked at compile
+/// time against its C type in `fmi-sys` (`fmi3DoStepTYPE`, ...).
 #[macro_export]
-macro_rules! export_fmi2 {
+macro_rules! export_fmi {
     ($model:ty) => {
         const _: () = {
             use ::std::ffi::{c_char, c_int};
             use $crate::abi;
             use $crate::ffi::*;
+            use $crate::fmi_sys::fmi3::{
+                fmi3Binary, fmi3Boolean, fmi3Byte, fmi3Clock, fmi3DependencyKind, fmi3FMUState, fmi3Float32,
+                fmi3Float64, fmi3Instance, fmi3InstanceEnvironment, fmi3Int16, fmi3Int32, fmi3Int64, fmi3Int8,
+                fmi3IntervalQualifier, fmi3Status, fmi3String, fmi3UInt16, fmi3UInt32, fmi3UInt64, fmi3UInt8,
+                fmi3ValueReference, types, Fmi3ClockUpdateCallback, Fmi3IntermediateUpdateCallback,
+                Fmi3LockPreemptionCallback, Fmi3LogMessageCallback, Fmi3UnlockPreemptionCallback,
+            };
+            use $crate::states::Function;
             type M = $model;
 
             #[no_mangle]
@@ -463,6 +475,740 @@ macro_rules! export_fmi2 {
             ) -> Fmi2Status {
                 abi::get_nominals_of_continuous_states::<M>(c, x, nx)
             }
+
+            // ---------------------------------------------------------------- FMI 3.0
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetVersion() -> *const c_char {
+                abi::fmi3::get_version()
+            }
+            const _: types::fmi3GetVersionTYPE = fmi3GetVersion;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3FreeInstance(a0: fmi3Instance) {
+                abi::fmi3::free_instance::<M>(a0)
+            }
+            const _: types::fmi3FreeInstanceTYPE = fmi3FreeInstance;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterInitializationMode(
+                a0: fmi3Instance,
+                a1: fmi3Boolean,
+                a2: fmi3Float64,
+                a3: fmi3Float64,
+                a4: fmi3Boolean,
+                a5: fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::enter_initialization_mode::<M>(a0, a1, a2, a3, a4, a5) as fmi3Status
+            }
+            const _: types::fmi3EnterInitializationModeTYPE = fmi3EnterInitializationMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3ExitInitializationMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::exit_initialization_mode::<M>(a0) as fmi3Status
+            }
+            const _: types::fmi3ExitInitializationModeTYPE = fmi3ExitInitializationMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3Terminate(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::terminate::<M>(a0) as fmi3Status
+            }
+            const _: types::fmi3TerminateTYPE = fmi3Terminate;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetFloat64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Float64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_float64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetFloat64TYPE = fmi3GetFloat64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetFloat64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Float64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_float64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetFloat64TYPE = fmi3SetFloat64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetDebugLogging(
+                a0: fmi3Instance,
+                a1: fmi3Boolean,
+                a2: usize,
+                a3: *const fmi3String,
+            ) -> fmi3Status {
+                abi::fmi3::set_debug_logging::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3SetDebugLoggingTYPE = fmi3SetDebugLogging;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateModelExchange(
+                a0: fmi3String,
+                a1: fmi3String,
+                a2: fmi3String,
+                a3: fmi3Boolean,
+                a4: fmi3Boolean,
+                a5: fmi3InstanceEnvironment,
+                a6: Option<Fmi3LogMessageCallback>,
+            ) -> fmi3Instance {
+                abi::fmi3::instantiate_model_exchange::<M>(a0, a1, a2, a3, a4, a5, a6)
+            }
+            const _: types::fmi3InstantiateModelExchangeTYPE = fmi3InstantiateModelExchange;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
+                a0: fmi3String,
+                a1: fmi3String,
+                a2: fmi3String,
+                a3: fmi3Boolean,
+                a4: fmi3Boolean,
+                a5: fmi3Boolean,
+                a6: fmi3Boolean,
+                a7: *const fmi3ValueReference,
+                a8: usize,
+                a9: fmi3InstanceEnvironment,
+                a10: Option<Fmi3LogMessageCallback>,
+                a11: Option<Fmi3IntermediateUpdateCallback>,
+            ) -> fmi3Instance {
+                abi::fmi3::instantiate_co_simulation::<M>(a0, a1, a2, a3, a4, a5, a6, a7, a8, a9, a10, a11)
+            }
+            const _: types::fmi3InstantiateCoSimulationTYPE = fmi3InstantiateCoSimulation;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
+                a0: fmi3String,
+                a1: fmi3String,
+                a2: fmi3String,
+                a3: fmi3Boolean,
+                a4: fmi3Boolean,
+                a5: fmi3InstanceEnvironment,
+                a6: Option<Fmi3LogMessageCallback>,
+                a7: Option<Fmi3ClockUpdateCallback>,
+                a8: Option<Fmi3LockPreemptionCallback>,
+                a9: Option<Fmi3UnlockPreemptionCallback>,
+            ) -> fmi3Instance {
+                abi::fmi3::instantiate_scheduled_execution::<M>(a0, a1, a2, a3, a4, a5, a6, a7, a8, a9)
+            }
+            const _: types::fmi3InstantiateScheduledExecutionTYPE = fmi3InstantiateScheduledExecution;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterEventMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::enter_event_mode::<M>(a0) as fmi3Status
+            }
+            const _: types::fmi3EnterEventModeTYPE = fmi3EnterEventMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3Reset(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::reset::<M>(a0) as fmi3Status
+            }
+            const _: types::fmi3ResetTYPE = fmi3Reset;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetFloat32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Float32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_float32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetFloat32TYPE = fmi3GetFloat32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetInt8(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Int8,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_int8::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetInt8TYPE = fmi3GetInt8;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetUInt8(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt8,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_uint8::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetUInt8TYPE = fmi3GetUInt8;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetInt16(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Int16,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_int16::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetInt16TYPE = fmi3GetInt16;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetUInt16(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt16,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_uint16::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetUInt16TYPE = fmi3GetUInt16;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetInt32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Int32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_int32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetInt32TYPE = fmi3GetInt32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetUInt32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_uint32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetUInt32TYPE = fmi3GetUInt32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetInt64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Int64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_int64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetInt64TYPE = fmi3GetInt64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetUInt64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_uint64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetUInt64TYPE = fmi3GetUInt64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetBoolean(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Boolean,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_boolean::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetBooleanTYPE = fmi3GetBoolean;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetString(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3String,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_string::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3GetStringTYPE = fmi3GetString;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetBinary(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut usize,
+                a4: *mut fmi3Binary,
+                a5: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_binary::<M>(a0, a1, a2, a3, a4, a5) as fmi3Status
+            }
+            const _: types::fmi3GetBinaryTYPE = fmi3GetBinary;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetClock(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Clock,
+            ) -> fmi3Status {
+                abi::fmi3::get_clock::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3GetClockTYPE = fmi3GetClock;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetFloat32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Float32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_float32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetFloat32TYPE = fmi3SetFloat32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetInt8(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Int8,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_int8::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetInt8TYPE = fmi3SetInt8;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetUInt8(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt8,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_uint8::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetUInt8TYPE = fmi3SetUInt8;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetInt16(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Int16,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_int16::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetInt16TYPE = fmi3SetInt16;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetUInt16(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt16,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_uint16::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetUInt16TYPE = fmi3SetUInt16;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetInt32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Int32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_int32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetInt32TYPE = fmi3SetInt32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetUInt32(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt32,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_uint32::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetUInt32TYPE = fmi3SetUInt32;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetInt64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Int64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_int64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetInt64TYPE = fmi3SetInt64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetUInt64(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt64,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_uint64::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetUInt64TYPE = fmi3SetUInt64;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetBoolean(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Boolean,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_boolean::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetBooleanTYPE = fmi3SetBoolean;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetString(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3String,
+                a4: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_string::<M>(a0, a1, a2, a3, a4) as fmi3Status
+            }
+            const _: types::fmi3SetStringTYPE = fmi3SetString;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetBinary(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const usize,
+                a4: *const fmi3Binary,
+                a5: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_binary::<M>(a0, a1, a2, a3, a4, a5) as fmi3Status
+            }
+            const _: types::fmi3SetBinaryTYPE = fmi3SetBinary;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetClock(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Clock,
+            ) -> fmi3Status {
+                abi::fmi3::set_clock::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3SetClockTYPE = fmi3SetClock;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
+                a0: fmi3Instance,
+                a1: fmi3ValueReference,
+                a2: *mut usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_number_of_variable_dependencies::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3GetNumberOfVariableDependenciesTYPE = fmi3GetNumberOfVariableDependencies;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetVariableDependencies(
+                a0: fmi3Instance,
+                a1: fmi3ValueReference,
+                a2: *mut usize,
+                a3: *mut fmi3ValueReference,
+                a4: *mut usize,
+                a5: *mut fmi3DependencyKind,
+                a6: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_variable_dependencies::<M>(a0, a1, a2, a3, a4, a5, a6) as fmi3Status
+            }
+            const _: types::fmi3GetVariableDependenciesTYPE = fmi3GetVariableDependencies;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetFMUState(a0: fmi3Instance, a1: *mut fmi3FMUState) -> fmi3Status {
+                abi::fmi3::get_fmu_state::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3GetFMUStateTYPE = fmi3GetFMUState;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetFMUState(a0: fmi3Instance, a1: fmi3FMUState) -> fmi3Status {
+                abi::fmi3::set_fmu_state::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3SetFMUStateTYPE = fmi3SetFMUState;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3FreeFMUState(a0: fmi3Instance, a1: *mut fmi3FMUState) -> fmi3Status {
+                abi::fmi3::free_fmu_state::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3FreeFMUStateTYPE = fmi3FreeFMUState;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
+                a0: fmi3Instance,
+                a1: fmi3FMUState,
+                a2: *mut usize,
+            ) -> fmi3Status {
+                abi::fmi3::serialized_fmu_state_size::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3SerializedFMUStateSizeTYPE = fmi3SerializedFMUStateSize;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SerializeFMUState(
+                a0: fmi3Instance,
+                a1: fmi3FMUState,
+                a2: *mut fmi3Byte,
+                a3: usize,
+            ) -> fmi3Status {
+                abi::fmi3::serialize_fmu_state::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3SerializeFMUStateTYPE = fmi3SerializeFMUState;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3DeserializeFMUState(
+                a0: fmi3Instance,
+                a1: *const fmi3Byte,
+                a2: usize,
+                a3: *mut fmi3FMUState,
+            ) -> fmi3Status {
+                abi::fmi3::deserialize_fmu_state::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3DeserializeFMUStateTYPE = fmi3DeserializeFMUState;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3ValueReference,
+                a4: usize,
+                a5: *const fmi3Float64,
+                a6: usize,
+                a7: *mut fmi3Float64,
+                a8: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_directional_derivative::<M>(a0, a1, a2, a3, a4, a5, a6, a7, a8) as fmi3Status
+            }
+            const _: types::fmi3GetDirectionalDerivativeTYPE = fmi3GetDirectionalDerivative;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetAdjointDerivative(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3ValueReference,
+                a4: usize,
+                a5: *const fmi3Float64,
+                a6: usize,
+                a7: *mut fmi3Float64,
+                a8: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_adjoint_derivative::<M>(a0, a1, a2, a3, a4, a5, a6, a7, a8) as fmi3Status
+            }
+            const _: types::fmi3GetAdjointDerivativeTYPE = fmi3GetAdjointDerivative;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterConfigurationMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3EnterConfigurationMode) as fmi3Status
+            }
+            const _: types::fmi3EnterConfigurationModeTYPE = fmi3EnterConfigurationMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3ExitConfigurationMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3ExitConfigurationMode) as fmi3Status
+            }
+            const _: types::fmi3ExitConfigurationModeTYPE = fmi3ExitConfigurationMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetIntervalDecimal(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Float64,
+                a4: *mut fmi3IntervalQualifier,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3GetIntervalDecimal) as fmi3Status
+            }
+            const _: types::fmi3GetIntervalDecimalTYPE = fmi3GetIntervalDecimal;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetIntervalFraction(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt64,
+                a4: *mut fmi3UInt64,
+                a5: *mut fmi3IntervalQualifier,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3GetIntervalFraction) as fmi3Status
+            }
+            const _: types::fmi3GetIntervalFractionTYPE = fmi3GetIntervalFraction;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetShiftDecimal(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3GetShiftDecimal) as fmi3Status
+            }
+            const _: types::fmi3GetShiftDecimalTYPE = fmi3GetShiftDecimal;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetShiftFraction(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *mut fmi3UInt64,
+                a4: *mut fmi3UInt64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3GetShiftFraction) as fmi3Status
+            }
+            const _: types::fmi3GetShiftFractionTYPE = fmi3GetShiftFraction;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetIntervalDecimal(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3SetIntervalDecimal) as fmi3Status
+            }
+            const _: types::fmi3SetIntervalDecimalTYPE = fmi3SetIntervalDecimal;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetIntervalFraction(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt64,
+                a4: *const fmi3UInt64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3SetIntervalFraction) as fmi3Status
+            }
+            const _: types::fmi3SetIntervalFractionTYPE = fmi3SetIntervalFraction;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetShiftDecimal(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3SetShiftDecimal) as fmi3Status
+            }
+            const _: types::fmi3SetShiftDecimalTYPE = fmi3SetShiftDecimal;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetShiftFraction(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3UInt64,
+                a4: *const fmi3UInt64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3SetShiftFraction) as fmi3Status
+            }
+            const _: types::fmi3SetShiftFractionTYPE = fmi3SetShiftFraction;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EvaluateDiscreteStates(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3EvaluateDiscreteStates) as fmi3Status
+            }
+            const _: types::fmi3EvaluateDiscreteStatesTYPE = fmi3EvaluateDiscreteStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
+                a0: fmi3Instance,
+                a1: *mut fmi3Boolean,
+                a2: *mut fmi3Boolean,
+                a3: *mut fmi3Boolean,
+                a4: *mut fmi3Boolean,
+                a5: *mut fmi3Boolean,
+                a6: *mut fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::update_discrete_states::<M>(a0, a1, a2, a3, a4, a5, a6) as fmi3Status
+            }
+            const _: types::fmi3UpdateDiscreteStatesTYPE = fmi3UpdateDiscreteStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::enter_continuous_time_mode::<M>(a0) as fmi3Status
+            }
+            const _: types::fmi3EnterContinuousTimeModeTYPE = fmi3EnterContinuousTimeMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
+                a0: fmi3Instance,
+                a1: fmi3Boolean,
+                a2: *mut fmi3Boolean,
+                a3: *mut fmi3Boolean,
+            ) -> fmi3Status {
+                abi::fmi3::completed_integrator_step::<M>(a0, a1, a2, a3) as fmi3Status
+            }
+            const _: types::fmi3CompletedIntegratorStepTYPE = fmi3CompletedIntegratorStep;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetTime(a0: fmi3Instance, a1: fmi3Float64) -> fmi3Status {
+                abi::fmi3::set_time::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3SetTimeTYPE = fmi3SetTime;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3SetContinuousStates(
+                a0: fmi3Instance,
+                a1: *const fmi3Float64,
+                a2: usize,
+            ) -> fmi3Status {
+                abi::fmi3::set_continuous_states::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3SetContinuousStatesTYPE = fmi3SetContinuousStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(
+                a0: fmi3Instance,
+                a1: *mut fmi3Float64,
+                a2: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_continuous_state_derivatives::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3GetContinuousStateDerivativesTYPE = fmi3GetContinuousStateDerivatives;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetEventIndicators(
+                a0: fmi3Instance,
+                a1: *mut fmi3Float64,
+                a2: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_event_indicators::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3GetEventIndicatorsTYPE = fmi3GetEventIndicators;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetContinuousStates(
+                a0: fmi3Instance,
+                a1: *mut fmi3Float64,
+                a2: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_continuous_states::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3GetContinuousStatesTYPE = fmi3GetContinuousStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(
+                a0: fmi3Instance,
+                a1: *mut fmi3Float64,
+                a2: usize,
+            ) -> fmi3Status {
+                abi::fmi3::get_nominals_of_continuous_states::<M>(a0, a1, a2) as fmi3Status
+            }
+            const _: types::fmi3GetNominalsOfContinuousStatesTYPE = fmi3GetNominalsOfContinuousStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(a0: fmi3Instance, a1: *mut usize) -> fmi3Status {
+                abi::fmi3::get_number_of_event_indicators::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3GetNumberOfEventIndicatorsTYPE = fmi3GetNumberOfEventIndicators;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(a0: fmi3Instance, a1: *mut usize) -> fmi3Status {
+                abi::fmi3::get_number_of_continuous_states::<M>(a0, a1) as fmi3Status
+            }
+            const _: types::fmi3GetNumberOfContinuousStatesTYPE = fmi3GetNumberOfContinuousStates;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3EnterStepMode(a0: fmi3Instance) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3EnterStepMode) as fmi3Status
+            }
+            const _: types::fmi3EnterStepModeTYPE = fmi3EnterStepMode;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3GetOutputDerivatives(
+                a0: fmi3Instance,
+                a1: *const fmi3ValueReference,
+                a2: usize,
+                a3: *const fmi3Int32,
+                a4: *mut fmi3Float64,
+                a5: usize,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3GetOutputDerivatives) as fmi3Status
+            }
+            const _: types::fmi3GetOutputDerivativesTYPE = fmi3GetOutputDerivatives;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3DoStep(
+                a0: fmi3Instance,
+                a1: fmi3Float64,
+                a2: fmi3Float64,
+                a3: fmi3Boolean,
+                a4: *mut fmi3Boolean,
+                a5: *mut fmi3Boolean,
+                a6: *mut fmi3Boolean,
+                a7: *mut fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::do_step::<M>(a0, a1, a2, a3, a4, a5, a6, a7) as fmi3Status
+            }
+            const _: types::fmi3DoStepTYPE = fmi3DoStep;
+            #[no_mangle]
+            pub unsafe extern "C" fn fmi3ActivateModelPartition(
+                a0: fmi3Instance,
+                a1: fmi3ValueReference,
+                a2: fmi3Float64,
+            ) -> fmi3Status {
+                abi::fmi3::undeclared::<M>(a0, Function::Fmi3ActivateModelPartition) as fmi3Status
+            }
+            const _: types::fmi3ActivateModelPartitionTYPE = fmi3ActivateModelPartition;
         };
     };
 }

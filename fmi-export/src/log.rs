@@ -1,11 +1,13 @@
-//! The typed logger: the importer's `fmi2CallbackLogger` behind categories, shared by the
-//! layer and the model (a model gets a clone in its [`crate::InstantiateContext`]).
+//! The typed logger: the importer's callback (FMI 2.0's `fmi2CallbackLogger` or FMI 3.0's
+//! `fmi3LogMessageCallback`) behind categories, shared by the layer and the model (a model
+//! gets a clone in its [`crate::InstantiateContext`]).
 
 use std::ffi::{c_int, CStr, CString};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use crate::ffi::{Fmi2CallbackFunctions, Fmi2Status};
+use fmi_sys::fmi3::{fmi3InstanceEnvironment, Fmi3LogMessageCallback};
 
 /// Log categories every FMU of ours offers.
 pub const LOG_CATEGORIES: [(&str, &str); 4] = [
@@ -38,8 +40,15 @@ impl LogCategory {
     }
 }
 
+/// Where the messages go: the callback of the generation the instance was created by.
+enum Sink {
+    None,
+    Fmi2(Fmi2CallbackFunctions),
+    Fmi3 { environment: fmi3InstanceEnvironment, log_message: Fmi3LogMessageCallback },
+}
+
 struct Shared {
-    callbacks: Option<Fmi2CallbackFunctions>,
+    callbacks: Sink,
     name: CString,
     logging_on: AtomicBool,
     enabled: [AtomicBool; 4],
@@ -73,7 +82,28 @@ impl Logger {
     pub(crate) fn new(callbacks: Fmi2CallbackFunctions, name: &CStr, logging_on: bool) -> Logger {
         Logger {
             shared: Arc::new(Shared {
-                callbacks: Some(callbacks),
+                callbacks: Sink::Fmi2(callbacks),
+                name: name.to_owned(),
+                logging_on: AtomicBool::new(logging_on),
+                enabled: [(); 4].map(|_| AtomicBool::new(true)),
+                warned: AtomicBool::new(false),
+            }),
+        }
+    }
+
+    /// A logger calling an FMI 3.0 importer's `logMessage` (none: messages are dropped).
+    pub(crate) fn new3(
+        environment: fmi3InstanceEnvironment,
+        log_message: Option<Fmi3LogMessageCallback>,
+        name: &CStr,
+        logging_on: bool,
+    ) -> Logger {
+        Logger {
+            shared: Arc::new(Shared {
+                callbacks: match log_message {
+                    Some(log_message) => Sink::Fmi3 { environment, log_message },
+                    None => Sink::None,
+                },
                 name: name.to_owned(),
                 logging_on: AtomicBool::new(logging_on),
                 enabled: [(); 4].map(|_| AtomicBool::new(true)),
@@ -87,7 +117,7 @@ impl Logger {
     pub fn silent() -> Logger {
         Logger {
             shared: Arc::new(Shared {
-                callbacks: None,
+                callbacks: Sink::None,
                 name: CString::default(),
                 logging_on: AtomicBool::new(false),
                 enabled: [(); 4].map(|_| AtomicBool::new(false)),
@@ -147,7 +177,17 @@ impl Logger {
 
     #[inline(never)]
     fn emit_now(&self, status: Fmi2Status, category: LogCategory, message: &str) {
-        let Some(callbacks) = &self.shared.callbacks else { return };
+        let callbacks = match &self.shared.callbacks {
+            Sink::None => return,
+            Sink::Fmi3 { environment, log_message } => {
+                let category = c_text(category.name());
+                let message = c_text(message);
+                // SAFETY: the importer's fmi3LogMessageCallback, called as its C prototype says.
+                unsafe { log_message(*environment, status as c_int, category.as_ptr(), message.as_ptr()) };
+                return;
+            }
+            Sink::Fmi2(callbacks) => callbacks,
+        };
         if let Some(logger) = callbacks.logger {
             let category = c_text(category.name());
             let message = c_text(message);

@@ -1,6 +1,17 @@
-//! The FMI 2.0 instance states and, in one table, where each of the 44 functions may be
-//! called: the standard's state tables for Model Exchange (section 3.2.3) and
-//! Co-Simulation (section 4.2.4), read row by row.
+//! The instance states and, in one table, where each of the 44 FMI 2.0 and the 75 FMI 3.0
+//! functions may be called: the state tables of FMI 2.0 (Model Exchange section 3.2.3,
+//! Co-Simulation section 4.2.4) and FMI 3.0 (section 3.2, Model Exchange 3.3,
+//! Co-Simulation 4.3), read row by row.
+//!
+//! One machine serves both generations. FMI 3.0's states are FMI 2.0's where they
+//! coincide: Instantiated, Initialization Mode, Event Mode and Continuous-Time Mode (Model
+//! Exchange), Terminated, and the error state; FMI 3.0's Step Mode is
+//! [`Machine::StepComplete`], and [`Machine::StepFailed`] is Step Mode after a step that
+//! returned Discard (in FMI 3.0 as in FMI 2.0 the importer may then read, terminate,
+//! restore an FMU state or reset, but not step). An FMU of ours declares no Event Mode for
+//! Co-Simulation, no clocks and no Configuration Mode, so those FMI 3.0 states never occur.
+//! An FMI 3.0 function that does the same as an FMI 2.0 one has that one's row
+//! ([`Function::counterpart`]).
 
 use model_description::{Causality, Initial, Variability};
 
@@ -53,24 +64,51 @@ pub enum Scope {
     Common,
     ModelExchange,
     CoSimulation,
+    /// FMI 3.0 Scheduled Execution (not offered by the layer).
+    ScheduledExecution,
 }
 
 macro_rules! functions {
-    ($($name:ident),* $(,)?) => {
-        /// The 44 functions of FMI 2.0.
+    (fmi2 { $($f2:ident),* $(,)? } fmi3 { $($f3:ident = $n3:ident),* $(,)? }) => {
+        /// The 44 functions of FMI 2.0 and the 75 of FMI 3.0, one enum: one table of where
+        /// each may be called ([`Function::allowed_in`]). An FMI 3.0 function's variant is
+        /// its C name with `Fmi3` in front (`Function::Fmi3DoStep` is `fmi3DoStep`).
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-        pub enum Function { $($name),* }
+        pub enum Function { $($f2,)* $($n3,)* }
         impl Function {
-            pub const ALL: [Function; 44] = [$(Function::$name),*];
-            /// The C name, e.g. `"fmi2GetReal"`.
+            pub const ALL: [Function; 119] = [$(Function::$f2,)* $(Function::$n3,)*];
+            /// The 44 FMI 2.0 functions.
+            pub const FMI2: [Function; 44] = [$(Function::$f2),*];
+            /// The 75 FMI 3.0 functions.
+            pub const FMI3: [Function; 75] = [$(Function::$n3),*];
+            /// The C name, e.g. `"fmi2GetReal"`, `"fmi3GetFloat64"`.
             pub fn name(self) -> &'static str {
-                match self { $(Function::$name => concat!("fmi2", stringify!($name))),* }
+                match self {
+                    $(Function::$f2 => concat!("fmi2", stringify!($f2)),)*
+                    $(Function::$n3 => concat!("fmi3", stringify!($f3)),)*
+                }
+            }
+            /// The FMI generation (2 or 3) the function belongs to.
+            pub fn generation(self) -> Generation {
+                match self {
+                    $(Function::$f2 => Generation::Fmi2,)*
+                    $(Function::$n3 => Generation::Fmi3,)*
+                }
             }
         }
     };
 }
 
+/// The generation of the FMI C API an instance was created by (`fmi2Instantiate` or an
+/// `fmi3Instantiate*`): only that generation's functions may be called on it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Generation {
+    Fmi2,
+    Fmi3,
+}
+
 functions!(
+    fmi2 {
     GetTypesPlatform,
     GetVersion,
     SetDebugLogging,
@@ -115,6 +153,84 @@ functions!(
     GetIntegerStatus,
     GetBooleanStatus,
     GetStringStatus,
+    }
+    fmi3 {
+        GetVersion = Fmi3GetVersion,
+        EnterInitializationMode = Fmi3EnterInitializationMode,
+        ExitInitializationMode = Fmi3ExitInitializationMode,
+        Terminate = Fmi3Terminate,
+        FreeInstance = Fmi3FreeInstance,
+        GetFloat64 = Fmi3GetFloat64,
+        SetFloat64 = Fmi3SetFloat64,
+        SetDebugLogging = Fmi3SetDebugLogging,
+        InstantiateModelExchange = Fmi3InstantiateModelExchange,
+        InstantiateCoSimulation = Fmi3InstantiateCoSimulation,
+        InstantiateScheduledExecution = Fmi3InstantiateScheduledExecution,
+        EnterEventMode = Fmi3EnterEventMode,
+        Reset = Fmi3Reset,
+        GetFloat32 = Fmi3GetFloat32,
+        GetInt8 = Fmi3GetInt8,
+        GetUInt8 = Fmi3GetUInt8,
+        GetInt16 = Fmi3GetInt16,
+        GetUInt16 = Fmi3GetUInt16,
+        GetInt32 = Fmi3GetInt32,
+        GetUInt32 = Fmi3GetUInt32,
+        GetInt64 = Fmi3GetInt64,
+        GetUInt64 = Fmi3GetUInt64,
+        GetBoolean = Fmi3GetBoolean,
+        GetString = Fmi3GetString,
+        GetBinary = Fmi3GetBinary,
+        GetClock = Fmi3GetClock,
+        SetFloat32 = Fmi3SetFloat32,
+        SetInt8 = Fmi3SetInt8,
+        SetUInt8 = Fmi3SetUInt8,
+        SetInt16 = Fmi3SetInt16,
+        SetUInt16 = Fmi3SetUInt16,
+        SetInt32 = Fmi3SetInt32,
+        SetUInt32 = Fmi3SetUInt32,
+        SetInt64 = Fmi3SetInt64,
+        SetUInt64 = Fmi3SetUInt64,
+        SetBoolean = Fmi3SetBoolean,
+        SetString = Fmi3SetString,
+        SetBinary = Fmi3SetBinary,
+        SetClock = Fmi3SetClock,
+        GetNumberOfVariableDependencies = Fmi3GetNumberOfVariableDependencies,
+        GetVariableDependencies = Fmi3GetVariableDependencies,
+        GetFMUState = Fmi3GetFMUState,
+        SetFMUState = Fmi3SetFMUState,
+        FreeFMUState = Fmi3FreeFMUState,
+        SerializedFMUStateSize = Fmi3SerializedFMUStateSize,
+        SerializeFMUState = Fmi3SerializeFMUState,
+        DeserializeFMUState = Fmi3DeserializeFMUState,
+        GetDirectionalDerivative = Fmi3GetDirectionalDerivative,
+        GetAdjointDerivative = Fmi3GetAdjointDerivative,
+        EnterConfigurationMode = Fmi3EnterConfigurationMode,
+        ExitConfigurationMode = Fmi3ExitConfigurationMode,
+        GetIntervalDecimal = Fmi3GetIntervalDecimal,
+        GetIntervalFraction = Fmi3GetIntervalFraction,
+        GetShiftDecimal = Fmi3GetShiftDecimal,
+        GetShiftFraction = Fmi3GetShiftFraction,
+        SetIntervalDecimal = Fmi3SetIntervalDecimal,
+        SetIntervalFraction = Fmi3SetIntervalFraction,
+        SetShiftDecimal = Fmi3SetShiftDecimal,
+        SetShiftFraction = Fmi3SetShiftFraction,
+        EvaluateDiscreteStates = Fmi3EvaluateDiscreteStates,
+        UpdateDiscreteStates = Fmi3UpdateDiscreteStates,
+        EnterContinuousTimeMode = Fmi3EnterContinuousTimeMode,
+        CompletedIntegratorStep = Fmi3CompletedIntegratorStep,
+        SetTime = Fmi3SetTime,
+        SetContinuousStates = Fmi3SetContinuousStates,
+        GetContinuousStateDerivatives = Fmi3GetContinuousStateDerivatives,
+        GetEventIndicators = Fmi3GetEventIndicators,
+        GetContinuousStates = Fmi3GetContinuousStates,
+        GetNominalsOfContinuousStates = Fmi3GetNominalsOfContinuousStates,
+        GetNumberOfEventIndicators = Fmi3GetNumberOfEventIndicators,
+        GetNumberOfContinuousStates = Fmi3GetNumberOfContinuousStates,
+        EnterStepMode = Fmi3EnterStepMode,
+        GetOutputDerivatives = Fmi3GetOutputDerivatives,
+        DoStep = Fmi3DoStep,
+        ActivateModelPartition = Fmi3ActivateModelPartition,
+    }
 );
 
 use Machine::*;
@@ -137,9 +253,90 @@ const READ: u16 =
     mask(&[InitializationMode, EventMode, ContinuousTimeMode, StepComplete, StepFailed, Terminated, Error]);
 
 impl Function {
+    /// The FMI 2.0 function an FMI 3.0 one does the same as (its row of the table, its
+    /// scope); `None` for an FMI 2.0 function and for an FMI 3.0 one without counterpart.
+    pub fn counterpart(self) -> Option<Function> {
+        use Function::*;
+        Some(match self {
+            Fmi3GetVersion => GetVersion,
+            Fmi3SetDebugLogging => SetDebugLogging,
+            Fmi3InstantiateModelExchange | Fmi3InstantiateCoSimulation => Instantiate,
+            Fmi3FreeInstance => FreeInstance,
+            Fmi3EnterInitializationMode => EnterInitializationMode,
+            Fmi3ExitInitializationMode => ExitInitializationMode,
+            Fmi3Terminate => Terminate,
+            Fmi3Reset => Reset,
+            Fmi3GetFloat64 | Fmi3GetFloat32 => GetReal,
+            Fmi3GetInt8 | Fmi3GetUInt8 | Fmi3GetInt16 | Fmi3GetUInt16 | Fmi3GetInt32 | Fmi3GetUInt32 | Fmi3GetInt64
+            | Fmi3GetUInt64 => GetInteger,
+            Fmi3GetBoolean | Fmi3GetClock => GetBoolean,
+            Fmi3GetString | Fmi3GetBinary => GetString,
+            Fmi3SetFloat64 | Fmi3SetFloat32 => SetReal,
+            Fmi3SetInt8 | Fmi3SetUInt8 | Fmi3SetInt16 | Fmi3SetUInt16 | Fmi3SetInt32 | Fmi3SetUInt32 | Fmi3SetInt64
+            | Fmi3SetUInt64 => SetInteger,
+            Fmi3SetBoolean | Fmi3SetClock => SetBoolean,
+            Fmi3SetString | Fmi3SetBinary => SetString,
+            Fmi3GetFMUState => GetFMUstate,
+            Fmi3SetFMUState => SetFMUstate,
+            Fmi3FreeFMUState => FreeFMUstate,
+            Fmi3SerializedFMUStateSize => SerializedFMUstateSize,
+            Fmi3SerializeFMUState => SerializeFMUstate,
+            Fmi3DeserializeFMUState => DeSerializeFMUstate,
+            // J^T w is computed from J's columns: where J is, J^T is
+            Fmi3GetDirectionalDerivative | Fmi3GetAdjointDerivative => GetDirectionalDerivative,
+            Fmi3EnterEventMode => EnterEventMode,
+            Fmi3UpdateDiscreteStates => NewDiscreteStates,
+            Fmi3EnterContinuousTimeMode => EnterContinuousTimeMode,
+            Fmi3CompletedIntegratorStep => CompletedIntegratorStep,
+            Fmi3SetTime => SetTime,
+            Fmi3SetContinuousStates => SetContinuousStates,
+            Fmi3GetContinuousStateDerivatives => GetDerivatives,
+            Fmi3GetEventIndicators => GetEventIndicators,
+            Fmi3GetContinuousStates => GetContinuousStates,
+            Fmi3GetNominalsOfContinuousStates => GetNominalsOfContinuousStates,
+            Fmi3DoStep => DoStep,
+            _ => return None,
+        })
+    }
+
+    /// The FMI 3.0 features the layer's FMUs do not declare, with what is missing: the
+    /// call is refused (`fmi3Error`, logged) in every state.
+    pub fn undeclared_feature(self) -> Option<&'static str> {
+        use Function::*;
+        Some(match self {
+            Fmi3InstantiateScheduledExecution | Fmi3ActivateModelPartition => "Scheduled Execution is not offered",
+            Fmi3EnterConfigurationMode | Fmi3ExitConfigurationMode => {
+                "no structural parameters, so no Configuration Mode"
+            }
+            Fmi3GetIntervalDecimal
+            | Fmi3GetIntervalFraction
+            | Fmi3GetShiftDecimal
+            | Fmi3GetShiftFraction
+            | Fmi3SetIntervalDecimal
+            | Fmi3SetIntervalFraction
+            | Fmi3SetShiftDecimal
+            | Fmi3SetShiftFraction => "no clocks are declared",
+            Fmi3EvaluateDiscreteStates => "providesEvaluateDiscreteStates is false",
+            Fmi3GetOutputDerivatives => "maxOutputDerivativeOrder is 0",
+            Fmi3EnterStepMode => "hasEventMode is false: a Co-Simulation instance never leaves Step Mode",
+            _ => return None,
+        })
+    }
+
     /// The interface the function belongs to.
     pub fn scope(self) -> Scope {
         use Function::*;
+        if let Some(f) = self.counterpart() {
+            // fmi3EnterEventMode and fmi3UpdateDiscreteStates are common to all interfaces
+            // in FMI 3.0, but Co-Simulation without Event Mode (ours) has no use for them
+            return f.scope();
+        }
+        match self {
+            Fmi3GetNumberOfEventIndicators | Fmi3GetNumberOfContinuousStates => return Scope::ModelExchange,
+            Fmi3EnterStepMode | Fmi3GetOutputDerivatives => return Scope::CoSimulation,
+            Fmi3ActivateModelPartition => return Scope::ScheduledExecution,
+            _ => {}
+        }
         match self {
             EnterEventMode
             | NewDiscreteStates
@@ -167,6 +364,15 @@ impl Function {
     /// The states in which the standard allows the call (for the function's own interface).
     fn allowed_mask(self) -> u16 {
         use Function::*;
+        if let Some(f) = self.counterpart() {
+            return f.allowed_mask();
+        }
+        // FMI 3.0 without an FMI 2.0 counterpart: the structure queries (the numbers of
+        // states and event indicators, the variable dependencies) in every state;
+        // undeclared features are refused by the instance before this table is asked
+        if self.generation() == Generation::Fmi3 {
+            return ANY;
+        }
         match self {
             // no instance involved
             GetTypesPlatform | GetVersion | Instantiate => ANY,
@@ -204,6 +410,8 @@ impl Function {
             GetStatus | GetRealStatus | GetIntegerStatus | GetBooleanStatus | GetStringStatus => {
                 mask(&[StepComplete, StepFailed, Terminated])
             }
+            // the FMI 3.0 functions, answered above
+            _ => ANY,
         }
     }
 
@@ -259,12 +467,52 @@ pub(crate) fn settable_in(
 mod tests {
     use super::*;
 
+    /// The names are the C symbols of both headers, as `fmi-sys` lists them, each once.
     #[test]
     fn names_are_the_c_symbols_and_unique() {
         let names: std::collections::HashSet<_> = Function::ALL.iter().map(|f| f.name()).collect();
-        assert_eq!(names.len(), 44);
-        assert!(names.contains("fmi2GetNominalsOfContinuousStates"));
-        assert!(names.contains("fmi2DeSerializeFMUstate"));
+        assert_eq!(names.len(), 44 + 75);
+        let fmi2: std::collections::BTreeSet<_> = Function::FMI2.iter().map(|f| f.name()).collect();
+        let fmi3: std::collections::BTreeSet<_> = Function::FMI3.iter().map(|f| f.name()).collect();
+        assert_eq!(fmi2, fmi_sys::fmi2::SYMBOLS.iter().map(|(s, _)| *s).collect());
+        assert_eq!(fmi3, fmi_sys::fmi3::SYMBOLS.iter().map(|(s, _)| *s).collect());
+        assert!(Function::FMI2.iter().all(|f| f.generation() == Generation::Fmi2));
+        assert!(Function::FMI3.iter().all(|f| f.generation() == Generation::Fmi3));
+    }
+
+    /// An FMI 3.0 function with an FMI 2.0 counterpart has its row; the scopes are those of
+    /// `fmi-sys` except the Event Mode calls, which only our Model Exchange has.
+    #[test]
+    fn fmi3_rows_are_their_fmi2_counterparts() {
+        use Function::*;
+        for f in Function::FMI3 {
+            if let Some(g) = f.counterpart() {
+                assert_eq!(g.generation(), Generation::Fmi2, "{f:?}");
+                for m in Machine::ALL {
+                    assert_eq!(f.allowed_in(m), g.allowed_in(m), "{f:?} in {m:?}");
+                }
+            }
+        }
+        assert!(Fmi3DoStep.allowed_in(StepComplete) && !Fmi3DoStep.allowed_in(StepFailed));
+        assert!(!Fmi3ExitInitializationMode.allowed_in(Instantiated));
+        assert!(
+            Fmi3EnterInitializationMode.allowed_in(Instantiated) && !Fmi3EnterInitializationMode.allowed_in(EventMode)
+        );
+        assert_eq!(Fmi3UpdateDiscreteStates.scope(), Scope::ModelExchange);
+        assert_eq!(Fmi3GetNumberOfContinuousStates.scope(), Scope::ModelExchange);
+        assert_eq!(Fmi3EnterStepMode.scope(), Scope::CoSimulation);
+        assert_eq!(Fmi3GetFloat64.scope(), Scope::Common);
+        for (symbol, part) in fmi_sys::fmi3::SYMBOLS {
+            let f = *Function::FMI3.iter().find(|f| f.name() == symbol).unwrap();
+            let expected = match part {
+                fmi_sys::fmi3::Fmi3Part::Common => Scope::Common,
+                fmi_sys::fmi3::Fmi3Part::ModelExchange => Scope::ModelExchange,
+                fmi_sys::fmi3::Fmi3Part::CoSimulation => Scope::CoSimulation,
+                fmi_sys::fmi3::Fmi3Part::ScheduledExecution => Scope::ScheduledExecution,
+            };
+            let event_mode = matches!(f, Fmi3EnterEventMode | Fmi3UpdateDiscreteStates);
+            assert!(f.scope() == expected || event_mode, "{symbol}");
+        }
     }
 
     #[test]

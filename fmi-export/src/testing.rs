@@ -1,5 +1,5 @@
 //! A tiny in-process importer over the layer's C entry points (`fmi_export::abi`, what
-//! `export_fmi2!` exports from the shared library), for the tests of the layer and of the
+//! `export_fmi!` exports from the shared library), for the tests of the layer and of the
 //! FMU crates: it instantiates a model type directly, without building or loading a
 //! library, and records the log (through the logger shim of `fmi-sys`, as a real importer
 //! receives it) so that tests can check the messages. Behind the feature `testing`, which

@@ -504,7 +504,7 @@ mod tests {
     fn value_references_are_assigned_per_base_type_in_declaration_order() {
         let (variables, handles) = declare();
         let d = declaration(variables).unwrap();
-        assert_eq!(d.value_reference_table(), "u_a 0\nu_b 1\nmode 0\ngain 2\non 0\ntwice 3\ny 4\n");
+        assert_eq!(d.value_reference_table(), "u_a 0 1\nu_b 1 2\nmode 0 3\ngain 2 4\non 0 5\ntwice 3 6\ny 4 7\n");
         let types = [BaseType::Real, BaseType::Real, BaseType::Integer, BaseType::Real, BaseType::Boolean];
         for (h, (v, t)) in handles.iter().zip(d.spec.variables.iter().zip(types)) {
             assert_eq!((h.base_type, h.value_reference), (t, v.value_reference), "{}", v.name);

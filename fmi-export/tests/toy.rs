@@ -1,5 +1,5 @@
 //! Every layer feature on a small sampled toy model, through the layer's C entry points
-//! (`fmi_export::abi`, what `export_fmi2!` exports): Integer/Boolean/Enumeration,
+//! (`fmi_export::abi`, what `export_fmi!` exports): Integer/Boolean/Enumeration,
 //! tunable and fixed parameters, time events in Model Exchange and inside `fmi2DoStep`,
 //! event iteration, the default FMU state from the declaration, opt-in capabilities,
 //! Warning/Discard, bad input, stopTime, and the FMU states an instance owns.
@@ -368,7 +368,7 @@ impl Model for Own {
 }
 
 // The macro must expand for a model with Integer/Boolean/Enumeration and defaults only.
-export_fmi2!(Toy);
+export_fmi!(Toy);
 
 // ------------------------------------------------------------------ the importer
 

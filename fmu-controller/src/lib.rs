@@ -379,7 +379,7 @@ impl Model for Controller {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi_export::export_fmi2!(Controller);
+fmi_export::export_fmi!(Controller);
 
 /// The law and its timing, for `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("documentation.html");

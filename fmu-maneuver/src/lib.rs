@@ -332,7 +332,7 @@ impl Model for TestBench {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi_export::export_fmi2!(TestBench);
+fmi_export::export_fmi!(TestBench);
 
 /// What the test bench computes, for `documentation/index.html`.
 pub const DOCUMENTATION: &str = include_str!("documentation.html");

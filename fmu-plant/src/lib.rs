@@ -663,7 +663,7 @@ impl Model for Plant {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi_export::export_fmi2!(Plant);
+fmi_export::export_fmi!(Plant);
 
 #[cfg(test)]
 mod tests {

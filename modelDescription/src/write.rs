@@ -31,7 +31,7 @@ pub fn format_f64(x: f64) -> String {
 /// C0 controls as character references, so that no XML parser normalizes them away.
 /// (U+0000 cannot be represented in XML at all: it is written as `&#0;`, which readers,
 /// ours included, refuse.)
-fn escape_attr(s: &str) -> Cow<'_, str> {
+pub(crate) fn escape_attr(s: &str) -> Cow<'_, str> {
     let needs = s.chars().any(|c| matches!(c, '&' | '<' | '>' | '"' | '\'') || (c as u32) < 0x20);
     if !needs {
         return Cow::Borrowed(s);
@@ -52,38 +52,38 @@ fn escape_attr(s: &str) -> Cow<'_, str> {
 }
 
 /// An element under construction: name plus attributes in insertion order.
-struct Elem {
-    start: BytesStart<'static>,
+pub(crate) struct Elem {
+    pub(crate) start: BytesStart<'static>,
 }
 
 impl Elem {
-    fn new(name: &'static str) -> Self {
+    pub(crate) fn new(name: &'static str) -> Self {
         Elem { start: BytesStart::new(name) }
     }
-    fn attr(&mut self, key: &str, value: &str) -> &mut Self {
+    pub(crate) fn attr(&mut self, key: &str, value: &str) -> &mut Self {
         let v = escape_attr(value);
         self.start.push_attribute((key.as_bytes(), v.as_bytes()));
         self
     }
-    fn opt_str(&mut self, key: &str, value: &Option<String>) -> &mut Self {
+    pub(crate) fn opt_str(&mut self, key: &str, value: &Option<String>) -> &mut Self {
         if let Some(v) = value {
             self.attr(key, v);
         }
         self
     }
-    fn opt_f64(&mut self, key: &str, value: Option<f64>) -> &mut Self {
+    pub(crate) fn opt_f64(&mut self, key: &str, value: Option<f64>) -> &mut Self {
         if let Some(v) = value {
             self.attr(key, &format_f64(v));
         }
         self
     }
-    fn opt_disp<T: std::fmt::Display>(&mut self, key: &str, value: Option<T>) -> &mut Self {
+    pub(crate) fn opt_disp<T: std::fmt::Display>(&mut self, key: &str, value: Option<T>) -> &mut Self {
         if let Some(v) = value {
             self.attr(key, &v.to_string());
         }
         self
     }
-    fn flag(&mut self, key: &str, value: bool) -> &mut Self {
+    pub(crate) fn flag(&mut self, key: &str, value: bool) -> &mut Self {
         if value {
             self.attr(key, "true");
         }
@@ -91,27 +91,27 @@ impl Elem {
     }
 }
 
-struct Out {
-    w: Writer<Vec<u8>>,
+pub(crate) struct Out {
+    pub(crate) w: Writer<Vec<u8>>,
 }
 
 impl Out {
-    fn ev(&mut self, e: Event<'_>) {
+    pub(crate) fn ev(&mut self, e: Event<'_>) {
         // Writing into a Vec<u8> cannot fail.
         let _ = self.w.write_event(e);
     }
-    fn empty(&mut self, e: Elem) {
+    pub(crate) fn empty(&mut self, e: Elem) {
         self.ev(Event::Empty(e.start));
     }
-    fn open(&mut self, e: Elem) {
+    pub(crate) fn open(&mut self, e: Elem) {
         self.ev(Event::Start(e.start));
     }
-    fn close(&mut self, name: &'static str) {
+    pub(crate) fn close(&mut self, name: &'static str) {
         self.ev(Event::End(BytesEnd::new(name)));
     }
 }
 
-fn join_u32(v: &[u32]) -> String {
+pub(crate) fn join_u32(v: &[u32]) -> String {
     v.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(" ")
 }
 

@@ -163,4 +163,4 @@ impl Model for OwnController {
 }
 
 #[cfg(feature = "fmi-export")]
-fmi_export::export_fmi2!(OwnController);
+fmi_export::export_fmi!(OwnController);

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod read;
 pub mod validate;
+pub mod write;
 
 pub use crate::read::{Position, ReadError};
 pub use read::fmi_version_of;

@@ -1,180 +1,15 @@
-//! The C ABI: every `fmi2*` function as a generic `unsafe fn` over the model type. The
-//! [`crate::export_fmi2!`] macro instantiates them as unmangled `extern "C"` symbols.
-//!
-//! Rules kept here, and only here: null pointers and lengths are checked before a slice
-//! is made, panics are caught at every entry point, every error is logged through the
-//! importer's logger (as `"%s"`, message) with the function name, and an `fmi2Error`
-//! moves the instance to the error state.
+//! The FMI 2.0 C ABI: the 44 `fmi2*` functions over the one instance.
 #![allow(clippy::missing_safety_doc, non_snake_case)]
 
 use std::collections::HashSet;
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ffi::{c_char, c_int, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+use super::{c_text, emit, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::*;
-use crate::instance::{Function, Instance, Machine, OpResult, SavedState};
+use crate::instance::{Function, Instance, Machine, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
-use crate::model::{InstantiateContext, Interface, Model, ModelError};
-
-/// Largest `nvr` (or `nx`, `nUnknown`, ...) accepted: far above any sensible request,
-/// far below what would make a slice or an allocation from a wrong length dangerous.
-pub const MAX_ARRAY_LENGTH: usize = 1 << 24;
-
-/// What `fmi2Component` points to.
-pub struct Component<M: Model> {
-    pub instance: Instance<M>,
-    logger: Logger,
-    /// The FMU states this instance handed out and has not freed: only these are
-    /// accepted back (a freed or foreign pointer is refused, never dereferenced).
-    live_states: HashSet<usize>,
-}
-
-impl<M: Model> Drop for Component<M> {
-    fn drop(&mut self) {
-        for state in self.live_states.drain() {
-            // SAFETY: every entry came from Box::into_raw of a SavedState<M> and is freed once.
-            drop(unsafe { Box::from_raw(state as *mut SavedState<M>) });
-        }
-    }
-}
-
-fn c_text(s: &str) -> CString {
-    CString::new(s.replace('\0', " ")).unwrap_or_default()
-}
-
-/// Calls the importer's variadic logger with format `"%s"` (for calls without an instance).
-unsafe fn emit(callbacks: &Fmi2CallbackFunctions, name: &CStr, status: Fmi2Status, category: &str, message: &str) {
-    if let Some(logger) = callbacks.logger {
-        let category = c_text(category);
-        let message = c_text(message);
-        logger(
-            callbacks.component_environment,
-            name.as_ptr(),
-            status as c_int,
-            category.as_ptr(),
-            c"%s".as_ptr(),
-            message.as_ptr(),
-        );
-    }
-}
-
-impl<M: Model> Component<M> {
-    fn log(&self, status: Fmi2Status, category: LogCategory, message: &str) {
-        self.logger.emit(status, category, message);
-    }
-
-    fn own_state(&self, state: fmi2FMUstate) -> OpResult<*mut SavedState<M>> {
-        if state.is_null() {
-            Err("FMUstate is NULL".into())
-        } else if self.live_states.contains(&(state as usize)) {
-            Ok(state as *mut SavedState<M>)
-        } else {
-            Err("FMUstate was not made by this instance or was already freed".into())
-        }
-    }
-
-    /// Stores `saved` in `*slot`: into the state already there when it is one of ours,
-    /// else as a new state.
-    unsafe fn put_state(&mut self, slot: &mut fmi2FMUstate, saved: SavedState<M>) -> OpResult {
-        if slot.is_null() {
-            let ptr = Box::into_raw(Box::new(saved));
-            self.live_states.insert(ptr as usize);
-            *slot = ptr as fmi2FMUstate;
-        } else {
-            *self.own_state(*slot)? = saved;
-        }
-        Ok(())
-    }
-}
-
-fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
-    if let Some(s) = payload.downcast_ref::<&str>() {
-        s.to_string()
-    } else if let Some(s) = payload.downcast_ref::<String>() {
-        s.clone()
-    } else {
-        "unknown panic".into()
-    }
-}
-
-/// Runs `f` on the instance behind `c`: null check, the state table, panic guard,
-/// logging, and the status: `fmi2Error` (to the error state), `fmi2Discard` (a failed
-/// step goes to stepFailed), `fmi2Warning` when the model logged a warning.
-unsafe fn with<M: Model>(
-    c: fmi2Component,
-    function: Function,
-    f: impl FnOnce(&mut Component<M>) -> OpResult,
-) -> Fmi2Status {
-    if c.is_null() {
-        return Fmi2Status::Error;
-    }
-    let component = &mut *(c as *mut Component<M>);
-    component.log(Fmi2Status::Ok, LogCategory::Calls, function.name());
-    component.logger.take_warned();
-    let outcome = catch_unwind(AssertUnwindSafe(|| {
-        component.instance.check_call(function)?;
-        f(component)
-    }));
-    let (status, message) = match outcome {
-        Ok(Ok(())) => {
-            return if component.logger.take_warned() { Fmi2Status::Warning } else { Fmi2Status::Ok };
-        }
-        Ok(Err(ModelError::Discard(message))) => (Fmi2Status::Discard, message),
-        Ok(Err(ModelError::Error(message))) => (Fmi2Status::Error, message),
-        Err(payload) => {
-            (Fmi2Status::Error, format!("internal error (panic caught at the C boundary): {}", panic_text(&*payload)))
-        }
-    };
-    let function_name = function.name();
-    if status == Fmi2Status::Discard {
-        if function == Function::DoStep {
-            component.instance.core.machine = Machine::StepFailed;
-        }
-        component.log(Fmi2Status::Discard, LogCategory::Warning, &format!("{function_name}: {message}"));
-    } else {
-        component.instance.core.machine = Machine::Error;
-        component.log(Fmi2Status::Error, LogCategory::Error, &format!("{function_name}: {message}"));
-    }
-    status
-}
-
-/// A slice from a C array, refusing a null pointer unless the length is 0, and an
-/// implausible length before anything is read or allocated.
-unsafe fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> OpResult<&'a [T]> {
-    if n == 0 {
-        Ok(&[])
-    } else if n > MAX_ARRAY_LENGTH {
-        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
-        Err(format!("{what} is NULL with length {n}").into())
-    } else {
-        Ok(std::slice::from_raw_parts(ptr, n))
-    }
-}
-
-unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpResult<&'a mut [T]> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if n > MAX_ARRAY_LENGTH {
-        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
-        Err(format!("{what} is NULL with length {n}").into())
-    } else {
-        Ok(std::slice::from_raw_parts_mut(ptr, n))
-    }
-}
-
-unsafe fn out_ptr<'a, T>(ptr: *mut T, what: &str) -> OpResult<&'a mut T> {
-    ptr.as_mut().ok_or_else(|| format!("{what} is NULL").into())
-}
-
-unsafe fn string<'a>(ptr: fmi2String) -> Option<&'a str> {
-    if ptr.is_null() {
-        None
-    } else {
-        CStr::from_ptr(ptr).to_str().ok()
-    }
-}
+use crate::model::{InstantiateContext, Interface, Model};
 
 // ------------------------------------------------------------------ common functions
 
@@ -192,20 +27,7 @@ pub unsafe fn set_debug_logging<M: Model>(
     n: usize,
     categories: *const fmi2String,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SetDebugLogging, |comp| {
-        let names = slice(categories, n, "categories")?;
-        let mut enabled = [n == 0; LOG_CATEGORIES.len()];
-        for &name in names {
-            let name = string(name).ok_or_else(|| ModelError::from("a category name is NULL or not UTF-8"))?;
-            let k = LOG_CATEGORIES
-                .iter()
-                .position(|(c, _)| *c == name)
-                .ok_or_else(|| format!("unknown log category {name:?}"))?;
-            enabled[k] = true;
-        }
-        comp.logger.configure(logging_on != FMI2_FALSE, enabled);
-        Ok(())
-    })
+    super::set_debug_logging_as::<M>(Function::SetDebugLogging, c, logging_on, n, categories)
 }
 
 pub unsafe fn instantiate<M: Model>(
@@ -405,31 +227,15 @@ pub unsafe fn set_string<M: Model>(
 // ------------------------------------------------------------------ FMU state
 
 pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, Function::GetFMUstate, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        let saved = comp.instance.save_state();
-        comp.put_state(slot, saved)
-    })
+    super::get_fmu_state_as::<M>(Function::GetFMUstate, c, state)
 }
 
 pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, Function::SetFMUstate, |comp| {
-        let saved = &*comp.own_state(state)?;
-        comp.instance.restore_state(saved)
-    })
+    super::set_fmu_state_as::<M>(Function::SetFMUstate, c, state)
 }
 
 pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, Function::FreeFMUstate, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            let ptr = comp.own_state(*slot)?;
-            comp.live_states.remove(&(ptr as usize));
-            drop(Box::from_raw(ptr));
-            *slot = std::ptr::null_mut();
-        }
-        Ok(())
-    })
+    super::free_fmu_state_as::<M>(Function::FreeFMUstate, c, state)
 }
 
 pub unsafe fn serialized_fmu_state_size<M: Model>(
@@ -437,11 +243,7 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(
     state: fmi2FMUstate,
     size: *mut usize,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SerializedFMUstateSize, |comp| {
-        let saved = &*comp.own_state(state)?;
-        *out_ptr(size, "size")? = Instance::serialize(saved)?.len();
-        Ok(())
-    })
+    super::serialized_fmu_state_size_as::<M>(Function::SerializedFMUstateSize, c, state, size)
 }
 
 pub unsafe fn serialize_fmu_state<M: Model>(
@@ -450,16 +252,7 @@ pub unsafe fn serialize_fmu_state<M: Model>(
     bytes: *mut fmi2Byte,
     size: usize,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SerializeFMUstate, |comp| {
-        let saved = &*comp.own_state(state)?;
-        let data = Instance::serialize(saved)?;
-        if size < data.len() {
-            return Err(format!("buffer of {size} bytes is too small for {} bytes", data.len()).into());
-        }
-        let out = slice_mut(bytes as *mut u8, data.len(), "serializedState")?;
-        out.copy_from_slice(&data);
-        Ok(())
-    })
+    super::serialize_fmu_state_as::<M>(Function::SerializeFMUstate, c, state, bytes, size)
 }
 
 pub unsafe fn deserialize_fmu_state<M: Model>(
@@ -468,15 +261,7 @@ pub unsafe fn deserialize_fmu_state<M: Model>(
     size: usize,
     state: *mut fmi2FMUstate,
 ) -> Fmi2Status {
-    with::<M>(c, Function::DeSerializeFMUstate, |comp| {
-        let data = slice(bytes as *const u8, size, "serializedState")?;
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            comp.own_state(*slot)?;
-        }
-        let saved = comp.instance.deserialize(data)?;
-        comp.put_state(slot, saved)
-    })
+    super::deserialize_fmu_state_as::<M>(Function::DeSerializeFMUstate, c, bytes, size, state)
 }
 
 pub unsafe fn get_directional_derivative<M: Model>(
@@ -581,9 +366,6 @@ pub unsafe fn get_string_status<M: Model>(c: fmi2Component, kind: c_int, _value:
 pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
     with::<M>(c, Function::EnterEventMode, |comp| comp.instance.enter_event_mode())
 }
-
-/// `fmi2EventInfo` (from `fmi-sys`).
-pub use crate::ffi::Fmi2EventInfo;
 
 pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut Fmi2EventInfo) -> Fmi2Status {
     with::<M>(c, Function::NewDiscreteStates, |comp| {

@@ -1,0 +1,301 @@
+//! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): [`fmi2`],
+//! every `fmi2*` function, and [`fmi3`], every `fmi3*` function, each as a generic
+//! `unsafe fn` over the model type; [`crate::export_fmi!`] instantiates both as unmangled
+//! `extern "C"` symbols of one library. The FMI 2.0 ones are re-exported here too
+//! (`abi::get_real` is `abi::fmi2::get_real`).
+//!
+//! Rules kept here, and only here: null pointers and lengths are checked before a slice
+//! is made, panics are caught at every entry point, every error is logged through the
+//! importer's logger with the function name, and an error status moves the instance to
+//! the error state.
+#![allow(clippy::missing_safety_doc, non_snake_case)]
+
+pub mod fmi2;
+pub mod fmi3;
+
+/// `fmi2EventInfo` (from `fmi-sys`).
+pub use crate::ffi::Fmi2EventInfo;
+pub use fmi2::*;
+
+use std::collections::HashSet;
+use std::ffi::{c_int, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use crate::ffi::*;
+use crate::instance::{Function, Instance, Machine, OpResult, SavedState};
+use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
+use crate::model::{Model, ModelError};
+
+/// Largest `nvr` (or `nx`, `nUnknown`, ...) accepted: far above any sensible request,
+/// far below what would make a slice or an allocation from a wrong length dangerous.
+pub const MAX_ARRAY_LENGTH: usize = 1 << 24;
+
+/// What `fmi2Component` points to.
+pub struct Component<M: Model> {
+    pub instance: Instance<M>,
+    pub(crate) logger: Logger,
+    /// The FMU states this instance handed out and has not freed: only these are
+    /// accepted back (a freed or foreign pointer is refused, never dereferenced).
+    pub(crate) live_states: HashSet<usize>,
+}
+
+impl<M: Model> Drop for Component<M> {
+    fn drop(&mut self) {
+        for state in self.live_states.drain() {
+            // SAFETY: every entry came from Box::into_raw of a SavedState<M> and is freed once.
+            drop(unsafe { Box::from_raw(state as *mut SavedState<M>) });
+        }
+    }
+}
+
+pub(crate) fn c_text(s: &str) -> CString {
+    CString::new(s.replace('\0', " ")).unwrap_or_default()
+}
+
+/// Calls the importer's variadic logger with format `"%s"` (for calls without an instance).
+pub(crate) unsafe fn emit(
+    callbacks: &Fmi2CallbackFunctions,
+    name: &CStr,
+    status: Fmi2Status,
+    category: &str,
+    message: &str,
+) {
+    if let Some(logger) = callbacks.logger {
+        let category = c_text(category);
+        let message = c_text(message);
+        logger(
+            callbacks.component_environment,
+            name.as_ptr(),
+            status as c_int,
+            category.as_ptr(),
+            c"%s".as_ptr(),
+            message.as_ptr(),
+        );
+    }
+}
+
+impl<M: Model> Component<M> {
+    pub(crate) fn log(&self, status: Fmi2Status, category: LogCategory, message: &str) {
+        self.logger.emit(status, category, message);
+    }
+
+    pub(crate) fn own_state(&self, state: fmi2FMUstate) -> OpResult<*mut SavedState<M>> {
+        if state.is_null() {
+            Err("FMUstate is NULL".into())
+        } else if self.live_states.contains(&(state as usize)) {
+            Ok(state as *mut SavedState<M>)
+        } else {
+            Err("FMUstate was not made by this instance or was already freed".into())
+        }
+    }
+
+    /// Stores `saved` in `*slot`: into the state already there when it is one of ours,
+    /// else as a new state.
+    pub(crate) unsafe fn put_state(&mut self, slot: &mut fmi2FMUstate, saved: SavedState<M>) -> OpResult {
+        if slot.is_null() {
+            let ptr = Box::into_raw(Box::new(saved));
+            self.live_states.insert(ptr as usize);
+            *slot = ptr as fmi2FMUstate;
+        } else {
+            *self.own_state(*slot)? = saved;
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+/// Runs `f` on the instance behind `c`: null check, the state table, panic guard,
+/// logging, and the status: `fmi2Error` (to the error state), `fmi2Discard` (a failed
+/// step goes to stepFailed), `fmi2Warning` when the model logged a warning.
+pub(crate) unsafe fn with<M: Model>(
+    c: fmi2Component,
+    function: Function,
+    f: impl FnOnce(&mut Component<M>) -> OpResult,
+) -> Fmi2Status {
+    if c.is_null() {
+        return Fmi2Status::Error;
+    }
+    let component = &mut *(c as *mut Component<M>);
+    component.log(Fmi2Status::Ok, LogCategory::Calls, function.name());
+    component.logger.take_warned();
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        component.instance.check_call(function)?;
+        f(component)
+    }));
+    let (status, message) = match outcome {
+        Ok(Ok(())) => {
+            return if component.logger.take_warned() { Fmi2Status::Warning } else { Fmi2Status::Ok };
+        }
+        Ok(Err(ModelError::Discard(message))) => (Fmi2Status::Discard, message),
+        Ok(Err(ModelError::Error(message))) => (Fmi2Status::Error, message),
+        Err(payload) => {
+            (Fmi2Status::Error, format!("internal error (panic caught at the C boundary): {}", panic_text(&*payload)))
+        }
+    };
+    let function_name = function.name();
+    if status == Fmi2Status::Discard {
+        if function == Function::DoStep {
+            component.instance.core.machine = Machine::StepFailed;
+        }
+        component.log(Fmi2Status::Discard, LogCategory::Warning, &format!("{function_name}: {message}"));
+    } else {
+        component.instance.core.machine = Machine::Error;
+        component.log(Fmi2Status::Error, LogCategory::Error, &format!("{function_name}: {message}"));
+    }
+    status
+}
+
+/// A slice from a C array, refusing a null pointer unless the length is 0, and an
+/// implausible length before anything is read or allocated.
+pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> OpResult<&'a [T]> {
+    if n == 0 {
+        Ok(&[])
+    } else if n > MAX_ARRAY_LENGTH {
+        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
+    } else if ptr.is_null() {
+        Err(format!("{what} is NULL with length {n}").into())
+    } else {
+        Ok(std::slice::from_raw_parts(ptr, n))
+    }
+}
+
+pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpResult<&'a mut [T]> {
+    if n == 0 {
+        Ok(&mut [])
+    } else if n > MAX_ARRAY_LENGTH {
+        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
+    } else if ptr.is_null() {
+        Err(format!("{what} is NULL with length {n}").into())
+    } else {
+        Ok(std::slice::from_raw_parts_mut(ptr, n))
+    }
+}
+
+pub(crate) unsafe fn out_ptr<'a, T>(ptr: *mut T, what: &str) -> OpResult<&'a mut T> {
+    ptr.as_mut().ok_or_else(|| format!("{what} is NULL").into())
+}
+
+pub(crate) unsafe fn string<'a>(ptr: fmi2String) -> Option<&'a str> {
+    if ptr.is_null() {
+        None
+    } else {
+        CStr::from_ptr(ptr).to_str().ok()
+    }
+}
+
+pub unsafe fn set_debug_logging_as<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    logging_on: fmi2Boolean,
+    n: usize,
+    categories: *const fmi2String,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let names = slice(categories, n, "categories")?;
+        let mut enabled = [n == 0; LOG_CATEGORIES.len()];
+        for &name in names {
+            let name = string(name).ok_or_else(|| ModelError::from("a category name is NULL or not UTF-8"))?;
+            let k = LOG_CATEGORIES
+                .iter()
+                .position(|(c, _)| *c == name)
+                .ok_or_else(|| format!("unknown log category {name:?}"))?;
+            enabled[k] = true;
+        }
+        comp.logger.configure(logging_on != FMI2_FALSE, enabled);
+        Ok(())
+    })
+}
+
+// ------------------------------------------------------------------ FMU state, both generations
+// (`function` names the call; an `fmi3FMUState` is the same pointer as an `fmi2FMUstate`)
+
+pub unsafe fn get_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let slot = out_ptr(state, "FMUstate")?;
+        let saved = comp.instance.save_state();
+        comp.put_state(slot, saved)
+    })
+}
+
+pub unsafe fn set_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let saved = &*comp.own_state(state)?;
+        comp.instance.restore_state(saved)
+    })
+}
+
+pub unsafe fn free_fmu_state_as<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    state: *mut fmi2FMUstate,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let slot = out_ptr(state, "FMUstate")?;
+        if !slot.is_null() {
+            let ptr = comp.own_state(*slot)?;
+            comp.live_states.remove(&(ptr as usize));
+            drop(Box::from_raw(ptr));
+            *slot = std::ptr::null_mut();
+        }
+        Ok(())
+    })
+}
+
+pub unsafe fn serialized_fmu_state_size_as<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let saved = &*comp.own_state(state)?;
+        *out_ptr(size, "size")? = Instance::serialize(saved)?.len();
+        Ok(())
+    })
+}
+
+pub unsafe fn serialize_fmu_state_as<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    bytes: *mut fmi2Byte,
+    size: usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let saved = &*comp.own_state(state)?;
+        let data = Instance::serialize(saved)?;
+        if size < data.len() {
+            return Err(format!("buffer of {size} bytes is too small for {} bytes", data.len()).into());
+        }
+        let out = slice_mut(bytes as *mut u8, data.len(), "serializedState")?;
+        out.copy_from_slice(&data);
+        Ok(())
+    })
+}
+
+pub unsafe fn deserialize_fmu_state_as<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    bytes: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let data = slice(bytes as *const u8, size, "serializedState")?;
+        let slot = out_ptr(state, "FMUstate")?;
+        if !slot.is_null() {
+            comp.own_state(*slot)?;
+        }
+        let saved = comp.instance.deserialize(data)?;
+        comp.put_state(slot, saved)
+    })
+}
