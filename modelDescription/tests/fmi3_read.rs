@@ -339,3 +339,12 @@ fn validation_of_the_ball_structure() {
     md.model_variables[5].name = "e".into();
     assert_eq!(rules(&md), vec![Rule::DuplicateName]);
 }
+
+#[test]
+fn round_trip_through_the_writer() {
+    for xml in [BALL, TYPES] {
+        let md = ModelDescription::from_xml(xml).unwrap();
+        let written = md.to_xml();
+        assert_eq!(ModelDescription::from_xml(&written).unwrap(), md, "{written}");
+    }
+}

@@ -472,15 +472,23 @@ fn readme_prints_the_plant_counts(plant: &[[usize; 4]]) {
     // "0.41 M OK, 310 Discard, 0.80 M Error": OK and Error in millions, the rare ones counted
     let text = |c: &[usize; 4]| {
         let mut parts = vec![format!("{:.2} M OK", c[0] as f64 / 1e6)];
-        parts.extend([(c[1], "Warning"), (c[2], "Discard")].iter().filter(|(n, _)| *n > 0).map(|(n, w)| format!("{n} {w}")));
+        parts.extend(
+            [(c[1], "Warning"), (c[2], "Discard")].iter().filter(|(n, _)| *n > 0).map(|(n, w)| format!("{n} {w}")),
+        );
         parts.push(format!("{:.2} M Error", c[3] as f64 / 1e6));
         parts.join(", ")
     };
     let total: usize = cs.iter().chain(me.iter()).sum();
     let expected = [
-        format!("150,000 seeded sequences per interface over all 44 functions with hostile arguments, {:.1} million", total as f64 / 1e6),
+        format!(
+            "150,000 seeded sequences per interface over all 44 functions with hostile arguments, {:.1} million",
+            total as f64 / 1e6
+        ),
         format!("calls for the plant (CS: {}; ME: {})", text(cs), text(me)),
-        format!("150,000 sequences over all 44 functions per FMU and interface, about {:.1} million calls", cs.iter().sum::<usize>() as f64 / 1e6),
+        format!(
+            "150,000 sequences over all 44 functions per FMU and interface, about {:.1} million calls",
+            cs.iter().sum::<usize>() as f64 / 1e6
+        ),
     ];
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
     let readme = std::fs::read_to_string(&path).expect("README.md");
