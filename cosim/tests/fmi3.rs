@@ -95,10 +95,13 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 15);
+    assert_eq!(md3.model_variables.len(), 30);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
-    assert_eq!(view.model_variables.len(), 15, "every variable has a type both generations have");
+    // the three arrays as their 3 + 2 + 2 elements
+    assert_eq!(view.model_variables.len(), 34);
+    let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
     assert_eq!(view.number_of_event_indicators, 1);
     assert!(fmu.not_in_view().is_empty());
@@ -109,7 +112,7 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
         "{mode:?}"
     );
     assert_eq!(view.variable("n").unwrap().variable_type.type_name(), "Integer");
-    assert_eq!(view.model_structure.outputs.len(), 5);
+    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1);
     assert!(fmu.can_get_and_set_state());
 }
 
@@ -217,7 +220,7 @@ fn bad_fmi3_input_is_refused() {
         ("malformed", XML.replace("</ModelVariables>", ""), "malformed XML"),
         (
             "clock",
-            XML.replace("</ModelVariables>", "<Clock name=\"tick\" valueReference=\"20\" causality=\"input\" intervalVariability=\"triggered\"/></ModelVariables>"),
+            XML.replace("</ModelVariables>", "<Clock name=\"tick\" valueReference=\"40\" causality=\"input\" intervalVariability=\"triggered\"/></ModelVariables>"),
             "clocks (Clock variable \"tick\")",
         ),
         ("noindependent", XML.replace("causality=\"independent\" ", ""), "independent"),
@@ -282,13 +285,14 @@ fn results_equal_fmpys() {
     let csv = dir.join("fmpy.csv");
     let script = r#"
 import sys
-from fmpy import simulate_fmu, write_csv
+from fmpy import simulate_fmu
+COLUMNS = ['y', 'n', 'odd', 'm', 'nb', 'f32', 'i8', 'u8', 'i16', 'u16', 'u32', 'i64', 'u64', 'f32out']
 r = simulate_fmu(sys.argv[1], fmi_type='CoSimulation', stop_time=1.0, output_interval=0.1,
-                 start_values={'u': 0.3, 'mode': 2, 'k': 5, 'b': True, 'label': 'xyz'},
-                 output=['y', 'n', 'odd', 'm', 'nb'])
+                 start_values={'u': 0.3, 'mode': 2, 'k': 5, 'b': True, 'label': 'xyz', 'f32in': 0.1},
+                 output=COLUMNS)
 with open(sys.argv[2], 'w') as f:
     for row in r:
-        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n', 'odd', 'm', 'nb']) + '\n')
+        f.write(' '.join(repr(float(row[c])) for c in ['time'] + COLUMNS) + '\n')
 "#;
     let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
     assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
@@ -305,11 +309,17 @@ with open(sys.argv[2], 'w') as f:
             ("k", Value::Integer(5)),
             ("b", Value::Boolean(true)),
             ("label", Value::String("xyz".into())),
+            ("f32in", Value::Real(0.1)),
         ],
     );
     let (r, _) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
     let ours: Vec<Vec<f64>> = (0..r.rows())
-        .map(|k| ["time", "y", "n", "odd", "m", "nb"].iter().map(|c| r.column(c).unwrap()[k]).collect())
+        .map(|k| {
+            ["time", "y", "n", "odd", "m", "nb", "f32", "i8", "u8", "i16", "u16", "u32", "i64", "u64", "f32out"]
+                .iter()
+                .map(|c| r.column(c).unwrap()[k])
+                .collect()
+        })
         .collect();
     assert_eq!(ours.len(), theirs.len(), "rows: ours {ours:?}\nfmpy {theirs:?}");
     for (a, b) in ours.iter().zip(&theirs) {
@@ -434,4 +444,38 @@ fn fmi2_and_fmi3_instances_in_one_system() {
             assert_eq!(yg[k], 2.0 * g, "{algorithm:?}: gain at t = {}", time[k]);
         }
     }
+}
+
+/// Every FMI 3.0 type recorded: each output of the counter against its definition in
+/// fmi3_counter.c, an array element set alone (`gains[2]`), a Float32 input.
+#[test]
+fn every_type_and_array_elements_are_recorded() {
+    let Some((_dir, path)) = counter("fmi3-types") else { return };
+    let system = with_starts(&path, &[("gains[2]", Value::Real(5.0)), ("f32in", Value::Real(0.1))]);
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let col = |name: &str| r.column(name).unwrap_or_else(|| panic!("no column {name}: {:?}", r.names));
+    let (y, n) = (col("y"), col("n"));
+    for k in 0..r.rows() {
+        let (y, n) = (y[k], n[k]);
+        assert_eq!(col("f32")[k], y as f32 as f64, "Float32: the f32 of y, widened exactly");
+        assert_eq!(col("i8")[k], n - 5.0);
+        assert_eq!(col("u8")[k], 20.0 * n);
+        assert_eq!(col("i16")[k], -1000.0 * n);
+        assert_eq!(col("u16")[k], 6000.0 * n);
+        assert_eq!(col("u32")[k], 4e8 * n);
+        assert_eq!(col("i64")[k], -(2f64.powi(40)) * n);
+        assert_eq!(col("u64")[k], 2f64.powi(48) * n);
+        assert_eq!(col("bin")[k], n, "a Binary recorded as its size");
+        assert_eq!([col("arr[1]")[k], col("arr[2]")[k], col("arr[3]")[k]], [y, 2.0 * y, 3.0 * y]);
+        assert_eq!(col("gy")[k], 1.0 * y + 5.0, "gains[1] kept its start value 1, gains[2] set to 5");
+        assert_eq!([col("flags[1]")[k], col("flags[2]")[k]], [n % 2.0, 1.0 - n % 2.0]);
+        assert_eq!(col("f32out")[k], 2.0 * (0.1f32 as f64), "2 f32in, f32in the f32 nearest 0.1");
+    }
+    // a value that is not one of the type's is refused, naming the variable
+    let fmu = Fmu::load(&path).unwrap();
+    let mut inst = Instance::new(&fmu, "c").unwrap();
+    let n_vr = fmu.description().variable("gains[1]").unwrap().value_reference;
+    inst.set_real(&[n_vr], &[3.0]).unwrap();
+    let e = inst.set_real(&[fmu.description().variable("bin").unwrap().value_reference], &[1.0]).unwrap_err();
+    assert!(e.to_string().contains("c.bin") && e.to_string().contains("cannot be set"), "{e}");
 }

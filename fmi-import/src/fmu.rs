@@ -428,7 +428,7 @@ impl Fmu {
                 feature: "FMI 3.0 instances in host processes (--isolate)".into(),
             });
         }
-        let (description, enumerations, not_in_view) = crate::fmi3::fmi2_view(&md);
+        let (description, special, not_in_view) = crate::fmi3::fmi2_view(&md);
         let interface = match options.interface {
             Some(i) => i,
             None if md.co_simulation.is_some() => Interface::CoSimulation,
@@ -478,7 +478,7 @@ impl Fmu {
             abi: Abi::Fmi3(Box::new(crate::fmi3::Fmi3Abi {
                 functions,
                 description: md,
-                enumerations,
+                special,
                 token,
                 resource_path,
             })),
@@ -506,8 +506,9 @@ impl Fmu {
         }
     }
 
-    /// FMI 3.0: the variables the view leaves out (arrays, Float32, the integer types
-    /// other than Int32, Binary), neither recorded nor settable; empty for FMI 2.0.
+    /// FMI 3.0: the variables the view leaves out (String and Binary arrays, clocks,
+    /// arrays of more than 100,000 elements or of sizes it cannot resolve), neither
+    /// recorded nor settable; empty for FMI 2.0.
     pub fn not_in_view(&self) -> &[String] {
         &self.not_in_view
     }
@@ -666,6 +667,8 @@ pub struct Instance {
     terminate_requested: Option<f64>,
     /// FMI 3.0: Booleans as the bytes the ABI has (reused).
     bytes: Vec<u8>,
+    /// FMI 3.0: the values of arrays set element by element, by value reference.
+    arrays: std::collections::HashMap<u32, Vec<f64>>,
 }
 
 /// A function of the FMI 3.0 table, or the error naming it.
@@ -762,6 +765,7 @@ impl Instance {
             experiment: (None, 0.0, None),
             terminate_requested: None,
             bytes: Vec::new(),
+            arrays: Default::default(),
         }
     }
 
@@ -1056,21 +1060,50 @@ impl Instance {
         self.status(function, raw, None)
     }
 
+    /// The access of the view's variable `vr` when it is not a plain scalar (FMI 3.0).
+    #[inline]
+    fn special(&self, vr: u32) -> Option<crate::fmi3::Access> {
+        match &self.fmu.abi {
+            Abi::Fmi3(a) if !a.special.is_empty() => a.special.get(&vr).copied(),
+            _ => None,
+        }
+    }
+
+    /// Whether some of `vrs` are not plain scalars (FMI 3.0): they go one by one.
+    #[inline]
+    fn any_special(&self, vrs: &[u32]) -> bool {
+        match &self.fmu.abi {
+            Abi::Fmi3(a) => !a.special.is_empty() && vrs.iter().any(|vr| a.special.contains_key(vr)),
+            Abi::Fmi2(_) => false,
+        }
+    }
+
     /// `fmi2GetReal` / `fmi3GetFloat64` of `vrs` into `values` (same length). A NaN or
     /// infinite value is [`Error::NonFinite`] unless the FMU was imported with
-    /// `allow_non_finite`.
+    /// `allow_non_finite`. FMI 3.0: Float32, UInt32, Int64, UInt64 (exact up to 2^53),
+    /// Binary (its size) and array elements by their own getters.
     #[inline]
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_real: one value per value reference");
         let c = self.component;
+        let special = self.any_special(vrs);
         match &self.fmu.abi {
             Abi::Fmi2(t) => {
                 let f = t.get_real;
                 call!(self, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?
             }
-            Abi::Fmi3(a) => {
+            Abi::Fmi3(a) if !special => {
                 let f = a.functions.get_float64;
                 call!(self, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.get_float64;
+                for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                    match self.special(*vr) {
+                        Some(access) => *value = self.get_element(access)?,
+                        None => call!(self, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
+                    }
+                }
             }
         }
         // all exponent bits set: Inf or NaN. An OR of integer compares over the values
@@ -1083,122 +1116,276 @@ impl Instance {
         Ok(())
     }
 
+    /// All values of the FMI 3.0 variable of `access`, as f64 (integers exact up to 2^53,
+    /// Booleans 0 or 1, a Binary its size in bytes).
+    fn get_all(&mut self, access: crate::fmi3::Access) -> Result<Vec<f64>> {
+        use model_description::fmi3::ValueType as T;
+        let c = self.component;
+        let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+        let (vr, n) = (access.vr, access.count);
+        macro_rules! get {
+            ($field:ident, $name:literal, $t:ty) => {{
+                let f = f3!(self, a, $field, $name);
+                let mut buf: Vec<$t> = vec![<$t>::default(); n];
+                call!(self, $name, None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf
+            }};
+        }
+        macro_rules! exact {
+            ($buf:expr, $name:literal) => {{
+                let mut out = Vec::with_capacity(n);
+                for x in $buf {
+                    let wide = x as i128;
+                    if wide.abs() > 1 << 53 {
+                        return Err(self.not_exact($name, vr, wide));
+                    }
+                    out.push(wide as f64);
+                }
+                out
+            }};
+        }
+        Ok(match access.value_type {
+            T::Float64 => {
+                let f = a.functions.get_float64;
+                let mut buf = vec![0.0; n];
+                call!(self, "fmi3GetFloat64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf
+            }
+            T::Float32 => get!(get_float32, "fmi3GetFloat32", f32).into_iter().map(f64::from).collect(),
+            T::Int8 => get!(get_int8, "fmi3GetInt8", i8).into_iter().map(f64::from).collect(),
+            T::UInt8 => get!(get_uint8, "fmi3GetUInt8", u8).into_iter().map(f64::from).collect(),
+            T::Int16 => get!(get_int16, "fmi3GetInt16", i16).into_iter().map(f64::from).collect(),
+            T::UInt16 => get!(get_uint16, "fmi3GetUInt16", u16).into_iter().map(f64::from).collect(),
+            T::Int32 => get!(get_int32, "fmi3GetInt32", i32).into_iter().map(f64::from).collect(),
+            T::UInt32 => get!(get_uint32, "fmi3GetUInt32", u32).into_iter().map(f64::from).collect(),
+            T::Int64 | T::Enumeration => exact!(get!(get_int64, "fmi3GetInt64", i64), "fmi3GetInt64"),
+            T::UInt64 => exact!(get!(get_uint64, "fmi3GetUInt64", u64), "fmi3GetUInt64"),
+            T::Boolean => get!(get_boolean, "fmi3GetBoolean", u8).into_iter().map(|b| (b != 0) as i32 as f64).collect(),
+            T::Binary => {
+                let f = f3!(self, a, get_binary, "fmi3GetBinary");
+                let mut sizes = vec![0usize; n];
+                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
+                call!(self, "fmi3GetBinary", None, f(c, &vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
+                sizes.into_iter().map(|s| s as f64).collect()
+            }
+            T::String | T::Clock => unreachable!("not in the view as a number"),
+        })
+    }
+
     #[cold]
-    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Error {
-        let k = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
-        let variable = self
+    fn not_exact(&self, function: &'static str, vr: u32, value: i128) -> Error {
+        Error::Fmi {
+            instance: self.name.clone(),
+            function,
+            status: Status::Error,
+            time: Some(self.time),
+            log: format!(
+                "value {value} of value reference {vr} is beyond 2^53, where f64 results cannot hold it exactly"
+            ),
+        }
+    }
+
+    fn get_element(&mut self, access: crate::fmi3::Access) -> Result<f64> {
+        let all = self.get_all(access)?;
+        Ok(all.get(access.element).copied().unwrap_or(f64::NAN))
+    }
+
+    /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
+    /// whole and in their type's range).
+    fn set_all(&mut self, access: crate::fmi3::Access, values: &[f64]) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
+        let c = self.component;
+        let name = self
             .fmu
             .description
             .model_variables
             .iter()
-            .find(|v| v.is_real() && v.value_reference == vrs[k])
-            .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
-        Error::NonFinite {
-            instance: self.name.clone(),
-            fmu: self.fmu.source.clone(),
-            variable,
-            value: values[k],
-            time: self.time,
+            .find(|v| v.value_reference == access.vr)
+            .map(|v| v.name.clone());
+        let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+        let (vr, n) = (access.vr, values.len());
+        let variable = || format!("{}.{}", self.name, name.clone().unwrap_or_else(|| format!("<vr {vr}>")));
+        macro_rules! set_int {
+            ($field:ident, $name:literal, $t:ty) => {{
+                let f = f3!(self, a, $field, $name);
+                let mut buf: Vec<$t> = Vec::with_capacity(n);
+                for x in values {
+                    let wide = *x as i128;
+                    let fits = wide as f64 == *x && wide >= <$t>::MIN as i128 && wide <= <$t>::MAX as i128;
+                    if !fits {
+                        return Err(Error::InvalidValue {
+                            variable: variable(),
+                            value: x.to_string(),
+                            reason: format!("not a whole number of {}", stringify!($t)),
+                        });
+                    }
+                    buf.push(wide as $t);
+                }
+                call!(self, $name, None, f(c, &vr, 1, buf.as_ptr(), n))
+            }};
+        }
+        match access.value_type {
+            T::Float64 => {
+                let f = a.functions.set_float64;
+                call!(self, "fmi3SetFloat64", None, f(c, &vr, 1, values.as_ptr(), n))
+            }
+            T::Float32 => {
+                let f = f3!(self, a, set_float32, "fmi3SetFloat32");
+                let buf: Vec<f32> = values.iter().map(|x| *x as f32).collect();
+                call!(self, "fmi3SetFloat32", None, f(c, &vr, 1, buf.as_ptr(), n))
+            }
+            T::Int8 => set_int!(set_int8, "fmi3SetInt8", i8),
+            T::UInt8 => set_int!(set_uint8, "fmi3SetUInt8", u8),
+            T::Int16 => set_int!(set_int16, "fmi3SetInt16", i16),
+            T::UInt16 => set_int!(set_uint16, "fmi3SetUInt16", u16),
+            T::Int32 => set_int!(set_int32, "fmi3SetInt32", i32),
+            T::UInt32 => set_int!(set_uint32, "fmi3SetUInt32", u32),
+            T::Int64 | T::Enumeration => set_int!(set_int64, "fmi3SetInt64", i64),
+            T::UInt64 => set_int!(set_uint64, "fmi3SetUInt64", u64),
+            T::Boolean => {
+                let f = f3!(self, a, set_boolean, "fmi3SetBoolean");
+                let buf: Vec<u8> = values.iter().map(|x| (*x != 0.0) as u8).collect();
+                call!(self, "fmi3SetBoolean", None, f(c, &vr, 1, buf.as_ptr(), n))
+            }
+            T::Binary | T::String | T::Clock => Err(Error::InvalidValue {
+                variable: variable(),
+                value: values.first().map(|x| x.to_string()).unwrap_or_default(),
+                reason: "a Binary is recorded as its size and cannot be set".into(),
+            }),
         }
     }
 
-    /// `fmi2SetReal` / `fmi3SetFloat64`.
+    /// Sets element `access.element` of its variable: the other elements keep the values
+    /// set or read before (the start values at first).
+    fn set_element(&mut self, access: crate::fmi3::Access, value: f64) -> Result<()> {
+        if access.count == 1 {
+            return self.set_all(access, &[value]);
+        }
+        let mut values = match self.arrays.remove(&access.vr) {
+            Some(v) => v,
+            None => self.array_start(access)?,
+        };
+        values[access.element] = value;
+        let result = self.set_all(access, &values);
+        self.arrays.insert(access.vr, values);
+        result
+    }
+
+    /// The values an array starts from for element-wise sets: its start values, else what
+    /// the FMU holds.
+    fn array_start(&mut self, access: crate::fmi3::Access) -> Result<Vec<f64>> {
+        use model_description::fmi3::Values;
+        let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+        let start = a.description.variable(access.vr).and_then(|v| v.start.clone());
+        let n = access.count;
+        let spread = |v: Vec<f64>| if v.len() == 1 { vec![v[0]; n] } else { v };
+        match start {
+            Some(Values::Float(v)) if v.len() == n || v.len() == 1 => Ok(spread(v)),
+            Some(Values::Int(v)) if v.len() == n || v.len() == 1 => {
+                Ok(spread(v.into_iter().map(|x| x as f64).collect()))
+            }
+            Some(Values::Boolean(v)) if v.len() == n || v.len() == 1 => {
+                Ok(spread(v.into_iter().map(|x| x as i32 as f64).collect()))
+            }
+            _ => self.get_all(access),
+        }
+    }
+
+    /// `fmi2SetReal` / `fmi3SetFloat64` (the other FMI 3.0 types as for [`Instance::get_real`]).
     #[inline]
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_real: one value per value reference");
         let c = self.component;
+        let special = self.any_special(vrs);
         match &self.fmu.abi {
             Abi::Fmi2(t) => {
                 let f = t.set_real;
                 call!(self, "fmi2SetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
             }
-            Abi::Fmi3(a) => {
+            Abi::Fmi3(a) if !special => {
                 let f = a.functions.set_float64;
                 call!(self, "fmi3SetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()))
             }
-        }
-    }
-
-    /// Whether some of `vrs` are FMI 3.0 Enumerations (accessed as Int64).
-    fn has_enumerations(&self, vrs: &[u32]) -> bool {
-        match &self.fmu.abi {
-            Abi::Fmi3(a) => !a.enumerations.is_empty() && vrs.iter().any(|vr| a.enumerations.contains(vr)),
-            Abi::Fmi2(_) => false,
-        }
-    }
-
-    /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`.
-    #[inline]
-    pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        assert_eq!(vrs.len(), values.len(), "get_integer: one value per value reference");
-        let c = self.component;
-        let enumerations = self.has_enumerations(vrs);
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = t.get_integer;
-                call!(self, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
-            }
-            Abi::Fmi3(a) if !enumerations => {
-                let f = f3!(self, a, get_int32, "fmi3GetInt32");
-                call!(self, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))
-            }
-            Abi::Fmi3(_) => {
-                for (vr, value) in vrs.iter().zip(values.iter_mut()) {
-                    *value = self.get_integer_fmi3(*vr)?;
+            Abi::Fmi3(a) => {
+                let f = a.functions.set_float64;
+                for (vr, value) in vrs.iter().zip(values) {
+                    match self.special(*vr) {
+                        Some(access) => self.set_element(access, *value)?,
+                        None => call!(self, "fmi3SetFloat64", None, f(c, vr, 1, value, 1))?,
+                    }
                 }
                 Ok(())
             }
         }
     }
 
-    fn get_integer_fmi3(&mut self, vr: u32) -> Result<i32> {
+    /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`, Int8 ..
+    /// UInt16 and array elements by their own getters.
+    #[inline]
+    pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        assert_eq!(vrs.len(), values.len(), "get_integer: one value per value reference");
         let c = self.component;
-        let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
-        if a.enumerations.contains(&vr) {
-            let f = f3!(self, a, get_int64, "fmi3GetInt64");
-            let mut wide = 0i64;
-            call!(self, "fmi3GetInt64", None, f(c, &vr, 1, &mut wide, 1))?;
-            i32::try_from(wide).map_err(|_| Error::Fmi {
-                instance: self.name.clone(),
-                function: "fmi3GetInt64",
-                status: Status::Error,
-                time: Some(self.time),
-                log: format!("Enumeration value {wide} of value reference {vr} is outside the Integer range"),
-            })
-        } else {
-            let f = f3!(self, a, get_int32, "fmi3GetInt32");
-            let mut value = 0i32;
-            call!(self, "fmi3GetInt32", None, f(c, &vr, 1, &mut value, 1))?;
-            Ok(value)
+        let special = self.any_special(vrs);
+        match &self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.get_integer;
+                call!(self, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+            }
+            Abi::Fmi3(a) if !special => {
+                let f = f3!(self, a, get_int32, "fmi3GetInt32");
+                call!(self, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))
+            }
+            Abi::Fmi3(a) => {
+                let get32 = a.functions.get_int32;
+                for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                    match self.special(*vr) {
+                        Some(access) => {
+                            let x = self.get_element(access)?;
+                            // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
+                            *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
+                                instance: self.name.clone(),
+                                function: "fmi3GetInt64",
+                                status: Status::Error,
+                                time: Some(self.time),
+                                log: format!("value {x} of value reference {} is outside the Integer range", access.vr),
+                            })?;
+                        }
+                        None => {
+                            let f = self.optional(get32, "fmi3GetInt32")?;
+                            call!(self, "fmi3GetInt32", None, f(c, vr, 1, value, 1))?
+                        }
+                    }
+                }
+                Ok(())
+            }
         }
     }
 
-    /// `fmi2SetInteger`; FMI 3.0: `fmi3SetInt32`, Enumerations by `fmi3SetInt64`.
+    /// `fmi2SetInteger`; FMI 3.0: `fmi3SetInt32`, the other types as for
+    /// [`Instance::get_integer`].
     #[inline]
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_integer: one value per value reference");
         let c = self.component;
-        let enumerations = self.has_enumerations(vrs);
+        let special = self.any_special(vrs);
         match &self.fmu.abi {
             Abi::Fmi2(t) => {
                 let f = t.set_integer;
                 call!(self, "fmi2SetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
             }
-            Abi::Fmi3(a) if !enumerations => {
+            Abi::Fmi3(a) if !special => {
                 let f = f3!(self, a, set_int32, "fmi3SetInt32");
                 call!(self, "fmi3SetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()))
             }
             Abi::Fmi3(a) => {
-                let (set32, set64) = (a.functions.set_int32, a.functions.set_int64);
-                let enums: Vec<bool> = vrs.iter().map(|vr| a.enumerations.contains(vr)).collect();
-                for ((vr, value), is_enum) in vrs.iter().zip(values).zip(enums) {
-                    if is_enum {
-                        let f = self.optional(set64, "fmi3SetInt64")?;
-                        let wide = *value as i64;
-                        call!(self, "fmi3SetInt64", None, f(c, vr, 1, &wide, 1))?;
-                    } else {
-                        let f = self.optional(set32, "fmi3SetInt32")?;
-                        call!(self, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?;
+                let set32 = a.functions.set_int32;
+                for (vr, value) in vrs.iter().zip(values) {
+                    match self.special(*vr) {
+                        Some(access) => self.set_element(access, *value as f64)?,
+                        None => {
+                            let f = self.optional(set32, "fmi3SetInt32")?;
+                            call!(self, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?
+                        }
                     }
                 }
                 Ok(())
@@ -1212,10 +1399,24 @@ impl Instance {
     pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_boolean: one value per value reference");
         let c = self.component;
+        let special = self.any_special(vrs);
         match &self.fmu.abi {
             Abi::Fmi2(t) => {
                 let f = t.get_boolean;
                 call!(self, "fmi2GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+            }
+            Abi::Fmi3(_) if special => {
+                for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                    *value = match self.special(*vr) {
+                        Some(access) => self.get_element(access)? as i32,
+                        None => {
+                            let mut one = [0];
+                            self.get_boolean(&[*vr], &mut one)?;
+                            one[0]
+                        }
+                    };
+                }
+                Ok(())
             }
             Abi::Fmi3(a) => {
                 let f = f3!(self, a, get_boolean, "fmi3GetBoolean");
@@ -1238,10 +1439,20 @@ impl Instance {
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_boolean: one value per value reference");
         let c = self.component;
+        let special = self.any_special(vrs);
         match &self.fmu.abi {
             Abi::Fmi2(t) => {
                 let f = t.set_boolean;
                 call!(self, "fmi2SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+            }
+            Abi::Fmi3(_) if special => {
+                for (vr, value) in vrs.iter().zip(values) {
+                    match self.special(*vr) {
+                        Some(access) => self.set_element(access, (*value != 0) as i32 as f64)?,
+                        None => self.set_boolean(&[*vr], &[*value])?,
+                    }
+                }
+                Ok(())
             }
             Abi::Fmi3(a) => {
                 let f = f3!(self, a, set_boolean, "fmi3SetBoolean");
@@ -1252,6 +1463,25 @@ impl Instance {
                 self.bytes = bytes;
                 r
             }
+        }
+    }
+
+    #[cold]
+    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Error {
+        let k = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+        let variable = self
+            .fmu
+            .description
+            .model_variables
+            .iter()
+            .find(|v| v.is_real() && v.value_reference == vrs[k])
+            .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
+        Error::NonFinite {
+            instance: self.name.clone(),
+            fmu: self.fmu.source.clone(),
+            variable,
+            value: values[k],
+            time: self.time,
         }
     }
 

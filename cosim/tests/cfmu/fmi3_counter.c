@@ -8,6 +8,13 @@
  *   9 k Int32 input             10 m Int32 output (2 k)      11 b Boolean input
  *   12 nb Boolean output (!b)
  *   13 der(y) Float64 local     14 z Float64 local (y - 0.55, the event indicator)
+ * and one output of every other type, derived from y and n:
+ *   15 f32 Float32 (float)y     16 i8 Int8 n - 5            17 u8 UInt8 20 n
+ *   18 i16 Int16 -1000 n        19 u16 UInt16 6000 n        20 u32 UInt32 400000000 n
+ *   21 i64 Int64 -2^40 n        22 u64 UInt64 2^48 n        23 bin Binary of n bytes
+ *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
+ *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
+ *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
@@ -22,6 +29,9 @@ typedef struct {
     int n, k, b, early_done, early_allowed, crossed;
     long long mode;
     char label[64];
+    double gains[2];
+    float f32in;
+    unsigned char bytes[64];
 } State;
 
 typedef struct {
@@ -67,6 +77,9 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
     c->s.mode = 1;
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
+    c->s.gains[0] = 1;
+    c->s.gains[1] = 2;
+    c->s.f32in = 0.5f;
     strcpy(c->s.label, "abc");
     return c;
 }
@@ -98,6 +111,9 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     c->s.mode = 1;
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
+    c->s.gains[0] = 1;
+    c->s.gains[1] = 2;
+    c->s.f32in = 0.5f;
     strcpy(c->s.label, "abc");
     return fmi3OK;
 }
@@ -130,34 +146,46 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Float64 values[], size_t nValues) {
     Counter *c = instance;
-    if (nvr != nValues) return fail(c, "fmi3GetFloat64: nValues != nValueReferences");
+    size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3GetFloat64: nValues too small");
         switch (vr[i]) {
-        case 0: values[i] = c->s.time; break;
-        case 1: values[i] = c->s.u; break;
-        case 2: values[i] = c->s.y; break;
-        case 7: values[i] = c->s.stop_at; break;
-        case 8: values[i] = c->s.early_at; break;
-        case 13: values[i] = (double)c->s.mode * c->s.u; break;
-        case 14: values[i] = c->s.y - 0.55; break;
+        case 0: values[k] = c->s.time; break;
+        case 1: values[k] = c->s.u; break;
+        case 2: values[k] = c->s.y; break;
+        case 7: values[k] = c->s.stop_at; break;
+        case 8: values[k] = c->s.early_at; break;
+        case 13: values[k] = (double)c->s.mode * c->s.u; break;
+        case 14: values[k] = c->s.y - 0.55; break;
+        case 24: values[k] = c->s.y; values[k + 1] = 2 * c->s.y; values[k + 2] = 3 * c->s.y; break;
+        case 25: values[k] = c->s.gains[0]; values[k + 1] = c->s.gains[1]; break;
+        case 26: values[k] = c->s.gains[0] * c->s.y + c->s.gains[1]; break;
         default: return fail(c, "fmi3GetFloat64: no such Float64");
         }
+        k += size;
     }
+    if (k != nValues) return fail(c, "fmi3GetFloat64: nValues is not the number of values");
     return fmi3OK;
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     const fmi3Float64 values[], size_t nValues) {
     Counter *c = instance;
-    if (nvr != nValues) return fail(c, "fmi3SetFloat64: nValues != nValueReferences");
+    size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 25 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3SetFloat64: nValues too small");
         switch (vr[i]) {
-        case 1: c->s.u = values[i]; break;
-        case 7: c->s.stop_at = values[i]; break;
-        case 8: c->s.early_at = values[i]; break;
+        case 1: c->s.u = values[k]; break;
+        case 7: c->s.stop_at = values[k]; break;
+        case 8: c->s.early_at = values[k]; break;
+        case 25: c->s.gains[0] = values[k]; c->s.gains[1] = values[k + 1]; break;
         default: return fail(c, "fmi3SetFloat64: not settable");
         }
+        k += size;
     }
+    if (k != nValues) return fail(c, "fmi3SetFloat64: nValues is not the number of values");
     return fmi3OK;
 }
 
@@ -191,8 +219,9 @@ fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     fmi3Int64 values[], size_t nValues) {
     Counter *c = instance;
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] != 5) return fail(c, "fmi3GetInt64: no such Int64");
-        values[i] = c->s.mode;
+        if (vr[i] == 5) values[i] = c->s.mode;
+        else if (vr[i] == 21) values[i] = -(1LL << 40) * c->s.n;
+        else return fail(c, "fmi3GetInt64: no such Int64");
     }
     return fmi3OK;
 }
@@ -211,15 +240,20 @@ fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Boolean values[], size_t nValues) {
     Counter *c = instance;
+    size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 27 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3GetBoolean: nValues too small");
         switch (vr[i]) {
-        case 4: values[i] = (c->s.n % 2) == 1; break;
-        case 11: values[i] = c->s.b != 0; break;
-        case 12: values[i] = c->s.b == 0; break;
+        case 4: values[k] = (c->s.n % 2) == 1; break;
+        case 11: values[k] = c->s.b != 0; break;
+        case 12: values[k] = c->s.b == 0; break;
+        case 27: values[k] = (c->s.n % 2) == 1; values[k + 1] = (c->s.n % 2) == 0; break;
         default: return fail(c, "fmi3GetBoolean: no such Boolean");
         }
+        k += size;
     }
-    return fmi3OK;
+    return k == nValues ? fmi3OK : fail(c, "fmi3GetBoolean: nValues is not the number of values");
 }
 
 fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
@@ -266,6 +300,54 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *state) {
     free(*state);
     *state = NULL;
+    return fmi3OK;
+}
+
+/* The outputs of the other types (one value each). */
+#define SCALAR_GETTER(T, VR, EXPR) \
+    fmi3Status fmi3Get##T(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3##T values[], size_t nValues) { \
+        Counter *c = instance; \
+        if (nvr != nValues) return fail(c, "fmi3Get" #T ": nValues != nValueReferences"); \
+        for (size_t i = 0; i < nvr; i++) { \
+            if (vr[i] != VR) return fail(c, "fmi3Get" #T ": no such variable"); \
+            values[i] = (fmi3##T)(EXPR); \
+        } \
+        return fmi3OK; \
+    }
+SCALAR_GETTER(Int8, 16, c->s.n - 5)
+SCALAR_GETTER(UInt8, 17, 20 * c->s.n)
+SCALAR_GETTER(Int16, 18, -1000 * c->s.n)
+SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
+SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
+SCALAR_GETTER(UInt64, 22, (1ULL << 48) * (unsigned long long)c->s.n)
+
+fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3GetFloat32: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 15) values[i] = (float)c->s.y;
+        else if (vr[i] == 28) values[i] = c->s.f32in;
+        else if (vr[i] == 29) values[i] = 2 * c->s.f32in;
+        else return fail(c, "fmi3GetFloat32: no such Float32");
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float32 values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 28) return fail(c, "fmi3SetFloat32: not settable");
+        c->s.f32in = values[i];
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
+    fmi3Binary values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 23) return fail(c, "fmi3GetBinary: no such Binary");
+        sizes[i] = (size_t)c->s.n < sizeof c->s.bytes ? (size_t)c->s.n : sizeof c->s.bytes;
+        values[i] = c->s.bytes;
+    }
     return fmi3OK;
 }
 
@@ -337,8 +419,12 @@ UNSUPPORTED(fmi3SetDebugLogging, fmi3Instance i, fmi3Boolean on, size_t n, const
 #define GETSET(T) \
     UNSUPPORTED(fmi3Get##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3##T v[], size_t m) \
     UNSUPPORTED(fmi3Set##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3##T v[], size_t m)
-GETSET(Float32) GETSET(Int8) GETSET(UInt8) GETSET(Int16) GETSET(UInt16) GETSET(UInt32) GETSET(UInt64)
-UNSUPPORTED(fmi3GetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, size_t s[], fmi3Binary v[], size_t m)
+UNSUPPORTED(fmi3SetInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int8 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt8 v[], size_t m)
+UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt64, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 v[], size_t m)
 UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
 UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
 UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])
