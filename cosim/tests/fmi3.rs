@@ -265,6 +265,8 @@ fn cosim_info_and_run() {
         "0.1",
         "--set",
         "u=2",
+        "--set",
+        "gains=[3, 4]",
         "--output",
         csv.to_str().unwrap(),
     ]);
@@ -275,6 +277,14 @@ fn cosim_info_and_run() {
     let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
     let y: f64 = last[col].parse().unwrap();
     assert!((y - 2.0).abs() < 1e-14, "{y}");
+    // the array set whole: gy = 3 y + 4; its elements are columns of their own
+    let gy = header.iter().position(|h| *h == "\"gy\"").unwrap();
+    assert_eq!(last[gy].parse::<f64>().unwrap(), 3.0 * y + 4.0);
+    assert!(header.contains(&"\"arr[3]\""), "{header:?}");
+    let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "1", "--set", "gains=[1 2 3]"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("3 values for the 2 elements of the array"), "{err}");
 }
 
 /// fmpy 0.3.32 runs the same FMU with the same step and start values of every type the
