@@ -434,6 +434,8 @@ fn fmi2_and_fmi3_instances_in_one_system() {
     let ssp = dir.join("mixed.ssp");
     write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
     let from_ssp = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
+    let out = cosim(&["info", ssp.to_str().unwrap()]);
+    assert!(out.status.success(), "cosim info of the mixed SSP: {}", String::from_utf8_lossy(&out.stderr));
     for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
         let experiment = Experiment { algorithm, ..Experiment::new(1.0, 0.1) };
         let (r, _) = simulate(&system, &experiment).unwrap();
@@ -488,4 +490,27 @@ fn every_type_and_array_elements_are_recorded() {
     inst.set_real(&[n_vr], &[3.0]).unwrap();
     let e = inst.set_real(&[fmu.description().variable("bin").unwrap().value_reference], &[1.0]).unwrap_err();
     assert!(e.to_string().contains("c.bin") && e.to_string().contains("cannot be set"), "{e}");
+}
+
+/// `--isolate=run` runs an FMI 3.0 FMU in the host of the whole run (called directly there):
+/// the same rows as in process; `--isolate=fmu` (a host per FMU, FMI 2.0's protocol) is
+/// refused naming the feature.
+#[test]
+fn isolation_of_fmi3_fmus() {
+    let Some((dir, path)) = counter("fmi3-isolate") else { return };
+    let run = |extra: &[&str], out: &Path| {
+        let mut args =
+            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        cosim(&args)
+    };
+    let (plain, hosted) = (dir.join("plain.csv"), dir.join("hosted.csv"));
+    assert!(run(&[], &plain).status.success());
+    let out = run(&["--isolate=run"], &hosted);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
+    let out = run(&["--isolate"], &dir.join("refused.csv"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("FMI 3.0 instances in host processes (--isolate)"), "{err}");
 }

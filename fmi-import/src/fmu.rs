@@ -278,6 +278,106 @@ fn checked_fmi3(xml: &str, path: &Path) -> Result<model_description::fmi3::Model
     Ok(md)
 }
 
+/// The table of an FMI 3.0 FMU imported isolated (its library never loaded here): the
+/// core functions are stubs that return fmi3Error, the others absent. No instance is ever
+/// made from it in this process ([`Instance::new`] refuses isolated FMUs).
+fn unloaded_fmi3_table() -> fmi_sys::fmi3::Fmi3Functions {
+    use fmi_sys::fmi3::*;
+    unsafe extern "C" fn version() -> *const c_char {
+        c"3.0".as_ptr()
+    }
+    unsafe extern "C" fn free(_: fmi3Instance) {}
+    unsafe extern "C" fn enter(_: fmi3Instance, _: fmi3Boolean, _: f64, _: f64, _: fmi3Boolean, _: f64) -> fmi3Status {
+        Fmi3Status::Error as fmi3Status
+    }
+    unsafe extern "C" fn one(_: fmi3Instance) -> fmi3Status {
+        Fmi3Status::Error as fmi3Status
+    }
+    unsafe extern "C" fn get(_: fmi3Instance, _: *const u32, _: usize, _: *mut f64, _: usize) -> fmi3Status {
+        Fmi3Status::Error as fmi3Status
+    }
+    unsafe extern "C" fn set(_: fmi3Instance, _: *const u32, _: usize, _: *const f64, _: usize) -> fmi3Status {
+        Fmi3Status::Error as fmi3Status
+    }
+    Fmi3Functions {
+        get_version: version,
+        free_instance: free,
+        enter_initialization_mode: enter,
+        exit_initialization_mode: one,
+        terminate: one,
+        get_float64: get,
+        set_float64: set,
+        set_debug_logging: None,
+        instantiate_model_exchange: None,
+        instantiate_co_simulation: None,
+        instantiate_scheduled_execution: None,
+        enter_event_mode: None,
+        reset: None,
+        get_float32: None,
+        get_int8: None,
+        get_uint8: None,
+        get_int16: None,
+        get_uint16: None,
+        get_int32: None,
+        get_uint32: None,
+        get_int64: None,
+        get_uint64: None,
+        get_boolean: None,
+        get_string: None,
+        get_binary: None,
+        get_clock: None,
+        set_float32: None,
+        set_int8: None,
+        set_uint8: None,
+        set_int16: None,
+        set_uint16: None,
+        set_int32: None,
+        set_uint32: None,
+        set_int64: None,
+        set_uint64: None,
+        set_boolean: None,
+        set_string: None,
+        set_binary: None,
+        set_clock: None,
+        get_number_of_variable_dependencies: None,
+        get_variable_dependencies: None,
+        get_fmu_state: None,
+        set_fmu_state: None,
+        free_fmu_state: None,
+        serialized_fmu_state_size: None,
+        serialize_fmu_state: None,
+        deserialize_fmu_state: None,
+        get_directional_derivative: None,
+        get_adjoint_derivative: None,
+        enter_configuration_mode: None,
+        exit_configuration_mode: None,
+        get_interval_decimal: None,
+        get_interval_fraction: None,
+        get_shift_decimal: None,
+        get_shift_fraction: None,
+        set_interval_decimal: None,
+        set_interval_fraction: None,
+        set_shift_decimal: None,
+        set_shift_fraction: None,
+        evaluate_discrete_states: None,
+        update_discrete_states: None,
+        enter_continuous_time_mode: None,
+        completed_integrator_step: None,
+        set_time: None,
+        set_continuous_states: None,
+        get_continuous_state_derivatives: None,
+        get_event_indicators: None,
+        get_continuous_states: None,
+        get_nominals_of_continuous_states: None,
+        get_number_of_event_indicators: None,
+        get_number_of_continuous_states: None,
+        enter_step_mode: None,
+        get_output_derivatives: None,
+        do_step: None,
+        activate_model_partition: None,
+    }
+}
+
 /// The problems of an FMI 3.0 description that make its import wrong, refused at load.
 const FMI3_REFUSED: &[model_description::fmi3::Rule] = {
     use model_description::fmi3::Rule as R;
@@ -422,12 +522,6 @@ impl Fmu {
         let path = shown_path.as_path();
         let refuse = |reason: String| Error::ModelDescription { path: path.to_path_buf(), reason };
         let md = checked_fmi3(xml, path)?;
-        if options.isolated {
-            return Err(Error::Unsupported {
-                path: path.to_path_buf(),
-                feature: "FMI 3.0 instances in host processes (--isolate)".into(),
-            });
-        }
         let (description, special, not_in_view) = crate::fmi3::fmi2_view(&md);
         let interface = match options.interface {
             Some(i) => i,
@@ -448,10 +542,19 @@ impl Fmu {
             return Err(Error::MissingBinary { expected: relative, platforms });
         }
         let shown = path.join(&relative);
-        let library = load_library(&so, &shown, &relative)?;
-        // SAFETY: the symbols are declared with the C signatures of the FMI 3.0 headers.
-        let functions = unsafe { fmi_sys::fmi3::Fmi3Functions::load(&library) }
-            .map_err(|missing| Error::MissingSymbol { path: shown.clone(), symbol: missing.0 })?;
+        let (library, functions) = if options.isolated {
+            // read and checked only: nothing of the library runs in this process
+            let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
+            crate::elf::check_shared_library(&bytes)
+                .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
+            (None, unloaded_fmi3_table())
+        } else {
+            let library = load_library(&so, &shown, &relative)?;
+            // SAFETY: the symbols are declared with the C signatures of the FMI 3.0 headers.
+            let functions = unsafe { fmi_sys::fmi3::Fmi3Functions::load(&library) }
+                .map_err(|missing| Error::MissingSymbol { path: shown.clone(), symbol: missing.0 })?;
+            (Some(library), functions)
+        };
         let needs: &[&str] = match interface {
             Interface::CoSimulation => &["fmi3InstantiateCoSimulation", "fmi3DoStep"],
             Interface::ModelExchange => &[
@@ -467,7 +570,7 @@ impl Fmu {
                 "fmi3GetContinuousStates",
             ],
         };
-        if let Some(symbol) = needs.iter().find(|s| !functions.has(s)) {
+        if let Some(symbol) = needs.iter().find(|s| library.is_some() && !functions.has(s)) {
             return Err(Error::MissingSymbol { path: shown, symbol });
         }
         let token =
@@ -483,7 +586,7 @@ impl Fmu {
                 resource_path,
             })),
             allow_non_finite: options.allow_non_finite,
-            _library: Some(library),
+            _library: library,
             description,
             interface,
             source: path.to_path_buf(),
