@@ -363,9 +363,22 @@ fn model_exchange_integrates_and_finds_the_state_event() {
     for k in 0..11 {
         // a few roundings of values up to 2 per step
         assert!((y[k] - 2.0 * time[k]).abs() < 64.0 * f64::EPSILON, "t = {}: y = {}", time[k], y[k]);
-        // 2 t crosses 0.55 at t = 0.275
-        assert_eq!(n[k], if time[k] > 0.275 { 1.0 } else { 0.0 }, "t = {}", time[k]);
+        // 2 t crosses 0.55 at t = 0.275 (+1), the time event at 0.75 (+10)
+        let expected = if time[k] > 0.275 { 1.0 } else { 0.0 } + if time[k] >= 0.75 { 10.0 } else { 0.0 };
+        assert_eq!(n[k], expected, "t = {}", time[k]);
     }
+}
+
+/// Model Exchange: terminateSimulation from fmi3UpdateDiscreteStates at the time event at
+/// stop_at ends the run there, the last row the communication point before it.
+#[test]
+fn model_exchange_terminates_at_the_time_event() {
+    let Some((_dir, path)) = counter("fmi3-me-end") else { return };
+    let system = model_exchange(&path, &[("stop_at", Value::Real(0.62))]);
+    let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end, reason), ("c", 0.62, "terminateSimulation"));
+    assert_eq!(r.rows(), 7, "rows 0 .. 0.6");
 }
 
 /// fmpy 0.3.32 integrates the same FMU in Model Exchange (CVode): the same event count, and
@@ -391,7 +404,7 @@ with open(sys.argv[2], 'w') as f:
         .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
         .collect();
     let (r, _) = simulate(&model_exchange(&path, &[("u", Value::Real(1.0))]), &Experiment::new(1.0, 0.1)).unwrap();
-    assert_eq!(*r.column("n").unwrap().last().unwrap(), 1.0, "y = t crossed 0.55");
+    assert_eq!(*r.column("n").unwrap().last().unwrap(), 11.0, "y = t crossed 0.55 (+1), the time event at 0.75 (+10)");
     // fmpy records rows before and after the event at t = 0.55 besides: the grid's only
     let at_grid: Vec<&Vec<f64>> =
         theirs.iter().filter(|row| (row[0] * 10.0 - (row[0] * 10.0).round()).abs() < 1e-9).collect();

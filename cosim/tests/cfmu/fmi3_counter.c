@@ -18,15 +18,15 @@
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
- * indicator z = y - 0.55 crossing zero is counted in n, and the event at or after stop_at
- * says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
+ * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
+ * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
 #include <stdlib.h>
 #include <string.h>
 #include "fmi3Functions.h"
 
 typedef struct {
     double time, u, y, stop_at, early_at;
-    int n, k, b, early_done, early_allowed, crossed;
+    int n, k, b, early_done, early_allowed, crossed, timed;
     long long mode;
     char label[64];
     double gains[2];
@@ -365,12 +365,16 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
         s->crossed = 1;
         s->n += 1;
     }
+    if (!s->timed && s->time >= 0.75) {
+        s->timed = 1;
+        s->n += 10;
+    }
     *needUpdate = fmi3False;
     *terminate = s->time >= s->stop_at;
     *nominalsChanged = fmi3False;
     *valuesChanged = fmi3False;
-    *nextDefined = fmi3False;
-    *next = 0;
+    *nextDefined = !s->timed || s->stop_at < 1e300;
+    *next = !s->timed && 0.75 < s->stop_at ? 0.75 : s->stop_at;
     return fmi3OK;
 }
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
