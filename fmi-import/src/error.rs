@@ -263,8 +263,8 @@ pub enum Error {
     },
     /// An FMU ended the simulation itself, as FMI 2 lets it: in Co-Simulation
     /// `fmi2DoStep` returned fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)` true,
-    /// in Model Exchange `terminateSimulation` was set. [`crate::simulate()`] ends the run
-    /// there and returns its results (with [`crate::Summary::ended_by`]); the step
+    /// in Model Exchange `terminateSimulation` was set. `nigel_cosim::simulate()` ends the run
+    /// there and returns its results (with `nigel_cosim::Summary::ended_by`); the step
     /// functions return this variant to it.
     Terminated {
         /// The instance that ended the run.
