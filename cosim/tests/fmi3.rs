@@ -95,11 +95,11 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 30);
+    assert_eq!(md3.model_variables.len(), 31);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
     // the three arrays as their 3 + 2 + 2 elements
-    assert_eq!(view.model_variables.len(), 34);
+    assert_eq!(view.model_variables.len(), 35);
     let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
@@ -522,6 +522,15 @@ fn isolation_of_fmi3_fmus() {
     let out = run(&["--isolate=run"], &hosted);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
+    // a crash in fmi3DoStep ends only the host: a typed error naming the call, the rows so far
+    let crashed = dir.join("crashed.csv");
+    let out = run(&["--isolate=run", "--set", "crash_at=0.45"], &crashed);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let want = "cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during fmi3DoStep at t = 0.5 s";
+    assert!(err.lines().any(|l| l == want), "{err}");
+    let rows = std::fs::read_to_string(&crashed).unwrap().lines().count() - 1;
+    assert_eq!(rows, 6, "the rows 0 .. 0.5: {err}");
     let out = run(&["--isolate"], &dir.join("refused.csv"));
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);

@@ -15,6 +15,7 @@
  *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
  *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
  *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
+ *   30 crash_at Float64 parameter: the step that starts at or after it writes through NULL
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
@@ -25,7 +26,7 @@
 #include "fmi3Functions.h"
 
 typedef struct {
-    double time, u, y, stop_at, early_at;
+    double time, u, y, stop_at, early_at, crash_at;
     int n, k, b, early_done, early_allowed, crossed, timed;
     long long mode;
     char label[64];
@@ -77,6 +78,7 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
     c->s.mode = 1;
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
+    c->s.crash_at = 1e300;
     c->s.gains[0] = 1;
     c->s.gains[1] = 2;
     c->s.f32in = 0.5f;
@@ -111,6 +113,7 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     c->s.mode = 1;
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
+    c->s.crash_at = 1e300;
     c->s.gains[0] = 1;
     c->s.gains[1] = 2;
     c->s.f32in = 0.5f;
@@ -127,6 +130,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;
+    if (t >= s->crash_at) *(volatile int *)0 = 1;
     if (s->early_allowed && !s->early_done && s->early_at > t && s->early_at < end) {
         s->early_done = 1;
         s->y += (double)s->mode * s->u * (s->early_at - t);
@@ -161,6 +165,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         case 24: values[k] = c->s.y; values[k + 1] = 2 * c->s.y; values[k + 2] = 3 * c->s.y; break;
         case 25: values[k] = c->s.gains[0]; values[k + 1] = c->s.gains[1]; break;
         case 26: values[k] = c->s.gains[0] * c->s.y + c->s.gains[1]; break;
+        case 30: values[k] = c->s.crash_at; break;
         default: return fail(c, "fmi3GetFloat64: no such Float64");
         }
         k += size;
@@ -181,6 +186,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         case 7: c->s.stop_at = values[k]; break;
         case 8: c->s.early_at = values[k]; break;
         case 25: c->s.gains[0] = values[k]; c->s.gains[1] = values[k + 1]; break;
+        case 30: c->s.crash_at = values[k]; break;
         default: return fail(c, "fmi3SetFloat64: not settable");
         }
         k += size;
