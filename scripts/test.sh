@@ -29,6 +29,16 @@ export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 echo "== Rust tests"
 cargo test --release --workspace --no-fail-fast
+echo "== the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
+# the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
+# read or write, a use after free or a double free in the layer stops the test
+rustup toolchain install nightly --profile minimal >/dev/null 2>&1 || true
+asan_test() {
+    RUSTFLAGS="-Zsanitizer=address" cargo +nightly test --target x86_64-unknown-linux-gnu \
+        --target-dir "$target_dir/asan" -p "$1" --test "$2"
+}
+asan_test fmi-export toy
+asan_test fmu-plant fmi3
 echo "== synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"

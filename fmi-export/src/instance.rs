@@ -274,11 +274,10 @@ impl<M: Model> Instance<M> {
         if let Some(missing) = function.undeclared_feature() {
             return err(format!("not supported: {missing}"));
         }
-        match (function, interface) {
-            (Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates, Interface::CoSimulation) => {
-                return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
-            }
-            _ => {}
+        if interface == Interface::CoSimulation
+            && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates)
+        {
+            return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
         }
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
@@ -1049,49 +1048,71 @@ impl<M: Model> Instance<M> {
 
     // ---------------------------------------------------------------- FMI 3.0 access
 
-    /// The FMI 2.0 value references (of the base type that `accessed` is in FMI 2.0) of the
-    /// FMI 3.0 value references `vrs`, each checked to be a variable of type `accessed`
-    /// (`function` names the call in the messages). `time` (0) is refused: the callers that
-    /// accept it handle it before.
-    pub fn fmi2_references(&self, vrs: &[u32], accessed: ValueType3) -> OpResult<Vec<u32>> {
+    /// The FMI 2.0 value reference (of the base type that `accessed` is in FMI 2.0) of the
+    /// FMI 3.0 value reference `vr`, checked to be a variable of type `accessed`. `time` (0)
+    /// is refused: the callers that accept it handle it before.
+    fn fmi2_reference(vr: u32, accessed: ValueType3) -> OpResult<u32> {
         let d = decl::<M>();
-        vrs.iter()
-            .map(|&vr| {
-                let Some(v) = d.variable3(vr) else {
-                    return err(format!(
-                        "unknown value reference {vr} (the FMU's are 0 ..= {})",
-                        d.spec.variables.len()
-                    ));
-                };
-                if v.value_type != accessed {
-                    return err(format!(
-                        "value reference {vr} is {}, a {} variable, not a {} one",
-                        v.name,
-                        v.value_type.element(),
-                        accessed.element()
-                    ));
-                }
-                match d.row3(vr) {
-                    Some(row) => Ok(d.variable(row).value_reference),
-                    None => err(format!("value reference {vr} is {}, the independent variable", v.name)),
-                }
-            })
-            .collect()
+        let Some(v) = d.variable3(vr) else {
+            return err(format!("unknown value reference {vr} (the FMU's are 0 ..= {})", d.spec.variables.len()));
+        };
+        if v.value_type != accessed {
+            return err(format!(
+                "value reference {vr} is {}, a {} variable, not a {} one",
+                v.name,
+                v.value_type.element(),
+                accessed.element()
+            ));
+        }
+        match d.row3(vr) {
+            Some(row) => Ok(d.variable(row).value_reference),
+            None => err(format!("value reference {vr} is {}, the independent variable", v.name)),
+        }
+    }
+
+    /// [`Instance::fmi2_reference`] of each of `vrs`, all checked before any is used.
+    pub fn fmi2_references(&self, vrs: &[u32], accessed: ValueType3) -> OpResult<Vec<u32>> {
+        vrs.iter().map(|&vr| Self::fmi2_reference(vr, accessed)).collect()
+    }
+
+    /// Runs `f` with the FMI 2.0 value references of `vrs` ([`Instance::fmi2_references`]):
+    /// on the stack for the calls a master makes at every communication point (up to 64
+    /// values), so that the FMI 3.0 getters and setters allocate no more than FMI 2.0's.
+    fn with_fmi2_references<T>(
+        &mut self,
+        vrs: &[u32],
+        accessed: ValueType3,
+        f: impl FnOnce(&mut Self, &[u32]) -> OpResult<T>,
+    ) -> OpResult<T> {
+        const ON_STACK: usize = 64;
+        if vrs.len() <= ON_STACK {
+            let mut buffer = [0u32; ON_STACK];
+            for (slot, &vr) in buffer.iter_mut().zip(vrs) {
+                *slot = Self::fmi2_reference(vr, accessed)?;
+            }
+            f(self, &buffer[..vrs.len()])
+        } else {
+            let vrs2 = self.fmi2_references(vrs, accessed)?;
+            f(self, &vrs2)
+        }
     }
 
     /// `fmi3GetFloat64`: the Float64 variables, `time` (value reference 0) included.
     pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         if !vrs.contains(&0) {
-            let vrs2 = self.fmi2_references(vrs, ValueType3::Float64)?;
-            return self.get_real(&vrs2, out);
+            return self.with_fmi2_references(vrs, ValueType3::Float64, |i, vrs2| i.get_real(vrs2, out));
         }
-        let vrs2 =
-            self.fmi2_references(&vrs.iter().copied().filter(|&vr| vr != 0).collect::<Vec<_>>(), ValueType3::Float64)?;
+        let others: Vec<u32> = vrs.iter().copied().filter(|&vr| vr != 0).collect();
+        let vrs2 = self.fmi2_references(&others, ValueType3::Float64)?;
         let mut values = vec![0.0; vrs2.len()];
         self.get_real(&vrs2, &mut values)?;
         let mut values = values.into_iter();
         for (o, &vr) in out.iter_mut().zip(vrs) {
-            *o = if vr == 0 { self.core.time } else { values.next().unwrap_or(f64::NAN) };
+            if vr == 0 {
+                *o = self.core.time;
+            } else if let Some(x) = values.next() {
+                *o = x;
+            }
         }
         Ok(())
     }
@@ -1102,14 +1123,12 @@ impl<M: Model> Instance<M> {
             return err("time (value reference 0) cannot be set: it is the independent variable, \
                  advanced by fmi3DoStep or set by fmi3SetTime");
         }
-        let vrs2 = self.fmi2_references(vrs, ValueType3::Float64)?;
-        self.set_real(&vrs2, values)
+        self.with_fmi2_references(vrs, ValueType3::Float64, |i, vrs2| i.set_real(vrs2, values))
     }
 
     /// `fmi3GetInt32` (Integers) or `fmi3GetInt64` (Enumerations).
     pub fn get_int(&mut self, vrs: &[u32], accessed: ValueType3, out: &mut [i32]) -> OpResult {
-        let vrs2 = self.fmi2_references(vrs, accessed)?;
-        self.get_integer(&vrs2, out)
+        self.with_fmi2_references(vrs, accessed, |i, vrs2| i.get_integer(vrs2, out))
     }
 
     /// `fmi3SetInt32` (Integers) or `fmi3SetInt64` (Enumerations): values outside the

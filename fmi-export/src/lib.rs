@@ -1,12 +1,44 @@
-//! The one shared FMI 2.0 export layer of nigel-fmi.
+//! The one shared FMI export layer of nigel-fmi, for FMI 2.0 and FMI 3.0 from one
+//! declaration.
 //!
 //! A model implements the safe [`Model`] trait and declares its variables once in a
-//! [`DeclarationSpec`]; this crate owns everything else: the C ABI (all 44 `fmi2*`
-//! functions, exported unmangled by [`export_fmi!`]), the instance state machine (one
-//! table of allowed states, [`states`]), the GUID check, typed logging through the
-//! importer's callback ([`Logger`]), time events and event iteration, FMU state
-//! get/set/serialize, and the generation of `modelDescription.xml` from the same
-//! declaration the binary dispatches on.
+//! [`DeclarationSpec`]; this crate owns everything else: both C ABIs (the 44 `fmi2*` and
+//! the 75 `fmi3*` functions, exported unmangled from one library by [`export_fmi!`]), the
+//! instance state machine (one table of allowed states for both generations, [`states`]),
+//! the GUID / instantiation-token check, typed logging through the importer's callback
+//! ([`Logger`]), time events and event iteration, FMU state get/set/serialize, directional
+//! and adjoint derivatives, and the generation of both `modelDescription.xml` files from
+//! the same declaration the binary dispatches on.
+//!
+//! # One declaration, two generations
+//!
+//! The shape of the layer: one [`instance::Instance`] (the state machine, the variable
+//! table, the semantics) under two thin C ABIs, [`abi::fmi2`] and [`abi::fmi3`], which
+//! only turn pointers into slices and value references into rows. A model gets both
+//! generations without writing anything per generation:
+//!
+//! - [`Declaration::xml`] is the FMI 2.0 `modelDescription.xml`, [`Declaration::xml3`]
+//!   the FMI 3.0 one ([`Declaration::model_description3`] as types): the same variables,
+//!   names, causalities, variabilities, initial, units, ranges, starts and descriptions as
+//!   typed elements (Real as `Float64`, Integer as `Int32`, Boolean, an enumeration as
+//!   `Enumeration` with its `<EnumerationType>`), the independent variable `time` at value
+//!   reference 0 and declaration row `r` at value reference `r + 1` (pinned next to the
+//!   FMI 2.0 ones in each FMU's value-reference table), the FMI 2.0 GUID as
+//!   `instantiationToken` (one library checks either), the ModelStructure by value
+//!   reference, `providesAdjointDerivatives` wherever directional derivatives are declared.
+//! - FMI 3.0 reads and writes an Enumeration through `fmi3GetInt64`/`fmi3SetInt64`; any
+//!   type the model has no variable of (Float32, the 8/16-bit and unsigned integers,
+//!   String, Binary, Clock) is an error naming the value reference and its actual type.
+//! - `fmi3GetAdjointDerivative` is `J^T w` computed by the layer from the columns of `J`
+//!   (one [`Model::directional_derivative`] per known, then the transposed product: exact
+//!   to rounding), in every mode the directional derivatives are offered.
+//! - Co-Simulation without Event Mode, early return or intermediate update; Model Exchange
+//!   with `fmi3UpdateDiscreteStates` in place of `fmi2NewDiscreteStates`. The functions of
+//!   features the FMUs do not declare (Scheduled Execution, clocks, Configuration Mode,
+//!   `fmi3EvaluateDiscreteStates`, `fmi3GetOutputDerivatives`, `fmi3EnterStepMode`) answer
+//!   `fmi3Error` with a logged message naming the function.
+//! - A serialized FMU state has one format: bytes from either generation restore into an
+//!   instance of the other.
 //!
 //! # Writing a new FMU
 //!
@@ -53,10 +85,12 @@
 //!      and discrete states must be settable by binding), plus [`Model::save_internal`] /
 //!      [`Model::load_internal`] for data that is no variable (a sample counter). A loaded
 //!      state goes through the same checks as `fmi2Set*` and `exit_initialization`.
-//! 4. `fmi_export::export_fmi!(MyModel);` under `#[cfg(feature = "fmi-export")]`, and one
-//!    entry `FmuTarget::of::<MyModel>("fmu-xyz", EQUATIONS_HTML)` in `build-fmu`'s list:
-//!    the identifier, interfaces and documentation come from the declaration, and the
-//!    generic C-ABI and fmpy tests then cover the new FMU.
+//! 4. `fmi_export::export_fmi!(MyModel);` under `#[cfg(feature = "fmi-export")]` (the
+//!    fmi2* and fmi3* symbols), and one entry `FmuTarget::of::<MyModel>("fmu-xyz",
+//!    EQUATIONS_HTML)` in `build-fmu`'s list: the identifier, interfaces and documentation
+//!    come from the declaration, and the generic C-ABI and fmpy tests then cover the new
+//!    FMU in both generations (`testing::assert_cs_runs_agree` compares its two
+//!    Co-Simulation runs to the bit).
 //!
 //! The layer checks value references, base types, the state table, who may be set when
 //! (fixed parameters only before initialization ends, tunable ones between steps and in
@@ -125,8 +159,9 @@
 //! (categories, the logger); [`fmu_state`] (the byte format of a serialized FMU state);
 //! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
 //! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
-//! the FMI semantics over a model); [`abi`] (the C entry points); with the feature
-//! `testing`, `testing` (the in-process importer of the FMU crates' tests).
+//! the FMI semantics over a model); [`abi`] (the C entry points: [`abi::fmi2`],
+//! [`abi::fmi3`]); with the feature `testing`, `testing` (the in-process importer of the
+//! FMU crates' tests, both generations).
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -6,16 +6,17 @@
 //! One machine serves both generations. FMI 3.0's states are FMI 2.0's where they
 //! coincide: Instantiated, Initialization Mode, Event Mode and Continuous-Time Mode (Model
 //! Exchange), Terminated, and the error state; FMI 3.0's Step Mode is
-//! [`Machine::StepComplete`], and [`Machine::StepFailed`] is Step Mode after a step that
-//! returned Discard (in FMI 3.0 as in FMI 2.0 the importer may then read, terminate,
-//! restore an FMU state or reset, but not step). An FMU of ours declares no Event Mode for
+//! [`Machine::StepComplete`], and [`Machine::StepFailed`] is FMI 3.0's Step Discarded (FMI
+//! 2.0's stepFailed), after a step that returned Discard: the importer may then read,
+//! terminate, restore an FMU state or reset, but not step. An FMU of ours declares no Event Mode for
 //! Co-Simulation, no clocks and no Configuration Mode, so those FMI 3.0 states never occur.
 //! An FMI 3.0 function that does the same as an FMI 2.0 one has that one's row
 //! ([`Function::counterpart`]).
 
 use model_description::{Causality, Initial, Variability};
 
-/// The FMI 2.0 instance states a synchronous FMU can be in.
+/// The instance states a synchronous FMU can be in (FMI 2.0's names; FMI 3.0's in the
+/// module documentation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Machine {
     Instantiated,

@@ -1,6 +1,6 @@
 //! A tiny in-process importer over the layer's C entry points (`fmi_export::abi`, what
-//! `export_fmi!` exports from the shared library), for the tests of the layer and of the
-//! FMU crates: it instantiates a model type directly, without building or loading a
+//! `export_fmi!` exports from the shared library; [`Fmu`] for FMI 2.0, [`Fmu3`] for FMI
+//! 3.0), for the tests of the layer and of the FMU crates: it instantiates a model type directly, without building or loading a
 //! library, and records the log (through the logger shim of `fmi-sys`, as a real importer
 //! receives it) so that tests can check the messages. Behind the feature `testing`, which
 //! the FMU crates enable from their dev-dependencies.
@@ -207,4 +207,420 @@ impl<M: Model> Drop for Fmu<M> {
     fn drop(&mut self) {
         unsafe { abi::free_instance::<M>(self.c) }
     }
+}
+
+// ------------------------------------------------------------------ FMI 3.0
+
+use crate::abi::fmi3 as abi3;
+pub use fmi_sys::fmi3::Fmi3Status;
+use fmi_sys::fmi3::{fmi3FMUState, fmi3Instance, fmi3Status, FMI3_FALSE, FMI3_TRUE};
+
+pub const OK3: Fmi3Status = Fmi3Status::Ok;
+pub const ERR3: Fmi3Status = Fmi3Status::Error;
+pub const DISCARD3: Fmi3Status = Fmi3Status::Discard;
+
+/// The importer's `fmi3LogMessageCallback`: the environment is the instance's [`Log`].
+unsafe extern "C" fn log_message(
+    environment: *mut std::ffi::c_void,
+    status: fmi3Status,
+    category: *const std::ffi::c_char,
+    message: *const std::ffi::c_char,
+) {
+    let text = |p: *const std::ffi::c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned()
+        }
+    };
+    if let Some(log) = (environment as *const Log).as_ref() {
+        log.0.borrow_mut().push((status, text(category), text(message)));
+    }
+}
+
+/// What `fmi3DoStep` reported besides its status.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepOutcome {
+    pub status: Fmi3Status,
+    pub event_handling_needed: bool,
+    pub terminate_simulation: bool,
+    pub early_return: bool,
+    pub last_successful_time: f64,
+}
+
+/// What `fmi3UpdateDiscreteStates` reported.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteUpdate {
+    pub discrete_states_need_update: bool,
+    pub terminate_simulation: bool,
+    pub next_event_time: Option<f64>,
+}
+
+/// One FMI 3.0 instance of `M` through the layer's `fmi3*` entry points, freed on drop.
+pub struct Fmu3<M: Model> {
+    pub c: fmi3Instance,
+    pub log: Box<Log>,
+    _m: std::marker::PhantomData<M>,
+}
+
+impl<M: Model> Fmu3<M> {
+    /// `fmi3InstantiateCoSimulation` with `token` and `eventModeUsed`; `None` (and the log)
+    /// when the layer refuses.
+    pub fn try_cs(token: &str, event_mode_used: bool) -> Result<Self, Box<Log>> {
+        let log = Box::<Log>::default();
+        let name = CString::new("test3").unwrap();
+        let token = CString::new(token).unwrap();
+        let env = &*log as *const Log as *mut std::ffi::c_void;
+        let c = unsafe {
+            abi3::instantiate_co_simulation::<M>(
+                name.as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                FMI3_FALSE,
+                FMI3_TRUE,
+                event_mode_used as u8,
+                FMI3_FALSE,
+                std::ptr::null(),
+                0,
+                env,
+                Some(log_message),
+                None,
+            )
+        };
+        if c.is_null() {
+            Err(log)
+        } else {
+            Ok(Fmu3 { c, log, _m: std::marker::PhantomData })
+        }
+    }
+
+    /// `fmi3InstantiateModelExchange` with `token`.
+    pub fn try_me(token: &str) -> Result<Self, Box<Log>> {
+        let log = Box::<Log>::default();
+        let name = CString::new("test3").unwrap();
+        let token = CString::new(token).unwrap();
+        let env = &*log as *const Log as *mut std::ffi::c_void;
+        let c = unsafe {
+            abi3::instantiate_model_exchange::<M>(
+                name.as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                FMI3_FALSE,
+                FMI3_TRUE,
+                env,
+                Some(log_message),
+            )
+        };
+        if c.is_null() {
+            Err(log)
+        } else {
+            Ok(Fmu3 { c, log, _m: std::marker::PhantomData })
+        }
+    }
+
+    /// A Co-Simulation instance with the right token; panics with the log if refused.
+    pub fn cs() -> Self {
+        Self::try_cs(M::declaration().guid(), false).unwrap_or_else(|log| panic!("{:?}", log.0.borrow()))
+    }
+
+    /// A Model Exchange instance with the right token; panics with the log if refused.
+    pub fn me() -> Self {
+        Self::try_me(M::declaration().guid()).unwrap_or_else(|log| panic!("{:?}", log.0.borrow()))
+    }
+
+    /// The last message logged with status Error or worse.
+    pub fn last_error(&self) -> String {
+        self.log.0.borrow().iter().rev().find(|r| r.0 >= 3).map(|r| r.2.clone()).unwrap_or_default()
+    }
+
+    /// `fmi3EnterInitializationMode(start, stop)` (no tolerance).
+    pub fn enter_init(&self, start: f64, stop: Option<f64>) -> Fmi3Status {
+        unsafe {
+            abi3::enter_initialization_mode::<M>(
+                self.c,
+                FMI3_FALSE,
+                0.0,
+                start,
+                stop.is_some() as u8,
+                stop.unwrap_or(0.0),
+            )
+        }
+    }
+
+    pub fn exit_init(&self) -> Fmi3Status {
+        unsafe { abi3::exit_initialization_mode::<M>(self.c) }
+    }
+
+    /// Enter and exit initialization at `start` with an optional stop time, all Ok.
+    pub fn init_until(&self, start: f64, stop: Option<f64>) {
+        assert_eq!(self.enter_init(start, stop), OK3, "{}", self.last_error());
+        assert_eq!(self.exit_init(), OK3, "{}", self.last_error());
+    }
+
+    pub fn get_float64(&self, vrs: &[u32], out: &mut [f64]) -> Fmi3Status {
+        unsafe { abi3::get_float64::<M>(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr(), out.len()) }
+    }
+
+    pub fn float64(&self, vr: u32) -> f64 {
+        let mut x = [f64::NAN];
+        assert_eq!(self.get_float64(&[vr], &mut x), OK3, "fmi3GetFloat64({vr}): {}", self.last_error());
+        x[0]
+    }
+
+    pub fn set_float64(&self, vrs: &[u32], values: &[f64]) -> Fmi3Status {
+        unsafe { abi3::set_float64::<M>(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()) }
+    }
+
+    pub fn int32(&self, vr: u32) -> i32 {
+        let mut x = [-7];
+        let s = unsafe { abi3::get_int32::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        x[0]
+    }
+
+    pub fn set_int32(&self, vr: u32, x: i32) -> Fmi3Status {
+        unsafe { abi3::set_int32::<M>(self.c, &vr, 1, &x, 1) }
+    }
+
+    pub fn int64(&self, vr: u32) -> i64 {
+        let mut x = [-7];
+        let s = unsafe { abi3::get_int64::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        x[0]
+    }
+
+    pub fn set_int64(&self, vr: u32, x: i64) -> Fmi3Status {
+        unsafe { abi3::set_int64::<M>(self.c, &vr, 1, &x, 1) }
+    }
+
+    pub fn boolean(&self, vr: u32) -> bool {
+        let mut x = [7u8];
+        let s = unsafe { abi3::get_boolean::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        x[0] != 0
+    }
+
+    pub fn set_boolean(&self, vr: u32, x: bool) -> Fmi3Status {
+        let b = x as u8;
+        unsafe { abi3::set_boolean::<M>(self.c, &vr, 1, &b, 1) }
+    }
+
+    /// `fmi3DoStep` and its outputs.
+    pub fn step(&self, t: f64, h: f64) -> StepOutcome {
+        let (mut event, mut terminate, mut early, mut last) = (7u8, 7u8, 7u8, f64::NAN);
+        let status =
+            unsafe { abi3::do_step::<M>(self.c, t, h, FMI3_TRUE, &mut event, &mut terminate, &mut early, &mut last) };
+        StepOutcome {
+            status,
+            event_handling_needed: event != 0,
+            terminate_simulation: terminate != 0,
+            early_return: early != 0,
+            last_successful_time: last,
+        }
+    }
+
+    pub fn terminate(&self) -> Fmi3Status {
+        unsafe { abi3::terminate::<M>(self.c) }
+    }
+
+    pub fn reset(&self) -> Fmi3Status {
+        unsafe { abi3::reset::<M>(self.c) }
+    }
+
+    // Model Exchange
+    pub fn set_time(&self, t: f64) -> Fmi3Status {
+        unsafe { abi3::set_time::<M>(self.c, t) }
+    }
+
+    pub fn enter_event_mode(&self) -> Fmi3Status {
+        unsafe { abi3::enter_event_mode::<M>(self.c) }
+    }
+
+    pub fn enter_continuous_time_mode(&self) -> Fmi3Status {
+        unsafe { abi3::enter_continuous_time_mode::<M>(self.c) }
+    }
+
+    /// `fmi3UpdateDiscreteStates`, which must return Ok.
+    pub fn update_discrete_states(&self) -> DiscreteUpdate {
+        let (mut need, mut terminate, mut nominals, mut values, mut defined, mut next) =
+            (7u8, 7u8, 7u8, 7u8, 7u8, f64::NAN);
+        let s = unsafe {
+            abi3::update_discrete_states::<M>(
+                self.c,
+                &mut need,
+                &mut terminate,
+                &mut nominals,
+                &mut values,
+                &mut defined,
+                &mut next,
+            )
+        };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        DiscreteUpdate {
+            discrete_states_need_update: need != 0,
+            terminate_simulation: terminate != 0,
+            next_event_time: (defined != 0).then_some(next),
+        }
+    }
+
+    pub fn continuous_states(&self) -> Vec<f64> {
+        let mut x = vec![f64::NAN; M::declaration().number_of_states()];
+        let s = unsafe { abi3::get_continuous_states::<M>(self.c, x.as_mut_ptr(), x.len()) };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        x
+    }
+
+    pub fn set_continuous_states(&self, x: &[f64]) -> Fmi3Status {
+        unsafe { abi3::set_continuous_states::<M>(self.c, x.as_ptr(), x.len()) }
+    }
+
+    pub fn derivatives(&self) -> Vec<f64> {
+        let mut dx = vec![f64::NAN; M::declaration().number_of_states()];
+        let s = unsafe { abi3::get_continuous_state_derivatives::<M>(self.c, dx.as_mut_ptr(), dx.len()) };
+        assert_eq!(s, OK3, "{}", self.last_error());
+        dx
+    }
+
+    /// `fmi3GetDirectionalDerivative`: `J seed` or the status.
+    pub fn directional(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
+        let mut out = vec![f64::NAN; unknowns.len()];
+        let s = unsafe {
+            abi3::get_directional_derivative::<M>(
+                self.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                seed.as_ptr(),
+                seed.len(),
+                out.as_mut_ptr(),
+                out.len(),
+            )
+        };
+        if s == OK3 {
+            Ok(out)
+        } else {
+            Err(s)
+        }
+    }
+
+    /// `fmi3GetAdjointDerivative`: `J^T seed` or the status.
+    pub fn adjoint(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
+        let mut out = vec![f64::NAN; knowns.len()];
+        let s = unsafe {
+            abi3::get_adjoint_derivative::<M>(
+                self.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                seed.as_ptr(),
+                seed.len(),
+                out.as_mut_ptr(),
+                out.len(),
+            )
+        };
+        if s == OK3 {
+            Ok(out)
+        } else {
+            Err(s)
+        }
+    }
+
+    /// FMU state round trip through serialization: the bytes.
+    pub fn serialized_state(&self) -> Vec<u8> {
+        unsafe {
+            let mut s: fmi3FMUState = null_mut();
+            assert_eq!(abi3::get_fmu_state::<M>(self.c, &mut s), OK3, "{}", self.last_error());
+            let mut n = 0usize;
+            assert_eq!(abi3::serialized_fmu_state_size::<M>(self.c, s, &mut n), OK3);
+            let mut bytes = vec![0u8; n];
+            assert_eq!(abi3::serialize_fmu_state::<M>(self.c, s, bytes.as_mut_ptr(), n), OK3);
+            assert_eq!(abi3::free_fmu_state::<M>(self.c, &mut s), OK3);
+            bytes
+        }
+    }
+
+    /// Deserializes `bytes` and sets the state: the first status that is not Ok, else Ok.
+    pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi3Status {
+        unsafe {
+            let mut s: fmi3FMUState = null_mut();
+            let st = abi3::deserialize_fmu_state::<M>(self.c, bytes.as_ptr(), bytes.len(), &mut s);
+            if st != OK3 {
+                return st;
+            }
+            let st = abi3::set_fmu_state::<M>(self.c, s);
+            abi3::free_fmu_state::<M>(self.c, &mut s);
+            st
+        }
+    }
+}
+
+impl<M: Model> Drop for Fmu3<M> {
+    fn drop(&mut self) {
+        unsafe { abi3::free_instance::<M>(self.c) }
+    }
+}
+
+/// Runs `M` in Co-Simulation through both ABIs side by side from `start` with `steps`
+/// steps of `h` (stop time `start + steps h`), setting before each step the Real inputs
+/// `input(k, name)` gives a value for, and asserts that every Real, Integer and Boolean
+/// output, the time and the step's FMI 3.0 outputs agree to the bit with the FMI 2.0 run
+/// (`terminateSimulation` only at the last step, when `ends_at_stop`). Returns the number
+/// of values compared.
+pub fn assert_cs_runs_agree<M: Model>(
+    start: f64,
+    h: f64,
+    steps: usize,
+    ends_at_stop: bool,
+    input: impl Fn(usize, &str) -> Option<f64>,
+) -> usize {
+    use crate::decl::{BaseType, Causality};
+    let d = M::declaration();
+    let stop = start + steps as f64 * h;
+    let f2 = Fmu::<M>::cs();
+    f2.init_until(start, Some(stop));
+    let f3 = Fmu3::<M>::cs();
+    f3.init_until(start, Some(stop));
+    let mut compared = 0;
+    let mut t = start;
+    for k in 0..steps {
+        for (row, v) in d.spec.variables.iter().enumerate() {
+            if v.causality != Causality::Input || v.base_type != BaseType::Real {
+                continue;
+            }
+            if let Some(x) = input(k, v.name) {
+                let vr3 = crate::Declaration::<M::Binding>::value_reference3(row);
+                assert_eq!(f2.set_real(v.value_reference, x), OK, "{}", f2.last_error());
+                assert_eq!(f3.set_float64(&[vr3], &[x]), OK3, "{}", f3.last_error());
+            }
+        }
+        assert_eq!(f2.step(t, h), OK, "{}", f2.last_error());
+        let s = f3.step(t, h);
+        assert_eq!(s.status, OK3, "{}", f3.last_error());
+        t = start + (k + 1) as f64 * h;
+        assert!(!s.event_handling_needed && !s.early_return);
+        assert_eq!(s.terminate_simulation, ends_at_stop && k + 1 == steps, "terminateSimulation after step {k}");
+        assert_eq!(s.last_successful_time.to_bits(), f2.last_successful_time().to_bits());
+        for (row, v) in d.spec.variables.iter().enumerate() {
+            if v.causality != Causality::Output {
+                continue;
+            }
+            let vr3 = crate::Declaration::<M::Binding>::value_reference3(row);
+            let same = match v.base_type {
+                BaseType::Real => f2.real(v.value_reference).to_bits() == f3.float64(vr3).to_bits(),
+                BaseType::Integer if v.declared_type.is_some() => f2.int(v.value_reference) as i64 == f3.int64(vr3),
+                BaseType::Integer => f2.int(v.value_reference) == f3.int32(vr3),
+                BaseType::Boolean => {
+                    let mut b = -1;
+                    let s = unsafe { abi::get_boolean::<M>(f2.c, &v.value_reference, 1, &mut b) };
+                    assert_eq!(s, OK);
+                    (b != 0) == f3.boolean(vr3)
+                }
+            };
+            assert!(same, "{} differs after step {k} (t = {t})", v.name);
+            compared += 1;
+        }
+    }
+    compared
 }

@@ -984,3 +984,320 @@ fn repeated_value_reference_arrays_are_checked_every_time() {
     assert_eq!(get(&[vr::U, 99]).0, ERR);
     assert!(f.last_error().contains("unknown Real value reference 99"), "{}", f.last_error());
 }
+
+// ------------------------------------------------------------------ FMI 3.0
+
+use fmi_export::testing::{Fmu3, DISCARD3, ERR3, OK3};
+
+/// FMI 3.0 value references of the toy: `time` 0, declaration row r at r + 1.
+mod vr3 {
+    pub const TIME: u32 = 0;
+    pub const U: u32 = 1;
+    pub const GAIN: u32 = 2;
+    pub const MODE: u32 = 4;
+    pub const OFFSET: u32 = 5;
+    pub const ENABLED: u32 = 6;
+    pub const ACC: u32 = 7;
+    pub const Y: u32 = 8;
+    pub const SAMPLES: u32 = 9;
+}
+
+#[test]
+fn fmi3_description_has_the_same_variables_typed_and_validates_in_its_structure() {
+    use fmi_export::model_description::fmi3::ValueType;
+    let d = Toy::declaration();
+    let md3 = d.model_description3();
+    let types: Vec<(&str, u32, ValueType)> =
+        md3.model_variables.iter().map(|v| (v.name.as_str(), v.value_reference, v.value_type)).collect();
+    assert_eq!(types[vr3::MODE as usize], ("mode", 4, ValueType::Enumeration));
+    assert_eq!(types[vr3::OFFSET as usize], ("offset", 5, ValueType::Int32));
+    assert_eq!(types[vr3::ENABLED as usize], ("enabled", 6, ValueType::Boolean));
+    assert_eq!(types[vr3::Y as usize], ("y", 8, ValueType::Float64));
+    assert_eq!(md3.instantiation_token, d.guid());
+    let xml = d.xml3();
+    assert!(xml.contains(r#"<EnumerationType name="Mode" description="what a sample does">"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="8" dependencies="1"/>"#), "{xml}");
+    let cs = md3.co_simulation.as_ref().unwrap();
+    assert!(cs.common.can_get_and_set_fmu_state && !cs.common.provides_adjoint_derivatives && !cs.has_event_mode);
+}
+
+/// The same run through both ABIs: every output equal to the bit, the step's FMI 3.0
+/// outputs as the standard says for an FMU without Event Mode and early return.
+#[test]
+fn fmi3_co_simulation_equals_the_fmi2_run_bit_for_bit() {
+    let f2 = Fmu::<Toy>::cs();
+    f2.init(Some(1.0));
+    let f3 = Fmu3::<Toy>::cs();
+    f3.init_until(0.0, Some(1.0));
+    let (mut t, h) = (0.0, 0.03);
+    for k in 0..30 {
+        let u = (k as f64 * 0.7).sin();
+        assert_eq!(f2.set_real(vr::U, u), OK);
+        assert_eq!(f3.set_float64(&[vr3::U], &[u]), OK3);
+        assert_eq!(f2.step(t, h), OK);
+        let s = f3.step(t, h);
+        assert_eq!(s.status, OK3, "{}", f3.last_error());
+        assert!(!s.event_handling_needed && !s.early_return && !s.terminate_simulation);
+        t += h;
+        assert_eq!(s.last_successful_time.to_bits(), t.to_bits());
+        assert_eq!(f3.float64(vr3::TIME).to_bits(), t.to_bits());
+        assert_eq!(f2.real(vr::Y).to_bits(), f3.float64(vr3::Y).to_bits());
+        assert_eq!(f2.real(vr::ACC).to_bits(), f3.float64(vr3::ACC).to_bits());
+        assert_eq!(f2.int(vr::SAMPLES), f3.int32(vr3::SAMPLES));
+    }
+    assert_eq!(f3.terminate(), OK3);
+}
+
+#[test]
+fn fmi3_model_exchange_updates_discrete_states_at_the_time_events() {
+    let f = Fmu3::<Toy>::me();
+    f.init_until(0.0, None);
+    assert_eq!(f.set_float64(&[vr3::U], &[1.0]), OK3);
+    let first = f.update_discrete_states();
+    assert_eq!(first.next_event_time, Some(0.1));
+    assert!(!first.discrete_states_need_update && !first.terminate_simulation);
+    assert_eq!(f.int32(vr3::SAMPLES), 1);
+    assert_eq!(f.enter_continuous_time_mode(), OK3);
+    assert!(f.continuous_states().is_empty() && f.derivatives().is_empty());
+    assert_eq!(f.set_time(0.1), OK3);
+    assert_eq!(f.enter_event_mode(), OK3);
+    assert_eq!(f.update_discrete_states().next_event_time, Some(0.2));
+    assert_eq!(f.float64(vr3::Y), expected(2.0, 0.1, &[1.0, 1.0]).0);
+    let mut n = 7usize;
+    unsafe {
+        assert_eq!(abi::fmi3::get_number_of_continuous_states::<Toy>(f.c, &mut n), OK3);
+        assert_eq!(n, 0);
+        assert_eq!(abi::fmi3::get_number_of_event_indicators::<Toy>(f.c, &mut n), OK3);
+        assert_eq!(n, 0);
+    }
+}
+
+#[test]
+fn fmi3_values_of_the_wrong_type_count_or_range_are_refused_naming_the_reason() {
+    // each refusal puts the instance in the error state: a fresh one in Initialization Mode
+    let fresh = || {
+        let f = Fmu3::<Toy>::cs();
+        assert_eq!(f.enter_init(0.0, None), OK3);
+        f
+    };
+    let mut f = fresh();
+    // Int32 of a Float64, Float64 of an Enumeration, a type the toy has none of
+    let mut i = [0i32];
+    assert_eq!(unsafe { abi::fmi3::get_int32::<Toy>(f.c, &vr3::U, 1, i.as_mut_ptr(), 1) }, ERR3);
+    assert!(f.last_error().contains("value reference 1 is u, a Float64 variable, not a Int32"), "{}", f.last_error());
+    f = fresh();
+    let mut x = [0.0];
+    assert_eq!(f.get_float64(&[vr3::MODE], &mut x), ERR3);
+    assert!(f.last_error().contains("mode, a Enumeration variable, not a Float64"), "{}", f.last_error());
+    f = fresh();
+    let mut g = [0.0f32];
+    assert_eq!(unsafe { abi::fmi3::get_float32::<Toy>(f.c, &vr3::U, 1, g.as_mut_ptr(), 1) }, ERR3);
+    assert!(f.last_error().starts_with("fmi3GetFloat32:") && f.last_error().contains("not a Float32"));
+    f = fresh();
+    let mut c = [0u8];
+    assert_eq!(unsafe { abi::fmi3::get_clock::<Toy>(f.c, &vr3::ENABLED, 1, c.as_mut_ptr()) }, ERR3);
+    assert!(f.last_error().contains("enabled, a Boolean variable, not a Clock"), "{}", f.last_error());
+    f = fresh();
+    // an empty call of such a type is fine
+    assert_eq!(unsafe { abi::fmi3::get_float32::<Toy>(f.c, std::ptr::null(), 0, std::ptr::null_mut(), 0) }, OK3);
+    // unknown value reference, bad nValues
+    assert_eq!(f.set_float64(&[99], &[1.0]), ERR3);
+    assert!(f.last_error().contains("unknown value reference 99"), "{}", f.last_error());
+    f = fresh();
+    assert_eq!(f.set_float64(&[vr3::U, vr3::GAIN], &[1.0]), ERR3);
+    assert!(f.last_error().contains("nValues = 1") && f.last_error().contains("nValues must be 2"));
+    f = fresh();
+    // NaN, below the minimum, not an enumeration item, outside 32 bits
+    assert_eq!(f.set_float64(&[vr3::GAIN], &[f64::NAN]), ERR3);
+    assert!(f.last_error().contains("gain = NaN refused"), "{}", f.last_error());
+    f = fresh();
+    assert_eq!(f.set_float64(&[vr3::GAIN], &[-1.0]), ERR3);
+    assert!(f.last_error().contains("below its minimum"), "{}", f.last_error());
+    f = fresh();
+    assert_eq!(f.set_int64(vr3::MODE, 7), ERR3);
+    assert!(f.last_error().contains("not an item of Mode"), "{}", f.last_error());
+    f = fresh();
+    assert_eq!(f.set_int64(vr3::MODE, 1 << 40), ERR3);
+    assert!(f.last_error().contains("outside the 32-bit range"), "{}", f.last_error());
+    f = fresh();
+    // time is read, never set
+    assert_eq!(f.set_float64(&[vr3::TIME], &[1.0]), ERR3);
+    assert!(f.last_error().contains("independent variable"), "{}", f.last_error());
+    f = fresh();
+    // the good values go through: Int64 enumerations, Int32, Boolean
+    assert_eq!(f.set_int64(vr3::MODE, SETTLE as i64), OK3);
+    assert_eq!(f.set_int32(vr3::OFFSET, -3), OK3);
+    assert_eq!(f.set_boolean(vr3::ENABLED, false), OK3);
+    assert_eq!(f.exit_init(), OK3);
+    assert_eq!((f.int64(vr3::MODE), f.int32(vr3::OFFSET), f.boolean(vr3::ENABLED)), (SETTLE as i64, -3, false));
+}
+
+#[test]
+fn fmi3_instantiation_checks_the_token_event_mode_and_interface() {
+    let log = Fmu3::<Toy>::try_cs("{00000000-0000-0000-0000-000000000000}", false).err().unwrap();
+    let msg = log.0.borrow().last().unwrap().2.clone();
+    assert!(msg.starts_with("fmi3InstantiateCoSimulation: instantiationToken"), "{msg}");
+    let log = Fmu3::<Toy>::try_cs(Toy::declaration().guid(), true).err().unwrap();
+    assert!(log.0.borrow().last().unwrap().2.contains("eventModeUsed = true refused"));
+    let log = Fmu3::<Bare>::try_me(Bare::declaration().guid()).err().unwrap();
+    assert!(log.0.borrow().last().unwrap().2.contains("does not offer ModelExchange"));
+    // Scheduled Execution: NULL and the reason
+    let log = Box::<testing::Log>::default();
+    let token = CString::new(Toy::declaration().guid()).unwrap();
+    let c = unsafe {
+        abi::fmi3::instantiate_scheduled_execution::<Toy>(
+            c"s".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            1,
+            &*log as *const testing::Log as *mut std::ffi::c_void,
+            None,
+            None,
+            None,
+            None,
+        )
+    };
+    assert!(c.is_null());
+    // no logger given: still NULL, nothing to crash on
+    let c = unsafe {
+        abi::fmi3::instantiate_model_exchange::<Toy>(
+            std::ptr::null(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            1,
+            null_mut(),
+            None,
+        )
+    };
+    assert!(c.is_null());
+}
+
+/// Every function of a feature the toy does not declare: fmi3Error and a message naming
+/// the function and what is missing, in every state reached here; a function of the other
+/// generation on an FMI 3.0 instance too.
+#[test]
+fn fmi3_undeclared_features_and_illegal_orders_are_errors_with_a_message() {
+    for f in Function::FMI3.into_iter().filter(|f| f.undeclared_feature().is_some()) {
+        let fmu = Fmu3::<Toy>::cs();
+        assert_eq!(unsafe { abi::fmi3::undeclared::<Toy>(fmu.c, f) }, ERR3);
+        let msg = fmu.last_error();
+        assert!(msg.starts_with(&format!("{}: not supported", f.name())), "{msg}");
+    }
+    let f = Fmu3::<Toy>::cs();
+    assert_eq!(f.enter_event_mode(), ERR3);
+    assert!(f.last_error().contains("hasEventMode is false"), "{}", f.last_error());
+    let f = Fmu3::<Toy>::cs();
+    assert_eq!(f.step(0.0, 0.1).status, ERR3);
+    assert!(f.last_error().starts_with("fmi3DoStep: not allowed in state Instantiated"), "{}", f.last_error());
+    assert_eq!(f.exit_init(), ERR3, "the error state allows no mode change");
+    assert_eq!(f.reset(), OK3);
+    assert_eq!(f.exit_init(), ERR3);
+    assert!(f.last_error().contains("not allowed in state Instantiated"));
+    assert_eq!(f.reset(), OK3);
+    // an fmi2 function on an FMI 3.0 instance
+    assert_eq!(unsafe { abi::do_step::<Toy>(f.c, 0.0, 0.1, 0) }, ERR);
+    assert!(f.last_error().contains("created by an fmi3Instantiate function"), "{}", f.last_error());
+    // ME only functions on a CS instance
+    assert_eq!(f.reset(), OK3);
+    assert_eq!(f.set_time(0.0), ERR3);
+    assert!(f.last_error().contains("created for CoSimulation"), "{}", f.last_error());
+    // a null instance
+    assert_eq!(unsafe { abi::fmi3::terminate::<Toy>(null_mut()) }, ERR3);
+}
+
+#[test]
+fn fmi3_fmu_state_round_trips_and_refuses_truncated_or_foreign_bytes() {
+    let f = Fmu3::<Toy>::cs();
+    f.init_until(0.0, None);
+    assert_eq!(f.set_float64(&[vr3::U], &[1.5]), OK3);
+    assert_eq!(f.step(0.0, 0.25).status, OK3);
+    let bytes = f.serialized_state();
+    let y = f.float64(vr3::Y);
+    assert_eq!(f.step(0.25, 0.25).status, OK3);
+    assert_ne!(f.float64(vr3::Y), y);
+    assert_eq!(f.restore_serialized(&bytes), OK3, "{}", f.last_error());
+    assert_eq!(f.float64(vr3::Y).to_bits(), y.to_bits());
+    assert_eq!(f.float64(vr3::TIME), 0.25);
+    // the same bytes restore into an FMI 2.0 instance of the same library (one format)
+    let f2 = Fmu::<Toy>::cs();
+    assert_eq!(f2.restore_serialized(&bytes), OK, "{}", f2.last_error());
+    assert_eq!(f2.real(vr::Y).to_bits(), y.to_bits());
+    for cut in [0, 1, bytes.len() / 2, bytes.len() - 1] {
+        let g = Fmu3::<Toy>::cs();
+        assert_eq!(g.restore_serialized(&bytes[..cut]), ERR3, "truncated to {cut}");
+        assert!(g.last_error().starts_with("fmi3DeserializeFMUState:"), "{}", g.last_error());
+    }
+    let mut foreign = bytes.clone();
+    for (k, b) in foreign.iter_mut().enumerate() {
+        *b = b.wrapping_mul(31).wrapping_add(k as u8);
+    }
+    let g = Fmu3::<Toy>::cs();
+    assert_eq!(g.restore_serialized(&foreign), ERR3);
+    // a state pointer the instance never made
+    let mut fake = 0x1000usize as *mut std::ffi::c_void;
+    assert_eq!(unsafe { abi::fmi3::set_fmu_state::<Toy>(g.c, fake) }, ERR3);
+    assert_eq!(g.reset(), OK3);
+    assert_eq!(unsafe { abi::fmi3::free_fmu_state::<Toy>(g.c, &mut fake) }, ERR3);
+}
+
+#[test]
+fn fmi3_variable_dependencies_are_the_model_structure() {
+    let f = Fmu3::<Toy>::cs();
+    f.init_until(0.0, None);
+    let mut n = 7usize;
+    assert_eq!(unsafe { abi::fmi3::get_number_of_variable_dependencies::<Toy>(f.c, vr3::Y, &mut n) }, OK3);
+    assert_eq!(n, 1);
+    let (mut e, mut on, mut eon, mut kind) = ([9usize], [9u32], [9usize], [9i32]);
+    let s = unsafe {
+        abi::fmi3::get_variable_dependencies::<Toy>(
+            f.c,
+            vr3::Y,
+            e.as_mut_ptr(),
+            on.as_mut_ptr(),
+            eon.as_mut_ptr(),
+            kind.as_mut_ptr(),
+            1,
+        )
+    };
+    assert_eq!(s, OK3, "{}", f.last_error());
+    assert_eq!((e, on, eon, kind), ([0], [vr3::U], [0], [fmi_export::fmi_sys::fmi3::FMI3_DEPENDENT]));
+    // wrong count, not an unknown
+    let s = unsafe {
+        abi::fmi3::get_variable_dependencies::<Toy>(
+            f.c,
+            vr3::Y,
+            e.as_mut_ptr(),
+            on.as_mut_ptr(),
+            eon.as_mut_ptr(),
+            kind.as_mut_ptr(),
+            2,
+        )
+    };
+    assert_eq!(s, ERR3);
+    assert!(f.last_error().contains("nDependencies = 2"), "{}", f.last_error());
+    assert_eq!(f.reset(), OK3);
+    assert_eq!(unsafe { abi::fmi3::get_number_of_variable_dependencies::<Toy>(f.c, vr3::GAIN, &mut n) }, ERR3);
+    assert!(f.last_error().contains("gain (value reference 2) is no unknown"), "{}", f.last_error());
+}
+
+/// The model's request to end the run: a Discard with terminateSimulation, as FMI 2.0's
+/// Discard with fmi2Terminated; lastSuccessfulTime where the model stopped.
+#[test]
+fn fmi3_the_model_ending_the_run_sets_terminate_simulation() {
+    let f = Fmu3::<Toy>::cs();
+    assert_eq!(f.set_int64(vr3::MODE, STOP_AT_3 as i64), OK3);
+    f.init_until(0.0, None);
+    let s = f.step(0.0, 0.5);
+    assert_eq!(s.status, DISCARD3, "{}", f.last_error());
+    assert!(s.terminate_simulation);
+    assert_eq!(s.last_successful_time, 0.2);
+    assert_eq!(f.step(0.2, 0.1).status, ERR3, "no step after a discarded one");
+    let g = Fmu::<Toy>::cs();
+    assert_eq!(g.set_int(vr::MODE, STOP_AT_3), OK);
+    g.init(None);
+    assert_eq!(g.step(0.0, 0.5), testing::DISCARD);
+    assert!(g.terminated());
+    assert_eq!(g.last_successful_time(), s.last_successful_time);
+}

@@ -482,3 +482,31 @@ fn value_references_are_the_pinned_ones() {
     let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
     TestBench::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// The test bench through FMI 3.0: every output equal to the FMI 2.0 run to the bit, the
+/// step that reaches the duration says terminateSimulation (the run ends there), and a
+/// step across it is discarded with terminateSimulation and lastSuccessfulTime at the
+/// duration, as FMI 2.0's Discard with fmi2Terminated.
+#[test]
+fn fmi3_co_simulation_equals_fmi2_and_ends_at_the_duration() {
+    use fmi_export::testing::{assert_cs_runs_agree, Fmu3, DISCARD3, OK3};
+    let vr3 =
+        |name: &str| TestBench::declaration().model_description3().variable_by_name(name).unwrap().value_reference;
+    // the default maneuver and fidelity, the first 0.3 s of its 30 s
+    let compared = assert_cs_runs_agree::<TestBench>(0.0, 0.01, 30, false, |_, _| None);
+    assert!(compared > 300, "{compared}");
+    let f = Fmu3::<TestBench>::cs();
+    assert_eq!(f.enter_init(0.0, None), OK3);
+    assert_eq!(f.set_float64(&[vr3("duration")], &[0.01]), OK3);
+    assert_eq!(f.exit_init(), OK3);
+    let s = f.step(0.0, 0.004);
+    assert!(s.status == OK3 && !s.terminate_simulation);
+    let s = f.step(0.004, 0.006);
+    assert!(s.status == OK3 && s.terminate_simulation, "the step reaching the duration: {s:?}");
+    assert_eq!(s.last_successful_time, 0.01);
+    let s = f.step(0.01, 0.004);
+    assert_eq!(s.status, DISCARD3, "past the duration");
+    assert!(s.terminate_simulation);
+    assert_eq!(s.last_successful_time, 0.01);
+    assert_eq!(f.terminate(), OK3);
+}

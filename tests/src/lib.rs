@@ -2,6 +2,9 @@
 //! symbols into the function table of `fmi-sys` (a missing one is an error, as in
 //! fmpy), and wraps an instance so tests can call the C ABI, including in the wrong order
 //! on purpose. The log goes through the logger shim of `fmi-sys`, as in the master.
+//!
+//! The same library exports the 75 `fmi3*` functions: [`Fmu::functions3`] is their table
+//! (all required), [`Fmu::instantiate3`] an FMI 3.0 instance with a capturing logger.
 
 use std::ffi::{c_int, CString};
 use std::io::Read;
@@ -70,6 +73,8 @@ pub struct Fmu {
     pub dir: PathBuf,
     pub description: ModelDescription,
     pub functions: Functions,
+    /// The `fmi3*` functions of the same library.
+    pub functions3: fmi_sys::fmi3::Fmi3Functions,
     _library: libloading::Library,
 }
 
@@ -121,7 +126,12 @@ impl Fmu {
         if let Some(missing) = SYMBOLS.iter().find(|s| !functions.has(s)) {
             return Err(format!("{}: the library does not export {missing}", so.display()));
         }
-        Ok(Fmu { dir, description, functions, _library: library })
+        // SAFETY: the library exports the FMI 3.0 functions with the header's signatures.
+        let functions3 = unsafe { fmi_sys::fmi3::Fmi3Functions::load(&library) }.map_err(|e| e.0.to_string())?;
+        if let Some(missing) = functions3.missing().first() {
+            return Err(format!("{}: the library does not export {missing}", so.display()));
+        }
+        Ok(Fmu { dir, description, functions, functions3, _library: library })
     }
 
     pub fn guid(&self) -> &str {
@@ -152,6 +162,96 @@ impl Fmu {
         } else {
             (Some(Instance { fmu: self, c, _callbacks: callbacks }), sink)
         }
+    }
+}
+
+/// The log of an FMI 3.0 instance (its `instanceEnvironment`).
+#[derive(Default, Debug)]
+pub struct Log3(pub LogSink);
+
+/// The `fmi3LogMessageCallback` of [`Fmu::instantiate3`]: the environment is a [`Log3`].
+unsafe extern "C" fn log_message3(
+    environment: *mut std::ffi::c_void,
+    status: c_int,
+    category: *const std::ffi::c_char,
+    message: *const std::ffi::c_char,
+) {
+    let text = |p: *const std::ffi::c_char| {
+        if p.is_null() {
+            String::new()
+        } else {
+            std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned()
+        }
+    };
+    if let Some(log) = (environment as *const Log3).as_ref() {
+        if let Ok(mut r) = log.0.records.lock() {
+            r.push(LogRecord { status, category: text(category), message: text(message) });
+        }
+    }
+}
+
+impl Fmu {
+    /// An FMI 3.0 instance (`fmi3InstantiateCoSimulation` when `co_simulation`, else Model
+    /// Exchange) with `token`, the resources folder as a native path and a capturing log;
+    /// `None` when the FMU returned NULL.
+    pub fn instantiate3(&self, name: &str, co_simulation: bool, token: &str) -> (Option<Instance3<'_>>, Box<Log3>) {
+        let log = Box::<Log3>::default();
+        let name_c = CString::new(name).unwrap();
+        let token_c = CString::new(token).unwrap();
+        let resources = CString::new(format!("{}/resources/", self.dir.display())).unwrap();
+        let env = &*log as *const Log3 as *mut std::ffi::c_void;
+        let f = &self.functions3;
+        let c = unsafe {
+            if co_simulation {
+                (f.instantiate_co_simulation.unwrap())(
+                    name_c.as_ptr(),
+                    token_c.as_ptr(),
+                    resources.as_ptr(),
+                    0,
+                    0,
+                    0,
+                    0,
+                    std::ptr::null(),
+                    0,
+                    env,
+                    Some(log_message3),
+                    None,
+                )
+            } else {
+                (f.instantiate_model_exchange.unwrap())(
+                    name_c.as_ptr(),
+                    token_c.as_ptr(),
+                    resources.as_ptr(),
+                    0,
+                    0,
+                    env,
+                    Some(log_message3),
+                )
+            }
+        };
+        if c.is_null() {
+            (None, log)
+        } else {
+            (Some(Instance3 { fmu: self, c }), log)
+        }
+    }
+}
+
+/// A live FMI 3.0 instance; freed on drop.
+pub struct Instance3<'a> {
+    pub fmu: &'a Fmu,
+    pub c: fmi_sys::fmi3::fmi3Instance,
+}
+
+impl Instance3<'_> {
+    pub fn f(&self) -> &fmi_sys::fmi3::Fmi3Functions {
+        &self.fmu.functions3
+    }
+}
+
+impl Drop for Instance3<'_> {
+    fn drop(&mut self) {
+        unsafe { (self.fmu.functions3.free_instance)(self.c) }
     }
 }
 

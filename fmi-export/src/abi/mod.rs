@@ -143,7 +143,7 @@ pub(crate) unsafe fn with<M: Model>(
     };
     let function_name = function.name();
     if status == Fmi2Status::Discard {
-        if function == Function::DoStep {
+        if function.counterpart().unwrap_or(function) == Function::DoStep {
             component.instance.core.machine = Machine::StepFailed;
         }
         component.log(Fmi2Status::Discard, LogCategory::Warning, &format!("{function_name}: {message}"));

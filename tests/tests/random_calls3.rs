@@ -1,0 +1,609 @@
+//! Seeded random call sequences over all 75 `fmi3*` functions of every FMU in
+//! `build-fmu`'s list (the same library as the FMI 2.0 archive), Co-Simulation and Model
+//! Exchange, in every state, with hostile arguments: unknown value references and the
+//! independent variable, every type's getter and setter, wrong `nValues`, NULL arrays,
+//! NaN/Inf, huge steps, stale and foreign FMU states, corrupted serialized states, the
+//! functions of undeclared features, and now and then an `fmi2*` call on the FMI 3.0
+//! instance. Checked after every call: no crash, a defined status, the one state table of
+//! `fmi_export::states` respected (a call it forbids returns fmi3Error, with a message
+//! naming the function), and no non-finite number handed out with fmi3OK.
+//!
+//! `NIGEL_RANDOM_SEQUENCES3` sets the number of sequences per FMU and interface (default
+//! 20,000).
+
+use std::ffi::c_void;
+use std::ptr::{null, null_mut};
+
+use fmi_export::states::{Function, Machine, Scope};
+use model_description::{ModelDescription, VariableType};
+use nigel_integration_tests::{built_fmu, Fmu, DISCARD, ERROR, OK};
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        // xorshift64*
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+    fn chance(&mut self, percent: u64) -> bool {
+        self.next() % 100 < percent
+    }
+    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
+        items[self.below(items.len())]
+    }
+}
+
+const HOSTILE: [f64; 12] =
+    [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
+
+/// FMI 3.0 value references by type (FMI 2.0 variable index i is FMI 3.0 value reference
+/// i; `time` is 0), each pool with foreign ones mixed in.
+struct Pools {
+    float64: Vec<u32>,
+    int32: Vec<u32>,
+    int64: Vec<u32>,
+    boolean: Vec<u32>,
+    any: Vec<u32>,
+    nx: usize,
+}
+
+fn pools(md: &ModelDescription) -> Pools {
+    let of = |keep: fn(&VariableType) -> bool| -> Vec<u32> {
+        let mut v: Vec<u32> = md
+            .model_variables
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| keep(&v.variable_type))
+            .map(|(row, _)| row as u32 + 1)
+            .collect();
+        v.extend([9999, u32::MAX]);
+        v
+    };
+    let mut float64 = of(|t| matches!(t, VariableType::Real { .. }));
+    float64.push(0);
+    Pools {
+        float64,
+        int32: of(|t| matches!(t, VariableType::Integer { .. })),
+        int64: of(|t| matches!(t, VariableType::Enumeration { .. })),
+        boolean: of(|t| matches!(t, VariableType::Boolean { .. })),
+        any: (0..md.model_variables.len() as u32 + 2).collect(),
+        nx: md.model_structure.derivatives.len(),
+    }
+}
+
+struct Shadow {
+    machine: Option<Machine>,
+    time: f64,
+    states: Vec<(*mut c_void, Option<Machine>)>,
+    freed: Vec<*mut c_void>,
+    bytes: Vec<u8>,
+}
+
+fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4] {
+    let p = pools(&fmu.description);
+    let f = &fmu.functions3;
+    let mut rng = Rng(seed);
+    let mut counts = [0usize; 4];
+    let interface_scope = if co_simulation { Scope::CoSimulation } else { Scope::ModelExchange };
+    for _ in 0..sequences {
+        let (instance, log) = fmu.instantiate3("random3", co_simulation, fmu.guid());
+        let i = instance.expect("instantiate");
+        let c = i.c;
+        let mut sh = Shadow {
+            machine: Some(Machine::Instantiated),
+            time: 0.0,
+            states: Vec::new(),
+            freed: Vec::new(),
+            bytes: Vec::new(),
+        };
+        for _ in 0..1 + rng.below(16) {
+            let progress: &[Function] = match sh.machine {
+                Some(Machine::Instantiated) => &[Function::Fmi3EnterInitializationMode, Function::Fmi3SetFloat64],
+                Some(Machine::InitializationMode) => &[Function::Fmi3ExitInitializationMode, Function::Fmi3SetFloat64],
+                Some(Machine::StepComplete) => {
+                    &[Function::Fmi3DoStep, Function::Fmi3SetFloat64, Function::Fmi3GetFMUState]
+                }
+                Some(Machine::EventMode) => {
+                    &[Function::Fmi3UpdateDiscreteStates, Function::Fmi3EnterContinuousTimeMode]
+                }
+                Some(Machine::ContinuousTimeMode) => &[
+                    Function::Fmi3SetTime,
+                    Function::Fmi3SetContinuousStates,
+                    Function::Fmi3GetContinuousStateDerivatives,
+                    Function::Fmi3EnterEventMode,
+                ],
+                _ => &[Function::Fmi3Reset, Function::Fmi3SetFMUState],
+            };
+            let function = if rng.chance(40) { rng.pick(progress) } else { rng.pick(&Function::FMI3) };
+            if matches!(
+                function,
+                Function::Fmi3InstantiateCoSimulation
+                    | Function::Fmi3InstantiateModelExchange
+                    | Function::Fmi3InstantiateScheduledExecution
+                    | Function::Fmi3FreeInstance
+            ) {
+                continue;
+            }
+            let n = rng.below(4);
+            // nValues: mostly right, sometimes one off
+            let n_values = if rng.chance(10) { n + 1 } else { n };
+            let null_array = rng.chance(3);
+            let vrs = |rng: &mut Rng, pool: &[u32]| -> Vec<u32> { (0..n).map(|_| rng.pick(pool)).collect() };
+            let ptr = |v: &Vec<u32>| if null_array { null() } else { v.as_ptr() };
+            let time_arg = |rng: &mut Rng, now: f64| -> f64 {
+                if rng.chance(70) {
+                    now
+                } else {
+                    rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
+                }
+            };
+            let mut reals_out = vec![f64::NAN; n_values.max(p.nx).max(1)];
+            let mut check_reals: Option<usize> = None;
+            let mut new_time = None;
+            let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
+                match rng.below(4) {
+                    0 | 1 if !sh.states.is_empty() => sh.states[rng.below(sh.states.len())].0,
+                    2 if !sh.freed.is_empty() => sh.freed[rng.below(sh.freed.len())],
+                    3 => 0x40usize as *mut c_void,
+                    _ => null_mut(),
+                }
+            };
+            let mut restored: Option<Option<Machine>> = None;
+            let (mut b1, mut b2, mut b3, mut b4, mut b5) = (7u8, 7u8, 7u8, 7u8, 7u8);
+            let mut t_out = f64::NAN;
+            let status = unsafe {
+                use Function::*;
+                match function {
+                    Fmi3GetVersion => {
+                        assert!(!(f.get_version)().is_null());
+                        continue;
+                    }
+                    Fmi3SetDebugLogging => {
+                        let cats = [c"logEvents".as_ptr(), c"noSuchCategory".as_ptr()];
+                        (f.set_debug_logging.unwrap())(c, 0, rng.below(3), cats.as_ptr())
+                    }
+                    Fmi3EnterInitializationMode => {
+                        let start = rng.pick(&[0.0, 0.0, 1.0, f64::NAN, -5.0]);
+                        let stop = rng.pick(&[10.0, 0.5, f64::NAN, f64::INFINITY, -1.0]);
+                        let s = (f.enter_initialization_mode)(
+                            c,
+                            rng.below(2) as u8,
+                            rng.pick(&HOSTILE),
+                            start,
+                            rng.below(2) as u8,
+                            stop,
+                        );
+                        if s == OK {
+                            new_time = Some(start);
+                        }
+                        s
+                    }
+                    Fmi3ExitInitializationMode => (f.exit_initialization_mode)(c),
+                    Fmi3Terminate => (f.terminate)(c),
+                    Fmi3Reset => (f.reset.unwrap())(c),
+                    Fmi3EnterEventMode => (f.enter_event_mode.unwrap())(c),
+                    Fmi3GetFloat64 => {
+                        let v = vrs(&mut rng, &p.float64);
+                        check_reals = Some(n.min(n_values));
+                        (f.get_float64)(c, ptr(&v), n, reals_out.as_mut_ptr(), n_values)
+                    }
+                    Fmi3SetFloat64 => {
+                        let v = vrs(&mut rng, &p.float64);
+                        let x: Vec<f64> = (0..n_values).map(|_| rng.pick(&HOSTILE)).collect();
+                        (f.set_float64)(c, ptr(&v), n, x.as_ptr(), n_values)
+                    }
+                    Fmi3GetInt32 => {
+                        let v = vrs(&mut rng, &p.int32);
+                        let mut out = [0i32; 5];
+                        (f.get_int32.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                    }
+                    Fmi3SetInt32 => {
+                        let v = vrs(&mut rng, &p.int32);
+                        let x: Vec<i32> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 7, i32::MAX])).collect();
+                        (f.set_int32.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
+                    }
+                    Fmi3GetInt64 => {
+                        let v = vrs(&mut rng, &p.int64);
+                        let mut out = [0i64; 5];
+                        (f.get_int64.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                    }
+                    Fmi3SetInt64 => {
+                        let v = vrs(&mut rng, &p.int64);
+                        let x: Vec<i64> =
+                            (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 1 << 40, i64::MIN])).collect();
+                        (f.set_int64.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
+                    }
+                    Fmi3GetBoolean => {
+                        let v = vrs(&mut rng, &p.boolean);
+                        let mut out = [0u8; 5];
+                        (f.get_boolean.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                    }
+                    Fmi3SetBoolean => {
+                        let v = vrs(&mut rng, &p.boolean);
+                        let x: Vec<u8> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 255])).collect();
+                        (f.set_boolean.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
+                    }
+                    // the types the FMUs have no variable of: any value reference
+                    Fmi3GetFloat32 | Fmi3SetFloat32 => {
+                        let v = vrs(&mut rng, &p.any);
+                        let mut out = [0f32; 5];
+                        if function == Fmi3GetFloat32 {
+                            (f.get_float32.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                        } else {
+                            (f.set_float32.unwrap())(c, ptr(&v), n, out.as_ptr(), n_values)
+                        }
+                    }
+                    Fmi3GetInt8 | Fmi3GetUInt8 | Fmi3SetInt8 | Fmi3SetUInt8 | Fmi3GetInt16 | Fmi3GetUInt16
+                    | Fmi3SetInt16 | Fmi3SetUInt16 | Fmi3GetUInt32 | Fmi3SetUInt32 | Fmi3GetUInt64 | Fmi3SetUInt64 => {
+                        let v = vrs(&mut rng, &p.any);
+                        let mut out = [0u64; 5];
+                        let o = out.as_mut_ptr();
+                        match function {
+                            Fmi3GetInt8 => (f.get_int8.unwrap())(c, ptr(&v), n, o as *mut i8, n_values),
+                            Fmi3GetUInt8 => (f.get_uint8.unwrap())(c, ptr(&v), n, o as *mut u8, n_values),
+                            Fmi3SetInt8 => (f.set_int8.unwrap())(c, ptr(&v), n, o as *const i8, n_values),
+                            Fmi3SetUInt8 => (f.set_uint8.unwrap())(c, ptr(&v), n, o as *const u8, n_values),
+                            Fmi3GetInt16 => (f.get_int16.unwrap())(c, ptr(&v), n, o as *mut i16, n_values),
+                            Fmi3GetUInt16 => (f.get_uint16.unwrap())(c, ptr(&v), n, o as *mut u16, n_values),
+                            Fmi3SetInt16 => (f.set_int16.unwrap())(c, ptr(&v), n, o as *const i16, n_values),
+                            Fmi3SetUInt16 => (f.set_uint16.unwrap())(c, ptr(&v), n, o as *const u16, n_values),
+                            Fmi3GetUInt32 => (f.get_uint32.unwrap())(c, ptr(&v), n, o as *mut u32, n_values),
+                            Fmi3SetUInt32 => (f.set_uint32.unwrap())(c, ptr(&v), n, o as *const u32, n_values),
+                            Fmi3GetUInt64 => (f.get_uint64.unwrap())(c, ptr(&v), n, o, n_values),
+                            _ => (f.set_uint64.unwrap())(c, ptr(&v), n, o, n_values),
+                        }
+                    }
+                    Fmi3GetString | Fmi3SetString => {
+                        let v = vrs(&mut rng, &p.any);
+                        let mut out = [c"a".as_ptr(); 5];
+                        if function == Fmi3GetString {
+                            (f.get_string.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                        } else {
+                            (f.set_string.unwrap())(c, ptr(&v), n, out.as_ptr(), n_values)
+                        }
+                    }
+                    Fmi3GetBinary | Fmi3SetBinary => {
+                        let v = vrs(&mut rng, &p.any);
+                        let mut sizes = [1usize; 5];
+                        let mut out = [c"a".as_ptr() as *const u8; 5];
+                        if function == Fmi3GetBinary {
+                            (f.get_binary.unwrap())(c, ptr(&v), n, sizes.as_mut_ptr(), out.as_mut_ptr(), n_values)
+                        } else {
+                            (f.set_binary.unwrap())(c, ptr(&v), n, sizes.as_ptr(), out.as_ptr(), n_values)
+                        }
+                    }
+                    Fmi3GetClock | Fmi3SetClock => {
+                        let v = vrs(&mut rng, &p.any);
+                        let mut out = [1u8; 5];
+                        if function == Fmi3GetClock {
+                            (f.get_clock.unwrap())(c, ptr(&v), n, out.as_mut_ptr())
+                        } else {
+                            (f.set_clock.unwrap())(c, ptr(&v), n, out.as_ptr())
+                        }
+                    }
+                    Fmi3GetNumberOfVariableDependencies => {
+                        let mut k = 0usize;
+                        (f.get_number_of_variable_dependencies.unwrap())(c, rng.pick(&p.any), &mut k)
+                    }
+                    Fmi3GetVariableDependencies => {
+                        let (mut e, mut on, mut eon, mut kind) = ([0usize; 64], [0u32; 64], [0usize; 64], [0i32; 64]);
+                        let k = rng.pick(&[0, 1, 3, 64]);
+                        (f.get_variable_dependencies.unwrap())(
+                            c,
+                            rng.pick(&p.any),
+                            e.as_mut_ptr(),
+                            on.as_mut_ptr(),
+                            eon.as_mut_ptr(),
+                            kind.as_mut_ptr(),
+                            k,
+                        )
+                    }
+                    Fmi3GetFMUState => {
+                        let mut s = if rng.chance(20) && !sh.states.is_empty() { sh.states[0].0 } else { null_mut() };
+                        let before = s;
+                        let status = (f.get_fmu_state.unwrap())(c, &mut s);
+                        if status == OK {
+                            if before.is_null() {
+                                sh.states.push((s, sh.machine));
+                            } else if let Some(e) = sh.states.iter_mut().find(|e| e.0 == s) {
+                                e.1 = sh.machine;
+                            }
+                        }
+                        status
+                    }
+                    Fmi3SetFMUState => {
+                        let s = state_arg(&mut rng, &sh);
+                        let status = (f.set_fmu_state.unwrap())(c, s);
+                        if status == OK {
+                            restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
+                        }
+                        status
+                    }
+                    Fmi3FreeFMUState => {
+                        let mut s = state_arg(&mut rng, &sh);
+                        let before = s;
+                        let status = (f.free_fmu_state.unwrap())(c, &mut s);
+                        if status == OK && !before.is_null() {
+                            assert!(s.is_null());
+                            sh.states.retain(|e| e.0 != before);
+                            sh.freed.push(before);
+                        }
+                        status
+                    }
+                    Fmi3SerializedFMUStateSize => {
+                        let mut size = 0usize;
+                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
+                    }
+                    Fmi3SerializeFMUState => {
+                        let s = state_arg(&mut rng, &sh);
+                        let mut size = 0usize;
+                        let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
+                        let size = if rng.chance(10) { size / 2 } else { size };
+                        let mut buf = vec![0u8; size.min(1 << 20)];
+                        let status = (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr(), buf.len());
+                        if status == OK {
+                            sh.bytes = buf;
+                        }
+                        status
+                    }
+                    Fmi3DeserializeFMUState => {
+                        let mut bytes = sh.bytes.clone();
+                        if !bytes.is_empty() && rng.chance(50) {
+                            let k = rng.below(bytes.len());
+                            bytes[k] ^= 1 << rng.below(8);
+                        }
+                        if !bytes.is_empty() && rng.chance(20) {
+                            bytes.truncate(rng.below(bytes.len()));
+                        }
+                        if rng.chance(10) {
+                            bytes = (0..rng.below(200)).map(|_| rng.next() as u8).collect();
+                        }
+                        let mut s = null_mut();
+                        let status = (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr(), bytes.len(), &mut s);
+                        if status == OK {
+                            sh.states.push((s, None));
+                        }
+                        status
+                    }
+                    Fmi3GetDirectionalDerivative | Fmi3GetAdjointDerivative => {
+                        let unknown = vrs(&mut rng, &p.float64);
+                        let known = vrs(&mut rng, &p.float64);
+                        let seeds: Vec<f64> = (0..n_values).map(|_| rng.pick(&HOSTILE)).collect();
+                        check_reals = Some(n.min(n_values));
+                        let g = if function == Fmi3GetDirectionalDerivative {
+                            f.get_directional_derivative.unwrap()
+                        } else {
+                            f.get_adjoint_derivative.unwrap()
+                        };
+                        g(
+                            c,
+                            ptr(&unknown),
+                            n,
+                            ptr(&known),
+                            n,
+                            seeds.as_ptr(),
+                            n_values,
+                            reals_out.as_mut_ptr(),
+                            n_values,
+                        )
+                    }
+                    Fmi3EnterConfigurationMode => (f.enter_configuration_mode.unwrap())(c),
+                    Fmi3ExitConfigurationMode => (f.exit_configuration_mode.unwrap())(c),
+                    Fmi3GetIntervalDecimal
+                    | Fmi3GetIntervalFraction
+                    | Fmi3GetShiftDecimal
+                    | Fmi3GetShiftFraction
+                    | Fmi3SetIntervalDecimal
+                    | Fmi3SetIntervalFraction
+                    | Fmi3SetShiftDecimal
+                    | Fmi3SetShiftFraction => {
+                        let v = vrs(&mut rng, &p.any);
+                        let (mut x, mut a, mut b, mut q) = ([0.0; 5], [0u64; 5], [0u64; 5], [0i32; 5]);
+                        match function {
+                            Fmi3GetIntervalDecimal => {
+                                (f.get_interval_decimal.unwrap())(c, ptr(&v), n, x.as_mut_ptr(), q.as_mut_ptr())
+                            }
+                            Fmi3GetIntervalFraction => (f.get_interval_fraction.unwrap())(
+                                c,
+                                ptr(&v),
+                                n,
+                                a.as_mut_ptr(),
+                                b.as_mut_ptr(),
+                                q.as_mut_ptr(),
+                            ),
+                            Fmi3GetShiftDecimal => (f.get_shift_decimal.unwrap())(c, ptr(&v), n, x.as_mut_ptr()),
+                            Fmi3GetShiftFraction => {
+                                (f.get_shift_fraction.unwrap())(c, ptr(&v), n, a.as_mut_ptr(), b.as_mut_ptr())
+                            }
+                            Fmi3SetIntervalDecimal => (f.set_interval_decimal.unwrap())(c, ptr(&v), n, x.as_ptr()),
+                            Fmi3SetIntervalFraction => {
+                                (f.set_interval_fraction.unwrap())(c, ptr(&v), n, a.as_ptr(), b.as_ptr())
+                            }
+                            Fmi3SetShiftDecimal => (f.set_shift_decimal.unwrap())(c, ptr(&v), n, x.as_ptr()),
+                            _ => (f.set_shift_fraction.unwrap())(c, ptr(&v), n, a.as_ptr(), b.as_ptr()),
+                        }
+                    }
+                    Fmi3EvaluateDiscreteStates => (f.evaluate_discrete_states.unwrap())(c),
+                    Fmi3UpdateDiscreteStates => {
+                        let s = (f.update_discrete_states.unwrap())(
+                            c, &mut b1, &mut b2, &mut b3, &mut b4, &mut b5, &mut t_out,
+                        );
+                        if s == OK && b5 != 0 {
+                            assert!(t_out.is_finite());
+                        }
+                        s
+                    }
+                    Fmi3EnterContinuousTimeMode => (f.enter_continuous_time_mode.unwrap())(c),
+                    Fmi3CompletedIntegratorStep => (f.completed_integrator_step.unwrap())(c, 1, &mut b1, &mut b2),
+                    Fmi3SetTime => {
+                        let t = time_arg(&mut rng, sh.time + 1e-3);
+                        let s = (f.set_time.unwrap())(c, t);
+                        if s == OK || s == 1 {
+                            new_time = Some(t);
+                        }
+                        s
+                    }
+                    Fmi3SetContinuousStates => {
+                        let nx = if rng.chance(80) { p.nx } else { n };
+                        let x: Vec<f64> = (0..nx).map(|_| rng.pick(&HOSTILE)).collect();
+                        (f.set_continuous_states.unwrap())(c, if null_array { null() } else { x.as_ptr() }, nx)
+                    }
+                    Fmi3GetContinuousStateDerivatives
+                    | Fmi3GetContinuousStates
+                    | Fmi3GetNominalsOfContinuousStates
+                    | Fmi3GetEventIndicators => {
+                        let nx = if rng.chance(80) { p.nx } else { n };
+                        let out = if null_array { null_mut() } else { reals_out.as_mut_ptr() };
+                        check_reals = Some(nx);
+                        match function {
+                            Fmi3GetContinuousStateDerivatives => {
+                                (f.get_continuous_state_derivatives.unwrap())(c, out, nx)
+                            }
+                            Fmi3GetContinuousStates => (f.get_continuous_states.unwrap())(c, out, nx),
+                            Fmi3GetNominalsOfContinuousStates => {
+                                (f.get_nominals_of_continuous_states.unwrap())(c, out, nx)
+                            }
+                            _ => (f.get_event_indicators.unwrap())(c, out, nx),
+                        }
+                    }
+                    Fmi3GetNumberOfEventIndicators => {
+                        let mut k = 7usize;
+                        let s = (f.get_number_of_event_indicators.unwrap())(c, &mut k);
+                        assert!(s != OK || k == 0);
+                        s
+                    }
+                    Fmi3GetNumberOfContinuousStates => {
+                        let mut k = 7usize;
+                        let s = (f.get_number_of_continuous_states.unwrap())(c, &mut k);
+                        assert!(s != OK || k == p.nx);
+                        s
+                    }
+                    Fmi3EnterStepMode => (f.enter_step_mode.unwrap())(c),
+                    Fmi3GetOutputDerivatives => {
+                        let v = vrs(&mut rng, &p.float64);
+                        let order = [1i32; 5];
+                        (f.get_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), reals_out.as_mut_ptr(), n)
+                    }
+                    Fmi3DoStep => {
+                        let t = time_arg(&mut rng, sh.time);
+                        let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
+                        let s = (f.do_step.unwrap())(c, t, h, 1, &mut b1, &mut b2, &mut b3, &mut t_out);
+                        if s == OK || s == 1 {
+                            assert_eq!((b1, b3), (0, 0), "no event handling, no early return");
+                            new_time = Some(t + h);
+                        }
+                        s
+                    }
+                    Fmi3ActivateModelPartition => (f.activate_model_partition.unwrap())(c, rng.pick(&p.any), 0.0),
+                    _ => unreachable!("{function:?}"),
+                }
+            };
+            assert!((0..=3).contains(&status), "{function:?} returned {status}");
+            counts[status as usize] += 1;
+            if let Some(m) = sh.machine {
+                let wrong_interface = function.scope() != Scope::Common && function.scope() != interface_scope;
+                let event_mode_in_cs = co_simulation
+                    && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates);
+                if wrong_interface
+                    || event_mode_in_cs
+                    || function.undeclared_feature().is_some()
+                    || !function.allowed_in(m)
+                {
+                    assert_eq!(status, ERROR, "{function:?} in {m:?} ({})", if co_simulation { "CS" } else { "ME" });
+                }
+            }
+            if status == ERROR {
+                let records = log.0.records.lock().unwrap();
+                let last = records.iter().rev().find(|r| r.status == ERROR).map(|r| r.message.as_str());
+                assert!(
+                    last.is_some_and(|m| m.starts_with(function.name())),
+                    "{function:?}: an error without its message ({last:?})"
+                );
+            }
+            if status == OK {
+                if let Some(k) = check_reals {
+                    if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
+                        panic!("{function:?} handed out {bad} with fmi3OK");
+                    }
+                }
+            }
+            if status == ERROR {
+                sh.machine = Some(Machine::Error);
+            } else if status == DISCARD && function == Function::Fmi3DoStep {
+                sh.machine = Some(Machine::StepFailed);
+            } else if status == OK || status == 1 {
+                if let Some(t) = new_time {
+                    sh.time = t;
+                }
+                let after = match function {
+                    Function::Fmi3EnterInitializationMode => Some(Some(Machine::InitializationMode)),
+                    Function::Fmi3ExitInitializationMode => {
+                        Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
+                    }
+                    Function::Fmi3Terminate => Some(Some(Machine::Terminated)),
+                    Function::Fmi3Reset => {
+                        sh.time = 0.0;
+                        Some(Some(Machine::Instantiated))
+                    }
+                    Function::Fmi3EnterEventMode => Some(Some(Machine::EventMode)),
+                    Function::Fmi3EnterContinuousTimeMode => Some(Some(Machine::ContinuousTimeMode)),
+                    Function::Fmi3SetFMUState => {
+                        sh.time = f64::NAN;
+                        restored
+                    }
+                    _ => None,
+                };
+                if let Some(m) = after {
+                    sh.machine = m;
+                }
+            }
+            if sh.time.is_nan() {
+                sh.time = 0.0;
+            }
+            // now and then an FMI 2.0 function on the FMI 3.0 instance: refused
+            if rng.chance(2) {
+                let s = unsafe { (fmu.functions.terminate)(c) };
+                assert_eq!(s, ERROR, "fmi2Terminate on an FMI 3.0 instance");
+                sh.machine = Some(Machine::Error);
+            }
+        }
+    }
+    counts
+}
+
+#[test]
+fn random_fmi3_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
+    let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES3").ok().and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    for (k, target) in build_fmu::targets().iter().enumerate() {
+        let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
+        for co_simulation in [true, false] {
+            let offered = if co_simulation {
+                fmu.description.co_simulation.is_some()
+            } else {
+                fmu.description.model_exchange.is_some()
+            };
+            if !offered {
+                continue;
+            }
+            let counts =
+                run(&fmu, co_simulation, sequences, 0x3C6E_F372_FE94_F82B ^ (k as u64 * 2 + co_simulation as u64));
+            let total: usize = counts.iter().sum();
+            println!(
+                "{} {} (FMI 3.0): {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
+                target.model_identifier,
+                if co_simulation { "CS" } else { "ME" },
+                counts[0],
+                counts[1],
+                counts[2],
+                counts[3]
+            );
+            assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
+        }
+    }
+}
