@@ -95,19 +95,22 @@ fn ssp_with_fmi3(fmi2_ssp: &Path, dir: &Path, which: &[&str], file: &str) -> Pat
     path
 }
 
-/// The FMI 2.0 closed loop, the one with the plant in FMI 3.0, the one of three FMI 3.0 FMUs.
+/// The FMI 2.0 closed loop, the one with the plant in FMI 3.0, the one of three FMI 3.0 FMUs
+/// (their `.ssp` files written once per test process, into a folder of its own).
 fn closed_loops() -> (nigel_cosim::System, nigel_cosim::System, nigel_cosim::System) {
-    let fmi2_ssp = target_dir().join("ssp").join("nigel_closed_loop.ssp");
-    assert!(fmi2_ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu`", fmi2_ssp.display());
-    let dir = target_dir().join("fmi3-closed-loop");
-    std::fs::create_dir_all(&dir).unwrap();
-    let read = |p: PathBuf| read_ssp(&p, &Default::default()).unwrap().system;
-    let all = ["nigel_plant", "nigel_controller", "nigel_maneuver"];
-    (
-        read(fmi2_ssp.clone()),
-        read(ssp_with_fmi3(&fmi2_ssp, &dir, &all[..1], "nigel_closed_loop_mixed.ssp")),
-        read(ssp_with_fmi3(&fmi2_ssp, &dir, &all, "nigel_closed_loop_fmi3.ssp")),
-    )
+    static SSPS: std::sync::OnceLock<[PathBuf; 3]> = std::sync::OnceLock::new();
+    let [fmi2_ssp, mixed, fmi3] = SSPS.get_or_init(|| {
+        let fmi2_ssp = target_dir().join("ssp").join("nigel_closed_loop.ssp");
+        assert!(fmi2_ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu`", fmi2_ssp.display());
+        let dir = target_dir().join(format!("fmi3-closed-loop-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let all = ["nigel_plant", "nigel_controller", "nigel_maneuver"];
+        let mixed = ssp_with_fmi3(&fmi2_ssp, &dir, &all[..1], "nigel_closed_loop_mixed.ssp");
+        let fmi3 = ssp_with_fmi3(&fmi2_ssp, &dir, &all, "nigel_closed_loop_fmi3.ssp");
+        [fmi2_ssp, mixed, fmi3]
+    });
+    let read = |p: &PathBuf| read_ssp(p, &Default::default()).unwrap().system;
+    (read(fmi2_ssp), read(mixed), read(fmi3))
 }
 
 #[test]
