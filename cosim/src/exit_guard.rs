@@ -16,41 +16,15 @@
 //! folders likewise; a lock that is held means "not written", said so, never a hang. It
 //! ends with `_exit`: calling `exit()` again from a handler is undefined, and the
 //! remaining handlers (the FMU's own destructors, run while the FMU is inside a call)
-//! are better not run. The marker holds pointers to the instance's name and its `Fmu`,
-//! both alive for the whole call it marks; they are read only in the calling thread.
-//! Only the thread-local `Cell`s of `Copy` values are read: they have no destructor, so
-//! glibc's run of thread-local destructors before the handlers leaves them intact.
+//! are better not run. The marker is `fmi_import::call_site`'s (what it holds and why
+//! reading it in the handler is sound is said there).
 
-use crate::fmu::Fmu;
+pub use fmi_import::call_site::ExitInsideCall;
+
 use crate::simulate::Results;
 use std::cell::Cell;
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
-
-/// The call an FMU was in when it called `exit()`.
-#[derive(Clone, Debug)]
-pub struct ExitInsideCall {
-    /// The instance.
-    pub instance: String,
-    /// The FMU's archive ([`Fmu::source`]).
-    pub fmu: PathBuf,
-    /// The FMI function.
-    pub function: &'static str,
-    /// The time the instance was at (the step's start for `fmi2DoStep`), s.
-    pub time: f64,
-}
-
-impl std::fmt::Display for ExitInsideCall {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let file = self.fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        write!(
-            f,
-            "{} ({file}) called exit() inside {} at t = {} s, ending the process in the middle of the run",
-            self.instance, self.function, self.time
-        )
-    }
-}
 
 /// What the program does with the rows when an FMU calls `exit()` during a run: given
 /// the call (`None`: `exit()` came from a thread in no FMU call, while a run was in
@@ -68,14 +42,6 @@ pub fn on_exit_inside_call(hook: Box<ExitHook>) -> bool {
     HOOK.set(hook).is_ok()
 }
 
-#[derive(Clone, Copy)]
-struct Site {
-    instance: *const str,
-    fmu: *const Fmu,
-    function: &'static str,
-    time: f64,
-}
-
 /// The rows of one run, shared with the handler.
 #[derive(Default)]
 pub(crate) struct RunRows {
@@ -83,34 +49,11 @@ pub(crate) struct RunRows {
 }
 
 thread_local! {
-    static CALL: Cell<Option<Site>> = const { Cell::new(None) };
     static RUN: Cell<*const RunRows> = const { Cell::new(std::ptr::null()) };
 }
 
 /// Runs in progress in this process.
 static ACTIVE: AtomicUsize = AtomicUsize::new(0);
-
-/// The mark of a call in progress; the previous mark comes back when it is dropped. It is
-/// the one marker of an FMU call: read by this process's `atexit` handler, and, inside the
-/// host of `--isolate=run`, also written to the region its parent reads after a crash
-/// ([`crate::isolate::whole`]).
-pub(crate) struct InCall(Option<Site>, #[allow(dead_code)] crate::isolate::whole::Mark);
-
-/// Marks the call `function` of `instance` (of `fmu`) at `time` as in progress in this
-/// thread.
-#[inline]
-pub(crate) fn enter(instance: &str, fmu: &Fmu, function: &'static str, time: f64) -> InCall {
-    let site = Site { instance, fmu, function, time };
-    let shared = crate::isolate::whole::Mark::call(instance, function, time);
-    InCall(CALL.with(|c| c.replace(Some(site))), shared)
-}
-
-impl Drop for InCall {
-    #[inline]
-    fn drop(&mut self) {
-        CALL.with(|c| c.set(self.0));
-    }
-}
 
 /// A run in progress: its rows known to this thread's handler while it lives.
 pub(crate) struct Registered {
@@ -165,17 +108,7 @@ extern "C" fn on_exit() {
     if ACTIVE.load(Ordering::SeqCst) == 0 {
         return; // the program ends normally, between runs
     }
-    let site = CALL.try_with(|c| c.get()).ok().flatten();
-    // SAFETY: the pointers of a mark are alive for the call it marks, and that call is
-    // in progress in this very thread (it is the one calling exit()).
-    let call = site.map(|s| unsafe {
-        ExitInsideCall {
-            instance: (*s.instance).to_string(),
-            fmu: (*s.fmu).source().to_path_buf(),
-            function: s.function,
-            time: s.time,
-        }
-    });
+    let call = fmi_import::call_site::current_call();
     let run = RUN.try_with(|r| r.get()).unwrap_or(std::ptr::null());
     // SAFETY: a registered run's rows outlive its registration, which is in progress.
     let rows = (!run.is_null()).then(|| unsafe { &*run }).and_then(|r| r.results.try_lock().ok());
@@ -187,7 +120,7 @@ extern "C" fn on_exit() {
         },
     }));
     drop(result);
-    crate::unpack::remove_temporary_folders_now();
+    fmi_import::unpack::remove_temporary_folders_now();
     // SAFETY: ends the process at once, as the handler must (see the module's comment).
     unsafe { libc::_exit(1) };
 }

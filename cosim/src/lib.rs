@@ -30,18 +30,21 @@
 #![warn(missing_docs)]
 
 pub mod bdf;
-mod elf;
-pub mod error;
+pub(crate) use fmi_import::suggest;
+pub use fmi_import::{error, fmu, unpack};
 pub mod exit_guard;
-pub mod fmu;
-pub mod isolate;
 pub mod mat;
 pub mod me;
 pub mod simulate;
 pub mod ssp;
-pub(crate) mod suggest;
 pub mod system;
-pub mod unpack;
+
+/// Isolation: instances in host processes of their own ([`fmi_import::isolate`]), and the
+/// whole run in one host process ([`isolate::whole`]).
+pub mod isolate {
+    pub use fmi_import::isolate::*;
+    pub mod whole;
+}
 
 pub use error::{Error, HostEnd, Result, Status};
 pub use exit_guard::{on_exit_inside_call, ExitInsideCall};

@@ -405,8 +405,28 @@ impl SystemBuilder {
         Ok(self)
     }
 
-    /// Sets a value given as text, parsed for the variable's type.
+    /// Sets a value given as text, parsed for the variable's type. An array of an FMI 3.0
+    /// FMU (its elements `name[1]`, `name[2]`, ... in the view) takes all its elements at
+    /// once as `[v1, v2, ...]` (row-major; commas, semicolons or spaces between them).
     pub fn set_text(&mut self, variable: &str, text: &str) -> Result<&mut Self> {
+        let t = text.trim();
+        if let (Some(inner), Some(elements)) =
+            (t.strip_prefix('[').and_then(|t| t.strip_suffix(']')), self.array_elements(variable))
+        {
+            let items: Vec<&str> =
+                inner.split(|c: char| c == ',' || c == ';' || c.is_whitespace()).filter(|s| !s.is_empty()).collect();
+            if items.len() != elements.len() {
+                return Err(Error::InvalidValue {
+                    variable: variable.into(),
+                    value: text.into(),
+                    reason: format!("{} values for the {} elements of the array", items.len(), elements.len()),
+                });
+            }
+            for (element, item) in elements.iter().zip(items) {
+                self.set_text(element, item)?;
+            }
+            return Ok(self);
+        }
         let r = self.system.resolve(variable)?;
         let value = Value::parse(r.base_type, text).map_err(|reason| Error::InvalidValue {
             variable: variable.into(),
@@ -421,6 +441,26 @@ impl SystemBuilder {
             },
         })?;
         self.set(variable, value)
+    }
+
+    /// The elements `instance.name[...]` of the array `variable` (`instance.name`), in
+    /// order; `None` when `variable` is a variable itself or has no elements.
+    fn array_elements(&self, variable: &str) -> Option<Vec<String>> {
+        if self.system.resolve(variable).is_ok() {
+            return None;
+        }
+        let (instance, name) = split_name(variable)?;
+        let md = self.system.description(self.system.instance_index(instance)?);
+        let prefix = format!("{name}[");
+        let elements: Vec<String> = md
+            .model_variables
+            .iter()
+            .filter(|v| {
+                v.name.strip_prefix(&prefix).and_then(|rest| rest.strip_suffix(']')).is_some_and(|i| !i.contains('['))
+            })
+            .map(|v| format!("{instance}.{}", v.name))
+            .collect();
+        (!elements.is_empty()).then_some(elements)
     }
 
     /// Connects output `from` to input `to` (`instance.variable` each).

@@ -103,10 +103,13 @@ pub enum ReadError {
         /// The element's start tag.
         position: Position,
     },
-    /// `fmiVersion` is not `"2.0"`.
+    /// `fmiVersion` is not the one this reader reads (`"2.0"` for [`ModelDescription::from_xml`],
+    /// `"3.x"` for [`crate::fmi3::ModelDescription::from_xml`]).
     UnsupportedFmiVersion {
         /// The value found.
         found: String,
+        /// What the reader accepts, e.g. `"2.0"`.
+        expected: &'static str,
         /// The root's start tag.
         position: Position,
     },
@@ -115,6 +118,27 @@ pub enum ReadError {
     MissingTypeChild {
         /// The variable's name.
         variable: String,
+        /// Its start tag.
+        position: Position,
+    },
+    /// An element the schema does not allow where it is (FMI 3.0: a variable or type
+    /// definition element that is not one of the standard's types, a ModelStructure entry
+    /// of an unknown kind).
+    UnknownElement {
+        /// The element's name.
+        element: String,
+        /// The element it is in.
+        parent: String,
+        /// Its start tag.
+        position: Position,
+    },
+    /// An element whose attributes contradict each other or the standard (e.g. a
+    /// `<Dimension>` with both or neither of `start` and `valueReference`).
+    Invalid {
+        /// The element.
+        element: String,
+        /// What is wrong.
+        message: String,
         /// Its start tag.
         position: Position,
     },
@@ -139,6 +163,8 @@ impl ReadError {
             | ReadError::UnknownEnumValue { position, .. }
             | ReadError::UnsupportedFmiVersion { position, .. }
             | ReadError::MissingTypeChild { position, .. }
+            | ReadError::UnknownElement { position, .. }
+            | ReadError::Invalid { position, .. }
             | ReadError::DuplicateElement { position, .. } => *position,
         }
     }
@@ -171,14 +197,18 @@ impl fmt::Display for ReadError {
                 f,
                 "{element} at {position}: attribute {attribute} has unknown value \"{value}\""
             ),
-            ReadError::UnsupportedFmiVersion { found, position } => write!(
+            ReadError::UnsupportedFmiVersion { found, expected, position } => write!(
                 f,
-                "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"2.0\")"
+                "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\")"
             ),
             ReadError::MissingTypeChild { variable, position } => write!(
                 f,
                 "ScalarVariable \"{variable}\" at {position}: no type element (<Real>, <Integer>, <Boolean>, <String> or <Enumeration>)"
             ),
+            ReadError::UnknownElement { element, parent, position } => {
+                write!(f, "unknown element <{element}> in <{parent}> at {position}")
+            }
+            ReadError::Invalid { element, message, position } => write!(f, "{element} at {position}: {message}"),
             ReadError::DuplicateElement { element, position } => {
                 write!(f, "duplicate <{element}> at {position}")
             }
@@ -194,15 +224,15 @@ impl std::error::Error for ReadError {}
 
 const MAX_DEPTH: usize = 5;
 
-struct Node {
-    name: String,
-    attrs: Vec<(String, String)>,
-    pos: usize,
-    children: Vec<Node>,
+pub(crate) struct Node {
+    pub(crate) name: String,
+    pub(crate) attrs: Vec<(String, String)>,
+    pub(crate) pos: usize,
+    pub(crate) children: Vec<Node>,
 }
 
 impl Node {
-    fn get(&self, key: &str) -> Option<&str> {
+    pub(crate) fn get(&self, key: &str) -> Option<&str> {
         self.attrs.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }
 }
@@ -238,7 +268,7 @@ fn make_node(src: &str, reader: &Reader<&[u8]>, e: &BytesStart<'_>, pos: usize) 
     Ok(Node { name, attrs, pos, children: Vec::new() })
 }
 
-fn parse_tree(src: &str) -> Result<Node, ReadError> {
+pub(crate) fn parse_tree(src: &str) -> Result<Node, ReadError> {
     let mut reader = Reader::from_str(src);
     reader.config_mut().trim_text(true);
     // Open elements: the stored ones (depth <= MAX_DEPTH), and name and position of
@@ -316,16 +346,16 @@ fn parse_tree(src: &str) -> Result<Node, ReadError> {
 // ---------------------------------------------------------------------------------------
 // Attribute access with typed errors.
 
-struct Ctx<'a> {
-    src: &'a str,
+pub(crate) struct Ctx<'a> {
+    pub(crate) src: &'a str,
 }
 
 impl Ctx<'_> {
-    fn pos(&self, n: &Node) -> Position {
+    pub(crate) fn pos(&self, n: &Node) -> Position {
         Position::in_text(self.src, n.pos)
     }
 
-    fn req<'n>(&self, n: &'n Node, label: &str, key: &str) -> Result<&'n str, ReadError> {
+    pub(crate) fn req<'n>(&self, n: &'n Node, label: &str, key: &str) -> Result<&'n str, ReadError> {
         n.get(key).ok_or_else(|| ReadError::MissingAttribute {
             element: label.to_string(),
             attribute: key.to_string(),
@@ -333,7 +363,7 @@ impl Ctx<'_> {
         })
     }
 
-    fn bad_number(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
+    pub(crate) fn bad_number(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
         ReadError::BadNumber {
             element: label.to_string(),
             attribute: key.to_string(),
@@ -342,7 +372,7 @@ impl Ctx<'_> {
         }
     }
 
-    fn bad_enum(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
+    pub(crate) fn bad_enum(&self, n: &Node, label: &str, key: &str, value: &str) -> ReadError {
         ReadError::UnknownEnumValue {
             element: label.to_string(),
             attribute: key.to_string(),
@@ -351,28 +381,28 @@ impl Ctx<'_> {
         }
     }
 
-    fn f64_of(&self, n: &Node, label: &str, key: &str, value: &str) -> Result<f64, ReadError> {
+    pub(crate) fn f64_of(&self, n: &Node, label: &str, key: &str, value: &str) -> Result<f64, ReadError> {
         parse_xs_double(value).ok_or_else(|| self.bad_number(n, label, key, value))
     }
 
-    fn opt_f64(&self, n: &Node, label: &str, key: &str) -> Result<Option<f64>, ReadError> {
+    pub(crate) fn opt_f64(&self, n: &Node, label: &str, key: &str) -> Result<Option<f64>, ReadError> {
         n.get(key).map(|v| self.f64_of(n, label, key, v)).transpose()
     }
 
-    fn opt_u32(&self, n: &Node, label: &str, key: &str) -> Result<Option<u32>, ReadError> {
+    pub(crate) fn opt_u32(&self, n: &Node, label: &str, key: &str) -> Result<Option<u32>, ReadError> {
         n.get(key).map(|v| v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))).transpose()
     }
 
-    fn req_u32(&self, n: &Node, label: &str, key: &str) -> Result<u32, ReadError> {
+    pub(crate) fn req_u32(&self, n: &Node, label: &str, key: &str) -> Result<u32, ReadError> {
         let v = self.req(n, label, key)?;
         v.trim().parse::<u32>().map_err(|_| self.bad_number(n, label, key, v))
     }
 
-    fn opt_i32(&self, n: &Node, label: &str, key: &str) -> Result<Option<i32>, ReadError> {
+    pub(crate) fn opt_i32(&self, n: &Node, label: &str, key: &str) -> Result<Option<i32>, ReadError> {
         n.get(key).map(|v| v.trim().parse::<i32>().map_err(|_| self.bad_number(n, label, key, v))).transpose()
     }
 
-    fn opt_bool(&self, n: &Node, label: &str, key: &str) -> Result<Option<bool>, ReadError> {
+    pub(crate) fn opt_bool(&self, n: &Node, label: &str, key: &str) -> Result<Option<bool>, ReadError> {
         n.get(key)
             .map(|v| match v.trim() {
                 "true" | "1" => Ok(true),
@@ -382,11 +412,11 @@ impl Ctx<'_> {
             .transpose()
     }
 
-    fn flag(&self, n: &Node, label: &str, key: &str) -> Result<bool, ReadError> {
+    pub(crate) fn flag(&self, n: &Node, label: &str, key: &str) -> Result<bool, ReadError> {
         Ok(self.opt_bool(n, label, key)?.unwrap_or(false))
     }
 
-    fn opt_enum<T>(
+    pub(crate) fn opt_enum<T>(
         &self,
         n: &Node,
         label: &str,
@@ -396,7 +426,7 @@ impl Ctx<'_> {
         n.get(key).map(|v| parse(v.trim()).ok_or_else(|| self.bad_enum(n, label, key, v))).transpose()
     }
 
-    fn opt_string(n: &Node, key: &str) -> Option<String> {
+    pub(crate) fn opt_string(n: &Node, key: &str) -> Option<String> {
         n.get(key).map(str::to_string)
     }
 }
@@ -422,7 +452,7 @@ struct TypeDefaults {
     nominal: Option<String>,
 }
 
-fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> Result<(), ReadError> {
+pub(crate) fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> Result<(), ReadError> {
     if slot.is_some() {
         return Err(ReadError::DuplicateElement { element: n.name.clone(), position: ctx.pos(n) });
     }
@@ -444,7 +474,11 @@ impl ModelDescription {
         let label = "fmiModelDescription";
         let fmi_version = ctx.req(&root, label, "fmiVersion")?;
         if fmi_version.trim() != "2.0" {
-            return Err(ReadError::UnsupportedFmiVersion { found: fmi_version.to_string(), position: ctx.pos(&root) });
+            return Err(ReadError::UnsupportedFmiVersion {
+                found: fmi_version.to_string(),
+                expected: "2.0",
+                position: ctx.pos(&root),
+            });
         }
         let model_name = ctx.req(&root, label, "modelName")?.to_string();
         let guid = ctx.req(&root, label, "guid")?.to_string();

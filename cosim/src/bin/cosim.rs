@@ -620,6 +620,10 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         };
     }
     let mut out = std::io::stdout().lock();
+    if let Some(md) = nigel_cosim::fmu::read_fmi3_description(path, limits)? {
+        info_fmi3(&mut out, &md);
+        return Ok(());
+    }
     let fmu = Fmu::load_with(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
     let md = fmu.description();
     w!(out, "model {} (FMI {}), guid {}", md.model_name, md.fmi_version, md.guid);
@@ -692,4 +696,144 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// `cosim info` of an FMI 3.0 FMU: interface types with their capabilities, and every
+/// variable with its type and dimensions.
+fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelDescription) {
+    use model_description::fmi3::{Bound, Dimension, Values};
+    // a closed pipe (`cosim info X | head`) ends the listing quietly
+    macro_rules! w {
+        ($o:expr, $($a:tt)*) => {
+            if writeln!($o, $($a)*).is_err() {
+                return;
+            }
+        };
+    }
+    w!(out, "model {} (FMI {}), instantiationToken {}", md.model_name, md.fmi_version, md.instantiation_token);
+    if let Some(d) = md.description.as_deref().filter(|d| !d.is_empty()) {
+        w!(out, "{d}");
+    }
+    let flags = |pairs: &[(bool, &str)]| -> String {
+        let v: Vec<&str> = pairs.iter().filter(|(on, _)| *on).map(|(_, n)| *n).collect();
+        if v.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", v.join(", "))
+        }
+    };
+    let mut interfaces = Vec::new();
+    if let Some(cs) = &md.co_simulation {
+        interfaces.push(format!(
+            "CoSimulation ({}{})",
+            cs.common.model_identifier,
+            flags(&[
+                (cs.can_handle_variable_communication_step_size, "variable step"),
+                (cs.might_return_early_from_do_step, "early return"),
+                (cs.has_event_mode, "event mode"),
+                (cs.common.can_get_and_set_fmu_state, "FMU state"),
+                (cs.common.provides_directional_derivatives, "directional derivatives"),
+            ])
+        ));
+    }
+    if let Some(me) = &md.model_exchange {
+        interfaces.push(format!(
+            "ModelExchange ({}{})",
+            me.common.model_identifier,
+            flags(&[
+                (me.needs_completed_integrator_step, "completed integrator step"),
+                (me.common.can_get_and_set_fmu_state, "FMU state"),
+                (me.common.provides_directional_derivatives, "directional derivatives"),
+            ])
+        ));
+    }
+    if let Some(se) = &md.scheduled_execution {
+        interfaces.push(format!("ScheduledExecution ({}; not run by cosim)", se.common.model_identifier));
+    }
+    w!(out, "interfaces: {}", interfaces.join(", "));
+    w!(
+        out,
+        "continuous states: {}, event indicators: {}",
+        md.model_structure.continuous_state_derivatives.len(),
+        md.model_structure.event_indicators.len()
+    );
+    if let Some(d) = &md.default_experiment {
+        let parts: Vec<String> = [
+            d.start_time.map(|v| format!("start {} s", plain(v))),
+            d.stop_time.map(|v| format!("stop {} s", plain(v))),
+            d.step_size.map(|v| format!("step {} s", plain(v))),
+            d.tolerance.map(|v| format!("tolerance {}", plain(v))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !parts.is_empty() {
+            w!(out, "default experiment: {}", parts.join(", "));
+        }
+    }
+    w!(
+        out,
+        "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} description",
+        "name",
+        "causality",
+        "variability",
+        "type",
+        "dimensions",
+        "unit",
+        "start",
+        "min .. max"
+    );
+    for v in &md.model_variables {
+        let dims = if v.dimensions.is_empty() {
+            "-".to_string()
+        } else {
+            let each: Vec<String> = v
+                .dimensions
+                .iter()
+                .map(|d| match d {
+                    Dimension::Fixed(n) => n.to_string(),
+                    Dimension::Variable(vr) => md.variable(*vr).map_or_else(|| format!("vr {vr}"), |s| s.name.clone()),
+                })
+                .collect();
+            format!("[{}]", each.join(","))
+        };
+        let start = v.start.as_ref().map(|s| {
+            let items: Vec<String> = match s {
+                Values::Float(x) => x.iter().map(|x| plain(*x)).collect(),
+                Values::Int(x) => x.iter().map(|x| x.to_string()).collect(),
+                Values::Boolean(x) => x.iter().map(|x| x.to_string()).collect(),
+                Values::String(x) => x.iter().map(|x| format!("{x:?}")).collect(),
+                // binary values as their size, as the results record them
+                Values::Binary(x) => x.iter().map(|x| format!("{} bytes", x.len())).collect(),
+            };
+            if items.len() == 1 {
+                items[0].clone()
+            } else {
+                format!("[{}]", items.join(" "))
+            }
+        });
+        let bound = |b: Option<Bound>| match b {
+            Some(Bound::Float(x)) => plain(x),
+            Some(Bound::Int(i)) => i.to_string(),
+            None => String::new(),
+        };
+        let range = if v.min.is_none() && v.max.is_none() {
+            String::new()
+        } else {
+            format!("{} .. {}", bound(v.min), bound(v.max))
+        };
+        w!(
+            out,
+            "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
+            v.name,
+            v.causality.as_str(),
+            v.variability.as_str(),
+            v.value_type.element(),
+            dims,
+            md.unit_of(v).unwrap_or("-"),
+            start.unwrap_or_else(|| "-".into()),
+            range,
+            v.description.as_deref().unwrap_or("")
+        );
+    }
 }

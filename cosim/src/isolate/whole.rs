@@ -7,7 +7,7 @@
 //! same command line, loads the FMUs in process and simulates ([`host_simulate`]),
 //! writing into the region:
 //! - before each fmi2 call, the instance, the function and the time, and after it that the
-//!   call returned ([`Mark`]; with one thread: `--threads` 1);
+//!   call returned (`fmi_import::call_site`; with one thread: `--threads` 1);
 //! - each recorded row as it comes (the region grows with `ftruncate` + `mremap`);
 //! - the folders its FMUs are unpacked in (the parent removes them if the host is killed);
 //! - at the end the outcome: the summary's JSON, or that the run failed (the host printed
@@ -21,18 +21,18 @@
 
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicPtr, AtomicU32, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::error::{Error, HostEnd, Result};
 use crate::simulate::{default_record, simulate_with, Experiment, Results, Summary};
 use crate::system::System;
+use fmi_import::call_site::{self, CallSlots};
 
 /// The environment variable that makes a `cosim` the host of a whole run.
 pub const HOST_VARIABLE: &str = "NIGEL_COSIM_WHOLE_RUN";
 
 const HEADER: usize = 64 << 10;
-const NAME: usize = 128;
 const MAGIC: u64 = 0x6e69_6765_6c57_484c;
 
 /// The start of the region.
@@ -41,88 +41,22 @@ struct Header {
     magic: u64,
     /// 0 running, 1 completed (the summary's JSON follows), 2 failed (reported by the host).
     state: AtomicU32,
-    /// 1 while a call is in progress.
-    in_call: AtomicU32,
+    /// The call in progress (or the last one).
+    call: CallSlots,
     /// Values per row (time first) and the rows written.
     width: AtomicU64,
     rows: AtomicU64,
-    /// The call in progress (or the last one).
-    time: AtomicU64,
-    instance_len: AtomicU32,
-    function_len: AtomicU32,
-    instance: [u8; NAME],
-    function: [u8; NAME],
     /// Bytes of the folder list and of the summary JSON, both in `text`.
     folders_len: AtomicU32,
     summary_len: AtomicU32,
-    text: [u8; HEADER - 8 * 5 - 4 * 6 - 2 * NAME],
+    text: [u8; HEADER - 8 * 3 - 4 * 4 - std::mem::size_of::<CallSlots>()],
 }
 
-/// The host's region, when this process is the host of a whole run.
-static REGION: AtomicPtr<Header> = AtomicPtr::new(std::ptr::null_mut());
-/// The function last written into the marker (its address).
-static LAST_FUNCTION: AtomicUsize = AtomicUsize::new(0);
+const _: () = assert!(std::mem::size_of::<Header>() <= HEADER);
 
 /// Whether this process is the host of a whole run (its parent set [`HOST_VARIABLE`]).
 pub fn is_host() -> bool {
     std::env::var_os(HOST_VARIABLE).is_some()
-}
-
-#[inline]
-fn copy_name(dst: &mut [u8; NAME], len: &AtomicU32, s: &str) {
-    let b = s.as_bytes();
-    let n = b.len().min(NAME);
-    if n <= 16 {
-        // a short name byte by byte: cheaper than a call of memcpy
-        for (d, c) in dst.iter_mut().zip(&b[..n]) {
-            *d = *c;
-        }
-    } else {
-        dst[..n].copy_from_slice(&b[..n]);
-    }
-    len.store(n as u32, Ordering::Relaxed);
-}
-
-/// Marks an fmi2 call of `instance` in the host's region until dropped (nothing outside a
-/// host or a marked process, and nothing when the run has several threads: one marker holds
-/// one call).
-pub(crate) struct Mark(bool);
-
-impl Mark {
-    #[inline]
-    pub(crate) fn call(instance: &str, function: &'static str, time: f64) -> Mark {
-        let p = REGION.load(Ordering::Relaxed);
-        if p.is_null() {
-            return Mark(false);
-        }
-        // SAFETY: the region stays mapped for the life of the host process; only the
-        // simulating thread writes the marker (REGION is set only for one thread).
-        let h = unsafe { &mut *p };
-        // the instance's name every time (a freed name's address may come back with another);
-        // the function's only when it changes (a static string)
-        copy_name(&mut h.instance, &h.instance_len, instance);
-        // plain loads and stores, no locked instruction: one thread writes the marker
-        if LAST_FUNCTION.load(Ordering::Relaxed) != function.as_ptr() as usize {
-            LAST_FUNCTION.store(function.as_ptr() as usize, Ordering::Relaxed);
-            copy_name(&mut h.function, &h.function_len, function);
-        }
-        h.time.store(time.to_bits(), Ordering::Relaxed);
-        h.in_call.store(1, Ordering::Release);
-        Mark(true)
-    }
-}
-
-impl Drop for Mark {
-    #[inline]
-    fn drop(&mut self) {
-        if self.0 {
-            let p = REGION.load(Ordering::Relaxed);
-            if !p.is_null() {
-                // SAFETY: as in `call`.
-                unsafe { (*p).in_call.store(0, Ordering::Release) };
-            }
-        }
-    }
 }
 
 /// A region that only holds the call marker, for a process that runs many runs (a
@@ -168,7 +102,7 @@ pub fn mark_calls(fd: i32) -> std::result::Result<(), String> {
     let mut region = Region { fd, base: std::ptr::null_mut(), len: 0 };
     region.grow(HEADER)?;
     region.header().magic = MAGIC;
-    REGION.store(region.base as *mut Header, Ordering::Release);
+    region.mark_calls();
     Ok(())
 }
 
@@ -193,7 +127,7 @@ pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
     h.folders_len.store(n as u32, Ordering::Release);
     h.magic = MAGIC;
     if experiment.threads <= 1 {
-        REGION.store(region.base as *mut Header, Ordering::Release);
+        region.mark_calls();
     }
     let mut rows = 0usize;
     let mut failed = None;
@@ -208,7 +142,7 @@ pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
                 return;
             }
             if experiment.threads <= 1 {
-                REGION.store(region.base as *mut Header, Ordering::Release);
+                region.mark_calls();
             }
         }
         // SAFETY: within the mapping just grown; the parent reads only `rows` rows.
@@ -221,7 +155,8 @@ pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
         region.header().rows.store(rows as u64, Ordering::Release);
     };
     let outcome = simulate_with(system, experiment, None, Some(&mut sink));
-    REGION.store(std::ptr::null_mut(), Ordering::Release);
+    // SAFETY: stops the marking.
+    unsafe { call_site::mark_calls_in(std::ptr::null_mut()) };
     let h = region.header();
     match outcome {
         Ok((_, summary)) => {
@@ -255,6 +190,13 @@ struct Region {
 }
 
 impl Region {
+    /// Copies each marked call of this process into the region's call slots, from now on.
+    fn mark_calls(&self) {
+        // SAFETY: the mapping lives as long as the process (it is never unmapped, only
+        // moved by `grow`, which is followed by another `mark_calls`).
+        unsafe { call_site::mark_calls_in(&mut self.header().call) };
+    }
+
     fn header(&self) -> &'static mut Header {
         // SAFETY: the mapping starts with a Header and lives as long as the process.
         unsafe { &mut *(self.base as *mut Header) }
@@ -425,16 +367,7 @@ fn read_region(fd: &OwnedFd, names: Option<Vec<String>>) -> Option<Read> {
             let summary = (state == 1)
                 .then(|| serde_json::from_slice(&h.text[folders_len..folders_len + summary_len]).ok())
                 .flatten();
-            let il = (h.instance_len.load(Ordering::Acquire) as usize).min(NAME);
-            let fl = (h.function_len.load(Ordering::Acquire) as usize).min(NAME);
-            let mark = (fl > 0).then(|| {
-                (
-                    String::from_utf8_lossy(&h.instance[..il]).into_owned(),
-                    String::from_utf8_lossy(&h.function[..fl]).into_owned(),
-                    f64::from_bits(h.time.load(Ordering::Acquire)),
-                    h.in_call.load(Ordering::Acquire) == 1,
-                )
-            });
+            let mark = (h.call.function_len.load(Ordering::Acquire) > 0).then(|| h.call.last_call());
             Some((Results { names, values }, state, folders, summary, mark))
         })();
         libc::munmap(p, len);

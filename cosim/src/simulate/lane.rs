@@ -176,6 +176,8 @@ impl Lane {
 
 /// How the FMU said it ended the run (Co-Simulation).
 pub(crate) const DISCARD_TERMINATED: &str = "fmi2DoStep returned fmi2Discard with fmi2Terminated";
+/// The same end of a run by an FMI 3.0 FMU.
+pub(crate) const FMI3_TERMINATED: &str = "fmi3DoStep returned terminateSimulation";
 
 /// The error of a step from `t`: an fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)`
 /// true is the FMU ending the run at `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the
@@ -184,7 +186,8 @@ pub(crate) const DISCARD_TERMINATED: &str = "fmi2DoStep returned fmi2Discard wit
 fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
     if matches!(e, Error::Fmi { status: crate::Status::Discard, .. }) && inst.terminated_status() == Some(true) {
         let time = inst.last_successful_time().filter(|x| x.is_finite()).unwrap_or(t);
-        return Error::Terminated { instance: inst.name().to_string(), time, reason: DISCARD_TERMINATED };
+        let reason = if inst.is_fmi3() { FMI3_TERMINATED } else { DISCARD_TERMINATED };
+        return Error::Terminated { instance: inst.name().to_string(), time, reason };
     }
     e
 }

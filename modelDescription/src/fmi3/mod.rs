@@ -9,7 +9,13 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod read;
+pub mod validate;
 pub mod write;
+
+pub use crate::read::{Position, ReadError};
+pub use read::fmi_version_of;
+pub use validate::{Problem, Rule};
 
 pub use crate::{BaseUnit, DefaultExperiment, DependencyKind, Initial, LogCategory, Unit, Variability};
 

@@ -121,6 +121,14 @@ pub enum Error {
         /// "CoSimulation" or "ModelExchange".
         interface: &'static str,
     },
+    /// The FMU uses a feature the master does not run (FMI 3.0 clocks, Scheduled
+    /// Execution, FMI 3.0 under isolation).
+    Unsupported {
+        /// The FMU.
+        path: PathBuf,
+        /// The feature, in words.
+        feature: String,
+    },
     /// `binaries/linux64/<modelIdentifier>.so` is not in the FMU.
     MissingBinary {
         /// The path expected inside the FMU.
@@ -142,10 +150,12 @@ pub enum Error {
         /// The function, e.g. `fmi2DoStep`.
         symbol: &'static str,
     },
-    /// `fmi2Instantiate` returned NULL.
+    /// `fmi2Instantiate` (or `fmi3Instantiate*`) returned NULL.
     Instantiate {
         /// The instance name.
         instance: String,
+        /// The function, e.g. `fmi3InstantiateCoSimulation`.
+        function: &'static str,
         /// The last messages the FMU logged.
         log: String,
     },
@@ -253,8 +263,8 @@ pub enum Error {
     },
     /// An FMU ended the simulation itself, as FMI 2 lets it: in Co-Simulation
     /// `fmi2DoStep` returned fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)` true,
-    /// in Model Exchange `terminateSimulation` was set. [`crate::simulate()`] ends the run
-    /// there and returns its results (with [`crate::Summary::ended_by`]); the step
+    /// in Model Exchange `terminateSimulation` was set. `nigel_cosim::simulate()` ends the run
+    /// there and returns its results (with `nigel_cosim::Summary::ended_by`); the step
     /// functions return this variant to it.
     Terminated {
         /// The instance that ended the run.
@@ -399,6 +409,9 @@ impl fmt::Display for Error {
             Error::NoInterface { path, interface } => {
                 write!(f, "{}: the FMU has no {interface} interface", path.display())
             }
+            Error::Unsupported { path, feature } => {
+                write!(f, "{}: uses {feature}, which cosim does not support", path.display())
+            }
             Error::MissingBinary { expected, platforms } => write!(
                 f,
                 "the FMU has no {expected}; platforms it has: {}",
@@ -406,7 +419,9 @@ impl fmt::Display for Error {
             ),
             Error::LoadLibrary { path, reason } => write!(f, "{}: cannot load: {reason}", path.display()),
             Error::MissingSymbol { path, symbol } => write!(f, "{}: missing function {symbol}", path.display()),
-            Error::Instantiate { instance, log } => write!(f, "{instance}: fmi2Instantiate returned NULL{}", tail(log)),
+            Error::Instantiate { instance, function, log } => {
+                write!(f, "{instance}: {function} returned NULL{}", tail(log))
+            }
             Error::Fmi { instance, function, status, time, log } => {
                 write!(f, "{instance}: {function} returned {status}")?;
                 if let Some(t) = time {

@@ -28,13 +28,12 @@
 //! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
 //! in-process ones. The host's side is [`host::run`], the whole of `cosim-host`.
 //!
-//! [`whole`]: the whole run in one host process (`--isolate=run`), the FMUs called in it
-//! directly.
+//! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
+//! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.
 
 pub(crate) mod channel;
 pub mod host;
 pub(crate) mod proxy;
-pub mod whole;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};

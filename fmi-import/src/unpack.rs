@@ -171,7 +171,7 @@ fn register(dir: &Path) {
 /// Removes the temporary folders this process made, without waiting: when another
 /// thread holds the list (it is adding one), nothing is removed. For a process that ends
 /// without unwinding (`_exit`).
-pub(crate) fn remove_temporary_folders_now() {
+pub fn remove_temporary_folders_now() {
     if let Ok(made) = MADE.try_lock() {
         for dir in made.iter() {
             let _ = std::fs::remove_dir_all(dir);
@@ -374,15 +374,18 @@ fn open_zip(path: &Path) -> Result<zip::ZipArchive<std::io::BufReader<std::fs::F
 }
 
 /// One entry of a checked archive: its index, name and relative path.
-pub(crate) struct Entry {
-    pub(crate) index: usize,
-    pub(crate) name: String,
-    pub(crate) rel: PathBuf,
+pub struct Entry {
+    /// Its index in the archive.
+    pub index: usize,
+    /// Its name as stored.
+    pub name: String,
+    /// The name as a safe relative path.
+    pub rel: PathBuf,
 }
 
 /// Checks every header of `zip` against `limits` (names, symbolic links, duplicates,
 /// sizes, ratios, the total) before anything is read; returns the entries.
-pub(crate) fn check_entries<R: Read + std::io::Seek>(
+pub fn check_entries<R: Read + std::io::Seek>(
     zip: &mut zip::ZipArchive<R>,
     shown: &Path,
     limits: &UnpackLimits,
@@ -449,7 +452,7 @@ pub(crate) fn check_entries<R: Read + std::io::Seek>(
 
 /// Reads the text entry `name` of a checked archive (at most `limit` bytes); `Ok(None)`
 /// if there is no such entry.
-pub(crate) fn read_text_entry<R: Read + std::io::Seek>(
+pub fn read_text_entry<R: Read + std::io::Seek>(
     zip: &mut zip::ZipArchive<R>,
     shown: &Path,
     name: &str,
@@ -480,10 +483,14 @@ pub(crate) fn read_text_entry<R: Read + std::io::Seek>(
 }
 
 /// The entries of an FMU a run in this process uses: `modelDescription.xml`, this
-/// platform's `binaries/linux64/` and `resources/` (other platforms' libraries, the
-/// documentation and sources are not written).
+/// platform's `binaries/linux64/` (FMI 2.0) or `binaries/x86_64-linux/` (FMI 3.0) and
+/// `resources/` (other platforms' libraries, the documentation and sources are not
+/// written).
 pub fn used_by_a_run(name: &Path) -> bool {
-    name == Path::new("modelDescription.xml") || name.starts_with("binaries/linux64") || name.starts_with("resources")
+    name == Path::new("modelDescription.xml")
+        || name.starts_with("binaries/linux64")
+        || name.starts_with("binaries/x86_64-linux")
+        || name.starts_with("resources")
 }
 
 /// An FMU unpacked for a run: its private folder and the platforms its archive carries.

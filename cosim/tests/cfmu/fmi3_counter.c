@@ -1,0 +1,461 @@
+/* An FMI 3.0 Co-Simulation test FMU written against the standard's headers
+ * (fmi3Functions.h; the test passes their folder with -I).
+ *
+ * Variables (value references as in fmi3_counter.xml):
+ *   0 time (independent)        1 u  Float64 input (1)      2 y  Float64 output
+ *   3 n Int32 output (steps)    4 odd Boolean output        5 mode Enumeration parameter (1)
+ *   6 label String parameter    7 stop_at Float64 parameter 8 early_at Float64 parameter
+ *   9 k Int32 input             10 m Int32 output (2 k)      11 b Boolean input
+ *   12 nb Boolean output (!b)
+ *   13 der(y) Float64 local     14 z Float64 local (y - 0.55, the event indicator)
+ * and one output of every other type, derived from y and n:
+ *   15 f32 Float32 (float)y     16 i8 Int8 n - 5            17 u8 UInt8 20 n
+ *   18 i16 Int16 -1000 n        19 u16 UInt16 6000 n        20 u32 UInt32 400000000 n
+ *   21 i64 Int64 -2^40 n        22 u64 UInt64 2^48 n        23 bin Binary of n bytes
+ *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
+ *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
+ *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
+ *   30 crash_at Float64 parameter: the step that starts at or after it writes through NULL
+ * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
+ * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
+ * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
+ * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
+ * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
+#include <stdlib.h>
+#include <string.h>
+#include "fmi3Functions.h"
+
+typedef struct {
+    double time, u, y, stop_at, early_at, crash_at;
+    int n, k, b, early_done, early_allowed, crossed, timed;
+    long long mode;
+    char label[64];
+    double gains[2];
+    float f32in;
+    unsigned char bytes[64];
+} State;
+
+typedef struct {
+    State s;
+    fmi3InstanceEnvironment env;
+    fmi3LogMessageCallback log;
+} Counter;
+
+static fmi3Status fail(Counter *c, const char *message) {
+    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
+    return fmi3Error;
+}
+
+const char *fmi3GetVersion(void) { return fmi3Version; }
+
+static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnvironment env, fmi3LogMessageCallback log);
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
+    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
+    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
+    Counter *c = make(token, resources, env, log);
+    if (!c) return NULL;
+    c->s.early_allowed = earlyReturnAllowed != 0;
+    strcpy(c->s.label, "abc");
+    return c;
+}
+
+static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    if (!token || strcmp(token, "{fmi3-counter}") != 0) {
+        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken");
+        return NULL;
+    }
+    if (!resources || resources[0] != '/' || resources[strlen(resources) - 1] != '/') {
+        if (log) log(env, fmi3Error, "logStatusError", "resourcePath is not an absolute path ending in /");
+        return NULL;
+    }
+    Counter *c = calloc(1, sizeof(Counter));
+    if (!c) return NULL;
+    c->env = env;
+    c->log = log;
+    c->s.u = 1;
+    c->s.mode = 1;
+    c->s.stop_at = 1e300;
+    c->s.early_at = -1;
+    c->s.crash_at = 1e300;
+    c->s.gains[0] = 1;
+    c->s.gains[1] = 2;
+    c->s.f32in = 0.5f;
+    strcpy(c->s.label, "abc");
+    return c;
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    return make(token, resources, env, log);
+}
+
+void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
+    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    ((Counter *)instance)->s.time = startTime;
+    return fmi3OK;
+}
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3Reset(fmi3Instance instance) {
+    Counter *c = instance;
+    fmi3InstanceEnvironment env = c->env;
+    fmi3LogMessageCallback log = c->log;
+    int early_allowed = c->s.early_allowed;
+    memset(c, 0, sizeof *c);
+    c->s.early_allowed = early_allowed;
+    c->env = env;
+    c->log = log;
+    c->s.u = 1;
+    c->s.mode = 1;
+    c->s.stop_at = 1e300;
+    c->s.early_at = -1;
+    c->s.crash_at = 1e300;
+    c->s.gains[0] = 1;
+    c->s.gains[1] = 2;
+    c->s.f32in = 0.5f;
+    strcpy(c->s.label, "abc");
+    return fmi3OK;
+}
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
+    fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn,
+    fmi3Float64 *lastSuccessfulTime) {
+    Counter *c = instance;
+    State *s = &c->s;
+    double end = t + h;
+    *eventHandlingNeeded = fmi3False;
+    *terminateSimulation = fmi3False;
+    *earlyReturn = fmi3False;
+    if (t >= s->crash_at) *(volatile int *)0 = 1;
+    if (s->early_allowed && !s->early_done && s->early_at > t && s->early_at < end) {
+        s->early_done = 1;
+        s->y += (double)s->mode * s->u * (s->early_at - t);
+        s->time = s->early_at;
+        *earlyReturn = fmi3True;
+        *lastSuccessfulTime = s->early_at;
+        return fmi3OK;
+    }
+    s->y += (double)s->mode * s->u * h;
+    s->n += 1;
+    s->time = end;
+    *lastSuccessfulTime = end;
+    if (end >= s->stop_at) *terminateSimulation = fmi3True;
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Float64 values[], size_t nValues) {
+    Counter *c = instance;
+    size_t k = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3GetFloat64: nValues too small");
+        switch (vr[i]) {
+        case 0: values[k] = c->s.time; break;
+        case 1: values[k] = c->s.u; break;
+        case 2: values[k] = c->s.y; break;
+        case 7: values[k] = c->s.stop_at; break;
+        case 8: values[k] = c->s.early_at; break;
+        case 13: values[k] = (double)c->s.mode * c->s.u; break;
+        case 14: values[k] = c->s.y - 0.55; break;
+        case 24: values[k] = c->s.y; values[k + 1] = 2 * c->s.y; values[k + 2] = 3 * c->s.y; break;
+        case 25: values[k] = c->s.gains[0]; values[k + 1] = c->s.gains[1]; break;
+        case 26: values[k] = c->s.gains[0] * c->s.y + c->s.gains[1]; break;
+        case 30: values[k] = c->s.crash_at; break;
+        default: return fail(c, "fmi3GetFloat64: no such Float64");
+        }
+        k += size;
+    }
+    if (k != nValues) return fail(c, "fmi3GetFloat64: nValues is not the number of values");
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Float64 values[], size_t nValues) {
+    Counter *c = instance;
+    size_t k = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 25 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3SetFloat64: nValues too small");
+        switch (vr[i]) {
+        case 1: c->s.u = values[k]; break;
+        case 7: c->s.stop_at = values[k]; break;
+        case 8: c->s.early_at = values[k]; break;
+        case 25: c->s.gains[0] = values[k]; c->s.gains[1] = values[k + 1]; break;
+        case 30: c->s.crash_at = values[k]; break;
+        default: return fail(c, "fmi3SetFloat64: not settable");
+        }
+        k += size;
+    }
+    if (k != nValues) return fail(c, "fmi3SetFloat64: nValues is not the number of values");
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Int32 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3GetInt32: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        switch (vr[i]) {
+        case 3: values[i] = c->s.n; break;
+        case 9: values[i] = c->s.k; break;
+        case 10: values[i] = 2 * c->s.k; break;
+        default: return fail(c, "fmi3GetInt32: no such Int32");
+        }
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Int32 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3SetInt32: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 9) return fail(c, "fmi3SetInt32: not settable");
+        c->s.k = values[i];
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Int64 values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 5) values[i] = c->s.mode;
+        else if (vr[i] == 21) values[i] = -(1LL << 40) * c->s.n;
+        else return fail(c, "fmi3GetInt64: no such Int64");
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Int64 values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 5) return fail(c, "fmi3SetInt64: not settable");
+        if (values[i] != 1 && values[i] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
+        c->s.mode = values[i];
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Boolean values[], size_t nValues) {
+    Counter *c = instance;
+    size_t k = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        size_t size = vr[i] == 27 ? 2 : 1;
+        if (k + size > nValues) return fail(c, "fmi3GetBoolean: nValues too small");
+        switch (vr[i]) {
+        case 4: values[k] = (c->s.n % 2) == 1; break;
+        case 11: values[k] = c->s.b != 0; break;
+        case 12: values[k] = c->s.b == 0; break;
+        case 27: values[k] = (c->s.n % 2) == 1; values[k + 1] = (c->s.n % 2) == 0; break;
+        default: return fail(c, "fmi3GetBoolean: no such Boolean");
+        }
+        k += size;
+    }
+    return k == nValues ? fmi3OK : fail(c, "fmi3GetBoolean: nValues is not the number of values");
+}
+
+fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Boolean values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 11) return fail(c, "fmi3SetBoolean: not settable");
+        c->s.b = values[i] ? 1 : 0;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3String values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 6) return fail(c, "fmi3GetString: no such String");
+        values[i] = c->s.label;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3String values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 6 || !values[i] || strlen(values[i]) >= sizeof c->s.label) return fail(c, "fmi3SetString: not settable");
+        strcpy(c->s.label, values[i]);
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *state) {
+    Counter *c = instance;
+    if (!*state) *state = malloc(sizeof(State));
+    if (!*state) return fail(c, "fmi3GetFMUState: out of memory");
+    memcpy(*state, &c->s, sizeof(State));
+    return fmi3OK;
+}
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {
+    memcpy(&((Counter *)instance)->s, state, sizeof(State));
+    return fmi3OK;
+}
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *state) {
+    free(*state);
+    *state = NULL;
+    return fmi3OK;
+}
+
+/* The outputs of the other types (one value each). */
+#define SCALAR_GETTER(T, VR, EXPR) \
+    fmi3Status fmi3Get##T(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3##T values[], size_t nValues) { \
+        Counter *c = instance; \
+        if (nvr != nValues) return fail(c, "fmi3Get" #T ": nValues != nValueReferences"); \
+        for (size_t i = 0; i < nvr; i++) { \
+            if (vr[i] != VR) return fail(c, "fmi3Get" #T ": no such variable"); \
+            values[i] = (fmi3##T)(EXPR); \
+        } \
+        return fmi3OK; \
+    }
+SCALAR_GETTER(Int8, 16, c->s.n - 5)
+SCALAR_GETTER(UInt8, 17, 20 * c->s.n)
+SCALAR_GETTER(Int16, 18, -1000 * c->s.n)
+SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
+SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
+SCALAR_GETTER(UInt64, 22, (1ULL << 48) * (unsigned long long)c->s.n)
+
+fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3GetFloat32: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 15) values[i] = (float)c->s.y;
+        else if (vr[i] == 28) values[i] = c->s.f32in;
+        else if (vr[i] == 29) values[i] = 2 * c->s.f32in;
+        else return fail(c, "fmi3GetFloat32: no such Float32");
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float32 values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 28) return fail(c, "fmi3SetFloat32: not settable");
+        c->s.f32in = values[i];
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
+    fmi3Binary values[], size_t nValues) {
+    Counter *c = instance;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 23) return fail(c, "fmi3GetBinary: no such Binary");
+        sizes[i] = (size_t)c->s.n < sizeof c->s.bytes ? (size_t)c->s.n : sizeof c->s.bytes;
+        values[i] = c->s.bytes;
+    }
+    return fmi3OK;
+}
+
+/* Model Exchange. */
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
+    ((Counter *)instance)->s.time = time;
+    return fmi3OK;
+}
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
+    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
+    State *s = &((Counter *)instance)->s;
+    if (!s->crossed && s->y - 0.55 >= 0) {
+        s->crossed = 1;
+        s->n += 1;
+    }
+    if (!s->timed && s->time >= 0.75) {
+        s->timed = 1;
+        s->n += 10;
+    }
+    *needUpdate = fmi3False;
+    *terminate = s->time >= s->stop_at;
+    *nominalsChanged = fmi3False;
+    *valuesChanged = fmi3False;
+    *nextDefined = !s->timed || s->stop_at < 1e300;
+    *next = !s->timed && 0.75 < s->stop_at ? 0.75 : s->stop_at;
+    return fmi3OK;
+}
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
+    fmi3Boolean *terminate) {
+    *enterEventMode = fmi3False;
+    *terminate = fmi3False;
+    return fmi3OK;
+}
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {
+    Counter *c = instance;
+    if (n != 1) return fail(c, "fmi3SetContinuousStates: one state");
+    c->s.y = x[0];
+    return fmi3OK;
+}
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
+    Counter *c = instance;
+    if (n != 1) return fail(c, "fmi3GetContinuousStates: one state");
+    x[0] = c->s.y;
+    return fmi3OK;
+}
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
+    Counter *c = instance;
+    if (n != 1) return fail(c, "fmi3GetContinuousStateDerivatives: one state");
+    dx[0] = (double)c->s.mode * c->s.u;
+    return fmi3OK;
+}
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) {
+    Counter *c = instance;
+    if (n != 1) return fail(c, "fmi3GetEventIndicators: one event indicator");
+    z[0] = c->s.y - 0.55;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
+    for (size_t i = 0; i < n; i++) x[i] = 1;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
+
+/* The functions this FMU does not implement: each returns fmi3Error. */
+#define UNSUPPORTED(name, ...) fmi3Status name(__VA_ARGS__) { return fmi3Error; }
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String a, fmi3String b, fmi3String c, fmi3Boolean d,
+    fmi3Boolean e, fmi3InstanceEnvironment f, fmi3LogMessageCallback g, fmi3ClockUpdateCallback h,
+    fmi3LockPreemptionCallback i, fmi3UnlockPreemptionCallback j) { return NULL; }
+UNSUPPORTED(fmi3SetDebugLogging, fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[])
+#define GETSET(T) \
+    UNSUPPORTED(fmi3Get##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3##T v[], size_t m) \
+    UNSUPPORTED(fmi3Set##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3##T v[], size_t m)
+UNSUPPORTED(fmi3SetInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int8 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt8 v[], size_t m)
+UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
+UNSUPPORTED(fmi3SetUInt64, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 v[], size_t m)
+UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
+UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
+UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])
+UNSUPPORTED(fmi3GetNumberOfVariableDependencies, fmi3Instance i, fmi3ValueReference vr, size_t *n)
+UNSUPPORTED(fmi3GetVariableDependencies, fmi3Instance i, fmi3ValueReference d, size_t e[], fmi3ValueReference k[], size_t ke[], fmi3DependencyKind dk[], size_t n)
+UNSUPPORTED(fmi3SerializedFMUStateSize, fmi3Instance i, fmi3FMUState s, size_t *n)
+UNSUPPORTED(fmi3SerializeFMUState, fmi3Instance i, fmi3FMUState s, fmi3Byte b[], size_t n)
+UNSUPPORTED(fmi3DeserializeFMUState, fmi3Instance i, const fmi3Byte b[], size_t n, fmi3FMUState *s)
+UNSUPPORTED(fmi3GetDirectionalDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
+UNSUPPORTED(fmi3GetAdjointDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
+UNSUPPORTED(fmi3EnterConfigurationMode, fmi3Instance i)
+UNSUPPORTED(fmi3ExitConfigurationMode, fmi3Instance i)
+UNSUPPORTED(fmi3GetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[], fmi3IntervalQualifier q[])
+UNSUPPORTED(fmi3GetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[], fmi3IntervalQualifier q[])
+UNSUPPORTED(fmi3GetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[])
+UNSUPPORTED(fmi3GetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[])
+UNSUPPORTED(fmi3SetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
+UNSUPPORTED(fmi3SetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
+UNSUPPORTED(fmi3SetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
+UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
+UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
+UNSUPPORTED(fmi3EnterStepMode, fmi3Instance i)
+UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
+UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)

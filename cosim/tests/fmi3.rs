@@ -1,0 +1,538 @@
+//! FMI 3.0 Co-Simulation with a C test FMU written against the standard's headers
+//! (`tests/cfmu/fmi3_counter.c`: y grows by mode * u * h per step; early return and
+//! termination when asked): load, the view the master works with, runs, parameters of
+//! every type the view has, early return, termination, FMU state, `cosim info` and
+//! `cosim run`, refusals; and the results against fmpy 0.3.32's.
+//!
+//! The headers come from fmpy's package (`fmpy/c-code`), found with `$FMPY_PYTHON`
+//! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
+
+mod common;
+use common::{work_dir, zip_entries};
+use nigel_cosim::{simulate, Error, Experiment, Fmu, Instance, System, SystemBuilder, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const XML: &str = include_str!("cfmu/fmi3_counter.xml");
+
+fn python() -> String {
+    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
+}
+
+/// The folder of the FMI 3.0 headers in fmpy's package, `None` (skip) without fmpy.
+fn headers() -> Option<PathBuf> {
+    let out = Command::new(python())
+        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success());
+    match out {
+        Some(o) => Some(PathBuf::from(String::from_utf8_lossy(&o.stdout).trim())),
+        None => {
+            assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
+            eprintln!("fmpy not importable with {}: FMI 3.0 tests skipped", python());
+            None
+        }
+    }
+}
+
+/// Builds `<dir>/<stem>.fmu` from fmi3_counter.c with `xml` as its description.
+fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
+    let headers = headers()?;
+    let so = dir.join("fmi3_counter.so");
+    {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/fmi3_counter.c");
+        let status = Command::new("cc")
+            .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
+            .arg("-I")
+            .arg(&headers)
+            .arg(&src)
+            .arg("-o")
+            .arg(&so)
+            .status()
+            .expect("run cc");
+        assert!(status.success(), "cc failed for fmi3_counter.c");
+    }
+    let fmu = dir.join(format!("{stem}.fmu"));
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", xml.as_bytes().to_vec()),
+            ("binaries/x86_64-linux/fmi3_counter.so", std::fs::read(&so).unwrap()),
+        ],
+    );
+    Some(fmu)
+}
+
+fn counter(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let dir = work_dir(test);
+    let fmu = build_counter(&dir, "fmi3_counter", XML)?;
+    Some((dir, fmu))
+}
+
+fn with_starts(fmu: &Path, starts: &[(&str, Value)]) -> System {
+    let mut b = SystemBuilder::new();
+    b.add_instance("c", Fmu::load(fmu).unwrap()).unwrap();
+    for (name, value) in starts {
+        b.set(&format!("c.{name}"), value.clone()).unwrap();
+    }
+    b.build()
+}
+
+/// y after the steps `steps`, summed as the FMU sums them (u = 1).
+fn summed(steps: &[f64], scale: f64) -> f64 {
+    steps.iter().fold(0.0, |y, h| y + scale * 1.0 * h)
+}
+
+/// The steps the master took: the differences of its time grid t0 + k h.
+fn steps_of(time: &[f64]) -> Vec<f64> {
+    time.windows(2).map(|w| w[1] - w[0]).collect()
+}
+
+#[test]
+fn the_view_has_the_scalars_and_the_description_every_variable() {
+    let Some((_dir, path)) = counter("fmi3-view") else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
+    assert_eq!(md3.instantiation_token, "{fmi3-counter}");
+    assert_eq!(md3.model_variables.len(), 31);
+    let view = fmu.description();
+    assert_eq!(view.fmi_version, "3.0");
+    // the three arrays as their 3 + 2 + 2 elements
+    assert_eq!(view.model_variables.len(), 35);
+    let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
+    assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
+    assert_eq!(view.number_of_event_indicators, 1);
+    assert!(fmu.not_in_view().is_empty());
+    assert_eq!(view.variable("y").unwrap().variable_type.type_name(), "Real");
+    let mode = &view.variable("mode").unwrap().variable_type;
+    assert!(
+        matches!(mode, model_description::VariableType::Enumeration { declared_type, .. } if declared_type == "Mode"),
+        "{mode:?}"
+    );
+    assert_eq!(view.variable("n").unwrap().variable_type.type_name(), "Integer");
+    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1);
+    assert!(fmu.can_get_and_set_state());
+}
+
+#[test]
+fn a_run_steps_the_fmu_and_records_every_type() {
+    let Some((_dir, path)) = counter("fmi3-run") else { return };
+    let system = with_starts(&path, &[("k", Value::Integer(21)), ("b", Value::Boolean(true))]);
+    let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    assert_eq!(r.rows(), 11);
+    assert_eq!(summary.steps, 10);
+    let y = r.column("y").unwrap();
+    let n = r.column("n").unwrap();
+    let odd = r.column("odd").unwrap();
+    let steps = steps_of(&r.column("time").unwrap());
+    for k in 0..11 {
+        assert_eq!(y[k], summed(&steps[..k], 1.0), "row {k}");
+        assert_eq!(n[k], k as f64);
+        assert_eq!(odd[k], (k % 2) as f64);
+    }
+    assert_eq!(r.column("m").unwrap(), vec![42.0; 11], "Int32 input 21 set before initialization, output 2 k");
+    assert_eq!(r.column("nb").unwrap(), vec![0.0; 11], "Boolean input true, output its negation");
+}
+
+#[test]
+fn an_enumeration_parameter_is_set_through_int64() {
+    let Some((_dir, path)) = counter("fmi3-enum") else { return };
+    let system = with_starts(&path, &[("mode", Value::Integer(2))]);
+    let (r, _) = simulate(&system, &Experiment::new(0.5, 0.1)).unwrap();
+    let steps = steps_of(&r.column("time").unwrap());
+    assert_eq!(*r.column("y").unwrap().last().unwrap(), summed(&steps, 2.0));
+    // the FMU refuses mode 3 (fmi3SetInt64 returns fmi3Error): an error naming the call
+    let system = with_starts(&path, &[("mode", Value::Integer(3))]);
+    let e = simulate(&system, &Experiment::new(0.5, 0.1)).unwrap_err();
+    assert!(e.to_string().contains("fmi3SetInt64"), "{e}");
+    assert!(e.to_string().contains("mode must be 1 or 2"), "the FMU's message: {e}");
+}
+
+#[test]
+fn an_early_return_is_continued_to_the_end_of_the_step() {
+    let Some((_dir, path)) = counter("fmi3-early") else { return };
+    let system = with_starts(&path, &[("early_at", Value::Real(0.35))]);
+    let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    assert_eq!(summary.steps, 10);
+    let y = r.column("y").unwrap();
+    let steps = steps_of(&r.column("time").unwrap());
+    assert_eq!(y[3], summed(&steps[..3], 1.0), "before the step that returned early");
+    // the step (0.3, 0.4] was taken as (0.3, 0.35] and (0.35, 0.4]: its y is 0.4 up to
+    // the roundings of the two parts (each below 0.5 ulp of 0.4)
+    assert!((y[4] - 0.4).abs() <= 2.0 * f64::EPSILON * 0.4, "{}", y[4]);
+    assert_eq!(r.column("n").unwrap()[4], 4.0, "the returned part is no step of its own");
+    assert!((y[10] - 1.0).abs() < 16.0 * f64::EPSILON, "{}: 11 roundings of values below 1", y[10]);
+}
+
+#[test]
+fn terminate_simulation_ends_the_run_there() {
+    let Some((_dir, path)) = counter("fmi3-terminate") else { return };
+    let system = with_starts(&path, &[("stop_at", Value::Real(0.45))]);
+    let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let time = r.column("time").unwrap();
+    // the step (0.4, 0.5] said terminateSimulation: its row is the last
+    assert_eq!(*time.last().unwrap(), 5.0 * 0.1);
+    assert_eq!(*r.column("n").unwrap().last().unwrap(), 5.0);
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end), ("c", 0.5));
+    assert_eq!(reason, "fmi3DoStep returned terminateSimulation");
+}
+
+#[test]
+fn fmu_state_and_strings_round_trip() {
+    let Some((_dir, path)) = counter("fmi3-state") else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let mut inst = Instance::new(&fmu, "c").unwrap();
+    inst.setup_experiment(None, 0.0, Some(1.0)).unwrap();
+    inst.set_string(6, "hello").unwrap();
+    inst.enter_initialization_mode().unwrap();
+    inst.exit_initialization_mode().unwrap();
+    assert_eq!(inst.get_string(6).unwrap(), "hello");
+    inst.do_step(0.0, 0.25).unwrap();
+    let saved = inst.get_state().unwrap();
+    let mut y = [0.0];
+    inst.get_real(&[2], &mut y).unwrap();
+    assert_eq!(y[0], 0.25);
+    inst.do_step(0.25, 0.5).unwrap();
+    inst.get_real(&[2], &mut y).unwrap();
+    assert_eq!(y[0], 0.75);
+    inst.set_state(&saved).unwrap();
+    inst.get_real(&[2], &mut y).unwrap();
+    assert_eq!(y[0], 0.25, "restored");
+    inst.free_state(saved).unwrap();
+    let mut flags = [7, 7];
+    inst.set_boolean(&[11], &[5]).unwrap(); // nonzero is true
+    inst.get_boolean(&[11, 12], &mut flags).unwrap();
+    assert_eq!(flags, [1, 0], "read back as 0 or 1");
+    let e = inst.get_real(&[99], &mut y).unwrap_err();
+    assert!(e.to_string().contains("fmi3GetFloat64") && e.to_string().contains("no such Float64"), "{e}");
+}
+
+#[test]
+fn bad_fmi3_input_is_refused() {
+    let dir = work_dir("fmi3-refused");
+    let cases = [
+        ("token", XML.replace("instantiationToken=\"{fmi3-counter}\"", "instantiationToken=\"{other}\""), "wrong instantiationToken"),
+        ("dupvr", XML.replace("name=\"k\" valueReference=\"9\"", "name=\"k\" valueReference=\"1\""), "duplicate-value-reference"),
+        ("unknown", XML.replace("<Int32 name=\"k\"", "<Int128 name=\"k\"").replace("start=\"0\"/>\n    <Int32 name=\"m\"", "start=\"0\"/>\n    <Int32 name=\"m\""), "unknown element <Int128>"),
+        ("malformed", XML.replace("</ModelVariables>", ""), "malformed XML"),
+        (
+            "clock",
+            XML.replace("</ModelVariables>", "<Clock name=\"tick\" valueReference=\"40\" causality=\"input\" intervalVariability=\"triggered\"/></ModelVariables>"),
+            "clocks (Clock variable \"tick\")",
+        ),
+        ("noindependent", XML.replace("causality=\"independent\" ", ""), "independent"),
+    ];
+    for (stem, xml, expected) in cases {
+        let Some(path) = build_counter(&dir, stem, &xml) else { return };
+        let e = match Fmu::load(&path) {
+            Ok(fmu) => Instance::new(&fmu, "c").map(|_| ()).unwrap_err(),
+            Err(e) => e,
+        };
+        assert!(e.to_string().contains(expected), "{stem}: {e}");
+        if stem == "token" {
+            assert!(matches!(&e, Error::Instantiate { function: "fmi3InstantiateCoSimulation", .. }), "{e:?}");
+        }
+    }
+}
+
+fn cosim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap()
+}
+
+#[test]
+fn cosim_info_and_run() {
+    let Some((dir, path)) = counter("fmi3-cli") else { return };
+    let out = cosim(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.starts_with("model fmi3_counter (FMI 3.0), instantiationToken {fmi3-counter}"), "{text}");
+    assert!(text.contains("interfaces: CoSimulation (fmi3_counter; variable step, early return, FMU state)"), "{text}");
+    let mode = text.lines().find(|l| l.starts_with("mode ")).unwrap();
+    assert!(mode.contains("Enumeration") && mode.contains("parameter"), "{mode}");
+    let label = text.lines().find(|l| l.starts_with("label ")).unwrap();
+    assert!(label.contains("String") && label.contains("\"abc\""), "{label}");
+
+    let csv = dir.join("out.csv");
+    let out = cosim(&[
+        "run",
+        path.to_str().unwrap(),
+        "--stop-time",
+        "1",
+        "--step",
+        "0.1",
+        "--set",
+        "u=2",
+        "--set",
+        "gains=[3, 4]",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "\"y\"").unwrap();
+    let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
+    let y: f64 = last[col].parse().unwrap();
+    assert!((y - 2.0).abs() < 1e-14, "{y}");
+    // the array set whole: gy = 3 y + 4; its elements are columns of their own
+    let gy = header.iter().position(|h| *h == "\"gy\"").unwrap();
+    assert_eq!(last[gy].parse::<f64>().unwrap(), 3.0 * y + 4.0);
+    assert!(header.contains(&"\"arr[3]\""), "{header:?}");
+    let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "1", "--set", "gains=[1 2 3]"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("3 values for the 2 elements of the array"), "{err}");
+}
+
+/// fmpy 0.3.32 runs the same FMU with the same step and start values of every type the
+/// view has: the same outputs, bit for bit.
+#[test]
+fn results_equal_fmpys() {
+    let Some((dir, path)) = counter("fmi3-fmpy") else { return };
+    let csv = dir.join("fmpy.csv");
+    let script = r#"
+import sys
+from fmpy import simulate_fmu
+COLUMNS = ['y', 'n', 'odd', 'm', 'nb', 'f32', 'i8', 'u8', 'i16', 'u16', 'u32', 'i64', 'u64', 'f32out']
+r = simulate_fmu(sys.argv[1], fmi_type='CoSimulation', stop_time=1.0, output_interval=0.1,
+                 start_values={'u': 0.3, 'mode': 2, 'k': 5, 'b': True, 'label': 'xyz', 'f32in': 0.1},
+                 output=COLUMNS)
+with open(sys.argv[2], 'w') as f:
+    for row in r:
+        f.write(' '.join(repr(float(row[c])) for c in ['time'] + COLUMNS) + '\n')
+"#;
+    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let system = with_starts(
+        &path,
+        &[
+            ("u", Value::Real(0.3)),
+            ("mode", Value::Integer(2)),
+            ("k", Value::Integer(5)),
+            ("b", Value::Boolean(true)),
+            ("label", Value::String("xyz".into())),
+            ("f32in", Value::Real(0.1)),
+        ],
+    );
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let ours: Vec<Vec<f64>> = (0..r.rows())
+        .map(|k| {
+            ["time", "y", "n", "odd", "m", "nb", "f32", "i8", "u8", "i16", "u16", "u32", "i64", "u64", "f32out"]
+                .iter()
+                .map(|c| r.column(c).unwrap()[k])
+                .collect()
+        })
+        .collect();
+    assert_eq!(ours.len(), theirs.len(), "rows: ours {ours:?}\nfmpy {theirs:?}");
+    for (a, b) in ours.iter().zip(&theirs) {
+        assert_eq!(a, b, "ours vs fmpy");
+    }
+}
+
+fn model_exchange(fmu: &Path, starts: &[(&str, Value)]) -> System {
+    let options = nigel_cosim::ImportOptions {
+        interface: Some(nigel_cosim::Interface::ModelExchange),
+        ..nigel_cosim::ImportOptions::default()
+    };
+    let mut b = SystemBuilder::new();
+    b.add_instance("c", Fmu::load_with(fmu, &options).unwrap()).unwrap();
+    for (name, value) in starts {
+        b.set(&format!("c.{name}"), value.clone()).unwrap();
+    }
+    b.build()
+}
+
+/// Model Exchange: the master integrates y' = mode u (RK4, exact for a constant slope up to
+/// rounding) and finds the crossing of z = y - 0.55 (counted in n by the FMU's
+/// fmi3UpdateDiscreteStates) between the rows at 0.5 and 0.6.
+#[test]
+fn model_exchange_integrates_and_finds_the_state_event() {
+    let Some((_dir, path)) = counter("fmi3-me") else { return };
+    let system = model_exchange(&path, &[("mode", Value::Integer(2))]);
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let (time, y, n) = (r.column("time").unwrap(), r.column("y").unwrap(), r.column("n").unwrap());
+    assert_eq!(r.rows(), 11);
+    for k in 0..11 {
+        // a few roundings of values up to 2 per step
+        assert!((y[k] - 2.0 * time[k]).abs() < 64.0 * f64::EPSILON, "t = {}: y = {}", time[k], y[k]);
+        // 2 t crosses 0.55 at t = 0.275 (+1), the time event at 0.75 (+10)
+        let expected = if time[k] > 0.275 { 1.0 } else { 0.0 } + if time[k] >= 0.75 { 10.0 } else { 0.0 };
+        assert_eq!(n[k], expected, "t = {}", time[k]);
+    }
+}
+
+/// Model Exchange: terminateSimulation from fmi3UpdateDiscreteStates at the time event at
+/// stop_at ends the run there, the last row the communication point before it.
+#[test]
+fn model_exchange_terminates_at_the_time_event() {
+    let Some((_dir, path)) = counter("fmi3-me-end") else { return };
+    let system = model_exchange(&path, &[("stop_at", Value::Real(0.62))]);
+    let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
+    assert_eq!((instance.as_str(), t_end, reason), ("c", 0.62, "terminateSimulation"));
+    assert_eq!(r.rows(), 7, "rows 0 .. 0.6");
+}
+
+/// fmpy 0.3.32 integrates the same FMU in Model Exchange (CVode): the same event count, and
+/// y within its tolerance.
+#[test]
+fn model_exchange_agrees_with_fmpy() {
+    let Some((dir, path)) = counter("fmi3-me-fmpy") else { return };
+    let csv = dir.join("fmpy.csv");
+    let script = r#"
+import sys
+from fmpy import simulate_fmu
+r = simulate_fmu(sys.argv[1], fmi_type='ModelExchange', stop_time=1.0, output_interval=0.1,
+                 start_values={'u': 1.0}, output=['y', 'n'])
+with open(sys.argv[2], 'w') as f:
+    for row in r:
+        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\n')
+"#;
+    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let (r, _) = simulate(&model_exchange(&path, &[("u", Value::Real(1.0))]), &Experiment::new(1.0, 0.1)).unwrap();
+    assert_eq!(*r.column("n").unwrap().last().unwrap(), 11.0, "y = t crossed 0.55 (+1), the time event at 0.75 (+10)");
+    // fmpy records rows before and after the event at t = 0.55 besides: the grid's only
+    let at_grid: Vec<&Vec<f64>> =
+        theirs.iter().filter(|row| (row[0] * 10.0 - (row[0] * 10.0).round()).abs() < 1e-9).collect();
+    assert_eq!(at_grid.len(), r.rows(), "{theirs:?}");
+    for (k, row) in at_grid.iter().enumerate() {
+        assert_eq!(row[0], r.column("time").unwrap()[k]);
+        // CVode at fmpy's default relative tolerance 1e-4 on a linear solution
+        assert!(
+            (row[1] - r.column("y").unwrap()[k]).abs() < 1e-4,
+            "t = {}: {} vs {}",
+            row[0],
+            row[1],
+            r.column("y").unwrap()[k]
+        );
+        assert_eq!(row[2], r.column("n").unwrap()[k]);
+    }
+}
+
+/// FMI 2.0 and FMI 3.0 instances in one system, connected by names (Real <-> Float64): an
+/// FMI 2.0 source (y = t) feeds the FMI 3.0 counter's u, whose y feeds an FMI 2.0 gain
+/// (y = 2 u). The counter (no direct feedthrough) adds the source's value at the step's
+/// start times h under both algorithms; the gain (direct feedthrough) doubles the counter's
+/// y of the same communication point under `ordered` (the inputs set in topological order)
+/// and of the point before under `jacobi`. Both as built and as written to an SSP and read
+/// back.
+#[test]
+fn fmi2_and_fmi3_instances_in_one_system() {
+    use common::{build_fmu, Model};
+    use nigel_cosim::{read_ssp, write_ssp, Algorithm, ImportOptions};
+    let Some((dir, counter_fmu)) = counter("fmi3-mixed") else { return };
+    let source = build_fmu(Model::Source, &dir, &[]);
+    let gain = build_fmu(Model::Gain, &dir, &[]);
+    let mut b = SystemBuilder::new();
+    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(&counter_fmu).unwrap()).unwrap();
+    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
+    b.connect_unconverted("source.y", "counter.u", None).unwrap();
+    b.connect("counter.y", "gain.u").unwrap();
+    let system = b.build();
+    let ssp = dir.join("mixed.ssp");
+    write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    let from_ssp = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
+    let out = cosim(&["info", ssp.to_str().unwrap()]);
+    assert!(out.status.success(), "cosim info of the mixed SSP: {}", String::from_utf8_lossy(&out.stderr));
+    for algorithm in [Algorithm::Ordered, Algorithm::Jacobi] {
+        let experiment = Experiment { algorithm, ..Experiment::new(1.0, 0.1) };
+        let (r, _) = simulate(&system, &experiment).unwrap();
+        let (rs, _) = simulate(&from_ssp, &experiment).unwrap();
+        assert_eq!((&r.names, &r.values), (&rs.names, &rs.values), "{algorithm:?}: the SSP's run is the system's");
+        let time = r.column("time").unwrap();
+        let ys = r.column("source.y").unwrap();
+        let yc = r.column("counter.y").unwrap();
+        let yg = r.column("gain.y").unwrap();
+        assert_eq!(ys, time, "the FMI 2.0 source: y = t");
+        for k in 1..r.rows() {
+            let h = time[k] - time[k - 1];
+            let g = match algorithm {
+                Algorithm::Ordered => yc[k],
+                _ => yc[k - 1],
+            };
+            assert_eq!(yc[k], yc[k - 1] + 1.0 * ys[k - 1] * h, "{algorithm:?}: counter at t = {}", time[k]);
+            assert_eq!(yg[k], 2.0 * g, "{algorithm:?}: gain at t = {}", time[k]);
+        }
+    }
+}
+
+/// Every FMI 3.0 type recorded: each output of the counter against its definition in
+/// fmi3_counter.c, an array element set alone (`gains[2]`), a Float32 input.
+#[test]
+fn every_type_and_array_elements_are_recorded() {
+    let Some((_dir, path)) = counter("fmi3-types") else { return };
+    let system = with_starts(&path, &[("gains[2]", Value::Real(5.0)), ("f32in", Value::Real(0.1))]);
+    let (r, _) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    let col = |name: &str| r.column(name).unwrap_or_else(|| panic!("no column {name}: {:?}", r.names));
+    let (y, n) = (col("y"), col("n"));
+    for k in 0..r.rows() {
+        let (y, n) = (y[k], n[k]);
+        assert_eq!(col("f32")[k], y as f32 as f64, "Float32: the f32 of y, widened exactly");
+        assert_eq!(col("i8")[k], n - 5.0);
+        assert_eq!(col("u8")[k], 20.0 * n);
+        assert_eq!(col("i16")[k], -1000.0 * n);
+        assert_eq!(col("u16")[k], 6000.0 * n);
+        assert_eq!(col("u32")[k], 4e8 * n);
+        assert_eq!(col("i64")[k], -(2f64.powi(40)) * n);
+        assert_eq!(col("u64")[k], 2f64.powi(48) * n);
+        assert_eq!(col("bin")[k], n, "a Binary recorded as its size");
+        assert_eq!([col("arr[1]")[k], col("arr[2]")[k], col("arr[3]")[k]], [y, 2.0 * y, 3.0 * y]);
+        assert_eq!(col("gy")[k], 1.0 * y + 5.0, "gains[1] kept its start value 1, gains[2] set to 5");
+        assert_eq!([col("flags[1]")[k], col("flags[2]")[k]], [n % 2.0, 1.0 - n % 2.0]);
+        assert_eq!(col("f32out")[k], 2.0 * (0.1f32 as f64), "2 f32in, f32in the f32 nearest 0.1");
+    }
+    // a value that is not one of the type's is refused, naming the variable
+    let fmu = Fmu::load(&path).unwrap();
+    let mut inst = Instance::new(&fmu, "c").unwrap();
+    let n_vr = fmu.description().variable("gains[1]").unwrap().value_reference;
+    inst.set_real(&[n_vr], &[3.0]).unwrap();
+    let e = inst.set_real(&[fmu.description().variable("bin").unwrap().value_reference], &[1.0]).unwrap_err();
+    assert!(e.to_string().contains("c.bin") && e.to_string().contains("cannot be set"), "{e}");
+}
+
+/// `--isolate=run` runs an FMI 3.0 FMU in the host of the whole run (called directly there):
+/// the same rows as in process; `--isolate=fmu` (a host per FMU, FMI 2.0's protocol) is
+/// refused naming the feature.
+#[test]
+fn isolation_of_fmi3_fmus() {
+    let Some((dir, path)) = counter("fmi3-isolate") else { return };
+    let run = |extra: &[&str], out: &Path| {
+        let mut args =
+            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        cosim(&args)
+    };
+    let (plain, hosted) = (dir.join("plain.csv"), dir.join("hosted.csv"));
+    assert!(run(&[], &plain).status.success());
+    let out = run(&["--isolate=run"], &hosted);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
+    // a crash in fmi3DoStep ends only the host: a typed error naming the call, the rows so far
+    let crashed = dir.join("crashed.csv");
+    let out = run(&["--isolate=run", "--set", "crash_at=0.45"], &crashed);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let want = "cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during fmi3DoStep at t = 0.5 s";
+    assert!(err.lines().any(|l| l == want), "{err}");
+    let rows = std::fs::read_to_string(&crashed).unwrap().lines().count() - 1;
+    assert_eq!(rows, 6, "the rows 0 .. 0.5: {err}");
+    let out = run(&["--isolate"], &dir.join("refused.csv"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("FMI 3.0 instances in host processes (--isolate)"), "{err}");
+}

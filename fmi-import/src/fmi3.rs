@@ -1,0 +1,501 @@
+//! What an FMI 3.0 FMU needs beyond the FMI 2.0 import: its function table, its own model
+//! description, the view of it the master's systems, observers and writers see, the log
+//! callback, and what is refused at load.
+//!
+//! The view is an FMI 2.0-shaped [`ModelDescription`] of the FMU's variables, with the same
+//! names, value references, causalities, variabilities, units and ModelStructure (indices
+//! into the view): Float64, Float32, UInt32, Int64 and UInt64 as Real (the 64-bit integers
+//! exact up to 2^53, beyond which reading them is an error), Int8 .. Int32 as Integer,
+//! Boolean, String, Enumeration (Int64 values of i32 items), a Binary as a Real holding its
+//! size in bytes (read-only); an array as one variable per element, `y[1]`, `y[2]`, ...
+//! (`A[1,2]`: 1-based, row-major, as FMI 2.0 names array elements) with value references
+//! of the view's own above the FMU's. An [`Instance`] translates each call on them to the
+//! FMI 3.0 function of the variable's type (an element set alone: the array's other
+//! elements as set before, or its start values). Variables the view cannot hold (String
+//! and Binary arrays, clocks) are listed by [`Fmu::not_in_view`].
+//!
+//! [`Instance`]: crate::Instance
+//! [`Fmu::not_in_view`]: crate::Fmu::not_in_view
+
+use std::collections::HashMap;
+use std::ffi::{c_char, CStr, CString};
+
+use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3Status, fmi3String, Fmi3Functions};
+use model_description::fmi3;
+use model_description::*;
+
+use crate::error::Status;
+use crate::fmu::{LogRecord, LogSink};
+
+/// An FMI 3.0 FMU's functions and description.
+pub(crate) struct Fmi3Abi {
+    /// The library's functions.
+    pub(crate) functions: Fmi3Functions,
+    /// The FMU's own model description.
+    pub(crate) description: fmi3::ModelDescription,
+    /// The view's variables that are not plain scalars of the FMI 2.0 types, by the view's
+    /// value reference.
+    pub(crate) special: HashMap<u32, Access>,
+    /// `instantiationToken`.
+    pub(crate) token: CString,
+    /// `resourcePath`: the unpacked `resources/` folder, a native path ending in `/`.
+    pub(crate) resource_path: CString,
+}
+
+/// What the master cannot run yet, named for the error at load; `None`: nothing.
+pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription) -> Option<String> {
+    if let Some(clock) = md.model_variables.iter().find(|v| v.value_type == fmi3::ValueType::Clock) {
+        return Some(format!("clocks (Clock variable {:?})", clock.name));
+    }
+    if md.co_simulation.is_none() && md.model_exchange.is_none() && md.scheduled_execution.is_some() {
+        return Some("Scheduled Execution (the FMU offers no other interface type)".into());
+    }
+    None
+}
+
+fn int32(v: Option<i128>) -> Option<i32> {
+    v.and_then(|x| i32::try_from(x).ok())
+}
+
+fn int_bound(b: Option<fmi3::Bound>) -> Option<i128> {
+    match b {
+        Some(fmi3::Bound::Int(i)) => Some(i),
+        _ => None,
+    }
+}
+
+/// How the master reaches one variable of the view that is not a plain scalar of the type
+/// FMI 2.0 has: an element of an array, or a type the view holds as another.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Access {
+    /// The FMU's value reference.
+    pub(crate) vr: u32,
+    /// The FMU variable's type.
+    pub(crate) value_type: fmi3::ValueType,
+    /// The element (0-based, row-major) and the variable's element count (1 for a scalar).
+    pub(crate) element: usize,
+    pub(crate) count: usize,
+}
+
+/// Arrays with more elements than this are left out of the view (one column each would
+/// make results no one reads).
+const MAX_ELEMENTS: u64 = 100_000;
+
+/// The size of each dimension of `v` (a `valueReference` dimension: the start value of
+/// the variable it names).
+fn sizes(md: &fmi3::ModelDescription, v: &fmi3::Variable) -> Option<Vec<u64>> {
+    v.dimensions
+        .iter()
+        .map(|d| match *d {
+            fmi3::Dimension::Fixed(n) => Some(n),
+            fmi3::Dimension::Variable(vr) => match &md.variable(vr)?.start {
+                Some(fmi3::Values::Int(s)) if s.len() == 1 => u64::try_from(s[0]).ok(),
+                _ => None,
+            },
+        })
+        .collect()
+}
+
+/// `name[i]`, `name[i,j]`, ... of element `k` (row-major, 1-based), as FMI 2.0 names the
+/// elements of arrays.
+fn element_name(name: &str, sizes: &[u64], k: u64) -> String {
+    let mut rest = k;
+    let mut index = vec![0u64; sizes.len()];
+    for (i, n) in sizes.iter().enumerate().rev() {
+        index[i] = rest % n + 1;
+        rest /= n;
+    }
+    let index: Vec<String> = index.iter().map(u64::to_string).collect();
+    format!("{name}[{}]", index.join(","))
+}
+
+/// The largest integer up to which every integer is an f64.
+const EXACT: i128 = 1 << 53;
+
+/// The FMI 2.0-shaped view of `md` (see the module): its variables, how to reach those that
+/// are not plain scalars of the types FMI 2.0 has (by the view's value reference), and the
+/// names of the variables it leaves out (String and Binary arrays, clocks).
+pub(crate) fn fmi2_view(md: &fmi3::ModelDescription) -> (ModelDescription, HashMap<u32, Access>, Vec<String>) {
+    use fmi3::ValueType as T;
+    let mut special = HashMap::new();
+    let mut left_out = Vec::new();
+    // value references for array elements: above every one the FMU uses
+    let mut next_vr = md.model_variables.iter().map(|v| v.value_reference as u64 + 1).max().unwrap_or(0);
+    // (FMU value reference, element) of each variable of the view
+    let mut elements: Vec<(u32, usize)> = Vec::new();
+    let mut variables: Vec<ScalarVariable> = Vec::new();
+    for v in &md.model_variables {
+        let dims = if v.is_array() { sizes(md, v) } else { Some(Vec::new()) };
+        let count = dims.as_ref().map(|d| d.iter().product::<u64>());
+        let supported = match v.value_type {
+            T::String | T::Binary => !v.is_array(),
+            T::Clock => false,
+            _ => true,
+        };
+        let (Some(dims), Some(count), true) = (dims, count, supported) else {
+            left_out.push(v.name.clone());
+            continue;
+        };
+        if count > MAX_ELEMENTS || next_vr + count > u32::MAX as u64 {
+            left_out.push(v.name.clone());
+            continue;
+        }
+        let plain = !v.is_array() && matches!(v.value_type, T::Float64 | T::Int32 | T::Boolean | T::String);
+        // a structural parameter is set in Configuration Mode only: read-only here
+        let causality = v.causality.to_fmi2().unwrap_or(Causality::CalculatedParameter);
+        let initial = if v.causality == fmi3::Causality::StructuralParameter { None } else { v.initial };
+        let start_values = v.start.as_ref();
+        for k in 0..count as usize {
+            // element k's start value, or the one value given for all elements
+            let pick = |n: usize| if n == 1 { 0 } else { k };
+            let float = |b: Option<fmi3::Bound>| match b {
+                Some(fmi3::Bound::Float(x)) => Some(x),
+                Some(fmi3::Bound::Int(i)) if i.abs() <= EXACT => Some(i as f64),
+                _ => None,
+            };
+            let variable_type = match v.value_type {
+                T::Float64 | T::Float32 | T::UInt32 | T::Int64 | T::UInt64 => VariableType::Real {
+                    start: match start_values {
+                        Some(fmi3::Values::Float(x)) => x.get(pick(x.len())).copied(),
+                        Some(fmi3::Values::Int(x)) => {
+                            x.get(pick(x.len())).filter(|i| i.abs() <= EXACT).map(|i| *i as f64)
+                        }
+                        _ => None,
+                    },
+                    unit: md.unit_of(v).map(str::to_string),
+                    derivative: None, // an index into the view, set below
+                    min: float(v.min),
+                    max: float(v.max),
+                    nominal: v.nominal,
+                },
+                T::Int8 | T::UInt8 | T::Int16 | T::UInt16 | T::Int32 => VariableType::Integer {
+                    start: match start_values {
+                        Some(fmi3::Values::Int(x)) => int32(x.get(pick(x.len())).copied()),
+                        _ => None,
+                    },
+                    min: int32(int_bound(v.min)),
+                    max: int32(int_bound(v.max)),
+                },
+                T::Enumeration => VariableType::Enumeration {
+                    declared_type: v.declared_type.clone().unwrap_or_default(),
+                    start: match start_values {
+                        Some(fmi3::Values::Int(x)) => int32(x.get(pick(x.len())).copied()),
+                        _ => None,
+                    },
+                    min: int32(int_bound(v.min)),
+                    max: int32(int_bound(v.max)),
+                },
+                T::Boolean => VariableType::Boolean {
+                    start: match start_values {
+                        Some(fmi3::Values::Boolean(b)) => b.get(pick(b.len())).copied(),
+                        _ => None,
+                    },
+                },
+                T::String => VariableType::String {
+                    start: match start_values {
+                        Some(fmi3::Values::String(s)) => s.first().cloned(),
+                        _ => None,
+                    },
+                },
+                // a Binary is recorded as its size in bytes
+                T::Binary => VariableType::Real {
+                    start: match start_values {
+                        Some(fmi3::Values::Binary(b)) => b.first().map(|b| b.len() as f64),
+                        _ => None,
+                    },
+                    unit: None,
+                    derivative: None,
+                    min: None,
+                    max: None,
+                    nominal: None,
+                },
+                T::Clock => unreachable!("left out above"),
+            };
+            let (name, value_reference) = if v.is_array() {
+                next_vr += 1;
+                (element_name(&v.name, &dims, k as u64), (next_vr - 1) as u32)
+            } else {
+                (v.name.clone(), v.value_reference)
+            };
+            if !plain {
+                special.insert(
+                    value_reference,
+                    Access { vr: v.value_reference, value_type: v.value_type, element: k, count: count as usize },
+                );
+            }
+            elements.push((v.value_reference, k));
+            variables.push(ScalarVariable {
+                name,
+                value_reference,
+                description: v.description.clone(),
+                causality,
+                variability: v.variability,
+                initial,
+                variable_type,
+            });
+        }
+    }
+    let element_index: HashMap<(u32, usize), u32> =
+        elements.iter().enumerate().map(|(i, e)| (*e, i as u32 + 1)).collect();
+    let mut indices_of: HashMap<u32, Vec<u32>> = HashMap::new();
+    for (i, (vr, _)) in elements.iter().enumerate() {
+        indices_of.entry(*vr).or_default().push(i as u32 + 1);
+    }
+    for (sv, (vr, k)) in variables.iter_mut().zip(&elements) {
+        if let (VariableType::Real { derivative, .. }, Some(state)) =
+            (&mut sv.variable_type, md.variable(*vr).and_then(|v| v.derivative))
+        {
+            *derivative = element_index.get(&(state, *k)).copied();
+        }
+    }
+    let unknowns = |list: &[fmi3::Unknown]| -> Vec<Unknown> {
+        let mut out = Vec::new();
+        for u in list {
+            // knowns outside the view cannot be set by the master: no ordering to keep
+            let (dependencies, dependencies_kind) = match (&u.dependencies, &u.dependencies_kind) {
+                (Some(d), kinds) => {
+                    let mut deps = Vec::new();
+                    let mut deps_kind = Vec::new();
+                    for (j, vr) in d.iter().enumerate() {
+                        for index in indices_of.get(vr).into_iter().flatten() {
+                            deps.push(*index);
+                            if let Some(kind) = kinds.as_ref().and_then(|ks| ks.get(j)) {
+                                deps_kind.push(*kind);
+                            }
+                        }
+                    }
+                    let kinds = kinds.as_ref().map(|_| deps_kind);
+                    (Some(deps), kinds)
+                }
+                (None, _) => (None, None),
+            };
+            for index in indices_of.get(&u.value_reference).into_iter().flatten() {
+                out.push(Unknown {
+                    index: *index,
+                    dependencies: dependencies.clone(),
+                    dependencies_kind: dependencies_kind.clone(),
+                });
+            }
+        }
+        out
+    };
+    let model_structure = ModelStructure {
+        outputs: unknowns(&md.model_structure.outputs),
+        derivatives: unknowns(&md.model_structure.continuous_state_derivatives),
+        initial_unknowns: unknowns(&md.model_structure.initial_unknowns),
+    };
+    let number_of_event_indicators = md
+        .model_structure
+        .event_indicators
+        .iter()
+        .map(|u| indices_of.get(&u.value_reference).map_or(0, Vec::len) as u32)
+        .sum();
+    let co_simulation = md.co_simulation.as_ref().map(|cs| CoSimulation {
+        model_identifier: cs.common.model_identifier.clone(),
+        needs_execution_tool: cs.common.needs_execution_tool,
+        can_handle_variable_communication_step_size: cs.can_handle_variable_communication_step_size,
+        can_interpolate_inputs: false,
+        max_output_derivative_order: 0,
+        can_run_asynchronuously: false,
+        can_be_instantiated_only_once_per_process: cs.common.can_be_instantiated_only_once_per_process,
+        can_not_use_memory_management_functions: true,
+        can_get_and_set_fmu_state: cs.common.can_get_and_set_fmu_state,
+        can_serialize_fmu_state: cs.common.can_serialize_fmu_state,
+        provides_directional_derivative: false,
+    });
+    let model_exchange = md.model_exchange.as_ref().map(|me| ModelExchange {
+        model_identifier: me.common.model_identifier.clone(),
+        needs_execution_tool: me.common.needs_execution_tool,
+        completed_integrator_step_not_needed: !me.needs_completed_integrator_step,
+        can_be_instantiated_only_once_per_process: me.common.can_be_instantiated_only_once_per_process,
+        can_not_use_memory_management_functions: true,
+        can_get_and_set_fmu_state: me.common.can_get_and_set_fmu_state,
+        can_serialize_fmu_state: me.common.can_serialize_fmu_state,
+        provides_directional_derivative: false,
+    });
+    let type_definitions = md
+        .type_definitions
+        .iter()
+        .filter_map(|t| match &t.kind {
+            fmi3::TypeKind::Enumeration { items, .. } => Some(EnumerationType {
+                name: t.name.clone(),
+                description: t.description.clone(),
+                items: items
+                    .iter()
+                    .filter_map(|i| {
+                        Some(EnumerationItem {
+                            name: i.name.clone(),
+                            value: i32::try_from(i.value).ok()?,
+                            description: i.description.clone(),
+                        })
+                    })
+                    .collect(),
+            }),
+            _ => None,
+        })
+        .collect();
+    let view = ModelDescription {
+        fmi_version: md.fmi_version.clone(),
+        model_name: md.model_name.clone(),
+        guid: md.instantiation_token.clone(),
+        description: md.description.clone(),
+        author: md.author.clone(),
+        version: md.version.clone(),
+        copyright: md.copyright.clone(),
+        license: md.license.clone(),
+        generation_tool: md.generation_tool.clone(),
+        generation_date_and_time: md.generation_date_and_time.clone(),
+        variable_naming_convention: md.variable_naming_convention.clone(),
+        number_of_event_indicators,
+        model_exchange,
+        co_simulation,
+        unit_definitions: md.unit_definitions.clone(),
+        type_definitions,
+        log_categories: md.log_categories.clone(),
+        default_experiment: md.default_experiment.clone(),
+        model_variables: variables,
+        model_structure,
+    };
+    (view, special, left_out)
+}
+
+fn text(p: fmi3String) -> String {
+    if p.is_null() {
+        return String::new();
+    }
+    // SAFETY: the FMU passes NUL-terminated strings valid for the call.
+    unsafe { CStr::from_ptr(p as *const c_char) }.to_string_lossy().into_owned()
+}
+
+/// `fmi3LogMessageCallback`: the instance environment is the instance's [`LogSink`].
+pub(crate) unsafe extern "C" fn log_message(
+    environment: fmi3InstanceEnvironment,
+    status: fmi3Status,
+    category: fmi3String,
+    message: fmi3String,
+) {
+    if environment.is_null() {
+        return;
+    }
+    // no panic may cross the C boundary: a failure to record drops the message
+    let _ = std::panic::catch_unwind(|| {
+        // SAFETY: the environment is the instance's boxed LogSink, alive while it logs.
+        let sink = unsafe { &*(environment as *const LogSink) };
+        sink.push(LogRecord { status: Status::from_raw(status), category: text(category), message: text(message) });
+    });
+}
+
+/// The resource path FMI 3.0 wants: an absolute native path ending in a separator.
+pub(crate) fn resource_path(dir: &std::path::Path) -> Option<CString> {
+    let mut s = dir.join("resources").to_string_lossy().into_owned();
+    s.push(std::path::MAIN_SEPARATOR);
+    CString::new(s).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const XML: &str = r#"<fmiModelDescription fmiVersion="3.0" modelName="m" instantiationToken="{tok}">
+  <ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>
+  <CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>
+  <UnitDefinitions><Unit name="m"/></UnitDefinitions>
+  <TypeDefinitions>
+    <Float64Type name="Length" unit="m"/>
+    <EnumerationType name="E"><Item name="a" value="1"/><Item name="b" value="5000000000"/></EnumerationType>
+  </TypeDefinitions>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent"/>
+    <Float64 name="x" valueReference="1" causality="output" declaredType="Length" start="1" initial="exact"/>
+    <Float64 name="der(x)" valueReference="2" derivative="1"/>
+    <Float32 name="f" valueReference="3" causality="input" start="0"/>
+    <Int32 name="k" valueReference="4" causality="input" start="-3"/>
+    <Enumeration name="e" valueReference="5" causality="parameter" variability="fixed" declaredType="E" start="1"/>
+    <Boolean name="b" valueReference="6" causality="input" start="true"/>
+    <Float64 name="y" valueReference="7" causality="output"><Dimension start="2"/></Float64>
+    <UInt64 name="n" valueReference="8" causality="structuralParameter" variability="fixed" start="2"/>
+    <Float64 name="z" valueReference="9"/>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="1"/>
+    <Output valueReference="7" dependencies="3 4" dependenciesKind="dependent constant"/>
+    <ContinuousStateDerivative valueReference="2" dependencies="1 3 4" dependenciesKind="fixed dependent constant"/>
+    <InitialUnknown valueReference="2"/>
+    <EventIndicator valueReference="9"/>
+  </ModelStructure>
+</fmiModelDescription>"#;
+
+    #[test]
+    fn the_view_holds_every_variable_with_a_value() {
+        let md = fmi3::ModelDescription::from_xml(XML).unwrap();
+        let (view, special, left_out) = fmi2_view(&md);
+        assert!(left_out.is_empty(), "{left_out:?}");
+        let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
+        assert_eq!(names, ["time", "x", "der(x)", "f", "k", "e", "b", "y[1]", "y[2]", "n", "z"]);
+        assert_eq!(view.guid, "{tok}");
+        // f (Float32), e (Enumeration), the elements of y (value references above the
+        // FMU's 9) and n (UInt64) go by their own getters
+        let access = |vr: u32| special.get(&vr).map(|a| (a.vr, a.value_type, a.element, a.count));
+        assert_eq!(special.len(), 5);
+        assert_eq!(access(3), Some((3, fmi3::ValueType::Float32, 0, 1)));
+        assert_eq!(access(5), Some((5, fmi3::ValueType::Enumeration, 0, 1)));
+        assert_eq!(view.variable("y[2]").unwrap().value_reference, 11);
+        assert_eq!(access(11), Some((7, fmi3::ValueType::Float64, 1, 2)));
+        assert_eq!(access(8), Some((8, fmi3::ValueType::UInt64, 0, 1)));
+        assert_eq!(view.variable("n").unwrap().variable_type.type_name(), "Real");
+        assert_eq!(view.variable("f").unwrap().variable_type.type_name(), "Real");
+        let x = view.variable("x").unwrap();
+        assert_eq!(x.variable_type.unit(), Some("m"), "from the declaredType");
+        // der(x) is variable 3 of the view, its state x variable 2
+        assert_eq!(view.variable("der(x)").unwrap().variable_type.derivative(), Some(2));
+        assert_eq!(view.states(), vec![2]);
+        // the output y is its two elements, each depending on f (4) and k (5)
+        let outputs: Vec<(u32, Option<Vec<u32>>)> =
+            view.model_structure.outputs.iter().map(|u| (u.index, u.dependencies.clone())).collect();
+        assert_eq!(outputs, vec![(2, None), (8, Some(vec![4, 5])), (9, Some(vec![4, 5]))]);
+        let der = &view.model_structure.derivatives[0];
+        assert_eq!(der.dependencies, Some(vec![2, 4, 5]));
+        assert_eq!(
+            der.dependencies_kind,
+            Some(vec![DependencyKind::Fixed, DependencyKind::Dependent, DependencyKind::Constant])
+        );
+        assert_eq!(view.number_of_event_indicators, 1);
+        assert!(view.model_exchange.as_ref().is_some_and(|m| !m.completed_integrator_step_not_needed));
+        // the item of 5e9 does not fit FMI 2.0's Integer
+        assert_eq!(view.type_definitions[0].items.len(), 1);
+        assert_eq!(view.variable("b").unwrap().variable_type, VariableType::Boolean { start: Some(true) });
+    }
+
+    #[test]
+    fn array_elements_are_named_row_major_from_one() {
+        assert_eq!(element_name("A", &[2, 3], 0), "A[1,1]");
+        assert_eq!(element_name("A", &[2, 3], 2), "A[1,3]");
+        assert_eq!(element_name("A", &[2, 3], 3), "A[2,1]");
+        assert_eq!(element_name("y", &[4], 3), "y[4]");
+    }
+
+    #[test]
+    fn clocks_and_scheduled_execution_are_named() {
+        let md = fmi3::ModelDescription::from_xml(XML).unwrap();
+        assert_eq!(unsupported_feature(&md), None);
+        let clock = XML.replace(
+            r#"<Float64 name="z" valueReference="9"/>"#,
+            r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
+        );
+        let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
+        assert_eq!(unsupported_feature(&md).as_deref(), Some("clocks (Clock variable \"tick\")"));
+        let se =
+            XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
+                r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,
+                r#"<ScheduledExecution modelIdentifier="m"/>"#,
+            );
+        let md = fmi3::ModelDescription::from_xml(&se).unwrap();
+        assert!(unsupported_feature(&md).unwrap().starts_with("Scheduled Execution"));
+    }
+
+    #[test]
+    fn resource_path_ends_in_a_separator() {
+        let p = resource_path(std::path::Path::new("/tmp/nigel-cosim-x")).unwrap();
+        assert_eq!(p.to_str().unwrap(), "/tmp/nigel-cosim-x/resources/");
+    }
+}

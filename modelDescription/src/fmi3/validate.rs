@@ -1,0 +1,539 @@
+//! Checks of an FMI 3.0 [`ModelDescription`] against the rules of the standard importers
+//! enforce (fmpy's `validate`, the FMI 3.0 schema's key constraints, section 2.4).
+
+use std::collections::{BTreeSet, HashMap, HashSet};
+use std::fmt;
+
+use super::*;
+use crate::is_c_identifier;
+
+/// The rule a [`Problem`] breaks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Rule {
+    /// `fmiVersion` must be a 3.x version.
+    FmiVersion,
+    /// At least one interface type (`<ModelExchange>`, `<CoSimulation>`,
+    /// `<ScheduledExecution>`) must be present.
+    NoInterface,
+    /// `modelIdentifier` must be a non-empty C identifier.
+    ModelIdentifier,
+    /// Variable names must be non-empty.
+    EmptyName,
+    /// Variable names must be unique.
+    DuplicateName,
+    /// Value references must be unique across all variables of all types.
+    DuplicateValueReference,
+    /// Unit names must be unique.
+    DuplicateUnit,
+    /// The (causality, variability) pair must be legal.
+    CausalityVariability,
+    /// `initial` must be one the table allows, and absent for inputs and the independent
+    /// variable.
+    Initial,
+    /// A start value is required (initial exact/approx, inputs, parameters, constants).
+    StartRequired,
+    /// A start value is forbidden (initial calculated, the independent variable).
+    StartForbidden,
+    /// The number of start values must be the number of elements (1 for a scalar; an
+    /// array may also give one value for all its elements).
+    StartCount,
+    /// Exactly one variable is the independent variable; it is a continuous Float.
+    Independent,
+    /// Only Float32/Float64 variables may be continuous.
+    ContinuousNonFloat,
+    /// A `unit` or `displayUnit` must be declared in `<UnitDefinitions>`.
+    UndeclaredUnit,
+    /// `derivative` must be the value reference of a continuous Float variable.
+    Derivative,
+    /// `min <= max` and `min <= start <= max`.
+    Bounds,
+    /// `nominal > 0`.
+    Nominal,
+    /// A `<Dimension valueReference>` must name an integer structural parameter or
+    /// constant.
+    Dimension,
+    /// `previous` and `clocks` must name variables of the right kind.
+    Reference,
+    /// A ModelStructure entry or dependency must be the value reference of a variable.
+    UnknownValueReference,
+    /// `<Output>` must list exactly the causality=output variables, in order.
+    Outputs,
+    /// `<ContinuousStateDerivative>` must name variables with a `derivative` attribute.
+    ContinuousStateDerivatives,
+    /// `<InitialUnknown>` must list exactly the outputs, continuous states and state
+    /// derivatives with initial approx or calculated, and the calculated parameters.
+    InitialUnknowns,
+    /// `<EventIndicator>` must name continuous Float variables.
+    EventIndicators,
+    /// `dependenciesKind` needs `dependencies` of the same length.
+    DependenciesKind,
+    /// A `declaredType` must name a type definition of the variable's type; enumeration
+    /// items must be unique and a start value one of them; type names unique.
+    DeclaredType,
+}
+
+impl Rule {
+    /// A short stable identifier, e.g. `"start-count"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Rule::FmiVersion => "fmi-version",
+            Rule::NoInterface => "no-interface",
+            Rule::ModelIdentifier => "model-identifier",
+            Rule::EmptyName => "empty-name",
+            Rule::DuplicateName => "duplicate-name",
+            Rule::DuplicateValueReference => "duplicate-value-reference",
+            Rule::DuplicateUnit => "duplicate-unit",
+            Rule::CausalityVariability => "causality-variability",
+            Rule::Initial => "initial",
+            Rule::StartRequired => "start-required",
+            Rule::StartForbidden => "start-forbidden",
+            Rule::StartCount => "start-count",
+            Rule::Independent => "independent",
+            Rule::ContinuousNonFloat => "continuous-non-float",
+            Rule::UndeclaredUnit => "undeclared-unit",
+            Rule::Derivative => "derivative",
+            Rule::Bounds => "bounds",
+            Rule::Nominal => "nominal",
+            Rule::Dimension => "dimension",
+            Rule::Reference => "reference",
+            Rule::UnknownValueReference => "unknown-value-reference",
+            Rule::Outputs => "outputs",
+            Rule::ContinuousStateDerivatives => "continuous-state-derivatives",
+            Rule::InitialUnknowns => "initial-unknowns",
+            Rule::EventIndicators => "event-indicators",
+            Rule::DependenciesKind => "dependencies-kind",
+            Rule::DeclaredType => "declared-type",
+        }
+    }
+}
+
+impl fmt::Display for Rule {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One violation found by [`ModelDescription::validate`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    /// The rule broken.
+    pub rule: Rule,
+    /// The variable concerned, if any.
+    pub variable: Option<String>,
+    /// What is wrong, in words.
+    pub message: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.variable {
+            Some(v) => write!(f, "[{}] variable \"{}\": {}", self.rule, v, self.message),
+            None => write!(f, "[{}] {}", self.rule, self.message),
+        }
+    }
+}
+
+/// The FMI 2.0 table of section 2.2.7 is FMI 3.0's too; a structural parameter is a
+/// parameter there.
+fn as_fmi2(c: Causality) -> crate::Causality {
+    c.to_fmi2().unwrap_or(crate::Causality::Parameter)
+}
+
+fn bound_value(b: Bound) -> f64 {
+    match b {
+        Bound::Float(x) => x,
+        Bound::Int(i) => i as f64,
+    }
+}
+
+impl ModelDescription {
+    /// The number of elements of `v` (1 for a scalar): the product of its dimensions, a
+    /// `valueReference` dimension taking the start value of the variable it names. `None`
+    /// if a dimension names no integer variable with one start value.
+    pub fn element_count(&self, v: &Variable) -> Option<u64> {
+        v.dimensions.iter().try_fold(1u64, |n, d| {
+            let size = match *d {
+                Dimension::Fixed(size) => size,
+                Dimension::Variable(vr) => match &self.variable(vr)?.start {
+                    Some(Values::Int(s)) if s.len() == 1 => u64::try_from(s[0]).ok()?,
+                    _ => return None,
+                },
+            };
+            n.checked_mul(size)
+        })
+    }
+
+    /// Checks the description against the FMI 3.0 rules (see [`Rule`]); an empty vector
+    /// means no problem was found. Problems come in a deterministic order.
+    pub fn validate(&self) -> Vec<Problem> {
+        let mut problems = Vec::new();
+        let mut push = |rule: Rule, variable: Option<&str>, message: String| {
+            problems.push(Problem { rule, variable: variable.map(str::to_string), message })
+        };
+        let by_vr: HashMap<u32, &Variable> = self.model_variables.iter().map(|v| (v.value_reference, v)).collect();
+
+        // Header.
+        if !self.fmi_version.starts_with("3.") {
+            push(Rule::FmiVersion, None, format!("fmiVersion is \"{}\", must be 3.x", self.fmi_version));
+        }
+        let interfaces = [
+            ("ModelExchange", self.model_exchange.as_ref().map(|i| &i.common)),
+            ("CoSimulation", self.co_simulation.as_ref().map(|i| &i.common)),
+            ("ScheduledExecution", self.scheduled_execution.as_ref().map(|i| &i.common)),
+        ];
+        if interfaces.iter().all(|(_, i)| i.is_none()) {
+            push(Rule::NoInterface, None, "no <ModelExchange>, <CoSimulation> or <ScheduledExecution>".into());
+        }
+        for (element, common) in interfaces {
+            if let Some(common) = common {
+                if !is_c_identifier(&common.model_identifier) {
+                    push(
+                        Rule::ModelIdentifier,
+                        None,
+                        format!("<{element}> modelIdentifier \"{}\" is not a C identifier", common.model_identifier),
+                    );
+                }
+            }
+        }
+        let mut unit_names = HashSet::new();
+        for u in &self.unit_definitions {
+            if !unit_names.insert(u.name.as_str()) {
+                push(Rule::DuplicateUnit, None, format!("unit \"{}\" is defined more than once", u.name));
+            }
+        }
+        let mut type_names = HashSet::new();
+        for t in &self.type_definitions {
+            if !type_names.insert(t.name.as_str()) {
+                push(Rule::DeclaredType, None, format!("type \"{}\" is defined more than once", t.name));
+            }
+            if let TypeKind::Enumeration { items, .. } = &t.kind {
+                if items.is_empty() {
+                    push(Rule::DeclaredType, None, format!("enumeration \"{}\" has no items", t.name));
+                }
+                let (mut names, mut values) = (HashSet::new(), HashSet::new());
+                for item in items {
+                    if !names.insert(item.name.as_str()) || !values.insert(item.value) {
+                        push(
+                            Rule::DeclaredType,
+                            None,
+                            format!("enumeration \"{}\": item {} = {} is not unique", t.name, item.name, item.value),
+                        );
+                    }
+                }
+            }
+        }
+
+        // Variables.
+        let mut names: HashMap<&str, usize> = HashMap::new();
+        let mut vrs: HashMap<u32, &str> = HashMap::new();
+        let mut independents = Vec::new();
+        for (i, v) in self.model_variables.iter().enumerate() {
+            let name = Some(v.name.as_str());
+            let element = v.value_type.element();
+            if v.name.is_empty() {
+                push(Rule::EmptyName, None, format!("variable {} (0-based {i}) has an empty name", i + 1));
+            } else if let Some(first) = names.get(v.name.as_str()) {
+                push(Rule::DuplicateName, name, format!("name used by variables {} and {}", first + 1, i + 1));
+            } else {
+                names.insert(v.name.as_str(), i);
+            }
+            if let Some(other) = vrs.get(&v.value_reference) {
+                push(
+                    Rule::DuplicateValueReference,
+                    name,
+                    format!("valueReference {} is also used by \"{other}\"", v.value_reference),
+                );
+            } else {
+                vrs.insert(v.value_reference, v.name.as_str());
+            }
+
+            let (c2, var) = (as_fmi2(v.causality), v.variability);
+            let legal = crate::legal_combination(c2, var);
+            if !legal {
+                push(
+                    Rule::CausalityVariability,
+                    name,
+                    format!(
+                        "causality=\"{}\" with variability=\"{}\" is not allowed",
+                        v.causality.as_str(),
+                        var.as_str()
+                    ),
+                );
+            }
+            let allowed = Initial::allowed(c2, var);
+            if let Some(init) = v.initial {
+                if matches!(v.causality, Causality::Input | Causality::Independent) {
+                    push(
+                        Rule::Initial,
+                        name,
+                        format!(
+                            "causality=\"{}\" must not define initial (has \"{}\")",
+                            v.causality.as_str(),
+                            init.as_str()
+                        ),
+                    );
+                } else if legal && !allowed.contains(&init) {
+                    push(
+                        Rule::Initial,
+                        name,
+                        format!(
+                            "initial=\"{}\" is not allowed for causality=\"{}\", variability=\"{}\"",
+                            init.as_str(),
+                            v.causality.as_str(),
+                            var.as_str()
+                        ),
+                    );
+                }
+            }
+            let initial = v.initial.or_else(|| Initial::default_for(c2, var));
+            let start_required = v.value_type != ValueType::Clock
+                && (v.causality == Causality::Input || matches!(initial, Some(Initial::Exact | Initial::Approx)));
+            let start_forbidden = v.causality == Causality::Independent || initial == Some(Initial::Calculated);
+            match (&v.start, start_required && !start_forbidden, start_forbidden) {
+                (None, true, _) => push(Rule::StartRequired, name, "a start value is required here".into()),
+                (Some(_), _, true) => push(
+                    Rule::StartForbidden,
+                    name,
+                    if v.causality == Causality::Independent {
+                        "the independent variable must not have a start value".into()
+                    } else {
+                        "initial=\"calculated\" must not have a start value".into()
+                    },
+                ),
+                _ => {}
+            }
+            if let Some(start) = &v.start {
+                match self.element_count(v) {
+                    Some(n) if start.len() as u64 != n && !(v.is_array() && start.len() == 1) => push(
+                        Rule::StartCount,
+                        name,
+                        format!("{} start values, the variable has {n} element(s)", start.len()),
+                    ),
+                    _ => {}
+                }
+            }
+            if v.causality == Causality::Independent {
+                independents.push(v.name.as_str());
+                if !v.value_type.is_float() || var != Variability::Continuous || v.is_array() {
+                    push(
+                        Rule::Independent,
+                        name,
+                        format!(
+                            "the independent variable must be a continuous scalar Float, is {element} {}",
+                            var.as_str()
+                        ),
+                    );
+                }
+            }
+            if var == Variability::Continuous && !v.value_type.is_float() {
+                push(Rule::ContinuousNonFloat, name, format!("{element} variables cannot be continuous"));
+            }
+            if let Some(unit) = &v.unit {
+                if !unit_names.contains(unit.as_str()) {
+                    push(Rule::UndeclaredUnit, name, format!("unit \"{unit}\" is not in <UnitDefinitions>"));
+                }
+            }
+            if let Some(d) = v.derivative {
+                match by_vr.get(&d) {
+                    Some(s) if s.value_type.is_float() && s.variability == Variability::Continuous => {}
+                    Some(s) => push(
+                        Rule::Derivative,
+                        name,
+                        format!("derivative={d} names \"{}\", which is not a continuous Float", s.name),
+                    ),
+                    None => push(Rule::Derivative, name, format!("derivative={d} names no variable")),
+                }
+            }
+            if let (Some(lo), Some(hi)) = (v.min, v.max) {
+                if bound_value(lo) > bound_value(hi) {
+                    push(Rule::Bounds, name, format!("min {} > max {}", bound_value(lo), bound_value(hi)));
+                }
+            }
+            let starts: Vec<f64> = match &v.start {
+                Some(Values::Float(s)) => s.clone(),
+                Some(Values::Int(s)) => s.iter().map(|&x| x as f64).collect(),
+                _ => Vec::new(),
+            };
+            for s in starts {
+                let below = v.min.is_some_and(|m| s < bound_value(m));
+                let above = v.max.is_some_and(|m| s > bound_value(m));
+                if below || above {
+                    push(Rule::Bounds, name, format!("start {s} is outside [min, max]"));
+                }
+            }
+            if let Some(nominal) = v.nominal {
+                if !(nominal > 0.0) {
+                    push(Rule::Nominal, name, format!("nominal {nominal} is not > 0"));
+                }
+            }
+            for d in &v.dimensions {
+                let Dimension::Variable(vr) = *d else { continue };
+                match by_vr.get(&vr) {
+                    Some(s)
+                        if s.value_type.is_integer()
+                            && s.value_type != ValueType::Enumeration
+                            && !s.is_array()
+                            && (s.causality == Causality::StructuralParameter || s.variability == Variability::Constant) => {}
+                    Some(s) => push(
+                        Rule::Dimension,
+                        name,
+                        format!(
+                            "Dimension valueReference={vr} names \"{}\", which is not an integer structural parameter or constant",
+                            s.name
+                        ),
+                    ),
+                    None => push(Rule::Dimension, name, format!("Dimension valueReference={vr} names no variable")),
+                }
+            }
+            if let Some(p) = v.previous {
+                match by_vr.get(&p) {
+                    Some(s) if s.value_type == v.value_type => {}
+                    Some(s) => {
+                        push(Rule::Reference, name, format!("previous={p} names \"{}\" of another type", s.name))
+                    }
+                    None => push(Rule::Reference, name, format!("previous={p} names no variable")),
+                }
+            }
+            for &c in &v.clocks {
+                if by_vr.get(&c).map(|s| s.value_type) != Some(ValueType::Clock) {
+                    push(Rule::Reference, name, format!("clocks entry {c} is not the value reference of a Clock"));
+                }
+            }
+            if let Some(t) = &v.declared_type {
+                match self.type_definition(t) {
+                    None => push(Rule::DeclaredType, name, format!("declaredType \"{t}\" is not in <TypeDefinitions>")),
+                    Some(def) => {
+                        let def_type = match &def.kind {
+                            TypeKind::Float { value_type, .. }
+                            | TypeKind::Integer { value_type, .. }
+                            | TypeKind::Other { value_type } => *value_type,
+                            TypeKind::Enumeration { .. } => ValueType::Enumeration,
+                        };
+                        if def_type != v.value_type {
+                            push(
+                                Rule::DeclaredType,
+                                name,
+                                format!(
+                                    "declaredType \"{t}\" is a {}Type, the variable is {element}",
+                                    def_type.element()
+                                ),
+                            );
+                        } else if let (TypeKind::Enumeration { items, .. }, Some(Values::Int(s))) =
+                            (&def.kind, &v.start)
+                        {
+                            for x in s {
+                                if !items.iter().any(|item| item.value as i128 == *x) {
+                                    push(Rule::DeclaredType, name, format!("start {x} is no item of \"{t}\""));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        match independents.len() {
+            1 => {}
+            0 => push(Rule::Independent, None, "no variable has causality=\"independent\" (exactly one must)".into()),
+            _ => push(
+                Rule::Independent,
+                None,
+                format!("{} independent variables: {}", independents.len(), independents.join(", ")),
+            ),
+        }
+
+        // ModelStructure.
+        let ms = &self.model_structure;
+        let lists: [(&str, &Vec<Unknown>); 5] = [
+            ("Output", &ms.outputs),
+            ("ContinuousStateDerivative", &ms.continuous_state_derivatives),
+            ("ClockedState", &ms.clocked_states),
+            ("InitialUnknown", &ms.initial_unknowns),
+            ("EventIndicator", &ms.event_indicators),
+        ];
+        for (element, list) in lists {
+            for u in list {
+                let Some(v) = by_vr.get(&u.value_reference) else {
+                    push(
+                        Rule::UnknownValueReference,
+                        None,
+                        format!("<{element} valueReference=\"{}\"> names no variable", u.value_reference),
+                    );
+                    continue;
+                };
+                let name = Some(v.name.as_str());
+                for d in u.dependencies.iter().flatten() {
+                    if !by_vr.contains_key(d) {
+                        push(
+                            Rule::UnknownValueReference,
+                            name,
+                            format!("<{element}> dependency {d} names no variable"),
+                        );
+                    }
+                }
+                match (&u.dependencies, &u.dependencies_kind) {
+                    (Some(d), Some(k)) if d.len() != k.len() => push(
+                        Rule::DependenciesKind,
+                        name,
+                        format!("<{element}>: {} dependencies, {} dependenciesKind", d.len(), k.len()),
+                    ),
+                    (None, Some(_)) => push(
+                        Rule::DependenciesKind,
+                        name,
+                        format!("<{element}>: dependenciesKind without dependencies"),
+                    ),
+                    _ => {}
+                }
+                match element {
+                    "ContinuousStateDerivative" if v.derivative.is_none() => push(
+                        Rule::ContinuousStateDerivatives,
+                        name,
+                        "listed as a <ContinuousStateDerivative> but has no derivative attribute".into(),
+                    ),
+                    "EventIndicator" if !(v.value_type.is_float() && v.variability == Variability::Continuous) => {
+                        push(Rule::EventIndicators, name, "an <EventIndicator> must be a continuous Float".into())
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let outputs: Vec<u32> = self
+            .model_variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+            .map(|v| v.value_reference)
+            .collect();
+        let listed: Vec<u32> = ms.outputs.iter().map(|u| u.value_reference).collect();
+        if outputs != listed {
+            push(
+                Rule::Outputs,
+                None,
+                format!("<Output> entries are {listed:?}, the causality=output variables are {outputs:?} (in order)"),
+            );
+        }
+        let states: HashSet<u32> = self.states().into_iter().collect();
+        let derivatives: HashSet<u32> = ms.continuous_state_derivatives.iter().map(|u| u.value_reference).collect();
+        let expected: BTreeSet<u32> = self
+            .model_variables
+            .iter()
+            .filter(|v| {
+                let initial = v.initial.or_else(|| Initial::default_for(as_fmi2(v.causality), v.variability));
+                let open = matches!(initial, Some(Initial::Approx | Initial::Calculated));
+                v.causality == Causality::CalculatedParameter
+                    || (open
+                        && (v.causality == Causality::Output
+                            || states.contains(&v.value_reference)
+                            || derivatives.contains(&v.value_reference)))
+            })
+            .map(|v| v.value_reference)
+            .collect();
+        let listed: BTreeSet<u32> = ms.initial_unknowns.iter().map(|u| u.value_reference).collect();
+        if expected != listed || listed.len() != ms.initial_unknowns.len() {
+            push(
+                Rule::InitialUnknowns,
+                None,
+                format!("<InitialUnknown> entries are {listed:?} (once each), expected {expected:?}"),
+            );
+        }
+        problems
+    }
+}

@@ -1,0 +1,219 @@
+//! Our FMUs in FMI 3.0 through the master's FMI 3.0 import:
+//! - each FMU's FMI 3.0 description (`model_description3` of its declaration) passes the
+//!   FMI 3.0 validation and reads back from its XML as it was written;
+//! - the closed loop with the plant in FMI 3.0 (the built plant library, which exports both
+//!   generations, in an FMI 3.0 archive) and the controller and test bench in FMI 2.0, and
+//!   the closed loop of the three in FMI 3.0, give the FMI 2.0 closed loop's results bit for
+//!   bit, under jacobi and ordered;
+//! - (ignored; `cargo test --release -p nigel-integration-tests --test fmi3_closed_loop --
+//!   --ignored --nocapture`) the speed of the FMI 3.0 closed loop against the FMI 2.0 one,
+//!   30 s at 1 ms, alternated, medians; and of the plant's calls alone (set inputs, step,
+//!   get outputs), which shows where an FMI 3.0 step's extra time goes.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use fmi_export::Model;
+use model_description::fmi3;
+use nigel_cosim::{read_ssp, simulate, Algorithm, Experiment};
+use nigel_integration_tests::target_dir;
+
+fn descriptions() -> Vec<(&'static str, &'static fmi3::ModelDescription, &'static str)> {
+    let plant = nigel_plant::Plant::declaration();
+    let controller = nigel_controller::Controller::declaration();
+    let maneuver = nigel_maneuver::TestBench::declaration();
+    vec![
+        ("nigel_plant", plant.model_description3(), plant.xml3()),
+        ("nigel_controller", controller.model_description3(), controller.xml3()),
+        ("nigel_maneuver", maneuver.model_description3(), maneuver.xml3()),
+    ]
+}
+
+#[test]
+fn our_fmi3_descriptions_validate_and_read_back() {
+    for (id, md, xml) in descriptions() {
+        assert_eq!(md.validate(), vec![], "{id}");
+        let read = fmi3::ModelDescription::from_xml(xml).unwrap_or_else(|e| panic!("{id}: {e}"));
+        assert_eq!(&read, md, "{id}: the XML reads back as the description it was written from");
+    }
+}
+
+fn entries(bytes: &[u8]) -> Vec<(String, Vec<u8>)> {
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).unwrap();
+    (0..zip.len())
+        .map(|i| {
+            let mut e = zip.by_index(i).unwrap();
+            let mut data = Vec::new();
+            e.read_to_end(&mut data).unwrap();
+            (e.name().to_string(), data)
+        })
+        .filter(|(name, _)| !name.ends_with('/'))
+        .collect()
+}
+
+fn zipped(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
+    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    for (name, data) in entries {
+        out.start_file(name.as_str(), options).unwrap();
+        out.write_all(data).unwrap();
+    }
+    out.finish().unwrap().into_inner()
+}
+
+/// The FMI 3.0 archive of one of our FMUs from its FMI 2.0 one: the same library under
+/// `binaries/x86_64-linux/`, the same resources, the FMI 3.0 description `xml3`.
+fn fmi3_archive(fmi2: &[u8], xml3: &str) -> Vec<u8> {
+    let mut out = vec![("modelDescription.xml".to_string(), xml3.as_bytes().to_vec())];
+    for (name, data) in entries(fmi2) {
+        if let Some(rest) = name.strip_prefix("binaries/linux64/") {
+            out.push((format!("binaries/x86_64-linux/{rest}"), data));
+        } else if name.starts_with("resources/") {
+            out.push((name, data));
+        }
+    }
+    assert!(out.iter().any(|(n, _)| n.starts_with("binaries/x86_64-linux/")), "the archive has a linux64 library");
+    zipped(&out)
+}
+
+/// The closed loop's `.ssp` with the FMUs `which` (model identifiers) in FMI 3.0.
+fn ssp_with_fmi3(fmi2_ssp: &Path, dir: &Path, which: &[&str], file: &str) -> PathBuf {
+    let bytes = std::fs::read(fmi2_ssp).unwrap();
+    let xml3 = descriptions();
+    let replaced: Vec<(String, Vec<u8>)> = entries(&bytes)
+        .into_iter()
+        .map(|(name, data)| {
+            let fmi3 = xml3.iter().find(|(id, _, _)| which.contains(id) && name.ends_with(&format!("{id}.fmu")));
+            match fmi3 {
+                Some((_, _, xml)) => (name, fmi3_archive(&data, xml)),
+                None => (name, data),
+            }
+        })
+        .collect();
+    let path = dir.join(file);
+    std::fs::write(&path, zipped(&replaced)).unwrap();
+    path
+}
+
+/// The FMI 2.0 closed loop, the one with the plant in FMI 3.0, the one of three FMI 3.0 FMUs
+/// (their `.ssp` files written once per test process, into a folder of its own).
+fn closed_loops() -> (nigel_cosim::System, nigel_cosim::System, nigel_cosim::System) {
+    static SSPS: std::sync::OnceLock<[PathBuf; 3]> = std::sync::OnceLock::new();
+    let [fmi2_ssp, mixed, fmi3] = SSPS.get_or_init(|| {
+        let fmi2_ssp = target_dir().join("ssp").join("nigel_closed_loop.ssp");
+        assert!(fmi2_ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu`", fmi2_ssp.display());
+        let dir = target_dir().join(format!("fmi3-closed-loop-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let all = ["nigel_plant", "nigel_controller", "nigel_maneuver"];
+        let mixed = ssp_with_fmi3(&fmi2_ssp, &dir, &all[..1], "nigel_closed_loop_mixed.ssp");
+        let fmi3 = ssp_with_fmi3(&fmi2_ssp, &dir, &all, "nigel_closed_loop_fmi3.ssp");
+        [fmi2_ssp, mixed, fmi3]
+    });
+    let read = |p: &PathBuf| read_ssp(p, &Default::default()).unwrap().system;
+    (read(fmi2_ssp), read(mixed), read(fmi3))
+}
+
+#[test]
+fn the_closed_loops_with_fmi3_fmus_are_the_fmi2_one_bit_for_bit() {
+    let (fmi2, mixed, fmi3) = closed_loops();
+    let generations = |s: &nigel_cosim::System| -> Vec<bool> {
+        s.instances.iter().map(|i| i.fmu.fmi3_description().is_some()).collect()
+    };
+    let plant = mixed.instance_index("plant").expect("an instance called plant");
+    let mut expected = vec![false; 3];
+    expected[plant] = true;
+    assert_eq!(generations(&mixed), expected, "only the plant in FMI 3.0");
+    assert_eq!(generations(&fmi3), vec![true; 3]);
+    for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+        let mut e = Experiment::new(2.0, 1e-3);
+        e.algorithm = algorithm;
+        let (a, _) = simulate(&fmi2, &e).unwrap();
+        assert_eq!(a.rows(), 2001);
+        for (name, system) in [("mixed", &mixed), ("FMI 3.0", &fmi3)] {
+            let (b, _) = simulate(system, &e).unwrap();
+            assert_eq!(a.names, b.names, "{algorithm:?} {name}");
+            let differing = a.values.iter().zip(&b.values).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
+            assert_eq!(differing, 0, "{algorithm:?}: values of the {name} closed loop differ from the FMI 2.0 one's");
+        }
+    }
+}
+
+/// The speed of the FMI 3.0 closed loop against the FMI 2.0 one: 30 s at 1 ms under
+/// `ordered`, recording all outputs, 7 runs each, alternated; medians.
+#[test]
+#[ignore]
+fn speed_of_the_fmi3_closed_loop() {
+    let (fmi2, mixed, fmi3) = closed_loops();
+    let e = Experiment { algorithm: Algorithm::Ordered, ..Experiment::new(30.0, 1e-3) };
+    let mut times: [Vec<f64>; 3] = Default::default();
+    for _ in 0..7 {
+        for (k, system) in [&fmi2, &mixed, &fmi3].into_iter().enumerate() {
+            let t = std::time::Instant::now();
+            simulate(system, &e).unwrap();
+            times[k].push(t.elapsed().as_secs_f64());
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let [a, b, c] = times.each_mut().map(median);
+    println!("closed loop, 30 s at 1 ms, ordered, medians of 7 alternated runs:");
+    println!(
+        "  FMI 2.0: {a:.3} s; plant in FMI 3.0: {b:.3} s ({:.3}x); all in FMI 3.0: {c:.3} s ({:.3}x)",
+        b / a,
+        c / a
+    );
+}
+
+/// Where the time of an FMI 3.0 step goes: the plant alone, 30,000 steps of (set its
+/// inputs, step, get its outputs) through `nigel_cosim::Instance`, FMI 2.0 against FMI 3.0,
+/// alternated, medians of 7, in ns per call.
+#[test]
+#[ignore]
+fn speed_of_the_fmi3_calls() {
+    let (fmi2, _, fmi3) = closed_loops();
+    let plant = fmi2.instance_index("plant").unwrap();
+    let run = |system: &nigel_cosim::System| -> [f64; 3] {
+        let fmu = &system.instances[plant].fmu;
+        let md = fmu.description();
+        let vrs = |c: model_description::Causality| -> Vec<u32> {
+            md.model_variables.iter().filter(|v| v.causality == c && v.is_real()).map(|v| v.value_reference).collect()
+        };
+        let (inputs, outputs) = (vrs(model_description::Causality::Input), vrs(model_description::Causality::Output));
+        let mut inst = nigel_cosim::Instance::new(fmu, "plant").unwrap();
+        inst.setup_experiment(None, 0.0, None).unwrap();
+        inst.enter_initialization_mode().unwrap();
+        inst.exit_initialization_mode().unwrap();
+        let (u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
+        let mut t = [0.0; 3];
+        let n = 30_000;
+        for k in 0..n {
+            let time = k as f64 * 1e-3;
+            let a = std::time::Instant::now();
+            inst.set_real(&inputs, &u).unwrap();
+            let b = std::time::Instant::now();
+            inst.do_step(time, 1e-3).unwrap();
+            let c = std::time::Instant::now();
+            inst.get_real(&outputs, &mut y).unwrap();
+            let d = std::time::Instant::now();
+            t[0] += (b - a).as_secs_f64();
+            t[1] += (c - b).as_secs_f64();
+            t[2] += (d - c).as_secs_f64();
+        }
+        t.map(|x| x / n as f64 * 1e9)
+    };
+    let mut runs: [Vec<[f64; 3]>; 2] = Default::default();
+    for _ in 0..7 {
+        runs[0].push(run(&fmi2));
+        runs[1].push(run(&fmi3));
+    }
+    for (name, r) in ["FMI 2.0", "FMI 3.0"].iter().zip(runs.iter_mut()) {
+        let med = |j: usize| {
+            let mut v: Vec<f64> = r.iter().map(|x| x[j]).collect();
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        println!("plant {name}: set inputs {:.0} ns, do_step {:.0} ns, get outputs {:.0} ns", med(0), med(1), med(2));
+    }
+}
