@@ -370,7 +370,8 @@ fn model_exchange_integrates_and_finds_the_state_event() {
 }
 
 /// Model Exchange: terminateSimulation from fmi3UpdateDiscreteStates at the time event at
-/// stop_at ends the run there, the last row the communication point before it.
+/// stop_at ends the run there, with the row at that event (as in Co-Simulation and as the
+/// FMI 2.0 path writes it).
 #[test]
 fn model_exchange_terminates_at_the_time_event() {
     let Some((_dir, path)) = counter("fmi3-me-end") else { return };
@@ -378,7 +379,8 @@ fn model_exchange_terminates_at_the_time_event() {
     let (r, summary) = simulate(&system, &Experiment::new(1.0, 0.1)).unwrap();
     let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
     assert_eq!((instance.as_str(), t_end, reason), ("c", 0.62, "terminateSimulation"));
-    assert_eq!(r.rows(), 7, "rows 0 .. 0.6");
+    assert_eq!(r.rows(), 8, "rows 0 .. 0.6, then 0.62");
+    assert_eq!(r.row(7)[0], 0.62);
 }
 
 /// fmpy 0.3.32 integrates the same FMU in Model Exchange (CVode): the same event count, and
