@@ -11,7 +11,12 @@ use common::{build_stair, work_dir};
 use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, Interface, System};
 
 fn stair(interface: Interface) -> System {
-    let dir = work_dir(&format!("stair-{}", interface.as_str()));
+    stair_in(interface, &format!("stair-{}", interface.as_str()))
+}
+
+/// As [`stair`], built in a scratch folder of the test's own (tests run in parallel).
+fn stair_in(interface: Interface, folder: &str) -> System {
+    let dir = work_dir(folder);
     let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
     System::single("model", Fmu::load_with(&build_stair(&dir), &options).unwrap()).unwrap()
 }
@@ -61,7 +66,7 @@ fn model_exchange_ends_at_the_event_with_the_row_at_the_event() {
 #[test]
 fn model_exchange_with_bdf_ends_at_the_event_with_the_row_at_the_event() {
     // no states (the bdf method has nothing to integrate), time events each second
-    let system = stair(Interface::ModelExchange);
+    let system = stair_in(Interface::ModelExchange, "stair-me-bdf");
     let mut e = Experiment::new(10.0, 0.2);
     e.solver = nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
     let (r, summary) = simulate(&system, &e).unwrap();
