@@ -225,6 +225,13 @@ impl System {
     }
 
     fn unknown_variable(&self, i: usize, variable: &str) -> Error {
+        if let Some((_, reason)) = self.instances[i].fmu.not_in_view().iter().find(|(name, _)| name == variable) {
+            return Error::NotInView {
+                instance: self.instances[i].name.clone(),
+                variable: variable.into(),
+                reason: *reason,
+            };
+        }
         let md = self.description(i);
         let closest = crate::suggest::closest(variable, md.model_variables.iter().map(|v| v.name.as_str()));
         Error::UnknownVariable {

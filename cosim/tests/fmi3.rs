@@ -95,11 +95,11 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 31);
+    assert_eq!(md3.model_variables.len(), 32);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
     // the three arrays as their 3 + 2 + 2 elements
-    assert_eq!(view.model_variables.len(), 35);
+    assert_eq!(view.model_variables.len(), 36);
     let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
@@ -524,17 +524,125 @@ fn isolation_of_fmi3_fmus() {
     let out = run(&["--isolate=run"], &hosted);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
-    // a crash in fmi3DoStep ends only the host: a typed error naming the call, the rows so far
-    let crashed = dir.join("crashed.csv");
-    let out = run(&["--isolate=run", "--set", "crash_at=0.45"], &crashed);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    let want = "cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during fmi3DoStep at t = 0.5 s";
-    assert!(err.lines().any(|l| l == want), "{err}");
-    let rows = std::fs::read_to_string(&crashed).unwrap().lines().count() - 1;
-    assert_eq!(rows, 6, "the rows 0 .. 0.5: {err}");
     let out = run(&["--isolate"], &dir.join("refused.csv"));
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("FMI 3.0 instances in host processes (--isolate)"), "{err}");
+}
+
+/// A misbehaving FMI 3.0 FMU under `--isolate=run`, as crash.c is for FMI 2.0: a write
+/// through NULL, abort() or exit(0) (which the host's exit guard reports) inside fmi3DoStep (Co-Simulation, the step from 0.5 s,
+/// crash_at = 0.45) or inside the fmi3UpdateDiscreteStates of the time event the FMU asks for
+/// at crash_at (Model Exchange) ends only the host: exit code 1, an error naming the
+/// instance, the call, the time and the signal or exit code, and the CSV with the rows
+/// before (Co-Simulation 0 .. 0.5 s; Model Exchange 0 .. 0.4 s, the grid points before the
+/// event), each equal to the same rows of a run without the crash.
+#[test]
+fn a_crashing_fmi3_fmu_under_isolate_run_is_a_typed_error_with_the_rows_so_far() {
+    let Some((dir, path)) = counter("fmi3-crash") else { return };
+    let run = |extra: &[&str], out: &Path| {
+        let _ = std::fs::remove_file(out);
+        let mut args =
+            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        cosim(&args)
+    };
+    let rows = |p: &Path| -> Vec<String> {
+        std::fs::read_to_string(p).unwrap_or_default().lines().skip(1).map(String::from).collect()
+    };
+    for (interface, function, time, kept) in
+        [("cs", "fmi3DoStep", "0.5", 6), ("me", "fmi3UpdateDiscreteStates", "0.45", 5)]
+    {
+        let whole = dir.join(format!("whole-{interface}.csv"));
+        let out = run(&["--interface", interface, "--isolate=run"], &whole);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        for how in 1..=3 {
+            let crashed = dir.join(format!("crashed-{interface}-{how}.csv"));
+            let how_arg = format!("crash_how={how}");
+            let out = run(
+                &["--interface", interface, "--isolate=run", "--set", "crash_at=0.45", "--set", &how_arg],
+                &crashed,
+            );
+            assert_eq!(out.status.code(), Some(1), "{interface} {how}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            let want = match how {
+                1 => format!("cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during {function} at t = {time} s"),
+                2 => format!("cosim: model: the FMU's host process was killed by signal 6 (SIGABRT) during {function} at t = {time} s"),
+                // the host's exit guard names the call the exit() came from, then ends with code 1
+                _ => format!("model (fmi3_counter.fmu) called exit() inside {function} at t = {time} s, ending the process in the middle of the run"),
+            };
+            assert!(err.lines().any(|l| l == want), "{interface} {how}: {err}");
+            assert_eq!(rows(&crashed), rows(&whole)[..kept], "{interface} {how}: the rows before the crash: {err}");
+        }
+    }
+}
+
+/// What the master's view leaves out (String and Binary arrays) is said, not dropped
+/// silently: listed by `Fmu::not_in_view` and `cosim info` with the reason, a note of
+/// `cosim run` on stderr, and a `--set` of it an error naming the variable and the reason;
+/// the rest of the FMU runs as without them.
+#[test]
+fn string_and_binary_arrays_are_left_out_and_said_so() {
+    let dir = work_dir("fmi3-left-out");
+    let arrays = r#"<Float64 name="crash_at" valueReference="30"#;
+    let xml = XML.replace(
+        arrays,
+        &format!(
+            "<String name=\"names\" valueReference=\"40\" causality=\"parameter\" variability=\"fixed\"><Dimension start=\"2\"/><Start value=\"a\"/><Start value=\"b\"/></String>\n    \
+             <Binary name=\"blobs\" valueReference=\"41\" causality=\"output\" variability=\"discrete\"><Dimension start=\"3\"/></Binary>\n    {arrays}"
+        ),
+    );
+    let Some(path) = build_counter(&dir, "left_out", &xml) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let left: Vec<(&str, &str)> = fmu.not_in_view().iter().map(|(n, why)| (n.as_str(), why.as_str())).collect();
+    assert_eq!(left, [("names", "a String array"), ("blobs", "a Binary array")]);
+    assert!(fmu.description().variable("names").is_none() && fmu.description().variable("blobs[1]").is_none());
+    let out = cosim(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines().any(|l| {
+            l
+            == "not run by cosim (neither recorded, set nor connected): names (a String array), blobs (a Binary array)"
+        }),
+        "{text}"
+    );
+    let csv = dir.join("out.csv");
+    let out = cosim(&[
+        "run",
+        path.to_str().unwrap(),
+        "--stop-time",
+        "0.5",
+        "--step",
+        "0.1",
+        "--output",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cosim: note: model.names is a String array: not recorded"), "{err}");
+    assert!(err.contains("cosim: note: model.blobs is a Binary array: not recorded"), "{err}");
+    // the same columns and values as the FMU without the two arrays
+    let (plain_dir, plain) = counter("fmi3-left-out-plain").unwrap();
+    let plain_csv = plain_dir.join("plain.csv");
+    let out = cosim(&[
+        "run",
+        plain.to_str().unwrap(),
+        "--stop-time",
+        "0.5",
+        "--step",
+        "0.1",
+        "--output",
+        plain_csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
+    let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "0.5", "--set", "names=x"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(
+            "variable \"names\" of instance \"model\" is a String array, which cosim does not record, set nor connect"
+        ),
+        "{err}"
+    );
 }

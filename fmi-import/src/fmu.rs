@@ -190,8 +190,8 @@ pub struct Fmu {
     isolated_from: Option<Arc<Fmu>>,
     /// The library inside the unpacked folder.
     library_path: PathBuf,
-    /// FMI 3.0: the variables not in the view (see [`crate::fmi3`]).
-    not_in_view: Vec<String>,
+    /// FMI 3.0: the variables not in the view and why (see [`crate::fmi3`]).
+    not_in_view: Vec<(String, crate::fmi3::LeftOut)>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -609,10 +609,10 @@ impl Fmu {
         }
     }
 
-    /// FMI 3.0: the variables the view leaves out (String and Binary arrays, clocks,
-    /// arrays of more than 100,000 elements or of sizes it cannot resolve), neither
-    /// recorded nor settable; empty for FMI 2.0.
-    pub fn not_in_view(&self) -> &[String] {
+    /// FMI 3.0: the variables the view leaves out (String and Binary arrays, arrays of
+    /// more than 100,000 elements or of sizes it cannot resolve), neither recorded, set nor
+    /// connected, each with the reason; empty for FMI 2.0.
+    pub fn not_in_view(&self) -> &[(String, crate::fmi3::LeftOut)] {
         &self.not_in_view
     }
 
