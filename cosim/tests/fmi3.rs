@@ -646,3 +646,38 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
         "{err}"
     );
 }
+
+/// An array whose `<Dimension>` names a structural parameter has the size of the parameter's
+/// start value: recorded as its elements as a fixed-size array is; setting the structural
+/// parameter (Configuration Mode, which the master does not run) is refused saying so.
+#[test]
+fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter_is_read_only() {
+    let dir = work_dir("fmi3-structural");
+    let sized = XML
+        .replace(
+            r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension start="3"/></Float64>"#,
+            r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension valueReference="40"/></Float64>"#,
+        )
+        .replace(
+            r#"<Float64 name="crash_at""#,
+            "<UInt64 name=\"size\" valueReference=\"40\" causality=\"structuralParameter\" variability=\"fixed\" start=\"3\"/>\n    <Float64 name=\"crash_at\"",
+        );
+    assert_ne!(sized, XML);
+    let Some(path) = build_counter(&dir, "structural", &sized) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let names: Vec<&str> = fmu.description().model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..27], ["arr[1]", "arr[2]", "arr[3]"]);
+    let run = |p: &Path| {
+        let system = with_starts(p, &[]);
+        simulate(&system, &Experiment::new(0.5, 0.1)).unwrap().0
+    };
+    let (_, plain) = counter("fmi3-structural-plain").unwrap();
+    let (a, b) = (run(&path), run(&plain));
+    for name in ["arr[1]", "arr[2]", "arr[3]", "y"] {
+        assert_eq!(a.column(name), b.column(name), "{name}");
+    }
+    let mut builder = SystemBuilder::new();
+    builder.add_instance("c", fmu).unwrap();
+    let e = builder.set("c.size", Value::Real(4.0)).map(|_| ()).unwrap_err();
+    assert!(e.to_string().contains("an FMI 3.0 structural parameter is set in Configuration Mode"), "{e}");
+}
