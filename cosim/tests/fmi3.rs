@@ -242,6 +242,15 @@ fn cosim(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap()
 }
 
+/// `cosim run FMU --stop-time STOP --step 0.1 --output OUT EXTRA...` (OUT removed first).
+fn run_to_csv(fmu: &Path, stop: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let _ = std::fs::remove_file(out);
+    let mut args =
+        vec!["run", fmu.to_str().unwrap(), "--stop-time", stop, "--step", "0.1", "--output", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    cosim(&args)
+}
+
 #[test]
 fn cosim_info_and_run() {
     let Some((dir, path)) = counter("fmi3-cli") else { return };
@@ -256,20 +265,7 @@ fn cosim_info_and_run() {
     assert!(label.contains("String") && label.contains("\"abc\""), "{label}");
 
     let csv = dir.join("out.csv");
-    let out = cosim(&[
-        "run",
-        path.to_str().unwrap(),
-        "--stop-time",
-        "1",
-        "--step",
-        "0.1",
-        "--set",
-        "u=2",
-        "--set",
-        "gains=[3, 4]",
-        "--output",
-        csv.to_str().unwrap(),
-    ]);
+    let out = run_to_csv(&path, "1", &csv, &["--set", "u=2", "--set", "gains=[3, 4]"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
@@ -513,12 +509,7 @@ fn every_type_and_array_elements_are_recorded() {
 #[test]
 fn isolation_of_fmi3_fmus() {
     let Some((dir, path)) = counter("fmi3-isolate") else { return };
-    let run = |extra: &[&str], out: &Path| {
-        let mut args =
-            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        cosim(&args)
-    };
+    let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
     let (plain, hosted) = (dir.join("plain.csv"), dir.join("hosted.csv"));
     assert!(run(&[], &plain).status.success());
     let out = run(&["--isolate=run"], &hosted);
@@ -540,13 +531,7 @@ fn isolation_of_fmi3_fmus() {
 #[test]
 fn a_crashing_fmi3_fmu_under_isolate_run_is_a_typed_error_with_the_rows_so_far() {
     let Some((dir, path)) = counter("fmi3-crash") else { return };
-    let run = |extra: &[&str], out: &Path| {
-        let _ = std::fs::remove_file(out);
-        let mut args =
-            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        cosim(&args)
-    };
+    let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
     let rows = |p: &Path| -> Vec<String> {
         std::fs::read_to_string(p).unwrap_or_default().lines().skip(1).map(String::from).collect()
     };
@@ -607,16 +592,7 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
         "{text}"
     );
     let csv = dir.join("out.csv");
-    let out = cosim(&[
-        "run",
-        path.to_str().unwrap(),
-        "--stop-time",
-        "0.5",
-        "--step",
-        "0.1",
-        "--output",
-        csv.to_str().unwrap(),
-    ]);
+    let out = run_to_csv(&path, "0.5", &csv, &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("cosim: note: model.names is a String array: not recorded"), "{err}");
@@ -624,17 +600,7 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
     // the same columns and values as the FMU without the two arrays
     let (plain_dir, plain) = counter("fmi3-left-out-plain").unwrap();
     let plain_csv = plain_dir.join("plain.csv");
-    let out = cosim(&[
-        "run",
-        plain.to_str().unwrap(),
-        "--stop-time",
-        "0.5",
-        "--step",
-        "0.1",
-        "--output",
-        plain_csv.to_str().unwrap(),
-    ]);
-    assert!(out.status.success());
+    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
     let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "0.5", "--set", "names=x"]);
     assert!(!out.status.success());
