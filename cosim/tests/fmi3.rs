@@ -647,3 +647,49 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter
     let e = builder.set("c.size", Value::Real(4.0)).map(|_| ()).unwrap_err();
     assert!(e.to_string().contains("an FMI 3.0 structural parameter is set in Configuration Mode"), "{e}");
 }
+
+/// Co-Simulation event mode: an FMU with `hasEventMode` is instantiated with `eventModeUsed`;
+/// the step in which the counter's y reaches 0.55 (u = 1: the step to 0.6 s) says
+/// `eventHandlingNeeded`, the master runs Event Mode (`fmi3UpdateDiscreteStates` adds 1 to
+/// n) and returns to Step Mode. fmpy 0.3.32 with `use_event_mode=True` does the same; it
+/// records the event's instant twice (before and after), the master once, after: the
+/// same rows as fmpy's last row at each time. Without `hasEventMode` no event is handled
+/// (n counts the steps only, `every_type_and_array_elements_are_recorded`).
+#[test]
+fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
+    let dir = work_dir("fmi3-event-mode");
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    assert_ne!(xml, XML);
+    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let (r, _) = simulate(&with_starts(&path, &[]), &Experiment::new(1.0, 0.1)).unwrap();
+    let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
+    for k in 0..r.rows() {
+        // the step count, and 1 from the event at the end of the step to 0.6 s
+        assert_eq!(n[k], k as f64 + if k >= 6 { 1.0 } else { 0.0 }, "t = {}", time[k]);
+    }
+    let csv = dir.join("fmpy.csv");
+    let script = r#"
+import sys
+from fmpy import simulate_fmu
+r = simulate_fmu(sys.argv[1], fmi_type='CoSimulation', stop_time=1.0, output_interval=0.1,
+                 use_event_mode=True, output=['y', 'n'])
+with open(sys.argv[2], 'w') as f:
+    for row in r:
+        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\n')
+"#;
+    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let mut theirs: Vec<Vec<f64>> = Vec::new();
+    for line in std::fs::read_to_string(&csv).unwrap().lines() {
+        let row: Vec<f64> = line.split(' ').map(|v| v.parse().unwrap()).collect();
+        match theirs.last_mut() {
+            Some(last) if last[0] == row[0] => *last = row,
+            _ => theirs.push(row),
+        }
+    }
+    let ours: Vec<Vec<f64>> = (0..r.rows()).map(|k| vec![time[k], r.column("y").unwrap()[k], n[k]]).collect();
+    assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
+}

@@ -905,9 +905,9 @@ impl Instance {
         }
     }
 
-    /// `fmi3InstantiateCoSimulation` (early return allowed, no event mode, no
-    /// intermediate update) or `fmi3InstantiateModelExchange`, logging off, the messages
-    /// to the instance's log.
+    /// `fmi3InstantiateCoSimulation` (early return allowed, event mode used when the FMU
+    /// has it, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
+    /// messages to the instance's log.
     fn new_fmi3(
         fmu: &Arc<Fmu>,
         abi: &crate::fmi3::Fmi3Abi,
@@ -922,6 +922,7 @@ impl Instance {
         let (function, component) = match fmu.interface {
             Interface::CoSimulation => {
                 let f = abi.functions.instantiate_co_simulation.ok_or(missing("fmi3InstantiateCoSimulation"))?;
+                let event_mode = abi.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode) as u8;
                 let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateCoSimulation", 0.0);
                 // SAFETY: every pointer is valid for the call; the log outlives the instance.
                 let c = unsafe {
@@ -931,7 +932,7 @@ impl Instance {
                         abi.resource_path.as_ptr(),
                         0,
                         0,
-                        0,
+                        event_mode,
                         1,
                         std::ptr::null(),
                         0,
@@ -1692,6 +1693,20 @@ impl Instance {
                     log: format!("terminateSimulation at t = {reached} s"),
                 });
             }
+            if event != 0 && self.uses_event_mode() {
+                let reached = if early != 0 { reached } else { end };
+                self.time = reached;
+                if let Some(t) = self.cs_event(reached)? {
+                    self.terminate_requested = Some(t);
+                    return Err(Error::Fmi {
+                        instance: self.name.clone(),
+                        function: "fmi3UpdateDiscreteStates",
+                        status: Status::Discard,
+                        time: Some(t),
+                        log: format!("terminateSimulation at t = {t} s"),
+                    });
+                }
+            }
             if early == 0 {
                 self.time = end;
                 return Ok(());
@@ -1721,6 +1736,46 @@ impl Instance {
             status: Status::Error,
             time: Some(at),
             log: format!("returned early 1000 times in the step from {time} s to {end} s"),
+        })
+    }
+
+    /// Whether the instance was instantiated with `eventModeUsed` (Co-Simulation of an FMU
+    /// with `hasEventMode`).
+    fn uses_event_mode(&self) -> bool {
+        match &self.fmu.abi {
+            Abi::Fmi3(a) => {
+                self.fmu.interface == Interface::CoSimulation
+                    && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode)
+            }
+            Abi::Fmi2(_) => false,
+        }
+    }
+
+    /// The event a Co-Simulation `fmi3DoStep` asked for (`eventHandlingNeeded`) at `time`:
+    /// Event Mode, `fmi3UpdateDiscreteStates` until no new discrete states are needed (at
+    /// most 1000 times), back to Step Mode. `Some(time)` when the FMU asked to terminate.
+    fn cs_event(&mut self, time: f64) -> Result<Option<f64>> {
+        self.enter_event_mode()?;
+        for _ in 0..1000 {
+            let info = self.new_discrete_states()?;
+            if info.terminate_simulation != 0 {
+                return Ok(Some(time));
+            }
+            if info.new_discrete_states_needed == 0 {
+                let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+                let f = f3!(self, a, enter_step_mode, "fmi3EnterStepMode");
+                let c = self.component;
+                call!(self, "fmi3EnterStepMode", Some(time), f(c))?;
+                return Ok(None);
+            }
+        }
+        self.state = InstanceState::Errored;
+        Err(Error::Fmi {
+            instance: self.name.clone(),
+            function: "fmi3UpdateDiscreteStates",
+            status: Status::Error,
+            time: Some(time),
+            log: "asked for new discrete states 1000 times in one event".into(),
         })
     }
 

@@ -21,7 +21,9 @@
  *      (SIGABRT), 3 exit(0)
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
- * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
+ * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
+ * y reaches 0.55 says eventHandlingNeeded, and fmi3UpdateDiscreteStates then adds 1 to n.
+ * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
  * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
 #include <stdlib.h>
@@ -30,7 +32,7 @@
 
 typedef struct {
     double time, u, y, stop_at, early_at, crash_at;
-    int n, k, b, early_done, early_allowed, crossed, timed, crash_how;
+    int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode;
     long long mode;
     char label[64];
     double gains[2];
@@ -60,6 +62,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     Counter *c = make(token, resources, env, log);
     if (!c) return NULL;
     c->s.early_allowed = earlyReturnAllowed != 0;
+    c->s.event_mode = eventMode != 0;
     strcpy(c->s.label, "abc");
     return c;
 }
@@ -108,9 +111,10 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     Counter *c = instance;
     fmi3InstanceEnvironment env = c->env;
     fmi3LogMessageCallback log = c->log;
-    int early_allowed = c->s.early_allowed;
+    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode;
     memset(c, 0, sizeof *c);
     c->s.early_allowed = early_allowed;
+    c->s.event_mode = event_mode;
     c->env = env;
     c->log = log;
     c->s.u = 1;
@@ -155,6 +159,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     s->n += 1;
     s->time = end;
     *lastSuccessfulTime = end;
+    if (s->event_mode && !s->crossed && s->y - 0.55 >= 0) *eventHandlingNeeded = fmi3True;
     if (end >= s->stop_at) *terminateSimulation = fmi3True;
     return fmi3OK;
 }
@@ -474,6 +479,9 @@ UNSUPPORTED(fmi3SetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr
 UNSUPPORTED(fmi3SetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
 UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
 UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
-UNSUPPORTED(fmi3EnterStepMode, fmi3Instance i)
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
+    Counter *c = instance;
+    return c->s.event_mode ? fmi3OK : fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
+}
 UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
 UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)
