@@ -333,6 +333,21 @@ with open(sys.argv[2], 'w') as f:
     }
 }
 
+/// fmpy 0.3.32's `simulate_fmu(fmu, stop_time=1.0, output_interval=0.1, ARGUMENTS)` rows of
+/// time, y and n (written to `csv` and read back).
+fn fmpy_rows(fmu: &Path, csv: &Path, arguments: &str) -> Vec<Vec<f64>> {
+    let script = format!(
+        "import sys\nfrom fmpy import simulate_fmu\n\
+         r = simulate_fmu(sys.argv[1], stop_time=1.0, output_interval=0.1, output=['y', 'n'], {arguments})\n\
+         with open(sys.argv[2], 'w') as f:\n    \
+         for row in r:\n        \
+         f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\\n')\n"
+    );
+    let out = Command::new(python()).args(["-c", &script]).arg(fmu).arg(csv).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    std::fs::read_to_string(csv).unwrap().lines().map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect()).collect()
+}
+
 fn model_exchange(fmu: &Path, starts: &[(&str, Value)]) -> System {
     let options = nigel_cosim::ImportOptions {
         interface: Some(nigel_cosim::Interface::ModelExchange),
@@ -384,23 +399,7 @@ fn model_exchange_terminates_at_the_time_event() {
 #[test]
 fn model_exchange_agrees_with_fmpy() {
     let Some((dir, path)) = counter("fmi3-me-fmpy") else { return };
-    let csv = dir.join("fmpy.csv");
-    let script = r#"
-import sys
-from fmpy import simulate_fmu
-r = simulate_fmu(sys.argv[1], fmi_type='ModelExchange', stop_time=1.0, output_interval=0.1,
-                 start_values={'u': 1.0}, output=['y', 'n'])
-with open(sys.argv[2], 'w') as f:
-    for row in r:
-        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\n')
-"#;
-    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
-    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
-    let theirs: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
-        .unwrap()
-        .lines()
-        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let theirs = fmpy_rows(&path, &dir.join("fmpy.csv"), "fmi_type='ModelExchange', start_values={'u': 1.0}");
     let (r, _) = simulate(&model_exchange(&path, &[("u", Value::Real(1.0))]), &Experiment::new(1.0, 0.1)).unwrap();
     assert_eq!(*r.column("n").unwrap().last().unwrap(), 11.0, "y = t crossed 0.55 (+1), the time event at 0.75 (+10)");
     // fmpy records rows before and after the event at t = 0.55 besides: the grid's only
@@ -670,21 +669,8 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
         // the step count, and 1 from the event at the end of the step to 0.6 s
         assert_eq!(n[k], k as f64 + if k >= 6 { 1.0 } else { 0.0 }, "t = {}", time[k]);
     }
-    let csv = dir.join("fmpy.csv");
-    let script = r#"
-import sys
-from fmpy import simulate_fmu
-r = simulate_fmu(sys.argv[1], fmi_type='CoSimulation', stop_time=1.0, output_interval=0.1,
-                 use_event_mode=True, output=['y', 'n'])
-with open(sys.argv[2], 'w') as f:
-    for row in r:
-        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\n')
-"#;
-    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
-    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
     let mut theirs: Vec<Vec<f64>> = Vec::new();
-    for line in std::fs::read_to_string(&csv).unwrap().lines() {
-        let row: Vec<f64> = line.split(' ').map(|v| v.parse().unwrap()).collect();
+    for row in fmpy_rows(&path, &dir.join("fmpy.csv"), "fmi_type='CoSimulation', use_event_mode=True") {
         match theirs.last_mut() {
             Some(last) if last[0] == row[0] => *last = row,
             _ => theirs.push(row),

@@ -1683,28 +1683,13 @@ impl Instance {
             )?;
             if terminate != 0 {
                 let reached = if early != 0 && reached.is_finite() { reached } else { end };
-                self.time = reached;
-                self.terminate_requested = Some(reached);
-                return Err(Error::Fmi {
-                    instance: self.name.clone(),
-                    function: "fmi3DoStep",
-                    status: Status::Discard,
-                    time: Some(at),
-                    log: format!("terminateSimulation at t = {reached} s"),
-                });
+                return Err(self.terminated_at("fmi3DoStep", at, reached));
             }
             if event != 0 && self.uses_event_mode() {
                 let reached = if early != 0 { reached } else { end };
                 self.time = reached;
                 if let Some(t) = self.cs_event(reached)? {
-                    self.terminate_requested = Some(t);
-                    return Err(Error::Fmi {
-                        instance: self.name.clone(),
-                        function: "fmi3UpdateDiscreteStates",
-                        status: Status::Discard,
-                        time: Some(t),
-                        log: format!("terminateSimulation at t = {t} s"),
-                    });
+                    return Err(self.terminated_at("fmi3UpdateDiscreteStates", t, t));
                 }
             }
             if early == 0 {
@@ -1737,6 +1722,21 @@ impl Instance {
             time: Some(at),
             log: format!("returned early 1000 times in the step from {time} s to {end} s"),
         })
+    }
+
+    /// FMI 3.0 `terminateSimulation` from `function` (called at `at`) at the time `reached`,
+    /// reported as FMI 2.0 reports it: a Discard, with [`Instance::terminated_status`] true
+    /// and [`Instance::last_successful_time`] `reached`.
+    fn terminated_at(&mut self, function: &'static str, at: f64, reached: f64) -> Error {
+        self.time = reached;
+        self.terminate_requested = Some(reached);
+        Error::Fmi {
+            instance: self.name.clone(),
+            function,
+            status: Status::Discard,
+            time: Some(at),
+            log: format!("terminateSimulation at t = {reached} s"),
+        }
     }
 
     /// Whether the instance was instantiated with `eventModeUsed` (Co-Simulation of an FMU
