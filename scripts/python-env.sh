@@ -29,6 +29,8 @@ python="${PYTHON:-python3}"
 # fmpy.util.plot_result and `fmpy simulate --show-plot` (a PNG from plotly would need kaleido
 # and a Chrome; HTML and the figure object need neither).
 # pandas (with the python-dateutil and tzdata above) reads the campaign's results.csv in its tests.
+# pythonfmu3 (no dependencies; its FMI 3.0 C++ wrapper ships prebuilt in the wheel) builds the
+# third-party FMI 3.0 FMU of cosim/tests/python/test_cosim_pythonfmu3.py.
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
@@ -72,6 +74,7 @@ rpds-py==2026.9.1
 traitlets==5.16.1
 typing_extensions==4.16.0
 pandas==3.1.1
+pythonfmu3==0.3.4
 EOF
 )"
 

@@ -31,7 +31,7 @@
 
 pub mod bdf;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{error, fmu, unpack};
+pub use fmi_import::{error, fmi3, fmu, unpack};
 pub mod exit_guard;
 pub mod mat;
 pub mod me;

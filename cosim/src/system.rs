@@ -225,6 +225,13 @@ impl System {
     }
 
     fn unknown_variable(&self, i: usize, variable: &str) -> Error {
+        if let Some((_, reason)) = self.instances[i].fmu.not_in_view().iter().find(|(name, _)| name == variable) {
+            return Error::NotInView {
+                instance: self.instances[i].name.clone(),
+                variable: variable.into(),
+                reason: *reason,
+            };
+        }
         let md = self.description(i);
         let closest = crate::suggest::closest(variable, md.model_variables.iter().map(|v| v.name.as_str()));
         Error::UnknownVariable {
@@ -382,7 +389,16 @@ impl SystemBuilder {
             && (matches!(v.causality, Causality::Parameter | Causality::Input)
                 || v.variable_type.has_start() && v.causality != Causality::CalculatedParameter);
         if !settable {
-            let what = if v.variability == Variability::Constant {
+            let structural = self.system.instances[r.instance].fmu.fmi3_description().is_some_and(|md| {
+                md.model_variables
+                    .iter()
+                    .any(|x| x.name == v.name && x.causality == model_description::fmi3::Causality::StructuralParameter)
+            });
+            let what = if structural {
+                "an FMI 3.0 structural parameter is set in Configuration Mode, which cosim does not run; \
+                 the arrays it sizes have the size of its start value"
+                    .to_string()
+            } else if v.variability == Variability::Constant {
                 format!("a constant cannot be set (causality {})", v.causality.as_str())
             } else if v.causality == Causality::CalculatedParameter {
                 "a calculated parameter is computed by the FMU from other parameters and cannot be set".to_string()

@@ -95,11 +95,11 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 31);
+    assert_eq!(md3.model_variables.len(), 32);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
     // the three arrays as their 3 + 2 + 2 elements
-    assert_eq!(view.model_variables.len(), 35);
+    assert_eq!(view.model_variables.len(), 36);
     let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
@@ -242,6 +242,15 @@ fn cosim(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap()
 }
 
+/// `cosim run FMU --stop-time STOP --step 0.1 --output OUT EXTRA...` (OUT removed first).
+fn run_to_csv(fmu: &Path, stop: &str, out: &Path, extra: &[&str]) -> std::process::Output {
+    let _ = std::fs::remove_file(out);
+    let mut args =
+        vec!["run", fmu.to_str().unwrap(), "--stop-time", stop, "--step", "0.1", "--output", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    cosim(&args)
+}
+
 #[test]
 fn cosim_info_and_run() {
     let Some((dir, path)) = counter("fmi3-cli") else { return };
@@ -256,20 +265,7 @@ fn cosim_info_and_run() {
     assert!(label.contains("String") && label.contains("\"abc\""), "{label}");
 
     let csv = dir.join("out.csv");
-    let out = cosim(&[
-        "run",
-        path.to_str().unwrap(),
-        "--stop-time",
-        "1",
-        "--step",
-        "0.1",
-        "--set",
-        "u=2",
-        "--set",
-        "gains=[3, 4]",
-        "--output",
-        csv.to_str().unwrap(),
-    ]);
+    let out = run_to_csv(&path, "1", &csv, &["--set", "u=2", "--set", "gains=[3, 4]"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
@@ -337,6 +333,21 @@ with open(sys.argv[2], 'w') as f:
     }
 }
 
+/// fmpy 0.3.32's `simulate_fmu(fmu, stop_time=1.0, output_interval=0.1, ARGUMENTS)` rows of
+/// time, y and n (written to `csv` and read back).
+fn fmpy_rows(fmu: &Path, csv: &Path, arguments: &str) -> Vec<Vec<f64>> {
+    let script = format!(
+        "import sys\nfrom fmpy import simulate_fmu\n\
+         r = simulate_fmu(sys.argv[1], stop_time=1.0, output_interval=0.1, output=['y', 'n'], {arguments})\n\
+         with open(sys.argv[2], 'w') as f:\n    \
+         for row in r:\n        \
+         f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\\n')\n"
+    );
+    let out = Command::new(python()).args(["-c", &script]).arg(fmu).arg(csv).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    std::fs::read_to_string(csv).unwrap().lines().map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect()).collect()
+}
+
 fn model_exchange(fmu: &Path, starts: &[(&str, Value)]) -> System {
     let options = nigel_cosim::ImportOptions {
         interface: Some(nigel_cosim::Interface::ModelExchange),
@@ -388,23 +399,7 @@ fn model_exchange_terminates_at_the_time_event() {
 #[test]
 fn model_exchange_agrees_with_fmpy() {
     let Some((dir, path)) = counter("fmi3-me-fmpy") else { return };
-    let csv = dir.join("fmpy.csv");
-    let script = r#"
-import sys
-from fmpy import simulate_fmu
-r = simulate_fmu(sys.argv[1], fmi_type='ModelExchange', stop_time=1.0, output_interval=0.1,
-                 start_values={'u': 1.0}, output=['y', 'n'])
-with open(sys.argv[2], 'w') as f:
-    for row in r:
-        f.write(' '.join(repr(float(row[c])) for c in ['time', 'y', 'n']) + '\n')
-"#;
-    let out = Command::new(python()).args(["-c", script]).arg(&path).arg(&csv).output().unwrap();
-    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
-    let theirs: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
-        .unwrap()
-        .lines()
-        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let theirs = fmpy_rows(&path, &dir.join("fmpy.csv"), "fmi_type='ModelExchange', start_values={'u': 1.0}");
     let (r, _) = simulate(&model_exchange(&path, &[("u", Value::Real(1.0))]), &Experiment::new(1.0, 0.1)).unwrap();
     assert_eq!(*r.column("n").unwrap().last().unwrap(), 11.0, "y = t crossed 0.55 (+1), the time event at 0.75 (+10)");
     // fmpy records rows before and after the event at t = 0.55 besides: the grid's only
@@ -513,28 +508,174 @@ fn every_type_and_array_elements_are_recorded() {
 #[test]
 fn isolation_of_fmi3_fmus() {
     let Some((dir, path)) = counter("fmi3-isolate") else { return };
-    let run = |extra: &[&str], out: &Path| {
-        let mut args =
-            vec!["run", path.to_str().unwrap(), "--stop-time", "1", "--step", "0.1", "--output", out.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        cosim(&args)
-    };
+    let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
     let (plain, hosted) = (dir.join("plain.csv"), dir.join("hosted.csv"));
     assert!(run(&[], &plain).status.success());
     let out = run(&["--isolate=run"], &hosted);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
-    // a crash in fmi3DoStep ends only the host: a typed error naming the call, the rows so far
-    let crashed = dir.join("crashed.csv");
-    let out = run(&["--isolate=run", "--set", "crash_at=0.45"], &crashed);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    let want = "cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during fmi3DoStep at t = 0.5 s";
-    assert!(err.lines().any(|l| l == want), "{err}");
-    let rows = std::fs::read_to_string(&crashed).unwrap().lines().count() - 1;
-    assert_eq!(rows, 6, "the rows 0 .. 0.5: {err}");
     let out = run(&["--isolate"], &dir.join("refused.csv"));
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("FMI 3.0 instances in host processes (--isolate)"), "{err}");
+}
+
+/// A misbehaving FMI 3.0 FMU under `--isolate=run`, as crash.c is for FMI 2.0: a write
+/// through NULL, abort() or exit(0) (which the host's exit guard reports) inside fmi3DoStep (Co-Simulation, the step from 0.5 s,
+/// crash_at = 0.45) or inside the fmi3UpdateDiscreteStates of the time event the FMU asks for
+/// at crash_at (Model Exchange) ends only the host: exit code 1, an error naming the
+/// instance, the call, the time and the signal or exit code, and the CSV with the rows
+/// before (Co-Simulation 0 .. 0.5 s; Model Exchange 0 .. 0.4 s, the grid points before the
+/// event), each equal to the same rows of a run without the crash.
+#[test]
+fn a_crashing_fmi3_fmu_under_isolate_run_is_a_typed_error_with_the_rows_so_far() {
+    let Some((dir, path)) = counter("fmi3-crash") else { return };
+    let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
+    let rows = |p: &Path| -> Vec<String> {
+        std::fs::read_to_string(p).unwrap_or_default().lines().skip(1).map(String::from).collect()
+    };
+    for (interface, function, time, kept) in
+        [("cs", "fmi3DoStep", "0.5", 6), ("me", "fmi3UpdateDiscreteStates", "0.45", 5)]
+    {
+        let whole = dir.join(format!("whole-{interface}.csv"));
+        let out = run(&["--interface", interface, "--isolate=run"], &whole);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        for how in 1..=3 {
+            let crashed = dir.join(format!("crashed-{interface}-{how}.csv"));
+            let how_arg = format!("crash_how={how}");
+            let out = run(
+                &["--interface", interface, "--isolate=run", "--set", "crash_at=0.45", "--set", &how_arg],
+                &crashed,
+            );
+            assert_eq!(out.status.code(), Some(1), "{interface} {how}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            let want = match how {
+                1 => format!("cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during {function} at t = {time} s"),
+                2 => format!("cosim: model: the FMU's host process was killed by signal 6 (SIGABRT) during {function} at t = {time} s"),
+                // the host's exit guard names the call the exit() came from, then ends with code 1
+                _ => format!("model (fmi3_counter.fmu) called exit() inside {function} at t = {time} s, ending the process in the middle of the run"),
+            };
+            assert!(err.lines().any(|l| l == want), "{interface} {how}: {err}");
+            assert_eq!(rows(&crashed), rows(&whole)[..kept], "{interface} {how}: the rows before the crash: {err}");
+        }
+    }
+}
+
+/// What the master's view leaves out (String and Binary arrays) is said, not dropped
+/// silently: listed by `Fmu::not_in_view` and `cosim info` with the reason, a note of
+/// `cosim run` on stderr, and a `--set` of it an error naming the variable and the reason;
+/// the rest of the FMU runs as without them.
+#[test]
+fn string_and_binary_arrays_are_left_out_and_said_so() {
+    let dir = work_dir("fmi3-left-out");
+    let arrays = r#"<Float64 name="crash_at" valueReference="30"#;
+    let xml = XML.replace(
+        arrays,
+        &format!(
+            "<String name=\"names\" valueReference=\"40\" causality=\"parameter\" variability=\"fixed\"><Dimension start=\"2\"/><Start value=\"a\"/><Start value=\"b\"/></String>\n    \
+             <Binary name=\"blobs\" valueReference=\"41\" causality=\"output\" variability=\"discrete\"><Dimension start=\"3\"/></Binary>\n    {arrays}"
+        ),
+    );
+    let Some(path) = build_counter(&dir, "left_out", &xml) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let left: Vec<(&str, &str)> = fmu.not_in_view().iter().map(|(n, why)| (n.as_str(), why.as_str())).collect();
+    assert_eq!(left, [("names", "a String array"), ("blobs", "a Binary array")]);
+    assert!(fmu.description().variable("names").is_none() && fmu.description().variable("blobs[1]").is_none());
+    let out = cosim(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines().any(|l| {
+            l
+            == "not run by cosim (neither recorded, set nor connected): names (a String array), blobs (a Binary array)"
+        }),
+        "{text}"
+    );
+    let csv = dir.join("out.csv");
+    let out = run_to_csv(&path, "0.5", &csv, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cosim: note: model.names is a String array: not recorded"), "{err}");
+    assert!(err.contains("cosim: note: model.blobs is a Binary array: not recorded"), "{err}");
+    // the same columns and values as the FMU without the two arrays
+    let (plain_dir, plain) = counter("fmi3-left-out-plain").unwrap();
+    let plain_csv = plain_dir.join("plain.csv");
+    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
+    let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "0.5", "--set", "names=x"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(
+            "variable \"names\" of instance \"model\" is a String array, which cosim does not record, set nor connect"
+        ),
+        "{err}"
+    );
+}
+
+/// An array whose `<Dimension>` names a structural parameter has the size of the parameter's
+/// start value: recorded as its elements as a fixed-size array is; setting the structural
+/// parameter (Configuration Mode, which the master does not run) is refused saying so.
+#[test]
+fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter_is_read_only() {
+    let dir = work_dir("fmi3-structural");
+    let sized = XML
+        .replace(
+            r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension start="3"/></Float64>"#,
+            r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension valueReference="40"/></Float64>"#,
+        )
+        .replace(
+            r#"<Float64 name="crash_at""#,
+            "<UInt64 name=\"size\" valueReference=\"40\" causality=\"structuralParameter\" variability=\"fixed\" start=\"3\"/>\n    <Float64 name=\"crash_at\"",
+        );
+    assert_ne!(sized, XML);
+    let Some(path) = build_counter(&dir, "structural", &sized) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let names: Vec<&str> = fmu.description().model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..27], ["arr[1]", "arr[2]", "arr[3]"]);
+    let run = |p: &Path| {
+        let system = with_starts(p, &[]);
+        simulate(&system, &Experiment::new(0.5, 0.1)).unwrap().0
+    };
+    let (_, plain) = counter("fmi3-structural-plain").unwrap();
+    let (a, b) = (run(&path), run(&plain));
+    for name in ["arr[1]", "arr[2]", "arr[3]", "y"] {
+        assert_eq!(a.column(name), b.column(name), "{name}");
+    }
+    let mut builder = SystemBuilder::new();
+    builder.add_instance("c", fmu).unwrap();
+    let e = builder.set("c.size", Value::Real(4.0)).map(|_| ()).unwrap_err();
+    assert!(e.to_string().contains("an FMI 3.0 structural parameter is set in Configuration Mode"), "{e}");
+}
+
+/// Co-Simulation event mode: an FMU with `hasEventMode` is instantiated with `eventModeUsed`;
+/// the step in which the counter's y reaches 0.55 (u = 1: the step to 0.6 s) says
+/// `eventHandlingNeeded`, the master runs Event Mode (`fmi3UpdateDiscreteStates` adds 1 to
+/// n) and returns to Step Mode. fmpy 0.3.32 with `use_event_mode=True` does the same; it
+/// records the event's instant twice (before and after), the master once, after: the
+/// same rows as fmpy's last row at each time. Without `hasEventMode` no event is handled
+/// (n counts the steps only, `every_type_and_array_elements_are_recorded`).
+#[test]
+fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
+    let dir = work_dir("fmi3-event-mode");
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    assert_ne!(xml, XML);
+    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let (r, _) = simulate(&with_starts(&path, &[]), &Experiment::new(1.0, 0.1)).unwrap();
+    let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
+    for k in 0..r.rows() {
+        // the step count, and 1 from the event at the end of the step to 0.6 s
+        assert_eq!(n[k], k as f64 + if k >= 6 { 1.0 } else { 0.0 }, "t = {}", time[k]);
+    }
+    let mut theirs: Vec<Vec<f64>> = Vec::new();
+    for row in fmpy_rows(&path, &dir.join("fmpy.csv"), "fmi_type='CoSimulation', use_event_mode=True") {
+        match theirs.last_mut() {
+            Some(last) if last[0] == row[0] => *last = row,
+            _ => theirs.push(row),
+        }
+    }
+    let ours: Vec<Vec<f64>> = (0..r.rows()).map(|k| vec![time[k], r.column("y").unwrap()[k], n[k]]).collect();
+    assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }

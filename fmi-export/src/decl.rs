@@ -440,6 +440,10 @@ pub struct Declaration<B> {
     xml: String,
     description3: md::fmi3::ModelDescription,
     xml3: String,
+    /// `fmi2_of_fmi3[vr]`: the FMI 3.0 type of value reference `vr` and its FMI 2.0 value
+    /// reference (`NO_ROW` for `time`): the translation of every FMI 3.0 get/set, one load
+    /// per value reference.
+    fmi2_of_fmi3: Vec<(md::fmi3::ValueType, u32)>,
 }
 
 /// One row of [`Declaration`]'s compact table: the model's binding and the set checks.
@@ -754,7 +758,18 @@ impl<B: Copy> Declaration<B> {
                 },
             })
             .collect();
+        let fmi2_of_fmi3 = description3
+            .model_variables
+            .iter()
+            .enumerate()
+            .map(|(vr, v)| {
+                // as `variable3` and `row3`: value reference vr is variable vr, row vr - 1
+                let row = vr.checked_sub(1).filter(|&r| r < spec.variables.len());
+                (v.value_type, row.map_or(NO_ROW, |r| spec.variables[r].value_reference))
+            })
+            .collect();
         Ok(Declaration {
+            fmi2_of_fmi3,
             spec,
             lookup,
             dense,
@@ -829,6 +844,16 @@ impl<B> Declaration<B> {
     pub fn row3(&self, vr: u32) -> Option<usize> {
         let row = (vr as usize).checked_sub(1)?;
         (row < self.spec.variables.len()).then_some(row)
+    }
+
+    /// The FMI 2.0 value reference of the FMI 3.0 value reference `vr` if that is a variable
+    /// of type `accessed` other than `time`.
+    #[inline]
+    pub fn fmi2_of_fmi3(&self, vr: u32, accessed: md::fmi3::ValueType) -> Option<u32> {
+        match self.fmi2_of_fmi3.get(vr as usize) {
+            Some(&(t, vr2)) if t == accessed && vr2 != NO_ROW => Some(vr2),
+            _ => None,
+        }
     }
 
     /// The FMI 3.0 variable of value reference `vr` (`time` for 0).

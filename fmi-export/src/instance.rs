@@ -1086,9 +1086,14 @@ impl<M: Model> Instance<M> {
     ) -> OpResult<T> {
         const ON_STACK: usize = 64;
         if vrs.len() <= ON_STACK {
+            let d = decl::<M>();
             let mut buffer = [0u32; ON_STACK];
             for (slot, &vr) in buffer.iter_mut().zip(vrs) {
-                *slot = Self::fmi2_reference(vr, accessed)?;
+                // the table's answer; the full check only to say why not
+                *slot = match d.fmi2_of_fmi3(vr, accessed) {
+                    Some(vr2) => vr2,
+                    None => Self::fmi2_reference(vr, accessed)?,
+                };
             }
             f(self, &buffer[..vrs.len()])
         } else {

@@ -211,6 +211,16 @@ pub enum Error {
         /// The closest names the instance has (at most 3).
         closest: Vec<String>,
     },
+    /// A variable of an FMI 3.0 FMU that the master's view leaves out (see
+    /// [`crate::fmi3::LeftOut`]): it cannot be recorded, set nor connected.
+    NotInView {
+        /// The instance.
+        instance: String,
+        /// The variable.
+        variable: String,
+        /// Why it is left out.
+        reason: crate::fmi3::LeftOut,
+    },
     /// An instance name is unknown in the system.
     UnknownInstance {
         /// The name as given.
@@ -447,6 +457,12 @@ impl fmt::Display for Error {
                 }
                 f.write_str(" (`cosim info` lists the variables)")
             }
+            Error::NotInView { instance, variable, reason } => write!(
+                f,
+                "variable {variable:?} of instance {instance:?} is {}, which cosim does not record, set nor connect \
+                 (FMI 3.0 String and Binary arrays are outside the master's view; `cosim info` lists what is left out)",
+                reason.as_str()
+            ),
             Error::UnknownInstance { name, instances } => {
                 write!(f, "the system has no instance {name:?}")?;
                 let close = crate::suggest::closest(name, instances.iter().map(String::as_str));

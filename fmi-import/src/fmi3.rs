@@ -112,10 +112,48 @@ fn element_name(name: &str, sizes: &[u64], k: u64) -> String {
 /// The largest integer up to which every integer is an f64.
 const EXACT: i128 = 1 << 53;
 
+/// Why a variable of an FMI 3.0 FMU is not in the master's view: it is neither recorded,
+/// set nor connected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeftOut {
+    /// A String array.
+    StringArray,
+    /// A Binary array.
+    BinaryArray,
+    /// A clock (an FMU with clocks is refused at load; listed for `cosim info`).
+    Clock,
+    /// An array of more than 100,000 elements.
+    TooLarge,
+    /// An array whose size its description does not give (a dimension naming a variable
+    /// without one integer start value).
+    UnknownSize,
+}
+
+impl LeftOut {
+    /// What it is, for messages.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LeftOut::StringArray => "a String array",
+            LeftOut::BinaryArray => "a Binary array",
+            LeftOut::Clock => "a clock",
+            LeftOut::TooLarge => "an array of more than 100,000 elements",
+            LeftOut::UnknownSize => "an array whose size the model description does not give",
+        }
+    }
+}
+
+/// The variables of `md` the master's view leaves out, with the reason (what
+/// [`crate::Fmu::not_in_view`] lists once the FMU is loaded).
+pub fn not_in_view(md: &fmi3::ModelDescription) -> Vec<(String, LeftOut)> {
+    fmi2_view(md).2
+}
+
 /// The FMI 2.0-shaped view of `md` (see the module): its variables, how to reach those that
 /// are not plain scalars of the types FMI 2.0 has (by the view's value reference), and the
-/// names of the variables it leaves out (String and Binary arrays, clocks).
-pub(crate) fn fmi2_view(md: &fmi3::ModelDescription) -> (ModelDescription, HashMap<u32, Access>, Vec<String>) {
+/// variables it leaves out, with the reason.
+pub(crate) fn fmi2_view(
+    md: &fmi3::ModelDescription,
+) -> (ModelDescription, HashMap<u32, Access>, Vec<(String, LeftOut)>) {
     use fmi3::ValueType as T;
     let mut special = HashMap::new();
     let mut left_out = Vec::new();
@@ -127,17 +165,22 @@ pub(crate) fn fmi2_view(md: &fmi3::ModelDescription) -> (ModelDescription, HashM
     for v in &md.model_variables {
         let dims = if v.is_array() { sizes(md, v) } else { Some(Vec::new()) };
         let count = dims.as_ref().map(|d| d.iter().product::<u64>());
-        let supported = match v.value_type {
-            T::String | T::Binary => !v.is_array(),
-            T::Clock => false,
-            _ => true,
+        let unsupported = match v.value_type {
+            T::String if v.is_array() => Some(LeftOut::StringArray),
+            T::Binary if v.is_array() => Some(LeftOut::BinaryArray),
+            T::Clock => Some(LeftOut::Clock),
+            _ => None,
         };
-        let (Some(dims), Some(count), true) = (dims, count, supported) else {
-            left_out.push(v.name.clone());
+        if let Some(reason) = unsupported {
+            left_out.push((v.name.clone(), reason));
+            continue;
+        }
+        let (Some(dims), Some(count)) = (dims, count) else {
+            left_out.push((v.name.clone(), LeftOut::UnknownSize));
             continue;
         };
         if count > MAX_ELEMENTS || next_vr + count > u32::MAX as u64 {
-            left_out.push(v.name.clone());
+            left_out.push((v.name.clone(), LeftOut::TooLarge));
             continue;
         }
         let plain = !v.is_array() && matches!(v.value_type, T::Float64 | T::Int32 | T::Boolean | T::String);
@@ -464,6 +507,32 @@ mod tests {
         // the item of 5e9 does not fit FMI 2.0's Integer
         assert_eq!(view.type_definitions[0].items.len(), 1);
         assert_eq!(view.variable("b").unwrap().variable_type, VariableType::Boolean { start: Some(true) });
+    }
+
+    #[test]
+    fn what_the_view_leaves_out_is_named_with_the_reason() {
+        let extra = r#"<Float64 name="z" valueReference="9"/>
+    <String name="names" valueReference="20" causality="parameter" variability="fixed"><Dimension start="2"/><Start value="a"/><Start value="b"/></String>
+    <Binary name="blobs" valueReference="21" causality="output"><Dimension start="3"/></Binary>
+    <Float64 name="huge" valueReference="22" causality="output"><Dimension start="100001"/></Float64>
+    <Float64 name="sized_by_z" valueReference="23" causality="output"><Dimension valueReference="9"/></Float64>
+    <Float64 name="fine" valueReference="24" causality="output"><Dimension start="100000"/></Float64>"#;
+        let md =
+            fmi3::ModelDescription::from_xml(&XML.replace(r#"<Float64 name="z" valueReference="9"/>"#, extra)).unwrap();
+        let (view, _, left_out) = fmi2_view(&md);
+        assert_eq!(
+            left_out,
+            vec![
+                ("names".to_string(), LeftOut::StringArray),
+                ("blobs".to_string(), LeftOut::BinaryArray),
+                ("huge".to_string(), LeftOut::TooLarge),
+                ("sized_by_z".to_string(), LeftOut::UnknownSize),
+            ]
+        );
+        assert_eq!(not_in_view(&md), left_out);
+        // 100,000 elements are kept, one variable each
+        assert_eq!(view.model_variables.len(), 11 + 100_000);
+        assert!(view.variable("fine[100000]").is_some() && view.variable("names").is_none());
     }
 
     #[test]

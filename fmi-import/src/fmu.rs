@@ -190,8 +190,8 @@ pub struct Fmu {
     isolated_from: Option<Arc<Fmu>>,
     /// The library inside the unpacked folder.
     library_path: PathBuf,
-    /// FMI 3.0: the variables not in the view (see [`crate::fmi3`]).
-    not_in_view: Vec<String>,
+    /// FMI 3.0: the variables not in the view and why (see [`crate::fmi3`]).
+    not_in_view: Vec<(String, crate::fmi3::LeftOut)>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -609,10 +609,10 @@ impl Fmu {
         }
     }
 
-    /// FMI 3.0: the variables the view leaves out (String and Binary arrays, clocks,
-    /// arrays of more than 100,000 elements or of sizes it cannot resolve), neither
-    /// recorded nor settable; empty for FMI 2.0.
-    pub fn not_in_view(&self) -> &[String] {
+    /// FMI 3.0: the variables the view leaves out (String and Binary arrays, arrays of
+    /// more than 100,000 elements or of sizes it cannot resolve), neither recorded, set nor
+    /// connected, each with the reason; empty for FMI 2.0.
+    pub fn not_in_view(&self) -> &[(String, crate::fmi3::LeftOut)] {
         &self.not_in_view
     }
 
@@ -802,6 +802,39 @@ macro_rules! call {
     }};
 }
 
+/// A function both generations have with the same arguments after the instance: FMI 2.0's
+/// `$f2` (named `$n2`), FMI 3.0's `$f3` (named `$n3`), each absent from its table an error
+/// naming it; called as [`call!`] calls, with the arguments `$arg`.
+macro_rules! either {
+    // a function every library of its generation has (the table's field is no Option)
+    (required $self:ident, $time:expr, $f2:ident $n2:literal, $f3:ident $n3:literal, ($($arg:expr),*)) => {{
+        let c = $self.component;
+        match &$self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = t.$f2;
+                call!($self, $n2, $time, f(c, $($arg),*))
+            }
+            Abi::Fmi3(a) => {
+                let f = a.functions.$f3;
+                call!($self, $n3, $time, f(c, $($arg),*))
+            }
+        }
+    }};
+    ($self:ident, $time:expr, $f2:ident $n2:literal, $f3:ident $n3:literal, ($($arg:expr),*)) => {{
+        let c = $self.component;
+        match &$self.fmu.abi {
+            Abi::Fmi2(t) => {
+                let f = $self.optional(t.$f2, $n2)?;
+                call!($self, $n2, $time, f(c, $($arg),*))
+            }
+            Abi::Fmi3(a) => {
+                let f = f3!($self, a, $f3, $n3);
+                call!($self, $n3, $time, f(c, $($arg),*))
+            }
+        }
+    }};
+}
+
 impl Instance {
     /// `fmi2Instantiate` with the FMU's interface, logging off (warnings and errors are
     /// still logged by the FMU and kept).
@@ -872,9 +905,9 @@ impl Instance {
         }
     }
 
-    /// `fmi3InstantiateCoSimulation` (early return allowed, no event mode, no
-    /// intermediate update) or `fmi3InstantiateModelExchange`, logging off, the messages
-    /// to the instance's log.
+    /// `fmi3InstantiateCoSimulation` (early return allowed, event mode used when the FMU
+    /// has it, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
+    /// messages to the instance's log.
     fn new_fmi3(
         fmu: &Arc<Fmu>,
         abi: &crate::fmi3::Fmi3Abi,
@@ -889,6 +922,7 @@ impl Instance {
         let (function, component) = match fmu.interface {
             Interface::CoSimulation => {
                 let f = abi.functions.instantiate_co_simulation.ok_or(missing("fmi3InstantiateCoSimulation"))?;
+                let event_mode = abi.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode) as u8;
                 let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateCoSimulation", 0.0);
                 // SAFETY: every pointer is valid for the call; the log outlives the instance.
                 let c = unsafe {
@@ -898,7 +932,7 @@ impl Instance {
                         abi.resource_path.as_ptr(),
                         0,
                         0,
-                        0,
+                        event_mode,
                         1,
                         std::ptr::null(),
                         0,
@@ -1108,17 +1142,7 @@ impl Instance {
 
     /// `fmi2ExitInitializationMode` / `fmi3ExitInitializationMode`.
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = t.exit_initialization_mode;
-                call!(self, "fmi2ExitInitializationMode", None, f(c))?
-            }
-            Abi::Fmi3(a) => {
-                let f = a.functions.exit_initialization_mode;
-                call!(self, "fmi3ExitInitializationMode", None, f(c))?
-            }
-        }
+        either!(required self, None, exit_initialization_mode "fmi2ExitInitializationMode", exit_initialization_mode "fmi3ExitInitializationMode", ())?;
         self.state = InstanceState::Running;
         Ok(())
     }
@@ -1129,17 +1153,7 @@ impl Instance {
         if !matches!(self.state, InstanceState::Running | InstanceState::Initialization) {
             return Ok(());
         }
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = t.terminate;
-                call!(self, "fmi2Terminate", None, f(c))?
-            }
-            Abi::Fmi3(a) => {
-                let f = a.functions.terminate;
-                call!(self, "fmi3Terminate", None, f(c))?
-            }
-        }
+        either!(required self, None, terminate "fmi2Terminate", terminate "fmi3Terminate", ())?;
         self.state = InstanceState::Terminated;
         Ok(())
     }
@@ -1669,15 +1683,14 @@ impl Instance {
             )?;
             if terminate != 0 {
                 let reached = if early != 0 && reached.is_finite() { reached } else { end };
+                return Err(self.terminated_at("fmi3DoStep", at, reached));
+            }
+            if event != 0 && self.uses_event_mode() {
+                let reached = if early != 0 { reached } else { end };
                 self.time = reached;
-                self.terminate_requested = Some(reached);
-                return Err(Error::Fmi {
-                    instance: self.name.clone(),
-                    function: "fmi3DoStep",
-                    status: Status::Discard,
-                    time: Some(at),
-                    log: format!("terminateSimulation at t = {reached} s"),
-                });
+                if let Some(t) = self.cs_event(reached)? {
+                    return Err(self.terminated_at("fmi3UpdateDiscreteStates", t, t));
+                }
             }
             if early == 0 {
                 self.time = end;
@@ -1711,6 +1724,61 @@ impl Instance {
         })
     }
 
+    /// FMI 3.0 `terminateSimulation` from `function` (called at `at`) at the time `reached`,
+    /// reported as FMI 2.0 reports it: a Discard, with [`Instance::terminated_status`] true
+    /// and [`Instance::last_successful_time`] `reached`.
+    fn terminated_at(&mut self, function: &'static str, at: f64, reached: f64) -> Error {
+        self.time = reached;
+        self.terminate_requested = Some(reached);
+        Error::Fmi {
+            instance: self.name.clone(),
+            function,
+            status: Status::Discard,
+            time: Some(at),
+            log: format!("terminateSimulation at t = {reached} s"),
+        }
+    }
+
+    /// Whether the instance was instantiated with `eventModeUsed` (Co-Simulation of an FMU
+    /// with `hasEventMode`).
+    fn uses_event_mode(&self) -> bool {
+        match &self.fmu.abi {
+            Abi::Fmi3(a) => {
+                self.fmu.interface == Interface::CoSimulation
+                    && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode)
+            }
+            Abi::Fmi2(_) => false,
+        }
+    }
+
+    /// The event a Co-Simulation `fmi3DoStep` asked for (`eventHandlingNeeded`) at `time`:
+    /// Event Mode, `fmi3UpdateDiscreteStates` until no new discrete states are needed (at
+    /// most 1000 times), back to Step Mode. `Some(time)` when the FMU asked to terminate.
+    fn cs_event(&mut self, time: f64) -> Result<Option<f64>> {
+        self.enter_event_mode()?;
+        for _ in 0..1000 {
+            let info = self.new_discrete_states()?;
+            if info.terminate_simulation != 0 {
+                return Ok(Some(time));
+            }
+            if info.new_discrete_states_needed == 0 {
+                let Abi::Fmi3(a) = &self.fmu.abi else { unreachable!("an FMI 3.0 instance") };
+                let f = f3!(self, a, enter_step_mode, "fmi3EnterStepMode");
+                let c = self.component;
+                call!(self, "fmi3EnterStepMode", Some(time), f(c))?;
+                return Ok(None);
+            }
+        }
+        self.state = InstanceState::Errored;
+        Err(Error::Fmi {
+            instance: self.name.clone(),
+            function: "fmi3UpdateDiscreteStates",
+            status: Status::Error,
+            time: Some(time),
+            log: "asked for new discrete states 1000 times in one event".into(),
+        })
+    }
+
     /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
     /// that the hosts of several instances step at the same time; the next
     /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
@@ -1728,35 +1796,15 @@ impl Instance {
     /// `fmi2GetFMUstate` / `fmi3GetFMUState`: saves the current state.
     pub fn get_state(&mut self) -> Result<FmuState> {
         let mut s: *mut c_void = std::ptr::null_mut();
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.get_fmu_state, "fmi2GetFMUstate")?;
-                call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, get_fmu_state, "fmi3GetFMUState");
-                call!(self, "fmi3GetFMUState", None, f(c, &mut s))?
-            }
-        }
+        either!(self, None, get_fmu_state "fmi2GetFMUstate", get_fmu_state "fmi3GetFMUState", (&mut s))?;
         self.saved.push(s);
         Ok(FmuState(s))
     }
 
     /// `fmi2GetFMUstate` / `fmi3GetFMUState` into an existing state (overwritten).
     pub fn update_state(&mut self, state: &mut FmuState) -> Result<()> {
-        let c = self.component;
         let mut s = state.0;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.get_fmu_state, "fmi2GetFMUstate")?;
-                call!(self, "fmi2GetFMUstate", None, f(c, &mut s))?
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, get_fmu_state, "fmi3GetFMUState");
-                call!(self, "fmi3GetFMUState", None, f(c, &mut s))?
-            }
-        }
+        either!(self, None, get_fmu_state "fmi2GetFMUstate", get_fmu_state "fmi3GetFMUState", (&mut s))?;
         if s != state.0 {
             self.saved.retain(|p| *p != state.0);
             self.saved.push(s);
@@ -1767,114 +1815,44 @@ impl Instance {
 
     /// `fmi2SetFMUstate` / `fmi3SetFMUState`: restores a saved state.
     pub fn set_state(&mut self, state: &FmuState) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.set_fmu_state, "fmi2SetFMUstate")?;
-                call!(self, "fmi2SetFMUstate", None, f(c, state.0))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, set_fmu_state, "fmi3SetFMUState");
-                call!(self, "fmi3SetFMUState", None, f(c, state.0))
-            }
-        }
+        either!(self, None, set_fmu_state "fmi2SetFMUstate", set_fmu_state "fmi3SetFMUState", (state.0))
     }
 
     /// `fmi2FreeFMUstate` / `fmi3FreeFMUState`.
     pub fn free_state(&mut self, state: FmuState) -> Result<()> {
         self.saved.retain(|p| *p != state.0);
         let mut s = state.0;
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.free_fmu_state, "fmi2FreeFMUstate")?;
-                call!(self, "fmi2FreeFMUstate", None, f(c, &mut s))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, free_fmu_state, "fmi3FreeFMUState");
-                call!(self, "fmi3FreeFMUState", None, f(c, &mut s))
-            }
-        }
+        either!(self, None, free_fmu_state "fmi2FreeFMUstate", free_fmu_state "fmi3FreeFMUState", (&mut s))
     }
 
     /// `fmi2SetTime` / `fmi3SetTime` (Model Exchange).
     #[inline]
     pub fn set_time(&mut self, time: f64) -> Result<()> {
-        let c = self.component;
         self.time = time;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.set_time, "fmi2SetTime")?;
-                call!(self, "fmi2SetTime", Some(time), f(c, time))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, set_time, "fmi3SetTime");
-                call!(self, "fmi3SetTime", Some(time), f(c, time))
-            }
-        }
+        either!(self, Some(time), set_time "fmi2SetTime", set_time "fmi3SetTime", (time))
     }
 
     /// `fmi2SetContinuousStates` / `fmi3SetContinuousStates`.
     #[inline]
     pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.set_continuous_states, "fmi2SetContinuousStates")?;
-                call!(self, "fmi2SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, set_continuous_states, "fmi3SetContinuousStates");
-                call!(self, "fmi3SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
-            }
-        }
+        either!(self, None, set_continuous_states "fmi2SetContinuousStates", set_continuous_states "fmi3SetContinuousStates", (x.as_ptr(), x.len()))
     }
 
     /// `fmi2GetContinuousStates` / `fmi3GetContinuousStates`.
     pub fn get_continuous_states(&mut self, x: &mut [f64]) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.get_continuous_states, "fmi2GetContinuousStates")?;
-                call!(self, "fmi2GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, get_continuous_states, "fmi3GetContinuousStates");
-                call!(self, "fmi3GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
-            }
-        }
+        either!(self, None, get_continuous_states "fmi2GetContinuousStates", get_continuous_states "fmi3GetContinuousStates", (x.as_mut_ptr(), x.len()))
     }
 
     /// `fmi2GetDerivatives` / `fmi3GetContinuousStateDerivatives`.
     #[inline]
     pub fn get_derivatives(&mut self, dx: &mut [f64]) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.get_derivatives, "fmi2GetDerivatives")?;
-                call!(self, "fmi2GetDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, get_continuous_state_derivatives, "fmi3GetContinuousStateDerivatives");
-                call!(self, "fmi3GetContinuousStateDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
-            }
-        }
+        either!(self, None, get_derivatives "fmi2GetDerivatives", get_continuous_state_derivatives "fmi3GetContinuousStateDerivatives", (dx.as_mut_ptr(), dx.len()))
     }
 
     /// `fmi2GetEventIndicators` / `fmi3GetEventIndicators`.
     #[inline]
     pub fn get_event_indicators(&mut self, z: &mut [f64]) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.get_event_indicators, "fmi2GetEventIndicators")?;
-                call!(self, "fmi2GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, get_event_indicators, "fmi3GetEventIndicators");
-                call!(self, "fmi3GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
-            }
-        }
+        either!(self, None, get_event_indicators "fmi2GetEventIndicators", get_event_indicators "fmi3GetEventIndicators", (z.as_mut_ptr(), z.len()))
     }
 
     /// Whether the FMU's library has `fmi2GetDirectionalDerivative` /
@@ -1940,17 +1918,7 @@ impl Instance {
 
     /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.enter_event_mode, "fmi2EnterEventMode")?;
-                call!(self, "fmi2EnterEventMode", None, f(c))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, enter_event_mode, "fmi3EnterEventMode");
-                call!(self, "fmi3EnterEventMode", None, f(c))
-            }
-        }
+        either!(self, None, enter_event_mode "fmi2EnterEventMode", enter_event_mode "fmi3EnterEventMode", ())
     }
 
     /// `fmi2NewDiscreteStates`; FMI 3.0: `fmi3UpdateDiscreteStates`, its outputs as the
@@ -1986,17 +1954,7 @@ impl Instance {
 
     /// `fmi2EnterContinuousTimeMode` / `fmi3EnterContinuousTimeMode`.
     pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
-        let c = self.component;
-        match &self.fmu.abi {
-            Abi::Fmi2(t) => {
-                let f = self.optional(t.enter_continuous_time_mode, "fmi2EnterContinuousTimeMode")?;
-                call!(self, "fmi2EnterContinuousTimeMode", None, f(c))
-            }
-            Abi::Fmi3(a) => {
-                let f = f3!(self, a, enter_continuous_time_mode, "fmi3EnterContinuousTimeMode");
-                call!(self, "fmi3EnterContinuousTimeMode", None, f(c))
-            }
-        }
+        either!(self, None, enter_continuous_time_mode "fmi2EnterContinuousTimeMode", enter_continuous_time_mode "fmi3EnterContinuousTimeMode", ())
     }
 
     /// `fmi2CompletedIntegratorStep` / `fmi3CompletedIntegratorStep`: (enter event mode,

@@ -70,6 +70,7 @@ fn to_py(e: CosimError) -> PyErr {
         | E::MissingSymbol { .. }
         | E::Ssp { .. } => LoadError::new_err(message),
         E::UnknownVariable { .. }
+        | E::NotInView { .. }
         | E::UnknownInstance { .. }
         | E::NoInstance { .. }
         | E::InvalidValue { .. }

@@ -4,11 +4,9 @@
 //! - the closed loop with the plant in FMI 3.0 (the built plant library, which exports both
 //!   generations, in an FMI 3.0 archive) and the controller and test bench in FMI 2.0, and
 //!   the closed loop of the three in FMI 3.0, give the FMI 2.0 closed loop's results bit for
-//!   bit, under jacobi and ordered;
-//! - (ignored; `cargo test --release -p nigel-integration-tests --test fmi3_closed_loop --
-//!   --ignored --nocapture`) the speed of the FMI 3.0 closed loop against the FMI 2.0 one,
-//!   30 s at 1 ms, alternated, medians; and of the plant's calls alone (set inputs, step,
-//!   get outputs), which shows where an FMI 3.0 step's extra time goes.
+//!   bit, under jacobi and ordered.
+//!
+//! Their speed against the FMI 2.0 closed loop is a benchmark, `cosim/benches/fmi3.py`.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -135,85 +133,5 @@ fn the_closed_loops_with_fmi3_fmus_are_the_fmi2_one_bit_for_bit() {
             let differing = a.values.iter().zip(&b.values).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
             assert_eq!(differing, 0, "{algorithm:?}: values of the {name} closed loop differ from the FMI 2.0 one's");
         }
-    }
-}
-
-/// The speed of the FMI 3.0 closed loop against the FMI 2.0 one: 30 s at 1 ms under
-/// `ordered`, recording all outputs, 7 runs each, alternated; medians.
-#[test]
-#[ignore]
-fn speed_of_the_fmi3_closed_loop() {
-    let (fmi2, mixed, fmi3) = closed_loops();
-    let e = Experiment { algorithm: Algorithm::Ordered, ..Experiment::new(30.0, 1e-3) };
-    let mut times: [Vec<f64>; 3] = Default::default();
-    for _ in 0..7 {
-        for (k, system) in [&fmi2, &mixed, &fmi3].into_iter().enumerate() {
-            let t = std::time::Instant::now();
-            simulate(system, &e).unwrap();
-            times[k].push(t.elapsed().as_secs_f64());
-        }
-    }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    let [a, b, c] = times.each_mut().map(median);
-    println!("closed loop, 30 s at 1 ms, ordered, medians of 7 alternated runs:");
-    println!(
-        "  FMI 2.0: {a:.3} s; plant in FMI 3.0: {b:.3} s ({:.3}x); all in FMI 3.0: {c:.3} s ({:.3}x)",
-        b / a,
-        c / a
-    );
-}
-
-/// Where the time of an FMI 3.0 step goes: the plant alone, 30,000 steps of (set its
-/// inputs, step, get its outputs) through `nigel_cosim::Instance`, FMI 2.0 against FMI 3.0,
-/// alternated, medians of 7, in ns per call.
-#[test]
-#[ignore]
-fn speed_of_the_fmi3_calls() {
-    let (fmi2, _, fmi3) = closed_loops();
-    let plant = fmi2.instance_index("plant").unwrap();
-    let run = |system: &nigel_cosim::System| -> [f64; 3] {
-        let fmu = &system.instances[plant].fmu;
-        let md = fmu.description();
-        let vrs = |c: model_description::Causality| -> Vec<u32> {
-            md.model_variables.iter().filter(|v| v.causality == c && v.is_real()).map(|v| v.value_reference).collect()
-        };
-        let (inputs, outputs) = (vrs(model_description::Causality::Input), vrs(model_description::Causality::Output));
-        let mut inst = nigel_cosim::Instance::new(fmu, "plant").unwrap();
-        inst.setup_experiment(None, 0.0, None).unwrap();
-        inst.enter_initialization_mode().unwrap();
-        inst.exit_initialization_mode().unwrap();
-        let (u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
-        let mut t = [0.0; 3];
-        let n = 30_000;
-        for k in 0..n {
-            let time = k as f64 * 1e-3;
-            let a = std::time::Instant::now();
-            inst.set_real(&inputs, &u).unwrap();
-            let b = std::time::Instant::now();
-            inst.do_step(time, 1e-3).unwrap();
-            let c = std::time::Instant::now();
-            inst.get_real(&outputs, &mut y).unwrap();
-            let d = std::time::Instant::now();
-            t[0] += (b - a).as_secs_f64();
-            t[1] += (c - b).as_secs_f64();
-            t[2] += (d - c).as_secs_f64();
-        }
-        t.map(|x| x / n as f64 * 1e9)
-    };
-    let mut runs: [Vec<[f64; 3]>; 2] = Default::default();
-    for _ in 0..7 {
-        runs[0].push(run(&fmi2));
-        runs[1].push(run(&fmi3));
-    }
-    for (name, r) in ["FMI 2.0", "FMI 3.0"].iter().zip(runs.iter_mut()) {
-        let med = |j: usize| {
-            let mut v: Vec<f64> = r.iter().map(|x| x[j]).collect();
-            v.sort_by(f64::total_cmp);
-            v[v.len() / 2]
-        };
-        println!("plant {name}: set inputs {:.0} ns, do_step {:.0} ns, get outputs {:.0} ns", med(0), med(1), med(2));
     }
 }

@@ -261,6 +261,16 @@ fn run(args: RunArgs) -> Result<(), Error> {
         for warning in sample_period_warnings(&system, experiment.step) {
             eprintln!("cosim: warning: {warning}");
         }
+        // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
+        for instance in &system.instances {
+            for (name, why) in instance.fmu.not_in_view() {
+                eprintln!(
+                    "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
+                    instance.name,
+                    why.as_str()
+                );
+            }
+        }
     }
 
     experiment.algorithm = algorithm;
@@ -835,5 +845,10 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             range,
             v.description.as_deref().unwrap_or("")
         );
+    }
+    let left_out = nigel_cosim::fmi3::not_in_view(md);
+    if !left_out.is_empty() {
+        let each: Vec<String> = left_out.iter().map(|(name, why)| format!("{name} ({})", why.as_str())).collect();
+        w!(out, "not run by cosim (neither recorded, set nor connected): {}", each.join(", "));
     }
 }

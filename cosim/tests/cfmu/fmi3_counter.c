@@ -15,10 +15,15 @@
  *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
  *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
  *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
- *   30 crash_at Float64 parameter: the step that starts at or after it writes through NULL
+ *   30 crash_at Float64 parameter: Co-Simulation: the step that starts at or after it crashes;
+ *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
+ *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
+ *      (SIGABRT), 3 exit(0)
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
- * terminateSimulation. Model Exchange: y is the state, der(y) = mode * u; the event
+ * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
+ * y reaches 0.55 says eventHandlingNeeded, and fmi3UpdateDiscreteStates then adds 1 to n.
+ * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
  * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
 #include <stdlib.h>
@@ -27,7 +32,7 @@
 
 typedef struct {
     double time, u, y, stop_at, early_at, crash_at;
-    int n, k, b, early_done, early_allowed, crossed, timed;
+    int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode;
     long long mode;
     char label[64];
     double gains[2];
@@ -57,6 +62,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     Counter *c = make(token, resources, env, log);
     if (!c) return NULL;
     c->s.early_allowed = earlyReturnAllowed != 0;
+    c->s.event_mode = eventMode != 0;
     strcpy(c->s.label, "abc");
     return c;
 }
@@ -79,6 +85,7 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
     c->s.crash_at = 1e300;
+    c->s.crash_how = 1;
     c->s.gains[0] = 1;
     c->s.gains[1] = 2;
     c->s.f32in = 0.5f;
@@ -104,9 +111,10 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     Counter *c = instance;
     fmi3InstanceEnvironment env = c->env;
     fmi3LogMessageCallback log = c->log;
-    int early_allowed = c->s.early_allowed;
+    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode;
     memset(c, 0, sizeof *c);
     c->s.early_allowed = early_allowed;
+    c->s.event_mode = event_mode;
     c->env = env;
     c->log = log;
     c->s.u = 1;
@@ -114,11 +122,19 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     c->s.stop_at = 1e300;
     c->s.early_at = -1;
     c->s.crash_at = 1e300;
+    c->s.crash_how = 1;
     c->s.gains[0] = 1;
     c->s.gains[1] = 2;
     c->s.f32in = 0.5f;
     strcpy(c->s.label, "abc");
     return fmi3OK;
+}
+
+/* The misbehaviour of third-party FMUs that --isolate contains. */
+static void crash(const State *s) {
+    if (s->crash_how == 2) abort();
+    if (s->crash_how == 3) exit(0);
+    *(volatile int *)0 = 1;
 }
 
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
@@ -130,7 +146,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;
-    if (t >= s->crash_at) *(volatile int *)0 = 1;
+    if (t >= s->crash_at) crash(s);
     if (s->early_allowed && !s->early_done && s->early_at > t && s->early_at < end) {
         s->early_done = 1;
         s->y += (double)s->mode * s->u * (s->early_at - t);
@@ -143,6 +159,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     s->n += 1;
     s->time = end;
     *lastSuccessfulTime = end;
+    if (s->event_mode && !s->crossed && s->y - 0.55 >= 0) *eventHandlingNeeded = fmi3True;
     if (end >= s->stop_at) *terminateSimulation = fmi3True;
     return fmi3OK;
 }
@@ -203,6 +220,7 @@ fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
         switch (vr[i]) {
         case 3: values[i] = c->s.n; break;
         case 9: values[i] = c->s.k; break;
+        case 31: values[i] = c->s.crash_how; break;
         case 10: values[i] = 2 * c->s.k; break;
         default: return fail(c, "fmi3GetInt32: no such Int32");
         }
@@ -215,8 +233,9 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     Counter *c = instance;
     if (nvr != nValues) return fail(c, "fmi3SetInt32: nValues != nValueReferences");
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] != 9) return fail(c, "fmi3SetInt32: not settable");
-        c->s.k = values[i];
+        if (vr[i] == 9) c->s.k = values[i];
+        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 3) c->s.crash_how = values[i];
+        else return fail(c, "fmi3SetInt32: not settable");
     }
     return fmi3OK;
 }
@@ -367,6 +386,7 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
     fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
     State *s = &((Counter *)instance)->s;
+    if (s->time >= s->crash_at) crash(s);
     if (!s->crossed && s->y - 0.55 >= 0) {
         s->crossed = 1;
         s->n += 1;
@@ -379,8 +399,11 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     *terminate = s->time >= s->stop_at;
     *nominalsChanged = fmi3False;
     *valuesChanged = fmi3False;
-    *nextDefined = !s->timed || s->stop_at < 1e300;
-    *next = !s->timed && 0.75 < s->stop_at ? 0.75 : s->stop_at;
+    /* the next of the time events at 0.75 s (once), stop_at and crash_at */
+    *next = s->stop_at;
+    if (!s->timed && 0.75 < *next) *next = 0.75;
+    if (s->crash_at > s->time && s->crash_at < *next) *next = s->crash_at;
+    *nextDefined = *next < 1e300;
     return fmi3OK;
 }
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
@@ -456,6 +479,9 @@ UNSUPPORTED(fmi3SetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr
 UNSUPPORTED(fmi3SetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
 UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
 UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
-UNSUPPORTED(fmi3EnterStepMode, fmi3Instance i)
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
+    Counter *c = instance;
+    return c->s.event_mode ? fmi3OK : fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
+}
 UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
 UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)
