@@ -278,3 +278,40 @@ fn bdf_runs_the_closed_loop_in_model_exchange_keeping_its_jacobian_across_events
     assert!(s.events.len() >= 2000, "{}", s.events.len());
     assert!(s.stiff.jacobians * 10 < s.events.len() as u64, "{:?}", s.stiff);
 }
+
+#[test]
+fn isolate_run_summary_reports_the_bdf_work_and_events_of_the_run_in_one_process() {
+    let dir = work_dir("stiff-isolate-summary");
+    let fmu = build_ball(&dir);
+    let summary = |extra: &[&str]| -> serde_json::Value {
+        let json = dir.join(format!("summary{}.json", extra.len()));
+        let mut args = vec![
+            "run",
+            fmu.to_str().unwrap(),
+            "--solver",
+            "bdf",
+            "--rtol",
+            "1e-8",
+            "--stop-time",
+            "2",
+            "--step",
+            "0.01",
+        ];
+        args.extend_from_slice(&["--summary", json.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(&args).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+    };
+    let (alone, isolated) = (summary(&[]), summary(&["--isolate=run"]));
+    // the same computation in the host process: the same counts, exactly
+    for key in ["bdf", "integrator_steps", "event_times", "events", "steps"] {
+        assert_eq!(alone[key], isolated[key], "{key}: {alone} vs {isolated}");
+    }
+    let work = &isolated["bdf"];
+    assert!(work["rhs"].as_u64().unwrap() > 0 && work["jacobians"].as_u64().unwrap() > 0, "{work}");
+    assert!(work["factorizations"].as_u64().unwrap() >= work["jacobians"].as_u64().unwrap(), "{work}");
+    // the bounces before 2 s: at t1 (1 + 2 e (1 - e^(k-1)) / (1 - e)), k = 1 .. 4 (0.45, 1.08,
+    // 1.53, 1.84 s; the fifth at 2.05 s)
+    assert_eq!(isolated["events"].as_u64(), Some(4), "{isolated}");
+}
