@@ -100,6 +100,9 @@ def fmu_reference(fmu, times, start_values, names, rtol=1e-10, atol=1e-12):
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Model
     from fmpy.simulation import apply_start_values
+    import ctypes
+
+    real_p = ctypes.POINTER(ctypes.c_double)
 
     md = read_model_description(str(fmu))
     assert md.numberOfEventIndicators == 0, f"{fmu}: the reference handles no events"
@@ -107,20 +110,22 @@ def fmu_reference(fmu, times, start_values, names, rtol=1e-10, atol=1e-12):
     model = FMU2Model(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.modelExchange.modelIdentifier,
                       instanceName="reference")
     vrs = {v.name: v.valueReference for v in md.modelVariables}
-    nx = len(md.modelStructure.derivatives)
+    nx = len(md.derivatives)
     try:
         model.instantiate()
         model.setupExperiment(startTime=0.0)
         apply_start_values(model, md, dict(start_values))
         model.enterInitializationMode()
         model.exitInitializationMode()
+        # fmpy's newDiscreteStates: (newDiscreteStatesNeeded, terminateSimulation,
+        # nominalsChanged, valuesChanged, nextEventTimeDefined, nextEventTime)
         info = model.newDiscreteStates()
-        while info.newDiscreteStatesNeeded == 1:
+        while info[0]:
             info = model.newDiscreteStates()
-        assert info.nextEventTimeDefined == 0, f"{fmu}: the reference handles no time events"
+        assert not info[4], f"{fmu}: the reference handles no time events"
         model.enterContinuousTimeMode()
         x0 = np.zeros(nx)
-        model.getContinuousStates(x0.ctypes.data_as(model.getContinuousStates.argtypes[1]), nx)
+        model.getContinuousStates(x0.ctypes.data_as(real_p), nx)
 
         dx = np.zeros(nx)
         x_buf = np.zeros(nx)
@@ -128,8 +133,8 @@ def fmu_reference(fmu, times, start_values, names, rtol=1e-10, atol=1e-12):
         def f(t, x):
             x_buf[:] = x
             model.setTime(t)
-            model.setContinuousStates(x_buf.ctypes.data_as(model.setContinuousStates.argtypes[1]), nx)
-            model.getDerivatives(dx.ctypes.data_as(model.getDerivatives.argtypes[1]), nx)
+            model.setContinuousStates(x_buf.ctypes.data_as(real_p), nx)
+            model.getDerivatives(dx.ctypes.data_as(real_p), nx)
             return dx.copy()
 
         times = np.asarray(times, dtype=float)
@@ -140,7 +145,7 @@ def fmu_reference(fmu, times, start_values, names, rtol=1e-10, atol=1e-12):
             x = sol.sol(t)
             x_buf[:] = x
             model.setTime(t)
-            model.setContinuousStates(x_buf.ctypes.data_as(model.setContinuousStates.argtypes[1]), nx)
+            model.setContinuousStates(x_buf.ctypes.data_as(real_p), nx)
             out[r] = model.getReal([vrs[n] for n in names])
         return out
     finally:
@@ -155,3 +160,71 @@ def relative_error(x, ref):
         return math.inf
     x = np.asarray(x)[: len(ref)]
     return float(np.max(np.abs(x - ref) / np.maximum(1.0, np.abs(ref))))
+
+
+# The work-precision cases of cosim/benches/stiff.py and of the README's table (checked in
+# tests/python/test_doc_figures.py): (label, FMU key, stop time, output interval, start
+# values, recorded names). The FMU keys: "vdp" and "ball" (cosim/tests/cfmu), "plant"
+# (target/fmu/nigel_plant.fmu, a steer and drive input held at their start values).
+PLANT_START = {"v_x_start": 0.35, "delta_fl": 0.2, "delta_fr": 0.2, "tau_rl": 0.02, "mu_rr": 0.3}
+PLANT_NAMES = ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]
+CASES = [(f"van der Pol mu = {mu:.0e}", "vdp", mu, mu / 500, {"mu": mu}, ["x0", "x1"]) for mu in (1e3, 1e4, 1e5)] + [
+    ("plant (ME)", "plant", 10.0, 0.01, PLANT_START, PLANT_NAMES),
+    ("bouncing ball", "ball", 2.4, 0.01, {}, ["h", "v"]),
+]
+
+
+def case_fmus(folder, plant):
+    """The FMU of each key: the C test FMUs compiled into `folder`, the plant's archive."""
+    return {"vdp": build_cfmu("vdp", folder), "ball": build_cfmu("ball", folder), "plant": Path(plant)}
+
+
+def case_reference(case, fmus):
+    """The reference rows of a case: Radau on the equations (van der Pol), Radau over the
+    FMU's right-hand side (the plant), the closed form (the ball)."""
+    _, key, stop, step, start, names = case
+    times = np.arange(round(stop / step) + 1) * step
+    if key == "vdp":
+        return vdp_reference(start["mu"], times)
+    if key == "ball":
+        return ball_reference(times)
+    return fmu_reference(fmus[key], times, start, names)
+
+
+def run_cosim(cosim, fmu, case, rtol, out):
+    """`cosim run FMU --interface me --solver bdf --rtol RTOL` on a case: (wall time of the
+    process, rows or None, the last line of stderr when it failed)."""
+    import time
+
+    _, _, stop, step, start, names = case
+    args = [str(cosim), "run", str(fmu), "--interface", "me", "--solver", "bdf", "--rtol", repr(rtol),
+            "--stop-time", repr(stop), "--step", repr(step), "--output", str(out)]
+    for k, v in start.items():
+        args += ["--set", f"{k}={v!r}"]
+    for n in names:
+        args += ["--record", n]
+    t = time.perf_counter()
+    done = subprocess.run(args, capture_output=True, text=True)
+    elapsed = time.perf_counter() - t
+    if done.returncode != 0:
+        return elapsed, None, (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+    r = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    return elapsed, np.column_stack([r[n] for n in names]), None
+
+
+def run_cvode(fmu, case, rtol):
+    """fmpy's simulate_fmu with CVode at `rtol` on a case: (time of the call, rows or None,
+    CVode's message when it failed)."""
+    import time
+
+    from fmpy import simulate_fmu
+
+    _, _, stop, step, start, names = case
+    t = time.perf_counter()
+    try:
+        r = simulate_fmu(str(fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=rtol, stop_time=stop,
+                         output_interval=step, start_values=start, output=names, record_events=False)
+    except Exception as e:  # CVode's failures (mxstep, error test) end the run
+        return time.perf_counter() - t, None, str(e).splitlines()[0]
+    elapsed = time.perf_counter() - t
+    return elapsed, np.column_stack([r[n] for n in names]), None
