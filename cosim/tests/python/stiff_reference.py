@@ -65,7 +65,10 @@ def ball_bounces(stop, g=9.81, e=0.7, h0=1.0):
     after each: t_1 = sqrt(2 h0 / g), v_1 = e g t_1, t_(k+1) = t_k + 2 v_k / g, v_(k+1) = e v_k."""
     t, v = math.sqrt(2.0 * h0 / g), e * math.sqrt(2.0 * g * h0)
     bounces = []
-    while t <= stop:
+    # past the accumulation point (ball_accumulation_time) the bounces are infinitely many:
+    # the list ends where the speed is 1e-12 of the first (a flight of 1e-12 s and less)
+    v_end = 1e-12 * v
+    while t <= stop and v > v_end:
         bounces.append((t, v))
         t, v = t + 2.0 * v / g, e * v
     return bounces
