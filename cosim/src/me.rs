@@ -250,6 +250,22 @@ impl MeUnit {
         })
     }
 
+    /// An accepted step of a group's method to `t_new`, whose states are in `x`: the FMU at
+    /// (t_new, x), the indicators of its end kept as the next step's start, and
+    /// `fmi2CompletedIntegratorStep`, whose `terminateSimulation` marks the unit terminated.
+    /// Whether the FMU asked for a step event.
+    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64) -> Result<bool> {
+        inst.set_time(t_new)?;
+        Self::set_states(inst, &self.x)?;
+        self.steps += 1;
+        std::mem::swap(&mut self.z0, &mut self.z);
+        let (step_event, terminate) = inst.completed_integrator_step()?;
+        if terminate {
+            self.terminated = true;
+        }
+        Ok(step_event)
+    }
+
     /// The first indicator that crossed from `z0` to `z` (0 when none did).
     pub(crate) fn first_crossing(&self) -> usize {
         self.z0.iter().zip(&self.z).position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0)).unwrap_or(0)

@@ -343,15 +343,7 @@ impl MeGroup {
             for (k, &m) in members.iter().enumerate() {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&bdf.state()[offsets[k]..offsets[k + 1]]);
-                inst.set_time(t_new)?;
-                MeUnit::set_states(inst, &u.x)?;
-                u.steps += 1;
-                std::mem::swap(&mut u.z0, &mut u.z);
-                let (step_event, terminate) = inst.completed_integrator_step()?;
-                if terminate {
-                    u.terminated = true;
-                }
-                if step_event {
+                if u.complete_step(inst, t_new)? {
                     step_events.push(m);
                 }
             }
