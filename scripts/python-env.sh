@@ -31,6 +31,9 @@ python="${PYTHON:-python3}"
 # pandas (with the python-dateutil and tzdata above) reads the campaign's results.csv in its tests.
 # pythonfmu3 (no dependencies; its FMI 3.0 C++ wrapper ships prebuilt in the wheel) builds the
 # third-party FMI 3.0 FMU of cosim/tests/python/test_cosim_pythonfmu3.py.
+# scipy 1.17.1 (the newest for Python 3.11; no dependencies beyond numpy) gives the stiff benchmark and tests (cosim/benches/stiff.py,
+# cosim/tests/python/test_stiff_reference.py) their reference solutions: solve_ivp's Radau
+# (an implicit Runge-Kutta method, independent of the master's BDF and of CVode).
 requirements="$(cat <<'EOF'
 fmpy==0.3.32
 ecospy==0.7.2
@@ -75,6 +78,7 @@ traitlets==5.16.1
 typing_extensions==4.16.0
 pandas==3.1.1
 pythonfmu3==0.3.4
+scipy==1.17.1
 EOF
 )"
 
@@ -103,6 +107,6 @@ trap 'rm -f "$req_file"' EXIT
 printf '%s\n' "$requirements" >"$req_file"
 PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-input --quiet -r "$req_file" >&2
 # a smoke check of the pieces the tests use, before the marker says "done"
-"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest, ecospy, libcosimpy, matplotlib, plotly' >&2
+"$venv/bin/python" -c 'import fmpy, fmpy.validation, fmpy.ssp.simulation, fmpy.sundials, lxml, numpy, pytest, ecospy, libcosimpy, matplotlib, plotly, scipy.integrate' >&2
 printf '%s\n' "$hash" >"$marker"
 echo "$venv"

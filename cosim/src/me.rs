@@ -240,41 +240,73 @@ impl MeUnit {
     /// `hi` just after the first crossing, found by the Illinois method on the step size
     /// (re-integrating from (t, x0)) to [`EVENT_TIME_TOLERANCE`].
     pub(crate) fn locate_crossing(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<f64> {
-        let (mut lo, mut hi) = (0.0, h);
-        let zi = self
-            .z0
-            .iter()
-            .zip(&self.z)
-            .position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0))
-            .unwrap_or(0);
-        let (mut f_lo, mut f_hi) = (self.z0[zi], self.z[zi]);
-        let mut side = 0i32;
-        let mut iterations = 0;
-        while hi - lo > EVENT_TIME_TOLERANCE && iterations < 200 {
-            iterations += 1;
-            let mut s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-            if !(s > lo && s < hi && s.is_finite()) {
-                s = 0.5 * (lo + hi);
-            }
+        let zi = self.first_crossing();
+        let (z_lo, z_hi) = (self.z0[zi], self.z[zi]);
+        illinois(0.0, h, z_lo, z_hi, |s| {
             self.one_step(inst, solver, t, s)?;
             self.indicators_at(inst, t + s)?;
             // any indicator crossing in (0, s]?
-            if Self::crossed(&self.z0, &self.z) {
-                hi = s;
-                f_hi = self.z[zi];
-                if side == 1 {
-                    f_lo *= 0.5;
-                }
-                side = 1;
-            } else {
-                lo = s;
-                f_lo = self.z[zi];
-                if side == -1 {
-                    f_hi *= 0.5;
-                }
-                side = -1;
-            }
-        }
-        Ok(hi)
+            Ok((Self::crossed(&self.z0, &self.z), self.z[zi]))
+        })
     }
+
+    /// An accepted step of a group's method to `t_new`, whose states are in `x`: the FMU at
+    /// (t_new, x), the indicators of its end kept as the next step's start, and
+    /// `fmi2CompletedIntegratorStep`, whose `terminateSimulation` marks the unit terminated.
+    /// Whether the FMU asked for a step event.
+    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64) -> Result<bool> {
+        inst.set_time(t_new)?;
+        Self::set_states(inst, &self.x)?;
+        self.steps += 1;
+        std::mem::swap(&mut self.z0, &mut self.z);
+        let (step_event, terminate) = inst.completed_integrator_step()?;
+        if terminate {
+            self.terminated = true;
+        }
+        Ok(step_event)
+    }
+
+    /// The first indicator that crossed from `z0` to `z` (0 when none did).
+    pub(crate) fn first_crossing(&self) -> usize {
+        self.z0.iter().zip(&self.z).position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0)).unwrap_or(0)
+    }
+}
+
+/// The Illinois method on a bracket [lo, hi] of a crossing, to [`EVENT_TIME_TOLERANCE`]:
+/// `probe(s)` says whether the crossing lies at or before `s` and gives the indicator's
+/// value there; `z_lo`, `z_hi` are its values at the ends. The end just after the
+/// crossing.
+pub(crate) fn illinois(
+    mut lo: f64,
+    mut hi: f64,
+    mut z_lo: f64,
+    mut z_hi: f64,
+    mut probe: impl FnMut(f64) -> Result<(bool, f64)>,
+) -> Result<f64> {
+    let mut side = 0i32;
+    let mut iterations = 0;
+    while hi - lo > EVENT_TIME_TOLERANCE && iterations < 200 {
+        iterations += 1;
+        let mut s = hi - z_hi * (hi - lo) / (z_hi - z_lo);
+        if !(s > lo && s < hi && s.is_finite()) {
+            s = 0.5 * (lo + hi);
+        }
+        let (crossed, z) = probe(s)?;
+        if crossed {
+            hi = s;
+            z_hi = z;
+            if side == 1 {
+                z_lo *= 0.5;
+            }
+            side = 1;
+        } else {
+            lo = s;
+            z_lo = z;
+            if side == -1 {
+                z_hi *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    Ok(hi)
 }

@@ -37,7 +37,9 @@ fn a_value_queued_at_a_row_applies_from_the_next_step_as_an_input_jump_there() {
     simulate_with(&system, &e, None, Some(&mut record)).unwrap();
     // the same with an input signal jumping at 0.5 s
     let mut e2 = Experiment::new(1.0, 0.1);
-    e2.input = Some(Arc::new(InputTable::new(vec!["u".into()], vec![0.0, 0.5, 0.5, 1.0], vec![vec![0.0, 0.0, 1.0, 1.0]]).unwrap()));
+    e2.input = Some(Arc::new(
+        InputTable::new(vec!["u".into()], vec![0.0, 0.5, 0.5, 1.0], vec![vec![0.0, 0.0, 1.0, 1.0]]).unwrap(),
+    ));
     let (r, _) = simulate(&system, &e2).unwrap();
     assert_eq!(rows.len(), r.rows());
     for (k, (t, row)) in rows.iter().enumerate() {

@@ -278,3 +278,81 @@ fn bdf_runs_the_closed_loop_in_model_exchange_keeping_its_jacobian_across_events
     assert!(s.events.len() >= 2000, "{}", s.events.len());
     assert!(s.stiff.jacobians * 10 < s.events.len() as u64, "{:?}", s.stiff);
 }
+
+#[test]
+fn isolate_run_summary_reports_the_bdf_work_and_events_of_the_run_in_one_process() {
+    let dir = work_dir("stiff-isolate-summary");
+    let fmu = build_ball(&dir);
+    let summary = |extra: &[&str]| -> serde_json::Value {
+        let json = dir.join(format!("summary{}.json", extra.len()));
+        let mut args = vec![
+            "run",
+            fmu.to_str().unwrap(),
+            "--solver",
+            "bdf",
+            "--rtol",
+            "1e-8",
+            "--stop-time",
+            "2",
+            "--step",
+            "0.01",
+        ];
+        args.extend_from_slice(&["--summary", json.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(&args).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+    };
+    let (alone, isolated) = (summary(&[]), summary(&["--isolate=run"]));
+    // the same computation in the host process: the same counts, exactly
+    for key in ["bdf", "integrator_steps", "event_times", "events", "steps"] {
+        assert_eq!(alone[key], isolated[key], "{key}: {alone} vs {isolated}");
+    }
+    let work = &isolated["bdf"];
+    assert!(work["rhs"].as_u64().unwrap() > 0 && work["jacobians"].as_u64().unwrap() > 0, "{work}");
+    assert!(work["factorizations"].as_u64().unwrap() >= work["jacobians"].as_u64().unwrap(), "{work}");
+    // the bounces before 2 s: at t1 (1 + 2 e (1 - e^(k-1)) / (1 - e)), k = 1 .. 4 (0.45, 1.08,
+    // 1.53, 1.84 s; the fifth at 2.05 s)
+    assert_eq!(isolated["events"].as_u64(), Some(4), "{isolated}");
+}
+
+#[test]
+fn past_the_balls_accumulation_point_bdf_and_dopri5_both_go_on_in_free_fall_from_their_last_bounce() {
+    // The bounces accumulate at t_inf = t1 (1 + 2 e / (1 - e)) = 2.5587 s: infinitely many,
+    // each flight 2 v_k / g shorter than the last. After a bounce the indicator h is exactly 0
+    // (neither side): a flight that lies within one integrator step is not seen, and from the
+    // first such flight on the ball falls through the floor. Both solvers: the same event test
+    // (a strict sign at a step's start), so each finds the bounces whose flight is longer than
+    // its steps and then falls freely from the last one it found, to the stop time.
+    let dir = work_dir("stiff-ball-zeno");
+    let fmu = build_ball(&dir);
+    let (g, e): (f64, f64) = (9.81, 0.7);
+    let t1 = (2.0 / g).sqrt();
+    let t_inf = t1 * (1.0 + 2.0 * e / (1.0 - e));
+    for solver in [Solver::Bdf { rtol: 1e-8, atol: 1e-10 }, Solver::Dopri5 { rtol: 1e-8, atol: 1e-10 }] {
+        let (r, s) = run(&fmu, "ball", &[], 3.0, 0.01, solver);
+        let bounces: Vec<f64> = s.events.iter().filter(|e| e.kind == "state").map(|e| e.time).collect();
+        eprintln!("{solver:?}: {} bounces, the last at {:?}", bounces.len(), bounces.last());
+        // the flights at the last located bounces are a few ms: both get within 10 ms of t_inf
+        assert!(bounces.len() >= 15 && *bounces.last().unwrap() > t_inf - 0.01, "{bounces:?}");
+        let mut tk = t1;
+        let mut vk = e * g * t1;
+        for (k, t) in bounces.iter().enumerate() {
+            // an event time is off by the state error (1e-9 m at these tolerances) over the
+            // impact speed, down to 7e-5 m/s at the 31st bounce (bdf finds 31): 1.5e-5 s; 1e-4 s
+            // bounds it
+            assert!((t - tk).abs() < 1e-4, "bounce {}: {t} vs {tk}", k + 1);
+            if k + 1 < bounces.len() {
+                tk += 2.0 * vk / g;
+                vk *= e;
+            }
+        }
+        // from the last bounce found (closed form: at tk with speed vk) a free fall to 3 s
+        let s_end = 3.0 - tk;
+        let (h_end, v_end) = (vk * s_end - 0.5 * g * s_end * s_end, vk - g * s_end);
+        let (h, v) = (*r.column("h").unwrap().last().unwrap(), *r.column("v").unwrap().last().unwrap());
+        // the last bounce's time error (< 1e-4 s) times the speeds (< 4.4 m/s, g): < 1e-3
+        assert!((h - h_end).abs() < 1e-3 && (v - v_end).abs() < 1e-3, "{solver:?}: ({h}, {v}) vs ({h_end}, {v_end})");
+        assert!(h < -0.9, "fell through the floor: {h}");
+    }
+}

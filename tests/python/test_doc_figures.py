@@ -390,3 +390,32 @@ def test_synthesis_figures(designs):
     check("README.md", "angles positive to the left): `[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]` (RL = RR).",
           *t["K"][0], *t["K"][2])
     assert t["K"][0] == t["K"][1] and t["K"][2] == t["K"][3]
+
+
+# --- stiff Model Exchange: cosim's bdf and fmpy's CVode against independent references --------
+
+def test_stiff_work_precision_errors(tmp_path):
+    """README.md's table of `cosim/benches/stiff.py`: the errors (deterministic) of each run
+    against the references of cosim/tests/python/stiff_reference.py (Radau on van der Pol's
+    equations and over the plant's right-hand side, the ball's closed form); the times are
+    measurements (`{*}`). A CVode run that ends with mxstep prints "mxstep" in place of its
+    error."""
+    from stiff_reference import CASES, case_fmus, case_reference, relative_error, run_cosim, run_cvode
+
+    fmus = case_fmus(tmp_path, target_dir() / "fmu" / "nigel_plant.fmu")
+    cosim = release_binary("cosim", "nigel-cosim")
+    names = {"van der Pol mu = 1e+03": "van der Pol, mu = 1e3", "van der Pol mu = 1e+04": "van der Pol, mu = 1e4",
+             "van der Pol mu = 1e+05": "van der Pol, mu = 1e5", "plant (ME)": "plant (ME)",
+             "bouncing ball": "bouncing ball"}
+    for case in CASES:
+        ref = case_reference(case, fmus)
+        for rtol, printed in ((1e-4, "1e-4"), (1e-6, "1e-6"), (1e-8, "1e-8")):
+            _, x, err = run_cosim(cosim, fmus[case[1]], case, rtol, tmp_path / "out.csv")
+            assert err is None, err
+            _, y, cv_err = run_cvode(fmus[case[1]], case, rtol)
+            row = f"| {names[case[0]]} | {printed} | {{}} | {{*}} |"
+            if cv_err is None:
+                check("README.md", row + " {} | {*} |", relative_error(x, ref), relative_error(y, ref))
+            else:
+                assert "code -1)" in cv_err, cv_err  # CV_TOO_MUCH_WORK: mxstep steps before an output
+                check("README.md", row + " mxstep | {*} |", relative_error(x, ref))

@@ -375,13 +375,50 @@ fn read_region(fd: &OwnedFd, names: Option<Vec<String>>) -> Option<Read> {
     }
 }
 
-/// The summary's fields the command line reads, from the host's JSON.
+/// The summary from the host's JSON: every field `Summary::to_json` writes, so that
+/// `--summary` prints the same under isolation as in one process.
 fn summary_of(v: &serde_json::Value) -> Summary {
+    let count = |x: &serde_json::Value| x.as_u64().unwrap_or(0);
+    let bdf = &v["bdf"];
     let mut s = Summary {
-        steps: v["steps"].as_u64().unwrap_or(0),
+        steps: count(&v["steps"]),
         wall_time: Duration::from_secs_f64(v["wall_time_s"].as_f64().unwrap_or(0.0).max(0.0)),
+        discard_retries: count(&v["discard_retries"]),
+        parallel_steps: count(&v["parallel_steps"]),
+        integrator_steps: (count(&v["integrator_steps"]["accepted"]), count(&v["integrator_steps"]["rejected"])),
+        stiff: crate::bdf::Work {
+            rhs: count(&bdf["rhs"]),
+            jacobian_rhs: count(&bdf["jacobian_rhs"]),
+            jacobians: count(&bdf["jacobians"]),
+            factorizations: count(&bdf["factorizations"]),
+            ..crate::bdf::Work::default()
+        },
         ..Summary::default()
     };
+    if let Some(e) = v["event_times"].as_array() {
+        s.events = e
+            .iter()
+            .map(|x| crate::me::Event {
+                instance: x["instance"].as_str().unwrap_or("").to_string(),
+                time: x["time"].as_f64().unwrap_or(f64::NAN),
+                kind: match x["kind"].as_str() {
+                    Some("time") => "time",
+                    Some("state") => "state",
+                    Some("step") => "step",
+                    _ => "unknown",
+                },
+            })
+            .collect();
+    }
+    if let Some(i) = v["instances"].as_array() {
+        s.instance_time = i
+            .iter()
+            .map(|x| {
+                let d = Duration::from_secs_f64(x["time_s"].as_f64().unwrap_or(0.0).max(0.0));
+                (x["name"].as_str().unwrap_or("").to_string(), d)
+            })
+            .collect();
+    }
     if let Some(w) = v["warnings"].as_array() {
         s.warnings = w
             .iter()

@@ -385,15 +385,7 @@ impl MeGroup {
             for &m in members {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&u.xt);
-                inst.set_time(t_new)?;
-                MeUnit::set_states(inst, &u.x)?;
-                u.steps += 1;
-                std::mem::swap(&mut u.z0, &mut u.z);
-                let (step_event, terminate) = inst.completed_integrator_step()?;
-                if terminate {
-                    u.terminated = true;
-                }
-                if step_event {
+                if u.complete_step(inst, t_new)? {
                     step_events.push(m);
                 }
             }

@@ -18,23 +18,10 @@ static void defaults(Ball *b) {
     b->r[5] = 0.7;  /* e */
 }
 
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
-                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
-    Ball *b;
-    if (!cb || !cb->logger || type != 0) return NULL;
-    b = calloc(1, sizeof *b);
-    defaults(b);
-    return b;
-}
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
-    ((Ball *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+FMI2_TEST_INSTANCE(Ball, type == 0)
+FMI2_TEST_EXIT_INITIALIZATION
+FMI2_TEST_CONTINUOUS_TIME(Ball)
+
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Ball *b = c;
     size_t i;
@@ -56,7 +43,6 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     return 0;
 }
 
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Ball *b = c;
     memset(info, 0, sizeof *info);
@@ -76,13 +62,6 @@ EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     }
     return 0;
 }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
-    *enterEventMode = 0;
-    *terminate = 0;
-    return 0;
-}
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Ball *)c)->time = t; return 0; }
 EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
     if (n != 2) return ERR;
     ((Ball *)c)->r[0] = x[0];

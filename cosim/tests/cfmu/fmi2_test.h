@@ -1,4 +1,5 @@
-/* Shared by the C test FMUs of the master's tests (ball.c, latch.c, models.c): the FMI 2.0
+/* Shared by the C test FMUs of the master's tests (ball.c, latch.c, linear.c, models.c, ramp.c,
+ * stair.c, vdp.c): the FMI 2.0
  * types they use and the exports that are the same in each, which refuse (fmi2Error) or
  * do nothing. Each .c file is one shared library and includes this header once, so the
  * definitions below are that library's exports.
@@ -6,7 +7,10 @@
  * Before the #include a file may define:
  *   FMI2_TEST_NO_FMU_STATE       fmi2Get/Set/FreeFMUstate refused (the file has no FMU state)
  *   FMI2_TEST_NO_MODEL_EXCHANGE  every Model Exchange function refused (Co-Simulation only),
- *                                and the Co-Simulation input/output derivatives refused. */
+ *                                and the Co-Simulation input/output derivatives refused.
+ * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted),
+ * FMI2_TEST_EXIT_INITIALIZATION and FMI2_TEST_CONTINUOUS_TIME(Type) (below) for the
+ * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
 #define FMI2_TEST_H
 
@@ -78,5 +82,46 @@ EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) 
 EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
 #endif
+
+/* The instance of a test model: a `Type` (a struct with a member `double time`) made by
+ * calloc and set up by the file's `static void defaults(Type *)`, accepted where `accepted`
+ * holds for the fmi2Type `type` (0 Model Exchange, 1 Co-Simulation). fmi2SetupExperiment
+ * sets the time, fmi2Reset the defaults; entering initialization and terminating do nothing.
+ * fmi2ExitInitializationMode is FMI2_TEST_EXIT_INITIALIZATION's, or the file's own. */
+#define FMI2_TEST_INSTANCE(Type, accepted)                                                              \
+    EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res, \
+                                         const fmi2CallbackFunctions *cb, int visible, int logging) {   \
+        Type *m;                                                                                        \
+        if (!cb || !cb->logger || !(accepted)) return NULL;                                             \
+        m = calloc(1, sizeof *m);                                                                       \
+        defaults(m);                                                                                    \
+        return m;                                                                                       \
+    }                                                                                                   \
+    EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }                                          \
+    EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d,         \
+                                          double stop) {                                                \
+        ((Type *)c)->time = t0;                                                                         \
+        return 0;                                                                                       \
+    }                                                                                                   \
+    EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }                        \
+    EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }                                      \
+    EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+
+#define FMI2_TEST_EXIT_INITIALIZATION \
+    EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
+
+/* Model Exchange's mode changes of a `Type` as FMI2_TEST_INSTANCE's: entering event mode and
+ * continuous-time mode do nothing, fmi2SetTime sets the time, fmi2CompletedIntegratorStep
+ * asks for no event and no end. */
+#define FMI2_TEST_CONTINUOUS_TIME(Type)                                                                  \
+    EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }                                 \
+    EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }                        \
+    EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Type *)c)->time = t; return 0; }       \
+    EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode,    \
+                                                  int *terminate) {                                     \
+        *enterEventMode = 0;                                                                            \
+        *terminate = 0;                                                                                 \
+        return 0;                                                                                       \
+    }
 
 #endif

@@ -18,28 +18,15 @@ static void defaults(Linear *m) {
     m->r[4] = 1e4;
 }
 
+FMI2_TEST_INSTANCE(Linear, type == 0)
+FMI2_TEST_EXIT_INITIALIZATION
+FMI2_TEST_CONTINUOUS_TIME(Linear)
+
 static void derivatives(Linear *m) {
     m->r[1] = -m->r[4] * m->r[0] + m->r[2];
     m->r[3] = -m->r[2];
 }
 
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
-                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
-    Linear *m;
-    if (!cb || !cb->logger || type != 0) return NULL;
-    m = calloc(1, sizeof *m);
-    defaults(m);
-    return m;
-}
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
-    ((Linear *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Linear *m = c;
     size_t i;
@@ -59,18 +46,10 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     memset(info, 0, sizeof *info);
     return 0;
 }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
-    *enterEventMode = 0;
-    *terminate = 0;
-    return 0;
-}
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Linear *)c)->time = t; return 0; }
 EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
     Linear *m = c;
     if (n != 2) return ERR;

@@ -19,23 +19,10 @@ static void defaults(Ramp *r) {
     r->time = 0.0;
 }
 
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
-                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
-    Ramp *r;
-    if (!cb || !cb->logger || type != 0) return NULL;
-    r = calloc(1, sizeof *r);
-    defaults(r);
-    return r;
-}
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
-    ((Ramp *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+FMI2_TEST_INSTANCE(Ramp, type == 0)
+FMI2_TEST_EXIT_INITIALIZATION
+FMI2_TEST_CONTINUOUS_TIME(Ramp)
+
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Ramp *r = c;
     size_t i;
@@ -61,7 +48,6 @@ EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], si
     return 0;
 }
 
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Ramp *r = c;
     memset(info, 0, sizeof *info);
@@ -72,13 +58,6 @@ EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     }
     return 0;
 }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
-    *enterEventMode = 0;
-    *terminate = 0;
-    return 0;
-}
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Ramp *)c)->time = t; return 0; }
 EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return ERR; }
 EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return ERR; }

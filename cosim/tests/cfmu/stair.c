@@ -25,23 +25,10 @@ static void defaults(Stair *s) {
     s->terminated = 0;
 }
 
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
-                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
-    Stair *s;
-    if (!cb || !cb->logger) return NULL;
-    s = calloc(1, sizeof *s);
-    defaults(s);
-    return s;
-}
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
-    ((Stair *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+FMI2_TEST_INSTANCE(Stair, 1)
+FMI2_TEST_EXIT_INITIALIZATION
+FMI2_TEST_CONTINUOUS_TIME(Stair)
+
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     size_t i;
     for (i = 0; i < n; i++) {
@@ -93,7 +80,6 @@ EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueR
                                                const int order[], double v[]) { return ERR; }
 
 /* Model Exchange */
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Stair *s = c;
     memset(info, 0, sizeof *info);
@@ -103,13 +89,6 @@ EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     info->nextEventTime = s->next_event;
     return 0;
 }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
-    *enterEventMode = 0;
-    *terminate = 0;
-    return 0;
-}
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Stair *)c)->time = t; return 0; }
 EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return n ? ERR : 0; }
 EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return n ? ERR : 0; }

@@ -20,29 +20,16 @@ static void defaults(Vdp *v) {
     v->r[4] = 1.0;
 }
 
+FMI2_TEST_INSTANCE(Vdp, type == 0)
+FMI2_TEST_EXIT_INITIALIZATION
+FMI2_TEST_CONTINUOUS_TIME(Vdp)
+
 static void derivatives(Vdp *v) {
     double x0 = v->r[0], x1 = v->r[2], mu = v->r[4];
     v->r[1] = x1;
     v->r[3] = mu * (1.0 - x0 * x0) * x1 - x0;
 }
 
-EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
-                                     const fmi2CallbackFunctions *cb, int visible, int logging) {
-    Vdp *v;
-    if (!cb || !cb->logger || type != 0) return NULL;
-    v = calloc(1, sizeof *v);
-    defaults(v);
-    return v;
-}
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d, double stop) {
-    ((Vdp *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Vdp *m = c;
     size_t i;
@@ -90,18 +77,10 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
     return 0;
 }
 
-EXPORT fmi2Status fmi2EnterEventMode(fmi2Component c) { return 0; }
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     memset(info, 0, sizeof *info);
     return 0;
 }
-EXPORT fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, int noPrior, int *enterEventMode, int *terminate) {
-    *enterEventMode = 0;
-    *terminate = 0;
-    return 0;
-}
-EXPORT fmi2Status fmi2SetTime(fmi2Component c, double t) { ((Vdp *)c)->time = t; return 0; }
 EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
     Vdp *m = c;
     if (n != 2) return ERR;

@@ -343,15 +343,7 @@ impl MeGroup {
             for (k, &m) in members.iter().enumerate() {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&bdf.state()[offsets[k]..offsets[k + 1]]);
-                inst.set_time(t_new)?;
-                MeUnit::set_states(inst, &u.x)?;
-                u.steps += 1;
-                std::mem::swap(&mut u.z0, &mut u.z);
-                let (step_event, terminate) = inst.completed_integrator_step()?;
-                if terminate {
-                    u.terminated = true;
-                }
-                if step_event {
+                if u.complete_step(inst, t_new)? {
                     step_events.push(m);
                 }
             }
@@ -387,36 +379,13 @@ fn locate_on_dense_output(
     t1: f64,
     x: &mut [f64],
 ) -> Result<f64> {
-    let zi = u.z0.iter().zip(&u.z).position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0)).unwrap_or(0);
-    let (mut lo, mut hi) = (t0, t1);
-    let (mut f_lo, mut f_hi) = (u.z0[zi], u.z[zi]);
+    let zi = u.first_crossing();
+    let (z_lo, z_hi) = (u.z0[zi], u.z[zi]);
     let n = u.xt.len();
-    let mut side = 0i32;
-    let mut iterations = 0;
-    while hi - lo > EVENT_TIME_TOLERANCE && iterations < 200 {
-        iterations += 1;
-        let mut s = hi - f_hi * (hi - lo) / (f_hi - f_lo);
-        if !(s > lo && s < hi && s.is_finite()) {
-            s = 0.5 * (lo + hi);
-        }
+    crate::me::illinois(t0, t1, z_lo, z_hi, |s| {
         bdf.interpolate(s, x);
         u.xt.copy_from_slice(&x[offset..offset + n]);
         u.indicators_at(inst, s)?;
-        if MeUnit::crossed(&u.z0, &u.z) {
-            hi = s;
-            f_hi = u.z[zi];
-            if side == 1 {
-                f_lo *= 0.5;
-            }
-            side = 1;
-        } else {
-            lo = s;
-            f_lo = u.z[zi];
-            if side == -1 {
-                f_hi *= 0.5;
-            }
-            side = -1;
-        }
-    }
-    Ok(hi)
+        Ok((MeUnit::crossed(&u.z0, &u.z), u.z[zi]))
+    })
 }
