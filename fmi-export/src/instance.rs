@@ -266,7 +266,12 @@ impl<M: Model> Instance<M> {
     /// The full rules of [`Instance::check_call`], with the reason: the function's
     /// generation, interface and declared features, the model's capabilities and the state
     /// table of [`crate::states`].
-    pub fn call_allowed(generation: Generation, interface: Interface, function: Function, machine: Machine) -> OpResult {
+    pub fn call_allowed(
+        generation: Generation,
+        interface: Interface,
+        function: Function,
+        machine: Machine,
+    ) -> OpResult {
         if function.generation() != generation {
             return err(match generation {
                 Generation::Fmi2 => "not available: this instance was created by fmi2Instantiate (FMI 2.0)",

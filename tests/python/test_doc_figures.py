@@ -390,3 +390,14 @@ def test_synthesis_figures(designs):
     check("README.md", "angles positive to the left): `[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]` (RL = RR).",
           *t["K"][0], *t["K"][2])
     assert t["K"][0] == t["K"][1] and t["K"][2] == t["K"][3]
+
+
+# --- the AddressSanitizer step of scripts/test.sh -------------------------------------------
+
+def test_readme_prints_the_random_sequences_the_asan_step_runs():
+    """README.md's "first 3,000 and 1,500 sequences" are the NIGEL_RANDOM_SEQUENCES and
+    NIGEL_RANDOM_SEQUENCES3 of scripts/test.sh's ASan step."""
+    script = (REPO / "scripts" / "test.sh").read_text()
+    fmi2 = int(re.search(r"NIGEL_RANDOM_SEQUENCES=(\d+)", script).group(1))
+    fmi3 = int(re.search(r"NIGEL_RANDOM_SEQUENCES3=(\d+)", script).group(1))
+    check("README.md", "first {} and {} sequences per FMU and interface", fmi2, fmi3)

@@ -85,6 +85,20 @@ pub fn target_dir() -> PathBuf {
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap_or(Path::new(".")).join("target"))
 }
 
+/// The environment variable naming a folder of cargo-built libraries (`lib<id>.so`) that
+/// replace the archives' linux64 ones, e.g. the AddressSanitizer build of scripts/test.sh.
+pub const LIBRARIES_VARIABLE: &str = "NIGEL_FMU_LIBRARIES";
+
+/// `lib<id>.so` in `folder` (cargo's name of the cdylib an archive's `<id>.so` is a copy of).
+fn instrumented_library(folder: &Path, id: &str) -> Result<PathBuf, String> {
+    let so = folder.join(format!("lib{id}.so"));
+    if so.is_file() {
+        Ok(so)
+    } else {
+        Err(format!("{LIBRARIES_VARIABLE} = {}: {} not found", folder.display(), so.display()))
+    }
+}
+
 /// Path of a built FMU (`target/fmu/<id>.fmu`), or a message saying how to build it.
 pub fn built_fmu(model_identifier: &str) -> Result<PathBuf, String> {
     let path = target_dir().join("fmu").join(format!("{model_identifier}.fmu"));
@@ -119,7 +133,10 @@ impl Fmu {
             .map(|c| c.model_identifier.clone())
             .or_else(|| description.model_exchange.as_ref().map(|m| m.model_identifier.clone()))
             .ok_or("no interface")?;
-        let so = dir.join("binaries").join("linux64").join(format!("{id}.so"));
+        let so = match std::env::var_os(LIBRARIES_VARIABLE) {
+            Some(folder) => instrumented_library(Path::new(&folder), &id)?,
+            None => dir.join("binaries").join("linux64").join(format!("{id}.so")),
+        };
         let library = unsafe { libloading::Library::new(&so) }.map_err(|e| format!("{}: {e}", so.display()))?;
         // SAFETY: an FMI 2.0 library; the table lives no longer than `_library`.
         let functions = unsafe { Functions::load(&library) }.map_err(|e| e.0.to_string())?;

@@ -16,8 +16,8 @@ use nigel_plant::Plant;
 /// `fmi3Get{VariableType}` and `fmi3Set{VariableType}` (section 2.2.6; the Clock
 /// functions are described with the Clocks and listed separately in the states).
 const VARIABLE_TYPES: [&str; 13] = [
-    "Float32", "Float64", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64", "Boolean", "String",
-    "Binary",
+    "Float32", "Float64", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64", "Boolean",
+    "String", "Binary",
 ];
 
 /// The states of FMI 3.0 an FMU without Clocks, Event Mode in Co-Simulation or
@@ -191,10 +191,8 @@ fn interface_allows(name: &str, interface: Interface) -> bool {
 fn declared(name: &str, interface: Interface) -> bool {
     let md = Plant::declaration().model_description3();
     let clocks = md.model_variables.iter().any(|v| v.value_type == model_description::fmi3::ValueType::Clock);
-    let structural = md
-        .model_variables
-        .iter()
-        .any(|v| v.causality == model_description::fmi3::Causality::StructuralParameter);
+    let structural =
+        md.model_variables.iter().any(|v| v.causality == model_description::fmi3::Causality::StructuralParameter);
     let cs = md.co_simulation.as_ref().expect("the plant offers Co-Simulation");
     let me = md.model_exchange.as_ref().expect("the plant offers Model Exchange");
     let common = match interface {
@@ -206,9 +204,16 @@ fn declared(name: &str, interface: Interface) -> bool {
         Interface::ModelExchange => me.provides_evaluate_discrete_states,
     };
     match name {
-        "fmi3GetClock" | "fmi3SetClock" | "fmi3GetIntervalDecimal" | "fmi3GetIntervalFraction"
-        | "fmi3GetShiftDecimal" | "fmi3GetShiftFraction" | "fmi3SetIntervalDecimal" | "fmi3SetIntervalFraction"
-        | "fmi3SetShiftDecimal" | "fmi3SetShiftFraction" => clocks,
+        "fmi3GetClock"
+        | "fmi3SetClock"
+        | "fmi3GetIntervalDecimal"
+        | "fmi3GetIntervalFraction"
+        | "fmi3GetShiftDecimal"
+        | "fmi3GetShiftFraction"
+        | "fmi3SetIntervalDecimal"
+        | "fmi3SetIntervalFraction"
+        | "fmi3SetShiftDecimal"
+        | "fmi3SetShiftFraction" => clocks,
         "fmi3EnterConfigurationMode" | "fmi3ExitConfigurationMode" => structural,
         "fmi3EvaluateDiscreteStates" => evaluate_discrete_states,
         "fmi3GetOutputDerivatives" => cs.max_output_derivative_order > 0,
