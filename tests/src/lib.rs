@@ -75,7 +75,20 @@ pub struct Fmu {
     pub functions: Functions,
     /// The `fmi3*` functions of the same library.
     pub functions3: fmi_sys::fmi3::Fmi3Functions,
-    _library: libloading::Library,
+    library: std::mem::ManuallyDrop<libloading::Library>,
+    /// A library of [`LIBRARIES_VARIABLE`] stays loaded after the drop: the tables it
+    /// builds on first use live in its data segment, which `dlclose` would unmap, and
+    /// LeakSanitizer would then report them as leaks.
+    keep_loaded: bool,
+}
+
+impl Drop for Fmu {
+    fn drop(&mut self) {
+        if !self.keep_loaded {
+            // SAFETY: dropped once, here; the function tables are not used after this
+            unsafe { std::mem::ManuallyDrop::drop(&mut self.library) }
+        }
+    }
 }
 
 /// The workspace's `target/` (honours `CARGO_TARGET_DIR`).
@@ -133,12 +146,13 @@ impl Fmu {
             .map(|c| c.model_identifier.clone())
             .or_else(|| description.model_exchange.as_ref().map(|m| m.model_identifier.clone()))
             .ok_or("no interface")?;
+        let keep_loaded = std::env::var_os(LIBRARIES_VARIABLE).is_some();
         let so = match std::env::var_os(LIBRARIES_VARIABLE) {
             Some(folder) => instrumented_library(Path::new(&folder), &id)?,
             None => dir.join("binaries").join("linux64").join(format!("{id}.so")),
         };
         let library = unsafe { libloading::Library::new(&so) }.map_err(|e| format!("{}: {e}", so.display()))?;
-        // SAFETY: an FMI 2.0 library; the table lives no longer than `_library`.
+        // SAFETY: an FMI 2.0 library; the table lives no longer than `library`.
         let functions = unsafe { Functions::load(&library) }.map_err(|e| e.0.to_string())?;
         if let Some(missing) = SYMBOLS.iter().find(|s| !functions.has(s)) {
             return Err(format!("{}: the library does not export {missing}", so.display()));
@@ -148,7 +162,7 @@ impl Fmu {
         if let Some(missing) = functions3.missing().first() {
             return Err(format!("{}: the library does not export {missing}", so.display()));
         }
-        Ok(Fmu { dir, description, functions, functions3, _library: library })
+        Ok(Fmu { dir, description, functions, functions3, library: std::mem::ManuallyDrop::new(library), keep_loaded })
     }
 
     pub fn guid(&self) -> &str {
