@@ -71,7 +71,6 @@ def test_validate_fmu_reports_no_problems(model_identifier):
     assert validate_fmu(str(fmi3)) == []
 
 
-@pytest.mark.parametrize("model_identifier", IDS)
 def fmi3_part(folder3, library):
     """What FMI 3.0 folder `folder3` carries of the FMI 2.0 archive's `library`: the library,
     or for a Mac folder the slice of its architecture in the universal library (the fat
@@ -89,6 +88,7 @@ def fmi3_part(folder3, library):
     raise AssertionError(f"no slice of CPU type {cpu:#x} for {folder3}")
 
 
+@pytest.mark.parametrize("model_identifier", IDS)
 def test_the_archive_carries_the_fmi2_archives_libraries_in_the_fmi3_folders(model_identifier):
     import zipfile
 
