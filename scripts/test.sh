@@ -46,6 +46,28 @@ asan_test() {
 }
 asan_test fmi-export toy
 asan_test fmu-plant fmi3
+echo "== the FMU libraries under AddressSanitizer: random call sequences, dlopen abuse, the C importers under ASan+UBSan"
+# the three cdylibs instrumented (the debug profile of target/asan, whose dependencies the
+# steps above built), loaded in place of the archives' linux64 libraries through
+# NIGEL_FMU_LIBRARIES: by the release test binaries of the tests crate (uninstrumented
+# Rust, with gcc's ASan runtime preloaded: it serves the instrumented library's checks and
+# takes over malloc and free) and by the C importers built with -fsanitize=address,undefined
+RUSTFLAGS="-Zsanitizer=address" cargo +nightly build --quiet --target x86_64-unknown-linux-gnu \
+    --target-dir "$target_dir/asan" --lib -p fmu-plant -p fmu-controller -p fmu-maneuver \
+    --features fmu-plant/fmi-export,fmu-controller/fmi-export,fmu-maneuver/fmi-export
+export NIGEL_FMU_LIBRARIES="$PWD/$target_dir/asan/x86_64-unknown-linux-gnu/debug"
+case "$target_dir" in /*) NIGEL_FMU_LIBRARIES="$target_dir/asan/x86_64-unknown-linux-gnu/debug" ;; esac
+asan_runtime=$(gcc -print-file-name=libasan.so)
+for t in random_calls random_calls3 c_abi c_abi3; do
+    exe=$(cargo test --release --quiet -p nigel-integration-tests --test "$t" --no-run --message-format=json \
+        | sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)
+    # the first 3,000 and 1,500 of the uninstrumented run's seeded sequences (150,000 and
+    # 20,000): the instrumented debug build is some ten times slower
+    NIGEL_RANDOM_SEQUENCES=3000 NIGEL_RANDOM_SEQUENCES3=1500 LD_PRELOAD="$asan_runtime" \
+        ASAN_OPTIONS=detect_leaks=1 "$exe" --quiet
+done
+cargo test --release --quiet -p build-fmu --test platforms linux64_c_importers_under_asan_and_ubsan
+unset NIGEL_FMU_LIBRARIES
 echo "== synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
 echo "== fmpy cross-checks"

@@ -412,9 +412,9 @@ impl std::fmt::Display for BuildError {
 impl std::error::Error for BuildError {}
 
 /// The `version` archive's bytes: `modelDescription.xml`, `binaries/<folder>/<id>.<ext>` for
-/// each library (in the order given; in FMI 3.0 the darwin64 universal library goes to both
-/// `x86_64-darwin` and `aarch64-darwin`), `documentation/index.html`, with fixed timestamps
-/// and modes.
+/// each library (in the order given; in FMI 3.0 the darwin64 universal library's x86-64
+/// slice goes to `x86_64-darwin`, its arm64 slice to `aarch64-darwin`),
+/// `documentation/index.html`, with fixed timestamps and modes.
 pub fn archive(
     version: FmiVersion,
     xml: &str,
@@ -431,6 +431,12 @@ pub fn archive(
     let mut entries: Vec<(String, &[u8], u32)> = vec![("modelDescription.xml".into(), xml.as_bytes(), 0o644)];
     for (platform, bytes) in libraries {
         for folder in version.folders(*platform) {
+            let bytes = match version {
+                FmiVersion::Fmi2 => bytes,
+                FmiVersion::Fmi3 => {
+                    platform.fmi3_library(folder, bytes).map_err(|e| BuildError::Zip(format!("{folder}: {e}")))?
+                }
+            };
             entries.push((format!("binaries/{folder}/{}", platform.library_file(model_identifier)), bytes, 0o755));
         }
     }
@@ -694,11 +700,19 @@ mod tests {
         let t = &targets()[0];
         let xml = t.xml(FmiVersion::Fmi3);
         assert!(xml.contains("fmiVersion=\"3.0\"") && xml.contains(&t.description.guid), "{xml}");
+        // a universal library of two 4-byte slices: the fat header of <mach-o/fat.h>
+        // (magic, 2 architectures), two fat_arch entries (cputype, cpusubtype, offset,
+        // size, align), the slices at bytes 48 and 52
+        let mut universal: Vec<u8> = [0xcafe_babe_u32, 2].iter().flat_map(|w| w.to_be_bytes()).collect();
+        for (cpu, offset) in [(0x0100_0007_u32, 48_u32), (0x0100_000c, 52)] {
+            universal.extend([cpu, 3, offset, 4, 2].iter().flat_map(|w| w.to_be_bytes()));
+        }
+        universal.extend(b"x64!arm!");
         let libs: [(Platform, &[u8]); 4] = [
             (Platform::Linux64, b"\x7fELF x86-64"),
             (Platform::Win64, b"MZ"),
             (Platform::Aarch64Linux, b"\x7fELF arm64"),
-            (Platform::Darwin64, b"\xca\xfe\xba\xbe universal"),
+            (Platform::Darwin64, &universal),
         ];
         let a = archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap();
         assert_eq!(a, archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap());
@@ -716,19 +730,48 @@ mod tests {
                 "documentation/index.html"
             ]
         );
-        // one universal library for both Mac architectures: the same bytes in both folders
-        for folder in ["x86_64-darwin", "aarch64-darwin"] {
+        // each Mac folder the slice of its architecture
+        for (folder, slice) in [("x86_64-darwin", b"x64!"), ("aarch64-darwin", b"arm!")] {
             let mut bytes = Vec::new();
             std::io::Read::read_to_end(
                 &mut z.by_name(&format!("binaries/{folder}/nigel_plant.dylib")).unwrap(),
                 &mut bytes,
             )
             .unwrap();
-            assert_eq!(bytes, b"\xca\xfe\xba\xbe universal");
+            assert_eq!(&bytes, slice);
         }
         let mut doc = String::new();
         std::io::Read::read_to_string(&mut z.by_name("documentation/index.html").unwrap(), &mut doc).unwrap();
         assert!(doc.contains("The FMI 3.0 archive") && doc.contains("<code>nigel_plant.fmu</code>"), "{doc}");
+    }
+
+    /// A darwin64 library that is no universal one, or lacks an architecture, is refused
+    /// for the FMI 3.0 archive (whose Mac folders take one slice each) and kept whole for
+    /// the FMI 2.0 one (whose darwin64 is the universal library).
+    #[test]
+    fn fmi3_mac_folders_need_both_slices_of_a_universal_library() {
+        let t = &targets()[0];
+        let thin: &[u8] = b"\xcf\xfa\xed\xfe thin x86-64";
+        let only_x86: Vec<u8> = [0xcafe_babe_u32, 1, 0x0100_0007, 3, 28, 4, 2]
+            .iter()
+            .flat_map(|w| w.to_be_bytes())
+            .chain(*b"x64!")
+            .collect();
+        for (library, reason) in
+            [(thin, "not a universal Mach-O library"), (&only_x86[..], "no slice of CPU type 0x100000c")]
+        {
+            let e = archive(FmiVersion::Fmi3, "<x/>", &[(Platform::Darwin64, library)], &t.model_identifier, "")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(reason), "{e}");
+            let a =
+                archive(FmiVersion::Fmi2, "<x/>", &[(Platform::Darwin64, library)], &t.model_identifier, "").unwrap();
+            let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut z.by_name("binaries/darwin64/nigel_plant.dylib").unwrap(), &mut bytes)
+                .unwrap();
+            assert_eq!(bytes, library);
+        }
     }
 
     #[test]

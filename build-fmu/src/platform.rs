@@ -67,13 +67,25 @@ impl Platform {
     }
 
     /// The FMI 3.0 platform folders (`<arch>-<os>`, FMI 3.0 section 2.5.1.1) of this
-    /// platform's library: the darwin64 universal library serves both Mac architectures.
+    /// platform's library: the darwin64 universal library's two slices go to the two Mac
+    /// folders ([`Platform::fmi3_library`]).
     pub fn fmi3_folders(self) -> &'static [&'static str] {
         match self {
             Platform::Linux64 => &["x86_64-linux"],
             Platform::Win64 => &["x86_64-windows"],
             Platform::Aarch64Linux => &["aarch64-linux"],
             Platform::Darwin64 => &["x86_64-darwin", "aarch64-darwin"],
+        }
+    }
+
+    /// What the FMI 3.0 platform folder `folder` carries of this platform's `library`: the
+    /// thin slice of the folder's architecture for the darwin64 universal library (FMI 3.0
+    /// names one architecture per folder), the library itself for the others.
+    pub fn fmi3_library<'a>(self, folder: &str, library: &'a [u8]) -> Result<&'a [u8], String> {
+        match (self, folder) {
+            (Platform::Darwin64, "x86_64-darwin") => thin_slice(library, CPU_TYPE_X86_64),
+            (Platform::Darwin64, "aarch64-darwin") => thin_slice(library, CPU_TYPE_ARM64),
+            _ => Ok(library),
         }
     }
 
@@ -105,7 +117,10 @@ impl Platform {
                 "64-bit Windows 10 or later (the Rust standard library calls ProcessPrng of bcryptprimitives.dll); no runtime to install"
             }
             Platform::Aarch64Linux => "64-bit ARM Linux with glibc 2.17 or later",
-            Platform::Darwin64 => "macOS 11 or later, Intel or Apple silicon (one universal library)",
+            Platform::Darwin64 => {
+                "macOS 11 or later, Intel or Apple silicon (darwin64: one universal library; FMI 3.0: \
+                 each folder the slice of its architecture)"
+            }
         }
     }
 
@@ -150,21 +165,26 @@ impl Platform {
             Platform::Linux64 => {
                 "by the test command, on this recipe's library: executed: fmpy (validate_fmu, Co-Simulation and Model \
                  Exchange against the FMI 2.0 archive) and the C FMI 3.0 importer build-fmu/tests/c/fmi3_closed_loop.c, \
-                 which runs the closed loop (plant, controller, test bench) 30 s at 1 ms equal to the FMI 2.0 run bit for bit"
+                 which runs the closed loop (plant, controller, test bench) 30 s at 1 ms equal to the FMI 2.0 run bit for bit, \
+                 and build-fmu/tests/c/me_fixed_step.c, the plant through Model Exchange (fixed-step RK4) equal to its \
+                 FMI 2.0 Model Exchange run bit for bit"
             }
             Platform::Win64 => {
                 "by the test command, on this recipe's library: executed under wine 8: the C FMI 3.0 importer \
                  build-fmu/tests/c/fmi3_closed_loop.c, built with mingw-w64, runs the closed loop 30 s at 1 ms, every \
-                 output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same DLL bit for bit"
+                 output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same DLL bit for bit; \
+                 build-fmu/tests/c/me_fixed_step.c runs the plant through Model Exchange equal to its FMI 2.0 run bit for bit"
             }
             Platform::Aarch64Linux => {
                 "by the test command, on this recipe's library: executed under qemu-user: the C FMI 3.0 importer \
                  build-fmu/tests/c/fmi3_closed_loop.c, built with aarch64-linux-gnu-gcc, runs the closed loop 30 s at 1 ms, \
-                 every output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same library bit for bit"
+                 every output compared with the linux64 FMI 2.0 run and equal to the FMI 2.0 run of the same library bit for \
+                 bit; build-fmu/tests/c/me_fixed_step.c runs the plant through Model Exchange equal to its FMI 2.0 run bit for bit"
             }
             Platform::Darwin64 => {
                 "by the test command, on this recipe's library: not executed (no macOS there): structural checks only, \
-                 both architectures present, the fmi3 exports, the minimum macOS version and only system libraries imported"
+                 each folder the thin slice of its architecture (the one llvm-lipo -thin extracts from the FMI 2.0 archive's \
+                 universal library), the fmi3 exports, the minimum macOS version and only system libraries imported"
             }
         }
     }
@@ -329,6 +349,39 @@ impl Platform {
             }
         }
     }
+}
+
+/// The Mach-O CPU types (`<mach/machine.h>`) of the two darwin64 architectures.
+pub const CPU_TYPE_X86_64: u32 = 0x0100_0007;
+pub const CPU_TYPE_ARM64: u32 = 0x0100_000c;
+/// The magic of a universal ("fat") Mach-O file with 32-bit offsets, big-endian, as
+/// `llvm-lipo -create` writes it (`<mach-o/fat.h>`).
+const FAT_MAGIC: u32 = 0xcafe_babe;
+
+/// The thin slice of CPU type `cpu` in the universal Mach-O file `universal`: its header
+/// (magic, number of architectures), then one `fat_arch` per architecture (cputype,
+/// cpusubtype, offset, size, align; 32-bit big-endian), the slices at their offsets.
+pub fn thin_slice(universal: &[u8], cpu: u32) -> Result<&[u8], String> {
+    let word = |at: usize| -> Result<u32, String> {
+        universal
+            .get(at..at + 4)
+            .map(|b| u32::from_be_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("universal library truncated at byte {at}"))
+    };
+    if word(0)? != FAT_MAGIC {
+        return Err(format!("not a universal Mach-O library (magic {:#010x})", word(0)?));
+    }
+    let count = word(4)? as usize;
+    for k in 0..count {
+        let entry = 8 + 20 * k;
+        if word(entry)? == cpu {
+            let (offset, size) = (word(entry + 8)? as usize, word(entry + 12)? as usize);
+            return universal
+                .get(offset..offset + size)
+                .ok_or_else(|| format!("the slice of CPU type {cpu:#x} ({size} bytes at {offset}) is past the end"));
+        }
+    }
+    Err(format!("the universal library has no slice of CPU type {cpu:#x}"))
 }
 
 /// `-Zbuild-std` with the standard library's source from rust-web-src.

@@ -263,8 +263,15 @@ impl<M: Model> Instance<M> {
         ))
     }
 
-    /// The full rules of [`Instance::check_call`], with the reason.
-    fn call_allowed(generation: Generation, interface: Interface, function: Function, machine: Machine) -> OpResult {
+    /// The full rules of [`Instance::check_call`], with the reason: the function's
+    /// generation, interface and declared features, the model's capabilities and the state
+    /// table of [`crate::states`].
+    pub fn call_allowed(
+        generation: Generation,
+        interface: Interface,
+        function: Function,
+        machine: Machine,
+    ) -> OpResult {
         if function.generation() != generation {
             return err(match generation {
                 Generation::Fmi2 => "not available: this instance was created by fmi2Instantiate (FMI 2.0)",
@@ -766,6 +773,14 @@ impl<M: Model> Instance<M> {
     /// communicationStepSize` exactly (FMI 2.0 section 4.2.2), so the FMU's time is the
     /// importer's and `fmi2LastSuccessfulTime` its arithmetic.
     pub fn do_step(&mut self, current_time: f64, step: f64) -> OpResult {
+        if self.core.terminate_requested && self.core.clock.is_none() {
+            // the Discard with terminateSimulation of the step that ended the run (FMI 3.0
+            // stays in Step Mode after it; FMI 2.0's stepFailed refuses the step before)
+            return err(format!(
+                "the model asked to terminate the simulation at t = {} s: no step after it (terminate or reset)",
+                self.core.time
+            ));
+        }
         if !(step > 0.0) || !step.is_finite() {
             return err(format!("communicationStepSize = {step} s refused: must be finite and > 0"));
         }
@@ -979,7 +994,8 @@ impl<M: Model> Instance<M> {
                 .ok_or_else(|| format!("unknown Real value reference {vr}").into())
         };
         let d = decl::<M>();
-        let initialization = self.core.machine == Machine::InitializationMode;
+        // before fmi3ExitInitializationMode the initial dependencies (FMI 3.0 section 2.2.11)
+        let initialization = matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode);
         for &vr in knowns {
             let row = Self::row_in(d, BaseType::Real, vr)?;
             let v = d.variable(row);
@@ -1102,8 +1118,30 @@ impl<M: Model> Instance<M> {
         }
     }
 
+    /// Before Initialization Mode an FMI 3.0 getter returns start values (FMI 3.0 section
+    /// 2.3.2): a variable without one, calculated in Initialization Mode, is refused.
+    fn check_start_values(&self, vrs: &[u32]) -> OpResult {
+        if self.core.machine != Machine::Instantiated {
+            return Ok(());
+        }
+        let d = decl::<M>();
+        for &vr in vrs {
+            let Some(row) = d.row3(vr) else { continue };
+            let v = d.variable(row);
+            if !matches!(v.initial, Some(Initial::Exact) | Some(Initial::Approx)) && v.causality != Causality::Input {
+                return err(format!(
+                    "{} (value reference {vr}) has no start value: it is calculated in Initialization Mode, so it \
+                     cannot be read in Instantiated",
+                    v.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `fmi3GetFloat64`: the Float64 variables, `time` (value reference 0) included.
     pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
+        self.check_start_values(vrs)?;
         if !vrs.contains(&0) {
             return self.with_fmi2_references(vrs, ValueType3::Float64, |i, vrs2| i.get_real(vrs2, out));
         }
@@ -1133,6 +1171,7 @@ impl<M: Model> Instance<M> {
 
     /// `fmi3GetInt32` (Integers) or `fmi3GetInt64` (Enumerations).
     pub fn get_int(&mut self, vrs: &[u32], accessed: ValueType3, out: &mut [i32]) -> OpResult {
+        self.check_start_values(vrs)?;
         self.with_fmi2_references(vrs, accessed, |i, vrs2| i.get_integer(vrs2, out))
     }
 
@@ -1155,6 +1194,7 @@ impl<M: Model> Instance<M> {
 
     /// `fmi3GetBoolean`.
     pub fn get_boolean3(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+        self.check_start_values(vrs)?;
         let vrs2 = self.fmi2_references(vrs, ValueType3::Boolean)?;
         self.get_boolean(&vrs2, out)
     }
@@ -1190,7 +1230,8 @@ impl<M: Model> Instance<M> {
         let d = decl::<M>();
         let Some(v) = d.variable3(vr) else { return err(format!("unknown value reference {vr}")) };
         let s = &d.model_description3().model_structure;
-        let initialization = self.core.machine == Machine::InitializationMode;
+        // before fmi3ExitInitializationMode the initial dependencies (FMI 3.0 section 2.2.11)
+        let initialization = matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode);
         let entry = if initialization {
             s.initial_unknowns.iter().find(|u| u.value_reference == vr)
         } else {

@@ -5,13 +5,16 @@
 //!
 //! One machine serves both generations. FMI 3.0's states are FMI 2.0's where they
 //! coincide: Instantiated, Initialization Mode, Event Mode and Continuous-Time Mode (Model
-//! Exchange), Terminated, and the error state; FMI 3.0's Step Mode is
-//! [`Machine::StepComplete`], and [`Machine::StepFailed`] is FMI 3.0's Step Discarded (FMI
-//! 2.0's stepFailed), after a step that returned Discard: the importer may then read,
-//! terminate, restore an FMU state or reset, but not step. An FMU of ours declares no Event Mode for
-//! Co-Simulation, no clocks and no Configuration Mode, so those FMI 3.0 states never occur.
-//! An FMI 3.0 function that does the same as an FMI 2.0 one has that one's row
-//! ([`Function::counterpart`]).
+//! Exchange) and Terminated; FMI 3.0's Step Mode is [`Machine::StepComplete`]. FMI 2.0's
+//! stepFailed ([`Machine::StepFailed`]), after a step that returned Discard (the importer may
+//! then read, terminate, restore an FMU state or reset, but not step), does not exist in FMI
+//! 3.0: there a Discard of `fmi3DoStep` leaves the FMU in Step Mode. FMI 2.0's error state
+//! ([`Machine::Error`]) is, for FMI 3.0, the Terminated that an `fmi3Error` leads to: the two
+//! have the same row. An FMU of ours declares no Event Mode for Co-Simulation, no clocks
+//! and no Configuration Mode, so those FMI 3.0 states never occur. An FMI 3.0 function that
+//! does the same as an FMI 2.0 one has that one's row ([`Function::counterpart`]) unless
+//! FMI 3.0 lists it in other states ([`Function::fmi3_row`]); tests/tests/fmi3_state_table.rs
+//! compares every FMI 3.0 cell with the standard's lists.
 
 use model_description::{Causality, Initial, Variability};
 
@@ -309,7 +312,9 @@ impl Function {
             Fmi3EnterConfigurationMode | Fmi3ExitConfigurationMode => {
                 "no structural parameters, so no Configuration Mode"
             }
-            Fmi3GetIntervalDecimal
+            Fmi3GetClock
+            | Fmi3SetClock
+            | Fmi3GetIntervalDecimal
             | Fmi3GetIntervalFraction
             | Fmi3GetShiftDecimal
             | Fmi3GetShiftFraction
@@ -365,6 +370,9 @@ impl Function {
     /// The states in which the standard allows the call (for the function's own interface).
     fn allowed_mask(self) -> u16 {
         use Function::*;
+        if let Some(m) = self.fmi3_row() {
+            return m;
+        }
         if let Some(f) = self.counterpart() {
             return f.allowed_mask();
         }
@@ -414,6 +422,37 @@ impl Function {
             // the FMI 3.0 functions, answered above
             _ => ANY,
         }
+    }
+
+    /// The FMI 3.0 rows that differ from their FMI 2.0 counterpart's, from the lists of
+    /// allowed calls per state in FMI 3.0.2 (sections 2.3, 3.2 and 4.2, with the erratum that
+    /// lists the getters in Instantiated). An fmi3Error leads to Terminated there, so the
+    /// layer's Error state has Terminated's row; Step Discarded does not exist (a Discard
+    /// of fmi3DoStep leaves the FMU in Step Mode), so StepFailed never occurs.
+    fn fmi3_row(self) -> Option<u16> {
+        use Function::*;
+        Some(match self {
+            // the start values (or those set) in Instantiated, as in every later state
+            Fmi3GetFloat64 | Fmi3GetFloat32 | Fmi3GetInt8 | Fmi3GetUInt8 | Fmi3GetInt16 | Fmi3GetUInt16
+            | Fmi3GetInt32 | Fmi3GetUInt32 | Fmi3GetInt64 | Fmi3GetUInt64 | Fmi3GetBoolean | Fmi3GetString
+            | Fmi3GetBinary => READ | mask(&[Instantiated]),
+            // Clocks are active in Event Mode only
+            Fmi3GetClock | Fmi3SetClock => mask(&[EventMode]),
+            // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode)
+            Fmi3EnterEventMode | Fmi3SetTime => mask(&[ContinuousTimeMode]),
+            // also in Initialization Mode (not in FMI 2.0)
+            Fmi3GetContinuousStateDerivatives => {
+                mask(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated, Error])
+            }
+            // Initialization Mode, the Initialized super state and Terminated; not in
+            // Instantiated (FMI 2.0 allows it there)
+            Fmi3GetNominalsOfContinuousStates => {
+                mask(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated, Error])
+            }
+            // listed in Instantiated and Event Mode only
+            Fmi3GetNumberOfContinuousStates | Fmi3GetNumberOfEventIndicators => mask(&[Instantiated, EventMode]),
+            _ => return None,
+        })
     }
 
     /// Whether the standard allows the call in `machine`.
@@ -481,19 +520,26 @@ mod tests {
         assert!(Function::FMI3.iter().all(|f| f.generation() == Generation::Fmi3));
     }
 
-    /// An FMI 3.0 function with an FMI 2.0 counterpart has its row; the scopes are those of
-    /// `fmi-sys` except the Event Mode calls, which only our Model Exchange has.
+    /// An FMI 3.0 function with an FMI 2.0 counterpart has its row unless FMI 3.0 lists it
+    /// elsewhere; the scopes are those of `fmi-sys` except the Event Mode calls, which only
+    /// our Model Exchange has.
     #[test]
     fn fmi3_rows_are_their_fmi2_counterparts() {
         use Function::*;
         for f in Function::FMI3 {
-            if let Some(g) = f.counterpart() {
+            if let (Some(g), None) = (f.counterpart(), f.fmi3_row()) {
                 assert_eq!(g.generation(), Generation::Fmi2, "{f:?}");
                 for m in Machine::ALL {
                     assert_eq!(f.allowed_in(m), g.allowed_in(m), "{f:?} in {m:?}");
                 }
             }
         }
+        // the rows FMI 3.0 changes
+        assert!(Fmi3GetFloat64.allowed_in(Instantiated) && !GetReal.allowed_in(Instantiated));
+        assert!(!Fmi3SetTime.allowed_in(EventMode) && SetTime.allowed_in(EventMode));
+        assert!(!Fmi3EnterEventMode.allowed_in(EventMode) && EnterEventMode.allowed_in(EventMode));
+        assert!(Fmi3GetContinuousStateDerivatives.allowed_in(InitializationMode));
+        assert!(!Fmi3GetNominalsOfContinuousStates.allowed_in(Instantiated));
         assert!(Fmi3DoStep.allowed_in(StepComplete) && !Fmi3DoStep.allowed_in(StepFailed));
         assert!(!Fmi3ExitInitializationMode.allowed_in(Instantiated));
         assert!(

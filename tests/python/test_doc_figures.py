@@ -419,3 +419,12 @@ def test_stiff_work_precision_errors(tmp_path):
             else:
                 assert "code -1)" in cv_err, cv_err  # CV_TOO_MUCH_WORK: mxstep steps before an output
                 check("README.md", row + " mxstep | {*} |", relative_error(x, ref))
+# --- the AddressSanitizer step of scripts/test.sh -------------------------------------------
+
+def test_readme_prints_the_random_sequences_the_asan_step_runs():
+    """README.md's "first 3,000 and 1,500 sequences" are the NIGEL_RANDOM_SEQUENCES and
+    NIGEL_RANDOM_SEQUENCES3 of scripts/test.sh's ASan step."""
+    script = (REPO / "scripts" / "test.sh").read_text()
+    fmi2 = int(re.search(r"NIGEL_RANDOM_SEQUENCES=(\d+)", script).group(1))
+    fmi3 = int(re.search(r"NIGEL_RANDOM_SEQUENCES3=(\d+)", script).group(1))
+    check("README.md", "first {} and {} sequences per FMU and interface", fmi2, fmi3)

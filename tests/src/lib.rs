@@ -75,7 +75,20 @@ pub struct Fmu {
     pub functions: Functions,
     /// The `fmi3*` functions of the same library.
     pub functions3: fmi_sys::fmi3::Fmi3Functions,
-    _library: libloading::Library,
+    library: std::mem::ManuallyDrop<libloading::Library>,
+    /// A library of [`LIBRARIES_VARIABLE`] stays loaded after the drop: the tables it
+    /// builds on first use live in its data segment, which `dlclose` would unmap, and
+    /// LeakSanitizer would then report them as leaks.
+    keep_loaded: bool,
+}
+
+impl Drop for Fmu {
+    fn drop(&mut self) {
+        if !self.keep_loaded {
+            // SAFETY: dropped once, here; the function tables are not used after this
+            unsafe { std::mem::ManuallyDrop::drop(&mut self.library) }
+        }
+    }
 }
 
 /// The workspace's `target/` (honours `CARGO_TARGET_DIR`).
@@ -83,6 +96,20 @@ pub fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap_or(Path::new(".")).join("target"))
+}
+
+/// The environment variable naming a folder of cargo-built libraries (`lib<id>.so`) that
+/// replace the archives' linux64 ones, e.g. the AddressSanitizer build of scripts/test.sh.
+pub const LIBRARIES_VARIABLE: &str = "NIGEL_FMU_LIBRARIES";
+
+/// `lib<id>.so` in `folder` (cargo's name of the cdylib an archive's `<id>.so` is a copy of).
+fn instrumented_library(folder: &Path, id: &str) -> Result<PathBuf, String> {
+    let so = folder.join(format!("lib{id}.so"));
+    if so.is_file() {
+        Ok(so)
+    } else {
+        Err(format!("{LIBRARIES_VARIABLE} = {}: {} not found", folder.display(), so.display()))
+    }
 }
 
 /// Path of a built FMU (`target/fmu/<id>.fmu`), or a message saying how to build it.
@@ -119,9 +146,13 @@ impl Fmu {
             .map(|c| c.model_identifier.clone())
             .or_else(|| description.model_exchange.as_ref().map(|m| m.model_identifier.clone()))
             .ok_or("no interface")?;
-        let so = dir.join("binaries").join("linux64").join(format!("{id}.so"));
+        let keep_loaded = std::env::var_os(LIBRARIES_VARIABLE).is_some();
+        let so = match std::env::var_os(LIBRARIES_VARIABLE) {
+            Some(folder) => instrumented_library(Path::new(&folder), &id)?,
+            None => dir.join("binaries").join("linux64").join(format!("{id}.so")),
+        };
         let library = unsafe { libloading::Library::new(&so) }.map_err(|e| format!("{}: {e}", so.display()))?;
-        // SAFETY: an FMI 2.0 library; the table lives no longer than `_library`.
+        // SAFETY: an FMI 2.0 library; the table lives no longer than `library`.
         let functions = unsafe { Functions::load(&library) }.map_err(|e| e.0.to_string())?;
         if let Some(missing) = SYMBOLS.iter().find(|s| !functions.has(s)) {
             return Err(format!("{}: the library does not export {missing}", so.display()));
@@ -131,7 +162,7 @@ impl Fmu {
         if let Some(missing) = functions3.missing().first() {
             return Err(format!("{}: the library does not export {missing}", so.display()));
         }
-        Ok(Fmu { dir, description, functions, functions3, _library: library })
+        Ok(Fmu { dir, description, functions, functions3, library: std::mem::ManuallyDrop::new(library), keep_loaded })
     }
 
     pub fn guid(&self) -> &str {

@@ -23,41 +23,7 @@
  * integer, so it does not drift; each step is t_(n+1) - t_n. Rows are written with 17 significant digits (%.17g),
  * which round-trip every double.
  */
-#define __USE_MINGW_ANSI_STDIO 1 /* C99 printf in mingw: %.17g round-trips */
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
-#ifdef _WIN32
-#include <windows.h>
-typedef HMODULE library_t;
-static library_t library_open(const char *path) { return LoadLibraryA(path); }
-static void *library_symbol(library_t l, const char *name) { return (void *)GetProcAddress(l, name); }
-#else
-#include <dlfcn.h>
-typedef void *library_t;
-static library_t library_open(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
-static void *library_symbol(library_t l, const char *name) { return dlsym(l, name); }
-#endif
-
-/* The FMI 2.0 C types this program uses (fmi2TypesPlatform.h, fmi2FunctionTypes.h). */
-typedef void *fmi2Component;
-typedef void *fmi2ComponentEnvironment;
-typedef double fmi2Real;
-typedef int fmi2Integer;
-typedef int fmi2Boolean;
-typedef unsigned int fmi2ValueReference;
-typedef const char *fmi2String;
-typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
-typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
-typedef struct {
-    void (*logger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
-    void *(*allocateMemory)(size_t, size_t);
-    void (*freeMemory)(void *);
-    void (*stepFinished)(fmi2ComponentEnvironment, fmi2Status);
-    fmi2ComponentEnvironment componentEnvironment;
-} fmi2CallbackFunctions;
+#include "importer.h"
 
 typedef fmi2Component (*Instantiate)(fmi2String, fmi2Type, fmi2String, fmi2String, const fmi2CallbackFunctions *,
                                      fmi2Boolean, fmi2Boolean);
@@ -96,17 +62,6 @@ static Connection connections[MAX_ITEMS];
 static int n_connections;
 static Recorded recorded[MAX_ITEMS];
 static int n_recorded;
-
-static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
-                   fmi2String message, ...) {
-    va_list args;
-    (void)env;
-    fprintf(stderr, "[%s] %s status %d: ", name ? name : "?", category ? category : "", (int)status);
-    va_start(args, message);
-    vfprintf(stderr, message ? message : "", args);
-    va_end(args);
-    fputc('\n', stderr);
-}
 
 static void fail(const char *what, const char *detail) {
     fprintf(stderr, "fmi2_closed_loop: %s%s%s\n", what, detail ? ": " : "", detail ? detail : "");
@@ -152,7 +107,7 @@ static void load(Instance *inst, const char *path) {
     inst->do_step = (DoStep)symbol(l, "fmi2DoStep", path);
 }
 
-static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+static const fmi2CallbackFunctions callbacks = {logger2, calloc, free, NULL, NULL};
 
 static void propagate(void) {
     for (int k = 0; k < n_connections; k++) {

@@ -29,25 +29,9 @@
  * lastSuccessfulTime = t + h. An instance that asks to terminate ends the run after the
  * row of that step (the CSV is then shorter, and the test says so).
  */
-#define __USE_MINGW_ANSI_STDIO 1 /* C99 printf in mingw: %.17g round-trips */
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
+#include "importer.h"
 
 #include "fmi3FunctionTypes.h"
-
-#ifdef _WIN32
-#include <windows.h>
-typedef HMODULE library_t;
-static library_t library_open(const char *path) { return LoadLibraryA(path); }
-static void *library_symbol(library_t l, const char *name) { return (void *)GetProcAddress(l, name); }
-#else
-#include <dlfcn.h>
-typedef void *library_t;
-static library_t library_open(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
-static void *library_symbol(library_t l, const char *name) { return dlsym(l, name); }
-#endif
 
 #define MAX_INSTANCES 8
 #define MAX_ITEMS 4096

@@ -143,7 +143,9 @@ pub(crate) unsafe fn with<M: Model>(
     };
     let function_name = function.name();
     if status == Fmi2Status::Discard {
-        if function.counterpart().unwrap_or(function) == Function::DoStep {
+        // FMI 2.0's stepFailed; FMI 3.0 has no such state: after a Discard of fmi3DoStep
+        // the FMU stays in Step Mode (the importer may retry with other arguments)
+        if function == Function::DoStep {
             component.instance.core.machine = Machine::StepFailed;
         }
         component.log(Fmi2Status::Discard, LogCategory::Warning, &format!("{function_name}: {message}"));
