@@ -191,6 +191,26 @@ fn metric_index(spec: &Spec, name: &str) -> Result<usize, Error> {
     })
 }
 
+/// Draws the mesh of a report chart: axis descriptions `$x_desc` and `$y_desc`, ticks as
+/// [`tick`] writes them, light grey grid lines; a drawing error returns from the function
+/// as `$err` makes it (a macro: the charts' coordinate types differ).
+macro_rules! draw_mesh {
+    ($chart:expr, $x_desc:expr, $y_desc:expr, $err:expr) => {
+        $chart
+            .configure_mesh()
+            .x_desc($x_desc)
+            .y_desc($y_desc)
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 16))
+            .x_label_formatter(&|v: &f64| tick(*v))
+            .y_label_formatter(&|v: &f64| tick(*v))
+            .light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(200, 200, 200))
+            .draw()
+            .map_err(|e| $err(&e))?
+    };
+}
+
 impl Report {
     /// Reads `dir/results.csv` of `spec` and groups it by the columns `by`.
     pub fn load(spec: Spec, dir: &Path, by: &[String]) -> Result<Report, Error> {
@@ -419,18 +439,7 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                chart
-                    .configure_mesh()
-                    .x_desc(name.as_str())
-                    .y_desc("fraction of runs <= value")
-                    .label_style(("sans-serif", 15))
-                    .axis_desc_style(("sans-serif", 16))
-                    .x_label_formatter(&|v: &f64| tick(*v))
-                    .y_label_formatter(&|v: &f64| tick(*v))
-                    .light_line_style(RGBColor(235, 235, 235))
-                    .bold_line_style(RGBColor(200, 200, 200))
-                    .draw()
-                    .map_err(|e| err(&e))?;
+                draw_mesh!(chart, name.as_str(), "fraction of runs <= value", err);
                 for (i, (_, v)) in series.iter().enumerate() {
                     let n = v.len() as f64;
                     let pts: Vec<(f64, f64)> = v.iter().enumerate().map(|(k, x)| (*x, (k + 1) as f64 / n)).collect();
@@ -489,18 +498,7 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                chart
-                    .configure_mesh()
-                    .x_desc(self.spec.columns[column].name.as_str())
-                    .y_desc(name.as_str())
-                    .label_style(("sans-serif", 15))
-                    .axis_desc_style(("sans-serif", 16))
-                    .x_label_formatter(&|v: &f64| tick(*v))
-                    .y_label_formatter(&|v: &f64| tick(*v))
-                    .light_line_style(RGBColor(235, 235, 235))
-                    .bold_line_style(RGBColor(200, 200, 200))
-                    .draw()
-                    .map_err(|e| err(&e))?;
+                draw_mesh!(chart, self.spec.columns[column].name.as_str(), name.as_str(), err);
                 for (i, (_, pts)) in series.iter().enumerate() {
                     chart
                         .draw_series(pts.iter().map(|p| {

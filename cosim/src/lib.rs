@@ -32,6 +32,7 @@
 pub mod bdf;
 pub(crate) use fmi_import::suggest;
 pub use fmi_import::{error, fmi3, fmu, unpack};
+pub mod defaults;
 pub mod exit_guard;
 pub mod mat;
 pub mod me;

@@ -429,6 +429,30 @@ impl Ctx<'_> {
     pub(crate) fn opt_string(n: &Node, key: &str) -> Option<String> {
         n.get(key).map(str::to_string)
     }
+
+    /// A whitespace-separated list of `u32` (`dependencies`, `clocks`), `None` when absent.
+    pub(crate) fn u32_list(&self, n: &Node, label: &str, key: &str) -> Result<Option<Vec<u32>>, ReadError> {
+        n.get(key)
+            .map(|s| {
+                s.split_ascii_whitespace()
+                    .map(|tok| tok.parse::<u32>().map_err(|_| self.bad_number(n, label, key, tok)))
+                    .collect::<Result<Vec<u32>, ReadError>>()
+            })
+            .transpose()
+    }
+
+    /// `dependenciesKind`: a whitespace-separated list of [`DependencyKind`]s, `None` when absent.
+    pub(crate) fn dependency_kinds(&self, n: &Node, label: &str) -> Result<Option<Vec<DependencyKind>>, ReadError> {
+        n.get("dependenciesKind")
+            .map(|s| {
+                s.split_ascii_whitespace()
+                    .map(|tok| {
+                        DependencyKind::parse(tok).ok_or_else(|| self.bad_enum(n, label, "dependenciesKind", tok))
+                    })
+                    .collect::<Result<Vec<DependencyKind>, ReadError>>()
+            })
+            .transpose()
+    }
 }
 
 /// Parses an `xs:double` (surrounding whitespace allowed; `INF`, `+INF`, `-INF`, `NaN`,
@@ -460,6 +484,99 @@ pub(crate) fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> R
     Ok(())
 }
 
+/// The struct literal `$md { $fields }` with the optional attributes of
+/// `<fmiModelDescription>` that FMI 2.0 and 3.0 share read from the root `$root` (a macro:
+/// the two generations' descriptions are different types with these fields).
+macro_rules! with_document_attributes {
+    ($md:ident, $root:expr, { $($fields:tt)* }) => {
+        $md {
+            description: Ctx::opt_string($root, "description"),
+            author: Ctx::opt_string($root, "author"),
+            version: Ctx::opt_string($root, "version"),
+            copyright: Ctx::opt_string($root, "copyright"),
+            license: Ctx::opt_string($root, "license"),
+            generation_tool: Ctx::opt_string($root, "generationTool"),
+            generation_date_and_time: Ctx::opt_string($root, "generationDateAndTime"),
+            variable_naming_convention: Ctx::opt_string($root, "variableNamingConvention"),
+            $($fields)*
+        }
+    };
+}
+pub(crate) use with_document_attributes;
+
+/// Refuses a document whose root is not `<fmiModelDescription>`.
+pub(crate) fn check_root(ctx: &Ctx, root: &Node) -> Result<(), ReadError> {
+    if root.name != "fmiModelDescription" {
+        return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(root) });
+    }
+    Ok(())
+}
+
+/// A `<Unit>` of `<UnitDefinitions>` with its optional `<BaseUnit>` (at most one;
+/// exponents default to 0, `factor` to 1, `offset` to 0), the same in FMI 2.0 and 3.0.
+pub(crate) fn read_unit(ctx: &Ctx, u: &Node) -> Result<Unit, ReadError> {
+    let name = ctx.req(u, "Unit", "name")?.to_string();
+    let ul = format!("Unit \"{name}\"");
+    let mut base_node = None;
+    for b in u.children.iter().filter(|c| c.name == "BaseUnit") {
+        once(ctx, &mut base_node, b)?;
+    }
+    let base_unit = base_node
+        .map(|b| -> Result<BaseUnit, ReadError> {
+            let bl = format!("BaseUnit of {ul}");
+            let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
+            Ok(BaseUnit {
+                kg: e("kg")?,
+                m: e("m")?,
+                s: e("s")?,
+                a: e("A")?,
+                k: e("K")?,
+                mol: e("mol")?,
+                cd: e("cd")?,
+                rad: e("rad")?,
+                factor: ctx.opt_f64(b, &bl, "factor")?.unwrap_or(1.0),
+                offset: ctx.opt_f64(b, &bl, "offset")?.unwrap_or(0.0),
+            })
+        })
+        .transpose()?;
+    Ok(Unit { name, base_unit })
+}
+
+/// The `<Unit>`s of `<UnitDefinitions>` (none when the element is absent).
+pub(crate) fn read_units(ctx: &Ctx, units: Option<&Node>) -> Result<Vec<Unit>, ReadError> {
+    let Some(units) = units else { return Ok(Vec::new()) };
+    units.children.iter().filter(|c| c.name == "Unit").map(|u| read_unit(ctx, u)).collect()
+}
+
+/// The `<Category>`s of `<LogCategories>` (none when the element is absent).
+pub(crate) fn read_log_categories(ctx: &Ctx, logs: Option<&Node>) -> Result<Vec<LogCategory>, ReadError> {
+    let Some(logs) = logs else { return Ok(Vec::new()) };
+    logs.children
+        .iter()
+        .filter(|c| c.name == "Category")
+        .map(|c| -> Result<LogCategory, ReadError> {
+            Ok(LogCategory {
+                name: ctx.req(c, "Category", "name")?.to_string(),
+                description: Ctx::opt_string(c, "description"),
+            })
+        })
+        .collect()
+}
+
+/// `<DefaultExperiment>`, if present.
+pub(crate) fn read_default_experiment(ctx: &Ctx, exp: Option<&Node>) -> Result<Option<DefaultExperiment>, ReadError> {
+    exp.map(|n| -> Result<DefaultExperiment, ReadError> {
+        let l = "DefaultExperiment";
+        Ok(DefaultExperiment {
+            start_time: ctx.opt_f64(n, l, "startTime")?,
+            stop_time: ctx.opt_f64(n, l, "stopTime")?,
+            tolerance: ctx.opt_f64(n, l, "tolerance")?,
+            step_size: ctx.opt_f64(n, l, "stepSize")?,
+        })
+    })
+    .transpose()
+}
+
 impl ModelDescription {
     /// Reads a `modelDescription.xml`. See [`ReadError`] for what is refused; unknown
     /// elements and attributes are skipped. `<Enumeration>` variables are read as
@@ -468,9 +585,7 @@ impl ModelDescription {
     pub fn from_xml(xml: &str) -> Result<ModelDescription, ReadError> {
         let root = parse_tree(xml)?;
         let ctx = Ctx { src: xml };
-        if root.name != "fmiModelDescription" {
-            return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(&root) });
-        }
+        check_root(&ctx, &root)?;
         let label = "fmiModelDescription";
         let fmi_version = ctx.req(&root, label, "fmiVersion")?;
         if fmi_version.trim() != "2.0" {
@@ -545,36 +660,7 @@ impl ModelDescription {
             })
             .transpose()?;
 
-        let mut unit_definitions = Vec::new();
-        if let Some(units) = units_node {
-            for u in units.children.iter().filter(|c| c.name == "Unit") {
-                let name = ctx.req(u, "Unit", "name")?.to_string();
-                let ul = format!("Unit \"{name}\"");
-                let mut base_node = None;
-                for b in u.children.iter().filter(|c| c.name == "BaseUnit") {
-                    once(&ctx, &mut base_node, b)?;
-                }
-                let base_unit = base_node
-                    .map(|b| -> Result<BaseUnit, ReadError> {
-                        let bl = format!("BaseUnit of {ul}");
-                        let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
-                        Ok(BaseUnit {
-                            kg: e("kg")?,
-                            m: e("m")?,
-                            s: e("s")?,
-                            a: e("A")?,
-                            k: e("K")?,
-                            mol: e("mol")?,
-                            cd: e("cd")?,
-                            rad: e("rad")?,
-                            factor: ctx.opt_f64(b, &bl, "factor")?.unwrap_or(1.0),
-                            offset: ctx.opt_f64(b, &bl, "offset")?.unwrap_or(0.0),
-                        })
-                    })
-                    .transpose()?;
-                unit_definitions.push(Unit { name, base_unit });
-            }
-        }
+        let unit_definitions = read_units(&ctx, units_node)?;
 
         // declaredType defaults (raw strings, parsed in the variable's context).
         let mut type_defaults: HashMap<String, TypeDefaults> = HashMap::new();
@@ -619,27 +705,8 @@ impl ModelDescription {
             }
         }
 
-        let mut log_categories = Vec::new();
-        if let Some(logs) = logs_node {
-            for c in logs.children.iter().filter(|c| c.name == "Category") {
-                log_categories.push(LogCategory {
-                    name: ctx.req(c, "Category", "name")?.to_string(),
-                    description: Ctx::opt_string(c, "description"),
-                });
-            }
-        }
-
-        let default_experiment = exp_node
-            .map(|n| -> Result<DefaultExperiment, ReadError> {
-                let l = "DefaultExperiment";
-                Ok(DefaultExperiment {
-                    start_time: ctx.opt_f64(n, l, "startTime")?,
-                    stop_time: ctx.opt_f64(n, l, "stopTime")?,
-                    tolerance: ctx.opt_f64(n, l, "tolerance")?,
-                    step_size: ctx.opt_f64(n, l, "stepSize")?,
-                })
-            })
-            .transpose()?;
+        let log_categories = read_log_categories(&ctx, logs_node)?;
+        let default_experiment = read_default_experiment(&ctx, exp_node)?;
 
         let mut model_variables = Vec::new();
         if let Some(vars) = vars_node {
@@ -668,18 +735,10 @@ impl ModelDescription {
             model_structure.initial_unknowns = read_list(inits)?;
         }
 
-        Ok(ModelDescription {
+        Ok(with_document_attributes!(ModelDescription, &root, {
             fmi_version: fmi_version.to_string(),
             model_name,
             guid,
-            description: Ctx::opt_string(&root, "description"),
-            author: Ctx::opt_string(&root, "author"),
-            version: Ctx::opt_string(&root, "version"),
-            copyright: Ctx::opt_string(&root, "copyright"),
-            license: Ctx::opt_string(&root, "license"),
-            generation_tool: Ctx::opt_string(&root, "generationTool"),
-            generation_date_and_time: Ctx::opt_string(&root, "generationDateAndTime"),
-            variable_naming_convention: Ctx::opt_string(&root, "variableNamingConvention"),
             number_of_event_indicators,
             model_exchange,
             co_simulation,
@@ -689,7 +748,7 @@ impl ModelDescription {
             default_experiment,
             model_variables,
             model_structure,
-        })
+        }))
     }
 }
 
@@ -763,22 +822,8 @@ fn read_variable(
 fn read_unknown(ctx: &Ctx, u: &Node, list: &str) -> Result<Unknown, ReadError> {
     let l = format!("Unknown of {list}");
     let index = ctx.req_u32(u, &l, "index")?;
-    let dependencies = u
-        .get("dependencies")
-        .map(|s| {
-            s.split_ascii_whitespace()
-                .map(|tok| tok.parse::<u32>().map_err(|_| ctx.bad_number(u, &l, "dependencies", tok)))
-                .collect::<Result<Vec<u32>, ReadError>>()
-        })
-        .transpose()?;
-    let dependencies_kind = u
-        .get("dependenciesKind")
-        .map(|s| {
-            s.split_ascii_whitespace()
-                .map(|tok| DependencyKind::parse(tok).ok_or_else(|| ctx.bad_enum(u, &l, "dependenciesKind", tok)))
-                .collect::<Result<Vec<DependencyKind>, ReadError>>()
-        })
-        .transpose()?;
+    let dependencies = ctx.u32_list(u, &l, "dependencies")?;
+    let dependencies_kind = ctx.dependency_kinds(u, &l)?;
     Ok(Unknown { index, dependencies, dependencies_kind })
 }
 

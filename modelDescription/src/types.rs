@@ -6,6 +6,30 @@
 
 use serde::{Deserialize, Serialize};
 
+/// `ALL` (the values, in the order given), `as_str` (the XML spelling) and `parse` (its
+/// inverse, exact and case-sensitive) of an enum of XML attribute values.
+macro_rules! xml_spellings {
+    ($t:ident, $all_doc:literal, $example:literal, { $($variant:ident => $spelling:literal),+ $(,)? }) => {
+        impl $t {
+            #[doc = $all_doc]
+            pub const ALL: [$t; [$($spelling),+].len()] = [$($t::$variant),+];
+
+            #[doc = concat!("The XML spelling, e.g. `\"", $example, "\"`.")]
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $($t::$variant => $spelling),+
+                }
+            }
+
+            /// Parses the XML spelling (exact, case-sensitive).
+            pub fn parse(s: &str) -> Option<$t> {
+                $t::ALL.into_iter().find(|x| x.as_str() == s)
+            }
+        }
+    };
+}
+pub(crate) use xml_spellings;
+
 /// `causality` of a ScalarVariable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase")]
@@ -350,80 +374,30 @@ pub struct ModelDescription {
     pub model_structure: ModelStructure,
 }
 
-impl Causality {
-    /// All values, in the order of the standard's table columns.
-    pub const ALL: [Causality; 6] = [
-        Causality::Parameter,
-        Causality::CalculatedParameter,
-        Causality::Input,
-        Causality::Output,
-        Causality::Local,
-        Causality::Independent,
-    ];
+xml_spellings!(Causality, "All values, in the order of the standard's table columns.", "calculatedParameter", {
+    Parameter => "parameter",
+    CalculatedParameter => "calculatedParameter",
+    Input => "input",
+    Output => "output",
+    Local => "local",
+    Independent => "independent",
+});
 
-    /// The XML spelling, e.g. `"calculatedParameter"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Causality::Parameter => "parameter",
-            Causality::CalculatedParameter => "calculatedParameter",
-            Causality::Input => "input",
-            Causality::Output => "output",
-            Causality::Local => "local",
-            Causality::Independent => "independent",
-        }
-    }
+xml_spellings!(Variability, "All values, in the order of the standard's table rows.", "tunable", {
+    Constant => "constant",
+    Fixed => "fixed",
+    Tunable => "tunable",
+    Discrete => "discrete",
+    Continuous => "continuous",
+});
 
-    /// Parses the XML spelling (exact, case-sensitive).
-    pub fn parse(s: &str) -> Option<Causality> {
-        Causality::ALL.into_iter().find(|c| c.as_str() == s)
-    }
-}
-
-impl Variability {
-    /// All values, in the order of the standard's table rows.
-    pub const ALL: [Variability; 5] = [
-        Variability::Constant,
-        Variability::Fixed,
-        Variability::Tunable,
-        Variability::Discrete,
-        Variability::Continuous,
-    ];
-
-    /// The XML spelling, e.g. `"tunable"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Variability::Constant => "constant",
-            Variability::Fixed => "fixed",
-            Variability::Tunable => "tunable",
-            Variability::Discrete => "discrete",
-            Variability::Continuous => "continuous",
-        }
-    }
-
-    /// Parses the XML spelling (exact, case-sensitive).
-    pub fn parse(s: &str) -> Option<Variability> {
-        Variability::ALL.into_iter().find(|v| v.as_str() == s)
-    }
-}
+xml_spellings!(Initial, "All values.", "approx", {
+    Exact => "exact",
+    Approx => "approx",
+    Calculated => "calculated",
+});
 
 impl Initial {
-    /// All values.
-    pub const ALL: [Initial; 3] = [Initial::Exact, Initial::Approx, Initial::Calculated];
-
-    /// The XML spelling, e.g. `"approx"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Initial::Exact => "exact",
-            Initial::Approx => "approx",
-            Initial::Calculated => "calculated",
-        }
-    }
-
-    /// Parses the XML spelling (exact, case-sensitive).
-    pub fn parse(s: &str) -> Option<Initial> {
-        Initial::ALL.into_iter().find(|i| i.as_str() == s)
-    }
-
     /// The `initial` values the standard (FMI 2.0, section 2.2.7) allows for a
     /// (causality, variability) pair, default first. Empty when the attribute must be
     /// absent: inputs, the independent variable, and illegal combinations.
@@ -468,32 +442,13 @@ pub fn legal_combination(causality: Causality, variability: Variability) -> bool
     )
 }
 
-impl DependencyKind {
-    /// All values.
-    pub const ALL: [DependencyKind; 5] = [
-        DependencyKind::Dependent,
-        DependencyKind::Constant,
-        DependencyKind::Fixed,
-        DependencyKind::Tunable,
-        DependencyKind::Discrete,
-    ];
-
-    /// The XML spelling, e.g. `"dependent"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            DependencyKind::Dependent => "dependent",
-            DependencyKind::Constant => "constant",
-            DependencyKind::Fixed => "fixed",
-            DependencyKind::Tunable => "tunable",
-            DependencyKind::Discrete => "discrete",
-        }
-    }
-
-    /// Parses the XML spelling (exact, case-sensitive).
-    pub fn parse(s: &str) -> Option<DependencyKind> {
-        DependencyKind::ALL.into_iter().find(|k| k.as_str() == s)
-    }
-}
+xml_spellings!(DependencyKind, "All values.", "dependent", {
+    Dependent => "dependent",
+    Constant => "constant",
+    Fixed => "fixed",
+    Tunable => "tunable",
+    Discrete => "discrete",
+});
 
 impl VariableType {
     /// The base type: `"Real"`, `"Integer"`, `"Boolean"` or `"String"` (an Enumeration is an

@@ -101,18 +101,19 @@ impl fmt::Display for Rule {
     }
 }
 
-/// One violation found by [`ModelDescription::validate`].
+/// One violation found by [`ModelDescription::validate`] (`R` = [`Rule`]) or by
+/// [`crate::fmi3::ModelDescription::validate`] (`R` = [`crate::fmi3::Rule`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Problem {
+pub struct Problem<R = Rule> {
     /// The rule broken.
-    pub rule: Rule,
+    pub rule: R,
     /// The variable concerned, if any.
     pub variable: Option<String>,
     /// What is wrong, in words.
     pub message: String,
 }
 
-impl fmt::Display for Problem {
+impl<R: fmt::Display> fmt::Display for Problem<R> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.variable {
             Some(v) => write!(f, "[{}] variable \"{}\": {}", self.rule, v, self.message),
@@ -129,6 +130,45 @@ pub fn is_c_identifier(s: &str) -> bool {
         _ => return false,
     }
     chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// For each interface element whose `modelIdentifier` is not a C identifier, what is wrong
+/// (`(element, modelIdentifier)` of the interfaces present).
+pub(crate) fn model_identifier_messages<'a>(interfaces: impl IntoIterator<Item = (&'a str, &'a str)>) -> Vec<String> {
+    interfaces
+        .into_iter()
+        .filter(|(_, id)| !is_c_identifier(id))
+        .map(|(element, id)| format!("<{element}> modelIdentifier \"{id}\" is not a C identifier"))
+        .collect()
+}
+
+/// For each unit defined again, what is wrong.
+pub(crate) fn duplicate_unit_messages(units: &[Unit]) -> Vec<String> {
+    let mut seen = HashSet::new();
+    units
+        .iter()
+        .filter(|u| !seen.insert(u.name.as_str()))
+        .map(|u| format!("unit \"{}\" is defined more than once", u.name))
+        .collect()
+}
+
+/// What is wrong with the items `(name, value)` of the enumeration type `name`: none at
+/// all, or an item whose name or value another has.
+pub(crate) fn enumeration_messages<'a, V: Copy + Eq + std::hash::Hash + fmt::Display>(
+    name: &str,
+    items: impl ExactSizeIterator<Item = (&'a str, V)>,
+) -> Vec<String> {
+    let mut messages = Vec::new();
+    if items.len() == 0 {
+        messages.push(format!("enumeration \"{name}\" has no items"));
+    }
+    let (mut names, mut values) = (HashSet::new(), HashSet::new());
+    for (item, value) in items {
+        if !names.insert(item) || !values.insert(value) {
+            messages.push(format!("enumeration \"{name}\": item {item} = {value} is not unique"));
+        }
+    }
+    messages
 }
 
 struct Checker<'a> {
@@ -173,44 +213,22 @@ impl ModelDescription {
             c.push(Rule::NoInterface, None, "neither <ModelExchange> nor <CoSimulation> is present".into());
         }
         let ids = [
-            ("ModelExchange", self.model_exchange.as_ref().map(|m| &m.model_identifier)),
-            ("CoSimulation", self.co_simulation.as_ref().map(|m| &m.model_identifier)),
+            self.model_exchange.as_ref().map(|m| ("ModelExchange", m.model_identifier.as_str())),
+            self.co_simulation.as_ref().map(|m| ("CoSimulation", m.model_identifier.as_str())),
         ];
-        for (elem, id) in ids {
-            if let Some(id) = id {
-                if !is_c_identifier(id) {
-                    c.push(
-                        Rule::ModelIdentifier,
-                        None,
-                        format!("<{elem}> modelIdentifier \"{id}\" is not a C identifier"),
-                    );
-                }
-            }
+        for message in model_identifier_messages(ids.into_iter().flatten()) {
+            c.push(Rule::ModelIdentifier, None, message);
         }
-        let mut seen = HashSet::new();
-        for u in &self.unit_definitions {
-            if !seen.insert(u.name.as_str()) {
-                c.push(Rule::DuplicateUnit, None, format!("unit \"{}\" is defined more than once", u.name));
-            }
+        for message in duplicate_unit_messages(&self.unit_definitions) {
+            c.push(Rule::DuplicateUnit, None, message);
         }
         let mut type_names = HashSet::new();
         for t in &self.type_definitions {
             if !type_names.insert(t.name.as_str()) {
                 c.push(Rule::DeclaredType, None, format!("type \"{}\" is defined more than once", t.name));
             }
-            if t.items.is_empty() {
-                c.push(Rule::DeclaredType, None, format!("enumeration \"{}\" has no items", t.name));
-            }
-            let mut item_names = HashSet::new();
-            let mut values = HashSet::new();
-            for item in &t.items {
-                if !item_names.insert(item.name.as_str()) || !values.insert(item.value) {
-                    c.push(
-                        Rule::DeclaredType,
-                        None,
-                        format!("enumeration \"{}\": item {} = {} is not unique", t.name, item.name, item.value),
-                    );
-                }
+            for message in enumeration_messages(&t.name, t.items.iter().map(|i| (i.name.as_str(), i.value))) {
+                c.push(Rule::DeclaredType, None, message);
             }
         }
     }

@@ -89,6 +89,21 @@ impl Elem {
         }
         self
     }
+    /// `dependencies` and `dependenciesKind` of a ModelStructure entry, each when present.
+    pub(crate) fn dependencies(
+        &mut self,
+        dependencies: &Option<Vec<u32>>,
+        kinds: &Option<Vec<DependencyKind>>,
+    ) -> &mut Self {
+        if let Some(d) = dependencies {
+            self.attr("dependencies", &join_u32(d));
+        }
+        if let Some(k) = kinds {
+            let s = k.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(" ");
+            self.attr("dependenciesKind", &s);
+        }
+        self
+    }
 }
 
 pub(crate) struct Out {
@@ -96,6 +111,20 @@ pub(crate) struct Out {
 }
 
 impl Out {
+    /// A document: two-space indentation, after the `<?xml version="1.0" encoding="UTF-8"?>`
+    /// declaration.
+    pub(crate) fn document() -> Out {
+        let mut o = Out { w: Writer::new_with_indent(Vec::new(), b' ', 2) };
+        o.ev(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)));
+        o
+    }
+    /// The text written, closed by a newline.
+    pub(crate) fn finish(self) -> String {
+        let mut bytes = self.w.into_inner();
+        bytes.push(b'\n');
+        // Everything written came from &str and ASCII markup: valid UTF-8.
+        String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+    }
     pub(crate) fn ev(&mut self, e: Event<'_>) {
         // Writing into a Vec<u8> cannot fail.
         let _ = self.w.write_event(e);
@@ -117,15 +146,103 @@ pub(crate) fn join_u32(v: &[u32]) -> String {
 
 fn unknown_elem(u: &Unknown) -> Elem {
     let mut e = Elem::new("Unknown");
-    e.attr("index", &u.index.to_string());
-    if let Some(d) = &u.dependencies {
-        e.attr("dependencies", &join_u32(d));
-    }
-    if let Some(k) = &u.dependencies_kind {
-        let s = k.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(" ");
-        e.attr("dependenciesKind", &s);
-    }
+    e.attr("index", &u.index.to_string()).dependencies(&u.dependencies, &u.dependencies_kind);
     e
+}
+
+/// The optional attributes of `<fmiModelDescription>` FMI 2.0 and 3.0 share, in the order
+/// of both schemas, from the fields of the same names (a macro: the two generations'
+/// descriptions are different types).
+macro_rules! document_attributes {
+    ($root:expr, $md:expr) => {
+        $root
+            .opt_str("description", &$md.description)
+            .opt_str("author", &$md.author)
+            .opt_str("version", &$md.version)
+            .opt_str("copyright", &$md.copyright)
+            .opt_str("license", &$md.license)
+            .opt_str("generationTool", &$md.generation_tool)
+            .opt_str("generationDateAndTime", &$md.generation_date_and_time)
+            .opt_str("variableNamingConvention", &$md.variable_naming_convention)
+    };
+}
+pub(crate) use document_attributes;
+
+/// `<UnitDefinitions>` (omitted when there are no units): each `<Unit>` with its
+/// `<BaseUnit>`, exponents written when non-zero, `factor` when not 1, `offset` when not 0.
+pub(crate) fn write_units(o: &mut Out, units: &[Unit]) {
+    if units.is_empty() {
+        return;
+    }
+    o.open(Elem::new("UnitDefinitions"));
+    for u in units {
+        let mut e = Elem::new("Unit");
+        e.attr("name", &u.name);
+        match &u.base_unit {
+            None => o.empty(e),
+            Some(b) => {
+                o.open(e);
+                let mut be = Elem::new("BaseUnit");
+                for (k, v) in [
+                    ("kg", b.kg),
+                    ("m", b.m),
+                    ("s", b.s),
+                    ("A", b.a),
+                    ("K", b.k),
+                    ("mol", b.mol),
+                    ("cd", b.cd),
+                    ("rad", b.rad),
+                ] {
+                    if v != 0 {
+                        be.attr(k, &v.to_string());
+                    }
+                }
+                // `!=` keeps NaN visible (NaN != 1).
+                if b.factor != 1.0 {
+                    be.attr("factor", &format_f64(b.factor));
+                }
+                if b.offset != 0.0 {
+                    be.attr("offset", &format_f64(b.offset));
+                }
+                o.empty(be);
+                o.close("Unit");
+            }
+        }
+    }
+    o.close("UnitDefinitions");
+}
+
+/// An `<Item>` of an enumeration type.
+pub(crate) fn item_elem(name: &str, value: impl std::fmt::Display, description: &Option<String>) -> Elem {
+    let mut e = Elem::new("Item");
+    e.attr("name", name).attr("value", &value.to_string()).opt_str("description", description);
+    e
+}
+
+/// `<LogCategories>` (omitted when there are none) and `<DefaultExperiment>` (when present),
+/// which follow each other in both generations' schemas.
+pub(crate) fn write_log_categories_and_experiment(
+    o: &mut Out,
+    log_categories: &[LogCategory],
+    default_experiment: Option<&DefaultExperiment>,
+) {
+    if !log_categories.is_empty() {
+        o.open(Elem::new("LogCategories"));
+        for c in log_categories {
+            let mut e = Elem::new("Category");
+            e.attr("name", &c.name).opt_str("description", &c.description);
+            o.empty(e);
+        }
+        o.close("LogCategories");
+    }
+    if let Some(d) = default_experiment {
+        let mut e = Elem::new("DefaultExperiment");
+        e.opt_f64("startTime", d.start_time)
+            .opt_f64("stopTime", d.stop_time)
+            .opt_f64("tolerance", d.tolerance)
+            .opt_f64("stepSize", d.step_size);
+        o.empty(e);
+    }
 }
 
 impl ModelDescription {
@@ -136,22 +253,11 @@ impl ModelDescription {
     /// round-trip through [`ModelDescription::from_xml`] (except U+0000, which XML
     /// cannot carry).
     pub fn to_xml(&self) -> String {
-        let mut o = Out { w: Writer::new_with_indent(Vec::new(), b' ', 2) };
-        o.ev(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)));
+        let mut o = Out::document();
 
         let mut root = Elem::new("fmiModelDescription");
-        root.attr("fmiVersion", &self.fmi_version)
-            .attr("modelName", &self.model_name)
-            .attr("guid", &self.guid)
-            .opt_str("description", &self.description)
-            .opt_str("author", &self.author)
-            .opt_str("version", &self.version)
-            .opt_str("copyright", &self.copyright)
-            .opt_str("license", &self.license)
-            .opt_str("generationTool", &self.generation_tool)
-            .opt_str("generationDateAndTime", &self.generation_date_and_time)
-            .opt_str("variableNamingConvention", &self.variable_naming_convention)
-            .attr("numberOfEventIndicators", &self.number_of_event_indicators.to_string());
+        root.attr("fmiVersion", &self.fmi_version).attr("modelName", &self.model_name).attr("guid", &self.guid);
+        document_attributes!(root, self).attr("numberOfEventIndicators", &self.number_of_event_indicators.to_string());
         o.open(root);
 
         if let Some(me) = &self.model_exchange {
@@ -184,44 +290,7 @@ impl ModelDescription {
             o.empty(e);
         }
 
-        if !self.unit_definitions.is_empty() {
-            o.open(Elem::new("UnitDefinitions"));
-            for u in &self.unit_definitions {
-                let mut e = Elem::new("Unit");
-                e.attr("name", &u.name);
-                match &u.base_unit {
-                    None => o.empty(e),
-                    Some(b) => {
-                        o.open(e);
-                        let mut be = Elem::new("BaseUnit");
-                        for (k, v) in [
-                            ("kg", b.kg),
-                            ("m", b.m),
-                            ("s", b.s),
-                            ("A", b.a),
-                            ("K", b.k),
-                            ("mol", b.mol),
-                            ("cd", b.cd),
-                            ("rad", b.rad),
-                        ] {
-                            if v != 0 {
-                                be.attr(k, &v.to_string());
-                            }
-                        }
-                        // `!=` keeps NaN visible (NaN != 1).
-                        if b.factor != 1.0 {
-                            be.attr("factor", &format_f64(b.factor));
-                        }
-                        if b.offset != 0.0 {
-                            be.attr("offset", &format_f64(b.offset));
-                        }
-                        o.empty(be);
-                        o.close("Unit");
-                    }
-                }
-            }
-            o.close("UnitDefinitions");
-        }
+        write_units(&mut o, &self.unit_definitions);
 
         if !self.type_definitions.is_empty() {
             o.open(Elem::new("TypeDefinitions"));
@@ -231,11 +300,7 @@ impl ModelDescription {
                 o.open(e);
                 o.open(Elem::new("Enumeration"));
                 for item in &t.items {
-                    let mut ie = Elem::new("Item");
-                    ie.attr("name", &item.name)
-                        .attr("value", &item.value.to_string())
-                        .opt_str("description", &item.description);
-                    o.empty(ie);
+                    o.empty(item_elem(&item.name, item.value, &item.description));
                 }
                 o.close("Enumeration");
                 o.close("SimpleType");
@@ -243,24 +308,7 @@ impl ModelDescription {
             o.close("TypeDefinitions");
         }
 
-        if !self.log_categories.is_empty() {
-            o.open(Elem::new("LogCategories"));
-            for c in &self.log_categories {
-                let mut e = Elem::new("Category");
-                e.attr("name", &c.name).opt_str("description", &c.description);
-                o.empty(e);
-            }
-            o.close("LogCategories");
-        }
-
-        if let Some(d) = &self.default_experiment {
-            let mut e = Elem::new("DefaultExperiment");
-            e.opt_f64("startTime", d.start_time)
-                .opt_f64("stopTime", d.stop_time)
-                .opt_f64("tolerance", d.tolerance)
-                .opt_f64("stepSize", d.step_size);
-            o.empty(e);
-        }
+        write_log_categories_and_experiment(&mut o, &self.log_categories, self.default_experiment.as_ref());
 
         if self.model_variables.is_empty() {
             o.empty(Elem::new("ModelVariables"));
@@ -339,9 +387,6 @@ impl ModelDescription {
         }
 
         o.close("fmiModelDescription");
-        let mut bytes = o.w.into_inner();
-        bytes.push(b'\n');
-        // Everything written came from &str and ASCII markup: valid UTF-8.
-        String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+        o.finish()
     }
 }

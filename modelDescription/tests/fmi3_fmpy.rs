@@ -3,21 +3,13 @@
 //! types, start values and dimensions. Runs when `$FMPY_PYTHON` (default `python3`) can
 //! import fmpy; when `$FMPY_PYTHON` is set, fmpy missing is a failure, not a skip.
 
+mod common;
+
+use common::{fmpy_available, fmpy_output};
 use model_description::fmi3::*;
-use std::process::Command;
 
-fn python() -> String {
-    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
-}
-
+/// Run after [`common::FMPY_PRELUDE`] (`md` is fmpy's reading of the document).
 const SCRIPT: &str = r#"
-import sys
-from fmpy import read_model_description
-from fmpy.validation import validate_fmu
-d = sys.argv[1]
-for p in validate_fmu(d):
-    print("PROBLEM", p.replace("\n", " "))
-md = read_model_description(d, validate=False)
 for v in md.modelVariables:
     dims = ",".join(str(x.start) if x.start is not None else "vr" + str(x.valueReference) for x in v.dimensions)
     print("VAR", v.name, v.valueReference, v.type, v.causality, v.variability, dims or "-", sep="\t")
@@ -25,10 +17,7 @@ for v in md.modelVariables:
 
 #[test]
 fn fmpy_accepts_and_reads_the_fmi3_documents() {
-    let available = Command::new(python()).args(["-c", "import fmpy"]).output().is_ok_and(|o| o.status.success());
-    if !available {
-        assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
-        eprintln!("fmpy not importable with {}: cross-check skipped", python());
+    if !fmpy_available() {
         return;
     }
     let base = std::env::temp_dir().join(format!("md3-fmpy-{}", std::process::id()));
@@ -37,14 +26,7 @@ fn fmpy_accepts_and_reads_the_fmi3_documents() {
     {
         let md = ModelDescription::from_xml(xml).unwrap();
         assert_eq!(md.validate(), vec![], "{name}");
-        let dir = base.join(name);
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("modelDescription.xml"), xml).unwrap();
-        let out = Command::new(python()).args(["-c", SCRIPT]).arg(&dir).output().unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(out.status.success(), "{name}: {}\n{stdout}", String::from_utf8_lossy(&out.stderr));
-        let problems: Vec<&str> = stdout.lines().filter(|l| l.starts_with("PROBLEM")).collect();
-        assert!(problems.is_empty(), "{name}: fmpy problems:\n{}", problems.join("\n"));
+        let stdout = fmpy_output(name, &base.join(name), xml, SCRIPT);
         let vars: Vec<Vec<&str>> =
             stdout.lines().filter_map(|l| l.strip_prefix("VAR\t")).map(|l| l.split('\t').collect()).collect();
         assert_eq!(vars.len(), md.model_variables.len(), "{name}");

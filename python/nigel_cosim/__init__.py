@@ -59,23 +59,9 @@ _DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Bo
 _SOLVERS = {None: "bdf", "CVode": "bdf", "bdf": "bdf", "dopri5": "dopri5", "rk4": "rk4", "Euler": None}
 
 
-def _auto_interval(t: float) -> float:
-    """fmpy's output interval for a run of length ``t``: 500 to 1000 points (fmpy.util)."""
-    h = 10 ** (np.round(np.log10(t)) - 3)
-    n = t / h
-    if n >= 2500:
-        h *= 5
-    elif n >= 2000:
-        h *= 4
-    elif n >= 1000:
-        h *= 2
-    elif n <= 200:
-        h /= 5
-    elif n <= 250:
-        h /= 4
-    elif n <= 500:
-        h /= 2
-    return float(h)
+def _float(value: Any) -> float | None:
+    """A time or tolerance as fmpy takes it (a number or its text), None left as it is."""
+    return None if value is None else float(value)
 
 
 def _text(value: Any) -> str:
@@ -269,11 +255,9 @@ class System:
 
     def _args(self, start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output, solver,
               relative_tolerance, timeout, threads):
-        d_start, d_stop, d_step, d_tol = self._native.default_experiment
-        start = float(start_time) if start_time is not None else (d_start if d_start is not None else 0.0)
-        stop = float(stop_time) if stop_time is not None else (d_stop if d_stop is not None else start + 1.0)
-        step = float(step_size) if step_size is not None else (d_step if d_step is not None else 1e-3)
-        tolerance = relative_tolerance if relative_tolerance is not None else d_tol
+        # the master's defaults (nigel_cosim::defaults::RunTimes::master)
+        start, stop, step, tolerance = self._native.run_times(_float(start_time), _float(stop_time), _float(step_size),
+                                                              relative_tolerance)
         self._output_interval = output_interval
         return self._arguments(start, stop, step, output_interval, algorithm, start_values, input, output, solver,
                                tolerance, timeout, threads)
@@ -340,26 +324,11 @@ def simulate_fmu(
     """
     with System(filename, fmi_type) as system:
         interface = fmi_type or system.interfaces[0]
-        d = system.default_experiment
-        start = float(start_time) if start_time is not None else (d["start_time"] if d["start_time"] is not None else 0.0)
-        stop = float(stop_time) if stop_time is not None else (d["stop_time"] if d["stop_time"] is not None else start + 1.0)
-        tolerance = relative_tolerance if relative_tolerance is not None else d["tolerance"]
-        total = stop - start
-        # fmpy.simulate_fmu's defaults, in its order
-        if step_size is None and total > 0:
-            step_size = float(10 ** (np.round(np.log10(total)) - 3))
-        if output_interval is None and interface == "CoSimulation" and d["step_size"] is not None:
-            output_interval = float(d["step_size"])
-            while total / output_interval > 1000:
-                output_interval *= 2
-        if output_interval is None:
-            if interface == "CoSimulation" or step_size is None:
-                output_interval = _auto_interval(total) if total > 0 else 1e-3
-            else:
-                output_interval = float(step_size)
-                while total / output_interval > 1000:
-                    output_interval *= 2
-        args = system._arguments(start, stop, float(output_interval), None, "jacobi", start_values, input, output,
+        # fmpy.simulate_fmu's defaults (nigel_cosim::defaults::RunTimes::fmpy)
+        start, stop, output_interval, tolerance = system._native.fmpy_times(
+            interface == "CoSimulation", _float(start_time), _float(stop_time), _float(step_size),
+            _float(output_interval), relative_tolerance)
+        args = system._arguments(start, stop, output_interval, None, "jacobi", start_values, input, output,
                                  solver, tolerance, timeout, 1)
         return system._simulate(args)
 

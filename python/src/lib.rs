@@ -15,6 +15,8 @@ use nigel_cosim::{
     Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, SetQueue,
     Solver, Summary, System, SystemBuilder,
 };
+use model_description::DefaultExperiment;
+use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
@@ -102,6 +104,11 @@ fn is_ssp(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
 }
 
+/// (start, stop, step, relative tolerance) as the Python half takes them.
+fn times_tuple(t: RunTimes) -> (f64, f64, f64, Option<f64>) {
+    (t.start_time, t.stop_time, t.step, t.relative_tolerance)
+}
+
 fn interface_name(i: Interface) -> &'static str {
     match i {
         Interface::CoSimulation => "CoSimulation",
@@ -133,6 +140,24 @@ impl NativeSystem {
             Some(instance) => format!("{instance}.{name}"),
             None => name.to_string(),
         }
+    }
+
+    fn experiment_defaults(&self) -> DefaultExperiment {
+        let (start_time, stop_time, step_size, tolerance) = self.default_experiment;
+        DefaultExperiment { start_time, stop_time, step_size, tolerance }
+    }
+
+    /// The system of a run (a copy of this one with `args.start_values` set) and its experiment.
+    fn run_setup(&self, args: &RunArgs) -> PyResult<(System, Experiment)> {
+        let system = {
+            let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
+            guard.clone().ok_or_else(|| Error::new_err("the system is closed"))?
+        };
+        let mut builder = SystemBuilder::from_system(system);
+        for (name, value) in &args.start_values {
+            builder.set_text(&self.qualify(name), value).map_err(to_py)?;
+        }
+        Ok((builder.build(), self.experiment(args).map_err(to_py)?))
     }
 
     fn experiment(&self, args: &RunArgs) -> Result<Experiment, CosimError> {
@@ -282,6 +307,37 @@ impl NativeSystem {
         self.default_experiment
     }
 
+    /// (start, stop, communication step, relative tolerance) of a run of the master: the
+    /// arguments given (None: left out), the rest from the DefaultExperiment
+    /// (`nigel_cosim::defaults::RunTimes::master`).
+    #[pyo3(signature = (start_time, stop_time, step_size, relative_tolerance))]
+    fn run_times(
+        &self,
+        start_time: Option<f64>,
+        stop_time: Option<f64>,
+        step_size: Option<f64>,
+        relative_tolerance: Option<f64>,
+    ) -> (f64, f64, f64, Option<f64>) {
+        let given = GivenTimes { start_time, stop_time, step_size, output_interval: None, relative_tolerance };
+        times_tuple(RunTimes::master(&self.experiment_defaults(), &given))
+    }
+
+    /// The same as fmpy's `simulate_fmu` fills it in, the communication step being fmpy's
+    /// output interval (`nigel_cosim::defaults::RunTimes::fmpy`).
+    #[pyo3(signature = (co_simulation, start_time, stop_time, step_size, output_interval, relative_tolerance))]
+    fn fmpy_times(
+        &self,
+        co_simulation: bool,
+        start_time: Option<f64>,
+        stop_time: Option<f64>,
+        step_size: Option<f64>,
+        output_interval: Option<f64>,
+        relative_tolerance: Option<f64>,
+    ) -> (f64, f64, f64, Option<f64>) {
+        let given = GivenTimes { start_time, stop_time, step_size, output_interval, relative_tolerance };
+        times_tuple(RunTimes::fmpy(&self.experiment_defaults(), co_simulation, &given))
+    }
+
     /// The interfaces a single FMU is run with (`CoSimulation` first), empty for an SSP.
     #[getter]
     fn interfaces(&self) -> Vec<&'static str> {
@@ -326,16 +382,7 @@ impl NativeSystem {
         py: Python<'py>,
         args: RunArgs,
     ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String)> {
-        let system = {
-            let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
-            guard.clone().ok_or_else(|| Error::new_err("the system is closed"))?
-        };
-        let mut builder = SystemBuilder::from_system(system);
-        for (name, value) in &args.start_values {
-            builder.set_text(&self.qualify(name), value).map_err(to_py)?;
-        }
-        let system = builder.build();
-        let mut experiment = self.experiment(&args).map_err(to_py)?;
+        let (system, mut experiment) = self.run_setup(&args)?;
         let cancel = Arc::new(AtomicBool::new(false));
         experiment.cancel = Some(cancel.clone());
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
@@ -353,16 +400,7 @@ impl NativeSystem {
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused
     /// at the start time. The recorded variables are `args.output` or every output.
     fn start(&self, py: Python<'_>, args: RunArgs) -> PyResult<NativeRun> {
-        let system = {
-            let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
-            guard.clone().ok_or_else(|| Error::new_err("the system is closed"))?
-        };
-        let mut builder = SystemBuilder::from_system(system);
-        for (name, value) in &args.start_values {
-            builder.set_text(&self.qualify(name), value).map_err(to_py)?;
-        }
-        let system = builder.build();
-        let mut experiment = self.experiment(&args).map_err(to_py)?;
+        let (system, mut experiment) = self.run_setup(&args)?;
         let record: Vec<String> = match &experiment.record {
             Some(names) => names.clone(),
             None => default_record(&system).iter().map(|r| system.name_of(r)).collect(),

@@ -1,6 +1,7 @@
 //! `cosim`: run an FMU or a system of FMUs, or list what is in one.
 
 use clap::{Parser, Subcommand};
+use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder, UnpackLimits};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -71,7 +72,7 @@ struct RunArgs {
     /// Start time, s (negative times are times like any other).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     start_time: f64,
-    /// Stop time, s (default: the FMU's DefaultExperiment, else 1).
+    /// Stop time, s (default: the FMU's DefaultExperiment, else the start time + 1).
     #[arg(long, allow_negative_numbers = true)]
     stop_time: Option<f64>,
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
@@ -229,17 +230,19 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let host_of_run = nigel_cosim::isolate::whole::is_host();
     let isolated = args.isolate.is_some() && !host_of_run;
     let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated };
-    let (mut builder, default_stop, default_step, single, _ssp) = if is_ssp(&args.model) {
+    let (mut builder, default, single, _ssp) = if is_ssp(&args.model) {
         // --interface applies to every FMU of the system (one without it is refused by name)
         let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
         let builder = SystemBuilder::from_system(ssp.system.clone());
-        (builder, ssp.default_start_stop.1, None, None, Some(ssp))
+        let (start_time, stop_time) = ssp.default_start_stop;
+        let default = model_description::DefaultExperiment { start_time, stop_time, ..Default::default() };
+        (builder, default, None, Some(ssp))
     } else {
         let fmu = Fmu::load_with(&args.model, &options)?;
         let default = fmu.description().default_experiment.clone().unwrap_or_default();
         let mut builder = SystemBuilder::new();
         builder.add_instance(SINGLE, fmu.clone())?;
-        (builder, default.stop_time, default.step_size, Some(fmu), None)
+        (builder, default, Some(fmu), None)
     };
     let single = single.as_deref();
     if let Some(path) = &args.gains {
@@ -253,9 +256,16 @@ fn run(args: RunArgs) -> Result<(), Error> {
         builder.set_text(&qualify(name.trim(), single), value)?;
     }
     let system: System = builder.build();
-    let mut experiment =
-        Experiment::new(args.stop_time.or(default_stop).unwrap_or(1.0), args.step.or(default_step).unwrap_or(1e-3));
-    experiment.start_time = args.start_time;
+    // the start time is --start-time's (default 0), not the DefaultExperiment's
+    let given = GivenTimes {
+        start_time: Some(args.start_time),
+        stop_time: args.stop_time,
+        step_size: args.step,
+        ..Default::default()
+    };
+    let times = RunTimes::master(&default, &given);
+    let mut experiment = Experiment::new(times.stop_time, times.step);
+    experiment.start_time = times.start_time;
     check_times(&experiment)?;
     if !host_of_run {
         for warning in sample_period_warnings(&system, experiment.step) {
@@ -615,6 +625,20 @@ fn plain(x: f64) -> String {
     }
 }
 
+/// `cosim info`'s line of the DefaultExperiment attributes present (`None` if none is).
+fn default_experiment_line(d: &model_description::DefaultExperiment) -> Option<String> {
+    let parts: Vec<String> = [
+        d.start_time.map(|v| format!("start {} s", plain(v))),
+        d.stop_time.map(|v| format!("stop {} s", plain(v))),
+        d.step_size.map(|v| format!("step {} s", plain(v))),
+        d.tolerance.map(|v| format!("tolerance {}", plain(v))),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    (!parts.is_empty()).then(|| format!("default experiment: {}", parts.join(", ")))
+}
+
 fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     if is_ssp(path) {
         return info_ssp(path, limits);
@@ -644,19 +668,8 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     let me = md.model_exchange.as_ref().map(|c| format!("ModelExchange ({})", c.model_identifier));
     w!(out, "interfaces: {}", [cs, me].into_iter().flatten().collect::<Vec<_>>().join(", "));
     w!(out, "continuous states: {}, event indicators: {}", md.states().len(), md.number_of_event_indicators);
-    if let Some(d) = &md.default_experiment {
-        let parts: Vec<String> = [
-            d.start_time.map(|v| format!("start {} s", plain(v))),
-            d.stop_time.map(|v| format!("stop {} s", plain(v))),
-            d.step_size.map(|v| format!("step {} s", plain(v))),
-            d.tolerance.map(|v| format!("tolerance {}", plain(v))),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        if !parts.is_empty() {
-            w!(out, "default experiment: {}", parts.join(", "));
-        }
+    if let Some(line) = md.default_experiment.as_ref().and_then(default_experiment_line) {
+        w!(out, "{line}");
     }
     w!(
         out,
@@ -767,19 +780,8 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
         md.model_structure.continuous_state_derivatives.len(),
         md.model_structure.event_indicators.len()
     );
-    if let Some(d) = &md.default_experiment {
-        let parts: Vec<String> = [
-            d.start_time.map(|v| format!("start {} s", plain(v))),
-            d.stop_time.map(|v| format!("stop {} s", plain(v))),
-            d.step_size.map(|v| format!("step {} s", plain(v))),
-            d.tolerance.map(|v| format!("tolerance {}", plain(v))),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        if !parts.is_empty() {
-            w!(out, "default experiment: {}", parts.join(", "));
-        }
+    if let Some(line) = md.default_experiment.as_ref().and_then(default_experiment_line) {
+        w!(out, "{line}");
     }
     w!(
         out,

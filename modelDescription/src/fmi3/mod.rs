@@ -39,36 +39,17 @@ pub enum Causality {
     Independent,
 }
 
+crate::types::xml_spellings!(Causality, "All values.", "structuralParameter", {
+    Parameter => "parameter",
+    CalculatedParameter => "calculatedParameter",
+    StructuralParameter => "structuralParameter",
+    Input => "input",
+    Output => "output",
+    Local => "local",
+    Independent => "independent",
+});
+
 impl Causality {
-    /// All values.
-    pub const ALL: [Causality; 7] = [
-        Causality::Parameter,
-        Causality::CalculatedParameter,
-        Causality::StructuralParameter,
-        Causality::Input,
-        Causality::Output,
-        Causality::Local,
-        Causality::Independent,
-    ];
-
-    /// The XML spelling, e.g. `"structuralParameter"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Causality::Parameter => "parameter",
-            Causality::CalculatedParameter => "calculatedParameter",
-            Causality::StructuralParameter => "structuralParameter",
-            Causality::Input => "input",
-            Causality::Output => "output",
-            Causality::Local => "local",
-            Causality::Independent => "independent",
-        }
-    }
-
-    /// Parses the XML spelling (exact, case-sensitive).
-    pub fn parse(s: &str) -> Option<Causality> {
-        Causality::ALL.into_iter().find(|c| c.as_str() == s)
-    }
-
     /// The FMI 2.0 causality of the same name (`None` for `structuralParameter`).
     pub fn to_fmi2(self) -> Option<crate::Causality> {
         Some(match self {

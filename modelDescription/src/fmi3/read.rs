@@ -10,8 +10,11 @@
 //! bounds and nominal are not copied onto the variable (see [`ModelDescription::unit_of`]).
 //! Never panics.
 
-use crate::read::{once, parse_tree, Ctx, Node, ReadError};
-use crate::{BaseUnit, DefaultExperiment, DependencyKind, Initial, LogCategory, Unit, Variability};
+use crate::read::{
+    check_root, once, parse_tree, read_default_experiment, read_log_categories, read_units, with_document_attributes,
+    Ctx, Node, ReadError,
+};
+use crate::{Initial, Variability};
 
 use super::*;
 
@@ -93,16 +96,6 @@ impl Ctx<'_> {
         } else {
             Bound::Int(self.int_of(n, label, key, text, value_type)?)
         }))
-    }
-
-    fn u32_list(&self, n: &Node, label: &str, key: &str) -> Result<Option<Vec<u32>>, ReadError> {
-        n.get(key)
-            .map(|s| {
-                s.split_ascii_whitespace()
-                    .map(|tok| tok.parse::<u32>().map_err(|_| self.bad_number(n, label, key, tok)))
-                    .collect::<Result<Vec<u32>, ReadError>>()
-            })
-            .transpose()
     }
 }
 
@@ -288,14 +281,7 @@ fn read_unknown(ctx: &Ctx, u: &Node) -> Result<Unknown, ReadError> {
     let l = u.name.as_str();
     let value_reference = ctx.req_u32(u, l, "valueReference")?;
     let dependencies = ctx.u32_list(u, l, "dependencies")?;
-    let dependencies_kind = u
-        .get("dependenciesKind")
-        .map(|s| {
-            s.split_ascii_whitespace()
-                .map(|tok| DependencyKind::parse(tok).ok_or_else(|| ctx.bad_enum(u, l, "dependenciesKind", tok)))
-                .collect::<Result<Vec<DependencyKind>, ReadError>>()
-        })
-        .transpose()?;
+    let dependencies_kind = ctx.dependency_kinds(u, l)?;
     Ok(Unknown { value_reference, dependencies, dependencies_kind })
 }
 
@@ -313,34 +299,6 @@ fn read_common(ctx: &Ctx, n: &Node) -> Result<InterfaceCommon, ReadError> {
     })
 }
 
-fn read_unit(ctx: &Ctx, u: &Node) -> Result<Unit, ReadError> {
-    let name = ctx.req(u, "Unit", "name")?.to_string();
-    let ul = format!("Unit \"{name}\"");
-    let mut base_node = None;
-    for b in u.children.iter().filter(|c| c.name == "BaseUnit") {
-        once(ctx, &mut base_node, b)?;
-    }
-    let base_unit = base_node
-        .map(|b| -> Result<BaseUnit, ReadError> {
-            let bl = format!("BaseUnit of {ul}");
-            let e = |k: &str| -> Result<i32, ReadError> { Ok(ctx.opt_i32(b, &bl, k)?.unwrap_or(0)) };
-            Ok(BaseUnit {
-                kg: e("kg")?,
-                m: e("m")?,
-                s: e("s")?,
-                a: e("A")?,
-                k: e("K")?,
-                mol: e("mol")?,
-                cd: e("cd")?,
-                rad: e("rad")?,
-                factor: ctx.opt_f64(b, &bl, "factor")?.unwrap_or(1.0),
-                offset: ctx.opt_f64(b, &bl, "offset")?.unwrap_or(0.0),
-            })
-        })
-        .transpose()?;
-    Ok(Unit { name, base_unit })
-}
-
 impl ModelDescription {
     /// Reads an FMI 3.0 `modelDescription.xml`. See [`ReadError`] for what is refused
     /// (an FMI 2.0 document is [`ReadError::UnsupportedFmiVersion`]; pick the reader with
@@ -348,9 +306,7 @@ impl ModelDescription {
     pub fn from_xml(xml: &str) -> Result<ModelDescription, ReadError> {
         let root = parse_tree(xml)?;
         let ctx = Ctx { src: xml };
-        if root.name != "fmiModelDescription" {
-            return Err(ReadError::NotAModelDescription { found: Some(root.name.clone()), position: ctx.pos(&root) });
-        }
+        check_root(&ctx, &root)?;
         let label = "fmiModelDescription";
         let fmi_version = ctx.req(&root, label, "fmiVersion")?.trim();
         if !is_fmi3_version(fmi_version) {
@@ -420,12 +376,7 @@ impl ModelDescription {
         let scheduled_execution =
             se.map(|n| read_common(&ctx, n).map(|common| ScheduledExecution { common })).transpose()?;
 
-        let unit_definitions = match units {
-            Some(u) => {
-                u.children.iter().filter(|c| c.name == "Unit").map(|c| read_unit(&ctx, c)).collect::<Result<_, _>>()?
-            }
-            None => Vec::new(),
-        };
+        let unit_definitions = read_units(&ctx, units)?;
         let type_definitions = match types {
             Some(t) => t
                 .children
@@ -435,31 +386,8 @@ impl ModelDescription {
                 .collect::<Result<_, _>>()?,
             None => Vec::new(),
         };
-        let log_categories = match logs {
-            Some(l) => l
-                .children
-                .iter()
-                .filter(|c| c.name == "Category")
-                .map(|c| -> Result<LogCategory, ReadError> {
-                    Ok(LogCategory {
-                        name: ctx.req(c, "Category", "name")?.to_string(),
-                        description: Ctx::opt_string(c, "description"),
-                    })
-                })
-                .collect::<Result<_, _>>()?,
-            None => Vec::new(),
-        };
-        let default_experiment = exp
-            .map(|n| -> Result<DefaultExperiment, ReadError> {
-                let l = "DefaultExperiment";
-                Ok(DefaultExperiment {
-                    start_time: ctx.opt_f64(n, l, "startTime")?,
-                    stop_time: ctx.opt_f64(n, l, "stopTime")?,
-                    tolerance: ctx.opt_f64(n, l, "tolerance")?,
-                    step_size: ctx.opt_f64(n, l, "stepSize")?,
-                })
-            })
-            .transpose()?;
+        let log_categories = read_log_categories(&ctx, logs)?;
+        let default_experiment = read_default_experiment(&ctx, exp)?;
 
         let mut model_variables = Vec::new();
         for c in vars.map_or(&[][..], |n| &n.children[..]) {
@@ -495,18 +423,10 @@ impl ModelDescription {
             list.push(read_unknown(&ctx, c)?);
         }
 
-        Ok(ModelDescription {
+        Ok(with_document_attributes!(ModelDescription, &root, {
             fmi_version: fmi_version.to_string(),
             model_name,
             instantiation_token,
-            description: Ctx::opt_string(&root, "description"),
-            author: Ctx::opt_string(&root, "author"),
-            version: Ctx::opt_string(&root, "version"),
-            copyright: Ctx::opt_string(&root, "copyright"),
-            license: Ctx::opt_string(&root, "license"),
-            generation_tool: Ctx::opt_string(&root, "generationTool"),
-            generation_date_and_time: Ctx::opt_string(&root, "generationDateAndTime"),
-            variable_naming_convention: Ctx::opt_string(&root, "variableNamingConvention"),
             model_exchange,
             co_simulation,
             scheduled_execution,
@@ -516,7 +436,7 @@ impl ModelDescription {
             default_experiment,
             model_variables,
             model_structure,
-        })
+        }))
     }
 
     /// The unit of a Float variable: its own `unit`, else its `declaredType`'s.

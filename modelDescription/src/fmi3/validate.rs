@@ -5,7 +5,7 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use super::*;
-use crate::is_c_identifier;
+use crate::validate::{duplicate_unit_messages, enumeration_messages, model_identifier_messages};
 
 /// The rule a [`Problem`] breaks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -114,24 +114,7 @@ impl fmt::Display for Rule {
 }
 
 /// One violation found by [`ModelDescription::validate`].
-#[derive(Clone, Debug, PartialEq)]
-pub struct Problem {
-    /// The rule broken.
-    pub rule: Rule,
-    /// The variable concerned, if any.
-    pub variable: Option<String>,
-    /// What is wrong, in words.
-    pub message: String,
-}
-
-impl fmt::Display for Problem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.variable {
-            Some(v) => write!(f, "[{}] variable \"{}\": {}", self.rule, v, self.message),
-            None => write!(f, "[{}] {}", self.rule, self.message),
-        }
-    }
-}
+pub type Problem = crate::validate::Problem<Rule>;
 
 /// The FMI 2.0 table of section 2.2.7 is FMI 3.0's too; a structural parameter is a
 /// parameter there.
@@ -184,41 +167,22 @@ impl ModelDescription {
         if interfaces.iter().all(|(_, i)| i.is_none()) {
             push(Rule::NoInterface, None, "no <ModelExchange>, <CoSimulation> or <ScheduledExecution>".into());
         }
-        for (element, common) in interfaces {
-            if let Some(common) = common {
-                if !is_c_identifier(&common.model_identifier) {
-                    push(
-                        Rule::ModelIdentifier,
-                        None,
-                        format!("<{element}> modelIdentifier \"{}\" is not a C identifier", common.model_identifier),
-                    );
-                }
-            }
+        let ids = interfaces.iter().filter_map(|(element, i)| i.map(|i| (*element, i.model_identifier.as_str())));
+        for message in model_identifier_messages(ids) {
+            push(Rule::ModelIdentifier, None, message);
         }
-        let mut unit_names = HashSet::new();
-        for u in &self.unit_definitions {
-            if !unit_names.insert(u.name.as_str()) {
-                push(Rule::DuplicateUnit, None, format!("unit \"{}\" is defined more than once", u.name));
-            }
+        for message in duplicate_unit_messages(&self.unit_definitions) {
+            push(Rule::DuplicateUnit, None, message);
         }
+        let unit_names: HashSet<&str> = self.unit_definitions.iter().map(|u| u.name.as_str()).collect();
         let mut type_names = HashSet::new();
         for t in &self.type_definitions {
             if !type_names.insert(t.name.as_str()) {
                 push(Rule::DeclaredType, None, format!("type \"{}\" is defined more than once", t.name));
             }
             if let TypeKind::Enumeration { items, .. } = &t.kind {
-                if items.is_empty() {
-                    push(Rule::DeclaredType, None, format!("enumeration \"{}\" has no items", t.name));
-                }
-                let (mut names, mut values) = (HashSet::new(), HashSet::new());
-                for item in items {
-                    if !names.insert(item.name.as_str()) || !values.insert(item.value) {
-                        push(
-                            Rule::DeclaredType,
-                            None,
-                            format!("enumeration \"{}\": item {} = {} is not unique", t.name, item.name, item.value),
-                        );
-                    }
+                for message in enumeration_messages(&t.name, items.iter().map(|i| (i.name.as_str(), i.value))) {
+                    push(Rule::DeclaredType, None, message);
                 }
             }
         }

@@ -4,9 +4,9 @@
 
 use super::*;
 use crate::format_f64;
-use crate::write::{join_u32, Elem, Out};
-use quick_xml::events::{BytesDecl, Event};
-use quick_xml::Writer;
+use crate::write::{
+    document_attributes, item_elem, join_u32, write_log_categories_and_experiment, write_units, Elem, Out,
+};
 
 fn join<T>(values: &[T], f: impl Fn(&T) -> String) -> String {
     values.iter().map(f).collect::<Vec<_>>().join(" ")
@@ -46,13 +46,7 @@ fn common_attributes(e: &mut Elem, c: &InterfaceCommon) {
 
 fn unknown_elem(name: &'static str, u: &Unknown) -> Elem {
     let mut e = Elem::new(name);
-    e.attr("valueReference", &u.value_reference.to_string());
-    if let Some(d) = &u.dependencies {
-        e.attr("dependencies", &join_u32(d));
-    }
-    if let Some(k) = &u.dependencies_kind {
-        e.attr("dependenciesKind", &join(k, |k| k.as_str().to_string()));
-    }
+    e.attr("valueReference", &u.value_reference.to_string()).dependencies(&u.dependencies, &u.dependencies_kind);
     e
 }
 
@@ -115,21 +109,13 @@ impl ModelDescription {
     /// `variability` always. Equal descriptions give byte-identical output; floats parse
     /// back to the identical `f64` ([`format_f64`]).
     pub fn to_xml(&self) -> String {
-        let mut o = Out { w: Writer::new_with_indent(Vec::new(), b' ', 2) };
-        o.ev(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)));
+        let mut o = Out::document();
 
         let mut root = Elem::new("fmiModelDescription");
         root.attr("fmiVersion", &self.fmi_version)
             .attr("modelName", &self.model_name)
-            .attr("instantiationToken", &self.instantiation_token)
-            .opt_str("description", &self.description)
-            .opt_str("author", &self.author)
-            .opt_str("version", &self.version)
-            .opt_str("copyright", &self.copyright)
-            .opt_str("license", &self.license)
-            .opt_str("generationTool", &self.generation_tool)
-            .opt_str("generationDateAndTime", &self.generation_date_and_time)
-            .opt_str("variableNamingConvention", &self.variable_naming_convention);
+            .attr("instantiationToken", &self.instantiation_token);
+        document_attributes!(root, self);
         o.open(root);
 
         if let Some(me) = &self.model_exchange {
@@ -166,44 +152,7 @@ impl ModelDescription {
             o.empty(e);
         }
 
-        if !self.unit_definitions.is_empty() {
-            o.open(Elem::new("UnitDefinitions"));
-            for u in &self.unit_definitions {
-                let mut e = Elem::new("Unit");
-                e.attr("name", &u.name);
-                match &u.base_unit {
-                    None => o.empty(e),
-                    Some(b) => {
-                        o.open(e);
-                        let mut be = Elem::new("BaseUnit");
-                        for (k, v) in [
-                            ("kg", b.kg),
-                            ("m", b.m),
-                            ("s", b.s),
-                            ("A", b.a),
-                            ("K", b.k),
-                            ("mol", b.mol),
-                            ("cd", b.cd),
-                            ("rad", b.rad),
-                        ] {
-                            if v != 0 {
-                                be.attr(k, &v.to_string());
-                            }
-                        }
-                        // `!=` keeps NaN visible (NaN != 1).
-                        if b.factor != 1.0 {
-                            be.attr("factor", &format_f64(b.factor));
-                        }
-                        if b.offset != 0.0 {
-                            be.attr("offset", &format_f64(b.offset));
-                        }
-                        o.empty(be);
-                        o.close("Unit");
-                    }
-                }
-            }
-            o.close("UnitDefinitions");
-        }
+        write_units(&mut o, &self.unit_definitions);
 
         if !self.type_definitions.is_empty() {
             o.open(Elem::new("TypeDefinitions"));
@@ -246,11 +195,7 @@ impl ModelDescription {
                         e.attr("name", &t.name).opt_str("description", &t.description).opt_str("quantity", quantity);
                         o.open(e);
                         for item in items {
-                            let mut ie = Elem::new("Item");
-                            ie.attr("name", &item.name)
-                                .attr("value", &item.value.to_string())
-                                .opt_str("description", &item.description);
-                            o.empty(ie);
+                            o.empty(item_elem(&item.name, item.value, &item.description));
                         }
                         o.close("EnumerationType");
                     }
@@ -270,24 +215,7 @@ impl ModelDescription {
             o.close("TypeDefinitions");
         }
 
-        if !self.log_categories.is_empty() {
-            o.open(Elem::new("LogCategories"));
-            for c in &self.log_categories {
-                let mut e = Elem::new("Category");
-                e.attr("name", &c.name).opt_str("description", &c.description);
-                o.empty(e);
-            }
-            o.close("LogCategories");
-        }
-
-        if let Some(d) = &self.default_experiment {
-            let mut e = Elem::new("DefaultExperiment");
-            e.opt_f64("startTime", d.start_time)
-                .opt_f64("stopTime", d.stop_time)
-                .opt_f64("tolerance", d.tolerance)
-                .opt_f64("stepSize", d.step_size);
-            o.empty(e);
-        }
+        write_log_categories_and_experiment(&mut o, &self.log_categories, self.default_experiment.as_ref());
 
         if self.model_variables.is_empty() {
             o.empty(Elem::new("ModelVariables"));
@@ -344,9 +272,7 @@ impl ModelDescription {
         }
 
         o.close("fmiModelDescription");
-        let mut bytes = o.w.into_inner();
-        bytes.push(b'\n');
-        String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+        o.finish()
     }
 }
 

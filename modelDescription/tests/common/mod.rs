@@ -278,3 +278,48 @@ impl Rng {
         (self.next_u64() % n.max(1) as u64) as usize
     }
 }
+
+/// The Python of the fmpy cross-checks: `$FMPY_PYTHON`, default `python3`.
+pub fn python() -> String {
+    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
+}
+
+/// Whether [`python`] can import fmpy. When it cannot: a failure if `$FMPY_PYTHON` is set
+/// (the README's test command sets it to its venv), else a skip, said on stderr.
+pub fn fmpy_available() -> bool {
+    let available =
+        std::process::Command::new(python()).args(["-c", "import fmpy"]).output().is_ok_and(|o| o.status.success());
+    if !available {
+        assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
+        eprintln!("fmpy not importable with {}: cross-check skipped (set FMPY_PYTHON to require it)", python());
+    }
+    available
+}
+
+/// The start of the fmpy scripts of [`fmpy_output`]: a `PROBLEM` line per finding of fmpy's
+/// `validate_fmu` on the folder `sys.argv[1]`, then `md`, fmpy's reading of its
+/// `modelDescription.xml`.
+pub const FMPY_PRELUDE: &str = r#"
+import sys
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+d = sys.argv[1]
+for p in validate_fmu(d):
+    print("PROBLEM", p.replace("\n", " "))
+md = read_model_description(d, validate=False)
+"#;
+
+/// Writes `xml` to `dir/modelDescription.xml` and runs [`FMPY_PRELUDE`] and then `script`
+/// on `dir`; their standard output, once asserted that they ran and that fmpy found no
+/// problem. `name` labels the failures.
+pub fn fmpy_output(name: &str, dir: &std::path::Path, xml: &str, script: &str) -> String {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("modelDescription.xml"), xml).unwrap();
+    let script = format!("{FMPY_PRELUDE}{script}");
+    let out = std::process::Command::new(python()).args(["-c", &script]).arg(dir).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{name}: {}\n{stdout}", String::from_utf8_lossy(&out.stderr));
+    let problems: Vec<&str> = stdout.lines().filter(|l| l.starts_with("PROBLEM")).collect();
+    assert!(problems.is_empty(), "{name}: fmpy problems:\n{}", problems.join("\n"));
+    stdout
+}

@@ -23,13 +23,11 @@ Conventions (see cosim/tests/python/test_cosim_ecos_libcosim.py): libcosim's obs
 the outputs right after a step, as our master records them; ecos reads after the
 connections are applied, which changes only direct-feedthrough outputs: the pose and the
 reference pose compared here have none."""
-import json
-import subprocess
 
 import numpy as np
 import pytest
 
-from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series, target_dir
+from closed_loop_tools import POSE, ecos_series, epsilon, libcosim_series
 from doc_figures import check as doc_check, check_at_most as doc_check_at_most
 
 # the rows of README.md's SSP table and cosim/README.md's speed table that print these runs
@@ -38,29 +36,7 @@ README_ROW = {"libcosim": "| libcosim (libcosimpy 0.0.6) | {} | < 1e-12 (pose wi
 COSIM_ROW = {"libcosim": "| libcosim (libcosimpy 0.0.6), same `.ssp`, `simulate_until(30 s)` |{*}| {} | {}, {}, {} |",
              "ecos": "| ecos (ecospy 0.7.2) on the same `.ssp`, `step(30000)` |{*}| {} | {}, {}, {} |"}
 
-JOB = "sim/lane_change/robust"
 N = 30_000
-
-
-@pytest.fixture(scope="module")
-def ssp(table3):
-    p = target_dir() / "ssp" / "nigel_closed_loop.ssp"
-    subprocess.run([str(table3), "--ssp", str(p), "--ssp-job", JOB], check=True, capture_output=True)
-    return p
-
-
-@pytest.fixture(scope="module")
-def ours(table3, tmp_path_factory):
-    d = tmp_path_factory.mktemp("ours")
-    out = {}
-    for alg in ("ordered", "jacobi"):
-        subprocess.run([str(table3), "--quiet", "--algorithm", alg, "--maneuver", "lane_change",
-                        "--json", str(d / f"{alg}.json"), "--csv", str(d / alg)],
-                       check=True, capture_output=True)
-        cells = json.loads((d / f"{alg}.json").read_text())["results"]["sim"]["lane_change"]
-        rows = np.genfromtxt(d / alg / "sim_lane_change_robust.csv", delimiter=",", names=True)
-        out[alg] = (cells["robust"]["eps"], rows)
-    return out
 
 
 def check(name, series, ours):

@@ -20,8 +20,6 @@ fmpy 0.3.32's simulate_ssp (fmpy/ssp/simulation.py, read and checked here)
 - does not apply the SSD's own ParameterBindings (only a `parameter_set` argument), and
   `set_value` sets a Boolean given as the text "false" to true (`value != 0.0`): the
   bindings are passed here as a ParameterSet with typed values, and both facts are checked."""
-import json
-import subprocess
 
 import numpy as np
 import pytest
@@ -32,35 +30,12 @@ from doc_figures import check as doc_check, check_at_most as doc_check_at_most
 from fmpy.ssp.simulation import find_components, simulate_ssp
 from fmpy.ssp.ssd import get_connections, read_ssd
 
-from closed_loop_tools import bound_parameters, target_dir
-
-JOB = "sim/lane_change/robust"
+from closed_loop_tools import bound_parameters
 
 
 def epsilon(x, y, psi, x_ref, y_ref, psi_ref):
     rmse = [np.sqrt(np.mean((a - b) ** 2)) for a, b in ((x, x_ref), (y, y_ref), (psi, psi_ref))]
     return float(np.linalg.norm(rmse))
-
-
-@pytest.fixture(scope="module")
-def ours(table3, tmp_path_factory):
-    d = tmp_path_factory.mktemp("ours")
-    out = {}
-    for alg in ("ordered", "jacobi"):
-        subprocess.run([str(table3), "--quiet", "--algorithm", alg, "--maneuver", "lane_change",
-                        "--json", str(d / f"{alg}.json"), "--csv", str(d / alg)],
-                       check=True, capture_output=True)
-        cells = json.loads((d / f"{alg}.json").read_text())["results"]["sim"]["lane_change"]
-        rows = np.genfromtxt(d / alg / "sim_lane_change_robust.csv", delimiter=",", names=True)
-        out[alg] = (cells["robust"]["eps"], rows)
-    return out
-
-
-@pytest.fixture(scope="module")
-def ssp(table3):
-    p = target_dir() / "ssp" / "nigel_closed_loop.ssp"
-    subprocess.run([str(table3), "--ssp", str(p), "--ssp-job", JOB], check=True, capture_output=True)
-    return p
 
 
 @pytest.fixture(scope="module")

@@ -5,18 +5,6 @@ that lists the values; the initial speed is the plant parameter `v_x_start`."""
 import subprocess
 
 import numpy as np
-import pytest
-
-from closed_loop_tools import target_dir
-
-SSP_JOB = "sim/lane_change/robust"
-
-
-@pytest.fixture(scope="module")
-def ssp(table3):
-    p = target_dir() / "ssp" / "nigel_closed_loop.ssp"
-    subprocess.run([str(table3), "--ssp", str(p), "--ssp-job", SSP_JOB], check=True, capture_output=True)
-    return p
 
 
 def run(cosim, ssp, *sets, out=None):
