@@ -126,7 +126,7 @@ fn fmi_rs_parses_and_validates_every_model_description_without_a_problem() {
         assert!(found.is_empty(), "{id}: fmi-rs validation: {found:#?}");
 
         // fmi-rs read the same document we wrote: variables, references, structure
-        let ours = nigel_integration_tests::Fmu::load(&archive(id)).unwrap().description;
+        let ours = nigel_integration_tests::Fmu::load(&archive(id)).unwrap().description.clone();
         assert_eq!(md.guid, ours.guid, "{id}");
         let theirs: Vec<(&str, u32)> = md.modelVariables.iter().map(|v| (v.name.as_str(), v.valueReference)).collect();
         let mine: Vec<(&str, u32)> =
@@ -148,7 +148,7 @@ fn fmi_rs_parses_and_validates_every_model_description_without_a_problem() {
 #[test]
 fn fmi_rs_validation_is_live_on_our_documents() {
     // the same XML with one defect each: the validation that passed above must now fail
-    let dir = nigel_integration_tests::Fmu::load(&archive("nigel_plant")).unwrap().dir;
+    let dir = nigel_integration_tests::Fmu::load(&archive("nigel_plant")).unwrap().dir.clone();
     let xml = std::fs::read_to_string(dir.join("modelDescription.xml")).unwrap();
     assert!(problems(&RsModelDescription::from_string(&xml).unwrap()).is_empty());
     // 1. an output dropped from <Outputs> (the first <Unknown> there)
