@@ -34,6 +34,7 @@
 pub(crate) mod channel;
 pub mod host;
 pub(crate) mod proxy;
+pub(crate) mod proxy3;
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
@@ -55,7 +56,7 @@ pub fn null_round_trips(
     let spin = Spin::of_run();
     let mut channels = Vec::new();
     for _ in 0..hosts {
-        channels.push(channel::Channel::start(host, library, 16, None, None, spin).map_err(|e| e.to_string())?);
+        channels.push(channel::Channel::start(host, library, false, 16, None, None, spin).map_err(|e| e.to_string())?);
     }
     let start = Instant::now();
     for _ in 0..n {
@@ -102,7 +103,7 @@ impl Isolation {
     }
 }
 
-/// Declares the calls of the protocol once: each variant with the fmi2 function it stands for.
+/// Declares the calls of the protocol once: each variant with the function it stands for.
 /// The numbers on the wire are the variants' positions from 1 (0 is never a request).
 macro_rules! protocol_ops {
     ($first:ident => $first_function:literal, $($(#[$doc:meta])* $op:ident => $function:literal,)*) => {
@@ -121,7 +122,7 @@ macro_rules! protocol_ops {
                 Op::ALL.get((v as usize).checked_sub(1)?).copied()
             }
 
-            /// The fmi2 function it is.
+            /// The function it is.
             pub(crate) fn function(self) -> &'static str {
                 match self {
                     Op::$first => $first_function,
@@ -163,6 +164,75 @@ protocol_ops! {
     GetNominalsOfContinuousStates => "fmi2GetNominalsOfContinuousStates",
     /// Only the queued sets.
     Flush => "fmi2Set*",
+    // FMI 3.0 (a host of an FMI 3.0 library answers only these, Flush and Free)
+    Instantiate3 => "fmi3InstantiateCoSimulation",
+    EnterInitializationMode3 => "fmi3EnterInitializationMode",
+    ExitInitializationMode3 => "fmi3ExitInitializationMode",
+    Terminate3 => "fmi3Terminate",
+    Reset3 => "fmi3Reset",
+    /// A typed `fmi3Get*`: the type's code in `i[0]` ([`Fmi3Type`]), `nValues` in `i[1]`.
+    Get3 => "fmi3Get*",
+    /// A typed `fmi3Set*`, arguments as for `Get3`.
+    Set3 => "fmi3Set*",
+    GetString3 => "fmi3GetString",
+    /// `nValues` in `i[1]`; the answer: the sizes (u64) after the references, then the bytes.
+    GetBinary3 => "fmi3GetBinary",
+    SetString3 => "fmi3SetString",
+    DoStep3 => "fmi3DoStep",
+    EnterEventMode3 => "fmi3EnterEventMode",
+    UpdateDiscreteStates3 => "fmi3UpdateDiscreteStates",
+    EnterStepMode3 => "fmi3EnterStepMode",
+    GetFmuState3 => "fmi3GetFMUState",
+    SetFmuState3 => "fmi3SetFMUState",
+    FreeFmuState3 => "fmi3FreeFMUState",
+}
+
+/// The value types of `Op::Get3` / `Op::Set3` (the code on the wire) and their bytes per value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub(crate) enum Fmi3Type {
+    Float64,
+    Float32,
+    Int8,
+    UInt8,
+    Int16,
+    UInt16,
+    Int32,
+    UInt32,
+    Int64,
+    UInt64,
+    /// `fmi3Boolean`, a C `bool`: one byte.
+    Boolean,
+}
+
+impl Fmi3Type {
+    const ALL: [Fmi3Type; 11] = [
+        Fmi3Type::Float64,
+        Fmi3Type::Float32,
+        Fmi3Type::Int8,
+        Fmi3Type::UInt8,
+        Fmi3Type::Int16,
+        Fmi3Type::UInt16,
+        Fmi3Type::Int32,
+        Fmi3Type::UInt32,
+        Fmi3Type::Int64,
+        Fmi3Type::UInt64,
+        Fmi3Type::Boolean,
+    ];
+
+    pub(crate) fn from_code(code: i64) -> Option<Fmi3Type> {
+        Fmi3Type::ALL.get(usize::try_from(code).ok()?).copied()
+    }
+
+    /// Bytes per value.
+    pub(crate) fn width(self) -> usize {
+        match self {
+            Fmi3Type::Float64 | Fmi3Type::Int64 | Fmi3Type::UInt64 => 8,
+            Fmi3Type::Float32 | Fmi3Type::Int32 | Fmi3Type::UInt32 => 4,
+            Fmi3Type::Int16 | Fmi3Type::UInt16 => 2,
+            Fmi3Type::Int8 | Fmi3Type::UInt8 | Fmi3Type::Boolean => 1,
+        }
+    }
 }
 
 /// The header at the start of the shared region.
@@ -197,6 +267,8 @@ pub(crate) struct Header {
     pub(crate) prefetch: u32,
     /// The prefetch was read (1) after the last step.
     pub(crate) prefetched: u32,
+    /// 1: the library is an FMI 3.0 one (set by the master before the host starts).
+    pub(crate) fmi3: u32,
     /// Array lengths and scalar arguments of the call.
     pub(crate) n: u64,
     pub(crate) f: [f64; 4],

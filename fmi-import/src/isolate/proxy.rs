@@ -17,13 +17,13 @@ type Component = *mut c_void;
 ///
 /// # Safety
 /// `c` is the address of the live channel of the instance calling (proxy table).
-unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
+pub(super) unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
     let channel = &mut *(c as *mut Channel);
     channel.settle();
     channel
 }
 
-fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
+pub(super) fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
     let data = channel.data();
     for (k, vr) in vrs.iter().enumerate() {
         data[4 * k..4 * k + 4].copy_from_slice(&vr.to_ne_bytes());
@@ -31,11 +31,11 @@ fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
     (4 * vrs.len()).div_ceil(8) * 8
 }
 
-fn fits(channel: &mut Channel, bytes: usize) -> bool {
+pub(super) fn fits(channel: &mut Channel, bytes: usize) -> bool {
     bytes <= channel.data().len()
 }
 
-unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
+pub(super) unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
     if n == 0 || p.is_null() {
         &[]
     } else {
@@ -43,7 +43,7 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
     }
 }
 
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> &'a mut [T] {
+pub(super) unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> &'a mut [T] {
     if n == 0 || p.is_null() {
         &mut []
     } else {
@@ -100,13 +100,15 @@ unsafe extern "C" fn setup_experiment(
     channel.call(Op::SetupExperiment)
 }
 
+/// A proxy function of the instance alone: one call of `$op`.
 macro_rules! plain {
     ($name:ident, $op:expr) => {
-        unsafe extern "C" fn $name(c: Component) -> c_int {
-            ch(c).call($op)
+        unsafe extern "C" fn $name(c: *mut std::ffi::c_void) -> std::ffi::c_int {
+            super::proxy::ch(c).call($op)
         }
     };
 }
+pub(super) use plain;
 plain!(enter_initialization_mode, Op::EnterInitializationMode);
 plain!(exit_initialization_mode, Op::ExitInitializationMode);
 plain!(terminate, Op::Terminate);
@@ -158,6 +160,12 @@ unsafe extern "C" fn get_boolean(c: Component, vr: *const u32, n: usize, v: *mut
 }
 
 unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut *const c_char) -> c_int {
+    get_strings(c, vr, n, v, Op::GetString)
+}
+
+/// A string getter (`op`: the fmi2 or the fmi3 one) of n scalars; the strings stay in the
+/// channel until its next string read.
+pub(super) unsafe fn get_strings(c: Component, vr: *const u32, n: usize, v: *mut *const c_char, op: Op) -> c_int {
     let channel = ch(c);
     let (vrs, out) = (slice(vr, n), slice_mut(v, n));
     if !fits(channel, 4 * n + 8) {
@@ -165,7 +173,7 @@ unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut 
     }
     let at = vrs_into(channel, vrs);
     channel.header().n = n as u64;
-    let s = channel.call(Op::GetString);
+    let s = channel.call(op);
     let mut strings = Vec::with_capacity(n);
     {
         let data = channel.data();
@@ -217,6 +225,11 @@ unsafe extern "C" fn set_boolean(c: Component, vr: *const u32, n: usize, v: *con
 }
 
 unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *const *const c_char) -> c_int {
+    set_strings(c, vr, n, v, Op::SetString)
+}
+
+/// A string setter (`op`: the fmi2 or the fmi3 one) of n scalars.
+pub(super) unsafe fn set_strings(c: Component, vr: *const u32, n: usize, v: *const *const c_char, op: Op) -> c_int {
     let channel = ch(c);
     let vrs = slice(vr, n);
     let values = slice(v, n);
@@ -233,55 +246,61 @@ unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *cons
     let at = vrs_into(channel, vrs);
     channel.data()[at..at + bytes.len()].copy_from_slice(&bytes);
     channel.header().n = n as u64;
-    channel.call(Op::SetString)
+    channel.call(op)
 }
 
-/// `fmi2DoStep(t, h)` posted to the host (see [`Channel::post`]); `do_step` with the same
-/// arguments collects it.
-pub(crate) fn post_step(channel: &mut Channel, t: f64, h: f64) {
+/// `fmi2DoStep(t, h)` or `fmi3DoStep(t, h)` (`op`) posted to the host (see
+/// [`Channel::post`]); `do_step` with the same arguments collects it.
+pub(crate) fn post_step(channel: &mut Channel, op: Op, t: f64, h: f64) {
     channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
     hdr.i = [1, 0, 0, 0];
     channel.last_time = t;
     channel.posted_step = Some((t, h));
-    channel.post(Op::DoStep);
+    channel.post(op);
 }
 
 unsafe extern "C" fn do_step(c: Component, t: f64, h: f64, no_set_prior: c_int) -> c_int {
+    step(c, Op::DoStep, t, h, no_set_prior != 0)
+}
+
+/// A step (`op`: `fmi2DoStep` or `fmi3DoStep`) from `t` over `h`: the answer to the one
+/// posted with these arguments, or a call of its own.
+pub(super) unsafe fn step(c: Component, op: Op, t: f64, h: f64, no_set_prior: bool) -> c_int {
     let channel = &mut *(c as *mut Channel);
-    if channel.is_pending(Op::DoStep) && channel.posted_step == Some((t, h)) && no_set_prior == 1 {
+    if channel.is_pending(op) && channel.posted_step == Some((t, h)) && no_set_prior {
         channel.posted_step = None;
         return channel.collect();
     }
     channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
-    hdr.i = [no_set_prior as i64, 0, 0, 0];
+    hdr.i = [i64::from(no_set_prior), 0, 0, 0];
     channel.last_time = t;
-    channel.call(Op::DoStep)
+    channel.call(op)
+}
+
+/// A call on a saved state (`op`: get, set or free, of either generation): the host's
+/// pointer to it goes there and back in `i[0]`.
+pub(super) unsafe fn state_call(c: Component, s: *mut *mut c_void, op: Op) -> c_int {
+    let channel = ch(c);
+    channel.header().i[0] = *s as usize as i64;
+    let r = channel.call(op);
+    *s = channel.header().i[0] as usize as *mut c_void;
+    r
 }
 
 unsafe extern "C" fn get_fmu_state(c: Component, s: *mut *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = *s as usize as i64;
-    let r = channel.call(Op::GetFmuState);
-    *s = channel.header().i[0] as usize as *mut c_void;
-    r
+    state_call(c, s, Op::GetFmuState)
 }
 
-unsafe extern "C" fn set_fmu_state(c: Component, s: *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = s as usize as i64;
-    channel.call(Op::SetFmuState)
+unsafe extern "C" fn set_fmu_state(c: Component, mut s: *mut c_void) -> c_int {
+    state_call(c, &mut s, Op::SetFmuState)
 }
 
 unsafe extern "C" fn free_fmu_state(c: Component, s: *mut *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = *s as usize as i64;
-    let r = channel.call(Op::FreeFmuState);
-    *s = channel.header().i[0] as usize as *mut c_void;
-    r
+    state_call(c, s, Op::FreeFmuState)
 }
 
 unsafe extern "C" fn get_boolean_status(c: Component, kind: c_int, v: *mut c_int) -> c_int {

@@ -1,0 +1,329 @@
+//! The FMI 3.0 function table of an isolated instance: each function, its instance being
+//! the instance's [`Channel`], carried to the host as one call (the host calls the FMU's
+//! FMI 3.0 function; see `host.rs`). The Booleans, typed values and strings go through the
+//! region as for FMI 2.0 (`proxy.rs`); sets are calls of their own (not queued), and Reals
+//! are read with a call (no prefetch).
+
+#![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
+
+use super::channel::Channel;
+use super::proxy::{ch, fits, plain, slice, slice_mut, state_call, vrs_into};
+use super::{Fmi3Type, Op};
+use fmi_sys::fmi3::{fmi3Boolean, fmi3FMUState, fmi3Instance, fmi3Status, fmi3String, Fmi3Functions};
+use std::ffi::{c_char, CStr};
+
+type Component = fmi3Instance;
+
+unsafe extern "C" fn get_version() -> *const c_char {
+    c"3.0".as_ptr()
+}
+
+/// `fmi3InstantiateCoSimulation` in the host of `channel` (`event_mode`: `eventModeUsed`);
+/// the fmi3 status.
+pub(crate) fn instantiate_in(
+    channel: &mut Channel,
+    name: &CStr,
+    token: &CStr,
+    resources: &CStr,
+    event_mode: bool,
+) -> i32 {
+    let bytes: Vec<u8> = [name.to_bytes_with_nul(), token.to_bytes_with_nul(), resources.to_bytes_with_nul()].concat();
+    if !fits(channel, bytes.len()) {
+        return 3;
+    }
+    channel.data()[..bytes.len()].copy_from_slice(&bytes);
+    channel.header().i = [i64::from(event_mode), 0, 0, 0];
+    channel.call(Op::Instantiate3)
+}
+
+unsafe extern "C" fn free_instance(c: Component) {
+    let _ = ch(c).call(Op::Free);
+}
+
+unsafe extern "C" fn enter_initialization_mode(
+    c: Component,
+    tol_defined: fmi3Boolean,
+    tol: f64,
+    start: f64,
+    stop_defined: fmi3Boolean,
+    stop: f64,
+) -> fmi3Status {
+    let channel = ch(c);
+    let h = channel.header();
+    h.i = [i64::from(tol_defined), i64::from(stop_defined), 0, 0];
+    h.f = [tol, start, stop, 0.0];
+    channel.last_time = start;
+    channel.call(Op::EnterInitializationMode3)
+}
+
+plain!(exit_initialization_mode, Op::ExitInitializationMode3);
+plain!(terminate, Op::Terminate3);
+plain!(reset, Op::Reset3);
+plain!(enter_event_mode, Op::EnterEventMode3);
+plain!(enter_step_mode, Op::EnterStepMode3);
+
+/// A typed get or set of `n_values` values of `ty` at n references, in one call.
+unsafe fn typed(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    values: *mut u8,
+    n_values: usize,
+    ty: Fmi3Type,
+    set: bool,
+) -> fmi3Status {
+    let channel = ch(c);
+    let bytes = ty.width() * n_values;
+    if !fits(channel, (4 * n).div_ceil(8) * 8 + bytes) {
+        return 3;
+    }
+    let at = vrs_into(channel, slice(vr, n));
+    if set {
+        channel.data()[at..at + bytes].copy_from_slice(slice(values as *const u8, bytes));
+    }
+    let h = channel.header();
+    h.n = n as u64;
+    h.i = [ty as i64, n_values as i64, 0, 0];
+    let s = channel.call(if set { Op::Set3 } else { Op::Get3 });
+    if !set {
+        slice_mut(values, bytes).copy_from_slice(&channel.data()[at..at + bytes]);
+    }
+    s
+}
+
+macro_rules! typed_functions {
+    ($($get:ident, $set:ident, $t:ty, $ty:ident;)*) => {$(
+        unsafe extern "C" fn $get(c: Component, vr: *const u32, n: usize, v: *mut $t, nv: usize) -> fmi3Status {
+            typed(c, vr, n, v as *mut u8, nv, Fmi3Type::$ty, false)
+        }
+        unsafe extern "C" fn $set(c: Component, vr: *const u32, n: usize, v: *const $t, nv: usize) -> fmi3Status {
+            typed(c, vr, n, v as *mut u8, nv, Fmi3Type::$ty, true)
+        }
+    )*};
+}
+
+typed_functions! {
+    get_float64, set_float64, f64, Float64;
+    get_float32, set_float32, f32, Float32;
+    get_int8, set_int8, i8, Int8;
+    get_uint8, set_uint8, u8, UInt8;
+    get_int16, set_int16, i16, Int16;
+    get_uint16, set_uint16, u16, UInt16;
+    get_int32, set_int32, i32, Int32;
+    get_uint32, set_uint32, u32, UInt32;
+    get_int64, set_int64, i64, Int64;
+    get_uint64, set_uint64, u64, UInt64;
+    get_boolean, set_boolean, fmi3Boolean, Boolean;
+}
+
+/// Strings of scalars only (the view holds no String arrays): `nValues` other than the
+/// number of references is an error.
+unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut fmi3String, nv: usize) -> fmi3Status {
+    if nv != n {
+        return 3;
+    }
+    super::proxy::get_strings(c, vr, n, v, Op::GetString3)
+}
+
+unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *const fmi3String, nv: usize) -> fmi3Status {
+    if nv != n {
+        return 3;
+    }
+    super::proxy::set_strings(c, vr, n, v, Op::SetString3)
+}
+
+/// The values are kept in the channel until its next `fmi3GetBinary`.
+unsafe extern "C" fn get_binary(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    sizes: *mut usize,
+    values: *mut *const u8,
+    nv: usize,
+) -> fmi3Status {
+    let channel = ch(c);
+    if !fits(channel, (4 * n).div_ceil(8) * 8 + 8 * nv) {
+        return 3;
+    }
+    let at = vrs_into(channel, slice(vr, n));
+    let h = channel.header();
+    h.n = n as u64;
+    h.i = [0, nv as i64, 0, 0];
+    let s = channel.call(Op::GetBinary3);
+    let mut binaries = Vec::with_capacity(nv);
+    {
+        let data = channel.data();
+        let mut p = at + 8 * nv;
+        for k in 0..nv {
+            let size = u64::from_ne_bytes(data[at + 8 * k..at + 8 * k + 8].try_into().unwrap_or([0; 8])) as usize;
+            let end = (p + size).min(data.len());
+            binaries.push(data[p..end].to_vec());
+            p = end;
+        }
+    }
+    channel.binaries = binaries;
+    for ((size, value), b) in slice_mut(sizes, nv).iter_mut().zip(slice_mut(values, nv)).zip(&channel.binaries) {
+        *size = b.len();
+        *value = b.as_ptr();
+    }
+    s
+}
+
+#[allow(clippy::too_many_arguments)]
+unsafe extern "C" fn do_step(
+    c: Component,
+    t: f64,
+    h: f64,
+    no_set_prior: fmi3Boolean,
+    event: *mut fmi3Boolean,
+    terminate: *mut fmi3Boolean,
+    early: *mut fmi3Boolean,
+    reached: *mut f64,
+) -> fmi3Status {
+    let s = super::proxy::step(c, Op::DoStep3, t, h, no_set_prior != 0);
+    let channel = &mut *(c as *mut Channel);
+    let hdr = channel.header();
+    // the host wrote them with the answer (on a failure they are not read)
+    *event = u8::from(hdr.i[1] != 0);
+    *terminate = u8::from(hdr.i[2] != 0);
+    *early = u8::from(hdr.i[3] != 0);
+    *reached = hdr.f[2];
+    s
+}
+
+unsafe extern "C" fn update_discrete_states(
+    c: Component,
+    need_update: *mut fmi3Boolean,
+    terminate: *mut fmi3Boolean,
+    nominals_changed: *mut fmi3Boolean,
+    values_changed: *mut fmi3Boolean,
+    next_defined: *mut fmi3Boolean,
+    next_time: *mut f64,
+) -> fmi3Status {
+    let channel = ch(c);
+    let r = channel.call(Op::UpdateDiscreteStates3);
+    // the host wrote the five Booleans as bytes 0..5 and nextEventTime at byte 8
+    let data = channel.data();
+    for (k, out) in [need_update, terminate, nominals_changed, values_changed, next_defined].into_iter().enumerate() {
+        *out = u8::from(data[k] != 0);
+    }
+    *next_time = f64::from_ne_bytes(data[8..16].try_into().unwrap_or([0; 8]));
+    r
+}
+
+unsafe extern "C" fn get_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3Status {
+    state_call(c, s, Op::GetFmuState3)
+}
+
+unsafe extern "C" fn set_fmu_state(c: Component, mut s: fmi3FMUState) -> fmi3Status {
+    state_call(c, &mut s, Op::SetFmuState3)
+}
+
+unsafe extern "C" fn free_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3Status {
+    state_call(c, s, Op::FreeFmuState3)
+}
+
+/// The proxy table for an FMI 3.0 FMU whose library has the functions `present` says it
+/// has (an optional function is in the table where the library has it, so the
+/// capabilities stay the FMU's). Co-Simulation only: the instantiation is
+/// [`instantiate_in`] (made by `Instance::new_isolated`); Model Exchange's functions,
+/// setting binaries (the view's Binaries are read-only), clocks, derivatives and
+/// serialized states are not carried to the host.
+pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
+    macro_rules! optional {
+        ($name:literal, $f:ident) => {
+            present($name).then_some($f as _)
+        };
+    }
+    Fmi3Functions {
+        get_version,
+        free_instance,
+        enter_initialization_mode,
+        exit_initialization_mode,
+        terminate,
+        get_float64,
+        set_float64,
+        set_debug_logging: None,
+        instantiate_model_exchange: None,
+        instantiate_co_simulation: None,
+        instantiate_scheduled_execution: None,
+        enter_event_mode: optional!("fmi3EnterEventMode", enter_event_mode),
+        reset: optional!("fmi3Reset", reset),
+        get_float32: optional!("fmi3GetFloat32", get_float32),
+        get_int8: optional!("fmi3GetInt8", get_int8),
+        get_uint8: optional!("fmi3GetUInt8", get_uint8),
+        get_int16: optional!("fmi3GetInt16", get_int16),
+        get_uint16: optional!("fmi3GetUInt16", get_uint16),
+        get_int32: optional!("fmi3GetInt32", get_int32),
+        get_uint32: optional!("fmi3GetUInt32", get_uint32),
+        get_int64: optional!("fmi3GetInt64", get_int64),
+        get_uint64: optional!("fmi3GetUInt64", get_uint64),
+        get_boolean: optional!("fmi3GetBoolean", get_boolean),
+        get_string: optional!("fmi3GetString", get_string),
+        get_binary: optional!("fmi3GetBinary", get_binary),
+        get_clock: None,
+        set_float32: optional!("fmi3SetFloat32", set_float32),
+        set_int8: optional!("fmi3SetInt8", set_int8),
+        set_uint8: optional!("fmi3SetUInt8", set_uint8),
+        set_int16: optional!("fmi3SetInt16", set_int16),
+        set_uint16: optional!("fmi3SetUInt16", set_uint16),
+        set_int32: optional!("fmi3SetInt32", set_int32),
+        set_uint32: optional!("fmi3SetUInt32", set_uint32),
+        set_int64: optional!("fmi3SetInt64", set_int64),
+        set_uint64: optional!("fmi3SetUInt64", set_uint64),
+        set_boolean: optional!("fmi3SetBoolean", set_boolean),
+        set_string: optional!("fmi3SetString", set_string),
+        set_binary: None,
+        set_clock: None,
+        get_number_of_variable_dependencies: None,
+        get_variable_dependencies: None,
+        get_fmu_state: optional!("fmi3GetFMUState", get_fmu_state),
+        set_fmu_state: optional!("fmi3SetFMUState", set_fmu_state),
+        free_fmu_state: optional!("fmi3FreeFMUState", free_fmu_state),
+        serialized_fmu_state_size: None,
+        serialize_fmu_state: None,
+        deserialize_fmu_state: None,
+        get_directional_derivative: None,
+        get_adjoint_derivative: None,
+        enter_configuration_mode: None,
+        exit_configuration_mode: None,
+        get_interval_decimal: None,
+        get_interval_fraction: None,
+        get_shift_decimal: None,
+        get_shift_fraction: None,
+        set_interval_decimal: None,
+        set_interval_fraction: None,
+        set_shift_decimal: None,
+        set_shift_fraction: None,
+        evaluate_discrete_states: None,
+        update_discrete_states: optional!("fmi3UpdateDiscreteStates", update_discrete_states),
+        enter_continuous_time_mode: None,
+        completed_integrator_step: None,
+        set_time: None,
+        set_continuous_states: None,
+        get_continuous_state_derivatives: None,
+        get_event_indicators: None,
+        get_continuous_states: None,
+        get_nominals_of_continuous_states: None,
+        get_number_of_event_indicators: None,
+        get_number_of_continuous_states: None,
+        enter_step_mode: optional!("fmi3EnterStepMode", enter_step_mode),
+        get_output_derivatives: None,
+        do_step: optional!("fmi3DoStep", do_step),
+        activate_model_partition: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// An optional function is there where the library has it and the host carries it;
+    /// what the host does not carry is absent even where the library has it.
+    #[test]
+    fn the_table_has_what_the_library_has() {
+        let t = super::table(&|s| s != "fmi3GetFMUState" && s != "fmi3GetInt8");
+        assert!(t.has("fmi3DoStep") && t.has("fmi3SetFMUState") && t.has("fmi3GetFloat64") && t.has("fmi3SetInt8"));
+        assert!(t.has("fmi3GetBinary") && t.has("fmi3UpdateDiscreteStates") && t.has("fmi3EnterStepMode"));
+        assert!(!t.has("fmi3GetFMUState") && !t.has("fmi3GetInt8"));
+        assert!(!t.has("fmi3SetBinary") && !t.has("fmi3GetDirectionalDerivative") && !t.has("fmi3SetTime"));
+    }
+}
