@@ -429,20 +429,9 @@ fn model_exchange_agrees_with_fmpy() {
 /// back.
 #[test]
 fn fmi2_and_fmi3_instances_in_one_system() {
-    use common::{build_fmu, Model};
-    use nigel_cosim::{read_ssp, write_ssp, Algorithm, ImportOptions};
+    use nigel_cosim::{read_ssp, Algorithm, ImportOptions};
     let Some((dir, counter_fmu)) = counter("fmi3-mixed") else { return };
-    let source = build_fmu(Model::Source, &dir, &[]);
-    let gain = build_fmu(Model::Gain, &dir, &[]);
-    let mut b = SystemBuilder::new();
-    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
-    b.add_instance("counter", Fmu::load(&counter_fmu).unwrap()).unwrap();
-    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
-    b.connect_unconverted("source.y", "counter.u", None).unwrap();
-    b.connect("counter.y", "gain.u").unwrap();
-    let system = b.build();
-    let ssp = dir.join("mixed.ssp");
-    write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    let (system, ssp) = mixed_system(&dir, &counter_fmu);
     let from_ssp = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
     let out = cosim(&["info", ssp.to_str().unwrap()]);
     assert!(out.status.success(), "cosim info of the mixed SSP: {}", String::from_utf8_lossy(&out.stderr));
@@ -466,6 +455,24 @@ fn fmi2_and_fmi3_instances_in_one_system() {
             assert_eq!(yg[k], 2.0 * g, "{algorithm:?}: gain at t = {}", time[k]);
         }
     }
+}
+
+/// The FMI 2.0 source, the FMI 3.0 counter (`counter_fmu`) and the FMI 2.0 gain of
+/// `fmi2_and_fmi3_instances_in_one_system`, and the same system written to `dir/mixed.ssp`.
+fn mixed_system(dir: &Path, counter_fmu: &Path) -> (System, PathBuf) {
+    use common::{build_fmu, Model};
+    let source = build_fmu(Model::Source, dir, &[]);
+    let gain = build_fmu(Model::Gain, dir, &[]);
+    let mut b = SystemBuilder::new();
+    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(counter_fmu).unwrap()).unwrap();
+    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
+    b.connect_unconverted("source.y", "counter.u", None).unwrap();
+    b.connect("counter.y", "gain.u").unwrap();
+    let system = b.build();
+    let ssp = dir.join("mixed.ssp");
+    nigel_cosim::write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    (system, ssp)
 }
 
 /// Every FMI 3.0 type recorded: each output of the counter against its definition in
@@ -551,19 +558,8 @@ fn isolation_of_fmi3_fmus() {
 /// process byte for byte, under `jacobi` and `ordered` (the hosts' steps overlapped).
 #[test]
 fn isolated_systems_with_fmi3_fmus_equal_in_process() {
-    use common::{build_fmu, Model};
-    use nigel_cosim::write_ssp;
     let Some((dir, counter_fmu)) = counter("fmi3-isolate-systems") else { return };
-    let source = build_fmu(Model::Source, &dir, &[]);
-    let gain = build_fmu(Model::Gain, &dir, &[]);
-    let mut b = SystemBuilder::new();
-    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
-    b.add_instance("counter", Fmu::load(&counter_fmu).unwrap()).unwrap();
-    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
-    b.connect_unconverted("source.y", "counter.u", None).unwrap();
-    b.connect("counter.y", "gain.u").unwrap();
-    let mixed = dir.join("mixed.ssp");
-    write_ssp(&b.build(), "mixed", Some(1.0), &mixed).unwrap();
+    let (_, mixed) = mixed_system(&dir, &counter_fmu);
     let closed_loop = common::plant_fmu().parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop_fmi3.ssp");
     assert!(closed_loop.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", closed_loop.display());
     for (name, ssp, stop, step) in [("mixed", &mixed, "1", "0.1"), ("closed-loop", &closed_loop, "0.3", "0.001")] {

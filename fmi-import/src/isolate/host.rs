@@ -5,9 +5,10 @@
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::{publish, wait_for, Fmi3Type, Header, Layout, Op, SpinGauge};
+use super::{fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
 use crate::fmu::{callbacks_for, load_functions, load_library, EventInfo, Functions, LogSink};
 use fmi_sys::fmi3::Fmi3Functions;
+use model_description::fmi3::ValueType;
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
@@ -24,6 +25,26 @@ impl Region {
         // it is the host's turn.
         unsafe { &mut *(self.base as *mut Header) }
     }
+    /// The call's array arguments: their count `n`, the data area, the references at its
+    /// start, and the offset of what follows them (8-aligned).
+    fn call_arrays(&self) -> (usize, *mut u8, *const u32, usize) {
+        let n = self.header().n as usize;
+        let data: *mut u8 = self.at(self.layout.data);
+        (n, data, data as *const u32, (4 * n).div_ceil(8) * 8)
+    }
+
+    /// The three NUL-ended strings of an instantiation at the start of the data area.
+    ///
+    /// # Safety
+    /// The master wrote them there (`proxy::instantiate_with`).
+    unsafe fn three_strings(&self) -> [&CStr; 3] {
+        let first = CStr::from_ptr(self.at::<c_char>(self.layout.data));
+        let second_at = self.at::<u8>(self.layout.data).add(first.to_bytes().len() + 1);
+        let second = CStr::from_ptr(second_at as *const c_char);
+        let third = CStr::from_ptr(second_at.add(second.to_bytes().len() + 1) as *const c_char);
+        [first, second, third]
+    }
+
     fn at<T>(&self, offset: usize) -> *mut T {
         // SAFETY: offsets within the mapping (Layout), 8-aligned where f64 are read.
         unsafe { self.base.add(offset) as *mut T }
@@ -276,11 +297,7 @@ impl Host {
     /// One fmi2 call.
     fn call2(&mut self, f: &Functions, op: Op, region: &Region) -> i32 {
         let h = region.header();
-        let l = region.layout;
-        let n = h.n as usize;
-        let data: *mut u8 = region.at(l.data);
-        let vrs = data as *const u32;
-        let after_vrs = (4 * n).div_ceil(8) * 8;
+        let (n, data, vrs, after_vrs) = region.call_arrays();
         let c = self.c;
         let missing = 3;
         // SAFETY: every pointer is inside the data area, laid out by the proxy for this
@@ -288,16 +305,13 @@ impl Host {
         unsafe {
             match op {
                 Op::Instantiate => {
-                    let name = CStr::from_ptr(data as *const c_char);
-                    let guid_at = data.add(name.to_bytes().len() + 1);
-                    let guid = CStr::from_ptr(guid_at as *const c_char);
-                    let uri_at = guid_at.add(guid.to_bytes().len() + 1);
+                    let [name, guid, uri] = region.three_strings();
                     let callbacks = callbacks_for(&self.log);
                     self.c = (f.instantiate)(
                         name.as_ptr(),
                         h.i[0] as c_int,
                         guid.as_ptr(),
-                        uri_at as *const c_char,
+                        uri.as_ptr(),
                         &*callbacks,
                         h.i[1] as c_int,
                         h.i[2] as c_int,
@@ -393,12 +407,8 @@ impl Host {
 
     /// One fmi3 call.
     fn call3(&mut self, f: &Fmi3Functions, op: Op, region: &Region) -> i32 {
-        let h = region.header();
-        let l = region.layout;
-        let n = h.n as usize;
-        let data: *mut u8 = region.at(l.data);
-        let vrs = data as *const u32;
-        let after_vrs = (4 * n).div_ceil(8) * 8;
+        let (h, l) = (region.header(), region.layout);
+        let (n, data, vrs, after_vrs) = region.call_arrays();
         let c = self.c;
         let missing = 3;
         // SAFETY: as in call2: every pointer inside the data area, laid out by the proxy
@@ -406,10 +416,7 @@ impl Host {
         unsafe {
             match op {
                 Op::Instantiate3 => {
-                    let name = CStr::from_ptr(data as *const c_char);
-                    let token_at = data.add(name.to_bytes().len() + 1);
-                    let token = CStr::from_ptr(token_at as *const c_char);
-                    let resources_at = token_at.add(token.to_bytes().len() + 1);
+                    let [name, token, resources] = region.three_strings();
                     let environment = &*self.log as *const LogSink as *mut c_void;
                     let Some(g) = f.instantiate_co_simulation else { return missing };
                     // visible false, logging off, eventModeUsed as asked, early return
@@ -417,7 +424,7 @@ impl Host {
                     self.c = g(
                         name.as_ptr(),
                         token.as_ptr(),
-                        resources_at as *const c_char,
+                        resources.as_ptr(),
                         0,
                         0,
                         h.i[0] as u8,
@@ -441,7 +448,7 @@ impl Host {
                 Op::Terminate3 => (f.terminate)(c),
                 Op::Reset3 => f.reset.map_or(missing, |g| g(c)),
                 Op::Get3 | Op::Set3 => {
-                    let Some(ty) = Fmi3Type::from_code(h.i[0]) else { return missing };
+                    let Some(ty) = fmi3_type(h.i[0]) else { return missing };
                     typed(f, ty, op == Op::Set3, c, vrs, n, data.add(after_vrs), h.i[1] as usize)
                 }
                 Op::GetString3 => {
@@ -542,7 +549,7 @@ unsafe fn get_strings(region: &Region, n: usize, call: impl FnOnce(*mut *const c
 #[allow(clippy::too_many_arguments)]
 unsafe fn typed(
     f: &Fmi3Functions,
-    ty: Fmi3Type,
+    ty: ValueType,
     set: bool,
     c: *mut c_void,
     vrs: *const u32,
@@ -560,17 +567,18 @@ unsafe fn typed(
         };
     }
     match ty {
-        Fmi3Type::Float64 if set => (f.set_float64)(c, vrs, n, values as *const f64, n_values),
-        Fmi3Type::Float64 => (f.get_float64)(c, vrs, n, values as *mut f64, n_values),
-        Fmi3Type::Float32 => go!(get_float32, set_float32, f32),
-        Fmi3Type::Int8 => go!(get_int8, set_int8, i8),
-        Fmi3Type::UInt8 => go!(get_uint8, set_uint8, u8),
-        Fmi3Type::Int16 => go!(get_int16, set_int16, i16),
-        Fmi3Type::UInt16 => go!(get_uint16, set_uint16, u16),
-        Fmi3Type::Int32 => go!(get_int32, set_int32, i32),
-        Fmi3Type::UInt32 => go!(get_uint32, set_uint32, u32),
-        Fmi3Type::Int64 => go!(get_int64, set_int64, i64),
-        Fmi3Type::UInt64 => go!(get_uint64, set_uint64, u64),
-        Fmi3Type::Boolean => go!(get_boolean, set_boolean, u8),
+        ValueType::Float64 if set => (f.set_float64)(c, vrs, n, values as *const f64, n_values),
+        ValueType::Float64 => (f.get_float64)(c, vrs, n, values as *mut f64, n_values),
+        ValueType::Float32 => go!(get_float32, set_float32, f32),
+        ValueType::Int8 => go!(get_int8, set_int8, i8),
+        ValueType::UInt8 => go!(get_uint8, set_uint8, u8),
+        ValueType::Int16 => go!(get_int16, set_int16, i16),
+        ValueType::UInt16 => go!(get_uint16, set_uint16, u16),
+        ValueType::Int32 => go!(get_int32, set_int32, i32),
+        ValueType::UInt32 => go!(get_uint32, set_uint32, u32),
+        ValueType::Int64 => go!(get_int64, set_int64, i64),
+        ValueType::UInt64 => go!(get_uint64, set_uint64, u64),
+        ValueType::Boolean => go!(get_boolean, set_boolean, u8),
+        _ => 3,
     }
 }

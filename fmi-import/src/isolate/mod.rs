@@ -36,6 +36,7 @@ pub mod host;
 pub(crate) mod proxy;
 pub(crate) mod proxy3;
 
+use model_description::fmi3::ValueType;
 use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::sync::OnceLock;
@@ -170,7 +171,7 @@ protocol_ops! {
     ExitInitializationMode3 => "fmi3ExitInitializationMode",
     Terminate3 => "fmi3Terminate",
     Reset3 => "fmi3Reset",
-    /// A typed `fmi3Get*`: the type's code in `i[0]` ([`Fmi3Type`]), `nValues` in `i[1]`.
+    /// A typed `fmi3Get*`: the type's code in `i[0]` ([`fmi3_type_code`]), `nValues` in `i[1]`.
     Get3 => "fmi3Get*",
     /// A typed `fmi3Set*`, arguments as for `Get3`.
     Set3 => "fmi3Set*",
@@ -187,51 +188,26 @@ protocol_ops! {
     FreeFmuState3 => "fmi3FreeFMUState",
 }
 
-/// The value types of `Op::Get3` / `Op::Set3` (the code on the wire) and their bytes per value.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub(crate) enum Fmi3Type {
-    Float64,
-    Float32,
-    Int8,
-    UInt8,
-    Int16,
-    UInt16,
-    Int32,
-    UInt32,
-    Int64,
-    UInt64,
-    /// `fmi3Boolean`, a C `bool`: one byte.
-    Boolean,
+/// The code on the wire of the value type `ty` of `Op::Get3` / `Op::Set3`: its position in
+/// `ValueType::ALL`.
+pub(crate) fn fmi3_type_code(ty: ValueType) -> i64 {
+    ValueType::ALL.iter().position(|t| *t == ty).map_or(-1, |k| k as i64)
 }
 
-impl Fmi3Type {
-    const ALL: [Fmi3Type; 11] = [
-        Fmi3Type::Float64,
-        Fmi3Type::Float32,
-        Fmi3Type::Int8,
-        Fmi3Type::UInt8,
-        Fmi3Type::Int16,
-        Fmi3Type::UInt16,
-        Fmi3Type::Int32,
-        Fmi3Type::UInt32,
-        Fmi3Type::Int64,
-        Fmi3Type::UInt64,
-        Fmi3Type::Boolean,
-    ];
+/// The value type of wire code `code`.
+pub(crate) fn fmi3_type(code: i64) -> Option<ValueType> {
+    ValueType::ALL.get(usize::try_from(code).ok()?).copied()
+}
 
-    pub(crate) fn from_code(code: i64) -> Option<Fmi3Type> {
-        Fmi3Type::ALL.get(usize::try_from(code).ok()?).copied()
-    }
-
-    /// Bytes per value.
-    pub(crate) fn width(self) -> usize {
-        match self {
-            Fmi3Type::Float64 | Fmi3Type::Int64 | Fmi3Type::UInt64 => 8,
-            Fmi3Type::Float32 | Fmi3Type::Int32 | Fmi3Type::UInt32 => 4,
-            Fmi3Type::Int16 | Fmi3Type::UInt16 => 2,
-            Fmi3Type::Int8 | Fmi3Type::UInt8 | Fmi3Type::Boolean => 1,
-        }
+/// Bytes per value of `ty` (`fmi3Boolean`, a C `bool`: one byte); 0 for a type the
+/// protocol does not carry as values.
+pub(crate) fn fmi3_width(ty: ValueType) -> usize {
+    match ty {
+        ValueType::Float64 | ValueType::Int64 | ValueType::UInt64 => 8,
+        ValueType::Float32 | ValueType::Int32 | ValueType::UInt32 => 4,
+        ValueType::Int16 | ValueType::UInt16 => 2,
+        ValueType::Int8 | ValueType::UInt8 | ValueType::Boolean => 1,
+        _ => 0,
     }
 }
 

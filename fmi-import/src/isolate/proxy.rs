@@ -70,14 +70,19 @@ unsafe extern "C" fn instantiate(
 
 /// `fmi2Instantiate` in the host of `channel`; the fmi2 status.
 pub(crate) fn instantiate_in(channel: &mut Channel, name: &CStr, fmi_type: c_int, guid: &CStr, uri: &CStr) -> i32 {
-    let bytes: Vec<u8> = [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
+    instantiate_with(channel, Op::Instantiate, [name, guid, uri], fmi_type as i64)
+}
+
+/// An instantiation (`op`) with its three strings in the data area, one after the other,
+/// and its one flag in `i[0]`; the status.
+pub(super) fn instantiate_with(channel: &mut Channel, op: Op, strings: [&CStr; 3], flag: i64) -> i32 {
+    let bytes: Vec<u8> = strings.iter().flat_map(|s| s.to_bytes_with_nul()).copied().collect();
     if !fits(channel, bytes.len()) {
         return 3;
     }
     channel.data()[..bytes.len()].copy_from_slice(&bytes);
-    let h = channel.header();
-    h.i = [fmi_type as i64, 0, 0, 0];
-    channel.call(Op::Instantiate)
+    channel.header().i = [flag, 0, 0, 0];
+    channel.call(op)
 }
 
 unsafe extern "C" fn free_instance(c: Component) {
@@ -92,12 +97,18 @@ unsafe extern "C" fn setup_experiment(
     stop_defined: c_int,
     stop: f64,
 ) -> c_int {
+    experiment(c, Op::SetupExperiment, [tol_defined != 0, stop_defined != 0], [tol, start, stop])
+}
+
+/// The call (`op`) that gives the experiment: tolerance and stop time defined, the
+/// tolerance, start and stop time.
+pub(super) unsafe fn experiment(c: Component, op: Op, defined: [bool; 2], [tol, start, stop]: [f64; 3]) -> c_int {
     let channel = ch(c);
     let h = channel.header();
-    h.i = [tol_defined as i64, stop_defined as i64, 0, 0];
+    h.i = [i64::from(defined[0]), i64::from(defined[1]), 0, 0];
     h.f = [tol, start, stop, 0.0];
     channel.last_time = start;
-    channel.call(Op::SetupExperiment)
+    channel.call(op)
 }
 
 /// A proxy function of the instance alone: one call of `$op`.

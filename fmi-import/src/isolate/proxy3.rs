@@ -8,8 +8,9 @@
 
 use super::channel::Channel;
 use super::proxy::{ch, fits, plain, slice, slice_mut, state_call, vrs_into};
-use super::{Fmi3Type, Op};
+use super::{fmi3_type_code, fmi3_width, Op};
 use fmi_sys::fmi3::{fmi3Boolean, fmi3FMUState, fmi3Instance, fmi3Status, fmi3String, Fmi3Functions};
+use model_description::fmi3::ValueType;
 use std::ffi::{c_char, CStr};
 
 type Component = fmi3Instance;
@@ -27,13 +28,7 @@ pub(crate) fn instantiate_in(
     resources: &CStr,
     event_mode: bool,
 ) -> i32 {
-    let bytes: Vec<u8> = [name.to_bytes_with_nul(), token.to_bytes_with_nul(), resources.to_bytes_with_nul()].concat();
-    if !fits(channel, bytes.len()) {
-        return 3;
-    }
-    channel.data()[..bytes.len()].copy_from_slice(&bytes);
-    channel.header().i = [i64::from(event_mode), 0, 0, 0];
-    channel.call(Op::Instantiate3)
+    super::proxy::instantiate_with(channel, Op::Instantiate3, [name, token, resources], i64::from(event_mode))
 }
 
 unsafe extern "C" fn free_instance(c: Component) {
@@ -48,12 +43,7 @@ unsafe extern "C" fn enter_initialization_mode(
     stop_defined: fmi3Boolean,
     stop: f64,
 ) -> fmi3Status {
-    let channel = ch(c);
-    let h = channel.header();
-    h.i = [i64::from(tol_defined), i64::from(stop_defined), 0, 0];
-    h.f = [tol, start, stop, 0.0];
-    channel.last_time = start;
-    channel.call(Op::EnterInitializationMode3)
+    super::proxy::experiment(c, Op::EnterInitializationMode3, [tol_defined != 0, stop_defined != 0], [tol, start, stop])
 }
 
 plain!(exit_initialization_mode, Op::ExitInitializationMode3);
@@ -69,11 +59,11 @@ unsafe fn typed(
     n: usize,
     values: *mut u8,
     n_values: usize,
-    ty: Fmi3Type,
+    ty: ValueType,
     set: bool,
 ) -> fmi3Status {
     let channel = ch(c);
-    let bytes = ty.width() * n_values;
+    let bytes = fmi3_width(ty) * n_values;
     if !fits(channel, (4 * n).div_ceil(8) * 8 + bytes) {
         return 3;
     }
@@ -83,7 +73,7 @@ unsafe fn typed(
     }
     let h = channel.header();
     h.n = n as u64;
-    h.i = [ty as i64, n_values as i64, 0, 0];
+    h.i = [fmi3_type_code(ty), n_values as i64, 0, 0];
     let s = channel.call(if set { Op::Set3 } else { Op::Get3 });
     if !set {
         slice_mut(values, bytes).copy_from_slice(&channel.data()[at..at + bytes]);
@@ -94,10 +84,10 @@ unsafe fn typed(
 macro_rules! typed_functions {
     ($($get:ident, $set:ident, $t:ty, $ty:ident;)*) => {$(
         unsafe extern "C" fn $get(c: Component, vr: *const u32, n: usize, v: *mut $t, nv: usize) -> fmi3Status {
-            typed(c, vr, n, v as *mut u8, nv, Fmi3Type::$ty, false)
+            typed(c, vr, n, v as *mut u8, nv, ValueType::$ty, false)
         }
         unsafe extern "C" fn $set(c: Component, vr: *const u32, n: usize, v: *const $t, nv: usize) -> fmi3Status {
-            typed(c, vr, n, v as *mut u8, nv, Fmi3Type::$ty, true)
+            typed(c, vr, n, v as *mut u8, nv, ValueType::$ty, true)
         }
     )*};
 }
