@@ -876,8 +876,7 @@ impl Instance {
 
     /// `fmi2Instantiate` / `fmi3InstantiateCoSimulation` in a host process of its own
     /// (`isolation` names the host binary and the per-call time limit; `run_deadline`: the
-    /// run's deadline and its limit). FMI 3.0 Model Exchange is refused: its host carries
-    /// only Co-Simulation's calls.
+    /// run's deadline and its limit); FMI 3.0 Model Exchange by `fmi3InstantiateModelExchange`.
     pub fn new_isolated(
         fmu: &Arc<Fmu>,
         name: &str,
@@ -886,15 +885,13 @@ impl Instance {
     ) -> Result<Instance> {
         use crate::error::HostEnd;
         let fmi3 = matches!(fmu.abi, Abi::Fmi3(_));
-        if fmi3 && fmu.interface == Interface::ModelExchange {
-            return Err(Error::Unsupported {
-                path: fmu.source.clone(),
-                feature: "FMI 3.0 Model Exchange instances in host processes (--isolate=fmu; the host carries Co-Simulation's calls only: use --interface cs or --isolate=run)".into(),
-            });
-        }
         let fmu = fmu.isolated();
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
-        let instantiate = if fmi3 { "fmi3InstantiateCoSimulation" } else { "fmi2Instantiate" };
+        let instantiate = match (fmi3, fmu.interface) {
+            (false, _) => "fmi2Instantiate",
+            (true, Interface::CoSimulation) => "fmi3InstantiateCoSimulation",
+            (true, Interface::ModelExchange) => "fmi3InstantiateModelExchange",
+        };
         let failed = |m: String| Error::Host {
             instance: name.into(),
             function: instantiate,
@@ -915,10 +912,10 @@ impl Instance {
             )
             .map_err(|cause| Error::Host {
                 instance: name.into(),
-                function: if fmi3 {
-                    "fmi3InstantiateCoSimulation (loading the library)"
-                } else {
-                    "fmi2Instantiate (loading the library)"
+                function: match instantiate {
+                    "fmi2Instantiate" => "fmi2Instantiate (loading the library)",
+                    "fmi3InstantiateCoSimulation" => "fmi3InstantiateCoSimulation (loading the library)",
+                    _ => "fmi3InstantiateModelExchange (loading the library)",
                 },
                 time: 0.0,
                 cause,
@@ -939,7 +936,12 @@ impl Instance {
                 )
             }
             Abi::Fmi3(a) => {
-                let event_mode = a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+                let event_mode = match fmu.interface {
+                    Interface::CoSimulation => {
+                        Some(a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode))
+                    }
+                    Interface::ModelExchange => None,
+                };
                 crate::isolate::proxy3::instantiate_in(&mut channel, &name_c, &a.token, &a.resource_path, event_mode)
             }
         };

@@ -441,6 +441,38 @@ impl Host {
                         0
                     }
                 }
+                Op::InstantiateModelExchange3 => {
+                    let [name, token, resources] = region.three_strings();
+                    let environment = &*self.log as *const LogSink as *mut c_void;
+                    let Some(g) = f.instantiate_model_exchange else { return missing };
+                    // visible false, logging off: as `Instance::new_fmi3`
+                    let logger = Some(crate::fmi3::log_message as fmi_sys::fmi3::Fmi3LogMessageCallback);
+                    self.c = g(name.as_ptr(), token.as_ptr(), resources.as_ptr(), 0, 0, environment, logger);
+                    if self.c.is_null() {
+                        3
+                    } else {
+                        0
+                    }
+                }
+                Op::EnterContinuousTimeMode3 => f.enter_continuous_time_mode.map_or(missing, |g| g(c)),
+                Op::CompletedIntegratorStep3 => {
+                    let (mut event, mut terminate) = (0u8, 0u8);
+                    let r =
+                        f.completed_integrator_step.map_or(missing, |g| g(c, h.i[0] as u8, &mut event, &mut terminate));
+                    h.i[1] = i64::from(event);
+                    h.i[2] = i64::from(terminate);
+                    r
+                }
+                Op::SetTime3 => f.set_time.map_or(missing, |g| g(c, h.f[0])),
+                Op::SetContinuousStates3 => f.set_continuous_states.map_or(missing, |g| g(c, data as *const f64, n)),
+                Op::GetContinuousStateDerivatives3 => {
+                    f.get_continuous_state_derivatives.map_or(missing, |g| g(c, data as *mut f64, n))
+                }
+                Op::GetEventIndicators3 => f.get_event_indicators.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetContinuousStates3 => f.get_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetNominalsOfContinuousStates3 => {
+                    f.get_nominals_of_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n))
+                }
                 Op::EnterInitializationMode3 => {
                     (f.enter_initialization_mode)(c, h.i[0] as u8, h.f[0], h.f[1], h.i[1] as u8, h.f[2])
                 }

@@ -186,6 +186,15 @@ protocol_ops! {
     GetFmuState3 => "fmi3GetFMUState",
     SetFmuState3 => "fmi3SetFMUState",
     FreeFmuState3 => "fmi3FreeFMUState",
+    InstantiateModelExchange3 => "fmi3InstantiateModelExchange",
+    EnterContinuousTimeMode3 => "fmi3EnterContinuousTimeMode",
+    CompletedIntegratorStep3 => "fmi3CompletedIntegratorStep",
+    SetTime3 => "fmi3SetTime",
+    SetContinuousStates3 => "fmi3SetContinuousStates",
+    GetContinuousStateDerivatives3 => "fmi3GetContinuousStateDerivatives",
+    GetEventIndicators3 => "fmi3GetEventIndicators",
+    GetContinuousStates3 => "fmi3GetContinuousStates",
+    GetNominalsOfContinuousStates3 => "fmi3GetNominalsOfContinuousStates",
 }
 
 /// The code on the wire of the value type `ty` of `Op::Get3` / `Op::Set3`: its position in

@@ -354,13 +354,23 @@ unsafe extern "C" fn completed_integrator_step(
 }
 
 unsafe extern "C" fn set_time(c: Component, t: f64) -> c_int {
+    time_call(c, t, Op::SetTime)
+}
+
+/// `fmi2SetTime` / `fmi3SetTime` (`op`).
+pub(super) unsafe fn time_call(c: Component, t: f64, op: Op) -> c_int {
     let channel = ch(c);
     channel.header().f[0] = t;
     channel.last_time = t;
-    channel.call(Op::SetTime)
+    channel.call(op)
 }
 
 unsafe extern "C" fn set_continuous_states(c: Component, x: *const f64, n: usize) -> c_int {
+    set_vector(c, x, n, Op::SetContinuousStates)
+}
+
+/// A vector of n Reals to the host (`op`: either generation's `SetContinuousStates`).
+pub(super) unsafe fn set_vector(c: Component, x: *const f64, n: usize, op: Op) -> c_int {
     let channel = ch(c);
     if !fits(channel, 8 * n) {
         return 3;
@@ -371,10 +381,12 @@ unsafe extern "C" fn set_continuous_states(c: Component, x: *const f64, n: usize
         data[8 * k..8 * k + 8].copy_from_slice(&v.to_ne_bytes());
     }
     channel.header().n = n as u64;
-    channel.call(Op::SetContinuousStates)
+    channel.call(op)
 }
 
-unsafe fn get_vector(c: Component, x: *mut f64, n: usize, op: Op) -> c_int {
+/// A vector of n Reals from the host (`op`: either generation's derivatives, event
+/// indicators, states or nominals).
+pub(super) unsafe fn get_vector(c: Component, x: *mut f64, n: usize, op: Op) -> c_int {
     let channel = ch(c);
     if !fits(channel, 8 * n) {
         return 3;

@@ -19,16 +19,20 @@ unsafe extern "C" fn get_version() -> *const c_char {
     c"3.0".as_ptr()
 }
 
-/// `fmi3InstantiateCoSimulation` in the host of `channel` (`event_mode`: `eventModeUsed`);
-/// the fmi3 status.
+/// `fmi3InstantiateCoSimulation` (`event_mode`: `eventModeUsed`) or, `None`,
+/// `fmi3InstantiateModelExchange` in the host of `channel`; the fmi3 status.
 pub(crate) fn instantiate_in(
     channel: &mut Channel,
     name: &CStr,
     token: &CStr,
     resources: &CStr,
-    event_mode: bool,
+    event_mode: Option<bool>,
 ) -> i32 {
-    super::proxy::instantiate_with(channel, Op::Instantiate3, [name, token, resources], i64::from(event_mode))
+    let (op, flag) = match event_mode {
+        Some(event_mode) => (Op::Instantiate3, i64::from(event_mode)),
+        None => (Op::InstantiateModelExchange3, 0),
+    };
+    super::proxy::instantiate_with(channel, op, [name, token, resources], flag)
 }
 
 unsafe extern "C" fn free_instance(c: Component) {
@@ -51,6 +55,7 @@ plain!(terminate, Op::Terminate3);
 plain!(reset, Op::Reset3);
 plain!(enter_event_mode, Op::EnterEventMode3);
 plain!(enter_step_mode, Op::EnterStepMode3);
+plain!(enter_continuous_time_mode, Op::EnterContinuousTimeMode3);
 
 /// A typed get or set of `n_values` values of `ty` at n references, in one call.
 unsafe fn typed(
@@ -201,6 +206,44 @@ unsafe extern "C" fn update_discrete_states(
     r
 }
 
+unsafe extern "C" fn completed_integrator_step(
+    c: Component,
+    no_set_prior: fmi3Boolean,
+    event: *mut fmi3Boolean,
+    terminate: *mut fmi3Boolean,
+) -> fmi3Status {
+    let channel = ch(c);
+    channel.header().i = [i64::from(no_set_prior), 0, 0, 0];
+    let r = channel.call(Op::CompletedIntegratorStep3);
+    *event = u8::from(channel.header().i[1] != 0);
+    *terminate = u8::from(channel.header().i[2] != 0);
+    r
+}
+
+unsafe extern "C" fn set_time(c: Component, t: f64) -> fmi3Status {
+    super::proxy::time_call(c, t, Op::SetTime3)
+}
+
+unsafe extern "C" fn set_continuous_states(c: Component, x: *const f64, n: usize) -> fmi3Status {
+    super::proxy::set_vector(c, x, n, Op::SetContinuousStates3)
+}
+
+/// The Model Exchange getters of a vector of Reals.
+macro_rules! vector_getters {
+    ($($name:ident => $op:ident;)*) => {$(
+        unsafe extern "C" fn $name(c: Component, x: *mut f64, n: usize) -> fmi3Status {
+            super::proxy::get_vector(c, x, n, Op::$op)
+        }
+    )*};
+}
+
+vector_getters! {
+    get_continuous_state_derivatives => GetContinuousStateDerivatives3;
+    get_event_indicators => GetEventIndicators3;
+    get_continuous_states => GetContinuousStates3;
+    get_nominals_of_continuous_states => GetNominalsOfContinuousStates3;
+}
+
 unsafe extern "C" fn get_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3Status {
     state_call(c, s, Op::GetFmuState3)
 }
@@ -215,10 +258,9 @@ unsafe extern "C" fn free_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3S
 
 /// The proxy table for an FMI 3.0 FMU whose library has the functions `present` says it
 /// has (an optional function is in the table where the library has it, so the
-/// capabilities stay the FMU's). Co-Simulation only: the instantiation is
-/// [`instantiate_in`] (made by `Instance::new_isolated`); Model Exchange's functions,
-/// setting binaries (the view's Binaries are read-only), clocks, derivatives and
-/// serialized states are not carried to the host.
+/// capabilities stay the FMU's). The instantiation is [`instantiate_in`] (made by
+/// `Instance::new_isolated`); setting binaries (the view's Binaries are read-only),
+/// clocks, directional derivatives and serialized states are not carried to the host.
 pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
     macro_rules! optional {
         ($name:literal, $f:ident) => {
@@ -287,14 +329,20 @@ pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         set_shift_fraction: None,
         evaluate_discrete_states: None,
         update_discrete_states: optional!("fmi3UpdateDiscreteStates", update_discrete_states),
-        enter_continuous_time_mode: None,
-        completed_integrator_step: None,
-        set_time: None,
-        set_continuous_states: None,
-        get_continuous_state_derivatives: None,
-        get_event_indicators: None,
-        get_continuous_states: None,
-        get_nominals_of_continuous_states: None,
+        enter_continuous_time_mode: optional!("fmi3EnterContinuousTimeMode", enter_continuous_time_mode),
+        completed_integrator_step: optional!("fmi3CompletedIntegratorStep", completed_integrator_step),
+        set_time: optional!("fmi3SetTime", set_time),
+        set_continuous_states: optional!("fmi3SetContinuousStates", set_continuous_states),
+        get_continuous_state_derivatives: optional!(
+            "fmi3GetContinuousStateDerivatives",
+            get_continuous_state_derivatives
+        ),
+        get_event_indicators: optional!("fmi3GetEventIndicators", get_event_indicators),
+        get_continuous_states: optional!("fmi3GetContinuousStates", get_continuous_states),
+        get_nominals_of_continuous_states: optional!(
+            "fmi3GetNominalsOfContinuousStates",
+            get_nominals_of_continuous_states
+        ),
         get_number_of_event_indicators: None,
         get_number_of_continuous_states: None,
         enter_step_mode: optional!("fmi3EnterStepMode", enter_step_mode),
@@ -314,6 +362,9 @@ mod tests {
         assert!(t.has("fmi3DoStep") && t.has("fmi3SetFMUState") && t.has("fmi3GetFloat64") && t.has("fmi3SetInt8"));
         assert!(t.has("fmi3GetBinary") && t.has("fmi3UpdateDiscreteStates") && t.has("fmi3EnterStepMode"));
         assert!(!t.has("fmi3GetFMUState") && !t.has("fmi3GetInt8"));
-        assert!(!t.has("fmi3SetBinary") && !t.has("fmi3GetDirectionalDerivative") && !t.has("fmi3SetTime"));
+        assert!(
+            t.has("fmi3SetTime") && t.has("fmi3GetContinuousStateDerivatives") && t.has("fmi3CompletedIntegratorStep")
+        );
+        assert!(!t.has("fmi3SetBinary") && !t.has("fmi3GetDirectionalDerivative") && !t.has("fmi3GetClock"));
     }
 }
