@@ -212,6 +212,7 @@ fn write_log_record(region: &Region, status: i32, cat: &[u8], msg: &[u8]) -> boo
 }
 
 /// The library's functions, of its generation.
+#[allow(clippy::large_enum_variant)] // one per host process, never moved
 enum Generation {
     Fmi2(Functions),
     Fmi3(Fmi3Functions),
@@ -527,10 +528,8 @@ impl Host {
                 Op::UpdateDiscreteStates3 => {
                     // the five Booleans as bytes 0..5, nextEventTime at byte 8
                     let b = data;
-                    let r = f
-                        .update_discrete_states
-                        .map_or(missing, |g| g(c, b, b.add(1), b.add(2), b.add(3), b.add(4), b.add(8) as *mut f64));
-                    r
+                    f.update_discrete_states
+                        .map_or(missing, |g| g(c, b, b.add(1), b.add(2), b.add(3), b.add(4), b.add(8) as *mut f64))
                 }
                 Op::GetFmuState3 => {
                     let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
