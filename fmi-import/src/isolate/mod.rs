@@ -7,7 +7,8 @@
 //! with two sequence numbers (futex words) and the arguments of one call, then the
 //! arrays of the call (value references, values, states), then the messages the FMU
 //! logged during it. A call is one round trip: the master writes the request and bumps
-//! the request number; the host runs the fmi2 function on the real FMU, writes the
+//! the request number; the host runs the FMU's function (FMI 2.0 or FMI 3.0, the
+//! library's generation given in the header), writes the
 //! results, the status and the log, and sets the response number. Each side spins while
 //! that pays (see [`Spin`]), then sleeps on the futex (woken only if it sleeps). While it waits
 //! the master checks every 10 ms that the host is alive (`waitpid`) and the call's and
@@ -25,8 +26,10 @@
 //! named in the log.
 //!
 //! The master's side is an [`Instance`](crate::Instance) whose function table is the
-//! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
-//! in-process ones. The host's side is [`host::run`], the whole of `cosim-host`.
+//! proxy of this module (`proxy.rs` for FMI 2.0, `proxy3.rs` for FMI 3.0): its state
+//! machine, status handling and log are the in-process ones. FMI 3.0's typed sets are
+//! calls of their own (not queued) and its Reals are read with a call (no prefetch). The
+//! host's side is [`host::run`], the whole of `cosim-host`.
 //!
 //! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
 //! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.
