@@ -518,7 +518,8 @@ fn every_type_and_array_elements_are_recorded() {
 /// (`hasEventMode`: `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`), and Model Exchange
 /// (the master's solver through the host: states, derivatives, event indicators; with
 /// `mode=2` the state event near 0.275 s and the time event at 0.75 s, with `stop_at` the
-/// termination at the time event).
+/// termination at the time event). A set the FMU refuses (`mode=3`), queued in the host
+/// for the next call, is the error of that call naming the set and the FMU's message.
 #[test]
 fn isolation_of_fmi3_fmus() {
     let Some((dir, path)) = counter("fmi3-isolate") else { return };
@@ -554,6 +555,12 @@ fn isolation_of_fmi3_fmus() {
             }
         }
     }
+    let out = run_to_csv(&path, "1", &dir.join("refused.csv"), &["--set", "mode=3", "--isolate=fmu"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cosim: model: fmi3EnterInitializationMode returned"), "{err}");
+    assert!(err.contains("fmi3SetInt64 (sent with fmi3EnterInitializationMode) returned"), "{err}");
+    assert!(err.contains("mode must be 1 or 2"), "{err}");
 }
 
 /// Systems with FMI 3.0 FMUs under `--isolate=fmu`: the closed loop of FMI 3.0 FMUs

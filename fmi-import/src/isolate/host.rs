@@ -229,8 +229,6 @@ struct Host {
 impl Host {
     /// The queued sets, in order; the status of the first that failed (the rest skipped).
     fn queued(&mut self, region: &Region) -> i32 {
-        // only FMI 2.0's sets are queued (FMI 3.0's are calls of their own)
-        let Generation::Fmi2(f) = &self.lib else { return 0 };
         let h = region.header();
         let l = region.layout;
         let mut p = 0usize;
@@ -241,14 +239,20 @@ impl Host {
             let vrs = unsafe { base.add(8) } as *const u32;
             let values = unsafe { base.add(8 + 4 * n) };
             // SAFETY: live component; n references and n values of the kind's type.
-            let s = unsafe {
-                match kind {
-                    0 => (f.set_real)(self.c, vrs, n, values as *const f64),
-                    1 => (f.set_integer)(self.c, vrs, n, values as *const c_int),
-                    _ => (f.set_boolean)(self.c, vrs, n, values as *const c_int),
+            let (s, width) = unsafe {
+                match (&self.lib, kind) {
+                    (Generation::Fmi2(f), 0) => ((f.set_real)(self.c, vrs, n, values as *const f64), 8),
+                    (Generation::Fmi2(f), 1) => ((f.set_integer)(self.c, vrs, n, values as *const c_int), 4),
+                    (Generation::Fmi2(f), _) => ((f.set_boolean)(self.c, vrs, n, values as *const c_int), 4),
+                    // FMI 3.0: QUEUED_FMI3 + the type's code (proxy3.rs), as many values as references
+                    (Generation::Fmi3(f), _) => {
+                        match kind.checked_sub(super::proxy3::QUEUED_FMI3).and_then(|k| fmi3_type(i64::from(k))) {
+                            Some(ty) => (typed(f, ty, true, self.c, vrs, n, values, n), super::fmi3_width(ty)),
+                            None => (3, 0),
+                        }
+                    }
                 }
             };
-            let width = if kind == 0 { 8 } else { 4 };
             p += (8 + 4 * n + width * n).div_ceil(8) * 8;
             if s > 1 {
                 h.queued_failed = k;

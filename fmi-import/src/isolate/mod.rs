@@ -27,9 +27,9 @@
 //!
 //! The master's side is an [`Instance`](crate::Instance) whose function table is the
 //! proxy of this module (`proxy.rs` for FMI 2.0, `proxy3.rs` for FMI 3.0): its state
-//! machine, status handling and log are the in-process ones. FMI 3.0's typed sets are
-//! calls of their own (not queued) and its Reals are read with a call (no prefetch). The
-//! host's side is [`host::run`], the whole of `cosim-host`.
+//! machine, status handling and log are the in-process ones. FMI 3.0's sets of scalars
+//! are queued as FMI 2.0's are (a set of array values is a call); its Reals are read with a
+//! call (no prefetch). The host's side is [`host::run`], the whole of `cosim-host`.
 //!
 //! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
 //! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.

@@ -202,7 +202,14 @@ pub(super) unsafe fn get_strings(c: Component, vr: *const u32, n: usize, v: *mut
     s
 }
 
-unsafe fn queue(c: Component, kind: u32, function: &'static str, vr: *const u32, n: usize, bytes: &[u8]) -> c_int {
+pub(super) unsafe fn queue(
+    c: Component,
+    kind: u32,
+    function: &'static str,
+    vr: *const u32,
+    n: usize,
+    bytes: &[u8],
+) -> c_int {
     let channel = ch(c);
     let vrs = slice(vr, n);
     if channel.queue_set(kind, function, vrs, bytes) {

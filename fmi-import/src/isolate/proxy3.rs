@@ -1,8 +1,9 @@
 //! The FMI 3.0 function table of an isolated instance: each function, its instance being
 //! the instance's [`Channel`], carried to the host as one call (the host calls the FMU's
 //! FMI 3.0 function; see `host.rs`). The Booleans, typed values and strings go through the
-//! region as for FMI 2.0 (`proxy.rs`); sets are calls of their own (not queued), and Reals
-//! are read with a call (no prefetch).
+//! region as for FMI 2.0 (`proxy.rs`); sets of scalars are queued for the next call as
+//! FMI 2.0's are (a set of array values is a call), and Reals are read with a call (no
+//! prefetch).
 
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
@@ -86,29 +87,39 @@ unsafe fn typed(
     s
 }
 
+/// The kind of a queued FMI 3.0 set of `ty` (FMI 2.0's kinds are 0, 1, 2).
+pub(super) const QUEUED_FMI3: u32 = 16;
+
+/// The typed getters, and the setters: a set of scalars (as many values as references) is
+/// queued for the next call as FMI 2.0's sets are, one of array values is a call.
 macro_rules! typed_functions {
-    ($($get:ident, $set:ident, $t:ty, $ty:ident;)*) => {$(
+    ($($get:ident, $set:ident, $t:ty, $ty:ident, $set_name:literal;)*) => {$(
         unsafe extern "C" fn $get(c: Component, vr: *const u32, n: usize, v: *mut $t, nv: usize) -> fmi3Status {
             typed(c, vr, n, v as *mut u8, nv, ValueType::$ty, false)
         }
         unsafe extern "C" fn $set(c: Component, vr: *const u32, n: usize, v: *const $t, nv: usize) -> fmi3Status {
-            typed(c, vr, n, v as *mut u8, nv, ValueType::$ty, true)
+            if nv != n {
+                return typed(c, vr, n, v as *mut u8, nv, ValueType::$ty, true);
+            }
+            let kind = QUEUED_FMI3 + fmi3_type_code(ValueType::$ty) as u32;
+            let bytes = slice(v as *const u8, std::mem::size_of::<$t>() * n);
+            super::proxy::queue(c, kind, $set_name, vr, n, bytes)
         }
     )*};
 }
 
 typed_functions! {
-    get_float64, set_float64, f64, Float64;
-    get_float32, set_float32, f32, Float32;
-    get_int8, set_int8, i8, Int8;
-    get_uint8, set_uint8, u8, UInt8;
-    get_int16, set_int16, i16, Int16;
-    get_uint16, set_uint16, u16, UInt16;
-    get_int32, set_int32, i32, Int32;
-    get_uint32, set_uint32, u32, UInt32;
-    get_int64, set_int64, i64, Int64;
-    get_uint64, set_uint64, u64, UInt64;
-    get_boolean, set_boolean, fmi3Boolean, Boolean;
+    get_float64, set_float64, f64, Float64, "fmi3SetFloat64";
+    get_float32, set_float32, f32, Float32, "fmi3SetFloat32";
+    get_int8, set_int8, i8, Int8, "fmi3SetInt8";
+    get_uint8, set_uint8, u8, UInt8, "fmi3SetUInt8";
+    get_int16, set_int16, i16, Int16, "fmi3SetInt16";
+    get_uint16, set_uint16, u16, UInt16, "fmi3SetUInt16";
+    get_int32, set_int32, i32, Int32, "fmi3SetInt32";
+    get_uint32, set_uint32, u32, UInt32, "fmi3SetUInt32";
+    get_int64, set_int64, i64, Int64, "fmi3SetInt64";
+    get_uint64, set_uint64, u64, UInt64, "fmi3SetUInt64";
+    get_boolean, set_boolean, fmi3Boolean, Boolean, "fmi3SetBoolean";
 }
 
 /// Strings of scalars only (the view holds no String arrays): `nValues` other than the
