@@ -429,20 +429,9 @@ fn model_exchange_agrees_with_fmpy() {
 /// back.
 #[test]
 fn fmi2_and_fmi3_instances_in_one_system() {
-    use common::{build_fmu, Model};
-    use nigel_cosim::{read_ssp, write_ssp, Algorithm, ImportOptions};
+    use nigel_cosim::{read_ssp, Algorithm, ImportOptions};
     let Some((dir, counter_fmu)) = counter("fmi3-mixed") else { return };
-    let source = build_fmu(Model::Source, &dir, &[]);
-    let gain = build_fmu(Model::Gain, &dir, &[]);
-    let mut b = SystemBuilder::new();
-    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
-    b.add_instance("counter", Fmu::load(&counter_fmu).unwrap()).unwrap();
-    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
-    b.connect_unconverted("source.y", "counter.u", None).unwrap();
-    b.connect("counter.y", "gain.u").unwrap();
-    let system = b.build();
-    let ssp = dir.join("mixed.ssp");
-    write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    let (system, ssp) = mixed_system(&dir, &counter_fmu);
     let from_ssp = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
     let out = cosim(&["info", ssp.to_str().unwrap()]);
     assert!(out.status.success(), "cosim info of the mixed SSP: {}", String::from_utf8_lossy(&out.stderr));
@@ -466,6 +455,24 @@ fn fmi2_and_fmi3_instances_in_one_system() {
             assert_eq!(yg[k], 2.0 * g, "{algorithm:?}: gain at t = {}", time[k]);
         }
     }
+}
+
+/// The FMI 2.0 source, the FMI 3.0 counter (`counter_fmu`) and the FMI 2.0 gain of
+/// `fmi2_and_fmi3_instances_in_one_system`, and the same system written to `dir/mixed.ssp`.
+fn mixed_system(dir: &Path, counter_fmu: &Path) -> (System, PathBuf) {
+    use common::{build_fmu, Model};
+    let source = build_fmu(Model::Source, dir, &[]);
+    let gain = build_fmu(Model::Gain, dir, &[]);
+    let mut b = SystemBuilder::new();
+    b.add_instance("source", Fmu::load(&source).unwrap()).unwrap();
+    b.add_instance("counter", Fmu::load(counter_fmu).unwrap()).unwrap();
+    b.add_instance("gain", Fmu::load(&gain).unwrap()).unwrap();
+    b.connect_unconverted("source.y", "counter.u", None).unwrap();
+    b.connect("counter.y", "gain.u").unwrap();
+    let system = b.build();
+    let ssp = dir.join("mixed.ssp");
+    nigel_cosim::write_ssp(&system, "mixed", Some(1.0), &ssp).unwrap();
+    (system, ssp)
 }
 
 /// Every FMI 3.0 type recorded: each output of the counter against its definition in
@@ -502,61 +509,137 @@ fn every_type_and_array_elements_are_recorded() {
     assert!(e.to_string().contains("c.bin") && e.to_string().contains("cannot be set"), "{e}");
 }
 
-/// `--isolate=run` runs an FMI 3.0 FMU in the host of the whole run (called directly there):
-/// the same rows as in process; `--isolate=fmu` (a host per FMU, FMI 2.0's protocol) is
-/// refused naming the feature.
+/// `--isolate=run` (the whole run in one host) and `--isolate=fmu` / `--isolate` (a host
+/// per FMU, the FMI 3.0 calls carried through the shared region to the host, which calls
+/// the FMU's functions with the master's arguments) write the CSV of the run in process,
+/// byte for byte, under `jacobi` and `ordered`: plain steps (every type of the view read
+/// through the typed getters), an early return (`early_at`: `earlyReturn` and
+/// `lastSuccessfulTime` through the host), `terminateSimulation` (`stop_at`), Event Mode
+/// (`hasEventMode`: `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`), and Model Exchange
+/// (the master's solver through the host: states, derivatives, event indicators; with
+/// `mode=2` the state event near 0.275 s and the time event at 0.75 s, with `stop_at` the
+/// termination at the time event). A set the FMU refuses (`mode=3`), queued in the host
+/// for the next call, is the error of that call naming the set and the FMU's message.
 #[test]
 fn isolation_of_fmi3_fmus() {
     let Some((dir, path)) = counter("fmi3-isolate") else { return };
-    let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
-    let (plain, hosted) = (dir.join("plain.csv"), dir.join("hosted.csv"));
-    assert!(run(&[], &plain).status.success());
-    let out = run(&["--isolate=run"], &hosted);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert_eq!(std::fs::read_to_string(&plain).unwrap(), std::fs::read_to_string(&hosted).unwrap());
-    let out = run(&["--isolate"], &dir.join("refused.csv"));
-    assert!(!out.status.success());
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    let Some(event_mode) = build_counter(&dir, "event_mode", &xml) else { return };
+    let cases: [(&Path, &[&str]); 6] = [
+        (&path, &[]),
+        (&path, &["--set", "early_at=0.35"]),
+        (&path, &["--set", "stop_at=0.45"]),
+        (&event_mode, &[]),
+        (&path, &["--interface", "me", "--set", "mode=2"]),
+        (&path, &["--interface", "me", "--set", "stop_at=0.62"]),
+    ];
+    for (case, (fmu, sets)) in cases.iter().enumerate() {
+        for algorithm in ["jacobi", "ordered"] {
+            let run = |isolate: &[&str], out: &Path| {
+                run_to_csv(fmu, "1", out, &[&["--algorithm", algorithm][..], sets, isolate].concat())
+            };
+            let plain = dir.join(format!("plain-{case}-{algorithm}.csv"));
+            let out = run(&[], &plain);
+            assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            let expected = std::fs::read_to_string(&plain).unwrap();
+            assert!(expected.lines().count() > 5, "{case}: {expected}");
+            for isolate in ["--isolate=run", "--isolate=fmu", "--isolate"] {
+                let hosted = dir.join(format!("hosted-{case}-{algorithm}{isolate}.csv"));
+                let out = run(&[isolate], &hosted);
+                assert!(out.status.success(), "{case} {algorithm} {isolate}: {}", String::from_utf8_lossy(&out.stderr));
+                let got = std::fs::read_to_string(&hosted).unwrap();
+                assert_eq!(got, expected, "{case} {algorithm} {isolate}");
+            }
+        }
+    }
+    let out = run_to_csv(&path, "1", &dir.join("refused.csv"), &["--set", "mode=3", "--isolate=fmu"]);
+    assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("FMI 3.0 instances in host processes (--isolate)"), "{err}");
+    assert!(err.contains("cosim: model: fmi3EnterInitializationMode returned"), "{err}");
+    assert!(err.contains("fmi3SetInt64 (sent with fmi3EnterInitializationMode) returned"), "{err}");
+    assert!(err.contains("mode must be 1 or 2"), "{err}");
 }
 
-/// A misbehaving FMI 3.0 FMU under `--isolate=run`, as crash.c is for FMI 2.0: a write
-/// through NULL, abort() or exit(0) (which the host's exit guard reports) inside fmi3DoStep (Co-Simulation, the step from 0.5 s,
-/// crash_at = 0.45) or inside the fmi3UpdateDiscreteStates of the time event the FMU asks for
-/// at crash_at (Model Exchange) ends only the host: exit code 1, an error naming the
-/// instance, the call, the time and the signal or exit code, and the CSV with the rows
-/// before (Co-Simulation 0 .. 0.5 s; Model Exchange 0 .. 0.4 s, the grid points before the
-/// event), each equal to the same rows of a run without the crash.
+/// Systems with FMI 3.0 FMUs under `--isolate=fmu`: the closed loop of FMI 3.0 FMUs
+/// (target/ssp/nigel_closed_loop_fmi3.ssp) and the FMI 2.0 source, FMI 3.0 counter and FMI
+/// 2.0 gain of `fmi2_and_fmi3_instances_in_one_system` as an SSP give the CSV of the run in
+/// process byte for byte, under `jacobi` and `ordered` (the hosts' steps overlapped).
 #[test]
-fn a_crashing_fmi3_fmu_under_isolate_run_is_a_typed_error_with_the_rows_so_far() {
+fn isolated_systems_with_fmi3_fmus_equal_in_process() {
+    let Some((dir, counter_fmu)) = counter("fmi3-isolate-systems") else { return };
+    let (_, mixed) = mixed_system(&dir, &counter_fmu);
+    let closed_loop = common::plant_fmu().parent().unwrap().parent().unwrap().join("ssp/nigel_closed_loop_fmi3.ssp");
+    assert!(closed_loop.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", closed_loop.display());
+    for (name, ssp, stop, step) in [("mixed", &mixed, "1", "0.1"), ("closed-loop", &closed_loop, "0.3", "0.001")] {
+        for algorithm in ["jacobi", "ordered"] {
+            let run = |isolate: &[&str], out: &Path| {
+                let _ = std::fs::remove_file(out);
+                let mut args = vec!["run", ssp.to_str().unwrap(), "--stop-time", stop, "--step", step];
+                args.extend_from_slice(&["--algorithm", algorithm, "--output", out.to_str().unwrap()]);
+                args.extend_from_slice(isolate);
+                cosim(&args)
+            };
+            let plain = dir.join(format!("{name}-{algorithm}.csv"));
+            let out = run(&[], &plain);
+            assert!(out.status.success(), "{name} {algorithm}: {}", String::from_utf8_lossy(&out.stderr));
+            let hosted = dir.join(format!("{name}-{algorithm}-isolated.csv"));
+            let out = run(&["--isolate=fmu"], &hosted);
+            assert!(out.status.success(), "{name} {algorithm}: {}", String::from_utf8_lossy(&out.stderr));
+            let expected = std::fs::read_to_string(&plain).unwrap();
+            assert!(expected.lines().count() > 10, "{name}: {expected}");
+            assert_eq!(std::fs::read_to_string(&hosted).unwrap(), expected, "{name} {algorithm}");
+        }
+    }
+}
+
+/// A misbehaving FMI 3.0 FMU under `--isolate=run` and `--isolate=fmu`, as crash.c is for
+/// FMI 2.0: a write through NULL, abort() or exit(0) inside fmi3DoStep (Co-Simulation, the
+/// step from 0.5 s, crash_at = 0.45) or inside the fmi3UpdateDiscreteStates of the time
+/// event the FMU asks for at crash_at (Model Exchange) ends only the host: exit code 1, an error naming the instance, the call, the
+/// time and the signal or exit code (under `--isolate=run` the host's exit guard reports
+/// the exit(); under `--isolate=fmu` the master sees the FMU's host exit with code 0),
+/// and the CSV with the rows before (Co-Simulation 0 .. 0.5 s; Model Exchange 0 .. 0.4 s,
+/// the grid points before the event), each equal to the same rows of a run without the
+/// crash.
+#[test]
+fn a_crashing_fmi3_fmu_under_isolation_is_a_typed_error_with_the_rows_so_far() {
     let Some((dir, path)) = counter("fmi3-crash") else { return };
     let run = |extra: &[&str], out: &Path| run_to_csv(&path, "1", out, extra);
     let rows = |p: &Path| -> Vec<String> {
         std::fs::read_to_string(p).unwrap_or_default().lines().skip(1).map(String::from).collect()
     };
-    for (interface, function, time, kept) in
-        [("cs", "fmi3DoStep", "0.5", 6), ("me", "fmi3UpdateDiscreteStates", "0.45", 5)]
-    {
-        let whole = dir.join(format!("whole-{interface}.csv"));
-        let out = run(&["--interface", interface, "--isolate=run"], &whole);
+    for (interface, isolate, function, time, kept) in [
+        ("cs", "--isolate=run", "fmi3DoStep", "0.5", 6),
+        ("cs", "--isolate=fmu", "fmi3DoStep", "0.5", 6),
+        ("me", "--isolate=run", "fmi3UpdateDiscreteStates", "0.45", 5),
+        ("me", "--isolate=fmu", "fmi3UpdateDiscreteStates", "0.45", 5),
+    ] {
+        let whole = dir.join(format!("whole-{interface}{isolate}.csv"));
+        let out = run(&["--interface", interface, isolate], &whole);
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         for how in 1..=3 {
-            let crashed = dir.join(format!("crashed-{interface}-{how}.csv"));
+            let crashed = dir.join(format!("crashed-{interface}{isolate}-{how}.csv"));
             let how_arg = format!("crash_how={how}");
-            let out = run(
-                &["--interface", interface, "--isolate=run", "--set", "crash_at=0.45", "--set", &how_arg],
-                &crashed,
-            );
-            assert_eq!(out.status.code(), Some(1), "{interface} {how}");
+            let out = run(&["--interface", interface, isolate, "--set", "crash_at=0.45", "--set", &how_arg], &crashed);
+            assert_eq!(out.status.code(), Some(1), "{interface} {isolate} {how}");
             let err = String::from_utf8_lossy(&out.stderr);
-            let want = match how {
-                1 => format!("cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during {function} at t = {time} s"),
-                2 => format!("cosim: model: the FMU's host process was killed by signal 6 (SIGABRT) during {function} at t = {time} s"),
-                // the host's exit guard names the call the exit() came from, then ends with code 1
-                _ => format!("model (fmi3_counter.fmu) called exit() inside {function} at t = {time} s, ending the process in the middle of the run"),
+            let want = match (how, isolate) {
+                (1, _) => format!("cosim: model: the FMU's host process was killed by signal 11 (SIGSEGV) during {function} at t = {time} s"),
+                (2, _) => format!("cosim: model: the FMU's host process was killed by signal 6 (SIGABRT) during {function} at t = {time} s"),
+                // the host of the run's exit guard names the call the exit() came from, then ends with code 1
+                (_, "--isolate=run") => format!("model (fmi3_counter.fmu) called exit() inside {function} at t = {time} s, ending the process in the middle of the run"),
+                // the FMU's own host ends with the FMU's code
+                _ => format!("cosim: model: the FMU's host process exited with code 0 during {function} at t = {time} s"),
             };
-            assert!(err.lines().any(|l| l == want), "{interface} {how}: {err}");
-            assert_eq!(rows(&crashed), rows(&whole)[..kept], "{interface} {how}: the rows before the crash: {err}");
+            assert!(err.lines().any(|l| l == want), "{interface} {isolate} {how}: {err}");
+            assert_eq!(
+                rows(&crashed),
+                rows(&whole)[..kept],
+                "{interface} {isolate} {how}: the rows before the crash: {err}"
+            );
         }
     }
 }

@@ -278,106 +278,6 @@ fn checked_fmi3(xml: &str, path: &Path) -> Result<model_description::fmi3::Model
     Ok(md)
 }
 
-/// The table of an FMI 3.0 FMU imported isolated (its library never loaded here): the
-/// core functions are stubs that return fmi3Error, the others absent. No instance is ever
-/// made from it in this process ([`Instance::new`] refuses isolated FMUs).
-fn unloaded_fmi3_table() -> fmi_sys::fmi3::Fmi3Functions {
-    use fmi_sys::fmi3::*;
-    unsafe extern "C" fn version() -> *const c_char {
-        c"3.0".as_ptr()
-    }
-    unsafe extern "C" fn free(_: fmi3Instance) {}
-    unsafe extern "C" fn enter(_: fmi3Instance, _: fmi3Boolean, _: f64, _: f64, _: fmi3Boolean, _: f64) -> fmi3Status {
-        Fmi3Status::Error as fmi3Status
-    }
-    unsafe extern "C" fn one(_: fmi3Instance) -> fmi3Status {
-        Fmi3Status::Error as fmi3Status
-    }
-    unsafe extern "C" fn get(_: fmi3Instance, _: *const u32, _: usize, _: *mut f64, _: usize) -> fmi3Status {
-        Fmi3Status::Error as fmi3Status
-    }
-    unsafe extern "C" fn set(_: fmi3Instance, _: *const u32, _: usize, _: *const f64, _: usize) -> fmi3Status {
-        Fmi3Status::Error as fmi3Status
-    }
-    Fmi3Functions {
-        get_version: version,
-        free_instance: free,
-        enter_initialization_mode: enter,
-        exit_initialization_mode: one,
-        terminate: one,
-        get_float64: get,
-        set_float64: set,
-        set_debug_logging: None,
-        instantiate_model_exchange: None,
-        instantiate_co_simulation: None,
-        instantiate_scheduled_execution: None,
-        enter_event_mode: None,
-        reset: None,
-        get_float32: None,
-        get_int8: None,
-        get_uint8: None,
-        get_int16: None,
-        get_uint16: None,
-        get_int32: None,
-        get_uint32: None,
-        get_int64: None,
-        get_uint64: None,
-        get_boolean: None,
-        get_string: None,
-        get_binary: None,
-        get_clock: None,
-        set_float32: None,
-        set_int8: None,
-        set_uint8: None,
-        set_int16: None,
-        set_uint16: None,
-        set_int32: None,
-        set_uint32: None,
-        set_int64: None,
-        set_uint64: None,
-        set_boolean: None,
-        set_string: None,
-        set_binary: None,
-        set_clock: None,
-        get_number_of_variable_dependencies: None,
-        get_variable_dependencies: None,
-        get_fmu_state: None,
-        set_fmu_state: None,
-        free_fmu_state: None,
-        serialized_fmu_state_size: None,
-        serialize_fmu_state: None,
-        deserialize_fmu_state: None,
-        get_directional_derivative: None,
-        get_adjoint_derivative: None,
-        enter_configuration_mode: None,
-        exit_configuration_mode: None,
-        get_interval_decimal: None,
-        get_interval_fraction: None,
-        get_shift_decimal: None,
-        get_shift_fraction: None,
-        set_interval_decimal: None,
-        set_interval_fraction: None,
-        set_shift_decimal: None,
-        set_shift_fraction: None,
-        evaluate_discrete_states: None,
-        update_discrete_states: None,
-        enter_continuous_time_mode: None,
-        completed_integrator_step: None,
-        set_time: None,
-        set_continuous_states: None,
-        get_continuous_state_derivatives: None,
-        get_event_indicators: None,
-        get_continuous_states: None,
-        get_nominals_of_continuous_states: None,
-        get_number_of_event_indicators: None,
-        get_number_of_continuous_states: None,
-        enter_step_mode: None,
-        get_output_derivatives: None,
-        do_step: None,
-        activate_model_partition: None,
-    }
-}
-
 /// The problems of an FMI 3.0 description that make its import wrong, refused at load.
 const FMI3_REFUSED: &[model_description::fmi3::Rule] = {
     use model_description::fmi3::Rule as R;
@@ -547,7 +447,15 @@ impl Fmu {
             let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
             crate::elf::check_shared_library(&bytes)
                 .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
-            (None, unloaded_fmi3_table())
+            // as for FMI 2.0: without section headers every function is taken as present
+            let exported = crate::elf::exported_symbols(&bytes);
+            let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
+            // the 7 core functions, which `Fmi3Functions::load` requires, lead SYMBOLS
+            let core = fmi_sys::fmi3::functions::SYMBOLS.iter().take(7).map(|(s, _)| *s);
+            if let Some(symbol) = core.into_iter().find(|s| !present(s)) {
+                return Err(Error::MissingSymbol { path: shown, symbol });
+            }
+            (None, crate::isolate::proxy3::table(&present))
         } else {
             let library = load_library(&so, &shown, &relative)?;
             // SAFETY: the symbols are declared with the C signatures of the FMI 3.0 headers.
@@ -619,14 +527,21 @@ impl Fmu {
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
-        let Abi::Fmi2(functions) = &self.abi else {
-            return self.clone(); // FMI 3.0: refused by Instance::new_isolated
-        };
         if self.is_isolated() {
             return self.clone();
         }
+        let abi = match &self.abi {
+            Abi::Fmi2(functions) => Abi::Fmi2(crate::isolate::proxy::table(&|symbol| functions.has(symbol))),
+            Abi::Fmi3(a) => Abi::Fmi3(Box::new(crate::fmi3::Fmi3Abi {
+                functions: crate::isolate::proxy3::table(&|symbol| a.functions.has(symbol)),
+                description: a.description.clone(),
+                special: a.special.clone(),
+                token: a.token.clone(),
+                resource_path: a.resource_path.clone(),
+            })),
+        };
         Arc::new(Fmu {
-            abi: Abi::Fmi2(crate::isolate::proxy::table(&|symbol| functions.has(symbol))),
+            abi,
             allow_non_finite: self.allow_non_finite,
             _library: self._library.clone(),
             description: self.description.clone(),
@@ -637,7 +552,7 @@ impl Fmu {
             dir: None,
             isolated_from: Some(self.clone()),
             library_path: self.library_path.clone(),
-            not_in_view: Vec::new(),
+            not_in_view: self.not_in_view.clone(),
         })
     }
 
@@ -959,8 +874,9 @@ impl Instance {
         Ok(Instance::with(component, name, name_c, log, callbacks, fmu.clone(), None))
     }
 
-    /// `fmi2Instantiate` in a host process of its own (`isolation` names the host binary
-    /// and the per-call time limit; `run_deadline`: the run's deadline and its limit).
+    /// `fmi2Instantiate` / `fmi3InstantiateCoSimulation` in a host process of its own
+    /// (`isolation` names the host binary and the per-call time limit; `run_deadline`: the
+    /// run's deadline and its limit); FMI 3.0 Model Exchange by `fmi3InstantiateModelExchange`.
     pub fn new_isolated(
         fmu: &Arc<Fmu>,
         name: &str,
@@ -968,19 +884,17 @@ impl Instance {
         run_deadline: Option<(std::time::Instant, std::time::Duration)>,
     ) -> Result<Instance> {
         use crate::error::HostEnd;
-        if matches!(fmu.abi, Abi::Fmi3(_)) {
-            return Err(Error::Unsupported {
-                path: fmu.source.clone(),
-                feature: "FMI 3.0 instances in host processes (--isolate)".into(),
-            });
-        }
+        let fmi3 = matches!(fmu.abi, Abi::Fmi3(_));
         let fmu = fmu.isolated();
         let name_c = CString::new(name).map_err(|_| Error::Instance { name: name.into(), reason: "NUL in name" })?;
-        let guid = CString::new(fmu.description.guid.as_str())
-            .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
+        let instantiate = match (fmi3, fmu.interface) {
+            (false, _) => "fmi2Instantiate",
+            (true, Interface::CoSimulation) => "fmi3InstantiateCoSimulation",
+            (true, Interface::ModelExchange) => "fmi3InstantiateModelExchange",
+        };
         let failed = |m: String| Error::Host {
             instance: name.into(),
-            function: "fmi2Instantiate",
+            function: instantiate,
             time: 0.0,
             cause: HostEnd::Failed(m),
         };
@@ -990,6 +904,7 @@ impl Instance {
             crate::isolate::channel::Channel::start(
                 &host,
                 &fmu.library_path,
+                fmi3,
                 variables,
                 isolation.call_timeout,
                 run_deadline,
@@ -997,27 +912,46 @@ impl Instance {
             )
             .map_err(|cause| Error::Host {
                 instance: name.into(),
-                function: "fmi2Instantiate (loading the library)",
+                function: match instantiate {
+                    "fmi2Instantiate" => "fmi2Instantiate (loading the library)",
+                    "fmi3InstantiateCoSimulation" => "fmi3InstantiateCoSimulation (loading the library)",
+                    _ => "fmi3InstantiateModelExchange (loading the library)",
+                },
                 time: 0.0,
                 cause,
             })?,
         );
         let log = Box::<LogSink>::default();
         channel.log = &*log as *const LogSink;
-        let status = crate::isolate::proxy::instantiate_in(
-            &mut channel,
-            &name_c,
-            fmu.interface.fmi_type(),
-            &guid,
-            &fmu.resource_uri,
-        );
+        let status = match &fmu.abi {
+            Abi::Fmi2(_) => {
+                let guid = CString::new(fmu.description.guid.as_str())
+                    .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
+                crate::isolate::proxy::instantiate_in(
+                    &mut channel,
+                    &name_c,
+                    fmu.interface.fmi_type(),
+                    &guid,
+                    &fmu.resource_uri,
+                )
+            }
+            Abi::Fmi3(a) => {
+                let event_mode = match fmu.interface {
+                    Interface::CoSimulation => {
+                        Some(a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode))
+                    }
+                    Interface::ModelExchange => None,
+                };
+                crate::isolate::proxy3::instantiate_in(&mut channel, &name_c, &a.token, &a.resource_path, event_mode)
+            }
+        };
         if status != 0 {
             if let Some(cause) = channel.failure.clone() {
-                return Err(Error::Host { instance: name.into(), function: "fmi2Instantiate", time: 0.0, cause });
+                return Err(Error::Host { instance: name.into(), function: instantiate, time: 0.0, cause });
             }
             return Err(Error::Instantiate {
                 instance: name.into(),
-                function: "fmi2Instantiate",
+                function: instantiate,
                 log: log.recent_problems(),
             });
         }
@@ -1779,17 +1713,22 @@ impl Instance {
         })
     }
 
-    /// Isolated: hands `fmi2DoStep(time, step)` to the host without waiting for it, so
+    /// Isolated: hands `fmi2DoStep(time, step)` (or `fmi3DoStep`) to the host without waiting for it, so
     /// that the hosts of several instances step at the same time; the next
     /// [`Instance::do_step`] with the same arguments takes its answer. False (nothing done)
     /// in process, and when the instance cannot step in its state (`do_step` then says why).
     pub fn post_step(&mut self, time: f64, step: f64) -> bool {
-        let has_do_step = matches!(&self.fmu.abi, Abi::Fmi2(t) if t.do_step.is_some());
+        // FMI 3.0: the arguments of the first fmi3DoStep of `do_step_fmi3`
+        let (op, step) = match &self.fmu.abi {
+            Abi::Fmi2(t) if t.do_step.is_some() => (crate::isolate::Op::DoStep, step),
+            Abi::Fmi3(a) if a.functions.do_step.is_some() => (crate::isolate::Op::DoStep3, (time + step) - time),
+            _ => return false,
+        };
         let Some(host) = self.host.as_deref_mut() else { return false };
-        if self.state != InstanceState::Running || !has_do_step {
+        if self.state != InstanceState::Running {
             return false;
         }
-        crate::isolate::proxy::post_step(host, time, step);
+        crate::isolate::proxy::post_step(host, op, time, step);
         true
     }
 

@@ -71,6 +71,8 @@ pub(crate) struct Channel {
     gets_since_step: Option<usize>,
     /// Strings returned by `fmi2GetString`, valid until the next call.
     pub(crate) strings: Vec<std::ffi::CString>,
+    /// The values of the last `fmi3GetBinary`, which its pointers point into.
+    pub(crate) binaries: Vec<Vec<u8>>,
     /// The messages of the last call (also in the instance's log once it has one).
     last_records: Vec<LogRecord>,
     /// The posted call waiting for its answer, and when it was posted.
@@ -87,10 +89,12 @@ pub(crate) struct Channel {
 unsafe impl Send for Channel {}
 
 impl Channel {
-    /// Starts `host` for the library `library` of an FMU of `variables` variables.
+    /// Starts `host` for the library `library` (an FMI 3.0 one if `fmi3`) of an FMU of
+    /// `variables` variables.
     pub(crate) fn start(
         host: &Path,
         library: &Path,
+        fmi3: bool,
         variables: usize,
         call_timeout: Option<Duration>,
         run_deadline: Option<(Instant, Duration)>,
@@ -128,6 +132,7 @@ impl Channel {
             h.host_spin_ns = spin.host.as_nanos().min(u128::from(u32::MAX)) as u32;
             h.host_yield_every = spin.yield_every;
             h.host_adaptive = u32::from(spin.adaptive);
+            h.fmi3 = u32::from(fmi3);
         }
         let mut command = std::process::Command::new(host);
         command
@@ -164,6 +169,7 @@ impl Channel {
             prefetch_valid: false,
             gets_since_step: None,
             strings: Vec::new(),
+            binaries: Vec::new(),
             last_records: Vec::new(),
             pending: None,
             posted_step: None,

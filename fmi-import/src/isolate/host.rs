@@ -1,11 +1,14 @@
 //! The host process of an isolated instance (`cosim-host FD SIZE LIBRARY`): maps the
-//! region the master shares (descriptor `FD`, `SIZE` bytes), loads the FMU's library and
-//! answers the master's calls until `fmi2FreeInstance`, then exits 0. Whatever the FMU
+//! region the master shares (descriptor `FD`, `SIZE` bytes), loads the FMU's library (FMI
+//! 2.0 or FMI 3.0, as the header says) and answers the master's calls until the instance is
+//! freed, then exits 0. Whatever the FMU
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::{publish, wait_for, Header, Layout, Op, SpinGauge};
+use super::{fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
 use crate::fmu::{callbacks_for, load_functions, load_library, EventInfo, Functions, LogSink};
+use fmi_sys::fmi3::Fmi3Functions;
+use model_description::fmi3::ValueType;
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::path::Path;
 use std::time::Duration;
@@ -22,6 +25,26 @@ impl Region {
         // it is the host's turn.
         unsafe { &mut *(self.base as *mut Header) }
     }
+    /// The call's array arguments: their count `n`, the data area, the references at its
+    /// start, and the offset of what follows them (8-aligned).
+    fn call_arrays(&self) -> (usize, *mut u8, *const u32, usize) {
+        let n = self.header().n as usize;
+        let data: *mut u8 = self.at(self.layout.data);
+        (n, data, data as *const u32, (4 * n).div_ceil(8) * 8)
+    }
+
+    /// The three NUL-ended strings of an instantiation at the start of the data area.
+    ///
+    /// # Safety
+    /// The master wrote them there (`proxy::instantiate_with`).
+    unsafe fn three_strings(&self) -> [&CStr; 3] {
+        let first = CStr::from_ptr(self.at::<c_char>(self.layout.data));
+        let second_at = self.at::<u8>(self.layout.data).add(first.to_bytes().len() + 1);
+        let second = CStr::from_ptr(second_at as *const c_char);
+        let third = CStr::from_ptr(second_at.add(second.to_bytes().len() + 1) as *const c_char);
+        [first, second, third]
+    }
+
     fn at<T>(&self, offset: usize) -> *mut T {
         // SAFETY: offsets within the mapping (Layout), 8-aligned where f64 are read.
         unsafe { self.base.add(offset) as *mut T }
@@ -50,8 +73,18 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     let region = Region { base: base as *mut u8, layout };
     let log = Box::<LogSink>::default();
     let library = Path::new(library);
-    let loaded = load_library(library, library, &library.display().to_string())
-        .and_then(|lib| unsafe { load_functions(&lib, library) }.map(|f| (lib, f)));
+    let fmi3 = region.header().fmi3 == 1;
+    let loaded = load_library(library, library, &library.display().to_string()).and_then(|lib| {
+        // SAFETY: the library is of the generation the master read in its model description.
+        let functions = if fmi3 {
+            unsafe { Fmi3Functions::load(&lib) }
+                .map(Generation::Fmi3)
+                .map_err(|m| crate::Error::MissingSymbol { path: library.into(), symbol: m.0 })
+        } else {
+            unsafe { load_functions(&lib, library) }.map(Generation::Fmi2)
+        };
+        functions.map(|f| (lib, f))
+    });
     let mut seen = 0u32;
     let mut gauge = SpinGauge::new();
     let (_lib, functions) = match loaded {
@@ -65,7 +98,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
             return 0;
         }
     };
-    let mut host = Host { f: functions, c: std::ptr::null_mut(), log, _callbacks: None, strings: Vec::new() };
+    let mut host = Host { lib: functions, c: std::ptr::null_mut(), log, _callbacks: None, strings: Vec::new() };
     loop {
         wait_next(&region, &mut seen, &mut gauge);
         let h = region.header();
@@ -86,7 +119,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
                 None => 3,
             };
         }
-        if op == Some(Op::DoStep) && status <= 1 && h.prefetch > 0 {
+        if let (Some(Op::DoStep), true, Generation::Fmi2(f)) = (op, status <= 1 && h.prefetch > 0, &host.lib) {
             // each batch: its count, its references, room for its values (channel::record_len)
             let mut at = 0usize;
             let mut ok = true;
@@ -101,7 +134,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
                 let vrs = unsafe { record.add(8) } as *const u32;
                 let values = unsafe { record.add(8 + (4 * n).div_ceil(8) * 8) } as *mut f64;
                 // SAFETY: live component; n references and n values inside the prefetch area.
-                ok &= unsafe { (host.f.get_real)(host.c, vrs, n, values) } <= 1;
+                ok &= unsafe { (f.get_real)(host.c, vrs, n, values) } <= 1;
                 at += super::channel::record_len(n);
             }
             h.prefetched = ok as u32;
@@ -178,8 +211,15 @@ fn write_log_record(region: &Region, status: i32, cat: &[u8], msg: &[u8]) -> boo
     true
 }
 
+/// The library's functions, of its generation.
+#[allow(clippy::large_enum_variant)] // one per host process, never moved
+enum Generation {
+    Fmi2(Functions),
+    Fmi3(Fmi3Functions),
+}
+
 struct Host {
-    f: Functions,
+    lib: Generation,
     c: *mut c_void,
     log: Box<LogSink>,
     _callbacks: Option<Box<crate::fmu::CallbackFunctions>>,
@@ -199,14 +239,20 @@ impl Host {
             let vrs = unsafe { base.add(8) } as *const u32;
             let values = unsafe { base.add(8 + 4 * n) };
             // SAFETY: live component; n references and n values of the kind's type.
-            let s = unsafe {
-                match kind {
-                    0 => (self.f.set_real)(self.c, vrs, n, values as *const f64),
-                    1 => (self.f.set_integer)(self.c, vrs, n, values as *const c_int),
-                    _ => (self.f.set_boolean)(self.c, vrs, n, values as *const c_int),
+            let (s, width) = unsafe {
+                match (&self.lib, kind) {
+                    (Generation::Fmi2(f), 0) => ((f.set_real)(self.c, vrs, n, values as *const f64), 8),
+                    (Generation::Fmi2(f), 1) => ((f.set_integer)(self.c, vrs, n, values as *const c_int), 4),
+                    (Generation::Fmi2(f), _) => ((f.set_boolean)(self.c, vrs, n, values as *const c_int), 4),
+                    // FMI 3.0: QUEUED_FMI3 + the type's code (proxy3.rs), as many values as references
+                    (Generation::Fmi3(f), _) => {
+                        match kind.checked_sub(super::proxy3::QUEUED_FMI3).and_then(|k| fmi3_type(i64::from(k))) {
+                            Some(ty) => (typed(f, ty, true, self.c, vrs, n, values, n), super::fmi3_width(ty)),
+                            None => (3, 0),
+                        }
+                    }
                 }
             };
-            let width = if kind == 0 { 8 } else { 4 };
             p += (8 + 4 * n + width * n).div_ceil(8) * 8;
             if s > 1 {
                 h.queued_failed = k;
@@ -219,8 +265,13 @@ impl Host {
 
     fn free(&mut self) {
         if !self.c.is_null() {
-            // SAFETY: the component from fmi2Instantiate, freed once.
-            unsafe { (self.f.free_instance)(self.c) };
+            // SAFETY: the component from the instantiation, freed once.
+            unsafe {
+                match &self.lib {
+                    Generation::Fmi2(f) => (f.free_instance)(self.c),
+                    Generation::Fmi3(f) => (f.free_instance)(self.c),
+                }
+            };
             self.c = std::ptr::null_mut();
         }
     }
@@ -233,32 +284,39 @@ impl Host {
         }
     }
 
-    /// One fmi2 call with its arguments from the region, results into it.
+    /// One call with its arguments from the region, results into it, to the library's
+    /// generation (an op of the other generation is an error).
     fn call(&mut self, op: Op, region: &Region) -> i32 {
+        match &self.lib {
+            Generation::Fmi2(f) => {
+                let f = *f;
+                self.call2(&f, op, region)
+            }
+            Generation::Fmi3(f) => {
+                let f = *f;
+                self.call3(&f, op, region)
+            }
+        }
+    }
+
+    /// One fmi2 call.
+    fn call2(&mut self, f: &Functions, op: Op, region: &Region) -> i32 {
         let h = region.header();
-        let l = region.layout;
-        let n = h.n as usize;
-        let data: *mut u8 = region.at(l.data);
-        let vrs = data as *const u32;
-        let after_vrs = (4 * n).div_ceil(8) * 8;
+        let (n, data, vrs, after_vrs) = region.call_arrays();
         let c = self.c;
-        let f = &self.f;
         let missing = 3;
         // SAFETY: every pointer is inside the data area, laid out by the proxy for this
         // op (proxy.rs); the component is live (the master's state machine orders calls).
         unsafe {
             match op {
                 Op::Instantiate => {
-                    let name = CStr::from_ptr(data as *const c_char);
-                    let guid_at = data.add(name.to_bytes().len() + 1);
-                    let guid = CStr::from_ptr(guid_at as *const c_char);
-                    let uri_at = guid_at.add(guid.to_bytes().len() + 1);
+                    let [name, guid, uri] = region.three_strings();
                     let callbacks = callbacks_for(&self.log);
                     self.c = (f.instantiate)(
                         name.as_ptr(),
                         h.i[0] as c_int,
                         guid.as_ptr(),
-                        uri_at as *const c_char,
+                        uri.as_ptr(),
                         &*callbacks,
                         h.i[1] as c_int,
                         h.i[2] as c_int,
@@ -280,30 +338,9 @@ impl Host {
                 Op::GetReal => (f.get_real)(c, vrs, n, data.add(after_vrs) as *mut f64),
                 Op::GetInteger => (f.get_integer)(c, vrs, n, data.add(after_vrs) as *mut c_int),
                 Op::GetBoolean => (f.get_boolean)(c, vrs, n, data.add(after_vrs) as *mut c_int),
-                Op::GetString => {
-                    let mut ptrs: Vec<*const c_char> = vec![std::ptr::null(); n];
-                    let s = (f.get_string)(c, vrs, n, ptrs.as_mut_ptr());
-                    let mut p = after_vrs;
-                    for q in ptrs {
-                        let bytes = if q.is_null() { &[][..] } else { CStr::from_ptr(q).to_bytes() };
-                        if p + bytes.len() + 1 > l.data_len {
-                            return 3;
-                        }
-                        std::ptr::copy_nonoverlapping(bytes.as_ptr(), data.add(p), bytes.len());
-                        *data.add(p + bytes.len()) = 0;
-                        p += bytes.len() + 1;
-                    }
-                    s
-                }
+                Op::GetString => get_strings(region, n, |ptrs| (f.get_string)(c, vrs, n, ptrs)),
                 Op::SetString => {
-                    self.strings.clear();
-                    let mut p = after_vrs;
-                    for _ in 0..n {
-                        let s = CStr::from_ptr(data.add(p) as *const c_char);
-                        p += s.to_bytes().len() + 1;
-                        self.strings.push(s.to_owned());
-                    }
-                    let ptrs: Vec<*const c_char> = self.strings.iter().map(|s| s.as_ptr()).collect();
+                    let ptrs = self.strings_of(region, n);
                     (f.set_string)(c, vrs, n, ptrs.as_ptr())
                 }
                 Op::DoStep => f.do_step.map_or(missing, |g| g(c, h.f[0], h.f[1], h.i[0] as c_int)),
@@ -351,7 +388,232 @@ impl Host {
                     f.get_nominals_of_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n))
                 }
                 Op::Free | Op::Flush => 0,
+                _ => missing,
             }
         }
+    }
+
+    /// The strings the master wrote after the references (n of them, each NUL-ended),
+    /// kept for the call; their pointers.
+    ///
+    /// # Safety
+    /// The data area holds n NUL-ended strings after the references (proxy.rs).
+    unsafe fn strings_of(&mut self, region: &Region, n: usize) -> Vec<*const c_char> {
+        let data: *mut u8 = region.at(region.layout.data);
+        self.strings.clear();
+        let mut p = (4 * n).div_ceil(8) * 8;
+        for _ in 0..n {
+            let s = CStr::from_ptr(data.add(p) as *const c_char);
+            p += s.to_bytes().len() + 1;
+            self.strings.push(s.to_owned());
+        }
+        self.strings.iter().map(|s| s.as_ptr()).collect()
+    }
+
+    /// One fmi3 call.
+    fn call3(&mut self, f: &Fmi3Functions, op: Op, region: &Region) -> i32 {
+        let (h, l) = (region.header(), region.layout);
+        let (n, data, vrs, after_vrs) = region.call_arrays();
+        let c = self.c;
+        let missing = 3;
+        // SAFETY: as in call2: every pointer inside the data area, laid out by the proxy
+        // for this op (proxy3.rs); the component live.
+        unsafe {
+            match op {
+                Op::Instantiate3 => {
+                    let [name, token, resources] = region.three_strings();
+                    let environment = &*self.log as *const LogSink as *mut c_void;
+                    let Some(g) = f.instantiate_co_simulation else { return missing };
+                    // visible false, logging off, eventModeUsed as asked, early return
+                    // allowed, no intermediate update: as `Instance::new_fmi3`
+                    self.c = g(
+                        name.as_ptr(),
+                        token.as_ptr(),
+                        resources.as_ptr(),
+                        0,
+                        0,
+                        h.i[0] as u8,
+                        1,
+                        std::ptr::null(),
+                        0,
+                        environment,
+                        Some(crate::fmi3::log_message),
+                        None,
+                    );
+                    if self.c.is_null() {
+                        3
+                    } else {
+                        0
+                    }
+                }
+                Op::InstantiateModelExchange3 => {
+                    let [name, token, resources] = region.three_strings();
+                    let environment = &*self.log as *const LogSink as *mut c_void;
+                    let Some(g) = f.instantiate_model_exchange else { return missing };
+                    // visible false, logging off: as `Instance::new_fmi3`
+                    let logger = Some(crate::fmi3::log_message as fmi_sys::fmi3::Fmi3LogMessageCallback);
+                    self.c = g(name.as_ptr(), token.as_ptr(), resources.as_ptr(), 0, 0, environment, logger);
+                    if self.c.is_null() {
+                        3
+                    } else {
+                        0
+                    }
+                }
+                Op::EnterContinuousTimeMode3 => f.enter_continuous_time_mode.map_or(missing, |g| g(c)),
+                Op::CompletedIntegratorStep3 => {
+                    let (mut event, mut terminate) = (0u8, 0u8);
+                    let r =
+                        f.completed_integrator_step.map_or(missing, |g| g(c, h.i[0] as u8, &mut event, &mut terminate));
+                    h.i[1] = i64::from(event);
+                    h.i[2] = i64::from(terminate);
+                    r
+                }
+                Op::SetTime3 => f.set_time.map_or(missing, |g| g(c, h.f[0])),
+                Op::SetContinuousStates3 => f.set_continuous_states.map_or(missing, |g| g(c, data as *const f64, n)),
+                Op::GetContinuousStateDerivatives3 => {
+                    f.get_continuous_state_derivatives.map_or(missing, |g| g(c, data as *mut f64, n))
+                }
+                Op::GetEventIndicators3 => f.get_event_indicators.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetContinuousStates3 => f.get_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n)),
+                Op::GetNominalsOfContinuousStates3 => {
+                    f.get_nominals_of_continuous_states.map_or(missing, |g| g(c, data as *mut f64, n))
+                }
+                Op::EnterInitializationMode3 => {
+                    (f.enter_initialization_mode)(c, h.i[0] as u8, h.f[0], h.f[1], h.i[1] as u8, h.f[2])
+                }
+                Op::ExitInitializationMode3 => (f.exit_initialization_mode)(c),
+                Op::Terminate3 => (f.terminate)(c),
+                Op::Reset3 => f.reset.map_or(missing, |g| g(c)),
+                Op::Get3 | Op::Set3 => {
+                    let Some(ty) = fmi3_type(h.i[0]) else { return missing };
+                    typed(f, ty, op == Op::Set3, c, vrs, n, data.add(after_vrs), h.i[1] as usize)
+                }
+                Op::GetString3 => {
+                    let Some(g) = f.get_string else { return missing };
+                    get_strings(region, n, |ptrs| g(c, vrs, n, ptrs, n))
+                }
+                Op::GetBinary3 => {
+                    let Some(g) = f.get_binary else { return missing };
+                    let n_values = h.i[1] as usize;
+                    let mut sizes = vec![0usize; n_values];
+                    let mut values: Vec<*const u8> = vec![std::ptr::null(); n_values];
+                    let s = g(c, vrs, n, sizes.as_mut_ptr(), values.as_mut_ptr(), n_values);
+                    let mut p = after_vrs + 8 * n_values;
+                    for (k, (size, value)) in sizes.iter().zip(&values).enumerate() {
+                        if p + size > l.data_len {
+                            return 3;
+                        }
+                        *(data.add(after_vrs + 8 * k) as *mut u64) = *size as u64;
+                        if *size > 0 && !value.is_null() {
+                            std::ptr::copy_nonoverlapping(*value, data.add(p), *size);
+                        }
+                        p += size;
+                    }
+                    s
+                }
+                Op::SetString3 => {
+                    let Some(g) = f.set_string else { return missing };
+                    let ptrs = self.strings_of(region, n);
+                    g(c, vrs, n, ptrs.as_ptr(), n)
+                }
+                Op::DoStep3 => {
+                    let (mut event, mut terminate, mut early, mut reached) = (0u8, 0u8, 0u8, h.f[0]);
+                    let r = f.do_step.map_or(missing, |g| {
+                        g(c, h.f[0], h.f[1], h.i[0] as u8, &mut event, &mut terminate, &mut early, &mut reached)
+                    });
+                    h.i[1] = i64::from(event);
+                    h.i[2] = i64::from(terminate);
+                    h.i[3] = i64::from(early);
+                    h.f[2] = reached;
+                    r
+                }
+                Op::EnterEventMode3 => f.enter_event_mode.map_or(missing, |g| g(c)),
+                Op::EnterStepMode3 => f.enter_step_mode.map_or(missing, |g| g(c)),
+                Op::UpdateDiscreteStates3 => {
+                    // the five Booleans as bytes 0..5, nextEventTime at byte 8
+                    let b = data;
+                    f.update_discrete_states
+                        .map_or(missing, |g| g(c, b, b.add(1), b.add(2), b.add(3), b.add(4), b.add(8) as *mut f64))
+                }
+                Op::GetFmuState3 => {
+                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
+                    let r = f.get_fmu_state.map_or(missing, |g| g(c, &mut s));
+                    h.i[0] = s as usize as i64;
+                    r
+                }
+                Op::SetFmuState3 => f.set_fmu_state.map_or(missing, |g| g(c, h.i[0] as usize as *mut c_void)),
+                Op::FreeFmuState3 => {
+                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
+                    let r = f.free_fmu_state.map_or(missing, |g| g(c, &mut s));
+                    h.i[0] = s as usize as i64;
+                    r
+                }
+                Op::Free | Op::Flush => 0,
+                _ => missing,
+            }
+        }
+    }
+}
+
+/// A string getter's results (`call` fills the n pointers) copied after the references,
+/// each NUL-ended; a status 3 if they do not fit.
+///
+/// # Safety
+/// `call` writes n pointers, each null or to a NUL-ended string.
+unsafe fn get_strings(region: &Region, n: usize, call: impl FnOnce(*mut *const c_char) -> c_int) -> c_int {
+    let data: *mut u8 = region.at(region.layout.data);
+    let mut ptrs: Vec<*const c_char> = vec![std::ptr::null(); n];
+    let s = call(ptrs.as_mut_ptr());
+    let mut p = (4 * n).div_ceil(8) * 8;
+    for q in ptrs {
+        let bytes = if q.is_null() { &[][..] } else { CStr::from_ptr(q).to_bytes() };
+        if p + bytes.len() + 1 > region.layout.data_len {
+            return 3;
+        }
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), data.add(p), bytes.len());
+        *data.add(p + bytes.len()) = 0;
+        p += bytes.len() + 1;
+    }
+    s
+}
+
+/// The typed `fmi3Get*` / `fmi3Set*` of `ty` (absent from the library: 3).
+///
+/// # Safety
+/// `vrs` holds n references and `values` room for `n_values` values of `ty`, 8-aligned.
+#[allow(clippy::too_many_arguments)]
+unsafe fn typed(
+    f: &Fmi3Functions,
+    ty: ValueType,
+    set: bool,
+    c: *mut c_void,
+    vrs: *const u32,
+    n: usize,
+    values: *mut u8,
+    n_values: usize,
+) -> c_int {
+    macro_rules! go {
+        ($get:ident, $set:ident, $t:ty) => {
+            if set {
+                f.$set.map_or(3, |g| g(c, vrs, n, values as *const $t, n_values))
+            } else {
+                f.$get.map_or(3, |g| g(c, vrs, n, values as *mut $t, n_values))
+            }
+        };
+    }
+    match ty {
+        ValueType::Float64 if set => (f.set_float64)(c, vrs, n, values as *const f64, n_values),
+        ValueType::Float64 => (f.get_float64)(c, vrs, n, values as *mut f64, n_values),
+        ValueType::Float32 => go!(get_float32, set_float32, f32),
+        ValueType::Int8 => go!(get_int8, set_int8, i8),
+        ValueType::UInt8 => go!(get_uint8, set_uint8, u8),
+        ValueType::Int16 => go!(get_int16, set_int16, i16),
+        ValueType::UInt16 => go!(get_uint16, set_uint16, u16),
+        ValueType::Int32 => go!(get_int32, set_int32, i32),
+        ValueType::UInt32 => go!(get_uint32, set_uint32, u32),
+        ValueType::Int64 => go!(get_int64, set_int64, i64),
+        ValueType::UInt64 => go!(get_uint64, set_uint64, u64),
+        ValueType::Boolean => go!(get_boolean, set_boolean, u8),
+        _ => 3,
     }
 }

@@ -7,7 +7,8 @@
 //! with two sequence numbers (futex words) and the arguments of one call, then the
 //! arrays of the call (value references, values, states), then the messages the FMU
 //! logged during it. A call is one round trip: the master writes the request and bumps
-//! the request number; the host runs the fmi2 function on the real FMU, writes the
+//! the request number; the host runs the FMU's function (FMI 2.0 or FMI 3.0, the
+//! library's generation given in the header), writes the
 //! results, the status and the log, and sets the response number. Each side spins while
 //! that pays (see [`Spin`]), then sleeps on the futex (woken only if it sleeps). While it waits
 //! the master checks every 10 ms that the host is alive (`waitpid`) and the call's and
@@ -25,8 +26,10 @@
 //! named in the log.
 //!
 //! The master's side is an [`Instance`](crate::Instance) whose function table is the
-//! proxy of this module (`proxy.rs`): its state machine, status handling and log are the
-//! in-process ones. The host's side is [`host::run`], the whole of `cosim-host`.
+//! proxy of this module (`proxy.rs` for FMI 2.0, `proxy3.rs` for FMI 3.0): its state
+//! machine, status handling and log are the in-process ones. FMI 3.0's sets of scalars
+//! are queued as FMI 2.0's are (a set of array values is a call); its Reals are read with a
+//! call (no prefetch). The host's side is [`host::run`], the whole of `cosim-host`.
 //!
 //! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
 //! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.
@@ -34,7 +37,9 @@
 pub(crate) mod channel;
 pub mod host;
 pub(crate) mod proxy;
+pub(crate) mod proxy3;
 
+use model_description::fmi3::ValueType;
 use std::path::Path;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::sync::OnceLock;
@@ -55,7 +60,7 @@ pub fn null_round_trips(
     let spin = Spin::of_run();
     let mut channels = Vec::new();
     for _ in 0..hosts {
-        channels.push(channel::Channel::start(host, library, 16, None, None, spin).map_err(|e| e.to_string())?);
+        channels.push(channel::Channel::start(host, library, false, 16, None, None, spin).map_err(|e| e.to_string())?);
     }
     let start = Instant::now();
     for _ in 0..n {
@@ -102,7 +107,7 @@ impl Isolation {
     }
 }
 
-/// Declares the calls of the protocol once: each variant with the fmi2 function it stands for.
+/// Declares the calls of the protocol once: each variant with the function it stands for.
 /// The numbers on the wire are the variants' positions from 1 (0 is never a request).
 macro_rules! protocol_ops {
     ($first:ident => $first_function:literal, $($(#[$doc:meta])* $op:ident => $function:literal,)*) => {
@@ -121,7 +126,7 @@ macro_rules! protocol_ops {
                 Op::ALL.get((v as usize).checked_sub(1)?).copied()
             }
 
-            /// The fmi2 function it is.
+            /// The function it is.
             pub(crate) fn function(self) -> &'static str {
                 match self {
                     Op::$first => $first_function,
@@ -163,6 +168,59 @@ protocol_ops! {
     GetNominalsOfContinuousStates => "fmi2GetNominalsOfContinuousStates",
     /// Only the queued sets.
     Flush => "fmi2Set*",
+    // FMI 3.0 (a host of an FMI 3.0 library answers only these, Flush and Free)
+    Instantiate3 => "fmi3InstantiateCoSimulation",
+    EnterInitializationMode3 => "fmi3EnterInitializationMode",
+    ExitInitializationMode3 => "fmi3ExitInitializationMode",
+    Terminate3 => "fmi3Terminate",
+    Reset3 => "fmi3Reset",
+    /// A typed `fmi3Get*`: the type's code in `i[0]` ([`fmi3_type_code`]), `nValues` in `i[1]`.
+    Get3 => "fmi3Get*",
+    /// A typed `fmi3Set*`, arguments as for `Get3`.
+    Set3 => "fmi3Set*",
+    GetString3 => "fmi3GetString",
+    /// `nValues` in `i[1]`; the answer: the sizes (u64) after the references, then the bytes.
+    GetBinary3 => "fmi3GetBinary",
+    SetString3 => "fmi3SetString",
+    DoStep3 => "fmi3DoStep",
+    EnterEventMode3 => "fmi3EnterEventMode",
+    UpdateDiscreteStates3 => "fmi3UpdateDiscreteStates",
+    EnterStepMode3 => "fmi3EnterStepMode",
+    GetFmuState3 => "fmi3GetFMUState",
+    SetFmuState3 => "fmi3SetFMUState",
+    FreeFmuState3 => "fmi3FreeFMUState",
+    InstantiateModelExchange3 => "fmi3InstantiateModelExchange",
+    EnterContinuousTimeMode3 => "fmi3EnterContinuousTimeMode",
+    CompletedIntegratorStep3 => "fmi3CompletedIntegratorStep",
+    SetTime3 => "fmi3SetTime",
+    SetContinuousStates3 => "fmi3SetContinuousStates",
+    GetContinuousStateDerivatives3 => "fmi3GetContinuousStateDerivatives",
+    GetEventIndicators3 => "fmi3GetEventIndicators",
+    GetContinuousStates3 => "fmi3GetContinuousStates",
+    GetNominalsOfContinuousStates3 => "fmi3GetNominalsOfContinuousStates",
+}
+
+/// The code on the wire of the value type `ty` of `Op::Get3` / `Op::Set3`: its position in
+/// `ValueType::ALL`.
+pub(crate) fn fmi3_type_code(ty: ValueType) -> i64 {
+    ValueType::ALL.iter().position(|t| *t == ty).map_or(-1, |k| k as i64)
+}
+
+/// The value type of wire code `code`.
+pub(crate) fn fmi3_type(code: i64) -> Option<ValueType> {
+    ValueType::ALL.get(usize::try_from(code).ok()?).copied()
+}
+
+/// Bytes per value of `ty` (`fmi3Boolean`, a C `bool`: one byte); 0 for a type the
+/// protocol does not carry as values.
+pub(crate) fn fmi3_width(ty: ValueType) -> usize {
+    match ty {
+        ValueType::Float64 | ValueType::Int64 | ValueType::UInt64 => 8,
+        ValueType::Float32 | ValueType::Int32 | ValueType::UInt32 => 4,
+        ValueType::Int16 | ValueType::UInt16 => 2,
+        ValueType::Int8 | ValueType::UInt8 | ValueType::Boolean => 1,
+        _ => 0,
+    }
 }
 
 /// The header at the start of the shared region.
@@ -197,6 +255,8 @@ pub(crate) struct Header {
     pub(crate) prefetch: u32,
     /// The prefetch was read (1) after the last step.
     pub(crate) prefetched: u32,
+    /// 1: the library is an FMI 3.0 one (set by the master before the host starts).
+    pub(crate) fmi3: u32,
     /// Array lengths and scalar arguments of the call.
     pub(crate) n: u64,
     pub(crate) f: [f64; 4],

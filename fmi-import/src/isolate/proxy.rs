@@ -17,13 +17,13 @@ type Component = *mut c_void;
 ///
 /// # Safety
 /// `c` is the address of the live channel of the instance calling (proxy table).
-unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
+pub(super) unsafe fn ch<'a>(c: Component) -> &'a mut Channel {
     let channel = &mut *(c as *mut Channel);
     channel.settle();
     channel
 }
 
-fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
+pub(super) fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
     let data = channel.data();
     for (k, vr) in vrs.iter().enumerate() {
         data[4 * k..4 * k + 4].copy_from_slice(&vr.to_ne_bytes());
@@ -31,11 +31,11 @@ fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
     (4 * vrs.len()).div_ceil(8) * 8
 }
 
-fn fits(channel: &mut Channel, bytes: usize) -> bool {
+pub(super) fn fits(channel: &mut Channel, bytes: usize) -> bool {
     bytes <= channel.data().len()
 }
 
-unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
+pub(super) unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
     if n == 0 || p.is_null() {
         &[]
     } else {
@@ -43,7 +43,7 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
     }
 }
 
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> &'a mut [T] {
+pub(super) unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> &'a mut [T] {
     if n == 0 || p.is_null() {
         &mut []
     } else {
@@ -70,14 +70,19 @@ unsafe extern "C" fn instantiate(
 
 /// `fmi2Instantiate` in the host of `channel`; the fmi2 status.
 pub(crate) fn instantiate_in(channel: &mut Channel, name: &CStr, fmi_type: c_int, guid: &CStr, uri: &CStr) -> i32 {
-    let bytes: Vec<u8> = [name.to_bytes_with_nul(), guid.to_bytes_with_nul(), uri.to_bytes_with_nul()].concat();
+    instantiate_with(channel, Op::Instantiate, [name, guid, uri], fmi_type as i64)
+}
+
+/// An instantiation (`op`) with its three strings in the data area, one after the other,
+/// and its one flag in `i[0]`; the status.
+pub(super) fn instantiate_with(channel: &mut Channel, op: Op, strings: [&CStr; 3], flag: i64) -> i32 {
+    let bytes: Vec<u8> = strings.iter().flat_map(|s| s.to_bytes_with_nul()).copied().collect();
     if !fits(channel, bytes.len()) {
         return 3;
     }
     channel.data()[..bytes.len()].copy_from_slice(&bytes);
-    let h = channel.header();
-    h.i = [fmi_type as i64, 0, 0, 0];
-    channel.call(Op::Instantiate)
+    channel.header().i = [flag, 0, 0, 0];
+    channel.call(op)
 }
 
 unsafe extern "C" fn free_instance(c: Component) {
@@ -92,21 +97,29 @@ unsafe extern "C" fn setup_experiment(
     stop_defined: c_int,
     stop: f64,
 ) -> c_int {
-    let channel = ch(c);
-    let h = channel.header();
-    h.i = [tol_defined as i64, stop_defined as i64, 0, 0];
-    h.f = [tol, start, stop, 0.0];
-    channel.last_time = start;
-    channel.call(Op::SetupExperiment)
+    experiment(c, Op::SetupExperiment, [tol_defined != 0, stop_defined != 0], [tol, start, stop])
 }
 
+/// The call (`op`) that gives the experiment: tolerance and stop time defined, the
+/// tolerance, start and stop time.
+pub(super) unsafe fn experiment(c: Component, op: Op, defined: [bool; 2], [tol, start, stop]: [f64; 3]) -> c_int {
+    let channel = ch(c);
+    let h = channel.header();
+    h.i = [i64::from(defined[0]), i64::from(defined[1]), 0, 0];
+    h.f = [tol, start, stop, 0.0];
+    channel.last_time = start;
+    channel.call(op)
+}
+
+/// A proxy function of the instance alone: one call of `$op`.
 macro_rules! plain {
     ($name:ident, $op:expr) => {
-        unsafe extern "C" fn $name(c: Component) -> c_int {
-            ch(c).call($op)
+        unsafe extern "C" fn $name(c: *mut std::ffi::c_void) -> std::ffi::c_int {
+            super::proxy::ch(c).call($op)
         }
     };
 }
+pub(super) use plain;
 plain!(enter_initialization_mode, Op::EnterInitializationMode);
 plain!(exit_initialization_mode, Op::ExitInitializationMode);
 plain!(terminate, Op::Terminate);
@@ -158,6 +171,12 @@ unsafe extern "C" fn get_boolean(c: Component, vr: *const u32, n: usize, v: *mut
 }
 
 unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut *const c_char) -> c_int {
+    get_strings(c, vr, n, v, Op::GetString)
+}
+
+/// A string getter (`op`: the fmi2 or the fmi3 one) of n scalars; the strings stay in the
+/// channel until its next string read.
+pub(super) unsafe fn get_strings(c: Component, vr: *const u32, n: usize, v: *mut *const c_char, op: Op) -> c_int {
     let channel = ch(c);
     let (vrs, out) = (slice(vr, n), slice_mut(v, n));
     if !fits(channel, 4 * n + 8) {
@@ -165,7 +184,7 @@ unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut 
     }
     let at = vrs_into(channel, vrs);
     channel.header().n = n as u64;
-    let s = channel.call(Op::GetString);
+    let s = channel.call(op);
     let mut strings = Vec::with_capacity(n);
     {
         let data = channel.data();
@@ -183,7 +202,14 @@ unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut 
     s
 }
 
-unsafe fn queue(c: Component, kind: u32, function: &'static str, vr: *const u32, n: usize, bytes: &[u8]) -> c_int {
+pub(super) unsafe fn queue(
+    c: Component,
+    kind: u32,
+    function: &'static str,
+    vr: *const u32,
+    n: usize,
+    bytes: &[u8],
+) -> c_int {
     let channel = ch(c);
     let vrs = slice(vr, n);
     if channel.queue_set(kind, function, vrs, bytes) {
@@ -217,6 +243,11 @@ unsafe extern "C" fn set_boolean(c: Component, vr: *const u32, n: usize, v: *con
 }
 
 unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *const *const c_char) -> c_int {
+    set_strings(c, vr, n, v, Op::SetString)
+}
+
+/// A string setter (`op`: the fmi2 or the fmi3 one) of n scalars.
+pub(super) unsafe fn set_strings(c: Component, vr: *const u32, n: usize, v: *const *const c_char, op: Op) -> c_int {
     let channel = ch(c);
     let vrs = slice(vr, n);
     let values = slice(v, n);
@@ -233,55 +264,61 @@ unsafe extern "C" fn set_string(c: Component, vr: *const u32, n: usize, v: *cons
     let at = vrs_into(channel, vrs);
     channel.data()[at..at + bytes.len()].copy_from_slice(&bytes);
     channel.header().n = n as u64;
-    channel.call(Op::SetString)
+    channel.call(op)
 }
 
-/// `fmi2DoStep(t, h)` posted to the host (see [`Channel::post`]); `do_step` with the same
-/// arguments collects it.
-pub(crate) fn post_step(channel: &mut Channel, t: f64, h: f64) {
+/// `fmi2DoStep(t, h)` or `fmi3DoStep(t, h)` (`op`) posted to the host (see
+/// [`Channel::post`]); `do_step` with the same arguments collects it.
+pub(crate) fn post_step(channel: &mut Channel, op: Op, t: f64, h: f64) {
     channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
     hdr.i = [1, 0, 0, 0];
     channel.last_time = t;
     channel.posted_step = Some((t, h));
-    channel.post(Op::DoStep);
+    channel.post(op);
 }
 
 unsafe extern "C" fn do_step(c: Component, t: f64, h: f64, no_set_prior: c_int) -> c_int {
+    step(c, Op::DoStep, t, h, no_set_prior != 0)
+}
+
+/// A step (`op`: `fmi2DoStep` or `fmi3DoStep`) from `t` over `h`: the answer to the one
+/// posted with these arguments, or a call of its own.
+pub(super) unsafe fn step(c: Component, op: Op, t: f64, h: f64, no_set_prior: bool) -> c_int {
     let channel = &mut *(c as *mut Channel);
-    if channel.is_pending(Op::DoStep) && channel.posted_step == Some((t, h)) && no_set_prior == 1 {
+    if channel.is_pending(op) && channel.posted_step == Some((t, h)) && no_set_prior {
         channel.posted_step = None;
         return channel.collect();
     }
     channel.settle();
     let hdr = channel.header();
     hdr.f = [t, h, 0.0, 0.0];
-    hdr.i = [no_set_prior as i64, 0, 0, 0];
+    hdr.i = [i64::from(no_set_prior), 0, 0, 0];
     channel.last_time = t;
-    channel.call(Op::DoStep)
+    channel.call(op)
+}
+
+/// A call on a saved state (`op`: get, set or free, of either generation): the host's
+/// pointer to it goes there and back in `i[0]`.
+pub(super) unsafe fn state_call(c: Component, s: *mut *mut c_void, op: Op) -> c_int {
+    let channel = ch(c);
+    channel.header().i[0] = *s as usize as i64;
+    let r = channel.call(op);
+    *s = channel.header().i[0] as usize as *mut c_void;
+    r
 }
 
 unsafe extern "C" fn get_fmu_state(c: Component, s: *mut *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = *s as usize as i64;
-    let r = channel.call(Op::GetFmuState);
-    *s = channel.header().i[0] as usize as *mut c_void;
-    r
+    state_call(c, s, Op::GetFmuState)
 }
 
-unsafe extern "C" fn set_fmu_state(c: Component, s: *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = s as usize as i64;
-    channel.call(Op::SetFmuState)
+unsafe extern "C" fn set_fmu_state(c: Component, mut s: *mut c_void) -> c_int {
+    state_call(c, &mut s, Op::SetFmuState)
 }
 
 unsafe extern "C" fn free_fmu_state(c: Component, s: *mut *mut c_void) -> c_int {
-    let channel = ch(c);
-    channel.header().i[0] = *s as usize as i64;
-    let r = channel.call(Op::FreeFmuState);
-    *s = channel.header().i[0] as usize as *mut c_void;
-    r
+    state_call(c, s, Op::FreeFmuState)
 }
 
 unsafe extern "C" fn get_boolean_status(c: Component, kind: c_int, v: *mut c_int) -> c_int {
@@ -324,13 +361,23 @@ unsafe extern "C" fn completed_integrator_step(
 }
 
 unsafe extern "C" fn set_time(c: Component, t: f64) -> c_int {
+    time_call(c, t, Op::SetTime)
+}
+
+/// `fmi2SetTime` / `fmi3SetTime` (`op`).
+pub(super) unsafe fn time_call(c: Component, t: f64, op: Op) -> c_int {
     let channel = ch(c);
     channel.header().f[0] = t;
     channel.last_time = t;
-    channel.call(Op::SetTime)
+    channel.call(op)
 }
 
 unsafe extern "C" fn set_continuous_states(c: Component, x: *const f64, n: usize) -> c_int {
+    set_vector(c, x, n, Op::SetContinuousStates)
+}
+
+/// A vector of n Reals to the host (`op`: either generation's `SetContinuousStates`).
+pub(super) unsafe fn set_vector(c: Component, x: *const f64, n: usize, op: Op) -> c_int {
     let channel = ch(c);
     if !fits(channel, 8 * n) {
         return 3;
@@ -341,10 +388,12 @@ unsafe extern "C" fn set_continuous_states(c: Component, x: *const f64, n: usize
         data[8 * k..8 * k + 8].copy_from_slice(&v.to_ne_bytes());
     }
     channel.header().n = n as u64;
-    channel.call(Op::SetContinuousStates)
+    channel.call(op)
 }
 
-unsafe fn get_vector(c: Component, x: *mut f64, n: usize, op: Op) -> c_int {
+/// A vector of n Reals from the host (`op`: either generation's derivatives, event
+/// indicators, states or nominals).
+pub(super) unsafe fn get_vector(c: Component, x: *mut f64, n: usize, op: Op) -> c_int {
     let channel = ch(c);
     if !fits(channel, 8 * n) {
         return 3;
