@@ -50,6 +50,18 @@ impl Status {
     }
 }
 
+impl Status {
+    /// The status as the generation of `function` spells it: `fmi3Error` after an `fmi3*`
+    /// call, `fmi2Error` otherwise (the two enumerations have the same values).
+    pub fn spelled_for(self, function: &str) -> String {
+        let name = self.to_string();
+        match name.strip_prefix("fmi2") {
+            Some(rest) if function.starts_with("fmi3") => format!("fmi3{rest}"),
+            _ => name,
+        }
+    }
+}
+
 impl fmt::Display for Status {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -433,7 +445,7 @@ impl fmt::Display for Error {
                 write!(f, "{instance}: {function} returned NULL{}", tail(log))
             }
             Error::Fmi { instance, function, status, time, log } => {
-                write!(f, "{instance}: {function} returned {status}")?;
+                write!(f, "{instance}: {function} returned {}", status.spelled_for(function))?;
                 if let Some(t) = time {
                     write!(f, " at t = {t}")?;
                 }
@@ -524,3 +536,16 @@ impl std::error::Error for Error {
 
 /// `Result` with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod status_spelling {
+    use super::Status;
+
+    #[test]
+    fn a_status_is_spelled_in_the_generation_of_the_call_that_returned_it() {
+        assert_eq!(Status::Error.spelled_for("fmi3DoStep"), "fmi3Error");
+        assert_eq!(Status::Discard.spelled_for("fmi3SetFloat64"), "fmi3Discard");
+        assert_eq!(Status::Error.spelled_for("fmi2DoStep"), "fmi2Error");
+        assert_eq!(Status::Invalid(7).spelled_for("fmi3DoStep"), "invalid status 7");
+    }
+}
