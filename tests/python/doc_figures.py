@@ -122,10 +122,11 @@ def check(path, template, *values):
         raise DocFigureError("\n".join(stale))
 
 
-def check_at_most(path, template, value):
+def check_at_most(path, template, value, room=10):
     """The doc prints a bound `{}` on `value` (e.g. "the two agree to 6e-11") for a figure
     that is rounding noise (its last digit follows the BLAS kernel or the summation order):
-    the bound must hold and be tight, `value <= printed <= 10 value` (any bound holds for 0)."""
+    the bound must hold and be tight, `value <= printed <= room * value` (any bound holds for
+    0); a larger `room` for a figure whose rounding varies more between machines."""
     text = doc(path)
     found = list(_pattern(template).finditer(text))
     if not found:
@@ -133,7 +134,7 @@ def check_at_most(path, template, value):
                              "change this check with the text")
     for m in found:
         printed = float(m.group(1).replace(",", ""))
-        if not (value <= printed and (value == 0 or printed <= 10 * value)):
+        if not (value <= printed and (value == 0 or printed <= room * value)):
             raise DocFigureError(f"{path} prints {' '.join(m.group(0).split())!r} as a bound on {value:.2g}: "
                                  f"{'exceeded' if value > printed else 'not tight'}")
 

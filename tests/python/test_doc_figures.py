@@ -377,8 +377,11 @@ def test_synthesis_figures(designs):
     check("README.md", "rows FL, FR, RL, RR): `[{}, {}], [{}, {}], [{}, {}], [{}, {}]`.", *np.ravel(p["K"]))
     check_at_most("README.md", "the H∞ norm by Hamiltonian bisection and by a frequency sweep (agree to {})",
                   max(d["actual"]["hinf_methods_rel_diff"] for d in (p, a, ph)))
-    check_at_most("README.md", "the H2 norm by a Lyapunov equation and by Gramian integration (agree to {})",
-                  max(d["actual"]["h2_methods_rel_diff"] for d in (p, a, ph)))
+    # rounding-limited on both sides (the Gramian's doubling adds one product's rounding per
+    # squaring, scaled by the closed loop's conditioning): 5.3e-13 to 1.4e-12 seen across
+    # machines and OpenBLAS kernels, so the README prints a bound with room above them
+    check_at_most("README.md", "the H2 norm by a Lyapunov equation and by Gramian integration (agree to {}:",
+                  max(d["actual"]["h2_methods_rel_diff"] for d in (p, a, ph)), room=100)
     for name, d in (("`paper`, 4WD4WS | (0.198, 0.556)", p), ("`paper`, Ackermann | (0.261, 0.645)", a),
                     ("`physical`, 4WD4WS | ", ph)):
         check("docs/synthesis.md", f"| {name} | {{}}, k = {{}}, ({{}}, {{}}) |", d["gamma_star"], *ch(d))
