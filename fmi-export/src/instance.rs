@@ -1069,6 +1069,11 @@ impl<M: Model> Instance<M> {
     /// is refused: the callers that accept it handle it before.
     fn fmi2_reference(vr: u32, accessed: ValueType3) -> OpResult<u32> {
         let d = decl::<M>();
+        // the declaration's table answers every accepted reference; the checks below only
+        // say why a reference is refused
+        if let Some(vr2) = d.fmi2_of_fmi3(vr, accessed) {
+            return Ok(vr2);
+        }
         let Some(v) = d.variable3(vr) else {
             return err(format!("unknown value reference {vr} (the FMU's are 0 ..= {})", d.spec.variables.len()));
         };
@@ -1102,14 +1107,9 @@ impl<M: Model> Instance<M> {
     ) -> OpResult<T> {
         const ON_STACK: usize = 64;
         if vrs.len() <= ON_STACK {
-            let d = decl::<M>();
             let mut buffer = [0u32; ON_STACK];
             for (slot, &vr) in buffer.iter_mut().zip(vrs) {
-                // the table's answer; the full check only to say why not
-                *slot = match d.fmi2_of_fmi3(vr, accessed) {
-                    Some(vr2) => vr2,
-                    None => Self::fmi2_reference(vr, accessed)?,
-                };
+                *slot = Self::fmi2_reference(vr, accessed)?;
             }
             f(self, &buffer[..vrs.len()])
         } else {

@@ -148,6 +148,15 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
     }
 }
 
+/// Calls an FMU-state function (get or free, either generation) on the state handle the
+/// header carries and writes back the handle the call leaves there.
+fn state_handle(slot: &mut i64, call: impl FnOnce(&mut *mut c_void) -> i32) -> i32 {
+    let mut state = *slot as usize as *mut c_void;
+    let status = call(&mut state);
+    *slot = state as usize as i64;
+    status
+}
+
 fn layout_of(size: usize) -> Layout {
     // the master sized the region with Layout::for_variables; find the same layout
     let mut v = 16;
@@ -344,19 +353,9 @@ impl Host {
                     (f.set_string)(c, vrs, n, ptrs.as_ptr())
                 }
                 Op::DoStep => f.do_step.map_or(missing, |g| g(c, h.f[0], h.f[1], h.i[0] as c_int)),
-                Op::GetFmuState => {
-                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
-                    let r = f.get_fmu_state.map_or(missing, |g| g(c, &mut s));
-                    h.i[0] = s as usize as i64;
-                    r
-                }
+                Op::GetFmuState => state_handle(&mut h.i[0], |s| f.get_fmu_state.map_or(missing, |g| g(c, s))),
                 Op::SetFmuState => f.set_fmu_state.map_or(missing, |g| g(c, h.i[0] as usize as *mut c_void)),
-                Op::FreeFmuState => {
-                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
-                    let r = f.free_fmu_state.map_or(missing, |g| g(c, &mut s));
-                    h.i[0] = s as usize as i64;
-                    r
-                }
+                Op::FreeFmuState => state_handle(&mut h.i[0], |s| f.free_fmu_state.map_or(missing, |g| g(c, s))),
                 Op::GetBooleanStatus => {
                     let mut v: c_int = 0;
                     let r = f.get_boolean_status.map_or(missing, |g| g(c, h.i[0] as c_int, &mut v));
@@ -535,19 +534,9 @@ impl Host {
                     f.update_discrete_states
                         .map_or(missing, |g| g(c, b, b.add(1), b.add(2), b.add(3), b.add(4), b.add(8) as *mut f64))
                 }
-                Op::GetFmuState3 => {
-                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
-                    let r = f.get_fmu_state.map_or(missing, |g| g(c, &mut s));
-                    h.i[0] = s as usize as i64;
-                    r
-                }
+                Op::GetFmuState3 => state_handle(&mut h.i[0], |s| f.get_fmu_state.map_or(missing, |g| g(c, s))),
                 Op::SetFmuState3 => f.set_fmu_state.map_or(missing, |g| g(c, h.i[0] as usize as *mut c_void)),
-                Op::FreeFmuState3 => {
-                    let mut s: *mut c_void = h.i[0] as usize as *mut c_void;
-                    let r = f.free_fmu_state.map_or(missing, |g| g(c, &mut s));
-                    h.i[0] = s as usize as i64;
-                    r
-                }
+                Op::FreeFmuState3 => state_handle(&mut h.i[0], |s| f.free_fmu_state.map_or(missing, |g| g(c, s))),
                 Op::Free | Op::Flush => 0,
                 _ => missing,
             }
