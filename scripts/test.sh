@@ -6,12 +6,39 @@
 # cross-checks, which load the archives' linux64 libraries.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+target_dir="${CARGO_TARGET_DIR:-target}"
+# Each stage prints its wall time and the CPU time of its processes (user + system, from the
+# shell's children in /proc), and the run ends with the table: on a shared machine the wall
+# time varies, the CPU time hardly.
+ticks=$(getconf CLK_TCK)
+children_cpu() { awk -v t="$ticks" '{ sub(/^.*\) /, ""); print ($14 + $15) / t }' /proc/$$/stat; }
+stage_table=""
+stage_name=""
+stage() {
+    local cpu now
+    cpu=$(children_cpu)
+    now=$SECONDS
+    if [ -n "$stage_name" ]; then
+        stage_table+=$(printf '%6d s %7.0f s  %s' $((now - stage_wall)) "$(awk -v a="$cpu" -v b="$stage_cpu" 'BEGIN { print a - b }')" "$stage_name")$'\n'
+    fi
+    stage_name="$1"
+    stage_wall=$now
+    stage_cpu=$cpu
+    [ -n "$1" ] && echo "== $1"
+    return 0
+}
+stage_summary() {
+    stage ""
+    echo "== time per stage (wall, CPU)"
+    printf '%s' "$stage_table"
+    printf '%6d s %7.0f s  all\n' "$SECONDS" "$(children_cpu)"
+}
+stage "system packages and cross toolchains"
 bash scripts/setup-system.sh
 bash scripts/setup-cross.sh
-target_dir="${CARGO_TARGET_DIR:-target}"
-echo "== building the FMUs (linux64, win64, aarch64-linux, darwin64)"
+stage "building the FMUs (linux64, win64, aarch64-linux, darwin64)"
 cargo run --release --quiet -p build-fmu -- --platforms all
-echo "== rebuilding from touched sources must give byte-identical archives"
+stage "rebuilding from touched sources must give byte-identical archives"
 # (the rebuild writes its closed-loop SSPs over target/ssp/: the first ones are kept aside)
 rm -rf "$target_dir/ssp-first" && cp -r "$target_dir/ssp" "$target_dir/ssp-first"
 touch fmu-plant/src/lib.rs fmi-export/src/abi/fmi2.rs fmi-export/src/abi/fmi3.rs
@@ -30,13 +57,13 @@ for ssp in nigel_closed_loop.ssp nigel_closed_loop_fmi3.ssp; do
 done
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
-echo "== Python venv with fmpy"
+stage "Python venv with fmpy"
 bash scripts/python-env.sh >/dev/null
 export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
-echo "== Rust tests"
+stage "Rust tests"
 cargo test --release --workspace --no-fail-fast
-echo "== the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
+stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
 rustup toolchain install nightly --profile minimal >/dev/null 2>&1 || true
@@ -46,7 +73,7 @@ asan_test() {
 }
 asan_test fmi-export toy
 asan_test fmu-plant fmi3
-echo "== the FMU libraries under AddressSanitizer: random call sequences, dlopen abuse, the C importers under ASan+UBSan"
+stage "the FMU libraries under AddressSanitizer: random call sequences, dlopen abuse, the C importers under ASan+UBSan"
 # the three cdylibs instrumented (the debug profile of target/asan, whose dependencies the
 # steps above built), loaded in place of the archives' linux64 libraries through
 # NIGEL_FMU_LIBRARIES: by the release test binaries of the tests crate (uninstrumented
@@ -68,21 +95,22 @@ for t in random_calls random_calls3 c_abi c_abi3; do
 done
 cargo test --release --quiet -p build-fmu --test platforms linux64_c_importers_under_asan_and_ubsan
 unset NIGEL_FMU_LIBRARIES
-echo "== synthesis tests under two more OpenBLAS kernels"
+stage "synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
-echo "== fmpy cross-checks"
+stage "fmpy cross-checks"
 # (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
 # own-controller example's two archives, which it builds with `cargo run -p own-controller`)
 "$target_dir/venv/bin/python" -m pytest tests/python -q
-echo "== co-simulation master cross-checks"
+stage "co-simulation master cross-checks"
 "$target_dir/venv/bin/python" -m pytest cosim/tests/python -q
-echo "== Table III closed loop as SSP in fmpy"
+stage "Table III closed loop as SSP in fmpy"
 "$target_dir/venv/bin/python" -m pytest table3/tests/python -q
-echo "== examples (each prints what its header says; checked against table3)"
+stage "examples (each prints what its header says; checked against table3)"
 "$target_dir/venv/bin/python" -m pytest examples -q
-echo "== campaign results in fmpy and pandas"
+stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
-echo "== the Python package: its wheel in a fresh venv, against fmpy and the command lines"
+stage "the Python package: its wheel in a fresh venv, against fmpy and the command lines"
 bash scripts/test-python-package.sh
-echo "== campaign on a local Slurm cluster"
+stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
+stage_summary
