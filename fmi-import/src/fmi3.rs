@@ -344,7 +344,7 @@ pub(crate) fn fmi2_view(
         can_not_use_memory_management_functions: true,
         can_get_and_set_fmu_state: cs.common.can_get_and_set_fmu_state,
         can_serialize_fmu_state: cs.common.can_serialize_fmu_state,
-        provides_directional_derivative: false,
+        provides_directional_derivative: cs.common.provides_directional_derivatives,
     });
     let model_exchange = md.model_exchange.as_ref().map(|me| ModelExchange {
         model_identifier: me.common.model_identifier.clone(),
@@ -354,7 +354,7 @@ pub(crate) fn fmi2_view(
         can_not_use_memory_management_functions: true,
         can_get_and_set_fmu_state: me.common.can_get_and_set_fmu_state,
         can_serialize_fmu_state: me.common.can_serialize_fmu_state,
-        provides_directional_derivative: false,
+        provides_directional_derivative: me.common.provides_directional_derivatives,
     });
     let type_definitions = md
         .type_definitions

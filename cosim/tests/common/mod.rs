@@ -163,6 +163,13 @@ pub fn plant_fmu() -> PathBuf {
     p
 }
 
+/// The plant's FMI 3.0 archive built by `cargo run --release -p build-fmu`.
+pub fn plant_fmu3() -> PathBuf {
+    let p = plant_fmu().with_file_name("fmi3").join("nigel_plant.fmu");
+    assert!(p.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", p.display());
+    p
+}
+
 /// Builds `<dir>/<file_stem>.fmu` for `model` with a modified modelDescription.xml.
 pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> PathBuf {
     let so = dir.join(format!("{file_stem}.so"));
