@@ -22,6 +22,11 @@ nor the import of fmpy). Each round runs every (case, tolerance) once with each 
 tool first in the pair alternating from round to round; printed: per case and tolerance the
 median time over the rounds, the range (min .. max), and the error (deterministic). With PNG,
 error against median time, log-log, one panel per case.
+
+Then the phase of van der Pol at rtol 1e-3 .. 1e-5 (mu = 1e3, 1e4, 1e5): the time of the first
+fast transition in each tool's run (rows 1/20,000 of mu apart) against Radau's, as a relative
+shift and in units of rtol, with the times of those runs (the same rounds, alternated). The
+tables and the rows of both go to results.json in a temporary folder.
 """
 import json
 import math
@@ -31,7 +36,8 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "python"))
-from stiff_reference import CASES, case_fmus, case_reference, relative_error, run_cosim, run_cvode  # noqa: E402
+from stiff_reference import (CASES, TRANSITION_RESOLUTION, case_fmus, case_reference, relative_error,  # noqa: E402
+                             run_cosim, run_cvode, transition_errors, vdp_transition_reference)
 
 cosim, plant = sys.argv[1], sys.argv[2]
 rounds = int(sys.argv[3]) if len(sys.argv) > 3 else 5
@@ -75,7 +81,36 @@ for case in CASES:
             rows.append({"case": label, "rtol": rtol, "tool": tool, "times": ts, "error": errors[k],
                          "failure": failures.get(k)})
         print("| " + " | ".join(row) + " |")
-(work / "results.json").write_text(json.dumps(rows, indent=1))
+# The phase of van der Pol at loose tolerances: the first transition's time against Radau's,
+# on rows 1/20,000 of mu apart (stiff_reference.transition_errors), the same rounds alternated
+TRANSITION_MUS = [1e3, 1e4, 1e5]
+TRANSITION_RTOLS = [1e-3, 1e-4, 1e-5]
+shifts, shift_times = {}, {}
+for r in range(rounds):
+    for mu in TRANSITION_MUS:
+        for rtol in TRANSITION_RTOLS:
+            # the pair's order alternates: bdf first in even rounds, CVode first in odd ones
+            bdf, cvode = transition_errors(cosim, fmus["vdp"], mu, rtol, work, cvode_first=r % 2 == 1)
+            for tool, (shift, seconds) in (("cosim bdf", bdf), ("fmpy CVode", cvode)):
+                shifts[(mu, rtol, tool)] = shift
+                shift_times.setdefault((mu, rtol, tool), []).append(seconds)
+print()
+print(f"the first transition of van der Pol: (t* - t*_ref) / t*_ref, and in units of rtol "
+      f"(resolution {TRANSITION_RESOLUTION:.1e}); time: median (min .. max) s")
+print("| mu | Radau t*_ref, s | rtol | cosim bdf: shift | rtol units | time | fmpy CVode: shift | rtol units | time |")
+print("|---|---|---|---|---|---|---|---|---|")
+transitions = []
+for mu in TRANSITION_MUS:
+    for rtol in TRANSITION_RTOLS:
+        row = [f"{mu:.0e}", f"{vdp_transition_reference(mu):.3f}", f"{rtol:.0e}"]
+        for tool in TOOLS:
+            k = (mu, rtol, tool)
+            ts = shift_times[k]
+            row += [f"{shifts[k]:+.1e}", f"{abs(shifts[k]) / rtol:.1f}",
+                    f"{statistics.median(ts):.3f} ({min(ts):.3f} .. {max(ts):.3f})"]
+            transitions.append({"mu": mu, "rtol": rtol, "tool": tool, "shift": shifts[k], "times": ts})
+        print("| " + " | ".join(row) + " |")
+(work / "results.json").write_text(json.dumps({"work_precision": rows, "transitions": transitions}, indent=1))
 print(f"raw results: {work / 'results.json'}")
 
 if png:

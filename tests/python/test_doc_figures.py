@@ -422,6 +422,24 @@ def test_stiff_work_precision_errors(tmp_path):
             else:
                 assert "code -1)" in cv_err, cv_err  # CV_TOO_MUCH_WORK: mxstep steps before an output
                 check("README.md", row + " mxstep | {*} |", relative_error(x, ref))
+def test_stiff_transition_shifts(tmp_path):
+    """The shifts of van der Pol's first transition (deterministic) in the tables of
+    docs/performance.md ("The phase of van der Pol at loose tolerances", printed by
+    `cosim/benches/stiff.py`) and README.md, both tools, against Radau's transition time."""
+    from stiff_reference import build_cfmu, transition_errors, vdp_transition_reference
+
+    fmu = build_cfmu("vdp", tmp_path)
+    cosim = release_binary("cosim", "nigel-cosim")
+    for mu, mu_text in ((1e3, "1e3"), (1e4, "1e4"), (1e5, "1e5")):
+        ref = vdp_transition_reference(mu)
+        for rtol, rtol_text in ((1e-3, "1e-03"), (1e-4, "1e-04"), (1e-5, "1e-05")):
+            (bdf, _), (cvode, _) = transition_errors(cosim, fmu, mu, rtol, tmp_path)
+            check("docs/performance.md", f"| {mu:.0e} | {{}} | {rtol_text} | {{}} | {{}} | {{*}} | {{}} | {{}} | {{*}} |",
+                  ref, bdf, abs(bdf) / rtol, cvode, abs(cvode) / rtol)
+            if rtol < 1e-3:
+                check("README.md", f"| {mu_text} | {rtol:.0e}".replace("e-0", "e-") + " | {} | {} |", bdf, cvode)
+
+
 # --- the AddressSanitizer step of scripts/test.sh -------------------------------------------
 
 def test_readme_prints_the_random_sequences_the_asan_step_runs():

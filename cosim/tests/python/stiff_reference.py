@@ -12,6 +12,7 @@ master's integrators (cosim's bdf and dopri5) and of CVode:
 Also: compiling a C test FMU of cosim/tests/cfmu into an archive, and the error measure of a
 run against a reference.
 """
+import functools
 import math
 import subprocess
 import zipfile
@@ -58,6 +59,89 @@ def vdp_reference(mu, times, rtol=REFERENCE_RTOL, atol=REFERENCE_ATOL):
     sol = solve_ivp(f, (0.0, times[-1]), [2.0, 0.0], method="Radau", jac=jac, t_eval=times, rtol=rtol, atol=atol)
     assert sol.success, sol.message
     return sol.y.T
+
+
+# The phase of van der Pol: the time of its first fast transition (x0 through 0, going down;
+# (3/2 - ln 2) mu + O(mu^(-1/3)), near 0.807 mu). On the slow branch before it an error of x0
+# is neither damped nor amplified, so a run's errors add up into a shift of the transition,
+# which is what a run's error at the rows after it measures. Measured on rows 1/20,000 of mu
+# apart (linear interpolation between the rows around the crossing): a resolution of
+# 1 / (0.807 * 20,000) = 6.2e-5 of the transition time at most.
+TRANSITION_ROWS = 20000
+TRANSITION_RESOLUTION = 1.0 / (0.807 * TRANSITION_ROWS)
+
+
+@functools.lru_cache(maxsize=None)
+def vdp_transition_reference(mu, rtol=REFERENCE_RTOL, atol=REFERENCE_ATOL):
+    """The time of van der Pol's first transition at `mu` by Radau on the equations
+    (rtol 1e-10), located by Radau's event search on x0 (a root of its dense output)."""
+
+    def f(t, x):
+        return [x[1], mu * (1.0 - x[0] * x[0]) * x[1] - x[0]]
+
+    def jac(t, x):
+        return [[0.0, 1.0], [-2.0 * mu * x[0] * x[1] - 1.0, mu * (1.0 - x[0] * x[0])]]
+
+    def crossing(t, x):
+        return x[0]
+
+    crossing.terminal = True
+    crossing.direction = -1.0
+    sol = solve_ivp(f, (0.0, mu), [2.0, 0.0], method="Radau", jac=jac, events=crossing, rtol=rtol, atol=atol)
+    assert sol.success and len(sol.t_events[0]) == 1, sol.message
+    return float(sol.t_events[0][0])
+
+
+def transition_time(t, x0):
+    """Where x0 first goes through 0 (downwards) in a run's rows: linear between the rows
+    around it; None when it does not."""
+    t, x0 = np.asarray(t), np.asarray(x0)
+    below = np.flatnonzero((x0[1:] < 0.0) & (x0[:-1] >= 0.0))
+    if len(below) == 0:
+        return None
+    k = below[0]
+    return float(t[k] + (t[k + 1] - t[k]) * x0[k] / (x0[k] - x0[k + 1]))
+
+
+def transition_case(mu):
+    """The case of a transition run (as CASES'): 0 to mu s, TRANSITION_ROWS rows, x0."""
+    return (f"van der Pol mu = {mu:.0e}, transition", "vdp", mu, mu / TRANSITION_ROWS, {"mu": mu}, ["x0"])
+
+
+def transition_shift(t, x, mu):
+    """A run's transition time relative to the reference's, minus one: (t* - t*_ref) / t*_ref
+    (inf when the run failed or did not cross)."""
+    if x is None:
+        return math.inf
+    found = transition_time(t, x[:, 0])
+    if found is None:
+        return math.inf
+    ref = vdp_transition_reference(mu)
+    return (found - ref) / ref
+
+
+def transition_errors(cosim, fmu, mu, rtol, folder, with_cvode=True, cvode_first=False):
+    """The relative shift of the first transition in `cosim run --solver bdf` and (with_cvode)
+    fmpy's CVode at `rtol`, each with the wall time of its run: ((shift, seconds),
+    (shift, seconds) or None); cvode_first runs CVode first (the benchmark alternates)."""
+    case = transition_case(mu)
+    step = case[3]
+
+    def bdf():
+        elapsed, x, _ = run_cosim(cosim, fmu, case, rtol, Path(folder) / "transition.csv")
+        return transition_shift(None if x is None else np.arange(len(x)) * step, x, mu), elapsed
+
+    def cvode():
+        elapsed, y, _ = run_cvode(fmu, case, rtol)
+        return transition_shift(None if y is None else np.arange(len(y)) * step, y, mu), elapsed
+
+    if not with_cvode:
+        return bdf(), None
+    if cvode_first:
+        c = cvode()
+        return bdf(), c
+    b = bdf()
+    return b, cvode()
 
 
 def ball_bounces(stop, g=9.81, e=0.7, h0=1.0):
