@@ -27,6 +27,26 @@ stage() {
     [ -n "$1" ] && echo "== $1"
     return 0
 }
+# Steps that need few cores run beside others (their output to target/background-NAME.log):
+# `background NAME CMD...` starts one, `wait_for NAME` waits for it and fails the run with its
+# log when it failed. Their CPU time counts in the stage that waits for them.
+declare -A background_pids
+# a failing stage ends the run: its background steps end with it
+trap 'kill $(jobs -p) 2>/dev/null || true' EXIT
+background() {
+    local name="$1"
+    shift
+    "$@" >"$target_dir/background-$name.log" 2>&1 &
+    background_pids[$name]=$!
+}
+wait_for() {
+    local name="$1"
+    if ! wait "${background_pids[$name]}"; then
+        cat "$target_dir/background-$name.log" >&2
+        echo "the background step '$name' failed (its log above: $target_dir/background-$name.log)" >&2
+        exit 1
+    fi
+}
 stage_summary() {
     stage ""
     echo "== time per stage (wall, CPU)"
@@ -36,6 +56,9 @@ stage_summary() {
 stage "system packages and cross toolchains"
 bash scripts/setup-system.sh
 bash scripts/setup-cross.sh
+mkdir -p "$target_dir"
+# the Python venv (pip, mostly waiting on downloads and unpacking) beside the FMUs' build
+background venv bash scripts/python-env.sh
 stage "building the FMUs (linux64, win64, aarch64-linux, darwin64)"
 cargo run --release --quiet -p build-fmu -- --platforms all
 stage "rebuilding from touched sources must give byte-identical archives"
@@ -57,31 +80,40 @@ for ssp in nigel_closed_loop.ssp nigel_closed_loop_fmi3.ssp; do
 done
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
-stage "Python venv with fmpy"
-bash scripts/python-env.sh >/dev/null
+stage "Python venv with fmpy (built beside the FMUs)"
+wait_for venv
 export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
 [ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
 stage "Rust tests"
+cargo test --release --workspace --no-fail-fast --no-run
+# the instrumented builds of the two ASan steps below (nightly, their own target dir) beside
+# the tests' runs, many of which use one core (wine, qemu, single long tests)
+rustup toolchain install nightly --profile minimal >/dev/null 2>&1 || true
+asan() {
+    RUSTFLAGS="-Zsanitizer=address" cargo +nightly "$1" --target x86_64-unknown-linux-gnu \
+        --target-dir "$target_dir/asan" "${@:2}"
+}
+asan_builds() {
+    asan test --no-run -p fmi-export --test toy
+    asan test --no-run -p fmu-plant --test fmi3
+    # the three cdylibs instrumented (the debug profile of target/asan)
+    asan build --lib -p fmu-plant -p fmu-controller -p fmu-maneuver \
+        --features fmu-plant/fmi-export,fmu-controller/fmi-export,fmu-maneuver/fmi-export
+}
+background asan-builds asan_builds
 cargo test --release --workspace --no-fail-fast
+wait_for asan-builds
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
-rustup toolchain install nightly --profile minimal >/dev/null 2>&1 || true
-asan_test() {
-    RUSTFLAGS="-Zsanitizer=address" cargo +nightly test --target x86_64-unknown-linux-gnu \
-        --target-dir "$target_dir/asan" -p "$1" --test "$2"
-}
-asan_test fmi-export toy
-asan_test fmu-plant fmi3
+asan test -p fmi-export --test toy
+asan test -p fmu-plant --test fmi3
 stage "the FMU libraries under AddressSanitizer: random call sequences, dlopen abuse, the C importers under ASan+UBSan"
-# the three cdylibs instrumented (the debug profile of target/asan, whose dependencies the
-# steps above built), loaded in place of the archives' linux64 libraries through
+# the three cdylibs instrumented (built beside the Rust tests: the debug profile of
+# target/asan), loaded in place of the archives' linux64 libraries through
 # NIGEL_FMU_LIBRARIES: by the release test binaries of the tests crate (uninstrumented
 # Rust, with gcc's ASan runtime preloaded: it serves the instrumented library's checks and
 # takes over malloc and free) and by the C importers built with -fsanitize=address,undefined
-RUSTFLAGS="-Zsanitizer=address" cargo +nightly build --quiet --target x86_64-unknown-linux-gnu \
-    --target-dir "$target_dir/asan" --lib -p fmu-plant -p fmu-controller -p fmu-maneuver \
-    --features fmu-plant/fmi-export,fmu-controller/fmi-export,fmu-maneuver/fmi-export
 export NIGEL_FMU_LIBRARIES="$PWD/$target_dir/asan/x86_64-unknown-linux-gnu/debug"
 case "$target_dir" in /*) NIGEL_FMU_LIBRARIES="$target_dir/asan/x86_64-unknown-linux-gnu/debug" ;; esac
 asan_runtime=$(gcc -print-file-name=libasan.so)
@@ -97,6 +129,10 @@ cargo test --release --quiet -p build-fmu --test platforms linux64_c_importers_u
 unset NIGEL_FMU_LIBRARIES
 stage "synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
+# the Python package's wheel (a release build of the master for glibc 2.17 by zig) beside
+# the Python suites, which use about one core; cargo's lock on target/ orders it with the
+# examples' own builds
+background wheel bash scripts/python-wheel.sh
 stage "fmpy cross-checks"
 # (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
 # own-controller example's two archives, which it builds with `cargo run -p own-controller`)
@@ -110,6 +146,7 @@ stage "examples (each prints what its header says; checked against table3)"
 stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
 stage "the Python package: its wheel in a fresh venv, against fmpy and the command lines"
+wait_for wheel
 bash scripts/test-python-package.sh
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
