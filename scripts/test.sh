@@ -103,6 +103,26 @@ asan_builds() {
 background asan-builds asan_builds
 cargo test --release --workspace --no-fail-fast
 wait_for asan-builds
+# the test executables of this build, for the steps below that run some again: a `cargo test
+# -p PACKAGE` would unify other features and rebuild dependencies
+export NIGEL_TEST_EXECUTABLES="$PWD/$target_dir/test-executables.json"
+case "$target_dir" in /*) NIGEL_TEST_EXECUTABLES="$target_dir/test-executables.json" ;; esac
+cargo test --release --workspace --no-run --message-format=json >"$NIGEL_TEST_EXECUTABLES"
+# test_executable CRATE_FOLDER TEST: the executable of the integration test TEST of the crate
+test_executable() {
+    python3 - "$NIGEL_TEST_EXECUTABLES" "$1" "$2" <<'PY'
+import json, sys
+path, folder, test = sys.argv[1:]
+for line in open(path):
+    m = json.loads(line)
+    if (m.get("reason") == "compiler-artifact" and m.get("executable") and m["profile"]["test"] and m["target"]["name"] == test
+            and m["target"]["kind"] == ["test"] and m["manifest_path"].endswith(f"/{folder}/Cargo.toml")):
+        print(m["executable"])
+        break
+else:
+    sys.exit(f"no test executable {test} of {folder}/ in {path}")
+PY
+}
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
@@ -118,21 +138,16 @@ export NIGEL_FMU_LIBRARIES="$PWD/$target_dir/asan/x86_64-unknown-linux-gnu/debug
 case "$target_dir" in /*) NIGEL_FMU_LIBRARIES="$target_dir/asan/x86_64-unknown-linux-gnu/debug" ;; esac
 asan_runtime=$(gcc -print-file-name=libasan.so)
 for t in random_calls random_calls3 c_abi c_abi3; do
-    exe=$(cargo test --release --quiet -p nigel-integration-tests --test "$t" --no-run --message-format=json \
-        | sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | tail -n 1)
+    exe=$(test_executable tests "$t")
     # the first 3,000 and 1,500 of the uninstrumented run's seeded sequences (150,000 and
     # 20,000): the instrumented debug build is some ten times slower
     NIGEL_RANDOM_SEQUENCES=3000 NIGEL_RANDOM_SEQUENCES3=1500 LD_PRELOAD="$asan_runtime" \
         ASAN_OPTIONS=detect_leaks=1 "$exe" --quiet
 done
-cargo test --release --quiet -p build-fmu --test platforms linux64_c_importers_under_asan_and_ubsan
+(cd build-fmu && "$(test_executable build-fmu platforms)" --quiet linux64_c_importers_under_asan_and_ubsan)
 unset NIGEL_FMU_LIBRARIES
 stage "synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
-# the Python package's wheel (a release build of the master for glibc 2.17 by zig) beside
-# the Python suites, which use about one core; cargo's lock on target/ orders it with the
-# examples' own builds
-background wheel bash scripts/python-wheel.sh
 stage "fmpy cross-checks"
 # (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
 # own-controller example's two archives, which it builds with `cargo run -p own-controller`)
@@ -146,7 +161,6 @@ stage "examples (each prints what its header says; checked against table3)"
 stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
 stage "the Python package: its wheel in a fresh venv, against fmpy and the command lines"
-wait_for wheel
 bash scripts/test-python-package.sh
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
