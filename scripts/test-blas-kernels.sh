@@ -36,15 +36,7 @@ artifacts() {
     if [ -n "${NIGEL_TEST_EXECUTABLES:-}" ]; then cat "$NIGEL_TEST_EXECUTABLES"
     else cargo test --release --workspace --no-run --message-format=json 2>/dev/null; fi
 }
-exes=$(artifacts | python3 -c '
-import json, sys
-for line in sys.stdin:
-    m = json.loads(line)
-    # test harnesses only (profile.test), not the binaries and examples of the crate
-    if (m.get("reason") == "compiler-artifact" and m.get("executable") and m["profile"]["test"]
-            and m["manifest_path"].endswith("/synthesis/Cargo.toml")):
-        print(m["executable"])')
-[ -n "$exes" ] || { echo "no test executable of nigel-synthesis found" >&2; exit 1; }
+exes=$(artifacts | python3 scripts/test-executables.py - synthesis)
 run_synthesis_tests() {
     local exe
     # as cargo test runs them: from the crate's folder

@@ -6,7 +6,9 @@
 # cross-checks, which load the archives' linux64 libraries.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# the target folder as an absolute path (CARGO_TARGET_DIR may be relative to the repository)
 target_dir="${CARGO_TARGET_DIR:-target}"
+case "$target_dir" in /*) ;; *) target_dir="$PWD/$target_dir" ;; esac
 # Each stage prints its wall time and the CPU time of its processes (user + system, from the
 # shell's children in /proc), and the run ends with the table: on a shared machine the wall
 # time varies, the CPU time hardly.
@@ -82,8 +84,7 @@ done
 export NIGEL_REQUIRE_PLATFORMS=all
 stage "Python venv with fmpy (built beside the FMUs)"
 wait_for venv
-export FMPY_PYTHON="$PWD/$target_dir/venv/bin/python"
-[ -x "$FMPY_PYTHON" ] || FMPY_PYTHON="$target_dir/venv/bin/python"
+export FMPY_PYTHON="$target_dir/venv/bin/python"
 stage "Rust tests"
 cargo test --release --workspace --no-fail-fast --no-run
 # the instrumented builds of the two ASan steps below (nightly, their own target dir) beside
@@ -105,24 +106,10 @@ cargo test --release --workspace --no-fail-fast
 wait_for asan-builds
 # the test executables of this build, for the steps below that run some again: a `cargo test
 # -p PACKAGE` would unify other features and rebuild dependencies
-export NIGEL_TEST_EXECUTABLES="$PWD/$target_dir/test-executables.json"
-case "$target_dir" in /*) NIGEL_TEST_EXECUTABLES="$target_dir/test-executables.json" ;; esac
+export NIGEL_TEST_EXECUTABLES="$target_dir/test-executables.json"
 cargo test --release --workspace --no-run --message-format=json >"$NIGEL_TEST_EXECUTABLES"
 # test_executable CRATE_FOLDER TEST: the executable of the integration test TEST of the crate
-test_executable() {
-    python3 - "$NIGEL_TEST_EXECUTABLES" "$1" "$2" <<'PY'
-import json, sys
-path, folder, test = sys.argv[1:]
-for line in open(path):
-    m = json.loads(line)
-    if (m.get("reason") == "compiler-artifact" and m.get("executable") and m["profile"]["test"] and m["target"]["name"] == test
-            and m["target"]["kind"] == ["test"] and m["manifest_path"].endswith(f"/{folder}/Cargo.toml")):
-        print(m["executable"])
-        break
-else:
-    sys.exit(f"no test executable {test} of {folder}/ in {path}")
-PY
-}
+test_executable() { python3 scripts/test-executables.py "$NIGEL_TEST_EXECUTABLES" "$1" "$2"; }
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
@@ -134,8 +121,7 @@ stage "the FMU libraries under AddressSanitizer: random call sequences, dlopen a
 # NIGEL_FMU_LIBRARIES: by the release test binaries of the tests crate (uninstrumented
 # Rust, with gcc's ASan runtime preloaded: it serves the instrumented library's checks and
 # takes over malloc and free) and by the C importers built with -fsanitize=address,undefined
-export NIGEL_FMU_LIBRARIES="$PWD/$target_dir/asan/x86_64-unknown-linux-gnu/debug"
-case "$target_dir" in /*) NIGEL_FMU_LIBRARIES="$target_dir/asan/x86_64-unknown-linux-gnu/debug" ;; esac
+export NIGEL_FMU_LIBRARIES="$target_dir/asan/x86_64-unknown-linux-gnu/debug"
 asan_runtime=$(gcc -print-file-name=libasan.so)
 for t in random_calls random_calls3 c_abi c_abi3; do
     exe=$(test_executable tests "$t")

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The third-party conformance run: the corpus's FMI 2.0 FMUs (cosim's default solver, then
+# Model Exchange under bdf), its FMI 3.0 FMUs and its SSP systems, each case in child processes
+# with the corpus's own runners, then one table (scripts/conformance_table.py).
+# usage: bash scripts/conformance.sh [COSIM] [CORPUS]     (defaults: target/release/cosim, ../shared/corpus)
+# Exit status: 0 when every case fmpy completes cosim completes with results equal to fmpy's
+# or to the shipped reference, or is listed in scripts/conformance-known.txt with its reason;
+# 1 otherwise (a crash, a hang or a wrong value always counts).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+target_dir="${CARGO_TARGET_DIR:-target}"
+cosim="$(realpath "${1:-$target_dir/release/cosim}")"
+corpus="${2:-../shared/corpus}"
+python="${FMPY_PYTHON:-$target_dir/venv/bin/python}"
+if [ ! -d "$corpus" ]; then
+    echo "conformance: no corpus at $corpus: the third-party cases were not run"
+    exit 0
+fi
+[ -x "$cosim" ] || { echo "conformance: no cosim at $cosim (build it: cargo build --release -p nigel-cosim)" >&2; exit 1; }
+work="${NIGEL_CONFORMANCE_WORK:-$target_dir/conformance}"
+rm -rf "$work" && mkdir -p "$work"
+# each case's TMPDIR under the work folder: an FMU that leaves its unpacked files shows there
+export TMPDIR="$work/tmp" && mkdir -p "$TMPDIR"
+run_part() {
+    local name="$1"
+    shift
+    echo "== conformance: $name"
+    "$python" "$@" >"$work/$name.log" 2>&1 || true
+    tail -n 3 "$work/$name.log"
+}
+run_part fmi2 "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2" --json "$work/fmi2.json"
+run_part fmi2-bdf "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2-bdf" --only me/ --solver bdf --json "$work/fmi2-bdf.json"
+run_part fmi3 "$corpus/fmi3.py" --suite "$corpus/fmi3" --cosim "$cosim" --work "$work/fmi3" --json "$work/fmi3.json"
+run_part ssp "$corpus/ssp.py" "$cosim" "$corpus/ssp" --work "$work/ssp" --json "$work/ssp.json"
+leftover=$(find "$TMPDIR" -mindepth 1 -maxdepth 1 | head -5)
+exec "$python" scripts/conformance_table.py "$work" scripts/conformance-known.txt ${leftover:+--leftover "$leftover"}
