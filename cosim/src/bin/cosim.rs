@@ -69,9 +69,10 @@ struct RunArgs {
     /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
     #[arg(long)]
     interface: Option<String>,
-    /// Start time, s (negative times are times like any other).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    start_time: f64,
+    /// Start time, s (negative times are times like any other; default 0, for an SSP its
+    /// DefaultExperiment's startTime).
+    #[arg(long, allow_negative_numbers = true)]
+    start_time: Option<f64>,
     /// Stop time, s (default: the FMU's DefaultExperiment, else the start time + 1).
     #[arg(long, allow_negative_numbers = true)]
     stop_time: Option<f64>,
@@ -233,6 +234,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let (mut builder, default, single, _ssp) = if is_ssp(&args.model) {
         // --interface applies to every FMU of the system (one without it is refused by name)
         let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
+        if !host_of_run {
+            for note in &ssp.notes {
+                eprintln!("cosim: note: {note}");
+            }
+        }
         let builder = SystemBuilder::from_system(ssp.system.clone());
         let (start_time, stop_time) = ssp.default_start_stop;
         let default = model_description::DefaultExperiment { start_time, stop_time, ..Default::default() };
@@ -256,9 +262,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         builder.set_text(&qualify(name.trim(), single), value)?;
     }
     let system: System = builder.build();
-    // the start time is --start-time's (default 0), not the DefaultExperiment's
+    // the start time is --start-time's, else an SSD's DefaultExperiment's (SSP 1.0 gives
+    // only start and stop), else 0: not an FMU's DefaultExperiment's
+    let start_time = args.start_time.or(if single.is_none() { default.start_time } else { None }).unwrap_or(0.0);
     let given = GivenTimes {
-        start_time: Some(args.start_time),
+        start_time: Some(start_time),
         stop_time: args.stop_time,
         step_size: args.step,
         ..Default::default()
@@ -573,14 +581,23 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     let s = &ssp.system;
     let mut out = std::io::stdout().lock();
     let mut lines = vec![format!(
-        "system {} ({} instances, {} connections)",
+        "system {} (root system {:?}; {} instances, {} connections)",
         path.display(),
+        ssp.root_name,
         s.instances.len(),
         s.connections.len()
     )];
-    if let (start, Some(stop)) = ssp.default_start_stop {
-        lines.push(format!("default experiment: start {} s, stop {stop} s", start.unwrap_or(0.0)));
-    }
+    // the experiment a run applies when no --start-time / --stop-time is given
+    let (start, stop) = ssp.default_start_stop;
+    let start_text = match start {
+        Some(t) => format!("start {} s (DefaultExperiment)", plain(t)),
+        None => "start 0 s".to_string(),
+    };
+    let stop_text = match stop {
+        Some(t) => format!("stop {} s (DefaultExperiment)", plain(t)),
+        None => format!("stop {} s (start + 1 s)", plain(start.unwrap_or(0.0) + 1.0)),
+    };
+    lines.push(format!("experiment applied without --start-time/--stop-time: {start_text}, {stop_text}"));
     for i in &s.instances {
         // an FMU unpacked from the .ssp is named by its place in the archive (the
         // temporary copy is gone when this command ends)
@@ -589,10 +606,13 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
             None => i.fmu.source().display().to_string(),
         };
         lines.push(format!("instance {:<20} {source} ({})", i.name, i.fmu.interface().as_str()));
-        for (index, v) in &i.start_values {
-            let var = &i.fmu.description().model_variables[*index];
-            let unit = var.variable_type.unit().map(|u| format!(" {u}")).unwrap_or_default();
-            lines.push(format!("  start {} = {v}{unit}", var.name));
+    }
+    if !ssp.applied.is_empty() {
+        // every value the SSD applies, with its binding, mapping, transformation, unit
+        // conversion or the system connector it comes through
+        lines.push(format!("values applied ({}):", ssp.applied.len()));
+        for a in &ssp.applied {
+            lines.push(format!("  {a}"));
         }
     }
     for c in &s.connections {
@@ -600,9 +620,22 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         let mut line =
             format!("connection {} [{}] -> {} [{}]", s.name_of(&c.from), unit(&c.from), s.name_of(&c.to), unit(&c.to));
         if c.gain != 1.0 || c.offset != 0.0 {
-            line.push_str(&format!("  (x {} + {})", c.gain, c.offset));
+            line.push_str(&format!("  (x {} + {}", c.gain, c.offset));
+            if let Some((f, o)) = c.linear_transformation {
+                if (f, o) != (c.gain, c.offset) {
+                    line.push_str(&format!(": unit conversion, then LinearTransformation x {f} + {o}"));
+                } else {
+                    line.push_str(": LinearTransformation");
+                }
+            } else {
+                line.push_str(": unit conversion");
+            }
+            line.push(')');
         }
         lines.push(line);
+    }
+    for n in &ssp.notes {
+        lines.push(format!("note: {n}"));
     }
     for l in lines {
         if writeln!(out, "{l}").is_err() {
