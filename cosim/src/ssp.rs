@@ -651,14 +651,13 @@ impl Flattener<'_> {
                             unmapped += 1;
                             continue;
                         };
-                        let how = e.transformation.as_ref().map(|t| format!(" ({t})")).unwrap_or_default();
                         applied.push((
                             e.target.clone(),
                             Bound {
                                 value: (*v).clone(),
                                 transformation: e.transformation.clone(),
                                 suppress_unit_conversion: e.suppress_unit_conversion,
-                                origin: format!("{whose}, {from} mapped by {mfrom}: {}{how}", e.source),
+                                origin: format!("{whose}, {from} mapped by {mfrom}: {}", e.source),
                             },
                         ));
                     }

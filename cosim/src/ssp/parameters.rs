@@ -246,3 +246,51 @@ pub(super) fn mapping_entries(mapping: &Element) -> Result<Vec<MappingEntry>, St
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn element(xml: &str) -> Element {
+        super::super::parse_xml(xml, std::path::Path::new("t.ssm")).unwrap()
+    }
+
+    #[test]
+    fn mapping_transformations_map_listed_values_and_pass_the_others() {
+        let m = element(
+            r#"<ssm:ParameterMapping xmlns:ssm="x" xmlns:ssc="y" version="1.0">
+  <ssm:MappingEntry source="b" target="B"><ssc:BooleanMappingTransformation><ssc:MapEntry source="true" target="false"/></ssc:BooleanMappingTransformation></ssm:MappingEntry>
+  <ssm:MappingEntry source="i" target="I" suppressUnitConversion="true"><ssc:IntegerMappingTransformation><ssc:MapEntry source="1" target="10"/><ssc:MapEntry source="2" target="-20"/></ssc:IntegerMappingTransformation></ssm:MappingEntry>
+  <ssm:MappingEntry source="e" target="E"><ssc:EnumerationMappingTransformation><ssc:MapEntry source="low" target="high"/></ssc:EnumerationMappingTransformation></ssm:MappingEntry>
+  <ssm:MappingEntry source="r" target="R"><ssc:LinearTransformation factor="-2"/></ssm:MappingEntry>
+</ssm:ParameterMapping>"#,
+        );
+        let e = mapping_entries(&m).unwrap();
+        let t = |k: usize| e[k].transformation.clone().unwrap();
+        // listed: true -> false; not listed: false stays false
+        assert_eq!(t(0).apply_text("true").unwrap(), "false");
+        assert_eq!(t(0).apply_text("0").unwrap(), "false");
+        assert!(e[1].suppress_unit_conversion && !e[0].suppress_unit_conversion);
+        assert_eq!(t(1).apply_text("2").unwrap(), "-20");
+        assert_eq!(t(1).apply_text("3").unwrap(), "3");
+        assert_eq!(t(2).apply_text("low").unwrap(), "high");
+        assert_eq!(t(2).apply_text("mid").unwrap(), "mid");
+        // -2 * 1.5 + 0 (offset defaults to 0)
+        assert_eq!(t(3).apply_real(1.5).unwrap(), -3.0);
+        assert!(t(3).apply_text("1").is_err() && t(1).apply_real(1.0).is_err());
+        let bad = element(
+            r#"<ParameterMapping><MappingEntry source="a" target="b"><IntegerMappingTransformation><MapEntry source="x" target="1"/></IntegerMappingTransformation></MappingEntry></ParameterMapping>"#,
+        );
+        assert!(mapping_entries(&bad).unwrap_err().contains("MapEntry source=\"x\""));
+    }
+
+    #[test]
+    fn units_of_a_set_are_read_with_their_factor_and_offset() {
+        let u = units_of(Some(&element(
+            r#"<Units><Unit name="degC"><BaseUnit K="1" offset="273.15"/></Unit><Unit name="km/h"><BaseUnit m="1" s="-1" factor="0.2777777777777778"/></Unit></Units>"#,
+        )))
+        .unwrap();
+        assert_eq!(u["degC"], SiUnit { dims: [0, 0, 0, 0, 1, 0, 0, 0], factor: 1.0, offset: 273.15 });
+        assert_eq!(u["km/h"].dims, [0, 1, -1, 0, 0, 0, 0, 0]);
+    }
+}
