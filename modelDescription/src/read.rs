@@ -197,6 +197,17 @@ impl fmt::Display for ReadError {
                 f,
                 "{element} at {position}: attribute {attribute} has unknown value \"{value}\""
             ),
+            // FMI 1.0 (and anything but 2.0 and 3.x) is read by neither reader of this crate:
+            // the message names both versions that are
+            ReadError::UnsupportedFmiVersion { found, expected, position }
+                if !found.trim().starts_with("2.") && !found.trim().starts_with("3.") =>
+            {
+                write!(
+                    f,
+                    "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported \
+                     (FMI 2.0 and FMI 3.0 are; this reader reads \"{expected}\")"
+                )
+            }
             ReadError::UnsupportedFmiVersion { found, expected, position } => write!(
                 f,
                 "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\")"
