@@ -34,6 +34,7 @@ pub(crate) use fmi_import::suggest;
 pub use fmi_import::{error, fmi3, fmu, unpack};
 pub mod defaults;
 pub mod exit_guard;
+pub mod loops;
 pub mod mat;
 pub mod me;
 pub mod simulate;

@@ -144,6 +144,13 @@ class System:
         return list(self._native.interfaces)
 
     @property
+    def notes(self) -> list[str]:
+        """What reading an SSP noted (the lines ``cosim run`` prints as notes): parameter
+        values whose names match nothing (ignored, as SSP 1.0 says), units taken as
+        written, an SSD of the SSP 2.0 draft."""
+        return list(self._native.notes)
+
+    @property
     def default_experiment(self) -> dict[str, float | None]:
         start, stop, step, tolerance = self._native.default_experiment
         return {"start_time": start, "stop_time": stop, "step_size": step, "tolerance": tolerance}
@@ -345,9 +352,15 @@ def simulate_ssp(
     output: Iterable[str] | None = None,
     timeout: float | None = None,
 ) -> np.ndarray:
-    """Simulates an SSP system as ``cosim run`` does (its parameter bindings applied);
-    fields are named ``instance.variable``; the same numbers as the command line."""
+    """Simulates an SSP system as ``cosim run`` does (its parameter bindings, parameter
+    mappings and system connector values applied; the SSD's DefaultExperiment start and
+    stop time where none is given); fields are named ``instance.variable``; the same
+    numbers as the command line. What reading the SSP noted is warned (``UserWarning``)."""
     with System(filename) as system:
+        import warnings
+
+        for note in system.notes:
+            warnings.warn(f"{os.fspath(filename)}: {note}", stacklevel=2)
         return system.simulate(
             start_time=start_time,
             stop_time=stop_time,

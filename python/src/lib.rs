@@ -96,6 +96,8 @@ struct NativeSystem {
     default_experiment: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
     /// `CoSimulation` / `ModelExchange` of each interface the (single) FMU offers.
     interfaces: Vec<&'static str>,
+    /// What reading an SSP noted (`nigel_cosim::SspSystem::notes`; `cosim run` prints them).
+    notes: Vec<String>,
 }
 
 const SINGLE: &str = "model";
@@ -272,6 +274,7 @@ impl NativeSystem {
                     single: None,
                     default_experiment: (start, stop, None, None),
                     interfaces: Vec::new(),
+                    notes: ssp.notes,
                 })
             } else {
                 let fmu = Fmu::load_with(&filename, &options)?;
@@ -295,10 +298,18 @@ impl NativeSystem {
                     single: Some(SINGLE.to_string()),
                     default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
                     interfaces,
+                    notes: Vec::new(),
                 })
             }
         })
         .map_err(to_py)
+    }
+
+    /// What reading an SSP noted: values ignored by the standard's rules, units taken as
+    /// written, an SSD of the 2.0 draft (`cosim run` prints the same lines).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.notes.clone()
     }
 
     /// (start, stop, step, tolerance) of the DefaultExperiment, each None when absent.
