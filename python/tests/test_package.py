@@ -87,6 +87,76 @@ def test_simulate_ssp_is_the_command_line_bit_for_bit(tmp_path):
         assert np.array_equal(ours[field].astype(np.float64), cli[field]), field
 
 
+def _closed_loop_with_mapping_connector_and_start(tmp_path):
+    """The closed loop with a system parameter connector `mass` feeding plant.m, bound
+    through a parameter mapping from a value in grams (`vehicle_mass_g` 2700 g, the set's
+    Units: g = 0.001 kg), and a DefaultExperiment from 1 s to 3 s."""
+    import re
+    import zipfile
+
+    out = tmp_path / "mapped_closed_loop.ssp"
+    with zipfile.ZipFile(SSP) as src, zipfile.ZipFile(out, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename == "SystemStructure.ssd":
+                ssd = data.decode()
+                ssd = re.sub(
+                    r'(<ssd:System name="[^"]*">)',
+                    r"""\1
+    <ssd:Connectors><ssd:Connector name="mass" kind="parameter"><ssc:Real/></ssd:Connector></ssd:Connectors>
+    <ssd:ParameterBindings><ssd:ParameterBinding source="resources/mass.ssv">
+      <ssd:ParameterMapping><ssm:ParameterMapping xmlns:ssm="http://ssp-standard.org/SSP1/SystemStructureParameterMapping" version="1.0">
+        <ssm:MappingEntry source="vehicle_mass_g" target="mass"/>
+      </ssm:ParameterMapping></ssd:ParameterMapping>
+    </ssd:ParameterBinding></ssd:ParameterBindings>""",
+                    ssd,
+                    count=1,
+                )
+                ssd = ssd.replace(
+                    "</ssd:Connections>",
+                    '<ssd:Connection startElement="plant" startConnector="m" endElement="" endConnector="mass"/></ssd:Connections>',
+                )
+                ssd = re.sub(r"<ssd:DefaultExperiment[^>]*/>", '<ssd:DefaultExperiment startTime="1" stopTime="3"/>', ssd)
+                data = ssd.encode()
+            dst.writestr(item, data)
+        dst.writestr(
+            "resources/mass.ssv",
+            """<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="1.0" name="m">
+  <ssv:Parameters><ssv:Parameter name="vehicle_mass_g"><ssv:Real value="2700" unit="g"/></ssv:Parameter></ssv:Parameters>
+  <ssv:Units><ssc:Unit name="g"><ssc:BaseUnit kg="1" factor="0.001"/></ssc:Unit></ssv:Units>
+</ssv:ParameterSet>""",
+        )
+    return out
+
+
+def test_simulate_ssp_applies_mappings_connector_values_and_start_as_the_command_line(tmp_path):
+    ssp = _closed_loop_with_mapping_connector_and_start(tmp_path)
+    csv = tmp_path / "cli.csv"
+    done = subprocess.run(
+        [COSIM, "run", ssp, "--step", "1e-3", "--output", csv, "--record", "plant.y", "--record", "plant.v_x"],
+        check=True,
+        capture_output=True,
+    )
+    cli = read_cli_csv(csv)
+    ours = nigel_cosim.simulate_ssp(ssp, step_size=1e-3, output=["plant.y", "plant.v_x"])
+    # from the SSD's 1 s to its 3 s, every value the same bit for bit
+    assert ours["time"][0] == 1.0 and ours["time"][-1] == 3.0 and len(ours) == 2001
+    for field in cli.dtype.names:
+        assert np.array_equal(ours[field].astype(np.float64), cli[field]), field
+    # plant.m = 2700 g = 2.7 kg through the mapping and the connector: the run equals one
+    # with plant.m set to 2.7 directly, and differs from one at the SSP's own mass
+    with nigel_cosim.System(ssp) as system:
+        assert not any("mass" in n for n in system.notes), system.notes
+        direct = system.simulate(step_size=1e-3, start_values={"plant.m": 2.7}, output=["plant.y", "plant.v_x"])
+    assert np.array_equal(direct["plant.y"], ours["plant.y"])
+    # the closed loop as built (plant.m its FMU's 2.68 kg), over the same span
+    own = nigel_cosim.simulate_ssp(SSP, start_time=1.0, stop_time=3.0, step_size=1e-3, output=["plant.y"])
+    assert not np.array_equal(own["plant.y"], ours["plant.y"])
+    info = subprocess.run([COSIM, "info", ssp], check=True, capture_output=True, text=True).stdout
+    assert "plant.m = 2.7 (from 2700 g)" in info, info
+    assert b"note" not in done.stderr or b"mass" not in done.stderr
+
+
 def test_a_system_runs_many_times_from_one_load_as_separate_runs():
     masses = [2.4, 2.7, 3.0]
     with nigel_cosim.System(SSP) as system:
