@@ -271,7 +271,7 @@ impl Flattener<'_> {
         let text = self.read_text(&rel, what, source)?;
         let doc = parse_xml(&text, &self.path.join(&rel))?;
         if doc.name != root {
-            return Err(self.err(format!("{what}: {source:?} has the root element <{}>, not <{root}>", doc.name)));
+            return Err(self.err(format!("{what} {source:?} has the root element <{}>, not <{root}>", doc.name)));
         }
         Ok(doc)
     }

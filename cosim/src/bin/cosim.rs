@@ -606,11 +606,16 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
             None => i.fmu.source().display().to_string(),
         };
         lines.push(format!("instance {:<20} {source} ({})", i.name, i.fmu.interface().as_str()));
+        for (index, v) in &i.start_values {
+            let var = &i.fmu.description().model_variables[*index];
+            let unit = var.variable_type.unit().map(|u| format!(" {u}")).unwrap_or_default();
+            lines.push(format!("  start {} = {v}{unit}", var.name));
+        }
     }
     if !ssp.applied.is_empty() {
         // every value the SSD applies, with its binding, mapping, transformation, unit
         // conversion or the system connector it comes through
-        lines.push(format!("values applied ({}):", ssp.applied.len()));
+        lines.push(format!("values applied, in order, where from ({}):", ssp.applied.len()));
         for a in &ssp.applied {
             lines.push(format!("  {a}"));
         }
