@@ -243,3 +243,43 @@ fn default_start_time_version_note_and_info() {
     );
     assert!(info.contains("note: the SSD says version=\"2.0\""), "{info}");
 }
+
+#[test]
+fn an_algebraic_loop_at_initialization_is_noted_and_a_chain_is_not() {
+    let dir = work_dir("ssp-init-loop");
+    build_fmu(Model::Source, &dir, &[]);
+    build_fmu(Model::Gain, &dir, &[]);
+    // a.y = k u depends on a.u (the gain's ModelStructure: y depends on u), likewise b:
+    // a.y -> b.u and b.y -> a.u close a loop through both FMUs' direct feedthrough
+    let ssd = |connections: &str| {
+        format!(
+            r#"{HEAD}<ssd:System name="top">
+  <ssd:Elements><ssd:Component name="src" source="source.fmu"/><ssd:Component name="a" source="gain.fmu"/><ssd:Component name="b" source="gain.fmu"/></ssd:Elements>
+  <ssd:Connections>{connections}</ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+        )
+    };
+    write(
+        &dir,
+        "loop.ssd",
+        &ssd(
+            r#"<ssd:Connection startElement="a" startConnector="y" endElement="b" endConnector="u"/><ssd:Connection startElement="b" startConnector="y" endElement="a" endConnector="u"/>"#,
+        ),
+    );
+    let s = read_ssp(&dir.join("loop.ssd"), &ImportOptions::default()).unwrap();
+    let note = s.notes.iter().find(|n| n.contains("algebraic loop")).expect("the loop noted");
+    assert!(
+        note.contains("a.y -> b.u") && note.contains("b.y -> a.u") && note.contains("carries each connection once"),
+        "{note}"
+    );
+    // src.y depends on nothing: src -> a -> b is a chain, no loop
+    write(
+        &dir,
+        "chain.ssd",
+        &ssd(
+            r#"<ssd:Connection startElement="src" startConnector="y" endElement="a" endConnector="u"/><ssd:Connection startElement="a" startConnector="y" endElement="b" endConnector="u"/>"#,
+        ),
+    );
+    let s = read_ssp(&dir.join("chain.ssd"), &ImportOptions::default()).unwrap();
+    assert!(s.notes.is_empty(), "{:?}", s.notes);
+}
