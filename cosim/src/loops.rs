@@ -8,6 +8,9 @@
 use crate::system::System;
 use std::collections::HashMap;
 
+/// A variable of an instance: (instance, 0-based variable index).
+type Var = (usize, usize);
+
 /// One algebraic loop at initialization, as `a.y -> b.u` connections in order, or `None`.
 pub fn initialization_loop(system: &System) -> Option<Vec<String>> {
     // nodes: connected inputs and outputs, (instance, 0-based variable index)
@@ -31,7 +34,7 @@ pub fn initialization_loop(system: &System) -> Option<Vec<String>> {
     };
     let outputs: Vec<(usize, usize)> = feeds.keys().copied().collect();
     // edges output -> output: o1 feeds input i of instance j, and j's output o2 depends on i
-    let mut next: HashMap<(usize, usize), Vec<((usize, usize), (usize, usize))>> = HashMap::new();
+    let mut next: HashMap<Var, Vec<(Var, Var)>> = HashMap::new();
     for &o in &outputs {
         for &(j, i) in &feeds[&o] {
             for &o2 in outputs.iter().filter(|(inst, _)| *inst == j) {

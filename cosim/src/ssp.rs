@@ -710,6 +710,10 @@ type Trace<'n> = (&'n Node, f64, f64, bool);
 
 type Edge = (Node, Node, f64, f64, bool);
 
+/// A value reaching an FMU variable (instance, variable) from a system connector, with the
+/// connection's composed (factor, offset, suppress unit conversion).
+type ViaConnector = (String, String, Bound, (f64, f64, bool));
+
 /// Traces `start` back through system connectors to an FMU output or to a system
 /// connector nothing feeds: walks back to a variable, an unfed connector or one traced
 /// before, then remembers the trace of every connector on the way.
@@ -918,7 +922,7 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     }
     let mut traced: HashMap<&Node, Trace> = HashMap::new();
     // values reaching FMU variables from system connectors, applied after the bindings
-    let mut from_connectors: Vec<(String, String, Bound, (f64, f64, bool))> = Vec::new();
+    let mut from_connectors: Vec<ViaConnector> = Vec::new();
     let mut used_connectors: std::collections::HashSet<(String, String)> = Default::default();
     for (a, b, k, o, s) in &edges {
         let Node::Variable { instance: bi, variable: bv } = b else { continue };
