@@ -762,3 +762,41 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let ours: Vec<Vec<f64>> = (0..r.rows()).map(|k| vec![time[k], r.column("y").unwrap()[k], n[k]]).collect();
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
+
+/// An FMI 3.0 Int64 output declared `ssc:Integer` in an SSP (as OMSimulator writes it;
+/// SSP 1.0 has no Int64), connected (written sink first) to another counter's Float64
+/// input: read, and its values beyond 32 bits carried exactly (the view carries Int64 as
+/// a Real, exact up to 2^53). A Boolean declaration of the same variable is refused.
+#[test]
+fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
+    use nigel_cosim::{read_ssp, Algorithm, ImportOptions};
+    let Some((dir, _)) = counter("fmi3-ssp-int64") else { return };
+    let ssd = |ty: &str| {
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" version="1.0" name="t">
+<ssd:System name="root"><ssd:Elements>
+  <ssd:Component name="c1" source="fmi3_counter.fmu"><ssd:Connectors><ssd:Connector name="i64" kind="output"><ssc:{ty}/></ssd:Connector></ssd:Connectors></ssd:Component>
+  <ssd:Component name="c2" source="fmi3_counter.fmu"/>
+</ssd:Elements><ssd:Connections><ssd:Connection startElement="c2" startConnector="u" endElement="c1" endConnector="i64"/></ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+        )
+    };
+    let path = dir.join("int64.ssd");
+    std::fs::write(&path, ssd("Boolean")).unwrap();
+    let e = read_ssp(&path, &ImportOptions::default()).err().expect("a Boolean Int64 refused").to_string();
+    assert!(e.contains("connector \"i64\" is declared Boolean"), "{e}");
+    std::fs::write(&path, ssd("Integer")).unwrap();
+    let s = read_ssp(&path, &ImportOptions::default()).unwrap();
+    assert_eq!(s.system.name_of(&s.system.connections[0].from), "c1.i64");
+    let mut e = Experiment::new(0.5, 0.1);
+    e.algorithm = Algorithm::Ordered;
+    e.record = Some(vec!["c1.n".into(), "c2.u".into()]);
+    let (r, _) = simulate(&s.system, &e).unwrap();
+    let (n, u) = (r.column("c1.n").unwrap(), r.column("c2.u").unwrap());
+    // i64 = -2^40 n (fmi3_counter.c), n the steps done: -5.5e12 after 5 steps, past i32
+    assert_eq!(n, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+    for k in 0..n.len() {
+        assert_eq!(u[k], -(2f64.powi(40)) * n[k], "c2.u at step {k}");
+    }
+}
