@@ -959,11 +959,15 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     let mut keys: Vec<&(String, String)> =
         f.connector_values.keys().filter(|k| !used_connectors.contains(*k)).collect();
     keys.sort();
-    for (system, connector) in keys {
-        f.notes.push(format!(
-            "the value bound to connector {connector} of {} reaches no FMU variable: it changes nothing",
-            f.shown(system)
-        ));
+    for key in keys {
+        let (system, connector) = key;
+        let node = Node::SystemConnector { system: system.clone(), connector: connector.clone() };
+        let why = if feeding.contains_key(&node) {
+            "is fed by a connection, which decides its value: the bound value is not used"
+        } else {
+            "reaches no FMU variable: it changes nothing"
+        };
+        f.notes.push(format!("the value bound to connector {connector} of {} {why}", f.shown(system)));
     }
     // bound values in their order (a higher level and a later binding win), then the
     // values that reach variables through connections from system connectors (the

@@ -134,6 +134,7 @@ fn system_connector_values_binding_priority_and_direction() {
   <ssv:Parameter name="amp.k"><ssv:Real value="7"/></ssv:Parameter>
   <ssv:Parameter name="src.slope"><ssv:Real value="4"/></ssv:Parameter>
   <ssv:Parameter name="nobody.k"><ssv:Real value="1"/></ssv:Parameter>
+  <ssv:Parameter name="Y"><ssv:Real value="5"/></ssv:Parameter>
 </ssv:Parameters></ssv:ParameterSet>"#,
     );
     // connections written sink first (end = source) and with startElement="" for the system
@@ -169,6 +170,12 @@ fn system_connector_values_binding_priority_and_direction() {
     assert_eq!(s.system.name_of(&s.system.connections[0].from), "src.y");
     assert!(s.notes.iter().any(|n| n.contains("nobody.k") && n.contains("ignored")), "{:?}", s.notes);
     assert!(s.notes.iter().all(|n| !n.contains("amp.k")), "{:?}", s.notes);
+    // the output connector Y is fed by amp.y: a value bound to it is not used, and said so
+    assert!(
+        s.notes.iter().any(|n| n.contains("connector Y of root system \"top\" is fed by a connection")),
+        "{:?}",
+        s.notes
+    );
     let at_1s = |column: &str| last(&dir.join("sys.ssd"), column, 1.0, 0.5);
     // amp.k = K = 3 (the connection wins over root.ssv's amp.k = 7); amp.u = U = 1.5
     assert_eq!(at_1s("amp.k"), 3.0);
