@@ -1,5 +1,6 @@
-//! SSP 1.0 import (`.ssp` archives and bare `.ssd` files) into a [`System`], and export of
-//! a [`System`] built in Rust as an `.ssp` that fmpy, ecos and libcosim can run.
+//! SSP 1.0 import (`.ssp` archives and bare `.ssd` files) into a [`System`]; the values
+//! it applies are `ssp/parameters.rs`, the export of a [`System`] as an `.ssp` is
+//! `ssp/write.rs`.
 //!
 //! Supported (docs/ssp.md says it in full): Components of type
 //! `application/x-fmu-sharedlibrary`, their Connectors, Connections in the direction
@@ -13,14 +14,15 @@
 //! Geometry, annotations and graphical elements are ignored.
 
 mod parameters;
+mod write;
+pub use write::{write_ssp, SSP_PARAMETER_SET};
 
 use crate::error::{Error, Result};
 use crate::fmu::{Fmu, ImportOptions};
-use crate::system::{BaseType, System, SystemBuilder, Value};
+use crate::system::{BaseType, System, SystemBuilder};
 use model_description::Causality;
-use parameters::{ParameterValue, SiUnit, Transformation};
+use parameters::{value_for, Bound, ParameterValue, Transformation};
 use std::collections::HashMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -155,16 +157,6 @@ enum Flow {
 enum Target {
     Variable { instance: String, variable: String },
     Connector { system: String, connector: String },
-}
-
-/// A value to apply: the value as the set gives it, the mapping's transformation and
-/// unit-conversion choice, and where it comes from (for messages and `cosim info`).
-#[derive(Clone, Debug)]
-struct Bound {
-    value: ParameterValue,
-    transformation: Option<Transformation>,
-    suppress_unit_conversion: bool,
-    origin: String,
 }
 
 struct Flattener<'a> {
@@ -749,105 +741,6 @@ fn trace<'e>(
     Ok(t)
 }
 
-/// The value `bound` gives the variable `instance.variable` of `system`, after the unit
-/// conversion (unless suppressed) and the mapping's transformation, then `then` (a
-/// connection's factor and offset, for a value reaching the variable through system
-/// connectors); a note where a unit is taken as written.
-fn value_for(
-    system: &System,
-    instance: &str,
-    variable: &str,
-    bound: &Bound,
-    then: (f64, f64, bool),
-    notes: &mut Vec<String>,
-) -> std::result::Result<(Value, String), String> {
-    let r = system.resolve_parts(instance, variable).map_err(|e| e.to_string())?;
-    let v = system.variable(&r);
-    let md = system.description(r.instance);
-    let name = format!("{instance}.{variable}");
-    let b = &bound.value;
-    match r.base_type {
-        BaseType::Real => {
-            let x = model_description::parse_xs_double(&b.text)
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("{name}: value {:?} is not a finite number", b.text))?;
-            let mut how = String::new();
-            let mut y = x;
-            let suppress = bound.suppress_unit_conversion || then.2;
-            if let (Some((unit, def)), false) = (&b.unit, suppress) {
-                let declared = v.variable_type.unit();
-                let target = declared.and_then(|u| md.unit_definitions.iter().find(|d| d.name == u));
-                match (declared, def, target.and_then(|t| t.base_unit.as_ref())) {
-                    (Some(d), _, _) if d == unit => {}
-                    (Some(d), Some(from), Some(to)) => {
-                        let to = SiUnit::of_fmu(to);
-                        if from.dims != to.dims {
-                            return Err(format!("{name}: a value in {unit:?} for a variable in {d:?}: different dimensions"));
-                        }
-                        y = (from.factor * x + from.offset - to.offset) / to.factor;
-                        how = format!(" (from {x} {unit})");
-                    }
-                    (Some(d), None, _) if unit.trim_start_matches('[').trim_end_matches(']') == d => {
-                        notes.push(format!(
-                            "{name}: the value's unit {unit:?} is defined in no Units of its file: taken as the variable's unit {d:?}"
-                        ));
-                    }
-                    (Some(d), None, _) => {
-                        return Err(format!(
-                            "{name}: the value's unit {unit:?} is defined in no Units of its file and is not the variable's unit {d:?}"
-                        ))
-                    }
-                    (Some(d), Some(_), None) => {
-                        return Err(format!(
-                            "{name}: a value in {unit:?} for a variable in {d:?}, which its FMU defines by no BaseUnit: cannot convert"
-                        ))
-                    }
-                    (None, _, _) => notes.push(format!(
-                        "{name}: the value is given in {unit:?}, the variable has no unit: applied as written"
-                    )),
-                }
-            }
-            if let Some(t) = &bound.transformation {
-                y = t.apply_real(y).map_err(|why| format!("{name}: {why}"))?;
-                how.push_str(&format!(" ({t})"));
-            }
-            if then.0 != 1.0 || then.1 != 0.0 {
-                y = then.0 * y + then.1;
-                how.push_str(&format!(" (x {} + {})", then.0, then.1));
-            }
-            Ok((Value::Real(y), how))
-        }
-        ty => {
-            if then.0 != 1.0 || then.1 != 0.0 {
-                return Err(format!("{name}: a linear transformation needs a Real variable"));
-            }
-            let mut text = b.text.clone();
-            let mut how = String::new();
-            if let Some(t) = &bound.transformation {
-                text = t.apply_text(&text).map_err(|why| format!("{name}: {why}"))?;
-                how = format!(" ({t})");
-            }
-            // an enumeration value by its item's name
-            if let (BaseType::Integer, model_description::VariableType::Enumeration { declared_type, .. }) =
-                (ty, &v.variable_type)
-            {
-                if text.trim().parse::<i64>().is_err() {
-                    let item = md
-                        .type_definitions
-                        .iter()
-                        .find(|t| &t.name == declared_type)
-                        .and_then(|t| t.items.iter().find(|i| i.name == text.trim()))
-                        .ok_or_else(|| format!("{name}: {text:?} is no item of its enumeration {declared_type}"))?;
-                    text = item.value.to_string();
-                }
-            }
-            Value::parse(ty, &text)
-                .map(|value| (value, how))
-                .map_err(|why| format!("{name}: the {} value {text:?}: {why}", b.kind))
-        }
-    }
-}
-
 /// Reads an `.ssp` archive or a bare `.ssd` file (FMU sources relative to its folder).
 pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
     let is_ssd = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssd"));
@@ -1007,155 +900,4 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         ));
     }
     Ok(SspSystem { system, default_start_stop, root_name: f.root_name, notes: f.notes, applied, archive })
-}
-
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-fn num(v: f64) -> String {
-    let mut s = String::new();
-    crate::simulate::push_number(&mut s, v);
-    s
-}
-
-/// The name of the ParameterSet that holds the start values in an SSP written by [`write_ssp`].
-pub const SSP_PARAMETER_SET: &str = "initialValues";
-
-/// Writes `system` as an SSP 1.0 archive: `SystemStructure.ssd` plus each FMU archive
-/// under `resources/` (one copy per distinct FMU), start values as inline parameter
-/// bindings, connections with their linear transformations.
-///
-/// Every component's bindings are one ParameterSet named [`SSP_PARAMETER_SET`]: libcosim
-/// applies each component's first set by default, ecos applies the sets of the one name
-/// given to its `init` (and none without a name), so one name serves both.
-pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
-    let io = |source| Error::Io { path: path.to_path_buf(), source };
-    // FMU files, one per distinct source
-    let mut files: Vec<(PathBuf, String)> = Vec::new();
-    for spec in &system.instances {
-        let src = spec.fmu.source().to_path_buf();
-        if !files.iter().any(|(p, _)| *p == src) {
-            let stem = src.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "fmu".into());
-            let mut file = format!("resources/{stem}.fmu");
-            let mut k = 1;
-            while files.iter().any(|(_, f)| *f == file) {
-                file = format!("resources/{stem}_{k}.fmu");
-                k += 1;
-            }
-            files.push((src, file));
-        }
-    }
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    x.push_str("<ssd:SystemStructureDescription xmlns:ssc=\"http://ssp-standard.org/SSP1/SystemStructureCommon\" xmlns:ssd=\"http://ssp-standard.org/SSP1/SystemStructureDescription\" xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"1.0\"");
-    x.push_str(&format!(" name=\"{}\" generationTool=\"nigel-cosim\">\n", esc(name)));
-    x.push_str(&format!("  <ssd:System name=\"{}\">\n    <ssd:Elements>\n", esc(name)));
-    for (i, spec) in system.instances.iter().enumerate() {
-        let md = spec.fmu.description();
-        let file = &files.iter().find(|(p, _)| p == spec.fmu.source()).map(|(_, f)| f.clone()).unwrap_or_default();
-        x.push_str(&format!(
-            "      <ssd:Component name=\"{}\" type=\"application/x-fmu-sharedlibrary\" source=\"{}\">\n",
-            esc(&spec.name),
-            esc(file)
-        ));
-        // connectors: every output, and the inputs that are connected (an unconnected
-        // input connector would be driven with 0 by fmpy's simulate_ssp, not left at its start)
-        let vars: Vec<_> = md
-            .model_variables
-            .iter()
-            .enumerate()
-            .filter(|(index, v)| match v.causality {
-                model_description::Causality::Output => true,
-                model_description::Causality::Input => {
-                    system.connections.iter().any(|c| c.to.instance == i && c.to.index == *index)
-                }
-                _ => false,
-            })
-            .map(|(_, v)| v)
-            .collect();
-        if !vars.is_empty() {
-            x.push_str("        <ssd:Connectors>\n");
-            for v in vars {
-                x.push_str(&format!(
-                    "          <ssd:Connector name=\"{}\" kind=\"{}\"><ssc:{}/></ssd:Connector>\n",
-                    esc(&v.name),
-                    v.causality.as_str(),
-                    BaseType::of(v).as_str()
-                ));
-            }
-            x.push_str("        </ssd:Connectors>\n");
-        }
-        if !spec.start_values.is_empty() {
-            x.push_str("        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n            <ssd:ParameterValues>\n");
-            x.push_str(&format!(
-                "              <ssv:ParameterSet version=\"1.0\" name=\"{}\">\n                <ssv:Parameters>\n",
-                SSP_PARAMETER_SET
-            ));
-            for (index, value) in &spec.start_values {
-                let vname = &md.model_variables[*index].name;
-                let v = match value {
-                    Value::Real(r) => format!("<ssv:Real value=\"{}\"/>", num(*r)),
-                    Value::Integer(k) => format!("<ssv:Integer value=\"{k}\"/>"),
-                    Value::Boolean(b) => format!("<ssv:Boolean value=\"{b}\"/>"),
-                    Value::String(s) => format!("<ssv:String value=\"{}\"/>", esc(s)),
-                };
-                x.push_str(&format!("                  <ssv:Parameter name=\"{}\">{v}</ssv:Parameter>\n", esc(vname)));
-            }
-            x.push_str("                </ssv:Parameters>\n              </ssv:ParameterSet>\n            </ssd:ParameterValues>\n          </ssd:ParameterBinding>\n        </ssd:ParameterBindings>\n");
-        }
-        x.push_str("      </ssd:Component>\n");
-    }
-    x.push_str("    </ssd:Elements>\n");
-    if !system.connections.is_empty() {
-        x.push_str("    <ssd:Connections>\n");
-        for c in &system.connections {
-            let (fi, ti) = (&system.instances[c.from.instance].name, &system.instances[c.to.instance].name);
-            let (fv, tv) = (&system.variable(&c.from).name, &system.variable(&c.to).name);
-            x.push_str(&format!(
-                "      <ssd:Connection startElement=\"{}\" startConnector=\"{}\" endElement=\"{}\" endConnector=\"{}\"",
-                esc(fi),
-                esc(fv),
-                esc(ti),
-                esc(tv)
-            ));
-            match c.linear_transformation {
-                Some((f, o)) => x.push_str(&format!(
-                    "><ssc:LinearTransformation factor=\"{}\" offset=\"{}\"/></ssd:Connection>\n",
-                    num(f),
-                    num(o)
-                )),
-                None => x.push_str("/>\n"),
-            }
-        }
-        x.push_str("    </ssd:Connections>\n");
-    }
-    x.push_str("  </ssd:System>\n");
-    if let Some(stop) = stop_time {
-        x.push_str(&format!("  <ssd:DefaultExperiment startTime=\"0\" stopTime=\"{}\"/>\n", num(stop)));
-    }
-    x.push_str("</ssd:SystemStructureDescription>\n");
-
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut zip = zip::ZipWriter::new(file);
-    let options = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated)
-        .last_modified_time(zip::DateTime::default());
-    let zerr = |e: zip::result::ZipError| Error::Archive { path: path.to_path_buf(), reason: e.to_string() };
-    zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
-    zip.write_all(x.as_bytes()).map_err(io)?;
-    // the FMUs stored, not deflated: they are compressed archives already (deflate gains
-    // under 1 %), and a stored FMU is read in place by importers that seek (see `unpack`)
-    let stored = options.compression_method(zip::CompressionMethod::Stored);
-    for (src, file) in &files {
-        let fmu = system.instances.iter().find(|i| i.fmu.source() == src.as_path()).map(|i| &i.fmu);
-        let bytes = match fmu {
-            Some(fmu) => fmu.archive_bytes()?,
-            None => std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?,
-        };
-        zip.start_file(file.as_str(), stored).map_err(zerr)?;
-        zip.write_all(&bytes).map_err(io)?;
-    }
-    zip.finish().map_err(zerr)?;
-    Ok(())
 }

@@ -3,6 +3,7 @@
 //! values (a set's `Units`), converted to the unit of the variable they are applied to.
 
 use super::Element;
+use crate::system::{BaseType, System, Value};
 use model_description::BaseUnit;
 use std::collections::HashMap;
 
@@ -245,6 +246,115 @@ pub(super) fn mapping_entries(mapping: &Element) -> Result<Vec<MappingEntry>, St
         });
     }
     Ok(out)
+}
+
+/// A value to apply: the value as the set gives it, the mapping's transformation and
+/// unit-conversion choice, and where it comes from (for messages and `cosim info`).
+#[derive(Clone, Debug)]
+pub(super) struct Bound {
+    pub value: ParameterValue,
+    pub transformation: Option<Transformation>,
+    pub suppress_unit_conversion: bool,
+    pub origin: String,
+}
+
+/// The value `bound` gives the variable `instance.variable` of `system`, after the unit
+/// conversion (unless suppressed) and the mapping's transformation, then `then` (a
+/// connection's factor and offset, for a value reaching the variable through system
+/// connectors); a note where a unit is taken as written.
+pub(super) fn value_for(
+    system: &System,
+    instance: &str,
+    variable: &str,
+    bound: &Bound,
+    then: (f64, f64, bool),
+    notes: &mut Vec<String>,
+) -> std::result::Result<(Value, String), String> {
+    let r = system.resolve_parts(instance, variable).map_err(|e| e.to_string())?;
+    let v = system.variable(&r);
+    let md = system.description(r.instance);
+    let name = format!("{instance}.{variable}");
+    let b = &bound.value;
+    match r.base_type {
+        BaseType::Real => {
+            let x = model_description::parse_xs_double(&b.text)
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{name}: value {:?} is not a finite number", b.text))?;
+            let mut how = String::new();
+            let mut y = x;
+            let suppress = bound.suppress_unit_conversion || then.2;
+            if let (Some((unit, def)), false) = (&b.unit, suppress) {
+                let declared = v.variable_type.unit();
+                let target = declared.and_then(|u| md.unit_definitions.iter().find(|d| d.name == u));
+                match (declared, def, target.and_then(|t| t.base_unit.as_ref())) {
+                    (Some(d), _, _) if d == unit => {}
+                    (Some(d), Some(from), Some(to)) => {
+                        let to = SiUnit::of_fmu(to);
+                        if from.dims != to.dims {
+                            return Err(format!("{name}: a value in {unit:?} for a variable in {d:?}: different dimensions"));
+                        }
+                        y = (from.factor * x + from.offset - to.offset) / to.factor;
+                        how = format!(" (from {x} {unit})");
+                    }
+                    (Some(d), None, _) if unit.trim_start_matches('[').trim_end_matches(']') == d => {
+                        notes.push(format!(
+                            "{name}: the value's unit {unit:?} is defined in no Units of its file: taken as the variable's unit {d:?}"
+                        ));
+                    }
+                    (Some(d), None, _) => {
+                        return Err(format!(
+                            "{name}: the value's unit {unit:?} is defined in no Units of its file and is not the variable's unit {d:?}"
+                        ))
+                    }
+                    (Some(d), Some(_), None) => {
+                        return Err(format!(
+                            "{name}: a value in {unit:?} for a variable in {d:?}, which its FMU defines by no BaseUnit: cannot convert"
+                        ))
+                    }
+                    (None, _, _) => notes.push(format!(
+                        "{name}: the value is given in {unit:?}, the variable has no unit: applied as written"
+                    )),
+                }
+            }
+            if let Some(t) = &bound.transformation {
+                y = t.apply_real(y).map_err(|why| format!("{name}: {why}"))?;
+                how.push_str(&format!(" ({t})"));
+            }
+            if then.0 != 1.0 || then.1 != 0.0 {
+                y = then.0 * y + then.1;
+                how.push_str(&format!(" (x {} + {})", then.0, then.1));
+            }
+            Ok((Value::Real(y), how))
+        }
+        ty => {
+            if then.0 != 1.0 || then.1 != 0.0 {
+                return Err(format!("{name}: a linear transformation needs a Real variable"));
+            }
+            let mut text = b.text.clone();
+            let mut how = String::new();
+            if let Some(t) = &bound.transformation {
+                text = t.apply_text(&text).map_err(|why| format!("{name}: {why}"))?;
+                how = format!(" ({t})");
+            }
+            // an enumeration value by its item's name
+            if let (BaseType::Integer, model_description::VariableType::Enumeration { declared_type, .. }) =
+                (ty, &v.variable_type)
+            {
+                if text.trim().parse::<i64>().is_err() {
+                    let item = md
+                        .type_definitions
+                        .iter()
+                        .find(|t| &t.name == declared_type)
+                        .and_then(|t| t.items.iter().find(|i| i.name == text.trim()))
+                        .ok_or_else(|| format!("{name}: {text:?} is no item of its enumeration {declared_type}"))?;
+                    text = item.value.to_string();
+                }
+            }
+            Value::parse(ty, &text)
+                .map(|value| (value, how))
+                .map_err(|why| format!("{name}: the {} value {text:?}: {why}", b.kind))
+        }
+    }
 }
 
 #[cfg(test)]
