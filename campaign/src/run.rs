@@ -20,14 +20,14 @@ use std::time::{Duration, Instant};
 
 use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
-use nigel_cosim::metric::Accumulators;
 use crate::results::{
     self, Appender, Row, Target, STATUS_CHECK_FAILED, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED,
     STATUS_TIMEOUT,
 };
-use nigel_cosim::check::CheckAccumulators;
 use crate::spec::{load_system, RunValues, Spec};
 use crate::Error;
+use nigel_cosim::check::CheckAccumulators;
+use nigel_cosim::metric::Accumulators;
 
 /// How to run.
 #[derive(Clone, Debug)]

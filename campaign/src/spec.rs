@@ -14,10 +14,10 @@ use model_description::VariableType;
 use nigel_cosim::{Algorithm, BaseType, System, SystemBuilder, Value};
 use sha2::{Digest, Sha256};
 
-use nigel_cosim::check::Check;
-use nigel_cosim::metric::Metric;
 use crate::rng;
 use crate::Error;
+use nigel_cosim::check::Check;
+use nigel_cosim::metric::Metric;
 
 /// A value written into a variable: the description's TOML scalar, typed.
 #[derive(Clone, Debug, PartialEq)]

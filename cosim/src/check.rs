@@ -4,6 +4,7 @@
 //! A check whose value is not a number (NaN) fails.
 
 use crate::metric::{Accumulators, Metric, Parser};
+use crate::simulate::number_text as num;
 
 /// A comparison operator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,15 +86,15 @@ impl Verdict {
         format!(
             "check {}: {} {op} {} {}{nan}",
             self.text,
-            self.left,
-            self.right,
+            num(self.left),
+            num(self.right),
             if self.holds { "holds" } else { "FAILS" }
         )
     }
 
     /// The failure message of a check that does not hold: `max(abs(plant.y)) < 0.6 fails: 0.71 < 0.6 is false`.
     pub fn failure(&self) -> String {
-        format!("{} fails: {} {} {} is false", self.text, self.left, self.cmp.as_str(), self.right)
+        format!("{} fails: {} {} {} is false", self.text, num(self.left), self.cmp.as_str(), num(self.right))
     }
 }
 
@@ -228,10 +229,11 @@ mod tests {
 
     #[test]
     fn verdicts_over_rows_against_hand_values() {
-        let checks: Vec<Check> = ["max(abs(a)) < 3", "max(abs(a)) <= 3", "final(b) == 2", "mean(a) != 0", "min(b) > -1"]
-            .iter()
-            .map(|t| Check::parse(t).unwrap())
-            .collect();
+        let checks: Vec<Check> =
+            ["max(abs(a)) < 3", "max(abs(a)) <= 3", "final(b) == 2", "mean(a) != 0", "min(b) > -1"]
+                .iter()
+                .map(|t| Check::parse(t).unwrap())
+                .collect();
         let mut acc = CheckAccumulators::new(&checks, &["a".to_string(), "b".to_string()]).unwrap();
         for row in [[1.0, 0.0], [-3.0, 1.0], [2.0, 2.0]] {
             acc.push(&row);

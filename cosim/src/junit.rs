@@ -211,7 +211,8 @@ mod tests {
 
     #[test]
     fn the_document_counts_and_escapes() {
-        let mut failed = TestCase::failed("cosim.check", "max(abs(y)) < 0.6", "max(abs(y)) < 0.6 fails: 0.7 < 0.6 is false");
+        let mut failed =
+            TestCase::failed("cosim.check", "max(abs(y)) < 0.6", "max(abs(y)) < 0.6 fails: 0.7 < 0.6 is false");
         failed.time = Some(0.0123);
         let suite = TestSuite {
             name: "cosim run a&b.ssp".into(),
@@ -223,13 +224,17 @@ mod tests {
             ],
         };
         let x = xml("cosim", &[suite.clone()]);
-        assert!(x.contains("<testsuites name=\"cosim\" tests=\"3\" failures=\"1\" errors=\"1\" skipped=\"0\" time=\"1.500\">"));
+        assert!(x.contains(
+            "<testsuites name=\"cosim\" tests=\"3\" failures=\"1\" errors=\"1\" skipped=\"0\" time=\"1.500\">"
+        ));
         assert!(x.contains("<testsuite name=\"cosim run a&amp;b.ssp\" tests=\"3\" failures=\"1\" errors=\"1\""));
         assert!(x.contains("<testcase classname=\"cosim.check\" name=\"final(x) &gt; 1\"/>"));
         assert!(x.contains("name=\"max(abs(y)) &lt; 0.6\" time=\"0.012\">"));
         assert!(x.contains("<error message=\"missing in the result?\" type=\"error\">missing in the result?</error>"));
         let md = markdown("cosim run", &[suite]);
         assert!(md.contains("**cosim run a&b.ssp**: FAILED (3 tests, 1 failed, 1 errors)"), "{md}");
-        assert!(md.contains("| cosim.check max(abs(y)) < 0.6 | **FAIL** | max(abs(y)) < 0.6 fails: 0.7 < 0.6 is false |"));
+        assert!(
+            md.contains("| cosim.check max(abs(y)) < 0.6 | **FAIL** | max(abs(y)) < 0.6 fails: 0.7 < 0.6 is false |")
+        );
     }
 }

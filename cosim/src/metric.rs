@@ -479,7 +479,10 @@ impl Accumulators {
     }
 
     /// [`Accumulators::new`], or the variable that is not among `slots`.
-    pub fn try_new<'a>(metrics: impl IntoIterator<Item = &'a Metric>, slots: &[String]) -> Result<Accumulators, String> {
+    pub fn try_new<'a>(
+        metrics: impl IntoIterator<Item = &'a Metric>,
+        slots: &[String],
+    ) -> Result<Accumulators, String> {
         let mut leaves = Vec::new();
         fn build(m: &Metric, slots: &[String], leaves: &mut Vec<Leaf>) -> Result<Tree, String> {
             Ok(match m {

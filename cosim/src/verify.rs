@@ -140,7 +140,8 @@ impl Judged {
 /// tolerances and the notes).
 pub fn comparison_cases(c: &Comparison) -> Vec<TestCase> {
     let t = &c.tolerance;
-    let tolerances = format!("rtol {}, atol {}, time-tol {} s", t.rtol, t.atol, t.time_tol);
+    let num = crate::simulate::number_text;
+    let tolerances = format!("rtol {}, atol {}, time-tol {} s", num(t.rtol), num(t.atol), num(t.time_tol));
     c.signals
         .iter()
         .map(|s| {
@@ -150,9 +151,6 @@ pub fn comparison_cases(c: &Comparison) -> Vec<TestCase> {
                 let mut case = TestCase::failed(BASELINE_CLASS, &s.name, &s.detail());
                 if let junit::Outcome::Failed { detail, .. } = &mut case.outcome {
                     detail.push_str(&format!("\ntolerances: {tolerances}"));
-                    for n in &c.notes {
-                        detail.push_str(&format!("\nnote: {n}"));
-                    }
                 }
                 case
             };

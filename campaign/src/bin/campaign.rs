@@ -208,7 +208,8 @@ fn main_inner(cli: Cli) -> Result<Outcome, Error> {
                     std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?,
                 )
             };
-            let options = Options { out, threads, shard, resume, progress: true, workers, allow_failures, cancel: None };
+            let options =
+                Options { out, threads, shard, resume, progress: true, workers, allow_failures, cancel: None };
             let done = nigel_campaign::run::run(&spec, &options)?;
             if let Some(m) = &done.stop_time_refused {
                 eprintln!("campaign: warning: {m} (checked before the first run; run anyway: --allow-failures)");

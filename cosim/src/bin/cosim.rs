@@ -516,9 +516,8 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     let summary = match outcome {
         Ok(s) => s,
         Err(failed) => {
-            let message = failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| {
-                e.to_string()
-            });
+            let message =
+                failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| e.to_string());
             let suite = nigel_cosim::verify::run_suite(
                 &suite_name,
                 started.elapsed().as_secs_f64(),
@@ -554,9 +553,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if verification.is_empty() && args.verify.report.junit.is_none() && args.verify.report.summary_md.is_none() {
         return Ok(true);
     }
-    let judged = verification
-        .judge(&results, |v| column(&qualify(v, single)))
-        .map_err(Failure::Message)?;
+    let judged = verification.judge(&results, |v| column(&qualify(v, single))).map_err(Failure::Message)?;
     let to_stderr = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     for line in judged.lines() {
         if to_stderr {
@@ -570,17 +567,19 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
 
 /// The checks and baseline of `cosim run`.
 fn verification(v: &VerifyArgs) -> Result<nigel_cosim::verify::Verification, Failure> {
-    let tolerance = nigel_cosim::compare::Tolerance {
-        rtol: v.baseline_rtol,
-        atol: v.baseline_atol,
-        time_tol: v.baseline_time_tol,
-    };
+    let tolerance =
+        nigel_cosim::compare::Tolerance { rtol: v.baseline_rtol, atol: v.baseline_atol, time_tol: v.baseline_time_tol };
     let signals = (!v.report.signals.is_empty()).then(|| v.report.signals.clone());
     if signals.is_some() && v.baseline.is_none() {
         return Err(Failure::Message("--signals needs --baseline".into()));
     }
-    nigel_cosim::verify::Verification::new(&v.checks, v.baseline.as_deref(), tolerance, signals)
-        .map_err(|e| Failure::Message(e.replace("--rtol", "--baseline-rtol").replace("--atol", "--baseline-atol").replace("--time-tol", "--baseline-time-tol")))
+    nigel_cosim::verify::Verification::new(&v.checks, v.baseline.as_deref(), tolerance, signals).map_err(|e| {
+        Failure::Message(
+            e.replace("--rtol", "--baseline-rtol")
+                .replace("--atol", "--baseline-atol")
+                .replace("--time-tol", "--baseline-time-tol"),
+        )
+    })
 }
 
 /// The figures, the JUnit file and the Markdown summary of a judged run or comparison;
@@ -598,8 +597,7 @@ fn report(
             eprintln!("cosim: figure {}", p.display());
         }
     }
-    let suite =
-        nigel_cosim::verify::run_suite(suite_name, started.elapsed().as_secs_f64(), None, judged, verification);
+    let suite = nigel_cosim::verify::run_suite(suite_name, started.elapsed().as_secs_f64(), None, judged, verification);
     nigel_cosim::verify::write_reports(&suite, r.junit.as_deref(), r.summary_md.as_deref())
         .map_err(Failure::Message)?;
     Ok(judged.passed())
@@ -610,8 +608,8 @@ fn compare(args: &CompareArgs) -> Result<bool, Failure> {
     let started = std::time::Instant::now();
     let tolerance = nigel_cosim::compare::Tolerance { rtol: args.rtol, atol: args.atol, time_tol: args.time_tol };
     let signals = (!args.report.signals.is_empty()).then(|| args.report.signals.clone());
-    let verification =
-        nigel_cosim::verify::Verification::new(&[], Some(&args.baseline), tolerance, signals).map_err(Failure::Message)?;
+    let verification = nigel_cosim::verify::Verification::new(&[], Some(&args.baseline), tolerance, signals)
+        .map_err(Failure::Message)?;
     let result = nigel_cosim::compare::csv::read_results_csv(&args.result).map_err(Failure::Message)?;
     let judged = verification.judge(&result, |v| v.to_string()).map_err(Failure::Message)?;
     println!("compare {} with the baseline {}", args.result.display(), args.baseline.display());

@@ -56,9 +56,7 @@ pub fn parse_results_csv(text: &str) -> Result<Results, String> {
             return Err(format!("{}: {} values, the header has {} names", k + 1, row.len(), names.len()));
         }
         for (j, c) in row.iter().enumerate() {
-            values.push(
-                number(c).ok_or_else(|| format!("{}: {c:?} (column {:?}) is not a number", k + 1, names[j]))?,
-            );
+            values.push(number(c).ok_or_else(|| format!("{}: {c:?} (column {:?}) is not a number", k + 1, names[j]))?);
         }
     }
     Ok(Results { names: names[1..].to_vec(), values })

@@ -134,8 +134,8 @@ mod tests {
         assert!((lo - 0.1).abs() < 1e-15 && (hi - 1.0).abs() < 1e-15, "{lo} {hi}");
         // outside the span by more than the time tolerance: no tube
         assert_eq!(b.tube(2.5, &tol(0.0, 0.1, 0.25)), None);
-        // within it: the window clipped to [1.75, 2]
-        assert_eq!(b.tube(2.2, &tol(0.0, 0.0, 0.25)), Some((1.75, 2.0)));
+        // within it: the window [1.875, 2.375] clipped to [1.875, 2]
+        assert_eq!(b.tube(2.125, &tol(0.0, 0.0, 0.25)), Some((1.875, 2.0)));
     }
 
     #[test]

@@ -183,6 +183,13 @@ pub fn push_number(out: &mut String, v: f64) {
     }
 }
 
+/// [`push_number`]'s text of `v` (`0.35`, `1.6940658945086007e-21`).
+pub fn number_text(v: f64) -> String {
+    let mut s = String::new();
+    push_number(&mut s, v);
+    s
+}
+
 /// A JSON-able run summary.
 #[derive(Clone, Debug, Default)]
 pub struct Summary {
