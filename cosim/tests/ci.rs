@@ -70,6 +70,59 @@ fn png_size(path: &Path) -> (u32, u32) {
     (be(16), be(20))
 }
 
+/// The output lines of docs/ci.md's block marked `<!-- tested: NAME -->` (the lines after
+/// the command: a `$` line and its continuations, indented).
+fn doc_block(name: &str) -> String {
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/ci.md")).unwrap();
+    let start = doc.find(&format!("<!-- tested: {name} -->")).unwrap_or_else(|| panic!("no block {name}"));
+    let body = doc[start..].split("```text\n").nth(1).unwrap().split("```").next().unwrap();
+    let mut out = String::new();
+    let mut command = true;
+    for line in body.lines() {
+        if command && (line.starts_with("$ ") || line.starts_with("    ")) {
+            continue;
+        }
+        command = false;
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+#[test]
+fn the_docs_worked_example_of_the_tube_prints_what_it_says() {
+    // docs/ci.md: a step from 0 to 1 at 2 s on points every 0.25 s, and the same 0.5 s late
+    let dir = work("step");
+    let step = |at: f64| -> String {
+        let mut s = String::from("\"time\",\"y\"\n");
+        for k in 0..=16 {
+            let t = k as f64 * 0.25;
+            s += &format!("{t},{}\n", if t >= at { 1 } else { 0 });
+        }
+        s
+    };
+    std::fs::write(dir.join("step.csv"), step(2.0)).unwrap();
+    std::fs::write(dir.join("step_late.csv"), step(2.5)).unwrap();
+    std::fs::write(dir.join("step_early.csv"), step(2.25)).unwrap();
+    let compare = |result: &str, time_tol: &str| {
+        let o = Command::new(cosim())
+            .args(["compare", result, "step.csv", "--rtol", "0", "--atol", "1e-3", "--time-tol", time_tol])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned())
+    };
+    let (code, stdout) = compare("step_late.csv", "0.25");
+    assert_eq!(code, Some(3));
+    assert_eq!(stdout, doc_block("step"));
+    // --time-tol 0.3: the tube at 2.25 s is [0.799, 1.001] (within rounding of 2.25 - 0.3)
+    let (code, stdout) = compare("step_late.csv", "0.3");
+    assert_eq!(code, Some(3));
+    assert!(stdout.contains("y  FAIL  1 of 17 points outside the tube; largest violation 0.79"), "{stdout}");
+    // 0.25 s late passes with --time-tol 0.3
+    assert_eq!(compare("step_early.csv", "0.3"), (Some(0), "compare step_early.csv with the baseline step.csv\ntolerances: rtol 0, atol 0.001, time-tol 0.3 s\ny  pass  17 points inside the tube\n1 signal compared: 1 passed, 0 failed\n".to_string()));
+}
+
 #[test]
 fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
     let dir = work("pass");
@@ -111,6 +164,8 @@ fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
     for name in &b.0[1..] {
         assert_eq!(column(&csv, name), column(&b, name), "{name}");
     }
+    // docs/ci.md shows this run's lines
+    assert_eq!(doc_block("run"), stdout);
     let xml = std::fs::read_to_string(&junit).unwrap();
     assert!(xml.contains("tests=\"9\" failures=\"0\" errors=\"0\""), "{xml}");
     let md = std::fs::read_to_string(&md).unwrap();

@@ -107,7 +107,8 @@ impl Comparison {
         out.push(if self.signals.is_empty() {
             "no signal compared: the result and the baseline have no signal in common".to_string()
         } else {
-            format!("{} signals compared: {} passed, {failed} failed", self.signals.len(), self.signals.len() - failed)
+            let n = self.signals.len();
+            format!("{n} signal{} compared: {} passed, {failed} failed", if n == 1 { "" } else { "s" }, n - failed)
         });
         out
     }
