@@ -403,7 +403,7 @@ def compare(
     ``cosim compare`` does (docs/ci.md): each a CSV path or a structured array (as
     ``simulate_fmu`` returns, time first). Returns the report: ``passed``, ``tolerance``,
     ``signals`` (per signal ``name``, ``passed``, ``points``, ``violations``, ``worst``,
-    ``problem``, ``detail``), ``notes``, ``lines``, ``figures`` (the PNGs drawn into
+    ``problem``, ``detail``), ``notes``, ``lines``, ``figures`` (the paths of the PNGs drawn into
     ``plot`` for the failing signals)."""
     import tempfile
 

@@ -388,7 +388,7 @@ def test_compare_gives_the_report_of_cosim_compare(tmp_path):
     assert y["worst"]["time"] == 15.0 and y["worst"]["value"] == data["plant.y"][300]
     assert (y["worst"]["lower"], y["worst"]["upper"]) == (b - w, b + w)
     assert report["signals"][2]["problem"] == "missing in the result"
-    assert report["figures"] == [str(tmp_path / "plots" / "plant.y.png")]
+    assert report["figures"] == [tmp_path / "plots" / "plant.y.png"]
     # the same files through the command line: the same lines
     path = tmp_path / "result.csv"
     nigel_cosim.write_csv(path, result)
