@@ -223,7 +223,7 @@ mod tests {
                 TestCase::error("cosim.baseline", "plant.y", "missing in the result\u{1}"),
             ],
         };
-        let x = xml("cosim", &[suite.clone()]);
+        let x = xml("cosim", std::slice::from_ref(&suite));
         assert!(x.contains(
             "<testsuites name=\"cosim\" tests=\"3\" failures=\"1\" errors=\"1\" skipped=\"0\" time=\"1.500\">"
         ));

@@ -102,7 +102,7 @@ impl Verification {
 impl Judged {
     /// Whether every check held and every compared signal passed.
     pub fn passed(&self) -> bool {
-        self.verdicts.iter().all(|v| v.holds) && self.comparison.as_ref().map_or(true, Comparison::passed)
+        self.verdicts.iter().all(|v| v.holds) && self.comparison.iter().all(Comparison::passed)
     }
 
     /// The lines to print: one per check, then the comparison's.

@@ -107,8 +107,8 @@ impl Baseline<'_> {
         take(self.at(b));
         let i0 = s.partition_point(|x| *x < a);
         let i1 = s.partition_point(|x| *x <= b);
-        for j in i0..i1 {
-            take(v[j]);
+        for y in &v[i0..i1] {
+            take(*y);
         }
         Some((lower, upper))
     }
