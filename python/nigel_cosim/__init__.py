@@ -42,6 +42,7 @@ __all__ = [
     "simulate_ssp",
     "System",
     "run_campaign",
+    "compare",
     "write_csv",
     "Error",
     "LoadError",
@@ -400,6 +401,37 @@ def run_campaign(
     except ImportError:
         return np.genfromtxt(csv, delimiter=",", names=True, dtype=None, encoding="utf-8")
     return pandas.read_csv(csv)
+
+
+def compare(
+    result: str | os.PathLike | np.ndarray,
+    baseline: str | os.PathLike | np.ndarray,
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    time_tol: float = 0.0,
+    signals: Sequence[str] | None = None,
+    plot: str | os.PathLike | None = None,
+) -> dict[str, Any]:
+    """Compares ``result`` with ``baseline`` signal by signal in tolerance tubes, as
+    ``cosim compare`` does (docs/ci.md): each a CSV path or a structured array (as
+    ``simulate_fmu`` returns, time first). Returns the report: ``passed``, ``tolerance``,
+    ``signals`` (per signal ``name``, ``passed``, ``points``, ``violations``, ``worst``,
+    ``problem``, ``detail``), ``notes``, ``lines``, ``figures`` (the paths of the PNGs drawn into
+    ``plot`` for the failing signals)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="nigel-compare-") as scratch:
+        paths = []
+        for what, data in (("result", result), ("baseline", baseline)):
+            if isinstance(data, np.ndarray):
+                path = Path(scratch) / f"{what}.csv"
+                write_csv(path, data)
+                paths.append(os.fspath(path))
+            else:
+                paths.append(os.fspath(data))
+        names = list(signals) if signals is not None else None
+        folder = os.fspath(plot) if plot is not None else None
+        return _native.compare(paths[0], paths[1], rtol, atol, time_tol, names, folder)
 
 
 def _toml_value(v: Any) -> str:

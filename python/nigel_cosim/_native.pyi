@@ -51,3 +51,13 @@ def run_campaign(
     shard: tuple[int, int] | None = None,
     progress: bool = False,
 ) -> tuple[str, int, int]: ...
+
+def compare(
+    result: str,
+    baseline: str,
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    time_tol: float = 0.0,
+    signals: list[str] | None = None,
+    plot: str | None = None,
+) -> dict[str, Any]: ...

@@ -10,13 +10,13 @@
 //! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
 //! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
 
+use model_description::DefaultExperiment;
+use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
     simulate::{default_record, simulate_with},
     Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, SetQueue,
     Solver, Summary, System, SystemBuilder,
 };
-use model_description::DefaultExperiment;
-use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
@@ -186,12 +186,10 @@ impl NativeSystem {
             experiment.record = Some(output.iter().map(|n| self.qualify(n)).collect());
         }
         if let Some(t) = args.timeout {
-            experiment.timeout = Some(
-                Duration::try_from_secs_f64(t)
-                    .ok()
-                    .filter(|d| !d.is_zero())
-                    .ok_or_else(|| CosimError::Experiment(format!("timeout {t} must be a positive number of seconds")))?,
-            );
+            experiment.timeout =
+                Some(Duration::try_from_secs_f64(t).ok().filter(|d| !d.is_zero()).ok_or_else(|| {
+                    CosimError::Experiment(format!("timeout {t} must be a positive number of seconds"))
+                })?);
         }
         if args.threads == 0 {
             return Err(CosimError::Experiment("threads must be at least 1".into()));
@@ -357,7 +355,9 @@ impl NativeSystem {
 
     /// One tuple per variable: (name, type, causality, variability, start as text or None,
     /// unit or None, description or None); names are `instance.variable` for an SSP.
-    fn variables(&self) -> PyResult<Vec<(String, String, String, String, Option<String>, Option<String>, Option<String>)>> {
+    fn variables(
+        &self,
+    ) -> PyResult<Vec<(String, String, String, String, Option<String>, Option<String>, Option<String>)>> {
         let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
         let system = guard.as_ref().ok_or_else(|| Error::new_err("the system is closed"))?;
         let mut out = Vec::new();
@@ -422,7 +422,9 @@ impl NativeSystem {
         }
         experiment.record = Some(record.clone());
         let names: Vec<String> = match &self.single {
-            Some(instance) => record.iter().map(|n| n.strip_prefix(&format!("{instance}.")).unwrap_or(n).to_string()).collect(),
+            Some(instance) => {
+                record.iter().map(|n| n.strip_prefix(&format!("{instance}.")).unwrap_or(n).to_string()).collect()
+            }
             None => record.clone(),
         };
         NativeRun::start(py, system, experiment, names, types, self.single.clone())
@@ -557,7 +559,9 @@ impl NativeRun {
                         return Err(e);
                     }
                 }
-                Err(RecvTimeoutError::Disconnected) => break RunEvent::Finished(Err(CosimError::Cancelled { time: f64::NAN })),
+                Err(RecvTimeoutError::Disconnected) => {
+                    break RunEvent::Finished(Err(CosimError::Cancelled { time: f64::NAN }))
+                }
             }
         };
         let mut state = self.state.lock().unwrap_or_else(|p| p.into_inner());
@@ -626,11 +630,9 @@ impl NativeRun {
 
     /// The recorded value of `name` at the current time.
     fn get(&self, name: &str) -> PyResult<f64> {
-        let j = self
-            .names
-            .iter()
-            .position(|n| n == name)
-            .ok_or_else(|| VariableError::new_err(format!("{name:?} is not recorded in this run (add it to output=)")))?;
+        let j = self.names.iter().position(|n| n == name).ok_or_else(|| {
+            VariableError::new_err(format!("{name:?} is not recorded in this run (add it to output=)"))
+        })?;
         let rows = self.rows.lock().unwrap_or_else(|p| p.into_inner());
         let width = self.names.len() + 1;
         let k = rows.len().checked_sub(width).ok_or_else(|| Error::new_err("the run has no row yet"))?;
@@ -726,12 +728,79 @@ fn run_campaign(
     Ok((out.join("results.csv"), done.ran, done.failed))
 }
 
+/// Compares the results CSV `result` with the baseline CSV `baseline` in tolerance tubes
+/// (`cosim compare`); with `plot`, a PNG per failing signal into that folder. Returns the
+/// report as a dict: `passed`, `tolerance`, `signals` (per signal `name`, `passed`,
+/// `points`, `violations`, `worst` (`time`, `value`, `lower`, `upper`, `excess`) or None,
+/// `problem`, `detail`), `notes`, `lines` (as `cosim compare` prints them), `figures`.
+#[pyfunction]
+#[pyo3(signature = (result, baseline, rtol=1e-3, atol=1e-6, time_tol=0.0, signals=None, plot=None))]
+#[allow(clippy::too_many_arguments)]
+fn compare<'py>(
+    py: Python<'py>,
+    result: PathBuf,
+    baseline: PathBuf,
+    rtol: f64,
+    atol: f64,
+    time_tol: f64,
+    signals: Option<Vec<String>>,
+    plot: Option<PathBuf>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    use nigel_cosim::compare;
+    use pyo3::types::PyDict;
+    let tolerance = compare::Tolerance { rtol, atol, time_tol };
+    let bad = |e: String| PyValueError::new_err(e);
+    let r = compare::csv::read_results_csv(&result).map_err(bad)?;
+    let b = compare::csv::read_results_csv(&baseline).map_err(bad)?;
+    let c = compare::compare(&r, &b, &tolerance, signals.as_deref()).map_err(bad)?;
+    let figures = match &plot {
+        Some(dir) => compare::plot::plot_failures(&r, &b, &c, dir).map_err(bad)?,
+        None => Vec::new(),
+    };
+    let out = PyDict::new(py);
+    out.set_item("passed", c.passed())?;
+    let tol = PyDict::new(py);
+    tol.set_item("rtol", rtol)?;
+    tol.set_item("atol", atol)?;
+    tol.set_item("time_tol", time_tol)?;
+    out.set_item("tolerance", tol)?;
+    let mut each = Vec::new();
+    for s in &c.signals {
+        let d = PyDict::new(py);
+        d.set_item("name", &s.name)?;
+        d.set_item("passed", s.passed)?;
+        d.set_item("points", s.points)?;
+        d.set_item("violations", s.violations)?;
+        match &s.worst {
+            Some(w) => {
+                let wd = PyDict::new(py);
+                wd.set_item("time", w.time)?;
+                wd.set_item("value", w.value)?;
+                wd.set_item("lower", w.lower)?;
+                wd.set_item("upper", w.upper)?;
+                wd.set_item("excess", w.excess)?;
+                d.set_item("worst", wd)?;
+            }
+            None => d.set_item("worst", py.None())?,
+        }
+        d.set_item("problem", s.problem.clone())?;
+        d.set_item("detail", s.detail())?;
+        each.push(d);
+    }
+    out.set_item("signals", each)?;
+    out.set_item("notes", c.notes.clone())?;
+    out.set_item("lines", c.lines())?;
+    out.set_item("figures", figures)?;
+    Ok(out)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<NativeSystem>()?;
     m.add_class::<NativeRun>()?;
     m.add_function(wrap_pyfunction!(run_campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add("Error", py.get_type::<Error>())?;
     m.add("LoadError", py.get_type::<LoadError>())?;
     m.add("VariableError", py.get_type::<VariableError>())?;

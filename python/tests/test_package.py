@@ -435,3 +435,37 @@ def test_ctrl_c_during_a_campaign_starts_no_further_run(tmp_path):
     # the rows of the runs that finished are written, far fewer than the 2000 asked for
     rows = pandas.read_csv(tmp_path / "out" / "results.csv")
     assert 0 < len(rows) < 2000
+
+
+def test_compare_gives_the_report_of_cosim_compare(tmp_path):
+    # the committed baseline of the closed loop against itself with one value off by 1 %
+    # and one signal left out: as `cosim compare` judges the same files
+    baseline = REPO / "cosim" / "tests" / "data" / "closed_loop_30s.csv"
+    data = np.genfromtxt(baseline, delimiter=",", names=True, deletechars="", dtype=np.float64)
+    b = data["plant.y"][300]
+    data["plant.y"][300] *= 1.01
+    result = data[["time", "plant.x", "plant.y"]]
+    report = nigel_cosim.compare(result, baseline, plot=tmp_path / "plots")
+    assert not report["passed"]
+    assert [(s["name"], s["passed"]) for s in report["signals"]] == [
+        ("plant.x", True),
+        ("plant.y", False),
+        ("plant.psi", False),
+        ("plant.speed", False),
+        ("plant.yaw_rate", False),
+    ]
+    y = report["signals"][1]
+    # the default tolerances: the tube at t = 15 s is b +- (1e-6 + 1e-3 |b|)
+    w = 1e-6 + 1e-3 * abs(b)
+    assert (y["points"], y["violations"]) == (601, 1)
+    assert y["worst"]["time"] == 15.0 and y["worst"]["value"] == data["plant.y"][300]
+    assert (y["worst"]["lower"], y["worst"]["upper"]) == (b - w, b + w)
+    assert report["signals"][2]["problem"] == "missing in the result"
+    assert report["figures"] == [tmp_path / "plots" / "plant.y.png"]
+    # the same files through the command line: the same lines
+    path = tmp_path / "result.csv"
+    nigel_cosim.write_csv(path, result)
+    p = subprocess.run([COSIM, "compare", path, baseline], capture_output=True, text=True)
+    assert p.returncode == 3
+    assert p.stdout.splitlines()[1:] == report["lines"]
+    assert nigel_cosim.compare(path, baseline, signals=["plant.x"])["passed"]

@@ -18,6 +18,9 @@ struct Cli {
 enum Command {
     /// Simulate MODEL.fmu (as a one-instance system) or SYSTEM.ssp / SYSTEM.ssd.
     Run(Box<RunArgs>),
+    /// Compare RESULT.csv with BASELINE.csv signal by signal in tolerance tubes (exit
+    /// status 3 when a signal leaves its tube or is missing; docs/ci.md).
+    Compare(CompareArgs),
     /// List the variables (causality, type, unit, start) of an FMU, or the instances and
     /// connections of an SSP.
     Info {
@@ -26,6 +29,67 @@ enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The results to judge (CSV: ours, fmpy's, Dymola's or OpenModelica's export).
+    result: PathBuf,
+    /// The baseline (CSV).
+    baseline: PathBuf,
+    /// Relative tolerance, of the baseline's magnitude at each point.
+    #[arg(long, default_value_t = 1e-3)]
+    rtol: f64,
+    /// Absolute tolerance, in each signal's unit.
+    #[arg(long, default_value_t = 1e-6)]
+    atol: f64,
+    /// Time tolerance, s: events shifted by up to this much pass.
+    #[arg(long, default_value_t = 0.0)]
+    time_tol: f64,
+    #[command(flatten)]
+    report: ReportArgs,
+}
+
+/// Where the verdicts of a run or a comparison go besides the terminal.
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// Compare only these signals (default: every signal of the baseline).
+    #[arg(long, num_args = 1.., value_name = "NAME")]
+    signals: Vec<String>,
+    /// Draw one PNG per failing signal into this folder (result, baseline, tube, violations).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    /// Write a JUnit XML report (a test case per check and per compared signal).
+    #[arg(long, value_name = "FILE.xml")]
+    junit: Option<PathBuf>,
+    /// Write a Markdown table of the verdicts (for a CI job summary).
+    #[arg(long, value_name = "FILE.md")]
+    summary_md: Option<PathBuf>,
+}
+
+/// Checks and a baseline of `cosim run`.
+#[derive(clap::Args)]
+struct VerifyArgs {
+    /// A check of the run, judged on every recorded row: a metric, a comparison, a number
+    /// or metric, e.g. 'max(abs(plant.y)) < 0.6' (repeatable; docs/ci.md). Exit status 3
+    /// when one fails (the results are still written).
+    #[arg(long = "check", value_name = "EXPR")]
+    checks: Vec<String>,
+    /// Compare the results with this baseline CSV in tolerance tubes (exit status 3 when
+    /// a signal leaves its tube).
+    #[arg(long, value_name = "BASE.csv")]
+    baseline: Option<PathBuf>,
+    /// --baseline's relative tolerance (cosim compare --rtol).
+    #[arg(long, default_value_t = 1e-3)]
+    baseline_rtol: f64,
+    /// --baseline's absolute tolerance (cosim compare --atol).
+    #[arg(long, default_value_t = 1e-6)]
+    baseline_atol: f64,
+    /// --baseline's time tolerance, s (cosim compare --time-tol).
+    #[arg(long, default_value_t = 0.0)]
+    baseline_time_tol: f64,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// Limits of the archives and XML files read; the defaults refuse zip bombs and files
@@ -147,8 +211,35 @@ struct RunArgs {
     #[arg(long)]
     summary: Option<PathBuf>,
     #[command(flatten)]
+    verify: VerifyArgs,
+    #[command(flatten)]
     limits: LimitArgs,
 }
+
+/// Why `cosim` stopped: an error of the master or a message of its own.
+enum Failure {
+    Cosim(Error),
+    Message(String),
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Failure {
+        Failure::Cosim(e)
+    }
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Failure::Cosim(e) => e.fmt(f),
+            Failure::Message(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Exit status of a run or comparison that was done and did not pass (1: not done, 2: a
+/// command line clap refused).
+const EXIT_NOT_PASSED: u8 = 3;
 
 /// Where `--isolate` draws the crash boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -164,10 +255,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
-        Command::Info { model, limits } => info(&model, &limits.limits()),
+        Command::Compare(args) => compare(&args),
+        Command::Info { model, limits } => info(&model, &limits.limits()).map(|()| true).map_err(Failure::from),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(EXIT_NOT_PASSED),
         Err(e) => {
             eprintln!("cosim: {e}");
             ExitCode::FAILURE
@@ -214,12 +307,13 @@ fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
     Ok(sets)
 }
 
-fn run(args: RunArgs) -> Result<(), Error> {
+fn run(args: RunArgs) -> Result<bool, Failure> {
+    let started = std::time::Instant::now();
     let interface = match args.interface.as_deref() {
         None => None,
         Some("cs") => Some(Interface::CoSimulation),
         Some("me") => Some(Interface::ModelExchange),
-        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)")).into()),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
     let format = match &args.output {
@@ -300,11 +394,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
             nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
         }
-        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
+        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol)).into()),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
-        return Err(Error::Experiment("--max-step must be positive".into()));
+        return Err(Error::Experiment("--max-step must be positive".into()).into());
     }
     if let Some(path) = &args.input {
         experiment.input = Some(std::sync::Arc::new(nigel_cosim::InputTable::read_csv(path)?));
@@ -314,7 +408,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // the time per FMU is only reported in the summary: measured only when one is asked for
     experiment.profile = args.summary.is_some();
     if args.threads == 0 {
-        return Err(Error::Experiment("--threads must be at least 1".into()));
+        return Err(Error::Experiment("--threads must be at least 1".into()).into());
     }
     experiment.threads = args.threads;
     experiment.max_steps = args.max_steps;
@@ -331,7 +425,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         return Err(Error::Experiment(
             "--timeout-call needs --isolate (=fmu: a call in this process cannot be stopped; a host process per FMU can be killed; --isolate=run has --timeout)"
                 .into(),
-        ));
+        ).into());
     }
     if args.isolate == Some(IsolateMode::Fmu) {
         experiment.isolation = Some(nigel_cosim::Isolation {
@@ -340,8 +434,40 @@ fn run(args: RunArgs) -> Result<(), Error> {
             host: None,
         });
     }
-    if !args.record.is_empty() {
-        experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
+    let verification = verification(&args.verify)?;
+    // the results' column of a system variable (a one-instance system's columns are bare)
+    let column = |name: &str| -> String {
+        match single {
+            Some(_) => name.strip_prefix(&format!("{SINGLE}.")).unwrap_or(name).to_string(),
+            None => name.to_string(),
+        }
+    };
+    let asked: Vec<String> = if args.record.is_empty() {
+        nigel_cosim::simulate::default_record(&system).iter().map(|r| system.name_of(r)).collect()
+    } else {
+        args.record.iter().map(|r| qualify(r, single)).collect()
+    };
+    // what the checks and the baseline read is recorded too, and left out of --output
+    let mut record = asked.clone();
+    for c in &verification.checks {
+        for v in c.variables() {
+            let q = qualify(&v, single);
+            system.resolve(&q).map_err(|e| Failure::Message(format!("--check {:?}: {e}", c.text)))?;
+            if !record.contains(&q) {
+                record.push(q);
+            }
+        }
+    }
+    for name in verification.columns() {
+        // a baseline column that is no variable of the system is reported missing
+        let q = qualify(&name, single);
+        if system.resolve(&q).is_ok() && !record.contains(&q) {
+            record.push(q);
+        }
+    }
+    let extra = record.len() > asked.len();
+    if !args.record.is_empty() || extra {
+        experiment.record = Some(record);
     }
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
@@ -350,7 +476,8 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
         Some(IsolateMode::Run) if host_of_run => {
-            return nigel_cosim::isolate::whole::host_simulate(&system, &experiment);
+            nigel_cosim::isolate::whole::host_simulate(&system, &experiment)?;
+            return Ok(true);
         }
         Some(IsolateMode::Run) => {
             let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
@@ -367,7 +494,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
             (results, outcome.map_err(Some))
         }
     };
-    if outcome.is_ok() && args.output.is_none() && args.summary.is_none() {
+    if outcome.is_ok() && args.output.is_none() && args.summary.is_none() && verification.is_empty() {
         eprintln!(
             "cosim: note: no --output or --summary given: the run completed but its results were not kept \
              (add --output out.csv or --output out.mat)"
@@ -379,11 +506,13 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // the rows recorded so far are written also when the run failed
     if let (Some(path), Some(format)) = (&args.output, format) {
         if outcome.is_ok() || results.rows() > 0 {
+            let asked_columns: Vec<String> = asked.iter().map(|n| column(n)).collect();
+            let kept = if extra { results.select(&asked_columns) } else { results.clone() };
             match format {
-                OutputFormat::Csv => write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?,
+                OutputFormat::Csv => write(path, &|f| kept.write_csv(std::io::BufWriter::new(f)))?,
                 OutputFormat::Mat => {
-                    let descriptions = column_descriptions(&system, &results);
-                    write(path, &|f| results.write_mat(std::io::BufWriter::new(f), &descriptions))?
+                    let descriptions = column_descriptions(&system, &kept);
+                    write(path, &|f| kept.write_mat(std::io::BufWriter::new(f), &descriptions))?
                 }
             }
             if outcome.is_err() {
@@ -391,10 +520,28 @@ fn run(args: RunArgs) -> Result<(), Error> {
             }
         }
     }
+    let suite_name = format!("cosim run {}", args.model.display());
     let summary = match outcome {
         Ok(s) => s,
-        Err(Some(e)) => return Err(e),
-        Err(None) => std::process::exit(1),
+        Err(failed) => {
+            let message =
+                failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| e.to_string());
+            let suite = nigel_cosim::verify::run_suite(
+                &suite_name,
+                started.elapsed().as_secs_f64(),
+                Some(&message),
+                &Default::default(),
+                &verification,
+            );
+            let r = &args.verify.report;
+            if let Err(e) = nigel_cosim::verify::write_reports(&suite, r.junit.as_deref(), r.summary_md.as_deref()) {
+                eprintln!("cosim: {e}");
+            }
+            match failed {
+                Some(e) => return Err(e.into()),
+                None => std::process::exit(1),
+            }
+        }
     };
     let json = serde_json::to_string_pretty(&host_json.unwrap_or_else(|| summary.to_json())).unwrap_or_default();
     match &args.summary {
@@ -411,7 +558,87 @@ fn run(args: RunArgs) -> Result<(), Error> {
             experiment.stop_time
         );
     }
-    Ok(())
+    if verification.is_empty() && args.verify.report.junit.is_none() && args.verify.report.summary_md.is_none() {
+        return Ok(true);
+    }
+    let judged = verification.judge(&results, |v| column(&qualify(v, single))).map_err(Failure::Message)?;
+    let to_stderr = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    for line in judged.lines() {
+        if to_stderr {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
+    }
+    report(&args.verify.report, &results, &verification, &judged, &suite_name, started)
+}
+
+/// The checks and baseline of `cosim run`.
+fn verification(v: &VerifyArgs) -> Result<nigel_cosim::verify::Verification, Failure> {
+    let tolerance =
+        nigel_cosim::compare::Tolerance { rtol: v.baseline_rtol, atol: v.baseline_atol, time_tol: v.baseline_time_tol };
+    let signals = (!v.report.signals.is_empty()).then(|| v.report.signals.clone());
+    if signals.is_some() && v.baseline.is_none() {
+        return Err(Failure::Message("--signals needs --baseline".into()));
+    }
+    nigel_cosim::verify::Verification::new(&v.checks, v.baseline.as_deref(), tolerance, signals).map_err(|e| {
+        Failure::Message(
+            e.replace("--rtol", "--baseline-rtol")
+                .replace("--atol", "--baseline-atol")
+                .replace("--time-tol", "--baseline-time-tol"),
+        )
+    })
+}
+
+/// The figures, the JUnit file and the Markdown summary of a judged run or comparison;
+/// whether it passed.
+fn report(
+    r: &ReportArgs,
+    results: &nigel_cosim::Results,
+    verification: &nigel_cosim::verify::Verification,
+    judged: &nigel_cosim::verify::Judged,
+    suite_name: &str,
+    started: std::time::Instant,
+) -> Result<bool, Failure> {
+    if let (Some(dir), Some(c), Some((_, base))) = (&r.plot, &judged.comparison, &verification.baseline) {
+        for p in nigel_cosim::compare::plot::plot_failures(results, base, c, dir).map_err(Failure::Message)? {
+            eprintln!("cosim: figure {}", p.display());
+        }
+    }
+    let suite = nigel_cosim::verify::run_suite(suite_name, started.elapsed().as_secs_f64(), None, judged, verification);
+    nigel_cosim::verify::write_reports(&suite, r.junit.as_deref(), r.summary_md.as_deref())
+        .map_err(Failure::Message)?;
+    Ok(judged.passed())
+}
+
+/// `cosim compare`: the comparison's lines; whether every signal passed.
+fn compare(args: &CompareArgs) -> Result<bool, Failure> {
+    let started = std::time::Instant::now();
+    let tolerance = nigel_cosim::compare::Tolerance { rtol: args.rtol, atol: args.atol, time_tol: args.time_tol };
+    let signals = (!args.report.signals.is_empty()).then(|| args.report.signals.clone());
+    let verification = nigel_cosim::verify::Verification::new(&[], Some(&args.baseline), tolerance, signals)
+        .map_err(Failure::Message)?;
+    let result = nigel_cosim::compare::csv::read_results_csv(&args.result).map_err(Failure::Message)?;
+    let judged = verification.judge(&result, |v| v.to_string()).map_err(Failure::Message)?;
+    println!("compare {} with the baseline {}", args.result.display(), args.baseline.display());
+    for line in judged.comparison.iter().flat_map(|c| c.lines()) {
+        println!("{line}");
+    }
+    let name = format!("cosim compare {} {}", args.result.display(), args.baseline.display());
+    // the comparison's cases alone: no run
+    if let (Some(dir), Some(c), Some((_, base))) = (&args.report.plot, &judged.comparison, &verification.baseline) {
+        for p in nigel_cosim::compare::plot::plot_failures(&result, base, c, dir).map_err(Failure::Message)? {
+            eprintln!("cosim: figure {}", p.display());
+        }
+    }
+    let suite = nigel_cosim::junit::TestSuite {
+        name: name.clone(),
+        time: started.elapsed().as_secs_f64(),
+        cases: judged.comparison.as_ref().map(nigel_cosim::verify::comparison_cases).unwrap_or_default(),
+    };
+    nigel_cosim::verify::write_reports(&suite, args.report.junit.as_deref(), args.report.summary_md.as_deref())
+        .map_err(Failure::Message)?;
+    Ok(judged.passed())
 }
 
 /// An FMU that calls exit() inside a call (in this process) ends `cosim` with status 1,

@@ -134,6 +134,18 @@ impl Results {
         Some((0..self.rows()).map(|k| self.row(k)[j]).collect())
     }
 
+    /// The columns called `names` (others left out), in this table's order, time first.
+    pub fn select(&self, names: &[String]) -> Results {
+        let keep: Vec<usize> = (0..self.names.len()).filter(|j| names.contains(&self.names[*j])).collect();
+        let mut values = Vec::with_capacity(self.rows() * (keep.len() + 1));
+        for k in 0..self.rows() {
+            let row = self.row(k);
+            values.push(row[0]);
+            values.extend(keep.iter().map(|j| row[j + 1]));
+        }
+        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values }
+    }
+
     /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
     /// in the shortest form that reads back to the same f64.
     pub fn write_csv<W: std::io::Write>(&self, mut w: W) -> std::io::Result<()> {
@@ -169,6 +181,13 @@ pub fn push_number(out: &mut String, v: f64) {
     } else {
         let _ = write!(out, "{v:e}");
     }
+}
+
+/// [`push_number`]'s text of `v` (`0.35`, `1.6940658945086007e-21`).
+pub fn number_text(v: f64) -> String {
+    let mut s = String::new();
+    push_number(&mut s, v);
+    s
 }
 
 /// A JSON-able run summary.
