@@ -12,6 +12,7 @@
 
 pub mod fmi2;
 pub mod fmi3;
+pub mod table;
 
 /// `fmi2EventInfo` (from `fmi-sys`).
 pub use crate::ffi::Fmi2EventInfo;
