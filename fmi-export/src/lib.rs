@@ -3,7 +3,8 @@
 //!
 //! A model implements the safe [`Model`] trait and declares its variables once in a
 //! [`DeclarationSpec`]; this crate owns everything else: both C ABIs (the 44 `fmi2*` and
-//! the 75 `fmi3*` functions, exported unmangled from one library by [`export_fmi!`]), the
+//! the 75 `fmi3*` functions, one table [`abi::table`], exported unmangled from one library
+//! by [`export_fmi!`]), the
 //! instance state machine (one table of allowed states for both generations, [`states`]),
 //! the GUID / instantiation-token check, typed logging through the importer's callback
 //! ([`Logger`]), time events and event iteration, FMU state get/set/serialize, directional
@@ -40,6 +41,25 @@
 //! - A serialized FMU state has one format: bytes from either generation restore into an
 //!   instance of the other.
 //!
+//! # Where things go
+//!
+//! - **A new FMU** (a model): a crate of its own, as in "Writing a new FMU" below: the
+//!   model type with `impl Model`, its declaration through [`declare_model!`], its symbols
+//!   through [`export_fmi!`], and one entry in `build-fmu`'s list. Nothing in this crate
+//!   changes.
+//! - **A new FMI function** (or one that starts doing something): one row of the table in
+//!   [`abi::table`] (symbol, its C type in `fmi-sys`, its [`Function`] variant, the layer
+//!   function and the C parameters): the exported wrapper, its compile-time signature check
+//!   and the `Function` variant come from that row. Then the layer function in
+//!   [`abi::fmi2`] or [`abi::fmi3`] (the `Function` first, pointers to slices, one call of
+//!   the instance under the shared guard: null checks, the state table, the panic catch,
+//!   the logged message naming the function); the function's row of the allowed-states
+//!   table in [`states`] where the standard lists it in other states than its FMI 2.0
+//!   counterpart; what it does in the [`instance`] module of its concern (values, events
+//!   and sampling, Model Exchange, derivatives, FMU state).
+//! - **A new value type** for `fmi3Get*`/`fmi3Set*`: its `abi::fmi3::Value` implementation
+//!   (the C element and the instance's access); the rows already name it.
+//!
 //! # Writing a new FMU
 //!
 //! 1. A crate `fmu-xyz` with `[lib] name = "<model identifier>"`,
@@ -62,7 +82,9 @@
 //!    [`Interfaces`]. A model with special needs (the plant's states, derivatives and
 //!    directional derivatives) keeps its own binding: `.bind(MyBinding::X)` and its own
 //!    `get_real` .. `set_boolean` ([`Access`]).
-//! 3. `impl Model`: [`Model::declaration`] and [`Model::instantiate`]; the getters and
+//! 3. `impl Model`: [`Model::declaration`] as
+//!    `fmi_export::declare_model!(Field<MyModel>, build_declaration());` (built once per
+//!    process from the spec) and [`Model::instantiate`]; the getters and
 //!    setters come from the declaration, and [`Model::parameters_changed`] is the one hook
 //!    for a model that caches what it computes from its parameters.
 //!    A sampled (discrete-time) model answers [`Model::sample_period`] and implements
@@ -103,7 +125,6 @@
 //! A toy FMU with three variables, `y_k = gain u(t_k)` sampled every 10 ms:
 //!
 //! ```
-//! use std::sync::OnceLock;
 //! use fmi_export::*;
 //!
 //! #[derive(Clone, Debug, Default)]
@@ -111,26 +132,23 @@
 //!
 //! impl Model for Sampler {
 //!     type Binding = Field<Sampler>;
-//!     fn declaration() -> &'static Declaration<Field<Sampler>> {
-//!         static D: OnceLock<Declaration<Field<Sampler>>> = OnceLock::new();
-//!         D.get_or_init(|| {
-//!             let mut v = Variables::<Field<Sampler>>::new();
-//!             let u = v.real("u").input(0.0).field(|m, _| &mut m.u);
-//!             v.real("gain").tunable_parameter(1.0).min(0.0).field(|m, _| &mut m.gain);
-//!             v.real("y").discrete_output([u]).describe("gain u at the last sample").field(|m, _| &mut m.y);
-//!             Declaration::new(DeclarationSpec {
-//!                 model_name: "sampler",
-//!                 model_identifier: "sampler",
-//!                 description: "y_k = gain u(t_k) at t_k = k 10 ms, held",
-//!                 version: "1",
-//!                 interfaces: Interfaces { model_exchange: true, co_simulation: true },
-//!                 capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, ..Default::default() },
-//!                 variables: v.into_vec(),
-//!                 ..Default::default()
-//!             })
-//!             .expect("valid declaration")
-//!         })
-//!     }
+//!     // `fn declaration()`, built once from this DeclarationSpec
+//!     declare_model!(Field<Sampler>, {
+//!         let mut v = Variables::<Field<Sampler>>::new();
+//!         let u = v.real("u").input(0.0).field(|m, _| &mut m.u);
+//!         v.real("gain").tunable_parameter(1.0).min(0.0).field(|m, _| &mut m.gain);
+//!         v.real("y").discrete_output([u]).describe("gain u at the last sample").field(|m, _| &mut m.y);
+//!         DeclarationSpec {
+//!             model_name: "sampler",
+//!             model_identifier: "sampler",
+//!             description: "y_k = gain u(t_k) at t_k = k 10 ms, held",
+//!             version: "1",
+//!             interfaces: Interfaces { model_exchange: true, co_simulation: true },
+//!             capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, ..Default::default() },
+//!             variables: v.into_vec(),
+//!             ..Default::default()
+//!         }
+//!     });
 //!     fn instantiate(_: &InstantiateContext) -> ModelResult<Self> {
 //!         Ok(Sampler::default())
 //!     }
@@ -159,9 +177,11 @@
 //! (categories, the logger); [`fmu_state`] (the byte format of a serialized FMU state);
 //! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
 //! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
-//! the FMI semantics over a model); [`abi`] (the C entry points: [`abi::fmi2`],
-//! [`abi::fmi3`]); with the feature `testing`, `testing` (the in-process importer of the
-//! FMU crates' tests, both generations).
+//! the FMI semantics over a model, one submodule per concern); [`abi`] (the C entry points:
+//! the table [`abi::table`], the layer functions [`abi::fmi2`], [`abi::fmi3`]); with the
+//! feature `testing`, `testing` (the in-process importer of the FMU crates' tests, both
+//! generations). The `Function` enum of [`states`] is expanded from [`abi::table`] (a
+//! macro, not an import: no circle).
 
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

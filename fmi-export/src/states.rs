@@ -82,7 +82,11 @@ pub enum Generation {
 
 /// `Function` from the rows of [`crate::abi::table`], in their order.
 macro_rules! function_enum {
-    ({} fmi2 { $($f2:ident : $_t2:ident = $n2:ident => $_m2:ident :: $_l2:ident $(::<$_v2:ident>)? $([$($_a2:ident),*])? ( $($_p2:ident : $_pt2:ty),* ) $(-> $_r2:ty)? ;)* } fmi3 { $($f3:ident : $_t3:ident = $n3:ident => $_m3:ident :: $_l3:ident $(::<$_v3:ident>)? $([$($_a3:ident),*])? ( $($_p3:ident : $_pt3:ty),* ) $(-> $_r3:ty)? ;)* }) => {
+    ({}
+     fmi2 { $($f2:ident : $_t2:ident = $n2:ident => $_m2:ident :: $_l2:ident $(::<$_v2:ident>)?
+                $([$($_a2:ident),*])? ( $($_p2:ident : $_pt2:ty),* ) $(-> $_r2:ty)? ;)* }
+     fmi3 { $($f3:ident : $_t3:ident = $n3:ident => $_m3:ident :: $_l3:ident $(::<$_v3:ident>)?
+                $([$($_a3:ident),*])? ( $($_p3:ident : $_pt3:ty),* ) $(-> $_r3:ty)? ;)* }) => {
         /// The 44 functions of FMI 2.0 and the 75 of FMI 3.0, one enum: one table of where
         /// each may be called ([`Function::allowed_in`]). An FMI 3.0 function's variant is
         /// its C name with `Fmi3` in front (`Function::Fmi3DoStep` is `fmi3DoStep`).

@@ -14,7 +14,6 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::ptr::null_mut;
-use std::sync::OnceLock;
 
 use fmi_export::abi::{self, Fmi2EventInfo};
 use fmi_export::ffi::*;
@@ -127,14 +126,11 @@ impl fmi_export::Access<Toy> for V {}
 impl Model for Toy {
     type Binding = V;
 
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
-            let both = Interfaces { model_exchange: true, co_simulation: true };
-            Declaration::new(spec(caps, both, "toy")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+        let both = Interfaces { model_exchange: true, co_simulation: true };
+        spec(caps, both, "toy")
+    });
 
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         LIVE.with(|l| *l.borrow_mut() += 1);
@@ -279,13 +275,10 @@ impl fmi_export::Access<Bare> for V {}
 
 impl Model for Bare {
     type Binding = V;
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let cs = Interfaces { model_exchange: false, co_simulation: true };
-            Declaration::new(spec(Capabilities::default(), cs, "bare")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let cs = Interfaces { model_exchange: false, co_simulation: true };
+        spec(Capabilities::default(), cs, "bare")
+    });
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         Toy::instantiate(context).map(Bare)
     }
@@ -322,14 +315,11 @@ impl fmi_export::Access<Own> for V {}
 impl Model for Own {
     type Binding = V;
     const SAVE_DECLARED_VARIABLES: bool = false;
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
-            let cs = Interfaces { model_exchange: false, co_simulation: true };
-            Declaration::new(spec(caps, cs, "own")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+        let cs = Interfaces { model_exchange: false, co_simulation: true };
+        spec(caps, cs, "own")
+    });
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         Toy::instantiate(context).map(Own)
     }
