@@ -1,5 +1,5 @@
 //! The FMI 2.0 C ABI: the 44 `fmi2*` functions over the one instance.
-#![allow(clippy::missing_safety_doc, non_snake_case)]
+#![allow(clippy::missing_safety_doc, clippy::too_many_arguments, non_snake_case)]
 
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr};
