@@ -39,7 +39,7 @@ impl<M: Model> Instance<M> {
     }
 
     /// Bytes of a saved state ([`crate::fmu_state`]): the layer's numbers, the declared
-    /// variables of [`Declaration::saved_rows`] and the model's internal numbers. Events
+    /// variables of [`crate::Declaration::saved_rows`] and the model's internal numbers. Events
     /// run lazily at the current time are saved as not run.
     pub fn serialize(state: &SavedState<M>) -> OpResult<Vec<u8>> {
         let (mut model, next_event, clock, presample) = match &state.pre_event {

@@ -5,10 +5,10 @@
 //! derivatives. The C ABIs in [`crate::abi`] only translate pointers to slices.
 //!
 //! Here: the instance, its construction, the gate every call passes and the calls of
-//! initialization; by concern in the submodules: [`values`] (get and set, both
-//! generations' value references), [`events`] (time events, sampling and the
-//! Co-Simulation step), [`model_exchange`] (the Model Exchange calls), [`derivatives`]
-//! (partial derivatives and variable dependencies), [`fmu_state`] (save, restore,
+//! initialization; by concern in the submodules: `values` (get and set, both
+//! generations' value references), `events` (time events, sampling and the
+//! Co-Simulation step), `model_exchange` (the Model Exchange calls), `derivatives`
+//! (partial derivatives and variable dependencies), `fmu_state` (save, restore,
 //! serialize).
 
 mod derivatives;
