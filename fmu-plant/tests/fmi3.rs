@@ -235,7 +235,8 @@ fn adjoint_derivatives_in_initialization_mode_and_bad_counts() {
     // counts
     let mut out = vec![0.0; knowns.len()];
     let st = unsafe {
-        fmi_export::abi::fmi3::get_adjoint_derivative::<Plant>(
+        fmi_export::abi::fmi3::get_partial_derivatives::<Plant>(
+            fmi_export::Function::Fmi3GetAdjointDerivative,
             f.c,
             unknowns.as_ptr(),
             unknowns.len(),
