@@ -44,6 +44,8 @@ pub mod loops;
 pub mod mat;
 pub mod me;
 pub mod metric;
+pub mod options;
+pub mod sampling;
 pub mod simulate;
 pub mod ssp;
 pub mod system;

@@ -50,6 +50,37 @@ impl Default for Solver {
     }
 }
 
+impl Solver {
+    /// The solver named `name` (`rk4`, `dopri5`, `bdf`): dopri5 and bdf with the relative
+    /// tolerance `rtol` and the absolute tolerance `rtol / 100`, rk4 with the largest step
+    /// `max_step` (`None`: the communication step). The error names the bad value.
+    pub fn named(name: &str, rtol: f64, max_step: Option<f64>) -> std::result::Result<Solver, String> {
+        if !(rtol > 0.0 && rtol.is_finite()) {
+            return Err(format!("the relative tolerance {rtol} must be positive"));
+        }
+        if max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+            return Err(format!("the largest step {} s must be positive", max_step.unwrap_or_default()));
+        }
+        match name {
+            "rk4" => Ok(Solver::Rk4 { max_step }),
+            "dopri5" => Ok(Solver::Dopri5 { rtol, atol: rtol / 100.0 }),
+            "bdf" => Ok(Solver::Bdf { rtol, atol: rtol / 100.0 }),
+            other => Err(format!("unknown solver {other:?} (rk4, dopri5, bdf)")),
+        }
+    }
+}
+
+/// `rk4`, `dopri5` or `bdf` with the default tolerance [`DEFAULT_RTOL`].
+impl std::str::FromStr for Solver {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Solver::named(s, DEFAULT_RTOL, None)
+    }
+}
+
+/// The relative tolerance of `dopri5` and `bdf` where none is given.
+pub const DEFAULT_RTOL: f64 = 1e-6;
+
 /// One located event.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Event {

@@ -466,7 +466,7 @@ fn the_cli_refuses_runs_it_cannot_mean_and_warns_of_long_steps() {
         cosim(&["run", s, "--step", "0.1", "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(
-        err.contains("warning: controller (nigel_controller.fmu) runs every 0.001 s (its parameter sample_period), but the communication step is 0.1 s"),
+        err.contains("warning: controller (nigel_controller.fmu) runs every 0.001 s (its DefaultExperiment stepSize), but the communication step is 0.1 s"),
         "{err}"
     );
     let (_, _, err) = cosim(&["run", s, "--stop-time", "0.2", "--summary", summary.to_str().unwrap()]);

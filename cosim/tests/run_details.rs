@@ -225,9 +225,9 @@ fn the_step_warning_is_only_for_fmus_that_sample() {
         err.contains("runs every 0.001 s (its DefaultExperiment stepSize), but the communication step is 0.002 s"),
         "{err}"
     );
-    // the controller by its sample_period parameter
+    // the controller: discrete outputs, DefaultExperiment stepSize 1e-3 s (not its parameter sample_period)
     let err = run(&fmu_dir.join("nigel_controller.fmu"), &[]);
-    assert!(err.contains("runs every 0.001 s (its parameter sample_period)"), "{err}");
+    assert!(err.contains("runs every 0.001 s (its DefaultExperiment stepSize)"), "{err}");
     // a Model Exchange FMU with a discrete local (stepSize 0.01 s) is continuous: no
     // warning at a step of 0.1 s; the same FMU with that variable an output samples it
     for (causality, warns) in [("local", false), ("output", true)] {

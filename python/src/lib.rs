@@ -15,7 +15,7 @@ use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
     simulate::{default_record, simulate_with},
     Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, SetQueue,
-    Solver, Summary, System, SystemBuilder,
+    Summary, System, SystemBuilder,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
@@ -163,38 +163,26 @@ impl NativeSystem {
     }
 
     fn experiment(&self, args: &RunArgs) -> Result<Experiment, CosimError> {
-        let mut experiment = Experiment::new(args.stop_time, args.step);
-        experiment.start_time = args.start_time;
-        experiment.output_interval = args.output_interval;
-        experiment.algorithm = args.algorithm.parse().map_err(CosimError::Experiment)?;
-        let rtol = args.relative_tolerance.unwrap_or(1e-5);
-        if !(rtol > 0.0 && rtol.is_finite()) {
-            return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
+        // the translation every front end shares; errors name the Python keywords
+        let mut experiment = nigel_cosim::options::RunOptions {
+            start_time: args.start_time,
+            stop_time: args.stop_time,
+            step: args.step,
+            output_interval: args.output_interval,
+            algorithm: &args.algorithm,
+            solver: &args.solver,
+            relative_tolerance: args.relative_tolerance.unwrap_or(1e-5),
+            max_step: None,
+            timeout: args.timeout,
+            threads: args.threads,
         }
-        experiment.solver = match args.solver.as_str() {
-            "rk4" => Solver::Rk4 { max_step: None },
-            "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
-            "bdf" => Solver::Bdf { rtol, atol: rtol / 100.0 },
-            other => {
-                return Err(CosimError::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")));
-            }
-        };
+        .experiment(|name| name.to_string())?;
         if let Some((names, time, columns)) = &args.input {
             experiment.input = Some(Arc::new(InputTable::new(names.clone(), time.clone(), columns.clone())?));
         }
         if let Some(output) = &args.output {
             experiment.record = Some(output.iter().map(|n| self.qualify(n)).collect());
         }
-        if let Some(t) = args.timeout {
-            experiment.timeout =
-                Some(Duration::try_from_secs_f64(t).ok().filter(|d| !d.is_zero()).ok_or_else(|| {
-                    CosimError::Experiment(format!("timeout {t} must be a positive number of seconds"))
-                })?);
-        }
-        if args.threads == 0 {
-            return Err(CosimError::Experiment("threads must be at least 1".into()));
-        }
-        experiment.threads = args.threads;
         Ok(experiment)
     }
 }

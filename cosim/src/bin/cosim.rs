@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use nigel_cosim::defaults::{GivenTimes, RunTimes};
-use nigel_cosim::{Algorithm, Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder, UnpackLimits};
+use nigel_cosim::{Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder, UnpackLimits};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -315,7 +315,6 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         Some("me") => Some(Interface::ModelExchange),
         Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)")).into()),
     };
-    let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
     let format = match &args.output {
         None => None,
         Some(p) => Some(OutputFormat::of(p)?),
@@ -366,11 +365,22 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         ..Default::default()
     };
     let times = RunTimes::master(&default, &given);
-    let mut experiment = Experiment::new(times.stop_time, times.step);
-    experiment.start_time = times.start_time;
+    let mut experiment = nigel_cosim::options::RunOptions {
+        start_time: times.start_time,
+        stop_time: times.stop_time,
+        step: times.step,
+        output_interval: args.output_interval,
+        algorithm: &args.algorithm,
+        solver: &args.solver,
+        relative_tolerance: args.rtol,
+        max_step: args.max_step,
+        timeout: args.timeout,
+        threads: args.threads,
+    }
+    .experiment(nigel_cosim::options::cli_option_name)?;
     check_times(&experiment)?;
     if !host_of_run {
-        for warning in sample_period_warnings(&system, experiment.step) {
+        for warning in nigel_cosim::sampling::sample_period_warnings(&system, experiment.step) {
             eprintln!("cosim: warning: {warning}");
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
@@ -385,32 +395,12 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
     }
 
-    experiment.algorithm = algorithm;
-    experiment.solver = match args.solver.as_str() {
-        "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
-        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol)).into()),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
-    };
-    if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
-        return Err(Error::Experiment("--max-step must be positive".into()).into());
-    }
     if let Some(path) = &args.input {
         experiment.input = Some(std::sync::Arc::new(nigel_cosim::InputTable::read_csv(path)?));
     }
-    experiment.output_interval = args.output_interval;
     experiment.retry_discard = args.retry_discard;
     // the time per FMU is only reported in the summary: measured only when one is asked for
     experiment.profile = args.summary.is_some();
-    if args.threads == 0 {
-        return Err(Error::Experiment("--threads must be at least 1".into()).into());
-    }
-    experiment.threads = args.threads;
     experiment.max_steps = args.max_steps;
     let seconds = |what: &str, s: f64| {
         std::time::Duration::try_from_secs_f64(s)
@@ -418,9 +408,6 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             .filter(|d| !d.is_zero())
             .ok_or_else(|| Error::Experiment(format!("{what} {s} must be a positive number of seconds")))
     };
-    if let Some(s) = args.timeout {
-        experiment.timeout = Some(seconds("--timeout", s)?);
-    }
     if args.timeout_call.is_some() && args.isolate != Some(IsolateMode::Fmu) {
         return Err(Error::Experiment(
             "--timeout-call needs --isolate (=fmu: a call in this process cannot be stopped; a host process per FMU can be killed; --isolate=run has --timeout)"
@@ -736,65 +723,6 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
         )));
     }
     Ok(())
-}
-
-/// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else, for an FMU with discrete states or outputs (Model Exchange: outputs), its DefaultExperiment stepSize) is shorter than the communication step: its
-/// inputs are then held and its outputs read less often than it is meant to run.
-fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
-    let mut out = Vec::new();
-    for spec in &system.instances {
-        let md = spec.fmu.description();
-        let parameter = md.model_variables.iter().enumerate().find(|(_, v)| {
-            v.name == "sample_period" && v.causality == model_description::Causality::Parameter && v.is_real()
-        });
-        let from_parameter = parameter.and_then(|(index, v)| {
-            let set = spec.start_values.iter().find(|(i, _)| *i == index).and_then(|(_, value)| match value {
-                nigel_cosim::Value::Real(x) => Some(*x),
-                _ => None,
-            });
-            let start = match v.variable_type {
-                model_description::VariableType::Real { start, .. } => start,
-                _ => None,
-            };
-            set.or(start).map(|p| (p, "its parameter sample_period"))
-        });
-        // the stepSize is only a suggestion of a continuous model (its integrator runs
-        // within any step); it is a sample period where the FMU has discrete-time values
-        // of its own, which change at its sample instants: in Co-Simulation discrete
-        // states or outputs; in Model Exchange discrete outputs only (its discrete states
-        // change at its events, which the master's integrator stops at within any
-        // communication step; a model with discrete locals, such as the when-conditions
-        // of a Modelica model, is continuous there)
-        let me = spec.fmu.interface() == nigel_cosim::Interface::ModelExchange;
-        let samples = md.model_variables.iter().any(|v| {
-            v.variability == model_description::Variability::Discrete
-                && match v.causality {
-                    model_description::Causality::Output => true,
-                    model_description::Causality::Input | model_description::Causality::Parameter => false,
-                    _ => !me,
-                }
-        });
-        let declared = from_parameter.or_else(|| {
-            md.default_experiment
-                .as_ref()
-                .and_then(|d| d.step_size)
-                .filter(|_| samples)
-                .map(|p| (p, "its DefaultExperiment stepSize"))
-        });
-        if let Some((period, source)) = declared {
-            // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
-            if period > 0.0 && step > period * (1.0 + 1e-9) {
-                out.push(format!(
-                    "{} ({}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
-                     are held and its outputs read only every {step} s (use --step {period})",
-                    spec.name,
-                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
-                ));
-            }
-        }
-    }
-    out
 }
 
 fn is_ssp(path: &Path) -> bool {
