@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod ci;
+pub mod collector;
 pub mod merge;
 /// The metric language, shared with `cosim run --check`.
 pub use nigel_cosim::metric;
@@ -29,6 +30,8 @@ pub mod report;
 pub mod results;
 pub mod rng;
 pub mod run;
+pub mod runner;
+pub mod scalar;
 pub mod slurm;
 pub mod spec;
 pub mod worker;

@@ -4,7 +4,31 @@
 
 use nigel_benchmark::noise::{mix, GOLDEN};
 
-use crate::spec::{Distribution, Scalar};
+use crate::scalar::Scalar;
+
+/// How a random column is drawn.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Distribution {
+    /// Uniform on `[low, high)`.
+    Uniform(f64, f64),
+    /// Normal with mean and standard deviation, optionally truncated to `[min, max]`
+    /// (rejection: the draw is repeated with the next counter until it falls inside; at least
+    /// 1 % of the distribution must lie inside).
+    Normal {
+        /// Mean.
+        mean: f64,
+        /// Standard deviation (> 0).
+        std: f64,
+        /// Lower bound, if any.
+        min: Option<f64>,
+        /// Upper bound, if any.
+        max: Option<f64>,
+    },
+    /// Integers `low ..= high`, each equally likely.
+    Integers(i64, i64),
+    /// One of the listed values, each equally likely.
+    Choice(Vec<Scalar>),
+}
 
 /// FNV-1a of the column name: columns draw from independent streams, and adding a column
 /// leaves the others' draws unchanged.

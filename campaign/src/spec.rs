@@ -19,59 +19,8 @@ use crate::Error;
 use nigel_cosim::check::Check;
 use nigel_cosim::metric::Metric;
 
-/// A value written into a variable: the description's TOML scalar, typed.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Scalar {
-    /// A real number.
-    Real(f64),
-    /// An integer.
-    Integer(i64),
-    /// A Boolean.
-    Boolean(bool),
-}
-
-impl Scalar {
-    /// The number in the results (Booleans as 0 / 1).
-    pub fn number(&self) -> f64 {
-        match *self {
-            Scalar::Real(x) => x,
-            Scalar::Integer(i) => i as f64,
-            Scalar::Boolean(b) => f64::from(u8::from(b)),
-        }
-    }
-
-    fn describe(&self) -> String {
-        match self {
-            Scalar::Real(x) => format!("{x} (Real)"),
-            Scalar::Integer(i) => format!("{i} (Integer)"),
-            Scalar::Boolean(b) => format!("{b} (Boolean)"),
-        }
-    }
-}
-
-/// How a random column is drawn.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Distribution {
-    /// Uniform on `[low, high)`.
-    Uniform(f64, f64),
-    /// Normal with mean and standard deviation, optionally truncated to `[min, max]`
-    /// (rejection: the draw is repeated with the next counter until it falls inside; at least
-    /// 1 % of the distribution must lie inside).
-    Normal {
-        /// Mean.
-        mean: f64,
-        /// Standard deviation (> 0).
-        std: f64,
-        /// Lower bound, if any.
-        min: Option<f64>,
-        /// Upper bound, if any.
-        max: Option<f64>,
-    },
-    /// Integers `low ..= high`, each equally likely.
-    Integers(i64, i64),
-    /// One of the listed values, each equally likely.
-    Choice(Vec<Scalar>),
-}
+pub use crate::rng::Distribution;
+pub use crate::scalar::Scalar;
 
 /// What a column's values are.
 #[derive(Clone, Debug, PartialEq)]

@@ -33,8 +33,9 @@ use std::time::{Duration, Instant};
 use nigel_cosim::isolate::whole::CallMarker;
 use nigel_cosim::HostEnd;
 
+use crate::collector::Collector;
 use crate::results::{parse_line, Row, STATUS_CRASHED, STATUS_TIMEOUT};
-use crate::run::{Collector, Worker};
+use crate::runner::Worker;
 use crate::spec::Spec;
 use crate::Error;
 
