@@ -2,7 +2,7 @@
 //! a parameter mapping (`.ssm`, or inline) with their transformations, and the units of
 //! values (a set's `Units`), converted to the unit of the variable they are applied to.
 
-use super::Element;
+use super::xml::Element;
 use crate::system::{BaseType, System, Value};
 use model_description::BaseUnit;
 use std::collections::HashMap;
@@ -362,7 +362,7 @@ mod tests {
     use super::*;
 
     fn element(xml: &str) -> Element {
-        super::super::parse_xml(xml, std::path::Path::new("t.ssm")).unwrap()
+        super::super::xml::parse_xml(xml, std::path::Path::new("t.ssm")).unwrap()
     }
 
     #[test]
