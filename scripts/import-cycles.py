@@ -18,10 +18,13 @@ import sys
 import tempfile
 from pathlib import Path
 
-# Crates whose circles are reported but do not fail the check, each with its reason; empty
-# it when that reason is gone.
+# Circles reported but not failing the check, by a path prefix of a file in them, each with
+# its reason; remove an entry when its reason is gone.
 KNOWN = {
-    "fmi-import": "being restructured on its own branch (issue 37 step 2); its circles go with that work",
+    "fmi-import/src/": "being restructured on its own branch (issue 37 step 2); its circles go with that work",
+    "cosim/src/simulate/": "mod.rs, types.rs and the algorithms share types both ways; not yet moved (issue 37 step 5)",
+    "fmi-export/src/units.rs": "its test compares with crate::si_unit of decl.rs (issue 37 step 5)",
+    "fmi-export/src/instance/": "instance/mod.rs and values.rs share types both ways (issue 37 step 5)",
 }
 
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"
@@ -284,8 +287,8 @@ def check(workspace):
     for crate_dir in workspace_crates(workspace):
         for name, root, src in crate_roots(crate_dir):
             for component in cycles(file_graph(root, src)):
-                known = KNOWN.get(crate_dir.name)
                 files = ", ".join(str(f.relative_to(workspace)) for f in component)
+                known = next((why for prefix, why in KNOWN.items() if prefix in files), None)
                 if known:
                     print(f"{name}: known exception ({known}): import circle between {files}")
                 else:
@@ -330,7 +333,7 @@ def main():
     if failing:
         print(f"{failing} import circle(s) between files (a type lives where it is defined: move it so the arrows run one way)")
         return 1
-    print("no import circle between the files of any crate")
+    print("no import circle between the files of any crate (outside the known exceptions above)")
     return 0
 
 

@@ -55,6 +55,9 @@ stage_summary() {
     printf '%s' "$stage_table"
     printf '%6d s %7.0f s  all\n' "$SECONDS" "$(children_cpu)"
 }
+stage "import circles between the files of each crate (scripts/import-cycles.py)"
+python3 scripts/import-cycles.py --self-test
+python3 scripts/import-cycles.py
 stage "system packages and cross toolchains"
 bash scripts/setup-system.sh
 bash scripts/setup-cross.sh
