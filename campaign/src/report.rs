@@ -400,7 +400,7 @@ impl Report {
         self.cdf(m, &path)?;
         out.push(path);
         for (k, c) in self.spec.columns.iter().enumerate() {
-            if matches!(c.domain, crate::spec::Domain::Random(_)) {
+            if matches!(c.domain, crate::spec::Domain::Random(_)) && !is_seed(c) {
                 let path = dir.join(format!("{}_vs_{}.png", file_safe(name), file_safe(&c.name)));
                 self.scatter(m, k, &path)?;
                 out.push(path);
@@ -655,8 +655,19 @@ pub enum Axis {
     Log(f64, f64),
 }
 
-/// More than this ratio of the largest to the smallest value (two decades) draws a log axis.
-pub const LOG_AXIS_RATIO: f64 = 100.0;
+/// A random column that is a noise seed (integers drawn into a variable named `seed`): its
+/// values are labels of random streams with no order, so a metric plotted against it shows
+/// nothing; [`Report::pngs`] draws no scatter for it.
+fn is_seed(c: &crate::spec::Column) -> bool {
+    let named_seed = |n: &str| n.rsplit(['.', '_']).next().is_some_and(|last| last.eq_ignore_ascii_case("seed"));
+    matches!(c.domain, crate::spec::Domain::Random(crate::spec::Distribution::Integers(..)))
+        && (named_seed(&c.name) || c.targets.iter().any(|v| named_seed(v)))
+}
+
+/// More than this ratio of the largest to the smallest value (one decade) draws a log axis:
+/// a metric such as epsilon spans a decade between maneuvers, and on a linear axis the
+/// groups of the small values are squashed against zero.
+pub const LOG_AXIS_RATIO: f64 = 10.0;
 
 /// Share of the span (of the decades on a log axis) left free at each end of an axis, so
 /// that no point sits on the frame.
@@ -664,7 +675,7 @@ pub const AXIS_PAD: f64 = 0.04;
 
 impl Axis {
     /// The axis of `values` (non-finite ones left out): logarithmic when all are positive
-    /// and span more than two decades ([`LOG_AXIS_RATIO`]), else linear; padded by
+    /// and span more than a decade ([`LOG_AXIS_RATIO`]), else linear; padded by
     /// [`AXIS_PAD`] at each end.
     pub fn of(values: &[f64]) -> Axis {
         let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
@@ -819,12 +830,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn an_axis_is_logarithmic_when_the_values_span_more_than_two_decades() {
+    fn an_axis_is_logarithmic_when_the_values_span_more_than_a_decade() {
         // 1e-3 .. 1: three decades, padded by 4 % of them (10^0.12) at each end
         let Axis::Log(lo, hi) = Axis::of(&[1e-3, 0.02, 1.0]) else { panic!("log expected") };
         assert!((lo - 1e-3 / 10f64.powf(0.12)).abs() < 1e-15 && (hi - 10f64.powf(0.12)).abs() < 1e-12);
-        // exactly two decades, a zero, a negative value: linear, padded by 4 % of the span
-        assert_eq!(Axis::of(&[0.01, 1.0]), Axis::Linear(0.01 - 0.0396, 1.0 + 0.0396));
+        // exactly one decade, a zero, a negative value: linear, padded by 4 % of the span
+        assert_eq!(Axis::of(&[0.1, 1.0]), Axis::Linear(0.1 - 0.036, 1.0 + 0.036));
+        // a decade and a half (the example's lane change against its skidpad): log
+        assert!(matches!(Axis::of(&[0.04, 1.3]), Axis::Log(..)));
         assert!(matches!(Axis::of(&[0.0, 1e-6, 1.0]), Axis::Linear(..)));
         assert!(matches!(Axis::of(&[-1e-3, 1e-5, 10.0]), Axis::Linear(..)));
         // non-finite values are left out; nothing left: [0, 1]
@@ -832,6 +845,25 @@ mod tests {
         assert_eq!(Axis::of(&[f64::NAN]), Axis::Linear(0.0, 1.0));
         // one value: a range around it
         assert_eq!(Axis::of(&[2.0, 2.0]), Axis::Linear(1.0, 3.0));
+    }
+
+    #[test]
+    fn a_noise_seed_gets_no_scatter() {
+        use crate::spec::{Column, Distribution, Domain, Scalar};
+        let column = |name: &str, targets: &[&str], domain: Domain| Column {
+            name: name.into(),
+            targets: targets.iter().map(|t| t.to_string()).collect(),
+            domain,
+        };
+        let ints = || Domain::Random(Distribution::Integers(0, 1000));
+        // the example's and the robustness study's test-bench seed
+        assert!(is_seed(&column("maneuver.seed", &["maneuver.seed"], ints())));
+        assert!(is_seed(&column("noise", &["plant.noise_seed"], ints())));
+        // a drawn quantity, an integer that is not a seed, a seed given on a grid
+        assert!(!is_seed(&column("plant.m", &["plant.m"], Domain::Random(Distribution::Uniform(2.4, 3.0)))));
+        assert!(!is_seed(&column("maneuver.maneuver", &["maneuver.maneuver"], ints())));
+        assert!(!is_seed(&column("maneuver.seed", &["maneuver.seed"], Domain::Grid(vec![Scalar::Integer(1)]))));
+        assert!(!is_seed(&column("seeds_per_cell", &["x.seeds"], ints())));
     }
 
     #[test]
