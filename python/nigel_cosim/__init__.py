@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
@@ -95,8 +96,12 @@ def _fmpy_keywords(interface: str, validate, debug_logging, record_events, apply
 def _warn_sample_periods(system: "System", args: dict) -> None:
     """`cosim run`'s warning about a communication step longer than an FMU's declared sample
     period, as a Python warning (the run goes on: it is what was asked for)."""
+    # the warning points at the user's line: the first frame outside this file
+    level, frame = 1, sys._getframe(0)
+    while frame is not None and frame.f_code.co_filename == __file__:
+        frame, level = frame.f_back, level + 1
     for message in system._native.sample_period_warnings(_Args(args)):
-        warnings.warn(message, UserWarning, stacklevel=4)
+        warnings.warn(message, UserWarning, stacklevel=level)
 
 
 def _float(value: Any) -> float | None:
