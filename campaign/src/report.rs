@@ -194,16 +194,24 @@ fn metric_index(spec: &Spec, name: &str) -> Result<usize, Error> {
 /// Draws the mesh of a report chart: axis descriptions `$x_desc` and `$y_desc`, ticks as
 /// [`tick`] writes them, light grey grid lines; a drawing error returns from the function
 /// as `$err` makes it (a macro: the charts' coordinate types differ).
+/// Labels asked of plotters on a linear axis (its default) and on a log axis: a log axis
+/// over one and a half decades needs every 1 .. 9 multiple labelled (15 and more), else
+/// plotters labels one decade and leaves the other bare.
+const LINEAR_LABELS: usize = 10;
+const LOG_LABELS: usize = 30;
+
 macro_rules! draw_mesh {
-    ($chart:expr, $x_desc:expr, $y_desc:expr, $err:expr) => {
+    ($chart:expr, $x_desc:expr, $y_desc:expr, $err:expr, $x_log:expr, $y_log:expr) => {
         $chart
             .configure_mesh()
+            .x_labels(if $x_log { LOG_LABELS } else { LINEAR_LABELS })
+            .y_labels(if $y_log { LOG_LABELS } else { LINEAR_LABELS })
             .x_desc($x_desc)
             .y_desc($y_desc)
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 16))
-            .x_label_formatter(&|v: &f64| tick(*v))
-            .y_label_formatter(&|v: &f64| tick(*v))
+            .x_label_formatter(&|v: &f64| if $x_log { log_tick(*v) } else { tick(*v) })
+            .y_label_formatter(&|v: &f64| if $y_log { log_tick(*v) } else { tick(*v) })
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(200, 200, 200))
             .draw()
@@ -439,7 +447,8 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                draw_mesh!(chart, name.as_str(), "fraction of runs <= value", err);
+                let x_log = matches!(axis, Axis::Log(..));
+                draw_mesh!(chart, name.as_str(), "fraction of runs <= value", err, x_log, false);
                 for (i, (_, v)) in series.iter().enumerate() {
                     let n = v.len() as f64;
                     let pts: Vec<(f64, f64)> = v.iter().enumerate().map(|(k, x)| (*x, (k + 1) as f64 / n)).collect();
@@ -498,7 +507,8 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                draw_mesh!(chart, self.spec.columns[column].name.as_str(), name.as_str(), err);
+                let y_log = matches!(y_axis, Axis::Log(..));
+                draw_mesh!(chart, self.spec.columns[column].name.as_str(), name.as_str(), err, false, y_log);
                 for (i, (_, pts)) in series.iter().enumerate() {
                     chart
                         .draw_series(pts.iter().map(|p| {
@@ -682,7 +692,17 @@ impl Axis {
         let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
         if lo > 0.0 && hi / lo > LOG_AXIS_RATIO {
             let pad = AXIS_PAD * (hi / lo).log10();
-            return Axis::Log(lo / 10f64.powf(pad), hi * 10f64.powf(pad));
+            let (mut lo, hi) = (lo / 10f64.powf(pad), hi * 10f64.powf(pad));
+            // plotters labels a log axis from its first power of ten up: where the values
+            // reach more than a factor 2 below it, the axis starts at the power of ten below
+            // (else those values would have no label at all)
+            let below = 10f64.powf(lo.log10().floor());
+            if 10.0 * below / lo > 2.0 {
+                // a hair below it, so that plotters' ceil(log10(lo)) is that power of ten
+                // (log10(0.01) in floating point may come out a hair above -2)
+                lo = below * (1.0 - 1e-9);
+            }
+            return Axis::Log(lo, hi);
         }
         Axis::linear(&v)
     }
@@ -711,6 +731,17 @@ impl Axis {
 
 /// Tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
 /// powers beyond 1e-4 .. 1e5 as `1e-5`; never `-0`.
+/// A log axis's label: 1, 2 and 5 times a power of ten (the other multiples get grid lines
+/// but no label: nine labels a decade run into each other at the decade's top).
+fn log_tick(v: f64) -> String {
+    let mantissa = v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0, 10.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
+        tick(v)
+    } else {
+        String::new()
+    }
+}
+
 fn tick(v: f64) -> String {
     if v == 0.0 {
         return "0".into();
@@ -836,8 +867,10 @@ mod tests {
         assert!((lo - 1e-3 / 10f64.powf(0.12)).abs() < 1e-15 && (hi - 10f64.powf(0.12)).abs() < 1e-12);
         // exactly one decade, a zero, a negative value: linear, padded by 4 % of the span
         assert_eq!(Axis::of(&[0.1, 1.0]), Axis::Linear(0.1 - 0.036, 1.0 + 0.036));
-        // a decade and a half (the example's lane change against its skidpad): log
-        assert!(matches!(Axis::of(&[0.04, 1.3]), Axis::Log(..)));
+        // a decade and a half (the example's lane change against its skidpad): log, from 0.01,
+        // the power of ten below the values (0.04 is a factor 2.5 below the first one, 0.1)
+        let Axis::Log(lo, _) = Axis::of(&[0.04, 1.3]) else { panic!("log expected") };
+        assert_eq!(lo, 0.01 * (1.0 - 1e-9));
         assert!(matches!(Axis::of(&[0.0, 1e-6, 1.0]), Axis::Linear(..)));
         assert!(matches!(Axis::of(&[-1e-3, 1e-5, 10.0]), Axis::Linear(..)));
         // non-finite values are left out; nothing left: [0, 1]
@@ -879,6 +912,12 @@ mod tests {
         for not in ["the mass of the car", "1 open_loop", "1 a, 1 b", "1 a, two b", "1 a b, 2 c", "1 a (x, 2 b"] {
             assert_eq!(items_in_description(not), None, "{not}");
         }
+    }
+
+    #[test]
+    fn a_log_axis_labels_1_2_and_5_times_a_power_of_ten() {
+        let t: Vec<String> = [0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.2 + 1e-12, 0.9, 50.0].iter().map(|v| log_tick(*v)).collect();
+        assert_eq!(t, ["0.01", "0.02", "", "0.05", "", "0.1", "0.2", "", "50"]);
     }
 
     #[test]
