@@ -78,7 +78,8 @@ struct RunArgs {
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
     #[arg(long)]
     step: Option<f64>,
-    /// ordered or jacobi.
+    /// jacobi (every connection one step late, as fmpy, libcosim and ecos step) or ordered
+    /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
     /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the

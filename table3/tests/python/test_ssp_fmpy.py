@@ -132,6 +132,7 @@ def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fm
     doc_check("docs/table3.md", "| fmpy 0.3.32 `simulate_ssp` | {} | {} | {} % |", eps_fmpy, rel,
               100 * abs(eps_fmpy - eps_ordered) / eps_ordered)
     doc_check("docs/cosim.md", "fmpy's epsilon equals ours to {} relative", rel)
+    doc_check("README.md", "fmpy, which starts every connection at 0, to {}:", rel)
     doc_check("docs/table3.md", "so its first millisecond sees mu = 0 and no wind: {} from `jacobi`", rel)
     doc_check("cosim/README.md", "fmpy's epsilon is ours (`jacobi`) to {} relative", rel)
     doc_check("docs/fmi-notes.md", "({} relative in epsilon)", rel)
