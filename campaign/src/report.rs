@@ -916,7 +916,8 @@ mod tests {
 
     #[test]
     fn a_log_axis_labels_1_2_and_5_times_a_power_of_ten() {
-        let t: Vec<String> = [0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.2 + 1e-12, 0.9, 50.0].iter().map(|v| log_tick(*v)).collect();
+        let t: Vec<String> =
+            [0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.2 + 1e-12, 0.9, 50.0].iter().map(|v| log_tick(*v)).collect();
         assert_eq!(t, ["0.01", "0.02", "", "0.05", "", "0.1", "0.2", "", "50"]);
     }
 

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "cosim", version, about = "FMI 2.0 and FMI 3.0 co-simulation master: FMUs and SSP systems, Co-Simulation and Model Exchange")]
+#[command(
+    name = "cosim",
+    version,
+    about = "FMI 2.0 and FMI 3.0 co-simulation master: FMUs and SSP systems, Co-Simulation and Model Exchange"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
