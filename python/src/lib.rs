@@ -130,6 +130,8 @@ struct RunArgs {
     input: Option<(Vec<String>, Vec<f64>, Vec<Vec<f64>>)>,
     output: Option<Vec<String>>,
     solver: String,
+    /// The largest step of `rk4` (fmpy's `step_size` in Model Exchange); None: the communication step.
+    max_step: Option<f64>,
     relative_tolerance: Option<f64>,
     timeout: Option<f64>,
     threads: usize,
@@ -172,7 +174,15 @@ impl NativeSystem {
             return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
         }
         experiment.solver = match args.solver.as_str() {
-            "rk4" => Solver::Rk4 { max_step: None },
+            "rk4" => {
+                if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+                    return Err(CosimError::Experiment(format!(
+                        "step_size {} must be a positive number of seconds",
+                        args.max_step.unwrap_or_default()
+                    )));
+                }
+                Solver::Rk4 { max_step: args.max_step }
+            }
             "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
             "bdf" => Solver::Bdf { rtol, atol: rtol / 100.0 },
             other => {
@@ -406,6 +416,17 @@ impl NativeSystem {
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
         let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
         Ok((results.names, types, array.into_any(), json))
+    }
+
+    /// The step-longer-than-sample-period warnings of a run with `args` (the same words as
+    /// `cosim run`'s, with the keyword that sets the step): the Python side raises them as
+    /// `warnings.warn`.
+    fn sample_period_warnings(&self, args: RunArgs) -> PyResult<Vec<String>> {
+        let (system, experiment) = self.run_setup(&args)?;
+        Ok(nigel_cosim::sample_period::warnings(&system, experiment.step)
+            .iter()
+            .map(|w| format!("{w} (use step_size={})", w.period))
+            .collect())
     }
 
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused

@@ -395,7 +395,7 @@ def test_figure8_switch_samples(bench):
     # a CS row at t_k is sampled after the step into t_k: it holds sample k
     flips = [int(round(r["time"][i] / T)) for i in range(1, len(d)) if d[i] != d[i - 1]]
     assert flips == [3144, 6267, 9390]
-    doc_check("README.md", "(first flips at samples {}, {}, {})", *flips)
+    doc_check("docs/fmus.md", "(first flips at samples {}, {}, {})", *flips)
     assert np.all(np.abs(d) == A) and np.all(r["delta_ff_rr"] == -d)
 
 

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "cosim", version, about = "FMI 2.0 co-simulation master")]
+#[command(
+    name = "cosim",
+    version,
+    about = "FMI 2.0 and FMI 3.0 co-simulation master: FMUs and SSP systems, Co-Simulation and Model Exchange"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -143,7 +147,8 @@ struct RunArgs {
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
     #[arg(long)]
     step: Option<f64>,
-    /// ordered or jacobi.
+    /// jacobi (every connection one step late, as fmpy, libcosim and ecos step) or ordered
+    /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
     /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
@@ -250,8 +255,25 @@ enum IsolateMode {
     Run,
 }
 
+/// Set by the first Ctrl-C (SIGINT, SIGTERM, SIGHUP): the run stops at its next step and the
+/// rows it computed are written, as after a failed run; a second signal ends at once.
+static STOP: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>> = std::sync::OnceLock::new();
+
+/// How long the first signal waits for the run to stop and its rows to be written.
+const STOP_GRACE: std::time::Duration = std::time::Duration::from_secs(10);
+
 fn main() -> ExitCode {
-    nigel_cosim::unpack::remove_on_signals();
+    let stop = STOP.get_or_init(Default::default).clone();
+    nigel_cosim::unpack::remove_on_signals_after_stop(
+        move |signal| {
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            eprintln!(
+                "\ncosim: {}: stopping at the next step and writing the rows so far (again to end at once)",
+                nigel_cosim::error::signal_name(signal)
+            );
+        },
+        STOP_GRACE,
+    );
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
@@ -370,8 +392,8 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     experiment.start_time = times.start_time;
     check_times(&experiment)?;
     if !host_of_run {
-        for warning in sample_period_warnings(&system, experiment.step) {
-            eprintln!("cosim: warning: {warning}");
+        for warning in nigel_cosim::sample_period::warnings(&system, experiment.step) {
+            eprintln!("cosim: warning: {warning} (use --step {})", warning.period);
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
         for instance in &system.instances {
@@ -472,6 +494,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
     }
+    experiment.cancel = STOP.get().cloned();
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
@@ -523,6 +546,11 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     let suite_name = format!("cosim run {}", args.model.display());
     let summary = match outcome {
         Ok(s) => s,
+        Err(Some(nigel_cosim::Error::Cancelled { time })) => {
+            // stopped by a signal: the rows so far are written above
+            eprintln!("cosim: stopped at t = {time} s of {} s", experiment.stop_time);
+            nigel_cosim::unpack::finish_stopped();
+        }
         Err(failed) => {
             let message =
                 failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| e.to_string());
@@ -736,65 +764,6 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
         )));
     }
     Ok(())
-}
-
-/// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else, for an FMU with discrete states or outputs (Model Exchange: outputs), its DefaultExperiment stepSize) is shorter than the communication step: its
-/// inputs are then held and its outputs read less often than it is meant to run.
-fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
-    let mut out = Vec::new();
-    for spec in &system.instances {
-        let md = spec.fmu.description();
-        let parameter = md.model_variables.iter().enumerate().find(|(_, v)| {
-            v.name == "sample_period" && v.causality == model_description::Causality::Parameter && v.is_real()
-        });
-        let from_parameter = parameter.and_then(|(index, v)| {
-            let set = spec.start_values.iter().find(|(i, _)| *i == index).and_then(|(_, value)| match value {
-                nigel_cosim::Value::Real(x) => Some(*x),
-                _ => None,
-            });
-            let start = match v.variable_type {
-                model_description::VariableType::Real { start, .. } => start,
-                _ => None,
-            };
-            set.or(start).map(|p| (p, "its parameter sample_period"))
-        });
-        // the stepSize is only a suggestion of a continuous model (its integrator runs
-        // within any step); it is a sample period where the FMU has discrete-time values
-        // of its own, which change at its sample instants: in Co-Simulation discrete
-        // states or outputs; in Model Exchange discrete outputs only (its discrete states
-        // change at its events, which the master's integrator stops at within any
-        // communication step; a model with discrete locals, such as the when-conditions
-        // of a Modelica model, is continuous there)
-        let me = spec.fmu.interface() == nigel_cosim::Interface::ModelExchange;
-        let samples = md.model_variables.iter().any(|v| {
-            v.variability == model_description::Variability::Discrete
-                && match v.causality {
-                    model_description::Causality::Output => true,
-                    model_description::Causality::Input | model_description::Causality::Parameter => false,
-                    _ => !me,
-                }
-        });
-        let declared = from_parameter.or_else(|| {
-            md.default_experiment
-                .as_ref()
-                .and_then(|d| d.step_size)
-                .filter(|_| samples)
-                .map(|p| (p, "its DefaultExperiment stepSize"))
-        });
-        if let Some((period, source)) = declared {
-            // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
-            if period > 0.0 && step > period * (1.0 + 1e-9) {
-                out.push(format!(
-                    "{} ({}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
-                     are held and its outputs read only every {step} s (use --step {period})",
-                    spec.name,
-                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
-                ));
-            }
-        }
-    }
-    out
 }
 
 fn is_ssp(path: &Path) -> bool {
