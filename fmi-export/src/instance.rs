@@ -327,9 +327,15 @@ impl<M: Model> Instance<M> {
                 return err(format!("tolerance {tol} must be finite and > 0"));
             }
         }
-        if let Some(stop) = stop_time {
-            self.check_stop_within_samples(start_time, stop)?;
+        // an f64 time must resolve an instant there: at |t| = f64::MAX the next double is
+        // infinity and every later time would pass as "now"
+        for (what, t) in [("startTime", Some(start_time)), ("stopTime", stop_time)] {
+            if let Some(t) = t.filter(|t| !instant_tolerance(*t).is_finite()) {
+                return err(format!("{what} {t} s is too large: an f64 cannot resolve a later time there"));
+            }
         }
+        // a stop time past a sampled model's last sample is refused when initialization
+        // ends: the parameter that sets the last sample may still be set before that
         self.core.time = start_time;
         self.core.stop_time = stop_time;
         self.core.model.set_time(start_time);
@@ -358,18 +364,27 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn exit_initialization_mode(&mut self) -> OpResult {
-        self.core.model.exit_initialization()?;
         let start = self.core.time;
-        if let Some(period) = self.core.model.sample_period() {
-            if !(period > 0.0 && period.is_finite()) {
-                return err(format!("the sample period {period} s is not finite and > 0"));
+        // the stop time against the last sample with the parameters as set (start values
+        // come after fmi2SetupExperiment), before the model's own work at the end of
+        // initialization
+        let clock = match self.core.model.sample_period() {
+            Some(period) => {
+                if !(period > 0.0 && period.is_finite()) {
+                    return err(format!("the sample period {period} s is not finite and > 0"));
+                }
+                let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
+                clock.check_resolution(start)?;
+                if let Some(stop) = self.core.stop_time {
+                    self.check_stop_within_samples(start, stop)?;
+                    clock.check_resolution(stop)?;
+                }
+                Some(clock)
             }
-            let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
-            clock.check_resolution(start)?;
-            if let Some(stop) = self.core.stop_time {
-                self.check_stop_within_samples(start, stop)?;
-                clock.check_resolution(stop)?;
-            }
+            None => None,
+        };
+        self.core.model.exit_initialization()?;
+        if let Some(clock) = clock {
             self.core.clock = Some(clock);
             self.core.presample = true;
         }
@@ -791,6 +806,13 @@ impl<M: Model> Instance<M> {
             ));
         }
         let end = current_time + step;
+        if !(end > current_time) || !end.is_finite() {
+            return err(format!(
+                "communicationStepSize = {step} s does not advance currentCommunicationPoint = {current_time} s \
+                 (an f64 resolves {:e} s there)",
+                crate::sampled::ulp(current_time)
+            ));
+        }
         if let Some(stop) = self.core.stop_time {
             if end > stop + time_eps(stop) {
                 return err(format!(
@@ -1266,14 +1288,16 @@ impl<M: Model> Instance<M> {
     /// Restores a saved state (the callbacks stay the current instance's).
     pub fn restore_state(&mut self, state: &SavedState<M>) -> OpResult {
         let fits = match state.machine {
+            // FMI 3.0 has no stepFailed state: a Discarded fmi3DoStep stays in Step Mode
+            Machine::StepFailed if self.generation == Generation::Fmi3 => false,
             Machine::StepComplete | Machine::StepFailed => self.context.interface == Interface::CoSimulation,
             Machine::EventMode | Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,
             _ => true,
         };
         if !fits {
             return err(format!(
-                "a state saved in {:?} cannot be restored into a {:?} instance",
-                state.machine, self.context.interface
+                "a state saved in {:?} cannot be restored into a {:?} {:?} instance",
+                state.machine, self.generation, self.context.interface
             ));
         }
         self.core = state.clone();
