@@ -169,6 +169,9 @@ impl NativeSystem {
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
         }
+        // fmpy tells Co-Simulation FMUs the relative tolerance (given, else the
+        // DefaultExperiment's, filled in by the caller)
+        experiment.co_simulation_tolerance = args.relative_tolerance;
         experiment.solver = match args.solver.as_str() {
             "rk4" => Solver::Rk4 { max_step: None },
             "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },

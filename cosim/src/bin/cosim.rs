@@ -85,9 +85,11 @@ struct RunArgs {
     /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
-    #[arg(long, default_value_t = 1e-6)]
-    rtol: f64,
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
+    /// DefaultExperiment tolerance, as fmpy does).
+    #[arg(long)]
+    rtol: Option<f64>,
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
@@ -284,15 +286,15 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
 
     experiment.algorithm = algorithm;
+    if let Some(rtol) = args.rtol.filter(|r| !(*r > 0.0 && r.is_finite())) {
+        return Err(Error::Experiment(format!("--rtol {rtol} must be positive")));
+    }
+    experiment.co_simulation_tolerance = args.rtol;
+    let rtol = args.rtol.unwrap_or(1e-6);
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
-        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
+        "dopri5" => nigel_cosim::Solver::Dopri5 { rtol, atol: rtol / 100.0 },
+        "bdf" => nigel_cosim::Solver::Bdf { rtol, atol: rtol / 100.0 },
         other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
@@ -396,6 +398,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
     for (instance, message) in &summary.warnings {
         eprintln!("cosim: warning from {instance}: {message}");
+    }
+    for note in &summary.notes {
+        eprintln!("cosim: note: {note}");
     }
     if let Some((instance, time, reason)) = &summary.ended_by {
         eprintln!(

@@ -346,3 +346,24 @@ pub fn build_vdp_without_directional_derivatives(dir: &Path) -> PathBuf {
         .replace(r#"providesDirectionalDerivative="true""#, r#"providesDirectionalDerivative="false""#);
     build_single_c_fmu(dir, "vdp", &xml)
 }
+
+/// The Co-Simulation FMU that reports the tolerance of fmi2SetupExperiment
+/// (tests/cfmu/tolerance.c) as `<dir>/tolerance.fmu`; `default_tolerance` is its
+/// DefaultExperiment's tolerance attribute (`None`: no attribute).
+pub fn build_tolerance(dir: &Path, default_tolerance: Option<&str>) -> PathBuf {
+    let tolerance = default_tolerance.map(|t| format!(r#" tolerance="{t}""#)).unwrap_or_default();
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="tolerance" guid="{{tolerance}}" numberOfEventIndicators="0">
+  <CoSimulation modelIdentifier="tolerance"/>
+  <DefaultExperiment startTime="0" stopTime="0.1" stepSize="0.05"{tolerance}/>
+  <ModelVariables>
+    <ScalarVariable name="told_tolerance" valueReference="0" causality="output" variability="discrete"><Real/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/><Unknown index="2" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#
+    );
+    build_single_c_fmu(dir, "tolerance", &xml)
+}
