@@ -215,6 +215,10 @@ fn run<'s>(
             parallel_steps: 0,
         };
         let t0 = clock.t0;
+        if clock.steps > 0 {
+            let last_point = clock.point(clock.steps - 1).t_next;
+            core.lanes.iter_mut().for_each(|lane| lane.last_point = last_point);
+        }
         for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
             let tolerance = match spec.fmu.interface() {
                 Interface::CoSimulation => experiment

@@ -31,6 +31,9 @@ pub(crate) struct Lane {
     pub(crate) error: Option<Error>,
     /// Its step was handed to its host ([`Lane::post_step`]) and waits to be collected.
     pub(crate) posted: bool,
+    /// The run's last communication point, s (NaN: not known): an FMU that asks to end
+    /// the simulation there has not ended it early ([`Lane::advance`]).
+    pub(crate) last_point: f64,
 }
 
 impl Instances for [Lane] {
@@ -64,6 +67,7 @@ impl Lane {
             retries: 0,
             error: None,
             posted: false,
+            last_point: f64::NAN,
         }
     }
 
@@ -75,8 +79,24 @@ impl Lane {
 
     /// `do_step` (or the integrator of its group of one over the step), with the Discard
     /// retry if enabled. A member of the coupled Model Exchange group is not advanced here.
+    ///
+    /// An FMU that completes the run's last step and asks to end the simulation there
+    /// (FMI 3.0 `terminateSimulation`, FMI 2.0 Discard with `fmi2Terminated` at
+    /// `lastSuccessfulTime` = the step's end, a Model Exchange `terminateSimulation` at
+    /// the stop time) has not ended it early: the step is complete, and the other
+    /// instances take theirs as in any other step.
     #[inline]
     pub(crate) fn advance(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
+        match self.advance_inner(solver, t, t_next) {
+            Err(Error::Terminated { time, .. }) if t_next == self.last_point && ends_the_step(t, t_next, time) => {
+                Ok(())
+            }
+            r => r,
+        }
+    }
+
+    #[inline]
+    fn advance_inner(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         self.posted = false;
         match (&mut self.unit, &mut self.saved) {
@@ -172,6 +192,13 @@ impl Lane {
         }
         Ok(())
     }
+}
+
+/// Whether `time`, where an FMU ended the run in the step from `t` to `t_next`, is that
+/// step's end: to a millionth of the step (the FMU's `t + (t_next - t)` may round away
+/// from `t_next` by an ulp; an FMU that stops short of the end by more has stopped early).
+fn ends_the_step(t: f64, t_next: f64, time: f64) -> bool {
+    time >= t_next - 1e-6 * (t_next - t)
 }
 
 /// How the FMU said it ended the run (Co-Simulation).
