@@ -1,9 +1,11 @@
 //! What third-party FMUs need of the master (issue 35), each shown by a small C FMU of our
-//! own (tests/cfmu/): the tolerance told to Co-Simulation FMUs as fmpy tells it.
+//! own (tests/cfmu/): the tolerance told to Co-Simulation FMUs as fmpy tells it; the
+//! continuous states of the ModelStructure's `<Derivatives>`, not of every `derivative`
+//! attribute.
 
 mod common;
-use common::{build_tolerance, work_dir};
-use nigel_cosim::{simulate, Experiment, Fmu, SystemBuilder};
+use common::{build_tolerance, build_vdp, build_vdp_with_a_derivative_of_no_state, work_dir};
+use nigel_cosim::{simulate, Experiment, Fmu, Solver, System, SystemBuilder};
 
 fn told_tolerance(fmu: std::sync::Arc<Fmu>, given: Option<f64>) -> f64 {
     let mut b = SystemBuilder::new();
@@ -56,4 +58,41 @@ fn the_cli_rtol_reaches_co_simulation_fmus() {
     };
     assert_eq!(run(&[]), 1e-7);
     assert_eq!(run(&["--rtol", "1e-3"]), 1e-3);
+}
+
+/// Van der Pol with a description that declares a derivative of a variable that is no
+/// state (as Dymola's CoupledClutches does: 18 `derivative` attributes, 8 states): the
+/// states are those of `<Derivatives>` (2; the library refuses any other nx), the Jacobian
+/// of the bdf method asks the state derivatives with respect to the states only (the
+/// library refuses anything else), and every solver's result is the plain description's
+/// bit for bit (the same library, the same calls).
+#[test]
+fn the_states_are_those_of_the_derivatives_list() {
+    let plain = Fmu::load(&build_vdp(&work_dir("tp-vdp-plain"))).unwrap();
+    let dymola_like = Fmu::load(&build_vdp_with_a_derivative_of_no_state(&work_dir("tp-vdp-dymola"))).unwrap();
+    assert_eq!(dymola_like.description().states(), vec![1, 3]);
+    assert_eq!(dymola_like.description().state_derivatives(), vec![2, 4]);
+    for solver in [
+        Solver::Rk4 { max_step: None },
+        Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 },
+        Solver::Bdf { rtol: 1e-6, atol: 1e-8 },
+    ] {
+        let mut e = Experiment::new(2.0, 0.01);
+        e.solver = solver;
+        e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+        let (want, _) = simulate(&System::single("model", plain.clone()).unwrap(), &e).unwrap();
+        let (got, _) = simulate(&System::single("model", dymola_like.clone()).unwrap(), &e)
+            .unwrap_or_else(|err| panic!("{solver:?}: {err}"));
+        assert_eq!(want.rows(), 201);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got.values), bits(&want.values), "{solver:?}");
+    }
+    // cosim info counts the states of <Derivatives>
+    let dir = work_dir("tp-vdp-info");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
+        .args(["info", build_vdp_with_a_derivative_of_no_state(&dir).to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("continuous states: 2,"), "{text}");
 }

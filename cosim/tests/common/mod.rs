@@ -347,6 +347,26 @@ pub fn build_vdp_without_directional_derivatives(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "vdp", &xml)
 }
 
+/// [`build_vdp`] whose description declares, as Dymola's do, a `derivative` attribute on a
+/// variable that is no state derivative: `derivative_calls` (a local) is declared the
+/// derivative of `directional_calls` (both made continuous), while `<Derivatives>` lists
+/// the two state derivatives only. The library is vdp.c's: it refuses nx other than 2
+/// and a directional derivative of anything but a state derivative with respect to a
+/// state. As `<dir>/vdp.fmu`.
+pub fn build_vdp_with_a_derivative_of_no_state(dir: &Path) -> PathBuf {
+    let xml = include_str!("../cfmu/vdp.xml")
+        .replace(
+            r#"<ScalarVariable name="directional_calls" valueReference="5"><Real/></ScalarVariable>"#,
+            r#"<ScalarVariable name="directional_calls" valueReference="5" variability="continuous"><Real/></ScalarVariable>"#,
+        )
+        .replace(
+            r#"<ScalarVariable name="derivative_calls" valueReference="6"><Real/></ScalarVariable>"#,
+            r#"<ScalarVariable name="derivative_calls" valueReference="6" variability="continuous"><Real derivative="6"/></ScalarVariable>"#,
+        );
+    assert!(xml.contains(r#"derivative="6""#));
+    build_single_c_fmu(dir, "vdp", &xml)
+}
+
 /// The Co-Simulation FMU that reports the tolerance of fmi2SetupExperiment
 /// (tests/cfmu/tolerance.c) as `<dir>/tolerance.fmu`; `default_tolerance` is its
 /// DefaultExperiment's tolerance attribute (`None`: no attribute).
