@@ -1,10 +1,13 @@
 //! What third-party FMUs need of the master (issue 35), each shown by a small C FMU of our
 //! own (tests/cfmu/): the tolerance told to Co-Simulation FMUs as fmpy tells it; the
 //! continuous states of the ModelStructure's `<Derivatives>`, not of every `derivative`
-//! attribute.
+//! attribute; an FMU Jacobian checked against finite differences at its first use.
 
 mod common;
-use common::{build_tolerance, build_vdp, build_vdp_with_a_derivative_of_no_state, work_dir};
+use common::{
+    build_tolerance, build_vdp, build_vdp_with_a_derivative_of_no_state, build_vdp_with_a_wrong_jacobian,
+    build_vdp_without_directional_derivatives, work_dir,
+};
 use nigel_cosim::{simulate, Experiment, Fmu, Solver, System, SystemBuilder};
 
 fn told_tolerance(fmu: std::sync::Arc<Fmu>, given: Option<f64>) -> f64 {
@@ -95,4 +98,29 @@ fn the_states_are_those_of_the_derivatives_list() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("continuous states: 2,"), "{text}");
+}
+
+/// An FMU whose directional derivatives are wrong (vdp.c built to double each partial
+/// derivative) does not steer bdf: at its first use the Jacobian is compared with forward
+/// differences, found to disagree, and bdf uses differences from then on, with a note
+/// naming the FMU, the entry and both values. The run is then the run of the same FMU
+/// declaring no directional derivatives, bit for bit (the same differences at the same
+/// points). The correct Jacobian passes the check: no note, and the FMU's Jacobian used.
+#[test]
+fn a_wrong_fmu_jacobian_is_found_at_first_use_and_replaced_by_differences() {
+    let mut e = Experiment::new(2.0, 0.01);
+    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+    let run =
+        |path: std::path::PathBuf| simulate(&System::single("model", Fmu::load(&path).unwrap()).unwrap(), &e).unwrap();
+    let (wrong, wrong_summary) = run(build_vdp_with_a_wrong_jacobian(&work_dir("tp-vdp-wrong")));
+    let (differences, _) = run(build_vdp_without_directional_derivatives(&work_dir("tp-vdp-fd")));
+    assert_eq!(wrong_summary.notes.len(), 1, "{:?}", wrong_summary.notes);
+    let note = &wrong_summary.notes[0];
+    assert!(note.starts_with("model: fmi2GetDirectionalDerivative") && note.contains("finite differences"), "{note}");
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&wrong.values), bits(&differences.values));
+    let (_, right_summary) = run(build_vdp(&work_dir("tp-vdp-right")));
+    assert!(right_summary.notes.is_empty(), "{:?}", right_summary.notes);
+    assert!(right_summary.stiff.jacobians > 0 && right_summary.stiff.jacobian_rhs == 0, "{:?}", right_summary.stiff);
 }

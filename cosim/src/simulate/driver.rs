@@ -328,6 +328,7 @@ fn run<'s>(
                 summary.stiff.steps += unit.stiff.steps;
                 summary.stiff.rejected += unit.stiff.rejected;
                 summary.events.extend(unit.events);
+                summary.notes.extend(unit.notes);
             }
         }
         for lane in core.lanes.iter_mut() {

@@ -187,10 +187,16 @@ pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> P
 
 /// Compiles `tests/cfmu/<id>.c` and packs it with `xml` as `<dir>/<id>.fmu`.
 fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
+    build_single_c_fmu_with_flags(dir, id, xml, &[])
+}
+
+/// [`build_single_c_fmu`] with extra `cc` flags (e.g. `-DWRONG_JACOBIAN`).
+fn build_single_c_fmu_with_flags(dir: &Path, id: &str, xml: &str, flags: &[&str]) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cfmu/{id}.c"));
     let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
+        .args(flags)
         .arg(&src)
         .arg("-o")
         .arg(&so)
@@ -365,6 +371,13 @@ pub fn build_vdp_with_a_derivative_of_no_state(dir: &Path) -> PathBuf {
         );
     assert!(xml.contains(r#"derivative="6""#));
     build_single_c_fmu(dir, "vdp", &xml)
+}
+
+/// [`build_vdp`] built with `-DWRONG_JACOBIAN`: its fmi2GetDirectionalDerivative gives
+/// twice every partial derivative (a wrong Jacobian that is otherwise well-behaved), as
+/// `<dir>/vdp.fmu`.
+pub fn build_vdp_with_a_wrong_jacobian(dir: &Path) -> PathBuf {
+    build_single_c_fmu_with_flags(dir, "vdp", include_str!("../cfmu/vdp.xml"), &["-DWRONG_JACOBIAN"])
 }
 
 /// The Co-Simulation FMU that reports the tolerance of fmi2SetupExperiment
