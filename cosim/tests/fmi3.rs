@@ -762,3 +762,32 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let ours: Vec<Vec<f64>> = (0..r.rows()).map(|k| vec![time[k], r.column("y").unwrap()[k], n[k]]).collect();
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
+
+/// A run whose result would lack every output it was asked to record (by default: all
+/// outputs) does not end with status 0: the counter described with one output, an array
+/// of 200,000 elements that the master leaves out of its view, is refused naming it,
+/// instead of writing a CSV of the time column alone.
+#[test]
+fn a_run_that_can_record_none_of_the_outputs_fails() {
+    let dir = work_dir("fmi3-no-output");
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
+  <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="24"/>
+    <InitialUnknown valueReference="24"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    let Some(fmu) = build_counter(&dir, "no_output", xml) else { return };
+    let csv = dir.join("out.csv");
+    let out =
+        cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.05", "-o", csv.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("no output of the system can be recorded") && err.contains("model.big"), "{err}");
+}

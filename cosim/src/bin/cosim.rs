@@ -334,6 +334,32 @@ fn run(args: RunArgs) -> Result<(), Error> {
             host: None,
         });
     }
+    if args.record.is_empty() && nigel_cosim::simulate::default_record(&system).is_empty() {
+        // every output left out of the master's view: a result of the time column alone
+        // is not what was asked for
+        let output = |fmu: &Fmu, name: &str| {
+            fmu.fmi3_description()
+                .and_then(|md| md.variable_by_name(name))
+                .is_some_and(|v| v.causality == model_description::fmi3::Causality::Output)
+        };
+        let left_out: Vec<String> = system
+            .instances
+            .iter()
+            .flat_map(|i| {
+                i.fmu
+                    .not_in_view()
+                    .iter()
+                    .filter(|(name, _)| output(&i.fmu, name))
+                    .map(move |(name, why)| format!("{}.{name} ({})", i.name, why.as_str()))
+            })
+            .collect();
+        if !left_out.is_empty() {
+            return Err(Error::Experiment(format!(
+                "no output of the system can be recorded: {} (name variables to record with --record)",
+                left_out.join(", ")
+            )));
+        }
+    }
     if !args.record.is_empty() {
         experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
     }
