@@ -791,3 +791,37 @@ fn a_run_that_can_record_none_of_the_outputs_fails() {
     assert!(!out.status.success(), "{err}");
     assert!(err.contains("no output of the system can be recorded") && err.contains("model.big"), "{err}");
 }
+
+/// An early return whose lastSuccessfulTime lies past the step (the counter with
+/// crash_how = 4: terminateSimulation "at" t + 1000 s from the step at 0.05 s) is no time
+/// of the run: an error naming the FMU, the call and the times, no row past the stop time,
+/// and no status 0.
+#[test]
+fn an_early_return_past_the_step_is_an_error_not_a_row() {
+    let Some((dir, fmu)) = counter("fmi3-early-past") else { return };
+    let csv = dir.join("out.csv");
+    let out = cosim(&[
+        "run",
+        fmu.to_str().unwrap(),
+        "--stop-time",
+        "0.1",
+        "--step",
+        "0.01",
+        "--set",
+        "crash_at=0.05",
+        "--set",
+        "crash_how=4",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("fmi3DoStep ended the simulation at lastSuccessfulTime = 1000.05")
+            && err.contains("outside the step"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let last: f64 = text.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!(last <= 0.1, "a row at {last} s");
+}

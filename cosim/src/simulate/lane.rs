@@ -102,7 +102,7 @@ impl Lane {
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
-                Err(e) => Err(ended_or(&mut self.inst, e, t)),
+                Err(e) => Err(ended_or(&mut self.inst, e, t, t_next)),
             },
             (None, Some(state)) => {
                 self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
@@ -206,13 +206,30 @@ pub(crate) const DISCARD_TERMINATED: &str = "fmi2DoStep returned fmi2Discard wit
 /// The same end of a run by an FMI 3.0 FMU.
 pub(crate) const FMI3_TERMINATED: &str = "fmi3DoStep returned terminateSimulation";
 
-/// The error of a step from `t`: an fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)`
-/// true is the FMU ending the run at `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the
-/// last point it reached, if it cannot say), anything else is `e`.
+/// The error of a step from `t` to `t_end`: an fmi2Discard with
+/// `fmi2GetBooleanStatus(fmi2Terminated)` true is the FMU ending the run at
+/// `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the last point it reached, if it
+/// cannot say), anything else is `e`. A time the FMU reports outside the step (an FMI 3.0
+/// `lastSuccessfulTime` of t + 1000 s) is an error naming the FMU, the call and the times,
+/// not a row at that time.
 #[cold]
-fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
+fn ended_or(inst: &mut Instance, e: Error, t: f64, t_end: f64) -> Error {
     if matches!(e, Error::Fmi { status: crate::Status::Discard, .. }) && inst.terminated_status() == Some(true) {
-        let time = inst.last_successful_time().filter(|x| x.is_finite()).unwrap_or(t);
+        let reported = inst.last_successful_time();
+        let function = if inst.is_fmi3() { "fmi3DoStep" } else { "fmi2GetRealStatus(fmi2LastSuccessfulTime)" };
+        let time = match reported {
+            Some(x) if x.is_finite() && x >= t && x <= t_end => x,
+            None => t,
+            // the FMU's statement is no time of this step: no row is written at it (an
+            // Experiment error: the call itself returned what the standard allows)
+            Some(x) => {
+                return Error::Experiment(format!(
+                    "{}: {function} ended the simulation at lastSuccessfulTime = {x} s, outside the step from {t} \
+                     to {t_end} s it was asked to take: the run stops at {t} s",
+                    inst.name()
+                ))
+            }
+        };
         let reason = if inst.is_fmi3() { FMI3_TERMINATED } else { DISCARD_TERMINATED };
         return Error::Terminated { instance: inst.name().to_string(), time, reason };
     }
@@ -224,7 +241,7 @@ fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
 /// (`fmi2Terminated`). Returns the number of retries.
 fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
     inst.update_state(state)?;
-    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e, t)) {
+    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e, t, t + dt)) {
         Ok(()) => Ok(0),
         Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
             inst.set_state(state)?;
