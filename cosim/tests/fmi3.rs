@@ -825,3 +825,19 @@ fn an_early_return_past_the_step_is_an_error_not_a_row() {
     let last: f64 = text.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
     assert!(last <= 0.1, "a row at {last} s");
 }
+
+/// A description of a later FMI 3 minor version ("3.1") runs as FMI 3.0, with a note saying
+/// so; a revision of 3.0 ("3.0.2") needs none.
+#[test]
+fn a_later_minor_version_runs_with_a_note() {
+    let dir = work_dir("fmi3-version");
+    for (version, noted) in [("3.1", true), ("3.0.2", false)] {
+        let xml = XML.replace(r#"fmiVersion="3.0""#, &format!(r#"fmiVersion="{version}""#));
+        let Some(fmu) = build_counter(&dir, &format!("v{}", version.replace('.', "_")), &xml) else { return };
+        let out = cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.05"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{version}: {err}");
+        let note = format!(r#"declares fmiVersion "{version}": run as FMI 3.0"#);
+        assert_eq!(err.contains(&note), noted, "{version}: {err}");
+    }
+}

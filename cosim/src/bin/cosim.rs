@@ -275,6 +275,14 @@ fn run(args: RunArgs) -> Result<(), Error> {
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
         for instance in &system.instances {
+            if let Some(version) = instance.fmu.fmi3_description().map(|md| md.fmi_version.as_str()) {
+                if version != "3.0" && !version.starts_with("3.0.") {
+                    eprintln!(
+                        "cosim: note: {} declares fmiVersion \"{version}\": run as FMI 3.0 (what a later version adds is unknown to cosim)",
+                        instance.name
+                    );
+                }
+            }
             for (name, why) in instance.fmu.not_in_view() {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
