@@ -1,8 +1,8 @@
-//! `nigel_cosim`: an FMI 2.0 co-simulation master.
+//! `nigel_cosim`: an FMI 2.0 and FMI 3.0 co-simulation master (FMUs and SSP systems).
 //!
-//! - [`Fmu::load`] imports any FMI 2.0 `.fmu` safely ([`unpack`]: no path escapes, no
+//! - [`Fmu::load`] imports any FMI 2.0 or FMI 3.0 `.fmu` safely ([`unpack`]: no path escapes, no
 //!   links, limits against archive bombs) and resolves the functions of its interface;
-//!   [`Instance`] wraps every fmi2 call in a typed [`Result`].
+//!   [`Instance`] wraps every FMI call in a typed [`Result`].
 //! - [`SystemBuilder`] makes a [`System`] of instances, start values and connections
 //!   checked for type, causality and unit.
 //! - [`simulate()`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
@@ -45,7 +45,7 @@ pub mod mat;
 pub mod me;
 pub mod metric;
 pub mod options;
-pub mod sampling;
+pub mod sample_period;
 pub mod simulate;
 pub mod ssp;
 pub mod system;

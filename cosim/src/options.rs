@@ -23,8 +23,11 @@ pub struct RunOptions<'a> {
     pub algorithm: &'a str,
     /// `rk4`, `dopri5` or `bdf`.
     pub solver: &'a str,
-    /// Relative tolerance of dopri5 and bdf.
-    pub relative_tolerance: f64,
+    /// Relative tolerance of dopri5 and bdf, and the one Co-Simulation FMUs are told
+    /// (`None`: the FMUs are told none, the solvers use `default_relative_tolerance`).
+    pub relative_tolerance: Option<f64>,
+    /// The solvers' relative tolerance where none is given (the front end's default).
+    pub default_relative_tolerance: f64,
     /// Largest rk4 step, s.
     pub max_step: Option<f64>,
     /// Wall-clock limit of the run, s.
@@ -42,13 +45,14 @@ impl RunOptions<'_> {
         experiment.start_time = self.start_time;
         experiment.output_interval = self.output_interval;
         experiment.algorithm = self.algorithm.parse::<Algorithm>().map_err(bad)?;
-        let rtol = self.relative_tolerance;
+        let rtol = self.relative_tolerance.unwrap_or(self.default_relative_tolerance);
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(bad(format!("{} {rtol} must be positive", option_name("relative_tolerance"))));
         }
-        if self.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
-            return Err(bad(format!("{} must be positive", option_name("max_step"))));
+        if let Some(m) = self.max_step.filter(|m| !(*m > 0.0 && m.is_finite())) {
+            return Err(bad(format!("{} {m} must be a positive number of seconds", option_name("max_step"))));
         }
+        experiment.co_simulation_tolerance = self.relative_tolerance;
         experiment.solver = Solver::named(self.solver, rtol, self.max_step).map_err(bad)?;
         if let Some(t) = self.timeout {
             experiment.timeout =
@@ -85,7 +89,8 @@ mod tests {
             output_interval: Some(0.01),
             algorithm: "ordered",
             solver: "dopri5",
-            relative_tolerance: 1e-4,
+            relative_tolerance: Some(1e-4),
+            default_relative_tolerance: 1e-6,
             max_step: None,
             timeout: Some(3.0),
             threads: 2,
@@ -99,6 +104,10 @@ mod tests {
         assert_eq!(e.algorithm, Algorithm::Ordered);
         // the absolute tolerance is the relative one / 100 (the documented rule)
         assert_eq!(e.solver, Solver::Dopri5 { rtol: 1e-4, atol: 1e-6 });
+        assert_eq!(e.co_simulation_tolerance, Some(1e-4));
+        // none given: the FMUs are told none, the solver takes the front end's default
+        let e = RunOptions { relative_tolerance: None, ..options() }.experiment(cli_option_name).unwrap();
+        assert_eq!((e.solver, e.co_simulation_tolerance), (Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 }, None));
         assert_eq!((e.timeout, e.threads), (Some(Duration::from_secs(3)), 2));
         assert_eq!("rk4".parse::<Solver>(), Ok(Solver::Rk4 { max_step: None }));
         assert_eq!("bdf".parse::<Solver>(), Ok(Solver::Bdf { rtol: 1e-6, atol: 1e-8 }));
@@ -107,7 +116,7 @@ mod tests {
     #[test]
     fn bad_options_are_named_in_the_front_end_spelling() {
         let message = |o: RunOptions, name: fn(&str) -> String| o.experiment(name).unwrap_err().to_string();
-        let o = RunOptions { relative_tolerance: 0.0, ..options() };
+        let o = RunOptions { relative_tolerance: Some(0.0), ..options() };
         assert!(message(o.clone(), cli_option_name).contains("--rtol 0 must be positive"));
         assert!(message(o, |n| n.to_string()).contains("relative_tolerance 0 must be positive"));
         let o = RunOptions { threads: 0, ..options() };
@@ -115,6 +124,6 @@ mod tests {
         let o = RunOptions { solver: "euler", ..options() };
         assert!(message(o, cli_option_name).contains("unknown solver \"euler\""));
         let o = RunOptions { max_step: Some(-1.0), solver: "rk4", ..options() };
-        assert!(message(o, cli_option_name).contains("--max-step must be positive"));
+        assert!(message(o, cli_option_name).contains("--max-step -1 must be a positive number of seconds"));
     }
 }

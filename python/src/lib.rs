@@ -130,6 +130,8 @@ struct RunArgs {
     input: Option<(Vec<String>, Vec<f64>, Vec<Vec<f64>>)>,
     output: Option<Vec<String>>,
     solver: String,
+    /// The largest step of `rk4` (fmpy's `step_size` in Model Exchange); None: the communication step.
+    max_step: Option<f64>,
     relative_tolerance: Option<f64>,
     timeout: Option<f64>,
     threads: usize,
@@ -171,12 +173,15 @@ impl NativeSystem {
             output_interval: args.output_interval,
             algorithm: &args.algorithm,
             solver: &args.solver,
-            relative_tolerance: args.relative_tolerance.unwrap_or(1e-5),
-            max_step: None,
+            // fmpy tells Co-Simulation FMUs the relative tolerance (given, else the
+            // DefaultExperiment's, filled in by the caller)
+            relative_tolerance: args.relative_tolerance,
+            default_relative_tolerance: 1e-5,
+            max_step: args.max_step,
             timeout: args.timeout,
             threads: args.threads,
         }
-        .experiment(|name| name.to_string())?;
+        .experiment(|name| if name == "max_step" { "step_size".into() } else { name.to_string() })?;
         if let Some((names, time, columns)) = &args.input {
             experiment.input = Some(Arc::new(InputTable::new(names.clone(), time.clone(), columns.clone())?));
         }
@@ -394,6 +399,17 @@ impl NativeSystem {
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
         let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
         Ok((results.names, types, array.into_any(), json))
+    }
+
+    /// The step-longer-than-sample-period warnings of a run with `args` (the same words as
+    /// `cosim run`'s, with the keyword that sets the step): the Python side raises them as
+    /// `warnings.warn`.
+    fn sample_period_warnings(&self, args: RunArgs) -> PyResult<Vec<String>> {
+        let (system, experiment) = self.run_setup(&args)?;
+        Ok(nigel_cosim::sample_period::warnings(&system, experiment.step)
+            .iter()
+            .map(|w| format!("{w} (use step_size={})", w.period))
+            .collect())
     }
 
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "cosim", version, about = "FMI 2.0 co-simulation master")]
+#[command(
+    name = "cosim",
+    version,
+    about = "FMI 2.0 and FMI 3.0 co-simulation master: FMUs and SSP systems, Co-Simulation and Model Exchange"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -143,16 +147,19 @@ struct RunArgs {
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
     #[arg(long)]
     step: Option<f64>,
-    /// ordered or jacobi.
+    /// jacobi (every connection one step late, as fmpy, libcosim and ecos step) or ordered
+    /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
     /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
     /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
-    #[arg(long, default_value_t = 1e-6)]
-    rtol: f64,
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
+    /// DefaultExperiment tolerance, as fmpy does).
+    #[arg(long)]
+    rtol: Option<f64>,
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
@@ -250,8 +257,25 @@ enum IsolateMode {
     Run,
 }
 
+/// Set by the first Ctrl-C (SIGINT, SIGTERM, SIGHUP): the run stops at its next step and the
+/// rows it computed are written, as after a failed run; a second signal ends at once.
+static STOP: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>> = std::sync::OnceLock::new();
+
+/// How long the first signal waits for the run to stop and its rows to be written.
+const STOP_GRACE: std::time::Duration = std::time::Duration::from_secs(10);
+
 fn main() -> ExitCode {
-    nigel_cosim::unpack::remove_on_signals();
+    let stop = STOP.get_or_init(Default::default).clone();
+    nigel_cosim::unpack::remove_on_signals_after_stop(
+        move |signal| {
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            eprintln!(
+                "\ncosim: {}: stopping at the next step and writing the rows so far (again to end at once)",
+                nigel_cosim::error::signal_name(signal)
+            );
+        },
+        STOP_GRACE,
+    );
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
@@ -373,6 +397,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         algorithm: &args.algorithm,
         solver: &args.solver,
         relative_tolerance: args.rtol,
+        default_relative_tolerance: nigel_cosim::me::DEFAULT_RTOL,
         max_step: args.max_step,
         timeout: args.timeout,
         threads: args.threads,
@@ -380,11 +405,19 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     .experiment(nigel_cosim::options::cli_option_name)?;
     check_times(&experiment)?;
     if !host_of_run {
-        for warning in nigel_cosim::sampling::sample_period_warnings(&system, experiment.step) {
-            eprintln!("cosim: warning: {warning}");
+        for warning in nigel_cosim::sample_period::warnings(&system, experiment.step) {
+            eprintln!("cosim: warning: {warning} (use --step {})", warning.period);
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
         for instance in &system.instances {
+            if let Some(version) = instance.fmu.fmi3_description().map(|md| md.fmi_version.as_str()) {
+                if version != "3.0" && !version.starts_with("3.0.") {
+                    eprintln!(
+                        "cosim: note: {} declares fmiVersion \"{version}\": run as FMI 3.0 (what a later version adds is unknown to cosim)",
+                        instance.name
+                    );
+                }
+            }
             for (name, why) in instance.fmu.not_in_view() {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
@@ -420,6 +453,33 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             call_timeout: args.timeout_call.map(|s| seconds("--timeout-call", s)).transpose()?,
             host: None,
         });
+    }
+    if args.record.is_empty() && nigel_cosim::simulate::default_record(&system).is_empty() {
+        // every output left out of the master's view: a result of the time column alone
+        // is not what was asked for
+        let output = |fmu: &Fmu, name: &str| {
+            fmu.fmi3_description()
+                .and_then(|md| md.variable_by_name(name))
+                .is_some_and(|v| v.causality == model_description::fmi3::Causality::Output)
+        };
+        let left_out: Vec<String> = system
+            .instances
+            .iter()
+            .flat_map(|i| {
+                i.fmu
+                    .not_in_view()
+                    .iter()
+                    .filter(|(name, _)| output(&i.fmu, name))
+                    .map(move |(name, why)| format!("{}.{name} ({})", i.name, why.as_str()))
+            })
+            .collect();
+        if !left_out.is_empty() {
+            return Err(Error::Experiment(format!(
+                "no output of the system can be recorded: {} (name variables to record with --record)",
+                left_out.join(", ")
+            ))
+            .into());
+        }
     }
     let verification = verification(&args.verify)?;
     // the results' column of a system variable (a one-instance system's columns are bare)
@@ -459,6 +519,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if std::io::stderr().is_terminal() {
         experiment.progress = Some(progress);
     }
+    experiment.cancel = STOP.get().cloned();
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
@@ -510,6 +571,11 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     let suite_name = format!("cosim run {}", args.model.display());
     let summary = match outcome {
         Ok(s) => s,
+        Err(Some(nigel_cosim::Error::Cancelled { time })) => {
+            // stopped by a signal: the rows so far are written above
+            eprintln!("cosim: stopped at t = {time} s of {} s", experiment.stop_time);
+            nigel_cosim::unpack::finish_stopped();
+        }
         Err(failed) => {
             let message =
                 failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| e.to_string());
@@ -538,6 +604,9 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     }
     for (instance, message) in &summary.warnings {
         eprintln!("cosim: warning from {instance}: {message}");
+    }
+    for note in &summary.notes {
+        eprintln!("cosim: note: {note}");
     }
     if let Some((instance, time, reason)) = &summary.ended_by {
         eprintln!(

@@ -1,11 +1,42 @@
-//! The sample period an FMU declares of itself, and the warning when the communication
-//! step is longer: read from what any FMU can declare (FMI 3.0 periodic clocks, and the
-//! DefaultExperiment stepSize of an FMU with discrete-time values of its own), never from
-//! a variable's name.
+//! The step-longer-than-sample-period warning: an FMU that declares how often it runs, read
+//! from what any FMU can declare (FMI 3.0 periodic clocks, and the DefaultExperiment stepSize
+//! of an FMU with discrete-time values of its own), never from a variable's name, and a
+//! communication step longer than that. The run is still what was asked for (the FMU runs its
+//! samples inside the step), but its inputs are held and its outputs read less often than it
+//! is meant to run, which changes a closed loop's result. `cosim run` and the Python package
+//! (`warnings.warn`) say the same words.
 
-use crate::system::System;
-use crate::Interface;
 use model_description::{Causality, Variability};
+
+use crate::{Interface, System};
+
+/// One FMU whose declared sample period is shorter than the communication step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplePeriodWarning {
+    /// The instance's name in the system.
+    pub instance: String,
+    /// The FMU's file name.
+    pub file: String,
+    /// The declared sample period [s].
+    pub period: f64,
+    /// Where the period was read: "its periodic clock" or "its DefaultExperiment stepSize".
+    pub source: &'static str,
+    /// The communication step [s].
+    pub step: f64,
+}
+
+impl std::fmt::Display for SamplePeriodWarning {
+    /// The warning without a remedy: each front end names its own option for the step
+    /// (`--step`, `step_size=`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (name, file, period, source, step) = (&self.instance, &self.file, self.period, self.source, self.step);
+        write!(
+            f,
+            "{name} ({file}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
+             are held and its outputs read only every {step} s"
+        )
+    }
+}
 
 /// Where a declared sample period comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,22 +103,21 @@ pub fn declared_period(fmu: &crate::Fmu) -> Option<(f64, PeriodSource)> {
         .map(|p| (p, PeriodSource::DefaultExperiment))
 }
 
-/// A warning for every FMU of `system` whose declared sample period is shorter than the
-/// communication step `step`: its inputs are then held and its outputs read less often
-/// than it is meant to run.
-pub fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
+/// A warning for every FMU of `system` whose declared sample period ([`declared_period`]) is
+/// shorter than the communication step `step`.
+pub fn warnings(system: &System, step: f64) -> Vec<SamplePeriodWarning> {
     let mut out = Vec::new();
     for spec in &system.instances {
         if let Some((period, source)) = declared_period(&spec.fmu) {
             // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
             if step > period * (1.0 + 1e-9) {
-                out.push(format!(
-                    "{} ({}) runs every {period} s ({}), but the communication step is {step} s: its inputs \
-                     are held and its outputs read only every {step} s (use --step {period})",
-                    spec.name,
-                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
-                    source.as_str()
-                ));
+                out.push(SamplePeriodWarning {
+                    instance: spec.name.clone(),
+                    file: spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
+                    period,
+                    source: source.as_str(),
+                    step,
+                });
             }
         }
     }
