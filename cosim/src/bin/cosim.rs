@@ -427,7 +427,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
         "dopri5" => nigel_cosim::Solver::Dopri5 { rtol, atol: rtol / 100.0 },
         "bdf" => nigel_cosim::Solver::Bdf { rtol, atol: rtol / 100.0 },
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()).into());
