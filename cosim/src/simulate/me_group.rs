@@ -21,7 +21,7 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
-use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
+use crate::me::{nan_max, Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
 use crate::simulate::plan::{ordered_ops, Instances, Op};
 use crate::system::{Connection, System, VariableRef};
 
@@ -157,6 +157,9 @@ impl MeGroup {
                 if info.terminate_simulation != 0 {
                     unit.terminated = true;
                 }
+                if info.next_event_time_defined != 0 && info.next_event_time.is_nan() {
+                    return Err(nan_event_time(inst, time));
+                }
                 unit.next_time_event = (info.next_event_time_defined != 0).then_some(info.next_event_time);
                 if info.new_discrete_states_needed != 0 {
                     unsettled.push(m);
@@ -220,6 +223,24 @@ impl MeGroup {
             names.join(", "),
             self.max_steps
         )))
+    }
+
+    /// The error of a Dormand-Prince step from `t` of size `h` whose error estimate is NaN.
+    #[cold]
+    fn nan_error_estimate<L: Members + ?Sized>(&self, lanes: &mut L, t: f64, h: f64) -> Error {
+        let names: Vec<String> = self
+            .members
+            .iter()
+            .map(|m| {
+                let inst = lanes.instance(*m);
+                format!("{} ({})", inst.name(), crate::me::fmu_file(inst))
+            })
+            .collect();
+        Error::Integration(format!(
+            "{}: the dopri5 error estimate of the step from t = {t} s of {h:e} s is NaN (the state derivatives \
+             the FMU returned with OK over the step are infinite or the states overflow); the step is not taken",
+            names.join(", ")
+        ))
     }
 
     /// [`Error::Terminated`] at `time` if a member set `terminateSimulation`.
@@ -316,8 +337,11 @@ impl MeGroup {
                     let mut err = 0.0f64;
                     for &m in members {
                         if let Some((inst, u)) = lanes.member(m) {
-                            err = err.max(u.dopri(inst, t, h, rtol, atol)?);
+                            err = nan_max(err, u.dopri(inst, t, h, rtol, atol)?);
                         }
+                    }
+                    if err.is_nan() {
+                        return Err(self.nan_error_estimate(lanes, t, h));
                     }
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     self.count_step(lanes, t)?;
@@ -404,6 +428,18 @@ impl MeGroup {
             }
         }
     }
+}
+
+/// The error of a NaN next event time an FMU defined at the event iteration at `time`.
+#[cold]
+fn nan_event_time(inst: &Instance, time: f64) -> Error {
+    let (call, ok) =
+        if inst.is_fmi3() { ("fmi3UpdateDiscreteStates", "fmi3OK") } else { ("fmi2NewDiscreteStates", "fmi2OK") };
+    Error::Integration(format!(
+        "{} ({}): {call} returned a next event time of NaN (nextEventTimeDefined true) with {ok} at t = {time} s",
+        inst.name(),
+        crate::me::fmu_file(inst)
+    ))
 }
 
 /// Two times closer than this within a communication step of length `span` ending at
