@@ -328,10 +328,7 @@ impl Channel {
         self.posted_step = None;
         let status = self.collect();
         if status > 1 && self.failure.is_none() {
-            self.push_log(
-                Status::from_raw(status),
-                format!("{} returned {}", op.function(), Status::from_raw(status).spelled_for(op.function())),
-            );
+            self.push_log(Status::from_raw(status), format!("{} returned {}", op.function(), Status::from_raw(status).spelled_for(op.function())));
         }
     }
 
@@ -385,11 +382,7 @@ impl Channel {
             status = hdr.queued_status;
             self.push_log(
                 Status::from_raw(status),
-                format!(
-                    "{function} (sent with {}) returned {}",
-                    op.function(),
-                    Status::from_raw(status).spelled_for(function)
-                ),
+                format!("{function} (sent with {}) returned {}", op.function(), Status::from_raw(status).spelled_for(function)),
             );
         }
         self.queued = 0;
