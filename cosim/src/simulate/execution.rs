@@ -251,10 +251,12 @@ impl<'s> Execution<'s> {
         self.recorder.reserve(self.clock.rows());
         let registered = crate::exit_guard::Registered::new(self.recorder.shared.clone());
         let outcome = self.initialize_inner();
-        drop(registered);
         if outcome.is_err() {
+            // the instances freed now, while an FMU's exit() in fmi2FreeInstance is reported
+            self.core = None;
             self.phase = Phase::Failed;
         }
+        drop(registered);
         outcome
     }
 
@@ -441,10 +443,12 @@ impl<'s> Execution<'s> {
             }
             other => other,
         };
-        drop(registered);
         if outcome.is_err() {
+            // the instances freed now, while an FMU's exit() in fmi2FreeInstance is reported
+            self.core = None;
             self.phase = Phase::Failed;
         }
+        drop(registered);
         outcome
     }
 
@@ -583,6 +587,18 @@ impl<'s> Execution<'s> {
         summary.instance_time = self.system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
         summary.wall_time = self.wall.elapsed();
         Ok(summary)
+    }
+}
+
+impl Drop for Execution<'_> {
+    /// Frees the instances still held (a run dropped before its end) while the run is
+    /// registered, so that an FMU's exit() in fmi2FreeInstance is reported with the rows.
+    fn drop(&mut self) {
+        if self.core.is_some() {
+            let registered = crate::exit_guard::Registered::new(self.recorder.shared.clone());
+            self.core = None;
+            drop(registered);
+        }
     }
 }
 
