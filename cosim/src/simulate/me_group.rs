@@ -210,6 +210,28 @@ impl MeGroup {
         self.iterate(lanes, time)
     }
 
+    /// The time events due at `t` (to `eps`), for every solver: the members whose next time
+    /// event is due are recorded and all members iterate together; a time event still due
+    /// after that is an error. Whether any was due.
+    fn time_events_due<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64, eps: f64) -> Result<bool> {
+        let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
+        let members = self.members.clone();
+        let due: Vec<usize> =
+            members.iter().copied().filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps)).collect();
+        if due.is_empty() {
+            return Ok(false);
+        }
+        self.event(lanes, t, "time", &due)?;
+        self.ended(lanes, t)?;
+        if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
+            return Err(Error::Experiment(format!(
+                "{}: time event at {t} repeats at the same time",
+                lanes.instance(*m).name()
+            )));
+        }
+        Ok(true)
+    }
+
     /// One more internal step tried at `t`; past the cap of the run, the error.
     #[inline]
     fn count_step<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64) -> Result<()> {
@@ -289,21 +311,7 @@ impl MeGroup {
             if t >= t_end - eps {
                 return Ok(());
             }
-            // time events due now
-            let due: Vec<usize> = members
-                .iter()
-                .copied()
-                .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps))
-                .collect();
-            if !due.is_empty() {
-                self.event(lanes, t, "time", &due)?;
-                self.ended(lanes, t)?;
-                if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
-                    return Err(Error::Experiment(format!(
-                        "{}: time event at {t} repeats at the same time",
-                        lanes.instance(*m).name()
-                    )));
-                }
+            if self.time_events_due(lanes, t, eps)? {
                 continue;
             }
             // the end of this stretch: the earliest time event or the end of the step
