@@ -131,3 +131,47 @@ fn the_cancel_flag_stops_the_run_between_steps_with_the_rows_so_far() {
     }
     assert_eq!(times.len(), 4);
 }
+
+/// A caller's own manipulator: u = 1 from the step that starts at 0.5 s (step 5).
+struct JumpAt5 {
+    u: nigel_cosim::VariableRef,
+}
+
+impl nigel_cosim::simulate::Manipulator for JumpAt5 {
+    fn before_step(
+        &mut self,
+        point: &nigel_cosim::simulate::Point,
+        instances: &mut nigel_cosim::simulate::StepInstances<'_>,
+    ) -> nigel_cosim::Result<()> {
+        if point.n == 5 {
+            instances.set(&self.u, Value::Real(1.0))?;
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn a_manipulator_of_the_callers_own_acts_before_the_step_as_an_input_jump_there() {
+    let system = integrator_system("stepping-manipulator");
+    let u = system.resolve("integrator.u").unwrap();
+    let mut seen = Vec::new();
+    let mut run = Execution::new(&system, &Experiment::new(1.0, 0.1)).unwrap();
+    run.add_manipulator(Box::new(JumpAt5 { u }));
+    struct Steps<'a>(&'a mut Vec<(u64, f64)>);
+    impl nigel_cosim::simulate::Observer for Steps<'_> {
+        fn step_complete(&mut self, point: &nigel_cosim::simulate::Point) -> nigel_cosim::Result<()> {
+            self.0.push((point.n, point.t_next));
+            Ok(())
+        }
+    }
+    run.add_observer(Box::new(Steps(&mut seen)));
+    nigel_cosim::simulate::run_to_end(&mut run).unwrap();
+    let stepped = run.take_results();
+    drop(run);
+    assert_eq!(stepped.values, with_input_jump(&system).values);
+    // the observer was told of every step, with the points t0 + (n + 1) h
+    assert_eq!(seen.len(), 10);
+    for (k, (n, t)) in seen.iter().enumerate() {
+        assert_eq!((*n, *t), (k as u64, (k + 1) as f64 * 0.1));
+    }
+}

@@ -72,28 +72,55 @@ pub(crate) fn set_value(inst: &mut Instance, r: &VariableRef, value: Value) -> R
     }
 }
 
-/// The algorithm with the queued values applied before each step.
-pub(crate) struct WithSets<'s> {
-    pub(crate) inner: Box<dyn Communication + Send + 's>,
-    pub(crate) queue: std::sync::Arc<SetQueue>,
+/// Applied before every communication step of an [`Execution`](crate::simulate::Execution)
+/// (libcosim's manipulator): sets inputs and tunable parameters of the instances
+/// ([`Execution::add_manipulator`](crate::simulate::Execution::add_manipulator)). A
+/// [`SetQueue`] is one; the experiment's [`InputTable`](crate::InputTable) is applied before
+/// them.
+pub trait Manipulator: Send {
+    /// Before the step `point` (from `point.t` to `point.t_next`). An error ends the run.
+    fn before_step(&mut self, point: &Point, instances: &mut StepInstances<'_>) -> Result<()>;
 }
 
-impl WithSets<'_> {
-    fn apply(&self, core: &mut Core) -> Result<()> {
-        for (r, value) in self.queue.take() {
-            set_value(&mut core.lanes[r.instance].inst, &r, value)?;
+/// The instances of a run, as a [`Manipulator`] sees them before a step.
+pub struct StepInstances<'a> {
+    pub(crate) core: &'a mut Core,
+}
+
+impl StepInstances<'_> {
+    /// The instance `index` of the system (the order of [`System::instances`]).
+    pub fn instance(&mut self, index: usize) -> &mut Instance {
+        &mut self.core.lanes[index].inst
+    }
+
+    /// Sets `value` on the variable `r` (a value of its type).
+    pub fn set(&mut self, r: &VariableRef, value: Value) -> Result<()> {
+        set_value(&mut self.core.lanes[r.instance].inst, r, value)
+    }
+}
+
+impl Manipulator for std::sync::Arc<SetQueue> {
+    fn before_step(&mut self, _point: &Point, instances: &mut StepInstances<'_>) -> Result<()> {
+        for (r, value) in self.take() {
+            instances.set(&r, value)?;
         }
         Ok(())
     }
 }
 
-impl Communication for WithSets<'_> {
+/// The algorithm with a manipulator applied before each step.
+pub(crate) struct WithManipulator<'s> {
+    pub(crate) inner: Box<dyn Communication + Send + 's>,
+    pub(crate) manipulator: Box<dyn Manipulator + 's>,
+}
+
+impl Communication for WithManipulator<'_> {
     fn propagate(&mut self, core: &mut Core) -> Result<()> {
         self.inner.propagate(core)
     }
 
     fn step(&mut self, core: &mut Core, p: Point, calls: Option<&mut Profiler>) -> Result<()> {
-        self.apply(core)?;
+        self.manipulator.before_step(&p, &mut StepInstances { core })?;
         self.inner.step(core, p, calls)
     }
 

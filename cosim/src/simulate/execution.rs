@@ -9,14 +9,15 @@
 //!   connections carried over one step;
 //! - [`Observer`]s: told after every step (the recorder of the rows, the time limit, a
 //!   cancel flag, the progress; a caller's own);
-//! - manipulators: values applied before a step (the experiment's [`InputTable`](crate::InputTable),
-//!   [`Execution::set`], a [`SetQueue`] filled from another thread).
+//! - [`Manipulator`]s: values applied before a step (the experiment's
+//!   [`InputTable`](crate::InputTable), [`Execution::set`], a [`SetQueue`] filled from
+//!   another thread, a caller's own).
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
 use crate::me::{MeUnit, Solver};
 use crate::simulate::algorithm::{Communication, Core, Jacobi, Ordered, ThreadedJacobi};
-use crate::simulate::between::{SetQueue, WithSets};
+use crate::simulate::between::{Manipulator, SetQueue, WithManipulator};
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
@@ -194,9 +195,16 @@ impl<'s> Execution<'s> {
     /// Applies the values of `queue` (filled from any thread, e.g. a row sink) before each
     /// communication step, as [`Execution::set`] does.
     pub fn with_set_queue(mut self, queue: Arc<SetQueue>) -> Self {
-        let inner = std::mem::replace(&mut self.algorithm, Box::new(Jacobi));
-        self.algorithm = Box::new(WithSets { inner, queue });
+        self.add_manipulator(Box::new(queue));
         self
+    }
+
+    /// Applies `manipulator` before every communication step: before the experiment's input
+    /// signals are applied and before the manipulators added earlier (the last added runs
+    /// first); the values of [`Execution::set`] come before all of them.
+    pub fn add_manipulator(&mut self, manipulator: Box<dyn Manipulator + 's>) {
+        let inner = std::mem::replace(&mut self.algorithm, Box::new(Jacobi));
+        self.algorithm = Box::new(WithManipulator { inner, manipulator });
     }
 
     /// The system run.

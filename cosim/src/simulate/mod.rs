@@ -31,7 +31,7 @@ mod observer;
 mod plan;
 mod types;
 
-pub use between::SetQueue;
+pub use between::{Manipulator, SetQueue, StepInstances};
 pub use clock::Point;
 pub use driver::{run_to_end, simulate, simulate_recorded, simulate_with};
 pub use execution::{Execution, InstancePool, Phase, RowSink};
