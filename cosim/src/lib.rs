@@ -1,8 +1,8 @@
-//! `nigel_cosim`: an FMI 2.0 co-simulation master.
+//! `nigel_cosim`: an FMI 2.0 and FMI 3.0 co-simulation master (FMUs and SSP systems).
 //!
-//! - [`Fmu::load`] imports any FMI 2.0 `.fmu` safely ([`unpack`]: no path escapes, no
+//! - [`Fmu::load`] imports any FMI 2.0 or FMI 3.0 `.fmu` safely ([`unpack`]: no path escapes, no
 //!   links, limits against archive bombs) and resolves the functions of its interface;
-//!   [`Instance`] wraps every fmi2 call in a typed [`Result`].
+//!   [`Instance`] wraps every FMI call in a typed [`Result`].
 //! - [`SystemBuilder`] makes a [`System`] of instances, start values and connections
 //!   checked for type, causality and unit.
 //! - [`simulate()`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
@@ -20,6 +20,9 @@
 //!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
 //!   ([`simulate::simulate_recorded`]); in process, an FMU that calls `exit()` inside a
 //!   call ends the process with status 1, reported with the rows so far ([`exit_guard`]).
+//! - CI: [`check`]s of a run in the [`metric`] language, [`compare`]d with a baseline in
+//!   tolerance tubes, reported as JUnit XML and Markdown ([`junit`]); [`verify`] joins them
+//!   for `cosim run`.
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
@@ -33,15 +36,22 @@
 #![warn(missing_docs)]
 
 pub mod bdf;
+pub mod check;
+pub mod compare;
 pub(crate) use fmi_import::suggest;
 pub use fmi_import::{error, fmi3, fmu, unpack};
 pub mod defaults;
 pub mod exit_guard;
+pub mod junit;
+pub mod loops;
 pub mod mat;
 pub mod me;
+pub mod metric;
+pub mod sample_period;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
+pub mod verify;
 
 /// Isolation: instances in host processes of their own ([`fmi_import::isolate`]), and the
 /// whole run in one host process ([`isolate::whole`]).

@@ -97,6 +97,8 @@ struct NativeSystem {
     default_experiment: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
     /// `CoSimulation` / `ModelExchange` of each interface the (single) FMU offers.
     interfaces: Vec<&'static str>,
+    /// What reading an SSP noted (`nigel_cosim::SspSystem::notes`; `cosim run` prints them).
+    notes: Vec<String>,
 }
 
 const SINGLE: &str = "model";
@@ -129,6 +131,8 @@ struct RunArgs {
     input: Option<(Vec<String>, Vec<f64>, Vec<Vec<f64>>)>,
     output: Option<Vec<String>>,
     solver: String,
+    /// The largest step of `rk4` (fmpy's `step_size` in Model Exchange); None: the communication step.
+    max_step: Option<f64>,
     relative_tolerance: Option<f64>,
     timeout: Option<f64>,
     threads: usize,
@@ -170,8 +174,19 @@ impl NativeSystem {
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
         }
+        // fmpy tells Co-Simulation FMUs the relative tolerance (given, else the
+        // DefaultExperiment's, filled in by the caller)
+        experiment.co_simulation_tolerance = args.relative_tolerance;
         experiment.solver = match args.solver.as_str() {
-            "rk4" => Solver::Rk4 { max_step: None },
+            "rk4" => {
+                if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+                    return Err(CosimError::Experiment(format!(
+                        "step_size {} must be a positive number of seconds",
+                        args.max_step.unwrap_or_default()
+                    )));
+                }
+                Solver::Rk4 { max_step: args.max_step }
+            }
             "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
             "bdf" => Solver::Bdf { rtol, atol: rtol / 100.0 },
             other => {
@@ -271,6 +286,7 @@ impl NativeSystem {
                     single: None,
                     default_experiment: (start, stop, None, None),
                     interfaces: Vec::new(),
+                    notes: ssp.notes,
                 })
             } else {
                 let fmu = Fmu::load_with(&filename, &options)?;
@@ -294,10 +310,18 @@ impl NativeSystem {
                     single: Some(SINGLE.to_string()),
                     default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
                     interfaces,
+                    notes: Vec::new(),
                 })
             }
         })
         .map_err(to_py)
+    }
+
+    /// What reading an SSP noted: values ignored by the standard's rules, units taken as
+    /// written, an SSD of the 2.0 draft (`cosim run` prints the same lines).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.notes.clone()
     }
 
     /// (start, stop, step, tolerance) of the DefaultExperiment, each None when absent.
@@ -398,6 +422,17 @@ impl NativeSystem {
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
         let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
         Ok((results.names, types, array.into_any(), json))
+    }
+
+    /// The step-longer-than-sample-period warnings of a run with `args` (the same words as
+    /// `cosim run`'s, with the keyword that sets the step): the Python side raises them as
+    /// `warnings.warn`.
+    fn sample_period_warnings(&self, args: RunArgs) -> PyResult<Vec<String>> {
+        let (system, experiment) = self.run_setup(&args)?;
+        Ok(nigel_cosim::sample_period::warnings(&system, experiment.step)
+            .iter()
+            .map(|w| format!("{w} (use step_size={})", w.period))
+            .collect())
     }
 
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused
@@ -632,12 +667,79 @@ fn run_campaign(
     Ok((out.join("results.csv"), done.ran, done.failed))
 }
 
+/// Compares the results CSV `result` with the baseline CSV `baseline` in tolerance tubes
+/// (`cosim compare`); with `plot`, a PNG per failing signal into that folder. Returns the
+/// report as a dict: `passed`, `tolerance`, `signals` (per signal `name`, `passed`,
+/// `points`, `violations`, `worst` (`time`, `value`, `lower`, `upper`, `excess`) or None,
+/// `problem`, `detail`), `notes`, `lines` (as `cosim compare` prints them), `figures`.
+#[pyfunction]
+#[pyo3(signature = (result, baseline, rtol=1e-3, atol=1e-6, time_tol=0.0, signals=None, plot=None))]
+#[allow(clippy::too_many_arguments)]
+fn compare<'py>(
+    py: Python<'py>,
+    result: PathBuf,
+    baseline: PathBuf,
+    rtol: f64,
+    atol: f64,
+    time_tol: f64,
+    signals: Option<Vec<String>>,
+    plot: Option<PathBuf>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    use nigel_cosim::compare;
+    use pyo3::types::PyDict;
+    let tolerance = compare::Tolerance { rtol, atol, time_tol };
+    let bad = |e: String| PyValueError::new_err(e);
+    let r = compare::csv::read_results_csv(&result).map_err(bad)?;
+    let b = compare::csv::read_results_csv(&baseline).map_err(bad)?;
+    let c = compare::compare(&r, &b, &tolerance, signals.as_deref()).map_err(bad)?;
+    let figures = match &plot {
+        Some(dir) => compare::plot::plot_failures(&r, &b, &c, dir).map_err(bad)?,
+        None => Vec::new(),
+    };
+    let out = PyDict::new(py);
+    out.set_item("passed", c.passed())?;
+    let tol = PyDict::new(py);
+    tol.set_item("rtol", rtol)?;
+    tol.set_item("atol", atol)?;
+    tol.set_item("time_tol", time_tol)?;
+    out.set_item("tolerance", tol)?;
+    let mut each = Vec::new();
+    for s in &c.signals {
+        let d = PyDict::new(py);
+        d.set_item("name", &s.name)?;
+        d.set_item("passed", s.passed)?;
+        d.set_item("points", s.points)?;
+        d.set_item("violations", s.violations)?;
+        match &s.worst {
+            Some(w) => {
+                let wd = PyDict::new(py);
+                wd.set_item("time", w.time)?;
+                wd.set_item("value", w.value)?;
+                wd.set_item("lower", w.lower)?;
+                wd.set_item("upper", w.upper)?;
+                wd.set_item("excess", w.excess)?;
+                d.set_item("worst", wd)?;
+            }
+            None => d.set_item("worst", py.None())?,
+        }
+        d.set_item("problem", s.problem.clone())?;
+        d.set_item("detail", s.detail())?;
+        each.push(d);
+    }
+    out.set_item("signals", each)?;
+    out.set_item("notes", c.notes.clone())?;
+    out.set_item("lines", c.lines())?;
+    out.set_item("figures", figures)?;
+    Ok(out)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<NativeSystem>()?;
     m.add_class::<NativeRun>()?;
     m.add_function(wrap_pyfunction!(run_campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add("Error", py.get_type::<Error>())?;
     m.add("LoadError", py.get_type::<LoadError>())?;
     m.add("VariableError", py.get_type::<VariableError>())?;
