@@ -516,10 +516,6 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if !args.record.is_empty() || extra {
         experiment.record = Some(record);
     }
-    if std::io::stderr().is_terminal() {
-        experiment.progress = Some(progress);
-    }
-    experiment.cancel = STOP.get().cloned();
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
@@ -538,8 +534,19 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
-            let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
-            (results, outcome.map_err(Some))
+            match nigel_cosim::simulate::Execution::new(&system, &experiment) {
+                Ok(mut execution) => {
+                    if std::io::stderr().is_terminal() {
+                        execution.on_progress(progress);
+                    }
+                    if let Some(flag) = STOP.get().cloned() {
+                        execution.cancel_on(flag);
+                    }
+                    let outcome = nigel_cosim::simulate::run_to_end(&mut execution);
+                    (execution.take_results(), outcome.map_err(Some))
+                }
+                Err(e) => (nigel_cosim::Results::default(), Err(Some(e))),
+            }
         }
     };
     if outcome.is_ok() && args.output.is_none() && args.summary.is_none() && verification.is_empty() {
