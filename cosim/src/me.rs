@@ -82,6 +82,9 @@ pub struct MeUnit {
     pub terminated: bool,
     /// The work of the bdf solver of this instance's group (held by its first member).
     pub stiff: crate::bdf::Work,
+    /// What the solver did differently from what the FMU declares (a directional
+    /// derivative that disagrees with finite differences, not used), one sentence each.
+    pub notes: Vec<String>,
 }
 
 impl MeUnit {
@@ -105,6 +108,7 @@ impl MeUnit {
             rejected: 0,
             terminated: false,
             stiff: crate::bdf::Work::default(),
+            notes: Vec::new(),
         }
     }
 

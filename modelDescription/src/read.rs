@@ -208,10 +208,18 @@ impl fmt::Display for ReadError {
                      (FMI 2.0 and FMI 3.0 are; this reader reads \"{expected}\")"
                 )
             }
-            ReadError::UnsupportedFmiVersion { found, expected, position } => write!(
-                f,
-                "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\")"
-            ),
+            ReadError::UnsupportedFmiVersion { found, expected, position } => {
+                // the FMI 3.0 reader takes the revisions and later minor versions too
+                let also = if expected.starts_with('3') {
+                    ", a revision such as \"3.0.2\" or a later minor version such as \"3.1\", read as FMI 3.0"
+                } else {
+                    ""
+                };
+                write!(
+                    f,
+                    "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\"{also})"
+                )
+            }
             ReadError::MissingTypeChild { variable, position } => write!(
                 f,
                 "ScalarVariable \"{variable}\" at {position}: no type element (<Real>, <Integer>, <Boolean>, <String> or <Enumeration>)"

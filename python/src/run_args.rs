@@ -36,6 +36,9 @@ impl RunArgs {
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
         }
+        // fmpy tells Co-Simulation FMUs the relative tolerance (given, else the
+        // DefaultExperiment's, filled in by the caller)
+        experiment.co_simulation_tolerance = args.relative_tolerance;
         experiment.solver = match args.solver.as_str() {
             "rk4" => {
                 if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {

@@ -155,9 +155,11 @@ struct RunArgs {
     /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
-    #[arg(long, default_value_t = 1e-6)]
-    rtol: f64,
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
+    /// DefaultExperiment tolerance, as fmpy does).
+    #[arg(long)]
+    rtol: Option<f64>,
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
@@ -397,6 +399,14 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
         for instance in &system.instances {
+            if let Some(version) = instance.fmu.fmi3_description().map(|md| md.fmi_version.as_str()) {
+                if version != "3.0" && !version.starts_with("3.0.") {
+                    eprintln!(
+                        "cosim: note: {} declares fmiVersion \"{version}\": run as FMI 3.0 (what a later version adds is unknown to cosim)",
+                        instance.name
+                    );
+                }
+            }
             for (name, why) in instance.fmu.not_in_view() {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
@@ -408,16 +418,16 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     }
 
     experiment.algorithm = algorithm;
+    if let Some(rtol) = args.rtol.filter(|r| !(*r > 0.0 && r.is_finite())) {
+        return Err(Error::Experiment(format!("--rtol {rtol} must be positive")).into());
+    }
+    experiment.co_simulation_tolerance = args.rtol;
+    let rtol = args.rtol.unwrap_or(1e-6);
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
-        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol)).into()),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
+        "dopri5" => nigel_cosim::Solver::Dopri5 { rtol, atol: rtol / 100.0 },
+        "bdf" => nigel_cosim::Solver::Bdf { rtol, atol: rtol / 100.0 },
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()).into());
@@ -455,6 +465,33 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             call_timeout: args.timeout_call.map(|s| seconds("--timeout-call", s)).transpose()?,
             host: None,
         });
+    }
+    if args.record.is_empty() && nigel_cosim::simulate::default_record(&system).is_empty() {
+        // every output left out of the master's view: a result of the time column alone
+        // is not what was asked for
+        let output = |fmu: &Fmu, name: &str| {
+            fmu.fmi3_description()
+                .and_then(|md| md.variable_by_name(name))
+                .is_some_and(|v| v.causality == model_description::fmi3::Causality::Output)
+        };
+        let left_out: Vec<String> = system
+            .instances
+            .iter()
+            .flat_map(|i| {
+                i.fmu
+                    .not_in_view()
+                    .iter()
+                    .filter(|(name, _)| output(&i.fmu, name))
+                    .map(move |(name, why)| format!("{}.{name} ({})", i.name, why.as_str()))
+            })
+            .collect();
+        if !left_out.is_empty() {
+            return Err(Error::Experiment(format!(
+                "no output of the system can be recorded: {} (name variables to record with --record)",
+                left_out.join(", ")
+            ))
+            .into());
+        }
     }
     let verification = verification(&args.verify)?;
     // the results' column of a system variable (a one-instance system's columns are bare)
@@ -579,6 +616,9 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     }
     for (instance, message) in &summary.warnings {
         eprintln!("cosim: warning from {instance}: {message}");
+    }
+    for note in &summary.notes {
+        eprintln!("cosim: note: {note}");
     }
     if let Some((instance, time, reason)) = &summary.ended_by {
         eprintln!(

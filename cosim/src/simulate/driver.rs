@@ -163,11 +163,14 @@ fn run<'s>(
         _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
         _ => Box::new(Jacobi),
     };
+    let mut notes = Vec::new();
     if let Some(table) = &experiment.input {
         if experiment.threads > 1 {
             return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
         }
-        algorithm = Box::new(crate::simulate::input::WithInput::new(algorithm, system, table, &clock)?);
+        let with_input = crate::simulate::input::WithInput::new(algorithm, system, table, &clock)?;
+        notes.extend(with_input.notes.iter().cloned());
+        algorithm = Box::new(with_input);
     }
     if let Some(queue) = &experiment.between_steps {
         algorithm = Box::new(crate::simulate::between::WithSets { inner: algorithm, queue: queue.clone() });
@@ -212,8 +215,20 @@ fn run<'s>(
             parallel_steps: 0,
         };
         let t0 = clock.t0;
+        if clock.steps > 0 {
+            let last_point = clock.point(clock.steps - 1).t_next;
+            core.lanes.iter_mut().for_each(|lane| lane.last_point = last_point);
+        }
         for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
-            lane.inst.setup_experiment(None, t0, Some(experiment.stop_time))?;
+            let tolerance = match spec.fmu.interface() {
+                Interface::CoSimulation => experiment
+                    .co_simulation_tolerance
+                    .or_else(|| spec.fmu.description().default_experiment.as_ref().and_then(|d| d.tolerance))
+                    // a declared tolerance that is no tolerance (0, negative, NaN) is not passed on
+                    .filter(|t| t.is_finite() && *t > 0.0),
+                Interface::ModelExchange => None,
+            };
+            lane.inst.setup_experiment(tolerance, t0, Some(experiment.stop_time))?;
             apply_start_values(&mut lane.inst, spec)?;
             lane.inst.enter_initialization_mode()?;
         }
@@ -295,6 +310,7 @@ fn run<'s>(
             parallel_steps: core.parallel_steps,
             wall_time: Duration::ZERO,
             ended_by,
+            notes: std::mem::take(&mut notes),
             ..Summary::default()
         };
         for lane in core.lanes.iter_mut() {
@@ -312,6 +328,7 @@ fn run<'s>(
                 summary.stiff.steps += unit.stiff.steps;
                 summary.stiff.rejected += unit.stiff.rejected;
                 summary.events.extend(unit.events);
+                summary.notes.extend(unit.notes);
             }
         }
         for lane in core.lanes.iter_mut() {

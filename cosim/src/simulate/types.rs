@@ -79,6 +79,11 @@ pub struct Experiment {
     /// Values a caller sets while the run is in progress (from another thread, e.g. the
     /// row sink of a run stepped from outside), applied before the next communication step.
     pub between_steps: Option<std::sync::Arc<crate::simulate::SetQueue>>,
+    /// The relative tolerance told to the Co-Simulation FMUs (`fmi2SetupExperiment`,
+    /// `fmi3EnterInitializationMode`) for their internal solvers; `None`: each FMU's
+    /// DefaultExperiment tolerance, else none (fmpy's rule). Model Exchange FMUs are told
+    /// none (the master's solver has its own, [`Experiment::solver`]).
+    pub co_simulation_tolerance: Option<f64>,
 }
 
 impl Experiment {
@@ -102,6 +107,7 @@ impl Experiment {
             timeout: None,
             cancel: None,
             between_steps: None,
+            co_simulation_tolerance: None,
         }
     }
 }
@@ -215,6 +221,9 @@ pub struct Summary {
     /// The FMU that ended the run itself (FMI's fmi2Terminated / terminateSimulation):
     /// its instance, the time the run ended, and how it said so.
     pub ended_by: Option<(String, f64, &'static str)>,
+    /// What the master did that a reader of the inputs may not expect (e.g. an input
+    /// event between communication points applied at the next one), one sentence each.
+    pub notes: Vec<String>,
 }
 
 impl Summary {
@@ -232,6 +241,7 @@ impl Summary {
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
+            "notes": self.notes,
         })
     }
 }

@@ -130,6 +130,13 @@ impl<M: Model> Instance<M> {
             ));
         }
         let end = current_time + step;
+        if !(end > current_time) || !end.is_finite() {
+            return err(format!(
+                "communicationStepSize = {step} s does not advance currentCommunicationPoint = {current_time} s \
+                 (an f64 resolves {:e} s there)",
+                crate::sampled::ulp(current_time)
+            ));
+        }
         if let Some(stop) = self.core.stop_time {
             if end > stop + time_eps(stop) {
                 return err(format!(

@@ -1,7 +1,7 @@
 //! FMU state: save and restore, and the byte format's serialize and deserialize with
 //! every check a loaded state passes.
 
-use super::{decl, err, time_eps, Core, Instance, OpResult, SavedState};
+use super::{decl, err, time_eps, Core, Generation, Instance, OpResult, SavedState};
 use crate::decl::BaseType;
 use crate::fmu_state::{self, LayerNumbers};
 use crate::model::{Interface, Model, ModelError};
@@ -15,14 +15,16 @@ impl<M: Model> Instance<M> {
     /// Restores a saved state (the callbacks stay the current instance's).
     pub fn restore_state(&mut self, state: &SavedState<M>) -> OpResult {
         let fits = match state.machine {
+            // FMI 3.0 has no stepFailed state: a Discarded fmi3DoStep stays in Step Mode
+            Machine::StepFailed if self.generation == Generation::Fmi3 => false,
             Machine::StepComplete | Machine::StepFailed => self.context.interface == Interface::CoSimulation,
             Machine::EventMode | Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,
             _ => true,
         };
         if !fits {
             return err(format!(
-                "a state saved in {:?} cannot be restored into a {:?} instance",
-                state.machine, self.context.interface
+                "a state saved in {:?} cannot be restored into a {:?} {:?} instance",
+                state.machine, self.generation, self.context.interface
             ));
         }
         self.core = state.clone();

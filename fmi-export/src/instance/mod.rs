@@ -256,9 +256,15 @@ impl<M: Model> Instance<M> {
                 return err(format!("tolerance {tol} must be finite and > 0"));
             }
         }
-        if let Some(stop) = stop_time {
-            self.check_stop_within_samples(start_time, stop)?;
+        // an f64 time must resolve an instant there: at |t| = f64::MAX the next double is
+        // infinity and every later time would pass as "now"
+        for (what, t) in [("startTime", Some(start_time)), ("stopTime", stop_time)] {
+            if let Some(t) = t.filter(|t| !instant_tolerance(*t).is_finite()) {
+                return err(format!("{what} {t} s is too large: an f64 cannot resolve a later time there"));
+            }
         }
+        // a stop time past a sampled model's last sample is refused when initialization
+        // ends: the parameter that sets the last sample may still be set before that
         self.core.time = start_time;
         self.core.stop_time = stop_time;
         self.core.model.set_time(start_time);
@@ -287,18 +293,27 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn exit_initialization_mode(&mut self) -> OpResult {
-        self.core.model.exit_initialization()?;
         let start = self.core.time;
-        if let Some(period) = self.core.model.sample_period() {
-            if !(period > 0.0 && period.is_finite()) {
-                return err(format!("the sample period {period} s is not finite and > 0"));
+        // the stop time against the last sample with the parameters as set (start values
+        // come after fmi2SetupExperiment), before the model's own work at the end of
+        // initialization
+        let clock = match self.core.model.sample_period() {
+            Some(period) => {
+                if !(period > 0.0 && period.is_finite()) {
+                    return err(format!("the sample period {period} s is not finite and > 0"));
+                }
+                let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
+                clock.check_resolution(start)?;
+                if let Some(stop) = self.core.stop_time {
+                    self.check_stop_within_samples(start, stop)?;
+                    clock.check_resolution(stop)?;
+                }
+                Some(clock)
             }
-            let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
-            clock.check_resolution(start)?;
-            if let Some(stop) = self.core.stop_time {
-                self.check_stop_within_samples(start, stop)?;
-                clock.check_resolution(stop)?;
-            }
+            None => None,
+        };
+        self.core.model.exit_initialization()?;
+        if let Some(clock) = clock {
             self.core.clock = Some(clock);
             self.core.presample = true;
         }
