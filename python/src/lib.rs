@@ -1,7 +1,7 @@
 //! `nigel_cosim._native`: the Rust half of the Python package `nigel_cosim`.
 //!
 //! A thin layer over the `nigel-cosim` and `nigel-campaign` libraries: it loads an FMU or
-//! an SSP once ([`NativeSystem`]), runs experiments on it with the interpreter's lock
+//! an SSP once (`system::NativeSystem`), runs experiments on it with the interpreter's lock
 //! released, and turns the master's errors into the package's exception classes. The
 //! fmpy-compatible keyword handling, the structured arrays and the DataFrame live in the
 //! Python half (`nigel_cosim/__init__.py`), where users can read them.
@@ -10,9 +10,9 @@
 //! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
 //! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
 //!
-//! One module per class or concern: [`errors`] (the exception classes), [`run_args`] (a
-//! run's arguments and their experiment), [`system`] (`NativeSystem`), [`stepped_run`]
-//! (`NativeRun`), [`interrupt`] (waiting with signals handled), [`campaign`], [`compare`];
+//! One module per class or concern: `errors` (the exception classes), `run_args` (a
+//! run's arguments and their experiment), `system` (`NativeSystem`), `stepped_run`
+//! (`NativeRun`), `interrupt` (waiting with signals handled), `campaign`, `compare`;
 //! this file only registers them. `nigel_cosim/_native.pyi` is their typed surface, checked
 //! against the built module by mypy's `stubtest` (scripts/test-python-package.sh).
 
