@@ -11,6 +11,9 @@
 //!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
 //!   those connected to each other advancing together with one event iteration across
 //!   them ([`Error::EventIteration`] when it has no fixed point).
+//! - [`simulate::Execution`]: a run advanced by its caller (`initialize`, `step`,
+//!   `simulate_until`, `get`/`set` between steps, [`simulate::Observer`]s); [`simulate()`]
+//!   and its variants are loops over it.
 //! - [`InputTable`]: input signals over time (fmpy's `input=`), [`Experiment::input`];
 //!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
 //! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),

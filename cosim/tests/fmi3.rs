@@ -798,6 +798,8 @@ fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
     assert_eq!(n, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
     for k in 0..n.len() {
         assert_eq!(u[k], -(2f64.powi(40)) * n[k], "c2.u at step {k}");
+    }
+}
 
 /// A run whose result would lack every output it was asked to record (by default: all
 /// outputs) does not end with status 0: the counter described with one output, an array

@@ -6,9 +6,11 @@
 //! fmpy-compatible keyword handling, the structured arrays and the DataFrame live in the
 //! Python half (`nigel_cosim/__init__.py`), where users can read them.
 //!
-//! A run happens on a worker thread while the calling thread waits without the GIL, waking
-//! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
-//! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
+//! A whole run happens on a worker thread while the calling thread waits without the GIL,
+//! waking every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the
+//! run stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
+//! A run stepped from Python (`NativeRun`) is an `Execution` advanced in the calling
+//! thread, the GIL released for at most 100 ms at a time between signal checks.
 //!
 //! One module per class or concern: `errors` (the exception classes), `run_args` (a
 //! run's arguments and their experiment), `system` (`NativeSystem`), `stepped_run`

@@ -7,7 +7,7 @@ use crate::stepped_run::NativeRun;
 use model_description::DefaultExperiment;
 use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
-    simulate::{default_record, simulate_with},
+    simulate::{default_record, run_to_end, Execution},
     Error as CosimError, Experiment, Fmu, ImportOptions, InstancePool, Interface, Results, Summary, System,
     SystemBuilder,
 };
@@ -244,12 +244,14 @@ impl NativeSystem {
         py: Python<'py>,
         args: RunArgs,
     ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String)> {
-        let (system, mut experiment) = self.run_setup(&args)?;
+        let (system, experiment) = self.run_setup(&args)?;
         let cancel = Arc::new(AtomicBool::new(false));
-        experiment.cancel = Some(cancel.clone());
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
             let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
-            simulate_with(&system, &experiment, Some(&mut pool), None)
+            let mut execution = Execution::new(&system, &experiment)?.with_pool(&mut pool);
+            execution.cancel_on(cancel.clone());
+            let summary = run_to_end(&mut execution)?;
+            Ok((execution.take_results(), summary))
         })?;
         let (results, summary) = outcome.map_err(to_py)?;
         let types = column_types(&system, &results, self.single.as_deref());

@@ -427,7 +427,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
         "dopri5" => nigel_cosim::Solver::Dopri5 { rtol, atol: rtol / 100.0 },
         "bdf" => nigel_cosim::Solver::Bdf { rtol, atol: rtol / 100.0 },
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
         return Err(Error::Experiment("--max-step must be positive".into()).into());
@@ -528,10 +528,6 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if !args.record.is_empty() || extra {
         experiment.record = Some(record);
     }
-    if std::io::stderr().is_terminal() {
-        experiment.progress = Some(progress);
-    }
-    experiment.cancel = STOP.get().cloned();
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
@@ -550,8 +546,19 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
-            let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
-            (results, outcome.map_err(Some))
+            match nigel_cosim::simulate::Execution::new(&system, &experiment) {
+                Ok(mut execution) => {
+                    if std::io::stderr().is_terminal() {
+                        execution.on_progress(progress);
+                    }
+                    if let Some(flag) = STOP.get().cloned() {
+                        execution.cancel_on(flag);
+                    }
+                    let outcome = nigel_cosim::simulate::run_to_end(&mut execution);
+                    (execution.take_results(), outcome.map_err(Some))
+                }
+                Err(e) => (nigel_cosim::Results::default(), Err(Some(e))),
+            }
         }
     };
     if outcome.is_ok() && args.output.is_none() && args.summary.is_none() && verification.is_empty() {

@@ -208,8 +208,8 @@ struct Column {
 }
 
 /// The inputs of a run, resolved, wrapped around the algorithm.
-pub(crate) struct WithInput {
-    pub(crate) inner: Box<dyn Communication>,
+pub(crate) struct WithInput<'s> {
+    pub(crate) inner: Box<dyn Communication + Send + 's>,
     table: InputTable,
     columns: Vec<Column>,
     /// The input events between communication points, ascending: a step is split at each.
@@ -221,16 +221,16 @@ pub(crate) struct WithInput {
     pub(crate) notes: Vec<String>,
 }
 
-impl WithInput {
+impl<'s> WithInput<'s> {
     /// Resolves the table's names in `system` (a bare name in a one-instance system is
     /// that instance's variable); refuses names that are not inputs (or tunable
     /// parameters) and inputs a connection already feeds.
     pub(crate) fn new(
-        inner: Box<dyn Communication>,
+        inner: Box<dyn Communication + Send + 's>,
         system: &System,
         table: &InputTable,
         clock: &Clock,
-    ) -> Result<WithInput> {
+    ) -> Result<WithInput<'s>> {
         let mut columns = Vec::new();
         for name in &table.names {
             let r = match system.resolve(name) {
@@ -296,7 +296,7 @@ impl WithInput {
     }
 }
 
-impl Communication for WithInput {
+impl Communication for WithInput<'_> {
     fn propagate(&mut self, core: &mut Core) -> Result<()> {
         self.apply(core, core.clock.t0, false)?;
         self.inner.propagate(core)

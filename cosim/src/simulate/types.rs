@@ -50,8 +50,6 @@ pub struct Experiment {
     /// thread). Each instance is called by one thread at a time; the results are the
     /// same for any number. `ordered` always runs in one thread.
     pub threads: usize,
-    /// Called with the fraction done (0..=1) at each output point.
-    pub progress: Option<fn(f64)>,
     /// Integration method of Model Exchange instances.
     pub solver: crate::me::Solver,
     /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
@@ -72,13 +70,6 @@ pub struct Experiment {
     /// The wall-clock limit of the whole run ([`Error::Timeout`](crate::Error::Timeout), or
     /// [`Error::Host`](crate::Error::Host) when it passes during a call of an isolated instance).
     pub timeout: Option<Duration>,
-    /// Set to true (from any thread) to stop the run between two steps with
-    /// [`Error::Cancelled`](crate::Error::Cancelled), the rows so far kept (a Python caller's
-    /// Ctrl-C).
-    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    /// Values a caller sets while the run is in progress (from another thread, e.g. the
-    /// row sink of a run stepped from outside), applied before the next communication step.
-    pub between_steps: Option<std::sync::Arc<crate::simulate::SetQueue>>,
     /// The relative tolerance told to the Co-Simulation FMUs (`fmi2SetupExperiment`,
     /// `fmi3EnterInitializationMode`) for their internal solvers; `None`: each FMU's
     /// DefaultExperiment tolerance, else none (fmpy's rule). Model Exchange FMUs are told
@@ -98,15 +89,12 @@ impl Experiment {
             record: None,
             profile: false,
             threads: 1,
-            progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
             input: None,
             max_steps: DEFAULT_MAX_STEPS,
             isolation: None,
             timeout: None,
-            cancel: None,
-            between_steps: None,
             co_simulation_tolerance: None,
         }
     }

@@ -240,6 +240,12 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "hostile", xml)
 }
 
+/// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
+/// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
+pub fn build_nanme(dir: &Path) -> PathBuf {
+    build_single_c_fmu(dir, "nanme", include_str!("../cfmu/nanme.xml"))
+}
+
 /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
 pub fn build_ball(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))

@@ -324,21 +324,9 @@ impl MeGroup {
             if t >= t_end - eps {
                 return Ok(());
             }
-            let due: Vec<usize> = members
-                .iter()
-                .copied()
-                .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps))
-                .collect();
-            if !due.is_empty() {
-                self.event(lanes, t, "time", &due)?;
+            // time events due now: the event iteration restarts the method
+            if self.time_events_due(lanes, t, eps)? {
                 s.started = false;
-                self.ended(lanes, t)?;
-                if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
-                    return Err(crate::error::Error::Experiment(format!(
-                        "{}: time event at {t} repeats at the same time",
-                        lanes.instance(*m).name()
-                    )));
-                }
                 continue;
             }
             // a step ends at the earliest time event, at the stop time, and, where an input
