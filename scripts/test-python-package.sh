@@ -4,8 +4,9 @@
 # `python3 -m venv .venv && .venv/bin/pip install "...whl[pandas]" matplotlib`, then the example
 # examples/python_cosim.py), from a fresh folder holding links to target/ and examples/; adds
 # the tests' own dependencies (fmpy, pytest, at the pins of scripts/python-env.sh) to that venv
-# and runs python/tests there. Needs target/release/{cosim,campaign} and target/fmu, target/ssp
-# (the test command builds them first).
+# and runs python/tests there, after mypy's stubtest on the installed package and mypy on
+# python/nigel_cosim (mypy pinned here; either failing fails the script). Needs
+# target/release/{cosim,campaign} and target/fmu, target/ssp (the test command builds them first).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
 target="${CARGO_TARGET_DIR:-$repo/target}"
@@ -36,6 +37,19 @@ venv="$work/.venv"
 requirements="$(mktemp)"
 trap 'rm -f "$requirements"' EXIT
 sed -n '/^requirements=/,/^EOF$/p' "$repo/scripts/python-env.sh" | grep '==' | grep -v -e '^ecospy==' -e '^libcosimpy==' >"$requirements"
+# mypy and its dependencies, pinned: the typing check of the package below
+cat >>"$requirements" <<'EOF'
+mypy==2.4.1
+mypy_extensions==1.2.0
+pathspec==1.1.1
+librt==0.17.0
+ast-serialize==0.13.1
+tomli==2.2.1; python_version < "3.11"
+EOF
 PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-input --quiet "$wheel" -r "$requirements" >&2
 cd "$repo"
+# typing: the stubs of the installed extension (_native.pyi) match what the module defines
+# (names, arguments, defaults: stubtest), and the Python half type-checks against them
+"$venv/bin/python" -m mypy.stubtest --mypy-config-file python/pyproject.toml nigel_cosim nigel_cosim._native
+"$venv/bin/python" -m mypy --config-file python/pyproject.toml python/nigel_cosim
 "$venv/bin/python" -m pytest python/tests -q "$@"

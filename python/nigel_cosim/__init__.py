@@ -22,6 +22,7 @@ import os
 import sys
 import warnings
 from pathlib import Path
+from types import FrameType
 from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
@@ -98,7 +99,8 @@ def _warn_sample_periods(system: "System", args: dict) -> None:
     """`cosim run`'s warning about a communication step longer than an FMU's declared sample
     period, as a Python warning (the run goes on: it is what was asked for)."""
     # the warning points at the user's line: the first frame outside this file
-    level, frame = 1, sys._getframe(0)
+    level = 1
+    frame: FrameType | None = sys._getframe(0)
     while frame is not None and frame.f_code.co_filename == __file__:
         frame, level = frame.f_back, level + 1
     for message in system._native.sample_period_warnings(_Args(args)):
@@ -161,7 +163,7 @@ class System:
         self._native = _native.NativeSystem(os.fspath(filename), fmi_type)
         self._filename = os.fspath(filename)
         self._start_values: dict[str, Any] = {}
-        self._run = None
+        self._run: _native.NativeRun | None = None
         self._step = 1e-3
         self._output_interval = None
         self.last_summary: dict | None = None
@@ -551,6 +553,9 @@ def write_csv(filename: str | os.PathLike, result: np.ndarray, columns: Sequence
     if columns is not None:
         result = result[["time"] + list(columns)]
     names = result.dtype.names
+    if names is None:
+        raise TypeError("write_csv: result must be a structured array (a result of simulate_fmu), "
+                        f"not an array of {result.dtype}")
     with open(filename, "w") as f:
         f.write(",".join(f'"{n}"' for n in names) + "\n")
         for row in result:

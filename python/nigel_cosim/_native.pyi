@@ -1,9 +1,26 @@
 """Type stubs of the Rust half of nigel_cosim (users call the functions of nigel_cosim)."""
 
-from typing import Any
+import os
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
+
+# the names the module exports (pyo3 fills its `__all__` as lib.rs registers them)
+__all__ = [
+    "CampaignError",
+    "Error",
+    "ExperimentError",
+    "LoadError",
+    "NativeRun",
+    "NativeSystem",
+    "RunTimeoutError",
+    "SimulationError",
+    "VariableError",
+    "__version__",
+    "compare",
+    "run_campaign",
+]
 
 __version__: str
 
@@ -15,8 +32,9 @@ class ExperimentError(Error): ...
 class RunTimeoutError(Error): ...
 class CampaignError(Error): ...
 
+@final
 class NativeSystem:
-    def __init__(self, filename: str, fmi_type: str | None = None) -> None: ...
+    def __new__(cls, filename: str | os.PathLike[str], fmi_type: str | None = None) -> NativeSystem: ...
     @property
     def default_experiment(self) -> tuple[float | None, float | None, float | None, float | None]: ...
     @property
@@ -25,6 +43,22 @@ class NativeSystem:
     def notes(self) -> list[str]: ...
     @property
     def closed(self) -> bool: ...
+    def run_times(
+        self,
+        start_time: float | None,
+        stop_time: float | None,
+        step_size: float | None,
+        relative_tolerance: float | None,
+    ) -> tuple[float, float, float, float | None]: ...
+    def fmpy_times(
+        self,
+        co_simulation: bool,
+        start_time: float | None,
+        stop_time: float | None,
+        step_size: float | None,
+        output_interval: float | None,
+        relative_tolerance: float | None,
+    ) -> tuple[float, float, float, float | None]: ...
     def variables(
         self,
     ) -> list[tuple[str, str, str, str, str | None, str | None, str | None]]: ...
@@ -33,6 +67,7 @@ class NativeSystem:
     def start(self, args: Any) -> NativeRun: ...
     def close(self) -> None: ...
 
+@final
 class NativeRun:
     @property
     def time(self) -> float: ...
