@@ -31,8 +31,9 @@
 
 pub mod bdf;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{error, fmi3, fmu, unpack};
+pub use fmi_import::{fmi3, fmu, unpack};
 pub mod defaults;
+pub mod error;
 pub mod exit_guard;
 pub mod mat;
 pub mod me;
@@ -47,7 +48,7 @@ pub mod isolate {
     pub mod whole;
 }
 
-pub use error::{Error, HostEnd, Result, Status};
+pub use error::{Error, HostEnd, ImportError, Result, Status};
 pub use exit_guard::{on_exit_inside_call, ExitInsideCall};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;

@@ -132,7 +132,7 @@ impl MeUnit {
             return Ok(());
         }
         inst.set_continuous_states(x)?;
-        inst.get_derivatives(dx)
+        Ok(inst.get_derivatives(dx)?)
     }
 
     /// `fmi2SetContinuousStates`, not called with no continuous states.
@@ -140,7 +140,7 @@ impl MeUnit {
         if x.is_empty() {
             return Ok(());
         }
-        inst.set_continuous_states(x)
+        Ok(inst.set_continuous_states(x)?)
     }
 
     /// `fmi2GetEventIndicators`, not called with no event indicators.
@@ -148,7 +148,7 @@ impl MeUnit {
         if z.is_empty() {
             return Ok(());
         }
-        inst.get_event_indicators(z)
+        Ok(inst.get_event_indicators(z)?)
     }
 
     /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).

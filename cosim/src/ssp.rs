@@ -189,8 +189,10 @@ impl Flattener<'_> {
             }
             crate::unpack::ArchiveSource::File(file) => {
                 crate::unpack::read_text_file(&file, source, limit).map_err(|e| match e {
-                    Error::Io { source: io, .. } => self.err(format!("{what}: {source:?} ({}): {io}", file.display())),
-                    other => other,
+                    crate::ImportError::Io { source: io, .. } => {
+                        self.err(format!("{what}: {source:?} ({}): {io}", file.display()))
+                    }
+                    other => other.into(),
                 })
             }
         }
@@ -323,13 +325,13 @@ impl Flattener<'_> {
                 }
                 // a missing or unreadable FMU is named by its component and the package
                 let f = Fmu::load_from(&origin, &options).map_err(|e| match e {
-                    Error::Io { path, source: io } => {
+                    crate::ImportError::Io { path, source: io } => {
                         self.err(format!("{what}: cannot read its source {source:?} ({}): {io}", path.display()))
                     }
-                    e @ (Error::Archive { .. } | Error::NotRegularFile { .. } | Error::MissingBinary { .. }) => {
-                        self.err(format!("{what} (source {source:?}): {e}"))
-                    }
-                    other => other,
+                    e @ (crate::ImportError::Archive { .. }
+                    | crate::ImportError::NotRegularFile { .. }
+                    | crate::ImportError::MissingBinary { .. }) => self.err(format!("{what} (source {source:?}): {e}")),
+                    other => other.into(),
                 })?;
                 self.fmus.insert(file.clone(), f.clone());
                 f
@@ -477,8 +479,9 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         // every header checked first; then only the .ssd, the .ssv files named and the
         // FMUs are read, straight from the archive
         let file = crate::unpack::open_regular(path)?;
-        let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file))
-            .map_err(|e| Error::Archive { path: path.to_path_buf(), reason: e.to_string() })?;
+        let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file)).map_err(|e| {
+            Error::Import(crate::ImportError::Archive { path: path.to_path_buf(), reason: e.to_string() })
+        })?;
         let entries: HashMap<PathBuf, String> = crate::unpack::check_entries(&mut zip, path, &options.limits)?
             .into_iter()
             .map(|e| (e.rel, e.name))
@@ -590,7 +593,7 @@ pub const SSP_PARAMETER_SET: &str = "initialValues";
 /// applies each component's first set by default, ecos applies the sets of the one name
 /// given to its `init` (and none without a name), so one name serves both.
 pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
-    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    let io = |source| Error::Import(crate::ImportError::Io { path: path.to_path_buf(), source });
     // FMU files, one per distinct source
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     for spec in &system.instances {
@@ -701,7 +704,9 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
     let options = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .last_modified_time(zip::DateTime::default());
-    let zerr = |e: zip::result::ZipError| Error::Archive { path: path.to_path_buf(), reason: e.to_string() };
+    let zerr = |e: zip::result::ZipError| {
+        Error::Import(crate::ImportError::Archive { path: path.to_path_buf(), reason: e.to_string() })
+    };
     zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
     zip.write_all(x.as_bytes()).map_err(io)?;
     // the FMUs stored, not deflated: they are compressed archives already (deflate gains
@@ -711,7 +716,8 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
         let fmu = system.instances.iter().find(|i| i.fmu.source() == src.as_path()).map(|i| &i.fmu);
         let bytes = match fmu {
             Some(fmu) => fmu.archive_bytes()?,
-            None => std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?,
+            None => std::fs::read(src)
+                .map_err(|source| Error::Import(crate::ImportError::Io { path: src.clone(), source }))?,
         };
         zip.start_file(file.as_str(), stored).map_err(zerr)?;
         zip.write_all(&bytes).map_err(io)?;

@@ -4,18 +4,17 @@
 //! scalars as the FMI 2.0-shaped view of [`crate::fmi3`]). An instance terminates and
 //! frees itself on drop.
 
+use crate::c_types::{CallbackFunctions, Component, Functions, RawStatus};
 use crate::error::{Error, Result, Status};
+use crate::library::{load_functions, load_library};
+use crate::log::{callbacks_for, LogRecord, LogSink};
 use crate::unpack::{ArchiveSource, UnpackLimits};
 use model_description::ModelDescription;
-use std::collections::VecDeque;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
-use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
-
-type Component = fmi_sys::fmi2::fmi2Component;
-type RawStatus = fmi_sys::fmi2::fmi2Status;
+pub use crate::c_types::EventInfo;
 
 /// The FMI interface an instance uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,102 +41,12 @@ impl Interface {
     }
 }
 
-/// `fmi2CallbackFunctions`.
-pub(crate) type CallbackFunctions = fmi_sys::fmi2::Fmi2CallbackFunctions;
-
-/// `fmi2EventInfo`.
-pub use fmi_sys::fmi2::Fmi2EventInfo as EventInfo;
-
-/// The fmi2 functions of a library: the ones every interface needs, the rest optional
-/// (absent when the library lacks them; calling one is then an error naming it).
-pub(crate) use fmi_sys::fmi2::Fmi2Functions as Functions;
-
 /// The functions of an FMU: FMI 2.0's table, or FMI 3.0's with the FMU's own description.
 pub(crate) enum Abi {
     /// FMI 2.0 (in process, or the isolation proxy).
     Fmi2(Functions),
     /// FMI 3.0.
     Fmi3(Box<crate::fmi3::Fmi3Abi>),
-}
-
-/// The callbacks of an instance whose messages go to `log` (the logger shim of fmi-sys
-/// formats them).
-pub(crate) fn callbacks_for(log: &LogSink) -> Box<CallbackFunctions> {
-    Box::new(log.environment.callbacks())
-}
-
-/// One message an FMU logged.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LogRecord {
-    /// The status the FMU gave it.
-    pub status: Status,
-    /// The category.
-    pub category: String,
-    /// The formatted message.
-    pub message: String,
-}
-
-/// The last messages of one instance (at most [`LogSink::CAPACITY`]). Its address is
-/// stable (boxed) while the instance logs to it.
-#[derive(Debug, Default)]
-pub struct LogSink {
-    environment: LogEnvironment<Records>,
-}
-
-#[derive(Debug, Default)]
-struct Records(Mutex<VecDeque<LogRecord>>);
-
-impl LogReceiver for Records {
-    fn receive(&self, m: &LogMessage<'_>) {
-        self.push(LogRecord {
-            status: Status::from_raw(m.status),
-            category: m.category.to_owned(),
-            message: m.message.to_owned(),
-        });
-    }
-}
-
-impl Records {
-    fn push(&self, record: LogRecord) {
-        if let Ok(mut r) = self.0.lock() {
-            if r.len() == LogSink::CAPACITY {
-                r.pop_front();
-            }
-            r.push_back(record);
-        }
-    }
-}
-
-impl LogSink {
-    /// Messages kept per instance.
-    pub const CAPACITY: usize = 64;
-
-    /// Takes the kept messages.
-    pub fn take(&self) -> Vec<LogRecord> {
-        self.environment.0.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
-    }
-
-    /// Keeps `record` (the oldest dropped beyond the capacity).
-    pub(crate) fn push(&self, record: LogRecord) {
-        self.environment.push(record)
-    }
-
-    /// The last messages at Warning or worse, joined, for an error message.
-    fn recent_problems(&self) -> String {
-        let Ok(records) = self.environment.0.lock() else { return String::new() };
-        let v: Vec<&str> =
-            records.iter().rev().filter(|r| r.status != Status::Ok).take(3).map(|r| r.message.as_str()).collect();
-        v.into_iter().rev().collect::<Vec<_>>().join("; ")
-    }
-}
-
-/// Resolves the fmi2 functions of `lib`; a missing required one is an error naming it and
-/// `path`.
-///
-/// # Safety
-/// `lib` must be an FMI 2.0 library whose symbols have these C signatures.
-pub(crate) unsafe fn load_functions(lib: &libloading::Library, path: &Path) -> Result<Functions> {
-    Functions::load(lib).map_err(|missing| Error::MissingSymbol { path: path.to_path_buf(), symbol: missing.0 })
 }
 
 /// The functions each interface needs beyond the common ones (checked at load).
@@ -198,36 +107,6 @@ impl std::fmt::Debug for Fmu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Fmu").field("source", &self.source).field("interface", &self.interface).finish()
     }
-}
-
-/// Libraries loaded so far, by the SHA-256 of their bytes. A binary loaded once stays
-/// loaded for the life of the process and later imports of the same binary share it:
-/// the dynamic loader cannot unload libraries that registered thread-local destructors
-/// (every Rust cdylib using std's thread locals), so loading a fresh copy from each new
-/// temporary folder would map it again and again (about 90 KiB of resident memory per
-/// import of our plant). The cost is bounded by the number of distinct binaries.
-static LIBRARIES: std::sync::OnceLock<Mutex<std::collections::HashMap<[u8; 32], Arc<libloading::Library>>>> =
-    std::sync::OnceLock::new();
-
-pub(crate) fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Arc<libloading::Library>> {
-    use sha2::Digest;
-    let bytes = std::fs::read(so).map_err(|source| Error::Io { path: shown.to_path_buf(), source })?;
-    let key: [u8; 32] = sha2::Sha256::digest(&bytes).into();
-    let cache = LIBRARIES.get_or_init(Default::default);
-    let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(lib) = cache.get(&key) {
-        return Ok(lib.clone());
-    }
-    crate::elf::check_shared_library(&bytes)
-        .map_err(|reason| Error::LoadLibrary { path: shown.to_path_buf(), reason })?;
-    // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
-    let library = unsafe { libloading::Library::new(so) }.map_err(|e| Error::LoadLibrary {
-        path: shown.to_path_buf(),
-        reason: e.to_string().replace(&so.display().to_string(), relative),
-    })?;
-    let library = Arc::new(library);
-    cache.insert(key, library.clone());
-    Ok(library)
 }
 
 /// The text of `modelDescription.xml` of an unpacked FMU (at most `limits.max_xml_bytes`).
@@ -392,8 +271,10 @@ impl Fmu {
             let symbol = [CS_NEEDS, ME_NEEDS].concat().into_iter().find(|s| s == missing).unwrap_or("fmi2?");
             return Err(Error::MissingSymbol { path: shown, symbol });
         }
-        let resource_uri = CString::new(file_uri(&dir.path().join("resources")))
-            .map_err(|_| Error::Experiment("temporary folder path contains NUL".into()))?;
+        let resource_uri = CString::new(file_uri(&dir.path().join("resources"))).map_err(|_| Error::LoadLibrary {
+            path: dir.path().to_path_buf(),
+            reason: "the temporary folder's path contains NUL".into(),
+        })?;
         Ok(Arc::new(Fmu {
             abi: Abi::Fmi2(functions),
             allow_non_finite: options.allow_non_finite,
@@ -483,8 +364,10 @@ impl Fmu {
         }
         let token =
             CString::new(md.instantiation_token.as_str()).map_err(|_| refuse("NUL in instantiationToken".into()))?;
-        let resource_path = crate::fmi3::resource_path(dir.path())
-            .ok_or_else(|| Error::Experiment("temporary folder path contains NUL".into()))?;
+        let resource_path = crate::fmi3::resource_path(dir.path()).ok_or_else(|| Error::LoadLibrary {
+            path: dir.path().to_path_buf(),
+            reason: "the temporary folder's path contains NUL".into(),
+        })?;
         Ok(Arc::new(Fmu {
             abi: Abi::Fmi3(Box::new(crate::fmi3::Fmi3Abi {
                 functions,
@@ -709,7 +592,7 @@ impl std::fmt::Debug for Instance {
 macro_rules! call {
     ($self:ident, $name:literal, $time:expr, $f:expr) => {{
         $self.check_callable($name)?;
-        let mark = crate::call_site::enter(&$self.name, &$self.fmu, $name, $time.unwrap_or($self.time));
+        let mark = crate::call_site::enter(&$self.name, &$self.fmu.source, $name, $time.unwrap_or($self.time));
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
         drop(mark);
@@ -769,7 +652,7 @@ impl Instance {
         };
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
-        let mark = crate::call_site::enter(name, fmu, "fmi2Instantiate", 0.0);
+        let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0);
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (functions.instantiate)(
@@ -832,13 +715,13 @@ impl Instance {
         callbacks: Box<CallbackFunctions>,
     ) -> Result<Instance> {
         let environment = &*log as *const LogSink as *mut c_void;
-        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::fmi3::log_message);
+        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message);
         let missing = |symbol| Error::MissingSymbol { path: fmu.source.clone(), symbol };
         let (function, component) = match fmu.interface {
             Interface::CoSimulation => {
                 let f = abi.functions.instantiate_co_simulation.ok_or(missing("fmi3InstantiateCoSimulation"))?;
                 let event_mode = abi.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode) as u8;
-                let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateCoSimulation", 0.0);
+                let _mark = crate::call_site::enter(name, &fmu.source, "fmi3InstantiateCoSimulation", 0.0);
                 // SAFETY: every pointer is valid for the call; the log outlives the instance.
                 let c = unsafe {
                     f(
@@ -860,7 +743,7 @@ impl Instance {
             }
             Interface::ModelExchange => {
                 let f = abi.functions.instantiate_model_exchange.ok_or(missing("fmi3InstantiateModelExchange"))?;
-                let _mark = crate::call_site::enter(name, fmu, "fmi3InstantiateModelExchange", 0.0);
+                let _mark = crate::call_site::enter(name, &fmu.source, "fmi3InstantiateModelExchange", 0.0);
                 // SAFETY: as above.
                 let c = unsafe {
                     f(name_c.as_ptr(), abi.token.as_ptr(), abi.resource_path.as_ptr(), 0, 0, environment, logger)
@@ -908,7 +791,7 @@ impl Instance {
                 variables,
                 isolation.call_timeout,
                 run_deadline,
-                crate::isolate::Spin::of_run(),
+                crate::isolate::protocol::Spin::of_run(),
             )
             .map_err(|cause| Error::Host {
                 instance: name.into(),
@@ -1102,7 +985,7 @@ impl Instance {
             Abi::Fmi2(t) => self.optional(t.reset, "fmi2Reset")?,
             Abi::Fmi3(a) => self.optional(a.functions.reset, "fmi3Reset")?,
         };
-        let mark = crate::call_site::enter(&self.name, &self.fmu, function, self.time);
+        let mark = crate::call_site::enter(&self.name, &self.fmu.source, function, self.time);
         // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.component) };
         drop(mark);
@@ -1720,8 +1603,10 @@ impl Instance {
     pub fn post_step(&mut self, time: f64, step: f64) -> bool {
         // FMI 3.0: the arguments of the first fmi3DoStep of `do_step_fmi3`
         let (op, step) = match &self.fmu.abi {
-            Abi::Fmi2(t) if t.do_step.is_some() => (crate::isolate::Op::DoStep, step),
-            Abi::Fmi3(a) if a.functions.do_step.is_some() => (crate::isolate::Op::DoStep3, (time + step) - time),
+            Abi::Fmi2(t) if t.do_step.is_some() => (crate::isolate::protocol::Op::DoStep, step),
+            Abi::Fmi3(a) if a.functions.do_step.is_some() => {
+                (crate::isolate::protocol::Op::DoStep3, (time + step) - time)
+            }
             _ => return false,
         };
         let Some(host) = self.host.as_deref_mut() else { return false };
@@ -1960,7 +1845,7 @@ impl Drop for Instance {
                 unsafe { free_state(self.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(&self.name, &self.fmu, function, self.time);
+        let _mark = crate::call_site::enter(&self.name, &self.fmu.source, function, self.time);
         // SAFETY: the component came from the instantiate call and is freed once.
         unsafe { free_instance(self.component) };
     }

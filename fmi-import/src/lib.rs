@@ -15,18 +15,25 @@
 
 #![warn(missing_docs)]
 
+pub mod c_types;
 pub mod call_site;
 pub mod elf;
 pub mod error;
 pub mod fmi3;
 pub mod fmu;
 pub mod isolate;
+pub(crate) mod library;
+pub mod log;
+pub mod status;
 #[doc(hidden)]
 pub mod suggest;
 pub mod unpack;
 
+pub use c_types::EventInfo;
 pub use call_site::ExitInsideCall;
-pub use error::{Error, HostEnd, Result, Status};
+pub use error::{Error, HostEnd, Result};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
+pub use log::{LogRecord, LogSink};
+pub use status::Status;
 pub use unpack::UnpackLimits;

@@ -10,13 +10,13 @@
 //! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
 //! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
 
+use model_description::DefaultExperiment;
+use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
     simulate::{default_record, simulate_with},
     Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, SetQueue,
     Solver, Summary, System, SystemBuilder,
 };
-use model_description::DefaultExperiment;
-use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
@@ -58,24 +58,27 @@ create_exception!(nigel_cosim, CampaignError, Error, "A campaign description or 
 /// The Python exception of a master error.
 fn to_py(e: CosimError) -> PyErr {
     let message = e.to_string();
+    use nigel_cosim::ImportError as I;
     use CosimError as E;
     match e {
-        E::Io { .. }
-        | E::NotRegularFile { .. }
-        | E::Archive { .. }
-        | E::UnsafeEntry { .. }
-        | E::ArchiveLimit { .. }
-        | E::ModelDescription { .. }
-        | E::NoInterface { .. }
-        | E::MissingBinary { .. }
-        | E::LoadLibrary { .. }
-        | E::MissingSymbol { .. }
+        E::Import(
+            I::Io { .. }
+            | I::NotRegularFile { .. }
+            | I::Archive { .. }
+            | I::UnsafeEntry { .. }
+            | I::ArchiveLimit { .. }
+            | I::ModelDescription { .. }
+            | I::NoInterface { .. }
+            | I::MissingBinary { .. }
+            | I::LoadLibrary { .. }
+            | I::MissingSymbol { .. },
+        )
         | E::Ssp { .. } => LoadError::new_err(message),
         E::UnknownVariable { .. }
         | E::NotInView { .. }
         | E::UnknownInstance { .. }
         | E::NoInstance { .. }
-        | E::InvalidValue { .. }
+        | E::Import(I::InvalidValue { .. })
         | E::Connection { .. } => VariableError::new_err(message),
         E::Timeout { .. } => RunTimeoutError::new_err(message),
         E::Experiment(_) => ExperimentError::new_err(message),
@@ -184,12 +187,10 @@ impl NativeSystem {
             experiment.record = Some(output.iter().map(|n| self.qualify(n)).collect());
         }
         if let Some(t) = args.timeout {
-            experiment.timeout = Some(
-                Duration::try_from_secs_f64(t)
-                    .ok()
-                    .filter(|d| !d.is_zero())
-                    .ok_or_else(|| CosimError::Experiment(format!("timeout {t} must be a positive number of seconds")))?,
-            );
+            experiment.timeout =
+                Some(Duration::try_from_secs_f64(t).ok().filter(|d| !d.is_zero()).ok_or_else(|| {
+                    CosimError::Experiment(format!("timeout {t} must be a positive number of seconds"))
+                })?);
         }
         if args.threads == 0 {
             return Err(CosimError::Experiment("threads must be at least 1".into()));
@@ -346,7 +347,9 @@ impl NativeSystem {
 
     /// One tuple per variable: (name, type, causality, variability, start as text or None,
     /// unit or None, description or None); names are `instance.variable` for an SSP.
-    fn variables(&self) -> PyResult<Vec<(String, String, String, String, Option<String>, Option<String>, Option<String>)>> {
+    fn variables(
+        &self,
+    ) -> PyResult<Vec<(String, String, String, String, Option<String>, Option<String>, Option<String>)>> {
         let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
         let system = guard.as_ref().ok_or_else(|| Error::new_err("the system is closed"))?;
         let mut out = Vec::new();
@@ -411,7 +414,9 @@ impl NativeSystem {
         }
         experiment.record = Some(record.clone());
         let names: Vec<String> = match &self.single {
-            Some(instance) => record.iter().map(|n| n.strip_prefix(&format!("{instance}.")).unwrap_or(n).to_string()).collect(),
+            Some(instance) => {
+                record.iter().map(|n| n.strip_prefix(&format!("{instance}.")).unwrap_or(n).to_string()).collect()
+            }
             None => record.clone(),
         };
         NativeRun::start(py, system, experiment, names, types, self.single.clone())
@@ -546,7 +551,9 @@ impl NativeRun {
                         return Err(e);
                     }
                 }
-                Err(RecvTimeoutError::Disconnected) => break RunEvent::Finished(Err(CosimError::Cancelled { time: f64::NAN })),
+                Err(RecvTimeoutError::Disconnected) => {
+                    break RunEvent::Finished(Err(CosimError::Cancelled { time: f64::NAN }))
+                }
             }
         };
         let mut state = self.state.lock().unwrap_or_else(|p| p.into_inner());
@@ -615,11 +622,9 @@ impl NativeRun {
 
     /// The recorded value of `name` at the current time.
     fn get(&self, name: &str) -> PyResult<f64> {
-        let j = self
-            .names
-            .iter()
-            .position(|n| n == name)
-            .ok_or_else(|| VariableError::new_err(format!("{name:?} is not recorded in this run (add it to output=)")))?;
+        let j = self.names.iter().position(|n| n == name).ok_or_else(|| {
+            VariableError::new_err(format!("{name:?} is not recorded in this run (add it to output=)"))
+        })?;
         let rows = self.rows.lock().unwrap_or_else(|p| p.into_inner());
         let width = self.names.len() + 1;
         let k = rows.len().checked_sub(width).ok_or_else(|| Error::new_err("the run has no row yet"))?;

@@ -201,7 +201,8 @@ fn progress(fraction: f64) {
 /// The `--set`s that run the controller FMU of the closed loop with the gain of a
 /// `synthesize --json` report: `controller = 4` (custom) and the eight `k_*` parameters.
 fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| Error::Import(nigel_cosim::ImportError::Io { path: path.to_path_buf(), source }))?;
     let k =
         nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
     let mut sets = vec![("controller.controller".to_string(), "4".to_string())];
@@ -366,7 +367,9 @@ fn run(args: RunArgs) -> Result<(), Error> {
         );
     }
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
-        std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
+        std::fs::File::create(path)
+            .and_then(f)
+            .map_err(|source| Error::Import(nigel_cosim::ImportError::Io { path: path.to_path_buf(), source }))
     };
     // the rows recorded so far are written also when the run failed
     if let (Some(path), Some(format)) = (&args.output, format) {

@@ -29,7 +29,13 @@ impl SetQueue {
     pub fn push_text(&self, system: &System, name: &str, text: &str) -> Result<()> {
         let r = system.resolve(name)?;
         let v = system.variable(&r);
-        let bad = |reason: String| Error::InvalidValue { variable: name.to_string(), value: text.to_string(), reason };
+        let bad = |reason: String| {
+            Error::Import(crate::ImportError::InvalidValue {
+                variable: name.to_string(),
+                value: text.to_string(),
+                reason,
+            })
+        };
         if !(v.causality == Causality::Input || v.variability == Variability::Tunable) {
             return Err(bad(format!(
                 "a {} {} variable cannot be set during a run (only inputs and tunable parameters)",

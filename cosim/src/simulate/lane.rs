@@ -82,7 +82,7 @@ impl Lane {
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
-                Err(e) => Err(ended_or(&mut self.inst, e, t)),
+                Err(e) => Err(ended_or(&mut self.inst, e.into(), t)),
             },
             (None, Some(state)) => {
                 self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
@@ -184,7 +184,9 @@ pub(crate) const FMI3_TERMINATED: &str = "fmi3DoStep returned terminateSimulatio
 /// last point it reached, if it cannot say), anything else is `e`.
 #[cold]
 fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
-    if matches!(e, Error::Fmi { status: crate::Status::Discard, .. }) && inst.terminated_status() == Some(true) {
+    if matches!(e, Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. }))
+        && inst.terminated_status() == Some(true)
+    {
         let time = inst.last_successful_time().filter(|x| x.is_finite()).unwrap_or(t);
         let reason = if inst.is_fmi3() { FMI3_TERMINATED } else { DISCARD_TERMINATED };
         return Error::Terminated { instance: inst.name().to_string(), time, reason };
@@ -197,9 +199,9 @@ fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
 /// (`fmi2Terminated`). Returns the number of retries.
 fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
     inst.update_state(state)?;
-    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e, t)) {
+    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e.into(), t)) {
         Ok(()) => Ok(0),
-        Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
+        Err(Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. })) if depth < 10 => {
             inst.set_state(state)?;
             let half = 0.5 * dt;
             let a = step_with_retry(inst, state, t, half, depth + 1)?;
