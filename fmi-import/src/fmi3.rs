@@ -1,6 +1,6 @@
 //! What an FMI 3.0 FMU needs beyond the FMI 2.0 import: its function table, its own model
-//! description, the view of it the master's systems, observers and writers see, the log
-//! callback, and what is refused at load.
+//! description, the view of it the master's systems, observers and writers see, and what
+//! is refused at load. The calls on the view's variables are `instance/fmi3.rs`.
 //!
 //! The view is an FMI 2.0-shaped [`ModelDescription`] of the FMU's variables, with the same
 //! names, value references, causalities, variabilities, units and ModelStructure (indices

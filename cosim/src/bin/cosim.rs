@@ -657,7 +657,7 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         };
     }
     let mut out = std::io::stdout().lock();
-    if let Some(md) = nigel_cosim::fmu::read_fmi3_description(path, limits)? {
+    if let Some(md) = nigel_cosim::load::read_fmi3_description(path, limits)? {
         info_fmi3(&mut out, &md);
         return Ok(());
     }
