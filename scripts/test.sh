@@ -102,6 +102,13 @@ asan_builds() {
         --features fmu-plant/fmi-export,fmu-controller/fmi-export,fmu-maneuver/fmi-export
 }
 background asan-builds asan_builds
+# the third-party corpus (../shared/corpus: FMUs and SSPs nobody here wrote) through the corpus's
+# own runners, one case at a time, beside the tests' runs; its table is printed below
+if [ -d ../shared/corpus ]; then
+    background conformance bash scripts/conformance.sh "$target_dir/release/cosim" ../shared/corpus
+else
+    echo "no ../shared/corpus beside the project: the third-party conformance cases are not run"
+fi
 cargo test --release --workspace --no-fail-fast
 wait_for asan-builds
 # the test executables of this build, for the steps below that run some again: a `cargo test
@@ -150,4 +157,9 @@ stage "the Python package: its wheel in a fresh venv, against fmpy and the comma
 bash scripts/test-python-package.sh
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
+if [ -d ../shared/corpus ]; then
+    stage "third-party conformance (run beside the Rust tests): the table"
+    wait_for conformance
+    cat "$target_dir/background-conformance.log"
+fi
 stage_summary
