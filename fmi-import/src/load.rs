@@ -17,6 +17,9 @@ use crate::fmu::{Abi, Fmu, ImportOptions, Interface};
 use crate::library::load_library;
 use crate::unpack::{ArchiveSource, UnpackLimits};
 
+/// What instantiation needs besides the table (see [`Generation::finish`]).
+type Loaded = (Abi, CString, Vec<(String, crate::fmi3::LeftOut)>);
+
 /// What loading an FMU differs in between the generations.
 trait Generation {
     /// The library's function table.
@@ -48,12 +51,7 @@ trait Generation {
     /// The table and what instantiation needs besides (FMI 2.0: the resources URI; FMI
     /// 3.0: the instantiation token and the resource path), and the variables the view
     /// leaves out.
-    fn finish(
-        table: Self::Table,
-        described: Self::Described,
-        dir: &Path,
-        path: &Path,
-    ) -> Result<(Abi, CString, Vec<(String, crate::fmi3::LeftOut)>)>;
+    fn finish(table: Self::Table, described: Self::Described, dir: &Path, path: &Path) -> Result<Loaded>;
 }
 
 /// FMI 2.0.
@@ -127,12 +125,7 @@ impl Generation for Fmi2 {
         }
     }
 
-    fn finish(
-        table: Functions,
-        _: (),
-        dir: &Path,
-        _: &Path,
-    ) -> Result<(Abi, CString, Vec<(String, crate::fmi3::LeftOut)>)> {
+    fn finish(table: Functions, _: (), dir: &Path, _: &Path) -> Result<Loaded> {
         let resource_uri = CString::new(file_uri(&dir.join("resources"))).map_err(|_| nul_in_folder(dir))?;
         Ok((Abi::Fmi2(Arc::new(table)), resource_uri, Vec::new()))
     }
@@ -200,7 +193,7 @@ impl Generation for Fmi3 {
         (md, special, not_in_view): Fmi3Described,
         dir: &Path,
         path: &Path,
-    ) -> Result<(Abi, CString, Vec<(String, crate::fmi3::LeftOut)>)> {
+    ) -> Result<Loaded> {
         let token = CString::new(md.instantiation_token.as_str()).map_err(|_| Error::ModelDescription {
             path: path.to_path_buf(),
             reason: "NUL in instantiationToken".into(),
