@@ -4,10 +4,10 @@ plant, robust controller and lane-change test bench, 30 s at 1 ms, ordered), its
 small Monte Carlo campaign as a pandas DataFrame, and a figure.
 
     bash scripts/run.sh                                  # target/ssp, target/wheels
-    python -m venv venv && venv/bin/pip install target/wheels/nigel_cosim-*.whl matplotlib pandas
-    venv/bin/python examples/python_cosim.py [OUT.png]
+    python3 -m venv .venv && .venv/bin/pip install "target/wheels/nigel_cosim-0.1.0-cp310-abi3-manylinux2014_x86_64.manylinux_2_17_x86_64.whl[pandas]" matplotlib
+    .venv/bin/python examples/python_cosim.py [OUT.png]      # or target/venv/bin/python, made by run.sh
 
-Prints (the sim lane change with the robust controller, seed 0, as `table3` computes it):
+Prints (the sim lane change with the robust controller, seed 0, `ordered`, as `table3` computes it):
 
     epsilon 4.204754401e-02 (RMSE X 0.0007 m, Y 0.0419 m, psi 0.00383 rad)
     mass 2.4 kg: epsilon ...

@@ -186,18 +186,3 @@ def test_the_closed_loop_in_fmpy_simulate_ssp_is_cosim_jacobi_but_its_first_step
     rel = abs(eps - cosim_jacobi["eps"]) / cosim_jacobi["eps"]
     assert 1e-7 < rel <= 1e-4, (eps, cosim_jacobi)
     assert abs(y - cosim_jacobi["y"]) <= 1e-5, (y, cosim_jacobi)
-
-
-def test_the_readme_quick_start_runs():
-    """The Python block of the README's quick start prints what its comment says."""
-    readme = (REPO / "README.md").read_text()
-    start = readme.index("## Quick start")
-    quick = readme[start:readme.index("\n## ", start + 1)]
-    assert len(quick.strip().splitlines()) <= 30
-    code = re.search(r"```python\n(.*?)```", quick, re.S).group(1)
-    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
-    printed = [float(v) for v in r.stdout.split()]
-    said = [float(v.rstrip(".")) for v in re.search(r"# (\S+) (\S+) (\S+) \[m, m, rad\]", code).groups()]
-    # the comment gives 10 digits: equal to them
-    assert all(abs(p - s) < 1e-9 * abs(s) for p, s in zip(printed, said)), (printed, said)
-    assert "cosim -- run target/ssp/nigel_closed_loop.ssp" in quick and "target/results" in quick

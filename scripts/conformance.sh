@@ -32,5 +32,7 @@ run_part fmi2 "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$
 run_part fmi2-bdf "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2-bdf" --only me/ --solver bdf --json "$work/fmi2-bdf.json"
 run_part fmi3 "$corpus/fmi3.py" --suite "$corpus/fmi3" --cosim "$cosim" --work "$work/fmi3" --json "$work/fmi3.json"
 run_part ssp "$corpus/ssp.py" "$cosim" "$corpus/ssp" --work "$work/ssp" --json "$work/ssp.json"
-leftover=$(find "$TMPDIR" -mindepth 1 -maxdepth 1 | head -5)
+# cosim unpacks into nigel-cosim-* folders and removes them, also after a failed run (fmpy
+# leaves its own tmp* folders behind: not ours to judge)
+leftover=$(find "$TMPDIR" -mindepth 1 -maxdepth 1 -name "nigel-cosim-*" | head -5)
 exec "$python" scripts/conformance_table.py "$work" scripts/conformance-known.txt ${leftover:+--leftover "$leftover"}

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs the system packages and cross toolchains (as the test command does),
 # builds every binary of the workspace into target/release/ (cosim, cosim-host, campaign,
-# table3, synthesize, build-fmu, ...), the Python package's wheel into target/wheels/, the three FMUs for all four platforms (the release
+# table3, synthesize, build-fmu, ...), the Python package's wheel into target/wheels/ and the venv
+# of the README's quick start (target/venv: fmpy, pandas, matplotlib and nigel_cosim), the three FMUs for all four platforms (the release
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
 # target/fmu/ and the closed loop as SSP into target/ssp/, co-simulates that closed loop with our master (30 s at 1 ms, ordered), runs
 # the paper's Table III and Fig. 7 through the FMUs, and synthesizes the robust controller
@@ -18,7 +19,9 @@ echo "== building every binary of the workspace (target/release)"
 cargo build --release --quiet --workspace --bins
 
 echo "== the Python package's wheel (target/wheels: pip install it into any CPython >= 3.10)"
-bash scripts/python-wheel.sh
+wheel="$(bash scripts/python-wheel.sh)"
+echo "== the venv of the README's quick start: target/venv with fmpy, pandas, matplotlib and nigel_cosim"
+bash scripts/python-venv-wheel.sh "$wheel"
 
 echo "== building the FMUs (all four platforms) and the closed-loop SSP"
 cargo run --release --quiet -p build-fmu -- --platforms all

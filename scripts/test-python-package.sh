@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Tests the Python package as a user gets it: builds the wheel (scripts/python-wheel.sh),
-# installs it into a new venv (target/wheel-venv, made afresh each time) with only the
-# tests' own dependencies (fmpy, pandas, matplotlib, pytest, at the pins of
-# scripts/python-env.sh), and
-# runs python/tests there. Needs target/release/{cosim,campaign} and target/fmu, target/ssp
+# Tests the Python package as a user gets it: builds the wheel (scripts/python-wheel.sh), runs
+# README.md's block that installs it into a venv of one's own, as printed (readme-install:
+# `python3 -m venv .venv && .venv/bin/pip install "...whl[pandas]" matplotlib`, then the example
+# examples/python_cosim.py), from a fresh folder holding links to target/ and examples/; adds
+# the tests' own dependencies (fmpy, pytest, at the pins of scripts/python-env.sh) to that venv
+# and runs python/tests there. Needs target/release/{cosim,campaign} and target/fmu, target/ssp
 # (the test command builds them first).
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -13,9 +14,24 @@ case "$target" in
     *) target="$repo/$target" ;;
 esac
 wheel="$(bash "$repo/scripts/python-wheel.sh")"
-venv="$target/wheel-venv"
-rm -rf "$venv"
-"${PYTHON:-python3}" -m venv "$venv"
+work="$target/wheel-user"
+rm -rf "$work" "$target/wheel-venv"
+mkdir -p "$work"
+ln -s "$target" "$work/target"
+ln -s "$repo/examples" "$work/examples"
+# readme-install: the README's ```sh block with `pip install`, run as printed
+install_block="$(python3 - "$repo/README.md" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+blocks = [b for b in re.findall(r"^```sh\n(.*?)^```", text, re.S | re.M) if "pip install" in b]
+assert len(blocks) == 1, f"README.md: {len(blocks)} blocks with pip install, expected 1"
+print(blocks[0])
+PY
+)"
+echo "$install_block" >&2
+(cd "$work" && PIP_DISABLE_PIP_VERSION_CHECK=1 bash -euo pipefail -c "$install_block")
+[ -f "$work/target/python_cosim.png" ] || { echo "README.md's install block did not draw target/python_cosim.png" >&2; exit 1; }
+venv="$work/.venv"
 # the pins of the test venv (scripts/python-env.sh), but not the other masters
 requirements="$(mktemp)"
 trap 'rm -f "$requirements"' EXIT

@@ -141,6 +141,11 @@ done
 unset NIGEL_FMU_LIBRARIES
 stage "synthesis tests under two more OpenBLAS kernels"
 bash scripts/test-blas-kernels.sh
+stage "the Python package: its wheel in a fresh venv (README.md's install line), against fmpy and the command lines"
+bash scripts/test-python-package.sh
+# the wheel also into target/venv, as the main command does: the README's quick start (run
+# by tests/python/test_doc_figures.py) imports nigel_cosim and fmpy from one venv
+bash scripts/python-venv-wheel.sh >/dev/null
 stage "fmpy cross-checks"
 # (tests/python/test_fmi3_archives.py: the FMI 3.0 archives against the FMI 2.0 ones, and the
 # own-controller example's two archives, which it builds with `cargo run -p own-controller`)
@@ -153,8 +158,6 @@ stage "examples (each prints what its header says; checked against table3)"
 "$target_dir/venv/bin/python" -m pytest examples -q
 stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
-stage "the Python package: its wheel in a fresh venv, against fmpy and the command lines"
-bash scripts/test-python-package.sh
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
 if [ -d ../shared/corpus ]; then

@@ -8,7 +8,8 @@
 //!   loading the system once; rows written as they finish; failed, crashed and timed-out
 //!   runs are rows with their status and message; the stop time checked before the first run.
 //! - [`results`]: the output folder's files; [`merge`] joins shards; [`slurm`] writes and
-//!   submits the job array; [`report`] summarises (markdown, JSON, PNG).
+//!   submits the job array; [`report`] summarises (markdown, JSON, PNG); [`ci`] makes the
+//!   runs a JUnit report.
 //!
 //! ```no_run
 //! use nigel_campaign::{spec::Spec, run::{run, Options}};
@@ -20,8 +21,10 @@
 
 #![warn(missing_docs)]
 
+pub mod ci;
 pub mod merge;
-pub mod metric;
+/// The metric language, shared with `cosim run --check`.
+pub use nigel_cosim::metric;
 pub mod report;
 pub mod results;
 pub mod rng;

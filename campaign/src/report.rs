@@ -194,16 +194,24 @@ fn metric_index(spec: &Spec, name: &str) -> Result<usize, Error> {
 /// Draws the mesh of a report chart: axis descriptions `$x_desc` and `$y_desc`, ticks as
 /// [`tick`] writes them, light grey grid lines; a drawing error returns from the function
 /// as `$err` makes it (a macro: the charts' coordinate types differ).
+/// Labels asked of plotters on a linear axis (its default) and on a log axis: a log axis
+/// over one and a half decades needs every 1 .. 9 multiple labelled (15 and more), else
+/// plotters labels one decade and leaves the other bare.
+const LINEAR_LABELS: usize = 10;
+const LOG_LABELS: usize = 30;
+
 macro_rules! draw_mesh {
-    ($chart:expr, $x_desc:expr, $y_desc:expr, $err:expr) => {
+    ($chart:expr, $x_desc:expr, $y_desc:expr, $err:expr, $x_log:expr, $y_log:expr) => {
         $chart
             .configure_mesh()
+            .x_labels(if $x_log { LOG_LABELS } else { LINEAR_LABELS })
+            .y_labels(if $y_log { LOG_LABELS } else { LINEAR_LABELS })
             .x_desc($x_desc)
             .y_desc($y_desc)
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 16))
-            .x_label_formatter(&|v: &f64| tick(*v))
-            .y_label_formatter(&|v: &f64| tick(*v))
+            .x_label_formatter(&|v: &f64| if $x_log { log_tick(*v) } else { tick(*v) })
+            .y_label_formatter(&|v: &f64| if $y_log { log_tick(*v) } else { tick(*v) })
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(200, 200, 200))
             .draw()
@@ -400,7 +408,7 @@ impl Report {
         self.cdf(m, &path)?;
         out.push(path);
         for (k, c) in self.spec.columns.iter().enumerate() {
-            if matches!(c.domain, crate::spec::Domain::Random(_)) {
+            if matches!(c.domain, crate::spec::Domain::Random(_)) && !is_seed(c) {
                 let path = dir.join(format!("{}_vs_{}.png", file_safe(name), file_safe(&c.name)));
                 self.scatter(m, k, &path)?;
                 out.push(path);
@@ -439,7 +447,8 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                draw_mesh!(chart, name.as_str(), "fraction of runs <= value", err);
+                let x_log = matches!(axis, Axis::Log(..));
+                draw_mesh!(chart, name.as_str(), "fraction of runs <= value", err, x_log, false);
                 for (i, (_, v)) in series.iter().enumerate() {
                     let n = v.len() as f64;
                     let pts: Vec<(f64, f64)> = v.iter().enumerate().map(|(k, x)| (*x, (k + 1) as f64 / n)).collect();
@@ -498,7 +507,8 @@ impl Report {
         macro_rules! draw {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                draw_mesh!(chart, self.spec.columns[column].name.as_str(), name.as_str(), err);
+                let y_log = matches!(y_axis, Axis::Log(..));
+                draw_mesh!(chart, self.spec.columns[column].name.as_str(), name.as_str(), err, false, y_log);
                 for (i, (_, pts)) in series.iter().enumerate() {
                     chart
                         .draw_series(pts.iter().map(|p| {
@@ -655,8 +665,19 @@ pub enum Axis {
     Log(f64, f64),
 }
 
-/// More than this ratio of the largest to the smallest value (two decades) draws a log axis.
-pub const LOG_AXIS_RATIO: f64 = 100.0;
+/// A random column that is a noise seed (integers drawn into a variable named `seed`): its
+/// values are labels of random streams with no order, so a metric plotted against it shows
+/// nothing; [`Report::pngs`] draws no scatter for it.
+fn is_seed(c: &crate::spec::Column) -> bool {
+    let named_seed = |n: &str| n.rsplit(['.', '_']).next().is_some_and(|last| last.eq_ignore_ascii_case("seed"));
+    matches!(c.domain, crate::spec::Domain::Random(crate::spec::Distribution::Integers(..)))
+        && (named_seed(&c.name) || c.targets.iter().any(|v| named_seed(v)))
+}
+
+/// More than this ratio of the largest to the smallest value (one decade) draws a log axis:
+/// a metric such as epsilon spans a decade between maneuvers, and on a linear axis the
+/// groups of the small values are squashed against zero.
+pub const LOG_AXIS_RATIO: f64 = 10.0;
 
 /// Share of the span (of the decades on a log axis) left free at each end of an axis, so
 /// that no point sits on the frame.
@@ -664,14 +685,24 @@ pub const AXIS_PAD: f64 = 0.04;
 
 impl Axis {
     /// The axis of `values` (non-finite ones left out): logarithmic when all are positive
-    /// and span more than two decades ([`LOG_AXIS_RATIO`]), else linear; padded by
+    /// and span more than a decade ([`LOG_AXIS_RATIO`]), else linear; padded by
     /// [`AXIS_PAD`] at each end.
     pub fn of(values: &[f64]) -> Axis {
         let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
         let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
         if lo > 0.0 && hi / lo > LOG_AXIS_RATIO {
             let pad = AXIS_PAD * (hi / lo).log10();
-            return Axis::Log(lo / 10f64.powf(pad), hi * 10f64.powf(pad));
+            let (mut lo, hi) = (lo / 10f64.powf(pad), hi * 10f64.powf(pad));
+            // plotters labels a log axis from its first power of ten up: where the values
+            // reach more than a factor 2 below it, the axis starts at the power of ten below
+            // (else those values would have no label at all)
+            let below = 10f64.powf(lo.log10().floor());
+            if 10.0 * below / lo > 2.0 {
+                // a hair below it, so that plotters' ceil(log10(lo)) is that power of ten
+                // (log10(0.01) in floating point may come out a hair above -2)
+                lo = below * (1.0 - 1e-9);
+            }
+            return Axis::Log(lo, hi);
         }
         Axis::linear(&v)
     }
@@ -700,6 +731,17 @@ impl Axis {
 
 /// Tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
 /// powers beyond 1e-4 .. 1e5 as `1e-5`; never `-0`.
+/// A log axis's label: 1, 2 and 5 times a power of ten (the other multiples get grid lines
+/// but no label: nine labels a decade run into each other at the decade's top).
+fn log_tick(v: f64) -> String {
+    let mantissa = v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0, 10.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
+        tick(v)
+    } else {
+        String::new()
+    }
+}
+
 fn tick(v: f64) -> String {
     if v == 0.0 {
         return "0".into();
@@ -819,12 +861,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn an_axis_is_logarithmic_when_the_values_span_more_than_two_decades() {
+    fn an_axis_is_logarithmic_when_the_values_span_more_than_a_decade() {
         // 1e-3 .. 1: three decades, padded by 4 % of them (10^0.12) at each end
         let Axis::Log(lo, hi) = Axis::of(&[1e-3, 0.02, 1.0]) else { panic!("log expected") };
         assert!((lo - 1e-3 / 10f64.powf(0.12)).abs() < 1e-15 && (hi - 10f64.powf(0.12)).abs() < 1e-12);
-        // exactly two decades, a zero, a negative value: linear, padded by 4 % of the span
-        assert_eq!(Axis::of(&[0.01, 1.0]), Axis::Linear(0.01 - 0.0396, 1.0 + 0.0396));
+        // exactly one decade, a zero, a negative value: linear, padded by 4 % of the span
+        assert_eq!(Axis::of(&[0.1, 1.0]), Axis::Linear(0.1 - 0.036, 1.0 + 0.036));
+        // a decade and a half (the example's lane change against its skidpad): log, from 0.01,
+        // the power of ten below the values (0.04 is a factor 2.5 below the first one, 0.1)
+        let Axis::Log(lo, _) = Axis::of(&[0.04, 1.3]) else { panic!("log expected") };
+        assert_eq!(lo, 0.01 * (1.0 - 1e-9));
         assert!(matches!(Axis::of(&[0.0, 1e-6, 1.0]), Axis::Linear(..)));
         assert!(matches!(Axis::of(&[-1e-3, 1e-5, 10.0]), Axis::Linear(..)));
         // non-finite values are left out; nothing left: [0, 1]
@@ -832,6 +878,25 @@ mod tests {
         assert_eq!(Axis::of(&[f64::NAN]), Axis::Linear(0.0, 1.0));
         // one value: a range around it
         assert_eq!(Axis::of(&[2.0, 2.0]), Axis::Linear(1.0, 3.0));
+    }
+
+    #[test]
+    fn a_noise_seed_gets_no_scatter() {
+        use crate::spec::{Column, Distribution, Domain, Scalar};
+        let column = |name: &str, targets: &[&str], domain: Domain| Column {
+            name: name.into(),
+            targets: targets.iter().map(|t| t.to_string()).collect(),
+            domain,
+        };
+        let ints = || Domain::Random(Distribution::Integers(0, 1000));
+        // the example's and the robustness study's test-bench seed
+        assert!(is_seed(&column("maneuver.seed", &["maneuver.seed"], ints())));
+        assert!(is_seed(&column("noise", &["plant.noise_seed"], ints())));
+        // a drawn quantity, an integer that is not a seed, a seed given on a grid
+        assert!(!is_seed(&column("plant.m", &["plant.m"], Domain::Random(Distribution::Uniform(2.4, 3.0)))));
+        assert!(!is_seed(&column("maneuver.maneuver", &["maneuver.maneuver"], ints())));
+        assert!(!is_seed(&column("maneuver.seed", &["maneuver.seed"], Domain::Grid(vec![Scalar::Integer(1)]))));
+        assert!(!is_seed(&column("seeds_per_cell", &["x.seeds"], ints())));
     }
 
     #[test]
@@ -847,6 +912,13 @@ mod tests {
         for not in ["the mass of the car", "1 open_loop", "1 a, 1 b", "1 a, two b", "1 a b, 2 c", "1 a (x, 2 b"] {
             assert_eq!(items_in_description(not), None, "{not}");
         }
+    }
+
+    #[test]
+    fn a_log_axis_labels_1_2_and_5_times_a_power_of_ten() {
+        let t: Vec<String> =
+            [0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.2 + 1e-12, 0.9, 50.0].iter().map(|v| log_tick(*v)).collect();
+        assert_eq!(t, ["0.01", "0.02", "", "0.05", "", "0.1", "0.2", "", "50"]);
     }
 
     #[test]

@@ -7,7 +7,8 @@
 //!   as well as pandas: `status` 0 = ok, 1 = the run failed (the FMU or the master
 //!   returned an error, or a value was refused), 2 = the run panicked, 3 = an FMU ended
 //!   the run before the stop time (metrics over the points it had), 4 = the run's worker
-//!   process crashed or exited, 5 = the run passed the description's `timeout`; `message` 1 when
+//!   process crashed or exited, 5 = the run passed the description's `timeout`, 6 = the run
+//!   completed and failed one of the description's `[checks]`; `message` 1 when
 //!   the run left a message in `messages.csv` (columns `run`, `status`, `message`, text),
 //!   else 0; a case column holds the case's index (its names are in `campaign.json`);
 //!   Booleans are 0 / 1; numbers in Rust's shortest round-trip form (`NaN` for a metric a
@@ -41,6 +42,10 @@ pub const STATUS_CRASHED: u8 = 4;
 /// steps, or its worker process killed while a call did not return.
 pub const STATUS_TIMEOUT: u8 = 5;
 
+/// Status of a run that completed and failed one of the description's `[checks]` (its
+/// metrics are those of the whole run; the message names the checks that failed).
+pub const STATUS_CHECK_FAILED: u8 = 6;
+
 /// The status in words.
 pub fn status_name(status: u8) -> &'static str {
     match status {
@@ -50,6 +55,7 @@ pub fn status_name(status: u8) -> &'static str {
         STATUS_ENDED => "ended by an FMU before the stop time",
         STATUS_CRASHED => "crashed",
         STATUS_TIMEOUT => "timed out",
+        STATUS_CHECK_FAILED => "failed a check",
         _ => "unknown",
     }
 }
@@ -89,7 +95,7 @@ pub struct Row {
     /// The run's number.
     pub run: u64,
     /// [`STATUS_OK`], [`STATUS_FAILED`], [`STATUS_PANICKED`], [`STATUS_ENDED`],
-    /// [`STATUS_CRASHED`] or [`STATUS_TIMEOUT`].
+    /// [`STATUS_CRASHED`], [`STATUS_TIMEOUT`] or [`STATUS_CHECK_FAILED`].
     pub status: u8,
     /// What went wrong (empty when ok).
     pub message: String,

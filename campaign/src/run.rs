@@ -20,12 +20,14 @@ use std::time::{Duration, Instant};
 
 use nigel_cosim::{simulate, simulate_with, Experiment, InstancePool, Results, System};
 
-use crate::metric::Accumulators;
 use crate::results::{
-    self, Appender, Row, Target, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED, STATUS_TIMEOUT,
+    self, Appender, Row, Target, STATUS_CHECK_FAILED, STATUS_ENDED, STATUS_FAILED, STATUS_OK, STATUS_PANICKED,
+    STATUS_TIMEOUT,
 };
 use crate::spec::{load_system, RunValues, Spec};
 use crate::Error;
+use nigel_cosim::check::CheckAccumulators;
+use nigel_cosim::metric::Accumulators;
 
 /// How to run.
 #[derive(Clone, Debug)]
@@ -128,14 +130,13 @@ pub fn experiment(spec: &Spec, record: Vec<String>) -> Experiment {
     e
 }
 
-/// The variables the metrics read.
+/// The variables the metrics read, then those only the checks read.
 pub fn metric_variables(spec: &Spec) -> Vec<String> {
     let mut vars: Vec<String> = Vec::new();
-    for (_, m) in &spec.metrics {
-        for v in m.variables() {
-            if !vars.contains(&v) {
-                vars.push(v);
-            }
+    let read = spec.metrics.iter().map(|(_, m)| m.variables()).chain(spec.checks.iter().map(|(_, c)| c.variables()));
+    for v in read.flatten() {
+        if !vars.contains(&v) {
+            vars.push(v);
         }
     }
     vars
@@ -214,33 +215,45 @@ impl<'a> Worker<'a> {
         let values = self.spec.values(i);
         let nan_metrics = || vec![f64::NAN; self.spec.metrics.len()];
         let mut inside = Duration::ZERO;
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(
-            || -> Result<(Vec<f64>, Option<String>), (String, bool)> {
-                let system = self.spec.system_of(&self.base, &values).map_err(|e| (e, false))?;
-                let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
-                // every row after the first: the communication points t_1 .. t_N
-                let mut first = true;
-                let mut sink = |_t: f64, row: &[f64]| {
-                    if first {
-                        first = false;
-                    } else {
-                        acc.push(row);
-                    }
-                };
-                // the master's time limit (checked between steps) is the run's timeout
-                let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
-                    .map_err(|e| (e.to_string(), matches!(e, nigel_cosim::Error::Timeout { .. })))?;
-                inside = summary.wall_time;
-                // an FMU that ends the run before the stop time: the metrics cover fewer points
-                let ended = summary.ended_by.map(|(instance, t, reason)| {
-                    format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
-                });
-                Ok((acc.values(), ended))
-            },
-        ));
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| -> Result<Judged, (String, bool)> {
+            let system = self.spec.system_of(&self.base, &values).map_err(|e| (e, false))?;
+            let mut acc = Accumulators::new(self.spec.metrics.iter().map(|(_, m)| m), &self.record);
+            let checks: Vec<_> = self.spec.checks.iter().map(|(_, c)| c.clone()).collect();
+            let mut judge = CheckAccumulators::new(&checks, &self.record).map_err(|e| (e, false))?;
+            // the metrics: every row after the first, the communication points t_1 .. t_N;
+            // the checks: every row, t_0 .. t_N (as `cosim run --check`)
+            let mut first = true;
+            let mut sink = |_t: f64, row: &[f64]| {
+                judge.push(row);
+                if first {
+                    first = false;
+                } else {
+                    acc.push(row);
+                }
+            };
+            // the master's time limit (checked between steps) is the run's timeout
+            let (_, summary) = simulate_with(&system, &self.experiment, Some(&mut self.pool), Some(&mut sink))
+                .map_err(|e| (e.to_string(), matches!(e, nigel_cosim::Error::Timeout { .. })))?;
+            inside = summary.wall_time;
+            // an FMU that ends the run before the stop time: the metrics cover fewer points
+            let ended = summary.ended_by.map(|(instance, t, reason)| {
+                format!("ended at t = {t} s by {instance} ({reason}), before the stop time")
+            });
+            let failed_checks: Vec<String> = self
+                .spec
+                .checks
+                .iter()
+                .zip(judge.verdicts())
+                .filter(|(_, v)| !v.holds)
+                .map(|((name, _), v)| format!("check {name}: {}", v.failure()))
+                .collect();
+            Ok((acc.values(), ended, failed_checks))
+        }));
         let (status, message, metrics) = match outcome {
-            Ok(Ok((m, None))) => (STATUS_OK, String::new(), m),
-            Ok(Ok((m, Some(ended)))) => (STATUS_ENDED, ended, m),
+            Ok(Ok((m, None, failed))) if failed.is_empty() => (STATUS_OK, String::new(), m),
+            // an FMU that ended the run early outranks the checks (which saw fewer points)
+            Ok(Ok((m, Some(ended), _))) => (STATUS_ENDED, ended, m),
+            Ok(Ok((m, None, failed))) => (STATUS_CHECK_FAILED, failed.join("; "), m),
             Ok(Err((e, true))) => (STATUS_TIMEOUT, e, nan_metrics()),
             Ok(Err((e, false))) => (STATUS_FAILED, e, nan_metrics()),
             Err(p) => {
@@ -267,6 +280,9 @@ impl<'a> Worker<'a> {
         simulate(&system, &e).map(|(r, _)| r).map_err(|e| e.to_string())
     }
 }
+
+/// A completed run: its metrics, how an FMU ended it early (if one did), the checks it failed.
+type Judged = (Vec<f64>, Option<String>, Vec<String>);
 
 /// Where the rows go as they arrive: the target's files (each row written at once, so a
 /// killed campaign keeps every finished run), the progress bar, the counts.

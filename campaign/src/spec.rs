@@ -14,9 +14,10 @@ use model_description::VariableType;
 use nigel_cosim::{Algorithm, BaseType, System, SystemBuilder, Value};
 use sha2::{Digest, Sha256};
 
-use crate::metric::Metric;
 use crate::rng;
 use crate::Error;
+use nigel_cosim::check::Check;
+use nigel_cosim::metric::Metric;
 
 /// A value written into a variable: the description's TOML scalar, typed.
 #[derive(Clone, Debug, PartialEq)]
@@ -130,6 +131,9 @@ pub struct Spec {
     pub columns: Vec<Column>,
     /// The metrics, in the order written.
     pub metrics: Vec<(String, Metric)>,
+    /// The checks (`[checks]`, name = "max(abs(plant.y)) < 0.6"), in the order written: a
+    /// run whose check fails is a failed run ([`crate::results::STATUS_CHECK_FAILED`]).
+    pub checks: Vec<(String, Check)>,
     /// SHA-256 of the description's text and of the system file's bytes (hex): what a
     /// shard and an output folder are checked against.
     pub hash: String,
@@ -467,11 +471,12 @@ impl Spec {
                 "cases",
                 "random",
                 "metrics",
+                "checks",
             ]
             .contains(&k.as_str())
             {
                 return Err(bad(format!(
-                    "unknown key {k:?} (expected system, stop_time, step, algorithm, timeout, seed, samples, grid, cases, random, metrics)"
+                    "unknown key {k:?} (expected system, stop_time, step, algorithm, timeout, seed, samples, grid, cases, random, metrics, checks)"
                 )));
             }
         }
@@ -553,6 +558,16 @@ impl Spec {
                 metrics.push((k.clone(), m));
             }
         }
+        let mut checks = Vec::new();
+        if let Some(t) = section("checks")? {
+            for (k, v) in t {
+                let e = v.as_str().ok_or_else(|| {
+                    bad(format!("[checks] {k:?}: expected a check such as \"max(abs(plant.y)) < 0.6\", got {v}"))
+                })?;
+                let c = Check::parse(e).map_err(|m| bad(format!("[checks] {k:?}: {m}")))?;
+                checks.push((k.clone(), c));
+            }
+        }
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
         let system_bytes = std::fs::read(&system).map_err(|e| bad(format!("{}: {e}", system.display())))?;
@@ -573,6 +588,7 @@ impl Spec {
                 samples,
                 columns,
                 metrics,
+                checks,
                 hash,
             },
             loaded,
@@ -610,6 +626,11 @@ impl Spec {
         for (name, m) in &self.metrics {
             for v in m.variables() {
                 system.resolve(&v).map_err(|e| format!("[metrics] {name:?}: unknown variable {v}: {e}"))?;
+            }
+        }
+        for (name, c) in &self.checks {
+            for v in c.variables() {
+                system.resolve(&v).map_err(|e| format!("[checks] {name:?}: unknown variable {v}: {e}"))?;
             }
         }
         // the first run's values go through the master's own checks (causality, settable)

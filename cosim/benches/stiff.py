@@ -21,7 +21,8 @@ Time of a run: cosim the whole process (start, unpack, load, run, CSV), fmpy the
 nor the import of fmpy). Each round runs every (case, tolerance) once with each tool, the
 tool first in the pair alternating from round to round; printed: per case and tolerance the
 median time over the rounds, the range (min .. max), and the error (deterministic). With PNG,
-error against median time, log-log, one panel per case.
+error against median time, log-log, one panel per case (cosim/benches/stiff_figure.py, which
+also redraws it from the table docs/performance.md records).
 
 Then the phase of van der Pol at rtol 1e-3 .. 1e-5 (mu = 1e3, 1e4, 1e5): the time of the first
 fast transition in each tool's run (rows 1/20,000 of mu apart) against Radau's, as a relative
@@ -36,6 +37,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "python"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 from stiff_reference import (CASES, TRANSITION_RESOLUTION, case_fmus, case_reference, relative_error,  # noqa: E402
                              run_cosim, run_cvode, transition_errors, vdp_transition_reference)
 
@@ -114,42 +116,9 @@ for mu in TRANSITION_MUS:
 print(f"raw results: {work / 'results.json'}")
 
 if png:
-    import matplotlib
+    from stiff_figure import draw
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, grid = plt.subplots(2, 3, figsize=(13.0, 8.0))
-    axes = list(grid.flat)
-    axes[-1].axis("off")
-    axes[-1].text(0.0, 0.5, "each point: one rtol (its label), median time over the rounds\n"
-                  "cosim bdf: the whole cosim process\nfmpy CVode: the simulate_fmu call\n"
-                  "error: largest |x - x_ref| / max(1, |x_ref|) over the rows\n"
-                  "references: Radau (SciPy) on the equations / over the\nFMU's right-hand side; the ball's closed form",
-                  fontsize=9, va="center")
-    for ax, case in zip(axes, CASES):
-        label = case[0]
-        for tool, style in zip(TOOLS, ("o-", "s--")):
-            pts = [(statistics.median(times[(label, r, tool)]), errors[(label, r, tool)], r) for r in RTOLS
-                   if math.isfinite(errors[(label, r, tool)])]
-            if pts:
-                line, = ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, label=tool)
-                for t, e, r in pts:
-                    ax.annotate(f"{r:.0e}", (t, e), fontsize=6, color=line.get_color(), xytext=(3, 3),
-                                textcoords="offset points")
-            failed = [r for r in RTOLS if (label, r, tool) in failures]
-            if failed:
-                ax.text(0.02, 0.02 if tool == TOOLS[0] else 0.08,
-                        f"{tool} failed (mxstep) at rtol {', '.join(f'{r:.0e}' for r in failed)}",
-                        transform=ax.transAxes, fontsize=7)
-        ax.set_title(label, fontsize=9)
-        ax.set_xlabel("time of the run, s (median)")
-        ax.grid(True, which="both", alpha=0.3)
-    for ax in (axes[0], axes[3]):
-        ax.set_ylabel("error vs the reference")
-    axes[0].legend(fontsize=7)
-    fig.suptitle(f"work-precision, rtol 1e-3 .. 1e-10, {rounds} rounds alternated: cosim process vs fmpy simulate_fmu",
-                 fontsize=11)
-    fig.tight_layout()
-    fig.savefig(png, dpi=110)
+    finished = {k: (statistics.median(times[k]), errors[k]) for k in times
+                if k not in failures and math.isfinite(errors[k])}
+    draw([case[0] for case in CASES], RTOLS, finished, set(failures), rounds, png)
     print(f"wrote {png}")

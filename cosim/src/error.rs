@@ -102,6 +102,10 @@ pub enum Error {
     },
     /// The experiment is not simulable as given (times, step, output interval).
     Experiment(String),
+    /// The Model Exchange integration cannot go on with what an FMU returned with OK (a NaN
+    /// state derivative, a NaN next event time, infinite derivatives): the message names
+    /// the instance, its FMU, the call and the time.
+    Integration(String),
     /// An SSP file is malformed or uses a part this master does not support.
     Ssp {
         /// The file.
@@ -168,6 +172,7 @@ impl fmt::Display for Error {
             }
             Error::Cancelled { time } => write!(f, "the run was cancelled at t = {time} s"),
             Error::Experiment(m) => write!(f, "experiment: {m}"),
+            Error::Integration(m) => f.write_str(m),
             Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
         }
     }

@@ -1,8 +1,8 @@
-//! `nigel_cosim`: an FMI 2.0 co-simulation master.
+//! `nigel_cosim`: an FMI 2.0 and FMI 3.0 co-simulation master (FMUs and SSP systems).
 //!
-//! - [`Fmu::load`] imports any FMI 2.0 `.fmu` safely ([`unpack`]: no path escapes, no
+//! - [`Fmu::load`] imports any FMI 2.0 or FMI 3.0 `.fmu` safely ([`unpack`]: no path escapes, no
 //!   links, limits against archive bombs) and resolves the functions of its interface;
-//!   [`Instance`] wraps every fmi2 call in a typed [`Result`].
+//!   [`Instance`] wraps every FMI call in a typed [`Result`].
 //! - [`SystemBuilder`] makes a [`System`] of instances, start values and connections
 //!   checked for type, causality and unit.
 //! - [`simulate()`] runs it with fixed-step Co-Simulation, [`Algorithm::Jacobi`] or
@@ -11,12 +11,18 @@
 //!   bit-identical results); Model Exchange instances integrated by the master ([`me`]),
 //!   those connected to each other advancing together with one event iteration across
 //!   them ([`Error::EventIteration`] when it has no fixed point).
+//! - [`simulate::Execution`]: a run advanced by its caller (`initialize`, `step`,
+//!   `simulate_until`, `get`/`set` between steps, [`simulate::Observer`]s); [`simulate()`]
+//!   and its variants are loops over it.
 //! - [`InputTable`]: input signals over time (fmpy's `input=`), [`Experiment::input`];
 //!   [`Results::write_mat`] writes MAT v4 as Dymola does ([`mat`]).
 //! - [`isolate`]: instances in host processes of their own ([`Experiment::isolation`]),
 //!   a crash or hang of an FMU being [`Error::Host`] with the rows so far
 //!   ([`simulate::simulate_recorded`]); in process, an FMU that calls `exit()` inside a
 //!   call ends the process with status 1, reported with the rows so far ([`exit_guard`]).
+//! - CI: [`check`]s of a run in the [`metric`] language, [`compare`]d with a baseline in
+//!   tolerance tubes, reported as JUnit XML and Markdown ([`junit`]); [`verify`] joins them
+//!   for `cosim run`.
 //!
 //! ```no_run
 //! use nigel_cosim::{Fmu, System, Experiment, simulate};
@@ -30,6 +36,8 @@
 #![warn(missing_docs)]
 
 pub mod bdf;
+pub mod check;
+pub mod compare;
 pub(crate) use fmi_import::suggest;
 pub use fmi_import::{fmi3, instance, load, unpack};
 /// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
@@ -43,11 +51,16 @@ pub mod fmu {
 pub mod defaults;
 pub mod error;
 pub mod exit_guard;
+pub mod junit;
+pub mod loops;
 pub mod mat;
 pub mod me;
+pub mod metric;
+pub mod sample_period;
 pub mod simulate;
 pub mod ssp;
 pub mod system;
+pub mod verify;
 
 /// Isolation: instances in host processes of their own ([`fmi_import::isolate`]), and the
 /// whole run in one host process ([`isolate::whole`]).

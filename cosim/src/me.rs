@@ -82,6 +82,9 @@ pub struct MeUnit {
     pub terminated: bool,
     /// The work of the bdf solver of this instance's group (held by its first member).
     pub stiff: crate::bdf::Work,
+    /// What the solver did differently from what the FMU declares (a directional
+    /// derivative that disagrees with finite differences, not used), one sentence each.
+    pub notes: Vec<String>,
 }
 
 impl MeUnit {
@@ -105,6 +108,7 @@ impl MeUnit {
             rejected: 0,
             terminated: false,
             stiff: crate::bdf::Work::default(),
+            notes: Vec::new(),
         }
     }
 
@@ -126,13 +130,19 @@ impl MeUnit {
 
     /// The time and the derivatives at (t, x); with no continuous states only the time
     /// (the state functions are never called with nx = 0: some FMUs refuse it).
+    /// A NaN derivative returned with OK is an error naming the FMU, the call and the time
+    /// (integrated on, it would make every later state NaN without a word).
     pub(crate) fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
         inst.set_time(t)?;
         if x.is_empty() {
             return Ok(());
         }
         inst.set_continuous_states(x)?;
-        Ok(inst.get_derivatives(dx)?)
+        inst.get_derivatives(dx)?;
+        if dx.iter().any(|d| d.is_nan()) {
+            return Err(nan_derivative(inst, t, dx));
+        }
+        Ok(())
     }
 
     /// `fmi2SetContinuousStates`, not called with no continuous states.
@@ -202,6 +212,9 @@ impl MeUnit {
             let _ = head;
         }
         // xt is the 5th-order solution (stage 7 = FSAL point), k[6] = f(t + h, xt)
+        // a NaN error estimate (infinite stages: inf - inf) is kept, never dropped by max, so
+        // that no such step is accepted; a zero error is zero also where the scale is (a
+        // state at zero with atol = 0)
         let mut err = 0.0f64;
         for j in 0..n {
             let mut e = 0.0;
@@ -209,7 +222,10 @@ impl MeUnit {
                 e += c * self.k[r][j];
             }
             let scale = atol + rtol * self.x0[j].abs().max(self.xt[j].abs());
-            err = err.max((h * e / scale).abs());
+            let he = h * e;
+            if he != 0.0 {
+                err = nan_max(err, (he / scale).abs());
+            }
         }
         Ok(err)
     }
@@ -270,6 +286,40 @@ impl MeUnit {
     pub(crate) fn first_crossing(&self) -> usize {
         self.z0.iter().zip(&self.z).position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0)).unwrap_or(0)
     }
+}
+
+/// The larger of `a` and `b`, NaN if either is (`f64::max` drops a NaN).
+#[inline]
+pub(crate) fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+/// The error of a NaN state derivative the FMU returned with OK.
+#[cold]
+fn nan_derivative(inst: &Instance, t: f64, dx: &[f64]) -> crate::error::Error {
+    let k = dx.iter().position(|d| d.is_nan()).unwrap_or(0);
+    let md = inst.fmu().description();
+    let variable = md
+        .state_derivatives()
+        .get(k)
+        .and_then(|d| md.variable_at(*d))
+        .map_or_else(|| format!("state derivative {}", k + 1), |v| v.name.clone());
+    let call = if inst.is_fmi3() { "fmi3GetContinuousStateDerivatives" } else { "fmi2GetDerivatives" };
+    let ok = if inst.is_fmi3() { "fmi3OK" } else { "fmi2OK" };
+    crate::error::Error::Integration(format!(
+        "{} ({}): {call} returned {variable} = NaN with {ok} at t = {t} s",
+        inst.name(),
+        fmu_file(inst)
+    ))
+}
+
+/// The file name of the instance's FMU.
+pub(crate) fn fmu_file(inst: &Instance) -> String {
+    inst.fmu().source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// The Illinois method on a bracket [lo, hi] of a crossing, to [`EVENT_TIME_TOLERANCE`]:

@@ -1,19 +1,28 @@
-//! SSP 1.0 import (`.ssp` archives and bare `.ssd` files) into a [`System`], and export of
-//! a [`System`] built in Rust as an `.ssp` that fmpy, ecos and libcosim can run.
+//! SSP 1.0 import (`.ssp` archives and bare `.ssd` files) into a [`System`]; the values
+//! it applies are `ssp/parameters.rs`, the export of a [`System`] as an `.ssp` is
+//! `ssp/write.rs`.
 //!
-//! Supported: Components of type `application/x-fmu-sharedlibrary`, their Connectors,
-//! Connections with `LinearTransformation` (factor defaults to 1, offset to 0),
-//! `suppressUnitConversion`, ParameterBindings inline or from `.ssv` files (with
-//! `prefix`), nested Systems (flattened: instance names are the element paths joined
-//! with `.`; connections through system connectors are followed), DefaultExperiment.
-//! Refused by name: signal dictionaries, parameter mappings, other transformations,
-//! other component types. Geometry, annotations and graphical elements are ignored.
+//! Supported (docs/ssp.md says it in full): Components of type
+//! `application/x-fmu-sharedlibrary`, their Connectors, Connections in the direction
+//! their connectors' kinds give (start and end carry none) with `LinearTransformation`
+//! and `suppressUnitConversion`, ParameterBindings inline or from `.ssv` files (with
+//! `prefix`, units of values converted) through ParameterMappings (`.ssm` or inline,
+//! with their transformations), values of system connectors, nested Systems (flattened:
+//! instance names are the element paths joined with `.`; connections through system
+//! connectors are followed), DefaultExperiment. Refused by name: signal dictionaries,
+//! array connectors, mapping transformations on connections, other component types.
+//! Geometry, annotations and graphical elements are ignored.
+
+mod parameters;
+mod write;
+pub use write::{write_ssp, SSP_PARAMETER_SET};
 
 use crate::error::{Error, Result};
 use crate::fmu::{Fmu, ImportOptions};
-use crate::system::{BaseType, System, SystemBuilder, Value};
+use crate::system::{BaseType, System, SystemBuilder};
+use model_description::Causality;
+use parameters::{value_for, Bound, ParameterValue, Transformation};
 use std::collections::HashMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -103,6 +112,16 @@ pub struct SspSystem {
     pub system: System,
     /// `DefaultExperiment` start and stop time, if given.
     pub default_start_stop: (Option<f64>, Option<f64>),
+    /// The name of the root system.
+    pub root_name: String,
+    /// What was read that the standard leaves to the importer or that changes no value
+    /// (parameter values matching no variable, units taken as written, an SSD of the 2.0
+    /// draft): said, not silent. `cosim run` prints each as a note.
+    pub notes: Vec<String>,
+    /// Every value the SSD applies, one line each, with where it comes from (a binding,
+    /// a parameter mapping and its transformation, a system connector's value, a unit
+    /// conversion): what `cosim info` lists.
+    pub applied: Vec<String>,
     /// The `.ssp` file (`None` for a bare `.ssd`).
     archive: Option<PathBuf>,
 }
@@ -125,6 +144,21 @@ enum Node {
     SystemConnector { system: String, connector: String },
 }
 
+/// Which way data flows through one end of a connection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Flow {
+    Out,
+    In,
+}
+
+/// What a parameter value of a binding names, resolved: a variable of an instance or a
+/// connector of a system.
+#[derive(Clone, Debug)]
+enum Target {
+    Variable { instance: String, variable: String },
+    Connector { system: String, connector: String },
+}
+
 struct Flattener<'a> {
     root: &'a Path,
     path: &'a Path,
@@ -133,18 +167,39 @@ struct Flattener<'a> {
     options: &'a ImportOptions,
     fmus: HashMap<PathBuf, Arc<Fmu>>,
     builder: SystemBuilder,
-    /// edges (from, to, factor, offset, suppress_unit_conversion)
+    root_name: String,
+    /// (from, to, factor, offset, suppress_unit_conversion), in the direction of the data
     edges: Vec<Edge>,
-    /// declared system connectors: (system path, connector name)
-    connectors: std::collections::HashSet<(String, String)>,
-    parameters: Vec<(String, String, String)>, // (instance.variable, type, value text)
+    /// declared system connectors: (system path, connector name) -> kind
+    connectors: HashMap<(String, String), String>,
+    /// the elements of every system: system path -> element name -> is a system
+    elements: HashMap<String, HashMap<String, bool>>,
+    /// values bound to FMU variables, in the order they apply (the last one wins)
+    bound: Vec<(String, String, Bound)>,
+    /// values bound to system connectors (the last one wins)
+    connector_values: HashMap<(String, String), Bound>,
+    notes: Vec<String>,
 }
 
 const FMU_TYPE: &str = "application/x-fmu-sharedlibrary";
 
+/// Connector types of a Real variable, and of an Integer (or Enumeration) one.
+const REAL_TYPES: [&str; 3] = ["Real", "Float64", "Float32"];
+const INTEGER_TYPES: [&str; 10] =
+    ["Integer", "Enumeration", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64"];
+
 impl Flattener<'_> {
     fn err(&self, reason: String) -> Error {
         Error::Ssp { path: self.path.to_path_buf(), reason }
+    }
+
+    /// A system as messages name it: the root by its name, the others by their path.
+    fn shown(&self, system: &str) -> String {
+        if system.is_empty() {
+            format!("root system {:?}", self.root_name)
+        } else {
+            format!("system {system:?}")
+        }
     }
 
     /// The relative path `source` names inside the package.
@@ -198,108 +253,216 @@ impl Flattener<'_> {
         }
     }
 
+    /// The XML document of the file `source` (a `.ssv` or `.ssm`), its root element checked.
+    fn read_document(&self, source: &str, sbase: Option<&str>, what: &str, root: &str) -> Result<Element> {
+        if sbase.is_some_and(|b| b != "SSD") {
+            return Err(self.err(format!(
+                "{what}: sourceBase={:?} is not supported (files of the package, sourceBase=\"SSD\", are)",
+                sbase.unwrap_or("")
+            )));
+        }
+        let rel = self.resource(source)?;
+        let text = self.read_text(&rel, what, source)?;
+        let doc = parse_xml(&text, &self.path.join(&rel))?;
+        if doc.name != root {
+            return Err(self.err(format!("{what} {source:?} has the root element <{}>, not <{root}>", doc.name)));
+        }
+        Ok(doc)
+    }
+
     fn system(&mut self, el: &Element, prefix: &str) -> Result<()> {
         let here = |name: &str| if prefix.is_empty() { name.to_string() } else { format!("{prefix}.{name}") };
-        for unsupported in ["SignalDictionaries"] {
-            if el.child(unsupported).is_some() {
-                return Err(self.err(format!("system {prefix:?}: {unsupported} are not supported")));
-            }
+        if el.child("SignalDictionaries").is_some() {
+            return Err(self.err(format!(
+                "{}: SignalDictionaries are not supported (signal dictionaries and their references are refused)",
+                self.shown(prefix)
+            )));
         }
         if let Some(connectors) = el.child("Connectors") {
             for c in connectors.all("Connector") {
                 let name = c.attr("name").unwrap_or("");
-                if !self.connectors.insert((prefix.to_string(), name.to_string())) {
-                    return Err(self.err(format!("system {prefix:?}: connector {name:?} is declared twice")));
+                let kind = c.attr("kind").unwrap_or("").to_string();
+                if self.connectors.insert((prefix.to_string(), name.to_string()), kind).is_some() {
+                    return Err(self.err(format!("{}: connector {name:?} is declared twice", self.shown(prefix))));
                 }
             }
         }
-        // element name -> whether it is a nested system
-        let mut elements: HashMap<&str, bool> = HashMap::new();
+        let mut elements: HashMap<String, bool> = HashMap::new();
         if let Some(list) = el.child("Elements") {
             for e in &list.children {
                 let name = e.attr("name").ok_or_else(|| self.err(format!("an element {} without name", e.name)))?;
                 if name.contains('.') || name.is_empty() || elements.contains_key(name) {
-                    return Err(self.err(format!("element name {name:?}: empty, containing '.' or repeated")));
+                    return Err(self.err(format!(
+                        "{}: element name {name:?}: empty, containing '.' or repeated",
+                        self.shown(prefix)
+                    )));
                 }
-                elements.insert(name, e.name == "System");
+                elements.insert(name.to_string(), e.name == "System");
                 match e.name.as_str() {
                     "Component" => self.component(e, &here(name))?,
                     "System" => self.system(e, &here(name))?,
-                    other => return Err(self.err(format!("element {name:?}: {other} is not supported"))),
+                    "SignalDictionaryReference" => {
+                        return Err(self.err(format!(
+                            "{}: element {name:?}: SignalDictionaryReference is not supported (signal dictionaries are refused)",
+                            self.shown(prefix)
+                        )))
+                    }
+                    other => {
+                        return Err(self.err(format!(
+                            "{}: element {name:?}: {other} is not supported",
+                            self.shown(prefix)
+                        )))
+                    }
                 }
             }
         }
+        self.elements.insert(prefix.to_string(), elements);
+        // the system's bindings after those of its elements: a higher level wins
         if let Some(bindings) = el.child("ParameterBindings") {
-            self.bindings(bindings, prefix, true)?;
+            self.bindings(bindings, prefix, false)?;
         }
         if let Some(connections) = el.child("Connections") {
             for c in connections.all("Connection") {
-                let start =
-                    c.attr("startConnector").ok_or_else(|| self.err("Connection without startConnector".into()))?;
-                let end = c.attr("endConnector").ok_or_else(|| self.err("Connection without endConnector".into()))?;
-                let shown = |element: Option<&str>, connector: &str| match element {
-                    Some(e) => format!("{e}.{connector}"),
-                    None => connector.to_string(),
-                };
-                let what = format!(
-                    "connection {} -> {} of system {prefix:?}",
-                    shown(c.attr("startElement"), start),
-                    shown(c.attr("endElement"), end)
-                );
-                // a component's variable, or a connector of this system or of a nested one
-                let node = |element: Option<&str>, connector: &str| -> Result<Node> {
-                    let system = match element {
-                        None => prefix.to_string(),
-                        Some(e) => match elements.get(e) {
-                            None => {
-                                let mut known: Vec<&str> = elements.keys().copied().collect();
-                                known.sort_unstable();
-                                return Err(self.err(format!(
-                                    "{what}: names an unknown element {e:?}{}",
-                                    crate::suggest::did_you_mean(e, known.iter().copied(), "elements")
-                                )));
-                            }
-                            Some(false) => {
-                                return Ok(Node::Variable { instance: here(e), variable: connector.to_string() })
-                            }
-                            Some(true) => here(e),
-                        },
-                    };
-                    if !self.connectors.contains(&(system.clone(), connector.to_string())) {
-                        let mut declared: Vec<&str> =
-                            self.connectors.iter().filter(|(s, _)| *s == system).map(|(_, c)| c.as_str()).collect();
-                        declared.sort_unstable();
-                        return Err(self.err(format!(
-                            "{what}: system {system:?} declares no connector {connector:?}{}",
-                            crate::suggest::did_you_mean(connector, declared.iter().copied(), "its connectors")
-                        )));
-                    }
-                    Ok(Node::SystemConnector { system, connector: connector.to_string() })
-                };
-                let (from, to) = (node(c.attr("startElement"), start)?, node(c.attr("endElement"), end)?);
-                let (mut factor, mut offset) = (1.0, 0.0);
-                for t in &c.children {
-                    match t.name.as_str() {
-                        "LinearTransformation" => {
-                            let num = |a: &str, d: f64| -> Result<f64> {
-                                t.attr(a).map_or(Ok(d), |v| {
-                                    model_description::parse_xs_double(v).filter(|x| x.is_finite()).ok_or_else(|| {
-                                        self.err(format!("LinearTransformation {a}={v:?} is not a finite number"))
-                                    })
-                                })
-                            };
-                            factor = num("factor", 1.0)?;
-                            offset = num("offset", 0.0)?;
-                        }
-                        "ConnectionGeometry" | "Annotations" => {}
-                        other => return Err(self.err(format!("{what}: {other} is not supported"))),
-                    }
-                }
-                let suppress = c.attr("suppressUnitConversion") == Some("true");
-                self.edges.push((from, to, factor, offset, suppress));
+                self.connection(c, prefix)?;
             }
         }
         Ok(())
+    }
+
+    /// One connection of the system `prefix`: its ends resolved, its direction decided by
+    /// the kinds of its connectors (SSP 1.0: start and end carry no direction).
+    fn connection(&mut self, c: &Element, prefix: &str) -> Result<()> {
+        let here = |name: &str| if prefix.is_empty() { name.to_string() } else { format!("{prefix}.{name}") };
+        let start = c.attr("startConnector").ok_or_else(|| self.err("Connection without startConnector".into()))?;
+        let end = c.attr("endConnector").ok_or_else(|| self.err("Connection without endConnector".into()))?;
+        // startElement="" (as OMSimulator writes it) or absent: the system itself
+        let (start_el, end_el) =
+            (c.attr("startElement").filter(|e| !e.is_empty()), c.attr("endElement").filter(|e| !e.is_empty()));
+        let shown = |element: Option<&str>, connector: &str| match element {
+            Some(e) => format!("{e}.{connector}"),
+            None => connector.to_string(),
+        };
+        let what = format!("connection {} -> {} of {}", shown(start_el, start), shown(end_el, end), self.shown(prefix));
+        for a in ["startIndices", "endIndices"] {
+            if c.attr(a).is_some() {
+                return Err(self.err(format!("{what}: {a} (array connectors) is not supported")));
+            }
+        }
+        let elements = self.elements.get(prefix).cloned().unwrap_or_default();
+        // a component's variable, or a connector of this system or of a nested one
+        let node = |element: Option<&str>, connector: &str| -> Result<Node> {
+            let system = match element {
+                None => prefix.to_string(),
+                Some(e) => match elements.get(e) {
+                    None => {
+                        let mut known: Vec<&str> = elements.keys().map(String::as_str).collect();
+                        known.sort_unstable();
+                        return Err(self.err(format!(
+                            "{what}: names an unknown element {e:?}{}",
+                            crate::suggest::did_you_mean(e, known.iter().copied(), "elements")
+                        )));
+                    }
+                    Some(false) => return Ok(Node::Variable { instance: here(e), variable: connector.to_string() }),
+                    Some(true) => here(e),
+                },
+            };
+            if !self.connectors.contains_key(&(system.clone(), connector.to_string())) {
+                let mut declared: Vec<&str> =
+                    self.connectors.keys().filter(|(s, _)| *s == system).map(|(_, c)| c.as_str()).collect();
+                declared.sort_unstable();
+                return Err(self.err(format!(
+                    "{what}: {} declares no connector {connector:?}{}",
+                    self.shown(&system),
+                    crate::suggest::did_you_mean(connector, declared.iter().copied(), "its connectors")
+                )));
+            }
+            Ok(Node::SystemConnector { system, connector: connector.to_string() })
+        };
+        let (a, b) = (node(start_el, start)?, node(end_el, end)?);
+        let (fa, fb) = (self.flow(&a, prefix), self.flow(&b, prefix));
+        let reversed = match (fa, fb) {
+            (Some(Flow::Out), Some(Flow::Out)) | (Some(Flow::In), Some(Flow::In)) => {
+                let side = if fa == Some(Flow::Out) { "sources (outputs)" } else { "destinations (inputs)" };
+                return Err(Error::Connection {
+                    from: shown(start_el, start),
+                    to: shown(end_el, end),
+                    reason: format!(
+                        "in {}: both ends are {side} by their kinds ({} and {}): not an output to an input",
+                        self.shown(prefix),
+                        self.kind_of(&a, prefix),
+                        self.kind_of(&b, prefix)
+                    ),
+                });
+            }
+            (Some(Flow::In), _) | (_, Some(Flow::Out)) => true,
+            _ => false,
+        };
+        let mut linear = (1.0, 0.0);
+        for t in &c.children {
+            match Transformation::read(t) {
+                Some(Ok(Transformation::Linear(f, o))) => linear = (f, o),
+                Some(Ok(other)) => {
+                    return Err(self.err(format!(
+                        "{what}: {} on a connection is not supported (LinearTransformation is; \
+                         mapping transformations are supported in parameter mappings)",
+                        other.name()
+                    )))
+                }
+                Some(Err(why)) => return Err(self.err(format!("{what}: {why}"))),
+                None if matches!(t.name.as_str(), "ConnectionGeometry" | "Annotations") => {}
+                None => return Err(self.err(format!("{what}: {} is not supported", t.name))),
+            }
+        }
+        let suppress = c.attr("suppressUnitConversion") == Some("true");
+        let (from, to) = if reversed { (b, a) } else { (a, b) };
+        self.edges.push((from, to, linear.0, linear.1, suppress));
+        Ok(())
+    }
+
+    /// The kind of a connection's end as messages name it.
+    fn kind_of(&self, n: &Node, _prefix: &str) -> String {
+        match n {
+            Node::Variable { instance, variable } => {
+                let causality = self
+                    .builder
+                    .system()
+                    .resolve_parts(instance, variable)
+                    .map(|r| self.builder.system().variable(&r).causality.as_str())
+                    .unwrap_or("unknown");
+                format!("{instance}.{variable} is {causality}")
+            }
+            Node::SystemConnector { system, connector } => {
+                let kind = self.connectors.get(&(system.clone(), connector.clone())).map_or("", String::as_str);
+                format!("connector {connector} of {} is {kind}", self.shown(system))
+            }
+        }
+    }
+
+    /// Which way data flows through `n` in a connection of the system `prefix`: an FMU
+    /// variable by its causality; a system connector by its kind, seen from inside its own
+    /// system (an input feeds) or from the enclosing one (an input is fed). `None`: the
+    /// kind does not say (inout, unspecified, absent).
+    fn flow(&self, n: &Node, prefix: &str) -> Option<Flow> {
+        match n {
+            Node::Variable { instance, variable } => {
+                let s = self.builder.system();
+                let r = s.resolve_parts(instance, variable).ok()?;
+                Some(match s.variable(&r).causality {
+                    Causality::Input | Causality::Parameter => Flow::In,
+                    _ => Flow::Out,
+                })
+            }
+            Node::SystemConnector { system, connector } => {
+                let kind = self.connectors.get(&(system.clone(), connector.clone()))?;
+                let inward = match kind.as_str() {
+                    "input" | "parameter" | "structuralParameter" => true,
+                    "output" | "calculatedParameter" | "local" | "constant" => false,
+                    _ => return None,
+                };
+                let inside = system == prefix;
+                Some(if inward == inside { Flow::Out } else { Flow::In })
+            }
+        }
     }
 
     fn component(&mut self, el: &Element, name: &str) -> Result<()> {
@@ -347,96 +510,207 @@ impl Flattener<'_> {
                         fmu.source().display()
                     ))
                 })?;
-                if let Some(t) = c.children.iter().find(|t| {
-                    ["Real", "Integer", "Boolean", "String", "Enumeration", "Binary"].contains(&t.name.as_str())
-                }) {
-                    let declared = match t.name.as_str() {
-                        "Enumeration" => "Integer",
-                        n => n,
+                let declared = c.children.iter().map(|t| t.name.as_str()).find(|t| {
+                    REAL_TYPES.contains(t) || INTEGER_TYPES.contains(t) || ["Boolean", "String", "Binary"].contains(t)
+                });
+                if let Some(declared) = declared {
+                    let actual = BaseType::of(v);
+                    // an FMI 3.0 64-bit or unsigned 32-bit integer is carried as a Real by
+                    // the master's view (exact up to 2^53): ssc:Integer declares it
+                    let wide_integer = fmu.fmi3_description().is_some_and(|md| {
+                        md.model_variables.iter().any(|x| {
+                            x.name == cname
+                                && matches!(
+                                    x.value_type,
+                                    model_description::fmi3::ValueType::Int64
+                                        | model_description::fmi3::ValueType::UInt64
+                                        | model_description::fmi3::ValueType::UInt32
+                                )
+                        })
+                    });
+                    let fits = match actual {
+                        BaseType::Real => {
+                            REAL_TYPES.contains(&declared) || wide_integer && INTEGER_TYPES.contains(&declared)
+                        }
+                        BaseType::Integer => INTEGER_TYPES.contains(&declared),
+                        BaseType::Boolean => declared == "Boolean",
+                        BaseType::String => declared == "String",
                     };
-                    if declared != BaseType::of(v).as_str() {
+                    if !fits {
                         return Err(self.err(format!(
                             "component {name:?}: connector {cname:?} is declared {declared} but the variable is {}",
-                            BaseType::of(v).as_str()
+                            actual.as_str()
                         )));
                     }
                 }
             }
         }
         if let Some(bindings) = el.child("ParameterBindings") {
-            self.bindings(bindings, name, false)?;
+            self.bindings(bindings, name, true)?;
         }
         Ok(())
     }
 
-    fn bindings(&mut self, el: &Element, owner: &str, is_system: bool) -> Result<()> {
+    /// Resolves the hierarchical `name` of a value bound in the system `system`: a
+    /// connector of it, or `element.rest` with `rest` a variable of a component or a
+    /// name inside a nested system.
+    fn resolve_in_system(&self, system: &str, name: &str) -> Option<Target> {
+        if self.connectors.contains_key(&(system.to_string(), name.to_string())) {
+            return Some(Target::Connector { system: system.to_string(), connector: name.to_string() });
+        }
+        let (head, rest) = name.split_once('.')?;
+        let path = if system.is_empty() { head.to_string() } else { format!("{system}.{head}") };
+        match self.elements.get(system)?.get(head)? {
+            true => self.resolve_in_system(&path, rest),
+            false => self.resolve_in_component(&path, rest),
+        }
+    }
+
+    fn resolve_in_component(&self, instance: &str, variable: &str) -> Option<Target> {
+        let s = self.builder.system();
+        let i = s.instance_index(instance)?;
+        s.description(i).variable(variable)?;
+        Some(Target::Variable { instance: instance.to_string(), variable: variable.to_string() })
+    }
+
+    /// The ParameterBindings of a component (`is_component`) or a system at `owner`.
+    fn bindings(&mut self, el: &Element, owner: &str, is_component: bool) -> Result<()> {
+        let whose = if is_component { format!("component {owner:?}") } else { self.shown(owner) };
         for b in el.all("ParameterBinding") {
-            if b.child("ParameterMapping").is_some() {
-                return Err(self.err(format!("{owner:?}: ParameterMapping is not supported")));
-            }
             if let Some(t) = b.attr("type") {
                 if t != "application/x-ssp-parameter-set" {
-                    return Err(self.err(format!("{owner:?}: parameter binding type {t:?} is not supported")));
+                    return Err(self.err(format!("{whose}: parameter binding type {t:?} is not supported")));
                 }
             }
-            let set = match (b.attr("source"), b.child("ParameterValues")) {
-                (Some(src), _) => {
-                    let rel = self.resource(src)?;
-                    let text = self.read_text(&rel, &format!("{owner:?}: parameter file"), src)?;
-                    let set = parse_xml(&text, &self.path.join(&rel))?;
-                    if set.name != "ParameterSet" {
-                        return Err(self.err(format!(
-                            "{owner:?}: parameter file {src:?} has the root element <{}>, not <ParameterSet> \
-                             (an SSP 1.0 .ssv file)",
-                            set.name
-                        )));
-                    }
-                    set
-                }
-                (None, Some(values)) => values
-                    .child("ParameterSet")
-                    .cloned()
-                    .ok_or_else(|| self.err(format!("{owner:?}: ParameterValues without ParameterSet")))?,
-                (None, None) => return Err(self.err(format!("{owner:?}: ParameterBinding without source or values"))),
+            let (set, from) = match (b.attr("source"), b.child("ParameterValues")) {
+                (Some(src), _) => (
+                    self.read_document(src, b.attr("sourceBase"), &format!("{whose}: parameter file"), "ParameterSet")?,
+                    src.to_string(),
+                ),
+                (None, Some(values)) => (
+                    values
+                        .child("ParameterSet")
+                        .cloned()
+                        .ok_or_else(|| self.err(format!("{whose}: ParameterValues without ParameterSet")))?,
+                    "inline values".to_string(),
+                ),
+                (None, None) => return Err(self.err(format!("{whose}: ParameterBinding without source or values"))),
             };
+            let values = parameters::parameter_set(&set).map_err(|why| self.err(format!("{whose}: {from}: {why}")))?;
             let prefix = b.attr("prefix").unwrap_or("");
-            let Some(params) = set.child("Parameters") else { continue };
-            for p in params.all("Parameter") {
-                let pname = p.attr("name").unwrap_or("");
-                let Some(rest) = pname.strip_prefix(prefix) else { continue };
-                // a component's binding names its variables; a system's names
-                // `element.variable` relative to the system: both are prefixed with the owner
-                let _ = is_system;
-                let target = if owner.is_empty() { rest.to_string() } else { format!("{owner}.{rest}") };
-                let v = p
-                    .children
-                    .iter()
-                    .find(|c| c.name != "Annotations")
-                    .ok_or_else(|| self.err(format!("parameter {pname:?} has no value")))?;
-                let value = v.attr("value").ok_or_else(|| self.err(format!("parameter {pname:?} has no value")))?;
-                if v.attr("unit").is_some() {
-                    // values in another unit than the variable's would need the ssv's unit
-                    // definitions; refused rather than guessed
-                    let unit = v.attr("unit").unwrap_or("");
-                    self.parameters.push((target.clone(), format!("unit:{unit}"), value.to_string()));
-                    continue;
+            // the prefix is prepended to every name of the set (SSP 1.0, ParameterBinding)
+            let values: Vec<(String, ParameterValue)> =
+                values.into_iter().map(|(n, v)| (format!("{prefix}{n}"), v)).collect();
+            let mut applied: Vec<(String, Bound)> = Vec::new();
+            match b.child("ParameterMapping") {
+                None => {
+                    for (n, v) in values {
+                        let origin = format!("{whose}, {from}");
+                        applied.push((
+                            n,
+                            Bound { value: v, transformation: None, suppress_unit_conversion: false, origin },
+                        ));
+                    }
                 }
-                self.parameters.push((target, v.name.clone(), value.to_string()));
+                Some(m) => {
+                    if let Some(t) = m.attr("type") {
+                        if t != "application/x-ssp-parameter-mapping" {
+                            return Err(self.err(format!("{whose}: parameter mapping type {t:?} is not supported")));
+                        }
+                    }
+                    let (mapping, mfrom) = match m.attr("source") {
+                        Some(src) => (
+                            self.read_document(
+                                src,
+                                m.attr("sourceBase"),
+                                &format!("{whose}: parameter mapping"),
+                                "ParameterMapping",
+                            )?,
+                            src.to_string(),
+                        ),
+                        None => (
+                            m.child("ParameterMapping").cloned().ok_or_else(|| {
+                                self.err(format!("{whose}: ParameterMapping without source or ssm:ParameterMapping"))
+                            })?,
+                            "inline mapping".to_string(),
+                        ),
+                    };
+                    let entries = parameters::mapping_entries(&mapping)
+                        .map_err(|why| self.err(format!("{whose}: {mfrom}: {why}")))?;
+                    // only the mapped values apply, under their mapped names
+                    let by_name: HashMap<&str, &ParameterValue> = values.iter().map(|(n, v)| (n.as_str(), v)).collect();
+                    let mut unmapped = 0;
+                    for e in &entries {
+                        let Some(v) = by_name.get(e.source.as_str()) else {
+                            unmapped += 1;
+                            continue;
+                        };
+                        applied.push((
+                            e.target.clone(),
+                            Bound {
+                                value: (*v).clone(),
+                                transformation: e.transformation.clone(),
+                                suppress_unit_conversion: e.suppress_unit_conversion,
+                                origin: format!("{whose}, {from} mapped by {mfrom}: {}", e.source),
+                            },
+                        ));
+                    }
+                    if unmapped > 0 {
+                        self.notes.push(format!(
+                            "{whose}: {unmapped} of the {} entries of the parameter mapping {mfrom} name no parameter \
+                             of {from} (source {:?}...): they apply nothing",
+                            entries.len(),
+                            entries.iter().find(|e| !by_name.contains_key(e.source.as_str())).map_or("", |e| &e.source)
+                        ));
+                    }
+                }
+            }
+            let mut ignored: Vec<String> = Vec::new();
+            for (name, bound) in applied {
+                let target = if is_component {
+                    self.resolve_in_component(owner, &name)
+                } else {
+                    self.resolve_in_system(owner, &name)
+                };
+                match target {
+                    Some(Target::Variable { instance, variable }) => self.bound.push((instance, variable, bound)),
+                    Some(Target::Connector { system, connector }) => {
+                        self.connector_values.insert((system, connector), bound);
+                    }
+                    None => ignored.push(name),
+                }
+            }
+            if !ignored.is_empty() {
+                let shown: Vec<&str> = ignored.iter().take(5).map(String::as_str).collect();
+                self.notes.push(format!(
+                    "{whose}, {from}: {} value{} name{} no variable or connector and {} ignored (SSP 1.0): {}{}",
+                    ignored.len(),
+                    if ignored.len() == 1 { "" } else { "s" },
+                    if ignored.len() == 1 { "s" } else { "" },
+                    if ignored.len() == 1 { "is" } else { "are" },
+                    shown.join(", "),
+                    if ignored.len() > 5 { ", ..." } else { "" }
+                ));
             }
         }
         Ok(())
     }
 }
 
-/// A system connector's source: the FMU output (or None: an unconnected system input)
-/// and the composed (factor, offset, suppress unit conversion).
-type Trace<'n> = (Option<&'n Node>, f64, f64, bool);
+/// A system connector's source: the node its data comes from (an FMU output, or a
+/// system connector nothing feeds) and the composed (factor, offset, suppress unit
+/// conversion).
+type Trace<'n> = (&'n Node, f64, f64, bool);
 
 type Edge = (Node, Node, f64, f64, bool);
 
-/// Traces `start` back through system connectors to an FMU output: walks back to a
-/// variable, an unfed connector or one traced before, then remembers the trace of every
-/// connector on the way.
+/// A value reaching an FMU variable (instance, variable) from a system connector, with the
+/// connection's composed (factor, offset, suppress unit conversion).
+type ViaConnector = (String, String, Bound, (f64, f64, bool));
+
+/// Traces `start` back through system connectors to an FMU output or to a system
+/// connector nothing feeds: walks back to a variable, an unfed connector or one traced
+/// before, then remembers the trace of every connector on the way.
 fn trace<'e>(
     start: &'e Node,
     edges: &'e [Edge],
@@ -447,12 +721,12 @@ fn trace<'e>(
     let mut node = start;
     let base: Trace = loop {
         if let Node::Variable { .. } = node {
-            break (Some(node), 1.0, 0.0, false);
+            break (node, 1.0, 0.0, false);
         }
         if let Some(t) = traced.get(node) {
             break *t;
         }
-        let Some(&k) = feeding.get(node) else { break (None, 1.0, 0.0, false) };
+        let Some(&k) = feeding.get(node) else { break (node, 1.0, 0.0, false) };
         if path.len() > edges.len() {
             return Err("connections through system connectors form a cycle".into());
         }
@@ -501,6 +775,8 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
             reason: format!("root element is {}, not SystemStructureDescription", doc.name),
         });
     }
+    let system_el =
+        doc.child("System").ok_or_else(|| Error::Ssp { path: path.to_path_buf(), reason: "no System".into() })?;
     let mut f = Flattener {
         root: &root,
         path,
@@ -508,56 +784,104 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         options,
         fmus: HashMap::new(),
         builder: SystemBuilder::new(),
+        root_name: system_el.attr("name").unwrap_or("").to_string(),
         edges: Vec::new(),
         connectors: Default::default(),
-        parameters: Vec::new(),
+        elements: HashMap::new(),
+        bound: Vec::new(),
+        connector_values: HashMap::new(),
+        notes: Vec::new(),
     };
-    let system_el = doc.child("System").ok_or_else(|| f.err("no System".into()))?;
+    match doc.attr("version").map(str::trim) {
+        Some("1.0") | None => {}
+        Some("2.0") => f.notes.push(
+            "the SSD says version=\"2.0\" (the SSP 2.0 draft): read as SSP 1.0 (FMI 3.0 connector types such as \
+             Float64 and Int64 accepted; array connectors, clocks and 2.0's other additions are refused by name)"
+                .into(),
+        ),
+        Some(v) => f.notes.push(format!("the SSD says version={v:?}: read as SSP 1.0")),
+    }
     f.system(system_el, "")?;
-    // follow connections through system connectors: every edge ending at an FMU input
-    // is traced back to an FMU output, composing the linear transformations. Each system
-    // connector is fed by at most one edge (a map from it to that edge), and a connector's
-    // trace is remembered, so the whole is linear in the number of connections.
+    // follow connections through system connectors: every edge ending at an FMU variable
+    // is traced back to an FMU output (a connection) or to a system connector nothing
+    // feeds (its bound value, if any). Each system connector is fed by at most one edge
+    // (a map from it to that edge), and a connector's trace is remembered, so the whole is
+    // linear in the number of connections.
     let edges = std::mem::take(&mut f.edges);
     let mut feeding: HashMap<&Node, usize> = HashMap::new();
     for (k, (_, to, ..)) in edges.iter().enumerate() {
         if let Node::SystemConnector { system, connector } = to {
             if feeding.insert(to, k).is_some() {
-                return Err(f.err(format!("system {system:?}: connector {connector:?} is fed by two connections")));
+                return Err(f.err(format!("{}: connector {connector:?} is fed by two connections", f.shown(system))));
             }
         }
     }
     let mut traced: HashMap<&Node, Trace> = HashMap::new();
+    // values reaching FMU variables from system connectors, applied after the bindings
+    let mut from_connectors: Vec<ViaConnector> = Vec::new();
+    let mut used_connectors: std::collections::HashSet<(String, String)> = Default::default();
     for (a, b, k, o, s) in &edges {
         let Node::Variable { instance: bi, variable: bv } = b else { continue };
-        let (src, factor0, offset0, suppress0) =
-            trace(a, &edges, &feeding, &mut traced).map_err(|reason| f.err(reason))?;
-        let Some(Node::Variable { instance: ai, variable: av }) = src else {
-            continue; // fed by an unconnected system input: left at its start value
-        };
+        let (src, factor0, offset0, suppress0) = trace(a, &edges, &feeding, &mut traced).map_err(|r| f.err(r))?;
         // to = k (factor0 x + offset0) + o
         let (factor, offset, suppress) = (k * factor0, k * offset0 + o, suppress0 | s);
-        let from = format!("{ai}.{av}");
-        let to = format!("{bi}.{bv}");
-        let linear = if factor == 1.0 && offset == 0.0 { None } else { Some((factor, offset)) };
-        if suppress {
-            f.builder.connect_unconverted(&from, &to, linear)?;
-        } else {
-            f.builder.connect_linear(&from, &to, linear)?;
-        }
-    }
-    let parameters = std::mem::take(&mut f.parameters);
-    for (target, kind, value) in parameters {
-        if let Some(unit) = kind.strip_prefix("unit:") {
-            let r = f.builder.system().resolve(&target)?;
-            let declared = f.builder.system().variable(&r).variable_type.unit().unwrap_or("").to_string();
-            if unit != declared {
-                return Err(f.err(format!(
-                    "parameter {target}: value in unit {unit:?}, the variable is in {declared:?} (conversion of parameter values is not supported)"
-                )));
+        match src {
+            Node::Variable { instance: ai, variable: av } => {
+                let from = format!("{ai}.{av}");
+                let to = format!("{bi}.{bv}");
+                let linear = if factor == 1.0 && offset == 0.0 { None } else { Some((factor, offset)) };
+                if suppress {
+                    f.builder.connect_unconverted(&from, &to, linear)?;
+                } else {
+                    f.builder.connect_linear(&from, &to, linear)?;
+                }
+            }
+            Node::SystemConnector { system, connector } => {
+                let key = (system.clone(), connector.clone());
+                match f.connector_values.get(&key) {
+                    Some(bound) => {
+                        used_connectors.insert(key);
+                        from_connectors.push((bi.clone(), bv.clone(), bound.clone(), (factor, offset, suppress)));
+                    }
+                    None => f.notes.push(format!(
+                        "{bi}.{bv} is connected to connector {connector} of {}, which nothing feeds and no value is \
+                         bound to: it keeps its start value",
+                        f.shown(system)
+                    )),
+                }
             }
         }
-        f.builder.set_text(&target, &value)?;
+    }
+    let mut keys: Vec<&(String, String)> =
+        f.connector_values.keys().filter(|k| !used_connectors.contains(*k)).collect();
+    keys.sort();
+    for key in keys {
+        let (system, connector) = key;
+        let node = Node::SystemConnector { system: system.clone(), connector: connector.clone() };
+        let why = if feeding.contains_key(&node) {
+            "is fed by a connection, which decides its value: the bound value is not used"
+        } else {
+            "reaches no FMU variable: it changes nothing"
+        };
+        f.notes.push(format!("the value bound to connector {connector} of {} {why}", f.shown(system)));
+    }
+    // bound values in their order (a higher level and a later binding win), then the
+    // values that reach variables through connections from system connectors (the
+    // connection decides the value of what it connects)
+    let mut applied: Vec<String> = Vec::new();
+    let bound = std::mem::take(&mut f.bound);
+    let direct = bound.into_iter().map(|(i, v, b)| (i, v, b, (1.0, 0.0, false), None));
+    let via = from_connectors.into_iter().map(|(i, v, b, t)| (i, v, b, t, Some(())));
+    for (instance, variable, b, then, through) in direct.chain(via) {
+        let (value, how) = value_for(f.builder.system(), &instance, &variable, &b, then, &mut f.notes)
+            .map_err(|why| f.err(format!("{}: {why}", b.origin)))?;
+        let full = format!("{instance}.{variable}");
+        let path = f.path.to_path_buf();
+        f.builder
+            .set(&full, value.clone())
+            .map_err(|e| Error::Ssp { path: path.clone(), reason: format!("{}: {e}", b.origin) })?;
+        let via = if through.is_some() { " through a system connector" } else { "" };
+        applied.push(format!("{full} = {value}{how}  [{}{via}]", b.origin));
     }
     let default_start_stop = doc
         .child("DefaultExperiment")
@@ -569,159 +893,14 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         })
         .unwrap_or((None, None));
     let archive = (!is_ssd).then(|| path.to_path_buf());
-    Ok(SspSystem { system: f.builder.build(), default_start_stop, archive })
-}
-
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
-
-fn num(v: f64) -> String {
-    let mut s = String::new();
-    crate::simulate::push_number(&mut s, v);
-    s
-}
-
-/// The name of the ParameterSet that holds the start values in an SSP written by [`write_ssp`].
-pub const SSP_PARAMETER_SET: &str = "initialValues";
-
-/// Writes `system` as an SSP 1.0 archive: `SystemStructure.ssd` plus each FMU archive
-/// under `resources/` (one copy per distinct FMU), start values as inline parameter
-/// bindings, connections with their linear transformations.
-///
-/// Every component's bindings are one ParameterSet named [`SSP_PARAMETER_SET`]: libcosim
-/// applies each component's first set by default, ecos applies the sets of the one name
-/// given to its `init` (and none without a name), so one name serves both.
-pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
-    let io = |source| Error::Import(crate::ImportError::Io { path: path.to_path_buf(), source });
-    // FMU files, one per distinct source
-    let mut files: Vec<(PathBuf, String)> = Vec::new();
-    for spec in &system.instances {
-        let src = spec.fmu.source().to_path_buf();
-        if !files.iter().any(|(p, _)| *p == src) {
-            let stem = src.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "fmu".into());
-            let mut file = format!("resources/{stem}.fmu");
-            let mut k = 1;
-            while files.iter().any(|(_, f)| *f == file) {
-                file = format!("resources/{stem}_{k}.fmu");
-                k += 1;
-            }
-            files.push((src, file));
-        }
-    }
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    x.push_str("<ssd:SystemStructureDescription xmlns:ssc=\"http://ssp-standard.org/SSP1/SystemStructureCommon\" xmlns:ssd=\"http://ssp-standard.org/SSP1/SystemStructureDescription\" xmlns:ssv=\"http://ssp-standard.org/SSP1/SystemStructureParameterValues\" version=\"1.0\"");
-    x.push_str(&format!(" name=\"{}\" generationTool=\"nigel-cosim\">\n", esc(name)));
-    x.push_str(&format!("  <ssd:System name=\"{}\">\n    <ssd:Elements>\n", esc(name)));
-    for (i, spec) in system.instances.iter().enumerate() {
-        let md = spec.fmu.description();
-        let file = &files.iter().find(|(p, _)| p == spec.fmu.source()).map(|(_, f)| f.clone()).unwrap_or_default();
-        x.push_str(&format!(
-            "      <ssd:Component name=\"{}\" type=\"application/x-fmu-sharedlibrary\" source=\"{}\">\n",
-            esc(&spec.name),
-            esc(file)
+    let system = f.builder.build();
+    if let Some(cycle) = crate::loops::initialization_loop(&system) {
+        f.notes.push(format!(
+            "the connections {} form an algebraic loop at initialization: the run carries each connection once \
+             before leaving initialization mode (no fixed-point iteration), so values on the loop may differ \
+             from a converged initialization",
+            cycle.join(", ")
         ));
-        // connectors: every output, and the inputs that are connected (an unconnected
-        // input connector would be driven with 0 by fmpy's simulate_ssp, not left at its start)
-        let vars: Vec<_> = md
-            .model_variables
-            .iter()
-            .enumerate()
-            .filter(|(index, v)| match v.causality {
-                model_description::Causality::Output => true,
-                model_description::Causality::Input => {
-                    system.connections.iter().any(|c| c.to.instance == i && c.to.index == *index)
-                }
-                _ => false,
-            })
-            .map(|(_, v)| v)
-            .collect();
-        if !vars.is_empty() {
-            x.push_str("        <ssd:Connectors>\n");
-            for v in vars {
-                x.push_str(&format!(
-                    "          <ssd:Connector name=\"{}\" kind=\"{}\"><ssc:{}/></ssd:Connector>\n",
-                    esc(&v.name),
-                    v.causality.as_str(),
-                    BaseType::of(v).as_str()
-                ));
-            }
-            x.push_str("        </ssd:Connectors>\n");
-        }
-        if !spec.start_values.is_empty() {
-            x.push_str("        <ssd:ParameterBindings>\n          <ssd:ParameterBinding>\n            <ssd:ParameterValues>\n");
-            x.push_str(&format!(
-                "              <ssv:ParameterSet version=\"1.0\" name=\"{}\">\n                <ssv:Parameters>\n",
-                SSP_PARAMETER_SET
-            ));
-            for (index, value) in &spec.start_values {
-                let vname = &md.model_variables[*index].name;
-                let v = match value {
-                    Value::Real(r) => format!("<ssv:Real value=\"{}\"/>", num(*r)),
-                    Value::Integer(k) => format!("<ssv:Integer value=\"{k}\"/>"),
-                    Value::Boolean(b) => format!("<ssv:Boolean value=\"{b}\"/>"),
-                    Value::String(s) => format!("<ssv:String value=\"{}\"/>", esc(s)),
-                };
-                x.push_str(&format!("                  <ssv:Parameter name=\"{}\">{v}</ssv:Parameter>\n", esc(vname)));
-            }
-            x.push_str("                </ssv:Parameters>\n              </ssv:ParameterSet>\n            </ssd:ParameterValues>\n          </ssd:ParameterBinding>\n        </ssd:ParameterBindings>\n");
-        }
-        x.push_str("      </ssd:Component>\n");
     }
-    x.push_str("    </ssd:Elements>\n");
-    if !system.connections.is_empty() {
-        x.push_str("    <ssd:Connections>\n");
-        for c in &system.connections {
-            let (fi, ti) = (&system.instances[c.from.instance].name, &system.instances[c.to.instance].name);
-            let (fv, tv) = (&system.variable(&c.from).name, &system.variable(&c.to).name);
-            x.push_str(&format!(
-                "      <ssd:Connection startElement=\"{}\" startConnector=\"{}\" endElement=\"{}\" endConnector=\"{}\"",
-                esc(fi),
-                esc(fv),
-                esc(ti),
-                esc(tv)
-            ));
-            match c.linear_transformation {
-                Some((f, o)) => x.push_str(&format!(
-                    "><ssc:LinearTransformation factor=\"{}\" offset=\"{}\"/></ssd:Connection>\n",
-                    num(f),
-                    num(o)
-                )),
-                None => x.push_str("/>\n"),
-            }
-        }
-        x.push_str("    </ssd:Connections>\n");
-    }
-    x.push_str("  </ssd:System>\n");
-    if let Some(stop) = stop_time {
-        x.push_str(&format!("  <ssd:DefaultExperiment startTime=\"0\" stopTime=\"{}\"/>\n", num(stop)));
-    }
-    x.push_str("</ssd:SystemStructureDescription>\n");
-
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut zip = zip::ZipWriter::new(file);
-    let options = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated)
-        .last_modified_time(zip::DateTime::default());
-    let zerr = |e: zip::result::ZipError| {
-        Error::Import(crate::ImportError::Archive { path: path.to_path_buf(), reason: e.to_string() })
-    };
-    zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
-    zip.write_all(x.as_bytes()).map_err(io)?;
-    // the FMUs stored, not deflated: they are compressed archives already (deflate gains
-    // under 1 %), and a stored FMU is read in place by importers that seek (see `unpack`)
-    let stored = options.compression_method(zip::CompressionMethod::Stored);
-    for (src, file) in &files {
-        let fmu = system.instances.iter().find(|i| i.fmu.source() == src.as_path()).map(|i| &i.fmu);
-        let bytes = match fmu {
-            Some(fmu) => fmu.archive_bytes()?,
-            None => std::fs::read(src)
-                .map_err(|source| Error::Import(crate::ImportError::Io { path: src.clone(), source }))?,
-        };
-        zip.start_file(file.as_str(), stored).map_err(zerr)?;
-        zip.write_all(&bytes).map_err(io)?;
-    }
-    zip.finish().map_err(zerr)?;
-    Ok(())
+    Ok(SspSystem { system, default_start_stop, root_name: f.root_name, notes: f.notes, applied, archive })
 }

@@ -82,3 +82,23 @@ fn model_exchange_with_bdf_ends_at_the_event_with_the_row_at_the_event() {
     let (instance, t_end, reason) = summary.ended_by.clone().unwrap();
     assert_eq!((instance.as_str(), t_end, reason), ("model", 9.0, "terminateSimulation"));
 }
+
+/// An FMU that asks to end the simulation at the stop time has not ended it early: with
+/// the stop time 9 s, the Co-Simulation Discard with fmi2Terminated at
+/// lastSuccessfulTime 9 s and the Model Exchange terminateSimulation at the event at 9 s
+/// complete the last step: every step counted, the last row at 9 s (counter 10), no
+/// `ended_by`.
+#[test]
+fn an_end_at_the_stop_time_is_no_early_end() {
+    for (interface, folder) in [(Interface::CoSimulation, "stair-cs-stop"), (Interface::ModelExchange, "stair-me-stop")]
+    {
+        let system = stair_in(interface, folder);
+        let (r, summary) = simulate(&system, &Experiment::new(9.0, 0.2)).unwrap();
+        assert_eq!(summary.ended_by, None, "{interface:?}");
+        assert_eq!(summary.steps, 45, "{interface:?}");
+        let time = r.column("time").unwrap();
+        let counter = r.column("counter").unwrap();
+        assert_eq!(r.rows(), 46, "{interface:?}");
+        assert_eq!((*time.last().unwrap(), *counter.last().unwrap()), (9.0, 10.0), "{interface:?}");
+    }
+}

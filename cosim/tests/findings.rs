@@ -293,7 +293,7 @@ fn a_parameter_file_whose_root_is_not_a_parameter_set_is_refused() {
     match read_ssp(&path, &ImportOptions::default()) {
         Err(Error::Ssp { reason, .. }) => assert_eq!(
             reason,
-            "\"\": parameter file \"values.ssv\" has the root element <html>, not <ParameterSet> (an SSP 1.0 .ssv file)"
+            "root system \"root\": parameter file \"values.ssv\" has the root element <html>, not <ParameterSet>"
         ),
         other => panic!("accepted: {:?}", other.is_ok()),
     }

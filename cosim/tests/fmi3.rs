@@ -765,3 +765,120 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let ours: Vec<Vec<f64>> = (0..r.rows()).map(|k| vec![time[k], r.column("y").unwrap()[k], n[k]]).collect();
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
+
+/// An FMI 3.0 Int64 output declared `ssc:Integer` in an SSP (as OMSimulator writes it;
+/// SSP 1.0 has no Int64), connected (written sink first) to another counter's Float64
+/// input: read, and its values beyond 32 bits carried exactly (the view carries Int64 as
+/// a Real, exact up to 2^53). A Boolean declaration of the same variable is refused.
+#[test]
+fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
+    use nigel_cosim::{read_ssp, Algorithm, ImportOptions};
+    let Some((dir, _)) = counter("fmi3-ssp-int64") else { return };
+    let ssd = |ty: &str| {
+        format!(
+            r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" version="1.0" name="t">
+<ssd:System name="root"><ssd:Elements>
+  <ssd:Component name="c1" source="fmi3_counter.fmu"><ssd:Connectors><ssd:Connector name="i64" kind="output"><ssc:{ty}/></ssd:Connector></ssd:Connectors></ssd:Component>
+  <ssd:Component name="c2" source="fmi3_counter.fmu"/>
+</ssd:Elements><ssd:Connections><ssd:Connection startElement="c2" startConnector="u" endElement="c1" endConnector="i64"/></ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+        )
+    };
+    let path = dir.join("int64.ssd");
+    std::fs::write(&path, ssd("Boolean")).unwrap();
+    let e = read_ssp(&path, &ImportOptions::default()).err().expect("a Boolean Int64 refused").to_string();
+    assert!(e.contains("connector \"i64\" is declared Boolean"), "{e}");
+    std::fs::write(&path, ssd("Integer")).unwrap();
+    let s = read_ssp(&path, &ImportOptions::default()).unwrap();
+    assert_eq!(s.system.name_of(&s.system.connections[0].from), "c1.i64");
+    let mut e = Experiment::new(0.5, 0.1);
+    e.algorithm = Algorithm::Ordered;
+    e.record = Some(vec!["c1.n".into(), "c2.u".into()]);
+    let (r, _) = simulate(&s.system, &e).unwrap();
+    let (n, u) = (r.column("c1.n").unwrap(), r.column("c2.u").unwrap());
+    // i64 = -2^40 n (fmi3_counter.c), n the steps done: -5.5e12 after 5 steps, past i32
+    assert_eq!(n, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+    for k in 0..n.len() {
+        assert_eq!(u[k], -(2f64.powi(40)) * n[k], "c2.u at step {k}");
+    }
+}
+
+/// A run whose result would lack every output it was asked to record (by default: all
+/// outputs) does not end with status 0: the counter described with one output, an array
+/// of 200,000 elements that the master leaves out of its view, is refused naming it,
+/// instead of writing a CSV of the time column alone.
+#[test]
+fn a_run_that_can_record_none_of_the_outputs_fails() {
+    let dir = work_dir("fmi3-no-output");
+    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
+  <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="24"/>
+    <InitialUnknown valueReference="24"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+    let Some(fmu) = build_counter(&dir, "no_output", xml) else { return };
+    let csv = dir.join("out.csv");
+    let out =
+        cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.05", "-o", csv.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("no output of the system can be recorded") && err.contains("model.big"), "{err}");
+}
+
+/// An early return whose lastSuccessfulTime lies past the step (the counter with
+/// crash_how = 4: terminateSimulation "at" t + 1000 s from the step at 0.05 s) is no time
+/// of the run: an error naming the FMU, the call and the times, no row past the stop time,
+/// and no status 0.
+#[test]
+fn an_early_return_past_the_step_is_an_error_not_a_row() {
+    let Some((dir, fmu)) = counter("fmi3-early-past") else { return };
+    let csv = dir.join("out.csv");
+    let out = cosim(&[
+        "run",
+        fmu.to_str().unwrap(),
+        "--stop-time",
+        "0.1",
+        "--step",
+        "0.01",
+        "--set",
+        "crash_at=0.05",
+        "--set",
+        "crash_how=4",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("fmi3DoStep ended the simulation at lastSuccessfulTime = 1000.05")
+            && err.contains("outside the step"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let last: f64 = text.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!(last <= 0.1, "a row at {last} s");
+}
+
+/// A description of a later FMI 3 minor version ("3.1") runs as FMI 3.0, with a note saying
+/// so; a revision of 3.0 ("3.0.2") needs none.
+#[test]
+fn a_later_minor_version_runs_with_a_note() {
+    let dir = work_dir("fmi3-version");
+    for (version, noted) in [("3.1", true), ("3.0.2", false)] {
+        let xml = XML.replace(r#"fmiVersion="3.0""#, &format!(r#"fmiVersion="{version}""#));
+        let Some(fmu) = build_counter(&dir, &format!("v{}", version.replace('.', "_")), &xml) else { return };
+        let out = cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.05"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{version}: {err}");
+        let note = format!(r#"declares fmiVersion "{version}": run as FMI 3.0"#);
+        assert_eq!(err.contains(&note), noted, "{version}: {err}");
+    }
+}

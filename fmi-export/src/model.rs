@@ -145,7 +145,8 @@ pub trait Access<M>: Copy + std::fmt::Debug + Send + Sync + 'static {
 pub trait Model: Clone + Send + Sized + 'static {
     type Binding: Access<Self>;
 
-    /// The declaration (variables, units, interfaces, capabilities), built once.
+    /// The declaration (variables, units, interfaces, capabilities), built once: write
+    /// [`crate::declare_model!`] in place of this function.
     fn declaration() -> &'static Declaration<Self::Binding>;
 
     /// A fresh instance. The layer then applies every declared start value through the
@@ -293,4 +294,23 @@ pub trait Model: Clone + Send + Sized + 'static {
             Err(format!("{} internal numbers, the model keeps none", data.len()).into())
         }
     }
+}
+
+/// [`Model::declaration`] from a [`DeclarationSpec`](crate::DeclarationSpec): the function
+/// that builds the declaration once per process (in a `OnceLock`, at the first call) from
+/// the expression `$spec` and returns it from then on. Written in the `impl Model` with the
+/// model's binding type: `fmi_export::declare_model!(Field<MyModel>, build_declaration());`.
+/// An invalid declaration is a programming error: the first call panics with the reason
+/// (every FMU crate's tests call it).
+#[macro_export]
+macro_rules! declare_model {
+    ($binding:ty, $spec:expr) => {
+        fn declaration() -> &'static $crate::Declaration<$binding> {
+            static DECLARATION: ::std::sync::OnceLock<$crate::Declaration<$binding>> = ::std::sync::OnceLock::new();
+            DECLARATION.get_or_init(|| {
+                $crate::Declaration::new($spec)
+                    .unwrap_or_else(|e| panic!("the declaration of {} is invalid: {e}", stringify!($binding)))
+            })
+        }
+    };
 }

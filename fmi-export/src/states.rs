@@ -72,37 +72,6 @@ pub enum Scope {
     ScheduledExecution,
 }
 
-macro_rules! functions {
-    (fmi2 { $($f2:ident),* $(,)? } fmi3 { $($f3:ident = $n3:ident),* $(,)? }) => {
-        /// The 44 functions of FMI 2.0 and the 75 of FMI 3.0, one enum: one table of where
-        /// each may be called ([`Function::allowed_in`]). An FMI 3.0 function's variant is
-        /// its C name with `Fmi3` in front (`Function::Fmi3DoStep` is `fmi3DoStep`).
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-        pub enum Function { $($f2,)* $($n3,)* }
-        impl Function {
-            pub const ALL: [Function; 119] = [$(Function::$f2,)* $(Function::$n3,)*];
-            /// The 44 FMI 2.0 functions.
-            pub const FMI2: [Function; 44] = [$(Function::$f2),*];
-            /// The 75 FMI 3.0 functions.
-            pub const FMI3: [Function; 75] = [$(Function::$n3),*];
-            /// The C name, e.g. `"fmi2GetReal"`, `"fmi3GetFloat64"`.
-            pub fn name(self) -> &'static str {
-                match self {
-                    $(Function::$f2 => concat!("fmi2", stringify!($f2)),)*
-                    $(Function::$n3 => concat!("fmi3", stringify!($f3)),)*
-                }
-            }
-            /// The FMI generation (2 or 3) the function belongs to.
-            pub fn generation(self) -> Generation {
-                match self {
-                    $(Function::$f2 => Generation::Fmi2,)*
-                    $(Function::$n3 => Generation::Fmi3,)*
-                }
-            }
-        }
-    };
-}
-
 /// The generation of the FMI C API an instance was created by (`fmi2Instantiate` or an
 /// `fmi3Instantiate*`): only that generation's functions may be called on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -111,131 +80,43 @@ pub enum Generation {
     Fmi3,
 }
 
-functions!(
-    fmi2 {
-    GetTypesPlatform,
-    GetVersion,
-    SetDebugLogging,
-    Instantiate,
-    FreeInstance,
-    SetupExperiment,
-    EnterInitializationMode,
-    ExitInitializationMode,
-    Terminate,
-    Reset,
-    GetReal,
-    GetInteger,
-    GetBoolean,
-    GetString,
-    SetReal,
-    SetInteger,
-    SetBoolean,
-    SetString,
-    GetFMUstate,
-    SetFMUstate,
-    FreeFMUstate,
-    SerializedFMUstateSize,
-    SerializeFMUstate,
-    DeSerializeFMUstate,
-    GetDirectionalDerivative,
-    EnterEventMode,
-    NewDiscreteStates,
-    EnterContinuousTimeMode,
-    CompletedIntegratorStep,
-    SetTime,
-    SetContinuousStates,
-    GetDerivatives,
-    GetEventIndicators,
-    GetContinuousStates,
-    GetNominalsOfContinuousStates,
-    SetRealInputDerivatives,
-    GetRealOutputDerivatives,
-    DoStep,
-    CancelStep,
-    GetStatus,
-    GetRealStatus,
-    GetIntegerStatus,
-    GetBooleanStatus,
-    GetStringStatus,
-    }
-    fmi3 {
-        GetVersion = Fmi3GetVersion,
-        EnterInitializationMode = Fmi3EnterInitializationMode,
-        ExitInitializationMode = Fmi3ExitInitializationMode,
-        Terminate = Fmi3Terminate,
-        FreeInstance = Fmi3FreeInstance,
-        GetFloat64 = Fmi3GetFloat64,
-        SetFloat64 = Fmi3SetFloat64,
-        SetDebugLogging = Fmi3SetDebugLogging,
-        InstantiateModelExchange = Fmi3InstantiateModelExchange,
-        InstantiateCoSimulation = Fmi3InstantiateCoSimulation,
-        InstantiateScheduledExecution = Fmi3InstantiateScheduledExecution,
-        EnterEventMode = Fmi3EnterEventMode,
-        Reset = Fmi3Reset,
-        GetFloat32 = Fmi3GetFloat32,
-        GetInt8 = Fmi3GetInt8,
-        GetUInt8 = Fmi3GetUInt8,
-        GetInt16 = Fmi3GetInt16,
-        GetUInt16 = Fmi3GetUInt16,
-        GetInt32 = Fmi3GetInt32,
-        GetUInt32 = Fmi3GetUInt32,
-        GetInt64 = Fmi3GetInt64,
-        GetUInt64 = Fmi3GetUInt64,
-        GetBoolean = Fmi3GetBoolean,
-        GetString = Fmi3GetString,
-        GetBinary = Fmi3GetBinary,
-        GetClock = Fmi3GetClock,
-        SetFloat32 = Fmi3SetFloat32,
-        SetInt8 = Fmi3SetInt8,
-        SetUInt8 = Fmi3SetUInt8,
-        SetInt16 = Fmi3SetInt16,
-        SetUInt16 = Fmi3SetUInt16,
-        SetInt32 = Fmi3SetInt32,
-        SetUInt32 = Fmi3SetUInt32,
-        SetInt64 = Fmi3SetInt64,
-        SetUInt64 = Fmi3SetUInt64,
-        SetBoolean = Fmi3SetBoolean,
-        SetString = Fmi3SetString,
-        SetBinary = Fmi3SetBinary,
-        SetClock = Fmi3SetClock,
-        GetNumberOfVariableDependencies = Fmi3GetNumberOfVariableDependencies,
-        GetVariableDependencies = Fmi3GetVariableDependencies,
-        GetFMUState = Fmi3GetFMUState,
-        SetFMUState = Fmi3SetFMUState,
-        FreeFMUState = Fmi3FreeFMUState,
-        SerializedFMUStateSize = Fmi3SerializedFMUStateSize,
-        SerializeFMUState = Fmi3SerializeFMUState,
-        DeserializeFMUState = Fmi3DeserializeFMUState,
-        GetDirectionalDerivative = Fmi3GetDirectionalDerivative,
-        GetAdjointDerivative = Fmi3GetAdjointDerivative,
-        EnterConfigurationMode = Fmi3EnterConfigurationMode,
-        ExitConfigurationMode = Fmi3ExitConfigurationMode,
-        GetIntervalDecimal = Fmi3GetIntervalDecimal,
-        GetIntervalFraction = Fmi3GetIntervalFraction,
-        GetShiftDecimal = Fmi3GetShiftDecimal,
-        GetShiftFraction = Fmi3GetShiftFraction,
-        SetIntervalDecimal = Fmi3SetIntervalDecimal,
-        SetIntervalFraction = Fmi3SetIntervalFraction,
-        SetShiftDecimal = Fmi3SetShiftDecimal,
-        SetShiftFraction = Fmi3SetShiftFraction,
-        EvaluateDiscreteStates = Fmi3EvaluateDiscreteStates,
-        UpdateDiscreteStates = Fmi3UpdateDiscreteStates,
-        EnterContinuousTimeMode = Fmi3EnterContinuousTimeMode,
-        CompletedIntegratorStep = Fmi3CompletedIntegratorStep,
-        SetTime = Fmi3SetTime,
-        SetContinuousStates = Fmi3SetContinuousStates,
-        GetContinuousStateDerivatives = Fmi3GetContinuousStateDerivatives,
-        GetEventIndicators = Fmi3GetEventIndicators,
-        GetContinuousStates = Fmi3GetContinuousStates,
-        GetNominalsOfContinuousStates = Fmi3GetNominalsOfContinuousStates,
-        GetNumberOfEventIndicators = Fmi3GetNumberOfEventIndicators,
-        GetNumberOfContinuousStates = Fmi3GetNumberOfContinuousStates,
-        EnterStepMode = Fmi3EnterStepMode,
-        GetOutputDerivatives = Fmi3GetOutputDerivatives,
-        DoStep = Fmi3DoStep,
-        ActivateModelPartition = Fmi3ActivateModelPartition,
-    }
-);
+/// `Function` from the rows of [`crate::abi::table`], in their order.
+macro_rules! function_enum {
+    ({}
+     fmi2 { $($f2:ident : $_t2:ident = $n2:ident => $_m2:ident :: $_l2:ident $(::<$_v2:ident>)?
+                $([$($_a2:ident),*])? ( $($_p2:ident : $_pt2:ty),* ) $(-> $_r2:ty)? ;)* }
+     fmi3 { $($f3:ident : $_t3:ident = $n3:ident => $_m3:ident :: $_l3:ident $(::<$_v3:ident>)?
+                $([$($_a3:ident),*])? ( $($_p3:ident : $_pt3:ty),* ) $(-> $_r3:ty)? ;)* }) => {
+        /// The 44 functions of FMI 2.0 and the 75 of FMI 3.0, one enum: one table of where
+        /// each may be called ([`Function::allowed_in`]). An FMI 3.0 function's variant is
+        /// its C name with `Fmi3` in front (`Function::Fmi3DoStep` is `fmi3DoStep`).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Function { $($n2,)* $($n3,)* }
+        impl Function {
+            pub const ALL: [Function; 119] = [$(Function::$n2,)* $(Function::$n3,)*];
+            /// The 44 FMI 2.0 functions.
+            pub const FMI2: [Function; 44] = [$(Function::$n2),*];
+            /// The 75 FMI 3.0 functions.
+            pub const FMI3: [Function; 75] = [$(Function::$n3),*];
+            /// The C name, e.g. `"fmi2GetReal"`, `"fmi3GetFloat64"`.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Function::$n2 => stringify!($f2),)*
+                    $(Function::$n3 => stringify!($f3),)*
+                }
+            }
+            /// The FMI generation (2 or 3) the function belongs to.
+            pub fn generation(self) -> Generation {
+                match self {
+                    $(Function::$n2 => Generation::Fmi2,)*
+                    $(Function::$n3 => Generation::Fmi3,)*
+                }
+            }
+        }
+    };
+}
+
+crate::__fmi_function_table!([function_enum] {});
 
 use Machine::*;
 

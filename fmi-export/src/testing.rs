@@ -12,7 +12,7 @@ use std::ptr::null_mut;
 
 use crate::abi::{self, Fmi2EventInfo};
 use crate::ffi::*;
-use crate::Model;
+use crate::{Function, Model};
 use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 
 /// The log of one instance: (status, category, message), in the order logged.
@@ -52,7 +52,18 @@ impl<M: Model> Fmu<M> {
         let callbacks = Box::new(log.callbacks());
         let name = CString::new("test").unwrap();
         let guid = CString::new(M::declaration().guid()).unwrap();
-        let c = unsafe { abi::instantiate::<M>(name.as_ptr(), kind, guid.as_ptr(), null_mut(), &*callbacks, 0, 1) };
+        let c = unsafe {
+            abi::instantiate::<M>(
+                Function::Instantiate,
+                name.as_ptr(),
+                kind,
+                guid.as_ptr(),
+                null_mut(),
+                &*callbacks,
+                0,
+                1,
+            )
+        };
         assert!(!c.is_null(), "{:?}", log.0.borrow());
         Fmu { c, log, _callbacks: callbacks, _m: std::marker::PhantomData }
     }
@@ -71,7 +82,7 @@ impl<M: Model> Fmu<M> {
         self.log.0.borrow().iter().rev().find(|r| r.0 >= 2).map(|r| r.2.clone()).unwrap_or_default()
     }
     pub fn setup(&self) -> Fmi2Status {
-        unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, 0.0, 0, 0.0) }
+        unsafe { abi::setup_experiment::<M>(Function::SetupExperiment, self.c, 0, 0.0, 0.0, 0, 0.0) }
     }
     /// setup at `start` with an optional stop time, enter and exit initialization, all Ok.
     pub fn init_until(&self, start: f64, stop: Option<f64>) {
@@ -81,7 +92,17 @@ impl<M: Model> Fmu<M> {
     }
     /// `fmi2SetupExperiment` with a start time and an optional stop time.
     pub fn setup_at(&self, start: f64, stop: Option<f64>) -> Fmi2Status {
-        unsafe { abi::setup_experiment::<M>(self.c, 0, 0.0, start, stop.is_some() as i32, stop.unwrap_or(0.0)) }
+        unsafe {
+            abi::setup_experiment::<M>(
+                Function::SetupExperiment,
+                self.c,
+                0,
+                0.0,
+                start,
+                stop.is_some() as i32,
+                stop.unwrap_or(0.0),
+            )
+        }
     }
     /// setup at `start`, enter and exit initialization, all Ok.
     pub fn init_at(&self, start: f64) {
@@ -93,7 +114,7 @@ impl<M: Model> Fmu<M> {
     pub fn last_successful_time(&self) -> f64 {
         let mut t = f64::NAN;
         assert_eq!(
-            unsafe { abi::get_real_status::<M>(self.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t) },
+            unsafe { abi::get_real_status::<M>(Function::GetRealStatus, self.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t) },
             OK,
             "{}",
             self.last_error()
@@ -104,7 +125,7 @@ impl<M: Model> Fmu<M> {
     pub fn terminated(&self) -> bool {
         let mut b = -1;
         assert_eq!(
-            unsafe { abi::get_boolean_status::<M>(self.c, FMI2_TERMINATED, &mut b) },
+            unsafe { abi::get_boolean_status::<M>(Function::GetBooleanStatus, self.c, FMI2_TERMINATED, &mut b) },
             OK,
             "{}",
             self.last_error()
@@ -112,10 +133,10 @@ impl<M: Model> Fmu<M> {
         b == 1
     }
     pub fn enter_init(&self) -> Fmi2Status {
-        unsafe { abi::enter_initialization_mode::<M>(self.c) }
+        unsafe { abi::enter_initialization_mode::<M>(Function::EnterInitializationMode, self.c) }
     }
     pub fn exit_init(&self) -> Fmi2Status {
-        unsafe { abi::exit_initialization_mode::<M>(self.c) }
+        unsafe { abi::exit_initialization_mode::<M>(Function::ExitInitializationMode, self.c) }
     }
     /// setup, enter and exit initialization, all Ok.
     pub fn init(&self) {
@@ -125,7 +146,7 @@ impl<M: Model> Fmu<M> {
     }
     pub fn real(&self, vr: u32) -> f64 {
         let mut x = f64::NAN;
-        let s = unsafe { abi::get_real::<M>(self.c, &vr, 1, &mut x) };
+        let s = unsafe { abi::get::<M, abi::value::Real>(Function::GetReal, self.c, &vr, 1, &mut x) };
         assert_eq!(s, OK, "get_real({vr}): {}", self.last_error());
         x
     }
@@ -134,35 +155,35 @@ impl<M: Model> Fmu<M> {
     }
     pub fn int(&self, vr: u32) -> i32 {
         let mut x = -7;
-        let s = unsafe { abi::get_integer::<M>(self.c, &vr, 1, &mut x) };
+        let s = unsafe { abi::get::<M, abi::value::Integer>(Function::GetInteger, self.c, &vr, 1, &mut x) };
         assert_eq!(s, OK, "{}", self.last_error());
         x
     }
     pub fn set_real(&self, vr: u32, x: f64) -> Fmi2Status {
-        unsafe { abi::set_real::<M>(self.c, &vr, 1, &x) }
+        unsafe { abi::set::<M, abi::value::Real>(Function::SetReal, self.c, &vr, 1, &x) }
     }
     pub fn set_int(&self, vr: u32, x: i32) -> Fmi2Status {
-        unsafe { abi::set_integer::<M>(self.c, &vr, 1, &x) }
+        unsafe { abi::set::<M, abi::value::Integer>(Function::SetInteger, self.c, &vr, 1, &x) }
     }
     pub fn set_bool(&self, vr: u32, x: bool) -> Fmi2Status {
         let v = x as fmi2Boolean;
-        unsafe { abi::set_boolean::<M>(self.c, &vr, 1, &v) }
+        unsafe { abi::set::<M, abi::value::Boolean>(Function::SetBoolean, self.c, &vr, 1, &v) }
     }
     pub fn step(&self, t: f64, h: f64) -> Fmi2Status {
-        unsafe { abi::do_step::<M>(self.c, t, h, 1) }
+        unsafe { abi::do_step::<M>(Function::DoStep, self.c, t, h, 1) }
     }
     pub fn reset(&self) -> Fmi2Status {
-        unsafe { abi::reset::<M>(self.c) }
+        unsafe { abi::reset::<M>(Function::Reset, self.c) }
     }
     // Model Exchange
     pub fn set_time(&self, t: f64) -> Fmi2Status {
-        unsafe { abi::set_time::<M>(self.c, t) }
+        unsafe { abi::set_time::<M>(Function::SetTime, self.c, t) }
     }
     pub fn enter_event_mode(&self) -> Fmi2Status {
-        unsafe { abi::enter_event_mode::<M>(self.c) }
+        unsafe { abi::enter_event_mode::<M>(Function::EnterEventMode, self.c) }
     }
     pub fn enter_continuous_time_mode(&self) -> Fmi2Status {
-        unsafe { abi::enter_continuous_time_mode::<M>(self.c) }
+        unsafe { abi::enter_continuous_time_mode::<M>(Function::EnterContinuousTimeMode, self.c) }
     }
     /// One event iteration; the next event time if defined.
     pub fn new_discrete_states(&self) -> Option<f64> {
@@ -171,7 +192,7 @@ impl<M: Model> Fmu<M> {
     /// One event iteration: the next event time if defined, and terminateSimulation.
     pub fn event_iteration(&self) -> (Option<f64>, bool) {
         let mut info = Fmi2EventInfo::default();
-        let s = unsafe { abi::new_discrete_states::<M>(self.c, &mut info) };
+        let s = unsafe { abi::new_discrete_states::<M>(Function::NewDiscreteStates, self.c, &mut info) };
         assert_eq!(s, OK, "{}", self.last_error());
         assert_eq!(info.new_discrete_states_needed, 0);
         ((info.next_event_time_defined != 0).then_some(info.next_event_time), info.terminate_simulation != 0)
@@ -180,24 +201,39 @@ impl<M: Model> Fmu<M> {
     pub fn serialized_state(&self) -> Vec<u8> {
         unsafe {
             let mut s: fmi2FMUstate = null_mut();
-            assert_eq!(abi::get_fmu_state::<M>(self.c, &mut s), OK, "{}", self.last_error());
+            assert_eq!(abi::get_fmu_state::<M>(Function::GetFMUstate, self.c, &mut s), OK, "{}", self.last_error());
             let mut n = 0usize;
-            assert_eq!(abi::serialized_fmu_state_size::<M>(self.c, s, &mut n), OK);
+            assert_eq!(abi::serialized_fmu_state_size::<M>(Function::SerializedFMUstateSize, self.c, s, &mut n), OK);
             let mut bytes = vec![0u8; n];
-            assert_eq!(abi::serialize_fmu_state::<M>(self.c, s, bytes.as_mut_ptr() as *mut fmi2Byte, n), OK);
-            assert_eq!(abi::free_fmu_state::<M>(self.c, &mut s), OK);
+            assert_eq!(
+                abi::serialize_fmu_state::<M>(
+                    Function::SerializeFMUstate,
+                    self.c,
+                    s,
+                    bytes.as_mut_ptr() as *mut fmi2Byte,
+                    n
+                ),
+                OK
+            );
+            assert_eq!(abi::free_fmu_state::<M>(Function::FreeFMUstate, self.c, &mut s), OK);
             bytes
         }
     }
     pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi2Status {
         unsafe {
             let mut s: fmi2FMUstate = null_mut();
-            let st = abi::deserialize_fmu_state::<M>(self.c, bytes.as_ptr() as *const fmi2Byte, bytes.len(), &mut s);
+            let st = abi::deserialize_fmu_state::<M>(
+                Function::DeSerializeFMUstate,
+                self.c,
+                bytes.as_ptr() as *const fmi2Byte,
+                bytes.len(),
+                &mut s,
+            );
             if st != OK {
                 return st;
             }
-            let st = abi::set_fmu_state::<M>(self.c, s);
-            abi::free_fmu_state::<M>(self.c, &mut s);
+            let st = abi::set_fmu_state::<M>(Function::SetFMUstate, self.c, s);
+            abi::free_fmu_state::<M>(Function::FreeFMUstate, self.c, &mut s);
             st
         }
     }
@@ -205,7 +241,7 @@ impl<M: Model> Fmu<M> {
 
 impl<M: Model> Drop for Fmu<M> {
     fn drop(&mut self) {
-        unsafe { abi::free_instance::<M>(self.c) }
+        unsafe { abi::free_instance::<M>(Function::FreeInstance, self.c) }
     }
 }
 
@@ -273,6 +309,7 @@ impl<M: Model> Fmu3<M> {
         let env = &*log as *const Log as *mut std::ffi::c_void;
         let c = unsafe {
             abi3::instantiate_co_simulation::<M>(
+                Function::Fmi3InstantiateCoSimulation,
                 name.as_ptr(),
                 token.as_ptr(),
                 std::ptr::null(),
@@ -302,6 +339,7 @@ impl<M: Model> Fmu3<M> {
         let env = &*log as *const Log as *mut std::ffi::c_void;
         let c = unsafe {
             abi3::instantiate_model_exchange::<M>(
+                Function::Fmi3InstantiateModelExchange,
                 name.as_ptr(),
                 token.as_ptr(),
                 std::ptr::null(),
@@ -337,6 +375,7 @@ impl<M: Model> Fmu3<M> {
     pub fn enter_init(&self, start: f64, stop: Option<f64>) -> Fmi3Status {
         unsafe {
             abi3::enter_initialization_mode::<M>(
+                Function::Fmi3EnterInitializationMode,
                 self.c,
                 FMI3_FALSE,
                 0.0,
@@ -348,7 +387,7 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn exit_init(&self) -> Fmi3Status {
-        unsafe { abi3::exit_initialization_mode::<M>(self.c) }
+        unsafe { abi3::exit_initialization_mode::<M>(Function::Fmi3ExitInitializationMode, self.c) }
     }
 
     /// Enter and exit initialization at `start` with an optional stop time, all Ok.
@@ -358,7 +397,16 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn get_float64(&self, vrs: &[u32], out: &mut [f64]) -> Fmi3Status {
-        unsafe { abi3::get_float64::<M>(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr(), out.len()) }
+        unsafe {
+            abi3::get::<M, abi3::value::Float64>(
+                Function::Fmi3GetFloat64,
+                self.c,
+                vrs.as_ptr(),
+                vrs.len(),
+                out.as_mut_ptr(),
+                out.len(),
+            )
+        }
     }
 
     pub fn float64(&self, vr: u32) -> f64 {
@@ -368,48 +416,73 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn set_float64(&self, vrs: &[u32], values: &[f64]) -> Fmi3Status {
-        unsafe { abi3::set_float64::<M>(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()) }
+        unsafe {
+            abi3::set::<M, abi3::value::Float64>(
+                Function::Fmi3SetFloat64,
+                self.c,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_ptr(),
+                values.len(),
+            )
+        }
     }
 
     pub fn int32(&self, vr: u32) -> i32 {
         let mut x = [-7];
-        let s = unsafe { abi3::get_int32::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        let s =
+            unsafe { abi3::get::<M, abi3::value::Int32>(Function::Fmi3GetInt32, self.c, &vr, 1, x.as_mut_ptr(), 1) };
         assert_eq!(s, OK3, "{}", self.last_error());
         x[0]
     }
 
     pub fn set_int32(&self, vr: u32, x: i32) -> Fmi3Status {
-        unsafe { abi3::set_int32::<M>(self.c, &vr, 1, &x, 1) }
+        unsafe { abi3::set::<M, abi3::value::Int32>(Function::Fmi3SetInt32, self.c, &vr, 1, &x, 1) }
     }
 
     pub fn int64(&self, vr: u32) -> i64 {
         let mut x = [-7];
-        let s = unsafe { abi3::get_int64::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        let s = unsafe {
+            abi3::get::<M, abi3::value::Enumeration>(Function::Fmi3GetInt64, self.c, &vr, 1, x.as_mut_ptr(), 1)
+        };
         assert_eq!(s, OK3, "{}", self.last_error());
         x[0]
     }
 
     pub fn set_int64(&self, vr: u32, x: i64) -> Fmi3Status {
-        unsafe { abi3::set_int64::<M>(self.c, &vr, 1, &x, 1) }
+        unsafe { abi3::set::<M, abi3::value::Enumeration>(Function::Fmi3SetInt64, self.c, &vr, 1, &x, 1) }
     }
 
     pub fn boolean(&self, vr: u32) -> bool {
         let mut x = [7u8];
-        let s = unsafe { abi3::get_boolean::<M>(self.c, &vr, 1, x.as_mut_ptr(), 1) };
+        let s = unsafe {
+            abi3::get::<M, abi3::value::Boolean>(Function::Fmi3GetBoolean, self.c, &vr, 1, x.as_mut_ptr(), 1)
+        };
         assert_eq!(s, OK3, "{}", self.last_error());
         x[0] != 0
     }
 
     pub fn set_boolean(&self, vr: u32, x: bool) -> Fmi3Status {
         let b = x as u8;
-        unsafe { abi3::set_boolean::<M>(self.c, &vr, 1, &b, 1) }
+        unsafe { abi3::set::<M, abi3::value::Boolean>(Function::Fmi3SetBoolean, self.c, &vr, 1, &b, 1) }
     }
 
     /// `fmi3DoStep` and its outputs.
     pub fn step(&self, t: f64, h: f64) -> StepOutcome {
         let (mut event, mut terminate, mut early, mut last) = (7u8, 7u8, 7u8, f64::NAN);
-        let status =
-            unsafe { abi3::do_step::<M>(self.c, t, h, FMI3_TRUE, &mut event, &mut terminate, &mut early, &mut last) };
+        let status = unsafe {
+            abi3::do_step::<M>(
+                Function::Fmi3DoStep,
+                self.c,
+                t,
+                h,
+                FMI3_TRUE,
+                &mut event,
+                &mut terminate,
+                &mut early,
+                &mut last,
+            )
+        };
         StepOutcome {
             status,
             event_handling_needed: event != 0,
@@ -420,24 +493,24 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn terminate(&self) -> Fmi3Status {
-        unsafe { abi3::terminate::<M>(self.c) }
+        unsafe { abi3::terminate::<M>(Function::Fmi3Terminate, self.c) }
     }
 
     pub fn reset(&self) -> Fmi3Status {
-        unsafe { abi3::reset::<M>(self.c) }
+        unsafe { abi3::reset::<M>(Function::Fmi3Reset, self.c) }
     }
 
     // Model Exchange
     pub fn set_time(&self, t: f64) -> Fmi3Status {
-        unsafe { abi3::set_time::<M>(self.c, t) }
+        unsafe { abi3::set_time::<M>(Function::Fmi3SetTime, self.c, t) }
     }
 
     pub fn enter_event_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_event_mode::<M>(self.c) }
+        unsafe { abi3::enter_event_mode::<M>(Function::Fmi3EnterEventMode, self.c) }
     }
 
     pub fn enter_continuous_time_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_continuous_time_mode::<M>(self.c) }
+        unsafe { abi3::enter_continuous_time_mode::<M>(Function::Fmi3EnterContinuousTimeMode, self.c) }
     }
 
     /// `fmi3UpdateDiscreteStates`, which must return Ok.
@@ -446,6 +519,7 @@ impl<M: Model> Fmu3<M> {
             (7u8, 7u8, 7u8, 7u8, 7u8, f64::NAN);
         let s = unsafe {
             abi3::update_discrete_states::<M>(
+                Function::Fmi3UpdateDiscreteStates,
                 self.c,
                 &mut need,
                 &mut terminate,
@@ -465,18 +539,27 @@ impl<M: Model> Fmu3<M> {
 
     pub fn continuous_states(&self) -> Vec<f64> {
         let mut x = vec![f64::NAN; M::declaration().number_of_states()];
-        let s = unsafe { abi3::get_continuous_states::<M>(self.c, x.as_mut_ptr(), x.len()) };
+        let s = unsafe {
+            abi3::get_continuous_states::<M>(Function::Fmi3GetContinuousStates, self.c, x.as_mut_ptr(), x.len())
+        };
         assert_eq!(s, OK3, "{}", self.last_error());
         x
     }
 
     pub fn set_continuous_states(&self, x: &[f64]) -> Fmi3Status {
-        unsafe { abi3::set_continuous_states::<M>(self.c, x.as_ptr(), x.len()) }
+        unsafe { abi3::set_continuous_states::<M>(Function::Fmi3SetContinuousStates, self.c, x.as_ptr(), x.len()) }
     }
 
     pub fn derivatives(&self) -> Vec<f64> {
         let mut dx = vec![f64::NAN; M::declaration().number_of_states()];
-        let s = unsafe { abi3::get_continuous_state_derivatives::<M>(self.c, dx.as_mut_ptr(), dx.len()) };
+        let s = unsafe {
+            abi3::get_continuous_state_derivatives::<M>(
+                Function::Fmi3GetContinuousStateDerivatives,
+                self.c,
+                dx.as_mut_ptr(),
+                dx.len(),
+            )
+        };
         assert_eq!(s, OK3, "{}", self.last_error());
         dx
     }
@@ -485,7 +568,8 @@ impl<M: Model> Fmu3<M> {
     pub fn directional(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
         let mut out = vec![f64::NAN; unknowns.len()];
         let s = unsafe {
-            abi3::get_directional_derivative::<M>(
+            abi3::get_partial_derivatives::<M>(
+                Function::Fmi3GetDirectionalDerivative,
                 self.c,
                 unknowns.as_ptr(),
                 unknowns.len(),
@@ -508,7 +592,8 @@ impl<M: Model> Fmu3<M> {
     pub fn adjoint(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
         let mut out = vec![f64::NAN; knowns.len()];
         let s = unsafe {
-            abi3::get_adjoint_derivative::<M>(
+            abi3::get_partial_derivatives::<M>(
+                Function::Fmi3GetAdjointDerivative,
                 self.c,
                 unknowns.as_ptr(),
                 unknowns.len(),
@@ -531,12 +616,23 @@ impl<M: Model> Fmu3<M> {
     pub fn serialized_state(&self) -> Vec<u8> {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
-            assert_eq!(abi3::get_fmu_state::<M>(self.c, &mut s), OK3, "{}", self.last_error());
+            assert_eq!(
+                abi3::get_fmu_state::<M>(Function::Fmi3GetFMUState, self.c, &mut s),
+                OK3,
+                "{}",
+                self.last_error()
+            );
             let mut n = 0usize;
-            assert_eq!(abi3::serialized_fmu_state_size::<M>(self.c, s, &mut n), OK3);
+            assert_eq!(
+                abi3::serialized_fmu_state_size::<M>(Function::Fmi3SerializedFMUStateSize, self.c, s, &mut n),
+                OK3
+            );
             let mut bytes = vec![0u8; n];
-            assert_eq!(abi3::serialize_fmu_state::<M>(self.c, s, bytes.as_mut_ptr(), n), OK3);
-            assert_eq!(abi3::free_fmu_state::<M>(self.c, &mut s), OK3);
+            assert_eq!(
+                abi3::serialize_fmu_state::<M>(Function::Fmi3SerializeFMUState, self.c, s, bytes.as_mut_ptr(), n),
+                OK3
+            );
+            assert_eq!(abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s), OK3);
             bytes
         }
     }
@@ -545,12 +641,18 @@ impl<M: Model> Fmu3<M> {
     pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi3Status {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
-            let st = abi3::deserialize_fmu_state::<M>(self.c, bytes.as_ptr(), bytes.len(), &mut s);
+            let st = abi3::deserialize_fmu_state::<M>(
+                Function::Fmi3DeserializeFMUState,
+                self.c,
+                bytes.as_ptr(),
+                bytes.len(),
+                &mut s,
+            );
             if st != OK3 {
                 return st;
             }
-            let st = abi3::set_fmu_state::<M>(self.c, s);
-            abi3::free_fmu_state::<M>(self.c, &mut s);
+            let st = abi3::set_fmu_state::<M>(Function::Fmi3SetFMUState, self.c, s);
+            abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s);
             st
         }
     }
@@ -558,7 +660,7 @@ impl<M: Model> Fmu3<M> {
 
 impl<M: Model> Drop for Fmu3<M> {
     fn drop(&mut self) {
-        unsafe { abi3::free_instance::<M>(self.c) }
+        unsafe { abi3::free_instance::<M>(Function::Fmi3FreeInstance, self.c) }
     }
 }
 
@@ -613,7 +715,9 @@ pub fn assert_cs_runs_agree<M: Model>(
                 BaseType::Integer => f2.int(v.value_reference) == f3.int32(vr3),
                 BaseType::Boolean => {
                     let mut b = -1;
-                    let s = unsafe { abi::get_boolean::<M>(f2.c, &v.value_reference, 1, &mut b) };
+                    let s = unsafe {
+                        abi::get::<M, abi::value::Boolean>(Function::GetBoolean, f2.c, &v.value_reference, 1, &mut b)
+                    };
                     assert_eq!(s, OK);
                     (b != 0) == f3.boolean(vr3)
                 }

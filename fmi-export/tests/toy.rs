@@ -14,7 +14,6 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CString};
 use std::ptr::null_mut;
-use std::sync::OnceLock;
 
 use fmi_export::abi::{self, Fmi2EventInfo};
 use fmi_export::ffi::*;
@@ -127,14 +126,11 @@ impl fmi_export::Access<Toy> for V {}
 impl Model for Toy {
     type Binding = V;
 
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
-            let both = Interfaces { model_exchange: true, co_simulation: true };
-            Declaration::new(spec(caps, both, "toy")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+        let both = Interfaces { model_exchange: true, co_simulation: true };
+        spec(caps, both, "toy")
+    });
 
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         LIVE.with(|l| *l.borrow_mut() += 1);
@@ -279,13 +275,10 @@ impl fmi_export::Access<Bare> for V {}
 
 impl Model for Bare {
     type Binding = V;
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let cs = Interfaces { model_exchange: false, co_simulation: true };
-            Declaration::new(spec(Capabilities::default(), cs, "bare")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let cs = Interfaces { model_exchange: false, co_simulation: true };
+        spec(Capabilities::default(), cs, "bare")
+    });
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         Toy::instantiate(context).map(Bare)
     }
@@ -322,14 +315,11 @@ impl fmi_export::Access<Own> for V {}
 impl Model for Own {
     type Binding = V;
     const SAVE_DECLARED_VARIABLES: bool = false;
-    fn declaration() -> &'static Declaration<V> {
-        static D: OnceLock<Declaration<V>> = OnceLock::new();
-        D.get_or_init(|| {
-            let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
-            let cs = Interfaces { model_exchange: false, co_simulation: true };
-            Declaration::new(spec(caps, cs, "own")).unwrap()
-        })
-    }
+    declare_model!(V, {
+        let caps = Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false };
+        let cs = Interfaces { model_exchange: false, co_simulation: true };
+        spec(caps, cs, "own")
+    });
     fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
         Toy::instantiate(context).map(Own)
     }
@@ -497,10 +487,10 @@ fn co_simulation_runs_the_samples_inside_do_step_with_the_inputs_of_their_instan
 fn model_exchange_reports_the_next_time_event_and_iterates() {
     let f = Fmu::<Toy>::me();
     unsafe {
-        assert_eq!(abi::setup_experiment::<Toy>(f.c, 0, 0.0, 0.0, 0, 0.0), OK);
-        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::setup_experiment::<Toy>(Function::SetupExperiment, f.c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK);
         assert_eq!(f.set_int(vr::MODE, SETTLE), OK);
-        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, f.c), OK);
         assert_eq!(f.set_real(vr::U, 1.0), OK);
         let mut info = Fmi2EventInfo {
             new_discrete_states_needed: 0,
@@ -513,27 +503,30 @@ fn model_exchange_reports_the_next_time_event_and_iterates() {
         let mut t = 0.0;
         for k in 1..=3 {
             // the event iteration: settle asks once for another round
-            assert_eq!(abi::new_discrete_states::<Toy>(f.c, &mut info), OK);
+            assert_eq!(abi::new_discrete_states::<Toy>(Function::NewDiscreteStates, f.c, &mut info), OK);
             assert_eq!(info.new_discrete_states_needed, FMI2_TRUE);
-            assert_eq!(abi::new_discrete_states::<Toy>(f.c, &mut info), OK);
+            assert_eq!(abi::new_discrete_states::<Toy>(Function::NewDiscreteStates, f.c, &mut info), OK);
             assert_eq!(info.new_discrete_states_needed, FMI2_FALSE);
             assert_eq!(info.next_event_time_defined, FMI2_TRUE);
             assert_eq!(info.next_event_time, k as f64 * 0.1);
             assert_eq!(f.int(vr::SAMPLES), k);
             assert_eq!(f.int(vr::ITERATIONS), 2 * k);
             // zero continuous states: nx = 0 everywhere
-            assert_eq!(abi::enter_continuous_time_mode::<Toy>(f.c), OK);
-            assert_eq!(abi::get_derivatives::<Toy>(f.c, null_mut(), 0), OK);
-            assert_eq!(abi::set_continuous_states::<Toy>(f.c, std::ptr::null(), 0), OK);
+            assert_eq!(abi::enter_continuous_time_mode::<Toy>(Function::EnterContinuousTimeMode, f.c), OK);
+            assert_eq!(abi::get_derivatives::<Toy>(Function::GetDerivatives, f.c, null_mut(), 0), OK);
+            assert_eq!(abi::set_continuous_states::<Toy>(Function::SetContinuousStates, f.c, std::ptr::null(), 0), OK);
             // integrating up to just before the event changes nothing
-            assert_eq!(abi::set_time::<Toy>(f.c, info.next_event_time - 1e-3), OK);
+            assert_eq!(abi::set_time::<Toy>(Function::SetTime, f.c, info.next_event_time - 1e-3), OK);
             let (mut enter, mut term) = (7, 7);
-            assert_eq!(abi::completed_integrator_step::<Toy>(f.c, 1, &mut enter, &mut term), OK);
+            assert_eq!(
+                abi::completed_integrator_step::<Toy>(Function::CompletedIntegratorStep, f.c, 1, &mut enter, &mut term),
+                OK
+            );
             assert_eq!((enter, term), (FMI2_FALSE, FMI2_FALSE));
             assert_eq!(f.int(vr::SAMPLES), k);
             t = info.next_event_time;
-            assert_eq!(abi::set_time::<Toy>(f.c, t), OK);
-            assert_eq!(abi::enter_event_mode::<Toy>(f.c), OK);
+            assert_eq!(abi::set_time::<Toy>(Function::SetTime, f.c, t), OK);
+            assert_eq!(abi::enter_event_mode::<Toy>(Function::EnterEventMode, f.c), OK);
         }
         assert_eq!(t, 0.30000000000000004);
         // a Co-Simulation call on a Model Exchange instance
@@ -547,9 +540,9 @@ fn model_exchange_reports_the_next_time_event_and_iterates() {
     // the same model in Co-Simulation runs both iterations per sample inside the step
     let g = Fmu::<Toy>::cs();
     unsafe {
-        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, g.c), OK);
         assert_eq!(g.set_int(vr::MODE, SETTLE), OK);
-        assert_eq!(abi::exit_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, g.c), OK);
     }
     assert_eq!(g.set_real(vr::U, 1.0), OK);
     assert_eq!(g.step(0.0, 0.25), OK);
@@ -566,12 +559,12 @@ fn tunable_parameters_change_between_steps_fixed_ones_are_refused_naming_the_var
     assert!(e.contains("fmi2SetReal") && e.contains("sample_period") && e.contains("fixed"), "{e}");
     assert_eq!(f.reset(), OK);
     // after reset the start values are back and everything works again
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
     assert_eq!(f.real(vr::GAIN), 2.0);
     // values cannot be read before initialization (FMI 2.0 state table)
     assert_eq!(f.reset(), OK);
     let (g, mut x) = (vr::GAIN, 0.0);
-    assert_eq!(unsafe { abi::get_real::<Toy>(f.c, &g, 1, &mut x) }, ERR);
+    assert_eq!(unsafe { abi::get::<Toy, abi::value::Real>(Function::GetReal, f.c, &g, 1, &mut x) }, ERR);
 }
 
 #[test]
@@ -586,7 +579,7 @@ fn bad_values_are_refused_naming_the_variable_and_reset_recovers() {
         ("sample_period", Box::new(|f| f.set_real(vr::PERIOD, f64::INFINITY))),
     ];
     for (name, bad) in cases {
-        unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+        unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
         assert_eq!(bad(&f), ERR, "{name}");
         let e = f.last_error();
         assert!(e.contains(name) && e.contains("refused"), "{name}: {e}");
@@ -604,9 +597,12 @@ fn bad_values_are_refused_naming_the_variable_and_reset_recovers() {
 
 unsafe fn serialize<M: Model>(c: fmi2Component, s: fmi2FMUstate) -> Vec<u8> {
     let mut size = 0;
-    assert_eq!(abi::serialized_fmu_state_size::<M>(c, s, &mut size), OK);
+    assert_eq!(abi::serialized_fmu_state_size::<M>(Function::SerializedFMUstateSize, c, s, &mut size), OK);
     let mut bytes = vec![0u8; size];
-    assert_eq!(abi::serialize_fmu_state::<M>(c, s, bytes.as_mut_ptr() as *mut c_char, size), OK);
+    assert_eq!(
+        abi::serialize_fmu_state::<M>(Function::SerializeFMUstate, c, s, bytes.as_mut_ptr() as *mut c_char, size),
+        OK
+    );
     bytes
 }
 
@@ -619,7 +615,7 @@ fn fmu_state_from_the_declaration_round_trips_bit_exactly_and_refuses_hostile_by
     assert_eq!(f.step(0.0, 0.25), OK);
     let mut state: fmi2FMUstate = null_mut();
     let bytes = unsafe {
-        assert_eq!(abi::get_fmu_state::<Toy>(f.c, &mut state), OK);
+        assert_eq!(abi::get_fmu_state::<Toy>(Function::GetFMUstate, f.c, &mut state), OK);
         serialize::<Toy>(f.c, state)
     };
     let run = |f: &Fmu<Toy>| -> Vec<u64> {
@@ -636,13 +632,13 @@ fn fmu_state_from_the_declaration_round_trips_bit_exactly_and_refuses_hostile_by
     };
     let first = run(&f);
     // restore the in-memory state, and a deserialized copy in a second instance
-    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(f.c, state), OK) };
+    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(Function::SetFMUstate, f.c, state), OK) };
     assert_eq!(run(&f), first);
     let g = Fmu::<Toy>::cs();
     let mut copy: fmi2FMUstate = null_mut();
     unsafe {
         assert_eq!(de_serialize(&g, &bytes, &mut copy), OK, "{}", g.last_error());
-        assert_eq!(abi::set_fmu_state::<Toy>(g.c, copy), OK);
+        assert_eq!(abi::set_fmu_state::<Toy>(Function::SetFMUstate, g.c, copy), OK);
     }
     assert_eq!(run(&g), first, "the sample counter (internal data) travels too");
 
@@ -671,13 +667,19 @@ fn fmu_state_from_the_declaration_round_trips_bit_exactly_and_refuses_hostile_by
         assert_eq!(g.reset(), OK);
     }
     unsafe {
-        assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut state), OK);
+        assert_eq!(abi::free_fmu_state::<Toy>(Function::FreeFMUstate, f.c, &mut state), OK);
         assert!(state.is_null());
     }
 }
 
 unsafe fn de_serialize(f: &Fmu<Toy>, bytes: &[u8], s: &mut fmi2FMUstate) -> Fmi2Status {
-    abi::deserialize_fmu_state::<Toy>(f.c, bytes.as_ptr() as *const c_char, bytes.len(), s)
+    abi::deserialize_fmu_state::<Toy>(
+        Function::DeSerializeFMUstate,
+        f.c,
+        bytes.as_ptr() as *const c_char,
+        bytes.len(),
+        s,
+    )
 }
 
 #[test]
@@ -689,22 +691,22 @@ fn fmu_states_belong_to_their_instance_and_are_freed_with_it() {
         f.init(None);
         let mut states = [null_mut(); 3];
         for s in &mut states {
-            unsafe { assert_eq!(abi::get_fmu_state::<Toy>(f.c, s), OK) };
+            unsafe { assert_eq!(abi::get_fmu_state::<Toy>(Function::GetFMUstate, f.c, s), OK) };
         }
         // a state of another instance, a freed one, a made-up pointer: refused, not used
         let mut foreign: fmi2FMUstate = null_mut();
         unsafe {
-            assert_eq!(abi::set_fmu_state::<Toy>(g.c, states[0]), ERR);
+            assert_eq!(abi::set_fmu_state::<Toy>(Function::SetFMUstate, g.c, states[0]), ERR);
             assert!(g.last_error().contains("not made by this instance"), "{}", g.last_error());
-            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut states[2]), OK);
+            assert_eq!(abi::free_fmu_state::<Toy>(Function::FreeFMUstate, f.c, &mut states[2]), OK);
             let freed = states[1];
-            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut states[1]), OK);
+            assert_eq!(abi::free_fmu_state::<Toy>(Function::FreeFMUstate, f.c, &mut states[1]), OK);
             assert_eq!(f.reset(), OK);
-            assert_eq!(abi::set_fmu_state::<Toy>(f.c, freed), ERR);
+            assert_eq!(abi::set_fmu_state::<Toy>(Function::SetFMUstate, f.c, freed), ERR);
             let mut made_up = 0x1234usize as fmi2FMUstate;
             assert_eq!(f.reset(), OK);
-            assert_eq!(abi::free_fmu_state::<Toy>(f.c, &mut made_up), ERR);
-            assert_eq!(abi::get_fmu_state::<Toy>(g.c, &mut foreign), OK);
+            assert_eq!(abi::free_fmu_state::<Toy>(Function::FreeFMUstate, f.c, &mut made_up), ERR);
+            assert_eq!(abi::get_fmu_state::<Toy>(Function::GetFMUstate, g.c, &mut foreign), OK);
         }
         // f still owns states[0], g owns `foreign`: freeing the instances frees them
         assert!(live() > before + 2);
@@ -718,7 +720,7 @@ fn capabilities_not_declared_are_refused_as_not_supported() {
     f.init(None);
     let mut s: fmi2FMUstate = null_mut();
     unsafe {
-        assert_eq!(abi::get_fmu_state::<Bare>(f.c, &mut s), ERR);
+        assert_eq!(abi::get_fmu_state::<Bare>(Function::GetFMUstate, f.c, &mut s), ERR);
         assert!(f.last_error().contains("fmi2GetFMUstate: not supported"), "{}", f.last_error());
         assert_eq!(f.reset(), OK);
     }
@@ -726,7 +728,9 @@ fn capabilities_not_declared_are_refused_as_not_supported() {
     let log = testing::Log::environment();
     let callbacks = log.callbacks();
     let guid = CString::new(Bare::declaration().guid()).unwrap();
-    let c = unsafe { abi::instantiate::<Bare>(c"x".as_ptr(), 0, guid.as_ptr(), null_mut(), &callbacks, 0, 0) };
+    let c = unsafe {
+        abi::instantiate::<Bare>(Function::Instantiate, c"x".as_ptr(), 0, guid.as_ptr(), null_mut(), &callbacks, 0, 0)
+    };
     assert!(c.is_null());
     assert!(log.0.borrow()[0].2.contains("does not offer ModelExchange"));
     // the toy has FMU state but not directional derivatives
@@ -735,7 +739,19 @@ fn capabilities_not_declared_are_refused_as_not_supported() {
     let (vy, vu, dv) = (vr::Y, vr::U, 1.0);
     let mut out = 0.0;
     unsafe {
-        assert_eq!(abi::get_directional_derivative::<Toy>(t.c, &vy, 1, &vu, 1, &dv, &mut out), ERR);
+        assert_eq!(
+            abi::get_directional_derivative::<Toy>(
+                Function::GetDirectionalDerivative,
+                t.c,
+                &vy,
+                1,
+                &vu,
+                1,
+                &dv,
+                &mut out
+            ),
+            ERR
+        );
     }
     assert!(t.last_error().contains("fmi2GetDirectionalDerivative: not supported"), "{}", t.last_error());
 }
@@ -745,7 +761,7 @@ fn warning_and_discard_and_step_failed() {
     let f = Fmu::<Toy>::cs();
     f.init(None);
     let mut saved: fmi2FMUstate = null_mut();
-    unsafe { assert_eq!(abi::get_fmu_state::<Toy>(f.c, &mut saved), OK) };
+    unsafe { assert_eq!(abi::get_fmu_state::<Toy>(Function::GetFMUstate, f.c, &mut saved), OK) };
     assert_eq!(f.set_real(vr::U, 200.0), OK);
     assert_eq!(f.step(0.0, 0.05), Fmi2Status::Warning);
     assert!(f.log.0.borrow().iter().any(|r| r.0 == 1 && r.1 == "logStatusWarning" && r.2.contains("u = 200")));
@@ -756,14 +772,14 @@ fn warning_and_discard_and_step_failed() {
     assert!(f.last_error().contains("fmi2DoStep: y = "), "{}", f.last_error());
     let (mut t, mut status) = (f64::NAN, -1);
     unsafe {
-        assert_eq!(abi::get_real_status::<Toy>(f.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t), OK);
-        assert_eq!(abi::get_status::<Toy>(f.c, FMI2_DO_STEP_STATUS, &mut status), OK);
+        assert_eq!(abi::get_real_status::<Toy>(Function::GetRealStatus, f.c, FMI2_LAST_SUCCESSFUL_TIME, &mut t), OK);
+        assert_eq!(abi::get_status::<Toy>(Function::GetStatus, f.c, FMI2_DO_STEP_STATUS, &mut status), OK);
     }
     assert_eq!(t, 0.15 + 0.05, "the sample at 0.2 failed");
     assert_eq!(status, Fmi2Status::Discard as c_int);
     assert_eq!(f.real(vr::Y), 2.0 * 200.0 + 0.1 * 200.0, "outputs of the last good sample (0.1)");
     // stepFailed: the saved state continues (as the standard says)
-    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(f.c, saved), OK) };
+    unsafe { assert_eq!(abi::set_fmu_state::<Toy>(Function::SetFMUstate, f.c, saved), OK) };
     assert_eq!(f.set_real(vr::U, 1.0), OK);
     assert_eq!(f.step(0.0, 0.1), OK);
     assert_eq!(f.real(vr::Y), 2.0 + 0.1, "the sample at the step's end, t = 0.1, with u(0.1)");
@@ -789,17 +805,25 @@ fn stop_time_is_enforced_and_setup_refuses_non_finite_numbers() {
         [(f64::NAN, 0.0, 1.0), (1e-6, f64::INFINITY, 1.0), (1e-6, 0.0, f64::NAN), (1e-6, 1.0, 0.5)]
     {
         assert_eq!(f.reset(), OK);
-        assert_eq!(unsafe { abi::setup_experiment::<Toy>(f.c, 1, tol, start, 1, stop) }, ERR, "{tol} {start} {stop}");
+        assert_eq!(
+            unsafe { abi::setup_experiment::<Toy>(Function::SetupExperiment, f.c, 1, tol, start, 1, stop) },
+            ERR,
+            "{tol} {start} {stop}"
+        );
     }
     let g = Fmu::<Toy>::me();
     unsafe {
-        assert_eq!(abi::setup_experiment::<Toy>(g.c, 0, 0.0, 0.0, 1, 1.0), OK);
-        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
-        assert_eq!(abi::set_time::<Toy>(g.c, 0.5), ERR, "SetTime is not allowed in Initialization Mode");
+        assert_eq!(abi::setup_experiment::<Toy>(Function::SetupExperiment, g.c, 0, 0.0, 0.0, 1, 1.0), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, g.c), OK);
+        assert_eq!(
+            abi::set_time::<Toy>(Function::SetTime, g.c, 0.5),
+            ERR,
+            "SetTime is not allowed in Initialization Mode"
+        );
         assert_eq!(g.reset(), OK);
         g.init(Some(1.0));
         // Model Exchange: integrators evaluate past the output time; a warning, not an error
-        assert_eq!(abi::set_time::<Toy>(g.c, 1.5), Fmi2Status::Warning);
+        assert_eq!(abi::set_time::<Toy>(Function::SetTime, g.c, 1.5), Fmi2Status::Warning);
         assert!(g.log.0.borrow().iter().any(|r| r.0 == 1 && r.2.contains("after the stopTime 1")));
     }
 }
@@ -808,22 +832,22 @@ fn stop_time_is_enforced_and_setup_refuses_non_finite_numbers() {
 fn booleans_and_integers_read_back_and_enabled_switch_acts() {
     let f = Fmu::<Toy>::cs();
     unsafe {
-        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK);
         let (b, off) = (FMI2_FALSE, 5);
-        assert_eq!(abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &b), OK);
+        assert_eq!(abi::set::<Toy, abi::value::Boolean>(Function::SetBoolean, f.c, &vr::ENABLED, 1, &b), OK);
         assert_eq!(f.set_int(vr::OFFSET, off), OK);
         let mut back = 9;
-        assert_eq!(abi::get_boolean::<Toy>(f.c, &vr::ENABLED, 1, &mut back), OK);
+        assert_eq!(abi::get::<Toy, abi::value::Boolean>(Function::GetBoolean, f.c, &vr::ENABLED, 1, &mut back), OK);
         assert_eq!(back, FMI2_FALSE);
         assert_eq!(f.int(vr::OFFSET), 5);
-        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, f.c), OK);
     }
     assert_eq!(f.set_real(vr::U, 1.0), OK);
     assert_eq!(f.step(0.0, 0.1), OK);
     assert_eq!(f.real(vr::Y), 0.0, "disabled");
     // a fixed Boolean after initialization: refused
     let t = FMI2_TRUE;
-    assert_eq!(unsafe { abi::set_boolean::<Toy>(f.c, &vr::ENABLED, 1, &t) }, ERR);
+    assert_eq!(unsafe { abi::set::<Toy, abi::value::Boolean>(Function::SetBoolean, f.c, &vr::ENABLED, 1, &t) }, ERR);
     assert!(f.last_error().contains("enabled"), "{}", f.last_error());
 }
 
@@ -835,11 +859,14 @@ fn a_model_can_override_the_fmu_state_format() {
     assert_eq!(f.step(0.0, 0.25), OK);
     let mut s: fmi2FMUstate = null_mut();
     let bytes = unsafe {
-        assert_eq!(abi::get_fmu_state::<Own>(f.c, &mut s), OK);
+        assert_eq!(abi::get_fmu_state::<Own>(Function::GetFMUstate, f.c, &mut s), OK);
         let mut size = 0;
-        assert_eq!(abi::serialized_fmu_state_size::<Own>(f.c, s, &mut size), OK);
+        assert_eq!(abi::serialized_fmu_state_size::<Own>(Function::SerializedFMUstateSize, f.c, s, &mut size), OK);
         let mut b = vec![0u8; size];
-        assert_eq!(abi::serialize_fmu_state::<Own>(f.c, s, b.as_mut_ptr() as *mut c_char, size), OK);
+        assert_eq!(
+            abi::serialize_fmu_state::<Own>(Function::SerializeFMUstate, f.c, s, b.as_mut_ptr() as *mut c_char, size),
+            OK
+        );
         b
     };
     // the layer's 12 numbers (the sample clock among them) and the model's own 7, no declared variables
@@ -848,9 +875,15 @@ fn a_model_can_override_the_fmu_state_format() {
     let g = Fmu::<Own>::cs();
     let mut copy: fmi2FMUstate = null_mut();
     unsafe {
-        let st = abi::deserialize_fmu_state::<Own>(g.c, bytes.as_ptr() as *const c_char, bytes.len(), &mut copy);
+        let st = abi::deserialize_fmu_state::<Own>(
+            Function::DeSerializeFMUstate,
+            g.c,
+            bytes.as_ptr() as *const c_char,
+            bytes.len(),
+            &mut copy,
+        );
         assert_eq!(st, OK, "{}", g.last_error());
-        assert_eq!(abi::set_fmu_state::<Own>(g.c, copy), OK);
+        assert_eq!(abi::set_fmu_state::<Own>(Function::SetFMUstate, g.c, copy), OK);
     }
     assert_eq!(g.step(0.25, 0.1), OK);
     assert_eq!(f.step(0.25, 0.1), OK);
@@ -863,19 +896,29 @@ fn a_model_can_ask_to_end_the_simulation() {
     // Co-Simulation: the step is discarded and fmi2Terminated reports it
     let f = Fmu::<Toy>::cs();
     unsafe {
-        assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK);
         assert_eq!(f.set_int(vr::MODE, STOP_AT_3), OK);
-        assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, f.c), OK);
     }
     let mut terminated = -1;
     assert_eq!(f.step(0.0, 0.15), OK);
-    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    unsafe {
+        assert_eq!(
+            abi::get_boolean_status::<Toy>(Function::GetBooleanStatus, f.c, FMI2_TERMINATED, &mut terminated),
+            OK
+        )
+    };
     assert_eq!(terminated, FMI2_FALSE);
     assert_eq!(f.step(0.15, 0.1), Fmi2Status::Discard);
     assert!(f.last_error().contains("asked to terminate"), "{}", f.last_error());
-    unsafe { assert_eq!(abi::get_boolean_status::<Toy>(f.c, FMI2_TERMINATED, &mut terminated), OK) };
+    unsafe {
+        assert_eq!(
+            abi::get_boolean_status::<Toy>(Function::GetBooleanStatus, f.c, FMI2_TERMINATED, &mut terminated),
+            OK
+        )
+    };
     assert_eq!(terminated, FMI2_TRUE);
-    unsafe { assert_eq!(abi::terminate::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::terminate::<Toy>(Function::Terminate, f.c), OK) };
     // Model Exchange: fmi2NewDiscreteStates says terminateSimulation
     let g = Fmu::<Toy>::me();
     let mut info = Fmi2EventInfo {
@@ -887,19 +930,19 @@ fn a_model_can_ask_to_end_the_simulation() {
         next_event_time: 0.0,
     };
     unsafe {
-        assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, g.c), OK);
         assert_eq!(g.set_int(vr::MODE, STOP_AT_3), OK);
-        assert_eq!(abi::exit_initialization_mode::<Toy>(g.c), OK);
+        assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, g.c), OK);
         for k in 0..3 {
-            assert_eq!(abi::new_discrete_states::<Toy>(g.c, &mut info), OK);
+            assert_eq!(abi::new_discrete_states::<Toy>(Function::NewDiscreteStates, g.c, &mut info), OK);
             assert_eq!(info.terminate_simulation, (k == 2) as c_int, "sample {k}");
             if k < 2 {
-                assert_eq!(abi::enter_continuous_time_mode::<Toy>(g.c), OK);
-                assert_eq!(abi::set_time::<Toy>(g.c, info.next_event_time), OK);
-                assert_eq!(abi::enter_event_mode::<Toy>(g.c), OK);
+                assert_eq!(abi::enter_continuous_time_mode::<Toy>(Function::EnterContinuousTimeMode, g.c), OK);
+                assert_eq!(abi::set_time::<Toy>(Function::SetTime, g.c, info.next_event_time), OK);
+                assert_eq!(abi::enter_event_mode::<Toy>(Function::EnterEventMode, g.c), OK);
             }
         }
-        assert_eq!(abi::terminate::<Toy>(g.c), OK);
+        assert_eq!(abi::terminate::<Toy>(Function::Terminate, g.c), OK);
     }
 }
 
@@ -910,8 +953,10 @@ fn a_model_can_ask_to_end_the_simulation() {
 #[test]
 fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
     let f = Fmu::<Toy>::cs();
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
-    let set = |vrs: &[u32], xs: &[f64]| unsafe { abi::set_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr()) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
+    let set = |vrs: &[u32], xs: &[f64]| unsafe {
+        abi::set::<Toy, abi::value::Real>(Function::SetReal, f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr())
+    };
     assert_eq!(set(&[vr::U, vr::ACC], &[0.5, 0.25]), OK);
     let before = (f.real(vr::U), f.real(vr::ACC), f.real(vr::GAIN));
     assert_eq!(before, (0.5, 0.25, 2.0));
@@ -933,15 +978,15 @@ fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
     assert_eq!(set(&[vr::U, vr::U], &[0.75, 0.5]), OK);
     assert_eq!(clones(), copies + 1);
     // the instance goes on as if the refused calls never happened
-    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, f.c), OK) };
     assert_eq!(set(&[vr::U, vr::GAIN], &[1.0, 3.0]), OK);
     assert_eq!(f.step(0.0, 0.05), OK);
     assert_eq!(f.real(vr::Y), 3.0 + 0.25); // gain 3 u 1 + acc 0.25
                                            // an Error refusal: the error state, whose diagnostic reads show the earlier values
     let g = Fmu::<Toy>::cs();
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(g.c), OK) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, g.c), OK) };
     let (vrs, xs) = ([vr::U, vr::GAIN, vr::ACC], [9.0, 4.0, 2e9]);
-    assert_eq!(unsafe { abi::set_real::<Toy>(g.c, vrs.as_ptr(), 3, xs.as_ptr()) }, ERR);
+    assert_eq!(unsafe { abi::set::<Toy, abi::value::Real>(Function::SetReal, g.c, vrs.as_ptr(), 3, xs.as_ptr()) }, ERR);
     let e = g.last_error();
     assert!(e.contains("acc") && e.contains("beyond the toy's accumulator"), "{e}");
     assert_eq!((g.real(vr::U), g.real(vr::GAIN), g.real(vr::ACC)), (0.0, 2.0, 0.0));
@@ -954,11 +999,15 @@ fn a_value_the_model_refuses_rolls_back_the_earlier_values_of_the_same_call() {
 #[test]
 fn repeated_value_reference_arrays_are_checked_every_time() {
     let f = Fmu::<Toy>::cs();
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
-    let set = |vrs: &[u32], xs: &[f64]| unsafe { abi::set_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr()) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
+    let set = |vrs: &[u32], xs: &[f64]| unsafe {
+        abi::set::<Toy, abi::value::Real>(Function::SetReal, f.c, vrs.as_ptr(), vrs.len(), xs.as_ptr())
+    };
     let get = |vrs: &[u32]| {
         let mut out = vec![f64::NAN; vrs.len()];
-        let s = unsafe { abi::get_real::<Toy>(f.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
+        let s = unsafe {
+            abi::get::<Toy, abi::value::Real>(Function::GetReal, f.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
+        };
         (s, out)
     };
     let vrs = [vr::U, vr::PERIOD, vr::GAIN];
@@ -971,14 +1020,14 @@ fn repeated_value_reference_arrays_are_checked_every_time() {
     assert!(f.last_error().contains("gain = -1 refused: below its minimum 0"), "{}", f.last_error());
     assert_eq!(get(&vrs), (OK, vec![2.0, 0.1, 4.0]));
     assert_eq!(f.reset(), OK);
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
     assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), OK);
-    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::exit_initialization_mode::<Toy>(Function::ExitInitializationMode, f.c), OK) };
     // the same array after initialization: the fixed parameter is refused now
     assert_eq!(set(&vrs, &[1.0, 0.1, 3.0]), ERR);
     assert!(f.last_error().contains("sample_period cannot be set after initialization"), "{}", f.last_error());
     assert_eq!(f.reset(), OK);
-    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(f.c), OK) };
+    unsafe { assert_eq!(abi::enter_initialization_mode::<Toy>(Function::EnterInitializationMode, f.c), OK) };
     // a known array then one with an unknown value reference at the end
     assert_eq!(get(&[vr::U, vr::GAIN]).0, OK);
     assert_eq!(get(&[vr::U, 99]).0, ERR);
@@ -1065,9 +1114,15 @@ fn fmi3_model_exchange_updates_discrete_states_at_the_time_events() {
     assert_eq!(f.float64(vr3::Y), expected(2.0, 0.1, &[1.0, 1.0]).0);
     let mut n = 7usize;
     unsafe {
-        assert_eq!(abi::fmi3::get_number_of_continuous_states::<Toy>(f.c, &mut n), OK3);
+        assert_eq!(
+            abi::fmi3::get_number_of_continuous_states::<Toy>(Function::Fmi3GetNumberOfContinuousStates, f.c, &mut n),
+            OK3
+        );
         assert_eq!(n, 0);
-        assert_eq!(abi::fmi3::get_number_of_event_indicators::<Toy>(f.c, &mut n), OK3);
+        assert_eq!(
+            abi::fmi3::get_number_of_event_indicators::<Toy>(Function::Fmi3GetNumberOfEventIndicators, f.c, &mut n),
+            OK3
+        );
         assert_eq!(n, 0);
     }
 }
@@ -1083,7 +1138,12 @@ fn fmi3_values_of_the_wrong_type_count_or_range_are_refused_naming_the_reason() 
     let mut f = fresh();
     // Int32 of a Float64, Float64 of an Enumeration, a type the toy has none of
     let mut i = [0i32];
-    assert_eq!(unsafe { abi::fmi3::get_int32::<Toy>(f.c, &vr3::U, 1, i.as_mut_ptr(), 1) }, ERR3);
+    assert_eq!(
+        unsafe {
+            abi::fmi3::get::<Toy, abi::fmi3::value::Int32>(Function::Fmi3GetInt32, f.c, &vr3::U, 1, i.as_mut_ptr(), 1)
+        },
+        ERR3
+    );
     assert!(f.last_error().contains("value reference 1 is u, a Float64 variable, not a Int32"), "{}", f.last_error());
     f = fresh();
     let mut x = [0.0];
@@ -1091,16 +1151,39 @@ fn fmi3_values_of_the_wrong_type_count_or_range_are_refused_naming_the_reason() 
     assert!(f.last_error().contains("mode, a Enumeration variable, not a Float64"), "{}", f.last_error());
     f = fresh();
     let mut g = [0.0f32];
-    assert_eq!(unsafe { abi::fmi3::get_float32::<Toy>(f.c, &vr3::U, 1, g.as_mut_ptr(), 1) }, ERR3);
+    assert_eq!(
+        unsafe {
+            abi::fmi3::get::<Toy, abi::fmi3::value::Float32>(
+                Function::Fmi3GetFloat32,
+                f.c,
+                &vr3::U,
+                1,
+                g.as_mut_ptr(),
+                1,
+            )
+        },
+        ERR3
+    );
     assert!(f.last_error().starts_with("fmi3GetFloat32:") && f.last_error().contains("not a Float32"));
     f = fresh();
-    let mut c = [0u8];
-    assert_eq!(unsafe { abi::fmi3::get_clock::<Toy>(f.c, &vr3::ENABLED, 1, c.as_mut_ptr()) }, ERR3);
+    assert_eq!(unsafe { abi::fmi3::clock::<Toy>(Function::Fmi3GetClock, f.c, &vr3::ENABLED, 1) }, ERR3);
     // the FMU declares no Clock: fmi3GetClock is refused as a feature it lacks
     assert!(f.last_error().contains("not supported: no clocks are declared"), "{}", f.last_error());
     f = fresh();
     // an empty call of such a type is fine
-    assert_eq!(unsafe { abi::fmi3::get_float32::<Toy>(f.c, std::ptr::null(), 0, std::ptr::null_mut(), 0) }, OK3);
+    assert_eq!(
+        unsafe {
+            abi::fmi3::get::<Toy, abi::fmi3::value::Float32>(
+                Function::Fmi3GetFloat32,
+                f.c,
+                std::ptr::null(),
+                0,
+                std::ptr::null_mut(),
+                0,
+            )
+        },
+        OK3
+    );
     // unknown value reference, bad nValues
     assert_eq!(f.set_float64(&[99], &[1.0]), ERR3);
     assert!(f.last_error().contains("unknown value reference 99"), "{}", f.last_error());
@@ -1147,15 +1230,8 @@ fn fmi3_instantiation_checks_the_token_event_mode_and_interface() {
     let token = CString::new(Toy::declaration().guid()).unwrap();
     let c = unsafe {
         abi::fmi3::instantiate_scheduled_execution::<Toy>(
-            c"s".as_ptr(),
-            token.as_ptr(),
-            std::ptr::null(),
-            0,
-            1,
+            Function::Fmi3InstantiateScheduledExecution,
             &*log as *const testing::Log as *mut std::ffi::c_void,
-            None,
-            None,
-            None,
             None,
         )
     };
@@ -1163,6 +1239,7 @@ fn fmi3_instantiation_checks_the_token_event_mode_and_interface() {
     // no logger given: still NULL, nothing to crash on
     let c = unsafe {
         abi::fmi3::instantiate_model_exchange::<Toy>(
+            Function::Fmi3InstantiateModelExchange,
             std::ptr::null(),
             token.as_ptr(),
             std::ptr::null(),
@@ -1182,7 +1259,7 @@ fn fmi3_instantiation_checks_the_token_event_mode_and_interface() {
 fn fmi3_undeclared_features_and_illegal_orders_are_errors_with_a_message() {
     for f in Function::FMI3.into_iter().filter(|f| f.undeclared_feature().is_some()) {
         let fmu = Fmu3::<Toy>::cs();
-        assert_eq!(unsafe { abi::fmi3::undeclared::<Toy>(fmu.c, f) }, ERR3);
+        assert_eq!(unsafe { abi::fmi3::undeclared::<Toy>(f, fmu.c) }, ERR3);
         let msg = fmu.last_error();
         assert!(msg.starts_with(&format!("{}: not supported", f.name())), "{msg}");
     }
@@ -1198,14 +1275,14 @@ fn fmi3_undeclared_features_and_illegal_orders_are_errors_with_a_message() {
     assert!(f.last_error().contains("not allowed in state Instantiated"));
     assert_eq!(f.reset(), OK3);
     // an fmi2 function on an FMI 3.0 instance
-    assert_eq!(unsafe { abi::do_step::<Toy>(f.c, 0.0, 0.1, 0) }, ERR);
+    assert_eq!(unsafe { abi::do_step::<Toy>(Function::DoStep, f.c, 0.0, 0.1, 0) }, ERR);
     assert!(f.last_error().contains("created by an fmi3Instantiate function"), "{}", f.last_error());
     // ME only functions on a CS instance
     assert_eq!(f.reset(), OK3);
     assert_eq!(f.set_time(0.0), ERR3);
     assert!(f.last_error().contains("created for CoSimulation"), "{}", f.last_error());
     // a null instance
-    assert_eq!(unsafe { abi::fmi3::terminate::<Toy>(null_mut()) }, ERR3);
+    assert_eq!(unsafe { abi::fmi3::terminate::<Toy>(Function::Fmi3Terminate, null_mut()) }, ERR3);
 }
 
 #[test]
@@ -1238,9 +1315,9 @@ fn fmi3_fmu_state_round_trips_and_refuses_truncated_or_foreign_bytes() {
     assert_eq!(g.restore_serialized(&foreign), ERR3);
     // a state pointer the instance never made
     let mut fake = 0x1000usize as *mut std::ffi::c_void;
-    assert_eq!(unsafe { abi::fmi3::set_fmu_state::<Toy>(g.c, fake) }, ERR3);
+    assert_eq!(unsafe { abi::fmi3::set_fmu_state::<Toy>(Function::Fmi3SetFMUState, g.c, fake) }, ERR3);
     assert_eq!(g.reset(), OK3);
-    assert_eq!(unsafe { abi::fmi3::free_fmu_state::<Toy>(g.c, &mut fake) }, ERR3);
+    assert_eq!(unsafe { abi::fmi3::free_fmu_state::<Toy>(Function::Fmi3FreeFMUState, g.c, &mut fake) }, ERR3);
 }
 
 #[test]
@@ -1248,11 +1325,22 @@ fn fmi3_variable_dependencies_are_the_model_structure() {
     let f = Fmu3::<Toy>::cs();
     f.init_until(0.0, None);
     let mut n = 7usize;
-    assert_eq!(unsafe { abi::fmi3::get_number_of_variable_dependencies::<Toy>(f.c, vr3::Y, &mut n) }, OK3);
+    assert_eq!(
+        unsafe {
+            abi::fmi3::get_number_of_variable_dependencies::<Toy>(
+                Function::Fmi3GetNumberOfVariableDependencies,
+                f.c,
+                vr3::Y,
+                &mut n,
+            )
+        },
+        OK3
+    );
     assert_eq!(n, 1);
     let (mut e, mut on, mut eon, mut kind) = ([9usize], [9u32], [9usize], [9i32]);
     let s = unsafe {
         abi::fmi3::get_variable_dependencies::<Toy>(
+            Function::Fmi3GetVariableDependencies,
             f.c,
             vr3::Y,
             e.as_mut_ptr(),
@@ -1267,6 +1355,7 @@ fn fmi3_variable_dependencies_are_the_model_structure() {
     // wrong count, not an unknown
     let s = unsafe {
         abi::fmi3::get_variable_dependencies::<Toy>(
+            Function::Fmi3GetVariableDependencies,
             f.c,
             vr3::Y,
             e.as_mut_ptr(),
@@ -1279,7 +1368,17 @@ fn fmi3_variable_dependencies_are_the_model_structure() {
     assert_eq!(s, ERR3);
     assert!(f.last_error().contains("nDependencies = 2"), "{}", f.last_error());
     assert_eq!(f.reset(), OK3);
-    assert_eq!(unsafe { abi::fmi3::get_number_of_variable_dependencies::<Toy>(f.c, vr3::GAIN, &mut n) }, ERR3);
+    assert_eq!(
+        unsafe {
+            abi::fmi3::get_number_of_variable_dependencies::<Toy>(
+                Function::Fmi3GetNumberOfVariableDependencies,
+                f.c,
+                vr3::GAIN,
+                &mut n,
+            )
+        },
+        ERR3
+    );
     assert!(f.last_error().contains("gain (value reference 2) is no unknown"), "{}", f.last_error());
 }
 

@@ -200,6 +200,72 @@ pub fn remove_on_signals() {
     });
 }
 
+/// The signal that asked the program to stop ([`remove_on_signals_after_stop`]), 0 before one.
+static STOPPED_BY: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+fn program_name() -> String {
+    std::env::args_os()
+        .next()
+        .map(std::path::PathBuf::from)
+        .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "cosim".to_string())
+}
+
+/// As [`remove_on_signals`], but the first SIGINT, SIGTERM or SIGHUP only calls `stop` (which
+/// asks the program to end by itself, e.g. by setting a run's cancel flag, so that it writes
+/// what it computed, then calls [`finish_stopped`]) and gives it `grace` to do so; a second
+/// signal, or the end of the grace, removes the temporary folders and exits with 128 + the
+/// signal's number as [`remove_on_signals`] does. Call it first in `main`.
+pub fn remove_on_signals_after_stop(stop: impl FnOnce(libc::c_int) + Send + 'static, grace: std::time::Duration) {
+    // SAFETY: plain libc calls on a local signal set and a local timespec.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
+            let mut first: libc::c_int = 0;
+            if libc::sigwait(&set, &mut first) != 0 {
+                return;
+            }
+            STOPPED_BY.store(first, std::sync::atomic::Ordering::SeqCst);
+            stop(first);
+            let timeout = libc::timespec {
+                tv_sec: grace.as_secs() as libc::time_t,
+                tv_nsec: grace.subsec_nanos() as libc::c_long,
+            };
+            let second = libc::sigtimedwait(&set, std::ptr::null_mut(), &timeout);
+            if second > 0 {
+                STOPPED_BY.store(second, std::sync::atomic::Ordering::SeqCst);
+            }
+            finish_stopped();
+        });
+    }
+}
+
+/// The signal [`remove_on_signals_after_stop`] received, if any (the program then stops by
+/// itself and ends with [`finish_stopped`]).
+pub fn stopped_by() -> Option<libc::c_int> {
+    Some(STOPPED_BY.load(std::sync::atomic::Ordering::SeqCst)).filter(|&s| s != 0)
+}
+
+/// Ends a program that a signal asked to stop: removes the temporary folders and exits with
+/// 128 + the signal's number (as a shell reports it), saying so on stderr.
+pub fn finish_stopped() -> ! {
+    let signal = stopped_by().unwrap_or(libc::SIGINT);
+    let made = MADE.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    for dir in made {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    eprintln!("{}: stopped by {}; temporary folders removed", program_name(), crate::error::signal_name(signal));
+    // SAFETY: ends the process without running other threads' code further.
+    unsafe { libc::_exit(128 + signal) }
+}
+
 /// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (and so in every thread and child
 /// started after it; call it first in `main`) and waits for them in a thread of its own,
 /// which runs `cleanup` with the signal and exits with 128 + its number. The one signal

@@ -25,12 +25,10 @@
 // `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::OnceLock;
-
 use core::f64::consts::FRAC_PI_2;
 use fmi_export::model_description::DefaultExperiment;
 use fmi_export::{
-    Capabilities, Declaration, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
+    Capabilities, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
     ModelResult, VarDecl, Variables,
 };
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
@@ -310,12 +308,7 @@ impl Controller {
 impl Model for Controller {
     type Binding = Field<Controller>;
 
-    fn declaration() -> &'static Declaration<Field<Controller>> {
-        static DECLARATION: OnceLock<Declaration<Field<Controller>>> = OnceLock::new();
-        DECLARATION.get_or_init(|| {
-            Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("controller declaration is invalid: {e}"))
-        })
-    }
+    fmi_export::declare_model!(Field<Controller>, build_declaration());
 
     fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
         // every variable 0 until the layer applies the declared start values

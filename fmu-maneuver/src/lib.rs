@@ -16,12 +16,12 @@
 // `!(x > 0.0)` is deliberate: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use core::f64::consts::{FRAC_PI_2, TAU};
 use fmi_export::model_description::DefaultExperiment;
 use fmi_export::{
-    declared_name, Capabilities, Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
+    declared_name, Capabilities, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
     ModelResult, SampleEnd, Variables,
 };
 use nigel_benchmark::{
@@ -279,12 +279,7 @@ impl TestBench {
 impl Model for TestBench {
     type Binding = Field<TestBench>;
 
-    fn declaration() -> &'static Declaration<Field<TestBench>> {
-        static DECLARATION: OnceLock<Declaration<Field<TestBench>>> = OnceLock::new();
-        DECLARATION.get_or_init(|| {
-            Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("test-bench declaration is invalid: {e}"))
-        })
-    }
+    fmi_export::declare_model!(Field<TestBench>, build_declaration());
 
     fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
         let scenario = Scenario::new(Maneuver::Straight, Fidelity::Paper);

@@ -310,8 +310,9 @@ fn large_start_times_give_the_same_reference_bit_for_bit() {
 /// The end of the benchmark, the FMI way. Model Exchange: the event at t = duration (the
 /// last sample) reports terminateSimulation and no next event. Co-Simulation: a step
 /// across it ends there with fmi2Discard, fmi2Terminated and fmi2LastSuccessfulTime =
-/// duration. A stop time past duration is refused at fmi2SetupExperiment, and when a
-/// duration set after it ends before the stop time, when initialization ends.
+/// duration. A stop time past duration is refused when initialization ends, not at
+/// fmi2SetupExperiment: an importer (fmpy) sets the start values (a longer duration) after
+/// that call.
 #[test]
 fn the_end_of_the_benchmark_is_announced_the_fmi_way() {
     let me = B::me();
@@ -344,9 +345,17 @@ fn the_end_of_the_benchmark_is_announced_the_fmi_way() {
     assert_eq!(cs.last_successful_time(), 0.01);
 
     let late = B::cs();
-    assert_eq!(late.setup_at(0.0, Some(40.0)), ERR);
+    assert_eq!(late.setup_at(0.0, Some(40.0)), OK, "duration may still be set");
+    assert_eq!(late.enter_init(), OK);
+    assert_eq!(late.exit_init(), ERR, "stopTime 40 s past the default duration of 30 s");
     let e = late.last_error();
-    assert!(e.contains("fmi2SetupExperiment") && e.contains("stopTime = 40") && e.contains("duration"), "{e}");
+    assert!(e.contains("fmi2ExitInitializationMode") && e.contains("stopTime = 40") && e.contains("duration"), "{e}");
+    // fmpy's order: fmi2SetupExperiment, the start values, then initialization
+    let longer = B::cs();
+    assert_eq!(longer.setup_at(0.0, Some(60.0)), OK);
+    assert_eq!(longer.set_real(vr("duration"), 600.0), OK);
+    assert_eq!(longer.enter_init(), OK);
+    assert_eq!(longer.exit_init(), OK, "{}", longer.last_error());
     let shortened = B::cs();
     assert_eq!(shortened.setup_at(0.0, Some(30.0)), OK);
     assert_eq!(shortened.enter_init(), OK);
@@ -509,4 +518,34 @@ fn fmi3_co_simulation_equals_fmi2_and_ends_at_the_duration() {
     assert!(s.terminate_simulation);
     assert_eq!(s.last_successful_time, 0.01);
     assert_eq!(f.terminate(), OK3);
+
+    // the stop time is checked against the duration when initialization ends, after the
+    // start values: 60 s with duration 600 s passes, with the default 30 s it does not
+    let longer = Fmu3::<TestBench>::cs();
+    assert_eq!(longer.enter_init(0.0, Some(60.0)), OK3, "{}", longer.last_error());
+    assert_eq!(longer.set_float64(&[vr3("duration")], &[600.0]), OK3);
+    assert_eq!(longer.exit_init(), OK3, "{}", longer.last_error());
+    let late = Fmu3::<TestBench>::cs();
+    assert_eq!(late.enter_init(0.0, Some(60.0)), OK3);
+    assert_eq!(late.exit_init(), fmi_export::testing::ERR3);
+    let e = late.last_error();
+    assert!(e.contains("stopTime = 60") && e.contains("duration"), "{e}");
+}
+
+/// An FMI 3.0 instance has no stepFailed state: a serialized FMI 2.0 state taken after a
+/// Discarded step is refused by fmi3SetFMUState, naming the state.
+#[test]
+fn an_fmi3_instance_refuses_an_fmi2_step_failed_state() {
+    use fmi_export::testing::{Fmu3, ERR3, OK3};
+    let cs = B::cs();
+    assert_eq!(cs.set_real(vr("duration"), 0.01), OK);
+    cs.init();
+    assert_eq!(cs.step(0.0, 0.02), DISCARD, "across t = duration");
+    let failed = cs.serialized_state();
+    let f = Fmu3::<TestBench>::cs();
+    assert_eq!(f.enter_init(0.0, None), OK3);
+    assert_eq!(f.exit_init(), OK3);
+    assert_eq!(f.restore_serialized(&failed), ERR3);
+    let e = f.last_error();
+    assert!(e.contains("StepFailed") && e.contains("Fmi3"), "{e}");
 }

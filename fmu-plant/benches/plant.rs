@@ -25,17 +25,45 @@ fn component(kind: c_int) -> *mut c_void {
         component_environment: std::ptr::null_mut(),
     }));
     let guid = CString::new(Plant::declaration().guid()).unwrap();
-    let c =
-        unsafe { abi::instantiate::<Plant>(c"bench".as_ptr(), kind, guid.as_ptr(), std::ptr::null(), callbacks, 0, 0) };
+    let c = unsafe {
+        abi::instantiate::<Plant>(
+            fmi_export::Function::Instantiate,
+            c"bench".as_ptr(),
+            kind,
+            guid.as_ptr(),
+            std::ptr::null(),
+            callbacks,
+            0,
+            0,
+        )
+    };
     assert!(!c.is_null());
     let d = Plant::declaration();
     let refs = ["v_x_start", "delta_fl", "delta_fr", "delta_rl", "delta_rr"].map(|n| d.value_reference(n).unwrap());
     let values = [0.35, 0.2, 0.2, -0.2, -0.2];
     unsafe {
-        assert_eq!(abi::set_real::<Plant>(c, refs.as_ptr(), refs.len(), values.as_ptr()), Fmi2Status::Ok);
-        assert_eq!(abi::setup_experiment::<Plant>(c, 0, 0.0, 0.0, 0, 0.0), Fmi2Status::Ok);
-        assert_eq!(abi::enter_initialization_mode::<Plant>(c), Fmi2Status::Ok);
-        assert_eq!(abi::exit_initialization_mode::<Plant>(c), Fmi2Status::Ok);
+        assert_eq!(
+            abi::set::<Plant, abi::value::Real>(
+                fmi_export::Function::SetReal,
+                c,
+                refs.as_ptr(),
+                refs.len(),
+                values.as_ptr()
+            ),
+            Fmi2Status::Ok
+        );
+        assert_eq!(
+            abi::setup_experiment::<Plant>(fmi_export::Function::SetupExperiment, c, 0, 0.0, 0.0, 0, 0.0),
+            Fmi2Status::Ok
+        );
+        assert_eq!(
+            abi::enter_initialization_mode::<Plant>(fmi_export::Function::EnterInitializationMode, c),
+            Fmi2Status::Ok
+        );
+        assert_eq!(
+            abi::exit_initialization_mode::<Plant>(fmi_export::Function::ExitInitializationMode, c),
+            Fmi2Status::Ok
+        );
     }
     c
 }
@@ -64,17 +92,25 @@ fn benches(cr: &mut Criterion) {
     // would drift into subnormal numbers, which are far slower on x86).
     let cs = component(1);
     let mut saved = std::ptr::null_mut();
-    unsafe { assert_eq!(abi::get_fmu_state::<Plant>(cs, &mut saved), Fmi2Status::Ok) };
+    unsafe {
+        assert_eq!(abi::get_fmu_state::<Plant>(fmi_export::Function::GetFMUstate, cs, &mut saved), Fmi2Status::Ok)
+    };
     cr.bench_function("fmi2DoStep 1 ms (CS, 2 RK4 sub-steps)", |b| {
         b.iter_custom(|iters| {
             let mut total = std::time::Duration::ZERO;
             let mut done = 0;
             while done < iters {
-                unsafe { assert_eq!(abi::set_fmu_state::<Plant>(cs, saved), Fmi2Status::Ok) };
+                unsafe {
+                    assert_eq!(
+                        abi::set_fmu_state::<Plant>(fmi_export::Function::SetFMUstate, cs, saved),
+                        Fmi2Status::Ok
+                    )
+                };
                 let run = (iters - done).min(1000);
                 let start = std::time::Instant::now();
                 for k in 0..run {
-                    let status = unsafe { abi::do_step::<Plant>(cs, k as f64 * 1e-3, 1e-3, 1) };
+                    let status =
+                        unsafe { abi::do_step::<Plant>(fmi_export::Function::DoStep, cs, k as f64 * 1e-3, 1e-3, 1) };
                     if status != Fmi2Status::Ok {
                         panic!("fmi2DoStep failed at step {k}");
                     }
@@ -86,21 +122,31 @@ fn benches(cr: &mut Criterion) {
         })
     });
     let me = component(0);
-    unsafe { assert_eq!(abi::enter_continuous_time_mode::<Plant>(me), Fmi2Status::Ok) };
+    unsafe {
+        assert_eq!(
+            abi::enter_continuous_time_mode::<Plant>(fmi_export::Function::EnterContinuousTimeMode, me),
+            Fmi2Status::Ok
+        )
+    };
     let mut x = [0.0; 10];
     let mut dx = [0.0; 10];
-    unsafe { assert_eq!(abi::get_continuous_states::<Plant>(me, x.as_mut_ptr(), 10), Fmi2Status::Ok) };
+    unsafe {
+        assert_eq!(
+            abi::get_continuous_states::<Plant>(fmi_export::Function::GetContinuousStates, me, x.as_mut_ptr(), 10),
+            Fmi2Status::Ok
+        )
+    };
     cr.bench_function("fmi2SetContinuousStates + fmi2GetDerivatives (ME)", |b| {
         b.iter(|| unsafe {
             x[5] += 1e-12;
-            abi::set_continuous_states::<Plant>(me, x.as_ptr(), 10);
-            black_box(abi::get_derivatives::<Plant>(me, dx.as_mut_ptr(), 10))
+            abi::set_continuous_states::<Plant>(fmi_export::Function::SetContinuousStates, me, x.as_ptr(), 10);
+            black_box(abi::get_derivatives::<Plant>(fmi_export::Function::GetDerivatives, me, dx.as_mut_ptr(), 10))
         })
     });
     unsafe {
-        abi::free_fmu_state::<Plant>(cs, &mut saved);
-        abi::free_instance::<Plant>(cs);
-        abi::free_instance::<Plant>(me);
+        abi::free_fmu_state::<Plant>(fmi_export::Function::FreeFMUstate, cs, &mut saved);
+        abi::free_instance::<Plant>(fmi_export::Function::FreeInstance, cs);
+        abi::free_instance::<Plant>(fmi_export::Function::FreeInstance, me);
     }
 }
 

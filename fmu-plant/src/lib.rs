@@ -5,12 +5,10 @@
 // `!(x > 0.0)` is deliberate throughout: it refuses NaN together with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::OnceLock;
-
 use fmi_export::model_description::DefaultExperiment;
 use fmi_export::{
-    declared_name, Access, Capabilities, Declaration, DeclarationSpec, Initial, InstantiateContext, Interfaces, Model,
-    ModelError, ModelResult, Start, VarHandle, Variables,
+    declared_name, Access, Capabilities, DeclarationSpec, Initial, InstantiateContext, Interfaces, Model, ModelError,
+    ModelResult, Start, VarHandle, Variables,
 };
 use nigel_vehicle::dynamics::idx;
 use nigel_vehicle::{evaluate, Dual, Evaluation, Inputs, ParamScalars, Scalar, State, VehicleParams, N_STATES, WHEELS};
@@ -503,12 +501,7 @@ impl Access<Plant> for PlantVar {}
 impl Model for Plant {
     type Binding = PlantVar;
 
-    fn declaration() -> &'static Declaration<PlantVar> {
-        static DECLARATION: OnceLock<Declaration<PlantVar>> = OnceLock::new();
-        DECLARATION.get_or_init(|| {
-            Declaration::new(build_declaration()).unwrap_or_else(|e| panic!("plant declaration is invalid: {e}"))
-        })
-    }
+    fmi_export::declare_model!(PlantVar, build_declaration());
 
     fn instantiate(_context: &InstantiateContext) -> ModelResult<Self> {
         Ok(Plant::default())

@@ -235,7 +235,8 @@ fn adjoint_derivatives_in_initialization_mode_and_bad_counts() {
     // counts
     let mut out = vec![0.0; knowns.len()];
     let st = unsafe {
-        fmi_export::abi::fmi3::get_adjoint_derivative::<Plant>(
+        fmi_export::abi::fmi3::get_partial_derivatives::<Plant>(
+            fmi_export::Function::Fmi3GetAdjointDerivative,
             f.c,
             unknowns.as_ptr(),
             unknowns.len(),
@@ -254,4 +255,29 @@ fn adjoint_derivatives_in_initialization_mode_and_bad_counts() {
     g.init_until(0.0, None);
     assert_eq!(g.adjoint(&unknowns, &[vr3("m")], &w), Err(ERR3));
     assert!(g.last_error().contains("known m is not an input"), "{}", g.last_error());
+}
+
+/// A time an f64 cannot resolve is refused: startTime = f64::MAX (the next double is
+/// infinite, so every later currentCommunicationPoint looked like "now") at
+/// fmi3EnterInitializationMode, and at startTime = 1e300 a step of 20 ms that leaves the
+/// time where it was (the doubles there are 1.5e284 apart) at fmi3DoStep.
+#[test]
+fn times_an_f64_cannot_resolve_are_refused() {
+    let f = P3::cs();
+    assert_eq!(f.enter_init(f64::MAX, None), ERR3);
+    let e = f.last_error();
+    assert!(e.contains("startTime") && e.contains("resolve"), "{e}");
+    let f = P3::cs();
+    assert_eq!(f.enter_init(0.0, Some(f64::MAX)), ERR3);
+    assert!(f.last_error().contains("stopTime"), "{}", f.last_error());
+    let f = P3::cs();
+    f.init_until(1e300, None);
+    let s = f.step(1e300, 0.02);
+    assert_eq!(s.status, ERR3);
+    let e = f.last_error();
+    assert!(e.contains("does not advance") && e.contains("resolves 1.48"), "{e}");
+    let f = P3::cs();
+    f.init_until(0.0, None);
+    assert_eq!(f.step(0.0, 0.02).status, OK3, "{}", f.last_error());
+    assert_eq!(f.step(1e300, 0.02).status, ERR3, "a current time far from the FMU's");
 }

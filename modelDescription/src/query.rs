@@ -24,9 +24,30 @@ impl ModelDescription {
         self.variable(name).filter(|v| v.is_real()).map(|v| v.value_reference)
     }
 
-    /// 1-based indices of the state derivatives: Real continuous variables with a
-    /// `derivative` attribute, in ModelVariables order.
+    /// 1-based indices of the state derivatives, in the order of the continuous states:
+    /// the ModelStructure's `<Derivatives>` (FMI 2.0 section 2.2.8: the list is the state
+    /// vector and its order; a variable with a `derivative` attribute outside it is no
+    /// state derivative, as Dymola declares derivatives of variables that are no states),
+    /// each a variable with a `derivative` attribute; for a description that lists none,
+    /// the Real continuous variables with a `derivative` attribute, in ModelVariables order.
     pub fn state_derivatives(&self) -> Vec<u32> {
+        let listed: Vec<u32> = self
+            .model_structure
+            .derivatives
+            .iter()
+            .map(|u| u.index)
+            .filter(|&k| self.variable_at(k).is_some_and(|v| v.variable_type.derivative().is_some()))
+            .collect();
+        if listed.is_empty() {
+            self.declared_derivatives()
+        } else {
+            listed
+        }
+    }
+
+    /// 1-based indices of the Real continuous variables with a `derivative` attribute, in
+    /// ModelVariables order (what `<Derivatives>` lists in a description we write).
+    fn declared_derivatives(&self) -> Vec<u32> {
         self.model_variables
             .iter()
             .enumerate()
@@ -64,7 +85,7 @@ impl ModelDescription {
             || self.model_variables.iter().enumerate().filter_map(|(i, v)| u32::try_from(i + 1).ok().map(|k| (k, v)));
         let outputs: Vec<Unknown> =
             indexed().filter(|(_, v)| v.causality == Causality::Output).map(|(k, _)| unknown(k)).collect();
-        let ders = self.state_derivatives();
+        let ders = self.declared_derivatives();
         let not_exact =
             |v: &ScalarVariable| matches!(v.effective_initial(), Some(Initial::Approx | Initial::Calculated));
         let mut init: std::collections::BTreeSet<u32> = indexed()

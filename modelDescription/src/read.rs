@@ -197,10 +197,29 @@ impl fmt::Display for ReadError {
                 f,
                 "{element} at {position}: attribute {attribute} has unknown value \"{value}\""
             ),
-            ReadError::UnsupportedFmiVersion { found, expected, position } => write!(
-                f,
-                "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\")"
-            ),
+            // FMI 1.0 (and anything but 2.0 and 3.x) is read by neither reader of this crate:
+            // the message names both versions that are
+            ReadError::UnsupportedFmiVersion { found, expected, position }
+                if !found.trim().starts_with("2.") && !found.trim().starts_with("3.") =>
+            {
+                write!(
+                    f,
+                    "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported \
+                     (FMI 2.0 and FMI 3.0 are; this reader reads \"{expected}\")"
+                )
+            }
+            ReadError::UnsupportedFmiVersion { found, expected, position } => {
+                // the FMI 3.0 reader takes the revisions and later minor versions too
+                let also = if expected.starts_with('3') {
+                    ", a revision such as \"3.0.2\" or a later minor version such as \"3.1\", read as FMI 3.0"
+                } else {
+                    ""
+                };
+                write!(
+                    f,
+                    "fmiModelDescription at {position}: fmiVersion=\"{found}\" is not supported (only \"{expected}\"{also})"
+                )
+            }
             ReadError::MissingTypeChild { variable, position } => write!(
                 f,
                 "ScalarVariable \"{variable}\" at {position}: no type element (<Real>, <Integer>, <Boolean>, <String> or <Enumeration>)"

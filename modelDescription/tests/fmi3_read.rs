@@ -129,6 +129,10 @@ fn wrong_generation_is_refused_both_ways() {
     let e = model_description::ModelDescription::from_xml(BALL).unwrap_err();
     assert!(matches!(&e, ReadError::UnsupportedFmiVersion { found, .. } if found == "3.0"), "{e:?}");
     assert!(e.to_string().contains("only \"2.0\""), "{e}");
+    // not a version: refused naming what the FMI 3.0 reader takes
+    let e = read(r#"<fmiModelDescription fmiVersion="3.0abc" modelName="m" instantiationToken="t"/>"#);
+    let text = e.to_string();
+    assert!(text.contains("fmiVersion=\"3.0abc\"") && text.contains("a later minor version such as \"3.1\""), "{text}");
 }
 
 #[test]

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import json
 import os
+import sys
+import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
@@ -42,6 +44,7 @@ __all__ = [
     "simulate_ssp",
     "System",
     "run_campaign",
+    "compare",
     "write_csv",
     "Error",
     "LoadError",
@@ -55,8 +58,51 @@ __all__ = [
 _DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
 
 # fmpy's names of the integrators, mapped onto the master's (Model Exchange): CVode is a
-# variable-order BDF method, as the master's bdf is
+# variable-order BDF method, as the master's bdf is; fmpy's Euler (explicit, fixed step) has
+# no counterpart here (refused, saying what to use)
 _SOLVERS = {None: "bdf", "CVode": "bdf", "bdf": "bdf", "dopri5": "dopri5", "rk4": "rk4", "Euler": None}
+
+
+def _fmpy_keywords(interface: str, validate, debug_logging, record_events, apply_default_start_values,
+                   step_finished, fmi_call_logger, extra: Mapping[str, Any]) -> None:
+    """fmpy.simulate_fmu's keywords that users pass out of habit: the ones that mean the same
+    here are accepted, the others refused with an :class:`Error` saying what to use instead."""
+    if validate is False:
+        raise Error("validate=False: nigel_cosim always reads the model description with its own checks "
+                    "(it refuses only what would make a run wrong, naming the variable); drop validate=False")
+    if debug_logging:
+        raise Error("debug_logging=True: nigel_cosim does not switch on the FMU's debug log; the FMU's warnings "
+                    "and errors come with the run (System.last_summary['warnings'], or the Error raised); "
+                    "for a call-by-call log use fmpy.simulate_fmu(..., debug_logging=True)")
+    if record_events is True and interface == "ModelExchange":
+        raise Error("record_events=True: nigel_cosim records Model Exchange runs at the output points only, "
+                    "not the rows just before and after each event that fmpy adds; pass record_events=False "
+                    "(the events are in System.last_summary['events']) or a smaller output_interval")
+    if step_finished is not None:
+        raise Error("step_finished: there is no per-step callback; step the run from Python instead: "
+                    "with nigel_cosim.System(filename) as s: s.initialize(...); then s.step() or "
+                    "s.step_until(t), s.get(name), s.set(name, value), s.results()")
+    if fmi_call_logger is not None:
+        raise Error("fmi_call_logger: nigel_cosim logs no FMI calls; use fmpy.simulate_fmu(..., "
+                    "fmi_call_logger=print) for a trace of the calls")
+    if extra:
+        raise Error(f"simulate_fmu got keywords it does not know: {', '.join(sorted(extra))} "
+                    "(fmpy's validate, debug_logging, record_events, apply_default_start_values, "
+                    "step_finished, fmi_call_logger and timeout are understood or refused with a reason)")
+    # apply_default_start_values: the FMU starts at its model description's start values either
+    # way (fmpy sets them explicitly only when asked); the same run, accepted either way
+    del apply_default_start_values
+
+
+def _warn_sample_periods(system: "System", args: dict) -> None:
+    """`cosim run`'s warning about a communication step longer than an FMU's declared sample
+    period, as a Python warning (the run goes on: it is what was asked for)."""
+    # the warning points at the user's line: the first frame outside this file
+    level, frame = 1, sys._getframe(0)
+    while frame is not None and frame.f_code.co_filename == __file__:
+        frame, level = frame.f_back, level + 1
+    for message in system._native.sample_period_warnings(_Args(args)):
+        warnings.warn(message, UserWarning, stacklevel=level)
 
 
 def _float(value: Any) -> float | None:
@@ -144,6 +190,13 @@ class System:
         return list(self._native.interfaces)
 
     @property
+    def notes(self) -> list[str]:
+        """What reading an SSP noted (the lines ``cosim run`` prints as notes): parameter
+        values whose names match nothing (ignored, as SSP 1.0 says), units taken as
+        written, an SSD of the SSP 2.0 draft."""
+        return list(self._native.notes)
+
+    @property
     def default_experiment(self) -> dict[str, float | None]:
         start, stop, step, tolerance = self._native.default_experiment
         return {"start_time": start, "stop_time": stop, "step_size": step, "tolerance": tolerance}
@@ -195,6 +248,7 @@ class System:
         self.terminate()
         args = self._args(start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output,
                           solver, relative_tolerance, None, 1)
+        _warn_sample_periods(self, args)
         self._step = args["step"]
         self._run = self._native.start(_Args(args))
         return self._run.time
@@ -251,6 +305,7 @@ class System:
         (a whole multiple of it) is given; returns a structured array, ``time`` first."""
         args = self._args(start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output,
                           solver, relative_tolerance, timeout, threads)
+        _warn_sample_periods(self, args)
         return self._simulate(args)
 
     def _args(self, start_time, stop_time, step_size, output_interval, algorithm, start_values, input, output, solver,
@@ -263,11 +318,14 @@ class System:
                                tolerance, timeout, threads)
 
     def _arguments(self, start, stop, step, output_interval, algorithm, start_values, input, output, solver, tolerance,
-                   timeout, threads):
+                   timeout, threads, max_step=None):
         if solver not in _SOLVERS:
             raise ExperimentError(f"unknown solver {solver!r} (CVode, bdf, dopri5, rk4)")
         if _SOLVERS[solver] is None:
-            raise ExperimentError(f"solver {solver!r} is not offered: use 'CVode' (bdf here), 'dopri5' or 'rk4'")
+            raise ExperimentError(
+                f"solver {solver!r}: fmpy's explicit Euler method (fixed steps of step_size) is not offered; "
+                "use solver='rk4' with the same step_size (fixed steps of step_size, fourth order, so not "
+                "Euler's numbers), or 'CVode' (the master's BDF method here) or 'dopri5' (variable step)")
         values = dict(self._start_values)
         values.update(start_values or {})
         return {
@@ -280,6 +338,7 @@ class System:
             "input": _input_table(input),
             "output": list(output) if output is not None else None,
             "solver": _SOLVERS[solver],
+            "max_step": max_step,
             "relative_tolerance": tolerance,
             "timeout": timeout,
             "threads": threads,
@@ -300,17 +359,24 @@ class _Args:
 
 def simulate_fmu(
     filename: str | os.PathLike,
+    validate: bool = True,
     start_time: float | None = None,
     stop_time: float | None = None,
+    solver: str | None = None,
     step_size: float | None = None,
+    relative_tolerance: float | None = None,
     output_interval: float | None = None,
+    record_events: bool | None = None,
     fmi_type: str | None = None,
     start_values: Mapping[str, Any] = {},
+    apply_default_start_values: bool = False,
     input: np.ndarray | None = None,
     output: Iterable[str] | None = None,
-    solver: str | None = None,
-    relative_tolerance: float | None = None,
     timeout: float | None = None,
+    debug_logging: bool = False,
+    fmi_call_logger: Any = None,
+    step_finished: Any = None,
+    **fmpy_keywords: Any,
 ) -> np.ndarray:
     """Simulates an FMU as ``fmpy.simulate_fmu`` does and returns its structured array.
 
@@ -320,16 +386,37 @@ def simulate_fmu(
     fmpy's automatic interval); Model Exchange integrates between output points
     (``solver='CVode'``, fmpy's default, is this master's variable-order BDF method with
     ``relative_tolerance``, default 1e-5, and the FMU's Jacobian; ``'dopri5'`` its explicit
-    Dormand-Prince method; ``'rk4'`` a fixed step of ``step_size``).
+    Dormand-Prince method; ``'rk4'`` fixed steps of ``step_size``, or of the output interval
+    when ``step_size`` is not given).
+
+    fmpy's other keywords, in fmpy's order: ``validate=True`` (the model description is
+    always checked), ``apply_default_start_values`` (the FMU starts at its start values
+    either way) and ``record_events=False`` are accepted with fmpy's meaning;
+    ``record_events=True`` means nothing in Co-Simulation, as in fmpy, and is refused for
+    Model Exchange, where this master records output points only (left out, fmpy's default
+    True, the output points are recorded: fmpy's rows less the ones it adds at events); ``timeout``
+    (seconds of wall time) raises :class:`RunTimeoutError` where fmpy returns the rows so far.
+    ``validate=False``, ``debug_logging=True``, ``step_finished`` and ``fmi_call_logger`` are
+    refused with an :class:`Error` that says what to use instead. An ``.ssp`` is refused:
+    use :func:`simulate_ssp`.
     """
+    if Path(os.fspath(filename)).suffix.lower() in (".ssp", ".ssd"):
+        raise LoadError(f"{os.fspath(filename)}: an SSP system, not an FMU: use nigel_cosim.simulate_ssp "
+                        "(or nigel_cosim.System for many runs)")
     with System(filename, fmi_type) as system:
         interface = fmi_type or system.interfaces[0]
+        _fmpy_keywords(interface, validate, debug_logging, record_events, apply_default_start_values, step_finished,
+                       fmi_call_logger, fmpy_keywords)
         # fmpy.simulate_fmu's defaults (nigel_cosim::defaults::RunTimes::fmpy)
         start, stop, output_interval, tolerance = system._native.fmpy_times(
             interface == "CoSimulation", _float(start_time), _float(stop_time), _float(step_size),
             _float(output_interval), relative_tolerance)
+        # fmpy's Model Exchange with a fixed-step solver integrates with steps of step_size
+        # between the output points; rk4 here likewise (its largest step)
+        max_step = _float(step_size) if interface == "ModelExchange" and solver == "rk4" else None
         args = system._arguments(start, stop, output_interval, None, "jacobi", start_values, input, output,
-                                 solver, tolerance, timeout, 1)
+                                 solver, tolerance, timeout, 1, max_step)
+        _warn_sample_periods(system, args)
         return system._simulate(args)
 
 
@@ -345,9 +432,15 @@ def simulate_ssp(
     output: Iterable[str] | None = None,
     timeout: float | None = None,
 ) -> np.ndarray:
-    """Simulates an SSP system as ``cosim run`` does (its parameter bindings applied);
-    fields are named ``instance.variable``; the same numbers as the command line."""
+    """Simulates an SSP system as ``cosim run`` does (its parameter bindings, parameter
+    mappings and system connector values applied; the SSD's DefaultExperiment start and
+    stop time where none is given); fields are named ``instance.variable``; the same
+    numbers as the command line. What reading the SSP noted is warned (``UserWarning``)."""
     with System(filename) as system:
+        import warnings
+
+        for note in system.notes:
+            warnings.warn(f"{os.fspath(filename)}: {note}", stacklevel=2)
         return system.simulate(
             start_time=start_time,
             stop_time=stop_time,
@@ -387,6 +480,37 @@ def run_campaign(
     except ImportError:
         return np.genfromtxt(csv, delimiter=",", names=True, dtype=None, encoding="utf-8")
     return pandas.read_csv(csv)
+
+
+def compare(
+    result: str | os.PathLike | np.ndarray,
+    baseline: str | os.PathLike | np.ndarray,
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    time_tol: float = 0.0,
+    signals: Sequence[str] | None = None,
+    plot: str | os.PathLike | None = None,
+) -> dict[str, Any]:
+    """Compares ``result`` with ``baseline`` signal by signal in tolerance tubes, as
+    ``cosim compare`` does (docs/ci.md): each a CSV path or a structured array (as
+    ``simulate_fmu`` returns, time first). Returns the report: ``passed``, ``tolerance``,
+    ``signals`` (per signal ``name``, ``passed``, ``points``, ``violations``, ``worst``,
+    ``problem``, ``detail``), ``notes``, ``lines``, ``figures`` (the paths of the PNGs drawn into
+    ``plot`` for the failing signals)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="nigel-compare-") as scratch:
+        paths = []
+        for what, data in (("result", result), ("baseline", baseline)):
+            if isinstance(data, np.ndarray):
+                path = Path(scratch) / f"{what}.csv"
+                write_csv(path, data)
+                paths.append(os.fspath(path))
+            else:
+                paths.append(os.fspath(data))
+        names = list(signals) if signals is not None else None
+        folder = os.fspath(plot) if plot is not None else None
+        return _native.compare(paths[0], paths[1], rtol, atol, time_tol, names, folder)
 
 
 def _toml_value(v: Any) -> str:

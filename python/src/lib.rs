@@ -6,16 +6,18 @@
 //! fmpy-compatible keyword handling, the structured arrays and the DataFrame live in the
 //! Python half (`nigel_cosim/__init__.py`), where users can read them.
 //!
-//! A run happens on a worker thread while the calling thread waits without the GIL, waking
-//! every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the run
-//! stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
+//! A whole run happens on a worker thread while the calling thread waits without the GIL,
+//! waking every 100 ms to let Python handle signals: Ctrl-C sets the run's cancel flag, the
+//! run stops at its next step, its instances are freed, and `KeyboardInterrupt` is raised.
+//! A run stepped from Python ([`NativeRun`]) is an [`Execution`] advanced in the calling
+//! thread, the GIL released for at most 100 ms at a time between signal checks.
 
 use model_description::DefaultExperiment;
 use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
-    simulate::{default_record, simulate_with},
-    Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, SetQueue,
-    Solver, Summary, System, SystemBuilder,
+    simulate::{default_record, run_to_end, Execution, Phase},
+    Error as CosimError, Experiment, Fmu, ImportOptions, InputTable, InstancePool, Interface, Results, Solver, Summary,
+    System, SystemBuilder,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
@@ -23,9 +25,8 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 create_exception!(nigel_cosim, Error, PyException, "Every error of nigel_cosim, with the master's message.");
 create_exception!(
@@ -99,6 +100,8 @@ struct NativeSystem {
     default_experiment: (Option<f64>, Option<f64>, Option<f64>, Option<f64>),
     /// `CoSimulation` / `ModelExchange` of each interface the (single) FMU offers.
     interfaces: Vec<&'static str>,
+    /// What reading an SSP noted (`nigel_cosim::SspSystem::notes`; `cosim run` prints them).
+    notes: Vec<String>,
 }
 
 const SINGLE: &str = "model";
@@ -131,6 +134,8 @@ struct RunArgs {
     input: Option<(Vec<String>, Vec<f64>, Vec<Vec<f64>>)>,
     output: Option<Vec<String>>,
     solver: String,
+    /// The largest step of `rk4` (fmpy's `step_size` in Model Exchange); None: the communication step.
+    max_step: Option<f64>,
     relative_tolerance: Option<f64>,
     timeout: Option<f64>,
     threads: usize,
@@ -172,8 +177,19 @@ impl NativeSystem {
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(CosimError::Experiment(format!("relative_tolerance {rtol} must be positive")));
         }
+        // fmpy tells Co-Simulation FMUs the relative tolerance (given, else the
+        // DefaultExperiment's, filled in by the caller)
+        experiment.co_simulation_tolerance = args.relative_tolerance;
         experiment.solver = match args.solver.as_str() {
-            "rk4" => Solver::Rk4 { max_step: None },
+            "rk4" => {
+                if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
+                    return Err(CosimError::Experiment(format!(
+                        "step_size {} must be a positive number of seconds",
+                        args.max_step.unwrap_or_default()
+                    )));
+                }
+                Solver::Rk4 { max_step: args.max_step }
+            }
             "dopri5" => Solver::Dopri5 { rtol, atol: rtol / 100.0 },
             "bdf" => Solver::Bdf { rtol, atol: rtol / 100.0 },
             other => {
@@ -273,6 +289,7 @@ impl NativeSystem {
                     single: None,
                     default_experiment: (start, stop, None, None),
                     interfaces: Vec::new(),
+                    notes: ssp.notes,
                 })
             } else {
                 let fmu = Fmu::load_with(&filename, &options)?;
@@ -296,10 +313,18 @@ impl NativeSystem {
                     single: Some(SINGLE.to_string()),
                     default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
                     interfaces,
+                    notes: Vec::new(),
                 })
             }
         })
         .map_err(to_py)
+    }
+
+    /// What reading an SSP noted: values ignored by the standard's rules, units taken as
+    /// written, an SSD of the 2.0 draft (`cosim run` prints the same lines).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.notes.clone()
     }
 
     /// (start, stop, step, tolerance) of the DefaultExperiment, each None when absent.
@@ -385,12 +410,14 @@ impl NativeSystem {
         py: Python<'py>,
         args: RunArgs,
     ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String)> {
-        let (system, mut experiment) = self.run_setup(&args)?;
+        let (system, experiment) = self.run_setup(&args)?;
         let cancel = Arc::new(AtomicBool::new(false));
-        experiment.cancel = Some(cancel.clone());
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
             let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
-            simulate_with(&system, &experiment, Some(&mut pool), None)
+            let mut execution = Execution::new(&system, &experiment)?.with_pool(&mut pool);
+            execution.cancel_on(cancel.clone());
+            let summary = run_to_end(&mut execution)?;
+            Ok((execution.take_results(), summary))
         })?;
         let (results, summary) = outcome.map_err(to_py)?;
         let types = column_types(&system, &results, self.single.as_deref());
@@ -398,6 +425,17 @@ impl NativeSystem {
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
         let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
         Ok((results.names, types, array.into_any(), json))
+    }
+
+    /// The step-longer-than-sample-period warnings of a run with `args` (the same words as
+    /// `cosim run`'s, with the keyword that sets the step): the Python side raises them as
+    /// `warnings.warn`.
+    fn sample_period_warnings(&self, args: RunArgs) -> PyResult<Vec<String>> {
+        let (system, experiment) = self.run_setup(&args)?;
+        Ok(nigel_cosim::sample_period::warnings(&system, experiment.step)
+            .iter()
+            .map(|w| format!("{w} (use step_size={})", w.period))
+            .collect())
     }
 
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused
@@ -436,40 +474,18 @@ impl NativeSystem {
     }
 }
 
-/// What the worker thread of a [`NativeRun`] tells the caller.
-enum RunEvent {
-    /// Paused at an output point.
-    Paused,
-    /// The run ended: the summary, or why it failed.
-    Finished(Result<Summary, CosimError>),
-}
-
-/// How far a [`NativeRun`] is.
-enum RunState {
-    Paused,
-    Finished(Option<Summary>),
-}
-
-/// A run stepped from outside: the master's loop on a worker thread that pauses at the
-/// first output point at or after the time asked for (its row sink waits there for the
-/// next target time), with the rows so far kept and values set between steps applied
-/// before the next step ([`SetQueue`]).
+/// A run stepped from Python: an [`Execution`] advanced in the calling thread to the first
+/// output point at or after the time asked for, the rows so far kept, values set between
+/// steps applied before the next step ([`Execution::set`]).
 #[pyclass(module = "nigel_cosim._native", frozen)]
 struct NativeRun {
-    system: System,
     /// Recorded columns (bare names for a single FMU) and their base types.
     names: Vec<String>,
     types: Vec<&'static str>,
     single: Option<String>,
-    /// `time, v1, v2, ...` per row so far.
-    rows: Arc<Mutex<Vec<f64>>>,
-    queue: Arc<SetQueue>,
-    cancel: Arc<AtomicBool>,
-    /// Target times to the worker (NaN: stop).
-    commands: Mutex<Sender<f64>>,
-    events: Mutex<Receiver<RunEvent>>,
-    state: Mutex<RunState>,
-    worker: Mutex<Option<std::thread::JoinHandle<()>>>,
+    execution: Mutex<Execution<'static>>,
+    /// The summary, once the run has reached its end and terminated its instances.
+    summary: Mutex<Option<Summary>>,
 }
 
 /// Whether `t` has reached `target` (fmpy's `isclose` with its defaults for the last bit).
@@ -477,110 +493,39 @@ fn reached(t: f64, target: f64) -> bool {
     t >= target || (t - target).abs() <= 1e-9 * t.abs().max(target.abs())
 }
 
+/// How long the GIL is released at a time while a stepped run advances (then Python
+/// handles its signals: Ctrl-C).
+const SIGNAL_CHECK: Duration = Duration::from_millis(100);
+
 impl NativeRun {
     fn start(
         py: Python<'_>,
         system: System,
-        mut experiment: Experiment,
+        experiment: Experiment,
         names: Vec<String>,
         types: Vec<&'static str>,
         single: Option<String>,
     ) -> PyResult<NativeRun> {
-        let rows = Arc::new(Mutex::new(Vec::new()));
-        let queue = Arc::new(SetQueue::new());
-        let cancel = Arc::new(AtomicBool::new(false));
-        experiment.cancel = Some(cancel.clone());
-        experiment.between_steps = Some(queue.clone());
-        let (command_tx, command_rx) = std::sync::mpsc::channel::<f64>();
-        let (event_tx, event_rx) = std::sync::mpsc::channel::<RunEvent>();
-        let worker = {
-            let (system, rows, cancel) = (system.clone(), rows.clone(), cancel.clone());
-            let mut target = experiment.start_time;
-            std::thread::spawn(move || {
-                let events = event_tx.clone();
-                let mut sink = |t: f64, row: &[f64]| {
-                    {
-                        let mut rows = rows.lock().unwrap_or_else(|p| p.into_inner());
-                        rows.push(t);
-                        rows.extend_from_slice(row);
-                    }
-                    // wait here until asked for a later time (or to stop: the cancel flag ends
-                    // the run at its next step)
-                    while reached(t, target) && !cancel.load(Ordering::Relaxed) {
-                        let _ = events.send(RunEvent::Paused);
-                        match command_rx.recv() {
-                            Ok(next) if !next.is_nan() => target = next,
-                            _ => cancel.store(true, Ordering::Relaxed),
-                        }
-                    }
-                };
-                let outcome = simulate_with(&system, &experiment, None, Some(&mut sink)).map(|(_, summary)| summary);
-                let _ = event_tx.send(RunEvent::Finished(outcome));
-            })
-        };
-        let run = NativeRun {
-            system,
-            names,
-            types,
-            single,
-            rows,
-            queue,
-            cancel,
-            commands: Mutex::new(command_tx),
-            events: Mutex::new(event_rx),
-            state: Mutex::new(RunState::Paused),
-            worker: Mutex::new(Some(worker)),
-        };
-        run.wait(py)?;
+        let mut execution = Execution::new(&system, &experiment).map_err(to_py)?;
+        py.detach(|| execution.initialize()).map_err(to_py)?;
+        let run = NativeRun { names, types, single, execution: Mutex::new(execution), summary: Mutex::new(None) };
+        run.finish_at_end()?;
         Ok(run)
     }
 
-    /// Waits for the worker's next event without the GIL, handling signals every 100 ms
-    /// (Ctrl-C stops the run and raises).
-    fn wait(&self, py: Python<'_>) -> PyResult<()> {
-        let event = loop {
-            let got = py.detach(|| {
-                let events = self.events.lock().unwrap_or_else(|p| p.into_inner());
-                events.recv_timeout(Duration::from_millis(100))
-            });
-            match got {
-                Ok(event) => break event,
-                Err(RecvTimeoutError::Timeout) => {
-                    if let Err(e) = py.check_signals() {
-                        self.stop(py);
-                        return Err(e);
-                    }
-                }
-                Err(RecvTimeoutError::Disconnected) => {
-                    break RunEvent::Finished(Err(CosimError::Cancelled { time: f64::NAN }))
-                }
-            }
-        };
-        let mut state = self.state.lock().unwrap_or_else(|p| p.into_inner());
-        match event {
-            RunEvent::Paused => *state = RunState::Paused,
-            RunEvent::Finished(Ok(summary)) => *state = RunState::Finished(Some(summary)),
-            RunEvent::Finished(Err(CosimError::Cancelled { .. })) => *state = RunState::Finished(None),
-            RunEvent::Finished(Err(e)) => {
-                *state = RunState::Finished(None);
-                return Err(to_py(e));
-            }
-        }
-        Ok(())
+    fn execution(&self) -> std::sync::MutexGuard<'_, Execution<'static>> {
+        self.execution.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Ends the run (the cancel flag and a stop command) and joins the worker.
-    fn stop(&self, py: Python<'_>) {
-        self.cancel.store(true, Ordering::Relaxed);
-        let _ = self.commands.lock().unwrap_or_else(|p| p.into_inner()).send(f64::NAN);
-        let worker = self.worker.lock().unwrap_or_else(|p| p.into_inner()).take();
-        if let Some(w) = worker {
-            let _ = py.detach(|| w.join());
+    /// At the end of the run (its stop time, or an FMU ended it): the instances terminated
+    /// and the summary kept.
+    fn finish_at_end(&self) -> PyResult<()> {
+        let mut execution = self.execution();
+        if execution.phase() == Phase::AtEnd {
+            let summary = execution.finish().map_err(to_py)?;
+            *self.summary.lock().unwrap_or_else(|p| p.into_inner()) = Some(summary);
         }
-        let mut state = self.state.lock().unwrap_or_else(|p| p.into_inner());
-        if let RunState::Paused = *state {
-            *state = RunState::Finished(None);
-        }
+        Ok(())
     }
 }
 
@@ -589,15 +534,13 @@ impl NativeRun {
     /// The time of the last recorded row (the run is paused there, or ended there).
     #[getter]
     fn time(&self) -> f64 {
-        let rows = self.rows.lock().unwrap_or_else(|p| p.into_inner());
-        let width = self.names.len() + 1;
-        rows.len().checked_sub(width).map_or(f64::NAN, |k| rows[k])
+        self.execution().last_row_time().unwrap_or(f64::NAN)
     }
 
     /// Whether the run has ended (its stop time, an FMU's terminate request, `terminate`).
     #[getter]
     fn finished(&self) -> bool {
-        matches!(*self.state.lock().unwrap_or_else(|p| p.into_inner()), RunState::Finished(_))
+        self.execution().phase() != Phase::Running
     }
 
     /// Runs on to the first output point at or after `time` (the stop time at most).
@@ -608,15 +551,33 @@ impl NativeRun {
         if self.finished() {
             return Err(Error::new_err("the run has ended (initialize a new one)"));
         }
-        if reached(self.time(), time) {
-            return Ok(self.time());
+        loop {
+            let done = py.detach(|| -> Result<bool, CosimError> {
+                let mut execution = self.execution();
+                let start = Instant::now();
+                loop {
+                    let paused = execution.at_output_point() && reached(execution.time(), time);
+                    if paused || execution.phase() != Phase::Running {
+                        return Ok(true);
+                    }
+                    if start.elapsed() > SIGNAL_CHECK {
+                        return Ok(false);
+                    }
+                    execution.step()?;
+                }
+            });
+            match done {
+                Ok(true) => break,
+                Ok(false) => {
+                    if let Err(e) = py.check_signals() {
+                        self.execution().stop();
+                        return Err(e);
+                    }
+                }
+                Err(e) => return Err(to_py(e)),
+            }
         }
-        self.commands
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .send(time)
-            .map_err(|_| Error::new_err("the run has ended (initialize a new one)"))?;
-        self.wait(py)?;
+        self.finish_at_end()?;
         Ok(self.time())
     }
 
@@ -625,10 +586,8 @@ impl NativeRun {
         let j = self.names.iter().position(|n| n == name).ok_or_else(|| {
             VariableError::new_err(format!("{name:?} is not recorded in this run (add it to output=)"))
         })?;
-        let rows = self.rows.lock().unwrap_or_else(|p| p.into_inner());
-        let width = self.names.len() + 1;
-        let k = rows.len().checked_sub(width).ok_or_else(|| Error::new_err("the run has no row yet"))?;
-        Ok(rows[k + 1 + j])
+        let row = self.execution().last_row().ok_or_else(|| Error::new_err("the run has no row yet"))?;
+        Ok(row[1 + j])
     }
 
     /// Sets an input or tunable parameter from the next communication step on.
@@ -640,12 +599,12 @@ impl NativeRun {
             Some(instance) => format!("{instance}.{name}"),
             None => name.to_string(),
         };
-        self.queue.push_text(&self.system, &full, value).map_err(to_py)
+        self.execution().set(&full, value).map_err(to_py)
     }
 
     /// (names, types, rows so far as a rows x (1 + columns) array).
     fn results<'py>(&self, py: Python<'py>) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>)> {
-        let values = self.rows.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        let values = self.execution().results().values;
         let width = self.names.len() + 1;
         let rows = values.len() / width;
         let array = PyArray1::from_vec(py, values).reshape([rows, width])?;
@@ -654,22 +613,13 @@ impl NativeRun {
 
     /// Ends the run (terminating and freeing its instances); the summary as JSON text, or
     /// None when it was ended before its stop time.
-    fn terminate(&self, py: Python<'_>) -> Option<String> {
-        self.stop(py);
-        match &*self.state.lock().unwrap_or_else(|p| p.into_inner()) {
-            RunState::Finished(Some(summary)) => serde_json::to_string(&summary.to_json()).ok(),
-            _ => None,
-        }
-    }
-}
-
-impl Drop for NativeRun {
-    fn drop(&mut self) {
-        self.cancel.store(true, Ordering::Relaxed);
-        let _ = self.commands.lock().unwrap_or_else(|p| p.into_inner()).send(f64::NAN);
-        if let Some(w) = self.worker.lock().unwrap_or_else(|p| p.into_inner()).take() {
-            let _ = w.join();
-        }
+    fn terminate(&self) -> Option<String> {
+        self.execution().stop();
+        self.summary
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .as_ref()
+            .and_then(|s| serde_json::to_string(&s.to_json()).ok())
     }
 }
 
@@ -720,12 +670,79 @@ fn run_campaign(
     Ok((out.join("results.csv"), done.ran, done.failed))
 }
 
+/// Compares the results CSV `result` with the baseline CSV `baseline` in tolerance tubes
+/// (`cosim compare`); with `plot`, a PNG per failing signal into that folder. Returns the
+/// report as a dict: `passed`, `tolerance`, `signals` (per signal `name`, `passed`,
+/// `points`, `violations`, `worst` (`time`, `value`, `lower`, `upper`, `excess`) or None,
+/// `problem`, `detail`), `notes`, `lines` (as `cosim compare` prints them), `figures`.
+#[pyfunction]
+#[pyo3(signature = (result, baseline, rtol=1e-3, atol=1e-6, time_tol=0.0, signals=None, plot=None))]
+#[allow(clippy::too_many_arguments)]
+fn compare<'py>(
+    py: Python<'py>,
+    result: PathBuf,
+    baseline: PathBuf,
+    rtol: f64,
+    atol: f64,
+    time_tol: f64,
+    signals: Option<Vec<String>>,
+    plot: Option<PathBuf>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    use nigel_cosim::compare;
+    use pyo3::types::PyDict;
+    let tolerance = compare::Tolerance { rtol, atol, time_tol };
+    let bad = |e: String| PyValueError::new_err(e);
+    let r = compare::csv::read_results_csv(&result).map_err(bad)?;
+    let b = compare::csv::read_results_csv(&baseline).map_err(bad)?;
+    let c = compare::compare(&r, &b, &tolerance, signals.as_deref()).map_err(bad)?;
+    let figures = match &plot {
+        Some(dir) => compare::plot::plot_failures(&r, &b, &c, dir).map_err(bad)?,
+        None => Vec::new(),
+    };
+    let out = PyDict::new(py);
+    out.set_item("passed", c.passed())?;
+    let tol = PyDict::new(py);
+    tol.set_item("rtol", rtol)?;
+    tol.set_item("atol", atol)?;
+    tol.set_item("time_tol", time_tol)?;
+    out.set_item("tolerance", tol)?;
+    let mut each = Vec::new();
+    for s in &c.signals {
+        let d = PyDict::new(py);
+        d.set_item("name", &s.name)?;
+        d.set_item("passed", s.passed)?;
+        d.set_item("points", s.points)?;
+        d.set_item("violations", s.violations)?;
+        match &s.worst {
+            Some(w) => {
+                let wd = PyDict::new(py);
+                wd.set_item("time", w.time)?;
+                wd.set_item("value", w.value)?;
+                wd.set_item("lower", w.lower)?;
+                wd.set_item("upper", w.upper)?;
+                wd.set_item("excess", w.excess)?;
+                d.set_item("worst", wd)?;
+            }
+            None => d.set_item("worst", py.None())?,
+        }
+        d.set_item("problem", s.problem.clone())?;
+        d.set_item("detail", s.detail())?;
+        each.push(d);
+    }
+    out.set_item("signals", each)?;
+    out.set_item("notes", c.notes.clone())?;
+    out.set_item("lines", c.lines())?;
+    out.set_item("figures", figures)?;
+    Ok(out)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<NativeSystem>()?;
     m.add_class::<NativeRun>()?;
     m.add_function(wrap_pyfunction!(run_campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add("Error", py.get_type::<Error>())?;
     m.add("LoadError", py.get_type::<LoadError>())?;
     m.add("VariableError", py.get_type::<VariableError>())?;

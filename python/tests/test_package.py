@@ -87,6 +87,79 @@ def test_simulate_ssp_is_the_command_line_bit_for_bit(tmp_path):
         assert np.array_equal(ours[field].astype(np.float64), cli[field]), field
 
 
+def _closed_loop_with_mapping_connector_and_start(tmp_path):
+    """The closed loop with a system parameter connector `mass` feeding plant.m, bound
+    through a parameter mapping from a value in grams (`vehicle_mass_g` 2700 g, the set's
+    Units: g = 0.001 kg), and a DefaultExperiment from 1 s to 3 s."""
+    import re
+    import zipfile
+
+    out = tmp_path / "mapped_closed_loop.ssp"
+    with zipfile.ZipFile(SSP) as src, zipfile.ZipFile(out, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename == "SystemStructure.ssd":
+                ssd = data.decode()
+                ssd = re.sub(
+                    r'(<ssd:System name="[^"]*">)',
+                    r"""\1
+    <ssd:Connectors><ssd:Connector name="mass" kind="parameter"><ssc:Real/></ssd:Connector></ssd:Connectors>
+    <ssd:ParameterBindings><ssd:ParameterBinding source="resources/mass.ssv">
+      <ssd:ParameterMapping><ssm:ParameterMapping xmlns:ssm="http://ssp-standard.org/SSP1/SystemStructureParameterMapping" version="1.0">
+        <ssm:MappingEntry source="vehicle_mass_g" target="mass"/>
+        <ssm:MappingEntry source="vehicle_mass_g" target="trailer.m"/>
+      </ssm:ParameterMapping></ssd:ParameterMapping>
+    </ssd:ParameterBinding></ssd:ParameterBindings>""",
+                    ssd,
+                    count=1,
+                )
+                ssd = ssd.replace(
+                    "</ssd:Connections>",
+                    '<ssd:Connection startElement="plant" startConnector="m" endElement="" endConnector="mass"/></ssd:Connections>',
+                )
+                ssd = re.sub(r"<ssd:DefaultExperiment[^>]*/>", '<ssd:DefaultExperiment startTime="1" stopTime="3"/>', ssd)
+                data = ssd.encode()
+            dst.writestr(item, data)
+        dst.writestr(
+            "resources/mass.ssv",
+            """<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="1.0" name="m">
+  <ssv:Parameters><ssv:Parameter name="vehicle_mass_g"><ssv:Real value="2700" unit="g"/></ssv:Parameter></ssv:Parameters>
+  <ssv:Units><ssc:Unit name="g"><ssc:BaseUnit kg="1" factor="0.001"/></ssc:Unit></ssv:Units>
+</ssv:ParameterSet>""",
+        )
+    return out
+
+
+def test_simulate_ssp_applies_mappings_connector_values_and_start_as_the_command_line(tmp_path):
+    ssp = _closed_loop_with_mapping_connector_and_start(tmp_path)
+    csv = tmp_path / "cli.csv"
+    done = subprocess.run(
+        [COSIM, "run", ssp, "--step", "1e-3", "--output", csv, "--record", "plant.y", "--record", "plant.v_x"],
+        check=True,
+        capture_output=True,
+    )
+    cli = read_cli_csv(csv)
+    # trailer.m names no variable: ignored as SSP 1.0 says, and warned
+    with pytest.warns(UserWarning, match="trailer.m"):
+        ours = nigel_cosim.simulate_ssp(ssp, step_size=1e-3, output=["plant.y", "plant.v_x"])
+    # from the SSD's 1 s to its 3 s, every value the same bit for bit
+    assert ours["time"][0] == 1.0 and ours["time"][-1] == 3.0 and len(ours) == 2001
+    for field in cli.dtype.names:
+        assert np.array_equal(ours[field].astype(np.float64), cli[field]), field
+    # plant.m = 2700 g = 2.7 kg through the mapping and the connector: the run equals one
+    # with plant.m set to 2.7 directly, and differs from one at the SSP's own mass
+    with nigel_cosim.System(ssp) as system:
+        assert len(system.notes) == 1 and "trailer.m" in system.notes[0] and "ignored" in system.notes[0], system.notes
+        direct = system.simulate(step_size=1e-3, start_values={"plant.m": 2.7}, output=["plant.y", "plant.v_x"])
+    assert np.array_equal(direct["plant.y"], ours["plant.y"])
+    # the closed loop as built (plant.m its FMU's 2.68 kg), over the same span
+    own = nigel_cosim.simulate_ssp(SSP, start_time=1.0, stop_time=3.0, step_size=1e-3, output=["plant.y"])
+    assert not np.array_equal(own["plant.y"], ours["plant.y"])
+    info = subprocess.run([COSIM, "info", ssp], check=True, capture_output=True, text=True).stdout
+    assert "plant.m = 2.7 (from 2700 g)" in info, info
+    assert b"cosim: note: " in done.stderr and b"trailer.m" in done.stderr, done.stderr
+
+
 def test_a_system_runs_many_times_from_one_load_as_separate_runs():
     masses = [2.4, 2.7, 3.0]
     with nigel_cosim.System(SSP) as system:
@@ -362,3 +435,37 @@ def test_ctrl_c_during_a_campaign_starts_no_further_run(tmp_path):
     # the rows of the runs that finished are written, far fewer than the 2000 asked for
     rows = pandas.read_csv(tmp_path / "out" / "results.csv")
     assert 0 < len(rows) < 2000
+
+
+def test_compare_gives_the_report_of_cosim_compare(tmp_path):
+    # the committed baseline of the closed loop against itself with one value off by 1 %
+    # and one signal left out: as `cosim compare` judges the same files
+    baseline = REPO / "cosim" / "tests" / "data" / "closed_loop_30s.csv"
+    data = np.genfromtxt(baseline, delimiter=",", names=True, deletechars="", dtype=np.float64)
+    b = data["plant.y"][300]
+    data["plant.y"][300] *= 1.01
+    result = data[["time", "plant.x", "plant.y"]]
+    report = nigel_cosim.compare(result, baseline, plot=tmp_path / "plots")
+    assert not report["passed"]
+    assert [(s["name"], s["passed"]) for s in report["signals"]] == [
+        ("plant.x", True),
+        ("plant.y", False),
+        ("plant.psi", False),
+        ("plant.speed", False),
+        ("plant.yaw_rate", False),
+    ]
+    y = report["signals"][1]
+    # the default tolerances: the tube at t = 15 s is b +- (1e-6 + 1e-3 |b|)
+    w = 1e-6 + 1e-3 * abs(b)
+    assert (y["points"], y["violations"]) == (601, 1)
+    assert y["worst"]["time"] == 15.0 and y["worst"]["value"] == data["plant.y"][300]
+    assert (y["worst"]["lower"], y["worst"]["upper"]) == (b - w, b + w)
+    assert report["signals"][2]["problem"] == "missing in the result"
+    assert report["figures"] == [tmp_path / "plots" / "plant.y.png"]
+    # the same files through the command line: the same lines
+    path = tmp_path / "result.csv"
+    nigel_cosim.write_csv(path, result)
+    p = subprocess.run([COSIM, "compare", path, baseline], capture_output=True, text=True)
+    assert p.returncode == 3
+    assert p.stdout.splitlines()[1:] == report["lines"]
+    assert nigel_cosim.compare(path, baseline, signals=["plant.x"])["passed"]

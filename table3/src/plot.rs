@@ -27,8 +27,9 @@ fn register_font() -> Result<(), String> {
 /// Points kept per series: every `STRIDE`-th sample (10 ms; 3001 points for 30 s).
 pub const STRIDE: usize = 10;
 
-const WHEEL_COLORS: [RGBColor; 4] =
-    [RGBColor(213, 94, 0), RGBColor(0, 114, 178), RGBColor(0, 158, 115), RGBColor(204, 121, 167)];
+/// The friction panels' colour: dark grey, none of the controllers' colours, because the
+/// road is the same for every controller (the test bench's, not a controller's output).
+const FRICTION_COLOR: RGBColor = RGBColor(64, 64, 64);
 
 /// The colour of a controller's lines (colour-blind safe).
 pub fn color(c: Controller) -> RGBColor {
@@ -462,7 +463,7 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
                 if window == (0.0, t_end) {
                     ""
                 } else {
-                    ": from 1 s before the steering program first reaches its largest magnitude (plot::focus_window)"
+                    ": from 1 s before the steering program first reaches its largest magnitude"
                 }
             ),
         ],
@@ -493,8 +494,8 @@ pub fn time_figure(runs: &[Run], fidelity: Fidelity, maneuver: Maneuver, path: &
         .map(|i| {
             vec![Series {
                 label: format!("mu {}", ["FL", "FR", "RL", "RR"][i]),
-                color: WHEEL_COLORS[i],
-                width: 2,
+                color: FRICTION_COLOR,
+                width: 1,
                 points: sampled(n - 1).map(|k| (Run::time(k), first.mu[k][i])).collect(),
             }]
         })

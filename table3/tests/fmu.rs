@@ -175,7 +175,7 @@ fn the_exported_ssp_runs_in_our_master_exactly_like_the_system_it_came_from() {
     assert!(e_j != e_o && (e_j - e_o).abs() < 0.06 * e_o, "jacobi {e_j}, ordered {e_o}");
 }
 
-/// The time figures the README shows (`table3/figures/time_sim_skidpad.png`,
+/// The time figures docs/table3.md shows (`table3/figures/time_sim_skidpad.png`,
 /// `time_real_figure_8.png`) are what `table3 --seed 0 --png DIR` draws today, byte for byte
 /// (the runs are bit-identical on this platform and the drawing is deterministic: the font is
 /// bundled). On a change of the figures, regenerate them with that command and copy the two.

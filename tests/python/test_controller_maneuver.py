@@ -129,6 +129,18 @@ def test_both_interfaces_run(fmi_type):
     assert r["delta_ff_fl"][-1] == pytest.approx(A, abs=1e-15) and r["x_ref"][-1] > 0.9
 
 
+@pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
+def test_a_stop_time_past_the_default_duration_with_a_longer_duration_set(fmi_type):
+    # fmpy sets the start values after fmi2SetupExperiment: the stop time is checked against
+    # duration when initialization ends. Straight ahead the reference holds speed_target
+    # (0.35 m/s) from x = 0: x_ref(31 s) = 10.85 m.
+    r = simulate_fmu(str(MANEUVER), fmi_type=fmi_type, stop_time=31.0, output_interval=0.1,
+                     start_values={"duration": 32.0}, output=["x_ref"])
+    assert r["time"][-1] == pytest.approx(31.0) and r["x_ref"][-1] == pytest.approx(0.35 * 31.0, rel=1e-9)
+    with pytest.raises(Exception):  # the default duration, 30 s, ends before the stop time
+        simulate_fmu(str(MANEUVER), fmi_type=fmi_type, stop_time=31.0, output_interval=0.1, output=["x_ref"])
+
+
 # ------------------------------------------------------------------------- controller
 
 INPUT_SETS = [
@@ -395,7 +407,7 @@ def test_figure8_switch_samples(bench):
     # a CS row at t_k is sampled after the step into t_k: it holds sample k
     flips = [int(round(r["time"][i] / T)) for i in range(1, len(d)) if d[i] != d[i - 1]]
     assert flips == [3144, 6267, 9390]
-    doc_check("README.md", "(first flips at samples {}, {}, {})", *flips)
+    doc_check("docs/fmus.md", "(first flips at samples {}, {}, {})", *flips)
     assert np.all(np.abs(d) == A) and np.all(r["delta_ff_rr"] == -d)
 
 

@@ -15,6 +15,7 @@ The commands are the ones the docs name, on the FMUs and the SSP the test comman
   study's 10,080 runs are a recorded run, not repeated here).
 """
 import json
+import os
 import re
 import subprocess
 import sys
@@ -28,8 +29,9 @@ sys.path.insert(0, str(REPO / "cosim" / "tests" / "python"))
 from closed_loop_tools import POSE, epsilon, release_binary, target_dir  # noqa: E402
 
 DOCS = ["README.md", "cosim/README.md", "campaign/README.md", "examples/README.md", "table3/README.md",
-        "docs/vehicle-model.md", "docs/synthesis.md", "docs/benchmark.md", "docs/fmi-notes.md",
-        "docs/performance.md"]
+        "python/README.md", "docs/vehicle-model.md", "docs/synthesis.md", "docs/benchmark.md", "docs/fmi-notes.md",
+        "docs/performance.md", "docs/fmus.md", "docs/platforms.md", "docs/cosim.md", "docs/python.md",
+        "docs/table3.md", "docs/reference.md", "docs/testing.md"]
 
 SSP = target_dir() / "ssp" / "nigel_closed_loop.ssp"
 
@@ -40,18 +42,68 @@ BLOCKS = [(path, line, code, expected) for path in DOCS for line, code, expected
 
 
 def test_the_docs_have_python_blocks_that_print():
-    # the README's fmpy examples of the three FMUs; a doc edit that drops `# prints` drops a check
-    assert sum(1 for b in BLOCKS if b[0] == "README.md") >= 3, BLOCKS
+    # the README's quick start (nigel_cosim, fmpy) and docs/fmus.md's fmpy examples of the three
+    # FMUs; a doc edit that drops `# prints` drops a check
+    assert sum(1 for b in BLOCKS if b[0] == "README.md") >= 2, BLOCKS
+    assert sum(1 for b in BLOCKS if b[0] == "docs/fmus.md") >= 3, BLOCKS
 
 
 @pytest.mark.parametrize("path,line,code,expected", BLOCKS, ids=[f"{b[0]}:{b[1]}" for b in BLOCKS])
 def test_python_block_prints_what_its_comment_says(path, line, code, expected):
+    if not (target_dir() / "fmu").is_dir():
+        pytest.skip(f"{target_dir() / 'fmu'} is absent: the blocks run on what `bash scripts/run.sh` builds")
     code = code.replace('"target/', f'"{target_dir()}/')
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, f"{path}:{line}: the block fails:\n{r.stderr}"
     got = " ".join(r.stdout.split())
     assert got == " ".join(expected.split()), \
         f"{path}:{line}: the block prints {got!r}, its comment says {expected!r}"
+
+
+
+# --- the README's shell blocks, as printed ----------------------------------------------------
+
+def shell_blocks(path):
+    """The fenced ```sh blocks of a doc, as (line number, text)."""
+    text = (REPO / path).read_text()
+    return [(text[: m.start()].count("\n") + 1, m.group(1))
+            for m in re.finditer(r"^```sh\n(.*?)^```", text, re.S | re.M)]
+
+
+def test_readme_shell_blocks_run_as_printed(tmp_path):
+    """Every ```sh block of README.md runs as printed, in order, from a folder that holds what
+    the main command made (`target`, linked to this build's) and the repository's `examples`
+    and `scripts`: the two commands themselves are what the test command is (not rerun here),
+    and the block that installs the wheel into a venv of one's own is what
+    scripts/test-python-package.sh runs (it reads it from README.md: a network install)."""
+    if not (target_dir() / "fmu").is_dir():
+        pytest.skip(f"{target_dir() / 'fmu'} is absent: the blocks run on what `bash scripts/run.sh` builds")
+    blocks = shell_blocks("README.md")
+    for name in ("target", "examples", "scripts", "campaigns"):
+        (tmp_path / name).symlink_to(target_dir() if name == "target" else REPO / name)
+    env = dict(os.environ)
+    ran = []
+    for line, block in blocks:
+        if "bash scripts/run.sh" in block:
+            assert "bash scripts/test.sh" in block, f"README.md:{line}"
+            continue
+        if "pip install" in block:
+            package_test = (REPO / "scripts" / "test-python-package.sh").read_text()
+            assert "readme-install" in package_test, "scripts/test-python-package.sh no longer runs README.md's install block"
+            continue
+        if block.strip().startswith("export PATH="):
+            # `$PWD/target/release`: the main command's programs, from the folder the blocks run in
+            env["PATH"] = f"{tmp_path / 'target' / 'release'}:{env['PATH']}"
+            ran.append(line)
+            continue
+        r = subprocess.run(["bash", "-euo", "pipefail", "-c", block], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, f"README.md:{line}: the block fails:\n{block}\n{r.stderr}"
+        ran.append(line)
+    assert len(ran) >= 2, blocks  # the PATH line and the command-line quick start
+    # the quick start's run wrote every output of the 30 s at 1 ms
+    rows = np.genfromtxt(tmp_path / "target" / "closed_loop.csv", delimiter=",", names=True)
+    assert len(rows) == 30001 and rows["time"][-1] == pytest.approx(30.0)
 
 
 def test_along_track_pole():
@@ -64,12 +116,12 @@ def test_along_track_pole():
     kp, ki, k = (float(ctl[n]) for n in ("kp_speed", "ki_speed", "k_along_track"))
     m = float(plant["m"])
     for name, value in (("kp_speed", kp), ("ki_speed", ki), ("k_along_track", k)):
-        check("README.md", f"`{name}` {{}}", value)
+        check("docs/fmus.md", f"`{name}` {{}}", value)
     poles = np.roots([1, kp / m, ki / m + k * kp / m, k * ki / m])
     dominant = max(poles, key=lambda p: p.real)
     assert abs(dominant.imag) < 1e-9, poles  # real: no overshoot
-    check("README.md", "time constant (dominant pole {} /s)", dominant.real)
-    check("README.md", "follows `-0.1 e^({} t)`", dominant.real)
+    check("docs/fmus.md", "time constant (dominant pole {} /s)", dominant.real)
+    check("docs/fmus.md", "follows `-0.1 e^({} t)`", dominant.real)
 
 
 # --- the closed-loop SSP in the master ------------------------------------------------------
@@ -98,14 +150,17 @@ def closed_loop(tmp_path_factory):
 def test_closed_loop_figures(closed_loop):
     eps_j, (x_j, y_j, psi_j) = closed_loop["jacobi"]
     eps_o, (x_o, y_o, psi_o) = closed_loop["ordered"]
-    check("README.md", "ecos and libcosim compute our `jacobi` run to every printed digit (epsilon {},", eps_j)
+    check("docs/cosim.md", "ecos and libcosim compute our `jacobi` run to every printed digit (epsilon {},", eps_j)
     check("cosim/README.md", "| **master `ordered`, recording nothing** |{*}| {} | {}, {}, {} |",
           eps_o, x_o, y_o, psi_o)
     check("cosim/README.md", "| **master `jacobi`, recording nothing** |{*}| {} | {}, {}, {} |",
           eps_j, x_j, y_j, psi_j)
-    check("README.md", "| our `ordered` | {} |", eps_o)
-    check("README.md", "| our `jacobi` | {} | | {} % |", eps_j, 100 * (eps_o - eps_j) / eps_o)
+    check("docs/table3.md", "| our `ordered` | {} |", eps_o)
+    check("docs/table3.md", "| our `jacobi` | {} | | {} % |", eps_j, 100 * (eps_o - eps_j) / eps_o)
     check("docs/fmi-notes.md", "On the benchmark the difference is about {} % in epsilon", 100 * (eps_o - eps_j) / eps_o)
+    # the README's "Which algorithm" (the quick start's Python block prints jacobi's itself)
+    check("README.md", "On this loop the two differ by {} % in epsilon: jacobi {}, ordered {}",
+          100 * (eps_o - eps_j) / eps_o, eps_j, eps_o)
 
 
 def run_epsilon(ssp, csv, *sets):
@@ -133,8 +188,8 @@ def test_real_straight_without_the_measurement_noise(table3_seed0, tmp_path):
         # the exported job is the table's cell (same FMUs, same master, same steps)
         assert noisy == pytest.approx(t["results"]["real"]["straight"][c]["eps"], rel=1e-12)
         eps[c] = (noisy, run_epsilon(ssp, tmp_path / f"{c}_quiet.csv", "maneuver.measurement_noise=false"))
-    check("README.md", "changes the tracking epsilon of real straight from {} to {})", *eps["robust_tracking"])
-    check("README.md", "(real straight {}, {} without the noise)", *eps["robust"])
+    check("docs/table3.md", "changes the tracking epsilon of real straight from {} to {})", *eps["robust_tracking"])
+    check("docs/table3.md", "(real straight {}, {} without the noise)", *eps["robust"])
 
 
 # --- Table III, seed 0, through the FMUs ----------------------------------------------------
@@ -159,9 +214,9 @@ def test_table3_seed0(table3_seed0):
     # the two tables, as `table3 --seed 0` prints them (the paper's columns included)
     for column in ("sim", "real"):
         header = next(l for l in markdown.splitlines() if l.startswith(f"| {column} | "))
-        require("README.md", header)
+        require("docs/table3.md", header)
         for row in rows_of(markdown, column):
-            require("README.md", row)
+            require("docs/table3.md", row)
     # the committed JSON is this run's (the wall time aside)
     committed = json.loads((REPO / "table3" / "figures" / "table3_seed0.json").read_text())
     assert committed["gains"] == t["gains"], "table3/figures/table3_seed0.json: gains are stale"
@@ -176,26 +231,26 @@ def test_table3_seed0(table3_seed0):
     R = t["results"]
     eps = lambda f, m, c: R[f][m][c]["eps"]  # noqa: E731
     aux = lambda f, m, c: R[f][m][c]["eps_state"]  # noqa: E731
-    check("README.md", "e.g. sim skidpad {} robust, {} robust tracking, {} open-loop, {} non-robust; "
+    check("docs/table3.md", "e.g. sim skidpad {} robust, {} robust tracking, {} open-loop, {} non-robust; "
           "sim straight {} / {} / {} / {})",
           *(aux("sim", "skidpad", c) for c in ("robust", "robust_tracking", "open_loop", "pole_placement")),
           *(aux("sim", "straight", c) for c in ("robust", "robust_tracking", "open_loop", "pole_placement")))
     g = t["gains"]
-    check("README.md", "Gains (from the controller FMU; the synthesis' baked values): robust "
+    check("docs/table3.md", "Gains (from the controller FMU; the synthesis' baked values): robust "
           "`[[{}, {}], [{}, {}], [{}, {}], [{}, {}]]`", *np.ravel(g["robust"]))
-    check("README.md", "placement (`Re(s) < -2` at mu = 0.4) `[[{}, {}], [{}, {}], [{}, {}], [{}, {}]]`",
+    check("docs/table3.md", "placement (`Re(s) < -2` at mu = 0.4) `[[{}, {}], [{}, {}], [{}, {}], [{}, {}]]`",
           *np.ravel(g["pole_placement"]))
-    check("README.md", "(columns e_y, e_psi, beta, yaw_rate) `[[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]]` (RL = RR)",
+    check("docs/table3.md", "(columns e_y, e_psi, beta, yaw_rate) `[[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]]` (RL = RR)",
           *g["robust_tracking"][0], *g["robust_tracking"][2])
     # the largest steering command of each controller in seed 0
     md = {c: max(R[f][m][c]["max_delta"] for f in R for m in R[f]) for c in R["sim"]["straight"]}
-    check("README.md", "in seed 0 its largest command is {} rad, against {} for robust, {} for non-robust and {} for the program alone",
+    check("docs/table3.md", "in seed 0 its largest command is {} rad, against {} for robust, {} for non-robust and {} for the program alone",
           md["robust_tracking"], md["robust"], md["pole_placement"], md["open_loop"])
     rows = [(f, m) for f in R for m in R[f]]
     ratios = [aux(f, m, "robust_tracking") / aux(f, m, "robust") for f, m in rows]
-    check("README.md", "its `||(RMSE_beta, RMSE_r)||` is {}-{}x the robust controller's in every row of seed 0",
+    check("docs/table3.md", "its `||(RMSE_beta, RMSE_r)||` is {}-{}x the robust controller's in every row of seed 0",
           min(ratios), max(ratios))
-    check("README.md", "epsilon (sim / real) is {} / {} on straight (robust {} / {}), {} / {} on skidpad ({} / {}), "
+    check("docs/table3.md", "epsilon (sim / real) is {} / {} on straight (robust {} / {}), {} / {} on skidpad ({} / {}), "
           "{} / {} on figure-8 ({} / {})",
           *(v for m in ("straight", "skidpad", "figure_8")
             for v in (eps("sim", m, "robust_tracking"), eps("real", m, "robust_tracking"),
@@ -205,24 +260,24 @@ def test_table3_seed0(table3_seed0):
     lowest = {(f, m): min(three, key=lambda c: eps(f, m, c)) for f, m in rows}
     assert [k for k, c in lowest.items() if c != "robust"] == [("sim", "straight")], lowest
     assert lowest[("sim", "straight")] == "open_loop"
-    check("README.md", "**Straight, sim column**: open-loop ({}) beats robust ({}, {}x)",
+    check("docs/table3.md", "**Straight, sim column**: open-loop ({}) beats robust ({}, {}x)",
           eps("sim", "straight", "open_loop"), eps("sim", "straight", "robust"),
           eps("sim", "straight", "robust") / eps("sim", "straight", "open_loop"))
-    check("README.md", "seed 0 robust is marginally lower ({} vs {})",
+    check("docs/table3.md", "seed 0 robust is marginally lower ({} vs {})",
           eps("real", "straight", "robust"), eps("real", "straight", "open_loop"))
     pp = [eps(f, m, "pole_placement") / eps(f, m, "open_loop") for f, m in rows]
     assert min(pp) > 1, "the non-robust baseline is the worst controller in every row"
-    check("README.md", "({}x to {}x the open-loop epsilon)", min(pp), max(pp))
+    check("docs/table3.md", "({}x to {}x the open-loop epsilon)", min(pp), max(pp))
     rings = [eps("sim", m, "open_loop") / eps("sim", m, "robust") for m in ("skidpad", "fishhook", "slalom", "figure_8")]
-    check("README.md", "(epsilon {}-{}x lower than open-loop in sim on skidpad, fishhook, slalom, figure-8)",
+    check("docs/table3.md", "(epsilon {}-{}x lower than open-loop in sim on skidpad, fishhook, slalom, figure-8)",
           min(rings), max(rings))
-    check("README.md", "it is for slalom ({} against {} open-loop)",
+    check("docs/table3.md", "it is for slalom ({} against {} open-loop)",
           abs(eps("real", "slalom", "robust") - eps("sim", "slalom", "robust")),
           abs(eps("real", "slalom", "open_loop") - eps("sim", "slalom", "open_loop")))
     rmse = R["real"]["straight"]["robust_tracking"]["rmse"]
-    check("README.md", "RMSE_psi {} rad against RMSE_Y {} mm", rmse[2], 1e3 * rmse[1])
+    check("docs/table3.md", "RMSE_psi {} rad against RMSE_Y {} mm", rmse[2], 1e3 * rmse[1])
     # the same cells quoted by the fmpy loop's test and the examples
-    check("README.md", "give Table III's epsilon (sim lane-change {}, real fishhook {}, robust) to 1e-5",
+    check("docs/fmus.md", "give Table III's epsilon (sim lane-change {}, real fishhook {}, robust) to 1e-5",
           eps("sim", "lane_change", "robust"), eps("real", "fishhook", "robust"))
     check("examples/README.md", "where ours scores {} (robust) and {} (open loop)",
           eps("sim", "lane_change", "robust"), eps("sim", "lane_change", "open_loop"))
@@ -248,7 +303,7 @@ def test_table3_seed0(table3_seed0):
     mag = {k: eps(*k, "robust") / v for k, v in paper.items()}
     others = [v for (f, m), v in mag.items() if m != "straight"]
     sim_ratio = [eps("sim", m, "open_loop") / eps("sim", m, "robust") for m in R["sim"] if m != "straight"]
-    check("README.md", "our robust epsilon is close to the paper's on straight ({}x / {}x) but {}-{}x the paper's on the "
+    check("docs/table3.md", "our robust epsilon is close to the paper's on straight ({}x / {}x) but {}-{}x the paper's on the "
           "other rows, and the robust/open-loop ratio is smaller ({}-{}x in sim",
           mag[("sim", "straight")], mag[("real", "straight")], min(others), max(others), min(sim_ratio), max(sim_ratio))
 
@@ -279,25 +334,25 @@ def test_seed_study(seeds):
              for f in ("sim", "real") for m in maneuvers}
     for m in maneuvers:
         s, q = ratio[("sim", m)], ratio[("real", m)]
-        check("README.md", f"| {m} | {{}} ({{}}) | {{}} ({{}}) |", max(s), np.mean(s), max(q), np.mean(q))
+        check("docs/table3.md", f"| {m} | {{}} ({{}}) | {{}} ({{}}) |", max(s), np.mean(s), max(q), np.mean(q))
     every = [x for v in ratio.values() for x in v]
-    check("README.md", "over seeds 0..9 its epsilon is {} to {} times the paper's robust controller's", min(every), max(every))
+    check("docs/synthesis.md", "over seeds 0..9 its epsilon is {} to {} times the paper's robust controller's", min(every), max(every))
     worst = lambda m: max(max(ratio[("sim", m)]), max(ratio[("real", m)]))  # noqa: E731
-    check("README.md", "so at least {}x lower in every cell, {}x on straight, {}x on skidpad and {}x on figure-8",
+    check("docs/table3.md", "so at least {}x lower in every cell, {}x on straight, {}x on skidpad and {}x on figure-8",
           1 / max(every), 1 / worst("straight"), 1 / worst("skidpad"), 1 / worst("figure_8"))
     md = {c: max(r[f][m][c]["max_delta"] for r in seeds for f in r for m in maneuvers) for c in controllers}
-    check("README.md", "The largest steering command over all 480 runs is {} rad for robust tracking ({} non-robust, "
+    check("docs/table3.md", "The largest steering command over all 480 runs is {} rad for robust tracking ({} non-robust, "
           "{} robust, {} open loop), {} % of `delta_max = pi/2`",
           md["robust_tracking"], md["pole_placement"], md["robust"], md["open_loop"],
           100 * md["robust_tracking"] / (np.pi / 2))
-    check("README.md", "over seeds 0..9, below, {} and {})", md["robust_tracking"], md["robust"])
+    check("docs/table3.md", "over seeds 0..9, below, {} and {})", md["robust_tracking"], md["robust"])
     # straight: open loop against robust over the seeds, per column
     for f, template in (("sim", "open-loop is lowest on straight in all {} seeds in sim (robust {}-{}x)"),
                         ("real", "and in {} of 10 in real (robust {}-{}x)")):
         rr = [eps(r, f, "straight", "robust") / eps(r, f, "straight", "open_loop") for r in seeds]
         lowest = sum(1 for r in seeds
                      if min(("open_loop", "pole_placement", "robust"), key=lambda c: eps(r, f, "straight", c)) == "open_loop")
-        check("README.md", template, lowest, min(rr), max(rr))
+        check("docs/table3.md", template, lowest, min(rr), max(rr))
     for r in seeds:
         for f in r:
             for m in maneuvers:
@@ -328,7 +383,7 @@ def test_robustness_study_tables_are_its_report():
           ol_r["p_more"], ol_r["pairs"], 1 / ol_r["median_ratio"], r_rt["p_more"], r_rt["median_ratio"])
     check("campaign/README.md", "the non-robust pole placement loses to the open loop in {} % of the pairs",
           100 * pairs[("open_loop", "pole_placement")]["p_less"])
-    check("README.md", "noise seed = {} runs, 0 failed): on the same draws P(robust < open loop) = {}, "
+    check("docs/reference.md", "noise seed = {} runs, 0 failed): on the same draws P(robust < open loop) = {}, "
           "P(robust tracking < robust) = {}, P(robust < pole placement) = {}; median epsilon open loop {}, "
           "pole placement {}, robust {}, robust tracking {};",
           rep["runs"], ol_r["p_more"], r_rt["p_more"], pp_r["p_more"], eps["open_loop"]["median"],
@@ -340,7 +395,7 @@ def test_robustness_study_tables_are_its_report():
     v = pp["values"]
     check("campaign/README.md", "(run {}, skidpad `sim`, {} m/s, {} kg, {} N/rad, friction mean {}: epsilon {},",
           pp["run"], v["speed"], v["plant.m"], v["c_tire"], v["maneuver.friction_mean"], pp["metrics"]["epsilon"])
-    check("README.md", "(epsilon {} at {} m/s,", pp["metrics"]["epsilon"], v["speed"])
+    check("docs/reference.md", "(epsilon {} at {} m/s,", pp["metrics"]["epsilon"], v["speed"])
     v = rt["values"]
     check("campaign/README.md", "Its worst run (run {}, skidpad `real`, {} m/s, friction mean {}) saturates the steering "
           "at 90 deg (`max_delta` {}):", rt["run"], v["speed"], v["maneuver.friction_mean"], rt["metrics"]["max_delta"])
@@ -369,28 +424,28 @@ def test_synthesis_figures(designs):
     nu_paper = designs["paper_point"]["chosen"]["nu"]
     ch = lambda d: (d["chosen"]["k"], d["chosen"]["g"], d["chosen"]["nu"])  # noqa: E731
     norms = lambda d: (d["actual"]["hinf_worst"], d["actual"]["h2_worst"])  # noqa: E731
-    check("README.md", "| paper, 4WD4WS | {} (MATLAB 0.1175) | {}, ({}, {}); the paper's (0.198, 0.556): ν(0.198) = {} | {} / {} |",
+    check("docs/synthesis.md", "| paper, 4WD4WS | {} (MATLAB 0.1175) | {}, ({}, {}); the paper's (0.198, 0.556): ν(0.198) = {} | {} / {} |",
           p["gamma_star"], *ch(p), nu_paper, *norms(p))
-    check("README.md", "| paper, Ackermann | {} | {}, ({}, {}) (paper 0.2606, 0.6449) | {} / {} |",
+    check("docs/synthesis.md", "| paper, Ackermann | {} | {}, ({}, {}) (paper 0.2606, 0.6449) | {} / {} |",
           a["gamma_star"], *ch(a), *norms(a))
-    check("README.md", "| physical, 4WD4WS | {} | {}, ({}, {}) | |", ph["gamma_star"], *ch(ph))
-    check("README.md", "rows FL, FR, RL, RR): `[{}, {}], [{}, {}], [{}, {}], [{}, {}]`.", *np.ravel(p["K"]))
-    check_at_most("README.md", "the H∞ norm by Hamiltonian bisection and by a frequency sweep (agree to {})",
+    check("docs/synthesis.md", "| physical, 4WD4WS | {} | {}, ({}, {}) | |", ph["gamma_star"], *ch(ph))
+    check("docs/synthesis.md", "rows FL, FR, RL, RR): `[{}, {}], [{}, {}], [{}, {}], [{}, {}]`.", *np.ravel(p["K"]))
+    check_at_most("docs/synthesis.md", "the H∞ norm by Hamiltonian bisection and by a frequency sweep (agree to {})",
                   max(d["actual"]["hinf_methods_rel_diff"] for d in (p, a, ph)))
     # rounding-limited on both sides (the Gramian's doubling adds one product's rounding per
     # squaring, scaled by the closed loop's conditioning): 5.3e-13 to 1.4e-12 seen across
     # machines and OpenBLAS kernels, so the README prints a bound with room above them
-    check_at_most("README.md", "the H2 norm by a Lyapunov equation and by Gramian integration (agree to {}:",
+    check_at_most("docs/synthesis.md", "the H2 norm by a Lyapunov equation and by Gramian integration (agree to {}:",
                   max(d["actual"]["h2_methods_rel_diff"] for d in (p, a, ph)), room=100)
     for name, d in (("`paper`, 4WD4WS | (0.198, 0.556)", p), ("`paper`, Ackermann | (0.261, 0.645)", a),
                     ("`physical`, 4WD4WS | ", ph)):
         check("docs/synthesis.md", f"| {name} | {{}}, k = {{}}, ({{}}, {{}}) |", d["gamma_star"], *ch(d))
     check("docs/synthesis.md", "Our `nu(0.198) = {}`", nu_paper)
     w = t["study"]["wind_step"]
-    check("README.md", "| {} | {}, ({}, {}) | {} / {} | {} ({} with the 0.03 s servo) | e_y {} mm, steering rate {} rad/s |",
+    check("docs/synthesis.md", "| {} | {}, ({}, {}) | {} / {} | {} ({} with the 0.03 s servo) | e_y {} mm, steering rate {} rad/s |",
           t["gamma_star"], *ch(t), *norms(t), t["verification"]["max_real_part"], t["study"]["servo_loop_max_real_part"],
           1e3 * w["lateral_peak"], w["steering_rate_peak"])
-    check("README.md", "angles positive to the left): `[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]` (RL = RR).",
+    check("docs/synthesis.md", "angles positive to the left): `[{}, {}, {}, {}]` (FL = FR), `[{}, {}, {}, {}]` (RL = RR).",
           *t["K"][0], *t["K"][2])
     assert t["K"][0] == t["K"][1] and t["K"][2] == t["K"][3]
 
@@ -418,10 +473,10 @@ def test_stiff_work_precision_errors(tmp_path):
             _, y, cv_err = run_cvode(fmus[case[1]], case, rtol)
             row = f"| {names[case[0]]} | {printed} | {{}} | {{*}} |"
             if cv_err is None:
-                check("README.md", row + " {} | {*} |", relative_error(x, ref), relative_error(y, ref))
+                check("docs/cosim.md", row + " {} | {*} |", relative_error(x, ref), relative_error(y, ref))
             else:
                 assert "code -1)" in cv_err, cv_err  # CV_TOO_MUCH_WORK: mxstep steps before an output
-                check("README.md", row + " mxstep | {*} |", relative_error(x, ref))
+                check("docs/cosim.md", row + " mxstep | {*} |", relative_error(x, ref))
 def test_stiff_transition_shifts(tmp_path):
     """The shifts of van der Pol's first transition (deterministic) in the tables of
     docs/performance.md ("The phase of van der Pol at loose tolerances", printed by
@@ -437,7 +492,7 @@ def test_stiff_transition_shifts(tmp_path):
             check("docs/performance.md", f"| {mu:.0e} | {{}} | {rtol_text} | {{}} | {{}} | {{*}} | {{}} | {{}} | {{*}} |",
                   ref, bdf, abs(bdf) / rtol, cvode, abs(cvode) / rtol)
             if rtol < 1e-3:
-                check("README.md", f"| {mu_text} | {rtol:.0e}".replace("e-0", "e-") + " | {} | {} |", bdf, cvode)
+                check("docs/cosim.md", f"| {mu_text} | {rtol:.0e}".replace("e-0", "e-") + " | {} | {} |", bdf, cvode)
 
 
 # --- the AddressSanitizer step of scripts/test.sh -------------------------------------------
@@ -448,4 +503,4 @@ def test_readme_prints_the_random_sequences_the_asan_step_runs():
     script = (REPO / "scripts" / "test.sh").read_text()
     fmi2 = int(re.search(r"NIGEL_RANDOM_SEQUENCES=(\d+)", script).group(1))
     fmi3 = int(re.search(r"NIGEL_RANDOM_SEQUENCES3=(\d+)", script).group(1))
-    check("README.md", "first {} and {} sequences per FMU and interface", fmi2, fmi3)
+    check("docs/testing.md", "first {} and {} sequences per FMU and interface", fmi2, fmi3)

@@ -465,7 +465,7 @@ def test_cs_and_me_agree(runs):
     diff = max_abs_diff(cs, me_grid)
     print("max |CS - ME|:", {k: f"{x:.2e}" for k, x in diff.items()})
     assert max(diff.values()) <= TRAJ_TOL, diff
-    doc_check("README.md", "Co-Simulation vs Model Exchange (CVode, rtol 1e-10) differ by at most {},", max(diff.values()))
+    doc_check("docs/testing.md", "Co-Simulation vs Model Exchange (CVode, rtol 1e-10) differ by at most {},", max(diff.values()))
     # the outputs that depend directly on the inputs agree too (both rows are left limits)
     names = ["lateral_accel", "der(yaw_rate)"] + [f"force_lat_{w}" for w in WHEELS]
     diff_out = max_abs_diff(cs, me_grid, names)
@@ -484,7 +484,7 @@ def test_cs_and_me_agree_with_the_reference(runs):
     print("max |ME - reference|:", {k: f"{x:.2e}" for k, x in d_me.items()})
     assert max(d_cs.values()) <= TRAJ_TOL, d_cs
     # the same RK4 in two implementations: rounding, printed as a bound
-    doc_check_at_most("README.md", "Co-Simulation vs an independent Python RK4 reference by {};", max(d_cs.values()))
+    doc_check_at_most("docs/testing.md", "Co-Simulation vs an independent Python RK4 reference by {};", max(d_cs.values()))
     assert max(d_me.values()) <= TRAJ_TOL, d_me
 
 
@@ -677,7 +677,7 @@ def test_directional_derivatives_match_finite_differences(md, unzipdir, vr, real
               f"at unknown vr {unknowns[worst[0]]}, known vr {knowns[worst[1]]}; |J|max = {np.max(np.abs(ad)):.1f}")
         assert np.all(err <= 1e-6 * scale), np.max(err / scale)
         if not real_fidelity:
-            doc_check("README.md", "directional derivatives vs central differences {} relative;", np.max(err / scale))
+            doc_check("docs/testing.md", "directional derivatives vs central differences {} relative;", np.max(err / scale))
         assert np.count_nonzero(np.abs(ad) > 1e-3) > 100  # a dense, non-trivial Jacobian
 
         # the sparsity agrees with the ModelStructure: a nonzero partial derivative is declared
@@ -857,7 +857,7 @@ def test_ssp_with_the_plant_matches_the_direct_cs_run(fmu_path, tmp_path):
     # can change the FMU's number of internal RK4 sub-steps; the effect is ~1e-12
     assert max(diff.values()) <= 1e-9, diff
     # the same FMU stepped by two loops: rounding, printed as a bound
-    doc_check_at_most("README.md", "`simulate_ssp` vs direct Co-Simulation {}.", max(diff.values()))
+    doc_check_at_most("docs/testing.md", "`simulate_ssp` vs direct Co-Simulation {}.", max(diff.values()))
     assert abs(ssp_cols["yaw_rate"][-1]) > 0.3  # the steering went through the connections
     assert abs(ssp_cols["v_x"][0] - 0.35) < 1e-3  # v_x_start = 0.35 from the ParameterValues
     # mu_rr and I_z from the ParameterValues matter: the run with the FMU's defaults differs

@@ -432,7 +432,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
 #[test]
 fn random_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
     let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES").ok().and_then(|s| s.parse().ok()).unwrap_or(150_000);
-    let mut plant = Vec::new(); // the plant's counts per interface, which README.md prints
+    let mut plant = Vec::new(); // the plant's counts per interface, which docs/testing.md prints
     for (k, target) in build_fmu::targets().iter().enumerate() {
         let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
         for kind in [CO_SIMULATION, MODEL_EXCHANGE] {
@@ -466,7 +466,7 @@ fn random_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_n
     }
 }
 
-/// README.md's figures of the default run (see "Figures in the docs" there): the plant's
+/// The figures docs/testing.md prints of the default run (see "Figures in the docs" there): the plant's
 /// calls in millions to the printed two digits, its Discards exactly.
 fn readme_prints_the_plant_counts(plant: &[[usize; 4]]) {
     let [cs, me] = plant else { panic!("the plant offers CS and ME: {plant:?}") };
@@ -491,11 +491,18 @@ fn readme_prints_the_plant_counts(plant: &[[usize; 4]]) {
             cs.iter().sum::<usize>() as f64 / 1e6
         ),
     ];
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md");
-    let readme = std::fs::read_to_string(&path).expect("README.md");
+    // docs/testing.md prints the default run's counts, docs/reference.md the sequences a new FMU gets
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
-    let readme = words(&readme);
+    let docs: String = ["docs/testing.md", "docs/reference.md"]
+        .iter()
+        .map(|d| words(&std::fs::read_to_string(root.join(d)).unwrap_or_else(|e| panic!("{d}: {e}"))))
+        .collect::<Vec<_>>()
+        .join(" ");
     for e in expected {
-        assert!(readme.contains(&words(&e)), "README.md no longer prints {e:?}: these are the counts now");
+        assert!(
+            docs.contains(&words(&e)),
+            "docs/testing.md or docs/reference.md no longer prints {e:?}: these are the counts now"
+        );
     }
 }

@@ -45,6 +45,13 @@ enum Command {
         /// crash boundary (an FMU's segfault ends the campaign), no timeout inside a call.
         #[arg(long)]
         in_process: bool,
+        /// Write a JUnit XML report: a test case per run (failed checks are failures, runs
+        /// that could not complete errors, each with its message).
+        #[arg(long, value_name = "FILE.xml")]
+        junit: Option<PathBuf>,
+        /// Write a Markdown table of the runs (for a CI job summary).
+        #[arg(long, value_name = "FILE.md")]
+        summary_md: Option<PathBuf>,
     },
     /// A worker process of `campaign run` (started by it; speaks its protocol on standard
     /// input and output).
@@ -174,7 +181,7 @@ fn judge(rows: &[nigel_campaign::results::Row], messages: &std::path::Path, allo
 fn main_inner(cli: Cli) -> Result<Outcome, Error> {
     match cli.command {
         Command::Worker { spec, hash } => std::process::exit(nigel_campaign::worker::serve(&spec, &hash)),
-        Command::Run { spec, out, threads, shard, resume, only, allow_failures, in_process } => {
+        Command::Run { spec, out, threads, shard, resume, only, allow_failures, in_process, junit, summary_md } => {
             let spec = Spec::load(&spec)?;
             if let Some(i) = only {
                 if i >= spec.runs() {
@@ -201,7 +208,8 @@ fn main_inner(cli: Cli) -> Result<Outcome, Error> {
                     std::env::current_exe().map_err(|e| Error::Io(format!("the campaign program: {e}")))?,
                 )
             };
-            let options = Options { out, threads, shard, resume, progress: true, workers, allow_failures, cancel: None };
+            let options =
+                Options { out, threads, shard, resume, progress: true, workers, allow_failures, cancel: None };
             let done = nigel_campaign::run::run(&spec, &options)?;
             if let Some(m) = &done.stop_time_refused {
                 eprintln!("campaign: warning: {m} (checked before the first run; run anyway: --allow-failures)");
@@ -220,6 +228,18 @@ fn main_inner(cli: Cli) -> Result<Outcome, Error> {
                 done.kept,
                 done.file.display()
             );
+            if junit.is_some() || summary_md.is_some() {
+                let suite = nigel_campaign::ci::suite(&spec, &done.rows, done.wall.as_secs_f64());
+                let suites = std::slice::from_ref(&suite);
+                if let Some(p) = &junit {
+                    std::fs::write(p, nigel_cosim::junit::xml(&suite.name, suites))
+                        .map_err(|e| Error::Io(format!("--junit {}: {e}", p.display())))?;
+                }
+                if let Some(p) = &summary_md {
+                    std::fs::write(p, nigel_cosim::junit::markdown(&suite.name, suites))
+                        .map_err(|e| Error::Io(format!("--summary-md {}: {e}", p.display())))?;
+                }
+            }
             Ok(judge(&done.rows, &done.messages, allow_failures))
         }
         Command::Slurm { spec, out, tasks, submit, partition, cpus_per_task, allow_failures } => {

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "cosim", version, about = "FMI 2.0 co-simulation master")]
+#[command(
+    name = "cosim",
+    version,
+    about = "FMI 2.0 and FMI 3.0 co-simulation master: FMUs and SSP systems, Co-Simulation and Model Exchange"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -18,6 +22,9 @@ struct Cli {
 enum Command {
     /// Simulate MODEL.fmu (as a one-instance system) or SYSTEM.ssp / SYSTEM.ssd.
     Run(Box<RunArgs>),
+    /// Compare RESULT.csv with BASELINE.csv signal by signal in tolerance tubes (exit
+    /// status 3 when a signal leaves its tube or is missing; docs/ci.md).
+    Compare(CompareArgs),
     /// List the variables (causality, type, unit, start) of an FMU, or the instances and
     /// connections of an SSP.
     Info {
@@ -26,6 +33,67 @@ enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The results to judge (CSV: ours, fmpy's, Dymola's or OpenModelica's export).
+    result: PathBuf,
+    /// The baseline (CSV).
+    baseline: PathBuf,
+    /// Relative tolerance, of the baseline's magnitude at each point.
+    #[arg(long, default_value_t = 1e-3)]
+    rtol: f64,
+    /// Absolute tolerance, in each signal's unit.
+    #[arg(long, default_value_t = 1e-6)]
+    atol: f64,
+    /// Time tolerance, s: events shifted by up to this much pass.
+    #[arg(long, default_value_t = 0.0)]
+    time_tol: f64,
+    #[command(flatten)]
+    report: ReportArgs,
+}
+
+/// Where the verdicts of a run or a comparison go besides the terminal.
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// Compare only these signals (default: every signal of the baseline).
+    #[arg(long, num_args = 1.., value_name = "NAME")]
+    signals: Vec<String>,
+    /// Draw one PNG per failing signal into this folder (result, baseline, tube, violations).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    /// Write a JUnit XML report (a test case per check and per compared signal).
+    #[arg(long, value_name = "FILE.xml")]
+    junit: Option<PathBuf>,
+    /// Write a Markdown table of the verdicts (for a CI job summary).
+    #[arg(long, value_name = "FILE.md")]
+    summary_md: Option<PathBuf>,
+}
+
+/// Checks and a baseline of `cosim run`.
+#[derive(clap::Args)]
+struct VerifyArgs {
+    /// A check of the run, judged on every recorded row: a metric, a comparison, a number
+    /// or metric, e.g. 'max(abs(plant.y)) < 0.6' (repeatable; docs/ci.md). Exit status 3
+    /// when one fails (the results are still written).
+    #[arg(long = "check", value_name = "EXPR")]
+    checks: Vec<String>,
+    /// Compare the results with this baseline CSV in tolerance tubes (exit status 3 when
+    /// a signal leaves its tube).
+    #[arg(long, value_name = "BASE.csv")]
+    baseline: Option<PathBuf>,
+    /// --baseline's relative tolerance (cosim compare --rtol).
+    #[arg(long, default_value_t = 1e-3)]
+    baseline_rtol: f64,
+    /// --baseline's absolute tolerance (cosim compare --atol).
+    #[arg(long, default_value_t = 1e-6)]
+    baseline_atol: f64,
+    /// --baseline's time tolerance, s (cosim compare --time-tol).
+    #[arg(long, default_value_t = 0.0)]
+    baseline_time_tol: f64,
+    #[command(flatten)]
+    report: ReportArgs,
 }
 
 /// Limits of the archives and XML files read; the defaults refuse zip bombs and files
@@ -69,25 +137,29 @@ struct RunArgs {
     /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
     #[arg(long)]
     interface: Option<String>,
-    /// Start time, s (negative times are times like any other).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    start_time: f64,
+    /// Start time, s (negative times are times like any other; default 0, for an SSP its
+    /// DefaultExperiment's startTime).
+    #[arg(long, allow_negative_numbers = true)]
+    start_time: Option<f64>,
     /// Stop time, s (default: the FMU's DefaultExperiment, else the start time + 1).
     #[arg(long, allow_negative_numbers = true)]
     stop_time: Option<f64>,
     /// Communication step, s (default: the FMU's DefaultExperiment stepSize, else 1e-3).
     #[arg(long)]
     step: Option<f64>,
-    /// ordered or jacobi.
+    /// jacobi (every connection one step late, as fmpy, libcosim and ecos step) or ordered
+    /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
     /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
     /// FMU's Jacobian).
     #[arg(long, default_value = "rk4")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100).
-    #[arg(long, default_value_t = 1e-6)]
-    rtol: f64,
+    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
+    /// DefaultExperiment tolerance, as fmpy does).
+    #[arg(long)]
+    rtol: Option<f64>,
     /// Largest RK4 step, s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
@@ -146,8 +218,35 @@ struct RunArgs {
     #[arg(long)]
     summary: Option<PathBuf>,
     #[command(flatten)]
+    verify: VerifyArgs,
+    #[command(flatten)]
     limits: LimitArgs,
 }
+
+/// Why `cosim` stopped: an error of the master or a message of its own.
+enum Failure {
+    Cosim(Error),
+    Message(String),
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Failure {
+        Failure::Cosim(e)
+    }
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Failure::Cosim(e) => e.fmt(f),
+            Failure::Message(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Exit status of a run or comparison that was done and did not pass (1: not done, 2: a
+/// command line clap refused).
+const EXIT_NOT_PASSED: u8 = 3;
 
 /// Where `--isolate` draws the crash boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -158,15 +257,34 @@ enum IsolateMode {
     Run,
 }
 
+/// Set by the first Ctrl-C (SIGINT, SIGTERM, SIGHUP): the run stops at its next step and the
+/// rows it computed are written, as after a failed run; a second signal ends at once.
+static STOP: std::sync::OnceLock<std::sync::Arc<std::sync::atomic::AtomicBool>> = std::sync::OnceLock::new();
+
+/// How long the first signal waits for the run to stop and its rows to be written.
+const STOP_GRACE: std::time::Duration = std::time::Duration::from_secs(10);
+
 fn main() -> ExitCode {
-    nigel_cosim::unpack::remove_on_signals();
+    let stop = STOP.get_or_init(Default::default).clone();
+    nigel_cosim::unpack::remove_on_signals_after_stop(
+        move |signal| {
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            eprintln!(
+                "\ncosim: {}: stopping at the next step and writing the rows so far (again to end at once)",
+                nigel_cosim::error::signal_name(signal)
+            );
+        },
+        STOP_GRACE,
+    );
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run(*args),
-        Command::Info { model, limits } => info(&model, &limits.limits()),
+        Command::Compare(args) => compare(&args),
+        Command::Info { model, limits } => info(&model, &limits.limits()).map(|()| true).map_err(Failure::from),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(EXIT_NOT_PASSED),
         Err(e) => {
             eprintln!("cosim: {e}");
             ExitCode::FAILURE
@@ -214,12 +332,13 @@ fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
     Ok(sets)
 }
 
-fn run(args: RunArgs) -> Result<(), Error> {
+fn run(args: RunArgs) -> Result<bool, Failure> {
+    let started = std::time::Instant::now();
     let interface = match args.interface.as_deref() {
         None => None,
         Some("cs") => Some(Interface::CoSimulation),
         Some("me") => Some(Interface::ModelExchange),
-        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)"))),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)")).into()),
     };
     let algorithm: Algorithm = args.algorithm.parse().map_err(Error::Experiment)?;
     let format = match &args.output {
@@ -234,12 +353,17 @@ fn run(args: RunArgs) -> Result<(), Error> {
     let (mut builder, default, single, _ssp) = if is_ssp(&args.model) {
         // --interface applies to every FMU of the system (one without it is refused by name)
         let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
+        if !host_of_run {
+            for note in &ssp.notes {
+                eprintln!("cosim: note: {note}");
+            }
+        }
         let builder = SystemBuilder::from_system(ssp.system.clone());
         let (start_time, stop_time) = ssp.default_start_stop;
         let default = model_description::DefaultExperiment { start_time, stop_time, ..Default::default() };
         (builder, default, None, Some(ssp))
     } else {
-        let fmu = Fmu::load_with(&args.model, &options)?;
+        let fmu = Fmu::load_with(&args.model, &options).map_err(Error::from)?;
         let default = fmu.description().default_experiment.clone().unwrap_or_default();
         let mut builder = SystemBuilder::new();
         builder.add_instance(SINGLE, fmu.clone())?;
@@ -257,9 +381,11 @@ fn run(args: RunArgs) -> Result<(), Error> {
         builder.set_text(&qualify(name.trim(), single), value)?;
     }
     let system: System = builder.build();
-    // the start time is --start-time's (default 0), not the DefaultExperiment's
+    // the start time is --start-time's, else an SSD's DefaultExperiment's (SSP 1.0 gives
+    // only start and stop), else 0: not an FMU's DefaultExperiment's
+    let start_time = args.start_time.or(if single.is_none() { default.start_time } else { None }).unwrap_or(0.0);
     let given = GivenTimes {
-        start_time: Some(args.start_time),
+        start_time: Some(start_time),
         stop_time: args.stop_time,
         step_size: args.step,
         ..Default::default()
@@ -269,11 +395,19 @@ fn run(args: RunArgs) -> Result<(), Error> {
     experiment.start_time = times.start_time;
     check_times(&experiment)?;
     if !host_of_run {
-        for warning in sample_period_warnings(&system, experiment.step) {
-            eprintln!("cosim: warning: {warning}");
+        for warning in nigel_cosim::sample_period::warnings(&system, experiment.step) {
+            eprintln!("cosim: warning: {warning} (use --step {})", warning.period);
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
         for instance in &system.instances {
+            if let Some(version) = instance.fmu.fmi3_description().map(|md| md.fmi_version.as_str()) {
+                if version != "3.0" && !version.starts_with("3.0.") {
+                    eprintln!(
+                        "cosim: note: {} declares fmiVersion \"{version}\": run as FMI 3.0 (what a later version adds is unknown to cosim)",
+                        instance.name
+                    );
+                }
+            }
             for (name, why) in instance.fmu.not_in_view() {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
@@ -285,19 +419,19 @@ fn run(args: RunArgs) -> Result<(), Error> {
     }
 
     experiment.algorithm = algorithm;
+    if let Some(rtol) = args.rtol.filter(|r| !(*r > 0.0 && r.is_finite())) {
+        return Err(Error::Experiment(format!("--rtol {rtol} must be positive")).into());
+    }
+    experiment.co_simulation_tolerance = args.rtol;
+    let rtol = args.rtol.unwrap_or(1e-6);
     experiment.solver = match args.solver.as_str() {
         "rk4" => nigel_cosim::Solver::Rk4 { max_step: args.max_step },
-        "dopri5" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Dopri5 { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "bdf" if args.rtol > 0.0 && args.rtol.is_finite() => {
-            nigel_cosim::Solver::Bdf { rtol: args.rtol, atol: args.rtol / 100.0 }
-        }
-        "dopri5" | "bdf" => return Err(Error::Experiment(format!("--rtol {} must be positive", args.rtol))),
-        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)"))),
+        "dopri5" => nigel_cosim::Solver::Dopri5 { rtol, atol: rtol / 100.0 },
+        "bdf" => nigel_cosim::Solver::Bdf { rtol, atol: rtol / 100.0 },
+        other => return Err(Error::Experiment(format!("unknown solver {other:?} (rk4, dopri5, bdf)")).into()),
     };
     if args.max_step.is_some_and(|m| !(m > 0.0 && m.is_finite())) {
-        return Err(Error::Experiment("--max-step must be positive".into()));
+        return Err(Error::Experiment("--max-step must be positive".into()).into());
     }
     if let Some(path) = &args.input {
         experiment.input = Some(std::sync::Arc::new(nigel_cosim::InputTable::read_csv(path)?));
@@ -307,7 +441,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // the time per FMU is only reported in the summary: measured only when one is asked for
     experiment.profile = args.summary.is_some();
     if args.threads == 0 {
-        return Err(Error::Experiment("--threads must be at least 1".into()));
+        return Err(Error::Experiment("--threads must be at least 1".into()).into());
     }
     experiment.threads = args.threads;
     experiment.max_steps = args.max_steps;
@@ -324,7 +458,7 @@ fn run(args: RunArgs) -> Result<(), Error> {
         return Err(Error::Experiment(
             "--timeout-call needs --isolate (=fmu: a call in this process cannot be stopped; a host process per FMU can be killed; --isolate=run has --timeout)"
                 .into(),
-        ));
+        ).into());
     }
     if args.isolate == Some(IsolateMode::Fmu) {
         experiment.isolation = Some(nigel_cosim::Isolation {
@@ -333,17 +467,74 @@ fn run(args: RunArgs) -> Result<(), Error> {
             host: None,
         });
     }
-    if !args.record.is_empty() {
-        experiment.record = Some(args.record.iter().map(|r| qualify(r, single)).collect());
+    if args.record.is_empty() && nigel_cosim::simulate::default_record(&system).is_empty() {
+        // every output left out of the master's view: a result of the time column alone
+        // is not what was asked for
+        let output = |fmu: &Fmu, name: &str| {
+            fmu.fmi3_description()
+                .and_then(|md| md.variable_by_name(name))
+                .is_some_and(|v| v.causality == model_description::fmi3::Causality::Output)
+        };
+        let left_out: Vec<String> = system
+            .instances
+            .iter()
+            .flat_map(|i| {
+                i.fmu
+                    .not_in_view()
+                    .iter()
+                    .filter(|(name, _)| output(&i.fmu, name))
+                    .map(move |(name, why)| format!("{}.{name} ({})", i.name, why.as_str()))
+            })
+            .collect();
+        if !left_out.is_empty() {
+            return Err(Error::Experiment(format!(
+                "no output of the system can be recorded: {} (name variables to record with --record)",
+                left_out.join(", ")
+            ))
+            .into());
+        }
     }
-    if std::io::stderr().is_terminal() {
-        experiment.progress = Some(progress);
+    let verification = verification(&args.verify)?;
+    // the results' column of a system variable (a one-instance system's columns are bare)
+    let column = |name: &str| -> String {
+        match single {
+            Some(_) => name.strip_prefix(&format!("{SINGLE}.")).unwrap_or(name).to_string(),
+            None => name.to_string(),
+        }
+    };
+    let asked: Vec<String> = if args.record.is_empty() {
+        nigel_cosim::simulate::default_record(&system).iter().map(|r| system.name_of(r)).collect()
+    } else {
+        args.record.iter().map(|r| qualify(r, single)).collect()
+    };
+    // what the checks and the baseline read is recorded too, and left out of --output
+    let mut record = asked.clone();
+    for c in &verification.checks {
+        for v in c.variables() {
+            let q = qualify(&v, single);
+            system.resolve(&q).map_err(|e| Failure::Message(format!("--check {:?}: {e}", c.text)))?;
+            if !record.contains(&q) {
+                record.push(q);
+            }
+        }
+    }
+    for name in verification.columns() {
+        // a baseline column that is no variable of the system is reported missing
+        let q = qualify(&name, single);
+        if system.resolve(&q).is_ok() && !record.contains(&q) {
+            record.push(q);
+        }
+    }
+    let extra = record.len() > asked.len();
+    if !args.record.is_empty() || extra {
+        experiment.record = Some(record);
     }
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
         Some(IsolateMode::Run) if host_of_run => {
-            return nigel_cosim::isolate::whole::host_simulate(&system, &experiment);
+            nigel_cosim::isolate::whole::host_simulate(&system, &experiment)?;
+            return Ok(true);
         }
         Some(IsolateMode::Run) => {
             let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
@@ -356,11 +547,22 @@ fn run(args: RunArgs) -> Result<(), Error> {
         }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
-            let (results, outcome) = nigel_cosim::simulate::simulate_recorded(&system, &experiment);
-            (results, outcome.map_err(Some))
+            match nigel_cosim::simulate::Execution::new(&system, &experiment) {
+                Ok(mut execution) => {
+                    if std::io::stderr().is_terminal() {
+                        execution.on_progress(progress);
+                    }
+                    if let Some(flag) = STOP.get().cloned() {
+                        execution.cancel_on(flag);
+                    }
+                    let outcome = nigel_cosim::simulate::run_to_end(&mut execution);
+                    (execution.take_results(), outcome.map_err(Some))
+                }
+                Err(e) => (nigel_cosim::Results::default(), Err(Some(e))),
+            }
         }
     };
-    if outcome.is_ok() && args.output.is_none() && args.summary.is_none() {
+    if outcome.is_ok() && args.output.is_none() && args.summary.is_none() && verification.is_empty() {
         eprintln!(
             "cosim: note: no --output or --summary given: the run completed but its results were not kept \
              (add --output out.csv or --output out.mat)"
@@ -374,11 +576,13 @@ fn run(args: RunArgs) -> Result<(), Error> {
     // the rows recorded so far are written also when the run failed
     if let (Some(path), Some(format)) = (&args.output, format) {
         if outcome.is_ok() || results.rows() > 0 {
+            let asked_columns: Vec<String> = asked.iter().map(|n| column(n)).collect();
+            let kept = if extra { results.select(&asked_columns) } else { results.clone() };
             match format {
-                OutputFormat::Csv => write(path, &|f| results.write_csv(std::io::BufWriter::new(f)))?,
+                OutputFormat::Csv => write(path, &|f| kept.write_csv(std::io::BufWriter::new(f)))?,
                 OutputFormat::Mat => {
-                    let descriptions = column_descriptions(&system, &results);
-                    write(path, &|f| results.write_mat(std::io::BufWriter::new(f), &descriptions))?
+                    let descriptions = column_descriptions(&system, &kept);
+                    write(path, &|f| kept.write_mat(std::io::BufWriter::new(f), &descriptions))?
                 }
             }
             if outcome.is_err() {
@@ -386,10 +590,33 @@ fn run(args: RunArgs) -> Result<(), Error> {
             }
         }
     }
+    let suite_name = format!("cosim run {}", args.model.display());
     let summary = match outcome {
         Ok(s) => s,
-        Err(Some(e)) => return Err(e),
-        Err(None) => std::process::exit(1),
+        Err(Some(nigel_cosim::Error::Cancelled { time })) => {
+            // stopped by a signal: the rows so far are written above
+            eprintln!("cosim: stopped at t = {time} s of {} s", experiment.stop_time);
+            nigel_cosim::unpack::finish_stopped();
+        }
+        Err(failed) => {
+            let message =
+                failed.as_ref().map_or("the run failed in its host process (see the log)".into(), |e| e.to_string());
+            let suite = nigel_cosim::verify::run_suite(
+                &suite_name,
+                started.elapsed().as_secs_f64(),
+                Some(&message),
+                &Default::default(),
+                &verification,
+            );
+            let r = &args.verify.report;
+            if let Err(e) = nigel_cosim::verify::write_reports(&suite, r.junit.as_deref(), r.summary_md.as_deref()) {
+                eprintln!("cosim: {e}");
+            }
+            match failed {
+                Some(e) => return Err(e.into()),
+                None => std::process::exit(1),
+            }
+        }
     };
     let json = serde_json::to_string_pretty(&host_json.unwrap_or_else(|| summary.to_json())).unwrap_or_default();
     match &args.summary {
@@ -400,13 +627,96 @@ fn run(args: RunArgs) -> Result<(), Error> {
     for (instance, message) in &summary.warnings {
         eprintln!("cosim: warning from {instance}: {message}");
     }
+    for note in &summary.notes {
+        eprintln!("cosim: note: {note}");
+    }
     if let Some((instance, time, reason)) = &summary.ended_by {
         eprintln!(
             "cosim: {instance} ended the simulation at t = {time} s ({reason}); stop time {} s",
             experiment.stop_time
         );
     }
-    Ok(())
+    if verification.is_empty() && args.verify.report.junit.is_none() && args.verify.report.summary_md.is_none() {
+        return Ok(true);
+    }
+    let judged = verification.judge(&results, |v| column(&qualify(v, single))).map_err(Failure::Message)?;
+    let to_stderr = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
+    for line in judged.lines() {
+        if to_stderr {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
+    }
+    report(&args.verify.report, &results, &verification, &judged, &suite_name, started)
+}
+
+/// The checks and baseline of `cosim run`.
+fn verification(v: &VerifyArgs) -> Result<nigel_cosim::verify::Verification, Failure> {
+    let tolerance =
+        nigel_cosim::compare::Tolerance { rtol: v.baseline_rtol, atol: v.baseline_atol, time_tol: v.baseline_time_tol };
+    let signals = (!v.report.signals.is_empty()).then(|| v.report.signals.clone());
+    if signals.is_some() && v.baseline.is_none() {
+        return Err(Failure::Message("--signals needs --baseline".into()));
+    }
+    nigel_cosim::verify::Verification::new(&v.checks, v.baseline.as_deref(), tolerance, signals).map_err(|e| {
+        Failure::Message(
+            e.replace("--rtol", "--baseline-rtol")
+                .replace("--atol", "--baseline-atol")
+                .replace("--time-tol", "--baseline-time-tol"),
+        )
+    })
+}
+
+/// The figures, the JUnit file and the Markdown summary of a judged run or comparison;
+/// whether it passed.
+fn report(
+    r: &ReportArgs,
+    results: &nigel_cosim::Results,
+    verification: &nigel_cosim::verify::Verification,
+    judged: &nigel_cosim::verify::Judged,
+    suite_name: &str,
+    started: std::time::Instant,
+) -> Result<bool, Failure> {
+    if let (Some(dir), Some(c), Some((_, base))) = (&r.plot, &judged.comparison, &verification.baseline) {
+        for p in nigel_cosim::compare::plot::plot_failures(results, base, c, dir).map_err(Failure::Message)? {
+            eprintln!("cosim: figure {}", p.display());
+        }
+    }
+    let suite = nigel_cosim::verify::run_suite(suite_name, started.elapsed().as_secs_f64(), None, judged, verification);
+    nigel_cosim::verify::write_reports(&suite, r.junit.as_deref(), r.summary_md.as_deref())
+        .map_err(Failure::Message)?;
+    Ok(judged.passed())
+}
+
+/// `cosim compare`: the comparison's lines; whether every signal passed.
+fn compare(args: &CompareArgs) -> Result<bool, Failure> {
+    let started = std::time::Instant::now();
+    let tolerance = nigel_cosim::compare::Tolerance { rtol: args.rtol, atol: args.atol, time_tol: args.time_tol };
+    let signals = (!args.report.signals.is_empty()).then(|| args.report.signals.clone());
+    let verification = nigel_cosim::verify::Verification::new(&[], Some(&args.baseline), tolerance, signals)
+        .map_err(Failure::Message)?;
+    let result = nigel_cosim::compare::csv::read_results_csv(&args.result).map_err(Failure::Message)?;
+    let judged = verification.judge(&result, |v| v.to_string()).map_err(Failure::Message)?;
+    println!("compare {} with the baseline {}", args.result.display(), args.baseline.display());
+    for line in judged.comparison.iter().flat_map(|c| c.lines()) {
+        println!("{line}");
+    }
+    let name = format!("cosim compare {} {}", args.result.display(), args.baseline.display());
+    // the comparison's cases alone: no run
+    if let (Some(dir), Some(c), Some((_, base))) = (&args.report.plot, &judged.comparison, &verification.baseline) {
+        for p in nigel_cosim::compare::plot::plot_failures(&result, base, c, dir).map_err(Failure::Message)? {
+            eprintln!("cosim: figure {}", p.display());
+        }
+    }
+    let suite = nigel_cosim::junit::TestSuite {
+        name: name.clone(),
+        time: started.elapsed().as_secs_f64(),
+        cases: judged.comparison.as_ref().map(nigel_cosim::verify::comparison_cases).unwrap_or_default(),
+    };
+    nigel_cosim::verify::write_reports(&suite, args.report.junit.as_deref(), args.report.summary_md.as_deref())
+        .map_err(Failure::Message)?;
+    Ok(judged.passed())
 }
 
 /// An FMU that calls exit() inside a call (in this process) ends `cosim` with status 1,
@@ -506,65 +816,6 @@ fn check_times(e: &Experiment) -> Result<(), Error> {
     Ok(())
 }
 
-/// A warning for every FMU whose declared sample period (a parameter `sample_period`,
-/// else, for an FMU with discrete states or outputs (Model Exchange: outputs), its DefaultExperiment stepSize) is shorter than the communication step: its
-/// inputs are then held and its outputs read less often than it is meant to run.
-fn sample_period_warnings(system: &System, step: f64) -> Vec<String> {
-    let mut out = Vec::new();
-    for spec in &system.instances {
-        let md = spec.fmu.description();
-        let parameter = md.model_variables.iter().enumerate().find(|(_, v)| {
-            v.name == "sample_period" && v.causality == model_description::Causality::Parameter && v.is_real()
-        });
-        let from_parameter = parameter.and_then(|(index, v)| {
-            let set = spec.start_values.iter().find(|(i, _)| *i == index).and_then(|(_, value)| match value {
-                nigel_cosim::Value::Real(x) => Some(*x),
-                _ => None,
-            });
-            let start = match v.variable_type {
-                model_description::VariableType::Real { start, .. } => start,
-                _ => None,
-            };
-            set.or(start).map(|p| (p, "its parameter sample_period"))
-        });
-        // the stepSize is only a suggestion of a continuous model (its integrator runs
-        // within any step); it is a sample period where the FMU has discrete-time values
-        // of its own, which change at its sample instants: in Co-Simulation discrete
-        // states or outputs; in Model Exchange discrete outputs only (its discrete states
-        // change at its events, which the master's integrator stops at within any
-        // communication step; a model with discrete locals, such as the when-conditions
-        // of a Modelica model, is continuous there)
-        let me = spec.fmu.interface() == nigel_cosim::Interface::ModelExchange;
-        let samples = md.model_variables.iter().any(|v| {
-            v.variability == model_description::Variability::Discrete
-                && match v.causality {
-                    model_description::Causality::Output => true,
-                    model_description::Causality::Input | model_description::Causality::Parameter => false,
-                    _ => !me,
-                }
-        });
-        let declared = from_parameter.or_else(|| {
-            md.default_experiment
-                .as_ref()
-                .and_then(|d| d.step_size)
-                .filter(|_| samples)
-                .map(|p| (p, "its DefaultExperiment stepSize"))
-        });
-        if let Some((period, source)) = declared {
-            // a relative margin for steps given in decimal (1e-3 vs 0.001000000000000002)
-            if period > 0.0 && step > period * (1.0 + 1e-9) {
-                out.push(format!(
-                    "{} ({}) runs every {period} s ({source}), but the communication step is {step} s: its inputs \
-                     are held and its outputs read only every {step} s (use --step {period})",
-                    spec.name,
-                    spec.fmu.source().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
-                ));
-            }
-        }
-    }
-    out
-}
-
 fn is_ssp(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
 }
@@ -576,14 +827,23 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     let s = &ssp.system;
     let mut out = std::io::stdout().lock();
     let mut lines = vec![format!(
-        "system {} ({} instances, {} connections)",
+        "system {} (root system {:?}; {} instances, {} connections)",
         path.display(),
+        ssp.root_name,
         s.instances.len(),
         s.connections.len()
     )];
-    if let (start, Some(stop)) = ssp.default_start_stop {
-        lines.push(format!("default experiment: start {} s, stop {stop} s", start.unwrap_or(0.0)));
-    }
+    // the experiment a run applies when no --start-time / --stop-time is given
+    let (start, stop) = ssp.default_start_stop;
+    let start_text = match start {
+        Some(t) => format!("start {} s (DefaultExperiment)", plain(t)),
+        None => "start 0 s".to_string(),
+    };
+    let stop_text = match stop {
+        Some(t) => format!("stop {} s (DefaultExperiment)", plain(t)),
+        None => format!("stop {} s (start + 1 s)", plain(start.unwrap_or(0.0) + 1.0)),
+    };
+    lines.push(format!("experiment applied without --start-time/--stop-time: {start_text}, {stop_text}"));
     for i in &s.instances {
         // an FMU unpacked from the .ssp is named by its place in the archive (the
         // temporary copy is gone when this command ends)
@@ -598,14 +858,35 @@ fn info_ssp(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
             lines.push(format!("  start {} = {v}{unit}", var.name));
         }
     }
+    if !ssp.applied.is_empty() {
+        // every value the SSD applies, with its binding, mapping, transformation, unit
+        // conversion or the system connector it comes through
+        lines.push(format!("values applied, in order, where from ({}):", ssp.applied.len()));
+        for a in &ssp.applied {
+            lines.push(format!("  {a}"));
+        }
+    }
     for c in &s.connections {
         let unit = |r: &nigel_cosim::VariableRef| s.variable(r).variable_type.unit().unwrap_or("-").to_string();
         let mut line =
             format!("connection {} [{}] -> {} [{}]", s.name_of(&c.from), unit(&c.from), s.name_of(&c.to), unit(&c.to));
         if c.gain != 1.0 || c.offset != 0.0 {
-            line.push_str(&format!("  (x {} + {})", c.gain, c.offset));
+            line.push_str(&format!("  (x {} + {}", c.gain, c.offset));
+            if let Some((f, o)) = c.linear_transformation {
+                if (f, o) != (c.gain, c.offset) {
+                    line.push_str(&format!(": unit conversion, then LinearTransformation x {f} + {o}"));
+                } else {
+                    line.push_str(": LinearTransformation");
+                }
+            } else {
+                line.push_str(": unit conversion");
+            }
+            line.push(')');
         }
         lines.push(line);
+    }
+    for n in &ssp.notes {
+        lines.push(format!("note: {n}"));
     }
     for l in lines {
         if writeln!(out, "{l}").is_err() {

@@ -189,6 +189,10 @@ struct Region {
     len: usize,
 }
 
+// SAFETY: the mapping belongs to the process, valid in any of its threads; a Region is
+// owned by one thread at a time (moved, never shared), as a row sink is.
+unsafe impl Send for Region {}
+
 impl Region {
     /// Copies each marked call of this process into the region's call slots, from now on.
     fn mark_calls(&self) {

@@ -18,17 +18,18 @@ pub(crate) fn ulp(x: f64) -> f64 {
     f64::from_bits(a.to_bits() + 1) - a
 }
 
-/// One communication step: from `t` to `t_next`.
+/// One communication step: from `t = t0 + n h` to `t_next` (`t0 + (n + 1) h`, or the stop
+/// time for a shorter last step).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Point {
+pub struct Point {
     /// Step number from the start (0-based).
-    pub(crate) n: u64,
+    pub n: u64,
     /// Start of the step, s.
-    pub(crate) t: f64,
+    pub t: f64,
     /// End of the step, s.
-    pub(crate) t_next: f64,
+    pub t_next: f64,
     /// A row is recorded at `t_next`.
-    pub(crate) output_point: bool,
+    pub output_point: bool,
 }
 
 /// The communication points of a run.

@@ -17,8 +17,10 @@
 //! which is fmpy's extra communication point, and for a Model Exchange FMU without
 //! discrete states its time event; no row is recorded at the event (fmpy records one
 //! there in Co-Simulation). Splitting needs every Co-Simulation instance to vary its
-//! step (`canHandleVariableCommunicationStepSize`); otherwise an event between points is
-//! refused, naming it and the points around it.
+//! step (`canHandleVariableCommunicationStepSize`); otherwise an event between points
+//! takes effect at the next communication point, as fmpy applies it there (the value at
+//! the step's start time), and the run's summary says so in a note naming the event, the
+//! point and the FMU.
 
 use crate::error::{Error, Result};
 use crate::simulate::algorithm::{Communication, Core};
@@ -179,17 +181,18 @@ fn on_grid(t: f64, clock: &Clock) -> bool {
     isclose(t, clock.t0 + n * clock.h) || isclose(t, clock.t0 + (n + 1.0) * clock.h)
 }
 
-/// The error for an input event between communication points that cannot split a step
-/// (instance `fixed` cannot vary its step).
-fn off_grid(what: &str, t: f64, clock: &Clock, fixed: &str) -> Error {
+/// The note for an input event between communication points that cannot split a step
+/// (instance `fixed` cannot vary its step): it takes effect at the next point.
+fn off_grid(what: &str, t: f64, clock: &Clock, fixed: &str) -> String {
     let n = ((t - clock.t0) / clock.h).floor();
     let (before, after) = (clock.t0 + n * clock.h, clock.t0 + (n + 1.0) * clock.h);
-    Error::Experiment(format!(
+    format!(
         "input: {what} falls between the communication points {before} and {after} s (step {} s), and \
          {fixed} cannot vary its communication step (canHandleVariableCommunicationStepSize) to stop \
-         there: move the event onto a communication point, or choose a step that has it",
+         there: it takes effect at {after} s, as fmpy applies it (move the event onto a communication \
+         point, or choose a step that has it, to apply it at its time)",
         clock.h
-    ))
+    )
 }
 
 /// Python's `math.isclose` with its defaults (relative tolerance 1e-9, no absolute one),
@@ -205,26 +208,29 @@ struct Column {
 }
 
 /// The inputs of a run, resolved, wrapped around the algorithm.
-pub(crate) struct WithInput {
-    pub(crate) inner: Box<dyn Communication>,
+pub(crate) struct WithInput<'s> {
+    pub(crate) inner: Box<dyn Communication + Send + 's>,
     table: InputTable,
     columns: Vec<Column>,
     /// The input events between communication points, ascending: a step is split at each.
     splits: Vec<f64>,
     /// The first of `splits` not yet passed.
     next_split: usize,
+    /// What the run does with the table that a reader of it may not expect (an event
+    /// between points that takes effect at the next point), for [`crate::Summary::notes`].
+    pub(crate) notes: Vec<String>,
 }
 
-impl WithInput {
+impl<'s> WithInput<'s> {
     /// Resolves the table's names in `system` (a bare name in a one-instance system is
     /// that instance's variable); refuses names that are not inputs (or tunable
     /// parameters) and inputs a connection already feeds.
     pub(crate) fn new(
-        inner: Box<dyn Communication>,
+        inner: Box<dyn Communication + Send + 's>,
         system: &System,
         table: &InputTable,
         clock: &Clock,
-    ) -> Result<WithInput> {
+    ) -> Result<WithInput<'s>> {
         let mut columns = Vec::new();
         for name in &table.names {
             let r = match system.resolve(name) {
@@ -264,17 +270,18 @@ impl WithInput {
             .iter()
             .find(|i| i.fmu.interface() == crate::fmu::Interface::CoSimulation && !i.fmu.can_handle_variable_step());
         let mut splits = Vec::new();
+        let mut notes = Vec::new();
         for (what, t) in input_events(table, &columns) {
             if !on_grid(t, clock) {
-                if let Some(i) = fixed_step {
-                    return Err(off_grid(&what, t, clock, &i.name));
+                match fixed_step {
+                    Some(i) => notes.push(off_grid(&what, t, clock, &i.name)),
+                    None => splits.push(t),
                 }
-                splits.push(t);
             }
         }
         splits.sort_by(f64::total_cmp);
         splits.dedup();
-        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0 })
+        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0, notes })
     }
 
     fn apply(&self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
@@ -294,7 +301,7 @@ impl WithInput {
     }
 }
 
-impl Communication for WithInput {
+impl Communication for WithInput<'_> {
     fn propagate(&mut self, core: &mut Core) -> Result<()> {
         self.apply(core, core.clock.t0, false)?;
         self.inner.propagate(core)

@@ -31,6 +31,9 @@ pub(crate) struct Lane {
     pub(crate) error: Option<Error>,
     /// Its step was handed to its host ([`Lane::post_step`]) and waits to be collected.
     pub(crate) posted: bool,
+    /// The run's last communication point, s (NaN: not known): an FMU that asks to end
+    /// the simulation there has not ended it early ([`Lane::advance`]).
+    pub(crate) last_point: f64,
 }
 
 impl Instances for [Lane] {
@@ -64,6 +67,7 @@ impl Lane {
             retries: 0,
             error: None,
             posted: false,
+            last_point: f64::NAN,
         }
     }
 
@@ -75,14 +79,30 @@ impl Lane {
 
     /// `do_step` (or the integrator of its group of one over the step), with the Discard
     /// retry if enabled. A member of the coupled Model Exchange group is not advanced here.
+    ///
+    /// An FMU that completes the run's last step and asks to end the simulation there
+    /// (FMI 3.0 `terminateSimulation`, FMI 2.0 Discard with `fmi2Terminated` at
+    /// `lastSuccessfulTime` = the step's end, a Model Exchange `terminateSimulation` at
+    /// the stop time) has not ended it early: the step is complete, and the other
+    /// instances take theirs as in any other step.
     #[inline]
     pub(crate) fn advance(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
+        match self.advance_inner(solver, t, t_next) {
+            Err(Error::Terminated { time, .. }) if t_next == self.last_point && ends_the_step(t, t_next, time) => {
+                Ok(())
+            }
+            r => r,
+        }
+    }
+
+    #[inline]
+    fn advance_inner(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         self.posted = false;
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
-                Err(e) => Err(ended_or(&mut self.inst, e.into(), t)),
+                Err(e) => Err(ended_or(&mut self.inst, e.into(), t, t_next)),
             },
             (None, Some(state)) => {
                 self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
@@ -174,20 +194,44 @@ impl Lane {
     }
 }
 
+/// Whether `time`, where an FMU ended the run in the step from `t` to `t_next`, is that
+/// step's end: to a millionth of the step (the FMU's `t + (t_next - t)` may round away
+/// from `t_next` by an ulp; an FMU that stops short of the end by more has stopped early).
+fn ends_the_step(t: f64, t_next: f64, time: f64) -> bool {
+    time >= t_next - 1e-6 * (t_next - t)
+}
+
 /// How the FMU said it ended the run (Co-Simulation).
 pub(crate) const DISCARD_TERMINATED: &str = "fmi2DoStep returned fmi2Discard with fmi2Terminated";
 /// The same end of a run by an FMI 3.0 FMU.
 pub(crate) const FMI3_TERMINATED: &str = "fmi3DoStep returned terminateSimulation";
 
-/// The error of a step from `t`: an fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)`
-/// true is the FMU ending the run at `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the
-/// last point it reached, if it cannot say), anything else is `e`.
+/// The error of a step from `t` to `t_end`: an fmi2Discard with
+/// `fmi2GetBooleanStatus(fmi2Terminated)` true is the FMU ending the run at
+/// `fmi2GetRealStatus(fmi2LastSuccessfulTime)` (`t`, the last point it reached, if it
+/// cannot say), anything else is `e`. A time the FMU reports outside the step (an FMI 3.0
+/// `lastSuccessfulTime` of t + 1000 s) is an error naming the FMU, the call and the times,
+/// not a row at that time.
 #[cold]
-fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
+fn ended_or(inst: &mut Instance, e: Error, t: f64, t_end: f64) -> Error {
     if matches!(e, Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. }))
         && inst.terminated_status() == Some(true)
     {
-        let time = inst.last_successful_time().filter(|x| x.is_finite()).unwrap_or(t);
+        let reported = inst.last_successful_time();
+        let function = if inst.is_fmi3() { "fmi3DoStep" } else { "fmi2GetRealStatus(fmi2LastSuccessfulTime)" };
+        let time = match reported {
+            Some(x) if x.is_finite() && x >= t && x <= t_end => x,
+            None => t,
+            // the FMU's statement is no time of this step: no row is written at it (an
+            // Experiment error: the call itself returned what the standard allows)
+            Some(x) => {
+                return Error::Experiment(format!(
+                    "{}: {function} ended the simulation at lastSuccessfulTime = {x} s, outside the step from {t} \
+                     to {t_end} s it was asked to take: the run stops at {t} s",
+                    inst.name()
+                ))
+            }
+        };
         let reason = if inst.is_fmi3() { FMI3_TERMINATED } else { DISCARD_TERMINATED };
         return Error::Terminated { instance: inst.name().to_string(), time, reason };
     }
@@ -199,7 +243,7 @@ fn ended_or(inst: &mut Instance, e: Error, t: f64) -> Error {
 /// (`fmi2Terminated`). Returns the number of retries.
 fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
     inst.update_state(state)?;
-    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e.into(), t)) {
+    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e.into(), t, t + dt)) {
         Ok(()) => Ok(0),
         Err(Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. })) if depth < 10 => {
             inst.set_state(state)?;

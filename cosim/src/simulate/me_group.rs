@@ -21,7 +21,7 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
-use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
+use crate::me::{nan_max, Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
 use crate::simulate::plan::{ordered_ops, Instances, Op};
 use crate::system::{Connection, System, VariableRef};
 
@@ -157,6 +157,9 @@ impl MeGroup {
                 if info.terminate_simulation != 0 {
                     unit.terminated = true;
                 }
+                if info.next_event_time_defined != 0 && info.next_event_time.is_nan() {
+                    return Err(nan_event_time(inst, time));
+                }
                 unit.next_time_event = (info.next_event_time_defined != 0).then_some(info.next_event_time);
                 if info.new_discrete_states_needed != 0 {
                     unsettled.push(m);
@@ -207,6 +210,28 @@ impl MeGroup {
         self.iterate(lanes, time)
     }
 
+    /// The time events due at `t` (to `eps`), for every solver: the members whose next time
+    /// event is due are recorded and all members iterate together; a time event still due
+    /// after that is an error. Whether any was due.
+    fn time_events_due<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64, eps: f64) -> Result<bool> {
+        let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
+        let members = self.members.clone();
+        let due: Vec<usize> =
+            members.iter().copied().filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps)).collect();
+        if due.is_empty() {
+            return Ok(false);
+        }
+        self.event(lanes, t, "time", &due)?;
+        self.ended(lanes, t)?;
+        if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
+            return Err(Error::Experiment(format!(
+                "{}: time event at {t} repeats at the same time",
+                lanes.instance(*m).name()
+            )));
+        }
+        Ok(true)
+    }
+
     /// One more internal step tried at `t`; past the cap of the run, the error.
     #[inline]
     fn count_step<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64) -> Result<()> {
@@ -220,6 +245,24 @@ impl MeGroup {
             names.join(", "),
             self.max_steps
         )))
+    }
+
+    /// The error of a Dormand-Prince step from `t` of size `h` whose error estimate is NaN.
+    #[cold]
+    fn nan_error_estimate<L: Members + ?Sized>(&self, lanes: &mut L, t: f64, h: f64) -> Error {
+        let names: Vec<String> = self
+            .members
+            .iter()
+            .map(|m| {
+                let inst = lanes.instance(*m);
+                format!("{} ({})", inst.name(), crate::me::fmu_file(inst))
+            })
+            .collect();
+        Error::Integration(format!(
+            "{}: the dopri5 error estimate of the step from t = {t} s of {h:e} s is NaN (the state derivatives \
+             the FMU returned with OK over the step are infinite or the states overflow); the step is not taken",
+            names.join(", ")
+        ))
     }
 
     /// [`Error::Terminated`] at `time` if a member set `terminateSimulation`.
@@ -268,21 +311,7 @@ impl MeGroup {
             if t >= t_end - eps {
                 return Ok(());
             }
-            // time events due now
-            let due: Vec<usize> = members
-                .iter()
-                .copied()
-                .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps))
-                .collect();
-            if !due.is_empty() {
-                self.event(lanes, t, "time", &due)?;
-                self.ended(lanes, t)?;
-                if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
-                    return Err(Error::Experiment(format!(
-                        "{}: time event at {t} repeats at the same time",
-                        lanes.instance(*m).name()
-                    )));
-                }
+            if self.time_events_due(lanes, t, eps)? {
                 continue;
             }
             // the end of this stretch: the earliest time event or the end of the step
@@ -316,8 +345,11 @@ impl MeGroup {
                     let mut err = 0.0f64;
                     for &m in members {
                         if let Some((inst, u)) = lanes.member(m) {
-                            err = err.max(u.dopri(inst, t, h, rtol, atol)?);
+                            err = nan_max(err, u.dopri(inst, t, h, rtol, atol)?);
                         }
+                    }
+                    if err.is_nan() {
+                        return Err(self.nan_error_estimate(lanes, t, h));
                     }
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     self.count_step(lanes, t)?;
@@ -404,6 +436,18 @@ impl MeGroup {
             }
         }
     }
+}
+
+/// The error of a NaN next event time an FMU defined at the event iteration at `time`.
+#[cold]
+fn nan_event_time(inst: &Instance, time: f64) -> Error {
+    let (call, ok) =
+        if inst.is_fmi3() { ("fmi3UpdateDiscreteStates", "fmi3OK") } else { ("fmi2NewDiscreteStates", "fmi2OK") };
+    Error::Integration(format!(
+        "{} ({}): {call} returned a next event time of NaN (nextEventTimeDefined true) with {ok} at t = {time} s",
+        inst.name(),
+        crate::me::fmu_file(inst)
+    ))
 }
 
 /// Two times closer than this within a communication step of length `span` ending at

@@ -16,12 +16,14 @@
 //! - `algorithm`: `jacobi`, `ordered` and `jacobi` in threads, each one file behind one
 //!   trait;
 //! - `input`: input signals over time ([`InputTable`]), applied around the algorithm;
-//! - `driver`: [`simulate()`].
+//! - `execution`: [`Execution`], a run advanced step by step by its caller;
+//! - `driver`: [`simulate()`] and its variants, loops over an [`Execution`].
 
 mod algorithm;
 mod between;
 mod clock;
 mod driver;
+mod execution;
 mod input;
 mod lane;
 mod me_group;
@@ -29,11 +31,14 @@ mod observer;
 mod plan;
 mod types;
 
-pub use between::SetQueue;
-pub use driver::{simulate, simulate_recorded, simulate_with, InstancePool, RowSink};
+pub use between::{Manipulator, SetQueue, StepInstances};
+pub use clock::Point;
+pub use driver::{run_to_end, simulate, simulate_recorded, simulate_with};
+pub use execution::{Execution, InstancePool, Phase, RowSink};
 pub use input::InputTable;
 pub use lane::apply_start_values;
+pub use observer::{Cancel, Observer, Progress};
 pub use plan::default_record;
-pub use types::{push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
+pub use types::{number_text, push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

@@ -2,7 +2,9 @@
 //! observers after every communication step; what is recorded and how long each FMU took
 //! is theirs, not the loop's.
 //!
-//! - [`Recorder`]: the rows of the results at output points, and the progress callback.
+//! - [`Recorder`]: the rows of the results at output points (told first, with the values).
+//! - [`Observer`]: the others, public ([`crate::simulate::Execution::add_observer`]): the
+//!   time limit, the cancel flag, the progress, a caller's own.
 //! - [`Profiler`]: the time spent in each instance's calls, one clock read per call
 //!   boundary; the algorithms tell it after each call (it is attached only when asked
 //!   for, so an unprofiled run reads no clock).
@@ -12,12 +14,13 @@ use crate::simulate::clock::Point;
 use crate::simulate::types::Results;
 use std::time::{Duration, Instant};
 
-/// Told after every communication step, with all values of the plan current at output
-/// points.
-pub(crate) trait Observer {
-    /// Step `point.n` ended at `point.t_next`; `values` is the value buffer of the plan.
-    /// An error ends the run.
-    fn step_complete(&mut self, point: &Point, values: &[f64]) -> Result<()>;
+/// Told after every communication step of an [`Execution`](crate::simulate::Execution)
+/// (libcosim's observer): the rows themselves go to the results or a
+/// [`RowSink`](crate::simulate::RowSink); [`Execution::get`](crate::simulate::Execution::get)
+/// reads any variable between steps.
+pub trait Observer {
+    /// Step `point.n` ended at `point.t_next`. An error ends the run.
+    fn step_complete(&mut self, point: &Point) -> Result<()>;
 }
 
 /// The rows of the results: time and the recorded slots at every output point.
@@ -27,41 +30,37 @@ pub(crate) struct Recorder<'s> {
     /// locked only while a row is appended (about 20 ns a row).
     pub(crate) shared: std::sync::Arc<crate::exit_guard::RunRows>,
     slots: Vec<usize>,
-    steps: u64,
     /// Steps completed so far.
     done: u64,
-    progress: Option<fn(f64)>,
-    sink: Option<&'s mut crate::simulate::RowSink<'s>>,
+    pub(crate) sink: Option<&'s mut crate::simulate::RowSink<'s>>,
     row: Vec<f64>,
     /// The time of the last row.
     last: Option<f64>,
 }
 
 impl<'s> Recorder<'s> {
-    /// A recorder of the slots `slots` under the column names `names`, with room reserved
-    /// for `rows` rows (up to 64 MiB up front: a huge run grows as it goes; nothing when
-    /// the rows go to `sink`).
-    pub(crate) fn new(
-        names: Vec<String>,
-        slots: Vec<usize>,
-        rows: u64,
-        steps: u64,
-        progress: Option<fn(f64)>,
-        sink: Option<&'s mut crate::simulate::RowSink<'s>>,
-    ) -> Self {
-        let wanted = if sink.is_some() { 0 } else { (rows as usize).saturating_mul(slots.len() + 1).min(8 << 20) };
+    /// A recorder of the slots `slots` under the column names `names`.
+    pub(crate) fn new(names: Vec<String>, slots: Vec<usize>) -> Self {
         let row = Vec::with_capacity(slots.len());
         Recorder {
             shared: std::sync::Arc::new(crate::exit_guard::RunRows {
-                results: std::sync::Mutex::new(Results { names, values: Vec::with_capacity(wanted) }),
+                results: std::sync::Mutex::new(Results { names, values: Vec::new() }),
             }),
             slots,
-            steps,
             done: 0,
-            progress,
-            sink,
+            sink: None,
             row,
             last: None,
+        }
+    }
+
+    /// Room for `rows` rows (up to 64 MiB up front: a huge run grows as it goes; nothing
+    /// when the rows go to the sink).
+    pub(crate) fn reserve(&mut self, rows: u64) {
+        if self.sink.is_none() {
+            let wanted = (rows as usize).saturating_mul(self.slots.len() + 1).min(8 << 20);
+            let mut results = self.shared.results.lock().unwrap_or_else(|e| e.into_inner());
+            results.values.reserve(wanted);
         }
     }
 
@@ -99,15 +98,31 @@ impl<'s> Recorder<'s> {
     }
 }
 
-impl Observer for Recorder<'_> {
+impl Recorder<'_> {
+    /// Step `point.n` is complete; `values`: the value buffer of the plan, every recorded
+    /// slot current at an output point.
     #[inline]
-    fn step_complete(&mut self, point: &Point, values: &[f64]) -> Result<()> {
+    pub(crate) fn step_complete(&mut self, point: &Point, values: &[f64]) {
         self.done = point.n + 1;
         if point.output_point {
             self.push_row(point.t_next, values);
-            if let Some(p) = self.progress {
-                p((point.n + 1) as f64 / self.steps as f64);
-            }
+        }
+    }
+}
+
+/// Calls `report` with the fraction done (0..=1) at each output point
+/// ([`Execution::on_progress`](crate::simulate::Execution::on_progress)).
+pub struct Progress {
+    /// Called with the fraction of the run's steps done.
+    pub report: fn(f64),
+    /// The run's communication steps ([`Execution::steps`](crate::simulate::Execution::steps)).
+    pub steps: u64,
+}
+
+impl Observer for Progress {
+    fn step_complete(&mut self, point: &Point) -> Result<()> {
+        if point.output_point {
+            (self.report)((point.n + 1) as f64 / self.steps as f64);
         }
         Ok(())
     }
@@ -127,7 +142,7 @@ impl Deadline {
 
 impl Observer for Deadline {
     #[inline]
-    fn step_complete(&mut self, point: &Point, _values: &[f64]) -> Result<()> {
+    fn step_complete(&mut self, point: &Point) -> Result<()> {
         if point.n.is_multiple_of(Self::EVERY) && Instant::now() > self.at {
             return Err(Error::Timeout { limit: self.limit, time: point.t_next });
         }
@@ -135,13 +150,13 @@ impl Observer for Deadline {
     }
 }
 
-/// Stops the run when its flag is set ([`Experiment::cancel`](crate::Experiment::cancel)):
-/// one relaxed load per step.
-pub(crate) struct Cancel(pub(crate) std::sync::Arc<std::sync::atomic::AtomicBool>);
+/// Stops the run with [`Error::Cancelled`] when its flag is set (from any thread; a Python
+/// caller's Ctrl-C): one relaxed load per step.
+pub struct Cancel(pub std::sync::Arc<std::sync::atomic::AtomicBool>);
 
 impl Observer for Cancel {
     #[inline]
-    fn step_complete(&mut self, point: &Point, _values: &[f64]) -> Result<()> {
+    fn step_complete(&mut self, point: &Point) -> Result<()> {
         if self.0.load(std::sync::atomic::Ordering::Relaxed) {
             return Err(Error::Cancelled { time: point.t_next });
         }
@@ -189,18 +204,21 @@ impl Profiler {
 }
 
 /// The observers of one run: told in order after every step.
-pub(crate) struct Observers<'a> {
+pub(crate) struct Observers<'a, 's> {
+    /// The rows, told first.
+    pub(crate) recorder: &'a mut Recorder<'s>,
     pub(crate) list: Vec<&'a mut dyn Observer>,
     /// The per-call profiler, when asked for.
     pub(crate) calls: Option<&'a mut Profiler>,
 }
 
-impl Observers<'_> {
+impl Observers<'_, '_> {
     /// Tells every observer that the step of `point` is complete.
     #[inline]
     pub(crate) fn step_complete(&mut self, point: &Point, values: &[f64]) -> Result<()> {
+        self.recorder.step_complete(point, values);
         for o in self.list.iter_mut() {
-            o.step_complete(point, values)?;
+            o.step_complete(point)?;
         }
         Ok(())
     }

@@ -50,8 +50,6 @@ pub struct Experiment {
     /// thread). Each instance is called by one thread at a time; the results are the
     /// same for any number. `ordered` always runs in one thread.
     pub threads: usize,
-    /// Called with the fraction done (0..=1) at each output point.
-    pub progress: Option<fn(f64)>,
     /// Integration method of Model Exchange instances.
     pub solver: crate::me::Solver,
     /// On fmi2Discard from `fmi2DoStep` of an FMU that can get and set its state and
@@ -72,13 +70,11 @@ pub struct Experiment {
     /// The wall-clock limit of the whole run ([`Error::Timeout`](crate::Error::Timeout), or
     /// [`Error::Host`](crate::Error::Host) when it passes during a call of an isolated instance).
     pub timeout: Option<Duration>,
-    /// Set to true (from any thread) to stop the run between two steps with
-    /// [`Error::Cancelled`](crate::Error::Cancelled), the rows so far kept (a Python caller's
-    /// Ctrl-C).
-    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    /// Values a caller sets while the run is in progress (from another thread, e.g. the
-    /// row sink of a run stepped from outside), applied before the next communication step.
-    pub between_steps: Option<std::sync::Arc<crate::simulate::SetQueue>>,
+    /// The relative tolerance told to the Co-Simulation FMUs (`fmi2SetupExperiment`,
+    /// `fmi3EnterInitializationMode`) for their internal solvers; `None`: each FMU's
+    /// DefaultExperiment tolerance, else none (fmpy's rule). Model Exchange FMUs are told
+    /// none (the master's solver has its own, [`Experiment::solver`]).
+    pub co_simulation_tolerance: Option<f64>,
 }
 
 impl Experiment {
@@ -93,15 +89,13 @@ impl Experiment {
             record: None,
             profile: false,
             threads: 1,
-            progress: None,
             solver: crate::me::Solver::default(),
             retry_discard: false,
             input: None,
             max_steps: DEFAULT_MAX_STEPS,
             isolation: None,
             timeout: None,
-            cancel: None,
-            between_steps: None,
+            co_simulation_tolerance: None,
         }
     }
 }
@@ -132,6 +126,18 @@ impl Results {
     pub fn column(&self, name: &str) -> Option<Vec<f64>> {
         let j = if name == "time" { 0 } else { self.names.iter().position(|n| n == name)? + 1 };
         Some((0..self.rows()).map(|k| self.row(k)[j]).collect())
+    }
+
+    /// The columns called `names` (others left out), in this table's order, time first.
+    pub fn select(&self, names: &[String]) -> Results {
+        let keep: Vec<usize> = (0..self.names.len()).filter(|j| names.contains(&self.names[*j])).collect();
+        let mut values = Vec::with_capacity(self.rows() * (keep.len() + 1));
+        for k in 0..self.rows() {
+            let row = self.row(k);
+            values.push(row[0]);
+            values.extend(keep.iter().map(|j| row[j + 1]));
+        }
+        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values }
     }
 
     /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
@@ -171,6 +177,13 @@ pub fn push_number(out: &mut String, v: f64) {
     }
 }
 
+/// [`push_number`]'s text of `v` (`0.35`, `1.6940658945086007e-21`).
+pub fn number_text(v: f64) -> String {
+    let mut s = String::new();
+    push_number(&mut s, v);
+    s
+}
+
 /// A JSON-able run summary.
 #[derive(Clone, Debug, Default)]
 pub struct Summary {
@@ -196,6 +209,9 @@ pub struct Summary {
     /// The FMU that ended the run itself (FMI's fmi2Terminated / terminateSimulation):
     /// its instance, the time the run ended, and how it said so.
     pub ended_by: Option<(String, f64, &'static str)>,
+    /// What the master did that a reader of the inputs may not expect (e.g. an input
+    /// event between communication points applied at the next one), one sentence each.
+    pub notes: Vec<String>,
 }
 
 impl Summary {
@@ -213,6 +229,7 @@ impl Summary {
             "wall_time_s": self.wall_time.as_secs_f64(),
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
+            "notes": self.notes,
         })
     }
 }

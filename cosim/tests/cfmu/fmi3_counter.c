@@ -18,7 +18,8 @@
  *   30 crash_at Float64 parameter: Co-Simulation: the step that starts at or after it crashes;
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
- *      (SIGABRT), 3 exit(0)
+ *      (SIGABRT), 3 exit(0); 4 no crash: Co-Simulation's step says terminateSimulation with an
+ *      early return at lastSuccessfulTime = t + 1000 s, past the step
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
@@ -146,6 +147,13 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;
+    if (t >= s->crash_at && s->crash_how == 4) {
+        /* no crash: terminateSimulation with an early return "at" t + 1000 s, past the step */
+        *terminateSimulation = fmi3True;
+        *earlyReturn = fmi3True;
+        *lastSuccessfulTime = t + 1000.0;
+        return fmi3OK;
+    }
     if (t >= s->crash_at) crash(s);
     if (s->early_allowed && !s->early_done && s->early_at > t && s->early_at < end) {
         s->early_done = 1;
@@ -234,7 +242,7 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     if (nvr != nValues) return fail(c, "fmi3SetInt32: nValues != nValueReferences");
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] == 9) c->s.k = values[i];
-        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 3) c->s.crash_how = values[i];
+        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 4) c->s.crash_how = values[i];
         else return fail(c, "fmi3SetInt32: not settable");
     }
     return fmi3OK;

@@ -4,7 +4,7 @@
  * (the Jacobian [[0, 1], [-2 mu x0 x1 - 1, mu (1 - x0^2)]]), each call counted.
  * Value references: 0 x0, 1 der(x0), 2 x1, 3 der(x1), 4 mu (parameter), 5 directional_calls,
  * 6 derivative_calls (locals: the calls of fmi2GetDirectionalDerivative and of
- * fmi2GetDerivatives so far). */
+ * fmi2GetDerivatives so far). Built with -DWRONG_JACOBIAN every partial derivative is doubled. */
 #define FMI2_TEST_NO_FMU_STATE
 #define FMI2_TEST_DIRECTIONAL_DERIVATIVE
 #include "fmi2_test.h"
@@ -58,6 +58,9 @@ static int partial(const Vdp *m, fmi2ValueReference unknown, fmi2ValueReference 
     else if (unknown == 3 && known == 0) *out = -2.0 * mu * x0 * x1 - 1.0;
     else if (unknown == 3 && known == 2) *out = mu * (1.0 - x0 * x0);
     else return 0;
+#ifdef WRONG_JACOBIAN
+    *out *= 2.0; /* a wrong Jacobian: built with -DWRONG_JACOBIAN */
+#endif
     return 1;
 }
 EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,

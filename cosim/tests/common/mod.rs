@@ -187,10 +187,16 @@ pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> P
 
 /// Compiles `tests/cfmu/<id>.c` and packs it with `xml` as `<dir>/<id>.fmu`.
 fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
+    build_single_c_fmu_with_flags(dir, id, xml, &[])
+}
+
+/// [`build_single_c_fmu`] with extra `cc` flags (e.g. `-DWRONG_JACOBIAN`).
+fn build_single_c_fmu_with_flags(dir: &Path, id: &str, xml: &str, flags: &[&str]) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cfmu/{id}.c"));
     let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
+        .args(flags)
         .arg(&src)
         .arg("-o")
         .arg(&so)
@@ -232,6 +238,12 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
 </fmiModelDescription>
 "#;
     build_single_c_fmu(dir, "hostile", xml)
+}
+
+/// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
+/// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
+pub fn build_nanme(dir: &Path) -> PathBuf {
+    build_single_c_fmu(dir, "nanme", include_str!("../cfmu/nanme.xml"))
 }
 
 /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
@@ -345,4 +357,52 @@ pub fn build_vdp_without_directional_derivatives(dir: &Path) -> PathBuf {
     let xml = include_str!("../cfmu/vdp.xml")
         .replace(r#"providesDirectionalDerivative="true""#, r#"providesDirectionalDerivative="false""#);
     build_single_c_fmu(dir, "vdp", &xml)
+}
+
+/// [`build_vdp`] whose description declares, as Dymola's do, a `derivative` attribute on a
+/// variable that is no state derivative: `derivative_calls` (a local) is declared the
+/// derivative of `directional_calls` (both made continuous), while `<Derivatives>` lists
+/// the two state derivatives only. The library is vdp.c's: it refuses nx other than 2
+/// and a directional derivative of anything but a state derivative with respect to a
+/// state. As `<dir>/vdp.fmu`.
+pub fn build_vdp_with_a_derivative_of_no_state(dir: &Path) -> PathBuf {
+    let xml = include_str!("../cfmu/vdp.xml")
+        .replace(
+            r#"<ScalarVariable name="directional_calls" valueReference="5"><Real/></ScalarVariable>"#,
+            r#"<ScalarVariable name="directional_calls" valueReference="5" variability="continuous"><Real/></ScalarVariable>"#,
+        )
+        .replace(
+            r#"<ScalarVariable name="derivative_calls" valueReference="6"><Real/></ScalarVariable>"#,
+            r#"<ScalarVariable name="derivative_calls" valueReference="6" variability="continuous"><Real derivative="6"/></ScalarVariable>"#,
+        );
+    assert!(xml.contains(r#"derivative="6""#));
+    build_single_c_fmu(dir, "vdp", &xml)
+}
+
+/// [`build_vdp`] built with `-DWRONG_JACOBIAN`: its fmi2GetDirectionalDerivative gives
+/// twice every partial derivative (a wrong Jacobian that is otherwise well-behaved), as
+/// `<dir>/vdp.fmu`.
+pub fn build_vdp_with_a_wrong_jacobian(dir: &Path) -> PathBuf {
+    build_single_c_fmu_with_flags(dir, "vdp", include_str!("../cfmu/vdp.xml"), &["-DWRONG_JACOBIAN"])
+}
+
+/// The Co-Simulation FMU that reports the tolerance of fmi2SetupExperiment
+/// (tests/cfmu/tolerance.c) as `<dir>/tolerance.fmu`; `default_tolerance` is its
+/// DefaultExperiment's tolerance attribute (`None`: no attribute).
+pub fn build_tolerance(dir: &Path, default_tolerance: Option<&str>) -> PathBuf {
+    let tolerance = default_tolerance.map(|t| format!(r#" tolerance="{t}""#)).unwrap_or_default();
+    let xml = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="tolerance" guid="{{tolerance}}" numberOfEventIndicators="0">
+  <CoSimulation modelIdentifier="tolerance"/>
+  <DefaultExperiment startTime="0" stopTime="0.1" stepSize="0.05"{tolerance}/>
+  <ModelVariables>
+    <ScalarVariable name="told_tolerance" valueReference="0" causality="output" variability="discrete"><Real/></ScalarVariable>
+    <ScalarVariable name="y" valueReference="1" causality="output"><Real/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure><Outputs><Unknown index="1" dependencies=""/><Unknown index="2" dependencies=""/></Outputs></ModelStructure>
+</fmiModelDescription>
+"#
+    );
+    build_single_c_fmu(dir, "tolerance", &xml)
 }

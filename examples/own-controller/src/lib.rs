@@ -10,10 +10,8 @@
 //! - drive: `F = clamp(kp_speed (speed_ref - speed), -force_max, force_max)`, the torque of
 //!   each wheel `tau_i = F r_wheel / 4`.
 
-use std::sync::OnceLock;
-
 use fmi_export::model_description::DefaultExperiment;
-use fmi_export::{Declaration, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables};
+use fmi_export::{DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, Variables};
 use nigel_vehicle::WHEELS;
 
 /// The sample period of the law \[s\].
@@ -133,10 +131,7 @@ impl OwnController {
 impl Model for OwnController {
     type Binding = Field<OwnController>;
 
-    fn declaration() -> &'static Declaration<Field<OwnController>> {
-        static D: OnceLock<Declaration<Field<OwnController>>> = OnceLock::new();
-        D.get_or_init(|| Declaration::new(build_declaration()).expect("the declaration is valid"))
-    }
+    fmi_export::declare_model!(Field<OwnController>, build_declaration());
 
     fn instantiate(_: &InstantiateContext) -> ModelResult<Self> {
         Ok(OwnController {

@@ -1,5 +1,5 @@
 //! The FMI 2.0 C ABI: the 44 `fmi2*` functions over the one instance.
-#![allow(clippy::missing_safety_doc, non_snake_case)]
+#![allow(clippy::missing_safety_doc, clippy::too_many_arguments, non_snake_case)]
 
 use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr};
@@ -13,24 +13,26 @@ use crate::model::{InstantiateContext, Interface, Model};
 
 // ------------------------------------------------------------------ common functions
 
-pub fn get_types_platform() -> *const c_char {
+pub fn get_types_platform<M>(_: Function) -> *const c_char {
     c"default".as_ptr()
 }
 
-pub fn get_version() -> *const c_char {
+pub fn get_version<M>(_: Function) -> *const c_char {
     c"2.0".as_ptr()
 }
 
 pub unsafe fn set_debug_logging<M: Model>(
+    function: Function,
     c: fmi2Component,
     logging_on: fmi2Boolean,
     n: usize,
     categories: *const fmi2String,
 ) -> Fmi2Status {
-    super::set_debug_logging_as::<M>(Function::SetDebugLogging, c, logging_on, n, categories)
+    super::set_debug_logging_as::<M>(function, c, logging_on, n, categories)
 }
 
 pub unsafe fn instantiate<M: Model>(
+    _: Function,
     instance_name: fmi2String,
     fmu_type: c_int,
     guid: fmi2String,
@@ -101,13 +103,14 @@ pub unsafe fn instantiate<M: Model>(
     }
 }
 
-pub unsafe fn free_instance<M: Model>(c: fmi2Component) {
+pub unsafe fn free_instance<M: Model>(_: Function, c: fmi2Component) {
     if !c.is_null() {
         let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(c as *mut Component<M>))));
     }
 }
 
 pub unsafe fn setup_experiment<M: Model>(
+    function: Function,
     c: fmi2Component,
     tolerance_defined: fmi2Boolean,
     tolerance: f64,
@@ -115,19 +118,19 @@ pub unsafe fn setup_experiment<M: Model>(
     stop_time_defined: fmi2Boolean,
     stop_time: f64,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SetupExperiment, |comp| {
+    with::<M>(c, function, |comp| {
         let tol = (tolerance_defined != FMI2_FALSE).then_some(tolerance);
         let stop = (stop_time_defined != FMI2_FALSE).then_some(stop_time);
         comp.instance.setup_experiment(tol, start_time, stop)
     })
 }
 
-pub unsafe fn enter_initialization_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::EnterInitializationMode, |comp| comp.instance.enter_initialization_mode())
+pub unsafe fn enter_initialization_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.enter_initialization_mode())
 }
 
-pub unsafe fn exit_initialization_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::ExitInitializationMode, |comp| {
+pub unsafe fn exit_initialization_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         comp.instance.exit_initialization_mode()?;
         comp.log(
             Fmi2Status::Ok,
@@ -138,133 +141,166 @@ pub unsafe fn exit_initialization_mode<M: Model>(c: fmi2Component) -> Fmi2Status
     })
 }
 
-pub unsafe fn terminate<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::Terminate, |comp| comp.instance.terminate())
+pub unsafe fn terminate<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.terminate())
 }
 
-pub unsafe fn reset<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::Reset, |comp| comp.instance.reset())
+pub unsafe fn reset<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.reset())
 }
 
-pub unsafe fn get_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut f64) -> Fmi2Status {
-    with::<M>(c, Function::GetReal, |comp| {
-        let vr = slice(vr, n, "vr")?;
-        let out = slice_mut(value, n, "value")?;
-        comp.instance.get_real(vr, out)
-    })
+/// The FMI 2.0 base types, the type argument of [`get`] and [`set`] (`fmi2GetReal` is
+/// `get::<M, value::Real>`).
+pub mod value {
+    pub struct Real;
+    pub struct Integer;
+    pub struct Boolean;
+    pub struct String;
 }
 
-pub unsafe fn get_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut c_int) -> Fmi2Status {
-    with::<M>(c, Function::GetInteger, |comp| {
-        let vr = slice(vr, n, "vr")?;
-        let out = slice_mut(value, n, "value")?;
-        comp.instance.get_integer(vr, out)
-    })
+/// An FMI 2.0 base type as its `fmi2Get*`/`fmi2Set*` pass it: the C element and the
+/// instance's access.
+pub trait Value {
+    type C: Copy;
+    /// Refuses the value references before the values are looked at (the model has no
+    /// variable of this type).
+    fn check(_vr: &[u32]) -> OpResult {
+        Ok(())
+    }
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [Self::C]) -> OpResult;
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[Self::C]) -> OpResult;
 }
 
-pub unsafe fn get_boolean<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *mut fmi2Boolean) -> Fmi2Status {
-    with::<M>(c, Function::GetBoolean, |comp| {
-        let vr = slice(vr, n, "vr")?;
-        let out = slice_mut(value, n, "value")?;
-        let mut values = vec![false; n];
-        comp.instance.get_boolean(vr, &mut values)?;
+impl Value for value::Real {
+    type C = fmi2Real;
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [f64]) -> OpResult {
+        instance.get_real(vr, out)
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[f64]) -> OpResult {
+        instance.set_real(vr, values)
+    }
+}
+
+impl Value for value::Integer {
+    type C = fmi2Integer;
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [c_int]) -> OpResult {
+        instance.get_integer(vr, out)
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[c_int]) -> OpResult {
+        instance.set_integer(vr, values)
+    }
+}
+
+impl Value for value::Boolean {
+    type C = fmi2Boolean;
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [fmi2Boolean]) -> OpResult {
+        let mut values = vec![false; out.len()];
+        instance.get_boolean(vr, &mut values)?;
         for (o, v) in out.iter_mut().zip(values) {
             *o = if v { FMI2_TRUE } else { FMI2_FALSE };
         }
         Ok(())
-    })
-}
-
-fn no_strings(vr: &[u32]) -> OpResult {
-    match vr.first() {
-        None => Ok(()),
-        Some(v) => Err(format!("unknown String value reference {v} (the model has no String variables)").into()),
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[fmi2Boolean]) -> OpResult {
+        let values: Vec<bool> = values.iter().map(|&b| b != FMI2_FALSE).collect();
+        instance.set_boolean(vr, &values)
     }
 }
 
-pub unsafe fn get_string<M: Model>(c: fmi2Component, vr: *const u32, n: usize, _value: *mut fmi2String) -> Fmi2Status {
-    with::<M>(c, Function::GetString, |_| no_strings(slice(vr, n, "vr")?))
+/// No String variables: every value reference is refused, an empty call is fine.
+impl Value for value::String {
+    type C = fmi2String;
+    fn check(vr: &[u32]) -> OpResult {
+        match vr.first() {
+            None => Ok(()),
+            Some(v) => Err(format!("unknown String value reference {v} (the model has no String variables)").into()),
+        }
+    }
+    fn get<M: Model>(_: &mut Instance<M>, _: &[u32], _: &mut [fmi2String]) -> OpResult {
+        Ok(())
+    }
+    fn set<M: Model>(_: &mut Instance<M>, _: &[u32], _: &[fmi2String]) -> OpResult {
+        Ok(())
+    }
 }
 
-pub unsafe fn set_real<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const f64) -> Fmi2Status {
-    with::<M>(c, Function::SetReal, |comp| {
-        let vr = slice(vr, n, "vr")?;
-        let values = slice(value, n, "value")?;
-        comp.instance.set_real(vr, values)
-    })
-}
-
-pub unsafe fn set_integer<M: Model>(c: fmi2Component, vr: *const u32, n: usize, value: *const c_int) -> Fmi2Status {
-    with::<M>(c, Function::SetInteger, |comp| {
-        let vr = slice(vr, n, "vr")?;
-        let values = slice(value, n, "value")?;
-        comp.instance.set_integer(vr, values)
-    })
-}
-
-pub unsafe fn set_boolean<M: Model>(
+/// `fmi2GetReal`, `fmi2GetInteger`, `fmi2GetBoolean`, `fmi2GetString`.
+pub unsafe fn get<M: Model, T: Value>(
+    function: Function,
     c: fmi2Component,
     vr: *const u32,
     n: usize,
-    value: *const fmi2Boolean,
+    values: *mut T::C,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SetBoolean, |comp| {
+    with::<M>(c, function, |comp| {
         let vr = slice(vr, n, "vr")?;
-        let values: Vec<bool> = slice(value, n, "value")?.iter().map(|&b| b != FMI2_FALSE).collect();
-        comp.instance.set_boolean(vr, &values)
+        T::check(vr)?;
+        let out = slice_mut(values, n, "value")?;
+        T::get(&mut comp.instance, vr, out)
     })
 }
 
-pub unsafe fn set_string<M: Model>(
+/// `fmi2SetReal`, `fmi2SetInteger`, `fmi2SetBoolean`, `fmi2SetString`.
+pub unsafe fn set<M: Model, T: Value>(
+    function: Function,
     c: fmi2Component,
     vr: *const u32,
     n: usize,
-    _value: *const fmi2String,
+    values: *const T::C,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SetString, |_| no_strings(slice(vr, n, "vr")?))
+    with::<M>(c, function, |comp| {
+        let vr = slice(vr, n, "vr")?;
+        T::check(vr)?;
+        let values = slice(values, n, "value")?;
+        T::set(&mut comp.instance, vr, values)
+    })
 }
 
 // ------------------------------------------------------------------ FMU state
 
-pub unsafe fn get_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    super::get_fmu_state_as::<M>(Function::GetFMUstate, c, state)
+pub unsafe fn get_fmu_state<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
+    super::get_fmu_state_as::<M>(function, c, state)
 }
 
-pub unsafe fn set_fmu_state<M: Model>(c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
-    super::set_fmu_state_as::<M>(Function::SetFMUstate, c, state)
+pub unsafe fn set_fmu_state<M: Model>(function: Function, c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
+    super::set_fmu_state_as::<M>(function, c, state)
 }
 
-pub unsafe fn free_fmu_state<M: Model>(c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    super::free_fmu_state_as::<M>(Function::FreeFMUstate, c, state)
+pub unsafe fn free_fmu_state<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
+    super::free_fmu_state_as::<M>(function, c, state)
 }
 
 pub unsafe fn serialized_fmu_state_size<M: Model>(
+    function: Function,
     c: fmi2Component,
     state: fmi2FMUstate,
     size: *mut usize,
 ) -> Fmi2Status {
-    super::serialized_fmu_state_size_as::<M>(Function::SerializedFMUstateSize, c, state, size)
+    super::serialized_fmu_state_size_as::<M>(function, c, state, size)
 }
 
 pub unsafe fn serialize_fmu_state<M: Model>(
+    function: Function,
     c: fmi2Component,
     state: fmi2FMUstate,
     bytes: *mut fmi2Byte,
     size: usize,
 ) -> Fmi2Status {
-    super::serialize_fmu_state_as::<M>(Function::SerializeFMUstate, c, state, bytes, size)
+    super::serialize_fmu_state_as::<M>(function, c, state, bytes, size)
 }
 
 pub unsafe fn deserialize_fmu_state<M: Model>(
+    function: Function,
     c: fmi2Component,
     bytes: *const fmi2Byte,
     size: usize,
     state: *mut fmi2FMUstate,
 ) -> Fmi2Status {
-    super::deserialize_fmu_state_as::<M>(Function::DeSerializeFMUstate, c, bytes, size, state)
+    super::deserialize_fmu_state_as::<M>(function, c, bytes, size, state)
 }
 
 pub unsafe fn get_directional_derivative<M: Model>(
+    function: Function,
     c: fmi2Component,
     unknown: *const u32,
     n_unknown: usize,
@@ -273,7 +309,7 @@ pub unsafe fn get_directional_derivative<M: Model>(
     dv_known: *const f64,
     dv_unknown: *mut f64,
 ) -> Fmi2Status {
-    with::<M>(c, Function::GetDirectionalDerivative, |comp| {
+    with::<M>(c, function, |comp| {
         let unknowns = slice(unknown, n_unknown, "vUnknown_ref")?;
         let knowns = slice(known, n_known, "vKnown_ref")?;
         let dv_k = slice(dv_known, n_known, "dvKnown")?;
@@ -284,36 +320,30 @@ pub unsafe fn get_directional_derivative<M: Model>(
 
 // ------------------------------------------------------------------ Co-Simulation
 
-pub unsafe fn set_real_input_derivatives<M: Model>(
+pub unsafe fn set_real_input_derivatives<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |_| Err("not supported (canInterpolateInputs is false)".into()))
+}
+
+pub unsafe fn get_real_output_derivatives<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |_| Err("not supported (maxOutputDerivativeOrder is 0)".into()))
+}
+
+pub unsafe fn do_step<M: Model>(
+    function: Function,
     c: fmi2Component,
-    _vr: *const u32,
-    _n: usize,
-    _order: *const c_int,
-    _value: *const f64,
+    current: f64,
+    step: f64,
+    _no_set_prior: fmi2Boolean,
 ) -> Fmi2Status {
-    with::<M>(c, Function::SetRealInputDerivatives, |_| Err("not supported (canInterpolateInputs is false)".into()))
+    with::<M>(c, function, |comp| comp.instance.do_step(current, step))
 }
 
-pub unsafe fn get_real_output_derivatives<M: Model>(
-    c: fmi2Component,
-    _vr: *const u32,
-    _n: usize,
-    _order: *const c_int,
-    _value: *mut f64,
-) -> Fmi2Status {
-    with::<M>(c, Function::GetRealOutputDerivatives, |_| Err("not supported (maxOutputDerivativeOrder is 0)".into()))
+pub unsafe fn cancel_step<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |_| Err("not supported: fmi2DoStep never returns fmi2Pending".into()))
 }
 
-pub unsafe fn do_step<M: Model>(c: fmi2Component, current: f64, step: f64, _no_set_prior: fmi2Boolean) -> Fmi2Status {
-    with::<M>(c, Function::DoStep, |comp| comp.instance.do_step(current, step))
-}
-
-pub unsafe fn cancel_step<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::CancelStep, |_| Err("not supported: fmi2DoStep never returns fmi2Pending".into()))
-}
-
-pub unsafe fn get_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut c_int) -> Fmi2Status {
-    with::<M>(c, Function::GetStatus, |comp| {
+pub unsafe fn get_status<M: Model>(function: Function, c: fmi2Component, kind: c_int, value: *mut c_int) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = out_ptr(value, "value")?;
         match kind {
             FMI2_DO_STEP_STATUS => {
@@ -326,8 +356,13 @@ pub unsafe fn get_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut c_
     })
 }
 
-pub unsafe fn get_real_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut f64) -> Fmi2Status {
-    with::<M>(c, Function::GetRealStatus, |comp| {
+pub unsafe fn get_real_status<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    kind: c_int,
+    value: *mut f64,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = out_ptr(value, "value")?;
         if kind == FMI2_LAST_SUCCESSFUL_TIME {
             *out = comp.instance.time();
@@ -338,12 +373,17 @@ pub unsafe fn get_real_status<M: Model>(c: fmi2Component, kind: c_int, value: *m
     })
 }
 
-pub unsafe fn get_integer_status<M: Model>(c: fmi2Component, kind: c_int, _value: *mut c_int) -> Fmi2Status {
-    with::<M>(c, Function::GetIntegerStatus, |_| Err(format!("status kind {kind} has no Integer value").into()))
+pub unsafe fn get_integer_status<M: Model>(function: Function, c: fmi2Component, kind: c_int) -> Fmi2Status {
+    with::<M>(c, function, |_| Err(format!("status kind {kind} has no Integer value").into()))
 }
 
-pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value: *mut fmi2Boolean) -> Fmi2Status {
-    with::<M>(c, Function::GetBooleanStatus, |comp| {
+pub unsafe fn get_boolean_status<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    kind: c_int,
+    value: *mut fmi2Boolean,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = out_ptr(value, "value")?;
         if kind == FMI2_TERMINATED {
             // after a Discard because the model asked to end the simulation
@@ -355,20 +395,22 @@ pub unsafe fn get_boolean_status<M: Model>(c: fmi2Component, kind: c_int, value:
     })
 }
 
-pub unsafe fn get_string_status<M: Model>(c: fmi2Component, kind: c_int, _value: *mut fmi2String) -> Fmi2Status {
-    with::<M>(c, Function::GetStringStatus, |_| {
-        Err(format!("status kind {kind} has no String value (no pending step)").into())
-    })
+pub unsafe fn get_string_status<M: Model>(function: Function, c: fmi2Component, kind: c_int) -> Fmi2Status {
+    with::<M>(c, function, |_| Err(format!("status kind {kind} has no String value (no pending step)").into()))
 }
 
 // ------------------------------------------------------------------ Model Exchange
 
-pub unsafe fn enter_event_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::EnterEventMode, |comp| comp.instance.enter_event_mode())
+pub unsafe fn enter_event_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.enter_event_mode())
 }
 
-pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut Fmi2EventInfo) -> Fmi2Status {
-    with::<M>(c, Function::NewDiscreteStates, |comp| {
+pub unsafe fn new_discrete_states<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    info: *mut Fmi2EventInfo,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let info = out_ptr(info, "fmi2EventInfo")?;
         let update = comp.instance.new_discrete_states()?;
         let b = |x: bool| if x { FMI2_TRUE } else { FMI2_FALSE };
@@ -387,17 +429,18 @@ pub unsafe fn new_discrete_states<M: Model>(c: fmi2Component, info: *mut Fmi2Eve
     })
 }
 
-pub unsafe fn enter_continuous_time_mode<M: Model>(c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, Function::EnterContinuousTimeMode, |comp| comp.instance.enter_continuous_time_mode())
+pub unsafe fn enter_continuous_time_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.enter_continuous_time_mode())
 }
 
 pub unsafe fn completed_integrator_step<M: Model>(
+    function: Function,
     c: fmi2Component,
     _no_set_prior: fmi2Boolean,
     enter_event_mode: *mut fmi2Boolean,
     terminate_simulation: *mut fmi2Boolean,
 ) -> Fmi2Status {
-    with::<M>(c, Function::CompletedIntegratorStep, |_| {
+    with::<M>(c, function, |_| {
         let enter = out_ptr(enter_event_mode, "enterEventMode")?;
         let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
         *enter = FMI2_FALSE;
@@ -406,40 +449,60 @@ pub unsafe fn completed_integrator_step<M: Model>(
     })
 }
 
-pub unsafe fn set_time<M: Model>(c: fmi2Component, time: f64) -> Fmi2Status {
-    with::<M>(c, Function::SetTime, |comp| comp.instance.set_time(time))
+pub unsafe fn set_time<M: Model>(function: Function, c: fmi2Component, time: f64) -> Fmi2Status {
+    with::<M>(c, function, |comp| comp.instance.set_time(time))
 }
 
-pub unsafe fn set_continuous_states<M: Model>(c: fmi2Component, x: *const f64, nx: usize) -> Fmi2Status {
-    with::<M>(c, Function::SetContinuousStates, |comp| {
+pub unsafe fn set_continuous_states<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    x: *const f64,
+    nx: usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let x = slice(x, nx, "x")?;
         comp.instance.set_continuous_states(x)
     })
 }
 
-pub unsafe fn get_derivatives<M: Model>(c: fmi2Component, dx: *mut f64, nx: usize) -> Fmi2Status {
-    with::<M>(c, Function::GetDerivatives, |comp| {
+pub unsafe fn get_derivatives<M: Model>(function: Function, c: fmi2Component, dx: *mut f64, nx: usize) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = slice_mut(dx, nx, "derivatives")?;
         comp.instance.get_derivatives(out)
     })
 }
 
-pub unsafe fn get_event_indicators<M: Model>(c: fmi2Component, z: *mut f64, ni: usize) -> Fmi2Status {
-    with::<M>(c, Function::GetEventIndicators, |comp| {
+pub unsafe fn get_event_indicators<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    z: *mut f64,
+    ni: usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = slice_mut(z, ni, "eventIndicators")?;
         comp.instance.get_event_indicators(out)
     })
 }
 
-pub unsafe fn get_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> Fmi2Status {
-    with::<M>(c, Function::GetContinuousStates, |comp| {
+pub unsafe fn get_continuous_states<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    x: *mut f64,
+    nx: usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = slice_mut(x, nx, "x")?;
         comp.instance.get_continuous_states(out)
     })
 }
 
-pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: fmi2Component, x: *mut f64, nx: usize) -> Fmi2Status {
-    with::<M>(c, Function::GetNominalsOfContinuousStates, |comp| {
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(
+    function: Function,
+    c: fmi2Component,
+    x: *mut f64,
+    nx: usize,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
         let out = slice_mut(x, nx, "x_nominal")?;
         comp.instance.get_nominals(out)
     })

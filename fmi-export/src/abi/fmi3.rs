@@ -67,18 +67,19 @@ fn check_n_values(n_value_references: usize, n_values: usize) -> OpResult {
 
 // ------------------------------------------------------------------ inquire, log, instantiate
 
-pub fn get_version() -> *const c_char {
+pub fn get_version<M>(_: Function) -> *const c_char {
     c"3.0".as_ptr()
 }
 
 pub unsafe fn set_debug_logging<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     logging_on: fmi3Boolean,
     n: usize,
     categories: *const fmi3String,
 ) -> Fmi3Status {
     let on = if logging_on != FMI3_FALSE { FMI2_TRUE } else { FMI2_FALSE };
-    status3(super::set_debug_logging_as::<M>(Function::Fmi3SetDebugLogging, instance, on, n, categories))
+    status3(super::set_debug_logging_as::<M>(function, instance, on, n, categories))
 }
 
 /// Logs `message` through an importer's `logMessage` for a call without an instance.
@@ -150,6 +151,7 @@ unsafe fn instantiate3<M: Model>(
 }
 
 pub unsafe fn instantiate_model_exchange<M: Model>(
+    function: Function,
     instance_name: fmi3String,
     instantiation_token: fmi3String,
     resource_path: fmi3String,
@@ -159,7 +161,7 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
     log_message: Option<Fmi3LogMessageCallback>,
 ) -> fmi3Instance {
     instantiate3::<M>(
-        Function::Fmi3InstantiateModelExchange,
+        function,
         Interface::ModelExchange,
         instance_name,
         instantiation_token,
@@ -172,6 +174,7 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
 }
 
 pub unsafe fn instantiate_co_simulation<M: Model>(
+    function: Function,
     instance_name: fmi3String,
     instantiation_token: fmi3String,
     resource_path: fmi3String,
@@ -187,7 +190,7 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
 ) -> fmi3Instance {
     // earlyReturnAllowed needs nothing: fmi3DoStep never returns early
     instantiate3::<M>(
-        Function::Fmi3InstantiateCoSimulation,
+        function,
         Interface::CoSimulation,
         instance_name,
         instantiation_token,
@@ -213,16 +216,9 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
 }
 
 pub unsafe fn instantiate_scheduled_execution<M: Model>(
-    _instance_name: fmi3String,
-    _instantiation_token: fmi3String,
-    _resource_path: fmi3String,
-    _visible: fmi3Boolean,
-    _logging_on: fmi3Boolean,
+    _: Function,
     environment: fmi3InstanceEnvironment,
     log_message: Option<Fmi3LogMessageCallback>,
-    _clock_update: Option<Fmi3ClockUpdateCallback>,
-    _lock_preemption: Option<Fmi3LockPreemptionCallback>,
-    _unlock_preemption: Option<Fmi3UnlockPreemptionCallback>,
 ) -> fmi3Instance {
     let _ = catch_unwind(AssertUnwindSafe(|| {
         emit3(
@@ -238,13 +234,14 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
     std::ptr::null_mut()
 }
 
-pub unsafe fn free_instance<M: Model>(instance: fmi3Instance) {
-    super::fmi2::free_instance::<M>(instance)
+pub unsafe fn free_instance<M: Model>(function: Function, instance: fmi3Instance) {
+    super::fmi2::free_instance::<M>(function, instance)
 }
 
 // ------------------------------------------------------------------ modes
 
 pub unsafe fn enter_initialization_mode<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     tolerance_defined: fmi3Boolean,
     tolerance: fmi3Float64,
@@ -252,7 +249,7 @@ pub unsafe fn enter_initialization_mode<M: Model>(
     stop_time_defined: fmi3Boolean,
     stop_time: fmi3Float64,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3EnterInitializationMode, |comp| {
+    with3::<M>(instance, function, |comp| {
         let tol = (tolerance_defined != FMI3_FALSE).then_some(tolerance);
         let stop = (stop_time_defined != FMI3_FALSE).then_some(stop_time);
         comp.instance.setup_experiment(tol, start_time, stop)?;
@@ -260,8 +257,8 @@ pub unsafe fn enter_initialization_mode<M: Model>(
     })
 }
 
-pub unsafe fn exit_initialization_mode<M: Model>(instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3ExitInitializationMode, |comp| {
+pub unsafe fn exit_initialization_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
         comp.instance.exit_initialization_mode()?;
         comp.log(
             Fmi2Status::Ok,
@@ -272,21 +269,21 @@ pub unsafe fn exit_initialization_mode<M: Model>(instance: fmi3Instance) -> Fmi3
     })
 }
 
-pub unsafe fn enter_event_mode<M: Model>(instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3EnterEventMode, |comp| comp.instance.enter_event_mode())
+pub unsafe fn enter_event_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.enter_event_mode())
 }
 
-pub unsafe fn terminate<M: Model>(instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3Terminate, |comp| comp.instance.terminate())
+pub unsafe fn terminate<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.terminate())
 }
 
-pub unsafe fn reset<M: Model>(instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3Reset, |comp| comp.instance.reset())
+pub unsafe fn reset<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.reset())
 }
 
 /// A function of a feature the FMU does not declare: refused by the instance's gate with
 /// the reason ([`Function::undeclared_feature`]).
-pub unsafe fn undeclared<M: Model>(instance: fmi3Instance, function: Function) -> Fmi3Status {
+pub unsafe fn undeclared<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
     with3::<M>(instance, function, |_| {
         Err(format!("not supported by {}", M::declaration().spec.model_identifier).into())
     })
@@ -294,240 +291,204 @@ pub unsafe fn undeclared<M: Model>(instance: fmi3Instance, function: Function) -
 
 // ------------------------------------------------------------------ getting and setting values
 
-pub unsafe fn get_float64<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *mut fmi3Float64,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetFloat64, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let out = slice_mut(values, n_values, "values")?;
-        comp.instance.get_float64(vr, out)
-    })
+/// The FMI 3.0 value types, the type argument of [`get`] and [`set`] (`fmi3GetFloat64` is
+/// `get::<M, value::Float64>`; `fmi3GetInt64` reads the Enumerations).
+pub mod value {
+    pub struct Float64;
+    pub struct Int32;
+    pub struct Enumeration;
+    pub struct Boolean;
+    pub struct Float32;
+    pub struct Int8;
+    pub struct UInt8;
+    pub struct Int16;
+    pub struct UInt16;
+    pub struct UInt32;
+    pub struct UInt64;
+    pub struct String;
 }
 
-pub unsafe fn set_float64<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *const fmi3Float64,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetFloat64, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let values = slice(values, n_values, "values")?;
-        comp.instance.set_float64(vr, values)
-    })
+/// An FMI 3.0 value type as its `fmi3Get*`/`fmi3Set*` pass it: the C element, the
+/// variable type it accesses and the instance's access. A type the FMUs have no variable
+/// of keeps the defaults: every value reference is refused naming its actual type (before
+/// the values are looked at), an empty call is fine.
+pub trait Value {
+    type C: Copy;
+    const ACCESSED: ValueType;
+    fn check<M: Model>(instance: &Instance<M>, vr: &[u32]) -> OpResult {
+        instance.fmi2_references(vr, Self::ACCESSED).map(|_| ())
+    }
+    fn get<M: Model>(_: &mut Instance<M>, _: &[u32], _: &mut [Self::C]) -> OpResult {
+        Ok(())
+    }
+    fn set<M: Model>(_: &mut Instance<M>, _: &[u32], _: &[Self::C]) -> OpResult {
+        Ok(())
+    }
 }
 
-pub unsafe fn get_int32<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *mut fmi3Int32,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetInt32, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let out = slice_mut(values, n_values, "values")?;
-        comp.instance.get_int(vr, ValueType::Int32, out)
-    })
+impl Value for value::Float64 {
+    type C = fmi3Float64;
+    const ACCESSED: ValueType = ValueType::Float64;
+    fn check<M: Model>(_: &Instance<M>, _: &[u32]) -> OpResult {
+        Ok(())
+    }
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [f64]) -> OpResult {
+        instance.get_float64(vr, out)
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[f64]) -> OpResult {
+        instance.set_float64(vr, values)
+    }
 }
 
-pub unsafe fn set_int32<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *const fmi3Int32,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetInt32, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let values: Vec<i64> = slice(values, n_values, "values")?.iter().map(|&x| x as i64).collect();
-        comp.instance.set_int(vr, ValueType::Int32, &values)
-    })
+impl Value for value::Int32 {
+    type C = fmi3Int32;
+    const ACCESSED: ValueType = ValueType::Int32;
+    fn check<M: Model>(_: &Instance<M>, _: &[u32]) -> OpResult {
+        Ok(())
+    }
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [i32]) -> OpResult {
+        instance.get_int(vr, Self::ACCESSED, out)
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[i32]) -> OpResult {
+        let values: Vec<i64> = values.iter().map(|&x| x as i64).collect();
+        instance.set_int(vr, Self::ACCESSED, &values)
+    }
 }
 
-/// `fmi3GetInt64`: the Enumerations (FMI 3.0 accesses them as Int64).
-pub unsafe fn get_int64<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *mut fmi3Int64,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetInt64, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let out = slice_mut(values, n_values, "values")?;
+/// The Enumerations, which FMI 3.0 reads and writes as Int64.
+impl Value for value::Enumeration {
+    type C = fmi3Int64;
+    const ACCESSED: ValueType = ValueType::Enumeration;
+    fn check<M: Model>(_: &Instance<M>, _: &[u32]) -> OpResult {
+        Ok(())
+    }
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [i64]) -> OpResult {
         let mut narrow = vec![0i32; vr.len()];
-        comp.instance.get_int(vr, ValueType::Enumeration, &mut narrow)?;
+        instance.get_int(vr, Self::ACCESSED, &mut narrow)?;
         for (o, x) in out.iter_mut().zip(narrow) {
             *o = x as i64;
         }
         Ok(())
-    })
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[i64]) -> OpResult {
+        instance.set_int(vr, Self::ACCESSED, values)
+    }
 }
 
-/// `fmi3SetInt64`: the Enumerations.
-pub unsafe fn set_int64<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *const fmi3Int64,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetInt64, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let values = slice(values, n_values, "values")?;
-        comp.instance.set_int(vr, ValueType::Enumeration, values)
-    })
-}
-
-pub unsafe fn get_boolean<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *mut fmi3Boolean,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetBoolean, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let out = slice_mut(values, n_values, "values")?;
+impl Value for value::Boolean {
+    type C = fmi3Boolean;
+    const ACCESSED: ValueType = ValueType::Boolean;
+    fn check<M: Model>(_: &Instance<M>, _: &[u32]) -> OpResult {
+        Ok(())
+    }
+    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [fmi3Boolean]) -> OpResult {
         let mut bools = vec![false; vr.len()];
-        comp.instance.get_boolean3(vr, &mut bools)?;
+        instance.get_boolean3(vr, &mut bools)?;
         for (o, b) in out.iter_mut().zip(bools) {
             *o = truth(b);
         }
         Ok(())
-    })
+    }
+    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[fmi3Boolean]) -> OpResult {
+        let values: Vec<bool> = values.iter().map(|&b| b != FMI3_FALSE).collect();
+        instance.set_boolean3(vr, &values)
+    }
 }
 
-pub unsafe fn set_boolean<M: Model>(
-    instance: fmi3Instance,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    values: *const fmi3Boolean,
-    n_values: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetBoolean, |comp| {
-        check_n_values(n_vr, n_values)?;
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        let values: Vec<bool> = slice(values, n_values, "values")?.iter().map(|&b| b != FMI3_FALSE).collect();
-        comp.instance.set_boolean3(vr, &values)
-    })
-}
-
-/// A Get or Set of a type the FMU has no variable of (Float32, the 8/16-bit and unsigned
-/// integers, UInt64, String, Binary, Clock): every value reference is refused, naming its
-/// actual type; an empty call is fine. `n_values` is `None` for the calls without it.
-unsafe fn other_type<M: Model>(
-    instance: fmi3Instance,
-    function: Function,
-    accessed: ValueType,
-    vr: *const fmi3ValueReference,
-    n_vr: usize,
-    n_values: Option<usize>,
-) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        if let Some(n_values) = n_values {
-            check_n_values(n_vr, n_values)?;
-        }
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        comp.instance.fmi2_references(vr, accessed).map(|_| ())
-    })
-}
-
-macro_rules! other_types {
-    ($($get:ident, $set:ident, $gf:ident, $sf:ident, $t:ty, $vt:ident;)*) => {$(
-        pub unsafe fn $get<M: Model>(
-            instance: fmi3Instance,
-            vr: *const fmi3ValueReference,
-            n_vr: usize,
-            _values: *mut $t,
-            n_values: usize,
-        ) -> Fmi3Status {
-            other_type::<M>(instance, Function::$gf, ValueType::$vt, vr, n_vr, Some(n_values))
-        }
-        pub unsafe fn $set<M: Model>(
-            instance: fmi3Instance,
-            vr: *const fmi3ValueReference,
-            n_vr: usize,
-            _values: *const $t,
-            n_values: usize,
-        ) -> Fmi3Status {
-            other_type::<M>(instance, Function::$sf, ValueType::$vt, vr, n_vr, Some(n_values))
+macro_rules! no_variables_of {
+    ($($marker:ident: $c:ty;)*) => {$(
+        impl Value for value::$marker {
+            type C = $c;
+            const ACCESSED: ValueType = ValueType::$marker;
         }
     )*};
 }
 
-other_types! {
-    get_float32, set_float32, Fmi3GetFloat32, Fmi3SetFloat32, fmi3Float32, Float32;
-    get_int8, set_int8, Fmi3GetInt8, Fmi3SetInt8, fmi3Int8, Int8;
-    get_uint8, set_uint8, Fmi3GetUInt8, Fmi3SetUInt8, fmi3UInt8, UInt8;
-    get_int16, set_int16, Fmi3GetInt16, Fmi3SetInt16, fmi3Int16, Int16;
-    get_uint16, set_uint16, Fmi3GetUInt16, Fmi3SetUInt16, fmi3UInt16, UInt16;
-    get_uint32, set_uint32, Fmi3GetUInt32, Fmi3SetUInt32, fmi3UInt32, UInt32;
-    get_uint64, set_uint64, Fmi3GetUInt64, Fmi3SetUInt64, fmi3UInt64, UInt64;
-    get_string, set_string, Fmi3GetString, Fmi3SetString, fmi3String, String;
+no_variables_of! {
+    Float32: fmi3Float32;
+    Int8: fmi3Int8;
+    UInt8: fmi3UInt8;
+    Int16: fmi3Int16;
+    UInt16: fmi3UInt16;
+    UInt32: fmi3UInt32;
+    UInt64: fmi3UInt64;
+    String: fmi3String;
 }
 
-pub unsafe fn get_binary<M: Model>(
+/// `fmi3Get<T>` for every value type but Binary and Clock.
+pub unsafe fn get<M: Model, T: Value>(
+    function: Function,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     n_vr: usize,
-    _value_sizes: *mut usize,
-    _values: *mut fmi3Binary,
+    values: *mut T::C,
     n_values: usize,
 ) -> Fmi3Status {
-    other_type::<M>(instance, Function::Fmi3GetBinary, ValueType::Binary, vr, n_vr, Some(n_values))
+    with3::<M>(instance, function, |comp| {
+        check_n_values(n_vr, n_values)?;
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        T::check(&comp.instance, vr)?;
+        let out = slice_mut(values, n_values, "values")?;
+        T::get(&mut comp.instance, vr, out)
+    })
 }
 
-pub unsafe fn set_binary<M: Model>(
+/// `fmi3Set<T>` for every value type but Binary and Clock.
+pub unsafe fn set<M: Model, T: Value>(
+    function: Function,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     n_vr: usize,
-    _value_sizes: *const usize,
-    _values: *const fmi3Binary,
+    values: *const T::C,
     n_values: usize,
 ) -> Fmi3Status {
-    other_type::<M>(instance, Function::Fmi3SetBinary, ValueType::Binary, vr, n_vr, Some(n_values))
+    with3::<M>(instance, function, |comp| {
+        check_n_values(n_vr, n_values)?;
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        T::check(&comp.instance, vr)?;
+        let values = slice(values, n_values, "values")?;
+        T::set(&mut comp.instance, vr, values)
+    })
 }
 
-pub unsafe fn get_clock<M: Model>(
+/// `fmi3GetBinary`, `fmi3SetBinary`: the FMUs have no Binary variables (see [`Value`]).
+pub unsafe fn binary<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     n_vr: usize,
-    _values: *mut fmi3Clock,
+    n_values: usize,
 ) -> Fmi3Status {
-    other_type::<M>(instance, Function::Fmi3GetClock, ValueType::Clock, vr, n_vr, None)
+    with3::<M>(instance, function, |comp| {
+        check_n_values(n_vr, n_values)?;
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        comp.instance.fmi2_references(vr, ValueType::Binary).map(|_| ())
+    })
 }
 
-pub unsafe fn set_clock<M: Model>(
+/// `fmi3GetClock`, `fmi3SetClock`: the FMUs have no clocks (refused by the instance's
+/// gate before this runs: [`Function::undeclared_feature`]).
+pub unsafe fn clock<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     n_vr: usize,
-    _values: *const fmi3Clock,
 ) -> Fmi3Status {
-    other_type::<M>(instance, Function::Fmi3SetClock, ValueType::Clock, vr, n_vr, None)
+    with3::<M>(instance, function, |comp| {
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        comp.instance.fmi2_references(vr, ValueType::Clock).map(|_| ())
+    })
 }
 
 // ------------------------------------------------------------------ variable dependencies
 
 pub unsafe fn get_number_of_variable_dependencies<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     vr: fmi3ValueReference,
     n: *mut usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetNumberOfVariableDependencies, |comp| {
+    with3::<M>(instance, function, |comp| {
         let out = out_ptr(n, "nDependencies")?;
         *out = comp.instance.variable_dependencies(vr)?.len();
         Ok(())
@@ -535,6 +496,7 @@ pub unsafe fn get_number_of_variable_dependencies<M: Model>(
 }
 
 pub unsafe fn get_variable_dependencies<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     dependent: fmi3ValueReference,
     element_indices_of_dependent: *mut usize,
@@ -543,7 +505,7 @@ pub unsafe fn get_variable_dependencies<M: Model>(
     dependency_kinds: *mut fmi3DependencyKind,
     n_dependencies: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetVariableDependencies, |comp| {
+    with3::<M>(instance, function, |comp| {
         let on = comp.instance.variable_dependencies(dependent)?;
         if n_dependencies != on.len() {
             return Err(format!(
@@ -571,61 +533,63 @@ pub unsafe fn get_variable_dependencies<M: Model>(
 
 // ------------------------------------------------------------------ FMU state
 
-pub unsafe fn get_fmu_state<M: Model>(instance: fmi3Instance, state: *mut fmi3FMUState) -> Fmi3Status {
-    status3(super::get_fmu_state_as::<M>(Function::Fmi3GetFMUState, instance, state))
+pub unsafe fn get_fmu_state<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    state: *mut fmi3FMUState,
+) -> Fmi3Status {
+    status3(super::get_fmu_state_as::<M>(function, instance, state))
 }
 
-pub unsafe fn set_fmu_state<M: Model>(instance: fmi3Instance, state: fmi3FMUState) -> Fmi3Status {
-    status3(super::set_fmu_state_as::<M>(Function::Fmi3SetFMUState, instance, state))
+pub unsafe fn set_fmu_state<M: Model>(function: Function, instance: fmi3Instance, state: fmi3FMUState) -> Fmi3Status {
+    status3(super::set_fmu_state_as::<M>(function, instance, state))
 }
 
-pub unsafe fn free_fmu_state<M: Model>(instance: fmi3Instance, state: *mut fmi3FMUState) -> Fmi3Status {
-    status3(super::free_fmu_state_as::<M>(Function::Fmi3FreeFMUState, instance, state))
+pub unsafe fn free_fmu_state<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    state: *mut fmi3FMUState,
+) -> Fmi3Status {
+    status3(super::free_fmu_state_as::<M>(function, instance, state))
 }
 
 pub unsafe fn serialized_fmu_state_size<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     state: fmi3FMUState,
     size: *mut usize,
 ) -> Fmi3Status {
-    status3(super::serialized_fmu_state_size_as::<M>(Function::Fmi3SerializedFMUStateSize, instance, state, size))
+    status3(super::serialized_fmu_state_size_as::<M>(function, instance, state, size))
 }
 
 pub unsafe fn serialize_fmu_state<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     state: fmi3FMUState,
     bytes: *mut fmi3Byte,
     size: usize,
 ) -> Fmi3Status {
-    status3(super::serialize_fmu_state_as::<M>(
-        Function::Fmi3SerializeFMUState,
-        instance,
-        state,
-        bytes as *mut crate::ffi::fmi2Byte,
-        size,
-    ))
+    status3(super::serialize_fmu_state_as::<M>(function, instance, state, bytes as *mut crate::ffi::fmi2Byte, size))
 }
 
 pub unsafe fn deserialize_fmu_state<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     bytes: *const fmi3Byte,
     size: usize,
     state: *mut fmi3FMUState,
 ) -> Fmi3Status {
-    status3(super::deserialize_fmu_state_as::<M>(
-        Function::Fmi3DeserializeFMUState,
-        instance,
-        bytes as *const crate::ffi::fmi2Byte,
-        size,
-        state,
-    ))
+    status3(super::deserialize_fmu_state_as::<M>(function, instance, bytes as *const crate::ffi::fmi2Byte, size, state))
 }
 
 // ------------------------------------------------------------------ partial derivatives
 
-/// `fmi3GetDirectionalDerivative`: `sensitivity = J seed`, `J` the partial derivatives of
-/// the unknowns with respect to the knowns.
-pub unsafe fn get_directional_derivative<M: Model>(
+/// `fmi3GetDirectionalDerivative` (`sensitivity = J seed`, a seed per known) and
+/// `fmi3GetAdjointDerivative` (`sensitivity = J^T seed`, a seed per unknown, exact from J's
+/// columns: [`Instance::adjoint_derivative`]), `J` the partial derivatives of the unknowns
+/// with respect to the knowns.
+pub unsafe fn get_partial_derivatives<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     unknowns: *const fmi3ValueReference,
     n_unknowns: usize,
@@ -636,11 +600,17 @@ pub unsafe fn get_directional_derivative<M: Model>(
     sensitivity: *mut fmi3Float64,
     n_sensitivity: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetDirectionalDerivative, |comp| {
-        if n_seed != n_knowns || n_sensitivity != n_unknowns {
+    let adjoint = function == Function::Fmi3GetAdjointDerivative;
+    with3::<M>(instance, function, |comp| {
+        let ((seeded, n_seeded), (sensed, n_sensed)) = if adjoint {
+            (("unknowns", n_unknowns), ("knowns", n_knowns))
+        } else {
+            (("knowns", n_knowns), ("unknowns", n_unknowns))
+        };
+        if n_seed != n_seeded || n_sensitivity != n_sensed {
             return Err(format!(
-                "nSeed = {n_seed} and nSensitivity = {n_sensitivity} refused: the {n_knowns} knowns and \
-                 {n_unknowns} unknowns are scalars, so nSeed must be {n_knowns} and nSensitivity {n_unknowns}"
+                "nSeed = {n_seed} and nSensitivity = {n_sensitivity} refused: the {n_seeded} {seeded} and \
+                 {n_sensed} {sensed} are scalars, so nSeed must be {n_seeded} and nSensitivity {n_sensed}"
             )
             .into());
         }
@@ -648,42 +618,18 @@ pub unsafe fn get_directional_derivative<M: Model>(
         let knowns = comp.instance.real_references(slice(knowns, n_knowns, "knowns")?)?;
         let seed = slice(seed, n_seed, "seed")?;
         let out = slice_mut(sensitivity, n_sensitivity, "sensitivity")?;
-        comp.instance.directional_derivative(&unknowns, &knowns, seed, out)
-    })
-}
-
-/// `fmi3GetAdjointDerivative`: `sensitivity = J^T seed` (seed per unknown, sensitivity per
-/// known), exact from J's columns ([`Instance::adjoint_derivative`]).
-pub unsafe fn get_adjoint_derivative<M: Model>(
-    instance: fmi3Instance,
-    unknowns: *const fmi3ValueReference,
-    n_unknowns: usize,
-    knowns: *const fmi3ValueReference,
-    n_knowns: usize,
-    seed: *const fmi3Float64,
-    n_seed: usize,
-    sensitivity: *mut fmi3Float64,
-    n_sensitivity: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetAdjointDerivative, |comp| {
-        if n_seed != n_unknowns || n_sensitivity != n_knowns {
-            return Err(format!(
-                "nSeed = {n_seed} and nSensitivity = {n_sensitivity} refused: the {n_unknowns} unknowns and \
-                 {n_knowns} knowns are scalars, so nSeed must be {n_unknowns} and nSensitivity {n_knowns}"
-            )
-            .into());
+        if adjoint {
+            comp.instance.adjoint_derivative(&unknowns, &knowns, seed, out)
+        } else {
+            comp.instance.directional_derivative(&unknowns, &knowns, seed, out)
         }
-        let unknowns = comp.instance.real_references(slice(unknowns, n_unknowns, "unknowns")?)?;
-        let knowns = comp.instance.real_references(slice(knowns, n_knowns, "knowns")?)?;
-        let seed = slice(seed, n_seed, "seed")?;
-        let out = slice_mut(sensitivity, n_sensitivity, "sensitivity")?;
-        comp.instance.adjoint_derivative(&unknowns, &knowns, seed, out)
     })
 }
 
 // ------------------------------------------------------------------ Model Exchange
 
 pub unsafe fn update_discrete_states<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     discrete_states_need_update: *mut fmi3Boolean,
     terminate_simulation: *mut fmi3Boolean,
@@ -692,7 +638,7 @@ pub unsafe fn update_discrete_states<M: Model>(
     next_event_time_defined: *mut fmi3Boolean,
     next_event_time: *mut fmi3Float64,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3UpdateDiscreteStates, |comp| {
+    with3::<M>(instance, function, |comp| {
         let need = out_ptr(discrete_states_need_update, "discreteStatesNeedUpdate")?;
         let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
         let nominals = out_ptr(nominals_changed, "nominalsOfContinuousStatesChanged")?;
@@ -713,17 +659,18 @@ pub unsafe fn update_discrete_states<M: Model>(
     })
 }
 
-pub unsafe fn enter_continuous_time_mode<M: Model>(instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3EnterContinuousTimeMode, |comp| comp.instance.enter_continuous_time_mode())
+pub unsafe fn enter_continuous_time_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.enter_continuous_time_mode())
 }
 
 pub unsafe fn completed_integrator_step<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     _no_set_prior: fmi3Boolean,
     enter_event_mode: *mut fmi3Boolean,
     terminate_simulation: *mut fmi3Boolean,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3CompletedIntegratorStep, |_| {
+    with3::<M>(instance, function, |_| {
         let enter = out_ptr(enter_event_mode, "enterEventMode")?;
         let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
         *enter = FMI3_FALSE;
@@ -732,63 +679,88 @@ pub unsafe fn completed_integrator_step<M: Model>(
     })
 }
 
-pub unsafe fn set_time<M: Model>(instance: fmi3Instance, time: fmi3Float64) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetTime, |comp| comp.instance.set_time(time))
+pub unsafe fn set_time<M: Model>(function: Function, instance: fmi3Instance, time: fmi3Float64) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.set_time(time))
 }
 
-pub unsafe fn set_continuous_states<M: Model>(instance: fmi3Instance, x: *const fmi3Float64, nx: usize) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3SetContinuousStates, |comp| {
+pub unsafe fn set_continuous_states<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    x: *const fmi3Float64,
+    nx: usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
         let x = slice(x, nx, "continuousStates")?;
         comp.instance.set_continuous_states(x)
     })
 }
 
 pub unsafe fn get_continuous_state_derivatives<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     dx: *mut fmi3Float64,
     nx: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetContinuousStateDerivatives, |comp| {
+    with3::<M>(instance, function, |comp| {
         let out = slice_mut(dx, nx, "derivatives")?;
         comp.instance.get_derivatives(out)
     })
 }
 
-pub unsafe fn get_event_indicators<M: Model>(instance: fmi3Instance, z: *mut fmi3Float64, n: usize) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetEventIndicators, |comp| {
+pub unsafe fn get_event_indicators<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    z: *mut fmi3Float64,
+    n: usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
         let out = slice_mut(z, n, "eventIndicators")?;
         comp.instance.get_event_indicators(out)
     })
 }
 
-pub unsafe fn get_continuous_states<M: Model>(instance: fmi3Instance, x: *mut fmi3Float64, nx: usize) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetContinuousStates, |comp| {
+pub unsafe fn get_continuous_states<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    x: *mut fmi3Float64,
+    nx: usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
         let out = slice_mut(x, nx, "continuousStates")?;
         comp.instance.get_continuous_states(out)
     })
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     x: *mut fmi3Float64,
     nx: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetNominalsOfContinuousStates, |comp| {
+    with3::<M>(instance, function, |comp| {
         let out = slice_mut(x, nx, "nominals")?;
         comp.instance.get_nominals(out)
     })
 }
 
-pub unsafe fn get_number_of_event_indicators<M: Model>(instance: fmi3Instance, n: *mut usize) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetNumberOfEventIndicators, |_| {
+pub unsafe fn get_number_of_event_indicators<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    n: *mut usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |_| {
         // no state events: the ModelStructure lists no <EventIndicator>
         *out_ptr(n, "nEventIndicators")? = 0;
         Ok(())
     })
 }
 
-pub unsafe fn get_number_of_continuous_states<M: Model>(instance: fmi3Instance, n: *mut usize) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3GetNumberOfContinuousStates, |_| {
+pub unsafe fn get_number_of_continuous_states<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    n: *mut usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |_| {
         *out_ptr(n, "nContinuousStates")? = M::declaration().number_of_states();
         Ok(())
     })
@@ -801,6 +773,7 @@ pub unsafe fn get_number_of_continuous_states<M: Model>(instance: fmi3Instance, 
 /// (a sampled model's last sample is due) or the model asked to end it (a Discard then, as
 /// in FMI 2.0); `lastSuccessfulTime` the instance's time after the call.
 pub unsafe fn do_step<M: Model>(
+    function: Function,
     instance: fmi3Instance,
     current: fmi3Float64,
     step: fmi3Float64,
@@ -810,7 +783,7 @@ pub unsafe fn do_step<M: Model>(
     early_return: *mut fmi3Boolean,
     last_successful_time: *mut fmi3Float64,
 ) -> Fmi3Status {
-    with3::<M>(instance, Function::Fmi3DoStep, |comp| {
+    with3::<M>(instance, function, |comp| {
         let event = out_ptr(event_handling_needed, "eventHandlingNeeded")?;
         let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
         let early = out_ptr(early_return, "earlyReturn")?;

@@ -1,8 +1,9 @@
 //! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): [`fmi2`],
 //! every `fmi2*` function, and [`fmi3`], every `fmi3*` function, each as a generic
-//! `unsafe fn` over the model type; [`crate::export_fmi!`] instantiates both as unmangled
-//! `extern "C"` symbols of one library. The FMI 2.0 ones are re-exported here too
-//! (`abi::get_real` is `abi::fmi2::get_real`).
+//! `unsafe fn` over the model type taking the [`Function`] it serves first; [`table`]
+//! lists them, and [`crate::export_fmi!`] instantiates the table as unmangled `extern "C"`
+//! symbols of one library. The FMI 2.0 ones are re-exported here too (`abi::get` is
+//! `abi::fmi2::get`).
 //!
 //! Rules kept here, and only here: null pointers and lengths are checked before a slice
 //! is made, panics are caught at every entry point, every error is logged through the
@@ -12,6 +13,7 @@
 
 pub mod fmi2;
 pub mod fmi3;
+pub mod table;
 
 /// `fmi2EventInfo` (from `fmi-sys`).
 pub use crate::ffi::Fmi2EventInfo;

@@ -129,10 +129,11 @@ def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fm
     assert abs(r["plant.y"][0] - rows["y"][1]) > 0.0
     assert abs(eps_fmpy - eps_jacobi) > 1e-7 * eps_jacobi, "the zero start of the connections shows"
     rel = abs(eps_fmpy - eps_jacobi) / eps_jacobi
-    doc_check("README.md", "| fmpy 0.3.32 `simulate_ssp` | {} | {} | {} % |", eps_fmpy, rel,
+    doc_check("docs/table3.md", "| fmpy 0.3.32 `simulate_ssp` | {} | {} | {} % |", eps_fmpy, rel,
               100 * abs(eps_fmpy - eps_ordered) / eps_ordered)
-    doc_check("README.md", "fmpy's epsilon equals ours to {} relative", rel)
-    doc_check("README.md", "so its first millisecond sees mu = 0 and no wind: {} from `jacobi`", rel)
+    doc_check("docs/cosim.md", "fmpy's epsilon equals ours to {} relative", rel)
+    doc_check("README.md", "fmpy, which starts every connection at 0, to {}:", rel)
+    doc_check("docs/table3.md", "so its first millisecond sees mu = 0 and no wind: {} from `jacobi`", rel)
     doc_check("cosim/README.md", "fmpy's epsilon is ours (`jacobi`) to {} relative", rel)
     doc_check("docs/fmi-notes.md", "({} relative in epsilon)", rel)
     doc_check("cosim/README.md", "| fmpy 0.3.32 `simulate_ssp`, same `.ssp` (records all every step) |{*}| {} | {}, {}, {} |",
@@ -155,10 +156,10 @@ def test_fmpy_with_the_initial_outputs_propagated_equals_our_jacobi(ours, fmpy_r
     assert abs(eps_init - eps_ordered) <= 0.02 * eps_ordered
     rel = abs(eps_init - eps_jacobi) / eps_jacobi
     # rounding (the summation order of fmpy's and our loops): printed as a bound
-    doc_check("README.md", "| fmpy, initial outputs propagated | {} | < {*} | {} % |", eps_init,
+    doc_check("docs/table3.md", "| fmpy, initial outputs propagated | {} | < {*} | {} % |", eps_init,
               100 * abs(eps_init - eps_ordered) / eps_ordered)
-    doc_check_at_most("README.md", "| fmpy, initial outputs propagated |{*}| < {} |", rel)
-    doc_check_at_most("README.md", "equals our `jacobi` to {}, which proves the explanation", rel)
+    doc_check_at_most("docs/table3.md", "| fmpy, initial outputs propagated |{*}| < {} |", rel)
+    doc_check_at_most("docs/table3.md", "equals our `jacobi` to {}, which proves the explanation", rel)
     # and the one change is what moved it: plain fmpy is 1e4 times farther from our jacobi
     eps_plain = pose_epsilon(fmpy_run)
     assert abs(eps_plain - eps_jacobi) > 1e3 * max(abs(eps_init - eps_jacobi), 1e-15 * eps_jacobi)

@@ -1,6 +1,6 @@
 //! The communication algorithms: how the instances are stepped and their connections
 //! carried over one communication step. Each is one file implementing [`Communication`];
-//! the driver (`simulate/driver.rs`) initializes the run, then hands the steps to the
+//! the execution (`simulate/execution.rs`) initializes the run, then hands the steps to the
 //! algorithm, which tells the observers after each step.
 
 mod jacobi;
@@ -17,6 +17,7 @@ use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::Lane;
 use crate::simulate::me_group::MeGroup;
 use crate::simulate::observer::{Observers, Profiler};
+use std::ops::Range;
 
 /// What an algorithm works on: the instances, the value buffer of the plan, the coupled
 /// Model Exchange group and the time base.
@@ -51,13 +52,14 @@ pub(crate) trait Communication {
         Ok(())
     }
 
-    /// Every step of the run, the observers told after each.
-    fn run(&mut self, core: &mut Core, observers: &mut Observers) -> Result<()> {
-        for n in 0..core.clock.steps {
+    /// The steps `steps` of the run, the observers told after each (the caller calls
+    /// `finish` after the last step of the run).
+    fn run(&mut self, core: &mut Core, observers: &mut Observers, steps: Range<u64>) -> Result<()> {
+        for n in steps {
             let p = core.clock.point(n);
             self.step(core, p, observers.calls())?;
             observers.step_complete(&p, &core.values)?;
         }
-        self.finish(core)
+        Ok(())
     }
 }

@@ -253,22 +253,22 @@ impl Communication for ThreadedJacobi {
         Jacobi.finish(core)
     }
 
-    fn run(&mut self, core: &mut Core, observers: &mut Observers) -> Result<()> {
+    fn run(&mut self, core: &mut Core, observers: &mut Observers, range: Range<u64>) -> Result<()> {
         let threads = if core.group.is_some() { 1 } else { self.threads.min(core.lanes.len()) };
-        let steps = core.clock.steps;
-        let mut first = 0;
+        let steps = range.end;
+        let mut first = range.start;
         if threads > 1 {
             // a few steps in one thread to measure each instance's cost, then the
             // instances spread over the threads by that cost
-            let calibration = steps.min(CALIBRATION_STEPS);
+            let calibration = steps.min(first + CALIBRATION_STEPS);
             let calibration_start = std::time::Instant::now();
-            for n in 0..calibration {
+            for n in first..calibration {
                 let p = core.clock.point(n);
                 Jacobi::step_lanes(core, p, true)?;
                 observers.step_complete(&p, &core.values)?;
             }
+            let serial_step = calibration_start.elapsed() / (calibration - first).max(1) as u32;
             first = calibration;
-            let serial_step = calibration_start.elapsed() / calibration.max(1) as u32;
             if first < steps {
                 let pool = Pool { threads, solver: core.solver, profile: core.profile, serial_step };
                 let lanes = std::mem::take(&mut core.lanes);
@@ -276,7 +276,7 @@ impl Communication for ThreadedJacobi {
                 let (back, next) = pool.run(lanes, &mut core.values, &clock, first..steps, observers);
                 core.lanes = back;
                 let next = next?;
-                core.parallel_steps = next - first;
+                core.parallel_steps += next - first;
                 first = next;
             }
         }
@@ -285,6 +285,6 @@ impl Communication for ThreadedJacobi {
             Jacobi.step(core, p, None)?;
             observers.step_complete(&p, &core.values)?;
         }
-        self.finish(core)
+        Ok(())
     }
 }

@@ -13,7 +13,10 @@
 //! The Jacobian of each member: with `providesDirectionalDerivative`, one
 //! `fmi2GetDirectionalDerivative` (unknowns: the state derivatives, knowns: the states)
 //! per group of columns sharing no row in the ModelStructure's derivative dependencies;
-//! else one forward difference of the right-hand side per such group.
+//! else one forward difference of the right-hand side per such group. At its first use
+//! the FMU's Jacobian is checked against those differences ([`agrees`]); when they
+//! disagree the member uses the differences for the rest of the run, and a note says so
+//! (an FMU whose directional derivatives are wrong must not steer the Newton iteration).
 
 use super::{MeGroup, Members};
 use crate::bdf::{Bdf, Colouring, OdeSystem};
@@ -29,6 +32,10 @@ struct MemberJacobian {
     derivative_vrs: Vec<u32>,
     state_vrs: Vec<u32>,
     directional: bool,
+    /// The FMU's Jacobian was compared with finite differences (at its first use).
+    checked: bool,
+    /// The note when it disagreed (taken into the member's [`MeUnit::notes`]).
+    note: Option<String>,
     seed: Vec<f64>,
     column: Vec<f64>,
     x: Vec<f64>,
@@ -61,6 +68,8 @@ impl MemberJacobian {
             derivative_vrs: derivatives.iter().take(n).map(|d| vr(*d)).collect(),
             state_vrs: states.iter().map(|s| vr(*s)).collect(),
             directional,
+            checked: false,
+            note: None,
             seed: vec![0.0; n],
             column: vec![0.0; n],
             x: vec![0.0; n],
@@ -79,6 +88,8 @@ pub(crate) struct GroupBdf {
     started: bool,
     /// Right-hand sides of the finite-difference Jacobians.
     difference_rhs: u64,
+    /// Right-hand sides of the first-use checks of the FMUs' Jacobians.
+    check_rhs: u64,
     x: Vec<f64>,
     /// Steps may pass the communication points (no member has an input, so nothing
     /// changes there): the states at a point come from the dense output.
@@ -97,6 +108,8 @@ struct GroupSystem<'a, L: Members + ?Sized> {
     /// magnitude below which it is taken of `floor` instead (atol / rtol).
     floor: f64,
     difference_rhs: &'a mut u64,
+    /// Right-hand sides of the first-use checks of the FMUs' Jacobians.
+    check_rhs: &'a mut u64,
 }
 
 impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
@@ -131,29 +144,95 @@ impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
                         }
                     }
                 }
-            } else {
-                mj.x.copy_from_slice(&x[a..b]);
-                let rel = f64::EPSILON.sqrt();
-                for group in &mj.colouring.groups {
-                    for &j in group {
-                        // an increment exact in binary: the difference of the two states
-                        let step = rel * (x[a + j].abs() + self.floor);
-                        mj.x[j] = x[a + j] + step;
-                        mj.seed[j] = mj.x[j] - x[a + j];
-                    }
-                    MeUnit::derivatives(inst, t, &mj.x, &mut mj.f)?;
-                    *self.difference_rhs += 1;
-                    for &j in group {
-                        for &i in &mj.colouring.rows[j] {
-                            jac[(a + i, a + j)] = (mj.f[i] - f[a + i]) / mj.seed[j];
-                        }
-                        mj.x[j] = x[a + j];
-                    }
+                if mj.checked {
+                    continue;
                 }
+                mj.checked = true;
+                let provided = jac.view((a, a), (b - a, b - a)).clone_owned();
+                differences(inst, mj, t, &x[a..b], &f[a..b], self.floor, jac, a, self.check_rhs)?;
+                let differenced = jac.view((a, a), (b - a, b - a)).clone_owned();
+                match disagreement(&provided, &differenced) {
+                    Some((i, j)) => {
+                        mj.directional = false;
+                        let name = |vrs: &[u32], k: usize| format!("value reference {}", vrs[k]);
+                        mj.note = Some(format!(
+                            "{}: fmi2GetDirectionalDerivative gives d der / d x = {:e} for the derivative ({}) with \
+                             respect to the state ({}) at t = {t} s where finite differences give {:e}: bdf uses \
+                             finite differences for it",
+                            inst.name(),
+                            provided[(i, j)],
+                            name(&mj.derivative_vrs, i),
+                            name(&mj.state_vrs, j),
+                            differenced[(i, j)]
+                        ));
+                    }
+                    // the FMU's own, as it is used from here on
+                    None => jac.view_mut((a, a), (b - a, b - a)).copy_from(&provided),
+                }
+            } else {
+                differences(inst, mj, t, &x[a..b], &f[a..b], self.floor, jac, a, self.difference_rhs)?;
             }
         }
         Ok(())
     }
+}
+
+/// One member's Jacobian by forward differences of its right-hand side at `x` (where it
+/// is `f`), one per colour group, into `jac` from row and column `a`; `rhs` counts them.
+#[allow(clippy::too_many_arguments)]
+fn differences(
+    inst: &mut Instance,
+    mj: &mut MemberJacobian,
+    t: f64,
+    x: &[f64],
+    f: &[f64],
+    floor: f64,
+    jac: &mut DMatrix<f64>,
+    a: usize,
+    rhs: &mut u64,
+) -> Result<()> {
+    mj.x.copy_from_slice(x);
+    let rel = f64::EPSILON.sqrt();
+    for group in &mj.colouring.groups {
+        for &j in group {
+            // an increment exact in binary: the difference of the two states
+            let step = rel * (x[j].abs() + floor);
+            mj.x[j] = x[j] + step;
+            mj.seed[j] = mj.x[j] - x[j];
+        }
+        MeUnit::derivatives(inst, t, &mj.x, &mut mj.f)?;
+        *rhs += 1;
+        for &j in group {
+            for &i in &mj.colouring.rows[j] {
+                jac[(a + i, a + j)] = (mj.f[i] - f[i]) / mj.seed[j];
+            }
+            mj.x[j] = x[j];
+        }
+    }
+    Ok(())
+}
+
+/// The first entry (row, column) where an FMU's Jacobian `provided` disagrees with the
+/// forward differences `differenced`, if any. A forward difference with the relative
+/// increment sqrt(eps) is off by about sqrt(eps) times the scale of the column's
+/// curvature plus rounding of eps |f| / increment; a tolerance of 1e-3 of the larger
+/// magnitude in the entry's column (and 1e-6 absolute) lets both through while a wrong
+/// entry (a factor, a sign, a missing term of the column's size) does not. A non-finite
+/// value from the FMU always disagrees.
+fn disagreement(provided: &DMatrix<f64>, differenced: &DMatrix<f64>) -> Option<(usize, usize)> {
+    for j in 0..provided.ncols() {
+        let scale = (0..provided.nrows())
+            .map(|i| provided[(i, j)].abs().max(differenced[(i, j)].abs()))
+            .filter(|m| m.is_finite())
+            .fold(0.0, f64::max);
+        for i in 0..provided.nrows() {
+            let (p, d) = (provided[(i, j)], differenced[(i, j)]);
+            if !p.is_finite() || (d.is_finite() && (p - d).abs() > 1e-3 * scale + 1e-6) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
 }
 
 impl MeGroup {
@@ -189,6 +268,7 @@ impl MeGroup {
             jacobians,
             started: false,
             difference_rhs: 0,
+            check_rhs: 0,
             x: vec![0.0; n],
             through,
             crossing: None,
@@ -208,9 +288,14 @@ impl MeGroup {
         let outcome = self.advance_bdf_with(lanes, &mut s, rtol, atol, t, t_end);
         if let Some((_, u)) = lanes.member(self.members[0]) {
             u.stiff = s.bdf.work;
-            u.stiff.rhs += s.difference_rhs;
+            u.stiff.rhs += s.difference_rhs + s.check_rhs;
             u.stiff.jacobian_rhs = s.difference_rhs;
             u.rejected = s.bdf.work.rejected;
+        }
+        for (k, &m) in self.members.iter().enumerate() {
+            if let (Some(note), Some((_, u))) = (s.jacobians[k].note.take(), lanes.member(m)) {
+                u.notes.push(note);
+            }
         }
         self.stiff = Some(s);
         outcome
@@ -239,21 +324,9 @@ impl MeGroup {
             if t >= t_end - eps {
                 return Ok(());
             }
-            let due: Vec<usize> = members
-                .iter()
-                .copied()
-                .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps))
-                .collect();
-            if !due.is_empty() {
-                self.event(lanes, t, "time", &due)?;
+            // time events due now: the event iteration restarts the method
+            if self.time_events_due(lanes, t, eps)? {
                 s.started = false;
-                self.ended(lanes, t)?;
-                if let Some(m) = members.iter().find(|m| next_time_event(lanes, **m).is_some_and(|te| te <= t + eps)) {
-                    return Err(crate::error::Error::Experiment(format!(
-                        "{}: time event at {t} repeats at the same time",
-                        lanes.instance(*m).name()
-                    )));
-                }
                 continue;
             }
             // a step ends at the earliest time event, at the stop time, and, where an input
@@ -266,9 +339,10 @@ impl MeGroup {
                     }
                 }
             }
-            let GroupBdf { bdf, offsets, jacobians, started, difference_rhs, x, crossing, .. } = &mut *s;
+            let GroupBdf { bdf, offsets, jacobians, started, difference_rhs, check_rhs, x, crossing, .. } = &mut *s;
             if bdf.t <= t + eps || !*started {
-                let mut sys = GroupSystem { lanes: &mut *lanes, members, offsets, jacobians, floor, difference_rhs };
+                let mut sys =
+                    GroupSystem { lanes: &mut *lanes, members, offsets, jacobians, floor, difference_rhs, check_rhs };
                 if !*started {
                     for (k, &m) in members.iter().enumerate() {
                         if let Some((_, u)) = sys.lanes.member(m) {

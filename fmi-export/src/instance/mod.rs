@@ -1,0 +1,340 @@
+//! One FMU instance in safe Rust, the same for both generations of the C API: the state
+//! machine (one table, [`crate::states`]), variable access checks (one variable table, the
+//! [`Declaration`], addressed by FMI 2.0 value references per base type or by FMI 3.0
+//! value references), time events, FMU state handling, directional and adjoint
+//! derivatives. The C ABIs in [`crate::abi`] only translate pointers to slices.
+//!
+//! Here: the instance, its construction, the gate every call passes and the calls of
+//! initialization; by concern in the submodules: `values` (get and set, both
+//! generations' value references), `events` (time events, sampling and the
+//! Co-Simulation step), `model_exchange` (the Model Exchange calls), `derivatives`
+//! (partial derivatives and variable dependencies), `fmu_state` (save, restore,
+//! serialize).
+
+mod derivatives;
+mod events;
+mod fmu_state;
+mod model_exchange;
+mod values;
+
+use crate::decl::{Declaration, Start};
+use crate::model::{InstantiateContext, Interface, Model, ModelError};
+use crate::sampled::{instant_tolerance, SampleClock};
+pub use crate::states::{Function, Generation, Machine, Scope};
+use values::CallMemos;
+
+/// Result of the fallible instance operations: the message is logged by the ABI layer.
+pub type OpResult<T = ()> = Result<T, ModelError>;
+
+/// Most event iterations at one time instant before the layer gives up (a model that
+/// keeps asking for another iteration, or keeps scheduling events at the same time).
+pub const MAX_EVENT_ITERATIONS: usize = 1000;
+
+/// The part of an instance a saved FMU state holds (never the callbacks).
+#[derive(Clone)]
+pub struct Core<M> {
+    pub machine: Machine,
+    pub time: f64,
+    pub stop_time: Option<f64>,
+    /// The next time event; in both interfaces the start time right after initialization
+    /// (the initial event).
+    pub next_event: Option<f64>,
+    /// Model Exchange: the model asked for another event iteration.
+    pub iteration_pending: bool,
+    /// The model asked to end the simulation (`fmi2GetBooleanStatus(fmi2Terminated)`).
+    pub terminate_requested: bool,
+    pub model: M,
+    /// A sampled model's clock, from the end of initialization on.
+    pub clock: Option<SampleClock>,
+    /// A sampled model before its sample 0: reads of its discrete outputs run sample 0
+    /// on a copy of the model.
+    pub presample: bool,
+    /// Co-Simulation: the instance before the events at the current time were run
+    /// (lazily, at the first read or step). Setting an input afterwards restores it, so
+    /// the events see the inputs of their own time instant. Held inline (not boxed): a
+    /// sampled model takes this copy at every communication point.
+    pre_event: Option<PreEvent<M>>,
+}
+
+/// What the events at one instant change, kept to undo them ([`Core`]'s `pre_event`).
+#[derive(Clone)]
+struct PreEvent<M> {
+    model: M,
+    next_event: Option<f64>,
+    clock: Option<SampleClock>,
+    presample: bool,
+    terminate_requested: bool,
+}
+
+impl<M: Model> Core<M> {
+    fn new(model: M) -> Self {
+        let presample = model.sample_period().is_some();
+        Core {
+            machine: Machine::Instantiated,
+            time: 0.0,
+            stop_time: None,
+            next_event: None,
+            iteration_pending: false,
+            terminate_requested: false,
+            model,
+            clock: None,
+            presample,
+            pre_event: None,
+        }
+    }
+}
+
+/// A saved FMU state (`fmi2FMUstate`).
+pub type SavedState<M> = Core<M>;
+
+/// One instance of model `M`.
+pub struct Instance<M: Model> {
+    pub context: InstantiateContext,
+    /// The C API the instance was created by: only its functions pass the gate.
+    pub generation: Generation,
+    pub core: Core<M>,
+    /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
+    /// through (0 for another interface's function or a capability the model did not
+    /// declare): the gate of every call as one table lookup; the reasons come from the
+    /// full checks, run only when the table says no.
+    allowed: [u16; Function::ALL.len()],
+    get_memo: CallMemos<M::Binding>,
+    set_memo: CallMemos<M::Binding>,
+}
+
+fn decl<M: Model>() -> &'static Declaration<M::Binding> {
+    M::declaration()
+}
+
+fn err<T>(message: impl Into<String>) -> OpResult<T> {
+    Err(ModelError::Error(message.into()))
+}
+
+/// Time tolerance for "this event is now" ([`instant_tolerance`]).
+fn time_eps(t: f64) -> f64 {
+    instant_tolerance(t)
+}
+
+impl<M: Model> Instance<M> {
+    /// A new instance with every declared start value applied.
+    pub fn new(context: InstantiateContext) -> OpResult<Self> {
+        Self::new_for(context, Generation::Fmi2)
+    }
+
+    /// A new instance for the C API of `generation`.
+    pub fn new_for(context: InstantiateContext, generation: Generation) -> OpResult<Self> {
+        let model = Self::fresh_model(&context)?;
+        let allowed = Function::ALL.map(|f| Self::allowed_states(generation, context.interface, f));
+        Ok(Instance {
+            allowed,
+            generation,
+            get_memo: CallMemos::new(),
+            set_memo: CallMemos::new(),
+            context,
+            core: Core::new(model),
+        })
+    }
+
+    pub fn machine(&self) -> Machine {
+        self.core.machine
+    }
+
+    pub fn time(&self) -> f64 {
+        self.core.time
+    }
+
+    pub fn model(&mut self) -> &mut M {
+        &mut self.core.model
+    }
+
+    pub(super) fn fresh_model(context: &InstantiateContext) -> OpResult<M> {
+        let mut model = M::instantiate(context)?;
+        for v in &decl::<M>().spec.variables {
+            let r = match v.start {
+                Start::None => Ok(()),
+                Start::Real(x) => model.set_real(v.binding, x),
+                Start::Integer(x) => model.set_integer(v.binding, x),
+                Start::Boolean(x) => model.set_boolean(v.binding, x),
+            };
+            r.map_err(|e| format!("start value of {} refused: {e}", v.name))?;
+        }
+        Ok(model)
+    }
+
+    /// The one gate every call passes: the function belongs to this instance's interface,
+    /// the model opted in to it, and the standard allows it in the current state.
+    #[inline]
+    pub fn check_call(&self, function: Function) -> OpResult {
+        if self.allowed[function as usize] & self.core.machine.bit() != 0 {
+            Ok(())
+        } else {
+            self.refuse_call(function)
+        }
+    }
+
+    /// The states in which `function` passes [`Instance::check_call`] for `interface`.
+    fn allowed_states(generation: Generation, interface: Interface, function: Function) -> u16 {
+        Machine::ALL
+            .into_iter()
+            .filter(|&m| Self::call_allowed(generation, interface, function, m).is_ok())
+            .fold(0, |mask, m| mask | m.bit())
+    }
+
+    /// Why `function` is refused now (the table of [`Instance::check_call`] said so).
+    #[cold]
+    #[inline(never)]
+    fn refuse_call(&self, function: Function) -> OpResult {
+        Self::call_allowed(self.generation, self.context.interface, function, self.core.machine)?;
+        err(format!(
+            "{} refused in state {:?} (internal: the call table and the rules disagree)",
+            function.name(),
+            self.core.machine
+        ))
+    }
+
+    /// The full rules of [`Instance::check_call`], with the reason: the function's
+    /// generation, interface and declared features, the model's capabilities and the state
+    /// table of [`crate::states`].
+    pub fn call_allowed(
+        generation: Generation,
+        interface: Interface,
+        function: Function,
+        machine: Machine,
+    ) -> OpResult {
+        if function.generation() != generation {
+            return err(match generation {
+                Generation::Fmi2 => "not available: this instance was created by fmi2Instantiate (FMI 2.0)",
+                Generation::Fmi3 => "not available: this instance was created by an fmi3Instantiate function (FMI 3.0)",
+            });
+        }
+        if let Some(missing) = function.undeclared_feature() {
+            return err(format!("not supported: {missing}"));
+        }
+        if interface == Interface::CoSimulation
+            && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates)
+        {
+            return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
+        }
+        match (function.scope(), interface) {
+            (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
+                return err(format!("not available: this instance was created for {interface:?}"));
+            }
+            _ => {}
+        }
+        let caps = decl::<M>().spec.capabilities;
+        let supported = match function.counterpart().unwrap_or(function) {
+            Function::GetFMUstate | Function::SetFMUstate | Function::FreeFMUstate => caps.fmu_state,
+            Function::SerializedFMUstateSize | Function::SerializeFMUstate | Function::DeSerializeFMUstate => {
+                caps.serialize_fmu_state
+            }
+            Function::GetDirectionalDerivative => caps.directional_derivatives,
+            _ => true,
+        };
+        if !supported {
+            return err(format!(
+                "not supported: {} did not declare this capability",
+                decl::<M>().spec.model_identifier
+            ));
+        }
+        if !function.allowed_in(machine) {
+            return err(format!("not allowed in state {machine:?}"));
+        }
+        Ok(())
+    }
+
+    pub fn setup_experiment(&mut self, tolerance: Option<f64>, start_time: f64, stop_time: Option<f64>) -> OpResult {
+        if !start_time.is_finite() {
+            return err(format!("startTime {start_time} is not finite"));
+        }
+        if let Some(stop) = stop_time {
+            if !stop.is_finite() || !(stop >= start_time) {
+                return err(format!("stopTime {stop} must be finite and not before startTime {start_time}"));
+            }
+        }
+        if let Some(tol) = tolerance {
+            if !(tol > 0.0) || !tol.is_finite() {
+                return err(format!("tolerance {tol} must be finite and > 0"));
+            }
+        }
+        // an f64 time must resolve an instant there: at |t| = f64::MAX the next double is
+        // infinity and every later time would pass as "now"
+        for (what, t) in [("startTime", Some(start_time)), ("stopTime", stop_time)] {
+            if let Some(t) = t.filter(|t| !instant_tolerance(*t).is_finite()) {
+                return err(format!("{what} {t} s is too large: an f64 cannot resolve a later time there"));
+            }
+        }
+        // a stop time past a sampled model's last sample is refused when initialization
+        // ends: the parameter that sets the last sample may still be set before that
+        self.core.time = start_time;
+        self.core.stop_time = stop_time;
+        self.core.model.set_time(start_time);
+        Ok(())
+    }
+
+    /// A sampled model with a last sample: `stop` must not be past it.
+    fn check_stop_within_samples(&self, start: f64, stop: f64) -> OpResult {
+        let model = &self.core.model;
+        let (Some(period), Some(end)) = (model.sample_period(), model.sample_end()) else { return Ok(()) };
+        let clock = SampleClock { start, period, next: 0, end: Some(end) };
+        let end_time = clock.end_time().unwrap_or(start);
+        if stop > end_time + time_eps(end_time) {
+            return err(format!(
+                "stopTime = {stop} s is past the model's last sample at t = {end_time} s \
+                 (sample {} of {period} s from startTime = {start} s, set by {})",
+                end.last, end.variable
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> OpResult {
+        self.core.machine = Machine::InitializationMode;
+        Ok(())
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> OpResult {
+        let start = self.core.time;
+        // the stop time against the last sample with the parameters as set (start values
+        // come after fmi2SetupExperiment), before the model's own work at the end of
+        // initialization
+        let clock = match self.core.model.sample_period() {
+            Some(period) => {
+                if !(period > 0.0 && period.is_finite()) {
+                    return err(format!("the sample period {period} s is not finite and > 0"));
+                }
+                let clock = SampleClock { start, period, next: 0, end: self.core.model.sample_end() };
+                clock.check_resolution(start)?;
+                if let Some(stop) = self.core.stop_time {
+                    self.check_stop_within_samples(start, stop)?;
+                    clock.check_resolution(stop)?;
+                }
+                Some(clock)
+            }
+            None => None,
+        };
+        self.core.model.exit_initialization()?;
+        if let Some(clock) = clock {
+            self.core.clock = Some(clock);
+            self.core.presample = true;
+        }
+        self.core.machine = match self.context.interface {
+            Interface::CoSimulation => Machine::StepComplete,
+            Interface::ModelExchange => Machine::EventMode,
+        };
+        // the initial event, at the start time
+        self.core.next_event = Some(start);
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) -> OpResult {
+        self.core.machine = Machine::Terminated;
+        Ok(())
+    }
+
+    /// Back to `Instantiated` with the start values, keeping name, interface and callbacks.
+    pub fn reset(&mut self) -> OpResult {
+        let model = Self::fresh_model(&self.context)?;
+        self.core = Core::new(model);
+        Ok(())
+    }
+}
