@@ -82,7 +82,7 @@ impl<'a> Worker<'a> {
             apply_start_values(&mut inst, spec)?;
             inst.enter_initialization_mode()?;
             inst.exit_initialization_mode()?;
-            inst.terminate()
+            Ok(inst.terminate()?)
         };
         for spec in &system.instances {
             if let Err(e) = init(spec, Some(self.spec.stop_time)) {

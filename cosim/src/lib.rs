@@ -39,8 +39,17 @@ pub mod bdf;
 pub mod check;
 pub mod compare;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{error, fmi3, fmu, unpack};
+pub use fmi_import::{fmi3, instance, load, unpack};
+/// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
+/// [`load`] in one place, as the master uses them).
+pub mod fmu {
+    pub use fmi_import::fmu::*;
+    pub use fmi_import::instance::{FmuState, Instance, InstanceState};
+    pub use fmi_import::load::{read_fmi3_description, read_model_description};
+    pub use fmi_import::EventInfo;
+}
 pub mod defaults;
+pub mod error;
 pub mod exit_guard;
 pub mod junit;
 pub mod loops;
@@ -61,7 +70,7 @@ pub mod isolate {
     pub mod whole;
 }
 
-pub use error::{Error, HostEnd, Result, Status};
+pub use error::{Error, HostEnd, ImportError, Result, Status};
 pub use exit_guard::{on_exit_inside_call, ExitInsideCall};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;

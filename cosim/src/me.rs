@@ -181,7 +181,7 @@ impl MeUnit {
         if x.is_empty() {
             return Ok(());
         }
-        inst.set_continuous_states(x)
+        Ok(inst.set_continuous_states(x)?)
     }
 
     /// `fmi2GetEventIndicators`, not called with no event indicators.
@@ -189,7 +189,7 @@ impl MeUnit {
         if z.is_empty() {
             return Ok(());
         }
-        inst.get_event_indicators(z)
+        Ok(inst.get_event_indicators(z)?)
     }
 
     /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).

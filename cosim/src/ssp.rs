@@ -167,8 +167,10 @@ impl Flattener<'_> {
             }
             crate::unpack::ArchiveSource::File(file) => {
                 crate::unpack::read_text_file(&file, source, limit).map_err(|e| match e {
-                    Error::Io { source: io, .. } => self.err(format!("{what}: {source:?} ({}): {io}", file.display())),
-                    other => other,
+                    crate::ImportError::Io { source: io, .. } => {
+                        self.err(format!("{what}: {source:?} ({}): {io}", file.display()))
+                    }
+                    other => other.into(),
                 })
             }
         }
@@ -409,13 +411,13 @@ impl Flattener<'_> {
                 }
                 // a missing or unreadable FMU is named by its component and the package
                 let f = Fmu::load_from(&origin, &options).map_err(|e| match e {
-                    Error::Io { path, source: io } => {
+                    crate::ImportError::Io { path, source: io } => {
                         self.err(format!("{what}: cannot read its source {source:?} ({}): {io}", path.display()))
                     }
-                    e @ (Error::Archive { .. } | Error::NotRegularFile { .. } | Error::MissingBinary { .. }) => {
-                        self.err(format!("{what} (source {source:?}): {e}"))
-                    }
-                    other => other,
+                    e @ (crate::ImportError::Archive { .. }
+                    | crate::ImportError::NotRegularFile { .. }
+                    | crate::ImportError::MissingBinary { .. }) => self.err(format!("{what} (source {source:?}): {e}")),
+                    other => other.into(),
                 })?;
                 self.fmus.insert(file.clone(), f.clone());
                 f
@@ -674,8 +676,9 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         // every header checked first; then only the .ssd, the .ssv files named and the
         // FMUs are read, straight from the archive
         let file = crate::unpack::open_regular(path)?;
-        let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file))
-            .map_err(|e| Error::Archive { path: path.to_path_buf(), reason: e.to_string() })?;
+        let mut zip = zip::ZipArchive::new(std::io::BufReader::with_capacity(64 * 1024, file)).map_err(|e| {
+            Error::Import(crate::ImportError::Archive { path: path.to_path_buf(), reason: e.to_string() })
+        })?;
         let entries: HashMap<PathBuf, String> = crate::unpack::check_entries(&mut zip, path, &options.limits)?
             .into_iter()
             .map(|e| (e.rel, e.name))

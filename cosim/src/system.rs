@@ -198,7 +198,7 @@ impl System {
             (1, _) => Ok(found.remove(0)),
             (0, Some((i, dot))) => Err(self.unknown_variable(i, &full[dot + 1..])),
             (0, None) => Err(self.no_instance(full)),
-            _ => Err(Error::InvalidValue {
+            _ => Err(Error::Import(crate::ImportError::InvalidValue {
                 variable: full.into(),
                 value: String::new(),
                 reason: format!(
@@ -213,7 +213,7 @@ impl System {
                         .collect::<Vec<_>>()
                         .join(" and as ")
                 ),
-            }),
+            })),
         }
     }
 
@@ -356,13 +356,16 @@ impl SystemBuilder {
     /// element names of a flattened nested system); returns its index.
     pub fn add_instance(&mut self, name: &str, fmu: Arc<Fmu>) -> Result<usize> {
         if name.is_empty() || name.contains('\0') || name.split('.').any(|p| p.is_empty()) {
-            return Err(Error::Instance {
+            return Err(Error::Import(crate::ImportError::Instance {
                 name: name.into(),
                 reason: "instance names are non-empty dotted paths without NUL",
-            });
+            }));
         }
         if self.names.contains_key(name) {
-            return Err(Error::Instance { name: name.into(), reason: "instance name used twice" });
+            return Err(Error::Import(crate::ImportError::Instance {
+                name: name.into(),
+                reason: "instance name used twice",
+            }));
         }
         let i = self.system.instances.len();
         self.system.instances.push(InstanceSpec { name: name.into(), fmu, start_values: Vec::new() });
@@ -374,7 +377,13 @@ impl SystemBuilder {
     pub fn set(&mut self, variable: &str, value: Value) -> Result<&mut Self> {
         let r = self.system.resolve(variable)?;
         let v = self.system.variable(&r);
-        let bad = |reason: String| Error::InvalidValue { variable: variable.into(), value: value.to_string(), reason };
+        let bad = |reason: String| {
+            Error::Import(crate::ImportError::InvalidValue {
+                variable: variable.into(),
+                value: value.to_string(),
+                reason,
+            })
+        };
         let value = match (r.base_type, &value) {
             (BaseType::Real, Value::Integer(i)) => Value::Real(f64::from(*i)),
             (t, v) if t == v.base_type() => v.clone(),
@@ -432,11 +441,11 @@ impl SystemBuilder {
             let items: Vec<&str> =
                 inner.split(|c: char| c == ',' || c == ';' || c.is_whitespace()).filter(|s| !s.is_empty()).collect();
             if items.len() != elements.len() {
-                return Err(Error::InvalidValue {
+                return Err(Error::Import(crate::ImportError::InvalidValue {
                     variable: variable.into(),
                     value: text.into(),
                     reason: format!("{} values for the {} elements of the array", items.len(), elements.len()),
-                });
+                }));
             }
             for (element, item) in elements.iter().zip(items) {
                 self.set_text(element, item)?;
@@ -444,17 +453,19 @@ impl SystemBuilder {
             return Ok(self);
         }
         let r = self.system.resolve(variable)?;
-        let value = Value::parse(r.base_type, text).map_err(|reason| Error::InvalidValue {
-            variable: variable.into(),
-            value: text.into(),
-            reason: match (r.base_type, self.system.variable(&r).description.as_deref()) {
-                // a switch whose values are listed in its description ("1 open_loop (...), 2 ...")
-                (BaseType::Integer, Some(d)) => match listed_value(d, text.trim()) {
-                    Some(k) => format!("{reason}; {text:?} is value {k} of this Integer: set {variable}={k}"),
-                    None => format!("{reason} (its description: {d})"),
+        let value = Value::parse(r.base_type, text).map_err(|reason| {
+            Error::Import(crate::ImportError::InvalidValue {
+                variable: variable.into(),
+                value: text.into(),
+                reason: match (r.base_type, self.system.variable(&r).description.as_deref()) {
+                    // a switch whose values are listed in its description ("1 open_loop (...), 2 ...")
+                    (BaseType::Integer, Some(d)) => match listed_value(d, text.trim()) {
+                        Some(k) => format!("{reason}; {text:?} is value {k} of this Integer: set {variable}={k}"),
+                        None => format!("{reason} (its description: {d})"),
+                    },
+                    _ => reason,
                 },
-                _ => reason,
-            },
+            })
         })?;
         self.set(variable, value)
     }

@@ -27,7 +27,7 @@ fn zip_owned(path: &Path, entries: &[(String, Vec<u8>)]) {
 }
 
 fn load(path: &Path, limits: UnpackLimits) -> Result<std::sync::Arc<Fmu>, Error> {
-    Fmu::load_with(path, &ImportOptions { limits, ..ImportOptions::default() })
+    Ok(Fmu::load_with(path, &ImportOptions { limits, ..ImportOptions::default() })?)
 }
 
 #[test]
@@ -54,7 +54,7 @@ fn an_entry_larger_than_its_header_is_refused_at_once() {
     assert_eq!(patched, 2, "local and central size fields");
     std::fs::write(&fmu, bytes).unwrap();
     match load(&fmu, UnpackLimits::default()) {
-        Err(Error::ArchiveLimit { entry, size, limit, limit_name }) => {
+        Err(Error::Import(nigel_cosim::ImportError::ArchiveLimit { entry, size, limit, limit_name })) => {
             assert_eq!(
                 (entry.as_str(), limit, limit_name),
                 ("resources/zeros.bin", 1024, "the size its header declares")
@@ -77,8 +77,10 @@ fn a_zip_bomb_within_the_size_limits_is_refused_by_its_ratio_before_writing() {
     let compressed = std::fs::metadata(&fmu).unwrap().len();
     assert!(compressed < 100_000, "{compressed}"); // deflate packs zeros about 1000:1
     match load(&fmu, UnpackLimits::default()) {
-        Err(e @ Error::ArchiveLimit { limit_name: "max_ratio", .. }) => {
-            let Error::ArchiveLimit { entry, size, limit, .. } = &e else { unreachable!() };
+        Err(e @ Error::Import(nigel_cosim::ImportError::ArchiveLimit { limit_name: "max_ratio", .. })) => {
+            let Error::Import(nigel_cosim::ImportError::ArchiveLimit { entry, size, limit, .. }) = &e else {
+                unreachable!()
+            };
             assert_eq!((entry.as_str(), *limit), ("resources/a.bin", 100));
             assert!(*size > 500, "ratio {size}");
             assert!(e.to_string().contains("--max-ratio"), "{e}");
@@ -93,7 +95,7 @@ fn a_zip_bomb_within_the_size_limits_is_refused_by_its_ratio_before_writing() {
     let small = UnpackLimits { max_ratio: 10_000, max_total_bytes: 10 << 20, ..UnpackLimits::default() };
     assert!(matches!(
         load(&dir.join("bomb.fmu"), small),
-        Err(Error::ArchiveLimit { limit_name: "max_total_bytes", .. })
+        Err(Error::Import(nigel_cosim::ImportError::ArchiveLimit { limit_name: "max_total_bytes", .. }))
     ));
 }
 
@@ -114,7 +116,7 @@ fn a_truncated_library_is_refused_before_dlopen() {
             &[("modelDescription.xml", xml.clone()), ("binaries/linux64/nigel_plant.so", so[..cut].to_vec())],
         );
         match Fmu::load(&fmu) {
-            Err(Error::LoadLibrary { path, reason }) => {
+            Err(nigel_cosim::ImportError::LoadLibrary { path, reason }) => {
                 assert!(reason.contains("past the end of the file"), "{what}: {reason}");
                 assert!(path.ends_with("binaries/linux64/nigel_plant.so"), "{}", path.display());
             }
@@ -141,16 +143,19 @@ fn only_regular_files_are_opened() {
         })
     };
     match Fmu::load(&fifo) {
-        Err(e @ Error::NotRegularFile { .. }) => assert!(e.to_string().contains("FIFO"), "{e}"),
+        Err(e @ nigel_cosim::ImportError::NotRegularFile { .. }) => assert!(e.to_string().contains("FIFO"), "{e}"),
         other => panic!("{other:?}"),
     }
     assert!(matches!(
         read_ssp(&dir.join("model.fmu").with_extension("ssp"), &ImportOptions::default()),
-        Err(Error::Io { .. })
+        Err(Error::Import(nigel_cosim::ImportError::Io { .. }))
     ));
     std::fs::rename(&fifo, dir.join("system.ssd")).unwrap();
-    assert!(matches!(read_ssp(&dir.join("system.ssd"), &ImportOptions::default()), Err(Error::NotRegularFile { .. })));
-    assert!(matches!(Fmu::load(&dir), Err(Error::NotRegularFile { .. })));
+    assert!(matches!(
+        read_ssp(&dir.join("system.ssd"), &ImportOptions::default()),
+        Err(Error::Import(nigel_cosim::ImportError::NotRegularFile { .. }))
+    ));
+    assert!(matches!(Fmu::load(&dir), Err(nigel_cosim::ImportError::NotRegularFile { .. })));
     drop(rescuer); // detached: it finds no reader and does nothing
 }
 
@@ -160,7 +165,7 @@ fn xml_size_limit_duplicate_names_and_many_attributes() {
     let xml = Model::Gain.model_description();
     let small = UnpackLimits { max_xml_bytes: 500, ..UnpackLimits::default() };
     match load(&build_fmu(Model::Gain, &dir, &[]), small) {
-        Err(e @ Error::ArchiveLimit { limit_name: "max_xml_bytes", .. }) => {
+        Err(e @ Error::Import(nigel_cosim::ImportError::ArchiveLimit { limit_name: "max_xml_bytes", .. })) => {
             assert!(e.to_string().contains("modelDescription.xml"), "{e}")
         }
         other => panic!("{other:?}"),
@@ -168,7 +173,7 @@ fn xml_size_limit_duplicate_names_and_many_attributes() {
     // two variables called u
     let twice = xml.replace(r#"name="k""#, r#"name="u""#);
     match Fmu::load(&build_fmu_with(Model::Gain, &dir, "twice", &twice)) {
-        Err(Error::ModelDescription { reason, .. }) => {
+        Err(nigel_cosim::ImportError::ModelDescription { reason, .. }) => {
             assert_eq!(reason, "variables 1 and 3 are both called \"u\" (variable names must be unique)")
         }
         other => panic!("{other:?}"),
@@ -180,7 +185,7 @@ fn xml_size_limit_duplicate_names_and_many_attributes() {
     // ... and a repeated one among them is still found and named
     let repeated = xml.replacen("<fmiModelDescription ", &format!("<fmiModelDescription{many} a7=\"x\" "), 1);
     match Fmu::load(&build_fmu_with(Model::Gain, &dir, "repeated", &repeated)) {
-        Err(Error::ModelDescription { reason, .. }) => {
+        Err(nigel_cosim::ImportError::ModelDescription { reason, .. }) => {
             assert!(reason.contains("attribute a7 repeated in <fmiModelDescription>"), "{reason}")
         }
         other => panic!("{other:?}"),
@@ -420,8 +425,12 @@ fn non_finite_outputs_are_refused_at_their_source() {
             let mut e = nigel_cosim::Experiment::new(1.0, 0.125);
             e.algorithm = algorithm;
             match nigel_cosim::simulate(&system, &e) {
-                Err(err @ Error::NonFinite { .. }) => {
-                    let Error::NonFinite { instance, variable, value, time, .. } = &err else { unreachable!() };
+                Err(err @ Error::Import(nigel_cosim::ImportError::NonFinite { .. })) => {
+                    let Error::Import(nigel_cosim::ImportError::NonFinite { instance, variable, value, time, .. }) =
+                        &err
+                    else {
+                        unreachable!()
+                    };
                     // y turns bad at t_bad = 0.5 s, a communication point (4 steps of 1/8 s: exact)
                     assert_eq!((instance.as_str(), variable.as_str(), *time), ("h", "y", 0.5), "{algorithm:?}");
                     assert_eq!(value.to_string(), shown);

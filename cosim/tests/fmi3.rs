@@ -9,7 +9,7 @@
 
 mod common;
 use common::{work_dir, zip_entries};
-use nigel_cosim::{simulate, Error, Experiment, Fmu, Instance, System, SystemBuilder, Value};
+use nigel_cosim::{simulate, Experiment, Fmu, Instance, System, SystemBuilder, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -233,7 +233,10 @@ fn bad_fmi3_input_is_refused() {
         };
         assert!(e.to_string().contains(expected), "{stem}: {e}");
         if stem == "token" {
-            assert!(matches!(&e, Error::Instantiate { function: "fmi3InstantiateCoSimulation", .. }), "{e:?}");
+            assert!(
+                matches!(&e, nigel_cosim::ImportError::Instantiate { function: "fmi3InstantiateCoSimulation", .. }),
+                "{e:?}"
+            );
         }
     }
 }

@@ -4,7 +4,7 @@
 
 mod common;
 use common::{build_fmu, compile, work_dir, zip_entries, Model};
-use nigel_cosim::{Error, Fmu, ImportOptions, UnpackLimits};
+use nigel_cosim::{Fmu, ImportError as Error, ImportOptions, UnpackLimits};
 use std::io::Write;
 use std::path::Path;
 

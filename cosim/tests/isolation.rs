@@ -133,7 +133,7 @@ fn per_instance_isolation_in_the_library_gives_the_typed_error_and_the_rows() {
     e.isolation = Some(Isolation { instances: Some(vec!["bad".into()]), ..isolation() });
     let (results, outcome) = simulate_recorded(&system, &e);
     match outcome {
-        Err(Error::Host { instance, function, time, cause }) => {
+        Err(Error::Import(nigel_cosim::ImportError::Host { instance, function, time, cause })) => {
             assert_eq!((instance.as_str(), function, time), ("bad", "fmi2DoStep", 0.5));
             assert_eq!(cause, HostEnd::Signal(11));
         }
@@ -221,14 +221,14 @@ fn a_library_that_crashes_while_loading_kills_only_its_host() {
     let imported = Fmu::load_with(&fmu, &ImportOptions { isolated: true, ..Default::default() }).unwrap();
     assert!(imported.is_isolated());
     match Instance::new(&imported, "ctor") {
-        Err(Error::Instance { name, reason }) => {
+        Err(nigel_cosim::ImportError::Instance { name, reason }) => {
             assert_eq!(name, "ctor");
             assert!(reason.contains("imported isolated"), "{reason}");
         }
         other => panic!("in process: {other:?}"),
     }
     match Instance::new_isolated(&imported, "ctor", &isolation(), None) {
-        Err(Error::Host { instance, function, time, cause }) => {
+        Err(nigel_cosim::ImportError::Host { instance, function, time, cause }) => {
             assert_eq!((instance.as_str(), function, time), ("ctor", "fmi2Instantiate (loading the library)", 0.0));
             assert_eq!(cause, HostEnd::Signal(11));
         }

@@ -97,7 +97,7 @@ fn an_error_in_a_worker_thread_is_typed_as_in_one_thread() {
         let mut e = Experiment::new(1.0, 1e-3);
         e.threads = threads;
         match simulate(&b.build(), &e) {
-            Err(Error::Fmi { instance, function, status, time, log }) => {
+            Err(Error::Import(nigel_cosim::ImportError::Fmi { instance, function, status, time, log })) => {
                 assert_eq!((instance.as_str(), function, status), ("bad", "fmi2DoStep", Status::Error));
                 // t_500 = 500 h: the first communication point at or after 0.5
                 assert_eq!(time, Some(500.0 * 1e-3), "threads {threads}");

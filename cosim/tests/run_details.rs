@@ -137,7 +137,9 @@ fn a_run_unpacks_only_what_it_uses_straight_from_the_ssp() {
     let hostile = dir.join("hostile.ssp");
     zip_entries(&hostile, &nested);
     match read_ssp(&hostile, &ImportOptions::default()) {
-        Err(Error::UnsafeEntry { entry, .. }) => assert_eq!(entry, "documentation/../../escaped.txt"),
+        Err(Error::Import(nigel_cosim::ImportError::UnsafeEntry { entry, .. })) => {
+            assert_eq!(entry, "documentation/../../escaped.txt")
+        }
         other => panic!("accepted or wrong error: {:?}", other.map(|_| ())),
     }
     assert!(!dir.join("escaped.txt").exists());

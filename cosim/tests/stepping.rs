@@ -62,7 +62,7 @@ fn an_execution_set_between_steps_acts_from_the_next_step_as_an_input_jump_there
     let mut run = Execution::new(&system, &Experiment::new(1.0, 0.1)).unwrap();
     run.initialize().unwrap();
     let e = run.set("integrator.x", "1").unwrap_err();
-    assert!(matches!(e, Error::InvalidValue { .. }), "{e}");
+    assert!(matches!(e, Error::Import(nigel_cosim::ImportError::InvalidValue { .. })), "{e}");
     assert!(e.to_string().contains("integrator.x"), "{e}");
     // stopped before its end: no finish, the rows kept
     run.simulate_until(0.3).unwrap();
@@ -104,7 +104,7 @@ fn a_value_queued_at_a_row_applies_from_the_next_step_as_an_input_jump_there() {
     assert!((x[10] - 0.5).abs() < 1e-15, "{}", x[10]);
     // what cannot be set during a run is refused when queued, by name
     let e = queue.push_text(&system, "integrator.x", "1").unwrap_err();
-    assert!(matches!(e, Error::InvalidValue { .. }), "{e}");
+    assert!(matches!(e, Error::Import(nigel_cosim::ImportError::InvalidValue { .. })), "{e}");
     assert!(e.to_string().contains("integrator.x"), "{e}");
 }
 

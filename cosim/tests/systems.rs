@@ -104,9 +104,12 @@ fn connections_are_checked_for_causality_type_and_unit() {
     assert!(err(b.connect("src.y", "g_ms.u")).contains("different dimensions"));
     b.connect("src.y", "g_mm.u").unwrap();
     // start values: type and causality
-    assert!(matches!(b.set("amp.k", Value::Boolean(true)), Err(Error::InvalidValue { .. })));
-    assert!(matches!(b.set_text("amp.k", "abc"), Err(Error::InvalidValue { .. })));
-    assert!(matches!(b.set_text("amp.y", "1"), Err(Error::InvalidValue { .. })));
+    assert!(matches!(
+        b.set("amp.k", Value::Boolean(true)),
+        Err(Error::Import(nigel_cosim::ImportError::InvalidValue { .. }))
+    ));
+    assert!(matches!(b.set_text("amp.k", "abc"), Err(Error::Import(nigel_cosim::ImportError::InvalidValue { .. }))));
+    assert!(matches!(b.set_text("amp.y", "1"), Err(Error::Import(nigel_cosim::ImportError::InvalidValue { .. }))));
     b.set_text("amp.k", "3").unwrap();
     let mut e = Experiment::new(0.5, 0.25);
     e.algorithm = Algorithm::Ordered;
@@ -156,7 +159,7 @@ fn an_fmu_failing_mid_run_gives_a_typed_error_naming_it() {
         b.add_instance("bad", fmu.clone()).unwrap();
         b.set("bad.mode", Value::Real(mode)).unwrap();
         match simulate(&b.build(), &Experiment::new(1.0, 0.25)) {
-            Err(Error::Fmi { instance, function, status: s, time, log }) => {
+            Err(Error::Import(nigel_cosim::ImportError::Fmi { instance, function, status: s, time, log })) => {
                 assert_eq!((instance.as_str(), function, s, time), ("bad", "fmi2DoStep", status, Some(0.5)));
                 assert!(log.contains("failing on purpose at t = 0.5"), "{log}");
             }
@@ -170,7 +173,7 @@ fn a_library_without_do_step_is_refused_by_name() {
     let dir = work_dir("nodostep");
     let fmu = build_fmu(Model::Gain, &dir, &["-DOMIT_DOSTEP"]);
     match Fmu::load(&fmu) {
-        Err(Error::MissingSymbol { symbol, .. }) => assert_eq!(symbol, "fmi2DoStep"),
+        Err(nigel_cosim::ImportError::MissingSymbol { symbol, .. }) => assert_eq!(symbol, "fmi2DoStep"),
         other => panic!("expected a missing symbol, got {other:?}"),
     }
 }
@@ -188,7 +191,12 @@ fn a_discarded_step_is_restored_and_retried_in_halves() {
     let mut e = Experiment::new(0.5, 0.1);
     // without retries: a clear error naming the Discard
     match simulate(&system, &e) {
-        Err(Error::Fmi { status: Status::Discard, function: "fmi2DoStep", log, .. }) => {
+        Err(Error::Import(nigel_cosim::ImportError::Fmi {
+            status: Status::Discard,
+            function: "fmi2DoStep",
+            log,
+            ..
+        })) => {
             assert!(log.contains("discarded"), "{log}")
         }
         other => panic!("expected a Discard, got {other:?}"),

@@ -4,14 +4,13 @@
 //! `atexit` handler reads the mark when an FMU ends the process with `exit()` inside a call
 //! ([`current_call`]), and a process that is the host of a whole run or a campaign's worker
 //! also copies it into a region shared with its parent ([`mark_calls_in`]), which reads it
-//! after a crash. The marker holds pointers to the instance's name and its `Fmu`, both
+//! after a crash. The marker holds pointers to the instance's name and its FMU's path, both
 //! alive for the whole call it marks; they are read only in the calling thread. Only
 //! thread-local `Cell`s of `Copy` values are read: they have no destructor, so glibc's run
 //! of thread-local destructors before the `atexit` handlers leaves them intact.
 
-use crate::fmu::Fmu;
 use std::cell::Cell;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicPtr, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 
 /// The call an FMU was in when it called `exit()`.
@@ -19,7 +18,7 @@ use std::sync::atomic::{AtomicPtr, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 pub struct ExitInsideCall {
     /// The instance.
     pub instance: String,
-    /// The FMU's archive ([`Fmu::source`]).
+    /// The FMU's archive ([`Fmu::source`](crate::Fmu::source)).
     pub fmu: PathBuf,
     /// The FMI function.
     pub function: &'static str,
@@ -41,7 +40,7 @@ impl std::fmt::Display for ExitInsideCall {
 #[derive(Clone, Copy)]
 struct Site {
     instance: *const str,
-    fmu: *const Fmu,
+    fmu: *const Path,
     function: &'static str,
     time: f64,
 }
@@ -117,10 +116,10 @@ fn copy_name(dst: &mut [u8; NAME], len: &AtomicU32, s: &str) {
 /// The mark of a call in progress; the previous mark comes back when it is dropped.
 pub(crate) struct InCall(Option<Site>, bool);
 
-/// Marks the call `function` of `instance` (of `fmu`) at `time` as in progress in this
+/// Marks the call `function` of `instance` (of the FMU archive `fmu`) at `time` as in progress in this
 /// thread.
 #[inline]
-pub(crate) fn enter(instance: &str, fmu: &Fmu, function: &'static str, time: f64) -> InCall {
+pub(crate) fn enter(instance: &str, fmu: &Path, function: &'static str, time: f64) -> InCall {
     let site = Site { instance, fmu, function, time };
     let p = SHARED.load(Ordering::Relaxed);
     let shared = !p.is_null();
@@ -165,7 +164,7 @@ pub fn current_call() -> Option<ExitInsideCall> {
     Some(unsafe {
         ExitInsideCall {
             instance: (*site.instance).to_string(),
-            fmu: (*site.fmu).source().to_path_buf(),
+            fmu: (*site.fmu).to_path_buf(),
             function: site.function,
             time: site.time,
         }

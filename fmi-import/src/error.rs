@@ -1,82 +1,12 @@
-//! The one error type of the master: every failure names its cause.
+//! The importing layer's error type: unpacking, loading, instantiating and calling an FMU,
+//! and the host processes of isolated instances. Every failure names its cause.
 
 use std::fmt;
 use std::path::PathBuf;
 
-/// FMI 2.0 status codes (`fmi2Status`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Status {
-    /// `fmi2OK`.
-    Ok,
-    /// `fmi2Warning`.
-    Warning,
-    /// `fmi2Discard`.
-    Discard,
-    /// `fmi2Error`.
-    Error,
-    /// `fmi2Fatal`.
-    Fatal,
-    /// `fmi2Pending` (asynchronous doStep: refused by this master).
-    Pending,
-    /// Any other integer: a broken FMU.
-    Invalid(i32),
-}
+pub use crate::status::Status;
 
-impl Status {
-    /// From the C integer.
-    pub fn from_raw(raw: i32) -> Status {
-        match raw {
-            0 => Status::Ok,
-            1 => Status::Warning,
-            2 => Status::Discard,
-            3 => Status::Error,
-            4 => Status::Fatal,
-            5 => Status::Pending,
-            other => Status::Invalid(other),
-        }
-    }
-
-    /// The C integer.
-    pub fn to_raw(self) -> i32 {
-        match self {
-            Status::Ok => 0,
-            Status::Warning => 1,
-            Status::Discard => 2,
-            Status::Error => 3,
-            Status::Fatal => 4,
-            Status::Pending => 5,
-            Status::Invalid(v) => v,
-        }
-    }
-}
-
-impl Status {
-    /// The status as the generation of `function` spells it: `fmi3Error` after an `fmi3*`
-    /// call, `fmi2Error` otherwise (the two enumerations have the same values).
-    pub fn spelled_for(self, function: &str) -> String {
-        let name = self.to_string();
-        match name.strip_prefix("fmi2") {
-            Some(rest) if function.starts_with("fmi3") => format!("fmi3{rest}"),
-            _ => name,
-        }
-    }
-}
-
-impl fmt::Display for Status {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Status::Ok => f.write_str("fmi2OK"),
-            Status::Warning => f.write_str("fmi2Warning"),
-            Status::Discard => f.write_str("fmi2Discard"),
-            Status::Error => f.write_str("fmi2Error"),
-            Status::Fatal => f.write_str("fmi2Fatal"),
-            Status::Pending => f.write_str("fmi2Pending"),
-            Status::Invalid(v) => write!(f, "invalid status {v}"),
-        }
-    }
-}
-
-/// Everything that can go wrong in import, system building and simulation.
+/// Everything that can go wrong in importing an FMU and calling it.
 #[derive(Debug)]
 pub enum Error {
     /// A file could not be read or written.
@@ -214,41 +144,6 @@ pub enum Error {
         /// What is wrong.
         reason: &'static str,
     },
-    /// A variable is unknown in an instance.
-    UnknownVariable {
-        /// The instance.
-        instance: String,
-        /// The variable.
-        variable: String,
-        /// The closest names the instance has (at most 3).
-        closest: Vec<String>,
-    },
-    /// A variable of an FMI 3.0 FMU that the master's view leaves out (see
-    /// [`crate::fmi3::LeftOut`]): it cannot be recorded, set nor connected.
-    NotInView {
-        /// The instance.
-        instance: String,
-        /// The variable.
-        variable: String,
-        /// Why it is left out.
-        reason: crate::fmi3::LeftOut,
-    },
-    /// An instance name is unknown in the system.
-    UnknownInstance {
-        /// The name as given.
-        name: String,
-        /// The instances of the system.
-        instances: Vec<String>,
-    },
-    /// A variable name without the instance it belongs to, in a system of several.
-    NoInstance {
-        /// The name as given.
-        name: String,
-        /// The instances of the system.
-        instances: Vec<String>,
-        /// `instance.variable` names that end in the name given.
-        candidates: Vec<String>,
-    },
     /// A value cannot be given to a variable (wrong type, unparsable, wrong causality).
     InvalidValue {
         /// `instance.variable`.
@@ -257,44 +152,6 @@ pub enum Error {
         value: String,
         /// Why.
         reason: String,
-    },
-    /// A connection is illegal (type, causality, unit, duplicate).
-    Connection {
-        /// `instance.variable` of the source.
-        from: String,
-        /// `instance.variable` of the destination.
-        to: String,
-        /// Why.
-        reason: String,
-    },
-    /// Direct-feedthrough dependencies form a cycle (for the `ordered` algorithm).
-    AlgebraicLoop {
-        /// The variables on the loop, `instance.variable`, in order.
-        variables: Vec<String>,
-    },
-    /// The event iteration of coupled Model Exchange instances found no fixed point: after
-    /// `rounds` rounds of `fmi2NewDiscreteStates` and propagation, `instances` still asked
-    /// for another iteration or had their inputs changed.
-    EventIteration {
-        /// The event time, s.
-        time: f64,
-        /// Rounds done.
-        rounds: usize,
-        /// The instances still not settled.
-        instances: Vec<String>,
-    },
-    /// An FMU ended the simulation itself, as FMI 2 lets it: in Co-Simulation
-    /// `fmi2DoStep` returned fmi2Discard with `fmi2GetBooleanStatus(fmi2Terminated)` true,
-    /// in Model Exchange `terminateSimulation` was set. `nigel_cosim::simulate()` ends the run
-    /// there and returns its results (with `nigel_cosim::Summary::ended_by`); the step
-    /// functions return this variant to it.
-    Terminated {
-        /// The instance that ended the run.
-        instance: String,
-        /// The time the run ends at, s (CS: `fmi2LastSuccessfulTime`; ME: the event).
-        time: f64,
-        /// How the FMU said so.
-        reason: &'static str,
     },
     /// The host process of an isolated instance ended or was killed while the master
     /// waited for a call: the FMU crashed (a signal), exited, or overran a time limit.
@@ -307,32 +164,6 @@ pub enum Error {
         time: f64,
         /// How the host ended.
         cause: HostEnd,
-    },
-    /// The whole run took longer than its time limit (`--timeout`); checked between steps.
-    Timeout {
-        /// The limit.
-        limit: std::time::Duration,
-        /// The simulation time reached, s.
-        time: f64,
-    },
-    /// The caller asked the run to stop ([`Experiment::cancel`](crate::Experiment::cancel));
-    /// checked between steps.
-    Cancelled {
-        /// The simulation time reached, s.
-        time: f64,
-    },
-    /// The experiment is not simulable as given (times, step, output interval).
-    Experiment(String),
-    /// The Model Exchange integration cannot go on with what an FMU returned with OK (a NaN
-    /// state derivative, a NaN next event time, infinite derivatives): the message names
-    /// the instance, its FMU, the call and the time.
-    Integration(String),
-    /// An SSP file is malformed or uses a part this master does not support.
-    Ssp {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong or unsupported, named.
-        reason: String,
     },
 }
 
@@ -465,59 +296,10 @@ impl fmt::Display for Error {
                 write!(f, "{instance}: {function} is not allowed in state {state}")
             }
             Error::Instance { name, reason } => write!(f, "instance {name:?}: {reason}"),
-            Error::UnknownVariable { instance, variable, closest } => {
-                write!(f, "instance {instance:?} has no variable {variable:?}")?;
-                if !closest.is_empty() {
-                    let q: Vec<String> = closest.iter().map(|c| format!("{c:?}")).collect();
-                    write!(f, "; did you mean {}?", q.join(" or "))?;
-                }
-                f.write_str(" (`cosim info` lists the variables)")
-            }
-            Error::NotInView { instance, variable, reason } => write!(
-                f,
-                "variable {variable:?} of instance {instance:?} is {}, which cosim does not record, set nor connect \
-                 (FMI 3.0 String and Binary arrays are outside the master's view; `cosim info` lists what is left out)",
-                reason.as_str()
-            ),
-            Error::UnknownInstance { name, instances } => {
-                write!(f, "the system has no instance {name:?}")?;
-                let close = crate::suggest::closest(name, instances.iter().map(String::as_str));
-                if let Some(c) = close.first() {
-                    write!(f, "; did you mean {c:?}?")?;
-                }
-                write!(f, " (its instances: {})", instances.join(", "))
-            }
-            Error::NoInstance { name, instances, candidates } => {
-                write!(f, "{name:?} names no instance: in a system, variables are named instance.variable")?;
-                match candidates.as_slice() {
-                    [] => write!(f, " (its instances: {})", instances.join(", ")),
-                    [one] => write!(f, "; did you mean {one:?}?"),
-                    many => write!(f, "; {name:?} is in {}", many.join(", ")),
-                }
-            }
             Error::InvalidValue { variable, value, reason } => write!(f, "{variable} = {value:?}: {reason}"),
-            Error::Connection { from, to, reason } => write!(f, "connection {from} -> {to}: {reason}"),
-            Error::AlgebraicLoop { variables } => {
-                write!(f, "algebraic loop (direct feedthrough cycle): {}", variables.join(" -> "))
-            }
-            Error::EventIteration { time, rounds, instances } => write!(
-                f,
-                "the event iteration at t = {time} s did not converge in {rounds} rounds: {} still changing",
-                instances.join(", ")
-            ),
-            Error::Terminated { instance, time, reason } => {
-                write!(f, "{instance} ended the simulation at t = {time} s ({reason})")
-            }
             Error::Host { instance, function, time, cause } => {
                 write!(f, "{instance}: the FMU's host process {cause} during {function} at t = {time} s")
             }
-            Error::Timeout { limit, time } => {
-                write!(f, "the run exceeded its time limit of {} s (--timeout) at t = {time} s", limit.as_secs_f64())
-            }
-            Error::Cancelled { time } => write!(f, "the run was cancelled at t = {time} s"),
-            Error::Experiment(m) => write!(f, "experiment: {m}"),
-            Error::Integration(m) => f.write_str(m),
-            Error::Ssp { path, reason } => write!(f, "{}: {reason}", path.display()),
         }
     }
 }
@@ -541,16 +323,3 @@ impl std::error::Error for Error {
 
 /// `Result` with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
-
-#[cfg(test)]
-mod status_spelling {
-    use super::Status;
-
-    #[test]
-    fn a_status_is_spelled_in_the_generation_of_the_call_that_returned_it() {
-        assert_eq!(Status::Error.spelled_for("fmi3DoStep"), "fmi3Error");
-        assert_eq!(Status::Discard.spelled_for("fmi3SetFloat64"), "fmi3Discard");
-        assert_eq!(Status::Error.spelled_for("fmi2DoStep"), "fmi2Error");
-        assert_eq!(Status::Invalid(7).spelled_for("fmi3DoStep"), "invalid status 7");
-    }
-}

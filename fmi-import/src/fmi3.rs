@@ -1,6 +1,6 @@
 //! What an FMI 3.0 FMU needs beyond the FMI 2.0 import: its function table, its own model
-//! description, the view of it the master's systems, observers and writers see, the log
-//! callback, and what is refused at load.
+//! description, the view of it the master's systems, observers and writers see, and what
+//! is refused at load. The calls on the view's variables are `instance/fmi3.rs`.
 //!
 //! The view is an FMI 2.0-shaped [`ModelDescription`] of the FMU's variables, with the same
 //! names, value references, causalities, variabilities, units and ModelStructure (indices
@@ -18,14 +18,11 @@
 //! [`Fmu::not_in_view`]: crate::Fmu::not_in_view
 
 use std::collections::HashMap;
-use std::ffi::{c_char, CStr, CString};
+use std::ffi::CString;
 
-use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3Status, fmi3String, Fmi3Functions};
+use crate::c_types::Fmi3Functions;
 use model_description::fmi3;
 use model_description::*;
-
-use crate::error::Status;
-use crate::fmu::{LogRecord, LogSink};
 
 /// An FMI 3.0 FMU's functions and description.
 pub(crate) struct Fmi3Abi {
@@ -400,32 +397,6 @@ pub(crate) fn fmi2_view(
         model_structure,
     };
     (view, special, left_out)
-}
-
-fn text(p: fmi3String) -> String {
-    if p.is_null() {
-        return String::new();
-    }
-    // SAFETY: the FMU passes NUL-terminated strings valid for the call.
-    unsafe { CStr::from_ptr(p as *const c_char) }.to_string_lossy().into_owned()
-}
-
-/// `fmi3LogMessageCallback`: the instance environment is the instance's [`LogSink`].
-pub(crate) unsafe extern "C" fn log_message(
-    environment: fmi3InstanceEnvironment,
-    status: fmi3Status,
-    category: fmi3String,
-    message: fmi3String,
-) {
-    if environment.is_null() {
-        return;
-    }
-    // no panic may cross the C boundary: a failure to record drops the message
-    let _ = std::panic::catch_unwind(|| {
-        // SAFETY: the environment is the instance's boxed LogSink, alive while it logs.
-        let sink = unsafe { &*(environment as *const LogSink) };
-        sink.push(LogRecord { status: Status::from_raw(status), category: text(category), message: text(message) });
-    });
 }
 
 /// The resource path FMI 3.0 wants: an absolute native path ending in a separator.

@@ -2,31 +2,70 @@
 //!
 //! - [`unpack`]: FMU and SSP archives unpacked safely (no path escapes, no links, limits
 //!   against archive bombs); [`elf`]: shared libraries checked before they are loaded.
-//! - [`Fmu::load`] reads the archive's model description (FMI 2.0 or FMI 3.0) and resolves
-//!   the functions of its interface; [`Instance`] wraps every call in a typed [`Result`]
-//!   and keeps the state machine, the same calls for both generations ([`fmi3`]: how an
-//!   FMI 3.0 FMU's variables appear to the master).
+//! - [`Fmu::load`] ([`load`]) reads the archive's model description (FMI 2.0 or FMI 3.0)
+//!   and resolves the functions of its interface, one pipeline for both generations;
+//!   [`Instance`] wraps every call in a typed [`Result`] and keeps the state machine, the
+//!   same calls for both generations ([`fmi3`]: how an FMI 3.0 FMU's variables appear to
+//!   the master).
 //! - [`isolate`]: an instance in a host process of its own (`cosim-host`), a crash or hang
 //!   of the FMU being [`Error::Host`].
 //! - [`call_site`]: the marker of the FMU call in progress, read after an `exit()` or a
 //!   crash inside it.
 //!
-//! The master (`nigel_cosim`) builds systems, algorithms and observers on these.
+//! The master (`nigel_cosim`) builds systems, algorithms and observers on these; its own
+//! errors are its own type, which wraps this crate's [`Error`].
+//!
+//! # Modules and what each uses
+//!
+//! Each file uses only files above it in this list (checked by
+//! `scripts/module-cycles.py fmi-import/src`: no import circle):
+//!
+//! ```text
+//! status, c_types, elf, suggest, call_site, fmi3   leaves (fmi3: the FMI 3.0 view)
+//! error        -> status
+//! log          -> status, c_types                  what FMUs log, both loggers
+//! unpack       -> error
+//! library      -> error, elf, c_types              loading a shared library once
+//! isolate/protocol                                 the host protocol's region and calls
+//! isolate/channel -> protocol, error, log, status  the master's end of a host
+//! isolate/proxy, proxy3 -> channel, protocol, c_types   tables that call a host
+//! isolate/host -> protocol, channel, proxy3, c_types, library, log, error
+//! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
+//! load         -> fmu, fmi3, library, elf, unpack, isolate/proxy*  the one pipeline
+//! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
+//! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
+//! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
+//! ```
+//!
+//! A new FMI function goes into the generation's module of `instance` (and
+//! [`instance`]'s `Calls` when both generations have it); a new generation-dependent
+//! step of loading into `load`'s `Generation`.
 
 #![warn(missing_docs)]
 
+pub mod c_types;
 pub mod call_site;
 pub mod elf;
 pub mod error;
 pub mod fmi3;
 pub mod fmu;
+pub mod instance;
 pub mod isolate;
+pub(crate) mod library;
+pub mod load;
+pub mod log;
+pub mod status;
 #[doc(hidden)]
 pub mod suggest;
 pub mod unpack;
 
+pub use c_types::EventInfo;
 pub use call_site::ExitInsideCall;
-pub use error::{Error, HostEnd, Result, Status};
-pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
+pub use error::{Error, HostEnd, Result};
+pub use fmu::{Fmu, ImportOptions, Interface};
+pub use instance::{FmuState, Instance, InstanceState};
 pub use isolate::Isolation;
+pub use load::{read_fmi3_description, read_model_description};
+pub use log::{LogRecord, LogSink};
+pub use status::Status;
 pub use unpack::UnpackLimits;

@@ -36,24 +36,27 @@ create_exception!(nigel_cosim, CampaignError, Error, "A campaign description or 
 /// The Python exception of a master error.
 pub(crate) fn to_py(e: CosimError) -> PyErr {
     let message = e.to_string();
+    use nigel_cosim::ImportError as I;
     use CosimError as E;
     match e {
-        E::Io { .. }
-        | E::NotRegularFile { .. }
-        | E::Archive { .. }
-        | E::UnsafeEntry { .. }
-        | E::ArchiveLimit { .. }
-        | E::ModelDescription { .. }
-        | E::NoInterface { .. }
-        | E::MissingBinary { .. }
-        | E::LoadLibrary { .. }
-        | E::MissingSymbol { .. }
+        E::Import(
+            I::Io { .. }
+            | I::NotRegularFile { .. }
+            | I::Archive { .. }
+            | I::UnsafeEntry { .. }
+            | I::ArchiveLimit { .. }
+            | I::ModelDescription { .. }
+            | I::NoInterface { .. }
+            | I::MissingBinary { .. }
+            | I::LoadLibrary { .. }
+            | I::MissingSymbol { .. },
+        )
         | E::Ssp { .. } => LoadError::new_err(message),
         E::UnknownVariable { .. }
         | E::NotInView { .. }
         | E::UnknownInstance { .. }
         | E::NoInstance { .. }
-        | E::InvalidValue { .. }
+        | E::Import(I::InvalidValue { .. })
         | E::Connection { .. } => VariableError::new_err(message),
         E::Timeout { .. } => RunTimeoutError::new_err(message),
         E::Experiment(_) => ExperimentError::new_err(message),

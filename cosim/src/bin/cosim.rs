@@ -319,7 +319,8 @@ fn progress(fraction: f64) {
 /// The `--set`s that run the controller FMU of the closed loop with the gain of a
 /// `synthesize --json` report: `controller = 4` (custom) and the eight `k_*` parameters.
 fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| Error::Import(nigel_cosim::ImportError::Io { path: path.to_path_buf(), source }))?;
     let k =
         nigel_benchmark::gain_file::read_gain_json(&text, &path.display().to_string()).map_err(Error::Experiment)?;
     let mut sets = vec![("controller.controller".to_string(), "4".to_string())];
@@ -361,7 +362,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         let default = model_description::DefaultExperiment { start_time, stop_time, ..Default::default() };
         (builder, default, None, Some(ssp))
     } else {
-        let fmu = Fmu::load_with(&args.model, &options)?;
+        let fmu = Fmu::load_with(&args.model, &options).map_err(Error::from)?;
         let default = fmu.description().default_experiment.clone().unwrap_or_default();
         let mut builder = SystemBuilder::new();
         builder.add_instance(SINGLE, fmu.clone())?;
@@ -556,7 +557,9 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         );
     }
     let write = |path: &Path, f: &dyn Fn(std::fs::File) -> std::io::Result<()>| {
-        std::fs::File::create(path).and_then(f).map_err(|source| Error::Io { path: path.to_path_buf(), source })
+        std::fs::File::create(path)
+            .and_then(f)
+            .map_err(|source| Error::Import(nigel_cosim::ImportError::Io { path: path.to_path_buf(), source }))
     };
     // the rows recorded so far are written also when the run failed
     if let (Some(path), Some(format)) = (&args.output, format) {
@@ -923,7 +926,7 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
         };
     }
     let mut out = std::io::stdout().lock();
-    if let Some(md) = nigel_cosim::fmu::read_fmi3_description(path, limits)? {
+    if let Some(md) = nigel_cosim::load::read_fmi3_description(path, limits)? {
         info_fmi3(&mut out, &md);
         return Ok(());
     }

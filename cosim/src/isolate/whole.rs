@@ -240,11 +240,13 @@ pub struct HostRun {
 /// Runs `system` with `experiment` in a host process: this program again, with `args`
 /// (its command line without the program) and [`HOST_VARIABLE`].
 pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::ffi::OsString]) -> Result<HostRun> {
-    let failed = |m: String| Error::Host {
-        instance: "(the run)".into(),
-        function: "starting",
-        time: 0.0,
-        cause: HostEnd::Failed(m),
+    let failed = |m: String| {
+        Error::Import(crate::ImportError::Host {
+            instance: "(the run)".into(),
+            function: "starting",
+            time: 0.0,
+            cause: HostEnd::Failed(m),
+        })
     };
     // SAFETY: a literal name; no CLOEXEC: the host inherits the descriptor.
     let raw = unsafe { libc::memfd_create(c"nigel-cosim-run".as_ptr(), 0) };
@@ -316,7 +318,7 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
                 None => ("(the run)".to_string(), "loading the FMUs".to_string(), 0.0),
             };
             let function: &'static str = Box::leak(function.into_boxed_str());
-            Err(Some(Error::Host { instance, function, time, cause }))
+            Err(Some(Error::Import(crate::ImportError::Host { instance, function, time, cause })))
         }
     };
     Ok(HostRun { results, outcome })

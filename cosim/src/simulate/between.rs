@@ -44,7 +44,9 @@ impl SetQueue {
 pub(crate) fn checked_value(system: &System, name: &str, text: &str) -> Result<(VariableRef, Value)> {
     let r = system.resolve(name)?;
     let v = system.variable(&r);
-    let bad = |reason: String| Error::InvalidValue { variable: name.to_string(), value: text.to_string(), reason };
+    let bad = |reason: String| {
+        Error::Import(crate::ImportError::InvalidValue { variable: name.to_string(), value: text.to_string(), reason })
+    };
     if !(v.causality == Causality::Input || v.variability == Variability::Tunable) {
         return Err(bad(format!(
             "a {} {} variable cannot be set during a run (only inputs and tunable parameters)",
@@ -63,10 +65,10 @@ pub(crate) fn checked_value(system: &System, name: &str, text: &str) -> Result<(
 pub(crate) fn set_value(inst: &mut Instance, r: &VariableRef, value: Value) -> Result<()> {
     let vr = [r.value_reference];
     match (r.base_type, value) {
-        (BaseType::Real, Value::Real(x)) => inst.set_real(&vr, &[x]),
-        (BaseType::Integer, Value::Integer(x)) => inst.set_integer(&vr, &[x]),
-        (BaseType::Boolean, Value::Boolean(x)) => inst.set_boolean(&vr, &[x as i32]),
-        (BaseType::String, Value::String(x)) => inst.set_string(r.value_reference, &x),
+        (BaseType::Real, Value::Real(x)) => Ok(inst.set_real(&vr, &[x])?),
+        (BaseType::Integer, Value::Integer(x)) => Ok(inst.set_integer(&vr, &[x])?),
+        (BaseType::Boolean, Value::Boolean(x)) => Ok(inst.set_boolean(&vr, &[x as i32])?),
+        (BaseType::String, Value::String(x)) => Ok(inst.set_string(r.value_reference, &x)?),
         // checked_value parsed the value for the variable's type
         (_, other) => Err(Error::Experiment(format!("a queued value {other:?} does not fit its variable"))),
     }

@@ -106,11 +106,11 @@ impl<'s> Execution<'s> {
             Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
         };
         if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
-            return Err(Error::InvalidValue {
+            return Err(Error::Import(crate::ImportError::InvalidValue {
                 variable: system.name_of(r),
                 value: String::new(),
                 reason: "String variables cannot be recorded in CSV".into(),
-            });
+            }));
         }
         let mut plan = Plan::new(system, &record, experiment.algorithm)?;
         // Model Exchange instances connected to each other are integrated together

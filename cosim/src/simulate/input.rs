@@ -241,8 +241,13 @@ impl<'s> WithInput<'s> {
                 Err(e) => return Err(e),
             };
             let v = system.variable(&r);
-            let bad =
-                |reason: String| Error::InvalidValue { variable: name.clone(), value: "(input column)".into(), reason };
+            let bad = |reason: String| {
+                Error::Import(crate::ImportError::InvalidValue {
+                    variable: name.clone(),
+                    value: "(input column)".into(),
+                    reason,
+                })
+            };
             if !(v.causality == Causality::Input || v.variability == Variability::Tunable) {
                 return Err(bad(format!(
                     "a {} variable cannot be driven over time (only inputs and tunable parameters)",

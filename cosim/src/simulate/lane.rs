@@ -102,7 +102,7 @@ impl Lane {
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
-                Err(e) => Err(ended_or(&mut self.inst, e, t, t_next)),
+                Err(e) => Err(ended_or(&mut self.inst, e.into(), t, t_next)),
             },
             (None, Some(state)) => {
                 self.retries += step_with_retry(&mut self.inst, state, t, dt, 0)?;
@@ -214,7 +214,9 @@ pub(crate) const FMI3_TERMINATED: &str = "fmi3DoStep returned terminateSimulatio
 /// not a row at that time.
 #[cold]
 fn ended_or(inst: &mut Instance, e: Error, t: f64, t_end: f64) -> Error {
-    if matches!(e, Error::Fmi { status: crate::Status::Discard, .. }) && inst.terminated_status() == Some(true) {
+    if matches!(e, Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. }))
+        && inst.terminated_status() == Some(true)
+    {
         let reported = inst.last_successful_time();
         let function = if inst.is_fmi3() { "fmi3DoStep" } else { "fmi2GetRealStatus(fmi2LastSuccessfulTime)" };
         let time = match reported {
@@ -241,9 +243,9 @@ fn ended_or(inst: &mut Instance, e: Error, t: f64, t_end: f64) -> Error {
 /// (`fmi2Terminated`). Returns the number of retries.
 fn step_with_retry(inst: &mut Instance, state: &mut FmuState, t: f64, dt: f64, depth: u32) -> Result<u64> {
     inst.update_state(state)?;
-    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e, t, t + dt)) {
+    match inst.do_step(t, dt).map_err(|e| ended_or(inst, e.into(), t, t + dt)) {
         Ok(()) => Ok(0),
-        Err(Error::Fmi { status: crate::Status::Discard, .. }) if depth < 10 => {
+        Err(Error::Import(crate::ImportError::Fmi { status: crate::Status::Discard, .. })) if depth < 10 => {
             inst.set_state(state)?;
             let half = 0.5 * dt;
             let a = step_with_retry(inst, state, t, half, depth + 1)?;

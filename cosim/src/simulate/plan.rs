@@ -92,11 +92,12 @@ impl Op {
     #[inline]
     pub(crate) fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
         match self.base_type {
-            BaseType::Real => inst.get_real(&self.vrs, &mut self.reals),
-            BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints),
-            BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints),
-            BaseType::String => Ok(()),
+            BaseType::Real => inst.get_real(&self.vrs, &mut self.reals)?,
+            BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
+            BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
+            BaseType::String => {}
         }
+        Ok(())
     }
 
     /// Get: the fetched values into their slots.
@@ -149,11 +150,12 @@ impl Op {
     #[inline]
     pub(crate) fn apply(&mut self, inst: &mut Instance) -> Result<()> {
         match self.base_type {
-            BaseType::Real => inst.set_real(&self.vrs, &self.reals),
-            BaseType::Integer => inst.set_integer(&self.vrs, &self.ints),
-            BaseType::Boolean => inst.set_boolean(&self.vrs, &self.ints),
-            BaseType::String => Ok(()),
+            BaseType::Real => inst.set_real(&self.vrs, &self.reals)?,
+            BaseType::Integer => inst.set_integer(&self.vrs, &self.ints)?,
+            BaseType::Boolean => inst.set_boolean(&self.vrs, &self.ints)?,
+            BaseType::String => {}
         }
+        Ok(())
     }
 }
 

@@ -27,7 +27,7 @@ pub const SSP_PARAMETER_SET: &str = "initialValues";
 /// applies each component's first set by default, ecos applies the sets of the one name
 /// given to its `init` (and none without a name), so one name serves both.
 pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Path) -> Result<()> {
-    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    let io = |source| Error::Import(crate::ImportError::Io { path: path.to_path_buf(), source });
     // FMU files, one per distinct source
     let mut files: Vec<(PathBuf, String)> = Vec::new();
     for spec in &system.instances {
@@ -138,7 +138,9 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
     let options = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
         .last_modified_time(zip::DateTime::default());
-    let zerr = |e: zip::result::ZipError| Error::Archive { path: path.to_path_buf(), reason: e.to_string() };
+    let zerr = |e: zip::result::ZipError| {
+        Error::Import(crate::ImportError::Archive { path: path.to_path_buf(), reason: e.to_string() })
+    };
     zip.start_file("SystemStructure.ssd", options).map_err(zerr)?;
     zip.write_all(x.as_bytes()).map_err(io)?;
     // the FMUs stored, not deflated: they are compressed archives already (deflate gains
@@ -148,7 +150,8 @@ pub fn write_ssp(system: &System, name: &str, stop_time: Option<f64>, path: &Pat
         let fmu = system.instances.iter().find(|i| i.fmu.source() == src.as_path()).map(|i| &i.fmu);
         let bytes = match fmu {
             Some(fmu) => fmu.archive_bytes()?,
-            None => std::fs::read(src).map_err(|source| Error::Io { path: src.clone(), source })?,
+            None => std::fs::read(src)
+                .map_err(|source| Error::Import(crate::ImportError::Io { path: src.clone(), source }))?,
         };
         zip.start_file(file.as_str(), stored).map_err(zerr)?;
         zip.write_all(&bytes).map_err(io)?;

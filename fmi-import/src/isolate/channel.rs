@@ -1,10 +1,10 @@
 //! The master's side of one host process: start, calls (one round trip each, sets queued),
 //! liveness and time limits, and the end of the host.
 
-use super::{publish, wait_for, Header, Layout, Op};
+use super::protocol::{publish, wait_for, Header, Layout, Op, Spin};
 use crate::error::HostEnd;
-use crate::fmu::{LogRecord, LogSink};
-use crate::Status;
+use crate::log::{LogRecord, LogSink};
+use crate::status::Status;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
@@ -78,10 +78,10 @@ pub(crate) struct Channel {
     /// The posted call waiting for its answer, and when it was posted.
     pending: Option<(Op, Instant)>,
     /// Whether the master's spins for this host have paid lately.
-    gauge: super::SpinGauge,
+    gauge: super::protocol::SpinGauge,
     /// The arguments (time, step) of the posted `fmi2DoStep`.
     pub(crate) posted_step: Option<(f64, f64)>,
-    spin: super::Spin,
+    spin: Spin,
 }
 
 // SAFETY: the region and the host are used only through `&mut self` (one caller at a
@@ -98,7 +98,7 @@ impl Channel {
         variables: usize,
         call_timeout: Option<Duration>,
         run_deadline: Option<(Instant, Duration)>,
-        spin: super::Spin,
+        spin: Spin,
     ) -> Result<Channel, HostEnd> {
         let layout = Layout::for_variables(variables);
         // SAFETY: plain syscalls; the name is a NUL-terminated literal.
@@ -173,11 +173,11 @@ impl Channel {
             last_records: Vec::new(),
             pending: None,
             posted_step: None,
-            gauge: super::SpinGauge::new(),
+            gauge: super::protocol::SpinGauge::new(),
             spin,
         };
         std::mem::forget(child); // reaped by waitpid in `reap`
-        super::LIVE_HOSTS.fetch_add(1, Ordering::Relaxed);
+        super::protocol::LIVE_HOSTS.fetch_add(1, Ordering::Relaxed);
         // the host answers a first empty call once it has loaded the library (its
         // load-time initializers ran there: a crash in them is the host's end)
         let status = channel.call(Op::Flush);
@@ -328,7 +328,10 @@ impl Channel {
         self.posted_step = None;
         let status = self.collect();
         if status > 1 && self.failure.is_none() {
-            self.push_log(Status::from_raw(status), format!("{} returned {}", op.function(), Status::from_raw(status).spelled_for(op.function())));
+            self.push_log(
+                Status::from_raw(status),
+                format!("{} returned {}", op.function(), Status::from_raw(status).spelled_for(op.function())),
+            );
         }
     }
 
@@ -382,7 +385,11 @@ impl Channel {
             status = hdr.queued_status;
             self.push_log(
                 Status::from_raw(status),
-                format!("{function} (sent with {}) returned {}", op.function(), Status::from_raw(status).spelled_for(function)),
+                format!(
+                    "{function} (sent with {}) returned {}",
+                    op.function(),
+                    Status::from_raw(status).spelled_for(function)
+                ),
             );
         }
         self.queued = 0;
@@ -502,7 +509,7 @@ pub(crate) fn record_len(n: usize) -> usize {
 
 impl Drop for Channel {
     fn drop(&mut self) {
-        super::LIVE_HOSTS.fetch_sub(1, Ordering::Relaxed);
+        super::protocol::LIVE_HOSTS.fetch_sub(1, Ordering::Relaxed);
         // a host that is still there after fmi2FreeInstance (or never got it) is killed
         if !self.reaped {
             let deadline = Instant::now() + Duration::from_millis(200);
@@ -519,4 +526,47 @@ impl Drop for Channel {
             libc::munmap(self.base as *mut libc::c_void, self.layout.total);
         }
     }
+}
+
+/// `n` null round trips (a call the host answers at once) to each of `hosts` host
+/// processes of the FMU library `library`, in turn (`overlapped`: the request posted to
+/// every host, then the answers collected); the time of all. For the isolation bench:
+/// the floor under the cost of an isolated step.
+#[doc(hidden)]
+pub fn null_round_trips(
+    host: &Path,
+    library: &Path,
+    hosts: usize,
+    n: u32,
+    overlapped: bool,
+) -> Result<Duration, String> {
+    let spin = Spin::of_run();
+    let mut channels = Vec::new();
+    for _ in 0..hosts {
+        channels.push(Channel::start(host, library, false, 16, None, None, spin).map_err(|e| e.to_string())?);
+    }
+    let start = Instant::now();
+    for _ in 0..n {
+        if overlapped {
+            for c in channels.iter_mut() {
+                c.post(Op::Flush);
+            }
+            for c in channels.iter_mut() {
+                if c.collect() != 0 {
+                    return Err(format!("null call failed: {:?}", c.failure));
+                }
+            }
+        } else {
+            for c in channels.iter_mut() {
+                if c.call(Op::Flush) != 0 {
+                    return Err(format!("null call failed: {:?}", c.failure));
+                }
+            }
+        }
+    }
+    let elapsed = start.elapsed();
+    for c in channels.iter_mut() {
+        c.call(Op::Free);
+    }
+    Ok(elapsed)
 }

@@ -5,8 +5,10 @@
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::{fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
-use crate::fmu::{callbacks_for, load_functions, load_library, EventInfo, Functions, LogSink};
+use super::protocol::{fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
+use crate::c_types::{EventInfo, Functions};
+use crate::library::{load_functions, load_library};
+use crate::log::{callbacks_for, LogSink};
 use fmi_sys::fmi3::Fmi3Functions;
 use model_description::fmi3::ValueType;
 use std::ffi::{c_char, c_int, c_void, CStr};
@@ -79,7 +81,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
         let functions = if fmi3 {
             unsafe { Fmi3Functions::load(&lib) }
                 .map(Generation::Fmi3)
-                .map_err(|m| crate::Error::MissingSymbol { path: library.into(), symbol: m.0 })
+                .map_err(|m| crate::error::Error::MissingSymbol { path: library.into(), symbol: m.0 })
         } else {
             unsafe { load_functions(&lib, library) }.map(Generation::Fmi2)
         };
@@ -231,7 +233,7 @@ struct Host {
     lib: Generation,
     c: *mut c_void,
     log: Box<LogSink>,
-    _callbacks: Option<Box<crate::fmu::CallbackFunctions>>,
+    _callbacks: Option<Box<crate::c_types::CallbackFunctions>>,
     strings: Vec<std::ffi::CString>,
 }
 
@@ -256,7 +258,9 @@ impl Host {
                     // FMI 3.0: QUEUED_FMI3 + the type's code (proxy3.rs), as many values as references
                     (Generation::Fmi3(f), _) => {
                         match kind.checked_sub(super::proxy3::QUEUED_FMI3).and_then(|k| fmi3_type(i64::from(k))) {
-                            Some(ty) => (typed(f, ty, true, self.c, vrs, n, values, n), super::fmi3_width(ty)),
+                            Some(ty) => {
+                                (typed(f, ty, true, self.c, vrs, n, values, n), super::protocol::fmi3_width(ty))
+                            }
                             None => (3, 0),
                         }
                     }
@@ -436,7 +440,7 @@ impl Host {
                         std::ptr::null(),
                         0,
                         environment,
-                        Some(crate::fmi3::log_message),
+                        Some(crate::log::log_message),
                         None,
                     );
                     if self.c.is_null() {
@@ -450,7 +454,7 @@ impl Host {
                     let environment = &*self.log as *const LogSink as *mut c_void;
                     let Some(g) = f.instantiate_model_exchange else { return missing };
                     // visible false, logging off: as `Instance::new_fmi3`
-                    let logger = Some(crate::fmi3::log_message as fmi_sys::fmi3::Fmi3LogMessageCallback);
+                    let logger = Some(crate::log::log_message as fmi_sys::fmi3::Fmi3LogMessageCallback);
                     self.c = g(name.as_ptr(), token.as_ptr(), resources.as_ptr(), 0, 0, environment, logger);
                     if self.c.is_null() {
                         3

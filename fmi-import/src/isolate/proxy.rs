@@ -6,8 +6,8 @@
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
 use super::channel::Channel;
-use super::Op;
-use crate::fmu::{CallbackFunctions, EventInfo, Functions};
+use super::protocol::Op;
+use crate::c_types::{CallbackFunctions, EventInfo, Functions};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 
 type Component = *mut c_void;

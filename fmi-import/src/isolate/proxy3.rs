@@ -8,8 +8,8 @@
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
 use super::channel::Channel;
+use super::protocol::{fmi3_type_code, fmi3_width, Op};
 use super::proxy::{ch, fits, plain, slice, slice_mut, state_call, vrs_into};
-use super::{fmi3_type_code, fmi3_width, Op};
 use fmi_sys::fmi3::{fmi3Boolean, fmi3FMUState, fmi3Instance, fmi3Status, fmi3String, Fmi3Functions};
 use model_description::fmi3::ValueType;
 use std::ffi::{c_char, CStr};

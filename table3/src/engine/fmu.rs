@@ -48,7 +48,8 @@ fn load(path: &Path) -> Result<Arc<Fmu>, Error> {
     if !path.is_file() {
         return Err(Error::MissingFmu { path: path.to_path_buf() });
     }
-    Fmu::load(path).map_err(|source| Error::Cosim { context: format!("loading {}", path.display()), source })
+    Fmu::load(path)
+        .map_err(|source| Error::Cosim { context: format!("loading {}", path.display()), source: source.into() })
 }
 
 /// The value of each name of `names` for the switch `variable` of `fmu`.

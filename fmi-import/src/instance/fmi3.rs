@@ -1,0 +1,750 @@
+//! An instance's calls of the FMI 3.0 C API, the FMI 3.0 view included: the view's Reals,
+//! Integers and Booleans of the other FMI 3.0 types and the elements of arrays (see
+//! [`crate::fmi3`]) go by their own getters and setters, an array element set alone with
+//! the array's other elements as set before; `fmi3DoStep`'s early returns, events and
+//! `terminateSimulation` become the step FMI 2.0 reports.
+
+use std::collections::HashMap;
+use std::ffi::{c_char, c_int, c_void, CString};
+use std::sync::Arc;
+
+use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use crate::c_types::{Component, EventInfo};
+use crate::error::{Error, Result};
+use crate::fmi3::{Access, Fmi3Abi};
+use crate::fmu::{Fmu, Interface};
+use crate::instance::core::InstanceState;
+use crate::log::LogSink;
+use crate::status::Status;
+
+/// The FMI 3.0 calls: the library's table and description, and what an instance keeps
+/// that FMI 2.0 has no place for.
+pub(crate) struct Fmi3 {
+    a: Arc<Fmi3Abi>,
+    /// What `setup_experiment` was given (tolerance, start, stop), passed on by
+    /// `fmi3EnterInitializationMode`.
+    experiment: (Option<f64>, f64, Option<f64>),
+    /// The time `fmi3DoStep` reported `terminateSimulation` at.
+    terminate_requested: Option<f64>,
+    /// Booleans as the bytes the ABI has (reused).
+    bytes: Vec<u8>,
+    /// The values of arrays set element by element, by value reference.
+    arrays: HashMap<u32, Vec<f64>>,
+    /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`).
+    event_mode: bool,
+}
+
+/// A function of the FMI 3.0 table that may be absent, or the error naming it.
+macro_rules! f3 {
+    ($core:expr, $a:expr, $field:ident, $name:literal) => {
+        $core.optional($a.functions.$field, $name)?
+    };
+}
+
+impl Fmi3 {
+    pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
+        let event_mode = interface == Interface::CoSimulation
+            && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+        Fmi3 {
+            a,
+            experiment: (None, 0.0, None),
+            terminate_requested: None,
+            bytes: Vec::new(),
+            arrays: HashMap::new(),
+            event_mode,
+        }
+    }
+
+    /// The access of the view's variable `vr` when it is not a plain scalar.
+    #[inline]
+    fn special(&self, vr: u32) -> Option<Access> {
+        if self.a.special.is_empty() {
+            return None;
+        }
+        self.a.special.get(&vr).copied()
+    }
+
+    /// Whether some of `vrs` are not plain scalars: they go one by one.
+    #[inline]
+    fn any_special(&self, vrs: &[u32]) -> bool {
+        !self.a.special.is_empty() && vrs.iter().any(|vr| self.a.special.contains_key(vr))
+    }
+
+    /// All values of the FMI 3.0 variable of `access`, as f64 (integers exact up to 2^53,
+    /// Booleans 0 or 1, a Binary its size in bytes).
+    fn get_all(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
+        use model_description::fmi3::ValueType as T;
+        let c = core.component;
+        let a = &*self.a;
+        let (vr, n) = (access.vr, access.count);
+        macro_rules! get {
+            ($field:ident, $name:literal, $t:ty) => {{
+                let f = f3!(core, a, $field, $name);
+                let mut buf: Vec<$t> = vec![<$t>::default(); n];
+                call!(core, $name, None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf
+            }};
+        }
+        macro_rules! exact {
+            ($buf:expr, $name:literal) => {{
+                let mut out = Vec::with_capacity(n);
+                for x in $buf {
+                    let wide = x as i128;
+                    if wide.abs() > 1 << 53 {
+                        return Err(not_exact(core, $name, vr, wide));
+                    }
+                    out.push(wide as f64);
+                }
+                out
+            }};
+        }
+        Ok(match access.value_type {
+            T::Float64 => {
+                let f = a.functions.get_float64;
+                let mut buf = vec![0.0; n];
+                call!(core, "fmi3GetFloat64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf
+            }
+            T::Float32 => get!(get_float32, "fmi3GetFloat32", f32).into_iter().map(f64::from).collect(),
+            T::Int8 => get!(get_int8, "fmi3GetInt8", i8).into_iter().map(f64::from).collect(),
+            T::UInt8 => get!(get_uint8, "fmi3GetUInt8", u8).into_iter().map(f64::from).collect(),
+            T::Int16 => get!(get_int16, "fmi3GetInt16", i16).into_iter().map(f64::from).collect(),
+            T::UInt16 => get!(get_uint16, "fmi3GetUInt16", u16).into_iter().map(f64::from).collect(),
+            T::Int32 => get!(get_int32, "fmi3GetInt32", i32).into_iter().map(f64::from).collect(),
+            T::UInt32 => get!(get_uint32, "fmi3GetUInt32", u32).into_iter().map(f64::from).collect(),
+            T::Int64 | T::Enumeration => exact!(get!(get_int64, "fmi3GetInt64", i64), "fmi3GetInt64"),
+            T::UInt64 => exact!(get!(get_uint64, "fmi3GetUInt64", u64), "fmi3GetUInt64"),
+            T::Boolean => get!(get_boolean, "fmi3GetBoolean", u8).into_iter().map(|b| (b != 0) as i32 as f64).collect(),
+            T::Binary => {
+                let f = f3!(core, a, get_binary, "fmi3GetBinary");
+                let mut sizes = vec![0usize; n];
+                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
+                call!(core, "fmi3GetBinary", None, f(c, &vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
+                sizes.into_iter().map(|s| s as f64).collect()
+            }
+            T::String | T::Clock => unreachable!("not in the view as a number"),
+        })
+    }
+
+    fn get_element(&mut self, core: &mut Core, access: Access) -> Result<f64> {
+        let all = self.get_all(core, access)?;
+        Ok(all.get(access.element).copied().unwrap_or(f64::NAN))
+    }
+
+    /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
+    /// whole and in their type's range).
+    fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
+        let c = core.component;
+        let name = core
+            .fmu
+            .description
+            .model_variables
+            .iter()
+            .find(|v| v.value_reference == access.vr)
+            .map(|v| v.name.clone());
+        let a = &*self.a;
+        let (vr, n) = (access.vr, values.len());
+        let instance = core.name.clone();
+        let variable = || format!("{instance}.{}", name.clone().unwrap_or_else(|| format!("<vr {vr}>")));
+        macro_rules! set_int {
+            ($field:ident, $name:literal, $t:ty) => {{
+                let f = f3!(core, a, $field, $name);
+                let mut buf: Vec<$t> = Vec::with_capacity(n);
+                for x in values {
+                    let wide = *x as i128;
+                    let fits = wide as f64 == *x && wide >= <$t>::MIN as i128 && wide <= <$t>::MAX as i128;
+                    if !fits {
+                        return Err(Error::InvalidValue {
+                            variable: variable(),
+                            value: x.to_string(),
+                            reason: format!("not a whole number of {}", stringify!($t)),
+                        });
+                    }
+                    buf.push(wide as $t);
+                }
+                call!(core, $name, None, f(c, &vr, 1, buf.as_ptr(), n))
+            }};
+        }
+        match access.value_type {
+            T::Float64 => {
+                let f = a.functions.set_float64;
+                call!(core, "fmi3SetFloat64", None, f(c, &vr, 1, values.as_ptr(), n))
+            }
+            T::Float32 => {
+                let f = f3!(core, a, set_float32, "fmi3SetFloat32");
+                let buf: Vec<f32> = values.iter().map(|x| *x as f32).collect();
+                call!(core, "fmi3SetFloat32", None, f(c, &vr, 1, buf.as_ptr(), n))
+            }
+            T::Int8 => set_int!(set_int8, "fmi3SetInt8", i8),
+            T::UInt8 => set_int!(set_uint8, "fmi3SetUInt8", u8),
+            T::Int16 => set_int!(set_int16, "fmi3SetInt16", i16),
+            T::UInt16 => set_int!(set_uint16, "fmi3SetUInt16", u16),
+            T::Int32 => set_int!(set_int32, "fmi3SetInt32", i32),
+            T::UInt32 => set_int!(set_uint32, "fmi3SetUInt32", u32),
+            T::Int64 | T::Enumeration => set_int!(set_int64, "fmi3SetInt64", i64),
+            T::UInt64 => set_int!(set_uint64, "fmi3SetUInt64", u64),
+            T::Boolean => {
+                let f = f3!(core, a, set_boolean, "fmi3SetBoolean");
+                let buf: Vec<u8> = values.iter().map(|x| (*x != 0.0) as u8).collect();
+                call!(core, "fmi3SetBoolean", None, f(c, &vr, 1, buf.as_ptr(), n))
+            }
+            T::Binary | T::String | T::Clock => Err(Error::InvalidValue {
+                variable: variable(),
+                value: values.first().map(|x| x.to_string()).unwrap_or_default(),
+                reason: "a Binary is recorded as its size and cannot be set".into(),
+            }),
+        }
+    }
+
+    /// Sets element `access.element` of its variable: the other elements keep the values
+    /// set or read before (the start values at first).
+    fn set_element(&mut self, core: &mut Core, access: Access, value: f64) -> Result<()> {
+        if access.count == 1 {
+            return self.set_all(core, access, &[value]);
+        }
+        let mut values = match self.arrays.remove(&access.vr) {
+            Some(v) => v,
+            None => self.array_start(core, access)?,
+        };
+        values[access.element] = value;
+        let result = self.set_all(core, access, &values);
+        self.arrays.insert(access.vr, values);
+        result
+    }
+
+    /// The values an array starts from for element-wise sets: its start values, else what
+    /// the FMU holds.
+    fn array_start(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
+        use model_description::fmi3::Values;
+        let start = self.a.description.variable(access.vr).and_then(|v| v.start.clone());
+        let n = access.count;
+        let spread = |v: Vec<f64>| if v.len() == 1 { vec![v[0]; n] } else { v };
+        match start {
+            Some(Values::Float(v)) if v.len() == n || v.len() == 1 => Ok(spread(v)),
+            Some(Values::Int(v)) if v.len() == n || v.len() == 1 => {
+                Ok(spread(v.into_iter().map(|x| x as f64).collect()))
+            }
+            Some(Values::Boolean(v)) if v.len() == n || v.len() == 1 => {
+                Ok(spread(v.into_iter().map(|x| x as i32 as f64).collect()))
+            }
+            _ => self.get_all(core, access),
+        }
+    }
+
+    /// `terminateSimulation` from `function` (called at `at`) at the time `reached`,
+    /// reported as FMI 2.0 reports it: a Discard, with `terminated_status` true and
+    /// `last_successful_time` `reached`.
+    fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
+        core.time = reached;
+        self.terminate_requested = Some(reached);
+        Error::Fmi {
+            instance: core.name.clone(),
+            function,
+            status: Status::Discard,
+            time: Some(at),
+            log: format!("terminateSimulation at t = {reached} s"),
+        }
+    }
+
+    /// The event a Co-Simulation `fmi3DoStep` asked for (`eventHandlingNeeded`) at `time`:
+    /// Event Mode, `fmi3UpdateDiscreteStates` until no new discrete states are needed (at
+    /// most 1000 times), back to Step Mode. `Some(time)` when the FMU asked to terminate.
+    fn cs_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
+        self.enter_event_mode(core)?;
+        for _ in 0..1000 {
+            let info = self.new_discrete_states(core)?;
+            if info.terminate_simulation != 0 {
+                return Ok(Some(time));
+            }
+            if info.new_discrete_states_needed == 0 {
+                let f = f3!(core, self.a, enter_step_mode, "fmi3EnterStepMode");
+                let c = core.component;
+                call!(core, "fmi3EnterStepMode", Some(time), f(c))?;
+                return Ok(None);
+            }
+        }
+        core.state = InstanceState::Errored;
+        Err(core.error(
+            "fmi3UpdateDiscreteStates",
+            time,
+            "asked for new discrete states 1000 times in one event".into(),
+        ))
+    }
+}
+
+#[cold]
+fn not_exact(core: &Core, function: &'static str, vr: u32, value: i128) -> Error {
+    Error::Fmi {
+        instance: core.name.clone(),
+        function,
+        status: Status::Error,
+        time: Some(core.time),
+        log: format!("value {value} of value reference {vr} is beyond 2^53, where f64 results cannot hold it exactly"),
+    }
+}
+
+impl Calls for Fmi3 {
+    /// The instantiate function of `interface`.
+    fn instantiate_function(&self, interface: Interface) -> &'static str {
+        match interface {
+            Interface::CoSimulation => "fmi3InstantiateCoSimulation",
+            Interface::ModelExchange => "fmi3InstantiateModelExchange",
+        }
+    }
+
+    /// `fmi3InstantiateCoSimulation` (early return allowed, event mode used when the FMU
+    /// has it, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
+    /// messages to `log` (which outlives the instance).
+    fn instantiate(
+        &self,
+        fmu: &Fmu,
+        name: &str,
+        name_c: &CString,
+        _: &crate::c_types::CallbackFunctions,
+        log: &LogSink,
+    ) -> Result<Component> {
+        let a = &self.a;
+        let environment = log as *const LogSink as *mut c_void;
+        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message);
+        let missing = |symbol| Error::MissingSymbol { path: fmu.source.clone(), symbol };
+        let function = self.instantiate_function(fmu.interface);
+        let component = match fmu.interface {
+            Interface::CoSimulation => {
+                let f = a.functions.instantiate_co_simulation.ok_or(missing(function))?;
+                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                // SAFETY: every pointer is valid for the call; the log outlives the instance.
+                unsafe {
+                    f(
+                        name_c.as_ptr(),
+                        a.token.as_ptr(),
+                        a.resource_path.as_ptr(),
+                        0,
+                        0,
+                        self.event_mode as u8,
+                        1,
+                        std::ptr::null(),
+                        0,
+                        environment,
+                        logger,
+                        None,
+                    )
+                }
+            }
+            Interface::ModelExchange => {
+                let f = a.functions.instantiate_model_exchange.ok_or(missing(function))?;
+                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                // SAFETY: as above.
+                unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
+            }
+        };
+        if component.is_null() {
+            return Err(Error::Instantiate { instance: name.into(), function, log: log.recent_problems() });
+        }
+        Ok(component)
+    }
+
+    /// `fmi3Instantiate*` in the host of `channel`; the status.
+    fn instantiate_in(
+        &self,
+        fmu: &Fmu,
+        channel: &mut crate::isolate::channel::Channel,
+        name_c: &CString,
+    ) -> Result<i32> {
+        let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode);
+        Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
+    }
+
+    fn reset_name(&self) -> &'static str {
+        "fmi3Reset"
+    }
+
+    fn setup_function(&self) -> &'static str {
+        "fmi3EnterInitializationMode"
+    }
+
+    fn setup_experiment(&mut self, _: &mut Core, tolerance: Option<f64>, start: f64, stop: Option<f64>) -> Result<()> {
+        self.experiment = (tolerance, start, stop);
+        Ok(())
+    }
+
+    fn enter_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.enter_initialization_mode);
+        let (tolerance, start, stop) = self.experiment;
+        call!(
+            core,
+            "fmi3EnterInitializationMode",
+            Some(start),
+            f(c, tolerance.is_some() as u8, tolerance.unwrap_or(0.0), start, stop.is_some() as u8, stop.unwrap_or(0.0))
+        )
+    }
+
+    fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
+        call!(core, "fmi3ExitInitializationMode", None, f(c))
+    }
+
+    fn terminate(&mut self, core: &mut Core) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.terminate);
+        call!(core, "fmi3Terminate", None, f(c))
+    }
+
+    fn reset_function(&self, core: &Core) -> Result<ResetFunction> {
+        core.optional(self.a.functions.reset, "fmi3Reset")
+    }
+
+    fn forget_run(&mut self) {
+        self.terminate_requested = None;
+    }
+
+    #[inline]
+    fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.get_float64);
+        if !self.any_special(vrs) {
+            return call!(
+                core,
+                "fmi3GetFloat64",
+                None,
+                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
+            );
+        }
+        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+            match self.special(*vr) {
+                Some(access) => *value = self.get_element(core, access)?,
+                None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.set_float64);
+        if !self.any_special(vrs) {
+            return call!(core, "fmi3SetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            match self.special(*vr) {
+                Some(access) => self.set_element(core, access, *value)?,
+                None => call!(core, "fmi3SetFloat64", None, f(c, vr, 1, value, 1))?,
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        let c = core.component;
+        if !self.any_special(vrs) {
+            let f = f3!(core, self.a, get_int32, "fmi3GetInt32");
+            return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
+        }
+        let get32 = self.a.functions.get_int32;
+        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+            match self.special(*vr) {
+                Some(access) => {
+                    let x = self.get_element(core, access)?;
+                    // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
+                    *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
+                        instance: core.name.clone(),
+                        function: "fmi3GetInt64",
+                        status: Status::Error,
+                        time: Some(core.time),
+                        log: format!("value {x} of value reference {} is outside the Integer range", access.vr),
+                    })?;
+                }
+                None => {
+                    let f = core.optional(get32, "fmi3GetInt32")?;
+                    call!(core, "fmi3GetInt32", None, f(c, vr, 1, value, 1))?
+                }
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
+        let c = core.component;
+        if !self.any_special(vrs) {
+            let f = f3!(core, self.a, set_int32, "fmi3SetInt32");
+            return call!(core, "fmi3SetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        }
+        let set32 = self.a.functions.set_int32;
+        for (vr, value) in vrs.iter().zip(values) {
+            match self.special(*vr) {
+                Some(access) => self.set_element(core, access, *value as f64)?,
+                None => {
+                    let f = core.optional(set32, "fmi3SetInt32")?;
+                    call!(core, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?
+                }
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        if self.any_special(vrs) {
+            for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                *value = match self.special(*vr) {
+                    Some(access) => self.get_element(core, access)? as i32,
+                    None => {
+                        let mut one = [0];
+                        self.get_boolean(core, &[*vr], &mut one)?;
+                        one[0]
+                    }
+                };
+            }
+            return Ok(());
+        }
+        let c = core.component;
+        let f = f3!(core, self.a, get_boolean, "fmi3GetBoolean");
+        let mut bytes = std::mem::take(&mut self.bytes);
+        bytes.clear();
+        bytes.resize(vrs.len(), 0);
+        let r = call!(core, "fmi3GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_mut_ptr(), bytes.len()));
+        for (v, b) in values.iter_mut().zip(&bytes) {
+            *v = (*b != 0) as i32;
+        }
+        self.bytes = bytes;
+        r
+    }
+
+    #[inline]
+    fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
+        if self.any_special(vrs) {
+            for (vr, value) in vrs.iter().zip(values) {
+                match self.special(*vr) {
+                    Some(access) => self.set_element(core, access, (*value != 0) as i32 as f64)?,
+                    None => self.set_boolean(core, &[*vr], &[*value])?,
+                }
+            }
+            return Ok(());
+        }
+        let c = core.component;
+        let f = f3!(core, self.a, set_boolean, "fmi3SetBoolean");
+        let mut bytes = std::mem::take(&mut self.bytes);
+        bytes.clear();
+        bytes.extend(values.iter().map(|v| (*v != 0) as u8));
+        let r = call!(core, "fmi3SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_ptr(), bytes.len()));
+        self.bytes = bytes;
+        r
+    }
+
+    fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {
+        let mut p: *const c_char = std::ptr::null();
+        let c = core.component;
+        let f = f3!(core, self.a, get_string, "fmi3GetString");
+        call!(core, "fmi3GetString", None, f(c, &vr, 1, &mut p, 1))?;
+        Ok(p)
+    }
+
+    fn set_string(&mut self, core: &mut Core, vr: u32, p: *const c_char) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, set_string, "fmi3SetString");
+        call!(core, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
+    }
+
+    /// An early return (`earlyReturn` with `lastSuccessfulTime` before the step's end) is
+    /// continued from the time reached until the step's end; a return that makes no
+    /// progress is an error naming the time.
+    fn do_step(&mut self, core: &mut Core, time: f64, step: f64) -> Result<()> {
+        let f = f3!(core, self.a, do_step, "fmi3DoStep");
+        let c = core.component;
+        let end = time + step;
+        let mut at = time;
+        // each early return must make progress; a bound on the returns per step besides,
+        // so that an FMU creeping forward by ulps cannot hold the run forever
+        for _ in 0..1000 {
+            let (mut event, mut terminate, mut early, mut reached) = (0u8, 0u8, 0u8, at);
+            call!(
+                core,
+                "fmi3DoStep",
+                Some(at),
+                f(c, at, end - at, 1, &mut event, &mut terminate, &mut early, &mut reached)
+            )?;
+            if terminate != 0 {
+                let reached = if early != 0 && reached.is_finite() { reached } else { end };
+                return Err(self.terminated_at(core, "fmi3DoStep", at, reached));
+            }
+            if event != 0 && self.event_mode {
+                let reached = if early != 0 { reached } else { end };
+                core.time = reached;
+                if let Some(t) = self.cs_event(core, reached)? {
+                    return Err(self.terminated_at(core, "fmi3UpdateDiscreteStates", t, t));
+                }
+            }
+            if early == 0 {
+                core.time = end;
+                return Ok(());
+            }
+            if !(reached > at && reached <= end) {
+                core.state = InstanceState::Errored;
+                return Err(core.error(
+                    "fmi3DoStep",
+                    at,
+                    format!(
+                        "returned early at lastSuccessfulTime = {reached} s, no progress from {at} s toward the step's end {end} s"
+                    ),
+                ));
+            }
+            if reached == end {
+                core.time = end;
+                return Ok(());
+            }
+            at = reached;
+        }
+        core.state = InstanceState::Errored;
+        Err(core.error("fmi3DoStep", at, format!("returned early 1000 times in the step from {time} s to {end} s")))
+    }
+
+    fn posted_step(&self, time: f64, step: f64) -> Option<(crate::isolate::protocol::Op, f64)> {
+        // the arguments of the first fmi3DoStep of `do_step`
+        self.a.functions.do_step.is_some().then_some((crate::isolate::protocol::Op::DoStep3, (time + step) - time))
+    }
+
+    fn get_state(&mut self, core: &mut Core, s: &mut *mut c_void) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, get_fmu_state, "fmi3GetFMUState");
+        call!(core, "fmi3GetFMUState", None, f(c, s))
+    }
+
+    fn set_state(&mut self, core: &mut Core, s: *mut c_void) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, set_fmu_state, "fmi3SetFMUState");
+        call!(core, "fmi3SetFMUState", None, f(c, s))
+    }
+
+    fn free_state(&mut self, core: &mut Core, s: &mut *mut c_void) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, free_fmu_state, "fmi3FreeFMUState");
+        call!(core, "fmi3FreeFMUState", None, f(c, s))
+    }
+
+    #[inline]
+    fn set_time(&mut self, core: &mut Core, time: f64) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, set_time, "fmi3SetTime");
+        call!(core, "fmi3SetTime", Some(time), f(c, time))
+    }
+
+    #[inline]
+    fn set_continuous_states(&mut self, core: &mut Core, x: &[f64]) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, set_continuous_states, "fmi3SetContinuousStates");
+        call!(core, "fmi3SetContinuousStates", None, f(c, x.as_ptr(), x.len()))
+    }
+
+    fn get_continuous_states(&mut self, core: &mut Core, x: &mut [f64]) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, get_continuous_states, "fmi3GetContinuousStates");
+        call!(core, "fmi3GetContinuousStates", None, f(c, x.as_mut_ptr(), x.len()))
+    }
+
+    #[inline]
+    fn get_derivatives(&mut self, core: &mut Core, dx: &mut [f64]) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, get_continuous_state_derivatives, "fmi3GetContinuousStateDerivatives");
+        call!(core, "fmi3GetContinuousStateDerivatives", None, f(c, dx.as_mut_ptr(), dx.len()))
+    }
+
+    #[inline]
+    fn get_event_indicators(&mut self, core: &mut Core, z: &mut [f64]) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, get_event_indicators, "fmi3GetEventIndicators");
+        call!(core, "fmi3GetEventIndicators", None, f(c, z.as_mut_ptr(), z.len()))
+    }
+
+    fn has_directional_derivative(&self) -> bool {
+        self.a.functions.get_directional_derivative.is_some()
+    }
+
+    fn get_directional_derivative(
+        &mut self,
+        core: &mut Core,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, get_directional_derivative, "fmi3GetDirectionalDerivative");
+        call!(
+            core,
+            "fmi3GetDirectionalDerivative",
+            None,
+            f(
+                c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                knowns.as_ptr(),
+                knowns.len(),
+                dv_known.as_ptr(),
+                dv_known.len(),
+                dv_unknown.as_mut_ptr(),
+                dv_unknown.len()
+            )
+        )
+    }
+
+    fn enter_event_mode(&mut self, core: &mut Core) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, enter_event_mode, "fmi3EnterEventMode");
+        call!(core, "fmi3EnterEventMode", None, f(c))
+    }
+
+    /// `fmi3UpdateDiscreteStates`, its outputs as the FMI 2.0 event info
+    /// (`discreteStatesNeedUpdate` is `newDiscreteStatesNeeded`).
+    fn new_discrete_states(&mut self, core: &mut Core) -> Result<EventInfo> {
+        let c = core.component;
+        let mut info = EventInfo::default();
+        let f = f3!(core, self.a, update_discrete_states, "fmi3UpdateDiscreteStates");
+        let (mut update, mut terminate, mut nominals, mut values, mut defined) = (0u8, 0u8, 0u8, 0u8, 0u8);
+        let mut next = 0.0;
+        call!(
+            core,
+            "fmi3UpdateDiscreteStates",
+            None,
+            f(c, &mut update, &mut terminate, &mut nominals, &mut values, &mut defined, &mut next)
+        )?;
+        info.new_discrete_states_needed = (update != 0) as c_int;
+        info.terminate_simulation = (terminate != 0) as c_int;
+        info.nominals_of_continuous_states_changed = (nominals != 0) as c_int;
+        info.values_of_continuous_states_changed = (values != 0) as c_int;
+        info.next_event_time_defined = (defined != 0) as c_int;
+        info.next_event_time = next;
+        Ok(info)
+    }
+
+    fn enter_continuous_time_mode(&mut self, core: &mut Core) -> Result<()> {
+        let c = core.component;
+        let f = f3!(core, self.a, enter_continuous_time_mode, "fmi3EnterContinuousTimeMode");
+        call!(core, "fmi3EnterContinuousTimeMode", None, f(c))
+    }
+
+    fn completed_integrator_step(&mut self, core: &mut Core) -> Result<(bool, bool)> {
+        let c = core.component;
+        let f = f3!(core, self.a, completed_integrator_step, "fmi3CompletedIntegratorStep");
+        let (mut event, mut terminate) = (0u8, 0u8);
+        call!(core, "fmi3CompletedIntegratorStep", None, f(c, 1, &mut event, &mut terminate))?;
+        Ok((event != 0, terminate != 0))
+    }
+
+    /// Whether the last `fmi3DoStep` said `terminateSimulation`.
+    fn terminated_status(&mut self, _: &mut Core) -> Option<bool> {
+        Some(self.terminate_requested.is_some())
+    }
+
+    /// The `lastSuccessfulTime` of the `fmi3DoStep` that said `terminateSimulation`.
+    fn last_successful_time(&mut self, _: &mut Core) -> Option<f64> {
+        self.terminate_requested
+    }
+
+    fn free_functions(&self) -> (Option<FreeStateFunction>, FreeInstanceFunction, &'static str) {
+        (self.a.functions.free_fmu_state, self.a.functions.free_instance, "fmi3FreeInstance")
+    }
+
+    fn is_fmi3(&self) -> bool {
+        true
+    }
+}
