@@ -21,7 +21,6 @@ from pathlib import Path
 # Circles reported but not failing the check, by a path prefix of a file in them, each with
 # its reason; remove an entry when its reason is gone.
 KNOWN = {
-    "fmi-import/src/": "being restructured on its own branch (issue 37 step 2); its circles go with that work",
     "cosim/src/simulate/": "mod.rs, types.rs and the algorithms share types both ways; not yet moved (issue 37 step 5)",
     "fmi-export/src/units.rs": "its test compares with crate::si_unit of decl.rs (issue 37 step 5)",
     "fmi-export/src/instance/": "instance/mod.rs and values.rs share types both ways (issue 37 step 5)",

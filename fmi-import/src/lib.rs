@@ -18,7 +18,7 @@
 //! # Modules and what each uses
 //!
 //! Each file uses only files above it in this list (checked by
-//! `scripts/module-cycles.py fmi-import/src`: no import circle):
+//! `scripts/import-cycles.py`, a stage of the test command: no import circle):
 //!
 //! ```text
 //! status, c_types, elf, suggest, call_site, fmi3   leaves (fmi3: the FMI 3.0 view)
