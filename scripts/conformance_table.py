@@ -5,7 +5,7 @@ every case that misses that goal, marked "known" when scripts/conformance-known.
 
 usage: python conformance_table.py WORK KNOWN_FILE [--leftover TEXT]
 Exit status 1 when a case misses the goal and is not listed, or crashed, hung or gave a wrong
-value (unless listed with a reason that starts "CRASH:"); 0 otherwise.
+value (unless listed with a reason that starts "CRASH:" or "HANG:"); 0 otherwise.
 """
 import json
 import os
@@ -82,9 +82,9 @@ def main():
         for case, fmpy_ok, _, right, note, bad in rows:
             key = name + ":" + case
             if bad or (fmpy_ok and not right):
-                # a crash or hang counts as known only where the list says "CRASH:" (the FMU's
-                # own fault, shown and explained there)
-                if key in known and (not bad or known[key].startswith("CRASH:")):
+                # a crash or hang counts as known only where the list says "CRASH:" or "HANG:"
+                # (the FMU's own fault, shown and explained there)
+                if key in known and (not bad or known[key].startswith(("CRASH:", "HANG:"))):
                     n_known += 1
                     misses.append(("known", key, note, known[key]))
                 else:

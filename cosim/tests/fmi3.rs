@@ -766,6 +766,26 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
 
+/// An FMU that declares `hasEventMode` but refuses to be instantiated with `eventModeUsed`
+/// (as the Reference FMUs' Roberts does; the counter refuses it for an instance named
+/// "...no-event-mode...") gets a second try without it and runs as an FMU without Event
+/// Mode: no event is handled, n counts the steps only (the same run as the counter's
+/// description without `hasEventMode`).
+#[test]
+fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
+    let dir = work_dir("fmi3-refuses-event-mode");
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let mut b = SystemBuilder::new();
+    b.add_instance("c-no-event-mode", Fmu::load(&path).unwrap()).unwrap();
+    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
+    let n = r.column("c-no-event-mode.n").or_else(|| r.column("n")).expect("the column n");
+    assert_eq!(n, (0..11).map(|k| k as f64).collect::<Vec<_>>());
+}
+
 /// An FMI 3.0 Int64 output declared `ssc:Integer` in an SSP (as OMSimulator writes it;
 /// SSP 1.0 has no Int64), connected (written sink first) to another counter's Float64
 /// input: read, and its values beyond 32 bits carried exactly (the view carries Int64 as

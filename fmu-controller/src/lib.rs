@@ -28,8 +28,8 @@
 use core::f64::consts::FRAC_PI_2;
 use fmi_export::model_description::DefaultExperiment;
 use fmi_export::{
-    Capabilities, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model,
-    ModelResult, VarDecl, Variables,
+    Capabilities, DeclarationSpec, Dependencies, Field, InstantiateContext, Interfaces, Model, ModelResult, VarDecl,
+    Variables,
 };
 use nigel_benchmark::control::{ALONG_TRACK_SPEED_MAX, FORCE_MAX, KI_SPEED, KP_SPEED, K_ALONG_TRACK};
 use nigel_benchmark::gains::{POLE_PLACEMENT, ROBUST, ROBUST_TRACKING};

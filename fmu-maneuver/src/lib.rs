@@ -21,8 +21,8 @@ use std::sync::Arc;
 use core::f64::consts::{FRAC_PI_2, TAU};
 use fmi_export::model_description::DefaultExperiment;
 use fmi_export::{
-    declared_name, Capabilities, DeclarationSpec, Field, InstantiateContext, Interfaces, Model,
-    ModelResult, SampleEnd, Variables,
+    declared_name, Capabilities, DeclarationSpec, Field, InstantiateContext, Interfaces, Model, ModelResult, SampleEnd,
+    Variables,
 };
 use nigel_benchmark::{
     BenchSample, BenchSampler, Benchmark, DisturbanceSettings, Fidelity, Maneuver, Scenario, DEFAULT_SPEED,

@@ -33,7 +33,7 @@
 
 typedef struct {
     double time, u, y, stop_at, early_at, crash_at;
-    int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode;
+    int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode, in_event_mode;
     long long mode;
     char label[64];
     double gains[2];
@@ -60,6 +60,12 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
     const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
     fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
+    /* an instance named "...no-event-mode..." refuses eventModeUsed although the description
+       may declare hasEventMode (as the Reference FMUs' Roberts does) */
+    if (eventMode && name && strstr(name, "no-event-mode")) {
+        if (log) log(env, fmi3Error, "logStatusError", "eventModeUsed is not supported");
+        return NULL;
+    }
     Counter *c = make(token, resources, env, log);
     if (!c) return NULL;
     c->s.early_allowed = earlyReturnAllowed != 0;
@@ -106,7 +112,13 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
     ((Counter *)instance)->s.time = startTime;
     return fmi3OK;
 }
-fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { return fmi3OK; }
+/* with eventModeUsed the instance is in Event Mode after initialization (FMI 3.0): fmi3DoStep
+   is an illegal call there until fmi3EnterStepMode */
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    Counter *c = instance;
+    c->s.in_event_mode = c->s.event_mode;
+    return fmi3OK;
+}
 fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 fmi3Status fmi3Reset(fmi3Instance instance) {
     Counter *c = instance;
@@ -144,6 +156,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     Counter *c = instance;
     State *s = &c->s;
     double end = t + h;
+    if (s->in_event_mode) return fail(c, "fmi3DoStep: Illegal call sequence: in Event Mode (fmi3EnterStepMode first)");
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;
@@ -385,7 +398,11 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
 }
 
 /* Model Exchange. */
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
+    Counter *c = instance;
+    c->s.in_event_mode = c->s.event_mode;
+    return fmi3OK;
+}
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3OK; }
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     ((Counter *)instance)->s.time = time;
@@ -489,7 +506,9 @@ UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[],
 UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Counter *c = instance;
-    return c->s.event_mode ? fmi3OK : fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
+    if (!c->s.event_mode) return fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
+    c->s.in_event_mode = 0;
+    return fmi3OK;
 }
 UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
 UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)

@@ -30,8 +30,9 @@ pub(crate) struct Fmi3 {
     bytes: Vec<u8>,
     /// The values of arrays set element by element, by value reference.
     arrays: HashMap<u32, Vec<f64>>,
-    /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`).
-    event_mode: bool,
+    /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
+    /// FMU refused to be instantiated with it and accepted without).
+    event_mode: std::cell::Cell<bool>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -51,7 +52,7 @@ impl Fmi3 {
             terminate_requested: None,
             bytes: Vec::new(),
             arrays: HashMap::new(),
-            event_mode,
+            event_mode: std::cell::Cell::new(event_mode),
         }
     }
 
@@ -252,6 +253,13 @@ impl Fmi3 {
     /// most 1000 times), back to Step Mode. `Some(time)` when the FMU asked to terminate.
     fn cs_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
         self.enter_event_mode(core)?;
+        self.settle_event(core, time)
+    }
+
+    /// In Event Mode at `time`: `fmi3UpdateDiscreteStates` until no new discrete states are
+    /// needed (at most 1000 times), then `fmi3EnterStepMode`. `Some(time)` when the FMU asked
+    /// to terminate.
+    fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
         for _ in 0..1000 {
             let info = self.new_discrete_states(core)?;
             if info.terminate_simulation != 0 {
@@ -301,7 +309,7 @@ impl Calls for Fmi3 {
         fmu: &Fmu,
         name: &str,
         name_c: &CString,
-        _: &crate::c_types::CallbackFunctions,
+        callbacks: &crate::c_types::CallbackFunctions,
         log: &LogSink,
     ) -> Result<Component> {
         let a = &self.a;
@@ -321,7 +329,7 @@ impl Calls for Fmi3 {
                         a.resource_path.as_ptr(),
                         0,
                         0,
-                        self.event_mode as u8,
+                        self.event_mode.get() as u8,
                         1,
                         std::ptr::null(),
                         0,
@@ -338,6 +346,13 @@ impl Calls for Fmi3 {
                 unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
             }
         };
+        if component.is_null() && fmu.interface == Interface::CoSimulation && self.event_mode.get() {
+            // an FMU that declares hasEventMode may still refuse eventModeUsed (the Reference
+            // FMUs' Roberts does): a second try without it, the run then stepping without
+            // Event Mode as for an FMU without it
+            self.event_mode.set(false);
+            return self.instantiate(fmu, name, name_c, callbacks, log);
+        }
         if component.is_null() {
             return Err(Error::Instantiate { instance: name.into(), function, log: log.recent_problems() });
         }
@@ -351,7 +366,7 @@ impl Calls for Fmi3 {
         channel: &mut crate::isolate::channel::Channel,
         name_c: &CString,
     ) -> Result<i32> {
-        let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode);
+        let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());
         Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
     }
 
@@ -381,7 +396,17 @@ impl Calls for Fmi3 {
 
     fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
         let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
-        call!(core, "fmi3ExitInitializationMode", None, f(c))
+        call!(core, "fmi3ExitInitializationMode", None, f(c))?;
+        // instantiated with eventModeUsed, the FMU is in Event Mode now (FMI 3.0's
+        // Co-Simulation state machine): its discrete states are settled and it enters Step
+        // Mode before the first fmi3DoStep
+        if self.event_mode.get() {
+            let time = core.time;
+            if let Some(t) = self.settle_event(core, time)? {
+                return Err(self.terminated_at(core, "fmi3UpdateDiscreteStates", t, t));
+            }
+        }
+        Ok(())
     }
 
     fn terminate(&mut self, core: &mut Core) -> Result<()> {
@@ -567,7 +592,7 @@ impl Calls for Fmi3 {
                 let reached = if early != 0 && reached.is_finite() { reached } else { end };
                 return Err(self.terminated_at(core, "fmi3DoStep", at, reached));
             }
-            if event != 0 && self.event_mode {
+            if event != 0 && self.event_mode.get() {
                 let reached = if early != 0 { reached } else { end };
                 core.time = reached;
                 if let Some(t) = self.cs_event(core, reached)? {
@@ -578,7 +603,11 @@ impl Calls for Fmi3 {
                 core.time = end;
                 return Ok(());
             }
-            if !(reached > at && reached <= end) {
+            // an early return at the time already reached is progress when it was to handle
+            // an event there (Event Mode was entered and left above): the next fmi3DoStep
+            // goes on from the settled discrete states
+            let settled_here = event != 0 && self.event_mode.get() && reached == at;
+            if !(reached > at && reached <= end) && !settled_here {
                 core.state = InstanceState::Errored;
                 return Err(core.error(
                     "fmi3DoStep",
