@@ -647,6 +647,38 @@ fn a_crashing_fmi3_fmu_under_isolation_is_a_typed_error_with_the_rows_so_far() {
     }
 }
 
+/// Value references up to 4294967295 are the FMU's to use (Dymola uses 4294967294): a
+/// parameter there leaves the rest of the view whole (before, the array elements' view
+/// references were counted above the largest one, overflowed u32, and every variable was
+/// left out with a false "more than 100,000 elements"), and an array whose dimensions
+/// multiply past u64 (3 x 6148914691236517206) is left out as too large instead of wrapping
+/// around to 2 elements. The run records the same columns and values as the plain counter.
+#[test]
+fn value_references_near_2_pow_32_and_overflowing_dimensions() {
+    let dir = work_dir("fmi3-far-vr");
+    let anchor = r#"<Float64 name="crash_at" valueReference="30"#;
+    let xml = XML.replace(
+        anchor,
+        &format!(
+            "<Float64 name=\"far\" valueReference=\"4294967295\" causality=\"parameter\" variability=\"fixed\" start=\"1\"/>\n    \
+             <Float64 name=\"huge\" valueReference=\"42\" causality=\"local\" variability=\"continuous\"><Dimension start=\"3\"/><Dimension start=\"6148914691236517206\"/></Float64>\n    {anchor}"
+        ),
+    );
+    assert_ne!(xml, XML);
+    let Some(path) = build_counter(&dir, "far_vr", &xml) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let left: Vec<(&str, &str)> = fmu.not_in_view().iter().map(|(n, why)| (n.as_str(), why.as_str())).collect();
+    assert_eq!(left, [("huge", "an array of more than 100,000 elements")]);
+    assert_eq!(fmu.description().variable("far").map(|v| v.value_reference), Some(4294967295));
+    let csv = dir.join("out.csv");
+    let out = run_to_csv(&path, "0.5", &csv, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (plain_dir, plain) = counter("fmi3-far-vr-plain").unwrap();
+    let plain_csv = plain_dir.join("plain.csv");
+    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
+}
+
 /// What the master's view leaves out (String and Binary arrays) is said, not dropped
 /// silently: listed by `Fmu::not_in_view` and `cosim info` with the reason, a note of
 /// `cosim run` on stderr, and a `--set` of it an error naming the variable and the reason;

@@ -154,14 +154,19 @@ pub(crate) fn fmi2_view(
     use fmi3::ValueType as T;
     let mut special = HashMap::new();
     let mut left_out = Vec::new();
-    // value references for array elements: above every one the FMU uses
-    let mut next_vr = md.model_variables.iter().map(|v| v.value_reference as u64 + 1).max().unwrap_or(0);
+    // value references for array elements: the numbers the FMU does not use, lowest first
+    // (an FMU may use any u32, up to 4294967295 as Dymola does: the free ones are not all
+    // above its largest)
+    let used: std::collections::HashSet<u32> = md.model_variables.iter().map(|v| v.value_reference).collect();
+    let mut free_vrs = (0..=u32::MAX).filter(move |vr| !used.contains(vr));
+    let mut free_left = (u32::MAX as u64 + 1).saturating_sub(md.model_variables.len() as u64);
     // (FMU value reference, element) of each variable of the view
     let mut elements: Vec<(u32, usize)> = Vec::new();
     let mut variables: Vec<ScalarVariable> = Vec::new();
     for v in &md.model_variables {
         let dims = if v.is_array() { sizes(md, v) } else { Some(Vec::new()) };
-        let count = dims.as_ref().map(|d| d.iter().product::<u64>());
+        // a product of sizes beyond u64 is too large, not a wrapped-around small one
+        let count = dims.as_ref().map(|d| d.iter().try_fold(1u64, |a, &n| a.checked_mul(n)).unwrap_or(u64::MAX));
         let unsupported = match v.value_type {
             T::String if v.is_array() => Some(LeftOut::StringArray),
             T::Binary if v.is_array() => Some(LeftOut::BinaryArray),
@@ -176,9 +181,12 @@ pub(crate) fn fmi2_view(
             left_out.push((v.name.clone(), LeftOut::UnknownSize));
             continue;
         };
-        if count > MAX_ELEMENTS || next_vr + count > u32::MAX as u64 {
+        if count > MAX_ELEMENTS || (v.is_array() && count > free_left) {
             left_out.push((v.name.clone(), LeftOut::TooLarge));
             continue;
+        }
+        if v.is_array() {
+            free_left -= count;
         }
         let plain = !v.is_array() && matches!(v.value_type, T::Float64 | T::Int32 | T::Boolean | T::String);
         // a structural parameter is set in Configuration Mode only: read-only here
@@ -252,8 +260,8 @@ pub(crate) fn fmi2_view(
                 T::Clock => unreachable!("left out above"),
             };
             let (name, value_reference) = if v.is_array() {
-                next_vr += 1;
-                (element_name(&v.name, &dims, k as u64), (next_vr - 1) as u32)
+                let vr = free_vrs.next().expect("counted in free_left");
+                (element_name(&v.name, &dims, k as u64), vr)
             } else {
                 (v.name.clone(), v.value_reference)
             };
