@@ -433,8 +433,18 @@ impl Calls for Fmi3 {
                 f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
             );
         }
+        // an array is read once per call, not once per element: the elements of one array
+        // are asked together (a row of the results), and the FMU does not change in between
+        let mut array: Option<(u32, Vec<f64>)> = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
+                Some(access) if access.count > 1 => {
+                    if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
+                        array = Some((access.vr, self.get_all(core, access)?));
+                    }
+                    let all = &array.as_ref().expect("read above").1;
+                    *value = all.get(access.element).copied().unwrap_or(f64::NAN);
+                }
                 Some(access) => *value = self.get_element(core, access)?,
                 None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
             }
