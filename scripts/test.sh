@@ -6,6 +6,8 @@
 # cross-checks, which load the archives' linux64 libraries.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# the repository (some steps below run from a crate's folder)
+repo_dir="$PWD"
 # the target folder as an absolute path (CARGO_TARGET_DIR may be relative to the repository)
 target_dir="${CARGO_TARGET_DIR:-target}"
 case "$target_dir" in /*) ;; *) target_dir="$PWD/$target_dir" ;; esac
@@ -119,7 +121,7 @@ wait_for asan-builds
 export NIGEL_TEST_EXECUTABLES="$target_dir/test-executables.json"
 cargo test --release --workspace --no-run --message-format=json >"$NIGEL_TEST_EXECUTABLES"
 # test_executable CRATE_FOLDER TEST: the executable of the integration test TEST of the crate
-test_executable() { python3 scripts/test-executables.py "$NIGEL_TEST_EXECUTABLES" "$1" "$2"; }
+test_executable() { python3 "$repo_dir/scripts/test-executables.py" "$NIGEL_TEST_EXECUTABLES" "$1" "$2"; }
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
