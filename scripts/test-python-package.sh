@@ -50,6 +50,6 @@ PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-input --q
 cd "$repo"
 # typing: the stubs of the installed extension (_native.pyi) match what the module defines
 # (names, arguments, defaults: stubtest), and the Python half type-checks against them
-"$venv/bin/python" -m mypy.stubtest --mypy-config-file python/pyproject.toml nigel_cosim nigel_cosim._native
+"$venv/bin/python" -m mypy.stubtest --mypy-config-file python/pyproject.toml nigel_cosim
 "$venv/bin/python" -m mypy --config-file python/pyproject.toml python/nigel_cosim
 "$venv/bin/python" -m pytest python/tests -q "$@"
