@@ -19,6 +19,8 @@ fi
 [ -x "$cosim" ] || { echo "conformance: no cosim at $cosim (build it: cargo build --release -p nigel-cosim)" >&2; exit 1; }
 work="${NIGEL_CONFORMANCE_WORK:-$target_dir/conformance}"
 rm -rf "$work" && mkdir -p "$work"
+# absolute: the runners run each case from a folder of its own
+work="$(cd "$work" && pwd)"
 # each case's TMPDIR under the work folder: an FMU that leaves its unpacked files shows there
 export TMPDIR="$work/tmp" && mkdir -p "$TMPDIR"
 run_part() {
