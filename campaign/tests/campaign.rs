@@ -507,8 +507,7 @@ fn the_report_names_enumerated_values_and_draws_its_figures() {
     let pngs = report.pngs(0, &out.join("png")).unwrap();
     // the CDF and epsilon against the random column plant.m; none against maneuver.seed,
     // a noise seed, whose value orders nothing
-    let names: Vec<String> =
-        pngs.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> = pngs.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
     assert_eq!(names, ["cdf_epsilon.png", "epsilon_vs_plant_m.png"]);
     for p in &pngs {
         assert_eq!(&std::fs::read(p).unwrap()[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());

@@ -211,6 +211,20 @@ fn program_name() -> String {
         .unwrap_or_else(|| "cosim".to_string())
 }
 
+/// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (and so in every thread started
+/// after it); the set, for `sigwait`, or `None` when they could not be blocked.
+fn block_stop_signals() -> Option<libc::sigset_t> {
+    // SAFETY: plain libc calls on a local signal set.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        (libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) == 0).then_some(set)
+    }
+}
+
 /// As [`remove_on_signals`], but the first SIGINT, SIGTERM or SIGHUP only calls `stop` (which
 /// asks the program to end by itself, e.g. by setting a run's cancel flag, so that it writes
 /// what it computed, then calls [`finish_stopped`]) and gives it `grace` to do so; a second
@@ -219,14 +233,7 @@ fn program_name() -> String {
 pub fn remove_on_signals_after_stop(stop: impl FnOnce(libc::c_int) + Send + 'static, grace: std::time::Duration) {
     // SAFETY: plain libc calls on a local signal set and a local timespec.
     unsafe {
-        let mut set: libc::sigset_t = std::mem::zeroed();
-        libc::sigemptyset(&mut set);
-        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
-            libc::sigaddset(&mut set, s);
-        }
-        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
-            return;
-        }
+        let Some(set) = block_stop_signals() else { return };
         let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
             let mut first: libc::c_int = 0;
             if libc::sigwait(&set, &mut first) != 0 {
@@ -273,14 +280,7 @@ pub fn finish_stopped() -> ! {
 pub fn on_signals(cleanup: impl FnOnce(libc::c_int) + Send + 'static) {
     // SAFETY: plain libc calls on a local signal set.
     unsafe {
-        let mut set: libc::sigset_t = std::mem::zeroed();
-        libc::sigemptyset(&mut set);
-        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
-            libc::sigaddset(&mut set, s);
-        }
-        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
-            return;
-        }
+        let Some(set) = block_stop_signals() else { return };
         let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
             let mut signal: libc::c_int = 0;
             if libc::sigwait(&set, &mut signal) == 0 {

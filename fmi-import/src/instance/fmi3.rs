@@ -309,7 +309,7 @@ impl Calls for Fmi3 {
         fmu: &Fmu,
         name: &str,
         name_c: &CString,
-        callbacks: &crate::c_types::CallbackFunctions,
+        _callbacks: &crate::c_types::CallbackFunctions,
         log: &LogSink,
     ) -> Result<Component> {
         let a = &self.a;
@@ -351,7 +351,7 @@ impl Calls for Fmi3 {
             // FMUs' Roberts does): a second try without it, the run then stepping without
             // Event Mode as for an FMU without it
             self.event_mode.set(false);
-            return self.instantiate(fmu, name, name_c, callbacks, log);
+            return self.instantiate(fmu, name, name_c, _callbacks, log);
         }
         if component.is_null() {
             return Err(Error::Instantiate { instance: name.into(), function, log: log.recent_problems() });
@@ -617,7 +617,8 @@ impl Calls for Fmi3 {
             // an event there (Event Mode was entered and left above): the next fmi3DoStep
             // goes on from the settled discrete states
             let settled_here = event != 0 && self.event_mode.get() && reached == at;
-            if !(reached > at && reached <= end) && !settled_here {
+            let progressed = settled_here || (reached > at && reached <= end);
+            if !progressed {
                 core.state = InstanceState::Errored;
                 return Err(core.error(
                     "fmi3DoStep",
