@@ -37,6 +37,10 @@ pub(crate) struct Fmi3Abi {
     pub(crate) token: CString,
     /// `resourcePath`: the unpacked `resources/` folder, a native path ending in `/`.
     pub(crate) resource_path: CString,
+    /// The structural parameters set in Configuration Mode before initialization (the FMU's
+    /// variable and the value; empty: Configuration Mode is not entered). See
+    /// [`crate::structural`].
+    pub(crate) configuration: Vec<(Access, f64)>,
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.

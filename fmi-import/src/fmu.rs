@@ -82,6 +82,9 @@ pub struct Fmu {
     pub(crate) library_path: PathBuf,
     /// FMI 3.0: the variables not in the view and why (see [`crate::fmi3`]).
     pub(crate) not_in_view: Vec<(String, crate::fmi3::LeftOut)>,
+    /// FMI 3.0 with structural parameters set ([`Fmu::configured`]): the FMU as loaded,
+    /// which holds the unpacked folder.
+    pub(crate) configured_from: Option<Arc<Fmu>>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -122,6 +125,7 @@ impl Fmu {
                 special: a.special.clone(),
                 token: a.token.clone(),
                 resource_path: a.resource_path.clone(),
+                configuration: a.configuration.clone(),
             })),
         };
         Arc::new(Fmu {
@@ -137,6 +141,7 @@ impl Fmu {
             isolated_from: Some(self.clone()),
             library_path: self.library_path.clone(),
             not_in_view: self.not_in_view.clone(),
+            configured_from: None,
         })
     }
 
@@ -173,7 +178,7 @@ impl Fmu {
 
     /// The private folder it is unpacked in (removed when the last `Arc` is dropped).
     pub fn unpacked_dir(&self) -> &Path {
-        match (&self.dir, &self.isolated_from) {
+        match (&self.dir, self.isolated_from.as_ref().or(self.configured_from.as_ref())) {
             (Some(d), _) => d.path(),
             (None, Some(f)) => f.unpacked_dir(),
             (None, None) => Path::new(""),

@@ -199,7 +199,14 @@ impl Generation for Fmi3 {
             reason: "NUL in instantiationToken".into(),
         })?;
         let resource_path = crate::fmi3::resource_path(dir).ok_or_else(|| nul_in_folder(dir))?;
-        let abi = crate::fmi3::Fmi3Abi { functions, description: md, special, token, resource_path };
+        let abi = crate::fmi3::Fmi3Abi {
+            functions,
+            description: md,
+            special,
+            token,
+            resource_path,
+            configuration: Vec::new(),
+        };
         Ok((Abi::Fmi3(Arc::new(abi)), CString::default(), not_in_view))
     }
 }
@@ -379,5 +386,6 @@ fn load<G: Generation>(
         isolated_from: None,
         library_path: so,
         not_in_view,
+        configured_from: None,
     }))
 }

@@ -1120,6 +1120,19 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             v.description.as_deref().unwrap_or("")
         );
     }
+    // what FMI 3.0 adds beyond variables, one line each: structural parameters here
+    // (Configuration Mode), then model partitions (Scheduled Execution)
+    for p in nigel_cosim::structural::structural_parameters(md) {
+        let sizes = if p.sizes.is_empty() { String::new() } else { format!(", sizes {}", p.sizes.join(", ")) };
+        w!(
+            out,
+            "structural parameter {} ({}, start {}{sizes}): set with --set {}=VALUE, in Configuration Mode",
+            p.name,
+            p.variability,
+            p.start.as_deref().unwrap_or("-"),
+            p.name
+        );
+    }
     let left_out = nigel_cosim::fmi3::not_in_view(md);
     if !left_out.is_empty() {
         let each: Vec<String> = left_out.iter().map(|(name, why)| format!("{name} ({})", why.as_str())).collect();

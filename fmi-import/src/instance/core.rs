@@ -139,6 +139,11 @@ pub(crate) trait Calls: Send {
     ) -> Result<i32>;
     /// The reset function's name.
     fn reset_name(&self) -> &'static str;
+    /// FMI 3.0: Configuration Mode for the structural parameters the FMU was configured
+    /// with, in Instantiated (after instantiation and after a reset).
+    fn configure(&mut self, _core: &mut Core) -> Result<()> {
+        Ok(())
+    }
     /// The name of the function that starts the experiment (for a call out of order).
     fn setup_function(&self) -> &'static str;
     /// `fmi2SetupExperiment`; FMI 3.0 keeps the arguments for initialization.

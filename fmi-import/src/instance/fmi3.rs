@@ -56,6 +56,11 @@ impl Fmi3 {
         }
     }
 
+    /// The FMU's table and description.
+    pub(super) fn abi(&self) -> &Fmi3Abi {
+        &self.a
+    }
+
     /// The access of the view's variable `vr` when it is not a plain scalar.
     #[inline]
     fn special(&self, vr: u32) -> Option<Access> {
@@ -134,7 +139,7 @@ impl Fmi3 {
 
     /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
     /// whole and in their type's range).
-    fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
+    pub(super) fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
         use model_description::fmi3::ValueType as T;
         let c = core.component;
         let name = core
@@ -372,6 +377,10 @@ impl Calls for Fmi3 {
 
     fn reset_name(&self) -> &'static str {
         "fmi3Reset"
+    }
+
+    fn configure(&mut self, core: &mut Core) -> Result<()> {
+        self.configure_structural(core)
     }
 
     fn setup_function(&self) -> &'static str {
