@@ -18,6 +18,9 @@ pub enum Interface {
     CoSimulation,
     /// Model Exchange: the master integrates the FMU's derivatives.
     ModelExchange,
+    /// FMI 3.0 Scheduled Execution: the master activates the FMU's model partitions at
+    /// their clocks' ticks (`fmi3ActivateModelPartition`; see `instance/scheduled.rs`).
+    ScheduledExecution,
 }
 
 impl Interface {
@@ -26,12 +29,14 @@ impl Interface {
         match self {
             Interface::CoSimulation => "CoSimulation",
             Interface::ModelExchange => "ModelExchange",
+            Interface::ScheduledExecution => "ScheduledExecution",
         }
     }
     pub(crate) fn fmi_type(self) -> c_int {
         match self {
             Interface::ModelExchange => 0,
-            Interface::CoSimulation => 1,
+            // FMI 2.0's fmi2Type: an FMU has no Scheduled Execution there (refused at load)
+            Interface::CoSimulation | Interface::ScheduledExecution => 1,
         }
     }
 }
@@ -200,6 +205,7 @@ impl Fmu {
             Interface::ModelExchange => {
                 self.description.model_exchange.as_ref().is_some_and(|c| c.can_get_and_set_fmu_state)
             }
+            Interface::ScheduledExecution => false,
         };
         flag && match &self.abi {
             Abi::Fmi2(f) => f.get_fmu_state.is_some() && f.set_fmu_state.is_some() && f.free_fmu_state.is_some(),

@@ -33,9 +33,11 @@
 //! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
 //! load         -> fmu, fmi3, library, elf, unpack, isolate/proxy*  the one pipeline
 //! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
+//! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
 //! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
 //! instance/configuration -> instance/core, instance/fmi3   Configuration Mode
+//! instance/scheduled -> instance/core, instance/fmi3, instance, fmu, log   Scheduled Execution
 //! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
 //! ```
 //!
@@ -56,6 +58,7 @@ pub mod isolate;
 pub(crate) mod library;
 pub mod load;
 pub mod log;
+pub mod partitions;
 pub mod status;
 pub mod structural;
 #[doc(hidden)]

@@ -8,6 +8,7 @@ mod configuration;
 pub(crate) mod core;
 mod fmi2;
 mod fmi3;
+mod scheduled;
 
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
