@@ -35,9 +35,10 @@
 //! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
 //! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
-//! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
+//! instance/callbacks -> log                       Scheduled Execution's callbacks
+//! instance/fmi2, instance/fmi3 -> instance/core, instance/callbacks, fmu, fmi3, log, isolate/proxy*
 //! instance/configuration -> instance/core, instance/fmi3   Configuration Mode
-//! instance/scheduled -> instance/core, instance/fmi3, instance, fmu, log   Scheduled Execution
+//! instance/scheduled -> instance/core, instance/fmi3, instance/callbacks, instance, fmu, log
 //! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
 //! ```
 //!

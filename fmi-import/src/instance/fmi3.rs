@@ -35,7 +35,7 @@ pub(crate) struct Fmi3 {
     event_mode: std::cell::Cell<bool>,
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
     /// the FMU's for as long as the instance lives).
-    scheduled: Option<Box<super::scheduled::ScheduledEnvironment>>,
+    scheduled: Option<Box<super::callbacks::ScheduledEnvironment>>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.

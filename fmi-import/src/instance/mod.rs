@@ -4,6 +4,7 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod callbacks;
 mod configuration;
 pub(crate) mod core;
 mod fmi2;
