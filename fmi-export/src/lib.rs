@@ -202,7 +202,8 @@ pub mod uri;
 pub mod variables;
 
 pub use decl::{
-    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec,
+    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
+    DeclarationSpec,
     Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use fmi_sys;

@@ -210,6 +210,25 @@ impl Function {
         })
     }
 
+    /// The functions of FMI 3.0 clocks: offered when the model declares a clock
+    /// ([`crate::ClockDecl`]), else refused as [`Function::undeclared_feature`]s.
+    pub fn is_clock_function(self) -> bool {
+        use Function::*;
+        matches!(
+            self,
+            Fmi3GetClock
+                | Fmi3SetClock
+                | Fmi3GetIntervalDecimal
+                | Fmi3GetIntervalFraction
+                | Fmi3GetShiftDecimal
+                | Fmi3GetShiftFraction
+                | Fmi3SetIntervalDecimal
+                | Fmi3SetIntervalFraction
+                | Fmi3SetShiftDecimal
+                | Fmi3SetShiftFraction
+        )
+    }
+
     /// The interface the function belongs to.
     pub fn scope(self) -> Scope {
         use Function::*;
@@ -319,8 +338,22 @@ impl Function {
             | Fmi3GetBinary => READ | mask(&[Instantiated]),
             // Clocks are active in Event Mode only
             Fmi3GetClock | Fmi3SetClock => mask(&[EventMode]),
-            // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode)
-            Fmi3EnterEventMode | Fmi3SetTime => mask(&[ContinuousTimeMode]),
+            // the intervals and shifts of time-based clocks: Initialization Mode and Event
+            // Mode (Scheduled Execution's Clock Activation Mode is not offered)
+            Fmi3GetIntervalDecimal
+            | Fmi3GetIntervalFraction
+            | Fmi3GetShiftDecimal
+            | Fmi3GetShiftFraction
+            | Fmi3SetIntervalDecimal
+            | Fmi3SetIntervalFraction
+            | Fmi3SetShiftDecimal
+            | Fmi3SetShiftFraction => mask(&[InitializationMode, EventMode]),
+            // Co-Simulation with Event Mode (an FMU with clocks): Event Mode back to Step Mode
+            Fmi3EnterStepMode => mask(&[EventMode]),
+            // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode);
+            // Co-Simulation with Event Mode: from Step Mode
+            Fmi3EnterEventMode => mask(&[ContinuousTimeMode, StepComplete]),
+            Fmi3SetTime => mask(&[ContinuousTimeMode]),
             // also in Initialization Mode (not in FMI 2.0)
             Fmi3GetContinuousStateDerivatives => {
                 mask(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated, Error])
