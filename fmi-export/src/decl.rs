@@ -1166,9 +1166,9 @@ fn clocked_rows<B>(spec: &DeclarationSpec<B>, lookup: &HashMap<(BaseType, u32), 
     }
     let mut rows = Vec::new();
     for h in &clock.governs {
-        let row = *lookup
-            .get(&(h.base_type, h.value_reference))
-            .ok_or_else(|| format!("clock {}: governs an unknown {:?} vr {}", clock.name, h.base_type, h.value_reference))?;
+        let row = *lookup.get(&(h.base_type, h.value_reference)).ok_or_else(|| {
+            format!("clock {}: governs an unknown {:?} vr {}", clock.name, h.base_type, h.value_reference)
+        })?;
         let v = &spec.variables[row];
         if v.causality != Causality::Output || v.variability != Variability::Discrete {
             return Err(format!(

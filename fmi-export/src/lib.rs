@@ -203,8 +203,7 @@ pub mod variables;
 
 pub use decl::{
     declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
-    DeclarationSpec,
-    Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
+    DeclarationSpec, Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use fmi_sys;
 pub use instance::Instance;

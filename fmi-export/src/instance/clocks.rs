@@ -63,10 +63,9 @@ impl<M: Model> Instance<M> {
             return err(format!("clock {} is declared, but the model answers no sample period", clock.name));
         };
         match clock.interval {
-            ClockInterval::Constant(t) if t.to_bits() != period.to_bits() => err(format!(
-                "the sample period {period} s is not the constant interval {t} s of clock {}",
-                clock.name
-            )),
+            ClockInterval::Constant(t) if t.to_bits() != period.to_bits() => {
+                err(format!("the sample period {period} s is not the constant interval {t} s of clock {}", clock.name))
+            }
             _ => Ok(()),
         }
     }

@@ -112,7 +112,7 @@ impl<M: Model> Instance<M> {
         };
         let clock =
             Self::consistent_clock(&model, initialized, clock, next_sample, time, next_event, presample, self.clocked)
-            .map_err(|e| ModelError::Error(format!("serialized state: {e}")))?;
+                .map_err(|e| ModelError::Error(format!("serialized state: {e}")))?;
         Ok(Core {
             machine,
             time,

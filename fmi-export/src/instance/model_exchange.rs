@@ -40,10 +40,7 @@ impl<M: Model> Instance<M> {
     pub fn new_discrete_states(&mut self) -> OpResult<EventUpdate> {
         if self.clocked {
             self.end_clock_activation()?;
-            return Ok(EventUpdate {
-                terminate_simulation: self.core.terminate_requested,
-                ..Default::default()
-            });
+            return Ok(EventUpdate { terminate_simulation: self.core.terminate_requested, ..Default::default() });
         }
         let now = self.core.time;
         let due = matches!(self.core.next_event, Some(te) if te <= now + time_eps(now));
