@@ -1211,6 +1211,10 @@ fn add_clocks(d3: &mut md::fmi3::ModelDescription, clocks: &[ClockDecl], clocked
     for &row in clocked_rows {
         d3.model_variables[row + 1].clocks = vec![vr];
     }
+    // a clocked variable gets its value at its clock's activations: no InitialUnknown (FMI
+    // 3.0 leaves it optional; fmpy's validation expects it left out)
+    let clocked_vrs: Vec<u32> = clocked_rows.iter().map(|&row| row as u32 + 1).collect();
+    d3.model_structure.initial_unknowns.retain(|u| !clocked_vrs.contains(&u.value_reference));
     d3.model_variables.push(c);
     if let Some(cs) = d3.co_simulation.as_mut() {
         cs.has_event_mode = true;
