@@ -53,6 +53,8 @@ def test_the_clocked_archive_validates_and_declares_its_clock(archives):
     md = read_model_description(fmu3)
     clocks = [v for v in md.modelVariables if v.type == "Clock"]
     assert [(c.name, c.causality, c.intervalVariability) for c in clocks] == [("sample_clock", "input", "fixed")]
+    # docs/fmus.md: value reference 60, after the 59 variables (time at 0, row r at r + 1)
+    assert clocks[0].valueReference == 60 == len(md.modelVariables) - 1
     clocked = sorted(v.name for v in md.modelVariables if v.clocks)
     assert clocked == sorted(HELD)
     assert md.coSimulation.hasEventMode
