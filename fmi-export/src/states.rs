@@ -10,8 +10,9 @@
 //! then read, terminate, restore an FMU state or reset, but not step), does not exist in FMI
 //! 3.0: there a Discard of `fmi3DoStep` leaves the FMU in Step Mode. FMI 2.0's error state
 //! ([`Machine::Error`]) is, for FMI 3.0, the Terminated that an `fmi3Error` leads to: the two
-//! have the same row. An FMU of ours declares no Event Mode for Co-Simulation, no clocks
-//! and no Configuration Mode, so those FMI 3.0 states never occur. An FMI 3.0 function that
+//! have the same row. An FMU of ours declares no Configuration Mode; Event Mode in
+//! Co-Simulation only with a declared clock ([`crate::ClockDecl`]), in which case
+//! [`Machine::EventMode`] is Co-Simulation's Event Mode too. An FMI 3.0 function that
 //! does the same as an FMI 2.0 one has that one's row ([`Function::counterpart`]) unless
 //! FMI 3.0 lists it in other states ([`Function::fmi3_row`]); tests/tests/fmi3_state_table.rs
 //! compares every FMI 3.0 cell with the standard's lists.
@@ -28,7 +29,7 @@ pub enum Machine {
     StepComplete,
     /// Co-Simulation, after `fmi2DoStep` returned `fmi2Discard`.
     StepFailed,
-    /// Model Exchange.
+    /// Model Exchange; Co-Simulation with a declared clock.
     EventMode,
     /// Model Exchange.
     ContinuousTimeMode,

@@ -5,9 +5,10 @@
 //! The FMUs of this layer offer Model Exchange and Co-Simulation (without Event Mode, early
 //! return or intermediate update), scalar variables of the types Float64, Int32, Boolean
 //! and Enumeration (as Int64), FMU state and its serialization, directional and adjoint
-//! derivatives as declared. Every other function (Scheduled Execution, clocks,
-//! Configuration Mode, ...) answers `fmi3Error` with a logged message naming it, as does
-//! a Get/Set of a type the FMU has no variable of.
+//! derivatives as declared; with a declared clock, the clock functions and Co-Simulation with
+//! Event Mode. Every other function (Scheduled Execution, Configuration Mode, ...) answers
+//! `fmi3Error` with a logged message naming it, as does a Get/Set of a type the FMU has no
+//! variable of.
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments, non_snake_case)]
 
 use std::collections::HashSet;
