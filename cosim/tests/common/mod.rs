@@ -2,6 +2,8 @@
 //! as proper FMI 2.0 archives: modelDescription.xml + binaries/linux64/<id>.so.
 #![allow(dead_code)]
 
+pub mod fmi3_c;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
