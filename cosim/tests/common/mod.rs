@@ -99,7 +99,7 @@ pub fn work_dir(test: &str) -> PathBuf {
 
 /// Compiles models.c for `model` into `out` (with extra `cc` flags).
 pub fn compile(model: Model, out: &Path, extra: &[&str]) {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/models.c");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/models.c");
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
         .arg(format!("-DMODEL={}", model.number()))
@@ -192,7 +192,7 @@ fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
 
 /// [`build_single_c_fmu`] with extra `cc` flags (e.g. `-DWRONG_JACOBIAN`).
 fn build_single_c_fmu_with_flags(dir: &Path, id: &str, xml: &str, flags: &[&str]) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cfmu/{id}.c"));
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../cosim/tests/cfmu/{id}.c"));
     let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
