@@ -62,6 +62,7 @@ pub mod simulate;
 pub mod ssp;
 pub mod system;
 pub mod verify;
+pub mod watchdog;
 
 /// Isolation: instances in host processes of their own ([`fmi_import::isolate`]), and the
 /// whole run in one host process ([`isolate::whole`]).

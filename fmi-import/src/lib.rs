@@ -56,6 +56,7 @@ pub mod fmi3;
 pub mod fmu;
 pub mod instance;
 pub mod isolate;
+mod janitor;
 pub(crate) mod library;
 pub mod load;
 pub mod log;

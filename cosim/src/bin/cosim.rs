@@ -179,7 +179,9 @@ struct RunArgs {
     /// Wall-clock limit of one FMU call, s (needs --isolate: the host is killed).
     #[arg(long, value_name = "SECONDS")]
     timeout_call: Option<f64>,
-    /// Wall-clock limit of the whole run, s.
+    /// Wall-clock limit of the whole run, s. In process (no --isolate) a call that never
+    /// returns cannot be stopped: 1 s past the limit the process ends, naming the call,
+    /// with the rows so far written; --isolate kills only the FMU's host.
     #[arg(long, value_name = "SECONDS")]
     timeout: Option<f64>,
     /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
@@ -546,6 +548,8 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
+            // in process, a call that never returns is stopped by ending the process
+            let _watchdog = experiment.timeout.filter(|_| args.isolate.is_none()).map(nigel_cosim::watchdog::start);
             match nigel_cosim::simulate::Execution::new(&system, &experiment) {
                 Ok(mut execution) => {
                     if std::io::stderr().is_terminal() {
@@ -737,11 +741,8 @@ fn report_exit_inside_calls(output: Option<PathBuf>, format: Option<OutputFormat
             .collect(),
         _ => Default::default(),
     };
-    nigel_cosim::on_exit_inside_call(Box::new(move |call, rows| {
-        match call {
-            Some(c) => eprintln!("cosim: {c}"),
-            None => eprintln!("cosim: exit() was called during the run, outside an FMU call of the calling thread"),
-        }
+    nigel_cosim::on_exit_inside_call(Box::new(move |what, rows| {
+        eprintln!("cosim: {what}");
         let (Some(path), Some(format)) = (&output, format) else { return };
         let Some(results) = rows.filter(|r| r.rows() > 0) else {
             eprintln!("cosim: no rows to write to {}", path.display());

@@ -618,6 +618,16 @@ impl<'s> Execution<'s> {
                 pool.put(lane.index, lane.inst);
             }
         }
+        // freed here, not dropped: a host process that ends in fmi2FreeInstance (an FMU
+        // that crashes in it) fails the run, its rows kept
+        let mut freed = Ok(());
+        for lane in std::mem::take(&mut core.lanes) {
+            let result = lane.inst.free();
+            if freed.is_ok() {
+                freed = result;
+            }
+        }
+        freed?;
         drop(core);
         summary.instance_time = self.system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
         summary.wall_time = self.wall.elapsed();

@@ -94,6 +94,9 @@ impl Core {
             Status::Error | Status::Pending | Status::Invalid(_) => self.state = InstanceState::Errored,
             Status::Fatal => self.state = InstanceState::Fatal,
         }
+        if let Some((needed, available)) = self.host.as_mut().and_then(|h| h.over_limit.take()) {
+            return Err(Error::IsolationLimit { instance: self.name.clone(), function, needed, available });
+        }
         if let Some(cause) = self.host.as_ref().and_then(|h| h.failure.clone()) {
             let time = time.unwrap_or(self.host.as_ref().map_or(0.0, |h| h.last_time));
             return Err(Error::Host { instance: self.name.clone(), function, time, cause });

@@ -129,13 +129,22 @@ impl Instance {
             cause: HostEnd::Failed(m),
         };
         let host = crate::isolate::channel::find_host(isolation.host.as_deref()).map_err(failed)?;
-        let variables = fmu.description.model_variables.len();
+        // the region holds the largest call this FMU can make: every scalar value (array
+        // elements one by one), every event indicator, the instantiation's strings (the
+        // resource URI: the folder's path percent-encoded, 3 bytes a byte at most)
+        let md = &fmu.description;
+        let strings = name.len() + md.guid.len() + 3 * fmu.unpacked_dir().as_os_str().len() + 64;
+        let layout = crate::isolate::protocol::Layout::for_fmu(
+            md.model_variables.len(),
+            md.number_of_event_indicators as usize,
+            strings,
+        );
         let mut channel = Box::new(
             crate::isolate::channel::Channel::start(
                 &host,
                 &fmu.library_path,
                 calls.is_fmi3(),
-                variables,
+                layout,
                 isolation.call_timeout,
                 run_deadline,
                 crate::isolate::protocol::Spin::of_run(),
@@ -155,6 +164,9 @@ impl Instance {
         channel.log = &*log as *const LogSink;
         let status = calls.instantiate_in(&fmu, &mut channel, &name_c)?;
         if status != 0 {
+            if let Some((needed, available)) = channel.over_limit.take() {
+                return Err(Error::IsolationLimit { instance: name.into(), function: instantiate, needed, available });
+            }
             if let Some(cause) = channel.failure.clone() {
                 return Err(Error::Host { instance: name.into(), function: instantiate, time: 0.0, cause });
             }
@@ -491,8 +503,24 @@ impl Instance {
     }
 }
 
-impl Drop for Instance {
-    fn drop(&mut self) {
+impl Instance {
+    /// Terminates (if not yet) and frees the instance, as dropping it does; for an
+    /// isolated instance, the end of its host process during the free (an FMU that
+    /// crashes in its free function) is the error, naming the function.
+    pub fn free(mut self) -> Result<()> {
+        let failed_before = self.core.host.as_ref().is_some_and(|h| h.failure.is_some());
+        self.release();
+        let function = self.calls.free_functions().2;
+        let cause = self.core.host.as_ref().and_then(|h| h.failure.clone()).filter(|_| !failed_before);
+        // freed: the drop calls nothing more
+        self.core.state = InstanceState::Fatal;
+        match cause {
+            Some(cause) => Err(Error::Host { instance: self.core.name.clone(), function, time: self.core.time, cause }),
+            None => Ok(()),
+        }
+    }
+
+    fn release(&mut self) {
         if self.core.state == InstanceState::Fatal {
             return; // the standard: nothing may be called after a fatal error
         }
@@ -506,7 +534,15 @@ impl Drop for Instance {
             }
         }
         let _mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
-        // SAFETY: the component came from the instantiate call and is freed once.
+        // SAFETY: the component came from the instantiate call and is freed once (the
+        // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };
+        self.core.state = InstanceState::Fatal;
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        self.release();
     }
 }
