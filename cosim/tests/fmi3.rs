@@ -8,61 +8,12 @@
 //! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
 
 mod common;
-use common::{work_dir, zip_entries};
+use common::{build_counter, headers, python, work_dir, zip_entries};
 use nigel_cosim::{simulate, Experiment, Fmu, Instance, System, SystemBuilder, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 const XML: &str = include_str!("cfmu/fmi3_counter.xml");
-
-fn python() -> String {
-    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
-}
-
-/// The folder of the FMI 3.0 headers in fmpy's package, `None` (skip) without fmpy.
-fn headers() -> Option<PathBuf> {
-    let out = Command::new(python())
-        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success());
-    match out {
-        Some(o) => Some(PathBuf::from(String::from_utf8_lossy(&o.stdout).trim())),
-        None => {
-            assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
-            eprintln!("fmpy not importable with {}: FMI 3.0 tests skipped", python());
-            None
-        }
-    }
-}
-
-/// Builds `<dir>/<stem>.fmu` from fmi3_counter.c with `xml` as its description.
-fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
-    let headers = headers()?;
-    let so = dir.join("fmi3_counter.so");
-    {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/fmi3_counter.c");
-        let status = Command::new("cc")
-            .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
-            .arg("-I")
-            .arg(&headers)
-            .arg(&src)
-            .arg("-o")
-            .arg(&so)
-            .status()
-            .expect("run cc");
-        assert!(status.success(), "cc failed for fmi3_counter.c");
-    }
-    let fmu = dir.join(format!("{stem}.fmu"));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            ("binaries/x86_64-linux/fmi3_counter.so", std::fs::read(&so).unwrap()),
-        ],
-    );
-    Some(fmu)
-}
 
 fn counter(test: &str) -> Option<(PathBuf, PathBuf)> {
     let dir = work_dir(test);

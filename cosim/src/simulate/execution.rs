@@ -103,7 +103,13 @@ impl<'s> Execution<'s> {
         }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
-            Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
+            Some(names) => names
+                .iter()
+                .map(|n| system.resolve_record(n))
+                .collect::<Result<Vec<_>>>()?
+                .into_iter()
+                .flatten()
+                .collect(),
         };
         if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
             return Err(Error::Import(crate::ImportError::InvalidValue {
