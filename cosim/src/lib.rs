@@ -39,7 +39,7 @@ pub mod bdf;
 pub mod check;
 pub mod compare;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{fmi3, instance, load, unpack};
+pub use fmi_import::{fmi3, instance, load, partitions, structural, unpack};
 /// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
 /// [`load`] in one place, as the master uses them).
 pub mod fmu {

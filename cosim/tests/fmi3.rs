@@ -8,10 +8,12 @@
 //! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
 
 mod common;
-use common::{build_counter, headers, python, work_dir, zip_entries};
+use common::{build_counter, work_dir};
 use nigel_cosim::{simulate, Experiment, Fmu, Instance, System, SystemBuilder, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use common::fmi3_c::python;
 
 const XML: &str = include_str!("cfmu/fmi3_counter.xml");
 
@@ -682,10 +684,12 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
 }
 
 /// An array whose `<Dimension>` names a structural parameter has the size of the parameter's
-/// start value: recorded as its elements as a fixed-size array is; setting the structural
-/// parameter (Configuration Mode, which the master does not run) is refused saying so.
+/// start value: recorded as its elements as a fixed-size array is. Setting the structural
+/// parameter gives the array its new size in the view; this FMU answers
+/// `fmi3EnterConfigurationMode` with fmi3Error, and the run says so (Configuration Mode
+/// itself: `fmi3_configuration.rs`).
 #[test]
-fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter_is_read_only() {
+fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
     let dir = work_dir("fmi3-structural");
     let sized = XML
         .replace(
@@ -712,8 +716,12 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter
     }
     let mut builder = SystemBuilder::new();
     builder.add_instance("c", fmu).unwrap();
-    let e = builder.set("c.size", Value::Real(4.0)).map(|_| ()).unwrap_err();
-    assert!(e.to_string().contains("an FMI 3.0 structural parameter is set in Configuration Mode"), "{e}");
+    builder.set("c.size", Value::Real(4.0)).unwrap();
+    let system = builder.build();
+    let names: Vec<&str> = system.description(0).model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..28], ["arr[1]", "arr[2]", "arr[3]", "arr[4]"]);
+    let e = simulate(&system, &Experiment::new(0.5, 0.1)).unwrap_err();
+    assert!(e.to_string().contains("fmi3EnterConfigurationMode"), "{e}");
 }
 
 /// Co-Simulation event mode: an FMU with `hasEventMode` is instantiated with `eventModeUsed`;

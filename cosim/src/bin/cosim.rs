@@ -134,7 +134,9 @@ impl LimitArgs {
 struct RunArgs {
     /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
-    /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
+    /// FMI interface: cs (Co-Simulation), me (Model Exchange) or se (FMI 3.0 Scheduled
+    /// Execution, one FMU: its model partitions activated at their clocks' ticks); default: cs
+    /// if the FMU has it, else me, else se.
     #[arg(long)]
     interface: Option<String>,
     /// Start time, s (negative times are times like any other; default 0, for an SSP its
@@ -340,7 +342,8 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         None => None,
         Some("cs") => Some(Interface::CoSimulation),
         Some("me") => Some(Interface::ModelExchange),
-        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)")).into()),
+        Some("se") => Some(Interface::ScheduledExecution),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me, se)")).into()),
     };
     let format = match &args.output {
         None => None,
@@ -421,7 +424,11 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     );
                 }
             }
+            let scheduled = instance.fmu.interface() == Interface::ScheduledExecution;
             for (name, why) in instance.fmu.not_in_view() {
+                if scheduled && *why == nigel_cosim::fmi3::LeftOut::Clock {
+                    continue; // recorded as its ticks
+                }
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
                     instance.name,
@@ -534,6 +541,10 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                 summary
             });
             (run.results, outcome)
+        }
+        _ if nigel_cosim::simulate::is_scheduled(&system) => {
+            let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
+            (results, outcome.map_err(Some))
         }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
@@ -1120,6 +1131,34 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             range,
             v.description.as_deref().unwrap_or("")
         );
+    }
+    // what FMI 3.0 adds beyond variables, one line each: structural parameters here
+    // (Configuration Mode), then model partitions (Scheduled Execution)
+    for p in nigel_cosim::structural::structural_parameters(md) {
+        let sizes = if p.sizes.is_empty() { String::new() } else { format!(", sizes {}", p.sizes.join(", ")) };
+        w!(
+            out,
+            "structural parameter {} ({}, start {}{sizes}): set with --set {}=VALUE, in Configuration Mode",
+            p.name,
+            p.variability,
+            p.start.as_deref().unwrap_or("-"),
+            p.name
+        );
+    }
+    match nigel_cosim::partitions::model_partitions(md) {
+        Ok(partitions) if md.scheduled_execution.is_some() => {
+            for p in partitions {
+                w!(
+                    out,
+                    "model partition {} (clock, priority {}): ticks {}; run with --interface se",
+                    p.name,
+                    p.priority,
+                    p.ticks_text()
+                );
+            }
+        }
+        Err(reason) if md.scheduled_execution.is_some() => w!(out, "model partitions: {reason}"),
+        _ => {}
     }
     let left_out = nigel_cosim::fmi3::not_in_view(md);
     if !left_out.is_empty() {

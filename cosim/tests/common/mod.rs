@@ -2,6 +2,8 @@
 //! as proper FMI 2.0 archives: modelDescription.xml + binaries/linux64/<id>.so.
 #![allow(dead_code)]
 
+pub mod fmi3_c;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -433,28 +435,6 @@ pub fn build_tolerance(dir: &Path, default_tolerance: Option<&str>) -> PathBuf {
     build_single_c_fmu(dir, "tolerance", &xml)
 }
 
-/// The Python that has fmpy (`$FMPY_PYTHON`, default `python3`).
-pub fn python() -> String {
-    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
-}
-
-/// The folder of the FMI 3.0 headers in fmpy's package, `None` (skip) without fmpy.
-pub fn headers() -> Option<PathBuf> {
-    let out = Command::new(python())
-        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success());
-    match out {
-        Some(o) => Some(PathBuf::from(String::from_utf8_lossy(&o.stdout).trim())),
-        None => {
-            assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
-            eprintln!("fmpy not importable with {}: FMI 3.0 tests skipped", python());
-            None
-        }
-    }
-}
-
 /// Builds `<dir>/<stem>.fmu` from the FMI 3.0 test FMU tests/cfmu/fmi3_counter.c with `xml` as its description.
 pub fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
     build_counter_with_flags(dir, stem, xml, &[])
@@ -462,7 +442,7 @@ pub fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
 
 /// [`build_counter`] with extra `cc` flags (`-DBIG=N`: the size of the large arrays).
 pub fn build_counter_with_flags(dir: &Path, stem: &str, xml: &str, flags: &[&str]) -> Option<PathBuf> {
-    let headers = headers()?;
+    let headers = fmi3_c::headers()?;
     let so = dir.join("fmi3_counter.so");
     {
         let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/fmi3_counter.c");

@@ -142,6 +142,23 @@ pub(crate) trait Calls: Send {
     ) -> Result<i32>;
     /// The reset function's name.
     fn reset_name(&self) -> &'static str;
+    /// FMI 3.0: Configuration Mode for the structural parameters the FMU was configured
+    /// with, in Instantiated (after instantiation and after a reset).
+    fn configure(&mut self, _core: &mut Core) -> Result<()> {
+        Ok(())
+    }
+    /// FMI 3.0 Scheduled Execution (`instance/scheduled.rs`); other interfaces: an error.
+    fn activate_model_partition(&mut self, core: &mut Core, _clock: u32, _time: f64) -> Result<bool> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
+    /// See [`Calls::activate_model_partition`].
+    fn countdown_interval(&mut self, core: &mut Core, _clock: u32) -> Result<Option<f64>> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
+    /// See [`Calls::activate_model_partition`].
+    fn output_clock_ticked(&mut self, core: &mut Core, _clock: u32) -> Result<bool> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
     /// The name of the function that starts the experiment (for a call out of order).
     fn setup_function(&self) -> &'static str;
     /// `fmi2SetupExperiment`; FMI 3.0 keeps the arguments for initialization.

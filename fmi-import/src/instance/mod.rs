@@ -4,9 +4,11 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod configuration;
 pub(crate) mod core;
 mod fmi2;
 mod fmi3;
+mod scheduled;
 
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
@@ -57,7 +59,9 @@ fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
 
 impl Instance {
     /// `fmi2Instantiate` / `fmi3Instantiate*` with the FMU's interface, logging off
-    /// (warnings and errors are still logged by the FMU and kept).
+    /// (warnings and errors are still logged by the FMU and kept); an FMU
+    /// [configured](Fmu::configured) with structural parameters then goes through
+    /// Configuration Mode to set them.
     pub fn new(fmu: &Arc<Fmu>, name: &str) -> Result<Instance> {
         if fmu.is_isolated() {
             return Err(Error::Instance {
@@ -70,7 +74,9 @@ impl Instance {
         let callbacks = callbacks_for(&log);
         let calls = calls_of(fmu);
         let component = calls.instantiate(fmu, name, &name_c, &callbacks, &log)?;
-        Ok(Instance::with(component, calls, name, name_c, log, callbacks, fmu.clone(), None))
+        let mut instance = Instance::with(component, calls, name, name_c, log, callbacks, fmu.clone(), None);
+        instance.calls.configure(&mut instance.core)?;
+        Ok(instance)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -171,7 +177,9 @@ impl Instance {
         }
         let callbacks = callbacks_for(&log);
         let component = &mut *channel as *mut crate::isolate::channel::Channel as *mut c_void;
-        Ok(Instance::with(component, calls, name, name_c, log, callbacks, fmu, Some(channel)))
+        let mut instance = Instance::with(component, calls, name, name_c, log, callbacks, fmu, Some(channel));
+        instance.calls.configure(&mut instance.core)?;
+        Ok(instance)
     }
 
     /// The instance name.
@@ -235,7 +243,8 @@ impl Instance {
         Ok(())
     }
 
-    /// `fmi2Reset` / `fmi3Reset`: back to instantiated (also after an error).
+    /// `fmi2Reset` / `fmi3Reset`: back to instantiated (also after an error; a configured
+    /// FMU's structural parameters set again in Configuration Mode).
     pub fn reset(&mut self) -> Result<()> {
         if self.core.state == InstanceState::Fatal {
             let function = self.calls.reset_name();
@@ -249,7 +258,8 @@ impl Instance {
         drop(mark);
         self.core.state = InstanceState::Instantiated;
         self.calls.forget_run();
-        self.core.status(function, raw, None)
+        self.core.status(function, raw, None)?;
+        self.calls.configure(&mut self.core)
     }
 
     /// `fmi2GetReal` / `fmi3GetFloat64` of `vrs` into `values` (same length). A NaN or
