@@ -34,7 +34,7 @@ pub(crate) fn iterate(core: &mut Core, cycle: &[String]) -> Result<usize> {
         for (new, old) in core.values.iter().zip(&before) {
             let change = (new - old).abs();
             let tolerance = RTOL * (new.abs().max(old.abs()) + 1e-6 * scale);
-            if !(change <= tolerance) {
+            if change > tolerance || change.is_nan() || tolerance.is_nan() {
                 settled = false;
                 worst = if change.is_nan() { f64::NAN } else { worst.max(change) };
             }
