@@ -817,13 +817,5 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         .unwrap_or((None, None));
     let archive = (!is_ssd).then(|| path.to_path_buf());
     let system = f.builder.build();
-    if let Some(cycle) = crate::loops::initialization_loop(&system) {
-        f.notes.push(format!(
-            "the connections {} form an algebraic loop at initialization: the run carries each connection once \
-             before leaving initialization mode (no fixed-point iteration), so values on the loop may differ \
-             from a converged initialization",
-            cycle.join(", ")
-        ));
-    }
     Ok(SspSystem { system, default_start_stop, root_name: f.root_name, notes: f.notes, applied, archive })
 }

@@ -100,7 +100,7 @@ impl std::fmt::Display for Value {
 }
 
 /// A variable of an instance, resolved.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct VariableRef {
     /// Index of the instance in the system.
     pub instance: usize,
@@ -261,6 +261,37 @@ impl System {
                 Error::NoInstance { name: full.into(), instances: self.instance_names(), candidates }
             }
         }
+    }
+
+    /// The variables `full` names for recording: the one variable, or, when `full` names an
+    /// array of an FMI 3.0 FMU (`instance.a`), its elements in the view's order (`a[1]`,
+    /// `a[2]`, ...).
+    pub fn resolve_record(&self, full: &str) -> Result<Vec<VariableRef>> {
+        let error = match self.resolve(full) {
+            Ok(r) => return Ok(vec![r]),
+            Err(e) => e,
+        };
+        for (dot, _) in full.match_indices('.') {
+            let Some(i) = self.instance_index(&full[..dot]) else { continue };
+            let prefix = format!("{}[", &full[dot + 1..]);
+            let elements: Vec<VariableRef> = self
+                .description(i)
+                .model_variables
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.name.starts_with(&prefix) && v.name.ends_with(']'))
+                .map(|(index, v)| VariableRef {
+                    instance: i,
+                    index,
+                    value_reference: v.value_reference,
+                    base_type: BaseType::of(v),
+                })
+                .collect();
+            if !elements.is_empty() {
+                return Ok(elements);
+            }
+        }
+        Err(error)
     }
 
     /// Resolves an instance name and a variable name.

@@ -86,6 +86,9 @@ pub struct Execution<'s> {
     ended_by: Option<(String, f64, &'static str)>,
     /// What the run does that a reader may not expect ([`Summary::notes`]).
     notes: Vec<String>,
+    /// An algebraic loop at initialization (its connections, `a.y -> b.u`), iterated to
+    /// its fixed point before Initialization Mode ends.
+    init_loop: Option<Vec<String>>,
     phase: Phase,
 }
 
@@ -109,7 +112,13 @@ impl<'s> Execution<'s> {
         }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
-            Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
+            Some(names) => names
+                .iter()
+                .map(|n| system.resolve_record(n))
+                .collect::<Result<Vec<_>>>()?
+                .into_iter()
+                .flatten()
+                .collect(),
         };
         if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
             return Err(Error::Import(crate::ImportError::InvalidValue {
@@ -167,6 +176,7 @@ impl<'s> Execution<'s> {
             next: 0,
             ended_by: None,
             notes,
+            init_loop: crate::loops::initialization_loop(system),
             phase: Phase::Created,
         })
     }
@@ -334,6 +344,15 @@ impl<'s> Execution<'s> {
             lane.inst.enter_initialization_mode()?;
         }
         self.algorithm.propagate(core)?;
+        if let Some(cycle) = &self.init_loop {
+            let sweeps = super::init_loop::iterate(core, cycle)?;
+            self.notes.push(format!(
+                "the connections {} form an algebraic loop at initialization: iterated to its fixed point in {sweeps} sweep{} of the connections (to {:e} relative)",
+                cycle.join(", "),
+                if sweeps == 1 { "" } else { "s" },
+                super::init_loop::RTOL
+            ));
+        }
         for lane in core.lanes.iter_mut() {
             lane.inst.exit_initialization_mode()?;
             if lane.inst.fmu().interface() == Interface::ModelExchange {

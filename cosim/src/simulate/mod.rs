@@ -26,6 +26,7 @@ mod between;
 mod clock;
 mod driver;
 mod execution;
+mod init_loop;
 mod input;
 mod lane;
 mod me_group;

@@ -136,6 +136,20 @@ impl Fmi3 {
         })
     }
 
+    /// Element `access` within one get call, whose last array read is `array`: an array is
+    /// read once per call, not once per element (the elements of one array are asked
+    /// together, a row of the results, and the FMU does not change in between), so that
+    /// a row costs time linear in the elements.
+    fn element_of_call(&mut self, core: &mut Core, access: Access, array: &mut Option<(u32, Vec<f64>)>) -> Result<f64> {
+        if access.count <= 1 {
+            return self.get_element(core, access);
+        }
+        if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
+            *array = Some((access.vr, self.get_all(core, access)?));
+        }
+        Ok(array.as_ref().and_then(|(_, all)| all.get(access.element)).copied().unwrap_or(f64::NAN))
+    }
+
     fn get_element(&mut self, core: &mut Core, access: Access) -> Result<f64> {
         let all = self.get_all(core, access)?;
         Ok(all.get(access.element).copied().unwrap_or(f64::NAN))
@@ -480,19 +494,10 @@ impl Calls for Fmi3 {
                 f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
             );
         }
-        // an array is read once per call, not once per element: the elements of one array
-        // are asked together (a row of the results), and the FMU does not change in between
-        let mut array: Option<(u32, Vec<f64>)> = None;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
-                Some(access) if access.count > 1 => {
-                    if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
-                        array = Some((access.vr, self.get_all(core, access)?));
-                    }
-                    let all = &array.as_ref().expect("read above").1;
-                    *value = all.get(access.element).copied().unwrap_or(f64::NAN);
-                }
-                Some(access) => *value = self.get_element(core, access)?,
+                Some(access) => *value = self.element_of_call(core, access, &mut array)?,
                 None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
             }
         }
@@ -522,10 +527,11 @@ impl Calls for Fmi3 {
             return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
         }
         let get32 = self.a.functions.get_int32;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
                 Some(access) => {
-                    let x = self.get_element(core, access)?;
+                    let x = self.element_of_call(core, access, &mut array)?;
                     // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
                     *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
                         instance: core.name.clone(),
@@ -567,9 +573,10 @@ impl Calls for Fmi3 {
     #[inline]
     fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         if self.any_special(vrs) {
+            let mut array = None;
             for (vr, value) in vrs.iter().zip(values.iter_mut()) {
                 *value = match self.special(*vr) {
-                    Some(access) => self.get_element(core, access)? as i32,
+                    Some(access) => self.element_of_call(core, access, &mut array)? as i32,
                     None => {
                         let mut one = [0];
                         self.get_boolean(core, &[*vr], &mut one)?;
