@@ -41,8 +41,8 @@ pub(crate) struct Fmi3Abi {
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
 pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription) -> Option<String> {
-    if let Some(clock) = md.model_variables.iter().find(|v| v.value_type == fmi3::ValueType::Clock) {
-        return Some(format!("clocks (Clock variable {:?})", clock.name));
+    if let Some(clock) = crate::clocks::unreadable_clock(md) {
+        return Some(clock);
     }
     if md.co_simulation.is_none() && md.model_exchange.is_none() && md.scheduled_execution.is_some() {
         return Some("Scheduled Execution (the FMU offers no other interface type)".into());
@@ -117,7 +117,7 @@ pub enum LeftOut {
     StringArray,
     /// A Binary array.
     BinaryArray,
-    /// A clock (an FMU with clocks is refused at load; listed for `cosim info`).
+    /// A clock (run by the master through the clock calls; listed by `Fmu::clocks`).
     Clock,
     /// An array of more than 100,000 elements.
     TooLarge,
@@ -531,7 +531,9 @@ mod tests {
             r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
-        assert_eq!(unsupported_feature(&md).as_deref(), Some("clocks (Clock variable \"tick\")"));
+        assert_eq!(unsupported_feature(&md), None, "clocks are run (in Co-Simulation with Event Mode)");
+        let md = fmi3::ModelDescription::from_xml(&clock.replace("constant", "often")).unwrap();
+        assert!(unsupported_feature(&md).unwrap().contains("intervalVariability \"often\""));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
                 r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,

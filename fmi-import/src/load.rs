@@ -366,7 +366,7 @@ fn load<G: Generation>(
         return Err(Error::MissingSymbol { path: shown, symbol });
     }
     let (abi, resource_uri, not_in_view) = G::finish(table, described, dir.path(), path)?;
-    Ok(Arc::new(Fmu {
+    let fmu = Fmu {
         abi,
         allow_non_finite: options.allow_non_finite,
         _library: library,
@@ -379,5 +379,25 @@ fn load<G: Generation>(
         isolated_from: None,
         library_path: so,
         not_in_view,
-    }))
+    };
+    if let Some(feature) = clocks_not_run(&fmu) {
+        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
+    }
+    Ok(Arc::new(fmu))
+}
+
+/// Clocks where the master does not run them: in Model Exchange, in Co-Simulation without
+/// Event Mode (where the FMU handles its clocks itself only when it declares none as input
+/// or output), in an instance of a host process (the host protocol carries no clock call).
+fn clocks_not_run(fmu: &Fmu) -> Option<String> {
+    let clocks = fmu.clocks();
+    let first = clocks.first()?;
+    let has_event_mode = fmu.fmi3_description()?.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+    let why = match fmu.interface {
+        Interface::ModelExchange => "in Model Exchange",
+        Interface::CoSimulation if !has_event_mode => "in Co-Simulation without Event Mode (hasEventMode)",
+        Interface::CoSimulation if fmu.is_isolated() => "in an isolated instance (a host process)",
+        Interface::CoSimulation => return None,
+    };
+    Some(format!("clocks {why} (Clock variable {:?})", first.name))
 }

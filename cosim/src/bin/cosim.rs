@@ -993,6 +993,41 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     Ok(())
 }
 
+/// `cosim info` of an FMI 3.0 FMU's clocks (kind, causality, interval, shift, what each
+/// governs) and structural parameters. (Model partitions of Scheduled Execution belong
+/// after the clocks.)
+fn info_clocks(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelDescription) {
+    let clocks = nigel_cosim::clocks::clocks_of(md);
+    if !clocks.is_empty() {
+        if writeln!(out, "clocks:").is_err() {
+            return;
+        }
+        for c in &clocks {
+            let interval = match c.interval {
+                Some(i) => format!("interval {} s, shift {} s", plain(i), plain(c.shift)),
+                None if c.kind.is_time_based() => "interval from the FMU".to_string(),
+                None => "no interval".to_string(),
+            };
+            let governs =
+                if c.governs.is_empty() { String::new() } else { format!("; governs {}", c.governs.join(", ")) };
+            let line =
+                format!("  {:<24} {:<6} {:<9} {interval}{governs}", c.name, c.causality.as_str(), c.kind.as_str());
+            if writeln!(out, "{}", line.trim_end()).is_err() {
+                return;
+            }
+        }
+    }
+    let structural: Vec<&str> = md
+        .model_variables
+        .iter()
+        .filter(|v| v.causality == model_description::fmi3::Causality::StructuralParameter)
+        .map(|v| v.name.as_str())
+        .collect();
+    if !structural.is_empty() {
+        let _ = writeln!(out, "structural parameters: {}", structural.join(", "));
+    }
+}
+
 /// `cosim info` of an FMI 3.0 FMU: interface types with their capabilities, and every
 /// variable with its type and dimensions.
 fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelDescription) {
@@ -1120,7 +1155,12 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             v.description.as_deref().unwrap_or("")
         );
     }
-    let left_out = nigel_cosim::fmi3::not_in_view(md);
+    info_clocks(out, md);
+    // clocks are run (listed above), not left out
+    let left_out: Vec<_> = nigel_cosim::fmi3::not_in_view(md)
+        .into_iter()
+        .filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
+        .collect();
     if !left_out.is_empty() {
         let each: Vec<String> = left_out.iter().map(|(name, why)| format!("{name} ({})", why.as_str())).collect();
         w!(out, "not run by cosim (neither recorded, set nor connected): {}", each.join(", "));

@@ -20,7 +20,7 @@ use crate::status::Status;
 /// The FMI 3.0 calls: the library's table and description, and what an instance keeps
 /// that FMI 2.0 has no place for.
 pub(crate) struct Fmi3 {
-    a: Arc<Fmi3Abi>,
+    pub(super) a: Arc<Fmi3Abi>,
     /// What `setup_experiment` was given (tolerance, start, stop), passed on by
     /// `fmi3EnterInitializationMode`.
     experiment: (Option<f64>, f64, Option<f64>),
@@ -33,6 +33,10 @@ pub(crate) struct Fmi3 {
     /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
+    /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
+    output_clocks: Vec<u32>,
+    /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
+    pub(super) output_ticks: Vec<super::clocks::OutputTick>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -46,6 +50,11 @@ impl Fmi3 {
     pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
         let event_mode = interface == Interface::CoSimulation
             && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+        let output_clocks = crate::clocks::clocks_of(&a.description)
+            .iter()
+            .filter(|c| c.causality == crate::clocks::ClockCausality::Output)
+            .map(|c| c.value_reference)
+            .collect();
         Fmi3 {
             a,
             experiment: (None, 0.0, None),
@@ -53,6 +62,8 @@ impl Fmi3 {
             bytes: Vec::new(),
             arrays: HashMap::new(),
             event_mode: std::cell::Cell::new(event_mode),
+            output_clocks,
+            output_ticks: Vec::new(),
         }
     }
 
@@ -236,7 +247,7 @@ impl Fmi3 {
     /// `terminateSimulation` from `function` (called at `at`) at the time `reached`,
     /// reported as FMI 2.0 reports it: a Discard, with `terminated_status` true and
     /// `last_successful_time` `reached`.
-    fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
+    pub(super) fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
         core.time = reached;
         self.terminate_requested = Some(reached);
         Error::Fmi {
@@ -259,13 +270,14 @@ impl Fmi3 {
     /// In Event Mode at `time`: `fmi3UpdateDiscreteStates` until no new discrete states are
     /// needed (at most 1000 times), then `fmi3EnterStepMode`. `Some(time)` when the FMU asked
     /// to terminate.
-    fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
+    pub(super) fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
         for _ in 0..1000 {
             let info = self.new_discrete_states(core)?;
             if info.terminate_simulation != 0 {
                 return Ok(Some(time));
             }
             if info.new_discrete_states_needed == 0 {
+                self.read_output_clocks(core, time)?;
                 let f = f3!(core, self.a, enter_step_mode, "fmi3EnterStepMode");
                 let c = core.component;
                 call!(core, "fmi3EnterStepMode", Some(time), f(c))?;
@@ -278,6 +290,25 @@ impl Fmi3 {
             time,
             "asked for new discrete states 1000 times in one event".into(),
         ))
+    }
+}
+
+impl Fmi3 {
+    /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`), kept for
+    /// `take_output_ticks`.
+    fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
+        if self.output_clocks.is_empty() {
+            return Ok(());
+        }
+        let vrs = self.output_clocks.clone();
+        let mut ticks = vec![false; vrs.len()];
+        super::clocks::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
+        for (vr, ticked) in vrs.into_iter().zip(ticks) {
+            if ticked {
+                self.output_ticks.push(super::clocks::OutputTick { time, value_reference: vr });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -419,6 +450,7 @@ impl Calls for Fmi3 {
     }
 
     fn forget_run(&mut self) {
+        self.output_ticks.clear();
         self.terminate_requested = None;
     }
 
@@ -786,5 +818,9 @@ impl Calls for Fmi3 {
 
     fn is_fmi3(&self) -> bool {
         true
+    }
+
+    fn clock_calls(&mut self) -> Option<&mut dyn super::clocks::ClockCalls> {
+        Some(self)
     }
 }

@@ -4,6 +4,7 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod clocks;
 pub(crate) mod core;
 mod fmi2;
 mod fmi3;
@@ -11,6 +12,7 @@ mod fmi3;
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
+pub use self::clocks::{Interval, OutputTick};
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
 use crate::c_types::{CallbackFunctions, EventInfo};
