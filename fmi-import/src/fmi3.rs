@@ -532,7 +532,10 @@ mod tests {
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
         assert_eq!(unsupported_feature(&md), None, "clocks are run (in Co-Simulation with Event Mode)");
-        let md = fmi3::ModelDescription::from_xml(&clock.replace("constant", "often")).unwrap();
+        let md = fmi3::ModelDescription::from_xml(
+            &clock.replace(r#"intervalVariability="constant""#, r#"intervalVariability="often""#),
+        )
+        .unwrap();
         assert!(unsupported_feature(&md).unwrap().contains("intervalVariability \"often\""));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
