@@ -419,7 +419,10 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     );
                 }
             }
-            for (name, why) in instance.fmu.not_in_view() {
+            // clocks are run and their ticks counted in the summary, not recorded as columns
+            for (name, why) in
+                instance.fmu.not_in_view().iter().filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
+            {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
                     instance.name,

@@ -23,6 +23,7 @@ use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
 use crate::simulate::observer::{Cancel, Deadline, Observer, Observers, Profiler, Progress, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Op, Plan};
+use crate::simulate::ticks::Ticks;
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
 use crate::system::{BaseType, System, Value, VariableRef};
 use std::sync::atomic::AtomicBool;
@@ -86,6 +87,8 @@ pub struct Execution<'s> {
     ended_by: Option<(String, f64, &'static str)>,
     /// What the run does that a reader may not expect ([`Summary::notes`]).
     notes: Vec<String>,
+    /// The input file's columns of triggered input clocks: (instance, clock, tick times).
+    clock_inputs: Vec<(usize, u32, Vec<f64>)>,
     phase: Phase,
 }
 
@@ -130,7 +133,14 @@ impl<'s> Execution<'s> {
             _ => Box::new(Jacobi),
         };
         let mut notes = Vec::new();
-        if let Some(table) = &experiment.input {
+        let (input, clock_inputs) = match &experiment.input {
+            Some(table) => {
+                let (rest, clocks) = crate::simulate::ticks::clock_columns(system, table)?;
+                (Some(rest), clocks)
+            }
+            None => (None, Vec::new()),
+        };
+        if let Some(table) = input.as_ref().filter(|t| !t.names.is_empty() || clock_inputs.is_empty()) {
             if experiment.threads > 1 {
                 return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
             }
@@ -161,6 +171,7 @@ impl<'s> Execution<'s> {
             next: 0,
             ended_by: None,
             notes,
+            clock_inputs,
             phase: Phase::Created,
         })
     }
@@ -337,6 +348,26 @@ impl<'s> Execution<'s> {
                     lane.solo = Some(solo);
                 }
             }
+        }
+        // FMI 3.0 clocks: the ticks of the input clocks scheduled (from the intervals the
+        // FMU gave in the event that ends initialization); the ticks at the start time are
+        // the first step's
+        for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
+            let clocks = spec.fmu.clocks();
+            if clocks.is_empty() || lane.unit.is_some() {
+                continue;
+            }
+            if lane.inst.fmu().is_isolated() {
+                return Err(Error::Experiment(format!(
+                    "{}: clocks in an isolated instance (a host process), which cosim does not support",
+                    spec.name
+                )));
+            }
+            let triggered: Vec<(u32, Vec<f64>)> =
+                self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
+            let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
+            ticks.after_events(&mut lane.inst, true)?;
+            lane.ticks = Some(ticks);
         }
         // the initial event iteration of every Model Exchange group
         for lane in core.lanes.iter_mut() {
@@ -580,7 +611,11 @@ impl<'s> Execution<'s> {
             notes: std::mem::take(&mut self.notes),
             ..Summary::default()
         };
+        let single = core.lanes.len() == 1;
         for lane in core.lanes.iter_mut() {
+            if let Some(ticks) = &lane.ticks {
+                summary.clock_ticks.extend(ticks.summary(lane.inst.name(), single));
+            }
             summary.discard_retries += lane.retries;
             if let Some(state) = lane.saved.take() {
                 lane.inst.free_state(state)?;

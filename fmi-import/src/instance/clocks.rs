@@ -42,6 +42,8 @@ pub(crate) trait ClockCalls {
     /// The output clocks' ticks since the last call (in Event Mode entered by a tick or by
     /// the FMU's own event in `fmi3DoStep`).
     fn take_output_ticks(&mut self) -> Vec<OutputTick>;
+    /// What the FMU said of its input clocks' intervals in the events since the last call.
+    fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)>;
 }
 
 impl ClockCalls for Fmi3 {
@@ -163,6 +165,10 @@ impl ClockCalls for Fmi3 {
     fn take_output_ticks(&mut self) -> Vec<OutputTick> {
         std::mem::take(&mut self.output_ticks)
     }
+
+    fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)> {
+        std::mem::take(&mut self.intervals)
+    }
 }
 
 /// The error of a clock call on an instance whose generation has no clocks.
@@ -231,5 +237,12 @@ impl Instance {
     /// `fmi3GetClock` in an event: a tick's, or one the FMU asked for in `fmi3DoStep`).
     pub fn take_output_ticks(&mut self) -> Vec<OutputTick> {
         self.calls.clock_calls().map(|c| c.take_output_ticks()).unwrap_or_default()
+    }
+
+    /// What the FMU said of its input clocks' intervals (fixed, tunable, changing,
+    /// countdown; `fmi3GetIntervalDecimal` in every event, initialization's included) since
+    /// the last call: (event time, clock, interval).
+    pub fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)> {
+        self.calls.clock_calls().map(|c| c.take_intervals()).unwrap_or_default()
     }
 }

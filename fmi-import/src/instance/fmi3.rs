@@ -37,6 +37,11 @@ pub(crate) struct Fmi3 {
     output_clocks: Vec<u32>,
     /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
     pub(super) output_ticks: Vec<super::clocks::OutputTick>,
+    /// The input clocks whose interval the FMU gives (fixed, tunable, changing,
+    /// countdown), read by `fmi3GetIntervalDecimal` in every event.
+    interval_clocks: Vec<u32>,
+    /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
+    pub(super) intervals: Vec<(f64, u32, super::clocks::Interval)>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -50,9 +55,13 @@ impl Fmi3 {
     pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
         let event_mode = interface == Interface::CoSimulation
             && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
-        let output_clocks = crate::clocks::clocks_of(&a.description)
+        use crate::clocks::{ClockCausality, ClockKind};
+        let clocks = crate::clocks::clocks_of(&a.description);
+        let output_clocks =
+            clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
+        let interval_clocks = clocks
             .iter()
-            .filter(|c| c.causality == crate::clocks::ClockCausality::Output)
+            .filter(|c| c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered))
             .map(|c| c.value_reference)
             .collect();
         Fmi3 {
@@ -64,6 +73,8 @@ impl Fmi3 {
             event_mode: std::cell::Cell::new(event_mode),
             output_clocks,
             output_ticks: Vec::new(),
+            interval_clocks,
+            intervals: Vec::new(),
         }
     }
 
@@ -294,9 +305,15 @@ impl Fmi3 {
 }
 
 impl Fmi3 {
-    /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`), kept for
-    /// `take_output_ticks`.
+    /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`) and the
+    /// intervals of the input clocks the FMU gives (`fmi3GetIntervalDecimal`), kept for
+    /// `take_output_ticks` and `take_intervals`.
     fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
+        if !self.interval_clocks.is_empty() {
+            let vrs = self.interval_clocks.clone();
+            let intervals = super::clocks::ClockCalls::get_intervals(self, core, &vrs)?;
+            self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
+        }
         if self.output_clocks.is_empty() {
             return Ok(());
         }
@@ -451,6 +468,7 @@ impl Calls for Fmi3 {
 
     fn forget_run(&mut self) {
         self.output_ticks.clear();
+        self.intervals.clear();
         self.terminate_requested = None;
     }
 

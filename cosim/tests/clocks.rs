@@ -1,0 +1,133 @@
+//! FMI 3.0 clocks in Co-Simulation with Event Mode, with a C test FMU that counts the ticks
+//! of one input clock of every kind and of an output clock (`tests/cfmu/fmi3_clocks.c`; its
+//! comment says when each clock ticks): the tick times derived by hand below, against the
+//! counts the FMU reports at every communication point and the run's summary.
+//!
+//! The headers come from fmpy's package (`fmpy/c-code`), found with `$FMPY_PYTHON`
+//! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
+
+mod common;
+use common::{work_dir, zip_entries};
+use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Arc;
+
+/// `fmi3_clocks.fmu` built in `dir` (`None`: no fmpy, skipped).
+fn clocks_fmu(dir: &Path) -> Option<PathBuf> {
+    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let found = Command::new(&python)
+        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success());
+    let Some(found) = found else {
+        assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={python} cannot import fmpy");
+        eprintln!("fmpy not importable with {python}: FMI 3.0 clock tests skipped");
+        return None;
+    };
+    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu");
+    let so = dir.join("fmi3_clocks.so");
+    let built = Command::new("cc")
+        .args(["-shared", "-fPIC", "-O2", "-Wall", "-Wno-unused-parameter", "-Werror", "-I"])
+        .arg(String::from_utf8_lossy(&found.stdout).trim())
+        .arg(cfmu.join("fmi3_clocks.c"))
+        .arg("-o")
+        .arg(&so)
+        .status()
+        .expect("run cc");
+    assert!(built.success(), "cc failed for fmi3_clocks.c");
+    let fmu = dir.join("fmi3_clocks.fmu");
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", std::fs::read(cfmu.join("fmi3_clocks.xml")).unwrap()),
+            ("binaries/x86_64-linux/fmi3_clocks.so", std::fs::read(&so).unwrap()),
+        ],
+    );
+    Some(fmu)
+}
+
+/// The tick times of each clock in a run from 0 to 1.5 s with steps of 0.1 s and `trig`
+/// ticked by an input file at 0.45 and 1.2 s, derived by hand from the FMU's comment. A
+/// tick at the stop time is not run (no step starts there).
+///
+/// - periodic: shift 0.1 + k 0.25 = 0.1, 0.35, 0.6, 0.85, 1.1, 1.35;
+/// - fixed: 0 + k 0.4 (the FMU's interval, not the description's 0.5) = 0, 0.4, 0.8, 1.2;
+/// - changing: intervals 0.1, 0.2, 0.3, 0.4 from 0 = 0.1, 0.3, 0.6, 1.0 (then 1.5: the stop);
+/// - countdown: started at periodic's second tick (0.35) with 0.5 = 0.85;
+/// - trig: 0.45, 1.2 (the input file);
+/// - out_clock: in the events of periodic's 2nd, 4th, 6th ticks = 0.35, 0.85, 1.35.
+const TICKS: [(&str, &[f64]); 6] = [
+    ("n_periodic", &[0.1, 0.35, 0.6, 0.85, 1.1, 1.35]),
+    ("n_fixed", &[0.0, 0.4, 0.8, 1.2]),
+    ("n_changing", &[0.1, 0.3, 0.6, 1.0]),
+    ("n_countdown", &[0.85]),
+    ("n_trig", &[0.45, 1.2]),
+    ("n_out", &[0.35, 0.85, 1.35]),
+];
+
+#[test]
+fn every_kind_of_clock_ticks_at_its_times() {
+    let dir = work_dir("clocks-kinds");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.5, 0.1);
+    // the input file's clock column: 1 at the times trig ticks, 0 elsewhere
+    experiment.input = Some(Arc::new(
+        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
+            .unwrap(),
+    ));
+    let (results, summary) = simulate(&system, &experiment).unwrap();
+    let time = results.column("time").unwrap();
+    assert_eq!(time.len(), 16, "rows at 0, 0.1, ..., 1.5 s");
+    for (name, ticks) in TICKS {
+        let counts = results.column(name).unwrap();
+        for (t, n) in time.iter().zip(&counts) {
+            // the row at a point holds the values before the ticks at it: the ticks before
+            // it (times differ from the points' t0 + n h by ulps at most: 1e-9 s apart)
+            let expected = ticks.iter().filter(|tick| **tick < t - 1e-9).count() as f64;
+            assert_eq!(*n, expected, "{name} at t = {t} s: ticks {ticks:?}");
+        }
+    }
+    let last_tick = results.column("last_tick").unwrap();
+    assert_eq!(*last_tick.last().unwrap(), 1.35, "periodic's last tick, 0.1 + 5 * 0.25 s");
+    let counted: Vec<(String, u64)> = summary.clock_ticks.clone();
+    assert_eq!(
+        counted,
+        [("periodic", 6), ("fixed", 4), ("changing", 4), ("countdown", 1), ("trig", 2), ("out_clock", 3)]
+            .map(|(n, k)| (n.to_string(), k))
+    );
+}
+
+#[test]
+fn cosim_info_lists_the_clocks() {
+    let dir = work_dir("clocks-info");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let out = Command::new(env!("CARGO_BIN_EXE_cosim")).arg("info").arg(&path).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let clocks: Vec<&str> = text.lines().skip_while(|l| *l != "clocks:").skip(1).take(6).collect();
+    assert_eq!(
+        clocks[0].split_whitespace().collect::<Vec<_>>().join(" "),
+        "periodic input constant interval 0.25 s, shift 0.1 s; governs n_periodic"
+    );
+    assert!(clocks[1].contains("fixed") && clocks[1].contains("interval 0.5 s"), "{}", clocks[1]);
+    assert!(clocks[2].contains("changing") && clocks[2].contains("interval from the FMU"), "{}", clocks[2]);
+    assert!(
+        clocks[5].contains("out_clock") && clocks[5].contains("output") && clocks[5].contains("no interval"),
+        "{}",
+        clocks[5]
+    );
+}
+
+#[test]
+fn a_clock_column_for_a_periodic_clock_is_refused() {
+    let dir = work_dir("clocks-bad-input");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.0, 0.1);
+    experiment.input = Some(Arc::new(InputTable::new(vec!["periodic".into()], vec![0.0], vec![vec![1.0]]).unwrap()));
+    let e = simulate(&system, &experiment).unwrap_err().to_string();
+    assert!(e.contains("\"periodic\"") && e.contains("only triggered input clocks"), "{e}");
+}
