@@ -8,7 +8,7 @@
 
 mod common;
 use common::{work_dir, zip_entries};
-use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System};
+use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System, SystemBuilder};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
@@ -130,4 +130,34 @@ fn a_clock_column_for_a_periodic_clock_is_refused() {
     experiment.input = Some(Arc::new(InputTable::new(vec!["periodic".into()], vec![0.0], vec![vec![1.0]]).unwrap()));
     let e = simulate(&system, &experiment).unwrap_err().to_string();
     assert!(e.contains("\"periodic\"") && e.contains("only triggered input clocks"), "{e}");
+}
+
+#[test]
+fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
+    let dir = work_dir("clocks-connected");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let fmu = Fmu::load(&path).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("a", fmu.clone()).unwrap();
+    b.add_instance("b", fmu).unwrap();
+    // a clock connects to a triggered input clock only
+    let e = b.connect("a.n_out", "b.trig").unwrap_err().to_string();
+    assert!(e.contains("the destination is a clock"), "{e}");
+    let e = b.connect("a.periodic", "b.trig").unwrap_err().to_string();
+    assert!(e.contains("not an output clock"), "{e}");
+    let e = b.connect("a.out_clock", "b.periodic").unwrap_err().to_string();
+    assert!(e.contains("only a triggered input clock"), "{e}");
+    b.connect("a.out_clock", "b.trig").unwrap();
+    let e = b.connect("a.out_clock", "b.trig").unwrap_err().to_string();
+    assert!(e.contains("already connected"), "{e}");
+    let (results, summary) = simulate(&b.build(), &Experiment::new(1.5, 0.1)).unwrap();
+    // a.out_clock ticks at 0.35, 0.85, 1.35 (TICKS); each tick is carried to b.trig at the
+    // end of its step, the next point: 0.4, 0.9, 1.4 s, where b's step starts with it
+    let carried = [0.4, 0.9, 1.4];
+    let time = results.column("time").unwrap();
+    for (t, n) in time.iter().zip(results.column("b.n_trig").unwrap()) {
+        assert_eq!(n, carried.iter().filter(|tick| **tick < t - 1e-9).count() as f64, "b.n_trig at t = {t} s");
+    }
+    let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
+    assert_eq!((ticks("a.out_clock"), ticks("b.trig"), ticks("a.trig")), (Some(3), Some(3), Some(0)));
 }

@@ -104,6 +104,9 @@ impl<'s> Execution<'s> {
         if experiment.threads == 0 {
             return Err(Error::Experiment("threads must be at least 1".into()));
         }
+        if experiment.threads > 1 && !system.clock_connections.is_empty() {
+            return Err(Error::Experiment("clock connections are carried in one thread: use threads = 1".into()));
+        }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
             Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
@@ -318,6 +321,7 @@ impl<'s> Execution<'s> {
             clock: self.clock,
             profile: experiment.profile,
             parallel_steps: 0,
+            clock_links: system.clock_connections.clone(),
         });
         let t0 = self.clock.t0;
         if self.clock.steps > 0 {

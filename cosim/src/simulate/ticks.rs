@@ -70,6 +70,8 @@ pub(crate) struct Ticks {
     inputs: Vec<Scheduled>,
     /// Every clock of the instance: (value reference, name, ticks so far).
     pub(crate) counts: Vec<(u32, String, u64)>,
+    /// The output clocks that ticked since [`Ticks::take_fired`] (for clock connections).
+    fired: Vec<u32>,
     /// A millionth of the communication step, s: ticks this close are one.
     tolerance: f64,
 }
@@ -102,7 +104,7 @@ impl Ticks {
             })
             .collect();
         let counts = clocks.iter().map(|c| (c.value_reference, c.name.clone(), 0)).collect();
-        Some(Ticks { inputs, counts, tolerance: 1e-6 * h })
+        Some(Ticks { inputs, counts, fired: Vec::new(), tolerance: 1e-6 * h })
     }
 
     /// The earliest tick from `after` on and before `until` (a tick within the tolerance of
@@ -145,6 +147,7 @@ impl Ticks {
     pub(crate) fn after_events(&mut self, inst: &mut Instance, initial: bool) -> Result<()> {
         let outputs: Vec<u32> = inst.take_output_ticks().iter().map(|t| t.value_reference).collect();
         self.count(&outputs);
+        self.fired.extend(outputs);
         for (time, vr, interval) in inst.take_intervals() {
             let Some(s) = self.inputs.iter_mut().find(|s| s.vr == vr) else { continue };
             let periodic = matches!(s.kind, ClockKind::Fixed | ClockKind::Tunable);
@@ -172,6 +175,22 @@ impl Ticks {
             }
         }
         Ok(())
+    }
+
+    /// The output clocks that ticked since the last call.
+    pub(crate) fn take_fired(&mut self) -> Vec<u32> {
+        std::mem::take(&mut self.fired)
+    }
+
+    /// The triggered input clock `vr` ticks at `time` (a connected output clock ticked).
+    pub(crate) fn trigger(&mut self, vr: u32, time: f64) {
+        if let Some(s) = self.inputs.iter_mut().find(|s| s.vr == vr) {
+            let rest = &s.times[s.next_time..];
+            if !rest.contains(&time) {
+                let at = s.next_time + rest.partition_point(|t| *t < time);
+                s.times.insert(at, time);
+            }
+        }
     }
 
     /// The ticks of every clock: (name, count).

@@ -34,6 +34,28 @@ pub(crate) struct Core {
     pub(crate) profile: bool,
     /// Steps run with the instances spread over threads.
     pub(crate) parallel_steps: u64,
+    /// Connections from output clocks to triggered input clocks: (instance, clock) pairs.
+    pub(crate) clock_links: Vec<crate::system::ClockConnection>,
+}
+
+impl Core {
+    /// The ticks of output clocks in the step that ends at `t_next` carried to the
+    /// triggered input clocks connected to them: each ticks at `t_next` (the start of the
+    /// next step), as `jacobi` carries every connection one step late.
+    pub(crate) fn carry_clock_ticks(&mut self, t_next: f64) {
+        if self.clock_links.is_empty() {
+            return;
+        }
+        let fired: Vec<(usize, Vec<u32>)> =
+            self.lanes.iter_mut().filter_map(|l| Some((l.index, l.ticks.as_mut()?.take_fired()))).collect();
+        for (index, vrs) in fired {
+            for link in self.clock_links.iter().filter(|c| c.from.0 == index && vrs.contains(&c.from.1)) {
+                if let Some(ticks) = self.lanes[link.to.0].ticks.as_mut() {
+                    ticks.trigger(link.to.1, t_next);
+                }
+            }
+        }
+    }
 }
 
 /// A communication algorithm.
@@ -58,6 +80,7 @@ pub(crate) trait Communication {
         for n in steps {
             let p = core.clock.point(n);
             self.step(core, p, observers.calls())?;
+            core.carry_clock_ticks(p.t_next);
             observers.step_complete(&p, &core.values)?;
         }
         Ok(())
