@@ -161,3 +161,53 @@ fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
     assert_eq!((ticks("a.out_clock"), ticks("b.trig"), ticks("a.trig")), (Some(3), Some(3), Some(0)));
 }
+
+/// An SSP (SSP 2.0 draft: ssc:Clock connectors) of two instances of the clock FMU with
+/// `connection` (start element.connector, end element.connector) between them.
+fn clock_ssp(dir: &Path, fmu: &Path, connection: (&str, &str, &str, &str), declared: &str) -> PathBuf {
+    let connectors =
+        |kind: &str, name: &str| format!(r#"<ssd:Connector name="{name}" kind="{kind}">{declared}</ssd:Connector>"#);
+    let component = |name: &str, connector: String| {
+        format!(
+            r#"<ssd:Component name="{name}" source="resources/fmi3_clocks.fmu"><ssd:Connectors>{connector}</ssd:Connectors></ssd:Component>"#
+        )
+    };
+    let (a, out, b, input) = connection;
+    let ssd = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="2.0" name="clocks">
+  <ssd:System name="root">
+    <ssd:Elements>{}{}</ssd:Elements>
+    <ssd:Connections><ssd:Connection startElement="{a}" startConnector="{out}" endElement="{b}" endConnector="{input}"/></ssd:Connections>
+  </ssd:System>
+</ssd:SystemStructureDescription>"#,
+        component(a, connectors("output", out)),
+        component(b, connectors("input", input)),
+    );
+    let ssp = dir.join("clocks.ssp");
+    zip_entries(
+        &ssp,
+        &[("SystemStructure.ssd", ssd.into_bytes()), ("resources/fmi3_clocks.fmu", std::fs::read(fmu).unwrap())],
+    );
+    ssp
+}
+
+#[test]
+fn an_ssp_connects_clocks_as_the_ssp_2_draft_writes_them() {
+    let dir = work_dir("clocks-ssp");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let clock = r#"<ssc:Clock intervalVariability="triggered"/>"#;
+    let ssp = clock_ssp(&dir, &path, ("a", "out_clock", "b", "trig"), clock);
+    let system = nigel_cosim::ssp::read_ssp(&ssp, &Default::default()).unwrap().system;
+    assert_eq!(system.clock_connections.len(), 1);
+    let (_, summary) = simulate(&system, &Experiment::new(1.5, 0.1)).unwrap();
+    // a.out_clock's three ticks (TICKS) carried to b.trig
+    assert!(summary.clock_ticks.contains(&("b.trig".to_string(), 3)), "{:?}", summary.clock_ticks);
+    // checked like any connection: a clock to a clock only, and the declared type
+    let ssp = clock_ssp(&dir, &path, ("a", "n_out", "b", "trig"), "");
+    let e = nigel_cosim::ssp::read_ssp(&ssp, &Default::default()).err().expect("refused").to_string();
+    assert!(e.contains("the destination is a clock"), "{e}");
+    let ssp = clock_ssp(&dir, &path, ("a", "out_clock", "b", "trig"), r#"<ssc:Real/>"#);
+    let e = nigel_cosim::ssp::read_ssp(&ssp, &Default::default()).err().expect("refused").to_string();
+    assert!(e.contains("is declared Real but the variable is a clock"), "{e}");
+}
