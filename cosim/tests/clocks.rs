@@ -80,7 +80,12 @@ fn every_kind_of_clock_ticks_at_its_times() {
     ));
     let (results, summary) = simulate(&system, &experiment).unwrap();
     let time = results.column("time").unwrap();
-    assert_eq!(time.len(), 16, "rows at 0, 0.1, ..., 1.5 s");
+    // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
+    // 1.35 (periodic) and 0.45 (trig)
+    assert_eq!(time.len(), 20, "{time:?}");
+    for tick in [0.35, 0.45, 0.85, 1.35] {
+        assert!(time.contains(&tick), "a row at the tick {tick} s: {time:?}");
+    }
     for (name, ticks) in TICKS {
         let counts = results.column(name).unwrap();
         for (t, n) in time.iter().zip(&counts) {

@@ -386,18 +386,16 @@ fn load<G: Generation>(
     Ok(Arc::new(fmu))
 }
 
-/// Clocks where the master does not run them: in Model Exchange, in Co-Simulation without
-/// Event Mode (where the FMU handles its clocks itself only when it declares none as input
-/// or output), in an instance of a host process (the host protocol carries no clock call).
+/// Clocks where the master does not run them: in Co-Simulation without Event Mode, in an
+/// instance of a host process (the host protocol carries no clock call).
 fn clocks_not_run(fmu: &Fmu) -> Option<String> {
     let clocks = fmu.clocks();
     let first = clocks.first()?;
     let has_event_mode = fmu.fmi3_description()?.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
     let why = match fmu.interface {
-        Interface::ModelExchange => "in Model Exchange",
         Interface::CoSimulation if !has_event_mode => "in Co-Simulation without Event Mode (hasEventMode)",
-        Interface::CoSimulation if fmu.is_isolated() => "in an isolated instance (a host process)",
-        Interface::CoSimulation => return None,
+        _ if fmu.is_isolated() => "in an isolated instance (a host process)",
+        _ => return None,
     };
     Some(format!("clocks {why} (Clock variable {:?})", first.name))
 }

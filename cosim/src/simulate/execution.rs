@@ -104,8 +104,8 @@ impl<'s> Execution<'s> {
         if experiment.threads == 0 {
             return Err(Error::Experiment("threads must be at least 1".into()));
         }
-        if experiment.threads > 1 && !system.clock_connections.is_empty() {
-            return Err(Error::Experiment("clock connections are carried in one thread: use threads = 1".into()));
+        if experiment.threads > 1 && system.instances.iter().any(|i| !i.fmu.clocks().is_empty()) {
+            return Err(Error::Experiment("FMI 3.0 clocks are run in one thread: use threads = 1".into()));
         }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
@@ -322,6 +322,7 @@ impl<'s> Execution<'s> {
             profile: experiment.profile,
             parallel_steps: 0,
             clock_links: system.clock_connections.clone(),
+            clocked: false,
         });
         let t0 = self.clock.t0;
         if self.clock.steps > 0 {
@@ -353,13 +354,30 @@ impl<'s> Execution<'s> {
                 }
             }
         }
+        // the initial event iteration of every Model Exchange group
+        for lane in core.lanes.iter_mut() {
+            if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
+                solo.iterate(&mut crate::simulate::me_group::Solo { inst: &mut lane.inst, unit }, t0)?;
+            }
+        }
+        if let Some(g) = core.group.as_mut() {
+            g.iterate(core.lanes.as_mut_slice(), t0)?;
+        }
         // FMI 3.0 clocks: the ticks of the input clocks scheduled (from the intervals the
-        // FMU gave in the event that ends initialization); the ticks at the start time are
+        // FMU gave in the event that ends initialization, Model Exchange's initial event
+        // iteration included); the ticks at the start time are
         // the first step's
         for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
             let clocks = spec.fmu.clocks();
-            if clocks.is_empty() || lane.unit.is_some() {
+            if clocks.is_empty() {
                 continue;
+            }
+            if lane.in_group() {
+                return Err(Error::Experiment(format!(
+                    "{}: clocks of a Model Exchange instance connected to other Model Exchange instances, which \
+                     cosim does not support (connect it through a Co-Simulation FMU, or run it alone)",
+                    spec.name
+                )));
             }
             if lane.inst.fmu().is_isolated() {
                 return Err(Error::Experiment(format!(
@@ -372,15 +390,7 @@ impl<'s> Execution<'s> {
             let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
             ticks.after_events(&mut lane.inst, true)?;
             lane.ticks = Some(ticks);
-        }
-        // the initial event iteration of every Model Exchange group
-        for lane in core.lanes.iter_mut() {
-            if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
-                solo.iterate(&mut crate::simulate::me_group::Solo { inst: &mut lane.inst, unit }, t0)?;
-            }
-        }
-        if let Some(g) = core.group.as_mut() {
-            g.iterate(core.lanes.as_mut_slice(), t0)?;
+            core.clocked = true;
         }
         for lane in core.lanes.iter_mut() {
             let fmu = lane.inst.fmu();

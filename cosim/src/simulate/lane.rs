@@ -103,8 +103,13 @@ impl Lane {
     fn advance_inner(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         self.posted = false;
-        if let (None, Some(ticks)) = (&self.unit, self.ticks.as_mut()) {
-            return step_ticking(&mut self.inst, ticks, t, t_next);
+        if let Some(ticks) = self.ticks.as_mut() {
+            return match (&mut self.unit, &mut self.solo) {
+                (None, _) => step_ticking(&mut self.inst, ticks, t, t_next),
+                (Some(unit), Some(group)) => me_ticking(&mut self.inst, unit, group, ticks, solver, t, t_next),
+                // clocks of a coupled group's member are refused at initialization
+                (Some(_), None) => Ok(()),
+            };
         }
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
@@ -215,6 +220,38 @@ fn step_ticking(inst: &mut Instance, ticks: &mut Ticks, t: f64, t_next: f64) -> 
         }
         let Some((tick, vrs)) = due else { return Ok(()) };
         inst.clock_event(tick, &vrs).map_err(|e| ended_or(inst, e.into(), tick, tick))?;
+        ticks.ticked(&vrs);
+        ticks.after_events(inst, false)?;
+        at = tick;
+    }
+}
+
+/// A Model Exchange step from `t` to `t_next` of an instance with clocks (integrated on its
+/// own): integrated to each tick of its input clocks in the step, the event there (Event
+/// Mode, `fmi3SetClock` of the ticking clocks, the event iteration), on to the next.
+fn me_ticking(
+    inst: &mut Instance,
+    unit: &mut MeUnit,
+    group: &mut MeGroup,
+    ticks: &mut Ticks,
+    solver: Solver,
+    t: f64,
+    t_next: f64,
+) -> Result<()> {
+    let mut at = t;
+    loop {
+        let due = ticks.due(at, t_next);
+        let end = due.as_ref().map_or(t_next, |(tick, _)| *tick);
+        if end > at {
+            group.advance(&mut Solo { inst, unit }, solver, at, end)?;
+            ticks.after_events(inst, false)?;
+        }
+        let Some((tick, vrs)) = due else { return Ok(()) };
+        inst.set_time(tick)?;
+        inst.enter_event_mode()?;
+        inst.set_clocks(&vrs)?;
+        group.iterate(&mut Solo { inst, unit }, tick)?;
+        group.ended(&mut Solo { inst, unit }, tick)?;
         ticks.ticked(&vrs);
         ticks.after_events(inst, false)?;
         at = tick;

@@ -126,6 +126,30 @@ impl Ticks {
         Some((at, vrs))
     }
 
+    /// The first tick after `from` (beyond the tolerance) and before `until`, as far as it
+    /// is known now (a changing or countdown clock's next tick is known after the event
+    /// that gives its interval): where the master splits a communication step.
+    pub(crate) fn next_inside(&self, from: f64, until: f64) -> Option<f64> {
+        let after = |t: f64| t > from + self.tolerance;
+        let mut first = f64::INFINITY;
+        for s in &self.inputs {
+            let candidate = match s.next() {
+                Some(t) if after(t) => Some(t),
+                // the tick at `from` is the step's first: the one after it
+                Some(_) => match s.kind {
+                    ClockKind::Triggered => s.times[s.next_time..].iter().copied().find(|t| after(*t)),
+                    ClockKind::Changing | ClockKind::Countdown => None,
+                    _ => s.interval.map(|i| s.origin + (s.k + 1) as f64 * i).filter(|t| after(*t)),
+                },
+                None => None,
+            };
+            if let Some(t) = candidate {
+                first = first.min(t);
+            }
+        }
+        (first < until - self.tolerance).then_some(first)
+    }
+
     /// The clocks `vrs` ticked.
     pub(crate) fn ticked(&mut self, vrs: &[u32]) {
         for s in self.inputs.iter_mut().filter(|s| vrs.contains(&s.vr)) {

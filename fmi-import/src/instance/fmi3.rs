@@ -61,7 +61,9 @@ impl Fmi3 {
             clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
         let interval_clocks = clocks
             .iter()
-            .filter(|c| c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered))
+            .filter(|c| {
+                c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered)
+            })
             .map(|c| c.value_reference)
             .collect();
         Fmi3 {
@@ -288,7 +290,6 @@ impl Fmi3 {
                 return Ok(Some(time));
             }
             if info.new_discrete_states_needed == 0 {
-                self.read_output_clocks(core, time)?;
                 let f = f3!(core, self.a, enter_step_mode, "fmi3EnterStepMode");
                 let c = core.component;
                 call!(core, "fmi3EnterStepMode", Some(time), f(c))?;
@@ -803,6 +804,12 @@ impl Calls for Fmi3 {
         info.values_of_continuous_states_changed = (values != 0) as c_int;
         info.next_event_time_defined = (defined != 0) as c_int;
         info.next_event_time = next;
+        // the event settled: the output clocks and the intervals the FMU gives read while
+        // still in Event Mode (both interface types)
+        if update == 0 && terminate == 0 {
+            let time = core.time;
+            self.read_output_clocks(core, time)?;
+        }
         Ok(info)
     }
 
