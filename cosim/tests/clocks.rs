@@ -64,7 +64,7 @@ const TICKS: [(&str, &[f64]); 6] = [
     ("n_changing", &[0.1, 0.3, 0.6, 1.0]),
     ("n_countdown", &[0.85]),
     ("n_trig", &[0.45, 1.2]),
-    ("n_out", &[0.35, 0.85, 1.35]),
+    ("n_out_clock", &[0.35, 0.85, 1.35]),
 ];
 
 #[test]
@@ -146,7 +146,7 @@ fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     b.add_instance("a", fmu.clone()).unwrap();
     b.add_instance("b", fmu).unwrap();
     // a clock connects to a triggered input clock only
-    let e = b.connect("a.n_out", "b.trig").unwrap_err().to_string();
+    let e = b.connect("a.n_out_clock", "b.trig").unwrap_err().to_string();
     assert!(e.contains("the destination is a clock"), "{e}");
     let e = b.connect("a.periodic", "b.trig").unwrap_err().to_string();
     assert!(e.contains("not an output clock"), "{e}");
@@ -209,10 +209,66 @@ fn an_ssp_connects_clocks_as_the_ssp_2_draft_writes_them() {
     // a.out_clock's three ticks (TICKS) carried to b.trig
     assert!(summary.clock_ticks.contains(&("b.trig".to_string(), 3)), "{:?}", summary.clock_ticks);
     // checked like any connection: a clock to a clock only, and the declared type
-    let ssp = clock_ssp(&dir, &path, ("a", "n_out", "b", "trig"), "");
+    let ssp = clock_ssp(&dir, &path, ("a", "n_out_clock", "b", "trig"), "");
     let e = nigel_cosim::ssp::read_ssp(&ssp, &Default::default()).err().expect("refused").to_string();
     assert!(e.contains("the destination is a clock"), "{e}");
     let ssp = clock_ssp(&dir, &path, ("a", "out_clock", "b", "trig"), r#"<ssc:Real/>"#);
     let e = nigel_cosim::ssp::read_ssp(&ssp, &Default::default()).err().expect("refused").to_string();
     assert!(e.contains("is declared Real but the variable is a clock"), "{e}");
+}
+
+/// The README's clock figure: `cosim run` of the test FMU with an input file ticking `trig`,
+/// drawn by scripts/clock_figure.py (with fmpy's Python, which has matplotlib); the ticks it
+/// draws are TICKS, and the counts the README's caption prints are the run's summary.
+#[test]
+fn the_readme_figure_of_the_ticks_is_drawn_from_a_run() {
+    let dir = work_dir("clocks-figure");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let input = dir.join("clocks_in.csv");
+    std::fs::write(&input, "time,trig\n0,0\n0.45,1\n0.5,0\n1.2,1\n1.3,0\n").unwrap();
+    let (csv, summary) = (dir.join("clocks.csv"), dir.join("summary.json"));
+    let run = Command::new(env!("CARGO_BIN_EXE_cosim"))
+        .arg("run")
+        .arg(&path)
+        .args(["--stop-time", "1.5", "--step", "0.1", "--input"])
+        .arg(&input)
+        .arg("-o")
+        .arg(&csv)
+        .arg("--summary")
+        .arg(&summary)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let png = if std::env::var_os("NIGEL_WRITE_DOC_FIGURES").is_some() {
+        repo.join("docs/figures/clock_ticks.png")
+    } else {
+        dir.join("clock_ticks.png")
+    };
+    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let drawn = Command::new(python)
+        .arg(repo.join("scripts/clock_figure.py"))
+        .arg(&csv)
+        .arg(&summary)
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(drawn.status.success(), "{}", String::from_utf8_lossy(&drawn.stderr));
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000, "a drawn PNG");
+    // each line: clock, count, tick times
+    let printed = String::from_utf8_lossy(&drawn.stdout).to_string();
+    let mut counts = Vec::new();
+    for (line, (name, ticks)) in printed.lines().zip(TICKS) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(words[0], &name[2..], "{printed}");
+        let times: Vec<f64> = words[2..].iter().map(|w| w.parse().unwrap()).collect();
+        assert_eq!(times.len(), ticks.len(), "{name}: {printed}");
+        for (a, b) in times.iter().zip(ticks) {
+            assert!((a - b).abs() < 1e-9, "{name}: drawn {times:?}, derived {ticks:?}");
+        }
+        counts.push(format!("{} {}", words[0], words[1]));
+    }
+    let caption = format!("({})", counts.join(", "));
+    let readme = std::fs::read_to_string(repo.join("README.md")).unwrap();
+    assert!(readme.contains(&caption), "README.md's clock figure caption should say {caption}");
 }
