@@ -37,10 +37,19 @@ pub(crate) struct Fmi3Abi {
     pub(crate) token: CString,
     /// `resourcePath`: the unpacked `resources/` folder, a native path ending in `/`.
     pub(crate) resource_path: CString,
+    /// The structural parameters set in Configuration Mode before initialization (the FMU's
+    /// variable and the value; empty: Configuration Mode is not entered). See
+    /// [`crate::structural`].
+    pub(crate) configuration: Vec<(Access, f64)>,
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
-pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription) -> Option<String> {
+/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions);
+/// elsewhere the clocks are run by the master (see [`crate::clocks`]).
+pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription, scheduled: bool) -> Option<String> {
+    if scheduled {
+        return None;
+    }
     if let Some(clock) = crate::clocks::unreadable_clock(md) {
         return Some(clock);
     }
@@ -525,25 +534,26 @@ mod tests {
     #[test]
     fn clocks_and_scheduled_execution_are_named() {
         let md = fmi3::ModelDescription::from_xml(XML).unwrap();
-        assert_eq!(unsupported_feature(&md), None);
+        assert_eq!(unsupported_feature(&md, false), None);
         let clock = XML.replace(
             r#"<Float64 name="z" valueReference="9"/>"#,
             r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
-        assert_eq!(unsupported_feature(&md), None, "clocks are run (in Co-Simulation with Event Mode)");
+        assert_eq!(unsupported_feature(&md, false), None, "clocks are run (in Co-Simulation with Event Mode)");
         let md = fmi3::ModelDescription::from_xml(
             &clock.replace(r#"intervalVariability="constant""#, r#"intervalVariability="often""#),
         )
         .unwrap();
-        assert!(unsupported_feature(&md).unwrap().contains("intervalVariability \"often\""));
+        assert!(unsupported_feature(&md, false).unwrap().contains("intervalVariability \"often\""));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
                 r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,
                 r#"<ScheduledExecution modelIdentifier="m"/>"#,
             );
         let md = fmi3::ModelDescription::from_xml(&se).unwrap();
-        assert!(unsupported_feature(&md).unwrap().starts_with("Scheduled Execution"));
+        assert!(unsupported_feature(&md, false).unwrap().starts_with("Scheduled Execution"));
+        assert_eq!(unsupported_feature(&md, true), None);
     }
 
     #[test]

@@ -42,6 +42,9 @@ pub(crate) struct Fmi3 {
     interval_clocks: Vec<u32>,
     /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
     pub(super) intervals: Vec<(f64, u32, super::clocks::Interval)>,
+    /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
+    /// the FMU's for as long as the instance lives).
+    scheduled: Option<Box<super::scheduled::ScheduledEnvironment>>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -56,7 +59,12 @@ impl Fmi3 {
         let event_mode = interface == Interface::CoSimulation
             && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
         use crate::clocks::{ClockCausality, ClockKind};
-        let clocks = crate::clocks::clocks_of(&a.description);
+        // Scheduled Execution runs the clocks through its own calls (`scheduled.rs`)
+        let clocks = if interface == Interface::ScheduledExecution {
+            Vec::new()
+        } else {
+            crate::clocks::clocks_of(&a.description)
+        };
         let output_clocks =
             clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
         let interval_clocks = clocks
@@ -77,7 +85,13 @@ impl Fmi3 {
             output_ticks: Vec::new(),
             interval_clocks,
             intervals: Vec::new(),
+            scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
         }
+    }
+
+    /// The FMU's table and description.
+    pub(super) fn abi(&self) -> &Fmi3Abi {
+        &self.a
     }
 
     /// The access of the view's variable `vr` when it is not a plain scalar.
@@ -158,7 +172,7 @@ impl Fmi3 {
 
     /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
     /// whole and in their type's range).
-    fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
+    pub(super) fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
         use model_description::fmi3::ValueType as T;
         let c = core.component;
         let name = core
@@ -330,6 +344,12 @@ impl Fmi3 {
     }
 }
 
+/// The error of a Scheduled Execution call on an instance of another interface.
+#[cold]
+pub(super) fn not_scheduled(name: &str) -> Error {
+    Error::Instance { name: name.into(), reason: "it is not instantiated for Scheduled Execution (--interface se)" }
+}
+
 #[cold]
 fn not_exact(core: &Core, function: &'static str, vr: u32, value: i128) -> Error {
     Error::Fmi {
@@ -347,6 +367,7 @@ impl Calls for Fmi3 {
         match interface {
             Interface::CoSimulation => "fmi3InstantiateCoSimulation",
             Interface::ModelExchange => "fmi3InstantiateModelExchange",
+            Interface::ScheduledExecution => "fmi3InstantiateScheduledExecution",
         }
     }
 
@@ -394,6 +415,10 @@ impl Calls for Fmi3 {
                 // SAFETY: as above.
                 unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
             }
+            Interface::ScheduledExecution => match self.scheduled.as_deref() {
+                Some(scheduled) => self.instantiate_scheduled(fmu, name, name_c, log, scheduled)?,
+                None => return Err(not_scheduled(name)),
+            },
         };
         if component.is_null() && fmu.interface == Interface::CoSimulation && self.event_mode.get() {
             // an FMU that declares hasEventMode may still refuse eventModeUsed (the Reference
@@ -415,12 +440,39 @@ impl Calls for Fmi3 {
         channel: &mut crate::isolate::channel::Channel,
         name_c: &CString,
     ) -> Result<i32> {
+        if fmu.interface == Interface::ScheduledExecution {
+            return Err(Error::Instance {
+                name: String::from_utf8_lossy(name_c.as_bytes()).into_owned(),
+                reason: "Scheduled Execution is not run in a host process (its callbacks are this process's): run it without isolation",
+            });
+        }
         let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());
         Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
     }
 
     fn reset_name(&self) -> &'static str {
         "fmi3Reset"
+    }
+
+    fn configure(&mut self, core: &mut Core) -> Result<()> {
+        self.configure_structural(core)
+    }
+
+    fn activate_model_partition(&mut self, core: &mut Core, clock: u32, time: f64) -> Result<bool> {
+        let scheduled = self.scheduled.take().ok_or_else(|| not_scheduled(&core.name))?;
+        let r = self.activate(core, &scheduled, clock, time);
+        self.scheduled = Some(scheduled);
+        r
+    }
+
+    fn countdown_interval(&mut self, core: &mut Core, clock: u32) -> Result<Option<f64>> {
+        self.scheduled.as_ref().ok_or_else(|| not_scheduled(&core.name))?;
+        self.changed_interval(core, clock)
+    }
+
+    fn output_clock_ticked(&mut self, core: &mut Core, clock: u32) -> Result<bool> {
+        self.scheduled.as_ref().ok_or_else(|| not_scheduled(&core.name))?;
+        self.clock_ticked(core, clock)
     }
 
     fn setup_function(&self) -> &'static str {
