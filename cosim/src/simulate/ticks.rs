@@ -114,7 +114,8 @@ impl Ticks {
         let times: Vec<(usize, f64)> =
             self.inputs.iter().enumerate().filter_map(|(j, s)| Some((j, s.next()?))).collect();
         let first = times.iter().map(|(_, t)| *t).fold(f64::INFINITY, f64::min);
-        if !(first < until - self.tolerance) {
+        // (no tick: first is infinite)
+        if first >= until - self.tolerance {
             return None;
         }
         let at = if (first - after).abs() <= self.tolerance { after } else { first.max(after) };
@@ -226,10 +227,13 @@ impl Ticks {
     }
 }
 
+/// Triggered input clocks' tick times from an input file: (instance, clock, times).
+pub(crate) type ClockColumns = Vec<(usize, u32, Vec<f64>)>;
+
 /// The columns of `table` that name a triggered input clock (`instance.clock`, or the
 /// clock's name in a one-instance system): each clock's tick times (the rows where the
 /// column is not 0; a time once), by (instance, clock); and the table without them.
-pub(crate) fn clock_columns(system: &System, table: &InputTable) -> Result<(InputTable, Vec<(usize, u32, Vec<f64>)>)> {
+pub(crate) fn clock_columns(system: &System, table: &InputTable) -> Result<(InputTable, ClockColumns)> {
     let single = system.instances.len() == 1;
     let mut rest = InputTable { names: Vec::new(), time: table.time.clone(), columns: Vec::new() };
     let mut clocks = Vec::new();
