@@ -15,37 +15,7 @@ use std::sync::Arc;
 
 /// `fmi3_clocks.fmu` built in `dir` (`None`: no fmpy, skipped).
 fn clocks_fmu(dir: &Path) -> Option<PathBuf> {
-    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let found = Command::new(&python)
-        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success());
-    let Some(found) = found else {
-        assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={python} cannot import fmpy");
-        eprintln!("fmpy not importable with {python}: FMI 3.0 clock tests skipped");
-        return None;
-    };
-    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu");
-    let so = dir.join("fmi3_clocks.so");
-    let built = Command::new("cc")
-        .args(["-shared", "-fPIC", "-O2", "-Wall", "-Wno-unused-parameter", "-Werror", "-I"])
-        .arg(String::from_utf8_lossy(&found.stdout).trim())
-        .arg(cfmu.join("fmi3_clocks.c"))
-        .arg("-o")
-        .arg(&so)
-        .status()
-        .expect("run cc");
-    assert!(built.success(), "cc failed for fmi3_clocks.c");
-    let fmu = dir.join("fmi3_clocks.fmu");
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", std::fs::read(cfmu.join("fmi3_clocks.xml")).unwrap()),
-            ("binaries/x86_64-linux/fmi3_clocks.so", std::fs::read(&so).unwrap()),
-        ],
-    );
-    Some(fmu)
+    common::fmi3_c::build(dir, "fmi3_clocks", include_str!("cfmu/fmi3_clocks.xml"))
 }
 
 /// The tick times of each clock in a run from 0 to 1.5 s with steps of 0.1 s and `trig`
@@ -271,4 +241,75 @@ fn the_readme_figure_of_the_ticks_is_drawn_from_a_run() {
     let caption = format!("({})", counts.join(", "));
     let readme = std::fs::read_to_string(repo.join("README.md")).unwrap();
     assert!(readme.contains(&caption), "README.md's clock figure caption should say {caption}");
+}
+
+/// fmpy's FMI 3.0 calls (fmpy.fmi3.FMU3Slave) drive the FMU through the ticks derived by
+/// hand (TICKS, not cosim's schedule): to each of cosim's row times, the outputs read, then
+/// the clock event of the clocks ticking there (Event Mode, fmi3SetClock,
+/// fmi3UpdateDiscreteStates, fmi3EnterStepMode). Prints one line per row: time and the
+/// outputs.
+const FMPY_DRIVER: &str = r#"
+import sys, json
+from fmpy import extract
+from fmpy.fmi3 import FMU3Slave
+fmu, rows, ticks = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3])
+s = FMU3Slave(guid='{fmi3-clocks}', unzipDirectory=extract(fmu), modelIdentifier='fmi3_clocks', instanceName='c')
+s.instantiate(eventModeUsed=True)
+s.enterInitializationMode(startTime=0.0, stopTime=rows[-1])
+s.exitInitializationMode()
+while s.updateDiscreteStates()[0]:
+    pass
+s.enterStepMode()
+t = 0.0
+for row in rows:
+    if row > t:
+        s.doStep(t, row - t)
+        t = row
+    print(row, *s.getInt32(list(range(10, 16))), *s.getFloat64([16]))
+    due = [vr for vr, times in ticks if any(abs(x - row) < 1e-9 for x in times)]
+    if due and row < rows[-1]:
+        s.enterEventMode()
+        s.setClock(due, [True] * len(due))
+        while s.updateDiscreteStates()[0]:
+            pass
+        s.enterStepMode()
+s.terminate()
+s.freeInstance()
+"#;
+
+#[test]
+fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
+    let dir = work_dir("clocks-fmpy");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.5, 0.1);
+    experiment.input = Some(Arc::new(
+        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
+            .unwrap(),
+    ));
+    let (results, _) = simulate(&system, &experiment).unwrap();
+    let time = results.column("time").unwrap();
+    // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
+    let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();
+    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
+    let out = Command::new(python)
+        .args(["-c", FMPY_DRIVER])
+        .arg(&path)
+        .arg(format!("{time:?}"))
+        .arg(format!("[{}]", ticks.join(", ")))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let columns = ["n_periodic", "n_fixed", "n_changing", "n_countdown", "n_trig", "n_out_clock", "last_tick"];
+    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(lines.len(), time.len());
+    for (name, k) in columns.iter().zip(1..) {
+        let ours = results.column(name).unwrap();
+        let theirs: Vec<f64> = lines.iter().map(|l| l[k]).collect();
+        // counts and times the FMU stores: equal, not close
+        assert_eq!(ours, theirs, "{name}: cosim vs fmpy's calls, rows at {time:?}");
+    }
 }
