@@ -5,6 +5,7 @@
 //! frees itself on drop.
 
 mod callbacks;
+mod clocks;
 mod configuration;
 pub(crate) mod core;
 mod fmi2;
@@ -14,6 +15,7 @@ mod scheduled;
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
+pub use self::clocks::{Interval, OutputTick};
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
 use crate::c_types::{CallbackFunctions, EventInfo};
