@@ -51,7 +51,11 @@ impl ClockCalls for Fmi3 {
         let f = core.optional(self.a.functions.set_clock, "fmi3SetClock")?;
         let c = core.component;
         let on = vec![1u8; vrs.len()];
-        call!(core, "fmi3SetClock", None, f(c, vrs.as_ptr(), vrs.len(), on.as_ptr()))
+        call!(core, "fmi3SetClock", None, f(c, vrs.as_ptr(), vrs.len(), on.as_ptr()))?;
+        // the clocks are active until fmi3UpdateDiscreteStates: their clocked inputs set,
+        // their clocked outputs read
+        self.apply_queued(core, vrs)?;
+        self.read_clocked(core, vrs)
     }
 
     fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()> {

@@ -69,7 +69,11 @@ impl Fmi3 {
         let c = core.component;
         environment.clock_update.store(false, Ordering::Release);
         core.time = time;
+        // the partition's clocked inputs set before its activation, its clocked outputs
+        // read after it (held until its next)
+        self.apply_queued(core, &[clock])?;
         call!(core, "fmi3ActivateModelPartition", Some(time), f(c, clock, time))?;
+        self.read_clocked(core, &[clock])?;
         Ok(environment.clock_update.swap(false, Ordering::Acquire))
     }
 
