@@ -115,6 +115,19 @@ impl ClockedExchange {
         self.of_clocks(active, false)
     }
 
+    /// The clocked variables the master reads that hold no value (no start value, not read
+    /// in Initialization Mode).
+    pub(crate) fn unheld(&self) -> Vec<Access> {
+        let mut out: Vec<Access> = self
+            .variables
+            .values()
+            .filter(|c| !c.input && !self.held.contains_key(&c.access.vr))
+            .map(|c| c.access)
+            .collect();
+        out.sort_by_key(|a| a.vr);
+        out
+    }
+
     fn of_clocks(&self, active: &[u32], inputs: bool) -> Vec<Access> {
         let mut out: Vec<Access> = self
             .variables

@@ -767,6 +767,12 @@ impl Calls for Fmi3 {
     }
 
     fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
+        // the clocked variables the master reads hold what initialization computed until
+        // their clocks' first ticks (read while Initialization Mode allows it)
+        for access in self.clocked.unheld() {
+            let values = self.get_all(core, access)?;
+            self.clocked.hold(access.vr, values);
+        }
         let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
         call!(core, "fmi3ExitInitializationMode", None, f(c))?;
         // instantiated with eventModeUsed, the FMU is in Event Mode now (FMI 3.0's
