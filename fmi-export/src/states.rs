@@ -351,6 +351,8 @@ impl Function {
             | Fmi3SetShiftFraction => mask(&[InitializationMode, EventMode]),
             // Co-Simulation with Event Mode (an FMU with clocks): Event Mode back to Step Mode
             Fmi3EnterStepMode => mask(&[EventMode]),
+            // Scheduled Execution's Clock Activation Mode (the layer's StepComplete)
+            Fmi3ActivateModelPartition => mask(&[StepComplete]),
             // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode);
             // Co-Simulation with Event Mode: from Step Mode
             Fmi3EnterEventMode => mask(&[ContinuousTimeMode, StepComplete]),

@@ -14,9 +14,9 @@
 //! another time than the next `t_k` and deactivating the clock (`canBeDeactivated` is
 //! false) are errors naming the clock and the times.
 
-use super::{decl, err, time_eps, Instance, OpResult, PreEvent};
+use super::{decl, err, time_eps, Function, Instance, OpResult, PreEvent};
 use crate::decl::{BaseType, ClockDecl, ClockInterval};
-use crate::model::Model;
+use crate::model::{Interface, Model};
 use crate::states::Machine;
 
 /// How `fmi3GetIntervalDecimal` qualifies an interval (FMI 3.0 `fmi3IntervalQualifier`).
@@ -166,7 +166,11 @@ impl<M: Model> Instance<M> {
         if self.core.clock_active {
             return self.sample_at_activation();
         }
-        if matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode) {
+        // Scheduled Execution reads a partition's outputs after fmi3ActivateModelPartition
+        // returned, in Clock Activation Mode
+        if matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode)
+            || self.context.interface == Interface::ScheduledExecution
+        {
             return Ok(());
         }
         let d = decl::<M>();
@@ -246,6 +250,56 @@ impl<M: Model> Instance<M> {
                 samples.next, clock.name
             ));
         }
+        Ok(())
+    }
+
+    /// The state table of a Scheduled Execution instance (the layer's `StepComplete` is its
+    /// Clock Activation Mode): the common calls as in Co-Simulation's Step Mode, the
+    /// partition's activation and the interval and shift queries there, never the calls of
+    /// Model Exchange and Co-Simulation nor `fmi3SetClock`/`fmi3GetClock` (an input clock's
+    /// partition is activated, not the clock).
+    pub(super) fn scheduled_call_allowed(function: Function, machine: Machine) -> OpResult {
+        use crate::states::Scope;
+        let allowed = match function {
+            Function::Fmi3GetClock | Function::Fmi3SetClock => {
+                return err("not available in Scheduled Execution: fmi3ActivateModelPartition activates the clock's \
+                            model partition");
+            }
+            Function::Fmi3ActivateModelPartition => machine == Machine::StepComplete,
+            f if f.is_clock_function() => matches!(machine, Machine::InitializationMode | Machine::StepComplete),
+            f => match f.scope() {
+                Scope::ModelExchange | Scope::CoSimulation => {
+                    return err("not available: this instance was created for ScheduledExecution");
+                }
+                _ => f.allowed_in(machine),
+            },
+        };
+        if allowed {
+            Ok(())
+        } else {
+            err(format!("not allowed in state {machine:?}"))
+        }
+    }
+
+    /// `fmi3ActivateModelPartition`: the partition of the declared clock, its sample, at the
+    /// clock's next activation time, with the inputs set before.
+    pub fn activate_model_partition(&mut self, clock_vr: u32, activation_time: f64) -> OpResult {
+        let clock = Self::check_clock_references(&[clock_vr])?;
+        let Some(mut samples) = self.core.clock.filter(|c| c.has_next()) else {
+            return err(format!("{} has no activation after its last at t = {} s", clock.name, self.core.time));
+        };
+        let due = samples.time_of(samples.next);
+        if !activation_time.is_finite() || (activation_time - due).abs() > time_eps(due) {
+            return err(format!(
+                "activationTime = {activation_time} s for {}, but its next activation is at t = {due} s (activation \
+                 {}: start {} s + {} x {} s)",
+                clock.name, samples.next, samples.start, samples.next, samples.period
+            ));
+        }
+        self.core.time = activation_time;
+        self.core.model.set_time(activation_time);
+        self.sample(&mut samples, activation_time)?;
+        self.core.next_event = None;
         Ok(())
     }
 }
