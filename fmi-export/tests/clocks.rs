@@ -412,3 +412,25 @@ fn scheduled_execution_activates_the_clocks_partition() {
     assert!(last_error(&log).contains("created for ScheduledExecution"), "{}", last_error(&log));
     unsafe { abi3::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
 }
+
+/// A serialized FMU state of a clocked instance (in Step Mode between activations) restores
+/// its sample count: the activations after it give the same y_k again.
+#[test]
+fn a_clocked_instance_restores_its_serialized_state() {
+    let f = cs3();
+    f.init_until(0.0, None);
+    activate(&f, 0.0);
+    assert_eq!(enter_step_mode(&f), OK3);
+    assert_eq!(f.step(0.0, 0.25).status, OK3);
+    let bytes = f.serialized_state();
+    let run = |f: &Fmu3<Summer>| {
+        assert_eq!(f.enter_event_mode(), OK3, "{}", f.last_error());
+        let y = activate(f, 0.25);
+        assert_eq!(enter_step_mode(f), OK3);
+        y
+    };
+    // y_1 = 0.25 (0 + 0.25) = 0.0625, n_1 = 2
+    assert_eq!(run(&f), (0.0625, 2.0));
+    assert_eq!(f.restore_serialized(&bytes), OK3, "{}", f.last_error());
+    assert_eq!(run(&f), (0.0625, 2.0));
+}
