@@ -186,7 +186,9 @@ impl Function {
     }
 
     /// The FMI 3.0 features the layer's FMUs do not declare, with what is missing: the
-    /// call is refused (`fmi3Error`, logged) in every state.
+    /// call is refused (`fmi3Error`, logged) in every state, except the clock functions,
+    /// `fmi3EnterStepMode` (Co-Simulation) and `fmi3ActivateModelPartition` (Scheduled
+    /// Execution) of a model that declares a clock ([`crate::ClockDecl`]).
     pub fn undeclared_feature(self) -> Option<&'static str> {
         use Function::*;
         Some(match self {
