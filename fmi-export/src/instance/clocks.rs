@@ -9,14 +9,14 @@
 //! `fmi3UpdateDiscreteStates`, with the inputs set by then; an input set after the sample
 //! ran undoes it (it runs again at the next read), as the lazy events of Co-Simulation do
 //! for FMI 2.0: so the sample `k` of a clocked instance is the FMI 2.0 one to the bit.
-//! Clocked variables can be read only while their clock is active (and in Initialization
-//! Mode), as FMI 3.0 section 2.2.9 says; a step past an activation, an activation at
-//! another time than the next `t_k` and deactivating the clock (`canBeDeactivated` is
-//! false) are errors naming the clock and the times.
+//! Between activations the clocked variables hold their values (an importer may record
+//! them there); a step past an activation, an activation at another time than the next
+//! `t_k` and deactivating the clock (`canBeDeactivated` is false) are errors naming the
+//! clock and the times.
 
 use super::{decl, err, time_eps, Function, Instance, OpResult, PreEvent};
-use crate::decl::{BaseType, ClockDecl, ClockInterval};
-use crate::model::{Interface, Model};
+use crate::decl::{ClockDecl, ClockInterval};
+use crate::model::Model;
 use crate::states::Machine;
 
 /// How `fmi3GetIntervalDecimal` qualifies an interval (FMI 3.0 `fmi3IntervalQualifier`).
@@ -160,30 +160,14 @@ impl<M: Model> Instance<M> {
     }
 
     /// Before a read of a clocked instance: the sample of an active clock runs (once per
-    /// activation, with the inputs set by then; a later set undoes it), and a clocked
-    /// variable of `rows` is refused while its clock is inactive.
-    pub(super) fn settle_clock(&mut self, base_type: BaseType, vrs: &[u32]) -> OpResult {
+    /// activation, with the inputs set by then; a later set undoes it). A clocked variable
+    /// read while its clock is inactive answers its value of the last activation (held
+    /// until the next): FMI 3.0 section 2.2.9 lets importers read clocked variables only
+    /// while their clock is active, and an importer that records them between activations
+    /// (as a master recording rows at its communication points does) gets what they hold.
+    pub(super) fn settle_clock(&mut self) -> OpResult {
         if self.core.clock_active {
             return self.sample_at_activation();
-        }
-        // Scheduled Execution reads a partition's outputs after fmi3ActivateModelPartition
-        // returned, in Clock Activation Mode
-        if matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode)
-            || self.context.interface == Interface::ScheduledExecution
-        {
-            return Ok(());
-        }
-        let d = decl::<M>();
-        for &vr in vrs {
-            if let Some(row) = d.row(base_type, vr).filter(|&row| d.is_clocked(row)) {
-                let (clock, _) = Self::declared_clock()?;
-                return err(format!(
-                    "{} is a clocked variable of {}, which is not active: it can be read only while its clock is \
-                     (in Event Mode, between fmi3SetClock and fmi3UpdateDiscreteStates)",
-                    d.variable(row).name,
-                    clock.name
-                ));
-            }
         }
         Ok(())
     }
