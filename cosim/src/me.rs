@@ -208,12 +208,15 @@ impl MeUnit {
     }
 
     /// An accepted step of a group's method to `t_new`, whose states are in `x`: the FMU at
-    /// (t_new, x), the indicators of its end kept as the next step's start, and
+    /// (t_new, x) (set unless `there`: its indicators were just read at that point), the
+    /// indicators of its end kept as the next step's start, and
     /// `fmi2CompletedIntegratorStep`, whose `terminateSimulation` marks the unit terminated.
     /// Whether the FMU asked for a step event.
-    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64) -> Result<bool> {
-        inst.set_time(t_new)?;
-        Self::set_states(inst, &self.x)?;
+    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64, there: bool) -> Result<bool> {
+        if !there {
+            inst.set_time(t_new)?;
+            Self::set_states(inst, &self.x)?;
+        }
         self.steps += 1;
         std::mem::swap(&mut self.z0, &mut self.z);
         let (step_event, terminate) = inst.completed_integrator_step()?;

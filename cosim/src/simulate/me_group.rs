@@ -353,7 +353,7 @@ impl MeGroup {
             for (k, &m) in members.iter().enumerate() {
                 let Some((inst, u)) = lanes.member(m) else { continue };
                 u.x.copy_from_slice(&g.integrator.state()[g.offsets[k]..g.offsets[k + 1]]);
-                if u.complete_step(inst, t_new)? {
+                if u.complete_step(inst, t_new, g.at_step_end && !u.z.is_empty())? {
                     step_events.push(m);
                 }
             }
@@ -394,6 +394,7 @@ impl MeGroup {
                 crossed.push(k);
             }
         }
+        g.at_step_end = crossed.is_empty();
         if crossed.is_empty() {
             return Ok(None);
         }
@@ -422,6 +423,7 @@ impl MeGroup {
         s: f64,
         completed: bool,
     ) -> Result<()> {
+        g.at_step_end = false;
         g.integrator.interpolate(s, &mut g.x);
         for (k, &m) in self.members.iter().enumerate() {
             let Some((inst, u)) = lanes.member(m) else { continue };

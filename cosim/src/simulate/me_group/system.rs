@@ -99,6 +99,9 @@ pub(crate) struct GroupIntegrator {
     pub(crate) through: bool,
     /// The first state event within the last step (time, members), not yet reached.
     pub(crate) crossing: Option<(f64, Vec<usize>)>,
+    /// The members with event indicators are at the end of the last step (their
+    /// indicators read there, nothing set since): completing the step sets nothing again.
+    pub(crate) at_step_end: bool,
 }
 
 impl GroupIntegrator {
@@ -144,6 +147,7 @@ impl GroupIntegrator {
             floor,
             through,
             crossing: None,
+            at_step_end: false,
         }
     }
 
