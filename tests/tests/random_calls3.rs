@@ -16,31 +16,24 @@ use std::ptr::{null, null_mut};
 
 use fmi_export::states::{Function, Machine, Scope};
 use model_description::{ModelDescription, VariableType};
-use nigel_integration_tests::{built_fmu, Fmu, DISCARD, ERROR, OK};
+use nigel_integration_tests::{Fmu, ERROR, OK};
 
-struct Rng(u64);
+mod random;
+use random::{every_fmu_and_interface, Moves, Rng, Shadow, HOSTILE};
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // xorshift64*
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-    fn chance(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
-    }
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[self.below(items.len())]
-    }
-}
-
-const HOSTILE: [f64; 12] =
-    [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
+/// The FMI 3.0 functions that move the importer's view of the state.
+const MOVES: Moves = Moves {
+    do_step: Function::Fmi3DoStep,
+    enter_initialization_mode: Function::Fmi3EnterInitializationMode,
+    exit_initialization_mode: Function::Fmi3ExitInitializationMode,
+    terminate: Function::Fmi3Terminate,
+    reset: Function::Fmi3Reset,
+    enter_event_mode: Function::Fmi3EnterEventMode,
+    enter_continuous_time_mode: Function::Fmi3EnterContinuousTimeMode,
+    set_fmu_state: Function::Fmi3SetFMUState,
+    discard_fails_the_step: false,
+    ok: "fmi3OK",
+};
 
 /// FMI 3.0 value references by type (FMI 2.0 variable index i is FMI 3.0 value reference
 /// i; `time` is 0), each pool with foreign ones mixed in.
@@ -77,14 +70,6 @@ fn pools(md: &ModelDescription) -> Pools {
     }
 }
 
-struct Shadow {
-    machine: Option<Machine>,
-    time: f64,
-    states: Vec<(*mut c_void, Option<Machine>)>,
-    freed: Vec<*mut c_void>,
-    bytes: Vec<u8>,
-}
-
 fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4] {
     let p = pools(&fmu.description);
     let f = &fmu.functions3;
@@ -95,13 +80,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
         let (instance, log) = fmu.instantiate3("random3", co_simulation, fmu.guid());
         let i = instance.expect("instantiate");
         let c = i.c;
-        let mut sh = Shadow {
-            machine: Some(Machine::Instantiated),
-            time: 0.0,
-            states: Vec::new(),
-            freed: Vec::new(),
-            bytes: Vec::new(),
-        };
+        let mut sh = Shadow::instantiated();
         for _ in 0..1 + rng.below(16) {
             let progress: &[Function] = match sh.machine {
                 Some(Machine::Instantiated) => &[Function::Fmi3EnterInitializationMode, Function::Fmi3SetFloat64],
@@ -526,48 +505,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     "{function:?}: an error without its message ({last:?})"
                 );
             }
-            if status == OK {
-                if let Some(k) = check_reals {
-                    if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
-                        panic!("{function:?} handed out {bad} with fmi3OK");
-                    }
-                }
-            }
-            if status == ERROR {
-                sh.machine = Some(Machine::Error);
-            } else if status == DISCARD && function == Function::Fmi3DoStep {
-                // still Step Mode (FMI 3.0 has no Step Discarded state), at the time the
-                // step reached (a guess below: a wrong one just gives an error)
-                sh.time = f64::NAN;
-            } else if status == OK || status == 1 {
-                if let Some(t) = new_time {
-                    sh.time = t;
-                }
-                let after = match function {
-                    Function::Fmi3EnterInitializationMode => Some(Some(Machine::InitializationMode)),
-                    Function::Fmi3ExitInitializationMode => {
-                        Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
-                    }
-                    Function::Fmi3Terminate => Some(Some(Machine::Terminated)),
-                    Function::Fmi3Reset => {
-                        sh.time = 0.0;
-                        Some(Some(Machine::Instantiated))
-                    }
-                    Function::Fmi3EnterEventMode => Some(Some(Machine::EventMode)),
-                    Function::Fmi3EnterContinuousTimeMode => Some(Some(Machine::ContinuousTimeMode)),
-                    Function::Fmi3SetFMUState => {
-                        sh.time = f64::NAN;
-                        restored
-                    }
-                    _ => None,
-                };
-                if let Some(m) = after {
-                    sh.machine = m;
-                }
-            }
-            if sh.time.is_nan() {
-                sh.time = 0.0;
-            }
+            sh.after(&MOVES, function, status, check_reals, &reals_out, new_time, restored, co_simulation);
             // now and then an FMI 2.0 function on the FMI 3.0 instance: refused
             if rng.chance(2) {
                 let s = unsafe { (fmu.functions.terminate)(c) };
@@ -582,30 +520,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
 #[test]
 fn random_fmi3_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
     let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES3").ok().and_then(|s| s.parse().ok()).unwrap_or(20_000);
-    for (k, target) in build_fmu::targets().iter().enumerate() {
-        let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
-        for co_simulation in [true, false] {
-            let offered = if co_simulation {
-                fmu.description.co_simulation.is_some()
-            } else {
-                fmu.description.model_exchange.is_some()
-            };
-            if !offered {
-                continue;
-            }
-            let counts =
-                run(&fmu, co_simulation, sequences, 0x3C6E_F372_FE94_F82B ^ (k as u64 * 2 + co_simulation as u64));
-            let total: usize = counts.iter().sum();
-            println!(
-                "{} {} (FMI 3.0): {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
-                target.model_identifier,
-                if co_simulation { "CS" } else { "ME" },
-                counts[0],
-                counts[1],
-                counts[2],
-                counts[3]
-            );
-            assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
-        }
-    }
+    every_fmu_and_interface(" (FMI 3.0)", sequences, 0x3C6E_F372_FE94_F82B, "", |fmu, co_simulation, seed| {
+        run(fmu, co_simulation, sequences, seed)
+    });
 }
