@@ -8,7 +8,7 @@
 //! `NIGEL_RANDOM_SEQUENCES` sets the number of sequences per FMU and interface
 //! (default 150,000: some 1.2 million calls per interface for the plant, a few seconds).
 
-use std::ffi::{c_char, c_int, c_void};
+use std::ffi::{c_char, c_int};
 use std::ptr::{null, null_mut};
 
 use fmi_export::states::{Function, Machine, Scope};
@@ -87,25 +87,10 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
             let null_array = rng.chance(3);
             let vrs = |rng: &mut Rng, pool: &[u32]| -> Vec<u32> { (0..n).map(|_| rng.pick(pool)).collect() };
             let ptr = |v: &Vec<u32>| if null_array { null() } else { v.as_ptr() };
-            let time_arg = |rng: &mut Rng, now: f64| -> f64 {
-                if rng.chance(70) {
-                    now
-                } else {
-                    rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
-                }
-            };
             // at least one slot: fmi2GetRealStatus writes one value (an FMU may have nx = 0)
             let mut reals_out = vec![f64::NAN; n.max(p.nx).max(1)];
             let mut check_reals: Option<usize> = None;
             let mut new_time = None;
-            let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
-                match rng.below(4) {
-                    0 | 1 if !sh.states.is_empty() => sh.states[rng.below(sh.states.len())].0,
-                    2 if !sh.freed.is_empty() => sh.freed[rng.below(sh.freed.len())],
-                    3 => 0x40usize as *mut c_void,
-                    _ => null_mut(),
-                }
-            };
             let mut restored: Option<Option<Machine>> = None;
             let status = unsafe {
                 match function {
@@ -195,7 +180,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         status
                     }
                     Function::SetFMUstate => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let status = (f.set_fmu_state.unwrap())(c, s);
                         if status == OK {
                             restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
@@ -203,7 +188,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         status
                     }
                     Function::FreeFMUstate => {
-                        let mut s = state_arg(&mut rng, &sh);
+                        let mut s = sh.state_arg(&mut rng);
                         let before = s;
                         let status = (f.free_fmu_state.unwrap())(c, &mut s);
                         if status == OK && !before.is_null() {
@@ -215,10 +200,10 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     }
                     Function::SerializedFMUstateSize => {
                         let mut size = 0usize;
-                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
+                        (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
                     Function::SerializeFMUstate => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let mut size = 0usize;
                         let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
                         let size = if rng.chance(10) { size / 2 } else { size };
@@ -274,7 +259,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         (f.get_real_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), x.as_mut_ptr())
                     }
                     Function::DoStep => {
-                        let t = time_arg(&mut rng, sh.time);
+                        let t = rng.time(sh.time);
                         let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
                         let s = (f.do_step.unwrap())(c, t, h, 1);
                         if s == OK || s == 1 {
@@ -318,7 +303,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         (f.completed_integrator_step.unwrap())(c, 1, &mut a, &mut b)
                     }
                     Function::SetTime => {
-                        let t = time_arg(&mut rng, sh.time + 1e-3);
+                        let t = rng.time(sh.time + 1e-3);
                         let s = (f.set_time.unwrap())(c, t);
                         if s == OK || s == 1 {
                             new_time = Some(t);

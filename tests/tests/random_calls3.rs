@@ -11,7 +11,6 @@
 //! `NIGEL_RANDOM_SEQUENCES3` sets the number of sequences per FMU and interface (default
 //! 20,000).
 
-use std::ffi::c_void;
 use std::ptr::{null, null_mut};
 
 use fmi_export::states::{Function, Machine, Scope};
@@ -115,24 +114,9 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
             let null_array = rng.chance(3);
             let vrs = |rng: &mut Rng, pool: &[u32]| -> Vec<u32> { (0..n).map(|_| rng.pick(pool)).collect() };
             let ptr = |v: &Vec<u32>| if null_array { null() } else { v.as_ptr() };
-            let time_arg = |rng: &mut Rng, now: f64| -> f64 {
-                if rng.chance(70) {
-                    now
-                } else {
-                    rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
-                }
-            };
             let mut reals_out = vec![f64::NAN; n_values.max(p.nx).max(1)];
             let mut check_reals: Option<usize> = None;
             let mut new_time = None;
-            let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
-                match rng.below(4) {
-                    0 | 1 if !sh.states.is_empty() => sh.states[rng.below(sh.states.len())].0,
-                    2 if !sh.freed.is_empty() => sh.freed[rng.below(sh.freed.len())],
-                    3 => 0x40usize as *mut c_void,
-                    _ => null_mut(),
-                }
-            };
             let mut restored: Option<Option<Machine>> = None;
             let (mut b1, mut b2, mut b3, mut b4, mut b5) = (7u8, 7u8, 7u8, 7u8, 7u8);
             let mut t_out = f64::NAN;
@@ -297,7 +281,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         status
                     }
                     Fmi3SetFMUState => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let status = (f.set_fmu_state.unwrap())(c, s);
                         if status == OK {
                             restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
@@ -305,7 +289,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         status
                     }
                     Fmi3FreeFMUState => {
-                        let mut s = state_arg(&mut rng, &sh);
+                        let mut s = sh.state_arg(&mut rng);
                         let before = s;
                         let status = (f.free_fmu_state.unwrap())(c, &mut s);
                         if status == OK && !before.is_null() {
@@ -317,10 +301,10 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     }
                     Fmi3SerializedFMUStateSize => {
                         let mut size = 0usize;
-                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
+                        (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
                     Fmi3SerializeFMUState => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let mut size = 0usize;
                         let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
                         let size = if rng.chance(10) { size / 2 } else { size };
@@ -421,7 +405,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     Fmi3EnterContinuousTimeMode => (f.enter_continuous_time_mode.unwrap())(c),
                     Fmi3CompletedIntegratorStep => (f.completed_integrator_step.unwrap())(c, 1, &mut b1, &mut b2),
                     Fmi3SetTime => {
-                        let t = time_arg(&mut rng, sh.time + 1e-3);
+                        let t = rng.time(sh.time + 1e-3);
                         let s = (f.set_time.unwrap())(c, t);
                         if s == OK || s == 1 {
                             new_time = Some(t);
@@ -470,7 +454,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         (f.get_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), reals_out.as_mut_ptr(), n)
                     }
                     Fmi3DoStep => {
-                        let t = time_arg(&mut rng, sh.time);
+                        let t = rng.time(sh.time);
                         let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
                         let s = (f.do_step.unwrap())(c, t, h, 1, &mut b1, &mut b2, &mut b3, &mut t_out);
                         if s == OK || s == 1 {

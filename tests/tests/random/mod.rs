@@ -28,6 +28,14 @@ impl Rng {
     pub fn pick<T: Copy>(&mut self, items: &[T]) -> T {
         items[self.below(items.len())]
     }
+    /// A time argument: mostly `now`, else one of the times a call must refuse or survive.
+    pub fn time(&mut self, now: f64) -> f64 {
+        if self.chance(70) {
+            now
+        } else {
+            self.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
+        }
+    }
 }
 
 /// The numbers the sequences pass where a number is asked for.
@@ -70,6 +78,16 @@ impl Shadow {
             states: Vec::new(),
             freed: Vec::new(),
             bytes: Vec::new(),
+        }
+    }
+
+    /// An FMU state argument: a live one, a freed one, a made-up pointer or NULL.
+    pub fn state_arg(&self, rng: &mut Rng) -> *mut c_void {
+        match rng.below(4) {
+            0 | 1 if !self.states.is_empty() => self.states[rng.below(self.states.len())].0,
+            2 if !self.freed.is_empty() => self.freed[rng.below(self.freed.len())],
+            3 => 0x40usize as *mut c_void,
+            _ => std::ptr::null_mut(),
         }
     }
 
