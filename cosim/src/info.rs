@@ -200,6 +200,26 @@ fn info_fmi2(out: &mut String, path: &Path, limits: &UnpackLimits) -> Result<()>
     Ok(())
 }
 
+/// `cosim info` of an FMI 3.0 FMU's clocks (kind, causality, interval, shift, what each
+/// governs).
+fn info_clocks(out: &mut String, md: &model_description::fmi3::ModelDescription) {
+    let clocks = crate::clocks::clocks_of(md);
+    if clocks.is_empty() {
+        return;
+    }
+    w!(out, "clocks:");
+    for c in &clocks {
+        let interval = match c.interval {
+            Some(i) => format!("interval {} s, shift {} s", plain(i), plain(c.shift)),
+            None if c.kind.is_time_based() => "interval from the FMU".to_string(),
+            None => "no interval".to_string(),
+        };
+        let governs = if c.governs.is_empty() { String::new() } else { format!("; governs {}", c.governs.join(", ")) };
+        let line = format!("  {:<24} {:<6} {:<9} {interval}{governs}", c.name, c.causality.as_str(), c.kind.as_str());
+        w!(out, "{}", line.trim_end());
+    }
+}
+
 /// `cosim info` of an FMI 3.0 FMU: interface types with their capabilities, and every
 /// variable with its type and dimensions.
 fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
@@ -319,6 +339,7 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
             v.description.as_deref().unwrap_or("")
         );
     }
+    info_clocks(out, md);
     // what FMI 3.0 adds beyond variables, one line each: structural parameters here
     // (Configuration Mode), then model partitions (Scheduled Execution)
     for p in crate::structural::structural_parameters(md) {
@@ -347,7 +368,9 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
         Err(reason) if md.scheduled_execution.is_some() => w!(out, "model partitions: {reason}"),
         _ => {}
     }
-    let left_out = crate::fmi3::not_in_view(md);
+    // clocks are run (listed above), not left out
+    let left_out: Vec<_> =
+        crate::fmi3::not_in_view(md).into_iter().filter(|(_, why)| *why != crate::fmi3::LeftOut::Clock).collect();
     if !left_out.is_empty() {
         let each: Vec<String> = left_out.iter().map(|(name, why)| format!("{name} ({})", why.as_str())).collect();
         w!(out, "not run by cosim (neither recorded, set nor connected): {}", each.join(", "));

@@ -424,11 +424,10 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     );
                 }
             }
-            let scheduled = instance.fmu.interface() == Interface::ScheduledExecution;
-            for (name, why) in instance.fmu.not_in_view() {
-                if scheduled && *why == nigel_cosim::fmi3::LeftOut::Clock {
-                    continue; // recorded as its ticks
-                }
+            // clocks are run and their ticks counted in the summary, not recorded as columns
+            for (name, why) in
+                instance.fmu.not_in_view().iter().filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
+            {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
                     instance.name,
