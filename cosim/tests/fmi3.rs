@@ -934,3 +934,61 @@ fn a_later_minor_version_runs_with_a_note() {
         assert_eq!(err.contains(&note), noted, "{version}: {err}");
     }
 }
+
+/// Model Exchange: discrete inputs change in Event Mode only (FMI 3.0 section 3.2.1; the
+/// counter, as the Reference FMUs, refuses `fmi3SetInt32` / `fmi3SetBoolean` of k and b in
+/// Continuous-Time Mode). An input table changes k from 1 to 4 and b to true at 0.3 s (a
+/// communication point) and k to -2 at 0.45 s (between points: the step is split there);
+/// each change is an input event, and a value that stays is not set again.
+///
+/// By hand (m = 2 k, nb = !b, read back from the FMU): the rows at 0 .. 0.3 s hold k = 1
+/// (m = 2, nb = 1; a row is recorded before the inputs of the next step are applied), the
+/// row at 0.4 s k = 4 (m = 8, nb = 0), and from 0.5 s on k = -2 (m = -4). fmpy 0.3.32 (the
+/// same table as its `input=`) gives the same values at every grid time but 0.3 s, where
+/// it records the row after the event. The counter is described without its event
+/// indicator here: fmpy's CVode root function sets every input, the discrete ones too, in
+/// Continuous-Time Mode, which the counter refuses (the Reference FMUs' Feedthrough has no
+/// event indicator, so fmpy never does so there).
+#[test]
+fn model_exchange_sets_discrete_inputs_in_event_mode() {
+    let dir = work_dir("fmi3-me-discrete-input");
+    let xml = XML.replace(r#"<EventIndicator valueReference="14" dependencies="2"/>"#, "");
+    let Some(path) = build_counter(&dir, "fmi3_counter", &xml) else { return };
+    let table = nigel_cosim::InputTable::new(
+        vec!["k".into(), "b".into()],
+        vec![0.0, 0.3, 0.45, 1.0],
+        vec![vec![1.0, 4.0, -2.0, -2.0], vec![0.0, 1.0, 1.0, 1.0]],
+    )
+    .unwrap();
+    let mut e = Experiment::new(1.0, 0.1);
+    e.input = Some(std::sync::Arc::new(table));
+    let (r, summary) = simulate(&model_exchange(&path, &[]), &e).unwrap();
+    let (time, m, nb) = (r.column("time").unwrap(), r.column("m").unwrap(), r.column("nb").unwrap());
+    assert_eq!(r.rows(), 11);
+    for k in 0..11 {
+        let (m_hand, nb_hand) = match k {
+            0..=3 => (2.0, 1.0),
+            4 => (8.0, 0.0),
+            _ => (-4.0, 0.0),
+        };
+        assert_eq!((m[k], nb[k]), (m_hand, nb_hand), "t = {}", time[k]);
+    }
+    let inputs: Vec<f64> = summary.events.iter().filter(|e| e.kind == "input").map(|e| e.time).collect();
+    assert_eq!(inputs, vec![0.30000000000000004, 0.45], "one input event per change (0.1 + 0.1 + 0.1 is the point)");
+    // fmpy with the same table, at the grid times but 0.3 s
+    let script = "import sys, numpy as np\nfrom fmpy import simulate_fmu\n\
+         sig = np.array([(0.0, 1, False), (0.3, 4, True), (0.45, -2, True), (1.0, -2, True)], dtype=[('time', np.double), ('k', np.int32), ('b', np.bool_)])\n\
+         r = simulate_fmu(sys.argv[1], fmi_type='ModelExchange', stop_time=1.0, output_interval=0.1, input=sig, output=['m', 'nb'])\n\
+         print('\\n'.join('%r %r %r' % (float(t), float(m), float(nb)) for t, m, nb in r))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&path).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("Warning")) // fmpy's "missing input for variable u"
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for k in (0..11).filter(|k| *k != 3) {
+        let row = theirs.iter().rev().find(|row| (row[0] - time[k]).abs() < 1e-9).expect("fmpy's row");
+        assert_eq!((row[1], row[2]), (m[k], nb[k]), "t = {}", time[k]);
+    }
+}

@@ -6,7 +6,9 @@
 //! after the last row the last values. Two rows at the same time are a jump: at that time
 //! the later row holds (fmpy's `after_event`), in initialization the earlier one.
 //! Model Exchange instances get the value at the start of each communication step, held
-//! over it (as the master holds connections).
+//! over it (as the master holds connections); a discrete input of theirs only when it
+//! changes, in an event of its own (Event Mode, the value set, the event iteration, as
+//! fmpy does): the standard allows no discrete input to change in Continuous-Time Mode.
 //!
 //! A jump (two rows at one time) and a change of a discrete column are input events.
 //! fmpy's `simulate_fmu` makes one a communication point of its own in Co-Simulation
@@ -219,6 +221,8 @@ pub(crate) struct WithInput<'s> {
     /// What the run does with the table that a reader of it may not expect (an event
     /// between points that takes effect at the next point), for [`crate::Summary::notes`].
     pub(crate) notes: Vec<String>,
+    /// The value each discrete column last set (its bits; `None`: not yet set).
+    held: Vec<Option<u64>>,
 }
 
 impl<'s> WithInput<'s> {
@@ -281,24 +285,87 @@ impl<'s> WithInput<'s> {
         }
         splits.sort_by(f64::total_cmp);
         splits.dedup();
-        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0, notes })
+        let held = vec![None; columns.len()];
+        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0, notes, held })
     }
 
-    fn apply(&self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
+    /// The table's values at `t` set: continuous inputs at every call; a discrete one when
+    /// its value changes, and in a Model Exchange instance out of Initialization Mode
+    /// through an event (Event Mode, the new values, the event iteration, back to
+    /// Continuous-Time Mode), as the standard allows discrete inputs to change only there
+    /// (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1) and as fmpy applies them.
+    fn apply(&mut self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
+        // (column, value) of the changed discrete inputs of Model Exchange instances
+        let mut events: Vec<(usize, f64)> = Vec::new();
         for (j, c) in self.columns.iter().enumerate() {
             let v = self.table.value(j, t, c.discrete, after_event);
-            let inst = &mut core.lanes[c.variable.instance].inst;
-            let vr = [c.variable.value_reference];
-            match c.variable.base_type {
-                BaseType::Real => inst.set_real(&vr, &[v])?,
-                // as fmpy's table cast to fmi2Integer / fmi2Boolean: truncated toward zero
-                BaseType::Integer => inst.set_integer(&vr, &[v as i32])?,
-                BaseType::Boolean => inst.set_boolean(&vr, &[(v as i32 != 0) as i32])?,
-                BaseType::String => {}
+            let lane = &mut core.lanes[c.variable.instance];
+            if c.discrete && lane.unit.is_some() {
+                if self.held[j] != Some(v.to_bits()) {
+                    events.push((j, v));
+                }
+                continue;
             }
+            set_input(&mut lane.inst, &c.variable, v)?;
+            self.held[j] = Some(v.to_bits());
+        }
+        if events.is_empty() {
+            return Ok(());
+        }
+        let columns = &self.columns;
+        let set = |lanes: &mut [crate::simulate::lane::Lane], of: &dyn Fn(usize) -> bool| -> Result<()> {
+            for &(j, v) in events.iter().filter(|(j, _)| of(columns[*j].variable.instance)) {
+                set_input(&mut lanes[columns[j].variable.instance].inst, &columns[j].variable, v)?;
+            }
+            Ok(())
+        };
+        let mut instances: Vec<usize> = events.iter().map(|(j, _)| columns[*j].variable.instance).collect();
+        instances.sort_unstable();
+        instances.dedup();
+        // the coupled group's members together, in one event
+        if let Some(group) = core.group.as_mut() {
+            let who: Vec<usize> = instances.iter().copied().filter(|i| group.contains(*i)).collect();
+            if !who.is_empty() {
+                let members = group.members.clone();
+                group.input_event(core.lanes.as_mut_slice(), t, "input", &who, |lanes| {
+                    set(lanes, &|i| members.contains(&i))
+                })?;
+                group.ended(core.lanes.as_mut_slice(), t)?;
+            }
+        }
+        for i in instances {
+            let lanes = core.lanes.as_mut_slice();
+            let lane = &mut lanes[i];
+            let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) else { continue };
+            let mut one = crate::simulate::me_group::Solo { inst: &mut lane.inst, unit };
+            // a group of one: its own lane alone
+            let (columns, events) = (&self.columns, &events);
+            solo.input_event(&mut one, t, "input", &[i], |one| {
+                for &(j, v) in events.iter().filter(|(j, _)| columns[*j].variable.instance == i) {
+                    set_input(one.inst, &columns[j].variable, v)?;
+                }
+                Ok(())
+            })?;
+            solo.ended(&mut one, t)?;
+        }
+        for (j, v) in events {
+            self.held[j] = Some(v.to_bits());
         }
         Ok(())
     }
+}
+
+/// Sets input `variable` of `inst` to the table's value `v`.
+fn set_input(inst: &mut crate::fmu::Instance, variable: &VariableRef, v: f64) -> Result<()> {
+    let vr = [variable.value_reference];
+    match variable.base_type {
+        BaseType::Real => inst.set_real(&vr, &[v])?,
+        // as fmpy's table cast to fmi2Integer / fmi2Boolean: truncated toward zero
+        BaseType::Integer => inst.set_integer(&vr, &[v as i32])?,
+        BaseType::Boolean => inst.set_boolean(&vr, &[(v as i32 != 0) as i32])?,
+        BaseType::String => {}
+    }
+    Ok(())
 }
 
 impl Communication for WithInput<'_> {

@@ -26,7 +26,8 @@
  * y reaches 0.55 says eventHandlingNeeded, and fmi3UpdateDiscreteStates then adds 1 to n.
  * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
- * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
+ * the time event at stop_at says terminateSimulation; the discrete inputs k and b cannot be set in
+ * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function exists and returns fmi3Error. */
 #include <stdlib.h>
 #include <string.h>
 #include "fmi3Functions.h"
@@ -34,6 +35,9 @@
 typedef struct {
     double time, u, y, stop_at, early_at, crash_at;
     int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode, in_event_mode;
+    /* Model Exchange: instantiated so, and in Continuous-Time Mode (where the discrete inputs
+       k and b cannot be set: FMI 3.0 section 3.2.1, as the Reference FMUs refuse them) */
+    int me, me_continuous;
     long long mode;
     char label[64];
     double gains[2];
@@ -102,7 +106,9 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
-    return make(token, resources, env, log);
+    Counter *c = make(token, resources, env, log);
+    if (c) c->s.me = 1;
+    return c;
 }
 
 void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
@@ -124,8 +130,9 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     Counter *c = instance;
     fmi3InstanceEnvironment env = c->env;
     fmi3LogMessageCallback log = c->log;
-    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode;
+    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode, me = c->s.me;
     memset(c, 0, sizeof *c);
+    c->s.me = me;
     c->s.early_allowed = early_allowed;
     c->s.event_mode = event_mode;
     c->env = env;
@@ -254,6 +261,8 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     Counter *c = instance;
     if (nvr != nValues) return fail(c, "fmi3SetInt32: nValues != nValueReferences");
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 9 && c->s.me_continuous)
+            return fail(c, "fmi3SetInt32: Illegal call sequence (the discrete input k in Continuous-Time Mode)");
         if (vr[i] == 9) c->s.k = values[i];
         else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 4) c->s.crash_how = values[i];
         else return fail(c, "fmi3SetInt32: not settable");
@@ -307,6 +316,8 @@ fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] != 11) return fail(c, "fmi3SetBoolean: not settable");
+        if (c->s.me_continuous)
+            return fail(c, "fmi3SetBoolean: Illegal call sequence (the discrete input b in Continuous-Time Mode)");
         c->s.b = values[i] ? 1 : 0;
     }
     return fmi3OK;
@@ -401,9 +412,13 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
 fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
     Counter *c = instance;
     c->s.in_event_mode = c->s.event_mode;
+    c->s.me_continuous = 0;
     return fmi3OK;
 }
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
+    ((Counter *)instance)->s.me_continuous = 1;
+    return fmi3OK;
+}
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     ((Counter *)instance)->s.time = time;
     return fmi3OK;

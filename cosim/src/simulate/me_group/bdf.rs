@@ -236,6 +236,14 @@ fn disagreement(provided: &DMatrix<f64>, differenced: &DMatrix<f64>) -> Option<(
 }
 
 impl MeGroup {
+    /// After an event outside the solver's own step (an input event): the method restarts
+    /// (order 1) at the next step, from the states the event iteration left.
+    pub(super) fn restart_stiff(&mut self) {
+        if let Some(s) = self.stiff.as_mut() {
+            s.started = false;
+        }
+    }
+
     /// The bdf state of the group, made on first use.
     fn stiff_state<L: Members + ?Sized>(&mut self, lanes: &mut L, rtol: f64, atol: f64) -> Box<GroupBdf> {
         if let Some(s) = self.stiff.take() {
