@@ -95,11 +95,11 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 32);
+    assert_eq!(md3.model_variables.len(), 36);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
     // the three arrays as their 3 + 2 + 2 elements
-    assert_eq!(view.model_variables.len(), 36);
+    assert_eq!(view.model_variables.len(), 40);
     let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
@@ -112,7 +112,7 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
         "{mode:?}"
     );
     assert_eq!(view.variable("n").unwrap().variable_type.type_name(), "Integer");
-    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1);
+    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1 + 2);
     assert!(fmu.can_get_and_set_state());
 }
 
@@ -990,5 +990,77 @@ fn model_exchange_sets_discrete_inputs_in_event_mode() {
     for k in (0..11).filter(|k| *k != 3) {
         let row = theirs.iter().rev().find(|row| (row[0] - time[k]).abs() < 1e-9).expect("fmpy's row");
         assert_eq!((row[1], row[2]), (m[k], nb[k]), "t = {}", time[k]);
+    }
+}
+
+/// 64-bit integers, Binaries and Strings recorded as the FMU holds them (issue 35, defects
+/// 4 and 5): an input file drives the counter's Int64 and UInt64 inputs with values an f64
+/// does not hold, read exactly; the outputs i64out = i64in ^ 1 and u64out = u64in ^ 1 (the
+/// lowest bit flipped, so that a rounding shows) are written in decimal, the Binary `bin`
+/// (n zero bytes after n steps) in hex, the String parameter `label` as its text.
+///
+/// By hand: at t = 0 (initialization takes the first row) i64in = -2^63, so i64out =
+/// -2^63 + 1 = -9223372036854775807; u64in = 2^64 - 1, so u64out = 18446744073709551614.
+/// The row at 0.25 s still holds them (a row is recorded before the next step's inputs),
+/// the row at 0.5 s the second row's 2^53 + 2 = 9007199254740994: out 9007199254740995,
+/// which is no f64 (the nearest are ...994 and ...996). fmpy 0.3.32, given the same
+/// values as int64 / uint64 columns, records the same integers.
+#[test]
+fn sixty_four_bit_integers_binaries_and_strings_are_recorded_exactly() {
+    let Some((dir, fmu)) = counter("fmi3-exact") else { return };
+    let input = dir.join("in.csv");
+    std::fs::write(
+        &input,
+        "time,i64in,u64in\n0,-9223372036854775808,18446744073709551615\n0.25,9007199254740994,9007199254740994\n1,9007199254740994,9007199254740994\n",
+    )
+    .unwrap();
+    let csv = dir.join("out.csv");
+    let fmu_arg = fmu.to_str().unwrap();
+    let columns = |path: &Path| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        ["i64out", "u64out", "bin", "label"]
+            .iter()
+            .map(|name| {
+                let j = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
+                rows.iter().map(|r| r[j].to_string()).collect()
+            })
+            .collect()
+    };
+    let by_hand = vec![
+        vec!["-9223372036854775807", "-9223372036854775807", "9007199254740995"],
+        vec!["18446744073709551614", "18446744073709551614", "9007199254740995"],
+        vec!["", "00", "0000"],
+        vec!["abc", "abc", "abc"],
+    ];
+    for isolate in ["", "--isolate=run", "--isolate=fmu"] {
+        let mut args = vec!["run", fmu_arg, "--stop-time", "0.5", "--step", "0.25", "--input", input.to_str().unwrap()];
+        args.extend(["--record", "i64out", "--record", "u64out", "--record", "bin", "--record", "label"]);
+        args.extend(["-o", csv.to_str().unwrap()]);
+        if !isolate.is_empty() {
+            args.push(isolate);
+        }
+        let out = cosim(&args);
+        assert!(out.status.success(), "{isolate}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(columns(&csv), by_hand, "{isolate}");
+    }
+    // fmpy with the same values as exact integer columns
+    let script = "import sys, numpy as np\nfrom fmpy import simulate_fmu\n\
+         sig = np.array([(0.0, -2**63, 2**64 - 1), (0.25, 2**53 + 2, 2**53 + 2), (1.0, 2**53 + 2, 2**53 + 2)], dtype=[('time', np.double), ('i64in', np.int64), ('u64in', np.uint64)])\n\
+         r = simulate_fmu(sys.argv[1], stop_time=0.5, output_interval=0.25, input=sig, output=['i64out', 'u64out'])\n\
+         print('\\n'.join('%d %d' % (i, u) for i, u in zip(r['i64out'], r['u64out'])))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<String>> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("Warning"))
+        .map(|l| l.split(' ').map(str::to_string).collect())
+        .collect();
+    let ours = columns(&csv);
+    assert_eq!(theirs.len(), 3, "{theirs:?}");
+    for (k, row) in theirs.iter().enumerate() {
+        assert_eq!((&row[0], &row[1]), (&ours[0][k], &ours[1][k]), "row {k}");
     }
 }

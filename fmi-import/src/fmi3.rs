@@ -74,6 +74,62 @@ pub(crate) struct Access {
     pub(crate) count: usize,
 }
 
+/// The kind of a variable of the view whose values an f64 does not hold exactly: its
+/// Real in the view is the nearest f64 (a Binary: its size in bytes), and
+/// [`crate::Instance::get_exact`] reads the value itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExactKind {
+    /// An FMI 3.0 Int64 (beyond 2^53 an f64 rounds it).
+    Int64,
+    /// An FMI 3.0 UInt64.
+    UInt64,
+    /// An FMI 3.0 Binary.
+    Binary,
+}
+
+/// A value as the FMU holds it, where the view's f64 is not it: a 64-bit integer, a
+/// String's text, a Binary's bytes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Exact {
+    /// An Int64 or UInt64.
+    Integer(i128),
+    /// A String.
+    Text(String),
+    /// A Binary.
+    Bytes(Vec<u8>),
+}
+
+impl Exact {
+    /// As fmpy writes it in a CSV file: an integer in decimal, a text as it is, bytes in
+    /// lower-case hex (Python's `bytes.hex()`).
+    pub fn to_text(&self) -> String {
+        match self {
+            Exact::Integer(i) => i.to_string(),
+            Exact::Text(s) => s.clone(),
+            Exact::Bytes(b) => {
+                use std::fmt::Write;
+                let mut s = String::with_capacity(2 * b.len());
+                for x in b {
+                    let _ = write!(s, "{x:02x}");
+                }
+                s
+            }
+        }
+    }
+}
+
+impl ExactKind {
+    /// The kind of a variable of `value_type`, if its values need it.
+    pub(crate) fn of(value_type: fmi3::ValueType) -> Option<ExactKind> {
+        match value_type {
+            fmi3::ValueType::Int64 => Some(ExactKind::Int64),
+            fmi3::ValueType::UInt64 => Some(ExactKind::UInt64),
+            fmi3::ValueType::Binary => Some(ExactKind::Binary),
+            _ => None,
+        }
+    }
+}
+
 /// Arrays with more elements than this are left out of the view (one column each would
 /// make results no one reads).
 const MAX_ELEMENTS: u64 = 100_000;

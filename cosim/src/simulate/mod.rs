@@ -39,6 +39,6 @@ pub use input::InputTable;
 pub use lane::apply_start_values;
 pub use observer::{Cancel, Observer, Progress};
 pub use plan::default_record;
-pub use types::{number_text, push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
+pub use types::{number_text, push_number, Algorithm, ExactColumn, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

@@ -475,7 +475,7 @@ pub fn default_record(system: &System) -> Vec<VariableRef> {
     let mut out = Vec::new();
     for (i, spec) in system.instances.iter().enumerate() {
         for (index, v) in spec.fmu.description().model_variables.iter().enumerate() {
-            if v.causality == Causality::Output && BaseType::of(v) != BaseType::String {
+            if v.causality == Causality::Output {
                 out.push(VariableRef {
                     instance: i,
                     index,

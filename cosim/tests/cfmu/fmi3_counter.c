@@ -15,6 +15,8 @@
  *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
  *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
  *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
+ *   32 i64in Int64 input (0)      33 i64out Int64 output i64in ^ 1 (the lowest bit flipped: exact or not at all)
+ *   34 u64in UInt64 input (0)     35 u64out UInt64 output u64in ^ 1
  *   30 crash_at Float64 parameter: Co-Simulation: the step that starts at or after it crashes;
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
@@ -42,6 +44,8 @@ typedef struct {
     char label[64];
     double gains[2];
     float f32in;
+    long long i64in;
+    unsigned long long u64in;
     unsigned char bytes[64];
 } State;
 
@@ -276,6 +280,8 @@ fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] == 5) values[i] = c->s.mode;
         else if (vr[i] == 21) values[i] = -(1LL << 40) * c->s.n;
+        else if (vr[i] == 32) values[i] = c->s.i64in;
+        else if (vr[i] == 33) values[i] = c->s.i64in ^ 1;
         else return fail(c, "fmi3GetInt64: no such Int64");
     }
     return fmi3OK;
@@ -285,6 +291,7 @@ fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     const fmi3Int64 values[], size_t nValues) {
     Counter *c = instance;
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 32) { c->s.i64in = values[i]; continue; }
         if (vr[i] != 5) return fail(c, "fmi3SetInt64: not settable");
         if (values[i] != 1 && values[i] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
         c->s.mode = values[i];
@@ -376,7 +383,26 @@ SCALAR_GETTER(UInt8, 17, 20 * c->s.n)
 SCALAR_GETTER(Int16, 18, -1000 * c->s.n)
 SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
 SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
-SCALAR_GETTER(UInt64, 22, (1ULL << 48) * (unsigned long long)c->s.n)
+fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3GetUInt64: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 22) values[i] = (1ULL << 48) * (unsigned long long)c->s.n;
+        else if (vr[i] == 34) values[i] = c->s.u64in;
+        else if (vr[i] == 35) values[i] = c->s.u64in ^ 1;
+        else return fail(c, "fmi3GetUInt64: no such variable");
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3SetUInt64: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 34) return fail(c, "fmi3SetUInt64: not settable");
+        c->s.u64in = values[i];
+    }
+    return fmi3OK;
+}
 
 fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {
     Counter *c = instance;
@@ -497,7 +523,6 @@ UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t 
 UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
 UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
 UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt64, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 v[], size_t m)
 UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
 UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
 UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])

@@ -58,6 +58,9 @@ pub(crate) trait Communication {
         for n in steps {
             let p = core.clock.point(n);
             self.step(core, p, observers.calls())?;
+            if p.output_point && observers.recorder.reads_exact() {
+                observers.recorder.read_exact(&mut core.lanes)?;
+            }
             observers.step_complete(&p, &core.values)?;
         }
         Ok(())
