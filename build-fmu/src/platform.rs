@@ -252,7 +252,7 @@ impl Platform {
         target_dir: &Path,
     ) -> Result<Vec<PathBuf>, BuildError> {
         let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
-        let features: Vec<String> = packages.iter().map(|p| format!("{p}/fmi-export")).collect();
+        let features = crate::library_features(packages);
         let mut args: Vec<String> = vec!["--release".into(), "--quiet".into()];
         for p in packages {
             args.extend(["--package".into(), p.to_string()]);
