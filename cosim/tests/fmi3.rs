@@ -1051,3 +1051,42 @@ fn sixty_four_bit_integers_binaries_and_strings_are_recorded_exactly() {
         assert_eq!((&row[0], &row[1]), (&ours[0][k], &ours[1][k]), "row {k}");
     }
 }
+
+/// An `<Alias>` (FMI 3.0 section 2.4.7.5) is another name of its variable: `cosim info`
+/// lists it, a run records it under its own name (by default, as an output like its
+/// variable), its value that of the variable in every row; fmpy 0.3.32 records it too,
+/// with the same values.
+#[test]
+fn an_alias_is_listed_and_recorded_under_its_name() {
+    let dir = work_dir("fmi3-alias");
+    let xml = XML.replace(
+        r#"<Float64 name="y" valueReference="2" causality="output" unit="m" initial="exact" start="0"/>"#,
+        r#"<Float64 name="y" valueReference="2" causality="output" unit="m" initial="exact" start="0"><Alias name="y_ft" description="y in feet"/></Float64>"#,
+    );
+    assert_ne!(xml, XML, "the alias is in the description");
+    let Some(fmu) = build_counter(&dir, "alias", &xml) else { return };
+    let out = cosim(&["info", fmu.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().find(|l| l.starts_with("y_ft ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("output") && line.contains("alias of y") && line.contains("y in feet"), "{line}");
+    let csv = dir.join("out.csv");
+    let out =
+        cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.3", "--step", "0.1", "-o", csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();
+    let (jy, jft) = (header.iter().position(|h| *h == "y").unwrap(), header.iter().position(|h| *h == "y_ft").unwrap());
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    // y = t (u = 1, mode 1): 0, 0.1, 0.2, 0.30000000000000004, the alias the same text
+    let y: Vec<&str> = rows.iter().map(|r| r[jy]).collect();
+    assert_eq!(y, ["0", "0.1", "0.2", "0.30000000000000004"]);
+    assert_eq!(rows.iter().map(|r| r[jft]).collect::<Vec<_>>(), y);
+    let script = "import sys\nfrom fmpy import simulate_fmu\n\
+         r = simulate_fmu(sys.argv[1], stop_time=0.3, output_interval=0.1)\n\
+         print(' '.join(repr(float(v)) for v in r['y_ft']))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<f64> =
+        String::from_utf8_lossy(&out.stdout).split_whitespace().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(theirs, y.iter().map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>());
+}

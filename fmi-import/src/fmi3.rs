@@ -9,7 +9,8 @@
 //! Boolean, String, Enumeration (Int64 values of i32 items), a Binary as a Real holding its
 //! size in bytes (read-only); an array as one variable per element, `y[1]`, `y[2]`, ...
 //! (`A[1,2]`: 1-based, row-major, as FMI 2.0 names array elements) with value references
-//! of the view's own above the FMU's. An [`Instance`] translates each call on them to the
+//! of the view's own above the FMU's; an `<Alias>` as one more variable of the same value
+//! reference (after all others, out of the ModelStructure, as FMI 2.0 aliases are). An [`Instance`] translates each call on them to the
 //! FMI 3.0 function of the variable's type (an element set alone: the array's other
 //! elements as set before, or its start values). Variables the view cannot hold (String
 //! and Binary arrays, clocks) are listed by [`Fmu::not_in_view`].
@@ -228,6 +229,8 @@ pub(crate) fn fmi2_view(
     // (FMU value reference, element) of each variable of the view
     let mut elements: Vec<(u32, usize)> = Vec::new();
     let mut variables: Vec<ScalarVariable> = Vec::new();
+    // the <Alias> names, after all variables (the ModelStructure's indices stay theirs)
+    let mut alias_variables: Vec<ScalarVariable> = Vec::new();
     for v in &md.model_variables {
         let dims = if v.is_array() { sizes(md, v) } else { Some(Vec::new()) };
         // a product of sizes beyond u64 is too large, not a wrapped-around small one
@@ -337,6 +340,19 @@ pub(crate) fn fmi2_view(
                 );
             }
             elements.push((v.value_reference, k));
+            // an <Alias>: the same value reference under its own name, out of the
+            // ModelStructure (as FMI 2.0 lists one variable of an alias set there)
+            for alias in &v.aliases {
+                alias_variables.push(ScalarVariable {
+                    name: if v.is_array() { element_name(&alias.name, &dims, k as u64) } else { alias.name.clone() },
+                    value_reference,
+                    description: alias.description.clone().or_else(|| v.description.clone()),
+                    causality,
+                    variability: v.variability,
+                    initial: None,
+                    variable_type: without_start(&variable_type),
+                });
+            }
             variables.push(ScalarVariable {
                 name,
                 value_reference,
@@ -466,10 +482,26 @@ pub(crate) fn fmi2_view(
         type_definitions,
         log_categories: md.log_categories.clone(),
         default_experiment: md.default_experiment.clone(),
-        model_variables: variables,
+        model_variables: variables.into_iter().chain(alias_variables).collect(),
         model_structure,
     };
     (view, special, left_out)
+}
+
+/// `t` without its start value (an alias has none of its own: FMI 2.0 gives a start to
+/// one variable of an alias set).
+fn without_start(t: &VariableType) -> VariableType {
+    let mut t = t.clone();
+    match &mut t {
+        VariableType::Real { start, derivative, .. } => {
+            *start = None;
+            *derivative = None;
+        }
+        VariableType::Integer { start, .. } | VariableType::Enumeration { start, .. } => *start = None,
+        VariableType::Boolean { start } => *start = None,
+        VariableType::String { start } => *start = None,
+    }
+    t
 }
 
 /// The resource path FMI 3.0 wants: an absolute native path ending in a separator.

@@ -1131,6 +1131,30 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             range,
             v.description.as_deref().unwrap_or("")
         );
+        // an <Alias>: recorded under its own name too, the same value as its variable's
+        for a in &v.aliases {
+            w!(
+                out,
+                "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
+                a.name,
+                v.causality.as_str(),
+                v.variability.as_str(),
+                v.value_type.element(),
+                dims,
+                md.unit_of(v).unwrap_or("-"),
+                "-",
+                "",
+                format!(
+                    "alias of {}{}{}",
+                    v.name,
+                    a.display_unit
+                        .as_ref()
+                        .map(|u| format!(" (display unit {u}; recorded in the variable's unit)"))
+                        .unwrap_or_default(),
+                    a.description.as_ref().map(|d| format!(": {d}")).unwrap_or_default()
+                )
+            );
+        }
     }
     // what FMI 3.0 adds beyond variables, one line each: structural parameters here
     // (Configuration Mode), then model partitions (Scheduled Execution)
