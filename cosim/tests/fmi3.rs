@@ -1090,3 +1090,28 @@ fn an_alias_is_listed_and_recorded_under_its_name() {
         String::from_utf8_lossy(&out.stdout).split_whitespace().map(|v| v.parse().unwrap()).collect();
     assert_eq!(theirs, y.iter().map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>());
 }
+
+/// A connection carries an Int64 output to an Int64 input as f64: exactly up to 2^53 (and
+/// beyond where an f64 holds the value), and a value it would round is an error naming the
+/// variable and the master's limit, not a silently rounded input. c1.i64out = c1.i64in ^ 1
+/// feeds c2.i64in, c2.i64out = c2.i64in ^ 1 is recorded: 6 gives 7, then 6 again; 2^53 + 2
+/// gives 2^53 + 3, which no f64 holds.
+#[test]
+fn a_sixty_four_bit_connection_is_exact_or_refused() {
+    let Some((_dir, path)) = counter("fmi3-wide-connection") else { return };
+    let system = |start: f64| {
+        let mut b = SystemBuilder::new();
+        for name in ["c1", "c2"] {
+            b.add_instance(name, Fmu::load(&path).unwrap()).unwrap();
+        }
+        b.set("c1.i64in", Value::Real(start)).unwrap();
+        b.connect("c1.i64out", "c2.i64in").unwrap();
+        b.build()
+    };
+    let mut e = Experiment::new(0.2, 0.1);
+    e.record = Some(vec!["c2.i64out".into()]);
+    let (r, _) = simulate(&system(6.0), &e).unwrap();
+    assert_eq!(r.exact_column(0).unwrap(), ["6", "6", "6"]);
+    let err = simulate(&system(9007199254740994.0), &e).err().expect("a rounded connection refused").to_string();
+    assert!(err.contains("c1.i64out = 9007199254740995") && err.contains("2^53"), "{err}");
+}

@@ -192,6 +192,11 @@ impl Instance {
         &self.core.fmu
     }
 
+    /// The instance's time as last set or reached (s).
+    pub fn time(&self) -> f64 {
+        self.core.time
+    }
+
     /// The life-cycle state.
     pub fn state(&self) -> InstanceState {
         self.core.state
