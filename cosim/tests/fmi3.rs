@@ -1112,6 +1112,6 @@ fn a_sixty_four_bit_connection_is_exact_or_refused() {
     e.record = Some(vec!["c2.i64out".into()]);
     let (r, _) = simulate(&system(6.0), &e).unwrap();
     assert_eq!(r.exact_column(0).unwrap(), ["6", "6", "6"]);
-    let err = simulate(&system(9007199254740994.0), &e).err().expect("a rounded connection refused").to_string();
+    let err = simulate(&system(9007199254740994.0), &e).expect_err("a rounded connection refused").to_string();
     assert!(err.contains("c1.i64out = 9007199254740995") && err.contains("2^53"), "{err}");
 }
