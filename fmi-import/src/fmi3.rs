@@ -45,14 +45,14 @@ pub(crate) struct Fmi3Abi {
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
-/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions).
+/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions);
+/// elsewhere the clocks are run by the master (see [`crate::clocks`]).
 pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription, scheduled: bool) -> Option<String> {
     if scheduled {
         return None;
     }
-    if let Some(clock) = md.model_variables.iter().find(|v| v.value_type == fmi3::ValueType::Clock) {
-        let scheduled = if md.scheduled_execution.is_some() { "; its Scheduled Execution runs them" } else { "" };
-        return Some(format!("clocks (Clock variable {:?}{scheduled})", clock.name));
+    if let Some(clock) = crate::clocks::unreadable_clock(md) {
+        return Some(clock);
     }
     if md.co_simulation.is_none() && md.model_exchange.is_none() && md.scheduled_execution.is_some() {
         return Some("Scheduled Execution (the FMU offers no other interface type)".into());
@@ -183,7 +183,7 @@ pub enum LeftOut {
     StringArray,
     /// A Binary array.
     BinaryArray,
-    /// A clock (an FMU with clocks is refused at load; listed for `cosim info`).
+    /// A clock (run by the master through the clock calls; listed by `Fmu::clocks`).
     Clock,
     /// An array of more than 100,000 elements.
     TooLarge,
@@ -628,7 +628,12 @@ mod tests {
             r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
-        assert_eq!(unsupported_feature(&md, false).as_deref(), Some("clocks (Clock variable \"tick\")"));
+        assert_eq!(unsupported_feature(&md, false), None, "clocks are run (in Co-Simulation with Event Mode)");
+        let md = fmi3::ModelDescription::from_xml(
+            &clock.replace(r#"intervalVariability="constant""#, r#"intervalVariability="often""#),
+        )
+        .unwrap();
+        assert!(unsupported_feature(&md, false).unwrap().contains("intervalVariability \"often\""));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
                 r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,

@@ -125,6 +125,11 @@ impl Fmu {
         &self.not_in_view
     }
 
+    /// The FMU's clocks (FMI 3.0; none for FMI 2.0), as its description declares them.
+    pub fn clocks(&self) -> Vec<crate::clocks::Clock> {
+        self.fmi3_description().map(crate::clocks::clocks_of).unwrap_or_default()
+    }
+
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {

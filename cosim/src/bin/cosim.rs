@@ -424,11 +424,10 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     );
                 }
             }
-            let scheduled = instance.fmu.interface() == Interface::ScheduledExecution;
-            for (name, why) in instance.fmu.not_in_view() {
-                if scheduled && *why == nigel_cosim::fmi3::LeftOut::Clock {
-                    continue; // recorded as its ticks
-                }
+            // clocks are run and their ticks counted in the summary, not recorded as columns
+            for (name, why) in
+                instance.fmu.not_in_view().iter().filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
+            {
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
                     instance.name,
@@ -1005,6 +1004,31 @@ fn info(path: &Path, limits: &UnpackLimits) -> Result<(), Error> {
     Ok(())
 }
 
+/// `cosim info` of an FMI 3.0 FMU's clocks (kind, causality, interval, shift, what each
+/// governs).
+fn info_clocks(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelDescription) {
+    let clocks = nigel_cosim::clocks::clocks_of(md);
+    if !clocks.is_empty() {
+        if writeln!(out, "clocks:").is_err() {
+            return;
+        }
+        for c in &clocks {
+            let interval = match c.interval {
+                Some(i) => format!("interval {} s, shift {} s", plain(i), plain(c.shift)),
+                None if c.kind.is_time_based() => "interval from the FMU".to_string(),
+                None => "no interval".to_string(),
+            };
+            let governs =
+                if c.governs.is_empty() { String::new() } else { format!("; governs {}", c.governs.join(", ")) };
+            let line =
+                format!("  {:<24} {:<6} {:<9} {interval}{governs}", c.name, c.causality.as_str(), c.kind.as_str());
+            if writeln!(out, "{}", line.trim_end()).is_err() {
+                return;
+            }
+        }
+    }
+}
+
 /// `cosim info` of an FMI 3.0 FMU: interface types with their capabilities, and every
 /// variable with its type and dimensions.
 fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelDescription) {
@@ -1156,6 +1180,7 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             );
         }
     }
+    info_clocks(out, md);
     // what FMI 3.0 adds beyond variables, one line each: structural parameters here
     // (Configuration Mode), then model partitions (Scheduled Execution)
     for p in nigel_cosim::structural::structural_parameters(md) {
@@ -1184,7 +1209,11 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
         Err(reason) if md.scheduled_execution.is_some() => w!(out, "model partitions: {reason}"),
         _ => {}
     }
-    let left_out = nigel_cosim::fmi3::not_in_view(md);
+    // clocks are run (listed above), not left out
+    let left_out: Vec<_> = nigel_cosim::fmi3::not_in_view(md)
+        .into_iter()
+        .filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
+        .collect();
     if !left_out.is_empty() {
         let each: Vec<String> = left_out.iter().map(|(name, why)| format!("{name} ({})", why.as_str())).collect();
         w!(out, "not run by cosim (neither recorded, set nor connected): {}", each.join(", "));

@@ -463,6 +463,9 @@ fn summary_of(v: &serde_json::Value) -> Summary {
         },
         ..Summary::default()
     };
+    if let Some(c) = v["clock_ticks"].as_array() {
+        s.clock_ticks = c.iter().map(|x| (x["clock"].as_str().unwrap_or("").to_string(), count(&x["ticks"]))).collect();
+    }
     if let Some(e) = v["event_times"].as_array() {
         s.events = e
             .iter()

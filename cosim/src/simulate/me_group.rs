@@ -97,7 +97,7 @@ impl MeGroup {
             return Ok(None);
         }
         let members: std::sync::Arc<[usize]> = (0..system.instances.len()).filter(|i| me(*i)).collect();
-        let sub = System { instances: system.instances.clone(), connections: links };
+        let sub = System { instances: system.instances.clone(), connections: links, clock_connections: Vec::new() };
         let mut sources: Vec<VariableRef> = Vec::new();
         for c in &sub.connections {
             if !sources.contains(&c.from) {

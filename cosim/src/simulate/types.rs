@@ -262,12 +262,16 @@ pub struct Summary {
     /// What the master did that a reader of the inputs may not expect (e.g. an input
     /// event between communication points applied at the next one), one sentence each.
     pub notes: Vec<String>,
+    /// FMI 3.0 clocks: every clock's ticks in the run (`instance.clock`, or the clock's
+    /// name in a one-instance system), input clocks ticked by the master and output clocks
+    /// the FMU said ticked; empty when no FMU has clocks.
+    pub clock_ticks: Vec<(String, u64)>,
 }
 
 impl Summary {
     /// As a JSON value.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut json = serde_json::json!({
             "steps": self.steps,
             "events": self.events.len(),
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
@@ -280,6 +284,11 @@ impl Summary {
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
             "notes": self.notes,
-        })
+        });
+        if !self.clock_ticks.is_empty() {
+            json["clock_ticks"] =
+                self.clock_ticks.iter().map(|(n, k)| serde_json::json!({"clock": n, "ticks": k})).collect();
+        }
+        json
     }
 }

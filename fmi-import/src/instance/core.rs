@@ -220,6 +220,10 @@ pub(crate) trait Calls: Send {
     fn free_functions(&self) -> (Option<FreeStateFunction>, FreeInstanceFunction, &'static str);
     /// Whether this is FMI 3.0.
     fn is_fmi3(&self) -> bool;
+    /// The clock calls (FMI 3.0 only; see `instance/clocks.rs`).
+    fn clock_calls(&mut self) -> Option<&mut dyn super::clocks::ClockCalls> {
+        None
+    }
 }
 
 /// `fmi2Reset` / `fmi3Reset`: both take the instance only.

@@ -20,7 +20,7 @@ use crate::status::Status;
 /// The FMI 3.0 calls: the library's table and description, and what an instance keeps
 /// that FMI 2.0 has no place for.
 pub(crate) struct Fmi3 {
-    a: Arc<Fmi3Abi>,
+    pub(super) a: Arc<Fmi3Abi>,
     /// What `setup_experiment` was given (tolerance, start, stop), passed on by
     /// `fmi3EnterInitializationMode`.
     experiment: (Option<f64>, f64, Option<f64>),
@@ -33,9 +33,18 @@ pub(crate) struct Fmi3 {
     /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
+    /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
+    output_clocks: Vec<u32>,
+    /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
+    pub(super) output_ticks: Vec<super::clocks::OutputTick>,
+    /// The input clocks whose interval the FMU gives (fixed, tunable, changing,
+    /// countdown), read by `fmi3GetIntervalDecimal` in every event.
+    interval_clocks: Vec<u32>,
+    /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
+    pub(super) intervals: Vec<(f64, u32, super::clocks::Interval)>,
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
     /// the FMU's for as long as the instance lives).
-    scheduled: Option<Box<super::scheduled::ScheduledEnvironment>>,
+    scheduled: Option<Box<super::callbacks::ScheduledEnvironment>>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -49,6 +58,22 @@ impl Fmi3 {
     pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
         let event_mode = interface == Interface::CoSimulation
             && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+        use crate::clocks::{ClockCausality, ClockKind};
+        // Scheduled Execution runs the clocks through its own calls (`scheduled.rs`)
+        let clocks = if interface == Interface::ScheduledExecution {
+            Vec::new()
+        } else {
+            crate::clocks::clocks_of(&a.description)
+        };
+        let output_clocks =
+            clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
+        let interval_clocks = clocks
+            .iter()
+            .filter(|c| {
+                c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered)
+            })
+            .map(|c| c.value_reference)
+            .collect();
         Fmi3 {
             a,
             experiment: (None, 0.0, None),
@@ -56,6 +81,10 @@ impl Fmi3 {
             bytes: Vec::new(),
             arrays: HashMap::new(),
             event_mode: std::cell::Cell::new(event_mode),
+            output_clocks,
+            output_ticks: Vec::new(),
+            interval_clocks,
+            intervals: Vec::new(),
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
         }
     }
@@ -122,6 +151,20 @@ impl Fmi3 {
             }
             T::String | T::Clock => unreachable!("not in the view as a number"),
         })
+    }
+
+    /// Element `access` within one get call, whose last array read is `array`: an array is
+    /// read once per call, not once per element (the elements of one array are asked
+    /// together, a row of the results, and the FMU does not change in between), so that
+    /// a row costs time linear in the elements.
+    fn element_of_call(&mut self, core: &mut Core, access: Access, array: &mut Option<(u32, Vec<f64>)>) -> Result<f64> {
+        if access.count <= 1 {
+            return self.get_element(core, access);
+        }
+        if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
+            *array = Some((access.vr, self.get_all(core, access)?));
+        }
+        Ok(array.as_ref().and_then(|(_, all)| all.get(access.element)).copied().unwrap_or(f64::NAN))
     }
 
     fn get_element(&mut self, core: &mut Core, access: Access) -> Result<f64> {
@@ -233,7 +276,7 @@ impl Fmi3 {
     /// `terminateSimulation` from `function` (called at `at`) at the time `reached`,
     /// reported as FMI 2.0 reports it: a Discard, with `terminated_status` true and
     /// `last_successful_time` `reached`.
-    fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
+    pub(super) fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
         core.time = reached;
         self.terminate_requested = Some(reached);
         Error::Fmi {
@@ -256,7 +299,7 @@ impl Fmi3 {
     /// In Event Mode at `time`: `fmi3UpdateDiscreteStates` until no new discrete states are
     /// needed (at most 1000 times), then `fmi3EnterStepMode`. `Some(time)` when the FMU asked
     /// to terminate.
-    fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
+    pub(super) fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
         for _ in 0..1000 {
             let info = self.new_discrete_states(core)?;
             if info.terminate_simulation != 0 {
@@ -275,6 +318,31 @@ impl Fmi3 {
             time,
             "asked for new discrete states 1000 times in one event".into(),
         ))
+    }
+}
+
+impl Fmi3 {
+    /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`) and the
+    /// intervals of the input clocks the FMU gives (`fmi3GetIntervalDecimal`), kept for
+    /// `take_output_ticks` and `take_intervals`.
+    fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
+        if !self.interval_clocks.is_empty() {
+            let vrs = self.interval_clocks.clone();
+            let intervals = super::clocks::ClockCalls::get_intervals(self, core, &vrs)?;
+            self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
+        }
+        if self.output_clocks.is_empty() {
+            return Ok(());
+        }
+        let vrs = self.output_clocks.clone();
+        let mut ticks = vec![false; vrs.len()];
+        super::clocks::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
+        for (vr, ticked) in vrs.into_iter().zip(ticks) {
+            if ticked {
+                self.output_ticks.push(super::clocks::OutputTick { time, value_reference: vr });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -453,6 +521,8 @@ impl Calls for Fmi3 {
     }
 
     fn forget_run(&mut self) {
+        self.output_ticks.clear();
+        self.intervals.clear();
         self.terminate_requested = None;
     }
 
@@ -467,19 +537,10 @@ impl Calls for Fmi3 {
                 f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
             );
         }
-        // an array is read once per call, not once per element: the elements of one array
-        // are asked together (a row of the results), and the FMU does not change in between
-        let mut array: Option<(u32, Vec<f64>)> = None;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
-                Some(access) if access.count > 1 => {
-                    if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
-                        array = Some((access.vr, self.get_all(core, access)?));
-                    }
-                    let all = &array.as_ref().expect("read above").1;
-                    *value = all.get(access.element).copied().unwrap_or(f64::NAN);
-                }
-                Some(access) => *value = self.get_element(core, access)?,
+                Some(access) => *value = self.element_of_call(core, access, &mut array)?,
                 None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
             }
         }
@@ -509,10 +570,11 @@ impl Calls for Fmi3 {
             return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
         }
         let get32 = self.a.functions.get_int32;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
                 Some(access) => {
-                    let x = self.get_element(core, access)?;
+                    let x = self.element_of_call(core, access, &mut array)?;
                     // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
                     *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
                         instance: core.name.clone(),
@@ -554,9 +616,10 @@ impl Calls for Fmi3 {
     #[inline]
     fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         if self.any_special(vrs) {
+            let mut array = None;
             for (vr, value) in vrs.iter().zip(values.iter_mut()) {
                 *value = match self.special(*vr) {
-                    Some(access) => self.get_element(core, access)? as i32,
+                    Some(access) => self.element_of_call(core, access, &mut array)? as i32,
                     None => {
                         let mut one = [0];
                         self.get_boolean(core, &[*vr], &mut one)?;
@@ -855,6 +918,12 @@ impl Calls for Fmi3 {
         info.values_of_continuous_states_changed = (values != 0) as c_int;
         info.next_event_time_defined = (defined != 0) as c_int;
         info.next_event_time = next;
+        // the event settled: the output clocks and the intervals the FMU gives read while
+        // still in Event Mode (both interface types)
+        if update == 0 && terminate == 0 {
+            let time = core.time;
+            self.read_output_clocks(core, time)?;
+        }
         Ok(info)
     }
 
@@ -888,5 +957,9 @@ impl Calls for Fmi3 {
 
     fn is_fmi3(&self) -> bool {
         true
+    }
+
+    fn clock_calls(&mut self) -> Option<&mut dyn super::clocks::ClockCalls> {
+        Some(self)
     }
 }

@@ -4,6 +4,8 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod callbacks;
+mod clocks;
 mod configuration;
 pub(crate) mod core;
 mod fmi2;
@@ -13,6 +15,7 @@ mod scheduled;
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
+pub use self::clocks::{Interval, OutputTick};
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
 use crate::c_types::{CallbackFunctions, EventInfo};
