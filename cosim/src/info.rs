@@ -306,7 +306,7 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
                 Values::Int(x) => x.iter().map(|x| x.to_string()).collect(),
                 Values::Boolean(x) => x.iter().map(|x| x.to_string()).collect(),
                 Values::String(x) => x.iter().map(|x| format!("{x:?}")).collect(),
-                // binary values as their size, as the results record them
+                // binary start values as their size (the results record binary values as hex)
                 Values::Binary(x) => x.iter().map(|x| format!("{} bytes", x.len())).collect(),
             };
             if items.len() == 1 {
@@ -338,6 +338,30 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
             range,
             v.description.as_deref().unwrap_or("")
         );
+        // an <Alias>: recorded under its own name too, the same value as its variable's
+        for a in &v.aliases {
+            w!(
+                out,
+                "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
+                a.name,
+                v.causality.as_str(),
+                v.variability.as_str(),
+                v.value_type.element(),
+                dims,
+                md.unit_of(v).unwrap_or("-"),
+                "-",
+                "",
+                format!(
+                    "alias of {}{}{}",
+                    v.name,
+                    a.display_unit
+                        .as_ref()
+                        .map(|u| format!(" (display unit {u}; recorded in the variable's unit)"))
+                        .unwrap_or_default(),
+                    a.description.as_ref().map(|d| format!(": {d}")).unwrap_or_default()
+                )
+            );
+        }
     }
     info_clocks(out, md);
     // what FMI 3.0 adds beyond variables, one line each: structural parameters here

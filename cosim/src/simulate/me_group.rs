@@ -194,15 +194,37 @@ impl MeGroup {
         kind: &'static str,
         who: &[usize],
     ) -> Result<()> {
+        self.input_event(lanes, time, kind, who, |_| Ok(()))
+    }
+
+    /// An event at `time` caused by `who` (recorded as `kind`) in which `set` sets inputs
+    /// first: all members enter Event Mode, `set` runs, and they iterate together. The
+    /// discrete inputs of a Model Exchange FMU are set so when they change (Event Mode only:
+    /// FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1), which restarts the bdf method.
+    pub(crate) fn input_event<L: Members + ?Sized>(
+        &mut self,
+        lanes: &mut L,
+        time: f64,
+        kind: &'static str,
+        who: &[usize],
+        set: impl FnOnce(&mut L) -> Result<()>,
+    ) -> Result<()> {
         for &m in self.members.iter() {
             lanes.instance(m).enter_event_mode()?;
         }
+        set(lanes)?;
         for &m in who {
             if let Some((inst, unit)) = lanes.member(m) {
                 unit.events.push(Event { instance: inst.name().to_string(), time, kind });
             }
         }
-        self.iterate(lanes, time)
+        self.iterate(lanes, time)?;
+        // the states may have jumped: the method starts again from them (an input change
+        // at a known time is a time event the master schedules)
+        if let Some(g) = self.integrator.as_mut() {
+            g.restart = Some(Start::TimeEvent);
+        }
+        Ok(())
     }
 
     /// The time events due at `t` (to `eps`), for every solver: the members whose next time
