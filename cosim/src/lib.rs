@@ -51,6 +51,8 @@ pub mod fmu {
 pub mod defaults;
 pub mod error;
 pub mod exit_guard;
+pub mod info;
+pub mod integrator;
 pub mod junit;
 pub mod loops;
 pub mod mat;

@@ -109,6 +109,15 @@ impl Fmu {
         }
     }
 
+    /// FMI 3.0: whether the view's variable `vr` holds values an f64 does not (Int64,
+    /// UInt64, Binary), and which; `None` for every other variable and for FMI 2.0.
+    pub fn exact_kind(&self, vr: u32) -> Option<crate::fmi3::ExactKind> {
+        match &self.abi {
+            Abi::Fmi2(_) => None,
+            Abi::Fmi3(a) => a.special.get(&vr).and_then(|access| crate::fmi3::ExactKind::of(access.value_type)),
+        }
+    }
+
     /// FMI 3.0: the variables the view leaves out (String and Binary arrays, arrays of
     /// more than 100,000 elements or of sizes it cannot resolve), neither recorded, set nor
     /// connected, each with the reason; empty for FMI 2.0.

@@ -21,7 +21,7 @@ use crate::simulate::between::{Manipulator, SetQueue, WithManipulator};
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Cancel, Deadline, Observer, Observers, Profiler, Progress, Recorder};
+use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Profiler, Progress, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Op, Plan};
 use crate::simulate::ticks::Ticks;
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
@@ -126,13 +126,21 @@ impl<'s> Execution<'s> {
                 .flatten()
                 .collect(),
         };
-        if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
-            return Err(Error::Import(crate::ImportError::InvalidValue {
-                variable: system.name_of(r),
-                value: String::new(),
-                reason: "String variables cannot be recorded in CSV".into(),
-            }));
-        }
+        // the columns an f64 does not hold: read exactly at each row
+        let exact: Vec<ExactSource> = record
+            .iter()
+            .enumerate()
+            .filter_map(|(column, r)| {
+                let text = r.base_type == BaseType::String;
+                let wide = system.instances[r.instance].fmu.exact_kind(r.value_reference).is_some();
+                (text || wide).then_some(ExactSource {
+                    column,
+                    instance: r.instance,
+                    value_reference: r.value_reference,
+                    text,
+                })
+            })
+            .collect();
         let mut plan = Plan::new(system, &record, experiment.algorithm)?;
         // Model Exchange instances connected to each other are integrated together
         let mut group = MeGroup::coupled(system, experiment.max_steps)?;
@@ -147,7 +155,9 @@ impl<'s> Execution<'s> {
                 let record_gets = plan.ordered_record_gets(&record);
                 Box::new(Ordered { ops: plan.ordered.take().unwrap_or_default(), record_gets })
             }
-            _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
+            // the observers of the threaded pipeline see the values only, not the instances
+            // the exact columns are read from
+            _ if experiment.threads > 1 && exact.is_empty() => Box::new(ThreadedJacobi { threads: experiment.threads }),
             _ => Box::new(Jacobi),
         };
         let mut notes = Vec::new();
@@ -169,7 +179,7 @@ impl<'s> Execution<'s> {
         let single = system.instances.len() == 1;
         let names: Vec<String> =
             record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
-        let recorder = Recorder::new(names, record_slots);
+        let recorder = Recorder::new(names, record_slots, exact);
         Ok(Execution {
             system: system.clone(),
             experiment: experiment.clone(),
@@ -429,6 +439,9 @@ impl<'s> Execution<'s> {
         }
         self.algorithm.propagate(core)?;
         run_ops(&mut self.record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+        if self.recorder.reads_exact() {
+            self.recorder.read_exact(&mut core.lanes)?;
+        }
         self.recorder.push_row(t0, &core.values);
         self.profiler = Some(Profiler::new(core.lanes.len()));
         self.phase = Phase::Running;
@@ -530,6 +543,10 @@ impl<'s> Execution<'s> {
                 // records it too)
                 let row = if time > self.recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
                     run_ops(&mut self.record_gets, core.lanes.as_mut_slice(), &mut core.values, None)
+                        .and_then(|()| match self.recorder.reads_exact() {
+                            true => self.recorder.read_exact(&mut core.lanes),
+                            false => Ok(()),
+                        })
                         .map(|()| self.recorder.push_row(time, &core.values))
                 } else {
                     Ok(())
@@ -815,8 +832,9 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
 }
 
 /// Where [`Execution::with_sink`] (and `simulate_with`) hands each row: the time and the recorded values, in the order
-/// of [`Experiment::record`](crate::Experiment::record).
-pub type RowSink<'s> = dyn FnMut(f64, &[f64]) + Send + 's;
+/// of [`Experiment::record`](crate::Experiment::record), and the (column, text) of the columns an f64 does not hold
+/// ([`Results::exact`](crate::Results::exact); empty when there are none).
+pub type RowSink<'s> = dyn FnMut(f64, &[f64], &[(usize, String)]) + Send + 's;
 
 /// Instances kept between runs of one system ([`Execution::with_pool`], `simulate_with`): the instance of each
 /// position, reused only for the same FMU (the same loaded archive) and name.

@@ -46,6 +46,6 @@ pub use lane::apply_start_values;
 pub use observer::{Cancel, Observer, Progress};
 pub use plan::default_record;
 pub use scheduled::{is_scheduled, simulate_scheduled};
-pub use types::{number_text, push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
+pub use types::{number_text, push_number, Algorithm, ExactColumn, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

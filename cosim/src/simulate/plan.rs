@@ -32,6 +32,10 @@ pub(crate) struct Op {
     /// A get of Reals whose slots are consecutive, from this one: fetched straight into
     /// the value buffer, with no copy through the op's own.
     direct: Option<usize>,
+    /// Get: the FMI 3.0 Int64 / UInt64 outputs among `vrs` that feed connections (index
+    /// into `vrs`, `instance.variable`), whose values the connections carry as f64: checked
+    /// at every get (empty for every other op).
+    wide_sources: Vec<(usize, String)>,
 }
 
 impl Op {
@@ -46,6 +50,7 @@ impl Op {
             reals: vec![],
             ints: vec![],
             direct: None,
+            wide_sources: vec![],
         }
     }
     fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64)) {
@@ -65,7 +70,13 @@ impl Op {
     pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
         match self.kind {
             OpKind::Get => match self.direct {
-                Some(first) => inst.get_real(&self.vrs, &mut values[first..first + self.vrs.len()])?,
+                Some(first) => {
+                    let got = &mut values[first..first + self.vrs.len()];
+                    inst.get_real(&self.vrs, got)?;
+                    if !self.wide_sources.is_empty() {
+                        check_wide(&self.wide_sources, &self.vrs, got, inst)?;
+                    }
+                }
                 None => {
                     self.fetch(inst)?;
                     self.scatter(values);
@@ -93,7 +104,12 @@ impl Op {
     #[inline]
     pub(crate) fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
         match self.base_type {
-            BaseType::Real => inst.get_real(&self.vrs, &mut self.reals)?,
+            BaseType::Real => {
+                inst.get_real(&self.vrs, &mut self.reals)?;
+                if !self.wide_sources.is_empty() {
+                    check_wide(&self.wide_sources, &self.vrs, &self.reals, inst)?;
+                }
+            }
             BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
             BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
             BaseType::String => {}
@@ -157,6 +173,50 @@ impl Op {
             BaseType::String => {}
         }
         Ok(())
+    }
+}
+
+/// The connections carry values as f64: a 64-bit integer output beyond 2^53 that no f64
+/// holds would arrive rounded at the inputs it feeds. Such a value is an error naming the
+/// variable and the master's limit (a value an f64 holds, as -2^63, is carried exactly).
+#[cold]
+fn check_wide(wide: &[(usize, String)], vrs: &[u32], got: &[f64], inst: &mut Instance) -> Result<()> {
+    const EXACT: f64 = 9007199254740992.0; // 2^53
+    for (k, name) in wide {
+        if got[*k].abs() <= EXACT {
+            continue;
+        }
+        if let fmi_import::fmi3::Exact::Integer(exact) = inst.get_exact(vrs[*k])? {
+            if got[*k] as i128 != exact {
+                return Err(Error::Experiment(format!(
+                    "{name} = {exact} at t = {} s: the master carries connections as f64 (64-bit integers exactly up to 2^53), which would round it to {}; record it instead (recorded 64-bit integers are exact), or keep the connected values within 2^53",
+                    inst.time(),
+                    got[*k] as i128
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Marks in the gets of `ops` the 64-bit integer outputs of `system` that feed connections
+/// ([`Op::wide_sources`]).
+pub(crate) fn mark_wide_sources(ops: &mut [Op], system: &System) {
+    for op in ops.iter_mut().filter(|op| op.kind == OpKind::Get && op.base_type == BaseType::Real) {
+        let fmu = &system.instances[op.instance].fmu;
+        op.wide_sources = op
+            .vrs
+            .iter()
+            .enumerate()
+            .filter(|(_, vr)| fmu.exact_kind(**vr).is_some_and(|k| k != fmi_import::fmi3::ExactKind::Binary))
+            .filter_map(|(k, vr)| {
+                let c = system
+                    .connections
+                    .iter()
+                    .find(|c| c.from.instance == op.instance && c.from.value_reference == *vr)?;
+                Some((k, system.name_of(&c.from)))
+            })
+            .collect();
     }
 }
 
@@ -396,6 +456,9 @@ impl Plan {
             Err(e) if algorithm == Algorithm::Ordered => return Err(e),
             Err(_) => None,
         };
+        for gets in jacobi_gets.iter_mut().chain(jacobi_gets_rec.iter_mut()) {
+            mark_wide_sources(gets, system);
+        }
         Ok(Plan { sources, slots, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
     }
 
@@ -486,6 +549,7 @@ pub(crate) fn ordered_ops(
             emit(&mut ops, c.to.instance, OpKind::Set, c.to.base_type, c.to.value_reference, slot, (c.gain, c.offset));
         }
     }
+    mark_wide_sources(&mut ops, system);
     Ok(ops)
 }
 
@@ -494,7 +558,7 @@ pub fn default_record(system: &System) -> Vec<VariableRef> {
     let mut out = Vec::new();
     for (i, spec) in system.instances.iter().enumerate() {
         for (index, v) in spec.fmu.description().model_variables.iter().enumerate() {
-            if v.causality == Causality::Output && BaseType::of(v) != BaseType::String {
+            if v.causality == Causality::Output {
                 out.push(VariableRef {
                     instance: i,
                     index,

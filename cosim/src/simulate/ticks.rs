@@ -235,9 +235,10 @@ pub(crate) type ClockColumns = Vec<(usize, u32, Vec<f64>)>;
 /// column is not 0; a time once), by (instance, clock); and the table without them.
 pub(crate) fn clock_columns(system: &System, table: &InputTable) -> Result<(InputTable, ClockColumns)> {
     let single = system.instances.len() == 1;
-    let mut rest = InputTable { names: Vec::new(), time: table.time.clone(), columns: Vec::new() };
+    let mut rest =
+        InputTable { names: Vec::new(), time: table.time.clone(), columns: Vec::new(), integers: Vec::new() };
     let mut clocks = Vec::new();
-    for (name, column) in table.names.iter().zip(&table.columns) {
+    for (j, (name, column)) in table.names.iter().zip(&table.columns).enumerate() {
         let found = system.instances.iter().enumerate().find_map(|(i, spec)| {
             let local = if single { name.as_str() } else { name.strip_prefix(&spec.name)?.strip_prefix('.')? };
             spec.fmu.clocks().into_iter().find(|c| c.name == local).map(|c| (i, c))
@@ -245,6 +246,7 @@ pub(crate) fn clock_columns(system: &System, table: &InputTable) -> Result<(Inpu
         let Some((i, clock)) = found else {
             rest.names.push(name.clone());
             rest.columns.push(column.clone());
+            rest.integers.push(table.integers.get(j).cloned().flatten());
             continue;
         };
         if clock.causality != ClockCausality::Input || clock.kind != ClockKind::Triggered {

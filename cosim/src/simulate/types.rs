@@ -107,6 +107,20 @@ pub struct Results {
     pub names: Vec<String>,
     /// Row-major values: `time, v1, v2, ...` per row.
     pub values: Vec<f64>,
+    /// The columns whose values an f64 does not hold (FMI 3.0 Int64 and UInt64, Binary,
+    /// String), each with the text of every row as fmpy writes it (an integer in decimal,
+    /// a Binary in hex, a String as it is); [`Results::values`] holds the nearest f64 there
+    /// (a Binary its size in bytes, a String NaN). The CSV file has the text.
+    pub exact: Vec<ExactColumn>,
+}
+
+/// The text of one column of [`Results`] whose values an f64 does not hold.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExactColumn {
+    /// The column (0-based among [`Results::names`]).
+    pub column: usize,
+    /// One text per row.
+    pub rows: Vec<String>,
 }
 
 impl Results {
@@ -137,7 +151,21 @@ impl Results {
             values.push(row[0]);
             values.extend(keep.iter().map(|j| row[j + 1]));
         }
-        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values }
+        let exact = self
+            .exact
+            .iter()
+            .filter_map(|e| {
+                let column = keep.iter().position(|j| *j == e.column)?;
+                Some(ExactColumn { column, rows: e.rows.clone() })
+            })
+            .collect();
+        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values, exact }
+    }
+
+    /// The text of column `column` (0-based among the names) in every row, if an f64 does
+    /// not hold its values ([`Results::exact`]).
+    pub fn exact_column(&self, column: usize) -> Option<&[String]> {
+        self.exact.iter().find(|e| e.column == column).map(|e| e.rows.as_slice())
     }
 
     /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
@@ -151,18 +179,40 @@ impl Results {
         }
         line.push('\n');
         w.write_all(line.as_bytes())?;
+        // the text of the columns an f64 does not hold, by column (time first)
+        let mut text: Vec<Option<&[String]>> = vec![None; self.width()];
+        for e in &self.exact {
+            if let Some(t) = text.get_mut(e.column + 1) {
+                *t = Some(&e.rows);
+            }
+        }
         for k in 0..self.rows() {
             line.clear();
             for (j, v) in self.row(k).iter().enumerate() {
                 if j > 0 {
                     line.push(',');
                 }
-                push_number(&mut line, *v);
+                match text[j].and_then(|rows| rows.get(k)) {
+                    Some(t) => push_text(&mut line, t),
+                    None => push_number(&mut line, *v),
+                }
             }
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
         w.flush()
+    }
+}
+
+/// A text cell: as it is, or quoted (quotes doubled) when it holds a comma, a quote or a
+/// line break.
+fn push_text(out: &mut String, t: &str) {
+    if t.contains([',', '"', '\n', '\r']) {
+        out.push('"');
+        out.push_str(&t.replace('"', "\"\""));
+        out.push('"');
+    } else {
+        out.push_str(t);
     }
 }
 

@@ -114,8 +114,8 @@ impl Fmi3 {
         !self.a.special.is_empty() && vrs.iter().any(|vr| self.a.special.contains_key(vr))
     }
 
-    /// All values of the FMI 3.0 variable of `access`, as f64 (integers exact up to 2^53,
-    /// Booleans 0 or 1, a Binary its size in bytes).
+    /// All values of the FMI 3.0 variable of `access`, as f64 (64-bit integers the nearest,
+    /// exact up to 2^53; Booleans 0 or 1, a Binary its size in bytes).
     fn get_all(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
         use model_description::fmi3::ValueType as T;
         let c = core.component;
@@ -127,19 +127,6 @@ impl Fmi3 {
                 let mut buf: Vec<$t> = vec![<$t>::default(); n];
                 call!(core, $name, None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
                 buf
-            }};
-        }
-        macro_rules! exact {
-            ($buf:expr, $name:literal) => {{
-                let mut out = Vec::with_capacity(n);
-                for x in $buf {
-                    let wide = x as i128;
-                    if wide.abs() > 1 << 53 {
-                        return Err(not_exact(core, $name, vr, wide));
-                    }
-                    out.push(wide as f64);
-                }
-                out
             }};
         }
         Ok(match access.value_type {
@@ -156,8 +143,9 @@ impl Fmi3 {
             T::UInt16 => get!(get_uint16, "fmi3GetUInt16", u16).into_iter().map(f64::from).collect(),
             T::Int32 => get!(get_int32, "fmi3GetInt32", i32).into_iter().map(f64::from).collect(),
             T::UInt32 => get!(get_uint32, "fmi3GetUInt32", u32).into_iter().map(f64::from).collect(),
-            T::Int64 | T::Enumeration => exact!(get!(get_int64, "fmi3GetInt64", i64), "fmi3GetInt64"),
-            T::UInt64 => exact!(get!(get_uint64, "fmi3GetUInt64", u64), "fmi3GetUInt64"),
+            // the nearest f64 (exact up to 2^53); `get_exact` reads the integer itself
+            T::Int64 | T::Enumeration => get!(get_int64, "fmi3GetInt64", i64).into_iter().map(|x| x as f64).collect(),
+            T::UInt64 => get!(get_uint64, "fmi3GetUInt64", u64).into_iter().map(|x| x as f64).collect(),
             T::Boolean => get!(get_boolean, "fmi3GetBoolean", u8).into_iter().map(|b| (b != 0) as i32 as f64).collect(),
             T::Binary => {
                 let f = f3!(core, a, get_binary, "fmi3GetBinary");
@@ -621,14 +609,13 @@ pub(super) fn not_scheduled(name: &str) -> Error {
     Error::Instance { name: name.into(), reason: "it is not instantiated for Scheduled Execution (--interface se)" }
 }
 
+/// The error of an exact read or set of `vr`, which is no 64-bit integer or Binary.
 #[cold]
-fn not_exact(core: &Core, function: &'static str, vr: u32, value: i128) -> Error {
-    Error::Fmi {
-        instance: core.name.clone(),
-        function,
-        status: Status::Error,
-        time: Some(core.time),
-        log: format!("value {value} of value reference {vr} is beyond 2^53, where f64 results cannot hold it exactly"),
+fn not_exact(core: &Core, vr: u32, value: String) -> Error {
+    Error::InvalidValue {
+        variable: format!("{}.<value reference {vr}>", core.name),
+        value,
+        reason: "not an Int64, UInt64 or Binary of the FMU's: its value is the view's".into(),
     }
 }
 
@@ -863,6 +850,74 @@ impl Calls for Fmi3 {
         let c = core.component;
         let f = f3!(core, self.a, set_string, "fmi3SetString");
         call!(core, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
+    }
+
+    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
+        use crate::fmi3::Exact;
+        use model_description::fmi3::ValueType as T;
+        let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
+        let (c, a, n, k) = (core.component, &*self.a, access.count, access.element);
+        let fmu_vr = access.vr;
+        Ok(match access.value_type {
+            T::Int64 => {
+                let f = f3!(core, a, get_int64, "fmi3GetInt64");
+                let mut buf = vec![0i64; n];
+                call!(core, "fmi3GetInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
+                Exact::Integer(i128::from(buf[k]))
+            }
+            T::UInt64 => {
+                let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
+                let mut buf = vec![0u64; n];
+                call!(core, "fmi3GetUInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
+                Exact::Integer(i128::from(buf[k]))
+            }
+            T::Binary => {
+                let f = f3!(core, a, get_binary, "fmi3GetBinary");
+                let mut sizes = vec![0usize; n];
+                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
+                call!(core, "fmi3GetBinary", None, f(c, &fmu_vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
+                let (p, size) = (data[k], sizes[k]);
+                if p.is_null() || size == 0 {
+                    Exact::Bytes(Vec::new())
+                } else {
+                    // SAFETY: the FMU returned `size` bytes at `p`, valid until its next call.
+                    Exact::Bytes(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
+                }
+            }
+            _ => return Err(not_exact(core, vr, String::new())),
+        })
+    }
+
+    fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
+        let access = match self.special(vr) {
+            Some(a) if a.count == 1 && matches!(a.value_type, T::Int64 | T::UInt64) => a,
+            // an element of a 64-bit array: set with the others as before, through f64
+            Some(a) if matches!(a.value_type, T::Int64 | T::UInt64) && (value as f64) as i128 == value => {
+                return self.set_element(core, a, value as f64);
+            }
+            _ => return Err(not_exact(core, vr, value.to_string())),
+        };
+        let c = core.component;
+        let fmu_vr = access.vr;
+        let out_of_range = |core: &Core, ty: &str| {
+            let name =
+                core.fmu.description.model_variables.iter().find(|v| v.value_reference == vr).map(|v| v.name.clone());
+            Error::InvalidValue {
+                variable: format!("{}.{}", core.name, name.unwrap_or_else(|| format!("<vr {vr}>"))),
+                value: value.to_string(),
+                reason: format!("outside the range of {ty}"),
+            }
+        };
+        if access.value_type == T::Int64 {
+            let x = i64::try_from(value).map_err(|_| out_of_range(core, "Int64"))?;
+            let f = f3!(core, self.a, set_int64, "fmi3SetInt64");
+            call!(core, "fmi3SetInt64", None, f(c, &fmu_vr, 1, &x, 1))
+        } else {
+            let x = u64::try_from(value).map_err(|_| out_of_range(core, "UInt64"))?;
+            let f = f3!(core, self.a, set_uint64, "fmi3SetUInt64");
+            call!(core, "fmi3SetUInt64", None, f(c, &fmu_vr, 1, &x, 1))
+        }
     }
 
     /// An early return (`earlyReturn` with `lastSuccessfulTime` before the step's end) is

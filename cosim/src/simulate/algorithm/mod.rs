@@ -102,6 +102,9 @@ pub(crate) trait Communication {
             let p = Point { t: from, ..p };
             self.step(core, p, observers.calls())?;
             core.carry_clock_ticks(p.t_next);
+            if p.output_point && observers.recorder.reads_exact() {
+                observers.recorder.read_exact(&mut core.lanes)?;
+            }
             observers.step_complete(&p, &core.values)?;
         }
         Ok(())
