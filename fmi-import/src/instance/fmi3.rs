@@ -572,7 +572,20 @@ impl Fmi3 {
         if self.clocked.is_empty() || active.is_empty() {
             return Ok(());
         }
-        for access in self.clocked.readable(active) {
+        let readable = self.clocked.readable(active);
+        // the Float64 scalars in one fmi3GetFloat64 (the others one call each)
+        let (scalars, others): (Vec<Access>, Vec<Access>) =
+            readable.iter().partition(|a| a.count == 1 && a.value_type == model_description::fmi3::ValueType::Float64);
+        if !scalars.is_empty() {
+            let vrs: Vec<u32> = scalars.iter().map(|a| a.vr).collect();
+            let mut values = vec![0.0; vrs.len()];
+            let (c, f) = (core.component, self.a.functions.get_float64);
+            call!(core, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?;
+            for (vr, value) in vrs.into_iter().zip(values) {
+                self.clocked.hold_element(vr, 0, value);
+            }
+        }
+        for access in others {
             let values = self.get_all(core, access)?;
             self.clocked.hold(access.vr, values);
         }
