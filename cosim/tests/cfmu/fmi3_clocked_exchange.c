@@ -1,7 +1,8 @@
 /* An FMI 3.0 Co-Simulation test FMU (Event Mode only) whose clocked variables may be
- * accessed only while their clock is active, as FMI 3.0 says: in Initialization Mode, and
- * in Event Mode between fmi3SetClock of `tick` and fmi3UpdateDiscreteStates; any other get
- * or set of them is an error naming the variable. Value references as in
+ * accessed only while their clock is active, as FMI 3.0 says: in Initialization Mode; set
+ * in Event Mode between fmi3SetClock of `tick` and fmi3UpdateDiscreteStates, read in the
+ * Event Mode in which `tick` ticked; any other get or set of them is an error naming the
+ * variable. Value references as in
  * fmi3_clocked_exchange.xml:
  *   1 tick   input clock, constant: interval 0.25 s, shift 0
  *   2 u      Float64 input clocked by tick (start 0)
@@ -15,7 +16,7 @@
 
 typedef struct {
     double time, u, y;
-    int ticks, initializing, in_event_mode, active;
+    int ticks, initializing, in_event_mode, active, ticked;
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
 } Exchange;
@@ -30,7 +31,7 @@ static void start(Exchange *c) {
     c->u = 0;
     c->y = -1;
     c->ticks = 0;
-    c->initializing = c->in_event_mode = c->active = 0;
+    c->initializing = c->in_event_mode = c->active = c->ticked = 0;
 }
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
@@ -76,6 +77,7 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Exchange *c = instance;
     if (c->active) return fail(c, "fmi3EnterStepMode: tick is still active");
     c->in_event_mode = 0;
+    c->ticked = 0;
     return fmi3OK;
 }
 fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
@@ -103,7 +105,7 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], si
     for (size_t k = 0; k < n; k++) {
         if (vr[k] != 1) return fail(c, "fmi3SetClock: not an input clock");
         if (!v[k]) continue;
-        c->active = 1;
+        c->active = c->ticked = 1;
         c->ticks++;
         c->y = 10 * c->u + c->ticks;
     }
@@ -140,8 +142,11 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     return fmi3OK;
 }
 
-/* whether a clocked variable may be accessed now */
+/* whether a clocked variable may be set now: while tick is active */
 static int clocked_open(Exchange *c) { return c->initializing || (c->in_event_mode && c->active); }
+/* whether it may be read now: in the Event Mode in which tick ticked (the values its
+ * activation left, also after fmi3UpdateDiscreteStates) */
+static int clocked_readable(Exchange *c) { return c->initializing || (c->in_event_mode && c->ticked); }
 
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Float64 values[], size_t nValues) {
@@ -152,7 +157,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         case 4: values[k] = c->time; break;
         case 2:
         case 3:
-            if (!clocked_open(c))
+            if (!clocked_readable(c))
                 return fail(c, vr[k] == 2 ? "fmi3GetFloat64: u is a clocked variable of tick, which is not active"
                                           : "fmi3GetFloat64: y is a clocked variable of tick, which is not active");
             values[k] = vr[k] == 2 ? c->u : c->y;

@@ -55,7 +55,8 @@ impl ClockCalls for Fmi3 {
         // the clocks are active until fmi3UpdateDiscreteStates: their clocked inputs set,
         // their clocked outputs read
         self.apply_queued(core, vrs)?;
-        self.read_clocked(core, vrs)
+        self.ticked_inputs.extend_from_slice(vrs);
+        Ok(())
     }
 
     fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()> {

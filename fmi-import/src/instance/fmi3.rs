@@ -49,6 +49,9 @@ pub(crate) struct Fmi3 {
     /// The clocked variables: held between their clocks' ticks, sets queued to the next
     /// (`clocked.rs`).
     pub(super) clocked: super::clocked::ClockedExchange,
+    /// The input clocks set (`fmi3SetClock`) in the current event: their clocked variables
+    /// are read when it settles.
+    pub(super) ticked_inputs: Vec<u32>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -90,6 +93,7 @@ impl Fmi3 {
             intervals: Vec::new(),
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
             clocked: super::clocked::ClockedExchange::new(&a.description, &a.special),
+            ticked_inputs: Vec::new(),
             a,
         }
     }
@@ -601,18 +605,21 @@ impl Fmi3 {
             let intervals = super::clocks::ClockCalls::get_intervals(self, core, &vrs)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
-        if self.output_clocks.is_empty() {
-            return Ok(());
-        }
         let vrs = self.output_clocks.clone();
+        if vrs.is_empty() {
+            let active = std::mem::take(&mut self.ticked_inputs);
+            return self.read_clocked(core, &active);
+        }
         let mut ticks = vec![false; vrs.len()];
         super::clocks::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
         let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
         for vr in &ticked {
             self.output_ticks.push(super::clocks::OutputTick { time, value_reference: *vr });
         }
-        // the clocked variables of the output clocks that ticked, read in this event
-        self.read_clocked(core, &ticked)
+        // the clocked variables of the clocks that ticked in this event, read as it settled
+        let mut active = std::mem::take(&mut self.ticked_inputs);
+        active.extend(ticked);
+        self.read_clocked(core, &active)
     }
 }
 
@@ -798,6 +805,7 @@ impl Calls for Fmi3 {
 
     fn forget_run(&mut self) {
         self.clocked.forget_run(&self.a.description);
+        self.ticked_inputs.clear();
         self.output_ticks.clear();
         self.intervals.clear();
         self.terminate_requested = None;
