@@ -4,47 +4,10 @@
 //! status handled as every other call's. An FMI 2.0 instance has no clocks: each call is
 //! an error naming it.
 
-use super::core::{call, Calls, Core};
+use super::core::{call, Calls, ClockCalls, Core, Interval, OutputTick};
 use super::fmi3::Fmi3;
 use super::Instance;
 use crate::error::{Error, Result};
-
-/// What the FMU said of a clock's interval (`fmi3IntervalQualifier`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Interval {
-    /// `fmi3IntervalNotYetKnown`: a countdown clock that is not counting down.
-    NotYetKnown,
-    /// `fmi3IntervalUnchanged`: as before (the value is the interval the master has).
-    Unchanged(f64),
-    /// `fmi3IntervalChanged`: the clock ticks this many seconds after now.
-    Changed(f64),
-}
-
-/// An output clock's tick: when and which (the FMU's value reference).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OutputTick {
-    /// The time of the event it ticked in, s.
-    pub time: f64,
-    /// The clock's value reference (the FMU's).
-    pub value_reference: u32,
-}
-
-/// The clock calls of one generation (FMI 3.0 only).
-pub(crate) trait ClockCalls {
-    fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()>;
-    fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()>;
-    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>>;
-    fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>>;
-    fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()>;
-    /// A clock event at `time` (Event Mode entered and the input clocks `vrs` set; the
-    /// discrete states updated until settled; the output clocks read; Step Mode again).
-    fn clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()>;
-    /// The output clocks' ticks since the last call (in Event Mode entered by a tick or by
-    /// the FMU's own event in `fmi3DoStep`).
-    fn take_output_ticks(&mut self) -> Vec<OutputTick>;
-    /// What the FMU said of its input clocks' intervals in the events since the last call.
-    fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)>;
-}
 
 impl ClockCalls for Fmi3 {
     fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()> {

@@ -9,7 +9,7 @@ use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
 use super::clocked::HeldNumber;
-use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmi3::{Access, Fmi3Abi};
@@ -37,12 +37,12 @@ pub(crate) struct Fmi3 {
     /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
     output_clocks: Vec<u32>,
     /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
-    pub(super) output_ticks: Vec<super::clocks::OutputTick>,
+    pub(super) output_ticks: Vec<super::core::OutputTick>,
     /// The input clocks whose interval the FMU gives (fixed, tunable, changing,
     /// countdown), read by `fmi3GetIntervalDecimal` in every event.
     interval_clocks: Vec<u32>,
     /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
-    pub(super) intervals: Vec<(f64, u32, super::clocks::Interval)>,
+    pub(super) intervals: Vec<(f64, u32, super::core::Interval)>,
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
     /// the FMU's for as long as the instance lives).
     scheduled: Option<Box<super::callbacks::ScheduledEnvironment>>,
@@ -602,7 +602,7 @@ impl Fmi3 {
     fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
         if !self.interval_clocks.is_empty() {
             let vrs = self.interval_clocks.clone();
-            let intervals = super::clocks::ClockCalls::get_intervals(self, core, &vrs)?;
+            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
         let vrs = self.output_clocks.clone();
@@ -611,10 +611,10 @@ impl Fmi3 {
             return self.read_clocked(core, &active);
         }
         let mut ticks = vec![false; vrs.len()];
-        super::clocks::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
+        ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
         let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
         for vr in &ticked {
-            self.output_ticks.push(super::clocks::OutputTick { time, value_reference: *vr });
+            self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
         }
         // the clocked variables of the clocks that ticked in this event, read as it settled
         let mut active = std::mem::take(&mut self.ticked_inputs);
@@ -1155,7 +1155,7 @@ impl Calls for Fmi3 {
         true
     }
 
-    fn clock_calls(&mut self) -> Option<&mut dyn super::clocks::ClockCalls> {
+    fn clock_calls(&mut self) -> Option<&mut dyn ClockCalls> {
         Some(self)
     }
 }

@@ -16,9 +16,9 @@ mod scheduled;
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
-pub use self::clocks::{Interval, OutputTick};
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
+pub use self::core::{Interval, OutputTick};
 use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};

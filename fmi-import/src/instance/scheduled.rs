@@ -10,7 +10,7 @@ use std::ffi::{c_void, CString};
 use std::sync::atomic::Ordering;
 
 use super::callbacks::{clock_update, lock_preemption, log_message, unlock_preemption, ScheduledEnvironment};
-use super::clocks::ClockCalls;
+use super::core::ClockCalls;
 use super::core::{call, Core};
 use super::fmi3::Fmi3;
 use super::Instance;
