@@ -43,7 +43,7 @@ fn clocked_variables_are_held_between_ticks_and_set_at_them() {
     assert_eq!(time.len(), 13, "{time:?}");
     for ((t, y), t_now) in time.iter().zip(&y).zip(&t_now) {
         // ticks and points differ by ulps at most: 1e-9 s apart
-        let expected = ticks.iter().filter(|(tick, _)| *tick < t - 1e-9).last().map_or(-1.0, |(_, y)| *y);
+        let expected = ticks.iter().rev().find(|(tick, _)| *tick < t - 1e-9).map_or(-1.0, |(_, y)| *y);
         assert_eq!(*y, expected, "y at t = {t} s");
         // the variable that is not clocked is read at every row: the FMU's time, the sum of
         // the master's step starts and sizes, within ulps of the row's t0 + n h
