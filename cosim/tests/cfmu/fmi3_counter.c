@@ -23,8 +23,8 @@
  *      (SIGABRT), 3 exit(0); 4 no crash: Co-Simulation's step says terminateSimulation with an
  *      early return at lastSuccessfulTime = t + 1000 s, past the step
  * and, in the descriptions of the tests of large arrays only (j from 0):
- *   32 big Float64[BIG] output y + j   33 bigi Int32[BIG] output n + j
- *   34 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
+ *   40 big Float64[BIG] output y + j   41 bigi Int32[BIG] output n + j
+ *   42 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
@@ -208,7 +208,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
-        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : vr[i] == 32 ? BIG : 1;
+        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : vr[i] == 40 ? BIG : 1;
         if (k + size > nValues) return fail(c, "fmi3GetFloat64: nValues too small");
         switch (vr[i]) {
         case 0: values[k] = c->s.time; break;
@@ -222,7 +222,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         case 25: values[k] = c->s.gains[0]; values[k + 1] = c->s.gains[1]; break;
         case 26: values[k] = c->s.gains[0] * c->s.y + c->s.gains[1]; break;
         case 30: values[k] = c->s.crash_at; break;
-        case 32: for (size_t j = 0; j < BIG; j++) values[k + j] = c->s.y + (double)j; break;
+        case 40: for (size_t j = 0; j < BIG; j++) values[k + j] = c->s.y + (double)j; break;
         default: return fail(c, "fmi3GetFloat64: no such Float64");
         }
         k += size;
@@ -255,7 +255,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
 fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Int32 values[], size_t nValues) {
     Counter *c = instance;
-    if (nvr == 1 && vr[0] == 33) { /* the array bigi */
+    if (nvr == 1 && vr[0] == 41) { /* the array bigi */
         if (nValues != BIG) return fail(c, "fmi3GetInt32: nValues is not the size of bigi");
         for (size_t j = 0; j < BIG; j++) values[j] = c->s.n + (fmi3Int32)j;
         return fmi3OK;
@@ -317,14 +317,14 @@ fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
-        size_t size = vr[i] == 27 ? 2 : vr[i] == 34 ? BIG : 1;
+        size_t size = vr[i] == 27 ? 2 : vr[i] == 42 ? BIG : 1;
         if (k + size > nValues) return fail(c, "fmi3GetBoolean: nValues too small");
         switch (vr[i]) {
         case 4: values[k] = (c->s.n % 2) == 1; break;
         case 11: values[k] = c->s.b != 0; break;
         case 12: values[k] = c->s.b == 0; break;
         case 27: values[k] = (c->s.n % 2) == 1; values[k + 1] = (c->s.n % 2) == 0; break;
-        case 34: for (size_t j = 0; j < BIG; j++) values[k + j] = ((c->s.n + j) % 2) == 1; break;
+        case 42: for (size_t j = 0; j < BIG; j++) values[k + j] = ((c->s.n + j) % 2) == 1; break;
         default: return fail(c, "fmi3GetBoolean: no such Boolean");
         }
         k += size;

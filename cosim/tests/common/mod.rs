@@ -477,7 +477,7 @@ pub fn counter_xml_with_large_arrays(n: usize, arrays: &[&str]) -> String {
     let arr = r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension start="3"/></Float64>"#;
     assert!(xml.contains(arr));
     let mut declared = arr.to_string();
-    for (name, ty, vr) in [("big", "Float64", 32), ("bigi", "Int32", 33), ("bigb", "Boolean", 34)] {
+    for (name, ty, vr) in [("big", "Float64", 40), ("bigi", "Int32", 41), ("bigb", "Boolean", 42)] {
         if arrays.contains(&name) {
             declared.push_str(&format!(
                 r#"
