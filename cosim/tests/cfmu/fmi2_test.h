@@ -8,7 +8,8 @@
  *   FMI2_TEST_NO_FMU_STATE       fmi2Get/Set/FreeFMUstate refused (the file has no FMU state)
  *   FMI2_TEST_NO_MODEL_EXCHANGE  every Model Exchange function refused (Co-Simulation only),
  *                                and the Co-Simulation input/output derivatives refused.
- * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted),
+ * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
+ * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
  * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type), FMI2_TEST_TWO_STATES(Type),
  * FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
@@ -98,6 +99,13 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         defaults(m);                                                                                    \
         return m;                                                                                       \
     }                                                                                                   \
+    FMI2_TEST_LIFECYCLE(Type)                                                                           \
+    EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+
+/* The lifecycle of a `Type` (a struct with a member `double time`) made by calloc, for a file
+ * with its own fmi2Instantiate and fmi2Reset: fmi2FreeInstance frees it, fmi2SetupExperiment
+ * sets the time, entering initialization and terminating do nothing. */
+#define FMI2_TEST_LIFECYCLE(Type)                                                                       \
     EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }                                          \
     EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d,         \
                                           double stop) {                                                \
@@ -105,8 +113,7 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         return 0;                                                                                       \
     }                                                                                                   \
     EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }                        \
-    EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }                                      \
-    EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+    EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
 
 #define FMI2_TEST_EXIT_INITIALIZATION \
     EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
