@@ -14,7 +14,12 @@ impl ClockCalls for Fmi3 {
         let f = core.optional(self.a.functions.set_clock, "fmi3SetClock")?;
         let c = core.component;
         let on = vec![1u8; vrs.len()];
-        call!(core, "fmi3SetClock", None, f(c, vrs.as_ptr(), vrs.len(), on.as_ptr()))
+        call!(core, "fmi3SetClock", None, f(c, vrs.as_ptr(), vrs.len(), on.as_ptr()))?;
+        // the clocks are active until fmi3UpdateDiscreteStates: their clocked inputs set,
+        // their clocked outputs read
+        self.apply_queued(core, vrs)?;
+        self.ticked_inputs.extend_from_slice(vrs);
+        Ok(())
     }
 
     fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()> {
@@ -29,37 +34,7 @@ impl ClockCalls for Fmi3 {
     }
 
     fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>> {
-        let mut values = vec![0.0; vrs.len()];
-        let mut qualifiers = vec![0i32; vrs.len()];
-        let c = core.component;
-        match (self.a.functions.get_interval_decimal, self.a.functions.get_interval_fraction) {
-            (Some(f), _) => call!(
-                core,
-                "fmi3GetIntervalDecimal",
-                None,
-                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), qualifiers.as_mut_ptr())
-            )?,
-            (None, Some(f)) => {
-                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
-                call!(
-                    core,
-                    "fmi3GetIntervalFraction",
-                    None,
-                    f(
-                        c,
-                        vrs.as_ptr(),
-                        vrs.len(),
-                        counters.as_mut_ptr(),
-                        resolutions.as_mut_ptr(),
-                        qualifiers.as_mut_ptr()
-                    )
-                )?;
-                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
-                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
-                }
-            }
-            (None, None) => return Err(core.optional(None::<()>, "fmi3GetIntervalDecimal").unwrap_err()),
-        }
+        let (values, qualifiers) = self.interval_call(core, vrs)?;
         vrs.iter()
             .zip(values.iter().zip(&qualifiers))
             .map(|(vr, (v, q))| match q {
@@ -131,6 +106,46 @@ impl ClockCalls for Fmi3 {
 
     fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)> {
         std::mem::take(&mut self.intervals)
+    }
+}
+
+impl Fmi3 {
+    /// The raw interval call: `fmi3GetIntervalDecimal` (or `Fraction` where only it is
+    /// present, its counter over its resolution, NaN for resolution 0): the values and the
+    /// qualifiers, each use reading them as it needs.
+    pub(super) fn interval_call(&mut self, core: &mut Core, vrs: &[u32]) -> Result<(Vec<f64>, Vec<i32>)> {
+        let mut values = vec![0.0; vrs.len()];
+        let mut qualifiers = vec![0i32; vrs.len()];
+        let c = core.component;
+        match (self.a.functions.get_interval_decimal, self.a.functions.get_interval_fraction) {
+            (Some(f), _) => call!(
+                core,
+                "fmi3GetIntervalDecimal",
+                None,
+                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), qualifiers.as_mut_ptr())
+            )?,
+            (None, Some(f)) => {
+                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
+                call!(
+                    core,
+                    "fmi3GetIntervalFraction",
+                    None,
+                    f(
+                        c,
+                        vrs.as_ptr(),
+                        vrs.len(),
+                        counters.as_mut_ptr(),
+                        resolutions.as_mut_ptr(),
+                        qualifiers.as_mut_ptr()
+                    )
+                )?;
+                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
+                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
+                }
+            }
+            (None, None) => return Err(core.optional(None::<()>, "fmi3GetIntervalDecimal").unwrap_err()),
+        }
+        Ok((values, qualifiers))
     }
 }
 

@@ -8,6 +8,7 @@ use std::collections::HashMap;
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
+use super::clocked::HeldNumber;
 use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
@@ -45,6 +46,12 @@ pub(crate) struct Fmi3 {
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
     /// the FMU's for as long as the instance lives).
     scheduled: Option<Box<super::callbacks::ScheduledEnvironment>>,
+    /// The clocked variables: held between their clocks' ticks, sets queued to the next
+    /// (`clocked.rs`).
+    pub(super) clocked: super::clocked::ClockedExchange,
+    /// The input clocks set (`fmi3SetClock`) in the current event: their clocked variables
+    /// are read when it settles.
+    pub(super) ticked_inputs: Vec<u32>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -75,7 +82,6 @@ impl Fmi3 {
             .map(|c| c.value_reference)
             .collect();
         Fmi3 {
-            a,
             experiment: (None, 0.0, None),
             terminate_requested: None,
             bytes: Vec::new(),
@@ -86,6 +92,9 @@ impl Fmi3 {
             interval_clocks,
             intervals: Vec::new(),
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
+            clocked: super::clocked::ClockedExchange::new(&a.description, &a.special),
+            ticked_inputs: Vec::new(),
+            a,
         }
     }
 
@@ -322,6 +331,271 @@ impl Fmi3 {
 }
 
 impl Fmi3 {
+    #[inline]
+    fn fmu_get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.get_float64);
+        if !self.any_special(vrs) {
+            return call!(
+                core,
+                "fmi3GetFloat64",
+                None,
+                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
+            );
+        }
+        let mut array = None;
+        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+            match self.special(*vr) {
+                Some(access) => *value = self.element_of_call(core, access, &mut array)?,
+                None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn fmu_get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        let c = core.component;
+        if !self.any_special(vrs) {
+            let f = f3!(core, self.a, get_int32, "fmi3GetInt32");
+            return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
+        }
+        let get32 = self.a.functions.get_int32;
+        let mut array = None;
+        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+            match self.special(*vr) {
+                Some(access) => {
+                    let x = self.element_of_call(core, access, &mut array)?;
+                    // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
+                    *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
+                        instance: core.name.clone(),
+                        function: "fmi3GetInt64",
+                        status: Status::Error,
+                        time: Some(core.time),
+                        log: format!("value {x} of value reference {} is outside the Integer range", access.vr),
+                    })?;
+                }
+                None => {
+                    let f = core.optional(get32, "fmi3GetInt32")?;
+                    call!(core, "fmi3GetInt32", None, f(c, vr, 1, value, 1))?
+                }
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn fmu_get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
+        if self.any_special(vrs) {
+            let mut array = None;
+            for (vr, value) in vrs.iter().zip(values.iter_mut()) {
+                *value = match self.special(*vr) {
+                    Some(access) => self.element_of_call(core, access, &mut array)? as i32,
+                    None => {
+                        let mut one = [0];
+                        self.fmu_get_boolean(core, &[*vr], &mut one)?;
+                        one[0]
+                    }
+                };
+            }
+            return Ok(());
+        }
+        let c = core.component;
+        let f = f3!(core, self.a, get_boolean, "fmi3GetBoolean");
+        let mut bytes = std::mem::take(&mut self.bytes);
+        bytes.clear();
+        bytes.resize(vrs.len(), 0);
+        let r = call!(core, "fmi3GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_mut_ptr(), bytes.len()));
+        for (v, b) in values.iter_mut().zip(&bytes) {
+            *v = (*b != 0) as i32;
+        }
+        self.bytes = bytes;
+        r
+    }
+
+    #[inline]
+    fn fmu_set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
+        let (c, f) = (core.component, self.a.functions.set_float64);
+        if !self.any_special(vrs) {
+            return call!(core, "fmi3SetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            match self.special(*vr) {
+                Some(access) => self.set_element(core, access, *value)?,
+                None => call!(core, "fmi3SetFloat64", None, f(c, vr, 1, value, 1))?,
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn fmu_set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
+        let c = core.component;
+        if !self.any_special(vrs) {
+            let f = f3!(core, self.a, set_int32, "fmi3SetInt32");
+            return call!(core, "fmi3SetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        }
+        let set32 = self.a.functions.set_int32;
+        for (vr, value) in vrs.iter().zip(values) {
+            match self.special(*vr) {
+                Some(access) => self.set_element(core, access, *value as f64)?,
+                None => {
+                    let f = core.optional(set32, "fmi3SetInt32")?;
+                    call!(core, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?
+                }
+            }
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn fmu_set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
+        if self.any_special(vrs) {
+            for (vr, value) in vrs.iter().zip(values) {
+                match self.special(*vr) {
+                    Some(access) => self.set_element(core, access, (*value != 0) as i32 as f64)?,
+                    None => self.fmu_set_boolean(core, &[*vr], &[*value])?,
+                }
+            }
+            return Ok(());
+        }
+        let c = core.component;
+        let f = f3!(core, self.a, set_boolean, "fmi3SetBoolean");
+        let mut bytes = std::mem::take(&mut self.bytes);
+        bytes.clear();
+        bytes.extend(values.iter().map(|v| (*v != 0) as u8));
+        let r = call!(core, "fmi3SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_ptr(), bytes.len()));
+        self.bytes = bytes;
+        r
+    }
+
+    /// A get of the view's `vrs` on an FMU with clocked variables: while running, a
+    /// clocked variable's value is the one held since its clocks' last activation (the
+    /// FMU refuses the access outside it); the others are read from the FMU by `fmu_get`,
+    /// in one call. In Initialization Mode everything is read, the clocked values kept as
+    /// held.
+    fn get_held<T: HeldNumber>(
+        &mut self,
+        core: &mut Core,
+        vrs: &[u32],
+        values: &mut [T],
+        fmu_get: fn(&mut Fmi3, &mut Core, &[u32], &mut [T]) -> Result<()>,
+    ) -> Result<()> {
+        let clocked: Vec<Option<(u32, usize)>> =
+            vrs.iter().map(|vr| self.clocked.clocked(*vr, self.special(*vr))).collect();
+        if clocked.iter().all(Option::is_none) {
+            return fmu_get(self, core, vrs, values);
+        }
+        if core.state != InstanceState::Running {
+            fmu_get(self, core, vrs, values)?;
+            for (at, value) in clocked.iter().zip(values.iter()) {
+                if let Some((fmu_vr, element)) = at {
+                    self.clocked.hold_element(*fmu_vr, *element, value.to_held());
+                }
+            }
+            return Ok(());
+        }
+        let (mut free_vrs, mut free_at) = (Vec::new(), Vec::new());
+        for (k, (vr, at)) in vrs.iter().zip(&clocked).enumerate() {
+            match at.and_then(|(fmu_vr, element)| self.clocked.held(fmu_vr, element)) {
+                Some(held) => values[k] = T::from_held(held),
+                None => {
+                    free_vrs.push(*vr);
+                    free_at.push(k);
+                }
+            }
+        }
+        if !free_vrs.is_empty() {
+            let mut free_values: Vec<T> = free_at.iter().map(|k| values[*k]).collect();
+            fmu_get(self, core, &free_vrs, &mut free_values)?;
+            for (k, value) in free_at.into_iter().zip(free_values) {
+                values[k] = value;
+            }
+        }
+        Ok(())
+    }
+
+    /// A set of the view's `vrs` on an FMU with clocked variables: while running, a set of
+    /// a clocked input is queued to its clocks' next activation (the FMU refuses it
+    /// outside one); the others are set by `fmu_set`, in one call. In Initialization Mode
+    /// everything is set, the clocked values kept as held.
+    fn set_queued<T: HeldNumber>(
+        &mut self,
+        core: &mut Core,
+        vrs: &[u32],
+        values: &[T],
+        fmu_set: fn(&mut Fmi3, &mut Core, &[u32], &[T]) -> Result<()>,
+    ) -> Result<()> {
+        let clocked: Vec<Option<(u32, usize)>> =
+            vrs.iter().map(|vr| self.clocked.clocked(*vr, self.special(*vr))).collect();
+        if clocked.iter().all(Option::is_none) {
+            return fmu_set(self, core, vrs, values);
+        }
+        if core.state != InstanceState::Running {
+            fmu_set(self, core, vrs, values)?;
+            for (at, value) in clocked.iter().zip(values) {
+                if let Some((fmu_vr, element)) = at {
+                    self.clocked.hold_element(*fmu_vr, *element, value.to_held());
+                }
+            }
+            return Ok(());
+        }
+        let (mut free_vrs, mut free_values) = (Vec::new(), Vec::new());
+        for ((vr, at), value) in vrs.iter().zip(&clocked).zip(values) {
+            match at {
+                Some((fmu_vr, element)) if self.clocked.is_input(*fmu_vr) => {
+                    self.clocked.queue(*fmu_vr, *element, value.to_held())
+                }
+                _ => {
+                    free_vrs.push(*vr);
+                    free_values.push(*value);
+                }
+            }
+        }
+        if free_vrs.is_empty() {
+            return Ok(());
+        }
+        fmu_set(self, core, &free_vrs, &free_values)
+    }
+
+    /// The queued sets of the clocked inputs of the clocks `active` applied (each as one
+    /// set of the whole variable), the values held.
+    pub(super) fn apply_queued(&mut self, core: &mut Core, active: &[u32]) -> Result<()> {
+        if self.clocked.is_empty() || active.is_empty() {
+            return Ok(());
+        }
+        for (access, values) in self.clocked.take_queued(active) {
+            self.set_all(core, access, &values)?;
+            self.clocked.hold(access.vr, values);
+        }
+        Ok(())
+    }
+
+    /// The clocked variables of the clocks `active` that the master reads (all but inputs)
+    /// read and held until the next activation.
+    pub(super) fn read_clocked(&mut self, core: &mut Core, active: &[u32]) -> Result<()> {
+        if self.clocked.is_empty() || active.is_empty() {
+            return Ok(());
+        }
+        let readable = self.clocked.readable(active);
+        // the Float64 scalars in one fmi3GetFloat64 (the others one call each)
+        let (scalars, others): (Vec<Access>, Vec<Access>) =
+            readable.iter().partition(|a| a.count == 1 && a.value_type == model_description::fmi3::ValueType::Float64);
+        if !scalars.is_empty() {
+            let vrs: Vec<u32> = scalars.iter().map(|a| a.vr).collect();
+            let mut values = vec![0.0; vrs.len()];
+            let (c, f) = (core.component, self.a.functions.get_float64);
+            call!(core, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?;
+            for (vr, value) in vrs.into_iter().zip(values) {
+                self.clocked.hold_element(vr, 0, value);
+            }
+        }
+        for access in others {
+            let values = self.get_all(core, access)?;
+            self.clocked.hold(access.vr, values);
+        }
+        Ok(())
+    }
+
     /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`) and the
     /// intervals of the input clocks the FMU gives (`fmi3GetIntervalDecimal`), kept for
     /// `take_output_ticks` and `take_intervals`.
@@ -331,18 +605,21 @@ impl Fmi3 {
             let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
-        if self.output_clocks.is_empty() {
-            return Ok(());
-        }
         let vrs = self.output_clocks.clone();
-        let mut ticks = vec![false; vrs.len()];
-        super::core::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
-        for (vr, ticked) in vrs.into_iter().zip(ticks) {
-            if ticked {
-                self.output_ticks.push(super::core::OutputTick { time, value_reference: vr });
-            }
+        if vrs.is_empty() {
+            let active = std::mem::take(&mut self.ticked_inputs);
+            return self.read_clocked(core, &active);
         }
-        Ok(())
+        let mut ticks = vec![false; vrs.len()];
+        ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
+        let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
+        for vr in &ticked {
+            self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
+        }
+        // the clocked variables of the clocks that ticked in this event, read as it settled
+        let mut active = std::mem::take(&mut self.ticked_inputs);
+        active.extend(ticked);
+        self.read_clocked(core, &active)
     }
 }
 
@@ -497,6 +774,12 @@ impl Calls for Fmi3 {
     }
 
     fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
+        // the clocked variables the master reads hold what initialization computed until
+        // their clocks' first ticks (read while Initialization Mode allows it)
+        for access in self.clocked.unheld() {
+            let values = self.get_all(core, access)?;
+            self.clocked.hold(access.vr, values);
+        }
         let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
         call!(core, "fmi3ExitInitializationMode", None, f(c))?;
         // instantiated with eventModeUsed, the FMU is in Event Mode now (FMI 3.0's
@@ -521,6 +804,8 @@ impl Calls for Fmi3 {
     }
 
     fn forget_run(&mut self) {
+        self.clocked.forget_run(&self.a.description);
+        self.ticked_inputs.clear();
         self.output_ticks.clear();
         self.intervals.clear();
         self.terminate_requested = None;
@@ -528,139 +813,50 @@ impl Calls for Fmi3 {
 
     #[inline]
     fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
-        let (c, f) = (core.component, self.a.functions.get_float64);
-        if !self.any_special(vrs) {
-            return call!(
-                core,
-                "fmi3GetFloat64",
-                None,
-                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
-            );
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.get_held(core, vrs, values, Self::fmu_get_real);
         }
-        let mut array = None;
-        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
-            match self.special(*vr) {
-                Some(access) => *value = self.element_of_call(core, access, &mut array)?,
-                None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
-            }
-        }
-        Ok(())
+        self.fmu_get_real(core, vrs, values)
     }
 
     #[inline]
     fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
-        let (c, f) = (core.component, self.a.functions.set_float64);
-        if !self.any_special(vrs) {
-            return call!(core, "fmi3SetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.set_queued(core, vrs, values, Self::fmu_set_real);
         }
-        for (vr, value) in vrs.iter().zip(values) {
-            match self.special(*vr) {
-                Some(access) => self.set_element(core, access, *value)?,
-                None => call!(core, "fmi3SetFloat64", None, f(c, vr, 1, value, 1))?,
-            }
-        }
-        Ok(())
+        self.fmu_set_real(core, vrs, values)
     }
 
     #[inline]
     fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        let c = core.component;
-        if !self.any_special(vrs) {
-            let f = f3!(core, self.a, get_int32, "fmi3GetInt32");
-            return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.get_held(core, vrs, values, Self::fmu_get_integer);
         }
-        let get32 = self.a.functions.get_int32;
-        let mut array = None;
-        for (vr, value) in vrs.iter().zip(values.iter_mut()) {
-            match self.special(*vr) {
-                Some(access) => {
-                    let x = self.element_of_call(core, access, &mut array)?;
-                    // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
-                    *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
-                        instance: core.name.clone(),
-                        function: "fmi3GetInt64",
-                        status: Status::Error,
-                        time: Some(core.time),
-                        log: format!("value {x} of value reference {} is outside the Integer range", access.vr),
-                    })?;
-                }
-                None => {
-                    let f = core.optional(get32, "fmi3GetInt32")?;
-                    call!(core, "fmi3GetInt32", None, f(c, vr, 1, value, 1))?
-                }
-            }
-        }
-        Ok(())
+        self.fmu_get_integer(core, vrs, values)
     }
 
     #[inline]
     fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        let c = core.component;
-        if !self.any_special(vrs) {
-            let f = f3!(core, self.a, set_int32, "fmi3SetInt32");
-            return call!(core, "fmi3SetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len()));
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.set_queued(core, vrs, values, Self::fmu_set_integer);
         }
-        let set32 = self.a.functions.set_int32;
-        for (vr, value) in vrs.iter().zip(values) {
-            match self.special(*vr) {
-                Some(access) => self.set_element(core, access, *value as f64)?,
-                None => {
-                    let f = core.optional(set32, "fmi3SetInt32")?;
-                    call!(core, "fmi3SetInt32", None, f(c, vr, 1, value, 1))?
-                }
-            }
-        }
-        Ok(())
+        self.fmu_set_integer(core, vrs, values)
     }
 
     #[inline]
     fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if self.any_special(vrs) {
-            let mut array = None;
-            for (vr, value) in vrs.iter().zip(values.iter_mut()) {
-                *value = match self.special(*vr) {
-                    Some(access) => self.element_of_call(core, access, &mut array)? as i32,
-                    None => {
-                        let mut one = [0];
-                        self.get_boolean(core, &[*vr], &mut one)?;
-                        one[0]
-                    }
-                };
-            }
-            return Ok(());
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.get_held(core, vrs, values, Self::fmu_get_boolean);
         }
-        let c = core.component;
-        let f = f3!(core, self.a, get_boolean, "fmi3GetBoolean");
-        let mut bytes = std::mem::take(&mut self.bytes);
-        bytes.clear();
-        bytes.resize(vrs.len(), 0);
-        let r = call!(core, "fmi3GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_mut_ptr(), bytes.len()));
-        for (v, b) in values.iter_mut().zip(&bytes) {
-            *v = (*b != 0) as i32;
-        }
-        self.bytes = bytes;
-        r
+        self.fmu_get_boolean(core, vrs, values)
     }
 
     #[inline]
     fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if self.any_special(vrs) {
-            for (vr, value) in vrs.iter().zip(values) {
-                match self.special(*vr) {
-                    Some(access) => self.set_element(core, access, (*value != 0) as i32 as f64)?,
-                    None => self.set_boolean(core, &[*vr], &[*value])?,
-                }
-            }
-            return Ok(());
+        if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            return self.set_queued(core, vrs, values, Self::fmu_set_boolean);
         }
-        let c = core.component;
-        let f = f3!(core, self.a, set_boolean, "fmi3SetBoolean");
-        let mut bytes = std::mem::take(&mut self.bytes);
-        bytes.clear();
-        bytes.extend(values.iter().map(|v| (*v != 0) as u8));
-        let r = call!(core, "fmi3SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), bytes.as_ptr(), bytes.len()));
-        self.bytes = bytes;
-        r
+        self.fmu_set_boolean(core, vrs, values)
     }
 
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {

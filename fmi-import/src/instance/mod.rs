@@ -5,6 +5,7 @@
 //! frees itself on drop.
 
 mod callbacks;
+mod clocked;
 mod clocks;
 mod configuration;
 pub(crate) mod core;

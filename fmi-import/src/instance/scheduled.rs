@@ -10,6 +10,7 @@ use std::ffi::{c_void, CString};
 use std::sync::atomic::Ordering;
 
 use super::callbacks::{clock_update, lock_preemption, log_message, unlock_preemption, ScheduledEnvironment};
+use super::core::ClockCalls;
 use super::core::{call, Core};
 use super::fmi3::Fmi3;
 use super::Instance;
@@ -69,20 +70,22 @@ impl Fmi3 {
         let c = core.component;
         environment.clock_update.store(false, Ordering::Release);
         core.time = time;
+        // the partition's clocked inputs set before its activation, its clocked outputs
+        // read after it (held until its next)
+        self.apply_queued(core, &[clock])?;
         call!(core, "fmi3ActivateModelPartition", Some(time), f(c, clock, time))?;
+        self.read_clocked(core, &[clock])?;
         Ok(environment.clock_update.swap(false, Ordering::Acquire))
     }
 
     /// `fmi3GetIntervalDecimal` of `clock`: the interval when its qualifier is
     /// `fmi3IntervalChanged`, else `None`.
     pub(super) fn changed_interval(&mut self, core: &mut Core, clock: u32) -> Result<Option<f64>> {
-        let f = core.optional(self.abi().functions.get_interval_decimal, "fmi3GetIntervalDecimal")?;
-        let c = core.component;
-        let (mut interval, mut qualifier) = (0.0, fmi_sys::fmi3::FMI3_INTERVAL_NOT_YET_KNOWN);
-        call!(core, "fmi3GetIntervalDecimal", None, f(c, &clock, 1, &mut interval, &mut qualifier))?;
-        if qualifier != fmi_sys::fmi3::FMI3_INTERVAL_CHANGED {
+        let (values, qualifiers) = self.interval_call(core, &[clock])?;
+        if qualifiers[0] != fmi_sys::fmi3::FMI3_INTERVAL_CHANGED {
             return Ok(None);
         }
+        let interval = values[0];
         if !(interval.is_finite() && interval >= 0.0) {
             core.state = super::core::InstanceState::Errored;
             let time = core.time;
@@ -97,11 +100,9 @@ impl Fmi3 {
 
     /// `fmi3GetClock` of the output clock `clock`: whether it ticked.
     pub(super) fn clock_ticked(&mut self, core: &mut Core, clock: u32) -> Result<bool> {
-        let f = core.optional(self.abi().functions.get_clock, "fmi3GetClock")?;
-        let c = core.component;
-        let mut value = 0u8;
-        call!(core, "fmi3GetClock", None, f(c, &clock, 1, &mut value))?;
-        Ok(value != 0)
+        let mut ticked = [false];
+        ClockCalls::get_clocks(self, core, &[clock], &mut ticked)?;
+        Ok(ticked[0])
     }
 }
 

@@ -1,0 +1,181 @@
+/* An FMI 3.0 Co-Simulation test FMU (Event Mode only) whose clocked variables may be
+ * accessed only while their clock is active, as FMI 3.0 says: in Initialization Mode; set
+ * in Event Mode between fmi3SetClock of `tick` and fmi3UpdateDiscreteStates, read in the
+ * Event Mode in which `tick` ticked; any other get or set of them is an error naming the
+ * variable. Value references as in
+ * fmi3_clocked_exchange.xml:
+ *   1 tick   input clock, constant: interval 0.25 s, shift 0
+ *   2 u      Float64 input clocked by tick (start 0)
+ *   3 y      Float64 output clocked by tick (start -1): at the k-th tick (k = 1, 2, ...)
+ *            y = 10 u + k, u as set in that activation (recomputed by a set of u in it)
+ *   4 t_now  Float64 output, not clocked: the time
+ * fmi3DoStep advances the time and never asks for an event. */
+#include <stdlib.h>
+#include <string.h>
+#include "fmi3Functions.h"
+
+typedef struct {
+    double time, u, y;
+    int ticks, initializing, in_event_mode, active, ticked;
+    fmi3InstanceEnvironment env;
+    fmi3LogMessageCallback log;
+} Exchange;
+
+static fmi3Status fail(Exchange *c, const char *message) {
+    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
+    return fmi3Error;
+}
+
+static void start(Exchange *c) {
+    c->time = 0;
+    c->u = 0;
+    c->y = -1;
+    c->ticks = 0;
+    c->initializing = c->in_event_mode = c->active = c->ticked = 0;
+}
+
+const char *fmi3GetVersion(void) { return fmi3Version; }
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
+    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
+    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
+    if (!token || strcmp(token, "{fmi3-clocked-exchange}") != 0 || !eventMode) {
+        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed");
+        return NULL;
+    }
+    Exchange *c = calloc(1, sizeof(Exchange));
+    if (!c) return NULL;
+    c->env = env;
+    c->log = log;
+    start(c);
+    return c;
+}
+
+void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
+    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    Exchange *c = instance;
+    c->time = startTime;
+    c->initializing = 1;
+    return fmi3OK;
+}
+/* after initialization the instance is in Event Mode (eventModeUsed), no clock active */
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    Exchange *c = instance;
+    c->initializing = 0;
+    c->in_event_mode = 1;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
+    ((Exchange *)instance)->in_event_mode = 1;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
+    Exchange *c = instance;
+    if (c->active) return fail(c, "fmi3EnterStepMode: tick is still active");
+    c->in_event_mode = 0;
+    c->ticked = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3Reset(fmi3Instance instance) {
+    start(instance);
+    return fmi3OK;
+}
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
+    fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn,
+    fmi3Float64 *lastSuccessfulTime) {
+    Exchange *c = instance;
+    if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");
+    c->time = t + h;
+    *eventHandlingNeeded = 0;
+    *terminateSimulation = 0;
+    *earlyReturn = 0;
+    *lastSuccessfulTime = c->time;
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) {
+    Exchange *c = instance;
+    if (!c->in_event_mode) return fail(c, "fmi3SetClock outside Event Mode");
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] != 1) return fail(c, "fmi3SetClock: not an input clock");
+        if (!v[k]) continue;
+        c->active = c->ticked = 1;
+        c->ticks++;
+        c->y = 10 * c->u + c->ticks;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3Float64 v[], fmi3IntervalQualifier q[]) {
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] != 1) return fail(instance, "fmi3GetIntervalDecimal: no interval");
+        v[k] = 0.25;
+        q[k] = fmi3IntervalUnchanged;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[]) {
+    for (size_t k = 0; k < n; k++) v[k] = 0.0;
+    return fmi3OK;
+}
+
+/* the end of the clock's activation */
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
+    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
+    Exchange *c = instance;
+    if (!c->in_event_mode) return fail(c, "fmi3UpdateDiscreteStates outside Event Mode");
+    c->active = 0;
+    *needUpdate = 0;
+    *terminate = 0;
+    *nominalsChanged = 0;
+    *valuesChanged = 0;
+    *nextDefined = 0;
+    *next = 0;
+    return fmi3OK;
+}
+
+/* whether a clocked variable may be set now: while tick is active */
+static int clocked_open(Exchange *c) { return c->initializing || (c->in_event_mode && c->active); }
+/* whether it may be read now: in the Event Mode in which tick ticked (the values its
+ * activation left, also after fmi3UpdateDiscreteStates) */
+static int clocked_readable(Exchange *c) { return c->initializing || (c->in_event_mode && c->ticked); }
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Float64 values[], size_t nValues) {
+    Exchange *c = instance;
+    for (size_t k = 0; k < nvr; k++) {
+        switch (vr[k]) {
+        case 0: values[k] = c->time; break;
+        case 4: values[k] = c->time; break;
+        case 2:
+        case 3:
+            if (!clocked_readable(c))
+                return fail(c, vr[k] == 2 ? "fmi3GetFloat64: u is a clocked variable of tick, which is not active"
+                                          : "fmi3GetFloat64: y is a clocked variable of tick, which is not active");
+            values[k] = vr[k] == 2 ? c->u : c->y;
+            break;
+        default: return fail(c, "fmi3GetFloat64: no such variable");
+        }
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Float64 values[], size_t nValues) {
+    Exchange *c = instance;
+    for (size_t k = 0; k < nvr; k++) {
+        if (vr[k] != 2) return fail(c, "fmi3SetFloat64: not an input");
+        if (!clocked_open(c)) return fail(c, "fmi3SetFloat64: u is a clocked variable of tick, which is not active");
+        c->u = values[k];
+        if (c->active) c->y = 10 * c->u + c->ticks;
+    }
+    return fmi3OK;
+}

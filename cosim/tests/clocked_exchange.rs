@@ -1,0 +1,52 @@
+//! Clocked variables exchanged only at their clock's ticks (FMI 3.0: a clocked variable may
+//! be read and set only while its clock is active), with a C test FMU that refuses any
+//! other access (`tests/cfmu/fmi3_clocked_exchange.c`): the held values at every row
+//! derived by hand below.
+//!
+//! The headers come from fmpy's package (`fmpy/c-code`), found with `$FMPY_PYTHON`
+//! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
+
+mod common;
+use common::work_dir;
+use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System};
+use std::sync::Arc;
+
+/// A run from 0 to 1 s with steps of 0.1 s, `u` from an input file: a discrete input, held
+/// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
+///
+/// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
+/// time 1 s is not run). At the k-th tick τ_k the master applies the last set of `u` (the
+/// input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held until the next tick:
+/// y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 = 10·7 + 4 = 74. The
+/// sets of `u` between ticks are queued (the FMU refuses them). A row holds the values before the
+/// ticks at its time: the row at 0 s the start value -1, a row at t > 0 the y of the last
+/// tick before t.
+#[test]
+fn clocked_variables_are_held_between_ticks_and_set_at_them() {
+    let dir = work_dir("clocked-exchange");
+    let Some(path) =
+        common::fmi3_c::build(&dir, "fmi3_clocked_exchange", include_str!("cfmu/fmi3_clocked_exchange.xml"))
+    else {
+        return;
+    };
+    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.0, 0.1);
+    experiment.input = Some(Arc::new(
+        InputTable::new(vec!["u".into()], vec![0.0, 0.2, 0.4, 0.7], vec![vec![0.0, 2.0, 4.0, 7.0]]).unwrap(),
+    ));
+    let (results, _) = simulate(&system, &experiment).unwrap();
+    let time = results.column("time").unwrap();
+    let y = results.column("y").unwrap();
+    let t_now = results.column("t_now").unwrap();
+    let ticks = [(0.0, 1.0), (0.25, 22.0), (0.5, 43.0), (0.75, 74.0)];
+    // rows at the points 0, 0.1, ..., 1 s and at the ticks between points, 0.25 and 0.75 s
+    assert_eq!(time.len(), 13, "{time:?}");
+    for ((t, y), t_now) in time.iter().zip(&y).zip(&t_now) {
+        // ticks and points differ by ulps at most: 1e-9 s apart
+        let expected = ticks.iter().rev().find(|(tick, _)| *tick < t - 1e-9).map_or(-1.0, |(_, y)| *y);
+        assert_eq!(*y, expected, "y at t = {t} s");
+        // the variable that is not clocked is read at every row: the FMU's time, the sum of
+        // the master's step starts and sizes, within ulps of the row's t0 + n h
+        assert!((t_now - t).abs() < 1e-12, "t_now {t_now} at t = {t} s");
+    }
+}
