@@ -5,7 +5,7 @@
 //! the exact bounce times.
 
 mod common;
-use common::{build_ball, build_linear, build_vdp, plant_fmu, plant_fmu3, work_dir};
+use common::{assert_counted_at_bounces, build_ball, build_linear, build_vdp, plant_fmu, plant_fmu3, work_dir};
 use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, Interface, Results, Solver, Summary, SystemBuilder};
 use std::path::Path;
 
@@ -169,18 +169,7 @@ fn bdf_integrates_a_coupled_model_exchange_group_with_its_events() {
         // the state error (a few rtol) over the impact speed (>= 3 m/s)
         assert!((a - b).abs() < 1e-8, "{a} vs {b}");
     }
-    let (t, count, t_last) =
-        (r.column("time").unwrap(), r.column("counter.count").unwrap(), r.column("counter.t_last").unwrap());
-    for k in 0..t.len() {
-        let (n, last) = if t[k] >= state[1] {
-            (2.0, state[1])
-        } else if t[k] >= state[0] {
-            (1.0, state[0])
-        } else {
-            (0.0, 0.0)
-        };
-        assert_eq!((count[k], t_last[k]), (n, last), "at t = {}", t[k]);
-    }
+    assert_counted_at_bounces(&r, &state, "bdf");
     assert!(s.stiff.jacobians > 0, "{:?}", s.stiff);
 }
 

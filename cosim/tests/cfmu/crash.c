@@ -88,9 +88,4 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior
     s->r[0] = t + h;
     return 0;
 }
-EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return ERR; }
-EXPORT fmi2Status fmi2GetStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, int s, double *v) { return ERR; }
-EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return ERR; }
+FMI2_TEST_NO_STATUS

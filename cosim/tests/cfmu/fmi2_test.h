@@ -8,8 +8,10 @@
  *   FMI2_TEST_NO_FMU_STATE       fmi2Get/Set/FreeFMUstate refused (the file has no FMU state)
  *   FMI2_TEST_NO_MODEL_EXCHANGE  every Model Exchange function refused (Co-Simulation only),
  *                                and the Co-Simulation input/output derivatives refused.
- * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted),
- * FMI2_TEST_EXIT_INITIALIZATION and FMI2_TEST_CONTINUOUS_TIME(Type) (below) for the
+ * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
+ * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
+ * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type), FMI2_TEST_TWO_STATES(Type),
+ * FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
 #define FMI2_TEST_H
@@ -97,6 +99,13 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         defaults(m);                                                                                    \
         return m;                                                                                       \
     }                                                                                                   \
+    FMI2_TEST_LIFECYCLE(Type)                                                                           \
+    EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+
+/* The lifecycle of a `Type` (a struct with a member `double time`) made by calloc, for a file
+ * with its own fmi2Instantiate and fmi2Reset: fmi2FreeInstance frees it, fmi2SetupExperiment
+ * sets the time, entering initialization and terminating do nothing. */
+#define FMI2_TEST_LIFECYCLE(Type)                                                                       \
     EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }                                          \
     EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int a, double tol, double t0, int d,         \
                                           double stop) {                                                \
@@ -104,8 +113,7 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         return 0;                                                                                       \
     }                                                                                                   \
     EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }                        \
-    EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }                                      \
-    EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults(c); return 0; }
+    EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
 
 #define FMI2_TEST_EXIT_INITIALIZATION \
     EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
@@ -123,5 +131,76 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         *terminate = 0;                                                                                 \
         return 0;                                                                                       \
     }
+
+/* The Real variables of a two-state `Type` whose `double r[]` holds, by value reference,
+ * 0 x1, 1 der(x1), 2 x2, 3 der(x2), 4 a parameter, then locals; its `static void
+ * derivatives(Type *)` fills r[1] and r[3]. fmi2GetReal reads any r (derivatives fresh),
+ * fmi2SetReal writes the states and the parameter; the states are r[0] and r[2], with nominal 1
+ * and no event indicators; fmi2NewDiscreteStates asks for nothing. The file writes its own
+ * fmi2GetDerivatives. */
+#define FMI2_TEST_TWO_STATES(Type)                                                                       \
+    EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) { \
+        Type *m = c;                                                                                     \
+        size_t i;                                                                                        \
+        derivatives(m);                                                                                  \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] >= sizeof m->r / sizeof m->r[0]) return ERR;                                       \
+            v[i] = m->r[vr[i]];                                                                          \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,              \
+                                  const double v[]) {                                                    \
+        Type *m = c;                                                                                     \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] != 0 && vr[i] != 2 && vr[i] != 4) return ERR;                                      \
+            m->r[vr[i]] = v[i];                                                                          \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {                     \
+        memset(info, 0, sizeof *info);                                                                   \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {             \
+        Type *m = c;                                                                                     \
+        if (n != 2) return ERR;                                                                          \
+        m->r[0] = x[0];                                                                                  \
+        m->r[2] = x[1];                                                                                  \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) {                   \
+        Type *m = c;                                                                                     \
+        if (n != 2) return ERR;                                                                          \
+        x[0] = m->r[0];                                                                                  \
+        x[1] = m->r[2];                                                                                  \
+        return 0;                                                                                        \
+    }                                                                                                    \
+    EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; } \
+    EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {         \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) x[i] = 1.0;                                                              \
+        return 0;                                                                                        \
+    }
+
+/* Co-Simulation without asynchronous steps or status queries: fmi2CancelStep and every
+ * fmi2Get*Status refused. */
+#define FMI2_TEST_NO_STATUS                                                                            \
+    EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return ERR; }                                   \
+    EXPORT fmi2Status fmi2GetStatus(fmi2Component c, int s, int *v) { return ERR; }                     \
+    EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, int s, double *v) { return ERR; }              \
+    EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return ERR; }              \
+    EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { return ERR; }              \
+    EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return ERR; }
+
+/* Model Exchange of a model without continuous states or event indicators: each of their
+ * calls accepts only zero of them. */
+#define FMI2_TEST_NO_CONTINUOUS_STATES                                                                  \
+    EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return n ? ERR : 0; } \
+    EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; } \
+    EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return n ? ERR : 0; } \
+    EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; } \
+    EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
 
 #endif

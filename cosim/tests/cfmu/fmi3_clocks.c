@@ -14,9 +14,7 @@
  *   10..15 n_*   Int32 outputs: the ticks of each clock so far
  *   16 last_tick Float64 output: the time of the last event with a tick
  * fmi3DoStep advances the time and never asks for an event. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 typedef struct {
     double time, fixed_interval, last_tick;
@@ -26,12 +24,7 @@ typedef struct {
     fmi3LogMessageCallback log;
 } Clocks;
 
-static fmi3Status fail(Clocks *c, const char *message) {
-    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
-}
-
-const char *fmi3GetVersion(void) { return fmi3Version; }
+FMI3_TEST_FAIL(Clocks)
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
@@ -103,11 +96,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     Clocks *c = instance;
     if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");
     c->time = t + h;
-    *eventHandlingNeeded = 0;
-    *terminateSimulation = 0;
-    *earlyReturn = 0;
-    *lastSuccessfulTime = c->time;
-    return fmi3OK;
+    return step_reached(c->time, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
 }
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) {

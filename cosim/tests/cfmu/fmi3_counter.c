@@ -33,9 +33,7 @@
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
  * the time event at stop_at says terminateSimulation; the discrete inputs k and b cannot be set in
  * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function exists and returns fmi3Error. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 #ifndef BIG
 #define BIG 100000 /* the size of the large arrays (-DBIG=N) */
@@ -62,12 +60,21 @@ typedef struct {
     fmi3LogMessageCallback log;
 } Counter;
 
-static fmi3Status fail(Counter *c, const char *message) {
-    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
+/* The start values of a new or reset instance (the rest zero). */
+static void defaults(State *s) {
+    s->u = 1;
+    s->mode = 1;
+    s->stop_at = 1e300;
+    s->early_at = -1;
+    s->crash_at = 1e300;
+    s->crash_how = 1;
+    s->gains[0] = 1;
+    s->gains[1] = 2;
+    s->f32in = 0.5f;
+    strcpy(s->label, "abc");
 }
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
+FMI3_TEST_FAIL(Counter)
 
 static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnvironment env, fmi3LogMessageCallback log);
 
@@ -102,16 +109,7 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
     if (!c) return NULL;
     c->env = env;
     c->log = log;
-    c->s.u = 1;
-    c->s.mode = 1;
-    c->s.stop_at = 1e300;
-    c->s.early_at = -1;
-    c->s.crash_at = 1e300;
-    c->s.crash_how = 1;
-    c->s.gains[0] = 1;
-    c->s.gains[1] = 2;
-    c->s.f32in = 0.5f;
-    strcpy(c->s.label, "abc");
+    defaults(&c->s);
     return c;
 }
 
@@ -148,16 +146,7 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     c->s.event_mode = event_mode;
     c->env = env;
     c->log = log;
-    c->s.u = 1;
-    c->s.mode = 1;
-    c->s.stop_at = 1e300;
-    c->s.early_at = -1;
-    c->s.crash_at = 1e300;
-    c->s.crash_how = 1;
-    c->s.gains[0] = 1;
-    c->s.gains[1] = 2;
-    c->s.f32in = 0.5f;
-    strcpy(c->s.label, "abc");
+    defaults(&c->s);
     return fmi3OK;
 }
 

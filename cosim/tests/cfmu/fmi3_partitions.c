@@ -13,9 +13,7 @@
  *   20 n_fast, 21 n_slow, 22 n_later, 23 n_kick Int32 outputs (activations), 24 first Int32
  *   output: the clock (value reference) of the first partition activated at the latest
  *   activation time. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 typedef struct {
     fmi3InstanceEnvironment env;
@@ -27,12 +25,7 @@ typedef struct {
     int n[4], first, out, later_changed;
 } Partitions;
 
-static fmi3Status fail(Partitions *p, const char *message) {
-    if (p->log) p->log(p->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
-}
-
-const char *fmi3GetVersion(void) { return fmi3Version; }
+FMI3_TEST_FAIL(Partitions)
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,

@@ -11,9 +11,7 @@
  * The arrays are sized when the FMU leaves Configuration Mode; every get and set of k and y
  * must pass exactly n values (fmi3Error otherwise), so a master that gets the size wrong
  * fails. The functions a Co-Simulation run calls exist; the others are absent. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 typedef struct {
     fmi3InstanceEnvironment env;
@@ -23,10 +21,7 @@ typedef struct {
     double time, u, *k, *y;
 } Sized;
 
-static fmi3Status fail(Sized *s, const char *message) {
-    if (s->log) s->log(s->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
-}
+FMI3_TEST_FAIL(Sized)
 
 /* k all 1 and y all 0, for the current n */
 static int size_arrays(Sized *s) {
@@ -38,8 +33,6 @@ static int size_arrays(Sized *s) {
     for (unsigned long long i = 0; i < s->n; i++) s->k[i] = 1.0;
     return 1;
 }
-
-const char *fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
@@ -88,11 +81,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     Sized *s = instance;
     s->time = t + h;
     for (unsigned long long i = 0; i < s->n; i++) s->y[i] = s->k[i] * s->u * s->time;
-    *event = 0;
-    *terminate = 0;
-    *early = 0;
-    *reached = s->time;
-    return fmi3OK;
+    return step_reached(s->time, event, terminate, early, reached);
 }
 
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,

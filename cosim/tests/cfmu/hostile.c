@@ -36,14 +36,8 @@ EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *gui
     m->t_bad = 0.5;
     return m;
 }
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int tolDef, double tol, double t0, int stopDef, double stop) {
-    ((Model *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+FMI2_TEST_LIFECYCLE(Model)
+FMI2_TEST_EXIT_INITIALIZATION
 EXPORT fmi2Status fmi2Reset(fmi2Component c) { return 0; }
 static void outputs(Model *m) {
     const double bad[3] = {NAN, INFINITY, -INFINITY};
@@ -76,9 +70,4 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior
     ((Model *)c)->time = t + h;
     return 0;
 }
-EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return ERR; }
-EXPORT fmi2Status fmi2GetStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, int s, double *v) { return ERR; }
-EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, int s, int *v) { return ERR; }
-EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, int s, const char **v) { return ERR; }
+FMI2_TEST_NO_STATUS

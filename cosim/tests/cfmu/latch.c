@@ -80,8 +80,4 @@ EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     }
     return 0;
 }
-EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return n ? ERR : 0; }
+FMI2_TEST_NO_CONTINUOUS_STATES

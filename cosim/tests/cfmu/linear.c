@@ -27,54 +27,12 @@ static void derivatives(Linear *m) {
     m->r[3] = -m->r[2];
 }
 
-EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
-    Linear *m = c;
-    size_t i;
-    derivatives(m);
-    for (i = 0; i < n; i++) {
-        if (vr[i] >= 5) return ERR;
-        v[i] = m->r[vr[i]];
-    }
-    return 0;
-}
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Linear *m = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] != 0 && vr[i] != 2 && vr[i] != 4) return ERR;
-        m->r[vr[i]] = v[i];
-    }
-    return 0;
-}
-EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
-    memset(info, 0, sizeof *info);
-    return 0;
-}
-EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
-    Linear *m = c;
-    if (n != 2) return ERR;
-    m->r[0] = x[0];
-    m->r[2] = x[1];
-    return 0;
-}
-EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) {
-    Linear *m = c;
-    if (n != 2) return ERR;
-    x[0] = m->r[0];
-    x[1] = m->r[2];
-    return 0;
-}
+FMI2_TEST_TWO_STATES(Linear)
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
     Linear *m = c;
     if (n != 2) return ERR;
     derivatives(m);
     dx[0] = m->r[1];
     dx[1] = m->r[3];
-    return 0;
-}
-EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) x[i] = 1.0;
     return 0;
 }

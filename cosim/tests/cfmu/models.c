@@ -60,14 +60,8 @@ EXPORT fmi2Component fmi2Instantiate(const char *name, int type, const char *gui
     defaults(m);
     return m;
 }
-EXPORT void fmi2FreeInstance(fmi2Component c) { free(c); }
-EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, int tolDef, double tol, double t0, int stopDef, double stop) {
-    ((Model *)c)->time = t0;
-    return 0;
-}
-EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return 0; }
-EXPORT fmi2Status fmi2Terminate(fmi2Component c) { return 0; }
+FMI2_TEST_LIFECYCLE(Model)
+FMI2_TEST_EXIT_INITIALIZATION
 EXPORT fmi2Status fmi2Reset(fmi2Component c) { defaults((Model *)c); return 0; }
 
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {

@@ -30,25 +30,7 @@ static void derivatives(Vdp *v) {
     v->r[3] = mu * (1.0 - x0 * x0) * x1 - x0;
 }
 
-EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
-    Vdp *m = c;
-    size_t i;
-    derivatives(m);
-    for (i = 0; i < n; i++) {
-        if (vr[i] >= 7) return ERR;
-        v[i] = m->r[vr[i]];
-    }
-    return 0;
-}
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Vdp *m = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] != 0 && vr[i] != 2 && vr[i] != 4) return ERR;
-        m->r[vr[i]] = v[i];
-    }
-    return 0;
-}
+FMI2_TEST_TWO_STATES(Vdp)
 
 /* d der(vr_unknown) / d state(vr_known) */
 static int partial(const Vdp *m, fmi2ValueReference unknown, fmi2ValueReference known, double *out) {
@@ -80,24 +62,6 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
     return 0;
 }
 
-EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
-    memset(info, 0, sizeof *info);
-    return 0;
-}
-EXPORT fmi2Status fmi2SetContinuousStates(fmi2Component c, const double x[], size_t n) {
-    Vdp *m = c;
-    if (n != 2) return ERR;
-    m->r[0] = x[0];
-    m->r[2] = x[1];
-    return 0;
-}
-EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n) {
-    Vdp *m = c;
-    if (n != 2) return ERR;
-    x[0] = m->r[0];
-    x[1] = m->r[2];
-    return 0;
-}
 EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
     Vdp *m = c;
     if (n != 2) return ERR;
@@ -105,11 +69,5 @@ EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
     derivatives(m);
     dx[0] = m->r[1];
     dx[1] = m->r[3];
-    return 0;
-}
-EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) x[i] = 1.0;
     return 0;
 }

@@ -2,12 +2,23 @@
 //! `fmpy/c-code`, found with `$FMPY_PYTHON`, default `python3`), zipped as FMI 3.0 archives:
 //! modelDescription.xml + binaries/x86_64-linux/<id>.so.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The Python with fmpy (`$FMPY_PYTHON`, default `python3`).
 pub fn python() -> String {
     std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
+}
+
+/// The `cc` flags of an FMI 3.0 test FMU: warnings are errors, the standard's headers from
+/// the folder `headers`.
+pub fn flags(headers: &Path) -> Vec<OsString> {
+    ["-Wall", "-Werror", "-Wno-unused-parameter", "-I"]
+        .into_iter()
+        .map(OsString::from)
+        .chain([headers.as_os_str().to_owned()])
+        .collect()
 }
 
 /// The folder of the FMI 3.0 headers in fmpy's package, `None` (skip) without fmpy.
@@ -33,27 +44,10 @@ pub fn headers() -> Option<PathBuf> {
 pub fn build(dir: &Path, id: &str, xml: &str) -> Option<PathBuf> {
     let headers = headers()?;
     let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu");
-    let src = cfmu.join(format!("{id}.c"));
     let so = dir.join(format!("{id}.so"));
-    let status = Command::new("cc")
-        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
-        .arg("-I")
-        .arg(&headers)
-        .arg(&src)
-        .arg(cfmu.join("fmi3_rest.c"))
-        .arg("-o")
-        .arg(&so)
-        .status()
-        .expect("run cc");
-    assert!(status.success(), "cc failed for {}", src.display());
+    super::cc(&flags(&headers), &[cfmu.join(format!("{id}.c")), cfmu.join("fmi3_rest.c")], &so);
     let fmu = dir.join(format!("{id}.fmu"));
-    super::zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            (&format!("binaries/x86_64-linux/{id}.so"), std::fs::read(&so).unwrap()),
-        ],
-    );
+    super::pack_library(&fmu, xml, &format!("binaries/x86_64-linux/{id}.so"), &so);
     Some(fmu)
 }
 

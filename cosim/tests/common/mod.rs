@@ -4,6 +4,7 @@
 
 pub mod fmi3_c;
 
+use std::ffi::OsString;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -102,16 +103,32 @@ pub fn work_dir(test: &str) -> PathBuf {
 /// Compiles models.c for `model` into `out` (with extra `cc` flags).
 pub fn compile(model: Model, out: &Path, extra: &[&str]) {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/models.c");
+    let mut flags = vec![OsString::from(format!("-DMODEL={}", model.number()))];
+    flags.extend(extra.iter().map(OsString::from));
+    cc(&flags, &[src], out);
+}
+
+/// Runs `cc -shared -fPIC -O2 -fvisibility=hidden -Wno-unused-parameter <flags> <sources> -o
+/// <so>`: the shared library of a C test FMU.
+pub fn cc(flags: &[OsString], sources: &[PathBuf], so: &Path) {
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
-        .arg(format!("-DMODEL={}", model.number()))
-        .args(extra)
-        .arg(&src)
+        .args(flags)
+        .args(sources)
         .arg("-o")
-        .arg(out)
+        .arg(so)
         .status()
         .expect("run cc");
-    assert!(status.success(), "cc failed for {model:?}");
+    assert!(status.success(), "cc failed for {sources:?}");
+}
+
+/// Packs `xml` as modelDescription.xml and the library `so` as `binary` (its path in the
+/// archive) into the FMU `fmu`.
+pub fn pack_library(fmu: &Path, xml: &str, binary: &str, so: &Path) {
+    zip_entries(
+        fmu,
+        &[("modelDescription.xml", xml.as_bytes().to_vec()), (binary, std::fs::read(so).expect("read so"))],
+    );
 }
 
 /// Zips `entries` (name, bytes) into `path`.
@@ -131,13 +148,7 @@ pub fn build_fmu(model: Model, dir: &Path, extra: &[&str]) -> PathBuf {
     let so = dir.join(format!("{}.so", model.id()));
     compile(model, &so, extra);
     let fmu = dir.join(format!("{}.fmu", model.id()));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", model.model_description().into_bytes()),
-            (&format!("binaries/linux64/{}.so", model.id()), std::fs::read(&so).expect("read so")),
-        ],
-    );
+    pack_library(&fmu, &model.model_description(), &format!("binaries/linux64/{}.so", model.id()), &so);
     fmu
 }
 
@@ -177,13 +188,7 @@ pub fn build_fmu_with(model: Model, dir: &Path, file_stem: &str, xml: &str) -> P
     let so = dir.join(format!("{file_stem}.so"));
     compile(model, &so, &[]);
     let fmu = dir.join(format!("{file_stem}.fmu"));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            (&format!("binaries/linux64/{}.so", model.id()), std::fs::read(&so).expect("read so")),
-        ],
-    );
+    pack_library(&fmu, xml, &format!("binaries/linux64/{}.so", model.id()), &so);
     fmu
 }
 
@@ -196,23 +201,9 @@ fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
 fn build_single_c_fmu_with_flags(dir: &Path, id: &str, xml: &str, flags: &[&str]) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../cosim/tests/cfmu/{id}.c"));
     let so = dir.join(format!("{id}.so"));
-    let status = Command::new("cc")
-        .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
-        .args(flags)
-        .arg(&src)
-        .arg("-o")
-        .arg(&so)
-        .status()
-        .expect("run cc");
-    assert!(status.success(), "cc failed for {}", src.display());
+    cc(&flags.iter().map(OsString::from).collect::<Vec<_>>(), &[src], &so);
     let fmu = dir.join(format!("{id}.fmu"));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            (&format!("binaries/linux64/{id}.so"), std::fs::read(&so).unwrap()),
-        ],
-    );
+    pack_library(&fmu, xml, &format!("binaries/linux64/{id}.so"), &so);
     fmu
 }
 
@@ -444,28 +435,12 @@ pub fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
 pub fn build_counter_with_flags(dir: &Path, stem: &str, xml: &str, flags: &[&str]) -> Option<PathBuf> {
     let headers = fmi3_c::headers()?;
     let so = dir.join("fmi3_counter.so");
-    {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/fmi3_counter.c");
-        let status = Command::new("cc")
-            .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
-            .arg("-I")
-            .arg(&headers)
-            .args(flags)
-            .arg(&src)
-            .arg("-o")
-            .arg(&so)
-            .status()
-            .expect("run cc");
-        assert!(status.success(), "cc failed for fmi3_counter.c");
-    }
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/fmi3_counter.c");
+    let mut all_flags = fmi3_c::flags(&headers);
+    all_flags.extend(flags.iter().map(OsString::from));
+    cc(&all_flags, &[src], &so);
     let fmu = dir.join(format!("{stem}.fmu"));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            ("binaries/x86_64-linux/fmi3_counter.so", std::fs::read(&so).unwrap()),
-        ],
-    );
+    pack_library(&fmu, xml, "binaries/x86_64-linux/fmi3_counter.so", &so);
     Some(fmu)
 }
 
@@ -486,4 +461,22 @@ pub fn counter_xml_with_large_arrays(n: usize, arrays: &[&str]) -> String {
         }
     }
     xml.replace(arr, &declared)
+}
+
+/// Asserts that the latch `counter` (tests/cfmu/latch.c) of the result `r`, coupled to the
+/// ball, has counted each of the ball's bounces at the `bounces` times (`[first, second]`)
+/// themselves: count and t_last change within the event, at the bounce time.
+pub fn assert_counted_at_bounces(r: &nigel_cosim::Results, bounces: &[f64], what: &str) {
+    let (t, count, t_last) =
+        (r.column("time").unwrap(), r.column("counter.count").unwrap(), r.column("counter.t_last").unwrap());
+    for k in 0..t.len() {
+        let (n, last) = if t[k] >= bounces[1] {
+            (2.0, bounces[1])
+        } else if t[k] >= bounces[0] {
+            (1.0, bounces[0])
+        } else {
+            (0.0, 0.0)
+        };
+        assert_eq!((count[k], t_last[k]), (n, last), "{what}: at t = {}", t[k]);
+    }
 }

@@ -5,7 +5,7 @@ use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use super::{c_text, emit, out_ptr, panic_text, slice, slice_mut, string, with, Component};
+use super::{c_text, emit, get_reals, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::*;
 use crate::instance::{Function, Instance, Machine, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
@@ -468,10 +468,7 @@ pub unsafe fn set_continuous_states<M: Model>(
 }
 
 pub unsafe fn get_derivatives<M: Model>(function: Function, c: fmi2Component, dx: *mut f64, nx: usize) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = slice_mut(dx, nx, "derivatives")?;
-        comp.instance.get_derivatives(out)
-    })
+    get_reals::<M>(c, function, dx, nx, "derivatives", Instance::get_derivatives)
 }
 
 pub unsafe fn get_event_indicators<M: Model>(
@@ -480,10 +477,7 @@ pub unsafe fn get_event_indicators<M: Model>(
     z: *mut f64,
     ni: usize,
 ) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = slice_mut(z, ni, "eventIndicators")?;
-        comp.instance.get_event_indicators(out)
-    })
+    get_reals::<M>(c, function, z, ni, "eventIndicators", Instance::get_event_indicators)
 }
 
 pub unsafe fn get_continuous_states<M: Model>(
@@ -492,10 +486,7 @@ pub unsafe fn get_continuous_states<M: Model>(
     x: *mut f64,
     nx: usize,
 ) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = slice_mut(x, nx, "x")?;
-        comp.instance.get_continuous_states(out)
-    })
+    get_reals::<M>(c, function, x, nx, "x", Instance::get_continuous_states)
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(
@@ -504,10 +495,7 @@ pub unsafe fn get_nominals_of_continuous_states<M: Model>(
     x: *mut f64,
     nx: usize,
 ) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = slice_mut(x, nx, "x_nominal")?;
-        comp.instance.get_nominals(out)
-    })
+    get_reals::<M>(c, function, x, nx, "x_nominal", Instance::get_nominals)
 }
 
 #[doc(hidden)]

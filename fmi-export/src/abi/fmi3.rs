@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use fmi_sys::fmi3::*;
 use model_description::fmi3::ValueType;
 
-use super::{c_text, out_ptr, panic_text, slice, slice_mut, string, with, Component};
+use super::{c_text, get_reals, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::{Fmi2Status, FMI2_FALSE, FMI2_TRUE};
 use crate::instance::{Function, Generation, Instance, IntervalQualifier, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
@@ -835,10 +835,7 @@ pub unsafe fn get_continuous_state_derivatives<M: Model>(
     dx: *mut fmi3Float64,
     nx: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let out = slice_mut(dx, nx, "derivatives")?;
-        comp.instance.get_derivatives(out)
-    })
+    status3(get_reals::<M>(instance, function, dx, nx, "derivatives", Instance::get_derivatives))
 }
 
 pub unsafe fn get_event_indicators<M: Model>(
@@ -847,10 +844,7 @@ pub unsafe fn get_event_indicators<M: Model>(
     z: *mut fmi3Float64,
     n: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let out = slice_mut(z, n, "eventIndicators")?;
-        comp.instance.get_event_indicators(out)
-    })
+    status3(get_reals::<M>(instance, function, z, n, "eventIndicators", Instance::get_event_indicators))
 }
 
 pub unsafe fn get_continuous_states<M: Model>(
@@ -859,10 +853,7 @@ pub unsafe fn get_continuous_states<M: Model>(
     x: *mut fmi3Float64,
     nx: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let out = slice_mut(x, nx, "continuousStates")?;
-        comp.instance.get_continuous_states(out)
-    })
+    status3(get_reals::<M>(instance, function, x, nx, "continuousStates", Instance::get_continuous_states))
 }
 
 pub unsafe fn get_nominals_of_continuous_states<M: Model>(
@@ -871,10 +862,7 @@ pub unsafe fn get_nominals_of_continuous_states<M: Model>(
     x: *mut fmi3Float64,
     nx: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let out = slice_mut(x, nx, "nominals")?;
-        comp.instance.get_nominals(out)
-    })
+    status3(get_reals::<M>(instance, function, x, nx, "nominals", Instance::get_nominals))
 }
 
 pub unsafe fn get_number_of_event_indicators<M: Model>(

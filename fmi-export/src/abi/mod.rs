@@ -184,6 +184,20 @@ pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpRe
     }
 }
 
+/// The body of both generations' Model Exchange calls that fill the caller's array of `n`
+/// reals at `ptr` (named `what` in a refusal) from the instance: continuous states, their
+/// derivatives, their nominals, the event indicators (`get`, one of [`Instance`]'s getters).
+pub(crate) unsafe fn get_reals<M: Model>(
+    c: fmi2Component,
+    function: Function,
+    ptr: *mut f64,
+    n: usize,
+    what: &str,
+    get: fn(&mut Instance<M>, &mut [f64]) -> OpResult,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| get(&mut comp.instance, slice_mut(ptr, n, what)?))
+}
+
 pub(crate) unsafe fn out_ptr<'a, T>(ptr: *mut T, what: &str) -> OpResult<&'a mut T> {
     ptr.as_mut().ok_or_else(|| format!("{what} is NULL").into())
 }
