@@ -22,16 +22,18 @@
 //!
 //! ```text
 //! status, c_types, elf, suggest, call_site, fmi3   leaves (fmi3: the FMI 3.0 view)
+//! platform     -> elf                              this build's binaries folders
 //! error        -> status
 //! log          -> status, c_types                  what FMUs log, both loggers
-//! unpack       -> error
-//! library      -> error, elf, c_types              loading a shared library once
-//! isolate/protocol                                 the host protocol's region and calls
-//! isolate/channel -> protocol, error, log, status  the master's end of a host
+//! unpack       -> error, platform
+//! library      -> error, platform, c_types         loading a shared library once
+//! isolate/os   -> error                            shared memory, host process, futex (Linux)
+//! isolate/protocol -> os                           the host protocol's region and calls
+//! isolate/channel -> os, protocol, error, log, status  the master's end of a host
 //! isolate/proxy, proxy3 -> channel, protocol, c_types   tables that call a host
-//! isolate/host -> protocol, channel, proxy3, c_types, library, log, error
+//! isolate/host -> os, protocol, channel, proxy3, c_types, library, log, error
 //! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
-//! load         -> fmu, fmi3, library, elf, unpack, isolate/proxy*  the one pipeline
+//! load         -> fmu, fmi3, library, platform, unpack, isolate/proxy*  the one pipeline
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
 //! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
 //! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
@@ -54,6 +56,7 @@ pub mod isolate;
 pub(crate) mod library;
 pub mod load;
 pub mod log;
+pub mod platform;
 pub mod status;
 #[doc(hidden)]
 pub mod suggest;
