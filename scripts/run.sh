@@ -6,7 +6,9 @@
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
 # target/fmu/ and the closed loop as SSP into target/ssp/, co-simulates that closed loop with our master (30 s at 1 ms, ordered), runs
 # the paper's Table III and Fig. 7 through the FMUs, and synthesizes the robust controller
-# (Pareto sweep of the paper). Everything it writes lands in target/results/.
+# (Pareto sweep of the paper). Everything it writes lands in target/results/; the master's
+# release archives (cosim, cosim-host, campaign for x86-64 and aarch64 Linux, Windows, macOS
+# x86-64 and arm64) in target/dist/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup-system.sh
@@ -25,6 +27,9 @@ bash scripts/python-venv-wheel.sh "$wheel"
 
 echo "== building the FMUs (all four platforms) and the closed-loop SSP"
 cargo run --release --quiet -p build-fmu -- --platforms all
+
+echo "== the master for every platform: target/dist/cosim-VERSION-TRIPLE.{tar.gz,zip} and SHA256SUMS"
+bash scripts/dist.sh
 
 echo "== co-simulation: plant + controller + test bench (lane change, robust), 30 s at 1 ms"
 cargo run --release --quiet -p nigel-cosim --bin cosim -- run "$target_dir/ssp/nigel_closed_loop.ssp" \

@@ -9,7 +9,7 @@
  *    positional `%1$` arguments is not formatted at all: the message says so and shows
  *    the format text;
  *  - a %s argument is read only if it points into readable memory (checked with
- *    process_vm_readv, ReadProcessMemory or mach_vm_read_overwrite, which fail instead of
+ *    process_vm_readv, ReadProcessMemory or vm_read_overwrite, which fail instead of
  *    faulting) outside the importer's own program
  *    image (its code, constants and static data); otherwise the message shows
  *    "<unreadable string>" or "<string in the importer's memory>" in its place. So a %s
@@ -28,7 +28,6 @@
 #elif defined(__APPLE__)
 #include <dlfcn.h>
 #include <mach/mach.h>
-#include <mach/mach_vm.h>
 #else
 #include <dlfcn.h>
 #include <sys/uio.h>
@@ -47,16 +46,15 @@ void fmi2_sys_logger(void *env, const char *instance_name, int status, const cha
 
 /* Reads `n` bytes at `at` of this process into `out` by a system call that fails instead of
  * faulting on unreadable memory: process_vm_readv (Linux), ReadProcessMemory (Windows),
- * mach_vm_read_overwrite (macOS). Returns the bytes read, 0 or less when none could be. */
+ * vm_read_overwrite (macOS). Returns the bytes read, 0 or less when none could be. */
 static long read_own_memory(uintptr_t at, char *out, size_t n) {
 #ifdef _WIN32
     SIZE_T got = 0;
     if (!ReadProcessMemory(GetCurrentProcess(), (LPCVOID)at, out, n, &got)) return 0;
     return (long)got;
 #elif defined(__APPLE__)
-    mach_vm_size_t got = 0;
-    if (mach_vm_read_overwrite(mach_task_self(), (mach_vm_address_t)at, n, (mach_vm_address_t)(uintptr_t)out, &got) !=
-        KERN_SUCCESS)
+    vm_size_t got = 0;
+    if (vm_read_overwrite(mach_task_self(), (vm_address_t)at, n, (vm_address_t)(uintptr_t)out, &got) != KERN_SUCCESS)
         return 0;
     return (long)got;
 #else
