@@ -465,7 +465,8 @@ pub fn build_host_linux64(targets: &[FmuTarget]) -> Result<Vec<PathBuf>, BuildEr
     for t in targets {
         c.args(["--package", t.package]);
     }
-    let features: Vec<String> = targets.iter().map(|t| format!("{}/fmi-export", t.package)).collect();
+    let packages: Vec<&str> = targets.iter().map(|t| t.package).collect();
+    let features = library_features(&packages);
     c.args(["--features", &features.join(","), "--manifest-path"]).arg(&manifest);
     let status = c.status().map_err(|e| BuildError::Cargo(e.to_string()))?;
     if !status.success() {
@@ -571,6 +572,17 @@ fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBui
         );
     }
     built
+}
+
+/// The cargo features of the FMU libraries of `packages`: each one's `fmi-export`, and with
+/// the build option `controller-sample-clock` the controller's `fmi3-sample-clock` (the
+/// library must declare what this process's declaration writes into the description).
+pub fn library_features(packages: &[&str]) -> Vec<String> {
+    let mut features: Vec<String> = packages.iter().map(|p| format!("{p}/fmi-export")).collect();
+    if cfg!(feature = "controller-sample-clock") && packages.contains(&"fmu-controller") {
+        features.push("fmu-controller/fmi3-sample-clock".into());
+    }
+    features
 }
 
 /// Builds one FMU for linux64 with the workspace's own cargo (no cross toolchain needed;

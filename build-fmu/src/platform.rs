@@ -327,7 +327,7 @@ impl Platform {
         model_identifiers: &[&str],
         target_dir: &Path,
     ) -> Result<Vec<PathBuf>, BuildError> {
-        let features: Vec<String> = packages.iter().map(|p| format!("{p}/fmi-export")).collect();
+        let features = crate::library_features(packages);
         let mut args: Vec<String> = Vec::new();
         for p in packages {
             args.extend(["--package".into(), p.to_string()]);

@@ -13,10 +13,11 @@ use crate::Error;
 use nigel_cosim::check::CheckAccumulators;
 use nigel_cosim::metric::Accumulators;
 
-/// The experiment of every run: the description's times and algorithm, recording only
-/// the metrics' variables.
+/// The experiment of every run: the description's times (from the SSD's start time) and
+/// algorithm, recording only the metrics' variables.
 pub fn experiment(spec: &Spec, record: Vec<String>) -> Experiment {
     let mut e = Experiment::new(spec.stop_time, spec.step);
+    e.start_time = spec.start_time;
     e.algorithm = spec.algorithm;
     e.record = Some(record);
     e.timeout = spec.timeout;

@@ -63,6 +63,9 @@ pub struct Spec {
     pub path: PathBuf,
     /// The system (`.ssp` / `.ssd`), resolved.
     pub system: PathBuf,
+    /// Start time, s: the SSD's `DefaultExperiment` `startTime` (SSP 1.0), else 0, as
+    /// `cosim run` starts it.
+    pub start_time: f64,
     /// Stop time, s.
     pub stop_time: f64,
     /// Communication step, s.
@@ -434,8 +437,8 @@ impl Spec {
         let system = resolve_system(path, system_text).map_err(bad)?;
         let stop_time = get_f("stop_time")?;
         let step = get_f("step")?;
-        if !(step > 0.0 && step.is_finite() && stop_time.is_finite() && stop_time >= step) {
-            return Err(bad(format!("need 0 < step <= stop_time, got step {step}, stop_time {stop_time}")));
+        if !(step > 0.0 && step.is_finite() && stop_time.is_finite()) {
+            return Err(bad(format!("need 0 < step, a finite stop_time, got step {step}, stop_time {stop_time}")));
         }
         let algorithm = match doc.get("algorithm").map(|v| v.as_str()) {
             None | Some(Some("ordered")) => Algorithm::Ordered,
@@ -524,11 +527,18 @@ impl Spec {
         let hash = hex(&hasher.finalize());
         // only the model descriptions are needed here: the FMUs' libraries are not loaded
         // (a library that crashes while loading ends a worker process, not the campaign)
-        let loaded = load_system_with(&system, true).map_err(bad)?;
+        let (loaded, start_time) = load_system_and_start(&system, true).map_err(bad)?;
+        if !(stop_time >= start_time + step) {
+            return Err(bad(format!(
+                "need start time + step <= stop_time, got start time {start_time} s{}, step {step}, stop_time {stop_time}",
+                if start_time != 0.0 { " (the SSD's DefaultExperiment)" } else { "" }
+            )));
+        }
         Ok((
             Spec {
                 path: path.to_path_buf(),
                 system,
+                start_time,
                 stop_time,
                 step,
                 algorithm,
@@ -713,12 +723,19 @@ pub fn load_system(path: &Path) -> Result<System, String> {
 /// descriptions and the functions their symbol tables list; such a system is checked, not
 /// run in this process).
 pub fn load_system_with(path: &Path, isolated: bool) -> Result<System, String> {
+    load_system_and_start(path, isolated).map(|(system, _)| system)
+}
+
+/// [`load_system_with`] and the run's start time: an SSD's `DefaultExperiment`
+/// `startTime`, else 0 (a single FMU starts at 0, as `cosim run` starts it).
+pub fn load_system_and_start(path: &Path, isolated: bool) -> Result<(System, f64), String> {
     let opts = nigel_cosim::ImportOptions { isolated, ..nigel_cosim::ImportOptions::default() };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if ext == "fmu" {
         let fmu = nigel_cosim::Fmu::load_with(path, &opts).map_err(|e| format!("{}: {e}", path.display()))?;
-        System::single("model", fmu).map_err(|e| format!("{}: {e}", path.display()))
+        Ok((System::single("model", fmu).map_err(|e| format!("{}: {e}", path.display()))?, 0.0))
     } else {
-        nigel_cosim::read_ssp(path, &opts).map(|s| s.system).map_err(|e| format!("{}: {e}", path.display()))
+        let ssp = nigel_cosim::read_ssp(path, &opts).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok((ssp.system, ssp.default_start_stop.0.unwrap_or(0.0)))
     }
 }

@@ -26,11 +26,12 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-/// What the program does with the rows when an FMU calls `exit()` during a run: given
-/// the call (`None`: `exit()` came from a thread in no FMU call, while a run was in
-/// progress) and the rows recorded so far (`None` when they could not be taken without
-/// waiting, or went to a [`crate::RowSink`]). The process then ends with status 1.
-pub type ExitHook = dyn Fn(Option<&ExitInsideCall>, Option<&Results>) + Send + Sync;
+/// What the program does with the rows when a run in this process ends the process (an
+/// FMU's `exit()` during a call, or [`end_process_during_run`]): given what happened (a
+/// sentence naming the call when there is one) and the rows recorded so far (`None` when
+/// they could not be taken without waiting, or went to a [`crate::RowSink`]). The process
+/// then ends with status 1.
+pub type ExitHook = dyn Fn(&str, Option<&Results>) + Send + Sync;
 
 static HOOK: OnceLock<Box<ExitHook>> = OnceLock::new();
 
@@ -62,8 +63,15 @@ pub(crate) struct Registered {
     previous: *const RunRows,
 }
 
+/// The rows of the run registered last in any thread (for [`end_process_during_run`],
+/// called from a thread of no run).
+static LATEST: Mutex<Option<Arc<RunRows>>> = Mutex::new(None);
+
 impl Registered {
     pub(crate) fn new(rows: Arc<RunRows>) -> Registered {
+        if let Ok(mut latest) = LATEST.lock() {
+            *latest = Some(rows.clone());
+        }
         static ONCE: std::sync::Once = std::sync::Once::new();
         // SAFETY: registers a plain `extern "C" fn()` with the C library.
         ONCE.call_once(|| unsafe {
@@ -84,8 +92,34 @@ pub(crate) fn current_run() -> RunHandle {
 impl Drop for Registered {
     fn drop(&mut self) {
         RUN.with(|r| r.set(self.previous));
-        ACTIVE.fetch_sub(1, Ordering::SeqCst);
+        if ACTIVE.fetch_sub(1, Ordering::SeqCst) == 1 {
+            if let Ok(mut latest) = LATEST.lock() {
+                *latest = None;
+            }
+        }
     }
+}
+
+/// Ends the process from any thread while a run is in progress in another (a call that
+/// never returns past the run's time limit): `what` and the rows recorded so far go to
+/// the program's hook (or `what` to standard error), the temporary folders are removed,
+/// and the process ends with `_exit(1)`. Nothing here waits for a lock the stuck run
+/// may hold (`try_lock`: a held lock means the rows are not written, and said so).
+pub fn end_process_during_run(what: &str) -> ! {
+    let rows = LATEST.try_lock().ok().and_then(|latest| latest.clone());
+    let results = rows.as_ref().and_then(|r| r.results.try_lock().ok());
+    report(what, results.as_deref());
+    fmi_import::unpack::remove_temporary_folders_now();
+    // SAFETY: ends the process at once: the stuck thread cannot be unwound.
+    unsafe { libc::_exit(1) }
+}
+
+fn report(what: &str, rows: Option<&Results>) {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match HOOK.get() {
+        Some(hook) => hook(what, rows),
+        None => eprintln!("{what}"),
+    }));
+    drop(result);
 }
 
 /// The run a worker thread steps instances of (valid while its [`Registered`] lives,
@@ -112,14 +146,11 @@ extern "C" fn on_exit() {
     let run = RUN.try_with(|r| r.get()).unwrap_or(std::ptr::null());
     // SAFETY: a registered run's rows outlive its registration, which is in progress.
     let rows = (!run.is_null()).then(|| unsafe { &*run }).and_then(|r| r.results.try_lock().ok());
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match HOOK.get() {
-        Some(hook) => hook(call.as_ref(), rows.as_deref()),
-        None => match &call {
-            Some(c) => eprintln!("{c}"),
-            None => eprintln!("exit() was called during a run, outside an FMU call of the calling thread"),
-        },
-    }));
-    drop(result);
+    let what = match &call {
+        Some(c) => c.to_string(),
+        None => "exit() was called during a run, outside an FMU call of the calling thread".to_string(),
+    };
+    report(&what, rows.as_deref());
     fmi_import::unpack::remove_temporary_folders_now();
     // SAFETY: ends the process at once, as the handler must (see the module's comment).
     unsafe { libc::_exit(1) };

@@ -39,7 +39,7 @@ pub mod bdf;
 pub mod check;
 pub mod compare;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{fmi3, instance, load, unpack};
+pub use fmi_import::{fmi3, instance, load, partitions, structural, unpack};
 /// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
 /// [`load`] in one place, as the master uses them).
 pub mod fmu {
@@ -62,6 +62,7 @@ pub mod simulate;
 pub mod ssp;
 pub mod system;
 pub mod verify;
+pub mod watchdog;
 
 /// Isolation: instances in host processes of their own ([`fmi_import::isolate`]), and the
 /// whole run in one host process ([`isolate::whole`]).

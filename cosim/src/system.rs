@@ -397,17 +397,22 @@ impl SystemBuilder {
         let settable = v.variability != Variability::Constant
             && (matches!(v.causality, Causality::Parameter | Causality::Input)
                 || v.variable_type.has_start() && v.causality != Causality::CalculatedParameter);
+        let structural = self.system.instances[r.instance].fmu.fmi3_description().is_some_and(|md| {
+            md.model_variables
+                .iter()
+                .any(|x| x.name == v.name && x.causality == model_description::fmi3::Causality::StructuralParameter)
+        });
+        if structural {
+            let x = match value {
+                Value::Real(x) => x,
+                Value::Integer(k) => f64::from(k),
+                _ => return Err(bad(format!("the variable is {}", r.base_type.as_str()))),
+            };
+            let name = v.name.clone();
+            return self.configure(r.instance, &name, x).map(|()| self);
+        }
         if !settable {
-            let structural = self.system.instances[r.instance].fmu.fmi3_description().is_some_and(|md| {
-                md.model_variables
-                    .iter()
-                    .any(|x| x.name == v.name && x.causality == model_description::fmi3::Causality::StructuralParameter)
-            });
-            let what = if structural {
-                "an FMI 3.0 structural parameter is set in Configuration Mode, which cosim does not run; \
-                 the arrays it sizes have the size of its start value"
-                    .to_string()
-            } else if v.variability == Variability::Constant {
+            let what = if v.variability == Variability::Constant {
                 format!("a constant cannot be set (causality {})", v.causality.as_str())
             } else if v.causality == Causality::CalculatedParameter {
                 "a calculated parameter is computed by the FMU from other parameters and cannot be set".to_string()
@@ -428,6 +433,41 @@ impl SystemBuilder {
         spec.start_values.retain(|(i, _)| *i != r.index);
         spec.start_values.push((r.index, value));
         Ok(self)
+    }
+
+    /// Sets the FMI 3.0 structural parameter `name` of instance `i` to `value`: the
+    /// instance's FMU becomes [`Fmu::configured`] with it (set in Configuration Mode before
+    /// initialization), the arrays it sizes take the new size, and what the system already
+    /// refers to in the instance (start values, connections) is found again by name.
+    fn configure(&mut self, i: usize, name: &str, value: f64) -> Result<()> {
+        let spec = &self.system.instances[i];
+        let fmu = spec.fmu.configured(&spec.name, &[(name, value)])?;
+        let old = spec.fmu.description().clone();
+        let new = fmu.description();
+        let gone = |index: usize| {
+            let variable = &old.model_variables[index].name;
+            Error::Import(crate::ImportError::InvalidValue {
+                variable: format!("{}.{name}", spec.name),
+                value: value.to_string(),
+                reason: format!("{variable} is set or connected, and the arrays {name} sizes no longer have it"),
+            })
+        };
+        let moved = |index: usize| new.model_variables.iter().position(|v| v.name == old.model_variables[index].name);
+        let mut start_values = spec.start_values.clone();
+        for (index, _) in &mut start_values {
+            *index = moved(*index).ok_or_else(|| gone(*index))?;
+        }
+        let mut connections = self.system.connections.clone();
+        for end in connections.iter_mut().flat_map(|c| [&mut c.from, &mut c.to]).filter(|e| e.instance == i) {
+            end.index = moved(end.index).ok_or_else(|| gone(end.index))?;
+            end.value_reference = new.model_variables[end.index].value_reference;
+        }
+        self.connected = connections.iter().map(|c| (c.to.instance, c.to.index)).collect();
+        self.system.connections = connections;
+        let spec = &mut self.system.instances[i];
+        spec.start_values = start_values;
+        spec.fmu = fmu;
+        Ok(())
     }
 
     /// Sets a value given as text, parsed for the variable's type. An array of an FMI 3.0

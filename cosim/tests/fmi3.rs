@@ -13,28 +13,9 @@ use nigel_cosim::{simulate, Experiment, Fmu, Instance, System, SystemBuilder, Va
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use common::fmi3_c::{headers, python};
+
 const XML: &str = include_str!("cfmu/fmi3_counter.xml");
-
-fn python() -> String {
-    std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
-}
-
-/// The folder of the FMI 3.0 headers in fmpy's package, `None` (skip) without fmpy.
-fn headers() -> Option<PathBuf> {
-    let out = Command::new(python())
-        .args(["-c", "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success());
-    match out {
-        Some(o) => Some(PathBuf::from(String::from_utf8_lossy(&o.stdout).trim())),
-        None => {
-            assert!(std::env::var_os("FMPY_PYTHON").is_none(), "FMPY_PYTHON={} cannot import fmpy", python());
-            eprintln!("fmpy not importable with {}: FMI 3.0 tests skipped", python());
-            None
-        }
-    }
-}
 
 /// Builds `<dir>/<stem>.fmu` from fmi3_counter.c with `xml` as its description.
 fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
@@ -731,10 +712,12 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
 }
 
 /// An array whose `<Dimension>` names a structural parameter has the size of the parameter's
-/// start value: recorded as its elements as a fixed-size array is; setting the structural
-/// parameter (Configuration Mode, which the master does not run) is refused saying so.
+/// start value: recorded as its elements as a fixed-size array is. Setting the structural
+/// parameter gives the array its new size in the view; this FMU answers
+/// `fmi3EnterConfigurationMode` with fmi3Error, and the run says so (Configuration Mode
+/// itself: `fmi3_configuration.rs`).
 #[test]
-fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter_is_read_only() {
+fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
     let dir = work_dir("fmi3-structural");
     let sized = XML
         .replace(
@@ -761,8 +744,12 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_and_the_parameter
     }
     let mut builder = SystemBuilder::new();
     builder.add_instance("c", fmu).unwrap();
-    let e = builder.set("c.size", Value::Real(4.0)).map(|_| ()).unwrap_err();
-    assert!(e.to_string().contains("an FMI 3.0 structural parameter is set in Configuration Mode"), "{e}");
+    builder.set("c.size", Value::Real(4.0)).unwrap();
+    let system = builder.build();
+    let names: Vec<&str> = system.description(0).model_variables.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names[24..28], ["arr[1]", "arr[2]", "arr[3]", "arr[4]"]);
+    let e = simulate(&system, &Experiment::new(0.5, 0.1)).unwrap_err();
+    assert!(e.to_string().contains("fmi3EnterConfigurationMode"), "{e}");
 }
 
 /// Co-Simulation event mode: an FMU with `hasEventMode` is instantiated with `eventModeUsed`;

@@ -107,6 +107,51 @@ fn a_step_that_never_returns_is_killed_by_the_call_or_the_run_limit() {
 }
 
 #[test]
+fn a_step_that_never_returns_in_process_ends_the_process_past_the_run_limit() {
+    // the thread cannot be stopped: 1 s (watchdog::GRACE) past the limit the process
+    // ends, naming the call, with the rows so far written and TMPDIR emptied
+    let (code, stderr, rows) = run_crash("inprocess-hang", 5, &["--timeout", "1"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains(
+            "the run's time limit of 1 s (--timeout) passed 1 s ago during fmi2DoStep of model at t = 0.5 s, which has not returned"
+        ),
+        "{stderr}"
+    );
+    assert_rows_to_half(&rows, "in process");
+}
+
+#[test]
+fn a_crash_in_process_leaves_no_unpacked_fmu_behind() {
+    let dir = work_dir("inprocess-crash");
+    let fmu = build_crash(&dir);
+    for (mode, signal) in [(1, libc_signal::SEGV), (2, libc_signal::ABRT)] {
+        let tmp = fresh_tmp(&dir, &format!("tmp-{mode}"));
+        let done = Command::new(cosim())
+            .args(["run", fmu.to_str().unwrap(), "--set", &format!("mode={mode}")])
+            .env("TMPDIR", &tmp)
+            .output()
+            .unwrap();
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(done.status.signal(), Some(signal), "mode {mode}");
+        // the janitor process removes the folder once the crashed process is gone: it
+        // runs after it, so wait for it (a few milliseconds; 10 s at most)
+        let start = std::time::Instant::now();
+        while std::fs::read_dir(&tmp).unwrap().next().is_some() && start.elapsed().as_secs() < 10 {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let left: Vec<_> = std::fs::read_dir(&tmp).unwrap().map(|e| e.unwrap().path()).collect();
+        assert!(left.is_empty(), "mode {mode}: left in TMPDIR: {left:?}");
+    }
+}
+
+/// The signals' numbers on Linux.
+mod libc_signal {
+    pub const ABRT: i32 = 6;
+    pub const SEGV: i32 = 11;
+}
+
+#[test]
 fn timeout_call_needs_isolate_and_in_process_nothing_changes() {
     let (code, stderr, _) = run_crash("isolation-local", 0, &["--timeout-call", "1"]);
     assert_eq!(code, Some(1));

@@ -363,6 +363,37 @@ pub struct Capabilities {
     pub serialize_fmu_state: bool,
 }
 
+/// How the interval of a declared clock is known (FMI 3.0 `intervalVariability`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClockInterval {
+    /// `intervalVariability="constant"` with `intervalDecimal` = this interval \[s\]: the
+    /// model's [`crate::Model::sample_period`] must answer it (checked when initialization
+    /// ends).
+    Constant(f64),
+    /// `intervalVariability="fixed"` without `intervalDecimal`: the interval is the model's
+    /// [`crate::Model::sample_period`] (from a fixed parameter), which the importer reads
+    /// with `fmi3GetIntervalDecimal` in Initialization Mode.
+    Fixed,
+}
+
+/// A periodic input clock of the FMI 3.0 description: the sample clock of a sampled model
+/// ([`crate::sampled`]) as the importer's to activate. Its activations are the samples
+/// `t_k = start + k interval` (shift 0); at each the importer calls `fmi3SetClock` in
+/// Event Mode and the layer runs [`crate::Model::sample`] with the inputs of `t_k`. The
+/// FMI 2.0 description has no clocks: that archive keeps sampling by time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClockDecl {
+    /// The name of the `<Clock>` variable.
+    pub name: &'static str,
+    pub description: &'static str,
+    pub interval: ClockInterval,
+    /// The variables the clock governs (its clocked variables: `clocks` attribute), discrete
+    /// outputs that change only at its activations.
+    pub governs: Vec<VarHandle>,
+    /// `priority` (Scheduled Execution orders the model partitions by it; 0 is the highest).
+    pub priority: u32,
+}
+
 /// Everything the layer needs to know about a model, and all that goes into the XML.
 #[derive(Clone, Debug)]
 pub struct DeclarationSpec<B> {
@@ -382,6 +413,8 @@ pub struct DeclarationSpec<B> {
     pub units: Vec<md::Unit>,
     pub default_experiment: Option<md::DefaultExperiment>,
     pub variables: Vec<VarDecl<B>>,
+    /// FMI 3.0 clocks (at most one: the sample clock of a sampled model); none by default.
+    pub clocks: Vec<ClockDecl>,
 }
 
 impl<B> Default for DeclarationSpec<B> {
@@ -398,6 +431,7 @@ impl<B> Default for DeclarationSpec<B> {
             units: Vec::new(),
             default_experiment: None,
             variables: Vec::new(),
+            clocks: Vec::new(),
         }
     }
 }
@@ -444,6 +478,8 @@ pub struct Declaration<B> {
     /// reference (`NO_ROW` for `time`): the translation of every FMI 3.0 get/set, one load
     /// per value reference.
     fmi2_of_fmi3: Vec<(md::fmi3::ValueType, u32)>,
+    /// Per row: governed by the declared clock (a clocked variable of FMI 3.0).
+    clocked: Vec<bool>,
 }
 
 /// One row of [`Declaration`]'s compact table: the model's binding and the set checks.
@@ -721,7 +757,18 @@ impl<B: Copy> Declaration<B> {
             ));
         }
         let xml = description.to_xml();
-        let description3 = fmi3_description(&description, spec.capabilities);
+        let clocked_rows = clocked_rows(&spec, &lookup)?;
+        let mut description3 = fmi3_description(&description, spec.capabilities);
+        add_clocks(&mut description3, &spec.clocks, &clocked_rows);
+        let problems3 = description3.validate();
+        if !problems3.is_empty() {
+            let list: Vec<String> = problems3.iter().map(|p| p.to_string()).collect();
+            return Err(format!(
+                "the declaration of {} is not a valid FMI 3.0 description: {}",
+                spec.model_name,
+                list.join("; ")
+            ));
+        }
         let xml3 = description3.to_xml();
         let saved_rows = (0..spec.variables.len())
             .filter(|&row| {
@@ -770,6 +817,7 @@ impl<B: Copy> Declaration<B> {
             .collect();
         Ok(Declaration {
             fmi2_of_fmi3,
+            clocked: (0..spec.variables.len()).map(|row| clocked_rows.contains(&row)).collect(),
             spec,
             lookup,
             dense,
@@ -862,6 +910,18 @@ impl<B> Declaration<B> {
         self.description3.model_variables.get(vr as usize)
     }
 
+    /// The declared clock (at most one) and its FMI 3.0 value reference (after the
+    /// variables: appending it keeps theirs).
+    pub fn clock(&self) -> Option<(&ClockDecl, u32)> {
+        self.spec.clocks.first().map(|c| (c, self.spec.variables.len() as u32 + 1))
+    }
+
+    /// Whether row `row` is a clocked variable (governed by the declared clock).
+    #[inline]
+    pub fn is_clocked(&self, row: usize) -> bool {
+        self.clocked.get(row).copied().unwrap_or(false)
+    }
+
     pub fn guid(&self) -> &str {
         &self.description.guid
     }
@@ -884,6 +944,8 @@ impl<B> Declaration<B> {
             .iter()
             .enumerate()
             .map(|(row, v)| format!("{} {} {}\n", v.name, v.value_reference, Self::value_reference3(row)))
+            // a clock has no FMI 2.0 value reference
+            .chain(self.clock().map(|(c, vr)| format!("{} - {vr}\n", c.name)))
             .collect()
     }
 
@@ -1079,6 +1141,83 @@ fn fmi3_description(d2: &md::ModelDescription, caps: Capabilities) -> md::fmi3::
             // the layer's models declare no event indicators (state events)
             event_indicators: Vec::new(),
         },
+    }
+}
+
+/// The rows each declared clock governs, after checking the clocks: at most one (the sample
+/// clock), a name of its own, a finite positive constant interval, and discrete outputs as
+/// its clocked variables (a clocked local state would need FMI 3.0's `previous`).
+fn clocked_rows<B>(spec: &DeclarationSpec<B>, lookup: &HashMap<(BaseType, u32), usize>) -> Result<Vec<usize>, String> {
+    let Some(clock) = spec.clocks.first() else { return Ok(Vec::new()) };
+    if spec.clocks.len() > 1 {
+        return Err(format!(
+            "{}: {} clocks declared; the layer runs one, the sample clock of a sampled model",
+            spec.model_name,
+            spec.clocks.len()
+        ));
+    }
+    if spec.variables.iter().any(|v| v.name == clock.name) || clock.name == "time" {
+        return Err(format!("clock {}: a variable has that name", clock.name));
+    }
+    if let ClockInterval::Constant(interval) = clock.interval {
+        if !(interval > 0.0 && interval.is_finite()) {
+            return Err(format!("clock {}: the constant interval {interval} s is not finite and > 0", clock.name));
+        }
+    }
+    let mut rows = Vec::new();
+    for h in &clock.governs {
+        let row = *lookup.get(&(h.base_type, h.value_reference)).ok_or_else(|| {
+            format!("clock {}: governs an unknown {:?} vr {}", clock.name, h.base_type, h.value_reference)
+        })?;
+        let v = &spec.variables[row];
+        if v.causality != Causality::Output || v.variability != Variability::Discrete {
+            return Err(format!(
+                "clock {}: governs {}, which is not a discrete output (only those can be its clocked variables)",
+                clock.name, v.name
+            ));
+        }
+        rows.push(row);
+    }
+    rows.sort_unstable();
+    rows.dedup();
+    Ok(rows)
+}
+
+/// Adds the declared clock to the FMI 3.0 description: the `<Clock>` variable after the
+/// others (an input clock, periodic, its interval constant or fixed), the `clocks`
+/// attribute of its clocked variables, and Event Mode for Co-Simulation (FMI 3.0 requires
+/// it of an FMU with clocks).
+fn add_clocks(d3: &mut md::fmi3::ModelDescription, clocks: &[ClockDecl], clocked_rows: &[usize]) {
+    use md::fmi3 as f3;
+    let Some(clock) = clocks.first() else { return };
+    let vr = d3.model_variables.len() as u32;
+    let mut c = f3::Variable::new(clock.name, vr, f3::ValueType::Clock, f3::Causality::Input, Variability::Discrete);
+    c.description = (!clock.description.is_empty()).then(|| clock.description.to_string());
+    c.clock = Some(f3::ClockAttributes {
+        priority: Some(clock.priority),
+        interval_variability: Some(
+            match clock.interval {
+                ClockInterval::Constant(_) => "constant",
+                ClockInterval::Fixed => "fixed",
+            }
+            .into(),
+        ),
+        interval_decimal: match clock.interval {
+            ClockInterval::Constant(t) => Some(t),
+            ClockInterval::Fixed => None,
+        },
+        ..Default::default()
+    });
+    for &row in clocked_rows {
+        d3.model_variables[row + 1].clocks = vec![vr];
+    }
+    // a clocked variable gets its value at its clock's activations: no InitialUnknown (FMI
+    // 3.0 leaves it optional; fmpy's validation expects it left out)
+    let clocked_vrs: Vec<u32> = clocked_rows.iter().map(|&row| row as u32 + 1).collect();
+    d3.model_structure.initial_unknowns.retain(|u| !clocked_vrs.contains(&u.value_reference));
+    d3.model_variables.push(c);
+    if let Some(cs) = d3.co_simulation.as_mut() {
+        cs.has_event_mode = true;
     }
 }
 

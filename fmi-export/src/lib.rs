@@ -38,6 +38,14 @@
 //!   features the FMUs do not declare (Scheduled Execution, clocks, Configuration Mode,
 //!   `fmi3EvaluateDiscreteStates`, `fmi3GetOutputDerivatives`, `fmi3EnterStepMode`) answer
 //!   `fmi3Error` with a logged message naming the function.
+//! - Clocks: a sampled model may declare its sample clock once ([`ClockDecl`] in
+//!   [`DeclarationSpec::clocks`]: a periodic input clock, its interval constant or fixed,
+//!   the discrete outputs it governs, its priority). The FMI 3.0 description then has the
+//!   `<Clock>` (after every variable), the `clocks` attribute of the clocked outputs and
+//!   `hasEventMode` in Co-Simulation; an FMI 3.0 instance samples at the importer's
+//!   activations (`fmi3SetClock` in Event Mode, then `fmi3UpdateDiscreteStates`), with the
+//!   same results as FMI 2.0's time events ([`instance`]'s `clocks`). The FMI 2.0
+//!   description is unchanged.
 //! - A serialized FMU state has one format: bytes from either generation restore into an
 //!   instance of the other.
 //!
@@ -202,8 +210,8 @@ pub mod uri;
 pub mod variables;
 
 pub use decl::{
-    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, Declaration, DeclarationSpec,
-    Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
+    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
+    DeclarationSpec, Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use fmi_sys;
 pub use instance::Instance;

@@ -10,8 +10,9 @@
 //! then read, terminate, restore an FMU state or reset, but not step), does not exist in FMI
 //! 3.0: there a Discard of `fmi3DoStep` leaves the FMU in Step Mode. FMI 2.0's error state
 //! ([`Machine::Error`]) is, for FMI 3.0, the Terminated that an `fmi3Error` leads to: the two
-//! have the same row. An FMU of ours declares no Event Mode for Co-Simulation, no clocks
-//! and no Configuration Mode, so those FMI 3.0 states never occur. An FMI 3.0 function that
+//! have the same row. An FMU of ours declares no Configuration Mode; Event Mode in
+//! Co-Simulation only with a declared clock ([`crate::ClockDecl`]), in which case
+//! [`Machine::EventMode`] is Co-Simulation's Event Mode too. An FMI 3.0 function that
 //! does the same as an FMI 2.0 one has that one's row ([`Function::counterpart`]) unless
 //! FMI 3.0 lists it in other states ([`Function::fmi3_row`]); tests/tests/fmi3_state_table.rs
 //! compares every FMI 3.0 cell with the standard's lists.
@@ -28,7 +29,7 @@ pub enum Machine {
     StepComplete,
     /// Co-Simulation, after `fmi2DoStep` returned `fmi2Discard`.
     StepFailed,
-    /// Model Exchange.
+    /// Model Exchange; Co-Simulation with a declared clock.
     EventMode,
     /// Model Exchange.
     ContinuousTimeMode,
@@ -210,6 +211,25 @@ impl Function {
         })
     }
 
+    /// The functions of FMI 3.0 clocks: offered when the model declares a clock
+    /// ([`crate::ClockDecl`]), else refused as [`Function::undeclared_feature`]s.
+    pub fn is_clock_function(self) -> bool {
+        use Function::*;
+        matches!(
+            self,
+            Fmi3GetClock
+                | Fmi3SetClock
+                | Fmi3GetIntervalDecimal
+                | Fmi3GetIntervalFraction
+                | Fmi3GetShiftDecimal
+                | Fmi3GetShiftFraction
+                | Fmi3SetIntervalDecimal
+                | Fmi3SetIntervalFraction
+                | Fmi3SetShiftDecimal
+                | Fmi3SetShiftFraction
+        )
+    }
+
     /// The interface the function belongs to.
     pub fn scope(self) -> Scope {
         use Function::*;
@@ -319,8 +339,22 @@ impl Function {
             | Fmi3GetBinary => READ | mask(&[Instantiated]),
             // Clocks are active in Event Mode only
             Fmi3GetClock | Fmi3SetClock => mask(&[EventMode]),
-            // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode)
-            Fmi3EnterEventMode | Fmi3SetTime => mask(&[ContinuousTimeMode]),
+            // the intervals and shifts of time-based clocks: Initialization Mode and Event
+            // Mode (Scheduled Execution's Clock Activation Mode is not offered)
+            Fmi3GetIntervalDecimal
+            | Fmi3GetIntervalFraction
+            | Fmi3GetShiftDecimal
+            | Fmi3GetShiftFraction
+            | Fmi3SetIntervalDecimal
+            | Fmi3SetIntervalFraction
+            | Fmi3SetShiftDecimal
+            | Fmi3SetShiftFraction => mask(&[InitializationMode, EventMode]),
+            // Co-Simulation with Event Mode (an FMU with clocks): Event Mode back to Step Mode
+            Fmi3EnterStepMode => mask(&[EventMode]),
+            // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode);
+            // Co-Simulation with Event Mode: from Step Mode
+            Fmi3EnterEventMode => mask(&[ContinuousTimeMode, StepComplete]),
+            Fmi3SetTime => mask(&[ContinuousTimeMode]),
             // also in Initialization Mode (not in FMI 2.0)
             Fmi3GetContinuousStateDerivatives => {
                 mask(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated, Error])

@@ -1166,7 +1166,11 @@ fn fmi3_values_of_the_wrong_type_count_or_range_are_refused_naming_the_reason() 
     );
     assert!(f.last_error().starts_with("fmi3GetFloat32:") && f.last_error().contains("not a Float32"));
     f = fresh();
-    assert_eq!(unsafe { abi::fmi3::clock::<Toy>(Function::Fmi3GetClock, f.c, &vr3::ENABLED, 1) }, ERR3);
+    let mut active = 0;
+    assert_eq!(
+        unsafe { abi::fmi3::get_clock::<Toy>(Function::Fmi3GetClock, f.c, &vr3::ENABLED, 1, &mut active) },
+        ERR3
+    );
     // the FMU declares no Clock: fmi3GetClock is refused as a feature it lacks
     assert!(f.last_error().contains("not supported: no clocks are declared"), "{}", f.last_error());
     f = fresh();

@@ -165,6 +165,18 @@ pub enum Error {
         /// How the host ended.
         cause: HostEnd,
     },
+    /// A call of an isolated instance carries more data than the region shared with its
+    /// host process holds: a limit of the master's isolation, not a failure of the FMU.
+    IsolationLimit {
+        /// The instance.
+        instance: String,
+        /// The function called.
+        function: &'static str,
+        /// The bytes the call needs in the region.
+        needed: usize,
+        /// The bytes the region holds for one call.
+        available: usize,
+    },
 }
 
 /// How the host process of an isolated instance ended.
@@ -300,6 +312,10 @@ impl fmt::Display for Error {
             Error::Host { instance, function, time, cause } => {
                 write!(f, "{instance}: the FMU's host process {cause} during {function} at t = {time} s")
             }
+            Error::IsolationLimit { instance, function, needed, available } => write!(
+                f,
+                "{instance}: {function} was not called: its data take {needed} bytes, more than the {available} bytes the master's region shared with the FMU's host process holds for one call (a limit of cosim's isolation, not of the FMU; run without --isolate)"
+            ),
         }
     }
 }

@@ -37,12 +37,21 @@ pub(crate) struct Fmi3Abi {
     pub(crate) token: CString,
     /// `resourcePath`: the unpacked `resources/` folder, a native path ending in `/`.
     pub(crate) resource_path: CString,
+    /// The structural parameters set in Configuration Mode before initialization (the FMU's
+    /// variable and the value; empty: Configuration Mode is not entered). See
+    /// [`crate::structural`].
+    pub(crate) configuration: Vec<(Access, f64)>,
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
-pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription) -> Option<String> {
+/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions).
+pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription, scheduled: bool) -> Option<String> {
+    if scheduled {
+        return None;
+    }
     if let Some(clock) = md.model_variables.iter().find(|v| v.value_type == fmi3::ValueType::Clock) {
-        return Some(format!("clocks (Clock variable {:?})", clock.name));
+        let scheduled = if md.scheduled_execution.is_some() { "; its Scheduled Execution runs them" } else { "" };
+        return Some(format!("clocks (Clock variable {:?}{scheduled})", clock.name));
     }
     if md.co_simulation.is_none() && md.model_exchange.is_none() && md.scheduled_execution.is_some() {
         return Some("Scheduled Execution (the FMU offers no other interface type)".into());
@@ -525,20 +534,21 @@ mod tests {
     #[test]
     fn clocks_and_scheduled_execution_are_named() {
         let md = fmi3::ModelDescription::from_xml(XML).unwrap();
-        assert_eq!(unsupported_feature(&md), None);
+        assert_eq!(unsupported_feature(&md, false), None);
         let clock = XML.replace(
             r#"<Float64 name="z" valueReference="9"/>"#,
             r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
-        assert_eq!(unsupported_feature(&md).as_deref(), Some("clocks (Clock variable \"tick\")"));
+        assert_eq!(unsupported_feature(&md, false).as_deref(), Some("clocks (Clock variable \"tick\")"));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
                 r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,
                 r#"<ScheduledExecution modelIdentifier="m"/>"#,
             );
         let md = fmi3::ModelDescription::from_xml(&se).unwrap();
-        assert!(unsupported_feature(&md).unwrap().starts_with("Scheduled Execution"));
+        assert!(unsupported_feature(&md, false).unwrap().starts_with("Scheduled Execution"));
+        assert_eq!(unsupported_feature(&md, true), None);
     }
 
     #[test]

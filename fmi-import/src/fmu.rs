@@ -18,6 +18,9 @@ pub enum Interface {
     CoSimulation,
     /// Model Exchange: the master integrates the FMU's derivatives.
     ModelExchange,
+    /// FMI 3.0 Scheduled Execution: the master activates the FMU's model partitions at
+    /// their clocks' ticks (`fmi3ActivateModelPartition`; see `instance/scheduled.rs`).
+    ScheduledExecution,
 }
 
 impl Interface {
@@ -26,12 +29,14 @@ impl Interface {
         match self {
             Interface::CoSimulation => "CoSimulation",
             Interface::ModelExchange => "ModelExchange",
+            Interface::ScheduledExecution => "ScheduledExecution",
         }
     }
     pub(crate) fn fmi_type(self) -> c_int {
         match self {
             Interface::ModelExchange => 0,
-            Interface::CoSimulation => 1,
+            // FMI 2.0's fmi2Type: an FMU has no Scheduled Execution there (refused at load)
+            Interface::CoSimulation | Interface::ScheduledExecution => 1,
         }
     }
 }
@@ -82,6 +87,9 @@ pub struct Fmu {
     pub(crate) library_path: PathBuf,
     /// FMI 3.0: the variables not in the view and why (see [`crate::fmi3`]).
     pub(crate) not_in_view: Vec<(String, crate::fmi3::LeftOut)>,
+    /// FMI 3.0 with structural parameters set ([`Fmu::configured`]): the FMU as loaded,
+    /// which holds the unpacked folder.
+    pub(crate) configured_from: Option<Arc<Fmu>>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -122,6 +130,7 @@ impl Fmu {
                 special: a.special.clone(),
                 token: a.token.clone(),
                 resource_path: a.resource_path.clone(),
+                configuration: a.configuration.clone(),
             })),
         };
         Arc::new(Fmu {
@@ -137,6 +146,7 @@ impl Fmu {
             isolated_from: Some(self.clone()),
             library_path: self.library_path.clone(),
             not_in_view: self.not_in_view.clone(),
+            configured_from: None,
         })
     }
 
@@ -173,7 +183,7 @@ impl Fmu {
 
     /// The private folder it is unpacked in (removed when the last `Arc` is dropped).
     pub fn unpacked_dir(&self) -> &Path {
-        match (&self.dir, &self.isolated_from) {
+        match (&self.dir, self.isolated_from.as_ref().or(self.configured_from.as_ref())) {
             (Some(d), _) => d.path(),
             (None, Some(f)) => f.unpacked_dir(),
             (None, None) => Path::new(""),
@@ -195,6 +205,7 @@ impl Fmu {
             Interface::ModelExchange => {
                 self.description.model_exchange.as_ref().is_some_and(|c| c.can_get_and_set_fmu_state)
             }
+            Interface::ScheduledExecution => false,
         };
         flag && match &self.abi {
             Abi::Fmi2(f) => f.get_fmu_state.is_some() && f.set_fmu_state.is_some() && f.free_fmu_state.is_some(),

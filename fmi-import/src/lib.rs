@@ -34,8 +34,12 @@
 //! isolate/host -> os, protocol, channel, proxy3, c_types, library, log, error
 //! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
 //! load         -> fmu, fmi3, library, platform, unpack, isolate/proxy*  the one pipeline
+//! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
+//! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
 //! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
+//! instance/configuration -> instance/core, instance/fmi3   Configuration Mode
+//! instance/scheduled -> instance/core, instance/fmi3, instance, fmu, log   Scheduled Execution
 //! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
 //! ```
 //!
@@ -53,11 +57,14 @@ pub mod fmi3;
 pub mod fmu;
 pub mod instance;
 pub mod isolate;
+mod janitor;
 pub(crate) mod library;
 pub mod load;
 pub mod log;
+pub mod partitions;
 pub mod platform;
 pub mod status;
+pub mod structural;
 #[doc(hidden)]
 pub mod suggest;
 pub mod unpack;

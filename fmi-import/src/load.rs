@@ -45,6 +45,14 @@ trait Generation {
     fn has(table: &Self::Table, symbol: &str) -> bool;
     /// The functions `interface` needs beyond the core ones.
     fn needs(interface: Interface) -> &'static [&'static str];
+    /// The model identifier of Scheduled Execution (FMI 3.0 only).
+    fn scheduled_identifier(_described: &Self::Described) -> Option<String> {
+        None
+    }
+    /// What the master cannot run of the FMU with `interface`, named; `None`: nothing.
+    fn unsupported(_described: &Self::Described, _interface: Interface) -> Option<String> {
+        None
+    }
     /// Whether the functions the interface needs are checked on the proxy table too (an
     /// FMI 3.0 proxy has no instantiate functions: its host instantiates).
     const NEEDS_CHECKED_ISOLATED: bool;
@@ -122,6 +130,8 @@ impl Generation for Fmi2 {
                 "fmi2GetEventIndicators",
                 "fmi2GetContinuousStates",
             ],
+            // FMI 2.0 has no Scheduled Execution: refused before (no model identifier)
+            Interface::ScheduledExecution => &[],
         }
     }
 
@@ -144,6 +154,14 @@ impl Generation for Fmi3 {
     type Described = Fmi3Described;
     const PLATFORM: &'static str = crate::platform::FMI3_FOLDER;
     const NEEDS_CHECKED_ISOLATED: bool = false;
+
+    fn unsupported((md, _, _): &Fmi3Described, interface: Interface) -> Option<String> {
+        crate::fmi3::unsupported_feature(md, interface == Interface::ScheduledExecution)
+    }
+
+    fn scheduled_identifier((md, _, _): &Fmi3Described) -> Option<String> {
+        md.scheduled_execution.as_ref().map(|se| se.common.model_identifier.clone())
+    }
 
     fn describe(xml: &str, path: &Path) -> Result<(ModelDescription, Fmi3Described)> {
         let md = checked_fmi3(xml, path)?;
@@ -185,6 +203,9 @@ impl Generation for Fmi3 {
                 "fmi3GetEventIndicators",
                 "fmi3GetContinuousStates",
             ],
+            Interface::ScheduledExecution => {
+                &["fmi3InstantiateScheduledExecution", "fmi3ActivateModelPartition", "fmi3GetIntervalDecimal"]
+            }
         }
     }
 
@@ -199,7 +220,14 @@ impl Generation for Fmi3 {
             reason: "NUL in instantiationToken".into(),
         })?;
         let resource_path = crate::fmi3::resource_path(dir).ok_or_else(|| nul_in_folder(dir))?;
-        let abi = crate::fmi3::Fmi3Abi { functions, description: md, special, token, resource_path };
+        let abi = crate::fmi3::Fmi3Abi {
+            functions,
+            description: md,
+            special,
+            token,
+            resource_path,
+            configuration: Vec::new(),
+        };
         Ok((Abi::Fmi3(Arc::new(abi)), CString::default(), not_in_view))
     }
 }
@@ -228,7 +256,8 @@ pub fn read_model_description(dir: &Path, source: &Path, limits: &UnpackLimits) 
 }
 
 /// The FMI 3.0 description of the FMU archive `path`, read and checked as
-/// [`Fmu::load`] does, without loading its library; `None` for an FMI 2.0 FMU.
+/// [`Fmu::load`] does (but for what the master runs: an FMU with clocks is read), without
+/// loading its library; `None` for an FMI 2.0 FMU.
 pub fn read_fmi3_description(
     path: &Path,
     limits: &UnpackLimits,
@@ -241,8 +270,8 @@ pub fn read_fmi3_description(
     checked_fmi3(&xml, path).map(Some)
 }
 
-/// Reads an FMI 3.0 description and refuses what [`FMI3_REFUSED`] lists and what the
-/// master does not run.
+/// Reads an FMI 3.0 description and refuses what [`FMI3_REFUSED`] lists (what the master
+/// does not run with the interface chosen is refused by [`load`]).
 fn checked_fmi3(xml: &str, path: &Path) -> Result<model_description::fmi3::ModelDescription> {
     let refuse = |reason: String| Error::ModelDescription { path: path.to_path_buf(), reason };
     let md = model_description::fmi3::ModelDescription::from_xml(xml).map_err(|e| refuse(e.to_string()))?;
@@ -250,9 +279,6 @@ fn checked_fmi3(xml: &str, path: &Path) -> Result<model_description::fmi3::Model
         md.validate().into_iter().filter(|p| FMI3_REFUSED.contains(&p.rule)).map(|p| p.to_string()).collect();
     if !problems.is_empty() {
         return Err(refuse(problems.join("; ")));
-    }
-    if let Some(feature) = crate::fmi3::unsupported_feature(&md) {
-        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
     }
     Ok(md)
 }
@@ -322,11 +348,18 @@ fn load<G: Generation>(
     let interface = match options.interface {
         Some(i) => i,
         None if description.co_simulation.is_some() => Interface::CoSimulation,
+        None if description.model_exchange.is_none() && G::scheduled_identifier(&described).is_some() => {
+            Interface::ScheduledExecution
+        }
         None => Interface::ModelExchange,
     };
+    if let Some(feature) = G::unsupported(&described, interface) {
+        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
+    }
     let identifier = match interface {
         Interface::CoSimulation => description.co_simulation.as_ref().map(|c| c.model_identifier.clone()),
         Interface::ModelExchange => description.model_exchange.as_ref().map(|m| m.model_identifier.clone()),
+        Interface::ScheduledExecution => G::scheduled_identifier(&described),
     }
     .ok_or(Error::NoInterface { path: path.to_path_buf(), interface: interface.as_str() })?;
     if !model_description::is_c_identifier(&identifier) {
@@ -378,5 +411,6 @@ fn load<G: Generation>(
         isolated_from: None,
         library_path: so,
         not_in_view,
+        configured_from: None,
     }))
 }

@@ -18,7 +18,7 @@ pub struct LogRecord {
     pub status: Status,
     /// The category.
     pub category: String,
-    /// The formatted message.
+    /// The formatted message (at most [`MAX_MESSAGE_BYTES`] and the note of its cut).
     pub message: String,
 }
 
@@ -32,18 +32,48 @@ pub struct LogSink {
 #[derive(Debug, Default)]
 struct Records(Mutex<VecDeque<LogRecord>>);
 
+/// The most of an FMI 2.0 message fmi-sys's logger shim formats (its buffer less the NUL):
+/// it reads the FMU's strings safely, so it cannot know how long a longer one is.
+const FMI2_SHIM_BYTES: usize = 4095;
+
 impl LogReceiver for Records {
     fn receive(&self, m: &LogMessage<'_>) {
-        self.push(LogRecord {
-            status: Status::from_raw(m.status),
-            category: m.category.to_owned(),
-            message: m.message.to_owned(),
-        });
+        let mut message = m.message.to_owned();
+        if message.len() >= FMI2_SHIM_BYTES {
+            message.push_str(&format!(" [... cut by cosim at {FMI2_SHIM_BYTES} bytes: the message may be longer]"));
+        }
+        self.push(LogRecord { status: Status::from_raw(m.status), category: m.category.to_owned(), message });
     }
 }
 
+/// The longest message kept, bytes: a longer one is cut there with a note of its length
+/// (in process and in a host process alike; a log is for reading, and a message of
+/// megabytes would flood the terminal or the region shared with a host). FMI 2.0 messages
+/// come cut to 4095 bytes already (fmi-sys's shim), with a note: the bound leaves room for it.
+pub const MAX_MESSAGE_BYTES: usize = 4096 + 128;
+/// The longest category kept, bytes (cut likewise).
+pub const MAX_CATEGORY_BYTES: usize = 256;
+
+/// `text` cut to at most `max` bytes (at a character boundary) followed by a note of its
+/// length, or as it is when it fits.
+pub(crate) fn bounded(mut text: String, max: usize) -> String {
+    if text.len() <= max {
+        return text;
+    }
+    let length = text.len();
+    let mut cut = max;
+    while !text.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    text.truncate(cut);
+    text.push_str(&format!(" [... cut by cosim at {cut} of the message's {length} bytes]"));
+    text
+}
+
 impl Records {
-    fn push(&self, record: LogRecord) {
+    fn push(&self, mut record: LogRecord) {
+        record.message = bounded(record.message, MAX_MESSAGE_BYTES);
+        record.category = bounded(record.category, MAX_CATEGORY_BYTES);
         if let Ok(mut r) = self.0.lock() {
             if r.len() == LogSink::CAPACITY {
                 r.pop_front();
@@ -62,7 +92,8 @@ impl LogSink {
         self.environment.0.lock().map(|mut r| r.drain(..).collect()).unwrap_or_default()
     }
 
-    /// Keeps `record` (the oldest dropped beyond the capacity).
+    /// Keeps `record` (the oldest dropped beyond the capacity; its message and category
+    /// bounded, [`MAX_MESSAGE_BYTES`]).
     pub(crate) fn push(&self, record: LogRecord) {
         self.environment.push(record)
     }
@@ -106,4 +137,19 @@ pub(crate) unsafe extern "C" fn log_message(
         let sink = unsafe { &*(environment as *const LogSink) };
         sink.push(LogRecord { status: Status::from_raw(status), category: text(category), message: text(message) });
     });
+}
+
+#[cfg(test)]
+mod log_tests {
+    use super::bounded;
+
+    #[test]
+    fn a_long_message_is_cut_at_a_character_boundary_with_its_length() {
+        assert_eq!(bounded("short".into(), 10), "short");
+        // "é" is two bytes: a cut at 3 bytes falls inside the second one, so 2 are kept
+        assert_eq!(bounded("ééé".into(), 3), "é [... cut by cosim at 2 of the message's 6 bytes]");
+        // an FMI 3.0 message (its whole length known) of 10 MB
+        let cut = bounded("x".repeat(10_000_000), super::MAX_MESSAGE_BYTES);
+        assert_eq!(cut, format!("{} [... cut by cosim at 4224 of the message's 10000000 bytes]", "x".repeat(4224)));
+    }
 }

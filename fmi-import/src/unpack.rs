@@ -175,6 +175,7 @@ fn register(dir: &Path) {
     let mut made = MADE.lock().unwrap_or_else(|e| e.into_inner());
     made.retain(|p| p.exists());
     made.push(dir.to_path_buf());
+    crate::janitor::watch(dir);
 }
 
 /// Removes the temporary folders this process made, without waiting: when another

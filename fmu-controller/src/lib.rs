@@ -133,15 +133,16 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
     let psi = pose(v.real("psi"), "rad", true).field(|m, _| &mut m.inputs.psi);
     let psi_ref = pose(v.real("psi_ref"), "rad", false).field(|m, _| &mut m.inputs.psi_ref);
     let poses = [x, x_ref, y, y_ref, psi, psi_ref];
-    v.family("delta", &WHEELS, |d, i| {
-        let mut on = vec![beta, yaw_rate, beta_ref, yaw_rate_ref, delta_ff[i]];
-        on.extend(poses);
-        d.discrete_output(on).unit("rad").describe(
-            "steering command delta_ff + K (q - q_ref), q = [beta, yaw_rate] (robust_tracking: \
+    let steering = v
+        .family("delta", &WHEELS, |d, i| {
+            let mut on = vec![beta, yaw_rate, beta_ref, yaw_rate_ref, delta_ff[i]];
+            on.extend(poses);
+            d.discrete_output(on).unit("rad").describe(
+                "steering command delta_ff + K (q - q_ref), q = [beta, yaw_rate] (robust_tracking: \
              delta_ff + K_track e), clamped to +-delta_max; held over a sample",
-        )
-    })
-    .field(|m, i| &mut m.held.delta[i]);
+            )
+        })
+        .field(|m, i| &mut m.held.delta[i]);
     let mut speed_outputs = v
         .family("tau", &WHEELS, |d, _| {
             d.discrete_output(Dependencies::All).unit("N.m").describe("drive torque F r_wheel / 4; held over a sample")
@@ -162,9 +163,10 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
         .field(|m, _| &mut m.integral);
     // the along-track error reads x, y and the reference pose (not psi); the PI its integrator
     // (a known in Initialization Mode only: the layer keeps it out of the Outputs list)
-    for output in speed_outputs {
+    for &output in &speed_outputs {
         v.set_dependencies(output, [speed, speed_ref, x, y, x_ref, y_ref, psi_ref, speed_integral]);
     }
+    let held_outputs: Vec<_> = steering.into_iter().chain(speed_outputs).collect();
     let parameters: [Parameter; 8] = [
         ("sample_period", 1e-3, MIN_SAMPLE_PERIOD, MAX_SAMPLE_PERIOD, "s", "sample period of the law", |m, _| {
             &mut m.settings.sample_period
@@ -241,8 +243,33 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
             step_size: Some(1e-3),
         }),
         variables: v.into_vec(),
+        clocks: sample_clock(held_outputs),
         ..Default::default()
     }
+}
+
+/// With the build option `fmi3-sample-clock`: the FMI 3.0 description declares the sample
+/// period as the periodic input clock `sample_clock` (interval fixed: the parameter
+/// `sample_period`, read with `fmi3GetIntervalDecimal` in Initialization Mode; shift 0)
+/// governing the held outputs, which then change only at its activations, and priority 0
+/// for Scheduled Execution. The FMI 2.0 description is the same either way (no clocks in
+/// FMI 2.0: that archive samples by time).
+#[cfg(feature = "fmi3-sample-clock")]
+fn sample_clock(held_outputs: Vec<fmi_export::VarHandle>) -> Vec<fmi_export::ClockDecl> {
+    vec![fmi_export::ClockDecl {
+        name: "sample_clock",
+        description: "the sample instants t_k = t_start + k sample_period: activate it at each to run the law",
+        interval: fmi_export::ClockInterval::Fixed,
+        governs: held_outputs,
+        priority: 0,
+    }]
+}
+
+/// Without the build option `fmi3-sample-clock`: no clock (the FMI 3.0 archive samples by
+/// time as the FMI 2.0 one does).
+#[cfg(not(feature = "fmi3-sample-clock"))]
+fn sample_clock(_held_outputs: Vec<fmi_export::VarHandle>) -> Vec<fmi_export::ClockDecl> {
+    Vec::new()
 }
 
 /// The controller instance.

@@ -188,7 +188,8 @@ class System:
     # -- what it is ----------------------------------------------------------------------
     @property
     def interfaces(self) -> list[str]:
-        """The interfaces of a single FMU (``CoSimulation``, ``ModelExchange``)."""
+        """The interfaces of a single FMU (``CoSimulation``, ``ModelExchange``,
+        ``ScheduledExecution``)."""
         return list(self._native.interfaces)
 
     @property

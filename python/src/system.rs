@@ -50,6 +50,7 @@ fn interface_name(i: Interface) -> &'static str {
     match i {
         Interface::CoSimulation => "CoSimulation",
         Interface::ModelExchange => "ModelExchange",
+        Interface::ScheduledExecution => "ScheduledExecution",
     }
 }
 
@@ -106,9 +107,10 @@ impl NativeSystem {
             None => None,
             Some("CoSimulation") => Some(Interface::CoSimulation),
             Some("ModelExchange") => Some(Interface::ModelExchange),
+            Some("ScheduledExecution") => Some(Interface::ScheduledExecution),
             Some(other) => {
                 return Err(PyValueError::new_err(format!(
-                    "fmi_type must be 'CoSimulation' or 'ModelExchange', not {other:?}"
+                    "fmi_type must be 'CoSimulation', 'ModelExchange' or 'ScheduledExecution', not {other:?}"
                 )))
             }
         };
@@ -135,6 +137,9 @@ impl NativeSystem {
                 }
                 if md.model_exchange.is_some() {
                     interfaces.push(interface_name(Interface::ModelExchange));
+                }
+                if fmu.fmi3_description().is_some_and(|md3| md3.scheduled_execution.is_some()) {
+                    interfaces.push(interface_name(Interface::ScheduledExecution));
                 }
                 let interfaces = match interface {
                     Some(i) => vec![interface_name(i)],
@@ -247,6 +252,11 @@ impl NativeSystem {
         let (system, experiment) = self.run_setup(&args)?;
         let cancel = Arc::new(AtomicBool::new(false));
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
+            if nigel_cosim::simulate::is_scheduled(&system) {
+                // one FMU's model partitions at their clocks' ticks (cosim run --interface se)
+                let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
+                return Ok((results, outcome?));
+            }
             let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
             let mut execution = Execution::new(&system, &experiment)?.with_pool(&mut pool);
             execution.cancel_on(cancel.clone());

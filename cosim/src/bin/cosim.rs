@@ -134,7 +134,9 @@ impl LimitArgs {
 struct RunArgs {
     /// The .fmu, .ssp or .ssd file.
     model: PathBuf,
-    /// FMI interface: cs (Co-Simulation) or me (Model Exchange); default: cs if the FMU has it.
+    /// FMI interface: cs (Co-Simulation), me (Model Exchange) or se (FMI 3.0 Scheduled
+    /// Execution, one FMU: its model partitions activated at their clocks' ticks); default: cs
+    /// if the FMU has it, else me, else se.
     #[arg(long)]
     interface: Option<String>,
     /// Start time, s (negative times are times like any other; default 0, for an SSP its
@@ -177,7 +179,9 @@ struct RunArgs {
     /// Wall-clock limit of one FMU call, s (needs --isolate: the host is killed).
     #[arg(long, value_name = "SECONDS")]
     timeout_call: Option<f64>,
-    /// Wall-clock limit of the whole run, s.
+    /// Wall-clock limit of the whole run, s. In process (no --isolate) a call that never
+    /// returns cannot be stopped: 1 s past the limit the process ends, naming the call,
+    /// with the rows so far written; --isolate kills only the FMU's host.
     #[arg(long, value_name = "SECONDS")]
     timeout: Option<f64>,
     /// On fmi2Discard, restore the FMU state and retry the step in halves (FMUs that can
@@ -338,7 +342,8 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         None => None,
         Some("cs") => Some(Interface::CoSimulation),
         Some("me") => Some(Interface::ModelExchange),
-        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me)")).into()),
+        Some("se") => Some(Interface::ScheduledExecution),
+        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me, se)")).into()),
     };
     let format = match &args.output {
         None => None,
@@ -423,7 +428,11 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     );
                 }
             }
+            let scheduled = instance.fmu.interface() == Interface::ScheduledExecution;
             for (name, why) in instance.fmu.not_in_view() {
+                if scheduled && *why == nigel_cosim::fmi3::LeftOut::Clock {
+                    continue; // recorded as its ticks
+                }
                 eprintln!(
                     "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
                     instance.name,
@@ -537,8 +546,14 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             });
             (run.results, outcome)
         }
+        _ if nigel_cosim::simulate::is_scheduled(&system) => {
+            let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
+            (results, outcome.map_err(Some))
+        }
         _ => {
             report_exit_inside_calls(args.output.clone(), format, &system);
+            // in process, a call that never returns is stopped by ending the process
+            let _watchdog = experiment.timeout.filter(|_| args.isolate.is_none()).map(nigel_cosim::watchdog::start);
             match nigel_cosim::simulate::Execution::new(&system, &experiment) {
                 Ok(mut execution) => {
                     if std::io::stderr().is_terminal() {
@@ -730,11 +745,8 @@ fn report_exit_inside_calls(output: Option<PathBuf>, format: Option<OutputFormat
             .collect(),
         _ => Default::default(),
     };
-    nigel_cosim::on_exit_inside_call(Box::new(move |call, rows| {
-        match call {
-            Some(c) => eprintln!("cosim: {c}"),
-            None => eprintln!("cosim: exit() was called during the run, outside an FMU call of the calling thread"),
-        }
+    nigel_cosim::on_exit_inside_call(Box::new(move |what, rows| {
+        eprintln!("cosim: {what}");
         let (Some(path), Some(format)) = (&output, format) else { return };
         let Some(results) = rows.filter(|r| r.rows() > 0) else {
             eprintln!("cosim: no rows to write to {}", path.display());
@@ -1123,6 +1135,34 @@ fn info_fmi3(out: &mut impl std::io::Write, md: &model_description::fmi3::ModelD
             range,
             v.description.as_deref().unwrap_or("")
         );
+    }
+    // what FMI 3.0 adds beyond variables, one line each: structural parameters here
+    // (Configuration Mode), then model partitions (Scheduled Execution)
+    for p in nigel_cosim::structural::structural_parameters(md) {
+        let sizes = if p.sizes.is_empty() { String::new() } else { format!(", sizes {}", p.sizes.join(", ")) };
+        w!(
+            out,
+            "structural parameter {} ({}, start {}{sizes}): set with --set {}=VALUE, in Configuration Mode",
+            p.name,
+            p.variability,
+            p.start.as_deref().unwrap_or("-"),
+            p.name
+        );
+    }
+    match nigel_cosim::partitions::model_partitions(md) {
+        Ok(partitions) if md.scheduled_execution.is_some() => {
+            for p in partitions {
+                w!(
+                    out,
+                    "model partition {} (clock, priority {}): ticks {}; run with --interface se",
+                    p.name,
+                    p.priority,
+                    p.ticks_text()
+                );
+            }
+        }
+        Err(reason) if md.scheduled_execution.is_some() => w!(out, "model partitions: {reason}"),
+        _ => {}
     }
     let left_out = nigel_cosim::fmi3::not_in_view(md);
     if !left_out.is_empty() {

@@ -95,6 +95,12 @@ impl<'s> Execution<'s> {
     pub fn new(system: &System, experiment: &Experiment) -> Result<Execution<'s>> {
         let wall = Instant::now();
         let deadline = experiment.timeout.map(|limit| (wall + limit, limit));
+        if let Some(spec) = system.instances.iter().find(|i| i.fmu.interface() == Interface::ScheduledExecution) {
+            return Err(Error::Experiment(format!(
+                "{} is loaded for Scheduled Execution, which steps no communication points: run it on its own with simulate_scheduled (cosim run --interface se)",
+                spec.name
+            )));
+        }
         let clock = Clock::new(experiment, system)?;
         check_solver(experiment, &clock, system)?;
         check_single_instance(system)?;
@@ -320,7 +326,8 @@ impl<'s> Execution<'s> {
                     .or_else(|| spec.fmu.description().default_experiment.as_ref().and_then(|d| d.tolerance))
                     // a declared tolerance that is no tolerance (0, negative, NaN) is not passed on
                     .filter(|t| t.is_finite() && *t > 0.0),
-                Interface::ModelExchange => None,
+                // refused by Execution::new (simulate_scheduled runs it)
+                Interface::ModelExchange | Interface::ScheduledExecution => None,
             };
             lane.inst.setup_experiment(tolerance, t0, Some(experiment.stop_time))?;
             apply_start_values(&mut lane.inst, spec)?;
@@ -611,6 +618,16 @@ impl<'s> Execution<'s> {
                 pool.put(lane.index, lane.inst);
             }
         }
+        // freed here, not dropped: a host process that ends in fmi2FreeInstance (an FMU
+        // that crashes in it) fails the run, its rows kept
+        let mut freed = Ok(());
+        for lane in std::mem::take(&mut core.lanes) {
+            let result = lane.inst.free();
+            if freed.is_ok() {
+                freed = result;
+            }
+        }
+        freed?;
         drop(core);
         summary.instance_time = self.system.instances.iter().map(|s| s.name.clone()).zip(profiler.spent).collect();
         summary.wall_time = self.wall.elapsed();
@@ -668,6 +685,7 @@ fn check_single_instance(system: &System) -> Result<()> {
             Interface::ModelExchange => {
                 md.model_exchange.as_ref().is_some_and(|m| m.can_be_instantiated_only_once_per_process)
             }
+            Interface::ScheduledExecution => false,
         };
         if !once {
             continue;

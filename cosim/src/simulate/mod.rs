@@ -17,7 +17,9 @@
 //!   trait;
 //! - `input`: input signals over time ([`InputTable`]), applied around the algorithm;
 //! - `execution`: [`Execution`], a run advanced step by step by its caller;
-//! - `driver`: [`simulate()`] and its variants, loops over an [`Execution`].
+//! - `driver`: [`simulate()`] and its variants, loops over an [`Execution`];
+//! - `scheduled`: FMI 3.0 Scheduled Execution of one FMU ([`simulate_scheduled`]), its
+//!   own loop over the model partitions' ticks.
 
 mod algorithm;
 mod between;
@@ -29,6 +31,7 @@ mod lane;
 mod me_group;
 mod observer;
 mod plan;
+mod scheduled;
 mod types;
 
 pub use between::{Manipulator, SetQueue, StepInstances};
@@ -39,6 +42,7 @@ pub use input::InputTable;
 pub use lane::apply_start_values;
 pub use observer::{Cancel, Observer, Progress};
 pub use plan::default_record;
+pub use scheduled::{is_scheduled, simulate_scheduled};
 pub use types::{number_text, push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

@@ -1,7 +1,10 @@
 /* Bouncing ball, FMI 2.0 Model Exchange: h' = v, v' = -g; event indicator z = h; at
  * h <= 0 with v < 0 the ball bounces: v = -e v, h = 0. A time event at t_kick (if > 0)
  * adds `kick` to v. Value references: 0 h, 1 v, 2 der(h), 3 der(v), 4 g, 5 e,
- * 6 t_kick, 7 kick. */
+ * 6 t_kick, 7 kick. Compiled with -DINDICATORS=N it has N event indicators, all z = h. */
+#ifndef INDICATORS
+#define INDICATORS 1
+#endif
 #define FMI2_TEST_NO_FMU_STATE
 #include "fmi2_test.h"
 
@@ -81,8 +84,9 @@ EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
     return 0;
 }
 EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) {
-    if (n != 1) return ERR;
-    z[0] = ((Ball *)c)->r[0];
+    size_t i;
+    if (n != INDICATORS) return ERR;
+    for (i = 0; i < n; i++) z[i] = ((Ball *)c)->r[0];
     return 0;
 }
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {

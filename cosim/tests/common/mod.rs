@@ -2,6 +2,8 @@
 //! as proper FMI 2.0 archives: modelDescription.xml + binaries/linux64/<id>.so.
 #![allow(dead_code)]
 
+pub mod fmi3_c;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -99,7 +101,7 @@ pub fn work_dir(test: &str) -> PathBuf {
 
 /// Compiles models.c for `model` into `out` (with extra `cc` flags).
 pub fn compile(model: Model, out: &Path, extra: &[&str]) {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/models.c");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/models.c");
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
         .arg(format!("-DMODEL={}", model.number()))
@@ -192,7 +194,7 @@ fn build_single_c_fmu(dir: &Path, id: &str, xml: &str) -> PathBuf {
 
 /// [`build_single_c_fmu`] with extra `cc` flags (e.g. `-DWRONG_JACOBIAN`).
 fn build_single_c_fmu_with_flags(dir: &Path, id: &str, xml: &str, flags: &[&str]) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cfmu/{id}.c"));
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../cosim/tests/cfmu/{id}.c"));
     let so = dir.join(format!("{id}.so"));
     let status = Command::new("cc")
         .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter"])
@@ -251,6 +253,13 @@ pub fn build_ball(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))
 }
 
+/// The bouncing ball with `n` event indicators (all z = h), as `<dir>/ball.fmu`.
+pub fn build_ball_with_indicators(dir: &Path, n: usize) -> PathBuf {
+    let xml = include_str!("../cfmu/ball.xml")
+        .replace(r#"numberOfEventIndicators="1""#, &format!(r#"numberOfEventIndicators="{n}""#));
+    build_single_c_fmu_with_flags(dir, "ball", &xml, &[&format!("-DINDICATORS={n}")])
+}
+
 /// The discrete latch (tests/cfmu/latch.c), Model Exchange only, as `<dir>/latch.fmu`.
 pub fn build_latch(dir: &Path) -> PathBuf {
     let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
@@ -279,9 +288,28 @@ pub fn build_stair(dir: &Path) -> PathBuf {
 }
 
 /// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
-/// exit(0) or a never-returning step at t_crash), as `<dir>/crash.fmu`.
+/// exit(0), a never-returning step at t_crash, a 10 MB log message, a double free), as
+/// `<dir>/crash.fmu`.
 pub fn build_crash(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "crash", include_str!("../cfmu/crash.xml"))
+}
+
+/// [`build_crash`] with a GUID of `bytes` bytes (`{crash}` then hexadecimal digits of a
+/// pseudo-random sequence up to that length: the archive compresses it no more than its
+/// zip-bomb limit allows).
+pub fn build_crash_with_guid(dir: &Path, bytes: usize) -> PathBuf {
+    let mut x = 0x9e3779b97f4a7c15u64;
+    let digits: String = (0..bytes.saturating_sub(7))
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            char::from_digit((x % 16) as u32, 16).unwrap()
+        })
+        .collect();
+    let guid = format!("{{crash}}{digits}");
+    let xml = include_str!("../cfmu/crash.xml").replace(r#"guid="{crash}""#, &format!(r#"guid="{guid}""#));
+    build_single_c_fmu(dir, "crash", &xml)
 }
 
 /// The rows `time,y` of a two-column CSV written by `cosim run` (header skipped).

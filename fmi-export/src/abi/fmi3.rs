@@ -5,9 +5,10 @@
 //! The FMUs of this layer offer Model Exchange and Co-Simulation (without Event Mode, early
 //! return or intermediate update), scalar variables of the types Float64, Int32, Boolean
 //! and Enumeration (as Int64), FMU state and its serialization, directional and adjoint
-//! derivatives as declared. Every other function (Scheduled Execution, clocks,
-//! Configuration Mode, ...) answers `fmi3Error` with a logged message naming it, as does
-//! a Get/Set of a type the FMU has no variable of.
+//! derivatives as declared; with a declared clock, the clock functions and Co-Simulation with
+//! Event Mode. Every other function (Scheduled Execution, Configuration Mode, ...) answers
+//! `fmi3Error` with a logged message naming it, as does a Get/Set of a type the FMU has no
+//! variable of.
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments, non_snake_case)]
 
 use std::collections::HashSet;
@@ -20,7 +21,7 @@ use model_description::fmi3::ValueType;
 
 use super::{c_text, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::{Fmi2Status, FMI2_FALSE, FMI2_TRUE};
-use crate::instance::{Function, Generation, Instance, OpResult};
+use crate::instance::{Function, Generation, Instance, IntervalQualifier, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
 use crate::model::{InstantiateContext, Interface, Model, ModelError};
 
@@ -199,10 +200,20 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
         environment,
         log_message,
         || {
-            if event_mode_used != FMI3_FALSE {
-                return Err("eventModeUsed = true refused: the FMU declares no Event Mode for Co-Simulation \
-                            (hasEventMode is false)"
-                    .into());
+            let clock = M::declaration().clock().map(|(c, _)| c.name);
+            match (event_mode_used != FMI3_FALSE, clock) {
+                (true, None) => {
+                    return Err("eventModeUsed = true refused: the FMU declares no Event Mode for Co-Simulation \
+                                (hasEventMode is false)"
+                        .into())
+                }
+                (false, Some(name)) => {
+                    return Err(format!(
+                        "eventModeUsed = false refused: the FMU has a clock ({name}), and FMI 3.0 requires Event Mode \
+                         of an importer of an FMU with clocks (section 2.3.1)"
+                    ))
+                }
+                _ => {}
             }
             if n_required_intermediate_variables != 0 {
                 return Err(format!(
@@ -466,18 +477,116 @@ pub unsafe fn binary<M: Model>(
     })
 }
 
-/// `fmi3GetClock`, `fmi3SetClock`: the FMUs have no clocks (refused by the instance's
-/// gate before this runs: [`Function::undeclared_feature`]).
-pub unsafe fn clock<M: Model>(
+// ------------------------------------------------------------------ clocks (a model with a declared clock)
+
+/// `fmi3GetClock`: whether the clock is active.
+pub unsafe fn get_clock<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    vr: *const fmi3ValueReference,
+    n_vr: usize,
+    values: *mut fmi3Clock,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        let out = slice_mut(values, n_vr, "values")?;
+        let mut active = vec![false; vr.len()];
+        comp.instance.get_clock(vr, &mut active)?;
+        for (o, a) in out.iter_mut().zip(active) {
+            *o = if a { FMI3_CLOCK_ACTIVE } else { FMI3_CLOCK_INACTIVE };
+        }
+        Ok(())
+    })
+}
+
+/// `fmi3SetClock`: activates the clock (a value other than 0 or 1 is refused).
+pub unsafe fn set_clock<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    vr: *const fmi3ValueReference,
+    n_vr: usize,
+    values: *const fmi3Clock,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        let values = slice(values, n_vr, "values")?;
+        if let Some(k) = values.iter().position(|&v| v != FMI3_CLOCK_ACTIVE && v != FMI3_CLOCK_INACTIVE) {
+            return Err(format!(
+                "values[{k}] = {} for value reference {} is neither fmi3ClockActive (1) nor fmi3ClockInactive (0)",
+                values[k], vr[k]
+            )
+            .into());
+        }
+        let active: Vec<bool> = values.iter().map(|&v| v == FMI3_CLOCK_ACTIVE).collect();
+        comp.instance.set_clock(vr, &active)
+    })
+}
+
+/// `fmi3GetIntervalDecimal`: the clock's interval and its qualifier.
+pub unsafe fn get_interval_decimal<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    vr: *const fmi3ValueReference,
+    n_vr: usize,
+    intervals: *mut fmi3Float64,
+    qualifiers: *mut fmi3IntervalQualifier,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        let intervals = slice_mut(intervals, n_vr, "intervals")?;
+        let qualifiers = slice_mut(qualifiers, n_vr, "qualifiers")?;
+        let mut values = vec![(0.0, IntervalQualifier::Unchanged); vr.len()];
+        comp.instance.clock_intervals(vr, &mut values)?;
+        for ((i, q), (interval, qualifier)) in intervals.iter_mut().zip(qualifiers.iter_mut()).zip(values) {
+            *i = interval;
+            *q = match qualifier {
+                IntervalQualifier::Unchanged => FMI3_INTERVAL_UNCHANGED,
+                IntervalQualifier::Changed => FMI3_INTERVAL_CHANGED,
+            };
+        }
+        Ok(())
+    })
+}
+
+/// `fmi3GetShiftDecimal`: the clock's shift (0: the first activation is at the start time).
+pub unsafe fn get_shift_decimal<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    vr: *const fmi3ValueReference,
+    n_vr: usize,
+    shifts: *mut fmi3Float64,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| {
+        let vr = slice(vr, n_vr, "valueReferences")?;
+        let out = slice_mut(shifts, n_vr, "shifts")?;
+        comp.instance.clock_shifts(vr, out)
+    })
+}
+
+/// `fmi3GetIntervalFraction`, `fmi3GetShiftFraction`: refused (`supportsFraction` is false).
+pub unsafe fn clock_fraction<M: Model>(
     function: Function,
     instance: fmi3Instance,
     vr: *const fmi3ValueReference,
     n_vr: usize,
 ) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let vr = slice(vr, n_vr, "valueReferences")?;
-        comp.instance.fmi2_references(vr, ValueType::Clock).map(|_| ())
-    })
+    with3::<M>(instance, function, |comp| comp.instance.refuse_clock_fraction(slice(vr, n_vr, "valueReferences")?))
+}
+
+/// `fmi3SetIntervalDecimal`/`Fraction`, `fmi3SetShiftDecimal`/`Fraction`: refused, the
+/// clock's timing is the FMU's.
+pub unsafe fn clock_timing<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    vr: *const fmi3ValueReference,
+    n_vr: usize,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.refuse_clock_timing(slice(vr, n_vr, "valueReferences")?))
+}
+
+/// `fmi3EnterStepMode` (Co-Simulation with Event Mode): from Event Mode to Step Mode.
+pub unsafe fn enter_step_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.enter_step_mode())
 }
 
 // ------------------------------------------------------------------ variable dependencies

@@ -88,7 +88,7 @@ impl<M: Model> Instance<M> {
     }
 
     /// The event of a sampled model at `time` = its next sample (or the end of its samples).
-    fn sample(&mut self, clock: &mut SampleClock, time: f64) -> OpResult<EventUpdate> {
+    pub(super) fn sample(&mut self, clock: &mut SampleClock, time: f64) -> OpResult<EventUpdate> {
         self.core.iteration_pending = false;
         if !clock.has_next() {
             return err(format!("no sample after sample {} at t = {time} s", clock.next));
@@ -157,6 +157,9 @@ impl<M: Model> Instance<M> {
                 )));
             }
             clock.check_resolution(end).map_err(ModelError::Discard)?;
+        }
+        if self.clocked {
+            self.check_no_activation_before(current_time, end)?;
         }
         self.core.time = current_time;
         self.settle_events()?;

@@ -18,7 +18,9 @@ impl<M: Model> Instance<M> {
             // FMI 3.0 has no stepFailed state: a Discarded fmi3DoStep stays in Step Mode
             Machine::StepFailed if self.generation == Generation::Fmi3 => false,
             Machine::StepComplete | Machine::StepFailed => self.context.interface == Interface::CoSimulation,
-            Machine::EventMode | Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,
+            // Co-Simulation with Event Mode: a clocked FMI 3.0 instance
+            Machine::EventMode => self.context.interface == Interface::ModelExchange || self.clocked,
+            Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,
             _ => true,
         };
         if !fits {
@@ -108,8 +110,9 @@ impl<M: Model> Instance<M> {
         } else {
             None
         };
-        let clock = Self::consistent_clock(&model, initialized, clock, next_sample, time, next_event, presample)
-            .map_err(|e| ModelError::Error(format!("serialized state: {e}")))?;
+        let clock =
+            Self::consistent_clock(&model, initialized, clock, next_sample, time, next_event, presample, self.clocked)
+                .map_err(|e| ModelError::Error(format!("serialized state: {e}")))?;
         Ok(Core {
             machine,
             time,
@@ -120,6 +123,8 @@ impl<M: Model> Instance<M> {
             model,
             clock,
             presample,
+            // an activation of the clock is not part of a state: the importer activates it again
+            clock_active: false,
             pre_event: None,
         })
     }
@@ -129,6 +134,7 @@ impl<M: Model> Instance<M> {
     /// parameters; the sample count is an integer within the model's samples; the time
     /// lies between the last sample run and the next; the next event is the next sample
     /// (or the end of the samples) to the bit; "before the first sample" is "no sample run".
+    #[allow(clippy::too_many_arguments)]
     fn consistent_clock(
         model: &M,
         initialized: bool,
@@ -137,6 +143,7 @@ impl<M: Model> Instance<M> {
         time: f64,
         next_event: Option<f64>,
         presample: bool,
+        clocked: bool,
     ) -> Result<Option<SampleClock>, String> {
         let period = model.sample_period();
         let Some(mut clock) = clock else {
@@ -185,7 +192,8 @@ impl<M: Model> Instance<M> {
                 clock.next
             ));
         }
-        let expected = clock.next_event();
+        // a clocked instance's samples are the importer's activations, no time events
+        let expected = if clocked { None } else { clock.next_event() };
         if next_event.map(f64::to_bits) != expected.map(f64::to_bits) {
             return Err(format!(
                 "the next event time {next_event:?} s disagrees with the sample clock: sample {} is due at {:?} s",

@@ -11,6 +11,7 @@
 //! (partial derivatives and variable dependencies), `fmu_state` (save, restore,
 //! serialize).
 
+mod clocks;
 mod derivatives;
 mod events;
 mod fmu_state;
@@ -21,6 +22,7 @@ use crate::decl::{Declaration, Start};
 use crate::model::{InstantiateContext, Interface, Model, ModelError};
 use crate::sampled::{instant_tolerance, SampleClock};
 pub use crate::states::{Function, Generation, Machine, Scope};
+pub use clocks::IntervalQualifier;
 use values::CallMemos;
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
@@ -49,6 +51,9 @@ pub struct Core<M> {
     /// A sampled model before its sample 0: reads of its discrete outputs run sample 0
     /// on a copy of the model.
     pub presample: bool,
+    /// FMI 3.0 with a declared clock: the importer activated it (`fmi3SetClock`) at this
+    /// instant and `fmi3UpdateDiscreteStates` has not ended the activation yet.
+    pub clock_active: bool,
     /// Co-Simulation: the instance before the events at the current time were run
     /// (lazily, at the first read or step). Setting an input afterwards restores it, so
     /// the events see the inputs of their own time instant. Held inline (not boxed): a
@@ -79,6 +84,7 @@ impl<M: Model> Core<M> {
             model,
             clock: None,
             presample,
+            clock_active: false,
             pre_event: None,
         }
     }
@@ -93,6 +99,9 @@ pub struct Instance<M: Model> {
     /// The C API the instance was created by: only its functions pass the gate.
     pub generation: Generation,
     pub core: Core<M>,
+    /// An FMI 3.0 instance of a model with a clock: the samples run at the importer's
+    /// activations of the clock (`fmi3SetClock`), not at time events of the layer's own.
+    pub clocked: bool,
     /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
     /// through (0 for another interface's function or a capability the model did not
     /// declare): the gate of every call as one table lookup; the reasons come from the
@@ -127,6 +136,7 @@ impl<M: Model> Instance<M> {
         let allowed = Function::ALL.map(|f| Self::allowed_states(generation, context.interface, f));
         Ok(Instance {
             allowed,
+            clocked: generation == Generation::Fmi3 && decl::<M>().clock().is_some(),
             generation,
             get_memo: CallMemos::new(),
             set_memo: CallMemos::new(),
@@ -207,15 +217,22 @@ impl<M: Model> Instance<M> {
                 Generation::Fmi3 => "not available: this instance was created by an fmi3Instantiate function (FMI 3.0)",
             });
         }
-        if let Some(missing) = function.undeclared_feature() {
+        // a model with a clock offers the clock functions and, in Co-Simulation, Event Mode
+        // (an FMI 3.0 instance of it is created with eventModeUsed = true: see abi::fmi3)
+        let clocked = decl::<M>().clock().is_some();
+        let event_mode_cs = clocked && interface == Interface::CoSimulation;
+        let declared_by_clock =
+            (clocked && function.is_clock_function()) || (event_mode_cs && function == Function::Fmi3EnterStepMode);
+        if let Some(missing) = function.undeclared_feature().filter(|_| !declared_by_clock) {
             return err(format!("not supported: {missing}"));
         }
-        if interface == Interface::CoSimulation
-            && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates)
-        {
+        let cs_event_mode_call = interface == Interface::CoSimulation
+            && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates);
+        if cs_event_mode_call && !event_mode_cs {
             return err("not available: this Co-Simulation FMU declares no Event Mode (hasEventMode is false)");
         }
         match (function.scope(), interface) {
+            (Scope::ModelExchange, Interface::CoSimulation) if cs_event_mode_call => {}
             (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
                 return err(format!("not available: this instance was created for {interface:?}"));
             }
@@ -312,17 +329,22 @@ impl<M: Model> Instance<M> {
             }
             None => None,
         };
+        if self.clocked {
+            self.check_clock_interval(clock.map(|c| c.period))?;
+        }
         self.core.model.exit_initialization()?;
         if let Some(clock) = clock {
             self.core.clock = Some(clock);
             self.core.presample = true;
         }
         self.core.machine = match self.context.interface {
-            Interface::CoSimulation => Machine::StepComplete,
-            Interface::ModelExchange => Machine::EventMode,
+            // Co-Simulation with Event Mode (a clocked FMU) starts in Event Mode too
+            Interface::CoSimulation if !self.clocked => Machine::StepComplete,
+            _ => Machine::EventMode,
         };
-        // the initial event, at the start time
-        self.core.next_event = Some(start);
+        // the initial event, at the start time; a clocked instance's samples are the
+        // importer's activations of its clock, no time events of the layer's
+        self.core.next_event = (!self.clocked).then_some(start);
         Ok(())
     }
 

@@ -38,6 +38,10 @@ impl<M: Model> Instance<M> {
     /// `fmi2NewDiscreteStates`: one event iteration when a time event is due (or the
     /// model asked for another); the next event time for the importer.
     pub fn new_discrete_states(&mut self) -> OpResult<EventUpdate> {
+        if self.clocked {
+            self.end_clock_activation()?;
+            return Ok(EventUpdate { terminate_simulation: self.core.terminate_requested, ..Default::default() });
+        }
         let now = self.core.time;
         let due = matches!(self.core.next_event, Some(te) if te <= now + time_eps(now));
         if due || self.core.iteration_pending {

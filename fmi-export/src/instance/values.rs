@@ -148,7 +148,11 @@ impl<M: Model> Instance<M> {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
-        self.settle_events()?;
+        if self.clocked {
+            self.settle_clock(BaseType::Real, vrs)?;
+        } else {
+            self.settle_events()?;
+        }
         if self.core.presample {
             return self.get_real_presample(vrs, out);
         }
@@ -197,7 +201,11 @@ impl<M: Model> Instance<M> {
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
         let d = decl::<M>();
         Self::check_rows(d, BaseType::Integer, vrs)?;
-        self.settle_events()?;
+        if self.clocked {
+            self.settle_clock(BaseType::Integer, vrs)?;
+        } else {
+            self.settle_events()?;
+        }
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Integer, vr)?;
             *o = self.core.model.get_integer(d.hot(row).binding)?;
@@ -208,7 +216,11 @@ impl<M: Model> Instance<M> {
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
         let d = decl::<M>();
         Self::check_rows(d, BaseType::Boolean, vrs)?;
-        self.settle_events()?;
+        if self.clocked {
+            self.settle_clock(BaseType::Boolean, vrs)?;
+        } else {
+            self.settle_events()?;
+        }
         for (o, &vr) in out.iter_mut().zip(vrs) {
             let row = Self::row_in(d, BaseType::Boolean, vr)?;
             *o = self.core.model.get_boolean(d.hot(row).binding)?;

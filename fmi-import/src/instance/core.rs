@@ -94,6 +94,9 @@ impl Core {
             Status::Error | Status::Pending | Status::Invalid(_) => self.state = InstanceState::Errored,
             Status::Fatal => self.state = InstanceState::Fatal,
         }
+        if let Some((needed, available)) = self.host.as_mut().and_then(|h| h.over_limit.take()) {
+            return Err(Error::IsolationLimit { instance: self.name.clone(), function, needed, available });
+        }
         if let Some(cause) = self.host.as_ref().and_then(|h| h.failure.clone()) {
             let time = time.unwrap_or(self.host.as_ref().map_or(0.0, |h| h.last_time));
             return Err(Error::Host { instance: self.name.clone(), function, time, cause });
@@ -139,6 +142,23 @@ pub(crate) trait Calls: Send {
     ) -> Result<i32>;
     /// The reset function's name.
     fn reset_name(&self) -> &'static str;
+    /// FMI 3.0: Configuration Mode for the structural parameters the FMU was configured
+    /// with, in Instantiated (after instantiation and after a reset).
+    fn configure(&mut self, _core: &mut Core) -> Result<()> {
+        Ok(())
+    }
+    /// FMI 3.0 Scheduled Execution (`instance/scheduled.rs`); other interfaces: an error.
+    fn activate_model_partition(&mut self, core: &mut Core, _clock: u32, _time: f64) -> Result<bool> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
+    /// See [`Calls::activate_model_partition`].
+    fn countdown_interval(&mut self, core: &mut Core, _clock: u32) -> Result<Option<f64>> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
+    /// See [`Calls::activate_model_partition`].
+    fn output_clock_ticked(&mut self, core: &mut Core, _clock: u32) -> Result<bool> {
+        Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
+    }
     /// The name of the function that starts the experiment (for a call out of order).
     fn setup_function(&self) -> &'static str;
     /// `fmi2SetupExperiment`; FMI 3.0 keeps the arguments for initialization.

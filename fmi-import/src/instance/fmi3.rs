@@ -33,6 +33,9 @@ pub(crate) struct Fmi3 {
     /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
+    /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
+    /// the FMU's for as long as the instance lives).
+    scheduled: Option<Box<super::scheduled::ScheduledEnvironment>>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -53,7 +56,13 @@ impl Fmi3 {
             bytes: Vec::new(),
             arrays: HashMap::new(),
             event_mode: std::cell::Cell::new(event_mode),
+            scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
         }
+    }
+
+    /// The FMU's table and description.
+    pub(super) fn abi(&self) -> &Fmi3Abi {
+        &self.a
     }
 
     /// The access of the view's variable `vr` when it is not a plain scalar.
@@ -134,7 +143,7 @@ impl Fmi3 {
 
     /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
     /// whole and in their type's range).
-    fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
+    pub(super) fn set_all(&mut self, core: &mut Core, access: Access, values: &[f64]) -> Result<()> {
         use model_description::fmi3::ValueType as T;
         let c = core.component;
         let name = core
@@ -281,6 +290,12 @@ impl Fmi3 {
     }
 }
 
+/// The error of a Scheduled Execution call on an instance of another interface.
+#[cold]
+pub(super) fn not_scheduled(name: &str) -> Error {
+    Error::Instance { name: name.into(), reason: "it is not instantiated for Scheduled Execution (--interface se)" }
+}
+
 #[cold]
 fn not_exact(core: &Core, function: &'static str, vr: u32, value: i128) -> Error {
     Error::Fmi {
@@ -298,6 +313,7 @@ impl Calls for Fmi3 {
         match interface {
             Interface::CoSimulation => "fmi3InstantiateCoSimulation",
             Interface::ModelExchange => "fmi3InstantiateModelExchange",
+            Interface::ScheduledExecution => "fmi3InstantiateScheduledExecution",
         }
     }
 
@@ -345,6 +361,10 @@ impl Calls for Fmi3 {
                 // SAFETY: as above.
                 unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
             }
+            Interface::ScheduledExecution => match self.scheduled.as_deref() {
+                Some(scheduled) => self.instantiate_scheduled(fmu, name, name_c, log, scheduled)?,
+                None => return Err(not_scheduled(name)),
+            },
         };
         if component.is_null() && fmu.interface == Interface::CoSimulation && self.event_mode.get() {
             // an FMU that declares hasEventMode may still refuse eventModeUsed (the Reference
@@ -366,12 +386,39 @@ impl Calls for Fmi3 {
         channel: &mut crate::isolate::channel::Channel,
         name_c: &CString,
     ) -> Result<i32> {
+        if fmu.interface == Interface::ScheduledExecution {
+            return Err(Error::Instance {
+                name: String::from_utf8_lossy(name_c.as_bytes()).into_owned(),
+                reason: "Scheduled Execution is not run in a host process (its callbacks are this process's): run it without isolation",
+            });
+        }
         let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());
         Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
     }
 
     fn reset_name(&self) -> &'static str {
         "fmi3Reset"
+    }
+
+    fn configure(&mut self, core: &mut Core) -> Result<()> {
+        self.configure_structural(core)
+    }
+
+    fn activate_model_partition(&mut self, core: &mut Core, clock: u32, time: f64) -> Result<bool> {
+        let scheduled = self.scheduled.take().ok_or_else(|| not_scheduled(&core.name))?;
+        let r = self.activate(core, &scheduled, clock, time);
+        self.scheduled = Some(scheduled);
+        r
+    }
+
+    fn countdown_interval(&mut self, core: &mut Core, clock: u32) -> Result<Option<f64>> {
+        self.scheduled.as_ref().ok_or_else(|| not_scheduled(&core.name))?;
+        self.changed_interval(core, clock)
+    }
+
+    fn output_clock_ticked(&mut self, core: &mut Core, clock: u32) -> Result<bool> {
+        self.scheduled.as_ref().ok_or_else(|| not_scheduled(&core.name))?;
+        self.clock_ticked(core, clock)
     }
 
     fn setup_function(&self) -> &'static str {

@@ -4,9 +4,11 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod configuration;
 pub(crate) mod core;
 mod fmi2;
 mod fmi3;
+mod scheduled;
 
 use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
@@ -57,7 +59,9 @@ fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
 
 impl Instance {
     /// `fmi2Instantiate` / `fmi3Instantiate*` with the FMU's interface, logging off
-    /// (warnings and errors are still logged by the FMU and kept).
+    /// (warnings and errors are still logged by the FMU and kept); an FMU
+    /// [configured](Fmu::configured) with structural parameters then goes through
+    /// Configuration Mode to set them.
     pub fn new(fmu: &Arc<Fmu>, name: &str) -> Result<Instance> {
         if fmu.is_isolated() {
             return Err(Error::Instance {
@@ -70,7 +74,9 @@ impl Instance {
         let callbacks = callbacks_for(&log);
         let calls = calls_of(fmu);
         let component = calls.instantiate(fmu, name, &name_c, &callbacks, &log)?;
-        Ok(Instance::with(component, calls, name, name_c, log, callbacks, fmu.clone(), None))
+        let mut instance = Instance::with(component, calls, name, name_c, log, callbacks, fmu.clone(), None);
+        instance.calls.configure(&mut instance.core)?;
+        Ok(instance)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -122,13 +128,22 @@ impl Instance {
             cause: HostEnd::Failed(m),
         };
         let host = crate::isolate::channel::find_host(isolation.host.as_deref()).map_err(failed)?;
-        let variables = fmu.description.model_variables.len();
+        // the region holds the largest call this FMU can make: every scalar value (array
+        // elements one by one), every event indicator, the instantiation's strings (the
+        // resource URI: the folder's path percent-encoded, 3 bytes a byte at most)
+        let md = &fmu.description;
+        let strings = name.len() + md.guid.len() + 3 * fmu.unpacked_dir().as_os_str().len() + 64;
+        let layout = crate::isolate::protocol::Layout::for_fmu(
+            md.model_variables.len(),
+            md.number_of_event_indicators as usize,
+            strings,
+        );
         let mut channel = Box::new(
             crate::isolate::channel::Channel::start(
                 &host,
                 &fmu.library_path,
                 calls.is_fmi3(),
-                variables,
+                layout,
                 isolation.call_timeout,
                 run_deadline,
                 crate::isolate::protocol::Spin::of_run(),
@@ -148,6 +163,9 @@ impl Instance {
         channel.log = &*log as *const LogSink;
         let status = calls.instantiate_in(&fmu, &mut channel, &name_c)?;
         if status != 0 {
+            if let Some((needed, available)) = channel.over_limit.take() {
+                return Err(Error::IsolationLimit { instance: name.into(), function: instantiate, needed, available });
+            }
             if let Some(cause) = channel.failure.clone() {
                 return Err(Error::Host { instance: name.into(), function: instantiate, time: 0.0, cause });
             }
@@ -159,7 +177,9 @@ impl Instance {
         }
         let callbacks = callbacks_for(&log);
         let component = &mut *channel as *mut crate::isolate::channel::Channel as *mut c_void;
-        Ok(Instance::with(component, calls, name, name_c, log, callbacks, fmu, Some(channel)))
+        let mut instance = Instance::with(component, calls, name, name_c, log, callbacks, fmu, Some(channel));
+        instance.calls.configure(&mut instance.core)?;
+        Ok(instance)
     }
 
     /// The instance name.
@@ -223,7 +243,8 @@ impl Instance {
         Ok(())
     }
 
-    /// `fmi2Reset` / `fmi3Reset`: back to instantiated (also after an error).
+    /// `fmi2Reset` / `fmi3Reset`: back to instantiated (also after an error; a configured
+    /// FMU's structural parameters set again in Configuration Mode).
     pub fn reset(&mut self) -> Result<()> {
         if self.core.state == InstanceState::Fatal {
             let function = self.calls.reset_name();
@@ -237,7 +258,8 @@ impl Instance {
         drop(mark);
         self.core.state = InstanceState::Instantiated;
         self.calls.forget_run();
-        self.core.status(function, raw, None)
+        self.core.status(function, raw, None)?;
+        self.calls.configure(&mut self.core)
     }
 
     /// `fmi2GetReal` / `fmi3GetFloat64` of `vrs` into `values` (same length). A NaN or
@@ -480,8 +502,24 @@ impl Instance {
     }
 }
 
-impl Drop for Instance {
-    fn drop(&mut self) {
+impl Instance {
+    /// Terminates (if not yet) and frees the instance, as dropping it does; for an
+    /// isolated instance, the end of its host process during the free (an FMU that
+    /// crashes in its free function) is the error, naming the function.
+    pub fn free(mut self) -> Result<()> {
+        let failed_before = self.core.host.as_ref().is_some_and(|h| h.failure.is_some());
+        self.release();
+        let function = self.calls.free_functions().2;
+        let cause = self.core.host.as_ref().and_then(|h| h.failure.clone()).filter(|_| !failed_before);
+        // freed: the drop calls nothing more
+        self.core.state = InstanceState::Fatal;
+        match cause {
+            Some(cause) => Err(Error::Host { instance: self.core.name.clone(), function, time: self.core.time, cause }),
+            None => Ok(()),
+        }
+    }
+
+    fn release(&mut self) {
         if self.core.state == InstanceState::Fatal {
             return; // the standard: nothing may be called after a fatal error
         }
@@ -495,7 +533,15 @@ impl Drop for Instance {
             }
         }
         let _mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
-        // SAFETY: the component came from the instantiate call and is freed once.
+        // SAFETY: the component came from the instantiate call and is freed once (the
+        // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };
+        self.core.state = InstanceState::Fatal;
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        self.release();
     }
 }

@@ -49,6 +49,9 @@ pub(crate) struct Channel {
     process: HostProcess,
     /// The host's end, once known (it is then reaped).
     pub(crate) failure: Option<HostEnd>,
+    /// A call refused before it was made because its data (bytes) exceed what the region
+    /// holds (bytes): taken by the status of that call.
+    pub(crate) over_limit: Option<(usize, usize)>,
     reaped: bool,
     seq: u32,
     call_timeout: Option<Duration>,
@@ -90,18 +93,17 @@ pub(crate) struct Channel {
 unsafe impl Send for Channel {}
 
 impl Channel {
-    /// Starts `host` for the library `library` (an FMI 3.0 one if `fmi3`) of an FMU of
-    /// `variables` variables.
+    /// Starts `host` for the library `library` (an FMI 3.0 one if `fmi3`) with the region
+    /// laid out as `layout` ([`Layout::for_fmu`]).
     pub(crate) fn start(
         host: &Path,
         library: &Path,
         fmi3: bool,
-        variables: usize,
+        layout: Layout,
         call_timeout: Option<Duration>,
         run_deadline: Option<(Instant, Duration)>,
         spin: Spin,
     ) -> Result<Channel, HostEnd> {
-        let layout = Layout::for_variables(variables);
         let region = SharedRegion::create(c"nigel-cosim-host", layout.total).map_err(HostEnd::Failed)?;
         let base = region.base();
         // SAFETY: the fresh mapping starts with a zeroed Header; the host is not started yet.
@@ -111,6 +113,7 @@ impl Channel {
             h.host_yield_every = spin.yield_every;
             h.host_adaptive = u32::from(spin.adaptive);
             h.fmi3 = u32::from(fmi3);
+            h.arrays = layout.data_len as u64;
         }
         let mut command = std::process::Command::new(host);
         command
@@ -126,6 +129,7 @@ impl Channel {
             _region: region,
             process,
             failure: None,
+            over_limit: None,
             reaped: false,
             seq: 0,
             call_timeout,
@@ -277,6 +281,7 @@ impl Channel {
             h.op = op as u32;
             h.log_count = 0;
             h.log_bytes = 0;
+            h.answer_needs = 0;
             h.prefetched = 0;
             h.queued = queued;
             h.queued_bytes = queued_bytes;
@@ -348,6 +353,9 @@ impl Channel {
             return FATAL;
         }
         self.read_log();
+        if hdr.answer_needs != 0 {
+            self.over_limit = Some((hdr.answer_needs as usize, self.layout.data_len));
+        }
         let mut status = hdr.status;
         if hdr.queued_failed != u32::MAX {
             let function = self.queued_functions.get(hdr.queued_failed as usize).copied().unwrap_or("fmi2Set*");
@@ -497,7 +505,10 @@ pub fn null_round_trips(
     let spin = Spin::of_run();
     let mut channels = Vec::new();
     for _ in 0..hosts {
-        channels.push(Channel::start(host, library, false, 16, None, None, spin).map_err(|e| e.to_string())?);
+        channels.push(
+            Channel::start(host, library, false, Layout::for_fmu(16, 0, 0), None, None, spin)
+                .map_err(|e| e.to_string())?,
+        );
     }
     let start = Instant::now();
     for _ in 0..n {

@@ -70,8 +70,14 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
             return 2;
         }
     };
-    // the layout is a function of the size the master chose
-    let layout = layout_of(size);
+    // the layout the master chose, from the header it wrote before starting the host
+    // SAFETY: the mapping starts with the Header, written before this process started.
+    let arrays = unsafe { (*(base as *const Header)).arrays } as usize;
+    let layout = Layout::with_area(arrays);
+    if layout.total != size {
+        eprintln!("cosim-host: the region's size {size} is not that of its layout ({})", layout.total);
+        return 2;
+    }
     let region = Region { base, layout };
     let log = Box::<LogSink>::default();
     let library = Path::new(library);
@@ -157,18 +163,6 @@ fn state_handle(slot: &mut i64, call: impl FnOnce(&mut *mut c_void) -> i32) -> i
     let status = call(&mut state);
     *slot = state as usize as i64;
     status
-}
-
-fn layout_of(size: usize) -> Layout {
-    // the master sized the region with Layout::for_variables; find the same layout
-    let mut v = 16;
-    loop {
-        let l = Layout::for_variables(v);
-        if l.total >= size {
-            return l;
-        }
-        v = (v * 2).max(v + 1);
-    }
 }
 
 fn wait_next(region: &Region, seen: &mut u32, gauge: &mut SpinGauge) {
@@ -502,10 +496,12 @@ impl Host {
                     let mut values: Vec<*const u8> = vec![std::ptr::null(); n_values];
                     let s = g(c, vrs, n, sizes.as_mut_ptr(), values.as_mut_ptr(), n_values);
                     let mut p = after_vrs + 8 * n_values;
+                    let needs = p + sizes.iter().sum::<usize>();
+                    if needs > l.data_len {
+                        h.answer_needs = needs as u64;
+                        return 3;
+                    }
                     for (k, (size, value)) in sizes.iter().zip(&values).enumerate() {
-                        if p + size > l.data_len {
-                            return 3;
-                        }
                         *(data.add(after_vrs + 8 * k) as *mut u64) = *size as u64;
                         if *size > 0 && !value.is_null() {
                             std::ptr::copy_nonoverlapping(*value, data.add(p), *size);
@@ -558,11 +554,14 @@ unsafe fn get_strings(region: &Region, n: usize, call: impl FnOnce(*mut *const c
     let mut ptrs: Vec<*const c_char> = vec![std::ptr::null(); n];
     let s = call(ptrs.as_mut_ptr());
     let mut p = (4 * n).div_ceil(8) * 8;
+    let text = |q: *const c_char| if q.is_null() { &[][..] } else { CStr::from_ptr(q).to_bytes() };
+    let needs = p + ptrs.iter().map(|q| text(*q).len() + 1).sum::<usize>();
+    if needs > region.layout.data_len {
+        region.header().answer_needs = needs as u64;
+        return 3;
+    }
     for q in ptrs {
-        let bytes = if q.is_null() { &[][..] } else { CStr::from_ptr(q).to_bytes() };
-        if p + bytes.len() + 1 > region.layout.data_len {
-            return 3;
-        }
+        let bytes = text(q);
         std::ptr::copy_nonoverlapping(bytes.as_ptr(), data.add(p), bytes.len());
         *data.add(p + bytes.len()) = 0;
         p += bytes.len() + 1;

@@ -157,14 +157,22 @@ pub(crate) struct Header {
     pub(crate) prefetched: u32,
     /// 1: the library is an FMI 3.0 one (set by the master before the host starts).
     pub(crate) fmi3: u32,
+    /// The bytes of each array area ([`Layout::with_area`]; set by the master before the
+    /// host starts, which lays the region out from it).
+    pub(crate) arrays: u64,
     /// Array lengths and scalar arguments of the call.
     pub(crate) n: u64,
     pub(crate) f: [f64; 4],
     pub(crate) i: [i64; 4],
+    /// Set by the host when the FMU's answer (strings, binaries) did not fit the data
+    /// area: the bytes it takes (0: it fit).
+    pub(crate) answer_needs: u64,
     /// Messages logged during the call, and the bytes they take in the log area.
     pub(crate) log_count: u32,
     pub(crate) log_bytes: u32,
 }
+
+const PAGE: usize = 4096;
 
 /// Layout of the region: the header, the call's arrays, the queued sets, the prefetch,
 /// the log. Sized from the FMU's numbers of variables and states.
@@ -182,17 +190,24 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
-    /// For an FMU of `variables` variables (bounding any one call's arrays: 12 bytes per
-    /// value with its reference; strings get 64 KiB more).
-    pub(crate) fn for_variables(variables: usize) -> Layout {
-        let page = 4096;
-        let round = |x: usize| x.div_ceil(page) * page;
-        let arrays = round(16 * variables.max(16) + (64 << 10));
+    /// For calls whose arrays (references and values, or an instantiation's strings) take
+    /// at most `arrays` bytes: each array area that plus 64 KiB (strings, alignment), in
+    /// whole pages; the log area what the host's log keeps.
+    pub(crate) fn for_bytes(arrays: usize) -> Layout {
+        Layout::with_area(arrays.saturating_add(64 << 10).div_ceil(PAGE) * PAGE)
+    }
+
+    /// With each array area `arrays` bytes (a whole number of pages, as the header's
+    /// [`Header::arrays`] gives it to the host).
+    pub(crate) fn with_area(arrays: usize) -> Layout {
+        let page = PAGE;
         let data = page;
         let sets = data + arrays;
         let prefetch = sets + arrays;
         let log = prefetch + arrays;
-        let log_len = 256 << 10;
+        // the host's log keeps at most CAPACITY messages, each bounded: all fit
+        let record = 12 + crate::log::MAX_CATEGORY_BYTES + crate::log::MAX_MESSAGE_BYTES + 64;
+        let log_len = (crate::log::LogSink::CAPACITY * record).div_ceil(page) * page;
         Layout {
             data,
             data_len: arrays,
@@ -204,6 +219,14 @@ impl Layout {
             log_len,
             total: log + log_len,
         }
+    }
+
+    /// For an FMU of `values` scalar values (array elements counted one by one) and
+    /// `indicators` event indicators, and an instantiation whose strings take `strings`
+    /// bytes: 16 bytes per value or indicator (8 for the value, 4 for its reference, and
+    /// room for a call that gives both), and the strings.
+    pub(crate) fn for_fmu(values: usize, indicators: usize, strings: usize) -> Layout {
+        Layout::for_bytes((16 * values.max(indicators).max(16)).max(strings))
     }
 }
 

@@ -31,8 +31,14 @@ pub(super) fn vrs_into(channel: &mut Channel, vrs: &[u32]) -> usize {
     (4 * vrs.len()).div_ceil(8) * 8
 }
 
+/// Whether a call whose data take `bytes` fits the region; if not, the channel keeps the
+/// sizes for the error ([`Channel::over_limit`]: the master's limit, not the FMU's error).
 pub(super) fn fits(channel: &mut Channel, bytes: usize) -> bool {
-    bytes <= channel.data().len()
+    let available = channel.data().len();
+    if bytes > available {
+        channel.over_limit = Some((bytes, available));
+    }
+    bytes <= available
 }
 
 pub(super) unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {

@@ -491,7 +491,14 @@ impl ModelDescription {
             .map(|v| v.value_reference)
             .collect();
         let listed: BTreeSet<u32> = ms.initial_unknowns.iter().map(|u| u.value_reference).collect();
-        if expected != listed || listed.len() != ms.initial_unknowns.len() {
+        // a clocked variable is an InitialUnknown only if the FMU initializes it in
+        // Initialization Mode (FMI 3.0.2 section 2.4.8): listed or not, both are right
+        let clocked: BTreeSet<u32> =
+            self.model_variables.iter().filter(|v| !v.clocks.is_empty()).map(|v| v.value_reference).collect();
+        let listed_unclocked: BTreeSet<u32> = listed.difference(&clocked).copied().collect();
+        let expected_unclocked: BTreeSet<u32> = expected.difference(&clocked).copied().collect();
+        let extra_clocked = listed.intersection(&clocked).any(|vr| !expected.contains(vr));
+        if expected_unclocked != listed_unclocked || extra_clocked || listed.len() != ms.initial_unknowns.len() {
             push(
                 Rule::InitialUnknowns,
                 None,

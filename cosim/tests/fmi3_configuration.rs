@@ -1,0 +1,176 @@
+//! FMI 3.0 Configuration Mode: a structural parameter set with `--set` (or
+//! [`SystemBuilder::set`]) goes through `fmi3EnterConfigurationMode` / the setter /
+//! `fmi3ExitConfigurationMode` right after instantiation, and the arrays it sizes have the
+//! new size in the master's view and the results. The C FMU `tests/cfmu/fmi3_sized.c`
+//! (y[i] = k[i] u t after each step, k and y of size n, n set in Configuration Mode only,
+//! every array get and set checked for exactly n values) against values derived by hand,
+//! fmpy 0.3.32's low-level calls, and the PMSF `DynamicArrayTest` of the corpus when
+//! the corpus is there (`common::corpus`).
+
+mod common;
+use common::fmi3_c::python;
+use common::work_dir;
+use nigel_cosim::{simulate, Experiment, Fmu, SystemBuilder, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="sized" instantiationToken="{fmi3-sized}">
+  <CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <UInt64 name="n" valueReference="1" causality="structuralParameter" variability="fixed" start="2" min="1" max="100"/>
+    <Float64 name="k" valueReference="2" causality="parameter" variability="fixed" start="1"><Dimension valueReference="1"/></Float64>
+    <Float64 name="u" valueReference="3" causality="input" start="1"/>
+    <Float64 name="y" valueReference="4" causality="output" variability="discrete" initial="calculated"><Dimension valueReference="1"/></Float64>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="4"/>
+    <InitialUnknown valueReference="4"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+
+fn sized(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let dir = work_dir(test);
+    let fmu = common::fmi3_c::build(&dir, "fmi3_sized", XML)?;
+    Some((dir, fmu))
+}
+
+/// The values of the columns `names` at each row of a run of `fmu` with the settings
+/// `sets` (`name`, text) to 1 s in steps of 0.5 s.
+fn run(fmu: &Path, sets: &[(&str, &str)]) -> nigel_cosim::Result<Vec<Vec<f64>>> {
+    let mut b = SystemBuilder::new();
+    b.add_instance("c", Fmu::load(fmu).unwrap()).unwrap();
+    for (name, text) in sets {
+        b.set_text(&format!("c.{name}"), text)?;
+    }
+    let system = b.build();
+    let (result, _) = simulate(&system, &Experiment::new(1.0, 0.5))?;
+    let names: Vec<String> = system
+        .description(0)
+        .model_variables
+        .iter()
+        .filter(|v| v.name.starts_with("y["))
+        .map(|v| v.name.clone())
+        .collect();
+    Ok((0..result.rows()).map(|r| names.iter().map(|n| result.column(n).unwrap()[r]).collect()).collect())
+}
+
+/// n = 4, k = [1 2 3 4], u = 2: y[i] = k[i] u t is [1 2 3 4] at 0.5 s and [2 4 6 8] at 1 s
+/// (exact: small integers times 0.5 and 1); before the first step y is all 0 (the FMU's
+/// arrays start at 0), four columns, not the two of n's start value.
+#[test]
+fn a_structural_parameter_sizes_its_arrays_through_configuration_mode() {
+    let Some((_dir, fmu)) = sized("fmi3-configuration") else { return };
+    let rows = run(&fmu, &[("n", "4"), ("k", "[1, 2, 3, 4]"), ("u", "2")]).unwrap();
+    assert_eq!(rows, vec![vec![0.0; 4], vec![1.0, 2.0, 3.0, 4.0], vec![2.0, 4.0, 6.0, 8.0]]);
+    // without it: n = 2, k = [1 1], u = 1: y = [t t]
+    let rows = run(&fmu, &[]).unwrap();
+    assert_eq!(rows, vec![vec![0.0; 2], vec![0.5, 0.5], vec![1.0, 1.0]]);
+}
+
+/// Values set before the structural parameter stay set, found again by name in the new
+/// view: k = [3 5] then n = 3 gives k = [3 5 1] (the FMU's 1 for the new element), so y at
+/// 1 s (u = 1) is [3 5 1]. An element the new size no longer has is refused naming it;
+/// a size that is no whole number of the type, or beyond `max`, is refused too.
+#[test]
+fn values_set_before_are_kept_and_a_lost_element_or_a_bad_size_is_refused() {
+    let Some((_dir, fmu)) = sized("fmi3-configuration-order") else { return };
+    let rows = run(&fmu, &[("k", "[3, 5]"), ("n", "3")]).unwrap();
+    assert_eq!(rows[2], vec![3.0, 5.0, 1.0]);
+    let e = run(&fmu, &[("k", "[3, 5]"), ("n", "1")]).unwrap_err().to_string();
+    assert!(e.contains("k[2] is set or connected, and the arrays n sizes no longer have it"), "{e}");
+    let e = run(&fmu, &[("n", "2.5")]).unwrap_err().to_string();
+    assert!(e.contains("not a whole number of UInt64"), "{e}");
+    let e = run(&fmu, &[("n", "101")]).unwrap_err().to_string();
+    assert!(e.contains("outside its range [1, 100]"), "{e}");
+}
+
+/// fmpy 0.3.32 driving the same FMU through its low-level calls (Configuration Mode, n = 3,
+/// k = [2 3 4], u = 0.5, two steps of 0.5 s) reads the same y at 1 s as `cosim run` writes,
+/// bit for bit; `cosim info` names the parameter and the arrays it sizes.
+#[test]
+fn cosim_run_equals_fmpy_low_level_calls_and_info_lists_the_parameter() {
+    let Some((dir, fmu)) = sized("fmi3-configuration-fmpy") else { return };
+    let script = r#"
+import sys, zipfile, tempfile
+from fmpy.fmi3 import FMU3Slave
+d = tempfile.mkdtemp()
+zipfile.ZipFile(sys.argv[1]).extractall(d)
+s = FMU3Slave(guid='{fmi3-sized}', unzipDirectory=d, modelIdentifier='fmi3_sized', instanceName='c')
+s.instantiate()
+s.enterConfigurationMode()
+s.setUInt64([1], [3])
+s.exitConfigurationMode()
+s.setFloat64([2], [2.0, 3.0, 4.0])
+s.setFloat64([3], [0.5])
+s.enterInitializationMode(startTime=0.0)
+s.exitInitializationMode()
+s.doStep(0.0, 0.5)
+s.doStep(0.5, 0.5)
+print(' '.join(repr(x) for x in s.getFloat64([4], nValues=3)))
+s.terminate()
+s.freeInstance()
+"#;
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<f64> =
+        String::from_utf8_lossy(&out.stdout).split_whitespace().map(|x| x.parse().unwrap()).collect();
+    // k[i] u t at 1 s
+    assert_eq!(theirs, [1.0, 1.5, 2.0]);
+    let csv = dir.join("out.csv");
+    let cosim = env!("CARGO_BIN_EXE_cosim");
+    let fmu_arg = fmu.to_str().unwrap();
+    let args = ["run", fmu_arg, "--stop-time", "1", "--step", "0.5", "--set", "n=3", "--set", "k=[2,3,4]"];
+    let out = Command::new(cosim).args(args).args(["--set", "u=0.5", "-o", csv.to_str().unwrap()]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.contains(r#""y[1]","y[2]","y[3]""#) && !header.contains("y[4]"), "{header}");
+    let last: Vec<f64> = lines.last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    let columns: Vec<&str> = header.split(',').map(|h| h.trim_matches('"')).collect();
+    let ours: Vec<f64> =
+        ["y[1]", "y[2]", "y[3]"].iter().map(|n| last[columns.iter().position(|c| c == n).unwrap()]).collect();
+    assert_eq!(ours, theirs);
+    let info = Command::new(cosim).args(["info", fmu_arg]).output().unwrap();
+    let info = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        info.lines().any(|l| l
+            == "structural parameter n (fixed, start 2, sizes k, y): set with --set n=VALUE, in Configuration Mode"),
+        "{info}"
+    );
+}
+
+/// The PMSF `DynamicArrayTest` (output = input * parameter, element by element, at each
+/// step; arrays XSize x YSize, 4 x 3 by default) with XSize = 6, the parameter 0 .. 17 and
+/// the input 2: 18 elements, the output 2 k for element k (0-based, row-major) after the
+/// first step. Skipped without the corpus.
+#[test]
+fn the_corpus_dynamic_array_test_records_18_elements_with_xsize_6() {
+    let fmu = common::fmi3_c::corpus().join("fmi3/cs/PMSF-FMI30TestFMUs/DynamicArrayTest/DynamicArrayTest.fmu");
+    if !fmu.is_file() {
+        eprintln!("{} not there: skipped", fmu.display());
+        return;
+    }
+    let parameter: Vec<String> = (0..18).map(|k| k.to_string()).collect();
+    let mut b = SystemBuilder::new();
+    b.add_instance("m", Fmu::load(&fmu).unwrap()).unwrap();
+    b.set("m.XSize", Value::Real(6.0)).unwrap();
+    b.set_text("m.Float64Parameter", &format!("[{}]", parameter.join(","))).unwrap();
+    b.set_text("m.Float64Input", &format!("[{}]", vec!["2"; 18].join(","))).unwrap();
+    let system = b.build();
+    let (result, _) = simulate(&system, &Experiment::new(0.04, 0.02)).unwrap();
+    let outputs: Vec<&str> = system
+        .description(0)
+        .model_variables
+        .iter()
+        .filter(|v| v.name.starts_with("Float64Output["))
+        .map(|v| v.name.as_str())
+        .collect();
+    assert_eq!(outputs.len(), 18);
+    assert_eq!((outputs[0], outputs[17]), ("Float64Output[1,1]", "Float64Output[6,3]"));
+    let after_first_step: Vec<f64> = outputs.iter().map(|n| result.column(n).unwrap()[1]).collect();
+    assert_eq!(after_first_step, (0..18).map(|k| 2.0 * k as f64).collect::<Vec<_>>());
+}

@@ -1,0 +1,251 @@
+//! FMI 3.0 clocks: the declared clock ([`crate::ClockDecl`]) of a sampled model as a
+//! periodic input clock the importer activates.
+//!
+//! The samples of a clocked instance are the importer's activations: it enters Event Mode
+//! at `t_k = start + k interval` (the layer's [`crate::sampled::SampleClock`] counts `k`),
+//! sets the inputs of `t_k`, activates the clock with `fmi3SetClock`, reads the clocked
+//! outputs and ends the activation with `fmi3UpdateDiscreteStates`. The sample
+//! ([`crate::Model::sample`]) runs at the first read while the clock is active, or at
+//! `fmi3UpdateDiscreteStates`, with the inputs set by then; an input set after the sample
+//! ran undoes it (it runs again at the next read), as the lazy events of Co-Simulation do
+//! for FMI 2.0: so the sample `k` of a clocked instance is the FMI 2.0 one to the bit.
+//! Clocked variables can be read only while their clock is active (and in Initialization
+//! Mode), as FMI 3.0 section 2.2.9 says; a step past an activation, an activation at
+//! another time than the next `t_k` and deactivating the clock (`canBeDeactivated` is
+//! false) are errors naming the clock and the times.
+
+use super::{decl, err, time_eps, Instance, OpResult, PreEvent};
+use crate::decl::{BaseType, ClockDecl, ClockInterval};
+use crate::model::Model;
+use crate::states::Machine;
+
+/// How `fmi3GetIntervalDecimal` qualifies an interval (FMI 3.0 `fmi3IntervalQualifier`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntervalQualifier {
+    /// `fmi3IntervalUnchanged`: the interval the importer knows stands.
+    Unchanged,
+    /// `fmi3IntervalChanged`: an interval the importer did not know before.
+    Changed,
+}
+
+impl<M: Model> Instance<M> {
+    /// The declared clock (the gate lets the clock functions through only when there is one).
+    fn declared_clock() -> OpResult<(&'static ClockDecl, u32)> {
+        match decl::<M>().clock() {
+            Some(c) => Ok(c),
+            None => err("no clock is declared"),
+        }
+    }
+
+    /// Each of `vrs` is the clock's value reference; the reason naming the variable if not.
+    fn check_clock_references(vrs: &[u32]) -> OpResult<&'static ClockDecl> {
+        let (clock, clock_vr) = Self::declared_clock()?;
+        for &vr in vrs {
+            if vr != clock_vr {
+                let what = match decl::<M>().variable3(vr) {
+                    Some(v) => format!("{}, a {} variable", v.name, v.value_type.element()),
+                    None => "no variable".to_string(),
+                };
+                return err(format!(
+                    "value reference {vr} is {what}, not a clock (the FMU's clock is {}, value reference {clock_vr})",
+                    clock.name
+                ));
+            }
+        }
+        Ok(clock)
+    }
+
+    /// When initialization ends: the model is sampled, and a constant interval is its
+    /// sample period to the bit.
+    pub(super) fn check_clock_interval(&self, period: Option<f64>) -> OpResult {
+        let (clock, _) = Self::declared_clock()?;
+        let Some(period) = period else {
+            return err(format!("clock {} is declared, but the model answers no sample period", clock.name));
+        };
+        match clock.interval {
+            ClockInterval::Constant(t) if t.to_bits() != period.to_bits() => {
+                err(format!("the sample period {period} s is not the constant interval {t} s of clock {}", clock.name))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// `fmi3SetClock`: activates the clock at its next activation time (a clock that
+    /// cannot be deactivated refuses `fmi3ClockInactive` while active).
+    pub fn set_clock(&mut self, vrs: &[u32], active: &[bool]) -> OpResult {
+        let clock = Self::check_clock_references(vrs)?;
+        for &on in active {
+            if on == self.core.clock_active {
+                continue;
+            }
+            if !on {
+                return err(format!(
+                    "{} cannot be deactivated (canBeDeactivated is false): fmi3UpdateDiscreteStates ends its \
+                     activation",
+                    clock.name
+                ));
+            }
+            let Some(samples) = self.core.clock.filter(|c| c.has_next()) else {
+                return err(format!("{} has no activation after its last at t = {} s", clock.name, self.core.time));
+            };
+            let now = self.core.time;
+            let due = samples.time_of(samples.next);
+            if (now - due).abs() > time_eps(now) {
+                return err(format!(
+                    "{} activated at t = {now} s, but its next activation is at t = {due} s (activation {}: \
+                     start {} s + {} x {} s)",
+                    clock.name, samples.next, samples.start, samples.next, samples.period
+                ));
+            }
+            self.core.clock_active = true;
+        }
+        Ok(())
+    }
+
+    /// `fmi3GetClock`: whether the clock is active.
+    pub fn get_clock(&self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+        Self::check_clock_references(vrs)?;
+        out.fill(self.core.clock_active);
+        Ok(())
+    }
+
+    /// `fmi3GetIntervalDecimal`: the clock's interval; a fixed interval (from a parameter) is
+    /// new to the importer in Initialization Mode and unchanged afterwards, a constant one
+    /// is always unchanged (the importer read it from the description).
+    pub fn clock_intervals(&self, vrs: &[u32], out: &mut [(f64, IntervalQualifier)]) -> OpResult {
+        let clock = Self::check_clock_references(vrs)?;
+        let value = match (clock.interval, self.core.clock) {
+            (ClockInterval::Constant(t), _) => (t, IntervalQualifier::Unchanged),
+            (ClockInterval::Fixed, Some(samples)) => (samples.period, IntervalQualifier::Unchanged),
+            (ClockInterval::Fixed, None) => match self.core.model.sample_period() {
+                Some(t) if t > 0.0 && t.is_finite() => (t, IntervalQualifier::Changed),
+                other => {
+                    return err(format!(
+                        "the interval of {} is the sample period, which is {other:?} s: not finite and > 0",
+                        clock.name
+                    ))
+                }
+            },
+        };
+        out.fill(value);
+        Ok(())
+    }
+
+    /// `fmi3GetShiftDecimal`: the first activation is at the start time (shift 0).
+    pub fn clock_shifts(&self, vrs: &[u32], out: &mut [f64]) -> OpResult {
+        Self::check_clock_references(vrs)?;
+        out.fill(0.0);
+        Ok(())
+    }
+
+    /// `fmi3SetIntervalDecimal`/`Fraction`, `fmi3SetShiftDecimal`/`Fraction`: the clock's
+    /// interval and shift are the FMU's, not the importer's.
+    pub fn refuse_clock_timing(&self, vrs: &[u32]) -> OpResult {
+        let clock = Self::check_clock_references(vrs)?;
+        let kind = match clock.interval {
+            ClockInterval::Constant(_) => "constant, declared by intervalDecimal",
+            ClockInterval::Fixed => "fixed, the sample period, without intervalDecimal",
+        };
+        err(format!(
+            "the interval and shift of {} are the FMU's (intervalVariability: {kind}; shift 0): read them with \
+             fmi3GetIntervalDecimal and fmi3GetShiftDecimal",
+            clock.name
+        ))
+    }
+
+    /// `fmi3GetIntervalFraction`, `fmi3GetShiftFraction`: not offered.
+    pub fn refuse_clock_fraction(&self, vrs: &[u32]) -> OpResult {
+        let clock = Self::check_clock_references(vrs)?;
+        err(format!("{} declares supportsFraction = false: use the Decimal functions", clock.name))
+    }
+
+    /// Before a read of a clocked instance: the sample of an active clock runs (once per
+    /// activation, with the inputs set by then; a later set undoes it), and a clocked
+    /// variable of `rows` is refused while its clock is inactive.
+    pub(super) fn settle_clock(&mut self, base_type: BaseType, vrs: &[u32]) -> OpResult {
+        if self.core.clock_active {
+            return self.sample_at_activation();
+        }
+        if matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode) {
+            return Ok(());
+        }
+        let d = decl::<M>();
+        for &vr in vrs {
+            if let Some(row) = d.row(base_type, vr).filter(|&row| d.is_clocked(row)) {
+                let (clock, _) = Self::declared_clock()?;
+                return err(format!(
+                    "{} is a clocked variable of {}, which is not active: it can be read only while its clock is \
+                     (in Event Mode, between fmi3SetClock and fmi3UpdateDiscreteStates)",
+                    d.variable(row).name,
+                    clock.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The sample of the current activation, unless it ran (the model from before it is kept
+    /// to undo it when an input is set afterwards).
+    fn sample_at_activation(&mut self) -> OpResult {
+        if self.core.pre_event.is_some() {
+            return Ok(());
+        }
+        let c = &self.core;
+        self.core.pre_event = Some(PreEvent {
+            model: c.model.clone(),
+            next_event: c.next_event,
+            clock: c.clock,
+            presample: c.presample,
+            terminate_requested: c.terminate_requested,
+        });
+        let now = self.core.time;
+        self.core.model.set_time(now);
+        let Some(mut samples) = self.core.clock else { return err("the sample clock is not running") };
+        self.sample(&mut samples, now)?;
+        // the next activation is the importer's to make: no time event
+        self.core.next_event = None;
+        Ok(())
+    }
+
+    /// `fmi3UpdateDiscreteStates` of a clocked instance: the sample of an active clock, then
+    /// the end of its activation. No time events: the next activation is the importer's.
+    pub(super) fn end_clock_activation(&mut self) -> OpResult {
+        if self.core.clock_active {
+            self.sample_at_activation()?;
+            self.core.pre_event = None;
+            self.core.clock_active = false;
+        }
+        Ok(())
+    }
+
+    /// `fmi3EnterStepMode`: from Event Mode with the clock's activation ended.
+    pub fn enter_step_mode(&mut self) -> OpResult {
+        if self.core.clock_active {
+            let (clock, _) = Self::declared_clock()?;
+            return err(format!(
+                "{} is still active: fmi3UpdateDiscreteStates ends its activation before Step Mode",
+                clock.name
+            ));
+        }
+        self.core.machine = Machine::StepComplete;
+        Ok(())
+    }
+
+    /// Before a step of a clocked Co-Simulation instance from `current` to `end`: no
+    /// activation of the clock is due before `end` (the importer steps to it and activates
+    /// the clock in Event Mode).
+    pub(super) fn check_no_activation_before(&self, current: f64, end: f64) -> OpResult {
+        let Some(samples) = self.core.clock.filter(|c| c.has_next()) else { return Ok(()) };
+        let due = samples.time_of(samples.next);
+        if due < end - time_eps(end) {
+            let (clock, _) = Self::declared_clock()?;
+            return err(format!(
+                "the step from {current} s to {end} s passes activation {} of {} at t = {due} s: step to it, then \
+                 activate the clock in Event Mode (fmi3EnterEventMode, fmi3SetClock, fmi3UpdateDiscreteStates, \
+                 fmi3EnterStepMode)",
+                samples.next, clock.name
+            ));
+        }
+        Ok(())
+    }
+}

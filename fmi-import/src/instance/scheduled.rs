@@ -1,0 +1,176 @@
+//! FMI 3.0 Scheduled Execution (section 5): `fmi3InstantiateScheduledExecution` with the
+//! `clockUpdate`, `lockPreemption` and `unlockPreemption` callbacks, and the calls a
+//! scheduler makes on the instance: [`Instance::activate_model_partition`], the interval of
+//! a countdown clock once the FMU has signalled it ([`Instance::countdown_interval`]), and
+//! whether an output clock ticked ([`Instance::output_clock_ticked`]).
+//!
+//! The instance environment the FMU passes to its callbacks is a [`ScheduledEnvironment`]
+//! the instance owns (boxed: its address stays put while the FMU lives): the log sink, and
+//! the flag `clockUpdate` raises. The master activates one partition at a time on one
+//! thread, so nothing preempts a partition: `lockPreemption` and `unlockPreemption` have
+//! nothing to lock, and the results do not depend on timing.
+
+use std::ffi::{c_void, CString};
+use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
+
+use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3Status, fmi3String};
+
+use super::core::{call, Core};
+use super::fmi3::Fmi3;
+use super::Instance;
+use crate::c_types::Component;
+use crate::error::{Error, Result};
+use crate::fmu::Fmu;
+use crate::log::LogSink;
+
+/// What the FMU's callbacks receive as their instance environment in Scheduled Execution.
+#[derive(Debug, Default)]
+pub(crate) struct ScheduledEnvironment {
+    /// The instance's log sink (set at instantiation; it outlives the FMU instance).
+    log: AtomicPtr<LogSink>,
+    /// Raised by `clockUpdate`: an output clock ticked or a countdown clock's interval is
+    /// known; taken by the master after the activation that raised it.
+    clock_update: AtomicBool,
+}
+
+/// `fmi3LogMessageCallback` of Scheduled Execution: on to the instance's log sink.
+unsafe extern "C" fn log_message(
+    environment: fmi3InstanceEnvironment,
+    status: fmi3Status,
+    category: fmi3String,
+    message: fmi3String,
+) {
+    if environment.is_null() {
+        return;
+    }
+    // SAFETY: the environment is the instance's boxed ScheduledEnvironment, alive while
+    // the FMU lives; the log sink it holds outlives the FMU.
+    let sink = unsafe { &*(environment as *const ScheduledEnvironment) }.log.load(Ordering::Relaxed);
+    // SAFETY: as `crate::log::log_message` takes it (its own catch_unwind inside).
+    unsafe { crate::log::log_message(sink as *mut c_void, status, category, message) };
+}
+
+/// `fmi3ClockUpdateCallback`: raises the flag (an atomic store: nothing here can panic).
+unsafe extern "C" fn clock_update(environment: fmi3InstanceEnvironment) {
+    if environment.is_null() {
+        return;
+    }
+    // SAFETY: as in `log_message`.
+    unsafe { &*(environment as *const ScheduledEnvironment) }.clock_update.store(true, Ordering::Release);
+}
+
+/// `fmi3LockPreemptionCallback`: nothing to lock (one partition at a time, one thread).
+unsafe extern "C" fn lock_preemption() {}
+
+/// `fmi3UnlockPreemptionCallback`: see [`lock_preemption`].
+unsafe extern "C" fn unlock_preemption() {}
+
+impl Fmi3 {
+    /// `fmi3InstantiateScheduledExecution` (logging off, the messages to `log`), the
+    /// callbacks' environment `environment`.
+    pub(super) fn instantiate_scheduled(
+        &self,
+        fmu: &Fmu,
+        name: &str,
+        name_c: &CString,
+        log: &LogSink,
+        environment: &ScheduledEnvironment,
+    ) -> Result<Component> {
+        let a = self.abi();
+        let function = "fmi3InstantiateScheduledExecution";
+        let f = a
+            .functions
+            .instantiate_scheduled_execution
+            .ok_or(Error::MissingSymbol { path: fmu.source.clone(), symbol: function })?;
+        environment.log.store(log as *const LogSink as *mut LogSink, Ordering::Relaxed);
+        let env = environment as *const ScheduledEnvironment as *mut c_void;
+        let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+        // SAFETY: every pointer is valid for the call; the environment (owned by the
+        // instance's calls, boxed) and the log outlive the FMU instance.
+        Ok(unsafe {
+            f(
+                name_c.as_ptr(),
+                a.token.as_ptr(),
+                a.resource_path.as_ptr(),
+                0,
+                0,
+                env,
+                Some(log_message),
+                Some(clock_update),
+                Some(lock_preemption),
+                Some(unlock_preemption),
+            )
+        })
+    }
+
+    /// `fmi3ActivateModelPartition(clock, time)`; whether the FMU called `clockUpdate`
+    /// during it.
+    pub(super) fn activate(
+        &mut self,
+        core: &mut Core,
+        environment: &ScheduledEnvironment,
+        clock: u32,
+        time: f64,
+    ) -> Result<bool> {
+        let f = core.optional(self.abi().functions.activate_model_partition, "fmi3ActivateModelPartition")?;
+        let c = core.component;
+        environment.clock_update.store(false, Ordering::Release);
+        core.time = time;
+        call!(core, "fmi3ActivateModelPartition", Some(time), f(c, clock, time))?;
+        Ok(environment.clock_update.swap(false, Ordering::Acquire))
+    }
+
+    /// `fmi3GetIntervalDecimal` of `clock`: the interval when its qualifier is
+    /// `fmi3IntervalChanged`, else `None`.
+    pub(super) fn changed_interval(&mut self, core: &mut Core, clock: u32) -> Result<Option<f64>> {
+        let f = core.optional(self.abi().functions.get_interval_decimal, "fmi3GetIntervalDecimal")?;
+        let c = core.component;
+        let (mut interval, mut qualifier) = (0.0, fmi_sys::fmi3::FMI3_INTERVAL_NOT_YET_KNOWN);
+        call!(core, "fmi3GetIntervalDecimal", None, f(c, &clock, 1, &mut interval, &mut qualifier))?;
+        if qualifier != fmi_sys::fmi3::FMI3_INTERVAL_CHANGED {
+            return Ok(None);
+        }
+        if !(interval.is_finite() && interval >= 0.0) {
+            core.state = super::core::InstanceState::Errored;
+            let time = core.time;
+            return Err(core.error(
+                "fmi3GetIntervalDecimal",
+                time,
+                format!("the interval of clock {clock} is {interval} s (a countdown is finite and not negative)"),
+            ));
+        }
+        Ok(Some(interval))
+    }
+
+    /// `fmi3GetClock` of the output clock `clock`: whether it ticked.
+    pub(super) fn clock_ticked(&mut self, core: &mut Core, clock: u32) -> Result<bool> {
+        let f = core.optional(self.abi().functions.get_clock, "fmi3GetClock")?;
+        let c = core.component;
+        let mut value = 0u8;
+        call!(core, "fmi3GetClock", None, f(c, &clock, 1, &mut value))?;
+        Ok(value != 0)
+    }
+}
+
+impl Instance {
+    /// Scheduled Execution: `fmi3ActivateModelPartition` of the partition of the input
+    /// clock `clock` (its value reference) at `time`; whether the FMU signalled
+    /// `clockUpdate` (an output clock ticked or a countdown clock's interval is known: ask
+    /// [`Instance::output_clock_ticked`] and [`Instance::countdown_interval`]).
+    pub fn activate_model_partition(&mut self, clock: u32, time: f64) -> Result<bool> {
+        self.calls.activate_model_partition(&mut self.core, clock, time)
+    }
+
+    /// Scheduled Execution: the interval of the countdown clock `clock` when the FMU has
+    /// set it since it was last asked (`fmi3GetIntervalDecimal` with
+    /// `fmi3IntervalChanged`), s; else `None`.
+    pub fn countdown_interval(&mut self, clock: u32) -> Result<Option<f64>> {
+        self.calls.countdown_interval(&mut self.core, clock)
+    }
+
+    /// Scheduled Execution: whether the output clock `clock` ticked (`fmi3GetClock`, which
+    /// resets it).
+    pub fn output_clock_ticked(&mut self, clock: u32) -> Result<bool> {
+        self.calls.output_clock_ticked(&mut self.core, clock)
+    }
+}

@@ -1,0 +1,178 @@
+//! FMI 3.0 structural parameters: [`Fmu::configured`] is the FMU with some of them set, its
+//! view (see [`crate::fmi3`]) computed with the new values, so that the arrays they size
+//! have the new size for the master (connections, results); its instances set them in
+//! Configuration Mode before initialization (`instance/configuration.rs`).
+//! [`structural_parameters`] lists them with the arrays each sizes (for `cosim info`).
+
+use std::sync::Arc;
+
+use model_description::fmi3;
+
+use crate::error::{Error, Result};
+use crate::fmi3::Access;
+use crate::fmu::{Abi, Fmu};
+
+/// A structural parameter of an FMI 3.0 FMU and the arrays whose size it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StructuralParameter {
+    /// Its name.
+    pub name: String,
+    /// `fixed` or `tunable` (tunable ones may change in Reconfiguration Mode too).
+    pub variability: &'static str,
+    /// Its start value, as written (`None`: the description gives none).
+    pub start: Option<String>,
+    /// The names of the arrays with a `<Dimension valueReference>` naming it.
+    pub sizes: Vec<String>,
+}
+
+/// The structural parameters of `md`, in document order.
+pub fn structural_parameters(md: &fmi3::ModelDescription) -> Vec<StructuralParameter> {
+    md.model_variables
+        .iter()
+        .filter(|v| v.causality == fmi3::Causality::StructuralParameter)
+        .map(|p| StructuralParameter {
+            name: p.name.clone(),
+            variability: p.variability.as_str(),
+            start: p.start.as_ref().map(|s| match s {
+                fmi3::Values::Float(x) => x.iter().map(f64::to_string).collect::<Vec<_>>().join(" "),
+                fmi3::Values::Int(x) => x.iter().map(i128::to_string).collect::<Vec<_>>().join(" "),
+                fmi3::Values::Boolean(x) => x.iter().map(bool::to_string).collect::<Vec<_>>().join(" "),
+                fmi3::Values::String(x) => x.join(" "),
+                fmi3::Values::Binary(x) => format!("{} binary values", x.len()),
+            }),
+            sizes: md
+                .model_variables
+                .iter()
+                .filter(|a| a.dimensions.contains(&fmi3::Dimension::Variable(p.value_reference)))
+                .map(|a| a.name.clone())
+                .collect(),
+        })
+        .collect()
+}
+
+/// The start value of the scalar structural parameter `v` for `value`, checked: a whole
+/// number in its type's range for the integer types, within its `min` and `max`.
+fn checked_value(instance: &str, v: &fmi3::Variable, value: f64) -> Result<fmi3::Values> {
+    use fmi3::ValueType as T;
+    let bad = |reason: String| Error::InvalidValue {
+        variable: format!("{instance}.{}", v.name),
+        value: value.to_string(),
+        reason,
+    };
+    if v.is_array() {
+        return Err(bad("an array structural parameter is not set by cosim (only scalars)".into()));
+    }
+    let (lowest, highest): (i128, i128) = match v.value_type {
+        T::Int8 => (i8::MIN.into(), i8::MAX.into()),
+        T::UInt8 => (0, u8::MAX.into()),
+        T::Int16 => (i16::MIN.into(), i16::MAX.into()),
+        T::UInt16 => (0, u16::MAX.into()),
+        T::Int32 => (i32::MIN.into(), i32::MAX.into()),
+        T::UInt32 => (0, u32::MAX.into()),
+        // beyond 2^53 the value is not held exactly as the f64 it arrives as
+        T::Int64 | T::UInt64 => (if v.value_type == T::UInt64 { 0 } else { -(1 << 53) }, 1 << 53),
+        T::Float32 | T::Float64 => {
+            let below = matches!(v.min, Some(fmi3::Bound::Float(m)) if value < m);
+            let above = matches!(v.max, Some(fmi3::Bound::Float(m)) if value > m);
+            if below || above || !value.is_finite() {
+                return Err(bad(format!("outside its range [{:?}, {:?}]", v.min, v.max)));
+            }
+            return Ok(fmi3::Values::Float(vec![value]));
+        }
+        other => return Err(bad(format!("a {other:?} structural parameter is not set by cosim"))),
+    };
+    let whole = value as i128;
+    if whole as f64 != value || whole < lowest || whole > highest {
+        return Err(bad(format!("not a whole number of {:?} (from {lowest} to {highest})", v.value_type)));
+    }
+    let min = match v.min {
+        Some(fmi3::Bound::Int(m)) => m.max(lowest),
+        _ => lowest,
+    };
+    let max = match v.max {
+        Some(fmi3::Bound::Int(m)) => m.min(highest),
+        _ => highest,
+    };
+    if whole < min || whole > max {
+        return Err(bad(format!("outside its range [{min}, {max}]")));
+    }
+    Ok(fmi3::Values::Int(vec![whole]))
+}
+
+impl Fmu {
+    /// This FMI 3.0 FMU with the structural parameters `values` (name, value) set for the
+    /// instance `instance` (named in errors): its view is that of the new values (an array
+    /// a parameter sizes has the new number of elements, named and reached as any array),
+    /// and its instances enter Configuration Mode before initialization to set them
+    /// (`fmi3EnterConfigurationMode`, the setters, `fmi3ExitConfigurationMode`). Values set
+    /// on an FMU configured before add to (or replace) its earlier ones.
+    pub fn configured(self: &Arc<Fmu>, instance: &str, values: &[(&str, f64)]) -> Result<Arc<Fmu>> {
+        let Abi::Fmi3(a) = &self.abi else {
+            let name = values.first().map_or("", |(n, _)| *n);
+            return Err(Error::InvalidValue {
+                variable: format!("{instance}.{name}"),
+                value: String::new(),
+                reason: "structural parameters are FMI 3.0's; this FMU is an FMI 2.0 one".into(),
+            });
+        };
+        let mut md = a.description.clone();
+        let mut configuration = a.configuration.clone();
+        for (name, value) in values {
+            let v = md
+                .model_variables
+                .iter_mut()
+                .find(|v| v.name == *name && v.causality == fmi3::Causality::StructuralParameter)
+                .ok_or_else(|| Error::InvalidValue {
+                    variable: format!("{instance}.{name}"),
+                    value: value.to_string(),
+                    reason: "not a structural parameter of the FMU".into(),
+                })?;
+            if !matches!(v.variability, fmi3::Variability::Fixed | fmi3::Variability::Tunable) {
+                return Err(Error::InvalidValue {
+                    variable: format!("{instance}.{name}"),
+                    value: value.to_string(),
+                    reason: format!("a {} structural parameter cannot be set", v.variability.as_str()),
+                });
+            }
+            v.start = Some(checked_value(instance, v, *value)?);
+            let access = Access { vr: v.value_reference, value_type: v.value_type, element: 0, count: 1 };
+            configuration.retain(|(set, _)| set.vr != access.vr);
+            configuration.push((access, *value));
+        }
+        let (view, special, not_in_view) = crate::fmi3::fmi2_view(&md);
+        let abi = crate::fmi3::Fmi3Abi {
+            functions: a.functions,
+            description: md,
+            special,
+            token: a.token.clone(),
+            resource_path: a.resource_path.clone(),
+            configuration,
+        };
+        let root = self.configured_from.clone().unwrap_or_else(|| self.clone());
+        Ok(Arc::new(Fmu {
+            abi: Abi::Fmi3(Arc::new(abi)),
+            allow_non_finite: self.allow_non_finite,
+            _library: self._library.clone(),
+            description: view,
+            interface: self.interface,
+            source: self.source.clone(),
+            origin: self.origin.clone(),
+            resource_uri: self.resource_uri.clone(),
+            dir: None,
+            isolated_from: None,
+            library_path: self.library_path.clone(),
+            not_in_view,
+            configured_from: Some(root),
+        }))
+    }
+
+    /// The structural parameters this FMU was [configured](Fmu::configured) with (name,
+    /// value), in the order they were set.
+    pub fn configuration(&self) -> Vec<(String, f64)> {
+        let Abi::Fmi3(a) = &self.abi else { return Vec::new() };
+        a.configuration
+            .iter()
+            .filter_map(|(access, x)| a.description.variable(access.vr).map(|v| (v.name.clone(), *x)))
+            .collect()
+    }
+}
