@@ -55,7 +55,12 @@ wine_cosim() {
         -u DISPLAY -u WAYLAND_DISPLAY wine "$(dir $windows)/cosim.exe" "$@"
 }
 wine_cosim run "$(wine_path "$ssp")" "${run_args[@]:2}" --output "$(wine_path "$work/windows.csv")"
-python3 "$repo/scripts/compare-platform-csv.py" "$work/reference.csv" "$work/windows.csv" "x86-64 Windows (wine)"
+windows_line=$(python3 "$repo/scripts/compare-platform-csv.py" "$work/reference.csv" "$work/windows.csv" "x86-64 Windows (wine)")
+echo "$windows_line"
+# docs/platforms.md prints the count of differing values: it must be this run's
+counts=$(echo "$windows_line" | python3 -c 'import re,sys; m=re.search(r"(\d+) of (\d+) values", sys.stdin.read()); print(f"{int(m[1]):,} of\n{int(m[2]):,}" if m else "byte-equal")')
+tr '\n' ' ' <"$repo/docs/platforms.md" | grep -qF "$(echo "$counts" | tr '\n' ' ' | sed 's/ $//; s/of /of the /')" \
+    || { echo "test-dist: docs/platforms.md does not print this run's count ($counts)" >&2; exit 1; }
 # --isolate is refused on Windows, naming the platform, before anything loads
 if wine_cosim run "$(wine_path "$ssp")" --stop-time 1 --isolate 2>"$work/windows-isolate.err"; then
     echo "test-dist: cosim.exe --isolate exited 0" >&2
