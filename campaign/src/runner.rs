@@ -117,7 +117,7 @@ impl<'a> Worker<'a> {
             // the metrics: every row after the first, the communication points t_1 .. t_N;
             // the checks: every row, t_0 .. t_N (as `cosim run --check`)
             let mut first = true;
-            let mut sink = |_t: f64, row: &[f64]| {
+            let mut sink = |_t: f64, row: &[f64], _: &[(usize, String)]| {
                 judge.push(row);
                 if first {
                     first = false;

@@ -528,7 +528,7 @@ impl Spec {
         // only the model descriptions are needed here: the FMUs' libraries are not loaded
         // (a library that crashes while loading ends a worker process, not the campaign)
         let (loaded, start_time) = load_system_and_start(&system, true).map_err(bad)?;
-        if !(stop_time >= start_time + step) {
+        if !start_time.is_finite() || stop_time < start_time + step {
             return Err(bad(format!(
                 "need start time + step <= stop_time, got start time {start_time} s{}, step {step}, stop_time {stop_time}",
                 if start_time != 0.0 { " (the SSD's DefaultExperiment)" } else { "" }

@@ -11,11 +11,14 @@
 //! differences is the dense output between steps.
 //!
 //! The right-hand side and its Jacobian come from an [`OdeSystem`]: the master's group
-//! of Model Exchange instances (`simulate/me_group/bdf.rs`) or, in tests, a closure.
+//! of Model Exchange instances (`simulate/me_group/system.rs`) or, in tests, a closure. It is
+//! one of the master's [`Integrator`]s.
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
 use crate::error::{Error, Result};
+use crate::integrator::{Integrator, Start};
+pub use crate::integrator::{OdeSystem, Work};
 use nalgebra::DMatrix;
 
 /// The highest order.
@@ -29,33 +32,6 @@ const MAX_FACTOR: f64 = 10.0;
 /// The NDF modifications kappa of the BDF of each order (Shampine and Reichelt, table 1;
 /// order 1 is Klopfenstein's NDF1 modification, 0 keeps the plain BDF).
 const KAPPA: [f64; MAX_ORDER + 1] = [0.0, -0.1850, -1.0 / 9.0, -0.0823, -0.0415, 0.0];
-
-/// A right-hand side x' = f(t, x) and its Jacobian df/dx.
-pub trait OdeSystem {
-    /// f(t, x) into `dx`.
-    fn rhs(&mut self, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()>;
-    /// The Jacobian at (t, x), where f(t, x) = `f`, into `jac` (n x n, zero outside the
-    /// pattern the system declares).
-    fn jacobian(&mut self, t: f64, x: &[f64], f: &[f64], jac: &mut DMatrix<f64>) -> Result<()>;
-}
-
-/// The work of the method: what a `--summary` reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Work {
-    /// Right-hand side evaluations (Newton iterations, starting steps, and those of
-    /// finite-difference Jacobians).
-    pub rhs: u64,
-    /// Of `rhs`, those of finite-difference Jacobians (one per column group).
-    pub jacobian_rhs: u64,
-    /// Jacobians evaluated.
-    pub jacobians: u64,
-    /// LU factorizations of `I - c J`.
-    pub factorizations: u64,
-    /// Accepted steps.
-    pub steps: u64,
-    /// Rejected attempts (error too large or Newton not converging).
-    pub rejected: u64,
-}
 
 /// The BDF integrator of one system of `n` states.
 #[derive(Debug)]
@@ -487,6 +463,44 @@ impl Bdf {
             last_norm = Some(dy_norm);
         }
         Ok((false, NEWTON_MAX_ITERATIONS))
+    }
+}
+
+/// The interface of the event loop: a start after an event is [`Bdf::restart`] (order 1,
+/// the Jacobian and the step asked for kept) once the method has taken a step, else
+/// [`Bdf::start`]; steps pass communication points where nothing changes (the history is
+/// worth keeping).
+impl Integrator for Bdf {
+    fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, x: &[f64], h_max: f64, _why: Start) -> Result<()> {
+        if self.work.steps == 0 {
+            Bdf::start(self, sys, t, x, h_max)
+        } else {
+            Bdf::restart(self, sys, t, x, h_max)
+        }
+    }
+
+    fn step(&mut self, sys: &mut dyn OdeSystem, t_limit: f64) -> Result<()> {
+        Bdf::step(self, sys, t_limit)
+    }
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn state(&self) -> &[f64] {
+        Bdf::state(self)
+    }
+
+    fn interpolate(&self, s: f64, out: &mut [f64]) {
+        Bdf::interpolate(self, s, out)
+    }
+
+    fn steps_past_points(&self) -> bool {
+        true
+    }
+
+    fn work(&self) -> Work {
+        self.work
     }
 }
 

@@ -39,18 +39,20 @@ pub mod bdf;
 pub mod check;
 pub mod compare;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{fmi3, instance, load, partitions, structural, unpack};
+pub use fmi_import::{clocks, fmi3, instance, load, partitions, structural, unpack};
 /// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
 /// [`load`] in one place, as the master uses them).
 pub mod fmu {
     pub use fmi_import::fmu::*;
-    pub use fmi_import::instance::{FmuState, Instance, InstanceState};
+    pub use fmi_import::instance::{FmuState, Instance, InstanceState, Interval, OutputTick};
     pub use fmi_import::load::{read_fmi3_description, read_model_description};
     pub use fmi_import::EventInfo;
 }
 pub mod defaults;
 pub mod error;
 pub mod exit_guard;
+pub mod info;
+pub mod integrator;
 pub mod junit;
 pub mod loops;
 pub mod mat;

@@ -1,9 +1,10 @@
 //! Algebraic loops of a system at initialization: a cycle of connections closed through
 //! FMUs whose connected outputs depend directly on their connected inputs (by the model
 //! description's InitialUnknowns, else its Outputs; no dependency list: on every input).
-//! The run carries each connection once at initialization (no fixed-point iteration), so
-//! a value on such a loop can enter `fmi2ExitInitializationMode` short of its converged
-//! value: [`initialization_loop`] finds one such loop for the run to say so.
+//! A value on such a loop enters `fmi2ExitInitializationMode` at its converged value only
+//! if the connections are carried until they settle: [`initialization_loop`] finds one
+//! such loop, and the run then iterates the connections to their fixed point in
+//! Initialization Mode (`simulate::init_loop`), saying so in a note.
 
 use crate::system::System;
 use std::collections::HashMap;

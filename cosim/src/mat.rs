@@ -112,7 +112,11 @@ mod tests {
 
     #[test]
     fn dymola_layout() {
-        let r = Results { names: vec!["x".into(), "plant.v_x".into()], values: vec![0.0, 1.0, 2.0, 0.5, -1.5, 1e-300] };
+        let r = Results {
+            names: vec!["x".into(), "plant.v_x".into()],
+            values: vec![0.0, 1.0, 2.0, 0.5, -1.5, 1e-300],
+            exact: Vec::new(),
+        };
         let mut bytes = Vec::new();
         r.write_mat(&mut bytes, &["".into(), "speed".into()]).unwrap();
         let m = matrices(&bytes);

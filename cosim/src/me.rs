@@ -1,6 +1,7 @@
-//! Model Exchange FMUs integrated by the master: the numerics of one instance, fixed-step
-//! RK4 and adaptive Dormand-Prince 5(4), event indicators and the location of a state
-//! event (an indicator changing sign) by the Illinois method to [`EVENT_TIME_TOLERANCE`].
+//! Model Exchange FMUs integrated by the master: the solvers ([`Solver`], each an
+//! [`Integrator`] of [`crate::integrator`]), the calls of one instance the integration
+//! makes (derivatives, event indicators) and its counts, and the Illinois method that
+//! locates a state event (an indicator changing sign) to [`EVENT_TIME_TOLERANCE`].
 //!
 //! Over a communication step the FMU's inputs are held (as for a Co-Simulation FMU),
 //! so an ME instance takes part in `jacobi` and `ordered` systems like a CS one. The
@@ -8,10 +9,9 @@
 //! one integrator of a group of ME instances (`simulate/me_group.rs`): an instance
 //! connected to no other ME instance is a group of one.
 
-#![allow(clippy::needless_range_loop)] // index loops read like the formulas
-
 use crate::error::Result;
 use crate::fmu::Instance;
+use crate::integrator::{dopri5::Dopri5, rk4::Rk4, Integrator};
 
 /// Width of the time bracket an event is located to, s.
 pub const EVENT_TIME_TOLERANCE: f64 = 1e-11;
@@ -70,6 +70,17 @@ impl Solver {
     }
 }
 
+impl Solver {
+    /// The integrator of this method for a system of `n` states.
+    pub fn integrator(&self, n: usize) -> Box<dyn Integrator> {
+        match *self {
+            Solver::Rk4 { max_step } => Box::new(Rk4::new(n, max_step)),
+            Solver::Dopri5 { rtol, atol } => Box::new(Dopri5::new(n, rtol, atol)),
+            Solver::Bdf { rtol, atol } => Box::new(crate::bdf::Bdf::new(n, rtol, atol)),
+        }
+    }
+}
+
 /// `rk4`, `dopri5` or `bdf` with the default tolerance [`DEFAULT_RTOL`].
 impl std::str::FromStr for Solver {
     type Err = String;
@@ -95,24 +106,26 @@ pub struct Event {
 /// Integration state of one ME instance; buffers allocated once.
 #[derive(Debug)]
 pub struct MeUnit {
+    /// The states (as the FMU has them after a step or an event).
     pub(crate) x: Vec<f64>,
-    pub(crate) x0: Vec<f64>,
+    /// Scratch: the states where the event indicators are read.
     pub(crate) xt: Vec<f64>,
-    k: [Vec<f64>; 7],
+    /// The event indicators at the start of the step, and at its end (or where read).
     pub(crate) z0: Vec<f64>,
     pub(crate) z: Vec<f64>,
+    /// The next time event the FMU asked for at its last event iteration: the input of
+    /// the group's time events.
     pub(crate) next_time_event: Option<f64>,
-    pub(crate) h_adaptive: f64,
     /// Events so far.
     pub events: Vec<Event>,
     /// Accepted internal steps.
     pub steps: u64,
-    /// Rejected internal steps (dopri5).
+    /// Rejected internal steps (dopri5, bdf; of the group, held by its first member).
     pub rejected: u64,
     /// The FMU asked to terminate.
     pub terminated: bool,
     /// The work of the bdf solver of this instance's group (held by its first member).
-    pub stiff: crate::bdf::Work,
+    pub stiff: crate::integrator::Work,
     /// What the solver did differently from what the FMU declares (a directional
     /// derivative that disagrees with finite differences, not used), one sentence each.
     pub notes: Vec<String>,
@@ -127,27 +140,17 @@ impl MeUnit {
         let m = md.number_of_event_indicators as usize;
         MeUnit {
             x: vec![0.0; n],
-            x0: vec![0.0; n],
             xt: vec![0.0; n],
-            k: std::array::from_fn(|_| vec![0.0; n]),
             z0: vec![0.0; m],
             z: vec![0.0; m],
             next_time_event: None,
-            h_adaptive: 0.0,
             events: Vec::new(),
             steps: 0,
             rejected: 0,
             terminated: false,
-            stiff: crate::bdf::Work::default(),
+            stiff: crate::integrator::Work::default(),
             notes: Vec::new(),
         }
-    }
-
-    /// The start of a step at `t`: x0 = x and the derivatives there (k1).
-    pub(crate) fn begin_step(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
-        self.x0.copy_from_slice(&self.x);
-        let (x0, k) = (&self.x0, &mut self.k[0]);
-        Self::derivatives(inst, t, x0, k)
     }
 
     /// After an event iteration that ended in continuous-time mode: the states and event
@@ -163,6 +166,7 @@ impl MeUnit {
     /// (the state functions are never called with nx = 0: some FMUs refuse it).
     /// A NaN derivative returned with OK is an error naming the FMU, the call and the time
     /// (integrated on, it would make every later state NaN without a word).
+    #[inline]
     pub(crate) fn derivatives(inst: &mut Instance, t: f64, x: &[f64], dx: &mut [f64]) -> Result<()> {
         inst.set_time(t)?;
         if x.is_empty() {
@@ -192,86 +196,6 @@ impl MeUnit {
         Ok(inst.get_event_indicators(z)?)
     }
 
-    /// One RK4 step of size `h` from (t, x0) into `xt` (k1 given in k[0]).
-    pub(crate) fn rk4(&mut self, inst: &mut Instance, t: f64, h: f64) -> Result<()> {
-        let n = self.x0.len();
-        let [k1, k2, k3, k4, ..] = &mut self.k;
-        for j in 0..n {
-            self.xt[j] = self.x0[j] + 0.5 * h * k1[j];
-        }
-        Self::derivatives(inst, t + 0.5 * h, &self.xt, k2)?;
-        for j in 0..n {
-            self.xt[j] = self.x0[j] + 0.5 * h * k2[j];
-        }
-        Self::derivatives(inst, t + 0.5 * h, &self.xt, k3)?;
-        for j in 0..n {
-            self.xt[j] = self.x0[j] + h * k3[j];
-        }
-        Self::derivatives(inst, t + h, &self.xt, k4)?;
-        for j in 0..n {
-            self.xt[j] = self.x0[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
-        }
-        Ok(())
-    }
-
-    /// One Dormand-Prince step of size `h` from (t, x0) into `xt` (k1 given in k[0]);
-    /// returns the scaled error norm (<= 1: accept). k[6] holds f(t+h, xt) afterwards.
-    pub(crate) fn dopri(&mut self, inst: &mut Instance, t: f64, h: f64, rtol: f64, atol: f64) -> Result<f64> {
-        const C: [f64; 6] = [1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
-        const A: [[f64; 6]; 6] = [
-            [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-            [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-            [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
-            [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
-            [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
-        ];
-        // error coefficients: 5th-order weights minus 4th-order weights
-        const E: [f64; 7] =
-            [71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0];
-        let n = self.x0.len();
-        for s in 0..6 {
-            for j in 0..n {
-                let mut acc = 0.0;
-                for (r, a) in A[s].iter().enumerate().take(s + 1) {
-                    acc += a * self.k[r][j];
-                }
-                self.xt[j] = self.x0[j] + h * acc;
-            }
-            let (head, tail) = self.k.split_at_mut(s + 1);
-            Self::derivatives(inst, t + C[s] * h, &self.xt, &mut tail[0])?;
-            let _ = head;
-        }
-        // xt is the 5th-order solution (stage 7 = FSAL point), k[6] = f(t + h, xt)
-        // a NaN error estimate (infinite stages: inf - inf) is kept, never dropped by max, so
-        // that no such step is accepted; a zero error is zero also where the scale is (a
-        // state at zero with atol = 0)
-        let mut err = 0.0f64;
-        for j in 0..n {
-            let mut e = 0.0;
-            for (r, c) in E.iter().enumerate() {
-                e += c * self.k[r][j];
-            }
-            let scale = atol + rtol * self.x0[j].abs().max(self.xt[j].abs());
-            let he = h * e;
-            if he != 0.0 {
-                err = nan_max(err, (he / scale).abs());
-            }
-        }
-        Ok(err)
-    }
-
-    pub(crate) fn one_step(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<()> {
-        match solver {
-            Solver::Rk4 { .. } => self.rk4(inst, t, h),
-            Solver::Dopri5 { rtol, atol } => self.dopri(inst, t, h, rtol, atol).map(|_| ()),
-            // the bdf path locates events on its dense output (simulate/me_group/bdf.rs)
-            Solver::Bdf { .. } => {
-                Err(crate::error::Error::Experiment("internal: a one-step method asked of the bdf solver".into()))
-            }
-        }
-    }
-
     /// Event indicators at (t, xt) into `z`.
     pub(crate) fn indicators_at(&mut self, inst: &mut Instance, t: f64) -> Result<()> {
         inst.set_time(t)?;
@@ -283,27 +207,16 @@ impl MeUnit {
         z0.iter().zip(z).any(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0))
     }
 
-    /// A step of `h` from (t, x0) crossed an event indicator (`z0` to `z`): the offset
-    /// `hi` just after the first crossing, found by the Illinois method on the step size
-    /// (re-integrating from (t, x0)) to [`EVENT_TIME_TOLERANCE`].
-    pub(crate) fn locate_crossing(&mut self, inst: &mut Instance, solver: Solver, t: f64, h: f64) -> Result<f64> {
-        let zi = self.first_crossing();
-        let (z_lo, z_hi) = (self.z0[zi], self.z[zi]);
-        illinois(0.0, h, z_lo, z_hi, |s| {
-            self.one_step(inst, solver, t, s)?;
-            self.indicators_at(inst, t + s)?;
-            // any indicator crossing in (0, s]?
-            Ok((Self::crossed(&self.z0, &self.z), self.z[zi]))
-        })
-    }
-
     /// An accepted step of a group's method to `t_new`, whose states are in `x`: the FMU at
-    /// (t_new, x), the indicators of its end kept as the next step's start, and
+    /// (t_new, x) (set unless `there`: its indicators were just read at that point), the
+    /// indicators of its end kept as the next step's start, and
     /// `fmi2CompletedIntegratorStep`, whose `terminateSimulation` marks the unit terminated.
     /// Whether the FMU asked for a step event.
-    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64) -> Result<bool> {
-        inst.set_time(t_new)?;
-        Self::set_states(inst, &self.x)?;
+    pub(crate) fn complete_step(&mut self, inst: &mut Instance, t_new: f64, there: bool) -> Result<bool> {
+        if !there {
+            inst.set_time(t_new)?;
+            Self::set_states(inst, &self.x)?;
+        }
         self.steps += 1;
         std::mem::swap(&mut self.z0, &mut self.z);
         let (step_event, terminate) = inst.completed_integrator_step()?;
@@ -316,16 +229,6 @@ impl MeUnit {
     /// The first indicator that crossed from `z0` to `z` (0 when none did).
     pub(crate) fn first_crossing(&self) -> usize {
         self.z0.iter().zip(&self.z).position(|(a, b)| (*a > 0.0 && *b <= 0.0) || (*a < 0.0 && *b >= 0.0)).unwrap_or(0)
-    }
-}
-
-/// The larger of `a` and `b`, NaN if either is (`f64::max` drops a NaN).
-#[inline]
-pub(crate) fn nan_max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
     }
 }
 

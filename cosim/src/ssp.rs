@@ -427,6 +427,28 @@ impl Flattener<'_> {
         if let Some(connectors) = el.child("Connectors") {
             for c in connectors.all("Connector") {
                 let cname = c.attr("name").unwrap_or("");
+                let declared_clock = c.child("Clock").is_some();
+                // SSP 2.0: a clock connector (ssc:Clock) names a clock of the FMU; its
+                // connections are checked as every connection (clock to clock only)
+                if fmu.clocks().iter().any(|k| k.name == cname) {
+                    let other = c.children.iter().map(|t| t.name.as_str()).find(|t| {
+                        REAL_TYPES.contains(t)
+                            || INTEGER_TYPES.contains(t)
+                            || ["Boolean", "String", "Binary"].contains(t)
+                    });
+                    if let Some(other) = other {
+                        return Err(self.err(format!(
+                            "component {name:?}: connector {cname:?} is declared {other} but the variable is a clock"
+                        )));
+                    }
+                    continue;
+                }
+                if declared_clock {
+                    return Err(self.err(format!(
+                        "component {name:?}: connector {cname:?} is declared Clock but the variable is no clock of {}",
+                        fmu.source().display()
+                    )));
+                }
                 let v = fmu.description().variable(cname).ok_or_else(|| {
                     self.err(format!(
                         "component {name:?}: connector {cname:?} is not a variable of {}",
@@ -719,7 +741,7 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         Some("1.0") | None => {}
         Some("2.0") => f.notes.push(
             "the SSD says version=\"2.0\" (the SSP 2.0 draft): read as SSP 1.0 (FMI 3.0 connector types such as \
-             Float64 and Int64 accepted; array connectors, clocks and 2.0's other additions are refused by name)"
+             Float64 and Int64 and clock connectors accepted; array connectors and 2.0's other additions are refused by name)"
                 .into(),
         ),
         Some(v) => f.notes.push(format!("the SSD says version={v:?}: read as SSP 1.0")),
@@ -817,13 +839,5 @@ pub fn read_ssp(path: &Path, options: &ImportOptions) -> Result<SspSystem> {
         .unwrap_or((None, None));
     let archive = (!is_ssd).then(|| path.to_path_buf());
     let system = f.builder.build();
-    if let Some(cycle) = crate::loops::initialization_loop(&system) {
-        f.notes.push(format!(
-            "the connections {} form an algebraic loop at initialization: the run carries each connection once \
-             before leaving initialization mode (no fixed-point iteration), so values on the loop may differ \
-             from a converged initialization",
-            cycle.join(", ")
-        ));
-    }
     Ok(SspSystem { system, default_start_stop, root_name: f.root_name, notes: f.notes, applied, archive })
 }

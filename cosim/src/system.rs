@@ -100,7 +100,7 @@ impl std::fmt::Display for Value {
 }
 
 /// A variable of an instance, resolved.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct VariableRef {
     /// Index of the instance in the system.
     pub instance: usize,
@@ -146,6 +146,19 @@ pub struct System {
     pub instances: Vec<InstanceSpec>,
     /// Connections, in the order they were added.
     pub connections: Vec<Connection>,
+    /// Connections from an FMI 3.0 output clock to a triggered input clock.
+    pub clock_connections: Vec<ClockConnection>,
+}
+
+/// A connection from an output clock to a triggered input clock: every tick of the source
+/// ticks the destination (at the next communication point, as `jacobi` carries every
+/// connection).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClockConnection {
+    /// The source: instance index and the output clock's value reference.
+    pub from: (usize, u32),
+    /// The destination: instance index and the input clock's value reference.
+    pub to: (usize, u32),
 }
 
 /// Builds a [`System`], checking every name, value and connection as it is added.
@@ -163,6 +176,15 @@ pub fn split_name(full: &str) -> Option<(&str, &str)> {
 }
 
 impl System {
+    /// The clock `instance.clock` names, if it names one: (instance index, clock).
+    pub fn clock_of(&self, full: &str) -> Option<(usize, crate::clocks::Clock)> {
+        full.match_indices('.').find_map(|(dot, _)| {
+            let i = self.instance_index(&full[..dot])?;
+            let clock = self.instances[i].fmu.clocks().into_iter().find(|c| c.name == full[dot + 1..])?;
+            Some((i, clock))
+        })
+    }
+
     /// A one-instance system of a single FMU.
     pub fn single(name: &str, fmu: Arc<Fmu>) -> Result<System> {
         let mut b = SystemBuilder::new();
@@ -261,6 +283,37 @@ impl System {
                 Error::NoInstance { name: full.into(), instances: self.instance_names(), candidates }
             }
         }
+    }
+
+    /// The variables `full` names for recording: the one variable, or, when `full` names an
+    /// array of an FMI 3.0 FMU (`instance.a`), its elements in the view's order (`a[1]`,
+    /// `a[2]`, ...).
+    pub fn resolve_record(&self, full: &str) -> Result<Vec<VariableRef>> {
+        let error = match self.resolve(full) {
+            Ok(r) => return Ok(vec![r]),
+            Err(e) => e,
+        };
+        for (dot, _) in full.match_indices('.') {
+            let Some(i) = self.instance_index(&full[..dot]) else { continue };
+            let prefix = format!("{}[", &full[dot + 1..]);
+            let elements: Vec<VariableRef> = self
+                .description(i)
+                .model_variables
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.name.starts_with(&prefix) && v.name.ends_with(']'))
+                .map(|(index, v)| VariableRef {
+                    instance: i,
+                    index,
+                    value_reference: v.value_reference,
+                    base_type: BaseType::of(v),
+                })
+                .collect();
+            if !elements.is_empty() {
+                return Ok(elements);
+            }
+        }
+        Err(error)
     }
 
     /// Resolves an instance name and a variable name.
@@ -549,6 +602,12 @@ impl SystemBuilder {
 
     fn connect_with(&mut self, from: &str, to: &str, linear: Option<(f64, f64)>, convert: bool) -> Result<&mut Self> {
         let err = |reason: String| Error::Connection { from: from.into(), to: to.into(), reason };
+        match (self.system.clock_of(from), self.system.clock_of(to)) {
+            (None, None) => {}
+            (Some(a), Some(b)) => return self.connect_clocks(a, b, linear).map_err(err),
+            (Some(_), None) => return Err(err("the source is a clock: a clock connects to a clock only".into())),
+            (None, Some(_)) => return Err(err("the destination is a clock: a clock connects to a clock only".into())),
+        }
         let a = self.system.resolve(from).map_err(|e| err(e.to_string()))?;
         let b = self.system.resolve(to).map_err(|e| err(e.to_string()))?;
         let (va, vb) = (self.system.variable(&a), self.system.variable(&b));
@@ -587,6 +646,35 @@ impl SystemBuilder {
         }
         self.connected.insert((b.instance, b.index));
         self.system.connections.push(Connection { from: a, to: b, gain, offset, linear_transformation: linear });
+        Ok(self)
+    }
+
+    /// A connection between two clocks (see [`ClockConnection`]).
+    fn connect_clocks(
+        &mut self,
+        (ia, a): (usize, crate::clocks::Clock),
+        (ib, b): (usize, crate::clocks::Clock),
+        linear: Option<(f64, f64)>,
+    ) -> std::result::Result<&mut Self, String> {
+        use crate::clocks::{ClockCausality, ClockKind};
+        if a.causality != ClockCausality::Output {
+            return Err(format!("the source is an {} clock, not an output clock", a.causality.as_str()));
+        }
+        if b.causality != ClockCausality::Input || b.kind != ClockKind::Triggered {
+            return Err(format!(
+                "the destination is a {} {} clock: only a triggered input clock ticks when another clock does",
+                b.kind.as_str(),
+                b.causality.as_str()
+            ));
+        }
+        if linear.is_some_and(|l| l != (1.0, 0.0)) {
+            return Err("a clock connection takes no linear transformation".into());
+        }
+        let to = (ib, b.value_reference);
+        if self.system.clock_connections.iter().any(|c| c.to == to) {
+            return Err("the input clock is already connected".into());
+        }
+        self.system.clock_connections.push(ClockConnection { from: (ia, a.value_reference), to });
         Ok(self)
     }
 

@@ -8,42 +8,14 @@
 //! (default `python3`); without fmpy the tests are skipped, unless `$FMPY_PYTHON` is set.
 
 mod common;
-use common::{work_dir, zip_entries};
+use common::{build_counter, work_dir};
 use nigel_cosim::{simulate, Experiment, Fmu, Instance, System, SystemBuilder, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::fmi3_c::{headers, python};
+use common::fmi3_c::python;
 
 const XML: &str = include_str!("cfmu/fmi3_counter.xml");
-
-/// Builds `<dir>/<stem>.fmu` from fmi3_counter.c with `xml` as its description.
-fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
-    let headers = headers()?;
-    let so = dir.join("fmi3_counter.so");
-    {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu/fmi3_counter.c");
-        let status = Command::new("cc")
-            .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
-            .arg("-I")
-            .arg(&headers)
-            .arg(&src)
-            .arg("-o")
-            .arg(&so)
-            .status()
-            .expect("run cc");
-        assert!(status.success(), "cc failed for fmi3_counter.c");
-    }
-    let fmu = dir.join(format!("{stem}.fmu"));
-    zip_entries(
-        &fmu,
-        &[
-            ("modelDescription.xml", xml.as_bytes().to_vec()),
-            ("binaries/x86_64-linux/fmi3_counter.so", std::fs::read(&so).unwrap()),
-        ],
-    );
-    Some(fmu)
-}
 
 fn counter(test: &str) -> Option<(PathBuf, PathBuf)> {
     let dir = work_dir(test);
@@ -76,11 +48,11 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
     let fmu = Fmu::load(&path).unwrap();
     let md3 = fmu.fmi3_description().expect("an FMI 3.0 FMU");
     assert_eq!(md3.instantiation_token, "{fmi3-counter}");
-    assert_eq!(md3.model_variables.len(), 32);
+    assert_eq!(md3.model_variables.len(), 36);
     let view = fmu.description();
     assert_eq!(view.fmi_version, "3.0");
     // the three arrays as their 3 + 2 + 2 elements
-    assert_eq!(view.model_variables.len(), 36);
+    assert_eq!(view.model_variables.len(), 40);
     let names: Vec<&str> = view.model_variables.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names[24..29], ["arr[1]", "arr[2]", "arr[3]", "gains[1]", "gains[2]"]);
     assert_eq!(view.states(), vec![3], "y, variable 3 of the view, is the state of der(y)");
@@ -93,7 +65,7 @@ fn the_view_has_the_scalars_and_the_description_every_variable() {
         "{mode:?}"
     );
     assert_eq!(view.variable("n").unwrap().variable_type.type_name(), "Integer");
-    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1);
+    assert_eq!(view.model_structure.outputs.len(), 5 + 10 + 3 + 2 + 1 + 2);
     assert!(fmu.can_get_and_set_state());
 }
 
@@ -202,7 +174,8 @@ fn bad_fmi3_input_is_refused() {
         (
             "clock",
             XML.replace("</ModelVariables>", "<Clock name=\"tick\" valueReference=\"40\" causality=\"input\" intervalVariability=\"triggered\"/></ModelVariables>"),
-            "clocks (Clock variable \"tick\")",
+            // the counter has no Event Mode, where the master would run its clocks
+            "clocks in Co-Simulation without Event Mode (hasEventMode) (Clock variable \"tick\")",
         ),
         ("noindependent", XML.replace("causality=\"independent\" ", ""), "independent"),
     ];
@@ -920,4 +893,198 @@ fn a_later_minor_version_runs_with_a_note() {
         let note = format!(r#"declares fmiVersion "{version}": run as FMI 3.0"#);
         assert_eq!(err.contains(&note), noted, "{version}: {err}");
     }
+}
+
+/// Model Exchange: discrete inputs change in Event Mode only (FMI 3.0 section 3.2.1; the
+/// counter, as the Reference FMUs, refuses `fmi3SetInt32` / `fmi3SetBoolean` of k and b in
+/// Continuous-Time Mode). An input table changes k from 1 to 4 and b to true at 0.3 s (a
+/// communication point) and k to -2 at 0.45 s (between points: the step is split there);
+/// each change is an input event, and a value that stays is not set again.
+///
+/// By hand (m = 2 k, nb = !b, read back from the FMU): the rows at 0 .. 0.3 s hold k = 1
+/// (m = 2, nb = 1; a row is recorded before the inputs of the next step are applied), the
+/// row at 0.4 s k = 4 (m = 8, nb = 0), and from 0.5 s on k = -2 (m = -4). fmpy 0.3.32 (the
+/// same table as its `input=`) gives the same values at every grid time but 0.3 s, where
+/// it records the row after the event. The counter is described without its event
+/// indicator here: fmpy's CVode root function sets every input, the discrete ones too, in
+/// Continuous-Time Mode, which the counter refuses (the Reference FMUs' Feedthrough has no
+/// event indicator, so fmpy never does so there).
+#[test]
+fn model_exchange_sets_discrete_inputs_in_event_mode() {
+    let dir = work_dir("fmi3-me-discrete-input");
+    let xml = XML.replace(r#"<EventIndicator valueReference="14" dependencies="2"/>"#, "");
+    let Some(path) = build_counter(&dir, "fmi3_counter", &xml) else { return };
+    let table = nigel_cosim::InputTable::new(
+        vec!["k".into(), "b".into()],
+        vec![0.0, 0.3, 0.45, 1.0],
+        vec![vec![1.0, 4.0, -2.0, -2.0], vec![0.0, 1.0, 1.0, 1.0]],
+    )
+    .unwrap();
+    let mut e = Experiment::new(1.0, 0.1);
+    e.input = Some(std::sync::Arc::new(table));
+    let (r, summary) = simulate(&model_exchange(&path, &[]), &e).unwrap();
+    let (time, m, nb) = (r.column("time").unwrap(), r.column("m").unwrap(), r.column("nb").unwrap());
+    assert_eq!(r.rows(), 11);
+    for k in 0..11 {
+        let (m_hand, nb_hand) = match k {
+            0..=3 => (2.0, 1.0),
+            4 => (8.0, 0.0),
+            _ => (-4.0, 0.0),
+        };
+        assert_eq!((m[k], nb[k]), (m_hand, nb_hand), "t = {}", time[k]);
+    }
+    let inputs: Vec<f64> = summary.events.iter().filter(|e| e.kind == "input").map(|e| e.time).collect();
+    assert_eq!(inputs, vec![0.30000000000000004, 0.45], "one input event per change (0.1 + 0.1 + 0.1 is the point)");
+    // fmpy with the same table, at the grid times but 0.3 s
+    let script = "import sys, numpy as np\nfrom fmpy import simulate_fmu\n\
+         sig = np.array([(0.0, 1, False), (0.3, 4, True), (0.45, -2, True), (1.0, -2, True)], dtype=[('time', np.double), ('k', np.int32), ('b', np.bool_)])\n\
+         r = simulate_fmu(sys.argv[1], fmi_type='ModelExchange', stop_time=1.0, output_interval=0.1, input=sig, output=['m', 'nb'])\n\
+         print('\\n'.join('%r %r %r' % (float(t), float(m), float(nb)) for t, m, nb in r))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&path).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("Warning")) // fmpy's "missing input for variable u"
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for k in (0..11).filter(|k| *k != 3) {
+        let row = theirs.iter().rev().find(|row| (row[0] - time[k]).abs() < 1e-9).expect("fmpy's row");
+        assert_eq!((row[1], row[2]), (m[k], nb[k]), "t = {}", time[k]);
+    }
+}
+
+/// 64-bit integers, Binaries and Strings recorded as the FMU holds them (issue 35, defects
+/// 4 and 5): an input file drives the counter's Int64 and UInt64 inputs with values an f64
+/// does not hold, read exactly; the outputs i64out = i64in ^ 1 and u64out = u64in ^ 1 (the
+/// lowest bit flipped, so that a rounding shows) are written in decimal, the Binary `bin`
+/// (n zero bytes after n steps) in hex, the String parameter `label` as its text.
+///
+/// By hand: at t = 0 (initialization takes the first row) i64in = -2^63, so i64out =
+/// -2^63 + 1 = -9223372036854775807; u64in = 2^64 - 1, so u64out = 18446744073709551614.
+/// The row at 0.25 s still holds them (a row is recorded before the next step's inputs),
+/// the row at 0.5 s the second row's 2^53 + 2 = 9007199254740994: out 9007199254740995,
+/// which is no f64 (the nearest are ...994 and ...996). fmpy 0.3.32, given the same
+/// values as int64 / uint64 columns, records the same integers.
+#[test]
+fn sixty_four_bit_integers_binaries_and_strings_are_recorded_exactly() {
+    let Some((dir, fmu)) = counter("fmi3-exact") else { return };
+    let input = dir.join("in.csv");
+    std::fs::write(
+        &input,
+        "time,i64in,u64in\n0,-9223372036854775808,18446744073709551615\n0.25,9007199254740994,9007199254740994\n1,9007199254740994,9007199254740994\n",
+    )
+    .unwrap();
+    let csv = dir.join("out.csv");
+    let fmu_arg = fmu.to_str().unwrap();
+    let columns = |path: &Path| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        ["i64out", "u64out", "bin", "label"]
+            .iter()
+            .map(|name| {
+                let j = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("{name} in {header:?}"));
+                rows.iter().map(|r| r[j].to_string()).collect()
+            })
+            .collect()
+    };
+    let by_hand = vec![
+        vec!["-9223372036854775807", "-9223372036854775807", "9007199254740995"],
+        vec!["18446744073709551614", "18446744073709551614", "9007199254740995"],
+        vec!["", "00", "0000"],
+        vec!["abc", "abc", "abc"],
+    ];
+    for isolate in ["", "--isolate=run", "--isolate=fmu"] {
+        let mut args = vec!["run", fmu_arg, "--stop-time", "0.5", "--step", "0.25", "--input", input.to_str().unwrap()];
+        args.extend(["--record", "i64out", "--record", "u64out", "--record", "bin", "--record", "label"]);
+        args.extend(["-o", csv.to_str().unwrap()]);
+        if !isolate.is_empty() {
+            args.push(isolate);
+        }
+        let out = cosim(&args);
+        assert!(out.status.success(), "{isolate}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(columns(&csv), by_hand, "{isolate}");
+    }
+    // fmpy with the same values as exact integer columns
+    let script = "import sys, numpy as np\nfrom fmpy import simulate_fmu\n\
+         sig = np.array([(0.0, -2**63, 2**64 - 1), (0.25, 2**53 + 2, 2**53 + 2), (1.0, 2**53 + 2, 2**53 + 2)], dtype=[('time', np.double), ('i64in', np.int64), ('u64in', np.uint64)])\n\
+         r = simulate_fmu(sys.argv[1], stop_time=0.5, output_interval=0.25, input=sig, output=['i64out', 'u64out'])\n\
+         print('\\n'.join('%d %d' % (i, u) for i, u in zip(r['i64out'], r['u64out'])))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<Vec<String>> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("Warning"))
+        .map(|l| l.split(' ').map(str::to_string).collect())
+        .collect();
+    let ours = columns(&csv);
+    assert_eq!(theirs.len(), 3, "{theirs:?}");
+    for (k, row) in theirs.iter().enumerate() {
+        assert_eq!((&row[0], &row[1]), (&ours[0][k], &ours[1][k]), "row {k}");
+    }
+}
+
+/// An `<Alias>` (FMI 3.0 section 2.4.7.5) is another name of its variable: `cosim info`
+/// lists it, a run records it under its own name (by default, as an output like its
+/// variable), its value that of the variable in every row; fmpy 0.3.32 records it too,
+/// with the same values.
+#[test]
+fn an_alias_is_listed_and_recorded_under_its_name() {
+    let dir = work_dir("fmi3-alias");
+    let xml = XML.replace(
+        r#"<Float64 name="y" valueReference="2" causality="output" unit="m" initial="exact" start="0"/>"#,
+        r#"<Float64 name="y" valueReference="2" causality="output" unit="m" initial="exact" start="0"><Alias name="y_ft" description="y in feet"/></Float64>"#,
+    );
+    assert_ne!(xml, XML, "the alias is in the description");
+    let Some(fmu) = build_counter(&dir, "alias", &xml) else { return };
+    let out = cosim(&["info", fmu.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().find(|l| l.starts_with("y_ft ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("output") && line.contains("alias of y") && line.contains("y in feet"), "{line}");
+    let csv = dir.join("out.csv");
+    let out =
+        cosim(&["run", fmu.to_str().unwrap(), "--stop-time", "0.3", "--step", "0.1", "-o", csv.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();
+    let (jy, jft) = (header.iter().position(|h| *h == "y").unwrap(), header.iter().position(|h| *h == "y_ft").unwrap());
+    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    // y = t (u = 1, mode 1): 0, 0.1, 0.2, 0.30000000000000004, the alias the same text
+    let y: Vec<&str> = rows.iter().map(|r| r[jy]).collect();
+    assert_eq!(y, ["0", "0.1", "0.2", "0.30000000000000004"]);
+    assert_eq!(rows.iter().map(|r| r[jft]).collect::<Vec<_>>(), y);
+    let script = "import sys\nfrom fmpy import simulate_fmu\n\
+         r = simulate_fmu(sys.argv[1], stop_time=0.3, output_interval=0.1)\n\
+         print(' '.join(repr(float(v)) for v in r['y_ft']))\n";
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "fmpy: {}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<f64> =
+        String::from_utf8_lossy(&out.stdout).split_whitespace().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(theirs, y.iter().map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>());
+}
+
+/// A connection carries an Int64 output to an Int64 input as f64: exactly up to 2^53 (and
+/// beyond where an f64 holds the value), and a value it would round is an error naming the
+/// variable and the master's limit, not a silently rounded input. c1.i64out = c1.i64in ^ 1
+/// feeds c2.i64in, c2.i64out = c2.i64in ^ 1 is recorded: 6 gives 7, then 6 again; 2^53 + 2
+/// gives 2^53 + 3, which no f64 holds.
+#[test]
+fn a_sixty_four_bit_connection_is_exact_or_refused() {
+    let Some((_dir, path)) = counter("fmi3-wide-connection") else { return };
+    let system = |start: f64| {
+        let mut b = SystemBuilder::new();
+        for name in ["c1", "c2"] {
+            b.add_instance(name, Fmu::load(&path).unwrap()).unwrap();
+        }
+        b.set("c1.i64in", Value::Real(start)).unwrap();
+        b.connect("c1.i64out", "c2.i64in").unwrap();
+        b.build()
+    };
+    let mut e = Experiment::new(0.2, 0.1);
+    e.record = Some(vec!["c2.i64out".into()]);
+    let (r, _) = simulate(&system(6.0), &e).unwrap();
+    assert_eq!(r.exact_column(0).unwrap(), ["6", "6", "6"]);
+    let err = simulate(&system(9007199254740994.0), &e).expect_err("a rounded connection refused").to_string();
+    assert!(err.contains("c1.i64out = 9007199254740995") && err.contains("2^53"), "{err}");
 }

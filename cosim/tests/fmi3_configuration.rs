@@ -174,3 +174,27 @@ fn the_corpus_dynamic_array_test_records_18_elements_with_xsize_6() {
     let after_first_step: Vec<f64> = outputs.iter().map(|n| result.column(n).unwrap()[1]).collect();
     assert_eq!(after_first_step, (0..18).map(|k| 2.0 * k as f64).collect::<Vec<_>>());
 }
+
+/// `fmi3Reset` puts the FMU back to n = 2 (this FMU's reset); the instance of a configured
+/// FMU goes through Configuration Mode again, so that the view's four elements of k are
+/// what the FMU holds after the reset too (a set of four values to an FMU with n = 2 is
+/// its fmi3Error). y[4] = k[4] u t = 4 * 1 * 0.5 after one step.
+#[test]
+fn a_reset_configures_the_structural_parameters_again() {
+    let Some((_dir, path)) = sized("fmi3-configuration-reset") else { return };
+    let fmu = Fmu::load(&path).unwrap().configured("c", &[("n", 4.0)]).unwrap();
+    assert_eq!(fmu.configuration(), [("n".to_string(), 4.0)]);
+    let md = fmu.description();
+    let vr = |name: &str| md.variable(name).unwrap().value_reference;
+    let k: Vec<u32> = (1..=4).map(|i| vr(&format!("k[{i}]"))).collect();
+    let mut instance = nigel_cosim::Instance::new(&fmu, "c").unwrap();
+    instance.reset().unwrap();
+    instance.set_real(&k, &[1.0, 2.0, 3.0, 4.0]).unwrap();
+    instance.setup_experiment(None, 0.0, None).unwrap();
+    instance.enter_initialization_mode().unwrap();
+    instance.exit_initialization_mode().unwrap();
+    instance.do_step(0.0, 0.5).unwrap();
+    let mut y = [0.0];
+    instance.get_real(&[vr("y[4]")], &mut y).unwrap();
+    assert_eq!(y, [2.0]);
+}

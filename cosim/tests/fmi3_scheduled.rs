@@ -98,6 +98,18 @@ fn partitions_tick_in_priority_order_with_countdown_triggered_and_output_clocks(
     assert_eq!(col("out"), [0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     // deterministic: a second run is the same, bit for bit
     assert_eq!(run(&fmu).values, r.values);
+    let info = Command::new(env!("CARGO_BIN_EXE_cosim")).args(["info", fmu.to_str().unwrap()]).output().unwrap();
+    let info = String::from_utf8_lossy(&info.stdout);
+    let partitions: Vec<&str> = info.lines().filter(|l| l.starts_with("model partition ")).collect();
+    assert_eq!(
+        partitions,
+        [
+            "model partition fast (clock, priority 1): ticks every 0.25 s from 0 s; run with --interface se",
+            "model partition slow (clock, priority 0): ticks every 1 s from 0.5 s; run with --interface se",
+            "model partition later (clock, priority 2): ticks countdown (set by the FMU); run with --interface se",
+            "model partition kick (clock, priority 3): ticks triggered (an input file's clock column); run with --interface se",
+        ]
+    );
 }
 
 /// The Reference FMUs' `Clocks` (Scheduled Execution only) through `cosim run --interface

@@ -41,7 +41,7 @@ fn reset_instances_and_streamed_rows_equal_fresh_runs() {
         assert_eq!(reused.names, fresh.names);
         // streamed: the same rows, none kept
         let mut rows: Vec<f64> = Vec::new();
-        let mut sink = |t: f64, v: &[f64]| {
+        let mut sink = |t: f64, v: &[f64], _: &[(usize, String)]| {
             rows.push(t);
             rows.extend_from_slice(v);
         };

@@ -85,7 +85,7 @@ fn a_value_queued_at_a_row_applies_from_the_next_step_as_an_input_jump_there() {
         }
     };
     let mut rows = Vec::new();
-    let mut record = |t: f64, row: &[f64]| {
+    let mut record = |t: f64, row: &[f64], _: &[(usize, String)]| {
         sink(t, row);
         rows.push((t, row.to_vec()));
     };
@@ -114,7 +114,7 @@ fn the_cancel_flag_stops_the_run_between_steps_with_the_rows_so_far() {
     let cancel = Arc::new(AtomicBool::new(false));
     let e = Experiment::new(1.0, 0.1);
     let mut times = Vec::new();
-    let mut sink = |t: f64, _row: &[f64]| {
+    let mut sink = |t: f64, _row: &[f64], _: &[(usize, String)]| {
         times.push(t);
         if times.len() == 4 {
             cancel.store(true, Ordering::Relaxed);

@@ -1185,8 +1185,8 @@ fn clocked_rows<B>(spec: &DeclarationSpec<B>, lookup: &HashMap<(BaseType, u32), 
 
 /// Adds the declared clock to the FMI 3.0 description: the `<Clock>` variable after the
 /// others (an input clock, periodic, its interval constant or fixed), the `clocks`
-/// attribute of its clocked variables, and Event Mode for Co-Simulation (FMI 3.0 requires
-/// it of an FMU with clocks).
+/// attribute of its clocked variables, Event Mode for Co-Simulation (FMI 3.0 requires it of
+/// an FMU with clocks) and `<ScheduledExecution>` (the clock's model partition).
 fn add_clocks(d3: &mut md::fmi3::ModelDescription, clocks: &[ClockDecl], clocked_rows: &[usize]) {
     use md::fmi3 as f3;
     let Some(clock) = clocks.first() else { return };
@@ -1216,6 +1216,10 @@ fn add_clocks(d3: &mut md::fmi3::ModelDescription, clocks: &[ClockDecl], clocked
     let clocked_vrs: Vec<u32> = clocked_rows.iter().map(|&row| row as u32 + 1).collect();
     d3.model_structure.initial_unknowns.retain(|u| !clocked_vrs.contains(&u.value_reference));
     d3.model_variables.push(c);
+    // Scheduled Execution: the clock's model partition, with the capabilities of the other
+    // interfaces (one library, one instance type)
+    let common = d3.co_simulation.as_ref().map(|cs| &cs.common).or(d3.model_exchange.as_ref().map(|me| &me.common));
+    d3.scheduled_execution = common.map(|c| f3::ScheduledExecution { common: c.clone() });
     if let Some(cs) = d3.co_simulation.as_mut() {
         cs.has_event_mode = true;
     }

@@ -23,6 +23,9 @@ pub struct InstantiateContext {
 pub enum Interface {
     ModelExchange,
     CoSimulation,
+    /// FMI 3.0 Scheduled Execution: offered by a model with a declared clock (its model
+    /// partition), activated by the importer with `fmi3ActivateModelPartition`.
+    ScheduledExecution,
 }
 
 /// Why a model call failed.

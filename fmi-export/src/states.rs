@@ -186,7 +186,9 @@ impl Function {
     }
 
     /// The FMI 3.0 features the layer's FMUs do not declare, with what is missing: the
-    /// call is refused (`fmi3Error`, logged) in every state.
+    /// call is refused (`fmi3Error`, logged) in every state, except the clock functions,
+    /// `fmi3EnterStepMode` (Co-Simulation) and `fmi3ActivateModelPartition` (Scheduled
+    /// Execution) of a model that declares a clock ([`crate::ClockDecl`]).
     pub fn undeclared_feature(self) -> Option<&'static str> {
         use Function::*;
         Some(match self {
@@ -351,6 +353,8 @@ impl Function {
             | Fmi3SetShiftFraction => mask(&[InitializationMode, EventMode]),
             // Co-Simulation with Event Mode (an FMU with clocks): Event Mode back to Step Mode
             Fmi3EnterStepMode => mask(&[EventMode]),
+            // Scheduled Execution's Clock Activation Mode (the layer's StepComplete)
+            Fmi3ActivateModelPartition => mask(&[StepComplete]),
             // Model Exchange: from Continuous-Time Mode only (FMI 2.0 also in Event Mode);
             // Co-Simulation with Event Mode: from Step Mode
             Fmi3EnterEventMode => mask(&[ContinuousTimeMode, StepComplete]),

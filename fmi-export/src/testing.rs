@@ -256,7 +256,7 @@ pub const ERR3: Fmi3Status = Fmi3Status::Error;
 pub const DISCARD3: Fmi3Status = Fmi3Status::Discard;
 
 /// The importer's `fmi3LogMessageCallback`: the environment is the instance's [`Log`].
-unsafe extern "C" fn log_message(
+pub unsafe extern "C" fn log_message(
     environment: *mut std::ffi::c_void,
     status: fmi3Status,
     category: *const std::ffi::c_char,

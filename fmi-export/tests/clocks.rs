@@ -188,6 +188,8 @@ fn co_simulation_samples_at_the_importers_activations_as_fmi2_samples_at_time_ev
         }
     }
     assert_eq!(f.float64(vr3::U), 1.25, "a non-clocked variable reads in Step Mode");
+    // a clocked output between activations holds the last activation's value
+    assert_eq!((f.float64(vr3::Y), f.float64(vr3::N)), expected[3]);
 }
 
 /// Model Exchange: the importer sets the time of each activation, enters Event Mode and
@@ -240,13 +242,6 @@ fn wrong_uses_of_the_clock_are_errors_naming_function_variable_and_reason() {
     let s = unsafe { set_clock(&f, vr3::TICK, FMI3_CLOCK_ACTIVE) };
     assert_eq!(s, ERR3);
     assert!(f.last_error().starts_with("fmi3SetClock: not allowed in state InitializationMode"), "{}", f.last_error());
-
-    let f = cs3();
-    f.init_until(0.0, None);
-    // a clocked output while the clock is inactive
-    let mut y = [0.0];
-    assert_eq!(f.get_float64(&[vr3::Y], &mut y), ERR3);
-    assert!(f.last_error().starts_with("fmi3GetFloat64: y is a clocked variable of tick, which is not active"));
 
     let f = cs3();
     f.init_until(0.0, None);
@@ -314,4 +309,123 @@ fn wrong_uses_of_the_clock_are_errors_naming_function_variable_and_reason() {
     assert_eq!(f.set_float64(&[vr3::PERIOD], &[0.5]), OK3);
     assert_eq!(f.enter_init(0.0, None), OK3);
     assert_eq!(interval(&f), (OK3, 0.5, FMI3_INTERVAL_CHANGED));
+}
+
+/// `fmi3InstantiateScheduledExecution` of the model (no callbacks the FMU would call).
+fn se3() -> (fmi3Instance, Box<fmi_export::testing::Log>) {
+    let log = Box::<fmi_export::testing::Log>::default();
+    let name = std::ffi::CString::new("se").unwrap();
+    let token = std::ffi::CString::new(Summer::declaration().guid()).unwrap();
+    let env = &*log as *const fmi_export::testing::Log as *mut std::ffi::c_void;
+    let c = unsafe {
+        abi3::instantiate_scheduled_execution::<Summer>(
+            Function::Fmi3InstantiateScheduledExecution,
+            name.as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            FMI3_FALSE,
+            FMI3_TRUE,
+            env,
+            Some(fmi_export::testing::log_message),
+            None,
+            None,
+            None,
+        )
+    };
+    assert!(!c.is_null(), "{:?}", log.0.borrow());
+    (c, log)
+}
+
+fn last_error(log: &fmi_export::testing::Log) -> String {
+    log.0.borrow().iter().rev().find(|r| r.0 >= 3).map(|r| r.2.clone()).unwrap_or_default()
+}
+
+/// Scheduled Execution: the clock's model partition activated at 0.5, 0.75 and 1.0 s (T
+/// = 0.25 s from start 0.5 s) gives the y_k of the other interfaces; the description
+/// offers it with the clock's priority; wrong activations are errors.
+#[test]
+fn scheduled_execution_activates_the_clocks_partition() {
+    assert!(Summer::declaration().xml3().contains("<ScheduledExecution"), "{}", Summer::declaration().xml3());
+    let (c, log) = se3();
+    let s = unsafe {
+        abi3::enter_initialization_mode::<Summer>(Function::Fmi3EnterInitializationMode, c, 0, 0.0, 0.5, 0, 0.0)
+    };
+    assert_eq!(s, OK3);
+    let (mut t, mut q) = (f64::NAN, -1);
+    let s = unsafe {
+        abi3::get_interval_decimal::<Summer>(Function::Fmi3GetIntervalDecimal, c, &vr3::TICK, 1, &mut t, &mut q)
+    };
+    assert_eq!((s, t, q), (OK3, 0.25, FMI3_INTERVAL_CHANGED));
+    assert_eq!(unsafe { abi3::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c) }, OK3);
+    let activate = |t: f64| unsafe {
+        abi3::activate_model_partition::<Summer>(Function::Fmi3ActivateModelPartition, c, vr3::TICK, t)
+    };
+    let get = |vrs: &[u32]| {
+        let mut out = vec![0.0; vrs.len()];
+        let s = unsafe {
+            abi3::get::<Summer, abi3::value::Float64>(
+                Function::Fmi3GetFloat64,
+                c,
+                vrs.as_ptr(),
+                vrs.len(),
+                out.as_mut_ptr(),
+                out.len(),
+            )
+        };
+        assert_eq!(s, OK3, "{}", last_error(&log));
+        out
+    };
+    for (k, want) in [(0.125, 1.0), (0.3125, 2.0), (0.5625, 3.0)].into_iter().enumerate() {
+        let t = 0.5 + 0.25 * k as f64;
+        let s = unsafe { abi3::set::<Summer, abi3::value::Float64>(Function::Fmi3SetFloat64, c, &vr3::U, 1, &t, 1) };
+        assert_eq!(s, OK3);
+        assert_eq!(activate(t), OK3, "{}", last_error(&log));
+        assert_eq!(get(&[vr3::Y, vr3::N, 0]), [want.0, want.1, t], "activation {k}");
+    }
+    // the next activation is at 1.25 s
+    assert_eq!(activate(1.2), ERR3);
+    assert!(
+        last_error(&log).starts_with(
+            "fmi3ActivateModelPartition: activationTime = 1.2 s for tick, but its next activation is at t = 1.25 s"
+        ),
+        "{}",
+        last_error(&log)
+    );
+    unsafe { abi3::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
+    let (c, log) = se3();
+    unsafe {
+        abi3::enter_initialization_mode::<Summer>(Function::Fmi3EnterInitializationMode, c, 0, 0.0, 0.0, 0, 0.0);
+        abi3::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c);
+    }
+    let on = FMI3_CLOCK_ACTIVE;
+    assert_eq!(unsafe { abi3::set_clock::<Summer>(Function::Fmi3SetClock, c, &vr3::TICK, 1, &on) }, ERR3);
+    assert!(last_error(&log).contains("not available in Scheduled Execution"), "{}", last_error(&log));
+    let (mut e, mut te, mut er, mut last) = (0, 0, 0, 0.0);
+    let s =
+        unsafe { abi3::do_step::<Summer>(Function::Fmi3DoStep, c, 0.0, 0.1, 0, &mut e, &mut te, &mut er, &mut last) };
+    assert_eq!(s, ERR3);
+    assert!(last_error(&log).contains("created for ScheduledExecution"), "{}", last_error(&log));
+    unsafe { abi3::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
+}
+
+/// A serialized FMU state of a clocked instance (in Step Mode between activations) restores
+/// its sample count: the activations after it give the same y_k again.
+#[test]
+fn a_clocked_instance_restores_its_serialized_state() {
+    let f = cs3();
+    f.init_until(0.0, None);
+    activate(&f, 0.0);
+    assert_eq!(enter_step_mode(&f), OK3);
+    assert_eq!(f.step(0.0, 0.25).status, OK3);
+    let bytes = f.serialized_state();
+    let run = |f: &Fmu3<Summer>| {
+        assert_eq!(f.enter_event_mode(), OK3, "{}", f.last_error());
+        let y = activate(f, 0.25);
+        assert_eq!(enter_step_mode(f), OK3);
+        y
+    };
+    // y_1 = 0.25 (0 + 0.25) = 0.0625, n_1 = 2
+    assert_eq!(run(&f), (0.0625, 2.0));
+    assert_eq!(f.restore_serialized(&bytes), OK3, "{}", f.last_error());
+    assert_eq!(run(&f), (0.0625, 2.0));
 }

@@ -1235,11 +1235,26 @@ fn fmi3_instantiation_checks_the_token_event_mode_and_interface() {
     let c = unsafe {
         abi::fmi3::instantiate_scheduled_execution::<Toy>(
             Function::Fmi3InstantiateScheduledExecution,
+            c"toy".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            1,
             &*log as *const testing::Log as *mut std::ffi::c_void,
+            Some(testing::log_message),
+            None,
+            None,
             None,
         )
     };
     assert!(c.is_null());
+    let msg = log.0.borrow().last().unwrap().2.clone();
+    assert!(
+        msg.starts_with(
+            "fmi3InstantiateScheduledExecution: toy does not offer ScheduledExecution (it declares no clock)"
+        ),
+        "{msg}"
+    );
     // no logger given: still NULL, nothing to crash on
     let c = unsafe {
         abi::fmi3::instantiate_model_exchange::<Toy>(

@@ -60,7 +60,7 @@ pub enum Error {
     NoInterface {
         /// The FMU.
         path: PathBuf,
-        /// "CoSimulation" or "ModelExchange".
+        /// "CoSimulation", "ModelExchange" or "ScheduledExecution".
         interface: &'static str,
     },
     /// The FMU uses a feature the master does not run (FMI 3.0 clocks, Scheduled

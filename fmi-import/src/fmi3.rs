@@ -9,7 +9,8 @@
 //! Boolean, String, Enumeration (Int64 values of i32 items), a Binary as a Real holding its
 //! size in bytes (read-only); an array as one variable per element, `y[1]`, `y[2]`, ...
 //! (`A[1,2]`: 1-based, row-major, as FMI 2.0 names array elements) with value references
-//! of the view's own above the FMU's. An [`Instance`] translates each call on them to the
+//! of the view's own above the FMU's; an `<Alias>` as one more variable of the same value
+//! reference (after all others, out of the ModelStructure, as FMI 2.0 aliases are). An [`Instance`] translates each call on them to the
 //! FMI 3.0 function of the variable's type (an element set alone: the array's other
 //! elements as set before, or its start values). Variables the view cannot hold (String
 //! and Binary arrays, clocks) are listed by [`Fmu::not_in_view`].
@@ -44,14 +45,14 @@ pub(crate) struct Fmi3Abi {
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
-/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions).
+/// `scheduled`: run in Scheduled Execution, which runs the clocks (its model partitions);
+/// elsewhere the clocks are run by the master (see [`crate::clocks`]).
 pub(crate) fn unsupported_feature(md: &fmi3::ModelDescription, scheduled: bool) -> Option<String> {
     if scheduled {
         return None;
     }
-    if let Some(clock) = md.model_variables.iter().find(|v| v.value_type == fmi3::ValueType::Clock) {
-        let scheduled = if md.scheduled_execution.is_some() { "; its Scheduled Execution runs them" } else { "" };
-        return Some(format!("clocks (Clock variable {:?}{scheduled})", clock.name));
+    if let Some(clock) = crate::clocks::unreadable_clock(md) {
+        return Some(clock);
     }
     if md.co_simulation.is_none() && md.model_exchange.is_none() && md.scheduled_execution.is_some() {
         return Some("Scheduled Execution (the FMU offers no other interface type)".into());
@@ -81,6 +82,62 @@ pub(crate) struct Access {
     /// The element (0-based, row-major) and the variable's element count (1 for a scalar).
     pub(crate) element: usize,
     pub(crate) count: usize,
+}
+
+/// The kind of a variable of the view whose values an f64 does not hold exactly: its
+/// Real in the view is the nearest f64 (a Binary: its size in bytes), and
+/// [`crate::Instance::get_exact`] reads the value itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExactKind {
+    /// An FMI 3.0 Int64 (beyond 2^53 an f64 rounds it).
+    Int64,
+    /// An FMI 3.0 UInt64.
+    UInt64,
+    /// An FMI 3.0 Binary.
+    Binary,
+}
+
+/// A value as the FMU holds it, where the view's f64 is not it: a 64-bit integer, a
+/// String's text, a Binary's bytes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Exact {
+    /// An Int64 or UInt64.
+    Integer(i128),
+    /// A String.
+    Text(String),
+    /// A Binary.
+    Bytes(Vec<u8>),
+}
+
+impl Exact {
+    /// As fmpy writes it in a CSV file: an integer in decimal, a text as it is, bytes in
+    /// lower-case hex (Python's `bytes.hex()`).
+    pub fn to_text(&self) -> String {
+        match self {
+            Exact::Integer(i) => i.to_string(),
+            Exact::Text(s) => s.clone(),
+            Exact::Bytes(b) => {
+                use std::fmt::Write;
+                let mut s = String::with_capacity(2 * b.len());
+                for x in b {
+                    let _ = write!(s, "{x:02x}");
+                }
+                s
+            }
+        }
+    }
+}
+
+impl ExactKind {
+    /// The kind of a variable of `value_type`, if its values need it.
+    pub(crate) fn of(value_type: fmi3::ValueType) -> Option<ExactKind> {
+        match value_type {
+            fmi3::ValueType::Int64 => Some(ExactKind::Int64),
+            fmi3::ValueType::UInt64 => Some(ExactKind::UInt64),
+            fmi3::ValueType::Binary => Some(ExactKind::Binary),
+            _ => None,
+        }
+    }
 }
 
 /// Arrays with more elements than this are left out of the view (one column each would
@@ -126,7 +183,7 @@ pub enum LeftOut {
     StringArray,
     /// A Binary array.
     BinaryArray,
-    /// A clock (an FMU with clocks is refused at load; listed for `cosim info`).
+    /// A clock (run by the master through the clock calls; listed by `Fmu::clocks`).
     Clock,
     /// An array of more than 100,000 elements.
     TooLarge,
@@ -172,6 +229,8 @@ pub(crate) fn fmi2_view(
     // (FMU value reference, element) of each variable of the view
     let mut elements: Vec<(u32, usize)> = Vec::new();
     let mut variables: Vec<ScalarVariable> = Vec::new();
+    // the <Alias> names, after all variables (the ModelStructure's indices stay theirs)
+    let mut alias_variables: Vec<ScalarVariable> = Vec::new();
     for v in &md.model_variables {
         let dims = if v.is_array() { sizes(md, v) } else { Some(Vec::new()) };
         // a product of sizes beyond u64 is too large, not a wrapped-around small one
@@ -281,6 +340,19 @@ pub(crate) fn fmi2_view(
                 );
             }
             elements.push((v.value_reference, k));
+            // an <Alias>: the same value reference under its own name, out of the
+            // ModelStructure (as FMI 2.0 lists one variable of an alias set there)
+            for alias in &v.aliases {
+                alias_variables.push(ScalarVariable {
+                    name: if v.is_array() { element_name(&alias.name, &dims, k as u64) } else { alias.name.clone() },
+                    value_reference,
+                    description: alias.description.clone().or_else(|| v.description.clone()),
+                    causality,
+                    variability: v.variability,
+                    initial: None,
+                    variable_type: without_start(&variable_type),
+                });
+            }
             variables.push(ScalarVariable {
                 name,
                 value_reference,
@@ -410,10 +482,26 @@ pub(crate) fn fmi2_view(
         type_definitions,
         log_categories: md.log_categories.clone(),
         default_experiment: md.default_experiment.clone(),
-        model_variables: variables,
+        model_variables: variables.into_iter().chain(alias_variables).collect(),
         model_structure,
     };
     (view, special, left_out)
+}
+
+/// `t` without its start value (an alias has none of its own: FMI 2.0 gives a start to
+/// one variable of an alias set).
+fn without_start(t: &VariableType) -> VariableType {
+    let mut t = t.clone();
+    match &mut t {
+        VariableType::Real { start, derivative, .. } => {
+            *start = None;
+            *derivative = None;
+        }
+        VariableType::Integer { start, .. } | VariableType::Enumeration { start, .. } => *start = None,
+        VariableType::Boolean { start } => *start = None,
+        VariableType::String { start } => *start = None,
+    }
+    t
 }
 
 /// The resource path FMI 3.0 wants: an absolute native path ending in a separator.
@@ -540,7 +628,12 @@ mod tests {
             r#"<Float64 name="z" valueReference="9"/><Clock name="tick" valueReference="10" causality="input" intervalVariability="constant" intervalDecimal="0.1"/>"#,
         );
         let md = fmi3::ModelDescription::from_xml(&clock).unwrap();
-        assert_eq!(unsupported_feature(&md, false).as_deref(), Some("clocks (Clock variable \"tick\")"));
+        assert_eq!(unsupported_feature(&md, false), None, "clocks are run (in Co-Simulation with Event Mode)");
+        let md = fmi3::ModelDescription::from_xml(
+            &clock.replace(r#"intervalVariability="constant""#, r#"intervalVariability="often""#),
+        )
+        .unwrap();
+        assert!(unsupported_feature(&md, false).unwrap().contains("intervalVariability \"often\""));
         let se =
             XML.replace(r#"<ModelExchange modelIdentifier="m" needsCompletedIntegratorStep="true"/>"#, "").replace(
                 r#"<CoSimulation modelIdentifier="m" canHandleVariableCommunicationStepSize="true"/>"#,

@@ -109,11 +109,25 @@ impl Fmu {
         }
     }
 
+    /// FMI 3.0: whether the view's variable `vr` holds values an f64 does not (Int64,
+    /// UInt64, Binary), and which; `None` for every other variable and for FMI 2.0.
+    pub fn exact_kind(&self, vr: u32) -> Option<crate::fmi3::ExactKind> {
+        match &self.abi {
+            Abi::Fmi2(_) => None,
+            Abi::Fmi3(a) => a.special.get(&vr).and_then(|access| crate::fmi3::ExactKind::of(access.value_type)),
+        }
+    }
+
     /// FMI 3.0: the variables the view leaves out (String and Binary arrays, arrays of
     /// more than 100,000 elements or of sizes it cannot resolve), neither recorded, set nor
     /// connected, each with the reason; empty for FMI 2.0.
     pub fn not_in_view(&self) -> &[(String, crate::fmi3::LeftOut)] {
         &self.not_in_view
+    }
+
+    /// The FMU's clocks (FMI 3.0; none for FMI 2.0), as its description declares them.
+    pub fn clocks(&self) -> Vec<crate::clocks::Clock> {
+        self.fmi3_description().map(crate::clocks::clocks_of).unwrap_or_default()
     }
 
     /// The same FMU with its instances in host processes: a function table that carries

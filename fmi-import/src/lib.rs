@@ -21,8 +21,9 @@
 //! `scripts/import-cycles.py`, a stage of the test command: no import circle):
 //!
 //! ```text
-//! status, c_types, elf, suggest, call_site, fmi3   leaves (fmi3: the FMI 3.0 view)
+//! status, c_types, elf, suggest, call_site, clocks   leaves
 //! platform     -> elf                              this build's binaries folders
+//! fmi3         -> clocks, c_types                  the FMI 3.0 view (clocks: of every generation)
 //! error        -> status
 //! log          -> status, c_types                  what FMUs log, both loggers
 //! unpack       -> error, platform
@@ -37,9 +38,10 @@
 //! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
 //! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
-//! instance/fmi2, instance/fmi3 -> instance/core, fmu, fmi3, log, isolate/proxy*
+//! instance/callbacks -> log                       Scheduled Execution's callbacks
+//! instance/fmi2, instance/fmi3 -> instance/core, instance/callbacks, fmu, fmi3, log, isolate/proxy*
 //! instance/configuration -> instance/core, instance/fmi3   Configuration Mode
-//! instance/scheduled -> instance/core, instance/fmi3, instance, fmu, log   Scheduled Execution
+//! instance/scheduled -> instance/core, instance/fmi3, instance/callbacks, instance, fmu, log
 //! instance     -> instance/core, instance/fmi2, instance/fmi3, fmu, log, isolate
 //! ```
 //!
@@ -51,6 +53,7 @@
 
 pub mod c_types;
 pub mod call_site;
+pub mod clocks;
 pub mod elf;
 pub mod error;
 pub mod fmi3;
@@ -73,7 +76,7 @@ pub use c_types::EventInfo;
 pub use call_site::ExitInsideCall;
 pub use error::{Error, HostEnd, Result};
 pub use fmu::{Fmu, ImportOptions, Interface};
-pub use instance::{FmuState, Instance, InstanceState};
+pub use instance::{FmuState, Instance, InstanceState, Interval, OutputTick};
 pub use isolate::Isolation;
 pub use load::{read_fmi3_description, read_model_description};
 pub use log::{LogRecord, LogSink};

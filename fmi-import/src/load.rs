@@ -353,15 +353,17 @@ fn load<G: Generation>(
         }
         None => Interface::ModelExchange,
     };
-    if let Some(feature) = G::unsupported(&described, interface) {
-        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
-    }
     let identifier = match interface {
         Interface::CoSimulation => description.co_simulation.as_ref().map(|c| c.model_identifier.clone()),
         Interface::ModelExchange => description.model_exchange.as_ref().map(|m| m.model_identifier.clone()),
         Interface::ScheduledExecution => G::scheduled_identifier(&described),
     }
     .ok_or(Error::NoInterface { path: path.to_path_buf(), interface: interface.as_str() })?;
+    // an interface the FMU does not offer is named first (the Clocks of the Reference FMUs
+    // asked for in Co-Simulation: it has none), then what the master does not run in it
+    if let Some(feature) = G::unsupported(&described, interface) {
+        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
+    }
     if !model_description::is_c_identifier(&identifier) {
         return Err(Error::ModelDescription {
             path: path.to_path_buf(),
@@ -398,7 +400,7 @@ fn load<G: Generation>(
         return Err(Error::MissingSymbol { path: shown, symbol });
     }
     let (abi, resource_uri, not_in_view) = G::finish(table, described, dir.path(), path)?;
-    Ok(Arc::new(Fmu {
+    let fmu = Fmu {
         abi,
         allow_non_finite: options.allow_non_finite,
         _library: library,
@@ -412,5 +414,25 @@ fn load<G: Generation>(
         library_path: so,
         not_in_view,
         configured_from: None,
-    }))
+    };
+    if let Some(feature) = clocks_not_run(&fmu) {
+        return Err(Error::Unsupported { path: path.to_path_buf(), feature });
+    }
+    Ok(Arc::new(fmu))
+}
+
+/// Clocks where the master does not run them: in Co-Simulation without Event Mode, in an
+/// instance of a host process (the host protocol carries no clock call).
+fn clocks_not_run(fmu: &Fmu) -> Option<String> {
+    let clocks = fmu.clocks();
+    let first = clocks.first()?;
+    let has_event_mode = fmu.fmi3_description()?.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+    let why = match fmu.interface {
+        // Scheduled Execution runs the clocks itself (its model partitions)
+        Interface::ScheduledExecution => return None,
+        Interface::CoSimulation if !has_event_mode => "in Co-Simulation without Event Mode (hasEventMode)",
+        _ if fmu.is_isolated() => "in an isolated instance (a host process)",
+        _ => return None,
+    };
+    Some(format!("clocks {why} (Clock variable {:?})", first.name))
 }

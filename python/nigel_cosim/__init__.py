@@ -46,6 +46,7 @@ __all__ = [
     "System",
     "run_campaign",
     "compare",
+    "info",
     "write_csv",
     "Error",
     "LoadError",
@@ -483,6 +484,14 @@ def run_campaign(
     except ImportError:
         return np.genfromtxt(csv, delimiter=",", names=True, dtype=None, encoding="utf-8")
     return pandas.read_csv(csv)
+
+
+def info(filename: str | os.PathLike) -> str:
+    """What the FMU or SSP ``filename`` declares, as ``cosim info`` prints it: the model,
+    its interfaces and default experiment and one line per variable (name, causality,
+    variability, type, unit, start, range, description); for an SSP its instances, the
+    values it applies and its connections. Raises ``LoadError`` for a file it cannot read."""
+    return _native.info(os.fspath(filename))
 
 
 def compare(

@@ -88,6 +88,7 @@ def run_campaign(
     progress: bool = False,
 ) -> tuple[str, int, int]: ...
 
+def info(filename: str | os.PathLike[str]) -> str: ...
 def compare(
     result: str,
     baseline: str,

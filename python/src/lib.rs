@@ -14,13 +14,14 @@
 //!
 //! One module per class or concern: `errors` (the exception classes), `run_args` (a
 //! run's arguments and their experiment), `system` (`NativeSystem`), `stepped_run`
-//! (`NativeRun`), `interrupt` (waiting with signals handled), `campaign`, `compare`;
+//! (`NativeRun`), `interrupt` (waiting with signals handled), `campaign`, `compare`, `info`;
 //! this file only registers them. `nigel_cosim/_native.pyi` is their typed surface, checked
 //! against the built module by mypy's `stubtest` (scripts/test-python-package.sh).
 
 mod campaign;
 mod compare;
 mod errors;
+mod info;
 mod interrupt;
 mod run_args;
 mod stepped_run;
@@ -34,6 +35,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stepped_run::NativeRun>()?;
     m.add_function(wrap_pyfunction!(campaign::run_campaign, m)?)?;
     m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(info::info, m)?)?;
     errors::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

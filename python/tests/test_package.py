@@ -157,7 +157,27 @@ def test_simulate_ssp_applies_mappings_connector_values_and_start_as_the_command
     assert not np.array_equal(own["plant.y"], ours["plant.y"])
     info = subprocess.run([COSIM, "info", ssp], check=True, capture_output=True, text=True).stdout
     assert "plant.m = 2.7 (from 2700 g)" in info, info
+    # nigel_cosim.info is the same function as `cosim info` (nigel_cosim::info::describe)
+    assert nigel_cosim.info(ssp) == info
     assert b"cosim: note: " in done.stderr and b"trailer.m" in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("name", ["nigel_plant", "nigel_controller"])
+def test_info_is_what_cosim_info_prints(name):
+    """`nigel_cosim.info` and `cosim info` share one library function: the same text, a
+    line per variable; a file that is no FMU raises LoadError naming it."""
+    fmu = FMU / f"{name}.fmu"
+    text = nigel_cosim.info(fmu)
+    assert text == subprocess.run([COSIM, "info", fmu], check=True, capture_output=True, text=True).stdout
+    with nigel_cosim.System(fmu) as system:
+        names = [v["name"] for v in system.variables()]
+    assert text.startswith("model "), text[:80]
+    # one line per variable, in the order of the modelDescription, each starting with its name
+    lines = text.splitlines()
+    rows = lines[lines.index(next(line for line in lines if line.startswith("name "))) + 1:]
+    assert [row.split()[0] for row in rows[:len(names)]] == names
+    with pytest.raises(nigel_cosim.LoadError, match="missing.fmu"):
+        nigel_cosim.info(FMU / "missing.fmu")
 
 
 def test_a_system_runs_many_times_from_one_load_as_separate_runs():

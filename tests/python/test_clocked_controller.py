@@ -1,8 +1,9 @@
 """The controller built with the option `controller-sample-clock` (its FMI 3.0 archive
 declares the sample period as the periodic input clock `sample_clock`), driven by fmpy's
-low-level FMI 3.0 calls as an independent importer: Co-Simulation with Event Mode, the clock
-activated at t_k = k T with T read by fmi3GetIntervalDecimal, against the FMI 2.0 archive of
-the same build stepped by fmpy's FMU2Slave on the same grid with the same inputs.
+low-level FMI 3.0 calls as an independent importer: Co-Simulation with Event Mode (the clock
+activated at t_k = k T with T read by fmi3GetIntervalDecimal) and Scheduled Execution (the
+clock's model partition activated at t_k), against the FMI 2.0 archive of the same build
+stepped by fmpy's FMU2Slave on the same grid with the same inputs.
 
 The archives are built by the test command (scripts/test.sh) into target/fmu-clocked/fmu:
 `cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64
@@ -11,6 +12,7 @@ target/fmu-clocked/fmu` (NIGEL_CLOCKED_FMU_DIR names another folder).
 
 import math
 import os
+import zipfile
 from ctypes import c_double, c_int, c_uint32
 from pathlib import Path
 
@@ -18,7 +20,7 @@ import pytest
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
+from fmpy.fmi3 import FMU3ScheduledExecution, FMU3Slave
 from fmpy.validation import validate_fmu
 
 REPO = Path(__file__).resolve().parents[2]
@@ -58,6 +60,11 @@ def test_the_clocked_archive_validates_and_declares_its_clock(archives):
     clocked = sorted(v.name for v in md.modelVariables if v.clocks)
     assert clocked == sorted(HELD)
     assert md.coSimulation.hasEventMode
+    # the model partition of Scheduled Execution, priority 0 (fmpy does not read priority)
+    assert md.scheduledExecution is not None
+    with zipfile.ZipFile(fmu3) as z:
+        xml = z.read("modelDescription.xml").decode()
+    assert '<Clock name="sample_clock" valueReference="60"' in xml and 'priority="0"' in xml
     # the FMI 2.0 archive of the same build has no clock
     assert all(v.type != "Clock" for v in read_model_description(fmu2).modelVariables)
 
@@ -100,9 +107,8 @@ def test_fmpy_activating_the_clock_gets_the_fmi2_outputs_bit_for_bit(archives):
         s3.enterStepMode()
         s3.doStep(currentCommunicationPoint=t, communicationStepSize=period)
         s2.doStep(currentCommunicationPoint=t, communicationStepSize=period)
-    # a clocked output in Step Mode is refused (the clock is active only in Event Mode)
-    with pytest.raises(Exception, match="status 3"):
-        s3.getFloat64([vr3["delta_fl"]])
+    # between activations (Step Mode) a clocked output holds the last activation's value
+    assert s3.getFloat64([vr3[n] for n in HELD]) == held3[:-1]
     s3.freeInstance()
     s2.terminate()
     s2.freeInstance()
@@ -115,3 +121,38 @@ def test_fmpy_cannot_use_the_clocked_archive_without_event_mode(archives):
                    modelIdentifier="nigel_controller", instanceName="no_event_mode")
     with pytest.raises(Exception):
         s3.instantiate(eventModeUsed=False)
+
+
+def test_fmpy_activating_the_partition_gets_the_fmi2_outputs_bit_for_bit(archives):
+    fmu3, fmu2 = archives
+    md3, md2 = read_model_description(fmu3), read_model_description(fmu2)
+    vr3 = {v.name: v.valueReference for v in md3.modelVariables}
+    vr2 = {v.name: v.valueReference for v in md2.modelVariables}
+    se = FMU3ScheduledExecution(guid=md3.instantiationToken, unzipDirectory=extract(fmu3),
+                                modelIdentifier="nigel_controller", instanceName="scheduled")
+    s2 = FMU2Slave(guid=md2.guid, unzipDirectory=extract(fmu2), modelIdentifier="nigel_controller",
+                   instanceName="sampled")
+    se.instantiate()
+    se.enterInitializationMode(startTime=0.0)
+    se.exitInitializationMode()
+    s2.instantiate()
+    s2.setupExperiment(startTime=0.0)
+    s2.enterInitializationMode()
+    s2.exitInitializationMode()
+    period = 1e-3
+    for k in range(300):
+        t = k * period  # the activation times by hand: t_k = start + k T
+        x = inputs(k)
+        se.setFloat64([vr3[n] for n in INPUTS], x)
+        s2.setReal([vr2[n] for n in INPUTS], x)
+        se.activateModelPartition(vr3["sample_clock"], t)
+        held3 = se.getFloat64([vr3[n] for n in HELD + ["speed_integral"]])
+        held2 = s2.getReal([vr2[n] for n in HELD + ["speed_integral"]])
+        assert [y.hex() for y in held3] == [y.hex() for y in held2], f"sample {k} at t = {t} s"
+        s2.doStep(currentCommunicationPoint=t, communicationStepSize=period)
+    # an activation off the clock's grid is refused
+    with pytest.raises(Exception, match="status 3"):
+        se.activateModelPartition(vr3["sample_clock"], 300.5 * period)
+    se.freeInstance()
+    s2.terminate()
+    s2.freeInstance()

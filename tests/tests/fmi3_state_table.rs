@@ -182,6 +182,8 @@ fn interface_allows(name: &str, interface: Interface) -> bool {
     match interface {
         Interface::CoSimulation => !MODEL_EXCHANGE_ONLY.contains(&name),
         Interface::ModelExchange => !CO_SIMULATION_ONLY.contains(&name),
+        // the plant declares no clock, so it offers no Scheduled Execution
+        Interface::ScheduledExecution => false,
     }
 }
 
@@ -198,10 +200,12 @@ fn declared(name: &str, interface: Interface) -> bool {
     let common = match interface {
         Interface::CoSimulation => &cs.common,
         Interface::ModelExchange => &me.common,
+        Interface::ScheduledExecution => panic!("the plant offers no Scheduled Execution"),
     };
     let evaluate_discrete_states = match interface {
         Interface::CoSimulation => cs.provides_evaluate_discrete_states,
         Interface::ModelExchange => me.provides_evaluate_discrete_states,
+        Interface::ScheduledExecution => false,
     };
     match name {
         "fmi3GetClock"

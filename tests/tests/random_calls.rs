@@ -8,36 +8,29 @@
 //! `NIGEL_RANDOM_SEQUENCES` sets the number of sequences per FMU and interface
 //! (default 150,000: some 1.2 million calls per interface for the plant, a few seconds).
 
-use std::ffi::{c_char, c_int, c_void};
+use std::ffi::{c_char, c_int};
 use std::ptr::{null, null_mut};
 
 use fmi_export::states::{Function, Machine, Scope};
 use model_description::ModelDescription;
-use nigel_integration_tests::{built_fmu, EventInfo, Fmu, CO_SIMULATION, DISCARD, ERROR, MODEL_EXCHANGE, OK};
+use nigel_integration_tests::{EventInfo, Fmu, CO_SIMULATION, ERROR, MODEL_EXCHANGE, OK};
 
-struct Rng(u64);
+mod random;
+use random::{every_fmu_and_interface, Moves, Rng, Shadow, HOSTILE};
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // xorshift64*
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-    fn chance(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
-    }
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[self.below(items.len())]
-    }
-}
-
-const HOSTILE: [f64; 12] =
-    [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
+/// The FMI 2.0 functions that move the importer's view of the state.
+const MOVES: Moves = Moves {
+    do_step: Function::DoStep,
+    enter_initialization_mode: Function::EnterInitializationMode,
+    exit_initialization_mode: Function::ExitInitializationMode,
+    terminate: Function::Terminate,
+    reset: Function::Reset,
+    enter_event_mode: Function::EnterEventMode,
+    enter_continuous_time_mode: Function::EnterContinuousTimeMode,
+    set_fmu_state: Function::SetFMUstate,
+    discard_fails_the_step: true,
+    ok: "fmi2OK",
+};
 
 struct Pools {
     real: Vec<u32>,
@@ -57,15 +50,6 @@ fn pools(md: &ModelDescription) -> Pools {
 }
 
 /// The importer side of one instance: what it believes the state is.
-struct Shadow {
-    machine: Option<Machine>,
-    time: f64,
-    /// live FMU states and the machine they were saved in (None: unknown, deserialized)
-    states: Vec<(*mut c_void, Option<Machine>)>,
-    freed: Vec<*mut c_void>,
-    bytes: Vec<u8>,
-}
-
 fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
     let md = &fmu.description;
     let p = pools(md);
@@ -77,13 +61,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
         let (instance, _log) = fmu.instantiate("random", kind, fmu.guid());
         let i = instance.expect("instantiate");
         let c = i.c;
-        let mut sh = Shadow {
-            machine: Some(Machine::Instantiated),
-            time: 0.0,
-            states: Vec::new(),
-            freed: Vec::new(),
-            bytes: Vec::new(),
-        };
+        let mut sh = Shadow::instantiated();
         let calls = 1 + rng.below(16);
         for _ in 0..calls {
             // 40 %: a call that makes progress from the current state (so that sequences
@@ -109,25 +87,10 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
             let null_array = rng.chance(3);
             let vrs = |rng: &mut Rng, pool: &[u32]| -> Vec<u32> { (0..n).map(|_| rng.pick(pool)).collect() };
             let ptr = |v: &Vec<u32>| if null_array { null() } else { v.as_ptr() };
-            let time_arg = |rng: &mut Rng, now: f64| -> f64 {
-                if rng.chance(70) {
-                    now
-                } else {
-                    rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
-                }
-            };
             // at least one slot: fmi2GetRealStatus writes one value (an FMU may have nx = 0)
             let mut reals_out = vec![f64::NAN; n.max(p.nx).max(1)];
             let mut check_reals: Option<usize> = None;
             let mut new_time = None;
-            let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
-                match rng.below(4) {
-                    0 | 1 if !sh.states.is_empty() => sh.states[rng.below(sh.states.len())].0,
-                    2 if !sh.freed.is_empty() => sh.freed[rng.below(sh.freed.len())],
-                    3 => 0x40usize as *mut c_void,
-                    _ => null_mut(),
-                }
-            };
             let mut restored: Option<Option<Machine>> = None;
             let status = unsafe {
                 match function {
@@ -217,7 +180,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         status
                     }
                     Function::SetFMUstate => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let status = (f.set_fmu_state.unwrap())(c, s);
                         if status == OK {
                             restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
@@ -225,7 +188,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         status
                     }
                     Function::FreeFMUstate => {
-                        let mut s = state_arg(&mut rng, &sh);
+                        let mut s = sh.state_arg(&mut rng);
                         let before = s;
                         let status = (f.free_fmu_state.unwrap())(c, &mut s);
                         if status == OK && !before.is_null() {
@@ -237,10 +200,10 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     }
                     Function::SerializedFMUstateSize => {
                         let mut size = 0usize;
-                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
+                        (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
                     Function::SerializeFMUstate => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let mut size = 0usize;
                         let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
                         let size = if rng.chance(10) { size / 2 } else { size };
@@ -296,7 +259,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         (f.get_real_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), x.as_mut_ptr())
                     }
                     Function::DoStep => {
-                        let t = time_arg(&mut rng, sh.time);
+                        let t = rng.time(sh.time);
                         let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
                         let s = (f.do_step.unwrap())(c, t, h, 1);
                         if s == OK || s == 1 {
@@ -340,7 +303,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         (f.completed_integrator_step.unwrap())(c, 1, &mut a, &mut b)
                     }
                     Function::SetTime => {
-                        let t = time_arg(&mut rng, sh.time + 1e-3);
+                        let t = rng.time(sh.time + 1e-3);
                         let s = (f.set_time.unwrap())(c, t);
                         if s == OK || s == 1 {
                             new_time = Some(t);
@@ -381,48 +344,7 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                     assert_eq!(status, ERROR, "{function:?} in {m:?} ({})", if kind == 1 { "CS" } else { "ME" });
                 }
             }
-            if status == OK {
-                if let Some(k) = check_reals {
-                    if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
-                        panic!("{function:?} handed out {bad} with fmi2OK");
-                    }
-                }
-            }
-            // the importer's view of the new state
-            if status == ERROR {
-                sh.machine = Some(Machine::Error);
-            } else if status == DISCARD && function == Function::DoStep {
-                sh.machine = Some(Machine::StepFailed);
-            } else if status == OK || status == 1 {
-                if let Some(t) = new_time {
-                    sh.time = t;
-                }
-                let after = match function {
-                    Function::EnterInitializationMode => Some(Some(Machine::InitializationMode)),
-                    Function::ExitInitializationMode => {
-                        Some(Some(if kind == CO_SIMULATION { Machine::StepComplete } else { Machine::EventMode }))
-                    }
-                    Function::Terminate => Some(Some(Machine::Terminated)),
-                    Function::Reset => {
-                        sh.time = 0.0;
-                        Some(Some(Machine::Instantiated))
-                    }
-                    Function::EnterEventMode => Some(Some(Machine::EventMode)),
-                    Function::EnterContinuousTimeMode => Some(Some(Machine::ContinuousTimeMode)),
-                    Function::SetFMUstate => {
-                        sh.time = f64::NAN; // unknown until the next reset
-                        restored
-                    }
-                    _ => None,
-                };
-                if let Some(m) = after {
-                    sh.machine = m;
-                }
-            }
-            if sh.time.is_nan() {
-                // the restored time is unknown here: a guess (a wrong one just gives an error)
-                sh.time = 0.0;
-            }
+            sh.after(&MOVES, function, status, check_reals, &reals_out, new_time, restored, kind == CO_SIMULATION);
         }
         // the instance is freed with its live FMU states (the allocator would report a double free)
     }
@@ -432,35 +354,10 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
 #[test]
 fn random_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
     let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES").ok().and_then(|s| s.parse().ok()).unwrap_or(150_000);
-    let mut plant = Vec::new(); // the plant's counts per interface, which docs/testing.md prints
-    for (k, target) in build_fmu::targets().iter().enumerate() {
-        let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
-        for kind in [CO_SIMULATION, MODEL_EXCHANGE] {
-            let offered = if kind == CO_SIMULATION {
-                fmu.description.co_simulation.is_some()
-            } else {
-                fmu.description.model_exchange.is_some()
-            };
-            if !offered {
-                continue;
-            }
-            let counts = run(&fmu, kind, sequences, 0x9E37_79B9_7F4A_7C15 ^ (k as u64 * 2 + kind as u64));
-            let total: usize = counts.iter().sum();
-            println!(
-                "{} {}: {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
-                target.model_identifier,
-                if kind == CO_SIMULATION { "CS" } else { "ME" },
-                counts[0],
-                counts[1],
-                counts[2],
-                counts[3]
-            );
-            assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
-            if target.model_identifier == "nigel_plant" {
-                plant.push(counts);
-            }
-        }
-    }
+    // the plant's counts per interface, which docs/testing.md prints
+    let plant = every_fmu_and_interface("", sequences, 0x9E37_79B9_7F4A_7C15, "nigel_plant", |fmu, cs, seed| {
+        run(fmu, if cs { CO_SIMULATION } else { MODEL_EXCHANGE }, sequences, seed)
+    });
     if sequences == 150_000 {
         readme_prints_the_plant_counts(&plant);
     }

@@ -11,36 +11,28 @@
 //! `NIGEL_RANDOM_SEQUENCES3` sets the number of sequences per FMU and interface (default
 //! 20,000).
 
-use std::ffi::c_void;
 use std::ptr::{null, null_mut};
 
 use fmi_export::states::{Function, Machine, Scope};
 use model_description::{ModelDescription, VariableType};
-use nigel_integration_tests::{built_fmu, Fmu, DISCARD, ERROR, OK};
+use nigel_integration_tests::{Fmu, ERROR, OK};
 
-struct Rng(u64);
+mod random;
+use random::{every_fmu_and_interface, Moves, Rng, Shadow, HOSTILE};
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        // xorshift64*
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-    fn chance(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
-    }
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[self.below(items.len())]
-    }
-}
-
-const HOSTILE: [f64; 12] =
-    [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
+/// The FMI 3.0 functions that move the importer's view of the state.
+const MOVES: Moves = Moves {
+    do_step: Function::Fmi3DoStep,
+    enter_initialization_mode: Function::Fmi3EnterInitializationMode,
+    exit_initialization_mode: Function::Fmi3ExitInitializationMode,
+    terminate: Function::Fmi3Terminate,
+    reset: Function::Fmi3Reset,
+    enter_event_mode: Function::Fmi3EnterEventMode,
+    enter_continuous_time_mode: Function::Fmi3EnterContinuousTimeMode,
+    set_fmu_state: Function::Fmi3SetFMUState,
+    discard_fails_the_step: false,
+    ok: "fmi3OK",
+};
 
 /// FMI 3.0 value references by type (FMI 2.0 variable index i is FMI 3.0 value reference
 /// i; `time` is 0), each pool with foreign ones mixed in.
@@ -77,14 +69,6 @@ fn pools(md: &ModelDescription) -> Pools {
     }
 }
 
-struct Shadow {
-    machine: Option<Machine>,
-    time: f64,
-    states: Vec<(*mut c_void, Option<Machine>)>,
-    freed: Vec<*mut c_void>,
-    bytes: Vec<u8>,
-}
-
 fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4] {
     let p = pools(&fmu.description);
     let f = &fmu.functions3;
@@ -95,13 +79,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
         let (instance, log) = fmu.instantiate3("random3", co_simulation, fmu.guid());
         let i = instance.expect("instantiate");
         let c = i.c;
-        let mut sh = Shadow {
-            machine: Some(Machine::Instantiated),
-            time: 0.0,
-            states: Vec::new(),
-            freed: Vec::new(),
-            bytes: Vec::new(),
-        };
+        let mut sh = Shadow::instantiated();
         for _ in 0..1 + rng.below(16) {
             let progress: &[Function] = match sh.machine {
                 Some(Machine::Instantiated) => &[Function::Fmi3EnterInitializationMode, Function::Fmi3SetFloat64],
@@ -136,24 +114,9 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
             let null_array = rng.chance(3);
             let vrs = |rng: &mut Rng, pool: &[u32]| -> Vec<u32> { (0..n).map(|_| rng.pick(pool)).collect() };
             let ptr = |v: &Vec<u32>| if null_array { null() } else { v.as_ptr() };
-            let time_arg = |rng: &mut Rng, now: f64| -> f64 {
-                if rng.chance(70) {
-                    now
-                } else {
-                    rng.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
-                }
-            };
             let mut reals_out = vec![f64::NAN; n_values.max(p.nx).max(1)];
             let mut check_reals: Option<usize> = None;
             let mut new_time = None;
-            let state_arg = |rng: &mut Rng, sh: &Shadow| -> *mut c_void {
-                match rng.below(4) {
-                    0 | 1 if !sh.states.is_empty() => sh.states[rng.below(sh.states.len())].0,
-                    2 if !sh.freed.is_empty() => sh.freed[rng.below(sh.freed.len())],
-                    3 => 0x40usize as *mut c_void,
-                    _ => null_mut(),
-                }
-            };
             let mut restored: Option<Option<Machine>> = None;
             let (mut b1, mut b2, mut b3, mut b4, mut b5) = (7u8, 7u8, 7u8, 7u8, 7u8);
             let mut t_out = f64::NAN;
@@ -318,7 +281,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         status
                     }
                     Fmi3SetFMUState => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let status = (f.set_fmu_state.unwrap())(c, s);
                         if status == OK {
                             restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
@@ -326,7 +289,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         status
                     }
                     Fmi3FreeFMUState => {
-                        let mut s = state_arg(&mut rng, &sh);
+                        let mut s = sh.state_arg(&mut rng);
                         let before = s;
                         let status = (f.free_fmu_state.unwrap())(c, &mut s);
                         if status == OK && !before.is_null() {
@@ -338,10 +301,10 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     }
                     Fmi3SerializedFMUStateSize => {
                         let mut size = 0usize;
-                        (f.serialized_fmu_state_size.unwrap())(c, state_arg(&mut rng, &sh), &mut size)
+                        (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
                     Fmi3SerializeFMUState => {
-                        let s = state_arg(&mut rng, &sh);
+                        let s = sh.state_arg(&mut rng);
                         let mut size = 0usize;
                         let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
                         let size = if rng.chance(10) { size / 2 } else { size };
@@ -442,7 +405,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     Fmi3EnterContinuousTimeMode => (f.enter_continuous_time_mode.unwrap())(c),
                     Fmi3CompletedIntegratorStep => (f.completed_integrator_step.unwrap())(c, 1, &mut b1, &mut b2),
                     Fmi3SetTime => {
-                        let t = time_arg(&mut rng, sh.time + 1e-3);
+                        let t = rng.time(sh.time + 1e-3);
                         let s = (f.set_time.unwrap())(c, t);
                         if s == OK || s == 1 {
                             new_time = Some(t);
@@ -491,7 +454,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         (f.get_output_derivatives.unwrap())(c, ptr(&v), n, order.as_ptr(), reals_out.as_mut_ptr(), n)
                     }
                     Fmi3DoStep => {
-                        let t = time_arg(&mut rng, sh.time);
+                        let t = rng.time(sh.time);
                         let h = rng.pick(&[1e-3, 1e-3, 0.02, 0.1, 0.0, -1e-3, f64::NAN, 1e9, 1e-300]);
                         let s = (f.do_step.unwrap())(c, t, h, 1, &mut b1, &mut b2, &mut b3, &mut t_out);
                         if s == OK || s == 1 {
@@ -526,48 +489,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                     "{function:?}: an error without its message ({last:?})"
                 );
             }
-            if status == OK {
-                if let Some(k) = check_reals {
-                    if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
-                        panic!("{function:?} handed out {bad} with fmi3OK");
-                    }
-                }
-            }
-            if status == ERROR {
-                sh.machine = Some(Machine::Error);
-            } else if status == DISCARD && function == Function::Fmi3DoStep {
-                // still Step Mode (FMI 3.0 has no Step Discarded state), at the time the
-                // step reached (a guess below: a wrong one just gives an error)
-                sh.time = f64::NAN;
-            } else if status == OK || status == 1 {
-                if let Some(t) = new_time {
-                    sh.time = t;
-                }
-                let after = match function {
-                    Function::Fmi3EnterInitializationMode => Some(Some(Machine::InitializationMode)),
-                    Function::Fmi3ExitInitializationMode => {
-                        Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
-                    }
-                    Function::Fmi3Terminate => Some(Some(Machine::Terminated)),
-                    Function::Fmi3Reset => {
-                        sh.time = 0.0;
-                        Some(Some(Machine::Instantiated))
-                    }
-                    Function::Fmi3EnterEventMode => Some(Some(Machine::EventMode)),
-                    Function::Fmi3EnterContinuousTimeMode => Some(Some(Machine::ContinuousTimeMode)),
-                    Function::Fmi3SetFMUState => {
-                        sh.time = f64::NAN;
-                        restored
-                    }
-                    _ => None,
-                };
-                if let Some(m) = after {
-                    sh.machine = m;
-                }
-            }
-            if sh.time.is_nan() {
-                sh.time = 0.0;
-            }
+            sh.after(&MOVES, function, status, check_reals, &reals_out, new_time, restored, co_simulation);
             // now and then an FMI 2.0 function on the FMI 3.0 instance: refused
             if rng.chance(2) {
                 let s = unsafe { (fmu.functions.terminate)(c) };
@@ -582,30 +504,7 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
 #[test]
 fn random_fmi3_call_sequences_respect_the_state_table_and_never_hand_out_non_finite_numbers() {
     let sequences: usize = std::env::var("NIGEL_RANDOM_SEQUENCES3").ok().and_then(|s| s.parse().ok()).unwrap_or(20_000);
-    for (k, target) in build_fmu::targets().iter().enumerate() {
-        let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
-        for co_simulation in [true, false] {
-            let offered = if co_simulation {
-                fmu.description.co_simulation.is_some()
-            } else {
-                fmu.description.model_exchange.is_some()
-            };
-            if !offered {
-                continue;
-            }
-            let counts =
-                run(&fmu, co_simulation, sequences, 0x3C6E_F372_FE94_F82B ^ (k as u64 * 2 + co_simulation as u64));
-            let total: usize = counts.iter().sum();
-            println!(
-                "{} {} (FMI 3.0): {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
-                target.model_identifier,
-                if co_simulation { "CS" } else { "ME" },
-                counts[0],
-                counts[1],
-                counts[2],
-                counts[3]
-            );
-            assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
-        }
-    }
+    every_fmu_and_interface(" (FMI 3.0)", sequences, 0x3C6E_F372_FE94_F82B, "", |fmu, co_simulation, seed| {
+        run(fmu, co_simulation, sequences, seed)
+    });
 }

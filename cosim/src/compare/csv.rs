@@ -59,7 +59,7 @@ pub fn parse_results_csv(text: &str) -> Result<Results, String> {
             values.push(number(c).ok_or_else(|| format!("{}: {c:?} (column {:?}) is not a number", k + 1, names[j]))?);
         }
     }
-    Ok(Results { names: names[1..].to_vec(), values })
+    Ok(Results { names: names[1..].to_vec(), values, exact: Vec::new() })
 }
 
 #[cfg(test)]

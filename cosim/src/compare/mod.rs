@@ -243,7 +243,7 @@ mod tests {
     use super::*;
 
     fn results(names: &[&str], rows: &[&[f64]]) -> Results {
-        Results { names: names.iter().map(|s| s.to_string()).collect(), values: rows.concat() }
+        Results { names: names.iter().map(|s| s.to_string()).collect(), values: rows.concat(), exact: Vec::new() }
     }
 
     fn tol(rtol: f64, atol: f64, time_tol: f64) -> Tolerance {
@@ -256,7 +256,7 @@ mod tests {
     fn step(at: f64) -> Results {
         let rows: Vec<Vec<f64>> =
             (0..=16).map(|k| k as f64 * 0.25).map(|t| vec![t, if t >= at { 1.0 } else { 0.0 }]).collect();
-        Results { names: vec!["y".into()], values: rows.concat() }
+        Results { names: vec!["y".into()], values: rows.concat(), exact: Vec::new() }
     }
 
     #[test]

@@ -3,12 +3,14 @@
 //! per call as with a host per FMU).
 //!
 //! The parent creates a shared region (`memfd_create`) and starts its own program again
-//! with `NIGEL_COSIM_WHOLE_RUN=FD` in the environment; the host ([`is_host`]) parses the
+//! with `NIGEL_COSIM_WHOLE_RUN=FD,TEXT_FD` in the environment; the host ([`is_host`]) parses the
 //! same command line, loads the FMUs in process and simulates ([`host_simulate`]),
 //! writing into the region:
 //! - before each fmi2 call, the instance, the function and the time, and after it that the
 //!   call returned (`fmi_import::call_site`; with one thread: `--threads` 1);
-//! - each recorded row as it comes (the region grows with `ftruncate` + `mremap`);
+//! - each recorded row as it comes (the region grows with `ftruncate` + `mremap`), and the
+//!   text of its exact columns (64-bit integers, Strings, Binaries) as a line of the
+//!   second file;
 //! - the folders its FMUs are unpacked in (the parent removes them if the host is killed);
 //! - at the end the outcome: the summary's JSON, or that the run failed (the host printed
 //!   the error itself).
@@ -107,10 +109,14 @@ pub fn mark_calls(fd: i32) -> std::result::Result<(), String> {
 /// written into it, and writes the outcome. Returns the process's exit code (the caller
 /// prints an error itself and exits with it).
 pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
-    let fd: i32 = std::env::var(HOST_VARIABLE)
+    // "FD,TEXT_FD": the region, and the file of the exact columns' text
+    let fds: Vec<i32> = std::env::var(HOST_VARIABLE)
         .ok()
-        .and_then(|v| v.parse().ok())
-        .ok_or_else(|| Error::Experiment(format!("{HOST_VARIABLE}: not a descriptor")))?;
+        .map(|v| v.split(',').filter_map(|f| f.parse().ok()).collect())
+        .unwrap_or_default();
+    let [fd, text_fd] = fds[..] else {
+        return Err(Error::Experiment(format!("{HOST_VARIABLE}: not two descriptors")));
+    };
     let width = experiment.record.as_ref().map_or_else(|| default_record(system).len(), |r| r.len()) + 1;
     let mut region = Region { fd, base: std::ptr::null_mut(), len: 0 };
     region.grow(HEADER + width * 8 * 1024).map_err(Error::Experiment)?;
@@ -128,9 +134,22 @@ pub fn host_simulate(system: &System, experiment: &Experiment) -> Result<()> {
     }
     let mut rows = 0usize;
     let mut failed = None;
-    let mut sink = |t: f64, values: &[f64]| {
+    let mut line = String::new();
+    let mut sink = |t: f64, values: &[f64], exact: &[(usize, String)]| {
         if failed.is_some() {
             return;
+        }
+        if !exact.is_empty() {
+            // the row's text first: the parent takes as many text lines as rows
+            line.clear();
+            line.push_str(&serde_json::to_string(exact).unwrap_or_default());
+            line.push('\n');
+            // SAFETY: a write of our own buffer to the inherited descriptor.
+            let written = unsafe { libc::write(text_fd, line.as_ptr() as *const libc::c_void, line.len()) };
+            if written != line.len() as isize {
+                failed = Some(format!("writing the text of a row: {}", std::io::Error::last_os_error()));
+                return;
+            }
         }
         let need = HEADER + (rows + 1) * width * 8;
         if need > region.len {
@@ -248,9 +267,15 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
     // no CLOEXEC: the host inherits the descriptor
     let fd = fmi_import::isolate::os::memfd_create(c"nigel-cosim-run", 0)
         .map_err(|e| failed(format!("memfd_create: {e}")))?;
+    // the text of the exact columns, one line per row (the host appends)
+    let text_fd = fmi_import::isolate::os::memfd_create(c"nigel-cosim-run-text", 0)
+        .map_err(|e| failed(format!("memfd_create: {e}")))?;
     let program = std::env::current_exe().map_err(|e| failed(format!("the running program: {e}")))?;
     let mut command = std::process::Command::new(&program);
-    command.args(args).env(HOST_VARIABLE, fd.as_raw_fd().to_string()).stdin(std::process::Stdio::null());
+    command
+        .args(args)
+        .env(HOST_VARIABLE, format!("{},{}", fd.as_raw_fd(), text_fd.as_raw_fd()))
+        .stdin(std::process::Stdio::null());
     // SAFETY: only prctl between fork and exec; the host dies with the parent.
     unsafe {
         use std::os::unix::process::CommandExt;
@@ -281,10 +306,25 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
     let names = record_names(system, experiment)?;
     let read = read_region(&fd, Some(names));
     let simulating = read.is_some();
-    let (results, state, folders, summary, mark) = match read {
+    let (mut results, state, folders, summary, mark) = match read {
         Some(r) => r,
-        None => (Results { names: record_names(system, experiment)?, values: Vec::new() }, 0, Vec::new(), None, None),
+        None => (
+            Results { names: record_names(system, experiment)?, values: Vec::new(), exact: Vec::new() },
+            0,
+            Vec::new(),
+            None,
+            None,
+        ),
     };
+    let mut text = String::new();
+    {
+        use std::io::{Read, Seek};
+        let mut file = std::fs::File::from(text_fd);
+        if file.rewind().is_ok() {
+            let _ = file.read_to_string(&mut text);
+        }
+    }
+    results.exact = exact_columns(&text, results.rows());
     use std::os::unix::process::ExitStatusExt;
     let outcome = match (state, summary) {
         (1, Some(json)) if killed.is_none() => Ok((summary_of(&json), json)),
@@ -367,11 +407,28 @@ fn read_region(fd: &OwnedFd, names: Option<Vec<String>>) -> Option<Read> {
                 .then(|| serde_json::from_slice(&h.text[folders_len..folders_len + summary_len]).ok())
                 .flatten();
             let mark = (h.call.function_len.load(Ordering::Acquire) > 0).then(|| h.call.last_call());
-            Some((Results { names, values }, state, folders, summary, mark))
+            Some((Results { names, values, exact: Vec::new() }, state, folders, summary, mark))
         })();
         libc::munmap(p, len);
         out
     }
+}
+
+/// The exact columns of the first `rows` rows from the host's text file: one JSON line
+/// per row, `[[column, text], ...]`.
+fn exact_columns(text: &str, rows: usize) -> Vec<crate::simulate::ExactColumn> {
+    let mut columns: Vec<crate::simulate::ExactColumn> = Vec::new();
+    for line in text.lines().take(rows) {
+        let Ok(serde_json::Value::Array(cells)) = serde_json::from_str::<serde_json::Value>(line) else { break };
+        for (k, cell) in cells.iter().enumerate() {
+            let (Some(column), Some(t)) = (cell[0].as_u64(), cell[1].as_str()) else { continue };
+            if columns.len() <= k {
+                columns.push(crate::simulate::ExactColumn { column: column as usize, rows: Vec::new() });
+            }
+            columns[k].rows.push(t.to_string());
+        }
+    }
+    columns
 }
 
 /// The summary from the host's JSON: every field `Summary::to_json` writes, so that
@@ -394,6 +451,9 @@ fn summary_of(v: &serde_json::Value) -> Summary {
         },
         ..Summary::default()
     };
+    if let Some(c) = v["clock_ticks"].as_array() {
+        s.clock_ticks = c.iter().map(|x| (x["clock"].as_str().unwrap_or("").to_string(), count(&x["ticks"]))).collect();
+    }
     if let Some(e) = v["event_times"].as_array() {
         s.events = e
             .iter()

@@ -21,8 +21,9 @@ use crate::simulate::between::{Manipulator, SetQueue, WithManipulator};
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Cancel, Deadline, Observer, Observers, Profiler, Progress, Recorder};
+use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Profiler, Progress, Recorder};
 use crate::simulate::plan::{default_record, run_ops, Op, Plan};
+use crate::simulate::ticks::Ticks;
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
 use crate::system::{BaseType, System, Value, VariableRef};
 use std::sync::atomic::AtomicBool;
@@ -86,6 +87,11 @@ pub struct Execution<'s> {
     ended_by: Option<(String, f64, &'static str)>,
     /// What the run does that a reader may not expect ([`Summary::notes`]).
     notes: Vec<String>,
+    /// An algebraic loop at initialization (its connections, `a.y -> b.u`), iterated to
+    /// its fixed point before Initialization Mode ends.
+    init_loop: Option<Vec<String>>,
+    /// The input file's columns of triggered input clocks: (instance, clock, tick times).
+    clock_inputs: Vec<(usize, u32, Vec<f64>)>,
     phase: Phase,
 }
 
@@ -107,17 +113,34 @@ impl<'s> Execution<'s> {
         if experiment.threads == 0 {
             return Err(Error::Experiment("threads must be at least 1".into()));
         }
+        if experiment.threads > 1 && system.instances.iter().any(|i| !i.fmu.clocks().is_empty()) {
+            return Err(Error::Experiment("FMI 3.0 clocks are run in one thread: use threads = 1".into()));
+        }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
-            Some(names) => names.iter().map(|n| system.resolve(n)).collect::<Result<_>>()?,
+            Some(names) => names
+                .iter()
+                .map(|n| system.resolve_record(n))
+                .collect::<Result<Vec<_>>>()?
+                .into_iter()
+                .flatten()
+                .collect(),
         };
-        if let Some(r) = record.iter().find(|r| r.base_type == BaseType::String) {
-            return Err(Error::Import(crate::ImportError::InvalidValue {
-                variable: system.name_of(r),
-                value: String::new(),
-                reason: "String variables cannot be recorded in CSV".into(),
-            }));
-        }
+        // the columns an f64 does not hold: read exactly at each row
+        let exact: Vec<ExactSource> = record
+            .iter()
+            .enumerate()
+            .filter_map(|(column, r)| {
+                let text = r.base_type == BaseType::String;
+                let wide = system.instances[r.instance].fmu.exact_kind(r.value_reference).is_some();
+                (text || wide).then_some(ExactSource {
+                    column,
+                    instance: r.instance,
+                    value_reference: r.value_reference,
+                    text,
+                })
+            })
+            .collect();
         let mut plan = Plan::new(system, &record, experiment.algorithm)?;
         // Model Exchange instances connected to each other are integrated together
         let mut group = MeGroup::coupled(system, experiment.max_steps)?;
@@ -132,11 +155,20 @@ impl<'s> Execution<'s> {
                 let record_gets = plan.ordered_record_gets(&record);
                 Box::new(Ordered { ops: plan.ordered.take().unwrap_or_default(), record_gets })
             }
-            _ if experiment.threads > 1 => Box::new(ThreadedJacobi { threads: experiment.threads }),
+            // the observers of the threaded pipeline see the values only, not the instances
+            // the exact columns are read from
+            _ if experiment.threads > 1 && exact.is_empty() => Box::new(ThreadedJacobi { threads: experiment.threads }),
             _ => Box::new(Jacobi),
         };
         let mut notes = Vec::new();
-        if let Some(table) = &experiment.input {
+        let (input, clock_inputs) = match &experiment.input {
+            Some(table) => {
+                let (rest, clocks) = crate::simulate::ticks::clock_columns(system, table)?;
+                (Some(rest), clocks)
+            }
+            None => (None, Vec::new()),
+        };
+        if let Some(table) = input.as_ref().filter(|t| !t.names.is_empty() || clock_inputs.is_empty()) {
             if experiment.threads > 1 {
                 return Err(Error::Experiment("input signals are applied in one thread: use threads = 1".into()));
             }
@@ -147,7 +179,7 @@ impl<'s> Execution<'s> {
         let single = system.instances.len() == 1;
         let names: Vec<String> =
             record.iter().map(|r| if single { system.variable(r).name.clone() } else { system.name_of(r) }).collect();
-        let recorder = Recorder::new(names, record_slots);
+        let recorder = Recorder::new(names, record_slots, exact);
         Ok(Execution {
             system: system.clone(),
             experiment: experiment.clone(),
@@ -167,6 +199,8 @@ impl<'s> Execution<'s> {
             next: 0,
             ended_by: None,
             notes,
+            init_loop: crate::loops::initialization_loop(system),
+            clock_inputs,
             phase: Phase::Created,
         })
     }
@@ -313,6 +347,8 @@ impl<'s> Execution<'s> {
             clock: self.clock,
             profile: experiment.profile,
             parallel_steps: 0,
+            clock_links: system.clock_connections.clone(),
+            clocked: false,
         });
         let t0 = self.clock.t0;
         if self.clock.steps > 0 {
@@ -334,6 +370,15 @@ impl<'s> Execution<'s> {
             lane.inst.enter_initialization_mode()?;
         }
         self.algorithm.propagate(core)?;
+        if let Some(cycle) = &self.init_loop {
+            let sweeps = super::init_loop::iterate(core, cycle)?;
+            self.notes.push(format!(
+                "the connections {} form an algebraic loop at initialization: iterated to its fixed point in {sweeps} sweep{} of the connections (to {:e} relative)",
+                cycle.join(", "),
+                if sweeps == 1 { "" } else { "s" },
+                super::init_loop::RTOL
+            ));
+        }
         for lane in core.lanes.iter_mut() {
             lane.inst.exit_initialization_mode()?;
             if lane.inst.fmu().interface() == Interface::ModelExchange {
@@ -354,6 +399,35 @@ impl<'s> Execution<'s> {
         if let Some(g) = core.group.as_mut() {
             g.iterate(core.lanes.as_mut_slice(), t0)?;
         }
+        // FMI 3.0 clocks: the ticks of the input clocks scheduled (from the intervals the
+        // FMU gave in the event that ends initialization, Model Exchange's initial event
+        // iteration included); the ticks at the start time are
+        // the first step's
+        for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
+            let clocks = spec.fmu.clocks();
+            if clocks.is_empty() {
+                continue;
+            }
+            if lane.in_group() {
+                return Err(Error::Experiment(format!(
+                    "{}: clocks of a Model Exchange instance connected to other Model Exchange instances, which \
+                     cosim does not support (connect it through a Co-Simulation FMU, or run it alone)",
+                    spec.name
+                )));
+            }
+            if lane.inst.fmu().is_isolated() {
+                return Err(Error::Experiment(format!(
+                    "{}: clocks in an isolated instance (a host process), which cosim does not support",
+                    spec.name
+                )));
+            }
+            let triggered: Vec<(u32, Vec<f64>)> =
+                self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
+            let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
+            ticks.after_events(&mut lane.inst, true)?;
+            lane.ticks = Some(ticks);
+            core.clocked = true;
+        }
         for lane in core.lanes.iter_mut() {
             let fmu = lane.inst.fmu();
             let capable = fmu.interface() == Interface::CoSimulation
@@ -365,6 +439,9 @@ impl<'s> Execution<'s> {
         }
         self.algorithm.propagate(core)?;
         run_ops(&mut self.record_gets, core.lanes.as_mut_slice(), &mut core.values, None)?;
+        if self.recorder.reads_exact() {
+            self.recorder.read_exact(&mut core.lanes)?;
+        }
         self.recorder.push_row(t0, &core.values);
         self.profiler = Some(Profiler::new(core.lanes.len()));
         self.phase = Phase::Running;
@@ -466,6 +543,10 @@ impl<'s> Execution<'s> {
                 // records it too)
                 let row = if time > self.recorder.last_time().unwrap_or(f64::NEG_INFINITY) {
                     run_ops(&mut self.record_gets, core.lanes.as_mut_slice(), &mut core.values, None)
+                        .and_then(|()| match self.recorder.reads_exact() {
+                            true => self.recorder.read_exact(&mut core.lanes),
+                            false => Ok(()),
+                        })
                         .map(|()| self.recorder.push_row(time, &core.values))
                 } else {
                     Ok(())
@@ -587,7 +668,11 @@ impl<'s> Execution<'s> {
             notes: std::mem::take(&mut self.notes),
             ..Summary::default()
         };
+        let single = core.lanes.len() == 1;
         for lane in core.lanes.iter_mut() {
+            if let Some(ticks) = &lane.ticks {
+                summary.clock_ticks.extend(ticks.summary(lane.inst.name(), single));
+            }
             summary.discard_retries += lane.retries;
             if let Some(state) = lane.saved.take() {
                 lane.inst.free_state(state)?;
@@ -747,8 +832,9 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
 }
 
 /// Where [`Execution::with_sink`] (and `simulate_with`) hands each row: the time and the recorded values, in the order
-/// of [`Experiment::record`](crate::Experiment::record).
-pub type RowSink<'s> = dyn FnMut(f64, &[f64]) + Send + 's;
+/// of [`Experiment::record`](crate::Experiment::record), and the (column, text) of the columns an f64 does not hold
+/// ([`Results::exact`](crate::Results::exact); empty when there are none).
+pub type RowSink<'s> = dyn FnMut(f64, &[f64], &[(usize, String)]) + Send + 's;
 
 /// Instances kept between runs of one system ([`Execution::with_pool`], `simulate_with`): the instance of each
 /// position, reused only for the same FMU (the same loaded archive) and name.

@@ -6,7 +6,9 @@
 //! after the last row the last values. Two rows at the same time are a jump: at that time
 //! the later row holds (fmpy's `after_event`), in initialization the earlier one.
 //! Model Exchange instances get the value at the start of each communication step, held
-//! over it (as the master holds connections).
+//! over it (as the master holds connections); a discrete input of theirs only when it
+//! changes, in an event of its own (Event Mode, the value set, the event iteration, as
+//! fmpy does): the standard allows no discrete input to change in Continuous-Time Mode.
 //!
 //! A jump (two rows at one time) and a change of a discrete column are input events.
 //! fmpy's `simulate_fmu` makes one a communication point of its own in Co-Simulation
@@ -41,6 +43,10 @@ pub struct InputTable {
     pub time: Vec<f64>,
     /// `columns[j][k]`: variable `j` at `time[k]`.
     pub columns: Vec<Vec<f64>>,
+    /// `integers[j]`: column `j` as written, when every value of it is an integer (read
+    /// from a file), so that a 64-bit integer input gets the value itself, not the nearest
+    /// f64; `None` for the others.
+    pub integers: Vec<Option<Vec<i128>>>,
 }
 
 impl InputTable {
@@ -68,7 +74,8 @@ impl InputTable {
                 return Err(bad(format!("{name} = {} at t = {} s is not finite", c[k], time[k])));
             }
         }
-        Ok(InputTable { names, time, columns })
+        let integers = vec![None; columns.len()];
+        Ok(InputTable { names, time, columns, integers })
     }
 
     /// Reads a CSV file in fmpy's format: a header of names (quoted or not, the first
@@ -87,6 +94,7 @@ impl InputTable {
         }
         let mut time = Vec::new();
         let mut columns = vec![Vec::new(); names.len() - 1];
+        let mut integers: Vec<Option<Vec<i128>>> = vec![Some(Vec::new()); names.len() - 1];
         for (k, line) in lines {
             let row = cells(line);
             if row.len() != names.len() {
@@ -100,14 +108,47 @@ impl InputTable {
             time.push(num(0)?);
             for (j, c) in columns.iter_mut().enumerate() {
                 c.push(num(j + 1)?);
+                if let Some(ints) = &mut integers[j] {
+                    match row[j + 1].parse::<i128>() {
+                        Ok(i) => ints.push(i),
+                        Err(_) => integers[j] = None,
+                    }
+                }
             }
         }
-        InputTable::new(names[1..].to_vec(), time, columns)
+        let mut table = InputTable::new(names[1..].to_vec(), time, columns)?;
+        table.integers = integers;
+        Ok(table)
     }
 
     /// The index `i0` of the first time at or after `t` (numpy's `searchsorted`, left).
     fn search(&self, t: f64) -> usize {
         self.time.partition_point(|x| *x < t)
+    }
+
+    /// The row whose values a discrete column holds at `t` (fmpy's `Input.interpolate`).
+    fn discrete_row(&self, t: f64, after_event: bool) -> usize {
+        let (time, n) = (&self.time, self.time.len());
+        let i0 = self.search(t);
+        if n < 2 || i0 == 0 {
+            return 0;
+        }
+        if i0 == n {
+            return n - 1;
+        }
+        let mut i = i0 - 1;
+        if after_event {
+            while i + 1 < n && (time[i + 1] < t || isclose(t, time[i + 1])) {
+                i += 1;
+            }
+        }
+        i
+    }
+
+    /// Column `j` at `t` as written, if it is a discrete column of integers.
+    fn integer(&self, j: usize, t: f64, after_event: bool) -> Option<i128> {
+        let ints = self.integers.get(j)?.as_ref()?;
+        ints.get(self.discrete_row(t, after_event)).copied()
     }
 
     /// The value of column `j` at `t`, as fmpy's `Input.interpolate` computes it.
@@ -125,13 +166,7 @@ impl InputTable {
             return v[n - 1];
         }
         if discrete {
-            let mut i = i0 - 1;
-            if after_event {
-                while i + 1 < n && (time[i + 1] < t || isclose(t, time[i + 1])) {
-                    i += 1;
-                }
-            }
-            return v[i];
+            return v[self.discrete_row(t, after_event)];
         }
         let mut i0 = i0;
         if isclose(t, time[i0]) && i0 < n - 1 && isclose(time[i0], time[i0 + 1]) {
@@ -219,6 +254,8 @@ pub(crate) struct WithInput<'s> {
     /// What the run does with the table that a reader of it may not expect (an event
     /// between points that takes effect at the next point), for [`crate::Summary::notes`].
     pub(crate) notes: Vec<String>,
+    /// The value each column last set ([`Cell::key`]; `None`: not yet set).
+    held: Vec<Option<i128>>,
 }
 
 impl<'s> WithInput<'s> {
@@ -281,24 +318,111 @@ impl<'s> WithInput<'s> {
         }
         splits.sort_by(f64::total_cmp);
         splits.dedup();
-        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0, notes })
+        let held = vec![None; columns.len()];
+        Ok(WithInput { inner, table: table.clone(), columns, splits, next_split: 0, notes, held })
     }
 
-    fn apply(&self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
+    /// The table's values at `t` set: continuous inputs at every call; a discrete one when
+    /// its value changes, and in a Model Exchange instance out of Initialization Mode
+    /// through an event (Event Mode, the new values, the event iteration, back to
+    /// Continuous-Time Mode), as the standard allows discrete inputs to change only there
+    /// (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1) and as fmpy applies them.
+    fn apply(&mut self, core: &mut Core, t: f64, after_event: bool) -> Result<()> {
+        // (column, value) of the changed discrete inputs of Model Exchange instances
+        let mut events: Vec<(usize, Cell)> = Vec::new();
         for (j, c) in self.columns.iter().enumerate() {
             let v = self.table.value(j, t, c.discrete, after_event);
-            let inst = &mut core.lanes[c.variable.instance].inst;
-            let vr = [c.variable.value_reference];
-            match c.variable.base_type {
-                BaseType::Real => inst.set_real(&vr, &[v])?,
-                // as fmpy's table cast to fmi2Integer / fmi2Boolean: truncated toward zero
-                BaseType::Integer => inst.set_integer(&vr, &[v as i32])?,
-                BaseType::Boolean => inst.set_boolean(&vr, &[(v as i32 != 0) as i32])?,
-                BaseType::String => {}
+            let exact = if c.discrete { self.table.integer(j, t, after_event) } else { None };
+            let v = Cell { value: v, exact };
+            let lane = &mut core.lanes[c.variable.instance];
+            if c.discrete && lane.unit.is_some() {
+                if self.held[j] != Some(v.key()) {
+                    events.push((j, v));
+                }
+                continue;
             }
+            set_input(&mut lane.inst, &c.variable, v)?;
+            self.held[j] = Some(v.key());
+        }
+        if events.is_empty() {
+            return Ok(());
+        }
+        let columns = &self.columns;
+        let set = |lanes: &mut [crate::simulate::lane::Lane], of: &dyn Fn(usize) -> bool| -> Result<()> {
+            for &(j, v) in events.iter().filter(|(j, _)| of(columns[*j].variable.instance)) {
+                set_input(&mut lanes[columns[j].variable.instance].inst, &columns[j].variable, v)?;
+            }
+            Ok(())
+        };
+        let mut instances: Vec<usize> = events.iter().map(|(j, _)| columns[*j].variable.instance).collect();
+        instances.sort_unstable();
+        instances.dedup();
+        // the coupled group's members together, in one event
+        if let Some(group) = core.group.as_mut() {
+            let who: Vec<usize> = instances.iter().copied().filter(|i| group.contains(*i)).collect();
+            if !who.is_empty() {
+                let members = group.members.clone();
+                group.input_event(core.lanes.as_mut_slice(), t, "input", &who, |lanes| {
+                    set(lanes, &|i| members.contains(&i))
+                })?;
+                group.ended(core.lanes.as_mut_slice(), t)?;
+            }
+        }
+        for i in instances {
+            let lanes = core.lanes.as_mut_slice();
+            let lane = &mut lanes[i];
+            let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) else { continue };
+            let mut one = crate::simulate::me_group::Solo { inst: &mut lane.inst, unit };
+            // a group of one: its own lane alone
+            let (columns, events) = (&self.columns, &events);
+            solo.input_event(&mut one, t, "input", &[i], |one| {
+                for &(j, v) in events.iter().filter(|(j, _)| columns[*j].variable.instance == i) {
+                    set_input(one.inst, &columns[j].variable, v)?;
+                }
+                Ok(())
+            })?;
+            solo.ended(&mut one, t)?;
+        }
+        for (j, v) in events {
+            self.held[j] = Some(v.key());
         }
         Ok(())
     }
+}
+
+/// A value of the table at one time: as interpolated, and as written when it is an
+/// integer of a discrete column.
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    value: f64,
+    exact: Option<i128>,
+}
+
+impl Cell {
+    /// What tells two values of one column apart.
+    fn key(self) -> i128 {
+        self.exact.unwrap_or(self.value.to_bits() as i128)
+    }
+}
+
+/// Sets input `variable` of `inst` to the table's value `v`: a 64-bit integer (FMI 3.0
+/// Int64, UInt64) to the integer as written.
+fn set_input(inst: &mut crate::fmu::Instance, variable: &VariableRef, v: Cell) -> Result<()> {
+    let vr = [variable.value_reference];
+    if let Some(i) = v.exact {
+        if inst.fmu().exact_kind(variable.value_reference).is_some_and(|k| k != crate::fmi3::ExactKind::Binary) {
+            return inst.set_exact_integer(variable.value_reference, i).map_err(Into::into);
+        }
+    }
+    let v = v.value;
+    match variable.base_type {
+        BaseType::Real => inst.set_real(&vr, &[v])?,
+        // as fmpy's table cast to fmi2Integer / fmi2Boolean: truncated toward zero
+        BaseType::Integer => inst.set_integer(&vr, &[v as i32])?,
+        BaseType::Boolean => inst.set_boolean(&vr, &[(v as i32 != 0) as i32])?,
+        BaseType::String => {}
+    }
+    Ok(())
 }
 
 impl Communication for WithInput<'_> {

@@ -6,6 +6,7 @@ use crate::me::{MeUnit, Solver};
 use crate::simulate::clock::Point;
 use crate::simulate::me_group::{MeGroup, Members, Solo};
 use crate::simulate::plan::{Instances, Op};
+use crate::simulate::ticks::Ticks;
 use crate::system::{InstanceSpec, Value};
 use std::time::{Duration, Instant};
 
@@ -34,6 +35,8 @@ pub(crate) struct Lane {
     /// The run's last communication point, s (NaN: not known): an FMU that asks to end
     /// the simulation there has not ended it early ([`Lane::advance`]).
     pub(crate) last_point: f64,
+    /// FMI 3.0 clocks: the input clocks' ticks and every clock's count (`ticks.rs`).
+    pub(crate) ticks: Option<Ticks>,
 }
 
 impl Instances for [Lane] {
@@ -68,6 +71,7 @@ impl Lane {
             error: None,
             posted: false,
             last_point: f64::NAN,
+            ticks: None,
         }
     }
 
@@ -99,6 +103,14 @@ impl Lane {
     fn advance_inner(&mut self, solver: Solver, t: f64, t_next: f64) -> Result<()> {
         let dt = t_next - t; // as fmpy: the step is the difference of the two points
         self.posted = false;
+        if let Some(ticks) = self.ticks.as_mut() {
+            return match (&mut self.unit, &mut self.solo) {
+                (None, _) => step_ticking(&mut self.inst, ticks, t, t_next),
+                (Some(unit), Some(group)) => me_ticking(&mut self.inst, unit, group, ticks, solver, t, t_next),
+                // clocks of a coupled group's member are refused at initialization
+                (Some(_), None) => Ok(()),
+            };
+        }
         match (&mut self.unit, &mut self.saved) {
             (None, None) => match self.inst.do_step(t, dt) {
                 Ok(()) => Ok(()),
@@ -191,6 +203,58 @@ impl Lane {
             op.apply(&mut self.inst)?;
         }
         Ok(())
+    }
+}
+
+/// A Co-Simulation step from `t` to `t_next` of an instance with clocks: to each tick of
+/// its input clocks in the step, the clock event there, on to the next (see `ticks.rs`);
+/// the output clocks' ticks and the intervals the FMU gives taken after every event.
+fn step_ticking(inst: &mut Instance, ticks: &mut Ticks, t: f64, t_next: f64) -> Result<()> {
+    let mut at = t;
+    loop {
+        let due = ticks.due(at, t_next);
+        let end = due.as_ref().map_or(t_next, |(tick, _)| *tick);
+        if end > at {
+            inst.do_step(at, end - at).map_err(|e| ended_or(inst, e.into(), at, end))?;
+            ticks.after_events(inst, false)?;
+        }
+        let Some((tick, vrs)) = due else { return Ok(()) };
+        inst.clock_event(tick, &vrs).map_err(|e| ended_or(inst, e.into(), tick, tick))?;
+        ticks.ticked(&vrs);
+        ticks.after_events(inst, false)?;
+        at = tick;
+    }
+}
+
+/// A Model Exchange step from `t` to `t_next` of an instance with clocks (integrated on its
+/// own): integrated to each tick of its input clocks in the step, the event there (Event
+/// Mode, `fmi3SetClock` of the ticking clocks, the event iteration), on to the next.
+fn me_ticking(
+    inst: &mut Instance,
+    unit: &mut MeUnit,
+    group: &mut MeGroup,
+    ticks: &mut Ticks,
+    solver: Solver,
+    t: f64,
+    t_next: f64,
+) -> Result<()> {
+    let mut at = t;
+    loop {
+        let due = ticks.due(at, t_next);
+        let end = due.as_ref().map_or(t_next, |(tick, _)| *tick);
+        if end > at {
+            group.advance(&mut Solo { inst, unit }, solver, at, end)?;
+            ticks.after_events(inst, false)?;
+        }
+        let Some((tick, vrs)) = due else { return Ok(()) };
+        inst.set_time(tick)?;
+        inst.enter_event_mode()?;
+        inst.set_clocks(&vrs)?;
+        group.iterate(&mut Solo { inst, unit }, tick)?;
+        group.ended(&mut Solo { inst, unit }, tick)?;
+        ticks.ticked(&vrs);
+        ticks.after_events(inst, false)?;
+        at = tick;
     }
 }
 

@@ -3,53 +3,47 @@
 //! for a system of FMUs). An ME instance connected to no other ME instance is a group of
 //! one; the ME instances connected to each other form one group.
 //!
-//! Over a communication step the members advance in lockstep: one common internal step
-//! (RK4 with the same sub-steps; Dormand-Prince with the smallest step any member asks
-//! for, rejected if any member's error is too large), each member's event indicators
-//! checked after it. The earliest event of any member (a time event, the first state
-//! event crossing located by the Illinois method, a step event) ends the step of all:
-//! every member is integrated to that time and enters event mode; then, until a fixed
-//! point, outputs are carried through the connections between members in topological
-//! order and every member calls `fmi2NewDiscreteStates`. The iteration ends when no
-//! member asks for another one and no input changed in the last propagation; after
-//! [`MAX_EVENT_ROUNDS`] rounds it stops with [`Error::EventIteration`] naming the members
-//! still changing. Then every member enters continuous-time mode.
+//! Over a communication step the members' states are one system stepped by one
+//! [`crate::integrator::Integrator`] (rk4, dopri5 or bdf: [`Solver::integrator`]), the members' inputs held
+//! between events. One event loop ([`MeGroup::advance`]) handles every method alike:
 //!
-//! Between events the members' inputs are held, as for any instance over a
-//! communication step; the connections from and to Co-Simulation instances are carried at
-//! communication points only.
+//! - **time events**, the input of the loop: each member's next event time
+//!   ([`MeUnit::next_time_event`], from its last event iteration) caps the step, which
+//!   ends exactly on it; the events due at a time (to the slack of [`time_slack`]) are
+//!   handled there. A future source of time events (FMI 3.0 clock ticks) sets the same
+//!   field or adds to the times [`MeGroup::next_time_event`] returns.
+//! - **state events**: after each accepted step every member's event indicators are read
+//!   at its end; an indicator that changed sign is located by the Illinois method on the
+//!   step's dense output ([`crate::integrator::Integrator::interpolate`]) to [`EVENT_TIME_TOLERANCE`], with
+//!   no re-integration; the earliest crossing of any member ends the step of all there.
+//! - **step events**: `fmi2CompletedIntegratorStep` after each accepted step.
+//!
+//! At an event every member enters event mode at that time; then, until a fixed point,
+//! outputs are carried through the connections between members in topological order and
+//! every member calls `fmi2NewDiscreteStates`. The iteration ends when no member asks for
+//! another one and no input changed in the last propagation; after [`MAX_EVENT_ROUNDS`]
+//! rounds it stops with [`Error::EventIteration`] naming the members still changing. Then
+//! every member enters continuous-time mode and the integrator starts again from the
+//! states the iteration left ([`Start`]).
+//!
+//! A step ends at the end of each communication step (where the members' inputs may
+//! change), except for a method that keeps a history ([`crate::integrator::Integrator::steps_past_points`])
+//! in a group without inputs: its steps pass the points, whose states come from the
+//! dense output. Between events the connections from and to Co-Simulation instances are
+//! carried at communication points only.
 
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
-use crate::me::{nan_max, Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
-use crate::simulate::plan::{ordered_ops, Instances, Op};
+use crate::integrator::Start;
+use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
+use crate::simulate::plan::{ordered_ops, Op};
 use crate::system::{Connection, System, VariableRef};
 
-mod bdf;
+mod members;
+mod system;
 
-/// Access to the members of a group: each one's instance and integration state.
-pub(crate) trait Members: Instances {
-    /// Member `m` (an instance index of the system), if it has its integration state.
-    fn member(&mut self, m: usize) -> Option<(&mut Instance, &mut MeUnit)>;
-}
-
-/// One ME instance on its own: the members of its group of one.
-pub(crate) struct Solo<'a> {
-    pub(crate) inst: &'a mut Instance,
-    pub(crate) unit: &'a mut MeUnit,
-}
-
-impl Instances for Solo<'_> {
-    fn instance(&mut self, _: usize) -> &mut Instance {
-        self.inst
-    }
-}
-
-impl Members for Solo<'_> {
-    fn member(&mut self, _: usize) -> Option<(&mut Instance, &mut MeUnit)> {
-        Some((&mut *self.inst, &mut *self.unit))
-    }
-}
+pub(crate) use members::{Members, Solo};
+use system::{locate_on_dense_output, GroupIntegrator};
 
 /// Rounds of the event iteration before it is declared not converging.
 pub const MAX_EVENT_ROUNDS: usize = 100;
@@ -65,10 +59,11 @@ pub(crate) struct MeGroup {
     /// Internal steps tried (accepted and rejected) so far, and the cap on them.
     tried: u64,
     max_steps: u64,
-    /// The bdf solver's state (its history between communication steps).
-    stiff: Option<Box<bdf::GroupBdf>>,
-    /// The stop time of the run: the bdf solver steps past communication points, not
-    /// past it.
+    /// The integrator of the group (made at its first step; its history and step size
+    /// kept between communication steps).
+    integrator: Option<Box<GroupIntegrator>>,
+    /// The stop time of the run: a method that steps past communication points does not
+    /// step past it.
     pub(crate) stop_time: f64,
 }
 
@@ -82,7 +77,7 @@ impl MeGroup {
             before: Vec::new(),
             tried: 0,
             max_steps,
-            stiff: None,
+            integrator: None,
             stop_time: f64::INFINITY,
         }
     }
@@ -97,7 +92,7 @@ impl MeGroup {
             return Ok(None);
         }
         let members: std::sync::Arc<[usize]> = (0..system.instances.len()).filter(|i| me(*i)).collect();
-        let sub = System { instances: system.instances.clone(), connections: links };
+        let sub = System { instances: system.instances.clone(), connections: links, clock_connections: Vec::new() };
         let mut sources: Vec<VariableRef> = Vec::new();
         for c in &sub.connections {
             if !sources.contains(&c.from) {
@@ -113,7 +108,7 @@ impl MeGroup {
             before: vec![0.0; n],
             tried: 0,
             max_steps,
-            stiff: None,
+            integrator: None,
             stop_time: f64::INFINITY,
         }))
     }
@@ -199,22 +194,44 @@ impl MeGroup {
         kind: &'static str,
         who: &[usize],
     ) -> Result<()> {
+        self.input_event(lanes, time, kind, who, |_| Ok(()))
+    }
+
+    /// An event at `time` caused by `who` (recorded as `kind`) in which `set` sets inputs
+    /// first: all members enter Event Mode, `set` runs, and they iterate together. The
+    /// discrete inputs of a Model Exchange FMU are set so when they change (Event Mode only:
+    /// FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1), which restarts the bdf method.
+    pub(crate) fn input_event<L: Members + ?Sized>(
+        &mut self,
+        lanes: &mut L,
+        time: f64,
+        kind: &'static str,
+        who: &[usize],
+        set: impl FnOnce(&mut L) -> Result<()>,
+    ) -> Result<()> {
         for &m in self.members.iter() {
             lanes.instance(m).enter_event_mode()?;
         }
+        set(lanes)?;
         for &m in who {
             if let Some((inst, unit)) = lanes.member(m) {
                 unit.events.push(Event { instance: inst.name().to_string(), time, kind });
             }
         }
-        self.iterate(lanes, time)
+        self.iterate(lanes, time)?;
+        // the states may have jumped: the method starts again from them (an input change
+        // at a known time is a time event the master schedules)
+        if let Some(g) = self.integrator.as_mut() {
+            g.restart = Some(Start::TimeEvent);
+        }
+        Ok(())
     }
 
     /// The time events due at `t` (to `eps`), for every solver: the members whose next time
     /// event is due are recorded and all members iterate together; a time event still due
     /// after that is an error. Whether any was due.
     fn time_events_due<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64, eps: f64) -> Result<bool> {
-        let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
+        let next_time_event = Self::next_time_event;
         let members = self.members.clone();
         let due: Vec<usize> =
             members.iter().copied().filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps)).collect();
@@ -247,24 +264,6 @@ impl MeGroup {
         )))
     }
 
-    /// The error of a Dormand-Prince step from `t` of size `h` whose error estimate is NaN.
-    #[cold]
-    fn nan_error_estimate<L: Members + ?Sized>(&self, lanes: &mut L, t: f64, h: f64) -> Error {
-        let names: Vec<String> = self
-            .members
-            .iter()
-            .map(|m| {
-                let inst = lanes.instance(*m);
-                format!("{} ({})", inst.name(), crate::me::fmu_file(inst))
-            })
-            .collect();
-        Error::Integration(format!(
-            "{}: the dopri5 error estimate of the step from t = {t} s of {h:e} s is NaN (the state derivatives \
-             the FMU returned with OK over the step are infinite or the states overflow); the step is not taken",
-            names.join(", ")
-        ))
-    }
-
     /// [`Error::Terminated`] at `time` if a member set `terminateSimulation`.
     pub(crate) fn ended<L: Members + ?Sized>(&self, lanes: &mut L, time: f64) -> Result<()> {
         for &m in self.members.iter() {
@@ -281,8 +280,14 @@ impl MeGroup {
         Ok(())
     }
 
-    /// Integrates all members from `t` to `t_end` together, their inputs held between
-    /// events.
+    /// The next time event of member `m`, if it has one: the input of the event loop's
+    /// time events.
+    pub(crate) fn next_time_event<L: Members + ?Sized>(lanes: &mut L, m: usize) -> Option<f64> {
+        lanes.member(m).and_then(|(_, u)| u.next_time_event)
+    }
+
+    /// Integrates all members from `t` to `t_end` together with `solver`, their inputs
+    /// held between events.
     pub(crate) fn advance<L: Members + ?Sized>(
         &mut self,
         lanes: &mut L,
@@ -290,151 +295,169 @@ impl MeGroup {
         t: f64,
         t_end: f64,
     ) -> Result<()> {
-        if let Solver::Bdf { rtol, atol } = solver {
-            return self.advance_bdf(lanes, rtol, atol, t, t_end);
-        }
+        let mut g = match self.integrator.take() {
+            Some(g) => g,
+            None => Box::new(GroupIntegrator::new(lanes, &self.members, solver)),
+        };
+        let outcome = self.advance_with(lanes, &mut g, t, t_end);
+        g.report(lanes, &self.members, solver);
+        self.integrator = Some(g);
+        outcome
+    }
+
+    /// The event loop of [`MeGroup::advance`].
+    fn advance_with<L: Members + ?Sized>(
+        &mut self,
+        lanes: &mut L,
+        g: &mut GroupIntegrator,
+        t: f64,
+        t_end: f64,
+    ) -> Result<()> {
         let mut t = t;
         let span = t_end - t;
         let eps = time_slack(t_end, span);
         let members = self.members.clone();
         let members: &[usize] = &members;
-        for &m in members {
-            if let Some((_, u)) = lanes.member(m) {
-                if u.h_adaptive <= 0.0 {
-                    u.h_adaptive = span * 0.1;
-                }
-            }
-        }
-        let next_time_event = |lanes: &mut L, m: usize| lanes.member(m).and_then(|(_, u)| u.next_time_event);
+        let stop_time = self.stop_time;
+        g.integrator.communication_step(span, eps);
         loop {
             self.ended(lanes, t)?;
             if t >= t_end - eps {
                 return Ok(());
             }
+            // time events due now: the event iteration starts the method again
             if self.time_events_due(lanes, t, eps)? {
+                g.restart = Some(Start::TimeEvent);
                 continue;
             }
-            // the end of this stretch: the earliest time event or the end of the step
-            let mut target = t_end;
-            let mut time_event = false;
+            // a step ends at the earliest time event, at the stop time, and, unless the
+            // method steps past them, at the end of the communication step
+            let mut limit = if g.through { stop_time.max(t_end) } else { t_end };
             for &m in members {
-                if let Some(te) = next_time_event(lanes, m) {
-                    if te <= t_end + eps && te.max(t) <= target {
-                        target = te.max(t);
-                        time_event = true;
+                if let Some(te) = Self::next_time_event(lanes, m) {
+                    if te.max(t) < limit {
+                        limit = te.max(t);
                     }
                 }
             }
-            let h_max = target - t;
-            let mut h = match solver {
-                Solver::Rk4 { max_step } => {
-                    let hm = max_step.unwrap_or(span).max(1e-300);
-                    h_max / ((h_max / hm) * (1.0 - 1e-12)).ceil().max(1.0)
+            if g.integrator.t() <= t + eps || g.restart.is_some() {
+                if g.restart.is_some() {
+                    g.start_if_due(lanes, members, t, limit - t)?;
                 }
-                Solver::Dopri5 { .. } | Solver::Bdf { .. } => {
-                    members.iter().filter_map(|m| lanes.member(*m).map(|(_, u)| u.h_adaptive)).fold(h_max, f64::min)
-                }
-            };
-            for &m in members {
-                if let Some((inst, u)) = lanes.member(m) {
-                    u.begin_step(inst, t)?;
-                }
-            }
-            match solver {
-                Solver::Dopri5 { rtol, atol } => loop {
-                    let mut err = 0.0f64;
-                    for &m in members {
-                        if let Some((inst, u)) = lanes.member(m) {
-                            err = nan_max(err, u.dopri(inst, t, h, rtol, atol)?);
-                        }
-                    }
-                    if err.is_nan() {
-                        return Err(self.nan_error_estimate(lanes, t, h));
-                    }
-                    let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+                let (mut sys, integrator, _) = g.parts(lanes, members);
+                integrator.step(&mut sys, limit)?;
+                // the attempts of the step: one accepted, the rest rejected
+                let rejected = g.integrator.work().rejected;
+                for _ in 0..=(rejected - g.rejected) {
                     self.count_step(lanes, t)?;
-                    if err <= 1.0 || h <= 0.1 * eps {
-                        for &m in members {
-                            if let Some((_, u)) = lanes.member(m) {
-                                u.h_adaptive = (h * factor).min(span.max(h));
-                            }
-                        }
-                        break;
-                    }
-                    if let Some((_, u)) = lanes.member(members[0]) {
-                        u.rejected += 1;
-                    }
-                    h *= factor.min(0.9);
-                },
-                Solver::Rk4 { .. } | Solver::Bdf { .. } => {
-                    self.count_step(lanes, t)?;
-                    for &m in members {
-                        if let Some((inst, u)) = lanes.member(m) {
-                            u.rk4(inst, t, h)?;
-                        }
-                    }
                 }
+                g.rejected = rejected;
+                g.crossing = self.first_crossing(lanes, g, t)?;
             }
-            let t_new = if (t + h - target).abs() <= eps { target } else { t + h };
-            // state events: the earliest crossing of any member
-            let mut first: Option<f64> = None;
-            let mut crossings: Vec<(usize, f64)> = Vec::new();
-            for &m in members {
-                let Some((inst, u)) = lanes.member(m) else { continue };
-                u.indicators_at(inst, t_new)?;
-                if MeUnit::crossed(&u.z0, &u.z) {
-                    let hi = u.locate_crossing(inst, solver, t, t_new - t)?;
-                    crossings.push((m, hi));
-                    first = Some(first.map_or(hi, |f: f64| f.min(hi)));
-                }
+            // where the step (or its first state event) ends
+            let reached = g.crossing.as_ref().map_or(g.integrator.t(), |(te, _)| *te);
+            if reached > t_end + eps {
+                // the communication point within the step: the states there from the dense
+                // output (the step is completed when the master reaches its end)
+                self.interpolate_members(lanes, g, t_end, false)?;
+                return Ok(());
             }
-            if let Some(hi) = first {
-                let te = t + hi;
-                for &m in members {
-                    let Some((inst, u)) = lanes.member(m) else { continue };
-                    u.one_step(inst, solver, t, hi)?;
-                    inst.set_time(te)?;
-                    MeUnit::set_states(inst, &u.xt)?;
-                    u.x.copy_from_slice(&u.xt);
-                    u.steps += 1;
-                    inst.completed_integrator_step()?;
-                }
-                let who: Vec<usize> =
-                    crossings.iter().filter(|(_, h)| *h <= hi + EVENT_TIME_TOLERANCE).map(|(m, _)| *m).collect();
+            if let Some((te, who)) = g.crossing.take() {
+                self.interpolate_members(lanes, g, te, true)?;
                 self.event(lanes, te, "state", &who)?;
-                if let Solver::Dopri5 { .. } = solver {
-                    for &m in members {
-                        if let Some((_, u)) = lanes.member(m) {
-                            u.h_adaptive = u.h_adaptive.min(span * 0.1);
-                        }
-                    }
-                }
+                g.restart = Some(Start::StateEvent);
                 t = te;
                 continue;
             }
             // the step is accepted by every member
+            let t_new = g.integrator.t();
             let mut step_events: Vec<usize> = Vec::new();
-            for &m in members {
+            for (k, &m) in members.iter().enumerate() {
                 let Some((inst, u)) = lanes.member(m) else { continue };
-                u.x.copy_from_slice(&u.xt);
-                if u.complete_step(inst, t_new)? {
+                u.x.copy_from_slice(&g.integrator.state()[g.offsets[k]..g.offsets[k + 1]]);
+                if u.complete_step(inst, t_new, g.at_step_end && !u.z.is_empty())? {
                     step_events.push(m);
                 }
             }
             t = t_new;
             self.ended(lanes, t)?;
-            let at_time_event = time_event && t >= target - eps;
-            if at_time_event {
-                let due: Vec<usize> = members
-                    .iter()
-                    .copied()
-                    .filter(|m| next_time_event(lanes, *m).is_some_and(|te| te <= t + eps) || step_events.contains(m))
-                    .collect();
+            let due_now = |lanes: &mut L, m: usize| Self::next_time_event(lanes, m).is_some_and(|te| te <= t + eps);
+            if members.iter().any(|m| due_now(lanes, *m)) {
+                let due: Vec<usize> =
+                    members.iter().copied().filter(|m| due_now(lanes, *m) || step_events.contains(m)).collect();
                 self.event(lanes, t, "time", &due)?;
+                g.restart = Some(Start::TimeEvent);
             } else if !step_events.is_empty() {
                 self.event(lanes, t, "step", &step_events)?;
+                g.restart = Some(Start::StepEvent);
             }
         }
+    }
+
+    /// The earliest state event of any member over the last step (t0, t], located on the
+    /// dense output, and the members whose crossings are at it (to
+    /// [`EVENT_TIME_TOLERANCE`]); `None` when no event indicator changed sign.
+    fn first_crossing<L: Members + ?Sized>(
+        &self,
+        lanes: &mut L,
+        g: &mut GroupIntegrator,
+        t0: f64,
+    ) -> Result<Option<(f64, Vec<usize>)>> {
+        let t1 = g.integrator.t();
+        let mut crossed: Vec<usize> = Vec::new();
+        for (k, &m) in self.members.iter().enumerate() {
+            let Some((inst, u)) = lanes.member(m) else { continue };
+            if u.z.is_empty() {
+                continue;
+            }
+            u.xt.copy_from_slice(&g.integrator.state()[g.offsets[k]..g.offsets[k + 1]]);
+            u.indicators_at(inst, t1)?;
+            if MeUnit::crossed(&u.z0, &u.z) {
+                crossed.push(k);
+            }
+        }
+        g.at_step_end = crossed.is_empty();
+        if crossed.is_empty() {
+            return Ok(None);
+        }
+        let (mut sys, integrator, _) = g.parts(lanes, &self.members);
+        integrator.prepare_dense_output(&mut sys)?;
+        let mut found: Vec<(usize, f64)> = Vec::new();
+        for k in crossed {
+            let m = self.members[k];
+            let Some((inst, u)) = lanes.member(m) else { continue };
+            let te = locate_on_dense_output(inst, u, &*g.integrator, g.offsets[k], t0, t1, &mut g.x)?;
+            found.push((m, te));
+        }
+        let first = found.iter().map(|(_, te)| *te).fold(f64::INFINITY, f64::min);
+        let who = found.iter().filter(|(_, te)| *te <= first + EVENT_TIME_TOLERANCE).map(|(m, _)| *m).collect();
+        Ok(Some((first, who)))
+    }
+
+    /// The members at `s` within the last step, from the dense output: their states set,
+    /// and, at an event (`completed`), the step completed there
+    /// (`fmi2CompletedIntegratorStep`, its step event left to the event iteration that
+    /// follows).
+    fn interpolate_members<L: Members + ?Sized>(
+        &self,
+        lanes: &mut L,
+        g: &mut GroupIntegrator,
+        s: f64,
+        completed: bool,
+    ) -> Result<()> {
+        g.at_step_end = false;
+        g.integrator.interpolate(s, &mut g.x);
+        for (k, &m) in self.members.iter().enumerate() {
+            let Some((inst, u)) = lanes.member(m) else { continue };
+            u.x.copy_from_slice(&g.x[g.offsets[k]..g.offsets[k + 1]]);
+            inst.set_time(s)?;
+            MeUnit::set_states(inst, &u.x)?;
+            if completed {
+                u.steps += 1;
+                inst.completed_integrator_step()?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -9,6 +9,7 @@
 //! - `types`: the public types ([`Experiment`], [`Algorithm`], [`Results`], [`Summary`]);
 //! - `clock`: the time base, communication point `n` at `t0 + n h`;
 //! - `plan`: the value slots and the batched fmi2Get/fmi2Set calls;
+//! - `ticks`: the ticks of an instance's FMI 3.0 input clocks and every clock's count;
 //! - `me_group`: the Model Exchange integrator of a group of ME instances (a group of
 //!   one for an ME instance on its own);
 //! - `lane`: one instance with its calls and integrator;
@@ -26,12 +27,14 @@ mod between;
 mod clock;
 mod driver;
 mod execution;
+mod init_loop;
 mod input;
 mod lane;
 mod me_group;
 mod observer;
 mod plan;
 mod scheduled;
+mod ticks;
 mod types;
 
 pub use between::{Manipulator, SetQueue, StepInstances};
@@ -43,6 +46,6 @@ pub use lane::apply_start_values;
 pub use observer::{Cancel, Observer, Progress};
 pub use plan::default_record;
 pub use scheduled::{is_scheduled, simulate_scheduled};
-pub use types::{number_text, push_number, Algorithm, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
+pub use types::{number_text, push_number, Algorithm, ExactColumn, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;

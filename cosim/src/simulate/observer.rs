@@ -24,7 +24,8 @@ pub trait Observer {
 }
 
 /// The rows of the results: time and the recorded slots at every output point.
-/// With a sink ([`crate::simulate::RowSink`]) the rows are handed to it instead of kept.
+/// With a sink ([`crate::simulate::RowSink`]) the rows are handed to it instead of kept,
+/// with the (column, text) of the exact columns ([`Results::exact`]).
 pub(crate) struct Recorder<'s> {
     /// The rows, shared with the handler of an FMU's exit() ([`crate::exit_guard`]):
     /// locked only while a row is appended (about 20 ns a row).
@@ -36,22 +37,76 @@ pub(crate) struct Recorder<'s> {
     row: Vec<f64>,
     /// The time of the last row.
     last: Option<f64>,
+    /// The recorded columns whose values an f64 does not hold (see
+    /// [`Results::exact`](crate::simulate::Results::exact)), read from their instances at
+    /// each row.
+    exact: Vec<ExactSource>,
+    /// Their text at the row being recorded.
+    exact_row: Vec<String>,
+    /// (column, text) of that row, for the sink.
+    exact_cells: Vec<(usize, String)>,
+}
+
+/// The text read by [`Recorder::read_exact`] (`row`) into the row that starts (after its
+/// time) at `start` of the values; a String's value there is NaN.
+#[cold]
+fn push_exact(exact: &[ExactSource], row: &[String], results: &mut Results, start: usize) {
+    for (k, e) in exact.iter().enumerate() {
+        results.exact[k].rows.push(row.get(k).cloned().unwrap_or_default());
+        if e.text {
+            results.values[start + e.column] = f64::NAN;
+        }
+    }
+}
+
+/// Where a column of [`Recorder::exact`] comes from.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ExactSource {
+    /// The column (0-based among the recorded names).
+    pub(crate) column: usize,
+    pub(crate) instance: usize,
+    pub(crate) value_reference: u32,
+    /// A String: NaN in the values.
+    pub(crate) text: bool,
 }
 
 impl<'s> Recorder<'s> {
     /// A recorder of the slots `slots` under the column names `names`.
-    pub(crate) fn new(names: Vec<String>, slots: Vec<usize>) -> Self {
+    pub(crate) fn new(names: Vec<String>, slots: Vec<usize>, exact: Vec<ExactSource>) -> Self {
         let row = Vec::with_capacity(slots.len());
+        let columns =
+            exact.iter().map(|e| crate::simulate::ExactColumn { column: e.column, rows: Vec::new() }).collect();
         Recorder {
             shared: std::sync::Arc::new(crate::exit_guard::RunRows {
-                results: std::sync::Mutex::new(Results { names, values: Vec::new() }),
+                results: std::sync::Mutex::new(Results { names, values: Vec::new(), exact: columns }),
             }),
             slots,
             done: 0,
             sink: None,
             row,
             last: None,
+            exact,
+            exact_row: Vec::new(),
+            exact_cells: Vec::new(),
         }
+    }
+
+    /// Whether some recorded columns are read exactly at each row ([`Recorder::read_exact`]).
+    #[inline]
+    pub(crate) fn reads_exact(&self) -> bool {
+        !self.exact.is_empty()
+    }
+
+    /// The text of the columns an f64 does not hold, read from the instances for the next
+    /// row (`fmi3GetInt64`, `fmi3GetUInt64`, `fmi3GetBinary`, `fmi2GetString` /
+    /// `fmi3GetString`).
+    pub(crate) fn read_exact(&mut self, lanes: &mut [crate::simulate::lane::Lane]) -> Result<()> {
+        self.exact_row.clear();
+        for e in &self.exact {
+            let value = lanes[e.instance].inst.get_exact(e.value_reference)?;
+            self.exact_row.push(value.to_text());
+        }
+        Ok(())
     }
 
     /// Room for `rows` rows (up to 64 MiB up front: a huge run grows as it goes; nothing
@@ -87,12 +142,18 @@ impl<'s> Recorder<'s> {
             Some(sink) => {
                 self.row.clear();
                 self.row.extend(self.slots.iter().map(|s| values[*s]));
-                sink(t, &self.row);
+                self.exact_cells.clear();
+                self.exact_cells.extend(self.exact.iter().zip(&self.exact_row).map(|(e, t)| (e.column, t.clone())));
+                sink(t, &self.row, &self.exact_cells);
             }
             None => {
                 let mut results = self.shared.results.lock().unwrap_or_else(|e| e.into_inner());
+                let start = results.values.len() + 1;
                 results.values.push(t);
                 results.values.extend(self.slots.iter().map(|s| values[*s]));
+                if !self.exact.is_empty() {
+                    push_exact(&self.exact, &self.exact_row, &mut results, start);
+                }
             }
         }
     }

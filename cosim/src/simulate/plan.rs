@@ -9,6 +9,7 @@ use crate::fmu::Instance;
 use crate::simulate::types::Algorithm;
 use crate::system::{BaseType, System, VariableRef};
 use model_description::Causality;
+use std::collections::{HashMap, HashSet};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum OpKind {
@@ -31,6 +32,10 @@ pub(crate) struct Op {
     /// A get of Reals whose slots are consecutive, from this one: fetched straight into
     /// the value buffer, with no copy through the op's own.
     direct: Option<usize>,
+    /// Get: the FMI 3.0 Int64 / UInt64 outputs among `vrs` that feed connections (index
+    /// into `vrs`, `instance.variable`), whose values the connections carry as f64: checked
+    /// at every get (empty for every other op).
+    wide_sources: Vec<(usize, String)>,
 }
 
 impl Op {
@@ -45,6 +50,7 @@ impl Op {
             reals: vec![],
             ints: vec![],
             direct: None,
+            wide_sources: vec![],
         }
     }
     fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64)) {
@@ -64,7 +70,13 @@ impl Op {
     pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
         match self.kind {
             OpKind::Get => match self.direct {
-                Some(first) => inst.get_real(&self.vrs, &mut values[first..first + self.vrs.len()])?,
+                Some(first) => {
+                    let got = &mut values[first..first + self.vrs.len()];
+                    inst.get_real(&self.vrs, got)?;
+                    if !self.wide_sources.is_empty() {
+                        check_wide(&self.wide_sources, &self.vrs, got, inst)?;
+                    }
+                }
                 None => {
                     self.fetch(inst)?;
                     self.scatter(values);
@@ -92,7 +104,12 @@ impl Op {
     #[inline]
     pub(crate) fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
         match self.base_type {
-            BaseType::Real => inst.get_real(&self.vrs, &mut self.reals)?,
+            BaseType::Real => {
+                inst.get_real(&self.vrs, &mut self.reals)?;
+                if !self.wide_sources.is_empty() {
+                    check_wide(&self.wide_sources, &self.vrs, &self.reals, inst)?;
+                }
+            }
             BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
             BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
             BaseType::String => {}
@@ -159,15 +176,55 @@ impl Op {
     }
 }
 
-/// Appends `node` to the op list, merging into the last op when it is the same call.
+/// The connections carry values as f64: a 64-bit integer output beyond 2^53 that no f64
+/// holds would arrive rounded at the inputs it feeds. Such a value is an error naming the
+/// variable and the master's limit (a value an f64 holds, as -2^63, is carried exactly).
+#[cold]
+fn check_wide(wide: &[(usize, String)], vrs: &[u32], got: &[f64], inst: &mut Instance) -> Result<()> {
+    const EXACT: f64 = 9007199254740992.0; // 2^53
+    for (k, name) in wide {
+        if got[*k].abs() <= EXACT {
+            continue;
+        }
+        if let fmi_import::fmi3::Exact::Integer(exact) = inst.get_exact(vrs[*k])? {
+            if got[*k] as i128 != exact {
+                return Err(Error::Experiment(format!(
+                    "{name} = {exact} at t = {} s: the master carries connections as f64 (64-bit integers exactly up to 2^53), which would round it to {}; record it instead (recorded 64-bit integers are exact), or keep the connected values within 2^53",
+                    inst.time(),
+                    got[*k] as i128
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Marks in the gets of `ops` the 64-bit integer outputs of `system` that feed connections
+/// ([`Op::wide_sources`]).
+pub(crate) fn mark_wide_sources(ops: &mut [Op], system: &System) {
+    for op in ops.iter_mut().filter(|op| op.kind == OpKind::Get && op.base_type == BaseType::Real) {
+        let fmu = &system.instances[op.instance].fmu;
+        op.wide_sources = op
+            .vrs
+            .iter()
+            .enumerate()
+            .filter(|(_, vr)| fmu.exact_kind(**vr).is_some_and(|k| k != fmi_import::fmi3::ExactKind::Binary))
+            .filter_map(|(k, vr)| {
+                let c = system
+                    .connections
+                    .iter()
+                    .find(|c| c.from.instance == op.instance && c.from.value_reference == *vr)?;
+                Some((k, system.name_of(&c.from)))
+            })
+            .collect();
+    }
+}
+
+/// Appends `node` to the op list, merging into the last op when it is the same call (the
+/// callers emit each get once: connected outputs and recorded variables without repeats).
 fn emit(ops: &mut Vec<Op>, instance: usize, kind: OpKind, ty: BaseType, vr: u32, slot: usize, gain: (f64, f64)) {
     match ops.last_mut() {
-        Some(op) if op.instance == instance && op.kind == kind && op.base_type == ty => {
-            if kind == OpKind::Get && op.vrs.contains(&vr) && op.slots.contains(&slot) {
-                return;
-            }
-            op.push(vr, slot, gain)
-        }
+        Some(op) if op.instance == instance && op.kind == kind && op.base_type == ty => op.push(vr, slot, gain),
         _ => {
             let mut op = Op::new(instance, kind, ty);
             op.push(vr, slot, gain);
@@ -182,6 +239,8 @@ fn emit(ops: &mut Vec<Op>, instance: usize, kind: OpKind, ty: BaseType, vr: u32,
 pub(crate) struct Plan {
     /// The variable behind each slot of the value buffer.
     pub(crate) sources: Vec<VariableRef>,
+    /// The slot of each variable of `sources`.
+    slots: HashMap<VariableRef, usize>,
     /// `ordered`: the batched calls in topological order (None: the graph has a loop).
     pub(crate) ordered: Option<Vec<Op>>,
     /// `jacobi`, per instance: one get per type of its connected outputs.
@@ -193,12 +252,21 @@ pub(crate) struct Plan {
     pub(crate) jacobi_sets: Vec<Vec<Op>>,
 }
 
-fn slot_of(sources: &mut Vec<VariableRef>, r: &VariableRef) -> usize {
-    if let Some(k) = sources.iter().position(|s| s == r) {
-        return k;
+/// The slot of `r` in `sources` (`slots`: the slot of each), added if new.
+fn slot_of(sources: &mut Vec<VariableRef>, slots: &mut HashMap<VariableRef, usize>, r: &VariableRef) -> usize {
+    *slots.entry(r.clone()).or_insert_with(|| {
+        sources.push(r.clone());
+        sources.len() - 1
+    })
+}
+
+/// The slot of each variable of `sources`.
+fn slots_of(sources: &[VariableRef]) -> HashMap<VariableRef, usize> {
+    let mut slots = HashMap::with_capacity(sources.len());
+    for (k, s) in sources.iter().enumerate() {
+        slots.entry(s.clone()).or_insert(k);
     }
-    sources.push(r.clone());
-    sources.len() - 1
+    slots
 }
 
 /// Whether output `out` of an FMU depends directly on input `input` (0-based indices).
@@ -311,34 +379,41 @@ impl Plan {
     /// The plan of `system` recording `record`; an algebraic loop is an error only for
     /// `ordered`.
     pub(crate) fn new(system: &System, record: &[VariableRef], algorithm: Algorithm) -> Result<Plan> {
+        // (hash maps and sets: a system of 100,000 recorded array elements is planned in
+        // time linear in them)
         let mut sources: Vec<VariableRef> = Vec::new();
+        let mut slots: HashMap<VariableRef, usize> = HashMap::new();
         let mut connected_outputs: Vec<VariableRef> = Vec::new();
+        let mut connected: HashSet<VariableRef> = HashSet::new();
         for c in &system.connections {
-            slot_of(&mut sources, &c.from);
-            if !connected_outputs.contains(&c.from) {
+            slot_of(&mut sources, &mut slots, &c.from);
+            if connected.insert(c.from.clone()) {
                 connected_outputs.push(c.from.clone());
             }
         }
         for r in record {
-            slot_of(&mut sources, r);
+            slot_of(&mut sources, &mut slots, r);
         }
         // slots in the order the propagation reads them, then the recorded-only variables
         // by instance and type: every get of the `ordered` plan then fills consecutive
         // slots, straight from its fmi2GetReal (`Op::direct`)
         if let Ok(ops) = ordered_ops(system, &sources, &connected_outputs) {
             let mut order: Vec<usize> = Vec::with_capacity(sources.len());
+            let mut placed = vec![false; sources.len()];
             for op in ops.iter().filter(|op| op.kind == OpKind::Get) {
                 for &slot in &op.slots {
-                    if !order.contains(&slot) {
+                    if !placed[slot] {
+                        placed[slot] = true;
                         order.push(slot);
                     }
                 }
             }
-            let mut rest: Vec<usize> = (0..sources.len()).filter(|k| !order.contains(k)).collect();
+            let mut rest: Vec<usize> = (0..sources.len()).filter(|k| !placed[*k]).collect();
             rest.sort_by_key(|&k| (sources[k].instance, sources[k].base_type));
             order.extend(rest);
             sources = order.into_iter().map(|k| sources[k].clone()).collect();
         }
+        let slots = slots_of(&sources);
         // jacobi: per instance and type one get of its connected outputs (and one with the
         // recorded variables too, for output points), then one set of its connected inputs
         let n = system.instances.len();
@@ -351,7 +426,7 @@ impl Plan {
                 let mut get_rec = Op::new(i, OpKind::Get, ty);
                 for (k, s) in sources.iter().enumerate() {
                     if s.instance == i && s.base_type == ty {
-                        if connected_outputs.contains(s) {
+                        if connected.contains(s) {
                             get.push(s.value_reference, k, (1.0, 0.0));
                         }
                         get_rec.push(s.value_reference, k, (1.0, 0.0));
@@ -365,7 +440,7 @@ impl Plan {
                 }
                 let mut set = Op::new(i, OpKind::Set, ty);
                 for c in system.connections.iter().filter(|c| c.to.instance == i && c.to.base_type == ty) {
-                    let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+                    let slot = slots.get(&c.from).copied().unwrap_or(0);
                     set.push(c.to.value_reference, slot, (c.gain, c.offset));
                 }
                 if !set.vrs.is_empty() {
@@ -381,17 +456,22 @@ impl Plan {
             Err(e) if algorithm == Algorithm::Ordered => return Err(e),
             Err(_) => None,
         };
-        Ok(Plan { sources, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
+        for gets in jacobi_gets.iter_mut().chain(jacobi_gets_rec.iter_mut()) {
+            mark_wide_sources(gets, system);
+        }
+        Ok(Plan { sources, slots, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
     }
 
     /// The slot of a planned variable.
     pub(crate) fn slot(&self, r: &VariableRef) -> usize {
-        self.sources.iter().position(|s| s == r).unwrap_or(0)
+        self.slots.get(r).copied().unwrap_or(0)
     }
 
-    /// One get per instance and type of the variables `record` (sorted by instance and type).
+    /// One get per instance and type of the variables `record` (sorted by instance and
+    /// type; a variable named twice read once).
     pub(crate) fn record_gets(&self, record: &[VariableRef]) -> Vec<Op> {
-        let mut sorted: Vec<&VariableRef> = record.iter().collect();
+        let mut seen = HashSet::with_capacity(record.len());
+        let mut sorted: Vec<&VariableRef> = record.iter().filter(|r| seen.insert(*r)).collect();
         sorted.sort_by_key(|r| (r.instance, r.base_type));
         let mut ops: Vec<Op> = Vec::new();
         for r in sorted {
@@ -411,12 +491,13 @@ impl Plan {
                 last_set[op.instance] = Some(k);
             }
         }
-        let fresh = |slot: usize| {
-            ops.iter().enumerate().any(|(k, op)| {
-                op.kind == OpKind::Get && last_set[op.instance].is_none_or(|l| k > l) && op.slots.contains(&slot)
-            })
-        };
-        let stale: Vec<VariableRef> = record.iter().filter(|r| !fresh(self.slot(r))).cloned().collect();
+        let fresh: HashSet<usize> = ops
+            .iter()
+            .enumerate()
+            .filter(|(k, op)| op.kind == OpKind::Get && last_set[op.instance].is_none_or(|l| *k > l))
+            .flat_map(|(_, op)| op.slots.iter().copied())
+            .collect();
+        let stale: Vec<VariableRef> = record.iter().filter(|r| !fresh.contains(&self.slot(r))).cloned().collect();
         self.record_gets(&stale)
     }
 }
@@ -455,18 +536,20 @@ pub(crate) fn ordered_ops(
     connected_outputs: &[VariableRef],
 ) -> Result<Vec<Op>> {
     let nodes = ordered_nodes(system, connected_outputs)?;
+    let slots = slots_of(sources);
     let mut ops = Vec::new();
     for (is_output, k) in nodes {
         if is_output {
             let r = &connected_outputs[k];
-            let slot = sources.iter().position(|s| s == r).unwrap_or(0);
+            let slot = slots.get(r).copied().unwrap_or(0);
             emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
         } else {
             let c = &system.connections[k];
-            let slot = sources.iter().position(|s| *s == c.from).unwrap_or(0);
+            let slot = slots.get(&c.from).copied().unwrap_or(0);
             emit(&mut ops, c.to.instance, OpKind::Set, c.to.base_type, c.to.value_reference, slot, (c.gain, c.offset));
         }
     }
+    mark_wide_sources(&mut ops, system);
     Ok(ops)
 }
 
@@ -475,7 +558,7 @@ pub fn default_record(system: &System) -> Vec<VariableRef> {
     let mut out = Vec::new();
     for (i, spec) in system.instances.iter().enumerate() {
         for (index, v) in spec.fmu.description().model_variables.iter().enumerate() {
-            if v.causality == Causality::Output && BaseType::of(v) != BaseType::String {
+            if v.causality == Causality::Output {
                 out.push(VariableRef {
                     instance: i,
                     index,

@@ -107,6 +107,20 @@ pub struct Results {
     pub names: Vec<String>,
     /// Row-major values: `time, v1, v2, ...` per row.
     pub values: Vec<f64>,
+    /// The columns whose values an f64 does not hold (FMI 3.0 Int64 and UInt64, Binary,
+    /// String), each with the text of every row as fmpy writes it (an integer in decimal,
+    /// a Binary in hex, a String as it is); [`Results::values`] holds the nearest f64 there
+    /// (a Binary its size in bytes, a String NaN). The CSV file has the text.
+    pub exact: Vec<ExactColumn>,
+}
+
+/// The text of one column of [`Results`] whose values an f64 does not hold.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExactColumn {
+    /// The column (0-based among [`Results::names`]).
+    pub column: usize,
+    /// One text per row.
+    pub rows: Vec<String>,
 }
 
 impl Results {
@@ -137,7 +151,21 @@ impl Results {
             values.push(row[0]);
             values.extend(keep.iter().map(|j| row[j + 1]));
         }
-        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values }
+        let exact = self
+            .exact
+            .iter()
+            .filter_map(|e| {
+                let column = keep.iter().position(|j| *j == e.column)?;
+                Some(ExactColumn { column, rows: e.rows.clone() })
+            })
+            .collect();
+        Results { names: keep.iter().map(|j| self.names[*j].clone()).collect(), values, exact }
+    }
+
+    /// The text of column `column` (0-based among the names) in every row, if an f64 does
+    /// not hold its values ([`Results::exact`]).
+    pub fn exact_column(&self, column: usize) -> Option<&[String]> {
+        self.exact.iter().find(|e| e.column == column).map(|e| e.rows.as_slice())
     }
 
     /// Writes CSV as fmpy does: comma-separated, quoted names, `time` first; numbers
@@ -151,18 +179,40 @@ impl Results {
         }
         line.push('\n');
         w.write_all(line.as_bytes())?;
+        // the text of the columns an f64 does not hold, by column (time first)
+        let mut text: Vec<Option<&[String]>> = vec![None; self.width()];
+        for e in &self.exact {
+            if let Some(t) = text.get_mut(e.column + 1) {
+                *t = Some(&e.rows);
+            }
+        }
         for k in 0..self.rows() {
             line.clear();
             for (j, v) in self.row(k).iter().enumerate() {
                 if j > 0 {
                     line.push(',');
                 }
-                push_number(&mut line, *v);
+                match text[j].and_then(|rows| rows.get(k)) {
+                    Some(t) => push_text(&mut line, t),
+                    None => push_number(&mut line, *v),
+                }
             }
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
         w.flush()
+    }
+}
+
+/// A text cell: as it is, or quoted (quotes doubled) when it holds a comma, a quote or a
+/// line break.
+fn push_text(out: &mut String, t: &str) {
+    if t.contains([',', '"', '\n', '\r']) {
+        out.push('"');
+        out.push_str(&t.replace('"', "\"\""));
+        out.push('"');
+    } else {
+        out.push_str(t);
     }
 }
 
@@ -212,12 +262,16 @@ pub struct Summary {
     /// What the master did that a reader of the inputs may not expect (e.g. an input
     /// event between communication points applied at the next one), one sentence each.
     pub notes: Vec<String>,
+    /// FMI 3.0 clocks: every clock's ticks in the run (`instance.clock`, or the clock's
+    /// name in a one-instance system), input clocks ticked by the master and output clocks
+    /// the FMU said ticked; empty when no FMU has clocks.
+    pub clock_ticks: Vec<(String, u64)>,
 }
 
 impl Summary {
     /// As a JSON value.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut json = serde_json::json!({
             "steps": self.steps,
             "events": self.events.len(),
             "event_times": self.events.iter().map(|e| serde_json::json!({"instance": e.instance, "time": e.time, "kind": e.kind})).collect::<Vec<_>>(),
@@ -230,6 +284,11 @@ impl Summary {
             "instances": self.instance_time.iter().map(|(n, d)| serde_json::json!({"name": n, "time_s": d.as_secs_f64()})).collect::<Vec<_>>(),
             "warnings": self.warnings.iter().map(|(n, m)| serde_json::json!({"instance": n, "message": m})).collect::<Vec<_>>(),
             "notes": self.notes,
-        })
+        });
+        if !self.clock_ticks.is_empty() {
+            json["clock_ticks"] =
+                self.clock_ticks.iter().map(|(n, k)| serde_json::json!({"clock": n, "ticks": k})).collect();
+        }
+        json
     }
 }

@@ -15,29 +15,44 @@
  *   24 arr Float64[3] (y, 2y, 3y)  25 gains Float64[2] parameter (1 2)
  *   26 gy Float64 gains[1] y + gains[2]   27 flags Boolean[2] (odd, !odd)
  *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
+ *   32 i64in Int64 input (0)      33 i64out Int64 output i64in ^ 1 (the lowest bit flipped: exact or not at all)
+ *   34 u64in UInt64 input (0)     35 u64out UInt64 output u64in ^ 1
  *   30 crash_at Float64 parameter: Co-Simulation: the step that starts at or after it crashes;
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
  *      (SIGABRT), 3 exit(0); 4 no crash: Co-Simulation's step says terminateSimulation with an
  *      early return at lastSuccessfulTime = t + 1000 s, past the step
+ * and, in the descriptions of the tests of large arrays only (j from 0):
+ *   32 big Float64[BIG] output y + j   33 bigi Int32[BIG] output n + j
+ *   34 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
  * y reaches 0.55 says eventHandlingNeeded, and fmi3UpdateDiscreteStates then adds 1 to n.
  * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
- * the time event at stop_at says terminateSimulation. Every other fmi3 function exists and returns fmi3Error. */
+ * the time event at stop_at says terminateSimulation; the discrete inputs k and b cannot be set in
+ * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function exists and returns fmi3Error. */
 #include <stdlib.h>
 #include <string.h>
 #include "fmi3Functions.h"
 
+#ifndef BIG
+#define BIG 100000 /* the size of the large arrays (-DBIG=N) */
+#endif
+
 typedef struct {
     double time, u, y, stop_at, early_at, crash_at;
     int n, k, b, early_done, early_allowed, crossed, timed, crash_how, event_mode, in_event_mode;
+    /* Model Exchange: instantiated so, and in Continuous-Time Mode (where the discrete inputs
+       k and b cannot be set: FMI 3.0 section 3.2.1, as the Reference FMUs refuse them) */
+    int me, me_continuous;
     long long mode;
     char label[64];
     double gains[2];
     float f32in;
+    long long i64in;
+    unsigned long long u64in;
     unsigned char bytes[64];
 } State;
 
@@ -102,7 +117,9 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
-    return make(token, resources, env, log);
+    Counter *c = make(token, resources, env, log);
+    if (c) c->s.me = 1;
+    return c;
 }
 
 void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
@@ -124,8 +141,9 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
     Counter *c = instance;
     fmi3InstanceEnvironment env = c->env;
     fmi3LogMessageCallback log = c->log;
-    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode;
+    int early_allowed = c->s.early_allowed, event_mode = c->s.event_mode, me = c->s.me;
     memset(c, 0, sizeof *c);
+    c->s.me = me;
     c->s.early_allowed = early_allowed;
     c->s.event_mode = event_mode;
     c->env = env;
@@ -190,7 +208,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
-        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : 1;
+        size_t size = vr[i] == 24 ? 3 : vr[i] == 25 ? 2 : vr[i] == 32 ? BIG : 1;
         if (k + size > nValues) return fail(c, "fmi3GetFloat64: nValues too small");
         switch (vr[i]) {
         case 0: values[k] = c->s.time; break;
@@ -204,6 +222,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         case 25: values[k] = c->s.gains[0]; values[k + 1] = c->s.gains[1]; break;
         case 26: values[k] = c->s.gains[0] * c->s.y + c->s.gains[1]; break;
         case 30: values[k] = c->s.crash_at; break;
+        case 32: for (size_t j = 0; j < BIG; j++) values[k + j] = c->s.y + (double)j; break;
         default: return fail(c, "fmi3GetFloat64: no such Float64");
         }
         k += size;
@@ -236,6 +255,11 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
 fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Int32 values[], size_t nValues) {
     Counter *c = instance;
+    if (nvr == 1 && vr[0] == 33) { /* the array bigi */
+        if (nValues != BIG) return fail(c, "fmi3GetInt32: nValues is not the size of bigi");
+        for (size_t j = 0; j < BIG; j++) values[j] = c->s.n + (fmi3Int32)j;
+        return fmi3OK;
+    }
     if (nvr != nValues) return fail(c, "fmi3GetInt32: nValues != nValueReferences");
     for (size_t i = 0; i < nvr; i++) {
         switch (vr[i]) {
@@ -254,6 +278,8 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     Counter *c = instance;
     if (nvr != nValues) return fail(c, "fmi3SetInt32: nValues != nValueReferences");
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 9 && c->s.me_continuous)
+            return fail(c, "fmi3SetInt32: Illegal call sequence (the discrete input k in Continuous-Time Mode)");
         if (vr[i] == 9) c->s.k = values[i];
         else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 4) c->s.crash_how = values[i];
         else return fail(c, "fmi3SetInt32: not settable");
@@ -267,6 +293,8 @@ fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] == 5) values[i] = c->s.mode;
         else if (vr[i] == 21) values[i] = -(1LL << 40) * c->s.n;
+        else if (vr[i] == 32) values[i] = c->s.i64in;
+        else if (vr[i] == 33) values[i] = c->s.i64in ^ 1;
         else return fail(c, "fmi3GetInt64: no such Int64");
     }
     return fmi3OK;
@@ -276,6 +304,7 @@ fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     const fmi3Int64 values[], size_t nValues) {
     Counter *c = instance;
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 32) { c->s.i64in = values[i]; continue; }
         if (vr[i] != 5) return fail(c, "fmi3SetInt64: not settable");
         if (values[i] != 1 && values[i] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
         c->s.mode = values[i];
@@ -288,13 +317,14 @@ fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     size_t k = 0;
     for (size_t i = 0; i < nvr; i++) {
-        size_t size = vr[i] == 27 ? 2 : 1;
+        size_t size = vr[i] == 27 ? 2 : vr[i] == 34 ? BIG : 1;
         if (k + size > nValues) return fail(c, "fmi3GetBoolean: nValues too small");
         switch (vr[i]) {
         case 4: values[k] = (c->s.n % 2) == 1; break;
         case 11: values[k] = c->s.b != 0; break;
         case 12: values[k] = c->s.b == 0; break;
         case 27: values[k] = (c->s.n % 2) == 1; values[k + 1] = (c->s.n % 2) == 0; break;
+        case 34: for (size_t j = 0; j < BIG; j++) values[k + j] = ((c->s.n + j) % 2) == 1; break;
         default: return fail(c, "fmi3GetBoolean: no such Boolean");
         }
         k += size;
@@ -307,6 +337,8 @@ fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], 
     Counter *c = instance;
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] != 11) return fail(c, "fmi3SetBoolean: not settable");
+        if (c->s.me_continuous)
+            return fail(c, "fmi3SetBoolean: Illegal call sequence (the discrete input b in Continuous-Time Mode)");
         c->s.b = values[i] ? 1 : 0;
     }
     return fmi3OK;
@@ -365,7 +397,26 @@ SCALAR_GETTER(UInt8, 17, 20 * c->s.n)
 SCALAR_GETTER(Int16, 18, -1000 * c->s.n)
 SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
 SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
-SCALAR_GETTER(UInt64, 22, (1ULL << 48) * (unsigned long long)c->s.n)
+fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3GetUInt64: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 22) values[i] = (1ULL << 48) * (unsigned long long)c->s.n;
+        else if (vr[i] == 34) values[i] = c->s.u64in;
+        else if (vr[i] == 35) values[i] = c->s.u64in ^ 1;
+        else return fail(c, "fmi3GetUInt64: no such variable");
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 values[], size_t nValues) {
+    Counter *c = instance;
+    if (nvr != nValues) return fail(c, "fmi3SetUInt64: nValues != nValueReferences");
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] != 34) return fail(c, "fmi3SetUInt64: not settable");
+        c->s.u64in = values[i];
+    }
+    return fmi3OK;
+}
 
 fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {
     Counter *c = instance;
@@ -401,9 +452,13 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
 fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
     Counter *c = instance;
     c->s.in_event_mode = c->s.event_mode;
+    c->s.me_continuous = 0;
     return fmi3OK;
 }
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
+    ((Counter *)instance)->s.me_continuous = 1;
+    return fmi3OK;
+}
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     ((Counter *)instance)->s.time = time;
     return fmi3OK;
@@ -482,7 +537,6 @@ UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t 
 UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
 UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
 UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt64, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 v[], size_t m)
 UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
 UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
 UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])

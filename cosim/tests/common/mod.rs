@@ -434,3 +434,56 @@ pub fn build_tolerance(dir: &Path, default_tolerance: Option<&str>) -> PathBuf {
     );
     build_single_c_fmu(dir, "tolerance", &xml)
 }
+
+/// Builds `<dir>/<stem>.fmu` from the FMI 3.0 test FMU tests/cfmu/fmi3_counter.c with `xml` as its description.
+pub fn build_counter(dir: &Path, stem: &str, xml: &str) -> Option<PathBuf> {
+    build_counter_with_flags(dir, stem, xml, &[])
+}
+
+/// [`build_counter`] with extra `cc` flags (`-DBIG=N`: the size of the large arrays).
+pub fn build_counter_with_flags(dir: &Path, stem: &str, xml: &str, flags: &[&str]) -> Option<PathBuf> {
+    let headers = fmi3_c::headers()?;
+    let so = dir.join("fmi3_counter.so");
+    {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu/fmi3_counter.c");
+        let status = Command::new("cc")
+            .args(["-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wall", "-Wno-unused-parameter", "-Werror"])
+            .arg("-I")
+            .arg(&headers)
+            .args(flags)
+            .arg(&src)
+            .arg("-o")
+            .arg(&so)
+            .status()
+            .expect("run cc");
+        assert!(status.success(), "cc failed for fmi3_counter.c");
+    }
+    let fmu = dir.join(format!("{stem}.fmu"));
+    zip_entries(
+        &fmu,
+        &[
+            ("modelDescription.xml", xml.as_bytes().to_vec()),
+            ("binaries/x86_64-linux/fmi3_counter.so", std::fs::read(&so).unwrap()),
+        ],
+    );
+    Some(fmu)
+}
+
+/// The FMI 3.0 test FMU's description (tests/cfmu/fmi3_counter.xml) with the large array
+/// outputs `arrays` (of `big` Float64, `bigi` Int32, `bigb` Boolean) of `n` elements each
+/// (fmi3_counter.c built with `-DBIG=n`).
+pub fn counter_xml_with_large_arrays(n: usize, arrays: &[&str]) -> String {
+    let xml = include_str!("../cfmu/fmi3_counter.xml");
+    let arr = r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension start="3"/></Float64>"#;
+    assert!(xml.contains(arr));
+    let mut declared = arr.to_string();
+    for (name, ty, vr) in [("big", "Float64", 32), ("bigi", "Int32", 33), ("bigb", "Boolean", 34)] {
+        if arrays.contains(&name) {
+            declared.push_str(&format!(
+                r#"
+    <{ty} name="{name}" valueReference="{vr}" causality="output"><Dimension start="{n}"/></{ty}>"#
+            ));
+        }
+    }
+    xml.replace(arr, &declared)
+}

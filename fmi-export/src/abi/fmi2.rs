@@ -60,6 +60,8 @@ pub unsafe fn instantiate<M: Model>(
         let supported = match interface {
             Interface::ModelExchange => offered.model_exchange,
             Interface::CoSimulation => offered.co_simulation,
+            // not an FMI 2.0 interface (fmuType above is 0 or 1)
+            Interface::ScheduledExecution => false,
         };
         if !supported {
             return Err(format!("{} does not offer {interface:?}", declaration.spec.model_identifier));

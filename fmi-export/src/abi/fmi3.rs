@@ -119,9 +119,12 @@ unsafe fn instantiate3<M: Model>(
         let supported = match interface {
             Interface::ModelExchange => offered.model_exchange,
             Interface::CoSimulation => offered.co_simulation,
+            // the model partition of Scheduled Execution is the declared clock's
+            Interface::ScheduledExecution => declaration.clock().is_some(),
         };
         if !supported {
-            return Err(format!("{} does not offer {interface:?}", declaration.spec.model_identifier));
+            let why = if interface == Interface::ScheduledExecution { " (it declares no clock)" } else { "" };
+            return Err(format!("{} does not offer {interface:?}{why}", declaration.spec.model_identifier));
         }
         let given = string(instantiation_token).ok_or("instantiationToken is NULL or not UTF-8")?;
         if given != declaration.guid() {
@@ -226,23 +229,34 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     )
 }
 
+/// `fmi3InstantiateScheduledExecution`: offered by a model with a declared clock, whose
+/// model partition `fmi3ActivateModelPartition` runs. The FMU calls none of the callbacks:
+/// its one clock is an input clock (no `clockUpdate`), and its one partition shares no data
+/// with another that could preempt it (no `lockPreemption`).
 pub unsafe fn instantiate_scheduled_execution<M: Model>(
-    _: Function,
+    function: Function,
+    instance_name: fmi3String,
+    instantiation_token: fmi3String,
+    resource_path: fmi3String,
+    _visible: fmi3Boolean,
+    logging_on: fmi3Boolean,
     environment: fmi3InstanceEnvironment,
     log_message: Option<Fmi3LogMessageCallback>,
+    _clock_update: Option<Fmi3ClockUpdateCallback>,
+    _lock_preemption: Option<Fmi3LockPreemptionCallback>,
+    _unlock_preemption: Option<Fmi3UnlockPreemptionCallback>,
 ) -> fmi3Instance {
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        emit3(
-            environment,
-            log_message,
-            &format!(
-                "fmi3InstantiateScheduledExecution: {} does not offer Scheduled Execution (only Model Exchange and \
-                 Co-Simulation)",
-                M::declaration().spec.model_identifier
-            ),
-        )
-    }));
-    std::ptr::null_mut()
+    instantiate3::<M>(
+        function,
+        Interface::ScheduledExecution,
+        instance_name,
+        instantiation_token,
+        resource_path,
+        logging_on,
+        environment,
+        log_message,
+        || Ok(()),
+    )
 }
 
 pub unsafe fn free_instance<M: Model>(function: Function, instance: fmi3Instance) {
@@ -582,6 +596,17 @@ pub unsafe fn clock_timing<M: Model>(
     n_vr: usize,
 ) -> Fmi3Status {
     with3::<M>(instance, function, |comp| comp.instance.refuse_clock_timing(slice(vr, n_vr, "valueReferences")?))
+}
+
+/// `fmi3ActivateModelPartition` (Scheduled Execution): the declared clock's partition (the
+/// model's sample) at `activationTime`.
+pub unsafe fn activate_model_partition<M: Model>(
+    function: Function,
+    instance: fmi3Instance,
+    clock: fmi3ValueReference,
+    activation_time: fmi3Float64,
+) -> Fmi3Status {
+    with3::<M>(instance, function, |comp| comp.instance.activate_model_partition(clock, activation_time))
 }
 
 /// `fmi3EnterStepMode` (Co-Simulation with Event Mode): from Event Mode to Step Mode.

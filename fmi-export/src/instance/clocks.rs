@@ -9,13 +9,13 @@
 //! `fmi3UpdateDiscreteStates`, with the inputs set by then; an input set after the sample
 //! ran undoes it (it runs again at the next read), as the lazy events of Co-Simulation do
 //! for FMI 2.0: so the sample `k` of a clocked instance is the FMI 2.0 one to the bit.
-//! Clocked variables can be read only while their clock is active (and in Initialization
-//! Mode), as FMI 3.0 section 2.2.9 says; a step past an activation, an activation at
-//! another time than the next `t_k` and deactivating the clock (`canBeDeactivated` is
-//! false) are errors naming the clock and the times.
+//! Between activations the clocked variables hold their values (an importer may record
+//! them there); a step past an activation, an activation at another time than the next
+//! `t_k` and deactivating the clock (`canBeDeactivated` is false) are errors naming the
+//! clock and the times.
 
-use super::{decl, err, time_eps, Instance, OpResult, PreEvent};
-use crate::decl::{BaseType, ClockDecl, ClockInterval};
+use super::{decl, err, time_eps, Function, Instance, OpResult, PreEvent};
+use crate::decl::{ClockDecl, ClockInterval};
 use crate::model::Model;
 use crate::states::Machine;
 
@@ -160,26 +160,14 @@ impl<M: Model> Instance<M> {
     }
 
     /// Before a read of a clocked instance: the sample of an active clock runs (once per
-    /// activation, with the inputs set by then; a later set undoes it), and a clocked
-    /// variable of `rows` is refused while its clock is inactive.
-    pub(super) fn settle_clock(&mut self, base_type: BaseType, vrs: &[u32]) -> OpResult {
+    /// activation, with the inputs set by then; a later set undoes it). A clocked variable
+    /// read while its clock is inactive answers its value of the last activation (held
+    /// until the next): FMI 3.0 section 2.2.9 lets importers read clocked variables only
+    /// while their clock is active, and an importer that records them between activations
+    /// (as a master recording rows at its communication points does) gets what they hold.
+    pub(super) fn settle_clock(&mut self) -> OpResult {
         if self.core.clock_active {
             return self.sample_at_activation();
-        }
-        if matches!(self.core.machine, Machine::Instantiated | Machine::InitializationMode) {
-            return Ok(());
-        }
-        let d = decl::<M>();
-        for &vr in vrs {
-            if let Some(row) = d.row(base_type, vr).filter(|&row| d.is_clocked(row)) {
-                let (clock, _) = Self::declared_clock()?;
-                return err(format!(
-                    "{} is a clocked variable of {}, which is not active: it can be read only while its clock is \
-                     (in Event Mode, between fmi3SetClock and fmi3UpdateDiscreteStates)",
-                    d.variable(row).name,
-                    clock.name
-                ));
-            }
         }
         Ok(())
     }
@@ -246,6 +234,56 @@ impl<M: Model> Instance<M> {
                 samples.next, clock.name
             ));
         }
+        Ok(())
+    }
+
+    /// The state table of a Scheduled Execution instance (the layer's `StepComplete` is its
+    /// Clock Activation Mode): the common calls as in Co-Simulation's Step Mode, the
+    /// partition's activation and the interval and shift queries there, never the calls of
+    /// Model Exchange and Co-Simulation nor `fmi3SetClock`/`fmi3GetClock` (an input clock's
+    /// partition is activated, not the clock).
+    pub(super) fn scheduled_call_allowed(function: Function, machine: Machine) -> OpResult {
+        use crate::states::Scope;
+        let allowed = match function {
+            Function::Fmi3GetClock | Function::Fmi3SetClock => {
+                return err("not available in Scheduled Execution: fmi3ActivateModelPartition activates the clock's \
+                            model partition");
+            }
+            Function::Fmi3ActivateModelPartition => machine == Machine::StepComplete,
+            f if f.is_clock_function() => matches!(machine, Machine::InitializationMode | Machine::StepComplete),
+            f => match f.scope() {
+                Scope::ModelExchange | Scope::CoSimulation => {
+                    return err("not available: this instance was created for ScheduledExecution");
+                }
+                _ => f.allowed_in(machine),
+            },
+        };
+        if allowed {
+            Ok(())
+        } else {
+            err(format!("not allowed in state {machine:?}"))
+        }
+    }
+
+    /// `fmi3ActivateModelPartition`: the partition of the declared clock, its sample, at the
+    /// clock's next activation time, with the inputs set before.
+    pub fn activate_model_partition(&mut self, clock_vr: u32, activation_time: f64) -> OpResult {
+        let clock = Self::check_clock_references(&[clock_vr])?;
+        let Some(mut samples) = self.core.clock.filter(|c| c.has_next()) else {
+            return err(format!("{} has no activation after its last at t = {} s", clock.name, self.core.time));
+        };
+        let due = samples.time_of(samples.next);
+        if !activation_time.is_finite() || (activation_time - due).abs() > time_eps(due) {
+            return err(format!(
+                "activationTime = {activation_time} s for {}, but its next activation is at t = {due} s (activation \
+                 {}: start {} s + {} x {} s)",
+                clock.name, samples.next, samples.start, samples.next, samples.period
+            ));
+        }
+        self.core.time = activation_time;
+        self.core.model.set_time(activation_time);
+        self.sample(&mut samples, activation_time)?;
+        self.core.next_event = None;
         Ok(())
     }
 }

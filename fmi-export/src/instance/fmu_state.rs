@@ -17,7 +17,9 @@ impl<M: Model> Instance<M> {
         let fits = match state.machine {
             // FMI 3.0 has no stepFailed state: a Discarded fmi3DoStep stays in Step Mode
             Machine::StepFailed if self.generation == Generation::Fmi3 => false,
-            Machine::StepComplete | Machine::StepFailed => self.context.interface == Interface::CoSimulation,
+            // Step Mode, or Scheduled Execution's Clock Activation Mode
+            Machine::StepComplete => self.context.interface != Interface::ModelExchange,
+            Machine::StepFailed => self.context.interface == Interface::CoSimulation,
             // Co-Simulation with Event Mode: a clocked FMI 3.0 instance
             Machine::EventMode => self.context.interface == Interface::ModelExchange || self.clocked,
             Machine::ContinuousTimeMode => self.context.interface == Interface::ModelExchange,

@@ -221,10 +221,16 @@ impl<M: Model> Instance<M> {
         // (an FMI 3.0 instance of it is created with eventModeUsed = true: see abi::fmi3)
         let clocked = decl::<M>().clock().is_some();
         let event_mode_cs = clocked && interface == Interface::CoSimulation;
-        let declared_by_clock =
-            (clocked && function.is_clock_function()) || (event_mode_cs && function == Function::Fmi3EnterStepMode);
+        let scheduled = interface == Interface::ScheduledExecution;
+        let declared_by_clock = (clocked && function.is_clock_function())
+            || (event_mode_cs && function == Function::Fmi3EnterStepMode)
+            || (scheduled && function == Function::Fmi3ActivateModelPartition);
         if let Some(missing) = function.undeclared_feature().filter(|_| !declared_by_clock) {
             return err(format!("not supported: {missing}"));
+        }
+        if scheduled {
+            Self::scheduled_call_allowed(function, machine)?;
+            return Self::capability_declared(function);
         }
         let cs_event_mode_call = interface == Interface::CoSimulation
             && matches!(function, Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates);
@@ -233,11 +239,23 @@ impl<M: Model> Instance<M> {
         }
         match (function.scope(), interface) {
             (Scope::ModelExchange, Interface::CoSimulation) if cs_event_mode_call => {}
-            (Scope::ModelExchange, Interface::CoSimulation) | (Scope::CoSimulation, Interface::ModelExchange) => {
+            (Scope::ModelExchange, Interface::CoSimulation)
+            | (Scope::CoSimulation, Interface::ModelExchange)
+            | (Scope::ScheduledExecution, _) => {
                 return err(format!("not available: this instance was created for {interface:?}"));
             }
             _ => {}
         }
+        Self::capability_declared(function)?;
+        if !function.allowed_in(machine) {
+            return err(format!("not allowed in state {machine:?}"));
+        }
+        Ok(())
+    }
+
+    /// The model declared the capability `function` belongs to (FMU state, its
+    /// serialization, directional derivatives).
+    fn capability_declared(function: Function) -> OpResult {
         let caps = decl::<M>().spec.capabilities;
         let supported = match function.counterpart().unwrap_or(function) {
             Function::GetFMUstate | Function::SetFMUstate | Function::FreeFMUstate => caps.fmu_state,
@@ -252,9 +270,6 @@ impl<M: Model> Instance<M> {
                 "not supported: {} did not declare this capability",
                 decl::<M>().spec.model_identifier
             ));
-        }
-        if !function.allowed_in(machine) {
-            return err(format!("not allowed in state {machine:?}"));
         }
         Ok(())
     }
@@ -340,6 +355,8 @@ impl<M: Model> Instance<M> {
         self.core.machine = match self.context.interface {
             // Co-Simulation with Event Mode (a clocked FMU) starts in Event Mode too
             Interface::CoSimulation if !self.clocked => Machine::StepComplete,
+            // Scheduled Execution's Clock Activation Mode
+            Interface::ScheduledExecution => Machine::StepComplete,
             _ => Machine::EventMode,
         };
         // the initial event, at the start time; a clocked instance's samples are the

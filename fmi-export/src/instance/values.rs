@@ -149,7 +149,7 @@ impl<M: Model> Instance<M> {
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> OpResult {
         let d = decl::<M>();
         if self.clocked {
-            self.settle_clock(BaseType::Real, vrs)?;
+            self.settle_clock()?;
         } else {
             self.settle_events()?;
         }
@@ -202,7 +202,7 @@ impl<M: Model> Instance<M> {
         let d = decl::<M>();
         Self::check_rows(d, BaseType::Integer, vrs)?;
         if self.clocked {
-            self.settle_clock(BaseType::Integer, vrs)?;
+            self.settle_clock()?;
         } else {
             self.settle_events()?;
         }
@@ -217,7 +217,7 @@ impl<M: Model> Instance<M> {
         let d = decl::<M>();
         Self::check_rows(d, BaseType::Boolean, vrs)?;
         if self.clocked {
-            self.settle_clock(BaseType::Boolean, vrs)?;
+            self.settle_clock()?;
         } else {
             self.settle_events()?;
         }

@@ -185,6 +185,10 @@ pub(crate) trait Calls: Send {
     /// The string of `vr` as the FMU returns it (valid until its next call).
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const std::ffi::c_char>;
     fn set_string(&mut self, core: &mut Core, vr: u32, value: *const std::ffi::c_char) -> Result<()>;
+    /// The exact value of a variable of [`crate::Fmu::exact_kind`] (FMI 3.0 only).
+    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact>;
+    /// Sets a 64-bit integer variable of [`crate::Fmu::exact_kind`] exactly (FMI 3.0 only).
+    fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()>;
     fn do_step(&mut self, core: &mut Core, time: f64, step: f64) -> Result<()>;
     /// Isolated: the operation and step size of the first call of `do_step`, if the
     /// table has the function.
@@ -216,6 +220,10 @@ pub(crate) trait Calls: Send {
     fn free_functions(&self) -> (Option<FreeStateFunction>, FreeInstanceFunction, &'static str);
     /// Whether this is FMI 3.0.
     fn is_fmi3(&self) -> bool;
+    /// The clock calls (FMI 3.0 only; see `instance/clocks.rs`).
+    fn clock_calls(&mut self) -> Option<&mut dyn ClockCalls> {
+        None
+    }
 }
 
 /// `fmi2Reset` / `fmi3Reset`: both take the instance only.
@@ -224,3 +232,44 @@ pub(crate) type ResetFunction = unsafe extern "C" fn(Component) -> RawStatus;
 pub(crate) type FreeStateFunction = unsafe extern "C" fn(Component, *mut *mut c_void) -> RawStatus;
 /// `fmi2FreeInstance` / `fmi3FreeInstance`.
 pub(crate) type FreeInstanceFunction = unsafe extern "C" fn(Component);
+
+// The clock calls' types live here, beside the calls of every generation (`Calls`), so
+// that the generations' modules and `clocks.rs` (the calls on an `Instance`) import them
+// one way.
+
+/// What the FMU said of a clock's interval (`fmi3IntervalQualifier`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Interval {
+    /// `fmi3IntervalNotYetKnown`: a countdown clock that is not counting down.
+    NotYetKnown,
+    /// `fmi3IntervalUnchanged`: as before (the value is the interval the master has).
+    Unchanged(f64),
+    /// `fmi3IntervalChanged`: the clock ticks this many seconds after now.
+    Changed(f64),
+}
+
+/// An output clock's tick: when and which (the FMU's value reference).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutputTick {
+    /// The time of the event it ticked in, s.
+    pub time: f64,
+    /// The clock's value reference (the FMU's).
+    pub value_reference: u32,
+}
+
+/// The clock calls of one generation (FMI 3.0 only).
+pub(crate) trait ClockCalls {
+    fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()>;
+    fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()>;
+    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>>;
+    fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>>;
+    fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()>;
+    /// A clock event at `time` (Event Mode entered and the input clocks `vrs` set; the
+    /// discrete states updated until settled; the output clocks read; Step Mode again).
+    fn clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()>;
+    /// The output clocks' ticks since the last call (in Event Mode entered by a tick or by
+    /// the FMU's own event in `fmi3DoStep`).
+    fn take_output_ticks(&mut self) -> Vec<OutputTick>;
+    /// What the FMU said of its input clocks' intervals in the events since the last call.
+    fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)>;
+}

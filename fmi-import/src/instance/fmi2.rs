@@ -172,6 +172,14 @@ impl Calls for Fmi2 {
         call!(core, "fmi2SetString", None, f(c, &vr, 1, &p))
     }
 
+    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
+        Err(no_exact(core, vr, String::new()))
+    }
+
+    fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {
+        Err(no_exact(core, vr, value.to_string()))
+    }
+
     #[inline]
     fn do_step(&mut self, core: &mut Core, time: f64, step: f64) -> Result<()> {
         let c = core.component;
@@ -317,5 +325,16 @@ impl Calls for Fmi2 {
 
     fn is_fmi3(&self) -> bool {
         false
+    }
+}
+
+/// An FMI 2.0 FMU has no variable whose values an f64 (or its Integer, Boolean, String)
+/// does not hold: no exact value to read or set.
+#[cold]
+fn no_exact(core: &Core, vr: u32, value: String) -> Error {
+    Error::InvalidValue {
+        variable: format!("{}.<value reference {vr}>", core.name),
+        value,
+        reason: "FMI 2.0 has no 64-bit integers or Binaries: nothing to read or set exactly".into(),
     }
 }

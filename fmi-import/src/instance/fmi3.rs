@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
-use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmi3::{Access, Fmi3Abi};
@@ -20,7 +20,7 @@ use crate::status::Status;
 /// The FMI 3.0 calls: the library's table and description, and what an instance keeps
 /// that FMI 2.0 has no place for.
 pub(crate) struct Fmi3 {
-    a: Arc<Fmi3Abi>,
+    pub(super) a: Arc<Fmi3Abi>,
     /// What `setup_experiment` was given (tolerance, start, stop), passed on by
     /// `fmi3EnterInitializationMode`.
     experiment: (Option<f64>, f64, Option<f64>),
@@ -33,9 +33,18 @@ pub(crate) struct Fmi3 {
     /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
+    /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
+    output_clocks: Vec<u32>,
+    /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
+    pub(super) output_ticks: Vec<super::core::OutputTick>,
+    /// The input clocks whose interval the FMU gives (fixed, tunable, changing,
+    /// countdown), read by `fmi3GetIntervalDecimal` in every event.
+    interval_clocks: Vec<u32>,
+    /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
+    pub(super) intervals: Vec<(f64, u32, super::core::Interval)>,
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
     /// the FMU's for as long as the instance lives).
-    scheduled: Option<Box<super::scheduled::ScheduledEnvironment>>,
+    scheduled: Option<Box<super::callbacks::ScheduledEnvironment>>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -49,6 +58,22 @@ impl Fmi3 {
     pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
         let event_mode = interface == Interface::CoSimulation
             && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+        use crate::clocks::{ClockCausality, ClockKind};
+        // Scheduled Execution runs the clocks through its own calls (`scheduled.rs`)
+        let clocks = if interface == Interface::ScheduledExecution {
+            Vec::new()
+        } else {
+            crate::clocks::clocks_of(&a.description)
+        };
+        let output_clocks =
+            clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
+        let interval_clocks = clocks
+            .iter()
+            .filter(|c| {
+                c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered)
+            })
+            .map(|c| c.value_reference)
+            .collect();
         Fmi3 {
             a,
             experiment: (None, 0.0, None),
@@ -56,6 +81,10 @@ impl Fmi3 {
             bytes: Vec::new(),
             arrays: HashMap::new(),
             event_mode: std::cell::Cell::new(event_mode),
+            output_clocks,
+            output_ticks: Vec::new(),
+            interval_clocks,
+            intervals: Vec::new(),
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
         }
     }
@@ -80,8 +109,8 @@ impl Fmi3 {
         !self.a.special.is_empty() && vrs.iter().any(|vr| self.a.special.contains_key(vr))
     }
 
-    /// All values of the FMI 3.0 variable of `access`, as f64 (integers exact up to 2^53,
-    /// Booleans 0 or 1, a Binary its size in bytes).
+    /// All values of the FMI 3.0 variable of `access`, as f64 (64-bit integers the nearest,
+    /// exact up to 2^53; Booleans 0 or 1, a Binary its size in bytes).
     fn get_all(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
         use model_description::fmi3::ValueType as T;
         let c = core.component;
@@ -93,19 +122,6 @@ impl Fmi3 {
                 let mut buf: Vec<$t> = vec![<$t>::default(); n];
                 call!(core, $name, None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
                 buf
-            }};
-        }
-        macro_rules! exact {
-            ($buf:expr, $name:literal) => {{
-                let mut out = Vec::with_capacity(n);
-                for x in $buf {
-                    let wide = x as i128;
-                    if wide.abs() > 1 << 53 {
-                        return Err(not_exact(core, $name, vr, wide));
-                    }
-                    out.push(wide as f64);
-                }
-                out
             }};
         }
         Ok(match access.value_type {
@@ -122,8 +138,9 @@ impl Fmi3 {
             T::UInt16 => get!(get_uint16, "fmi3GetUInt16", u16).into_iter().map(f64::from).collect(),
             T::Int32 => get!(get_int32, "fmi3GetInt32", i32).into_iter().map(f64::from).collect(),
             T::UInt32 => get!(get_uint32, "fmi3GetUInt32", u32).into_iter().map(f64::from).collect(),
-            T::Int64 | T::Enumeration => exact!(get!(get_int64, "fmi3GetInt64", i64), "fmi3GetInt64"),
-            T::UInt64 => exact!(get!(get_uint64, "fmi3GetUInt64", u64), "fmi3GetUInt64"),
+            // the nearest f64 (exact up to 2^53); `get_exact` reads the integer itself
+            T::Int64 | T::Enumeration => get!(get_int64, "fmi3GetInt64", i64).into_iter().map(|x| x as f64).collect(),
+            T::UInt64 => get!(get_uint64, "fmi3GetUInt64", u64).into_iter().map(|x| x as f64).collect(),
             T::Boolean => get!(get_boolean, "fmi3GetBoolean", u8).into_iter().map(|b| (b != 0) as i32 as f64).collect(),
             T::Binary => {
                 let f = f3!(core, a, get_binary, "fmi3GetBinary");
@@ -134,6 +151,20 @@ impl Fmi3 {
             }
             T::String | T::Clock => unreachable!("not in the view as a number"),
         })
+    }
+
+    /// Element `access` within one get call, whose last array read is `array`: an array is
+    /// read once per call, not once per element (the elements of one array are asked
+    /// together, a row of the results, and the FMU does not change in between), so that
+    /// a row costs time linear in the elements.
+    fn element_of_call(&mut self, core: &mut Core, access: Access, array: &mut Option<(u32, Vec<f64>)>) -> Result<f64> {
+        if access.count <= 1 {
+            return self.get_element(core, access);
+        }
+        if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
+            *array = Some((access.vr, self.get_all(core, access)?));
+        }
+        Ok(array.as_ref().and_then(|(_, all)| all.get(access.element)).copied().unwrap_or(f64::NAN))
     }
 
     fn get_element(&mut self, core: &mut Core, access: Access) -> Result<f64> {
@@ -245,7 +276,7 @@ impl Fmi3 {
     /// `terminateSimulation` from `function` (called at `at`) at the time `reached`,
     /// reported as FMI 2.0 reports it: a Discard, with `terminated_status` true and
     /// `last_successful_time` `reached`.
-    fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
+    pub(super) fn terminated_at(&mut self, core: &mut Core, function: &'static str, at: f64, reached: f64) -> Error {
         core.time = reached;
         self.terminate_requested = Some(reached);
         Error::Fmi {
@@ -268,7 +299,7 @@ impl Fmi3 {
     /// In Event Mode at `time`: `fmi3UpdateDiscreteStates` until no new discrete states are
     /// needed (at most 1000 times), then `fmi3EnterStepMode`. `Some(time)` when the FMU asked
     /// to terminate.
-    fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
+    pub(super) fn settle_event(&mut self, core: &mut Core, time: f64) -> Result<Option<f64>> {
         for _ in 0..1000 {
             let info = self.new_discrete_states(core)?;
             if info.terminate_simulation != 0 {
@@ -290,20 +321,44 @@ impl Fmi3 {
     }
 }
 
+impl Fmi3 {
+    /// In Event Mode at `time`: which output clocks ticked (`fmi3GetClock`) and the
+    /// intervals of the input clocks the FMU gives (`fmi3GetIntervalDecimal`), kept for
+    /// `take_output_ticks` and `take_intervals`.
+    fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
+        if !self.interval_clocks.is_empty() {
+            let vrs = self.interval_clocks.clone();
+            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
+            self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
+        }
+        if self.output_clocks.is_empty() {
+            return Ok(());
+        }
+        let vrs = self.output_clocks.clone();
+        let mut ticks = vec![false; vrs.len()];
+        super::core::ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
+        for (vr, ticked) in vrs.into_iter().zip(ticks) {
+            if ticked {
+                self.output_ticks.push(super::core::OutputTick { time, value_reference: vr });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The error of a Scheduled Execution call on an instance of another interface.
 #[cold]
 pub(super) fn not_scheduled(name: &str) -> Error {
     Error::Instance { name: name.into(), reason: "it is not instantiated for Scheduled Execution (--interface se)" }
 }
 
+/// The error of an exact read or set of `vr`, which is no 64-bit integer or Binary.
 #[cold]
-fn not_exact(core: &Core, function: &'static str, vr: u32, value: i128) -> Error {
-    Error::Fmi {
-        instance: core.name.clone(),
-        function,
-        status: Status::Error,
-        time: Some(core.time),
-        log: format!("value {value} of value reference {vr} is beyond 2^53, where f64 results cannot hold it exactly"),
+fn not_exact(core: &Core, vr: u32, value: String) -> Error {
+    Error::InvalidValue {
+        variable: format!("{}.<value reference {vr}>", core.name),
+        value,
+        reason: "not an Int64, UInt64 or Binary of the FMU's: its value is the view's".into(),
     }
 }
 
@@ -466,6 +521,8 @@ impl Calls for Fmi3 {
     }
 
     fn forget_run(&mut self) {
+        self.output_ticks.clear();
+        self.intervals.clear();
         self.terminate_requested = None;
     }
 
@@ -480,19 +537,10 @@ impl Calls for Fmi3 {
                 f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
             );
         }
-        // an array is read once per call, not once per element: the elements of one array
-        // are asked together (a row of the results), and the FMU does not change in between
-        let mut array: Option<(u32, Vec<f64>)> = None;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
-                Some(access) if access.count > 1 => {
-                    if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
-                        array = Some((access.vr, self.get_all(core, access)?));
-                    }
-                    let all = &array.as_ref().expect("read above").1;
-                    *value = all.get(access.element).copied().unwrap_or(f64::NAN);
-                }
-                Some(access) => *value = self.get_element(core, access)?,
+                Some(access) => *value = self.element_of_call(core, access, &mut array)?,
                 None => call!(core, "fmi3GetFloat64", None, f(c, vr, 1, value, 1))?,
             }
         }
@@ -522,10 +570,11 @@ impl Calls for Fmi3 {
             return call!(core, "fmi3GetInt32", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()));
         }
         let get32 = self.a.functions.get_int32;
+        let mut array = None;
         for (vr, value) in vrs.iter().zip(values.iter_mut()) {
             match self.special(*vr) {
                 Some(access) => {
-                    let x = self.get_element(core, access)?;
+                    let x = self.element_of_call(core, access, &mut array)?;
                     // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
                     *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
                         instance: core.name.clone(),
@@ -567,9 +616,10 @@ impl Calls for Fmi3 {
     #[inline]
     fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
         if self.any_special(vrs) {
+            let mut array = None;
             for (vr, value) in vrs.iter().zip(values.iter_mut()) {
                 *value = match self.special(*vr) {
-                    Some(access) => self.get_element(core, access)? as i32,
+                    Some(access) => self.element_of_call(core, access, &mut array)? as i32,
                     None => {
                         let mut one = [0];
                         self.get_boolean(core, &[*vr], &mut one)?;
@@ -625,6 +675,74 @@ impl Calls for Fmi3 {
         let c = core.component;
         let f = f3!(core, self.a, set_string, "fmi3SetString");
         call!(core, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
+    }
+
+    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
+        use crate::fmi3::Exact;
+        use model_description::fmi3::ValueType as T;
+        let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
+        let (c, a, n, k) = (core.component, &*self.a, access.count, access.element);
+        let fmu_vr = access.vr;
+        Ok(match access.value_type {
+            T::Int64 => {
+                let f = f3!(core, a, get_int64, "fmi3GetInt64");
+                let mut buf = vec![0i64; n];
+                call!(core, "fmi3GetInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
+                Exact::Integer(i128::from(buf[k]))
+            }
+            T::UInt64 => {
+                let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
+                let mut buf = vec![0u64; n];
+                call!(core, "fmi3GetUInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
+                Exact::Integer(i128::from(buf[k]))
+            }
+            T::Binary => {
+                let f = f3!(core, a, get_binary, "fmi3GetBinary");
+                let mut sizes = vec![0usize; n];
+                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
+                call!(core, "fmi3GetBinary", None, f(c, &fmu_vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
+                let (p, size) = (data[k], sizes[k]);
+                if p.is_null() || size == 0 {
+                    Exact::Bytes(Vec::new())
+                } else {
+                    // SAFETY: the FMU returned `size` bytes at `p`, valid until its next call.
+                    Exact::Bytes(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
+                }
+            }
+            _ => return Err(not_exact(core, vr, String::new())),
+        })
+    }
+
+    fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
+        let access = match self.special(vr) {
+            Some(a) if a.count == 1 && matches!(a.value_type, T::Int64 | T::UInt64) => a,
+            // an element of a 64-bit array: set with the others as before, through f64
+            Some(a) if matches!(a.value_type, T::Int64 | T::UInt64) && (value as f64) as i128 == value => {
+                return self.set_element(core, a, value as f64);
+            }
+            _ => return Err(not_exact(core, vr, value.to_string())),
+        };
+        let c = core.component;
+        let fmu_vr = access.vr;
+        let out_of_range = |core: &Core, ty: &str| {
+            let name =
+                core.fmu.description.model_variables.iter().find(|v| v.value_reference == vr).map(|v| v.name.clone());
+            Error::InvalidValue {
+                variable: format!("{}.{}", core.name, name.unwrap_or_else(|| format!("<vr {vr}>"))),
+                value: value.to_string(),
+                reason: format!("outside the range of {ty}"),
+            }
+        };
+        if access.value_type == T::Int64 {
+            let x = i64::try_from(value).map_err(|_| out_of_range(core, "Int64"))?;
+            let f = f3!(core, self.a, set_int64, "fmi3SetInt64");
+            call!(core, "fmi3SetInt64", None, f(c, &fmu_vr, 1, &x, 1))
+        } else {
+            let x = u64::try_from(value).map_err(|_| out_of_range(core, "UInt64"))?;
+            let f = f3!(core, self.a, set_uint64, "fmi3SetUInt64");
+            call!(core, "fmi3SetUInt64", None, f(c, &fmu_vr, 1, &x, 1))
+        }
     }
 
     /// An early return (`earlyReturn` with `lastSuccessfulTime` before the step's end) is
@@ -800,6 +918,12 @@ impl Calls for Fmi3 {
         info.values_of_continuous_states_changed = (values != 0) as c_int;
         info.next_event_time_defined = (defined != 0) as c_int;
         info.next_event_time = next;
+        // the event settled: the output clocks and the intervals the FMU gives read while
+        // still in Event Mode (both interface types)
+        if update == 0 && terminate == 0 {
+            let time = core.time;
+            self.read_output_clocks(core, time)?;
+        }
         Ok(info)
     }
 
@@ -833,5 +957,9 @@ impl Calls for Fmi3 {
 
     fn is_fmi3(&self) -> bool {
         true
+    }
+
+    fn clock_calls(&mut self) -> Option<&mut dyn ClockCalls> {
+        Some(self)
     }
 }

@@ -4,6 +4,8 @@
 //! view's types and arrays included) behind [`core::Calls`]. An instance terminates and
 //! frees itself on drop.
 
+mod callbacks;
+mod clocks;
 mod configuration;
 pub(crate) mod core;
 mod fmi2;
@@ -15,6 +17,7 @@ use std::sync::Arc;
 
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
+pub use self::core::{Interval, OutputTick};
 use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};
@@ -192,6 +195,11 @@ impl Instance {
         &self.core.fmu
     }
 
+    /// The instance's time as last set or reached (s).
+    pub fn time(&self) -> f64 {
+        self.core.time
+    }
+
     /// The life-cycle state.
     pub fn state(&self) -> InstanceState {
         self.core.state
@@ -264,8 +272,9 @@ impl Instance {
 
     /// `fmi2GetReal` / `fmi3GetFloat64` of `vrs` into `values` (same length). A NaN or
     /// infinite value is [`Error::NonFinite`] unless the FMU was imported with
-    /// `allow_non_finite`. FMI 3.0: Float32, UInt32, Int64, UInt64 (exact up to 2^53),
-    /// Binary (its size) and array elements by their own getters.
+    /// `allow_non_finite`. FMI 3.0: Float32, UInt32, Int64, UInt64 (the nearest f64, exact
+    /// up to 2^53: [`Instance::get_exact`] reads them exactly), Binary (its size) and array
+    /// elements by their own getters.
     #[inline]
     pub fn get_real(&mut self, vrs: &[u32], values: &mut [f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "get_real: one value per value reference");
@@ -346,6 +355,25 @@ impl Instance {
         }
         // SAFETY: the FMU returns a NUL-terminated string valid until the next call.
         Ok(unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+    }
+
+    /// The value of `vr` as the FMU holds it, where the view's f64 is not it
+    /// ([`Fmu::exact_kind`]: `fmi3GetInt64`, `fmi3GetUInt64`, `fmi3GetBinary` of the
+    /// element), or a String's text.
+    pub fn get_exact(&mut self, vr: u32) -> Result<crate::fmi3::Exact> {
+        let is_string = self.core.fmu.description.model_variables.iter().any(|v| {
+            v.value_reference == vr && matches!(v.variable_type, model_description::VariableType::String { .. })
+        });
+        if is_string {
+            return self.get_string(vr).map(crate::fmi3::Exact::Text);
+        }
+        self.calls.get_exact(&mut self.core, vr)
+    }
+
+    /// `fmi3SetInt64` / `fmi3SetUInt64` of `vr` exactly (a variable of
+    /// [`Fmu::exact_kind`] Int64 or UInt64); a value outside its type's range is refused.
+    pub fn set_exact_integer(&mut self, vr: u32, value: i128) -> Result<()> {
+        self.calls.set_exact_integer(&mut self.core, vr, value)
     }
 
     /// `fmi2SetString` / `fmi3SetString` of one variable.

@@ -4,17 +4,12 @@
 //! a countdown clock once the FMU has signalled it ([`Instance::countdown_interval`]), and
 //! whether an output clock ticked ([`Instance::output_clock_ticked`]).
 //!
-//! The instance environment the FMU passes to its callbacks is a [`ScheduledEnvironment`]
-//! the instance owns (boxed: its address stays put while the FMU lives): the log sink, and
-//! the flag `clockUpdate` raises. The master activates one partition at a time on one
-//! thread, so nothing preempts a partition: `lockPreemption` and `unlockPreemption` have
-//! nothing to lock, and the results do not depend on timing.
+//! The callbacks and their environment are `callbacks.rs`.
 
 use std::ffi::{c_void, CString};
-use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
+use std::sync::atomic::Ordering;
 
-use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3Status, fmi3String};
-
+use super::callbacks::{clock_update, lock_preemption, log_message, unlock_preemption, ScheduledEnvironment};
 use super::core::{call, Core};
 use super::fmi3::Fmi3;
 use super::Instance;
@@ -22,48 +17,6 @@ use crate::c_types::Component;
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
 use crate::log::LogSink;
-
-/// What the FMU's callbacks receive as their instance environment in Scheduled Execution.
-#[derive(Debug, Default)]
-pub(crate) struct ScheduledEnvironment {
-    /// The instance's log sink (set at instantiation; it outlives the FMU instance).
-    log: AtomicPtr<LogSink>,
-    /// Raised by `clockUpdate`: an output clock ticked or a countdown clock's interval is
-    /// known; taken by the master after the activation that raised it.
-    clock_update: AtomicBool,
-}
-
-/// `fmi3LogMessageCallback` of Scheduled Execution: on to the instance's log sink.
-unsafe extern "C" fn log_message(
-    environment: fmi3InstanceEnvironment,
-    status: fmi3Status,
-    category: fmi3String,
-    message: fmi3String,
-) {
-    if environment.is_null() {
-        return;
-    }
-    // SAFETY: the environment is the instance's boxed ScheduledEnvironment, alive while
-    // the FMU lives; the log sink it holds outlives the FMU.
-    let sink = unsafe { &*(environment as *const ScheduledEnvironment) }.log.load(Ordering::Relaxed);
-    // SAFETY: as `crate::log::log_message` takes it (its own catch_unwind inside).
-    unsafe { crate::log::log_message(sink as *mut c_void, status, category, message) };
-}
-
-/// `fmi3ClockUpdateCallback`: raises the flag (an atomic store: nothing here can panic).
-unsafe extern "C" fn clock_update(environment: fmi3InstanceEnvironment) {
-    if environment.is_null() {
-        return;
-    }
-    // SAFETY: as in `log_message`.
-    unsafe { &*(environment as *const ScheduledEnvironment) }.clock_update.store(true, Ordering::Release);
-}
-
-/// `fmi3LockPreemptionCallback`: nothing to lock (one partition at a time, one thread).
-unsafe extern "C" fn lock_preemption() {}
-
-/// `fmi3UnlockPreemptionCallback`: see [`lock_preemption`].
-unsafe extern "C" fn unlock_preemption() {}
 
 impl Fmi3 {
     /// `fmi3InstantiateScheduledExecution` (logging off, the messages to `log`), the

@@ -329,6 +329,21 @@ pub struct Variable {
     pub max_size: Option<u64>,
     /// Clock attributes (Clock only).
     pub clock: Option<ClockAttributes>,
+    /// `<Alias>` children: other names of the same variable.
+    #[serde(default)]
+    pub aliases: Vec<Alias>,
+}
+
+/// An `<Alias>` of a variable (FMI 3.0 section 2.4.7.5): another name for the same
+/// variable, with its own description and display unit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Alias {
+    /// Unique name (among all variables and aliases).
+    pub name: String,
+    /// Optional description.
+    pub description: Option<String>,
+    /// `displayUnit` (Float only).
+    pub display_unit: Option<String>,
 }
 
 impl Variable {
@@ -368,6 +383,7 @@ impl Variable {
             mime_type: None,
             max_size: None,
             clock: None,
+            aliases: Vec::new(),
         }
     }
 

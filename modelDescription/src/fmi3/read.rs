@@ -223,6 +223,16 @@ fn read_variable(ctx: &Ctx, t: &Node, value_type: ValueType) -> Result<Variable,
         .filter(|c| c.name == "Dimension")
         .map(|d| read_dimension(ctx, d, &l))
         .collect::<Result<_, _>>()?;
+    v.aliases = t
+        .children
+        .iter()
+        .filter(|c| c.name == "Alias")
+        .map(|a| {
+            let name = ctx.req(a, &format!("Alias of {l}"), "name")?.to_string();
+            let display_unit = if float { Ctx::opt_string(a, "displayUnit") } else { None };
+            Ok(Alias { name, description: Ctx::opt_string(a, "description"), display_unit })
+        })
+        .collect::<Result<_, ReadError>>()?;
     Ok(v)
 }
 

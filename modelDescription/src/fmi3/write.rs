@@ -228,7 +228,7 @@ impl ModelDescription {
                     Some(Values::Binary(b)) => b.iter().map(|b| hex(b)).collect(),
                     _ => Vec::new(),
                 };
-                if v.dimensions.is_empty() && starts.is_empty() {
+                if v.dimensions.is_empty() && starts.is_empty() && v.aliases.is_empty() {
                     o.empty(e);
                     continue;
                 }
@@ -245,6 +245,17 @@ impl ModelDescription {
                     let mut se = Elem::new("Start");
                     se.attr("value", s);
                     o.empty(se);
+                }
+                for a in &v.aliases {
+                    let mut ae = Elem::new("Alias");
+                    ae.attr("name", &a.name);
+                    if let Some(d) = &a.description {
+                        ae.attr("description", d);
+                    }
+                    if let Some(u) = &a.display_unit {
+                        ae.attr("displayUnit", u);
+                    }
+                    o.empty(ae);
                 }
                 o.close(v.value_type.element());
             }

@@ -34,6 +34,39 @@ pub(crate) struct Core {
     pub(crate) profile: bool,
     /// Steps run with the instances spread over threads.
     pub(crate) parallel_steps: u64,
+    /// Connections from output clocks to triggered input clocks: (instance, clock) pairs.
+    pub(crate) clock_links: Vec<crate::system::ClockConnection>,
+    /// Some instance has clocks (its steps are split at their ticks).
+    pub(crate) clocked: bool,
+}
+
+impl Core {
+    /// The ticks of output clocks in the step that ends at `t_next` carried to the
+    /// triggered input clocks connected to them: each ticks at `t_next` (the start of the
+    /// next step), as `jacobi` carries every connection one step late.
+    /// The first tick of any instance's input clocks after `from` and before `until`.
+    #[inline]
+    pub(crate) fn next_tick_inside(&self, from: f64, until: f64) -> Option<f64> {
+        if !self.clocked {
+            return None;
+        }
+        self.lanes.iter().filter_map(|l| l.ticks.as_ref()?.next_inside(from, until)).reduce(f64::min)
+    }
+
+    pub(crate) fn carry_clock_ticks(&mut self, t_next: f64) {
+        if self.clock_links.is_empty() {
+            return;
+        }
+        let fired: Vec<(usize, Vec<u32>)> =
+            self.lanes.iter_mut().filter_map(|l| Some((l.index, l.ticks.as_mut()?.take_fired()))).collect();
+        for (index, vrs) in fired {
+            for link in self.clock_links.iter().filter(|c| c.from.0 == index && vrs.contains(&c.from.1)) {
+                if let Some(ticks) = self.lanes[link.to.0].ticks.as_mut() {
+                    ticks.trigger(link.to.1, t_next);
+                }
+            }
+        }
+    }
 }
 
 /// A communication algorithm.
@@ -57,7 +90,21 @@ pub(crate) trait Communication {
     fn run(&mut self, core: &mut Core, observers: &mut Observers, steps: Range<u64>) -> Result<()> {
         for n in steps {
             let p = core.clock.point(n);
+            // FMI 3.0 clocks: the step split at every tick inside it, a row recorded there
+            // (the values before the tick, whose event starts the next part)
+            let mut from = p.t;
+            while let Some(tick) = core.next_tick_inside(from, p.t_next) {
+                self.step(core, Point { t: from, t_next: tick, output_point: true, ..p }, observers.calls())?;
+                core.carry_clock_ticks(tick);
+                observers.recorder.push_row(tick, &core.values);
+                from = tick;
+            }
+            let p = Point { t: from, ..p };
             self.step(core, p, observers.calls())?;
+            core.carry_clock_ticks(p.t_next);
+            if p.output_point && observers.recorder.reads_exact() {
+                observers.recorder.read_exact(&mut core.lanes)?;
+            }
             observers.step_complete(&p, &core.values)?;
         }
         Ok(())

@@ -1,0 +1,51 @@
+//! An algebraic loop at initialization (`crate::loops`: connections closed through FMUs
+//! whose outputs depend on their inputs at initialization) iterated to its fixed point in
+//! Initialization Mode, as OMSimulator solves it: the connected outputs got and the
+//! connected inputs set (one Jacobi sweep, every connection carried) until no carried value
+//! changes by more than [`RTOL`] of its magnitude, at most [`MAX_SWEEPS`] sweeps.
+
+use crate::error::{Error, Result};
+use crate::simulate::algorithm::Core;
+
+/// The relative change below which a value on the loop has converged: far above the
+/// rounding of one sweep (a few ulps, 1e-16 relative), far below what any result shows.
+pub(crate) const RTOL: f64 = 1e-10;
+/// The sweeps after the first carry of the connections at most.
+pub(crate) const MAX_SWEEPS: usize = 100;
+
+/// Sweeps the connections of `core` (carried once already) until their values settle;
+/// the sweeps taken, or the error naming the loop `cycle` and the largest change left.
+/// A value's tolerance is [`RTOL`] of the larger of its old and new magnitude, and of a
+/// millionth of the largest magnitude on the loop, so that a value converging to 0 among
+/// others of size 1e5 settles at 1e-11 rather than never.
+pub(crate) fn iterate(core: &mut Core, cycle: &[String]) -> Result<usize> {
+    let mut before = core.values.clone();
+    let mut worst = 0.0f64;
+    for sweep in 1..=MAX_SWEEPS {
+        for lane in core.lanes.iter_mut() {
+            lane.get_outputs(&mut core.values)?;
+        }
+        for lane in core.lanes.iter_mut() {
+            lane.set_inputs(&core.values)?;
+        }
+        let scale = core.values.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        worst = 0.0;
+        let mut settled = true;
+        for (new, old) in core.values.iter().zip(&before) {
+            let change = (new - old).abs();
+            let tolerance = RTOL * (new.abs().max(old.abs()) + 1e-6 * scale);
+            if change > tolerance || change.is_nan() || tolerance.is_nan() {
+                settled = false;
+                worst = if change.is_nan() { f64::NAN } else { worst.max(change) };
+            }
+        }
+        if settled {
+            return Ok(sweep);
+        }
+        before.copy_from_slice(&core.values);
+    }
+    Err(Error::Experiment(format!(
+        "the algebraic loop at initialization {} did not converge: after {MAX_SWEEPS} sweeps of its connections a value still changed by {worst} (more than {RTOL} of its magnitude)",
+        cycle.join(", ")
+    )))
+}

@@ -1,0 +1,214 @@
+/* An FMI 3.0 Co-Simulation test FMU with clocks (Event Mode only), written against the
+ * standard's headers (the test passes their folder with -I). Value references as in
+ * fmi3_clocks.xml:
+ *   1 periodic   input clock, constant: interval 0.25 s, shift 0.1 s (the description's)
+ *   2 fixed      input clock, fixed: the interval is the parameter fixed_interval (20, 0.4 s),
+ *                given by fmi3GetIntervalDecimal (the description's 0.5 s is not used)
+ *   3 changing   input clock, changing: the k-th interval (k = 1, 2, ...) is 0.1 k s, given
+ *                (fmi3IntervalChanged) in the event that ends initialization and in the
+ *                event of each of its ticks; otherwise fmi3IntervalUnchanged
+ *   4 countdown  input clock, countdown: started (interval 0.5 s, fmi3IntervalChanged) in the
+ *                event of the second tick of periodic; fmi3IntervalNotYetKnown otherwise
+ *   5 trig       input clock, triggered
+ *   6 out_clock  output clock: ticks in the event of every second tick of periodic
+ *   10..15 n_*   Int32 outputs: the ticks of each clock so far
+ *   16 last_tick Float64 output: the time of the last event with a tick
+ * fmi3DoStep advances the time and never asks for an event. */
+#include <stdlib.h>
+#include <string.h>
+#include "fmi3Functions.h"
+
+typedef struct {
+    double time, fixed_interval, last_tick;
+    int n[6];             /* ticks of clocks 1..6 */
+    int in_event_mode, changing_given, countdown_given, out_ticked;
+    fmi3InstanceEnvironment env;
+    fmi3LogMessageCallback log;
+} Clocks;
+
+static fmi3Status fail(Clocks *c, const char *message) {
+    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
+    return fmi3Error;
+}
+
+const char *fmi3GetVersion(void) { return fmi3Version; }
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
+    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
+    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
+    if (!token || strcmp(token, "{fmi3-clocks}") != 0 || !eventMode) {
+        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed");
+        return NULL;
+    }
+    Clocks *c = calloc(1, sizeof(Clocks));
+    if (!c) return NULL;
+    c->env = env;
+    c->log = log;
+    c->fixed_interval = 0.4;
+    c->last_tick = -1;
+    return c;
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    return NULL;
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String a, fmi3String b, fmi3String c, fmi3Boolean d,
+    fmi3Boolean e, fmi3InstanceEnvironment f, fmi3LogMessageCallback g, fmi3ClockUpdateCallback h,
+    fmi3LockPreemptionCallback i, fmi3UnlockPreemptionCallback j) { return NULL; }
+
+void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
+    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    ((Clocks *)instance)->time = startTime;
+    return fmi3OK;
+}
+/* after initialization the instance is in Event Mode (eventModeUsed) */
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    Clocks *c = instance;
+    c->in_event_mode = 1;
+    c->changing_given = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
+    ((Clocks *)instance)->in_event_mode = 1;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
+    Clocks *c = instance;
+    c->in_event_mode = 0;
+    c->out_ticked = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3Reset(fmi3Instance instance) {
+    Clocks *c = instance;
+    fmi3InstanceEnvironment env = c->env;
+    fmi3LogMessageCallback log = c->log;
+    memset(c, 0, sizeof(Clocks));
+    c->env = env;
+    c->log = log;
+    c->fixed_interval = 0.4;
+    c->last_tick = -1;
+    return fmi3OK;
+}
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
+    fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn,
+    fmi3Float64 *lastSuccessfulTime) {
+    Clocks *c = instance;
+    if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");
+    c->time = t + h;
+    *eventHandlingNeeded = 0;
+    *terminateSimulation = 0;
+    *earlyReturn = 0;
+    *lastSuccessfulTime = c->time;
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) {
+    Clocks *c = instance;
+    if (!c->in_event_mode) return fail(c, "fmi3SetClock outside Event Mode");
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] < 1 || vr[k] > 5) return fail(c, "fmi3SetClock: not an input clock");
+        if (!v[k]) continue;
+        c->n[vr[k] - 1]++;
+        c->last_tick = c->time;
+        if (vr[k] == 1 && c->n[0] % 2 == 0) {
+            c->n[5]++;
+            c->out_ticked = 1;
+            if (c->n[0] == 2) c->countdown_given = 1;
+        }
+        if (vr[k] == 3) c->changing_given = 0;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Clock v[]) {
+    Clocks *c = instance;
+    if (!c->in_event_mode) return fail(c, "fmi3GetClock outside Event Mode");
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] != 6) return fail(c, "fmi3GetClock: not an output clock");
+        v[k] = c->out_ticked;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3Float64 v[], fmi3IntervalQualifier q[]) {
+    Clocks *c = instance;
+    for (size_t k = 0; k < n; k++) {
+        switch (vr[k]) {
+        case 1: v[k] = 0.25; q[k] = fmi3IntervalUnchanged; break;
+        case 2: v[k] = c->fixed_interval; q[k] = fmi3IntervalUnchanged; break;
+        case 3:
+            v[k] = 0.1 * (c->n[2] + 1);
+            q[k] = c->changing_given ? fmi3IntervalUnchanged : fmi3IntervalChanged;
+            c->changing_given = 1;
+            break;
+        case 4:
+            v[k] = 0.5;
+            q[k] = c->countdown_given == 1 ? fmi3IntervalChanged : fmi3IntervalNotYetKnown;
+            if (c->countdown_given == 1) c->countdown_given = 2;
+            break;
+        default: return fail(c, "fmi3GetIntervalDecimal: no interval");
+        }
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[]) {
+    for (size_t k = 0; k < n; k++) v[k] = vr[k] == 1 ? 0.1 : 0.0;
+    return fmi3OK;
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
+    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
+    Clocks *c = instance;
+    if (!c->in_event_mode) return fail(c, "fmi3UpdateDiscreteStates outside Event Mode");
+    *needUpdate = 0;
+    *terminate = 0;
+    *nominalsChanged = 0;
+    *valuesChanged = 0;
+    *nextDefined = 0;
+    *next = 0;
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Float64 values[], size_t nValues) {
+    Clocks *c = instance;
+    for (size_t k = 0; k < nvr; k++) {
+        switch (vr[k]) {
+        case 0: values[k] = c->time; break;
+        case 16: values[k] = c->last_tick; break;
+        case 20: values[k] = c->fixed_interval; break;
+        default: return fail(c, "fmi3GetFloat64: no such variable");
+        }
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    const fmi3Float64 values[], size_t nValues) {
+    Clocks *c = instance;
+    for (size_t k = 0; k < nvr; k++) {
+        if (vr[k] != 20) return fail(c, "fmi3SetFloat64: not a parameter");
+        c->fixed_interval = values[k];
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+    fmi3Int32 values[], size_t nValues) {
+    Clocks *c = instance;
+    for (size_t k = 0; k < nvr; k++) {
+        if (vr[k] < 10 || vr[k] > 15) return fail(c, "fmi3GetInt32: no such variable");
+        values[k] = c->n[vr[k] - 10];
+    }
+    return fmi3OK;
+}

@@ -1,0 +1,211 @@
+//! The FMI 3.0 clock calls of an instance (`fmi3SetClock`, `fmi3GetClock`,
+//! `fmi3GetIntervalDecimal`/`Fraction`, `fmi3GetShiftDecimal`/`Fraction`,
+//! `fmi3SetIntervalDecimal`) and the clock event the master runs at a tick, each call's
+//! status handled as every other call's. An FMI 2.0 instance has no clocks: each call is
+//! an error naming it.
+
+use super::core::{call, Calls, ClockCalls, Core, Interval, OutputTick};
+use super::fmi3::Fmi3;
+use super::Instance;
+use crate::error::{Error, Result};
+
+impl ClockCalls for Fmi3 {
+    fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()> {
+        let f = core.optional(self.a.functions.set_clock, "fmi3SetClock")?;
+        let c = core.component;
+        let on = vec![1u8; vrs.len()];
+        call!(core, "fmi3SetClock", None, f(c, vrs.as_ptr(), vrs.len(), on.as_ptr()))
+    }
+
+    fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()> {
+        let f = core.optional(self.a.functions.get_clock, "fmi3GetClock")?;
+        let c = core.component;
+        let mut raw = vec![0u8; vrs.len()];
+        call!(core, "fmi3GetClock", None, f(c, vrs.as_ptr(), vrs.len(), raw.as_mut_ptr()))?;
+        for (t, r) in ticks.iter_mut().zip(&raw) {
+            *t = *r != 0;
+        }
+        Ok(())
+    }
+
+    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>> {
+        let mut values = vec![0.0; vrs.len()];
+        let mut qualifiers = vec![0i32; vrs.len()];
+        let c = core.component;
+        match (self.a.functions.get_interval_decimal, self.a.functions.get_interval_fraction) {
+            (Some(f), _) => call!(
+                core,
+                "fmi3GetIntervalDecimal",
+                None,
+                f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), qualifiers.as_mut_ptr())
+            )?,
+            (None, Some(f)) => {
+                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
+                call!(
+                    core,
+                    "fmi3GetIntervalFraction",
+                    None,
+                    f(
+                        c,
+                        vrs.as_ptr(),
+                        vrs.len(),
+                        counters.as_mut_ptr(),
+                        resolutions.as_mut_ptr(),
+                        qualifiers.as_mut_ptr()
+                    )
+                )?;
+                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
+                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
+                }
+            }
+            (None, None) => return Err(core.optional(None::<()>, "fmi3GetIntervalDecimal").unwrap_err()),
+        }
+        vrs.iter()
+            .zip(values.iter().zip(&qualifiers))
+            .map(|(vr, (v, q))| match q {
+                0 => Ok(Interval::NotYetKnown),
+                1 | 2 if !(v.is_finite() && *v > 0.0) => Err(core.error(
+                    "fmi3GetIntervalDecimal",
+                    core.time,
+                    format!("clock {vr}: interval {v} s is no positive time"),
+                )),
+                1 => Ok(Interval::Unchanged(*v)),
+                2 => Ok(Interval::Changed(*v)),
+                other => Err(core.error(
+                    "fmi3GetIntervalDecimal",
+                    core.time,
+                    format!("clock {vr}: qualifier {other} is none of fmi3IntervalNotYetKnown, Unchanged, Changed"),
+                )),
+            })
+            .collect()
+    }
+
+    fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>> {
+        let mut values = vec![0.0; vrs.len()];
+        let c = core.component;
+        match (self.a.functions.get_shift_decimal, self.a.functions.get_shift_fraction) {
+            (Some(f), _) => {
+                call!(core, "fmi3GetShiftDecimal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?
+            }
+            (None, Some(f)) => {
+                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
+                call!(
+                    core,
+                    "fmi3GetShiftFraction",
+                    None,
+                    f(c, vrs.as_ptr(), vrs.len(), counters.as_mut_ptr(), resolutions.as_mut_ptr())
+                )?;
+                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
+                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
+                }
+            }
+            (None, None) => return Err(core.optional(None::<()>, "fmi3GetShiftDecimal").unwrap_err()),
+        }
+        if let Some((vr, v)) = vrs.iter().zip(&values).find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+            return Err(core.error("fmi3GetShiftDecimal", core.time, format!("clock {vr}: shift {v} s is no time")));
+        }
+        Ok(values)
+    }
+
+    fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()> {
+        let f = core.optional(self.a.functions.set_interval_decimal, "fmi3SetIntervalDecimal")?;
+        let c = core.component;
+        call!(core, "fmi3SetIntervalDecimal", None, f(c, vrs.as_ptr(), vrs.len(), intervals.as_ptr()))
+    }
+
+    fn clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()> {
+        core.time = time;
+        Calls::enter_event_mode(self, core)?;
+        if !vrs.is_empty() {
+            self.set_clocks(core, vrs)?;
+        }
+        match self.settle_event(core, time)? {
+            None => Ok(()),
+            Some(t) => Err(self.terminated_at(core, "fmi3UpdateDiscreteStates", t, t)),
+        }
+    }
+
+    fn take_output_ticks(&mut self) -> Vec<OutputTick> {
+        std::mem::take(&mut self.output_ticks)
+    }
+
+    fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)> {
+        std::mem::take(&mut self.intervals)
+    }
+}
+
+/// The error of a clock call on an instance whose generation has no clocks.
+fn no_clocks(inst: &Instance) -> Error {
+    Error::Instance { name: inst.core.name.clone(), reason: "an FMI 2.0 instance has no clocks (a clock call)" }
+}
+
+impl Instance {
+    /// `fmi3SetClock`: the input clocks `vrs` tick now (in Event Mode).
+    pub fn set_clocks(&mut self, vrs: &[u32]) -> Result<()> {
+        match self.calls.clock_calls() {
+            Some(c) => c.set_clocks(&mut self.core, vrs),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// `fmi3GetClock`: whether each of the output clocks `vrs` ticked (in Event Mode).
+    pub fn get_clocks(&mut self, vrs: &[u32], ticks: &mut [bool]) -> Result<()> {
+        assert_eq!(vrs.len(), ticks.len(), "get_clocks: one answer per clock");
+        match self.calls.clock_calls() {
+            Some(c) => c.get_clocks(&mut self.core, vrs, ticks),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// `fmi3GetIntervalDecimal` (or `Fraction` where only it is present): the intervals of
+    /// the clocks `vrs` and what the FMU says of each.
+    pub fn get_intervals(&mut self, vrs: &[u32]) -> Result<Vec<Interval>> {
+        match self.calls.clock_calls() {
+            Some(c) => c.get_intervals(&mut self.core, vrs),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// `fmi3GetShiftDecimal` (or `Fraction`): the shifts of the clocks `vrs`, s.
+    pub fn get_shifts(&mut self, vrs: &[u32]) -> Result<Vec<f64>> {
+        match self.calls.clock_calls() {
+            Some(c) => c.get_shifts(&mut self.core, vrs),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// `fmi3SetIntervalDecimal`: the intervals of the clocks `vrs` (fixed and tunable
+    /// input clocks), s.
+    pub fn set_intervals(&mut self, vrs: &[u32], intervals: &[f64]) -> Result<()> {
+        assert_eq!(vrs.len(), intervals.len(), "set_intervals: one interval per clock");
+        match self.calls.clock_calls() {
+            Some(c) => c.set_intervals(&mut self.core, vrs, intervals),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// A clock event at `time` (Co-Simulation with Event Mode, the instance at `time`):
+    /// `fmi3EnterEventMode`, `fmi3SetClock` of the input clocks `vrs` that tick,
+    /// `fmi3UpdateDiscreteStates` until settled (at most 1000 times), `fmi3GetClock` of the
+    /// output clocks ([`Instance::take_output_ticks`]), `fmi3EnterStepMode`. An FMU that asks
+    /// to terminate in it ends the run as `fmi3DoStep`'s `terminateSimulation` does.
+    pub fn clock_event(&mut self, time: f64, vrs: &[u32]) -> Result<()> {
+        match self.calls.clock_calls() {
+            Some(c) => c.clock_event(&mut self.core, time, vrs),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// The output clocks' ticks since the last call, in time order (each read by
+    /// `fmi3GetClock` in an event: a tick's, or one the FMU asked for in `fmi3DoStep`).
+    pub fn take_output_ticks(&mut self) -> Vec<OutputTick> {
+        self.calls.clock_calls().map(|c| c.take_output_ticks()).unwrap_or_default()
+    }
+
+    /// What the FMU said of its input clocks' intervals (fixed, tunable, changing,
+    /// countdown; `fmi3GetIntervalDecimal` in every event, initialization's included) since
+    /// the last call: (event time, clock, interval).
+    pub fn take_intervals(&mut self) -> Vec<(f64, u32, Interval)> {
+        self.calls.clock_calls().map(|c| c.take_intervals()).unwrap_or_default()
+    }
+}

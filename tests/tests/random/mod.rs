@@ -1,0 +1,200 @@
+//! What the random call sequences of both generations share (`random_calls.rs` for FMI 2.0,
+//! `random_calls3.rs` for FMI 3.0): the seeded generator, the hostile numbers, the
+//! importer's shadow of the instance's state and how a call's status moves it, the check
+//! that no non-finite number is handed out with OK, and the loop over every built FMU and
+//! interface. Each generation's file keeps only its own calls.
+
+use std::ffi::c_void;
+
+use fmi_export::states::{Function, Machine};
+use nigel_integration_tests::{built_fmu, Fmu, DISCARD, ERROR, OK};
+
+/// xorshift64*: the same sequences on every platform.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+    pub fn chance(&mut self, percent: u64) -> bool {
+        self.next() % 100 < percent
+    }
+    pub fn pick<T: Copy>(&mut self, items: &[T]) -> T {
+        items[self.below(items.len())]
+    }
+    /// A time argument: mostly `now`, else one of the times a call must refuse or survive.
+    pub fn time(&mut self, now: f64) -> f64 {
+        if self.chance(70) {
+            now
+        } else {
+            self.pick(&[0.0, -1.0, 1.0, f64::NAN, f64::INFINITY, now + 1e-3])
+        }
+    }
+}
+
+/// The numbers the sequences pass where a number is asked for.
+pub const HOSTILE: [f64; 12] =
+    [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
+
+/// The importer side of one instance: what it believes the state is.
+pub struct Shadow {
+    pub machine: Option<Machine>,
+    pub time: f64,
+    /// live FMU states and the machine they were saved in (None: unknown, deserialized)
+    pub states: Vec<(*mut c_void, Option<Machine>)>,
+    pub freed: Vec<*mut c_void>,
+    pub bytes: Vec<u8>,
+}
+
+/// The functions of one generation that move the shadow's state.
+pub struct Moves {
+    pub do_step: Function,
+    pub enter_initialization_mode: Function,
+    pub exit_initialization_mode: Function,
+    pub terminate: Function,
+    pub reset: Function,
+    pub enter_event_mode: Function,
+    pub enter_continuous_time_mode: Function,
+    pub set_fmu_state: Function,
+    /// A Discard of the step leaves the instance in Step Failed (FMI 2.0); else it stays
+    /// in Step Mode at the time the step reached (FMI 3.0 has no such state).
+    pub discard_fails_the_step: bool,
+    /// The generation's OK status by name, for the messages.
+    pub ok: &'static str,
+}
+
+impl Shadow {
+    /// A freshly instantiated instance.
+    pub fn instantiated() -> Shadow {
+        Shadow {
+            machine: Some(Machine::Instantiated),
+            time: 0.0,
+            states: Vec::new(),
+            freed: Vec::new(),
+            bytes: Vec::new(),
+        }
+    }
+
+    /// An FMU state argument: a live one, a freed one, a made-up pointer or NULL.
+    pub fn state_arg(&self, rng: &mut Rng) -> *mut c_void {
+        match rng.below(4) {
+            0 | 1 if !self.states.is_empty() => self.states[rng.below(self.states.len())].0,
+            2 if !self.freed.is_empty() => self.freed[rng.below(self.freed.len())],
+            3 => 0x40usize as *mut c_void,
+            _ => std::ptr::null_mut(),
+        }
+    }
+
+    /// After `function` returned `status`: no non-finite number in `reals_out[..k]` with
+    /// OK (where `check_reals` is `Some(k)`), and the importer's view of the new state
+    /// (`new_time`: the time the call set, `restored`: the machine of a restored state).
+    #[allow(clippy::too_many_arguments)]
+    pub fn after(
+        &mut self,
+        moves: &Moves,
+        function: Function,
+        status: i32,
+        check_reals: Option<usize>,
+        reals_out: &[f64],
+        new_time: Option<f64>,
+        restored: Option<Option<Machine>>,
+        co_simulation: bool,
+    ) {
+        if status == OK {
+            if let Some(k) = check_reals {
+                if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
+                    panic!("{function:?} handed out {bad} with {}", moves.ok);
+                }
+            }
+        }
+        if status == ERROR {
+            self.machine = Some(Machine::Error);
+        } else if status == DISCARD && function == moves.do_step {
+            if moves.discard_fails_the_step {
+                self.machine = Some(Machine::StepFailed);
+            } else {
+                // at the time the step reached (a guess below: a wrong one just gives an error)
+                self.time = f64::NAN;
+            }
+        } else if status == OK || status == 1 {
+            if let Some(t) = new_time {
+                self.time = t;
+            }
+            let after = if function == moves.enter_initialization_mode {
+                Some(Some(Machine::InitializationMode))
+            } else if function == moves.exit_initialization_mode {
+                Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
+            } else if function == moves.terminate {
+                Some(Some(Machine::Terminated))
+            } else if function == moves.reset {
+                self.time = 0.0;
+                Some(Some(Machine::Instantiated))
+            } else if function == moves.enter_event_mode {
+                Some(Some(Machine::EventMode))
+            } else if function == moves.enter_continuous_time_mode {
+                Some(Some(Machine::ContinuousTimeMode))
+            } else if function == moves.set_fmu_state {
+                self.time = f64::NAN; // unknown until the next reset
+                restored
+            } else {
+                None
+            };
+            if let Some(m) = after {
+                self.machine = m;
+            }
+        }
+        if self.time.is_nan() {
+            // the restored time is unknown here: a guess (a wrong one just gives an error)
+            self.time = 0.0;
+        }
+    }
+}
+
+/// Runs `run(fmu, co_simulation, seed)` on every FMU of `build-fmu`'s list and each
+/// interface it offers, prints the counts (OK, Warning, Discard, Error) with `what`, and
+/// checks that enough calls succeeded to mean anything; returns the counts of `plant`
+/// (CS, then ME).
+pub fn every_fmu_and_interface(
+    what: &str,
+    sequences: usize,
+    seed: u64,
+    plant: &str,
+    mut run: impl FnMut(&Fmu, bool, u64) -> [usize; 4],
+) -> Vec<[usize; 4]> {
+    let mut plant_counts = Vec::new();
+    for (k, target) in build_fmu::targets().iter().enumerate() {
+        let fmu = Fmu::load(&built_fmu(&target.model_identifier).unwrap()).unwrap();
+        for co_simulation in [true, false] {
+            let offered = if co_simulation {
+                fmu.description.co_simulation.is_some()
+            } else {
+                fmu.description.model_exchange.is_some()
+            };
+            if !offered {
+                continue;
+            }
+            let counts = run(&fmu, co_simulation, seed ^ (k as u64 * 2 + co_simulation as u64));
+            let total: usize = counts.iter().sum();
+            println!(
+                "{} {}{what}: {sequences} sequences, {total} calls: {} OK, {} Warning, {} Discard, {} Error",
+                target.model_identifier,
+                if co_simulation { "CS" } else { "ME" },
+                counts[0],
+                counts[1],
+                counts[2],
+                counts[3]
+            );
+            assert!(counts[0] > total / 20, "too few successful calls to mean anything: {counts:?}");
+            if target.model_identifier == plant {
+                plant_counts.push(counts);
+            }
+        }
+    }
+    plant_counts
+}
