@@ -28,9 +28,6 @@ bash scripts/python-venv-wheel.sh "$wheel"
 echo "== building the FMUs (all four platforms) and the closed-loop SSP"
 cargo run --release --quiet -p build-fmu -- --platforms all
 
-echo "== the master for every platform: target/dist/cosim-VERSION-TRIPLE.{tar.gz,zip} and SHA256SUMS"
-bash scripts/dist.sh
-
 echo "== co-simulation: plant + controller + test bench (lane change, robust), 30 s at 1 ms"
 cargo run --release --quiet -p nigel-cosim --bin cosim -- run "$target_dir/ssp/nigel_closed_loop.ssp" \
     --stop-time 30 --step 1e-3 --algorithm ordered \

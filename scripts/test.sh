@@ -172,10 +172,6 @@ stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
-stage "the master on every platform: release archives; Windows under wine, aarch64 under qemu, macOS headers"
-# (builds the archives of scripts/dist.sh where the main command has not: a fresh CI clone
-# compiles the master for the four other targets here)
-bash scripts/test-dist.sh
 if [ -d ../shared/corpus ]; then
     stage "third-party conformance (run beside the Rust tests): the table"
     wait_for conformance
