@@ -6,9 +6,7 @@
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
 # target/fmu/ and the closed loop as SSP into target/ssp/, co-simulates that closed loop with our master (30 s at 1 ms, ordered), runs
 # the paper's Table III and Fig. 7 through the FMUs, and synthesizes the robust controller
-# (Pareto sweep of the paper). Everything it writes lands in target/results/; the master's
-# release archives (cosim, cosim-host, campaign for x86-64 and aarch64 Linux, Windows, macOS
-# x86-64 and arm64) in target/dist/.
+# (Pareto sweep of the paper). Everything it writes lands in target/results/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup-system.sh
