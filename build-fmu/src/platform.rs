@@ -242,6 +242,82 @@ impl Platform {
         }
     }
 
+    /// The target triples of this platform's builds (darwin64: two, joined afterwards).
+    pub fn triples(self) -> &'static [&'static str] {
+        match self {
+            Platform::Linux64 => &[LINUX64_TRIPLE],
+            Platform::Win64 => &[WIN64_TRIPLE],
+            Platform::Aarch64Linux => &[AARCH64_TRIPLE],
+            Platform::Darwin64 => &DARWIN_TRIPLES,
+        }
+    }
+
+    /// The one recipe of this platform: runs cargo (build, release profile) with `args`
+    /// (packages, features, what to build) for its triples into its target directory under
+    /// `target_dir`, and returns each triple's release folder. The FMUs' libraries
+    /// ([`Platform::build`]) and the master's programs ([`Platform::build_programs`]) both
+    /// come from here, into the same target directories, so that what they share compiles once.
+    pub fn cargo_build(self, args: &[String], target_dir: &Path) -> Result<Vec<(&'static str, PathBuf)>, BuildError> {
+        let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
+        let mut c = match self {
+            Platform::Linux64 => zigbuild(&host_cargo()),
+            Platform::Win64 => {
+                let mut c = rust_web_cargo();
+                c.arg("build").args(build_std());
+                // no time stamp in the PE header: the binary is byte-identical on rebuild
+                c.env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", "x86_64-w64-mingw32-gcc")
+                    .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUSTFLAGS", "-C link-arg=-Wl,--no-insert-timestamp");
+                c
+            }
+            Platform::Aarch64Linux => {
+                let mut c = zigbuild(&rust_web_bin("cargo"));
+                c.env("RUSTC", rust_web_bin("rustc"));
+                c
+            }
+            Platform::Darwin64 => {
+                let mut c = zigbuild(&rust_web_bin("cargo"));
+                c.env("RUSTC", rust_web_bin("rustc")).env("MACOSX_DEPLOYMENT_TARGET", MACOS_MINIMUM).args(build_std());
+                c
+            }
+        };
+        c.args(["--release", "--quiet"]).args(args).arg("--manifest-path").arg(&manifest);
+        for t in self.triples() {
+            // the glibc baseline of the Linux platforms is chosen through zigbuild's triple
+            let glibc = matches!(self, Platform::Linux64 | Platform::Aarch64Linux);
+            let t = if glibc { format!("{t}.{GLIBC_BASELINE}") } else { t.to_string() };
+            c.args(["--target", &t]);
+        }
+        // linux64 with the workspace's own toolchain into target/; the others with
+        // rustc-web into target/rust-web (another compiler: artifacts kept apart)
+        let dir = match self {
+            Platform::Linux64 => target_dir.to_path_buf(),
+            _ => target_dir.join("rust-web"),
+        };
+        c.arg("--target-dir").arg(&dir);
+        run(c, self)?;
+        Ok(self.triples().iter().map(|t| (*t, dir.join(t).join("release"))).collect())
+    }
+
+    /// Builds the programs (`[[bin]]`s) of `packages` for this platform ([`Platform::cargo_build`])
+    /// and returns, per triple, the path of each program named in `programs`.
+    pub fn build_programs(
+        self,
+        packages: &[&str],
+        programs: &[&str],
+        target_dir: &Path,
+    ) -> Result<Vec<(&'static str, Vec<PathBuf>)>, BuildError> {
+        let mut args: Vec<String> = vec!["--bins".into()];
+        for p in packages {
+            args.extend(["--package".into(), p.to_string()]);
+        }
+        let exe = if self == Platform::Win64 { ".exe" } else { "" };
+        Ok(self
+            .cargo_build(&args, target_dir)?
+            .into_iter()
+            .map(|(t, dir)| (t, programs.iter().map(|p| dir.join(format!("{p}{exe}"))).collect()))
+            .collect())
+    }
+
     /// Builds the libraries of `packages` (cargo packages; their `[lib] name`s are
     /// `model_identifiers`, in the same order) for this platform with their `fmi-export`
     /// feature, all in one cargo invocation, and returns each library's path.
@@ -251,50 +327,27 @@ impl Platform {
         model_identifiers: &[&str],
         target_dir: &Path,
     ) -> Result<Vec<PathBuf>, BuildError> {
-        let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("Cargo.toml");
         let features = crate::library_features(packages);
-        let mut args: Vec<String> = vec!["--release".into(), "--quiet".into()];
+        let mut args: Vec<String> = Vec::new();
         for p in packages {
             args.extend(["--package".into(), p.to_string()]);
         }
-        args.extend([
-            "--features".into(),
-            features.join(","),
-            "--manifest-path".into(),
-            manifest.display().to_string(),
-        ]);
-        let web_dir = target_dir.join("rust-web");
-        let lib = |dir: PathBuf, prefix: &str, id: &str| dir.join(format!("{prefix}{id}.{}", self.extension()));
+        args.extend(["--features".into(), features.join(",")]);
+        let dirs = self.cargo_build(&args, target_dir)?;
+        let lib = |dir: &Path, prefix: &str, id: &str| dir.join(format!("{prefix}{id}.{}", self.extension()));
         match self {
-            Platform::Linux64 => {
-                let mut c = zigbuild(&host_cargo());
-                c.args(&args)
-                    .args(["--target", &format!("{LINUX64_TRIPLE}.{GLIBC_BASELINE}"), "--target-dir"])
-                    .arg(target_dir);
-                run(c, self)?;
-                let dir = target_dir.join(LINUX64_TRIPLE).join("release");
-                Ok(model_identifiers.iter().map(|id| lib(dir.clone(), "lib", id)).collect())
+            Platform::Linux64 | Platform::Aarch64Linux => {
+                Ok(model_identifiers.iter().map(|id| lib(&dirs[0].1, "lib", id)).collect())
             }
             Platform::Win64 => {
-                let mut c = rust_web_cargo();
-                c.arg("build")
-                    .args(&args)
-                    .args(build_std())
-                    .args(["--target", WIN64_TRIPLE, "--target-dir"])
-                    .arg(&web_dir);
-                // no time stamp in the PE header: the DLL is byte-identical on rebuild
-                c.env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", "x86_64-w64-mingw32-gcc")
-                    .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUSTFLAGS", "-C link-arg=-Wl,--no-insert-timestamp");
-                run(c, self)?;
                 // the symbol table out (2.4 MB -> 1.6 MB; the exports stay): llvm-strip
                 // writes no time stamp, so the copy is byte-identical on rebuild
-                let dir = web_dir.join(WIN64_TRIPLE).join("release");
                 let stripped_dir = target_dir.join("win64-stripped");
                 std::fs::create_dir_all(&stripped_dir).map_err(|e| BuildError::Io(stripped_dir.clone(), e))?;
                 let strip = llvm_tool("llvm-strip").ok_or_else(|| BuildError::Cargo("llvm-strip not found".into()))?;
                 let mut out = Vec::new();
                 for id in model_identifiers {
-                    let (built, stripped) = (lib(dir.clone(), "", id), lib(stripped_dir.clone(), "", id));
+                    let (built, stripped) = (lib(&dirs[0].1, "", id), lib(&stripped_dir, "", id));
                     if !up_to_date(&stripped, std::slice::from_ref(&built)) {
                         let mut c = Command::new(&strip);
                         c.arg("--strip-all").arg("-o").arg(&stripped).arg(&built);
@@ -304,33 +357,14 @@ impl Platform {
                 }
                 Ok(out)
             }
-            Platform::Aarch64Linux => {
-                let mut c = zigbuild(&rust_web_bin("cargo"));
-                c.env("RUSTC", rust_web_bin("rustc"));
-                c.args(&args)
-                    .args(["--target", &format!("{AARCH64_TRIPLE}.{GLIBC_BASELINE}"), "--target-dir"])
-                    .arg(&web_dir);
-                run(c, self)?;
-                let dir = web_dir.join(AARCH64_TRIPLE).join("release");
-                Ok(model_identifiers.iter().map(|id| lib(dir.clone(), "lib", id)).collect())
-            }
             Platform::Darwin64 => {
-                let mut c = zigbuild(&rust_web_bin("cargo"));
-                c.env("RUSTC", rust_web_bin("rustc")).env("MACOSX_DEPLOYMENT_TARGET", MACOS_MINIMUM);
-                c.args(&args).args(build_std());
-                for t in DARWIN_TRIPLES {
-                    c.args(["--target", t]);
-                }
-                c.arg("--target-dir").arg(&web_dir);
-                run(c, self)?;
                 let universal_dir = target_dir.join("darwin64-universal");
                 std::fs::create_dir_all(&universal_dir).map_err(|e| BuildError::Io(universal_dir.clone(), e))?;
                 let lipo = llvm_tool("llvm-lipo").ok_or_else(|| BuildError::Cargo("llvm-lipo not found".into()))?;
                 let mut out = Vec::new();
                 for id in model_identifiers {
-                    let parts: Vec<PathBuf> =
-                        DARWIN_TRIPLES.iter().map(|t| lib(web_dir.join(t).join("release"), "lib", id)).collect();
-                    let universal = lib(universal_dir.clone(), "lib", id);
+                    let parts: Vec<PathBuf> = dirs.iter().map(|(_, dir)| lib(dir, "lib", id)).collect();
+                    let universal = lib(&universal_dir, "lib", id);
                     if !up_to_date(&universal, &parts) {
                         let status = Command::new(&lipo)
                             .arg("-create")

@@ -565,14 +565,7 @@ fn wine_runner(dir: &Path) -> impl FnMut(&Path) -> Command {
     // Rust's standard library (1.78 and later) imports ProcessPrng from
     // bcryptprimitives.dll, which Windows 10 has and wine 8 lacks: a shim next to the
     // importer forwards it to BCryptGenRandom (test only; nothing of it is in the archive)
-    let shim = dir.join("process_prng_shim.c");
-    std::fs::write(
-        &shim,
-        "#include <windows.h>\n#include <bcrypt.h>\n\
-         __declspec(dllexport) BOOL WINAPI ProcessPrng(PBYTE data, SIZE_T len) {\n\
-         return BCryptGenRandom(NULL, data, (ULONG)len, BCRYPT_USE_SYSTEM_PREFERRED_RNG) == 0;\n}\n",
-    )
-    .unwrap();
+    let shim = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/process_prng_shim.c");
     run(Command::new("x86_64-w64-mingw32-gcc")
         .args(["-shared", "-O2", "-o"])
         .arg(dir.join("bcryptprimitives.dll"))

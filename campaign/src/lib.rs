@@ -34,6 +34,10 @@ pub mod runner;
 pub mod scalar;
 pub mod slurm;
 pub mod spec;
+#[cfg(target_os = "linux")]
+pub mod worker;
+#[cfg(not(target_os = "linux"))]
+#[path = "worker_unsupported.rs"]
 pub mod worker;
 
 /// What can go wrong, each a one-line message naming the culprit.

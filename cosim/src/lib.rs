@@ -70,6 +70,10 @@ pub mod watchdog;
 /// whole run in one host process ([`isolate::whole`]).
 pub mod isolate {
     pub use fmi_import::isolate::*;
+    #[cfg(target_os = "linux")]
+    pub mod whole;
+    #[cfg(not(target_os = "linux"))]
+    #[path = "whole_unsupported.rs"]
     pub mod whole;
 }
 

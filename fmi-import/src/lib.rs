@@ -22,17 +22,19 @@
 //!
 //! ```text
 //! status, c_types, elf, suggest, call_site, clocks   leaves
+//! platform     -> elf                              this build's binaries folders
 //! fmi3         -> clocks, c_types                  the FMI 3.0 view (clocks: of every generation)
 //! error        -> status
 //! log          -> status, c_types                  what FMUs log, both loggers
-//! unpack       -> error
-//! library      -> error, elf, c_types              loading a shared library once
-//! isolate/protocol                                 the host protocol's region and calls
-//! isolate/channel -> protocol, error, log, status  the master's end of a host
+//! unpack       -> error, platform
+//! library      -> error, platform, c_types         loading a shared library once
+//! isolate/os   -> error                            shared memory, host process, futex (Linux)
+//! isolate/protocol -> os                           the host protocol's region and calls
+//! isolate/channel -> os, protocol, error, log, status  the master's end of a host
 //! isolate/proxy, proxy3 -> channel, protocol, c_types   tables that call a host
-//! isolate/host -> protocol, channel, proxy3, c_types, library, log, error
+//! isolate/host -> os, protocol, channel, proxy3, c_types, library, log, error
 //! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
-//! load         -> fmu, fmi3, library, elf, unpack, isolate/proxy*  the one pipeline
+//! load         -> fmu, fmi3, library, platform, unpack, isolate/proxy*  the one pipeline
 //! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
 //! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
@@ -63,6 +65,7 @@ pub(crate) mod library;
 pub mod load;
 pub mod log;
 pub mod partitions;
+pub mod platform;
 pub mod status;
 pub mod structural;
 #[doc(hidden)]

@@ -26,7 +26,7 @@ pub(crate) fn load_library(so: &Path, shown: &Path, relative: &str) -> Result<Ar
     if let Some(lib) = cache.get(&key) {
         return Ok(lib.clone());
     }
-    crate::elf::check_shared_library(&bytes)
+    crate::platform::check_library(&bytes)
         .map_err(|reason| Error::LoadLibrary { path: shown.to_path_buf(), reason })?;
     // SAFETY: loading runs the library's initializers; that is what importing an FMU means.
     let library = unsafe { libloading::Library::new(so) }.map_err(|e| Error::LoadLibrary {

@@ -76,7 +76,7 @@ fn nul_in_folder(dir: &Path) -> Error {
 impl Generation for Fmi2 {
     type Table = Functions;
     type Described = ();
-    const PLATFORM: &'static str = "linux64";
+    const PLATFORM: &'static str = crate::platform::FMI2_FOLDER;
     const NEEDS_CHECKED_ISOLATED: bool = true;
 
     fn describe(xml: &str, path: &Path) -> Result<(ModelDescription, ())> {
@@ -152,7 +152,7 @@ type Fmi3Described = (
 impl Generation for Fmi3 {
     type Table = Fmi3Functions;
     type Described = Fmi3Described;
-    const PLATFORM: &'static str = "x86_64-linux";
+    const PLATFORM: &'static str = crate::platform::FMI3_FOLDER;
     const NEEDS_CHECKED_ISOLATED: bool = false;
 
     fn unsupported((md, _, _): &Fmi3Described, interface: Interface) -> Option<String> {
@@ -370,7 +370,7 @@ fn load<G: Generation>(
             reason: format!("modelIdentifier {identifier:?} is not a C identifier"),
         });
     }
-    let relative = format!("binaries/{}/{identifier}.so", G::PLATFORM);
+    let relative = format!("binaries/{}/{identifier}.{}", G::PLATFORM, crate::platform::LIBRARY_EXTENSION);
     let so = dir.path().join(&relative);
     if !so.is_file() {
         return Err(Error::MissingBinary { expected: relative, platforms: unpacked.platforms });
@@ -380,11 +380,10 @@ fn load<G: Generation>(
     let (library, table) = if options.isolated {
         // read and checked only: nothing of the library runs in this process
         let bytes = std::fs::read(&so).map_err(|source| Error::Io { path: shown.clone(), source })?;
-        crate::elf::check_shared_library(&bytes)
-            .map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
+        crate::platform::check_library(&bytes).map_err(|reason| Error::LoadLibrary { path: shown.clone(), reason })?;
         // without section headers every function is taken as present: a missing one
         // is then the host's error when called
-        let exported = crate::elf::exported_symbols(&bytes);
+        let exported = crate::platform::exported_symbols(&bytes);
         let present = |symbol: &str| exported.as_ref().is_none_or(|e| e.contains(symbol));
         if let Some(symbol) = G::missing_core(&present) {
             return Err(Error::MissingSymbol { path: shown, symbol });

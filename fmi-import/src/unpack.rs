@@ -93,20 +93,23 @@ pub fn safe_relative_path(name: &str) -> std::result::Result<PathBuf, &'static s
 /// without opening it: opening a FIFO would wait for a writer). Non-blocking open, so
 /// that a file swapped for a FIFO after the check does not block either.
 pub fn open_regular(path: &Path) -> Result<std::fs::File> {
-    use std::os::unix::fs::OpenOptionsExt;
     let io = |source| Error::Io { path: path.to_path_buf(), source };
     let not_regular = |kind: &str| Error::NotRegularFile { path: path.to_path_buf(), kind: kind.to_string() };
     let kind = |m: &std::fs::Metadata| {
-        use std::os::unix::fs::FileTypeExt;
         let t = m.file_type();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            if t.is_fifo() {
+                return "a FIFO (named pipe)";
+            } else if t.is_socket() {
+                return "a socket";
+            } else if t.is_block_device() || t.is_char_device() {
+                return "a device";
+            }
+        }
         if t.is_dir() {
             "a folder"
-        } else if t.is_fifo() {
-            "a FIFO (named pipe)"
-        } else if t.is_socket() {
-            "a socket"
-        } else if t.is_block_device() || t.is_char_device() {
-            "a device"
         } else {
             "not a regular file"
         }
@@ -115,8 +118,14 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File> {
     if !meta.is_file() {
         return Err(not_regular(kind(&meta)));
     }
-    const O_NONBLOCK: i32 = 0o4000; // Linux
-    let file = std::fs::OpenOptions::new().read(true).custom_flags(O_NONBLOCK).open(path).map_err(io)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if !meta.is_file() {
         return Err(not_regular(kind(&meta)));
@@ -214,6 +223,7 @@ fn program_name() -> String {
 
 /// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (and so in every thread started
 /// after it); the set, for `sigwait`, or `None` when they could not be blocked.
+#[cfg(unix)]
 fn block_stop_signals() -> Option<libc::sigset_t> {
     // SAFETY: plain libc calls on a local signal set.
     unsafe {
@@ -231,6 +241,7 @@ fn block_stop_signals() -> Option<libc::sigset_t> {
 /// what it computed, then calls [`finish_stopped`]) and gives it `grace` to do so; a second
 /// signal, or the end of the grace, removes the temporary folders and exits with 128 + the
 /// signal's number as [`remove_on_signals`] does. Call it first in `main`.
+#[cfg(unix)]
 pub fn remove_on_signals_after_stop(stop: impl FnOnce(libc::c_int) + Send + 'static, grace: std::time::Duration) {
     // SAFETY: plain libc calls on a local signal set and a local timespec.
     unsafe {
@@ -278,6 +289,7 @@ pub fn finish_stopped() -> ! {
 /// started after it; call it first in `main`) and waits for them in a thread of its own,
 /// which runs `cleanup` with the signal and exits with 128 + its number. The one signal
 /// waiter of the master's programs ([`remove_on_signals`], a campaign's worker processes).
+#[cfg(unix)]
 pub fn on_signals(cleanup: impl FnOnce(libc::c_int) + Send + 'static) {
     // SAFETY: plain libc calls on a local signal set.
     unsafe {
@@ -291,6 +303,15 @@ pub fn on_signals(cleanup: impl FnOnce(libc::c_int) + Send + 'static) {
         });
     }
 }
+
+/// Windows has no SIGINT, SIGTERM, SIGHUP to wait for: Ctrl+C ends the process at once, and
+/// the temporary folders of the run stay in %TEMP%.
+#[cfg(not(unix))]
+pub fn on_signals(_cleanup: impl FnOnce(libc::c_int) + Send + 'static) {}
+
+/// As [`on_signals`] on Windows: nothing to wait for.
+#[cfg(not(unix))]
+pub fn remove_on_signals_after_stop(_stop: impl FnOnce(libc::c_int) + Send + 'static, _grace: std::time::Duration) {}
 
 /// Where an archive is: a file, or an entry of an `.ssp` (an FMU in `resources/`), read
 /// straight from the outer archive without writing it to disk.
@@ -550,13 +571,14 @@ pub fn read_text_entry<R: Read + std::io::Seek>(
 }
 
 /// The entries of an FMU a run in this process uses: `modelDescription.xml`, this
-/// platform's `binaries/linux64/` (FMI 2.0) or `binaries/x86_64-linux/` (FMI 3.0) and
-/// `resources/` (other platforms' libraries, the documentation and sources are not
-/// written).
+/// platform's `binaries/` folders ([`crate::platform`]: `linux64` and `x86_64-linux` on
+/// x86-64 Linux) and `resources/` (other platforms' libraries, the documentation and
+/// sources are not written).
 pub fn used_by_a_run(name: &Path) -> bool {
+    let binaries = Path::new("binaries");
     name == Path::new("modelDescription.xml")
-        || name.starts_with("binaries/linux64")
-        || name.starts_with("binaries/x86_64-linux")
+        || name.starts_with(binaries.join(crate::platform::FMI2_FOLDER))
+        || name.starts_with(binaries.join(crate::platform::FMI3_FOLDER))
         || name.starts_with("resources")
 }
 

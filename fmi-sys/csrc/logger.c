@@ -9,7 +9,8 @@
  *    positional `%1$` arguments is not formatted at all: the message says so and shows
  *    the format text;
  *  - a %s argument is read only if it points into readable memory (checked with
- *    process_vm_readv, which fails instead of faulting) outside the importer's own program
+ *    process_vm_readv, ReadProcessMemory or vm_read_overwrite, which fail instead of
+ *    faulting) outside the importer's own program
  *    image (its code, constants and static data); otherwise the message shows
  *    "<unreadable string>" or "<string in the importer's memory>" in its place. So a %s
  *    without an argument (whatever pointer the register or stack slot holds) never crashes
@@ -18,13 +19,20 @@
  * Numbers of missing arguments still print whatever the register or stack slot holds: a
  * number, not memory behind it. */
 #define _GNU_SOURCE
-#include <dlfcn.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#ifdef _WIN32
+#include <windows.h>
+#elif defined(__APPLE__)
+#include <dlfcn.h>
+#include <mach/mach.h>
+#else
+#include <dlfcn.h>
 #include <sys/uio.h>
 #include <unistd.h>
+#endif
 
 /* The first field of the object the component environment points to. */
 typedef void (*fmi2_sys_receive)(void *env, const char *instance_name, int status, const char *category,
@@ -36,19 +44,36 @@ void fmi2_sys_logger(void *env, const char *instance_name, int status, const cha
 #define BUFFER 4096
 #define PAGE 4096
 
+/* Reads `n` bytes at `at` of this process into `out` by a system call that fails instead of
+ * faulting on unreadable memory: process_vm_readv (Linux), ReadProcessMemory (Windows),
+ * vm_read_overwrite (macOS). Returns the bytes read, 0 or less when none could be. */
+static long read_own_memory(uintptr_t at, char *out, size_t n) {
+#ifdef _WIN32
+    SIZE_T got = 0;
+    if (!ReadProcessMemory(GetCurrentProcess(), (LPCVOID)at, out, n, &got)) return 0;
+    return (long)got;
+#elif defined(__APPLE__)
+    vm_size_t got = 0;
+    if (vm_read_overwrite(mach_task_self(), (vm_address_t)at, n, (vm_address_t)(uintptr_t)out, &got) != KERN_SUCCESS)
+        return 0;
+    return (long)got;
+#else
+    struct iovec local = {out, n};
+    struct iovec remote = {(void *)at, n};
+    return (long)process_vm_readv(getpid(), &local, 1, &remote, 1, 0);
+#endif
+}
+
 /* Copies at most `cap` bytes of the C string at `p` into `out` (NUL-terminated), page by
- * page with process_vm_readv. Returns the length copied, or -1 if the first byte is not
+ * page with read_own_memory. Returns the length copied, or -1 if the first byte is not
  * readable. A string that becomes unreadable before its NUL is cut there. */
 static long safe_copy_string(const char *p, char *out, size_t cap) {
     size_t n = 0;
-    pid_t self = getpid();
     while (n < cap) {
         uintptr_t at = (uintptr_t)p + n;
         size_t chunk = PAGE - (at % PAGE);
         if (chunk > cap - n) chunk = cap - n;
-        struct iovec local = {out + n, chunk};
-        struct iovec remote = {(void *)at, chunk};
-        ssize_t got = process_vm_readv(self, &local, 1, &remote, 1, 0);
+        long got = read_own_memory(at, out + n, chunk);
         if (got <= 0) {
             if (n == 0) return -1;
             break;
@@ -65,10 +90,18 @@ static long safe_copy_string(const char *p, char *out, size_t cap) {
 /* Whether `p` lies in the importer's program image (the executable this shim is linked
  * into: its code, constants and static data). */
 static int in_importer_image(const void *p) {
+#ifdef _WIN32
+    HMODULE mine, theirs;
+    DWORD flags = GET_MODULE_HANDLE_EX_FLAG_FROM_ADDRESS | GET_MODULE_HANDLE_EX_FLAG_UNCHANGED_REFCOUNT;
+    if (!GetModuleHandleExA(flags, (LPCSTR)(uintptr_t)&fmi2_sys_logger, &mine)) return 0;
+    if (!GetModuleHandleExA(flags, (LPCSTR)p, &theirs)) return 0;
+    return theirs == mine;
+#else
     Dl_info mine, theirs;
     if (!dladdr((void *)&fmi2_sys_logger, &mine)) return 0;
     if (!dladdr(p, &theirs)) return 0;
     return theirs.dli_fbase == mine.dli_fbase;
+#endif
 }
 
 /* Appends to buf[*len .. BUFFER). */

@@ -201,6 +201,12 @@ fn main_inner(cli: Cli) -> Result<Outcome, Error> {
                 return Ok(Outcome::Done);
             }
             let shard = shard.as_deref().map(parse_shard).transpose()?;
+            // worker processes are Linux-only: elsewhere the runs go in threads, said once
+            #[cfg(not(target_os = "linux"))]
+            if !in_process {
+                eprintln!("campaign: note: {}", nigel_campaign::worker::unsupported());
+            }
+            let in_process = in_process || !cfg!(target_os = "linux");
             let workers = if in_process {
                 Workers::Threads
             } else {

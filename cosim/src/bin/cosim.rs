@@ -350,6 +350,10 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         Some(p) => Some(OutputFormat::of(p)?),
     };
     let limits = args.limits.limits();
+    // isolation needs Linux's shared memory and futexes: elsewhere refused before anything loads
+    if let (Some(_), Some(why)) = (args.isolate, nigel_cosim::isolate::os::unsupported()) {
+        return Err(Error::Experiment(why).into());
+    }
     // the parent of --isolate=run loads no FMU library (its host does)
     let host_of_run = nigel_cosim::isolate::whole::is_host();
     let isolated = args.isolate.is_some() && !host_of_run;

@@ -21,7 +21,7 @@
 //! [`Error::Host`] naming the instance, the call, the time and the signal or exit code
 //! when the host ended without an outcome.
 
-use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::os::fd::{AsRawFd, OwnedFd};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -72,13 +72,10 @@ pub struct CallMarker {
 impl CallMarker {
     /// A fresh region (`memfd_create`, close-on-exec: the parent lets one child inherit it).
     pub fn new() -> std::result::Result<CallMarker, String> {
-        // SAFETY: a literal name; plain syscalls on the fresh descriptor.
+        let fd = fmi_import::isolate::os::memfd_create(c"nigel-cosim-mark", libc::MFD_CLOEXEC)
+            .map_err(|e| format!("memfd_create: {e}"))?;
+        // SAFETY: plain syscalls on the fresh descriptor.
         unsafe {
-            let raw = libc::memfd_create(c"nigel-cosim-mark".as_ptr(), libc::MFD_CLOEXEC);
-            if raw < 0 {
-                return Err(format!("memfd_create: {}", std::io::Error::last_os_error()));
-            }
-            let fd = OwnedFd::from_raw_fd(raw);
             if libc::ftruncate(fd.as_raw_fd(), HEADER as libc::off_t) != 0 {
                 return Err(format!("ftruncate: {}", std::io::Error::last_os_error()));
             }
@@ -267,21 +264,12 @@ pub fn simulate_in_host(system: &System, experiment: &Experiment, args: &[std::f
             cause: HostEnd::Failed(m),
         })
     };
-    // SAFETY: a literal name; no CLOEXEC: the host inherits the descriptor.
-    let raw = unsafe { libc::memfd_create(c"nigel-cosim-run".as_ptr(), 0) };
-    if raw < 0 {
-        return Err(failed(format!("memfd_create: {}", std::io::Error::last_os_error())));
-    }
-    // SAFETY: a fresh descriptor we own.
-    let fd = unsafe { OwnedFd::from_raw_fd(raw) };
+    // no CLOEXEC: the host inherits the descriptor
+    let fd = fmi_import::isolate::os::memfd_create(c"nigel-cosim-run", 0)
+        .map_err(|e| failed(format!("memfd_create: {e}")))?;
     // the text of the exact columns, one line per row (the host appends)
-    // SAFETY: as above.
-    let raw = unsafe { libc::memfd_create(c"nigel-cosim-run-text".as_ptr(), 0) };
-    if raw < 0 {
-        return Err(failed(format!("memfd_create: {}", std::io::Error::last_os_error())));
-    }
-    // SAFETY: a fresh descriptor we own.
-    let text_fd = unsafe { OwnedFd::from_raw_fd(raw) };
+    let text_fd = fmi_import::isolate::os::memfd_create(c"nigel-cosim-run-text", 0)
+        .map_err(|e| failed(format!("memfd_create: {e}")))?;
     let program = std::env::current_exe().map_err(|e| failed(format!("the running program: {e}")))?;
     let mut command = std::process::Command::new(&program);
     command

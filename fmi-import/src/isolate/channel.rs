@@ -1,11 +1,11 @@
 //! The master's side of one host process: start, calls (one round trip each, sets queued),
 //! liveness and time limits, and the end of the host.
 
+use super::os::{HostProcess, SharedRegion};
 use super::protocol::{publish, wait_for, Header, Layout, Op, Spin};
 use crate::error::HostEnd;
 use crate::log::{LogRecord, LogSink};
 use crate::status::Status;
-use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -44,8 +44,9 @@ pub(crate) fn find_host(explicit: Option<&Path>) -> Result<PathBuf, String> {
 pub(crate) struct Channel {
     base: *mut u8,
     layout: Layout,
-    _fd: OwnedFd,
-    pid: libc::pid_t,
+    /// The region (unmapped when the channel ends, after the host).
+    _region: SharedRegion,
+    process: HostProcess,
     /// The host's end, once known (it is then reaped).
     pub(crate) failure: Option<HostEnd>,
     /// A call refused before it was made because its data (bytes) exceed what the region
@@ -103,31 +104,8 @@ impl Channel {
         run_deadline: Option<(Instant, Duration)>,
         spin: Spin,
     ) -> Result<Channel, HostEnd> {
-        // SAFETY: plain syscalls; the name is a NUL-terminated literal.
-        let raw = unsafe { libc::memfd_create(c"nigel-cosim-host".as_ptr(), 0) };
-        if raw < 0 {
-            return Err(HostEnd::Failed(format!("memfd_create: {}", std::io::Error::last_os_error())));
-        }
-        // SAFETY: `raw` is a fresh descriptor we own.
-        let fd = unsafe { OwnedFd::from_raw_fd(raw) };
-        // SAFETY: a descriptor we own, a size in range.
-        if unsafe { libc::ftruncate(fd.as_raw_fd(), layout.total as libc::off_t) } != 0 {
-            return Err(HostEnd::Failed(format!("ftruncate: {}", std::io::Error::last_os_error())));
-        }
-        // SAFETY: maps the whole memfd shared, read-write.
-        let base = unsafe {
-            libc::mmap(
-                std::ptr::null_mut(),
-                layout.total,
-                libc::PROT_READ | libc::PROT_WRITE,
-                libc::MAP_SHARED,
-                fd.as_raw_fd(),
-                0,
-            )
-        };
-        if base == libc::MAP_FAILED {
-            return Err(HostEnd::Failed(format!("mmap: {}", std::io::Error::last_os_error())));
-        }
+        let region = SharedRegion::create(c"nigel-cosim-host", layout.total).map_err(HostEnd::Failed)?;
+        let base = region.base();
         // SAFETY: the fresh mapping starts with a zeroed Header; the host is not started yet.
         unsafe {
             let h = &mut *(base as *mut Header);
@@ -139,25 +117,17 @@ impl Channel {
         }
         let mut command = std::process::Command::new(host);
         command
-            .arg(fd.as_raw_fd().to_string())
+            .arg(region.handle_argument())
             .arg(layout.total.to_string())
             .arg(library)
             .stdin(std::process::Stdio::null());
-        // SAFETY: runs in the child between fork and exec: only async-signal-safe calls
-        // (prctl). The host dies with the master.
-        unsafe {
-            use std::os::unix::process::CommandExt;
-            command.pre_exec(|| {
-                libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
-                Ok(())
-            });
-        }
-        let child = command.spawn().map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
+        let process = HostProcess::spawn(command)
+            .map_err(|e| HostEnd::Failed(format!("cannot start {}: {e}", host.display())))?;
         let mut channel = Channel {
-            base: base as *mut u8,
+            base,
             layout,
-            _fd: fd,
-            pid: child.id() as libc::pid_t,
+            _region: region,
+            process,
             failure: None,
             over_limit: None,
             reaped: false,
@@ -180,7 +150,6 @@ impl Channel {
             gauge: super::protocol::SpinGauge::new(),
             spin,
         };
-        std::mem::forget(child); // reaped by waitpid in `reap`
         super::protocol::LIVE_HOSTS.fetch_add(1, Ordering::Relaxed);
         // the host answers a first empty call once it has loaded the library (its
         // load-time initializers ran there: a crash in them is the host's end)
@@ -442,26 +411,14 @@ impl Channel {
         if self.reaped {
             return Some(HostEnd::Failed("the host is gone".into()));
         }
-        let mut status: libc::c_int = 0;
-        // SAFETY: our own child; WNOHANG does not block.
-        let r = unsafe { libc::waitpid(self.pid, &mut status, libc::WNOHANG) };
-        if r == self.pid {
-            self.reaped = true;
-            if libc::WIFSIGNALED(status) {
-                return Some(HostEnd::Signal(libc::WTERMSIG(status)));
-            }
-            return Some(HostEnd::Exit(libc::WEXITSTATUS(status)));
-        }
-        None
+        let end = self.process.try_wait();
+        self.reaped |= end.is_some();
+        end
     }
 
     fn kill(&mut self) {
         if !self.reaped {
-            // SAFETY: our own child, not yet reaped (its pid is still ours).
-            unsafe {
-                libc::kill(self.pid, libc::SIGKILL);
-                libc::waitpid(self.pid, std::ptr::null_mut(), 0);
-            }
+            self.process.kill();
             self.reaped = true;
         }
     }
@@ -529,10 +486,7 @@ impl Drop for Channel {
             }
             self.kill();
         }
-        // SAFETY: the mapping made in `start`, unmapped once.
-        unsafe {
-            libc::munmap(self.base as *mut libc::c_void, self.layout.total);
-        }
+        // the region is unmapped when `_region` drops, after this
     }
 }
 

@@ -59,17 +59,17 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
         eprintln!("cosim-host: started by the master (cosim --isolate), not by hand");
         return 2;
     };
-    let (Ok(fd), Ok(size)) = (fd.to_string_lossy().parse::<i32>(), size.to_string_lossy().parse::<usize>()) else {
+    let Ok(size) = size.to_string_lossy().parse::<usize>() else {
         eprintln!("cosim-host: bad arguments");
         return 2;
     };
-    // SAFETY: maps the descriptor the master passed, of the size it made it.
-    let base =
-        unsafe { libc::mmap(std::ptr::null_mut(), size, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0) };
-    if base == libc::MAP_FAILED {
-        eprintln!("cosim-host: mmap: {}", std::io::Error::last_os_error());
-        return 2;
-    }
+    let base = match super::os::map_inherited(&fd.to_string_lossy(), size) {
+        Ok(base) => base,
+        Err(e) => {
+            eprintln!("cosim-host: {e}");
+            return 2;
+        }
+    };
     // the layout the master chose, from the header it wrote before starting the host
     // SAFETY: the mapping starts with the Header, written before this process started.
     let arrays = unsafe { (*(base as *const Header)).arrays } as usize;
@@ -78,7 +78,7 @@ pub fn run(args: &[std::ffi::OsString]) -> i32 {
         eprintln!("cosim-host: the region's size {size} is not that of its layout ({})", layout.total);
         return 2;
     }
-    let region = Region { base: base as *mut u8, layout };
+    let region = Region { base, layout };
     let log = Box::<LogSink>::default();
     let library = Path::new(library);
     let fmi3 = region.header().fmi3 == 1;

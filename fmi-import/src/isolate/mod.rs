@@ -34,13 +34,15 @@
 //! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
 //! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.
 //!
-//! Files: `protocol` (the shared region's layout, the calls, waiting and waking), `channel`
+//! Files: `os` (the region, the host process and the futex: Linux only; elsewhere isolation
+//! is refused with [`os::unsupported`]'s message), `protocol` (the shared region's layout, the calls, waiting and waking), `channel`
 //! (the master's end: starting a host, a call's round trip, the time limits), `proxy` and
 //! `proxy3` (the function tables that carry each FMI 2.0 / 3.0 call over a channel),
 //! `host` (the host's end). Each depends only on those before it.
 
 pub(crate) mod channel;
 pub mod host;
+pub mod os;
 pub(crate) mod protocol;
 pub(crate) mod proxy;
 pub(crate) mod proxy3;

@@ -368,14 +368,7 @@ pub(crate) fn wait_for<E>(
             sleeping.store(0, Ordering::SeqCst);
             return Ok(());
         }
-        let ts =
-            libc::timespec { tv_sec: slice.as_secs() as libc::time_t, tv_nsec: slice.subsec_nanos() as libc::c_long };
-        // SAFETY: `word` is a live u32 in shared memory; FUTEX_WAIT (not private: the
-        // region is shared between processes) returns when woken, on timeout or at once
-        // if the word is no longer `old`.
-        unsafe {
-            libc::syscall(libc::SYS_futex, word.as_ptr(), libc::FUTEX_WAIT, old, &ts as *const libc::timespec);
-        }
+        super::os::sleep_on(word, old, slice);
         sleeping.store(0, Ordering::SeqCst);
         if word.load(Ordering::Acquire) != old {
             return Ok(());
@@ -388,10 +381,7 @@ pub(crate) fn wait_for<E>(
 pub(crate) fn publish(word: &AtomicU32, value: u32, sleeping: &AtomicU32) {
     word.store(value, Ordering::SeqCst);
     if sleeping.load(Ordering::SeqCst) != 0 {
-        // SAFETY: `word` is a live u32 in shared memory; wakes every waiter on it.
-        unsafe {
-            libc::syscall(libc::SYS_futex, word.as_ptr(), libc::FUTEX_WAKE, i32::MAX);
-        }
+        super::os::wake(word);
     }
 }
 

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# The master on every platform (a stage of the test command): builds the release archives
+# (scripts/dist.sh: nothing recompiles when the main command built them in the same target
+# folder), checks them against SHA256SUMS, unpacks them, and runs the 30 s closed loop
+# (target/ssp/nigel_closed_loop.ssp, whose FMUs carry every platform's libraries) with each
+# executable build: x86-64 Linux natively (in process, --isolate, --isolate=run: the
+# reference, each byte for byte equal), x86-64 Windows under wine (its FMUs' win64 libraries),
+# aarch64 Linux under qemu-user (aarch64-linux libraries; also --isolate, equal to its own
+# in-process run byte for byte). Those two run other FMU libraries, whose C library rounds
+# sin, cos, atan2, hypot otherwise in the last bit: scripts/compare-platform-csv.py says
+# how many values differ and holds each within 1e-12 of its column's largest magnitude. The
+# macOS builds are checked by their Mach-O headers (no Mac here).
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+target="${CARGO_TARGET_DIR:-$repo/target}"
+case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$repo/Cargo.toml" | head -1)"
+ssp="$target/ssp/nigel_closed_loop.ssp"
+[ -f "$ssp" ] || { echo "test-dist: no $ssp (build-fmu writes it)" >&2; exit 1; }
+bash "$repo/scripts/dist.sh" >/dev/null
+work="$target/dist-test"
+rm -rf "$work" && mkdir -p "$work"
+(cd "$target/dist" && sha256sum -c --quiet SHA256SUMS)
+linux_x86="x86_64-unknown-linux-gnu" windows="x86_64-pc-windows-gnu" linux_arm="aarch64-unknown-linux-gnu"
+for t in "$linux_x86" "$linux_arm" x86_64-apple-darwin aarch64-apple-darwin; do
+    tar -C "$work" -xzf "$target/dist/cosim-$version-$t.tar.gz"
+done
+(cd "$work" && unzip -q "$target/dist/cosim-$version-$windows.zip")
+dir() { echo "$work/cosim-$version-$1"; }
+run_args=(run "$ssp" --stop-time 30 --step 1e-3 --algorithm ordered --output-interval 0.01)
+same() { # same NAME CSV: byte for byte equal to the reference
+    if cmp -s "$work/reference.csv" "$2"; then
+        echo "identical to x86-64 Linux: $1"
+    else
+        echo "test-dist: $1 differs from the x86-64 Linux run:" >&2
+        cmp "$work/reference.csv" "$2" >&2 || true
+        diff <(head -c 2000 "$work/reference.csv") <(head -c 2000 "$2") | head -5 >&2 || true
+        exit 1
+    fi
+}
+
+# x86-64 Linux, the release build (glibc 2.17): the reference, and its isolated runs
+"$(dir $linux_x86)/cosim" "${run_args[@]}" --output "$work/reference.csv"
+"$(dir $linux_x86)/cosim" "${run_args[@]}" --isolate --output "$work/linux-isolate.csv"
+same "x86-64 Linux --isolate" "$work/linux-isolate.csv"
+"$(dir $linux_x86)/cosim" "${run_args[@]}" --isolate=run --output "$work/linux-isolate-run.csv"
+same "x86-64 Linux --isolate=run" "$work/linux-isolate-run.csv"
+
+# x86-64 Windows under wine (the ProcessPrng shim next to the program: wine 8 lacks it)
+x86_64-w64-mingw32-gcc -shared -O2 -o "$(dir $windows)/bcryptprimitives.dll" \
+    "$repo/build-fmu/tests/c/process_prng_shim.c" -lbcrypt
+wine_path() { echo "Z:${1//\//\\}"; }
+wine_cosim() {
+    env WINEPREFIX="$target/wine-prefix" WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml=;bcryptprimitives=n" \
+        -u DISPLAY -u WAYLAND_DISPLAY wine "$(dir $windows)/cosim.exe" "$@"
+}
+wine_cosim run "$(wine_path "$ssp")" "${run_args[@]:2}" --output "$(wine_path "$work/windows.csv")"
+windows_line=$(python3 "$repo/scripts/compare-platform-csv.py" "$work/reference.csv" "$work/windows.csv" "x86-64 Windows (wine)")
+echo "$windows_line"
+# docs/platforms.md prints the count of differing values: it must be this run's
+counts=$(echo "$windows_line" | python3 -c 'import re,sys; m=re.search(r"(\d+) of (\d+) values", sys.stdin.read()); print(f"{int(m[1]):,} of\n{int(m[2]):,}" if m else "byte-equal")')
+tr '\n' ' ' <"$repo/docs/platforms.md" | grep -qF "$(echo "$counts" | tr '\n' ' ' | sed 's/ $//; s/of /of the /')" \
+    || { echo "test-dist: docs/platforms.md does not print this run's count ($counts)" >&2; exit 1; }
+# --isolate is refused on Windows, naming the platform, before anything loads
+if wine_cosim run "$(wine_path "$ssp")" --stop-time 1 --isolate 2>"$work/windows-isolate.err"; then
+    echo "test-dist: cosim.exe --isolate exited 0" >&2
+    exit 1
+fi
+grep -q "available on Linux only, not on Windows" "$work/windows-isolate.err" \
+    || { cat "$work/windows-isolate.err" >&2; echo "test-dist: cosim.exe --isolate: not the refusal" >&2; exit 1; }
+echo "refused on Windows: --isolate ($(tr -d '\r' <"$work/windows-isolate.err" | head -1))"
+
+# aarch64 Linux under qemu-user (its glibc from libc6-dev-arm64-cross)
+qemu=(qemu-aarch64 -L /usr/aarch64-linux-gnu)
+"${qemu[@]}" "$(dir $linux_arm)/cosim" "${run_args[@]}" --output "$work/aarch64.csv"
+python3 "$repo/scripts/compare-platform-csv.py" "$work/reference.csv" "$work/aarch64.csv" "aarch64 Linux (qemu)"
+# --isolate: the host is an aarch64 program too, started through qemu by a wrapper (no
+# binfmt_misc here to start it by itself)
+printf '#!/bin/sh\nexec qemu-aarch64 -L /usr/aarch64-linux-gnu "%s" "$@"\n' "$(dir $linux_arm)/cosim-host" \
+    >"$work/cosim-host-aarch64"
+chmod +x "$work/cosim-host-aarch64"
+NIGEL_COSIM_HOST="$work/cosim-host-aarch64" "${qemu[@]}" "$(dir $linux_arm)/cosim" "${run_args[@]}" --isolate \
+    --output "$work/aarch64-isolate.csv"
+# in a host or in process, the same libraries give the same bytes
+cmp "$work/aarch64.csv" "$work/aarch64-isolate.csv" && echo "identical to its in-process run: aarch64 Linux (qemu) --isolate"
+
+# macOS: the Mach-O header of each program (64-bit magic, CPU type) and its minimum macOS
+for arch in x86_64 aarch64; do
+    for p in cosim cosim-host campaign; do
+        python3 "$repo/scripts/macho-check.py" "$(dir "$arch-apple-darwin")/$p" "$arch"
+    done
+done
