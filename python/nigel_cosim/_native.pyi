@@ -19,6 +19,7 @@ __all__ = [
     "VariableError",
     "__version__",
     "compare",
+    "info",
     "run_campaign",
 ]
 
