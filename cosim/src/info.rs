@@ -325,42 +325,32 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
         } else {
             format!("{} .. {}", bound(v.min), bound(v.max))
         };
-        w!(
-            out,
-            "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
-            v.name,
-            v.causality.as_str(),
-            v.variability.as_str(),
-            v.value_type.element(),
-            dims,
-            md.unit_of(v).unwrap_or("-"),
-            start.unwrap_or_else(|| "-".into()),
-            range,
-            v.description.as_deref().unwrap_or("")
-        );
-        // an <Alias>: recorded under its own name too, the same value as its variable's
-        for a in &v.aliases {
+        // one row per name: the variable's, then each <Alias>'s (recorded under its own name
+        // too, the same value as its variable's)
+        let mut row = |name: &str, start: &str, range: &str, what: &str| {
             w!(
                 out,
                 "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
-                a.name,
+                name,
                 v.causality.as_str(),
                 v.variability.as_str(),
                 v.value_type.element(),
                 dims,
                 md.unit_of(v).unwrap_or("-"),
-                "-",
-                "",
-                format!(
-                    "alias of {}{}{}",
-                    v.name,
-                    a.display_unit
-                        .as_ref()
-                        .map(|u| format!(" (display unit {u}; recorded in the variable's unit)"))
-                        .unwrap_or_default(),
-                    a.description.as_ref().map(|d| format!(": {d}")).unwrap_or_default()
-                )
+                start,
+                range,
+                what
             );
+        };
+        row(&v.name, start.as_deref().unwrap_or("-"), &range, v.description.as_deref().unwrap_or(""));
+        for a in &v.aliases {
+            let display_unit = a
+                .display_unit
+                .as_ref()
+                .map(|u| format!(" (display unit {u}; recorded in the variable's unit)"))
+                .unwrap_or_default();
+            let description = a.description.as_ref().map(|d| format!(": {d}")).unwrap_or_default();
+            row(&a.name, "-", "", &format!("alias of {}{display_unit}{description}", v.name));
         }
     }
     info_clocks(out, md);
