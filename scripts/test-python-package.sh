@@ -53,3 +53,5 @@ cd "$repo"
 "$venv/bin/python" -m mypy.stubtest --mypy-config-file python/pyproject.toml nigel_cosim
 "$venv/bin/python" -m mypy --config-file python/pyproject.toml python/nigel_cosim
 "$venv/bin/python" -m pytest python/tests -q "$@"
+# the user's folder (its venv some 700 MB) is kept only when a step above failed
+rm -rf "$work"

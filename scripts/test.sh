@@ -57,6 +57,32 @@ stage_summary() {
     printf '%s' "$stage_table"
     printf '%6d s %7.0f s  all\n' "$SECONDS" "$(children_cpu)"
 }
+# A fresh run writes some 8 GB under target/ and 3 GB of toolchains under ~/.rustup and
+# ~/.cargo: with less room it would fail hours later at a random step, so it stops here.
+free_mib=$(df -Pm "$repo_dir" | awk 'NR == 2 { print $4 }')
+echo "free disk space beside the repository: $free_mib MiB"
+if [ "$free_mib" -lt 4096 ]; then
+    echo "scripts/test.sh: only $free_mib MiB free on the disk of $repo_dir; a run needs up to 11 GB (8 GB of it under target/ when fresh)" >&2
+    exit 1
+elif [ "$free_mib" -lt 12288 ]; then
+    echo "warning: $free_mib MiB free; a fresh run needs up to 11 GB (less when target/ is already built)" >&2
+fi
+# A test that hangs must not hold CI for its whole 90 minutes: after 70 (the run takes some
+# 21 on CI) the run is stopped with a message, and the last "== stage" line above says where.
+watchdog_minutes="${NIGEL_TEST_WATCHDOG_MINUTES:-70}"
+kill_tree() {
+    local child
+    for child in $(ps -o pid= --ppid "$1"); do kill_tree "$child"; done
+    kill -TERM "$1" 2>/dev/null || true
+}
+(
+    sleep $((watchdog_minutes * 60)) </dev/null >/dev/null 2>&1
+    echo "scripts/test.sh: still running after $watchdog_minutes minutes: stopped (a test hangs?)" >&2
+    for child in $(ps -o pid= --ppid $$); do
+        [ "$child" != "$BASHPID" ] && kill_tree "$child"
+    done
+    kill -TERM $$
+) &
 stage "import circles between the files of each crate (scripts/import-cycles.py)"
 python3 scripts/import-cycles.py --self-test
 python3 scripts/import-cycles.py

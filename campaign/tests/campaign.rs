@@ -152,6 +152,29 @@ fn tmp_empties(tmp: &Path) -> bool {
     false
 }
 
+/// Waits until `results.csv` in `out` holds `rows` rows; fails (killing the child) when the
+/// campaign ends before that or writes none within two minutes (a full disk, say), so that a
+/// test never waits forever.
+fn wait_for_rows(child: &mut std::process::Child, out: &Path, rows: usize) {
+    let start = std::time::Instant::now();
+    while rows_in(out) < rows {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut stderr = String::new();
+            if let Some(mut e) = child.stderr.take() {
+                use std::io::Read;
+                let _ = e.read_to_string(&mut stderr);
+            }
+            panic!("the campaign ended ({status}) before it wrote {rows} rows: {stderr}");
+        }
+        if start.elapsed() > std::time::Duration::from_secs(120) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the campaign wrote {} of {rows} rows within 120 s", rows_in(out));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
 /// The rows `results.csv` in `out` holds so far.
 fn rows_in(out: &Path) -> usize {
     std::fs::read_to_string(out.join("results.csv")).map_or(0, |t| t.lines().count().saturating_sub(1))
@@ -168,10 +191,7 @@ fn resume_after_a_killed_run_completes_it() {
     let (mut child, _tmp) = spawn_campaign(&spec_path, &out);
     let rows = out.join("results.csv");
     let count = || rows_in(&out);
-    while count() < 3 {
-        assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be killed");
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    wait_for_rows(&mut child, &out, 3);
     child.kill().unwrap();
     child.wait().unwrap();
     // SIGKILL of the campaign ends its worker processes too (SIGTERM to each, which
@@ -439,11 +459,9 @@ fn sigterm_removes_the_unpacked_fmus_and_keeps_the_rows_written() {
     let dir = tempfile::tempdir().unwrap();
     let spec_path = small(dir.path(), 30.0, 10);
     let out = dir.path().join("stopped");
-    let (child, tmp) = spawn_campaign(&spec_path, &out);
+    let (mut child, tmp) = spawn_campaign(&spec_path, &out);
     let count = || rows_in(&out);
-    while count() < 2 {
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    wait_for_rows(&mut child, &out, 2);
     assert!(std::fs::read_dir(&tmp).unwrap().count() > 0, "the FMUs are unpacked while the campaign runs");
     let kill = Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap();
     assert!(kill.success());

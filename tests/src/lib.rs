@@ -88,6 +88,9 @@ impl Drop for Fmu {
             // SAFETY: dropped once, here; the function tables are not used after this
             unsafe { std::mem::ManuallyDrop::drop(&mut self.library) }
         }
+        // the unpacked archive (some 9 MB with its five platforms' libraries): a run of the
+        // suite unpacks dozens; a mapped library stays valid after its file is removed
+        let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
 
