@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs the system packages and cross toolchains (as the test command does),
 # builds every binary of the workspace into target/release/ (cosim, cosim-host, campaign,
-# table3, synthesize, build-fmu, ...), the Python package's wheel into target/wheels/ and the venv
+# table3, synthesize, build-fmu, ...), the Python package's wheel into target/wheels/, the master's release archives for five platforms
+# into target/dist/ (scripts/dist.sh), the venv
 # of the README's quick start (target/venv: fmpy, pandas, matplotlib and nigel_cosim), the three FMUs for all four platforms (the release
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
 # target/fmu/ and the closed loop as SSP into target/ssp/, co-simulates that closed loop with our master (30 s at 1 ms, ordered), runs
@@ -25,6 +26,9 @@ bash scripts/python-venv-wheel.sh "$wheel"
 
 echo "== building the FMUs (all four platforms) and the closed-loop SSP"
 cargo run --release --quiet -p build-fmu -- --platforms all
+
+echo "== the master for every platform: target/dist/cosim-VERSION-TRIPLE.{tar.gz,zip} and SHA256SUMS"
+bash scripts/dist.sh
 
 echo "== co-simulation: plant + controller + test bench (lane change, robust), 30 s at 1 ms"
 cargo run --release --quiet -p nigel-cosim --bin cosim -- run "$target_dir/ssp/nigel_closed_loop.ssp" \

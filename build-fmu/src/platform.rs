@@ -277,6 +277,12 @@ impl Platform {
             Platform::Darwin64 => {
                 let mut c = zigbuild(&rust_web_bin("cargo"));
                 c.env("RUSTC", rust_web_bin("rustc")).env("MACOSX_DEPLOYMENT_TARGET", MACOS_MINIMUM).args(build_std());
+                // a library's install name @rpath/lib<name>.dylib, not the path it was built at
+                // (ld64's default): the same bytes from any folder, and no build path shipped
+                for t in DARWIN_TRIPLES {
+                    let var = format!("CARGO_TARGET_{}_RUSTFLAGS", t.to_uppercase().replace('-', "_"));
+                    c.env(var, "-Zosx-rpath-install-name");
+                }
                 c
             }
         };
