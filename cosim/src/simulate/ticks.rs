@@ -74,6 +74,9 @@ pub(crate) struct Ticks {
     fired: Vec<u32>,
     /// A millionth of the communication step, s: ticks this close are one.
     tolerance: f64,
+    /// The event of the ticks at the end of the last step is open (Co-Simulation: the
+    /// exchange at that point happens in it; the next step closes it).
+    open: bool,
 }
 
 impl Ticks {
@@ -104,7 +107,7 @@ impl Ticks {
             })
             .collect();
         let counts = clocks.iter().map(|c| (c.value_reference, c.name.clone(), 0)).collect();
-        Some(Ticks { inputs, counts, fired: Vec::new(), tolerance: 1e-6 * h })
+        Some(Ticks { inputs, counts, fired: Vec::new(), tolerance: 1e-6 * h, open: false })
     }
 
     /// The earliest tick from `after` on and before `until` (a tick within the tolerance of
@@ -149,6 +152,29 @@ impl Ticks {
             }
         }
         (first < until - self.tolerance).then_some(first)
+    }
+
+    /// The input clocks whose next tick is at `t` (within the tolerance), if any: the ticks
+    /// at the end of a step, whose event the step opens.
+    pub(crate) fn at(&self, t: f64) -> Option<Vec<u32>> {
+        let vrs: Vec<u32> = self
+            .inputs
+            .iter()
+            .filter(|s| s.next().is_some_and(|next| (next - t).abs() <= self.tolerance))
+            .map(|s| s.vr)
+            .collect();
+        (!vrs.is_empty()).then_some(vrs)
+    }
+
+    /// The clocks `vrs` ticked at the end of a step, their event left open.
+    pub(crate) fn opened(&mut self, vrs: &[u32]) {
+        self.ticked(vrs);
+        self.open = true;
+    }
+
+    /// Whether an event is open (and from now on not).
+    pub(crate) fn take_open(&mut self) -> bool {
+        std::mem::take(&mut self.open)
     }
 
     /// The clocks `vrs` ticked.

@@ -74,6 +74,13 @@ impl ClockedExchange {
         self.variables.get(&fmu_vr).is_some_and(|c| c.input)
     }
 
+    /// Whether one of the clocks of the clocked variable `fmu_vr` is among `active` (the
+    /// input clocks set in the open event): it is read and set through the FMU.
+    #[inline]
+    pub(crate) fn is_active(&self, fmu_vr: u32, active: &[u32]) -> bool {
+        !active.is_empty() && self.variables.get(&fmu_vr).is_some_and(|c| c.clocks.iter().any(|k| active.contains(k)))
+    }
+
     /// The value held for element `element` of `fmu_vr`.
     pub(crate) fn held(&self, fmu_vr: u32, element: usize) -> Option<f64> {
         self.held.get(&fmu_vr).and_then(|v| v.get(element)).copied()

@@ -496,7 +496,10 @@ impl Fmi3 {
         }
         let (mut free_vrs, mut free_at) = (Vec::new(), Vec::new());
         for (k, (vr, at)) in vrs.iter().zip(&clocked).enumerate() {
-            match at.and_then(|(fmu_vr, element)| self.clocked.held(fmu_vr, element)) {
+            let held = at
+                .filter(|(fmu_vr, _)| !self.clocked.is_active(*fmu_vr, &self.ticked_inputs))
+                .and_then(|(fmu_vr, element)| self.clocked.held(fmu_vr, element));
+            match held {
                 Some(held) => values[k] = T::from_held(held),
                 None => {
                     free_vrs.push(*vr);
@@ -509,6 +512,10 @@ impl Fmi3 {
             fmu_get(self, core, &free_vrs, &mut free_values)?;
             for (k, value) in free_at.into_iter().zip(free_values) {
                 values[k] = value;
+                // a clocked variable read while its clock is active: held from now on
+                if let Some((fmu_vr, element)) = clocked[k] {
+                    self.clocked.hold_element(fmu_vr, element, value.to_held());
+                }
             }
         }
         Ok(())
@@ -543,7 +550,14 @@ impl Fmi3 {
         for ((vr, at), value) in vrs.iter().zip(&clocked).zip(values) {
             match at {
                 Some((fmu_vr, element)) if self.clocked.is_input(*fmu_vr) => {
-                    self.clocked.queue(*fmu_vr, *element, value.to_held())
+                    if self.clocked.is_active(*fmu_vr, &self.ticked_inputs) {
+                        // its clock is active (an open clock event): set now, held
+                        self.clocked.hold_element(*fmu_vr, *element, value.to_held());
+                        free_vrs.push(*vr);
+                        free_values.push(*value);
+                    } else {
+                        self.clocked.queue(*fmu_vr, *element, value.to_held())
+                    }
                 }
                 _ => {
                     free_vrs.push(*vr);
