@@ -114,18 +114,18 @@ impl Ticks {
     /// either is at it: a tick on a communication point belongs to the step that starts
     /// there), and the value references of the clocks ticking then.
     pub(crate) fn due(&self, after: f64, until: f64) -> Option<(f64, Vec<u32>)> {
-        let times: Vec<(usize, f64)> =
-            self.inputs.iter().enumerate().filter_map(|(j, s)| Some((j, s.next()?))).collect();
-        let first = times.iter().map(|(_, t)| *t).fold(f64::INFINITY, f64::min);
+        // (called at every step: nothing allocated unless a tick is due)
+        let first = self.inputs.iter().filter_map(Scheduled::next).fold(f64::INFINITY, f64::min);
         // (no tick: first is infinite)
         if first >= until - self.tolerance {
             return None;
         }
         let at = if (first - after).abs() <= self.tolerance { after } else { first.max(after) };
-        let vrs = times
+        let vrs = self
+            .inputs
             .iter()
-            .filter(|(_, t)| (*t - first).abs() <= self.tolerance)
-            .map(|(j, _)| self.inputs[*j].vr)
+            .filter(|s| s.next().is_some_and(|t| (t - first).abs() <= self.tolerance))
+            .map(|s| s.vr)
             .collect();
         Some((at, vrs))
     }

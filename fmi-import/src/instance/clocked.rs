@@ -10,7 +10,9 @@
 use std::collections::HashMap;
 
 use crate::fmi3::Access;
+// looked up on every get and set of a running instance: a fast hash of the value reference
 use model_description::fmi3;
+use rustc_hash::FxHashMap;
 
 /// One clocked variable: its whole-variable access (element 0), its clocks, whether the
 /// master sets it (an input) or reads it.
@@ -25,12 +27,24 @@ pub(crate) struct Clocked {
 /// value reference (all elements of an array).
 #[derive(Default)]
 pub(crate) struct ClockedExchange {
-    variables: HashMap<u32, Clocked>,
-    held: HashMap<u32, Vec<f64>>,
-    queued: HashMap<u32, Vec<f64>>,
-    /// The last `readable` answer and the clocks it was for (the same clocks tick again and
-    /// again).
-    last_readable: Option<(Vec<u32>, Vec<Access>)>,
+    variables: FxHashMap<u32, Clocked>,
+    held: FxHashMap<u32, Vec<f64>>,
+    queued: FxHashMap<u32, Vec<f64>>,
+    /// The last [`ReadPlan`] (the same clocks tick again and again).
+    last_plan: Option<ReadPlan>,
+}
+
+/// The reads of the clocked variables of some clocks when their event settles: the
+/// Float64 scalars in one call, the others one call each.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ReadPlan {
+    /// The clocks it is for.
+    clocks: Vec<u32>,
+    /// The Float64 scalars' value references, and a buffer for their values.
+    pub(crate) scalars: Vec<u32>,
+    pub(crate) values: Vec<f64>,
+    /// The other clocked variables the master reads.
+    pub(crate) others: Vec<Access>,
 }
 
 impl ClockedExchange {
@@ -115,21 +129,32 @@ impl ClockedExchange {
     /// The queued sets of the inputs of the clocks `active`, taken (each access with all
     /// its values).
     pub(crate) fn take_queued(&mut self, active: &[u32]) -> Vec<(Access, Vec<f64>)> {
+        if self.queued.is_empty() {
+            return Vec::new();
+        }
         let due: Vec<Access> = self.of_clocks(active, true);
         due.into_iter().filter_map(|a| self.queued.remove(&a.vr).map(|values| (a, values))).collect()
     }
 
-    /// The clocked variables the master reads (outputs and every other non-input) of the
-    /// clocks `active`.
-    pub(crate) fn readable(&mut self, active: &[u32]) -> Vec<Access> {
-        if let Some((clocks, accesses)) = &self.last_readable {
-            if clocks == active {
-                return accesses.clone();
+    /// The reads of the clocked variables the master reads (outputs and every other
+    /// non-input) of the clocks `active`, taken (give it back with [`ClockedExchange::put_plan`]).
+    pub(crate) fn take_plan(&mut self, active: &[u32]) -> ReadPlan {
+        if let Some(plan) = self.last_plan.take() {
+            if plan.clocks == active {
+                return plan;
             }
         }
-        let accesses = self.of_clocks(active, false);
-        self.last_readable = Some((active.to_vec(), accesses.clone()));
-        accesses
+        let (scalars, others): (Vec<Access>, Vec<Access>) = self
+            .of_clocks(active, false)
+            .into_iter()
+            .partition(|a| a.count == 1 && a.value_type == fmi3::ValueType::Float64);
+        let scalars: Vec<u32> = scalars.iter().map(|a| a.vr).collect();
+        ReadPlan { clocks: active.to_vec(), values: vec![0.0; scalars.len()], scalars, others }
+    }
+
+    /// The plan back, for the next event of the same clocks.
+    pub(crate) fn put_plan(&mut self, plan: ReadPlan) {
+        self.last_plan = Some(plan);
     }
 
     /// The clocked variables the master reads that hold no value (no start value, not read
