@@ -19,6 +19,7 @@ impl ClockCalls for Fmi3 {
         // their clocked outputs read
         self.apply_queued(core, vrs)?;
         self.ticked_inputs.extend_from_slice(vrs);
+        self.clocked.activate(vrs);
         Ok(())
     }
 

@@ -496,8 +496,8 @@ impl Fmi3 {
         if core.state != InstanceState::Running {
             fmu_get(self, core, vrs, values)?;
             for (vr, value) in vrs.iter().zip(values.iter()) {
-                if let Some((fmu_vr, element)) = at(self, *vr) {
-                    self.clocked.hold_element(fmu_vr, element, value.to_held());
+                if let Some((slot, element)) = at(self, *vr) {
+                    self.clocked.hold_element(slot, element, value.to_held());
                 }
             }
             return Ok(());
@@ -507,8 +507,8 @@ impl Fmi3 {
         // common case of a plain read, or of the reads in an open clock event)
         let held = |me: &Fmi3, vr: u32| {
             at(me, vr)
-                .filter(|(fmu_vr, _)| !me.clocked.is_active(*fmu_vr, &me.ticked_inputs))
-                .and_then(|(fmu_vr, element)| me.clocked.held(fmu_vr, element))
+                .filter(|(slot, _)| !me.clocked.is_active(*slot))
+                .and_then(|(slot, element)| me.clocked.held(slot, element))
         };
         if vrs.iter().all(|vr| held(self, *vr).is_none()) {
             fmu_get(self, core, vrs, values)?;
@@ -541,9 +541,9 @@ impl Fmi3 {
             return;
         }
         for (vr, value) in vrs.iter().zip(values) {
-            if let Some((fmu_vr, element)) = self.clocked.clocked(*vr, self.special(*vr)) {
-                if self.clocked.is_active(fmu_vr, &self.ticked_inputs) {
-                    self.clocked.hold_element(fmu_vr, element, value.to_held());
+            if let Some((slot, element)) = self.clocked.clocked(*vr, self.special(*vr)) {
+                if self.clocked.is_active(slot) {
+                    self.clocked.hold_element(slot, element, value.to_held());
                 }
             }
         }
@@ -564,8 +564,8 @@ impl Fmi3 {
         if core.state != InstanceState::Running {
             fmu_set(self, core, vrs, values)?;
             for (vr, value) in vrs.iter().zip(values) {
-                if let Some((fmu_vr, element)) = at(self, *vr) {
-                    self.clocked.hold_element(fmu_vr, element, value.to_held());
+                if let Some((slot, element)) = at(self, *vr) {
+                    self.clocked.hold_element(slot, element, value.to_held());
                 }
             }
             return Ok(());
@@ -573,8 +573,7 @@ impl Fmi3 {
         // a clocked input whose clocks are inactive is queued; every other variable set (a
         // clocked input of an active clock, in an open clock event, held too)
         let queued = |me: &Fmi3, vr: u32| {
-            at(me, vr)
-                .filter(|(fmu_vr, _)| me.clocked.is_input(*fmu_vr) && !me.clocked.is_active(*fmu_vr, &me.ticked_inputs))
+            at(me, vr).filter(|(slot, _)| me.clocked.is_input(*slot) && !me.clocked.is_active(*slot))
         };
         if vrs.iter().all(|vr| queued(self, *vr).is_none()) {
             fmu_set(self, core, vrs, values)?;
@@ -584,7 +583,7 @@ impl Fmi3 {
         let (mut free_vrs, mut free_values) = (Vec::new(), Vec::new());
         for (vr, value) in vrs.iter().zip(values) {
             match queued(self, *vr) {
-                Some((fmu_vr, element)) => self.clocked.queue(fmu_vr, element, value.to_held()),
+                Some((slot, element)) => self.clocked.queue(slot, element, value.to_held()),
                 None => {
                     free_vrs.push(*vr);
                     free_values.push(*value);
@@ -605,9 +604,9 @@ impl Fmi3 {
         if self.clocked.is_empty() || active.is_empty() {
             return Ok(());
         }
-        for (access, values) in self.clocked.take_queued(active) {
+        for (slot, access, values) in self.clocked.take_queued(active) {
             self.set_all(core, access, &values)?;
-            self.clocked.hold(access.vr, values);
+            self.clocked.hold(slot, values);
         }
         Ok(())
     }
@@ -629,13 +628,13 @@ impl Fmi3 {
             let (vrs, values) = (&plan.scalars, &mut plan.values);
             let (c, f) = (core.component, self.a.functions.get_float64);
             call!(core, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?;
-            for (vr, value) in vrs.iter().zip(values.iter()) {
-                self.clocked.hold_element(*vr, 0, *value);
+            for (slot, value) in plan.scalar_slots.iter().zip(values.iter()) {
+                self.clocked.hold_element(*slot, 0, *value);
             }
         }
-        for access in plan.others.iter() {
+        for (slot, access) in plan.others.iter() {
             let values = self.get_all(core, *access)?;
-            self.clocked.hold(access.vr, values);
+            self.clocked.hold(*slot, values);
         }
         Ok(())
     }
@@ -654,6 +653,7 @@ impl Fmi3 {
         if self.output_clocks.is_empty() {
             // (the list's buffer kept for the next event)
             let mut active = std::mem::take(&mut self.ticked_inputs);
+            self.clocked.deactivate();
             let outcome = self.read_clocked(core, &active);
             active.clear();
             self.ticked_inputs = active;
@@ -668,6 +668,7 @@ impl Fmi3 {
         }
         // the clocked variables of the clocks that ticked in this event, read as it settled
         let mut active = std::mem::take(&mut self.ticked_inputs);
+        self.clocked.deactivate();
         active.extend(ticked);
         self.read_clocked(core, &active)
     }
@@ -826,9 +827,9 @@ impl Calls for Fmi3 {
     fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
         // the clocked variables the master reads hold what initialization computed until
         // their clocks' first ticks (read while Initialization Mode allows it)
-        for access in self.clocked.unheld() {
+        for (slot, access) in self.clocked.unheld() {
             let values = self.get_all(core, access)?;
-            self.clocked.hold(access.vr, values);
+            self.clocked.hold(slot, values);
         }
         let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
         call!(core, "fmi3ExitInitializationMode", None, f(c))?;
