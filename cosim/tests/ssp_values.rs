@@ -335,3 +335,36 @@ fn an_algebraic_loop_at_initialization_is_iterated_to_its_fixed_point_and_a_chai
     let s = read_ssp(&dir.join("chain.ssd"), &ImportOptions::default()).unwrap();
     assert!(nigel_cosim::loops::initialization_loop(&s.system).is_none());
 }
+
+#[test]
+fn a_chain_of_direct_feedthrough_enters_its_first_row_at_its_sources_values() {
+    // src -> a -> b -> c, each connection written sink first (as OMSimulator's
+    // AircraftVehicleDemonstrator script writes 109 of them), gains k = 2 with y = k u
+    // (direct feedthrough), from t0 = 2 s, Jacobi (the default: connections delayed by one
+    // step after the first row)
+    let dir = work_dir("ssp-init-chain");
+    build_fmu(Model::Source, &dir, &[]);
+    build_fmu(Model::Gain, &dir, &[]);
+    let ssd = format!(
+        r#"{HEAD}<ssd:System name="top">
+  <ssd:Elements><ssd:Component name="src" source="source.fmu"/><ssd:Component name="a" source="gain.fmu"/><ssd:Component name="b" source="gain.fmu"/><ssd:Component name="c" source="gain.fmu"/></ssd:Elements>
+  <ssd:Connections><ssd:Connection startElement="a" startConnector="u" endElement="src" endConnector="y"/><ssd:Connection startElement="b" startConnector="u" endElement="a" endConnector="y"/><ssd:Connection startElement="c" startConnector="u" endElement="b" endConnector="y"/></ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+    );
+    write(&dir, "chain.ssd", &ssd);
+    let s = read_ssp(&dir.join("chain.ssd"), &ImportOptions::default()).unwrap();
+    assert!(nigel_cosim::loops::initialization_loop(&s.system).is_none());
+    let mut e = Experiment::new(2.5, 0.5);
+    e.start_time = 2.0;
+    e.algorithm = Algorithm::Jacobi;
+    e.record = Some(["a.u", "b.u", "c.u"].map(String::from).to_vec());
+    let (r, _) = simulate(&s.system, &e).unwrap();
+    let column = |name: &str| r.column(name).unwrap();
+    // the first row, t = 2 s, every input at its source's value when Initialization Mode
+    // ends: a.u = src.y = slope t = 1 * 2 = 2; b.u = a.y = 2 * 2 = 4; c.u = b.y = 2 * 4 = 8
+    // (carried once from the start values u = 0, c.u would be b.y of b.u = 0, that is 0)
+    assert_eq!((column("a.u")[0], column("b.u")[0], column("c.u")[0]), (2.0, 4.0, 8.0));
+    // t = 2.5 s, Jacobi: an input row holds the value its instance stepped from 2 s with
+    // (the values got at 2.5 s are set before the next step), the consistent 2, 4, 8 again
+    assert_eq!((column("a.u")[1], column("b.u")[1], column("c.u")[1]), (2.0, 4.0, 8.0));
+}
