@@ -11,12 +11,14 @@
 //!   (a value of 1 at a row: a tick at its time).
 //!
 //! A tick within a millionth of a communication step of a point is at the point (the
-//! point's time is `t0 + n h`, the tick's `t0 + shift + k i`: the two may differ by an ulp),
-//! and belongs to the step that starts there: the row recorded at a point holds the values
-//! before its ticks (the left limit at the tick, as the Altair Activate references record
-//! them), the next row the values after. A tick inside a step splits it: the lane steps to
-//! the tick, runs the clock event there, and goes on (`Lane::advance`). A tick at the stop
-//! time is not run (no step starts there).
+//! point's time is `t0 + n h`, the tick's `t0 + shift + k i`: the two may differ by an ulp).
+//! In Co-Simulation the step that reaches a tick opens its event ([`Ticks::at`],
+//! [`Ticks::opened`]): the exchange and the row at that point happen in it, and the next
+//! step closes it before it steps (`lane.rs`, docs/clocks.md); the tick at the start time,
+//! and a tick that becomes known inside a step, run whole where the step starts or where
+//! they fall (a tick inside a step splits it: the lane steps to the tick, runs the clock
+//! event there, and goes on). Model Exchange runs every tick whole at the start of the step
+//! from it.
 
 use crate::clocks::{Clock, ClockCausality, ClockKind};
 use crate::error::{Error, Result};
