@@ -34,6 +34,9 @@ pub(crate) struct ClockedExchange {
     /// The slot of each clocked variable by the FMU's value reference (all elements of an
     /// array); looked up on every get and set of a running instance: a fast hash.
     slots: FxHashMap<u32, usize>,
+    /// The same by index when every value reference is below [`DENSE_LIMIT`]: the slot + 1
+    /// of each value reference, 0 for a variable that is not clocked (no hash at all).
+    dense: Vec<u32>,
     /// By slot, in the order of the description.
     variables: Vec<Clocked>,
     /// Some value is queued.
@@ -41,6 +44,9 @@ pub(crate) struct ClockedExchange {
     /// The last [`ReadPlan`] (the same clocks tick again and again).
     last_plan: Option<ReadPlan>,
 }
+
+/// Value references below this are looked up by index (64 KiB of table at most).
+const DENSE_LIMIT: u32 = 1 << 14;
 
 /// The reads of the clocked variables of some clocks when their event settles: the
 /// Float64 scalars in one call, the others one call each.
@@ -83,6 +89,13 @@ impl ClockedExchange {
                 queued: None,
             });
         }
+        let largest = md.model_variables.iter().map(|v| v.value_reference).max().unwrap_or(0);
+        if !exchange.variables.is_empty() && largest < DENSE_LIMIT {
+            exchange.dense = vec![0; largest as usize + 1];
+            for (vr, slot) in exchange.slots.iter() {
+                exchange.dense[*vr as usize] = *slot as u32 + 1;
+            }
+        }
         exchange
     }
 
@@ -97,6 +110,12 @@ impl ClockedExchange {
     #[inline]
     pub(crate) fn clocked(&self, vr: u32, special: Option<Access>) -> Option<(usize, usize)> {
         let (fmu_vr, element) = special.map_or((vr, 0), |a| (a.vr, a.element));
+        if !self.dense.is_empty() {
+            return match self.dense.get(fmu_vr as usize) {
+                Some(&k) if k > 0 => Some((k as usize - 1, element)),
+                _ => None,
+            };
+        }
         self.slots.get(&fmu_vr).map(|slot| (*slot, element))
     }
 
