@@ -25,72 +25,12 @@ pub enum Fmi3Part {
     ScheduledExecution,
 }
 
-pub use super::super::fmi2::functions::MissingSymbol;
+pub use crate::table::MissingSymbol;
 
-macro_rules! fmi3_functions {
-    (core { $($cf:ident : $cs:ident = $cn:literal, $cp:ident => fn($($ca:ty),*) $(-> $cr:ty)?;)* }
-     optional { $($of:ident : $os:ident = $on:literal, $op:ident => fn($($oa:ty),*) $(-> $or:ty)?;)* }) => {
-        pub mod types {
-            //! The C type of each function, named as in `fmi3FunctionTypes.h`. The
-            //! Booleans are C `bool`s; an importer reads what an FMU wrote through an
-            //! `fmi3Boolean*` as a byte (any value but 0 is true), never as a Rust `bool`.
-            use super::*;
-            $(#[doc = concat!("`", stringify!($cs), "`.")]
-              pub type $cs = unsafe extern "C" fn($($ca),*) $(-> $cr)?;)*
-            $(#[doc = concat!("`", stringify!($os), "`.")]
-              pub type $os = unsafe extern "C" fn($($oa),*) $(-> $or)?;)*
-        }
-
-        /// The functions of an FMI 3.0 library: the 7 every importer calls as function
-        /// pointers, the others as `Option` (`None`: the library does not export it).
-        #[derive(Clone, Copy, Debug)]
-        pub struct Fmi3Functions {
-            $(#[doc = concat!("`", $cn, "`.")] pub $cf: types::$cs,)*
-            $(#[doc = concat!("`", $on, "`.")] pub $of: Option<types::$os>,)*
-        }
-
-        /// Every symbol with the part of FMI 3.0 it belongs to: the common ones first
-        /// (the 15 of the core first among them), then Co-Simulation, then Model Exchange.
-        pub const SYMBOLS: [(&str, Fmi3Part); 75] = [
-            $(($cn, Fmi3Part::$cp),)*
-            $(($on, Fmi3Part::$op),)*
-        ];
-
-        impl Fmi3Functions {
-            /// Resolves the symbols in `library`: the 7 core ones must be there (the
-            /// first absent one is the error), the others are `None` when absent.
-            ///
-            /// # Safety
-            /// `library` must be an FMI 3.0 library: each exported `fmi3*` symbol has the C
-            /// signature of the FMI 3.0 headers. The pointers are valid while the library
-            /// stays loaded.
-            #[cfg(feature = "import")]
-            pub unsafe fn load(library: &libloading::Library) -> Result<Fmi3Functions, MissingSymbol> {
-                Ok(Fmi3Functions {
-                    $($cf: *library
-                        .get::<types::$cs>(concat!($cn, "\0").as_bytes())
-                        .map_err(|_| MissingSymbol($cn))?,)*
-                    $($of: library
-                        .get::<types::$os>(concat!($on, "\0").as_bytes())
-                        .ok()
-                        .map(|s| *s),)*
-                })
-            }
-
-            /// Whether the library exports `symbol` (`"fmi3DoStep"`, ...); false for a
-            /// name that is not an FMI 3.0 function.
-            pub fn has(&self, symbol: &str) -> bool {
-                match symbol {
-                    $($cn => true,)*
-                    $($on => self.$of.is_some(),)*
-                    _ => false,
-                }
-            }
-        }
-    };
-}
-
-fmi3_functions! {
+crate::table::function_table! {
+    table Fmi3Functions, part Fmi3Part, count 75, generation "FMI 3.0",
+    types_doc "The C type of each function, named as in `fmi3FunctionTypes.h`. The Booleans are C `bool`s; an importer reads what an FMU wrote through an `fmi3Boolean*` as a byte (any value but 0 is true), never as a Rust `bool`.",
+    table_doc "The functions of an FMI 3.0 library: the 7 every importer calls as function pointers, the others as `Option` (`None`: the library does not export it).",
     core {
         get_version: fmi3GetVersionTYPE = "fmi3GetVersion", Common => fn() -> *const c_char;
         free_instance: fmi3FreeInstanceTYPE = "fmi3FreeInstance", Common => fn(fmi3Instance);
@@ -179,11 +119,6 @@ impl Fmi3Functions {
     pub fn missing(&self) -> Vec<&'static str> {
         SYMBOLS.iter().filter(|(s, _)| !self.has(s)).map(|(s, _)| *s).collect()
     }
-}
-
-/// The symbols of one part of FMI 3.0.
-pub fn symbols_of(part: Fmi3Part) -> impl Iterator<Item = &'static str> {
-    SYMBOLS.iter().filter(move |(_, p)| *p == part).map(|(s, _)| *s)
 }
 
 #[cfg(test)]
