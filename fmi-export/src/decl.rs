@@ -1246,17 +1246,10 @@ fn unit_definitions<B>(spec: &DeclarationSpec<B>) -> Result<Vec<md::Unit>, Strin
     Ok(units)
 }
 
-/// A unit with base-unit exponents `[kg, m, s, rad]`.
-pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
-    md::Unit {
-        name: name.to_string(),
-        base_unit: Some(md::BaseUnit { kg, m, s, rad, factor: 1.0, ..Default::default() }),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::units::si_unit;
 
     fn spec(variables: Vec<VarDecl<u8>>) -> DeclarationSpec<u8> {
         DeclarationSpec {

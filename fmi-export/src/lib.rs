@@ -210,7 +210,7 @@ pub mod uri;
 pub mod variables;
 
 pub use decl::{
-    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
+    declared_name, enumeration_type, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
     DeclarationSpec, Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use fmi_sys;
@@ -220,6 +220,7 @@ pub use model::{Access, EventUpdate, InstantiateContext, Interface, Model, Model
 pub use model_description;
 pub use sampled::{SampleClock, SampleEnd};
 pub use states::{Function, Machine};
+pub use units::si_unit;
 pub use variables::{Accessor, Family, Field, FieldValue, Pending, Variables};
 
 /// Exports the 44 FMI 2.0 and the 75 FMI 3.0 functions for model type `$model` from the
