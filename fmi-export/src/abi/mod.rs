@@ -158,30 +158,28 @@ pub(crate) unsafe fn with<M: Model>(
     status
 }
 
-/// A slice from a C array, refusing a null pointer unless the length is 0, and an
-/// implausible length before anything is read or allocated.
-pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> OpResult<&'a [T]> {
+/// Whether a C array of length `n` holds anything to read, refusing a null pointer unless
+/// the length is 0, and an implausible length before anything is read or allocated.
+fn array_filled(is_null: bool, n: usize, what: &str) -> OpResult<bool> {
     if n == 0 {
-        Ok(&[])
+        Ok(false)
     } else if n > MAX_ARRAY_LENGTH {
         Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
+    } else if is_null {
         Err(format!("{what} is NULL with length {n}").into())
     } else {
-        Ok(std::slice::from_raw_parts(ptr, n))
+        Ok(true)
     }
 }
 
+/// A slice from a C array (see [`array_filled`]).
+pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> OpResult<&'a [T]> {
+    Ok(if array_filled(ptr.is_null(), n, what)? { std::slice::from_raw_parts(ptr, n) } else { &[] })
+}
+
+/// A mutable slice from a C array (see [`array_filled`]).
 pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpResult<&'a mut [T]> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if n > MAX_ARRAY_LENGTH {
-        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
-        Err(format!("{what} is NULL with length {n}").into())
-    } else {
-        Ok(std::slice::from_raw_parts_mut(ptr, n))
-    }
+    Ok(if array_filled(ptr.is_null(), n, what)? { std::slice::from_raw_parts_mut(ptr, n) } else { &mut [] })
 }
 
 /// The body of both generations' Model Exchange calls that fill the caller's array of `n`

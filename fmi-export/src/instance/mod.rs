@@ -74,6 +74,17 @@ struct PreEvent<M> {
 }
 
 impl<M: Model> Core<M> {
+    /// What the events at the current instant may change, as it is before them.
+    fn pre_event(&self) -> PreEvent<M> {
+        PreEvent {
+            model: self.model.clone(),
+            next_event: self.next_event,
+            clock: self.clock,
+            presample: self.presample,
+            terminate_requested: self.terminate_requested,
+        }
+    }
+
     fn new(model: M) -> Self {
         let presample = model.sample_period().is_some();
         Core {

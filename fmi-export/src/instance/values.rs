@@ -123,31 +123,32 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
-        let d = decl::<M>();
-        Self::check_rows(d, BaseType::Integer, vrs)?;
-        if self.clocked {
-            self.settle_clock()?;
-        } else {
-            self.settle_events()?;
-        }
-        for (o, &vr) in out.iter_mut().zip(vrs) {
-            let row = Self::row_in(d, BaseType::Integer, vr)?;
-            *o = self.core.model.get_integer(d.hot(row).binding)?;
-        }
-        Ok(())
+        self.get_discrete(BaseType::Integer, vrs, out, M::get_integer)
     }
 
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+        self.get_discrete(BaseType::Boolean, vrs, out, M::get_boolean)
+    }
+
+    /// The Integers or Booleans of `vrs`, after the events due at the current time.
+    #[inline(always)]
+    fn get_discrete<T>(
+        &mut self,
+        base_type: BaseType,
+        vrs: &[u32],
+        out: &mut [T],
+        read: impl Fn(&mut M, M::Binding) -> crate::model::ModelResult<T>,
+    ) -> OpResult {
         let d = decl::<M>();
-        Self::check_rows(d, BaseType::Boolean, vrs)?;
+        Self::check_rows(d, base_type, vrs)?;
         if self.clocked {
             self.settle_clock()?;
         } else {
             self.settle_events()?;
         }
         for (o, &vr) in out.iter_mut().zip(vrs) {
-            let row = Self::row_in(d, BaseType::Boolean, vr)?;
-            *o = self.core.model.get_boolean(d.hot(row).binding)?;
+            let row = Self::row_in(d, base_type, vr)?;
+            *o = read(&mut self.core.model, d.hot(row).binding)?;
         }
         Ok(())
     }
