@@ -247,7 +247,7 @@ impl<M: Model> Drop for Fmu<M> {
 
 // ------------------------------------------------------------------ FMI 3.0
 
-use crate::abi::fmi3 as abi3;
+use crate::abi::fmi3::{self as abi3, status3};
 pub use fmi_sys::fmi3::Fmi3Status;
 use fmi_sys::fmi3::{fmi3FMUState, fmi3Instance, fmi3Status, FMI3_FALSE, FMI3_TRUE};
 
@@ -387,7 +387,7 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn exit_init(&self) -> Fmi3Status {
-        unsafe { abi3::exit_initialization_mode::<M>(Function::Fmi3ExitInitializationMode, self.c) }
+        unsafe { status3(abi::exit_initialization_mode::<M>(Function::Fmi3ExitInitializationMode, self.c)) }
     }
 
     /// Enter and exit initialization at `start` with an optional stop time, all Ok.
@@ -493,24 +493,24 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn terminate(&self) -> Fmi3Status {
-        unsafe { abi3::terminate::<M>(Function::Fmi3Terminate, self.c) }
+        unsafe { status3(abi::terminate::<M>(Function::Fmi3Terminate, self.c)) }
     }
 
     pub fn reset(&self) -> Fmi3Status {
-        unsafe { abi3::reset::<M>(Function::Fmi3Reset, self.c) }
+        unsafe { status3(abi::reset::<M>(Function::Fmi3Reset, self.c)) }
     }
 
     // Model Exchange
     pub fn set_time(&self, t: f64) -> Fmi3Status {
-        unsafe { abi3::set_time::<M>(Function::Fmi3SetTime, self.c, t) }
+        unsafe { status3(abi::set_time::<M>(Function::Fmi3SetTime, self.c, t)) }
     }
 
     pub fn enter_event_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_event_mode::<M>(Function::Fmi3EnterEventMode, self.c) }
+        unsafe { status3(abi::enter_event_mode::<M>(Function::Fmi3EnterEventMode, self.c)) }
     }
 
     pub fn enter_continuous_time_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_continuous_time_mode::<M>(Function::Fmi3EnterContinuousTimeMode, self.c) }
+        unsafe { status3(abi::enter_continuous_time_mode::<M>(Function::Fmi3EnterContinuousTimeMode, self.c)) }
     }
 
     /// `fmi3UpdateDiscreteStates`, which must return Ok.
@@ -540,25 +540,27 @@ impl<M: Model> Fmu3<M> {
     pub fn continuous_states(&self) -> Vec<f64> {
         let mut x = vec![f64::NAN; M::declaration().number_of_states()];
         let s = unsafe {
-            abi3::get_continuous_states::<M>(Function::Fmi3GetContinuousStates, self.c, x.as_mut_ptr(), x.len())
+            status3(abi::get_continuous_states::<M>(Function::Fmi3GetContinuousStates, self.c, x.as_mut_ptr(), x.len()))
         };
         assert_eq!(s, OK3, "{}", self.last_error());
         x
     }
 
     pub fn set_continuous_states(&self, x: &[f64]) -> Fmi3Status {
-        unsafe { abi3::set_continuous_states::<M>(Function::Fmi3SetContinuousStates, self.c, x.as_ptr(), x.len()) }
+        unsafe {
+            status3(abi::set_continuous_states::<M>(Function::Fmi3SetContinuousStates, self.c, x.as_ptr(), x.len()))
+        }
     }
 
     pub fn derivatives(&self) -> Vec<f64> {
         let mut dx = vec![f64::NAN; M::declaration().number_of_states()];
         let s = unsafe {
-            abi3::get_continuous_state_derivatives::<M>(
+            status3(abi::get_derivatives::<M>(
                 Function::Fmi3GetContinuousStateDerivatives,
                 self.c,
                 dx.as_mut_ptr(),
                 dx.len(),
-            )
+            ))
         };
         assert_eq!(s, OK3, "{}", self.last_error());
         dx
@@ -617,22 +619,28 @@ impl<M: Model> Fmu3<M> {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
             assert_eq!(
-                abi3::get_fmu_state::<M>(Function::Fmi3GetFMUState, self.c, &mut s),
+                status3(abi::get_fmu_state::<M>(Function::Fmi3GetFMUState, self.c, &mut s)),
                 OK3,
                 "{}",
                 self.last_error()
             );
             let mut n = 0usize;
             assert_eq!(
-                abi3::serialized_fmu_state_size::<M>(Function::Fmi3SerializedFMUStateSize, self.c, s, &mut n),
+                status3(abi::serialized_fmu_state_size::<M>(Function::Fmi3SerializedFMUStateSize, self.c, s, &mut n)),
                 OK3
             );
             let mut bytes = vec![0u8; n];
             assert_eq!(
-                abi3::serialize_fmu_state::<M>(Function::Fmi3SerializeFMUState, self.c, s, bytes.as_mut_ptr(), n),
+                status3(abi::serialize_fmu_state::<M>(
+                    Function::Fmi3SerializeFMUState,
+                    self.c,
+                    s,
+                    bytes.as_mut_ptr(),
+                    n
+                )),
                 OK3
             );
-            assert_eq!(abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s), OK3);
+            assert_eq!(status3(abi::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s)), OK3);
             bytes
         }
     }
@@ -641,18 +649,18 @@ impl<M: Model> Fmu3<M> {
     pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi3Status {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
-            let st = abi3::deserialize_fmu_state::<M>(
+            let st = status3(abi::deserialize_fmu_state::<M>(
                 Function::Fmi3DeserializeFMUState,
                 self.c,
                 bytes.as_ptr(),
                 bytes.len(),
                 &mut s,
-            );
+            ));
             if st != OK3 {
                 return st;
             }
-            let st = abi3::set_fmu_state::<M>(Function::Fmi3SetFMUState, self.c, s);
-            abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s);
+            let st = status3(abi::set_fmu_state::<M>(Function::Fmi3SetFMUState, self.c, s));
+            abi::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s);
             st
         }
     }
@@ -660,7 +668,7 @@ impl<M: Model> Fmu3<M> {
 
 impl<M: Model> Drop for Fmu3<M> {
     fn drop(&mut self) {
-        unsafe { abi3::free_instance::<M>(Function::Fmi3FreeInstance, self.c) }
+        unsafe { abi::free_instance::<M>(Function::Fmi3FreeInstance, self.c) }
     }
 }
 

@@ -13,11 +13,13 @@
 
 pub mod fmi2;
 pub mod fmi3;
+pub mod shared;
 pub mod table;
 
 /// `fmi2EventInfo` (from `fmi-sys`).
 pub use crate::ffi::Fmi2EventInfo;
 pub use fmi2::*;
+pub use shared::*;
 
 use std::collections::HashSet;
 use std::ffi::{c_int, CStr, CString};
@@ -25,7 +27,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use crate::ffi::*;
 use crate::instance::{Function, Instance, Machine, OpResult, SavedState};
-use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
+use crate::log::{LogCategory, Logger};
 use crate::model::{Model, ModelError};
 
 /// Largest `nvr` (or `nx`, `nUnknown`, ...) accepted: far above any sensible request,
@@ -182,20 +184,6 @@ pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpRe
     Ok(if array_filled(ptr.is_null(), n, what)? { std::slice::from_raw_parts_mut(ptr, n) } else { &mut [] })
 }
 
-/// The body of both generations' Model Exchange calls that fill the caller's array of `n`
-/// reals at `ptr` (named `what` in a refusal) from the instance: continuous states, their
-/// derivatives, their nominals, the event indicators (`get`, one of [`Instance`]'s getters).
-pub(crate) unsafe fn get_reals<M: Model>(
-    c: fmi2Component,
-    function: Function,
-    ptr: *mut f64,
-    n: usize,
-    what: &str,
-    get: fn(&mut Instance<M>, &mut [f64]) -> OpResult,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| get(&mut comp.instance, slice_mut(ptr, n, what)?))
-}
-
 pub(crate) unsafe fn out_ptr<'a, T>(ptr: *mut T, what: &str) -> OpResult<&'a mut T> {
     ptr.as_mut().ok_or_else(|| format!("{what} is NULL").into())
 }
@@ -206,112 +194,4 @@ pub(crate) unsafe fn string<'a>(ptr: fmi2String) -> Option<&'a str> {
     } else {
         CStr::from_ptr(ptr).to_str().ok()
     }
-}
-
-pub unsafe fn set_debug_logging_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    logging_on: fmi2Boolean,
-    n: usize,
-    categories: *const fmi2String,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let names = slice(categories, n, "categories")?;
-        let mut enabled = [n == 0; LOG_CATEGORIES.len()];
-        for &name in names {
-            let name = string(name).ok_or_else(|| ModelError::from("a category name is NULL or not UTF-8"))?;
-            let k = LOG_CATEGORIES
-                .iter()
-                .position(|(c, _)| *c == name)
-                .ok_or_else(|| format!("unknown log category {name:?}"))?;
-            enabled[k] = true;
-        }
-        comp.logger.configure(logging_on != FMI2_FALSE, enabled);
-        Ok(())
-    })
-}
-
-// ------------------------------------------------------------------ FMU state, both generations
-// (`function` names the call; an `fmi3FMUState` is the same pointer as an `fmi2FMUstate`)
-
-pub unsafe fn get_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        let saved = comp.instance.save_state();
-        comp.put_state(slot, saved)
-    })
-}
-
-pub unsafe fn set_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        comp.instance.restore_state(saved)
-    })
-}
-
-pub unsafe fn free_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: *mut fmi2FMUstate,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            let ptr = comp.own_state(*slot)?;
-            comp.live_states.remove(&(ptr as usize));
-            drop(Box::from_raw(ptr));
-            *slot = std::ptr::null_mut();
-        }
-        Ok(())
-    })
-}
-
-pub unsafe fn serialized_fmu_state_size_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    size: *mut usize,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        *out_ptr(size, "size")? = Instance::serialize(saved)?.len();
-        Ok(())
-    })
-}
-
-pub unsafe fn serialize_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    bytes: *mut fmi2Byte,
-    size: usize,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        let data = Instance::serialize(saved)?;
-        if size < data.len() {
-            return Err(format!("buffer of {size} bytes is too small for {} bytes", data.len()).into());
-        }
-        let out = slice_mut(bytes as *mut u8, data.len(), "serializedState")?;
-        out.copy_from_slice(&data);
-        Ok(())
-    })
-}
-
-pub unsafe fn deserialize_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    bytes: *const fmi2Byte,
-    size: usize,
-    state: *mut fmi2FMUstate,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let data = slice(bytes as *const u8, size, "serializedState")?;
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            comp.own_state(*slot)?;
-        }
-        let saved = comp.instance.deserialize(data)?;
-        comp.put_state(slot, saved)
-    })
 }
