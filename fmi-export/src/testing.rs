@@ -303,15 +303,11 @@ impl<M: Model> Fmu3<M> {
     /// `fmi3InstantiateCoSimulation` with `token` and `eventModeUsed`; `None` (and the log)
     /// when the layer refuses.
     pub fn try_cs(token: &str, event_mode_used: bool) -> Result<Self, Box<Log>> {
-        let log = Box::<Log>::default();
-        let name = CString::new("test3").unwrap();
-        let token = CString::new(token).unwrap();
-        let env = &*log as *const Log as *mut std::ffi::c_void;
-        let c = unsafe {
+        Self::try_instantiate(token, |name, token, env| unsafe {
             abi3::instantiate_co_simulation::<M>(
                 Function::Fmi3InstantiateCoSimulation,
-                name.as_ptr(),
-                token.as_ptr(),
+                name,
+                token,
                 std::ptr::null(),
                 FMI3_FALSE,
                 FMI3_TRUE,
@@ -323,32 +319,36 @@ impl<M: Model> Fmu3<M> {
                 Some(log_message),
                 None,
             )
-        };
-        if c.is_null() {
-            Err(log)
-        } else {
-            Ok(Fmu3 { c, log, _m: std::marker::PhantomData })
-        }
+        })
     }
 
     /// `fmi3InstantiateModelExchange` with `token`.
     pub fn try_me(token: &str) -> Result<Self, Box<Log>> {
-        let log = Box::<Log>::default();
-        let name = CString::new("test3").unwrap();
-        let token = CString::new(token).unwrap();
-        let env = &*log as *const Log as *mut std::ffi::c_void;
-        let c = unsafe {
+        Self::try_instantiate(token, |name, token, env| unsafe {
             abi3::instantiate_model_exchange::<M>(
                 Function::Fmi3InstantiateModelExchange,
-                name.as_ptr(),
-                token.as_ptr(),
+                name,
+                token,
                 std::ptr::null(),
                 FMI3_FALSE,
                 FMI3_TRUE,
                 env,
                 Some(log_message),
             )
-        };
+        })
+    }
+
+    /// An instance from `instantiate(instanceName, instantiationToken, instanceEnvironment)`,
+    /// its log the environment; the log when the layer refuses.
+    fn try_instantiate(
+        token: &str,
+        instantiate: impl FnOnce(*const std::ffi::c_char, *const std::ffi::c_char, *mut std::ffi::c_void) -> fmi3Instance,
+    ) -> Result<Self, Box<Log>> {
+        let log = Box::<Log>::default();
+        let name = CString::new("test3").unwrap();
+        let token = CString::new(token).unwrap();
+        let env = &*log as *const Log as *mut std::ffi::c_void;
+        let c = instantiate(name.as_ptr(), token.as_ptr(), env);
         if c.is_null() {
             Err(log)
         } else {
@@ -568,34 +568,27 @@ impl<M: Model> Fmu3<M> {
 
     /// `fmi3GetDirectionalDerivative`: `J seed` or the status.
     pub fn directional(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
-        let mut out = vec![f64::NAN; unknowns.len()];
-        let s = unsafe {
-            abi3::get_partial_derivatives::<M>(
-                Function::Fmi3GetDirectionalDerivative,
-                self.c,
-                unknowns.as_ptr(),
-                unknowns.len(),
-                knowns.as_ptr(),
-                knowns.len(),
-                seed.as_ptr(),
-                seed.len(),
-                out.as_mut_ptr(),
-                out.len(),
-            )
-        };
-        if s == OK3 {
-            Ok(out)
-        } else {
-            Err(s)
-        }
+        self.partial_derivatives(Function::Fmi3GetDirectionalDerivative, unknowns, knowns, seed, unknowns.len())
     }
 
     /// `fmi3GetAdjointDerivative`: `J^T seed` or the status.
     pub fn adjoint(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
-        let mut out = vec![f64::NAN; knowns.len()];
+        self.partial_derivatives(Function::Fmi3GetAdjointDerivative, unknowns, knowns, seed, knowns.len())
+    }
+
+    /// `function` (directional or adjoint) with a sensitivity of `n` values.
+    fn partial_derivatives(
+        &self,
+        function: Function,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        n: usize,
+    ) -> Result<Vec<f64>, Fmi3Status> {
+        let mut out = vec![f64::NAN; n];
         let s = unsafe {
             abi3::get_partial_derivatives::<M>(
-                Function::Fmi3GetAdjointDerivative,
+                function,
                 self.c,
                 unknowns.as_ptr(),
                 unknowns.len(),
