@@ -28,9 +28,13 @@ pub enum Fmi3Part {
 pub use crate::table::MissingSymbol;
 
 crate::table::function_table! {
-    table Fmi3Functions, part Fmi3Part, count 75, generation "FMI 3.0",
-    types_doc "The C type of each function, named as in `fmi3FunctionTypes.h`. The Booleans are C `bool`s; an importer reads what an FMU wrote through an `fmi3Boolean*` as a byte (any value but 0 is true), never as a Rust `bool`.",
-    table_doc "The functions of an FMI 3.0 library: the 7 every importer calls as function pointers, the others as `Option` (`None`: the library does not export it).",
+    /// The C type of each function, named as in `fmi3FunctionTypes.h`. The Booleans are C
+    /// `bool`s; an importer reads what an FMU wrote through an `fmi3Boolean*` as a byte
+    /// (any value but 0 is true), never as a Rust `bool`.
+    mod types;
+    /// The functions of an FMI 3.0 library: the 7 every importer calls as function
+    /// pointers, the others as `Option` (`None`: the library does not export it).
+    pub struct Fmi3Functions: Fmi3Part, 75 symbols of "FMI 3.0";
     core {
         get_version: fmi3GetVersionTYPE = "fmi3GetVersion", Common => fn() -> *const c_char;
         free_instance: fmi3FreeInstanceTYPE = "fmi3FreeInstance", Common => fn(fmi3Instance);
@@ -121,34 +125,16 @@ impl Fmi3Functions {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The function counts of `fmi3FunctionTypes.h` (3.0.2): 61 common (with the three
-    /// instantiation functions), 10 Model Exchange, 3 Co-Simulation, 1 Scheduled
-    /// Execution; names all distinct.
-    #[test]
-    fn the_symbols_are_those_of_the_header() {
-        assert_eq!(symbols_of(Fmi3Part::Common).count(), 61);
-        assert_eq!(symbols_of(Fmi3Part::ModelExchange).count(), 10);
-        assert_eq!(symbols_of(Fmi3Part::CoSimulation).count(), 3);
-        assert_eq!(symbols_of(Fmi3Part::ScheduledExecution).count(), 1);
-        let mut names: Vec<&str> = SYMBOLS.iter().map(|(s, _)| *s).collect();
-        names.sort();
-        names.dedup();
-        assert_eq!(names.len(), 75);
-        assert!(names.contains(&"fmi3GetAdjointDerivative"));
-        assert!(names.contains(&"fmi3GetContinuousStateDerivatives"));
-    }
-
-    /// A shared library that is no FMU: the first core symbol is the error.
-    #[cfg(feature = "import")]
-    #[test]
-    fn a_library_without_the_core_functions_is_refused_naming_the_first() {
-        // SAFETY: the C library's initializers already ran in this process.
-        let libc = unsafe { libloading::Library::new("libc.so.6") }.unwrap();
-        let e = unsafe { Fmi3Functions::load(&libc) }.unwrap_err();
-        assert_eq!(e, MissingSymbol("fmi3GetVersion"));
+/// The function counts of `fmi3FunctionTypes.h` (3.0.2): 61 common (with the three
+/// instantiation functions), 10 Model Exchange, 3 Co-Simulation, 1 Scheduled Execution.
+#[test]
+fn the_symbols_are_those_of_the_header() {
+    use Fmi3Part::*;
+    assert_eq!(
+        [Common, ModelExchange, CoSimulation, ScheduledExecution].map(|p| symbols_of(p).count()),
+        [61, 10, 3, 1]
+    );
+    for name in ["fmi3GetAdjointDerivative", "fmi3GetContinuousStateDerivatives"] {
+        assert!(SYMBOLS.iter().any(|(s, _)| *s == name), "{name}");
     }
 }
