@@ -59,8 +59,8 @@
 //!   [`abi::table`] (symbol, its C type in `fmi-sys`, its [`Function`] variant, the layer
 //!   function and the C parameters): the exported wrapper, its compile-time signature check
 //!   and the `Function` variant come from that row. Then the layer function in
-//!   [`abi::fmi2`] or [`abi::fmi3`] (the `Function` first, pointers to slices, one call of
-//!   the instance under the shared guard: null checks, the state table, the panic catch,
+//!   [`abi::shared`] (both generations), [`abi::fmi2`] or [`abi::fmi3`] (the `Function`
+//!   first, pointers to slices, one call of the instance under the shared guard: null checks, the state table, the panic catch,
 //!   the logged message naming the function); the function's row of the allowed-states
 //!   table in [`states`] where the standard lists it in other states than its FMI 2.0
 //!   counterpart; what it does in the [`instance`] module of its concern (values, events
@@ -186,7 +186,7 @@
 //! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
 //! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
 //! the FMI semantics over a model, one submodule per concern); [`abi`] (the C entry points:
-//! the table [`abi::table`], the layer functions [`abi::fmi2`], [`abi::fmi3`]); with the
+//! the table [`abi::table`], the layer functions [`abi::fmi2`], [`abi::fmi3`], [`abi::shared`]); with the
 //! feature `testing`, `testing` (the in-process importer of the FMU crates' tests, both
 //! generations). The `Function` enum of [`states`] is expanded from [`abi::table`] (a
 //! macro, not an import: no circle).

@@ -873,18 +873,7 @@ fn a_model_can_override_the_fmu_state_format() {
     let guid = Own::declaration().guid().len();
     assert_eq!(bytes.len(), 8 + 4 + 4 + guid + 8 + 8 * (12 + 7));
     let g = Fmu::<Own>::cs();
-    let mut copy: fmi2FMUstate = null_mut();
-    unsafe {
-        let st = abi::deserialize_fmu_state::<Own>(
-            Function::DeSerializeFMUstate,
-            g.c,
-            bytes.as_ptr() as *const c_char,
-            bytes.len(),
-            &mut copy,
-        );
-        assert_eq!(st, OK, "{}", g.last_error());
-        assert_eq!(abi::set_fmu_state::<Own>(Function::SetFMUstate, g.c, copy), OK);
-    }
+    assert_eq!(g.restore_serialized(&bytes), OK, "{}", g.last_error());
     assert_eq!(g.step(0.25, 0.1), OK);
     assert_eq!(f.step(0.25, 0.1), OK);
     assert_eq!(g.real(vr::Y).to_bits(), f.real(vr::Y).to_bits());

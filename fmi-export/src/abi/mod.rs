@@ -1,9 +1,11 @@
-//! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): [`fmi2`],
-//! every `fmi2*` function, and [`fmi3`], every `fmi3*` function, each as a generic
-//! `unsafe fn` over the model type taking the [`Function`] it serves first; [`table`]
-//! lists them, and [`crate::export_fmi!`] instantiates the table as unmangled `extern "C"`
-//! symbols of one library. The FMI 2.0 ones are re-exported here too (`abi::get` is
-//! `abi::fmi2::get`).
+//! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): the layer
+//! functions of the `fmi2*` calls in [`fmi2`], of the `fmi3*` calls in [`fmi3`], and those
+//! both generations' calls share (the same pointers under other C names) in [`shared`],
+//! each a generic `unsafe fn` over the model type taking the [`Function`] it serves first;
+//! [`table`] lists which one serves which symbol, and [`crate::export_fmi!`] instantiates
+//! the table as unmangled `extern "C"` symbols of one library. The FMI 2.0 and shared ones
+//! are re-exported here too (`abi::get` is `abi::fmi2::get`, `abi::terminate`
+//! `abi::shared::terminate`).
 //!
 //! Rules kept here, and only here: null pointers and lengths are checked before a slice
 //! is made, panics are caught at every entry point, every error is logged through the

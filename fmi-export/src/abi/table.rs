@@ -20,7 +20,8 @@
 //!
 //! Adding an FMI function: one row here (its variant then exists; give it its row of the
 //! state table in `states.rs` if it differs from the default) and the layer function in
-//! `abi/fmi2.rs` or `abi/fmi3.rs`, taking the `Function` first.
+//! `abi/shared.rs` (when both generations' rows can call it) or in `abi/fmi2.rs` or
+//! `abi/fmi3.rs`, taking the `Function` first.
 
 /// Hands the table to the callback macro `$callback` (a path in brackets) with `$head`
 /// (one token tree, passed through) in front: `{head} fmi2 { rows } fmi3 { rows }`.
