@@ -247,6 +247,7 @@ impl<M: Model> Drop for Fmu<M> {
 
 // ------------------------------------------------------------------ FMI 3.0
 
+use crate::abi::fmi3::value::Float64;
 use crate::abi::fmi3::{self as abi3, status3};
 pub use fmi_sys::fmi3::Fmi3Status;
 use fmi_sys::fmi3::{fmi3FMUState, fmi3Instance, fmi3Status, FMI3_FALSE, FMI3_TRUE};
@@ -397,16 +398,8 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn get_float64(&self, vrs: &[u32], out: &mut [f64]) -> Fmi3Status {
-        unsafe {
-            abi3::get::<M, abi3::value::Float64>(
-                Function::Fmi3GetFloat64,
-                self.c,
-                vrs.as_ptr(),
-                vrs.len(),
-                out.as_mut_ptr(),
-                out.len(),
-            )
-        }
+        let (vr, n_vr) = (vrs.as_ptr(), vrs.len());
+        unsafe { abi3::get::<M, Float64>(Function::Fmi3GetFloat64, self.c, vr, n_vr, out.as_mut_ptr(), out.len()) }
     }
 
     pub fn float64(&self, vr: u32) -> f64 {
@@ -416,16 +409,8 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn set_float64(&self, vrs: &[u32], values: &[f64]) -> Fmi3Status {
-        unsafe {
-            abi3::set::<M, abi3::value::Float64>(
-                Function::Fmi3SetFloat64,
-                self.c,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_ptr(),
-                values.len(),
-            )
-        }
+        let (vr, n_vr) = (vrs.as_ptr(), vrs.len());
+        unsafe { abi3::set::<M, Float64>(Function::Fmi3SetFloat64, self.c, vr, n_vr, values.as_ptr(), values.len()) }
     }
 
     pub fn int32(&self, vr: u32) -> i32 {
