@@ -253,17 +253,45 @@ pub fn remove_on_signals_after_stop(stop: impl FnOnce(libc::c_int) + Send + 'sta
             }
             STOPPED_BY.store(first, std::sync::atomic::Ordering::SeqCst);
             stop(first);
-            let timeout = libc::timespec {
-                tv_sec: grace.as_secs() as libc::time_t,
-                tv_nsec: grace.subsec_nanos() as libc::c_long,
-            };
-            let second = libc::sigtimedwait(&set, std::ptr::null_mut(), &timeout);
+            let second = wait_for_signal(&set, grace);
             if second > 0 {
                 STOPPED_BY.store(second, std::sync::atomic::Ordering::SeqCst);
             }
             finish_stopped();
         });
     }
+}
+
+/// Waits up to `grace` for one of the blocked signals of `set` and returns it (0 when none came).
+#[cfg(target_os = "linux")]
+unsafe fn wait_for_signal(set: &libc::sigset_t, grace: std::time::Duration) -> libc::c_int {
+    let timeout =
+        libc::timespec { tv_sec: grace.as_secs() as libc::time_t, tv_nsec: grace.subsec_nanos() as libc::c_long };
+    // SAFETY: `set` and `timeout` are valid for the call.
+    unsafe { libc::sigtimedwait(set, std::ptr::null_mut(), &timeout) }
+}
+
+/// As on Linux, for the Unixes without `sigtimedwait` (macOS): polls the pending signals every
+/// 10 ms and takes a pending one with `sigwait`.
+#[cfg(all(unix, not(target_os = "linux")))]
+unsafe fn wait_for_signal(set: &libc::sigset_t, grace: std::time::Duration) -> libc::c_int {
+    let end = std::time::Instant::now() + grace;
+    while std::time::Instant::now() < end {
+        // SAFETY: plain libc calls on local signal sets.
+        unsafe {
+            let mut pending: libc::sigset_t = std::mem::zeroed();
+            if libc::sigpending(&mut pending) == 0 {
+                for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+                    let mut signal = 0;
+                    if libc::sigismember(&pending, s) == 1 && libc::sigwait(set, &mut signal) == 0 {
+                        return signal;
+                    }
+                }
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    0
 }
 
 /// The signal [`remove_on_signals_after_stop`] received, if any (the program then stops by
