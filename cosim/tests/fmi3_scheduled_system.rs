@@ -1,0 +1,129 @@
+//! FMI 3.0 Scheduled Execution of a system of several FMUs: two instances, A and B, of the C
+//! FMU `tests/cfmu/fmi3_se_node.c` (built twice, from two descriptions that differ in the
+//! priority of the partition `sample`), connected both ways (A.y -> B.u, a clocked input;
+//! A.y -> B.v and B.y -> A.v, unclocked) and clock to clock (A.done -> B.trigger). The
+//! partitions of both are activated at their ticks in priority order across the instances,
+//! the clocked values exchanged at the ticks; the fixed clock's interval is the FMU's after
+//! initialization, the tunable clock's new interval is taken when the FMU says. Every value
+//! derived by hand next to the test.
+
+mod common;
+use common::work_dir;
+use nigel_cosim::simulate::simulate_scheduled;
+use nigel_cosim::system::Value;
+use nigel_cosim::{Experiment, Fmu, ImportOptions, Interface, SystemBuilder};
+use std::path::{Path, PathBuf};
+
+/// The description, `sample` at priority `sample_priority`. The description's interval of
+/// the fixed clock `sample` is 1 s; the FMU gives its parameter `period` instead.
+fn xml(sample_priority: u32) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="se_node" instantiationToken="{{fmi3-se-node}}">
+  <ScheduledExecution modelIdentifier="fmi3_se_node"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <Clock name="sample" valueReference="1" causality="input" intervalVariability="fixed" intervalDecimal="1" priority="{sample_priority}"/>
+    <Clock name="trigger" valueReference="2" causality="input" intervalVariability="triggered" priority="2"/>
+    <Clock name="done" valueReference="3" causality="output" intervalVariability="triggered" clocks="1"/>
+    <Clock name="rate" valueReference="4" causality="input" intervalVariability="tunable" intervalDecimal="0.5" priority="3"/>
+    <Float64 name="period" valueReference="10" causality="parameter" variability="fixed" start="0.5"/>
+    <Float64 name="u" valueReference="11" causality="input" variability="discrete" start="0" clocks="2"/>
+    <Float64 name="v" valueReference="12" causality="input" variability="discrete" start="0"/>
+    <Float64 name="y" valueReference="13" causality="output" variability="discrete" clocks="1"/>
+    <Float64 name="z" valueReference="14" causality="output" variability="discrete" clocks="2"/>
+    <Float64 name="w" valueReference="15" causality="output" variability="discrete" clocks="1"/>
+    <Int32 name="n_sample" valueReference="20" causality="output" variability="discrete"/>
+    <Int32 name="n_trigger" valueReference="21" causality="output" variability="discrete"/>
+    <Int32 name="n_rate" valueReference="22" causality="output" variability="discrete"/>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="3"/>
+    <Output valueReference="13"/>
+    <Output valueReference="14"/>
+    <Output valueReference="15"/>
+    <Output valueReference="20"/>
+    <Output valueReference="21"/>
+    <Output valueReference="22"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#
+    )
+}
+
+/// The two FMUs: A's `sample` at priority 1, B's at priority 0; `None` (skip) without fmpy's
+/// headers.
+fn build(dir: &Path) -> Option<(PathBuf, PathBuf)> {
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    Some((common::fmi3_c::build(&a, "fmi3_se_node", &xml(1))?, common::fmi3_c::build(&b, "fmi3_se_node", &xml(0))?))
+}
+
+fn system(a: &Path, b: &Path) -> nigel_cosim::System {
+    let options = ImportOptions { interface: Some(Interface::ScheduledExecution), ..ImportOptions::default() };
+    let mut s = SystemBuilder::new();
+    s.add_instance("A", Fmu::load_with(a, &options).unwrap()).unwrap();
+    s.add_instance("B", Fmu::load_with(b, &options).unwrap()).unwrap();
+    s.set("B.period", Value::Real(0.25)).unwrap();
+    s.connect("A.y", "B.u").unwrap();
+    s.connect("A.y", "B.v").unwrap();
+    s.connect("B.y", "A.v").unwrap();
+    s.connect("A.done", "B.trigger").unwrap();
+    s.build()
+}
+
+/// The ticks, derived by hand (stop 2 s, ticks in [0, 2)):
+/// - A.sample every 0.5 s (A's period, not the description's 1 s): 0, 0.5, 1, 1.5;
+///   B.sample every 0.25 s (B.period = 0.25): 0, 0.25, ..., 1.75. y = the partition's count.
+/// - B.trigger at A.done's ticks, which A.sample ticks: 0, 0.5, 1, 1.5 (priority 2: after
+///   both samples at the same time).
+/// - rate (tunable, 0.5 s) of both: 0 and 0.5; at its 2nd activation (0.5) the FMU makes
+///   the interval 0.75 s: next 0.5 + 0.75 = 1.25, then 2 (not < 2). Three activations each.
+///
+/// Where A.sample and B.sample tick together (0, 0.5, 1, 1.5) B's (priority 0) runs first:
+/// - B.w = B.v = A.y before A's activation at that time = A's activations before t:
+///   0, 1, 1, 2, 2, 3, 3, 4 at 0, 0.25, ..., 1.75 (and 4 at the stop row).
+/// - A.w = A.v = B.y after B's activation at t = B's count at t: 1, 3, 5, 7 at 0, 0.5, 1, 1.5.
+/// - B.z = B.u at B.trigger = A.y after A's activation at t: 1, 2, 3, 4.
+///
+/// Rows at every tick time and at the stop time, holding the values after the activations.
+#[test]
+fn partitions_of_two_fmus_tick_in_priority_order_across_them_and_exchange_at_their_ticks() {
+    let dir = work_dir("fmi3-scheduled-system");
+    let Some((a, b)) = build(&dir) else { return };
+    let system = system(&a, &b);
+    let experiment = Experiment::new(2.0, 0.25);
+    let (r, outcome) = simulate_scheduled(&system, &experiment);
+    let summary = outcome.unwrap();
+    assert_eq!(
+        summary.notes,
+        [
+            "Scheduled Execution: partitions activated: A.sample 4, A.trigger 0, A.rate 3, B.sample 8, B.trigger 4, B.rate 3",
+            "Scheduled Execution: output clocks ticked: A.done 4, B.done 8",
+        ]
+    );
+    let col = |n: &str| r.column(n).unwrap_or_else(|| panic!("column {n}"));
+    assert_eq!(col("time"), [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0]);
+    assert_eq!(col("A.n_sample"), [1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 4.0]);
+    assert_eq!(col("B.n_sample"), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 8.0]);
+    assert_eq!(col("A.y"), col("A.n_sample"));
+    assert_eq!(col("B.w"), [0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0]);
+    assert_eq!(col("A.w"), [1.0, 1.0, 3.0, 3.0, 5.0, 5.0, 7.0, 7.0, 7.0]);
+    assert_eq!(col("B.z"), [1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 4.0]);
+    assert_eq!(col("B.n_trigger"), col("B.z"));
+    assert_eq!(col("A.n_trigger"), [0.0; 9]);
+    for name in ["A.n_rate", "B.n_rate"] {
+        assert_eq!(col(name), [1.0, 1.0, 2.0, 2.0, 2.0, 3.0, 3.0, 3.0, 3.0], "{name}");
+    }
+    // the clock columns: 1 at the rows where the clock ticked
+    let a_sample = [1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0];
+    assert_eq!(col("A.sample"), a_sample);
+    assert_eq!(col("A.done"), a_sample);
+    assert_eq!(col("B.trigger"), a_sample);
+    assert_eq!(col("B.sample"), [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0]);
+    assert_eq!(col("B.rate"), [1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+    // deterministic: a second run is the same, bit for bit
+    let (again, _) = simulate_scheduled(&system, &experiment);
+    assert_eq!(again.values, r.values);
+}
