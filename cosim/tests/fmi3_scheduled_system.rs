@@ -127,3 +127,77 @@ fn partitions_of_two_fmus_tick_in_priority_order_across_them_and_exchange_at_the
     let (again, _) = simulate_scheduled(&system, &experiment);
     assert_eq!(again.values, r.values);
 }
+
+/// The same system as an SSP (SSP 2.0 draft clock connectors), run with `cosim run
+/// --interface se` and B.period from `--set`: the CSV holds the values derived above.
+#[test]
+fn an_ssp_of_scheduled_fmus_runs_from_the_command_line() {
+    let dir = work_dir("fmi3-scheduled-ssp");
+    let Some((a, b)) = build(&dir) else { return };
+    let connector = |name: &str, kind: &str, declared: &str| {
+        format!(r#"<ssd:Connector name="{name}" kind="{kind}">{declared}</ssd:Connector>"#)
+    };
+    let (real, clock) = ("<ssc:Real/>", r#"<ssc:Clock intervalVariability="triggered"/>"#);
+    let component = |name: &str| {
+        let connectors = [
+            connector("y", "output", real),
+            connector("u", "input", real),
+            connector("v", "input", real),
+            connector("done", "output", clock),
+            connector("trigger", "input", clock),
+        ]
+        .concat();
+        format!(
+            r#"<ssd:Component name="{name}" source="resources/{name}.fmu"><ssd:Connectors>{connectors}</ssd:Connectors></ssd:Component>"#
+        )
+    };
+    let connection = |a: &str, x: &str, b: &str, y: &str| {
+        format!(r#"<ssd:Connection startElement="{a}" startConnector="{x}" endElement="{b}" endConnector="{y}"/>"#)
+    };
+    let connections = [
+        connection("A", "y", "B", "u"),
+        connection("A", "y", "B", "v"),
+        connection("B", "y", "A", "v"),
+        connection("A", "done", "B", "trigger"),
+    ]
+    .concat();
+    let ssd = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="2.0" name="scheduled">
+  <ssd:System name="root">
+    <ssd:Elements>{}{}</ssd:Elements>
+    <ssd:Connections>{connections}</ssd:Connections>
+  </ssd:System>
+</ssd:SystemStructureDescription>"#,
+        component("A"),
+        component("B")
+    );
+    let ssp = dir.join("scheduled.ssp");
+    common::zip_entries(
+        &ssp,
+        &[
+            ("SystemStructure.ssd", ssd.into_bytes()),
+            ("resources/A.fmu", std::fs::read(&a).unwrap()),
+            ("resources/B.fmu", std::fs::read(&b).unwrap()),
+        ],
+    );
+    let csv = dir.join("out.csv");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
+        .args(["run", ssp.to_str().unwrap(), "--interface", "se", "--stop-time", "2", "--set", "B.period=0.25", "-o"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    let col = |name: &str| {
+        let j = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("column {name} in {header:?}"));
+        rows.iter().map(|r| r[j]).collect::<Vec<f64>>()
+    };
+    assert_eq!(col("time"), [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0]);
+    assert_eq!(col("B.w"), [0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0]);
+    assert_eq!(col("A.w"), [1.0, 1.0, 3.0, 3.0, 5.0, 5.0, 7.0, 7.0, 7.0]);
+    assert_eq!(col("B.z"), [1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 4.0]);
+}
