@@ -8,33 +8,46 @@
 
 mod common;
 use common::work_dir;
-use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System};
+use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, InputTable, Interface, System};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// A run from 0 to 1 s with steps of 0.1 s, `u` from an input file: a discrete input, held
-/// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
-///
-/// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
-/// time 1 s is not run). At the k-th tick τ_k the master applies the last set of `u` (the
-/// input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held until the next tick:
-/// y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 = 10·7 + 4 = 74. The
-/// sets of `u` between ticks are queued (the FMU refuses them). A row holds the values before the
-/// ticks at its time: the row at 0 s the start value -1, a row at t > 0 the y of the last
-/// tick before t.
-#[test]
-fn clocked_variables_are_held_between_ticks_and_set_at_them() {
-    let dir = work_dir("clocked-exchange");
-    let Some(path) =
-        common::fmi3_c::build(&dir, "fmi3_clocked_exchange", include_str!("cfmu/fmi3_clocked_exchange.xml"))
-    else {
-        return;
+/// The test FMU built in `dir` with the description declaring `interface` (`None`: no
+/// fmpy, skipped).
+fn exchange_fmu(dir: &Path, interface: Interface) -> Option<PathBuf> {
+    let xml = include_str!("cfmu/fmi3_clocked_exchange.xml");
+    let cs = r#"<CoSimulation modelIdentifier="fmi3_clocked_exchange" hasEventMode="true" canHandleVariableCommunicationStepSize="true"/>"#;
+    assert!(xml.contains(cs), "the description's CoSimulation element");
+    let xml = match interface {
+        Interface::CoSimulation => xml.to_string(),
+        Interface::ModelExchange => xml.replace(cs, r#"<ModelExchange modelIdentifier="fmi3_clocked_exchange"/>"#),
+        // a partition needs a priority
+        Interface::ScheduledExecution => xml
+            .replace(cs, r#"<ScheduledExecution modelIdentifier="fmi3_clocked_exchange"/>"#)
+            .replace(r#"intervalDecimal="0.25"/>"#, r#"intervalDecimal="0.25" priority="0"/>"#),
     };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    common::fmi3_c::build(dir, "fmi3_clocked_exchange", &xml)
+}
+
+/// The system of the FMU loaded for `interface`, `u` from the input file of the tests.
+fn run_exchange(path: &Path, interface: Interface) -> nigel_cosim::Results {
+    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    let system = System::single("c", Fmu::load_with(path, &options).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.0, 0.1);
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["u".into()], vec![0.0, 0.2, 0.4, 0.7], vec![vec![0.0, 2.0, 4.0, 7.0]]).unwrap(),
     ));
-    let (results, _) = simulate(&system, &experiment).unwrap();
+    if interface == Interface::ScheduledExecution {
+        let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
+        outcome.unwrap();
+        return results;
+    }
+    simulate(&system, &experiment).unwrap().0
+}
+
+/// The held values of the test below at each row: y of the last tick before the row's
+/// time (the row holds the values before the ticks at its time).
+fn check_held(results: &nigel_cosim::Results) {
     let time = results.column("time").unwrap();
     let y = results.column("y").unwrap();
     let t_now = results.column("t_now").unwrap();
@@ -49,4 +62,47 @@ fn clocked_variables_are_held_between_ticks_and_set_at_them() {
         // the master's step starts and sizes, within ulps of the row's t0 + n h
         assert!((t_now - t).abs() < 1e-12, "t_now {t_now} at t = {t} s");
     }
+}
+
+/// A run from 0 to 1 s with steps of 0.1 s, `u` from an input file: a discrete input, held
+/// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
+///
+/// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
+/// time 1 s is not run). At the k-th tick τ_k the master applies the last set of `u` (the
+/// input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held until the next tick:
+/// y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 = 10·7 + 4 = 74. The
+/// sets of `u` between ticks are queued (the FMU refuses them). A row holds the values before the
+/// ticks at its time: the row at 0 s the start value -1, a row at t > 0 the y of the last
+/// tick before t.
+#[test]
+fn clocked_variables_are_held_between_ticks_and_set_at_them() {
+    let dir = work_dir("clocked-exchange");
+    let Some(path) = exchange_fmu(&dir, Interface::CoSimulation) else { return };
+    check_held(&run_exchange(&path, Interface::CoSimulation));
+}
+
+/// The same in Model Exchange (the instance integrated on its own, no states): the ticks
+/// run in events between fmi3EnterEventMode and fmi3EnterContinuousTimeMode, the same rows
+/// and held values as derived above.
+#[test]
+fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
+    let dir = work_dir("clocked-exchange-me");
+    let Some(path) = exchange_fmu(&dir, Interface::ModelExchange) else { return };
+    check_held(&run_exchange(&path, Interface::ModelExchange));
+}
+
+/// The same in Scheduled Execution: `u` set once before each fmi3ActivateModelPartition of
+/// tick (the input file's value at the tick: 0, 2, 4, 7), y read right after it. The rows
+/// are at the ticks 0, 0.25, 0.5, 0.75 s and the stop time 1 s and hold the values after
+/// the activations: y = 1, 22, 43, 74, then 74 held (derived above). t_now is the
+/// activation's time.
+#[test]
+fn scheduled_execution_exchanges_clocked_variables_at_their_activations_only() {
+    let dir = work_dir("clocked-exchange-se");
+    let Some(path) = exchange_fmu(&dir, Interface::ScheduledExecution) else { return };
+    let results = run_exchange(&path, Interface::ScheduledExecution);
+    assert_eq!(results.column("time").unwrap(), [0.0, 0.25, 0.5, 0.75, 1.0]);
+    assert_eq!(results.column("y").unwrap(), [1.0, 22.0, 43.0, 74.0, 74.0]);
+    assert_eq!(results.column("t_now").unwrap(), [0.0, 0.25, 0.5, 0.75, 0.75]);
+    assert_eq!(results.column("tick").unwrap(), [1.0, 1.0, 1.0, 1.0, 0.0]);
 }
