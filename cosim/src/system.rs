@@ -329,6 +329,17 @@ impl System {
         format!("{}.{}", self.instances[r.instance].name, self.variable(r).name)
     }
 
+    /// Whether `r` is an FMI 3.0 structural parameter (set in Configuration Mode, and a
+    /// tunable one in Reconfiguration Mode).
+    pub fn is_structural(&self, r: &VariableRef) -> bool {
+        let name = &self.variable(r).name;
+        self.instances[r.instance].fmu.fmi3_description().is_some_and(|md| {
+            md.model_variables
+                .iter()
+                .any(|x| &x.name == name && x.causality == model_description::fmi3::Causality::StructuralParameter)
+        })
+    }
+
     /// The ScalarVariable of a resolved reference.
     pub fn variable(&self, r: &VariableRef) -> &ScalarVariable {
         &self.description(r.instance).model_variables[r.index]
@@ -495,6 +506,29 @@ impl SystemBuilder {
     fn configure(&mut self, i: usize, name: &str, value: f64) -> Result<()> {
         let spec = &self.system.instances[i];
         let fmu = spec.fmu.configured(&spec.name, &[(name, value)])?;
+        self.replace_fmu(i, fmu, name, value)
+    }
+
+    /// Sizes the results for the FMI 3.0 tunable structural parameter `variable`
+    /// (`instance.parameter`) taking the value `value` during the run, in Reconfiguration
+    /// Mode ([`crate::simulate::Execution::reconfigure`]): the instance's FMU becomes
+    /// [`Fmu::sized_for`] it (the arrays it sizes have a column per element they can have;
+    /// the instance starts with its own value), what the system refers to in it found again
+    /// by name.
+    pub fn size_for(&mut self, variable: &str, value: f64) -> Result<&mut Self> {
+        let r = self.system.resolve(variable)?;
+        let name = self.system.variable(&r).name.clone();
+        let spec = &self.system.instances[r.instance];
+        let fmu = spec.fmu.sized_for(&spec.name, &[(&name, value)])?;
+        self.replace_fmu(r.instance, fmu, &name, value)?;
+        Ok(self)
+    }
+
+    /// Instance `i` with the FMU `fmu`, a view of the same FMU resized by its structural
+    /// parameter `name` (the value `value`, for errors): start values and connections found
+    /// again by name.
+    fn replace_fmu(&mut self, i: usize, fmu: Arc<Fmu>, name: &str, value: f64) -> Result<()> {
+        let spec = &self.system.instances[i];
         let old = spec.fmu.description().clone();
         let new = fmu.description();
         let gone = |index: usize| {

@@ -42,6 +42,11 @@ pub(crate) struct Fmi3Abi {
     /// variable and the value; empty: Configuration Mode is not entered). See
     /// [`crate::structural`].
     pub(crate) configuration: Vec<(Access, f64)>,
+    /// The structural parameters whose value at the start (after Configuration Mode) is
+    /// not the one the view is sized for (the FMU's value reference and the value; empty
+    /// but for an FMU [sized for](crate::Fmu::sized_for) a change in Reconfiguration Mode):
+    /// the arrays they size have fewer elements than the view until then.
+    pub(crate) initial_sizes: Vec<(u32, f64)>,
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
@@ -146,7 +151,7 @@ const MAX_ELEMENTS: u64 = 100_000;
 
 /// The size of each dimension of `v` (a `valueReference` dimension: the start value of
 /// the variable it names).
-fn sizes(md: &fmi3::ModelDescription, v: &fmi3::Variable) -> Option<Vec<u64>> {
+pub(crate) fn sizes(md: &fmi3::ModelDescription, v: &fmi3::Variable) -> Option<Vec<u64>> {
     v.dimensions
         .iter()
         .map(|d| match *d {

@@ -145,6 +145,7 @@ impl Fmu {
                 token: a.token.clone(),
                 resource_path: a.resource_path.clone(),
                 configuration: a.configuration.clone(),
+                initial_sizes: a.initial_sizes.clone(),
             })),
         };
         Arc::new(Fmu {

@@ -80,6 +80,9 @@ pub struct Execution<'s> {
     pool: Option<&'s mut InstancePool>,
     /// Values from [`Execution::set`] for the next step.
     pending: Vec<(VariableRef, Value)>,
+    /// Tunable structural parameters from [`Execution::reconfigure`] for the next step:
+    /// (instance, parameter, value).
+    reconfigurations: Vec<(usize, String, f64)>,
     core: Option<Core>,
     profiler: Option<Profiler>,
     /// The next communication step (`n`: the run is at `t0 + n h`).
@@ -194,6 +197,7 @@ impl<'s> Execution<'s> {
             observers: Vec::new(),
             pool: None,
             pending: Vec::new(),
+            reconfigurations: Vec::new(),
             core: None,
             profiler: None,
             next: 0,
@@ -512,6 +516,9 @@ impl<'s> Execution<'s> {
         let Some(core) = self.core.as_mut() else { return Err(not_running(self.phase)) };
         let registered = crate::exit_guard::Registered::new(self.recorder.shared.clone());
         let outcome = (|| -> Result<()> {
+            for (i, name, value) in std::mem::take(&mut self.reconfigurations) {
+                core.lanes[i].inst.reconfigure(&[(&name, value)])?;
+            }
             if !self.pending.is_empty() {
                 apply_values(core, std::mem::take(&mut self.pending))?;
             }
@@ -568,9 +575,31 @@ impl<'s> Execution<'s> {
 
     /// Sets an input no connection feeds, or a tunable parameter, from the next
     /// communication step on (`name`: `instance.variable`; `text`: a value of its type).
+    /// A tunable structural parameter goes through Reconfiguration Mode
+    /// ([`Execution::reconfigure`]).
     pub fn set(&mut self, name: &str, text: &str) -> Result<()> {
+        if let Ok(r) = self.system.resolve(name) {
+            if self.system.is_structural(&r) {
+                let value = text.trim().parse::<f64>().map_err(|_| {
+                    Error::Experiment(format!("{name} = {text:?}: a structural parameter's value is a number"))
+                })?;
+                return self.reconfigure(name, value);
+            }
+        }
         let (r, value) = crate::simulate::between::checked_value(&self.system, name, text)?;
         self.pending.push((r, value));
+        Ok(())
+    }
+
+    /// Sets the FMI 3.0 tunable structural parameter `name` (`instance.parameter`) to
+    /// `value` in Reconfiguration Mode before the next communication step (a Co-Simulation
+    /// instance in process; see [`crate::Instance::reconfigure`]). The arrays it sizes have
+    /// their new size from then on: the results keep the columns the system was built with
+    /// ([`crate::SystemBuilder::size_for`] sizes them for the largest), NaN in the elements an
+    /// array lacks at a row.
+    pub fn reconfigure(&mut self, name: &str, value: f64) -> Result<()> {
+        let r = self.system.resolve(name)?;
+        self.reconfigurations.push((r.instance, self.system.variable(&r).name.clone(), value));
         Ok(())
     }
 

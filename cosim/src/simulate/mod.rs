@@ -39,7 +39,7 @@ mod types;
 
 pub use between::{Manipulator, SetQueue, StepInstances};
 pub use clock::Point;
-pub use driver::{run_to_end, simulate, simulate_recorded, simulate_with};
+pub use driver::{run_to_end, run_to_end_with, simulate, simulate_recorded, simulate_with, TimedSet};
 pub use execution::{Execution, InstancePool, Phase, RowSink};
 pub use input::InputTable;
 pub use lane::apply_start_values;

@@ -285,14 +285,17 @@ impl Instance {
         const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
         let any = values.iter().fold(false, |any, v| any | (v.to_bits() & EXPONENT == EXPONENT));
         if any && !self.core.fmu.allow_non_finite {
-            return Err(self.non_finite(vrs, values));
+            return self.non_finite(vrs, values).map_or(Ok(()), Err);
         }
         Ok(())
     }
 
+    /// The error of the first value that is not finite, `None` when each is the NaN of an
+    /// array element that is not there now (a structural parameter made the array smaller
+    /// than the view).
     #[cold]
-    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Error {
-        let k = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Option<Error> {
+        let k = vrs.iter().zip(values).position(|(vr, v)| !v.is_finite() && !self.calls.absent_element(*vr))?;
         let variable = self
             .core
             .fmu
@@ -301,13 +304,13 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
-        Error::NonFinite {
+        Some(Error::NonFinite {
             instance: self.core.name.clone(),
             fmu: self.core.fmu.source.clone(),
             variable,
             value: values[k],
             time: self.core.time,
-        }
+        })
     }
 
     /// `fmi2SetReal` / `fmi3SetFloat64` (the other FMI 3.0 types as for [`Instance::get_real`]).
