@@ -270,6 +270,18 @@ s.freeInstance()
         .collect();
     let (_, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "n=3"]).unwrap();
     assert_eq!(rows[2][1..], theirs);
+    // Model Exchange: the change in an event at 0.5 s (Event Mode), the same rows (y = k u t
+    // at the time set)
+    let me = work_dir("fmi3-reconfiguration-me");
+    let me_xml = tunable_xml().replace(
+        r#"<CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>"#,
+        r#"<ModelExchange modelIdentifier="fmi3_sized"/>"#,
+    );
+    let Some(me_fmu) = common::fmi3_c::build(&me, "fmi3_sized", &me_xml) else { return };
+    let (header, rows) = run_cli(&me_fmu, &me, &["--set-at", "0.5", "n=3"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
+    let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
+    assert_eq!(cells, [vec!["0", "0", "0", "NaN"], vec!["0.5", "0.5", "0.5", "NaN"], vec!["1", "1", "1", "1"]]);
     // a fixed structural parameter is not changed during a run
     let fixed = work_dir("fmi3-reconfiguration-fixed");
     let Some(fmu) = common::fmi3_c::build(&fixed, "fmi3_sized", XML) else { return };

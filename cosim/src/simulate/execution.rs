@@ -515,11 +515,12 @@ impl<'s> Execution<'s> {
 
     /// Steps `self.next..end`, telling the observers after each.
     fn advance(&mut self, end: u64) -> Result<()> {
+        let now = self.time();
         let Some(core) = self.core.as_mut() else { return Err(not_running(self.phase)) };
         let registered = crate::exit_guard::Registered::new(self.recorder.shared.clone());
         let outcome = (|| -> Result<()> {
             for (i, name, value) in std::mem::take(&mut self.reconfigurations) {
-                core.lanes[i].inst.reconfigure(&[(&name, value)])?;
+                reconfigure(core, i, &name, value, now)?;
             }
             if !self.pending.is_empty() {
                 apply_values(core, std::mem::take(&mut self.pending))?;
@@ -782,6 +783,27 @@ fn not_running(phase: Phase) -> Error {
 }
 
 /// The values of [`Execution::set`], before the next step.
+/// Instance `i` sets its tunable structural parameter `name` to `value` in Reconfiguration
+/// Mode at `time`: a Co-Simulation instance between steps (from Step Mode), a Model
+/// Exchange one in an event of its group (Event Mode, the event iterated after and the
+/// integrator restarted, as for an input event).
+fn reconfigure(core: &mut Core, i: usize, name: &str, value: f64, time: f64) -> Result<()> {
+    let set = [(name, value)];
+    if let Some(group) = core.group.as_mut().filter(|g| g.contains(i)) {
+        group.input_event(core.lanes.as_mut_slice(), time, "reconfiguration", &[i], |lanes| {
+            Ok(lanes[i].inst.reconfigure(&set)?)
+        })?;
+        return group.ended(core.lanes.as_mut_slice(), time);
+    }
+    let lane = &mut core.lanes[i];
+    if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
+        let mut one = crate::simulate::me_group::Solo { inst: &mut lane.inst, unit };
+        solo.input_event(&mut one, time, "reconfiguration", &[i], |one| Ok(one.inst.reconfigure(&set)?))?;
+        return solo.ended(&mut one, time);
+    }
+    Ok(lane.inst.reconfigure(&set)?)
+}
+
 fn apply_values(core: &mut Core, values: Vec<(VariableRef, Value)>) -> Result<()> {
     for (r, value) in values {
         crate::simulate::between::set_value(&mut core.lanes[r.instance].inst, &r, value)?;

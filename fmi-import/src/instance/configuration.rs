@@ -3,8 +3,9 @@
 //! and `fmi3ExitConfigurationMode`, right after instantiation (and after a reset), before
 //! any other value is set: an FMU sizes its arrays when it leaves Configuration Mode.
 //! Reconfiguration Mode ([`Instance::reconfigure`]): a tunable structural parameter set the
-//! same way between two communication steps of a Co-Simulation instance (from Step Mode),
-//! the arrays it sizes read and set with their new size from then on.
+//! same way between two communication steps of a Co-Simulation instance (from Step Mode) or
+//! in an event of a Model Exchange instance (from Event Mode), the arrays it sizes read and
+//! set with their new size from then on.
 
 use super::core::{call, Core, InstanceState};
 use super::fmi3::Fmi3;
@@ -57,12 +58,11 @@ impl Fmi3 {
                 "Reconfiguration Mode is not forwarded to a host process: run without isolation".into(),
             ));
         }
-        if core.fmu.interface() != Interface::CoSimulation {
+        if core.fmu.interface() == Interface::ScheduledExecution {
             return Err(bad(
                 first,
                 *x,
-                "Reconfiguration Mode between steps is run for Co-Simulation instances only (not Model Exchange or \
-                 Scheduled Execution)"
+                "Reconfiguration Mode is run for Co-Simulation and Model Exchange instances (not Scheduled Execution)"
                     .into(),
             ));
         }
@@ -134,13 +134,14 @@ impl Fmi3 {
 }
 
 impl Instance {
-    /// Reconfiguration Mode between two communication steps of a Co-Simulation instance:
-    /// `fmi3EnterConfigurationMode` (from Step Mode), the setters of the tunable structural
-    /// parameters `values` (name, value), `fmi3ExitConfigurationMode`. The arrays they size
+    /// Reconfiguration Mode between two communication steps of a Co-Simulation instance
+    /// (from Step Mode) or of a Model Exchange instance in Event Mode (the caller enters it
+    /// and iterates the event after): `fmi3EnterConfigurationMode`, the setters of the
+    /// tunable structural parameters `values` (name, value), `fmi3ExitConfigurationMode`. The arrays they size
     /// have their new size from then on: the elements of the view they lack read as NaN,
     /// and a set of one is an error naming it. A parameter that is not tunable, a size beyond
-    /// the view's (see [`crate::Fmu::sized_for`]), a Model Exchange, Scheduled Execution or
-    /// isolated instance are errors naming the parameter and the reason.
+    /// the view's (see [`crate::Fmu::sized_for`]), a Scheduled Execution or isolated instance
+    /// are errors naming the parameter and the reason.
     pub fn reconfigure(&mut self, values: &[(&str, f64)]) -> Result<()> {
         self.calls.reconfigure(&mut self.core, values)
     }
