@@ -282,6 +282,16 @@ s.freeInstance()
     assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
     let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
     assert_eq!(cells, [vec!["0", "0", "0", "NaN"], vec!["0.5", "0.5", "0.5", "NaN"], vec!["1", "1", "1", "1"]]);
+    // an array n sizes as an event indicator: the integrator's count cannot change
+    let indicators = work_dir("fmi3-reconfiguration-me-indicators");
+    let xml = me_xml.replace(
+        r#"<InitialUnknown valueReference="4"/>"#,
+        r#"<InitialUnknown valueReference="4"/>
+    <EventIndicator valueReference="4"/>"#,
+    );
+    let Some(fmu) = common::fmi3_c::build(&indicators, "fmi3_sized", &xml) else { return };
+    let e = run_cli(&fmu, &indicators, &["--set-at", "0.5", "n=3"]).unwrap_err();
+    assert!(e.contains("it sizes y, a continuous state, derivative or event indicator of a Model Exchange FMU"), "{e}");
     // a fixed structural parameter is not changed during a run
     let fixed = work_dir("fmi3-reconfiguration-fixed");
     let Some(fmu) = common::fmi3_c::build(&fixed, "fmi3_sized", XML) else { return };

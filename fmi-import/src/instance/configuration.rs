@@ -118,6 +118,29 @@ impl Fmi3 {
                     ),
                 ));
             }
+            // Model Exchange: the integrator keeps the states and event indicators it has
+            if core.fmu.interface() == Interface::ModelExchange {
+                let structure = &md.model_structure;
+                let states: Vec<u32> = structure
+                    .continuous_state_derivatives
+                    .iter()
+                    .chain(&structure.event_indicators)
+                    .map(|u| u.value_reference)
+                    .chain(md.model_variables.iter().filter_map(|d| d.derivative))
+                    .collect();
+                let sized = md.model_variables.iter().filter(|a| a.dimensions.contains(&fmi3::Dimension::Variable(vr)));
+                if let Some(array) = sized.map(|a| (a.value_reference, &a.name)).find(|(a, _)| states.contains(a)) {
+                    let array = array.1;
+                    return Err(bad(
+                        name,
+                        *value,
+                        format!(
+                            "it sizes {array}, a continuous state, derivative or event indicator of a Model Exchange \
+                             FMU: the integrator cannot change its number of states during the run"
+                        ),
+                    ));
+                }
+            }
             sets.push((Access { vr, value_type: v.value_type, element: 0, count: 1 }, *value));
         }
         let enter = core.optional(self.abi().functions.enter_configuration_mode, "fmi3EnterConfigurationMode")?;
