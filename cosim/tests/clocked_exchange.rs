@@ -45,18 +45,23 @@ fn run_exchange(path: &Path, interface: Interface) -> nigel_cosim::Results {
     simulate(&system, &experiment).unwrap().0
 }
 
-/// The held values of the test below at each row: y of the last tick before the row's
-/// time (the row holds the values before the ticks at its time).
-fn check_held(results: &nigel_cosim::Results) {
+/// The held values of the test below at each row. `open`: the row at a tick after the
+/// start is recorded with the tick's event open (Co-Simulation, docs/clocks.md), where this
+/// FMU answers the tick's y (it computes y in fmi3SetClock and again on a set of u while
+/// active), the tick at the stop time (k = 5, y = 10·7 + 5 = 75) opened for the last row;
+/// else (Model Exchange) a row holds the values before the ticks at its time: y of the last
+/// tick before it. The row at 0 s holds what initialization left, -1, in both.
+fn check_held(results: &nigel_cosim::Results, open: bool) {
     let time = results.column("time").unwrap();
     let y = results.column("y").unwrap();
     let t_now = results.column("t_now").unwrap();
-    let ticks = [(0.0, 1.0), (0.25, 22.0), (0.5, 43.0), (0.75, 74.0)];
+    let ticks = [(0.0, 1.0), (0.25, 22.0), (0.5, 43.0), (0.75, 74.0), (1.0, 75.0)];
     // rows at the points 0, 0.1, ..., 1 s and at the ticks between points, 0.25 and 0.75 s
     assert_eq!(time.len(), 13, "{time:?}");
     for ((t, y), t_now) in time.iter().zip(&y).zip(&t_now) {
         // ticks and points differ by ulps at most: 1e-9 s apart
-        let expected = ticks.iter().rev().find(|(tick, _)| *tick < t - 1e-9).map_or(-1.0, |(_, y)| *y);
+        let before = |tick: f64| if open && *t > 1e-9 { tick < t + 1e-9 } else { tick < t - 1e-9 };
+        let expected = ticks.iter().rev().find(|(tick, _)| before(*tick)).map_or(-1.0, |(_, y)| *y);
         assert_eq!(*y, expected, "y at t = {t} s");
         // the variable that is not clocked is read at every row: the FMU's time, the sum of
         // the master's step starts and sizes, within ulps of the row's t0 + n h
@@ -68,17 +73,18 @@ fn check_held(results: &nigel_cosim::Results) {
 /// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
 ///
 /// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
-/// time 1 s is not run). At the k-th tick τ_k the master applies the last set of `u` (the
-/// input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held until the next tick:
-/// y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 = 10·7 + 4 = 74. The
-/// sets of `u` between ticks are queued (the FMU refuses them). A row holds the values before the
-/// ticks at its time: the row at 0 s the start value -1, a row at t > 0 the y of the last
-/// tick before t.
+/// time 1 s is opened for the last row only). At the k-th tick τ_k the master applies the
+/// last set of `u` (the input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held
+/// until the next tick: y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 =
+/// 10·7 + 4 = 74 (y_5 = 75 at the stop). The sets of `u` between ticks are queued (the FMU
+/// refuses them). The row at 0 s holds the start value -1; a row at a later tick is recorded
+/// with its event open, where the FMU answers the tick's y; a row between ticks the y of the
+/// last tick before it (`check_held`).
 #[test]
 fn clocked_variables_are_held_between_ticks_and_set_at_them() {
     let dir = work_dir("clocked-exchange");
     let Some(path) = exchange_fmu(&dir, Interface::CoSimulation) else { return };
-    check_held(&run_exchange(&path, Interface::CoSimulation));
+    check_held(&run_exchange(&path, Interface::CoSimulation), true);
 }
 
 /// The same in Model Exchange (the instance integrated on its own, no states): the ticks
@@ -88,7 +94,7 @@ fn clocked_variables_are_held_between_ticks_and_set_at_them() {
 fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
     let dir = work_dir("clocked-exchange-me");
     let Some(path) = exchange_fmu(&dir, Interface::ModelExchange) else { return };
-    check_held(&run_exchange(&path, Interface::ModelExchange));
+    check_held(&run_exchange(&path, Interface::ModelExchange), false);
 }
 
 /// The same in Scheduled Execution: `u` set once before each fmi3ActivateModelPartition of
