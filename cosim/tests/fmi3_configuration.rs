@@ -242,6 +242,10 @@ fn a_tunable_structural_parameter_changes_between_steps_in_reconfiguration_mode(
     assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
     let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
     assert_eq!(cells, [vec!["0", "0", "0", "0"], vec!["0.5", "0.5", "0.5", "0.5"], vec!["1", "1", "NaN", "NaN"]]);
+    // an input set the same way is a plain set: u = 2 from 0.5 s, y = k u t = 2 at 1 s
+    let (header, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "u=2"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]"]);
+    assert_eq!(rows[2], ["1", "2", "2"]);
     // fmpy's low-level calls through the same change: Reconfiguration Mode from Step Mode
     // after the first step, y read with its three elements after the second
     let script = r#"
