@@ -61,6 +61,11 @@ fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
     }
 }
 
+/// The values of the red zone after dvUnknown (a NaN no FMU computes by arithmetic) and
+/// their number (64 bytes).
+const DV_RED_ZONE: f64 = f64::from_bits(0x7ff8_dead_beef_0001);
+const DV_RED_ZONE_LEN: usize = 8;
+
 impl Instance {
     /// `fmi2Instantiate` / `fmi3Instantiate*` with the FMU's interface, logging off
     /// (warnings and errors are still logged by the FMU and kept); an FMU
@@ -484,6 +489,9 @@ impl Instance {
 
     /// The directional derivative at the instance's current point: `dv_unknown` =
     /// d(unknowns)/d(knowns) `dv_known` (FMI 2.0 section 2.1.9, FMI 3.0 section 2.2.11).
+    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown`, or
+    /// (FMI 2.0) past a block it allocated through `allocateMemory`: the guard's red zone
+    /// took the write; the instance is still usable, the values are not.
     pub fn get_directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -493,7 +501,24 @@ impl Instance {
     ) -> Result<()> {
         assert_eq!(knowns.len(), dv_known.len(), "get_directional_derivative: one seed per known");
         assert_eq!(unknowns.len(), dv_unknown.len(), "get_directional_derivative: one value per unknown");
-        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, dv_unknown)
+        // dvUnknown with a red zone after it: a write past its nUnknown values is seen
+        // there (and overwrites nothing of the master's)
+        let n = dv_unknown.len();
+        let zone = |v: &[f64]| v[n..].iter().rposition(|x| x.to_bits() != DV_RED_ZONE.to_bits());
+        let mut out = vec![DV_RED_ZONE; n + DV_RED_ZONE_LEN];
+        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, &mut out[..n])?;
+        dv_unknown.copy_from_slice(&out[..n]);
+        match zone(&out) {
+            Some(k) => Err(Error::Overrun {
+                instance: self.core.name.clone(),
+                function: match self.core.fmu.abi {
+                    Abi::Fmi2(_) => "fmi2GetDirectionalDerivative",
+                    Abi::Fmi3(_) => "fmi3GetDirectionalDerivative",
+                },
+                what: format!("{} bytes past the {} bytes of dvUnknown (nUnknown = {n})", 8 * (k + 1), 8 * n),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
