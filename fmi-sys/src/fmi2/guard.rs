@@ -153,4 +153,11 @@ mod tests {
             assert!(allocate(1, usize::MAX - 8).is_null());
         }
     }
+
+    /// The size docs/third-party-fmus.md prints is this one.
+    #[test]
+    fn the_doc_prints_the_red_zone() {
+        let doc = include_str!("../../../docs/third-party-fmus.md").split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(doc.contains(&format!("keep a red zone of {RED_ZONE} bytes after every block")));
+    }
 }
