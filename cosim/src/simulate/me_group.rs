@@ -295,6 +295,7 @@ impl MeGroup {
         t: f64,
         t_end: f64,
     ) -> Result<()> {
+        self.pending_inputs(lanes, t)?;
         let mut g = match self.integrator.take() {
             Some(g) => g,
             None => Box::new(GroupIntegrator::new(lanes, &self.members, solver)),
@@ -303,6 +304,23 @@ impl MeGroup {
         g.report(lanes, &self.members, solver);
         self.integrator = Some(g);
         outcome
+    }
+
+    /// The discrete inputs that connections set since the last step (the importing layer
+    /// holds them back in Continuous-Time Mode: only continuous inputs may change there)
+    /// set in an input event at `t`, the members iterating together, as an input file's.
+    fn pending_inputs<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64) -> Result<()> {
+        let who: Vec<usize> =
+            self.members.iter().copied().filter(|m| lanes.instance(*m).has_pending_inputs()).collect();
+        if who.is_empty() {
+            return Ok(());
+        }
+        self.input_event(lanes, t, "input", &who, |lanes| {
+            for &m in &who {
+                lanes.instance(m).apply_pending_inputs()?;
+            }
+            Ok(())
+        })
     }
 
     /// The event loop of [`MeGroup::advance`].

@@ -85,6 +85,11 @@ EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n)
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
 #endif
 
+/* The importer's memory callbacks as FMI2_TEST_INSTANCE received them (for a model that
+ * allocates through them). */
+static void *(*fmi2_test_allocate)(size_t, size_t);
+static void (*fmi2_test_free)(void *);
+
 /* The instance of a test model: a `Type` (a struct with a member `double time`) made by
  * calloc and set up by the file's `static void defaults(Type *)`, accepted where `accepted`
  * holds for the fmi2Type `type` (0 Model Exchange, 1 Co-Simulation). fmi2SetupExperiment
@@ -95,6 +100,8 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
                                          const fmi2CallbackFunctions *cb, int visible, int logging) {   \
         Type *m;                                                                                        \
         if (!cb || !cb->logger || !(accepted)) return NULL;                                             \
+        fmi2_test_allocate = cb->allocateMemory;                                                        \
+        fmi2_test_free = cb->freeMemory;                                                                \
         m = calloc(1, sizeof *m);                                                                       \
         defaults(m);                                                                                    \
         return m;                                                                                       \
