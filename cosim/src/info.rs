@@ -267,29 +267,27 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
             format!("; {}", v.join(", "))
         }
     };
+    // an interface element, its own capabilities and then those every interface may have
+    let interface = |element: &str, common: &model_description::fmi3::InterfaceCommon, own: &[(bool, &str)]| {
+        let mut pairs = own.to_vec();
+        pairs.push((common.can_get_and_set_fmu_state, "FMU state"));
+        pairs.push((common.provides_directional_derivatives, "directional derivatives"));
+        format!("{element} ({}{})", common.model_identifier, flags(&pairs))
+    };
     let mut interfaces = Vec::new();
     if let Some(cs) = &md.co_simulation {
-        interfaces.push(format!(
-            "CoSimulation ({}{})",
-            cs.common.model_identifier,
-            flags(&[
-                (cs.can_handle_variable_communication_step_size, "variable step"),
-                (cs.might_return_early_from_do_step, "early return"),
-                (cs.has_event_mode, "event mode"),
-                (cs.common.can_get_and_set_fmu_state, "FMU state"),
-                (cs.common.provides_directional_derivatives, "directional derivatives"),
-            ])
-        ));
+        let own = [
+            (cs.can_handle_variable_communication_step_size, "variable step"),
+            (cs.might_return_early_from_do_step, "early return"),
+            (cs.has_event_mode, "event mode"),
+        ];
+        interfaces.push(interface("CoSimulation", &cs.common, &own));
     }
     if let Some(me) = &md.model_exchange {
-        interfaces.push(format!(
-            "ModelExchange ({}{})",
-            me.common.model_identifier,
-            flags(&[
-                (me.needs_completed_integrator_step, "completed integrator step"),
-                (me.common.can_get_and_set_fmu_state, "FMU state"),
-                (me.common.provides_directional_derivatives, "directional derivatives"),
-            ])
+        interfaces.push(interface(
+            "ModelExchange",
+            &me.common,
+            &[(me.needs_completed_integrator_step, "completed integrator step")],
         ));
     }
     if let Some(se) = &md.scheduled_execution {
