@@ -242,23 +242,20 @@ fn closed_loop_system() -> (System, nigel_cosim::SspSystem) {
     (imported.system.clone(), imported)
 }
 
-/// The recorded columns: every Real output of every instance, `instance.name`.
-fn recorded(system: &System) -> Vec<(usize, u32, String)> {
-    let mut v = Vec::new();
-    for (i, inst) in system.instances.iter().enumerate() {
-        for var in &inst.fmu.description().model_variables {
-            let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
-            if real && var.causality == model_description::Causality::Output {
-                v.push((i, var.value_reference, format!("{}.{}", inst.name, var.name)));
-            }
+/// The job file of `tests/c/fmi2_closed_loop.c`, or with `fmi3` of `fmi3_closed_loop.c`,
+/// for `system`, with `library(i)` the path of instance i's library as the importer must
+/// open it. It records every Real output of every instance as `instance.name`. FMI 3.0 has
+/// its own value references (declaration row r, the index into the FMI 2.0 variables, has
+/// value reference r + 1), the instantiationToken (the FMI 2.0 GUID), and each Integer start
+/// value set as Int32 or, for an enumeration, as Int64.
+fn job_file(system: &System, library: &dyn Fn(usize) -> String, fmi3: bool) -> String {
+    let vr_of = |var: &model_description::ScalarVariable, index: usize| {
+        if fmi3 {
+            index as u32 + 1
+        } else {
+            var.value_reference
         }
-    }
-    v
-}
-
-/// The job file of `tests/c/fmi2_closed_loop.c` for `system`, with `library(i)` the path
-/// of instance i's library as the importer must open it.
-fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
+    };
     let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
     for (i, inst) in system.instances.iter().enumerate() {
         job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
@@ -266,50 +263,11 @@ fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
     for inst in &system.instances {
         let vars = &inst.fmu.description().model_variables;
         for (index, value) in &inst.start_values {
-            let vr = vars[*index].value_reference;
-            job += &match value {
-                Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
-                Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
-                Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
-                Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
-            };
-        }
-    }
-    for c in &system.connections {
-        job += &format!(
-            "connect {} {} {} {} {:?} {:?}\n",
-            system.instances[c.from.instance].name,
-            c.from.value_reference,
-            system.instances[c.to.instance].name,
-            c.to.value_reference,
-            c.gain,
-            c.offset
-        );
-    }
-    for (i, vr, name) in recorded(system) {
-        job += &format!("record {} {vr} {name}\n", system.instances[i].name);
-    }
-    job
-}
-
-/// The job file of `tests/c/fmi3_closed_loop.c` for `system`: [`job_file`]'s, with the FMI
-/// 3.0 value references (declaration row r, the index into the FMI 2.0 variables, has value
-/// reference r + 1), the instantiationToken (the FMI 2.0 GUID) and each Integer start value
-/// set as Int32 or, for an enumeration, as Int64.
-fn job_file3(system: &System, library: &dyn Fn(usize) -> String) -> String {
-    let vr3 = |index: usize| index as u32 + 1;
-    let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
-    for (i, inst) in system.instances.iter().enumerate() {
-        job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
-    }
-    for inst in &system.instances {
-        let vars = &inst.fmu.description().model_variables;
-        for (index, value) in &inst.start_values {
-            let vr = vr3(*index);
+            let vr = vr_of(&vars[*index], *index);
             let enumeration = matches!(vars[*index].variable_type, model_description::VariableType::Enumeration { .. });
             job += &match value {
                 Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
-                Value::Integer(n) if enumeration => format!("enumeration {} {vr} {n}\n", inst.name),
+                Value::Integer(n) if enumeration && fmi3 => format!("enumeration {} {vr} {n}\n", inst.name),
                 Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
                 Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
                 Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
@@ -317,21 +275,16 @@ fn job_file3(system: &System, library: &dyn Fn(usize) -> String) -> String {
         }
     }
     for c in &system.connections {
-        job += &format!(
-            "connect {} {} {} {} {:?} {:?}\n",
-            system.instances[c.from.instance].name,
-            vr3(c.from.index),
-            system.instances[c.to.instance].name,
-            vr3(c.to.index),
-            c.gain,
-            c.offset
-        );
+        let (from, to) = (&system.instances[c.from.instance], &system.instances[c.to.instance]);
+        let from_vr = vr_of(&from.fmu.description().model_variables[c.from.index], c.from.index);
+        let to_vr = vr_of(&to.fmu.description().model_variables[c.to.index], c.to.index);
+        job += &format!("connect {} {from_vr} {} {to_vr} {:?} {:?}\n", from.name, to.name, c.gain, c.offset);
     }
-    for (i, inst) in system.instances.iter().enumerate() {
+    for inst in &system.instances {
         for (index, var) in inst.fmu.description().model_variables.iter().enumerate() {
             let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
             if real && var.causality == model_description::Causality::Output {
-                job += &format!("record {} {} {}.{}\n", system.instances[i].name, vr3(index), inst.name, var.name);
+                job += &format!("record {} {} {}.{}\n", inst.name, vr_of(var, index), inst.name, var.name);
             }
         }
     }
@@ -396,7 +349,7 @@ fn closed_loop_through(
         let id = &system.instances[i].fmu.description().co_simulation.as_ref().unwrap().model_identifier;
         path_of(&libs[index[id.as_str()]])
     };
-    let job = if fmi3 { job_file3(&system, &library) } else { job_file(&system, &library) };
+    let job = job_file(&system, &library, fmi3);
     let job_path = dir.join("closed_loop.job");
     std::fs::write(&job_path, job).unwrap();
     let exe = dir.join(exe_name);
@@ -505,11 +458,7 @@ fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
     for lib in libraries("linux64", &work_dir("linux64-exports")) {
         let v = highest_glibc("objdump", &lib);
         assert!(((2, 2)..=(2, 17)).contains(&v), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
-        let n = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib))
-            .lines()
-            .filter(|l| l.contains(" T fmi2"))
-            .count();
-        assert_eq!(n, 44, "{}: fmi2 exports", lib.display());
+        assert_eq!(exports(&LINUX64, &lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
     }
     let c_run = fmi2_run(&LINUX64);
     // the same SSP through nigel_cosim's Jacobi master: another importer, the same numbers
@@ -572,9 +521,8 @@ fn win64_closed_loop_under_wine_matches_linux64() {
     let dir = work_dir("win64");
     let libs = libraries("win64", &dir);
     for lib in &libs {
+        assert_eq!(exports(&WIN64, lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
         let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib));
-        let exports = text.lines().filter(|l| l.trim_start().starts_with('[') && l.contains(" fmi2")).count();
-        assert_eq!(exports, 44, "{}: fmi2 exports", lib.display());
         let dlls: Vec<String> =
             text.lines().filter_map(|l| l.trim().strip_prefix("DLL Name: ")).map(|s| s.to_lowercase()).collect();
         let system = [
@@ -795,52 +743,56 @@ fn linux64_c_importers_under_asan_and_ubsan_on_the_instrumented_libraries() {
     assert_same_bits("me_fixed_step FMI 3.0 under ASan+UBSan", &reference, &fmi3);
 }
 
-#[test]
-fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
-    if !built("linux64") {
+/// The names of the functions the library `lib` of `p` exports that begin with `prefix`,
+/// sorted (`nm -D` of an ELF library, `objdump -p`'s export table of a DLL).
+fn exports(p: &Platform, lib: &Path, prefix: &str) -> Vec<String> {
+    let mut names: Vec<String> = match p.starts {
+        Start::UnderWine => run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib))
+            .lines()
+            .filter(|l| l.trim_start().starts_with('['))
+            .filter_map(|l| l.split_whitespace().last().map(str::to_string))
+            .collect(),
+        Start::Natively | Start::UnderQemu => {
+            let nm = if matches!(p.starts, Start::UnderQemu) { "aarch64-linux-gnu-nm" } else { "nm" };
+            run(Command::new(nm).args(["-D", "--defined-only"]).arg(lib))
+                .lines()
+                .filter_map(|l| l.split_whitespace().nth(2).map(str::to_string))
+                .collect()
+        }
+    };
+    names.retain(|n| n.starts_with(prefix));
+    names.sort();
+    names
+}
+
+/// The FMI 3.0 archives' libraries of `p` export every fmi3 function, and the FMI 3.0 closed
+/// loop through them matches ([`fmi3_closed_loop_matches`]).
+fn fmi3_closed_loop_test(p: &Platform) {
+    if !built(p.folder) {
         return;
     }
-    let dir = work_dir("x86_64-linux");
-    for lib in libraries3("linux64", "x86_64-linux", &dir) {
-        let text = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib));
-        let mut exports: Vec<&str> =
-            text.lines().filter_map(|l| l.split_whitespace().nth(2)).filter(|n| n.starts_with("fmi3")).collect();
-        exports.sort();
-        let mut want = fmi3_symbols();
-        want.sort();
-        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
+    let dir = work_dir(&format!("{}-fmi3", p.folder3));
+    let mut want = fmi3_symbols();
+    want.sort();
+    for lib in libraries3(p.folder, p.folder3, &dir) {
+        assert_eq!(exports(p, &lib, "fmi3"), want, "{}: fmi3 exports", lib.display());
     }
-    fmi3_closed_loop_matches(&LINUX64, &dir);
+    fmi3_closed_loop_matches(p, &dir);
+}
+
+#[test]
+fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
+    fmi3_closed_loop_test(&LINUX64);
 }
 
 #[test]
 fn x86_64_windows_fmi3_closed_loop_under_wine_matches_linux64() {
-    if !built("win64") {
-        return;
-    }
-    let dir = work_dir("x86_64-windows");
-    for lib in libraries3("win64", "x86_64-windows", &dir) {
-        let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(&lib));
-        let mut exports: Vec<&str> = text
-            .lines()
-            .filter(|l| l.trim_start().starts_with('['))
-            .filter_map(|l| l.split_whitespace().last())
-            .filter(|n| n.starts_with("fmi3"))
-            .collect();
-        exports.sort();
-        let mut want = fmi3_symbols();
-        want.sort();
-        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
-    }
-    fmi3_closed_loop_matches(&WIN64, &dir);
+    fmi3_closed_loop_test(&WIN64);
 }
 
 #[test]
 fn aarch64_linux_fmi3_closed_loop_under_qemu_matches_linux64() {
-    if !built("aarch64-linux") {
-        return;
-    }
-    fmi3_closed_loop_matches(&AARCH64_LINUX, &work_dir("aarch64-linux-fmi3"));
+    fmi3_closed_loop_test(&AARCH64_LINUX);
 }
 
 // ---- Mach-O, the little of it the darwin64 checks read --------------------------------
