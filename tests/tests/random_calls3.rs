@@ -120,6 +120,22 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
             let mut restored: Option<Option<Machine>> = None;
             let (mut b1, mut b2, mut b3, mut b4, mut b5) = (7u8, 7u8, 7u8, 7u8, 7u8);
             let mut t_out = f64::NAN;
+            // one type's values of `pool`: got into a zeroed buffer, or set to values picked
+            // from `picks`
+            macro_rules! get {
+                ($getter:expr, $pool:expr, $zero:expr) => {{
+                    let v = vrs(&mut rng, $pool);
+                    let mut out = [$zero; 5];
+                    ($getter)(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                }};
+            }
+            macro_rules! set {
+                ($setter:expr, $pool:expr, $picks:expr) => {{
+                    let v = vrs(&mut rng, $pool);
+                    let x: Vec<_> = (0..n_values).map(|_| rng.pick($picks)).collect();
+                    ($setter)(c, ptr(&v), n, x.as_ptr(), n_values)
+                }};
+            }
             let status = unsafe {
                 use Function::*;
                 match function {
@@ -155,42 +171,13 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         check_reals = Some(n.min(n_values));
                         (f.get_float64)(c, ptr(&v), n, reals_out.as_mut_ptr(), n_values)
                     }
-                    Fmi3SetFloat64 => {
-                        let v = vrs(&mut rng, &p.float64);
-                        let x: Vec<f64> = (0..n_values).map(|_| rng.pick(&HOSTILE)).collect();
-                        (f.set_float64)(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetInt32 => {
-                        let v = vrs(&mut rng, &p.int32);
-                        let mut out = [0i32; 5];
-                        (f.get_int32.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetInt32 => {
-                        let v = vrs(&mut rng, &p.int32);
-                        let x: Vec<i32> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 7, i32::MAX])).collect();
-                        (f.set_int32.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetInt64 => {
-                        let v = vrs(&mut rng, &p.int64);
-                        let mut out = [0i64; 5];
-                        (f.get_int64.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetInt64 => {
-                        let v = vrs(&mut rng, &p.int64);
-                        let x: Vec<i64> =
-                            (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 1 << 40, i64::MIN])).collect();
-                        (f.set_int64.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetBoolean => {
-                        let v = vrs(&mut rng, &p.boolean);
-                        let mut out = [0u8; 5];
-                        (f.get_boolean.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetBoolean => {
-                        let v = vrs(&mut rng, &p.boolean);
-                        let x: Vec<u8> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 255])).collect();
-                        (f.set_boolean.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
+                    Fmi3SetFloat64 => set!(f.set_float64, &p.float64, &HOSTILE),
+                    Fmi3GetInt32 => get!(f.get_int32.unwrap(), &p.int32, 0i32),
+                    Fmi3SetInt32 => set!(f.set_int32.unwrap(), &p.int32, &[0, 1, 2, 3, -1, 7, i32::MAX]),
+                    Fmi3GetInt64 => get!(f.get_int64.unwrap(), &p.int64, 0i64),
+                    Fmi3SetInt64 => set!(f.set_int64.unwrap(), &p.int64, &[0, 1, 2, 3, -1, 1 << 40, i64::MIN]),
+                    Fmi3GetBoolean => get!(f.get_boolean.unwrap(), &p.boolean, 0u8),
+                    Fmi3SetBoolean => set!(f.set_boolean.unwrap(), &p.boolean, &[0, 1, 2, 255]),
                     // the types the FMUs have no variable of: any value reference
                     Fmi3GetFloat32 | Fmi3SetFloat32 => {
                         let v = vrs(&mut rng, &p.any);
