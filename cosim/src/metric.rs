@@ -456,19 +456,11 @@ struct Leaf {
 /// The accumulators of a list of metrics over the rows of one run.
 #[derive(Clone, Debug)]
 pub struct Accumulators {
+    /// The aggregates of every metric, in the order of the metrics and, within one, of a
+    /// depth-first walk (the order [`Accumulators::values`] reads them back in).
     leaves: Vec<Leaf>,
-    trees: Vec<Tree>,
+    metrics: Vec<Metric>,
     n: u64,
-}
-
-#[derive(Clone, Debug)]
-enum Tree {
-    Leaf(usize),
-    Norm(Vec<Tree>),
-    Const(f64),
-    Abs(Box<Tree>),
-    Neg(Box<Tree>),
-    Bin(Op, Box<Tree>, Box<Tree>),
 }
 
 impl Accumulators {
@@ -484,8 +476,8 @@ impl Accumulators {
         slots: &[String],
     ) -> Result<Accumulators, String> {
         let mut leaves = Vec::new();
-        fn build(m: &Metric, slots: &[String], leaves: &mut Vec<Leaf>) -> Result<Tree, String> {
-            Ok(match m {
+        fn build(m: &Metric, slots: &[String], leaves: &mut Vec<Leaf>) -> Result<(), String> {
+            match m {
                 Metric::Of(agg, signals) => {
                     let a = signals[0].slotted(slots)?;
                     let b = signals.get(1).map(|s| s.slotted(slots)).transpose()?;
@@ -495,19 +487,20 @@ impl Accumulators {
                         _ => 0.0,
                     };
                     leaves.push(Leaf { agg: *agg, a, b, acc });
-                    Tree::Leaf(leaves.len() - 1)
                 }
-                Metric::Norm(ms) => Tree::Norm(ms.iter().map(|m| build(m, slots, leaves)).collect::<Result<_, _>>()?),
-                Metric::Const(c) => Tree::Const(*c),
-                Metric::Abs(m) => Tree::Abs(Box::new(build(m, slots, leaves)?)),
-                Metric::Neg(m) => Tree::Neg(Box::new(build(m, slots, leaves)?)),
-                Metric::Bin(op, a, b) => {
-                    Tree::Bin(*op, Box::new(build(a, slots, leaves)?), Box::new(build(b, slots, leaves)?))
+                Metric::Norm(ms) => ms.iter().try_for_each(|m| build(m, slots, leaves))?,
+                Metric::Const(_) => {}
+                Metric::Abs(m) | Metric::Neg(m) => build(m, slots, leaves)?,
+                Metric::Bin(_, a, b) => {
+                    build(a, slots, leaves)?;
+                    build(b, slots, leaves)?;
                 }
-            })
+            }
+            Ok(())
         }
-        let trees = metrics.into_iter().map(|m| build(m, slots, &mut leaves)).collect::<Result<_, _>>()?;
-        Ok(Accumulators { leaves, trees, n: 0 })
+        let metrics: Vec<Metric> = metrics.into_iter().cloned().collect();
+        metrics.iter().try_for_each(|m| build(m, slots, &mut leaves))?;
+        Ok(Accumulators { leaves, metrics, n: 0 })
     }
 
     /// Adds one row.
@@ -550,18 +543,19 @@ impl Accumulators {
                 _ => l.acc,
             }
         };
-        fn eval(t: &Tree, leaves: &[f64]) -> f64 {
-            match t {
-                Tree::Leaf(i) => leaves[*i],
-                Tree::Norm(ts) => ts.iter().map(|t| eval(t, leaves)).map(|x| x * x).sum::<f64>().sqrt(),
-                Tree::Const(c) => *c,
-                Tree::Abs(t) => eval(t, leaves).abs(),
-                Tree::Neg(t) => -eval(t, leaves),
-                Tree::Bin(op, a, b) => op.apply(eval(a, leaves), eval(b, leaves)),
+        // the metric with its aggregates' values read in the depth-first order they were made in
+        fn eval(m: &Metric, leaves: &mut impl Iterator<Item = f64>) -> f64 {
+            match m {
+                Metric::Of(..) => leaves.next().expect("one aggregate per leaf"),
+                Metric::Norm(ms) => ms.iter().map(|m| eval(m, leaves)).map(|x| x * x).sum::<f64>().sqrt(),
+                Metric::Const(c) => *c,
+                Metric::Abs(m) => eval(m, leaves).abs(),
+                Metric::Neg(m) => -eval(m, leaves),
+                Metric::Bin(op, a, b) => op.apply(eval(a, leaves), eval(b, leaves)),
             }
         }
-        let leaves: Vec<f64> = self.leaves.iter().map(leaf).collect();
-        self.trees.iter().map(|t| eval(t, &leaves)).collect()
+        let mut leaves = self.leaves.iter().map(leaf);
+        self.metrics.iter().map(|m| eval(m, &mut leaves)).collect()
     }
 }
 
