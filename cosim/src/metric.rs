@@ -198,32 +198,24 @@ impl<'a> Parser<'a> {
 
     /// `term (('+' | '-') term)*`
     fn sum(&mut self) -> Result<Node, String> {
-        let mut a = self.product()?;
-        loop {
-            let op = if self.eat('+') {
-                Op::Add
-            } else if self.eat('-') {
-                Op::Sub
-            } else {
-                return Ok(a);
-            };
-            let b = self.product()?;
-            a = self.join(op, a, b)?;
-        }
+        self.left_associative([('+', Op::Add), ('-', Op::Sub)], Self::product)
     }
 
     /// `factor (('*' | '/') factor)*`
     fn product(&mut self) -> Result<Node, String> {
-        let mut a = self.factor()?;
+        self.left_associative([('*', Op::Mul), ('/', Op::Div)], Self::factor)
+    }
+
+    /// `operand (op operand)*` with the operators `ops`, joined from the left.
+    fn left_associative(
+        &mut self,
+        ops: [(char, Op); 2],
+        operand: fn(&mut Self) -> Result<Node, String>,
+    ) -> Result<Node, String> {
+        let mut a = operand(self)?;
         loop {
-            let op = if self.eat('*') {
-                Op::Mul
-            } else if self.eat('/') {
-                Op::Div
-            } else {
-                return Ok(a);
-            };
-            let b = self.factor()?;
+            let Some(op) = ops.iter().find(|(c, _)| self.eat(*c)).map(|(_, op)| *op) else { return Ok(a) };
+            let b = operand(self)?;
             a = self.join(op, a, b)?;
         }
     }
