@@ -578,8 +578,7 @@ mod tests {
         // max(abs(v)) is max_abs(v); abs, -, *, / and numbers inside and outside
         let m = Metric::parse("max(abs(plant.y))").unwrap();
         assert_eq!(m, Metric::Of(Aggregate::Max, vec![Signal::Abs(Box::new(Signal::Var("plant.y".into())))]));
-        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
-        let ms: Vec<Metric> = [
+        let metrics = [
             "max(abs(a))",
             "max(a - 2 * b)",
             "mean((a + b) / 2)",
@@ -587,25 +586,19 @@ mod tests {
             "-min(-a)",
             "abs(final(a) - 3)",
             "2.5e-1 * final(b)",
-        ]
-        .iter()
-        .map(|t| Metric::parse(t).unwrap())
-        .collect();
-        let mut acc = Accumulators::new(&ms, &slots);
-        for row in [[1.0, 0.0], [-3.0, 1.0], [2.0, 2.0]] {
-            acc.push(&row);
-        }
+        ];
+        let values = values_over_three_rows(&metrics);
         // by hand: |a| = 1, 3, 2 -> 3; a - 2b = 1, -5, -2 -> 1; (a + b)/2 = 0.5, -1, 2 -> mean 0.5;
         // final a = 2 -> 1; -min(-a) = max a = 2; |2 - 3| = 1; 0.25 * 2 = 0.5
-        assert_eq!(acc.values(), [3.0, 1.0, 0.5, 1.0, 2.0, 1.0, 0.5]);
+        assert_eq!(values, [3.0, 1.0, 0.5, 1.0, 2.0, 1.0, 0.5]);
+        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
         let e = Accumulators::try_new(&[Metric::parse("max(c)").unwrap()], &slots).unwrap_err();
         assert_eq!(e, "c is not among the recorded variables");
     }
 
     #[test]
     fn aggregates_against_hand_sums() {
-        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
-        let ms: Vec<Metric> = [
+        let values = values_over_three_rows(&[
             "final(a)",
             "max_abs(a)",
             "mean(a)",
@@ -614,17 +607,21 @@ mod tests {
             "norm(final(a), mean(b))",
             "min(a)",
             "max_abs_diff(a, b)",
-        ]
-        .iter()
-        .map(|t| Metric::parse(t).unwrap())
-        .collect();
+        ]);
+        // by hand: final 2, max |a| 3, mean 0, rms sqrt(14/3), diffs 1, -4, 0 -> sqrt(17/3),
+        // norm(2, 1) = sqrt(5), min -3, max |a - b| 4
+        let want = [2.0, 3.0, 0.0, (14.0f64 / 3.0).sqrt(), (17.0f64 / 3.0).sqrt(), 5f64.sqrt(), -3.0, 4.0];
+        assert_eq!(values, want);
+    }
+
+    /// The values of `metrics` over the rows (a, b) = (1, 0), (-3, 1), (2, 2).
+    fn values_over_three_rows(metrics: &[&str]) -> Vec<f64> {
+        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
+        let ms: Vec<Metric> = metrics.iter().map(|t| Metric::parse(t).unwrap()).collect();
         let mut acc = Accumulators::new(&ms, &slots);
         for row in [[1.0, 0.0], [-3.0, 1.0], [2.0, 2.0]] {
             acc.push(&row);
         }
-        // by hand: final 2, max |a| 3, mean 0, rms sqrt(14/3), diffs 1, -4, 0 -> sqrt(17/3),
-        // norm(2, 1) = sqrt(5), min -3, max |a - b| 4
-        let want = [2.0, 3.0, 0.0, (14.0f64 / 3.0).sqrt(), (17.0f64 / 3.0).sqrt(), 5f64.sqrt(), -3.0, 4.0];
-        assert_eq!(acc.values(), want);
+        acc.values()
     }
 }
