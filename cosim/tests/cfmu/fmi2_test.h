@@ -10,8 +10,9 @@
  *                                and the Co-Simulation input/output derivatives refused.
  * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
  * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
- * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type), FMI2_TEST_TWO_STATES(Type),
- * FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
+ * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type) (the three at once:
+ * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count),
+ * FMI2_TEST_UNIT_NOMINALS, FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
 #define FMI2_TEST_H
@@ -185,9 +186,34 @@ static void (*fmi2_test_free)(void *);
         return 0;                                                                                        \
     }                                                                                                    \
     EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; } \
+    FMI2_TEST_UNIT_NOMINALS
+
+/* Every continuous state has nominal 1. */
+#define FMI2_TEST_UNIT_NOMINALS                                                                         \
     EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {         \
         size_t i;                                                                                        \
         for (i = 0; i < n; i++) x[i] = 1.0;                                                              \
+        return 0;                                                                                        \
+    }
+
+/* A Model Exchange only model (FMI2_TEST_INSTANCE accepting fmi2ModelExchange) with
+ * FMI2_TEST_EXIT_INITIALIZATION and FMI2_TEST_CONTINUOUS_TIME. */
+#define FMI2_TEST_MODEL_EXCHANGE(Type) \
+    FMI2_TEST_INSTANCE(Type, type == 0) \
+    FMI2_TEST_EXIT_INITIALIZATION      \
+    FMI2_TEST_CONTINUOUS_TIME(Type)
+
+/* fmi2SetReal of a `Type` whose `double r[]` holds its Real variables by value reference:
+ * any of the first `count` may be set, a value reference beyond them is refused. */
+#define FMI2_TEST_SET_REALS(Type, count)                                                                 \
+    EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,              \
+                                  const double v[]) {                                                    \
+        Type *m = c;                                                                                     \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] >= (count)) return ERR;                                                            \
+            m->r[vr[i]] = v[i];                                                                          \
+        }                                                                                                \
         return 0;                                                                                        \
     }
 

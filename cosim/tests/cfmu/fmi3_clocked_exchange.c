@@ -13,9 +13,7 @@
  *            y = 10 u + k, u as set in that activation (recomputed by a set of u in it)
  *   4 t_now  Float64 output, not clocked: the time
  * fmi3DoStep advances the time and never asks for an event. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 typedef struct {
     double time, u, y;
@@ -24,10 +22,7 @@ typedef struct {
     fmi3LogMessageCallback log;
 } Exchange;
 
-static fmi3Status fail(Exchange *c, const char *message) {
-    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
-}
+FMI3_TEST_FAIL(Exchange)
 
 static void start(Exchange *c) {
     c->time = 0;
@@ -37,23 +32,7 @@ static void start(Exchange *c) {
     c->initializing = c->in_event_mode = c->active = c->ticked = c->u_set = 0;
 }
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
-
-fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
-    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
-    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
-    if (!token || strcmp(token, "{fmi3-clocked-exchange}") != 0 || !eventMode) {
-        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed");
-        return NULL;
-    }
-    Exchange *c = calloc(1, sizeof(Exchange));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
-    start(c);
-    return c;
-}
+FMI3_TEST_EVENT_MODE_INSTANCE(Exchange, "{fmi3-clocked-exchange}", start)
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
@@ -73,9 +52,6 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token
     if (c) c->scheduled = 1;
     return c;
 }
-
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
     fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {

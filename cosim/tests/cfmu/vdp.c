@@ -24,9 +24,7 @@ static void defaults(Vdp *v) {
     v->r[4] = 1.0;
 }
 
-FMI2_TEST_INSTANCE(Vdp, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Vdp)
+FMI2_TEST_MODEL_EXCHANGE(Vdp)
 
 static void derivatives(Vdp *v) {
     double x0 = v->r[0], x1 = v->r[2], mu = v->r[4];
