@@ -1064,27 +1064,111 @@ fn an_alias_is_listed_and_recorded_under_its_name() {
     assert_eq!(theirs, y.iter().map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>());
 }
 
-/// A connection carries an Int64 output to an Int64 input as f64: exactly up to 2^53 (and
-/// beyond where an f64 holds the value), and a value it would round is an error naming the
-/// variable and the master's limit, not a silently rounded input. c1.i64out = c1.i64in ^ 1
-/// feeds c2.i64in, c2.i64out = c2.i64in ^ 1 is recorded: 6 gives 7, then 6 again; 2^53 + 2
-/// gives 2^53 + 3, which no f64 holds.
+/// Two counters, c1 feeding c2 (`i64out -> i64in`, `u64out -> u64in`); c1's inputs from
+/// `inputs` (an input table of exact integers, held), each instance loaded for `interface`.
+fn counters_connected(
+    path: &Path,
+    interface: nigel_cosim::Interface,
+    connections: &[(&str, &str)],
+    inputs: &[(&str, i128)],
+) -> (System, nigel_cosim::InputTable) {
+    let options = nigel_cosim::ImportOptions { interface: Some(interface), ..nigel_cosim::ImportOptions::default() };
+    let mut b = SystemBuilder::new();
+    for name in ["c1", "c2"] {
+        b.add_instance(name, Fmu::load_with(path, &options).unwrap()).unwrap();
+    }
+    for (from, to) in connections {
+        b.connect(from, to).unwrap();
+    }
+    let names = inputs.iter().map(|(n, _)| n.to_string()).collect();
+    let columns = inputs.iter().map(|(_, v)| vec![*v as f64; 2]).collect();
+    let mut table = nigel_cosim::InputTable::new(names, vec![0.0, 1.0], columns).unwrap();
+    table.integers = inputs.iter().map(|(_, v)| Some(vec![*v; 2])).collect();
+    (b.build(), table)
+}
+
+/// Connections carry 64-bit integers exactly, in Co-Simulation and Model Exchange, under
+/// `jacobi` and `ordered` (issue 35 defect 4, issue 36 defect 6). The counter's outputs
+/// are its inputs with the lowest bit flipped (i64out = i64in ^ 1, u64out = u64in ^ 1),
+/// so that a rounding anywhere shows. By hand: c1.i64in = 2^62 gives c1.i64out = 2^62 + 1
+/// = 4611686018427387905, which no f64 holds (the f64s there are 2^10 apart); it arrives
+/// in c2.i64in as it is, and c2.i64out = 2^62 = 4611686018427387904. c1.u64in = 2^64 - 1
+/// (u64::MAX, above i64::MAX) gives c1.u64out = 18446744073709551614 = c2.u64in, and
+/// c2.u64out = 18446744073709551615. Every row the same (the inputs are held, and the
+/// connections carried at initialization already).
 #[test]
-fn a_sixty_four_bit_connection_is_exact_or_refused() {
+fn sixty_four_bit_connections_carry_their_values_to_the_bit() {
+    use nigel_cosim::{Algorithm, Interface};
     let Some((_dir, path)) = counter("fmi3-wide-connection") else { return };
-    let system = |start: f64| {
-        let mut b = SystemBuilder::new();
-        for name in ["c1", "c2"] {
-            b.add_instance(name, Fmu::load(&path).unwrap()).unwrap();
+    let record = ["c1.i64out", "c2.i64in", "c2.i64out", "c1.u64out", "c2.u64in", "c2.u64out"];
+    let by_hand = [
+        "4611686018427387905",
+        "4611686018427387905",
+        "4611686018427387904",
+        "18446744073709551614",
+        "18446744073709551614",
+        "18446744073709551615",
+    ];
+    for interface in [Interface::CoSimulation, Interface::ModelExchange] {
+        for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+            let (system, input) = counters_connected(
+                &path,
+                interface,
+                &[("c1.i64out", "c2.i64in"), ("c1.u64out", "c2.u64in")],
+                &[("c1.i64in", 1 << 62), ("c1.u64in", i128::from(u64::MAX))],
+            );
+            let mut e = Experiment::new(0.2, 0.1);
+            e.algorithm = algorithm;
+            e.record = Some(record.iter().map(|n| n.to_string()).collect());
+            e.input = Some(std::sync::Arc::new(input));
+            let (r, _) = simulate(&system, &e).unwrap_or_else(|err| panic!("{interface:?} {algorithm:?}: {err}"));
+            for (column, value) in by_hand.iter().enumerate() {
+                assert_eq!(
+                    r.exact_column(column).unwrap(),
+                    [*value; 3],
+                    "{interface:?} {algorithm:?} {}",
+                    record[column]
+                );
+            }
         }
-        b.set("c1.i64in", Value::Real(start)).unwrap();
-        b.connect("c1.i64out", "c2.i64in").unwrap();
-        b.build()
+    }
+}
+
+/// An integer connection checks the value against the input's type at every set: a
+/// negative Int64 into a UInt64, a UInt64 above i64::MAX into an Int64, an Int64 beyond
+/// 32 bits into an Int32 are errors naming both ends, the value and the time, never
+/// wrapped or clamped. A value in range crosses to the narrower type: c1.i64out = 6 ^ 1 = 7
+/// into the Int32 c2.k gives c2.m = 2 k = 14 (fmi3_counter.c).
+#[test]
+fn an_integer_connection_refuses_a_value_its_input_cannot_hold() {
+    use nigel_cosim::Interface;
+    let Some((_dir, path)) = counter("fmi3-integer-range") else { return };
+    let run = |connection: (&str, &str), input: (&str, i128)| {
+        let (system, table) = counters_connected(&path, Interface::CoSimulation, &[connection], &[input]);
+        let mut e = Experiment::new(0.2, 0.1);
+        e.record = Some(vec!["c2.m".into()]);
+        e.input = Some(std::sync::Arc::new(table));
+        simulate(&system, &e).map(|(r, _)| r.column("c2.m").unwrap())
     };
-    let mut e = Experiment::new(0.2, 0.1);
-    e.record = Some(vec!["c2.i64out".into()]);
-    let (r, _) = simulate(&system(6.0), &e).unwrap();
-    assert_eq!(r.exact_column(0).unwrap(), ["6", "6", "6"]);
-    let err = simulate(&system(9007199254740994.0), &e).expect_err("a rounded connection refused").to_string();
-    assert!(err.contains("c1.i64out = 9007199254740995") && err.contains("2^53"), "{err}");
+    for (connection, input, message) in [
+        (
+            ("c1.i64out", "c2.u64in"),
+            ("c1.i64in", -4),
+            "connection c1.i64out -> c2.u64in: c1.i64out = -3 at t = 0 s is outside the range of c2.u64in (UInt64, 0 to 18446744073709551615)",
+        ),
+        (
+            ("c1.u64out", "c2.i64in"),
+            ("c1.u64in", i128::from(u64::MAX)),
+            "connection c1.u64out -> c2.i64in: c1.u64out = 18446744073709551614 at t = 0 s is outside the range of c2.i64in (Int64, -9223372036854775808 to 9223372036854775807)",
+        ),
+        (
+            ("c1.i64out", "c2.k"),
+            ("c1.i64in", 1 << 40),
+            "connection c1.i64out -> c2.k: c1.i64out = 1099511627777 at t = 0 s is outside the range of c2.k (Int32, -2147483648 to 2147483647)",
+        ),
+    ] {
+        let err = run(connection, input).expect_err(message).to_string();
+        assert!(err.contains(message), "{err}");
+    }
+    assert_eq!(run(("c1.i64out", "c2.k"), ("c1.i64in", 6)).unwrap(), [14.0; 3]);
 }

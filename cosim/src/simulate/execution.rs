@@ -341,7 +341,7 @@ impl<'s> Execution<'s> {
         }
         let core = self.core.insert(Core {
             lanes,
-            values: vec![0.0; self.plan.sources.len()],
+            values: vec![0.0; self.plan.exchange_len],
             group: self.group.take(),
             solver: experiment.solver,
             clock: self.clock,
