@@ -19,11 +19,26 @@ pub(crate) enum OpKind {
 }
 
 /// What an op carries: values of one base type of the view through their f64 slots, or
-/// integers exactly (see `integers.rs`).
+/// integers exactly (see `integers.rs`). One flat enum, so that an op's call is one match.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Carried {
-    View(BaseType),
+    Real,
+    Integer,
+    Boolean,
+    String,
     ExactInteger,
+}
+
+impl Carried {
+    /// Values of `base_type` through their f64 slots.
+    fn view(base_type: BaseType) -> Carried {
+        match base_type {
+            BaseType::Real => Carried::Real,
+            BaseType::Integer => Carried::Integer,
+            BaseType::Boolean => Carried::Boolean,
+            BaseType::String => Carried::String,
+        }
+    }
 }
 
 /// One batched fmi2Get/fmi2Set call of one instance and one base type (or, carrying
@@ -65,7 +80,7 @@ impl Op {
     }
     fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64), link: Option<Link>) {
         self.direct = match (self.kind, self.carried, self.slots.first()) {
-            (OpKind::Get, Carried::View(BaseType::Real), None) => Some(slot),
+            (OpKind::Get, Carried::Real, None) => Some(slot),
             (_, _, Some(&first)) if self.direct == Some(first) && slot == first + self.slots.len() => Some(first),
             _ => None,
         };
@@ -119,17 +134,11 @@ impl Op {
     #[inline]
     pub(crate) fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
         match self.carried {
-            Carried::View(BaseType::Real) => inst.get_real(&self.vrs, &mut self.reals)?,
-            Carried::View(BaseType::Integer) => inst.get_integer(&self.vrs, &mut self.ints)?,
-            Carried::View(BaseType::Boolean) => inst.get_boolean(&self.vrs, &mut self.ints)?,
-            Carried::View(BaseType::String) => {}
-            Carried::ExactInteger => {
-                for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&mut self.integers) {
-                    if let Link::Source { read, .. } = link {
-                        *value = integers::read(inst, *vr, *read)?;
-                    }
-                }
-            }
+            Carried::Real => inst.get_real(&self.vrs, &mut self.reals)?,
+            Carried::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
+            Carried::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
+            Carried::String => {}
+            Carried::ExactInteger => self.fetch_integers(inst)?,
         }
         Ok(())
     }
@@ -138,27 +147,23 @@ impl Op {
     #[inline]
     pub(crate) fn scatter(&self, values: &mut [f64]) {
         match self.carried {
-            Carried::View(BaseType::Real) => {
+            Carried::Real => {
                 for (s, v) in self.slots.iter().zip(&self.reals) {
                     values[*s] = *v;
                 }
             }
-            Carried::View(BaseType::Integer) => {
+            Carried::Integer => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = f64::from(*v);
                 }
             }
-            Carried::View(BaseType::Boolean) => {
+            Carried::Boolean => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = if *v != 0 { 1.0 } else { 0.0 };
                 }
             }
-            Carried::View(BaseType::String) => {}
-            Carried::ExactInteger => {
-                for ((s, link), v) in self.slots.iter().zip(&self.links).zip(&self.integers) {
-                    (values[*s], values[link.residual()]) = integers::split(*v);
-                }
-            }
+            Carried::String => {}
+            Carried::ExactInteger => self.scatter_integers(values),
         }
     }
 
@@ -166,27 +171,23 @@ impl Op {
     #[inline]
     pub(crate) fn gather(&mut self, values: &[f64]) {
         match self.carried {
-            Carried::View(BaseType::Real) => {
+            Carried::Real => {
                 for ((r, s), (g, o)) in self.reals.iter_mut().zip(&self.slots).zip(&self.gains) {
                     *r = g * values[*s] + o;
                 }
             }
-            Carried::View(BaseType::Integer) => {
+            Carried::Integer => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = values[*s] as i32;
                 }
             }
-            Carried::View(BaseType::Boolean) => {
+            Carried::Boolean => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = (values[*s] != 0.0) as i32;
                 }
             }
-            Carried::View(BaseType::String) => {}
-            Carried::ExactInteger => {
-                for ((r, s), link) in self.integers.iter_mut().zip(&self.slots).zip(&self.links) {
-                    *r = integers::join(values[*s], values[link.residual()]);
-                }
-            }
+            Carried::String => {}
+            Carried::ExactInteger => self.gather_integers(values),
         }
     }
 
@@ -194,16 +195,47 @@ impl Op {
     #[inline]
     pub(crate) fn apply(&mut self, inst: &mut Instance) -> Result<()> {
         match self.carried {
-            Carried::View(BaseType::Real) => inst.set_real(&self.vrs, &self.reals)?,
-            Carried::View(BaseType::Integer) => inst.set_integer(&self.vrs, &self.ints)?,
-            Carried::View(BaseType::Boolean) => inst.set_boolean(&self.vrs, &self.ints)?,
-            Carried::View(BaseType::String) => {}
-            Carried::ExactInteger => {
-                for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&self.integers) {
-                    if let Link::Sink { sink, .. } = link {
-                        integers::write(inst, *vr, *value, sink)?;
-                    }
-                }
+            Carried::Real => inst.set_real(&self.vrs, &self.reals)?,
+            Carried::Integer => inst.set_integer(&self.vrs, &self.ints)?,
+            Carried::Boolean => inst.set_boolean(&self.vrs, &self.ints)?,
+            Carried::String => {}
+            Carried::ExactInteger => self.apply_integers(inst)?,
+        }
+        Ok(())
+    }
+
+    // The integer ops' calls, out of line: the calls of the other types (every step of
+    // every run) keep the few registers and instructions they had.
+
+    #[inline(never)]
+    fn fetch_integers(&mut self, inst: &mut Instance) -> Result<()> {
+        for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&mut self.integers) {
+            if let Link::Source { read, .. } = link {
+                *value = integers::read(inst, *vr, *read)?;
+            }
+        }
+        Ok(())
+    }
+
+    #[inline(never)]
+    fn scatter_integers(&self, values: &mut [f64]) {
+        for ((s, link), v) in self.slots.iter().zip(&self.links).zip(&self.integers) {
+            (values[*s], values[link.residual()]) = integers::split(*v);
+        }
+    }
+
+    #[inline(never)]
+    fn gather_integers(&mut self, values: &[f64]) {
+        for ((r, s), link) in self.integers.iter_mut().zip(&self.slots).zip(&self.links) {
+            *r = integers::join(values[*s], values[link.residual()]);
+        }
+    }
+
+    #[inline(never)]
+    fn apply_integers(&mut self, inst: &mut Instance) -> Result<()> {
+        for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&self.integers) {
+            if let Link::Sink { sink, .. } = link {
+                integers::write(inst, *vr, *value, sink)?;
             }
         }
         Ok(())
@@ -240,7 +272,7 @@ fn emit(
 fn get_carried(links: &HashMap<VariableRef, Link>, r: &VariableRef) -> (Carried, Option<Link>) {
     match links.get(r) {
         Some(link) => (Carried::ExactInteger, Some(link.clone())),
-        None => (Carried::View(r.base_type), None),
+        None => (Carried::view(r.base_type), None),
     }
 }
 
@@ -248,7 +280,7 @@ fn get_carried(links: &HashMap<VariableRef, Link>, r: &VariableRef) -> (Carried,
 fn set_carried(system: &System, residuals: &HashMap<VariableRef, usize>, c: &Connection) -> (Carried, Option<Link>) {
     match integers::sink_link(system, residuals, c) {
         Some(link) => (Carried::ExactInteger, Some(link)),
-        None => (Carried::View(c.to.base_type), None),
+        None => (Carried::view(c.to.base_type), None),
     }
 }
 
@@ -451,12 +483,7 @@ impl Plan {
         let n = system.instances.len();
         let (mut jacobi_gets, mut jacobi_gets_rec, mut jacobi_sets) =
             (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
-        let carried_types = [
-            Carried::View(BaseType::Real),
-            Carried::View(BaseType::Integer),
-            Carried::View(BaseType::Boolean),
-            Carried::ExactInteger,
-        ];
+        let carried_types = [Carried::Real, Carried::Integer, Carried::Boolean, Carried::ExactInteger];
         for i in 0..n {
             let (mut gets, mut gets_rec, mut sets) = (Vec::new(), Vec::new(), Vec::new());
             for carried in carried_types {
