@@ -1134,6 +1134,51 @@ fn sixty_four_bit_connections_carry_their_values_to_the_bit() {
     }
 }
 
+/// The same through the command line on an SSP system (`tests/data/int64_chain.ssd`: the
+/// counters' 64-bit connectors declared `ssc:Integer`, one connection written sink first),
+/// c1's inputs from an input file of exact integers: the CSV holds the values to the bit,
+/// under both algorithms, in Co-Simulation and Model Exchange, in process and with every
+/// FMU in a host process of its own. By hand as above: c1.i64in = 2^62 gives 2^62 + 1 at
+/// c1.i64out and c2.i64in, and 2^62 at c2.i64out; c1.u64in = 2^64 - 1 gives 2^64 - 2 at
+/// c1.u64out and c2.u64in, and 2^64 - 1 at c2.u64out.
+#[test]
+fn an_ssp_of_int64_connectors_carries_them_exactly_from_the_command_line() {
+    let Some((dir, _fmu)) = counter("fmi3-int64-ssp") else { return };
+    let ssd = dir.join("int64_chain.ssd");
+    std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/int64_chain.ssd"), &ssd).unwrap();
+    let input = dir.join("in.csv");
+    std::fs::write(&input, "time,c1.i64in,c1.u64in\n0,4611686018427387904,18446744073709551615\n1,4611686018427387904,18446744073709551615\n").unwrap();
+    let record = ["c1.i64out", "c2.i64in", "c2.i64out", "c1.u64out", "c2.u64in", "c2.u64out"];
+    let by_hand = "4611686018427387905,4611686018427387905,4611686018427387904,18446744073709551614,18446744073709551614,18446744073709551615";
+    let csv = dir.join("out.csv");
+    for (algorithm, interface, isolate) in [
+        ("jacobi", "cs", ""),
+        ("ordered", "cs", ""),
+        ("jacobi", "me", ""),
+        ("ordered", "me", ""),
+        ("jacobi", "cs", "--isolate=fmu"),
+    ] {
+        let mut args = vec!["run", ssd.to_str().unwrap(), "--step", "0.1", "--input", input.to_str().unwrap()];
+        args.extend(["--algorithm", algorithm, "--interface", interface, "-o", csv.to_str().unwrap()]);
+        for r in &record {
+            args.extend(["--record", r]);
+        }
+        if !isolate.is_empty() {
+            args.push(isolate);
+        }
+        let out = cosim(&args);
+        let what = format!("{algorithm} {interface} {isolate}");
+        assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[0],
+            "\"time\",\"c1.i64out\",\"c2.i64in\",\"c2.i64out\",\"c1.u64out\",\"c2.u64in\",\"c2.u64out\""
+        );
+        assert_eq!(lines[1..], [format!("0,{by_hand}"), format!("0.1,{by_hand}"), format!("0.2,{by_hand}")], "{what}");
+    }
+}
+
 /// An integer connection checks the value against the input's type at every set: a
 /// negative Int64 into a UInt64, a UInt64 above i64::MAX into an Int64, an Int64 beyond
 /// 32 bits into an Int32 are errors naming both ends, the value and the time, never
