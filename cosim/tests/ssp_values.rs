@@ -335,3 +335,85 @@ fn an_algebraic_loop_at_initialization_is_iterated_to_its_fixed_point_and_a_chai
     let s = read_ssp(&dir.join("chain.ssd"), &ImportOptions::default()).unwrap();
     assert!(nigel_cosim::loops::initialization_loop(&s.system).is_none());
 }
+
+#[test]
+fn a_chain_of_direct_feedthrough_enters_its_first_row_at_its_sources_values() {
+    // src -> a -> b -> c, each connection written sink first (as OMSimulator's
+    // AircraftVehicleDemonstrator script writes 109 of them), gains k = 2 with y = k u
+    // (direct feedthrough), from t0 = 2 s, Jacobi (the default: connections delayed by one
+    // step after the first row)
+    let dir = work_dir("ssp-init-chain");
+    build_fmu(Model::Source, &dir, &[]);
+    build_fmu(Model::Gain, &dir, &[]);
+    let ssd = format!(
+        r#"{HEAD}<ssd:System name="top">
+  <ssd:Elements><ssd:Component name="src" source="source.fmu"/><ssd:Component name="a" source="gain.fmu"/><ssd:Component name="b" source="gain.fmu"/><ssd:Component name="c" source="gain.fmu"/></ssd:Elements>
+  <ssd:Connections><ssd:Connection startElement="a" startConnector="u" endElement="src" endConnector="y"/><ssd:Connection startElement="b" startConnector="u" endElement="a" endConnector="y"/><ssd:Connection startElement="c" startConnector="u" endElement="b" endConnector="y"/></ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+    );
+    write(&dir, "chain.ssd", &ssd);
+    let s = read_ssp(&dir.join("chain.ssd"), &ImportOptions::default()).unwrap();
+    assert!(nigel_cosim::loops::initialization_loop(&s.system).is_none());
+    let mut e = Experiment::new(2.5, 0.5);
+    e.start_time = 2.0;
+    e.algorithm = Algorithm::Jacobi;
+    e.record = Some(["a.u", "b.u", "c.u"].map(String::from).to_vec());
+    let (r, _) = simulate(&s.system, &e).unwrap();
+    let column = |name: &str| r.column(name).unwrap();
+    // the first row, t = 2 s, every input at its source's value when Initialization Mode
+    // ends: a.u = src.y = slope t = 1 * 2 = 2; b.u = a.y = 2 * 2 = 4; c.u = b.y = 2 * 4 = 8
+    // (carried once from the start values u = 0, c.u would be b.y of b.u = 0, that is 0)
+    assert_eq!((column("a.u")[0], column("b.u")[0], column("c.u")[0]), (2.0, 4.0, 8.0));
+    // t = 2.5 s, Jacobi: an input row holds the value its instance stepped from 2 s with
+    // (the values got at 2.5 s are set before the next step), the consistent 2, 4, 8 again
+    assert_eq!((column("a.u")[1], column("b.u")[1], column("c.u")[1]), (2.0, 4.0, 8.0));
+}
+
+#[test]
+fn a_loop_the_fmus_do_not_declare_at_initialization_is_iterated_too_or_named_when_it_diverges() {
+    // gains y = k u whose InitialUnknowns say y depends on nothing at initialization while
+    // their Outputs say it depends on u (as the AircraftVehicleDemonstrator's Dymola FMUs
+    // declare their ports): a.y -> b.u (+ 1) and b.y -> a.u are no loop by the declarations
+    let dir = work_dir("ssp-init-undeclared");
+    let xml = Model::Gain.model_description().replace(
+        r#"<Outputs><Unknown index="2" dependencies="1"/></Outputs>"#,
+        r#"<Outputs><Unknown index="2" dependencies="1"/></Outputs><InitialUnknowns><Unknown index="2" dependencies=""/></InitialUnknowns>"#,
+    );
+    assert!(xml.contains("<InitialUnknowns>"));
+    build_fmu_with(Model::Gain, &dir, "gain", &xml);
+    write(
+        &dir,
+        "loop.ssd",
+        &format!(
+            r#"{HEAD}<ssd:System name="top">
+  <ssd:Elements><ssd:Component name="a" source="gain.fmu"/><ssd:Component name="b" source="gain.fmu"/></ssd:Elements>
+  <ssd:Connections><ssd:Connection startElement="a" startConnector="y" endElement="b" endConnector="u"><ssc:LinearTransformation offset="1"/></ssd:Connection><ssd:Connection startElement="b" startConnector="y" endElement="a" endConnector="u"/></ssd:Connections>
+</ssd:System></ssd:SystemStructureDescription>"#
+        ),
+    );
+    let s = read_ssp(&dir.join("loop.ssd"), &ImportOptions::default()).unwrap();
+    assert!(nigel_cosim::loops::initialization_loop(&s.system).is_none());
+    let csv = dir.join("loop.csv");
+    let run = |k: &str| {
+        let (ssd, out) = (dir.join("loop.ssd"), csv.to_str().unwrap());
+        let (ka, kb) = (format!("a.k={k}"), format!("b.k={k}"));
+        let args = ["run", ssd.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.1", "--set", &ka, "--set", &kb];
+        let args = [&args[..], &["--record", "a.u", "--record", "b.u", "-o", out]].concat();
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap()
+    };
+    // k = 0.5: the fixed point by hand (as in the declared loop's test): a.u = 0.25 a.u + 0.5,
+    // a.u = 2/3, b.u = 4/3; each sweep shrinks the error 4 times and the sweeps stop once a
+    // change is below 1e-10 of the value, so the error left is below 1e-10 / 3 of it
+    let out = run("0.5");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let first: Vec<f64> = text.lines().nth(1).unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+    assert!((first[1] - 2.0 / 3.0).abs() < 1e-9, "a.u = {}", first[1]);
+    assert!((first[2] - 4.0 / 3.0).abs() < 1e-9, "b.u = {}", first[2]);
+    // k = 2: a.u = 4 a.u + 2 diverges: refused, saying what was not declared
+    let out = run("2");
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(message.contains("no algebraic loop by the FMUs' declared dependencies"), "{message}");
+    assert!(message.contains("did not converge"), "{message}");
+}

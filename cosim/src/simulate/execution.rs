@@ -370,8 +370,10 @@ impl<'s> Execution<'s> {
             lane.inst.enter_initialization_mode()?;
         }
         self.algorithm.propagate(core)?;
+        // every input at its source's value when Initialization Mode ends: chains of direct
+        // feedthrough settle in one sweep per link, a loop at its fixed point
+        let sweeps = super::init_loop::iterate(core, self.init_loop.as_deref().unwrap_or_default())?;
         if let Some(cycle) = &self.init_loop {
-            let sweeps = super::init_loop::iterate(core, cycle)?;
             self.notes.push(format!(
                 "the connections {} form an algebraic loop at initialization: iterated to its fixed point in {sweeps} sweep{} of the connections (to {:e} relative)",
                 cycle.join(", "),

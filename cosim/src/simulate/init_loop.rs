@@ -1,8 +1,12 @@
-//! An algebraic loop at initialization (`crate::loops`: connections closed through FMUs
-//! whose outputs depend on their inputs at initialization) iterated to its fixed point in
-//! Initialization Mode, as OMSimulator solves it: the connected outputs got and the
-//! connected inputs set (one Jacobi sweep, every connection carried) until no carried value
-//! changes by more than [`RTOL`] of its magnitude, at most [`MAX_SWEEPS`] sweeps.
+//! The connections of a system carried in Initialization Mode until they settle: the
+//! connected outputs got and the connected inputs set (one Jacobi sweep, every connection
+//! carried) until no carried value changes by more than [`RTOL`] of its magnitude, at most
+//! [`MAX_SWEEPS`] sweeps. An algebraic loop at initialization (`crate::loops`: connections
+//! closed through FMUs whose outputs depend on their inputs at initialization) settles at
+//! its fixed point, as OMSimulator solves it; a chain of such FMUs (`a.y -> b.u`, `b.y`
+//! depending on `b.u`, `b.y -> c.u`) settles exactly, one sweep per link, so that every
+//! input enters `exitInitializationMode` at its source's value, not at a value its source
+//! had from its own inputs' start values (carried once, `c.u` would be `b.y` of `b.u`'s start).
 
 use crate::error::{Error, Result};
 use crate::simulate::algorithm::Core;
@@ -14,7 +18,8 @@ pub(crate) const RTOL: f64 = 1e-10;
 pub(crate) const MAX_SWEEPS: usize = 100;
 
 /// Sweeps the connections of `core` (carried once already) until their values settle;
-/// the sweeps taken, or the error naming the loop `cycle` and the largest change left.
+/// the sweeps taken, or the error naming the loop `cycle` (none declared: empty) and the
+/// largest change left.
 /// A value's tolerance is [`RTOL`] of the larger of its old and new magnitude, and of a
 /// millionth of the largest magnitude on the loop, so that a value converging to 0 among
 /// others of size 1e5 settles at 1e-11 rather than never.
@@ -44,8 +49,14 @@ pub(crate) fn iterate(core: &mut Core, cycle: &[String]) -> Result<usize> {
         }
         before.copy_from_slice(&core.values);
     }
+    let what = if cycle.is_empty() {
+        // no loop by the model descriptions: an FMU's outputs depend on its inputs at
+        // initialization beyond its declared dependencies
+        "the connections at initialization (no algebraic loop by the FMUs' declared dependencies: one of them depends on more than it declares)".to_string()
+    } else {
+        format!("the algebraic loop at initialization {}", cycle.join(", "))
+    };
     Err(Error::Experiment(format!(
-        "the algebraic loop at initialization {} did not converge: after {MAX_SWEEPS} sweeps of its connections a value still changed by {worst} (more than {RTOL} of its magnitude)",
-        cycle.join(", ")
+        "{what} did not converge: after {MAX_SWEEPS} sweeps of its connections a value still changed by {worst} (more than {RTOL} of its magnitude)"
     )))
 }
