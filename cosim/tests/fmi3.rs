@@ -1179,6 +1179,38 @@ fn an_ssp_of_int64_connectors_carries_them_exactly_from_the_command_line() {
     }
 }
 
+/// At initialization the connections are carried until no value changes, and an integer
+/// settles only when it no longer changes at all: a change of 1 at 2^62 (a relative 2e-19,
+/// far below the Reals' tolerance of 1e-10) is no convergence. A chain c1 -> c2 -> .. -> c5
+/// of the counter (i64out = i64in ^ 1, depending on i64in at initialization) under
+/// `jacobi`, c2.i64in .. c4.i64in starting at 2^62, each one off or on its settled value.
+/// By hand: c1.i64in = 2^62 gives c1.i64out = 2^62 + 1 = c2.i64in, c2.i64out = 2^62 =
+/// c3.i64in, then 2^62 + 1 = c4.i64in and 2^62 = c5.i64in: the row at the start time
+/// holds them. Sweeps that stopped at the first small change (then one more carry before
+/// the first row) would leave c5.i64in at 2^62 + 1.
+#[test]
+fn an_integer_chain_settles_exactly_at_initialization() {
+    use nigel_cosim::Algorithm;
+    let Some((_dir, path)) = counter("fmi3-integer-chain") else { return };
+    let mut b = SystemBuilder::new();
+    let names = ["c1", "c2", "c3", "c4", "c5"];
+    for name in names {
+        b.add_instance(name, Fmu::load(&path).unwrap()).unwrap();
+    }
+    for name in &names[..4] {
+        b.set(&format!("{name}.i64in"), Value::Real(2f64.powi(62))).unwrap();
+    }
+    for pair in names.windows(2) {
+        b.connect(&format!("{}.i64out", pair[0]), &format!("{}.i64in", pair[1])).unwrap();
+    }
+    let mut e = Experiment::new(0.1, 0.1);
+    e.algorithm = Algorithm::Jacobi;
+    e.record = Some(names[1..].iter().map(|n| format!("{n}.i64in")).collect());
+    let (r, _) = simulate(&b.build(), &e).unwrap();
+    let first_row: Vec<&str> = (0..4).map(|k| r.exact_column(k).unwrap()[0].as_str()).collect();
+    assert_eq!(first_row, ["4611686018427387905", "4611686018427387904", "4611686018427387905", "4611686018427387904"]);
+}
+
 /// An integer connection checks the value against the input's type at every set: a
 /// negative Int64 into a UInt64, a UInt64 above i64::MAX into an Int64, an Int64 beyond
 /// 32 bits into an Int32 are errors naming both ends, the value and the time, never

@@ -529,6 +529,12 @@ impl Plan {
         Ok(Plan { slots, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets, links, exchange_len })
     }
 
+    /// The slots of the integer connections' outputs and their residual slots: the values
+    /// that are integers, exact or wrong (see `integers.rs`).
+    pub(crate) fn exact_slots(&self) -> Vec<usize> {
+        self.links.iter().flat_map(|(r, link)| [self.slot(r), link.residual()]).collect()
+    }
+
     /// The slot of a planned variable.
     pub(crate) fn slot(&self, r: &VariableRef) -> usize {
         self.slots.get(r).copied().unwrap_or(0)
