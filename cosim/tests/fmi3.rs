@@ -780,8 +780,8 @@ fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
 
 /// An FMI 3.0 Int64 output declared `ssc:Integer` in an SSP (as OMSimulator writes it;
 /// SSP 1.0 has no Int64), connected (written sink first) to another counter's Float64
-/// input: read, and its values beyond 32 bits carried exactly (the view carries Int64 as
-/// a Real, exact up to 2^53). A Boolean declaration of the same variable is refused.
+/// input: read, and its values beyond 32 bits carried exactly (the view holds an Int64 as
+/// a Real). A Boolean declaration of the same variable is refused.
 #[test]
 fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
     use nigel_cosim::{read_ssp, Algorithm, ImportOptions};

@@ -5,7 +5,7 @@
 //! The view is an FMI 2.0-shaped [`ModelDescription`] of the FMU's variables, with the same
 //! names, value references, causalities, variabilities, units and ModelStructure (indices
 //! into the view): Float64, Float32, UInt32, Int64 and UInt64 as Real (the 64-bit integers
-//! exact up to 2^53, beyond which reading them is an error), Int8 .. Int32 as Integer,
+//! exact up to 2^53; [`crate::Instance::get_exact`] reads them exactly), Int8 .. Int32 as Integer,
 //! Boolean, String, Enumeration (Int64 values of i32 items), a Binary as a Real holding its
 //! size in bytes (read-only); an array as one variable per element, `y[1]`, `y[2]`, ...
 //! (`A[1,2]`: 1-based, row-major, as FMI 2.0 names array elements) with value references
