@@ -22,8 +22,6 @@ from pathlib import Path
 # its reason; remove an entry when its reason is gone.
 KNOWN = {
     "cosim/src/simulate/": "mod.rs, types.rs and the algorithms share types both ways; not yet moved (issue 37 step 5)",
-    "fmi-export/src/units.rs": "its test compares with crate::si_unit of decl.rs (issue 37 step 5)",
-    "fmi-export/src/instance/": "instance/mod.rs and values.rs share types both ways (issue 37 step 5)",
 }
 
 IDENT = r"[A-Za-z_][A-Za-z0-9_]*"

@@ -114,7 +114,8 @@ done
 stage "the controller with its FMI 3.0 sample clock (build option controller-sample-clock, off by default)"
 # its FMI 3.0 archive declares the sample period as a periodic input clock: built into a
 # folder of its own (target/fmu and target/ssp stay the shipped ones) for
-# tests/python/test_clocked_controller.py (fmpy drives the clock); the layer-level run
+# tests/python/test_clocked_controller.py (fmpy drives the clock) and
+# tests/tests/fmi3_closed_loop.rs (its closed loop equals the FMI 2.0 one); the layer-level run
 cargo run --release --quiet -p build-fmu --features controller-sample-clock -- --platforms linux64 \
     "$target_dir/fmu-clocked/fmu" >/dev/null
 cargo test --release --quiet -p fmu-controller --features fmi3-sample-clock --test sample_clock

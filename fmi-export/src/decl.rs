@@ -150,7 +150,13 @@ impl<B> VarDecl<B> {
 
     /// The same variable with another binding, and the binding it had.
     pub(crate) fn with_binding<C>(self, binding: C) -> (VarDecl<C>, B) {
-        let VarDecl {
+        macro_rules! rebind {
+            ($($field:ident),*) => {{
+                let VarDecl { $($field,)* binding: old } = self;
+                (VarDecl { $($field,)* binding }, old)
+            }};
+        }
+        rebind!(
             name,
             value_reference,
             base_type,
@@ -166,29 +172,8 @@ impl<B> VarDecl<B> {
             derivative_of,
             dependencies,
             declared_type,
-            mismatched_accessor,
-            binding: old,
-        } = self;
-        let v = VarDecl {
-            name,
-            value_reference,
-            base_type,
-            description,
-            causality,
-            variability,
-            initial,
-            start,
-            unit,
-            min,
-            max,
-            nominal,
-            derivative_of,
-            dependencies,
-            declared_type,
-            mismatched_accessor,
-            binding,
-        };
-        (v, old)
+            mismatched_accessor
+        )
     }
 
     /// A Real variable.
@@ -241,13 +226,8 @@ impl<B> VarDecl<B> {
     }
 
     /// `causality="parameter" variability="fixed" initial="exact"` with a start value.
-    pub fn parameter(mut self, start: impl Into<Start>) -> Self {
-        let start = start.into();
-        self.causality = Causality::Parameter;
-        self.variability = Variability::Fixed;
-        self.initial = Some(Initial::Exact);
-        self.start = start;
-        self
+    pub fn parameter(self, start: impl Into<Start>) -> Self {
+        VarDecl { start: start.into(), ..self.kind(Causality::Parameter, Variability::Fixed, Some(Initial::Exact)) }
     }
 
     /// `causality="parameter" variability="tunable" initial="exact"`: settable between
@@ -260,25 +240,16 @@ impl<B> VarDecl<B> {
 
     /// A discrete state (`causality="local" variability="discrete" initial="exact"`): it
     /// changes only at events; saved with the FMU state through the model's setter.
-    pub fn discrete_state(mut self, start: impl Into<Start>) -> Self {
-        let start = start.into();
-        self.causality = Causality::Local;
-        self.variability = Variability::Discrete;
-        self.initial = Some(Initial::Exact);
-        self.start = start;
-        self
+    pub fn discrete_state(self, start: impl Into<Start>) -> Self {
+        VarDecl { start: start.into(), ..self.kind(Causality::Local, Variability::Discrete, Some(Initial::Exact)) }
     }
 
     /// A discrete output (`variability="discrete"`, `initial="calculated"`): held between
     /// events, computed by the model at events; saved with the FMU state through the
     /// model's setter (a held value is not a function of the current inputs).
-    pub fn discrete_output(mut self, dependencies: impl Into<Dependencies>) -> Self {
+    pub fn discrete_output(self, dependencies: impl Into<Dependencies>) -> Self {
         let dependencies = dependencies.into();
-        self.causality = Causality::Output;
-        self.variability = Variability::Discrete;
-        self.initial = Some(Initial::Calculated);
-        self.dependencies = dependencies;
-        self
+        VarDecl { dependencies, ..self.kind(Causality::Output, Variability::Discrete, Some(Initial::Calculated)) }
     }
 
     /// Sets the start value and `initial` (e.g. a discrete output with an exact start
@@ -290,57 +261,51 @@ impl<B> VarDecl<B> {
     }
 
     /// `causality="input"` (continuous for Reals, discrete otherwise) with a start value.
-    pub fn input(mut self, start: impl Into<Start>) -> Self {
-        let start = start.into();
-        self.causality = Causality::Input;
-        self.variability =
+    pub fn input(self, start: impl Into<Start>) -> Self {
+        let variability =
             if self.base_type == BaseType::Real { Variability::Continuous } else { Variability::Discrete };
-        self.initial = None;
-        self.start = start;
-        self
+        VarDecl { start: start.into(), ..self.kind(Causality::Input, variability, None) }
     }
 
     /// A continuous state whose start value (`initial="exact"`) is the initial condition;
     /// `output` makes it a model output too.
-    pub fn state(mut self, start: f64, output: bool) -> Self {
-        self.causality = if output { Causality::Output } else { Causality::Local };
-        self.variability = Variability::Continuous;
-        self.initial = Some(Initial::Exact);
-        self.start = Start::Real(start);
+    pub fn state(self, start: f64, output: bool) -> Self {
+        let causality = if output { Causality::Output } else { Causality::Local };
+        let mut state = VarDecl {
+            start: Start::Real(start),
+            ..self.kind(causality, Variability::Continuous, Some(Initial::Exact))
+        };
         if output {
-            self.dependencies = Dependencies::On(vec![self.value_reference]);
+            state.dependencies = Dependencies::On(vec![state.value_reference]);
         }
-        self
+        state
     }
 
     /// The derivative of the state `state` (its handle or Real value reference; local, calculated).
-    pub fn derivative(mut self, state: impl RealReference, dependencies: impl Into<Dependencies>) -> Self {
-        let (state_vr, dependencies) = (state.real_value_reference(), dependencies.into());
-        self.causality = Causality::Local;
-        self.variability = Variability::Continuous;
-        self.initial = Some(Initial::Calculated);
-        self.derivative_of = Some(state_vr);
-        self.dependencies = dependencies;
-        self
+    pub fn derivative(self, state: impl RealReference, dependencies: impl Into<Dependencies>) -> Self {
+        let (derivative_of, dependencies) = (Some(state.real_value_reference()), dependencies.into());
+        VarDecl {
+            derivative_of,
+            dependencies,
+            ..self.kind(Causality::Local, Variability::Continuous, Some(Initial::Calculated))
+        }
     }
 
     /// `causality="calculatedParameter" variability="tunable" initial="calculated"`: a
     /// value the model computes from the parameters (recomputed when a tunable one changes).
-    pub fn calculated_parameter(mut self) -> Self {
-        self.causality = Causality::CalculatedParameter;
-        self.variability = Variability::Tunable;
-        self.initial = Some(Initial::Calculated);
-        self
+    pub fn calculated_parameter(self) -> Self {
+        self.kind(Causality::CalculatedParameter, Variability::Tunable, Some(Initial::Calculated))
     }
 
     /// A calculated continuous output.
-    pub fn output(mut self, dependencies: impl Into<Dependencies>) -> Self {
+    pub fn output(self, dependencies: impl Into<Dependencies>) -> Self {
         let dependencies = dependencies.into();
-        self.causality = Causality::Output;
-        self.variability = Variability::Continuous;
-        self.initial = Some(Initial::Calculated);
-        self.dependencies = dependencies;
-        self
+        VarDecl { dependencies, ..self.kind(Causality::Output, Variability::Continuous, Some(Initial::Calculated)) }
+    }
+
+    /// The variable with `causality`, `variability` and `initial`.
+    fn kind(self, causality: Causality, variability: Variability, initial: Option<Initial>) -> Self {
+        VarDecl { causality, variability, initial, ..self }
     }
 }
 
@@ -703,24 +668,22 @@ impl<B: Copy> Declaration<B> {
                 }
             }
         }
-        let capabilities_cs = md::CoSimulation {
-            model_identifier: spec.model_identifier.to_string(),
-            can_handle_variable_communication_step_size: true,
-            can_not_use_memory_management_functions: true,
-            can_get_and_set_fmu_state: caps.fmu_state,
-            can_serialize_fmu_state: caps.serialize_fmu_state,
-            provides_directional_derivative: caps.directional_derivatives,
-            ..Default::default()
-        };
-        let capabilities_me = md::ModelExchange {
-            model_identifier: spec.model_identifier.to_string(),
-            completed_integrator_step_not_needed: true,
-            can_not_use_memory_management_functions: true,
-            can_get_and_set_fmu_state: caps.fmu_state,
-            can_serialize_fmu_state: caps.serialize_fmu_state,
-            provides_directional_derivative: caps.directional_derivatives,
-            ..Default::default()
-        };
+        // the capability flags both interfaces' elements have, and each one's own
+        macro_rules! capabilities {
+            ($interface:ident { $($own:ident),* }) => {
+                md::$interface {
+                    model_identifier: spec.model_identifier.to_string(),
+                    can_not_use_memory_management_functions: true,
+                    can_get_and_set_fmu_state: caps.fmu_state,
+                    can_serialize_fmu_state: caps.serialize_fmu_state,
+                    provides_directional_derivative: caps.directional_derivatives,
+                    $($own: true,)*
+                    ..Default::default()
+                }
+            };
+        }
+        let capabilities_cs = capabilities!(CoSimulation { can_handle_variable_communication_step_size });
+        let capabilities_me = capabilities!(ModelExchange { completed_integrator_step_not_needed });
         let description = md::ModelDescription {
             fmi_version: "2.0".into(),
             model_name: spec.model_name.into(),
@@ -747,28 +710,12 @@ impl<B: Copy> Declaration<B> {
             model_structure: structure,
         }
         .with_content_guid();
-        let problems = description.validate();
-        if !problems.is_empty() {
-            let list: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
-            return Err(format!(
-                "the declaration of {} is not a valid FMI 2.0 description: {}",
-                spec.model_name,
-                list.join("; ")
-            ));
-        }
+        valid(&spec, "FMI 2.0", &description.validate())?;
         let xml = description.to_xml();
         let clocked_rows = clocked_rows(&spec, &lookup)?;
         let mut description3 = fmi3_description(&description, spec.capabilities);
         add_clocks(&mut description3, &spec.clocks, &clocked_rows);
-        let problems3 = description3.validate();
-        if !problems3.is_empty() {
-            let list: Vec<String> = problems3.iter().map(|p| p.to_string()).collect();
-            return Err(format!(
-                "the declaration of {} is not a valid FMI 3.0 description: {}",
-                spec.model_name,
-                list.join("; ")
-            ));
-        }
+        valid(&spec, "FMI 3.0", &description3.validate())?;
         let xml3 = description3.to_xml();
         let saved_rows = (0..spec.variables.len())
             .filter(|&row| {
@@ -1232,6 +1179,15 @@ pub fn declared_name(name: String) -> &'static str {
     Box::leak(name.into_boxed_str())
 }
 
+/// Refuses a declaration whose `generation` description has `problems` (listed).
+fn valid<B>(spec: &DeclarationSpec<B>, generation: &str, problems: &[impl std::fmt::Display]) -> Result<(), String> {
+    if problems.is_empty() {
+        return Ok(());
+    }
+    let list: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+    Err(format!("the declaration of {} is not a valid {generation} description: {}", spec.model_name, list.join("; ")))
+}
+
 /// The `<UnitDefinitions>`: the units the spec lists, then those the variables use in the
 /// order of first use, derived from their names.
 fn unit_definitions<B>(spec: &DeclarationSpec<B>) -> Result<Vec<md::Unit>, String> {
@@ -1246,17 +1202,10 @@ fn unit_definitions<B>(spec: &DeclarationSpec<B>) -> Result<Vec<md::Unit>, Strin
     Ok(units)
 }
 
-/// A unit with base-unit exponents `[kg, m, s, rad]`.
-pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
-    md::Unit {
-        name: name.to_string(),
-        base_unit: Some(md::BaseUnit { kg, m, s, rad, factor: 1.0, ..Default::default() }),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::units::si_unit;
 
     fn spec(variables: Vec<VarDecl<u8>>) -> DeclarationSpec<u8> {
         DeclarationSpec {

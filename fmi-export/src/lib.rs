@@ -59,8 +59,8 @@
 //!   [`abi::table`] (symbol, its C type in `fmi-sys`, its [`Function`] variant, the layer
 //!   function and the C parameters): the exported wrapper, its compile-time signature check
 //!   and the `Function` variant come from that row. Then the layer function in
-//!   [`abi::fmi2`] or [`abi::fmi3`] (the `Function` first, pointers to slices, one call of
-//!   the instance under the shared guard: null checks, the state table, the panic catch,
+//!   [`abi::shared`] (both generations), [`abi::fmi2`] or [`abi::fmi3`] (the `Function`
+//!   first, pointers to slices, one call of the instance under the shared guard: null checks, the state table, the panic catch,
 //!   the logged message naming the function); the function's row of the allowed-states
 //!   table in [`states`] where the standard lists it in other states than its FMI 2.0
 //!   counterpart; what it does in the [`instance`] module of its concern (values, events
@@ -186,7 +186,7 @@
 //! [`decl`] (the declaration and the generated XML); [`model`] (the trait a model
 //! implements); [`variables`] (declaring each variable once); [`instance`] (one instance:
 //! the FMI semantics over a model, one submodule per concern); [`abi`] (the C entry points:
-//! the table [`abi::table`], the layer functions [`abi::fmi2`], [`abi::fmi3`]); with the
+//! the table [`abi::table`], the layer functions [`abi::fmi2`], [`abi::fmi3`], [`abi::shared`]); with the
 //! feature `testing`, `testing` (the in-process importer of the FMU crates' tests, both
 //! generations). The `Function` enum of [`states`] is expanded from [`abi::table`] (a
 //! macro, not an import: no circle).
@@ -210,7 +210,7 @@ pub mod uri;
 pub mod variables;
 
 pub use decl::{
-    declared_name, enumeration_type, si_unit, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
+    declared_name, enumeration_type, BaseType, Capabilities, Causality, ClockDecl, ClockInterval, Declaration,
     DeclarationSpec, Dependencies, Initial, Interfaces, RealReference, Start, VarDecl, VarHandle, Variability,
 };
 pub use fmi_sys;
@@ -220,6 +220,7 @@ pub use model::{Access, EventUpdate, InstantiateContext, Interface, Model, Model
 pub use model_description;
 pub use sampled::{SampleClock, SampleEnd};
 pub use states::{Function, Machine};
+pub use units::si_unit;
 pub use variables::{Accessor, Family, Field, FieldValue, Pending, Variables};
 
 /// Exports the 44 FMI 2.0 and the 75 FMI 3.0 functions for model type `$model` from the

@@ -196,16 +196,7 @@ impl Function {
             Fmi3EnterConfigurationMode | Fmi3ExitConfigurationMode => {
                 "no structural parameters, so no Configuration Mode"
             }
-            Fmi3GetClock
-            | Fmi3SetClock
-            | Fmi3GetIntervalDecimal
-            | Fmi3GetIntervalFraction
-            | Fmi3GetShiftDecimal
-            | Fmi3GetShiftFraction
-            | Fmi3SetIntervalDecimal
-            | Fmi3SetIntervalFraction
-            | Fmi3SetShiftDecimal
-            | Fmi3SetShiftFraction => "no clocks are declared",
+            f if f.is_clock_function() => "no clocks are declared",
             Fmi3EvaluateDiscreteStates => "providesEvaluateDiscreteStates is false",
             Fmi3GetOutputDerivatives => "maxOutputDerivativeOrder is 0",
             Fmi3EnterStepMode => "hasEventMode is false: a Co-Simulation instance never leaves Step Mode",
@@ -343,14 +334,7 @@ impl Function {
             Fmi3GetClock | Fmi3SetClock => mask(&[EventMode]),
             // the intervals and shifts of time-based clocks: Initialization Mode and Event
             // Mode (Scheduled Execution's Clock Activation Mode is not offered)
-            Fmi3GetIntervalDecimal
-            | Fmi3GetIntervalFraction
-            | Fmi3GetShiftDecimal
-            | Fmi3GetShiftFraction
-            | Fmi3SetIntervalDecimal
-            | Fmi3SetIntervalFraction
-            | Fmi3SetShiftDecimal
-            | Fmi3SetShiftFraction => mask(&[InitializationMode, EventMode]),
+            f if f.is_clock_function() => mask(&[InitializationMode, EventMode]),
             // Co-Simulation with Event Mode (an FMU with clocks): Event Mode back to Step Mode
             Fmi3EnterStepMode => mask(&[EventMode]),
             // Scheduled Execution's Clock Activation Mode (the layer's StepComplete)

@@ -247,7 +247,8 @@ impl<M: Model> Drop for Fmu<M> {
 
 // ------------------------------------------------------------------ FMI 3.0
 
-use crate::abi::fmi3 as abi3;
+use crate::abi::fmi3::value::Float64;
+use crate::abi::fmi3::{self as abi3, status3};
 pub use fmi_sys::fmi3::Fmi3Status;
 use fmi_sys::fmi3::{fmi3FMUState, fmi3Instance, fmi3Status, FMI3_FALSE, FMI3_TRUE};
 
@@ -303,15 +304,11 @@ impl<M: Model> Fmu3<M> {
     /// `fmi3InstantiateCoSimulation` with `token` and `eventModeUsed`; `None` (and the log)
     /// when the layer refuses.
     pub fn try_cs(token: &str, event_mode_used: bool) -> Result<Self, Box<Log>> {
-        let log = Box::<Log>::default();
-        let name = CString::new("test3").unwrap();
-        let token = CString::new(token).unwrap();
-        let env = &*log as *const Log as *mut std::ffi::c_void;
-        let c = unsafe {
+        Self::try_instantiate(token, |name, token, env| unsafe {
             abi3::instantiate_co_simulation::<M>(
                 Function::Fmi3InstantiateCoSimulation,
-                name.as_ptr(),
-                token.as_ptr(),
+                name,
+                token,
                 std::ptr::null(),
                 FMI3_FALSE,
                 FMI3_TRUE,
@@ -323,32 +320,36 @@ impl<M: Model> Fmu3<M> {
                 Some(log_message),
                 None,
             )
-        };
-        if c.is_null() {
-            Err(log)
-        } else {
-            Ok(Fmu3 { c, log, _m: std::marker::PhantomData })
-        }
+        })
     }
 
     /// `fmi3InstantiateModelExchange` with `token`.
     pub fn try_me(token: &str) -> Result<Self, Box<Log>> {
-        let log = Box::<Log>::default();
-        let name = CString::new("test3").unwrap();
-        let token = CString::new(token).unwrap();
-        let env = &*log as *const Log as *mut std::ffi::c_void;
-        let c = unsafe {
+        Self::try_instantiate(token, |name, token, env| unsafe {
             abi3::instantiate_model_exchange::<M>(
                 Function::Fmi3InstantiateModelExchange,
-                name.as_ptr(),
-                token.as_ptr(),
+                name,
+                token,
                 std::ptr::null(),
                 FMI3_FALSE,
                 FMI3_TRUE,
                 env,
                 Some(log_message),
             )
-        };
+        })
+    }
+
+    /// An instance from `instantiate(instanceName, instantiationToken, instanceEnvironment)`,
+    /// its log the environment; the log when the layer refuses.
+    fn try_instantiate(
+        token: &str,
+        instantiate: impl FnOnce(*const std::ffi::c_char, *const std::ffi::c_char, *mut std::ffi::c_void) -> fmi3Instance,
+    ) -> Result<Self, Box<Log>> {
+        let log = Box::<Log>::default();
+        let name = CString::new("test3").unwrap();
+        let token = CString::new(token).unwrap();
+        let env = &*log as *const Log as *mut std::ffi::c_void;
+        let c = instantiate(name.as_ptr(), token.as_ptr(), env);
         if c.is_null() {
             Err(log)
         } else {
@@ -387,7 +388,7 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn exit_init(&self) -> Fmi3Status {
-        unsafe { abi3::exit_initialization_mode::<M>(Function::Fmi3ExitInitializationMode, self.c) }
+        unsafe { status3(abi::exit_initialization_mode::<M>(Function::Fmi3ExitInitializationMode, self.c)) }
     }
 
     /// Enter and exit initialization at `start` with an optional stop time, all Ok.
@@ -397,16 +398,8 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn get_float64(&self, vrs: &[u32], out: &mut [f64]) -> Fmi3Status {
-        unsafe {
-            abi3::get::<M, abi3::value::Float64>(
-                Function::Fmi3GetFloat64,
-                self.c,
-                vrs.as_ptr(),
-                vrs.len(),
-                out.as_mut_ptr(),
-                out.len(),
-            )
-        }
+        let (vr, n_vr) = (vrs.as_ptr(), vrs.len());
+        unsafe { abi3::get::<M, Float64>(Function::Fmi3GetFloat64, self.c, vr, n_vr, out.as_mut_ptr(), out.len()) }
     }
 
     pub fn float64(&self, vr: u32) -> f64 {
@@ -416,16 +409,8 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn set_float64(&self, vrs: &[u32], values: &[f64]) -> Fmi3Status {
-        unsafe {
-            abi3::set::<M, abi3::value::Float64>(
-                Function::Fmi3SetFloat64,
-                self.c,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_ptr(),
-                values.len(),
-            )
-        }
+        let (vr, n_vr) = (vrs.as_ptr(), vrs.len());
+        unsafe { abi3::set::<M, Float64>(Function::Fmi3SetFloat64, self.c, vr, n_vr, values.as_ptr(), values.len()) }
     }
 
     pub fn int32(&self, vr: u32) -> i32 {
@@ -493,24 +478,24 @@ impl<M: Model> Fmu3<M> {
     }
 
     pub fn terminate(&self) -> Fmi3Status {
-        unsafe { abi3::terminate::<M>(Function::Fmi3Terminate, self.c) }
+        unsafe { status3(abi::terminate::<M>(Function::Fmi3Terminate, self.c)) }
     }
 
     pub fn reset(&self) -> Fmi3Status {
-        unsafe { abi3::reset::<M>(Function::Fmi3Reset, self.c) }
+        unsafe { status3(abi::reset::<M>(Function::Fmi3Reset, self.c)) }
     }
 
     // Model Exchange
     pub fn set_time(&self, t: f64) -> Fmi3Status {
-        unsafe { abi3::set_time::<M>(Function::Fmi3SetTime, self.c, t) }
+        unsafe { status3(abi::set_time::<M>(Function::Fmi3SetTime, self.c, t)) }
     }
 
     pub fn enter_event_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_event_mode::<M>(Function::Fmi3EnterEventMode, self.c) }
+        unsafe { status3(abi::enter_event_mode::<M>(Function::Fmi3EnterEventMode, self.c)) }
     }
 
     pub fn enter_continuous_time_mode(&self) -> Fmi3Status {
-        unsafe { abi3::enter_continuous_time_mode::<M>(Function::Fmi3EnterContinuousTimeMode, self.c) }
+        unsafe { status3(abi::enter_continuous_time_mode::<M>(Function::Fmi3EnterContinuousTimeMode, self.c)) }
     }
 
     /// `fmi3UpdateDiscreteStates`, which must return Ok.
@@ -540,25 +525,27 @@ impl<M: Model> Fmu3<M> {
     pub fn continuous_states(&self) -> Vec<f64> {
         let mut x = vec![f64::NAN; M::declaration().number_of_states()];
         let s = unsafe {
-            abi3::get_continuous_states::<M>(Function::Fmi3GetContinuousStates, self.c, x.as_mut_ptr(), x.len())
+            status3(abi::get_continuous_states::<M>(Function::Fmi3GetContinuousStates, self.c, x.as_mut_ptr(), x.len()))
         };
         assert_eq!(s, OK3, "{}", self.last_error());
         x
     }
 
     pub fn set_continuous_states(&self, x: &[f64]) -> Fmi3Status {
-        unsafe { abi3::set_continuous_states::<M>(Function::Fmi3SetContinuousStates, self.c, x.as_ptr(), x.len()) }
+        unsafe {
+            status3(abi::set_continuous_states::<M>(Function::Fmi3SetContinuousStates, self.c, x.as_ptr(), x.len()))
+        }
     }
 
     pub fn derivatives(&self) -> Vec<f64> {
         let mut dx = vec![f64::NAN; M::declaration().number_of_states()];
         let s = unsafe {
-            abi3::get_continuous_state_derivatives::<M>(
+            status3(abi::get_derivatives::<M>(
                 Function::Fmi3GetContinuousStateDerivatives,
                 self.c,
                 dx.as_mut_ptr(),
                 dx.len(),
-            )
+            ))
         };
         assert_eq!(s, OK3, "{}", self.last_error());
         dx
@@ -566,34 +553,27 @@ impl<M: Model> Fmu3<M> {
 
     /// `fmi3GetDirectionalDerivative`: `J seed` or the status.
     pub fn directional(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
-        let mut out = vec![f64::NAN; unknowns.len()];
-        let s = unsafe {
-            abi3::get_partial_derivatives::<M>(
-                Function::Fmi3GetDirectionalDerivative,
-                self.c,
-                unknowns.as_ptr(),
-                unknowns.len(),
-                knowns.as_ptr(),
-                knowns.len(),
-                seed.as_ptr(),
-                seed.len(),
-                out.as_mut_ptr(),
-                out.len(),
-            )
-        };
-        if s == OK3 {
-            Ok(out)
-        } else {
-            Err(s)
-        }
+        self.partial_derivatives(Function::Fmi3GetDirectionalDerivative, unknowns, knowns, seed, unknowns.len())
     }
 
     /// `fmi3GetAdjointDerivative`: `J^T seed` or the status.
     pub fn adjoint(&self, unknowns: &[u32], knowns: &[u32], seed: &[f64]) -> Result<Vec<f64>, Fmi3Status> {
-        let mut out = vec![f64::NAN; knowns.len()];
+        self.partial_derivatives(Function::Fmi3GetAdjointDerivative, unknowns, knowns, seed, knowns.len())
+    }
+
+    /// `function` (directional or adjoint) with a sensitivity of `n` values.
+    fn partial_derivatives(
+        &self,
+        function: Function,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        n: usize,
+    ) -> Result<Vec<f64>, Fmi3Status> {
+        let mut out = vec![f64::NAN; n];
         let s = unsafe {
             abi3::get_partial_derivatives::<M>(
-                Function::Fmi3GetAdjointDerivative,
+                function,
                 self.c,
                 unknowns.as_ptr(),
                 unknowns.len(),
@@ -617,22 +597,28 @@ impl<M: Model> Fmu3<M> {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
             assert_eq!(
-                abi3::get_fmu_state::<M>(Function::Fmi3GetFMUState, self.c, &mut s),
+                status3(abi::get_fmu_state::<M>(Function::Fmi3GetFMUState, self.c, &mut s)),
                 OK3,
                 "{}",
                 self.last_error()
             );
             let mut n = 0usize;
             assert_eq!(
-                abi3::serialized_fmu_state_size::<M>(Function::Fmi3SerializedFMUStateSize, self.c, s, &mut n),
+                status3(abi::serialized_fmu_state_size::<M>(Function::Fmi3SerializedFMUStateSize, self.c, s, &mut n)),
                 OK3
             );
             let mut bytes = vec![0u8; n];
             assert_eq!(
-                abi3::serialize_fmu_state::<M>(Function::Fmi3SerializeFMUState, self.c, s, bytes.as_mut_ptr(), n),
+                status3(abi::serialize_fmu_state::<M>(
+                    Function::Fmi3SerializeFMUState,
+                    self.c,
+                    s,
+                    bytes.as_mut_ptr(),
+                    n
+                )),
                 OK3
             );
-            assert_eq!(abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s), OK3);
+            assert_eq!(status3(abi::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s)), OK3);
             bytes
         }
     }
@@ -641,18 +627,18 @@ impl<M: Model> Fmu3<M> {
     pub fn restore_serialized(&self, bytes: &[u8]) -> Fmi3Status {
         unsafe {
             let mut s: fmi3FMUState = null_mut();
-            let st = abi3::deserialize_fmu_state::<M>(
+            let st = status3(abi::deserialize_fmu_state::<M>(
                 Function::Fmi3DeserializeFMUState,
                 self.c,
                 bytes.as_ptr(),
                 bytes.len(),
                 &mut s,
-            );
+            ));
             if st != OK3 {
                 return st;
             }
-            let st = abi3::set_fmu_state::<M>(Function::Fmi3SetFMUState, self.c, s);
-            abi3::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s);
+            let st = status3(abi::set_fmu_state::<M>(Function::Fmi3SetFMUState, self.c, s));
+            abi::free_fmu_state::<M>(Function::Fmi3FreeFMUState, self.c, &mut s);
             st
         }
     }
@@ -660,7 +646,7 @@ impl<M: Model> Fmu3<M> {
 
 impl<M: Model> Drop for Fmu3<M> {
     fn drop(&mut self) {
-        unsafe { abi3::free_instance::<M>(Function::Fmi3FreeInstance, self.c) }
+        unsafe { abi::free_instance::<M>(Function::Fmi3FreeInstance, self.c) }
     }
 }
 

@@ -9,9 +9,17 @@
 //! `s`, `A`, `K`, `mol`, `cd`, the radian `rad` (FMI keeps it as a base unit of its own, so
 //! that `rad/s` and `1/s` stay apart), and the derived units `N`, `J`, `W`, `Pa`, `Hz`,
 //! `V`, `C`. Prefixes (`mm`, `km`) and factors other than 1 are not derived: declare those
-//! units explicitly with [`crate::si_unit`] or a full [`model_description::Unit`].
+//! units explicitly with [`si_unit`] or a full [`model_description::Unit`].
 
 use model_description as md;
+
+/// A unit with base-unit exponents `[kg, m, s, rad]`.
+pub fn si_unit(name: &str, kg: i32, m: i32, s: i32, rad: i32) -> md::Unit {
+    md::Unit {
+        name: name.to_string(),
+        base_unit: Some(md::BaseUnit { kg, m, s, rad, factor: 1.0, ..Default::default() }),
+    }
+}
 
 /// Exponents of kg, m, s, A, K, mol, cd, rad.
 type Exponents = [i32; 8];
@@ -123,7 +131,7 @@ mod tests {
         }
         // the same units as the explicit `si_unit` writes them
         for (name, kg, m, s, rad) in [("N.m", 1, 2, -2, 0), ("rad/s2", 0, 0, -2, 1), ("N.s/m", 1, 0, -1, 0)] {
-            assert_eq!(derived_unit(name).unwrap(), crate::si_unit(name, kg, m, s, rad));
+            assert_eq!(derived_unit(name).unwrap(), si_unit(name, kg, m, s, rad));
         }
         assert_eq!(exponents("W"), exponents("J/s"));
         assert_eq!(exponents("Pa"), exponents("N/m2"));

@@ -202,34 +202,25 @@ pub trait FieldValue: Copy + 'static {
     fn get_set<M>(get: fn(&M, usize) -> Self, set: fn(&mut M, usize, Self) -> ModelResult) -> Accessor<M>;
 }
 
-impl FieldValue for f64 {
-    const BASE_TYPE: BaseType = BaseType::Real;
-    fn field<M>(f: fn(&mut M, usize) -> &mut f64) -> Accessor<M> {
-        Accessor::Real(f)
-    }
-    fn get_set<M>(get: fn(&M, usize) -> f64, set: fn(&mut M, usize, f64) -> ModelResult) -> Accessor<M> {
-        Accessor::RealGetSet(get, set)
-    }
+/// `FieldValue` for each value type: its base type and its two [`Accessor`] variants.
+macro_rules! field_values {
+    ($($value:ty: $base_type:ident, $field:ident, $get_set:ident;)*) => {$(
+        impl FieldValue for $value {
+            const BASE_TYPE: BaseType = BaseType::$base_type;
+            fn field<M>(f: fn(&mut M, usize) -> &mut $value) -> Accessor<M> {
+                Accessor::$field(f)
+            }
+            fn get_set<M>(get: fn(&M, usize) -> $value, set: fn(&mut M, usize, $value) -> ModelResult) -> Accessor<M> {
+                Accessor::$get_set(get, set)
+            }
+        }
+    )*};
 }
 
-impl FieldValue for i32 {
-    const BASE_TYPE: BaseType = BaseType::Integer;
-    fn field<M>(f: fn(&mut M, usize) -> &mut i32) -> Accessor<M> {
-        Accessor::Integer(f)
-    }
-    fn get_set<M>(get: fn(&M, usize) -> i32, set: fn(&mut M, usize, i32) -> ModelResult) -> Accessor<M> {
-        Accessor::IntegerGetSet(get, set)
-    }
-}
-
-impl FieldValue for bool {
-    const BASE_TYPE: BaseType = BaseType::Boolean;
-    fn field<M>(f: fn(&mut M, usize) -> &mut bool) -> Accessor<M> {
-        Accessor::Boolean(f)
-    }
-    fn get_set<M>(get: fn(&M, usize) -> bool, set: fn(&mut M, usize, bool) -> ModelResult) -> Accessor<M> {
-        Accessor::BooleanGetSet(get, set)
-    }
+field_values! {
+    f64: Real, Real, RealGetSet;
+    i32: Integer, Integer, IntegerGetSet;
+    bool: Boolean, Boolean, BooleanGetSet;
 }
 
 /// How a [`Field`] reaches its value. Every function gets the model and the variable's
@@ -286,6 +277,32 @@ impl<M> std::fmt::Debug for Field<M> {
 
 const NOT_SETTABLE: &str = "a calculated variable, not settable";
 
+/// A field's getter and setter of Integers or Booleans (no computed ones): the accessor
+/// variants of the type and the refusal for a variable of another type.
+macro_rules! discrete_access {
+    ($($get:ident, $set:ident: $value:ty, $field:ident, $get_set:ident, $other:literal;)*) => {$(
+        fn $get(self, m: &mut M) -> ModelResult<$value> {
+            match self.accessor {
+                Accessor::$field(f) => Ok(*f(m, self.index)),
+                Accessor::$get_set(get, _) => Ok(get(m, self.index)),
+                _ => Err($other.into()),
+            }
+        }
+
+        fn $set(self, m: &mut M, value: $value) -> ModelResult {
+            match self.accessor {
+                Accessor::$field(f) => *f(m, self.index) = value,
+                Accessor::$get_set(_, set) => set(m, self.index, value)?,
+                _ => return Err($other.into()),
+            }
+            if self.parameter {
+                m.parameters_changed();
+            }
+            Ok(())
+        }
+    )*};
+}
+
 impl<M: Model> Access<M> for Field<M> {
     #[inline(always)]
     fn get_real(self, m: &mut M) -> ModelResult<f64> {
@@ -310,44 +327,9 @@ impl<M: Model> Access<M> for Field<M> {
         Ok(())
     }
 
-    fn get_integer(self, m: &mut M) -> ModelResult<i32> {
-        match self.accessor {
-            Accessor::Integer(f) => Ok(*f(m, self.index)),
-            Accessor::IntegerGetSet(get, _) => Ok(get(m, self.index)),
-            _ => Err("not an Integer".into()),
-        }
-    }
-
-    fn set_integer(self, m: &mut M, value: i32) -> ModelResult {
-        match self.accessor {
-            Accessor::Integer(f) => *f(m, self.index) = value,
-            Accessor::IntegerGetSet(_, set) => set(m, self.index, value)?,
-            _ => return Err("not an Integer".into()),
-        }
-        if self.parameter {
-            m.parameters_changed();
-        }
-        Ok(())
-    }
-
-    fn get_boolean(self, m: &mut M) -> ModelResult<bool> {
-        match self.accessor {
-            Accessor::Boolean(f) => Ok(*f(m, self.index)),
-            Accessor::BooleanGetSet(get, _) => Ok(get(m, self.index)),
-            _ => Err("not a Boolean".into()),
-        }
-    }
-
-    fn set_boolean(self, m: &mut M, value: bool) -> ModelResult {
-        match self.accessor {
-            Accessor::Boolean(f) => *f(m, self.index) = value,
-            Accessor::BooleanGetSet(_, set) => set(m, self.index, value)?,
-            _ => return Err("not a Boolean".into()),
-        }
-        if self.parameter {
-            m.parameters_changed();
-        }
-        Ok(())
+    discrete_access! {
+        get_integer, set_integer: i32, Integer, IntegerGetSet, "not an Integer";
+        get_boolean, set_boolean: bool, Boolean, BooleanGetSet, "not a Boolean";
     }
 
     /// A field takes every value the declaration lets through; a get/set pair may refuse.

@@ -356,7 +356,12 @@ fn scheduled_execution_activates_the_clocks_partition() {
         abi3::get_interval_decimal::<Summer>(Function::Fmi3GetIntervalDecimal, c, &vr3::TICK, 1, &mut t, &mut q)
     };
     assert_eq!((s, t, q), (OK3, 0.25, FMI3_INTERVAL_CHANGED));
-    assert_eq!(unsafe { abi3::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c) }, OK3);
+    assert_eq!(
+        unsafe {
+            abi3::status3(fmi_export::abi::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c))
+        },
+        OK3
+    );
     let activate = |t: f64| unsafe {
         abi3::activate_model_partition::<Summer>(Function::Fmi3ActivateModelPartition, c, vr3::TICK, t)
     };
@@ -391,11 +396,11 @@ fn scheduled_execution_activates_the_clocks_partition() {
         "{}",
         last_error(&log)
     );
-    unsafe { abi3::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
+    unsafe { fmi_export::abi::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
     let (c, log) = se3();
     unsafe {
         abi3::enter_initialization_mode::<Summer>(Function::Fmi3EnterInitializationMode, c, 0, 0.0, 0.0, 0, 0.0);
-        abi3::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c);
+        fmi_export::abi::exit_initialization_mode::<Summer>(Function::Fmi3ExitInitializationMode, c);
     }
     let on = FMI3_CLOCK_ACTIVE;
     assert_eq!(unsafe { abi3::set_clock::<Summer>(Function::Fmi3SetClock, c, &vr3::TICK, 1, &on) }, ERR3);
@@ -405,7 +410,7 @@ fn scheduled_execution_activates_the_clocks_partition() {
         unsafe { abi3::do_step::<Summer>(Function::Fmi3DoStep, c, 0.0, 0.1, 0, &mut e, &mut te, &mut er, &mut last) };
     assert_eq!(s, ERR3);
     assert!(last_error(&log).contains("created for ScheduledExecution"), "{}", last_error(&log));
-    unsafe { abi3::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
+    unsafe { fmi_export::abi::free_instance::<Summer>(Function::Fmi3FreeInstance, c) };
 }
 
 /// A serialized FMU state of a clocked instance (in Step Mode between activations) restores

@@ -13,5 +13,7 @@
 //! caller can get wrong stays `unsafe` here; the safe wrappers are the layers' business.
 #![allow(non_camel_case_types)]
 
+mod table;
+
 pub mod fmi2;
 pub mod fmi3;

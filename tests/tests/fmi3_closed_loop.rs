@@ -140,3 +140,47 @@ fn the_closed_loops_with_fmi3_fmus_are_the_fmi2_one_bit_for_bit() {
         }
     }
 }
+
+/// The closed loop of the FMI 3.0 archives with the controller built with its sample clock
+/// (`build-fmu --features controller-sample-clock`, into target/fmu-clocked by the test
+/// command: `sample_clock`, a fixed periodic input clock of 1 ms governing the held
+/// outputs) gives the FMI 2.0 closed loop's results bit for bit, under jacobi and ordered:
+/// the master opens the clock event of each tick at the end of the step that reaches it
+/// and exchanges the values of that communication point in it, so the controller samples
+/// with the inputs it holds there and the exchange reads that sample, as the FMI 2.0
+/// controller samples lazily at the first read (docs/clocks.md). Every communication point
+/// of the 30 s is a tick, the one at the stop time included: 30001 ticks.
+#[test]
+fn the_clocked_fmi3_closed_loop_is_the_fmi2_one_bit_for_bit() {
+    let clocked_ssp = target_dir().join("fmu-clocked").join("ssp").join("nigel_closed_loop_fmi3.ssp");
+    assert!(
+        clocked_ssp.is_file(),
+        "{} missing: run `cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64 \
+         target/fmu-clocked/fmu`",
+        clocked_ssp.display()
+    );
+    let clocked = read_ssp(&clocked_ssp, &Default::default()).unwrap().system;
+    let controller = clocked.instance_index("controller").expect("an instance called controller");
+    let md = clocked.instances[controller].fmu.fmi3_description().expect("the controller in FMI 3.0");
+    let clocks: Vec<&str> =
+        md.model_variables.iter().filter(|v| v.value_type == fmi3::ValueType::Clock).map(|v| v.name.as_str()).collect();
+    assert_eq!(clocks, ["sample_clock"], "the clocked build's controller declares its sample clock");
+    let fmi2 = closed_loops().0;
+    for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+        let mut e = Experiment::new(30.0, 1e-3);
+        e.algorithm = algorithm;
+        let (a, _) = simulate(&fmi2, &e).unwrap();
+        let (b, summary) = simulate(&clocked, &e).unwrap();
+        assert_eq!(summary.ended_by, None, "{algorithm:?}");
+        assert_eq!(summary.clock_ticks, vec![("controller.sample_clock".to_string(), 30001)], "{algorithm:?}");
+        assert_eq!((a.rows(), &a.names), (b.rows(), &b.names), "{algorithm:?}");
+        // (variable, row) of the first value that differs in its bits, if one does
+        let width = a.width();
+        let first = a.values.iter().zip(&b.values).position(|(x, y)| x.to_bits() != y.to_bits());
+        let name = |i: usize| if i % width == 0 { "time".to_string() } else { a.names[i % width - 1].clone() };
+        assert_eq!(first.map(|i| (name(i), i / width)), None, "{algorithm:?}: the clocked loop differs");
+        // the controller did something: its drive force moved
+        let force = 1 + a.names.iter().position(|n| n == "controller.drive_force").expect("drive_force recorded");
+        assert!((0..b.rows()).any(|r| b.values[r * width + force].abs() > 1e-3), "{algorithm:?}");
+    }
+}

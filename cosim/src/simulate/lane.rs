@@ -206,11 +206,19 @@ impl Lane {
     }
 }
 
-/// A Co-Simulation step from `t` to `t_next` of an instance with clocks: to each tick of
-/// its input clocks in the step, the clock event there, on to the next (see `ticks.rs`);
-/// the output clocks' ticks and the intervals the FMU gives taken after every event.
+/// A Co-Simulation step from `t` to `t_next` of an instance with clocks: the clock event
+/// opened at `t` by the step before closed, then to each tick of its input clocks in the
+/// step, the clock event there, on to the next (see `ticks.rs`); the output clocks' ticks
+/// and the intervals the FMU gives taken after every event. The ticks at `t_next` open
+/// their event: the exchange at `t_next` happens in it, as at any event (the clocked
+/// variables of the ticking clocks read and set through the FMU), and the next step closes
+/// it before it steps.
 fn step_ticking(inst: &mut Instance, ticks: &mut Ticks, t: f64, t_next: f64) -> Result<()> {
     let mut at = t;
+    if ticks.take_open() {
+        inst.close_clock_event().map_err(|e| ended_or(inst, e.into(), at, at))?;
+        ticks.after_events(inst, false)?;
+    }
     loop {
         let due = ticks.due(at, t_next);
         let end = due.as_ref().map_or(t_next, |(tick, _)| *tick);
@@ -218,12 +226,17 @@ fn step_ticking(inst: &mut Instance, ticks: &mut Ticks, t: f64, t_next: f64) -> 
             inst.do_step(at, end - at).map_err(|e| ended_or(inst, e.into(), at, end))?;
             ticks.after_events(inst, false)?;
         }
-        let Some((tick, vrs)) = due else { return Ok(()) };
+        let Some((tick, vrs)) = due else { break };
         inst.clock_event(tick, &vrs).map_err(|e| ended_or(inst, e.into(), tick, tick))?;
         ticks.ticked(&vrs);
         ticks.after_events(inst, false)?;
         at = tick;
     }
+    if let Some(vrs) = ticks.at(t_next) {
+        inst.open_clock_event(t_next, &vrs).map_err(|e| ended_or(inst, e.into(), t_next, t_next))?;
+        ticks.opened(&vrs);
+    }
+    Ok(())
 }
 
 /// A Model Exchange step from `t` to `t_next` of an instance with clocks (integrated on its

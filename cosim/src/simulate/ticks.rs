@@ -11,12 +11,14 @@
 //!   (a value of 1 at a row: a tick at its time).
 //!
 //! A tick within a millionth of a communication step of a point is at the point (the
-//! point's time is `t0 + n h`, the tick's `t0 + shift + k i`: the two may differ by an ulp),
-//! and belongs to the step that starts there: the row recorded at a point holds the values
-//! before its ticks (the left limit at the tick, as the Altair Activate references record
-//! them), the next row the values after. A tick inside a step splits it: the lane steps to
-//! the tick, runs the clock event there, and goes on (`Lane::advance`). A tick at the stop
-//! time is not run (no step starts there).
+//! point's time is `t0 + n h`, the tick's `t0 + shift + k i`: the two may differ by an ulp).
+//! In Co-Simulation the step that reaches a tick opens its event ([`Ticks::at`],
+//! [`Ticks::opened`]): the exchange and the row at that point happen in it, and the next
+//! step closes it before it steps (`lane.rs`, docs/clocks.md); the tick at the start time,
+//! and a tick that becomes known inside a step, run whole where the step starts or where
+//! they fall (a tick inside a step splits it: the lane steps to the tick, runs the clock
+//! event there, and goes on). Model Exchange runs every tick whole at the start of the step
+//! from it.
 
 use crate::clocks::{Clock, ClockCausality, ClockKind};
 use crate::error::{Error, Result};
@@ -74,6 +76,9 @@ pub(crate) struct Ticks {
     fired: Vec<u32>,
     /// A millionth of the communication step, s: ticks this close are one.
     tolerance: f64,
+    /// The event of the ticks at the end of the last step is open (Co-Simulation: the
+    /// exchange at that point happens in it; the next step closes it).
+    open: bool,
 }
 
 impl Ticks {
@@ -104,25 +109,25 @@ impl Ticks {
             })
             .collect();
         let counts = clocks.iter().map(|c| (c.value_reference, c.name.clone(), 0)).collect();
-        Some(Ticks { inputs, counts, fired: Vec::new(), tolerance: 1e-6 * h })
+        Some(Ticks { inputs, counts, fired: Vec::new(), tolerance: 1e-6 * h, open: false })
     }
 
     /// The earliest tick from `after` on and before `until` (a tick within the tolerance of
     /// either is at it: a tick on a communication point belongs to the step that starts
     /// there), and the value references of the clocks ticking then.
     pub(crate) fn due(&self, after: f64, until: f64) -> Option<(f64, Vec<u32>)> {
-        let times: Vec<(usize, f64)> =
-            self.inputs.iter().enumerate().filter_map(|(j, s)| Some((j, s.next()?))).collect();
-        let first = times.iter().map(|(_, t)| *t).fold(f64::INFINITY, f64::min);
+        // (called at every step: nothing allocated unless a tick is due)
+        let first = self.inputs.iter().filter_map(Scheduled::next).fold(f64::INFINITY, f64::min);
         // (no tick: first is infinite)
         if first >= until - self.tolerance {
             return None;
         }
         let at = if (first - after).abs() <= self.tolerance { after } else { first.max(after) };
-        let vrs = times
+        let vrs = self
+            .inputs
             .iter()
-            .filter(|(_, t)| (*t - first).abs() <= self.tolerance)
-            .map(|(j, _)| self.inputs[*j].vr)
+            .filter(|s| s.next().is_some_and(|t| (t - first).abs() <= self.tolerance))
+            .map(|s| s.vr)
             .collect();
         Some((at, vrs))
     }
@@ -149,6 +154,29 @@ impl Ticks {
             }
         }
         (first < until - self.tolerance).then_some(first)
+    }
+
+    /// The input clocks whose next tick is at `t` (within the tolerance), if any: the ticks
+    /// at the end of a step, whose event the step opens.
+    pub(crate) fn at(&self, t: f64) -> Option<Vec<u32>> {
+        let vrs: Vec<u32> = self
+            .inputs
+            .iter()
+            .filter(|s| s.next().is_some_and(|next| (next - t).abs() <= self.tolerance))
+            .map(|s| s.vr)
+            .collect();
+        (!vrs.is_empty()).then_some(vrs)
+    }
+
+    /// The clocks `vrs` ticked at the end of a step, their event left open.
+    pub(crate) fn opened(&mut self, vrs: &[u32]) {
+        self.ticked(vrs);
+        self.open = true;
+    }
+
+    /// Whether an event is open (and from now on not).
+    pub(crate) fn take_open(&mut self) -> bool {
+        std::mem::take(&mut self.open)
     }
 
     /// The clocks `vrs` ticked.

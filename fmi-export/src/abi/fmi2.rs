@@ -5,7 +5,7 @@ use std::collections::HashSet;
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use super::{c_text, emit, get_reals, out_ptr, panic_text, slice, slice_mut, string, with, Component};
+use super::{c_text, emit, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::*;
 use crate::instance::{Function, Instance, Machine, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
@@ -19,16 +19,6 @@ pub fn get_types_platform<M>(_: Function) -> *const c_char {
 
 pub fn get_version<M>(_: Function) -> *const c_char {
     c"2.0".as_ptr()
-}
-
-pub unsafe fn set_debug_logging<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    logging_on: fmi2Boolean,
-    n: usize,
-    categories: *const fmi2String,
-) -> Fmi2Status {
-    super::set_debug_logging_as::<M>(function, c, logging_on, n, categories)
 }
 
 pub unsafe fn instantiate<M: Model>(
@@ -105,12 +95,6 @@ pub unsafe fn instantiate<M: Model>(
     }
 }
 
-pub unsafe fn free_instance<M: Model>(_: Function, c: fmi2Component) {
-    if !c.is_null() {
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(c as *mut Component<M>))));
-    }
-}
-
 pub unsafe fn setup_experiment<M: Model>(
     function: Function,
     c: fmi2Component,
@@ -125,30 +109,6 @@ pub unsafe fn setup_experiment<M: Model>(
         let stop = (stop_time_defined != FMI2_FALSE).then_some(stop_time);
         comp.instance.setup_experiment(tol, start_time, stop)
     })
-}
-
-pub unsafe fn enter_initialization_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.enter_initialization_mode())
-}
-
-pub unsafe fn exit_initialization_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        comp.instance.exit_initialization_mode()?;
-        comp.log(
-            Fmi2Status::Ok,
-            LogCategory::Events,
-            &format!("initialization done, now {:?}", comp.instance.machine()),
-        );
-        Ok(())
-    })
-}
-
-pub unsafe fn terminate<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.terminate())
-}
-
-pub unsafe fn reset<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.reset())
 }
 
 /// The FMI 2.0 base types, the type argument of [`get`] and [`set`] (`fmi2GetReal` is
@@ -260,47 +220,6 @@ pub unsafe fn set<M: Model, T: Value>(
 
 // ------------------------------------------------------------------ FMU state
 
-pub unsafe fn get_fmu_state<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    super::get_fmu_state_as::<M>(function, c, state)
-}
-
-pub unsafe fn set_fmu_state<M: Model>(function: Function, c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
-    super::set_fmu_state_as::<M>(function, c, state)
-}
-
-pub unsafe fn free_fmu_state<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    super::free_fmu_state_as::<M>(function, c, state)
-}
-
-pub unsafe fn serialized_fmu_state_size<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    size: *mut usize,
-) -> Fmi2Status {
-    super::serialized_fmu_state_size_as::<M>(function, c, state, size)
-}
-
-pub unsafe fn serialize_fmu_state<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    bytes: *mut fmi2Byte,
-    size: usize,
-) -> Fmi2Status {
-    super::serialize_fmu_state_as::<M>(function, c, state, bytes, size)
-}
-
-pub unsafe fn deserialize_fmu_state<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    bytes: *const fmi2Byte,
-    size: usize,
-    state: *mut fmi2FMUstate,
-) -> Fmi2Status {
-    super::deserialize_fmu_state_as::<M>(function, c, bytes, size, state)
-}
-
 pub unsafe fn get_directional_derivative<M: Model>(
     function: Function,
     c: fmi2Component,
@@ -403,10 +322,6 @@ pub unsafe fn get_string_status<M: Model>(function: Function, c: fmi2Component, 
 
 // ------------------------------------------------------------------ Model Exchange
 
-pub unsafe fn enter_event_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.enter_event_mode())
-}
-
 pub unsafe fn new_discrete_states<M: Model>(
     function: Function,
     c: fmi2Component,
@@ -429,73 +344,6 @@ pub unsafe fn new_discrete_states<M: Model>(
         }
         Ok(())
     })
-}
-
-pub unsafe fn enter_continuous_time_mode<M: Model>(function: Function, c: fmi2Component) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.enter_continuous_time_mode())
-}
-
-pub unsafe fn completed_integrator_step<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    _no_set_prior: fmi2Boolean,
-    enter_event_mode: *mut fmi2Boolean,
-    terminate_simulation: *mut fmi2Boolean,
-) -> Fmi2Status {
-    with::<M>(c, function, |_| {
-        let enter = out_ptr(enter_event_mode, "enterEventMode")?;
-        let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
-        *enter = FMI2_FALSE;
-        *terminate = FMI2_FALSE;
-        Ok(())
-    })
-}
-
-pub unsafe fn set_time<M: Model>(function: Function, c: fmi2Component, time: f64) -> Fmi2Status {
-    with::<M>(c, function, |comp| comp.instance.set_time(time))
-}
-
-pub unsafe fn set_continuous_states<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    x: *const f64,
-    nx: usize,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let x = slice(x, nx, "x")?;
-        comp.instance.set_continuous_states(x)
-    })
-}
-
-pub unsafe fn get_derivatives<M: Model>(function: Function, c: fmi2Component, dx: *mut f64, nx: usize) -> Fmi2Status {
-    get_reals::<M>(c, function, dx, nx, "derivatives", Instance::get_derivatives)
-}
-
-pub unsafe fn get_event_indicators<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    z: *mut f64,
-    ni: usize,
-) -> Fmi2Status {
-    get_reals::<M>(c, function, z, ni, "eventIndicators", Instance::get_event_indicators)
-}
-
-pub unsafe fn get_continuous_states<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    x: *mut f64,
-    nx: usize,
-) -> Fmi2Status {
-    get_reals::<M>(c, function, x, nx, "x", Instance::get_continuous_states)
-}
-
-pub unsafe fn get_nominals_of_continuous_states<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    x: *mut f64,
-    nx: usize,
-) -> Fmi2Status {
-    get_reals::<M>(c, function, x, nx, "x_nominal", Instance::get_nominals)
 }
 
 #[doc(hidden)]

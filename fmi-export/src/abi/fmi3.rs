@@ -19,14 +19,14 @@ use std::path::PathBuf;
 use fmi_sys::fmi3::*;
 use model_description::fmi3::ValueType;
 
-use super::{c_text, get_reals, out_ptr, panic_text, slice, slice_mut, string, with, Component};
+use super::{c_text, out_ptr, panic_text, slice, slice_mut, string, with, Component};
 use crate::ffi::{Fmi2Status, FMI2_FALSE, FMI2_TRUE};
 use crate::instance::{Function, Generation, Instance, IntervalQualifier, OpResult};
 use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
 use crate::model::{InstantiateContext, Interface, Model, ModelError};
 
 /// The layer's status as FMI 3.0's (the same numbers; FMI 2.0's `fmi2Pending` never occurs).
-fn status3(s: Fmi2Status) -> Fmi3Status {
+pub fn status3(s: Fmi2Status) -> Fmi3Status {
     match s {
         Fmi2Status::Ok => Fmi3Status::Ok,
         Fmi2Status::Warning => Fmi3Status::Warning,
@@ -80,7 +80,7 @@ pub unsafe fn set_debug_logging<M: Model>(
     categories: *const fmi3String,
 ) -> Fmi3Status {
     let on = if logging_on != FMI3_FALSE { FMI2_TRUE } else { FMI2_FALSE };
-    status3(super::set_debug_logging_as::<M>(function, instance, on, n, categories))
+    status3(super::shared::set_debug_logging::<M>(function, instance, on, n, categories))
 }
 
 /// Logs `message` through an importer's `logMessage` for a call without an instance.
@@ -259,10 +259,6 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
     )
 }
 
-pub unsafe fn free_instance<M: Model>(function: Function, instance: fmi3Instance) {
-    super::fmi2::free_instance::<M>(function, instance)
-}
-
 // ------------------------------------------------------------------ modes
 
 pub unsafe fn enter_initialization_mode<M: Model>(
@@ -280,30 +276,6 @@ pub unsafe fn enter_initialization_mode<M: Model>(
         comp.instance.setup_experiment(tol, start_time, stop)?;
         comp.instance.enter_initialization_mode()
     })
-}
-
-pub unsafe fn exit_initialization_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        comp.instance.exit_initialization_mode()?;
-        comp.log(
-            Fmi2Status::Ok,
-            LogCategory::Events,
-            &format!("initialization done, now {:?}", comp.instance.machine()),
-        );
-        Ok(())
-    })
-}
-
-pub unsafe fn enter_event_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| comp.instance.enter_event_mode())
-}
-
-pub unsafe fn terminate<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| comp.instance.terminate())
-}
-
-pub unsafe fn reset<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| comp.instance.reset())
 }
 
 /// A function of a feature the FMU does not declare: refused by the instance's gate with
@@ -667,55 +639,6 @@ pub unsafe fn get_variable_dependencies<M: Model>(
 
 // ------------------------------------------------------------------ FMU state
 
-pub unsafe fn get_fmu_state<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    state: *mut fmi3FMUState,
-) -> Fmi3Status {
-    status3(super::get_fmu_state_as::<M>(function, instance, state))
-}
-
-pub unsafe fn set_fmu_state<M: Model>(function: Function, instance: fmi3Instance, state: fmi3FMUState) -> Fmi3Status {
-    status3(super::set_fmu_state_as::<M>(function, instance, state))
-}
-
-pub unsafe fn free_fmu_state<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    state: *mut fmi3FMUState,
-) -> Fmi3Status {
-    status3(super::free_fmu_state_as::<M>(function, instance, state))
-}
-
-pub unsafe fn serialized_fmu_state_size<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    state: fmi3FMUState,
-    size: *mut usize,
-) -> Fmi3Status {
-    status3(super::serialized_fmu_state_size_as::<M>(function, instance, state, size))
-}
-
-pub unsafe fn serialize_fmu_state<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    state: fmi3FMUState,
-    bytes: *mut fmi3Byte,
-    size: usize,
-) -> Fmi3Status {
-    status3(super::serialize_fmu_state_as::<M>(function, instance, state, bytes as *mut crate::ffi::fmi2Byte, size))
-}
-
-pub unsafe fn deserialize_fmu_state<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    bytes: *const fmi3Byte,
-    size: usize,
-    state: *mut fmi3FMUState,
-) -> Fmi3Status {
-    status3(super::deserialize_fmu_state_as::<M>(function, instance, bytes as *const crate::ffi::fmi2Byte, size, state))
-}
-
 // ------------------------------------------------------------------ partial derivatives
 
 /// `fmi3GetDirectionalDerivative` (`sensitivity = J seed`, a seed per known) and
@@ -791,78 +714,6 @@ pub unsafe fn update_discrete_states<M: Model>(
         }
         Ok(())
     })
-}
-
-pub unsafe fn enter_continuous_time_mode<M: Model>(function: Function, instance: fmi3Instance) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| comp.instance.enter_continuous_time_mode())
-}
-
-pub unsafe fn completed_integrator_step<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    _no_set_prior: fmi3Boolean,
-    enter_event_mode: *mut fmi3Boolean,
-    terminate_simulation: *mut fmi3Boolean,
-) -> Fmi3Status {
-    with3::<M>(instance, function, |_| {
-        let enter = out_ptr(enter_event_mode, "enterEventMode")?;
-        let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
-        *enter = FMI3_FALSE;
-        *terminate = FMI3_FALSE;
-        Ok(())
-    })
-}
-
-pub unsafe fn set_time<M: Model>(function: Function, instance: fmi3Instance, time: fmi3Float64) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| comp.instance.set_time(time))
-}
-
-pub unsafe fn set_continuous_states<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    x: *const fmi3Float64,
-    nx: usize,
-) -> Fmi3Status {
-    with3::<M>(instance, function, |comp| {
-        let x = slice(x, nx, "continuousStates")?;
-        comp.instance.set_continuous_states(x)
-    })
-}
-
-pub unsafe fn get_continuous_state_derivatives<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    dx: *mut fmi3Float64,
-    nx: usize,
-) -> Fmi3Status {
-    status3(get_reals::<M>(instance, function, dx, nx, "derivatives", Instance::get_derivatives))
-}
-
-pub unsafe fn get_event_indicators<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    z: *mut fmi3Float64,
-    n: usize,
-) -> Fmi3Status {
-    status3(get_reals::<M>(instance, function, z, n, "eventIndicators", Instance::get_event_indicators))
-}
-
-pub unsafe fn get_continuous_states<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    x: *mut fmi3Float64,
-    nx: usize,
-) -> Fmi3Status {
-    status3(get_reals::<M>(instance, function, x, nx, "continuousStates", Instance::get_continuous_states))
-}
-
-pub unsafe fn get_nominals_of_continuous_states<M: Model>(
-    function: Function,
-    instance: fmi3Instance,
-    x: *mut fmi3Float64,
-    nx: usize,
-) -> Fmi3Status {
-    status3(get_reals::<M>(instance, function, x, nx, "nominals", Instance::get_nominals))
 }
 
 pub unsafe fn get_number_of_event_indicators<M: Model>(

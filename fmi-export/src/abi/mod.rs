@@ -1,9 +1,11 @@
-//! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): [`fmi2`],
-//! every `fmi2*` function, and [`fmi3`], every `fmi3*` function, each as a generic
-//! `unsafe fn` over the model type taking the [`Function`] it serves first; [`table`]
-//! lists them, and [`crate::export_fmi!`] instantiates the table as unmangled `extern "C"`
-//! symbols of one library. The FMI 2.0 ones are re-exported here too (`abi::get` is
-//! `abi::fmi2::get`).
+//! The two thin C ABIs over the one instance ([`crate::instance::Instance`]): the layer
+//! functions of the `fmi2*` calls in [`fmi2`], of the `fmi3*` calls in [`fmi3`], and those
+//! both generations' calls share (the same pointers under other C names) in [`shared`],
+//! each a generic `unsafe fn` over the model type taking the [`Function`] it serves first;
+//! [`table`] lists which one serves which symbol, and [`crate::export_fmi!`] instantiates
+//! the table as unmangled `extern "C"` symbols of one library. The FMI 2.0 and shared ones
+//! are re-exported here too (`abi::get` is `abi::fmi2::get`, `abi::terminate`
+//! `abi::shared::terminate`).
 //!
 //! Rules kept here, and only here: null pointers and lengths are checked before a slice
 //! is made, panics are caught at every entry point, every error is logged through the
@@ -13,11 +15,13 @@
 
 pub mod fmi2;
 pub mod fmi3;
+pub mod shared;
 pub mod table;
 
 /// `fmi2EventInfo` (from `fmi-sys`).
 pub use crate::ffi::Fmi2EventInfo;
 pub use fmi2::*;
+pub use shared::*;
 
 use std::collections::HashSet;
 use std::ffi::{c_int, CStr, CString};
@@ -25,7 +29,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use crate::ffi::*;
 use crate::instance::{Function, Instance, Machine, OpResult, SavedState};
-use crate::log::{LogCategory, Logger, LOG_CATEGORIES};
+use crate::log::{LogCategory, Logger};
 use crate::model::{Model, ModelError};
 
 /// Largest `nvr` (or `nx`, `nUnknown`, ...) accepted: far above any sensible request,
@@ -158,44 +162,28 @@ pub(crate) unsafe fn with<M: Model>(
     status
 }
 
-/// A slice from a C array, refusing a null pointer unless the length is 0, and an
-/// implausible length before anything is read or allocated.
+/// Whether a C array of length `n` holds anything to read, refusing a null pointer unless
+/// the length is 0, and an implausible length before anything is read or allocated.
+fn array_filled(is_null: bool, n: usize, what: &str) -> OpResult<bool> {
+    if n == 0 {
+        Ok(false)
+    } else if n > MAX_ARRAY_LENGTH {
+        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
+    } else if is_null {
+        Err(format!("{what} is NULL with length {n}").into())
+    } else {
+        Ok(true)
+    }
+}
+
+/// A slice from a C array (see [`array_filled`]).
 pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> OpResult<&'a [T]> {
-    if n == 0 {
-        Ok(&[])
-    } else if n > MAX_ARRAY_LENGTH {
-        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
-        Err(format!("{what} is NULL with length {n}").into())
-    } else {
-        Ok(std::slice::from_raw_parts(ptr, n))
-    }
+    Ok(if array_filled(ptr.is_null(), n, what)? { std::slice::from_raw_parts(ptr, n) } else { &[] })
 }
 
+/// A mutable slice from a C array (see [`array_filled`]).
 pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> OpResult<&'a mut [T]> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if n > MAX_ARRAY_LENGTH {
-        Err(format!("{what}: length {n} refused (more than {MAX_ARRAY_LENGTH})").into())
-    } else if ptr.is_null() {
-        Err(format!("{what} is NULL with length {n}").into())
-    } else {
-        Ok(std::slice::from_raw_parts_mut(ptr, n))
-    }
-}
-
-/// The body of both generations' Model Exchange calls that fill the caller's array of `n`
-/// reals at `ptr` (named `what` in a refusal) from the instance: continuous states, their
-/// derivatives, their nominals, the event indicators (`get`, one of [`Instance`]'s getters).
-pub(crate) unsafe fn get_reals<M: Model>(
-    c: fmi2Component,
-    function: Function,
-    ptr: *mut f64,
-    n: usize,
-    what: &str,
-    get: fn(&mut Instance<M>, &mut [f64]) -> OpResult,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| get(&mut comp.instance, slice_mut(ptr, n, what)?))
+    Ok(if array_filled(ptr.is_null(), n, what)? { std::slice::from_raw_parts_mut(ptr, n) } else { &mut [] })
 }
 
 pub(crate) unsafe fn out_ptr<'a, T>(ptr: *mut T, what: &str) -> OpResult<&'a mut T> {
@@ -208,112 +196,4 @@ pub(crate) unsafe fn string<'a>(ptr: fmi2String) -> Option<&'a str> {
     } else {
         CStr::from_ptr(ptr).to_str().ok()
     }
-}
-
-pub unsafe fn set_debug_logging_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    logging_on: fmi2Boolean,
-    n: usize,
-    categories: *const fmi2String,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let names = slice(categories, n, "categories")?;
-        let mut enabled = [n == 0; LOG_CATEGORIES.len()];
-        for &name in names {
-            let name = string(name).ok_or_else(|| ModelError::from("a category name is NULL or not UTF-8"))?;
-            let k = LOG_CATEGORIES
-                .iter()
-                .position(|(c, _)| *c == name)
-                .ok_or_else(|| format!("unknown log category {name:?}"))?;
-            enabled[k] = true;
-        }
-        comp.logger.configure(logging_on != FMI2_FALSE, enabled);
-        Ok(())
-    })
-}
-
-// ------------------------------------------------------------------ FMU state, both generations
-// (`function` names the call; an `fmi3FMUState` is the same pointer as an `fmi2FMUstate`)
-
-pub unsafe fn get_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        let saved = comp.instance.save_state();
-        comp.put_state(slot, saved)
-    })
-}
-
-pub unsafe fn set_fmu_state_as<M: Model>(function: Function, c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        comp.instance.restore_state(saved)
-    })
-}
-
-pub unsafe fn free_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: *mut fmi2FMUstate,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            let ptr = comp.own_state(*slot)?;
-            comp.live_states.remove(&(ptr as usize));
-            drop(Box::from_raw(ptr));
-            *slot = std::ptr::null_mut();
-        }
-        Ok(())
-    })
-}
-
-pub unsafe fn serialized_fmu_state_size_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    size: *mut usize,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        *out_ptr(size, "size")? = Instance::serialize(saved)?.len();
-        Ok(())
-    })
-}
-
-pub unsafe fn serialize_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    state: fmi2FMUstate,
-    bytes: *mut fmi2Byte,
-    size: usize,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let saved = &*comp.own_state(state)?;
-        let data = Instance::serialize(saved)?;
-        if size < data.len() {
-            return Err(format!("buffer of {size} bytes is too small for {} bytes", data.len()).into());
-        }
-        let out = slice_mut(bytes as *mut u8, data.len(), "serializedState")?;
-        out.copy_from_slice(&data);
-        Ok(())
-    })
-}
-
-pub unsafe fn deserialize_fmu_state_as<M: Model>(
-    function: Function,
-    c: fmi2Component,
-    bytes: *const fmi2Byte,
-    size: usize,
-    state: *mut fmi2FMUstate,
-) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let data = slice(bytes as *const u8, size, "serializedState")?;
-        let slot = out_ptr(state, "FMUstate")?;
-        if !slot.is_null() {
-            comp.own_state(*slot)?;
-        }
-        let saved = comp.instance.deserialize(data)?;
-        comp.put_state(slot, saved)
-    })
 }

@@ -20,7 +20,8 @@
 //!
 //! Adding an FMI function: one row here (its variant then exists; give it its row of the
 //! state table in `states.rs` if it differs from the default) and the layer function in
-//! `abi/fmi2.rs` or `abi/fmi3.rs`, taking the `Function` first.
+//! `abi/shared.rs` (when both generations' rows can call it) or in `abi/fmi2.rs` or
+//! `abi/fmi3.rs`, taking the `Function` first.
 
 /// Hands the table to the callback macro `$callback` (a path in brackets) with `$head`
 /// (one token tree, passed through) in front: `{head} fmi2 { rows } fmi3 { rows }`.
@@ -32,14 +33,14 @@ macro_rules! __fmi_function_table {
             fmi2 {
                 fmi2GetTypesPlatform: fmi2GetTypesPlatformTYPE = GetTypesPlatform => fmi2::get_types_platform() -> fmi2String;
                 fmi2GetVersion: fmi2GetVersionTYPE = GetVersion => fmi2::get_version() -> fmi2String;
-                fmi2SetDebugLogging: fmi2SetDebugLoggingTYPE = SetDebugLogging => fmi2::set_debug_logging(c: fmi2Component, on: fmi2Boolean, n: usize, categories: *const fmi2String) -> fmi2Status;
+                fmi2SetDebugLogging: fmi2SetDebugLoggingTYPE = SetDebugLogging => shared::set_debug_logging(c: fmi2Component, on: fmi2Boolean, n: usize, categories: *const fmi2String) -> fmi2Status;
                 fmi2Instantiate: fmi2InstantiateTYPE = Instantiate => fmi2::instantiate(name: fmi2String, kind: c_int, guid: fmi2String, resources: fmi2String, functions: *const Fmi2CallbackFunctions, visible: fmi2Boolean, logging_on: fmi2Boolean) -> fmi2Component;
-                fmi2FreeInstance: fmi2FreeInstanceTYPE = FreeInstance => fmi2::free_instance(c: fmi2Component);
+                fmi2FreeInstance: fmi2FreeInstanceTYPE = FreeInstance => shared::free_instance(c: fmi2Component);
                 fmi2SetupExperiment: fmi2SetupExperimentTYPE = SetupExperiment => fmi2::setup_experiment(c: fmi2Component, tolerance_defined: fmi2Boolean, tolerance: fmi2Real, start: fmi2Real, stop_defined: fmi2Boolean, stop: fmi2Real) -> fmi2Status;
-                fmi2EnterInitializationMode: fmi2EnterInitializationModeTYPE = EnterInitializationMode => fmi2::enter_initialization_mode(c: fmi2Component) -> fmi2Status;
-                fmi2ExitInitializationMode: fmi2ExitInitializationModeTYPE = ExitInitializationMode => fmi2::exit_initialization_mode(c: fmi2Component) -> fmi2Status;
-                fmi2Terminate: fmi2TerminateTYPE = Terminate => fmi2::terminate(c: fmi2Component) -> fmi2Status;
-                fmi2Reset: fmi2ResetTYPE = Reset => fmi2::reset(c: fmi2Component) -> fmi2Status;
+                fmi2EnterInitializationMode: fmi2EnterInitializationModeTYPE = EnterInitializationMode => shared::enter_initialization_mode(c: fmi2Component) -> fmi2Status;
+                fmi2ExitInitializationMode: fmi2ExitInitializationModeTYPE = ExitInitializationMode => shared::exit_initialization_mode(c: fmi2Component) -> fmi2Status;
+                fmi2Terminate: fmi2TerminateTYPE = Terminate => shared::terminate(c: fmi2Component) -> fmi2Status;
+                fmi2Reset: fmi2ResetTYPE = Reset => shared::reset(c: fmi2Component) -> fmi2Status;
                 fmi2GetReal: fmi2GetRealTYPE = GetReal => fmi2::get::<Real>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *mut fmi2Real) -> fmi2Status;
                 fmi2GetInteger: fmi2GetIntegerTYPE = GetInteger => fmi2::get::<Integer>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *mut fmi2Integer) -> fmi2Status;
                 fmi2GetBoolean: fmi2GetBooleanTYPE = GetBoolean => fmi2::get::<Boolean>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *mut fmi2Boolean) -> fmi2Status;
@@ -48,23 +49,23 @@ macro_rules! __fmi_function_table {
                 fmi2SetInteger: fmi2SetIntegerTYPE = SetInteger => fmi2::set::<Integer>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *const fmi2Integer) -> fmi2Status;
                 fmi2SetBoolean: fmi2SetBooleanTYPE = SetBoolean => fmi2::set::<Boolean>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *const fmi2Boolean) -> fmi2Status;
                 fmi2SetString: fmi2SetStringTYPE = SetString => fmi2::set::<String>(c: fmi2Component, vr: *const fmi2ValueReference, n: usize, values: *const fmi2String) -> fmi2Status;
-                fmi2GetFMUstate: fmi2GetFMUstateTYPE = GetFMUstate => fmi2::get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
-                fmi2SetFMUstate: fmi2SetFMUstateTYPE = SetFMUstate => fmi2::set_fmu_state(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status;
-                fmi2FreeFMUstate: fmi2FreeFMUstateTYPE = FreeFMUstate => fmi2::free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
-                fmi2SerializedFMUstateSize: fmi2SerializedFMUstateSizeTYPE = SerializedFMUstateSize => fmi2::serialized_fmu_state_size(c: fmi2Component, state: fmi2FMUstate, size: *mut usize) -> fmi2Status;
-                fmi2SerializeFMUstate: fmi2SerializeFMUstateTYPE = SerializeFMUstate => fmi2::serialize_fmu_state(c: fmi2Component, state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status;
-                fmi2DeSerializeFMUstate: fmi2DeSerializeFMUstateTYPE = DeSerializeFMUstate => fmi2::deserialize_fmu_state(c: fmi2Component, bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate) -> fmi2Status;
+                fmi2GetFMUstate: fmi2GetFMUstateTYPE = GetFMUstate => shared::get_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+                fmi2SetFMUstate: fmi2SetFMUstateTYPE = SetFMUstate => shared::set_fmu_state(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status;
+                fmi2FreeFMUstate: fmi2FreeFMUstateTYPE = FreeFMUstate => shared::free_fmu_state(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+                fmi2SerializedFMUstateSize: fmi2SerializedFMUstateSizeTYPE = SerializedFMUstateSize => shared::serialized_fmu_state_size(c: fmi2Component, state: fmi2FMUstate, size: *mut usize) -> fmi2Status;
+                fmi2SerializeFMUstate: fmi2SerializeFMUstateTYPE = SerializeFMUstate => shared::serialize_fmu_state(c: fmi2Component, state: fmi2FMUstate, bytes: *mut fmi2Byte, size: usize) -> fmi2Status;
+                fmi2DeSerializeFMUstate: fmi2DeSerializeFMUstateTYPE = DeSerializeFMUstate => shared::deserialize_fmu_state(c: fmi2Component, bytes: *const fmi2Byte, size: usize, state: *mut fmi2FMUstate) -> fmi2Status;
                 fmi2GetDirectionalDerivative: fmi2GetDirectionalDerivativeTYPE = GetDirectionalDerivative => fmi2::get_directional_derivative(c: fmi2Component, unknowns: *const fmi2ValueReference, n_unknowns: usize, knowns: *const fmi2ValueReference, n_knowns: usize, dv_known: *const fmi2Real, dv_unknown: *mut fmi2Real) -> fmi2Status;
-                fmi2EnterEventMode: fmi2EnterEventModeTYPE = EnterEventMode => fmi2::enter_event_mode(c: fmi2Component) -> fmi2Status;
+                fmi2EnterEventMode: fmi2EnterEventModeTYPE = EnterEventMode => shared::enter_event_mode(c: fmi2Component) -> fmi2Status;
                 fmi2NewDiscreteStates: fmi2NewDiscreteStatesTYPE = NewDiscreteStates => fmi2::new_discrete_states(c: fmi2Component, info: *mut Fmi2EventInfo) -> fmi2Status;
-                fmi2EnterContinuousTimeMode: fmi2EnterContinuousTimeModeTYPE = EnterContinuousTimeMode => fmi2::enter_continuous_time_mode(c: fmi2Component) -> fmi2Status;
-                fmi2CompletedIntegratorStep: fmi2CompletedIntegratorStepTYPE = CompletedIntegratorStep => fmi2::completed_integrator_step(c: fmi2Component, no_set_prior: fmi2Boolean, enter_event_mode: *mut fmi2Boolean, terminate_simulation: *mut fmi2Boolean) -> fmi2Status;
-                fmi2SetTime: fmi2SetTimeTYPE = SetTime => fmi2::set_time(c: fmi2Component, time: fmi2Real) -> fmi2Status;
-                fmi2SetContinuousStates: fmi2SetContinuousStatesTYPE = SetContinuousStates => fmi2::set_continuous_states(c: fmi2Component, x: *const fmi2Real, nx: usize) -> fmi2Status;
-                fmi2GetDerivatives: fmi2GetDerivativesTYPE = GetDerivatives => fmi2::get_derivatives(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status;
-                fmi2GetEventIndicators: fmi2GetEventIndicatorsTYPE = GetEventIndicators => fmi2::get_event_indicators(c: fmi2Component, z: *mut fmi2Real, ni: usize) -> fmi2Status;
-                fmi2GetContinuousStates: fmi2GetContinuousStatesTYPE = GetContinuousStates => fmi2::get_continuous_states(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status;
-                fmi2GetNominalsOfContinuousStates: fmi2GetNominalsOfContinuousStatesTYPE = GetNominalsOfContinuousStates => fmi2::get_nominals_of_continuous_states(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status;
+                fmi2EnterContinuousTimeMode: fmi2EnterContinuousTimeModeTYPE = EnterContinuousTimeMode => shared::enter_continuous_time_mode(c: fmi2Component) -> fmi2Status;
+                fmi2CompletedIntegratorStep: fmi2CompletedIntegratorStepTYPE = CompletedIntegratorStep => shared::completed_integrator_step(c: fmi2Component, no_set_prior: fmi2Boolean, enter_event_mode: *mut fmi2Boolean, terminate_simulation: *mut fmi2Boolean) -> fmi2Status;
+                fmi2SetTime: fmi2SetTimeTYPE = SetTime => shared::set_time(c: fmi2Component, time: fmi2Real) -> fmi2Status;
+                fmi2SetContinuousStates: fmi2SetContinuousStatesTYPE = SetContinuousStates => shared::set_continuous_states(c: fmi2Component, x: *const fmi2Real, nx: usize) -> fmi2Status;
+                fmi2GetDerivatives: fmi2GetDerivativesTYPE = GetDerivatives => shared::get_derivatives(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status;
+                fmi2GetEventIndicators: fmi2GetEventIndicatorsTYPE = GetEventIndicators => shared::get_event_indicators(c: fmi2Component, z: *mut fmi2Real, ni: usize) -> fmi2Status;
+                fmi2GetContinuousStates: fmi2GetContinuousStatesTYPE = GetContinuousStates => shared::get_continuous_states(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status;
+                fmi2GetNominalsOfContinuousStates: fmi2GetNominalsOfContinuousStatesTYPE = GetNominalsOfContinuousStates => shared::get_nominals_of_continuous_states(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status;
                 fmi2SetRealInputDerivatives: fmi2SetRealInputDerivativesTYPE = SetRealInputDerivatives => fmi2::set_real_input_derivatives[c](c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, values: *const fmi2Real) -> fmi2Status;
                 fmi2GetRealOutputDerivatives: fmi2GetRealOutputDerivativesTYPE = GetRealOutputDerivatives => fmi2::get_real_output_derivatives[c](c: fmi2Component, vr: *const fmi2ValueReference, n: usize, order: *const fmi2Integer, values: *mut fmi2Real) -> fmi2Status;
                 fmi2DoStep: fmi2DoStepTYPE = DoStep => fmi2::do_step(c: fmi2Component, current: fmi2Real, step: fmi2Real, no_set_prior: fmi2Boolean) -> fmi2Status;
@@ -78,17 +79,17 @@ macro_rules! __fmi_function_table {
             fmi3 {
                 fmi3GetVersion: fmi3GetVersionTYPE = Fmi3GetVersion => fmi3::get_version() -> *const c_char;
                 fmi3EnterInitializationMode: fmi3EnterInitializationModeTYPE = Fmi3EnterInitializationMode => fmi3::enter_initialization_mode(instance: fmi3Instance, tolerance_defined: fmi3Boolean, tolerance: fmi3Float64, start: fmi3Float64, stop_defined: fmi3Boolean, stop: fmi3Float64) -> fmi3Status;
-                fmi3ExitInitializationMode: fmi3ExitInitializationModeTYPE = Fmi3ExitInitializationMode => fmi3::exit_initialization_mode(instance: fmi3Instance) -> fmi3Status;
-                fmi3Terminate: fmi3TerminateTYPE = Fmi3Terminate => fmi3::terminate(instance: fmi3Instance) -> fmi3Status;
-                fmi3FreeInstance: fmi3FreeInstanceTYPE = Fmi3FreeInstance => fmi3::free_instance(instance: fmi3Instance);
+                fmi3ExitInitializationMode: fmi3ExitInitializationModeTYPE = Fmi3ExitInitializationMode => shared::exit_initialization_mode(instance: fmi3Instance) -> fmi3Status;
+                fmi3Terminate: fmi3TerminateTYPE = Fmi3Terminate => shared::terminate(instance: fmi3Instance) -> fmi3Status;
+                fmi3FreeInstance: fmi3FreeInstanceTYPE = Fmi3FreeInstance => shared::free_instance(instance: fmi3Instance);
                 fmi3GetFloat64: fmi3GetFloat64TYPE = Fmi3GetFloat64 => fmi3::get::<Float64>(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *mut fmi3Float64, n_values: usize) -> fmi3Status;
                 fmi3SetFloat64: fmi3SetFloat64TYPE = Fmi3SetFloat64 => fmi3::set::<Float64>(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *const fmi3Float64, n_values: usize) -> fmi3Status;
                 fmi3SetDebugLogging: fmi3SetDebugLoggingTYPE = Fmi3SetDebugLogging => fmi3::set_debug_logging(instance: fmi3Instance, on: fmi3Boolean, n: usize, categories: *const fmi3String) -> fmi3Status;
                 fmi3InstantiateModelExchange: fmi3InstantiateModelExchangeTYPE = Fmi3InstantiateModelExchange => fmi3::instantiate_model_exchange(name: fmi3String, token: fmi3String, resources: fmi3String, visible: fmi3Boolean, logging_on: fmi3Boolean, environment: fmi3InstanceEnvironment, log_message: Option<Fmi3LogMessageCallback>) -> fmi3Instance;
                 fmi3InstantiateCoSimulation: fmi3InstantiateCoSimulationTYPE = Fmi3InstantiateCoSimulation => fmi3::instantiate_co_simulation(name: fmi3String, token: fmi3String, resources: fmi3String, visible: fmi3Boolean, logging_on: fmi3Boolean, event_mode_used: fmi3Boolean, early_return_allowed: fmi3Boolean, intermediate: *const fmi3ValueReference, n_intermediate: usize, environment: fmi3InstanceEnvironment, log_message: Option<Fmi3LogMessageCallback>, intermediate_update: Option<Fmi3IntermediateUpdateCallback>) -> fmi3Instance;
                 fmi3InstantiateScheduledExecution: fmi3InstantiateScheduledExecutionTYPE = Fmi3InstantiateScheduledExecution => fmi3::instantiate_scheduled_execution(name: fmi3String, token: fmi3String, resources: fmi3String, visible: fmi3Boolean, logging_on: fmi3Boolean, environment: fmi3InstanceEnvironment, log_message: Option<Fmi3LogMessageCallback>, clock_update: Option<Fmi3ClockUpdateCallback>, lock: Option<Fmi3LockPreemptionCallback>, unlock: Option<Fmi3UnlockPreemptionCallback>) -> fmi3Instance;
-                fmi3EnterEventMode: fmi3EnterEventModeTYPE = Fmi3EnterEventMode => fmi3::enter_event_mode(instance: fmi3Instance) -> fmi3Status;
-                fmi3Reset: fmi3ResetTYPE = Fmi3Reset => fmi3::reset(instance: fmi3Instance) -> fmi3Status;
+                fmi3EnterEventMode: fmi3EnterEventModeTYPE = Fmi3EnterEventMode => shared::enter_event_mode(instance: fmi3Instance) -> fmi3Status;
+                fmi3Reset: fmi3ResetTYPE = Fmi3Reset => shared::reset(instance: fmi3Instance) -> fmi3Status;
                 fmi3GetFloat32: fmi3GetFloat32TYPE = Fmi3GetFloat32 => fmi3::get::<Float32>(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *mut fmi3Float32, n_values: usize) -> fmi3Status;
                 fmi3GetInt8: fmi3GetInt8TYPE = Fmi3GetInt8 => fmi3::get::<Int8>(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *mut fmi3Int8, n_values: usize) -> fmi3Status;
                 fmi3GetUInt8: fmi3GetUInt8TYPE = Fmi3GetUInt8 => fmi3::get::<UInt8>(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *mut fmi3UInt8, n_values: usize) -> fmi3Status;
@@ -117,12 +118,12 @@ macro_rules! __fmi_function_table {
                 fmi3SetClock: fmi3SetClockTYPE = Fmi3SetClock => fmi3::set_clock(instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, values: *const fmi3Clock) -> fmi3Status;
                 fmi3GetNumberOfVariableDependencies: fmi3GetNumberOfVariableDependenciesTYPE = Fmi3GetNumberOfVariableDependencies => fmi3::get_number_of_variable_dependencies(instance: fmi3Instance, vr: fmi3ValueReference, n: *mut usize) -> fmi3Status;
                 fmi3GetVariableDependencies: fmi3GetVariableDependenciesTYPE = Fmi3GetVariableDependencies => fmi3::get_variable_dependencies(instance: fmi3Instance, dependent: fmi3ValueReference, element_of_dependent: *mut usize, independents: *mut fmi3ValueReference, element_of_independents: *mut usize, kinds: *mut fmi3DependencyKind, n: usize) -> fmi3Status;
-                fmi3GetFMUState: fmi3GetFMUStateTYPE = Fmi3GetFMUState => fmi3::get_fmu_state(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status;
-                fmi3SetFMUState: fmi3SetFMUStateTYPE = Fmi3SetFMUState => fmi3::set_fmu_state(instance: fmi3Instance, state: fmi3FMUState) -> fmi3Status;
-                fmi3FreeFMUState: fmi3FreeFMUStateTYPE = Fmi3FreeFMUState => fmi3::free_fmu_state(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status;
-                fmi3SerializedFMUStateSize: fmi3SerializedFMUStateSizeTYPE = Fmi3SerializedFMUStateSize => fmi3::serialized_fmu_state_size(instance: fmi3Instance, state: fmi3FMUState, size: *mut usize) -> fmi3Status;
-                fmi3SerializeFMUState: fmi3SerializeFMUStateTYPE = Fmi3SerializeFMUState => fmi3::serialize_fmu_state(instance: fmi3Instance, state: fmi3FMUState, bytes: *mut fmi3Byte, size: usize) -> fmi3Status;
-                fmi3DeserializeFMUState: fmi3DeserializeFMUStateTYPE = Fmi3DeserializeFMUState => fmi3::deserialize_fmu_state(instance: fmi3Instance, bytes: *const fmi3Byte, size: usize, state: *mut fmi3FMUState) -> fmi3Status;
+                fmi3GetFMUState: fmi3GetFMUStateTYPE = Fmi3GetFMUState => shared::get_fmu_state(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status;
+                fmi3SetFMUState: fmi3SetFMUStateTYPE = Fmi3SetFMUState => shared::set_fmu_state(instance: fmi3Instance, state: fmi3FMUState) -> fmi3Status;
+                fmi3FreeFMUState: fmi3FreeFMUStateTYPE = Fmi3FreeFMUState => shared::free_fmu_state(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status;
+                fmi3SerializedFMUStateSize: fmi3SerializedFMUStateSizeTYPE = Fmi3SerializedFMUStateSize => shared::serialized_fmu_state_size(instance: fmi3Instance, state: fmi3FMUState, size: *mut usize) -> fmi3Status;
+                fmi3SerializeFMUState: fmi3SerializeFMUStateTYPE = Fmi3SerializeFMUState => shared::serialize_fmu_state(instance: fmi3Instance, state: fmi3FMUState, bytes: *mut fmi3Byte, size: usize) -> fmi3Status;
+                fmi3DeserializeFMUState: fmi3DeserializeFMUStateTYPE = Fmi3DeserializeFMUState => shared::deserialize_fmu_state(instance: fmi3Instance, bytes: *const fmi3Byte, size: usize, state: *mut fmi3FMUState) -> fmi3Status;
                 fmi3GetDirectionalDerivative: fmi3GetDirectionalDerivativeTYPE = Fmi3GetDirectionalDerivative => fmi3::get_partial_derivatives(instance: fmi3Instance, unknowns: *const fmi3ValueReference, n_unknowns: usize, knowns: *const fmi3ValueReference, n_knowns: usize, seed: *const fmi3Float64, n_seed: usize, sensitivity: *mut fmi3Float64, n_sensitivity: usize) -> fmi3Status;
                 fmi3GetAdjointDerivative: fmi3GetAdjointDerivativeTYPE = Fmi3GetAdjointDerivative => fmi3::get_partial_derivatives(instance: fmi3Instance, unknowns: *const fmi3ValueReference, n_unknowns: usize, knowns: *const fmi3ValueReference, n_knowns: usize, seed: *const fmi3Float64, n_seed: usize, sensitivity: *mut fmi3Float64, n_sensitivity: usize) -> fmi3Status;
                 fmi3EnterConfigurationMode: fmi3EnterConfigurationModeTYPE = Fmi3EnterConfigurationMode => fmi3::undeclared[instance](instance: fmi3Instance) -> fmi3Status;
@@ -137,14 +138,14 @@ macro_rules! __fmi_function_table {
                 fmi3SetShiftFraction: fmi3SetShiftFractionTYPE = Fmi3SetShiftFraction => fmi3::clock_timing[instance, vr, n_vr](instance: fmi3Instance, vr: *const fmi3ValueReference, n_vr: usize, counters: *const fmi3UInt64, resolutions: *const fmi3UInt64) -> fmi3Status;
                 fmi3EvaluateDiscreteStates: fmi3EvaluateDiscreteStatesTYPE = Fmi3EvaluateDiscreteStates => fmi3::undeclared[instance](instance: fmi3Instance) -> fmi3Status;
                 fmi3UpdateDiscreteStates: fmi3UpdateDiscreteStatesTYPE = Fmi3UpdateDiscreteStates => fmi3::update_discrete_states(instance: fmi3Instance, need_update: *mut fmi3Boolean, terminate_simulation: *mut fmi3Boolean, nominals_changed: *mut fmi3Boolean, values_changed: *mut fmi3Boolean, next_time_defined: *mut fmi3Boolean, next_time: *mut fmi3Float64) -> fmi3Status;
-                fmi3EnterContinuousTimeMode: fmi3EnterContinuousTimeModeTYPE = Fmi3EnterContinuousTimeMode => fmi3::enter_continuous_time_mode(instance: fmi3Instance) -> fmi3Status;
-                fmi3CompletedIntegratorStep: fmi3CompletedIntegratorStepTYPE = Fmi3CompletedIntegratorStep => fmi3::completed_integrator_step(instance: fmi3Instance, no_set_prior: fmi3Boolean, enter_event_mode: *mut fmi3Boolean, terminate_simulation: *mut fmi3Boolean) -> fmi3Status;
-                fmi3SetTime: fmi3SetTimeTYPE = Fmi3SetTime => fmi3::set_time(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status;
-                fmi3SetContinuousStates: fmi3SetContinuousStatesTYPE = Fmi3SetContinuousStates => fmi3::set_continuous_states(instance: fmi3Instance, x: *const fmi3Float64, nx: usize) -> fmi3Status;
-                fmi3GetContinuousStateDerivatives: fmi3GetContinuousStateDerivativesTYPE = Fmi3GetContinuousStateDerivatives => fmi3::get_continuous_state_derivatives(instance: fmi3Instance, dx: *mut fmi3Float64, nx: usize) -> fmi3Status;
-                fmi3GetEventIndicators: fmi3GetEventIndicatorsTYPE = Fmi3GetEventIndicators => fmi3::get_event_indicators(instance: fmi3Instance, z: *mut fmi3Float64, ni: usize) -> fmi3Status;
-                fmi3GetContinuousStates: fmi3GetContinuousStatesTYPE = Fmi3GetContinuousStates => fmi3::get_continuous_states(instance: fmi3Instance, x: *mut fmi3Float64, nx: usize) -> fmi3Status;
-                fmi3GetNominalsOfContinuousStates: fmi3GetNominalsOfContinuousStatesTYPE = Fmi3GetNominalsOfContinuousStates => fmi3::get_nominals_of_continuous_states(instance: fmi3Instance, x: *mut fmi3Float64, nx: usize) -> fmi3Status;
+                fmi3EnterContinuousTimeMode: fmi3EnterContinuousTimeModeTYPE = Fmi3EnterContinuousTimeMode => shared::enter_continuous_time_mode(instance: fmi3Instance) -> fmi3Status;
+                fmi3CompletedIntegratorStep: fmi3CompletedIntegratorStepTYPE = Fmi3CompletedIntegratorStep => shared::completed_integrator_step(instance: fmi3Instance, no_set_prior: fmi3Boolean, enter_event_mode: *mut fmi3Boolean, terminate_simulation: *mut fmi3Boolean) -> fmi3Status;
+                fmi3SetTime: fmi3SetTimeTYPE = Fmi3SetTime => shared::set_time(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status;
+                fmi3SetContinuousStates: fmi3SetContinuousStatesTYPE = Fmi3SetContinuousStates => shared::set_continuous_states(instance: fmi3Instance, x: *const fmi3Float64, nx: usize) -> fmi3Status;
+                fmi3GetContinuousStateDerivatives: fmi3GetContinuousStateDerivativesTYPE = Fmi3GetContinuousStateDerivatives => shared::get_derivatives(instance: fmi3Instance, dx: *mut fmi3Float64, nx: usize) -> fmi3Status;
+                fmi3GetEventIndicators: fmi3GetEventIndicatorsTYPE = Fmi3GetEventIndicators => shared::get_event_indicators(instance: fmi3Instance, z: *mut fmi3Float64, ni: usize) -> fmi3Status;
+                fmi3GetContinuousStates: fmi3GetContinuousStatesTYPE = Fmi3GetContinuousStates => shared::get_continuous_states(instance: fmi3Instance, x: *mut fmi3Float64, nx: usize) -> fmi3Status;
+                fmi3GetNominalsOfContinuousStates: fmi3GetNominalsOfContinuousStatesTYPE = Fmi3GetNominalsOfContinuousStates => shared::get_nominals_of_continuous_states(instance: fmi3Instance, x: *mut fmi3Float64, nx: usize) -> fmi3Status;
                 fmi3GetNumberOfEventIndicators: fmi3GetNumberOfEventIndicatorsTYPE = Fmi3GetNumberOfEventIndicators => fmi3::get_number_of_event_indicators(instance: fmi3Instance, n: *mut usize) -> fmi3Status;
                 fmi3GetNumberOfContinuousStates: fmi3GetNumberOfContinuousStatesTYPE = Fmi3GetNumberOfContinuousStates => fmi3::get_number_of_continuous_states(instance: fmi3Instance, n: *mut usize) -> fmi3Status;
                 fmi3EnterStepMode: fmi3EnterStepModeTYPE = Fmi3EnterStepMode => fmi3::enter_step_mode(instance: fmi3Instance) -> fmi3Status;

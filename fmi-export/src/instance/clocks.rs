@@ -14,7 +14,7 @@
 //! `t_k` and deactivating the clock (`canBeDeactivated` is false) are errors naming the
 //! clock and the times.
 
-use super::{decl, err, time_eps, Function, Instance, OpResult, PreEvent};
+use super::{decl, err, time_eps, Function, Instance, OpResult};
 use crate::decl::{ClockDecl, ClockInterval};
 use crate::model::Model;
 use crate::states::Machine;
@@ -178,14 +178,7 @@ impl<M: Model> Instance<M> {
         if self.core.pre_event.is_some() {
             return Ok(());
         }
-        let c = &self.core;
-        self.core.pre_event = Some(PreEvent {
-            model: c.model.clone(),
-            next_event: c.next_event,
-            clock: c.clock,
-            presample: c.presample,
-            terminate_requested: c.terminate_requested,
-        });
+        self.core.pre_event = Some(self.core.pre_event());
         let now = self.core.time;
         self.core.model.set_time(now);
         let Some(mut samples) = self.core.clock else { return err("the sample clock is not running") };

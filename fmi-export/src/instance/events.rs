@@ -1,7 +1,7 @@
 //! Time events and sampling: the event iteration at an instant, the sample clock of a
 //! sampled model, the lazy events of Co-Simulation and the Co-Simulation step.
 
-use super::{err, time_eps, Instance, OpResult, PreEvent, MAX_EVENT_ITERATIONS};
+use super::{err, time_eps, Instance, OpResult, MAX_EVENT_ITERATIONS};
 use crate::model::{EventUpdate, Interface, Model, ModelError};
 use crate::sampled::{SampleClock, MAX_SAMPLES_PER_STEP};
 use crate::states::Machine;
@@ -25,14 +25,7 @@ impl<M: Model> Instance<M> {
     #[inline(never)]
     fn run_due_events(&mut self, now: f64) -> OpResult {
         if self.core.pre_event.is_none() {
-            let c = &self.core;
-            self.core.pre_event = Some(PreEvent {
-                model: c.model.clone(),
-                next_event: c.next_event,
-                clock: c.clock,
-                presample: c.presample,
-                terminate_requested: c.terminate_requested,
-            });
+            self.core.pre_event = Some(self.core.pre_event());
         }
         self.run_events_at(now)
     }

@@ -9,8 +9,10 @@
 //! generations' value references), `events` (time events, sampling and the
 //! Co-Simulation step), `model_exchange` (the Model Exchange calls), `derivatives`
 //! (partial derivatives and variable dependencies), `fmu_state` (save, restore,
-//! serialize).
+//! serialize), `call_memo` (the lookups of the arrays a master sends at every step),
+//! `clocks` (FMI 3.0 clocks).
 
+mod call_memo;
 mod clocks;
 mod derivatives;
 mod events;
@@ -22,8 +24,8 @@ use crate::decl::{Declaration, Start};
 use crate::model::{InstantiateContext, Interface, Model, ModelError};
 use crate::sampled::{instant_tolerance, SampleClock};
 pub use crate::states::{Function, Generation, Machine, Scope};
+use call_memo::CallMemos;
 pub use clocks::IntervalQualifier;
-use values::CallMemos;
 
 /// Result of the fallible instance operations: the message is logged by the ABI layer.
 pub type OpResult<T = ()> = Result<T, ModelError>;
@@ -72,6 +74,17 @@ struct PreEvent<M> {
 }
 
 impl<M: Model> Core<M> {
+    /// What the events at the current instant may change, as it is before them.
+    fn pre_event(&self) -> PreEvent<M> {
+        PreEvent {
+            model: self.model.clone(),
+            next_event: self.next_event,
+            clock: self.clock,
+            presample: self.presample,
+            terminate_requested: self.terminate_requested,
+        }
+    }
+
     fn new(model: M) -> Self {
         let presample = model.sample_period().is_some();
         Core {

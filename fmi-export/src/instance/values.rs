@@ -4,89 +4,13 @@
 use model_description::fmi3::ValueType as ValueType3;
 
 use super::{decl, err, Instance, OpResult};
-use crate::decl::{BaseType, Causality, Declaration, HotRow, Initial, SetAccess, Variability};
+use crate::decl::{BaseType, Causality, Declaration, Initial, SetAccess, Variability};
 use crate::model::{Model, ModelError};
 use crate::states::{settable_in, Machine};
+
 /// Values of one `fmi2Set*` call whose earlier values are kept for the way back without
 /// copying the model (a longer call copies the model once, at its 33rd value).
 const SET_UNDO_CAPACITY: usize = 32;
-
-/// The value references of the last `fmi2GetReal` or `fmi2SetReal` call and their rows
-/// of the declaration: a master sends the same arrays at every communication point, so
-/// the lookups run once per array, not once per value and call. Only the lookups are
-/// kept: every check still runs on every value of every call.
-struct CallMemo<B> {
-    vrs: Vec<u32>,
-    rows: Vec<MemoRow<B>>,
-    /// Whether the model may refuse one of them ([`Model::setter_may_refuse`]).
-    may_refuse: bool,
-}
-
-#[derive(Clone, Copy)]
-struct MemoRow<B> {
-    row: usize,
-    hot: HotRow<B>,
-}
-
-/// Longest call whose lookups are kept (the memo is allocated once, with the instance).
-const MEMO_CAPACITY: usize = 64;
-/// Arrays kept per direction (a master reads an instance's connected outputs and its
-/// recorded variables in two calls, say).
-const MEMO_ARRAYS: usize = 4;
-
-/// The last [`MEMO_ARRAYS`] arrays, the oldest replaced first.
-pub(super) struct CallMemos<B> {
-    arrays: [CallMemo<B>; MEMO_ARRAYS],
-    next: usize,
-}
-
-impl<B: Copy> CallMemos<B> {
-    pub(super) fn new() -> Self {
-        CallMemos { arrays: std::array::from_fn(|_| CallMemo::new()), next: 0 }
-    }
-
-    /// The kept array equal to `vrs`.
-    #[inline]
-    fn find(&self, vrs: &[u32]) -> Option<usize> {
-        self.arrays.iter().position(|m| m.matches(vrs))
-    }
-
-    /// Keeps the lookups of `vrs` in place of the oldest.
-    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
-        self.arrays[self.next].fill(d, vrs, may_refuse);
-        self.next = (self.next + 1) % MEMO_ARRAYS;
-    }
-}
-
-impl<B: Copy> CallMemo<B> {
-    fn new() -> Self {
-        CallMemo { vrs: Vec::with_capacity(MEMO_CAPACITY), rows: Vec::with_capacity(MEMO_CAPACITY), may_refuse: true }
-    }
-
-    #[inline]
-    fn matches(&self, vrs: &[u32]) -> bool {
-        !self.vrs.is_empty() && self.vrs.as_slice() == vrs
-    }
-
-    /// Keeps the lookups of `vrs` (all known Reals: the caller checked).
-    fn fill(&mut self, d: &Declaration<B>, vrs: &[u32], may_refuse: impl Fn(B) -> bool) {
-        self.vrs.clear();
-        self.rows.clear();
-        if vrs.len() > MEMO_CAPACITY {
-            return;
-        }
-        for &vr in vrs {
-            let Some(row) = d.row(BaseType::Real, vr) else {
-                self.vrs.clear();
-                self.rows.clear();
-                return;
-            };
-            self.rows.push(MemoRow { row, hot: *d.hot(row) });
-        }
-        self.vrs.extend_from_slice(vrs);
-        self.may_refuse = self.rows.iter().any(|r| may_refuse(r.hot.binding));
-    }
-}
 
 impl<M: Model> Instance<M> {
     /// The row of value reference `vr` of `base_type` in declaration `d` (fetched once per call).
@@ -199,31 +123,32 @@ impl<M: Model> Instance<M> {
     }
 
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> OpResult {
-        let d = decl::<M>();
-        Self::check_rows(d, BaseType::Integer, vrs)?;
-        if self.clocked {
-            self.settle_clock()?;
-        } else {
-            self.settle_events()?;
-        }
-        for (o, &vr) in out.iter_mut().zip(vrs) {
-            let row = Self::row_in(d, BaseType::Integer, vr)?;
-            *o = self.core.model.get_integer(d.hot(row).binding)?;
-        }
-        Ok(())
+        self.get_discrete(BaseType::Integer, vrs, out, M::get_integer)
     }
 
     pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+        self.get_discrete(BaseType::Boolean, vrs, out, M::get_boolean)
+    }
+
+    /// The Integers or Booleans of `vrs`, after the events due at the current time.
+    #[inline(always)]
+    fn get_discrete<T>(
+        &mut self,
+        base_type: BaseType,
+        vrs: &[u32],
+        out: &mut [T],
+        read: impl Fn(&mut M, M::Binding) -> crate::model::ModelResult<T>,
+    ) -> OpResult {
         let d = decl::<M>();
-        Self::check_rows(d, BaseType::Boolean, vrs)?;
+        Self::check_rows(d, base_type, vrs)?;
         if self.clocked {
             self.settle_clock()?;
         } else {
             self.settle_events()?;
         }
         for (o, &vr) in out.iter_mut().zip(vrs) {
-            let row = Self::row_in(d, BaseType::Boolean, vr)?;
-            *o = self.core.model.get_boolean(d.hot(row).binding)?;
+            let row = Self::row_in(d, base_type, vr)?;
+            *o = read(&mut self.core.model, d.hot(row).binding)?;
         }
         Ok(())
     }

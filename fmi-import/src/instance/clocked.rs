@@ -10,27 +10,56 @@
 use std::collections::HashMap;
 
 use crate::fmi3::Access;
+// looked up on every get and set of a running instance: a fast hash of the value reference
 use model_description::fmi3;
+use rustc_hash::FxHashMap;
 
 /// One clocked variable: its whole-variable access (element 0), its clocks, whether the
-/// master sets it (an input) or reads it.
+/// master sets it (an input) or reads it, the values it holds and those queued for it.
 #[derive(Clone, Debug)]
 pub(crate) struct Clocked {
     pub(crate) access: Access,
     clocks: Vec<u32>,
     input: bool,
+    /// One of its clocks is active (set in the open event).
+    active: bool,
+    held: Option<Vec<f64>>,
+    queued: Option<Vec<f64>>,
 }
 
-/// The clocked variables of one instance and their held and queued values, by the FMU's
-/// value reference (all elements of an array).
+/// The clocked variables of one instance and their held and queued values. A variable is
+/// found by the FMU's value reference once (its slot), then every access is by slot.
 #[derive(Default)]
 pub(crate) struct ClockedExchange {
-    variables: HashMap<u32, Clocked>,
-    held: HashMap<u32, Vec<f64>>,
-    queued: HashMap<u32, Vec<f64>>,
-    /// The last `readable` answer and the clocks it was for (the same clocks tick again and
-    /// again).
-    last_readable: Option<(Vec<u32>, Vec<Access>)>,
+    /// The slot of each clocked variable by the FMU's value reference (all elements of an
+    /// array); looked up on every get and set of a running instance: a fast hash.
+    slots: FxHashMap<u32, usize>,
+    /// The same by index when every value reference is below [`DENSE_LIMIT`]: the slot + 1
+    /// of each value reference, 0 for a variable that is not clocked (no hash at all).
+    dense: Vec<u32>,
+    /// By slot, in the order of the description.
+    variables: Vec<Clocked>,
+    /// Some value is queued.
+    any_queued: bool,
+    /// The last [`ReadPlan`] (the same clocks tick again and again).
+    last_plan: Option<ReadPlan>,
+}
+
+/// Value references below this are looked up by index (64 KiB of table at most).
+const DENSE_LIMIT: u32 = 1 << 14;
+
+/// The reads of the clocked variables of some clocks when their event settles: the
+/// Float64 scalars in one call, the others one call each.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ReadPlan {
+    /// The clocks it is for.
+    clocks: Vec<u32>,
+    /// The Float64 scalars' value references, their slots, and a buffer for their values.
+    pub(crate) scalars: Vec<u32>,
+    pub(crate) scalar_slots: Vec<usize>,
+    pub(crate) values: Vec<f64>,
+    /// The other clocked variables the master reads, with their slots.
+    pub(crate) others: Vec<(usize, Access)>,
 }
 
 impl ClockedExchange {
@@ -42,15 +71,29 @@ impl ClockedExchange {
         let counts: HashMap<u32, usize> = special.values().map(|a| (a.vr, a.count)).collect();
         let mut exchange = ClockedExchange::default();
         for v in md.model_variables.iter().filter(|v| !v.clocks.is_empty()) {
-            if matches!(v.value_type, T::String | T::Binary | T::Clock) {
+            if matches!(v.value_type, T::String | T::Binary | T::Clock)
+                || exchange.slots.contains_key(&v.value_reference)
+            {
                 continue;
             }
             let count = counts.get(&v.value_reference).copied().unwrap_or(1);
             let access = Access { vr: v.value_reference, value_type: v.value_type, element: 0, count };
             let input = v.causality == fmi3::Causality::Input;
-            exchange.variables.insert(v.value_reference, Clocked { access, clocks: v.clocks.clone(), input });
-            if let Some(start) = start_values(v.start.as_ref(), count) {
-                exchange.held.insert(v.value_reference, start);
+            exchange.slots.insert(v.value_reference, exchange.variables.len());
+            exchange.variables.push(Clocked {
+                access,
+                clocks: v.clocks.clone(),
+                input,
+                active: false,
+                held: start_values(v.start.as_ref(), count),
+                queued: None,
+            });
+        }
+        let largest = md.model_variables.iter().map(|v| v.value_reference).max().unwrap_or(0);
+        if !exchange.variables.is_empty() && largest < DENSE_LIMIT {
+            exchange.dense = vec![0; largest as usize + 1];
+            for (vr, slot) in exchange.slots.iter() {
+                exchange.dense[*vr as usize] = *slot as u32 + 1;
             }
         }
         exchange
@@ -62,102 +105,167 @@ impl ClockedExchange {
         self.variables.is_empty()
     }
 
-    /// The FMU variable and element of the view's `vr` (`special` its access when it is no
-    /// plain scalar) when that variable is clocked.
-    pub(crate) fn clocked(&self, vr: u32, special: Option<Access>) -> Option<(u32, usize)> {
+    /// The slot and element of the view's `vr` (`special` its access when it is no plain
+    /// scalar) when that variable is clocked.
+    #[inline]
+    pub(crate) fn clocked(&self, vr: u32, special: Option<Access>) -> Option<(usize, usize)> {
         let (fmu_vr, element) = special.map_or((vr, 0), |a| (a.vr, a.element));
-        self.variables.contains_key(&fmu_vr).then_some((fmu_vr, element))
+        if !self.dense.is_empty() {
+            return match self.dense.get(fmu_vr as usize) {
+                Some(&k) if k > 0 => Some((k as usize - 1, element)),
+                _ => None,
+            };
+        }
+        self.slots.get(&fmu_vr).map(|slot| (*slot, element))
     }
 
-    /// Whether the clocked variable `fmu_vr` is an input.
-    pub(crate) fn is_input(&self, fmu_vr: u32) -> bool {
-        self.variables.get(&fmu_vr).is_some_and(|c| c.input)
+    /// Whether the clocked variable in `slot` is an input.
+    #[inline]
+    pub(crate) fn is_input(&self, slot: usize) -> bool {
+        self.variables[slot].input
     }
 
-    /// The value held for element `element` of `fmu_vr`.
-    pub(crate) fn held(&self, fmu_vr: u32, element: usize) -> Option<f64> {
-        self.held.get(&fmu_vr).and_then(|v| v.get(element)).copied()
+    /// Whether one of the clocks of the variable in `slot` is active (set in the open
+    /// event): it is read and set through the FMU.
+    #[inline]
+    pub(crate) fn is_active(&self, slot: usize) -> bool {
+        self.variables[slot].active
     }
 
-    /// Holds `value` for element `element` of `fmu_vr` (the other elements as held, NaN
-    /// when none was).
-    pub(crate) fn hold_element(&mut self, fmu_vr: u32, element: usize, value: f64) {
-        let count = self.variables.get(&fmu_vr).map_or(1, |c| c.access.count);
-        let held = self.held.entry(fmu_vr).or_insert_with(|| vec![f64::NAN; count]);
+    /// The clocks `active` are set: their variables are active until [`ClockedExchange::deactivate`].
+    pub(crate) fn activate(&mut self, active: &[u32]) {
+        for c in self.variables.iter_mut() {
+            c.active |= c.clocks.iter().any(|k| active.contains(k));
+        }
+    }
+
+    /// The event settled: no clock is active.
+    pub(crate) fn deactivate(&mut self) {
+        for c in self.variables.iter_mut() {
+            c.active = false;
+        }
+    }
+
+    /// The value held for element `element` of the variable in `slot`.
+    #[inline]
+    pub(crate) fn held(&self, slot: usize, element: usize) -> Option<f64> {
+        self.variables[slot].held.as_ref().and_then(|v| v.get(element)).copied()
+    }
+
+    /// Holds `value` for element `element` of the variable in `slot` (the other elements
+    /// as held, NaN when none was).
+    #[inline]
+    pub(crate) fn hold_element(&mut self, slot: usize, element: usize, value: f64) {
+        let c = &mut self.variables[slot];
+        let held = c.held.get_or_insert_with(|| vec![f64::NAN; c.access.count]);
         if let Some(x) = held.get_mut(element) {
             *x = value;
         }
     }
 
-    /// Holds all values of `fmu_vr`.
-    pub(crate) fn hold(&mut self, fmu_vr: u32, values: Vec<f64>) {
-        self.held.insert(fmu_vr, values);
+    /// Holds all values of the variable in `slot`.
+    pub(crate) fn hold(&mut self, slot: usize, values: Vec<f64>) {
+        self.variables[slot].held = Some(values);
     }
 
-    /// Queues `value` for element `element` of the clocked input `fmu_vr`, applied at the
+    /// Queues `value` for element `element` of the clocked input in `slot`, applied at the
     /// next activation of one of its clocks (the other elements as queued or held).
-    pub(crate) fn queue(&mut self, fmu_vr: u32, element: usize, value: f64) {
-        let count = self.variables.get(&fmu_vr).map_or(1, |c| c.access.count);
-        let held = self.held.get(&fmu_vr).cloned();
-        let queued = self.queued.entry(fmu_vr).or_insert_with(|| held.unwrap_or_else(|| vec![f64::NAN; count]));
+    pub(crate) fn queue(&mut self, slot: usize, element: usize, value: f64) {
+        let c = &mut self.variables[slot];
+        let (held, count) = (&c.held, c.access.count);
+        let queued = c.queued.get_or_insert_with(|| held.clone().unwrap_or_else(|| vec![f64::NAN; count]));
         if let Some(x) = queued.get_mut(element) {
             *x = value;
         }
+        self.any_queued = true;
     }
 
-    /// The queued sets of the inputs of the clocks `active`, taken (each access with all
-    /// its values).
-    pub(crate) fn take_queued(&mut self, active: &[u32]) -> Vec<(Access, Vec<f64>)> {
-        let due: Vec<Access> = self.of_clocks(active, true);
-        due.into_iter().filter_map(|a| self.queued.remove(&a.vr).map(|values| (a, values))).collect()
-    }
-
-    /// The clocked variables the master reads (outputs and every other non-input) of the
-    /// clocks `active`.
-    pub(crate) fn readable(&mut self, active: &[u32]) -> Vec<Access> {
-        if let Some((clocks, accesses)) = &self.last_readable {
-            if clocks == active {
-                return accesses.clone();
+    /// The queued sets of the inputs of the clocks `active`, taken (each access with its
+    /// slot and all its values).
+    pub(crate) fn take_queued(&mut self, active: &[u32]) -> Vec<(usize, Access, Vec<f64>)> {
+        if !self.any_queued {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        for (slot, c) in self.variables.iter_mut().enumerate() {
+            if c.input && c.clocks.iter().any(|k| active.contains(k)) {
+                if let Some(values) = c.queued.take() {
+                    out.push((slot, c.access, values));
+                }
             }
         }
-        let accesses = self.of_clocks(active, false);
-        self.last_readable = Some((active.to_vec(), accesses.clone()));
-        accesses
+        self.any_queued = self.variables.iter().any(|c| c.queued.is_some());
+        // a fixed order of calls: by value reference
+        out.sort_by_key(|(_, a, _)| a.vr);
+        out
+    }
+
+    /// The reads of the clocked variables the master reads (outputs and every other
+    /// non-input) of the clocks `active`, taken (give it back with [`ClockedExchange::put_plan`]).
+    pub(crate) fn take_plan(&mut self, active: &[u32]) -> ReadPlan {
+        if let Some(plan) = self.last_plan.take() {
+            if plan.clocks == active {
+                return plan;
+            }
+        }
+        let mut plan = ReadPlan { clocks: active.to_vec(), ..ReadPlan::default() };
+        for (slot, access) in self.of_clocks(active, false) {
+            if access.count == 1 && access.value_type == fmi3::ValueType::Float64 {
+                plan.scalars.push(access.vr);
+                plan.scalar_slots.push(slot);
+            } else {
+                plan.others.push((slot, access));
+            }
+        }
+        plan.values = vec![0.0; plan.scalars.len()];
+        plan
+    }
+
+    /// The plan back, for the next event of the same clocks.
+    pub(crate) fn put_plan(&mut self, plan: ReadPlan) {
+        self.last_plan = Some(plan);
     }
 
     /// The clocked variables the master reads that hold no value (no start value, not read
-    /// in Initialization Mode).
-    pub(crate) fn unheld(&self) -> Vec<Access> {
-        let mut out: Vec<Access> = self
+    /// in Initialization Mode), with their slots.
+    pub(crate) fn unheld(&self) -> Vec<(usize, Access)> {
+        let mut out: Vec<(usize, Access)> = self
             .variables
-            .values()
-            .filter(|c| !c.input && !self.held.contains_key(&c.access.vr))
-            .map(|c| c.access)
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| !c.input && c.held.is_none())
+            .map(|(slot, c)| (slot, c.access))
             .collect();
-        out.sort_by_key(|a| a.vr);
+        out.sort_by_key(|(_, a)| a.vr);
         out
     }
 
-    fn of_clocks(&self, active: &[u32], inputs: bool) -> Vec<Access> {
-        let mut out: Vec<Access> = self
+    fn of_clocks(&self, active: &[u32], inputs: bool) -> Vec<(usize, Access)> {
+        let mut out: Vec<(usize, Access)> = self
             .variables
-            .values()
-            .filter(|c| c.input == inputs && c.clocks.iter().any(|k| active.contains(k)))
-            .map(|c| c.access)
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.input == inputs && c.clocks.iter().any(|k| active.contains(k)))
+            .map(|(slot, c)| (slot, c.access))
             .collect();
-        // a fixed order of calls (the map's is not)
-        out.sort_by_key(|a| a.vr);
+        // a fixed order of calls: by value reference
+        out.sort_by_key(|(_, a)| a.vr);
         out
     }
 
-    /// A new run: the held values the start values again, nothing queued.
+    /// A new run: the held values the start values again, nothing queued, no clock active.
     pub(crate) fn forget_run(&mut self, md: &fmi3::ModelDescription) {
-        self.queued.clear();
-        self.held.clear();
+        self.any_queued = false;
+        for c in self.variables.iter_mut() {
+            c.queued = None;
+            c.held = None;
+            c.active = false;
+        }
         for v in md.model_variables.iter() {
-            if let Some(c) = self.variables.get(&v.value_reference) {
-                if let Some(start) = start_values(v.start.as_ref(), c.access.count) {
-                    self.held.insert(v.value_reference, start);
+            if let Some(&slot) = self.slots.get(&v.value_reference) {
+                let c = &mut self.variables[slot];
+                if c.held.is_none() {
+                    c.held = start_values(v.start.as_ref(), c.access.count);
                 }
             }
         }

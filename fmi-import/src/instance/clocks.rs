@@ -19,6 +19,7 @@ impl ClockCalls for Fmi3 {
         // their clocked outputs read
         self.apply_queued(core, vrs)?;
         self.ticked_inputs.extend_from_slice(vrs);
+        self.clocked.activate(vrs);
         Ok(())
     }
 
@@ -88,12 +89,17 @@ impl ClockCalls for Fmi3 {
         call!(core, "fmi3SetIntervalDecimal", None, f(c, vrs.as_ptr(), vrs.len(), intervals.as_ptr()))
     }
 
-    fn clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()> {
+    fn open_clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()> {
         core.time = time;
         Calls::enter_event_mode(self, core)?;
         if !vrs.is_empty() {
             self.set_clocks(core, vrs)?;
         }
+        Ok(())
+    }
+
+    fn close_clock_event(&mut self, core: &mut Core) -> Result<()> {
+        let time = core.time;
         match self.settle_event(core, time)? {
             None => Ok(()),
             Some(t) => Err(self.terminated_at(core, "fmi3UpdateDiscreteStates", t, t)),
@@ -205,8 +211,28 @@ impl Instance {
     /// output clocks ([`Instance::take_output_ticks`]), `fmi3EnterStepMode`. An FMU that asks
     /// to terminate in it ends the run as `fmi3DoStep`'s `terminateSimulation` does.
     pub fn clock_event(&mut self, time: f64, vrs: &[u32]) -> Result<()> {
+        self.open_clock_event(time, vrs)?;
+        self.close_clock_event()
+    }
+
+    /// The first half of [`Instance::clock_event`]: `fmi3EnterEventMode` at `time` and
+    /// `fmi3SetClock` of the input clocks `vrs`, the queued sets of their clocked inputs
+    /// applied. Until [`Instance::close_clock_event`] the clocks are active: the master may
+    /// exchange values at the tick (a get of a clocked variable of an active clock and a set
+    /// of a clocked input of one go to the FMU, the values held), as it does at any event.
+    pub fn open_clock_event(&mut self, time: f64, vrs: &[u32]) -> Result<()> {
         match self.calls.clock_calls() {
-            Some(c) => c.clock_event(&mut self.core, time, vrs),
+            Some(c) => c.open_clock_event(&mut self.core, time, vrs),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// The second half of [`Instance::clock_event`]: `fmi3UpdateDiscreteStates` until
+    /// settled, the output clocks and intervals read, the clocked variables of the event's
+    /// clocks read and held, `fmi3EnterStepMode`.
+    pub fn close_clock_event(&mut self) -> Result<()> {
+        match self.calls.clock_calls() {
+            Some(c) => c.close_clock_event(&mut self.core),
             None => Err(no_clocks(self)),
         }
     }

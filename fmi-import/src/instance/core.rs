@@ -264,9 +264,12 @@ pub(crate) trait ClockCalls {
     fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>>;
     fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>>;
     fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()>;
-    /// A clock event at `time` (Event Mode entered and the input clocks `vrs` set; the
-    /// discrete states updated until settled; the output clocks read; Step Mode again).
-    fn clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()>;
+    /// The start of a clock event at `time`: Event Mode entered and the input clocks `vrs`
+    /// set (active until the close).
+    fn open_clock_event(&mut self, core: &mut Core, time: f64, vrs: &[u32]) -> Result<()>;
+    /// The end of the open clock event: the discrete states updated until settled, the
+    /// output clocks read, Step Mode again.
+    fn close_clock_event(&mut self, core: &mut Core) -> Result<()>;
     /// The output clocks' ticks since the last call (in Event Mode entered by a tick or by
     /// the FMU's own event in `fmi3DoStep`).
     fn take_output_ticks(&mut self) -> Vec<OutputTick>;

@@ -38,9 +38,14 @@ pub(crate) struct Fmi3 {
     output_clocks: Vec<u32>,
     /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
     pub(super) output_ticks: Vec<super::core::OutputTick>,
-    /// The input clocks whose interval the FMU gives (fixed, tunable, changing,
-    /// countdown), read by `fmi3GetIntervalDecimal` in every event.
+    /// The input clocks whose interval the FMU gives (tunable, changing, countdown), read
+    /// by `fmi3GetIntervalDecimal` in every event.
     interval_clocks: Vec<u32>,
+    /// The fixed input clocks: their interval read in the first event of a run (the one
+    /// that ends initialization) only, as it cannot change afterwards.
+    fixed_clocks: Vec<u32>,
+    /// The fixed clocks' intervals were read in this run.
+    fixed_read: bool,
     /// What the FMU said of their intervals, not yet taken: (event time, clock, interval).
     pub(super) intervals: Vec<(f64, u32, super::core::Interval)>,
     /// Scheduled Execution: the environment of the FMU's callbacks (boxed: its address is
@@ -74,13 +79,18 @@ impl Fmi3 {
         };
         let output_clocks =
             clocks.iter().filter(|c| c.causality == ClockCausality::Output).map(|c| c.value_reference).collect();
-        let interval_clocks = clocks
-            .iter()
-            .filter(|c| {
-                c.causality == ClockCausality::Input && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered)
-            })
-            .map(|c| c.value_reference)
-            .collect();
+        let given = |fixed: bool| -> Vec<u32> {
+            clocks
+                .iter()
+                .filter(|c| {
+                    c.causality == ClockCausality::Input
+                        && !matches!(c.kind, ClockKind::Constant | ClockKind::Triggered)
+                        && (c.kind == ClockKind::Fixed) == fixed
+                })
+                .map(|c| c.value_reference)
+                .collect()
+        };
+        let (interval_clocks, fixed_clocks) = (given(false), given(true));
         Fmi3 {
             experiment: (None, 0.0, None),
             terminate_requested: None,
@@ -90,6 +100,8 @@ impl Fmi3 {
             output_clocks,
             output_ticks: Vec::new(),
             interval_clocks,
+            fixed_clocks,
+            fixed_read: false,
             intervals: Vec::new(),
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
             clocked: super::clocked::ClockedExchange::new(&a.description, &a.special),
@@ -480,23 +492,32 @@ impl Fmi3 {
         values: &mut [T],
         fmu_get: fn(&mut Fmi3, &mut Core, &[u32], &mut [T]) -> Result<()>,
     ) -> Result<()> {
-        let clocked: Vec<Option<(u32, usize)>> =
-            vrs.iter().map(|vr| self.clocked.clocked(*vr, self.special(*vr))).collect();
-        if clocked.iter().all(Option::is_none) {
-            return fmu_get(self, core, vrs, values);
-        }
+        let at = |me: &Fmi3, vr: u32| me.clocked.clocked(vr, me.special(vr));
         if core.state != InstanceState::Running {
             fmu_get(self, core, vrs, values)?;
-            for (at, value) in clocked.iter().zip(values.iter()) {
-                if let Some((fmu_vr, element)) = at {
-                    self.clocked.hold_element(*fmu_vr, *element, value.to_held());
+            for (vr, value) in vrs.iter().zip(values.iter()) {
+                if let Some((slot, element)) = at(self, *vr) {
+                    self.clocked.hold_element(slot, element, value.to_held());
                 }
             }
             return Ok(());
         }
+        // a clocked variable is answered from its held value unless one of its clocks is
+        // active (then read, and held); the rest (no allocation when nothing is held: the
+        // common case of a plain read, or of the reads in an open clock event)
+        let held = |me: &Fmi3, vr: u32| {
+            at(me, vr)
+                .filter(|(slot, _)| !me.clocked.is_active(*slot))
+                .and_then(|(slot, element)| me.clocked.held(slot, element))
+        };
+        if vrs.iter().all(|vr| held(self, *vr).is_none()) {
+            fmu_get(self, core, vrs, values)?;
+            self.hold_read(vrs, values);
+            return Ok(());
+        }
         let (mut free_vrs, mut free_at) = (Vec::new(), Vec::new());
-        for (k, (vr, at)) in vrs.iter().zip(&clocked).enumerate() {
-            match at.and_then(|(fmu_vr, element)| self.clocked.held(fmu_vr, element)) {
+        for (k, vr) in vrs.iter().enumerate() {
+            match held(self, *vr) {
                 Some(held) => values[k] = T::from_held(held),
                 None => {
                     free_vrs.push(*vr);
@@ -504,14 +525,28 @@ impl Fmi3 {
                 }
             }
         }
-        if !free_vrs.is_empty() {
-            let mut free_values: Vec<T> = free_at.iter().map(|k| values[*k]).collect();
-            fmu_get(self, core, &free_vrs, &mut free_values)?;
-            for (k, value) in free_at.into_iter().zip(free_values) {
-                values[k] = value;
-            }
+        let mut free_values: Vec<T> = free_at.iter().map(|k| values[*k]).collect();
+        fmu_get(self, core, &free_vrs, &mut free_values)?;
+        self.hold_read(&free_vrs, &free_values);
+        for (k, value) in free_at.into_iter().zip(free_values) {
+            values[k] = value;
         }
         Ok(())
+    }
+
+    /// The clocked variables among `vrs` whose clocks are active, just read from or set
+    /// to the FMU, held.
+    fn hold_read<T: HeldNumber>(&mut self, vrs: &[u32], values: &[T]) {
+        if self.ticked_inputs.is_empty() {
+            return;
+        }
+        for (vr, value) in vrs.iter().zip(values) {
+            if let Some((slot, element)) = self.clocked.clocked(*vr, self.special(*vr)) {
+                if self.clocked.is_active(slot) {
+                    self.clocked.hold_element(slot, element, value.to_held());
+                }
+            }
+        }
     }
 
     /// A set of the view's `vrs` on an FMU with clocked variables: while running, a set of
@@ -525,27 +560,31 @@ impl Fmi3 {
         values: &[T],
         fmu_set: fn(&mut Fmi3, &mut Core, &[u32], &[T]) -> Result<()>,
     ) -> Result<()> {
-        let clocked: Vec<Option<(u32, usize)>> =
-            vrs.iter().map(|vr| self.clocked.clocked(*vr, self.special(*vr))).collect();
-        if clocked.iter().all(Option::is_none) {
-            return fmu_set(self, core, vrs, values);
-        }
+        let at = |me: &Fmi3, vr: u32| me.clocked.clocked(vr, me.special(vr));
         if core.state != InstanceState::Running {
             fmu_set(self, core, vrs, values)?;
-            for (at, value) in clocked.iter().zip(values) {
-                if let Some((fmu_vr, element)) = at {
-                    self.clocked.hold_element(*fmu_vr, *element, value.to_held());
+            for (vr, value) in vrs.iter().zip(values) {
+                if let Some((slot, element)) = at(self, *vr) {
+                    self.clocked.hold_element(slot, element, value.to_held());
                 }
             }
             return Ok(());
         }
+        // a clocked input whose clocks are inactive is queued; every other variable set (a
+        // clocked input of an active clock, in an open clock event, held too)
+        let queued = |me: &Fmi3, vr: u32| {
+            at(me, vr).filter(|(slot, _)| me.clocked.is_input(*slot) && !me.clocked.is_active(*slot))
+        };
+        if vrs.iter().all(|vr| queued(self, *vr).is_none()) {
+            fmu_set(self, core, vrs, values)?;
+            self.hold_read(vrs, values);
+            return Ok(());
+        }
         let (mut free_vrs, mut free_values) = (Vec::new(), Vec::new());
-        for ((vr, at), value) in vrs.iter().zip(&clocked).zip(values) {
-            match at {
-                Some((fmu_vr, element)) if self.clocked.is_input(*fmu_vr) => {
-                    self.clocked.queue(*fmu_vr, *element, value.to_held())
-                }
-                _ => {
+        for (vr, value) in vrs.iter().zip(values) {
+            match queued(self, *vr) {
+                Some((slot, element)) => self.clocked.queue(slot, element, value.to_held()),
+                None => {
                     free_vrs.push(*vr);
                     free_values.push(*value);
                 }
@@ -554,7 +593,9 @@ impl Fmi3 {
         if free_vrs.is_empty() {
             return Ok(());
         }
-        fmu_set(self, core, &free_vrs, &free_values)
+        fmu_set(self, core, &free_vrs, &free_values)?;
+        self.hold_read(&free_vrs, &free_values);
+        Ok(())
     }
 
     /// The queued sets of the clocked inputs of the clocks `active` applied (each as one
@@ -563,9 +604,9 @@ impl Fmi3 {
         if self.clocked.is_empty() || active.is_empty() {
             return Ok(());
         }
-        for (access, values) in self.clocked.take_queued(active) {
+        for (slot, access, values) in self.clocked.take_queued(active) {
             self.set_all(core, access, &values)?;
-            self.clocked.hold(access.vr, values);
+            self.clocked.hold(slot, values);
         }
         Ok(())
     }
@@ -576,22 +617,24 @@ impl Fmi3 {
         if self.clocked.is_empty() || active.is_empty() {
             return Ok(());
         }
-        let readable = self.clocked.readable(active);
-        // the Float64 scalars in one fmi3GetFloat64 (the others one call each)
-        let (scalars, others): (Vec<Access>, Vec<Access>) =
-            readable.iter().partition(|a| a.count == 1 && a.value_type == model_description::fmi3::ValueType::Float64);
-        if !scalars.is_empty() {
-            let vrs: Vec<u32> = scalars.iter().map(|a| a.vr).collect();
-            let mut values = vec![0.0; vrs.len()];
+        let mut plan = self.clocked.take_plan(active);
+        let outcome = self.read_planned(core, &mut plan);
+        self.clocked.put_plan(plan);
+        outcome
+    }
+
+    fn read_planned(&mut self, core: &mut Core, plan: &mut super::clocked::ReadPlan) -> Result<()> {
+        if !plan.scalars.is_empty() {
+            let (vrs, values) = (&plan.scalars, &mut plan.values);
             let (c, f) = (core.component, self.a.functions.get_float64);
             call!(core, "fmi3GetFloat64", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len()))?;
-            for (vr, value) in vrs.into_iter().zip(values) {
-                self.clocked.hold_element(vr, 0, value);
+            for (slot, value) in plan.scalar_slots.iter().zip(values.iter()) {
+                self.clocked.hold_element(*slot, 0, *value);
             }
         }
-        for access in others {
-            let values = self.get_all(core, access)?;
-            self.clocked.hold(access.vr, values);
+        for (slot, access) in plan.others.iter() {
+            let values = self.get_all(core, *access)?;
+            self.clocked.hold(*slot, values);
         }
         Ok(())
     }
@@ -600,16 +643,23 @@ impl Fmi3 {
     /// intervals of the input clocks the FMU gives (`fmi3GetIntervalDecimal`), kept for
     /// `take_output_ticks` and `take_intervals`.
     fn read_output_clocks(&mut self, core: &mut Core, time: f64) -> Result<()> {
-        if !self.interval_clocks.is_empty() {
-            let vrs = self.interval_clocks.clone();
+        let fixed = if self.fixed_read { &[][..] } else { &self.fixed_clocks[..] };
+        if !self.interval_clocks.is_empty() || !fixed.is_empty() {
+            let vrs: Vec<u32> = self.interval_clocks.iter().chain(fixed).copied().collect();
+            self.fixed_read = true;
             let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
-        let vrs = self.output_clocks.clone();
-        if vrs.is_empty() {
-            let active = std::mem::take(&mut self.ticked_inputs);
-            return self.read_clocked(core, &active);
+        if self.output_clocks.is_empty() {
+            // (the list's buffer kept for the next event)
+            let mut active = std::mem::take(&mut self.ticked_inputs);
+            self.clocked.deactivate();
+            let outcome = self.read_clocked(core, &active);
+            active.clear();
+            self.ticked_inputs = active;
+            return outcome;
         }
+        let vrs = self.output_clocks.clone();
         let mut ticks = vec![false; vrs.len()];
         ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
         let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
@@ -618,6 +668,7 @@ impl Fmi3 {
         }
         // the clocked variables of the clocks that ticked in this event, read as it settled
         let mut active = std::mem::take(&mut self.ticked_inputs);
+        self.clocked.deactivate();
         active.extend(ticked);
         self.read_clocked(core, &active)
     }
@@ -776,9 +827,9 @@ impl Calls for Fmi3 {
     fn exit_initialization_mode(&mut self, core: &mut Core) -> Result<()> {
         // the clocked variables the master reads hold what initialization computed until
         // their clocks' first ticks (read while Initialization Mode allows it)
-        for access in self.clocked.unheld() {
+        for (slot, access) in self.clocked.unheld() {
             let values = self.get_all(core, access)?;
-            self.clocked.hold(access.vr, values);
+            self.clocked.hold(slot, values);
         }
         let (c, f) = (core.component, self.a.functions.exit_initialization_mode);
         call!(core, "fmi3ExitInitializationMode", None, f(c))?;
@@ -806,6 +857,7 @@ impl Calls for Fmi3 {
     fn forget_run(&mut self) {
         self.clocked.forget_run(&self.a.description);
         self.ticked_inputs.clear();
+        self.fixed_read = false;
         self.output_ticks.clear();
         self.intervals.clear();
         self.terminate_requested = None;

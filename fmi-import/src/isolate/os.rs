@@ -88,8 +88,9 @@ mod imp {
 
     fn map(fd: i32, len: usize) -> Result<*mut u8, String> {
         // SAFETY: maps `len` bytes of the descriptor shared, read-write.
-        let base =
-            unsafe { libc::mmap(std::ptr::null_mut(), len, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0) };
+        let base = unsafe {
+            libc::mmap(std::ptr::null_mut(), len, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_SHARED, fd, 0)
+        };
         if base == libc::MAP_FAILED {
             return Err(format!("mmap: {}", std::io::Error::last_os_error()));
         }
@@ -221,6 +222,6 @@ mod imp {
     pub(crate) fn wake(_word: &AtomicU32) {}
 }
 
-pub(crate) use imp::{map_inherited, sleep_on, wake, HostProcess, SharedRegion};
 #[cfg(target_os = "linux")]
 pub use imp::memfd_create;
+pub(crate) use imp::{map_inherited, sleep_on, wake, HostProcess, SharedRegion};

@@ -26,83 +26,17 @@ pub enum Fmi2Part {
     ModelExchange,
 }
 
-/// A symbol the loader required and the library does not export.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MissingSymbol(pub &'static str);
+pub use crate::table::MissingSymbol;
+use std::ffi::c_int;
 
-impl std::fmt::Display for MissingSymbol {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "the library does not export {}", self.0)
-    }
-}
-
-impl std::error::Error for MissingSymbol {}
-
-macro_rules! fmi2_functions {
-    (core { $($cf:ident : $cs:ident = $cn:literal, $cp:ident => fn($($ca:ty),*) $(-> $cr:ty)?;)* }
-     optional { $($of:ident : $os:ident = $on:literal, $op:ident => fn($($oa:ty),*) $(-> $or:ty)?;)* }) => {
-        pub mod types {
-            //! The C type of each function, named as in `fmi2FunctionTypes.h`. The
-            //! `fmuType` of `fmi2Instantiate` is a C `int` (an [`Fmi2Type`] value), so that
-            //! an importer can pass what its user asked for and hear the FMU refuse it.
-            use super::*;
-            use std::ffi::c_int;
-            $(#[doc = concat!("`", stringify!($cs), "`.")]
-              pub type $cs = unsafe extern "C" fn($($ca),*) $(-> $cr)?;)*
-            $(#[doc = concat!("`", stringify!($os), "`.")]
-              pub type $os = unsafe extern "C" fn($($oa),*) $(-> $or)?;)*
-        }
-
-        /// The 44 functions of an FMI 2.0 library: the 15 every importer calls as function
-        /// pointers, the others as `Option` (`None`: the library does not export it).
-        #[derive(Clone, Copy, Debug)]
-        pub struct Fmi2Functions {
-            $(#[doc = concat!("`", $cn, "`.")] pub $cf: types::$cs,)*
-            $(#[doc = concat!("`", $on, "`.")] pub $of: Option<types::$os>,)*
-        }
-
-        /// Every symbol with the part of FMI 2.0 it belongs to: the common ones first
-        /// (the 15 of the core first among them), then Co-Simulation, then Model Exchange.
-        pub const SYMBOLS: [(&str, Fmi2Part); 44] = [
-            $(($cn, Fmi2Part::$cp),)*
-            $(($on, Fmi2Part::$op),)*
-        ];
-
-        impl Fmi2Functions {
-            /// Resolves the 44 symbols in `library`: the 15 core ones must be there (the
-            /// first absent one is the error), the others are `None` when absent.
-            ///
-            /// # Safety
-            /// `library` must be an FMI 2.0 library: each exported `fmi2*` symbol has the C
-            /// signature of the FMI 2.0 headers. The pointers are valid while the library
-            /// stays loaded.
-            #[cfg(feature = "import")]
-            pub unsafe fn load(library: &libloading::Library) -> Result<Fmi2Functions, MissingSymbol> {
-                Ok(Fmi2Functions {
-                    $($cf: *library
-                        .get::<types::$cs>(concat!($cn, "\0").as_bytes())
-                        .map_err(|_| MissingSymbol($cn))?,)*
-                    $($of: library
-                        .get::<types::$os>(concat!($on, "\0").as_bytes())
-                        .ok()
-                        .map(|s| *s),)*
-                })
-            }
-
-            /// Whether the library exports `symbol` (`"fmi2DoStep"`, ...); false for a
-            /// name that is not an FMI 2.0 function.
-            pub fn has(&self, symbol: &str) -> bool {
-                match symbol {
-                    $($cn => true,)*
-                    $($on => self.$of.is_some(),)*
-                    _ => false,
-                }
-            }
-        }
-    };
-}
-
-fmi2_functions! {
+crate::table::function_table! {
+    /// The C type of each function, named as in `fmi2FunctionTypes.h`. The `fmuType` of
+    /// `fmi2Instantiate` is a C `int` (an [`Fmi2Type`] value), so that an importer can pass
+    /// what its user asked for and hear the FMU refuse it.
+    mod types;
+    /// The 44 functions of an FMI 2.0 library: the 15 every importer calls as function
+    /// pointers, the others as `Option` (`None`: the library does not export it).
+    pub struct Fmi2Functions: Fmi2Part, 44 symbols of "FMI 2.0";
     core {
         get_version: fmi2GetVersionTYPE = "fmi2GetVersion", Common => fn() -> fmi2String;
         instantiate: fmi2InstantiateTYPE = "fmi2Instantiate", Common => fn(fmi2String, c_int, fmi2String, fmi2String, *const Fmi2CallbackFunctions, fmi2Boolean, fmi2Boolean) -> fmi2Component;
@@ -169,40 +103,12 @@ impl Fmi2Functions {
     }
 }
 
-/// The symbols of one part of FMI 2.0.
-pub fn symbols_of(part: Fmi2Part) -> impl Iterator<Item = &'static str> {
-    SYMBOLS.iter().filter(move |(_, p)| *p == part).map(|(s, _)| *s)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The counts of the FMI 2.0 standard, section 2.1 (common), 4.2 (Co-Simulation),
-    /// 3.2 (Model Exchange), and names that are all distinct.
-    #[test]
-    fn the_44_symbols_are_25_common_9_co_simulation_10_model_exchange() {
-        assert_eq!(symbols_of(Fmi2Part::Common).count(), 25);
-        assert_eq!(symbols_of(Fmi2Part::CoSimulation).count(), 9);
-        assert_eq!(symbols_of(Fmi2Part::ModelExchange).count(), 10);
-        let mut names: Vec<&str> = SYMBOLS.iter().map(|(s, _)| *s).collect();
-        names.sort();
-        names.dedup();
-        assert_eq!(names.len(), 44);
-        assert!(names.contains(&"fmi2DeSerializeFMUstate"));
-        assert!(names.contains(&"fmi2GetNominalsOfContinuousStates"));
-        assert_eq!(SYMBOLS[0].0, "fmi2GetVersion");
-        assert_eq!(SYMBOLS[43].0, "fmi2GetNominalsOfContinuousStates");
-    }
-
-    /// A shared library that is no FMU: the first core symbol is the error.
-    #[cfg(feature = "import")]
-    #[test]
-    fn a_library_without_the_core_functions_is_refused_naming_the_first() {
-        // SAFETY: the C library's initializers already ran in this process.
-        let libc = unsafe { libloading::Library::new("libc.so.6") }.unwrap();
-        let e = unsafe { Fmi2Functions::load(&libc) }.unwrap_err();
-        assert_eq!(e, MissingSymbol("fmi2GetVersion"));
-        assert_eq!(e.to_string(), "the library does not export fmi2GetVersion");
-    }
+/// The counts of the FMI 2.0 standard, section 2.1 (common), 4.2 (Co-Simulation), 3.2
+/// (Model Exchange), in the order of the table.
+#[test]
+fn the_44_symbols_are_25_common_9_co_simulation_10_model_exchange() {
+    let parts = [Fmi2Part::Common, Fmi2Part::CoSimulation, Fmi2Part::ModelExchange];
+    assert_eq!(parts.map(|p| symbols_of(p).count()), [25, 9, 10]);
+    assert_eq!((SYMBOLS[0].0, SYMBOLS[43].0), ("fmi2GetVersion", "fmi2GetNominalsOfContinuousStates"));
+    assert!(SYMBOLS.iter().any(|(s, _)| *s == "fmi2DeSerializeFMUstate"));
 }

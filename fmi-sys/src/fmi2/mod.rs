@@ -42,30 +42,15 @@ pub const FMI2_FALSE: fmi2Boolean = 0;
 /// undefined behaviour. [`Fmi2Status::from_raw`] classifies it.
 pub type fmi2Status = c_int;
 
-/// `fmi2Status` as an FMU returns it (same ABI as the C enum, an `int`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Fmi2Status {
-    Ok = 0,
-    Warning = 1,
-    Discard = 2,
-    Error = 3,
-    Fatal = 4,
-    Pending = 5,
-}
-
-impl Fmi2Status {
-    /// The status a raw value stands for; `None` for a value outside `fmi2Status`.
-    pub fn from_raw(raw: fmi2Status) -> Option<Fmi2Status> {
-        Some(match raw {
-            0 => Fmi2Status::Ok,
-            1 => Fmi2Status::Warning,
-            2 => Fmi2Status::Discard,
-            3 => Fmi2Status::Error,
-            4 => Fmi2Status::Fatal,
-            5 => Fmi2Status::Pending,
-            _ => return None,
-        })
+crate::table::status_enum! {
+    /// `fmi2Status` as an FMU returns it (same ABI as the C enum, an `int`).
+    Fmi2Status, fmi2Status {
+        Ok = 0,
+        Warning = 1,
+        Discard = 2,
+        Error = 3,
+        Fatal = 4,
+        Pending = 5,
     }
 }
 

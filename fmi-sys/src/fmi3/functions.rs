@@ -25,72 +25,16 @@ pub enum Fmi3Part {
     ScheduledExecution,
 }
 
-pub use super::super::fmi2::functions::MissingSymbol;
+pub use crate::table::MissingSymbol;
 
-macro_rules! fmi3_functions {
-    (core { $($cf:ident : $cs:ident = $cn:literal, $cp:ident => fn($($ca:ty),*) $(-> $cr:ty)?;)* }
-     optional { $($of:ident : $os:ident = $on:literal, $op:ident => fn($($oa:ty),*) $(-> $or:ty)?;)* }) => {
-        pub mod types {
-            //! The C type of each function, named as in `fmi3FunctionTypes.h`. The
-            //! Booleans are C `bool`s; an importer reads what an FMU wrote through an
-            //! `fmi3Boolean*` as a byte (any value but 0 is true), never as a Rust `bool`.
-            use super::*;
-            $(#[doc = concat!("`", stringify!($cs), "`.")]
-              pub type $cs = unsafe extern "C" fn($($ca),*) $(-> $cr)?;)*
-            $(#[doc = concat!("`", stringify!($os), "`.")]
-              pub type $os = unsafe extern "C" fn($($oa),*) $(-> $or)?;)*
-        }
-
-        /// The functions of an FMI 3.0 library: the 7 every importer calls as function
-        /// pointers, the others as `Option` (`None`: the library does not export it).
-        #[derive(Clone, Copy, Debug)]
-        pub struct Fmi3Functions {
-            $(#[doc = concat!("`", $cn, "`.")] pub $cf: types::$cs,)*
-            $(#[doc = concat!("`", $on, "`.")] pub $of: Option<types::$os>,)*
-        }
-
-        /// Every symbol with the part of FMI 3.0 it belongs to: the common ones first
-        /// (the 15 of the core first among them), then Co-Simulation, then Model Exchange.
-        pub const SYMBOLS: [(&str, Fmi3Part); 75] = [
-            $(($cn, Fmi3Part::$cp),)*
-            $(($on, Fmi3Part::$op),)*
-        ];
-
-        impl Fmi3Functions {
-            /// Resolves the symbols in `library`: the 7 core ones must be there (the
-            /// first absent one is the error), the others are `None` when absent.
-            ///
-            /// # Safety
-            /// `library` must be an FMI 3.0 library: each exported `fmi3*` symbol has the C
-            /// signature of the FMI 3.0 headers. The pointers are valid while the library
-            /// stays loaded.
-            #[cfg(feature = "import")]
-            pub unsafe fn load(library: &libloading::Library) -> Result<Fmi3Functions, MissingSymbol> {
-                Ok(Fmi3Functions {
-                    $($cf: *library
-                        .get::<types::$cs>(concat!($cn, "\0").as_bytes())
-                        .map_err(|_| MissingSymbol($cn))?,)*
-                    $($of: library
-                        .get::<types::$os>(concat!($on, "\0").as_bytes())
-                        .ok()
-                        .map(|s| *s),)*
-                })
-            }
-
-            /// Whether the library exports `symbol` (`"fmi3DoStep"`, ...); false for a
-            /// name that is not an FMI 3.0 function.
-            pub fn has(&self, symbol: &str) -> bool {
-                match symbol {
-                    $($cn => true,)*
-                    $($on => self.$of.is_some(),)*
-                    _ => false,
-                }
-            }
-        }
-    };
-}
-
-fmi3_functions! {
+crate::table::function_table! {
+    /// The C type of each function, named as in `fmi3FunctionTypes.h`. The Booleans are C
+    /// `bool`s; an importer reads what an FMU wrote through an `fmi3Boolean*` as a byte
+    /// (any value but 0 is true), never as a Rust `bool`.
+    mod types;
+    /// The functions of an FMI 3.0 library: the 7 every importer calls as function
+    /// pointers, the others as `Option` (`None`: the library does not export it).
+    pub struct Fmi3Functions: Fmi3Part, 75 symbols of "FMI 3.0";
     core {
         get_version: fmi3GetVersionTYPE = "fmi3GetVersion", Common => fn() -> *const c_char;
         free_instance: fmi3FreeInstanceTYPE = "fmi3FreeInstance", Common => fn(fmi3Instance);
@@ -181,39 +125,16 @@ impl Fmi3Functions {
     }
 }
 
-/// The symbols of one part of FMI 3.0.
-pub fn symbols_of(part: Fmi3Part) -> impl Iterator<Item = &'static str> {
-    SYMBOLS.iter().filter(move |(_, p)| *p == part).map(|(s, _)| *s)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The function counts of `fmi3FunctionTypes.h` (3.0.2): 61 common (with the three
-    /// instantiation functions), 10 Model Exchange, 3 Co-Simulation, 1 Scheduled
-    /// Execution; names all distinct.
-    #[test]
-    fn the_symbols_are_those_of_the_header() {
-        assert_eq!(symbols_of(Fmi3Part::Common).count(), 61);
-        assert_eq!(symbols_of(Fmi3Part::ModelExchange).count(), 10);
-        assert_eq!(symbols_of(Fmi3Part::CoSimulation).count(), 3);
-        assert_eq!(symbols_of(Fmi3Part::ScheduledExecution).count(), 1);
-        let mut names: Vec<&str> = SYMBOLS.iter().map(|(s, _)| *s).collect();
-        names.sort();
-        names.dedup();
-        assert_eq!(names.len(), 75);
-        assert!(names.contains(&"fmi3GetAdjointDerivative"));
-        assert!(names.contains(&"fmi3GetContinuousStateDerivatives"));
-    }
-
-    /// A shared library that is no FMU: the first core symbol is the error.
-    #[cfg(feature = "import")]
-    #[test]
-    fn a_library_without_the_core_functions_is_refused_naming_the_first() {
-        // SAFETY: the C library's initializers already ran in this process.
-        let libc = unsafe { libloading::Library::new("libc.so.6") }.unwrap();
-        let e = unsafe { Fmi3Functions::load(&libc) }.unwrap_err();
-        assert_eq!(e, MissingSymbol("fmi3GetVersion"));
+/// The function counts of `fmi3FunctionTypes.h` (3.0.2): 61 common (with the three
+/// instantiation functions), 10 Model Exchange, 3 Co-Simulation, 1 Scheduled Execution.
+#[test]
+fn the_symbols_are_those_of_the_header() {
+    use Fmi3Part::*;
+    assert_eq!(
+        [Common, ModelExchange, CoSimulation, ScheduledExecution].map(|p| symbols_of(p).count()),
+        [61, 10, 3, 1]
+    );
+    for name in ["fmi3GetAdjointDerivative", "fmi3GetContinuousStateDerivatives"] {
+        assert!(SYMBOLS.iter().any(|(s, _)| *s == name), "{name}");
     }
 }

@@ -56,28 +56,14 @@ pub const FMI3_CLOCK_INACTIVE: fmi3Clock = 0;
 /// classifies it.
 pub type fmi3Status = c_int;
 
-/// `fmi3Status` as an FMU returns it (same ABI as the C enum, an `int`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Fmi3Status {
-    Ok = 0,
-    Warning = 1,
-    Discard = 2,
-    Error = 3,
-    Fatal = 4,
-}
-
-impl Fmi3Status {
-    /// The status a raw value stands for; `None` for a value outside `fmi3Status`.
-    pub fn from_raw(raw: fmi3Status) -> Option<Fmi3Status> {
-        Some(match raw {
-            0 => Fmi3Status::Ok,
-            1 => Fmi3Status::Warning,
-            2 => Fmi3Status::Discard,
-            3 => Fmi3Status::Error,
-            4 => Fmi3Status::Fatal,
-            _ => return None,
-        })
+crate::table::status_enum! {
+    /// `fmi3Status` as an FMU returns it (same ABI as the C enum, an `int`).
+    Fmi3Status, fmi3Status {
+        Ok = 0,
+        Warning = 1,
+        Discard = 2,
+        Error = 3,
+        Fatal = 4,
     }
 }
 
