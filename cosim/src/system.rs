@@ -651,7 +651,12 @@ impl SystemBuilder {
         if vb.causality != Causality::Input {
             return Err(err(format!("the destination is a {} variable, not an input", vb.causality.as_str())));
         }
-        if a.base_type != b.base_type {
+        // integers of different widths connect (an FMI 3.0 Int64, UInt64 or UInt32 is a
+        // Real of the view, the smaller ones Integers): the value is carried as an integer
+        // and checked against the input's type at every set (`simulate/integers.rs`)
+        let integer = |r: &VariableRef| self.system.instances[r.instance].fmu.integer_type(r.value_reference);
+        let integers = integer(&a).zip(integer(&b));
+        if a.base_type != b.base_type && integers.is_none() {
             return Err(err(format!("types differ: {} -> {}", a.base_type.as_str(), b.base_type.as_str())));
         }
         if a.base_type == BaseType::String {
@@ -670,7 +675,7 @@ impl SystemBuilder {
                     .map_err(err)?;
         }
         if let Some((f, o)) = linear {
-            if a.base_type != BaseType::Real && (f != 1.0 || o != 0.0) {
+            if (a.base_type != BaseType::Real || a.base_type != b.base_type) && (f != 1.0 || o != 0.0) {
                 return Err(err("a linear transformation needs Real variables".into()));
             }
             if !f.is_finite() || !o.is_finite() {

@@ -345,7 +345,7 @@ impl<'s> Execution<'s> {
         }
         let core = self.core.insert(Core {
             lanes,
-            values: vec![0.0; self.plan.sources.len()],
+            values: vec![0.0; self.plan.exchange_len],
             group: self.group.take(),
             solver: experiment.solver,
             clock: self.clock,
@@ -376,7 +376,8 @@ impl<'s> Execution<'s> {
         self.algorithm.propagate(core)?;
         // every input at its source's value when Initialization Mode ends: chains of direct
         // feedthrough settle in one sweep per link, a loop at its fixed point
-        let sweeps = super::init_loop::iterate(core, self.init_loop.as_deref().unwrap_or_default())?;
+        let exact = self.plan.exact_slots();
+        let sweeps = super::init_loop::iterate(core, self.init_loop.as_deref().unwrap_or_default(), &exact)?;
         if let Some(cycle) = &self.init_loop {
             self.notes.push(format!(
                 "the connections {} form an algebraic loop at initialization: iterated to its fixed point in {sweeps} sweep{} of the connections (to {:e} relative)",

@@ -36,7 +36,7 @@ use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
 use crate::integrator::Start;
 use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
-use crate::simulate::plan::{ordered_ops, Op};
+use crate::simulate::plan::{exchange_len, ordered_ops, Op};
 use crate::system::{Connection, System, VariableRef};
 
 mod members;
@@ -100,7 +100,7 @@ impl MeGroup {
             }
         }
         let ops = ordered_ops(&sub, &sources, &sources)?;
-        let n = sources.len();
+        let n = exchange_len(&sub, &sources);
         Ok(Some(MeGroup {
             members,
             ops,
@@ -127,7 +127,8 @@ impl MeGroup {
         }
         let mut any = false;
         for op in &self.ops {
-            if op.is_set() && op.slots().iter().any(|s| self.values[*s].to_bits() != self.before[*s].to_bits()) {
+            let read = op.slots().iter().copied().chain(op.residual_slots());
+            if op.is_set() && read.into_iter().any(|s| self.values[s].to_bits() != self.before[s].to_bits()) {
                 any = true;
                 if !changed.contains(&op.instance) {
                     changed.push(op.instance);

@@ -8,6 +8,7 @@
 //! The modules, each using only those above it:
 //! - `types`: the public types ([`Experiment`], [`Algorithm`], [`Results`], [`Summary`]);
 //! - `clock`: the time base, communication point `n` at `t0 + n h`;
+//! - `integers`: connections between integers carried exactly (64-bit ones too);
 //! - `plan`: the value slots and the batched fmi2Get/fmi2Set calls;
 //! - `ticks`: the ticks of an instance's FMI 3.0 input clocks and every clock's count;
 //! - `me_group`: the Model Exchange integrator of a group of ME instances (a group of
@@ -29,6 +30,7 @@ mod driver;
 mod execution;
 mod init_loop;
 mod input;
+mod integers;
 mod lane;
 mod me_group;
 mod observer;
