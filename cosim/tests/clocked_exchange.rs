@@ -45,12 +45,12 @@ fn run_exchange(path: &Path, interface: Interface) -> nigel_cosim::Results {
     simulate(&system, &experiment).unwrap().0
 }
 
-/// The held values of the test below at each row. `open`: the row at a tick after the
-/// start is recorded with the tick's event open (Co-Simulation, docs/clocks.md), where this
+/// The held values of the test below at each row. `open`: the row at a tick (the start
+/// time's too) is recorded with the tick's event open (Co-Simulation, docs/clocks.md), where this
 /// FMU answers the tick's y (it computes y in fmi3SetClock and again on a set of u while
 /// active), the tick at the stop time (k = 5, y = 10·7 + 5 = 75) opened for the last row;
 /// else (Model Exchange) a row holds the values before the ticks at its time: y of the last
-/// tick before it. The row at 0 s holds what initialization left, -1, in both.
+/// tick before it; the row at 0 s then holds what initialization left, -1.
 fn check_held(results: &nigel_cosim::Results, open: bool) {
     let time = results.column("time").unwrap();
     let y = results.column("y").unwrap();
@@ -60,7 +60,7 @@ fn check_held(results: &nigel_cosim::Results, open: bool) {
     assert_eq!(time.len(), 13, "{time:?}");
     for ((t, y), t_now) in time.iter().zip(&y).zip(&t_now) {
         // ticks and points differ by ulps at most: 1e-9 s apart
-        let before = |tick: f64| if open && *t > 1e-9 { tick < t + 1e-9 } else { tick < t - 1e-9 };
+        let before = |tick: f64| if open { tick < t + 1e-9 } else { tick < t - 1e-9 };
         let expected = ticks.iter().rev().find(|(tick, _)| before(*tick)).map_or(-1.0, |(_, y)| *y);
         assert_eq!(*y, expected, "y at t = {t} s");
         // the variable that is not clocked is read at every row: the FMU's time, the sum of
@@ -77,8 +77,8 @@ fn check_held(results: &nigel_cosim::Results, open: bool) {
 /// last set of `u` (the input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held
 /// until the next tick: y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 =
 /// 10·7 + 4 = 74 (y_5 = 75 at the stop). The sets of `u` between ticks are queued (the FMU
-/// refuses them). The row at 0 s holds the start value -1; a row at a later tick is recorded
-/// with its event open, where the FMU answers the tick's y; a row between ticks the y of the
+/// refuses them). A row at a tick, the one at 0 s included, is recorded with its event open,
+/// where the FMU answers the tick's y (y_1 = 1 at 0 s); a row between ticks the y of the
 /// last tick before it (`check_held`).
 #[test]
 fn clocked_variables_are_held_between_ticks_and_set_at_them() {

@@ -432,6 +432,16 @@ impl<'s> Execution<'s> {
                 self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
             let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
             ticks.after_events(&mut lane.inst, true)?;
+            // Co-Simulation: the ticks at the start time open their event as those at any
+            // later point do, so the first row, like every row at a tick, holds what the FMU
+            // answers with the clock active (Model Exchange runs every tick whole at the
+            // start of the step from it)
+            if lane.unit.is_none() {
+                if let Some(vrs) = ticks.at(t0) {
+                    lane.inst.open_clock_event(t0, &vrs)?;
+                    ticks.opened(&vrs);
+                }
+            }
             lane.ticks = Some(ticks);
             core.clocked = true;
         }

@@ -41,7 +41,7 @@ pub(crate) struct Fmi3 {
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
     /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
-    output_clocks: Vec<u32>,
+    pub(super) output_clocks: Vec<u32>,
     /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
     pub(super) output_ticks: Vec<super::core::OutputTick>,
     /// The input clocks whose interval the FMU gives (tunable, changing, countdown), read
@@ -63,6 +63,10 @@ pub(crate) struct Fmi3 {
     /// The input clocks set (`fmi3SetClock`) in the current event: their clocked variables
     /// are read when it settles.
     pub(super) ticked_inputs: Vec<u32>,
+    /// The output clocks `fmi3GetClock` reported active as the current event opened (an FMU
+    /// may activate one in `fmi3SetClock`): counted then, their variables read from the FMU
+    /// while it is open, not counted again when it settles.
+    pub(super) opened_outputs: Vec<u32>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -114,6 +118,7 @@ impl Fmi3 {
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
             clocked: super::clocked::ClockedExchange::new(&a.description, &a.special),
             ticked_inputs: Vec::new(),
+            opened_outputs: Vec::new(),
             a,
         }
     }
@@ -715,13 +720,20 @@ impl Fmi3 {
         let vrs = self.output_clocks.clone();
         let mut ticks = vec![false; vrs.len()];
         ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
-        let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
+        let opened = std::mem::take(&mut self.opened_outputs);
+        let ticked: Vec<u32> = vrs
+            .into_iter()
+            .zip(ticks)
+            .filter(|(vr, t)| *t && !opened.contains(vr))
+            .map(|(vr, _)| vr)
+            .collect();
         for vr in &ticked {
             self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
         }
         // the clocked variables of the clocks that ticked in this event, read as it settled
         let mut active = std::mem::take(&mut self.ticked_inputs);
         self.clocked.deactivate();
+        active.extend(opened);
         active.extend(ticked);
         self.read_clocked(core, &active)
     }
@@ -918,6 +930,7 @@ impl Calls for Fmi3 {
     fn forget_run(&mut self) {
         self.clocked.forget_run(&self.a.description);
         self.ticked_inputs.clear();
+        self.opened_outputs.clear();
         self.fixed_read = false;
         self.output_ticks.clear();
         self.intervals.clear();
