@@ -17,18 +17,18 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def ticks_of(path):
-    """{clock: [times its counter went up]}: the count at a row counts the ticks before it,
-    so a tick lies between the row before the step up and the row of it; drawn at the former
-    (the tick's own row holds the values before it)."""
+    """{clock: [times its counter went up]}: a row at a tick is recorded with the tick's event
+    open, and the test FMU counts a tick as its clock is set, so a tick is at the row where
+    the count goes up (docs/clocks.md)."""
     rows = list(csv.DictReader(open(path)))
     out = {}
     for name in rows[0]:
         if not name.startswith("n_"):
             continue
         times = []
-        for before, now in zip(rows, rows[1:]):
+        for before, now in zip([{name: "0"}] + rows, rows):
             for _ in range(int(float(now[name])) - int(float(before[name]))):
-                times.append(float(before["time"]))
+                times.append(float(now["time"]))
         out[name[2:]] = times
     return out
 
@@ -36,17 +36,18 @@ def ticks_of(path):
 def main(result, summary, png):
     counts = {c["clock"]: c["ticks"] for c in json.load(open(summary)).get("clock_ticks", [])}
     ticks = ticks_of(result)
-    times = [float(r["time"]) for r in csv.DictReader(open(result))]
+    row_times = [float(r["time"]) for r in csv.DictReader(open(result))]
     fig, ax = plt.subplots(figsize=(7, 2.6), dpi=110)
-    for k, (clock, times) in enumerate(ticks.items()):
-        ax.plot(times, [k] * len(times), "|", markersize=16, markeredgewidth=2)
+    for k, (clock, tick_times) in enumerate(ticks.items()):
+        ax.plot(tick_times, [k] * len(tick_times), "|", markersize=16, markeredgewidth=2)
     ax.set_yticks(range(len(ticks)))
     ax.set_yticklabels([f"{c} ({counts.get(c, len(t))})" for c, t in ticks.items()])
     ax.set_xlabel("time, s")
     ax.set_title("FMI 3.0 clock ticks run by cosim (C test FMU, steps of 0.1 s)", fontsize=10)
     ax.grid(axis="x", alpha=0.3)
     ax.set_ylim(-0.6, len(ticks) - 0.4)
-    ax.set_xlim(times[0] - 0.02, times[-1] + 0.02)
+    # the whole run: its first and last rows
+    ax.set_xlim(row_times[0] - 0.02, row_times[-1] + 0.02)
     fig.tight_layout()
     fig.savefig(png)
     for clock, times in ticks.items():

@@ -56,22 +56,30 @@ fn work_dir(test: &str) -> PathBuf {
     d
 }
 
-/// The platform folders of the manifest (the same for every FMU: build-fmu packs each
-/// platform into every archive).
-fn manifest_platforms() -> Vec<String> {
+/// The manifest's path and its entries of the archives of `fmi_version` ("2.0", "3.0").
+fn manifest_entries(fmi_version: &str) -> (PathBuf, Vec<serde_json::Value>) {
     let path = target_dir().join("fmu").join("manifest.json");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e} (run `cargo run --release -p build-fmu` first)", path.display()));
     let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let entries = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == fmi_version).cloned().collect();
+    (path, entries)
+}
+
+/// The platform folders of one manifest entry, in its order.
+fn entry_folders(entry: &serde_json::Value) -> Vec<String> {
+    entry["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect()
+}
+
+/// The platform folders of the manifest (the same for every FMU: build-fmu packs each
+/// platform into every archive).
+fn manifest_platforms() -> Vec<String> {
     // the FMI 2.0 archives' entries; the FMI 3.0 ones name the same libraries by other folders
-    let entries: Vec<&serde_json::Value> = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == "2.0").collect();
+    let (path, entries) = manifest_entries("2.0");
     assert!(!entries.is_empty(), "{}: no FMI 2.0 archive", path.display());
-    let first: Vec<String> =
-        entries[0]["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
-    for e in entries {
-        let these: Vec<String> =
-            e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
-        assert_eq!(these, first, "{}: platforms differ between archives", e["fmu"]);
+    let first = entry_folders(&entries[0]);
+    for e in &entries {
+        assert_eq!(entry_folders(e), first, "{}: platforms differ between archives", e["fmu"]);
     }
     first
 }
@@ -79,16 +87,11 @@ fn manifest_platforms() -> Vec<String> {
 /// The FMI 3.0 archives' platform folders of the manifest, checked to be the FMI 3.0
 /// names of the FMI 2.0 archives' platforms (the same in every archive).
 fn manifest_platforms3() -> Vec<String> {
-    let path = target_dir().join("fmu").join("manifest.json");
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let m: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let entries: Vec<&serde_json::Value> = m.as_array().unwrap().iter().filter(|e| e["fmi_version"] == "3.0").collect();
+    let (path, entries) = manifest_entries("3.0");
     assert_eq!(entries.len(), FMUS.len(), "{}: one FMI 3.0 archive per FMU", path.display());
     let want: Vec<String> = manifest_platforms().iter().flat_map(|f| fmi3_folders(f)).map(|f| f.to_string()).collect();
-    for e in entries {
-        let these: Vec<String> =
-            e["platforms"].as_array().unwrap().iter().map(|p| p["folder"].as_str().unwrap().to_string()).collect();
-        assert_eq!(these, want, "{}: FMI 3.0 folders", e["fmu"]);
+    for e in &entries {
+        assert_eq!(entry_folders(e), want, "{}: FMI 3.0 folders", e["fmu"]);
     }
     want
 }
@@ -129,17 +132,23 @@ fn extension(folder: &str) -> &'static str {
     }
 }
 
+/// The bytes of the file `name` in the zip archive at `archive`.
+fn archive_entry(archive: &Path, name: &str) -> Vec<u8> {
+    let mut z = zip::ZipArchive::new(std::fs::File::open(archive).unwrap()).unwrap();
+    let mut entry = z.by_name(name).unwrap_or_else(|e| panic!("{}: {name}: {e}", archive.display()));
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut entry, &mut bytes).unwrap();
+    bytes
+}
+
 /// Unpacks `binaries/<folder>/<id>.<ext>` of every archive into `dir`.
 fn libraries(folder: &str, dir: &Path) -> Vec<PathBuf> {
     FMUS.iter()
         .map(|id| {
             let archive = target_dir().join("fmu").join(format!("{id}.fmu"));
-            let mut z = zip::ZipArchive::new(std::fs::File::open(&archive).unwrap()).unwrap();
-            let name = format!("binaries/{folder}/{id}.{}", extension(folder));
-            let mut entry = z.by_name(&name).unwrap_or_else(|e| panic!("{}: {name}: {e}", archive.display()));
+            let bytes = archive_entry(&archive, &format!("binaries/{folder}/{id}.{}", extension(folder)));
             let path = dir.join(format!("{id}.{}", extension(folder)));
-            let mut out = std::fs::File::create(&path).unwrap();
-            std::io::copy(&mut entry, &mut out).unwrap();
+            std::fs::write(&path, bytes).unwrap();
             path
         })
         .collect()
@@ -179,13 +188,7 @@ fn expected_fmi3_library(folder3: &str, fmi2: Vec<u8>, dir: &Path, id: &str) -> 
 fn libraries3(folder: &str, folder3: &str, dir: &Path) -> Vec<PathBuf> {
     assert!(fmi3_folders(folder).contains(&folder3));
     assert!(manifest_platforms3().iter().any(|f| f == folder3), "{folder3}: not in the FMI 3.0 archives");
-    let read = |archive: &Path, name: &str| {
-        let mut z = zip::ZipArchive::new(std::fs::File::open(archive).unwrap()).unwrap();
-        let mut entry = z.by_name(name).unwrap_or_else(|e| panic!("{}: {name}: {e}", archive.display()));
-        let mut bytes = Vec::new();
-        std::io::Read::read_to_end(&mut entry, &mut bytes).unwrap();
-        bytes
-    };
+    let read = archive_entry;
     FMUS.iter()
         .map(|id| {
             let ext = extension(folder);
@@ -239,23 +242,20 @@ fn closed_loop_system() -> (System, nigel_cosim::SspSystem) {
     (imported.system.clone(), imported)
 }
 
-/// The recorded columns: every Real output of every instance, `instance.name`.
-fn recorded(system: &System) -> Vec<(usize, u32, String)> {
-    let mut v = Vec::new();
-    for (i, inst) in system.instances.iter().enumerate() {
-        for var in &inst.fmu.description().model_variables {
-            let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
-            if real && var.causality == model_description::Causality::Output {
-                v.push((i, var.value_reference, format!("{}.{}", inst.name, var.name)));
-            }
+/// The job file of `tests/c/fmi2_closed_loop.c`, or with `fmi3` of `fmi3_closed_loop.c`,
+/// for `system`, with `library(i)` the path of instance i's library as the importer must
+/// open it. It records every Real output of every instance as `instance.name`. FMI 3.0 has
+/// its own value references (declaration row r, the index into the FMI 2.0 variables, has
+/// value reference r + 1), the instantiationToken (the FMI 2.0 GUID), and each Integer start
+/// value set as Int32 or, for an enumeration, as Int64.
+fn job_file(system: &System, library: &dyn Fn(usize) -> String, fmi3: bool) -> String {
+    let vr_of = |var: &model_description::ScalarVariable, index: usize| {
+        if fmi3 {
+            index as u32 + 1
+        } else {
+            var.value_reference
         }
-    }
-    v
-}
-
-/// The job file of `tests/c/fmi2_closed_loop.c` for `system`, with `library(i)` the path
-/// of instance i's library as the importer must open it.
-fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
+    };
     let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
     for (i, inst) in system.instances.iter().enumerate() {
         job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
@@ -263,50 +263,11 @@ fn job_file(system: &System, library: &dyn Fn(usize) -> String) -> String {
     for inst in &system.instances {
         let vars = &inst.fmu.description().model_variables;
         for (index, value) in &inst.start_values {
-            let vr = vars[*index].value_reference;
-            job += &match value {
-                Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
-                Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
-                Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
-                Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
-            };
-        }
-    }
-    for c in &system.connections {
-        job += &format!(
-            "connect {} {} {} {} {:?} {:?}\n",
-            system.instances[c.from.instance].name,
-            c.from.value_reference,
-            system.instances[c.to.instance].name,
-            c.to.value_reference,
-            c.gain,
-            c.offset
-        );
-    }
-    for (i, vr, name) in recorded(system) {
-        job += &format!("record {} {vr} {name}\n", system.instances[i].name);
-    }
-    job
-}
-
-/// The job file of `tests/c/fmi3_closed_loop.c` for `system`: [`job_file`]'s, with the FMI
-/// 3.0 value references (declaration row r, the index into the FMI 2.0 variables, has value
-/// reference r + 1), the instantiationToken (the FMI 2.0 GUID) and each Integer start value
-/// set as Int32 or, for an enumeration, as Int64.
-fn job_file3(system: &System, library: &dyn Fn(usize) -> String) -> String {
-    let vr3 = |index: usize| index as u32 + 1;
-    let mut job = format!("experiment {STOP_TIME:?} {STEP:?}\n");
-    for (i, inst) in system.instances.iter().enumerate() {
-        job += &format!("fmu {} {} {}\n", inst.name, inst.fmu.description().guid, library(i));
-    }
-    for inst in &system.instances {
-        let vars = &inst.fmu.description().model_variables;
-        for (index, value) in &inst.start_values {
-            let vr = vr3(*index);
+            let vr = vr_of(&vars[*index], *index);
             let enumeration = matches!(vars[*index].variable_type, model_description::VariableType::Enumeration { .. });
             job += &match value {
                 Value::Real(x) => format!("real {} {vr} {x:?}\n", inst.name),
-                Value::Integer(n) if enumeration => format!("enumeration {} {vr} {n}\n", inst.name),
+                Value::Integer(n) if enumeration && fmi3 => format!("enumeration {} {vr} {n}\n", inst.name),
                 Value::Integer(n) => format!("integer {} {vr} {n}\n", inst.name),
                 Value::Boolean(b) => format!("boolean {} {vr} {}\n", inst.name, u8::from(*b)),
                 Value::String(s) => panic!("{}: String start value {s:?}: the C importer sets none", inst.name),
@@ -314,21 +275,16 @@ fn job_file3(system: &System, library: &dyn Fn(usize) -> String) -> String {
         }
     }
     for c in &system.connections {
-        job += &format!(
-            "connect {} {} {} {} {:?} {:?}\n",
-            system.instances[c.from.instance].name,
-            vr3(c.from.index),
-            system.instances[c.to.instance].name,
-            vr3(c.to.index),
-            c.gain,
-            c.offset
-        );
+        let (from, to) = (&system.instances[c.from.instance], &system.instances[c.to.instance]);
+        let from_vr = vr_of(&from.fmu.description().model_variables[c.from.index], c.from.index);
+        let to_vr = vr_of(&to.fmu.description().model_variables[c.to.index], c.to.index);
+        job += &format!("connect {} {from_vr} {} {to_vr} {:?} {:?}\n", from.name, to.name, c.gain, c.offset);
     }
-    for (i, inst) in system.instances.iter().enumerate() {
+    for inst in &system.instances {
         for (index, var) in inst.fmu.description().model_variables.iter().enumerate() {
             let real = matches!(var.variable_type, model_description::VariableType::Real { .. });
             if real && var.causality == model_description::Causality::Output {
-                job += &format!("record {} {} {}.{}\n", system.instances[i].name, vr3(index), inst.name, var.name);
+                job += &format!("record {} {} {}.{}\n", inst.name, vr_of(var, index), inst.name, var.name);
             }
         }
     }
@@ -366,20 +322,9 @@ fn instrumented_libraries() -> Option<PathBuf> {
     std::env::var_os("NIGEL_FMU_LIBRARIES").map(PathBuf::from)
 }
 
-/// Runs the C importer built by `compiler` on the libraries of `folder`; `runner` prefixes
-/// the command (wine, qemu); `path_of` turns a host path into the one the program opens.
-fn closed_loop(
-    folder: &str,
-    dir: &Path,
-    compiler: &[&str],
-    exe_name: &str,
-    runner: &mut dyn FnMut(&Path) -> Command,
-    path_of: &dyn Fn(&Path) -> String,
-) -> (Vec<String>, Vec<Vec<f64>>) {
-    closed_loop_through(Abi::Fmi2, folder, dir, compiler, exe_name, runner, path_of)
-}
-
-/// [`closed_loop`] through the C API `abi`.
+/// Runs the C importer of the C API `abi` built by `compiler` on the libraries of `folder`;
+/// `runner` prefixes the command (wine, qemu); `path_of` turns a host path into the one the
+/// program opens.
 fn closed_loop_through(
     abi: Abi,
     folder: &str,
@@ -404,7 +349,7 @@ fn closed_loop_through(
         let id = &system.instances[i].fmu.description().co_simulation.as_ref().unwrap().model_identifier;
         path_of(&libs[index[id.as_str()]])
     };
-    let job = if fmi3 { job_file3(&system, &library) } else { job_file(&system, &library) };
+    let job = job_file(&system, &library, fmi3);
     let job_path = dir.join("closed_loop.job");
     std::fs::write(&job_path, job).unwrap();
     let exe = dir.join(exe_name);
@@ -425,18 +370,6 @@ fn closed_loop_through(
 }
 
 type Table = (Vec<String>, Vec<Vec<f64>>);
-
-/// The linux64 closed loop, the reference of every other platform: run once per test
-/// binary, in its own folder, whichever test asks first (the others wait for it).
-fn linux64_run() -> &'static Table {
-    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
-    RUN.get_or_init(|| {
-        let dir = work_dir("linux64-reference");
-        closed_loop("linux64", &dir, &["gcc"], "fmi2_closed_loop", &mut |exe| Command::new(exe), &|p| {
-            p.display().to_string()
-        })
-    })
-}
 
 /// Columns computed with our own arithmetic only (+ - * / and sqrt on doubles, correctly
 /// rounded by IEEE 754 on every platform; Rust contracts no a * b + c into a fused
@@ -525,13 +458,9 @@ fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
     for lib in libraries("linux64", &work_dir("linux64-exports")) {
         let v = highest_glibc("objdump", &lib);
         assert!(((2, 2)..=(2, 17)).contains(&v), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
-        let n = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib))
-            .lines()
-            .filter(|l| l.contains(" T fmi2"))
-            .count();
-        assert_eq!(n, 44, "{}: fmi2 exports", lib.display());
+        assert_eq!(exports(&LINUX64, &lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
     }
-    let c_run = linux64_run();
+    let c_run = fmi2_run(&LINUX64);
     // the same SSP through nigel_cosim's Jacobi master: another importer, the same numbers
     let (system, _keep) = closed_loop_system();
     let names: Vec<String> = c_run.0[1..].to_vec();
@@ -592,9 +521,8 @@ fn win64_closed_loop_under_wine_matches_linux64() {
     let dir = work_dir("win64");
     let libs = libraries("win64", &dir);
     for lib in &libs {
+        assert_eq!(exports(&WIN64, lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
         let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib));
-        let exports = text.lines().filter(|l| l.trim_start().starts_with('[') && l.contains(" fmi2")).count();
-        assert_eq!(exports, 44, "{}: fmi2 exports", lib.display());
         let dlls: Vec<String> =
             text.lines().filter_map(|l| l.trim().strip_prefix("DLL Name: ")).map(|s| s.to_lowercase()).collect();
         let system = [
@@ -614,30 +542,107 @@ fn win64_closed_loop_under_wine_matches_linux64() {
             );
         }
     }
-    compare_with_linux64("win64", linux64_run(), win64_run());
+    compare_with_linux64("win64", fmi2_run(&LINUX64), fmi2_run(&WIN64));
 }
 
-/// The win64 closed loop through the FMI 2.0 importer under wine, run once per test binary
-/// (the FMI 3.0 run of the same DLLs is compared with it).
-fn win64_run() -> &'static Table {
-    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
-    RUN.get_or_init(|| {
-        let dir = work_dir("win64-run");
-        let mut wine = wine_runner(&dir);
-        closed_loop("win64", &dir, &["x86_64-w64-mingw32-gcc"], "fmi2_closed_loop.exe", &mut wine, &wine_path)
+/// A platform whose libraries run here: its FMI 2.0 and FMI 3.0 folders, its C compiler,
+/// and how its programs start.
+struct Platform {
+    folder: &'static str,
+    folder3: &'static str,
+    compiler: &'static str,
+    /// The executables' file-name ending (`.exe` on Windows).
+    exe: &'static str,
+    starts: Start,
+    /// Its FMI 2.0 closed loop's place in [`fmi2_run`]'s cache.
+    index: usize,
+}
+
+/// How a platform's programs start here.
+#[derive(Clone, Copy)]
+enum Start {
+    Natively,
+    UnderWine,
+    UnderQemu,
+}
+
+const LINUX64: Platform = Platform {
+    folder: "linux64",
+    folder3: "x86_64-linux",
+    compiler: "gcc",
+    exe: "",
+    starts: Start::Natively,
+    index: 0,
+};
+const WIN64: Platform = Platform {
+    folder: "win64",
+    folder3: "x86_64-windows",
+    compiler: "x86_64-w64-mingw32-gcc",
+    exe: ".exe",
+    starts: Start::UnderWine,
+    index: 1,
+};
+const AARCH64_LINUX: Platform = Platform {
+    folder: "aarch64-linux",
+    folder3: "aarch64-linux",
+    compiler: "aarch64-linux-gnu-gcc",
+    exe: "",
+    starts: Start::UnderQemu,
+    index: 2,
+};
+
+type Runner = Box<dyn FnMut(&Path) -> Command>;
+
+impl Platform {
+    /// How the platform's programs in `dir` start (wine's shim goes there), and how a host
+    /// path is spelled to them.
+    fn runner(&self, dir: &Path) -> (Runner, fn(&Path) -> String) {
+        match self.starts {
+            Start::Natively => (Box::new(|exe: &Path| Command::new(exe)), host_path),
+            Start::UnderWine => (Box::new(wine_runner(dir)), wine_path),
+            Start::UnderQemu => (Box::new(qemu), host_path),
+        }
+    }
+
+    /// [`closed_loop_through`] the C API `abi` on this platform, `stem` the importer's name.
+    fn closed_loop(&self, abi: Abi, dir: &Path, stem: &str) -> Table {
+        let (mut runner, path_of) = self.runner(dir);
+        let exe = format!("{stem}{}", self.exe);
+        closed_loop_through(abi, self.folder, dir, &[self.compiler], &exe, &mut *runner, &path_of)
+    }
+
+    /// [`model_exchange_through_both_apis`] on this platform.
+    fn model_exchange(&self, dir: &Path) -> (Table, Table) {
+        let (mut runner, path_of) = self.runner(dir);
+        let exe = format!("me_fixed_step{}", self.exe);
+        model_exchange_through_both_apis(self.folder, self.folder3, dir, &[self.compiler], &exe, &mut *runner, &path_of)
+    }
+}
+
+fn host_path(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// The FMI 2.0 closed loop of `p`, run once per test binary in its own folder, whichever
+/// test asks first (the others wait for it): linux64's is the reference of every other
+/// platform; each platform's FMI 3.0 run is compared with its own.
+fn fmi2_run(p: &Platform) -> &'static Table {
+    static RUNS: [std::sync::OnceLock<Table>; 3] =
+        [std::sync::OnceLock::new(), std::sync::OnceLock::new(), std::sync::OnceLock::new()];
+    RUNS[p.index].get_or_init(|| {
+        let dir = work_dir(&format!("{}-run", p.folder));
+        p.closed_loop(Abi::Fmi2, &dir, "fmi2_closed_loop")
     })
 }
 
-/// The aarch64-linux closed loop through the FMI 2.0 importer under qemu-user, run once per
-/// test binary.
-fn aarch64_run() -> &'static Table {
-    static RUN: std::sync::OnceLock<Table> = std::sync::OnceLock::new();
-    RUN.get_or_init(|| {
-        let dir = work_dir("aarch64-linux-run");
-        closed_loop("aarch64-linux", &dir, &["aarch64-linux-gnu-gcc"], "fmi2_closed_loop", &mut qemu, &|p| {
-            p.display().to_string()
-        })
-    })
+/// The FMI 3.0 closed loop on `p` in `dir`: equal bit for bit to `p`'s FMI 2.0 run (the
+/// same library), and, off linux64, compared with linux64's as the FMI 2.0 run is.
+fn fmi3_closed_loop_matches(p: &Platform, dir: &Path) {
+    let fmi3 = p.closed_loop(Abi::Fmi3(p.folder3), dir, "fmi3_closed_loop");
+    if p.index != LINUX64.index {
+        compare_with_linux64(&format!("{} (FMI 3.0)", p.folder3), fmi2_run(&LINUX64), &fmi3);
+    }
+    assert_same_bits(p.folder3, fmi2_run(p), &fmi3);
 }
 
 fn qemu(exe: &Path) -> Command {
@@ -676,7 +681,7 @@ fn aarch64_closed_loop_under_qemu_matches_linux64() {
         let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
         assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
     }
-    compare_with_linux64("aarch64-linux", linux64_run(), aarch64_run());
+    compare_with_linux64("aarch64-linux", fmi2_run(&LINUX64), fmi2_run(&AARCH64_LINUX));
 }
 
 /// The names of the FMI 3.0 functions every library exports (all of them: the FMU answers
@@ -718,7 +723,7 @@ fn linux64_c_importers_under_asan_and_ubsan_on_the_instrumented_libraries() {
             &mut |e| sanitized(e),
             &|p| p.display().to_string(),
         );
-        assert_same_bits(&format!("{exe} under ASan+UBSan"), linux64_run(), &table);
+        assert_same_bits(&format!("{exe} under ASan+UBSan"), fmi2_run(&LINUX64), &table);
     }
     // Model Exchange through both C APIs, against the release library's FMI 2.0 run
     let dir = work_dir("sanitized-me");
@@ -733,96 +738,61 @@ fn linux64_c_importers_under_asan_and_ubsan_on_the_instrumented_libraries() {
     );
     let release = dir.join("release");
     std::fs::create_dir_all(&release).unwrap();
-    let (reference, _) = model_exchange_through_both_apis(
-        "linux64",
-        "x86_64-linux",
-        &release,
-        &["gcc"],
-        "me_fixed_step",
-        &mut |exe| Command::new(exe),
-        &|p| p.display().to_string(),
-    );
+    let (reference, _) = LINUX64.model_exchange(&release);
     assert_same_bits("me_fixed_step FMI 2.0 under ASan+UBSan", &reference, &fmi2);
     assert_same_bits("me_fixed_step FMI 3.0 under ASan+UBSan", &reference, &fmi3);
 }
 
-#[test]
-fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
-    if !built("linux64") {
+/// The names of the functions the library `lib` of `p` exports that begin with `prefix`,
+/// sorted (`nm -D` of an ELF library, `objdump -p`'s export table of a DLL).
+fn exports(p: &Platform, lib: &Path, prefix: &str) -> Vec<String> {
+    let mut names: Vec<String> = match p.starts {
+        Start::UnderWine => run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib))
+            .lines()
+            .filter(|l| l.trim_start().starts_with('['))
+            .filter_map(|l| l.split_whitespace().last().map(str::to_string))
+            .collect(),
+        Start::Natively | Start::UnderQemu => {
+            let nm = if matches!(p.starts, Start::UnderQemu) { "aarch64-linux-gnu-nm" } else { "nm" };
+            run(Command::new(nm).args(["-D", "--defined-only"]).arg(lib))
+                .lines()
+                .filter_map(|l| l.split_whitespace().nth(2).map(str::to_string))
+                .collect()
+        }
+    };
+    names.retain(|n| n.starts_with(prefix));
+    names.sort();
+    names
+}
+
+/// The FMI 3.0 archives' libraries of `p` export every fmi3 function, and the FMI 3.0 closed
+/// loop through them matches ([`fmi3_closed_loop_matches`]).
+fn fmi3_closed_loop_test(p: &Platform) {
+    if !built(p.folder) {
         return;
     }
-    let dir = work_dir("x86_64-linux");
-    for lib in libraries3("linux64", "x86_64-linux", &dir) {
-        let text = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib));
-        let mut exports: Vec<&str> =
-            text.lines().filter_map(|l| l.split_whitespace().nth(2)).filter(|n| n.starts_with("fmi3")).collect();
-        exports.sort();
-        let mut want = fmi3_symbols();
-        want.sort();
-        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
+    let dir = work_dir(&format!("{}-fmi3", p.folder3));
+    let mut want = fmi3_symbols();
+    want.sort();
+    for lib in libraries3(p.folder, p.folder3, &dir) {
+        assert_eq!(exports(p, &lib, "fmi3"), want, "{}: fmi3 exports", lib.display());
     }
-    let fmi3 = closed_loop_through(
-        Abi::Fmi3("x86_64-linux"),
-        "linux64",
-        &dir,
-        &["gcc"],
-        "fmi3_closed_loop",
-        &mut |exe| Command::new(exe),
-        &|p| p.display().to_string(),
-    );
-    assert_same_bits("x86_64-linux", linux64_run(), &fmi3);
+    fmi3_closed_loop_matches(p, &dir);
+}
+
+#[test]
+fn x86_64_linux_fmi3_closed_loop_equals_the_fmi2_one_bit_for_bit() {
+    fmi3_closed_loop_test(&LINUX64);
 }
 
 #[test]
 fn x86_64_windows_fmi3_closed_loop_under_wine_matches_linux64() {
-    if !built("win64") {
-        return;
-    }
-    let dir = work_dir("x86_64-windows");
-    for lib in libraries3("win64", "x86_64-windows", &dir) {
-        let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(&lib));
-        let mut exports: Vec<&str> = text
-            .lines()
-            .filter(|l| l.trim_start().starts_with('['))
-            .filter_map(|l| l.split_whitespace().last())
-            .filter(|n| n.starts_with("fmi3"))
-            .collect();
-        exports.sort();
-        let mut want = fmi3_symbols();
-        want.sort();
-        assert_eq!(exports, want, "{}: fmi3 exports", lib.display());
-    }
-    let mut wine = wine_runner(&dir);
-    let win = closed_loop_through(
-        Abi::Fmi3("x86_64-windows"),
-        "win64",
-        &dir,
-        &["x86_64-w64-mingw32-gcc"],
-        "fmi3_closed_loop.exe",
-        &mut wine,
-        &wine_path,
-    );
-    compare_with_linux64("x86_64-windows (FMI 3.0)", linux64_run(), &win);
-    assert_same_bits("x86_64-windows", win64_run(), &win);
+    fmi3_closed_loop_test(&WIN64);
 }
 
 #[test]
 fn aarch64_linux_fmi3_closed_loop_under_qemu_matches_linux64() {
-    if !built("aarch64-linux") {
-        return;
-    }
-    let dir = work_dir("aarch64-linux-fmi3");
-    let arm = closed_loop_through(
-        Abi::Fmi3("aarch64-linux"),
-        "aarch64-linux",
-        &dir,
-        &["aarch64-linux-gnu-gcc"],
-        "fmi3_closed_loop",
-        &mut qemu,
-        &|p| p.display().to_string(),
-    );
-    compare_with_linux64("aarch64-linux (FMI 3.0)", linux64_run(), &arm);
-    assert_same_bits("aarch64-linux", aarch64_run(), &arm);
+    fmi3_closed_loop_test(&AARCH64_LINUX);
 }
 
 // ---- Mach-O, the little of it the darwin64 checks read --------------------------------
@@ -1046,59 +1016,27 @@ fn model_exchange_through_both_apis(
 /// The FMI 3.0 Model Exchange run of the plant equals the FMI 2.0 one bit for bit on each
 /// platform that runs here: the same library, the same RK4 arithmetic in the same C
 /// program, only the calls of the other API (whose functions reach the same model code).
-#[test]
-fn x86_64_linux_fmi3_model_exchange_equals_the_fmi2_one_bit_for_bit() {
-    if !built("linux64") {
+fn fmi3_model_exchange_equals_the_fmi2_one(p: &Platform) {
+    if !built(p.folder) {
         return;
     }
-    let dir = work_dir("me-x86_64-linux");
-    let (fmi2, fmi3) = model_exchange_through_both_apis(
-        "linux64",
-        "x86_64-linux",
-        &dir,
-        &["gcc"],
-        "me_fixed_step",
-        &mut |exe| Command::new(exe),
-        &|p| p.display().to_string(),
-    );
-    assert_same_bits("x86_64-linux Model Exchange", &fmi2, &fmi3);
+    let (fmi2, fmi3) = p.model_exchange(&work_dir(&format!("me-{}", p.folder3)));
+    assert_same_bits(&format!("{} Model Exchange", p.folder3), &fmi2, &fmi3);
+}
+
+#[test]
+fn x86_64_linux_fmi3_model_exchange_equals_the_fmi2_one_bit_for_bit() {
+    fmi3_model_exchange_equals_the_fmi2_one(&LINUX64);
 }
 
 #[test]
 fn x86_64_windows_fmi3_model_exchange_under_wine_equals_the_fmi2_one_bit_for_bit() {
-    if !built("win64") {
-        return;
-    }
-    let dir = work_dir("me-x86_64-windows");
-    let mut wine = wine_runner(&dir);
-    let (fmi2, fmi3) = model_exchange_through_both_apis(
-        "win64",
-        "x86_64-windows",
-        &dir,
-        &["x86_64-w64-mingw32-gcc"],
-        "me_fixed_step.exe",
-        &mut wine,
-        &wine_path,
-    );
-    assert_same_bits("x86_64-windows Model Exchange", &fmi2, &fmi3);
+    fmi3_model_exchange_equals_the_fmi2_one(&WIN64);
 }
 
 #[test]
 fn aarch64_linux_fmi3_model_exchange_under_qemu_equals_the_fmi2_one_bit_for_bit() {
-    if !built("aarch64-linux") {
-        return;
-    }
-    let dir = work_dir("me-aarch64-linux");
-    let (fmi2, fmi3) = model_exchange_through_both_apis(
-        "aarch64-linux",
-        "aarch64-linux",
-        &dir,
-        &["aarch64-linux-gnu-gcc"],
-        "me_fixed_step",
-        &mut qemu,
-        &|p| p.display().to_string(),
-    );
-    assert_same_bits("aarch64-linux Model Exchange", &fmi2, &fmi3);
+    fmi3_model_exchange_equals_the_fmi2_one(&AARCH64_LINUX);
 }
 
 /// The folder of the unpacked release archive of the master for `triple`

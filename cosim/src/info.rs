@@ -117,6 +117,44 @@ fn default_experiment_line(d: &model_description::DefaultExperiment) -> Option<S
     (!parts.is_empty()).then(|| format!("default experiment: {}", parts.join(", ")))
 }
 
+/// What `cosim info` prints first of an FMU of either generation.
+struct Heading<'a> {
+    model_name: &'a str,
+    fmi_version: &'a str,
+    /// The identifying attribute's name and value (`guid` or `instantiationToken`).
+    token: (&'a str, &'a str),
+    description: Option<&'a str>,
+    interfaces: Vec<String>,
+    continuous_states: usize,
+    event_indicators: usize,
+    default_experiment: Option<&'a model_description::DefaultExperiment>,
+}
+
+impl Heading<'_> {
+    /// The model line, its description, interfaces, sizes and default experiment.
+    fn write(&self, out: &mut String) {
+        let (token_name, token) = self.token;
+        w!(out, "model {} (FMI {}), {token_name} {token}", self.model_name, self.fmi_version);
+        if let Some(d) = self.description.filter(|d| !d.is_empty()) {
+            w!(out, "{d}");
+        }
+        w!(out, "interfaces: {}", self.interfaces.join(", "));
+        w!(out, "continuous states: {}, event indicators: {}", self.continuous_states, self.event_indicators);
+        if let Some(line) = self.default_experiment.and_then(default_experiment_line) {
+            w!(out, "{line}");
+        }
+    }
+}
+
+/// One row of the variables' table: each cell left-aligned in its column's width, then the
+/// last (unpadded) cell.
+fn table_row(out: &mut String, widths: &[usize], cells: &[&str], last: &str) {
+    for (cell, width) in cells.iter().zip(widths) {
+        let _ = write!(out, "{cell:<width$} ");
+    }
+    w!(out, "{last}");
+}
+
 /// What `cosim info` prints of the FMU or SSP at `path`: the model, its interfaces and
 /// experiment, and one line per variable (an FMU); the instances, the values applied and
 /// the connections (an SSP). One line per item, each ending in a newline.
@@ -139,27 +177,25 @@ fn info_fmi2(out: &mut String, path: &Path, limits: &UnpackLimits) -> Result<()>
     use model_description::VariableType;
     let fmu = Fmu::load_with(path, &ImportOptions { limits: *limits, isolated: true, ..ImportOptions::default() })?;
     let md = fmu.description();
-    w!(out, "model {} (FMI {}), guid {}", md.model_name, md.fmi_version, md.guid);
-    if let Some(d) = md.description.as_deref().filter(|d| !d.is_empty()) {
-        w!(out, "{d}");
-    }
     let cs = md.co_simulation.as_ref().map(|c| format!("CoSimulation ({})", c.model_identifier));
     let me = md.model_exchange.as_ref().map(|c| format!("ModelExchange ({})", c.model_identifier));
-    w!(out, "interfaces: {}", [cs, me].into_iter().flatten().collect::<Vec<_>>().join(", "));
-    w!(out, "continuous states: {}, event indicators: {}", md.states().len(), md.number_of_event_indicators);
-    if let Some(line) = md.default_experiment.as_ref().and_then(default_experiment_line) {
-        w!(out, "{line}");
+    Heading {
+        model_name: &md.model_name,
+        fmi_version: &md.fmi_version,
+        token: ("guid", &md.guid),
+        description: md.description.as_deref(),
+        interfaces: [cs, me].into_iter().flatten().collect(),
+        continuous_states: md.states().len(),
+        event_indicators: md.number_of_event_indicators as usize,
+        default_experiment: md.default_experiment.as_ref(),
     }
-    w!(
+    .write(out);
+    const WIDTHS: [usize; 7] = [24, 19, 11, 8, 8, 12, 18];
+    table_row(
         out,
-        "{:<24} {:<19} {:<11} {:<8} {:<8} {:<12} {:<18} description",
-        "name",
-        "causality",
-        "variability",
-        "type",
-        "unit",
-        "start",
-        "min .. max"
+        &WIDTHS,
+        &["name", "causality", "variability", "type", "unit", "start", "min .. max"],
+        "description",
     );
     for v in &md.model_variables {
         let range = |min: Option<String>, max: Option<String>| match (min, max) {
@@ -184,18 +220,17 @@ fn info_fmi2(out: &mut String, path: &Path, limits: &UnpackLimits) -> Result<()>
             VariableType::Boolean { start } => (start.map(|x| x.to_string()), String::new()),
             VariableType::String { start } => (start.as_ref().map(|x| format!("{x:?}")), String::new()),
         };
-        w!(
-            out,
-            "{:<24} {:<19} {:<11} {:<8} {:<8} {:<12} {:<18} {}",
-            v.name,
+        let start = start.unwrap_or_else(|| "-".into());
+        let cells = [
+            v.name.as_str(),
             v.causality.as_str(),
             v.variability.as_str(),
             v.variable_type.type_name(),
             v.variable_type.unit().unwrap_or("-"),
-            start.unwrap_or_else(|| "-".into()),
-            bounds,
-            v.description.as_deref().unwrap_or("")
-        );
+            &start,
+            &bounds,
+        ];
+        table_row(out, &WIDTHS, &cells, v.description.as_deref().unwrap_or(""));
     }
     Ok(())
 }
@@ -224,10 +259,6 @@ fn info_clocks(out: &mut String, md: &model_description::fmi3::ModelDescription)
 /// variable with its type and dimensions.
 fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
     use model_description::fmi3::{Bound, Dimension, Values};
-    w!(out, "model {} (FMI {}), instantiationToken {}", md.model_name, md.fmi_version, md.instantiation_token);
-    if let Some(d) = md.description.as_deref().filter(|d| !d.is_empty()) {
-        w!(out, "{d}");
-    }
     let flags = |pairs: &[(bool, &str)]| -> String {
         let v: Vec<&str> = pairs.iter().filter(|(on, _)| *on).map(|(_, n)| *n).collect();
         if v.is_empty() {
@@ -236,56 +267,46 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
             format!("; {}", v.join(", "))
         }
     };
+    // an interface element, its own capabilities and then those every interface may have
+    let interface = |element: &str, common: &model_description::fmi3::InterfaceCommon, own: &[(bool, &str)]| {
+        let mut pairs = own.to_vec();
+        pairs.push((common.can_get_and_set_fmu_state, "FMU state"));
+        pairs.push((common.provides_directional_derivatives, "directional derivatives"));
+        format!("{element} ({}{})", common.model_identifier, flags(&pairs))
+    };
     let mut interfaces = Vec::new();
     if let Some(cs) = &md.co_simulation {
-        interfaces.push(format!(
-            "CoSimulation ({}{})",
-            cs.common.model_identifier,
-            flags(&[
-                (cs.can_handle_variable_communication_step_size, "variable step"),
-                (cs.might_return_early_from_do_step, "early return"),
-                (cs.has_event_mode, "event mode"),
-                (cs.common.can_get_and_set_fmu_state, "FMU state"),
-                (cs.common.provides_directional_derivatives, "directional derivatives"),
-            ])
-        ));
+        let own = [
+            (cs.can_handle_variable_communication_step_size, "variable step"),
+            (cs.might_return_early_from_do_step, "early return"),
+            (cs.has_event_mode, "event mode"),
+        ];
+        interfaces.push(interface("CoSimulation", &cs.common, &own));
     }
     if let Some(me) = &md.model_exchange {
-        interfaces.push(format!(
-            "ModelExchange ({}{})",
-            me.common.model_identifier,
-            flags(&[
-                (me.needs_completed_integrator_step, "completed integrator step"),
-                (me.common.can_get_and_set_fmu_state, "FMU state"),
-                (me.common.provides_directional_derivatives, "directional derivatives"),
-            ])
+        interfaces.push(interface(
+            "ModelExchange",
+            &me.common,
+            &[(me.needs_completed_integrator_step, "completed integrator step")],
         ));
     }
     if let Some(se) = &md.scheduled_execution {
         interfaces.push(format!("ScheduledExecution ({}; not run by cosim)", se.common.model_identifier));
     }
-    w!(out, "interfaces: {}", interfaces.join(", "));
-    w!(
-        out,
-        "continuous states: {}, event indicators: {}",
-        md.model_structure.continuous_state_derivatives.len(),
-        md.model_structure.event_indicators.len()
-    );
-    if let Some(line) = md.default_experiment.as_ref().and_then(default_experiment_line) {
-        w!(out, "{line}");
+    Heading {
+        model_name: &md.model_name,
+        fmi_version: &md.fmi_version,
+        token: ("instantiationToken", &md.instantiation_token),
+        description: md.description.as_deref(),
+        interfaces,
+        continuous_states: md.model_structure.continuous_state_derivatives.len(),
+        event_indicators: md.model_structure.event_indicators.len(),
+        default_experiment: md.default_experiment.as_ref(),
     }
-    w!(
-        out,
-        "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} description",
-        "name",
-        "causality",
-        "variability",
-        "type",
-        "dimensions",
-        "unit",
-        "start",
-        "min .. max"
-    );
+    .write(out);
+    const WIDTHS: [usize; 8] = [24, 19, 11, 11, 10, 8, 12, 18];
+    let heading = ["name", "causality", "variability", "type", "dimensions", "unit", "start", "min .. max"];
+    table_row(out, &WIDTHS, &heading, "description");
     for v in &md.model_variables {
         let dims = if v.dimensions.is_empty() {
             "-".to_string()
@@ -328,19 +349,17 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
         // one row per name: the variable's, then each <Alias>'s (recorded under its own name
         // too, the same value as its variable's)
         let mut row = |name: &str, start: &str, range: &str, what: &str| {
-            w!(
-                out,
-                "{:<24} {:<19} {:<11} {:<11} {:<10} {:<8} {:<12} {:<18} {}",
+            let cells = [
                 name,
                 v.causality.as_str(),
                 v.variability.as_str(),
                 v.value_type.element(),
-                dims,
+                &dims,
                 md.unit_of(v).unwrap_or("-"),
                 start,
                 range,
-                what
-            );
+            ];
+            table_row(out, &WIDTHS, &cells, what);
         };
         row(&v.name, start.as_deref().unwrap_or("-"), &range, v.description.as_deref().unwrap_or(""));
         for a in &v.aliases {

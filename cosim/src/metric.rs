@@ -198,32 +198,24 @@ impl<'a> Parser<'a> {
 
     /// `term (('+' | '-') term)*`
     fn sum(&mut self) -> Result<Node, String> {
-        let mut a = self.product()?;
-        loop {
-            let op = if self.eat('+') {
-                Op::Add
-            } else if self.eat('-') {
-                Op::Sub
-            } else {
-                return Ok(a);
-            };
-            let b = self.product()?;
-            a = self.join(op, a, b)?;
-        }
+        self.left_associative([('+', Op::Add), ('-', Op::Sub)], Self::product)
     }
 
     /// `factor (('*' | '/') factor)*`
     fn product(&mut self) -> Result<Node, String> {
-        let mut a = self.factor()?;
+        self.left_associative([('*', Op::Mul), ('/', Op::Div)], Self::factor)
+    }
+
+    /// `operand (op operand)*` with the operators `ops`, joined from the left.
+    fn left_associative(
+        &mut self,
+        ops: [(char, Op); 2],
+        operand: fn(&mut Self) -> Result<Node, String>,
+    ) -> Result<Node, String> {
+        let mut a = operand(self)?;
         loop {
-            let op = if self.eat('*') {
-                Op::Mul
-            } else if self.eat('/') {
-                Op::Div
-            } else {
-                return Ok(a);
-            };
-            let b = self.factor()?;
+            let Some(op) = ops.iter().find(|(c, _)| self.eat(*c)).map(|(_, op)| *op) else { return Ok(a) };
+            let b = operand(self)?;
             a = self.join(op, a, b)?;
         }
     }
@@ -456,19 +448,11 @@ struct Leaf {
 /// The accumulators of a list of metrics over the rows of one run.
 #[derive(Clone, Debug)]
 pub struct Accumulators {
+    /// The aggregates of every metric, in the order of the metrics and, within one, of a
+    /// depth-first walk (the order [`Accumulators::values`] reads them back in).
     leaves: Vec<Leaf>,
-    trees: Vec<Tree>,
+    metrics: Vec<Metric>,
     n: u64,
-}
-
-#[derive(Clone, Debug)]
-enum Tree {
-    Leaf(usize),
-    Norm(Vec<Tree>),
-    Const(f64),
-    Abs(Box<Tree>),
-    Neg(Box<Tree>),
-    Bin(Op, Box<Tree>, Box<Tree>),
 }
 
 impl Accumulators {
@@ -484,8 +468,8 @@ impl Accumulators {
         slots: &[String],
     ) -> Result<Accumulators, String> {
         let mut leaves = Vec::new();
-        fn build(m: &Metric, slots: &[String], leaves: &mut Vec<Leaf>) -> Result<Tree, String> {
-            Ok(match m {
+        fn build(m: &Metric, slots: &[String], leaves: &mut Vec<Leaf>) -> Result<(), String> {
+            match m {
                 Metric::Of(agg, signals) => {
                     let a = signals[0].slotted(slots)?;
                     let b = signals.get(1).map(|s| s.slotted(slots)).transpose()?;
@@ -495,19 +479,20 @@ impl Accumulators {
                         _ => 0.0,
                     };
                     leaves.push(Leaf { agg: *agg, a, b, acc });
-                    Tree::Leaf(leaves.len() - 1)
                 }
-                Metric::Norm(ms) => Tree::Norm(ms.iter().map(|m| build(m, slots, leaves)).collect::<Result<_, _>>()?),
-                Metric::Const(c) => Tree::Const(*c),
-                Metric::Abs(m) => Tree::Abs(Box::new(build(m, slots, leaves)?)),
-                Metric::Neg(m) => Tree::Neg(Box::new(build(m, slots, leaves)?)),
-                Metric::Bin(op, a, b) => {
-                    Tree::Bin(*op, Box::new(build(a, slots, leaves)?), Box::new(build(b, slots, leaves)?))
+                Metric::Norm(ms) => ms.iter().try_for_each(|m| build(m, slots, leaves))?,
+                Metric::Const(_) => {}
+                Metric::Abs(m) | Metric::Neg(m) => build(m, slots, leaves)?,
+                Metric::Bin(_, a, b) => {
+                    build(a, slots, leaves)?;
+                    build(b, slots, leaves)?;
                 }
-            })
+            }
+            Ok(())
         }
-        let trees = metrics.into_iter().map(|m| build(m, slots, &mut leaves)).collect::<Result<_, _>>()?;
-        Ok(Accumulators { leaves, trees, n: 0 })
+        let metrics: Vec<Metric> = metrics.into_iter().cloned().collect();
+        metrics.iter().try_for_each(|m| build(m, slots, &mut leaves))?;
+        Ok(Accumulators { leaves, metrics, n: 0 })
     }
 
     /// Adds one row.
@@ -550,18 +535,19 @@ impl Accumulators {
                 _ => l.acc,
             }
         };
-        fn eval(t: &Tree, leaves: &[f64]) -> f64 {
-            match t {
-                Tree::Leaf(i) => leaves[*i],
-                Tree::Norm(ts) => ts.iter().map(|t| eval(t, leaves)).map(|x| x * x).sum::<f64>().sqrt(),
-                Tree::Const(c) => *c,
-                Tree::Abs(t) => eval(t, leaves).abs(),
-                Tree::Neg(t) => -eval(t, leaves),
-                Tree::Bin(op, a, b) => op.apply(eval(a, leaves), eval(b, leaves)),
+        // the metric with its aggregates' values read in the depth-first order they were made in
+        fn eval(m: &Metric, leaves: &mut impl Iterator<Item = f64>) -> f64 {
+            match m {
+                Metric::Of(..) => leaves.next().expect("one aggregate per leaf"),
+                Metric::Norm(ms) => ms.iter().map(|m| eval(m, leaves)).map(|x| x * x).sum::<f64>().sqrt(),
+                Metric::Const(c) => *c,
+                Metric::Abs(m) => eval(m, leaves).abs(),
+                Metric::Neg(m) => -eval(m, leaves),
+                Metric::Bin(op, a, b) => op.apply(eval(a, leaves), eval(b, leaves)),
             }
         }
-        let leaves: Vec<f64> = self.leaves.iter().map(leaf).collect();
-        self.trees.iter().map(|t| eval(t, &leaves)).collect()
+        let mut leaves = self.leaves.iter().map(leaf);
+        self.metrics.iter().map(|m| eval(m, &mut leaves)).collect()
     }
 }
 
@@ -592,8 +578,7 @@ mod tests {
         // max(abs(v)) is max_abs(v); abs, -, *, / and numbers inside and outside
         let m = Metric::parse("max(abs(plant.y))").unwrap();
         assert_eq!(m, Metric::Of(Aggregate::Max, vec![Signal::Abs(Box::new(Signal::Var("plant.y".into())))]));
-        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
-        let ms: Vec<Metric> = [
+        let metrics = [
             "max(abs(a))",
             "max(a - 2 * b)",
             "mean((a + b) / 2)",
@@ -601,25 +586,19 @@ mod tests {
             "-min(-a)",
             "abs(final(a) - 3)",
             "2.5e-1 * final(b)",
-        ]
-        .iter()
-        .map(|t| Metric::parse(t).unwrap())
-        .collect();
-        let mut acc = Accumulators::new(&ms, &slots);
-        for row in [[1.0, 0.0], [-3.0, 1.0], [2.0, 2.0]] {
-            acc.push(&row);
-        }
+        ];
+        let values = values_over_three_rows(&metrics);
         // by hand: |a| = 1, 3, 2 -> 3; a - 2b = 1, -5, -2 -> 1; (a + b)/2 = 0.5, -1, 2 -> mean 0.5;
         // final a = 2 -> 1; -min(-a) = max a = 2; |2 - 3| = 1; 0.25 * 2 = 0.5
-        assert_eq!(acc.values(), [3.0, 1.0, 0.5, 1.0, 2.0, 1.0, 0.5]);
+        assert_eq!(values, [3.0, 1.0, 0.5, 1.0, 2.0, 1.0, 0.5]);
+        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
         let e = Accumulators::try_new(&[Metric::parse("max(c)").unwrap()], &slots).unwrap_err();
         assert_eq!(e, "c is not among the recorded variables");
     }
 
     #[test]
     fn aggregates_against_hand_sums() {
-        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
-        let ms: Vec<Metric> = [
+        let values = values_over_three_rows(&[
             "final(a)",
             "max_abs(a)",
             "mean(a)",
@@ -628,17 +607,21 @@ mod tests {
             "norm(final(a), mean(b))",
             "min(a)",
             "max_abs_diff(a, b)",
-        ]
-        .iter()
-        .map(|t| Metric::parse(t).unwrap())
-        .collect();
+        ]);
+        // by hand: final 2, max |a| 3, mean 0, rms sqrt(14/3), diffs 1, -4, 0 -> sqrt(17/3),
+        // norm(2, 1) = sqrt(5), min -3, max |a - b| 4
+        let want = [2.0, 3.0, 0.0, (14.0f64 / 3.0).sqrt(), (17.0f64 / 3.0).sqrt(), 5f64.sqrt(), -3.0, 4.0];
+        assert_eq!(values, want);
+    }
+
+    /// The values of `metrics` over the rows (a, b) = (1, 0), (-3, 1), (2, 2).
+    fn values_over_three_rows(metrics: &[&str]) -> Vec<f64> {
+        let slots: Vec<String> = ["a", "b"].map(String::from).to_vec();
+        let ms: Vec<Metric> = metrics.iter().map(|t| Metric::parse(t).unwrap()).collect();
         let mut acc = Accumulators::new(&ms, &slots);
         for row in [[1.0, 0.0], [-3.0, 1.0], [2.0, 2.0]] {
             acc.push(&row);
         }
-        // by hand: final 2, max |a| 3, mean 0, rms sqrt(14/3), diffs 1, -4, 0 -> sqrt(17/3),
-        // norm(2, 1) = sqrt(5), min -3, max |a - b| 4
-        let want = [2.0, 3.0, 0.0, (14.0f64 / 3.0).sqrt(), (17.0f64 / 3.0).sqrt(), 5f64.sqrt(), -3.0, 4.0];
-        assert_eq!(acc.values(), want);
+        acc.values()
     }
 }

@@ -460,8 +460,9 @@ impl Flattener<'_> {
                 });
                 if let Some(declared) = declared {
                     let actual = BaseType::of(v);
-                    // an FMI 3.0 64-bit or unsigned 32-bit integer is carried as a Real by
-                    // the master's view (exact up to 2^53): ssc:Integer declares it
+                    // an FMI 3.0 64-bit or unsigned 32-bit integer is a Real of the master's
+                    // view, and connections carry it as an integer, exactly
+                    // (`simulate/integers.rs`): ssc:Integer declares it
                     let wide_integer = fmu.fmi3_description().is_some_and(|md| {
                         md.model_variables.iter().any(|x| {
                             x.name == cname

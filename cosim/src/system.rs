@@ -329,6 +329,17 @@ impl System {
         format!("{}.{}", self.instances[r.instance].name, self.variable(r).name)
     }
 
+    /// Whether `r` is an FMI 3.0 structural parameter (set in Configuration Mode, and a
+    /// tunable one in Reconfiguration Mode).
+    pub fn is_structural(&self, r: &VariableRef) -> bool {
+        let name = &self.variable(r).name;
+        self.instances[r.instance].fmu.fmi3_description().is_some_and(|md| {
+            md.model_variables
+                .iter()
+                .any(|x| &x.name == name && x.causality == model_description::fmi3::Causality::StructuralParameter)
+        })
+    }
+
     /// The ScalarVariable of a resolved reference.
     pub fn variable(&self, r: &VariableRef) -> &ScalarVariable {
         &self.description(r.instance).model_variables[r.index]
@@ -495,6 +506,29 @@ impl SystemBuilder {
     fn configure(&mut self, i: usize, name: &str, value: f64) -> Result<()> {
         let spec = &self.system.instances[i];
         let fmu = spec.fmu.configured(&spec.name, &[(name, value)])?;
+        self.replace_fmu(i, fmu, name, value)
+    }
+
+    /// Sizes the results for the FMI 3.0 tunable structural parameter `variable`
+    /// (`instance.parameter`) taking the value `value` during the run, in Reconfiguration
+    /// Mode ([`crate::simulate::Execution::reconfigure`]): the instance's FMU becomes
+    /// [`Fmu::sized_for`] it (the arrays it sizes have a column per element they can have;
+    /// the instance starts with its own value), what the system refers to in it found again
+    /// by name.
+    pub fn size_for(&mut self, variable: &str, value: f64) -> Result<&mut Self> {
+        let r = self.system.resolve(variable)?;
+        let name = self.system.variable(&r).name.clone();
+        let spec = &self.system.instances[r.instance];
+        let fmu = spec.fmu.sized_for(&spec.name, &[(&name, value)])?;
+        self.replace_fmu(r.instance, fmu, &name, value)?;
+        Ok(self)
+    }
+
+    /// Instance `i` with the FMU `fmu`, a view of the same FMU resized by its structural
+    /// parameter `name` (the value `value`, for errors): start values and connections found
+    /// again by name.
+    fn replace_fmu(&mut self, i: usize, fmu: Arc<Fmu>, name: &str, value: f64) -> Result<()> {
+        let spec = &self.system.instances[i];
         let old = spec.fmu.description().clone();
         let new = fmu.description();
         let gone = |index: usize| {
@@ -617,7 +651,12 @@ impl SystemBuilder {
         if vb.causality != Causality::Input {
             return Err(err(format!("the destination is a {} variable, not an input", vb.causality.as_str())));
         }
-        if a.base_type != b.base_type {
+        // integers of different widths connect (an FMI 3.0 Int64, UInt64 or UInt32 is a
+        // Real of the view, the smaller ones Integers): the value is carried as an integer
+        // and checked against the input's type at every set (`simulate/integers.rs`)
+        let integer = |r: &VariableRef| self.system.instances[r.instance].fmu.integer_type(r.value_reference);
+        let integers = integer(&a).zip(integer(&b));
+        if a.base_type != b.base_type && integers.is_none() {
             return Err(err(format!("types differ: {} -> {}", a.base_type.as_str(), b.base_type.as_str())));
         }
         if a.base_type == BaseType::String {
@@ -636,7 +675,7 @@ impl SystemBuilder {
                     .map_err(err)?;
         }
         if let Some((f, o)) = linear {
-            if a.base_type != BaseType::Real && (f != 1.0 || o != 0.0) {
+            if (a.base_type != BaseType::Real || a.base_type != b.base_type) && (f != 1.0 || o != 0.0) {
                 return Err(err("a linear transformation needs Real variables".into()));
             }
             if !f.is_finite() || !o.is_finite() {

@@ -8,45 +8,107 @@
 
 mod common;
 use common::work_dir;
-use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System};
+use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, InputTable, Interface, System};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// A run from 0 to 1 s with steps of 0.1 s, `u` from an input file: a discrete input, held
-/// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
-///
-/// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
-/// time 1 s is not run). At the k-th tick τ_k the master applies the last set of `u` (the
-/// input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held until the next tick:
-/// y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 = 10·7 + 4 = 74. The
-/// sets of `u` between ticks are queued (the FMU refuses them). A row holds the values before the
-/// ticks at its time: the row at 0 s the start value -1, a row at t > 0 the y of the last
-/// tick before t.
-#[test]
-fn clocked_variables_are_held_between_ticks_and_set_at_them() {
-    let dir = work_dir("clocked-exchange");
-    let Some(path) =
-        common::fmi3_c::build(&dir, "fmi3_clocked_exchange", include_str!("cfmu/fmi3_clocked_exchange.xml"))
-    else {
-        return;
+/// The test FMU built in `dir` with the description declaring `interface` (`None`: no
+/// fmpy, skipped).
+fn exchange_fmu(dir: &Path, interface: Interface) -> Option<PathBuf> {
+    let xml = include_str!("cfmu/fmi3_clocked_exchange.xml");
+    let cs = r#"<CoSimulation modelIdentifier="fmi3_clocked_exchange" hasEventMode="true" canHandleVariableCommunicationStepSize="true"/>"#;
+    assert!(xml.contains(cs), "the description's CoSimulation element");
+    let xml = match interface {
+        Interface::CoSimulation => xml.to_string(),
+        Interface::ModelExchange => xml.replace(cs, r#"<ModelExchange modelIdentifier="fmi3_clocked_exchange"/>"#),
+        // a partition needs a priority
+        Interface::ScheduledExecution => xml
+            .replace(cs, r#"<ScheduledExecution modelIdentifier="fmi3_clocked_exchange"/>"#)
+            .replace(r#"intervalDecimal="0.25"/>"#, r#"intervalDecimal="0.25" priority="0"/>"#),
     };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    common::fmi3_c::build(dir, "fmi3_clocked_exchange", &xml)
+}
+
+/// The system of the FMU loaded for `interface`, `u` from the input file of the tests.
+fn run_exchange(path: &Path, interface: Interface) -> nigel_cosim::Results {
+    let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
+    let system = System::single("c", Fmu::load_with(path, &options).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.0, 0.1);
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["u".into()], vec![0.0, 0.2, 0.4, 0.7], vec![vec![0.0, 2.0, 4.0, 7.0]]).unwrap(),
     ));
-    let (results, _) = simulate(&system, &experiment).unwrap();
+    if interface == Interface::ScheduledExecution {
+        let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
+        outcome.unwrap();
+        return results;
+    }
+    simulate(&system, &experiment).unwrap().0
+}
+
+/// The held values of the test below at each row. `open`: the row at a tick (the start
+/// time's too) is recorded with the tick's event open (Co-Simulation, docs/clocks.md), where this
+/// FMU answers the tick's y (it computes y in fmi3SetClock and again on a set of u while
+/// active), the tick at the stop time (k = 5, y = 10·7 + 5 = 75) opened for the last row;
+/// else (Model Exchange) a row holds the values before the ticks at its time: y of the last
+/// tick before it; the row at 0 s then holds what initialization left, -1.
+fn check_held(results: &nigel_cosim::Results, open: bool) {
     let time = results.column("time").unwrap();
     let y = results.column("y").unwrap();
     let t_now = results.column("t_now").unwrap();
-    let ticks = [(0.0, 1.0), (0.25, 22.0), (0.5, 43.0), (0.75, 74.0)];
+    let ticks = [(0.0, 1.0), (0.25, 22.0), (0.5, 43.0), (0.75, 74.0), (1.0, 75.0)];
     // rows at the points 0, 0.1, ..., 1 s and at the ticks between points, 0.25 and 0.75 s
     assert_eq!(time.len(), 13, "{time:?}");
     for ((t, y), t_now) in time.iter().zip(&y).zip(&t_now) {
         // ticks and points differ by ulps at most: 1e-9 s apart
-        let expected = ticks.iter().rev().find(|(tick, _)| *tick < t - 1e-9).map_or(-1.0, |(_, y)| *y);
+        let before = |tick: f64| if open { tick < t + 1e-9 } else { tick < t - 1e-9 };
+        let expected = ticks.iter().rev().find(|(tick, _)| before(*tick)).map_or(-1.0, |(_, y)| *y);
         assert_eq!(*y, expected, "y at t = {t} s");
         // the variable that is not clocked is read at every row: the FMU's time, the sum of
         // the master's step starts and sizes, within ulps of the row's t0 + n h
         assert!((t_now - t).abs() < 1e-12, "t_now {t_now} at t = {t} s");
     }
+}
+
+/// A run from 0 to 1 s with steps of 0.1 s, `u` from an input file: a discrete input, held
+/// from each row (0 from 0 s, 2 from 0.2 s, 4 from 0.4 s, 7 from 0.7 s).
+///
+/// `tick` ticks at 0, 0.25, 0.5, 0.75 s (interval 0.25 s, shift 0; the tick at the stop
+/// time 1 s is opened for the last row only). At the k-th tick τ_k the master applies the
+/// last set of `u` (the input file's value at τ_k: 0, 2, 4, 7) and reads y = 10 u + k, held
+/// until the next tick: y_1 = 10·0 + 1 = 1, y_2 = 10·2 + 2 = 22, y_3 = 10·4 + 3 = 43, y_4 =
+/// 10·7 + 4 = 74 (y_5 = 75 at the stop). The sets of `u` between ticks are queued (the FMU
+/// refuses them). A row at a tick, the one at 0 s included, is recorded with its event open,
+/// where the FMU answers the tick's y (y_1 = 1 at 0 s); a row between ticks the y of the
+/// last tick before it (`check_held`).
+#[test]
+fn clocked_variables_are_held_between_ticks_and_set_at_them() {
+    let dir = work_dir("clocked-exchange");
+    let Some(path) = exchange_fmu(&dir, Interface::CoSimulation) else { return };
+    check_held(&run_exchange(&path, Interface::CoSimulation), true);
+}
+
+/// The same in Model Exchange (the instance integrated on its own, no states): the ticks
+/// run in events between fmi3EnterEventMode and fmi3EnterContinuousTimeMode, the same rows
+/// and held values as derived above.
+#[test]
+fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
+    let dir = work_dir("clocked-exchange-me");
+    let Some(path) = exchange_fmu(&dir, Interface::ModelExchange) else { return };
+    check_held(&run_exchange(&path, Interface::ModelExchange), false);
+}
+
+/// The same in Scheduled Execution: `u` set once before each fmi3ActivateModelPartition of
+/// tick (the input file's value at the tick: 0, 2, 4, 7), y read right after it. The rows
+/// are at the ticks 0, 0.25, 0.5, 0.75 s and the stop time 1 s and hold the values after
+/// the activations: y = 1, 22, 43, 74, then 74 held (derived above). t_now is the
+/// activation's time.
+#[test]
+fn scheduled_execution_exchanges_clocked_variables_at_their_activations_only() {
+    let dir = work_dir("clocked-exchange-se");
+    let Some(path) = exchange_fmu(&dir, Interface::ScheduledExecution) else { return };
+    let results = run_exchange(&path, Interface::ScheduledExecution);
+    assert_eq!(results.column("time").unwrap(), [0.0, 0.25, 0.5, 0.75, 1.0]);
+    assert_eq!(results.column("y").unwrap(), [1.0, 22.0, 43.0, 74.0, 74.0]);
+    assert_eq!(results.column("t_now").unwrap(), [0.0, 0.25, 0.5, 0.75, 0.75]);
+    assert_eq!(results.column("tick").unwrap(), [1.0, 1.0, 1.0, 1.0, 0.0]);
 }

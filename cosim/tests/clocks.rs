@@ -20,18 +20,18 @@ fn clocks_fmu(dir: &Path) -> Option<PathBuf> {
 
 /// The tick times of each clock in a run from 0 to 1.5 s with steps of 0.1 s and `trig`
 /// ticked by an input file at 0.45 and 1.2 s, derived by hand from the FMU's comment. A
-/// tick at the stop time is not run (no step starts there).
+/// tick at the stop time is opened for the last row (docs/clocks.md).
 ///
 /// - periodic: shift 0.1 + k 0.25 = 0.1, 0.35, 0.6, 0.85, 1.1, 1.35;
 /// - fixed: 0 + k 0.4 (the FMU's interval, not the description's 0.5) = 0, 0.4, 0.8, 1.2;
-/// - changing: intervals 0.1, 0.2, 0.3, 0.4 from 0 = 0.1, 0.3, 0.6, 1.0 (then 1.5: the stop);
+/// - changing: intervals 0.1, 0.2, 0.3, 0.4, 0.5 from 0 = 0.1, 0.3, 0.6, 1.0, 1.5 (the stop);
 /// - countdown: started at periodic's second tick (0.35) with 0.5 = 0.85;
 /// - trig: 0.45, 1.2 (the input file);
 /// - out_clock: in the events of periodic's 2nd, 4th, 6th ticks = 0.35, 0.85, 1.35.
 const TICKS: [(&str, &[f64]); 6] = [
     ("n_periodic", &[0.1, 0.35, 0.6, 0.85, 1.1, 1.35]),
     ("n_fixed", &[0.0, 0.4, 0.8, 1.2]),
-    ("n_changing", &[0.1, 0.3, 0.6, 1.0]),
+    ("n_changing", &[0.1, 0.3, 0.6, 1.0, 1.5]),
     ("n_countdown", &[0.85]),
     ("n_trig", &[0.45, 1.2]),
     ("n_out_clock", &[0.35, 0.85, 1.35]),
@@ -59,18 +59,20 @@ fn every_kind_of_clock_ticks_at_its_times() {
     for (name, ticks) in TICKS {
         let counts = results.column(name).unwrap();
         for (t, n) in time.iter().zip(&counts) {
-            // the row at a point holds the values before the ticks at it: the ticks before
-            // it (times differ from the points' t0 + n h by ulps at most: 1e-9 s apart)
-            let expected = ticks.iter().filter(|tick| **tick < t - 1e-9).count() as f64;
+            // the row at a point is recorded with the event of the ticks at it open (the
+            // start time's too): this FMU counts a tick in fmi3SetClock, so the row counts the
+            // ticks up to it (times differ from the points' t0 + n h by ulps at most: 1e-9 s
+            // apart)
+            let expected = ticks.iter().filter(|tick| **tick < t + 1e-9).count() as f64;
             assert_eq!(*n, expected, "{name} at t = {t} s: ticks {ticks:?}");
         }
     }
     let last_tick = results.column("last_tick").unwrap();
-    assert_eq!(*last_tick.last().unwrap(), 1.35, "periodic's last tick, 0.1 + 5 * 0.25 s");
+    assert_eq!(*last_tick.last().unwrap(), 1.5, "changing's last tick, at the stop time: 0.1 + 0.2 + 0.3 + 0.4 + 0.5 s");
     let counted: Vec<(String, u64)> = summary.clock_ticks.clone();
     assert_eq!(
         counted,
-        [("periodic", 6), ("fixed", 4), ("changing", 4), ("countdown", 1), ("trig", 2), ("out_clock", 3)]
+        [("periodic", 6), ("fixed", 4), ("changing", 5), ("countdown", 1), ("trig", 2), ("out_clock", 3)]
             .map(|(n, k)| (n.to_string(), k))
     );
 }
@@ -244,10 +246,10 @@ fn the_readme_figure_of_the_ticks_is_drawn_from_a_run() {
 }
 
 /// fmpy's FMI 3.0 calls (fmpy.fmi3.FMU3Slave) drive the FMU through the ticks derived by
-/// hand (TICKS, not cosim's schedule): to each of cosim's row times, the outputs read, then
-/// the clock event of the clocks ticking there (Event Mode, fmi3SetClock,
-/// fmi3UpdateDiscreteStates, fmi3EnterStepMode). Prints one line per row: time and the
-/// outputs.
+/// hand (TICKS, not cosim's schedule): to each of cosim's row times, the clock event of the
+/// clocks ticking there opened (Event Mode, fmi3SetClock), the outputs read, the event closed
+/// (fmi3UpdateDiscreteStates, fmi3EnterStepMode; not after the last row). Prints one line per
+/// row: time and the outputs.
 const FMPY_DRIVER: &str = r#"
 import sys, json
 from fmpy import extract
@@ -265,11 +267,12 @@ for row in rows:
     if row > t:
         s.doStep(t, row - t)
         t = row
-    print(row, *s.getInt32(list(range(10, 16))), *s.getFloat64([16]))
     due = [vr for vr, times in ticks if any(abs(x - row) < 1e-9 for x in times)]
-    if due and row < rows[-1]:
+    if due:
         s.enterEventMode()
         s.setClock(due, [True] * len(due))
+    print(row, *s.getInt32(list(range(10, 16))), *s.getFloat64([16]))
+    if due and row < rows[-1]:
         while s.updateDiscreteStates()[0]:
             pass
         s.enterStepMode()

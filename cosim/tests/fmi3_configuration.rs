@@ -198,3 +198,107 @@ fn a_reset_configures_the_structural_parameters_again() {
     instance.get_real(&[vr("y[4]")], &mut y).unwrap();
     assert_eq!(y, [2.0]);
 }
+
+/// The description with n tunable: Reconfiguration Mode may change it between steps.
+fn tunable_xml() -> String {
+    let fixed = r#"causality="structuralParameter" variability="fixed""#;
+    assert!(XML.contains(fixed));
+    XML.replace(fixed, r#"causality="structuralParameter" variability="tunable""#)
+}
+
+/// `cosim run` of `fmu` to 1 s in steps of 0.5 s with `args`: the CSV's header and rows
+/// (cells as text), or the error.
+fn run_cli(fmu: &Path, dir: &Path, args: &[&str]) -> Result<(Vec<String>, Vec<Vec<String>>), String> {
+    let csv = dir.join("out.csv");
+    let out = Command::new(env!("CARGO_BIN_EXE_cosim"))
+        .args(["run", fmu.to_str().unwrap(), "--stop-time", "1", "--step", "0.5", "-o", csv.to_str().unwrap()])
+        .args(args)
+        .output()
+        .unwrap();
+    if !out.status.success() {
+        return Err(String::from_utf8_lossy(&out.stderr).into_owned());
+    }
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
+    Ok((header, lines.map(|l| l.split(',').map(str::to_string).collect()).collect()))
+}
+
+/// Reconfiguration Mode: `--set-at 0.5 n=3` with n tunable (start 2). The results have a
+/// column for each element y can have (y[1] .. y[3]); the row at 0.5 s holds the values
+/// before the change (as a row at a clock tick does), y[3] NaN there: n was 2. The FMU
+/// resizes its arrays when it leaves (Re)Configuration Mode, k all 1 again, so at 1 s y[i] =
+/// k[i] u t = 1 * 1 * 1 for the three elements. Shrinking (`--set n=3`, then `--set-at 0.5
+/// n=1`) leaves y[2] and y[3] NaN after the change: y[1] = 1 at 1 s.
+#[test]
+fn a_tunable_structural_parameter_changes_between_steps_in_reconfiguration_mode() {
+    let dir = work_dir("fmi3-reconfiguration");
+    let Some(fmu) = common::fmi3_c::build(&dir, "fmi3_sized", &tunable_xml()) else { return };
+    let (header, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "n=3"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
+    let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
+    assert_eq!(cells, [vec!["0", "0", "0", "NaN"], vec!["0.5", "0.5", "0.5", "NaN"], vec!["1", "1", "1", "1"]]);
+    let (header, rows) = run_cli(&fmu, &dir, &["--set", "n=3", "--set-at", "0.5", "n=1"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
+    let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
+    assert_eq!(cells, [vec!["0", "0", "0", "0"], vec!["0.5", "0.5", "0.5", "0.5"], vec!["1", "1", "NaN", "NaN"]]);
+    // an input set the same way is a plain set: u = 2 from 0.5 s, y = k u t = 2 at 1 s
+    let (header, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "u=2"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]"]);
+    assert_eq!(rows[2], ["1", "2", "2"]);
+    // fmpy's low-level calls through the same change: Reconfiguration Mode from Step Mode
+    // after the first step, y read with its three elements after the second
+    let script = r#"
+import sys, zipfile, tempfile
+from fmpy.fmi3 import FMU3Slave
+d = tempfile.mkdtemp()
+zipfile.ZipFile(sys.argv[1]).extractall(d)
+s = FMU3Slave(guid='{fmi3-sized}', unzipDirectory=d, modelIdentifier='fmi3_sized', instanceName='c')
+s.instantiate()
+s.enterInitializationMode(startTime=0.0)
+s.exitInitializationMode()
+s.doStep(0.0, 0.5)
+s.enterConfigurationMode()
+s.setUInt64([1], [3])
+s.exitConfigurationMode()
+s.doStep(0.5, 0.5)
+print(' '.join(repr(x) for x in s.getFloat64([4], nValues=3)))
+s.terminate()
+s.freeInstance()
+"#;
+    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .map(|x| x.parse::<f64>().unwrap().to_string())
+        .collect();
+    let (_, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "n=3"]).unwrap();
+    assert_eq!(rows[2][1..], theirs);
+    // Model Exchange: the change in an event at 0.5 s (Event Mode), the same rows (y = k u t
+    // at the time set)
+    let me = work_dir("fmi3-reconfiguration-me");
+    let me_xml = tunable_xml().replace(
+        r#"<CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>"#,
+        r#"<ModelExchange modelIdentifier="fmi3_sized"/>"#,
+    );
+    let Some(me_fmu) = common::fmi3_c::build(&me, "fmi3_sized", &me_xml) else { return };
+    let (header, rows) = run_cli(&me_fmu, &me, &["--set-at", "0.5", "n=3"]).unwrap();
+    assert_eq!(header, ["time", "y[1]", "y[2]", "y[3]"]);
+    let cells: Vec<Vec<&str>> = rows.iter().map(|r| r.iter().map(String::as_str).collect()).collect();
+    assert_eq!(cells, [vec!["0", "0", "0", "NaN"], vec!["0.5", "0.5", "0.5", "NaN"], vec!["1", "1", "1", "1"]]);
+    // an array n sizes as an event indicator: the integrator's count cannot change
+    let indicators = work_dir("fmi3-reconfiguration-me-indicators");
+    let xml = me_xml.replace(
+        r#"<InitialUnknown valueReference="4"/>"#,
+        r#"<InitialUnknown valueReference="4"/>
+    <EventIndicator valueReference="4"/>"#,
+    );
+    let Some(fmu) = common::fmi3_c::build(&indicators, "fmi3_sized", &xml) else { return };
+    let e = run_cli(&fmu, &indicators, &["--set-at", "0.5", "n=3"]).unwrap_err();
+    assert!(e.contains("it sizes y, a continuous state, derivative or event indicator of a Model Exchange FMU"), "{e}");
+    // a fixed structural parameter is not changed during a run
+    let fixed = work_dir("fmi3-reconfiguration-fixed");
+    let Some(fmu) = common::fmi3_c::build(&fixed, "fmi3_sized", XML) else { return };
+    let e = run_cli(&fmu, &fixed, &["--set-at", "0.5", "n=3"]).unwrap_err();
+    assert!(e.contains("a fixed structural parameter is set before initialization only"), "{e}");
+}

@@ -40,7 +40,7 @@ impl ClockKind {
         self != ClockKind::Triggered
     }
 
-    fn parse(s: Option<&str>) -> Option<ClockKind> {
+    pub(crate) fn parse(s: Option<&str>) -> Option<ClockKind> {
         Some(match s? {
             "constant" => ClockKind::Constant,
             "fixed" => ClockKind::Fixed,

@@ -165,6 +165,17 @@ pub enum Error {
         /// How the host ended.
         cause: HostEnd,
     },
+    /// A call wrote past memory it was given or had allocated, and the master's guard
+    /// caught the write (a red zone after the block, nothing else written): the call's
+    /// results are not to be used.
+    Overrun {
+        /// The instance.
+        instance: String,
+        /// The function called.
+        function: &'static str,
+        /// Where it wrote, e.g. "8 bytes past the 8 bytes of dvUnknown".
+        what: String,
+    },
     /// A call of an isolated instance carries more data than the region shared with its
     /// host process holds: a limit of the master's isolation, not a failure of the FMU.
     IsolationLimit {
@@ -312,6 +323,11 @@ impl fmt::Display for Error {
             Error::Host { instance, function, time, cause } => {
                 write!(f, "{instance}: the FMU's host process {cause} during {function} at t = {time} s")
             }
+            Error::Overrun { instance, function, what } => write!(
+                f,
+                "{instance}: {function} wrote {what} (caught in the red zone the master keeps after it: nothing \
+                 else was overwritten; the call's results are not used)"
+            ),
             Error::IsolationLimit { instance, function, needed, available } => write!(
                 f,
                 "{instance}: {function} was not called: its data take {needed} bytes, more than the {available} bytes the master's region shared with the FMU's host process holds for one call (a limit of cosim's isolation, not of the FMU; run without --isolate)"

@@ -5,7 +5,7 @@
 //! The view is an FMI 2.0-shaped [`ModelDescription`] of the FMU's variables, with the same
 //! names, value references, causalities, variabilities, units and ModelStructure (indices
 //! into the view): Float64, Float32, UInt32, Int64 and UInt64 as Real (the 64-bit integers
-//! exact up to 2^53, beyond which reading them is an error), Int8 .. Int32 as Integer,
+//! exact up to 2^53; [`crate::Instance::get_exact`] reads them exactly), Int8 .. Int32 as Integer,
 //! Boolean, String, Enumeration (Int64 values of i32 items), a Binary as a Real holding its
 //! size in bytes (read-only); an array as one variable per element, `y[1]`, `y[2]`, ...
 //! (`A[1,2]`: 1-based, row-major, as FMI 2.0 names array elements) with value references
@@ -42,6 +42,11 @@ pub(crate) struct Fmi3Abi {
     /// variable and the value; empty: Configuration Mode is not entered). See
     /// [`crate::structural`].
     pub(crate) configuration: Vec<(Access, f64)>,
+    /// The structural parameters whose value at the start (after Configuration Mode) is
+    /// not the one the view is sized for (the FMU's value reference and the value; empty
+    /// but for an FMU [sized for](crate::Fmu::sized_for) a change in Reconfiguration Mode):
+    /// the arrays they size have fewer elements than the view until then.
+    pub(crate) initial_sizes: Vec<(u32, f64)>,
 }
 
 /// What the master cannot run yet, named for the error at load; `None`: nothing.
@@ -128,6 +133,48 @@ impl Exact {
     }
 }
 
+/// The type of an integer variable of the view, as the FMU declares it: its name and the
+/// range of its values (an FMI 2.0 Integer or Enumeration is an Int32; an FMI 3.0
+/// Enumeration in the view holds Int32 items). A connection between integers carries the
+/// value as an integer and checks it against this range ([`crate::Fmu::integer_type`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IntegerType {
+    /// The FMI type's name (`Int8` .. `UInt64`, `Enumeration`).
+    pub name: &'static str,
+    /// The smallest value.
+    pub min: i128,
+    /// The largest value.
+    pub max: i128,
+}
+
+impl IntegerType {
+    /// FMI 2.0's Integer.
+    pub const INT32: IntegerType = IntegerType { name: "Int32", min: i32::MIN as i128, max: i32::MAX as i128 };
+
+    /// Of an FMI 3.0 variable of `value_type` (`None`: no integer).
+    pub(crate) fn of(value_type: fmi3::ValueType) -> Option<IntegerType> {
+        use fmi3::ValueType as T;
+        let (name, min, max) = match value_type {
+            T::Int8 => ("Int8", i8::MIN as i128, i8::MAX as i128),
+            T::UInt8 => ("UInt8", 0, u8::MAX as i128),
+            T::Int16 => ("Int16", i16::MIN as i128, i16::MAX as i128),
+            T::UInt16 => ("UInt16", 0, u16::MAX as i128),
+            T::Int32 => return Some(IntegerType::INT32),
+            T::UInt32 => ("UInt32", 0, u32::MAX as i128),
+            T::Int64 => ("Int64", i64::MIN as i128, i64::MAX as i128),
+            T::UInt64 => ("UInt64", 0, u64::MAX as i128),
+            T::Enumeration => ("Enumeration", i32::MIN as i128, i32::MAX as i128),
+            _ => return None,
+        };
+        Some(IntegerType { name, min, max })
+    }
+
+    /// Whether `value` is one of the type's.
+    pub fn holds(&self, value: i128) -> bool {
+        (self.min..=self.max).contains(&value)
+    }
+}
+
 impl ExactKind {
     /// The kind of a variable of `value_type`, if its values need it.
     pub(crate) fn of(value_type: fmi3::ValueType) -> Option<ExactKind> {
@@ -146,7 +193,7 @@ const MAX_ELEMENTS: u64 = 100_000;
 
 /// The size of each dimension of `v` (a `valueReference` dimension: the start value of
 /// the variable it names).
-fn sizes(md: &fmi3::ModelDescription, v: &fmi3::Variable) -> Option<Vec<u64>> {
+pub(crate) fn sizes(md: &fmi3::ModelDescription, v: &fmi3::Variable) -> Option<Vec<u64>> {
     v.dimensions
         .iter()
         .map(|d| match *d {

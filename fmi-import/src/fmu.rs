@@ -118,6 +118,22 @@ impl Fmu {
         }
     }
 
+    /// The integer type of the view's variable `vr` as the FMU declares it (FMI 2.0
+    /// Integer and Enumeration: Int32); `None` for a float, Boolean, String or Binary.
+    pub fn integer_type(&self, vr: u32) -> Option<crate::fmi3::IntegerType> {
+        use model_description::VariableType;
+        if let Abi::Fmi3(a) = &self.abi {
+            if let Some(access) = a.special.get(&vr) {
+                return crate::fmi3::IntegerType::of(access.value_type);
+            }
+        }
+        let v = self.description.model_variables.iter().find(|v| v.value_reference == vr)?;
+        match v.variable_type {
+            VariableType::Integer { .. } | VariableType::Enumeration { .. } => Some(crate::fmi3::IntegerType::INT32),
+            _ => None,
+        }
+    }
+
     /// FMI 3.0: the variables the view leaves out (String and Binary arrays, arrays of
     /// more than 100,000 elements or of sizes it cannot resolve), neither recorded, set nor
     /// connected, each with the reason; empty for FMI 2.0.
@@ -145,6 +161,7 @@ impl Fmu {
                 token: a.token.clone(),
                 resource_path: a.resource_path.clone(),
                 configuration: a.configuration.clone(),
+                initial_sizes: a.initial_sizes.clone(),
             })),
         };
         Arc::new(Fmu {

@@ -227,6 +227,7 @@ impl Generation for Fmi3 {
             token,
             resource_path,
             configuration: Vec::new(),
+            initial_sizes: Vec::new(),
         };
         Ok((Abi::Fmi3(Arc::new(abi)), CString::default(), not_in_view))
     }

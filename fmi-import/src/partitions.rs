@@ -3,18 +3,22 @@
 //! periodic from `intervalDecimal` and `shiftDecimal`, triggered by the importer, or
 //! counted down by the FMU (`intervalVariability="countdown"`). Its output clocks, whose
 //! ticks the FMU signals through `clockUpdate`. Read from the description; the calls are
-//! `instance/scheduled.rs`.
+//! `instance/scheduled.rs`. A `fixed` or `tunable` clock's interval is the FMU's to give
+//! (`fmi3GetIntervalDecimal` after initialization, a tunable one again when the FMU signals
+//! `clockUpdate`): the description's is what the master uses until then, and may be absent.
 
+use crate::clocks::ClockKind;
 use model_description::fmi3;
 
 /// How the ticks of a partition's input clock come.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Ticks {
     /// Every `interval` s from `shift` s after the start (`constant`, `fixed`, `tunable`
-    /// or `changing` clocks with `intervalDecimal`).
+    /// or `changing` clocks with `intervalDecimal`; `fixed` and `tunable` ones also without).
     Periodic {
-        /// `intervalDecimal`, s.
-        interval: f64,
+        /// `intervalDecimal`, s; `None` for a `fixed` or `tunable` clock whose description
+        /// gives none (the FMU gives it after initialization).
+        interval: Option<f64>,
         /// `shiftDecimal` (0 when absent), s.
         shift: f64,
     },
@@ -36,13 +40,27 @@ pub struct ModelPartition {
     pub priority: u32,
     /// How its ticks come.
     pub ticks: Ticks,
+    /// Its `intervalVariability`.
+    pub kind: ClockKind,
 }
 
 impl ModelPartition {
     /// How its ticks come, in words (`every 1 s from 0 s`, `triggered`, `countdown`).
     pub fn ticks_text(&self) -> String {
         match self.ticks {
-            Ticks::Periodic { interval, shift } => format!("every {interval} s from {shift} s"),
+            Ticks::Periodic { interval, shift } => {
+                let every = match interval {
+                    Some(interval) => format!("every {interval} s"),
+                    None => "every interval the FMU gives".into(),
+                };
+                match self.kind {
+                    ClockKind::Fixed => {
+                        format!("{every} from {shift} s (fixed: the FMU's interval after initialization)")
+                    }
+                    ClockKind::Tunable => format!("{every} from {shift} s (tunable: the FMU's interval when it says)"),
+                    _ => format!("{every} from {shift} s"),
+                }
+            }
             Ticks::Triggered => "triggered (an input file's clock column)".into(),
             Ticks::Countdown => "countdown (set by the FMU)".into(),
         }
@@ -62,23 +80,29 @@ pub fn model_partitions(md: &fmi3::ModelDescription) -> Result<Vec<ModelPartitio
         let priority = attributes
             .priority
             .ok_or_else(|| format!("input clock {:?} has no priority (Scheduled Execution needs one)", v.name))?;
-        let ticks = match attributes.interval_variability.as_deref() {
-            Some("triggered") => Ticks::Triggered,
-            Some("countdown") => Ticks::Countdown,
+        let kind = ClockKind::parse(attributes.interval_variability.as_deref());
+        let shift = attributes.shift_decimal.unwrap_or(0.0);
+        let ticks = match kind {
+            Some(ClockKind::Triggered) => Ticks::Triggered,
+            Some(ClockKind::Countdown) => Ticks::Countdown,
             kind => match attributes.interval_decimal {
                 Some(interval) if interval > 0.0 && interval.is_finite() => {
-                    Ticks::Periodic { interval, shift: attributes.shift_decimal.unwrap_or(0.0) }
+                    Ticks::Periodic { interval: Some(interval), shift }
+                }
+                None if matches!(kind, Some(ClockKind::Fixed | ClockKind::Tunable)) => {
+                    Ticks::Periodic { interval: None, shift }
                 }
                 _ => {
                     return Err(format!(
                         "input clock {:?} ({} interval) has no intervalDecimal: its ticks are not known to cosim",
                         v.name,
-                        kind.unwrap_or("no")
+                        kind.map_or("no", ClockKind::as_str)
                     ))
                 }
             },
         };
-        out.push(ModelPartition { name: v.name.clone(), clock: v.value_reference, priority, ticks });
+        let kind = kind.unwrap_or(ClockKind::Constant);
+        out.push(ModelPartition { name: v.name.clone(), clock: v.value_reference, priority, ticks, kind });
     }
     Ok(out)
 }

@@ -64,6 +64,9 @@ static long read_own_memory(uintptr_t at, char *out, size_t n) {
 #endif
 }
 
+/* read_own_memory for the memory guard of the importer's allocator (fmi2/guard.rs). */
+long fmi2_sys_read_own_memory(uintptr_t at, char *out, size_t n) { return read_own_memory(at, out, n); }
+
 /* Copies at most `cap` bytes of the C string at `p` into `out` (NUL-terminated), page by
  * page with read_own_memory. Returns the length copied, or -1 if the first byte is not
  * readable. A string that becomes unreadable before its NUL is cut there. */

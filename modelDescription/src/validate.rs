@@ -5,100 +5,103 @@ use std::fmt;
 
 use crate::types::*;
 
-/// The rule a [`Problem`] breaks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Rule {
-    /// `fmiVersion` must be "2.0".
-    FmiVersion,
-    /// At least one of `<ModelExchange>` / `<CoSimulation>` must be present.
-    NoInterface,
-    /// `modelIdentifier` must be a non-empty C identifier.
-    ModelIdentifier,
-    /// Variable names must be non-empty.
-    EmptyName,
-    /// Variable names must be unique.
-    DuplicateName,
-    /// Value references must be unique per base type (Real, Integer, Boolean, String).
-    DuplicateValueReference,
-    /// Unit names must be unique.
-    DuplicateUnit,
-    /// The (causality, variability) pair must be legal (section 2.2.7 table).
-    CausalityVariability,
-    /// `initial` must be one the table allows for (causality, variability), and absent
-    /// for inputs and the independent variable.
-    Initial,
-    /// A start value is required (initial exact/approx, inputs, parameters, constants).
-    StartRequired,
-    /// A start value is forbidden (initial calculated, the independent variable).
-    StartForbidden,
-    /// The independent variable must be Real, and there may be at most one.
-    Independent,
-    /// Only Real variables may be continuous.
-    ContinuousNonReal,
-    /// A `unit` must be declared in `<UnitDefinitions>`.
-    UndeclaredUnit,
-    /// `derivative` must be the index of another Real continuous variable.
-    Derivative,
-    /// `min <= max` and `min <= start <= max`.
-    Bounds,
-    /// `nominal > 0`.
-    Nominal,
-    /// `<Outputs>` must list exactly the causality=output variables, in order.
-    Outputs,
-    /// `<Derivatives>` must list exactly the state derivatives, once each.
-    Derivatives,
-    /// `<InitialUnknowns>` must list exactly the required set, sorted by index.
-    InitialUnknowns,
-    /// An `index` or `dependencies` entry is outside `1..=n`.
-    IndexOutOfRange,
-    /// `dependencies` must be sorted ascending without duplicates.
-    DependencyOrder,
-    /// `dependencies` may only refer to knowns.
-    DependencyNotKnown,
-    /// `dependenciesKind` needs `dependencies` of the same length.
-    DependenciesKind,
-    /// An Enumeration's `declaredType` must name an enumeration type of `<TypeDefinitions>`
-    /// whose item names and values are unique, and its start must be one of the items.
-    DeclaredType,
-}
-
-impl Rule {
-    /// A short stable identifier, e.g. `"start-required"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Rule::FmiVersion => "fmi-version",
-            Rule::NoInterface => "no-interface",
-            Rule::ModelIdentifier => "model-identifier",
-            Rule::EmptyName => "empty-name",
-            Rule::DuplicateName => "duplicate-name",
-            Rule::DuplicateValueReference => "duplicate-value-reference",
-            Rule::DuplicateUnit => "duplicate-unit",
-            Rule::CausalityVariability => "causality-variability",
-            Rule::Initial => "initial",
-            Rule::StartRequired => "start-required",
-            Rule::StartForbidden => "start-forbidden",
-            Rule::Independent => "independent",
-            Rule::ContinuousNonReal => "continuous-non-real",
-            Rule::UndeclaredUnit => "undeclared-unit",
-            Rule::Derivative => "derivative",
-            Rule::Bounds => "bounds",
-            Rule::Nominal => "nominal",
-            Rule::Outputs => "outputs",
-            Rule::Derivatives => "derivatives",
-            Rule::InitialUnknowns => "initial-unknowns",
-            Rule::IndexOutOfRange => "index-out-of-range",
-            Rule::DependencyOrder => "dependency-order",
-            Rule::DependencyNotKnown => "dependency-not-known",
-            Rule::DependenciesKind => "dependencies-kind",
-            Rule::DeclaredType => "declared-type",
+/// `Rule`, the rule a [`Problem`] breaks, of one generation's checks: the rules both
+/// generations share (below, once) and the generation's own (`$own`), each with its short
+/// stable identifier ([`Rule::as_str`]) and `Display`.
+macro_rules! rules {
+    (@all $($(#[$doc:meta])* $variant:ident => $text:literal,)*) => {
+        /// The rule a [`Problem`] breaks.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Rule {
+            $($(#[$doc])* $variant,)*
         }
-    }
-}
 
-impl fmt::Display for Rule {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
+        impl Rule {
+            /// A short stable identifier, e.g. `"start-required"`.
+            pub fn as_str(self) -> &'static str {
+                match self {
+                    $(Rule::$variant => $text,)*
+                }
+            }
+        }
+
+        impl fmt::Display for Rule {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.as_str())
+            }
+        }
+    };
+    ($($own:tt)*) => {
+        $crate::validate::rules!(@all
+            /// `fmiVersion` must be the generation's: "2.0" (FMI 2.0), a 3.x version (FMI 3.0).
+            FmiVersion => "fmi-version",
+            /// At least one interface type must be present: `<ModelExchange>`, `<CoSimulation>` (FMI
+            /// 3.0 also `<ScheduledExecution>`).
+            NoInterface => "no-interface",
+            /// `modelIdentifier` must be a non-empty C identifier.
+            ModelIdentifier => "model-identifier",
+            /// Variable names must be non-empty.
+            EmptyName => "empty-name",
+            /// Variable names must be unique.
+            DuplicateName => "duplicate-name",
+            /// Value references must be unique: per base type (Real, Integer, Boolean, String) in
+            /// FMI 2.0, across all variables of all types in FMI 3.0.
+            DuplicateValueReference => "duplicate-value-reference",
+            /// Unit names must be unique.
+            DuplicateUnit => "duplicate-unit",
+            /// The (causality, variability) pair must be legal (FMI 2.0 section 2.2.7 table, FMI
+            /// 3.0's too).
+            CausalityVariability => "causality-variability",
+            /// `initial` must be one the table allows for (causality, variability), and absent
+            /// for inputs and the independent variable.
+            Initial => "initial",
+            /// A start value is required (initial exact/approx, inputs, parameters, constants).
+            StartRequired => "start-required",
+            /// A start value is forbidden (initial calculated, the independent variable).
+            StartForbidden => "start-forbidden",
+            /// The independent variable must be a continuous Real (FMI 3.0: Float); FMI 2.0 allows at
+            /// most one, FMI 3.0 requires exactly one.
+            Independent => "independent",
+            /// A `unit` (FMI 3.0: or `displayUnit`) must be declared in `<UnitDefinitions>`.
+            UndeclaredUnit => "undeclared-unit",
+            /// `derivative` must name a continuous Real (Float) variable: in FMI 2.0 by its index, in
+            /// FMI 3.0 by its value reference.
+            Derivative => "derivative",
+            /// `min <= max` and `min <= start <= max`.
+            Bounds => "bounds",
+            /// `nominal > 0`.
+            Nominal => "nominal",
+            /// `<Outputs>` (FMI 3.0: the `<Output>` entries) must list exactly the causality=output
+            /// variables, in order.
+            Outputs => "outputs",
+            /// The initial unknowns (FMI 2.0 `<InitialUnknowns>`, sorted by index; FMI 3.0
+            /// `<InitialUnknown>` entries) must list exactly the required set: the outputs, continuous
+            /// states and state derivatives with initial approx or calculated, and the calculated
+            /// parameters.
+            InitialUnknowns => "initial-unknowns",
+            /// `dependenciesKind` needs `dependencies` of the same length.
+            DependenciesKind => "dependencies-kind",
+            /// A `declaredType` must name a type definition of the variable's type (FMI 2.0: an
+            /// Enumeration's an enumeration type); enumeration items must be unique and a start value
+            /// one of them.
+            DeclaredType => "declared-type",
+            $($own)*
+        );
+    };
+}
+pub(crate) use rules;
+
+rules! {
+    /// Only Real variables may be continuous.
+    ContinuousNonReal => "continuous-non-real",
+    /// `<Derivatives>` must list exactly the state derivatives, once each.
+    Derivatives => "derivatives",
+    /// An `index` or `dependencies` entry is outside `1..=n`.
+    IndexOutOfRange => "index-out-of-range",
+    /// `dependencies` must be sorted ascending without duplicates.
+    DependencyOrder => "dependency-order",
+    /// `dependencies` may only refer to knowns.
+    DependencyNotKnown => "dependency-not-known",
 }
 
 /// One violation found by [`ModelDescription::validate`] (`R` = [`Rule`]) or by

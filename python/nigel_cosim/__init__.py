@@ -57,7 +57,17 @@ __all__ = [
     "CampaignError",
 ]
 
-_DTYPES = {"Real": np.float64, "Integer": np.int32, "Enumeration": np.int32, "Boolean": np.bool_}
+# the column types of the native results, as numpy types (fmpy's for FMI 3.0: Int64 and
+# UInt64 as int64 / uint64, every value exact; a String as text)
+_DTYPES = {
+    "Real": np.float64,
+    "Integer": np.int32,
+    "Enumeration": np.int32,
+    "Boolean": np.bool_,
+    "Int64": np.int64,
+    "UInt64": np.uint64,
+    "String": object,
+}
 
 # fmpy's names of the integrators, mapped onto the master's (Model Exchange): CVode is a
 # variable-order BDF method, as the master's bdf is; fmpy's Euler (explicit, fixed step) has
@@ -138,15 +148,28 @@ def _input_table(signals: np.ndarray | None):
     )
 
 
-def _structured(names: Sequence[str], types: Sequence[str], values: np.ndarray) -> np.ndarray:
+def _structured(names: Sequence[str], types: Sequence[str], values: np.ndarray,
+                exact: Sequence[tuple[int, Sequence[str]]] = ()) -> np.ndarray:
     """fmpy's structured array from the native rows (float64, time first): a view of the
-    rows as float64 fields, cast field by field where a column is Integer or Boolean."""
+    rows as float64 fields, cast field by field where a column is Integer or Boolean; the
+    columns an f64 does not hold (``exact``: column and the text of every row) from their
+    text: 64-bit integers exactly (int64 / uint64), Strings as str (object dtype)."""
     rows = np.ascontiguousarray(values, dtype=np.float64)
     fields = ["time", *names]
     as_float = np.dtype([(n, np.float64) for n in fields])
     result = rows.view(as_float).reshape(rows.shape[0])
     wanted = np.dtype([("time", np.float64)] + [(n, _DTYPES.get(t, np.float64)) for n, t in zip(names, types)])
-    return result if wanted == as_float else result.astype(wanted)
+    texts = {names[column]: text for column, text in exact if _DTYPES.get(types[column]) in (np.int64, np.uint64, object)}
+    if not texts:
+        return result if wanted == as_float else result.astype(wanted)
+    out = np.empty(rows.shape[0], dtype=wanted)
+    for name in fields:
+        if name in texts:
+            kind = wanted[name]
+            out[name] = np.array([int(v) for v in texts[name]] if kind != object else texts[name], dtype=kind)
+        else:
+            out[name] = result[name]
+    return out
 
 
 class System:
@@ -349,9 +372,9 @@ class System:
         }
 
     def _simulate(self, args: dict) -> np.ndarray:
-        names, types, array, summary = self._native.simulate(_Args(args))
+        names, types, array, summary, exact = self._native.simulate(_Args(args))
         self.last_summary = json.loads(summary) if summary else None
-        return _structured(names, types, array)
+        return _structured(names, types, array, exact)
 
 
 class _Args:

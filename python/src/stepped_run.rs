@@ -139,13 +139,19 @@ impl NativeRun {
         self.execution().set(&full, value).map_err(to_py)
     }
 
-    /// (names, types, rows so far as a rows x (1 + columns) array).
-    fn results<'py>(&self, py: Python<'py>) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>)> {
-        let values = self.execution().results().values;
+    /// (names, types, rows so far as a rows x (1 + columns) array, the exact columns as
+    /// (column, text of every row)).
+    #[allow(clippy::type_complexity)]
+    fn results<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, Vec<(usize, Vec<String>)>)> {
+        let results = self.execution().results();
+        let exact = crate::system::exact_columns(&results);
         let width = self.names.len() + 1;
-        let rows = values.len() / width;
-        let array = PyArray1::from_vec(py, values).reshape([rows, width])?;
-        Ok((self.names.clone(), self.types.clone(), array.into_any()))
+        let rows = results.values.len() / width;
+        let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
+        Ok((self.names.clone(), self.types.clone(), array.into_any(), exact))
     }
 
     /// Ends the run (terminating and freeing its instances); the summary as JSON text, or

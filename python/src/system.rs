@@ -9,7 +9,7 @@ use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
     simulate::{default_record, run_to_end, Execution},
     Error as CosimError, Experiment, Fmu, ImportOptions, InstancePool, Interface, Results, Summary, System,
-    SystemBuilder,
+    SystemBuilder, VariableRef,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -82,7 +82,9 @@ impl NativeSystem {
     }
 }
 
-/// The base type name of each recorded column (`Real`, `Integer`, `Boolean`).
+/// The type name of each recorded column: `Real`, `Integer`, `Boolean`, `String`, or
+/// `Int64` / `UInt64` for an FMI 3.0 64-bit integer (whose values the results hold exactly,
+/// as text: [`Results::exact`]).
 fn column_types(system: &System, results: &Results, single: Option<&str>) -> Vec<&'static str> {
     results
         .names
@@ -92,9 +94,25 @@ fn column_types(system: &System, results: &Results, single: Option<&str>) -> Vec
                 Some(instance) => format!("{instance}.{n}"),
                 None => n.clone(),
             };
-            system.resolve(&full).map(|r| r.base_type.as_str()).unwrap_or("Real")
+            system.resolve(&full).map(|r| column_type(system, &r)).unwrap_or("Real")
         })
         .collect()
+}
+
+/// The type name of a recorded variable (see [`column_types`]).
+pub(crate) fn column_type(system: &System, r: &VariableRef) -> &'static str {
+    use nigel_cosim::fmi3::ExactKind;
+    match system.instances[r.instance].fmu.exact_kind(r.value_reference) {
+        Some(ExactKind::Int64) => "Int64",
+        Some(ExactKind::UInt64) => "UInt64",
+        _ => r.base_type.as_str(),
+    }
+}
+
+/// The columns of `results` whose values an f64 does not hold: (column among the names,
+/// the text of every row).
+pub(crate) fn exact_columns(results: &Results) -> Vec<(usize, Vec<String>)> {
+    results.exact.iter().map(|e| (e.column, e.rows.clone())).collect()
 }
 
 #[pymethods]
@@ -243,12 +261,14 @@ impl NativeSystem {
     }
 
     /// Runs one experiment; returns (column names, column types, values as a rows x
-    /// (1 + columns) float64 array with time first, the run's summary as JSON text).
+    /// (1 + columns) float64 array with time first, the run's summary as JSON text, the
+    /// exact columns as (column, text of every row)).
+    #[allow(clippy::type_complexity)]
     fn simulate<'py>(
         &self,
         py: Python<'py>,
         args: RunArgs,
-    ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String)> {
+    ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String, Vec<(usize, Vec<String>)>)> {
         let (system, experiment) = self.run_setup(&args)?;
         let cancel = Arc::new(AtomicBool::new(false));
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
@@ -265,10 +285,11 @@ impl NativeSystem {
         })?;
         let (results, summary) = outcome.map_err(to_py)?;
         let types = column_types(&system, &results, self.single.as_deref());
+        let exact = exact_columns(&results);
         let (rows, width) = (results.rows(), results.width());
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
         let json = serde_json::to_string(&summary.to_json()).unwrap_or_default();
-        Ok((results.names, types, array.into_any(), json))
+        Ok((results.names, types, array.into_any(), json, exact))
     }
 
     /// The step-longer-than-sample-period warnings of a run with `args` (the same words as
@@ -292,7 +313,7 @@ impl NativeSystem {
         };
         let mut types = Vec::with_capacity(record.len());
         for name in &record {
-            types.push(system.resolve(name).map_err(to_py)?.base_type.as_str());
+            types.push(column_type(&system, &system.resolve(name).map_err(to_py)?));
         }
         experiment.record = Some(record.clone());
         let names: Vec<String> = match &self.single {

@@ -489,3 +489,61 @@ def test_compare_gives_the_report_of_cosim_compare(tmp_path):
     assert p.returncode == 3
     assert p.stdout.splitlines()[1:] == report["lines"]
     assert nigel_cosim.compare(path, baseline, signals=["plant.x"])["passed"]
+
+
+@pytest.fixture(scope="module")
+def counter3_fmu(tmp_path_factory):
+    """The FMI 3.0 test FMU of our own (cosim/tests/cfmu/fmi3_counter.c, built against the
+    standard's headers in fmpy's package): i64out = i64in ^ 1 and u64out = u64in ^ 1 (the
+    lowest bit flipped, so that a rounding shows), the String parameter label = "abc"."""
+    import zipfile
+
+    cfmu = REPO / "cosim" / "tests" / "cfmu"
+    headers = Path(fmpy.__file__).parent / "c-code"
+    d = tmp_path_factory.mktemp("counter3")
+    so = d / "fmi3_counter.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-I", str(headers), str(cfmu / "fmi3_counter.c"), "-o", str(so)],
+                   check=True)
+    fmu = d / "fmi3_counter.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.write(cfmu / "fmi3_counter.xml", "modelDescription.xml")
+        z.write(so, "binaries/x86_64-linux/fmi3_counter.so")
+    return fmu
+
+
+def test_sixty_four_bit_integers_are_exact_and_strings_text_as_fmpy(counter3_fmu):
+    # i64in = 2^62 gives i64out = 2^62 + 1, u64in = 2^63 gives u64out = 2^63 + 1 (above
+    # i64::MAX): neither is an f64 (the f64s there are 2^10 and 2^11 apart); fmpy 0.3.32
+    # records them as int64 / uint64, exactly
+    signals = np.array([(0.0, 2**62, 2**63), (1.0, 2**62, 2**63)],
+                       dtype=[("time", np.double), ("i64in", np.int64), ("u64in", np.uint64)])
+    kwargs = dict(stop_time=0.2, output_interval=0.1, input=signals, output=["i64out", "u64out", "label"])
+    ours = nigel_cosim.simulate_fmu(counter3_fmu, **kwargs)
+    theirs = fmpy.simulate_fmu(str(counter3_fmu), **kwargs)
+    for name, dtype, value in [("i64out", np.int64, 2**62 + 1), ("u64out", np.uint64, 2**63 + 1)]:
+        assert ours.dtype[name] == theirs.dtype[name] == dtype, name
+        assert [int(v) for v in ours[name]] == [int(v) for v in theirs[name]] == [value] * 3, name
+    # the String parameter as its text (fmpy leaves Strings out of its result)
+    assert ours.dtype["label"] == object
+    assert list(ours["label"]) == ["abc"] * 3
+
+
+def test_an_ssp_of_int64_connectors_gives_exact_int64_and_uint64_fields(counter3_fmu, tmp_path):
+    # cosim/tests/data/int64_chain.ssd: c1 feeds c2 its Int64 and UInt64 (ssc:Integer
+    # connectors); by hand: c1.i64in = 2^62 gives 2^62 + 1 at c2.i64in and 2^62 at
+    # c2.i64out; c1.u64in = 2^63 gives 2^63 + 1 at c2.u64in and 2^63 at c2.u64out
+    ssd = tmp_path / "int64_chain.ssd"
+    ssd.write_bytes((REPO / "cosim" / "tests" / "data" / "int64_chain.ssd").read_bytes())
+    (tmp_path / "fmi3_counter.fmu").write_bytes(counter3_fmu.read_bytes())
+    signals = np.array([(0.0, 2**62, 2**63), (1.0, 2**62, 2**63)],
+                       dtype=[("time", np.double), ("c1.i64in", np.int64), ("c1.u64in", np.uint64)])
+    output = ["c2.i64in", "c2.i64out", "c2.u64in", "c2.u64out"]
+    whole = nigel_cosim.simulate_ssp(ssd, step_size=0.1, input=signals, output=output, algorithm="ordered")
+    with nigel_cosim.System(ssd) as system:
+        system.initialize(step_size=0.1, input=signals, output=output)
+        system.step_until(0.2)
+        stepped = system.results()
+        system.terminate()
+    for result in (whole, stepped):
+        assert [result.dtype[n] for n in output] == [np.int64, np.int64, np.uint64, np.uint64]
+        assert [[int(v) for v in result[n]] for n in output] == [[v] * 3 for v in (2**62 + 1, 2**62, 2**63 + 1, 2**63)]

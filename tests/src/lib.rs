@@ -331,6 +331,23 @@ impl Instance<'_> {
             Err(s)
         }
     }
+    /// fmi2GetDirectionalDerivative of `unknowns` for a unit seed of the one `known`: the
+    /// status and the derivatives (zeros where the call wrote none).
+    pub fn directional_derivative(&self, unknowns: &[u32], known: u32) -> (Status, Vec<f64>) {
+        let mut out = vec![0.0; unknowns.len()];
+        let s = unsafe {
+            (self.f().get_directional_derivative.unwrap())(
+                self.c,
+                unknowns.as_ptr(),
+                unknowns.len(),
+                &known,
+                1,
+                &1.0,
+                out.as_mut_ptr(),
+            )
+        };
+        (s, out)
+    }
     pub fn set_boolean(&self, vrs: &[u32], values: &[bool]) -> Status {
         let v: Vec<c_int> = values.iter().map(|&b| b as c_int).collect();
         unsafe { (self.f().set_boolean)(self.c, vrs.as_ptr(), vrs.len(), v.as_ptr()) }

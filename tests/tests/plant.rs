@@ -388,7 +388,6 @@ fn initial_unknowns_depend_only_on_initialization_knowns() {
 fn initialization_mode_directional_derivatives_with_respect_to_the_start_values() {
     let (i, log) = fmu().instantiate("dd-init", CO_SIMULATION, fmu().guid());
     let i = i.unwrap();
-    let f = i.f();
     let starts = ["v_x_start", "v_y_start", "yaw_rate_start", "psi_start"];
     let point = [0.35, 0.02, 0.4, 0.3];
     assert_eq!(i.setup(0.0), OK);
@@ -397,18 +396,7 @@ fn initialization_mode_directional_derivatives_with_respect_to_the_start_values(
     let unknowns = vrs(&["der(x)", "der(y)", "der(v_x)", "der(v_y)", "der(yaw_rate)", "v_y"]);
     for (k, start) in starts.iter().enumerate() {
         let known = fmu().vr(start);
-        let mut exact = vec![0.0; unknowns.len()];
-        let s = unsafe {
-            (f.get_directional_derivative.unwrap())(
-                i.c,
-                unknowns.as_ptr(),
-                unknowns.len(),
-                &known,
-                1,
-                &1.0,
-                exact.as_mut_ptr(),
-            )
-        };
+        let (s, exact) = i.directional_derivative(&unknowns, known);
         assert_eq!(s, OK, "{start}: {:?}", log.last_error());
         // central differences, h = 1e-6: truncation O(h^2 f''') ~ 1e-10 relative on these
         // smooth terms, rounding O(eps / h) ~ 1e-10; 1e-6 relative (+1e-8 absolute) holds
@@ -488,18 +476,7 @@ fn initialization_mode_directional_derivatives_with_respect_to_the_parameters() 
     for name in parameters {
         let known = fmu().vr(name);
         let p0 = i.get_real(&[known]).unwrap()[0];
-        let mut exact = vec![0.0; unknowns.len()];
-        let s = unsafe {
-            (f.get_directional_derivative.unwrap())(
-                i.c,
-                unknowns.as_ptr(),
-                unknowns.len(),
-                &known,
-                1,
-                &1.0,
-                exact.as_mut_ptr(),
-            )
-        };
+        let (s, exact) = i.directional_derivative(&unknowns, known);
         assert_eq!(s, OK, "{name}: {:?}", log.last_error());
         // central differences with h = 1e-6 |p|: truncation O(h^2 f''') is about 1e-12 of
         // the derivative's scale on these smooth terms; rounding is eps |f| / h, at most

@@ -16,7 +16,7 @@ use model_description::ModelDescription;
 use nigel_integration_tests::{EventInfo, Fmu, CO_SIMULATION, ERROR, MODEL_EXCHANGE, OK};
 
 mod random;
-use random::{every_fmu_and_interface, Moves, Rng, Shadow, HOSTILE};
+use random::{every_fmu_and_interface, Experiment, Moves, Rng, Shadow, HOSTILE};
 
 /// The FMI 2.0 functions that move the importer's view of the state.
 const MOVES: Moves = Moves {
@@ -107,18 +107,17 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         (f.set_debug_logging.unwrap())(c, 0, rng.below(3), cats.as_ptr())
                     }
                     Function::SetupExperiment => {
-                        let start = rng.pick(&[0.0, 0.0, 1.0, f64::NAN, -5.0]);
-                        let stop = rng.pick(&[10.0, 0.5, f64::NAN, f64::INFINITY, -1.0]);
+                        let e = Experiment::draw(&mut rng);
                         let s = (f.setup_experiment)(
                             c,
-                            rng.below(2) as c_int,
-                            rng.pick(&HOSTILE),
-                            start,
-                            rng.below(2) as c_int,
-                            stop,
+                            e.tolerance_defined as c_int,
+                            e.tolerance,
+                            e.start,
+                            e.stop_defined as c_int,
+                            e.stop,
                         );
                         if s == OK {
-                            new_time = Some(start);
+                            new_time = Some(e.start);
                         }
                         s
                     }
@@ -166,71 +165,23 @@ fn run(fmu: &Fmu, kind: c_int, sequences: usize, seed: u64) -> [usize; 4] {
                         let x = [c"a".as_ptr(); 4];
                         (f.set_string)(c, ptr(&v), n, x.as_ptr())
                     }
-                    Function::GetFMUstate => {
-                        let mut s = if rng.chance(20) && !sh.states.is_empty() { sh.states[0].0 } else { null_mut() };
-                        let before = s;
-                        let status = (f.get_fmu_state.unwrap())(c, &mut s);
-                        if status == OK {
-                            if before.is_null() {
-                                sh.states.push((s, sh.machine));
-                            } else if let Some(e) = sh.states.iter_mut().find(|e| e.0 == s) {
-                                e.1 = sh.machine;
-                            }
-                        }
-                        status
-                    }
+                    Function::GetFMUstate => sh.get_state(&mut rng, |s| (f.get_fmu_state.unwrap())(c, s)),
                     Function::SetFMUstate => {
-                        let s = sh.state_arg(&mut rng);
-                        let status = (f.set_fmu_state.unwrap())(c, s);
-                        if status == OK {
-                            restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
-                        }
-                        status
+                        sh.set_state(&mut rng, &mut restored, |s| (f.set_fmu_state.unwrap())(c, s))
                     }
-                    Function::FreeFMUstate => {
-                        let mut s = sh.state_arg(&mut rng);
-                        let before = s;
-                        let status = (f.free_fmu_state.unwrap())(c, &mut s);
-                        if status == OK && !before.is_null() {
-                            assert!(s.is_null());
-                            sh.states.retain(|e| e.0 != before);
-                            sh.freed.push(before);
-                        }
-                        status
-                    }
+                    Function::FreeFMUstate => sh.free_state(&mut rng, |s| (f.free_fmu_state.unwrap())(c, s)),
                     Function::SerializedFMUstateSize => {
                         let mut size = 0usize;
                         (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
-                    Function::SerializeFMUstate => {
-                        let s = sh.state_arg(&mut rng);
-                        let mut size = 0usize;
-                        let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
-                        let size = if rng.chance(10) { size / 2 } else { size };
-                        let mut buf = vec![0u8; size.min(1 << 20)];
-                        let status = (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr() as *mut c_char, buf.len());
-                        if status == OK {
-                            sh.bytes = buf;
-                        }
-                        status
-                    }
-                    Function::DeSerializeFMUstate => {
-                        let mut bytes = sh.bytes.clone();
-                        if !bytes.is_empty() && rng.chance(50) {
-                            let k = rng.below(bytes.len());
-                            bytes[k] ^= 1 << rng.below(8);
-                        }
-                        if rng.chance(10) {
-                            bytes = (0..rng.below(200)).map(|_| rng.next() as u8).collect();
-                        }
-                        let mut s = null_mut();
-                        let status =
-                            (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr() as *const c_char, bytes.len(), &mut s);
-                        if status == OK {
-                            sh.states.push((s, None));
-                        }
-                        status
-                    }
+                    Function::SerializeFMUstate => sh.serialize_state(
+                        &mut rng,
+                        |s, size| (f.serialized_fmu_state_size.unwrap())(c, s, size),
+                        |s, buf| (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr() as *mut c_char, buf.len()),
+                    ),
+                    Function::DeSerializeFMUstate => sh.deserialize_state(&mut rng, false, |bytes, s| {
+                        (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr() as *const c_char, bytes.len(), s)
+                    }),
                     Function::GetDirectionalDerivative => {
                         let unknown = vrs(&mut rng, &p.real);
                         let known = vrs(&mut rng, &p.real);

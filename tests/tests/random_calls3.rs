@@ -18,7 +18,7 @@ use model_description::{ModelDescription, VariableType};
 use nigel_integration_tests::{Fmu, ERROR, OK};
 
 mod random;
-use random::{every_fmu_and_interface, Moves, Rng, Shadow, HOSTILE};
+use random::{every_fmu_and_interface, Experiment, Moves, Rng, Shadow, HOSTILE};
 
 /// The FMI 3.0 functions that move the importer's view of the state.
 const MOVES: Moves = Moves {
@@ -120,6 +120,22 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
             let mut restored: Option<Option<Machine>> = None;
             let (mut b1, mut b2, mut b3, mut b4, mut b5) = (7u8, 7u8, 7u8, 7u8, 7u8);
             let mut t_out = f64::NAN;
+            // one type's values of `pool`: got into a zeroed buffer, or set to values picked
+            // from `picks`
+            macro_rules! get {
+                ($getter:expr, $pool:expr, $zero:expr) => {{
+                    let v = vrs(&mut rng, $pool);
+                    let mut out = [$zero; 5];
+                    ($getter)(c, ptr(&v), n, out.as_mut_ptr(), n_values)
+                }};
+            }
+            macro_rules! set {
+                ($setter:expr, $pool:expr, $picks:expr) => {{
+                    let v = vrs(&mut rng, $pool);
+                    let x: Vec<_> = (0..n_values).map(|_| rng.pick($picks)).collect();
+                    ($setter)(c, ptr(&v), n, x.as_ptr(), n_values)
+                }};
+            }
             let status = unsafe {
                 use Function::*;
                 match function {
@@ -132,18 +148,17 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         (f.set_debug_logging.unwrap())(c, 0, rng.below(3), cats.as_ptr())
                     }
                     Fmi3EnterInitializationMode => {
-                        let start = rng.pick(&[0.0, 0.0, 1.0, f64::NAN, -5.0]);
-                        let stop = rng.pick(&[10.0, 0.5, f64::NAN, f64::INFINITY, -1.0]);
+                        let e = Experiment::draw(&mut rng);
                         let s = (f.enter_initialization_mode)(
                             c,
-                            rng.below(2) as u8,
-                            rng.pick(&HOSTILE),
-                            start,
-                            rng.below(2) as u8,
-                            stop,
+                            e.tolerance_defined as u8,
+                            e.tolerance,
+                            e.start,
+                            e.stop_defined as u8,
+                            e.stop,
                         );
                         if s == OK {
-                            new_time = Some(start);
+                            new_time = Some(e.start);
                         }
                         s
                     }
@@ -156,42 +171,13 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                         check_reals = Some(n.min(n_values));
                         (f.get_float64)(c, ptr(&v), n, reals_out.as_mut_ptr(), n_values)
                     }
-                    Fmi3SetFloat64 => {
-                        let v = vrs(&mut rng, &p.float64);
-                        let x: Vec<f64> = (0..n_values).map(|_| rng.pick(&HOSTILE)).collect();
-                        (f.set_float64)(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetInt32 => {
-                        let v = vrs(&mut rng, &p.int32);
-                        let mut out = [0i32; 5];
-                        (f.get_int32.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetInt32 => {
-                        let v = vrs(&mut rng, &p.int32);
-                        let x: Vec<i32> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 7, i32::MAX])).collect();
-                        (f.set_int32.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetInt64 => {
-                        let v = vrs(&mut rng, &p.int64);
-                        let mut out = [0i64; 5];
-                        (f.get_int64.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetInt64 => {
-                        let v = vrs(&mut rng, &p.int64);
-                        let x: Vec<i64> =
-                            (0..n_values).map(|_| rng.pick(&[0, 1, 2, 3, -1, 1 << 40, i64::MIN])).collect();
-                        (f.set_int64.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
-                    Fmi3GetBoolean => {
-                        let v = vrs(&mut rng, &p.boolean);
-                        let mut out = [0u8; 5];
-                        (f.get_boolean.unwrap())(c, ptr(&v), n, out.as_mut_ptr(), n_values)
-                    }
-                    Fmi3SetBoolean => {
-                        let v = vrs(&mut rng, &p.boolean);
-                        let x: Vec<u8> = (0..n_values).map(|_| rng.pick(&[0, 1, 2, 255])).collect();
-                        (f.set_boolean.unwrap())(c, ptr(&v), n, x.as_ptr(), n_values)
-                    }
+                    Fmi3SetFloat64 => set!(f.set_float64, &p.float64, &HOSTILE),
+                    Fmi3GetInt32 => get!(f.get_int32.unwrap(), &p.int32, 0i32),
+                    Fmi3SetInt32 => set!(f.set_int32.unwrap(), &p.int32, &[0, 1, 2, 3, -1, 7, i32::MAX]),
+                    Fmi3GetInt64 => get!(f.get_int64.unwrap(), &p.int64, 0i64),
+                    Fmi3SetInt64 => set!(f.set_int64.unwrap(), &p.int64, &[0, 1, 2, 3, -1, 1 << 40, i64::MIN]),
+                    Fmi3GetBoolean => get!(f.get_boolean.unwrap(), &p.boolean, 0u8),
+                    Fmi3SetBoolean => set!(f.set_boolean.unwrap(), &p.boolean, &[0, 1, 2, 255]),
                     // the types the FMUs have no variable of: any value reference
                     Fmi3GetFloat32 | Fmi3SetFloat32 => {
                         let v = vrs(&mut rng, &p.any);
@@ -267,73 +253,21 @@ fn run(fmu: &Fmu, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4
                             k,
                         )
                     }
-                    Fmi3GetFMUState => {
-                        let mut s = if rng.chance(20) && !sh.states.is_empty() { sh.states[0].0 } else { null_mut() };
-                        let before = s;
-                        let status = (f.get_fmu_state.unwrap())(c, &mut s);
-                        if status == OK {
-                            if before.is_null() {
-                                sh.states.push((s, sh.machine));
-                            } else if let Some(e) = sh.states.iter_mut().find(|e| e.0 == s) {
-                                e.1 = sh.machine;
-                            }
-                        }
-                        status
-                    }
-                    Fmi3SetFMUState => {
-                        let s = sh.state_arg(&mut rng);
-                        let status = (f.set_fmu_state.unwrap())(c, s);
-                        if status == OK {
-                            restored = Some(sh.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
-                        }
-                        status
-                    }
-                    Fmi3FreeFMUState => {
-                        let mut s = sh.state_arg(&mut rng);
-                        let before = s;
-                        let status = (f.free_fmu_state.unwrap())(c, &mut s);
-                        if status == OK && !before.is_null() {
-                            assert!(s.is_null());
-                            sh.states.retain(|e| e.0 != before);
-                            sh.freed.push(before);
-                        }
-                        status
-                    }
+                    Fmi3GetFMUState => sh.get_state(&mut rng, |s| (f.get_fmu_state.unwrap())(c, s)),
+                    Fmi3SetFMUState => sh.set_state(&mut rng, &mut restored, |s| (f.set_fmu_state.unwrap())(c, s)),
+                    Fmi3FreeFMUState => sh.free_state(&mut rng, |s| (f.free_fmu_state.unwrap())(c, s)),
                     Fmi3SerializedFMUStateSize => {
                         let mut size = 0usize;
                         (f.serialized_fmu_state_size.unwrap())(c, sh.state_arg(&mut rng), &mut size)
                     }
-                    Fmi3SerializeFMUState => {
-                        let s = sh.state_arg(&mut rng);
-                        let mut size = 0usize;
-                        let _ = (f.serialized_fmu_state_size.unwrap())(c, s, &mut size);
-                        let size = if rng.chance(10) { size / 2 } else { size };
-                        let mut buf = vec![0u8; size.min(1 << 20)];
-                        let status = (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr(), buf.len());
-                        if status == OK {
-                            sh.bytes = buf;
-                        }
-                        status
-                    }
-                    Fmi3DeserializeFMUState => {
-                        let mut bytes = sh.bytes.clone();
-                        if !bytes.is_empty() && rng.chance(50) {
-                            let k = rng.below(bytes.len());
-                            bytes[k] ^= 1 << rng.below(8);
-                        }
-                        if !bytes.is_empty() && rng.chance(20) {
-                            bytes.truncate(rng.below(bytes.len()));
-                        }
-                        if rng.chance(10) {
-                            bytes = (0..rng.below(200)).map(|_| rng.next() as u8).collect();
-                        }
-                        let mut s = null_mut();
-                        let status = (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr(), bytes.len(), &mut s);
-                        if status == OK {
-                            sh.states.push((s, None));
-                        }
-                        status
-                    }
+                    Fmi3SerializeFMUState => sh.serialize_state(
+                        &mut rng,
+                        |s, size| (f.serialized_fmu_state_size.unwrap())(c, s, size),
+                        |s, buf| (f.serialize_fmu_state.unwrap())(c, s, buf.as_mut_ptr(), buf.len()),
+                    ),
+                    Fmi3DeserializeFMUState => sh.deserialize_state(&mut rng, true, |bytes, s| {
+                        (f.deserialize_fmu_state.unwrap())(c, bytes.as_ptr(), bytes.len(), s)
+                    }),
                     Fmi3GetDirectionalDerivative | Fmi3GetAdjointDerivative => {
                         let unknown = vrs(&mut rng, &p.float64);
                         let known = vrs(&mut rng, &p.float64);

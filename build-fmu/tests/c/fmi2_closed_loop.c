@@ -16,12 +16,7 @@
  *   record NAME VR COLUMN               Real variable recorded as column COLUMN
  * Values are read with strtod, so hexadecimal floats (%a) carry every bit.
  *
- * Algorithm: fixed-step Jacobi, as fmpy, libcosim and nigel_cosim's `jacobi` do it: every
- * instance steps from t to t + h with the inputs set at t, the row of t + h is recorded
- * (outputs before any input changes), then every input is set from the outputs at t + h. In Initialization Mode the connections are applied as many times as there are
- * instances, so values reach the end of any feedthrough chain. Time is t0 + n h, with n an
- * integer, so it does not drift; each step is t_(n+1) - t_n. Rows are written with 17 significant digits (%.17g),
- * which round-trip every double.
+ * Algorithm: closed_loop.h's fixed-step Jacobi; this file binds it to the FMI 2.0 C API.
  */
 #include "importer.h"
 
@@ -35,13 +30,9 @@ typedef fmi2Status (*SetInteger)(fmi2Component, const fmi2ValueReference *, size
 typedef fmi2Status (*SetBoolean)(fmi2Component, const fmi2ValueReference *, size_t, const fmi2Boolean *);
 typedef fmi2Status (*DoStep)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
 
-#define MAX_INSTANCES 8
-#define MAX_ITEMS 4096
-#define LINE 4096
-
 typedef struct {
     char name[64];
-    char guid[128];
+    char token[128]; /* the GUID */
     fmi2Component c;
     Instantiate instantiate;
     SetupExperiment setup_experiment;
@@ -53,43 +44,9 @@ typedef struct {
     DoStep do_step;
 } Instance;
 
-typedef struct { int from, to; fmi2ValueReference from_vr, to_vr; double gain, offset; } Connection;
-typedef struct { int instance; fmi2ValueReference vr; char column[128]; } Recorded;
-
-static Instance instances[MAX_INSTANCES];
-static int n_instances;
-static Connection connections[MAX_ITEMS];
-static int n_connections;
-static Recorded recorded[MAX_ITEMS];
-static int n_recorded;
-
-static void fail(const char *what, const char *detail) {
-    fprintf(stderr, "fmi2_closed_loop: %s%s%s\n", what, detail ? ": " : "", detail ? detail : "");
-    exit(1);
-}
-
-static void check(fmi2Status s, const char *function, const Instance *inst) {
-    if (s != fmi2OK) {
-        fprintf(stderr, "fmi2_closed_loop: %s of %s returned status %d\n", function, inst->name, (int)s);
-        exit(1);
-    }
-}
-
-static int instance_index(const char *name) {
-    for (int i = 0; i < n_instances; i++)
-        if (strcmp(instances[i].name, name) == 0) return i;
-    fail("unknown instance", name);
-    return -1;
-}
-
-static void *symbol(library_t l, const char *name, const char *path) {
-    void *p = library_symbol(l, name);
-    if (!p) {
-        fprintf(stderr, "fmi2_closed_loop: %s: no symbol %s\n", path, name);
-        exit(1);
-    }
-    return p;
-}
+#define PROGRAM "fmi2_closed_loop"
+typedef fmi2ValueReference ValueReference;
+#include "closed_loop.h"
 
 static void load(Instance *inst, const char *path) {
     library_t l = library_open(path);
@@ -109,140 +66,57 @@ static void load(Instance *inst, const char *path) {
 
 static const fmi2CallbackFunctions callbacks = {logger2, calloc, free, NULL, NULL};
 
-static void propagate(void) {
-    for (int k = 0; k < n_connections; k++) {
-        const Connection *c = &connections[k];
-        fmi2Real v;
-        check(instances[c->from].get_real(instances[c->from].c, &c->from_vr, 1, &v), "fmi2GetReal", &instances[c->from]);
-        v = c->gain * v + c->offset;
-        check(instances[c->to].set_real(instances[c->to].c, &c->to_vr, 1, &v), "fmi2SetReal", &instances[c->to]);
-    }
+static void instantiate(Instance *inst) {
+    inst->c = inst->instantiate(inst->name, fmi2CoSimulation, inst->token, "file:///", &callbacks, 0, 0);
+    if (!inst->c) fail("fmi2Instantiate failed", inst->name);
 }
 
-/* Jacobi: every source value read before any input is set. */
-static void propagate_jacobi(fmi2Real *buffer) {
-    for (int k = 0; k < n_connections; k++) {
-        const Connection *c = &connections[k];
-        check(instances[c->from].get_real(instances[c->from].c, &c->from_vr, 1, &buffer[k]), "fmi2GetReal",
-              &instances[c->from]);
-        buffer[k] = c->gain * buffer[k] + c->offset;
+/* real, integer and boolean (FMI 2.0 sets an Enumeration as an Integer: no such line). */
+static int set_start(Instance *inst, char kind, ValueReference vr, const char *text) {
+    if (kind == 'r') {
+        fmi2Real v = strtod(text, NULL);
+        check(inst->set_real(inst->c, &vr, 1, &v), "fmi2SetReal", inst);
+    } else if (kind == 'i') {
+        fmi2Integer v = (fmi2Integer)strtol(text, NULL, 10);
+        check(inst->set_integer(inst->c, &vr, 1, &v), "fmi2SetInteger", inst);
+    } else if (kind == 'b') {
+        fmi2Boolean v = strcmp(text, "0") != 0;
+        check(inst->set_boolean(inst->c, &vr, 1, &v), "fmi2SetBoolean", inst);
+    } else {
+        return 0;
     }
-    for (int k = 0; k < n_connections; k++) {
-        const Connection *c = &connections[k];
-        check(instances[c->to].set_real(instances[c->to].c, &c->to_vr, 1, &buffer[k]), "fmi2SetReal", &instances[c->to]);
-    }
+    return 1;
 }
 
-static void write_row(FILE *out, double t) {
-    fprintf(out, "%.17g", t);
-    for (int k = 0; k < n_recorded; k++) {
-        const Recorded *r = &recorded[k];
-        fmi2Real v;
-        check(instances[r->instance].get_real(instances[r->instance].c, &r->vr, 1, &v), "fmi2GetReal",
-              &instances[r->instance]);
-        fprintf(out, ",%.17g", v);
-    }
-    fputc('\n', out);
+static double get_real(Instance *inst, ValueReference vr) {
+    fmi2Real v;
+    check(inst->get_real(inst->c, &vr, 1, &v), "fmi2GetReal", inst);
+    return v;
 }
 
-int main(int argc, char **argv) {
-    if (argc != 3) {
-        fprintf(stderr, "usage: fmi2_closed_loop JOB_FILE OUT_CSV\n");
-        return 2;
-    }
-    FILE *job = fopen(argv[1], "r");
-    if (!job) fail("cannot open job file", argv[1]);
-    double stop = 0.0, step = 0.0;
-    char line[LINE];
-    while (fgets(line, sizeof line, job)) {
-        line[strcspn(line, "\r\n")] = 0;
-        char kind[32], a[128], b[128], c[128], d[128];
-        int pos = 0;
-        if (sscanf(line, "%31s%n", kind, &pos) != 1) continue;
-        if (strcmp(kind, "experiment") == 0) {
-            if (sscanf(line + pos, "%127s %127s", a, b) != 2) fail("bad line", line);
-            stop = strtod(a, NULL);
-            step = strtod(b, NULL);
-        } else if (strcmp(kind, "fmu") == 0) {
-            int rest = 0;
-            if (n_instances == MAX_INSTANCES) fail("too many instances", line);
-            Instance *inst = &instances[n_instances];
-            if (sscanf(line + pos, " %63s %127s %n", inst->name, inst->guid, &rest) != 2 || rest == 0)
-                fail("bad line", line);
-            load(inst, line + pos + rest);
-            inst->c = inst->instantiate(inst->name, fmi2CoSimulation, inst->guid, "file:///", &callbacks, 0, 0);
-            if (!inst->c) fail("fmi2Instantiate failed", inst->name);
-            n_instances++;
-        } else if (strcmp(kind, "real") == 0 || strcmp(kind, "integer") == 0 || strcmp(kind, "boolean") == 0) {
-            if (sscanf(line + pos, "%127s %127s %127s", a, b, c) != 3) fail("bad line", line);
-            Instance *inst = &instances[instance_index(a)];
-            fmi2ValueReference vr = (fmi2ValueReference)strtoul(b, NULL, 10);
-            if (kind[0] == 'r') {
-                fmi2Real v = strtod(c, NULL);
-                check(inst->set_real(inst->c, &vr, 1, &v), "fmi2SetReal", inst);
-            } else if (kind[0] == 'i') {
-                fmi2Integer v = (fmi2Integer)strtol(c, NULL, 10);
-                check(inst->set_integer(inst->c, &vr, 1, &v), "fmi2SetInteger", inst);
-            } else {
-                fmi2Boolean v = strcmp(c, "0") != 0;
-                check(inst->set_boolean(inst->c, &vr, 1, &v), "fmi2SetBoolean", inst);
-            }
-        } else if (strcmp(kind, "connect") == 0) {
-            char e[128], f[128];
-            if (sscanf(line + pos, "%127s %127s %127s %127s %127s %127s", a, b, c, d, e, f) != 6) fail("bad line", line);
-            if (n_connections == MAX_ITEMS) fail("too many connections", line);
-            Connection *k = &connections[n_connections++];
-            k->from = instance_index(a);
-            k->from_vr = (fmi2ValueReference)strtoul(b, NULL, 10);
-            k->to = instance_index(c);
-            k->to_vr = (fmi2ValueReference)strtoul(d, NULL, 10);
-            k->gain = strtod(e, NULL);
-            k->offset = strtod(f, NULL);
-        } else if (strcmp(kind, "record") == 0) {
-            if (n_recorded == MAX_ITEMS) fail("too many recorded variables", line);
-            Recorded *r = &recorded[n_recorded];
-            if (sscanf(line + pos, "%127s %127s %127s", a, b, r->column) != 3) fail("bad line", line);
-            r->instance = instance_index(a);
-            r->vr = (fmi2ValueReference)strtoul(b, NULL, 10);
-            n_recorded++;
-        } else {
-            fail("unknown directive", line);
-        }
-    }
-    fclose(job);
-    if (!(step > 0.0) || !(stop > 0.0)) fail("no experiment line with a positive stop time and step", argv[1]);
+static void set_real(Instance *inst, ValueReference vr, double v) {
+    check(inst->set_real(inst->c, &vr, 1, &v), "fmi2SetReal", inst);
+}
 
-    for (int i = 0; i < n_instances; i++)
-        check(instances[i].setup_experiment(instances[i].c, 0, 0.0, 0.0, 1, stop), "fmi2SetupExperiment", &instances[i]);
-    for (int i = 0; i < n_instances; i++)
-        check(instances[i].enter_initialization(instances[i].c), "fmi2EnterInitializationMode", &instances[i]);
-    for (int pass = 0; pass < n_instances; pass++) propagate();
-    for (int i = 0; i < n_instances; i++)
-        check(instances[i].exit_initialization(instances[i].c), "fmi2ExitInitializationMode", &instances[i]);
+static void setup_experiment(Instance *inst, double stop) {
+    check(inst->setup_experiment(inst->c, 0, 0.0, 0.0, 1, stop), "fmi2SetupExperiment", inst);
+}
 
-    FILE *out = fopen(argv[2], "w");
-    if (!out) fail("cannot write", argv[2]);
-    fprintf(out, "\"time\"");
-    for (int k = 0; k < n_recorded; k++) fprintf(out, ",\"%s\"", recorded[k].column);
-    fputc('\n', out);
-    write_row(out, 0.0);
-    /* the number of steps, rounded: stop is a multiple of step up to rounding of the text */
-    long steps = (long)(stop / step + 0.5);
-    fmi2Real *buffer = calloc((size_t)n_connections + 1, sizeof(fmi2Real));
-    for (long n = 0; n < steps; n++) {
-        /* from t_n = n h to t_(n+1) = (n + 1) h: the step is their difference, so that
-           t_n + step lands on the grid (nigel_cosim does the same) */
-        double t = (double)n * step, t_next = (double)(n + 1) * step;
-        for (int i = 0; i < n_instances; i++)
-            check(instances[i].do_step(instances[i].c, t, t_next - t, 1), "fmi2DoStep", &instances[i]);
-        write_row(out, t_next);
-        propagate_jacobi(buffer);
-    }
-    free(buffer);
-    if (fclose(out) != 0) fail("cannot write", argv[2]);
-    for (int i = 0; i < n_instances; i++) {
-        check(instances[i].terminate(instances[i].c), "fmi2Terminate", &instances[i]);
-        instances[i].free_instance(instances[i].c);
-    }
+static void enter_initialization(Instance *inst, double stop) {
+    (void)stop;
+    check(inst->enter_initialization(inst->c), "fmi2EnterInitializationMode", inst);
+}
+
+static void exit_initialization(Instance *inst) {
+    check(inst->exit_initialization(inst->c), "fmi2ExitInitializationMode", inst);
+}
+
+static int do_step(Instance *inst, double t, double h) {
+    check(inst->do_step(inst->c, t, h, 1), "fmi2DoStep", inst);
     return 0;
+}
+
+static void end(Instance *inst) {
+    check(inst->terminate(inst->c), "fmi2Terminate", inst);
+    inst->free_instance(inst->c);
 }

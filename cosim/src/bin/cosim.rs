@@ -206,6 +206,12 @@ struct RunArgs {
     /// Start value or parameter: instance.variable=value (or variable=value for one FMU).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
+    /// A value set during the run, from the first step starting at or after TIME s: an
+    /// input or tunable parameter, or a tunable FMI 3.0 structural parameter (set in
+    /// Reconfiguration Mode; the arrays it sizes get columns for their largest size, NaN
+    /// where an array lacks the element). Repeatable.
+    #[arg(long = "set-at", num_args = 2, value_names = ["TIME", "NAME=VALUE"])]
+    set_at: Vec<String>,
     /// Run the closed loop's `controller` instance with one's own gain: a `synthesize --json`
     /// report (its "K", rows FL, FR, RL, RR, columns beta, r). Sets `controller.controller=4`
     /// (custom) and `controller.k_beta_*`, `controller.k_yaw_rate_*`; `--set` applies after it.
@@ -388,6 +394,26 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
         builder.set_text(&qualify(name.trim(), single), value)?;
     }
+    let mut timed_sets = Vec::new();
+    for pair in args.set_at.chunks(2) {
+        let [time, setting] = pair else { unreachable!("clap gives --set-at two values") };
+        let bad = |why: &str| Error::Experiment(format!("--set-at {time} {setting}: {why}"));
+        let time: f64 =
+            time.trim().parse().ok().filter(|t: &f64| t.is_finite()).ok_or_else(|| bad("TIME is no number"))?;
+        let (name, text) = setting.split_once('=').ok_or_else(|| bad("expected NAME=VALUE"))?;
+        let name = qualify(name.trim(), single);
+        if builder.system().resolve(&name).is_ok_and(|r| builder.system().is_structural(&r)) {
+            let value: f64 = text.trim().parse().map_err(|_| bad("a structural parameter's value is a number"))?;
+            builder.size_for(&name, value)?;
+        }
+        timed_sets.push(nigel_cosim::simulate::TimedSet { time, name, text: text.to_string() });
+    }
+    if !timed_sets.is_empty() && (args.isolate.is_some() || nigel_cosim::simulate::is_scheduled(builder.system())) {
+        return Err(Error::Experiment(
+            "--set-at is run in process by the stepping master (not with --isolate, not in Scheduled Execution)".into(),
+        )
+        .into());
+    }
     let system: System = builder.build();
     // the start time is --start-time's, else an SSD's DefaultExperiment's (SSP 1.0 gives
     // only start and stop), else 0: not an FMU's DefaultExperiment's
@@ -561,7 +587,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
                     if let Some(flag) = STOP.get().cloned() {
                         execution.cancel_on(flag);
                     }
-                    let outcome = nigel_cosim::simulate::run_to_end(&mut execution);
+                    let outcome = nigel_cosim::simulate::run_to_end_with(&mut execution, &timed_sets);
                     (execution.take_results(), outcome.map_err(Some))
                 }
                 Err(e) => (nigel_cosim::Results::default(), Err(Some(e))),

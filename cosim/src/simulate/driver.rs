@@ -47,6 +47,33 @@ pub fn simulate_with<'s>(
     Ok((execution.take_results(), summary))
 }
 
+/// A value set during a run (`cosim run --set-at TIME NAME=VALUE`): `name`
+/// (`instance.variable`) takes `text` before the first communication step that starts at or
+/// after `time` s ([`Execution::set`]; a tunable structural parameter in Reconfiguration
+/// Mode).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimedSet {
+    /// When, s.
+    pub time: f64,
+    /// `instance.variable`.
+    pub name: String,
+    /// The value, as text of the variable's type.
+    pub text: String,
+}
+
+/// [`run_to_end`] with the values `sets` set during the run, in time order.
+pub fn run_to_end_with(execution: &mut Execution, sets: &[TimedSet]) -> Result<Summary> {
+    execution.initialize()?;
+    let mut sets: Vec<&TimedSet> = sets.iter().collect();
+    sets.sort_by(|a, b| a.time.total_cmp(&b.time));
+    for s in sets {
+        execution.simulate_until(s.time)?;
+        execution.set(&s.name, &s.text)?;
+    }
+    execution.simulate_to_end()?;
+    execution.finish()
+}
+
 /// Initializes `execution`, steps it to its end and finishes it.
 pub fn run_to_end(execution: &mut Execution) -> Result<Summary> {
     execution.initialize()?;

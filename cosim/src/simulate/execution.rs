@@ -80,6 +80,9 @@ pub struct Execution<'s> {
     pool: Option<&'s mut InstancePool>,
     /// Values from [`Execution::set`] for the next step.
     pending: Vec<(VariableRef, Value)>,
+    /// Tunable structural parameters from [`Execution::reconfigure`] for the next step:
+    /// (instance, parameter, value).
+    reconfigurations: Vec<(usize, String, f64)>,
     core: Option<Core>,
     profiler: Option<Profiler>,
     /// The next communication step (`n`: the run is at `t0 + n h`).
@@ -194,6 +197,7 @@ impl<'s> Execution<'s> {
             observers: Vec::new(),
             pool: None,
             pending: Vec::new(),
+            reconfigurations: Vec::new(),
             core: None,
             profiler: None,
             next: 0,
@@ -341,7 +345,7 @@ impl<'s> Execution<'s> {
         }
         let core = self.core.insert(Core {
             lanes,
-            values: vec![0.0; self.plan.sources.len()],
+            values: vec![0.0; self.plan.exchange_len],
             group: self.group.take(),
             solver: experiment.solver,
             clock: self.clock,
@@ -372,7 +376,8 @@ impl<'s> Execution<'s> {
         self.algorithm.propagate(core)?;
         // every input at its source's value when Initialization Mode ends: chains of direct
         // feedthrough settle in one sweep per link, a loop at its fixed point
-        let sweeps = super::init_loop::iterate(core, self.init_loop.as_deref().unwrap_or_default())?;
+        let exact = self.plan.exact_slots();
+        let sweeps = super::init_loop::iterate(core, self.init_loop.as_deref().unwrap_or_default(), &exact)?;
         if let Some(cycle) = &self.init_loop {
             self.notes.push(format!(
                 "the connections {} form an algebraic loop at initialization: iterated to its fixed point in {sweeps} sweep{} of the connections (to {:e} relative)",
@@ -427,6 +432,16 @@ impl<'s> Execution<'s> {
                 self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
             let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
             ticks.after_events(&mut lane.inst, true)?;
+            // Co-Simulation: the ticks at the start time open their event as those at any
+            // later point do, so the first row, like every row at a tick, holds what the FMU
+            // answers with the clock active (Model Exchange runs every tick whole at the
+            // start of the step from it)
+            if lane.unit.is_none() {
+                if let Some(vrs) = ticks.at(t0) {
+                    lane.inst.open_clock_event(t0, &vrs)?;
+                    ticks.opened(&vrs);
+                }
+            }
             lane.ticks = Some(ticks);
             core.clocked = true;
         }
@@ -511,9 +526,13 @@ impl<'s> Execution<'s> {
 
     /// Steps `self.next..end`, telling the observers after each.
     fn advance(&mut self, end: u64) -> Result<()> {
+        let now = self.time();
         let Some(core) = self.core.as_mut() else { return Err(not_running(self.phase)) };
         let registered = crate::exit_guard::Registered::new(self.recorder.shared.clone());
         let outcome = (|| -> Result<()> {
+            for (i, name, value) in std::mem::take(&mut self.reconfigurations) {
+                reconfigure(core, i, &name, value, now)?;
+            }
             if !self.pending.is_empty() {
                 apply_values(core, std::mem::take(&mut self.pending))?;
             }
@@ -570,9 +589,31 @@ impl<'s> Execution<'s> {
 
     /// Sets an input no connection feeds, or a tunable parameter, from the next
     /// communication step on (`name`: `instance.variable`; `text`: a value of its type).
+    /// A tunable structural parameter goes through Reconfiguration Mode
+    /// ([`Execution::reconfigure`]).
     pub fn set(&mut self, name: &str, text: &str) -> Result<()> {
+        if let Ok(r) = self.system.resolve(name) {
+            if self.system.is_structural(&r) {
+                let value = text.trim().parse::<f64>().map_err(|_| {
+                    Error::Experiment(format!("{name} = {text:?}: a structural parameter's value is a number"))
+                })?;
+                return self.reconfigure(name, value);
+            }
+        }
         let (r, value) = crate::simulate::between::checked_value(&self.system, name, text)?;
         self.pending.push((r, value));
+        Ok(())
+    }
+
+    /// Sets the FMI 3.0 tunable structural parameter `name` (`instance.parameter`) to
+    /// `value` in Reconfiguration Mode before the next communication step (a Co-Simulation
+    /// instance in process; see [`crate::Instance::reconfigure`]). The arrays it sizes have
+    /// their new size from then on: the results keep the columns the system was built with
+    /// ([`crate::SystemBuilder::size_for`] sizes them for the largest), NaN in the elements an
+    /// array lacks at a row.
+    pub fn reconfigure(&mut self, name: &str, value: f64) -> Result<()> {
+        let r = self.system.resolve(name)?;
+        self.reconfigurations.push((r.instance, self.system.variable(&r).name.clone(), value));
         Ok(())
     }
 
@@ -753,6 +794,27 @@ fn not_running(phase: Phase) -> Error {
 }
 
 /// The values of [`Execution::set`], before the next step.
+/// Instance `i` sets its tunable structural parameter `name` to `value` in Reconfiguration
+/// Mode at `time`: a Co-Simulation instance between steps (from Step Mode), a Model
+/// Exchange one in an event of its group (Event Mode, the event iterated after and the
+/// integrator restarted, as for an input event).
+fn reconfigure(core: &mut Core, i: usize, name: &str, value: f64, time: f64) -> Result<()> {
+    let set = [(name, value)];
+    if let Some(group) = core.group.as_mut().filter(|g| g.contains(i)) {
+        group.input_event(core.lanes.as_mut_slice(), time, "reconfiguration", &[i], |lanes| {
+            Ok(lanes[i].inst.reconfigure(&set)?)
+        })?;
+        return group.ended(core.lanes.as_mut_slice(), time);
+    }
+    let lane = &mut core.lanes[i];
+    if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
+        let mut one = crate::simulate::me_group::Solo { inst: &mut lane.inst, unit };
+        solo.input_event(&mut one, time, "reconfiguration", &[i], |one| Ok(one.inst.reconfigure(&set)?))?;
+        return solo.ended(&mut one, time);
+    }
+    Ok(lane.inst.reconfigure(&set)?)
+}
+
 fn apply_values(core: &mut Core, values: Vec<(VariableRef, Value)>) -> Result<()> {
     for (r, value) in values {
         crate::simulate::between::set_value(&mut core.lanes[r.instance].inst, &r, value)?;

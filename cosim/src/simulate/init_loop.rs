@@ -22,8 +22,14 @@ pub(crate) const MAX_SWEEPS: usize = 100;
 /// largest change left.
 /// A value's tolerance is [`RTOL`] of the larger of its old and new magnitude, and of a
 /// millionth of the largest magnitude on the loop, so that a value converging to 0 among
-/// others of size 1e5 settles at 1e-11 rather than never.
-pub(crate) fn iterate(core: &mut Core, cycle: &[String]) -> Result<usize> {
+/// others of size 1e5 settles at 1e-11 rather than never. The slots `exact` (the integer
+/// connections' outputs and their residuals, `integers.rs`) settle only when they no longer
+/// change at all (an integer is its value or wrong) and take no part in that magnitude.
+pub(crate) fn iterate(core: &mut Core, cycle: &[String], exact: &[usize]) -> Result<usize> {
+    let mut is_exact = vec![false; core.values.len()];
+    for &s in exact {
+        is_exact[s] = true;
+    }
     let mut before = core.values.clone();
     let mut worst = 0.0f64;
     for sweep in 1..=MAX_SWEEPS {
@@ -33,12 +39,12 @@ pub(crate) fn iterate(core: &mut Core, cycle: &[String]) -> Result<usize> {
         for lane in core.lanes.iter_mut() {
             lane.set_inputs(&core.values)?;
         }
-        let scale = core.values.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = core.values.iter().zip(&is_exact).filter(|(_, e)| !**e).fold(0.0f64, |m, (x, _)| m.max(x.abs()));
         worst = 0.0;
         let mut settled = true;
-        for (new, old) in core.values.iter().zip(&before) {
+        for ((new, old), exact) in core.values.iter().zip(&before).zip(&is_exact) {
             let change = (new - old).abs();
-            let tolerance = RTOL * (new.abs().max(old.abs()) + 1e-6 * scale);
+            let tolerance = if *exact { 0.0 } else { RTOL * (new.abs().max(old.abs()) + 1e-6 * scale) };
             if change > tolerance || change.is_nan() || tolerance.is_nan() {
                 settled = false;
                 worst = if change.is_nan() { f64::NAN } else { worst.max(change) };

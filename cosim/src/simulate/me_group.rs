@@ -36,7 +36,7 @@ use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface};
 use crate::integrator::Start;
 use crate::me::{Event, MeUnit, Solver, EVENT_TIME_TOLERANCE};
-use crate::simulate::plan::{ordered_ops, Op};
+use crate::simulate::plan::{exchange_len, ordered_ops, Op};
 use crate::system::{Connection, System, VariableRef};
 
 mod members;
@@ -100,7 +100,7 @@ impl MeGroup {
             }
         }
         let ops = ordered_ops(&sub, &sources, &sources)?;
-        let n = sources.len();
+        let n = exchange_len(&sub, &sources);
         Ok(Some(MeGroup {
             members,
             ops,
@@ -127,7 +127,8 @@ impl MeGroup {
         }
         let mut any = false;
         for op in &self.ops {
-            if op.is_set() && op.slots().iter().any(|s| self.values[*s].to_bits() != self.before[*s].to_bits()) {
+            let read = op.slots().iter().copied().chain(op.residual_slots());
+            if op.is_set() && read.into_iter().any(|s| self.values[s].to_bits() != self.before[s].to_bits()) {
                 any = true;
                 if !changed.contains(&op.instance) {
                     changed.push(op.instance);
@@ -295,6 +296,7 @@ impl MeGroup {
         t: f64,
         t_end: f64,
     ) -> Result<()> {
+        self.pending_inputs(lanes, t)?;
         let mut g = match self.integrator.take() {
             Some(g) => g,
             None => Box::new(GroupIntegrator::new(lanes, &self.members, solver)),
@@ -303,6 +305,23 @@ impl MeGroup {
         g.report(lanes, &self.members, solver);
         self.integrator = Some(g);
         outcome
+    }
+
+    /// The discrete inputs that connections set since the last step (the importing layer
+    /// holds them back in Continuous-Time Mode: only continuous inputs may change there)
+    /// set in an input event at `t`, the members iterating together, as an input file's.
+    fn pending_inputs<L: Members + ?Sized>(&mut self, lanes: &mut L, t: f64) -> Result<()> {
+        let who: Vec<usize> =
+            self.members.iter().copied().filter(|m| lanes.instance(*m).has_pending_inputs()).collect();
+        if who.is_empty() {
+            return Ok(());
+        }
+        self.input_event(lanes, t, "input", &who, |lanes| {
+            for &m in &who {
+                lanes.instance(m).apply_pending_inputs()?;
+            }
+            Ok(())
+        })
     }
 
     /// The event loop of [`MeGroup::advance`].

@@ -8,6 +8,7 @@
 //! The modules, each using only those above it:
 //! - `types`: the public types ([`Experiment`], [`Algorithm`], [`Results`], [`Summary`]);
 //! - `clock`: the time base, communication point `n` at `t0 + n h`;
+//! - `integers`: connections between integers carried exactly (64-bit ones too);
 //! - `plan`: the value slots and the batched fmi2Get/fmi2Set calls;
 //! - `ticks`: the ticks of an instance's FMI 3.0 input clocks and every clock's count;
 //! - `me_group`: the Model Exchange integrator of a group of ME instances (a group of
@@ -29,6 +30,7 @@ mod driver;
 mod execution;
 mod init_loop;
 mod input;
+mod integers;
 mod lane;
 mod me_group;
 mod observer;
@@ -39,7 +41,7 @@ mod types;
 
 pub use between::{Manipulator, SetQueue, StepInstances};
 pub use clock::Point;
-pub use driver::{run_to_end, simulate, simulate_recorded, simulate_with};
+pub use driver::{run_to_end, run_to_end_with, simulate, simulate_recorded, simulate_with, TimedSet};
 pub use execution::{Execution, InstancePool, Phase, RowSink};
 pub use input::InputTable;
 pub use lane::apply_start_values;

@@ -6,8 +6,9 @@
 
 use crate::error::{Error, Result};
 use crate::fmu::Instance;
+use crate::simulate::integers::{self, Link};
 use crate::simulate::types::Algorithm;
-use crate::system::{BaseType, System, VariableRef};
+use crate::system::{BaseType, Connection, System, VariableRef};
 use model_description::Causality;
 use std::collections::{HashMap, HashSet};
 
@@ -17,12 +18,36 @@ pub(crate) enum OpKind {
     Set,
 }
 
-/// One batched fmi2Get/fmi2Set call of one instance and one base type.
+/// What an op carries: values of one base type of the view through their f64 slots, or
+/// integers exactly (see `integers.rs`). One flat enum, so that an op's call is one match.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Carried {
+    Real,
+    Integer,
+    Boolean,
+    String,
+    ExactInteger,
+}
+
+impl Carried {
+    /// Values of `base_type` through their f64 slots.
+    fn view(base_type: BaseType) -> Carried {
+        match base_type {
+            BaseType::Real => Carried::Real,
+            BaseType::Integer => Carried::Integer,
+            BaseType::Boolean => Carried::Boolean,
+            BaseType::String => Carried::String,
+        }
+    }
+}
+
+/// One batched fmi2Get/fmi2Set call of one instance and one base type (or, carrying
+/// integers exactly, one call per variable).
 #[derive(Debug)]
 pub(crate) struct Op {
     pub(crate) instance: usize,
     pub(crate) kind: OpKind,
-    base_type: BaseType,
+    carried: Carried,
     vrs: Vec<u32>,
     /// Get: slot each value goes to. Set: (slot, gain, offset) each value comes from.
     slots: Vec<usize>,
@@ -32,51 +57,50 @@ pub(crate) struct Op {
     /// A get of Reals whose slots are consecutive, from this one: fetched straight into
     /// the value buffer, with no copy through the op's own.
     direct: Option<usize>,
-    /// Get: the FMI 3.0 Int64 / UInt64 outputs among `vrs` that feed connections (index
-    /// into `vrs`, `instance.variable`), whose values the connections carry as f64: checked
-    /// at every get (empty for every other op).
-    wide_sources: Vec<(usize, String)>,
+    /// [`Carried::ExactInteger`]: the link of each variable and the integers read or to set.
+    links: Vec<Link>,
+    integers: Vec<i128>,
 }
 
 impl Op {
-    fn new(instance: usize, kind: OpKind, base_type: BaseType) -> Op {
+    fn new(instance: usize, kind: OpKind, carried: Carried) -> Op {
         Op {
             instance,
             kind,
-            base_type,
+            carried,
             vrs: vec![],
             slots: vec![],
             gains: vec![],
             reals: vec![],
             ints: vec![],
             direct: None,
-            wide_sources: vec![],
+            links: vec![],
+            integers: vec![],
         }
     }
-    fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64)) {
-        self.direct = match (self.kind, self.base_type, self.slots.first()) {
-            (OpKind::Get, BaseType::Real, None) => Some(slot),
+    fn push(&mut self, vr: u32, slot: usize, gain: (f64, f64), link: Option<Link>) {
+        self.direct = match (self.kind, self.carried, self.slots.first()) {
+            (OpKind::Get, Carried::Real, None) => Some(slot),
             (_, _, Some(&first)) if self.direct == Some(first) && slot == first + self.slots.len() => Some(first),
             _ => None,
         };
         self.vrs.push(vr);
         self.slots.push(slot);
         self.gains.push(gain);
-        self.reals.push(0.0);
-        self.ints.push(0);
+        if let Some(link) = link {
+            self.links.push(link);
+            self.integers.push(0);
+        } else {
+            self.reals.push(0.0);
+            self.ints.push(0);
+        }
     }
 
     #[inline]
     pub(crate) fn run(&mut self, inst: &mut Instance, values: &mut [f64]) -> Result<()> {
         match self.kind {
             OpKind::Get => match self.direct {
-                Some(first) => {
-                    let got = &mut values[first..first + self.vrs.len()];
-                    inst.get_real(&self.vrs, got)?;
-                    if !self.wide_sources.is_empty() {
-                        check_wide(&self.wide_sources, &self.vrs, got, inst)?;
-                    }
-                }
+                Some(first) => inst.get_real(&self.vrs, &mut values[first..first + self.vrs.len()])?,
                 None => {
                     self.fetch(inst)?;
                     self.scatter(values);
@@ -100,19 +124,21 @@ impl Op {
         &self.slots
     }
 
+    /// The residual slots the op reads (set) or writes (get) beside [`Op::slots`], when it
+    /// carries integers exactly (see `integers.rs`).
+    pub(crate) fn residual_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        self.links.iter().map(Link::residual)
+    }
+
     /// Get: the fmi2Get call into the op's own buffer.
     #[inline]
     pub(crate) fn fetch(&mut self, inst: &mut Instance) -> Result<()> {
-        match self.base_type {
-            BaseType::Real => {
-                inst.get_real(&self.vrs, &mut self.reals)?;
-                if !self.wide_sources.is_empty() {
-                    check_wide(&self.wide_sources, &self.vrs, &self.reals, inst)?;
-                }
-            }
-            BaseType::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
-            BaseType::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
-            BaseType::String => {}
+        match self.carried {
+            Carried::Real => inst.get_real(&self.vrs, &mut self.reals)?,
+            Carried::Integer => inst.get_integer(&self.vrs, &mut self.ints)?,
+            Carried::Boolean => inst.get_boolean(&self.vrs, &mut self.ints)?,
+            Carried::String => {}
+            Carried::ExactInteger => self.fetch_integers(inst)?,
         }
         Ok(())
     }
@@ -120,126 +146,158 @@ impl Op {
     /// Get: the fetched values into their slots.
     #[inline]
     pub(crate) fn scatter(&self, values: &mut [f64]) {
-        match self.base_type {
-            BaseType::Real => {
+        match self.carried {
+            Carried::Real => {
                 for (s, v) in self.slots.iter().zip(&self.reals) {
                     values[*s] = *v;
                 }
             }
-            BaseType::Integer => {
+            Carried::Integer => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = f64::from(*v);
                 }
             }
-            BaseType::Boolean => {
+            Carried::Boolean => {
                 for (s, v) in self.slots.iter().zip(&self.ints) {
                     values[*s] = if *v != 0 { 1.0 } else { 0.0 };
                 }
             }
-            BaseType::String => {}
+            Carried::String => {}
+            Carried::ExactInteger => self.scatter_integers(values),
         }
     }
 
     /// Set: the source slots, transformed, into the op's buffer.
     #[inline]
     pub(crate) fn gather(&mut self, values: &[f64]) {
-        match self.base_type {
-            BaseType::Real => {
+        match self.carried {
+            Carried::Real => {
                 for ((r, s), (g, o)) in self.reals.iter_mut().zip(&self.slots).zip(&self.gains) {
                     *r = g * values[*s] + o;
                 }
             }
-            BaseType::Integer => {
+            Carried::Integer => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = values[*s] as i32;
                 }
             }
-            BaseType::Boolean => {
+            Carried::Boolean => {
                 for (r, s) in self.ints.iter_mut().zip(&self.slots) {
                     *r = (values[*s] != 0.0) as i32;
                 }
             }
-            BaseType::String => {}
+            Carried::String => {}
+            Carried::ExactInteger => self.gather_integers(values),
         }
     }
 
     /// Set: the fmi2Set call from the op's buffer.
     #[inline]
     pub(crate) fn apply(&mut self, inst: &mut Instance) -> Result<()> {
-        match self.base_type {
-            BaseType::Real => inst.set_real(&self.vrs, &self.reals)?,
-            BaseType::Integer => inst.set_integer(&self.vrs, &self.ints)?,
-            BaseType::Boolean => inst.set_boolean(&self.vrs, &self.ints)?,
-            BaseType::String => {}
+        match self.carried {
+            Carried::Real => inst.set_real(&self.vrs, &self.reals)?,
+            Carried::Integer => inst.set_integer(&self.vrs, &self.ints)?,
+            Carried::Boolean => inst.set_boolean(&self.vrs, &self.ints)?,
+            Carried::String => {}
+            Carried::ExactInteger => self.apply_integers(inst)?,
+        }
+        Ok(())
+    }
+
+    // The integer ops' calls, out of line: the calls of the other types (every step of
+    // every run) keep the few registers and instructions they had.
+
+    #[inline(never)]
+    fn fetch_integers(&mut self, inst: &mut Instance) -> Result<()> {
+        for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&mut self.integers) {
+            if let Link::Source { read, .. } = link {
+                *value = integers::read(inst, *vr, *read)?;
+            }
+        }
+        Ok(())
+    }
+
+    #[inline(never)]
+    fn scatter_integers(&self, values: &mut [f64]) {
+        for ((s, link), v) in self.slots.iter().zip(&self.links).zip(&self.integers) {
+            (values[*s], values[link.residual()]) = integers::split(*v);
+        }
+    }
+
+    #[inline(never)]
+    fn gather_integers(&mut self, values: &[f64]) {
+        for ((r, s), link) in self.integers.iter_mut().zip(&self.slots).zip(&self.links) {
+            *r = integers::join(values[*s], values[link.residual()]);
+        }
+    }
+
+    #[inline(never)]
+    fn apply_integers(&mut self, inst: &mut Instance) -> Result<()> {
+        for ((vr, link), value) in self.vrs.iter().zip(&self.links).zip(&self.integers) {
+            if let Link::Sink { sink, .. } = link {
+                integers::write(inst, *vr, *value, sink)?;
+            }
         }
         Ok(())
     }
 }
 
-/// The connections carry values as f64: a 64-bit integer output beyond 2^53 that no f64
-/// holds would arrive rounded at the inputs it feeds. Such a value is an error naming the
-/// variable and the master's limit (a value an f64 holds, as -2^63, is carried exactly).
-#[cold]
-fn check_wide(wide: &[(usize, String)], vrs: &[u32], got: &[f64], inst: &mut Instance) -> Result<()> {
-    const EXACT: f64 = 9007199254740992.0; // 2^53
-    for (k, name) in wide {
-        if got[*k].abs() <= EXACT {
-            continue;
-        }
-        if let fmi_import::fmi3::Exact::Integer(exact) = inst.get_exact(vrs[*k])? {
-            if got[*k] as i128 != exact {
-                return Err(Error::Experiment(format!(
-                    "{name} = {exact} at t = {} s: the master carries connections as f64 (64-bit integers exactly up to 2^53), which would round it to {}; record it instead (recorded 64-bit integers are exact), or keep the connected values within 2^53",
-                    inst.time(),
-                    got[*k] as i128
-                )));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Marks in the gets of `ops` the 64-bit integer outputs of `system` that feed connections
-/// ([`Op::wide_sources`]).
-pub(crate) fn mark_wide_sources(ops: &mut [Op], system: &System) {
-    for op in ops.iter_mut().filter(|op| op.kind == OpKind::Get && op.base_type == BaseType::Real) {
-        let fmu = &system.instances[op.instance].fmu;
-        op.wide_sources = op
-            .vrs
-            .iter()
-            .enumerate()
-            .filter(|(_, vr)| fmu.exact_kind(**vr).is_some_and(|k| k != fmi_import::fmi3::ExactKind::Binary))
-            .filter_map(|(k, vr)| {
-                let c = system
-                    .connections
-                    .iter()
-                    .find(|c| c.from.instance == op.instance && c.from.value_reference == *vr)?;
-                Some((k, system.name_of(&c.from)))
-            })
-            .collect();
-    }
-}
-
 /// Appends `node` to the op list, merging into the last op when it is the same call (the
 /// callers emit each get once: connected outputs and recorded variables without repeats).
-fn emit(ops: &mut Vec<Op>, instance: usize, kind: OpKind, ty: BaseType, vr: u32, slot: usize, gain: (f64, f64)) {
+#[allow(clippy::too_many_arguments)]
+fn emit(
+    ops: &mut Vec<Op>,
+    instance: usize,
+    kind: OpKind,
+    carried: Carried,
+    vr: u32,
+    slot: usize,
+    gain: (f64, f64),
+    link: Option<Link>,
+) {
     match ops.last_mut() {
-        Some(op) if op.instance == instance && op.kind == kind && op.base_type == ty => op.push(vr, slot, gain),
+        Some(op) if op.instance == instance && op.kind == kind && op.carried == carried => {
+            op.push(vr, slot, gain, link)
+        }
         _ => {
-            let mut op = Op::new(instance, kind, ty);
-            op.push(vr, slot, gain);
+            let mut op = Op::new(instance, kind, carried);
+            op.push(vr, slot, gain, link);
             ops.push(op);
         }
     }
+}
+
+/// What a get of `r` carries, and its link when an integer (`links`: the integer
+/// connections' outputs, see [`source_links`]).
+fn get_carried(links: &HashMap<VariableRef, Link>, r: &VariableRef) -> (Carried, Option<Link>) {
+    match links.get(r) {
+        Some(link) => (Carried::ExactInteger, Some(link.clone())),
+        None => (Carried::view(r.base_type), None),
+    }
+}
+
+/// What the set of `c`'s input carries, and its link when an integer.
+fn set_carried(system: &System, residuals: &HashMap<VariableRef, usize>, c: &Connection) -> (Carried, Option<Link>) {
+    match integers::sink_link(system, residuals, c) {
+        Some(link) => (Carried::ExactInteger, Some(link)),
+        None => (Carried::view(c.to.base_type), None),
+    }
+}
+
+/// The link of every integer connection's output among `sources` (its residual slot after
+/// the slots of `sources`).
+fn source_links(system: &System, sources: &[VariableRef]) -> (HashMap<VariableRef, usize>, HashMap<VariableRef, Link>) {
+    let residuals = integers::residual_slots(system, sources);
+    let links =
+        residuals.keys().filter_map(|r| Some((r.clone(), integers::source_link(system, &residuals, r)?))).collect();
+    (residuals, links)
 }
 
 /// The communication plan of a system: slots for every connected output and recorded
 /// variable, and the batched calls.
 #[derive(Debug)]
 pub(crate) struct Plan {
-    /// The variable behind each slot of the value buffer.
-    pub(crate) sources: Vec<VariableRef>,
-    /// The slot of each variable of `sources`.
+    /// The slot of each connected output and recorded variable in the value buffer.
     slots: HashMap<VariableRef, usize>,
     /// `ordered`: the batched calls in topological order (None: the graph has a loop).
     pub(crate) ordered: Option<Vec<Op>>,
@@ -250,6 +308,11 @@ pub(crate) struct Plan {
     pub(crate) jacobi_gets_rec: Vec<Vec<Op>>,
     /// `jacobi`, per instance: one set per type of its connected inputs.
     pub(crate) jacobi_sets: Vec<Vec<Op>>,
+    /// The outputs of integer connections, each with its residual slot after the slots
+    /// of `sources` (see `integers.rs`).
+    links: HashMap<VariableRef, Link>,
+    /// The length of the value buffer: the slots of `sources` and the residual slots.
+    pub(crate) exchange_len: usize,
 }
 
 /// The slot of `r` in `sources` (`slots`: the slot of each), added if new.
@@ -414,22 +477,25 @@ impl Plan {
             sources = order.into_iter().map(|k| sources[k].clone()).collect();
         }
         let slots = slots_of(&sources);
+        let (residuals, links) = source_links(system, &sources);
         // jacobi: per instance and type one get of its connected outputs (and one with the
         // recorded variables too, for output points), then one set of its connected inputs
         let n = system.instances.len();
         let (mut jacobi_gets, mut jacobi_gets_rec, mut jacobi_sets) =
             (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        let carried_types = [Carried::Real, Carried::Integer, Carried::Boolean, Carried::ExactInteger];
         for i in 0..n {
             let (mut gets, mut gets_rec, mut sets) = (Vec::new(), Vec::new(), Vec::new());
-            for ty in [BaseType::Real, BaseType::Integer, BaseType::Boolean] {
-                let mut get = Op::new(i, OpKind::Get, ty);
-                let mut get_rec = Op::new(i, OpKind::Get, ty);
-                for (k, s) in sources.iter().enumerate() {
-                    if s.instance == i && s.base_type == ty {
+            for carried in carried_types {
+                let mut get = Op::new(i, OpKind::Get, carried);
+                let mut get_rec = Op::new(i, OpKind::Get, carried);
+                for (k, s) in sources.iter().enumerate().filter(|(_, s)| s.instance == i) {
+                    let (c, link) = get_carried(&links, s);
+                    if c == carried {
                         if connected.contains(s) {
-                            get.push(s.value_reference, k, (1.0, 0.0));
+                            get.push(s.value_reference, k, (1.0, 0.0), link.clone());
                         }
-                        get_rec.push(s.value_reference, k, (1.0, 0.0));
+                        get_rec.push(s.value_reference, k, (1.0, 0.0), link);
                     }
                 }
                 if !get.vrs.is_empty() {
@@ -438,10 +504,13 @@ impl Plan {
                 if !get_rec.vrs.is_empty() {
                     gets_rec.push(get_rec);
                 }
-                let mut set = Op::new(i, OpKind::Set, ty);
-                for c in system.connections.iter().filter(|c| c.to.instance == i && c.to.base_type == ty) {
-                    let slot = slots.get(&c.from).copied().unwrap_or(0);
-                    set.push(c.to.value_reference, slot, (c.gain, c.offset));
+                let mut set = Op::new(i, OpKind::Set, carried);
+                for c in system.connections.iter().filter(|c| c.to.instance == i) {
+                    let (carries, link) = set_carried(system, &residuals, c);
+                    if carries == carried {
+                        let slot = slots.get(&c.from).copied().unwrap_or(0);
+                        set.push(c.to.value_reference, slot, (c.gain, c.offset), link);
+                    }
                 }
                 if !set.vrs.is_empty() {
                     sets.push(set);
@@ -456,10 +525,14 @@ impl Plan {
             Err(e) if algorithm == Algorithm::Ordered => return Err(e),
             Err(_) => None,
         };
-        for gets in jacobi_gets.iter_mut().chain(jacobi_gets_rec.iter_mut()) {
-            mark_wide_sources(gets, system);
-        }
-        Ok(Plan { sources, slots, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets })
+        let exchange_len = sources.len() + residuals.len();
+        Ok(Plan { slots, ordered, jacobi_gets, jacobi_gets_rec, jacobi_sets, links, exchange_len })
+    }
+
+    /// The slots of the integer connections' outputs and their residual slots: the values
+    /// that are integers, exact or wrong (see `integers.rs`).
+    pub(crate) fn exact_slots(&self) -> Vec<usize> {
+        self.links.iter().flat_map(|(r, link)| [self.slot(r), link.residual()]).collect()
     }
 
     /// The slot of a planned variable.
@@ -472,10 +545,11 @@ impl Plan {
     pub(crate) fn record_gets(&self, record: &[VariableRef]) -> Vec<Op> {
         let mut seen = HashSet::with_capacity(record.len());
         let mut sorted: Vec<&VariableRef> = record.iter().filter(|r| seen.insert(*r)).collect();
-        sorted.sort_by_key(|r| (r.instance, r.base_type));
+        sorted.sort_by_key(|r| (r.instance, r.base_type, self.links.contains_key(r)));
         let mut ops: Vec<Op> = Vec::new();
         for r in sorted {
-            emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, self.slot(r), (1.0, 0.0));
+            let (carried, link) = get_carried(&self.links, r);
+            emit(&mut ops, r.instance, OpKind::Get, carried, r.value_reference, self.slot(r), (1.0, 0.0), link);
         }
         ops
     }
@@ -537,20 +611,28 @@ pub(crate) fn ordered_ops(
 ) -> Result<Vec<Op>> {
     let nodes = ordered_nodes(system, connected_outputs)?;
     let slots = slots_of(sources);
+    let (residuals, links) = source_links(system, sources);
     let mut ops = Vec::new();
     for (is_output, k) in nodes {
         if is_output {
             let r = &connected_outputs[k];
             let slot = slots.get(r).copied().unwrap_or(0);
-            emit(&mut ops, r.instance, OpKind::Get, r.base_type, r.value_reference, slot, (1.0, 0.0));
+            let (carried, link) = get_carried(&links, r);
+            emit(&mut ops, r.instance, OpKind::Get, carried, r.value_reference, slot, (1.0, 0.0), link);
         } else {
             let c = &system.connections[k];
             let slot = slots.get(&c.from).copied().unwrap_or(0);
-            emit(&mut ops, c.to.instance, OpKind::Set, c.to.base_type, c.to.value_reference, slot, (c.gain, c.offset));
+            let (carried, link) = set_carried(system, &residuals, c);
+            emit(&mut ops, c.to.instance, OpKind::Set, carried, c.to.value_reference, slot, (c.gain, c.offset), link);
         }
     }
-    mark_wide_sources(&mut ops, system);
     Ok(ops)
+}
+
+/// The length of the value buffer of `ordered_ops(system, sources, ..)`: the slots of
+/// `sources` and the residual slots of the integer connections' outputs among them.
+pub(crate) fn exchange_len(system: &System, sources: &[VariableRef]) -> usize {
+    sources.len() + integers::residual_slots(system, sources).len()
 }
 
 /// The variables recorded by default: every output of every instance.

@@ -21,9 +21,7 @@ static void defaults(Ball *b) {
     b->r[5] = 0.7;  /* e */
 }
 
-FMI2_TEST_INSTANCE(Ball, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Ball)
+FMI2_TEST_MODEL_EXCHANGE(Ball)
 
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Ball *b = c;
@@ -36,15 +34,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Ball *b = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] >= 8) return ERR;
-        b->r[vr[i]] = v[i];
-    }
-    return 0;
-}
+FMI2_TEST_SET_REALS(Ball, 8)
 
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Ball *b = c;
@@ -89,8 +79,4 @@ EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) 
     for (i = 0; i < n; i++) z[i] = ((Ball *)c)->r[0];
     return 0;
 }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) x[i] = 1.0;
-    return 0;
-}
+FMI2_TEST_UNIT_NOMINALS

@@ -10,8 +10,9 @@
  *                                and the Co-Simulation input/output derivatives refused.
  * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
  * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
- * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type), FMI2_TEST_TWO_STATES(Type),
- * FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
+ * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type) (the three at once:
+ * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count),
+ * FMI2_TEST_UNIT_NOMINALS, FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
 #define FMI2_TEST_H
@@ -85,6 +86,11 @@ EXPORT fmi2Status fmi2GetContinuousStates(fmi2Component c, double x[], size_t n)
 EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) { return ERR; }
 #endif
 
+/* The importer's memory callbacks as FMI2_TEST_INSTANCE received them (for a model that
+ * allocates through them). */
+static void *(*fmi2_test_allocate)(size_t, size_t);
+static void (*fmi2_test_free)(void *);
+
 /* The instance of a test model: a `Type` (a struct with a member `double time`) made by
  * calloc and set up by the file's `static void defaults(Type *)`, accepted where `accepted`
  * holds for the fmi2Type `type` (0 Model Exchange, 1 Co-Simulation). fmi2SetupExperiment
@@ -95,6 +101,8 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
                                          const fmi2CallbackFunctions *cb, int visible, int logging) {   \
         Type *m;                                                                                        \
         if (!cb || !cb->logger || !(accepted)) return NULL;                                             \
+        fmi2_test_allocate = cb->allocateMemory;                                                        \
+        fmi2_test_free = cb->freeMemory;                                                                \
         m = calloc(1, sizeof *m);                                                                       \
         defaults(m);                                                                                    \
         return m;                                                                                       \
@@ -178,9 +186,34 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
         return 0;                                                                                        \
     }                                                                                                    \
     EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) { return n ? ERR : 0; } \
+    FMI2_TEST_UNIT_NOMINALS
+
+/* Every continuous state has nominal 1. */
+#define FMI2_TEST_UNIT_NOMINALS                                                                         \
     EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {         \
         size_t i;                                                                                        \
         for (i = 0; i < n; i++) x[i] = 1.0;                                                              \
+        return 0;                                                                                        \
+    }
+
+/* A Model Exchange only model (FMI2_TEST_INSTANCE accepting fmi2ModelExchange) with
+ * FMI2_TEST_EXIT_INITIALIZATION and FMI2_TEST_CONTINUOUS_TIME. */
+#define FMI2_TEST_MODEL_EXCHANGE(Type) \
+    FMI2_TEST_INSTANCE(Type, type == 0) \
+    FMI2_TEST_EXIT_INITIALIZATION      \
+    FMI2_TEST_CONTINUOUS_TIME(Type)
+
+/* fmi2SetReal of a `Type` whose `double r[]` holds its Real variables by value reference:
+ * any of the first `count` may be set, a value reference beyond them is refused. */
+#define FMI2_TEST_SET_REALS(Type, count)                                                                 \
+    EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,              \
+                                  const double v[]) {                                                    \
+        Type *m = c;                                                                                     \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] >= (count)) return ERR;                                                            \
+            m->r[vr[i]] = v[i];                                                                          \
+        }                                                                                                \
         return 0;                                                                                        \
     }
 

@@ -1,8 +1,11 @@
-/* An FMI 3.0 Co-Simulation test FMU (Event Mode only) whose clocked variables may be
- * accessed only while their clock is active, as FMI 3.0 says: in Initialization Mode; set
- * in Event Mode between fmi3SetClock of `tick` and fmi3UpdateDiscreteStates, read in the
- * Event Mode in which `tick` ticked; any other get or set of them is an error naming the
- * variable. Value references as in
+/* An FMI 3.0 test FMU (Co-Simulation with Event Mode only, Model Exchange, Scheduled
+ * Execution) whose clocked variables may be accessed only while their clock is active, as
+ * FMI 3.0 says: in Initialization Mode; set in Event Mode between fmi3SetClock of `tick` and
+ * fmi3UpdateDiscreteStates, read in the Event Mode in which `tick` ticked (Co-Simulation and
+ * Model Exchange: no states, no event indicators); in Scheduled Execution set once before
+ * each fmi3ActivateModelPartition of `tick` (a second set before it is refused) and read
+ * right after it (before the next set). Any other get or set of them is an error naming
+ * the variable. Value references as in
  * fmi3_clocked_exchange.xml:
  *   1 tick   input clock, constant: interval 0.25 s, shift 0
  *   2 u      Float64 input clocked by tick (start 0)
@@ -10,40 +13,30 @@
  *            y = 10 u + k, u as set in that activation (recomputed by a set of u in it)
  *   4 t_now  Float64 output, not clocked: the time
  * fmi3DoStep advances the time and never asks for an event. */
-#include <stdlib.h>
-#include <string.h>
-#include "fmi3Functions.h"
+#include "fmi3_test.h"
 
 typedef struct {
     double time, u, y;
-    int ticks, initializing, in_event_mode, active, ticked;
+    int ticks, initializing, in_event_mode, active, ticked, scheduled, u_set;
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
 } Exchange;
 
-static fmi3Status fail(Exchange *c, const char *message) {
-    if (c && c->log) c->log(c->env, fmi3Error, "logStatusError", message);
-    return fmi3Error;
-}
+FMI3_TEST_FAIL(Exchange)
 
 static void start(Exchange *c) {
     c->time = 0;
     c->u = 0;
     c->y = -1;
     c->ticks = 0;
-    c->initializing = c->in_event_mode = c->active = c->ticked = 0;
+    c->initializing = c->in_event_mode = c->active = c->ticked = c->u_set = 0;
 }
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
+FMI3_TEST_EVENT_MODE_INSTANCE(Exchange, "{fmi3-clocked-exchange}", start)
 
-fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
-    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
-    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
-    if (!token || strcmp(token, "{fmi3-clocked-exchange}") != 0 || !eventMode) {
-        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed");
-        return NULL;
-    }
+fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    if (!token || strcmp(token, "{fmi3-clocked-exchange}") != 0) return NULL;
     Exchange *c = calloc(1, sizeof(Exchange));
     if (!c) return NULL;
     c->env = env;
@@ -52,8 +45,13 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     return c;
 }
 
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
+    fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
+    Exchange *c = fmi3InstantiateModelExchange(name, token, resources, visible, logging, env, log);
+    if (c) c->scheduled = 1;
+    return c;
+}
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
     fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
@@ -66,7 +64,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     Exchange *c = instance;
     c->initializing = 0;
-    c->in_event_mode = 1;
+    c->in_event_mode = !c->scheduled;
     return fmi3OK;
 }
 fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
@@ -80,6 +78,44 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     c->ticked = 0;
     return fmi3OK;
 }
+/* Model Exchange: no states, no event indicators; the time the importer sets */
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3EnterStepMode(instance); }
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
+    ((Exchange *)instance)->time = time;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
+    *n = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
+    *n = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
+    fmi3Boolean *terminateSimulation) {
+    *enterEventMode = 0;
+    *terminateSimulation = 0;
+    return fmi3OK;
+}
+
+/* Scheduled Execution: the activation of tick at `time` (u as set before it) */
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
+    Exchange *c = instance;
+    if (clock != 1) return fail(c, "fmi3ActivateModelPartition: not an input clock");
+    c->time = time;
+    c->ticks++;
+    c->y = 10 * c->u + c->ticks;
+    c->ticked = 1;
+    c->u_set = 0;
+    return fmi3OK;
+}
+
 fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 fmi3Status fmi3Reset(fmi3Instance instance) {
     start(instance);
@@ -142,11 +178,17 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     return fmi3OK;
 }
 
-/* whether a clocked variable may be set now: while tick is active */
-static int clocked_open(Exchange *c) { return c->initializing || (c->in_event_mode && c->active); }
+/* whether a clocked variable may be set now: while tick is active (Scheduled Execution:
+ * once before its activation) */
+static int clocked_open(Exchange *c) {
+    return c->initializing || (c->scheduled ? !c->u_set : c->in_event_mode && c->active);
+}
 /* whether it may be read now: in the Event Mode in which tick ticked (the values its
- * activation left, also after fmi3UpdateDiscreteStates) */
-static int clocked_readable(Exchange *c) { return c->initializing || (c->in_event_mode && c->ticked); }
+ * activation left, also after fmi3UpdateDiscreteStates; Scheduled Execution: right after
+ * the activation) */
+static int clocked_readable(Exchange *c) {
+    return c->initializing || ((c->scheduled || c->in_event_mode) && c->ticked);
+}
 
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Float64 values[], size_t nValues) {
@@ -175,6 +217,10 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         if (vr[k] != 2) return fail(c, "fmi3SetFloat64: not an input");
         if (!clocked_open(c)) return fail(c, "fmi3SetFloat64: u is a clocked variable of tick, which is not active");
         c->u = values[k];
+        if (c->scheduled && !c->initializing) {
+            c->u_set = 1;
+            c->ticked = 0;
+        }
         if (c->active) c->y = 10 * c->u + c->ticks;
     }
     return fmi3OK;

@@ -26,34 +26,13 @@ typedef struct {
 
 FMI3_TEST_FAIL(Clocks)
 
-fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed,
-    const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,
-    fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {
-    if (!token || strcmp(token, "{fmi3-clocks}") != 0 || !eventMode) {
-        if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed");
-        return NULL;
-    }
-    Clocks *c = calloc(1, sizeof(Clocks));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
+static void start(Clocks *c) {
     c->fixed_interval = 0.4;
     c->last_tick = -1;
-    return c;
 }
 
-fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
-    return NULL;
-}
-
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String a, fmi3String b, fmi3String c, fmi3Boolean d,
-    fmi3Boolean e, fmi3InstanceEnvironment f, fmi3LogMessageCallback g, fmi3ClockUpdateCallback h,
-    fmi3LockPreemptionCallback i, fmi3UnlockPreemptionCallback j) { return NULL; }
-
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
+/* no Model Exchange or Scheduled Execution instance: fmi3_rest.c's NULL */
+FMI3_TEST_EVENT_MODE_INSTANCE(Clocks, "{fmi3-clocks}", start)
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
     fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {

@@ -8,15 +8,17 @@
  *   2 k  Float64[n] parameter (start 1 for every element)
  *   3 u  Float64 input (start 1)
  *   4 y  Float64[n] output: y[i] = k[i] u t after each step (0 before the first)
- * The arrays are sized when the FMU leaves Configuration Mode; every get and set of k and y
- * must pass exactly n values (fmi3Error otherwise), so a master that gets the size wrong
- * fails. The functions a Co-Simulation run calls exist; the others are absent. */
+ * The arrays are sized when the FMU leaves Configuration Mode (before initialization, or in
+ * Reconfiguration Mode from Step Mode or Event Mode: k all 1 and y all 0 again); every get
+ * and set of k and y must pass exactly n values (fmi3Error otherwise), so a master that gets
+ * the size wrong fails. Model Exchange: no states, y = k u t at the time set (fmi3SetTime).
+ * The functions a Co-Simulation or Model Exchange run calls exist; the others are absent. */
 #include "fmi3_test.h"
 
 typedef struct {
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
-    int configuring;
+    int configuring, model_exchange;
     unsigned long long n;
     double time, u, *k, *y;
 } Sized;
@@ -47,6 +49,52 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     s->u = 1.0;
     if (!size_arrays(s)) return NULL;
     return s;
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    Sized *s = fmi3InstantiateCoSimulation(name, token, resources, visible, logging, 0, 0, NULL, 0, env, log, NULL);
+    if (s) s->model_exchange = 1;
+    return s;
+}
+
+/* Model Exchange: y follows the time set */
+static void compute_me(Sized *s) {
+    if (s->model_exchange)
+        for (unsigned long long i = 0; i < s->n; i++) s->y[i] = s->k[i] * s->u * s->time;
+}
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
+    ((Sized *)instance)->time = time;
+    compute_me(instance);
+    return fmi3OK;
+}
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) { return fmi3OK; }
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
+    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
+    compute_me(instance);
+    *needUpdate = *terminate = *nominalsChanged = *valuesChanged = *nextDefined = 0;
+    *next = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
+    *n = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
+    *n = 0;
+    return fmi3OK;
+}
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
+    fmi3Boolean *terminateSimulation) {
+    *enterEventMode = 0;
+    *terminateSimulation = 0;
+    return fmi3OK;
 }
 
 void fmi3FreeInstance(fmi3Instance instance) {
@@ -114,6 +162,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
             for (unsigned long long e = 0; e < s->n; e++) s->k[e] = values[j++];
         } else if (vr[i] == 3 && j < nValues) {
             s->u = values[j++];
+            compute_me(s);
         } else {
             return fail(s, "fmi3SetFloat64: not a settable value reference");
         }

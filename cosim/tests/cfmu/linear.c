@@ -18,9 +18,7 @@ static void defaults(Linear *m) {
     m->r[4] = 1e4;
 }
 
-FMI2_TEST_INSTANCE(Linear, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Linear)
+FMI2_TEST_MODEL_EXCHANGE(Linear)
 
 static void derivatives(Linear *m) {
     m->r[1] = -m->r[4] * m->r[0] + m->r[2];

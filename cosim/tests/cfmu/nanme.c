@@ -18,9 +18,7 @@ static void defaults(Decay *d) {
     d->r[2] = 0.5; /* t_bad */
 }
 
-FMI2_TEST_INSTANCE(Decay, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Decay)
+FMI2_TEST_MODEL_EXCHANGE(Decay)
 
 static double derivative(const Decay *d) {
     if (d->time >= d->r[2] && d->r[3] == 1.0) return NAN;
@@ -37,15 +35,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Decay *d = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] >= 4) return ERR;
-        d->r[vr[i]] = v[i];
-    }
-    return 0;
-}
+FMI2_TEST_SET_REALS(Decay, 4)
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Decay *d = c;
     memset(info, 0, sizeof *info);
@@ -73,8 +63,4 @@ EXPORT fmi2Status fmi2GetDerivatives(fmi2Component c, double dx[], size_t n) {
 EXPORT fmi2Status fmi2GetEventIndicators(fmi2Component c, double z[], size_t n) {
     return n == 0 ? 0 : ERR;
 }
-EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[], size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) x[i] = 1.0;
-    return 0;
-}
+FMI2_TEST_UNIT_NOMINALS

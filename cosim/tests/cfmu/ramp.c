@@ -19,9 +19,7 @@ static void defaults(Ramp *r) {
     r->time = 0.0;
 }
 
-FMI2_TEST_INSTANCE(Ramp, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Ramp)
+FMI2_TEST_MODEL_EXCHANGE(Ramp)
 
 EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, double v[]) {
     Ramp *r = c;

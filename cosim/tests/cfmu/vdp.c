@@ -4,7 +4,11 @@
  * (the Jacobian [[0, 1], [-2 mu x0 x1 - 1, mu (1 - x0^2)]]), each call counted.
  * Value references: 0 x0, 1 der(x0), 2 x1, 3 der(x1), 4 mu (parameter), 5 directional_calls,
  * 6 derivative_calls (locals: the calls of fmi2GetDirectionalDerivative and of
- * fmi2GetDerivatives so far). Built with -DWRONG_JACOBIAN every partial derivative is doubled. */
+ * fmi2GetDerivatives so far). Built with -DWRONG_JACOBIAN every partial derivative is doubled;
+ * with -DOVERRUN_OWN_BLOCK fmi2GetDirectionalDerivative writes 16 bytes past a block of two
+ * doubles it allocated through allocateMemory at its first call and keeps (as MapleSim 2023's
+ * ControlledTemperature does with a block of its own); with -DOVERRUN_DV_UNKNOWN it writes
+ * dvUnknown[nUnknown] and dvUnknown[nUnknown + 1], past the master's buffer. */
 #define FMI2_TEST_NO_FMU_STATE
 #define FMI2_TEST_DIRECTIONAL_DERIVATIVE
 #include "fmi2_test.h"
@@ -20,9 +24,7 @@ static void defaults(Vdp *v) {
     v->r[4] = 1.0;
 }
 
-FMI2_TEST_INSTANCE(Vdp, type == 0)
-FMI2_TEST_EXIT_INITIALIZATION
-FMI2_TEST_CONTINUOUS_TIME(Vdp)
+FMI2_TEST_MODEL_EXCHANGE(Vdp)
 
 static void derivatives(Vdp *v) {
     double x0 = v->r[0], x1 = v->r[2], mu = v->r[4];
@@ -51,6 +53,14 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
     Vdp *m = c;
     size_t i, j;
     double p;
+#ifdef OVERRUN_OWN_BLOCK
+    static double *work;
+    if (!work && !(work = fmi2_test_allocate(2, sizeof *work))) return ERR;
+    for (i = 0; i < 4; i++) work[i] = 0.0; /* two doubles past the block's end */
+#endif
+#ifdef OVERRUN_DV_UNKNOWN
+    dz[nu] = dz[nu + 1] = 0.0; /* past the nu values of the master's buffer */
+#endif
     m->r[5] += 1.0;
     for (i = 0; i < nu; i++) {
         dz[i] = 0.0;

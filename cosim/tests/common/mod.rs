@@ -405,6 +405,13 @@ pub fn build_vdp_with_a_wrong_jacobian(dir: &Path) -> PathBuf {
     build_single_c_fmu_with_flags(dir, "vdp", include_str!("../cfmu/vdp.xml"), &["-DWRONG_JACOBIAN"])
 }
 
+/// [`build_vdp`] built with `flag`, `-DOVERRUN_OWN_BLOCK` (its fmi2GetDirectionalDerivative
+/// writes 16 bytes past a block of 16 it allocated through allocateMemory) or
+/// `-DOVERRUN_DV_UNKNOWN` (it writes two values past dvUnknown), as `<dir>/vdp.fmu`.
+pub fn build_vdp_with_an_overrun(dir: &Path, flag: &str) -> PathBuf {
+    build_single_c_fmu_with_flags(dir, "vdp", include_str!("../cfmu/vdp.xml"), &[flag])
+}
+
 /// The Co-Simulation FMU that reports the tolerance of fmi2SetupExperiment
 /// (tests/cfmu/tolerance.c) as `<dir>/tolerance.fmu`; `default_tolerance` is its
 /// DefaultExperiment's tolerance attribute (`None`: no attribute).

@@ -95,6 +95,20 @@ impl ClockCalls for Fmi3 {
         if !vrs.is_empty() {
             self.set_clocks(core, vrs)?;
         }
+        // the output clocks the ticks activated: their variables read at the open event,
+        // as the input clocks' are (fmi3GetClock resets an output clock it reports, so each is
+        // counted here or, when it becomes active in fmi3UpdateDiscreteStates, as the event
+        // settles)
+        if !self.output_clocks.is_empty() {
+            let outputs = self.output_clocks.clone();
+            let mut ticks = vec![false; outputs.len()];
+            self.get_clocks(core, &outputs, &mut ticks)?;
+            for (vr, _) in outputs.into_iter().zip(ticks).filter(|(_, t)| *t) {
+                self.output_ticks.push(OutputTick { time, value_reference: vr });
+                self.clocked.activate(&[vr]);
+                self.opened_outputs.push(vr);
+            }
+        }
         Ok(())
     }
 

@@ -159,6 +159,19 @@ pub(crate) trait Calls: Send {
     fn output_clock_ticked(&mut self, core: &mut Core, _clock: u32) -> Result<bool> {
         Err(Error::Instance { name: core.name.clone(), reason: "it is not instantiated for Scheduled Execution" })
     }
+    /// Whether the view's variable `vr` is an array element the array does not have now (FMI
+    /// 3.0: a structural parameter made it smaller; read as NaN).
+    fn absent_element(&self, _vr: u32) -> bool {
+        false
+    }
+    /// FMI 3.0 Reconfiguration Mode (`instance/configuration.rs`); others: an error.
+    fn reconfigure(&mut self, core: &mut Core, _values: &[(&str, f64)]) -> Result<()> {
+        Err(Error::Instance {
+            name: core.name.clone(),
+            reason:
+                "Reconfiguration Mode is run for FMI 3.0 instances in this process only (not FMI 2.0, not isolated)",
+        })
+    }
     /// The name of the function that starts the experiment (for a call out of order).
     fn setup_function(&self) -> &'static str;
     /// `fmi2SetupExperiment`; FMI 3.0 keeps the arguments for initialization.

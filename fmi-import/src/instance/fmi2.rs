@@ -259,6 +259,9 @@ impl Calls for Fmi2 {
     ) -> Result<()> {
         let c = core.component;
         let f = core.optional(self.t.get_directional_derivative, "fmi2GetDirectionalDerivative")?;
+        // a write past a block the FMU allocated through allocateMemory lands in its red
+        // zone (MapleSim 2023's ControlledTemperature writes 16 bytes past one here)
+        let before = fmi_sys::fmi2::guard::overruns().count;
         call!(
             core,
             "fmi2GetDirectionalDerivative",
@@ -272,7 +275,19 @@ impl Calls for Fmi2 {
                 dv_known.as_ptr(),
                 dv_unknown.as_mut_ptr()
             )
-        )
+        )?;
+        let after = fmi_sys::fmi2::guard::overruns();
+        match after.first {
+            Some((size, past)) if after.count > before => Err(Error::Overrun {
+                instance: core.name.clone(),
+                function: "fmi2GetDirectionalDerivative",
+                what: format!(
+                    "{past} bytes past the end of a block of {size} bytes that the FMU allocated through allocateMemory{}",
+                    if before > 0 { " (or past another such block: the first write seen in this process)" } else { "" }
+                ),
+            }),
+            _ => Ok(()),
+        }
     }
 
     fn enter_event_mode(&mut self, core: &mut Core) -> Result<()> {

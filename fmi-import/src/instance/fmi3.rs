@@ -31,11 +31,17 @@ pub(crate) struct Fmi3 {
     bytes: Vec<u8>,
     /// The values of arrays set element by element, by value reference.
     arrays: HashMap<u32, Vec<f64>>,
+    /// The arrays whose size now is not the view's (a structural parameter changed in
+    /// Reconfiguration Mode, or to be): by the FMU's value reference, the view's dimensions
+    /// and those of now (`structural::resized_arrays`); empty almost always.
+    pub(super) resized: HashMap<u32, (Vec<u64>, Vec<u64>)>,
+    /// The structural parameters whose value now is not the view's (value reference, value).
+    pub(super) sizes_now: Vec<(u32, f64)>,
     /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
     /// FMU refused to be instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
     /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
-    output_clocks: Vec<u32>,
+    pub(super) output_clocks: Vec<u32>,
     /// The output clocks' ticks not yet taken (`instance/clocks.rs`).
     pub(super) output_ticks: Vec<super::core::OutputTick>,
     /// The input clocks whose interval the FMU gives (tunable, changing, countdown), read
@@ -57,6 +63,10 @@ pub(crate) struct Fmi3 {
     /// The input clocks set (`fmi3SetClock`) in the current event: their clocked variables
     /// are read when it settles.
     pub(super) ticked_inputs: Vec<u32>,
+    /// The output clocks `fmi3GetClock` reported active as the current event opened (an FMU
+    /// may activate one in `fmi3SetClock`): counted then, their variables read from the FMU
+    /// while it is open, not counted again when it settles.
+    pub(super) opened_outputs: Vec<u32>,
 }
 
 /// A function of the FMI 3.0 table that may be absent, or the error naming it.
@@ -96,6 +106,8 @@ impl Fmi3 {
             terminate_requested: None,
             bytes: Vec::new(),
             arrays: HashMap::new(),
+            resized: HashMap::new(),
+            sizes_now: Vec::new(),
             event_mode: std::cell::Cell::new(event_mode),
             output_clocks,
             output_ticks: Vec::new(),
@@ -106,6 +118,7 @@ impl Fmi3 {
             scheduled: (interface == Interface::ScheduledExecution).then(Box::default),
             clocked: super::clocked::ClockedExchange::new(&a.description, &a.special),
             ticked_inputs: Vec::new(),
+            opened_outputs: Vec::new(),
             a,
         }
     }
@@ -130,13 +143,40 @@ impl Fmi3 {
         !self.a.special.is_empty() && vrs.iter().any(|vr| self.a.special.contains_key(vr))
     }
 
-    /// All values of the FMI 3.0 variable of `access`, as f64 (64-bit integers the nearest,
-    /// exact up to 2^53; Booleans 0 or 1, a Binary its size in bytes).
+    /// The number of elements `access`'s variable has now, and which of them `access` is
+    /// (`None`: an element the array does not have now): the view's unless a structural
+    /// parameter sizes the array otherwise now.
+    #[inline]
+    fn now(&self, access: Access) -> (usize, Option<usize>) {
+        if self.resized.is_empty() {
+            return (access.count, Some(access.element));
+        }
+        match self.resized.get(&access.vr) {
+            None => (access.count, Some(access.element)),
+            Some((view, dims)) => {
+                (dims.iter().product::<u64>() as usize, crate::structural::element_now(view, dims, access.element))
+            }
+        }
+    }
+
+    /// The structural parameters have the values `now` (value reference, value) where they
+    /// are not the view's: the arrays they size are read and set with their sizes now.
+    pub(super) fn resize(&mut self, now: Vec<(u32, f64)>) {
+        self.resized = crate::structural::resized_arrays(&self.a.description, &now);
+        self.sizes_now = now;
+        let resized = &self.resized;
+        self.arrays.retain(|vr, _| !resized.contains_key(vr));
+    }
+
+    /// All values of the FMI 3.0 variable of `access` (as many as it has now), as f64
+    /// (64-bit integers the nearest, exact up to 2^53; Booleans 0 or 1, a Binary its size in
+    /// bytes).
     fn get_all(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
         use model_description::fmi3::ValueType as T;
+        let n = self.now(access).0;
         let c = core.component;
         let a = &*self.a;
-        let (vr, n) = (access.vr, access.count);
+        let vr = access.vr;
         macro_rules! get {
             ($field:ident, $name:literal, $t:ty) => {{
                 let f = f3!(core, a, $field, $name);
@@ -185,12 +225,14 @@ impl Fmi3 {
         if array.as_ref().is_none_or(|(read, _)| *read != access.vr) {
             *array = Some((access.vr, self.get_all(core, access)?));
         }
-        Ok(array.as_ref().and_then(|(_, all)| all.get(access.element)).copied().unwrap_or(f64::NAN))
+        let element = self.now(access).1;
+        Ok(array.as_ref().zip(element).and_then(|((_, all), k)| all.get(k)).copied().unwrap_or(f64::NAN))
     }
 
+    /// One element; NaN for one its array does not have now.
     fn get_element(&mut self, core: &mut Core, access: Access) -> Result<f64> {
         let all = self.get_all(core, access)?;
-        Ok(all.get(access.element).copied().unwrap_or(f64::NAN))
+        Ok(self.now(access).1.and_then(|k| all.get(k)).copied().unwrap_or(f64::NAN))
     }
 
     /// Sets all values of the FMI 3.0 variable of `access` from f64 (integers must be
@@ -265,11 +307,23 @@ impl Fmi3 {
         if access.count == 1 {
             return self.set_all(core, access, &[value]);
         }
-        let mut values = match self.arrays.remove(&access.vr) {
-            Some(v) => v,
-            None => self.array_start(core, access)?,
+        let (n, element) = self.now(access);
+        let Some(element) = element else {
+            let name = self.a.description.variable(access.vr).map_or("?", |v| v.name.as_str());
+            return Err(Error::InvalidValue {
+                variable: format!("{}.{name}", core.name),
+                value: value.to_string(),
+                reason: format!(
+                    "element {} of an array that has {n} elements now (a structural parameter sized it so)",
+                    access.element + 1
+                ),
+            });
         };
-        values[access.element] = value;
+        let mut values = match self.arrays.remove(&access.vr) {
+            Some(v) if v.len() == n => v,
+            _ => self.array_start(core, access)?,
+        };
+        values[element] = value;
         let result = self.set_all(core, access, &values);
         self.arrays.insert(access.vr, values);
         result
@@ -279,8 +333,12 @@ impl Fmi3 {
     /// the FMU holds.
     fn array_start(&mut self, core: &mut Core, access: Access) -> Result<Vec<f64>> {
         use model_description::fmi3::Values;
-        let start = self.a.description.variable(access.vr).and_then(|v| v.start.clone());
-        let n = access.count;
+        // a resized array: what the FMU holds (its start values are the view's size)
+        let start = match self.resized.contains_key(&access.vr) {
+            true => None,
+            false => self.a.description.variable(access.vr).and_then(|v| v.start.clone()),
+        };
+        let n = self.now(access).0;
         let spread = |v: Vec<f64>| if v.len() == 1 { vec![v[0]; n] } else { v };
         match start {
             Some(Values::Float(v)) if v.len() == n || v.len() == 1 => Ok(spread(v)),
@@ -662,13 +720,20 @@ impl Fmi3 {
         let vrs = self.output_clocks.clone();
         let mut ticks = vec![false; vrs.len()];
         ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
-        let ticked: Vec<u32> = vrs.into_iter().zip(ticks).filter(|(_, t)| *t).map(|(vr, _)| vr).collect();
+        let opened = std::mem::take(&mut self.opened_outputs);
+        let ticked: Vec<u32> = vrs
+            .into_iter()
+            .zip(ticks)
+            .filter(|(vr, t)| *t && !opened.contains(vr))
+            .map(|(vr, _)| vr)
+            .collect();
         for vr in &ticked {
             self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
         }
         // the clocked variables of the clocks that ticked in this event, read as it settled
         let mut active = std::mem::take(&mut self.ticked_inputs);
         self.clocked.deactivate();
+        active.extend(opened);
         active.extend(ticked);
         self.read_clocked(core, &active)
     }
@@ -794,6 +859,14 @@ impl Calls for Fmi3 {
         r
     }
 
+    fn reconfigure(&mut self, core: &mut Core, values: &[(&str, f64)]) -> Result<()> {
+        self.reconfigure_between_steps(core, values)
+    }
+
+    fn absent_element(&self, vr: u32) -> bool {
+        !self.resized.is_empty() && self.special(vr).is_some_and(|access| self.now(access).1.is_none())
+    }
+
     fn countdown_interval(&mut self, core: &mut Core, clock: u32) -> Result<Option<f64>> {
         self.scheduled.as_ref().ok_or_else(|| not_scheduled(&core.name))?;
         self.changed_interval(core, clock)
@@ -857,6 +930,7 @@ impl Calls for Fmi3 {
     fn forget_run(&mut self) {
         self.clocked.forget_run(&self.a.description);
         self.ticked_inputs.clear();
+        self.opened_outputs.clear();
         self.fixed_read = false;
         self.output_ticks.clear();
         self.intervals.clear();

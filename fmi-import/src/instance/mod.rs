@@ -9,6 +9,7 @@ mod clocked;
 mod clocks;
 mod configuration;
 pub(crate) mod core;
+mod discrete_inputs;
 mod fmi2;
 mod fmi3;
 mod scheduled;
@@ -19,6 +20,7 @@ use std::sync::Arc;
 pub use self::core::InstanceState;
 use self::core::{Calls, Core};
 pub use self::core::{Interval, OutputTick};
+use self::discrete_inputs::{DiscreteInputs, Held, Kind};
 use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};
@@ -41,6 +43,8 @@ pub struct Instance {
     calls: Box<dyn Calls>,
     _name_c: CString,
     _callbacks: Box<CallbackFunctions>,
+    /// Model Exchange: the discrete inputs set in Continuous-Time Mode, waiting for Event Mode.
+    discrete: Option<Box<DiscreteInputs>>,
 }
 
 // SAFETY: an FMI instance may be used from any thread as long as calls to it are not
@@ -60,6 +64,11 @@ fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
         Abi::Fmi3(a) => Box::new(fmi3::Fmi3::new(a.clone(), fmu.interface)),
     }
 }
+
+/// The values of the red zone after dvUnknown (a NaN no FMU computes by arithmetic) and
+/// their number (64 bytes).
+const DV_RED_ZONE: f64 = f64::from_bits(0x7ff8_dead_beef_0001);
+const DV_RED_ZONE_LEN: usize = 8;
 
 impl Instance {
     /// `fmi2Instantiate` / `fmi3Instantiate*` with the FMU's interface, logging off
@@ -94,7 +103,9 @@ impl Instance {
         fmu: Arc<Fmu>,
         host: Option<Box<crate::isolate::channel::Channel>>,
     ) -> Instance {
+        let discrete = DiscreteInputs::new(&fmu.description, fmu.interface());
         Instance {
+            discrete,
             core: Core {
                 component,
                 state: InstanceState::Instantiated,
@@ -238,7 +249,76 @@ impl Instance {
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
         self.calls.exit_initialization_mode(&mut self.core)?;
         self.core.state = InstanceState::Running;
+        self.set_continuous_time(false);
         Ok(())
+    }
+
+    /// Model Exchange: whether the instance is in Continuous-Time Mode (discrete inputs
+    /// wait for Event Mode then).
+    fn set_continuous_time(&mut self, on: bool) {
+        if let Some(d) = self.discrete.as_deref_mut() {
+            d.continuous_time = on;
+        }
+    }
+
+    /// Model Exchange: whether discrete inputs set in Continuous-Time Mode wait for Event
+    /// Mode (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1 let only continuous inputs
+    /// change there; a set of a value the FMU already holds is dropped, not kept).
+    pub fn has_pending_inputs(&self) -> bool {
+        self.discrete.as_deref().is_some_and(|d| !d.pending.is_empty())
+    }
+
+    /// The discrete inputs that wait (see [`Instance::has_pending_inputs`]) set, in the
+    /// order they were set; in Event Mode (after [`Instance::enter_event_mode`]).
+    pub fn apply_pending_inputs(&mut self) -> Result<()> {
+        let Some(d) = self.discrete.as_deref_mut() else { return Ok(()) };
+        if d.continuous_time {
+            let instance = self.core.name.clone();
+            return Err(Error::IllegalCall {
+                instance,
+                function: "a set of a discrete input",
+                state: "Continuous-Time Mode",
+            });
+        }
+        for (_, vr, value) in std::mem::take(&mut d.pending) {
+            match value {
+                Held::Real(bits) => self.set_real(&[vr], &[f64::from_bits(bits)])?,
+                Held::Integer(v) => self.set_integer(&[vr], &[v])?,
+                Held::Boolean(v) => self.set_boolean(&[vr], &[v as i32])?,
+                Held::String(v) => self.set_string(vr, &v)?,
+                Held::Exact(v) => self.set_exact_integer(vr, v)?,
+            }
+        }
+        Ok(())
+    }
+
+    /// The values of a set that reach the FMU now: `None` all of them (noted where
+    /// discrete), else those left when the discrete ones that wait or that the FMU already
+    /// holds are taken out (see `discrete_inputs.rs`).
+    #[inline]
+    fn passing<T: Copy>(
+        &mut self,
+        kind: Kind,
+        vrs: &[u32],
+        values: &[T],
+        held: impl Fn(T) -> Held,
+    ) -> Option<(Vec<u32>, Vec<T>)> {
+        let d = self.discrete.as_deref_mut()?;
+        if d.any_deferred(kind, vrs) {
+            return Some(
+                vrs.iter()
+                    .zip(values)
+                    .filter(|(vr, v)| !d.defer(kind, **vr, held(**v)))
+                    .map(|(vr, v)| (*vr, *v))
+                    .unzip(),
+            );
+        }
+        if !d.continuous_time {
+            for (vr, v) in vrs.iter().zip(values) {
+                d.defer(kind, *vr, held(*v));
+            }
+        }
+        None
     }
 
     /// `fmi2Terminate` / `fmi3Terminate` (only from initialization or running; otherwise
@@ -267,6 +347,7 @@ impl Instance {
         drop(mark);
         self.core.state = InstanceState::Instantiated;
         self.calls.forget_run();
+        self.discrete = DiscreteInputs::new(&self.core.fmu.description, self.core.fmu.interface());
         self.core.status(function, raw, None)?;
         self.calls.configure(&mut self.core)
     }
@@ -285,14 +366,17 @@ impl Instance {
         const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
         let any = values.iter().fold(false, |any, v| any | (v.to_bits() & EXPONENT == EXPONENT));
         if any && !self.core.fmu.allow_non_finite {
-            return Err(self.non_finite(vrs, values));
+            return self.non_finite(vrs, values).map_or(Ok(()), Err);
         }
         Ok(())
     }
 
+    /// The error of the first value that is not finite, `None` when each is the NaN of an
+    /// array element that is not there now (a structural parameter made the array smaller
+    /// than the view).
     #[cold]
-    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Error {
-        let k = values.iter().position(|v| !v.is_finite()).unwrap_or(0);
+    fn non_finite(&self, vrs: &[u32], values: &[f64]) -> Option<Error> {
+        let k = vrs.iter().zip(values).position(|(vr, v)| !v.is_finite() && !self.calls.absent_element(*vr))?;
         let variable = self
             .core
             .fmu
@@ -301,20 +385,24 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
-        Error::NonFinite {
+        Some(Error::NonFinite {
             instance: self.core.name.clone(),
             fmu: self.core.fmu.source.clone(),
             variable,
             value: values[k],
             time: self.core.time,
-        }
+        })
     }
 
     /// `fmi2SetReal` / `fmi3SetFloat64` (the other FMI 3.0 types as for [`Instance::get_real`]).
     #[inline]
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_real: one value per value reference");
-        self.calls.set_real(&mut self.core, vrs, values)
+        match self.passing(Kind::Real, vrs, values, |v: f64| Held::Real(v.to_bits())) {
+            None => self.calls.set_real(&mut self.core, vrs, values),
+            Some((vrs, _)) if vrs.is_empty() => Ok(()),
+            Some((vrs, values)) => self.calls.set_real(&mut self.core, &vrs, &values),
+        }
     }
 
     /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`, Int8 ..
@@ -330,7 +418,11 @@ impl Instance {
     #[inline]
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_integer: one value per value reference");
-        self.calls.set_integer(&mut self.core, vrs, values)
+        match self.passing(Kind::Integer, vrs, values, Held::Integer) {
+            None => self.calls.set_integer(&mut self.core, vrs, values),
+            Some((vrs, _)) if vrs.is_empty() => Ok(()),
+            Some((vrs, values)) => self.calls.set_integer(&mut self.core, &vrs, &values),
+        }
     }
 
     /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true); FMI 3.0:
@@ -345,7 +437,11 @@ impl Instance {
     #[inline]
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_boolean: one value per value reference");
-        self.calls.set_boolean(&mut self.core, vrs, values)
+        match self.passing(Kind::Boolean, vrs, values, |v: i32| Held::Boolean(v != 0)) {
+            None => self.calls.set_boolean(&mut self.core, vrs, values),
+            Some((vrs, _)) if vrs.is_empty() => Ok(()),
+            Some((vrs, values)) => self.calls.set_boolean(&mut self.core, &vrs, &values),
+        }
     }
 
     /// `fmi2GetString` / `fmi3GetString` of one variable (copied).
@@ -374,6 +470,11 @@ impl Instance {
     /// `fmi3SetInt64` / `fmi3SetUInt64` of `vr` exactly (a variable of
     /// [`Fmu::exact_kind`] Int64 or UInt64); a value outside its type's range is refused.
     pub fn set_exact_integer(&mut self, vr: u32, value: i128) -> Result<()> {
+        if let Some(d) = self.discrete.as_deref_mut() {
+            if d.defer(Kind::Exact, vr, Held::Exact(value)) {
+                return Ok(());
+            }
+        }
         self.calls.set_exact_integer(&mut self.core, vr, value)
     }
 
@@ -384,6 +485,11 @@ impl Instance {
             value: value.into(),
             reason: "NUL in string".into(),
         })?;
+        if let Some(d) = self.discrete.as_deref_mut() {
+            if d.defer(Kind::String, vr, Held::String(value.into())) {
+                return Ok(());
+            }
+        }
         self.calls.set_string(&mut self.core, vr, s.as_ptr())
     }
 
@@ -436,7 +542,12 @@ impl Instance {
 
     /// `fmi2SetFMUstate` / `fmi3SetFMUState`: restores a saved state.
     pub fn set_state(&mut self, state: &FmuState) -> Result<()> {
-        self.calls.set_state(&mut self.core, state.0)
+        self.calls.set_state(&mut self.core, state.0)?;
+        // the FMU holds the inputs of the state now: a later set is not compared with ours
+        if let Some(d) = self.discrete.as_deref_mut() {
+            d.forget_given();
+        }
+        Ok(())
     }
 
     /// `fmi2FreeFMUstate` / `fmi3FreeFMUState`.
@@ -484,6 +595,9 @@ impl Instance {
 
     /// The directional derivative at the instance's current point: `dv_unknown` =
     /// d(unknowns)/d(knowns) `dv_known` (FMI 2.0 section 2.1.9, FMI 3.0 section 2.2.11).
+    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown`, or
+    /// (FMI 2.0) past a block it allocated through `allocateMemory`: the guard's red zone
+    /// took the write; the instance is still usable, the values are not.
     pub fn get_directional_derivative(
         &mut self,
         unknowns: &[u32],
@@ -493,12 +607,31 @@ impl Instance {
     ) -> Result<()> {
         assert_eq!(knowns.len(), dv_known.len(), "get_directional_derivative: one seed per known");
         assert_eq!(unknowns.len(), dv_unknown.len(), "get_directional_derivative: one value per unknown");
-        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, dv_unknown)
+        // dvUnknown with a red zone after it: a write past its nUnknown values is seen
+        // there (and overwrites nothing of the master's)
+        let n = dv_unknown.len();
+        let zone = |v: &[f64]| v[n..].iter().rposition(|x| x.to_bits() != DV_RED_ZONE.to_bits());
+        let mut out = vec![DV_RED_ZONE; n + DV_RED_ZONE_LEN];
+        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, &mut out[..n])?;
+        dv_unknown.copy_from_slice(&out[..n]);
+        match zone(&out) {
+            Some(k) => Err(Error::Overrun {
+                instance: self.core.name.clone(),
+                function: match self.core.fmu.abi {
+                    Abi::Fmi2(_) => "fmi2GetDirectionalDerivative",
+                    Abi::Fmi3(_) => "fmi3GetDirectionalDerivative",
+                },
+                what: format!("{} bytes past the {} bytes of dvUnknown (nUnknown = {n})", 8 * (k + 1), 8 * n),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
-        self.calls.enter_event_mode(&mut self.core)
+        self.calls.enter_event_mode(&mut self.core)?;
+        self.set_continuous_time(false);
+        Ok(())
     }
 
     /// `fmi2NewDiscreteStates`; FMI 3.0: `fmi3UpdateDiscreteStates`, its outputs as the
@@ -509,7 +642,9 @@ impl Instance {
 
     /// `fmi2EnterContinuousTimeMode` / `fmi3EnterContinuousTimeMode`.
     pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
-        self.calls.enter_continuous_time_mode(&mut self.core)
+        self.calls.enter_continuous_time_mode(&mut self.core)?;
+        self.set_continuous_time(true);
+        Ok(())
     }
 
     /// `fmi2CompletedIntegratorStep` / `fmi3CompletedIntegratorStep`: (enter event mode,

@@ -47,8 +47,6 @@ extern "C" {
         message: fmi2String,
         ...
     );
-    fn calloc(n: usize, size: usize) -> *mut c_void;
-    fn free(p: *mut c_void);
 }
 
 /// One formatted message.
@@ -118,25 +116,17 @@ impl<R: LogReceiver> LogEnvironment<R> {
         self as *const Self as fmi2ComponentEnvironment
     }
 
-    /// The callbacks of an instance whose messages go here: the logger shim, calloc and
-    /// free. Valid while `self` stays where it is.
+    /// The callbacks of an instance whose messages go here: the logger shim and the
+    /// guarded calloc and free ([`super::guard`]). Valid while `self` stays where it is.
     pub fn callbacks(&self) -> Fmi2CallbackFunctions {
         Fmi2CallbackFunctions {
             logger: Some(fmi2_sys_logger),
-            allocate_memory: Some(allocate),
-            free_memory: Some(release),
+            allocate_memory: Some(super::guard::allocate),
+            free_memory: Some(super::guard::release),
             step_finished: None,
             component_environment: self.as_environment(),
         }
     }
-}
-
-unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {
-    calloc(n, size)
-}
-
-unsafe extern "C" fn release(p: *mut c_void) {
-    free(p)
 }
 
 /// What the C shim calls: `env` is the [`LogEnvironment<R>`] it was given, the strings are

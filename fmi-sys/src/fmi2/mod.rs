@@ -14,10 +14,14 @@
 //!   `*` widths, positional arguments, wide strings; a `%s` argument is copied only if it
 //!   points to readable memory outside the importer's program image), and hands the text
 //!   to a Rust [`logger::LogReceiver`].
+//! - [`guard`] (feature `import`): the importer's memory callbacks, calloc and free with a
+//!   red zone after every block, in which an FMU's write past a block lands and is seen.
 
 use std::ffi::{c_char, c_int, c_uint, c_void};
 
 pub mod functions;
+#[cfg(feature = "import")]
+pub mod guard;
 #[cfg(feature = "import")]
 pub mod logger;
 

@@ -7,110 +7,23 @@ use std::fmt;
 use super::*;
 use crate::validate::{duplicate_unit_messages, enumeration_messages, model_identifier_messages};
 
-/// The rule a [`Problem`] breaks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Rule {
-    /// `fmiVersion` must be a 3.x version.
-    FmiVersion,
-    /// At least one interface type (`<ModelExchange>`, `<CoSimulation>`,
-    /// `<ScheduledExecution>`) must be present.
-    NoInterface,
-    /// `modelIdentifier` must be a non-empty C identifier.
-    ModelIdentifier,
-    /// Variable names must be non-empty.
-    EmptyName,
-    /// Variable names must be unique.
-    DuplicateName,
-    /// Value references must be unique across all variables of all types.
-    DuplicateValueReference,
-    /// Unit names must be unique.
-    DuplicateUnit,
-    /// The (causality, variability) pair must be legal.
-    CausalityVariability,
-    /// `initial` must be one the table allows, and absent for inputs and the independent
-    /// variable.
-    Initial,
-    /// A start value is required (initial exact/approx, inputs, parameters, constants).
-    StartRequired,
-    /// A start value is forbidden (initial calculated, the independent variable).
-    StartForbidden,
+crate::validate::rules! {
     /// The number of start values must be the number of elements (1 for a scalar; an
     /// array may also give one value for all its elements).
-    StartCount,
-    /// Exactly one variable is the independent variable; it is a continuous Float.
-    Independent,
+    StartCount => "start-count",
     /// Only Float32/Float64 variables may be continuous.
-    ContinuousNonFloat,
-    /// A `unit` or `displayUnit` must be declared in `<UnitDefinitions>`.
-    UndeclaredUnit,
-    /// `derivative` must be the value reference of a continuous Float variable.
-    Derivative,
-    /// `min <= max` and `min <= start <= max`.
-    Bounds,
-    /// `nominal > 0`.
-    Nominal,
+    ContinuousNonFloat => "continuous-non-float",
     /// A `<Dimension valueReference>` must name an integer structural parameter or
     /// constant.
-    Dimension,
+    Dimension => "dimension",
     /// `previous` and `clocks` must name variables of the right kind.
-    Reference,
+    Reference => "reference",
     /// A ModelStructure entry or dependency must be the value reference of a variable.
-    UnknownValueReference,
-    /// `<Output>` must list exactly the causality=output variables, in order.
-    Outputs,
+    UnknownValueReference => "unknown-value-reference",
     /// `<ContinuousStateDerivative>` must name variables with a `derivative` attribute.
-    ContinuousStateDerivatives,
-    /// `<InitialUnknown>` must list exactly the outputs, continuous states and state
-    /// derivatives with initial approx or calculated, and the calculated parameters.
-    InitialUnknowns,
+    ContinuousStateDerivatives => "continuous-state-derivatives",
     /// `<EventIndicator>` must name continuous Float variables.
-    EventIndicators,
-    /// `dependenciesKind` needs `dependencies` of the same length.
-    DependenciesKind,
-    /// A `declaredType` must name a type definition of the variable's type; enumeration
-    /// items must be unique and a start value one of them; type names unique.
-    DeclaredType,
-}
-
-impl Rule {
-    /// A short stable identifier, e.g. `"start-count"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Rule::FmiVersion => "fmi-version",
-            Rule::NoInterface => "no-interface",
-            Rule::ModelIdentifier => "model-identifier",
-            Rule::EmptyName => "empty-name",
-            Rule::DuplicateName => "duplicate-name",
-            Rule::DuplicateValueReference => "duplicate-value-reference",
-            Rule::DuplicateUnit => "duplicate-unit",
-            Rule::CausalityVariability => "causality-variability",
-            Rule::Initial => "initial",
-            Rule::StartRequired => "start-required",
-            Rule::StartForbidden => "start-forbidden",
-            Rule::StartCount => "start-count",
-            Rule::Independent => "independent",
-            Rule::ContinuousNonFloat => "continuous-non-float",
-            Rule::UndeclaredUnit => "undeclared-unit",
-            Rule::Derivative => "derivative",
-            Rule::Bounds => "bounds",
-            Rule::Nominal => "nominal",
-            Rule::Dimension => "dimension",
-            Rule::Reference => "reference",
-            Rule::UnknownValueReference => "unknown-value-reference",
-            Rule::Outputs => "outputs",
-            Rule::ContinuousStateDerivatives => "continuous-state-derivatives",
-            Rule::InitialUnknowns => "initial-unknowns",
-            Rule::EventIndicators => "event-indicators",
-            Rule::DependenciesKind => "dependencies-kind",
-            Rule::DeclaredType => "declared-type",
-        }
-    }
-}
-
-impl fmt::Display for Rule {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
+    EventIndicators => "event-indicators",
 }
 
 /// One violation found by [`ModelDescription::validate`].

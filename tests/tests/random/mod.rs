@@ -38,6 +38,27 @@ impl Rng {
     }
 }
 
+/// The arguments of fmi2SetupExperiment / fmi3EnterInitializationMode, drawn in this
+/// order: start, stop, toleranceDefined, tolerance, stopTimeDefined.
+pub struct Experiment {
+    pub start: f64,
+    pub stop: f64,
+    pub tolerance_defined: bool,
+    pub tolerance: f64,
+    pub stop_defined: bool,
+}
+
+impl Experiment {
+    pub fn draw(rng: &mut Rng) -> Experiment {
+        let start = rng.pick(&[0.0, 0.0, 1.0, f64::NAN, -5.0]);
+        let stop = rng.pick(&[10.0, 0.5, f64::NAN, f64::INFINITY, -1.0]);
+        let tolerance_defined = rng.below(2) == 1;
+        let tolerance = rng.pick(&HOSTILE);
+        let stop_defined = rng.below(2) == 1;
+        Experiment { start, stop, tolerance_defined, tolerance, stop_defined }
+    }
+}
+
 /// The numbers the sequences pass where a number is asked for.
 pub const HOSTILE: [f64; 12] =
     [0.0, 1.0, -1.0, 0.3, 1e-3, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e308, -1e308, 5e-324, 2.5];
@@ -89,6 +110,100 @@ impl Shadow {
             3 => 0x40usize as *mut c_void,
             _ => std::ptr::null_mut(),
         }
+    }
+
+    /// fmiXGetFMUstate through `get`: now and then into a live state (overwriting it),
+    /// else into a new one; a new state is remembered with the machine it was saved in.
+    pub fn get_state(&mut self, rng: &mut Rng, get: impl FnOnce(&mut *mut c_void) -> i32) -> i32 {
+        let mut s = if rng.chance(20) && !self.states.is_empty() { self.states[0].0 } else { std::ptr::null_mut() };
+        let before = s;
+        let status = get(&mut s);
+        if status == OK {
+            if before.is_null() {
+                self.states.push((s, self.machine));
+            } else if let Some(e) = self.states.iter_mut().find(|e| e.0 == s) {
+                e.1 = self.machine;
+            }
+        }
+        status
+    }
+
+    /// fmiXSetFMUstate through `set` with a state argument; with OK, `restored` is the
+    /// machine the state was saved in (None: unknown).
+    pub fn set_state(
+        &mut self,
+        rng: &mut Rng,
+        restored: &mut Option<Option<Machine>>,
+        set: impl FnOnce(*mut c_void) -> i32,
+    ) -> i32 {
+        let s = self.state_arg(rng);
+        let status = set(s);
+        if status == OK {
+            *restored = Some(self.states.iter().find(|e| e.0 == s).map(|e| e.1).unwrap_or(None));
+        }
+        status
+    }
+
+    /// fmiXFreeFMUstate through `free` with a state argument: a freed live state must come
+    /// back as NULL and is remembered as freed.
+    pub fn free_state(&mut self, rng: &mut Rng, free: impl FnOnce(&mut *mut c_void) -> i32) -> i32 {
+        let mut s = self.state_arg(rng);
+        let before = s;
+        let status = free(&mut s);
+        if status == OK && !before.is_null() {
+            assert!(s.is_null());
+            self.states.retain(|e| e.0 != before);
+            self.freed.push(before);
+        }
+        status
+    }
+
+    /// fmiXSerializeFMUstate of a state argument into a buffer of the size `size` tells
+    /// (now and then half of it); with OK the bytes are kept for deserialization.
+    pub fn serialize_state(
+        &mut self,
+        rng: &mut Rng,
+        size: impl FnOnce(*mut c_void, &mut usize) -> i32,
+        serialize: impl FnOnce(*mut c_void, &mut [u8]) -> i32,
+    ) -> i32 {
+        let s = self.state_arg(rng);
+        let mut n = 0usize;
+        let _ = size(s, &mut n);
+        let n = if rng.chance(10) { n / 2 } else { n };
+        let mut buf = vec![0u8; n.min(1 << 20)];
+        let status = serialize(s, &mut buf);
+        if status == OK {
+            self.bytes = buf;
+        }
+        status
+    }
+
+    /// fmiXDeSerializeFMUstate through `deserialize` of the kept bytes, now and then with a
+    /// flipped bit, cut short (where `truncate`) or replaced by random bytes; a state made
+    /// is remembered with an unknown machine.
+    pub fn deserialize_state(
+        &mut self,
+        rng: &mut Rng,
+        truncate: bool,
+        deserialize: impl FnOnce(&[u8], &mut *mut c_void) -> i32,
+    ) -> i32 {
+        let mut bytes = self.bytes.clone();
+        if !bytes.is_empty() && rng.chance(50) {
+            let k = rng.below(bytes.len());
+            bytes[k] ^= 1 << rng.below(8);
+        }
+        if truncate && !bytes.is_empty() && rng.chance(20) {
+            bytes.truncate(rng.below(bytes.len()));
+        }
+        if rng.chance(10) {
+            bytes = (0..rng.below(200)).map(|_| rng.next() as u8).collect();
+        }
+        let mut s = std::ptr::null_mut();
+        let status = deserialize(&bytes, &mut s);
+        if status == OK {
+            self.states.push((s, None));
+        }
+        status
     }
 
     /// After `function` returned `status`: no non-finite number in `reals_out[..k]` with

@@ -11,10 +11,12 @@
 //! the FMU's Jacobian is checked against those differences ([`disagreement`]); when they
 //! disagree the member uses the differences for the rest of the run, and a note says so
 //! (an FMU whose directional derivatives are wrong must not steer the Newton iteration).
+//! A call that writes past `dvUnknown` or past a block the FMU allocated (caught in the
+//! importing layer's red zones, [`ImportError::Overrun`]) does the same at any use.
 
 use super::members::Members;
 use crate::bdf::Colouring;
-use crate::error::Result;
+use crate::error::{ImportError, Result};
 use crate::fmu::Instance;
 use crate::integrator::{Integrator, OdeSystem, Start};
 use crate::me::{MeUnit, Solver};
@@ -257,17 +259,15 @@ impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
             if mj.directional {
                 inst.set_time(t)?;
                 MeUnit::set_states(inst, &x[a..b])?;
-                for group in &mj.colouring.groups {
-                    mj.seed.fill(0.0);
-                    for &j in group {
-                        mj.seed[j] = 1.0;
-                    }
-                    inst.get_directional_derivative(&mj.derivative_vrs, &mj.state_vrs, &mj.seed, &mut mj.column)?;
-                    for &j in group {
-                        for &i in &mj.colouring.rows[j] {
-                            jac[(a + i, a + j)] = mj.column[i];
-                        }
-                    }
+                if let Err(e) = provided(inst, mj, jac, a) {
+                    let ImportError::Overrun { .. } = e else { return Err(e.into()) };
+                    // the write went into the guard's red zone: the FMU is intact, its
+                    // Jacobian is not to be trusted
+                    mj.directional = false;
+                    mj.checked = true;
+                    mj.note = Some(format!("{e}: bdf uses finite differences for its Jacobian"));
+                    differences(inst, mj, t, &x[a..b], &f[a..b], self.floor, jac, a, self.difference_rhs)?;
+                    continue;
                 }
                 if mj.checked {
                     continue;
@@ -300,6 +300,29 @@ impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
         }
         Ok(())
     }
+}
+
+/// One member's Jacobian from the FMU's directional derivatives, one call per colour
+/// group, into `jac` from row and column `a`.
+fn provided(
+    inst: &mut Instance,
+    mj: &mut MemberJacobian,
+    jac: &mut DMatrix<f64>,
+    a: usize,
+) -> std::result::Result<(), ImportError> {
+    for group in &mj.colouring.groups {
+        mj.seed.fill(0.0);
+        for &j in group {
+            mj.seed[j] = 1.0;
+        }
+        inst.get_directional_derivative(&mj.derivative_vrs, &mj.state_vrs, &mj.seed, &mut mj.column)?;
+        for &j in group {
+            for &i in &mj.colouring.rows[j] {
+                jac[(a + i, a + j)] = mj.column[i];
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One member's Jacobian by forward differences of its right-hand side at `x` (where it

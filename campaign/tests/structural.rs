@@ -1,0 +1,88 @@
+//! A structural parameter as a campaign's sweep dimension: the C FMU
+//! `cosim/tests/cfmu/fmi3_sized.c` (n sizes k and y, set in Configuration Mode; y[i] =
+//! k[i] u t after each step, k all 1 and u = 1 by default) swept over n = 1, 2, 3. Each run
+//! configures its own instance and records y with n elements: the run's CSV (`--only`)
+//! has the columns y[1] .. y[n], each 1 at 1 s (k[i] u t = 1 * 1 * 1); the metric
+//! final(model.y[1]) is 1 in every run.
+
+#[path = "../../cosim/tests/common/mod.rs"]
+#[allow(dead_code, unused_imports)]
+mod cosim_common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="sized" instantiationToken="{fmi3-sized}">
+  <CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    <UInt64 name="n" valueReference="1" causality="structuralParameter" variability="fixed" start="2" min="1" max="100"/>
+    <Float64 name="k" valueReference="2" causality="parameter" variability="fixed" start="1"><Dimension valueReference="1"/></Float64>
+    <Float64 name="u" valueReference="3" causality="input" start="1"/>
+    <Float64 name="y" valueReference="4" causality="output" variability="discrete" initial="calculated"><Dimension valueReference="1"/></Float64>
+  </ModelVariables>
+  <ModelStructure>
+    <Output valueReference="4"/>
+    <InitialUnknown valueReference="4"/>
+  </ModelStructure>
+</fmiModelDescription>
+"#;
+
+/// `fmi3_sized.fmu` built in `dir`; `None` (skipped) without fmpy's FMI 3.0 headers.
+fn sized_fmu(dir: &Path) -> Option<PathBuf> {
+    let headers = cosim_common::fmi3_c::headers()?;
+    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu");
+    let so = dir.join("fmi3_sized.so");
+    cosim_common::cc(
+        &cosim_common::fmi3_c::flags(&headers),
+        &[cfmu.join("fmi3_sized.c"), cfmu.join("fmi3_rest.c")],
+        &so,
+    );
+    let fmu = dir.join("fmi3_sized.fmu");
+    cosim_common::pack_library(&fmu, XML, "binaries/x86_64-linux/fmi3_sized.so", &so);
+    Some(fmu)
+}
+
+#[test]
+fn a_structural_parameter_is_a_sweep_dimension_and_sizes_each_runs_arrays() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(fmu) = sized_fmu(dir.path()) else { return };
+    let spec = dir.path().join("sized.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "system = {:?}\nstop_time = 1.0\nstep = 0.5\n\n[grid]\n\"model.n\" = [1, 2, 3]\n\n[metrics]\ny1 = \"final(model.y[1])\"\n",
+            fmu.display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let campaign = env!("CARGO_BIN_EXE_campaign");
+    let o = Command::new(campaign).arg("run").arg(&spec).arg("--out").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let spec_loaded = nigel_campaign::spec::Spec::load(&spec).unwrap();
+    let mut worker = nigel_campaign::run::Worker::new(&spec_loaded).unwrap();
+    for run in 0..3u64 {
+        let n = run as usize + 1;
+        let row = worker.run(run);
+        assert_eq!(row.status, nigel_campaign::results::STATUS_OK, "run {run}: {:?}", row.message);
+        assert_eq!(row.values, [n as f64, 1.0], "run {run}: n, then y1");
+        // the run's every output: y with n elements
+        let o = Command::new(campaign)
+            .arg("run")
+            .arg(&spec)
+            .arg("--out")
+            .arg(&out)
+            .args(["--only", &run.to_string()])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(out.join(format!("run-{run}.csv"))).unwrap();
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();
+        let ys: Vec<String> = (1..=n).map(|i| format!("y[{i}]")).collect();
+        assert_eq!(header[1..], ys, "run {run}");
+        let last: Vec<f64> = text.lines().last().unwrap().split(',').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(last, [[1.0].as_slice(), &vec![1.0; n]].concat(), "run {run}: t = 1 s, y = k u t = 1");
+    }
+}

@@ -1,0 +1,40 @@
+//! An FMU whose directional derivatives write past memory (issue 35, MapleSim 2023's
+//! ControlledTemperature: 16 bytes past a 48-byte block of its own, which glibc found later
+//! and aborted the master on in `fmi2FreeInstance`) neither crashes nor misleads bdf: the
+//! importing layer keeps a red zone after every block an FMI 2.0 FMU allocates through
+//! `allocateMemory` and after `dvUnknown`, the write lands there, and bdf takes finite
+//! differences for that FMU from then on, with a note. Its own test binary (its own
+//! process): the guard's count of overruns is the process's, and another test's FMU
+//! writing past a block during one of these calls would be taken for this one's.
+
+mod common;
+use common::{build_vdp_with_an_overrun, build_vdp_without_directional_derivatives, work_dir};
+use nigel_cosim::{simulate, Experiment, Fmu, Solver, System};
+
+/// vdp.c writing 16 bytes past a block of two doubles it allocated (kept alive), and vdp.c
+/// writing two values past dvUnknown: each run completes, the note names the call and the
+/// write, and the rows are those of the same FMU declaring no directional derivatives, bit
+/// for bit (from the first Jacobian on, the same differences at the same points).
+#[test]
+fn a_directional_derivative_that_writes_past_memory_is_caught_and_replaced_by_differences() {
+    let mut e = Experiment::new(2.0, 0.01);
+    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+    let run =
+        |path: std::path::PathBuf| simulate(&System::single("model", Fmu::load(&path).unwrap()).unwrap(), &e).unwrap();
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let (differences, d) = run(build_vdp_without_directional_derivatives(&work_dir("overrun-fd")));
+    assert!(d.notes.is_empty() && d.stiff.jacobians > 0, "{:?} {:?}", d.notes, d.stiff);
+    for (flag, what) in [
+        ("-DOVERRUN_OWN_BLOCK", "wrote 16 bytes past the end of a block of 16 bytes that the FMU allocated"),
+        ("-DOVERRUN_DV_UNKNOWN", "wrote 16 bytes past the 16 bytes of dvUnknown (nUnknown = 2)"),
+    ] {
+        let (got, s) = run(build_vdp_with_an_overrun(&work_dir(&format!("overrun{flag}")), flag));
+        assert_eq!(s.notes.len(), 1, "{flag}: {:?}", s.notes);
+        let note = &s.notes[0];
+        assert!(note.starts_with("model: fmi2GetDirectionalDerivative ") && note.contains(what), "{flag}: {note}");
+        assert!(note.ends_with("bdf uses finite differences for its Jacobian"), "{note}");
+        assert_eq!(s.stiff.jacobians, d.stiff.jacobians, "{flag}");
+        assert_eq!(bits(&got.values), bits(&differences.values), "{flag}");
+    }
+}
