@@ -121,9 +121,6 @@ cargo run --release --quiet -p build-fmu --features controller-sample-clock -- -
 cargo test --release --quiet -p fmu-controller --features fmi3-sample-clock --test sample_clock
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
-# the master's release archives (cross builds: cargo with rustc-web and zig) beside the
-# stages below, tested by the stage "the master on every platform"
-background cross-builds bash scripts/dist.sh
 stage "Python venv with fmpy (built beside the FMUs)"
 wait_for venv
 export FMPY_PYTHON="$target_dir/venv/bin/python"
@@ -202,11 +199,6 @@ stage "campaign results in fmpy and pandas"
 "$target_dir/venv/bin/python" -m pytest campaign/tests/python -q
 stage "campaign on a local Slurm cluster"
 bash scripts/test-campaign-slurm.sh
-stage "the master on every platform (built beside the stages above)"
-wait_for cross-builds
-# the archives: x86-64 Linux and Windows (wine) executed, the aarch64 Linux and macOS programs'
-# headers checked (scripts/test-dist.sh says what each run must equal, and why aarch64 is not run)
-bash scripts/test-dist.sh
 if [ -d ../shared/corpus ]; then
     stage "third-party conformance (run beside the Rust tests): the table"
     wait_for conformance
