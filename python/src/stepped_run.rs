@@ -147,7 +147,7 @@ impl NativeRun {
         py: Python<'py>,
     ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, Vec<(usize, Vec<String>)>)> {
         let results = self.execution().results();
-        let exact = crate::system::exact_columns(&results);
+        let exact = exact_columns(&results);
         let width = self.names.len() + 1;
         let rows = results.values.len() / width;
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
@@ -164,4 +164,10 @@ impl NativeRun {
             .as_ref()
             .and_then(|s| serde_json::to_string(&s.to_json()).ok())
     }
+}
+
+/// The columns of `results` whose values an f64 does not hold: (column among the names,
+/// the text of every row).
+pub(crate) fn exact_columns(results: &nigel_cosim::Results) -> Vec<(usize, Vec<String>)> {
+    results.exact.iter().map(|e| (e.column, e.rows.clone())).collect()
 }

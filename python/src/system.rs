@@ -3,7 +3,7 @@
 use crate::errors::{to_py, Error};
 use crate::interrupt::interruptible;
 use crate::run_args::RunArgs;
-use crate::stepped_run::NativeRun;
+use crate::stepped_run::{exact_columns, NativeRun};
 use model_description::DefaultExperiment;
 use nigel_cosim::defaults::{GivenTimes, RunTimes};
 use nigel_cosim::{
@@ -107,12 +107,6 @@ pub(crate) fn column_type(system: &System, r: &VariableRef) -> &'static str {
         Some(ExactKind::UInt64) => "UInt64",
         _ => r.base_type.as_str(),
     }
-}
-
-/// The columns of `results` whose values an f64 does not hold: (column among the names,
-/// the text of every row).
-pub(crate) fn exact_columns(results: &Results) -> Vec<(usize, Vec<String>)> {
-    results.exact.iter().map(|e| (e.column, e.rows.clone())).collect()
 }
 
 #[pymethods]
