@@ -12,22 +12,8 @@ mod cosim_common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="sized" instantiationToken="{fmi3-sized}">
-  <CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <UInt64 name="n" valueReference="1" causality="structuralParameter" variability="fixed" start="2" min="1" max="100"/>
-    <Float64 name="k" valueReference="2" causality="parameter" variability="fixed" start="1"><Dimension valueReference="1"/></Float64>
-    <Float64 name="u" valueReference="3" causality="input" start="1"/>
-    <Float64 name="y" valueReference="4" causality="output" variability="discrete" initial="calculated"><Dimension valueReference="1"/></Float64>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="4"/>
-    <InitialUnknown valueReference="4"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+/// The description of the C FMU (shared with cosim's Configuration Mode tests).
+const XML: &str = include_str!("../../cosim/tests/cfmu/fmi3_sized.xml");
 
 /// `fmi3_sized.fmu` built in `dir`; `None` (skipped) without fmpy's FMI 3.0 headers.
 fn sized_fmu(dir: &Path) -> Option<PathBuf> {

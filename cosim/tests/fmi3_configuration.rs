@@ -14,22 +14,8 @@ use nigel_cosim::{simulate, Experiment, Fmu, SystemBuilder, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="sized" instantiationToken="{fmi3-sized}">
-  <CoSimulation modelIdentifier="fmi3_sized" canHandleVariableCommunicationStepSize="true"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <UInt64 name="n" valueReference="1" causality="structuralParameter" variability="fixed" start="2" min="1" max="100"/>
-    <Float64 name="k" valueReference="2" causality="parameter" variability="fixed" start="1"><Dimension valueReference="1"/></Float64>
-    <Float64 name="u" valueReference="3" causality="input" start="1"/>
-    <Float64 name="y" valueReference="4" causality="output" variability="discrete" initial="calculated"><Dimension valueReference="1"/></Float64>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="4"/>
-    <InitialUnknown valueReference="4"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+/// The description of `cfmu/fmi3_sized.c` (the campaign's structural sweep builds it too).
+const XML: &str = include_str!("cfmu/fmi3_sized.xml");
 
 fn sized(test: &str) -> Option<(PathBuf, PathBuf)> {
     let dir = work_dir(test);

@@ -148,7 +148,9 @@ fn fmi_rs_parses_and_validates_every_model_description_without_a_problem() {
 #[test]
 fn fmi_rs_validation_is_live_on_our_documents() {
     // the same XML with one defect each: the validation that passed above must now fail
-    let dir = nigel_integration_tests::Fmu::load(&archive("nigel_plant")).unwrap().dir.clone();
+    // (the unpacked archive lives as long as its Fmu)
+    let fmu = nigel_integration_tests::Fmu::load(&archive("nigel_plant")).unwrap();
+    let dir = fmu.dir.clone();
     let xml = std::fs::read_to_string(dir.join("modelDescription.xml")).unwrap();
     assert!(problems(&RsModelDescription::from_string(&xml).unwrap()).is_empty());
     // 1. an output dropped from <Outputs> (the first <Unknown> there)

@@ -84,25 +84,7 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     ((Exchange *)instance)->time = time;
     return fmi3OK;
 }
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
-    *n = 0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
-    *n = 0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
-fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) { return fmi3OK; }
-fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; }
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; }
-fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
-    fmi3Boolean *terminateSimulation) {
-    *enterEventMode = 0;
-    *terminateSimulation = 0;
-    return fmi3OK;
-}
+FMI3_TEST_NO_CONTINUOUS_STATES
 
 /* Scheduled Execution: the activation of tick at `time` (u as set before it) */
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {

@@ -56,4 +56,27 @@ static inline fmi3Status step_reached(fmi3Float64 time, fmi3Boolean *eventHandli
     return fmi3OK;
 }
 
+/* Model Exchange without continuous states or event indicators: the counts 0, the state
+ * and indicator calls accept their empty arrays, no integrator step asks for an event. */
+#define FMI3_TEST_NO_CONTINUOUS_STATES                                                             \
+    fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {                 \
+        *n = 0;                                                                                    \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {                  \
+        *n = 0;                                                                                    \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior,          \
+        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {                           \
+        *enterEventMode = 0;                                                                       \
+        *terminateSimulation = 0;                                                                  \
+        return fmi3OK;                                                                             \
+    }
+
 #endif
