@@ -76,7 +76,13 @@ kill_tree() {
     kill -TERM "$1" 2>/dev/null || true
 }
 (
-    sleep $((watchdog_minutes * 60)) </dev/null >/dev/null 2>&1
+    # (the sleep is this subshell's child, ended with it when the run ends first: no process
+    # of the run outlives it)
+    sleeper=""
+    trap 'kill "$sleeper" 2>/dev/null; exit 0' TERM
+    sleep $((watchdog_minutes * 60)) </dev/null >/dev/null 2>&1 &
+    sleeper=$!
+    wait "$sleeper"
     echo "scripts/test.sh: still running after $watchdog_minutes minutes: stopped (a test hangs?)" >&2
     for child in $(ps -o pid= --ppid $$); do
         [ "$child" != "$BASHPID" ] && kill_tree "$child"
