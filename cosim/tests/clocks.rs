@@ -37,18 +37,23 @@ const TICKS: [(&str, &[f64]); 6] = [
     ("n_out_clock", &[0.35, 0.85, 1.35]),
 ];
 
-#[test]
-fn every_kind_of_clock_ticks_at_its_times() {
-    let dir = work_dir("clocks-kinds");
-    let Some(path) = clocks_fmu(&dir) else { return };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+/// The FMU at `path` alone from 0 to 1.5 s in steps of 0.1 s with `trig` ticked by an input
+/// table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks, 0 elsewhere).
+fn run_with_trig(path: &Path) -> (nigel_cosim::Results, nigel_cosim::Summary) {
+    let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);
-    // the input file's clock column: 1 at the times trig ticks, 0 elsewhere
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
             .unwrap(),
     ));
-    let (results, summary) = simulate(&system, &experiment).unwrap();
+    simulate(&system, &experiment).unwrap()
+}
+
+#[test]
+fn every_kind_of_clock_ticks_at_its_times() {
+    let dir = work_dir("clocks-kinds");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let (results, summary) = run_with_trig(&path);
     let time = results.column("time").unwrap();
     // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
     // 1.35 (periodic) and 0.45 (trig)
@@ -68,7 +73,11 @@ fn every_kind_of_clock_ticks_at_its_times() {
         }
     }
     let last_tick = results.column("last_tick").unwrap();
-    assert_eq!(*last_tick.last().unwrap(), 1.5, "changing's last tick, at the stop time: 0.1 + 0.2 + 0.3 + 0.4 + 0.5 s");
+    assert_eq!(
+        *last_tick.last().unwrap(),
+        1.5,
+        "changing's last tick, at the stop time: 0.1 + 0.2 + 0.3 + 0.4 + 0.5 s"
+    );
     let counted: Vec<(String, u64)> = summary.clock_ticks.clone();
     assert_eq!(
         counted,
@@ -284,13 +293,7 @@ s.freeInstance()
 fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
     let dir = work_dir("clocks-fmpy");
     let Some(path) = clocks_fmu(&dir) else { return };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
-    let mut experiment = Experiment::new(1.5, 0.1);
-    experiment.input = Some(Arc::new(
-        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
-            .unwrap(),
-    ));
-    let (results, _) = simulate(&system, &experiment).unwrap();
+    let (results, _) = run_with_trig(&path);
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();

@@ -8,7 +8,7 @@
  *   FMI2_TEST_NO_FMU_STATE       fmi2Get/Set/FreeFMUstate refused (the file has no FMU state)
  *   FMI2_TEST_NO_MODEL_EXCHANGE  every Model Exchange function refused (Co-Simulation only),
  *                                and the Co-Simulation input/output derivatives refused.
- * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
+ * After its model's struct and `defaults` (or FMI2_TEST_REALS_MODEL for both), a file may write FMI2_TEST_INSTANCE(Type, accepted)
  * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
  * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type) (the three at once:
  * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count),
@@ -90,6 +90,19 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
  * allocates through them). */
 static void *(*fmi2_test_allocate)(size_t, size_t);
 static void (*fmi2_test_free)(void *);
+
+/* A model `Type` whose variables are `count` Reals, value reference k the member r[k], and
+ * the time; its `defaults` sets r to the start values `...` (the rest 0) and the time to 0. */
+#define FMI2_TEST_REALS_MODEL(Type, count, ...)                   \
+    typedef struct {                                              \
+        double r[count];                                          \
+        double time;                                              \
+    } Type;                                                       \
+    static void defaults(Type *m) {                               \
+        static const double starts[count] = {__VA_ARGS__};        \
+        memset(m, 0, sizeof *m);                                  \
+        memcpy(m->r, starts, sizeof starts);                      \
+    }
 
 /* The instance of a test model: a `Type` (a struct with a member `double time`) made by
  * calloc and set up by the file's `static void defaults(Type *)`, accepted where `accepted`

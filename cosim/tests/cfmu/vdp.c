@@ -13,16 +13,8 @@
 #define FMI2_TEST_DIRECTIONAL_DERIVATIVE
 #include "fmi2_test.h"
 
-typedef struct {
-    double r[7];
-    double time;
-} Vdp;
-
-static void defaults(Vdp *v) {
-    memset(v, 0, sizeof *v);
-    v->r[0] = 2.0;
-    v->r[4] = 1.0;
-}
+/* x0, der(x0), x1, der(x1), mu; the call counts 0 */
+FMI2_TEST_REALS_MODEL(Vdp, 7, 2.0, 0.0, 0.0, 0.0, 1.0)
 
 FMI2_TEST_MODEL_EXCHANGE(Vdp)
 

@@ -315,6 +315,59 @@ pub fn time_and_y(csv: &str) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The vdp FMU at `path` alone ("model") to 2 s in steps of 0.01 s under bdf (rtol 1e-6,
+/// atol 1e-8), its states recorded: the tests that compare its Jacobians with differences.
+pub fn run_vdp_under_bdf(path: &Path) -> (nigel_cosim::Results, nigel_cosim::Summary) {
+    let mut e = nigel_cosim::Experiment::new(2.0, 0.01);
+    e.solver = nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+    let fmu = nigel_cosim::Fmu::load(path).unwrap();
+    nigel_cosim::simulate(&nigel_cosim::System::single("model", fmu).unwrap(), &e).unwrap()
+}
+
+/// The folder `work_dir(test)` with the FMUs source.fmu and gain.fmu built in it (the
+/// parts of the SSP tests' systems).
+pub fn work_dir_with_source_and_gain(test: &str) -> PathBuf {
+    let dir = work_dir(test);
+    build_fmu(Model::Source, &dir, &[]);
+    build_fmu(Model::Gain, &dir, &[]);
+    dir
+}
+
+/// Packs the SSP `ssp`: `ssd` as SystemStructure.ssd and the files `files` of `dir` under
+/// their names.
+pub fn pack_ssp(ssp: &Path, ssd: String, dir: &Path, files: &[&str]) {
+    let mut entries = vec![("SystemStructure.ssd", ssd.into_bytes())];
+    entries.extend(files.iter().map(|name| (*name, std::fs::read(dir.join(name)).unwrap())));
+    zip_entries(ssp, &entries);
+}
+
+/// A system builder with an instance of `fmu` under each of `names`.
+pub fn builder_with(fmu: &std::sync::Arc<nigel_cosim::Fmu>, names: &[&str]) -> nigel_cosim::SystemBuilder {
+    let mut b = nigel_cosim::SystemBuilder::new();
+    for name in names {
+        b.add_instance(name, fmu.clone()).unwrap();
+    }
+    b
+}
+
+/// Runs `command` (a run that writes the CSV `csv`), asserts that it succeeded (showing its
+/// stderr otherwise) and reads the CSV: the header's names (quotes removed) and the rows.
+pub fn run_to_csv(command: &mut Command, csv: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let out = command.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    read_csv(csv)
+}
+
+/// The CSV `cosim run` writes: the header's names (quotes removed) and the rows.
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    (header, rows)
+}
+
 /// The model description of the FMU with no states (tests/cfmu/ramp.c); `offset_causality`
 /// of its discrete variable `offset` ("local" as the FMU has it, "output" to test the
 /// sample-period warning).
