@@ -74,6 +74,14 @@ fn run_closed_loop_against_the_baseline(
     )
 }
 
+/// Asserts that the text file `path` (a report) contains each of `parts`.
+fn assert_file_says(path: &Path, parts: &[&str]) {
+    let text = std::fs::read_to_string(path).unwrap();
+    for part in parts {
+        assert!(text.contains(part), "{part} not in {text}");
+    }
+}
+
 fn column(csv: &(Vec<String>, Vec<Vec<f64>>), name: &str) -> Vec<f64> {
     let j = csv.0.iter().position(|n| n == name).unwrap_or_else(|| panic!("{name} not in {:?}", csv.0));
     csv.1.iter().map(|r| r[j]).collect()
@@ -175,8 +183,7 @@ fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
     }
     // docs/ci.md shows this run's lines
     assert_eq!(doc_block("run"), stdout);
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"9\" failures=\"0\" errors=\"0\""), "{xml}");
+    assert_file_says(&junit, &["tests=\"9\" failures=\"0\" errors=\"0\""]);
     let md = std::fs::read_to_string(&md).unwrap();
     assert!(md.contains("passed (9 tests, 0 failed, 0 errors)"), "{md}");
     assert!(md.contains(
@@ -187,7 +194,7 @@ fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
 #[test]
 fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
     let dir = work("fail");
-    let (base, out, junit, plots) = (baseline(), dir.join("out.csv"), dir.join("junit.xml"), dir.join("plots"));
+    let (out, junit, plots) = (dir.join("out.csv"), dir.join("junit.xml"), dir.join("plots"));
     let (code, stdout, stderr) = run_closed_loop_against_the_baseline(
         &out,
         &["--set", "plant.m=2.6800001"],
@@ -202,7 +209,7 @@ fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
     assert!(stdout.contains("baseline: plant.x         pass  601 points inside the tube"), "{stdout}");
     // the largest violation of plant.yaw_rate, derived from the two files: at each point the
     // tube is b +- (1e-12 + 1e-9 |b|) (same grid, no time tolerance)
-    let (r, b) = (column(&csv, "plant.yaw_rate"), column(&read_csv(&base), "plant.yaw_rate"));
+    let (r, b) = (column(&csv, "plant.yaw_rate"), column(&read_csv(&baseline()), "plant.yaw_rate"));
     let excess: Vec<f64> = r.iter().zip(&b).map(|(r, b)| (r - b).abs() - (1e-12 + 1e-9 * b.abs())).collect();
     let outside = excess.iter().filter(|e| **e > 0.0).count();
     let k = (0..601).max_by(|i, j| excess[*i].total_cmp(&excess[*j])).unwrap();
@@ -221,9 +228,10 @@ fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
         assert!(stderr.contains(&format!("cosim: figure {}", png.display())), "{stderr}");
     }
     assert!(!plots.join("plant.x.png").exists(), "a passing signal has no figure");
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"7\" failures=\"5\" errors=\"0\""), "{xml}");
-    assert!(xml.contains("<testcase classname=\"cosim.baseline\" name=\"plant.x\">"), "{xml}");
+    assert_file_says(
+        &junit,
+        &["tests=\"7\" failures=\"5\" errors=\"0\"", "<testcase classname=\"cosim.baseline\" name=\"plant.x\">"],
+    );
 }
 
 #[test]
@@ -286,9 +294,10 @@ fn a_run_that_cannot_be_done_exits_1_and_says_why() {
         junit.to_str().unwrap(),
     ]);
     assert_eq!(code, Some(1), "{stderr}");
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"2\" failures=\"0\" errors=\"2\""), "{xml}");
-    assert!(xml.contains("<error message=\"not judged: the run failed\""), "{xml}");
+    assert_file_says(
+        &junit,
+        &["tests=\"2\" failures=\"0\" errors=\"2\"", "<error message=\"not judged: the run failed\""],
+    );
 }
 
 #[test]

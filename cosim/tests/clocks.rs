@@ -37,23 +37,24 @@ const TICKS: [(&str, &[f64]); 6] = [
     ("n_out_clock", &[0.35, 0.85, 1.35]),
 ];
 
-/// The FMU at `path` alone from 0 to 1.5 s in steps of 0.1 s with `trig` ticked by an input
-/// table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks, 0 elsewhere).
-fn run_with_trig(path: &Path) -> (nigel_cosim::Results, nigel_cosim::Summary) {
-    let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
+/// The FMU built in `work_dir(test)` alone from 0 to 1.5 s in steps of 0.1 s with `trig`
+/// ticked by an input table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks,
+/// 0 elsewhere): the FMU's path, the results and the summary; `None` without fmpy.
+fn run_with_trig(test: &str) -> Option<(PathBuf, nigel_cosim::Results, nigel_cosim::Summary)> {
+    let path = clocks_fmu(&work_dir(test))?;
+    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
             .unwrap(),
     ));
-    simulate(&system, &experiment).unwrap()
+    let (results, summary) = simulate(&system, &experiment).unwrap();
+    Some((path, results, summary))
 }
 
 #[test]
 fn every_kind_of_clock_ticks_at_its_times() {
-    let dir = work_dir("clocks-kinds");
-    let Some(path) = clocks_fmu(&dir) else { return };
-    let (results, summary) = run_with_trig(&path);
+    let Some((_, results, summary)) = run_with_trig("clocks-kinds") else { return };
     let time = results.column("time").unwrap();
     // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
     // 1.35 (periodic) and 0.45 (trig)
@@ -291,9 +292,7 @@ s.freeInstance()
 
 #[test]
 fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
-    let dir = work_dir("clocks-fmpy");
-    let Some(path) = clocks_fmu(&dir) else { return };
-    let (results, _) = run_with_trig(&path);
+    let Some((path, results, _)) = run_with_trig("clocks-fmpy") else { return };
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();

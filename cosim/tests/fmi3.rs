@@ -623,6 +623,18 @@ fn run_as_the_plain_counter(path: &Path, dir: &Path, plain_test: &str) -> std::p
     out
 }
 
+/// The counter declaring `hasEventMode`, built in `work_dir(test)` (with the folder).
+fn counter_with_event_mode(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let dir = work_dir(test);
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    assert_ne!(xml, XML);
+    let path = build_counter(&dir, "event_mode", &xml)?;
+    Some((dir, path))
+}
+
 /// Value references up to 4294967295 are the FMU's to use (Dymola uses 4294967294): a
 /// parameter there leaves the rest of the view whole (before, the array elements' view
 /// references were counted above the largest one, overflowed u32, and every variable was
@@ -735,13 +747,7 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
 /// (n counts the steps only, `every_type_and_array_elements_are_recorded`).
 #[test]
 fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
-    let dir = work_dir("fmi3-event-mode");
-    let xml = XML.replace(
-        "mightReturnEarlyFromDoStep=\"true\"/>",
-        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
-    );
-    assert_ne!(xml, XML);
-    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let Some((dir, path)) = counter_with_event_mode("fmi3-event-mode") else { return };
     let (r, _) = simulate(&with_starts(&path, &[]), &Experiment::new(1.0, 0.1)).unwrap();
     let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
     for k in 0..r.rows() {
@@ -766,12 +772,7 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
 /// description without `hasEventMode`).
 #[test]
 fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
-    let dir = work_dir("fmi3-refuses-event-mode");
-    let xml = XML.replace(
-        "mightReturnEarlyFromDoStep=\"true\"/>",
-        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
-    );
-    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let Some((_, path)) = counter_with_event_mode("fmi3-refuses-event-mode") else { return };
     let mut b = SystemBuilder::new();
     b.add_instance("c-no-event-mode", Fmu::load(&path).unwrap()).unwrap();
     let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();

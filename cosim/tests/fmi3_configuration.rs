@@ -23,6 +23,18 @@ fn sized(test: &str) -> Option<(PathBuf, PathBuf)> {
     Some((dir, fmu))
 }
 
+/// The names of the first instance's variables that start with `prefix` (an array's
+/// elements, as the view has them after configuration).
+fn element_names(system: &nigel_cosim::System, prefix: &str) -> Vec<String> {
+    system
+        .description(0)
+        .model_variables
+        .iter()
+        .filter(|v| v.name.starts_with(prefix))
+        .map(|v| v.name.clone())
+        .collect()
+}
+
 /// The values of the columns `names` at each row of a run of `fmu` with the settings
 /// `sets` (`name`, text) to 1 s in steps of 0.5 s.
 fn run(fmu: &Path, sets: &[(&str, &str)]) -> nigel_cosim::Result<Vec<Vec<f64>>> {
@@ -33,13 +45,7 @@ fn run(fmu: &Path, sets: &[(&str, &str)]) -> nigel_cosim::Result<Vec<Vec<f64>>> 
     }
     let system = b.build();
     let (result, _) = simulate(&system, &Experiment::new(1.0, 0.5))?;
-    let names: Vec<String> = system
-        .description(0)
-        .model_variables
-        .iter()
-        .filter(|v| v.name.starts_with("y["))
-        .map(|v| v.name.clone())
-        .collect();
+    let names = element_names(&system, "y[");
     Ok((0..result.rows()).map(|r| names.iter().map(|n| result.column(n).unwrap()[r]).collect()).collect())
 }
 
@@ -159,15 +165,9 @@ fn the_corpus_dynamic_array_test_records_18_elements_with_xsize_6() {
     b.set_text("m.Float64Input", &format!("[{}]", vec!["2"; 18].join(","))).unwrap();
     let system = b.build();
     let (result, _) = simulate(&system, &Experiment::new(0.04, 0.02)).unwrap();
-    let outputs: Vec<&str> = system
-        .description(0)
-        .model_variables
-        .iter()
-        .filter(|v| v.name.starts_with("Float64Output["))
-        .map(|v| v.name.as_str())
-        .collect();
+    let outputs = element_names(&system, "Float64Output[");
     assert_eq!(outputs.len(), 18);
-    assert_eq!((outputs[0], outputs[17]), ("Float64Output[1,1]", "Float64Output[6,3]"));
+    assert_eq!((outputs[0].as_str(), outputs[17].as_str()), ("Float64Output[1,1]", "Float64Output[6,3]"));
     let after_first_step: Vec<f64> = outputs.iter().map(|n| result.column(n).unwrap()[1]).collect();
     assert_eq!(after_first_step, (0..18).map(|k| 2.0 * k as f64).collect::<Vec<_>>());
 }

@@ -11,7 +11,8 @@
  * After its model's struct and `defaults` (or FMI2_TEST_REALS_MODEL for both), a file may write FMI2_TEST_INSTANCE(Type, accepted)
  * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
  * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type) (the three at once:
- * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count),
+ * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count) or
+ * FMI2_TEST_SET_REAL_MEMBERS(Type, ...),
  * FMI2_TEST_UNIT_NOMINALS, FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
@@ -215,6 +216,22 @@ static void (*fmi2_test_free)(void *);
     FMI2_TEST_INSTANCE(Type, type == 0) \
     FMI2_TEST_EXIT_INITIALIZATION      \
     FMI2_TEST_CONTINUOUS_TIME(Type)
+
+/* fmi2SetReal of a `Type` whose settable Reals are at the addresses `...`, designated
+ * initializers `[vr] = &m->member` (`m` the instance); another value reference is refused
+ * (fmi2Error). */
+#define FMI2_TEST_SET_REAL_MEMBERS(Type, ...)                                                            \
+    EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,              \
+                                  const double v[]) {                                                    \
+        Type *m = c;                                                                                     \
+        double *slots[] = {__VA_ARGS__};                                                                 \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] >= sizeof slots / sizeof *slots || !slots[vr[i]]) return ERR;                      \
+            *slots[vr[i]] = v[i];                                                                        \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }
 
 /* fmi2SetReal of a `Type` whose `double r[]` holds its Real variables by value reference:
  * any of the first `count` may be set, a value reference beyond them is refused. */

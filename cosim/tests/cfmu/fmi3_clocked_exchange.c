@@ -16,10 +16,10 @@
 #include "fmi3_test.h"
 
 typedef struct {
-    double time, u, y;
-    int ticks, initializing, in_event_mode, active, ticked, scheduled, u_set;
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
+    double time, u, y;
+    int ticks, initializing, in_event_mode, active, ticked, scheduled, u_set;
 } Exchange;
 
 FMI3_TEST_FAIL(Exchange)

@@ -64,6 +64,8 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     }
 }
 
+FMI3_TEST_OUTPUT_CLOCK(Node, 3, done)
+
 /* The fixed clock's interval is known after initialization only (the period set before). */
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
     fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
@@ -86,7 +88,6 @@ fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReferenc
     return fmi3OK;
 }
 
-FMI3_TEST_OUTPUT_CLOCK(Node, 3, done)
 
 FMI3_TEST_GET(Float64, fmi3Float64, Node, [10] = &c->period, [11] = &c->u, [12] = &c->v, [13] = &c->y, [14] = &c->z,
     [15] = &c->w)

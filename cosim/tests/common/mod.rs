@@ -233,17 +233,36 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "hostile", xml)
 }
 
-/// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
-/// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
-pub fn build_nanme(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "nanme", include_str!("../cfmu/nanme.xml"))
+/// `pub fn $name(dir: &Path) -> PathBuf` for each `$name => "$id"`: the C test FMU
+/// tests/cfmu/$id.c with its description tests/cfmu/$id.xml, as `<dir>/$id.fmu`.
+macro_rules! c_fmu_builders {
+    ($($(#[$doc:meta])* $name:ident => $id:literal;)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(dir: &Path) -> PathBuf {
+                build_single_c_fmu(dir, $id, include_str!(concat!("../cfmu/", $id, ".xml")))
+            }
+        )*
+    };
 }
 
-/// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
-pub fn build_ball(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))
+c_fmu_builders! {
+    /// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
+    /// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
+    build_nanme => "nanme";
+    /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
+    build_ball => "ball";
+    /// The self-ending counter (tests/cfmu/stair.c, after the Reference FMU Stair), Model
+    /// Exchange and Co-Simulation, as `<dir>/stair.fmu`.
+    build_stair => "stair";
+    /// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
+    /// exit(0), a never-returning step at t_crash, a 10 MB log message, a double free), as
+    /// `<dir>/crash.fmu`.
+    build_crash => "crash";
+    /// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
+    /// `<dir>/vdp.fmu`.
+    build_vdp => "vdp";
 }
-
 /// The bouncing ball with `n` event indicators (all z = h), as `<dir>/ball.fmu`.
 pub fn build_ball_with_indicators(dir: &Path, n: usize) -> PathBuf {
     let xml = include_str!("../cfmu/ball.xml")
@@ -270,19 +289,6 @@ pub fn build_latch(dir: &Path) -> PathBuf {
 </fmiModelDescription>
 "#;
     build_single_c_fmu(dir, "latch", xml)
-}
-
-/// The self-ending counter (tests/cfmu/stair.c, after the Reference FMU Stair), Model
-/// Exchange and Co-Simulation, as `<dir>/stair.fmu`.
-pub fn build_stair(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "stair", include_str!("../cfmu/stair.xml"))
-}
-
-/// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
-/// exit(0), a never-returning step at t_crash, a 10 MB log message, a double free), as
-/// `<dir>/crash.fmu`.
-pub fn build_crash(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "crash", include_str!("../cfmu/crash.xml"))
 }
 
 /// [`build_crash`] with a GUID of `bytes` bytes (`{crash}` then hexadecimal digits of a
@@ -393,12 +399,6 @@ pub fn ramp_xml(offset_causality: &str) -> String {
 /// Exchange only, with the model description `xml` ([`ramp_xml`]), as `<dir>/ramp.fmu`.
 pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
     build_single_c_fmu(dir, "ramp", xml)
-}
-
-/// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
-/// `<dir>/vdp.fmu`.
-pub fn build_vdp(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "vdp", include_str!("../cfmu/vdp.xml"))
 }
 
 /// The stiff linear system with a closed-form solution (tests/cfmu/linear.c), Model
