@@ -39,11 +39,16 @@ const TICKS: [(&str, &[f64]); 6] = [
 
 /// The FMU built in `work_dir(test)` alone from 0 to 1.5 s in steps of 0.1 s with `trig`
 /// ticked by an input table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks,
-/// 0 elsewhere): the FMU's path, the results and the summary; `None` without fmpy.
-fn run_with_trig(test: &str) -> Option<(PathBuf, nigel_cosim::Results, nigel_cosim::Summary)> {
+/// 0 elsewhere), with `isolation`: the FMU's path, the results and the summary; `None`
+/// without fmpy.
+fn run_with_trig(
+    test: &str,
+    isolation: Option<nigel_cosim::Isolation>,
+) -> Option<(PathBuf, nigel_cosim::Results, nigel_cosim::Summary)> {
     let path = clocks_fmu(&work_dir(test))?;
     let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);
+    experiment.isolation = isolation;
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
             .unwrap(),
@@ -54,7 +59,19 @@ fn run_with_trig(test: &str) -> Option<(PathBuf, nigel_cosim::Results, nigel_cos
 
 #[test]
 fn every_kind_of_clock_ticks_at_its_times() {
-    let Some((_, results, summary)) = run_with_trig("clocks-kinds") else { return };
+    every_kind_ticks_at_its_times("clocks-kinds", None);
+}
+
+/// The same with the instance in a host process (`--isolate`): every clock call
+/// (`fmi3SetClock`, `fmi3GetClock`, `fmi3GetIntervalDecimal`, `fmi3GetShiftDecimal`, the
+/// event's calls) crosses the process boundary, the same counts at every row.
+#[test]
+fn every_kind_of_clock_ticks_at_its_times_in_a_host_process() {
+    every_kind_ticks_at_its_times("clocks-kinds-isolated", Some(common::isolate_all()));
+}
+
+fn every_kind_ticks_at_its_times(test: &str, isolation: Option<nigel_cosim::Isolation>) {
+    let Some((_, results, summary)) = run_with_trig(test, isolation) else { return };
     let time = results.column("time").unwrap();
     // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
     // 1.35 (periodic) and 0.45 (trig)
@@ -119,14 +136,16 @@ fn a_clock_column_for_a_periodic_clock_is_refused() {
     assert!(e.contains("\"periodic\"") && e.contains("only triggered input clocks"), "{e}");
 }
 
+/// Instances `a` and `b` of the FMU at `path`, not connected.
+fn two_instances(path: &Path) -> SystemBuilder {
+    common::builder_with(&Fmu::load(path).unwrap(), &["a", "b"])
+}
+
 #[test]
 fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     let dir = work_dir("clocks-connected");
     let Some(path) = clocks_fmu(&dir) else { return };
-    let fmu = Fmu::load(&path).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("a", fmu.clone()).unwrap();
-    b.add_instance("b", fmu).unwrap();
+    let mut b = two_instances(&path);
     // a clock connects to a triggered input clock only
     let e = b.connect("a.n_out_clock", "b.trig").unwrap_err().to_string();
     assert!(e.contains("the destination is a clock"), "{e}");
@@ -147,6 +166,35 @@ fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     }
     let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
     assert_eq!((ticks("a.out_clock"), ticks("b.trig"), ticks("a.trig")), (Some(3), Some(3), Some(0)));
+}
+
+/// Two instances connected clock to clock (`a.out_clock -> b.trig`) stepped in two threads
+/// (`--threads 2`), in steps of 30 ms so that the periodic clock's ticks (0.1 + k 0.25 s)
+/// fall inside steps and split them: after the 200 calibration steps each instance is in a
+/// thread of its own, the pool splits every step at the ticks and carries `a`'s output
+/// clock ticks to `b` across the threads as one thread does; 60 s, the single-thread run's
+/// rows and ticks bit for bit.
+#[test]
+fn connected_clocks_in_two_threads_give_the_single_thread_run() {
+    let dir = work_dir("clocks-threads");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let mut b = two_instances(&path);
+    b.connect("a.out_clock", "b.trig").unwrap();
+    let system = b.build();
+    let mut e = Experiment::new(60.0, 0.03);
+    let (serial, serial_summary) = simulate(&system, &e).unwrap();
+    e.threads = 2;
+    let (parallel, summary) = simulate(&system, &e).unwrap();
+    assert!(summary.parallel_steps >= 1000, "{} steps in the pool", summary.parallel_steps);
+    // rows at the 2001 points and at the periodic ticks between them (0.35 s the first)
+    assert!(serial.rows() > 2001 && serial.column("time").unwrap().contains(&0.35), "{}", serial.rows());
+    assert_eq!((parallel.rows(), &parallel.names), (serial.rows(), &serial.names));
+    let differing = serial.values.iter().zip(&parallel.values).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
+    assert_eq!(differing, 0, "values of the two-thread run differ from the single-thread one's");
+    assert_eq!(summary.clock_ticks, serial_summary.clock_ticks);
+    let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
+    // a.out_clock ticks at every second periodic tick, each carried to b.trig
+    assert!(ticks("a.out_clock").is_some_and(|k| k > 100) && ticks("a.out_clock") == ticks("b.trig"));
 }
 
 /// An SSP (SSP 2.0 draft: ssc:Clock connectors) of two instances of the clock FMU with
@@ -292,7 +340,7 @@ s.freeInstance()
 
 #[test]
 fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
-    let Some((path, results, _)) = run_with_trig("clocks-fmpy") else { return };
+    let Some((path, results, _)) = run_with_trig("clocks-fmpy", None) else { return };
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();

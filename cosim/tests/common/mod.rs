@@ -540,3 +540,13 @@ pub fn assert_counted_at_bounces(r: &nigel_cosim::Results, bounces: &[f64], what
         assert_eq!((count[k], t_last[k]), (n, last), "{what}: at t = {}", t[k]);
     }
 }
+
+/// Every instance in a host process of its own (`--isolate`), the host the one this
+/// package builds (`option_env!`: the campaign's tests include this module and build no host).
+pub fn isolate_all() -> nigel_cosim::Isolation {
+    nigel_cosim::Isolation {
+        instances: None,
+        call_timeout: None,
+        host: option_env!("CARGO_BIN_EXE_cosim-host").map(PathBuf::from),
+    }
+}
