@@ -36,11 +36,10 @@ fn a_structural_parameter_is_a_sweep_dimension_and_sizes_each_runs_arrays() {
     let dir = tempfile::tempdir().unwrap();
     let Some(fmu) = sized_fmu(dir.path()) else { return };
     let spec = dir.path().join("sized.toml");
-    write_spec(
-        &spec,
-        &fmu,
-        "stop_time = 1.0\nstep = 0.5\n\n[grid]\n\"model.n\" = [1, 2, 3]\n\n[metrics]\ny1 = \"final(model.y[1])\"\n",
-    );
+    // n = 1, 2, 3: the sweep; y[1] exists in every run
+    let sweep =
+        "stop_time = 1.0\nstep = 0.5\n\n[grid]\n\"model.n\" = [1, 2, 3]\n\n[metrics]\ny1 = \"final(model.y[1])\"\n";
+    write_spec(&spec, &fmu, sweep);
     let out = dir.path().join("out");
     let o = campaign_run(&spec, &out).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
