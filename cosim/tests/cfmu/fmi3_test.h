@@ -3,8 +3,11 @@
  * their folder with -I; fmi3_clocked_exchange.c too): fmi3GetVersion and the helpers that are the same in each. Each .c
  * file is one shared library and includes this header once. After its instance's struct (a
  * `Type` with members `fmi3InstanceEnvironment env` and `fmi3LogMessageCallback log`), a
- * file writes FMI3_TEST_FAIL(Type) for its `fail`, and an Event Mode only Co-Simulation
- * FMU FMI3_TEST_EVENT_MODE_INSTANCE for its lifecycle. */
+ * file writes FMI3_TEST_FAIL(Type) for its `fail`; an Event Mode only Co-Simulation FMU
+ * FMI3_TEST_EVENT_MODE_INSTANCE, FMI3_TEST_EVENT_MODE_STEPS and FMI3_TEST_RESET for its
+ * lifecycle, a Scheduled Execution FMU FMI3_TEST_SCHEDULED_INSTANCE; FMI3_TEST_GET and
+ * FMI3_TEST_SET give typed gets and sets from a table of the variables' addresses,
+ * FMI3_TEST_OUTPUT_CLOCK the read of a single output clock. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
