@@ -160,3 +160,19 @@ fn fmpy_driving_the_changing_partition_through_the_hand_derived_ticks_gives_cosi
         assert_eq!(r.column(name).unwrap(), theirs, "{name}: cosim vs fmpy's calls");
     }
 }
+
+/// A first interval that is no time (first_delay -1 s, which the FMU gives as it is) ends the
+/// run before any activation with an error naming the call, the clock and the value.
+#[test]
+fn a_changing_clock_interval_that_is_no_time_is_an_error_naming_it() {
+    let dir = work_dir("fmi3-scheduled-changing-bad");
+    let Some(fmu) = build(&dir) else { return };
+    let options = ImportOptions { interface: Some(Interface::ScheduledExecution), ..ImportOptions::default() };
+    let mut b = SystemBuilder::new();
+    b.add_instance("c", Fmu::load_with(&fmu, &options).unwrap()).unwrap();
+    b.set("c.first_delay", Value::Real(-1.0)).unwrap();
+    let (results, outcome) = simulate_scheduled(&b.build(), &Experiment::new(3.0, 0.5));
+    let e = outcome.unwrap_err().to_string();
+    assert!(e.contains("fmi3GetIntervalDecimal") && e.contains("clock 1: interval -1 s is no time"), "{e}");
+    assert_eq!(results.rows(), 0, "no row: no activation ran");
+}
