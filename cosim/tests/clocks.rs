@@ -37,29 +37,11 @@ const TICKS: [(&str, &[f64]); 6] = [
     ("n_out_clock", &[0.35, 0.85, 1.35]),
 ];
 
-/// The FMU built in `work_dir(test)` alone from 0 to 1.5 s in steps of 0.1 s with `trig`
-/// ticked by an input table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks,
-/// 0 elsewhere), with `isolation`: the FMU's path, the results and the summary; `None`
-/// without fmpy.
-fn run_with_trig(
-    test: &str,
-    isolation: Option<nigel_cosim::Isolation>,
-) -> Option<(PathBuf, nigel_cosim::Results, nigel_cosim::Summary)> {
-    let path = clocks_fmu(&work_dir(test))?;
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
-    let mut experiment = Experiment::new(1.5, 0.1);
-    experiment.isolation = isolation;
-    experiment.input = Some(Arc::new(
-        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
-            .unwrap(),
-    ));
-    let (results, summary) = simulate(&system, &experiment).unwrap();
-    Some((path, results, summary))
-}
-
 #[test]
 fn every_kind_of_clock_ticks_at_its_times() {
-    every_kind_ticks_at_its_times("clocks-kinds", None);
+    let dir = work_dir("clocks-kinds");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    every_kind_ticks_at_its_times(&path, None);
 }
 
 /// The same with the instance in a host process (`--isolate`): every clock call
@@ -67,11 +49,50 @@ fn every_kind_of_clock_ticks_at_its_times() {
 /// event's calls) crosses the process boundary, the same counts at every row.
 #[test]
 fn every_kind_of_clock_ticks_at_its_times_in_a_host_process() {
-    every_kind_ticks_at_its_times("clocks-kinds-isolated", Some(common::isolate_all()));
+    let dir = work_dir("clocks-kinds-isolated");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
 }
 
-fn every_kind_ticks_at_its_times(test: &str, isolation: Option<nigel_cosim::Isolation>) {
-    let Some((_, results, summary)) = run_with_trig(test, isolation) else { return };
+/// The same FMU built with `FMI3_FRACTION_ONLY`: it gives its intervals only as fractions
+/// (`fmi3GetIntervalFraction`: periodic 1/4, fixed 400/1000, changing k/10, countdown 1/2)
+/// and exports no `fmi3GetIntervalDecimal` (nor `fmi3GetShiftDecimal`), so the master takes
+/// each interval as counter / resolution: the same hand-derived ticks (the counts are of
+/// ticks within 1e-9 s of a row, so 3/10 for 0.1 * 3, an ulp apart, changes no count), in
+/// process and in a host process.
+#[test]
+fn every_kind_of_clock_ticks_at_its_times_from_fractional_intervals() {
+    let dir = work_dir("clocks-kinds-fraction");
+    let xml = include_str!("cfmu/fmi3_clocks.xml");
+    let Some(path) = common::fmi3_c::build_with(&dir, "fmi3_clocks", xml, &["FMI3_FRACTION_ONLY"]) else { return };
+    // the library names no fmi3GetIntervalDecimal (its symbol table holds every name it
+    // exports), but fmi3GetIntervalFraction
+    let so = std::fs::read(dir.join("fmi3_clocks.so")).unwrap();
+    let names = |name: &str| so.windows(name.len()).any(|w| w == name.as_bytes());
+    assert!(!names("fmi3GetIntervalDecimal") && names("fmi3GetIntervalFraction"));
+    every_kind_ticks_at_its_times(&path, None);
+    every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
+}
+
+/// The FMU at `path` alone from 0 to 1.5 s in steps of 0.1 s with `trig` ticked by an input
+/// table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks, 0 elsewhere), with
+/// `isolation`.
+fn run_with_trig(
+    path: &Path,
+    isolation: Option<nigel_cosim::Isolation>,
+) -> (nigel_cosim::Results, nigel_cosim::Summary) {
+    let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.5, 0.1);
+    experiment.isolation = isolation;
+    experiment.input = Some(Arc::new(
+        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
+            .unwrap(),
+    ));
+    simulate(&system, &experiment).unwrap()
+}
+
+fn every_kind_ticks_at_its_times(path: &Path, isolation: Option<nigel_cosim::Isolation>) {
+    let (results, summary) = run_with_trig(path, isolation);
     let time = results.column("time").unwrap();
     // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
     // 1.35 (periodic) and 0.45 (trig)
@@ -340,7 +361,9 @@ s.freeInstance()
 
 #[test]
 fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
-    let Some((path, results, _)) = run_with_trig("clocks-fmpy", None) else { return };
+    let dir = work_dir("clocks-fmpy");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let (results, _) = run_with_trig(&path, None);
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();
