@@ -367,20 +367,9 @@ fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();
-    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let out = Command::new(python)
-        .args(["-c", FMPY_DRIVER])
-        .arg(&path)
-        .arg(format!("{time:?}"))
-        .arg(format!("[{}]", ticks.join(", ")))
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (times, ticks) = (format!("{time:?}"), format!("[{}]", ticks.join(", ")));
+    let lines = common::fmi3_c::fmpy_lines(FMPY_DRIVER, &[path.as_os_str(), times.as_ref(), ticks.as_ref()]);
     let columns = ["n_periodic", "n_fixed", "n_changing", "n_countdown", "n_trig", "n_out_clock", "last_tick"];
-    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
-        .collect();
     assert_eq!(lines.len(), time.len());
     for (name, k) in columns.iter().zip(1..) {
         let ours = results.column(name).unwrap();

@@ -257,17 +257,8 @@ fn fmpy_driving_the_fmus_through_the_hand_derived_activations_gives_cosims_rows(
     let Some((a, b)) = build(&dir) else { return };
     let (r, outcome) = simulate_scheduled(&system(&a, &b), &Experiment::new(2.0, 0.25));
     outcome.unwrap();
-    let out = std::process::Command::new(common::fmi3_c::python())
-        .args(["-c", FMPY_DRIVER])
-        .args([&a, &b])
-        .args([ACTIVATIONS, "2"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
-        .collect();
+    let lines =
+        common::fmi3_c::fmpy_lines(FMPY_DRIVER, &[a.as_os_str(), b.as_os_str(), ACTIVATIONS.as_ref(), "2".as_ref()]);
     assert_eq!(lines.iter().map(|l| l[0]).collect::<Vec<_>>(), r.column("time").unwrap());
     let names = ["y", "z", "w", "n_sample", "n_trigger", "n_rate"];
     let columns = ["A", "B"].iter().flat_map(|i| names.iter().map(move |n| format!("{i}.{n}")));

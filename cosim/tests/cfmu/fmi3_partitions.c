@@ -39,10 +39,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
     Partitions *p = instance;
-    if (time != p->last_time) {
-        p->first = (int)clock;
-        p->last_time = time;
-    }
+    note_first_partition(&p->first, &p->last_time, clock, time);
     switch (clock) {
     case 1:
         if (!p->lock || !p->unlock) return fail(p, "fast: no lockPreemption/unlockPreemption");
@@ -72,17 +69,8 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     }
 }
 
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 3) return fail(p, "fmi3GetIntervalDecimal: only the countdown clock later");
-        qualifiers[i] = p->later_changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;
-        intervals[i] = 0.125;
-        p->later_changed = 0;
-    }
-    return fmi3OK;
-}
+/* the countdown clock later: 0.125 s, changed when slow set it */
+FMI3_TEST_ONE_INTERVAL(Partitions, 3, 0.125, later_changed)
 
 FMI3_TEST_OUTPUT_CLOCK(Partitions, 4, out)
 

@@ -7,7 +7,8 @@
  * FMI3_TEST_EVENT_MODE_INSTANCE, FMI3_TEST_EVENT_MODE_STEPS and FMI3_TEST_RESET for its
  * lifecycle, a Scheduled Execution FMU FMI3_TEST_SCHEDULED_INSTANCE; FMI3_TEST_GET and
  * FMI3_TEST_SET give typed gets and sets from a table of the variables' addresses,
- * FMI3_TEST_OUTPUT_CLOCK the read of a single output clock. */
+ * FMI3_TEST_OUTPUT_CLOCK the read of a single output clock, FMI3_TEST_ONE_INTERVAL the
+ * interval of a single clock. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
@@ -148,6 +149,31 @@ static inline fmi3Status step_reached(fmi3Float64 time, fmi3Boolean *eventHandli
         }                                                                                          \
         return fmi3OK;                                                                             \
     }
+
+/* fmi3GetIntervalDecimal of a `Type` with one clock whose interval the FMU gives, value
+ * reference `clock`: `interval` (an expression of `c`, the instance), fmi3IntervalChanged
+ * when the int member `changed` is set (the read clears it), else fmi3IntervalUnchanged. */
+#define FMI3_TEST_ONE_INTERVAL(Type, clock, interval, changed)                                     \
+    fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, \
+        fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {                             \
+        Type *c = instance;                                                                        \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] != clock) return fail(c, "fmi3GetIntervalDecimal: not the clock of the FMU's intervals"); \
+            intervals[k] = interval;                                                               \
+            qualifiers[k] = c->changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;              \
+            c->changed = 0;                                                                        \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
+
+/* The partition activated first at the latest activation time: at an activation of `clock`
+ * at `time` later than `*last_time`, `*first` becomes the clock and `*last_time` the time. */
+static inline void note_first_partition(int *first, double *last_time, fmi3ValueReference clock, fmi3Float64 time) {
+    if (time != *last_time) {
+        *first = (int)clock;
+        *last_time = time;
+    }
+}
 
 /* fmi3GetClock of a `Type` with one output clock, value reference `clock`: whether it ticked
  * (the int member `ticked` nonzero), which the read clears. */

@@ -11,6 +11,17 @@ pub fn python() -> String {
     std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
 }
 
+/// The lines the fmpy script `script` prints (`python -c script args...`, asserted to
+/// succeed), each as its whitespace-separated numbers.
+pub fn fmpy_lines<S: AsRef<std::ffi::OsStr>>(script: &str, args: &[S]) -> Vec<Vec<f64>> {
+    let out = Command::new(python()).args(["-c", script]).args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
+        .collect()
+}
+
 /// The `cc` flags of an FMI 3.0 test FMU: warnings are errors, the standard's headers from
 /// the folder `headers`.
 pub fn flags(headers: &Path) -> Vec<OsString> {
