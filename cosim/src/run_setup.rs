@@ -373,3 +373,21 @@ pub fn run_in_process(
     let outcome = crate::simulate::run_to_end_with(&mut execution, timed_sets);
     (execution.take_results(), outcome)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_a_run_cannot_mean_are_named_in_the_front_ends_spelling() {
+        let mut e = Experiment::new(0.5, 1e-3);
+        e.start_time = 1.0;
+        let message = check_times(&e, crate::options::cli_option_name).unwrap_err().to_string();
+        assert!(message.contains("the stop time 0.5 s must be after the start time 1 s (--stop-time, --start-time)"));
+        // a step of 2 s in a run of 1 s (0 to 1 s)
+        let e = Experiment::new(1.0, 2.0);
+        let message = check_times(&e, |n| n.to_string()).unwrap_err().to_string();
+        assert!(message.contains("the step 2 s is longer than the run (1 s from 0 to 1 s): choose a step of at most 1"));
+        assert!(check_times(&Experiment::new(1.0, 1.0), crate::options::cli_option_name).is_ok());
+    }
+}

@@ -51,12 +51,10 @@ impl Interface {
 impl std::str::FromStr for Interface {
     type Err = String;
     fn from_str(name: &str) -> std::result::Result<Interface, String> {
-        match name {
-            "cs" => Ok(Interface::CoSimulation),
-            "me" => Ok(Interface::ModelExchange),
-            "se" => Ok(Interface::ScheduledExecution),
-            other => Err(format!("unknown interface {other:?} (cs, me, se)")),
-        }
+        let short =
+            [("cs", Interface::CoSimulation), ("me", Interface::ModelExchange), ("se", Interface::ScheduledExecution)];
+        let found = short.into_iter().find(|(short_name, _)| *short_name == name);
+        found.map(|(_, interface)| interface).ok_or_else(|| format!("unknown interface {name:?} (cs, me, se)"))
     }
 }
 
