@@ -47,18 +47,9 @@ fn a_single_fmus_variables_are_named_bare_or_qualified() {
     let csv = dir.join("out.csv");
     // x qualified, y bare: both columns bare; the check's v_x is recorded for the check but
     // left out of the file (it was not asked for)
-    let (status, stderr) = cosim_run(&[
-        "--stop-time",
-        "0.002",
-        "--record",
-        "model.x",
-        "--record",
-        "y",
-        "--check",
-        "max(abs(v_x)) < 1",
-        "--output",
-        csv.to_str().unwrap(),
-    ]);
+    let mut args: Vec<&str> = "--stop-time 0.002 --record model.x --record y".split(' ').collect();
+    args.extend(["--check", "max(abs(v_x)) < 1", "--output", csv.to_str().unwrap()]);
+    let (status, stderr) = cosim_run(&args);
     assert_eq!(status, Some(0), "{stderr}");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().next(), Some("\"time\",\"x\",\"y\""));
