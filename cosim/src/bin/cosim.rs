@@ -371,6 +371,9 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         let (name, text) = setting.split_once('=').ok_or_else(|| bad("expected NAME=VALUE"))?;
         setup.set_at(time, name.trim(), text, &label)?;
     }
+    if args.isolate.is_some() && nigel_cosim::simulate::is_scheduled(setup.system()) {
+        return Err(Error::Experiment(nigel_cosim::simulate::SCHEDULED_NOT_ISOLATED.into()).into());
+    }
     if !setup.timed_sets().is_empty() && (args.isolate.is_some() || nigel_cosim::simulate::is_scheduled(setup.system()))
     {
         return Err(Error::Experiment(
