@@ -825,19 +825,8 @@ fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
 #[test]
 fn a_run_that_can_record_none_of_the_outputs_fails() {
     let dir = work_dir("fmi3-no-output");
-    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
-  <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="24"/>
-    <InitialUnknown valueReference="24"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+    // shared with the Python package's test of the same refusal
+    let xml = include_str!("cfmu/fmi3_counter_no_output.xml");
     let Some(fmu) = build_counter(&dir, "no_output", xml) else { return };
     let csv = dir.join("out.csv");
     let out =

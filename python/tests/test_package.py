@@ -215,20 +215,7 @@ def test_a_run_that_can_record_none_of_the_outputs_is_refused(tmp_path):
     # column alone is not what simulate_fmu was asked for (every output), so it raises, as
     # `cosim run` exits 1 (cosim/tests/fmi3.rs a_run_that_can_record_none_of_the_outputs_fails)
     import zipfile
-    xml = textwrap.dedent("""\
-        <?xml version="1.0" encoding="UTF-8"?>
-        <fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
-          <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
-          <ModelVariables>
-            <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-            <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
-          </ModelVariables>
-          <ModelStructure>
-            <Output valueReference="24"/>
-            <InitialUnknown valueReference="24"/>
-          </ModelStructure>
-        </fmiModelDescription>
-        """)
+    xml = (REPO / "cosim/tests/cfmu/fmi3_counter_no_output.xml").read_text()
     headers = Path(fmpy.__file__).parent / "c-code"
     so = tmp_path / "fmi3_counter.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter", "-I",
