@@ -277,8 +277,9 @@ pub unsafe extern "C" fn log_message(
     category: *const std::ffi::c_char,
     message: *const std::ffi::c_char,
 ) {
-    let text = |p: *const std::ffi::c_char| {
-        (!p.is_null()).then(|| std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned()).unwrap_or_default()
+    let text = |p: *const std::ffi::c_char| match p.is_null() {
+        true => String::new(),
+        false => std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned(),
     };
     if let Some(log) = (environment as *const Log).as_ref() {
         log.0.borrow_mut().push((status, text(category), text(message)));
