@@ -721,12 +721,8 @@ impl Fmi3 {
         let mut ticks = vec![false; vrs.len()];
         ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
         let opened = std::mem::take(&mut self.opened_outputs);
-        let ticked: Vec<u32> = vrs
-            .into_iter()
-            .zip(ticks)
-            .filter(|(vr, t)| *t && !opened.contains(vr))
-            .map(|(vr, _)| vr)
-            .collect();
+        let ticked: Vec<u32> =
+            vrs.into_iter().zip(ticks).filter(|(vr, t)| *t && !opened.contains(vr)).map(|(vr, _)| vr).collect();
         for vr in &ticked {
             self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
         }
@@ -753,6 +749,29 @@ fn not_exact(core: &Core, vr: u32, value: String) -> Error {
         value,
         reason: "not an Int64, UInt64 or Binary of the FMU's: its value is the view's".into(),
     }
+}
+
+/// The typed getters and setters of [`Calls`]: the FMU's own calls, but while the instance
+/// runs with clocked variables, their values held between ticks (read) and queued until
+/// their clock ticks (set). (getter, setter, value type, the FMU's getter and setter) a row.
+macro_rules! get_set {
+    ($($get:ident, $set:ident, $t:ty, $fmu_get:ident, $fmu_set:ident;)*) => {$(
+        #[inline]
+        fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.get_held(core, vrs, values, Self::$fmu_get);
+            }
+            self.$fmu_get(core, vrs, values)
+        }
+
+        #[inline]
+        fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.set_queued(core, vrs, values, Self::$fmu_set);
+            }
+            self.$fmu_set(core, vrs, values)
+        }
+    )*};
 }
 
 impl Calls for Fmi3 {
@@ -937,52 +956,10 @@ impl Calls for Fmi3 {
         self.terminate_requested = None;
     }
 
-    #[inline]
-    fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_real);
-        }
-        self.fmu_get_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_real);
-        }
-        self.fmu_set_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_integer);
-        }
-        self.fmu_get_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_integer);
-        }
-        self.fmu_set_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_boolean);
-        }
-        self.fmu_get_boolean(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_boolean);
-        }
-        self.fmu_set_boolean(core, vrs, values)
+    get_set! {
+        get_real, set_real, f64, fmu_get_real, fmu_set_real;
+        get_integer, set_integer, i32, fmu_get_integer, fmu_set_integer;
+        get_boolean, set_boolean, i32, fmu_get_boolean, fmu_set_boolean;
     }
 
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {
