@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 
 static FONT: &[u8] = include_bytes!("../../../table3/assets/DejaVuSans.ttf");
 
-fn register_font() -> Result<(), String> {
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif` (once per process), so that
+/// the figures look the same on every machine.
+pub fn register_font() -> Result<(), String> {
     static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     if *DONE.get_or_init(|| plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()) {
         Ok(())
@@ -72,12 +74,17 @@ pub fn plot_failures(
 
 /// Tick label: 4 significant digits without trailing zeros, `1.5e-9` outside 1e-3 .. 1e5.
 fn tick(v: &f64) -> String {
-    let v = *v;
+    tick_label(*v, 1e-3)
+}
+
+/// A tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
+/// magnitudes outside `plain_from` .. 1e5 as `1.5e-9`; never `-0`.
+pub fn tick_label(v: f64, plain_from: f64) -> String {
     if v == 0.0 {
         return "0".into();
     }
     let a = v.abs();
-    if !(1e-3..1e5).contains(&a) {
+    if !(plain_from..1e5).contains(&a) {
         let s = format!("{v:.3e}");
         let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
         let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
