@@ -3,7 +3,7 @@
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
-use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction, Seed};
 use crate::c_types::{Component, EventInfo, Functions};
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
@@ -237,14 +237,8 @@ impl Calls for Fmi2 {
         self.t.get_directional_derivative.is_some()
     }
 
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()> {
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()> {
+        let Seed { unknowns, knowns, dv_known } = seed;
         let c = core.component;
         let f = core.optional(self.t.get_directional_derivative, "fmi2GetDirectionalDerivative")?;
         // a write past a block the FMU allocated through allocateMemory lands in its red

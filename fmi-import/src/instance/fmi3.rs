@@ -9,7 +9,7 @@ use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
 use super::clocked::HeldNumber;
-use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction, Seed};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmi3::{Access, Fmi3Abi};
@@ -1163,14 +1163,8 @@ impl Calls for Fmi3 {
         self.a.functions.get_directional_derivative.is_some()
     }
 
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()> {
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()> {
+        let Seed { unknowns, knowns, dv_known } = seed;
         let c = core.component;
         let f = f3!(core, self.a, get_directional_derivative, "fmi3GetDirectionalDerivative");
         call!(

@@ -18,7 +18,7 @@ use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
 pub use self::core::InstanceState;
-use self::core::{Calls, Core};
+use self::core::{Calls, Core, Seed};
 pub use self::core::{Interval, OutputTick};
 use self::discrete_inputs::{DiscreteInputs, Held, Kind};
 use crate::c_types::{CallbackFunctions, EventInfo};
@@ -611,7 +611,7 @@ impl Instance {
         let n = dv_unknown.len();
         let zone = |v: &[f64]| v[n..].iter().rposition(|x| x.to_bits() != DV_RED_ZONE.to_bits());
         let mut out = vec![DV_RED_ZONE; n + DV_RED_ZONE_LEN];
-        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, &mut out[..n])?;
+        self.calls.get_directional_derivative(&mut self.core, Seed { unknowns, knowns, dv_known }, &mut out[..n])?;
         dv_unknown.copy_from_slice(&out[..n]);
         match zone(&out) {
             Some(k) => Err(Error::Overrun {
