@@ -109,6 +109,18 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+type Axis = plotters::coord::types::RangedCoordf64;
+
+/// A chart on `area` over `x` (time) and `y`, with `x_label_area` pixels below for the time
+/// axis' labels and 90 at the left for the values' (the two charts' y axes line up).
+fn chart_on<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    x_label_area: u32,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+) -> Result<ChartContext<'a, DB, Cartesian2d<Axis, Axis>>, DrawingAreaErrorKind<DB::ErrorType>> {
+    ChartBuilder::on(area).margin(12).x_label_area_size(x_label_area).y_label_area_size(90).build_cartesian_2d(x, y)
+}
+
 fn draw(
     path: &Path,
     s: &SignalReport,
@@ -150,11 +162,7 @@ fn draw(
     );
     let root = root.titled(&title, ("sans-serif", 20))?;
     let (upper, lower) = root.split_vertically(430);
-    let mut chart = ChartBuilder::on(&upper)
-        .margin(12)
-        .x_label_area_size(30)
-        .y_label_area_size(90)
-        .build_cartesian_2d(t0..t1, v0..v1)?;
+    let mut chart = chart_on(&upper, 30, (t0..t1, v0..v1))?;
     chart
         .configure_mesh()
         .y_desc(s.name.as_str())
@@ -201,11 +209,7 @@ fn draw(
         .position(SeriesLabelPosition::UpperLeft)
         .draw()?;
     // below: the same relative to the baseline, where a tube too thin to see above shows
-    let mut chart = ChartBuilder::on(&lower)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(90)
-        .build_cartesian_2d(t0..t1, d0..d1)?;
+    let mut chart = chart_on(&lower, 40, (t0..t1, d0..d1))?;
     chart
         .configure_mesh()
         .x_desc("time, s")
