@@ -391,7 +391,7 @@ impl ArchiveSource {
                     reason: format!("entry {entry:?}: {e}"),
                 };
                 let raw = zip.by_index_raw(index).map_err(bad)?;
-                within_limit(&entry, raw.size(), limits.max_entry_bytes, "max_entry_bytes")?;
+                within_limit(entry, raw.size(), limits.max_entry_bytes, "max_entry_bytes")?;
                 if raw.compression() == zip::CompressionMethod::Stored && !raw.encrypted() {
                     // stored (as `write_ssp` writes FMUs): read in place, seeking in the outer file
                     let (start, len) = (raw.data_start(), raw.size());
@@ -408,7 +408,7 @@ impl ArchiveSource {
                     .take(declared + 1)
                     .read_to_end(&mut bytes)
                     .map_err(|err| Error::Archive { path: outer.clone(), reason: format!("entry {entry:?}: {err}") })?;
-                within_limit(&entry, bytes.len() as u64, declared, "the size its header declares")?;
+                within_limit(entry, bytes.len() as u64, declared, "the size its header declares")?;
                 Ok(Reader::Memory(std::io::Cursor::new(bytes)))
             }
         }
@@ -649,7 +649,7 @@ fn extract<R: Read + std::io::Seek>(
             written += n as u64;
             // the declared sizes passed every limit above: holding each entry to its
             // declared size holds the archive to all of them
-            within_limit(&name, written, declared, "the size its header declares")?;
+            within_limit(name, written, declared, "the size its header declares")?;
             out.write_all(&buffer[..n]).map_err(io(&target))?;
         }
     }

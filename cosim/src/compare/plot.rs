@@ -110,6 +110,8 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 type Axis = plotters::coord::types::RangedCoordf64;
+/// A chart of f64 over f64.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Axis, Axis>>;
 
 /// A chart on `area` over `x` (time) and `y`, with `x_label_area` pixels below for the time
 /// axis' labels and 90 at the left for the values' (the two charts' y axes line up).
@@ -117,7 +119,7 @@ fn chart_on<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, plotters::coord::Shift>,
     x_label_area: u32,
     (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
-) -> Result<ChartContext<'a, DB, Cartesian2d<Axis, Axis>>, DrawingAreaErrorKind<DB::ErrorType>> {
+) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
     ChartBuilder::on(area).margin(12).x_label_area_size(x_label_area).y_label_area_size(90).build_cartesian_2d(x, y)
 }
 
