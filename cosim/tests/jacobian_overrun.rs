@@ -38,3 +38,37 @@ fn a_directional_derivative_that_writes_past_memory_is_caught_and_replaced_by_di
         assert_eq!(bits(&got.values), bits(&differences.values), "{flag}");
     }
 }
+
+/// The FMI 3.0 van der Pol (`tests/cfmu/fmi3_vdp.c`) built with -DOVERRUN_SENSITIVITY writes
+/// two values past the `nSensitivity` values of `fmi3GetDirectionalDerivative`'s
+/// `sensitivity`: the red zone after the master's buffer takes them, the note names the call
+/// and the buffer in FMI 3.0 terms, and bdf differences the Jacobian from the first call on:
+/// the rows equal those of the same FMU declaring `providesDirectionalDerivatives="false"`
+/// bit for bit (the same differences at the same points).
+#[test]
+fn an_fmi3_directional_derivative_that_writes_past_sensitivity_is_caught_and_replaced_by_differences() {
+    let xml = include_str!("cfmu/fmi3_vdp.xml");
+    let without = xml.replace(r#"providesDirectionalDerivatives="true""#, r#"providesDirectionalDerivatives="false""#);
+    let Some(plain) = common::fmi3_c::build(&work_dir("overrun3-fd"), "fmi3_vdp", &without) else { return };
+    let overrun =
+        common::fmi3_c::build_with_flags(&work_dir("overrun3"), "fmi3_vdp", xml, &["-DOVERRUN_SENSITIVITY"]).unwrap();
+    let mut e = Experiment::new(2.0, 0.01);
+    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+    let run =
+        |path: &std::path::Path| simulate(&System::single("model", Fmu::load(path).unwrap()).unwrap(), &e).unwrap();
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let (differences, d) = run(&plain);
+    assert!(d.notes.is_empty() && d.stiff.jacobians > 0, "{:?} {:?}", d.notes, d.stiff);
+    let (got, s) = run(&overrun);
+    assert_eq!(s.notes.len(), 1, "{:?}", s.notes);
+    let note = &s.notes[0];
+    assert!(
+        note.starts_with("model: fmi3GetDirectionalDerivative ")
+            && note.contains("wrote 16 bytes past the 16 bytes of sensitivity (nSensitivity = 2)"),
+        "{note}"
+    );
+    assert!(note.ends_with("bdf uses finite differences for its Jacobian"), "{note}");
+    assert_eq!(s.stiff.jacobians, d.stiff.jacobians);
+    assert_eq!(bits(&got.values), bits(&differences.values));
+}

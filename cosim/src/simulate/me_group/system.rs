@@ -297,8 +297,13 @@ impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
                     Some((i, j)) => {
                         mj.directional = false;
                         let name = |vrs: &[u32], k: usize| format!("value reference {}", vrs[k]);
+                        let call = if inst.is_fmi3() {
+                            "fmi3GetDirectionalDerivative"
+                        } else {
+                            "fmi2GetDirectionalDerivative"
+                        };
                         mj.note = Some(format!(
-                            "{}: fmi2GetDirectionalDerivative gives d der / d x = {:e} for the derivative ({}) with \
+                            "{}: {call} gives d der / d x = {:e} for the derivative ({}) with \
                              respect to the state ({}) at t = {t} s where finite differences give {:e}: bdf uses \
                              finite differences for it",
                             inst.name(),
