@@ -405,13 +405,12 @@ impl Fmi3 {
     fn set_wide(&mut self, core: &mut Core, access: Access, values: &[i128]) -> Result<()> {
         use model_description::fmi3::ValueType as T;
         let (c, vr, n) = (core.component, access.vr, values.len());
-        let out_of_range = |core: &Core, value: i128, ty: &str| {
-            let name = core.fmu.description.model_variables.iter().find(|v| v.value_reference == vr);
-            Error::InvalidValue {
-                variable: format!("{}.{}", core.name, name.map_or_else(|| format!("<vr {vr}>"), |v| v.name.clone())),
-                value: value.to_string(),
-                reason: format!("outside the range of {ty}"),
-            }
+        // the FMU's own name of the variable (the view's element names are not its)
+        let name = self.a.description.variable(vr).map_or_else(|| format!("<vr {vr}>"), |v| v.name.clone());
+        let out_of_range = |core: &Core, value: i128, ty: &str| Error::InvalidValue {
+            variable: format!("{}.{name}", core.name),
+            value: value.to_string(),
+            reason: format!("outside the range of {ty}"),
         };
         if access.value_type == T::Int64 {
             let buf = values
