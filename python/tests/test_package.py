@@ -209,6 +209,19 @@ def test_errors_carry_the_masters_messages():
     assert issubclass(nigel_cosim.Error, Exception)
 
 
+def test_a_single_fmus_names_are_those_of_cosim_run_and_its_fmi_type_the_xml_names():
+    # as `cosim run --set`: a single FMU's variable bare or as `model.<name>`
+    plant = FMU / "nigel_plant.fmu"
+    run = lambda values: nigel_cosim.simulate_fmu(plant, stop_time=0.1, start_values=values, output=["x"])["x"]
+    bare, qualified, still = run({"v_x_start": 1.0}), run({"model.v_x_start": 1.0}), run({})
+    assert np.array_equal(bare, qualified)
+    # at 1 m/s without torque or steering the plant rolls straight on: x = 1 m/s * 0.1 s (to
+    # the integrator's rounding, 1e-9); at rest it stays at 0
+    assert bare[-1] == pytest.approx(0.1, abs=1e-9) and not still.any()
+    with pytest.raises(ValueError, match="fmi_type must be 'CoSimulation', 'ModelExchange' or 'ScheduledExecution', not \"cs\""):
+        nigel_cosim.System(plant, fmi_type="cs")
+
+
 def test_runs_release_the_gil_two_threads_overlap():
     # each thread notes when its run started and ended; with the GIL held for a whole run
     # the second could not start before the first ended
