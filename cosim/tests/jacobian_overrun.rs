@@ -50,8 +50,7 @@ fn an_fmi3_directional_derivative_that_writes_past_sensitivity_is_caught_and_rep
     let xml = include_str!("cfmu/fmi3_vdp.xml");
     let without = xml.replace(r#"providesDirectionalDerivatives="true""#, r#"providesDirectionalDerivatives="false""#);
     let Some(plain) = common::fmi3_c::build(&work_dir("overrun3-fd"), "fmi3_vdp", &without) else { return };
-    let overrun =
-        common::fmi3_c::build_with(&work_dir("overrun3"), "fmi3_vdp", xml, &["OVERRUN_SENSITIVITY"]).unwrap();
+    let overrun = common::fmi3_c::build_with(&work_dir("overrun3"), "fmi3_vdp", xml, &["OVERRUN_SENSITIVITY"]).unwrap();
     let mut e = Experiment::new(2.0, 0.01);
     e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
     e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
