@@ -92,7 +92,7 @@ fn the_default_solver_switches_to_bdf_on_a_stiff_system_and_matches_the_closed_f
     match try_run(&fmu, "lin", &[], 2.0, 0.01, Solver::Rk4 { max_step: None }) {
         Ok((r, _)) => {
             let e = linear_error(&r, lambda);
-            assert!(!(e < 1.0), "rk4 alone cannot be right here: {e:e}");
+            assert!(e.is_nan() || e >= 1.0, "rk4 alone cannot be right here: {e:e}");
         }
         // measured: x1 = NaN at t = 0.47 s
         Err(e) => assert!(e.to_string().contains("NaN"), "{e}"),

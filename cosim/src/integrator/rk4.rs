@@ -132,7 +132,7 @@ impl Integrator for Rk4 {
         if self.stiffness_test {
             let h_rho = h_rho(k1, k2, k3);
             // NaN (infinite stages) is stiff too: the step cannot be taken
-            if !(h_rho <= STIFF_H_RHO) {
+            if h_rho.is_nan() || h_rho > STIFF_H_RHO {
                 self.work.rhs += 3;
                 self.stiff = Some(StiffStep { t, h, h_rho });
                 return Ok(());
