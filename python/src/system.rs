@@ -58,6 +58,11 @@ impl NativeSystem {
             setup.set(name, value).map_err(to_py)?;
         }
         let prepared = setup.build();
+        if args.output.is_none() {
+            // every output left out of the master's view: a result of the time column alone
+            // is not what was asked for (as `cosim run`)
+            prepared.check_recordable("output").map_err(to_py)?;
+        }
         let experiment = args.experiment(|n| prepared.qualify(n)).map_err(to_py)?;
         Ok((prepared, experiment))
     }

@@ -615,26 +615,7 @@ impl<'s> Execution<'s> {
     pub fn get(&mut self, name: &str) -> Result<Value> {
         let r = self.system.resolve(name)?;
         let Some(core) = self.core.as_mut() else { return Err(not_running(self.phase)) };
-        let inst = &mut core.lanes[r.instance].inst;
-        let vr = [r.value_reference];
-        Ok(match r.base_type {
-            BaseType::Real => {
-                let mut v = [0.0];
-                inst.get_real(&vr, &mut v)?;
-                Value::Real(v[0])
-            }
-            BaseType::Integer => {
-                let mut v = [0];
-                inst.get_integer(&vr, &mut v)?;
-                Value::Integer(v[0])
-            }
-            BaseType::Boolean => {
-                let mut v = [0];
-                inst.get_boolean(&vr, &mut v)?;
-                Value::Boolean(v[0] != 0)
-            }
-            BaseType::String => Value::String(inst.get_string(r.value_reference)?),
-        })
+        crate::simulate::lane::get_value(&mut core.lanes[r.instance].inst, &r)
     }
 
     /// The last row recorded (time first), unless the rows go to a sink.

@@ -120,6 +120,15 @@ impl Core {
     }
 }
 
+/// A directional derivative's arguments but its result: d(`unknowns`)/d(`knowns`) times
+/// `dv_known` (one seed per known).
+#[derive(Clone, Copy)]
+pub(crate) struct Seed<'a> {
+    pub(crate) unknowns: &'a [u32],
+    pub(crate) knowns: &'a [u32],
+    pub(crate) dv_known: &'a [f64],
+}
+
 /// The calls of one generation's C API on an instance: everything [`crate::Instance`]
 /// does that differs between FMI 2.0 and FMI 3.0. The state transitions that do not
 /// differ are the instance's.
@@ -218,14 +227,7 @@ pub(crate) trait Calls: Send {
     fn get_derivatives(&mut self, core: &mut Core, dx: &mut [f64]) -> Result<()>;
     fn get_event_indicators(&mut self, core: &mut Core, z: &mut [f64]) -> Result<()>;
     fn has_directional_derivative(&self) -> bool;
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()>;
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()>;
     fn enter_event_mode(&mut self, core: &mut Core) -> Result<()>;
     fn new_discrete_states(&mut self, core: &mut Core) -> Result<EventInfo>;
     fn enter_continuous_time_mode(&mut self, core: &mut Core) -> Result<()>;

@@ -9,7 +9,7 @@ use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
 use super::clocked::HeldNumber;
-use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction, Seed};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmi3::{Access, Fmi3Abi};
@@ -851,6 +851,29 @@ fn not_exact(core: &Core, vr: u32, value: String) -> Error {
     }
 }
 
+/// The typed getters and setters of [`Calls`]: the FMU's own calls, but while the instance
+/// runs with clocked variables, their values held between ticks (read) and queued until
+/// their clock ticks (set). (getter, setter, value type, the FMU's getter and setter) a row.
+macro_rules! get_set {
+    ($($get:ident, $set:ident, $t:ty, $fmu_get:ident, $fmu_set:ident;)*) => {$(
+        #[inline]
+        fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.get_held(core, vrs, values, Self::$fmu_get);
+            }
+            self.$fmu_get(core, vrs, values)
+        }
+
+        #[inline]
+        fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.set_queued(core, vrs, values, Self::$fmu_set);
+            }
+            self.$fmu_set(core, vrs, values)
+        }
+    )*};
+}
+
 impl Calls for Fmi3 {
     /// The instantiate function of `interface`.
     fn instantiate_function(&self, interface: Interface) -> &'static str {
@@ -1033,52 +1056,10 @@ impl Calls for Fmi3 {
         self.terminate_requested = None;
     }
 
-    #[inline]
-    fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_real);
-        }
-        self.fmu_get_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_real);
-        }
-        self.fmu_set_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_integer);
-        }
-        self.fmu_get_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_integer);
-        }
-        self.fmu_set_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_boolean);
-        }
-        self.fmu_get_boolean(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_boolean);
-        }
-        self.fmu_set_boolean(core, vrs, values)
+    get_set! {
+        get_real, set_real, f64, fmu_get_real, fmu_set_real;
+        get_integer, set_integer, i32, fmu_get_integer, fmu_set_integer;
+        get_boolean, set_boolean, i32, fmu_get_boolean, fmu_set_boolean;
     }
 
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {
@@ -1259,14 +1240,8 @@ impl Calls for Fmi3 {
         self.a.functions.get_directional_derivative.is_some()
     }
 
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()> {
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()> {
+        let Seed { unknowns, knowns, dv_known } = seed;
         let c = core.component;
         let f = f3!(core, self.a, get_directional_derivative, "fmi3GetDirectionalDerivative");
         call!(
