@@ -66,8 +66,11 @@ macro_rules! call {
         core.check_callable($name)?;
         let time: Option<f64> = $time;
         let mark = $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time));
+        // the blocks the FMU allocates in the call are this instance's (fmi-sys's guard)
+        let owner = fmi_sys::fmi2::guard::enter_owner(core.log.owner());
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
+        drop(owner);
         drop(mark);
         core.status($name, raw, time)
     }};

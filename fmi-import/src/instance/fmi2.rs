@@ -56,6 +56,7 @@ impl Calls for Fmi2 {
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0);
+        let owner = fmi_sys::fmi2::guard::enter_owner(log.owner());
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (self.t.instantiate)(
@@ -68,6 +69,7 @@ impl Calls for Fmi2 {
                 0,
             )
         };
+        drop(owner);
         drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate {
@@ -242,8 +244,10 @@ impl Calls for Fmi2 {
         let c = core.component;
         let f = core.optional(self.t.get_directional_derivative, "fmi2GetDirectionalDerivative")?;
         // a write past a block the FMU allocated through allocateMemory lands in its red
-        // zone (MapleSim 2023's ControlledTemperature writes 16 bytes past one here)
-        let before = fmi_sys::fmi2::guard::overruns().count;
+        // zone (MapleSim 2023's ControlledTemperature writes 16 bytes past one here); only
+        // this instance's blocks are read
+        let owner = core.log.owner();
+        let before = fmi_sys::fmi2::guard::overruns_of(owner).count;
         call!(
             core,
             "fmi2GetDirectionalDerivative",
@@ -258,14 +262,14 @@ impl Calls for Fmi2 {
                 dv_unknown.as_mut_ptr()
             )
         )?;
-        let after = fmi_sys::fmi2::guard::overruns();
+        let after = fmi_sys::fmi2::guard::overruns_of(owner);
         match after.first {
             Some((size, past)) if after.count > before => Err(Error::Overrun {
                 instance: core.name.clone(),
                 function: "fmi2GetDirectionalDerivative",
                 what: format!(
                     "{past} bytes past the end of a block of {size} bytes that the FMU allocated through allocateMemory{}",
-                    if before > 0 { " (or past another such block: the first write seen in this process)" } else { "" }
+                    if before > 0 { " (or past another of its blocks: the first write seen in this instance)" } else { "" }
                 ),
             }),
             _ => Ok(()),

@@ -594,7 +594,8 @@ impl Instance {
 
     /// The directional derivative at the instance's current point: `dv_unknown` =
     /// d(unknowns)/d(knowns) `dv_known` (FMI 2.0 section 2.1.9, FMI 3.0 section 2.2.11).
-    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown`, or
+    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown` (FMI
+    /// 3.0: the `nSensitivity` values of `sensitivity`), or
     /// (FMI 2.0) past a block it allocated through `allocateMemory`: the guard's red zone
     /// took the write; the instance is still usable, the values are not.
     pub fn get_directional_derivative(
@@ -614,14 +615,18 @@ impl Instance {
         self.calls.get_directional_derivative(&mut self.core, Seed { unknowns, knowns, dv_known }, &mut out[..n])?;
         dv_unknown.copy_from_slice(&out[..n]);
         match zone(&out) {
-            Some(k) => Err(Error::Overrun {
-                instance: self.core.name.clone(),
-                function: match self.core.fmu.abi {
-                    Abi::Fmi2(_) => "fmi2GetDirectionalDerivative",
-                    Abi::Fmi3(_) => "fmi3GetDirectionalDerivative",
-                },
-                what: format!("{} bytes past the {} bytes of dvUnknown (nUnknown = {n})", 8 * (k + 1), 8 * n),
-            }),
+            Some(k) => {
+                // each generation's names of the call and its buffer
+                let (function, buffer, count) = match self.core.fmu.abi {
+                    Abi::Fmi2(_) => ("fmi2GetDirectionalDerivative", "dvUnknown", "nUnknown"),
+                    Abi::Fmi3(_) => ("fmi3GetDirectionalDerivative", "sensitivity", "nSensitivity"),
+                };
+                Err(Error::Overrun {
+                    instance: self.core.name.clone(),
+                    function,
+                    what: format!("{} bytes past the {} bytes of {buffer} ({count} = {n})", 8 * (k + 1), 8 * n),
+                })
+            }
             None => Ok(()),
         }
     }
