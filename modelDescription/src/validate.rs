@@ -135,6 +135,12 @@ pub fn is_c_identifier(s: &str) -> bool {
     chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// The problem of an `initial` attribute on an input or the independent variable (of
+/// causality `causality`), which both generations forbid.
+pub(crate) fn initial_not_allowed_message(causality: &str, initial: Initial) -> String {
+    format!("causality=\"{causality}\" must not define initial (has \"{}\")", initial.as_str())
+}
+
 /// For each interface element whose `modelIdentifier` is not a C identifier, what is wrong
 /// (`(element, modelIdentifier)` of the interfaces present).
 pub(crate) fn model_identifier_messages<'a>(interfaces: impl IntoIterator<Item = (&'a str, &'a str)>) -> Vec<String> {
@@ -279,15 +285,7 @@ impl ModelDescription {
             }
             if let Some(init) = v.initial {
                 if matches!(v.causality, Causality::Input | Causality::Independent) {
-                    c.push(
-                        Rule::Initial,
-                        name,
-                        format!(
-                            "causality=\"{}\" must not define initial (has \"{}\")",
-                            v.causality.as_str(),
-                            init.as_str()
-                        ),
-                    );
+                    c.push(Rule::Initial, name, initial_not_allowed_message(v.causality.as_str(), init));
                 } else if legal && !Initial::allowed(v.causality, v.variability).contains(&init) {
                     let allowed: Vec<&str> =
                         Initial::allowed(v.causality, v.variability).iter().map(|i| i.as_str()).collect();
