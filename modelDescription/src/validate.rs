@@ -470,19 +470,9 @@ impl ModelDescription {
         let expected = self.expected_model_structure();
 
         // Outputs: exactly the outputs, in ModelVariables order.
-        let outs: Vec<u32> = ms.outputs.iter().map(|u| u.index).collect();
-        let want_outs: Vec<u32> = expected.outputs.iter().map(|u| u.index).collect();
-        if outs != want_outs {
-            c.push(
-                Rule::Outputs,
-                None,
-                format!(
-                    "<Outputs> lists {} but the causality=\"output\" variables are {}",
-                    self.names_of(&outs),
-                    self.names_of(&want_outs)
-                ),
-            );
-        }
+        self.check_list(&mut c, Rule::Outputs, &ms.outputs, &expected.outputs, |listed, wanted| {
+            format!("<Outputs> lists {listed} but the causality=\"output\" variables are {wanted}")
+        });
 
         // Derivatives: exactly the state derivatives, each once (any order).
         let ders: Vec<u32> = ms.derivatives.iter().map(|u| u.index).collect();
@@ -501,19 +491,11 @@ impl ModelDescription {
         }
 
         // InitialUnknowns: exactly the required set, sorted by index.
-        let inits: Vec<u32> = ms.initial_unknowns.iter().map(|u| u.index).collect();
-        let want_inits: Vec<u32> = expected.initial_unknowns.iter().map(|u| u.index).collect();
-        if inits != want_inits {
-            c.push(
-                Rule::InitialUnknowns,
-                None,
-                format!(
-                    "<InitialUnknowns> lists {} but must list, sorted by index, {} (outputs with initial approx/calculated, calculated parameters, states and derivatives with initial approx/calculated)",
-                    self.names_of(&inits),
-                    self.names_of(&want_inits)
-                ),
-            );
-        }
+        self.check_list(&mut c, Rule::InitialUnknowns, &ms.initial_unknowns, &expected.initial_unknowns, |listed, wanted| {
+            format!(
+                "<InitialUnknowns> lists {listed} but must list, sorted by index, {wanted} (outputs with initial approx/calculated, calculated parameters, states and derivatives with initial approx/calculated)"
+            )
+        });
 
         // Dependencies refer to knowns only.
         let states: HashSet<u32> = self.states().into_iter().collect();
@@ -559,6 +541,23 @@ impl ModelDescription {
                     }
                 }
             }
+        }
+    }
+
+    /// A problem of `rule` (its text from the names of the `listed` and the `wanted` indices)
+    /// unless the ModelStructure list `listed` holds exactly the `wanted` entries, in order.
+    fn check_list(
+        &self,
+        c: &mut Checker,
+        rule: Rule,
+        listed: &[Unknown],
+        wanted: &[Unknown],
+        message: impl FnOnce(String, String) -> String,
+    ) {
+        let listed: Vec<u32> = listed.iter().map(|u| u.index).collect();
+        let wanted: Vec<u32> = wanted.iter().map(|u| u.index).collect();
+        if listed != wanted {
+            c.push(rule, None, message(self.names_of(&listed), self.names_of(&wanted)));
         }
     }
 

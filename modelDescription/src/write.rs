@@ -138,6 +138,16 @@ impl Out {
     pub(crate) fn close(&mut self, name: &'static str) {
         self.ev(Event::End(BytesEnd::new(name)));
     }
+    /// Opens `<name>` (to be closed by the caller) and returns true, or, when it has no
+    /// children (`empty`), writes `<name/>` and returns false.
+    pub(crate) fn open_unless_empty(&mut self, name: &'static str, empty: bool) -> bool {
+        if empty {
+            self.empty(Elem::new(name));
+        } else {
+            self.open(Elem::new(name));
+        }
+        !empty
+    }
 }
 
 pub(crate) fn join_u32(v: &[u32]) -> String {
@@ -315,10 +325,7 @@ impl ModelDescription {
 
         write_log_categories_and_experiment(&mut o, &self.log_categories, self.default_experiment.as_ref());
 
-        if self.model_variables.is_empty() {
-            o.empty(Elem::new("ModelVariables"));
-        } else {
-            o.open(Elem::new("ModelVariables"));
+        if o.open_unless_empty("ModelVariables", self.model_variables.is_empty()) {
             for v in &self.model_variables {
                 let mut e = Elem::new("ScalarVariable");
                 e.attr("name", &v.name)
