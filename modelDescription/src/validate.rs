@@ -470,7 +470,7 @@ impl ModelDescription {
         let expected = self.expected_model_structure();
 
         // Outputs: exactly the outputs, in ModelVariables order.
-        self.check_list(&mut c, Rule::Outputs, &ms.outputs, &expected.outputs, |listed, wanted| {
+        self.check_list(c, Rule::Outputs, &ms.outputs, &expected.outputs, |listed, wanted| {
             format!("<Outputs> lists {listed} but the causality=\"output\" variables are {wanted}")
         });
 
@@ -491,7 +491,7 @@ impl ModelDescription {
         }
 
         // InitialUnknowns: exactly the required set, sorted by index.
-        self.check_list(&mut c, Rule::InitialUnknowns, &ms.initial_unknowns, &expected.initial_unknowns, |listed, wanted| {
+        self.check_list(c, Rule::InitialUnknowns, &ms.initial_unknowns, &expected.initial_unknowns, |listed, wanted| {
             format!(
                 "<InitialUnknowns> lists {listed} but must list, sorted by index, {wanted} (outputs with initial approx/calculated, calculated parameters, states and derivatives with initial approx/calculated)"
             )
