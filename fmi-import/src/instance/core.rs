@@ -274,7 +274,9 @@ pub struct OutputTick {
 pub(crate) trait ClockCalls {
     fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()>;
     fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()>;
-    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>>;
+    /// `zero`: an interval of 0 s is one (the delay to a changing clock's first tick at the
+    /// start), else an error.
+    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32], zero: bool) -> Result<Vec<Interval>>;
     fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>>;
     fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()>;
     /// The start of a clock event at `time`: Event Mode entered and the input clocks `vrs`

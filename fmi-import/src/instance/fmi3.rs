@@ -705,7 +705,7 @@ impl Fmi3 {
         if !self.interval_clocks.is_empty() || !fixed.is_empty() {
             let vrs: Vec<u32> = self.interval_clocks.iter().chain(fixed).copied().collect();
             self.fixed_read = true;
-            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
+            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs, false)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
         if self.output_clocks.is_empty() {
