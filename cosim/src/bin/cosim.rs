@@ -155,16 +155,17 @@ struct RunArgs {
     /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
-    /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
+    /// Model Exchange solver: auto (RK4 that continues with bdf from the first step it finds
+    /// stiff, with a note), rk4, dopri5, or bdf (stiff models: variable-order BDF with the
     /// FMU's Jacobian).
-    #[arg(long, default_value = "rk4")]
+    #[arg(long, default_value = "auto")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// Relative tolerance of dopri5 and bdf (and auto's bdf; absolute: rtol / 100; default 1e-6), and the
     /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
     /// DefaultExperiment tolerance, as fmpy does).
     #[arg(long)]
     rtol: Option<f64>,
-    /// Largest RK4 step, s (default: the communication step).
+    /// Largest RK4 step (rk4, auto), s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
     /// The cap on the steps of a run (communication steps, and the Model Exchange

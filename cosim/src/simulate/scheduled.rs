@@ -37,7 +37,7 @@ use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface, Interval};
 use crate::partitions::{model_partitions, output_clocks, ModelPartition, Ticks};
 use crate::simulate::{apply_start_values, Experiment, InputTable, Results, Summary};
-use crate::system::{BaseType, System, VariableRef};
+use crate::system::{BaseType, System, Value, VariableRef};
 
 /// Why Scheduled Execution is not run isolated (`--isolate`, `--isolate=run`).
 pub const NOT_ISOLATED: &str = "Scheduled Execution is run in process only (leave out --isolate): the FMU calls \
@@ -474,26 +474,16 @@ fn set_inputs(
     Ok(())
 }
 
-/// The value of `r` as an f64 (NaN for a String).
+/// The value of `r` as an f64 (a Boolean 0 or 1; NaN for a String, not read).
 fn get_value(instance: &mut Instance, r: &VariableRef) -> Result<f64> {
-    let vr = [r.value_reference];
-    Ok(match r.base_type {
-        BaseType::Real => {
-            let mut v = [0.0];
-            instance.get_real(&vr, &mut v)?;
-            v[0]
-        }
-        BaseType::Integer => {
-            let mut v = [0];
-            instance.get_integer(&vr, &mut v)?;
-            f64::from(v[0])
-        }
-        BaseType::Boolean => {
-            let mut v = [0];
-            instance.get_boolean(&vr, &mut v)?;
-            f64::from(v[0])
-        }
-        BaseType::String => f64::NAN,
+    if r.base_type == BaseType::String {
+        return Ok(f64::NAN);
+    }
+    Ok(match crate::simulate::lane::get_value(instance, r)? {
+        Value::Real(x) => x,
+        Value::Integer(i) => f64::from(i),
+        Value::Boolean(b) => f64::from(u8::from(b)),
+        Value::String(_) => f64::NAN,
     })
 }
 
