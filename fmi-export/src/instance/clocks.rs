@@ -70,6 +70,27 @@ impl<M: Model> Instance<M> {
         }
     }
 
+    /// Co-Simulation instantiated with `eventModeUsed = false` (fmpy's `simulate_fmu` does
+    /// so): the importer cannot enter Event Mode, so it cannot activate the clock. FMI 3.0
+    /// requires `eventModeUsed = true` of an importer of an FMU with clocks but asks the FMU
+    /// to raise an error only for `eventModeUsed = true` without `hasEventMode`; without Event
+    /// Mode it has the FMU "detect and handle events internally" (`hasEventMode`) and its
+    /// discrete variables change "at communication points" (`variability`). So the instance
+    /// samples by time as the FMI 2.0 archive does (the same time events, the same lazy
+    /// samples at the communication points), and the Event Mode calls are refused. The
+    /// message to log (once, at instantiation) says so.
+    pub fn sample_without_event_mode(&mut self) -> OpResult<String> {
+        let (clock, _) = Self::declared_clock()?;
+        self.clocked = false;
+        self.allowed = Self::allowed_table(self.generation, self.context.interface, false);
+        Ok(format!(
+            "eventModeUsed = false: {} is not driven by the importer; the FMU samples by time itself at start + k \
+             sample_period, as its FMI 2.0 archive does (FMI 3.0 asks eventModeUsed = true of an importer of an FMU \
+             with clocks; without Event Mode an FMU handles its events internally)",
+            clock.name
+        ))
+    }
+
     /// `fmi3SetClock`: activates the clock at its next activation time (a clock that
     /// cannot be deactivated refuses `fmi3ClockInactive` while active).
     pub fn set_clock(&mut self, vrs: &[u32], active: &[bool]) -> OpResult {
