@@ -21,8 +21,9 @@ use crate::simulate::between::{Manipulator, SetQueue, WithManipulator};
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Profiler, Progress, Recorder};
+use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Progress, Recorder, RowSink};
 use crate::simulate::plan::{default_record, run_ops, Op, Plan};
+use crate::simulate::profiler::Profiler;
 use crate::simulate::ticks::Ticks;
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
 use crate::system::{BaseType, System, Value, VariableRef};
@@ -894,11 +895,6 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
     }
     Ok(())
 }
-
-/// Where [`Execution::with_sink`] (and `simulate_with`) hands each row: the time and the recorded values, in the order
-/// of [`Experiment::record`](crate::Experiment::record), and the (column, text) of the columns an f64 does not hold
-/// ([`Results::exact`](crate::Results::exact); empty when there are none).
-pub type RowSink<'s> = dyn FnMut(f64, &[f64], &[(usize, String)]) + Send + 's;
 
 /// Instances kept between runs of one system ([`Execution::with_pool`], `simulate_with`): the instance of each
 /// position, reused only for the same FMU (the same loaded archive) and name.

@@ -16,7 +16,8 @@ use crate::me::Solver;
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::Lane;
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Observers, Profiler};
+use crate::simulate::observer::Observers;
+use crate::simulate::profiler::Profiler;
 use std::ops::Range;
 
 /// What an algorithm works on: the instances, the value buffer of the plan, the coupled
