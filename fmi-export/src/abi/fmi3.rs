@@ -476,11 +476,8 @@ pub unsafe fn get_clock<M: Model>(
     with3::<M>(instance, function, |comp| {
         let vr = slice(vr, n_vr, "valueReferences")?;
         let out = slice_mut(values, n_vr, "values")?;
-        let mut active = vec![false; vr.len()];
-        comp.instance.get_clock(vr, &mut active)?;
-        for (o, a) in out.iter_mut().zip(active) {
-            *o = if a { FMI3_CLOCK_ACTIVE } else { FMI3_CLOCK_INACTIVE };
-        }
+        let active = comp.instance.get_clock(vr)?;
+        out.fill(if active { FMI3_CLOCK_ACTIVE } else { FMI3_CLOCK_INACTIVE });
         Ok(())
     })
 }
@@ -503,8 +500,8 @@ pub unsafe fn set_clock<M: Model>(
             )
             .into());
         }
-        let active: Vec<bool> = values.iter().map(|&v| v == FMI3_CLOCK_ACTIVE).collect();
-        comp.instance.set_clock(vr, &active)
+        // (no buffer: called at every activation)
+        comp.instance.set_clock(vr, values.iter().map(|&v| v == FMI3_CLOCK_ACTIVE))
     })
 }
 

@@ -93,9 +93,9 @@ impl<M: Model> Instance<M> {
 
     /// `fmi3SetClock`: activates the clock at its next activation time (a clock that
     /// cannot be deactivated refuses `fmi3ClockInactive` while active).
-    pub fn set_clock(&mut self, vrs: &[u32], active: &[bool]) -> OpResult {
+    pub fn set_clock(&mut self, vrs: &[u32], active: impl IntoIterator<Item = bool>) -> OpResult {
         let clock = Self::check_clock_references(vrs)?;
-        for &on in active {
+        for on in active {
             if on == self.core.clock_active {
                 continue;
             }
@@ -123,11 +123,10 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// `fmi3GetClock`: whether the clock is active.
-    pub fn get_clock(&self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+    /// `fmi3GetClock`: whether the clock (each of `vrs`) is active.
+    pub fn get_clock(&self, vrs: &[u32]) -> OpResult<bool> {
         Self::check_clock_references(vrs)?;
-        out.fill(self.core.clock_active);
-        Ok(())
+        Ok(self.core.clock_active)
     }
 
     /// `fmi3GetIntervalDecimal`: the clock's interval; a fixed interval (from a parameter) is
