@@ -117,9 +117,6 @@ impl<'s> Execution<'s> {
         if experiment.threads == 0 {
             return Err(Error::Experiment("threads must be at least 1".into()));
         }
-        if experiment.threads > 1 && system.instances.iter().any(|i| !i.fmu.clocks().is_empty()) {
-            return Err(Error::Experiment("FMI 3.0 clocks are run in one thread: use threads = 1".into()));
-        }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
             Some(names) => names
@@ -420,12 +417,6 @@ impl<'s> Execution<'s> {
                 return Err(Error::Experiment(format!(
                     "{}: clocks of a Model Exchange instance connected to other Model Exchange instances, which \
                      cosim does not support (connect it through a Co-Simulation FMU, or run it alone)",
-                    spec.name
-                )));
-            }
-            if lane.inst.fmu().is_isolated() {
-                return Err(Error::Experiment(format!(
-                    "{}: clocks in an isolated instance (a host process), which cosim does not support",
                     spec.name
                 )));
             }

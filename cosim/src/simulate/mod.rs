@@ -54,7 +54,7 @@ pub use input_table::InputTable;
 pub use lane::apply_start_values;
 pub use observer::{Cancel, Observer, Progress, RowSink};
 pub use plan::default_record;
-pub use scheduled::{is_scheduled, simulate_scheduled};
+pub use scheduled::{is_scheduled, simulate_scheduled, NOT_ISOLATED as SCHEDULED_NOT_ISOLATED};
 pub use types::{number_text, push_number, Algorithm, ExactColumn, Experiment, Results, Summary, DEFAULT_MAX_STEPS};
 
 pub use me_group::MAX_EVENT_ROUNDS;
