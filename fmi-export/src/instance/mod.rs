@@ -117,6 +117,10 @@ pub struct Instance<M: Model> {
     /// layer's own. False for Co-Simulation instantiated with `eventModeUsed = false`
     /// ([`Instance::sample_without_event_mode`]): that instance samples by time.
     pub clocked: bool,
+    /// A clocked Model Exchange instance whose importer reached `fmi3UpdateDiscreteStates`
+    /// at a sample time without activating the clock: it samples by its time events since
+    /// ([`Instance::sample_by_time_events`]), and `fmi3SetClock` is refused.
+    pub undriven_clock: bool,
     /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
     /// through (0 for another interface's function or a capability the model did not
     /// declare): the gate of every call as one table lookup; the reasons come from the
@@ -153,6 +157,7 @@ impl<M: Model> Instance<M> {
         Ok(Instance {
             allowed,
             clocked,
+            undriven_clock: false,
             generation,
             get_memo: CallMemos::new(),
             set_memo: CallMemos::new(),
@@ -421,6 +426,11 @@ impl<M: Model> Instance<M> {
     pub fn reset(&mut self) -> OpResult {
         let model = Self::fresh_model(&self.context)?;
         self.core = Core::new(model);
+        // the importer of the next run may drive the clock
+        if self.undriven_clock {
+            self.undriven_clock = false;
+            self.clocked = true;
+        }
         Ok(())
     }
 }
