@@ -1,6 +1,6 @@
-//! Our closed loop with the controller's FMI 3.0 sample clock (`build-fmu --features
-//! controller-sample-clock`, into target/fmu-clocked: `sample_clock`, a periodic input clock
-//! of 1 ms, ticking at every communication point) with its instances in host processes
+//! Our FMI 3.0 closed loop (target/ssp, built by build-fmu), whose controller declares its
+//! sample clock (`sample_clock`, a periodic input clock of 1 ms, ticking at every
+//! communication point), with its instances in host processes
 //! (`--isolate`, `--isolate=run`) and stepped in threads (`--threads 2`): the clock calls
 //! (`fmi3SetClock`, the intervals, `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`) cross
 //! the process boundary in the order they are made in process, and the thread pool opens
@@ -18,13 +18,8 @@ fn clocked_ssp() -> PathBuf {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
-    let p = target.join("fmu-clocked").join("ssp").join("nigel_closed_loop_fmi3.ssp");
-    assert!(
-        p.is_file(),
-        "{} missing: run `cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64 \
-         --this-glibc target/fmu-clocked/fmu`",
-        p.display()
-    );
+    let p = target.join("ssp").join("nigel_closed_loop_fmi3.ssp");
+    assert!(p.is_file(), "{} missing: run `cargo run --release -p build-fmu -- --platforms linux64 --this-glibc`", p.display());
     p
 }
 

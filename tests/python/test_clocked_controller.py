@@ -1,5 +1,5 @@
-"""The controller built with the option `controller-sample-clock` (its FMI 3.0 archive
-declares the sample period as the periodic input clock `sample_clock`), driven by fmpy's
+"""The controller, whose FMI 3.0 archive declares the sample period as the periodic input
+clock `sample_clock`, driven by fmpy's
 low-level FMI 3.0 calls as an independent importer: Co-Simulation with Event Mode (the clock
 activated at t_k = k T with T read by fmi3GetIntervalDecimal) and Scheduled Execution (the
 clock's model partition activated at t_k), and Co-Simulation without Event Mode as fmpy's
@@ -7,9 +7,8 @@ simulate_fmu instantiates it (the archive then samples by time itself: alone thr
 simulate_fmu, and in the closed loop with the FMI 3.0 plant and test bench), each against the
 FMI 2.0 archives of the same build stepped by fmpy on the same grid with the same inputs.
 
-The archives are built by the test command (scripts/test.sh) into target/fmu-clocked/fmu:
-`cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64
-target/fmu-clocked/fmu` (NIGEL_CLOCKED_FMU_DIR names another folder).
+The archives are those the test command (scripts/test.sh) builds into target/fmu
+(NIGEL_FMU_DIR names another folder).
 """
 
 import math
@@ -28,7 +27,7 @@ from fmpy.validation import validate_fmu
 
 REPO = Path(__file__).resolve().parents[2]
 TARGET = REPO / os.environ.get("CARGO_TARGET_DIR", "target")
-CLOCKED = Path(os.environ.get("NIGEL_CLOCKED_FMU_DIR", TARGET / "fmu-clocked" / "fmu"))
+CLOCKED = Path(os.environ.get("NIGEL_FMU_DIR", TARGET / "fmu"))
 FMU3 = CLOCKED / "fmi3" / "nigel_controller.fmu"
 FMU2 = CLOCKED / "nigel_controller.fmu"
 
