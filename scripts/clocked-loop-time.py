@@ -1,14 +1,14 @@
-"""CPU time of the clocked FMI 3.0 closed loop against the unclocked one (docs/fmus.md, "Its
+"""CPU time of the clocked FMI 3.0 closed loop against another closed loop (docs/fmus.md, "Its
 time"): alternating runs of `cosim run SSP --stop-time 30 --step 1e-3 --algorithm ALGORITHM`,
 which goes first alternating from pair to pair, each run's user + system time from getrusage.
 
     python3 scripts/clocked-loop-time.py PAIRS ALGORITHM [UNCLOCKED_SSP CLOCKED_SSP]
 
-The SSPs default to target/fmu-plain/ssp and target/fmu-clocked/ssp's
-nigel_closed_loop_fmi3.ssp, built alike:
-    cargo run --release -p build-fmu -- --platforms linux64 --this-glibc target/fmu-plain/fmu
-    cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64 \\
-        --this-glibc target/fmu-clocked/fmu
+The SSPs default to target/ssp's nigel_closed_loop.ssp (FMI 2.0, no clock: the "unclocked"
+runs) and nigel_closed_loop_fmi3.ssp (the FMI 3.0 archives, the controller with its sample
+clock), built alike by `cargo run --release -p build-fmu -- --platforms linux64 --this-glibc`.
+(An unclocked FMI 3.0 loop is built from a commit before the clock became the default, when
+it was the option `controller-sample-clock`.)
 Prints the median CPU time of each and the median, smallest and largest ratio of the pairs.
 """
 import os
@@ -32,9 +32,8 @@ def cpu_time(ssp, algorithm, out):
 
 def main():
     pairs, algorithm = int(sys.argv[1]), sys.argv[2]
-    name = "nigel_closed_loop_fmi3.ssp"
     unclocked, clocked = (sys.argv[3:5] if len(sys.argv) > 4
-                          else (TARGET / "fmu-plain" / "ssp" / name, TARGET / "fmu-clocked" / "ssp" / name))
+                          else (TARGET / "ssp" / "nigel_closed_loop.ssp", TARGET / "ssp" / "nigel_closed_loop_fmi3.ssp"))
     times = {"unclocked": [], "clocked": []}
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(pairs):
