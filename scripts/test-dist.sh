@@ -11,9 +11,7 @@
 # DLLs). The aarch64 Linux and macOS builds are checked as built (ELF and Mach-O headers):
 # see below why aarch64 is not executed.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/target-dir.sh"
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$repo/Cargo.toml" | head -1)"
 ssp="$target/ssp/nigel_closed_loop.ssp"
 [ -f "$ssp" ] || { echo "test-dist: no $ssp (build-fmu writes it)" >&2; exit 1; }
