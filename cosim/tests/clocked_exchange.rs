@@ -29,11 +29,13 @@ fn exchange_fmu(dir: &Path, interface: Interface) -> Option<PathBuf> {
     common::fmi3_c::build(dir, "fmi3_clocked_exchange", &xml)
 }
 
-/// The system of the FMU loaded for `interface`, `u` from the input file of the tests.
-fn run_exchange(path: &Path, interface: Interface) -> nigel_cosim::Results {
+/// The system of the FMU loaded for `interface`, `u` from the input file of the tests
+/// (`isolated`: the instance in a host process, `--isolate`).
+fn run_exchange(path: &Path, interface: Interface, isolated: bool) -> nigel_cosim::Results {
     let options = ImportOptions { interface: Some(interface), ..ImportOptions::default() };
     let system = System::single("c", Fmu::load_with(path, &options).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.0, 0.1);
+    experiment.isolation = isolated.then(common::isolate_all);
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["u".into()], vec![0.0, 0.2, 0.4, 0.7], vec![vec![0.0, 2.0, 4.0, 7.0]]).unwrap(),
     ));
@@ -84,7 +86,22 @@ fn check_held(results: &nigel_cosim::Results, open: bool) {
 fn clocked_variables_are_held_between_ticks_and_set_at_them() {
     let dir = work_dir("clocked-exchange");
     let Some(path) = exchange_fmu(&dir, Interface::CoSimulation) else { return };
-    check_held(&run_exchange(&path, Interface::CoSimulation), true);
+    check_held(&run_exchange(&path, Interface::CoSimulation, false), true);
+}
+
+/// The same with the instance in a host process (`--isolate`): `fmi3SetClock`, the
+/// intervals, `fmi3UpdateDiscreteStates` and the clocked sets and gets cross the process
+/// boundary in the order they are made in process (a set queued for the next call goes
+/// with it, so the clocked input set after `fmi3SetClock` reaches the FMU while its clock
+/// is active, and the FMU refuses it otherwise): the same held values, in Co-Simulation and
+/// Model Exchange.
+#[test]
+fn isolated_instances_exchange_clocked_variables_at_their_ticks_only() {
+    for (interface, open) in [(Interface::CoSimulation, true), (Interface::ModelExchange, false)] {
+        let dir = work_dir(&format!("clocked-exchange-isolated-{interface:?}"));
+        let Some(path) = exchange_fmu(&dir, interface) else { return };
+        check_held(&run_exchange(&path, interface, true), open);
+    }
 }
 
 /// The same in Model Exchange (the instance integrated on its own, no states): the ticks
@@ -94,7 +111,7 @@ fn clocked_variables_are_held_between_ticks_and_set_at_them() {
 fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
     let dir = work_dir("clocked-exchange-me");
     let Some(path) = exchange_fmu(&dir, Interface::ModelExchange) else { return };
-    check_held(&run_exchange(&path, Interface::ModelExchange), false);
+    check_held(&run_exchange(&path, Interface::ModelExchange, false), false);
 }
 
 /// The same in Scheduled Execution: `u` set once before each fmi3ActivateModelPartition of
@@ -106,9 +123,36 @@ fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
 fn scheduled_execution_exchanges_clocked_variables_at_their_activations_only() {
     let dir = work_dir("clocked-exchange-se");
     let Some(path) = exchange_fmu(&dir, Interface::ScheduledExecution) else { return };
-    let results = run_exchange(&path, Interface::ScheduledExecution);
+    let results = run_exchange(&path, Interface::ScheduledExecution, false);
     assert_eq!(results.column("time").unwrap(), [0.0, 0.25, 0.5, 0.75, 1.0]);
     assert_eq!(results.column("y").unwrap(), [1.0, 22.0, 43.0, 74.0, 74.0]);
     assert_eq!(results.column("t_now").unwrap(), [0.0, 0.25, 0.5, 0.75, 0.75]);
     assert_eq!(results.column("tick").unwrap(), [1.0, 1.0, 1.0, 1.0, 0.0]);
+}
+
+/// Scheduled Execution with isolation is refused, saying why (the FMU calls the scheduler
+/// back from inside `fmi3ActivateModelPartition`, which a host process cannot carry): in the
+/// library, and by `cosim run --isolate` and `--isolate=run`, exit code 1 before any call.
+#[test]
+fn scheduled_execution_with_isolation_is_refused_saying_why() {
+    let dir = work_dir("clocked-exchange-se-isolated");
+    let Some(path) = exchange_fmu(&dir, Interface::ScheduledExecution) else { return };
+    let options = ImportOptions { interface: Some(Interface::ScheduledExecution), ..ImportOptions::default() };
+    let system = System::single("c", Fmu::load_with(&path, &options).unwrap()).unwrap();
+    let mut experiment = Experiment::new(1.0, 0.1);
+    experiment.isolation = Some(common::isolate_all());
+    let e = nigel_cosim::simulate::simulate_scheduled(&system, &experiment).1.unwrap_err().to_string();
+    assert!(e.contains("clockUpdate") && e.contains("leave out --isolate"), "{e}");
+    for flag in ["--isolate", "--isolate=run"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .arg("run")
+            .arg(&path)
+            .args(["--interface", "se", "--stop-time", "1", flag])
+            .env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag}: {stderr}");
+        assert!(stderr.contains("Scheduled Execution is run in process only"), "{flag}: {stderr}");
+    }
 }

@@ -41,8 +41,23 @@ const TICKS: [(&str, &[f64]); 6] = [
 fn every_kind_of_clock_ticks_at_its_times() {
     let dir = work_dir("clocks-kinds");
     let Some(path) = clocks_fmu(&dir) else { return };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
+    every_kind_ticks_at_its_times(&path, None);
+}
+
+/// The same with the instance in a host process (`--isolate`): every clock call
+/// (`fmi3SetClock`, `fmi3GetClock`, `fmi3GetIntervalDecimal`, `fmi3GetShiftDecimal`, the
+/// event's calls) crosses the process boundary, the same counts at every row.
+#[test]
+fn every_kind_of_clock_ticks_at_its_times_in_a_host_process() {
+    let dir = work_dir("clocks-kinds-isolated");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
+}
+
+fn every_kind_ticks_at_its_times(path: &Path, isolation: Option<nigel_cosim::Isolation>) {
+    let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);
+    experiment.isolation = isolation;
     // the input file's clock column: 1 at the times trig ticks, 0 elsewhere
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
@@ -68,7 +83,11 @@ fn every_kind_of_clock_ticks_at_its_times() {
         }
     }
     let last_tick = results.column("last_tick").unwrap();
-    assert_eq!(*last_tick.last().unwrap(), 1.5, "changing's last tick, at the stop time: 0.1 + 0.2 + 0.3 + 0.4 + 0.5 s");
+    assert_eq!(
+        *last_tick.last().unwrap(),
+        1.5,
+        "changing's last tick, at the stop time: 0.1 + 0.2 + 0.3 + 0.4 + 0.5 s"
+    );
     let counted: Vec<(String, u64)> = summary.clock_ticks.clone();
     assert_eq!(
         counted,
@@ -109,14 +128,20 @@ fn a_clock_column_for_a_periodic_clock_is_refused() {
     assert!(e.contains("\"periodic\"") && e.contains("only triggered input clocks"), "{e}");
 }
 
+/// Instances `a` and `b` of the FMU at `path`, not connected.
+fn two_instances(path: &Path) -> SystemBuilder {
+    let fmu = Fmu::load(path).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("a", fmu.clone()).unwrap();
+    b.add_instance("b", fmu).unwrap();
+    b
+}
+
 #[test]
 fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     let dir = work_dir("clocks-connected");
     let Some(path) = clocks_fmu(&dir) else { return };
-    let fmu = Fmu::load(&path).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("a", fmu.clone()).unwrap();
-    b.add_instance("b", fmu).unwrap();
+    let mut b = two_instances(&path);
     // a clock connects to a triggered input clock only
     let e = b.connect("a.n_out_clock", "b.trig").unwrap_err().to_string();
     assert!(e.contains("the destination is a clock"), "{e}");
@@ -137,6 +162,35 @@ fn an_output_clock_ticks_a_connected_triggered_clock_at_the_next_point() {
     }
     let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
     assert_eq!((ticks("a.out_clock"), ticks("b.trig"), ticks("a.trig")), (Some(3), Some(3), Some(0)));
+}
+
+/// Two instances connected clock to clock (`a.out_clock -> b.trig`) stepped in two threads
+/// (`--threads 2`), in steps of 30 ms so that the periodic clock's ticks (0.1 + k 0.25 s)
+/// fall inside steps and split them: after the 200 calibration steps each instance is in a
+/// thread of its own, the pool splits every step at the ticks and carries `a`'s output
+/// clock ticks to `b` across the threads as one thread does; 60 s, the single-thread run's
+/// rows and ticks bit for bit.
+#[test]
+fn connected_clocks_in_two_threads_give_the_single_thread_run() {
+    let dir = work_dir("clocks-threads");
+    let Some(path) = clocks_fmu(&dir) else { return };
+    let mut b = two_instances(&path);
+    b.connect("a.out_clock", "b.trig").unwrap();
+    let system = b.build();
+    let mut e = Experiment::new(60.0, 0.03);
+    let (serial, serial_summary) = simulate(&system, &e).unwrap();
+    e.threads = 2;
+    let (parallel, summary) = simulate(&system, &e).unwrap();
+    assert!(summary.parallel_steps >= 1000, "{} steps in the pool", summary.parallel_steps);
+    // rows at the 2001 points and at the periodic ticks between them (0.35 s the first)
+    assert!(serial.rows() > 2001 && serial.column("time").unwrap().contains(&0.35), "{}", serial.rows());
+    assert_eq!((parallel.rows(), &parallel.names), (serial.rows(), &serial.names));
+    let differing = serial.values.iter().zip(&parallel.values).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
+    assert_eq!(differing, 0, "values of the two-thread run differ from the single-thread one's");
+    assert_eq!(summary.clock_ticks, serial_summary.clock_ticks);
+    let ticks = |name: &str| summary.clock_ticks.iter().find(|(n, _)| n == name).map(|(_, k)| *k);
+    // a.out_clock ticks at every second periodic tick, each carried to b.trig
+    assert!(ticks("a.out_clock").is_some_and(|k| k > 100) && ticks("a.out_clock") == ticks("b.trig"));
 }
 
 /// An SSP (SSP 2.0 draft: ssc:Clock connectors) of two instances of the clock FMU with

@@ -422,8 +422,7 @@ fn load<G: Generation>(
     Ok(Arc::new(fmu))
 }
 
-/// Clocks where the master does not run them: in Co-Simulation without Event Mode, in an
-/// instance of a host process (the host protocol carries no clock call).
+/// Clocks where the master does not run them: in Co-Simulation without Event Mode.
 fn clocks_not_run(fmu: &Fmu) -> Option<String> {
     let clocks = fmu.clocks();
     let first = clocks.first()?;
@@ -432,7 +431,6 @@ fn clocks_not_run(fmu: &Fmu) -> Option<String> {
         // Scheduled Execution runs the clocks itself (its model partitions)
         Interface::ScheduledExecution => return None,
         Interface::CoSimulation if !has_event_mode => "in Co-Simulation without Event Mode (hasEventMode)",
-        _ if fmu.is_isolated() => "in an isolated instance (a host process)",
         _ => return None,
     };
     Some(format!("clocks {why} (Clock variable {:?})", first.name))

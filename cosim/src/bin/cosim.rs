@@ -408,6 +408,9 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         }
         timed_sets.push(nigel_cosim::simulate::TimedSet { time, name, text: text.to_string() });
     }
+    if args.isolate.is_some() && nigel_cosim::simulate::is_scheduled(builder.system()) {
+        return Err(Error::Experiment(nigel_cosim::simulate::SCHEDULED_NOT_ISOLATED.into()).into());
+    }
     if !timed_sets.is_empty() && (args.isolate.is_some() || nigel_cosim::simulate::is_scheduled(builder.system())) {
         return Err(Error::Experiment(
             "--set-at is run in process by the stepping master (not with --isolate, not in Scheduled Execution)".into(),

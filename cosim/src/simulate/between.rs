@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::fmu::Instance;
 use crate::simulate::algorithm::{Communication, Core};
 use crate::simulate::clock::Point;
-use crate::simulate::observer::Profiler;
+use crate::simulate::profiler::Profiler;
 use crate::system::{BaseType, System, Value, VariableRef};
 use model_description::{Causality, Variability};
 use std::sync::Mutex;

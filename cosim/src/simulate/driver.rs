@@ -2,7 +2,8 @@
 //! initialization to its end.
 
 use crate::error::Result;
-use crate::simulate::execution::{Execution, InstancePool, RowSink};
+use crate::simulate::execution::{Execution, InstancePool};
+use crate::simulate::observer::RowSink;
 use crate::simulate::types::{Experiment, Results, Summary};
 use crate::system::System;
 

@@ -21,8 +21,9 @@ use crate::simulate::between::{Manipulator, SetQueue, WithManipulator};
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::{apply_start_values, Lane};
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Profiler, Progress, Recorder};
+use crate::simulate::observer::{Cancel, Deadline, ExactSource, Observer, Observers, Progress, Recorder, RowSink};
 use crate::simulate::plan::{default_record, run_ops, Op, Plan};
+use crate::simulate::profiler::Profiler;
 use crate::simulate::ticks::Ticks;
 use crate::simulate::types::{Algorithm, Experiment, Results, Summary};
 use crate::system::{BaseType, System, Value, VariableRef};
@@ -115,9 +116,6 @@ impl<'s> Execution<'s> {
         check_single_instance(system)?;
         if experiment.threads == 0 {
             return Err(Error::Experiment("threads must be at least 1".into()));
-        }
-        if experiment.threads > 1 && system.instances.iter().any(|i| !i.fmu.clocks().is_empty()) {
-            return Err(Error::Experiment("FMI 3.0 clocks are run in one thread: use threads = 1".into()));
         }
         let record: Vec<VariableRef> = match &experiment.record {
             None => default_record(system),
@@ -419,12 +417,6 @@ impl<'s> Execution<'s> {
                 return Err(Error::Experiment(format!(
                     "{}: clocks of a Model Exchange instance connected to other Model Exchange instances, which \
                      cosim does not support (connect it through a Co-Simulation FMU, or run it alone)",
-                    spec.name
-                )));
-            }
-            if lane.inst.fmu().is_isolated() {
-                return Err(Error::Experiment(format!(
-                    "{}: clocks in an isolated instance (a host process), which cosim does not support",
                     spec.name
                 )));
             }
@@ -894,11 +886,6 @@ fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
     }
     Ok(())
 }
-
-/// Where [`Execution::with_sink`] (and `simulate_with`) hands each row: the time and the recorded values, in the order
-/// of [`Experiment::record`](crate::Experiment::record), and the (column, text) of the columns an f64 does not hold
-/// ([`Results::exact`](crate::Results::exact); empty when there are none).
-pub type RowSink<'s> = dyn FnMut(f64, &[f64], &[(usize, String)]) + Send + 's;
 
 /// Instances kept between runs of one system ([`Execution::with_pool`], `simulate_with`): the instance of each
 /// position, reused only for the same FMU (the same loaded archive) and name.

@@ -136,10 +136,11 @@ impl Lane {
         self.posted
     }
 
-    /// Whether [`Lane::post_step`] hands the step to a host.
+    /// Whether [`Lane::post_step`] hands the step to a host: one `fmi3DoStep`, so not an
+    /// instance with clocks (its step closes and opens clock events around its steps).
     #[inline]
     pub(crate) fn can_post(&self) -> bool {
-        self.unit.is_none() && self.saved.is_none() && self.inst.fmu().is_isolated()
+        self.unit.is_none() && self.saved.is_none() && self.ticks.is_none() && self.inst.fmu().is_isolated()
     }
 
     /// One `jacobi` step of this instance: its inputs set from `values` (the outputs of

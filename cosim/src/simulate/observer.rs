@@ -5,12 +5,13 @@
 //! - [`Recorder`]: the rows of the results at output points (told first, with the values).
 //! - [`Observer`]: the others, public ([`crate::simulate::Execution::add_observer`]): the
 //!   time limit, the cancel flag, the progress, a caller's own.
-//! - [`Profiler`]: the time spent in each instance's calls, one clock read per call
-//!   boundary; the algorithms tell it after each call (it is attached only when asked
-//!   for, so an unprofiled run reads no clock).
+//!
+//! The [`Profiler`] (the time spent in each instance's calls) is `profiler`'s; the
+//! observers of a run carry it to the algorithms.
 
 use crate::error::{Error, Result};
 use crate::simulate::clock::Point;
+use crate::simulate::profiler::Profiler;
 use crate::simulate::types::Results;
 use std::time::{Duration, Instant};
 
@@ -23,6 +24,11 @@ pub trait Observer {
     fn step_complete(&mut self, point: &Point) -> Result<()>;
 }
 
+/// Where [`Execution::with_sink`](crate::simulate::Execution::with_sink) (and `simulate_with`) hands each row: the time and the recorded values, in the order
+/// of [`Experiment::record`](crate::Experiment::record), and the (column, text) of the columns an f64 does not hold
+/// ([`Results::exact`](crate::Results::exact); empty when there are none).
+pub type RowSink<'s> = dyn FnMut(f64, &[f64], &[(usize, String)]) + Send + 's;
+
 /// The rows of the results: time and the recorded slots at every output point.
 /// With a sink ([`crate::simulate::RowSink`]) the rows are handed to it instead of kept,
 /// with the (column, text) of the exact columns ([`Results::exact`]).
@@ -33,7 +39,7 @@ pub(crate) struct Recorder<'s> {
     slots: Vec<usize>,
     /// Steps completed so far.
     done: u64,
-    pub(crate) sink: Option<&'s mut crate::simulate::RowSink<'s>>,
+    pub(crate) sink: Option<&'s mut RowSink<'s>>,
     row: Vec<f64>,
     /// The time of the last row.
     last: Option<f64>,
@@ -222,45 +228,6 @@ impl Observer for Cancel {
             return Err(Error::Cancelled { time: point.t_next });
         }
         Ok(())
-    }
-}
-
-/// Time spent in each instance's calls, one clock read per call boundary: the time from
-/// the previous mark to the end of a call is charged to that call's instance (the
-/// master's marshalling of the call's arguments included). Lanes stepped in threads
-/// measure their own time ([`crate::simulate::lane::Lane::spent`]), added at the end.
-pub(crate) struct Profiler {
-    last: Instant,
-    pub(crate) spent: Vec<Duration>,
-}
-
-impl Profiler {
-    pub(crate) fn new(n: usize) -> Profiler {
-        Profiler { last: Instant::now(), spent: vec![Duration::ZERO; n] }
-    }
-
-    /// Starts a stretch of calls.
-    #[inline]
-    pub(crate) fn restart(&mut self) {
-        self.last = Instant::now();
-    }
-
-    /// Charges the time since the last mark evenly to `instances` (a coupled group).
-    pub(crate) fn charge_shared(&mut self, instances: &[usize]) {
-        let now = Instant::now();
-        let share = (now - self.last) / instances.len().max(1) as u32;
-        for &i in instances {
-            self.spent[i] += share;
-        }
-        self.last = now;
-    }
-
-    /// Charges the time since the last mark to `instance`.
-    #[inline]
-    pub(crate) fn charge(&mut self, instance: usize) {
-        let now = Instant::now();
-        self.spent[instance] += now - self.last;
-        self.last = now;
     }
 }
 

@@ -588,7 +588,7 @@ pub(crate) fn run_ops<I: Instances + ?Sized>(
     ops: &mut [Op],
     insts: &mut I,
     values: &mut [f64],
-    mut calls: Option<&mut crate::simulate::observer::Profiler>,
+    mut calls: Option<&mut crate::simulate::profiler::Profiler>,
 ) -> Result<()> {
     if let Some(p) = calls.as_deref_mut() {
         p.restart();

@@ -37,6 +37,12 @@ use crate::partitions::{model_partitions, output_clocks, ModelPartition, Ticks};
 use crate::simulate::{apply_start_values, Experiment, InputTable, Results, Summary};
 use crate::system::{BaseType, System, VariableRef};
 
+/// Why Scheduled Execution is not run isolated (`--isolate`, `--isolate=run`).
+pub const NOT_ISOLATED: &str = "Scheduled Execution is run in process only (leave out --isolate): the FMU calls \
+     the scheduler back from inside fmi3ActivateModelPartition (clockUpdate, lockPreemption, unlockPreemption), \
+     which a host process cannot carry (it answers one call at a time and cannot call this process during one), \
+     and --isolate=run streams the rows of a stepped run only";
+
 /// Whether `system` is run in Scheduled Execution (an instance loaded for it).
 pub fn is_scheduled(system: &System) -> bool {
     system.instances.iter().any(|i| i.fmu.interface() == Interface::ScheduledExecution)
@@ -121,9 +127,7 @@ pub fn simulate_scheduled(system: &System, experiment: &Experiment) -> (Results,
 fn run(system: &System, experiment: &Experiment, results: &mut Results) -> Result<Summary> {
     let started = std::time::Instant::now();
     if experiment.isolation.is_some() {
-        return Err(Error::Experiment(
-            "Scheduled Execution runs in process: the FMU's callbacks are this process's (leave out --isolate)".into(),
-        ));
+        return Err(Error::Experiment(NOT_ISOLATED.into()));
     }
     if let Some(other) = system.instances.iter().find(|i| i.fmu.interface() != Interface::ScheduledExecution) {
         return Err(Error::Experiment(format!(

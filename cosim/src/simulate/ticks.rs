@@ -23,7 +23,7 @@
 use crate::clocks::{Clock, ClockCausality, ClockKind};
 use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interval};
-use crate::simulate::input::InputTable;
+use crate::simulate::input_table::InputTable;
 use crate::system::System;
 
 /// One input clock's schedule.

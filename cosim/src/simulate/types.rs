@@ -59,7 +59,7 @@ pub struct Experiment {
     pub retry_discard: bool,
     /// Input signals over time (fmpy's `input=`), applied before every communication
     /// step; the variables they drive must not be connected.
-    pub input: Option<std::sync::Arc<crate::simulate::InputTable>>,
+    pub input: Option<std::sync::Arc<crate::simulate::input_table::InputTable>>,
     /// The cap on the steps of a run: communication steps, and the internal steps
     /// (accepted and rejected) of the Model Exchange integrator; a run that would take
     /// more stops with [`Error::Experiment`](crate::Error::Experiment) (an adaptive step that shrinks without end

@@ -487,3 +487,13 @@ pub fn assert_counted_at_bounces(r: &nigel_cosim::Results, bounces: &[f64], what
         assert_eq!((count[k], t_last[k]), (n, last), "{what}: at t = {}", t[k]);
     }
 }
+
+/// Every instance in a host process of its own (`--isolate`), the host the one this
+/// package builds.
+pub fn isolate_all() -> nigel_cosim::Isolation {
+    nigel_cosim::Isolation {
+        instances: None,
+        call_timeout: None,
+        host: Some(PathBuf::from(env!("CARGO_BIN_EXE_cosim-host"))),
+    }
+}

@@ -721,12 +721,8 @@ impl Fmi3 {
         let mut ticks = vec![false; vrs.len()];
         ClockCalls::get_clocks(self, core, &vrs, &mut ticks)?;
         let opened = std::mem::take(&mut self.opened_outputs);
-        let ticked: Vec<u32> = vrs
-            .into_iter()
-            .zip(ticks)
-            .filter(|(vr, t)| *t && !opened.contains(vr))
-            .map(|(vr, _)| vr)
-            .collect();
+        let ticked: Vec<u32> =
+            vrs.into_iter().zip(ticks).filter(|(vr, t)| *t && !opened.contains(vr)).map(|(vr, _)| vr).collect();
         for vr in &ticked {
             self.output_ticks.push(super::core::OutputTick { time, value_reference: *vr });
         }
@@ -837,7 +833,7 @@ impl Calls for Fmi3 {
         if fmu.interface == Interface::ScheduledExecution {
             return Err(Error::Instance {
                 name: String::from_utf8_lossy(name_c.as_bytes()).into_owned(),
-                reason: "Scheduled Execution is not run in a host process (its callbacks are this process's): run it without isolation",
+                reason: "Scheduled Execution is not run in a host process: the FMU calls this process back (clockUpdate, lockPreemption) from inside fmi3ActivateModelPartition, and a host answers one call at a time: run it without isolation",
             });
         }
         let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());

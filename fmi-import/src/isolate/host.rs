@@ -5,7 +5,7 @@
 //! does to this process (a crash, `exit`, a call that never returns) the master sees as
 //! the host's end.
 
-use super::protocol::{fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
+use super::protocol::{clock_arrays, fmi3_type, publish, wait_for, Header, Layout, Op, SpinGauge};
 use crate::c_types::{EventInfo, Functions};
 use crate::library::{load_functions, load_library};
 use crate::log::{callbacks_for, LogSink};
@@ -533,6 +533,39 @@ impl Host {
                     let b = data;
                     f.update_discrete_states
                         .map_or(missing, |g| g(c, b, b.add(1), b.add(2), b.add(3), b.add(4), b.add(8) as *mut f64))
+                }
+                // the clock calls: their arrays after the references, as the proxy laid them out
+                Op::SetClock3 => {
+                    let ([a], _) = clock_arrays(n, [1]);
+                    f.set_clock.map_or(missing, |g| g(c, vrs, n, data.add(a)))
+                }
+                Op::GetClock3 => {
+                    let ([a], _) = clock_arrays(n, [1]);
+                    f.get_clock.map_or(missing, |g| g(c, vrs, n, data.add(a)))
+                }
+                Op::GetIntervalDecimal3 => {
+                    let ([v, q], _) = clock_arrays(n, [8, 4]);
+                    f.get_interval_decimal
+                        .map_or(missing, |g| g(c, vrs, n, data.add(v) as *mut f64, data.add(q) as *mut c_int))
+                }
+                Op::GetIntervalFraction3 => {
+                    let ([k, r, q], _) = clock_arrays(n, [8, 8, 4]);
+                    f.get_interval_fraction.map_or(missing, |g| {
+                        g(c, vrs, n, data.add(k) as *mut u64, data.add(r) as *mut u64, data.add(q) as *mut c_int)
+                    })
+                }
+                Op::GetShiftDecimal3 => {
+                    let ([v], _) = clock_arrays(n, [8]);
+                    f.get_shift_decimal.map_or(missing, |g| g(c, vrs, n, data.add(v) as *mut f64))
+                }
+                Op::GetShiftFraction3 => {
+                    let ([k, r], _) = clock_arrays(n, [8, 8]);
+                    f.get_shift_fraction
+                        .map_or(missing, |g| g(c, vrs, n, data.add(k) as *mut u64, data.add(r) as *mut u64))
+                }
+                Op::SetIntervalDecimal3 => {
+                    let ([v], _) = clock_arrays(n, [8]);
+                    f.set_interval_decimal.map_or(missing, |g| g(c, vrs, n, data.add(v) as *const f64))
                 }
                 Op::GetFmuState3 => state_handle(&mut h.i[0], |s| f.get_fmu_state.map_or(missing, |g| g(c, s))),
                 Op::SetFmuState3 => f.set_fmu_state.map_or(missing, |g| g(c, h.i[0] as usize as *mut c_void)),

@@ -98,6 +98,28 @@ protocol_ops! {
     GetEventIndicators3 => "fmi3GetEventIndicators",
     GetContinuousStates3 => "fmi3GetContinuousStates",
     GetNominalsOfContinuousStates3 => "fmi3GetNominalsOfContinuousStates",
+    // FMI 3.0 clocks: the references, then each array of the call ([`clock_arrays`])
+    SetClock3 => "fmi3SetClock",
+    GetClock3 => "fmi3GetClock",
+    GetIntervalDecimal3 => "fmi3GetIntervalDecimal",
+    GetIntervalFraction3 => "fmi3GetIntervalFraction",
+    GetShiftDecimal3 => "fmi3GetShiftDecimal",
+    GetShiftFraction3 => "fmi3GetShiftFraction",
+    SetIntervalDecimal3 => "fmi3SetIntervalDecimal",
+}
+
+/// Where the arrays of a clock call lie in the data area, after its `n` references: one
+/// array of `n` values per width in `widths` (bytes per value), each 8-aligned; the
+/// offsets, and the bytes the call takes. The master (`proxy3.rs`) and the host lay them
+/// out by this one function.
+pub(crate) fn clock_arrays<const K: usize>(n: usize, widths: [usize; K]) -> ([usize; K], usize) {
+    let mut at = (4 * n).div_ceil(8) * 8;
+    let mut offsets = [0; K];
+    for (o, w) in offsets.iter_mut().zip(widths) {
+        *o = at;
+        at += (w * n).div_ceil(8) * 8;
+    }
+    (offsets, at)
 }
 
 /// The code on the wire of the value type `ty` of `Op::Get3` / `Op::Set3`: its position in

@@ -8,9 +8,11 @@
 #![allow(clippy::missing_safety_doc)] // called only by `Instance` through the function table
 
 use super::channel::Channel;
-use super::protocol::{fmi3_type_code, fmi3_width, Op};
+use super::protocol::{clock_arrays, fmi3_type_code, fmi3_width, Op};
 use super::proxy::{ch, fits, plain, slice, slice_mut, state_call, vrs_into};
-use fmi_sys::fmi3::{fmi3Boolean, fmi3FMUState, fmi3Instance, fmi3Status, fmi3String, Fmi3Functions};
+use fmi_sys::fmi3::{
+    fmi3Boolean, fmi3Clock, fmi3FMUState, fmi3Instance, fmi3IntervalQualifier, fmi3Status, fmi3String, Fmi3Functions,
+};
 use model_description::fmi3::ValueType;
 use std::ffi::{c_char, CStr};
 
@@ -255,6 +257,86 @@ vector_getters! {
     get_nominals_of_continuous_states => GetNominalsOfContinuousStates3;
 }
 
+/// One clock call (`op`) on n references and the arrays of n values each: (bytes per
+/// value, the caller's array, whether it goes to the FMU) in the function's order, laid out
+/// by [`clock_arrays`]; the arrays that do not go to the FMU are its answers.
+unsafe fn clock_call<const K: usize>(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    op: Op,
+    arrays: [(usize, *mut u8, bool); K],
+) -> fmi3Status {
+    let channel = ch(c);
+    let (offsets, bytes) = clock_arrays(n, arrays.map(|a| a.0));
+    if !fits(channel, bytes) {
+        return 3;
+    }
+    vrs_into(channel, slice(vr, n));
+    for (&(width, values, given), at) in arrays.iter().zip(offsets) {
+        if given {
+            channel.data()[at..at + width * n].copy_from_slice(slice(values as *const u8, width * n));
+        }
+    }
+    channel.header().n = n as u64;
+    let s = channel.call(op);
+    for (&(width, values, given), at) in arrays.iter().zip(offsets) {
+        if !given {
+            slice_mut(values, width * n).copy_from_slice(&channel.data()[at..at + width * n]);
+        }
+    }
+    s
+}
+
+unsafe extern "C" fn set_clock(c: Component, vr: *const u32, n: usize, v: *const fmi3Clock) -> fmi3Status {
+    clock_call(c, vr, n, Op::SetClock3, [(1, v as *mut u8, true)])
+}
+
+unsafe extern "C" fn get_clock(c: Component, vr: *const u32, n: usize, v: *mut fmi3Clock) -> fmi3Status {
+    clock_call(c, vr, n, Op::GetClock3, [(1, v, false)])
+}
+
+unsafe extern "C" fn get_interval_decimal(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    intervals: *mut f64,
+    qualifiers: *mut fmi3IntervalQualifier,
+) -> fmi3Status {
+    clock_call(c, vr, n, Op::GetIntervalDecimal3, [(8, intervals as *mut u8, false), (4, qualifiers as *mut u8, false)])
+}
+
+unsafe extern "C" fn get_interval_fraction(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    counters: *mut u64,
+    resolutions: *mut u64,
+    qualifiers: *mut fmi3IntervalQualifier,
+) -> fmi3Status {
+    let arrays =
+        [(8, counters as *mut u8, false), (8, resolutions as *mut u8, false), (4, qualifiers as *mut u8, false)];
+    clock_call(c, vr, n, Op::GetIntervalFraction3, arrays)
+}
+
+unsafe extern "C" fn get_shift_decimal(c: Component, vr: *const u32, n: usize, shifts: *mut f64) -> fmi3Status {
+    clock_call(c, vr, n, Op::GetShiftDecimal3, [(8, shifts as *mut u8, false)])
+}
+
+unsafe extern "C" fn get_shift_fraction(
+    c: Component,
+    vr: *const u32,
+    n: usize,
+    counters: *mut u64,
+    resolutions: *mut u64,
+) -> fmi3Status {
+    clock_call(c, vr, n, Op::GetShiftFraction3, [(8, counters as *mut u8, false), (8, resolutions as *mut u8, false)])
+}
+
+unsafe extern "C" fn set_interval_decimal(c: Component, vr: *const u32, n: usize, intervals: *const f64) -> fmi3Status {
+    clock_call(c, vr, n, Op::SetIntervalDecimal3, [(8, intervals as *mut u8, true)])
+}
+
 unsafe extern "C" fn get_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3Status {
     state_call(c, s, Op::GetFmuState3)
 }
@@ -271,7 +353,8 @@ unsafe extern "C" fn free_fmu_state(c: Component, s: *mut fmi3FMUState) -> fmi3S
 /// has (an optional function is in the table where the library has it, so the
 /// capabilities stay the FMU's). The instantiation is [`instantiate_in`] (made by
 /// `Instance::new_isolated`); setting binaries (the view's Binaries are read-only),
-/// clocks, directional derivatives and serialized states are not carried to the host.
+/// setting shifts and fractional intervals (the master sets none), directional
+/// derivatives, serialized states and Scheduled Execution are not carried to the host.
 pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
     macro_rules! optional {
         ($name:literal, $f:ident) => {
@@ -304,7 +387,7 @@ pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         get_boolean: optional!("fmi3GetBoolean", get_boolean),
         get_string: optional!("fmi3GetString", get_string),
         get_binary: optional!("fmi3GetBinary", get_binary),
-        get_clock: None,
+        get_clock: optional!("fmi3GetClock", get_clock),
         set_float32: optional!("fmi3SetFloat32", set_float32),
         set_int8: optional!("fmi3SetInt8", set_int8),
         set_uint8: optional!("fmi3SetUInt8", set_uint8),
@@ -317,7 +400,7 @@ pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         set_boolean: optional!("fmi3SetBoolean", set_boolean),
         set_string: optional!("fmi3SetString", set_string),
         set_binary: None,
-        set_clock: None,
+        set_clock: optional!("fmi3SetClock", set_clock),
         get_number_of_variable_dependencies: None,
         get_variable_dependencies: None,
         get_fmu_state: optional!("fmi3GetFMUState", get_fmu_state),
@@ -330,11 +413,11 @@ pub(crate) fn table(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         get_adjoint_derivative: None,
         enter_configuration_mode: None,
         exit_configuration_mode: None,
-        get_interval_decimal: None,
-        get_interval_fraction: None,
-        get_shift_decimal: None,
-        get_shift_fraction: None,
-        set_interval_decimal: None,
+        get_interval_decimal: optional!("fmi3GetIntervalDecimal", get_interval_decimal),
+        get_interval_fraction: optional!("fmi3GetIntervalFraction", get_interval_fraction),
+        get_shift_decimal: optional!("fmi3GetShiftDecimal", get_shift_decimal),
+        get_shift_fraction: optional!("fmi3GetShiftFraction", get_shift_fraction),
+        set_interval_decimal: optional!("fmi3SetIntervalDecimal", set_interval_decimal),
         set_interval_fraction: None,
         set_shift_decimal: None,
         set_shift_fraction: None,
@@ -376,6 +459,9 @@ mod tests {
         assert!(
             t.has("fmi3SetTime") && t.has("fmi3GetContinuousStateDerivatives") && t.has("fmi3CompletedIntegratorStep")
         );
-        assert!(!t.has("fmi3SetBinary") && !t.has("fmi3GetDirectionalDerivative") && !t.has("fmi3GetClock"));
+        assert!(
+            !t.has("fmi3SetBinary") && !t.has("fmi3GetDirectionalDerivative") && !t.has("fmi3ActivateModelPartition")
+        );
+        assert!(t.has("fmi3GetClock") && t.has("fmi3SetClock") && t.has("fmi3GetIntervalFraction"));
     }
 }

@@ -5,7 +5,7 @@
 use super::{Communication, Core};
 use crate::error::{Error, Result};
 use crate::simulate::clock::Point;
-use crate::simulate::observer::Profiler;
+use crate::simulate::profiler::Profiler;
 use std::time::Instant;
 
 /// The `jacobi` algorithm in one thread (each lane holds its own batched calls).

@@ -16,7 +16,8 @@ use crate::me::Solver;
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::Lane;
 use crate::simulate::me_group::MeGroup;
-use crate::simulate::observer::{Observers, Profiler};
+use crate::simulate::observer::Observers;
+use crate::simulate::profiler::Profiler;
 use std::ops::Range;
 
 /// What an algorithm works on: the instances, the value buffer of the plan, the coupled
@@ -41,29 +42,45 @@ pub(crate) struct Core {
 }
 
 impl Core {
-    /// The ticks of output clocks in the step that ends at `t_next` carried to the
-    /// triggered input clocks connected to them: each ticks at `t_next` (the start of the
-    /// next step), as `jacobi` carries every connection one step late.
     /// The first tick of any instance's input clocks after `from` and before `until`.
     #[inline]
     pub(crate) fn next_tick_inside(&self, from: f64, until: f64) -> Option<f64> {
         if !self.clocked {
             return None;
         }
-        self.lanes.iter().filter_map(|l| l.ticks.as_ref()?.next_inside(from, until)).reduce(f64::min)
+        next_tick_inside(self.lanes.iter(), from, until)
     }
 
+    /// The ticks of output clocks in the step that ends at `t_next` carried to the
+    /// triggered input clocks connected to them (see [`carry_clock_ticks`]).
     pub(crate) fn carry_clock_ticks(&mut self, t_next: f64) {
         if self.clock_links.is_empty() {
             return;
         }
-        let fired: Vec<(usize, Vec<u32>)> =
-            self.lanes.iter_mut().filter_map(|l| Some((l.index, l.ticks.as_mut()?.take_fired()))).collect();
-        for (index, vrs) in fired {
-            for link in self.clock_links.iter().filter(|c| c.from.0 == index && vrs.contains(&c.from.1)) {
-                if let Some(ticks) = self.lanes[link.to.0].ticks.as_mut() {
-                    ticks.trigger(link.to.1, t_next);
-                }
+        carry_clock_ticks(self.lanes.iter_mut(), &self.clock_links, t_next);
+    }
+}
+
+/// The first tick of the input clocks of any of `lanes` after `from` and before `until`.
+pub(crate) fn next_tick_inside<'a>(lanes: impl Iterator<Item = &'a Lane>, from: f64, until: f64) -> Option<f64> {
+    lanes.filter_map(|l| l.ticks.as_ref()?.next_inside(from, until)).reduce(f64::min)
+}
+
+/// The ticks of output clocks in the step that ends at `t_next` carried to the triggered
+/// input clocks connected to them (`links`): each ticks at `t_next` (the start of the next
+/// step), as `jacobi` carries every connection one step late.
+pub(crate) fn carry_clock_ticks<'a>(
+    lanes: impl Iterator<Item = &'a mut Lane>,
+    links: &[crate::system::ClockConnection],
+    t_next: f64,
+) {
+    let mut lanes: Vec<&mut Lane> = lanes.collect();
+    let fired: Vec<(usize, Vec<u32>)> =
+        lanes.iter_mut().filter_map(|l| Some((l.index, l.ticks.as_mut()?.take_fired()))).collect();
+    for (index, vrs) in fired {
+        for link in links.iter().filter(|c| c.from.0 == index && vrs.contains(&c.from.1)) {
+            if let Some(ticks) = lanes.iter_mut().find(|l| l.index == link.to.0).and_then(|l| l.ticks.as_mut()) {
+                ticks.trigger(link.to.1, t_next);
             }
         }
     }

@@ -5,8 +5,8 @@
 use super::{Communication, Core};
 use crate::error::{Error, Result};
 use crate::simulate::clock::Point;
-use crate::simulate::observer::Profiler;
 use crate::simulate::plan::{run_ops, Op};
+use crate::simulate::profiler::Profiler;
 
 /// The `ordered` algorithm: the plan's calls in topological order.
 pub(crate) struct Ordered {

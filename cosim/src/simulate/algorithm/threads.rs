@@ -28,7 +28,8 @@ use crate::error::{Error, Result};
 use crate::me::Solver;
 use crate::simulate::clock::{Clock, Point};
 use crate::simulate::lane::Lane;
-use crate::simulate::observer::{Observers, Profiler};
+use crate::simulate::observer::Observers;
+use crate::simulate::profiler::Profiler;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard, RwLock};
@@ -112,7 +113,7 @@ fn partition(mut lanes: Vec<Lane>, threads: usize) -> Vec<Vec<Lane>> {
 const PROBE_STEPS: u64 = 1000;
 
 /// A pool for one run.
-struct Pool {
+struct Pool<'a> {
     /// Threads, the calling one included (at least 2, at most the number of lanes).
     threads: usize,
     solver: Solver,
@@ -121,9 +122,12 @@ struct Pool {
     /// Wall time of one step in one thread (measured): after [`PROBE_STEPS`] steps
     /// slower than this, the pool stops and the caller goes on in one thread.
     serial_step: std::time::Duration,
+    /// Some instance has FMI 3.0 clocks ([`Core::clocked`]), and the clock connections.
+    clocked: bool,
+    clock_links: &'a [crate::system::ClockConnection],
 }
 
-impl Pool {
+impl Pool<'_> {
     /// Runs the `jacobi` steps `steps` of `clock`; the observers are told after each step
     /// with all outputs in their slots. Returns the lanes in their original order and the
     /// first step not run (the end of `steps` unless the pool was slower than one thread),
@@ -171,6 +175,53 @@ impl Pool {
                 });
                 workers.push(handle.thread().clone());
             }
+            // one step of every lane in the pool, from `a.t` to `a.t_next`: the errors
+            // taken (the lowest instance's first), the outputs scattered into their slots
+            let step_all = |a: Point| -> Result<()> {
+                *lock(&shared.args) = a;
+                shared.done.store(0, Ordering::Release);
+                shared.epoch.fetch_add(1, Ordering::AcqRel);
+                for w in &workers {
+                    w.unpark();
+                }
+                work(&shared, 0, solver, profile);
+                wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
+                if shared.panicked.load(Ordering::Acquire) {
+                    return Err(Error::Experiment("a thread stepping the instances panicked".into()));
+                }
+                let mut values = shared.values.write().unwrap_or_else(|e| e.into_inner());
+                let mut first: Option<(usize, Error)> = None;
+                for g in &shared.groups {
+                    for lane in lock(g).iter_mut() {
+                        if let Some(e) = lane.error.take() {
+                            if first.as_ref().is_none_or(|(i, _)| lane.index < *i) {
+                                first = Some((lane.index, e));
+                            }
+                        }
+                    }
+                }
+                if let Some((_, e)) = first {
+                    return Err(e);
+                }
+                for g in &shared.groups {
+                    for lane in lock(g).iter() {
+                        lane.scatter(&mut values, a.output_point);
+                    }
+                }
+                Ok(())
+            };
+            // FMI 3.0 clocks, as `Communication::run` in one thread: the step split at
+            // every tick inside it (a row there), the output clocks' ticks carried
+            let next_tick = |from: f64, until: f64| -> Option<f64> {
+                let guards: Vec<_> = shared.groups.iter().map(lock).collect();
+                super::next_tick_inside(guards.iter().flat_map(|g| g.iter()), from, until)
+            };
+            let carry = |t_next: f64| {
+                if !self.clock_links.is_empty() {
+                    let mut guards: Vec<_> = shared.groups.iter().map(lock).collect();
+                    super::carry_clock_ticks(guards.iter_mut().flat_map(|g| g.iter_mut()), self.clock_links, t_next);
+                }
+            };
             let mut drive = || -> Result<u64> {
                 let start = std::time::Instant::now();
                 let first = steps.start;
@@ -178,38 +229,16 @@ impl Pool {
                     if n == first + PROBE_STEPS && start.elapsed() > self.serial_step * PROBE_STEPS as u32 {
                         return Ok(n); // slower than one thread: the caller goes on alone
                     }
-                    let a = clock.point(n);
-                    *lock(&shared.args) = a;
-                    shared.done.store(0, Ordering::Release);
-                    shared.epoch.fetch_add(1, Ordering::AcqRel);
-                    for w in &workers {
-                        w.unpark();
+                    let mut a = clock.point(n);
+                    while let Some(tick) = self.clocked.then(|| next_tick(a.t, a.t_next)).flatten() {
+                        step_all(Point { t_next: tick, output_point: true, ..a })?;
+                        carry(tick);
+                        observers.recorder.push_row(tick, &shared.values.read().unwrap_or_else(|e| e.into_inner()));
+                        a.t = tick;
                     }
-                    work(&shared, 0, solver, profile);
-                    wait_until(|| shared.done.load(Ordering::Acquire) == threads - 1);
-                    if shared.panicked.load(Ordering::Acquire) {
-                        return Err(Error::Experiment("a thread stepping the instances panicked".into()));
-                    }
-                    let mut values = shared.values.write().unwrap_or_else(|e| e.into_inner());
-                    let mut first: Option<(usize, Error)> = None;
-                    for g in &shared.groups {
-                        for lane in lock(g).iter_mut() {
-                            if let Some(e) = lane.error.take() {
-                                if first.as_ref().is_none_or(|(i, _)| lane.index < *i) {
-                                    first = Some((lane.index, e));
-                                }
-                            }
-                        }
-                    }
-                    if let Some((_, e)) = first {
-                        return Err(e);
-                    }
-                    for g in &shared.groups {
-                        for lane in lock(g).iter() {
-                            lane.scatter(&mut values, a.output_point);
-                        }
-                    }
-                    observers.step_complete(&a, &values)?;
+                    step_all(a)?;
+                    carry(a.t_next);
+                    observers.step_complete(&a, &shared.values.read().unwrap_or_else(|e| e.into_inner()))?;
                 }
                 Ok(steps.end)
             };
@@ -262,29 +291,34 @@ impl Communication for ThreadedJacobi {
             // instances spread over the threads by that cost
             let calibration = steps.min(first + CALIBRATION_STEPS);
             let calibration_start = std::time::Instant::now();
-            for n in first..calibration {
-                let p = core.clock.point(n);
-                Jacobi::step_lanes(core, p, true)?;
-                observers.step_complete(&p, &core.values)?;
-            }
+            // in one thread as `Jacobi` runs (the steps split at clock ticks), each lane
+            // measuring the time of its calls
+            let profile = std::mem::replace(&mut core.profile, true);
+            let calibrated = Jacobi.run(core, observers, first..calibration);
+            core.profile = profile;
+            calibrated?;
             let serial_step = calibration_start.elapsed() / (calibration - first).max(1) as u32;
             first = calibration;
             if first < steps {
-                let pool = Pool { threads, solver: core.solver, profile: core.profile, serial_step };
                 let lanes = std::mem::take(&mut core.lanes);
                 let clock = core.clock;
+                let clock_links = std::mem::take(&mut core.clock_links);
+                let pool = Pool {
+                    threads,
+                    solver: core.solver,
+                    profile: core.profile,
+                    serial_step,
+                    clocked: core.clocked,
+                    clock_links: &clock_links,
+                };
                 let (back, next) = pool.run(lanes, &mut core.values, &clock, first..steps, observers);
                 core.lanes = back;
+                core.clock_links = clock_links;
                 let next = next?;
                 core.parallel_steps += next - first;
                 first = next;
             }
         }
-        for n in first..steps {
-            let p = core.clock.point(n);
-            Jacobi.step(core, p, None)?;
-            observers.step_complete(&p, &core.values)?;
-        }
-        Ok(())
+        Jacobi.run(core, observers, first..steps)
     }
 }
