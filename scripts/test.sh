@@ -166,12 +166,18 @@ test_executable() { python3 "$repo_dir/scripts/test-executables.py" "$NIGEL_TEST
 # cross builds take one core most of the time; docs/platforms.md has what each costs): the
 # master's release archives for x86-64 and aarch64 Linux and Windows built and run under wine
 # and qemu on the closed loop, compared with x86-64 Linux (scripts/test-dist.sh), and the
-# aarch64 Linux wheel built, its tags and native module checked (scripts/wheel-check.py).
+# aarch64 Linux wheel built, its tags and native module checked (scripts/wheel-check.py) and
+# run under qemu by an aarch64 CPython (scripts/test-wheel-aarch64.sh).
 # The macOS archives and the Windows and macOS wheels are left out: never built to the end
 # on this machine within the time measured (docs/platforms.md)
 other_platforms() {
     NIGEL_DIST_PLATFORMS=linux64,win64,aarch64-linux bash scripts/test-dist.sh
-    python3 scripts/wheel-check.py "$(bash scripts/python-wheel.sh linux-aarch64)" linux-aarch64
+    local wheel version
+    wheel="$(bash scripts/python-wheel.sh linux-aarch64)"
+    python3 scripts/wheel-check.py "$wheel" linux-aarch64
+    # its run under qemu by Debian's arm64 CPython, against test-dist.sh's aarch64 cosim
+    version="$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)"
+    bash scripts/test-wheel-aarch64.sh "$wheel" "$target_dir/dist-test/cosim-$version-aarch64-unknown-linux-gnu/cosim"
 }
 background other-platforms other_platforms
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
