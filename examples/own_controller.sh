@@ -17,9 +17,7 @@
 # epsilon from the CSV, checks the recorded commands against the P law, and that the result
 # differs from the robust and the open-loop ones of table3.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/../scripts/target-dir.sh"
 out="${1:-$target/examples/own_controller}"
 mkdir -p "$out"
 cd "$repo"

@@ -15,9 +15,7 @@
 # The test (examples/test_examples.py) checks that the two epsilons agree to 1e-9 relative
 # and that both use the gain in k.json.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/../scripts/target-dir.sh"
 out="${1:-$target/examples/own_gain}"
 mkdir -p "$out"
 cd "$repo"

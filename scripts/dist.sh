@@ -7,9 +7,7 @@
 # Archives are byte-identical from the same binaries (sorted, time stamps and owners fixed).
 # Usage: bash scripts/dist.sh [--platforms LIST]   (LIST as build-dist's: linux64,win64,...)
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/target-dir.sh"
 dist="$target/dist"
 rm -rf "$dist/stage"
 folders=$(cd "$repo" && cargo run --release --quiet -p build-fmu --bin build-dist -- "$@" "$dist/stage")

@@ -14,26 +14,14 @@
 # 16817) for slurmctld and the next one for slurmd.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/apt-install.sh
 action="${1:-}"
 dir="$(realpath -m "${SLURM_LOCAL_DIR:-target/slurm-local}")"
 port="${SLURM_LOCAL_PORT:-16817}"
 conf="$dir/slurm/slurm.conf"
 
 install_packages() {
-    local needed=()
-    for pkg in slurmctld slurmd slurm-client munge; do
-        dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || needed+=("$pkg")
-    done
-    [ ${#needed[@]} -eq 0 ] && return 0
-    echo "slurm-local: installing ${needed[*]}" >&2
-    local sudo_cmd=()
-    if [ "$(id -u)" -ne 0 ]; then
-        command -v sudo >/dev/null || { echo "slurm-local: need root (or sudo) to install ${needed[*]}" >&2; exit 1; }
-        sudo_cmd=(sudo)
-    fi
-    export DEBIAN_FRONTEND=noninteractive
-    "${sudo_cmd[@]}" apt-get update -qq
-    "${sudo_cmd[@]}" apt-get install -y -qq "${needed[@]}" >/dev/null
+    apt_install_missing slurm-local slurmctld slurmd slurm-client munge
 }
 
 alive() { [ -f "$1" ] && kill -0 "$(cat "$1")" 2>/dev/null; }

@@ -13,9 +13,7 @@
 # NIGEL_DIST_PLATFORMS (build-dist's list: linux64,win64,aarch64-linux,darwin64; default all)
 # limits it to those platforms' archives (linux64, the reference, always).
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/target-dir.sh"
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' "$repo/Cargo.toml" | head -1)"
 ssp="$target/ssp/nigel_closed_loop.ssp"
 [ -f "$ssp" ] || { echo "test-dist: no $ssp (build-fmu writes it)" >&2; exit 1; }

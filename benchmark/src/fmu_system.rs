@@ -125,10 +125,15 @@ pub fn closed_loop(
 mod tests {
     use super::*;
 
+    /// The start value the system sets for the parameter `name`.
+    fn parameter(s: &FmuSystem, name: &str) -> Option<StartValue> {
+        s.parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
+
     #[test]
     fn lane_change_robust_sets_the_switch_positions_and_wires_every_input_once() {
         let s = closed_loop(Fidelity::Paper, Maneuver::LaneChange, Controller::Robust, 0, true).unwrap();
-        let get = |name: &str| s.parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+        let get = |name: &str| parameter(&s, name);
         assert_eq!(get("maneuver.maneuver"), Some(StartValue::Integer(2)));
         assert_eq!(get("maneuver.fidelity"), Some(StartValue::Integer(1)));
         assert_eq!(get("controller.controller"), Some(StartValue::Integer(3)));
@@ -148,7 +153,7 @@ mod tests {
     #[test]
     fn tracking_real_undisturbed_and_refusals() {
         let s = closed_loop(Fidelity::Real, Maneuver::Figure8, Controller::RobustTracking, 7, false).unwrap();
-        let get = |name: &str| s.parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+        let get = |name: &str| parameter(&s, name);
         assert_eq!(get("controller.controller"), Some(StartValue::Integer(5)));
         assert_eq!(get("maneuver.maneuver"), Some(StartValue::Integer(6)));
         assert_eq!(get("maneuver.fidelity"), Some(StartValue::Integer(2)));
@@ -157,7 +162,7 @@ mod tests {
         assert_eq!(get("plant.friction_circle"), Some(StartValue::Boolean(true)));
         let k = [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]];
         let c = closed_loop(Fidelity::Paper, Maneuver::Straight, Controller::Custom(k), 0, true).unwrap();
-        let get = |name: &str| c.parameters.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+        let get = |name: &str| parameter(&c, name);
         assert_eq!(get("controller.controller"), Some(StartValue::Integer(4)));
         assert_eq!(get("controller.k_beta_rl"), Some(StartValue::Real(0.5)));
         assert_eq!(get("controller.k_yaw_rate_rr"), Some(StartValue::Real(0.8)));

@@ -72,18 +72,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn uniform_moments_and_range() {
-        let n = 200_000u64;
+    /// The sample mean and (biased) variance of `sample(0)` .. `sample(n - 1)`.
+    fn mean_and_variance(n: u64, sample: impl Fn(u64) -> f64) -> (f64, f64) {
         let (mut s, mut s2) = (0.0, 0.0);
         for k in 0..n {
-            let x = u(11, 2, k);
-            assert!((0.0..1.0).contains(&x));
+            let x = sample(k);
             s += x;
             s2 += x * x;
         }
         let mean = s / n as f64;
-        let var = s2 / n as f64 - mean * mean;
+        (mean, s2 / n as f64 - mean * mean)
+    }
+
+    #[test]
+    fn uniform_moments_and_range() {
+        let (mean, var) = mean_and_variance(200_000, |k| {
+            let x = u(11, 2, k);
+            assert!((0.0..1.0).contains(&x));
+            x
+        });
         // standard error of the mean 0.29 / sqrt(2e5) = 6.5e-4
         assert!((mean - 0.5).abs() < 3e-3, "{mean}");
         assert!((var - 1.0 / 12.0).abs() < 2e-3, "{var}");
@@ -91,16 +98,11 @@ mod tests {
 
     #[test]
     fn gaussian_moments() {
-        let n = 100_000u64;
-        let (mut s, mut s2) = (0.0, 0.0);
-        for k in 0..n {
+        let (mean, var) = mean_and_variance(100_000, |k| {
             let x = g(1, 5, k);
             assert!(x.is_finite());
-            s += x;
-            s2 += x * x;
-        }
-        let mean = s / n as f64;
-        let var = s2 / n as f64 - mean * mean;
+            x
+        });
         assert!(mean.abs() < 0.015, "{mean}");
         assert!((var - 1.0).abs() < 0.02, "{var}");
     }

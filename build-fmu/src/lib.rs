@@ -682,6 +682,13 @@ pub fn build_all(
 mod tests {
     use super::*;
 
+    /// The archive `bytes` opened, with the names of its entries in archive order.
+    fn opened(bytes: Vec<u8>) -> (zip::ZipArchive<Cursor<Vec<u8>>>, Vec<String>) {
+        let mut z = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+        let names = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
+        (z, names)
+    }
+
     #[test]
     fn archive_is_byte_identical_and_has_the_layout_importers_expect() {
         let t = &targets()[0];
@@ -691,8 +698,7 @@ mod tests {
         let a = archive(FmiVersion::Fmi2, &xml, &libs, &t.model_identifier, doc).unwrap();
         let b = archive(FmiVersion::Fmi2, &xml, &libs, &t.model_identifier, doc).unwrap();
         assert_eq!(a, b);
-        let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
-        let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
+        let (mut z, names) = opened(a);
         assert_eq!(
             names,
             [
@@ -728,8 +734,7 @@ mod tests {
         ];
         let a = archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap();
         assert_eq!(a, archive(FmiVersion::Fmi3, &xml, &libs, &t.model_identifier, &t.documentation3).unwrap());
-        let mut z = zip::ZipArchive::new(Cursor::new(a)).unwrap();
-        let names: Vec<String> = (0..z.len()).map(|i| z.by_index(i).unwrap().name().to_string()).collect();
+        let (mut z, names) = opened(a);
         assert_eq!(
             names,
             [
@@ -1006,19 +1011,10 @@ mod tests {
             assert_eq!(p["minimum_os"], "Linux with glibc 2.35 or later");
         }
         assert_eq!(fmi3["platforms"][0]["folder"], "x86_64-linux");
-        let doc = with_platform_table(
-            "<html><body></body></html>",
-            "nigel_plant",
-            std::slice::from_ref(&host),
-            FmiVersion::Fmi2,
-        );
+        let [doc, doc3] = [FmiVersion::Fmi2, FmiVersion::Fmi3].map(|version| {
+            with_platform_table("<html><body></body></html>", "nigel_plant", std::slice::from_ref(&host), version)
+        });
         assert!(doc.contains("not a release build") && doc.contains("<li>darwin64: not built"), "{doc}");
-        let doc3 = with_platform_table(
-            "<html><body></body></html>",
-            "nigel_plant",
-            std::slice::from_ref(&host),
-            FmiVersion::Fmi3,
-        );
         assert!(doc3.contains("<li>aarch64-darwin: not built") && doc3.contains("<code>x86_64-linux</code>"), "{doc3}");
         for version in FmiVersion::ALL {
             assert!(!with_platform_table("<body></body>", "nigel_plant", &all, version).contains("not a release build"));

@@ -93,6 +93,11 @@ fn choose(list: &str, this_glibc: bool) -> Result<(Vec<Platform>, Vec<String>), 
     Ok((chosen, notes))
 }
 
+/// The end of an archive's `built ...` line: its interfaces and its platform folders.
+fn interfaces_and_platforms(target: &build_fmu::FmuTarget, platforms: &str) -> String {
+    format!("interfaces: {}, platforms: {platforms}", target.interfaces().join(" "))
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     let targets = build_fmu::targets();
@@ -122,28 +127,24 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
         };
+    let fmi3_folders = platforms.iter().flat_map(|p| p.fmi3_folders()).copied().collect::<Vec<_>>().join(" ");
     for (target, (path, size)) in targets.iter().zip(&written) {
         let md = target.description;
+        let what = format!("{} variables, GUID {}", md.model_variables.len(), md.guid);
         println!(
-            "built {} ({} bytes): {} variables, GUID {}, interfaces: {}, platforms: {}",
+            "built {} ({size} bytes): {what}, {}",
             path.display(),
-            size,
-            md.model_variables.len(),
-            md.guid,
-            target.interfaces().join(" "),
-            names.join(" "),
+            interfaces_and_platforms(target, &names.join(" "))
         );
     }
     for (target, (path, size)) in targets.iter().zip(&archives3) {
         let md = target.description3;
+        let what =
+            format!("FMI 3.0, {} variables, instantiationToken {}", md.model_variables.len(), md.instantiation_token);
         println!(
-            "built {} ({} bytes): FMI 3.0, {} variables, instantiationToken {}, interfaces: {}, platforms: {}",
+            "built {} ({size} bytes): {what}, {}",
             path.display(),
-            size,
-            md.model_variables.len(),
-            md.instantiation_token,
-            target.interfaces().join(" "),
-            platforms.iter().flat_map(|p| p.fmi3_folders()).copied().collect::<Vec<_>>().join(" "),
+            interfaces_and_platforms(target, &fmi3_folders)
         );
     }
     let manifest_path = out_dir.join("manifest.json");

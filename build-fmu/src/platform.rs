@@ -192,49 +192,39 @@ impl Platform {
     /// What is missing to build this platform here, with how to install it; `None` when
     /// everything is present.
     pub fn missing_toolchain(self) -> Option<String> {
-        let mut missing = Vec::new();
         let zig = || find_tool("cargo-zigbuild").is_some() && zig_available();
-        match self {
-            Platform::Linux64 => {
-                if !zig() {
-                    missing.push("cargo-zigbuild and zig (PyPI: cargo-zigbuild, ziglang)");
-                }
-            }
-            Platform::Win64 => {
-                if !rust_web_src() {
-                    missing.push("rustc-web, cargo-web and rust-web-src (Debian)");
-                }
-                if find_tool("x86_64-w64-mingw32-gcc").is_none() {
-                    missing.push("x86_64-w64-mingw32-gcc (Debian: gcc-mingw-w64-x86-64)");
-                }
-                if llvm_tool("llvm-strip").is_none() {
-                    missing.push("llvm-strip (Debian: llvm-22)");
-                }
-            }
-            Platform::Aarch64Linux => {
-                if !Path::new(RUST_WEB).join("lib/rustlib").join(AARCH64_TRIPLE).is_dir() || !rust_web_recent() {
-                    missing.push("rustc-web, cargo-web and libstd-rust-web-dev:arm64 (Debian, arm64 added to dpkg)");
-                }
-                if !zig() {
-                    missing.push("cargo-zigbuild and zig (PyPI: cargo-zigbuild, ziglang)");
-                }
-            }
-            Platform::Darwin64 => {
-                if !rust_web_src() {
-                    missing.push("rustc-web, cargo-web and rust-web-src (Debian)");
-                }
-                if !zig() {
-                    missing.push("cargo-zigbuild and zig (PyPI: cargo-zigbuild, ziglang)");
-                }
-                if llvm_tool("llvm-lipo").is_none() {
-                    missing.push("llvm-lipo (Debian: llvm-22)");
-                }
+        const ZIG: &str = "cargo-zigbuild and zig (PyPI: cargo-zigbuild, ziglang)";
+        const RUST_WEB_SRC: &str = "rustc-web, cargo-web and rust-web-src (Debian)";
+        // (present, what to install), in the order the message lists them
+        let needs: Vec<(bool, &str)> = match self {
+            Platform::Linux64 => vec![(zig(), ZIG)],
+            Platform::Win64 => vec![
+                (rust_web_src(), RUST_WEB_SRC),
+                (
+                    find_tool("x86_64-w64-mingw32-gcc").is_some(),
+                    "x86_64-w64-mingw32-gcc (Debian: gcc-mingw-w64-x86-64)",
+                ),
+                (llvm_tool("llvm-strip").is_some(), "llvm-strip (Debian: llvm-22)"),
+            ],
+            Platform::Aarch64Linux => vec![
+                (
+                    Path::new(RUST_WEB).join("lib/rustlib").join(AARCH64_TRIPLE).is_dir() && rust_web_recent(),
+                    "rustc-web, cargo-web and libstd-rust-web-dev:arm64 (Debian, arm64 added to dpkg)",
+                ),
+                (zig(), ZIG),
+            ],
+            Platform::Darwin64 => vec![
+                (rust_web_src(), RUST_WEB_SRC),
+                (zig(), ZIG),
+                (llvm_tool("llvm-lipo").is_some(), "llvm-lipo (Debian: llvm-22)"),
                 // rustc strips macOS libraries with this name for llvm-objcopy
-                if find_tool("rust-objcopy").is_none() {
-                    missing.push("rust-objcopy (llvm-objcopy of llvm-22 under that name in target/cross-venv/bin)");
-                }
-            }
-        }
+                (
+                    find_tool("rust-objcopy").is_some(),
+                    "rust-objcopy (llvm-objcopy of llvm-22 under that name in target/cross-venv/bin)",
+                ),
+            ],
+        };
+        let missing: Vec<&str> = needs.into_iter().filter(|(present, _)| !present).map(|(_, what)| what).collect();
         if missing.is_empty() {
             None
         } else {

@@ -729,8 +729,6 @@ impl Axis {
     }
 }
 
-/// Tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
-/// powers beyond 1e-4 .. 1e5 as `1e-5`; never `-0`.
 /// A log axis's label: 1, 2 and 5 times a power of ten (the other multiples get grid lines
 /// but no label: nine labels a decade run into each other at the decade's top).
 fn log_tick(v: f64) -> String {
@@ -742,24 +740,10 @@ fn log_tick(v: f64) -> String {
     }
 }
 
+/// Tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
+/// magnitudes beyond 1e-4 .. 1e5 as `1e-5`; never `-0`.
 fn tick(v: f64) -> String {
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if !(1e-4..1e5).contains(&a) {
-        let s = format!("{v:.3e}");
-        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
-        return format!("{m}e{e}");
-    }
-    let decimals = (3 - a.log10().floor() as i32).clamp(0, 8) as usize;
-    let s = format!("{v:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
+    nigel_cosim::compare::plot::tick_label(v, 1e-4)
 }
 
 /// Group colours: the Okabe-Ito palette without its yellow (which vanishes on white),
@@ -845,15 +829,10 @@ fn file_safe(s: &str) -> String {
     s.chars().map(|c| if c.is_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
 }
 
-static FONT: &[u8] = include_bytes!("../../table3/assets/DejaVuSans.ttf");
-
+/// The bundled font as the master's comparison plots register it (the same figures on every
+/// machine).
 fn register_font() -> Result<(), Error> {
-    static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    if *DONE.get_or_init(|| plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()) {
-        Ok(())
-    } else {
-        Err(Error::Plot("the bundled DejaVu Sans font is invalid".into()))
-    }
+    nigel_cosim::compare::plot::register_font().map_err(Error::Plot)
 }
 
 #[cfg(test)]

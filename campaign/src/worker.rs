@@ -342,166 +342,134 @@ pub(crate) fn run_processes(
     let mut next = 0usize;
     let mut checked = false;
     let mut check_since: Option<Instant> = None;
-    let mut result = Ok(());
-    'events: loop {
-        // hand out runs to the ready idle workers
-        if checked {
-            for slot in slots.iter_mut().filter(|s| s.ready && s.busy.is_none()) {
-                let Some(&i) = todo.get(next) else { break };
-                next += 1;
-                slot.busy = Some((i, Instant::now()));
-                send(slot, &format!("run {i}"));
-            }
-            if next >= todo.len() && slots.iter().all(|s| s.busy.is_none()) {
-                break;
-            }
-        }
-        let now = Instant::now();
-        let checking = if checked { None } else { check_since };
-        let wait = slots
-            .iter()
-            .filter_map(|s| Some(s.busy?.1 + limit?))
-            .chain(checking.and_then(|since| Some(since + limit?)))
-            .map(|at| at.saturating_duration_since(now))
-            .min()
-            .unwrap_or(Duration::from_secs(1));
-        match rx.recv_timeout(wait) {
-            Ok((k, generation, said)) => {
-                if !slots.get(k).is_some_and(|s| s.generation == generation) {
-                    continue; // a worker already ended and replaced
+    // the events until the last run is done or an error ends the campaign
+    let mut serve = || -> Result<(), Error> {
+        loop {
+            // hand out runs to the ready idle workers
+            if checked {
+                for slot in slots.iter_mut().filter(|s| s.ready && s.busy.is_none()) {
+                    let Some(&i) = todo.get(next) else { break };
+                    next += 1;
+                    slot.busy = Some((i, Instant::now()));
+                    send(slot, &format!("run {i}"));
                 }
-                match said {
-                    Said::Line(line) => {
-                        let slot = &mut slots[k];
-                        if line == "ready" {
-                            slot.ready = true;
-                            if !checked {
-                                send(slot, "check");
-                                check_since = Some(Instant::now());
-                            }
-                        } else if let Some(answer) = line.strip_prefix("check ") {
-                            if let Some(m) = answer.strip_prefix("refused ") {
-                                match refused(m.to_string()) {
-                                    Ok(kept) => out.done.stop_time_refused = kept,
-                                    Err(e) => {
-                                        result = Err(e);
-                                        break 'events;
-                                    }
+                if next >= todo.len() && slots.iter().all(|s| s.busy.is_none()) {
+                    break;
+                }
+            }
+            let now = Instant::now();
+            let checking = if checked { None } else { check_since };
+            let wait = slots
+                .iter()
+                .filter_map(|s| Some(s.busy?.1 + limit?))
+                .chain(checking.and_then(|since| Some(since + limit?)))
+                .map(|at| at.saturating_duration_since(now))
+                .min()
+                .unwrap_or(Duration::from_secs(1));
+            match rx.recv_timeout(wait) {
+                Ok((k, generation, said)) => {
+                    if !slots.get(k).is_some_and(|s| s.generation == generation) {
+                        continue; // a worker already ended and replaced
+                    }
+                    match said {
+                        Said::Line(line) => {
+                            let slot = &mut slots[k];
+                            if line == "ready" {
+                                slot.ready = true;
+                                if !checked {
+                                    send(slot, "check");
+                                    check_since = Some(Instant::now());
                                 }
-                            }
-                            checked = true;
-                            if let Err(e) = start_others(program, spec, workers, &mut generations, &tx, &mut slots) {
-                                result = Err(e);
-                                break 'events;
-                            }
-                        } else if let Some(rest) = line.strip_prefix("row ") {
-                            let Some((row, timing)) = parse_row(spec, rest) else {
-                                result = Err(Error::Io(format!("a worker process sent a malformed row: {line}")));
-                                break 'events;
-                            };
-                            slot.busy = None;
-                            if let Err(e) = out.push(row, timing) {
-                                result = Err(e);
-                                break 'events;
-                            }
-                        } else {
-                            let m = line.strip_prefix("error ").unwrap_or(&line);
-                            result = Err(Error::Spec(format!("worker process: {m}")));
-                            break 'events;
-                        }
-                    }
-                    Said::End => {
-                        let end = finish(&mut slots[k], false);
-                        if !slots[k].ready {
-                            // it could not load the system: no run would do better
-                            result = Err(Error::Spec(format!(
-                                "a worker process {end} while loading {} (before any run)",
-                                spec.system.display()
-                            )));
-                            break 'events;
-                        }
-                        if let Some((i, _)) = slots[k].busy.take() {
-                            let why = match end {
-                                HostEnd::Exit(_) => " (an FMU called exit?)",
-                                _ => "",
-                            };
-                            let at = where_it_was(&slots[k]);
-                            let message =
-                                format!("crashed: the run's worker process {end}{at}{why}; the worker was restarted");
-                            if let Err(e) = out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default()) {
-                                result = Err(e);
-                                break 'events;
-                            }
-                        } else if !checked {
-                            // it crashed checking the stop time: the runs will say how they end
-                            checked = true;
-                            if let Err(e) = start_others(program, spec, workers, &mut generations, &tx, &mut slots) {
-                                result = Err(e);
-                                break 'events;
+                            } else if let Some(answer) = line.strip_prefix("check ") {
+                                if let Some(m) = answer.strip_prefix("refused ") {
+                                    out.done.stop_time_refused = refused(m.to_string())?;
+                                }
+                                checked = true;
+                                start_others(program, spec, workers, &mut generations, &tx, &mut slots)?;
+                            } else if let Some(rest) = line.strip_prefix("row ") {
+                                let Some((row, timing)) = parse_row(spec, rest) else {
+                                    return Err(Error::Io(format!("a worker process sent a malformed row: {line}")));
+                                };
+                                slot.busy = None;
+                                out.push(row, timing)?;
+                            } else {
+                                let m = line.strip_prefix("error ").unwrap_or(&line);
+                                return Err(Error::Spec(format!("worker process: {m}")));
                             }
                         }
-                        let restarted =
-                            restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots);
-                        if let Err(e) = restarted {
-                            result = Err(e);
-                            break 'events;
+                        Said::End => {
+                            let end = finish(&mut slots[k], false);
+                            if !slots[k].ready {
+                                // it could not load the system: no run would do better
+                                return Err(Error::Spec(format!(
+                                    "a worker process {end} while loading {} (before any run)",
+                                    spec.system.display()
+                                )));
+                            }
+                            if let Some((i, _)) = slots[k].busy.take() {
+                                let why = match end {
+                                    HostEnd::Exit(_) => " (an FMU called exit?)",
+                                    _ => "",
+                                };
+                                let at = where_it_was(&slots[k]);
+                                let message = format!(
+                                    "crashed: the run's worker process {end}{at}{why}; the worker was restarted"
+                                );
+                                out.push(failed_row(spec, i, STATUS_CRASHED, message), Default::default())?;
+                            } else if !checked {
+                                // it crashed checking the stop time: the runs will say how they end
+                                checked = true;
+                                start_others(program, spec, workers, &mut generations, &tx, &mut slots)?;
+                            }
+                            restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots)?;
                         }
                     }
                 }
-            }
-            Err(mpsc::RecvTimeoutError::Timeout) => {
-                let (Some(limit), Some(timeout)) = (limit, spec.timeout) else { continue };
-                if let (false, Some(since)) = (checked, check_since) {
-                    if since.elapsed() >= limit {
-                        // the check hangs as a run would: the runs will say how they end
-                        finish(&mut slots[0], true);
-                        checked = true;
-                        let restarted =
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    let (Some(limit), Some(timeout)) = (limit, spec.timeout) else { continue };
+                    if let (false, Some(since)) = (checked, check_since) {
+                        if since.elapsed() >= limit {
+                            // the check hangs as a run would: the runs will say how they end
+                            finish(&mut slots[0], true);
+                            checked = true;
                             restart(program, spec, 0, &mut generations, &mut out.done.restarts, &tx, &mut slots)
-                                .and_then(|_| start_others(program, spec, workers, &mut generations, &tx, &mut slots));
-                        if let Err(e) = restarted {
-                            result = Err(e);
-                            break 'events;
+                                .and_then(|_| {
+                                    start_others(program, spec, workers, &mut generations, &tx, &mut slots)
+                                })?;
                         }
                     }
-                }
-                // by index: a slot is replaced in place by the worker started for it
-                #[allow(clippy::needless_range_loop)]
-                for k in 0..slots.len() {
-                    let Some((i, since)) = slots[k].busy else { continue };
-                    if since.elapsed() < limit {
-                        continue;
-                    }
-                    slots[k].busy = None;
-                    finish(&mut slots[k], true);
-                    let at = match slots[k].marker.as_ref().and_then(|m| m.last_call()) {
-                        Some((instance, function, t, true)) => {
-                            format!("{function} of {instance} at t = {t} s did not return")
+                    // by index: a slot is replaced in place by the worker started for it
+                    #[allow(clippy::needless_range_loop)]
+                    for k in 0..slots.len() {
+                        let Some((i, since)) = slots[k].busy else { continue };
+                        if since.elapsed() < limit {
+                            continue;
                         }
-                        Some((instance, function, t, false)) => {
-                            format!("the last call, {function} of {instance} at t = {t} s, had returned")
-                        }
-                        None => "a call did not return".into(),
-                    };
-                    let message = format!(
+                        slots[k].busy = None;
+                        finish(&mut slots[k], true);
+                        let at = match slots[k].marker.as_ref().and_then(|m| m.last_call()) {
+                            Some((instance, function, t, true)) => {
+                                format!("{function} of {instance} at t = {t} s did not return")
+                            }
+                            Some((instance, function, t, false)) => {
+                                format!("the last call, {function} of {instance} at t = {t} s, had returned")
+                            }
+                            None => "a call did not return".into(),
+                        };
+                        let message = format!(
                         "timeout: the run took longer than the description's timeout of {} s ({at}); its worker process was killed and restarted",
                         timeout.as_secs_f64()
                     );
-                    if let Err(e) = out.push(failed_row(spec, i, STATUS_TIMEOUT, message), Default::default()) {
-                        result = Err(e);
-                        break 'events;
-                    }
-                    let restarted =
-                        restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots);
-                    if let Err(e) = restarted {
-                        result = Err(e);
-                        break 'events;
+                        out.push(failed_row(spec, i, STATUS_TIMEOUT, message), Default::default())?;
+                        restart(program, spec, k, &mut generations, &mut out.done.restarts, &tx, &mut slots)?;
                     }
                 }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
             }
-            Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
-    }
+        Ok(())
+    };
+    let result = serve();
     // the workers end when their input does; a worker still busy (after an error) is killed
     for mut slot in slots {
         slot.stdin = None;

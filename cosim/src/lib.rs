@@ -59,6 +59,7 @@ pub mod mat;
 pub mod me;
 pub mod metric;
 pub mod options;
+pub mod run_setup;
 pub mod sample_period;
 pub mod simulate;
 pub mod ssp;

@@ -11,7 +11,7 @@
 
 use crate::error::Result;
 use crate::fmu::Instance;
-use crate::integrator::{dopri5::Dopri5, rk4::Rk4, Integrator};
+use crate::integrator::{dopri5::Dopri5, rk4::Rk4, switching::Switching, Integrator};
 
 /// Width of the time bracket an event is located to, s.
 pub const EVENT_TIME_TOLERANCE: f64 = 1e-11;
@@ -19,6 +19,18 @@ pub const EVENT_TIME_TOLERANCE: f64 = 1e-11;
 /// The integration method for Model Exchange instances.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solver {
+    /// The default: classical 4th-order Runge-Kutta as [`Solver::Rk4`], each step tested
+    /// for stiffness (h rho from its stages beyond RK4's stability bound), continuing with
+    /// [`Solver::Bdf`] from the start of the first stiff step, with a note
+    /// ([`crate::integrator::switching`]). Its steps before a switch are RK4's to the bit.
+    Auto {
+        /// Largest RK4 step, s (`None`: the communication step).
+        max_step: Option<f64>,
+        /// Relative tolerance of the bdf it continues with.
+        rtol: f64,
+        /// Absolute tolerance of the bdf it continues with.
+        atol: f64,
+    },
     /// Classical 4th-order Runge-Kutta, fixed step (at most `max_step`, else the
     /// communication step).
     Rk4 {
@@ -46,14 +58,15 @@ pub enum Solver {
 
 impl Default for Solver {
     fn default() -> Self {
-        Solver::Rk4 { max_step: None }
+        Solver::Auto { max_step: None, rtol: DEFAULT_RTOL, atol: DEFAULT_RTOL / 100.0 }
     }
 }
 
 impl Solver {
-    /// The solver named `name` (`rk4`, `dopri5`, `bdf`): dopri5 and bdf with the relative
-    /// tolerance `rtol` and the absolute tolerance `rtol / 100`, rk4 with the largest step
-    /// `max_step` (`None`: the communication step). The error names the bad value.
+    /// The solver named `name` (`auto`, `rk4`, `dopri5`, `bdf`): dopri5 and bdf (and the bdf
+    /// of auto) with the relative tolerance `rtol` and the absolute tolerance `rtol / 100`,
+    /// rk4 (and the rk4 of auto) with the largest step `max_step` (`None`: the
+    /// communication step). The error names the bad value.
     pub fn named(name: &str, rtol: f64, max_step: Option<f64>) -> std::result::Result<Solver, String> {
         if !(rtol > 0.0 && rtol.is_finite()) {
             return Err(format!("the relative tolerance {rtol} must be positive"));
@@ -62,10 +75,11 @@ impl Solver {
             return Err(format!("the largest step {} s must be positive", max_step.unwrap_or_default()));
         }
         match name {
+            "auto" => Ok(Solver::Auto { max_step, rtol, atol: rtol / 100.0 }),
             "rk4" => Ok(Solver::Rk4 { max_step }),
             "dopri5" => Ok(Solver::Dopri5 { rtol, atol: rtol / 100.0 }),
             "bdf" => Ok(Solver::Bdf { rtol, atol: rtol / 100.0 }),
-            other => Err(format!("unknown solver {other:?} (rk4, dopri5, bdf)")),
+            other => Err(format!("unknown solver {other:?} (auto, rk4, dopri5, bdf)")),
         }
     }
 }
@@ -74,6 +88,7 @@ impl Solver {
     /// The integrator of this method for a system of `n` states.
     pub fn integrator(&self, n: usize) -> Box<dyn Integrator> {
         match *self {
+            Solver::Auto { max_step, rtol, atol } => Box::new(Switching::new(n, max_step, rtol, atol)),
             Solver::Rk4 { max_step } => Box::new(Rk4::new(n, max_step)),
             Solver::Dopri5 { rtol, atol } => Box::new(Dopri5::new(n, rtol, atol)),
             Solver::Bdf { rtol, atol } => Box::new(crate::bdf::Bdf::new(n, rtol, atol)),
@@ -81,7 +96,7 @@ impl Solver {
     }
 }
 
-/// `rk4`, `dopri5` or `bdf` with the default tolerance [`DEFAULT_RTOL`].
+/// `auto`, `rk4`, `dopri5` or `bdf` with the default tolerance [`DEFAULT_RTOL`].
 impl std::str::FromStr for Solver {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {

@@ -54,6 +54,26 @@ fn every_kind_of_clock_ticks_at_its_times_in_a_host_process() {
     every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
 }
 
+/// The same FMU built with `FMI3_FRACTION_ONLY`: it gives its intervals only as fractions
+/// (`fmi3GetIntervalFraction`: periodic 1/4, fixed 400/1000, changing k/10, countdown 1/2)
+/// and exports no `fmi3GetIntervalDecimal` (nor `fmi3GetShiftDecimal`), so the master takes
+/// each interval as counter / resolution: the same hand-derived ticks (the counts are of
+/// ticks within 1e-9 s of a row, so 3/10 for 0.1 * 3, an ulp apart, changes no count), in
+/// process and in a host process.
+#[test]
+fn every_kind_of_clock_ticks_at_its_times_from_fractional_intervals() {
+    let dir = work_dir("clocks-kinds-fraction");
+    let xml = include_str!("cfmu/fmi3_clocks.xml");
+    let Some(path) = common::fmi3_c::build_with(&dir, "fmi3_clocks", xml, &["FMI3_FRACTION_ONLY"]) else { return };
+    // the library names no fmi3GetIntervalDecimal (its symbol table holds every name it
+    // exports), but fmi3GetIntervalFraction
+    let so = std::fs::read(dir.join("fmi3_clocks.so")).unwrap();
+    let names = |name: &str| so.windows(name.len()).any(|w| w == name.as_bytes());
+    assert!(!names("fmi3GetIntervalDecimal") && names("fmi3GetIntervalFraction"));
+    every_kind_ticks_at_its_times(&path, None);
+    every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
+}
+
 fn every_kind_ticks_at_its_times(path: &Path, isolation: Option<nigel_cosim::Isolation>) {
     let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);

@@ -1134,6 +1134,101 @@ fn sixty_four_bit_connections_carry_their_values_to_the_bit() {
     }
 }
 
+/// The counter's description with its 64-bit array inputs and outputs (`tests/cfmu/fmi3_counter.c`:
+/// i64aout[k] = i64ain[k] ^ 1, u64aout[k] = u64ain[k] ^ 1, two elements each).
+fn counter_with_wide_arrays(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let last = r#"<UInt64 name="u64out" valueReference="35" causality="output"/>"#;
+    assert!(XML.contains(last));
+    let arrays = format!(
+        r#"{last}
+    <Int64 name="i64ain" valueReference="36" causality="input" start="0"><Dimension start="2"/></Int64>
+    <Int64 name="i64aout" valueReference="37" causality="output"><Dimension start="2"/></Int64>
+    <UInt64 name="u64ain" valueReference="38" causality="input" start="0"><Dimension start="2"/></UInt64>
+    <UInt64 name="u64aout" valueReference="39" causality="output"><Dimension start="2"/></UInt64>"#
+    );
+    let dir = work_dir(test);
+    let fmu = build_counter(&dir, "fmi3_counter", &XML.replace(last, &arrays))?;
+    Some((dir, fmu))
+}
+
+/// The elements of 64-bit arrays are carried exactly as the scalars are: from an input
+/// file, across connections element to element, into the results, in Co-Simulation and
+/// Model Exchange under both algorithms. By hand (the outputs flip the lowest bit of their
+/// inputs): c1.i64ain = (2^62, -2^62 - 3) gives c1.i64aout = (2^62 + 1, -2^62 - 4), in
+/// c2.i64ain as they are (connected crosswise: element 1 to 2, 2 to 1), so c2.i64ain =
+/// (-2^62 - 4, 2^62 + 1) and c2.i64aout = (-2^62 - 3, 2^62); c1.u64ain = (2^64 - 1, 2^53 + 2)
+/// gives c1.u64aout = (2^64 - 2, 2^53 + 3) = c2.u64ain, c2.u64aout = (2^64 - 1, 2^53 + 2).
+/// None of 2^62 + 1, -2^62 - 3, 2^64 - 2, 2^53 + 3 is an f64 (before: refused beyond 2^53).
+#[test]
+fn sixty_four_bit_array_elements_carry_their_values_to_the_bit() {
+    use nigel_cosim::{Algorithm, Interface};
+    let Some((_dir, path)) = counter_with_wide_arrays("fmi3-wide-arrays") else { return };
+    let record = [
+        "c1.i64aout[1]",
+        "c1.i64aout[2]",
+        "c2.i64ain[1]",
+        "c2.i64ain[2]",
+        "c2.i64aout[1]",
+        "c2.i64aout[2]",
+        "c2.u64ain[1]",
+        "c2.u64ain[2]",
+        "c2.u64aout[1]",
+        "c2.u64aout[2]",
+    ];
+    let p62 = 1i128 << 62;
+    let by_hand = [p62 + 1, -p62 - 4, -p62 - 4, p62 + 1, -p62 - 3, p62]
+        .into_iter()
+        .chain([(1i128 << 64) - 2, (1i128 << 53) + 3, (1i128 << 64) - 1, (1i128 << 53) + 2])
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>();
+    for interface in [Interface::CoSimulation, Interface::ModelExchange] {
+        for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
+            let (system, input) = counters_connected(
+                &path,
+                interface,
+                &[
+                    ("c1.i64aout[1]", "c2.i64ain[2]"),
+                    ("c1.i64aout[2]", "c2.i64ain[1]"),
+                    ("c1.u64aout[1]", "c2.u64ain[1]"),
+                    ("c1.u64aout[2]", "c2.u64ain[2]"),
+                ],
+                &[
+                    ("c1.i64ain[1]", p62),
+                    ("c1.i64ain[2]", -p62 - 3),
+                    ("c1.u64ain[1]", i128::from(u64::MAX)),
+                    ("c1.u64ain[2]", (1 << 53) + 2),
+                ],
+            );
+            let mut e = Experiment::new(0.2, 0.1);
+            e.algorithm = algorithm;
+            e.record = Some(record.iter().map(|n| n.to_string()).collect());
+            e.input = Some(std::sync::Arc::new(input));
+            let (r, _) = simulate(&system, &e).unwrap_or_else(|err| panic!("{interface:?} {algorithm:?}: {err}"));
+            for (column, value) in by_hand.iter().enumerate() {
+                assert_eq!(
+                    r.exact_column(column).unwrap(),
+                    [value.as_str(); 3],
+                    "{interface:?} {algorithm:?} {}",
+                    record[column]
+                );
+            }
+        }
+    }
+}
+
+/// An element beyond its type's range is refused naming the variable and the value
+/// (2^63 into an Int64 array element), never wrapped.
+#[test]
+fn a_sixty_four_bit_array_element_out_of_range_is_refused() {
+    let Some((_dir, path)) = counter_with_wide_arrays("fmi3-wide-array-range") else { return };
+    let (system, input) =
+        counters_connected(&path, nigel_cosim::Interface::CoSimulation, &[], &[("c1.i64ain[2]", 1i128 << 63)]);
+    let mut e = Experiment::new(0.2, 0.1);
+    e.input = Some(std::sync::Arc::new(input));
+    let err = simulate(&system, &e).unwrap_err().to_string();
+    assert!(err.contains("i64ain") && err.contains("9223372036854775808") && err.contains("Int64"), "{err}");
+}
+
 /// The same through the command line on an SSP system (`tests/data/int64_chain.ssd`: the
 /// counters' 64-bit connectors declared `ssc:Integer`, one connection written sink first),
 /// c1's inputs from an input file of exact integers: the CSV holds the values to the bit,

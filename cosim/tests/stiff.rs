@@ -1,5 +1,6 @@
 //! The bdf solver (`--solver bdf`) on C test FMUs of known solution and against dopri5:
-//! a stiff linear system against its closed form, van der Pol at mu = 1e3 with the FMU's
+//! a stiff linear system against its closed form (with bdf, and with the default solver,
+//! which finds it stiff and switches to bdf), van der Pol at mu = 1e3 with the FMU's
 //! directional derivatives (one call per column group) against dopri5 at a tight
 //! tolerance, the plant against dopri5, and the bouncing ball's events against dopri5 and
 //! the exact bounce times.
@@ -10,6 +11,17 @@ use nigel_cosim::{simulate, Experiment, Fmu, ImportOptions, Interface, Results, 
 use std::path::Path;
 
 fn run(fmu: &Path, name: &str, set: &[(&str, &str)], stop: f64, step: f64, solver: Solver) -> (Results, Summary) {
+    try_run(fmu, name, set, stop, step, solver).unwrap()
+}
+
+fn try_run(
+    fmu: &Path,
+    name: &str,
+    set: &[(&str, &str)],
+    stop: f64,
+    step: f64,
+    solver: Solver,
+) -> nigel_cosim::Result<(Results, Summary)> {
     let options = ImportOptions { interface: Some(Interface::ModelExchange), ..ImportOptions::default() };
     let mut b = SystemBuilder::new();
     b.add_instance(name, Fmu::load_with(fmu, &options).unwrap()).unwrap();
@@ -18,7 +30,7 @@ fn run(fmu: &Path, name: &str, set: &[(&str, &str)], stop: f64, step: f64, solve
     }
     let mut e = Experiment::new(stop, step);
     e.solver = solver;
-    simulate(&b.build(), &e).unwrap()
+    simulate(&b.build(), &e)
 }
 
 #[test]
@@ -46,6 +58,69 @@ fn bdf_on_a_stiff_linear_system_matches_the_closed_form() {
         assert!(s.stiff.jacobians >= 1 && s.stiff.factorizations >= s.stiff.jacobians, "{:?}", s.stiff);
         assert!(s.stiff.rhs > s.integrator_steps.0, "{:?}", s.stiff);
     }
+}
+
+/// The largest error of x1, x2 over the rows against the closed form of `tests/cfmu/linear.c`
+/// (x2 = e^-t, x1 = (1 - 1/(lambda - 1)) e^(-lambda t) + e^-t / (lambda - 1)).
+fn linear_error(r: &Results, lambda: f64) -> f64 {
+    let (t, x1, x2) = (r.column("time").unwrap(), r.column("x1").unwrap(), r.column("x2").unwrap());
+    let mut worst = 0.0f64;
+    for k in 0..t.len() {
+        let e2 = (-t[k]).exp();
+        let e1 = (1.0 - 1.0 / (lambda - 1.0)) * (-lambda * t[k]).exp() + e2 / (lambda - 1.0);
+        worst = nan_max(nan_max(worst, (x1[k] - e1).abs()), (x2[k] - e2).abs());
+    }
+    worst
+}
+
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
+#[test]
+fn the_default_solver_switches_to_bdf_on_a_stiff_system_and_matches_the_closed_form() {
+    let dir = work_dir("stiff-auto");
+    let fmu = build_linear(&dir);
+    let lambda = 1e4;
+    // RK4 alone at the communication step of 0.01 s: h lambda = 100, far outside its
+    // stability interval (2.785): the fast mode grows by |R(-100)| = 3.9e6 per step until
+    // the states overflow (an error) or, if it ends first, the rows are wrong
+    match try_run(&fmu, "lin", &[], 2.0, 0.01, Solver::Rk4 { max_step: None }) {
+        Ok((r, _)) => {
+            let e = linear_error(&r, lambda);
+            assert!(e.is_nan() || e >= 1.0, "rk4 alone cannot be right here: {e:e}");
+        }
+        // measured: x1 = NaN at t = 0.47 s
+        Err(e) => assert!(e.to_string().contains("NaN"), "{e}"),
+    }
+    // the default: RK4 that tests each step (h rho = 2 |k3 - k2| / |k2 - k1| = h lambda for
+    // a linear system) and continues with bdf (rtol 1e-6, atol 1e-8) from the first stiff step
+    let (r, s) = run(&fmu, "lin", &[], 2.0, 0.01, Solver::default());
+    let worst = linear_error(&r, lambda);
+    eprintln!("auto: largest error {worst:e}, notes {:?}, bdf {:?}", s.notes, s.stiff);
+    // as bdf_on_a_stiff_linear_system_matches_the_closed_form: each step's local error is
+    // below rtol |x| + atol (|x| <= 1), adding up to a few rtol over the decaying solution:
+    // 10 rtol
+    assert!(worst < 10.0 * 1e-6, "{worst:e}");
+    assert_eq!(r.column("time").unwrap().len(), 201);
+    // the switch at the first step (t = 0; h rho = 100 up to rounding), named in a note
+    let note = s.notes.iter().find(|n| n.contains("stiff at")).expect("a note on the switch");
+    assert!(note.starts_with("lin: stiff at t = 0 s: an RK4 step of 1e-2 s has h*rho = 1.000e2"), "{note}");
+    assert!(s.stiff.steps > 0 && s.stiff.jacobians >= 1, "{:?}", s.stiff);
+    // a step that is not stiff is not switched: RK4 at 1e-4 s (h lambda = 1) gives the rows
+    // of rk4 alone to the bit, and no note
+    let small = Solver::Auto { max_step: Some(1e-4), rtol: 1e-6, atol: 1e-8 };
+    let (a, sa) = run(&fmu, "lin", &[], 0.05, 0.01, small);
+    let (b, _) = run(&fmu, "lin", &[], 0.05, 0.01, Solver::Rk4 { max_step: Some(1e-4) });
+    for c in ["x1", "x2"] {
+        let bits = |r: &Results| r.column(c).unwrap().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b), "{c}");
+    }
+    assert!(sa.notes.iter().all(|n| !n.contains("stiff at")), "{:?}", sa.notes);
 }
 
 #[test]

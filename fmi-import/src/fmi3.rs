@@ -316,6 +316,11 @@ pub(crate) fn fmi2_view(
                 Some(fmi3::Bound::Int(i)) if i.abs() <= EXACT => Some(i as f64),
                 _ => None,
             };
+            // an Integer's or an Enumeration's start value
+            let int32_start = || match start_values {
+                Some(fmi3::Values::Int(x)) => int32(x.get(pick(x.len())).copied()),
+                _ => None,
+            };
             let variable_type = match v.value_type {
                 T::Float64 | T::Float32 | T::UInt32 | T::Int64 | T::UInt64 => VariableType::Real {
                     start: match start_values {
@@ -332,19 +337,13 @@ pub(crate) fn fmi2_view(
                     nominal: v.nominal,
                 },
                 T::Int8 | T::UInt8 | T::Int16 | T::UInt16 | T::Int32 => VariableType::Integer {
-                    start: match start_values {
-                        Some(fmi3::Values::Int(x)) => int32(x.get(pick(x.len())).copied()),
-                        _ => None,
-                    },
+                    start: int32_start(),
                     min: int32(int_bound(v.min)),
                     max: int32(int_bound(v.max)),
                 },
                 T::Enumeration => VariableType::Enumeration {
                     declared_type: v.declared_type.clone().unwrap_or_default(),
-                    start: match start_values {
-                        Some(fmi3::Values::Int(x)) => int32(x.get(pick(x.len())).copied()),
-                        _ => None,
-                    },
+                    start: int32_start(),
                     min: int32(int_bound(v.min)),
                     max: int32(int_bound(v.max)),
                 },

@@ -32,12 +32,29 @@ impl Interface {
             Interface::ScheduledExecution => "ScheduledExecution",
         }
     }
+    /// The interface whose XML element name is `name` (the inverse of [`Interface::as_str`]).
+    pub fn from_element_name(name: &str) -> Option<Interface> {
+        [Interface::CoSimulation, Interface::ModelExchange, Interface::ScheduledExecution]
+            .into_iter()
+            .find(|i| i.as_str() == name)
+    }
     pub(crate) fn fmi_type(self) -> c_int {
         match self {
             Interface::ModelExchange => 0,
             // FMI 2.0's fmi2Type: an FMU has no Scheduled Execution there (refused at load)
             Interface::CoSimulation | Interface::ScheduledExecution => 1,
         }
+    }
+}
+
+/// `cs`, `me` or `se` (as `cosim run --interface` takes them).
+impl std::str::FromStr for Interface {
+    type Err = String;
+    fn from_str(name: &str) -> std::result::Result<Interface, String> {
+        let short =
+            [("cs", Interface::CoSimulation), ("me", Interface::ModelExchange), ("se", Interface::ScheduledExecution)];
+        let found = short.into_iter().find(|(short_name, _)| *short_name == name);
+        found.map(|(_, interface)| interface).ok_or_else(|| format!("unknown interface {name:?} (cs, me, se)"))
     }
 }
 

@@ -32,6 +32,14 @@ pub struct LogSink {
 #[derive(Debug, Default)]
 struct Records(Mutex<VecDeque<LogRecord>>);
 
+impl LogSink {
+    /// The instance's `componentEnvironment` (this log's environment), which owns the
+    /// blocks the FMU allocates in the instance's calls (fmi-sys's `fmi2::guard`).
+    pub(crate) fn owner(&self) -> usize {
+        self.environment.as_environment() as usize
+    }
+}
+
 /// The most of an FMI 2.0 message fmi-sys's logger shim formats (its buffer less the NUL):
 /// it reads the FMU's strings safely, so it cannot know how long a longer one is.
 const FMI2_SHIM_BYTES: usize = 4095;

@@ -1,7 +1,8 @@
 //! The model partitions of an FMI 3.0 FMU for Scheduled Execution: one per input clock,
 //! with its `priority` (smaller first when clocks tick together) and how its ticks come:
-//! periodic from `intervalDecimal` and `shiftDecimal`, triggered by the importer, or
-//! counted down by the FMU (`intervalVariability="countdown"`). Its output clocks, whose
+//! periodic from `intervalDecimal` and `shiftDecimal`, triggered by the importer, counted
+//! down by the FMU (`intervalVariability="countdown"`), or each interval from the FMU after
+//! the last activation (`changing`). Its output clocks, whose
 //! ticks the FMU signals through `clockUpdate`. Read from the description; the calls are
 //! `instance/scheduled.rs`. A `fixed` or `tunable` clock's interval is the FMU's to give
 //! (`fmi3GetIntervalDecimal` after initialization, a tunable one again when the FMU signals
@@ -13,8 +14,8 @@ use model_description::fmi3;
 /// How the ticks of a partition's input clock come.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Ticks {
-    /// Every `interval` s from `shift` s after the start (`constant`, `fixed`, `tunable`
-    /// or `changing` clocks with `intervalDecimal`; `fixed` and `tunable` ones also without).
+    /// Every `interval` s from `shift` s after the start (`constant`, `fixed` or `tunable`
+    /// clocks with `intervalDecimal`; `fixed` and `tunable` ones also without).
     Periodic {
         /// `intervalDecimal`, s; `None` for a `fixed` or `tunable` clock whose description
         /// gives none (the FMU gives it after initialization).
@@ -27,6 +28,10 @@ pub enum Ticks {
     /// `countdown`: when the FMU sets its interval during another partition
     /// (`clockUpdate`, then `fmi3GetIntervalDecimal`), that long after the activation.
     Countdown,
+    /// `changing` (aperiodic): the first tick the interval `fmi3GetIntervalDecimal` gives in
+    /// Initialization Mode after the start, each next one the interval it gives right after
+    /// the partition's activation (`fmi3IntervalChanged`) after that activation.
+    Changing,
 }
 
 /// A model partition: an input clock with a priority.
@@ -63,6 +68,7 @@ impl ModelPartition {
             }
             Ticks::Triggered => "triggered (an input file's clock column)".into(),
             Ticks::Countdown => "countdown (set by the FMU)".into(),
+            Ticks::Changing => "changing (each interval from the FMU after an activation)".into(),
         }
     }
 }
@@ -85,6 +91,7 @@ pub fn model_partitions(md: &fmi3::ModelDescription) -> Result<Vec<ModelPartitio
         let ticks = match kind {
             Some(ClockKind::Triggered) => Ticks::Triggered,
             Some(ClockKind::Countdown) => Ticks::Countdown,
+            Some(ClockKind::Changing) => Ticks::Changing,
             kind => match attributes.interval_decimal {
                 Some(interval) if interval > 0.0 && interval.is_finite() => {
                     Ticks::Periodic { interval: Some(interval), shift }

@@ -6,36 +6,22 @@
 //! architecture loads FMI 2.0's `darwin64`, a universal library or one of its own
 //! architecture.
 
+/// (FMI 2.0 folder, FMI 3.0 folder) of this build.
 #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
-mod names {
-    pub const FMI2: &str = "linux64";
-    pub const FMI3: &str = "x86_64-linux";
-}
+const NAMES: (&str, &str) = ("linux64", "x86_64-linux");
 #[cfg(all(target_os = "linux", target_arch = "aarch64"))]
-mod names {
-    pub const FMI2: &str = "aarch64-linux";
-    pub const FMI3: &str = "aarch64-linux";
-}
+const NAMES: (&str, &str) = ("aarch64-linux", "aarch64-linux");
 #[cfg(all(target_os = "windows", target_arch = "x86_64"))]
-mod names {
-    pub const FMI2: &str = "win64";
-    pub const FMI3: &str = "x86_64-windows";
-}
+const NAMES: (&str, &str) = ("win64", "x86_64-windows");
 #[cfg(all(target_os = "macos", target_arch = "x86_64"))]
-mod names {
-    pub const FMI2: &str = "darwin64";
-    pub const FMI3: &str = "x86_64-darwin";
-}
+const NAMES: (&str, &str) = ("darwin64", "x86_64-darwin");
 #[cfg(all(target_os = "macos", target_arch = "aarch64"))]
-mod names {
-    pub const FMI2: &str = "darwin64";
-    pub const FMI3: &str = "aarch64-darwin";
-}
+const NAMES: (&str, &str) = ("darwin64", "aarch64-darwin");
 
 /// The FMI 2.0 platform folder of this build (`binaries/<folder>/`).
-pub const FMI2_FOLDER: &str = names::FMI2;
+pub const FMI2_FOLDER: &str = NAMES.0;
 /// The FMI 3.0 platform folder of this build.
-pub const FMI3_FOLDER: &str = names::FMI3;
+pub const FMI3_FOLDER: &str = NAMES.1;
 /// The extension of an FMU's library here: `so`, `dll` or `dylib`.
 pub const LIBRARY_EXTENSION: &str = std::env::consts::DLL_EXTENSION;
 

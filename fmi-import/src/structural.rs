@@ -112,14 +112,7 @@ impl Fmu {
     /// (`fmi3EnterConfigurationMode`, the setters, `fmi3ExitConfigurationMode`). Values set
     /// on an FMU configured before add to (or replace) its earlier ones.
     pub fn configured(self: &Arc<Fmu>, instance: &str, values: &[(&str, f64)]) -> Result<Arc<Fmu>> {
-        let Abi::Fmi3(a) = &self.abi else {
-            let name = values.first().map_or("", |(n, _)| *n);
-            return Err(Error::InvalidValue {
-                variable: format!("{instance}.{name}"),
-                value: String::new(),
-                reason: "structural parameters are FMI 3.0's; this FMU is an FMI 2.0 one".into(),
-            });
-        };
+        let a = self.fmi3_for_structural(instance, values)?;
         let mut md = a.description.clone();
         let mut configuration = a.configuration.clone();
         // a value set now is the start and the view's size (sized_for after it, if at all)
@@ -194,14 +187,7 @@ impl Fmu {
     /// the run can have. The instances start with their own values (those elements they lack
     /// read as NaN).
     pub fn sized_for(self: &Arc<Fmu>, instance: &str, sizes: &[(&str, f64)]) -> Result<Arc<Fmu>> {
-        let Abi::Fmi3(a) = &self.abi else {
-            let name = sizes.first().map_or("", |(n, _)| *n);
-            return Err(Error::InvalidValue {
-                variable: format!("{instance}.{name}"),
-                value: String::new(),
-                reason: "structural parameters are FMI 3.0's; this FMU is an FMI 2.0 one".into(),
-            });
-        };
+        let a = self.fmi3_for_structural(instance, sizes)?;
         let mut md = a.description.clone();
         let mut initial = a.initial_sizes.clone();
         for (name, value) in sizes {
@@ -244,6 +230,19 @@ impl Fmu {
             }
         }
         Ok(self.rebuilt(a, md, a.configuration.clone(), initial))
+    }
+
+    /// The FMI 3.0 functions of this FMU, for setting the structural parameters `values` of
+    /// `instance`; an FMI 2.0 FMU has none (the error names the first value's variable).
+    fn fmi3_for_structural(&self, instance: &str, values: &[(&str, f64)]) -> Result<&crate::fmi3::Fmi3Abi> {
+        match &self.abi {
+            Abi::Fmi3(a) => Ok(a),
+            Abi::Fmi2(_) => Err(Error::InvalidValue {
+                variable: format!("{instance}.{}", values.first().map_or("", |(n, _)| *n)),
+                value: String::new(),
+                reason: "structural parameters are FMI 3.0's; this FMU is an FMI 2.0 one".into(),
+            }),
+        }
     }
 
     /// The structural parameters this FMU was [configured](Fmu::configured) with (name,

@@ -133,26 +133,26 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File> {
     Ok(file)
 }
 
+/// `Ok` when `size` (of `entry`) is within `limit` (the limit called `limit_name`), else
+/// the error that says so.
+fn within_limit(entry: &str, size: u64, limit: u64, limit_name: &'static str) -> Result<()> {
+    if size > limit {
+        return Err(Error::ArchiveLimit { entry: entry.to_string(), size, limit, limit_name });
+    }
+    Ok(())
+}
+
 /// Reads the text file `path` (a regular file of at most `limit` bytes, checked
 /// before reading); `shown` names it in errors.
 pub fn read_text_file(path: &Path, shown: &str, limit: u64) -> Result<String> {
     use std::io::Read;
     let file = open_regular(path)?;
     let size = file.metadata().map_err(|source| Error::Io { path: path.to_path_buf(), source })?.len();
-    if size > limit {
-        return Err(Error::ArchiveLimit { entry: shown.to_string(), size, limit, limit_name: "max_xml_bytes" });
-    }
+    within_limit(shown, size, limit, "max_xml_bytes")?;
     let mut bytes = Vec::with_capacity(size as usize);
     // `take`: a file grown since the check is still held to the limit
     file.take(limit + 1).read_to_end(&mut bytes).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    if bytes.len() as u64 > limit {
-        return Err(Error::ArchiveLimit {
-            entry: shown.to_string(),
-            size: bytes.len() as u64,
-            limit,
-            limit_name: "max_xml_bytes",
-        });
-    }
+    within_limit(shown, bytes.len() as u64, limit, "max_xml_bytes")?;
     String::from_utf8(bytes).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         source: std::io::Error::new(std::io::ErrorKind::InvalidData, format!("{shown} is not UTF-8 text: {e}")),
@@ -391,14 +391,7 @@ impl ArchiveSource {
                     reason: format!("entry {entry:?}: {e}"),
                 };
                 let raw = zip.by_index_raw(index).map_err(bad)?;
-                if raw.size() > limits.max_entry_bytes {
-                    return Err(Error::ArchiveLimit {
-                        entry: entry.clone(),
-                        size: raw.size(),
-                        limit: limits.max_entry_bytes,
-                        limit_name: "max_entry_bytes",
-                    });
-                }
+                within_limit(entry, raw.size(), limits.max_entry_bytes, "max_entry_bytes")?;
                 if raw.compression() == zip::CompressionMethod::Stored && !raw.encrypted() {
                     // stored (as `write_ssp` writes FMUs): read in place, seeking in the outer file
                     let (start, len) = (raw.data_start(), raw.size());
@@ -415,14 +408,7 @@ impl ArchiveSource {
                     .take(declared + 1)
                     .read_to_end(&mut bytes)
                     .map_err(|err| Error::Archive { path: outer.clone(), reason: format!("entry {entry:?}: {err}") })?;
-                if bytes.len() as u64 > declared {
-                    return Err(Error::ArchiveLimit {
-                        entry: entry.clone(),
-                        size: bytes.len() as u64,
-                        limit: declared,
-                        limit_name: "the size its header declares",
-                    });
-                }
+                within_limit(entry, bytes.len() as u64, declared, "the size its header declares")?;
                 Ok(Reader::Memory(std::io::Cursor::new(bytes)))
             }
         }
@@ -508,14 +494,7 @@ pub fn check_entries<R: Read + std::io::Seek>(
 ) -> Result<Vec<Entry>> {
     let bad = |e: zip::result::ZipError| Error::Archive { path: shown.to_path_buf(), reason: e.to_string() };
     let count = zip.len() as u64;
-    if count > limits.max_entries {
-        return Err(Error::ArchiveLimit {
-            entry: "<number of entries>".into(),
-            size: count,
-            limit: limits.max_entries,
-            limit_name: "max_entries",
-        });
-    }
+    within_limit("<number of entries>", count, limits.max_entries, "max_entries")?;
     let mut declared_total = 0u64;
     let mut seen = std::collections::HashSet::with_capacity(zip.len());
     let mut entries = Vec::with_capacity(zip.len());
@@ -532,14 +511,7 @@ pub fn check_entries<R: Read + std::io::Seek>(
         if !is_dir && !seen.insert(rel.clone()) {
             return Err(Error::UnsafeEntry { entry: name, reason: "duplicate name in the archive" });
         }
-        if entry.size() > limits.max_entry_bytes {
-            return Err(Error::ArchiveLimit {
-                entry: name,
-                size: entry.size(),
-                limit: limits.max_entry_bytes,
-                limit_name: "max_entry_bytes",
-            });
-        }
+        within_limit(&name, entry.size(), limits.max_entry_bytes, "max_entry_bytes")?;
         if entry.size() > UnpackLimits::RATIO_FREE_BYTES
             && entry.size() / entry.compressed_size().max(1) >= limits.max_ratio
         {
@@ -551,14 +523,7 @@ pub fn check_entries<R: Read + std::io::Seek>(
             });
         }
         declared_total = declared_total.saturating_add(entry.size());
-        if declared_total > limits.max_total_bytes {
-            return Err(Error::ArchiveLimit {
-                entry: "<total>".into(),
-                size: declared_total,
-                limit: limits.max_total_bytes,
-                limit_name: "max_total_bytes",
-            });
-        }
+        within_limit("<total>", declared_total, limits.max_total_bytes, "max_total_bytes")?;
         if !is_dir {
             entries.push(Entry { index: i, name, rel });
         }
@@ -577,24 +542,10 @@ pub fn read_text_entry<R: Read + std::io::Seek>(
     let Some(index) = zip.index_for_name(name) else { return Ok(None) };
     let bad = |e: String| Error::Archive { path: shown.to_path_buf(), reason: format!("entry {name:?}: {e}") };
     let mut e = zip.by_index(index).map_err(|e| bad(e.to_string()))?;
-    if e.size() > limit {
-        return Err(Error::ArchiveLimit {
-            entry: name.to_string(),
-            size: e.size(),
-            limit,
-            limit_name: "max_xml_bytes",
-        });
-    }
+    within_limit(name, e.size(), limit, "max_xml_bytes")?;
     let mut bytes = Vec::with_capacity(e.size() as usize);
     (&mut e).take(limit + 1).read_to_end(&mut bytes).map_err(|e| bad(e.to_string()))?;
-    if bytes.len() as u64 > limit {
-        return Err(Error::ArchiveLimit {
-            entry: name.to_string(),
-            size: bytes.len() as u64,
-            limit,
-            limit_name: "max_xml_bytes",
-        });
-    }
+    within_limit(name, bytes.len() as u64, limit, "max_xml_bytes")?;
     String::from_utf8(bytes).map(Some).map_err(|e| bad(format!("not UTF-8 text: {e}")))
 }
 
@@ -698,14 +649,7 @@ fn extract<R: Read + std::io::Seek>(
             written += n as u64;
             // the declared sizes passed every limit above: holding each entry to its
             // declared size holds the archive to all of them
-            if written > declared {
-                return Err(Error::ArchiveLimit {
-                    entry: name.clone(),
-                    size: written,
-                    limit: declared,
-                    limit_name: "the size its header declares",
-                });
-            }
+            within_limit(name, written, declared, "the size its header declares")?;
             out.write_all(&buffer[..n]).map_err(io(&target))?;
         }
     }

@@ -87,40 +87,22 @@ fn pose<B>(d: VarDecl<B>, unit: &'static str, measured: bool) -> VarDecl<B> {
 /// its own), unit, description, field.
 type Parameter = (&'static str, f64, f64, f64, &'static str, &'static str, fn(&mut Controller, usize) -> &mut f64);
 
+/// A Real input: name, start, unit, description, field.
+type Signal = (&'static str, f64, &'static str, &'static str, fn(&mut Controller, usize) -> &mut f64);
+
 fn build_declaration() -> DeclarationSpec<Field<Controller>> {
     let mut v = Variables::<Field<Controller>>::new();
-    let beta = v
-        .real("beta")
-        .input(0.0)
-        .unit("rad")
-        .describe("measured body slip angle atan2(v_y, v_x)")
-        .field(|m, _| &mut m.inputs.beta);
-    let yaw_rate =
-        v.real("yaw_rate").input(0.0).unit("rad/s").describe("measured yaw rate").field(|m, _| &mut m.inputs.yaw_rate);
-    let speed = v
-        .real("speed")
-        .input(0.35)
-        .unit("m/s")
-        .describe("measured speed hypot(v_x, v_y)")
-        .field(|m, _| &mut m.inputs.speed);
-    let beta_ref = v
-        .real("beta_ref")
-        .input(0.0)
-        .unit("rad")
-        .describe("reference body slip angle")
-        .field(|m, _| &mut m.inputs.beta_ref);
-    let yaw_rate_ref = v
-        .real("yaw_rate_ref")
-        .input(0.0)
-        .unit("rad/s")
-        .describe("reference yaw rate")
-        .field(|m, _| &mut m.inputs.yaw_rate_ref);
-    let speed_ref = v
-        .real("speed_ref")
-        .input(0.35)
-        .unit("m/s")
-        .describe("speed the PI holds")
-        .field(|m, _| &mut m.inputs.speed_ref);
+    // the measured and reference signals, in value-reference order
+    let signals: [Signal; 6] = [
+        ("beta", 0.0, "rad", "measured body slip angle atan2(v_y, v_x)", |m, _| &mut m.inputs.beta),
+        ("yaw_rate", 0.0, "rad/s", "measured yaw rate", |m, _| &mut m.inputs.yaw_rate),
+        ("speed", 0.35, "m/s", "measured speed hypot(v_x, v_y)", |m, _| &mut m.inputs.speed),
+        ("beta_ref", 0.0, "rad", "reference body slip angle", |m, _| &mut m.inputs.beta_ref),
+        ("yaw_rate_ref", 0.0, "rad/s", "reference yaw rate", |m, _| &mut m.inputs.yaw_rate_ref),
+        ("speed_ref", 0.35, "m/s", "speed the PI holds", |m, _| &mut m.inputs.speed_ref),
+    ];
+    let [beta, yaw_rate, speed, beta_ref, yaw_rate_ref, speed_ref] = signals
+        .map(|(name, start, unit, text, field)| v.real(name).input(start).unit(unit).describe(text).field(field));
     let delta_ff = v
         .family("delta_ff", &WHEELS, |d, _| {
             d.input(0.0).unit("rad").describe("feed-forward steering (the maneuver's program)")

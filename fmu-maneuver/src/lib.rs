@@ -198,34 +198,33 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
     }
 }
 
+/// The Integer parameter `$field` of the scenario choosing one of `$choice::ALL` by its
+/// 1-based position (`$value`): declared 1 .. the number of choices, starting at `$start`,
+/// described by `$items`; a value outside is refused with `$refusal` (a macro: the getter
+/// and setter are plain functions, one pair per field).
+macro_rules! choice_parameter {
+    ($v:expr, $field:ident: $choice:ident = $start:expr, $value:ident, $items:expr, $refusal:literal) => {
+        $v.integer(stringify!($field))
+            .parameter($value($start))
+            .min(1.0)
+            .max($choice::ALL.len() as f64)
+            .describe($items)
+            .get_set(
+                |m, _| $value(m.scenario.$field),
+                |m, _, x| {
+                    m.scenario.$field = *$choice::ALL.get(x as usize - 1).ok_or($refusal)?;
+                    Ok(())
+                },
+            )
+    };
+}
+
 /// The Integer and Boolean parameters.
 fn switches(v: &mut Variables<Field<TestBench>>) {
     // the switches: the declared ranges (1 .. the number of items, seed >= 0) make each
     // conversion exact, so the setters never refuse what the layer let through
-    v.integer("maneuver")
-        .parameter(maneuver_value(Maneuver::Straight))
-        .min(1.0)
-        .max(Maneuver::ALL.len() as f64)
-        .describe(maneuver_items())
-        .get_set(
-            |m, _| maneuver_value(m.scenario.maneuver),
-            |m, _, x| {
-                m.scenario.maneuver = *Maneuver::ALL.get(x as usize - 1).ok_or("not a maneuver")?;
-                Ok(())
-            },
-        );
-    v.integer("fidelity")
-        .parameter(fidelity_value(Fidelity::Paper))
-        .min(1.0)
-        .max(Fidelity::ALL.len() as f64)
-        .describe(fidelity_items())
-        .get_set(
-            |m, _| fidelity_value(m.scenario.fidelity),
-            |m, _, x| {
-                m.scenario.fidelity = *Fidelity::ALL.get(x as usize - 1).ok_or("not a fidelity")?;
-                Ok(())
-            },
-        );
+    choice_parameter!(v, maneuver: Maneuver = Maneuver::Straight, maneuver_value, maneuver_items(), "not a maneuver");
+    choice_parameter!(v, fidelity: Fidelity = Fidelity::Paper, fidelity_value, fidelity_items(), "not a fidelity");
     v.integer("seed").parameter(0).min(0.0).describe("seed of every noise stream (counter-based SplitMix64)").get_set(
         |m, _| m.scenario.seed as i32,
         |m, _, x| {

@@ -208,30 +208,22 @@ fn build_declaration() -> DeclarationSpec<PlantVar> {
             d.input(0.4).min(0.0).max(MU_MAX).describe("road-tire friction coefficient, 0 .. 3")
         })
         .bind(|i| input(Input::Friction(i)));
-    let wind_head = v
-        .real("wind_head")
-        .input(0.0)
-        .unit("N")
-        .describe("head wind force, positive opposes forward motion")
-        .bind(input(Input::WindHead));
-    let wind_side = v
-        .real("wind_side")
-        .input(0.0)
-        .unit("N")
-        .describe("side wind force toward body +y, at the geometric centre")
-        .bind(input(Input::WindSide));
-    let wind_x = v
-        .real("wind_x")
-        .input(0.0)
-        .unit("N")
-        .describe("wind force along world +X at the geometric centre, rotated with the instantaneous psi")
-        .bind(input(Input::WindX));
-    let wind_y = v
-        .real("wind_y")
-        .input(0.0)
-        .unit("N")
-        .describe("wind force along world +Y at the geometric centre, rotated with the instantaneous psi")
-        .bind(input(Input::WindY));
+    let winds = [
+        ("wind_head", Input::WindHead, "head wind force, positive opposes forward motion"),
+        ("wind_side", Input::WindSide, "side wind force toward body +y, at the geometric centre"),
+        (
+            "wind_x",
+            Input::WindX,
+            "wind force along world +X at the geometric centre, rotated with the instantaneous psi",
+        ),
+        (
+            "wind_y",
+            Input::WindY,
+            "wind force along world +Y at the geometric centre, rotated with the instantaneous psi",
+        ),
+    ];
+    let [wind_head, wind_side, wind_x, wind_y] =
+        winds.map(|(name, which, text)| v.real(name).input(0.0).unit("N").describe(text).bind(input(which)));
 
     // initial state of the body: parameters, declared before the states so that restoring
     // a serialized FMU state sets them first and the saved states after them

@@ -503,6 +503,70 @@ pub(crate) fn once<'a>(ctx: &Ctx, slot: &mut Option<&'a Node>, n: &'a Node) -> R
     Ok(())
 }
 
+/// The children of `<fmiModelDescription>` that FMI 2.0 and 3.0 share, in the schemas' order.
+pub(crate) const DOCUMENT_ELEMENTS: [&str; 8] = [
+    "ModelExchange",
+    "CoSimulation",
+    "UnitDefinitions",
+    "TypeDefinitions",
+    "LogCategories",
+    "DefaultExperiment",
+    "ModelVariables",
+    "ModelStructure",
+];
+
+/// The children of `parent` named in `names`, in that order, each at most once (a second
+/// one is [`ReadError::DuplicateElement`]); children of other names are skipped.
+pub(crate) fn children_once<'n, const N: usize>(
+    ctx: &Ctx,
+    parent: &'n Node,
+    names: [&str; N],
+) -> Result<[Option<&'n Node>; N], ReadError> {
+    let mut slots = [None; N];
+    for c in &parent.children {
+        if let Some(i) = names.iter().position(|name| *name == c.name) {
+            once(ctx, &mut slots[i], c)?;
+        }
+    }
+    Ok(slots)
+}
+
+/// Parses `xml` into its `<fmiModelDescription>` root and returns it with its `fmiVersion`
+/// as written, refusing another root, and a version that `accepts` refuses (given without
+/// surrounding white space) with [`ReadError::UnsupportedFmiVersion`] naming `expected`.
+pub(crate) fn read_root<'x>(
+    xml: &'x str,
+    expected: &'static str,
+    accepts: fn(&str) -> bool,
+) -> Result<(Node, Ctx<'x>, String), ReadError> {
+    let root = parse_tree(xml)?;
+    let ctx = Ctx { src: xml };
+    check_root(&ctx, &root)?;
+    let fmi_version = ctx.req(&root, "fmiModelDescription", "fmiVersion")?.to_string();
+    if !accepts(fmi_version.trim()) {
+        return Err(ReadError::UnsupportedFmiVersion { found: fmi_version, expected, position: ctx.pos(&root) });
+    }
+    Ok((root, ctx, fmi_version))
+}
+
+/// The struct literal `$interface { $fields }` of an FMI 2.0 `<ModelExchange>` or
+/// `<CoSimulation>` element `$n` (labelled `$l` in errors): the attributes both elements
+/// have, read in the schema's order around the element's own `$fields`.
+macro_rules! fmi2_interface {
+    ($interface:ident, $ctx:expr, $n:expr, $l:expr, { $($fields:tt)* }) => {
+        $interface {
+            model_identifier: $ctx.req($n, $l, "modelIdentifier")?.to_string(),
+            needs_execution_tool: $ctx.flag($n, $l, "needsExecutionTool")?,
+            $($fields)*
+            can_be_instantiated_only_once_per_process: $ctx.flag($n, $l, "canBeInstantiatedOnlyOncePerProcess")?,
+            can_not_use_memory_management_functions: $ctx.flag($n, $l, "canNotUseMemoryManagementFunctions")?,
+            can_get_and_set_fmu_state: $ctx.flag($n, $l, "canGetAndSetFMUstate")?,
+            can_serialize_fmu_state: $ctx.flag($n, $l, "canSerializeFMUstate")?,
+            provides_directional_derivative: $ctx.flag($n, $l, "providesDirectionalDerivative")?,
+        }
+    };
+}
+
 /// The struct literal `$md { $fields }` with the optional attributes of
 /// `<fmiModelDescription>` that FMI 2.0 and 3.0 share read from the root `$root` (a macro:
 /// the two generations' descriptions are different types with these fields).
@@ -602,66 +666,29 @@ impl ModelDescription {
     /// `Integer`; a `declaredType`'s `unit`, `min`, `max` and `nominal` are copied onto
     /// variables that do not set them.
     pub fn from_xml(xml: &str) -> Result<ModelDescription, ReadError> {
-        let root = parse_tree(xml)?;
-        let ctx = Ctx { src: xml };
-        check_root(&ctx, &root)?;
+        let (root, ctx, fmi_version) = read_root(xml, "2.0", |v| v == "2.0")?;
         let label = "fmiModelDescription";
-        let fmi_version = ctx.req(&root, label, "fmiVersion")?;
-        if fmi_version.trim() != "2.0" {
-            return Err(ReadError::UnsupportedFmiVersion {
-                found: fmi_version.to_string(),
-                expected: "2.0",
-                position: ctx.pos(&root),
-            });
-        }
         let model_name = ctx.req(&root, label, "modelName")?.to_string();
         let guid = ctx.req(&root, label, "guid")?.to_string();
         let number_of_event_indicators = ctx.opt_u32(&root, label, "numberOfEventIndicators")?.unwrap_or(0);
 
-        let mut me_node = None;
-        let mut cs_node = None;
-        let mut units_node = None;
-        let mut types_node = None;
-        let mut logs_node = None;
-        let mut exp_node = None;
-        let mut vars_node = None;
-        let mut struct_node = None;
-        for c in &root.children {
-            match c.name.as_str() {
-                "ModelExchange" => once(&ctx, &mut me_node, c)?,
-                "CoSimulation" => once(&ctx, &mut cs_node, c)?,
-                "UnitDefinitions" => once(&ctx, &mut units_node, c)?,
-                "TypeDefinitions" => once(&ctx, &mut types_node, c)?,
-                "LogCategories" => once(&ctx, &mut logs_node, c)?,
-                "DefaultExperiment" => once(&ctx, &mut exp_node, c)?,
-                "ModelVariables" => once(&ctx, &mut vars_node, c)?,
-                "ModelStructure" => once(&ctx, &mut struct_node, c)?,
-                _ => {} // VendorAnnotations and anything unknown
-            }
-        }
+        // VendorAnnotations and anything unknown are skipped.
+        let [me_node, cs_node, units_node, types_node, logs_node, exp_node, vars_node, struct_node] =
+            children_once(&ctx, &root, DOCUMENT_ELEMENTS)?;
 
         let model_exchange = me_node
             .map(|n| -> Result<ModelExchange, ReadError> {
                 let l = "ModelExchange";
-                Ok(ModelExchange {
-                    model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
-                    needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
+                Ok(fmi2_interface!(ModelExchange, ctx, n, l, {
                     completed_integrator_step_not_needed: ctx.flag(n, l, "completedIntegratorStepNotNeeded")?,
-                    can_be_instantiated_only_once_per_process: ctx.flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
-                    can_not_use_memory_management_functions: ctx.flag(n, l, "canNotUseMemoryManagementFunctions")?,
-                    can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
-                    can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
-                })
+                }))
             })
             .transpose()?;
 
         let co_simulation = cs_node
             .map(|n| -> Result<CoSimulation, ReadError> {
                 let l = "CoSimulation";
-                Ok(CoSimulation {
-                    model_identifier: ctx.req(n, l, "modelIdentifier")?.to_string(),
-                    needs_execution_tool: ctx.flag(n, l, "needsExecutionTool")?,
+                Ok(fmi2_interface!(CoSimulation, ctx, n, l, {
                     can_handle_variable_communication_step_size: ctx.flag(
                         n,
                         l,
@@ -670,12 +697,7 @@ impl ModelDescription {
                     can_interpolate_inputs: ctx.flag(n, l, "canInterpolateInputs")?,
                     max_output_derivative_order: ctx.opt_u32(n, l, "maxOutputDerivativeOrder")?.unwrap_or(0),
                     can_run_asynchronuously: ctx.flag(n, l, "canRunAsynchronuously")?,
-                    can_be_instantiated_only_once_per_process: ctx.flag(n, l, "canBeInstantiatedOnlyOncePerProcess")?,
-                    can_not_use_memory_management_functions: ctx.flag(n, l, "canNotUseMemoryManagementFunctions")?,
-                    can_get_and_set_fmu_state: ctx.flag(n, l, "canGetAndSetFMUstate")?,
-                    can_serialize_fmu_state: ctx.flag(n, l, "canSerializeFMUstate")?,
-                    provides_directional_derivative: ctx.flag(n, l, "providesDirectionalDerivative")?,
-                })
+                }))
             })
             .transpose()?;
 
@@ -736,15 +758,7 @@ impl ModelDescription {
 
         let mut model_structure = ModelStructure::default();
         if let Some(ms) = struct_node {
-            let (mut outs, mut ders, mut inits) = (None, None, None);
-            for c in &ms.children {
-                match c.name.as_str() {
-                    "Outputs" => once(&ctx, &mut outs, c)?,
-                    "Derivatives" => once(&ctx, &mut ders, c)?,
-                    "InitialUnknowns" => once(&ctx, &mut inits, c)?,
-                    _ => {}
-                }
-            }
+            let [outs, ders, inits] = children_once(&ctx, ms, ["Outputs", "Derivatives", "InitialUnknowns"])?;
             let read_list = |n: Option<&Node>| -> Result<Vec<Unknown>, ReadError> {
                 let Some(n) = n else { return Ok(Vec::new()) };
                 n.children.iter().filter(|c| c.name == "Unknown").map(|u| read_unknown(&ctx, u, &n.name)).collect()
@@ -755,7 +769,7 @@ impl ModelDescription {
         }
 
         Ok(with_document_attributes!(ModelDescription, &root, {
-            fmi_version: fmi_version.to_string(),
+            fmi_version,
             model_name,
             guid,
             number_of_event_indicators,

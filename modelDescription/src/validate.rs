@@ -135,6 +135,12 @@ pub fn is_c_identifier(s: &str) -> bool {
     chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// The problem of an `initial` attribute on an input or the independent variable (of
+/// causality `causality`), which both generations forbid.
+pub(crate) fn initial_not_allowed_message(causality: &str, initial: Initial) -> String {
+    format!("causality=\"{causality}\" must not define initial (has \"{}\")", initial.as_str())
+}
+
 /// For each interface element whose `modelIdentifier` is not a C identifier, what is wrong
 /// (`(element, modelIdentifier)` of the interfaces present).
 pub(crate) fn model_identifier_messages<'a>(interfaces: impl IntoIterator<Item = (&'a str, &'a str)>) -> Vec<String> {
@@ -279,15 +285,7 @@ impl ModelDescription {
             }
             if let Some(init) = v.initial {
                 if matches!(v.causality, Causality::Input | Causality::Independent) {
-                    c.push(
-                        Rule::Initial,
-                        name,
-                        format!(
-                            "causality=\"{}\" must not define initial (has \"{}\")",
-                            v.causality.as_str(),
-                            init.as_str()
-                        ),
-                    );
+                    c.push(Rule::Initial, name, initial_not_allowed_message(v.causality.as_str(), init));
                 } else if legal && !Initial::allowed(v.causality, v.variability).contains(&init) {
                     let allowed: Vec<&str> =
                         Initial::allowed(v.causality, v.variability).iter().map(|i| i.as_str()).collect();
@@ -472,19 +470,9 @@ impl ModelDescription {
         let expected = self.expected_model_structure();
 
         // Outputs: exactly the outputs, in ModelVariables order.
-        let outs: Vec<u32> = ms.outputs.iter().map(|u| u.index).collect();
-        let want_outs: Vec<u32> = expected.outputs.iter().map(|u| u.index).collect();
-        if outs != want_outs {
-            c.push(
-                Rule::Outputs,
-                None,
-                format!(
-                    "<Outputs> lists {} but the causality=\"output\" variables are {}",
-                    self.names_of(&outs),
-                    self.names_of(&want_outs)
-                ),
-            );
-        }
+        self.check_list(c, Rule::Outputs, &ms.outputs, &expected.outputs, |listed, wanted| {
+            format!("<Outputs> lists {listed} but the causality=\"output\" variables are {wanted}")
+        });
 
         // Derivatives: exactly the state derivatives, each once (any order).
         let ders: Vec<u32> = ms.derivatives.iter().map(|u| u.index).collect();
@@ -503,19 +491,11 @@ impl ModelDescription {
         }
 
         // InitialUnknowns: exactly the required set, sorted by index.
-        let inits: Vec<u32> = ms.initial_unknowns.iter().map(|u| u.index).collect();
-        let want_inits: Vec<u32> = expected.initial_unknowns.iter().map(|u| u.index).collect();
-        if inits != want_inits {
-            c.push(
-                Rule::InitialUnknowns,
-                None,
-                format!(
-                    "<InitialUnknowns> lists {} but must list, sorted by index, {} (outputs with initial approx/calculated, calculated parameters, states and derivatives with initial approx/calculated)",
-                    self.names_of(&inits),
-                    self.names_of(&want_inits)
-                ),
-            );
-        }
+        self.check_list(c, Rule::InitialUnknowns, &ms.initial_unknowns, &expected.initial_unknowns, |listed, wanted| {
+            format!(
+                "<InitialUnknowns> lists {listed} but must list, sorted by index, {wanted} (outputs with initial approx/calculated, calculated parameters, states and derivatives with initial approx/calculated)"
+            )
+        });
 
         // Dependencies refer to knowns only.
         let states: HashSet<u32> = self.states().into_iter().collect();
@@ -561,6 +541,23 @@ impl ModelDescription {
                     }
                 }
             }
+        }
+    }
+
+    /// A problem of `rule` (its text from the names of the `listed` and the `wanted` indices)
+    /// unless the ModelStructure list `listed` holds exactly the `wanted` entries, in order.
+    fn check_list(
+        &self,
+        c: &mut Checker,
+        rule: Rule,
+        listed: &[Unknown],
+        wanted: &[Unknown],
+        message: impl FnOnce(String, String) -> String,
+    ) {
+        let listed: Vec<u32> = listed.iter().map(|u| u.index).collect();
+        let wanted: Vec<u32> = wanted.iter().map(|u| u.index).collect();
+        if listed != wanted {
+            c.push(rule, None, message(self.names_of(&listed), self.names_of(&wanted)));
         }
     }
 

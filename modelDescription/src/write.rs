@@ -138,6 +138,16 @@ impl Out {
     pub(crate) fn close(&mut self, name: &'static str) {
         self.ev(Event::End(BytesEnd::new(name)));
     }
+    /// Opens `<name>` (to be closed by the caller) and returns true, or, when it has no
+    /// children (`empty`), writes `<name/>` and returns false.
+    pub(crate) fn open_unless_empty(&mut self, name: &'static str, empty: bool) -> bool {
+        if empty {
+            self.empty(Elem::new(name));
+        } else {
+            self.open(Elem::new(name));
+        }
+        !empty
+    }
 }
 
 pub(crate) fn join_u32(v: &[u32]) -> String {
@@ -167,6 +177,19 @@ macro_rules! document_attributes {
     };
 }
 pub(crate) use document_attributes;
+
+/// The capability flags that end both FMI 2.0 interface elements, `<ModelExchange>` and
+/// `<CoSimulation>`, in the schema's order, each when true, from the fields of the same
+/// names of `$interface` (a macro: the two elements are different types).
+macro_rules! fmi2_capability_flags {
+    ($e:expr, $interface:expr) => {
+        $e.flag("canBeInstantiatedOnlyOncePerProcess", $interface.can_be_instantiated_only_once_per_process)
+            .flag("canNotUseMemoryManagementFunctions", $interface.can_not_use_memory_management_functions)
+            .flag("canGetAndSetFMUstate", $interface.can_get_and_set_fmu_state)
+            .flag("canSerializeFMUstate", $interface.can_serialize_fmu_state)
+            .flag("providesDirectionalDerivative", $interface.provides_directional_derivative)
+    };
+}
 
 /// `<UnitDefinitions>` (omitted when there are no units): each `<Unit>` with its
 /// `<BaseUnit>`, exponents written when non-zero, `factor` when not 1, `offset` when not 0.
@@ -264,12 +287,8 @@ impl ModelDescription {
             let mut e = Elem::new("ModelExchange");
             e.attr("modelIdentifier", &me.model_identifier)
                 .flag("needsExecutionTool", me.needs_execution_tool)
-                .flag("completedIntegratorStepNotNeeded", me.completed_integrator_step_not_needed)
-                .flag("canBeInstantiatedOnlyOncePerProcess", me.can_be_instantiated_only_once_per_process)
-                .flag("canNotUseMemoryManagementFunctions", me.can_not_use_memory_management_functions)
-                .flag("canGetAndSetFMUstate", me.can_get_and_set_fmu_state)
-                .flag("canSerializeFMUstate", me.can_serialize_fmu_state)
-                .flag("providesDirectionalDerivative", me.provides_directional_derivative);
+                .flag("completedIntegratorStepNotNeeded", me.completed_integrator_step_not_needed);
+            fmi2_capability_flags!(e, me);
             o.empty(e);
         }
         if let Some(cs) = &self.co_simulation {
@@ -281,12 +300,8 @@ impl ModelDescription {
             if cs.max_output_derivative_order != 0 {
                 e.attr("maxOutputDerivativeOrder", &cs.max_output_derivative_order.to_string());
             }
-            e.flag("canRunAsynchronuously", cs.can_run_asynchronuously)
-                .flag("canBeInstantiatedOnlyOncePerProcess", cs.can_be_instantiated_only_once_per_process)
-                .flag("canNotUseMemoryManagementFunctions", cs.can_not_use_memory_management_functions)
-                .flag("canGetAndSetFMUstate", cs.can_get_and_set_fmu_state)
-                .flag("canSerializeFMUstate", cs.can_serialize_fmu_state)
-                .flag("providesDirectionalDerivative", cs.provides_directional_derivative);
+            e.flag("canRunAsynchronuously", cs.can_run_asynchronuously);
+            fmi2_capability_flags!(e, cs);
             o.empty(e);
         }
 
@@ -310,10 +325,7 @@ impl ModelDescription {
 
         write_log_categories_and_experiment(&mut o, &self.log_categories, self.default_experiment.as_ref());
 
-        if self.model_variables.is_empty() {
-            o.empty(Elem::new("ModelVariables"));
-        } else {
-            o.open(Elem::new("ModelVariables"));
+        if o.open_unless_empty("ModelVariables", self.model_variables.is_empty()) {
             for v in &self.model_variables {
                 let mut e = Elem::new("ScalarVariable");
                 e.attr("name", &v.name)

@@ -6,15 +6,15 @@ use crate::run_args::RunArgs;
 use crate::stepped_run::{exact_columns, NativeRun};
 use model_description::DefaultExperiment;
 use nigel_cosim::defaults::{GivenTimes, RunTimes};
+use nigel_cosim::run_setup::{run_in_process, InProcess, PreparedRun, RunSetup};
 use nigel_cosim::{
-    simulate::{default_record, run_to_end, Execution},
-    Error as CosimError, Experiment, Fmu, ImportOptions, InstancePool, Interface, Results, Summary, System,
-    SystemBuilder, VariableRef,
+    simulate::default_record, Error as CosimError, Experiment, ImportOptions, InstancePool, Interface, Results,
+    Summary, System, VariableRef,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
@@ -35,50 +35,36 @@ pub(crate) struct NativeSystem {
     notes: Vec<String>,
 }
 
-const SINGLE: &str = "model";
-
-fn is_ssp(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp") || e.eq_ignore_ascii_case("ssd"))
-}
-
 /// (start, stop, step, relative tolerance) as the Python half takes them.
 fn times_tuple(t: RunTimes) -> (f64, f64, f64, Option<f64>) {
     (t.start_time, t.stop_time, t.step, t.relative_tolerance)
 }
 
-fn interface_name(i: Interface) -> &'static str {
-    match i {
-        Interface::CoSimulation => "CoSimulation",
-        Interface::ModelExchange => "ModelExchange",
-        Interface::ScheduledExecution => "ScheduledExecution",
-    }
-}
-
 impl NativeSystem {
-    /// The system name of `name`: for a single FMU, `model.<name>`.
-    fn qualify(&self, name: &str) -> String {
-        match &self.single {
-            Some(instance) => format!("{instance}.{name}"),
-            None => name.to_string(),
-        }
-    }
-
     fn experiment_defaults(&self) -> DefaultExperiment {
         let (start_time, stop_time, step_size, tolerance) = self.default_experiment;
         DefaultExperiment { start_time, stop_time, step_size, tolerance }
     }
 
-    /// The system of a run (a copy of this one with `args.start_values` set) and its experiment.
-    fn run_setup(&self, args: &RunArgs) -> PyResult<(System, Experiment)> {
+    /// The system of a run (a copy of this one with `args.start_values` set, by the names
+    /// `cosim run --set` takes) and its experiment.
+    fn run_setup(&self, args: &RunArgs) -> PyResult<(PreparedRun, Experiment)> {
         let system = {
             let guard = self.system.lock().unwrap_or_else(|p| p.into_inner());
             guard.clone().ok_or_else(|| Error::new_err("the system is closed"))?
         };
-        let mut builder = SystemBuilder::from_system(system);
+        let mut setup = RunSetup::of_system(system, self.experiment_defaults(), self.single.is_some());
         for (name, value) in &args.start_values {
-            builder.set_text(&self.qualify(name), value).map_err(to_py)?;
+            setup.set(name, value).map_err(to_py)?;
         }
-        Ok((builder.build(), args.experiment(|n| self.qualify(n)).map_err(to_py)?))
+        let prepared = setup.build();
+        if args.output.is_none() {
+            // every output left out of the master's view: a result of the time column alone
+            // is not what was asked for (as `cosim run`)
+            prepared.check_recordable("output").map_err(to_py)?;
+        }
+        let experiment = args.experiment(|n| prepared.qualify(n)).map_err(to_py)?;
+        Ok((prepared, experiment))
     }
 }
 
@@ -117,56 +103,45 @@ impl NativeSystem {
     fn new(py: Python<'_>, filename: PathBuf, fmi_type: Option<&str>) -> PyResult<NativeSystem> {
         let interface = match fmi_type {
             None => None,
-            Some("CoSimulation") => Some(Interface::CoSimulation),
-            Some("ModelExchange") => Some(Interface::ModelExchange),
-            Some("ScheduledExecution") => Some(Interface::ScheduledExecution),
-            Some(other) => {
-                return Err(PyValueError::new_err(format!(
-                    "fmi_type must be 'CoSimulation', 'ModelExchange' or 'ScheduledExecution', not {other:?}"
-                )))
-            }
+            Some(name) => Some(Interface::from_element_name(name).ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "fmi_type must be 'CoSimulation', 'ModelExchange' or 'ScheduledExecution', not {name:?}"
+                ))
+            })?),
         };
         let options = ImportOptions { interface, ..ImportOptions::default() };
         py.detach(|| {
-            if is_ssp(&filename) {
-                let ssp = nigel_cosim::read_ssp(&filename, &options)?;
-                let (start, stop) = ssp.default_start_stop;
-                Ok(NativeSystem {
-                    system: Mutex::new(Some(ssp.system)),
-                    pool: Mutex::new(InstancePool::new()),
-                    single: None,
-                    default_experiment: (start, stop, None, None),
-                    interfaces: Vec::new(),
-                    notes: ssp.notes,
-                })
-            } else {
-                let fmu = Fmu::load_with(&filename, &options)?;
-                let d = fmu.description().default_experiment.clone().unwrap_or_default();
-                let md = fmu.description();
-                let mut interfaces = Vec::new();
-                if md.co_simulation.is_some() {
-                    interfaces.push(interface_name(Interface::CoSimulation));
+            let setup = RunSetup::load(&filename, &options)?;
+            let d = setup.default_experiment().clone();
+            let notes = setup.notes().to_vec();
+            // the interfaces a single FMU is run with: the one asked for, else each it has
+            let interfaces = match (setup.single_fmu(), interface) {
+                (None, _) => Vec::new(),
+                (Some(_), Some(i)) => vec![i.as_str()],
+                (Some(fmu), None) => {
+                    let md = fmu.description();
+                    let mut interfaces = Vec::new();
+                    if md.co_simulation.is_some() {
+                        interfaces.push(Interface::CoSimulation.as_str());
+                    }
+                    if md.model_exchange.is_some() {
+                        interfaces.push(Interface::ModelExchange.as_str());
+                    }
+                    if fmu.fmi3_description().is_some_and(|md3| md3.scheduled_execution.is_some()) {
+                        interfaces.push(Interface::ScheduledExecution.as_str());
+                    }
+                    interfaces
                 }
-                if md.model_exchange.is_some() {
-                    interfaces.push(interface_name(Interface::ModelExchange));
-                }
-                if fmu.fmi3_description().is_some_and(|md3| md3.scheduled_execution.is_some()) {
-                    interfaces.push(interface_name(Interface::ScheduledExecution));
-                }
-                let interfaces = match interface {
-                    Some(i) => vec![interface_name(i)],
-                    None => interfaces,
-                };
-                let system = System::single(SINGLE, fmu.clone())?;
-                Ok(NativeSystem {
-                    system: Mutex::new(Some(system)),
-                    pool: Mutex::new(InstancePool::new()),
-                    single: Some(SINGLE.to_string()),
-                    default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
-                    interfaces,
-                    notes: Vec::new(),
-                })
-            }
+            };
+            let single = setup.single_fmu().map(|_| nigel_cosim::run_setup::SINGLE.to_string());
+            Ok::<_, CosimError>(NativeSystem {
+                system: Mutex::new(Some(setup.build().system)),
+                pool: Mutex::new(InstancePool::new()),
+                single,
+                default_experiment: (d.start_time, d.stop_time, d.step_size, d.tolerance),
+                interfaces,
+                notes,
+            })
         })
         .map_err(to_py)
     }
@@ -263,22 +238,17 @@ impl NativeSystem {
         py: Python<'py>,
         args: RunArgs,
     ) -> PyResult<(Vec<String>, Vec<&'static str>, Bound<'py, PyAny>, String, Vec<(usize, Vec<String>)>)> {
-        let (system, experiment) = self.run_setup(&args)?;
+        let (prepared, experiment) = self.run_setup(&args)?;
+        let system = &prepared.system;
         let cancel = Arc::new(AtomicBool::new(false));
         let outcome: Result<(Results, Summary), CosimError> = interruptible(py, &cancel, || {
-            if nigel_cosim::simulate::is_scheduled(&system) {
-                // one FMU's model partitions at their clocks' ticks (cosim run --interface se)
-                let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
-                return Ok((results, outcome?));
-            }
             let mut pool = self.pool.lock().unwrap_or_else(|p| p.into_inner());
-            let mut execution = Execution::new(&system, &experiment)?.with_pool(&mut pool);
-            execution.cancel_on(cancel.clone());
-            let summary = run_to_end(&mut execution)?;
-            Ok((execution.take_results(), summary))
+            let watch = InProcess { pool: Some(&mut pool), cancel: Some(cancel.clone()), progress: None };
+            let (results, outcome) = run_in_process(system, &experiment, &[], watch);
+            Ok((results, outcome?))
         })?;
         let (results, summary) = outcome.map_err(to_py)?;
-        let types = column_types(&system, &results, self.single.as_deref());
+        let types = column_types(system, &results, self.single.as_deref());
         let exact = exact_columns(&results);
         let (rows, width) = (results.rows(), results.width());
         let array = PyArray1::from_vec(py, results.values).reshape([rows, width])?;
@@ -290,8 +260,8 @@ impl NativeSystem {
     /// `cosim run`'s, with the keyword that sets the step): the Python side raises them as
     /// `warnings.warn`.
     fn sample_period_warnings(&self, args: RunArgs) -> PyResult<Vec<String>> {
-        let (system, experiment) = self.run_setup(&args)?;
-        Ok(nigel_cosim::sample_period::warnings(&system, experiment.step)
+        let (prepared, experiment) = self.run_setup(&args)?;
+        Ok(nigel_cosim::sample_period::warnings(&prepared.system, experiment.step)
             .iter()
             .map(|w| format!("{w} (use step_size={})", w.period))
             .collect())
@@ -300,23 +270,19 @@ impl NativeSystem {
     /// Starts a run stepped from outside ([`NativeRun`]): instantiated and initialized, paused
     /// at the start time. The recorded variables are `args.output` or every output.
     fn start(&self, py: Python<'_>, args: RunArgs) -> PyResult<NativeRun> {
-        let (system, mut experiment) = self.run_setup(&args)?;
+        let (prepared, mut experiment) = self.run_setup(&args)?;
+        let system = &prepared.system;
         let record: Vec<String> = match &experiment.record {
             Some(names) => names.clone(),
-            None => default_record(&system).iter().map(|r| system.name_of(r)).collect(),
+            None => default_record(system).iter().map(|r| system.name_of(r)).collect(),
         };
         let mut types = Vec::with_capacity(record.len());
         for name in &record {
-            types.push(column_type(&system, &system.resolve(name).map_err(to_py)?));
+            types.push(column_type(system, &system.resolve(name).map_err(to_py)?));
         }
         experiment.record = Some(record.clone());
-        let names: Vec<String> = match &self.single {
-            Some(instance) => {
-                record.iter().map(|n| n.strip_prefix(&format!("{instance}.")).unwrap_or(n).to_string()).collect()
-            }
-            None => record.clone(),
-        };
-        NativeRun::start(py, system, experiment, names, types, self.single.clone())
+        let names: Vec<String> = record.iter().map(|n| prepared.column(n)).collect();
+        NativeRun::start(py, prepared.system, experiment, names, types, self.single.clone())
     }
 
     /// Frees the instances and the FMUs, removing their unpacked folders; the object cannot

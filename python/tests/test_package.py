@@ -209,6 +209,51 @@ def test_errors_carry_the_masters_messages():
     assert issubclass(nigel_cosim.Error, Exception)
 
 
+def test_a_run_that_can_record_none_of_the_outputs_is_refused(tmp_path):
+    # cosim's FMI 3.0 counter (cosim/tests/cfmu/fmi3_counter.c) described with one output, an
+    # array of 200,000 elements that the master leaves out of its view: a result of the time
+    # column alone is not what simulate_fmu was asked for (every output), so it raises, as
+    # `cosim run` exits 1 (cosim/tests/fmi3.rs a_run_that_can_record_none_of_the_outputs_fails)
+    import zipfile
+    xml = textwrap.dedent("""\
+        <?xml version="1.0" encoding="UTF-8"?>
+        <fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
+          <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
+          <ModelVariables>
+            <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+            <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
+          </ModelVariables>
+          <ModelStructure>
+            <Output valueReference="24"/>
+            <InitialUnknown valueReference="24"/>
+          </ModelStructure>
+        </fmiModelDescription>
+        """)
+    headers = Path(fmpy.__file__).parent / "c-code"
+    so = tmp_path / "fmi3_counter.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter", "-I",
+                    str(headers), str(REPO / "cosim/tests/cfmu/fmi3_counter.c"), "-o", str(so)], check=True)
+    fmu = tmp_path / "no_output.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.writestr("modelDescription.xml", xml)
+        z.write(so, "binaries/x86_64-linux/fmi3_counter.so")
+    with pytest.raises(nigel_cosim.ExperimentError, match=r"no output of the system can be recorded: model\.big .*output"):
+        nigel_cosim.simulate_fmu(fmu, stop_time=0.1, step_size=0.05)
+
+
+def test_a_single_fmus_names_are_those_of_cosim_run_and_its_fmi_type_the_xml_names():
+    # as `cosim run --set`: a single FMU's variable bare or as `model.<name>`
+    plant = FMU / "nigel_plant.fmu"
+    run = lambda values: nigel_cosim.simulate_fmu(plant, stop_time=0.1, start_values=values, output=["x"])["x"]
+    bare, qualified, still = run({"v_x_start": 1.0}), run({"model.v_x_start": 1.0}), run({})
+    assert np.array_equal(bare, qualified)
+    # at 1 m/s without torque or steering the plant rolls straight on: x = 1 m/s * 0.1 s (to
+    # the integrator's rounding, 1e-9); at rest it stays at 0
+    assert bare[-1] == pytest.approx(0.1, abs=1e-9) and not still.any()
+    with pytest.raises(ValueError, match="fmi_type must be 'CoSimulation', 'ModelExchange' or 'ScheduledExecution', not \"cs\""):
+        nigel_cosim.System(plant, fmi_type="cs")
+
+
 def test_runs_release_the_gil_two_threads_overlap():
     # each thread notes when its run started and ended; with the GIL held for a whole run
     # the second could not start before the first ended

@@ -111,26 +111,20 @@ impl fmt::Display for SynthesisError {
 
 impl std::error::Error for SynthesisError {}
 
-impl From<PlantError> for SynthesisError {
-    fn from(e: PlantError) -> Self {
-        SynthesisError::Plant(e)
-    }
+/// `From` each wrapped error for `?`: `(error type, variant)` pairs.
+macro_rules! synthesis_error_from {
+    ($(($error:ty, $variant:ident)),* $(,)?) => {
+        $(
+            impl From<$error> for SynthesisError {
+                fn from(e: $error) -> Self {
+                    SynthesisError::$variant(e)
+                }
+            }
+        )*
+    };
 }
-impl From<RegionError> for SynthesisError {
-    fn from(e: RegionError) -> Self {
-        SynthesisError::Region(e)
-    }
-}
-impl From<LmiError> for SynthesisError {
-    fn from(e: LmiError) -> Self {
-        SynthesisError::Lmi(e)
-    }
-}
-impl From<SolveError> for SynthesisError {
-    fn from(e: SolveError) -> Self {
-        SynthesisError::Solve(e)
-    }
-}
+
+synthesis_error_from!((PlantError, Plant), (RegionError, Region), (LmiError, Lmi), (SolveError, Solve));
 
 /// A state-feedback gain with what the solver certified about it.
 #[derive(Clone, Debug, PartialEq)]

@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -86,6 +87,29 @@ fn sampled(n: usize) -> impl Iterator<Item = usize> + Clone {
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
+/// The axes of a chart: descriptions `(x, y)`, tick labels of `label_size` px with [`tick`]
+/// (`x_labels` of them on x when given), descriptions one px larger, no light grid lines.
+fn draw_axes(
+    chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    (x_desc, y_desc): (&str, &str),
+    label_size: u32,
+    x_labels: Option<usize>,
+    path: &Path,
+) -> Result<(), Error> {
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", label_size))
+        .axis_desc_style(("sans-serif", label_size + 1))
+        .light_line_style(WHITE.mix(0.0))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick);
+    if let Some(n) = x_labels {
+        mesh.x_labels(n);
+    }
+    mesh.draw().map_err(plot_err(path))
+}
+
 /// The reference band: wide and light, drawn first, so that a controller on the reference
 /// (robust tracking) stays visible on top of it.
 const REFERENCE_BAND: RGBColor = RGBColor(210, 210, 210);
@@ -159,17 +183,7 @@ fn xy_panel(area: &Area, maneuver: Maneuver, runs: &[&Run], path: &Path) -> Resu
         .y_label_area_size(55)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(&err)?;
-    chart
-        .configure_mesh()
-        .x_desc("X [m]")
-        .y_desc("Y [m]")
-        .label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 15))
-        .light_line_style(WHITE.mix(0.0))
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .draw()
-        .map_err(&err)?;
+    draw_axes(&mut chart, ("X [m]", "Y [m]"), 14, None, path)?;
     chart
         .draw_series(LineSeries::new(
             sampled(n).map(|k| (first.x_ref[k], first.y_ref[k])),
@@ -337,18 +351,7 @@ fn time_panel(
         .map_err(&err)?;
     let every = if t.1 - t.0 > 10.0 { 5.0 } else { 1.0 };
     let ticks = ((t.1 - t.0) / every).floor() as usize + 1;
-    chart
-        .configure_mesh()
-        .x_desc("t [s]")
-        .y_desc(y_desc)
-        .x_labels(ticks.max(2))
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 14))
-        .light_line_style(WHITE.mix(0.0))
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .draw()
-        .map_err(&err)?;
+    draw_axes(&mut chart, ("t [s]", y_desc), 13, Some(ticks.max(2)), path)?;
     for s in series {
         chart.draw_series(LineSeries::new(s.points.iter().copied(), s.color.stroke_width(s.width))).map_err(&err)?;
     }

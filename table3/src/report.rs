@@ -75,6 +75,35 @@ pub fn sci(x: f64) -> String {
     format!("{x:.3e}")
 }
 
+/// The start of a table's heading row: the column (`fidelity`) and one heading per controller.
+fn write_heading_start(s: &mut String, fidelity: &str, controllers: &[Controller]) {
+    let _ = write!(s, "| {fidelity} | ");
+    for &c in controllers {
+        let _ = write!(s, "{} | ", heading(c));
+    }
+}
+
+/// One cell per controller: its `value` (bold for the `lowest` controller), `-` where it
+/// has none.
+fn write_cells(
+    s: &mut String,
+    controllers: &[Controller],
+    lowest: Option<Controller>,
+    value: impl Fn(Controller) -> Option<f64>,
+) {
+    for &c in controllers {
+        match value(c) {
+            Some(v) if Some(c) == lowest => {
+                let _ = write!(s, "**{}** | ", sci(v));
+            }
+            Some(v) => {
+                let _ = write!(s, "{} | ", sci(v));
+            }
+            None => s.push_str("- | "),
+        }
+    }
+}
+
 /// The markdown report: per column Table III (ours and the paper's, the lowest of each
 /// row), the auxiliary `||(RMSE_beta, RMSE_r)||`, and the gains.
 pub fn markdown(table: &Table) -> String {
@@ -89,10 +118,7 @@ pub fn markdown(table: &Table) -> String {
     );
     let _ = writeln!(s);
     for f in table.fidelities() {
-        let _ = write!(s, "| {} | ", f.column());
-        for &c in &controllers {
-            let _ = write!(s, "{} | ", heading(c));
-        }
+        write_heading_start(&mut s, f.column(), &controllers);
         let _ = write!(s, "lowest | ");
         for &c in &paper {
             let _ = write!(s, "paper {} | ", heading(c));
@@ -102,17 +128,7 @@ pub fn markdown(table: &Table) -> String {
         for m in table.maneuvers() {
             let _ = write!(s, "| {} | ", m.name());
             let lowest = table.lowest(f, m);
-            for &c in &controllers {
-                match table.get(f, m, c) {
-                    Some(cell) if Some(c) == lowest => {
-                        let _ = write!(s, "**{}** | ", sci(cell.metric.eps));
-                    }
-                    Some(cell) => {
-                        let _ = write!(s, "{} | ", sci(cell.metric.eps));
-                    }
-                    None => s.push_str("- | "),
-                }
-            }
+            write_cells(&mut s, &controllers, lowest, |c| table.get(f, m, c).map(|cell| cell.metric.eps));
             let _ = write!(s, "{} | ", lowest.map_or("-", heading));
             let mut paper_best: Option<(Controller, f64)> = None;
             for &c in &paper {
@@ -133,10 +149,7 @@ pub fn markdown(table: &Table) -> String {
     let _ = writeln!(s, "Auxiliary: ||(RMSE_beta, RMSE_r)||_2 [rad, rad/s] (what the controllers regulate)");
     let _ = writeln!(s);
     for f in table.fidelities() {
-        let _ = write!(s, "| {} | ", f.column());
-        for &c in &controllers {
-            let _ = write!(s, "{} | ", heading(c));
-        }
+        write_heading_start(&mut s, f.column(), &controllers);
         let _ = writeln!(s, "lowest |");
         let _ = writeln!(s, "|---|{}", "---:|".repeat(controllers.len() + 1));
         for m in table.maneuvers() {
@@ -144,17 +157,7 @@ pub fn markdown(table: &Table) -> String {
             let cells: Vec<_> = controllers.iter().filter_map(|&c| table.get(f, m, c)).collect();
             let lowest =
                 cells.iter().min_by(|a, b| a.metric.eps_state.total_cmp(&b.metric.eps_state)).map(|c| c.controller);
-            for &c in &controllers {
-                match table.get(f, m, c) {
-                    Some(cell) if Some(c) == lowest => {
-                        let _ = write!(s, "**{}** | ", sci(cell.metric.eps_state));
-                    }
-                    Some(cell) => {
-                        let _ = write!(s, "{} | ", sci(cell.metric.eps_state));
-                    }
-                    None => s.push_str("- | "),
-                }
-            }
+            write_cells(&mut s, &controllers, lowest, |c| table.get(f, m, c).map(|cell| cell.metric.eps_state));
             let _ = writeln!(s, "{} |", lowest.map_or("-", heading));
         }
         let _ = writeln!(s);

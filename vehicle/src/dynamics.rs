@@ -30,47 +30,29 @@ pub trait ParamsOf<T: Scalar> {
     fn switches(&self) -> (bool, bool, bool);
 }
 
+/// The accessors of [`ParamsOf`] that read one field of the same name (`c` one element
+/// of it), each value passed through `$as_scalar` (a closure: `T::constant` for
+/// [`VehicleParams`], the identity for [`ParamScalars`]).
+macro_rules! scalar_parameters {
+    ($as_scalar:expr) => {
+        scalar_parameters!($as_scalar; m, i_z, r_wheel, v_fade, delta_max, servo_time_constant, servo_rate_max, wheel_speed_max, motor_taper);
+        #[inline(always)]
+        fn c(&self, i: usize) -> T {
+            ($as_scalar)(self.c[i])
+        }
+    };
+    ($as_scalar:expr; $($name:ident),*) => {
+        $(
+            #[inline(always)]
+            fn $name(&self) -> T {
+                ($as_scalar)(self.$name)
+            }
+        )*
+    };
+}
+
 impl<T: Scalar> ParamsOf<T> for VehicleParams {
-    #[inline(always)]
-    fn m(&self) -> T {
-        T::constant(self.m)
-    }
-    #[inline(always)]
-    fn i_z(&self) -> T {
-        T::constant(self.i_z)
-    }
-    #[inline(always)]
-    fn r_wheel(&self) -> T {
-        T::constant(self.r_wheel)
-    }
-    #[inline(always)]
-    fn c(&self, i: usize) -> T {
-        T::constant(self.c[i])
-    }
-    #[inline(always)]
-    fn v_fade(&self) -> T {
-        T::constant(self.v_fade)
-    }
-    #[inline(always)]
-    fn delta_max(&self) -> T {
-        T::constant(self.delta_max)
-    }
-    #[inline(always)]
-    fn servo_time_constant(&self) -> T {
-        T::constant(self.servo_time_constant)
-    }
-    #[inline(always)]
-    fn servo_rate_max(&self) -> T {
-        T::constant(self.servo_rate_max)
-    }
-    #[inline(always)]
-    fn wheel_speed_max(&self) -> T {
-        T::constant(self.wheel_speed_max)
-    }
-    #[inline(always)]
-    fn motor_taper(&self) -> T {
-        T::constant(self.motor_taper)
-    }
+    scalar_parameters!(|x| T::constant(x));
     #[inline(always)]
     fn wheel_positions(&self) -> [(T, T); 4] {
         VehicleParams::wheel_positions(self).map(|(x, y)| (T::constant(x), T::constant(y)))
@@ -140,36 +122,7 @@ impl<T: Scalar> ParamScalars<T> {
 }
 
 impl<T: Scalar> ParamsOf<T> for ParamScalars<T> {
-    fn m(&self) -> T {
-        self.m
-    }
-    fn i_z(&self) -> T {
-        self.i_z
-    }
-    fn r_wheel(&self) -> T {
-        self.r_wheel
-    }
-    fn c(&self, i: usize) -> T {
-        self.c[i]
-    }
-    fn v_fade(&self) -> T {
-        self.v_fade
-    }
-    fn delta_max(&self) -> T {
-        self.delta_max
-    }
-    fn servo_time_constant(&self) -> T {
-        self.servo_time_constant
-    }
-    fn servo_rate_max(&self) -> T {
-        self.servo_rate_max
-    }
-    fn wheel_speed_max(&self) -> T {
-        self.wheel_speed_max
-    }
-    fn motor_taper(&self) -> T {
-        self.motor_taper
-    }
+    scalar_parameters!(|x| x);
     fn wheel_positions(&self) -> [(T, T); 4] {
         let h = self.track * 0.5;
         [(self.l_f, h), (self.l_f, -h), (-self.l_r, h), (-self.l_r, -h)]

@@ -69,6 +69,15 @@ impl fmt::Display for ParamError {
 
 impl std::error::Error for ParamError {}
 
+/// `Ok` when `valid`, else the refusal of parameter `name` = `value` for `reason`.
+fn refuse_unless(valid: bool, name: &'static str, value: f64, reason: &'static str) -> Result<(), ParamError> {
+    if valid {
+        Ok(())
+    } else {
+        Err(ParamError { name, value, reason })
+    }
+}
+
 impl VehicleParams {
     /// Table II of the paper, paper fidelity (all "real" options off).
     pub fn table2() -> Self {
@@ -137,40 +146,23 @@ impl VehicleParams {
                 return Err(ParamError { name, value, reason: "cornering stiffness must be >= 0" });
             }
         }
-        if !(self.delta_max.is_finite() && self.delta_max > 0.0 && self.delta_max <= core::f64::consts::FRAC_PI_2) {
-            return Err(ParamError { name: "delta_max", value: self.delta_max, reason: "must be in (0, pi/2]" });
-        }
+        let delta_max = self.delta_max;
+        let in_range = delta_max.is_finite() && delta_max > 0.0 && delta_max <= core::f64::consts::FRAC_PI_2;
+        refuse_unless(in_range, "delta_max", delta_max, "must be in (0, pi/2]")?;
         if self.steering_servo {
-            if !(self.servo_time_constant.is_finite() && self.servo_time_constant > 0.0) {
-                return Err(ParamError {
-                    name: "servo_time_constant",
-                    value: self.servo_time_constant,
-                    reason: "must be > 0 when the steering servo is on",
-                });
-            }
-            if !(self.servo_rate_max > 0.0) || self.servo_rate_max.is_nan() {
-                return Err(ParamError {
-                    name: "servo_rate_max",
-                    value: self.servo_rate_max,
-                    reason: "must be > 0 when the steering servo is on",
-                });
-            }
+            const WHY: &str = "must be > 0 when the steering servo is on";
+            let time_constant = self.servo_time_constant;
+            refuse_unless(time_constant.is_finite() && time_constant > 0.0, "servo_time_constant", time_constant, WHY)?;
+            // An infinite rate limit is no limit: only values <= 0 and NaN (never > 0) are refused.
+            let rate = self.servo_rate_max;
+            refuse_unless(rate > 0.0, "servo_rate_max", rate, WHY)?;
         }
         if self.motor_speed_limit {
-            if !(self.wheel_speed_max.is_finite() && self.wheel_speed_max > 0.0) {
-                return Err(ParamError {
-                    name: "wheel_speed_max",
-                    value: self.wheel_speed_max,
-                    reason: "must be > 0 when the motor speed limit is on",
-                });
-            }
-            if !(self.motor_taper.is_finite() && self.motor_taper > 0.0) {
-                return Err(ParamError {
-                    name: "motor_taper",
-                    value: self.motor_taper,
-                    reason: "must be > 0 when the motor speed limit is on",
-                });
-            }
+            const WHY: &str = "must be > 0 when the motor speed limit is on";
+            let speed = self.wheel_speed_max;
+            refuse_unless(speed.is_finite() && speed > 0.0, "wheel_speed_max", speed, WHY)?;
+            let taper = self.motor_taper;
+            refuse_unless(taper.is_finite() && taper > 0.0, "motor_taper", taper, WHY)?;
         }
         Ok(())
     }

@@ -1,8 +1,10 @@
 //! `cosim`: run an FMU or a system of FMUs, or list what is in one.
 
 use clap::{Parser, Subcommand};
-use nigel_cosim::defaults::{GivenTimes, RunTimes};
-use nigel_cosim::{Error, Experiment, Fmu, ImportOptions, Interface, System, SystemBuilder, UnpackLimits};
+use nigel_cosim::defaults::GivenTimes;
+use nigel_cosim::options::{cli_option_name, RunOptions};
+use nigel_cosim::run_setup::{run_in_process, InProcess, RunSetup, SINGLE};
+use nigel_cosim::{Error, ImportOptions, Interface, System, UnpackLimits};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -153,16 +155,17 @@ struct RunArgs {
     /// (outputs along the direct-feedthrough chains within the step: how Table III is defined).
     #[arg(long, default_value = "jacobi")]
     algorithm: String,
-    /// Model Exchange solver: rk4, dopri5, or bdf (stiff models: variable-order BDF with the
+    /// Model Exchange solver: auto (RK4 that continues with bdf from the first step it finds
+    /// stiff, with a note), rk4, dopri5, or bdf (stiff models: variable-order BDF with the
     /// FMU's Jacobian).
-    #[arg(long, default_value = "rk4")]
+    #[arg(long, default_value = "auto")]
     solver: String,
-    /// Relative tolerance of dopri5 and bdf (absolute: rtol / 100; default 1e-6), and the
+    /// Relative tolerance of dopri5 and bdf (and auto's bdf; absolute: rtol / 100; default 1e-6), and the
     /// one told to Co-Simulation FMUs for their own solvers (default: each FMU's
     /// DefaultExperiment tolerance, as fmpy does).
     #[arg(long)]
     rtol: Option<f64>,
-    /// Largest RK4 step, s (default: the communication step).
+    /// Largest RK4 step (rk4, auto), s (default: the communication step).
     #[arg(long)]
     max_step: Option<f64>,
     /// The cap on the steps of a run (communication steps, and the Model Exchange
@@ -302,18 +305,6 @@ fn main() -> ExitCode {
     }
 }
 
-const SINGLE: &str = "model";
-
-/// The system name of `name`: for a single FMU its variable (an exact variable name wins,
-/// so a variable called `model.beta` is not read as `beta` of the instance), else as given.
-fn qualify(name: &str, single: Option<&Fmu>) -> String {
-    match single {
-        Some(fmu) if fmu.description().variable(name).is_some() => format!("{SINGLE}.{name}"),
-        Some(_) if !name.starts_with(&format!("{SINGLE}.")) => format!("{SINGLE}.{name}"),
-        _ => name.to_string(),
-    }
-}
-
 fn progress(fraction: f64) {
     use std::sync::atomic::{AtomicU64, Ordering};
     static LAST: AtomicU64 = AtomicU64::new(u64::MAX);
@@ -344,17 +335,8 @@ fn custom_gain_settings(path: &Path) -> Result<Vec<(String, String)>, Error> {
 
 fn run(args: RunArgs) -> Result<bool, Failure> {
     let started = std::time::Instant::now();
-    let interface = match args.interface.as_deref() {
-        None => None,
-        Some("cs") => Some(Interface::CoSimulation),
-        Some("me") => Some(Interface::ModelExchange),
-        Some("se") => Some(Interface::ScheduledExecution),
-        Some(other) => return Err(Error::Experiment(format!("unknown interface {other:?} (cs, me, se)")).into()),
-    };
-    let format = match &args.output {
-        None => None,
-        Some(p) => Some(OutputFormat::of(p)?),
-    };
+    let interface = args.interface.as_deref().map(str::parse::<Interface>).transpose().map_err(Error::Experiment)?;
+    let format = args.output.as_deref().map(OutputFormat::of).transpose()?;
     let limits = args.limits.limits();
     // isolation needs Linux's shared memory and futexes: elsewhere refused before anything loads
     if let (Some(_), Some(why)) = (args.isolate, nigel_cosim::isolate::os::unsupported()) {
@@ -364,71 +346,51 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     let host_of_run = nigel_cosim::isolate::whole::is_host();
     let isolated = args.isolate.is_some() && !host_of_run;
     let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated };
-    let (mut builder, default, single, _ssp) = if nigel_cosim::info::is_ssp(&args.model) {
-        // --interface applies to every FMU of the system (one without it is refused by name)
-        let ssp = nigel_cosim::read_ssp(&args.model, &options)?;
-        if !host_of_run {
-            for note in &ssp.notes {
-                eprintln!("cosim: note: {note}");
-            }
+    // --interface applies to every FMU of a system (one without it is refused by name)
+    let mut setup = RunSetup::load(&args.model, &options)?;
+    if !host_of_run {
+        for note in setup.notes() {
+            eprintln!("cosim: note: {note}");
         }
-        let builder = SystemBuilder::from_system(ssp.system.clone());
-        let (start_time, stop_time) = ssp.default_start_stop;
-        let default = model_description::DefaultExperiment { start_time, stop_time, ..Default::default() };
-        (builder, default, None, Some(ssp))
-    } else {
-        let fmu = Fmu::load_with(&args.model, &options).map_err(Error::from)?;
-        let default = fmu.description().default_experiment.clone().unwrap_or_default();
-        let mut builder = SystemBuilder::new();
-        builder.add_instance(SINGLE, fmu.clone())?;
-        (builder, default, Some(fmu), None)
-    };
-    let single = single.as_deref();
+    }
     if let Some(path) = &args.gains {
         for (name, value) in custom_gain_settings(path)? {
-            builder.set_text(&name, &value)?;
+            setup.set_system_name(&name, &value)?;
         }
     }
     for s in &args.set {
         let (name, value) =
             s.split_once('=').ok_or_else(|| Error::Experiment(format!("--set {s:?}: expected NAME=VALUE")))?;
-        builder.set_text(&qualify(name.trim(), single), value)?;
+        setup.set(name.trim(), value)?;
     }
-    let mut timed_sets = Vec::new();
     for pair in args.set_at.chunks(2) {
         let [time, setting] = pair else { unreachable!("clap gives --set-at two values") };
-        let bad = |why: &str| Error::Experiment(format!("--set-at {time} {setting}: {why}"));
+        let label = format!("--set-at {time} {setting}");
+        let bad = |why: &str| Error::Experiment(format!("{label}: {why}"));
         let time: f64 =
             time.trim().parse().ok().filter(|t: &f64| t.is_finite()).ok_or_else(|| bad("TIME is no number"))?;
         let (name, text) = setting.split_once('=').ok_or_else(|| bad("expected NAME=VALUE"))?;
-        let name = qualify(name.trim(), single);
-        if builder.system().resolve(&name).is_ok_and(|r| builder.system().is_structural(&r)) {
-            let value: f64 = text.trim().parse().map_err(|_| bad("a structural parameter's value is a number"))?;
-            builder.size_for(&name, value)?;
-        }
-        timed_sets.push(nigel_cosim::simulate::TimedSet { time, name, text: text.to_string() });
+        setup.set_at(time, name.trim(), text, &label)?;
     }
-    if args.isolate.is_some() && nigel_cosim::simulate::is_scheduled(builder.system()) {
+    if args.isolate.is_some() && nigel_cosim::simulate::is_scheduled(setup.system()) {
         return Err(Error::Experiment(nigel_cosim::simulate::SCHEDULED_NOT_ISOLATED.into()).into());
     }
-    if !timed_sets.is_empty() && (args.isolate.is_some() || nigel_cosim::simulate::is_scheduled(builder.system())) {
+    if !setup.timed_sets().is_empty() && (args.isolate.is_some() || nigel_cosim::simulate::is_scheduled(setup.system()))
+    {
         return Err(Error::Experiment(
             "--set-at is run in process by the stepping master (not with --isolate, not in Scheduled Execution)".into(),
         )
         .into());
     }
-    let system: System = builder.build();
-    // the start time is --start-time's, else an SSD's DefaultExperiment's (SSP 1.0 gives
-    // only start and stop), else 0: not an FMU's DefaultExperiment's
-    let start_time = args.start_time.or(if single.is_none() { default.start_time } else { None }).unwrap_or(0.0);
     let given = GivenTimes {
-        start_time: Some(start_time),
+        start_time: args.start_time,
         stop_time: args.stop_time,
         step_size: args.step,
         ..Default::default()
     };
-    let times = RunTimes::master(&default, &given);
-    let mut experiment = nigel_cosim::options::RunOptions {
+    let times = setup.times(&given);
+    let prepared = setup.build();
+    let run_options = RunOptions {
         start_time: times.start_time,
         stop_time: times.stop_time,
         step: times.step,
@@ -440,33 +402,16 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
         max_step: args.max_step,
         timeout: args.timeout,
         threads: args.threads,
-    }
-    .experiment(nigel_cosim::options::cli_option_name)?;
-    check_times(&experiment)?;
+    };
+    let mut experiment = prepared.experiment(&run_options, cli_option_name)?;
+    let system = &prepared.system;
     if !host_of_run {
-        for warning in nigel_cosim::sample_period::warnings(&system, experiment.step) {
+        for warning in nigel_cosim::sample_period::warnings(system, experiment.step) {
             eprintln!("cosim: warning: {warning} (use --step {})", warning.period);
         }
         // what an FMI 3.0 FMU has and the results will not: said, not silently dropped
-        for instance in &system.instances {
-            if let Some(version) = instance.fmu.fmi3_description().map(|md| md.fmi_version.as_str()) {
-                if version != "3.0" && !version.starts_with("3.0.") {
-                    eprintln!(
-                        "cosim: note: {} declares fmiVersion \"{version}\": run as FMI 3.0 (what a later version adds is unknown to cosim)",
-                        instance.name
-                    );
-                }
-            }
-            // clocks are run and their ticks counted in the summary, not recorded as columns
-            for (name, why) in
-                instance.fmu.not_in_view().iter().filter(|(_, why)| *why != nigel_cosim::fmi3::LeftOut::Clock)
-            {
-                eprintln!(
-                    "cosim: note: {}.{name} is {}: not recorded (outside the master's view)",
-                    instance.name,
-                    why.as_str()
-                );
-            }
+        for note in prepared.view_notes() {
+            eprintln!("cosim: note: {note}");
         }
     }
 
@@ -496,105 +441,50 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
             host: None,
         });
     }
-    if args.record.is_empty() && nigel_cosim::simulate::default_record(&system).is_empty() {
-        // every output left out of the master's view: a result of the time column alone
-        // is not what was asked for
-        let output = |fmu: &Fmu, name: &str| {
-            fmu.fmi3_description()
-                .and_then(|md| md.variable_by_name(name))
-                .is_some_and(|v| v.causality == model_description::fmi3::Causality::Output)
-        };
-        let left_out: Vec<String> = system
-            .instances
-            .iter()
-            .flat_map(|i| {
-                i.fmu
-                    .not_in_view()
-                    .iter()
-                    .filter(|(name, _)| output(&i.fmu, name))
-                    .map(move |(name, why)| format!("{}.{name} ({})", i.name, why.as_str()))
-            })
-            .collect();
-        if !left_out.is_empty() {
-            return Err(Error::Experiment(format!(
-                "no output of the system can be recorded: {} (name variables to record with --record)",
-                left_out.join(", ")
-            ))
-            .into());
-        }
+    if args.record.is_empty() {
+        prepared.check_recordable("--record")?;
     }
     let verification = verification(&args.verify)?;
-    // the results' column of a system variable (a one-instance system's columns are bare)
-    let column = |name: &str| -> String {
-        match single {
-            Some(_) => name.strip_prefix(&format!("{SINGLE}.")).unwrap_or(name).to_string(),
-            None => name.to_string(),
-        }
-    };
-    let asked: Vec<String> = if args.record.is_empty() {
-        nigel_cosim::simulate::default_record(&system).iter().map(|r| system.name_of(r)).collect()
-    } else {
-        args.record.iter().map(|r| qualify(r, single)).collect()
-    };
     // what the checks and the baseline read is recorded too, and left out of --output
-    let mut record = asked.clone();
-    for c in &verification.checks {
-        for v in c.variables() {
-            let q = qualify(&v, single);
-            system.resolve(&q).map_err(|e| Failure::Message(format!("--check {:?}: {e}", c.text)))?;
-            if !record.contains(&q) {
-                record.push(q);
-            }
-        }
-    }
-    for name in verification.columns() {
-        // a baseline column that is no variable of the system is reported missing
-        let q = qualify(&name, single);
-        if system.resolve(&q).is_ok() && !record.contains(&q) {
-            record.push(q);
-        }
-    }
-    let extra = record.len() > asked.len();
+    let checks: Vec<(String, Vec<String>)> =
+        verification.checks.iter().map(|c| (format!("--check {:?}", c.text), c.variables())).collect();
+    let columns = prepared.columns(&args.record, &checks, &verification.columns()).map_err(Failure::Message)?;
+    let extra = columns.extra();
     if !args.record.is_empty() || extra {
-        experiment.record = Some(record);
+        experiment.record = Some(columns.record.clone());
     }
     // Err(None): the run failed in the host of --isolate=run, which said why itself
     let mut host_json = None;
     let (results, outcome): (_, Result<_, Option<Error>>) = match args.isolate {
         Some(IsolateMode::Run) if host_of_run => {
-            nigel_cosim::isolate::whole::host_simulate(&system, &experiment)?;
+            nigel_cosim::isolate::whole::host_simulate(system, &experiment)?;
             return Ok(true);
         }
         Some(IsolateMode::Run) => {
             let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
-            let run = nigel_cosim::isolate::whole::simulate_in_host(&system, &experiment, &argv)?;
+            let run = nigel_cosim::isolate::whole::simulate_in_host(system, &experiment, &argv)?;
             let outcome = run.outcome.map(|(summary, json)| {
                 host_json = Some(json);
                 summary
             });
             (run.results, outcome)
         }
-        _ if nigel_cosim::simulate::is_scheduled(&system) => {
-            let (results, outcome) = nigel_cosim::simulate::simulate_scheduled(&system, &experiment);
-            (results, outcome.map_err(Some))
-        }
         _ => {
-            report_exit_inside_calls(args.output.clone(), format, &system);
-            // in process, a call that never returns is stopped by ending the process
-            let _watchdog = experiment.timeout.filter(|_| args.isolate.is_none()).map(nigel_cosim::watchdog::start);
-            match nigel_cosim::simulate::Execution::new(&system, &experiment) {
-                Ok(mut execution) => {
-                    if std::io::stderr().is_terminal() {
-                        execution.on_progress(progress);
-                    }
-                    if let Some(flag) = STOP.get().cloned() {
-                        execution.cancel_on(flag);
-                    }
-                    let outcome = nigel_cosim::simulate::run_to_end_with(&mut execution, &timed_sets);
-                    (execution.take_results(), outcome.map_err(Some))
-                }
-                Err(e) => (nigel_cosim::Results::default(), Err(Some(e))),
+            // in process, an exit() inside a call is reported, and a call that never returns
+            // is stopped by ending the process (a run in Scheduled Execution watches itself)
+            let scheduled = prepared.is_scheduled();
+            if !scheduled {
+                report_exit_inside_calls(args.output.clone(), format, system);
             }
+            let _watchdog =
+                experiment.timeout.filter(|_| args.isolate.is_none() && !scheduled).map(nigel_cosim::watchdog::start);
+            let watch = InProcess {
+                pool: None,
+                cancel: STOP.get().cloned(),
+                progress: std::io::stderr().is_terminal().then_some(progress as fn(f64)),
+            };
+            let (results, outcome) = run_in_process(system, &experiment, &prepared.timed_sets, watch);
+            (results, outcome.map_err(Some))
         }
     };
     if outcome.is_ok() && args.output.is_none() && args.summary.is_none() && verification.is_empty() {
@@ -611,12 +501,12 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     // the rows recorded so far are written also when the run failed
     if let (Some(path), Some(format)) = (&args.output, format) {
         if outcome.is_ok() || results.rows() > 0 {
-            let asked_columns: Vec<String> = asked.iter().map(|n| column(n)).collect();
+            let asked_columns: Vec<String> = columns.asked.iter().map(|n| prepared.column(n)).collect();
             let kept = if extra { results.select(&asked_columns) } else { results.clone() };
             match format {
                 OutputFormat::Csv => write(path, &|f| kept.write_csv(std::io::BufWriter::new(f)))?,
                 OutputFormat::Mat => {
-                    let descriptions = column_descriptions(&system, &kept);
+                    let descriptions = column_descriptions(system, &kept);
                     write(path, &|f| kept.write_mat(std::io::BufWriter::new(f), &descriptions))?
                 }
             }
@@ -674,7 +564,7 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     if verification.is_empty() && args.verify.report.junit.is_none() && args.verify.report.summary_md.is_none() {
         return Ok(true);
     }
-    let judged = verification.judge(&results, |v| column(&qualify(v, single))).map_err(Failure::Message)?;
+    let judged = verification.judge(&results, |v| prepared.column(&prepared.qualify(v))).map_err(Failure::Message)?;
     let to_stderr = args.summary.as_ref().is_some_and(|p| p.as_os_str() == "-");
     for line in judged.lines() {
         if to_stderr {
@@ -828,24 +718,6 @@ fn column_descriptions(system: &System, results: &nigel_cosim::Results) -> Vec<S
             system.resolve(&full).ok().and_then(|r| system.variable(&r).description.clone()).unwrap_or_default()
         })
         .collect()
-}
-
-/// Times a run cannot mean: refused before anything is loaded into an FMU.
-fn check_times(e: &Experiment) -> Result<(), Error> {
-    let span = e.stop_time - e.start_time;
-    if span.is_nan() || span <= 0.0 {
-        return Err(Error::Experiment(format!(
-            "the stop time {} s must be after the start time {} s (--stop-time, --start-time)",
-            e.stop_time, e.start_time
-        )));
-    }
-    if e.step > span {
-        return Err(Error::Experiment(format!(
-            "the step {} s is longer than the run ({span} s from {} to {} s): choose a --step of at most {span}",
-            e.step, e.start_time, e.stop_time
-        )));
-    }
-    Ok(())
 }
 
 /// `cosim info`: [`nigel_cosim::info::describe`] on standard output; a closed pipe

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 
 static FONT: &[u8] = include_bytes!("../../../table3/assets/DejaVuSans.ttf");
 
-fn register_font() -> Result<(), String> {
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif` (once per process), so that
+/// the figures look the same on every machine.
+pub fn register_font() -> Result<(), String> {
     static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     if *DONE.get_or_init(|| plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()) {
         Ok(())
@@ -72,12 +74,17 @@ pub fn plot_failures(
 
 /// Tick label: 4 significant digits without trailing zeros, `1.5e-9` outside 1e-3 .. 1e5.
 fn tick(v: &f64) -> String {
-    let v = *v;
+    tick_label(*v, 1e-3)
+}
+
+/// A tick label: up to 4 significant digits without trailing zeros (`0.001`, `10`, `2.5`),
+/// magnitudes outside `plain_from` .. 1e5 as `1.5e-9`; never `-0`.
+pub fn tick_label(v: f64, plain_from: f64) -> String {
     if v == 0.0 {
         return "0".into();
     }
     let a = v.abs();
-    if !(1e-3..1e5).contains(&a) {
+    if !(plain_from..1e5).contains(&a) {
         let s = format!("{v:.3e}");
         let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
         let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
@@ -100,6 +107,20 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
     let pad = if hi > lo { 0.04 * (hi - lo) } else { 0.5 * lo.abs().max(1e-3) };
     (lo - pad, hi + pad)
+}
+
+type Axis = plotters::coord::types::RangedCoordf64;
+/// A chart of f64 over f64.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Axis, Axis>>;
+
+/// A chart on `area` over `x` (time) and `y`, with `x_label_area` pixels below for the time
+/// axis' labels and 90 at the left for the values' (the two charts' y axes line up).
+fn chart_on<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    x_label_area: u32,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    ChartBuilder::on(area).margin(12).x_label_area_size(x_label_area).y_label_area_size(90).build_cartesian_2d(x, y)
 }
 
 fn draw(
@@ -143,11 +164,7 @@ fn draw(
     );
     let root = root.titled(&title, ("sans-serif", 20))?;
     let (upper, lower) = root.split_vertically(430);
-    let mut chart = ChartBuilder::on(&upper)
-        .margin(12)
-        .x_label_area_size(30)
-        .y_label_area_size(90)
-        .build_cartesian_2d(t0..t1, v0..v1)?;
+    let mut chart = chart_on(&upper, 30, (t0..t1, v0..v1))?;
     chart
         .configure_mesh()
         .y_desc(s.name.as_str())
@@ -194,11 +211,7 @@ fn draw(
         .position(SeriesLabelPosition::UpperLeft)
         .draw()?;
     // below: the same relative to the baseline, where a tube too thin to see above shows
-    let mut chart = ChartBuilder::on(&lower)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(90)
-        .build_cartesian_2d(t0..t1, d0..d1)?;
+    let mut chart = chart_on(&lower, 40, (t0..t1, d0..d1))?;
     chart
         .configure_mesh()
         .x_desc("time, s")

@@ -7,13 +7,15 @@
 //! state events on the dense output.
 //!
 //! Implemented by [`rk4::Rk4`] (fixed step, cubic Hermite dense output),
-//! [`dopri5::Dopri5`] (Dormand-Prince 5(4), its 4th-order continuous extension) and
+//! [`dopri5::Dopri5`] (Dormand-Prince 5(4), its 4th-order continuous extension),
 //! [`crate::bdf::Bdf`] (variable-order NDF, the interpolating polynomial of its
-//! differences). A new method is a file of its own here implementing [`Integrator`] and a
+//! differences) and [`switching::Switching`] (the default: RK4 testing each step for
+//! stiffness, bdf from the first stiff step on). A new method is a file of its own here implementing [`Integrator`] and a
 //! variant of [`crate::me::Solver`] that makes it ([`crate::me::Solver::integrator`]).
 
 pub mod dopri5;
 pub mod rk4;
+pub mod switching;
 
 use crate::error::Result;
 use nalgebra::DMatrix;
@@ -104,6 +106,17 @@ pub trait Integrator: std::fmt::Debug + Send {
 
     /// The work done so far.
     fn work(&self) -> Work;
+
+    /// The step where a method that changes itself found the system stiff and switched,
+    /// once, for the master's note ([`switching::Switching`]; the others never switch).
+    fn take_switch(&mut self) -> Option<rk4::StiffStep> {
+        None
+    }
+
+    /// Whether it has switched to bdf (its work is then reported as bdf's).
+    fn switched(&self) -> bool {
+        false
+    }
 }
 
 /// What the one-step methods share: the step from (t_old, x0) to (t, x), and the

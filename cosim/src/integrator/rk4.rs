@@ -7,11 +7,38 @@
 //! integrates exactly, and it is continuous with its derivative across steps, so that a
 //! crossing at a step's end is found once. It costs one derivative at the step's end,
 //! evaluated only for a step with an event to locate.
+//!
+//! Its stiffness test (for the default solver, [`super::switching`]) observes each step's
+//! stages: stages 2 and 3 are both at t + h/2, at the states Y2 = x0 + h/2 k1 and
+//! Y3 = x0 + h/2 k2, so |k3 - k2| / |Y3 - Y2| estimates the largest eigenvalue's modulus
+//! rho of the Jacobian (Hairer and Wanner, Solving ODEs II, IV.2, the test of DOPRI5 on its
+//! last two stages, which share their time as these do), and h rho = 2 |k3 - k2| / |k2 - k1|.
+//! Classical RK4 is stable on the negative real axis for h rho up to 2.785 (on the
+//! imaginary axis 2.83); a fixed step has no step control to bring it back inside, so a step
+//! beyond [`STIFF_H_RHO`] is not taken: the method stops at its start and says so
+//! ([`Rk4::take_stiff`]).
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
 use super::{Integrator, OdeSystem, Start, Stretch, Work};
 use crate::error::Result;
+
+/// The h rho above which a step is stiff: beyond RK4's stability interval on the negative
+/// real axis (2.785), where the step's amplification of the stiff component
+/// |1 + z + z^2/2 + z^3/6 + z^4/24| at z = -3 is 1.375 and grows as z^4/24 from there (a
+/// margin over the bound: the estimate of rho is the quotient along one direction).
+pub const STIFF_H_RHO: f64 = 3.0;
+
+/// A step found stiff, not taken.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StiffStep {
+    /// Its start, s (where the method stopped).
+    pub t: f64,
+    /// Its size, s.
+    pub h: f64,
+    /// Its estimate of h rho.
+    pub h_rho: f64,
+}
 
 /// The RK4 integrator of `n` states.
 #[derive(Debug)]
@@ -24,6 +51,10 @@ pub struct Rk4 {
     /// f(t, x) at the end of the last step (when [`Rk4::prepare_dense_output`] made it).
     f1: Vec<f64>,
     work: Work,
+    /// Whether each step's stages are tested for stiffness (the default solver).
+    stiffness_test: bool,
+    /// The step found stiff, not taken.
+    stiff: Option<StiffStep>,
 }
 
 impl Rk4 {
@@ -37,8 +68,37 @@ impl Rk4 {
             k: std::array::from_fn(|_| vec![0.0; n]),
             f1: vec![0.0; n],
             work: Work::default(),
+            stiffness_test: false,
+            stiff: None,
         }
     }
+
+    /// The method testing each step for stiffness: a step whose h rho exceeds
+    /// [`STIFF_H_RHO`] stops the method at the step's start (its time and states unchanged)
+    /// and is reported by [`Rk4::take_stiff`]. The test only observes the stages: the steps
+    /// it passes are those of [`Rk4::new`] to the bit.
+    pub fn testing_stiffness(n: usize, max_step: Option<f64>) -> Rk4 {
+        Rk4 { stiffness_test: true, ..Rk4::new(n, max_step) }
+    }
+
+    /// The step found stiff since the last call, if any.
+    pub fn take_stiff(&mut self) -> Option<StiffStep> {
+        self.stiff.take()
+    }
+}
+
+/// h rho of an RK4 step from its first three stages: 2 |k3 - k2| / |k2 - k1| (Euclidean
+/// norms); 0 where k2 = k1 (the states of stages 2 and 3 coincide: no direction to measure).
+fn h_rho(k1: &[f64], k2: &[f64], k3: &[f64]) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for j in 0..k1.len() {
+        num += (k3[j] - k2[j]) * (k3[j] - k2[j]);
+        den += (k2[j] - k1[j]) * (k2[j] - k1[j]);
+    }
+    if den == 0.0 {
+        return 0.0;
+    }
+    2.0 * (num / den).sqrt()
 }
 
 impl Integrator for Rk4 {
@@ -69,6 +129,15 @@ impl Integrator for Rk4 {
             self.xt[j] = x0[j] + 0.5 * h * k2[j];
         }
         sys.rhs(t + 0.5 * h, &self.xt, k3)?;
+        if self.stiffness_test {
+            let h_rho = h_rho(k1, k2, k3);
+            // NaN (infinite stages) is stiff too: the step cannot be taken
+            if h_rho.is_nan() || h_rho > STIFF_H_RHO {
+                self.work.rhs += 3;
+                self.stiff = Some(StiffStep { t, h, h_rho });
+                return Ok(());
+            }
+        }
         for j in 0..n {
             self.xt[j] = x0[j] + h * k3[j];
         }

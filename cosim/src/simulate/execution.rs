@@ -615,26 +615,7 @@ impl<'s> Execution<'s> {
     pub fn get(&mut self, name: &str) -> Result<Value> {
         let r = self.system.resolve(name)?;
         let Some(core) = self.core.as_mut() else { return Err(not_running(self.phase)) };
-        let inst = &mut core.lanes[r.instance].inst;
-        let vr = [r.value_reference];
-        Ok(match r.base_type {
-            BaseType::Real => {
-                let mut v = [0.0];
-                inst.get_real(&vr, &mut v)?;
-                Value::Real(v[0])
-            }
-            BaseType::Integer => {
-                let mut v = [0];
-                inst.get_integer(&vr, &mut v)?;
-                Value::Integer(v[0])
-            }
-            BaseType::Boolean => {
-                let mut v = [0];
-                inst.get_boolean(&vr, &mut v)?;
-                Value::Boolean(v[0] != 0)
-            }
-            BaseType::String => Value::String(inst.get_string(r.value_reference)?),
-        })
+        crate::simulate::lane::get_value(&mut core.lanes[r.instance].inst, &r)
     }
 
     /// The last row recorded (time first), unless the rows go to a sink.
@@ -847,41 +828,42 @@ pub(crate) const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
 
 /// Refuses integrator settings that cannot progress: an RK4 `max_step` so small that the
 /// run's internal steps would exceed its cap (or below the resolution of its times), a
-/// `dopri5` tolerance no f64 step can meet.
+/// `dopri5` or `bdf` tolerance no f64 step can meet (for `auto`, those of its rk4 and bdf).
 fn check_solver(e: &Experiment, clock: &Clock, system: &System) -> Result<()> {
     if !system.instances.iter().any(|i| i.fmu.interface() == Interface::ModelExchange) {
         return Ok(());
     }
-    match e.solver {
-        Solver::Rk4 { max_step: Some(m) } => {
-            let resolution = 2.0 * crate::simulate::clock::ulp(clock.t0.abs().max(clock.stop.abs()));
-            if !(m.is_finite() && m > 0.0) || m < resolution {
-                return Err(Error::Experiment(format!(
-                    "the largest RK4 step {m:e} s must be finite and above the resolution of the run's times ({resolution:e} s)"
-                )));
-            }
-            let per_step = (clock.h / m).ceil().max(1.0);
-            let total = per_step * clock.steps as f64;
-            if total > e.max_steps as f64 {
-                return Err(Error::Experiment(format!(
-                    "the largest RK4 step {m:e} s makes {total:e} internal steps ({per_step:e} per communication step of {} s), over the cap of {} steps of a run (Experiment::max_steps, --max-steps)",
-                    clock.h, e.max_steps
-                )));
-            }
+    // auto: its rk4's largest step and its bdf's tolerances
+    let (max_step, tolerances) = match e.solver {
+        Solver::Auto { max_step, rtol, atol } => (max_step, Some(("bdf", rtol, atol))),
+        Solver::Rk4 { max_step } => (max_step, None),
+        Solver::Dopri5 { rtol, atol } => (None, Some(("dopri5", rtol, atol))),
+        Solver::Bdf { rtol, atol } => (None, Some(("bdf", rtol, atol))),
+    };
+    if let Some(m) = max_step {
+        let resolution = 2.0 * crate::simulate::clock::ulp(clock.t0.abs().max(clock.stop.abs()));
+        if !(m.is_finite() && m > 0.0) || m < resolution {
+            return Err(Error::Experiment(format!(
+                "the largest RK4 step {m:e} s must be finite and above the resolution of the run's times ({resolution:e} s)"
+            )));
         }
-        Solver::Rk4 { max_step: None } => {}
-        Solver::Dopri5 { rtol, atol } | Solver::Bdf { rtol, atol } => {
-            let name = if matches!(e.solver, Solver::Bdf { .. }) { "bdf" } else { "dopri5" };
-            if !(rtol.is_finite() && rtol >= MIN_RTOL) {
-                return Err(Error::Experiment(format!(
-                    "the {name} relative tolerance {rtol:e} is below {MIN_RTOL:e} (100 machine epsilons), which no f64 step can meet"
-                )));
-            }
-            if !(atol.is_finite() && atol >= 0.0) {
-                return Err(Error::Experiment(format!(
-                    "the {name} absolute tolerance {atol:e} must be finite and >= 0"
-                )));
-            }
+        let per_step = (clock.h / m).ceil().max(1.0);
+        let total = per_step * clock.steps as f64;
+        if total > e.max_steps as f64 {
+            return Err(Error::Experiment(format!(
+                "the largest RK4 step {m:e} s makes {total:e} internal steps ({per_step:e} per communication step of {} s), over the cap of {} steps of a run (Experiment::max_steps, --max-steps)",
+                clock.h, e.max_steps
+            )));
+        }
+    }
+    if let Some((name, rtol, atol)) = tolerances {
+        if !(rtol.is_finite() && rtol >= MIN_RTOL) {
+            return Err(Error::Experiment(format!(
+                "the {name} relative tolerance {rtol:e} is below {MIN_RTOL:e} (100 machine epsilons), which no f64 step can meet"
+            )));
+        }
+        if !(atol.is_finite() && atol >= 0.0) {
+            return Err(Error::Experiment(format!("the {name} absolute tolerance {atol:e} must be finite and >= 0")));
         }
     }
     Ok(())

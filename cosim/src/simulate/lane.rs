@@ -7,7 +7,7 @@ use crate::simulate::clock::Point;
 use crate::simulate::me_group::{MeGroup, Members, Solo};
 use crate::simulate::plan::{Instances, Op};
 use crate::simulate::ticks::Ticks;
-use crate::system::{InstanceSpec, Value};
+use crate::system::{BaseType, InstanceSpec, Value, VariableRef};
 use std::time::{Duration, Instant};
 
 /// One instance with its integrator (Model Exchange), its saved state (Discard retry)
@@ -347,4 +347,27 @@ pub fn apply_start_values(inst: &mut Instance, spec: &InstanceSpec) -> Result<()
         }
     }
     Ok(())
+}
+
+/// The value of `r` as its instance has it now, one call.
+pub(crate) fn get_value(inst: &mut Instance, r: &VariableRef) -> Result<Value> {
+    let vr = [r.value_reference];
+    Ok(match r.base_type {
+        BaseType::Real => {
+            let mut v = [0.0];
+            inst.get_real(&vr, &mut v)?;
+            Value::Real(v[0])
+        }
+        BaseType::Integer => {
+            let mut v = [0];
+            inst.get_integer(&vr, &mut v)?;
+            Value::Integer(v[0])
+        }
+        BaseType::Boolean => {
+            let mut v = [0];
+            inst.get_boolean(&vr, &mut v)?;
+            Value::Boolean(v[0] != 0)
+        }
+        BaseType::String => Value::String(inst.get_string(r.value_reference)?),
+    })
 }

@@ -9,7 +9,9 @@
 //! clocks at the times an input file's column of the clock's name is nonzero, and when an
 //! output clock connected to them ticks (at its activation's time); countdown clocks when
 //! the FMU, during an activation, signals `clockUpdate` and `fmi3GetIntervalDecimal` then
-//! says the interval changed: that long after the activation's time.
+//! says the interval changed: that long after the activation's time; changing clocks first
+//! the interval `fmi3GetIntervalDecimal` gives in Initialization Mode after the start, then
+//! each interval it gives right after an activation after that activation.
 //!
 //! The ticks of one time go in priority order across all instances (smaller first, then
 //! the instances' order in the system, then document order), a countdown of 0 s or a
@@ -35,7 +37,7 @@ use crate::error::{Error, Result};
 use crate::fmu::{Instance, Interface, Interval};
 use crate::partitions::{model_partitions, output_clocks, ModelPartition, Ticks};
 use crate::simulate::{apply_start_values, Experiment, InputTable, Results, Summary};
-use crate::system::{BaseType, System, VariableRef};
+use crate::system::{BaseType, System, Value, VariableRef};
 
 /// Why Scheduled Execution is not run isolated (`--isolate`, `--isolate=run`).
 pub const NOT_ISOLATED: &str = "Scheduled Execution is run in process only (leave out --isolate): the FMU calls \
@@ -223,6 +225,7 @@ fn run(system: &System, experiment: &Experiment, results: &mut Results) -> Resul
         exchange_into(system, &mut run, m)?;
     }
     for (m, member) in run.iter_mut().enumerate() {
+        first_changing_ticks(member, &system.instances[m].name, start, stop, &mut schedule, m)?;
         member.instance.exit_initialization_mode()?;
         first_intervals(member, &system.instances[m].name, start)?;
         for (p, partition) in member.partitions.iter().enumerate() {
@@ -255,6 +258,12 @@ fn run(system: &System, experiment: &Experiment, results: &mut Results) -> Resul
                 let next = periodic.take();
                 if next < stop {
                     schedule.push((next, partition.priority, m, p));
+                }
+            }
+            if partition.ticks == Ticks::Changing {
+                let next = t + changing_interval(member, &system.instances[m].name, p, t)?;
+                if next < stop {
+                    schedule.push((next, member.partitions[p].priority, m, p));
                 }
             }
             if !update {
@@ -340,6 +349,59 @@ fn first_intervals(member: &mut Member, name: &str, start: f64) -> Result<()> {
     Ok(())
 }
 
+/// The first ticks of the `changing` partitions of `member` (instance `m`, called `name`):
+/// the interval `fmi3GetIntervalDecimal` gives in Initialization Mode after the start (FMI
+/// 3.0: a changing clock's first interval is retrieved there and may be 0 s; no interval,
+/// `fmi3IntervalNotYetKnown`, is for countdown clocks only).
+fn first_changing_ticks(
+    member: &mut Member,
+    name: &str,
+    start: f64,
+    stop: f64,
+    schedule: &mut Schedule,
+    m: usize,
+) -> Result<()> {
+    let changing: Vec<usize> =
+        (0..member.partitions.len()).filter(|&p| member.partitions[p].ticks == Ticks::Changing).collect();
+    if changing.is_empty() {
+        return Ok(());
+    }
+    let vrs: Vec<u32> = changing.iter().map(|&p| member.partitions[p].clock).collect();
+    let given = member.instance.get_first_intervals(&vrs)?;
+    for (&p, interval) in changing.iter().zip(given) {
+        let partition = &member.partitions[p];
+        let (Interval::Changed(delay) | Interval::Unchanged(delay)) = interval else {
+            return Err(Error::Experiment(format!(
+                "{name}: changing clock {:?}: fmi3GetIntervalDecimal in Initialization Mode gave no interval \
+                 (fmi3IntervalNotYetKnown, which FMI 3.0 allows for countdown clocks only): its first tick is unknown",
+                partition.name
+            )));
+        };
+        if start + delay < stop {
+            schedule.push((start + delay, partition.priority, m, p));
+        }
+    }
+    Ok(())
+}
+
+/// The interval from the activation at `t` of the `changing` partition `p` of `member`
+/// (called `name`) to its next: `fmi3GetIntervalDecimal` right after the activation (FMI
+/// 3.0: the next interval of a changing clock is known once it was activated; the FMU says
+/// `fmi3IntervalChanged`, and `fmi3IntervalUnchanged` for the interval it gave before, still
+/// valid). A partition is activated once at a time, so an interval of 0 s is an error, as
+/// is no interval.
+fn changing_interval(member: &mut Member, name: &str, p: usize, t: f64) -> Result<f64> {
+    let partition = &member.partitions[p];
+    match member.instance.get_intervals(&[partition.clock])?[..] {
+        [Interval::Changed(interval) | Interval::Unchanged(interval)] => Ok(interval),
+        _ => Err(Error::Experiment(format!(
+            "{name}: changing clock {:?}: fmi3GetIntervalDecimal after its activation at t = {t} s gave no interval \
+             (fmi3IntervalNotYetKnown, which FMI 3.0 allows for countdown clocks only): its next tick is unknown",
+            partition.name
+        ))),
+    }
+}
+
 /// After an activation of `member` at `t` in which the FMU signalled `clockUpdate`: the
 /// countdown clocks it set are scheduled, the tunable clocks whose interval it changed
 /// rescheduled from `t`, and the output clocks that ticked counted and marked in `ticked`;
@@ -412,26 +474,16 @@ fn set_inputs(
     Ok(())
 }
 
-/// The value of `r` as an f64 (NaN for a String).
+/// The value of `r` as an f64 (a Boolean 0 or 1; NaN for a String, not read).
 fn get_value(instance: &mut Instance, r: &VariableRef) -> Result<f64> {
-    let vr = [r.value_reference];
-    Ok(match r.base_type {
-        BaseType::Real => {
-            let mut v = [0.0];
-            instance.get_real(&vr, &mut v)?;
-            v[0]
-        }
-        BaseType::Integer => {
-            let mut v = [0];
-            instance.get_integer(&vr, &mut v)?;
-            f64::from(v[0])
-        }
-        BaseType::Boolean => {
-            let mut v = [0];
-            instance.get_boolean(&vr, &mut v)?;
-            f64::from(v[0])
-        }
-        BaseType::String => f64::NAN,
+    if r.base_type == BaseType::String {
+        return Ok(f64::NAN);
+    }
+    Ok(match crate::simulate::lane::get_value(instance, r)? {
+        Value::Real(x) => x,
+        Value::Integer(i) => f64::from(i),
+        Value::Boolean(b) => f64::from(u8::from(b)),
+        Value::String(_) => f64::NAN,
     })
 }
 

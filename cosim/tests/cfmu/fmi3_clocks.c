@@ -106,25 +106,34 @@ fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], si
     return fmi3OK;
 }
 
+/* The qualifier of clock vr's interval now, and what asking it changes; 0: no interval. */
+static int interval_qualifier(Clocks *c, fmi3ValueReference vr, fmi3IntervalQualifier *q) {
+    switch (vr) {
+    case 1: case 2: *q = fmi3IntervalUnchanged; return 1;
+    case 3:
+        *q = c->changing_given ? fmi3IntervalUnchanged : fmi3IntervalChanged;
+        c->changing_given = 1;
+        return 1;
+    case 4:
+        *q = c->countdown_given == 1 ? fmi3IntervalChanged : fmi3IntervalNotYetKnown;
+        if (c->countdown_given == 1) c->countdown_given = 2;
+        return 1;
+    default: return 0;
+    }
+}
+
+#ifndef FMI3_FRACTION_ONLY
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
     fmi3Float64 v[], fmi3IntervalQualifier q[]) {
     Clocks *c = instance;
     for (size_t k = 0; k < n; k++) {
         switch (vr[k]) {
-        case 1: v[k] = 0.25; q[k] = fmi3IntervalUnchanged; break;
-        case 2: v[k] = c->fixed_interval; q[k] = fmi3IntervalUnchanged; break;
-        case 3:
-            v[k] = 0.1 * (c->n[2] + 1);
-            q[k] = c->changing_given ? fmi3IntervalUnchanged : fmi3IntervalChanged;
-            c->changing_given = 1;
-            break;
-        case 4:
-            v[k] = 0.5;
-            q[k] = c->countdown_given == 1 ? fmi3IntervalChanged : fmi3IntervalNotYetKnown;
-            if (c->countdown_given == 1) c->countdown_given = 2;
-            break;
-        default: return fail(c, "fmi3GetIntervalDecimal: no interval");
+        case 1: v[k] = 0.25; break;
+        case 2: v[k] = c->fixed_interval; break;
+        case 3: v[k] = 0.1 * (c->n[2] + 1); break;
+        case 4: v[k] = 0.5; break;
         }
+        if (!interval_qualifier(c, vr[k], &q[k])) return fail(c, "fmi3GetIntervalDecimal: no interval");
     }
     return fmi3OK;
 }
@@ -133,6 +142,36 @@ fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference v
     for (size_t k = 0; k < n; k++) v[k] = vr[k] == 1 ? 0.1 : 0.0;
     return fmi3OK;
 }
+#else
+/* Built with FMI3_FRACTION_ONLY (and fmi3_rest.c likewise): the same intervals and shifts as
+ * fractions, counter / resolution, and no fmi3GetIntervalDecimal or fmi3GetShiftDecimal at
+ * all, so that the importer must use the Fraction functions: periodic 1/4, fixed
+ * fixed_interval in thousandths (400/1000), changing k/10, countdown 1/2; periodic's shift
+ * 1/10. */
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3UInt64 counters[], fmi3UInt64 resolutions[], fmi3IntervalQualifier q[]) {
+    Clocks *c = instance;
+    for (size_t k = 0; k < n; k++) {
+        switch (vr[k]) {
+        case 1: counters[k] = 1; resolutions[k] = 4; break;
+        case 2: counters[k] = (fmi3UInt64)(c->fixed_interval * 1000 + 0.5); resolutions[k] = 1000; break;
+        case 3: counters[k] = (fmi3UInt64)(c->n[2] + 1); resolutions[k] = 10; break;
+        case 4: counters[k] = 1; resolutions[k] = 2; break;
+        }
+        if (!interval_qualifier(c, vr[k], &q[k])) return fail(c, "fmi3GetIntervalFraction: no interval");
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3UInt64 counters[], fmi3UInt64 resolutions[]) {
+    for (size_t k = 0; k < n; k++) {
+        counters[k] = vr[k] == 1 ? 1 : 0;
+        resolutions[k] = 10;
+    }
+    return fmi3OK;
+}
+#endif
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
     fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {

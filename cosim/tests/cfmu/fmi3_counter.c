@@ -17,6 +17,9 @@
  *   28 f32in Float32 input (0.5)   29 f32out Float32 2 f32in
  *   32 i64in Int64 input (0)      33 i64out Int64 output i64in ^ 1 (the lowest bit flipped: exact or not at all)
  *   34 u64in UInt64 input (0)     35 u64out UInt64 output u64in ^ 1
+ * and, in the descriptions of the tests of 64-bit arrays only:
+ *   36 i64ain Int64[2] input (0 0)   37 i64aout Int64[2] output i64ain[k] ^ 1
+ *   38 u64ain UInt64[2] input (0 0)  39 u64aout UInt64[2] output u64ain[k] ^ 1
  *   30 crash_at Float64 parameter: Co-Simulation: the step that starts at or after it crashes;
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
@@ -49,8 +52,8 @@ typedef struct {
     char label[64];
     double gains[2];
     float f32in;
-    long long i64in;
-    unsigned long long u64in;
+    long long i64in, i64ain[2];
+    unsigned long long u64in, u64ain[2];
     unsigned char bytes[64];
 } State;
 
@@ -279,26 +282,40 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
 fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Int64 values[], size_t nValues) {
     Counter *c = instance;
+    size_t j = 0; /* the next value: an array takes as many as it has elements */
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 5) values[i] = c->s.mode;
-        else if (vr[i] == 21) values[i] = -(1LL << 40) * c->s.n;
-        else if (vr[i] == 32) values[i] = c->s.i64in;
-        else if (vr[i] == 33) values[i] = c->s.i64in ^ 1;
+        if (vr[i] == 36 || vr[i] == 37) {
+            if (j + 2 > nValues) return fail(c, "fmi3GetInt64: nValues too small");
+            for (int k = 0; k < 2; k++) values[j++] = vr[i] == 36 ? c->s.i64ain[k] : c->s.i64ain[k] ^ 1;
+            continue;
+        }
+        if (j + 1 > nValues) return fail(c, "fmi3GetInt64: nValues too small");
+        if (vr[i] == 5) values[j++] = c->s.mode;
+        else if (vr[i] == 21) values[j++] = -(1LL << 40) * c->s.n;
+        else if (vr[i] == 32) values[j++] = c->s.i64in;
+        else if (vr[i] == 33) values[j++] = c->s.i64in ^ 1;
         else return fail(c, "fmi3GetInt64: no such Int64");
     }
-    return fmi3OK;
+    return j == nValues ? fmi3OK : fail(c, "fmi3GetInt64: nValues does not match");
 }
 
 fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     const fmi3Int64 values[], size_t nValues) {
     Counter *c = instance;
+    size_t j = 0;
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 32) { c->s.i64in = values[i]; continue; }
+        if (vr[i] == 36) {
+            if (j + 2 > nValues) return fail(c, "fmi3SetInt64: nValues too small");
+            for (int k = 0; k < 2; k++) c->s.i64ain[k] = values[j++];
+            continue;
+        }
+        if (j + 1 > nValues) return fail(c, "fmi3SetInt64: nValues too small");
+        if (vr[i] == 32) { c->s.i64in = values[j++]; continue; }
         if (vr[i] != 5) return fail(c, "fmi3SetInt64: not settable");
-        if (values[i] != 1 && values[i] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
-        c->s.mode = values[i];
+        if (values[j] != 1 && values[j] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
+        c->s.mode = values[j++];
     }
-    return fmi3OK;
+    return j == nValues ? fmi3OK : fail(c, "fmi3SetInt64: nValues does not match");
 }
 
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
@@ -388,23 +405,35 @@ SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
 SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
 fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 values[], size_t nValues) {
     Counter *c = instance;
-    if (nvr != nValues) return fail(c, "fmi3GetUInt64: nValues != nValueReferences");
+    size_t j = 0;
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 22) values[i] = (1ULL << 48) * (unsigned long long)c->s.n;
-        else if (vr[i] == 34) values[i] = c->s.u64in;
-        else if (vr[i] == 35) values[i] = c->s.u64in ^ 1;
+        if (vr[i] == 38 || vr[i] == 39) {
+            if (j + 2 > nValues) return fail(c, "fmi3GetUInt64: nValues too small");
+            for (int k = 0; k < 2; k++) values[j++] = vr[i] == 38 ? c->s.u64ain[k] : c->s.u64ain[k] ^ 1;
+            continue;
+        }
+        if (j + 1 > nValues) return fail(c, "fmi3GetUInt64: nValues too small");
+        if (vr[i] == 22) values[j++] = (1ULL << 48) * (unsigned long long)c->s.n;
+        else if (vr[i] == 34) values[j++] = c->s.u64in;
+        else if (vr[i] == 35) values[j++] = c->s.u64in ^ 1;
         else return fail(c, "fmi3GetUInt64: no such variable");
     }
-    return fmi3OK;
+    return j == nValues ? fmi3OK : fail(c, "fmi3GetUInt64: nValues does not match");
 }
 fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 values[], size_t nValues) {
     Counter *c = instance;
-    if (nvr != nValues) return fail(c, "fmi3SetUInt64: nValues != nValueReferences");
+    size_t j = 0;
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 38) {
+            if (j + 2 > nValues) return fail(c, "fmi3SetUInt64: nValues too small");
+            for (int k = 0; k < 2; k++) c->s.u64ain[k] = values[j++];
+            continue;
+        }
+        if (j + 1 > nValues) return fail(c, "fmi3SetUInt64: nValues too small");
         if (vr[i] != 34) return fail(c, "fmi3SetUInt64: not settable");
-        c->s.u64in = values[i];
+        c->s.u64in = values[j++];
     }
-    return fmi3OK;
+    return j == nValues ? fmi3OK : fail(c, "fmi3SetUInt64: nValues does not match");
 }
 
 fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {

@@ -6,7 +6,7 @@
  * 6 derivative_calls (locals: the calls of fmi2GetDirectionalDerivative and of
  * fmi2GetDerivatives so far). Built with -DWRONG_JACOBIAN every partial derivative is doubled;
  * with -DOVERRUN_OWN_BLOCK fmi2GetDirectionalDerivative writes 16 bytes past a block of two
- * doubles it allocated through allocateMemory at its first call and keeps (as MapleSim 2023's
+ * doubles the instance allocated through allocateMemory at its first call and keeps (as MapleSim 2023's
  * ControlledTemperature does with a block of its own); with -DOVERRUN_DV_UNKNOWN it writes
  * dvUnknown[nUnknown] and dvUnknown[nUnknown + 1], past the master's buffer. */
 #define FMI2_TEST_NO_FMU_STATE
@@ -16,6 +16,7 @@
 typedef struct {
     double r[7];
     double time;
+    double *work; /* -DOVERRUN_OWN_BLOCK: the instance's block of two doubles */
 } Vdp;
 
 static void defaults(Vdp *v) {
@@ -54,9 +55,8 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueR
     size_t i, j;
     double p;
 #ifdef OVERRUN_OWN_BLOCK
-    static double *work;
-    if (!work && !(work = fmi2_test_allocate(2, sizeof *work))) return ERR;
-    for (i = 0; i < 4; i++) work[i] = 0.0; /* two doubles past the block's end */
+    if (!m->work && !(m->work = fmi2_test_allocate(2, sizeof *m->work))) return ERR;
+    for (i = 0; i < 4; i++) m->work[i] = 0.0; /* two doubles past the block's end */
 #endif
 #ifdef OVERRUN_DV_UNKNOWN
     dz[nu] = dz[nu + 1] = 0.0; /* past the nu values of the master's buffer */

@@ -42,10 +42,17 @@ pub fn headers() -> Option<PathBuf> {
 /// 3.0 function, answering fmi3Error) and packs it with `xml` as `<dir>/<id>.fmu`; `None`
 /// (skip) without fmpy's headers.
 pub fn build(dir: &Path, id: &str, xml: &str) -> Option<PathBuf> {
+    build_with(dir, id, xml, &[])
+}
+
+/// The same, compiled with the preprocessor `defines` (`-D` each, in both files).
+pub fn build_with(dir: &Path, id: &str, xml: &str, defines: &[&str]) -> Option<PathBuf> {
     let headers = headers()?;
     let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu");
     let so = dir.join(format!("{id}.so"));
-    super::cc(&flags(&headers), &[cfmu.join(format!("{id}.c")), cfmu.join("fmi3_rest.c")], &so);
+    let mut flags = flags(&headers);
+    flags.extend(defines.iter().map(|d| OsString::from(format!("-D{d}"))));
+    super::cc(&flags, &[cfmu.join(format!("{id}.c")), cfmu.join("fmi3_rest.c")], &so);
     let fmu = dir.join(format!("{id}.fmu"));
     super::pack_library(&fmu, xml, &format!("binaries/x86_64-linux/{id}.so"), &so);
     Some(fmu)

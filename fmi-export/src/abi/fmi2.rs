@@ -133,24 +133,25 @@ pub trait Value {
     fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[Self::C]) -> OpResult;
 }
 
-impl Value for value::Real {
-    type C = fmi2Real;
-    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [f64]) -> OpResult {
-        instance.get_real(vr, out)
-    }
-    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[f64]) -> OpResult {
-        instance.set_real(vr, values)
-    }
+/// The base types the instance holds as their C type: (type, C type, the instance's getter
+/// and setter) a row.
+macro_rules! value_as_is {
+    ($($t:ident: $c:ty, $get:ident, $set:ident;)*) => {$(
+        impl Value for value::$t {
+            type C = $c;
+            fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [$c]) -> OpResult {
+                instance.$get(vr, out)
+            }
+            fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[$c]) -> OpResult {
+                instance.$set(vr, values)
+            }
+        }
+    )*};
 }
 
-impl Value for value::Integer {
-    type C = fmi2Integer;
-    fn get<M: Model>(instance: &mut Instance<M>, vr: &[u32], out: &mut [c_int]) -> OpResult {
-        instance.get_integer(vr, out)
-    }
-    fn set<M: Model>(instance: &mut Instance<M>, vr: &[u32], values: &[c_int]) -> OpResult {
-        instance.set_integer(vr, values)
-    }
+value_as_is! {
+    Real: fmi2Real, get_real, set_real;
+    Integer: fmi2Integer, get_integer, set_integer;
 }
 
 impl Value for value::Boolean {
@@ -277,21 +278,31 @@ pub unsafe fn get_status<M: Model>(function: Function, c: fmi2Component, kind: c
     })
 }
 
+/// `fmi2Get<Type>Status` of a kind with a value: `read` of the instance when `kind` is
+/// `available`, else an error naming the type (`type_name`).
+unsafe fn status_value<M: Model, T>(
+    (function, c, kind, value): (Function, fmi2Component, c_int, *mut T),
+    (available, type_name): (c_int, &str),
+    read: impl FnOnce(&Component<M>) -> T,
+) -> Fmi2Status {
+    with::<M>(c, function, |comp| {
+        let out = out_ptr(value, "value")?;
+        if kind == available {
+            *out = read(comp);
+            Ok(())
+        } else {
+            Err(format!("status kind {kind} has no {type_name} value").into())
+        }
+    })
+}
+
 pub unsafe fn get_real_status<M: Model>(
     function: Function,
     c: fmi2Component,
     kind: c_int,
     value: *mut f64,
 ) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = out_ptr(value, "value")?;
-        if kind == FMI2_LAST_SUCCESSFUL_TIME {
-            *out = comp.instance.time();
-            Ok(())
-        } else {
-            Err(format!("status kind {kind} has no Real value").into())
-        }
-    })
+    status_value::<M, _>((function, c, kind, value), (FMI2_LAST_SUCCESSFUL_TIME, "Real"), |comp| comp.instance.time())
 }
 
 pub unsafe fn get_integer_status<M: Model>(function: Function, c: fmi2Component, kind: c_int) -> Fmi2Status {
@@ -304,14 +315,12 @@ pub unsafe fn get_boolean_status<M: Model>(
     kind: c_int,
     value: *mut fmi2Boolean,
 ) -> Fmi2Status {
-    with::<M>(c, function, |comp| {
-        let out = out_ptr(value, "value")?;
-        if kind == FMI2_TERMINATED {
-            // after a Discard because the model asked to end the simulation
-            *out = if comp.instance.core.terminate_requested { FMI2_TRUE } else { FMI2_FALSE };
-            Ok(())
+    // true after a Discard because the model asked to end the simulation
+    status_value::<M, _>((function, c, kind, value), (FMI2_TERMINATED, "Boolean"), |comp| {
+        if comp.instance.core.terminate_requested {
+            FMI2_TRUE
         } else {
-            Err(format!("status kind {kind} has no Boolean value").into())
+            FMI2_FALSE
         }
     })
 }

@@ -34,16 +34,17 @@ impl ClockCalls for Fmi3 {
         Ok(())
     }
 
-    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>> {
+    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32], zero: bool) -> Result<Vec<Interval>> {
         let (values, qualifiers) = self.interval_call(core, vrs)?;
+        let least = if zero { "no time (negative or not finite)" } else { "no positive time" };
         vrs.iter()
             .zip(values.iter().zip(&qualifiers))
             .map(|(vr, (v, q))| match q {
                 0 => Ok(Interval::NotYetKnown),
-                1 | 2 if !(v.is_finite() && *v > 0.0) => Err(core.error(
+                1 | 2 if !(v.is_finite() && (*v > 0.0 || zero && *v == 0.0)) => Err(core.error(
                     "fmi3GetIntervalDecimal",
                     core.time,
-                    format!("clock {vr}: interval {v} s is no positive time"),
+                    format!("clock {vr}: interval {v} s is {least}"),
                 )),
                 1 => Ok(Interval::Unchanged(*v)),
                 2 => Ok(Interval::Changed(*v)),
@@ -196,7 +197,16 @@ impl Instance {
     /// the clocks `vrs` and what the FMU says of each.
     pub fn get_intervals(&mut self, vrs: &[u32]) -> Result<Vec<Interval>> {
         match self.calls.clock_calls() {
-            Some(c) => c.get_intervals(&mut self.core, vrs),
+            Some(c) => c.get_intervals(&mut self.core, vrs, false),
+            None => Err(no_clocks(self)),
+        }
+    }
+
+    /// The same, an interval of 0 s included: the delay from the start to a `changing`
+    /// clock's first tick, which may be at the start (in Initialization Mode).
+    pub fn get_first_intervals(&mut self, vrs: &[u32]) -> Result<Vec<Interval>> {
+        match self.calls.clock_calls() {
+            Some(c) => c.get_intervals(&mut self.core, vrs, true),
             None => Err(no_clocks(self)),
         }
     }

@@ -31,11 +31,17 @@ impl Fmi3 {
                 reason: "its FMU has structural parameters set, and Configuration Mode is not forwarded to a host process: run it without isolation",
             });
         }
+        self.in_configuration_mode(core, configuration)
+    }
+
+    /// `fmi3EnterConfigurationMode`, each (variable, value) of `sets` set, and
+    /// `fmi3ExitConfigurationMode`.
+    fn in_configuration_mode(&mut self, core: &mut Core, sets: impl IntoIterator<Item = (Access, f64)>) -> Result<()> {
         let enter = core.optional(self.abi().functions.enter_configuration_mode, "fmi3EnterConfigurationMode")?;
         let exit = core.optional(self.abi().functions.exit_configuration_mode, "fmi3ExitConfigurationMode")?;
         let c = core.component;
         call!(core, "fmi3EnterConfigurationMode", None, enter(c))?;
-        for (access, value) in configuration {
+        for (access, value) in sets {
             self.set_all(core, access, &[value])?;
         }
         call!(core, "fmi3ExitConfigurationMode", None, exit(c))
@@ -143,14 +149,7 @@ impl Fmi3 {
             }
             sets.push((Access { vr, value_type: v.value_type, element: 0, count: 1 }, *value));
         }
-        let enter = core.optional(self.abi().functions.enter_configuration_mode, "fmi3EnterConfigurationMode")?;
-        let exit = core.optional(self.abi().functions.exit_configuration_mode, "fmi3ExitConfigurationMode")?;
-        let c = core.component;
-        call!(core, "fmi3EnterConfigurationMode", None, enter(c))?;
-        for (access, value) in sets {
-            self.set_all(core, access, &[value])?;
-        }
-        call!(core, "fmi3ExitConfigurationMode", None, exit(c))?;
+        self.in_configuration_mode(core, sets)?;
         self.resize(now);
         Ok(())
     }

@@ -66,8 +66,11 @@ macro_rules! call {
         core.check_callable($name)?;
         let time: Option<f64> = $time;
         let mark = $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time));
+        // the blocks the FMU allocates in the call are this instance's (fmi-sys's guard)
+        let owner = fmi_sys::fmi2::guard::enter_owner(core.log.owner());
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
+        drop(owner);
         drop(mark);
         core.status($name, raw, time)
     }};
@@ -115,6 +118,15 @@ impl Core {
     pub(crate) fn error(&self, function: &'static str, time: f64, log: String) -> Error {
         Error::Fmi { instance: self.name.clone(), function, status: Status::Error, time: Some(time), log }
     }
+}
+
+/// A directional derivative's arguments but its result: d(`unknowns`)/d(`knowns`) times
+/// `dv_known` (one seed per known).
+#[derive(Clone, Copy)]
+pub(crate) struct Seed<'a> {
+    pub(crate) unknowns: &'a [u32],
+    pub(crate) knowns: &'a [u32],
+    pub(crate) dv_known: &'a [f64],
 }
 
 /// The calls of one generation's C API on an instance: everything [`crate::Instance`]
@@ -215,14 +227,7 @@ pub(crate) trait Calls: Send {
     fn get_derivatives(&mut self, core: &mut Core, dx: &mut [f64]) -> Result<()>;
     fn get_event_indicators(&mut self, core: &mut Core, z: &mut [f64]) -> Result<()>;
     fn has_directional_derivative(&self) -> bool;
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()>;
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()>;
     fn enter_event_mode(&mut self, core: &mut Core) -> Result<()>;
     fn new_discrete_states(&mut self, core: &mut Core) -> Result<EventInfo>;
     fn enter_continuous_time_mode(&mut self, core: &mut Core) -> Result<()>;
@@ -274,7 +279,9 @@ pub struct OutputTick {
 pub(crate) trait ClockCalls {
     fn set_clocks(&mut self, core: &mut Core, vrs: &[u32]) -> Result<()>;
     fn get_clocks(&mut self, core: &mut Core, vrs: &[u32], ticks: &mut [bool]) -> Result<()>;
-    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<Interval>>;
+    /// `zero`: an interval of 0 s is one (the delay to a changing clock's first tick at the
+    /// start), else an error.
+    fn get_intervals(&mut self, core: &mut Core, vrs: &[u32], zero: bool) -> Result<Vec<Interval>>;
     fn get_shifts(&mut self, core: &mut Core, vrs: &[u32]) -> Result<Vec<f64>>;
     fn set_intervals(&mut self, core: &mut Core, vrs: &[u32], intervals: &[f64]) -> Result<()>;
     /// The start of a clock event at `time`: Event Mode entered and the input clocks `vrs`

@@ -3,7 +3,7 @@
 use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
-use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction, Seed};
 use crate::c_types::{Component, EventInfo, Functions};
 use crate::error::{Error, Result};
 use crate::fmu::Fmu;
@@ -18,6 +18,24 @@ impl Fmi2 {
     pub(crate) fn new(t: Arc<Functions>) -> Fmi2 {
         Fmi2 { t }
     }
+}
+
+/// The typed getters and setters of [`Calls`], one C call each: (getter, setter, value type,
+/// their FMI names) a row.
+macro_rules! get_set {
+    ($($get:ident, $set:ident, $t:ty, $get_name:literal, $set_name:literal;)*) => {$(
+        #[inline]
+        fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
+            let (c, f) = (core.component, self.t.$get);
+            call!(core, $get_name, None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
+        }
+
+        #[inline]
+        fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
+            let (c, f) = (core.component, self.t.$set);
+            call!(core, $set_name, None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+        }
+    )*};
 }
 
 impl Calls for Fmi2 {
@@ -38,6 +56,7 @@ impl Calls for Fmi2 {
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
         let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0);
+        let owner = fmi_sys::fmi2::guard::enter_owner(log.owner());
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (self.t.instantiate)(
@@ -50,6 +69,7 @@ impl Calls for Fmi2 {
                 0,
             )
         };
+        drop(owner);
         drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate {
@@ -124,40 +144,10 @@ impl Calls for Fmi2 {
         core.optional(self.t.reset, "fmi2Reset")
     }
 
-    #[inline]
-    fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
-        let (c, f) = (core.component, self.t.get_real);
-        call!(core, "fmi2GetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
-    }
-
-    #[inline]
-    fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
-        let (c, f) = (core.component, self.t.set_real);
-        call!(core, "fmi2SetReal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
-    }
-
-    #[inline]
-    fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        let (c, f) = (core.component, self.t.get_integer);
-        call!(core, "fmi2GetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
-    }
-
-    #[inline]
-    fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        let (c, f) = (core.component, self.t.set_integer);
-        call!(core, "fmi2SetInteger", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
-    }
-
-    #[inline]
-    fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        let (c, f) = (core.component, self.t.get_boolean);
-        call!(core, "fmi2GetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))
-    }
-
-    #[inline]
-    fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        let (c, f) = (core.component, self.t.set_boolean);
-        call!(core, "fmi2SetBoolean", None, f(c, vrs.as_ptr(), vrs.len(), values.as_ptr()))
+    get_set! {
+        get_real, set_real, f64, "fmi2GetReal", "fmi2SetReal";
+        get_integer, set_integer, i32, "fmi2GetInteger", "fmi2SetInteger";
+        get_boolean, set_boolean, i32, "fmi2GetBoolean", "fmi2SetBoolean";
     }
 
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {
@@ -249,19 +239,15 @@ impl Calls for Fmi2 {
         self.t.get_directional_derivative.is_some()
     }
 
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()> {
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()> {
+        let Seed { unknowns, knowns, dv_known } = seed;
         let c = core.component;
         let f = core.optional(self.t.get_directional_derivative, "fmi2GetDirectionalDerivative")?;
         // a write past a block the FMU allocated through allocateMemory lands in its red
-        // zone (MapleSim 2023's ControlledTemperature writes 16 bytes past one here)
-        let before = fmi_sys::fmi2::guard::overruns().count;
+        // zone (MapleSim 2023's ControlledTemperature writes 16 bytes past one here); only
+        // this instance's blocks are read
+        let owner = core.log.owner();
+        let before = fmi_sys::fmi2::guard::overruns_of(owner).count;
         call!(
             core,
             "fmi2GetDirectionalDerivative",
@@ -276,14 +262,14 @@ impl Calls for Fmi2 {
                 dv_unknown.as_mut_ptr()
             )
         )?;
-        let after = fmi_sys::fmi2::guard::overruns();
+        let after = fmi_sys::fmi2::guard::overruns_of(owner);
         match after.first {
             Some((size, past)) if after.count > before => Err(Error::Overrun {
                 instance: core.name.clone(),
                 function: "fmi2GetDirectionalDerivative",
                 what: format!(
                     "{past} bytes past the end of a block of {size} bytes that the FMU allocated through allocateMemory{}",
-                    if before > 0 { " (or past another such block: the first write seen in this process)" } else { "" }
+                    if before > 0 { " (or past another of its blocks: the first write seen in this instance)" } else { "" }
                 ),
             }),
             _ => Ok(()),

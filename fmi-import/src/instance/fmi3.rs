@@ -9,7 +9,7 @@ use std::ffi::{c_char, c_int, c_void, CString};
 use std::sync::Arc;
 
 use super::clocked::HeldNumber;
-use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction};
+use super::core::{call, Calls, ClockCalls, Core, FreeInstanceFunction, FreeStateFunction, ResetFunction, Seed};
 use crate::c_types::{Component, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmi3::{Access, Fmi3Abi};
@@ -31,6 +31,9 @@ pub(crate) struct Fmi3 {
     bytes: Vec<u8>,
     /// The values of arrays set element by element, by value reference.
     arrays: HashMap<u32, Vec<f64>>,
+    /// Those of the Int64 and UInt64 arrays, as the integers themselves (an f64 holds them
+    /// exactly only up to 2^53).
+    wide_arrays: HashMap<u32, Vec<i128>>,
     /// The arrays whose size now is not the view's (a structural parameter changed in
     /// Reconfiguration Mode, or to be): by the FMU's value reference, the view's dimensions
     /// and those of now (`structural::resized_arrays`); empty almost always.
@@ -106,6 +109,7 @@ impl Fmi3 {
             terminate_requested: None,
             bytes: Vec::new(),
             arrays: HashMap::new(),
+            wide_arrays: HashMap::new(),
             resized: HashMap::new(),
             sizes_now: Vec::new(),
             event_mode: std::cell::Cell::new(event_mode),
@@ -166,6 +170,7 @@ impl Fmi3 {
         self.sizes_now = now;
         let resized = &self.resized;
         self.arrays.retain(|vr, _| !resized.contains_key(vr));
+        self.wide_arrays.retain(|vr, _| !resized.contains_key(vr));
     }
 
     /// All values of the FMI 3.0 variable of `access` (as many as it has now), as f64
@@ -304,20 +309,26 @@ impl Fmi3 {
     /// Sets element `access.element` of its variable: the other elements keep the values
     /// set or read before (the start values at first).
     fn set_element(&mut self, core: &mut Core, access: Access, value: f64) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
         if access.count == 1 {
             return self.set_all(core, access, &[value]);
         }
+        // a 64-bit array keeps its elements as integers: set through the same values
+        if matches!(access.value_type, T::Int64 | T::UInt64) {
+            let whole = value as i128;
+            if whole as f64 != value {
+                let name = self.a.description.variable(access.vr).map_or("?", |v| v.name.as_str());
+                return Err(Error::InvalidValue {
+                    variable: format!("{}.{name}", core.name),
+                    value: value.to_string(),
+                    reason: format!("not a whole number of {:?}", access.value_type),
+                });
+            }
+            return self.set_wide_element(core, access, whole);
+        }
         let (n, element) = self.now(access);
         let Some(element) = element else {
-            let name = self.a.description.variable(access.vr).map_or("?", |v| v.name.as_str());
-            return Err(Error::InvalidValue {
-                variable: format!("{}.{name}", core.name),
-                value: value.to_string(),
-                reason: format!(
-                    "element {} of an array that has {n} elements now (a structural parameter sized it so)",
-                    access.element + 1
-                ),
-            });
+            return Err(self.absent_element(core, access, n, value.to_string()));
         };
         let mut values = match self.arrays.remove(&access.vr) {
             Some(v) if v.len() == n => v,
@@ -327,6 +338,95 @@ impl Fmi3 {
         let result = self.set_all(core, access, &values);
         self.arrays.insert(access.vr, values);
         result
+    }
+
+    /// The error of a set of an element the array does not have now (`n` elements).
+    fn absent_element(&self, core: &Core, access: Access, n: usize, value: String) -> Error {
+        let name = self.a.description.variable(access.vr).map_or("?", |v| v.name.as_str());
+        Error::InvalidValue {
+            variable: format!("{}.{name}", core.name),
+            value,
+            reason: format!(
+                "element {} of an array that has {n} elements now (a structural parameter sized it so)",
+                access.element + 1
+            ),
+        }
+    }
+
+    /// Sets element `access.element` of an Int64 or UInt64 array to the integer `value`
+    /// exactly: the other elements keep the integers set or read before (the start values
+    /// at first).
+    fn set_wide_element(&mut self, core: &mut Core, access: Access, value: i128) -> Result<()> {
+        let (n, element) = self.now(access);
+        let Some(element) = element else {
+            return Err(self.absent_element(core, access, n, value.to_string()));
+        };
+        let mut values = match self.wide_arrays.remove(&access.vr) {
+            Some(v) if v.len() == n => v,
+            _ => self.wide_array_start(core, access)?,
+        };
+        values[element] = value;
+        let result = self.set_wide(core, access, &values);
+        self.wide_arrays.insert(access.vr, values);
+        result
+    }
+
+    /// The integers a 64-bit array starts from for element-wise sets: its start values,
+    /// else what the FMU holds.
+    fn wide_array_start(&mut self, core: &mut Core, access: Access) -> Result<Vec<i128>> {
+        use model_description::fmi3::{ValueType as T, Values};
+        let n = self.now(access).0;
+        if !self.resized.contains_key(&access.vr) {
+            if let Some(Values::Int(v)) = self.a.description.variable(access.vr).and_then(|v| v.start.clone()) {
+                if v.len() == n {
+                    return Ok(v);
+                }
+                if v.len() == 1 {
+                    return Ok(vec![v[0]; n]);
+                }
+            }
+        }
+        let (c, a, vr) = (core.component, &*self.a, access.vr);
+        Ok(if access.value_type == T::UInt64 {
+            let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
+            let mut buf = vec![0u64; n];
+            call!(core, "fmi3GetUInt64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+            buf.into_iter().map(i128::from).collect()
+        } else {
+            let f = f3!(core, a, get_int64, "fmi3GetInt64");
+            let mut buf = vec![0i64; n];
+            call!(core, "fmi3GetInt64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+            buf.into_iter().map(i128::from).collect()
+        })
+    }
+
+    /// Sets all values of the Int64 or UInt64 variable of `access` to the integers
+    /// `values`, each checked against the type's range (an error names the variable).
+    fn set_wide(&mut self, core: &mut Core, access: Access, values: &[i128]) -> Result<()> {
+        use model_description::fmi3::ValueType as T;
+        let (c, vr, n) = (core.component, access.vr, values.len());
+        // the FMU's own name of the variable (the view's element names are not its)
+        let name = self.a.description.variable(vr).map_or_else(|| format!("<vr {vr}>"), |v| v.name.clone());
+        let out_of_range = |core: &Core, value: i128, ty: &str| Error::InvalidValue {
+            variable: format!("{}.{name}", core.name),
+            value: value.to_string(),
+            reason: format!("outside the range of {ty}"),
+        };
+        if access.value_type == T::Int64 {
+            let buf = values
+                .iter()
+                .map(|x| i64::try_from(*x).map_err(|_| out_of_range(core, *x, "Int64")))
+                .collect::<Result<Vec<i64>>>()?;
+            let f = f3!(core, self.a, set_int64, "fmi3SetInt64");
+            call!(core, "fmi3SetInt64", None, f(c, &vr, 1, buf.as_ptr(), n))
+        } else {
+            let buf = values
+                .iter()
+                .map(|x| u64::try_from(*x).map_err(|_| out_of_range(core, *x, "UInt64")))
+                .collect::<Result<Vec<u64>>>()?;
+            let f = f3!(core, self.a, set_uint64, "fmi3SetUInt64");
+            call!(core, "fmi3SetUInt64", None, f(c, &vr, 1, buf.as_ptr(), n))
+        }
     }
 
     /// The values an array starts from for element-wise sets: its start values, else what
@@ -705,7 +805,7 @@ impl Fmi3 {
         if !self.interval_clocks.is_empty() || !fixed.is_empty() {
             let vrs: Vec<u32> = self.interval_clocks.iter().chain(fixed).copied().collect();
             self.fixed_read = true;
-            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs)?;
+            let intervals = super::core::ClockCalls::get_intervals(self, core, &vrs, false)?;
             self.intervals.extend(vrs.into_iter().zip(intervals).map(|(vr, i)| (time, vr, i)));
         }
         if self.output_clocks.is_empty() {
@@ -749,6 +849,29 @@ fn not_exact(core: &Core, vr: u32, value: String) -> Error {
         value,
         reason: "not an Int64, UInt64 or Binary of the FMU's: its value is the view's".into(),
     }
+}
+
+/// The typed getters and setters of [`Calls`]: the FMU's own calls, but while the instance
+/// runs with clocked variables, their values held between ticks (read) and queued until
+/// their clock ticks (set). (getter, setter, value type, the FMU's getter and setter) a row.
+macro_rules! get_set {
+    ($($get:ident, $set:ident, $t:ty, $fmu_get:ident, $fmu_set:ident;)*) => {$(
+        #[inline]
+        fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.get_held(core, vrs, values, Self::$fmu_get);
+            }
+            self.$fmu_get(core, vrs, values)
+        }
+
+        #[inline]
+        fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
+            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+                return self.set_queued(core, vrs, values, Self::$fmu_set);
+            }
+            self.$fmu_set(core, vrs, values)
+        }
+    )*};
 }
 
 impl Calls for Fmi3 {
@@ -933,52 +1056,10 @@ impl Calls for Fmi3 {
         self.terminate_requested = None;
     }
 
-    #[inline]
-    fn get_real(&mut self, core: &mut Core, vrs: &[u32], values: &mut [f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_real);
-        }
-        self.fmu_get_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_real(&mut self, core: &mut Core, vrs: &[u32], values: &[f64]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_real);
-        }
-        self.fmu_set_real(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_integer(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_integer);
-        }
-        self.fmu_get_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_integer(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_integer);
-        }
-        self.fmu_set_integer(core, vrs, values)
-    }
-
-    #[inline]
-    fn get_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.get_held(core, vrs, values, Self::fmu_get_boolean);
-        }
-        self.fmu_get_boolean(core, vrs, values)
-    }
-
-    #[inline]
-    fn set_boolean(&mut self, core: &mut Core, vrs: &[u32], values: &[i32]) -> Result<()> {
-        if !self.clocked.is_empty() && core.state == InstanceState::Running {
-            return self.set_queued(core, vrs, values, Self::fmu_set_boolean);
-        }
-        self.fmu_set_boolean(core, vrs, values)
+    get_set! {
+        get_real, set_real, f64, fmu_get_real, fmu_set_real;
+        get_integer, set_integer, i32, fmu_get_integer, fmu_set_integer;
+        get_boolean, set_boolean, i32, fmu_get_boolean, fmu_set_boolean;
     }
 
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const c_char> {
@@ -1033,33 +1114,10 @@ impl Calls for Fmi3 {
 
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {
         use model_description::fmi3::ValueType as T;
-        let access = match self.special(vr) {
-            Some(a) if a.count == 1 && matches!(a.value_type, T::Int64 | T::UInt64) => a,
-            // an element of a 64-bit array: set with the others as before, through f64
-            Some(a) if matches!(a.value_type, T::Int64 | T::UInt64) && (value as f64) as i128 == value => {
-                return self.set_element(core, a, value as f64);
-            }
-            _ => return Err(not_exact(core, vr, value.to_string())),
-        };
-        let c = core.component;
-        let fmu_vr = access.vr;
-        let out_of_range = |core: &Core, ty: &str| {
-            let name =
-                core.fmu.description.model_variables.iter().find(|v| v.value_reference == vr).map(|v| v.name.clone());
-            Error::InvalidValue {
-                variable: format!("{}.{}", core.name, name.unwrap_or_else(|| format!("<vr {vr}>"))),
-                value: value.to_string(),
-                reason: format!("outside the range of {ty}"),
-            }
-        };
-        if access.value_type == T::Int64 {
-            let x = i64::try_from(value).map_err(|_| out_of_range(core, "Int64"))?;
-            let f = f3!(core, self.a, set_int64, "fmi3SetInt64");
-            call!(core, "fmi3SetInt64", None, f(c, &fmu_vr, 1, &x, 1))
-        } else {
-            let x = u64::try_from(value).map_err(|_| out_of_range(core, "UInt64"))?;
-            let f = f3!(core, self.a, set_uint64, "fmi3SetUInt64");
-            call!(core, "fmi3SetUInt64", None, f(c, &fmu_vr, 1, &x, 1))
+        match self.special(vr) {
+            Some(a) if a.count == 1 && matches!(a.value_type, T::Int64 | T::UInt64) => self.set_wide(core, a, &[value]),
+            Some(a) if matches!(a.value_type, T::Int64 | T::UInt64) => self.set_wide_element(core, a, value),
+            _ => Err(not_exact(core, vr, value.to_string())),
         }
     }
 
@@ -1182,14 +1240,8 @@ impl Calls for Fmi3 {
         self.a.functions.get_directional_derivative.is_some()
     }
 
-    fn get_directional_derivative(
-        &mut self,
-        core: &mut Core,
-        unknowns: &[u32],
-        knowns: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> Result<()> {
+    fn get_directional_derivative(&mut self, core: &mut Core, seed: Seed, dv_unknown: &mut [f64]) -> Result<()> {
+        let Seed { unknowns, knowns, dv_known } = seed;
         let c = core.component;
         let f = f3!(core, self.a, get_directional_derivative, "fmi3GetDirectionalDerivative");
         call!(

@@ -18,7 +18,7 @@ use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
 pub use self::core::InstanceState;
-use self::core::{Calls, Core};
+use self::core::{Calls, Core, Seed};
 pub use self::core::{Interval, OutputTick};
 use self::discrete_inputs::{DiscreteInputs, Held, Kind};
 use crate::c_types::{CallbackFunctions, EventInfo};
@@ -69,6 +69,27 @@ fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
 /// their number (64 bytes).
 const DV_RED_ZONE: f64 = f64::from_bits(0x7ff8_dead_beef_0001);
 const DV_RED_ZONE_LEN: usize = 8;
+
+/// Typed getters and setters of [`Instance`], one value per value reference, a set through
+/// [`Instance::set_passing`]: (getter, setter, value type, the discrete inputs' kind and
+/// held value) a row.
+macro_rules! get_set {
+    ($($(#[$get_doc:meta])* $get:ident; $(#[$set_doc:meta])* $set:ident; $t:ty, $kind:expr, $held:expr;)*) => {$(
+        $(#[$get_doc])*
+        #[inline]
+        pub fn $get(&mut self, vrs: &[u32], values: &mut [$t]) -> Result<()> {
+            assert_eq!(vrs.len(), values.len(), concat!(stringify!($get), ": one value per value reference"));
+            self.calls.$get(&mut self.core, vrs, values)
+        }
+
+        $(#[$set_doc])*
+        #[inline]
+        pub fn $set(&mut self, vrs: &[u32], values: &[$t]) -> Result<()> {
+            assert_eq!(vrs.len(), values.len(), concat!(stringify!($set), ": one value per value reference"));
+            self.set_passing(($kind, $held), vrs, values, <dyn Calls>::$set)
+        }
+    )*};
+}
 
 impl Instance {
     /// `fmi2Instantiate` / `fmi3Instantiate*` with the FMU's interface, logging off
@@ -292,33 +313,37 @@ impl Instance {
         Ok(())
     }
 
-    /// The values of a set that reach the FMU now: `None` all of them (noted where
-    /// discrete), else those left when the discrete ones that wait or that the FMU already
-    /// holds are taken out (see `discrete_inputs.rs`).
+    /// Sets `values` with `set`: all of them (noted where discrete), or those left when the
+    /// discrete ones that wait or that the FMU already holds are taken out (see
+    /// `discrete_inputs.rs`; none left: no call).
     #[inline]
-    fn passing<T: Copy>(
+    fn set_passing<T: Copy>(
         &mut self,
-        kind: Kind,
+        (kind, held): (Kind, impl Fn(T) -> Held),
         vrs: &[u32],
         values: &[T],
-        held: impl Fn(T) -> Held,
-    ) -> Option<(Vec<u32>, Vec<T>)> {
-        let d = self.discrete.as_deref_mut()?;
-        if d.any_deferred(kind, vrs) {
-            return Some(
-                vrs.iter()
+        set: impl Fn(&mut (dyn Calls + 'static), &mut Core, &[u32], &[T]) -> Result<()>,
+    ) -> Result<()> {
+        if let Some(d) = self.discrete.as_deref_mut() {
+            if d.any_deferred(kind, vrs) {
+                let (vrs, values): (Vec<u32>, Vec<T>) = vrs
+                    .iter()
                     .zip(values)
                     .filter(|(vr, v)| !d.defer(kind, **vr, held(**v)))
                     .map(|(vr, v)| (*vr, *v))
-                    .unzip(),
-            );
-        }
-        if !d.continuous_time {
-            for (vr, v) in vrs.iter().zip(values) {
-                d.defer(kind, *vr, held(*v));
+                    .unzip();
+                if vrs.is_empty() {
+                    return Ok(());
+                }
+                return set(self.calls.as_mut(), &mut self.core, &vrs, &values);
+            }
+            if !d.continuous_time {
+                for (vr, v) in vrs.iter().zip(values) {
+                    d.defer(kind, *vr, held(*v));
+                }
             }
         }
-        None
+        set(self.calls.as_mut(), &mut self.core, vrs, values)
     }
 
     /// `fmi2Terminate` / `fmi3Terminate` (only from initialization or running; otherwise
@@ -398,50 +423,24 @@ impl Instance {
     #[inline]
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Result<()> {
         assert_eq!(vrs.len(), values.len(), "set_real: one value per value reference");
-        match self.passing(Kind::Real, vrs, values, |v: f64| Held::Real(v.to_bits())) {
-            None => self.calls.set_real(&mut self.core, vrs, values),
-            Some((vrs, _)) if vrs.is_empty() => Ok(()),
-            Some((vrs, values)) => self.calls.set_real(&mut self.core, &vrs, &values),
-        }
+        self.set_passing((Kind::Real, |v: f64| Held::Real(v.to_bits())), vrs, values, <dyn Calls>::set_real)
     }
 
-    /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`, Int8 ..
-    /// UInt16 and array elements by their own getters.
-    #[inline]
-    pub fn get_integer(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        assert_eq!(vrs.len(), values.len(), "get_integer: one value per value reference");
-        self.calls.get_integer(&mut self.core, vrs, values)
-    }
+    get_set! {
+        /// `fmi2GetInteger`; FMI 3.0: `fmi3GetInt32`, Enumerations by `fmi3GetInt64`, Int8 ..
+        /// UInt16 and array elements by their own getters.
+        get_integer;
+        /// `fmi2SetInteger`; FMI 3.0: `fmi3SetInt32`, the other types as for
+        /// [`Instance::get_integer`].
+        set_integer;
+        i32, Kind::Integer, Held::Integer;
 
-    /// `fmi2SetInteger`; FMI 3.0: `fmi3SetInt32`, the other types as for
-    /// [`Instance::get_integer`].
-    #[inline]
-    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
-        assert_eq!(vrs.len(), values.len(), "set_integer: one value per value reference");
-        match self.passing(Kind::Integer, vrs, values, Held::Integer) {
-            None => self.calls.set_integer(&mut self.core, vrs, values),
-            Some((vrs, _)) if vrs.is_empty() => Ok(()),
-            Some((vrs, values)) => self.calls.set_integer(&mut self.core, &vrs, &values),
-        }
-    }
-
-    /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true); FMI 3.0:
-    /// `fmi3GetBoolean` (a C `bool`, read as a byte: nonzero is true), as 0 or 1.
-    #[inline]
-    pub fn get_boolean(&mut self, vrs: &[u32], values: &mut [i32]) -> Result<()> {
-        assert_eq!(vrs.len(), values.len(), "get_boolean: one value per value reference");
-        self.calls.get_boolean(&mut self.core, vrs, values)
-    }
-
-    /// `fmi2SetBoolean` / `fmi3SetBoolean` (nonzero is true).
-    #[inline]
-    pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Result<()> {
-        assert_eq!(vrs.len(), values.len(), "set_boolean: one value per value reference");
-        match self.passing(Kind::Boolean, vrs, values, |v: i32| Held::Boolean(v != 0)) {
-            None => self.calls.set_boolean(&mut self.core, vrs, values),
-            Some((vrs, _)) if vrs.is_empty() => Ok(()),
-            Some((vrs, values)) => self.calls.set_boolean(&mut self.core, &vrs, &values),
-        }
+        /// `fmi2GetBoolean` (fmi2Boolean is a C int: 0 false, else true); FMI 3.0:
+        /// `fmi3GetBoolean` (a C `bool`, read as a byte: nonzero is true), as 0 or 1.
+        get_boolean;
+        /// `fmi2SetBoolean` / `fmi3SetBoolean` (nonzero is true).
+        set_boolean;
+        i32, Kind::Boolean, |v: i32| Held::Boolean(v != 0);
     }
 
     /// `fmi2GetString` / `fmi3GetString` of one variable (copied).
@@ -595,7 +594,8 @@ impl Instance {
 
     /// The directional derivative at the instance's current point: `dv_unknown` =
     /// d(unknowns)/d(knowns) `dv_known` (FMI 2.0 section 2.1.9, FMI 3.0 section 2.2.11).
-    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown`, or
+    /// [`Error::Overrun`] when the FMU wrote past the `nUnknown` values of `dvUnknown` (FMI
+    /// 3.0: the `nSensitivity` values of `sensitivity`), or
     /// (FMI 2.0) past a block it allocated through `allocateMemory`: the guard's red zone
     /// took the write; the instance is still usable, the values are not.
     pub fn get_directional_derivative(
@@ -612,17 +612,21 @@ impl Instance {
         let n = dv_unknown.len();
         let zone = |v: &[f64]| v[n..].iter().rposition(|x| x.to_bits() != DV_RED_ZONE.to_bits());
         let mut out = vec![DV_RED_ZONE; n + DV_RED_ZONE_LEN];
-        self.calls.get_directional_derivative(&mut self.core, unknowns, knowns, dv_known, &mut out[..n])?;
+        self.calls.get_directional_derivative(&mut self.core, Seed { unknowns, knowns, dv_known }, &mut out[..n])?;
         dv_unknown.copy_from_slice(&out[..n]);
         match zone(&out) {
-            Some(k) => Err(Error::Overrun {
-                instance: self.core.name.clone(),
-                function: match self.core.fmu.abi {
-                    Abi::Fmi2(_) => "fmi2GetDirectionalDerivative",
-                    Abi::Fmi3(_) => "fmi3GetDirectionalDerivative",
-                },
-                what: format!("{} bytes past the {} bytes of dvUnknown (nUnknown = {n})", 8 * (k + 1), 8 * n),
-            }),
+            Some(k) => {
+                // each generation's names of the call and its buffer
+                let (function, buffer, count) = match self.core.fmu.abi {
+                    Abi::Fmi2(_) => ("fmi2GetDirectionalDerivative", "dvUnknown", "nUnknown"),
+                    Abi::Fmi3(_) => ("fmi3GetDirectionalDerivative", "sensitivity", "nSensitivity"),
+                };
+                Err(Error::Overrun {
+                    instance: self.core.name.clone(),
+                    function,
+                    what: format!("{} bytes past the {} bytes of {buffer} ({count} = {n})", 8 * (k + 1), 8 * n),
+                })
+            }
             None => Ok(()),
         }
     }

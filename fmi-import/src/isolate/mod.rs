@@ -29,7 +29,11 @@
 //! proxy of this module (`proxy.rs` for FMI 2.0, `proxy3.rs` for FMI 3.0): its state
 //! machine, status handling and log are the in-process ones. FMI 3.0's sets of scalars
 //! are queued as FMI 2.0's are (a set of array values is a call); its Reals are read with a
-//! call (no prefetch). The host's side is [`host::run`], the whole of `cosim-host`.
+//! call (no prefetch); its clock calls (`fmi3SetClock`, `fmi3GetClock`, the intervals and
+//! shifts) are calls, their arrays after the references as `protocol::clock_arrays` lays
+//! them out. Scheduled Execution is not carried: its FMU calls the importer back from inside
+//! `fmi3ActivateModelPartition`, and a host answers one call at a time. The host's side is
+//! [`host::run`], the whole of `cosim-host`.
 //!
 //! The whole run in one host process (`--isolate=run`, the FMUs called in it directly) is
 //! the master's (`nigel_cosim::isolate::whole`): it runs the simulation.

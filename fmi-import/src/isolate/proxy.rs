@@ -41,6 +41,18 @@ pub(super) fn fits(channel: &mut Channel, bytes: usize) -> bool {
     bytes <= available
 }
 
+/// A getter's request of `n` values: when `room` bytes fit in the channel, the value
+/// references written and `op` called; its status and where the values start in the data
+/// (`None`: they do not fit, the status is Error).
+fn ask(channel: &mut Channel, (vrs, n): (&[u32], usize), room: usize, op: Op) -> Option<(c_int, usize)> {
+    if !fits(channel, room) {
+        return None;
+    }
+    let at = vrs_into(channel, vrs);
+    channel.header().n = n as u64;
+    Some((channel.call(op), at))
+}
+
 pub(super) unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
     if n == 0 || p.is_null() {
         &[]
@@ -139,12 +151,7 @@ unsafe extern "C" fn get_real(c: Component, vr: *const u32, n: usize, v: *mut f6
     if channel.prefetched_reals(vrs, out) {
         return 0;
     }
-    if !fits(channel, 12 * n + 8) {
-        return 3;
-    }
-    let at = vrs_into(channel, vrs);
-    channel.header().n = n as u64;
-    let s = channel.call(Op::GetReal);
+    let Some((s, at)) = ask(channel, (vrs, n), 12 * n + 8, Op::GetReal) else { return 3 };
     let data = channel.data();
     for (k, x) in out.iter_mut().enumerate() {
         *x = f64::from_ne_bytes(data[at + 8 * k..at + 8 * k + 8].try_into().unwrap_or([0; 8]));
@@ -155,12 +162,7 @@ unsafe extern "C" fn get_real(c: Component, vr: *const u32, n: usize, v: *mut f6
 unsafe fn get_ints(c: Component, vr: *const u32, n: usize, v: *mut c_int, op: Op) -> c_int {
     let channel = ch(c);
     let (vrs, out) = (slice(vr, n), slice_mut(v, n));
-    if !fits(channel, 8 * n + 8) {
-        return 3;
-    }
-    let at = vrs_into(channel, vrs);
-    channel.header().n = n as u64;
-    let s = channel.call(op);
+    let Some((s, at)) = ask(channel, (vrs, n), 8 * n + 8, op) else { return 3 };
     let data = channel.data();
     for (k, x) in out.iter_mut().enumerate() {
         *x = c_int::from_ne_bytes(data[at + 4 * k..at + 4 * k + 4].try_into().unwrap_or([0; 4]));
@@ -185,12 +187,7 @@ unsafe extern "C" fn get_string(c: Component, vr: *const u32, n: usize, v: *mut 
 pub(super) unsafe fn get_strings(c: Component, vr: *const u32, n: usize, v: *mut *const c_char, op: Op) -> c_int {
     let channel = ch(c);
     let (vrs, out) = (slice(vr, n), slice_mut(v, n));
-    if !fits(channel, 4 * n + 8) {
-        return 3;
-    }
-    let at = vrs_into(channel, vrs);
-    channel.header().n = n as u64;
-    let s = channel.call(op);
+    let Some((s, at)) = ask(channel, (vrs, n), 4 * n + 8, op) else { return 3 };
     let mut strings = Vec::with_capacity(n);
     {
         let data = channel.data();

@@ -3,43 +3,83 @@
 //! that writes a little past a block it allocated writes into the red zone, not into the
 //! heap's own bookkeeping (which glibc finds later and aborts on, far from the write).
 //!
-//! The blocks alive are kept in one table (address, size): [`overruns`] tells how many
-//! blocks have had their red zone written, alive or freed, and the first such write it
-//! saw. An importer compares it before and after a call to know whether the call wrote
-//! past a block (MapleSim 2023's ControlledTemperature writes 16 bytes past a 48-byte
-//! block of its own in `fmi2GetDirectionalDerivative`). The pointer the FMU receives is
+//! The blocks alive are kept by owner, the instance whose call allocated them: the
+//! allocator has no `componentEnvironment` argument, so the importer marks each call it makes
+//! with the calling instance's `componentEnvironment` in a thread-local ([`enter_owner`]),
+//! and a block allocated during the call belongs to that instance (an FMU's calls run on
+//! the thread that called it; a block allocated on a thread of the FMU's own has owner 0).
+//! [`overruns_of`] tells how many blocks of one owner have had their red zone written,
+//! alive or freed, and the first such write it saw, reading that owner's blocks only; an
+//! importer compares it before and after a call to know whether the call wrote past a block
+//! of its instance (MapleSim 2023's ControlledTemperature writes 16 bytes past a 48-byte
+//! block of its own in `fmi2GetDirectionalDerivative`), and with several instances in
+//! threads one instance's write is never blamed on another's call. [`overruns`] is the
+//! process's count. The pointer the FMU receives is
 //! calloc's own, so an FMU that frees it with `free` instead of `freeMemory` still works;
 //! its table entry then stays, and the red zone is read through a system call that fails
 //! instead of faulting ([`read_own_memory`]), so reading it never crashes. Memory an FMU
 //! gets from `malloc` itself, and FMI 3.0 (no memory callbacks), are not guarded.
 //!
 //! ```
-//! use fmi_sys::fmi2::guard::{allocate, overruns, release};
-//! let before = overruns().count;
+//! use fmi_sys::fmi2::guard::{allocate, enter_owner, overruns_of, release};
+//! let owner = 0x5eed; // an instance's componentEnvironment
+//! let p = {
+//!     let _call = enter_owner(owner); // the importer's mark around a call of that instance
+//!     unsafe { allocate(6, 8) as *mut f64 }
+//! };
 //! unsafe {
-//!     let p = allocate(6, 8) as *mut f64;
 //!     *p.add(6) = 1.0; // one past the six doubles: into the red zone
-//!     assert_eq!(overruns().count, before + 1);
+//!     assert_eq!(overruns_of(owner).count, 1);
+//!     assert_eq!(overruns_of(owner + 1).count, 0, "another instance's count");
 //!     release(p.cast());
 //! }
-//! assert_eq!(overruns().count, before + 1);
+//! assert_eq!(overruns_of(owner).count, 1);
 //! ```
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::ffi::{c_char, c_void};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
 /// The bytes after every block that an overrun writes into harmlessly (and is seen in).
 pub const RED_ZONE: usize = 64;
 const PATTERN: u8 = 0xA5;
 
-/// The blocks alive: address -> the size the FMU asked for.
-static LIVE: Mutex<BTreeMap<usize, usize>> = Mutex::new(BTreeMap::new());
-/// Blocks freed with their red zone written.
-static FREED_OVERRUN: AtomicU64 = AtomicU64::new(0);
-/// The first overrun seen (block size, bytes written past it), 0 when none.
-static FIRST: Mutex<(usize, usize)> = Mutex::new((0, 0));
+/// The blocks alive: (owner, address) -> the size the FMU asked for.
+static LIVE: Mutex<BTreeMap<(usize, usize), usize>> = Mutex::new(BTreeMap::new());
+/// The owner of each block alive: address -> owner.
+static OWNER_OF: Mutex<BTreeMap<usize, usize>> = Mutex::new(BTreeMap::new());
+/// By owner: blocks freed with their red zone written, and the first overrun seen (block
+/// size, bytes written past it).
+static SEEN: Mutex<BTreeMap<usize, Seen>> = Mutex::new(BTreeMap::new());
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Seen {
+    freed_overrun: u64,
+    first: Option<(usize, usize)>,
+}
+
+thread_local! {
+    /// The owner of the blocks allocated on this thread now (0: none marked).
+    static OWNER: Cell<usize> = const { Cell::new(0) };
+}
+
+/// The mark of a call of one instance ([`enter_owner`]); the owner before it again when
+/// dropped.
+#[must_use]
+pub struct OwnerMark(usize);
+
+impl Drop for OwnerMark {
+    fn drop(&mut self) {
+        OWNER.with(|o| o.set(self.0));
+    }
+}
+
+/// Marks the calls that follow on this thread, until the mark is dropped, as those of the
+/// instance `owner` (its `componentEnvironment`): the blocks they allocate are its own.
+pub fn enter_owner(owner: usize) -> OwnerMark {
+    OwnerMark(OWNER.with(|o| o.replace(owner)))
+}
 
 extern "C" {
     fn calloc(n: usize, size: usize) -> *mut c_void;
@@ -56,8 +96,8 @@ pub struct Overruns {
     pub first: Option<(usize, usize)>,
 }
 
-fn live() -> std::sync::MutexGuard<'static, BTreeMap<usize, usize>> {
-    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+fn lock<T>(m: &'static Mutex<T>) -> std::sync::MutexGuard<'static, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// How many bytes past the block of `size` bytes at `at` were written (the last red-zone
@@ -73,25 +113,46 @@ fn written_past(at: usize, size: usize) -> usize {
     zone.iter().rposition(|b| *b != PATTERN).map_or(0, |k| k + 1)
 }
 
-fn note_first(size: usize, past: usize) {
-    let mut first = FIRST.lock().unwrap_or_else(|e| e.into_inner());
-    if first.1 == 0 {
-        *first = (size, past);
-    }
+fn note_overrun(owner: usize, size: usize, past: usize, freed: bool) {
+    let mut seen = lock(&SEEN);
+    let s = seen.entry(owner).or_default();
+    s.freed_overrun += u64::from(freed);
+    s.first.get_or_insert((size, past));
 }
 
-/// The overruns so far: the blocks alive are read now.
-pub fn overruns() -> Overruns {
-    let mut count = FREED_OVERRUN.load(Ordering::Relaxed);
-    for (&at, &size) in live().iter() {
+/// The overruns of the blocks of `owner` so far: its blocks alive are read now (one
+/// `process_vm_readv` each), no other's.
+pub fn overruns_of(owner: usize) -> Overruns {
+    let blocks: Vec<(usize, usize)> =
+        lock(&LIVE).range((owner, 0)..=(owner, usize::MAX)).map(|(&(_, at), &size)| (at, size)).collect();
+    let mut count = 0;
+    for (at, size) in blocks {
         let past = written_past(at, size);
         if past > 0 {
             count += 1;
-            note_first(size, past);
+            note_overrun(owner, size, past, false);
         }
     }
-    let first = *FIRST.lock().unwrap_or_else(|e| e.into_inner());
-    Overruns { count, first: (first.1 > 0).then_some(first) }
+    let seen = lock(&SEEN).get(&owner).copied().unwrap_or_default();
+    Overruns { count: count + seen.freed_overrun, first: seen.first }
+}
+
+/// The overruns of every owner's blocks so far (the process's).
+pub fn overruns() -> Overruns {
+    let owners: Vec<usize> = {
+        let mut o: Vec<usize> = lock(&LIVE).keys().map(|(owner, _)| *owner).collect();
+        o.extend(lock(&SEEN).keys());
+        o.sort_unstable();
+        o.dedup();
+        o
+    };
+    let mut all = Overruns::default();
+    for owner in owners {
+        let o = overruns_of(owner);
+        all.count += o.count;
+        all.first = all.first.or(o.first);
+    }
+    all
 }
 
 /// `allocateMemory`: calloc's contract (zeroed, null when `n * size` overflows or memory
@@ -107,7 +168,9 @@ pub unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {
         return p;
     }
     std::ptr::write_bytes(p.cast::<u8>().add(bytes), PATTERN, RED_ZONE);
-    live().insert(p as usize, bytes);
+    let owner = OWNER.with(|o| o.get());
+    lock(&LIVE).insert((owner, p as usize), bytes);
+    lock(&OWNER_OF).insert(p as usize, owner);
     p
 }
 
@@ -119,11 +182,11 @@ pub unsafe extern "C" fn release(p: *mut c_void) {
     if p.is_null() {
         return;
     }
-    if let Some(size) = live().remove(&(p as usize)) {
+    let owner = lock(&OWNER_OF).remove(&(p as usize));
+    if let Some(size) = owner.and_then(|owner| lock(&LIVE).remove(&(owner, p as usize))) {
         let past = written_past(p as usize, size);
         if past > 0 {
-            FREED_OVERRUN.fetch_add(1, Ordering::Relaxed);
-            note_first(size, past);
+            note_overrun(owner.unwrap_or(0), size, past, true);
         }
     }
     free(p)

@@ -11,8 +11,8 @@
 //! Never panics.
 
 use crate::read::{
-    check_root, once, parse_tree, read_default_experiment, read_log_categories, read_units, with_document_attributes,
-    Ctx, Node, ReadError,
+    children_once, read_default_experiment, read_log_categories, read_root, read_units, with_document_attributes, Ctx,
+    Node, ReadError, DOCUMENT_ELEMENTS,
 };
 use crate::{Initial, Variability};
 
@@ -314,37 +314,14 @@ impl ModelDescription {
     /// (an FMI 2.0 document is [`ReadError::UnsupportedFmiVersion`]; pick the reader with
     /// [`fmi_version_of`]).
     pub fn from_xml(xml: &str) -> Result<ModelDescription, ReadError> {
-        let root = parse_tree(xml)?;
-        let ctx = Ctx { src: xml };
-        check_root(&ctx, &root)?;
+        let (root, ctx, fmi_version) = read_root(xml, "3.0", is_fmi3_version)?;
         let label = "fmiModelDescription";
-        let fmi_version = ctx.req(&root, label, "fmiVersion")?.trim();
-        if !is_fmi3_version(fmi_version) {
-            return Err(ReadError::UnsupportedFmiVersion {
-                found: fmi_version.to_string(),
-                expected: "3.0",
-                position: ctx.pos(&root),
-            });
-        }
         let model_name = ctx.req(&root, label, "modelName")?.to_string();
         let instantiation_token = ctx.req(&root, label, "instantiationToken")?.to_string();
 
-        let (mut me, mut cs, mut se, mut units, mut types, mut logs, mut exp, mut vars, mut ms) =
-            (None, None, None, None, None, None, None, None, None);
-        for c in &root.children {
-            match c.name.as_str() {
-                "ModelExchange" => once(&ctx, &mut me, c)?,
-                "CoSimulation" => once(&ctx, &mut cs, c)?,
-                "ScheduledExecution" => once(&ctx, &mut se, c)?,
-                "UnitDefinitions" => once(&ctx, &mut units, c)?,
-                "TypeDefinitions" => once(&ctx, &mut types, c)?,
-                "LogCategories" => once(&ctx, &mut logs, c)?,
-                "DefaultExperiment" => once(&ctx, &mut exp, c)?,
-                "ModelVariables" => once(&ctx, &mut vars, c)?,
-                "ModelStructure" => once(&ctx, &mut ms, c)?,
-                _ => {} // Annotations and elements of later minor versions
-            }
-        }
+        // Annotations and elements of later minor versions are skipped.
+        let [me, cs, units, types, logs, exp, vars, ms] = children_once(&ctx, &root, DOCUMENT_ELEMENTS)?;
+        let [se] = children_once(&ctx, &root, ["ScheduledExecution"])?;
 
         let model_exchange = me
             .map(|n| -> Result<ModelExchange, ReadError> {
@@ -434,7 +411,7 @@ impl ModelDescription {
         }
 
         Ok(with_document_attributes!(ModelDescription, &root, {
-            fmi_version: fmi_version.to_string(),
+            fmi_version: fmi_version.trim().to_string(),
             model_name,
             instantiation_token,
             model_exchange,

@@ -5,7 +5,9 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
 
 use super::*;
-use crate::validate::{duplicate_unit_messages, enumeration_messages, model_identifier_messages};
+use crate::validate::{
+    duplicate_unit_messages, enumeration_messages, initial_not_allowed_message, model_identifier_messages,
+};
 
 crate::validate::rules! {
     /// The number of start values must be the number of elements (1 for a scalar; an
@@ -140,15 +142,7 @@ impl ModelDescription {
             let allowed = Initial::allowed(c2, var);
             if let Some(init) = v.initial {
                 if matches!(v.causality, Causality::Input | Causality::Independent) {
-                    push(
-                        Rule::Initial,
-                        name,
-                        format!(
-                            "causality=\"{}\" must not define initial (has \"{}\")",
-                            v.causality.as_str(),
-                            init.as_str()
-                        ),
-                    );
+                    push(Rule::Initial, name, initial_not_allowed_message(v.causality.as_str(), init));
                 } else if legal && !allowed.contains(&init) {
                     push(
                         Rule::Initial,

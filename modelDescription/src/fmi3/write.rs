@@ -33,7 +33,10 @@ fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-fn common_attributes(e: &mut Elem, c: &InterfaceCommon) {
+/// The interface element `name` (`<ModelExchange>`, `<CoSimulation>`,
+/// `<ScheduledExecution>`) with the attributes the three share.
+fn interface_elem(name: &'static str, c: &InterfaceCommon) -> Elem {
+    let mut e = Elem::new(name);
     e.attr("modelIdentifier", &c.model_identifier)
         .flag("needsExecutionTool", c.needs_execution_tool)
         .flag("canBeInstantiatedOnlyOncePerProcess", c.can_be_instantiated_only_once_per_process)
@@ -42,6 +45,7 @@ fn common_attributes(e: &mut Elem, c: &InterfaceCommon) {
         .flag("providesDirectionalDerivatives", c.provides_directional_derivatives)
         .flag("providesAdjointDerivatives", c.provides_adjoint_derivatives)
         .flag("providesPerElementDependencies", c.provides_per_element_dependencies);
+    e
 }
 
 fn unknown_elem(name: &'static str, u: &Unknown) -> Elem {
@@ -119,15 +123,13 @@ impl ModelDescription {
         o.open(root);
 
         if let Some(me) = &self.model_exchange {
-            let mut e = Elem::new("ModelExchange");
-            common_attributes(&mut e, &me.common);
+            let mut e = interface_elem("ModelExchange", &me.common);
             e.flag("needsCompletedIntegratorStep", me.needs_completed_integrator_step)
                 .flag("providesEvaluateDiscreteStates", me.provides_evaluate_discrete_states);
             o.empty(e);
         }
         if let Some(cs) = &self.co_simulation {
-            let mut e = Elem::new("CoSimulation");
-            common_attributes(&mut e, &cs.common);
+            let mut e = interface_elem("CoSimulation", &cs.common);
             e.flag("canHandleVariableCommunicationStepSize", cs.can_handle_variable_communication_step_size)
                 .opt_f64("fixedInternalStepSize", cs.fixed_internal_step_size);
             if cs.max_output_derivative_order != 0 {
@@ -147,8 +149,7 @@ impl ModelDescription {
             o.empty(e);
         }
         if let Some(se) = &self.scheduled_execution {
-            let mut e = Elem::new("ScheduledExecution");
-            common_attributes(&mut e, &se.common);
+            let e = interface_elem("ScheduledExecution", &se.common);
             o.empty(e);
         }
 
@@ -217,10 +218,7 @@ impl ModelDescription {
 
         write_log_categories_and_experiment(&mut o, &self.log_categories, self.default_experiment.as_ref());
 
-        if self.model_variables.is_empty() {
-            o.empty(Elem::new("ModelVariables"));
-        } else {
-            o.open(Elem::new("ModelVariables"));
+        if o.open_unless_empty("ModelVariables", self.model_variables.is_empty()) {
             for v in &self.model_variables {
                 let e = variable_elem(v);
                 let starts: Vec<String> = match &v.start {

@@ -12,7 +12,8 @@ use nigel_synthesis::report::{
 };
 use nigel_synthesis::tracking::tracking_region;
 use nigel_synthesis::{
-    Architecture, DisturbanceVariant, PlantSpec, PoleRegion, Region, SweepProgress, TrackingSpec, TrackingWeights,
+    Architecture, DisturbanceVariant, PlantSpec, PoleRegion, Region, SweepProgress, SynthesisError, TrackingSpec,
+    TrackingWeights,
 };
 
 const USAGE: &str = "\
@@ -309,6 +310,29 @@ fn write_json<T: serde::Serialize>(path: &str, report: &T) -> Result<(), String>
     Ok(())
 }
 
+/// Prints the report of a design (`text`) and writes its JSON and its figure (`svg`) where
+/// the command line asks; the report, or exit code 1 when there is no design or a file
+/// cannot be written.
+fn deliver<R: serde::Serialize>(
+    cli: &Cli,
+    designed: Result<R, SynthesisError>,
+    text: fn(&R) -> String,
+    svg: fn(&R) -> String,
+) -> Result<R, ExitCode> {
+    let report = designed.map_err(|e| {
+        eprintln!("synthesize: no controller: {e}");
+        ExitCode::from(1)
+    })?;
+    print!("{}", text(&report));
+    let json = cli.json.as_ref().map_or(Ok(()), |path| write_json(path, &report));
+    let figure = || cli.plot.as_ref().map_or(Ok(()), |path| write_figure(path, &svg(&report)));
+    json.and_then(|()| figure()).map_err(|e| {
+        eprintln!("synthesize: {e}");
+        ExitCode::from(1)
+    })?;
+    Ok(report)
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let cli = match parse_args(&args) {
@@ -338,53 +362,21 @@ fn main() -> ExitCode {
             if !cli.quiet && request.objective == Objective::Pareto {
                 eprintln!("synthesize: gamma*, then the Pareto grid ...");
             }
-            let report = match run(request, progress_ref) {
-                Ok(r) => r,
-                Err(e) => {
-                    eprintln!("synthesize: no controller: {e}");
-                    return ExitCode::from(1);
-                }
-            };
-            print!("{}", render_text(&report));
-            if let Some(path) = &cli.json {
-                if let Err(e) = write_json(path, &report) {
-                    eprintln!("synthesize: {e}");
-                    return ExitCode::from(1);
-                }
+            let designed = run(request, progress_ref);
+            match deliver(&cli, designed, render_text, nigel_synthesis::plot::render_svg) {
+                Ok(report) => report.verification.passed,
+                Err(code) => return code,
             }
-            if let Some(path) = &cli.plot {
-                if let Err(e) = write_figure(path, &nigel_synthesis::plot::render_svg(&report)) {
-                    eprintln!("synthesize: {e}");
-                    return ExitCode::from(1);
-                }
-            }
-            report.verification.passed
         }
         Job::Tracking(request) => {
             if !cli.quiet {
                 eprintln!("synthesize: tracking model: gamma*, then the Pareto grid ...");
             }
-            let report = match run_tracking(request, progress_ref) {
-                Ok(r) => r,
-                Err(e) => {
-                    eprintln!("synthesize: no controller: {e}");
-                    return ExitCode::from(1);
-                }
-            };
-            print!("{}", render_tracking_text(&report));
-            if let Some(path) = &cli.json {
-                if let Err(e) = write_json(path, &report) {
-                    eprintln!("synthesize: {e}");
-                    return ExitCode::from(1);
-                }
+            let designed = run_tracking(request, progress_ref);
+            match deliver(&cli, designed, render_tracking_text, nigel_synthesis::plot::render_tracking_svg) {
+                Ok(report) => report.verification.passed,
+                Err(code) => return code,
             }
-            if let Some(path) = &cli.plot {
-                if let Err(e) = write_figure(path, &nigel_synthesis::plot::render_tracking_svg(&report)) {
-                    eprintln!("synthesize: {e}");
-                    return ExitCode::from(1);
-                }
-            }
-            report.verification.passed
         }
     };
     if !passed {

@@ -133,7 +133,7 @@ impl GroupIntegrator {
                     .any(|v| v.causality == model_description::Causality::Input)
             });
         let floor = match solver {
-            Solver::Bdf { rtol, atol } if rtol > 0.0 => atol / rtol,
+            Solver::Bdf { rtol, atol } | Solver::Auto { rtol, atol, .. } if rtol > 0.0 => atol / rtol,
             _ => 1.0,
         }
         .max(f64::MIN_POSITIVE);
@@ -189,8 +189,25 @@ impl GroupIntegrator {
     /// summary), and the notes on the members' Jacobians into theirs.
     pub(crate) fn report<L: Members + ?Sized>(&mut self, lanes: &mut L, members: &[usize], solver: Solver) {
         let work = self.integrator.work();
+        if let Some(stiff) = self.integrator.take_switch() {
+            let names: Vec<String> = members.iter().map(|m| lanes.instance(*m).name().to_string()).collect();
+            let tolerance = match solver {
+                Solver::Auto { rtol, .. } => format!(" (rtol {rtol:e})"),
+                _ => String::new(),
+            };
+            if let Some((_, u)) = members.first().and_then(|m| lanes.member(*m)) {
+                u.notes.push(format!(
+                    "{}: stiff at t = {} s: an RK4 step of {:e} s has h*rho = {:.3e} (its stability bound: 2.785), so the \
+                     default solver continues with bdf{tolerance} from there (--solver rk4|dopri5|bdf forces one method)",
+                    names.join(", "),
+                    stiff.t,
+                    stiff.h,
+                    stiff.h_rho
+                ));
+            }
+        }
         if let Some((_, u)) = members.first().and_then(|m| lanes.member(*m)) {
-            if let Solver::Bdf { .. } = solver {
+            if matches!(solver, Solver::Bdf { .. }) || self.integrator.switched() {
                 u.stiff = work;
                 u.stiff.rhs += self.difference_rhs + self.check_rhs;
                 u.stiff.jacobian_rhs = self.difference_rhs;
@@ -280,8 +297,13 @@ impl<L: Members + ?Sized> OdeSystem for GroupSystem<'_, L> {
                     Some((i, j)) => {
                         mj.directional = false;
                         let name = |vrs: &[u32], k: usize| format!("value reference {}", vrs[k]);
+                        let call = if inst.is_fmi3() {
+                            "fmi3GetDirectionalDerivative"
+                        } else {
+                            "fmi2GetDirectionalDerivative"
+                        };
                         mj.note = Some(format!(
-                            "{}: fmi2GetDirectionalDerivative gives d der / d x = {:e} for the derivative ({}) with \
+                            "{}: {call} gives d der / d x = {:e} for the derivative ({}) with \
                              respect to the state ({}) at t = {t} s where finite differences give {:e}: bdf uses \
                              finite differences for it",
                             inst.name(),

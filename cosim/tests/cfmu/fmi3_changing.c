@@ -1,0 +1,130 @@
+/* An FMI 3.0 Scheduled Execution test FMU with a changing (aperiodic) clock as a model
+ * partition, written against the standard's headers.
+ *
+ * Clocks (value references as the test's description has them):
+ *   1 steps  input, changing, priority 0: its first tick `first_delay` after the start (the
+ *            interval fmi3GetIntervalDecimal gives in Initialization Mode), and after its
+ *            k-th activation the next one 0.25 (k + 1) s later (the interval
+ *            fmi3GetIntervalDecimal gives right after that activation, fmi3IntervalChanged;
+ *            asked again before the next activation, the same with fmi3IntervalUnchanged).
+ *            An activation at another time than the tick the FMU gave is an error.
+ *   2 fast   input, constant, every 0.5 s, priority 1
+ * Variables: 10 first_delay Float64 parameter (0.25 s), 11 t_steps Float64 output (the time
+ *   of steps' latest activation), 20 n_steps, 21 n_fast Int32 outputs (activations), 22
+ *   first Int32 output: the clock (value reference) of the first partition activated at the
+ *   latest activation time. */
+#include "fmi3_test.h"
+
+typedef struct {
+    fmi3InstanceEnvironment env;
+    fmi3LogMessageCallback log;
+    double first_delay, t_steps, last_time, next_steps, interval;
+    int n_steps, n_fast, first, changed, initializing;
+} Changing;
+
+FMI3_TEST_FAIL(Changing)
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
+    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
+    fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
+    if (!token || strcmp(token, "{fmi3-changing}") != 0) return NULL;
+    Changing *c = calloc(1, sizeof(Changing));
+    if (!c) return NULL;
+    c->env = env;
+    c->log = log;
+    c->first_delay = 0.25;
+    c->last_time = -1.0;
+    return c;
+}
+
+void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
+    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    Changing *c = instance;
+    c->initializing = 1;
+    c->interval = c->first_delay;
+    c->next_steps = startTime + c->first_delay;
+    c->changed = 1;
+    return fmi3OK;
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    Changing *c = instance;
+    c->initializing = 0;
+    return fmi3OK;
+}
+
+fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
+    Changing *c = instance;
+    if (time != c->last_time) {
+        c->first = (int)clock;
+        c->last_time = time;
+    }
+    switch (clock) {
+    case 1:
+        if (time != c->next_steps) return fail(c, "steps activated at another time than the tick the FMU gave");
+        c->n_steps++;
+        c->t_steps = time;
+        c->interval = 0.25 * (c->n_steps + 1);
+        c->next_steps = time + c->interval;
+        c->changed = 1;
+        return fmi3OK;
+    case 2:
+        c->n_fast++;
+        return fmi3OK;
+    default:
+        return fail(c, "fmi3ActivateModelPartition: not an input clock");
+    }
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
+    Changing *c = instance;
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] != 1) return fail(c, "fmi3GetIntervalDecimal: only the changing clock steps");
+        intervals[i] = c->interval;
+        qualifiers[i] = c->changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;
+        c->changed = 0;
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3Float64 values[], size_t nValues) {
+    Changing *c = instance;
+    for (size_t i = 0; i < n; i++) {
+        switch (vr[i]) {
+        case 10: values[i] = c->first_delay; break;
+        case 11: values[i] = c->t_steps; break;
+        default: return fail(c, "fmi3GetFloat64: unknown value reference");
+        }
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    const fmi3Float64 values[], size_t nValues) {
+    Changing *c = instance;
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] != 10) return fail(c, "fmi3SetFloat64: only first_delay");
+        c->first_delay = values[i];
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
+    fmi3Int32 values[], size_t nValues) {
+    Changing *c = instance;
+    for (size_t i = 0; i < n; i++) {
+        switch (vr[i]) {
+        case 20: values[i] = c->n_steps; break;
+        case 21: values[i] = c->n_fast; break;
+        case 22: values[i] = c->first; break;
+        default: return fail(c, "fmi3GetInt32: unknown value reference");
+        }
+    }
+    return fmi3OK;
+}
