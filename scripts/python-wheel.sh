@@ -14,12 +14,7 @@
 # target folder (target/rust-web), so that what they share compiles once. maturin and zig
 # come from scripts/setup-cross.sh's venv.
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in
-    /*) ;;
-    *) target="$repo/$target" ;;
-esac
+. "$(dirname "$0")/target-dir.sh"
 platform="${1:-linux-x86_64}"
 bash "$repo/scripts/setup-cross.sh"
 venv="$target/cross-venv"

@@ -8,9 +8,7 @@
 # needs fmpy and pandas, which have no arm64 build here).
 # Usage: test-wheel-aarch64.sh WHEEL COSIM (COSIM: the aarch64 program, e.g. test-dist.sh's).
 set -euo pipefail
-repo="$(cd "$(dirname "$0")/.." && pwd)"
-target="${CARGO_TARGET_DIR:-$repo/target}"
-case "$target" in /*) ;; *) target="$repo/$target" ;; esac
+. "$(dirname "$0")/target-dir.sh"
 wheel="$1" cosim="$2"
 root="$target/arm64-python"
 packages=(python3.11-minimal libpython3.11-minimal libpython3.11-stdlib python3-numpy libexpat1 zlib1g
