@@ -117,14 +117,6 @@ for ssp in nigel_closed_loop.ssp nigel_closed_loop_fmi3.ssp; do
     cmp "$target_dir/ssp-first/$ssp" "$target_dir/ssp/$ssp" || { echo "rebuilt $ssp differs" >&2; exit 1; }
     echo "identical: $ssp"
 done
-stage "the controller with its FMI 3.0 sample clock (build option controller-sample-clock, off by default)"
-# its FMI 3.0 archive declares the sample period as a periodic input clock: built into a
-# folder of its own (target/fmu and target/ssp stay the shipped ones) for
-# tests/python/test_clocked_controller.py (fmpy drives the clock) and
-# tests/tests/fmi3_closed_loop.rs (its closed loop equals the FMI 2.0 one); the layer-level run
-cargo run --release --quiet -p build-fmu --features controller-sample-clock -- --platforms linux64 \
-    "$target_dir/fmu-clocked/fmu" >/dev/null
-cargo test --release --quiet -p fmu-controller --features fmi3-sample-clock --test sample_clock
 # the platform tests fail, rather than skip, when an archive lacks a platform
 export NIGEL_REQUIRE_PLATFORMS=all
 stage "Python venv with fmpy (built beside the FMUs)"

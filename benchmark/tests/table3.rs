@@ -3,6 +3,10 @@
 
 use nigel_benchmark::{table3, Benchmark, Controller, Fidelity, Maneuver, Scenario};
 
+#[path = "common/self_check.rs"]
+mod self_check;
+use self_check::self_check_cells;
+
 /// The robust gain the self-check's robust cells were computed with (rows FL, FR, RL, RR;
 /// columns beta, yaw_rate): a solution of the robust synthesis's LMIs without the mirror
 /// symmetry imposed. The optimum of those LMIs is flat in `K` to about 1e-5, so this gain and
@@ -16,22 +20,6 @@ const SELF_CHECK_ROBUST_GAIN: [[f64; 2]; 4] = [
     [-0.14797866319162523, 0.4092793222431792],
 ];
 
-/// `(column, maneuver, open_loop, robust)` from the independent implementation.
-const SELF_CHECK: [(Fidelity, Maneuver, f64, f64); 12] = [
-    (Fidelity::Paper, Maneuver::Straight, 0.0205799, 0.0238091),
-    (Fidelity::Paper, Maneuver::LaneChange, 0.0593189, 0.0420524),
-    (Fidelity::Paper, Maneuver::Skidpad, 0.791631, 0.325539),
-    (Fidelity::Paper, Maneuver::Fishhook, 0.292381, 0.114311),
-    (Fidelity::Paper, Maneuver::Slalom, 1.12056, 0.509415),
-    (Fidelity::Paper, Maneuver::Figure8, 0.617197, 0.262837),
-    (Fidelity::Real, Maneuver::Straight, 0.0205799, 0.0198954),
-    (Fidelity::Real, Maneuver::LaneChange, 0.0298599, 0.0184275),
-    (Fidelity::Real, Maneuver::Skidpad, 0.874354, 0.463698),
-    (Fidelity::Real, Maneuver::Fishhook, 0.290312, 0.135593),
-    (Fidelity::Real, Maneuver::Slalom, 0.970792, 0.500319),
-    (Fidelity::Real, Maneuver::Figure8, 0.650735, 0.42491),
-];
-
 #[test]
 fn table3_epsilon_matches_the_independent_implementation() {
     let self_check_robust = Controller::Custom(SELF_CHECK_ROBUST_GAIN);
@@ -42,14 +30,13 @@ fn table3_epsilon_matches_the_independent_implementation() {
         let cell = cells.iter().find(|x| x.fidelity == f && x.maneuver == m && x.controller == c).unwrap();
         cell.metric.epsilon
     };
-    let results: Vec<(Fidelity, Maneuver, f64, f64, f64, f64)> = SELF_CHECK
-        .iter()
-        .map(|&(f, m, ol, rb)| (f, m, epsilon(f, m, Controller::OpenLoop), ol, epsilon(f, m, self_check_robust), rb))
+    let results: Vec<(Fidelity, Maneuver, f64, f64, f64, f64)> = self_check_cells()
+        .map(|(f, m, ol, rb)| (f, m, epsilon(f, m, Controller::OpenLoop), ol, epsilon(f, m, self_check_robust), rb))
         .collect();
     // the baked gain, another point of the same optimum: its robust cells are 2.0e-4 (relative)
     // at most from the self-check's (measured); 5e-4 holds that and still catches any change of
     // the definition, which moves these cells by percents
-    for &(f, m, _, rb) in &SELF_CHECK {
+    for (f, m, _, rb) in self_check_cells() {
         let baked = epsilon(f, m, Controller::Robust);
         assert!((baked - rb).abs() <= 5e-4 * rb, "{} {m}: baked robust gain {baked} vs self-check {rb}", f.column());
     }

@@ -574,15 +574,9 @@ fn with_glibc_of(mut built: PlatformBuild, libraries: &[Vec<u8>]) -> PlatformBui
     built
 }
 
-/// The cargo features of the FMU libraries of `packages`: each one's `fmi-export`, and with
-/// the build option `controller-sample-clock` the controller's `fmi3-sample-clock` (the
-/// library must declare what this process's declaration writes into the description).
+/// The cargo features of the FMU libraries of `packages`: each one's `fmi-export`.
 pub fn library_features(packages: &[&str]) -> Vec<String> {
-    let mut features: Vec<String> = packages.iter().map(|p| format!("{p}/fmi-export")).collect();
-    if cfg!(feature = "controller-sample-clock") && packages.contains(&"fmu-controller") {
-        features.push("fmu-controller/fmi3-sample-clock".into());
-    }
-    features
+    packages.iter().map(|p| format!("{p}/fmi-export")).collect()
 }
 
 /// Builds one FMU for linux64 with the workspace's own cargo (no cross toolchain needed;

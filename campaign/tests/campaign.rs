@@ -11,7 +11,10 @@ use nigel_campaign::run::{run, Options, Worker};
 use nigel_campaign::spec::Spec;
 
 mod common;
-use common::{root, target_dir};
+use common::{campaign_run, root, target_dir};
+#[path = "../../cosim/tests/common/mod.rs"]
+mod cosim_common;
+use cosim_common::read_csv as read_cosim_csv;
 
 fn ssp() -> PathBuf {
     target_dir().join("ssp").join("nigel_closed_loop.ssp")
@@ -212,15 +215,6 @@ fn resume_after_a_killed_run_completes_it() {
     assert_eq!(std::fs::read(&rows).unwrap(), std::fs::read(local.join("results.csv")).unwrap());
 }
 
-/// Reads the CSV `cosim run` writes: names and rows.
-fn read_cosim_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names = lines.next().unwrap().split(',').map(|n| n.trim_matches('"').to_string()).collect();
-    let rows = lines.map(|l| l.split(',').map(|f| f.parse().unwrap()).collect()).collect();
-    (names, rows)
-}
-
 #[test]
 fn metrics_equal_those_of_cosim_runs_csv() {
     let dir = tempfile::tempdir().unwrap();
@@ -377,13 +371,23 @@ fn bad_input_is_a_one_line_error_naming_the_culprit() {
     let e = run(&other, &quiet(&out)).unwrap_err().to_string();
     assert!(e.contains("holds another campaign") && e.contains("choose another --out"), "{e}");
     // the CLI prints the same line and fails
-    let o = Command::new(CAMPAIGN).arg("run").arg(&other_path).arg("--out").arg(&out).output().unwrap();
+    let o = campaign_run(&other_path, &out).output().unwrap();
     assert!(!o.status.success());
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.starts_with("campaign: ") && stderr.contains("holds another campaign"), "{stderr}");
     let o = Command::new(CAMPAIGN).arg("run").arg(&spec_path).args(["--out", "x", "--shard", "3/3"]).output().unwrap();
     assert!(String::from_utf8_lossy(&o.stderr).contains("--shard 3/3: expected I/N with 0 <= I < N"));
+}
+
+/// Writes the spec `text` of three runs to `path` and runs it into `out`: all three ran,
+/// `failed` of them failed; the rows.
+fn run_three_of_which_fail(path: &Path, text: &str, out: &Path, failed: u64) -> Vec<nigel_campaign::results::Row> {
+    std::fs::write(path, text).unwrap();
+    let spec = Spec::load(path).unwrap();
+    let done = run(&spec, &quiet(out)).unwrap();
+    assert_eq!((done.ran, done.failed), (3, failed));
+    nigel_campaign::results::read_rows(&Target::whole(out), &spec, false).unwrap()
 }
 
 #[test]
@@ -397,12 +401,8 @@ fn a_failing_run_is_a_row_and_the_campaign_goes_on() {
         ssp().display().to_string()
     );
     let path = dir.path().join("fail.toml");
-    std::fs::write(&path, text).unwrap();
-    let spec = Spec::load(&path).unwrap();
     let out = dir.path().join("out");
-    let done = run(&spec, &quiet(&out)).unwrap();
-    assert_eq!((done.ran, done.failed), (3, 1));
-    let rows = nigel_campaign::results::read_rows(&Target::whole(&out), &spec, false).unwrap();
+    let rows = run_three_of_which_fail(&path, &text, &out, 1);
     assert_eq!(rows.iter().map(|r| r.status).collect::<Vec<_>>(), [0, 1, 0]);
     assert!(rows[1].message.contains("duration"), "{}", rows[1].message);
     assert!(rows[1].values[1].is_nan() && rows[0].values[1].is_finite());
@@ -410,12 +410,7 @@ fn a_failing_run_is_a_row_and_the_campaign_goes_on() {
     assert!(text.lines().nth(2).unwrap().starts_with("1,1,1,0.02,NaN"), "{text}");
     // a time limit no run can meet: every run fails with the master's timeout, none is lost
     let text = std::fs::read_to_string(&path).unwrap().replace("step = 1e-3\n", "step = 1e-3\ntimeout = 1e-9\n");
-    std::fs::write(&path, text).unwrap();
-    let spec = Spec::load(&path).unwrap();
-    let out = dir.path().join("timeout");
-    let done = run(&spec, &quiet(&out)).unwrap();
-    assert_eq!((done.ran, done.failed), (3, 3));
-    let rows = nigel_campaign::results::read_rows(&Target::whole(&out), &spec, false).unwrap();
+    let rows = run_three_of_which_fail(&path, &text, &dir.path().join("timeout"), 3);
     // status 5: timed out (the middle run may fail for its duration first, status 1)
     assert!(rows[0].status == 5 && rows[2].status == 5 && rows[1].status != 0, "{rows:?}");
     assert!(rows[0].message.contains("time limit") && rows[2].message.contains("time limit"), "{:?}", rows[0].message);
@@ -426,14 +421,7 @@ fn only_prints_one_run_by_name_and_writes_its_every_output() {
     let dir = tempfile::tempdir().unwrap();
     let spec_path = small(dir.path(), 1.0, 2);
     let out = dir.path().join("out");
-    let o = Command::new(CAMPAIGN)
-        .arg("run")
-        .arg(&spec_path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--only", "3"])
-        .output()
-        .unwrap();
+    let o = campaign_run(&spec_path, &out).args(["--only", "3"]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8(o.stdout).unwrap();
     let lines: Vec<(&str, &str)> = text.lines().map(|l| l.split_once(" = ").unwrap()).collect();

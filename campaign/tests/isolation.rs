@@ -16,7 +16,7 @@ use nigel_campaign::spec::Spec;
 const CAMPAIGN: &str = env!("CARGO_BIN_EXE_campaign");
 
 mod common;
-use common::{root, target_dir};
+use common::{campaign_run, root, target_dir, write_spec};
 
 /// crash.c compiled with the system `cc` and zipped with crash.xml as `<dir>/crash.fmu`.
 fn build_crash(dir: &Path) -> PathBuf {
@@ -58,13 +58,12 @@ const MODES: [u32; 9] = [0, 1, 0, 5, 4, 0, 2, 0, 0];
 fn crash_campaign(dir: &Path) -> PathBuf {
     let fmu = build_crash(dir);
     let modes: Vec<String> = MODES.iter().map(|m| format!("{m}.0")).collect();
-    let text = format!(
-        "system = {:?}\nstop_time = 1.0\nstep = 0.1\ntimeout = 1.0\n[grid]\n\"model.mode\" = [{}]\n[metrics]\ny = \"final(model.y)\"\n",
-        fmu.display().to_string(),
+    let path = dir.join("crash.toml");
+    let rest = format!(
+        "stop_time = 1.0\nstep = 0.1\ntimeout = 1.0\n[grid]\n\"model.mode\" = [{}]\n[metrics]\ny = \"final(model.y)\"\n",
         modes.join(", ")
     );
-    let path = dir.join("crash.toml");
-    std::fs::write(&path, text).unwrap();
+    write_spec(&path, &fmu, &rest);
     path
 }
 
@@ -146,16 +145,9 @@ fn a_stop_time_past_the_test_bench_is_refused_before_the_first_run() {
         assert_eq!(std::fs::read_to_string(out.join("results.csv")).unwrap().lines().count(), 1, "{workers:?}");
     }
     // run anyway: every run is a failed row naming the cause, and the exit status says so
-    let o = Command::new(CAMPAIGN).arg("run").arg(&path).arg("--out").arg(&out).output().unwrap();
+    let o = campaign_run(&path, &out).output().unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = Command::new(CAMPAIGN)
-        .arg("run")
-        .arg(&path)
-        .arg("--out")
-        .arg(&out)
-        .args(["--allow-failures", "--resume"])
-        .output()
-        .unwrap();
+    let o = campaign_run(&path, &out).args(["--allow-failures", "--resume"]).output().unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{stderr}");
     assert!(stderr.contains("warning: stop_time = 31 s is past"), "{stderr}");
@@ -193,14 +185,11 @@ fn a_library_that_crashes_while_loading_is_one_line_and_not_a_crash_of_the_campa
     let dir = tempfile::tempdir().unwrap();
     let fmu = build_c_fmu(dir.path(), "ctor");
     let path = dir.path().join("ctor.toml");
-    std::fs::write(
+    write_spec(
         &path,
-        format!(
-            "system = {:?}\nstop_time = 1.0\nstep = 0.1\n[grid]\n\"model.mode\" = [0.0, 1.0]\n[metrics]\ny = \"final(model.y)\"\n",
-            fmu.display().to_string()
-        ),
-    )
-    .unwrap();
+        &fmu,
+        "stop_time = 1.0\nstep = 0.1\n[grid]\n\"model.mode\" = [0.0, 1.0]\n[metrics]\ny = \"final(model.y)\"\n",
+    );
     // the description is checked without loading the library; the worker that loads it dies
     let tmp = dir.path().join("tmp");
     std::fs::create_dir(&tmp).unwrap();

@@ -9,8 +9,9 @@
 #[allow(dead_code, unused_imports)]
 mod cosim_common;
 
+mod common;
+use common::{campaign_run, write_spec};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The description of the C FMU (shared with cosim's Configuration Mode tests).
 const XML: &str = include_str!("../../cosim/tests/cfmu/fmi3_sized.xml");
@@ -35,17 +36,12 @@ fn a_structural_parameter_is_a_sweep_dimension_and_sizes_each_runs_arrays() {
     let dir = tempfile::tempdir().unwrap();
     let Some(fmu) = sized_fmu(dir.path()) else { return };
     let spec = dir.path().join("sized.toml");
-    std::fs::write(
-        &spec,
-        format!(
-            "system = {:?}\nstop_time = 1.0\nstep = 0.5\n\n[grid]\n\"model.n\" = [1, 2, 3]\n\n[metrics]\ny1 = \"final(model.y[1])\"\n",
-            fmu.display().to_string()
-        ),
-    )
-    .unwrap();
+    // n = 1, 2, 3: the sweep; y[1] exists in every run
+    let sweep =
+        "stop_time = 1.0\nstep = 0.5\n\n[grid]\n\"model.n\" = [1, 2, 3]\n\n[metrics]\ny1 = \"final(model.y[1])\"\n";
+    write_spec(&spec, &fmu, sweep);
     let out = dir.path().join("out");
-    let campaign = env!("CARGO_BIN_EXE_campaign");
-    let o = Command::new(campaign).arg("run").arg(&spec).arg("--out").arg(&out).output().unwrap();
+    let o = campaign_run(&spec, &out).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let spec_loaded = nigel_campaign::spec::Spec::load(&spec).unwrap();
     let mut worker = nigel_campaign::run::Worker::new(&spec_loaded).unwrap();
@@ -55,14 +51,7 @@ fn a_structural_parameter_is_a_sweep_dimension_and_sizes_each_runs_arrays() {
         assert_eq!(row.status, nigel_campaign::results::STATUS_OK, "run {run}: {:?}", row.message);
         assert_eq!(row.values, [n as f64, 1.0], "run {run}: n, then y1");
         // the run's every output: y with n elements
-        let o = Command::new(campaign)
-            .arg("run")
-            .arg(&spec)
-            .arg("--out")
-            .arg(&out)
-            .args(["--only", &run.to_string()])
-            .output()
-            .unwrap();
+        let o = campaign_run(&spec, &out).args(["--only", &run.to_string()]).output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let text = std::fs::read_to_string(out.join(format!("run-{run}.csv"))).unwrap();
         let header: Vec<&str> = text.lines().next().unwrap().split(',').map(|h| h.trim_matches('"')).collect();

@@ -11,6 +11,8 @@
 //! the tube; a car 3.7e-8 heavier (plant.m 2.68 -> 2.6800001) moves plant.yaw_rate by up to
 //! 2.7e-9 beyond it, and fails (the second test).
 
+mod common;
+use common::read_csv;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -49,13 +51,35 @@ fn cosim_with(args: &[&str]) -> (Option<i32>, String, String) {
 
 const LOOP: [&str; 7] = ["--stop-time", "30", "--step", "1e-3", "--algorithm", "ordered", "--output-interval"];
 
-/// A CSV as (names, rows).
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+/// `cosim run` of the closed loop (LOOP, output every 0.05 s into `out`) with `first` and
+/// `checks`, compared with the committed baseline (rtol 1e-9, atol 1e-12), then `reports`.
+fn run_closed_loop_against_the_baseline(
+    out: &Path,
+    first: &[&str],
+    checks: &[&str],
+    reports: &[&str],
+) -> (Option<i32>, String, String) {
+    let (ssp, base) = (closed_loop(), baseline());
+    cosim_with(
+        &[
+            &["run", ssp.to_str().unwrap()][..],
+            &LOOP,
+            &["0.05", "--output", out.to_str().unwrap()],
+            first,
+            checks,
+            &["--baseline", base.to_str().unwrap(), "--baseline-rtol", "1e-9", "--baseline-atol", "1e-12"],
+            reports,
+        ]
+        .concat(),
+    )
+}
+
+/// Asserts that the text file `path` (a report) contains each of `parts`.
+fn assert_file_says(path: &Path, parts: &[&str]) {
     let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let names = lines.next().unwrap().split(',').map(|n| n.trim_matches('"').to_string()).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
-    (names, rows)
+    for part in parts {
+        assert!(text.contains(part), "{part} not in {text}");
+    }
 }
 
 fn column(csv: &(Vec<String>, Vec<Vec<f64>>), name: &str) -> Vec<f64> {
@@ -126,19 +150,12 @@ fn the_docs_worked_example_of_the_tube_prints_what_it_says() {
 #[test]
 fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
     let dir = work("pass");
-    let (ssp, base, out, junit, md) =
-        (closed_loop(), baseline(), dir.join("out.csv"), dir.join("junit.xml"), dir.join("summary.md"));
-    let (code, stdout, stderr) = cosim_with(
-        &[
-            &["run", ssp.to_str().unwrap()][..],
-            &LOOP,
-            &["0.05", "--output", out.to_str().unwrap()],
-            &["--check", "max(abs(plant.y)) < 0.6", "--check", "final(plant.x) > 1"],
-            &["--check", "rms_diff(plant.y, maneuver.y_ref) <= 0.05"],
-            &["--baseline", base.to_str().unwrap(), "--baseline-rtol", "1e-9", "--baseline-atol", "1e-12"],
-            &["--junit", junit.to_str().unwrap(), "--summary-md", md.to_str().unwrap()],
-        ]
-        .concat(),
+    let (base, out, junit, md) = (baseline(), dir.join("out.csv"), dir.join("junit.xml"), dir.join("summary.md"));
+    let (code, stdout, stderr) = run_closed_loop_against_the_baseline(
+        &out,
+        &["--check", "max(abs(plant.y)) < 0.6", "--check", "final(plant.x) > 1"],
+        &["--check", "rms_diff(plant.y, maneuver.y_ref) <= 0.05"],
+        &["--junit", junit.to_str().unwrap(), "--summary-md", md.to_str().unwrap()],
     );
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
     // the checks' values, derived from the written results (every output, every row t_0 .. t_N)
@@ -166,8 +183,7 @@ fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
     }
     // docs/ci.md shows this run's lines
     assert_eq!(doc_block("run"), stdout);
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"9\" failures=\"0\" errors=\"0\""), "{xml}");
+    assert_file_says(&junit, &["tests=\"9\" failures=\"0\" errors=\"0\""]);
     let md = std::fs::read_to_string(&md).unwrap();
     assert!(md.contains("passed (9 tests, 0 failed, 0 errors)"), "{md}");
     assert!(md.contains(
@@ -178,18 +194,12 @@ fn the_closed_loop_holds_its_checks_and_stays_in_the_committed_baseline() {
 #[test]
 fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
     let dir = work("fail");
-    let (ssp, base, out, junit, plots) =
-        (closed_loop(), baseline(), dir.join("out.csv"), dir.join("junit.xml"), dir.join("plots"));
-    let (code, stdout, stderr) = cosim_with(
-        &[
-            &["run", ssp.to_str().unwrap()][..],
-            &LOOP,
-            &["0.05", "--output", out.to_str().unwrap(), "--set", "plant.m=2.6800001"],
-            &["--check", "final(plant.x) > 11"],
-            &["--baseline", base.to_str().unwrap(), "--baseline-rtol", "1e-9", "--baseline-atol", "1e-12"],
-            &["--plot", plots.to_str().unwrap(), "--junit", junit.to_str().unwrap()],
-        ]
-        .concat(),
+    let (out, junit, plots) = (dir.join("out.csv"), dir.join("junit.xml"), dir.join("plots"));
+    let (code, stdout, stderr) = run_closed_loop_against_the_baseline(
+        &out,
+        &["--set", "plant.m=2.6800001"],
+        &["--check", "final(plant.x) > 11"],
+        &["--plot", plots.to_str().unwrap(), "--junit", junit.to_str().unwrap()],
     );
     assert_eq!(code, Some(3), "{stdout}\n{stderr}");
     let csv = read_csv(&out);
@@ -199,7 +209,7 @@ fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
     assert!(stdout.contains("baseline: plant.x         pass  601 points inside the tube"), "{stdout}");
     // the largest violation of plant.yaw_rate, derived from the two files: at each point the
     // tube is b +- (1e-12 + 1e-9 |b|) (same grid, no time tolerance)
-    let (r, b) = (column(&csv, "plant.yaw_rate"), column(&read_csv(&base), "plant.yaw_rate"));
+    let (r, b) = (column(&csv, "plant.yaw_rate"), column(&read_csv(&baseline()), "plant.yaw_rate"));
     let excess: Vec<f64> = r.iter().zip(&b).map(|(r, b)| (r - b).abs() - (1e-12 + 1e-9 * b.abs())).collect();
     let outside = excess.iter().filter(|e| **e > 0.0).count();
     let k = (0..601).max_by(|i, j| excess[*i].total_cmp(&excess[*j])).unwrap();
@@ -218,9 +228,10 @@ fn a_heavier_car_leaves_the_tube_exits_3_and_keeps_its_results() {
         assert!(stderr.contains(&format!("cosim: figure {}", png.display())), "{stderr}");
     }
     assert!(!plots.join("plant.x.png").exists(), "a passing signal has no figure");
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"7\" failures=\"5\" errors=\"0\""), "{xml}");
-    assert!(xml.contains("<testcase classname=\"cosim.baseline\" name=\"plant.x\">"), "{xml}");
+    assert_file_says(
+        &junit,
+        &["tests=\"7\" failures=\"5\" errors=\"0\"", "<testcase classname=\"cosim.baseline\" name=\"plant.x\">"],
+    );
 }
 
 #[test]
@@ -283,9 +294,10 @@ fn a_run_that_cannot_be_done_exits_1_and_says_why() {
         junit.to_str().unwrap(),
     ]);
     assert_eq!(code, Some(1), "{stderr}");
-    let xml = std::fs::read_to_string(&junit).unwrap();
-    assert!(xml.contains("tests=\"2\" failures=\"0\" errors=\"2\""), "{xml}");
-    assert!(xml.contains("<error message=\"not judged: the run failed\""), "{xml}");
+    assert_file_says(
+        &junit,
+        &["tests=\"2\" failures=\"0\" errors=\"2\"", "<error message=\"not judged: the run failed\""],
+    );
 }
 
 #[test]

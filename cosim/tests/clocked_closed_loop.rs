@@ -1,6 +1,6 @@
-//! Our closed loop with the controller's FMI 3.0 sample clock (`build-fmu --features
-//! controller-sample-clock`, into target/fmu-clocked: `sample_clock`, a periodic input clock
-//! of 1 ms, ticking at every communication point) with its instances in host processes
+//! Our FMI 3.0 closed loop (target/ssp, built by build-fmu), whose controller declares its
+//! sample clock (`sample_clock`, a periodic input clock of 1 ms, ticking at every
+//! communication point), with its instances in host processes
 //! (`--isolate`, `--isolate=run`) and stepped in threads (`--threads 2`): the clock calls
 //! (`fmi3SetClock`, the intervals, `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`) cross
 //! the process boundary in the order they are made in process, and the thread pool opens
@@ -13,16 +13,19 @@ use nigel_cosim::{read_ssp, simulate, Algorithm, Experiment, Results};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The target folder (the FMUs and SSPs the test command builds).
+fn target() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"))
+}
+
 /// The clocked closed loop's SSP, built by the test command.
 fn clocked_ssp() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
-    let p = target.join("fmu-clocked").join("ssp").join("nigel_closed_loop_fmi3.ssp");
+    let p = target().join("ssp").join("nigel_closed_loop_fmi3.ssp");
     assert!(
         p.is_file(),
-        "{} missing: run `cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64 \
-         --this-glibc target/fmu-clocked/fmu`",
+        "{} missing: run `cargo run --release -p build-fmu -- --platforms linux64 --this-glibc`",
         p.display()
     );
     p
@@ -103,4 +106,64 @@ fn cosim_run_writes_the_same_clocked_loop_isolated_and_in_threads() {
         assert!(csv == plain, "{name}: the CSV differs from the in-process run's");
         assert_eq!(t, ticks, "{name}");
     }
+}
+
+/// The controller alone in Model Exchange (`--interface me`, steps of 0.5 ms, so its 1 ms
+/// ticks fall on every other communication point), inputs from a file: the FMI 3.0 archive
+/// publishes each next activation as `nextEventTime`, which cosim takes as that tick's event
+/// (one sample per tick: 20 ticks, at 0, 1, ..., 19 ms; the one at the stop time would run
+/// at the start of a step after it, which the run does not take), and the tick at the start
+/// time is activated in the event that ends initialization (else the FMU would sample by
+/// time events from there and refuse the later fmi3SetClock, failing the run). Each tick
+/// samples with the inputs of its time, as the same archive in Co-Simulation does (whose
+/// clocked loop is the FMI 2.0 one's to the bit: tests/tests/fmi3_closed_loop.rs): cosim
+/// runs a Model Exchange tick at the start of the step from it, a Co-Simulation tick at the
+/// end of the step reaching it (docs/clocks.md), so the rows agree at the start and between
+/// ticks (t_k + 0.5 ms), where both hold sample k.
+#[test]
+fn the_clocked_controller_in_model_exchange_samples_once_per_tick_as_in_co_simulation() {
+    let dir = common::work_dir("clocked-controller-me");
+    let input = dir.join("input.csv");
+    let mut text = String::from("time,beta,yaw_rate,speed,yaw_rate_ref\n");
+    for i in 0..=40 {
+        let t = i as f64 * 5e-4;
+        let s = (70.0 * t).sin();
+        text += &format!("{t:?},{:?},{:?},{:?},{:?}\n", 0.02 * s, 0.3 * (30.0 * t).cos(), 0.2 + 5.0 * t, 0.1 * s);
+    }
+    std::fs::write(&input, text).unwrap();
+    let fmu = target().join("fmu").join("fmi3").join("nigel_controller.fmu");
+    let run = |interface: &str| -> (Vec<Vec<f64>>, String) {
+        let (csv, summary) = (dir.join(format!("{interface}.csv")), dir.join(format!("{interface}.json")));
+        let out = Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .arg("run")
+            .arg(&fmu)
+            .args(["--interface", interface, "--stop-time", "0.02", "--step", "5e-4", "--input"])
+            .arg(&input)
+            .arg("-o")
+            .arg(&csv)
+            .arg("--summary")
+            .arg(&summary)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{interface}: {}", String::from_utf8_lossy(&out.stderr));
+        let rows = std::fs::read_to_string(&csv)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect())
+            .collect();
+        let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+        (rows, summary["clock_ticks"].to_string())
+    };
+    let (me, me_ticks) = run("me");
+    let (cs, cs_ticks) = run("cs");
+    assert_eq!(me_ticks, r#"[{"clock":"sample_clock","ticks":20}]"#);
+    assert_eq!(cs_ticks, r#"[{"clock":"sample_clock","ticks":21}]"#, "Co-Simulation: the stop time's tick too");
+    assert_eq!((me.len(), cs.len()), (41, 41));
+    let bits = |row: &Vec<f64>| row.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for r in (0..41).filter(|r| *r == 0 || r % 2 == 1) {
+        assert_eq!(bits(&me[r]), bits(&cs[r]), "row {r} (t = {} s)", cs[r][0]);
+    }
+    // the law did something: the steering moved from sample to sample
+    assert!(me.iter().any(|row| (row[1] - me[0][1]).abs() > 1e-3));
 }

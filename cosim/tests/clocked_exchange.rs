@@ -47,6 +47,14 @@ fn run_exchange(path: &Path, interface: Interface, isolated: bool) -> nigel_cosi
     simulate(&system, &experiment).unwrap().0
 }
 
+/// The test FMU built in `work_dir(test)` for `interface`, run (in a host process when
+/// `isolated`), its rows' held values checked ([`check_held`] with `open`); nothing without
+/// fmpy.
+fn assert_held_in(test: &str, interface: Interface, isolated: bool, open: bool) {
+    let Some(path) = exchange_fmu(&work_dir(test), interface) else { return };
+    check_held(&run_exchange(&path, interface, isolated), open);
+}
+
 /// The held values of the test below at each row. `open`: the row at a tick (the start
 /// time's too) is recorded with the tick's event open (Co-Simulation, docs/clocks.md), where this
 /// FMU answers the tick's y (it computes y in fmi3SetClock and again on a set of u while
@@ -84,9 +92,7 @@ fn check_held(results: &nigel_cosim::Results, open: bool) {
 /// last tick before it (`check_held`).
 #[test]
 fn clocked_variables_are_held_between_ticks_and_set_at_them() {
-    let dir = work_dir("clocked-exchange");
-    let Some(path) = exchange_fmu(&dir, Interface::CoSimulation) else { return };
-    check_held(&run_exchange(&path, Interface::CoSimulation, false), true);
+    assert_held_in("clocked-exchange", Interface::CoSimulation, false, true);
 }
 
 /// The same with the instance in a host process (`--isolate`): `fmi3SetClock`, the
@@ -98,9 +104,7 @@ fn clocked_variables_are_held_between_ticks_and_set_at_them() {
 #[test]
 fn isolated_instances_exchange_clocked_variables_at_their_ticks_only() {
     for (interface, open) in [(Interface::CoSimulation, true), (Interface::ModelExchange, false)] {
-        let dir = work_dir(&format!("clocked-exchange-isolated-{interface:?}"));
-        let Some(path) = exchange_fmu(&dir, interface) else { return };
-        check_held(&run_exchange(&path, interface, true), open);
+        assert_held_in(&format!("clocked-exchange-isolated-{interface:?}"), interface, true, open);
     }
 }
 
@@ -109,9 +113,7 @@ fn isolated_instances_exchange_clocked_variables_at_their_ticks_only() {
 /// and held values as derived above.
 #[test]
 fn model_exchange_exchanges_clocked_variables_at_their_ticks_only() {
-    let dir = work_dir("clocked-exchange-me");
-    let Some(path) = exchange_fmu(&dir, Interface::ModelExchange) else { return };
-    check_held(&run_exchange(&path, Interface::ModelExchange, false), false);
+    assert_held_in("clocked-exchange-me", Interface::ModelExchange, false, false);
 }
 
 /// The same in Scheduled Execution: `u` set once before each fmi3ActivateModelPartition of

@@ -74,16 +74,25 @@ fn every_kind_of_clock_ticks_at_its_times_from_fractional_intervals() {
     every_kind_ticks_at_its_times(&path, Some(common::isolate_all()));
 }
 
-fn every_kind_ticks_at_its_times(path: &Path, isolation: Option<nigel_cosim::Isolation>) {
+/// The FMU at `path` alone from 0 to 1.5 s in steps of 0.1 s with `trig` ticked by an input
+/// table at 0.45 and 1.2 s (the clock column: 1 at the times trig ticks, 0 elsewhere), with
+/// `isolation`.
+fn run_with_trig(
+    path: &Path,
+    isolation: Option<nigel_cosim::Isolation>,
+) -> (nigel_cosim::Results, nigel_cosim::Summary) {
     let system = System::single("c", Fmu::load(path).unwrap()).unwrap();
     let mut experiment = Experiment::new(1.5, 0.1);
     experiment.isolation = isolation;
-    // the input file's clock column: 1 at the times trig ticks, 0 elsewhere
     experiment.input = Some(Arc::new(
         InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
             .unwrap(),
     ));
-    let (results, summary) = simulate(&system, &experiment).unwrap();
+    simulate(&system, &experiment).unwrap()
+}
+
+fn every_kind_ticks_at_its_times(path: &Path, isolation: Option<nigel_cosim::Isolation>) {
+    let (results, summary) = run_with_trig(path, isolation);
     let time = results.column("time").unwrap();
     // rows at the points 0, 0.1, ..., 1.5 s and at the ticks between points: 0.35, 0.85,
     // 1.35 (periodic) and 0.45 (trig)
@@ -150,11 +159,7 @@ fn a_clock_column_for_a_periodic_clock_is_refused() {
 
 /// Instances `a` and `b` of the FMU at `path`, not connected.
 fn two_instances(path: &Path) -> SystemBuilder {
-    let fmu = Fmu::load(path).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("a", fmu.clone()).unwrap();
-    b.add_instance("b", fmu).unwrap();
-    b
+    common::builder_with(&Fmu::load(path).unwrap(), &["a", "b"])
 }
 
 #[test]
@@ -358,30 +363,13 @@ s.freeInstance()
 fn fmpy_driving_the_fmu_through_the_hand_derived_ticks_gives_cosims_rows() {
     let dir = work_dir("clocks-fmpy");
     let Some(path) = clocks_fmu(&dir) else { return };
-    let system = System::single("c", Fmu::load(&path).unwrap()).unwrap();
-    let mut experiment = Experiment::new(1.5, 0.1);
-    experiment.input = Some(Arc::new(
-        InputTable::new(vec!["trig".into()], vec![0.0, 0.45, 0.5, 1.2, 1.3], vec![vec![0.0, 1.0, 0.0, 1.0, 0.0]])
-            .unwrap(),
-    ));
-    let (results, _) = simulate(&system, &experiment).unwrap();
+    let (results, _) = run_with_trig(&path, None);
     let time = results.column("time").unwrap();
     // the input clocks' value references (1 periodic .. 5 trig) and their hand-derived ticks
     let ticks: Vec<String> = TICKS[..5].iter().enumerate().map(|(k, (_, t))| format!("[{}, {t:?}]", k + 1)).collect();
-    let python = std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".into());
-    let out = Command::new(python)
-        .args(["-c", FMPY_DRIVER])
-        .arg(&path)
-        .arg(format!("{time:?}"))
-        .arg(format!("[{}]", ticks.join(", ")))
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (times, ticks) = (format!("{time:?}"), format!("[{}]", ticks.join(", ")));
+    let lines = common::fmi3_c::fmpy_lines(FMPY_DRIVER, &[path.as_os_str(), times.as_ref(), ticks.as_ref()]);
     let columns = ["n_periodic", "n_fixed", "n_changing", "n_countdown", "n_trig", "n_out_clock", "last_tick"];
-    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
-        .collect();
     assert_eq!(lines.len(), time.len());
     for (name, k) in columns.iter().zip(1..) {
         let ours = results.column(name).unwrap();

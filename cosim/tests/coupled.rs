@@ -4,7 +4,7 @@
 //! counts the bounce at the bounce's own time; a loop without a fixed point is named.
 
 mod common;
-use common::{assert_counted_at_bounces, build_ball, build_latch, work_dir};
+use common::{assert_counted_at_bounces, build_ball, build_latch, builder_with, work_dir};
 use nigel_cosim::{simulate, Algorithm, Error, Experiment, Fmu, Solver, SystemBuilder, Value};
 
 const G: f64 = 9.81;
@@ -75,10 +75,7 @@ fn an_event_iteration_without_a_fixed_point_names_the_fmus() {
     // a follower (follows its input from its time event at 0.25 s on) and an inverter in
     // a loop: settled before 0.25 s, no fixed point after
     let dir = work_dir("coupled-loop");
-    let latch = Fmu::load(&build_latch(&dir)).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("follower", latch.clone()).unwrap();
-    b.add_instance("inverter", latch).unwrap();
+    let mut b = builder_with(&Fmu::load(&build_latch(&dir)).unwrap(), &["follower", "inverter"]);
     b.set("follower.mode", Value::Real(1.0)).unwrap();
     b.set("follower.t_event", Value::Real(0.25)).unwrap();
     b.set("inverter.mode", Value::Real(2.0)).unwrap();

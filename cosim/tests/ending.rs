@@ -26,14 +26,18 @@ fn counter_at(t: f64) -> f64 {
     1.0 + (t + 1e-9).floor()
 }
 
+/// The stair through `interface` to 10 s in steps of 0.2 s: its columns time and counter
+/// (asserted 46 rows) and the run's summary.
+fn stair_to_10s_in_46_rows(interface: Interface) -> (Vec<f64>, Vec<f64>, nigel_cosim::Summary) {
+    let (r, summary) = simulate(&stair(interface), &Experiment::new(10.0, 0.2)).unwrap();
+    assert_eq!(r.rows(), 46);
+    (r.column("time").unwrap(), r.column("counter").unwrap(), summary)
+}
+
 #[test]
 fn co_simulation_ends_at_the_last_successful_time_with_that_row() {
-    let system = stair(Interface::CoSimulation);
-    let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
-    let time = r.column("time").unwrap();
-    let counter = r.column("counter").unwrap();
     // rows 0, 0.2, ..., 8.8 (45 communication points), then the row at 9
-    assert_eq!(r.rows(), 46);
+    let (time, counter, summary) = stair_to_10s_in_46_rows(Interface::CoSimulation);
     assert_eq!(*time.last().unwrap(), 9.0);
     assert_eq!(*counter.last().unwrap(), 10.0);
     for (t, c) in time.iter().zip(&counter).take(45) {
@@ -47,12 +51,8 @@ fn co_simulation_ends_at_the_last_successful_time_with_that_row() {
 
 #[test]
 fn model_exchange_ends_at_the_event_with_the_row_at_the_event() {
-    let system = stair(Interface::ModelExchange);
-    let (r, summary) = simulate(&system, &Experiment::new(10.0, 0.2)).unwrap();
-    let time = r.column("time").unwrap();
-    let counter = r.column("counter").unwrap();
     // rows 0, 0.2, ..., 8.8 (45 communication points), then the row at the event at 9
-    assert_eq!(r.rows(), 46);
+    let (time, counter, summary) = stair_to_10s_in_46_rows(Interface::ModelExchange);
     assert!((time[44] - 8.8).abs() < 1e-12, "{}", time[44]); // 44 * 0.2 in f64
     assert_eq!(*time.last().unwrap(), 9.0);
     assert_eq!(*counter.last().unwrap(), 10.0);

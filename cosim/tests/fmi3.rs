@@ -601,6 +601,40 @@ fn a_crashing_fmi3_fmu_under_isolation_is_a_typed_error_with_the_rows_so_far() {
     }
 }
 
+/// The counter's description with `variables` (XML elements) before its `crash_at`.
+fn counter_xml_with(variables: &[&str]) -> String {
+    let anchor = r#"<Float64 name="crash_at" valueReference="30"#;
+    let inserted: String = variables.iter().map(|v| format!("{v}\n    ")).collect();
+    let xml = XML.replace(anchor, &format!("{inserted}{anchor}"));
+    assert_ne!(xml, XML);
+    xml
+}
+
+/// Runs `path` to 0.5 s into `dir`/out.csv and asserts that it succeeded and wrote the same
+/// CSV as the plain counter (built in the work folder `plain_test`); the run's output.
+fn run_as_the_plain_counter(path: &Path, dir: &Path, plain_test: &str) -> std::process::Output {
+    let csv = dir.join("out.csv");
+    let out = run_to_csv(path, "0.5", &csv, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (plain_dir, plain) = counter(plain_test).unwrap();
+    let plain_csv = plain_dir.join("plain.csv");
+    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
+    out
+}
+
+/// The counter declaring `hasEventMode`, built in `work_dir(test)` (with the folder).
+fn counter_with_event_mode(test: &str) -> Option<(PathBuf, PathBuf)> {
+    let dir = work_dir(test);
+    let xml = XML.replace(
+        "mightReturnEarlyFromDoStep=\"true\"/>",
+        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
+    );
+    assert_ne!(xml, XML);
+    let path = build_counter(&dir, "event_mode", &xml)?;
+    Some((dir, path))
+}
+
 /// Value references up to 4294967295 are the FMU's to use (Dymola uses 4294967294): a
 /// parameter there leaves the rest of the view whole (before, the array elements' view
 /// references were counted above the largest one, overflowed u32, and every variable was
@@ -610,27 +644,16 @@ fn a_crashing_fmi3_fmu_under_isolation_is_a_typed_error_with_the_rows_so_far() {
 #[test]
 fn value_references_near_2_pow_32_and_overflowing_dimensions() {
     let dir = work_dir("fmi3-far-vr");
-    let anchor = r#"<Float64 name="crash_at" valueReference="30"#;
-    let xml = XML.replace(
-        anchor,
-        &format!(
-            "<Float64 name=\"far\" valueReference=\"4294967295\" causality=\"parameter\" variability=\"fixed\" start=\"1\"/>\n    \
-             <Float64 name=\"huge\" valueReference=\"42\" causality=\"local\" variability=\"continuous\"><Dimension start=\"3\"/><Dimension start=\"6148914691236517206\"/></Float64>\n    {anchor}"
-        ),
-    );
-    assert_ne!(xml, XML);
+    let xml = counter_xml_with(&[
+        r#"<Float64 name="far" valueReference="4294967295" causality="parameter" variability="fixed" start="1"/>"#,
+        r#"<Float64 name="huge" valueReference="42" causality="local" variability="continuous"><Dimension start="3"/><Dimension start="6148914691236517206"/></Float64>"#,
+    ]);
     let Some(path) = build_counter(&dir, "far_vr", &xml) else { return };
     let fmu = Fmu::load(&path).unwrap();
     let left: Vec<(&str, &str)> = fmu.not_in_view().iter().map(|(n, why)| (n.as_str(), why.as_str())).collect();
     assert_eq!(left, [("huge", "an array of more than 100,000 elements")]);
     assert_eq!(fmu.description().variable("far").map(|v| v.value_reference), Some(4294967295));
-    let csv = dir.join("out.csv");
-    let out = run_to_csv(&path, "0.5", &csv, &[]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let (plain_dir, plain) = counter("fmi3-far-vr-plain").unwrap();
-    let plain_csv = plain_dir.join("plain.csv");
-    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
-    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
+    run_as_the_plain_counter(&path, &dir, "fmi3-far-vr-plain");
 }
 
 /// What the master's view leaves out (String and Binary arrays) is said, not dropped
@@ -640,14 +663,10 @@ fn value_references_near_2_pow_32_and_overflowing_dimensions() {
 #[test]
 fn string_and_binary_arrays_are_left_out_and_said_so() {
     let dir = work_dir("fmi3-left-out");
-    let arrays = r#"<Float64 name="crash_at" valueReference="30"#;
-    let xml = XML.replace(
-        arrays,
-        &format!(
-            "<String name=\"names\" valueReference=\"40\" causality=\"parameter\" variability=\"fixed\"><Dimension start=\"2\"/><Start value=\"a\"/><Start value=\"b\"/></String>\n    \
-             <Binary name=\"blobs\" valueReference=\"41\" causality=\"output\" variability=\"discrete\"><Dimension start=\"3\"/></Binary>\n    {arrays}"
-        ),
-    );
+    let xml = counter_xml_with(&[
+        r#"<String name="names" valueReference="40" causality="parameter" variability="fixed"><Dimension start="2"/><Start value="a"/><Start value="b"/></String>"#,
+        r#"<Binary name="blobs" valueReference="41" causality="output" variability="discrete"><Dimension start="3"/></Binary>"#,
+    ]);
     let Some(path) = build_counter(&dir, "left_out", &xml) else { return };
     let fmu = Fmu::load(&path).unwrap();
     let left: Vec<(&str, &str)> = fmu.not_in_view().iter().map(|(n, why)| (n.as_str(), why.as_str())).collect();
@@ -662,17 +681,11 @@ fn string_and_binary_arrays_are_left_out_and_said_so() {
         }),
         "{text}"
     );
-    let csv = dir.join("out.csv");
-    let out = run_to_csv(&path, "0.5", &csv, &[]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // the same columns and values as the FMU without the two arrays
+    let out = run_as_the_plain_counter(&path, &dir, "fmi3-left-out-plain");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("cosim: note: model.names is a String array: not recorded"), "{err}");
     assert!(err.contains("cosim: note: model.blobs is a Binary array: not recorded"), "{err}");
-    // the same columns and values as the FMU without the two arrays
-    let (plain_dir, plain) = counter("fmi3-left-out-plain").unwrap();
-    let plain_csv = plain_dir.join("plain.csv");
-    assert!(run_to_csv(&plain, "0.5", &plain_csv, &[]).status.success());
-    assert_eq!(std::fs::read_to_string(&csv).unwrap(), std::fs::read_to_string(&plain_csv).unwrap());
     let out = cosim(&["run", path.to_str().unwrap(), "--stop-time", "0.5", "--set", "names=x"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
@@ -734,13 +747,7 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
 /// (n counts the steps only, `every_type_and_array_elements_are_recorded`).
 #[test]
 fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
-    let dir = work_dir("fmi3-event-mode");
-    let xml = XML.replace(
-        "mightReturnEarlyFromDoStep=\"true\"/>",
-        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
-    );
-    assert_ne!(xml, XML);
-    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let Some((dir, path)) = counter_with_event_mode("fmi3-event-mode") else { return };
     let (r, _) = simulate(&with_starts(&path, &[]), &Experiment::new(1.0, 0.1)).unwrap();
     let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
     for k in 0..r.rows() {
@@ -765,12 +772,7 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
 /// description without `hasEventMode`).
 #[test]
 fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
-    let dir = work_dir("fmi3-refuses-event-mode");
-    let xml = XML.replace(
-        "mightReturnEarlyFromDoStep=\"true\"/>",
-        "mightReturnEarlyFromDoStep=\"true\" hasEventMode=\"true\"/>",
-    );
-    let Some(path) = build_counter(&dir, "event_mode", &xml) else { return };
+    let Some((_, path)) = counter_with_event_mode("fmi3-refuses-event-mode") else { return };
     let mut b = SystemBuilder::new();
     b.add_instance("c-no-event-mode", Fmu::load(&path).unwrap()).unwrap();
     let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
@@ -823,19 +825,8 @@ fn an_int64_connector_declared_integer_in_an_ssp_carries_its_values_exactly() {
 #[test]
 fn a_run_that_can_record_none_of_the_outputs_fails() {
     let dir = work_dir("fmi3-no-output");
-    let xml = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
-  <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="24"/>
-    <InitialUnknown valueReference="24"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+    // shared with the Python package's test of the same refusal
+    let xml = include_str!("cfmu/fmi3_counter_no_output.xml");
     let Some(fmu) = build_counter(&dir, "no_output", xml) else { return };
     let csv = dir.join("out.csv");
     let out =

@@ -23,6 +23,18 @@ fn sized(test: &str) -> Option<(PathBuf, PathBuf)> {
     Some((dir, fmu))
 }
 
+/// The names of the first instance's variables that start with `prefix` (an array's
+/// elements, as the view has them after configuration).
+fn element_names(system: &nigel_cosim::System, prefix: &str) -> Vec<String> {
+    system
+        .description(0)
+        .model_variables
+        .iter()
+        .filter(|v| v.name.starts_with(prefix))
+        .map(|v| v.name.clone())
+        .collect()
+}
+
 /// The values of the columns `names` at each row of a run of `fmu` with the settings
 /// `sets` (`name`, text) to 1 s in steps of 0.5 s.
 fn run(fmu: &Path, sets: &[(&str, &str)]) -> nigel_cosim::Result<Vec<Vec<f64>>> {
@@ -33,13 +45,7 @@ fn run(fmu: &Path, sets: &[(&str, &str)]) -> nigel_cosim::Result<Vec<Vec<f64>>> 
     }
     let system = b.build();
     let (result, _) = simulate(&system, &Experiment::new(1.0, 0.5))?;
-    let names: Vec<String> = system
-        .description(0)
-        .model_variables
-        .iter()
-        .filter(|v| v.name.starts_with("y["))
-        .map(|v| v.name.clone())
-        .collect();
+    let names = element_names(&system, "y[");
     Ok((0..result.rows()).map(|r| names.iter().map(|n| result.column(n).unwrap()[r]).collect()).collect())
 }
 
@@ -73,36 +79,47 @@ fn values_set_before_are_kept_and_a_lost_element_or_a_bad_size_is_refused() {
     assert!(e.contains("outside its range [1, 100]"), "{e}");
 }
 
+/// y (its three elements) at 1 s from fmpy 0.3.32's low-level calls on the FMU at `fmu`:
+/// instantiate, `calls` (Python lines on the FMU3Slave `s`, ending in Step Mode at 0.5 s),
+/// the step from 0.5 to 1 s.
+fn fmpy_y_at_1s(fmu: &Path, calls: &str) -> Vec<f64> {
+    let script = format!(
+        r#"
+import sys, zipfile, tempfile
+from fmpy.fmi3 import FMU3Slave
+d = tempfile.mkdtemp()
+zipfile.ZipFile(sys.argv[1]).extractall(d)
+s = FMU3Slave(guid='{{fmi3-sized}}', unzipDirectory=d, modelIdentifier='fmi3_sized', instanceName='c')
+s.instantiate()
+{calls}
+s.doStep(0.5, 0.5)
+print(' '.join(repr(x) for x in s.getFloat64([4], nValues=3)))
+s.terminate()
+s.freeInstance()
+"#
+    );
+    let out = Command::new(python()).args(["-c", &script]).arg(fmu).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).split_whitespace().map(|x| x.parse().unwrap()).collect()
+}
+
 /// fmpy 0.3.32 driving the same FMU through its low-level calls (Configuration Mode, n = 3,
 /// k = [2 3 4], u = 0.5, two steps of 0.5 s) reads the same y at 1 s as `cosim run` writes,
 /// bit for bit; `cosim info` names the parameter and the arrays it sizes.
 #[test]
 fn cosim_run_equals_fmpy_low_level_calls_and_info_lists_the_parameter() {
     let Some((dir, fmu)) = sized("fmi3-configuration-fmpy") else { return };
-    let script = r#"
-import sys, zipfile, tempfile
-from fmpy.fmi3 import FMU3Slave
-d = tempfile.mkdtemp()
-zipfile.ZipFile(sys.argv[1]).extractall(d)
-s = FMU3Slave(guid='{fmi3-sized}', unzipDirectory=d, modelIdentifier='fmi3_sized', instanceName='c')
-s.instantiate()
-s.enterConfigurationMode()
+    let theirs = fmpy_y_at_1s(
+        &fmu,
+        "s.enterConfigurationMode()
 s.setUInt64([1], [3])
 s.exitConfigurationMode()
 s.setFloat64([2], [2.0, 3.0, 4.0])
 s.setFloat64([3], [0.5])
 s.enterInitializationMode(startTime=0.0)
 s.exitInitializationMode()
-s.doStep(0.0, 0.5)
-s.doStep(0.5, 0.5)
-print(' '.join(repr(x) for x in s.getFloat64([4], nValues=3)))
-s.terminate()
-s.freeInstance()
-"#;
-    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let theirs: Vec<f64> =
-        String::from_utf8_lossy(&out.stdout).split_whitespace().map(|x| x.parse().unwrap()).collect();
+s.doStep(0.0, 0.5)",
+    );
     // k[i] u t at 1 s
     assert_eq!(theirs, [1.0, 1.5, 2.0]);
     let csv = dir.join("out.csv");
@@ -148,15 +165,9 @@ fn the_corpus_dynamic_array_test_records_18_elements_with_xsize_6() {
     b.set_text("m.Float64Input", &format!("[{}]", vec!["2"; 18].join(","))).unwrap();
     let system = b.build();
     let (result, _) = simulate(&system, &Experiment::new(0.04, 0.02)).unwrap();
-    let outputs: Vec<&str> = system
-        .description(0)
-        .model_variables
-        .iter()
-        .filter(|v| v.name.starts_with("Float64Output["))
-        .map(|v| v.name.as_str())
-        .collect();
+    let outputs = element_names(&system, "Float64Output[");
     assert_eq!(outputs.len(), 18);
-    assert_eq!((outputs[0], outputs[17]), ("Float64Output[1,1]", "Float64Output[6,3]"));
+    assert_eq!((outputs[0].as_str(), outputs[17].as_str()), ("Float64Output[1,1]", "Float64Output[6,3]"));
     let after_first_step: Vec<f64> = outputs.iter().map(|n| result.column(n).unwrap()[1]).collect();
     assert_eq!(after_first_step, (0..18).map(|k| 2.0 * k as f64).collect::<Vec<_>>());
 }
@@ -234,30 +245,18 @@ fn a_tunable_structural_parameter_changes_between_steps_in_reconfiguration_mode(
     assert_eq!(rows[2], ["1", "2", "2"]);
     // fmpy's low-level calls through the same change: Reconfiguration Mode from Step Mode
     // after the first step, y read with its three elements after the second
-    let script = r#"
-import sys, zipfile, tempfile
-from fmpy.fmi3 import FMU3Slave
-d = tempfile.mkdtemp()
-zipfile.ZipFile(sys.argv[1]).extractall(d)
-s = FMU3Slave(guid='{fmi3-sized}', unzipDirectory=d, modelIdentifier='fmi3_sized', instanceName='c')
-s.instantiate()
-s.enterInitializationMode(startTime=0.0)
+    let theirs: Vec<String> = fmpy_y_at_1s(
+        &fmu,
+        "s.enterInitializationMode(startTime=0.0)
 s.exitInitializationMode()
 s.doStep(0.0, 0.5)
 s.enterConfigurationMode()
 s.setUInt64([1], [3])
-s.exitConfigurationMode()
-s.doStep(0.5, 0.5)
-print(' '.join(repr(x) for x in s.getFloat64([4], nValues=3)))
-s.terminate()
-s.freeInstance()
-"#;
-    let out = Command::new(python()).args(["-c", script]).arg(&fmu).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
-        .split_whitespace()
-        .map(|x| x.parse::<f64>().unwrap().to_string())
-        .collect();
+s.exitConfigurationMode()",
+    )
+    .iter()
+    .map(f64::to_string)
+    .collect();
     let (_, rows) = run_cli(&fmu, &dir, &["--set-at", "0.5", "n=3"]).unwrap();
     assert_eq!(rows[2][1..], theirs);
     // Model Exchange: the change in an event at 0.5 s (Event Mode), the same rows (y = k u t

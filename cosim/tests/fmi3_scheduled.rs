@@ -13,12 +13,12 @@ use std::path::Path;
 use std::process::Command;
 use std::sync::Arc;
 
-const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="partitions" instantiationToken="{fmi3-partitions}">
-  <ScheduledExecution modelIdentifier="fmi3_partitions"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <Clock name="fast" valueReference="1" causality="input" intervalVariability="constant" intervalDecimal="0.25" priority="1"/>
+/// The description of tests/cfmu/fmi3_partitions.c.
+fn xml() -> String {
+    common::fmi3_c::scheduled_description(
+        "partitions",
+        "fmi3_partitions",
+        r#"<Clock name="fast" valueReference="1" causality="input" intervalVariability="constant" intervalDecimal="0.25" priority="1"/>
     <Clock name="slow" valueReference="2" causality="input" intervalVariability="constant" intervalDecimal="1" shiftDecimal="0.5" priority="0"/>
     <Clock name="later" valueReference="3" causality="input" intervalVariability="countdown" priority="2" clocks="2"/>
     <Clock name="out" valueReference="4" causality="output" intervalVariability="triggered" clocks="1"/>
@@ -31,19 +31,10 @@ const XML: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
     <Int32 name="n_later" valueReference="22" causality="output" clocks="3"/>
     <Int32 name="n_kick" valueReference="23" causality="output" clocks="5"/>
     <Int32 name="first" valueReference="24" causality="output"/>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="4"/>
-    <Output valueReference="11"/>
-    <Output valueReference="12"/>
-    <Output valueReference="20"/>
-    <Output valueReference="21"/>
-    <Output valueReference="22"/>
-    <Output valueReference="23"/>
-    <Output valueReference="24"/>
-  </ModelStructure>
-</fmiModelDescription>
-"#;
+"#,
+        &[4, 11, 12, 20, 21, 22, 23, 24],
+    )
+}
 
 /// The run to 2 s with `kick` at 0.25 and 1 s and u = 2 from 1 s (an input file).
 fn run(fmu: &Path) -> nigel_cosim::Results {
@@ -81,7 +72,7 @@ fn run(fmu: &Path) -> nigel_cosim::Results {
 #[test]
 fn partitions_tick_in_priority_order_with_countdown_triggered_and_output_clocks() {
     let dir = work_dir("fmi3-scheduled");
-    let Some(fmu) = common::fmi3_c::build(&dir, "fmi3_partitions", XML) else { return };
+    let Some(fmu) = common::fmi3_c::build(&dir, "fmi3_partitions", &xml()) else { return };
     let r = run(&fmu);
     let col = |n: &str| r.column(n).unwrap_or_else(|| panic!("column {n}"));
     assert_eq!(col("time"), [0.0, 0.25, 0.5, 0.625, 0.75, 1.0, 1.25, 1.5, 1.625, 1.75, 2.0]);
@@ -128,18 +119,14 @@ fn the_reference_clocks_fmu_runs_the_scenario_its_model_documents() {
     let input = dir.join("in.csv");
     std::fs::write(&input, "time,inClock2\n0,1\n1,1\n2,0\n8,1\n9,1\n").unwrap();
     let csv = dir.join("out.csv");
-    let out = Command::new(env!("CARGO_BIN_EXE_cosim"))
-        .args(["run", fmu.to_str().unwrap(), "--interface", "se", "--stop-time", "10", "--input"])
-        .arg(&input)
-        .arg("-o")
-        .arg(&csv)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    let (header, rows) = common::run_to_csv(
+        Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .args(["run", fmu.to_str().unwrap(), "--interface", "se", "--stop-time", "10", "--input"])
+            .arg(&input)
+            .arg("-o")
+            .arg(&csv),
+        &csv,
+    );
     let at = |t: f64, name: &str| {
         let j = header.iter().position(|h| h == name).unwrap();
         rows.iter().find(|r| r[0] == t).unwrap()[j]

@@ -138,17 +138,10 @@ fn fmpy_driving_the_changing_partition_through_the_hand_derived_ticks_gives_cosi
     let dir = work_dir("fmi3-scheduled-changing-fmpy");
     let Some(fmu) = build(&dir) else { return };
     let r = run(&fmu, 0.25);
-    let out = std::process::Command::new(common::fmi3_c::python())
-        .args(["-c", FMPY_DRIVER])
-        .arg(&fmu)
-        .args(["0.25", ACTIVATIONS, "3"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
-        .collect();
+    let lines = common::fmi3_c::fmpy_lines(
+        FMPY_DRIVER,
+        &[fmu.as_os_str(), "0.25".as_ref(), ACTIVATIONS.as_ref(), "3".as_ref()],
+    );
     // the intervals the FMU gave fmpy: 0.25 in Initialization Mode, then 0.5, 0.75, 1, 1.25
     // after steps' activations, each fmi3IntervalChanged (2): the ones derived above
     assert_eq!(lines[0], [0.25, 2.0, 0.5, 2.0, 0.75, 2.0, 1.0, 2.0, 1.25, 2.0]);

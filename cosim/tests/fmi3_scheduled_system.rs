@@ -17,13 +17,11 @@ use std::path::{Path, PathBuf};
 /// The description, `sample` at priority `sample_priority`. The description's interval of
 /// the fixed clock `sample` is 1 s; the FMU gives its parameter `period` instead.
 fn xml(sample_priority: u32) -> String {
-    format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="se_node" instantiationToken="{{fmi3-se-node}}">
-  <ScheduledExecution modelIdentifier="fmi3_se_node"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    <Clock name="sample" valueReference="1" causality="input" intervalVariability="fixed" intervalDecimal="1" priority="{sample_priority}"/>
+    common::fmi3_c::scheduled_description(
+        "se_node",
+        "fmi3_se_node",
+        &format!(
+            r#"<Clock name="sample" valueReference="1" causality="input" intervalVariability="fixed" intervalDecimal="1" priority="{sample_priority}"/>
     <Clock name="trigger" valueReference="2" causality="input" intervalVariability="triggered" priority="2"/>
     <Clock name="done" valueReference="3" causality="output" intervalVariability="triggered" clocks="1"/>
     <Clock name="rate" valueReference="4" causality="input" intervalVariability="tunable" intervalDecimal="0.5" priority="3"/>
@@ -36,18 +34,9 @@ fn xml(sample_priority: u32) -> String {
     <Int32 name="n_sample" valueReference="20" causality="output" variability="discrete"/>
     <Int32 name="n_trigger" valueReference="21" causality="output" variability="discrete"/>
     <Int32 name="n_rate" valueReference="22" causality="output" variability="discrete"/>
-  </ModelVariables>
-  <ModelStructure>
-    <Output valueReference="3"/>
-    <Output valueReference="13"/>
-    <Output valueReference="14"/>
-    <Output valueReference="15"/>
-    <Output valueReference="20"/>
-    <Output valueReference="21"/>
-    <Output valueReference="22"/>
-  </ModelStructure>
-</fmiModelDescription>
 "#
+        ),
+        &[3, 13, 14, 15, 20, 21, 22],
     )
 }
 
@@ -182,16 +171,22 @@ fn an_ssp_of_scheduled_fmus_runs_from_the_command_line() {
         ],
     );
     let csv = dir.join("out.csv");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
-        .args(["run", ssp.to_str().unwrap(), "--interface", "se", "--stop-time", "2", "--set", "B.period=0.25", "-o"])
-        .arg(&csv)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let text = std::fs::read_to_string(&csv).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    let (header, rows) = common::run_to_csv(
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .args([
+                "run",
+                ssp.to_str().unwrap(),
+                "--interface",
+                "se",
+                "--stop-time",
+                "2",
+                "--set",
+                "B.period=0.25",
+                "-o",
+            ])
+            .arg(&csv),
+        &csv,
+    );
     let col = |name: &str| {
         let j = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("column {name} in {header:?}"));
         rows.iter().map(|r| r[j]).collect::<Vec<f64>>()
@@ -262,17 +257,8 @@ fn fmpy_driving_the_fmus_through_the_hand_derived_activations_gives_cosims_rows(
     let Some((a, b)) = build(&dir) else { return };
     let (r, outcome) = simulate_scheduled(&system(&a, &b), &Experiment::new(2.0, 0.25));
     outcome.unwrap();
-    let out = std::process::Command::new(common::fmi3_c::python())
-        .args(["-c", FMPY_DRIVER])
-        .args([&a, &b])
-        .args([ACTIVATIONS, "2"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let lines: Vec<Vec<f64>> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
-        .collect();
+    let lines =
+        common::fmi3_c::fmpy_lines(FMPY_DRIVER, &[a.as_os_str(), b.as_os_str(), ACTIVATIONS.as_ref(), "2".as_ref()]);
     assert_eq!(lines.iter().map(|l| l[0]).collect::<Vec<_>>(), r.column("time").unwrap());
     let names = ["y", "z", "w", "n_sample", "n_trigger", "n_rate"];
     let columns = ["A", "B"].iter().flat_map(|i| names.iter().map(move |n| format!("{i}.{n}")));

@@ -7,7 +7,7 @@
 
 mod common;
 use common::{build_fmu, build_fmu_with, work_dir, Model};
-use nigel_cosim::{simulate, Experiment, Fmu, InputTable, SystemBuilder};
+use nigel_cosim::{simulate, Experiment, Fmu, InputTable, System, SystemBuilder};
 use std::sync::Arc;
 
 fn jump_at_quarter() -> Arc<InputTable> {
@@ -18,10 +18,7 @@ fn jump_at_quarter() -> Arc<InputTable> {
 #[test]
 fn a_jump_between_points_splits_the_step_there() {
     let dir = work_dir("input-split");
-    let fmu = Fmu::load(&build_fmu(Model::Integrator, &dir, &[])).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("integrator", fmu).unwrap();
-    let system = b.build();
+    let system = System::single("integrator", Fmu::load(&build_fmu(Model::Integrator, &dir, &[])).unwrap()).unwrap();
     for algorithm in [nigel_cosim::Algorithm::Jacobi, nigel_cosim::Algorithm::Ordered] {
         let mut e = Experiment::new(1.0, 0.1);
         e.algorithm = algorithm;

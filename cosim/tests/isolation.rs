@@ -6,7 +6,7 @@
 //! y = t); the exit code is non-zero; TMPDIR (a fresh folder per run) is empty after.
 
 mod common;
-use common::{build_crash, build_ctor_crash, plant_fmu, work_dir};
+use common::{build_crash, build_ctor_crash, builder_with, plant_fmu, work_dir};
 use nigel_cosim::{
     read_ssp, simulate, simulate::simulate_recorded, Algorithm, Error, Experiment, Fmu, HostEnd, ImportOptions,
     Instance, Isolation, SystemBuilder, Value,
@@ -90,20 +90,15 @@ fn crashes_under_isolate_are_typed_errors_with_the_rows_so_far() {
 
 #[test]
 fn a_step_that_never_returns_is_killed_by_the_call_or_the_run_limit() {
-    let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout-call", "0.5"]);
-    assert_eq!(code, Some(1), "{stderr}");
-    assert!(
-        stderr.contains("the call took longer than 0.5 s (--timeout-call) during fmi2DoStep at t = 0.5 s"),
-        "{stderr}"
-    );
-    assert_rows_to_half(&rows, "call limit");
-    let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", "--timeout", "1"]);
-    assert_eq!(code, Some(1), "{stderr}");
-    assert!(
-        stderr.contains("the run's time limit of 1 s passed (--timeout) during fmi2DoStep at t = 0.5 s"),
-        "{stderr}"
-    );
-    assert_rows_to_half(&rows, "run limit");
+    for (limit, message, what) in [
+        (["--timeout-call", "0.5"], "the call took longer than 0.5 s (--timeout-call)", "call limit"),
+        (["--timeout", "1"], "the run's time limit of 1 s passed (--timeout)", "run limit"),
+    ] {
+        let (code, stderr, rows) = run_crash("isolation-hang", 5, &["--isolate", limit[0], limit[1]]);
+        assert_eq!(code, Some(1), "{stderr}");
+        assert!(stderr.contains(&format!("{message} during fmi2DoStep at t = 0.5 s")), "{stderr}");
+        assert_rows_to_half(&rows, what);
+    }
 }
 
 #[test]
@@ -168,10 +163,7 @@ fn timeout_call_needs_isolate_and_in_process_nothing_changes() {
 #[test]
 fn per_instance_isolation_in_the_library_gives_the_typed_error_and_the_rows() {
     let dir = work_dir("isolation-api");
-    let crash = Fmu::load(&build_crash(&dir)).unwrap();
-    let mut b = SystemBuilder::new();
-    b.add_instance("bad", crash.clone()).unwrap();
-    b.add_instance("good", crash).unwrap();
+    let mut b = builder_with(&Fmu::load(&build_crash(&dir)).unwrap(), &["bad", "good"]);
     b.set("bad.mode", Value::Real(1.0)).unwrap();
     let system = b.build();
     let mut e = Experiment::new(1.0, 0.1);

@@ -8,7 +8,9 @@
 //! blamed on another's call, in threads too.
 
 mod common;
-use common::{build_vdp, build_vdp_with_an_overrun, build_vdp_without_directional_derivatives, work_dir};
+use common::{
+    build_vdp, build_vdp_with_an_overrun, build_vdp_without_directional_derivatives, run_vdp_under_bdf, work_dir,
+};
 use nigel_cosim::{simulate, Experiment, Fmu, Solver, System};
 
 /// vdp.c writing 16 bytes past a block of two doubles it allocated (kept alive), and vdp.c
@@ -17,11 +19,7 @@ use nigel_cosim::{simulate, Experiment, Fmu, Solver, System};
 /// for bit (from the first Jacobian on, the same differences at the same points).
 #[test]
 fn a_directional_derivative_that_writes_past_memory_is_caught_and_replaced_by_differences() {
-    let mut e = Experiment::new(2.0, 0.01);
-    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
-    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
-    let run =
-        |path: std::path::PathBuf| simulate(&System::single("model", Fmu::load(&path).unwrap()).unwrap(), &e).unwrap();
+    let run = |path: std::path::PathBuf| run_vdp_under_bdf(&path);
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     let (differences, d) = run(build_vdp_without_directional_derivatives(&work_dir("overrun-fd")));
     assert!(d.notes.is_empty() && d.stiff.jacobians > 0, "{:?} {:?}", d.notes, d.stiff);
@@ -51,11 +49,7 @@ fn an_fmi3_directional_derivative_that_writes_past_sensitivity_is_caught_and_rep
     let without = xml.replace(r#"providesDirectionalDerivatives="true""#, r#"providesDirectionalDerivatives="false""#);
     let Some(plain) = common::fmi3_c::build(&work_dir("overrun3-fd"), "fmi3_vdp", &without) else { return };
     let overrun = common::fmi3_c::build_with(&work_dir("overrun3"), "fmi3_vdp", xml, &["OVERRUN_SENSITIVITY"]).unwrap();
-    let mut e = Experiment::new(2.0, 0.01);
-    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
-    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
-    let run =
-        |path: &std::path::Path| simulate(&System::single("model", Fmu::load(path).unwrap()).unwrap(), &e).unwrap();
+    let run = run_vdp_under_bdf;
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     let (differences, d) = run(&plain);
     assert!(d.notes.is_empty() && d.stiff.jacobians > 0, "{:?} {:?}", d.notes, d.stiff);

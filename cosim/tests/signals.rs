@@ -4,32 +4,38 @@
 
 mod common;
 use common::{plant_fmu, work_dir};
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-fn interrupt(signal: i32, extra: &[&str]) {
-    let dir = work_dir(&format!("signals-{signal}-{}", extra.len()));
-    let tmp = dir.join("tmp");
-    std::fs::create_dir_all(&tmp).unwrap();
-    // a run of hours (1e5 s at 1 ms): it is interrupted long before its end
-    let child = Command::new(env!("CARGO_BIN_EXE_cosim"))
-        .args(["run", plant_fmu().to_str().unwrap(), "--stop-time", "100000", "--step", "1e-3", "--record", "x"])
-        .args(extra)
-        .env("TMPDIR", &tmp)
-        .env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host"))
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    // wait until the FMU is unpacked, then a little into the run
+/// Starts `run` (a long `cosim run`) with TMPDIR `tmp`, waits until the FMU is unpacked
+/// there, then a little into the run, sends it `signal` and gives its output.
+fn signal_during_the_run(run: &mut Command, tmp: &Path, signal: i32) -> std::process::Output {
+    let child = run.env("TMPDIR", tmp).stderr(std::process::Stdio::piped()).spawn().unwrap();
     let start = Instant::now();
-    while std::fs::read_dir(&tmp).unwrap().next().is_none() {
+    while std::fs::read_dir(tmp).unwrap().next().is_none() {
         assert!(start.elapsed() < Duration::from_secs(60), "the FMU was never unpacked");
         std::thread::sleep(Duration::from_millis(20));
     }
     std::thread::sleep(Duration::from_millis(300));
     // SAFETY: our own child's pid.
     unsafe { libc::kill(child.id() as libc::pid_t, signal) };
-    let out = child.wait_with_output().unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn interrupt(signal: i32, extra: &[&str]) {
+    let dir = work_dir(&format!("signals-{signal}-{}", extra.len()));
+    let tmp = dir.join("tmp");
+    std::fs::create_dir_all(&tmp).unwrap();
+    // a run of hours (1e5 s at 1 ms): it is interrupted long before its end
+    let out = signal_during_the_run(
+        Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .args(["run", plant_fmu().to_str().unwrap(), "--stop-time", "100000", "--step", "1e-3", "--record", "x"])
+            .args(extra)
+            .env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host")),
+        &tmp,
+        signal,
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(128 + signal), "{stderr}");
     assert!(stderr.contains("temporary folders removed"), "{stderr}");
@@ -53,22 +59,13 @@ fn sigint_writes_the_rows_computed_so_far() {
     std::fs::create_dir_all(&tmp).unwrap();
     let csv = dir.join("out.csv");
     let _ = std::fs::remove_file(&csv);
-    let child = Command::new(env!("CARGO_BIN_EXE_cosim"))
-        .args(["run", plant_fmu().to_str().unwrap(), "--stop-time", "100000", "--step", "1e-3", "--record", "x"])
-        .args(["--set", "v_x_start=0.35", "--output", csv.to_str().unwrap()])
-        .env("TMPDIR", &tmp)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while std::fs::read_dir(&tmp).unwrap().next().is_none() {
-        assert!(start.elapsed() < Duration::from_secs(60), "the FMU was never unpacked");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    std::thread::sleep(Duration::from_millis(300));
-    // SAFETY: our own child's pid.
-    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
-    let out = child.wait_with_output().unwrap();
+    let out = signal_during_the_run(
+        Command::new(env!("CARGO_BIN_EXE_cosim"))
+            .args(["run", plant_fmu().to_str().unwrap(), "--stop-time", "100000", "--step", "1e-3", "--record", "x"])
+            .args(["--set", "v_x_start=0.35", "--output", csv.to_str().unwrap()]),
+        &tmp,
+        libc::SIGINT,
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(128 + libc::SIGINT), "{stderr}");
     assert!(stderr.contains("written to"), "{stderr}");

@@ -3,7 +3,7 @@
 //! refused by name. Also writes the system the fmpy cross-check (tests/python) runs.
 
 mod common;
-use common::{build_fmu, build_fmu_with, plant_fmu, work_dir, zip_entries, Model};
+use common::{build_fmu, build_fmu_with, pack_ssp, plant_fmu, work_dir, work_dir_with_source_and_gain, Model};
 use nigel_cosim::{read_ssp, simulate, write_ssp, Algorithm, Error, Experiment, Fmu, ImportOptions, SystemBuilder};
 use std::path::Path;
 
@@ -158,26 +158,14 @@ fn nested_systems_ssv_units_and_default_factor() {
 
     // the same as an .ssp archive
     let ssp = dir.join("nested.ssp");
-    let read = |n: &str| std::fs::read(dir.join(n)).unwrap();
-    zip_entries(
-        &ssp,
-        &[
-            ("SystemStructure.ssd", ssd.into_bytes()),
-            ("gains.ssv", read("gains.ssv")),
-            ("source.fmu", read("source.fmu")),
-            ("gain_mm.fmu", read("gain_mm.fmu")),
-            ("integrator.fmu", read("integrator.fmu")),
-        ],
-    );
+    pack_ssp(&ssp, ssd, &dir, &["gains.ssv", "source.fmu", "gain_mm.fmu", "integrator.fmu"]);
     let s2 = read_ssp(&ssp, &ImportOptions::default()).unwrap();
     assert_eq!(simulate(&s2.system, &e).unwrap().0.values, r.values);
 }
 
 #[test]
 fn bad_ssps_are_refused_by_name() {
-    let dir = work_dir("ssp-bad");
-    build_fmu(Model::Source, &dir, &[]);
-    build_fmu(Model::Gain, &dir, &[]);
+    let dir = work_dir_with_source_and_gain("ssp-bad");
     let system = |elements: &str, connections: &str, extra: &str| {
         format!(
             r#"{SSD_HEAD}<ssd:System name="r">

@@ -7,7 +7,7 @@
 //! tests/cfmu/models.c (source: y = slope t; gain: y = k u).
 
 mod common;
-use common::{build_fmu, build_fmu_with, work_dir, zip_entries, Model};
+use common::{build_fmu, build_fmu_with, pack_ssp, work_dir, work_dir_with_source_and_gain, Model};
 use nigel_cosim::{read_ssp, simulate, Algorithm, Experiment, ImportOptions};
 use std::path::Path;
 
@@ -33,9 +33,7 @@ fn last(ssd: &Path, column: &str, stop: f64, h: f64) -> f64 {
 
 #[test]
 fn parameter_mappings_with_transformations_and_units_of_values() {
-    let dir = work_dir("ssp-mapping");
-    build_fmu(Model::Source, &dir, &[]);
-    build_fmu(Model::Gain, &dir, &[]);
+    let dir = work_dir_with_source_and_gain("ssp-mapping");
     // the set: a slope in mm/s (its Units say mm/s = 0.001 m/s) and a gain; "unused" is
     // mapped nowhere, so it applies nowhere
     write(
@@ -119,9 +117,7 @@ fn parameter_mappings_with_transformations_and_units_of_values() {
 
 #[test]
 fn system_connector_values_binding_priority_and_direction() {
-    let dir = work_dir("ssp-connectors");
-    build_fmu(Model::Source, &dir, &[]);
-    build_fmu(Model::Gain, &dir, &[]);
+    let dir = work_dir_with_source_and_gain("ssp-connectors");
     // root.ssv: the system parameter K, the system input U, amp.k (overridden by K through
     // the connection), src.slope (wins over the component's own binding), and a name
     // that matches nothing (ignored with a note)
@@ -203,15 +199,7 @@ fn default_start_time_version_note_and_info() {
     )
     .replace(r#"version="1.0" name="t""#, r#"version="2.0" name="t""#);
     let ssp = dir.join("start.ssp");
-    let read = |n: &str| std::fs::read(dir.join(n)).unwrap();
-    zip_entries(
-        &ssp,
-        &[
-            ("SystemStructure.ssd", ssd.into_bytes()),
-            ("source.fmu", read("source.fmu")),
-            ("gain_mm.fmu", read("gain_mm.fmu")),
-        ],
-    );
+    pack_ssp(&ssp, ssd, &dir, &["source.fmu", "gain_mm.fmu"]);
     let cosim = |args: &[&str]| std::process::Command::new(env!("CARGO_BIN_EXE_cosim")).args(args).output().unwrap();
     let csv = dir.join("out.csv");
     let out = cosim(&[
@@ -253,9 +241,7 @@ fn default_start_time_version_note_and_info() {
 
 #[test]
 fn an_algebraic_loop_at_initialization_is_iterated_to_its_fixed_point_and_a_chain_is_not() {
-    let dir = work_dir("ssp-init-loop");
-    build_fmu(Model::Source, &dir, &[]);
-    build_fmu(Model::Gain, &dir, &[]);
+    let dir = work_dir_with_source_and_gain("ssp-init-loop");
     // a.y = k u depends on a.u (the gain's ModelStructure: y depends on u), likewise b:
     // a.y -> b.u (+ 1, a LinearTransformation) and b.y -> a.u close a loop through both
     // FMUs' direct feedthrough
@@ -342,9 +328,7 @@ fn a_chain_of_direct_feedthrough_enters_its_first_row_at_its_sources_values() {
     // AircraftVehicleDemonstrator script writes 109 of them), gains k = 2 with y = k u
     // (direct feedthrough), from t0 = 2 s, Jacobi (the default: connections delayed by one
     // step after the first row)
-    let dir = work_dir("ssp-init-chain");
-    build_fmu(Model::Source, &dir, &[]);
-    build_fmu(Model::Gain, &dir, &[]);
+    let dir = work_dir_with_source_and_gain("ssp-init-chain");
     let ssd = format!(
         r#"{HEAD}<ssd:System name="top">
   <ssd:Elements><ssd:Component name="src" source="source.fmu"/><ssd:Component name="a" source="gain.fmu"/><ssd:Component name="b" source="gain.fmu"/><ssd:Component name="c" source="gain.fmu"/></ssd:Elements>

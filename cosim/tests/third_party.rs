@@ -6,7 +6,7 @@
 mod common;
 use common::{
     build_tolerance, build_vdp, build_vdp_with_a_derivative_of_no_state, build_vdp_with_a_wrong_jacobian,
-    build_vdp_without_directional_derivatives, work_dir,
+    build_vdp_without_directional_derivatives, run_vdp_under_bdf, work_dir,
 };
 use nigel_cosim::{simulate, Experiment, Fmu, Solver, System, SystemBuilder};
 
@@ -108,11 +108,7 @@ fn the_states_are_those_of_the_derivatives_list() {
 /// points). The correct Jacobian passes the check: no note, and the FMU's Jacobian used.
 #[test]
 fn a_wrong_fmu_jacobian_is_found_at_first_use_and_replaced_by_differences() {
-    let mut e = Experiment::new(2.0, 0.01);
-    e.solver = Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
-    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
-    let run =
-        |path: std::path::PathBuf| simulate(&System::single("model", Fmu::load(&path).unwrap()).unwrap(), &e).unwrap();
+    let run = |path: std::path::PathBuf| run_vdp_under_bdf(&path);
     let (wrong, wrong_summary) = run(build_vdp_with_a_wrong_jacobian(&work_dir("tp-vdp-wrong")));
     let (differences, _) = run(build_vdp_without_directional_derivatives(&work_dir("tp-vdp-fd")));
     assert_eq!(wrong_summary.notes.len(), 1, "{:?}", wrong_summary.notes);

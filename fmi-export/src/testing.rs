@@ -15,6 +15,13 @@ use crate::ffi::*;
 use crate::{Function, Model};
 use fmi_sys::fmi2::logger::{LogEnvironment, LogMessage, LogReceiver};
 
+/// Asserts that `M`'s value references are the ones pinned in the file
+/// `value_references.txt` of the crate at `crate_dir` (its `CARGO_MANIFEST_DIR`).
+pub fn assert_pinned_value_references<M: Model>(crate_dir: &str) {
+    let pinned = std::path::Path::new(crate_dir).join("value_references.txt");
+    M::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
+}
+
 /// The log of one instance: (status, category, message), in the order logged.
 #[derive(Debug, Default)]
 pub struct Log(pub RefCell<Vec<(c_int, String, String)>>);
@@ -175,6 +182,13 @@ impl<M: Model> Fmu<M> {
     pub fn reset(&self) -> Fmi2Status {
         unsafe { abi::reset::<M>(Function::Reset, self.c) }
     }
+    /// Asserts that `status` (of a set of bad input) is fmi2Error with a message naming
+    /// `name`, then that fmi2Reset recovers the instance.
+    pub fn assert_refused_then_reset(&self, status: Fmi2Status, name: &str) {
+        assert_eq!(status, ERR, "{name}");
+        assert!(self.last_error().contains(name), "{}", self.last_error());
+        assert_eq!(self.reset(), OK);
+    }
     // Model Exchange
     pub fn set_time(&self, t: f64) -> Fmi2Status {
         unsafe { abi::set_time::<M>(Function::SetTime, self.c, t) }
@@ -263,12 +277,9 @@ pub unsafe extern "C" fn log_message(
     category: *const std::ffi::c_char,
     message: *const std::ffi::c_char,
 ) {
-    let text = |p: *const std::ffi::c_char| {
-        if p.is_null() {
-            String::new()
-        } else {
-            std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned()
-        }
+    let text = |p: *const std::ffi::c_char| match p.is_null() {
+        true => String::new(),
+        false => std::ffi::CStr::from_ptr(p).to_string_lossy().into_owned(),
     };
     if let Some(log) = (environment as *const Log).as_ref() {
         log.0.borrow_mut().push((status, text(category), text(message)));

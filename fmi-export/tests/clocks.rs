@@ -113,18 +113,26 @@ fn input(t: f64) -> f64 {
     t
 }
 
-/// One activation at `t` in Event Mode: the input, the clock, the outputs, the update.
+/// One activation at `t` in Event Mode: the input, the clock, the outputs, the update
+/// (Co-Simulation: no time event, the activations are the importer's).
 fn activate(f: &Fmu3<Summer>, t: f64) -> (f64, f64) {
+    let (out, next) = activate_publishing(f, t);
+    assert_eq!(next, None, "the activations are the importer's: no time event");
+    out
+}
+
+/// [`activate`], with the `nextEventTime` the update gives (Model Exchange: the next
+/// activation time).
+fn activate_publishing(f: &Fmu3<Summer>, t: f64) -> ((f64, f64), Option<f64>) {
     assert_eq!(f.set_float64(&[vr3::U], &[input(t)]), OK3, "{}", f.last_error());
     assert_eq!(unsafe { set_clock(f, vr3::TICK, FMI3_CLOCK_ACTIVE) }, OK3, "{}", f.last_error());
     assert!(get_clock(f));
     let mut out = [0.0; 2];
     assert_eq!(f.get_float64(&[vr3::Y, vr3::N], &mut out), OK3, "{}", f.last_error());
     let update = f.update_discrete_states();
-    assert_eq!(update.next_event_time, None, "the activations are the importer's: no time event");
     assert!(!update.terminate_simulation && !update.discrete_states_need_update);
     assert!(!get_clock(f));
-    (out[0], out[1])
+    ((out[0], out[1]), update.next_event_time)
 }
 
 #[test]
@@ -192,8 +200,52 @@ fn co_simulation_samples_at_the_importers_activations_as_fmi2_samples_at_time_ev
     assert_eq!((f.float64(vr3::Y), f.float64(vr3::N)), expected[3]);
 }
 
+/// Co-Simulation instantiated with `eventModeUsed = false` (as fmpy's `simulate_fmu` does):
+/// the instance samples by time itself, so the same run as the FMI 2.0 one stepped on the
+/// same grid with the same inputs, to the bit: from start 0.5 s with T = 0.25 s, steps of
+/// 0.125 s, the samples at 0.5, 0.75, 1.0 and 1.25 s give y = 0.125, 0.3125, 0.5625, 0.875
+/// (as the activations above), read at every communication point; the clock is not the
+/// importer's (one info message says so), and the Event Mode calls are refused.
+#[test]
+fn co_simulation_without_event_mode_samples_by_time_as_fmi2() {
+    let f = Fmu3::<Summer>::try_cs(Summer::declaration().guid(), false)
+        .unwrap_or_else(|log| panic!("refused: {:?}", log.0.borrow()));
+    let infos: Vec<String> = f.log.0.borrow().iter().filter(|r| r.0 == 0).map(|r| r.2.clone()).collect();
+    assert_eq!(infos.len(), 1, "{infos:?}");
+    assert!(
+        infos[0].starts_with("fmi3InstantiateCoSimulation: eventModeUsed = false: tick is not driven"),
+        "{infos:?}"
+    );
+    assert_eq!(f.enter_init(0.5, Some(2.0)), OK3);
+    assert_eq!(f.exit_init(), OK3, "{}", f.last_error());
+    let fmi2 = Fmu::<Summer>::cs();
+    fmi2.init_at(0.5);
+    let expected = [0.125, 0.125, 0.3125, 0.3125, 0.5625, 0.5625, 0.875, 0.875];
+    let mut t = 0.5;
+    for (i, want) in expected.into_iter().enumerate() {
+        assert_eq!(f.set_float64(&[vr3::U], &[input(t)]), OK3, "{}", f.last_error());
+        assert_eq!(fmi2.set_real(0, input(t)), OK);
+        let (y3, n3) = (f.float64(vr3::Y), f.float64(vr3::N));
+        assert_eq!((y3.to_bits(), n3), (fmi2.real(2).to_bits(), fmi2.real(3)), "FMI 2.0 at t = {t} s");
+        assert_eq!((y3, n3), (want, (i / 2 + 1) as f64), "at t = {t} s");
+        assert_eq!(f.step(t, 0.125).status, OK3, "{}", f.last_error());
+        assert_eq!(fmi2.step(t, 0.125), OK);
+        t += 0.125;
+    }
+    assert_eq!(f.enter_event_mode(), ERR3);
+    assert!(
+        f.last_error()
+            .contains("fmi3EnterEventMode: not available: the instance was created with eventModeUsed = false"),
+        "{}",
+        f.last_error()
+    );
+    assert_eq!(enter_step_mode(&f), ERR3);
+    assert!(f.last_error().contains("eventModeUsed = false"), "{}", f.last_error());
+}
+
 /// Model Exchange: the importer sets the time of each activation, enters Event Mode and
-/// activates the clock; the same y_k as above.
+/// activates the clock; the same y_k as above, and each update publishes the next
+/// activation t_(k+1) = t_k + 0.25 s as `nextEventTime`.
 #[test]
 fn model_exchange_samples_at_the_importers_activations() {
     let f = Fmu3::<Summer>::me();
@@ -205,9 +257,63 @@ fn model_exchange_samples_at_the_importers_activations() {
             assert_eq!(f.set_time(t), OK3);
             assert_eq!(f.enter_event_mode(), OK3, "{}", f.last_error());
         }
-        assert_eq!(activate(&f, t), want, "activation {k} at t = {t} s");
+        assert_eq!(activate_publishing(&f, t), (want, Some(t + 0.25)), "activation {k} at t = {t} s");
+        // a second update at the same instant: no activation due, nothing sampled
+        let again = f.update_discrete_states();
+        assert_eq!((again.next_event_time, f.float64(vr3::Y)), (Some(t + 0.25), want.0), "{}", f.last_error());
         t += 0.25;
     }
+    assert!(f.log.0.borrow().iter().all(|r| !r.2.contains("not activated")), "no fallback: {:?}", f.log.0.borrow());
+}
+
+/// Model Exchange by an importer that never calls fmi3SetClock (fmpy's Model Exchange): at
+/// the initial event (t_0 = 0.5 s) the update finds the activation due and the clock not
+/// activated, so the instance samples by its time events as the FMI 2.0 archive: y_k =
+/// 0.125, 0.3125, 0.5625, 0.875 at t_k = 0.5 + 0.25 k with u(t_k) = t_k (the values derived
+/// above), nextEventTime t_(k+1) after each, to the bit the FMI 2.0 instance driven by the
+/// same calls; one info message names the clock; a late fmi3SetClock is an error naming it.
+#[test]
+fn model_exchange_without_clock_activations_samples_by_time_events_as_fmi2() {
+    let f = Fmu3::<Summer>::me();
+    let fmi2 = Fmu::<Summer>::me();
+    assert_eq!(f.enter_init(0.5, None), OK3);
+    assert_eq!(f.set_float64(&[vr3::U], &[input(0.5)]), OK3);
+    assert_eq!(f.exit_init(), OK3, "{}", f.last_error());
+    assert_eq!(fmi2.setup_at(0.5, None), OK);
+    assert_eq!(fmi2.enter_init(), OK);
+    assert_eq!(fmi2.set_real(0, input(0.5)), OK);
+    assert_eq!(fmi2.exit_init(), OK, "{}", fmi2.last_error());
+    let mut t = 0.5;
+    for (k, want) in [0.125, 0.3125, 0.5625, 0.875].into_iter().enumerate() {
+        if k > 0 {
+            assert_eq!(f.enter_continuous_time_mode(), OK3);
+            assert_eq!(f.set_time(t), OK3);
+            assert_eq!(f.set_float64(&[vr3::U], &[input(t)]), OK3);
+            assert_eq!(f.enter_event_mode(), OK3, "{}", f.last_error());
+            assert_eq!(fmi2.enter_continuous_time_mode(), OK);
+            assert_eq!(fmi2.set_time(t), OK);
+            assert_eq!(fmi2.set_real(0, input(t)), OK);
+            assert_eq!(fmi2.enter_event_mode(), OK);
+        }
+        let update = f.update_discrete_states();
+        assert!(!update.discrete_states_need_update, "{}", f.last_error());
+        assert_eq!(update.next_event_time, Some(t + 0.25), "at t = {t} s: {}", f.last_error());
+        let next2 = fmi2.new_discrete_states();
+        let (y, n) = (f.float64(vr3::Y), f.float64(vr3::N));
+        assert_eq!((y, n), (want, (k + 1) as f64), "sample {k} at t = {t} s");
+        assert_eq!((y.to_bits(), n, update.next_event_time), (fmi2.real(2).to_bits(), fmi2.real(3), next2));
+        t += 0.25;
+    }
+    let infos: Vec<String> = f.log.0.borrow().iter().filter(|r| r.0 == 0).map(|r| r.2.clone()).collect();
+    let fallback: Vec<&String> = infos.iter().filter(|m| m.contains("not activated")).collect();
+    assert_eq!(fallback.len(), 1, "{infos:?}");
+    assert!(fallback[0].contains("tick not activated (fmi3SetClock) at its activation time t = 0.5 s"), "{infos:?}");
+    assert_eq!(unsafe { set_clock(&f, vr3::TICK, FMI3_CLOCK_ACTIVE) }, ERR3);
+    assert!(
+        f.last_error().contains("fmi3SetClock: tick activated, but the instance samples by time events"),
+        "{}",
+        f.last_error()
+    );
 }
 
 /// An input set after the sample ran while the clock is active undoes it: the sample
@@ -232,11 +338,6 @@ fn an_input_set_during_the_activation_is_the_samples() {
 /// variable, and the reason.
 #[test]
 fn wrong_uses_of_the_clock_are_errors_naming_function_variable_and_reason() {
-    let refused = Fmu3::<Summer>::try_cs(Summer::declaration().guid(), false).err().expect("refused");
-    let message = refused.0.borrow().last().unwrap().2.clone();
-    assert!(message.starts_with("fmi3InstantiateCoSimulation: eventModeUsed = false refused"), "{message}");
-    assert!(message.contains("tick"), "{message}");
-
     let f = cs3();
     assert_eq!(f.enter_init(0.0, None), OK3);
     let s = unsafe { set_clock(&f, vr3::TICK, FMI3_CLOCK_ACTIVE) };

@@ -266,6 +266,30 @@ impl Model for Toy {
     }
 }
 
+/// The Model methods of a newtype `$wrapper` around the toy that are the toy's own:
+/// instantiate, the typed gets and sets, event_update.
+macro_rules! toy_methods {
+    ($wrapper:ident) => {
+        fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
+            Toy::instantiate(context).map($wrapper)
+        }
+        fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
+            self.0.event_update(t)
+        }
+        toy_methods!(@typed get_real set_real f64, get_integer set_integer i32, get_boolean set_boolean bool);
+    };
+    (@typed $($get:ident $set:ident $value:ty),*) => {
+        $(
+            fn $get(&mut self, b: V) -> ModelResult<$value> {
+                self.0.$get(b)
+            }
+            fn $set(&mut self, b: V, x: $value) -> ModelResult {
+                self.0.$set(b, x)
+            }
+        )*
+    };
+}
+
 /// The same toy with no optional capability and Co-Simulation only.
 #[derive(Clone, Debug)]
 struct Bare(Toy);
@@ -279,30 +303,7 @@ impl Model for Bare {
         let cs = Interfaces { model_exchange: false, co_simulation: true };
         spec(Capabilities::default(), cs, "bare")
     });
-    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
-        Toy::instantiate(context).map(Bare)
-    }
-    fn get_real(&mut self, b: V) -> ModelResult<f64> {
-        self.0.get_real(b)
-    }
-    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
-        self.0.set_real(b, x)
-    }
-    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
-        self.0.get_integer(b)
-    }
-    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
-        self.0.set_integer(b, x)
-    }
-    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
-        self.0.get_boolean(b)
-    }
-    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
-        self.0.set_boolean(b, x)
-    }
-    fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
-        self.0.event_update(t)
-    }
+    toy_methods!(Bare);
 }
 
 /// The toy with its own FMU-state format (the override): only its internal numbers.
@@ -320,30 +321,7 @@ impl Model for Own {
         let cs = Interfaces { model_exchange: false, co_simulation: true };
         spec(caps, cs, "own")
     });
-    fn instantiate(context: &InstantiateContext) -> ModelResult<Self> {
-        Toy::instantiate(context).map(Own)
-    }
-    fn get_real(&mut self, b: V) -> ModelResult<f64> {
-        self.0.get_real(b)
-    }
-    fn set_real(&mut self, b: V, x: f64) -> ModelResult {
-        self.0.set_real(b, x)
-    }
-    fn get_integer(&mut self, b: V) -> ModelResult<i32> {
-        self.0.get_integer(b)
-    }
-    fn set_integer(&mut self, b: V, x: i32) -> ModelResult {
-        self.0.set_integer(b, x)
-    }
-    fn get_boolean(&mut self, b: V) -> ModelResult<bool> {
-        self.0.get_boolean(b)
-    }
-    fn set_boolean(&mut self, b: V, x: bool) -> ModelResult {
-        self.0.set_boolean(b, x)
-    }
-    fn event_update(&mut self, t: f64) -> ModelResult<EventUpdate> {
-        self.0.event_update(t)
-    }
+    toy_methods!(Own);
     fn save_internal(&self, out: &mut Vec<f64>) {
         let t = &self.0;
         out.extend([t.u, t.gain, t.period, t.acc, t.y, t.samples as f64, t.k as f64]);

@@ -230,13 +230,12 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
     }
 }
 
-/// With the build option `fmi3-sample-clock`: the FMI 3.0 description declares the sample
+/// The FMI 3.0 description declares the sample
 /// period as the periodic input clock `sample_clock` (interval fixed: the parameter
 /// `sample_period`, read with `fmi3GetIntervalDecimal` in Initialization Mode; shift 0)
 /// governing the held outputs, which then change only at its activations, and priority 0
 /// for Scheduled Execution. The FMI 2.0 description is the same either way (no clocks in
 /// FMI 2.0: that archive samples by time).
-#[cfg(feature = "fmi3-sample-clock")]
 fn sample_clock(held_outputs: Vec<fmi_export::VarHandle>) -> Vec<fmi_export::ClockDecl> {
     vec![fmi_export::ClockDecl {
         name: "sample_clock",
@@ -245,13 +244,6 @@ fn sample_clock(held_outputs: Vec<fmi_export::VarHandle>) -> Vec<fmi_export::Clo
         governs: held_outputs,
         priority: 0,
     }]
-}
-
-/// Without the build option `fmi3-sample-clock`: no clock (the FMI 3.0 archive samples by
-/// time as the FMI 2.0 one does).
-#[cfg(not(feature = "fmi3-sample-clock"))]
-fn sample_clock(_held_outputs: Vec<fmi_export::VarHandle>) -> Vec<fmi_export::ClockDecl> {
-    Vec::new()
 }
 
 /// The controller instance.

@@ -335,32 +335,20 @@ fn fmu_state_round_trip_reproduces_the_run() {
 #[test]
 fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     let c = C::cs();
-    // an out-of-range enumeration
-    assert_eq!(c.set_int(vr("controller"), 7), ERR);
-    assert!(c.last_error().contains("controller"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_int(vr("controller"), 6), ERR);
-    assert!(c.last_error().contains("controller"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    // a negative sample period
-    assert_eq!(c.set_real(vr("sample_period"), -1e-3), ERR);
-    assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    // zero is refused too (by the model)
-    assert_eq!(c.set_real(vr("sample_period"), 0.0), ERR);
-    assert!(c.last_error().contains("sample_period"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    // NaN gains
-    assert_eq!(c.set_real(vr("k_beta_fl") + 3, f64::NAN), ERR);
-    assert!(c.last_error().contains("k_yaw_rate_fr"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_real(vr("beta"), f64::INFINITY), ERR);
-    assert!(c.last_error().contains("beta"), "{}", c.last_error());
-    assert_eq!(c.reset(), OK);
-    assert_eq!(c.set_real(vr("delta_max"), 2.0), ERR);
-    assert!(c.last_error().contains("delta_max"), "{}", c.last_error());
+    // out-of-range enumerations
+    for value in [7, 6] {
+        c.assert_refused_then_reset(c.set_int(vr("controller"), value), "controller");
+    }
+    for (reference, value, named) in [
+        (vr("sample_period"), -1e-3, "sample_period"), // negative
+        (vr("sample_period"), 0.0, "sample_period"),   // zero is refused too (by the model)
+        (vr("k_beta_fl") + 3, f64::NAN, "k_yaw_rate_fr"), // NaN gains
+        (vr("beta"), f64::INFINITY, "beta"),
+        (vr("delta_max"), 2.0, "delta_max"),
+    ] {
+        c.assert_refused_then_reset(c.set_real(reference, value), named);
+    }
     // after reset: the start values and a normal run
-    assert_eq!(c.reset(), OK);
     c.init();
     assert_eq!(c.int(vr("controller")), mode::ROBUST);
     assert_eq!(c.real(vr("sample_period")), T);
@@ -721,8 +709,7 @@ fn an_inconsistent_sample_clock_in_a_state_is_refused() {
 /// The value references the layer assigned, pinned: a change shows in review.
 #[test]
 fn value_references_are_the_pinned_ones() {
-    let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
-    Controller::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
+    fmi_export::testing::assert_pinned_value_references::<Controller>(env!("CARGO_MANIFEST_DIR"));
 }
 
 /// The controller through FMI 3.0: every output equal to the FMI 2.0 run to the bit, with

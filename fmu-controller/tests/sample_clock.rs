@@ -1,9 +1,8 @@
-//! The controller built with `fmi3-sample-clock`: its FMI 3.0 description declares the
+//! The controller's FMI 3.0 description declares the
 //! sample period as the periodic input clock `sample_clock`, and a run driven by the
 //! clock's activations (Co-Simulation with Event Mode, through the layer's C entry points)
 //! gives the FMI 2.0 run's outputs to the bit at every sample, inputs set at the same
-//! instants. Run with `cargo test --release -p fmu-controller --features fmi3-sample-clock`.
-#![cfg(feature = "fmi3-sample-clock")]
+//! instants.
 
 use fmi_export::abi::fmi3 as abi3;
 use fmi_export::fmi_sys::fmi3::*;
@@ -43,7 +42,7 @@ fn inputs(k: usize) -> [f64; 10] {
 #[test]
 fn the_fmi3_description_declares_the_sample_clock_governing_the_held_outputs() {
     let d = Controller::declaration();
-    let (clock, vr) = d.clock().expect("a clock with fmi3-sample-clock");
+    let (clock, vr) = d.clock().expect("the sample clock");
     assert_eq!(clock.name, "sample_clock");
     let xml3 = d.xml3();
     assert!(xml3.contains(&format!(r#"<Clock name="sample_clock" valueReference="{vr}""#)), "{xml3}");

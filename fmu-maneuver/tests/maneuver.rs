@@ -207,27 +207,13 @@ fn fmu_state_round_trip() {
 #[test]
 fn bad_input_is_refused_naming_the_variable_and_reset_recovers() {
     let b = B::cs();
-    assert_eq!(b.set_int(vr("maneuver"), 7), ERR);
-    assert!(b.last_error().contains("maneuver"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_int(vr("fidelity"), 0), ERR);
-    assert!(b.last_error().contains("fidelity"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_int(vr("seed"), -1), ERR);
-    assert!(b.last_error().contains("seed"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr("steer_amplitude"), f64::NAN), ERR);
-    assert!(b.last_error().contains("steer_amplitude"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr("speed_target"), 0.0), ERR);
-    assert!(b.last_error().contains("speed_target"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr("duration"), -1.0), ERR);
-    assert!(b.last_error().contains("duration"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
-    assert_eq!(b.set_real(vr("duration"), 1e308), ERR, "longer than the 600 s a reference may cover");
-    assert!(b.last_error().contains("duration"), "{}", b.last_error());
-    assert_eq!(b.reset(), OK);
+    for (name, value) in [("maneuver", 7), ("fidelity", 0), ("seed", -1)] {
+        b.assert_refused_then_reset(b.set_int(vr(name), value), name);
+    }
+    // 1e308 s: longer than the 600 s a reference may cover
+    for (name, value) in [("steer_amplitude", f64::NAN), ("speed_target", 0.0), ("duration", -1.0), ("duration", 1e308)] {
+        b.assert_refused_then_reset(b.set_real(vr(name), value), name);
+    }
     // a step far past the reference is refused, not run
     assert_eq!(b.set_real(vr("duration"), 0.5), OK);
     b.init();
@@ -488,8 +474,7 @@ fn disturbance_settings_out_of_range_are_refused_naming_the_variable() {
 /// The value references the layer assigned, pinned: a change shows in review.
 #[test]
 fn value_references_are_the_pinned_ones() {
-    let pinned = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("value_references.txt");
-    TestBench::declaration().check_pinned_value_references(&pinned).unwrap_or_else(|e| panic!("{e}"));
+    fmi_export::testing::assert_pinned_value_references::<TestBench>(env!("CARGO_MANIFEST_DIR"));
 }
 
 /// The test bench through FMI 3.0: every output equal to the FMI 2.0 run to the bit, the

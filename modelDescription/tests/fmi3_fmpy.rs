@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{fmpy_available, fmpy_output};
+use common::{fmpy_output, fmpy_scratch};
 use model_description::fmi3::*;
 
 /// Run after [`common::FMPY_PRELUDE`] (`md` is fmpy's reading of the document).
@@ -17,10 +17,7 @@ for v in md.modelVariables:
 
 #[test]
 fn fmpy_accepts_and_reads_the_fmi3_documents() {
-    if !fmpy_available() {
-        return;
-    }
-    let base = std::env::temp_dir().join(format!("md3-fmpy-{}", std::process::id()));
+    let Some(base) = fmpy_scratch("md3-fmpy") else { return };
     for (name, xml) in
         [("ball", include_str!("fixtures/fmi3_ball.xml")), ("types", include_str!("fixtures/fmi3_types.xml"))]
     {

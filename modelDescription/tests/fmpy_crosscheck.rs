@@ -19,10 +19,7 @@ for u in md.initialUnknowns:
 
 #[test]
 fn fmpy_accepts_and_reads_what_we_write() {
-    if !fmpy_available() {
-        return;
-    }
-    let base = std::env::temp_dir().join(format!("md-fmpy-{}", std::process::id()));
+    let Some(base) = fmpy_scratch("md-fmpy") else { return };
     for (name, md) in [
         ("rich", rich()),
         ("minimal", minimal()),

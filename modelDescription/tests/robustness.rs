@@ -145,8 +145,7 @@ fn malformed_xml_names_the_position() {
 fn unexpected_eof_names_the_open_element() {
     let e = read(&format!("{HEAD}\n  <ModelVariables>\n    <ScalarVariable name=\"x\" valueReference=\"1\">"));
     let ReadError::UnexpectedEof { element, position } = &e else { panic!("{e:?}") };
-    assert_eq!(element, "ScalarVariable");
-    assert_eq!(position.line, 3);
+    assert_eq!((element.as_str(), position.line), ("ScalarVariable", 3));
     assert!(e.to_string().contains("<ScalarVariable>"), "{e}");
 }
 

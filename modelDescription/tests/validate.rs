@@ -31,6 +31,13 @@ fn var_mut<'a>(md: &'a mut ModelDescription, name: &str) -> &'a mut ScalarVariab
     md.model_variables.iter_mut().find(|v| v.name == name).unwrap()
 }
 
+/// `rich()` with the variable `name` of `variability`.
+fn rich_with_variability(name: &str, variability: Variability) -> ModelDescription {
+    let mut md = rich();
+    var_mut(&mut md, name).variability = variability;
+    md
+}
+
 fn set_start(v: &mut ScalarVariable, value: Option<f64>) {
     match &mut v.variable_type {
         VariableType::Real { start, .. } => *start = value,
@@ -185,16 +192,11 @@ fn causality_variability_initial_table() {
 
 #[test]
 fn illegal_combinations_are_named() {
-    let mut md = rich();
-    var_mut(&mut md, "mass").variability = Variability::Continuous;
-    let p = expect(&md, Rule::CausalityVariability, Some("mass"));
+    let p = expect(&rich_with_variability("mass", Variability::Continuous), Rule::CausalityVariability, Some("mass"));
     assert!(p.message.contains("parameter") && p.message.contains("continuous"), "{p}");
-    let mut md = rich();
-    var_mut(&mut md, "u").variability = Variability::Fixed;
-    expect(&md, Rule::CausalityVariability, Some("u"));
-    let mut md = rich();
-    var_mut(&mut md, "time").variability = Variability::Discrete;
-    expect(&md, Rule::CausalityVariability, Some("time"));
+    for (name, variability) in [("u", Variability::Fixed), ("time", Variability::Discrete)] {
+        expect(&rich_with_variability(name, variability), Rule::CausalityVariability, Some(name));
+    }
 }
 
 #[test]
@@ -275,12 +277,9 @@ fn independent_variable() {
 
 #[test]
 fn only_real_is_continuous() {
-    let mut md = rich();
-    var_mut(&mut md, "gear").variability = Variability::Continuous;
-    expect(&md, Rule::ContinuousNonReal, Some("gear"));
-    let mut md = rich();
-    var_mut(&mut md, "on").variability = Variability::Continuous;
-    expect(&md, Rule::ContinuousNonReal, Some("on"));
+    for name in ["gear", "on"] {
+        expect(&rich_with_variability(name, Variability::Continuous), Rule::ContinuousNonReal, Some(name));
+    }
 }
 
 #[test]
@@ -349,38 +348,36 @@ fn nominal_is_positive() {
     }
 }
 
+/// The problem of `rule` (no variable named) in `rich()` after `change`.
+fn expect_after(rule: Rule, change: impl FnOnce(&mut ModelDescription)) -> Problem {
+    let mut md = rich();
+    change(&mut md);
+    expect(&md, rule, None)
+}
+
 fn indices(list: &[Unknown]) -> Vec<u32> {
     list.iter().map(|u| u.index).collect()
 }
 
 #[test]
 fn outputs_exactly_in_order() {
-    let mut md = rich();
-    md.model_structure.outputs.remove(1);
-    let p = expect(&md, Rule::Outputs, None);
+    let p = expect_after(Rule::Outputs, |md| {
+        md.model_structure.outputs.remove(1);
+    });
     assert!(p.message.contains("\"count\""), "{p}");
-    let mut md = rich();
-    md.model_structure.outputs.swap(0, 1);
-    expect(&md, Rule::Outputs, None);
-    let mut md = rich();
-    md.model_structure.outputs.push(unknown(4, None, None));
-    expect(&md, Rule::Outputs, None);
-    let mut md = rich();
-    var_mut(&mut md, "v").causality = Causality::Output; // new output not listed
-    expect(&md, Rule::Outputs, None);
+    expect_after(Rule::Outputs, |md| md.model_structure.outputs.swap(0, 1));
+    expect_after(Rule::Outputs, |md| md.model_structure.outputs.push(unknown(4, None, None)));
+    // a new output not listed
+    expect_after(Rule::Outputs, |md| var_mut(md, "v").causality = Causality::Output);
 }
 
 #[test]
 fn derivatives_exactly() {
-    let mut md = rich();
-    md.model_structure.derivatives.pop();
-    expect(&md, Rule::Derivatives, None);
-    let mut md = rich();
-    md.model_structure.derivatives.push(unknown(4, None, None));
-    expect(&md, Rule::Derivatives, None);
-    let mut md = rich();
-    md.model_structure.derivatives.push(unknown(3, None, None));
-    expect(&md, Rule::Derivatives, None);
+    expect_after(Rule::Derivatives, |md| {
+        md.model_structure.derivatives.pop();
+    });
+    expect_after(Rule::Derivatives, |md| md.model_structure.derivatives.push(unknown(4, None, None)));
+    expect_after(Rule::Derivatives, |md| md.model_structure.derivatives.push(unknown(3, None, None)));
     // Any order is fine.
     let mut md = rich();
     md.model_structure.derivatives.reverse();
@@ -394,21 +391,14 @@ fn initial_unknowns_exactly_sorted() {
     md.model_structure.initial_unknowns.retain(|u| u.index != 9); // calculated parameter
     let p = expect(&md, Rule::InitialUnknowns, None);
     assert!(p.message.contains("\"w\""), "{p}");
-    let mut md = rich();
-    md.model_structure.initial_unknowns.retain(|u| u.index != 4); // state with approx
-    expect(&md, Rule::InitialUnknowns, None);
-    let mut md = rich();
-    md.model_structure.initial_unknowns.retain(|u| u.index != 16); // output calculated
-    expect(&md, Rule::InitialUnknowns, None);
-    let mut md = rich();
-    md.model_structure.initial_unknowns.insert(0, unknown(2, None, None)); // output exact: not an unknown
-    expect(&md, Rule::InitialUnknowns, None);
-    let mut md = rich();
-    md.model_structure.initial_unknowns.swap(0, 1);
-    expect(&md, Rule::InitialUnknowns, None);
-    let mut md = rich();
-    md.model_structure.initial_unknowns.push(unknown(16, None, None));
-    expect(&md, Rule::InitialUnknowns, None);
+    // state with approx
+    expect_after(Rule::InitialUnknowns, |md| md.model_structure.initial_unknowns.retain(|u| u.index != 4));
+    // output calculated
+    expect_after(Rule::InitialUnknowns, |md| md.model_structure.initial_unknowns.retain(|u| u.index != 16));
+    // output exact: not an unknown
+    expect_after(Rule::InitialUnknowns, |md| md.model_structure.initial_unknowns.insert(0, unknown(2, None, None)));
+    expect_after(Rule::InitialUnknowns, |md| md.model_structure.initial_unknowns.swap(0, 1));
+    expect_after(Rule::InitialUnknowns, |md| md.model_structure.initial_unknowns.push(unknown(16, None, None)));
 }
 
 #[test]

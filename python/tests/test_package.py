@@ -215,20 +215,7 @@ def test_a_run_that_can_record_none_of_the_outputs_is_refused(tmp_path):
     # column alone is not what simulate_fmu was asked for (every output), so it raises, as
     # `cosim run` exits 1 (cosim/tests/fmi3.rs a_run_that_can_record_none_of_the_outputs_fails)
     import zipfile
-    xml = textwrap.dedent("""\
-        <?xml version="1.0" encoding="UTF-8"?>
-        <fmiModelDescription fmiVersion="3.0" modelName="fmi3_counter" instantiationToken="{fmi3-counter}">
-          <CoSimulation modelIdentifier="fmi3_counter" canHandleVariableCommunicationStepSize="true"/>
-          <ModelVariables>
-            <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-            <Float64 name="big" valueReference="24" causality="output"><Dimension start="200000"/></Float64>
-          </ModelVariables>
-          <ModelStructure>
-            <Output valueReference="24"/>
-            <InitialUnknown valueReference="24"/>
-          </ModelStructure>
-        </fmiModelDescription>
-        """)
+    xml = (REPO / "cosim/tests/cfmu/fmi3_counter_no_output.xml").read_text()
     headers = Path(fmpy.__file__).parent / "c-code"
     so = tmp_path / "fmi3_counter.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter", "-I",
@@ -273,6 +260,20 @@ def test_runs_release_the_gil_two_threads_overlap():
     assert a0 < b1 and b0 < a1, spans
 
 
+def sigint_latency(script, after, timeout, env=None):
+    """Runs the Python `script` (prints "started", then on KeyboardInterrupt "interrupted"
+    and its time.monotonic(), exit code 7), sends it SIGINT `after` seconds after it
+    started, and gives the seconds from the signal to the interrupt."""
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(after)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=timeout)
+    assert p.returncode == 7, out
+    return float(out.split()[1]) - sent
+
+
 def test_ctrl_c_raises_keyboard_interrupt_and_leaves_no_folder(tmp_path):
     scratch = tmp_path / "tmp"
     scratch.mkdir()
@@ -288,15 +289,8 @@ def test_ctrl_c_raises_keyboard_interrupt_and_leaves_no_folder(tmp_path):
             sys.exit(7)
         """
     )
-    env = dict(os.environ, TMPDIR=str(scratch))
-    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=env)
-    assert p.stdout.readline().strip() == "started"
-    time.sleep(1.0)  # inside the run: loading the SSP takes well under this
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    out, _ = p.communicate(timeout=60)
-    assert p.returncode == 7, out
-    latency = float(out.split()[1]) - sent
+    # inside the run after 1 s: loading the SSP takes well under this
+    latency = sigint_latency(script, 1.0, 60, env=dict(os.environ, TMPDIR=str(scratch)))
     # the run stops at its next step and waits at most 100 ms between signal checks; 5 s
     # only bounds a loaded machine, the latency is printed for the record
     print(f"KeyboardInterrupt {latency:.3f} s after SIGINT")
@@ -487,14 +481,7 @@ def test_ctrl_c_during_a_campaign_starts_no_further_run(tmp_path):
             sys.exit(7)
         """
     )
-    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    assert p.stdout.readline().strip() == "started"
-    time.sleep(1.5)
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    out, _ = p.communicate(timeout=120)
-    assert p.returncode == 7, out
-    latency = float(out.split()[1]) - sent
+    latency = sigint_latency(script, 1.5, 120)
     print(f"KeyboardInterrupt {latency:.3f} s after SIGINT (the runs in progress finish: 2 s each at most)")
     assert latency < 10.0
     # the rows of the runs that finished are written, far fewer than the 2000 asked for

@@ -9,7 +9,10 @@ fn spec() -> PlantSpec {
     PlantSpec::paper(Architecture::FourWheelSteering)
 }
 
-fn refused(s: PlantSpec, needle: &str) {
+/// The paper's spec after `change` is refused, the message naming `needle`.
+fn refused(change: impl FnOnce(&mut PlantSpec), needle: &str) {
+    let mut s = spec();
+    change(&mut s);
     let e = s.polytope().expect_err("must be refused");
     let msg = e.to_string();
     assert!(msg.contains(needle), "message '{msg}' should name '{needle}'");
@@ -17,33 +20,15 @@ fn refused(s: PlantSpec, needle: &str) {
 
 #[test]
 fn nan_and_negative_plant_parameters_are_refused() {
-    let mut s = spec();
-    s.params.m = f64::NAN;
-    refused(s, "m = NaN");
-    let mut s = spec();
-    s.params.i_z = -0.01944;
-    refused(s, "I_z");
-    let mut s = spec();
-    s.params.c[2] = -1.0;
-    refused(s, "c_rl");
-    let mut s = spec();
-    s.params.c = [0.0; 4];
-    refused(s, "cornering");
-    let mut s = spec();
-    s.speed = -0.35;
-    refused(s, "speed = -0.35");
-    let mut s = spec();
-    s.speed = f64::INFINITY;
-    refused(s, "speed");
-    let mut s = spec();
-    s.mu_min = -0.1;
-    refused(s, "mu_min = -0.1");
-    let mut s = spec();
-    s.mu_min = f64::NAN;
-    refused(s, "mu_min");
-    let mut s = spec();
-    s.mu_max = 0.05;
-    refused(s, "mu_max");
+    refused(|s| s.params.m = f64::NAN, "m = NaN");
+    refused(|s| s.params.i_z = -0.01944, "I_z");
+    refused(|s| s.params.c[2] = -1.0, "c_rl");
+    refused(|s| s.params.c = [0.0; 4], "cornering");
+    refused(|s| s.speed = -0.35, "speed = -0.35");
+    refused(|s| s.speed = f64::INFINITY, "speed");
+    refused(|s| s.mu_min = -0.1, "mu_min = -0.1");
+    refused(|s| s.mu_min = f64::NAN, "mu_min");
+    refused(|s| s.mu_max = 0.05, "mu_max");
     let e = {
         let mut s = spec();
         s.params.l_r = f64::NAN;

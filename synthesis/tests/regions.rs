@@ -1,10 +1,12 @@
 //! Pole regions: their LMI characteristic matches their geometry, a binding region
 //! raises gamma* and holds every closed-loop pole, an empty region is infeasible.
 
+mod common;
+use common::paper_4ws;
 use nalgebra::{Complex, DMatrix, SymmetricEigen};
 use nigel_synthesis::verify::SplitMix64;
 use nigel_synthesis::{
-    min_hinf, verify_design, Architecture, PlantSpec, PoleRegion, Region, SolveError, SynthesisError, SynthesisOptions,
+    min_hinf, verify_design, PoleRegion, Region, SolveError, SynthesisError, SynthesisOptions,
     VerifyOptions,
 };
 
@@ -52,10 +54,6 @@ fn lmi_characteristic_matches_geometry() {
     let s = Region::sector_inner_angle_deg(135.0);
     let t = 67.5f64.to_radians().tan();
     assert!(s.contains(Complex::new(-1.0, 0.99 * t)) && !s.contains(Complex::new(-1.0, 1.01 * t)));
-}
-
-fn paper_4ws() -> nigel_synthesis::Polytope {
-    PlantSpec::paper(Architecture::FourWheelSteering).polytope().unwrap()
 }
 
 #[test]

@@ -1,10 +1,12 @@
 //! The norm computations against closed-form values, the two methods against each other,
 //! and the other problems (weighted, H2, baseline) verified.
 
+mod common;
+use common::paper_4ws;
 use nalgebra::DMatrix;
 use nigel_synthesis::verify::{ClosedLoop, NormError, SplitMix64};
 use nigel_synthesis::{
-    min_h2, min_hinf, pole_placement_baseline, verify_design, weighted, Architecture, PlantSpec, PoleRegion,
+    min_h2, min_hinf, pole_placement_baseline, verify_design, weighted, PoleRegion,
     SynthesisOptions, VerifyOptions,
 };
 
@@ -84,13 +86,9 @@ fn the_two_ways_agree_on_random_stable_systems() {
     }
 }
 
-fn four_ws() -> nigel_synthesis::Polytope {
-    PlantSpec::paper(Architecture::FourWheelSteering).polytope().unwrap()
-}
-
 #[test]
 fn weighted_and_h2_designs_verify() {
-    let poly = four_ws();
+    let poly = paper_4ws();
     let opts = SynthesisOptions::default();
     let region = PoleRegion::paper();
     let gs = min_hinf(&poly, &region, &opts).unwrap().gamma.unwrap();
@@ -113,7 +111,7 @@ fn weighted_and_h2_designs_verify() {
 
 #[test]
 fn pole_placement_baseline_is_deterministic_and_reports_robustness() {
-    let poly = four_ws();
+    let poly = paper_4ws();
     let opts = SynthesisOptions::default();
     let b = pole_placement_baseline(&poly, 0.4, -2.0, &opts).unwrap();
     let again = pole_placement_baseline(&poly, 0.4, -2.0, &opts).unwrap();

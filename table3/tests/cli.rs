@@ -13,20 +13,24 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// The stderr of `table3 args`, asserted to fail without a panic.
+fn refused(args: &[&str]) -> String {
+    let o = table3(args);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{args:?}: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+    e
+}
+
 #[test]
 fn unknown_maneuver_is_a_clear_error() {
-    let o = table3(&["--engine", "in-process", "--maneuver", "drift"]);
-    assert!(!o.status.success());
-    let e = stderr(&o);
+    let e = refused(&["--engine", "in-process", "--maneuver", "drift"]);
     assert!(e.contains("unknown maneuver \"drift\"") && e.contains("figure_8"), "{e}");
-    assert!(!e.contains("panicked"), "{e}");
 }
 
 #[test]
 fn controllers_can_be_chosen_and_unknown_ones_are_a_clear_error() {
-    let o = table3(&["--engine", "in-process", "--controller", "lqr"]);
-    assert!(!o.status.success());
-    let e = stderr(&o);
+    let e = refused(&["--engine", "in-process", "--controller", "lqr"]);
     assert!(e.contains("unknown controller \"lqr\"") && e.contains("robust_tracking"), "{e}");
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("t.json");
@@ -41,22 +45,15 @@ fn controllers_can_be_chosen_and_unknown_ones_are_a_clear_error() {
 #[test]
 fn unparsable_seed_is_a_clear_error() {
     for seed in ["abc", "-1", "1.5", "99999999999999999999999"] {
-        let o = table3(&["--engine", "in-process", "--seed", seed]);
-        assert!(!o.status.success(), "{seed}");
-        let e = stderr(&o);
+        let e = refused(&["--engine", "in-process", "--seed", seed]);
         assert!(e.contains("--seed") && e.contains(seed), "{seed}: {e}");
-        assert!(!e.contains("panicked"), "{e}");
     }
 }
 
 #[test]
 fn missing_fmus_are_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let o = table3(&["--fmu-dir", dir.path().to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(1));
-    let e = stderr(&o);
-    assert!(e.contains("nigel_plant.fmu not found") && e.contains("build-fmu"), "{e}");
-    assert!(!e.contains("panicked"), "{e}");
+    assert_fmu_dir_fails_saying(dir.path(), &["nigel_plant.fmu not found", "build-fmu"]);
 }
 
 #[test]
@@ -65,10 +62,15 @@ fn corrupt_fmus_are_a_clear_error() {
     for name in nigel_table3::engine::FMU_FILES {
         std::fs::write(dir.path().join(name), b"PK\x03\x04 this is not a zip archive").unwrap();
     }
-    let o = table3(&["--fmu-dir", dir.path().to_str().unwrap()]);
+    assert_fmu_dir_fails_saying(dir.path(), &["loading", "nigel_plant.fmu"]);
+}
+
+/// `table3 --fmu-dir dir` exits 1 with a message (no panic) that says each of `words`.
+fn assert_fmu_dir_fails_saying(dir: &std::path::Path, words: &[&str]) {
+    let o = table3(&["--fmu-dir", dir.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
-    assert!(e.contains("loading") && e.contains("nigel_plant.fmu"), "{e}");
+    assert!(words.iter().all(|w| e.contains(w)), "{e}");
     assert!(!e.contains("panicked"), "{e}");
 }
 

@@ -50,15 +50,11 @@ fn max_difference(a: &Run, b: &Run) -> f64 {
     d
 }
 
-#[test]
-fn self_check_24_cells_through_the_fmus() {
-    common::assert_self_check(table_seed0());
-}
-
-#[test]
-fn robust_tracking_is_lowest_in_all_12_rows_through_the_fmus() {
-    common::assert_tracking_lowest(table_seed0());
-}
+common::self_check_tests!(
+    table_seed0,
+    self_check_24_cells_through_the_fmus,
+    robust_tracking_is_lowest_in_all_12_rows_through_the_fmus
+);
 
 #[test]
 fn fmu_table_equals_the_in_process_table() {

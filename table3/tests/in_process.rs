@@ -14,15 +14,7 @@ fn table_seed0() -> &'static Table {
     T.get_or_init(|| run_table(&InProcess::new(), &Options::new(0)).expect("the in-process table runs").table)
 }
 
-#[test]
-fn self_check_24_cells() {
-    common::assert_self_check(table_seed0());
-}
-
-#[test]
-fn robust_tracking_is_lowest_in_all_12_rows() {
-    common::assert_tracking_lowest(table_seed0());
-}
+common::self_check_tests!(table_seed0, self_check_24_cells, robust_tracking_is_lowest_in_all_12_rows);
 
 #[test]
 fn the_table_has_every_cell_and_the_baked_gains() {

@@ -86,10 +86,8 @@ fn wrong_token_and_refused_options_give_null_with_a_logged_reason() {
 
 #[test]
 fn a_null_instance_gives_error_everywhere_and_never_crashes() {
-    let f = &fmu().functions3;
-    let c = null_mut();
-    let mut x = [0.0; 4];
-    let vr = [1u32];
+    let (f, c) = (&fmu().functions3, null_mut());
+    let (mut x, vr) = ([0.0; 4], [1u32]);
     let (mut b1, mut b2, mut b3, mut t) = (0u8, 0u8, 0u8, 0.0);
     unsafe {
         assert_eq!((f.enter_initialization_mode)(c, 0, 0.0, 0.0, 0, 0.0), ERROR);

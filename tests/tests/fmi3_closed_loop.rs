@@ -141,10 +141,9 @@ fn the_closed_loops_with_fmi3_fmus_are_the_fmi2_one_bit_for_bit() {
     }
 }
 
-/// The closed loop of the FMI 3.0 archives with the controller built with its sample clock
-/// (`build-fmu --features controller-sample-clock`, into target/fmu-clocked by the test
-/// command: `sample_clock`, a fixed periodic input clock of 1 ms governing the held
-/// outputs) gives the FMI 2.0 closed loop's results bit for bit, under jacobi and ordered:
+/// The shipped closed loop of the FMI 3.0 archives (target/ssp, built by build-fmu), whose
+/// controller declares its sample clock (`sample_clock`, a fixed periodic input clock of
+/// 1 ms governing the held outputs), gives the FMI 2.0 closed loop's results bit for bit, under jacobi and ordered:
 /// the master opens the clock event of each tick at the end of the step that reaches it
 /// and exchanges the values of that communication point in it, so the controller samples
 /// with the inputs it holds there and the exchange reads that sample, as the FMI 2.0
@@ -152,19 +151,14 @@ fn the_closed_loops_with_fmi3_fmus_are_the_fmi2_one_bit_for_bit() {
 /// of the 30 s is a tick, the one at the stop time included: 30001 ticks.
 #[test]
 fn the_clocked_fmi3_closed_loop_is_the_fmi2_one_bit_for_bit() {
-    let clocked_ssp = target_dir().join("fmu-clocked").join("ssp").join("nigel_closed_loop_fmi3.ssp");
-    assert!(
-        clocked_ssp.is_file(),
-        "{} missing: run `cargo run --release -p build-fmu --features controller-sample-clock -- --platforms linux64 \
-         target/fmu-clocked/fmu`",
-        clocked_ssp.display()
-    );
+    let clocked_ssp = target_dir().join("ssp").join("nigel_closed_loop_fmi3.ssp");
+    assert!(clocked_ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu`", clocked_ssp.display());
     let clocked = read_ssp(&clocked_ssp, &Default::default()).unwrap().system;
     let controller = clocked.instance_index("controller").expect("an instance called controller");
     let md = clocked.instances[controller].fmu.fmi3_description().expect("the controller in FMI 3.0");
     let clocks: Vec<&str> =
         md.model_variables.iter().filter(|v| v.value_type == fmi3::ValueType::Clock).map(|v| v.name.as_str()).collect();
-    assert_eq!(clocks, ["sample_clock"], "the clocked build's controller declares its sample clock");
+    assert_eq!(clocks, ["sample_clock"], "the controller declares its sample clock");
     let fmi2 = closed_loops().0;
     for algorithm in [Algorithm::Jacobi, Algorithm::Ordered] {
         let mut e = Experiment::new(30.0, 1e-3);

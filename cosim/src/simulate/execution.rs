@@ -395,6 +395,24 @@ impl<'s> Execution<'s> {
                 }
             }
         }
+        // FMI 3.0 clocks of a Model Exchange instance: its input clocks ticking at the start
+        // time are activated in the Event Mode that ends initialization, before its initial
+        // event iteration (an FMU that samples at its clock's activations, and only there,
+        // has its first sample in that event, as its FMI 2.0 form has at its initial event)
+        let mut start_ticks: Vec<(usize, Vec<u32>)> = Vec::new();
+        for (lane, spec) in core.lanes.iter_mut().zip(&system.instances) {
+            let clocks = spec.fmu.clocks();
+            if lane.solo.is_none() || clocks.is_empty() {
+                continue;
+            }
+            let triggered: Vec<(u32, Vec<f64>)> =
+                self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
+            let vrs = Ticks::at_start(&clocks, t0, self.clock.h, &triggered);
+            if !vrs.is_empty() {
+                lane.inst.set_clocks(&vrs)?;
+                start_ticks.push((lane.index, vrs));
+            }
+        }
         // the initial event iteration of every Model Exchange group
         for lane in core.lanes.iter_mut() {
             if let (Some(unit), Some(solo)) = (lane.unit.as_mut(), lane.solo.as_mut()) {
@@ -424,6 +442,9 @@ impl<'s> Execution<'s> {
                 self.clock_inputs.iter().filter(|c| c.0 == lane.index).map(|c| (c.1, c.2.clone())).collect();
             let Some(mut ticks) = Ticks::new(&clocks, t0, self.clock.h, &triggered) else { continue };
             ticks.after_events(&mut lane.inst, true)?;
+            if let Some((_, vrs)) = start_ticks.iter().find(|(i, _)| *i == lane.index) {
+                ticks.ticked(vrs);
+            }
             // Co-Simulation: the ticks at the start time open their event as those at any
             // later point do, so the first row, like every row at a tick, holds what the FMU
             // answers with the clock active (Model Exchange runs every tick whole at the

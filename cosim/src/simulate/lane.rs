@@ -256,6 +256,12 @@ fn me_ticking(
     loop {
         let due = ticks.due(at, t_next);
         let end = due.as_ref().map_or(t_next, |(tick, _)| *tick);
+        // a time event the FMU gives at a tick where this advance ends is that tick's event
+        // (a clocked FMU may publish its next activation as nextEventTime): the tick runs it
+        // with its clocks activated, not the integrator as a time event without them
+        if unit.next_time_event.is_some_and(|te| (te - end).abs() <= ticks.tolerance()) && ticks.at(end).is_some() {
+            unit.next_time_event = None;
+        }
         if end > at {
             group.advance(&mut Solo { inst, unit }, solver, at, end)?;
             ticks.after_events(inst, false)?;

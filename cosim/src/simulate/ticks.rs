@@ -156,6 +156,32 @@ impl Ticks {
         (first < until - self.tolerance).then_some(first)
     }
 
+    /// The input clocks of `clocks` that tick at the start time `t0` (within a millionth of
+    /// the communication step `h`): periodic clocks with shift 0, triggered clocks whose
+    /// first tick time from the input file is `t0`. Known before the event that ends
+    /// initialization (Model Exchange activates them there, before its event iteration).
+    pub(crate) fn at_start(clocks: &[Clock], t0: f64, h: f64, triggered: &[(u32, Vec<f64>)]) -> Vec<u32> {
+        let at_t0 = |t: f64| (t - t0).abs() <= 1e-6 * h;
+        clocks
+            .iter()
+            .filter(|c| c.causality == ClockCausality::Input)
+            .filter(|c| match c.kind {
+                ClockKind::Constant | ClockKind::Fixed | ClockKind::Tunable => at_t0(t0 + c.shift),
+                ClockKind::Triggered => triggered
+                    .iter()
+                    .find(|(vr, _)| *vr == c.value_reference)
+                    .is_some_and(|(_, times)| times.first().is_some_and(|t| at_t0(*t))),
+                _ => false,
+            })
+            .map(|c| c.value_reference)
+            .collect()
+    }
+
+    /// Ticks this close are one, s (a millionth of the communication step).
+    pub(crate) fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
     /// The input clocks whose next tick is at `t` (within the tolerance), if any: the ticks
     /// at the end of a step, whose event the step opens.
     pub(crate) fn at(&self, t: f64) -> Option<Vec<u32>> {

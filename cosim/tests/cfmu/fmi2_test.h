@@ -8,10 +8,11 @@
  *   FMI2_TEST_NO_FMU_STATE       fmi2Get/Set/FreeFMUstate refused (the file has no FMU state)
  *   FMI2_TEST_NO_MODEL_EXCHANGE  every Model Exchange function refused (Co-Simulation only),
  *                                and the Co-Simulation input/output derivatives refused.
- * After its model's struct and `defaults`, a file may write FMI2_TEST_INSTANCE(Type, accepted)
+ * After its model's struct and `defaults` (or FMI2_TEST_REALS_MODEL for both), a file may write FMI2_TEST_INSTANCE(Type, accepted)
  * (or, with its own fmi2Instantiate and fmi2Reset, FMI2_TEST_LIFECYCLE(Type)),
  * FMI2_TEST_EXIT_INITIALIZATION, FMI2_TEST_CONTINUOUS_TIME(Type) (the three at once:
- * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count),
+ * FMI2_TEST_MODEL_EXCHANGE(Type)), FMI2_TEST_TWO_STATES(Type), FMI2_TEST_SET_REALS(Type, count) or
+ * FMI2_TEST_SET_REAL_MEMBERS(Type, ...),
  * FMI2_TEST_UNIT_NOMINALS, FMI2_TEST_NO_STATUS and FMI2_TEST_NO_CONTINUOUS_STATES (below) for the
  * lifecycle and mode changes that do nothing model-specific: the file then holds its model. */
 #ifndef FMI2_TEST_H
@@ -90,6 +91,19 @@ EXPORT fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, double x[],
  * allocates through them). */
 static void *(*fmi2_test_allocate)(size_t, size_t);
 static void (*fmi2_test_free)(void *);
+
+/* A model `Type` whose variables are `count` Reals, value reference k the member r[k], and
+ * the time; its `defaults` sets r to the start values `...` (the rest 0) and the time to 0. */
+#define FMI2_TEST_REALS_MODEL(Type, count, ...)                   \
+    typedef struct {                                              \
+        double r[count];                                          \
+        double time;                                              \
+    } Type;                                                       \
+    static void defaults(Type *m) {                               \
+        static const double starts[count] = {__VA_ARGS__};        \
+        memset(m, 0, sizeof *m);                                  \
+        memcpy(m->r, starts, sizeof starts);                      \
+    }
 
 /* The instance of a test model: a `Type` (a struct with a member `double time`) made by
  * calloc and set up by the file's `static void defaults(Type *)`, accepted where `accepted`
@@ -202,6 +216,22 @@ static void (*fmi2_test_free)(void *);
     FMI2_TEST_INSTANCE(Type, type == 0) \
     FMI2_TEST_EXIT_INITIALIZATION      \
     FMI2_TEST_CONTINUOUS_TIME(Type)
+
+/* fmi2SetReal of a `Type` whose settable Reals are at the addresses `...`, designated
+ * initializers `[vr] = &m->member` (`m` the instance); another value reference is refused
+ * (fmi2Error). */
+#define FMI2_TEST_SET_REAL_MEMBERS(Type, ...)                                                            \
+    EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,              \
+                                  const double v[]) {                                                    \
+        Type *m = c;                                                                                     \
+        double *slots[] = {__VA_ARGS__};                                                                 \
+        size_t i;                                                                                        \
+        for (i = 0; i < n; i++) {                                                                        \
+            if (vr[i] >= sizeof slots / sizeof *slots || !slots[vr[i]]) return ERR;                      \
+            *slots[vr[i]] = v[i];                                                                        \
+        }                                                                                                \
+        return 0;                                                                                        \
+    }
 
 /* fmi2SetReal of a `Type` whose `double r[]` holds its Real variables by value reference:
  * any of the first `count` may be set, a value reference beyond them is refused. */

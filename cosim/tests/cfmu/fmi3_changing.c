@@ -59,10 +59,7 @@ fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
     Changing *c = instance;
-    if (time != c->last_time) {
-        c->first = (int)clock;
-        c->last_time = time;
-    }
+    note_first_partition(&c->first, &c->last_time, clock, time);
     switch (clock) {
     case 1:
         if (time != c->next_steps) return fail(c, "steps activated at another time than the tick the FMU gave");
@@ -80,51 +77,9 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     }
 }
 
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
-    Changing *c = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 1) return fail(c, "fmi3GetIntervalDecimal: only the changing clock steps");
-        intervals[i] = c->interval;
-        qualifiers[i] = c->changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;
-        c->changed = 0;
-    }
-    return fmi3OK;
-}
+/* steps: the interval to its next tick, changed at initialization and after each activation */
+FMI3_TEST_ONE_INTERVAL(Changing, 1, c->interval, changed)
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 values[], size_t nValues) {
-    Changing *c = instance;
-    for (size_t i = 0; i < n; i++) {
-        switch (vr[i]) {
-        case 10: values[i] = c->first_delay; break;
-        case 11: values[i] = c->t_steps; break;
-        default: return fail(c, "fmi3GetFloat64: unknown value reference");
-        }
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    const fmi3Float64 values[], size_t nValues) {
-    Changing *c = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 10) return fail(c, "fmi3SetFloat64: only first_delay");
-        c->first_delay = values[i];
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Int32 values[], size_t nValues) {
-    Changing *c = instance;
-    for (size_t i = 0; i < n; i++) {
-        switch (vr[i]) {
-        case 20: values[i] = c->n_steps; break;
-        case 21: values[i] = c->n_fast; break;
-        case 22: values[i] = c->first; break;
-        default: return fail(c, "fmi3GetInt32: unknown value reference");
-        }
-    }
-    return fmi3OK;
-}
+FMI3_TEST_GET(Float64, fmi3Float64, Changing, [10] = &c->first_delay, [11] = &c->t_steps)
+FMI3_TEST_SET(Float64, fmi3Float64, Changing, "only first_delay", [10] = &c->first_delay)
+FMI3_TEST_GET(Int32, fmi3Int32, Changing, [20] = &c->n_steps, [21] = &c->n_fast, [22] = &c->first)

@@ -16,10 +16,10 @@
 #include "fmi3_test.h"
 
 typedef struct {
-    double time, u, y;
-    int ticks, initializing, in_event_mode, active, ticked, scheduled, u_set;
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
+    double time, u, y;
+    int ticks, initializing, in_event_mode, active, ticked, scheduled, u_set;
 } Exchange;
 
 FMI3_TEST_FAIL(Exchange)
@@ -67,10 +67,6 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     c->in_event_mode = !c->scheduled;
     return fmi3OK;
 }
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
-    ((Exchange *)instance)->in_event_mode = 1;
-    return fmi3OK;
-}
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Exchange *c = instance;
     if (c->active) return fail(c, "fmi3EnterStepMode: tick is still active");
@@ -98,22 +94,10 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     return fmi3OK;
 }
 
-fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+FMI3_TEST_EVENT_MODE_STEPS(Exchange)
+/* the scheduled flag (the instance's interface) stays */
 fmi3Status fmi3Reset(fmi3Instance instance) {
     start(instance);
-    return fmi3OK;
-}
-
-fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
-    fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn,
-    fmi3Float64 *lastSuccessfulTime) {
-    Exchange *c = instance;
-    if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");
-    c->time = t + h;
-    *eventHandlingNeeded = 0;
-    *terminateSimulation = 0;
-    *earlyReturn = 0;
-    *lastSuccessfulTime = c->time;
     return fmi3OK;
 }
 
@@ -151,13 +135,7 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     Exchange *c = instance;
     if (!c->in_event_mode) return fail(c, "fmi3UpdateDiscreteStates outside Event Mode");
     c->active = 0;
-    *needUpdate = 0;
-    *terminate = 0;
-    *nominalsChanged = 0;
-    *valuesChanged = 0;
-    *nextDefined = 0;
-    *next = 0;
-    return fmi3OK;
+    return updated_discrete_states(needUpdate, terminate, nominalsChanged, valuesChanged, nextDefined, next);
 }
 
 /* whether a clocked variable may be set now: while tick is active (Scheduled Execution:

@@ -41,14 +41,8 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
 }
 /* after initialization the instance is in Event Mode (eventModeUsed) */
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-    Clocks *c = instance;
-    c->in_event_mode = 1;
-    c->changing_given = 0;
-    return fmi3OK;
-}
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
-    ((Clocks *)instance)->in_event_mode = 1;
-    return fmi3OK;
+    ((Clocks *)instance)->changing_given = 0;
+    return fmi3EnterEventMode(instance);
 }
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Clocks *c = instance;
@@ -56,27 +50,8 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     c->out_ticked = 0;
     return fmi3OK;
 }
-fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
-fmi3Status fmi3Reset(fmi3Instance instance) {
-    Clocks *c = instance;
-    fmi3InstanceEnvironment env = c->env;
-    fmi3LogMessageCallback log = c->log;
-    memset(c, 0, sizeof(Clocks));
-    c->env = env;
-    c->log = log;
-    c->fixed_interval = 0.4;
-    c->last_tick = -1;
-    return fmi3OK;
-}
-
-fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
-    fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn,
-    fmi3Float64 *lastSuccessfulTime) {
-    Clocks *c = instance;
-    if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");
-    c->time = t + h;
-    return step_reached(c->time, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
-}
+FMI3_TEST_EVENT_MODE_STEPS(Clocks)
+FMI3_TEST_RESET(Clocks, start)
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) {
     Clocks *c = instance;
@@ -177,45 +152,11 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
     Clocks *c = instance;
     if (!c->in_event_mode) return fail(c, "fmi3UpdateDiscreteStates outside Event Mode");
-    *needUpdate = 0;
-    *terminate = 0;
-    *nominalsChanged = 0;
-    *valuesChanged = 0;
-    *nextDefined = 0;
-    *next = 0;
-    return fmi3OK;
+    return updated_discrete_states(needUpdate, terminate, nominalsChanged, valuesChanged, nextDefined, next);
 }
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    fmi3Float64 values[], size_t nValues) {
-    Clocks *c = instance;
-    for (size_t k = 0; k < nvr; k++) {
-        switch (vr[k]) {
-        case 0: values[k] = c->time; break;
-        case 16: values[k] = c->last_tick; break;
-        case 20: values[k] = c->fixed_interval; break;
-        default: return fail(c, "fmi3GetFloat64: no such variable");
-        }
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    const fmi3Float64 values[], size_t nValues) {
-    Clocks *c = instance;
-    for (size_t k = 0; k < nvr; k++) {
-        if (vr[k] != 20) return fail(c, "fmi3SetFloat64: not a parameter");
-        c->fixed_interval = values[k];
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    fmi3Int32 values[], size_t nValues) {
-    Clocks *c = instance;
-    for (size_t k = 0; k < nvr; k++) {
-        if (vr[k] < 10 || vr[k] > 15) return fail(c, "fmi3GetInt32: no such variable");
-        values[k] = c->n[vr[k] - 10];
-    }
-    return fmi3OK;
-}
+FMI3_TEST_GET(Float64, fmi3Float64, Clocks, [0] = &c->time, [16] = &c->last_tick, [20] = &c->fixed_interval)
+FMI3_TEST_SET(Float64, fmi3Float64, Clocks, "not a parameter", [20] = &c->fixed_interval)
+/* the tick counts n_* (10 .. 15) */
+FMI3_TEST_GET(Int32, fmi3Int32, Clocks, [10] = &c->n[0], [11] = &c->n[1], [12] = &c->n[2], [13] = &c->n[3],
+    [14] = &c->n[4], [15] = &c->n[5])

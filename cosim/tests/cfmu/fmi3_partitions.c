@@ -27,36 +27,19 @@ typedef struct {
 
 FMI3_TEST_FAIL(Partitions)
 
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
-    fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
-    if (!token || strcmp(token, "{fmi3-partitions}") != 0 || !update) return NULL;
-    Partitions *p = calloc(1, sizeof(Partitions));
-    if (!p) return NULL;
-    p->env = env;
-    p->log = log;
-    p->update = update;
+static void start(Partitions *p, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
     p->lock = lock;
     p->unlock = unlock;
     p->u = 1.0;
     p->last_time = -1.0;
-    return p;
 }
 
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
-    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    return fmi3OK;
-}
+FMI3_TEST_SCHEDULED_INSTANCE(Partitions, "{fmi3-partitions}", start)
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { return fmi3OK; }
-fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
     Partitions *p = instance;
-    if (time != p->last_time) {
-        p->first = (int)clock;
-        p->last_time = time;
-    }
+    note_first_partition(&p->first, &p->last_time, clock, time);
     switch (clock) {
     case 1:
         if (!p->lock || !p->unlock) return fail(p, "fast: no lockPreemption/unlockPreemption");
@@ -86,59 +69,13 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     }
 }
 
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 3) return fail(p, "fmi3GetIntervalDecimal: only the countdown clock later");
-        qualifiers[i] = p->later_changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;
-        intervals[i] = 0.125;
-        p->later_changed = 0;
-    }
-    return fmi3OK;
-}
+/* the countdown clock later: 0.125 s, changed when slow set it */
+FMI3_TEST_ONE_INTERVAL(Partitions, 3, 0.125, later_changed)
 
-fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Clock values[]) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 4) return fail(p, "fmi3GetClock: only the output clock out");
-        values[i] = p->out != 0;
-        p->out = 0;
-    }
-    return fmi3OK;
-}
+FMI3_TEST_OUTPUT_CLOCK(Partitions, 4, out)
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 values[], size_t nValues) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        switch (vr[i]) {
-        case 10: values[i] = p->u; break;
-        case 11: values[i] = p->x; break;
-        case 12: values[i] = p->t_later; break;
-        default: return fail(p, "fmi3GetFloat64: unknown value reference");
-        }
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    const fmi3Float64 values[], size_t nValues) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 10) return fail(p, "fmi3SetFloat64: only u");
-        p->u = values[i];
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Int32 values[], size_t nValues) {
-    Partitions *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] >= 20 && vr[i] <= 23) values[i] = p->n[vr[i] - 20];
-        else if (vr[i] == 24) values[i] = p->first;
-        else return fail(p, "fmi3GetInt32: unknown value reference");
-    }
-    return fmi3OK;
-}
+FMI3_TEST_GET(Float64, fmi3Float64, Partitions, [10] = &c->u, [11] = &c->x, [12] = &c->t_later)
+FMI3_TEST_SET(Float64, fmi3Float64, Partitions, "only u", [10] = &c->u)
+/* the counts n_fast .. n_kick (20 .. 23) and first (24) */
+FMI3_TEST_GET(Int32, fmi3Int32, Partitions, [20] = &c->n[0], [21] = &c->n[1], [22] = &c->n[2], [23] = &c->n[3],
+    [24] = &c->first)

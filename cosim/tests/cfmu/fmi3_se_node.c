@@ -24,32 +24,18 @@ typedef struct {
 
 FMI3_TEST_FAIL(Node)
 
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
-    fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
-    if (!token || strcmp(token, "{fmi3-se-node}") != 0 || !update) return NULL;
-    Node *p = calloc(1, sizeof(Node));
-    if (!p) return NULL;
-    p->env = env;
-    p->log = log;
-    p->update = update;
+static void start(Node *p, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
     p->period = 0.5; /* the start of the description's period */
     p->rate_interval = 0.5;
     p->sample_fresh = 1;
     p->rate_fresh = 1;
-    return p;
 }
 
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
-fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
-    fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    return fmi3OK;
-}
+FMI3_TEST_SCHEDULED_INSTANCE(Node, "{fmi3-se-node}", start)
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     ((Node *)instance)->initialized = 1;
     return fmi3OK;
 }
-fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
     Node *p = instance;
@@ -78,6 +64,8 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
     }
 }
 
+FMI3_TEST_OUTPUT_CLOCK(Node, 3, done)
+
 /* The fixed clock's interval is known after initialization only (the period set before). */
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
     fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
@@ -100,56 +88,11 @@ fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReferenc
     return fmi3OK;
 }
 
-fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Clock values[]) {
-    Node *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 3) return fail(p, "fmi3GetClock: only the output clock done");
-        values[i] = p->done != 0;
-        p->done = 0;
-    }
-    return fmi3OK;
-}
 
-static double *float64(Node *p, fmi3ValueReference vr) {
-    switch (vr) {
-    case 10: return &p->period;
-    case 11: return &p->u;
-    case 12: return &p->v;
-    case 13: return &p->y;
-    case 14: return &p->z;
-    case 15: return &p->w;
-    default: return NULL;
-    }
-}
-
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 values[], size_t nValues) {
-    Node *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        double *x = float64(p, vr[i]);
-        if (!x) return fail(p, "fmi3GetFloat64: unknown value reference");
-        values[i] = *x;
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    const fmi3Float64 values[], size_t nValues) {
-    Node *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] == 10 && p->initialized) return fail(p, "fmi3SetFloat64: period is fixed after initialization");
-        if (vr[i] != 10 && vr[i] != 11 && vr[i] != 12) return fail(p, "fmi3SetFloat64: only period, u and v");
-        *float64(p, vr[i]) = values[i];
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Int32 values[], size_t nValues) {
-    Node *p = instance;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] < 20 || vr[i] > 22) return fail(p, "fmi3GetInt32: unknown value reference");
-        values[i] = p->n[vr[i] - 20];
-    }
-    return fmi3OK;
-}
+FMI3_TEST_GET(Float64, fmi3Float64, Node, [10] = &c->period, [11] = &c->u, [12] = &c->v, [13] = &c->y, [14] = &c->z,
+    [15] = &c->w)
+/* the inputs u and v, and the parameter period before initialization (fixed after) */
+FMI3_TEST_SET(Float64, fmi3Float64, Node, "only period (fixed after initialization), u and v",
+    [10] = c->initialized ? NULL : &c->period, [11] = &c->u, [12] = &c->v)
+/* the counts n_sample, n_trigger, n_rate (20 .. 22) */
+FMI3_TEST_GET(Int32, fmi3Int32, Node, [20] = &c->n[0], [21] = &c->n[1], [22] = &c->n[2])

@@ -1,10 +1,14 @@
 /* Shared by the FMI 3.0 C test FMUs of the master's tests (fmi3_clocks.c, fmi3_counter.c,
- * fmi3_partitions.c, fmi3_sized.c), written against the standard's headers (the tests pass
+ * fmi3_partitions.c, fmi3_se_node.c, fmi3_sized.c), written against the standard's headers (the tests pass
  * their folder with -I; fmi3_clocked_exchange.c too): fmi3GetVersion and the helpers that are the same in each. Each .c
  * file is one shared library and includes this header once. After its instance's struct (a
  * `Type` with members `fmi3InstanceEnvironment env` and `fmi3LogMessageCallback log`), a
- * file writes FMI3_TEST_FAIL(Type) for its `fail`, and an Event Mode only Co-Simulation
- * FMU FMI3_TEST_EVENT_MODE_INSTANCE for its lifecycle. */
+ * file writes FMI3_TEST_FAIL(Type) for its `fail`; an Event Mode only Co-Simulation FMU
+ * FMI3_TEST_EVENT_MODE_INSTANCE, FMI3_TEST_EVENT_MODE_STEPS and FMI3_TEST_RESET for its
+ * lifecycle, a Scheduled Execution FMU FMI3_TEST_SCHEDULED_INSTANCE; FMI3_TEST_GET and
+ * FMI3_TEST_SET give typed gets and sets from a table of the variables' addresses,
+ * FMI3_TEST_OUTPUT_CLOCK the read of a single output clock, FMI3_TEST_ONE_INTERVAL the
+ * interval of a single clock. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
@@ -55,6 +59,149 @@ static inline fmi3Status step_reached(fmi3Float64 time, fmi3Boolean *eventHandli
     *lastSuccessfulTime = time;
     return fmi3OK;
 }
+
+/* The steps of an Event Mode only Co-Simulation `Type` (members `double time` and
+ * `int in_event_mode`): fmi3EnterEventMode enters it; fmi3DoStep is refused in Event Mode,
+ * else advances the time to t + h with no event; fmi3Terminate does nothing. */
+#define FMI3_TEST_EVENT_MODE_STEPS(Type)                                                           \
+    fmi3Status fmi3EnterEventMode(fmi3Instance instance) {                                         \
+        ((Type *)instance)->in_event_mode = 1;                                                     \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior, \
+        fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, \
+        fmi3Float64 *lastSuccessfulTime) {                                                         \
+        Type *c = instance;                                                                        \
+        if (c->in_event_mode) return fail(c, "fmi3DoStep in Event Mode");                          \
+        c->time = t + h;                                                                           \
+        return step_reached(c->time, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime); \
+    }                                                                                              \
+    fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+
+/* fmi3Reset of a `Type` of FMI3_TEST_EVENT_MODE_INSTANCE: zeroed but for env and log, then
+ * `start(Type *)` as at instantiation. */
+#define FMI3_TEST_RESET(Type, start)                                                               \
+    fmi3Status fmi3Reset(fmi3Instance instance) {                                                  \
+        Type *c = instance;                                                                        \
+        fmi3InstanceEnvironment env = c->env;                                                      \
+        fmi3LogMessageCallback log = c->log;                                                       \
+        memset(c, 0, sizeof(Type));                                                                \
+        c->env = env;                                                                              \
+        c->log = log;                                                                              \
+        start(c);                                                                                  \
+        return fmi3OK;                                                                             \
+    }
+
+/* The lifecycle of a Scheduled Execution `Type` (members `env`, `log` and `update`):
+ * fmi3InstantiateScheduledExecution refuses (NULL) another instantiation token than
+ * `token_text` or no clockUpdate callback, else calls `start(Type *, lock, unlock)` on the
+ * zeroed instance with env, log and update set; fmi3FreeInstance frees it; entering
+ * initialization and terminating do nothing. */
+#define FMI3_TEST_SCHEDULED_INSTANCE(Type, token_text, start)                                      \
+    fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token,             \
+        fmi3String resources, fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, \
+        fmi3LogMessageCallback log, fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, \
+        fmi3UnlockPreemptionCallback unlock) {                                                     \
+        if (!token || strcmp(token, token_text) != 0 || !update) return NULL;                      \
+        Type *p = calloc(1, sizeof(Type));                                                         \
+        if (!p) return NULL;                                                                       \
+        p->env = env;                                                                              \
+        p->log = log;                                                                              \
+        p->update = update;                                                                        \
+        start(p, lock, unlock);                                                                    \
+        return p;                                                                                  \
+    }                                                                                              \
+    void fmi3FreeInstance(fmi3Instance instance) { free(instance); }                               \
+    fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,    \
+        fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) { \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+
+/* fmi3Get<Kind> (values of C type `CType`) of a `Type`: `...` the addresses of its variables
+ * as designated initializers `[vr] = &c->member` (`c` the instance); another value reference
+ * is no such variable, fmi3Error. */
+#define FMI3_TEST_GET(Kind, CType, Type, ...)                                                      \
+    fmi3Status fmi3Get##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,      \
+        CType values[], size_t nValues) {                                                          \
+        Type *c = instance;                                                                        \
+        CType *slots[] = {__VA_ARGS__};                                                            \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] >= sizeof slots / sizeof *slots || !slots[vr[k]])                            \
+                return fail(c, "fmi3Get" #Kind ": no such variable");                              \
+            values[k] = *slots[vr[k]];                                                             \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
+
+/* fmi3Set<Kind> (values of C type `CType`) of a `Type`: `...` the addresses of the variables
+ * that may be set now, as FMI3_TEST_GET's (an address may be an expression giving NULL:
+ * not now); another value reference is refused (fmi3Error, logged as `refusal`). */
+#define FMI3_TEST_SET(Kind, CType, Type, refusal, ...)                                             \
+    fmi3Status fmi3Set##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,      \
+        const CType values[], size_t nValues) {                                                    \
+        Type *c = instance;                                                                        \
+        CType *slots[] = {__VA_ARGS__};                                                            \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] >= sizeof slots / sizeof *slots || !slots[vr[k]])                            \
+                return fail(c, "fmi3Set" #Kind ": " refusal);                                      \
+            *slots[vr[k]] = values[k];                                                             \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
+
+/* fmi3GetIntervalDecimal of a `Type` with one clock whose interval the FMU gives, value
+ * reference `clock`: `interval` (an expression of `c`, the instance), fmi3IntervalChanged
+ * when the int member `changed` is set (the read clears it), else fmi3IntervalUnchanged. */
+#define FMI3_TEST_ONE_INTERVAL(Type, clock, interval, changed)                                     \
+    fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, \
+        fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {                             \
+        Type *c = instance;                                                                        \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] != clock) return fail(c, "fmi3GetIntervalDecimal: not the clock of the FMU's intervals"); \
+            intervals[k] = interval;                                                               \
+            qualifiers[k] = c->changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;              \
+            c->changed = 0;                                                                        \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
+
+/* The partition activated first at the latest activation time: at an activation of `clock`
+ * at `time` later than `*last_time`, `*first` becomes the clock and `*last_time` the time. */
+static inline void note_first_partition(int *first, double *last_time, fmi3ValueReference clock, fmi3Float64 time) {
+    if (time != *last_time) {
+        *first = (int)clock;
+        *last_time = time;
+    }
+}
+
+/* fmi3GetClock of a `Type` with one output clock, value reference `clock`: whether it ticked
+ * (the int member `ticked` nonzero), which the read clears. */
+#define FMI3_TEST_OUTPUT_CLOCK(Type, clock, ticked)                                                \
+    fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,       \
+        fmi3Clock values[]) {                                                                      \
+        Type *c = instance;                                                                        \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] != clock) return fail(c, "fmi3GetClock: not the output clock");              \
+            values[k] = c->ticked != 0;                                                            \
+            c->ticked = 0;                                                                         \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
+
+/* The end of an fmi3UpdateDiscreteStates that asks for nothing more: no further update, no
+ * end, nothing changed, no next event time. */
+static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Boolean *terminate,
+    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
+    *needUpdate = 0;
+    *terminate = 0;
+    *nominalsChanged = 0;
+    *valuesChanged = 0;
+    *nextDefined = 0;
+    *next = 0;
+    return fmi3OK;
+}
+
 
 /* Model Exchange without continuous states or event indicators: the counts 0, the state
  * and indicator calls accept their empty arrays, no integrator step asks for an event. */

@@ -56,16 +56,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Model *m = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] == 1) m->t_bad = v[i];
-        else if (vr[i] == 2) m->bad = v[i];
-        else return ERR;
-    }
-    return 0;
-}
+FMI2_TEST_SET_REAL_MEMBERS(Model, [1] = &m->t_bad, [2] = &m->bad)
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, double t, double h, int noSetPrior) {
     ((Model *)c)->time = t + h;
     return 0;

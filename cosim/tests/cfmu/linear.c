@@ -6,17 +6,8 @@
 #define FMI2_TEST_NO_FMU_STATE
 #include "fmi2_test.h"
 
-typedef struct {
-    double r[5];
-    double time;
-} Linear;
-
-static void defaults(Linear *m) {
-    memset(m, 0, sizeof *m);
-    m->r[0] = 1.0;
-    m->r[2] = 1.0;
-    m->r[4] = 1e4;
-}
+/* x1, der(x1), x2, der(x2), lambda */
+FMI2_TEST_REALS_MODEL(Linear, 5, 1.0, 0.0, 1.0, 0.0, 1e4)
 
 FMI2_TEST_MODEL_EXCHANGE(Linear)
 

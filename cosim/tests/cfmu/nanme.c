@@ -7,16 +7,8 @@
 #include "fmi2_test.h"
 #include <math.h>
 
-typedef struct {
-    double r[4];
-    double time;
-} Decay;
-
-static void defaults(Decay *d) {
-    memset(d, 0, sizeof *d);
-    d->r[0] = 1.0; /* x */
-    d->r[2] = 0.5; /* t_bad */
-}
+/* x, der(x), t_bad, mode */
+FMI2_TEST_REALS_MODEL(Decay, 4, 1.0, 0.0, 0.5, 0.0)
 
 FMI2_TEST_MODEL_EXCHANGE(Decay)
 

@@ -12,12 +12,8 @@ typedef struct {
     double slope, t_step, offset, time;
 } Ramp;
 
-static void defaults(Ramp *r) {
-    r->slope = 2.0;
-    r->t_step = 0.55;
-    r->offset = 0.0;
-    r->time = 0.0;
-}
+/* offset and time 0 */
+static void defaults(Ramp *r) { *r = (Ramp){.slope = 2.0, .t_step = 0.55}; }
 
 FMI2_TEST_MODEL_EXCHANGE(Ramp)
 
@@ -35,16 +31,7 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     }
     return 0;
 }
-EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const double v[]) {
-    Ramp *r = c;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        if (vr[i] == 1) r->slope = v[i];
-        else if (vr[i] == 2) r->t_step = v[i];
-        else return ERR;
-    }
-    return 0;
-}
+FMI2_TEST_SET_REAL_MEMBERS(Ramp, [1] = &m->slope, [2] = &m->t_step)
 
 EXPORT fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
     Ramp *r = c;

@@ -18,12 +18,8 @@ typedef struct {
     int terminated;
 } Stair;
 
-static void defaults(Stair *s) {
-    s->counter = 1.0;
-    s->time = 0.0;
-    s->next_event = 1.0;
-    s->terminated = 0;
-}
+/* the counter 1, its first event at 1 s, the time 0, not terminated */
+static void defaults(Stair *s) { *s = (Stair){.counter = 1.0, .next_event = 1.0}; }
 
 FMI2_TEST_INSTANCE(Stair, 1)
 FMI2_TEST_EXIT_INITIALIZATION

@@ -11,6 +11,17 @@ pub fn python() -> String {
     std::env::var("FMPY_PYTHON").unwrap_or_else(|_| "python3".to_string())
 }
 
+/// The lines the fmpy script `script` prints (`python -c script args...`, asserted to
+/// succeed), each as its whitespace-separated numbers.
+pub fn fmpy_lines<S: AsRef<std::ffi::OsStr>>(script: &str, args: &[S]) -> Vec<Vec<f64>> {
+    let out = Command::new(python()).args(["-c", script]).args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| l.split_whitespace().map(|w| w.parse().unwrap()).collect())
+        .collect()
+}
+
 /// The `cc` flags of an FMI 3.0 test FMU: warnings are errors, the standard's headers from
 /// the folder `headers`.
 pub fn flags(headers: &Path) -> Vec<OsString> {
@@ -64,4 +75,25 @@ pub fn corpus() -> PathBuf {
     std::env::var_os("NIGEL_CORPUS")
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus"))
+}
+
+/// An FMI 3.0 Scheduled Execution description of the C FMU `model_identifier` (its
+/// instantiation token `{fmi3-<model_name with - for _>}` as the C file checks it): the
+/// independent variable `time` (value reference 0), then `variables` (XML elements, one a
+/// line), and the ModelStructure's outputs `outputs` (value references, in order).
+pub fn scheduled_description(model_name: &str, model_identifier: &str, variables: &str, outputs: &[u32]) -> String {
+    let token = format!("{{fmi3-{}}}", model_name.replace('_', "-"));
+    let outputs: String = outputs.iter().map(|vr| format!("    <Output valueReference=\"{vr}\"/>\n")).collect();
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName="{model_name}" instantiationToken="{token}">
+  <ScheduledExecution modelIdentifier="{model_identifier}"/>
+  <ModelVariables>
+    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
+    {variables}  </ModelVariables>
+  <ModelStructure>
+{outputs}  </ModelStructure>
+</fmiModelDescription>
+"#
+    )
 }

@@ -233,17 +233,36 @@ pub fn build_hostile(dir: &Path) -> PathBuf {
     build_single_c_fmu(dir, "hostile", xml)
 }
 
-/// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
-/// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
-pub fn build_nanme(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "nanme", include_str!("../cfmu/nanme.xml"))
+/// `pub fn $name(dir: &Path) -> PathBuf` for each `$name => "$id"`: the C test FMU
+/// tests/cfmu/$id.c with its description tests/cfmu/$id.xml, as `<dir>/$id.fmu`.
+macro_rules! c_fmu_builders {
+    ($($(#[$doc:meta])* $name:ident => $id:literal;)*) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(dir: &Path) -> PathBuf {
+                build_single_c_fmu(dir, $id, include_str!(concat!("../cfmu/", $id, ".xml")))
+            }
+        )*
+    };
 }
 
-/// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
-pub fn build_ball(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "ball", include_str!("../cfmu/ball.xml"))
+c_fmu_builders! {
+    /// Exponential decay that returns NaN or infinite derivatives, or a NaN next event time,
+    /// with fmi2OK (tests/cfmu/nanme.c), Model Exchange only, as `<dir>/nanme.fmu`.
+    build_nanme => "nanme";
+    /// The bouncing ball (tests/cfmu/ball.c), Model Exchange only, as `<dir>/ball.fmu`.
+    build_ball => "ball";
+    /// The self-ending counter (tests/cfmu/stair.c, after the Reference FMU Stair), Model
+    /// Exchange and Co-Simulation, as `<dir>/stair.fmu`.
+    build_stair => "stair";
+    /// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
+    /// exit(0), a never-returning step at t_crash, a 10 MB log message, a double free), as
+    /// `<dir>/crash.fmu`.
+    build_crash => "crash";
+    /// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
+    /// `<dir>/vdp.fmu`.
+    build_vdp => "vdp";
 }
-
 /// The bouncing ball with `n` event indicators (all z = h), as `<dir>/ball.fmu`.
 pub fn build_ball_with_indicators(dir: &Path, n: usize) -> PathBuf {
     let xml = include_str!("../cfmu/ball.xml")
@@ -270,19 +289,6 @@ pub fn build_latch(dir: &Path) -> PathBuf {
 </fmiModelDescription>
 "#;
     build_single_c_fmu(dir, "latch", xml)
-}
-
-/// The self-ending counter (tests/cfmu/stair.c, after the Reference FMU Stair), Model
-/// Exchange and Co-Simulation, as `<dir>/stair.fmu`.
-pub fn build_stair(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "stair", include_str!("../cfmu/stair.xml"))
-}
-
-/// The misbehaving Co-Simulation FMU (tests/cfmu/crash.c: segfault, abort, stack overflow,
-/// exit(0), a never-returning step at t_crash, a 10 MB log message, a double free), as
-/// `<dir>/crash.fmu`.
-pub fn build_crash(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "crash", include_str!("../cfmu/crash.xml"))
 }
 
 /// [`build_crash`] with a GUID of `bytes` bytes (`{crash}` then hexadecimal digits of a
@@ -315,6 +321,59 @@ pub fn time_and_y(csv: &str) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The vdp FMU at `path` alone ("model") to 2 s in steps of 0.01 s under bdf (rtol 1e-6,
+/// atol 1e-8), its states recorded: the tests that compare its Jacobians with differences.
+pub fn run_vdp_under_bdf(path: &Path) -> (nigel_cosim::Results, nigel_cosim::Summary) {
+    let mut e = nigel_cosim::Experiment::new(2.0, 0.01);
+    e.solver = nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 };
+    e.record = Some(vec!["model.x0".into(), "model.x1".into()]);
+    let fmu = nigel_cosim::Fmu::load(path).unwrap();
+    nigel_cosim::simulate(&nigel_cosim::System::single("model", fmu).unwrap(), &e).unwrap()
+}
+
+/// The folder `work_dir(test)` with the FMUs source.fmu and gain.fmu built in it (the
+/// parts of the SSP tests' systems).
+pub fn work_dir_with_source_and_gain(test: &str) -> PathBuf {
+    let dir = work_dir(test);
+    build_fmu(Model::Source, &dir, &[]);
+    build_fmu(Model::Gain, &dir, &[]);
+    dir
+}
+
+/// Packs the SSP `ssp`: `ssd` as SystemStructure.ssd and the files `files` of `dir` under
+/// their names.
+pub fn pack_ssp(ssp: &Path, ssd: String, dir: &Path, files: &[&str]) {
+    let mut entries = vec![("SystemStructure.ssd", ssd.into_bytes())];
+    entries.extend(files.iter().map(|name| (*name, std::fs::read(dir.join(name)).unwrap())));
+    zip_entries(ssp, &entries);
+}
+
+/// A system builder with an instance of `fmu` under each of `names`.
+pub fn builder_with(fmu: &std::sync::Arc<nigel_cosim::Fmu>, names: &[&str]) -> nigel_cosim::SystemBuilder {
+    let mut b = nigel_cosim::SystemBuilder::new();
+    for name in names {
+        b.add_instance(name, fmu.clone()).unwrap();
+    }
+    b
+}
+
+/// Runs `command` (a run that writes the CSV `csv`), asserts that it succeeded (showing its
+/// stderr otherwise) and reads the CSV: the header's names (quotes removed) and the rows.
+pub fn run_to_csv(command: &mut Command, csv: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let out = command.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    read_csv(csv)
+}
+
+/// The CSV `cosim run` writes: the header's names (quotes removed) and the rows.
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(|h| h.trim_matches('"').to_string()).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    (header, rows)
+}
+
 /// The model description of the FMU with no states (tests/cfmu/ramp.c); `offset_causality`
 /// of its discrete variable `offset` ("local" as the FMU has it, "output" to test the
 /// sample-period warning).
@@ -340,12 +399,6 @@ pub fn ramp_xml(offset_causality: &str) -> String {
 /// Exchange only, with the model description `xml` ([`ramp_xml`]), as `<dir>/ramp.fmu`.
 pub fn build_ramp(dir: &Path, xml: &str) -> PathBuf {
     build_single_c_fmu(dir, "ramp", xml)
-}
-
-/// Van der Pol with directional derivatives (tests/cfmu/vdp.c), Model Exchange only, as
-/// `<dir>/vdp.fmu`.
-pub fn build_vdp(dir: &Path) -> PathBuf {
-    build_single_c_fmu(dir, "vdp", include_str!("../cfmu/vdp.xml"))
 }
 
 /// The stiff linear system with a closed-form solution (tests/cfmu/linear.c), Model
@@ -489,11 +542,11 @@ pub fn assert_counted_at_bounces(r: &nigel_cosim::Results, bounces: &[f64], what
 }
 
 /// Every instance in a host process of its own (`--isolate`), the host the one this
-/// package builds.
+/// package builds (`option_env!`: the campaign's tests include this module and build no host).
 pub fn isolate_all() -> nigel_cosim::Isolation {
     nigel_cosim::Isolation {
         instances: None,
         call_timeout: None,
-        host: Some(PathBuf::from(env!("CARGO_BIN_EXE_cosim-host"))),
+        host: option_env!("CARGO_BIN_EXE_cosim-host").map(PathBuf::from),
     }
 }

@@ -3,27 +3,17 @@
 `simulate_fmu` in both interfaces: the same rows, the same values (Model Exchange: and the
 row at the event that ended the run, which fmpy does not write)."""
 import subprocess
-import zipfile
-from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-CFMU = Path(__file__).resolve().parent.parent / "cfmu"
+from stiff_reference import build_cfmu
 
 
 @pytest.fixture(scope="module")
 def stair_fmu(tmp_path_factory):
-    d = tmp_path_factory.mktemp("stair")
-    so = d / "stair.so"
-    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", str(CFMU / "stair.c"), "-o", str(so)],
-                   check=True)
-    fmu = d / "stair.fmu"
-    with zipfile.ZipFile(fmu, "w") as z:
-        z.write(CFMU / "stair.xml", "modelDescription.xml")
-        z.write(so, "binaries/linux64/stair.so")
-    return fmu
+    return build_cfmu("stair", tmp_path_factory.mktemp("stair"))
 
 
 @pytest.mark.parametrize("interface,fmi_type", [("cs", "CoSimulation"), ("me", "ModelExchange")])

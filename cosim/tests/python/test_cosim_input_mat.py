@@ -66,6 +66,38 @@ def jump_signals(t_jump):
     return signals
 
 
+def assert_same_bits(ours, ref):
+    """Every column of fmpy's `ref` but time equals ours, bit for bit."""
+    names = [n for n in ref.dtype.names if n != "time"]
+    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
+    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
+
+
+def model_exchange_against_cvode(cosim, plant_fmu, csv, signals, stop, tmp_path, rows):
+    """The plant (v_x_start 0.35) with the input file `csv` (`signals`) to `stop` in Model
+    Exchange: our dopri5 against fmpy's CVode, both to rtol 1e-10, inputs held over each
+    10 ms step in both (fmpy applies them at communication points); `rows` rows each, every
+    state within 1e-7 of its scale. Each integrator's global error is near 1e-10 of the
+    state's scale, so 1e-7 of the scale is a thousandfold margin that no libm or BLAS
+    difference approaches, while a jump applied one step (10 ms) late moves psi by 4e-3 rad
+    and x by 3e-4 m. Gives (ours, fmpy's)."""
+    h = 1e-2
+    out = tmp_path / "me.csv"
+    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
+                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", str(stop), "--step", str(h),
+                    "--output", str(out)], check=True)
+    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
+                       stop_time=stop, output_interval=h, start_values={"v_x_start": 0.35}, input=signals,
+                       record_events=False)
+    assert len(ours) == len(ref) == rows
+    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
+        scale = max(1.0, float(np.max(np.abs(ref[name]))))
+        diff = float(np.max(np.abs(ours[name] - ref[name])))
+        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
+    return ours, ref
+
+
 def test_input_jumps_equal_fmpy_in_both_interfaces(cosim, plant_fmu, tmp_path):
     # jumps on communication points: fmpy applies the later row from the jump on, in
     # Co-Simulation before the step from it, in Model Exchange as a time event there
@@ -81,29 +113,11 @@ def test_input_jumps_equal_fmpy_in_both_interfaces(cosim, plant_fmu, tmp_path):
     ref = simulate_fmu(str(plant_fmu), fmi_type="CoSimulation", stop_time=stop, output_interval=1e-3,
                        start_values=start, input=signals)
     assert len(ours) == len(ref) == 2001 and np.array_equal(ours["time"], ref["time"])
-    names = [n for n in ref.dtype.names if n != "time"]
     # the same FMU given the same input values before the same steps: the same bits
-    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
-    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
-    # Model Exchange: CVode restarted at each jump (fmpy's time event) against our dopri5,
-    # both to rtol 1e-10 over 2 s; inputs held over each 10 ms step in both (fmpy applies
-    # them at communication points). Each integrator's global error is near 1e-10 of the
-    # state's scale, so 1e-7 of the scale is a thousandfold margin that no libm or BLAS
-    # difference approaches, while the jump applied one step (10 ms) late moves psi by
-    # 4e-3 rad and x by 3e-4 m.
-    h = 1e-2
-    out = tmp_path / "me.csv"
-    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
-                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", str(stop), "--step", str(h),
-                    "--output", str(out)], check=True)
-    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
-    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
-                       stop_time=stop, output_interval=h, start_values=start, input=signals, record_events=False)
-    assert len(ours) == len(ref) == 201 and np.allclose(ours["time"], ref["time"], rtol=0, atol=1e-12)
-    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
-        scale = max(1.0, float(np.max(np.abs(ref[name]))))
-        diff = float(np.max(np.abs(ours[name] - ref[name])))
-        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
+    assert_same_bits(ours, ref)
+    # Model Exchange: CVode restarted at each jump (fmpy's time event) against our dopri5
+    ours, ref = model_exchange_against_cvode(cosim, plant_fmu, csv, signals, stop, tmp_path, 201)
+    assert np.allclose(ours["time"], ref["time"], rtol=0, atol=1e-12)
     assert abs(ours["psi"][-1]) > 1e-3
 
 
@@ -124,25 +138,10 @@ def test_an_input_jump_between_communication_points_splits_the_step_as_fmpy(cosi
                     "--stop-time", "1.5", "--step", "1e-3", "--output", str(out)], check=True)
     ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
     assert len(ours) == 1501 and np.array_equal(ours["time"], ref["time"])
-    names = [n for n in ref.dtype.names if n != "time"]
     # the same steps (0.5 -> 0.5004 -> 0.501 s) with the same inputs: the same bits
-    worst = max(float(np.max(np.abs(ours[n] - ref[n]))) for n in names)
-    assert worst == 0.0, f"Co-Simulation: largest difference {worst}"
-    # Model Exchange: fmpy's time event at the jump, our integrator stopped there; the
-    # tolerance as in test_input_jumps_equal_fmpy_in_both_interfaces
-    h = 1e-2
-    out = tmp_path / "me.csv"
-    subprocess.run([str(cosim), "run", str(plant_fmu), "--interface", "me", "--solver", "dopri5", "--rtol", "1e-10",
-                    "--input", str(csv), "--set", "v_x_start=0.35", "--stop-time", "1.5", "--step", str(h),
-                    "--output", str(out)], check=True)
-    ours = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
-    ref = simulate_fmu(str(plant_fmu), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
-                       stop_time=1.5, output_interval=h, start_values=start, input=signals, record_events=False)
-    assert len(ours) == len(ref) == 151
-    for name in ["x", "y", "psi", "v_x", "v_y", "yaw_rate"]:
-        scale = max(1.0, float(np.max(np.abs(ref[name]))))
-        diff = float(np.max(np.abs(ours[name] - ref[name])))
-        assert diff <= 1e-7 * scale, f"Model Exchange {name}: {diff}"
+    assert_same_bits(ours, ref)
+    # Model Exchange: fmpy's time event at the jump, our integrator stopped there
+    model_exchange_against_cvode(cosim, plant_fmu, csv, signals, 1.5, tmp_path, 151)
 
 
 def read_mat_v4(path):

@@ -107,6 +107,7 @@ unsafe fn instantiate3<M: Model>(
     logging_on: fmi3Boolean,
     environment: fmi3InstanceEnvironment,
     log_message: Option<Fmi3LogMessageCallback>,
+    event_mode_used: bool,
     refuse: impl FnOnce() -> Result<(), String>,
 ) -> fmi3Instance {
     let fn_name = function.name();
@@ -138,7 +139,11 @@ unsafe fn instantiate3<M: Model>(
             resource_path: resource_path(resource_location),
             logger: logger.clone(),
         };
-        let instance = Instance::<M>::new_for(context, Generation::Fmi3).map_err(|e| e.to_string())?;
+        let mut instance = Instance::<M>::new_for(context, Generation::Fmi3).map_err(|e| e.to_string())?;
+        if !event_mode_used && interface == Interface::CoSimulation && declaration.clock().is_some() {
+            let why = instance.sample_without_event_mode().map_err(|e| e.to_string())?;
+            logger.log(LogCategory::Events, &format!("{fn_name}: {why}"));
+        }
         Ok(Box::new(Component { instance, logger, live_states: HashSet::new() }))
     }));
     match result {
@@ -173,6 +178,7 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
         logging_on,
         environment,
         log_message,
+        true,
         || Ok(()),
     )
 }
@@ -202,21 +208,14 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
         logging_on,
         environment,
         log_message,
+        event_mode_used != FMI3_FALSE,
         || {
-            let clock = M::declaration().clock().map(|(c, _)| c.name);
-            match (event_mode_used != FMI3_FALSE, clock) {
-                (true, None) => {
-                    return Err("eventModeUsed = true refused: the FMU declares no Event Mode for Co-Simulation \
-                                (hasEventMode is false)"
-                        .into())
-                }
-                (false, Some(name)) => {
-                    return Err(format!(
-                        "eventModeUsed = false refused: the FMU has a clock ({name}), and FMI 3.0 requires Event Mode \
-                         of an importer of an FMU with clocks (section 2.3.1)"
-                    ))
-                }
-                _ => {}
+            // eventModeUsed = false with a clock: the instance samples by time itself
+            // (Instance::sample_without_event_mode, in instantiate3)
+            if event_mode_used != FMI3_FALSE && M::declaration().clock().is_none() {
+                return Err("eventModeUsed = true refused: the FMU declares no Event Mode for Co-Simulation \
+                            (hasEventMode is false)"
+                    .into());
             }
             if n_required_intermediate_variables != 0 {
                 return Err(format!(
@@ -255,6 +254,7 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
         logging_on,
         environment,
         log_message,
+        true,
         || Ok(()),
     )
 }
@@ -476,11 +476,8 @@ pub unsafe fn get_clock<M: Model>(
     with3::<M>(instance, function, |comp| {
         let vr = slice(vr, n_vr, "valueReferences")?;
         let out = slice_mut(values, n_vr, "values")?;
-        let mut active = vec![false; vr.len()];
-        comp.instance.get_clock(vr, &mut active)?;
-        for (o, a) in out.iter_mut().zip(active) {
-            *o = if a { FMI3_CLOCK_ACTIVE } else { FMI3_CLOCK_INACTIVE };
-        }
+        let active = comp.instance.get_clock(vr)?;
+        out.fill(if active { FMI3_CLOCK_ACTIVE } else { FMI3_CLOCK_INACTIVE });
         Ok(())
     })
 }
@@ -503,8 +500,8 @@ pub unsafe fn set_clock<M: Model>(
             )
             .into());
         }
-        let active: Vec<bool> = values.iter().map(|&v| v == FMI3_CLOCK_ACTIVE).collect();
-        comp.instance.set_clock(vr, &active)
+        // (no buffer: called at every activation)
+        comp.instance.set_clock(vr, values.iter().map(|&v| v == FMI3_CLOCK_ACTIVE))
     })
 }
 

@@ -70,11 +70,81 @@ impl<M: Model> Instance<M> {
         }
     }
 
+    /// Co-Simulation instantiated with `eventModeUsed = false` (fmpy's `simulate_fmu` does
+    /// so): the importer cannot enter Event Mode, so it cannot activate the clock. FMI 3.0
+    /// requires `eventModeUsed = true` of an importer of an FMU with clocks but asks the FMU
+    /// to raise an error only for `eventModeUsed = true` without `hasEventMode`; without Event
+    /// Mode it has the FMU "detect and handle events internally" (`hasEventMode`) and its
+    /// discrete variables change "at communication points" (`variability`). So the instance
+    /// samples by time as the FMI 2.0 archive does (the same time events, the same lazy
+    /// samples at the communication points), and the Event Mode calls are refused. The
+    /// message to log (once, at instantiation) says so.
+    pub fn sample_without_event_mode(&mut self) -> OpResult<String> {
+        let (clock, _) = Self::declared_clock()?;
+        self.clocked = false;
+        self.allowed = Self::allowed_table(self.generation, self.context.interface, false);
+        Ok(format!(
+            "eventModeUsed = false: {} is not driven by the importer; the FMU samples by time itself at start + k \
+             sample_period, as its FMI 2.0 archive does (FMI 3.0 asks eventModeUsed = true of an importer of an FMU \
+             with clocks; without Event Mode an FMU handles its events internally)",
+            clock.name
+        ))
+    }
+
+    /// Whether the clock's next activation is due at the current time.
+    pub(super) fn sample_due_now(&self) -> bool {
+        let now = self.core.time;
+        self.core.clock.is_some_and(|c| c.has_next() && (c.time_of(c.next) - now).abs() <= time_eps(now))
+    }
+
+    /// Model Exchange: the next activation time `t_(k+1)` as the `nextEventTime` of
+    /// `fmi3UpdateDiscreteStates` (an importer that drives the clock enters Event Mode then
+    /// anyway; one that does not handles it as a time event: [`Instance::sample_by_time_events`]).
+    pub(super) fn next_activation_to_publish(&self) -> Option<f64> {
+        if self.context.interface != crate::model::Interface::ModelExchange {
+            return None;
+        }
+        self.core.clock.filter(|c| c.has_next()).map(|c| c.time_of(c.next))
+    }
+
+    /// Model Exchange has no `eventModeUsed`: an importer that reaches
+    /// `fmi3UpdateDiscreteStates` at an activation time `t_k` (the initial event included)
+    /// without having activated the clock with `fmi3SetClock` in that Event Mode does not
+    /// drive clocks (fmpy's Model Exchange does not). FMI 3.0 has the importer activate
+    /// time-based clocks, so that importer already broke the standard's premise; rather than
+    /// never sampling, the instance samples from then on at its time events (the sample now,
+    /// then `nextEventTime` = each next sample time), exactly as the FMI 2.0 archive does.
+    /// Logged once (`logEvents`); a later `fmi3SetClock` is an error naming the clock.
+    pub(super) fn sample_by_time_events(&mut self) -> OpResult {
+        let (clock, _) = Self::declared_clock()?;
+        self.clocked = false;
+        self.undriven_clock = true;
+        // the sample due now is the FMI 2.0 archive's time event at this instant
+        self.core.next_event = Some(self.core.time);
+        self.context.logger.log(
+            crate::log::LogCategory::Events,
+            &format!(
+                "fmi3UpdateDiscreteStates: {} not activated (fmi3SetClock) at its activation time t = {} s: the \
+                 importer does not drive clocks, so the FMU samples by time events from now on (nextEventTime = \
+                 start + k sample_period), as its FMI 2.0 archive does",
+                clock.name, self.core.time
+            ),
+        );
+        Ok(())
+    }
+
     /// `fmi3SetClock`: activates the clock at its next activation time (a clock that
     /// cannot be deactivated refuses `fmi3ClockInactive` while active).
-    pub fn set_clock(&mut self, vrs: &[u32], active: &[bool]) -> OpResult {
+    pub fn set_clock(&mut self, vrs: &[u32], active: impl IntoIterator<Item = bool>) -> OpResult {
         let clock = Self::check_clock_references(vrs)?;
-        for &on in active {
+        if self.undriven_clock {
+            return err(format!(
+                "{} activated, but the instance samples by time events since fmi3UpdateDiscreteStates ran at an \
+                 activation time without fmi3SetClock: an importer drives the clock at every activation or never",
+                clock.name
+            ));
+        }
+        for on in active {
             if on == self.core.clock_active {
                 continue;
             }
@@ -102,11 +172,10 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
-    /// `fmi3GetClock`: whether the clock is active.
-    pub fn get_clock(&self, vrs: &[u32], out: &mut [bool]) -> OpResult {
+    /// `fmi3GetClock`: whether the clock (each of `vrs`) is active.
+    pub fn get_clock(&self, vrs: &[u32]) -> OpResult<bool> {
         Self::check_clock_references(vrs)?;
-        out.fill(self.core.clock_active);
-        Ok(())
+        Ok(self.core.clock_active)
     }
 
     /// `fmi3GetIntervalDecimal`: the clock's interval; a fixed interval (from a parameter) is

@@ -112,9 +112,15 @@ pub struct Instance<M: Model> {
     /// The C API the instance was created by: only its functions pass the gate.
     pub generation: Generation,
     pub core: Core<M>,
-    /// An FMI 3.0 instance of a model with a clock: the samples run at the importer's
-    /// activations of the clock (`fmi3SetClock`), not at time events of the layer's own.
+    /// An FMI 3.0 instance of a model with a clock whose importer drives it: the samples run
+    /// at the importer's activations of the clock (`fmi3SetClock`), not at time events of the
+    /// layer's own. False for Co-Simulation instantiated with `eventModeUsed = false`
+    /// ([`Instance::sample_without_event_mode`]): that instance samples by time.
     pub clocked: bool,
+    /// A clocked Model Exchange instance whose importer reached `fmi3UpdateDiscreteStates`
+    /// at a sample time without activating the clock: it samples by its time events since
+    /// ([`Instance::sample_by_time_events`]), and `fmi3SetClock` is refused.
+    pub undriven_clock: bool,
     /// Per [`Function`], the instance states in which [`Instance::check_call`] lets it
     /// through (0 for another interface's function or a capability the model did not
     /// declare): the gate of every call as one table lookup; the reasons come from the
@@ -146,10 +152,12 @@ impl<M: Model> Instance<M> {
     /// A new instance for the C API of `generation`.
     pub fn new_for(context: InstantiateContext, generation: Generation) -> OpResult<Self> {
         let model = Self::fresh_model(&context)?;
-        let allowed = Function::ALL.map(|f| Self::allowed_states(generation, context.interface, f));
+        let clocked = generation == Generation::Fmi3 && decl::<M>().clock().is_some();
+        let allowed = Self::allowed_table(generation, context.interface, clocked);
         Ok(Instance {
             allowed,
-            clocked: generation == Generation::Fmi3 && decl::<M>().clock().is_some(),
+            clocked,
+            undriven_clock: false,
             generation,
             get_memo: CallMemos::new(),
             set_memo: CallMemos::new(),
@@ -195,19 +203,28 @@ impl<M: Model> Instance<M> {
         }
     }
 
-    /// The states in which `function` passes [`Instance::check_call`] for `interface`.
-    fn allowed_states(generation: Generation, interface: Interface, function: Function) -> u16 {
-        Machine::ALL
-            .into_iter()
-            .filter(|&m| Self::call_allowed(generation, interface, function, m).is_ok())
-            .fold(0, |mask, m| mask | m.bit())
+    /// Per function, the states in which it passes [`Instance::check_call`] for `interface`
+    /// (`clock_driven`: the importer drives the declared clock in Event Mode).
+    fn allowed_table(generation: Generation, interface: Interface, clock_driven: bool) -> [u16; Function::ALL.len()] {
+        Function::ALL.map(|function| {
+            Machine::ALL
+                .into_iter()
+                .filter(|&m| Self::call_allowed_driven(generation, interface, clock_driven, function, m).is_ok())
+                .fold(0, |mask, m| mask | m.bit())
+        })
     }
 
     /// Why `function` is refused now (the table of [`Instance::check_call`] said so).
     #[cold]
     #[inline(never)]
     fn refuse_call(&self, function: Function) -> OpResult {
-        Self::call_allowed(self.generation, self.context.interface, function, self.core.machine)?;
+        Self::call_allowed_driven(
+            self.generation,
+            self.context.interface,
+            self.clocked || decl::<M>().clock().is_none(),
+            function,
+            self.core.machine,
+        )?;
         err(format!(
             "{} refused in state {:?} (internal: the call table and the rules disagree)",
             function.name(),
@@ -224,6 +241,18 @@ impl<M: Model> Instance<M> {
         function: Function,
         machine: Machine,
     ) -> OpResult {
+        Self::call_allowed_driven(generation, interface, true, function, machine)
+    }
+
+    /// [`Instance::call_allowed`] for an instance whose importer drives the declared clock
+    /// (`clock_driven`) or not (Co-Simulation with `eventModeUsed = false`: no Event Mode).
+    fn call_allowed_driven(
+        generation: Generation,
+        interface: Interface,
+        clock_driven: bool,
+        function: Function,
+        machine: Machine,
+    ) -> OpResult {
         if function.generation() != generation {
             return err(match generation {
                 Generation::Fmi2 => "not available: this instance was created by fmi2Instantiate (FMI 2.0)",
@@ -231,9 +260,19 @@ impl<M: Model> Instance<M> {
             });
         }
         // a model with a clock offers the clock functions and, in Co-Simulation, Event Mode
-        // (an FMI 3.0 instance of it is created with eventModeUsed = true: see abi::fmi3)
+        // unless the importer instantiated it with eventModeUsed = false (see abi::fmi3)
         let clocked = decl::<M>().clock().is_some();
         let event_mode_cs = clocked && interface == Interface::CoSimulation;
+        if event_mode_cs
+            && !clock_driven
+            && matches!(
+                function,
+                Function::Fmi3EnterEventMode | Function::Fmi3UpdateDiscreteStates | Function::Fmi3EnterStepMode
+            )
+        {
+            return err("not available: the instance was created with eventModeUsed = false (no Event Mode), so the \
+                        FMU samples by time itself");
+        }
         let scheduled = interface == Interface::ScheduledExecution;
         let declared_by_clock = (clocked && function.is_clock_function())
             || (event_mode_cs && function == Function::Fmi3EnterStepMode)
@@ -387,6 +426,11 @@ impl<M: Model> Instance<M> {
     pub fn reset(&mut self) -> OpResult {
         let model = Self::fresh_model(&self.context)?;
         self.core = Core::new(model);
+        // the importer of the next run may drive the clock
+        if self.undriven_clock {
+            self.undriven_clock = false;
+            self.clocked = true;
+        }
         Ok(())
     }
 }

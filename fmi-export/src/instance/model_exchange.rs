@@ -2,7 +2,7 @@
 //! their derivatives.
 
 use super::{decl, err, time_eps, Instance, OpResult};
-use crate::model::{EventUpdate, Model};
+use crate::model::{EventUpdate, Interface, Model};
 use crate::states::Machine;
 impl<M: Model> Instance<M> {
     pub fn set_time(&mut self, time: f64) -> OpResult {
@@ -39,8 +39,16 @@ impl<M: Model> Instance<M> {
     /// model asked for another); the next event time for the importer.
     pub fn new_discrete_states(&mut self) -> OpResult<EventUpdate> {
         if self.clocked {
+            if self.context.interface == Interface::ModelExchange && !self.core.clock_active && self.sample_due_now() {
+                self.sample_by_time_events()?;
+                return self.new_discrete_states();
+            }
             self.end_clock_activation()?;
-            return Ok(EventUpdate { terminate_simulation: self.core.terminate_requested, ..Default::default() });
+            return Ok(EventUpdate {
+                next_event_time: self.next_activation_to_publish(),
+                terminate_simulation: self.core.terminate_requested,
+                ..Default::default()
+            });
         }
         let now = self.core.time;
         let due = matches!(self.core.next_event, Some(te) if te <= now + time_eps(now));

@@ -41,6 +41,9 @@ pub(crate) struct ClockedExchange {
     variables: Vec<Clocked>,
     /// Some value is queued.
     any_queued: bool,
+    /// Some clocked variable can be set: an input or a parameter (else no set is ever queued
+    /// or held, and the sets of a running instance go straight to the FMU).
+    any_settable: bool,
     /// The last [`ReadPlan`] (the same clocks tick again and again).
     last_plan: Option<ReadPlan>,
 }
@@ -79,6 +82,8 @@ impl ClockedExchange {
             let count = counts.get(&v.value_reference).copied().unwrap_or(1);
             let access = Access { vr: v.value_reference, value_type: v.value_type, element: 0, count };
             let input = v.causality == fmi3::Causality::Input;
+            exchange.any_settable |=
+                input || matches!(v.causality, fmi3::Causality::Parameter | fmi3::Causality::StructuralParameter);
             exchange.slots.insert(v.value_reference, exchange.variables.len());
             exchange.variables.push(Clocked {
                 access,
@@ -117,6 +122,12 @@ impl ClockedExchange {
             };
         }
         self.slots.get(&fmu_vr).map(|slot| (*slot, element))
+    }
+
+    /// Whether some clocked variable can be set (an input or a parameter).
+    #[inline]
+    pub(crate) fn has_settable(&self) -> bool {
+        self.any_settable
     }
 
     /// Whether the clocked variable in `slot` is an input.

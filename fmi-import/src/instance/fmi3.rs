@@ -728,6 +728,11 @@ impl Fmi3 {
             }
             return Ok(());
         }
+        // no settable clocked variable (a sampled controller's clocked outputs, say): nothing
+        // to queue or hold, the set goes to the FMU without a lookup per value reference
+        if !self.clocked.has_settable() {
+            return fmu_set(self, core, vrs, values);
+        }
         // a clocked input whose clocks are inactive is queued; every other variable set (a
         // clocked input of an active clock, in an open clock event, held too)
         let queued = |me: &Fmi3, vr: u32| {

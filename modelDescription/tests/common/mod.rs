@@ -296,6 +296,12 @@ pub fn fmpy_available() -> bool {
     available
 }
 
+/// A scratch folder `<temp>/<prefix>-<pid>` for the fmpy cross-checks, `None` (skip) when
+/// fmpy is not available ([`fmpy_available`]).
+pub fn fmpy_scratch(prefix: &str) -> Option<std::path::PathBuf> {
+    fmpy_available().then(|| std::env::temp_dir().join(format!("{prefix}-{}", std::process::id())))
+}
+
 /// The start of the fmpy scripts of [`fmpy_output`]: a `PROBLEM` line per finding of fmpy's
 /// `validate_fmu` on the folder `sys.argv[1]`, then `md`, fmpy's reading of its
 /// `modelDescription.xml`.

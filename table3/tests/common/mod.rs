@@ -4,25 +4,9 @@
 
 use nigel_table3::{Controller, Fidelity, Maneuver, Table};
 
-/// `(maneuver, open_loop, robust)` epsilon, seed 0, sim column.
-pub const SELF_CHECK_SIM: [(Maneuver, f64, f64); 6] = [
-    (Maneuver::Straight, 0.0205799, 0.0238091),
-    (Maneuver::LaneChange, 0.0593189, 0.0420524),
-    (Maneuver::Skidpad, 0.791631, 0.325539),
-    (Maneuver::Fishhook, 0.292381, 0.114311),
-    (Maneuver::Slalom, 1.12056, 0.509415),
-    (Maneuver::Figure8, 0.617197, 0.262837),
-];
-
-/// The same for the real column.
-pub const SELF_CHECK_REAL: [(Maneuver, f64, f64); 6] = [
-    (Maneuver::Straight, 0.0205799, 0.0198954),
-    (Maneuver::LaneChange, 0.0298599, 0.0184275),
-    (Maneuver::Skidpad, 0.874354, 0.463698),
-    (Maneuver::Fishhook, 0.290312, 0.135593),
-    (Maneuver::Slalom, 0.970792, 0.500319),
-    (Maneuver::Figure8, 0.650735, 0.42491),
-];
+#[path = "../../../benchmark/tests/common/self_check.rs"]
+mod self_check;
+use self_check::self_check_cells;
 
 /// Relative tolerance of the robust cells against the self-check. The self-check's robust gain
 /// is another solution of the same LMIs than the baked `gains::ROBUST` (the optimum is flat in
@@ -37,21 +21,20 @@ pub const ROBUST_CELL_TOLERANCE: f64 = 5e-4;
 /// the robust cells of the sim column to [`ROBUST_CELL_TOLERANCE`]).
 pub fn assert_self_check(table: &Table) {
     let mut worst: [f64; 2] = [0.0; 2];
-    for (f, rows, tol) in [(Fidelity::Paper, SELF_CHECK_SIM, 1e-4), (Fidelity::Real, SELF_CHECK_REAL, 1e-3)] {
-        for (m, open, robust) in rows {
-            for (c, expected, tol) in
-                [(Controller::OpenLoop, open, tol), (Controller::Robust, robust, f64::max(tol, ROBUST_CELL_TOLERANCE))]
-            {
-                let got = table.get(f, m, c).unwrap_or_else(|| panic!("no cell {f:?} {m} {c}")).metric.eps;
-                let rel = (got - expected).abs() / expected;
-                let i = if f == Fidelity::Paper { 0 } else { 1 };
-                worst[i] = worst[i].max(rel);
-                assert!(
-                    rel < tol,
-                    "{} {m} {c}: epsilon {got} vs self-check {expected} (relative {rel:.2e} > {tol:e})",
-                    f.column()
-                );
-            }
+    for (f, m, open, robust) in self_check_cells() {
+        let tol = if f == Fidelity::Paper { 1e-4 } else { 1e-3 };
+        for (c, expected, tol) in
+            [(Controller::OpenLoop, open, tol), (Controller::Robust, robust, f64::max(tol, ROBUST_CELL_TOLERANCE))]
+        {
+            let got = table.get(f, m, c).unwrap_or_else(|| panic!("no cell {f:?} {m} {c}")).metric.eps;
+            let rel = (got - expected).abs() / expected;
+            let i = if f == Fidelity::Paper { 0 } else { 1 };
+            worst[i] = worst[i].max(rel);
+            assert!(
+                rel < tol,
+                "{} {m} {c}: epsilon {got} vs self-check {expected} (relative {rel:.2e} > {tol:e})",
+                f.column()
+            );
         }
     }
     eprintln!("self-check: worst relative difference sim {:.2e}, real {:.2e}", worst[0], worst[1]);
@@ -82,3 +65,21 @@ pub fn assert_tracking_lowest(table: &Table) {
         assert!(c.metric.max_delta < core::f64::consts::FRAC_PI_2, "{c:?}");
     }
 }
+
+/// The two tests of the self-check on the table `$table()` (a cached `&'static Table`), named
+/// `$self_check` (the 24 cells, [`assert_self_check`]) and `$tracking_lowest` (robust
+/// tracking lowest in all 12 rows, [`assert_tracking_lowest`]).
+macro_rules! self_check_tests {
+    ($table:ident, $self_check:ident, $tracking_lowest:ident) => {
+        #[test]
+        fn $self_check() {
+            common::assert_self_check($table());
+        }
+
+        #[test]
+        fn $tracking_lowest() {
+            common::assert_tracking_lowest($table());
+        }
+    };
+}
+pub(crate) use self_check_tests;

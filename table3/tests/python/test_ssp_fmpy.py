@@ -108,14 +108,24 @@ def pose_epsilon(r):
                    r["maneuver.x_ref"], r["maneuver.y_ref"], r["maneuver.psi_ref"])
 
 
-def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fmpy_run):
-    r = fmpy_run
+# our rows of fmpy's samples: fmpy records from the first step on, our CSV from the start
+OUR_SAMPLES = slice(1, 30_001)
+
+
+def epsilons(r, ours):
+    """The epsilon of fmpy's run `r` (30000 samples), of our ordered and jacobi runs, and
+    the rows of our jacobi run."""
     assert len(r) == 30_000
-    eps_fmpy = pose_epsilon(r)
     eps_ordered, _ = ours["ordered"]
     eps_jacobi, rows = ours["jacobi"]
+    return pose_epsilon(r), eps_ordered, eps_jacobi, rows
+
+
+def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fmpy_run):
+    r = fmpy_run
+    eps_fmpy, eps_ordered, eps_jacobi, rows = epsilons(r, ours)
     # our metric over samples 1 .. 30000 of the jacobi run, recomputed from its CSV
-    k = slice(1, 30_001)
+    k = OUR_SAMPLES
     eps_csv = epsilon(rows["x"][k], rows["y"][k], rows["psi"][k], rows["x_ref"][k], rows["y_ref"][k], rows["psi_ref"][k])
     assert abs(eps_csv - eps_jacobi) <= 1e-12 * eps_jacobi
     print(f"epsilon: fmpy simulate_ssp {eps_fmpy:.12g}, ours jacobi {eps_jacobi:.12g}, ordered {eps_ordered:.12g}; "
@@ -142,11 +152,8 @@ def test_fmpy_runs_the_exported_closed_loop_like_our_jacobi_and_ordered(ours, fm
 
 def test_fmpy_with_the_initial_outputs_propagated_equals_our_jacobi(ours, fmpy_run, fmpy_run_initialized):
     r = fmpy_run_initialized
-    assert len(r) == 30_000
-    eps_init = pose_epsilon(r)
-    eps_ordered, _ = ours["ordered"]
-    eps_jacobi, rows = ours["jacobi"]
-    k = slice(1, 30_001)
+    eps_init, eps_ordered, eps_jacobi, rows = epsilons(r, ours)
+    k = OUR_SAMPLES
     worst = max(float(np.max(np.abs(r[f"plant.{n}"] - rows[n][k]))) for n in ("x", "y", "psi"))
     print(f"epsilon: fmpy simulate_ssp with the initial outputs propagated {eps_init:.12g}, ours jacobi "
           f"{eps_jacobi:.12g} (relative {abs(eps_init - eps_jacobi) / eps_jacobi:.3g}); largest pose "
