@@ -2,7 +2,8 @@
 expected architecture, built for macOS (LC_BUILD_VERSION platform 1) no later than 11.0,
 linking system libraries only (/usr/lib, /System). Usage: macho-check.py PROGRAM x86_64|aarch64.
 Layout: <mach-o/loader.h> (mach_header_64: magic, cputype, cpusubtype, filetype, ncmds,
-sizeofcmds, flags, reserved; then the load commands, each cmd and cmdsize first)."""
+sizeofcmds, flags, reserved; then the load commands, each cmd and cmdsize first).
+scripts/wheel-check.py reads the wheels' native modules with read_header."""
 import struct
 import sys
 
@@ -12,35 +13,46 @@ LC_LOAD_DYLIB, LC_BUILD_VERSION = 0xC, 0x32
 PLATFORM_MACOS = 1
 
 
+def read_header(data, at=0):
+    """The thin 64-bit Mach-O file at offset `at` of `data`: (cputype, filetype, platform,
+    minos, dylibs), platform and minos from LC_BUILD_VERSION (None without one), minos as
+    "major.minor"; None when `at` holds no 64-bit Mach-O header."""
+    magic, cputype, _sub, filetype, ncmds, _size, _flags, _res = struct.unpack_from("<8I", data, at)
+    if magic != MH_MAGIC_64:
+        return None
+    pos, platform, minos, dylibs = at + 32, None, None, []
+    for _ in range(ncmds):
+        cmd, size = struct.unpack_from("<2I", data, pos)
+        if cmd == LC_BUILD_VERSION:
+            platform, version = struct.unpack_from("<2I", data, pos + 8)
+            minos = f"{version >> 16}.{(version >> 8) & 0xFF}"
+        elif cmd == LC_LOAD_DYLIB:
+            offset = struct.unpack_from("<I", data, pos + 8)[0]
+            dylibs.append(data[pos + offset : pos + size].split(b"\0")[0].decode())
+        pos += size
+    return cputype, filetype, platform, minos, dylibs
+
+
 def check(path, arch):
     data = open(path, "rb").read()
-    magic, cputype, _sub, filetype, ncmds, _size, _flags, _res = struct.unpack_from("<8I", data, 0)
-    if magic != MH_MAGIC_64:
-        return f"not a thin 64-bit Mach-O file (magic {magic:#x})"
+    header = read_header(data)
+    if header is None:
+        return f"not a thin 64-bit Mach-O file (magic {struct.unpack_from('<I', data)[0]:#x})"
+    cputype, filetype, platform, minos, dylibs = header
     if cputype != CPU[arch]:
         return f"CPU type {cputype:#x}, not {arch}'s {CPU[arch]:#x}"
     if filetype != MH_EXECUTE:
         return f"file type {filetype}, not an executable (2)"
-    at, minos, dylibs = 32, None, []
-    for _ in range(ncmds):
-        cmd, size = struct.unpack_from("<2I", data, at)
-        if cmd == LC_BUILD_VERSION:
-            platform, minos = struct.unpack_from("<2I", data, at + 8)
-            if platform != PLATFORM_MACOS:
-                return f"built for platform {platform}, not macOS (1)"
-        elif cmd == LC_LOAD_DYLIB:
-            offset = struct.unpack_from("<I", data, at + 8)[0]
-            dylibs.append(data[at + offset : at + size].split(b"\0")[0].decode())
-        at += size
     if minos is None:
         return "no LC_BUILD_VERSION"
-    version = f"{minos >> 16}.{(minos >> 8) & 0xFF}"
-    if (minos >> 16) > 11:
-        return f"needs macOS {version}, not 11"
+    if platform != PLATFORM_MACOS:
+        return f"built for platform {platform}, not macOS (1)"
+    if int(minos.split(".")[0]) > 11:
+        return f"needs macOS {minos}, not 11"
     foreign = [d for d in dylibs if not d.startswith(("/usr/lib/", "/System/"))]
     if foreign:
         return f"links non-system libraries: {foreign}"
-    print(f"Mach-O {arch} executable, macOS {version} or later, system libraries only: {path}")
+    print(f"Mach-O {arch} executable, macOS {minos} or later, system libraries only: {path}")
     return None
 
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs the system packages and cross toolchains (as the test command does),
 # builds every binary of the workspace into target/release/ (cosim, cosim-host, campaign,
-# table3, synthesize, build-fmu, ...), the Python package's wheel into target/wheels/, the master's release archives for five platforms
+# table3, synthesize, build-fmu, ...), the Python package's wheels into target/wheels/ (x86-64
+# and aarch64 Linux), the master's release archives for five platforms
 # into target/dist/ (scripts/dist.sh), the venv
 # of the README's quick start (target/venv: fmpy, pandas, matplotlib and nigel_cosim), the three FMUs for all four platforms (the release
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
@@ -21,6 +22,10 @@ cargo build --release --quiet --workspace --bins
 
 echo "== the Python package's wheel (target/wheels: pip install it into any CPython >= 3.10)"
 wheel="$(bash scripts/python-wheel.sh)"
+# (the Windows and macOS wheels, `python-wheel.sh windows-x86_64|macos-universal2`, are not
+# built here yet: never built to the end on this machine, docs/platforms.md)
+echo "== the Python package's wheel for aarch64 Linux (manylinux2014)"
+bash scripts/python-wheel.sh linux-aarch64
 echo "== the venv of the README's quick start: target/venv with fmpy, pandas, matplotlib and nigel_cosim"
 bash scripts/python-venv-wheel.sh "$wheel"
 

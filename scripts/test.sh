@@ -154,6 +154,24 @@ export NIGEL_TEST_EXECUTABLES="$target_dir/test-executables.json"
 cargo test --release --workspace --no-run --message-format=json >"$NIGEL_TEST_EXECUTABLES"
 # test_executable CRATE_FOLDER TEST: the executable of the integration test TEST of the crate
 test_executable() { python3 "$repo_dir/scripts/test-executables.py" "$NIGEL_TEST_EXECUTABLES" "$1" "$2"; }
+# the master and the Python package on the other platforms, beside the stages below (their
+# cross builds take one core most of the time; docs/platforms.md has what each costs): the
+# master's release archives for x86-64 and aarch64 Linux and Windows built and run under wine
+# and qemu on the closed loop, compared with x86-64 Linux (scripts/test-dist.sh), and the
+# aarch64 Linux wheel built, its tags and native module checked (scripts/wheel-check.py) and
+# run under qemu by an aarch64 CPython (scripts/test-wheel-aarch64.sh).
+# The macOS archives and the Windows and macOS wheels are left out: never built to the end
+# on this machine within the time measured (docs/platforms.md)
+other_platforms() {
+    NIGEL_DIST_PLATFORMS=linux64,win64,aarch64-linux bash scripts/test-dist.sh
+    local wheel version
+    wheel="$(bash scripts/python-wheel.sh linux-aarch64)"
+    python3 scripts/wheel-check.py "$wheel" linux-aarch64
+    # its run under qemu by Debian's arm64 CPython, against test-dist.sh's aarch64 cosim
+    version="$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)"
+    bash scripts/test-wheel-aarch64.sh "$wheel" "$target_dir/dist-test/cosim-$version-aarch64-unknown-linux-gnu/cosim"
+}
+background other-platforms other_platforms
 stage "the layer's C ABIs (FMI 2.0 and 3.0) in process under AddressSanitizer"
 # the toy through both ABIs, the plant's FMI 3.0 runs and derivatives: an out-of-bounds
 # read or write, a use after free or a double free in the layer stops the test
@@ -202,4 +220,7 @@ if [ -d ../shared/corpus ]; then
     wait_for conformance
     cat "$target_dir/background-conformance.log"
 fi
+stage "the master and the Python package on every platform (run beside the stages above): the log"
+wait_for other-platforms
+cat "$target_dir/background-other-platforms.log"
 stage_summary

@@ -5,9 +5,16 @@ ELF 64-bit e_machine (EM_X86_64 62, EM_AARCH64 183), PE32+ COFF Machine (0x8664 
 (CPU_TYPE_X86_64, CPU_TYPE_ARM64; universal: both slices), each slice a bundle or dylib for
 macOS 11 or earlier.
 Usage: wheel-check.py WHEEL linux-aarch64|windows-x86_64|macos-universal2"""
+import importlib.util
+import os
 import struct
 import sys
 import zipfile
+
+# the Mach-O reader of scripts/macho-check.py (a file name with a hyphen: loaded by path)
+_spec = importlib.util.spec_from_file_location("macho_check", os.path.join(os.path.dirname(os.path.abspath(__file__)), "macho-check.py"))
+macho = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(macho)
 
 EXPECTED = {
     "linux-aarch64": (["cp310-abi3-manylinux2014_aarch64", "cp310-abi3-manylinux_2_17_aarch64"], "nigel_cosim/_native.abi3.so"),
@@ -16,9 +23,9 @@ EXPECTED = {
 }
 EM_AARCH64 = 183
 IMAGE_FILE_MACHINE_AMD64 = 0x8664
-CPU = {0x01000007: "x86_64", 0x0100000C: "arm64"}
-FAT_MAGIC, MH_MAGIC_64 = 0xCAFEBABE, 0xFEEDFACF
-MH_DYLIB, MH_BUNDLE, LC_BUILD_VERSION = 6, 8, 0x32
+CPU = {macho.CPU["x86_64"]: "x86_64", macho.CPU["aarch64"]: "arm64"}
+FAT_MAGIC = 0xCAFEBABE
+MH_DYLIB, MH_BUNDLE = 6, 8
 
 
 def tags_of_name(name):
@@ -28,17 +35,12 @@ def tags_of_name(name):
 
 
 def macho_slice(data, at):
-    magic, cputype, _sub, filetype, ncmds = struct.unpack_from("<5I", data, at)
-    if magic != MH_MAGIC_64 or filetype not in (MH_DYLIB, MH_BUNDLE):
-        return None, f"slice at {at}: magic {magic:#x}, file type {filetype} (a 64-bit bundle or dylib expected)"
-    pos, minos = at + 32, None
-    for _ in range(ncmds):
-        cmd, size = struct.unpack_from("<2I", data, pos)
-        if cmd == LC_BUILD_VERSION:
-            minos = struct.unpack_from("<I", data, pos + 12)[0]
-        pos += size
-    if minos is None or (minos >> 16) > 11:
-        return None, f"slice at {at}: minimum macOS {minos and minos >> 16} (11 expected)"
+    header = macho.read_header(data, at)
+    if header is None or header[1] not in (MH_DYLIB, MH_BUNDLE):
+        return None, f"slice at {at}: not a 64-bit Mach-O bundle or dylib"
+    cputype, _filetype, platform, minos, _dylibs = header
+    if platform != macho.PLATFORM_MACOS or minos is None or int(minos.split(".")[0]) > 11:
+        return None, f"slice at {at}: platform {platform}, minimum macOS {minos} (macOS 11 expected)"
     return CPU.get(cputype, hex(cputype)), None
 
 
@@ -78,7 +80,7 @@ def check(path, kind):
         declared = sorted(line.split(": ", 1)[1] for line in z.read(wheel_files[0]).decode().splitlines() if line.startswith("Tag: "))
         if declared != sorted(tags):
             return f"WHEEL declares {declared}, expected {sorted(tags)}"
-        natives = [n for n in z.namelist() if n.startswith("nigel_cosim/_native")]
+        natives = [n for n in z.namelist() if n.startswith("nigel_cosim/_native") and not n.endswith(".pyi")]  # (its typing stub aside)
         if natives != [module]:
             return f"native module {natives}, expected [{module!r}]"
         arch, problem = architecture(z.read(module))

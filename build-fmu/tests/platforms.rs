@@ -645,9 +645,21 @@ fn fmi3_closed_loop_matches(p: &Platform, dir: &Path) {
     assert_same_bits(p.folder3, fmi2_run(p), &fmi3);
 }
 
+/// The arm64 glibc the programs run with under qemu-user: the loader and every library from
+/// one build of it, Debian's cross package (libc6-arm64-cross, what aarch64-linux-gnu-gcc
+/// links against). `-L` alone gives its loader, which searches `/lib/aarch64-linux-gnu`,
+/// where multiarch's libc6:arm64 (another build of glibc 2.36, pulled in by the arm64 Rust
+/// standard library) lives: the two disagree on the loader's private data, and the first
+/// `pthread_create` then loops in the loader for ever (a program without threads, as the C
+/// importers, happens to run). QEMU_LD_PREFIX and QEMU_SET_ENV (not `-L`, `-E`) so that a
+/// program started under qemu by the program (the isolation's host, through a wrapper)
+/// inherits them.
+const QEMU_ENV: [(&str, &str); 2] =
+    [("QEMU_LD_PREFIX", "/usr/aarch64-linux-gnu"), ("QEMU_SET_ENV", "LD_LIBRARY_PATH=/usr/aarch64-linux-gnu/lib")];
+
 fn qemu(exe: &Path) -> Command {
     let mut c = Command::new("qemu-aarch64");
-    c.args(["-L", "/usr/aarch64-linux-gnu"]).arg(exe);
+    c.envs(QEMU_ENV).arg(exe);
     c
 }
 
@@ -1049,11 +1061,12 @@ fn dist_folder(triple: &str) -> PathBuf {
 }
 
 /// The master's `cosim run` of the closed-loop SSP (Jacobi, 30 s at 1 ms, every output at
-/// every step: the C importer's job) started by `runner`, its CSV read; `path_of` turns a
-/// host path into the one the program opens.
+/// every step: the C importer's job) with the options `extra`, started by `runner`, its CSV
+/// read; `path_of` turns a host path into the one the program opens.
 fn master_run(
     dir: &Path,
     cosim: &Path,
+    extra: &[&str],
     runner: &mut dyn FnMut(&Path) -> Command,
     path_of: &dyn Fn(&Path) -> String,
 ) -> Table {
@@ -1064,7 +1077,8 @@ fn master_run(
         .current_dir(dir)
         .args(["run", &path_of(&ssp), "--algorithm", "jacobi"])
         .args(["--stop-time", &format!("{STOP_TIME:?}"), "--step", &format!("{STEP:?}")])
-        .args(["--output", &path_of(&csv)]));
+        .args(["--output", &path_of(&csv)])
+        .args(extra));
     read_csv(&csv)
 }
 
@@ -1094,6 +1108,32 @@ fn windows_master_under_wine_equals_the_c_importer_on_the_same_dlls_bit_for_bit(
     let cosim = dist_folder("x86_64-pc-windows-gnu").join("cosim.exe");
     let dir = work_dir("windows-master");
     let mut wine = wine_runner(&dir);
-    let master = master_run(&dir, &cosim, &mut wine, &wine_path);
+    let master = master_run(&dir, &cosim, &[], &mut wine, &wine_path);
     assert_master_equals_c_importer("x86-64 Windows master (wine)", fmi2_run(&WIN64), &master);
+}
+
+/// The master's aarch64 Linux build under qemu-user loads the FMUs' aarch64-linux libraries
+/// and gives what the plain C importer (fmi2_closed_loop.c, aarch64-linux-gnu-gcc, under
+/// qemu) gives with the same libraries and the same glibc, to the bit, as the Windows master
+/// does above; in process and with each FMU in a host process of its own (`--isolate`: the
+/// aarch64 `cosim-host`, started under qemu through a two-line wrapper named by
+/// `NIGEL_COSIM_HOST`, since qemu-user cannot exec a foreign program without binfmt_misc).
+#[test]
+#[ignore = "run by scripts/test-dist.sh on the unpacked release archives (NIGEL_DIST_DIR)"]
+fn aarch64_master_under_qemu_equals_the_c_importer_on_the_same_libraries_bit_for_bit() {
+    let folder = dist_folder("aarch64-unknown-linux-gnu");
+    let dir = work_dir("aarch64-master");
+    let master = master_run(&dir, &folder.join("cosim"), &[], &mut qemu, &host_path);
+    assert_master_equals_c_importer("aarch64 Linux master (qemu)", fmi2_run(&AARCH64_LINUX), &master);
+    let wrapper = dir.join("cosim-host-under-qemu");
+    let host = folder.join("cosim-host");
+    std::fs::write(&wrapper, format!("#!/bin/sh\nexec qemu-aarch64 '{}' \"$@\"\n", host.display())).unwrap();
+    std::fs::set_permissions(&wrapper, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let mut isolated = |exe: &Path| {
+        let mut c = qemu(exe);
+        c.env("NIGEL_COSIM_HOST", &wrapper);
+        c
+    };
+    let master = master_run(&dir, &folder.join("cosim"), &["--isolate"], &mut isolated, &host_path);
+    assert_master_equals_c_importer("aarch64 Linux master --isolate (qemu)", fmi2_run(&AARCH64_LINUX), &master);
 }
