@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The third-party conformance run: the corpus's FMI 2.0 FMUs (cosim's default solver, then
-# Model Exchange under bdf), its FMI 3.0 FMUs and its SSP systems, each case in child processes
+# The third-party conformance run: the corpus's FMI 2.0 FMUs (Model Exchange under dopri5, then
+# under cosim's default solver, auto, and under bdf), its FMI 3.0 FMUs and its SSP systems, each case in child processes
 # with the corpus's own runners, then one table (scripts/conformance_table.py).
 # usage: bash scripts/conformance.sh [COSIM] [CORPUS]     (defaults: target/release/cosim, ../shared/corpus)
 # Exit status: 0 when every case fmpy completes cosim completes with results equal to fmpy's
@@ -30,7 +30,10 @@ run_part() {
     "$python" "$@" >"$work/$name.log" 2>&1 || true
     tail -n 3 "$work/$name.log"
 }
-run_part fmi2 "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2" --json "$work/fmi2.json"
+run_part fmi2 "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2" --solver dopri5 --json "$work/fmi2.json"
+# the Model Exchange cases again with cosim's default (rk4 switching to bdf on a stiff step):
+# what a user who names no solver gets, against fmpy's default (CVode)
+run_part fmi2-auto "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2-auto" --only me/ --solver auto --json "$work/fmi2-auto.json"
 run_part fmi2-bdf "$corpus/fmi2.py" --fmus "$corpus/fmi2" --cosim "$cosim" --work "$work/fmi2-bdf" --only me/ --solver bdf --json "$work/fmi2-bdf.json"
 run_part fmi3 "$corpus/fmi3.py" --suite "$corpus/fmi3" --cosim "$cosim" --work "$work/fmi3" --json "$work/fmi3.json"
 run_part ssp "$corpus/ssp.py" "$cosim" "$corpus/ssp" --work "$work/ssp" --json "$work/ssp.json"

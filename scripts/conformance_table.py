@@ -64,7 +64,7 @@ def main():
             if line and not line.startswith("#"):
                 key, _, why = line.partition("  ")
                 known[key.strip()] = why.strip()
-    parts = [("fmi2", fmi2_rows), ("fmi2-bdf", fmi2_rows), ("fmi3", fmi3_rows), ("ssp", ssp_rows)]
+    parts = [("fmi2", fmi2_rows), ("fmi2-auto", fmi2_rows), ("fmi2-bdf", fmi2_rows), ("fmi3", fmi3_rows), ("ssp", ssp_rows)]
     print("== conformance table (cases where fmpy completes: cosim must complete and be right)")
     print("%-9s %6s %12s %13s %16s %7s" % ("part", "cases", "fmpy done", "cosim done", "cosim right*", "known"))
     misses, failed, fixed = [], False, []
