@@ -1055,6 +1055,27 @@ fn an_alias_is_listed_and_recorded_under_its_name() {
     assert_eq!(theirs, y.iter().map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>());
 }
 
+/// Runs `system` 0.2 s in steps of 0.1 s under `algorithm` with `input`, recording
+/// `record`: every one of its three rows holds `by_hand`'s exact value in each column
+/// (`what` names the run in a failure).
+fn assert_exact_rows(
+    system: &System,
+    input: nigel_cosim::InputTable,
+    algorithm: nigel_cosim::Algorithm,
+    record: &[&str],
+    by_hand: &[&str],
+    what: &str,
+) {
+    let mut e = Experiment::new(0.2, 0.1);
+    e.algorithm = algorithm;
+    e.record = Some(record.iter().map(|n| n.to_string()).collect());
+    e.input = Some(std::sync::Arc::new(input));
+    let (r, _) = simulate(system, &e).unwrap_or_else(|err| panic!("{what}: {err}"));
+    for (column, value) in by_hand.iter().enumerate() {
+        assert_eq!(r.exact_column(column).unwrap(), [*value; 3], "{what} {}", record[column]);
+    }
+}
+
 /// Two counters, c1 feeding c2 (`i64out -> i64in`, `u64out -> u64in`); c1's inputs from
 /// `inputs` (an input table of exact integers, held), each instance loaded for `interface`.
 fn counters_connected(
@@ -1108,19 +1129,7 @@ fn sixty_four_bit_connections_carry_their_values_to_the_bit() {
                 &[("c1.i64out", "c2.i64in"), ("c1.u64out", "c2.u64in")],
                 &[("c1.i64in", 1 << 62), ("c1.u64in", i128::from(u64::MAX))],
             );
-            let mut e = Experiment::new(0.2, 0.1);
-            e.algorithm = algorithm;
-            e.record = Some(record.iter().map(|n| n.to_string()).collect());
-            e.input = Some(std::sync::Arc::new(input));
-            let (r, _) = simulate(&system, &e).unwrap_or_else(|err| panic!("{interface:?} {algorithm:?}: {err}"));
-            for (column, value) in by_hand.iter().enumerate() {
-                assert_eq!(
-                    r.exact_column(column).unwrap(),
-                    [*value; 3],
-                    "{interface:?} {algorithm:?} {}",
-                    record[column]
-                );
-            }
+            assert_exact_rows(&system, input, algorithm, &record, &by_hand, &format!("{interface:?} {algorithm:?}"));
         }
     }
 }
@@ -1190,19 +1199,8 @@ fn sixty_four_bit_array_elements_carry_their_values_to_the_bit() {
                     ("c1.u64ain[2]", (1 << 53) + 2),
                 ],
             );
-            let mut e = Experiment::new(0.2, 0.1);
-            e.algorithm = algorithm;
-            e.record = Some(record.iter().map(|n| n.to_string()).collect());
-            e.input = Some(std::sync::Arc::new(input));
-            let (r, _) = simulate(&system, &e).unwrap_or_else(|err| panic!("{interface:?} {algorithm:?}: {err}"));
-            for (column, value) in by_hand.iter().enumerate() {
-                assert_eq!(
-                    r.exact_column(column).unwrap(),
-                    [value.as_str(); 3],
-                    "{interface:?} {algorithm:?} {}",
-                    record[column]
-                );
-            }
+            let by_hand: Vec<&str> = by_hand.iter().map(String::as_str).collect();
+            assert_exact_rows(&system, input, algorithm, &record, &by_hand, &format!("{interface:?} {algorithm:?}"));
         }
     }
 }
