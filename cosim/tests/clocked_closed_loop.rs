@@ -134,17 +134,8 @@ fn the_clocked_controller_in_model_exchange_samples_once_per_tick_as_in_co_simul
     let fmu = target().join("fmu").join("fmi3").join("nigel_controller.fmu");
     let run = |interface: &str| -> (Vec<Vec<f64>>, String) {
         let (csv, summary) = (dir.join(format!("{interface}.csv")), dir.join(format!("{interface}.json")));
-        let out = Command::new(env!("CARGO_BIN_EXE_cosim"))
-            .arg("run")
-            .arg(&fmu)
-            .args(["--interface", interface, "--stop-time", "0.02", "--step", "5e-4", "--input"])
-            .arg(&input)
-            .arg("-o")
-            .arg(&csv)
-            .arg("--summary")
-            .arg(&summary)
-            .output()
-            .unwrap();
+        let args = ["--interface", interface, "--stop-time", "0.02", "--step", "5e-4"];
+        let out = common::cosim_run_with_input(&fmu, &args, &input, &csv, &summary);
         assert!(out.status.success(), "{interface}: {}", String::from_utf8_lossy(&out.stderr));
         let rows = std::fs::read_to_string(&csv)
             .unwrap()

@@ -278,17 +278,7 @@ fn the_readme_figure_of_the_ticks_is_drawn_from_a_run() {
     let input = dir.join("clocks_in.csv");
     std::fs::write(&input, "time,trig\n0,0\n0.45,1\n0.5,0\n1.2,1\n1.3,0\n").unwrap();
     let (csv, summary) = (dir.join("clocks.csv"), dir.join("summary.json"));
-    let run = Command::new(env!("CARGO_BIN_EXE_cosim"))
-        .arg("run")
-        .arg(&path)
-        .args(["--stop-time", "1.5", "--step", "0.1", "--input"])
-        .arg(&input)
-        .arg("-o")
-        .arg(&csv)
-        .arg("--summary")
-        .arg(&summary)
-        .output()
-        .unwrap();
+    let run = common::cosim_run_with_input(&path, &["--stop-time", "1.5", "--step", "0.1"], &input, &csv, &summary);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let png = if std::env::var_os("NIGEL_WRITE_DOC_FIGURES").is_some() {

@@ -365,6 +365,31 @@ pub fn run_to_csv(command: &mut Command, csv: &Path) -> (Vec<String>, Vec<Vec<f6
     read_csv(csv)
 }
 
+/// `cosim run MODEL ARGS... --input INPUT -o CSV --summary SUMMARY`, its output (the
+/// program of this package's build; a package without it, such as the campaign's tests
+/// that include this module, has no use for this).
+pub fn cosim_run_with_input(
+    model: &Path,
+    args: &[&str],
+    input: &Path,
+    csv: &Path,
+    summary: &Path,
+) -> std::process::Output {
+    let cosim = option_env!("CARGO_BIN_EXE_cosim").expect("the cosim program of this package");
+    Command::new(cosim)
+        .arg("run")
+        .arg(model)
+        .args(args)
+        .arg("--input")
+        .arg(input)
+        .arg("-o")
+        .arg(csv)
+        .arg("--summary")
+        .arg(summary)
+        .output()
+        .unwrap()
+}
+
 /// The CSV `cosim run` writes: the header's names (quotes removed) and the rows.
 pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();
