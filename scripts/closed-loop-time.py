@@ -1,5 +1,5 @@
 """CPU time of the 30 s closed loop under two builds of `cosim` (docs/architecture.md, "The
-closed loop's time before and after"): alternating runs of
+closed loop's time before and after the seams"): alternating runs of
 `COSIM run SSP --stop-time 30 --step 1e-3 --algorithm ALGORITHM -o OUT.csv`, which build goes
 first alternating from pair to pair, each run's user + system time from getrusage (load on the
 machine disturbs CPU time less than wall time).
