@@ -1,6 +1,8 @@
 """Checks a macOS program's Mach-O header without a Mac: a thin 64-bit executable of the
 expected architecture, built for macOS (LC_BUILD_VERSION platform 1) no later than 11.0,
-linking system libraries only (/usr/lib, /System). Usage: macho-check.py PROGRAM x86_64|aarch64.
+linking system libraries only (/usr/lib, /System), and on arm64 signed (LC_CODE_SIGNATURE: Apple
+silicon kills an unsigned arm64 program at its start; an ad-hoc signature is enough).
+Prints the libraries' names. Usage: macho-check.py PROGRAM x86_64|aarch64.
 Layout: <mach-o/loader.h> (mach_header_64: magic, cputype, cpusubtype, filetype, ncmds,
 sizeofcmds, flags, reserved; then the load commands, each cmd and cmdsize first).
 scripts/wheel-check.py reads the wheels' native modules with read_header."""
@@ -9,7 +11,7 @@ import sys
 
 CPU = {"x86_64": 0x01000007, "aarch64": 0x0100000C}
 MH_MAGIC_64, MH_EXECUTE = 0xFEEDFACF, 2
-LC_LOAD_DYLIB, LC_BUILD_VERSION = 0xC, 0x32
+LC_LOAD_DYLIB, LC_CODE_SIGNATURE, LC_BUILD_VERSION = 0xC, 0x1D, 0x32
 PLATFORM_MACOS = 1
 
 
@@ -33,6 +35,17 @@ def read_header(data, at=0):
     return cputype, filetype, platform, minos, dylibs
 
 
+def load_commands(data, at=0):
+    """The load command types (cmd) of the thin 64-bit Mach-O file at offset `at` of `data`."""
+    ncmds = struct.unpack_from("<I", data, at + 16)[0]
+    pos, cmds = at + 32, []
+    for _ in range(ncmds):
+        cmd, size = struct.unpack_from("<2I", data, pos)
+        cmds.append(cmd)
+        pos += size
+    return cmds
+
+
 def check(path, arch):
     data = open(path, "rb").read()
     header = read_header(data)
@@ -52,7 +65,10 @@ def check(path, arch):
     foreign = [d for d in dylibs if not d.startswith(("/usr/lib/", "/System/"))]
     if foreign:
         return f"links non-system libraries: {foreign}"
-    print(f"Mach-O {arch} executable, macOS {minos} or later, system libraries only: {path}")
+    if arch == "aarch64" and LC_CODE_SIGNATURE not in load_commands(data):
+        return "no code signature (LC_CODE_SIGNATURE): macOS on Apple silicon would not start it"
+    names = ", ".join(d.rsplit("/", 1)[-1] for d in dylibs)
+    print(f"Mach-O {arch} executable, macOS {minos} or later, system libraries only ({names}): {path}")
     return None
 
 

@@ -129,10 +129,16 @@ if [ ${#master_tests[@]} -gt 0 ]; then
 fi
 
 if wanted darwin64; then
-    # macOS: the Mach-O header of each program (64-bit magic, CPU type) and its minimum macOS
+    # macOS: the Mach-O header of each program (64-bit magic, CPU type), its minimum macOS,
+    # its libraries (docs/platforms.md must name them as macho-check.py prints them) and, on
+    # arm64, its signature
     for arch in x86_64 aarch64; do
         for p in cosim cosim-host campaign; do
-            python3 "$repo/scripts/macho-check.py" "$(dir "$arch-apple-darwin")/$p" "$arch"
+            line=$(python3 "$repo/scripts/macho-check.py" "$(dir "$arch-apple-darwin")/$p" "$arch")
+            echo "$line"
+            libs=$(echo "$line" | sed -n 's/.*system libraries only (\(.*\)): .*/\1/p')
+            tr '\n' ' ' <"$repo/docs/platforms.md" | sed 's/  */ /g' | grep -qF "system libraries only: $libs" \
+                || { echo "test-dist: docs/platforms.md does not print the libraries of $arch $p ($libs)" >&2; exit 1; }
         done
     done
 fi
