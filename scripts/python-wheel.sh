@@ -45,6 +45,9 @@ case "$platform" in
     macos-universal2)
         tag=macosx_11_0_universal2
         export MACOSX_DEPLOYMENT_TARGET=11.0
+        # the FMUs' flags (Platform::cargo_build), so that the libraries they share compile once
+        export CARGO_TARGET_X86_64_APPLE_DARWIN_RUSTFLAGS=-Zosx-rpath-install-name
+        export CARGO_TARGET_AARCH64_APPLE_DARWIN_RUSTFLAGS=-Zosx-rpath-install-name
         args=(--zig --target universal2-apple-darwin -Zbuild-std=std,panic_unwind) ;;
     *) echo "python-wheel: unknown platform $platform (linux-x86_64, linux-aarch64, windows-x86_64, macos-universal2)" >&2; exit 2 ;;
 esac
