@@ -142,7 +142,8 @@ def linked(libraries):
     if library.format == "ELF":
         return f"manylinux2014 libraries, symbol versions up to {max((v for v in library.versions if v.startswith('GLIBC_')), key=glibc_version)}"
     if library.format == "PE":
-        return f"a DLL exporting {ENTRY_POINT}, importing {', '.join(library.needed)}"
+        # (one DLL may stand in several import descriptors: rustc's raw-dylib writes its own)
+        return f"a DLL exporting {ENTRY_POINT}, importing {', '.join(sorted({d.lower() for d in library.needed}))}"
     return f"macOS {max(l.minos for l in libraries)} or later, {', '.join(library.needed)}, Python's symbols by dynamic lookup"
 
 

@@ -111,6 +111,6 @@ def test_a_windows_wheel_around_a_dll_of_mingw(tmp_path, dlls, entry_point, prob
     if problem is None:
         assert r.returncode == 0, r.stderr
         # (msvcrt.dll: mingw-w64's C runtime, a DLL of every Windows)
-        assert r.stdout.endswith(": PE x86_64, a DLL exporting PyInit__native, importing KERNEL32.dll, msvcrt.dll, python3.dll\n"), r.stdout
+        assert r.stdout.endswith(": PE x86_64, a DLL exporting PyInit__native, importing kernel32.dll, msvcrt.dll, python3.dll\n"), r.stdout
     else:
         assert r.returncode == 1 and r.stderr.rstrip().endswith(problem), r.stderr
