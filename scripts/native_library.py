@@ -22,17 +22,18 @@ IMAGE_FILE_MACHINE_AMD64, IMAGE_FILE_DLL, PE32_PLUS = 0x8664, 0x2000, 0x20B
 MACHO_CPU = {macho.CPU["x86_64"]: "x86_64", macho.CPU["aarch64"]: "arm64"}
 FAT_MAGIC = 0xCAFEBABE
 MH_DYLIB, MH_BUNDLE = 6, 8
-LC_SYMTAB = 0x2
-N_EXT, N_TYPE, N_UNDF, N_SECT = 0x01, 0x0E, 0x0, 0xE
-DYNAMIC_LOOKUP_ORDINAL = 0xFE
+LC_SYMTAB, LC_DYLD_INFO, LC_DYLD_INFO_ONLY, LC_DYLD_CHAINED_FIXUPS = 0x2, 0x22, 0x80000022, 0x80000034
+N_EXT, N_TYPE, N_SECT = 0x01, 0x0E, 0xE
+BIND_SPECIAL_DYLIB_FLAT_LOOKUP = -2
 
 
 class Library:
     """One library (one slice of a universal Mach-O file): `format` ("ELF", "PE", "Mach-O"),
     `arch`, `needed` (the libraries it links), `exports` (the symbols it defines for others),
     and per format: ELF `versions` (the symbol versions it needs, e.g. GLIBC_2.17); PE `dll`
-    (a DLL, not a program); Mach-O `filetype`, `platform`, `minos` and `lookup`, the undefined
-    symbols each with the library it is bound to ("dynamic lookup": whatever image loaded it)."""
+    (a DLL, not a program); Mach-O `filetype`, `platform`, `minos` and `lookup`, the symbols
+    dyld binds, each with the library it binds it from ("dynamic lookup": the flat namespace,
+    any image loaded, i.e. the interpreter that loads the module)."""
 
     def __init__(self, format, arch, needed, exports, **details):
         self.format, self.arch, self.needed, self.exports = format, arch, needed, exports
@@ -114,27 +115,98 @@ def read_pe(data):
     return [Library("PE", arch, needed, exports, dll=bool(characteristics & IMAGE_FILE_DLL))]
 
 
+def _uleb(data, at):
+    value = shift = 0
+    while True:
+        byte = data[at]
+        at += 1
+        value |= (byte & 0x7F) << shift
+        shift += 7
+        if byte < 0x80:
+            return value, at
+
+
+def _bind_ordinals(data, start, size):
+    """{symbol: library ordinal} of a dyld bind opcode stream (<mach-o/loader.h>, BIND_OPCODE_*):
+    the symbol and ordinal (BIND_SPECIAL_DYLIB_* negative) set when each DO_BIND* comes."""
+    ordinals, ordinal, symbol, at, end = {}, 0, None, start, start + size
+    while at < end:
+        opcode, immediate = data[at] & 0xF0, data[at] & 0x0F
+        at += 1
+        if opcode in (0x90, 0xA0, 0xB0, 0xC0) and symbol is not None:  # DO_BIND*
+            ordinals[symbol] = ordinal
+        if opcode == 0x10:  # SET_DYLIB_ORDINAL_IMM
+            ordinal = immediate
+        elif opcode == 0x20:  # SET_DYLIB_ORDINAL_ULEB
+            ordinal, at = _uleb(data, at)
+        elif opcode == 0x30:  # SET_DYLIB_SPECIAL_IMM: 0, -1, -2, -3 as a 4-bit two's complement
+            ordinal = immediate - 16 if immediate else 0
+        elif opcode == 0x40:  # SET_SYMBOL_TRAILING_FLAGS_IMM, then the name
+            name_end = data.index(b"\0", at)
+            symbol = data[at:name_end].decode()
+            at = name_end + 1
+        elif opcode in (0x60, 0x70, 0x80, 0xA0):  # SET_ADDEND_SLEB, SET_SEGMENT_AND_OFFSET_ULEB, ADD_ADDR_ULEB, DO_BIND_ADD_ADDR_ULEB
+            _, at = _uleb(data, at)
+        elif opcode == 0xC0:  # DO_BIND_ULEB_TIMES_SKIPPING_ULEB
+            _, at = _uleb(data, at)
+            _, at = _uleb(data, at)
+        elif opcode == 0xD0 and immediate == 0:  # THREADED, SET_BIND_ORDINAL_TABLE_SIZE_ULEB
+            _, at = _uleb(data, at)
+        # (DONE 0x00, SET_TYPE_IMM 0x50, DO_BIND 0x90, DO_BIND_ADD_ADDR_IMM_SCALED 0xB0 and
+        # THREADED's APPLY carry no operand; DONE ends one symbol's run, not the stream)
+    return ordinals
+
+
+def _chained_import_ordinals(data, start):
+    """{symbol: library ordinal} of the imports table of LC_DYLD_CHAINED_FIXUPS
+    (<mach-o/fixup-chains.h>: dyld_chained_fixups_header, DYLD_CHAINED_IMPORT{,_ADDEND,_ADDEND64})."""
+    _version, _starts, imports, symbols, count, imports_format, _symbols_format = struct.unpack_from("<7I", data, start)
+    ordinals = {}
+    for k in range(count):
+        if imports_format == 3:
+            entry = struct.unpack_from("<Q", data, start + imports + 16 * k)[0]
+            ordinal, name = entry & 0xFFFF, entry >> 32
+            ordinal = ordinal - 0x10000 if ordinal >= 0xFFF0 else ordinal
+        else:
+            entry = struct.unpack_from("<I", data, start + imports + (4 if imports_format == 1 else 8) * k)[0]
+            ordinal, name = entry & 0xFF, entry >> 9
+            ordinal = ordinal - 0x100 if ordinal >= 0xF0 else ordinal
+        ordinals[_cstring(data, start + symbols + name)] = ordinal
+    return ordinals
+
+
 def _macho_slice(data, at):
     header = macho.read_header(data, at)
     if header is None:
         raise ValueError(f"no 64-bit Mach-O header at {at}")
     cputype, filetype, platform, minos, dylibs = header
     _magic, _cpu, _sub, _filetype, ncmds = struct.unpack_from("<5I", data, at)
-    pos, exports, lookup = at + 32, [], {}
+    pos, exports, ordinals = at + 32, [], {}
     for _ in range(ncmds):
         cmd, size = struct.unpack_from("<2I", data, pos)
         if cmd == LC_SYMTAB:
             symoff, nsyms, stroff, _strsize = struct.unpack_from("<4I", data, pos + 8)
             for k in range(nsyms):
                 # nlist_64: string index, type, section, description, value
-                strx, kind, _sect, desc, _value = struct.unpack_from("<IBBHQ", data, at + symoff + 16 * k)
-                name = _cstring(data, at + stroff + strx)
+                strx, kind, _sect, _desc, _value = struct.unpack_from("<IBBHQ", data, at + symoff + 16 * k)
                 if kind & N_EXT and kind & N_TYPE == N_SECT:
-                    exports.append(name)
-                elif kind & N_EXT and kind & N_TYPE == N_UNDF:
-                    ordinal = desc >> 8
-                    lookup[name] = "dynamic lookup" if ordinal == DYNAMIC_LOOKUP_ORDINAL else (dylibs[ordinal - 1] if 0 < ordinal <= len(dylibs) else f"ordinal {ordinal}")
+                    exports.append(_cstring(data, at + stroff + strx))
+        elif cmd in (LC_DYLD_INFO, LC_DYLD_INFO_ONLY):
+            # rebase, bind, weak bind, lazy bind, export: (offset, size) each
+            streams = struct.unpack_from("<10I", data, pos + 8)
+            for offset, length in (streams[2:4], streams[4:6], streams[6:8]):
+                ordinals.update(_bind_ordinals(data, at + offset, length))
+        elif cmd == LC_DYLD_CHAINED_FIXUPS:
+            offset, _length = struct.unpack_from("<2I", data, pos + 8)
+            ordinals.update(_chained_import_ordinals(data, at + offset))
         pos += size
+
+    def source(ordinal):
+        if ordinal == BIND_SPECIAL_DYLIB_FLAT_LOOKUP:
+            return "dynamic lookup"
+        return dylibs[ordinal - 1] if 0 < ordinal <= len(dylibs) else f"ordinal {ordinal}"
+
+    lookup = {name: source(ordinal) for name, ordinal in ordinals.items()}
     arch = MACHO_CPU.get(cputype, hex(cputype))
     return Library("Mach-O", arch, dylibs, exports, filetype=filetype, platform=platform, minos=minos, lookup=lookup)
 

@@ -69,7 +69,7 @@ def glibc_version(name):
     return tuple(int(part) for part in name[len("GLIBC_") :].split("."))
 
 
-def linking_problem(library, kind):
+def linking_problem(library):
     """None when `library` (one slice) links only what every machine of the platform has."""
     if library.format == "ELF":
         foreign = sorted(set(library.needed) - MANYLINUX2014_LIBRARIES)
@@ -104,7 +104,7 @@ def linking_problem(library, kind):
 
 
 def check(path, kind):
-    tags, module, format, arches = EXPECTED[kind]
+    tags, module, file_format, arches = EXPECTED[kind]
     name = path.rsplit("/", 1)[-1]
     if tags_of_name(name) != sorted(tags):
         return f"file name tags {tags_of_name(name)}, expected {sorted(tags)}"
@@ -124,16 +124,16 @@ def check(path, kind):
         except ValueError as error:
             return f"{module}: {error}"
     found = sorted((library.format, library.arch) for library in libraries)
-    if found != sorted((format, arch) for arch in arches):
-        return f"{module}: {found}, expected {format} {arches}"
+    if found != sorted((file_format, arch) for arch in arches):
+        return f"{module}: {found}, expected {file_format} {arches}"
     for library in libraries:
         # (Mach-O names C symbols with a leading underscore)
         if ENTRY_POINT not in library.exports and "_" + ENTRY_POINT not in library.exports:
             return f"{module}: {library.arch}: does not export {ENTRY_POINT}"
-        problem = linking_problem(library, kind)
+        problem = linking_problem(library)
         if problem:
             return f"{module}: {problem}"
-    print(f"{name}: tags {', '.join(tags)}; RECORD's hashes; {module}: {format} {'+'.join(arches)}, {linked(libraries)}")
+    print(f"{name}: tags {', '.join(tags)}; RECORD's hashes; {module}: {file_format} {'+'.join(arches)}, {linked(libraries)}")
     return None
 
 

@@ -3,7 +3,9 @@ command built passes; a copy with one byte changed fails on RECORD, one renamed 
 platform's tags fails on its tags; a win_amd64 wheel around a DLL that mingw-w64's gcc and
 dlltool link here (an independent writer of PE files: scripts/setup-cross.sh installs them)
 passes when the DLL exports PyInit__native and imports python3.dll, and fails when it imports
-a versioned python311.dll or lacks the entry point."""
+a versioned python311.dll or lacks the entry point; a universal2 wheel around Mach-O modules
+zig links here and llvm-lipo joins passes when both slices are for macOS 11 and take Python
+by dynamic lookup, and fails with one slice, for macOS 12, or linking a libpython."""
 
 import base64
 import hashlib
@@ -112,5 +114,49 @@ def test_a_windows_wheel_around_a_dll_of_mingw(tmp_path, dlls, entry_point, prob
         assert r.returncode == 0, r.stderr
         # (msvcrt.dll: mingw-w64's C runtime, a DLL of every Windows)
         assert r.stdout.endswith(": PE x86_64, a DLL exporting PyInit__native, importing kernel32.dll, msvcrt.dll, python3.dll\n"), r.stdout
+    else:
+        assert r.returncode == 1 and r.stderr.rstrip().endswith(problem), r.stderr
+
+
+ZIG = [str(TARGET / "cross-venv" / "bin" / "python3"), "-m", "ziglang", "cc"]
+LIPO = "/usr/lib/llvm-22/bin/llvm-lipo"
+
+
+def zig_module(folder, arch, macos, link_libpython=False):
+    """A Mach-O module zig links for `arch` and macOS `macos`, exporting PyInit__native and
+    calling PyModule_Create2: taken by dynamic lookup, or from a libpython3.11.dylib
+    (no C library: -nostdlib keeps zig from building one, a second's work)."""
+    target = ["-target", f"{arch}-macos.{macos}", "-shared", "-nostdlib"]
+    (folder / "module.c").write_text("void *PyModule_Create2(void *, int);\n__attribute__((visibility(\"default\"))) void *PyInit__native(void) { return PyModule_Create2(0, 1013); }\n")
+    if link_libpython:
+        (folder / "python.c").write_text("void *PyModule_Create2(void *m, int v) { return m; }\n")
+        subprocess.run(ZIG + target + ["-o", "libpython3.11.dylib", "python.c"], cwd=folder, check=True)
+        linking = ["-L.", "-lpython3.11"]
+    else:
+        linking = ["-undefined", "dynamic_lookup"]
+    out = f"module-{arch}-{macos}.so"
+    subprocess.run(ZIG + target + ["-o", out, "module.c"] + linking, cwd=folder, check=True)
+    return folder / out
+
+
+@pytest.mark.parametrize(
+    "slices, link_libpython, problem",
+    [
+        ([("x86_64", "11.0"), ("aarch64", "11.0")], False, None),
+        ([("x86_64", "11.0")], False, "[('Mach-O', 'x86_64')], expected Mach-O ['x86_64', 'arm64']"),
+        ([("x86_64", "11.0"), ("aarch64", "12.0")], False, "arm64: platform 1, minimum macOS 12.0 (macOS 11 expected)"),
+        ([("x86_64", "11.0"), ("aarch64", "11.0")], True, "x86_64: links ['libpython3.11.dylib'], not a system library"),
+    ],
+)
+def test_a_macos_wheel_around_modules_of_zig(tmp_path, slices, link_libpython, problem):
+    modules = [zig_module(tmp_path, arch, macos, link_libpython) for arch, macos in slices]
+    subprocess.run([LIPO, "-create", *map(str, modules), "-output", str(tmp_path / "universal.so")], check=True)
+    wheel = linux_wheel()
+    tag = "macosx_11_0_universal2"
+    native = ("nigel_cosim/_native.abi3.so", (tmp_path / "universal.so").read_bytes())
+    r = wheel_check(rewrite(wheel, tmp_path / wheel.name.replace(LINUX_TAG, tag), tag, native=native), "macos-universal2")
+    if problem is None:
+        assert r.returncode == 0, r.stderr
+        assert r.stdout.endswith(": Mach-O x86_64+arm64, macOS 11.0 or later, /usr/lib/libSystem.B.dylib, Python's symbols by dynamic lookup\n"), r.stdout
     else:
         assert r.returncode == 1 and r.stderr.rstrip().endswith(problem), r.stderr
