@@ -26,7 +26,7 @@ EXPECTED = {
     "linux-x86_64": (["cp310-abi3-manylinux2014_x86_64", "cp310-abi3-manylinux_2_17_x86_64"], SO, "ELF", ["x86_64"]),
     "linux-aarch64": (["cp310-abi3-manylinux2014_aarch64", "cp310-abi3-manylinux_2_17_aarch64"], SO, "ELF", ["aarch64"]),
     "windows-x86_64": (["cp310-abi3-win_amd64"], "nigel_cosim/_native.pyd", "PE", ["x86_64"]),
-    "macos-universal2": (["cp310-abi3-macosx_11_0_universal2"], SO, "Mach-O", ["x86_64", "arm64"]),
+    "macos-universal2": (["cp310-abi3-macosx_11_0_arm64", "cp310-abi3-macosx_11_0_universal2", "cp310-abi3-macosx_11_0_x86_64"], SO, "Mach-O", ["x86_64", "arm64"]),
 }
 ENTRY_POINT = "PyInit__native"
 # PEP 599's manylinux2014 libraries (those our module can need) and its glibc

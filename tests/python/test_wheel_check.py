@@ -152,7 +152,7 @@ def test_a_macos_wheel_around_modules_of_zig(tmp_path, slices, link_libpython, p
     modules = [zig_module(tmp_path, arch, macos, link_libpython) for arch, macos in slices]
     subprocess.run([LIPO, "-create", *map(str, modules), "-output", str(tmp_path / "universal.so")], check=True)
     wheel = linux_wheel()
-    tag = "macosx_11_0_universal2"
+    tag = "macosx_11_0_arm64.macosx_11_0_universal2.macosx_11_0_x86_64"
     native = ("nigel_cosim/_native.abi3.so", (tmp_path / "universal.so").read_bytes())
     r = wheel_check(rewrite(wheel, tmp_path / wheel.name.replace(LINUX_TAG, tag), tag, native=native), "macos-universal2")
     if problem is None:
