@@ -40,8 +40,9 @@ pub(crate) struct Fmi3 {
     pub(super) resized: HashMap<u32, (Vec<u64>, Vec<u64>)>,
     /// The structural parameters whose value now is not the view's (value reference, value).
     pub(super) sizes_now: Vec<(u32, f64)>,
-    /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
-    /// FMU refused to be instantiated with it and accepted without).
+    /// Co-Simulation with `eventModeUsed` (as [`crate::Fmu::event_mode`] decided: an FMU
+    /// with clocks, or asked for; false again when an FMU without clocks refused to be
+    /// instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
     /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
     pub(super) output_clocks: Vec<u32>,
@@ -84,9 +85,10 @@ mod arrays;
 mod typed;
 
 impl Fmi3 {
-    pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
-        let event_mode = interface == Interface::CoSimulation
-            && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+    /// The calls of an instance of `interface`; `event_mode`: Co-Simulation with
+    /// `eventModeUsed` (the FMU's decision, [`crate::Fmu::event_mode`]).
+    pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface, event_mode: bool) -> Fmi3 {
+        let event_mode = interface == Interface::CoSimulation && event_mode;
         use crate::clocks::{ClockCausality, ClockKind};
         // Scheduled Execution runs the clocks through its own calls (`scheduled.rs`)
         let clocks = if interface == Interface::ScheduledExecution {
@@ -233,8 +235,8 @@ impl Calls for Fmi3 {
         }
     }
 
-    /// `fmi3InstantiateCoSimulation` (early return allowed, event mode used when the FMU
-    /// has it, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
+    /// `fmi3InstantiateCoSimulation` (early return allowed, `eventModeUsed` as the FMU's
+    /// decision says, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
     /// messages to `log` (which outlives the instance).
     fn instantiate(
         &self,
@@ -282,11 +284,23 @@ impl Calls for Fmi3 {
                 None => return Err(not_scheduled(name)),
             },
         };
-        if component.is_null() && fmu.interface == Interface::CoSimulation && self.event_mode.get() {
+        if component.is_null()
+            && fmu.interface == Interface::CoSimulation
+            && self.event_mode.get()
+            && crate::clocks::clocks_of(&a.description).is_empty()
+        {
             // an FMU that declares hasEventMode may still refuse eventModeUsed (the Reference
-            // FMUs' Roberts does): a second try without it, the run then stepping without
-            // Event Mode as for an FMU without it
+            // FMUs' Roberts does): without clocks, which need Event Mode, a second try
+            // without it, the run then stepping without Event Mode as for an FMU without it
             self.event_mode.set(false);
+            log.push(crate::log::LogRecord {
+                status: Status::Warning,
+                category: "cosim".into(),
+                message: format!(
+                    "{function} returned NULL with eventModeUsed = true although the FMU declares hasEventMode: \
+                     instantiated again without Event Mode (the FMU handles its events inside fmi3DoStep)"
+                ),
+            });
             return self.instantiate(fmu, name, name_c, _callbacks, log);
         }
         if component.is_null() {
