@@ -36,7 +36,8 @@ impl RunSetup {
         let mut setup = RunSetup::load_model(model, options)?;
         // an Event Mode choice that applies to none of the model's FMUs is said, not dropped
         let instances = &setup.system().instances;
-        if options.event_mode != crate::EventModeChoice::Auto && instances.iter().all(|i| i.fmu.event_mode().is_none()) {
+        if options.event_mode != crate::EventModeChoice::Auto && instances.iter().all(|i| i.fmu.event_mode().is_none())
+        {
             setup.notes.push(format!(
                 "event mode {} does not apply: it chooses eventModeUsed of FMI 3.0 Co-Simulation FMUs, and the model \
                  has none (FMI 2.0 Co-Simulation has no Event Mode; Model Exchange always has it)",
