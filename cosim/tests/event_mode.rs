@@ -63,7 +63,9 @@ fn assert_rows(rows: &[Vec<f64>], event_mode: bool) {
 
 /// By default an FMU with Event Mode but no clocks is instantiated without it and handles its
 /// event itself: x = 1.45 at 1 s; the same rows as fmpy 0.3.32's `simulate_fmu` with its
-/// default (`use_event_mode=False`). `--event-mode off` is the same run.
+/// default (`use_event_mode=False`, and no early return, so the FMU's early return at 0 s
+/// with eventHandlingNeeded, which the master takes as the FMU's own event there and steps
+/// on from, is not made in fmpy's run). `--event-mode off` is the same run.
 #[test]
 fn by_default_an_fmu_without_clocks_runs_without_event_mode_as_fmpy_does() {
     let Some((dir, fmu)) = event_model("event-mode-auto", XML) else { return };

@@ -5,6 +5,9 @@
  * communication point); without it, the FMU handles the event inside fmi3DoStep at the
  * crossing itself, as an FMU without Event Mode does (FMI 3.0 section 4.1.2). Outputs: x,
  * event_mode_used (eventModeUsed as instantiated), events (the events handled).
+ * Without eventModeUsed but with earlyReturnAllowed, its first fmi3DoStep returns early at
+ * its start time with eventHandlingNeeded, the initial event handled inside (as Dymola 2025x
+ * CoupledClutches with Dassl does); the next fmi3DoStep from there steps on.
  * An instance named "...refuses..." refuses eventModeUsed = true (as the Reference FMUs'
  * Roberts does although it declares hasEventMode). */
 #include <stdio.h>
@@ -16,7 +19,7 @@ typedef struct {
     fmi3Float64 time, x, rate;
     fmi3Boolean event_mode_used;
     fmi3Int32 events;
-    int in_event_mode, pending;
+    int in_event_mode, pending, early_allowed, announced;
 } EventModel;
 
 FMI3_TEST_FAIL(EventModel)
@@ -46,6 +49,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     c->env = env;
     c->log = log;
     c->event_mode_used = eventMode;
+    c->early_allowed = earlyReturnAllowed;
     start(c);
     return c;
 }
@@ -92,6 +96,14 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
     EventModel *c = instance;
     if (c->in_event_mode) return fail(c, "fmi3DoStep: Illegal call sequence: in Event Mode (fmi3EnterStepMode first)");
     if (c->pending) return fail(c, "fmi3DoStep: the event of the last step was not handled in Event Mode");
+    if (!c->event_mode_used && c->early_allowed && !c->announced) {
+        /* the initial event, handled inside: an early return at t, no progress */
+        c->announced = 1;
+        step_reached(t, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
+        *eventHandlingNeeded = 1;
+        *earlyReturn = 1;
+        return fmi3OK;
+    }
     double end = t + h;
     double x_end = c->x + c->rate * h;
     int crosses = c->events == 0 && c->x < X_EVENT && x_end >= X_EVENT;

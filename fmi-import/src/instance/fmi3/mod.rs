@@ -518,9 +518,11 @@ impl Calls for Fmi3 {
                 return Ok(());
             }
             // an early return at the time already reached is progress when it was to handle
-            // an event there (Event Mode was entered and left above): the next fmi3DoStep
-            // goes on from the settled discrete states
-            let settled_here = event != 0 && self.event_mode.get() && reached == at;
+            // an event there: in Event Mode, entered and left above, or, instantiated without
+            // it, inside the FMU, which said so (Dymola 2025x CoupledClutches with Dassl
+            // returns early so at t = 0 and steps on from there, as in fmpy's loop): the next
+            // fmi3DoStep goes on from the settled discrete states (at most 1000 returns a step)
+            let settled_here = event != 0 && reached == at;
             let progressed = settled_here || (reached > at && reached <= end);
             if !progressed {
                 core.state = InstanceState::Errored;
