@@ -6,7 +6,6 @@
 //! at x = 0.55: inside the step at the crossing without Event Mode, at the step's end in
 //! Event Mode with it, so the two runs differ where the event is.
 
-#[allow(dead_code)]
 mod common;
 
 use common::{fmi3_c, read_csv, run_to_csv, work_dir};

@@ -771,8 +771,7 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
 
 /// The counter loaded with Event Mode asked for (`cosim run --event-mode on`).
 fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
-    let options =
-        nigel_cosim::ImportOptions { event_mode: nigel_cosim::EventModeChoice::On, ..Default::default() };
+    let options = nigel_cosim::ImportOptions { event_mode: nigel_cosim::EventModeChoice::On, ..Default::default() };
     Fmu::load_with(path, &options).unwrap()
 }
 
