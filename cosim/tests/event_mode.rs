@@ -170,3 +170,32 @@ fn an_event_mode_choice_that_applies_to_no_fmu_is_noted() {
     assert!(stderr.contains("cosim: note: event mode on does not apply"), "{stderr}");
     assert_eq!(read_csv(&csv).1.len(), 11, "the rows at 0, 1 ms, ..., 10 ms");
 }
+
+/// In an SSP the choice applies to each FMU: `cosim run SYSTEM.ssd --event-mode on` drives the
+/// component's Event Mode (x = 1.4 at 1 s), the default does not (1.45), and `cosim info`
+/// says which per instance.
+#[test]
+fn in_an_ssp_the_choice_applies_to_each_fmu() {
+    let Some((dir, _)) = event_model("event-mode-ssp", XML) else { return };
+    let ssd = dir.join("one.ssd");
+    std::fs::write(
+        &ssd,
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" version="1.0" name="one">
+<ssd:System name="root"><ssd:Elements><ssd:Component name="e" source="fmi3_event_mode.fmu"/></ssd:Elements></ssd:System>
+</ssd:SystemStructureDescription>"#,
+    )
+    .unwrap();
+    for (args, event_mode) in [(&[][..], false), (&["--event-mode", "on"][..], true)] {
+        let csv = dir.join(format!("ssp{}.csv", args.len()));
+        let mut command = cosim();
+        command.arg("run").arg(&ssd).args(["--stop-time", "1", "--step", "0.1"]).args(args).arg("-o").arg(&csv);
+        let (header, rows) = run_to_csv(&mut command, &csv);
+        // one instance: its columns by the variables' names, as for a single FMU
+        assert_eq!(header, ["time", "x", "event_mode_used", "events"]);
+        assert_rows(&rows, event_mode);
+    }
+    let out = cosim().arg("info").arg(&ssd).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("(CoSimulation, no Event Mode)"), "{text}");
+}
