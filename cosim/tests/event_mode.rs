@@ -171,21 +171,26 @@ fn an_event_mode_choice_that_applies_to_no_fmu_is_noted() {
     assert_eq!(read_csv(&csv).1.len(), 11, "the rows at 0, 1 ms, ..., 10 ms");
 }
 
+/// An SSD in `dir` of the one component `name`, the test FMU (built there).
+fn one_component_ssd(dir: &Path, name: &str) -> PathBuf {
+    let ssd = dir.join("one.ssd");
+    let text = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" version="1.0" name="one">
+<ssd:System name="root"><ssd:Elements><ssd:Component name="{name}" source="fmi3_event_mode.fmu"/></ssd:Elements></ssd:System>
+</ssd:SystemStructureDescription>"#
+    );
+    std::fs::write(&ssd, text).unwrap();
+    ssd
+}
+
 /// In an SSP the choice applies to each FMU: `cosim run SYSTEM.ssd --event-mode on` drives the
 /// component's Event Mode (x = 1.4 at 1 s), the default does not (1.45), and `cosim info`
 /// says which per instance.
 #[test]
 fn in_an_ssp_the_choice_applies_to_each_fmu() {
     let Some((dir, _)) = event_model("event-mode-ssp", XML) else { return };
-    let ssd = dir.join("one.ssd");
-    std::fs::write(
-        &ssd,
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" version="1.0" name="one">
-<ssd:System name="root"><ssd:Elements><ssd:Component name="e" source="fmi3_event_mode.fmu"/></ssd:Elements></ssd:System>
-</ssd:SystemStructureDescription>"#,
-    )
-    .unwrap();
+    let ssd = one_component_ssd(&dir, "e");
     for (args, event_mode) in [(&[][..], false), (&["--event-mode", "on"][..], true)] {
         let csv = dir.join(format!("ssp{}.csv", args.len()));
         let mut command = cosim();
@@ -198,4 +203,21 @@ fn in_an_ssp_the_choice_applies_to_each_fmu() {
     let out = cosim().arg("info").arg(&ssd).output().unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("(CoSimulation, no Event Mode)"), "{text}");
+}
+
+/// The second try of an FMU that refuses eventModeUsed = true (`on`) is made in its host
+/// process too (`--isolate`): the run is the one without Event Mode (x = 1.45 at 1 s), the
+/// warning printed.
+#[test]
+fn under_on_the_second_try_is_made_in_the_host_too() {
+    let Some((dir, _)) = event_model("event-mode-refused-isolated", XML) else { return };
+    let ssd = one_component_ssd(&dir, "refuses");
+    let csv = dir.join("isolated.csv");
+    let mut command = cosim();
+    command.arg("run").arg(&ssd).args(["--stop-time", "1", "--step", "0.1", "--event-mode", "on", "--isolate"]);
+    command.env("NIGEL_COSIM_HOST", env!("CARGO_BIN_EXE_cosim-host")).arg("-o").arg(&csv);
+    let out = command.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("instantiated again without Event Mode"));
+    assert_rows(&read_csv(&csv).1, false);
 }

@@ -186,6 +186,14 @@ impl Fmi3 {
     }
 }
 
+/// The warning of a second instantiation without Event Mode after `function` refused it.
+fn refused_event_mode(function: &str) -> String {
+    format!(
+        "{function} returned NULL with eventModeUsed = true although the FMU declares hasEventMode: instantiated \
+         again without Event Mode (the FMU handles its events inside fmi3DoStep)"
+    )
+}
+
 /// The error of a Scheduled Execution call on an instance of another interface.
 #[cold]
 pub(super) fn not_scheduled(name: &str) -> Error {
@@ -296,10 +304,7 @@ impl Calls for Fmi3 {
             log.push(crate::log::LogRecord {
                 status: Status::Warning,
                 category: "cosim".into(),
-                message: format!(
-                    "{function} returned NULL with eventModeUsed = true although the FMU declares hasEventMode: \
-                     instantiated again without Event Mode (the FMU handles its events inside fmi3DoStep)"
-                ),
+                message: refused_event_mode(function),
             });
             return self.instantiate(fmu, name, name_c, _callbacks, log);
         }
@@ -323,7 +328,16 @@ impl Calls for Fmi3 {
             });
         }
         let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());
-        Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
+        let status =
+            crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode);
+        let refused = status != 0 && channel.failure.is_none() && channel.over_limit.is_none();
+        if refused && event_mode == Some(true) && crate::clocks::clocks_of(&self.a.description).is_empty() {
+            // the second try of `instantiate`, in the host
+            self.event_mode.set(false);
+            channel.push_log(Status::Warning, refused_event_mode("fmi3InstantiateCoSimulation"));
+            return self.instantiate_in(fmu, channel, name_c);
+        }
+        Ok(status)
     }
 
     fn reset_name(&self) -> &'static str {
