@@ -170,7 +170,8 @@ def main():
     print("%-11s %6s %10s %11s %16s %10s %6s" % ("part", "cases", "fmpy done", "cosim done", "cosim right*", "refereed*", "known"))
     print("\n".join(table))
     print("* of the cases fmpy completes (SSP: of all cases; fmpy is no yardstick there); right: equal to fmpy's")
-    print("  result, or, where they differ, right by the referee (refereed: how many of those)")
+    print("  result (or by the FMI 3.0 runner within 1e-3 of the reference where fmpy is not: ref-ok), or, where")
+    print("  they differ, right by the referee (refereed: how many of those)")
     print("== referee (cases where cosim and fmpy both complete and differ)")
     for key, verdict in judged:
         print("%s  %s by %s%s" % (key, "cosim right" if verdict["right"] else "cosim NOT right", ", ".join(verdict["referees"]),
