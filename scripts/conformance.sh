@@ -35,6 +35,9 @@ run_part() {
 run_part fmi3 "$corpus/fmi3.py" --suite "$corpus/fmi3" --cosim "$cosim" --work "$work/fmi3" --json "$work/fmi3.json"
 # the referee of the FMI 3.0 cases where cosim and fmpy differ (a tight-tolerance fmpy run each,
 # 1 to 80 s) beside the other parts
+# the tight runs' results are kept between runs (they depend on the FMU, its input and fmpy only:
+# MapleSim SlidingCrank's takes 50 to 140 s)
+export NIGEL_CONFORMANCE_REFEREE_CACHE="$(realpath -m "$target_dir/conformance-referee")"
 "$python" scripts/conformance_table.py --referee-only "$work" "$corpus" fmi3 >"$work/fmi3-referee.log" 2>&1 &
 referee_pid=$!
 # every FMI 2.0 case (CS and ME) with cosim's default solver, auto (rk4, continuing with bdf

@@ -100,3 +100,21 @@ def test_table_counts_a_refereed_case_right_and_fails_on_an_unlisted_miss(tmp_pa
     assert miss.returncode == 1 and "NEW   fmi3:me/T/M" in miss.stdout
     listed = table(tmp_path / "listed", wrong_rows, known="fmi3:me/T/M  the reason\n")
     assert listed.returncode == 0 and "known fmi3:me/T/M" in listed.stdout
+
+
+def test_tight_run_kept_between_runs_is_read_not_rerun(tmp_path, monkeypatch):
+    # no FMU at all: fmpy could not run this case, so a result can only come from the cache
+    fmu = write(tmp_path / "M.fmu", "not an FMU")
+    case = dict(fmu=fmu, interface="me", start=0.0, stop=1.0, step=0.5, input=None)
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("NIGEL_CONFORMANCE_REFEREE_CACHE", str(cache))
+    result, message = referee.tight_run(case, str(tmp_path / "tight.csv"))
+    assert result is None and "failed" in message
+    cache.mkdir()
+    import gzip
+    with gzip.open(cache / (referee.tight_run_key(case) + ".csv.gz"), "wt") as f:
+        f.write("time,y\n0.0,1\n0.5,2\n1.0,3\n")
+    result, message = referee.tight_run(case, str(tmp_path / "tight.csv"))
+    assert message == "kept from an earlier run" and result == ([0.0, 0.5, 1.0], {"y": [1, 2, 3]})
+    # another experiment (another step) is another key: not read
+    assert referee.tight_run_key(dict(case, step=0.25)) != referee.tight_run_key(case)
