@@ -9,6 +9,7 @@ use std::ffi::CString;
 use std::path::Path;
 use std::sync::Arc;
 
+use fmi_sys::FunctionTable;
 use model_description::ModelDescription;
 
 use crate::c_types::{Fmi3Functions, Functions};
@@ -23,7 +24,7 @@ type Loaded = (Abi, CString, Vec<(String, crate::fmi3::LeftOut)>);
 /// What loading an FMU differs in between the generations.
 trait Generation {
     /// The library's function table.
-    type Table;
+    type Table: fmi_sys::FunctionTable;
     /// The model description as read, beyond the view every FMU has.
     type Described;
     /// The platform folder under `binaries/` (the standard's name for 64-bit Linux).
@@ -41,8 +42,6 @@ trait Generation {
     unsafe fn resolve(library: &libloading::Library, shown: &Path) -> Result<Self::Table>;
     /// The table of an FMU imported isolated: every call goes to the instance's host.
     fn proxy(present: &dyn Fn(&str) -> bool) -> Self::Table;
-    /// Whether the table has `symbol`.
-    fn has(table: &Self::Table, symbol: &str) -> bool;
     /// The functions `interface` needs beyond the core ones.
     fn needs(interface: Interface) -> &'static [&'static str];
     /// The model identifier of Scheduled Execution (FMI 3.0 only).
@@ -112,10 +111,6 @@ impl Generation for Fmi2 {
         crate::isolate::proxy::table(present)
     }
 
-    fn has(table: &Functions, symbol: &str) -> bool {
-        table.has(symbol)
-    }
-
     fn needs(interface: Interface) -> &'static [&'static str] {
         match interface {
             Interface::CoSimulation => &["fmi2DoStep"],
@@ -182,10 +177,6 @@ impl Generation for Fmi3 {
 
     fn proxy(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         crate::isolate::proxy3::table(present)
-    }
-
-    fn has(table: &Fmi3Functions, symbol: &str) -> bool {
-        table.has(symbol)
     }
 
     fn needs(interface: Interface) -> &'static [&'static str] {
@@ -397,7 +388,7 @@ fn load<G: Generation>(
         (Some(library), table)
     };
     let checked = library.is_some() || G::NEEDS_CHECKED_ISOLATED;
-    if let Some(symbol) = G::needs(interface).iter().find(|s| checked && !G::has(&table, s)) {
+    if let Some(symbol) = G::needs(interface).iter().find(|s| checked && !table.has(s)) {
         return Err(Error::MissingSymbol { path: shown, symbol });
     }
     let (abi, resource_uri, not_in_view) = G::finish(table, described, dir.path(), path)?;

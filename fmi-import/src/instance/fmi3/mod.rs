@@ -246,7 +246,7 @@ impl Calls for Fmi3 {
     ) -> Result<Component> {
         let a = &self.a;
         let environment = log as *const LogSink as *mut c_void;
-        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message);
+        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message::<LogSink>);
         let missing = |symbol| Error::MissingSymbol { path: fmu.source.clone(), symbol };
         let function = self.instantiate_function(fmu.interface);
         let component = match fmu.interface {
