@@ -28,6 +28,8 @@
  * and, in the descriptions of the tests of large arrays only (j from 0):
  *   40 big Float64[BIG] output y + j   41 bigi Int32[BIG] output n + j
  *   42 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
+ *   43 bigw Int64[BIG] output 2^62 + 1 + n + j (none of them an f64)
+ *   44 bigw_reads Int32 output: the number of fmi3GetInt64 calls that asked for bigw so far
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
@@ -55,6 +57,7 @@ typedef struct {
     long long i64in, i64ain[2];
     unsigned long long u64in, u64ain[2];
     unsigned char bytes[64];
+    int bigw_reads;
 } State;
 
 typedef struct {
@@ -258,6 +261,7 @@ fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
         case 3: values[i] = c->s.n; break;
         case 9: values[i] = c->s.k; break;
         case 31: values[i] = c->s.crash_how; break;
+        case 44: values[i] = c->s.bigw_reads; break;
         case 10: values[i] = 2 * c->s.k; break;
         default: return fail(c, "fmi3GetInt32: no such Int32");
         }
@@ -284,6 +288,12 @@ fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], si
     Counter *c = instance;
     size_t j = 0; /* the next value: an array takes as many as it has elements */
     for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] == 43) { /* the array bigw */
+            if (j + BIG > nValues) return fail(c, "fmi3GetInt64: nValues too small");
+            for (size_t e = 0; e < BIG; e++) values[j++] = (1LL << 62) + 1 + c->s.n + (fmi3Int64)e;
+            c->s.bigw_reads += 1;
+            continue;
+        }
         if (vr[i] == 36 || vr[i] == 37) {
             if (j + 2 > nValues) return fail(c, "fmi3GetInt64: nValues too small");
             for (int k = 0; k < 2; k++) values[j++] = vr[i] == 36 ? c->s.i64ain[k] : c->s.i64ain[k] ^ 1;

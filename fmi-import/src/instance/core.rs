@@ -210,8 +210,9 @@ pub(crate) trait Calls: Send {
     /// The string of `vr` as the FMU returns it (valid until its next call).
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const std::ffi::c_char>;
     fn set_string(&mut self, core: &mut Core, vr: u32, value: *const std::ffi::c_char) -> Result<()>;
-    /// The exact value of a variable of [`crate::Fmu::exact_kind`] (FMI 3.0 only).
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact>;
+    /// The exact values of variables of [`crate::Fmu::exact_kind`], appended to `values`
+    /// (FMI 3.0 only): an array read once for all its elements among `vrs`.
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()>;
     /// Sets a 64-bit integer variable of [`crate::Fmu::exact_kind`] exactly (FMI 3.0 only).
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()>;
     fn do_step(&mut self, core: &mut Core, time: f64, step: f64) -> Result<()>;

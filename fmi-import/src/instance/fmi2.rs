@@ -162,8 +162,8 @@ impl Calls for Fmi2 {
         call!(core, "fmi2SetString", None, f(c, &vr, 1, &p))
     }
 
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
-        Err(no_exact(core, vr, String::new()))
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], _values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        Err(no_exact(core, vrs.first().copied().unwrap_or_default(), String::new()))
     }
 
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {

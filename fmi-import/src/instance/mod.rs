@@ -457,13 +457,38 @@ impl Instance {
     /// ([`Fmu::exact_kind`]: `fmi3GetInt64`, `fmi3GetUInt64`, `fmi3GetBinary` of the
     /// element), or a String's text.
     pub fn get_exact(&mut self, vr: u32) -> Result<crate::fmi3::Exact> {
-        let is_string = self.core.fmu.description.model_variables.iter().any(|v| {
-            v.value_reference == vr && matches!(v.variable_type, model_description::VariableType::String { .. })
-        });
-        if is_string {
-            return self.get_string(vr).map(crate::fmi3::Exact::Text);
+        let mut values = Vec::with_capacity(1);
+        self.get_exact_many(&[vr], &mut values)?;
+        Ok(values.pop().expect("one value per value reference"))
+    }
+
+    /// [`Instance::get_exact`] of each of `vrs` into `values` (cleared first, then one per
+    /// value reference): each array is read once for all its elements among `vrs`, so
+    /// that a row of the results costs time linear in the elements.
+    pub fn get_exact_many(&mut self, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        values.clear();
+        let mut rest = vrs;
+        while let Some(&first) = rest.first() {
+            if self.is_string(first) {
+                values.push(self.get_string(first).map(crate::fmi3::Exact::Text)?);
+                rest = &rest[1..];
+                continue;
+            }
+            // the run of values up to the next String, in one call
+            let run = rest.iter().position(|vr| self.is_string(*vr)).unwrap_or(rest.len());
+            self.calls.get_exact(&mut self.core, &rest[..run], values)?;
+            rest = &rest[run..];
         }
-        self.calls.get_exact(&mut self.core, vr)
+        Ok(())
+    }
+
+    /// Whether the view's variable `vr` is a String (an Int64, UInt64 or Binary found in
+    /// the view's map first: no scan of the variables per element of an array).
+    fn is_string(&self, vr: u32) -> bool {
+        self.core.fmu.exact_kind(vr).is_none()
+            && self.core.fmu.description.model_variables.iter().any(|v| {
+                v.value_reference == vr && matches!(v.variable_type, model_description::VariableType::String { .. })
+            })
     }
 
     /// `fmi3SetInt64` / `fmi3SetUInt64` of `vr` exactly (a variable of

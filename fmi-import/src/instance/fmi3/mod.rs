@@ -425,40 +425,25 @@ impl Calls for Fmi3 {
         call!(core, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
     }
 
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
-        use crate::fmi3::Exact;
-        use model_description::fmi3::ValueType as T;
-        let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
-        let (c, a, n, k) = (core.component, &*self.a, access.count, access.element);
-        let fmu_vr = access.vr;
-        Ok(match access.value_type {
-            T::Int64 => {
-                let f = f3!(core, a, get_int64, "fmi3GetInt64");
-                let mut buf = vec![0i64; n];
-                call!(core, "fmi3GetInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
-                Exact::Integer(i128::from(buf[k]))
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        // each array read once for all its elements asked here (a row of the results):
+        // the FMU does not change in between, and a row costs time linear in the elements
+        let mut arrays: HashMap<u32, Vec<crate::fmi3::Exact>> = HashMap::new();
+        for &vr in vrs {
+            let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
+            let (n, element) = self.now(access);
+            let Some(k) = element else { return Err(self.absent_element(core, access, n, String::new())) };
+            if access.count <= 1 {
+                values.extend(self.exact_all(core, access)?);
+                continue;
             }
-            T::UInt64 => {
-                let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
-                let mut buf = vec![0u64; n];
-                call!(core, "fmi3GetUInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
-                Exact::Integer(i128::from(buf[k]))
+            if !arrays.contains_key(&access.vr) {
+                let all = self.exact_all(core, access)?;
+                arrays.insert(access.vr, all);
             }
-            T::Binary => {
-                let f = f3!(core, a, get_binary, "fmi3GetBinary");
-                let mut sizes = vec![0usize; n];
-                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
-                call!(core, "fmi3GetBinary", None, f(c, &fmu_vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
-                let (p, size) = (data[k], sizes[k]);
-                if p.is_null() || size == 0 {
-                    Exact::Bytes(Vec::new())
-                } else {
-                    // SAFETY: the FMU returned `size` bytes at `p`, valid until its next call.
-                    Exact::Bytes(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
-                }
-            }
-            _ => return Err(not_exact(core, vr, String::new())),
-        })
+            values.push(arrays[&access.vr][k].clone());
+        }
+        Ok(())
     }
 
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {
