@@ -18,8 +18,12 @@ pub enum InstanceState {
     Instantiated,
     /// After `fmi2EnterInitializationMode`.
     Initialization,
-    /// After `fmi2ExitInitializationMode` (step complete / event or continuous-time mode).
+    /// After `fmi2ExitInitializationMode` (step complete / event mode; Model Exchange after
+    /// `fmi2EnterEventMode`).
     Running,
+    /// Model Exchange after `fmi2EnterContinuousTimeMode`, until `fmi2EnterEventMode`: only
+    /// continuous inputs may change (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1).
+    ContinuousTime,
     /// After `fmi2Terminate`.
     Terminated,
     /// After an `fmi2Error`: only free is called.
@@ -29,11 +33,18 @@ pub enum InstanceState {
 }
 
 impl InstanceState {
+    /// Whether it runs: after initialization, in any mode, before termination or an error.
+    #[inline]
+    pub fn is_running(self) -> bool {
+        matches!(self, InstanceState::Running | InstanceState::ContinuousTime)
+    }
+
     pub(crate) fn as_str(self) -> &'static str {
         match self {
             InstanceState::Instantiated => "instantiated",
             InstanceState::Initialization => "initialization mode",
             InstanceState::Running => "running",
+            InstanceState::ContinuousTime => "continuous-time mode",
             InstanceState::Terminated => "terminated",
             InstanceState::Errored => "errored",
             InstanceState::Fatal => "fatal",
@@ -65,12 +76,11 @@ macro_rules! call {
         let core: &mut $crate::instance::core::Core = $core;
         core.check_callable($name)?;
         let time: Option<f64> = $time;
-        let mark = $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time));
         // the blocks the FMU allocates in the call are this instance's (fmi-sys's guard)
-        let owner = fmi_sys::fmi2::guard::enter_owner(core.log.owner());
+        let mark =
+            $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time), core.log.owner());
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
-        drop(owner);
         drop(mark);
         core.status($name, raw, time)
     }};

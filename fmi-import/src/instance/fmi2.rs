@@ -55,8 +55,9 @@ impl Calls for Fmi2 {
     ) -> Result<Component> {
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
-        let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0);
-        let owner = fmi_sys::fmi2::guard::enter_owner(log.owner());
+        // the guard reads the owner of a block from the call's mark (once a process)
+        fmi_sys::fmi2::guard::owners_from(crate::call_site::owner_of_call);
+        let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0, log.owner());
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (self.t.instantiate)(
@@ -69,7 +70,6 @@ impl Calls for Fmi2 {
                 0,
             )
         };
-        drop(owner);
         drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate {

@@ -270,16 +270,14 @@ impl Instance {
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
         self.calls.exit_initialization_mode(&mut self.core)?;
         self.core.state = InstanceState::Running;
-        self.set_continuous_time(false);
         Ok(())
     }
 
     /// Model Exchange: whether the instance is in Continuous-Time Mode (discrete inputs
     /// wait for Event Mode then).
-    fn set_continuous_time(&mut self, on: bool) {
-        if let Some(d) = self.discrete.as_deref_mut() {
-            d.continuous_time = on;
-        }
+    #[inline]
+    fn in_continuous_time(&self) -> bool {
+        self.core.state == InstanceState::ContinuousTime
     }
 
     /// Model Exchange: whether discrete inputs set in Continuous-Time Mode wait for Event
@@ -292,8 +290,7 @@ impl Instance {
     /// The discrete inputs that wait (see [`Instance::has_pending_inputs`]) set, in the
     /// order they were set; in Event Mode (after [`Instance::enter_event_mode`]).
     pub fn apply_pending_inputs(&mut self) -> Result<()> {
-        let Some(d) = self.discrete.as_deref_mut() else { return Ok(()) };
-        if d.continuous_time {
+        if self.in_continuous_time() {
             let instance = self.core.name.clone();
             return Err(Error::IllegalCall {
                 instance,
@@ -301,6 +298,7 @@ impl Instance {
                 state: "Continuous-Time Mode",
             });
         }
+        let Some(d) = self.discrete.as_deref_mut() else { return Ok(()) };
         for (_, vr, value) in std::mem::take(&mut d.pending) {
             match value {
                 Held::Real(bits) => self.set_real(&[vr], &[f64::from_bits(bits)])?,
@@ -324,12 +322,13 @@ impl Instance {
         values: &[T],
         set: impl Fn(&mut (dyn Calls + 'static), &mut Core, &[u32], &[T]) -> Result<()>,
     ) -> Result<()> {
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.any_deferred(kind, vrs) {
+            if d.any_deferred(continuous_time, kind, vrs) {
                 let (vrs, values): (Vec<u32>, Vec<T>) = vrs
                     .iter()
                     .zip(values)
-                    .filter(|(vr, v)| !d.defer(kind, **vr, held(**v)))
+                    .filter(|(vr, v)| !d.defer(continuous_time, kind, **vr, held(**v)))
                     .map(|(vr, v)| (*vr, *v))
                     .unzip();
                 if vrs.is_empty() {
@@ -337,9 +336,9 @@ impl Instance {
                 }
                 return set(self.calls.as_mut(), &mut self.core, &vrs, &values);
             }
-            if !d.continuous_time {
+            if !continuous_time {
                 for (vr, v) in vrs.iter().zip(values) {
-                    d.defer(kind, *vr, held(*v));
+                    d.defer(false, kind, *vr, held(*v));
                 }
             }
         }
@@ -349,7 +348,10 @@ impl Instance {
     /// `fmi2Terminate` / `fmi3Terminate` (only from initialization or running; otherwise
     /// nothing to do).
     pub fn terminate(&mut self) -> Result<()> {
-        if !matches!(self.core.state, InstanceState::Running | InstanceState::Initialization) {
+        if !matches!(
+            self.core.state,
+            InstanceState::Running | InstanceState::ContinuousTime | InstanceState::Initialization
+        ) {
             return Ok(());
         }
         self.calls.terminate(&mut self.core)?;
@@ -366,7 +368,13 @@ impl Instance {
         }
         let function = self.calls.reset_name();
         let f = self.calls.reset_function(&self.core)?;
-        let mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
+        let mark = crate::call_site::enter(
+            &self.core.name,
+            &self.core.fmu.source,
+            function,
+            self.core.time,
+            crate::call_site::owner_of_call(),
+        );
         // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.core.component) };
         drop(mark);
@@ -494,8 +502,9 @@ impl Instance {
     /// `fmi3SetInt64` / `fmi3SetUInt64` of `vr` exactly (a variable of
     /// [`Fmu::exact_kind`] Int64 or UInt64); a value outside its type's range is refused.
     pub fn set_exact_integer(&mut self, vr: u32, value: i128) -> Result<()> {
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.defer(Kind::Exact, vr, Held::Exact(value)) {
+            if d.defer(continuous_time, Kind::Exact, vr, Held::Exact(value)) {
                 return Ok(());
             }
         }
@@ -509,8 +518,9 @@ impl Instance {
             value: value.into(),
             reason: "NUL in string".into(),
         })?;
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.defer(Kind::String, vr, Held::String(value.into())) {
+            if d.defer(continuous_time, Kind::String, vr, Held::String(value.into())) {
                 return Ok(());
             }
         }
@@ -537,7 +547,7 @@ impl Instance {
     pub fn post_step(&mut self, time: f64, step: f64) -> bool {
         let Some((op, step)) = self.calls.posted_step(time, step) else { return false };
         let Some(host) = self.core.host.as_deref_mut() else { return false };
-        if self.core.state != InstanceState::Running {
+        if !self.core.state.is_running() {
             return false;
         }
         crate::isolate::proxy::post_step(host, op, time, step);
@@ -659,7 +669,9 @@ impl Instance {
     /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
         self.calls.enter_event_mode(&mut self.core)?;
-        self.set_continuous_time(false);
+        if self.core.state == InstanceState::ContinuousTime {
+            self.core.state = InstanceState::Running;
+        }
         Ok(())
     }
 
@@ -672,7 +684,9 @@ impl Instance {
     /// `fmi2EnterContinuousTimeMode` / `fmi3EnterContinuousTimeMode`.
     pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
         self.calls.enter_continuous_time_mode(&mut self.core)?;
-        self.set_continuous_time(true);
+        if self.core.state == InstanceState::Running {
+            self.core.state = InstanceState::ContinuousTime;
+        }
         Ok(())
     }
 
@@ -725,7 +739,13 @@ impl Instance {
                 unsafe { free_state(self.core.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
+        let _mark = crate::call_site::enter(
+            &self.core.name,
+            &self.core.fmu.source,
+            function,
+            self.core.time,
+            crate::call_site::owner_of_call(),
+        );
         // SAFETY: the component came from the instantiate call and is freed once (the
         // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };

@@ -207,7 +207,7 @@ macro_rules! get_set {
     ($($get:ident, $set:ident, $t:ty, $fmu_get:ident, $fmu_set:ident;)*) => {$(
         #[inline]
         fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
-            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            if !self.clocked.is_empty() && core.state.is_running() {
                 return self.get_held(core, vrs, values, Self::$fmu_get);
             }
             self.$fmu_get(core, vrs, values)
@@ -215,7 +215,7 @@ macro_rules! get_set {
 
         #[inline]
         fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
-            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            if !self.clocked.is_empty() && core.state.is_running() {
                 return self.set_queued(core, vrs, values, Self::$fmu_set);
             }
             self.$fmu_set(core, vrs, values)
@@ -252,7 +252,8 @@ impl Calls for Fmi3 {
         let component = match fmu.interface {
             Interface::CoSimulation => {
                 let f = a.functions.instantiate_co_simulation.ok_or(missing(function))?;
-                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                let _mark =
+                    crate::call_site::enter(name, &fmu.source, function, 0.0, crate::call_site::owner_of_call());
                 // SAFETY: every pointer is valid for the call; the log outlives the instance.
                 unsafe {
                     f(
@@ -273,7 +274,8 @@ impl Calls for Fmi3 {
             }
             Interface::ModelExchange => {
                 let f = a.functions.instantiate_model_exchange.ok_or(missing(function))?;
-                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                let _mark =
+                    crate::call_site::enter(name, &fmu.source, function, 0.0, crate::call_site::owner_of_call());
                 // SAFETY: as above.
                 unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
             }
