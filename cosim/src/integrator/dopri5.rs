@@ -126,7 +126,7 @@ impl Dopri5 {
     /// logic, [`STIFF_H_LAMBDA`]).
     fn test_stiffness(&mut self, t: f64, h: f64) {
         self.test.accepted += 1;
-        if self.test.accepted % NSTIFF != 0 && self.test.stiff == 0 {
+        if !self.test.accepted.is_multiple_of(NSTIFF) && self.test.stiff == 0 {
             return;
         }
         // where y1 = y6 their code keeps the last estimate; none here is not stiff

@@ -439,11 +439,11 @@ impl Calls for Fmi3 {
                 values.extend(self.exact_all(core, access)?);
                 continue;
             }
-            if !arrays.contains_key(&access.vr) {
-                let all = self.exact_all(core, access)?;
-                arrays.insert(access.vr, all);
-            }
-            values.push(arrays[&access.vr][k].clone());
+            let all = match arrays.entry(access.vr) {
+                std::collections::hash_map::Entry::Occupied(read) => read.into_mut(),
+                std::collections::hash_map::Entry::Vacant(unread) => unread.insert(self.exact_all(core, access)?),
+            };
+            values.push(all[k].clone());
         }
         Ok(())
     }
