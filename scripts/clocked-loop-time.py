@@ -11,39 +11,24 @@ clock), built alike by `cargo run --release -p build-fmu -- --platforms linux64 
 it was the option `controller-sample-clock`.)
 Prints the median CPU time of each and the median, smallest and largest ratio of the pairs.
 """
+import importlib.util
 import os
-import resource
-import statistics
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 TARGET = Path(__file__).resolve().parents[1] / os.environ.get("CARGO_TARGET_DIR", "target")
-
-
-def cpu_time(ssp, algorithm, out):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([str(TARGET / "release" / "cosim"), "run", str(ssp), "--stop-time", "30", "--step", "1e-3",
-                    "--algorithm", algorithm, "-o", str(out)], check=True, stdout=subprocess.DEVNULL)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+# the alternating loop of closed-loop-time.py (a file name with hyphens: loaded by path)
+_spec = importlib.util.spec_from_file_location("closed_loop_time", Path(__file__).with_name("closed-loop-time.py"))
+closed_loop_time = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(closed_loop_time)
 
 
 def main():
     pairs, algorithm = int(sys.argv[1]), sys.argv[2]
     unclocked, clocked = (sys.argv[3:5] if len(sys.argv) > 4
                           else (TARGET / "ssp" / "nigel_closed_loop.ssp", TARGET / "ssp" / "nigel_closed_loop_fmi3.ssp"))
-    times = {"unclocked": [], "clocked": []}
-    with tempfile.TemporaryDirectory() as tmp:
-        for i in range(pairs):
-            order = [("unclocked", unclocked), ("clocked", clocked)]
-            for label, ssp in order if i % 2 == 0 else order[::-1]:
-                times[label].append(cpu_time(ssp, algorithm, Path(tmp) / f"{label}.csv"))
-    ratios = sorted(c / u for u, c in zip(times["unclocked"], times["clocked"]))
-    print(f"{algorithm}: unclocked {statistics.median(times['unclocked']):.3f} s, clocked "
-          f"{statistics.median(times['clocked']):.3f} s (medians); clocked / unclocked per pair: median "
-          f"{statistics.median(ratios):.3f}, {ratios[0]:.3f} to {ratios[-1]:.3f} ({pairs} pairs)")
+    cosim = TARGET / "release" / "cosim"
+    closed_loop_time.alternate(pairs, algorithm, ("unclocked", cosim, unclocked), ("clocked", cosim, clocked), False)
 
 
 if __name__ == "__main__":

@@ -463,25 +463,15 @@ fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
     let c_run = fmi2_run(&LINUX64);
     // the same SSP through nigel_cosim's Jacobi master: another importer, the same numbers
     let (system, _keep) = closed_loop_system();
-    let names: Vec<String> = c_run.0[1..].to_vec();
-    let experiment =
-        Experiment { algorithm: Algorithm::Jacobi, record: Some(names.clone()), ..Experiment::new(STOP_TIME, STEP) };
+    let record = Some(c_run.0[1..].to_vec());
+    let experiment = Experiment { algorithm: Algorithm::Jacobi, record, ..Experiment::new(STOP_TIME, STEP) };
     let (results, _) = simulate(&system, &experiment).unwrap();
-    assert_eq!(results.rows(), c_run.1.len());
-    for (k, row) in c_run.1.iter().enumerate() {
-        let theirs = results.row(k);
-        for j in 0..row.len() {
-            let col = if j == 0 { 0 } else { 1 + results.names.iter().position(|n| *n == names[j - 1]).unwrap() };
-            assert_eq!(
-                row[j].to_bits(),
-                theirs[col].to_bits(),
-                "row {k}, {}: C {} nigel_cosim {}",
-                c_run.0[j],
-                row[j],
-                theirs[col]
-            );
-        }
-    }
+    // the results as a table: time, then the recorded columns
+    let master: Table = (
+        std::iter::once("time".to_owned()).chain(results.names.iter().cloned()).collect(),
+        (0..results.rows()).map(|k| results.row(k).to_vec()).collect(),
+    );
+    assert_master_equals_c_importer("linux64 nigel_cosim in process", c_run, &master);
 }
 
 fn wine_path(p: &Path) -> String {

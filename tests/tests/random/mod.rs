@@ -1,13 +1,16 @@
-//! What the random call sequences of both generations share (`random_calls.rs` for FMI 2.0,
-//! `random_calls3.rs` for FMI 3.0): the seeded generator, the hostile numbers, the
-//! importer's shadow of the instance's state and how a call's status moves it, the check
-//! that no non-finite number is handed out with OK, and the loop over every built FMU and
-//! interface. Each generation's file keeps only its own calls.
+//! The random call sequences of `random_calls.rs`, one loop for both generations: the seeded
+//! generator, the hostile numbers, the importer's shadow of the instance's state and how a
+//! call's status moves it, the state-table check after every call, the check that no
+//! non-finite number is handed out with OK, and the loop over every built FMU and interface.
+//! Each generation ([`Generation`], `fmi2.rs` and `fmi3.rs`) brings only its own calls.
 
 use std::ffi::c_void;
 
-use fmi_export::states::{Function, Machine};
+use fmi_export::states::{Function, Generation as Abi, Machine, Scope};
 use nigel_integration_tests::{built_fmu, Fmu, DISCARD, ERROR, OK};
+
+pub mod fmi2;
+pub mod fmi3;
 
 /// xorshift64*: the same sequences on every platform.
 pub struct Rng(pub u64);
@@ -71,23 +74,6 @@ pub struct Shadow {
     pub states: Vec<(*mut c_void, Option<Machine>)>,
     pub freed: Vec<*mut c_void>,
     pub bytes: Vec<u8>,
-}
-
-/// The functions of one generation that move the shadow's state.
-pub struct Moves {
-    pub do_step: Function,
-    pub enter_initialization_mode: Function,
-    pub exit_initialization_mode: Function,
-    pub terminate: Function,
-    pub reset: Function,
-    pub enter_event_mode: Function,
-    pub enter_continuous_time_mode: Function,
-    pub set_fmu_state: Function,
-    /// A Discard of the step leaves the instance in Step Failed (FMI 2.0); else it stays
-    /// in Step Mode at the time the step reached (FMI 3.0 has no such state).
-    pub discard_fails_the_step: bool,
-    /// The generation's OK status by name, for the messages.
-    pub ok: &'static str,
 }
 
 impl Shadow {
@@ -206,59 +192,51 @@ impl Shadow {
         status
     }
 
-    /// After `function` returned `status`: no non-finite number in `reals_out[..k]` with
-    /// OK (where `check_reals` is `Some(k)`), and the importer's view of the new state
-    /// (`new_time`: the time the call set, `restored`: the machine of a restored state).
-    #[allow(clippy::too_many_arguments)]
-    pub fn after(
-        &mut self,
-        moves: &Moves,
-        function: Function,
-        status: i32,
-        check_reals: Option<usize>,
-        reals_out: &[f64],
-        new_time: Option<f64>,
-        restored: Option<Option<Machine>>,
-        co_simulation: bool,
-    ) {
-        if status == OK {
-            if let Some(k) = check_reals {
-                if let Some(bad) = reals_out[..k].iter().find(|x| !x.is_finite()) {
-                    panic!("{function:?} handed out {bad} with {}", moves.ok);
+    /// After `function` made `call`: no non-finite number in `call.reals_out[..k]` with OK
+    /// (where `call.check_reals` is `Some(k)`), and the importer's view of the new state.
+    pub fn after(&mut self, function: Function, call: Call, co_simulation: bool) {
+        let fmi2 = function.generation() == Abi::Fmi2;
+        if call.status == OK {
+            if let Some(k) = call.check_reals {
+                if let Some(bad) = call.reals_out[..k].iter().find(|x| !x.is_finite()) {
+                    panic!("{function:?} handed out {bad} with {}", if fmi2 { "fmi2OK" } else { "fmi3OK" });
                 }
             }
         }
-        if status == ERROR {
+        // an FMI 3.0 function moves the state as its FMI 2.0 counterpart does
+        let as_fmi2 = function.counterpart().unwrap_or(function);
+        if call.status == ERROR {
             self.machine = Some(Machine::Error);
-        } else if status == DISCARD && function == moves.do_step {
-            if moves.discard_fails_the_step {
+        } else if call.status == DISCARD && as_fmi2 == Function::DoStep {
+            // a Discard of the step leaves an FMI 2.0 instance in Step Failed; FMI 3.0 has
+            // no such state: the instance stays in Step Mode at the time the step reached
+            if fmi2 {
                 self.machine = Some(Machine::StepFailed);
             } else {
                 // at the time the step reached (a guess below: a wrong one just gives an error)
                 self.time = f64::NAN;
             }
-        } else if status == OK || status == 1 {
-            if let Some(t) = new_time {
+        } else if call.status == OK || call.status == 1 {
+            if let Some(t) = call.new_time {
                 self.time = t;
             }
-            let after = if function == moves.enter_initialization_mode {
-                Some(Some(Machine::InitializationMode))
-            } else if function == moves.exit_initialization_mode {
-                Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
-            } else if function == moves.terminate {
-                Some(Some(Machine::Terminated))
-            } else if function == moves.reset {
-                self.time = 0.0;
-                Some(Some(Machine::Instantiated))
-            } else if function == moves.enter_event_mode {
-                Some(Some(Machine::EventMode))
-            } else if function == moves.enter_continuous_time_mode {
-                Some(Some(Machine::ContinuousTimeMode))
-            } else if function == moves.set_fmu_state {
-                self.time = f64::NAN; // unknown until the next reset
-                restored
-            } else {
-                None
+            let after = match as_fmi2 {
+                Function::EnterInitializationMode => Some(Some(Machine::InitializationMode)),
+                Function::ExitInitializationMode => {
+                    Some(Some(if co_simulation { Machine::StepComplete } else { Machine::EventMode }))
+                }
+                Function::Terminate => Some(Some(Machine::Terminated)),
+                Function::Reset => {
+                    self.time = 0.0;
+                    Some(Some(Machine::Instantiated))
+                }
+                Function::EnterEventMode => Some(Some(Machine::EventMode)),
+                Function::EnterContinuousTimeMode => Some(Some(Machine::ContinuousTimeMode)),
+                Function::SetFMUstate => {
+                    self.time = f64::NAN; // unknown until the next reset
+                    call.restored
+                }
+                _ => None,
             };
             if let Some(m) = after {
                 self.machine = m;
@@ -312,4 +290,79 @@ pub fn every_fmu_and_interface(
         }
     }
     plant_counts
+}
+
+/// What one call did: its status and what the shadow learns from it.
+pub struct Call {
+    pub status: i32,
+    /// with OK, the first this many of `reals_out` must be finite
+    pub check_reals: Option<usize>,
+    pub reals_out: Vec<f64>,
+    /// the time the call set (with OK or Warning)
+    pub new_time: Option<f64>,
+    /// with OK of the set-state call: the machine the state was saved in (None: unknown)
+    pub restored: Option<Option<Machine>>,
+}
+
+/// One FMI generation's side of the random sequences on one FMU and interface.
+pub trait Generation {
+    /// A live instance with its log, freed on drop.
+    type Live;
+    /// Every function of the generation, which the sequences draw from.
+    const FUNCTIONS: &'static [Function];
+    /// A new instance (the sequence's first call).
+    fn instantiate(&self) -> Self::Live;
+    /// The calls that make progress from `machine` (so that sequences reach the deeper
+    /// states).
+    fn progress(machine: Option<Machine>) -> &'static [Function];
+    /// The functions the sequences leave out (instantiation and freeing).
+    fn left_out(function: Function) -> bool;
+    /// Draws the arguments of `function` and calls it; `None` for a call without status
+    /// (the version and platform strings, checked there).
+    ///
+    /// # Safety
+    /// `live` is a live instance of this generation.
+    unsafe fn call(&self, live: &Self::Live, function: Function, rng: &mut Rng, sh: &mut Shadow) -> Option<Call>;
+    /// A rule of the generation beyond the state table by which `function` must be refused.
+    fn refuses(&self, _function: Function) -> bool {
+        false
+    }
+    /// What the generation checks or does after the shadow has moved.
+    fn after_call(&self, _live: &Self::Live, _function: Function, _status: i32, _rng: &mut Rng, _sh: &mut Shadow) {}
+}
+
+/// `sequences` seeded sequences of 1 to 16 calls of `generation` on fresh instances, each call
+/// checked: a defined status, a call the state table (or the generation's own rule) forbids
+/// refused with Error, no non-finite number with OK. Returns the counts of OK, Warning,
+/// Discard, Error.
+pub fn run<G: Generation>(generation: &G, co_simulation: bool, sequences: usize, seed: u64) -> [usize; 4] {
+    let mut rng = Rng(seed);
+    let mut counts = [0usize; 4];
+    let interface_scope = if co_simulation { Scope::CoSimulation } else { Scope::ModelExchange };
+    for _ in 0..sequences {
+        let live = generation.instantiate();
+        let mut sh = Shadow::instantiated();
+        for _ in 0..1 + rng.below(16) {
+            // 40 %: a call that makes progress from the current state, else any function
+            let function = if rng.chance(40) { rng.pick(G::progress(sh.machine)) } else { rng.pick(G::FUNCTIONS) };
+            if G::left_out(function) {
+                continue;
+            }
+            let Some(call) = (unsafe { generation.call(&live, function, &mut rng, &mut sh) }) else { continue };
+            let status = call.status;
+            assert!((0..=3).contains(&status), "{function:?} returned {status}");
+            counts[status as usize] += 1;
+            // the state table: a call it forbids is an error
+            if let Some(m) = sh.machine {
+                let wrong_interface = function.scope() != Scope::Common && function.scope() != interface_scope;
+                if wrong_interface || generation.refuses(function) || !function.allowed_in(m) {
+                    assert_eq!(status, ERROR, "{function:?} in {m:?} ({})", if co_simulation { "CS" } else { "ME" });
+                }
+            }
+            sh.after(function, call, co_simulation);
+            generation.after_call(&live, function, status, &mut rng, &mut sh);
+        }
+        // the instance is freed with its live FMU states (the allocator would report a double free)
+    }
+    counts
 }
