@@ -35,7 +35,8 @@
  * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
  * the time event at stop_at says terminateSimulation; the discrete inputs k and b cannot be set in
- * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function exists and returns fmi3Error. */
+ * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function
+ * exists and returns fmi3Error (fmi3_rest.c, linked beside it). */
 #include "fmi3_test.h"
 
 #ifndef BIG
@@ -538,47 +539,9 @@ fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 
 }
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
-
-/* The functions this FMU does not implement: each returns fmi3Error. */
-#define UNSUPPORTED(name, ...) fmi3Status name(__VA_ARGS__) { return fmi3Error; }
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String a, fmi3String b, fmi3String c, fmi3Boolean d,
-    fmi3Boolean e, fmi3InstanceEnvironment f, fmi3LogMessageCallback g, fmi3ClockUpdateCallback h,
-    fmi3LockPreemptionCallback i, fmi3UnlockPreemptionCallback j) { return NULL; }
-UNSUPPORTED(fmi3SetDebugLogging, fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[])
-#define GETSET(T) \
-    UNSUPPORTED(fmi3Get##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3##T v[], size_t m) \
-    UNSUPPORTED(fmi3Set##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3##T v[], size_t m)
-UNSUPPORTED(fmi3SetInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int8 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt8 v[], size_t m)
-UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
-UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
-UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
-UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])
-UNSUPPORTED(fmi3GetNumberOfVariableDependencies, fmi3Instance i, fmi3ValueReference vr, size_t *n)
-UNSUPPORTED(fmi3GetVariableDependencies, fmi3Instance i, fmi3ValueReference d, size_t e[], fmi3ValueReference k[], size_t ke[], fmi3DependencyKind dk[], size_t n)
-UNSUPPORTED(fmi3SerializedFMUStateSize, fmi3Instance i, fmi3FMUState s, size_t *n)
-UNSUPPORTED(fmi3SerializeFMUState, fmi3Instance i, fmi3FMUState s, fmi3Byte b[], size_t n)
-UNSUPPORTED(fmi3DeserializeFMUState, fmi3Instance i, const fmi3Byte b[], size_t n, fmi3FMUState *s)
-UNSUPPORTED(fmi3GetDirectionalDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
-UNSUPPORTED(fmi3GetAdjointDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
-UNSUPPORTED(fmi3EnterConfigurationMode, fmi3Instance i)
-UNSUPPORTED(fmi3ExitConfigurationMode, fmi3Instance i)
-UNSUPPORTED(fmi3GetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[], fmi3IntervalQualifier q[])
-UNSUPPORTED(fmi3GetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[], fmi3IntervalQualifier q[])
-UNSUPPORTED(fmi3GetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[])
-UNSUPPORTED(fmi3GetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[])
-UNSUPPORTED(fmi3SetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
-UNSUPPORTED(fmi3SetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
-UNSUPPORTED(fmi3SetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
-UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
-UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Counter *c = instance;
     if (!c->s.event_mode) return fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
     c->s.in_event_mode = 0;
     return fmi3OK;
 }
-UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
-UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)
