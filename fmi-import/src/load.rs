@@ -392,7 +392,7 @@ fn load<G: Generation>(
         return Err(Error::MissingSymbol { path: shown, symbol });
     }
     let (abi, resource_uri, not_in_view) = G::finish(table, described, dir.path(), path)?;
-    let fmu = Fmu {
+    let mut fmu = Fmu {
         abi,
         allow_non_finite: options.allow_non_finite,
         _library: library,
@@ -406,11 +406,25 @@ fn load<G: Generation>(
         library_path: so,
         not_in_view,
         configured_from: None,
+        event_mode: None,
     };
     if let Some(feature) = clocks_not_run(&fmu) {
         return Err(Error::Unsupported { path: path.to_path_buf(), feature });
     }
+    fmu.event_mode = event_mode_of(&fmu, options.event_mode)
+        .map_err(|reason| Error::EventMode { path: path.to_path_buf(), reason })?;
     Ok(Arc::new(fmu))
+}
+
+/// FMI 3.0 Co-Simulation: `eventModeUsed` of `fmu`'s instances under `choice`
+/// ([`crate::event_mode::decide`]); `None` for the other generation and interfaces.
+fn event_mode_of(fmu: &Fmu, choice: crate::EventModeChoice) -> std::result::Result<Option<crate::EventMode>, String> {
+    match fmu.fmi3_description() {
+        Some(md) if fmu.interface == Interface::CoSimulation => {
+            crate::event_mode::decide(md, &fmu.clocks(), choice).map(Some)
+        }
+        _ => Ok(None),
+    }
 }
 
 /// Clocks where the master does not run them: in Co-Simulation without Event Mode.
