@@ -750,9 +750,7 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
 #[test]
 fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let Some((dir, path)) = counter_with_event_mode("fmi3-event-mode") else { return };
-    let mut b = SystemBuilder::new();
-    b.add_instance("c", event_mode_on(&path)).unwrap();
-    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
+    let r = run_with_event_mode(&path, "c");
     let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
     for k in 0..r.rows() {
         // the step count, and 1 from the event at the end of the step to 0.6 s
@@ -769,10 +767,13 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
 
-/// The counter loaded with Event Mode asked for (`cosim run --event-mode on`).
-fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
+/// The counter at `path` loaded with Event Mode asked for (`cosim run --event-mode on`) as
+/// the one instance `name`, run 1 s at 0.1 s.
+fn run_with_event_mode(path: &Path, name: &str) -> nigel_cosim::Results {
     let options = nigel_cosim::ImportOptions { event_mode: nigel_cosim::EventModeChoice::On, ..Default::default() };
-    Fmu::load_with(path, &options).unwrap()
+    let mut b = SystemBuilder::new();
+    b.add_instance(name, Fmu::load_with(path, &options).unwrap()).unwrap();
+    simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap().0
 }
 
 /// An FMU that declares `hasEventMode` but refuses to be instantiated with `eventModeUsed`
@@ -783,9 +784,7 @@ fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
 #[test]
 fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
     let Some((_, path)) = counter_with_event_mode("fmi3-refuses-event-mode") else { return };
-    let mut b = SystemBuilder::new();
-    b.add_instance("c-no-event-mode", event_mode_on(&path)).unwrap();
-    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
+    let r = run_with_event_mode(&path, "c-no-event-mode");
     let n = r.column("c-no-event-mode.n").or_else(|| r.column("n")).expect("the column n");
     assert_eq!(n, (0..11).map(|k| k as f64).collect::<Vec<_>>());
 }

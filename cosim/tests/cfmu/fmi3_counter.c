@@ -105,16 +105,8 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
         if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken");
         return NULL;
     }
-    if (!resources || resources[0] != '/' || resources[strlen(resources) - 1] != '/') {
-        if (log) log(env, fmi3Error, "logStatusError", "resourcePath is not an absolute path ending in /");
-        return NULL;
-    }
-    Counter *c = calloc(1, sizeof(Counter));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
-    defaults(&c->s);
-    return c;
+    FMI3_TEST_NEW(Counter, !resources || resources[0] != '/' || resources[strlen(resources) - 1] != '/',
+        "resourcePath is not an absolute path ending in /", defaults(&c->s))
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
