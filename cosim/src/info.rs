@@ -46,7 +46,12 @@ fn info_ssp(out: &mut String, path: &Path, limits: &UnpackLimits) -> Result<()> 
             Some(inside) => format!("{} in {}", inside.display(), path.display()),
             None => i.fmu.source().display().to_string(),
         };
-        lines.push(format!("instance {:<20} {source} ({})", i.name, i.fmu.interface().as_str()));
+        let event_mode = match i.fmu.event_mode() {
+            Some(e) if e.used => ", Event Mode used",
+            Some(_) => ", no Event Mode",
+            None => "",
+        };
+        lines.push(format!("instance {:<20} {source} ({}{event_mode})", i.name, i.fmu.interface().as_str()));
         for (index, v) in &i.start_values {
             let var = &i.fmu.description().model_variables[*index];
             let unit = var.variable_type.unit().map(|u| format!(" {u}")).unwrap_or_default();
@@ -255,6 +260,22 @@ fn info_clocks(out: &mut String, md: &model_description::fmi3::ModelDescription)
     }
 }
 
+/// `cosim info` of an FMI 3.0 Co-Simulation FMU's Event Mode: whether a run uses it by
+/// default and why, and what `--event-mode on` and `off` would do.
+fn info_event_mode(out: &mut String, md: &model_description::fmi3::ModelDescription) {
+    use crate::EventModeChoice;
+    let clocks = crate::clocks::clocks_of(md);
+    let said = |choice| match crate::event_mode::decide(md, &clocks, choice) {
+        Ok(e) if e.used => format!("used: {}", e.why),
+        Ok(e) => format!("not used: {}", e.why),
+        Err(reason) => format!("refused: {reason}"),
+    };
+    w!(out, "Co-Simulation Event Mode (eventModeUsed): {}", said(EventModeChoice::Auto));
+    for choice in [EventModeChoice::On, EventModeChoice::Off] {
+        w!(out, "  with --event-mode {}: {}", choice.as_str(), said(choice));
+    }
+}
+
 /// `cosim info` of an FMI 3.0 FMU: interface types with their capabilities, and every
 /// variable with its type and dimensions.
 fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
@@ -304,6 +325,9 @@ fn info_fmi3(out: &mut String, md: &model_description::fmi3::ModelDescription) {
         default_experiment: md.default_experiment.as_ref(),
     }
     .write(out);
+    if md.co_simulation.is_some() {
+        info_event_mode(out, md);
+    }
     const WIDTHS: [usize; 8] = [24, 19, 11, 11, 10, 8, 12, 18];
     let heading = ["name", "causality", "variability", "type", "dimensions", "unit", "start", "min .. max"];
     table_row(out, &WIDTHS, &heading, "description");

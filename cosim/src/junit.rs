@@ -90,23 +90,12 @@ impl TestSuite {
     }
 }
 
-/// `text` escaped for XML 1.0 attributes and text: `& < > " '` as entities, the control
-/// characters XML 1.0 does not allow as `?`.
+/// `text` escaped for XML 1.0 attributes and text: `& < > " '` as entities (quick-xml's
+/// `escape`), the control characters XML 1.0 does not allow as `?`.
 pub fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\t' | '\n' | '\r' => out.push(c),
-            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('?'),
-            c => out.push(c),
-        }
-    }
-    out
+    let allowed = |c: char| matches!(c, '\t' | '\n' | '\r') || (c as u32 >= 0x20 && c != '\u{FFFE}' && c != '\u{FFFF}');
+    let text: String = text.chars().map(|c| if allowed(c) { c } else { '?' }).collect();
+    quick_xml::escape::escape(text).into_owned()
 }
 
 /// A one-line message: the first line, at most 500 characters.

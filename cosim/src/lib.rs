@@ -39,7 +39,7 @@ pub mod bdf;
 pub mod check;
 pub mod compare;
 pub(crate) use fmi_import::suggest;
-pub use fmi_import::{clocks, fmi3, instance, load, partitions, structural, unpack};
+pub use fmi_import::{clocks, event_mode, fmi3, instance, load, partitions, structural, unpack};
 /// An imported FMU and its instances (`fmi_import`'s [`fmi_import::fmu`], [`instance`] and
 /// [`load`] in one place, as the master uses them).
 pub mod fmu {
@@ -80,6 +80,7 @@ pub mod isolate {
 
 pub use error::{Error, HostEnd, ImportError, Result, Status};
 pub use exit_guard::{on_exit_inside_call, ExitInsideCall};
+pub use fmi_import::{EventMode, EventModeChoice};
 pub use fmu::{Fmu, ImportOptions, Instance, InstanceState, Interface};
 pub use isolate::Isolation;
 pub use me::{Event, Solver};

@@ -33,6 +33,22 @@ impl RunSetup {
     /// Loads `model`: an `.ssp` or `.ssd` (`options.interface` applies to each of its FMUs),
     /// else an FMU as the one instance [`SINGLE`].
     pub fn load(model: &Path, options: &ImportOptions) -> Result<RunSetup> {
+        let mut setup = RunSetup::load_model(model, options)?;
+        // an Event Mode choice that applies to none of the model's FMUs is said, not dropped
+        let instances = &setup.system().instances;
+        if options.event_mode != crate::EventModeChoice::Auto && instances.iter().all(|i| i.fmu.event_mode().is_none())
+        {
+            setup.notes.push(format!(
+                "event mode {} does not apply: it chooses eventModeUsed of FMI 3.0 Co-Simulation FMUs, and the model \
+                 has none (FMI 2.0 Co-Simulation has no Event Mode; Model Exchange always has it)",
+                options.event_mode.as_str()
+            ));
+        }
+        Ok(setup)
+    }
+
+    /// [`RunSetup::load`] without its note.
+    fn load_model(model: &Path, options: &ImportOptions) -> Result<RunSetup> {
         if crate::info::is_ssp(model) {
             let ssp = crate::read_ssp(model, options)?;
             let (start_time, stop_time) = ssp.default_start_stop;

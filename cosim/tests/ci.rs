@@ -20,16 +20,8 @@ fn cosim() -> &'static str {
     env!("CARGO_BIN_EXE_cosim")
 }
 
-fn target() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"))
-}
-
 fn closed_loop() -> PathBuf {
-    let ssp = target().join("ssp").join("nigel_closed_loop.ssp");
-    assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
-    ssp
+    common::built_ssp("nigel_closed_loop.ssp")
 }
 
 fn baseline() -> PathBuf {
@@ -37,7 +29,7 @@ fn baseline() -> PathBuf {
 }
 
 fn work(name: &str) -> PathBuf {
-    let d = target().join("test-ci").join(name);
+    let d = common::target_dir().join("test-ci").join(name);
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d

@@ -10,25 +10,12 @@
 
 mod common;
 use nigel_cosim::{read_ssp, simulate, Algorithm, Experiment, Results};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
-
-/// The target folder (the FMUs and SSPs the test command builds).
-fn target() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"))
-}
 
 /// The clocked closed loop's SSP, built by the test command.
 fn clocked_ssp() -> PathBuf {
-    let p = target().join("ssp").join("nigel_closed_loop_fmi3.ssp");
-    assert!(
-        p.is_file(),
-        "{} missing: run `cargo run --release -p build-fmu -- --platforms linux64 --this-glibc`",
-        p.display()
-    );
-    p
+    common::built_ssp("nigel_closed_loop_fmi3.ssp")
 }
 
 /// `b` equals `a` in every bit: the same columns and rows, no value that differs.
@@ -131,7 +118,7 @@ fn the_clocked_controller_in_model_exchange_samples_once_per_tick_as_in_co_simul
         text += &format!("{t:?},{:?},{:?},{:?},{:?}\n", 0.02 * s, 0.3 * (30.0 * t).cos(), 0.2 + 5.0 * t, 0.1 * s);
     }
     std::fs::write(&input, text).unwrap();
-    let fmu = target().join("fmu").join("fmi3").join("nigel_controller.fmu");
+    let fmu = common::target_dir().join("fmu").join("fmi3").join("nigel_controller.fmu");
     let run = |interface: &str| -> (Vec<Vec<f64>>, String) {
         let (csv, summary) = (dir.join(format!("{interface}.csv")), dir.join(format!("{interface}.json")));
         let args = ["--interface", interface, "--stop-time", "0.02", "--step", "5e-4"];

@@ -472,7 +472,7 @@ fn every_type_and_array_elements_are_recorded() {
 /// byte for byte, under `jacobi` and `ordered`: plain steps (every type of the view read
 /// through the typed getters), an early return (`early_at`: `earlyReturn` and
 /// `lastSuccessfulTime` through the host), `terminateSimulation` (`stop_at`), Event Mode
-/// (`hasEventMode`: `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`), and Model Exchange
+/// (`hasEventMode`, `--event-mode on`: `fmi3UpdateDiscreteStates`, `fmi3EnterStepMode`), and Model Exchange
 /// (the master's solver through the host: states, derivatives, event indicators; with
 /// `mode=2` the state event near 0.275 s and the time event at 0.75 s, with `stop_at` the
 /// termination at the time event). A set the FMU refuses (`mode=3`), queued in the host
@@ -489,7 +489,8 @@ fn isolation_of_fmi3_fmus() {
         (&path, &[]),
         (&path, &["--set", "early_at=0.35"]),
         (&path, &["--set", "stop_at=0.45"]),
-        (&event_mode, &[]),
+        // without clocks Event Mode is used when asked for (tests/event_mode.rs)
+        (&event_mode, &["--event-mode", "on"]),
         (&path, &["--interface", "me", "--set", "mode=2"]),
         (&path, &["--interface", "me", "--set", "stop_at=0.62"]),
     ];
@@ -738,8 +739,9 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
     assert!(e.to_string().contains("fmi3EnterConfigurationMode"), "{e}");
 }
 
-/// Co-Simulation event mode: an FMU with `hasEventMode` is instantiated with `eventModeUsed`;
-/// the step in which the counter's y reaches 0.55 (u = 1: the step to 0.6 s) says
+/// Co-Simulation event mode: an FMU with `hasEventMode` asked to use it (`--event-mode on`;
+/// without clocks the default is no Event Mode, tests/event_mode.rs) is instantiated with
+/// `eventModeUsed`; the step in which the counter's y reaches 0.55 (u = 1: the step to 0.6 s) says
 /// `eventHandlingNeeded`, the master runs Event Mode (`fmi3UpdateDiscreteStates` adds 1 to
 /// n) and returns to Step Mode. fmpy 0.3.32 with `use_event_mode=True` does the same; it
 /// records the event's instant twice (before and after), the master once, after: the
@@ -748,7 +750,9 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
 #[test]
 fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let Some((dir, path)) = counter_with_event_mode("fmi3-event-mode") else { return };
-    let (r, _) = simulate(&with_starts(&path, &[]), &Experiment::new(1.0, 0.1)).unwrap();
+    let mut b = SystemBuilder::new();
+    b.add_instance("c", event_mode_on(&path)).unwrap();
+    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
     let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
     for k in 0..r.rows() {
         // the step count, and 1 from the event at the end of the step to 0.6 s
@@ -765,16 +769,22 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
 
+/// The counter loaded with Event Mode asked for (`cosim run --event-mode on`).
+fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
+    let options = nigel_cosim::ImportOptions { event_mode: nigel_cosim::EventModeChoice::On, ..Default::default() };
+    Fmu::load_with(path, &options).unwrap()
+}
+
 /// An FMU that declares `hasEventMode` but refuses to be instantiated with `eventModeUsed`
 /// (as the Reference FMUs' Roberts does; the counter refuses it for an instance named
-/// "...no-event-mode...") gets a second try without it and runs as an FMU without Event
-/// Mode: no event is handled, n counts the steps only (the same run as the counter's
-/// description without `hasEventMode`).
+/// "...no-event-mode...") gets, when Event Mode is asked for, a second try without it and
+/// runs as an FMU without Event Mode: no event is handled, n counts the steps only (the
+/// same run as the counter's description without `hasEventMode`).
 #[test]
 fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
     let Some((_, path)) = counter_with_event_mode("fmi3-refuses-event-mode") else { return };
     let mut b = SystemBuilder::new();
-    b.add_instance("c-no-event-mode", Fmu::load(&path).unwrap()).unwrap();
+    b.add_instance("c-no-event-mode", event_mode_on(&path)).unwrap();
     let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
     let n = r.column("c-no-event-mode.n").or_else(|| r.column("n")).expect("the column n");
     assert_eq!(n, (0..11).map(|k| k as f64).collect::<Vec<_>>());

@@ -14,27 +14,7 @@ use std::process::Command;
 use std::sync::Arc;
 
 /// The description of tests/cfmu/fmi3_partitions.c.
-fn xml() -> String {
-    common::fmi3_c::scheduled_description(
-        "partitions",
-        "fmi3_partitions",
-        r#"<Clock name="fast" valueReference="1" causality="input" intervalVariability="constant" intervalDecimal="0.25" priority="1"/>
-    <Clock name="slow" valueReference="2" causality="input" intervalVariability="constant" intervalDecimal="1" shiftDecimal="0.5" priority="0"/>
-    <Clock name="later" valueReference="3" causality="input" intervalVariability="countdown" priority="2" clocks="2"/>
-    <Clock name="out" valueReference="4" causality="output" intervalVariability="triggered" clocks="1"/>
-    <Clock name="kick" valueReference="5" causality="input" intervalVariability="triggered" priority="3"/>
-    <Float64 name="u" valueReference="10" causality="input" variability="discrete" start="1"/>
-    <Float64 name="x" valueReference="11" causality="output" variability="discrete" clocks="1"/>
-    <Float64 name="t_later" valueReference="12" causality="output" variability="discrete" clocks="3"/>
-    <Int32 name="n_fast" valueReference="20" causality="output" clocks="1"/>
-    <Int32 name="n_slow" valueReference="21" causality="output" clocks="2"/>
-    <Int32 name="n_later" valueReference="22" causality="output" clocks="3"/>
-    <Int32 name="n_kick" valueReference="23" causality="output" clocks="5"/>
-    <Int32 name="first" valueReference="24" causality="output"/>
-"#,
-        &[4, 11, 12, 20, 21, 22, 23, 24],
-    )
-}
+const XML: &str = include_str!("cfmu/fmi3_partitions.xml");
 
 /// The run to 2 s with `kick` at 0.25 and 1 s and u = 2 from 1 s (an input file).
 fn run(fmu: &Path) -> nigel_cosim::Results {
@@ -72,7 +52,7 @@ fn run(fmu: &Path) -> nigel_cosim::Results {
 #[test]
 fn partitions_tick_in_priority_order_with_countdown_triggered_and_output_clocks() {
     let dir = work_dir("fmi3-scheduled");
-    let Some(fmu) = common::fmi3_c::build(&dir, "fmi3_partitions", &xml()) else { return };
+    let Some(fmu) = common::fmi3_c::build(&dir, "fmi3_partitions", XML) else { return };
     let r = run(&fmu);
     let col = |n: &str| r.column(n).unwrap_or_else(|| panic!("column {n}"));
     assert_eq!(col("time"), [0.0, 0.25, 0.5, 0.625, 0.75, 1.0, 1.25, 1.5, 1.625, 1.75, 2.0]);

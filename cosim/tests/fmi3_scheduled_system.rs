@@ -14,30 +14,12 @@ use nigel_cosim::system::Value;
 use nigel_cosim::{Experiment, Fmu, ImportOptions, Interface, SystemBuilder};
 use std::path::{Path, PathBuf};
 
-/// The description, `sample` at priority `sample_priority`. The description's interval of
-/// the fixed clock `sample` is 1 s; the FMU gives its parameter `period` instead.
+/// The description (tests/cfmu/fmi3_se_node.xml), `sample` at priority `sample_priority`
+/// (the file's is 1). The description's interval of the fixed clock `sample` is 1 s; the FMU
+/// gives its parameter `period` instead.
 fn xml(sample_priority: u32) -> String {
-    common::fmi3_c::scheduled_description(
-        "se_node",
-        "fmi3_se_node",
-        &format!(
-            r#"<Clock name="sample" valueReference="1" causality="input" intervalVariability="fixed" intervalDecimal="1" priority="{sample_priority}"/>
-    <Clock name="trigger" valueReference="2" causality="input" intervalVariability="triggered" priority="2"/>
-    <Clock name="done" valueReference="3" causality="output" intervalVariability="triggered" clocks="1"/>
-    <Clock name="rate" valueReference="4" causality="input" intervalVariability="tunable" intervalDecimal="0.5" priority="3"/>
-    <Float64 name="period" valueReference="10" causality="parameter" variability="fixed" start="0.5"/>
-    <Float64 name="u" valueReference="11" causality="input" variability="discrete" start="0" clocks="2"/>
-    <Float64 name="v" valueReference="12" causality="input" variability="discrete" start="0"/>
-    <Float64 name="y" valueReference="13" causality="output" variability="discrete" clocks="1"/>
-    <Float64 name="z" valueReference="14" causality="output" variability="discrete" clocks="2"/>
-    <Float64 name="w" valueReference="15" causality="output" variability="discrete" clocks="1"/>
-    <Int32 name="n_sample" valueReference="20" causality="output" variability="discrete"/>
-    <Int32 name="n_trigger" valueReference="21" causality="output" variability="discrete"/>
-    <Int32 name="n_rate" valueReference="22" causality="output" variability="discrete"/>
-"#
-        ),
-        &[3, 13, 14, 15, 20, 21, 22],
-    )
+    let at = |priority: u32| format!(r#"intervalDecimal="1" priority="{priority}""#);
+    include_str!("cfmu/fmi3_se_node.xml").replace(&at(1), &at(sample_priority))
 }
 
 /// The two FMUs: A's `sample` at priority 1, B's at priority 0; `None` (skip) without fmpy's

@@ -84,11 +84,7 @@ fn a_good_run_in_its_host_writes_what_the_run_in_process_writes() {
     assert_eq!(jb["steps"], ja["steps"]);
     assert_eq!(jb["warnings"], ja["warnings"]);
     // the closed loop (three Rust FMUs, ordered), 1 s at 1 ms, every output: bit for bit
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
-    let ssp = target.join("ssp").join("nigel_closed_loop.ssp");
-    assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
+    let ssp = common::built_ssp("nigel_closed_loop.ssp");
     let args = ["--stop-time", "1", "--step", "1e-3", "--algorithm", "ordered"];
     let (code, stderr, in_process) = run(&ssp, &args, &a, &tmp);
     assert_eq!(code, Some(0), "{stderr}");

@@ -182,7 +182,7 @@ fn per_instance_isolation_in_the_library_gives_the_typed_error_and_the_rows() {
 
 #[test]
 fn the_isolated_closed_loop_is_bit_identical_to_in_process() {
-    let ssp = plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
+    let ssp = common::built_ssp("nigel_closed_loop.ssp");
     let system = read_ssp(&ssp, &Default::default()).unwrap().system;
     // every output recorded every step; and two recorded every 6th step, so that the
     // Reals read after a step alternate between two patterns (the host's prefetch

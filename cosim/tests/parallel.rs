@@ -69,7 +69,7 @@ fn threads_give_the_serial_numbers_bit_for_bit_and_the_derived_values() {
 
 #[test]
 fn the_closed_loop_in_two_threads_equals_one_thread() {
-    let ssp = common::plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
+    let ssp = common::built_ssp("nigel_closed_loop.ssp");
     assert!(ssp.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", ssp.display());
     let system = nigel_cosim::read_ssp(&ssp, &Default::default()).unwrap().system;
     let (serial, _) = run_threads(&system, 1, 1.0, 1e-3);

@@ -10,7 +10,7 @@ use nigel_cosim::{
 
 #[test]
 fn reset_instances_and_streamed_rows_equal_fresh_runs() {
-    let ssp = common::plant_fmu().parent().unwrap().parent().unwrap().join("ssp").join("nigel_closed_loop.ssp");
+    let ssp = common::built_ssp("nigel_closed_loop.ssp");
     let base = read_ssp(&ssp, &ImportOptions::default()).unwrap().system;
     let with = |sets: &[(&str, Value)]| {
         let mut b = SystemBuilder::from_system(base.clone());

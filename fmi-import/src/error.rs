@@ -71,6 +71,14 @@ pub enum Error {
         /// The feature, in words.
         feature: String,
     },
+    /// The Event Mode asked for ([`crate::EventModeChoice`]) is not the FMU's to give: `on`
+    /// without `hasEventMode`, `off` with clocks.
+    EventMode {
+        /// The FMU.
+        path: PathBuf,
+        /// Why, in words (naming the clocks for `off`).
+        reason: String,
+    },
     /// `binaries/linux64/<modelIdentifier>.so` is not in the FMU.
     MissingBinary {
         /// The path expected inside the FMU.
@@ -292,6 +300,7 @@ impl fmt::Display for Error {
             Error::Unsupported { path, feature } => {
                 write!(f, "{}: uses {feature}, which cosim does not support", path.display())
             }
+            Error::EventMode { path, reason } => write!(f, "{}: {reason}", path.display()),
             Error::MissingBinary { expected, platforms } => write!(
                 f,
                 "the FMU has no {expected}; platforms it has: {}",

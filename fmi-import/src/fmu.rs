@@ -81,6 +81,9 @@ pub struct ImportOptions {
     /// ([`Instance::new_isolated`], `Experiment::isolation`), so that not even its
     /// load-time initializers run here.
     pub isolated: bool,
+    /// FMI 3.0 Co-Simulation: whether instances use Event Mode (`eventModeUsed`); by
+    /// default where the FMU needs it (its clocks). See [`crate::event_mode`].
+    pub event_mode: crate::EventModeChoice,
 }
 
 /// An imported FMU: its unpacked folder (removed on drop), model description and library.
@@ -107,6 +110,9 @@ pub struct Fmu {
     /// FMI 3.0 with structural parameters set ([`Fmu::configured`]): the FMU as loaded,
     /// which holds the unpacked folder.
     pub(crate) configured_from: Option<Arc<Fmu>>,
+    /// FMI 3.0 Co-Simulation: `eventModeUsed` of its instances and why (`None` for FMI 2.0,
+    /// Model Exchange and Scheduled Execution, which have no such choice).
+    pub(crate) event_mode: Option<crate::EventMode>,
 }
 
 impl std::fmt::Debug for Fmu {
@@ -163,6 +169,14 @@ impl Fmu {
         self.fmi3_description().map(crate::clocks::clocks_of).unwrap_or_default()
     }
 
+    /// FMI 3.0 Co-Simulation: whether its instances are instantiated with `eventModeUsed`,
+    /// and why (`None` where there is no such choice: FMI 2.0, Model Exchange, Scheduled
+    /// Execution). An instance of an FMU that refuses `eventModeUsed = true` although it
+    /// declares `hasEventMode` runs without it (a second try, logged as a warning).
+    pub fn event_mode(&self) -> Option<&crate::EventMode> {
+        self.event_mode.as_ref()
+    }
+
     /// The same FMU with its instances in host processes: a function table that carries
     /// every call to the instance's host (see `isolate`).
     pub fn isolated(self: &Arc<Fmu>) -> Arc<Fmu> {
@@ -195,6 +209,7 @@ impl Fmu {
             library_path: self.library_path.clone(),
             not_in_view: self.not_in_view.clone(),
             configured_from: None,
+            event_mode: self.event_mode.clone(),
         })
     }
 

@@ -22,6 +22,7 @@
 //!
 //! ```text
 //! status, c_types, elf, suggest, call_site, clocks   leaves
+//! event_mode   -> clocks                           eventModeUsed: the user's choice, the decision
 //! platform     -> elf                              this build's binaries folders
 //! fmi3         -> clocks, c_types                  the FMI 3.0 view (clocks: of every generation)
 //! error        -> status
@@ -33,8 +34,8 @@
 //! isolate/channel -> os, protocol, error, log, status  the master's end of a host
 //! isolate/proxy, proxy3 -> channel, protocol, c_types   tables that call a host
 //! isolate/host -> os, protocol, channel, proxy3, c_types, library, log, error
-//! fmu          -> c_types, fmi3, isolate/proxy*, unpack, error    Fmu and its table
-//! load         -> fmu, fmi3, library, platform, unpack, isolate/proxy*  the one pipeline
+//! fmu          -> c_types, fmi3, event_mode, isolate/proxy*, unpack, error    Fmu and its table
+//! load         -> fmu, fmi3, event_mode, library, platform, unpack, isolate/proxy*  the one pipeline
 //! structural   -> fmu, fmi3, error                  structural parameters, Fmu::configured
 //! partitions                                       model partitions (Scheduled Execution)
 //! instance/core -> fmu, log, c_types, error, status, call_site, isolate/channel
@@ -56,6 +57,7 @@ pub mod call_site;
 pub mod clocks;
 pub mod elf;
 pub mod error;
+pub mod event_mode;
 pub mod fmi3;
 pub mod fmu;
 pub mod instance;
@@ -75,6 +77,7 @@ pub mod unpack;
 pub use c_types::EventInfo;
 pub use call_site::ExitInsideCall;
 pub use error::{Error, HostEnd, Result};
+pub use event_mode::{EventMode, EventModeChoice};
 pub use fmu::{Fmu, ImportOptions, Interface};
 pub use instance::{FmuState, Instance, InstanceState, Interval, OutputTick};
 pub use isolate::Isolation;

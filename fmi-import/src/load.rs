@@ -9,6 +9,7 @@ use std::ffi::CString;
 use std::path::Path;
 use std::sync::Arc;
 
+use fmi_sys::FunctionTable;
 use model_description::ModelDescription;
 
 use crate::c_types::{Fmi3Functions, Functions};
@@ -23,7 +24,7 @@ type Loaded = (Abi, CString, Vec<(String, crate::fmi3::LeftOut)>);
 /// What loading an FMU differs in between the generations.
 trait Generation {
     /// The library's function table.
-    type Table;
+    type Table: fmi_sys::FunctionTable;
     /// The model description as read, beyond the view every FMU has.
     type Described;
     /// The platform folder under `binaries/` (the standard's name for 64-bit Linux).
@@ -41,8 +42,6 @@ trait Generation {
     unsafe fn resolve(library: &libloading::Library, shown: &Path) -> Result<Self::Table>;
     /// The table of an FMU imported isolated: every call goes to the instance's host.
     fn proxy(present: &dyn Fn(&str) -> bool) -> Self::Table;
-    /// Whether the table has `symbol`.
-    fn has(table: &Self::Table, symbol: &str) -> bool;
     /// The functions `interface` needs beyond the core ones.
     fn needs(interface: Interface) -> &'static [&'static str];
     /// The model identifier of Scheduled Execution (FMI 3.0 only).
@@ -112,10 +111,6 @@ impl Generation for Fmi2 {
         crate::isolate::proxy::table(present)
     }
 
-    fn has(table: &Functions, symbol: &str) -> bool {
-        table.has(symbol)
-    }
-
     fn needs(interface: Interface) -> &'static [&'static str] {
         match interface {
             Interface::CoSimulation => &["fmi2DoStep"],
@@ -182,10 +177,6 @@ impl Generation for Fmi3 {
 
     fn proxy(present: &dyn Fn(&str) -> bool) -> Fmi3Functions {
         crate::isolate::proxy3::table(present)
-    }
-
-    fn has(table: &Fmi3Functions, symbol: &str) -> bool {
-        table.has(symbol)
     }
 
     fn needs(interface: Interface) -> &'static [&'static str] {
@@ -397,11 +388,11 @@ fn load<G: Generation>(
         (Some(library), table)
     };
     let checked = library.is_some() || G::NEEDS_CHECKED_ISOLATED;
-    if let Some(symbol) = G::needs(interface).iter().find(|s| checked && !G::has(&table, s)) {
+    if let Some(symbol) = G::needs(interface).iter().find(|s| checked && !table.has(s)) {
         return Err(Error::MissingSymbol { path: shown, symbol });
     }
     let (abi, resource_uri, not_in_view) = G::finish(table, described, dir.path(), path)?;
-    let fmu = Fmu {
+    let mut fmu = Fmu {
         abi,
         allow_non_finite: options.allow_non_finite,
         _library: library,
@@ -415,11 +406,25 @@ fn load<G: Generation>(
         library_path: so,
         not_in_view,
         configured_from: None,
+        event_mode: None,
     };
     if let Some(feature) = clocks_not_run(&fmu) {
         return Err(Error::Unsupported { path: path.to_path_buf(), feature });
     }
+    fmu.event_mode = event_mode_of(&fmu, options.event_mode)
+        .map_err(|reason| Error::EventMode { path: path.to_path_buf(), reason })?;
     Ok(Arc::new(fmu))
+}
+
+/// FMI 3.0 Co-Simulation: `eventModeUsed` of `fmu`'s instances under `choice`
+/// ([`crate::event_mode::decide`]); `None` for the other generation and interfaces.
+fn event_mode_of(fmu: &Fmu, choice: crate::EventModeChoice) -> std::result::Result<Option<crate::EventMode>, String> {
+    match fmu.fmi3_description() {
+        Some(md) if fmu.interface == Interface::CoSimulation => {
+            crate::event_mode::decide(md, &fmu.clocks(), choice).map(Some)
+        }
+        _ => Ok(None),
+    }
 }
 
 /// Clocks where the master does not run them: in Co-Simulation without Event Mode.

@@ -129,8 +129,22 @@ fn text(p: fmi3String) -> String {
     unsafe { CStr::from_ptr(p as *const c_char) }.to_string_lossy().into_owned()
 }
 
-/// `fmi3LogMessageCallback`: the instance environment is the instance's [`LogSink`].
-pub(crate) unsafe extern "C" fn log_message(
+/// What an FMI 3.0 instance environment gives the log callback: the instance's log sink.
+pub(crate) trait Fmi3LogEnvironment {
+    /// The sink, null when there is none (yet).
+    fn sink(&self) -> *const LogSink;
+}
+
+/// The environment of an instance that is only its log.
+impl Fmi3LogEnvironment for LogSink {
+    fn sink(&self) -> *const LogSink {
+        self
+    }
+}
+
+/// `fmi3LogMessageCallback` of an instance whose environment is an `E` (the instance's own,
+/// alive while the FMU lives): the message to its [`LogSink`].
+pub(crate) unsafe extern "C" fn log_message<E: Fmi3LogEnvironment>(
     environment: fmi3InstanceEnvironment,
     status: fmi3Status,
     category: fmi3String,
@@ -141,8 +155,9 @@ pub(crate) unsafe extern "C" fn log_message(
     }
     // no panic may cross the C boundary: a failure to record drops the message
     let _ = std::panic::catch_unwind(|| {
-        // SAFETY: the environment is the instance's boxed LogSink, alive while it logs.
-        let sink = unsafe { &*(environment as *const LogSink) };
+        // SAFETY: the environment is the instance's boxed E, alive while it logs; the sink it
+        // gives outlives the FMU.
+        let Some(sink) = (unsafe { (*(environment as *const E)).sink().as_ref() }) else { return };
         sink.push(LogRecord { status: Status::from_raw(status), category: text(category), message: text(message) });
     });
 }

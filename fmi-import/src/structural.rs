@@ -176,6 +176,7 @@ impl Fmu {
             library_path: self.library_path.clone(),
             not_in_view,
             configured_from: Some(root),
+            event_mode: self.event_mode.clone(),
         })
     }
 

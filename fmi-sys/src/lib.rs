@@ -15,5 +15,7 @@
 
 mod table;
 
+pub use table::FunctionTable;
+
 pub mod fmi2;
 pub mod fmi3;

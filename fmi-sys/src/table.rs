@@ -1,7 +1,8 @@
 //! What both generations' function tables share: the macro that makes, from one list of
 //! rows (field, C type name, symbol, part of the standard, signature), the C function
 //! types, the table of function pointers, the list of symbols with their parts, the
-//! loader and the lookup by name; the error of a missing required symbol; and the macro
+//! loader and the lookup by name (also as [`FunctionTable`]); the error of a missing
+//! required symbol; and the macro
 //! of a C status enum with its classifier of raw values.
 
 /// A symbol the loader required and the library does not export.
@@ -15,6 +16,14 @@ impl std::fmt::Display for MissingSymbol {
 }
 
 impl std::error::Error for MissingSymbol {}
+
+/// What both generations' function tables answer alike (for code generic over the
+/// generation).
+pub trait FunctionTable {
+    /// Whether the library exports `symbol`; false for a name that is not a function of
+    /// the table's generation.
+    fn has(&self, symbol: &str) -> bool;
+}
 
 /// One generation's function table: `core` rows are plain function pointers the loader
 /// requires, `optional` rows are `Option`s (`None`: the library does not export it).
@@ -76,6 +85,12 @@ macro_rules! function_table {
                     $($on => self.$of.is_some(),)*
                     _ => false,
                 }
+            }
+        }
+
+        impl crate::table::FunctionTable for $table {
+            fn has(&self, symbol: &str) -> bool {
+                $table::has(self, symbol)
             }
         }
 

@@ -218,12 +218,7 @@ fn build_declaration() -> DeclarationSpec<Field<Controller>> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        default_experiment: Some(DefaultExperiment {
-            start_time: Some(0.0),
-            stop_time: Some(30.0),
-            tolerance: None,
-            step_size: Some(1e-3),
-        }),
+        default_experiment: Some(DefaultExperiment::fixed_step(30.0, 1e-3)),
         variables: v.into_vec(),
         clocks: sample_clock(held_outputs),
         ..Default::default()

@@ -187,12 +187,7 @@ fn build_declaration() -> DeclarationSpec<Field<TestBench>> {
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: true, co_simulation: true },
         capabilities: Capabilities { fmu_state: true, serialize_fmu_state: true, directional_derivatives: false },
-        default_experiment: Some(DefaultExperiment {
-            start_time: Some(0.0),
-            stop_time: Some(30.0),
-            tolerance: None,
-            step_size: Some(SAMPLE_PERIOD),
-        }),
+        default_experiment: Some(DefaultExperiment::fixed_step(30.0, SAMPLE_PERIOD)),
         variables: v.into_vec(),
         ..Default::default()
     }

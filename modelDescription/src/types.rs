@@ -241,6 +241,19 @@ pub struct DefaultExperiment {
     pub step_size: Option<f64>,
 }
 
+impl DefaultExperiment {
+    /// From 0 to `stop_time` s in communication steps of `step_size` s, no tolerance: the
+    /// default run of a sampled model, its step the sample period.
+    pub fn fixed_step(stop_time: f64, step_size: f64) -> Self {
+        DefaultExperiment {
+            start_time: Some(0.0),
+            stop_time: Some(stop_time),
+            tolerance: None,
+            step_size: Some(step_size),
+        }
+    }
+}
+
 /// `<CoSimulation>` capability flags.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct CoSimulation {
@@ -329,7 +342,8 @@ pub struct ModelStructure {
 }
 
 /// The whole `<fmiModelDescription>`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// (`Default`: no attribute, no element; a base for `..Default::default()`.)
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct ModelDescription {
     /// Always "2.0" for what we write; checked on read.
     pub fmi_version: String,

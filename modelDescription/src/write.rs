@@ -27,25 +27,21 @@ pub fn format_f64(x: f64) -> String {
     }
 }
 
-/// Escapes an attribute value: the five XML specials plus TAB/LF/CR and the other
-/// C0 controls as character references, so that no XML parser normalizes them away.
+/// Escapes an attribute value: the five XML specials as entities (quick-xml's `escape`),
+/// TAB/LF/CR and the other C0 controls as character references, so that no XML parser normalizes them away.
 /// (U+0000 cannot be represented in XML at all: it is written as `&#0;`, which readers,
 /// ours included, refuse.)
 pub(crate) fn escape_attr(s: &str) -> Cow<'_, str> {
-    let needs = s.chars().any(|c| matches!(c, '&' | '<' | '>' | '"' | '\'') || (c as u32) < 0x20);
-    if !needs {
-        return Cow::Borrowed(s);
+    let escaped = quick_xml::escape::escape(s);
+    if !escaped.chars().any(|c| (c as u32) < 0x20) {
+        return escaped;
     }
-    let mut out = String::with_capacity(s.len() + 16);
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("&#{};", c as u32)),
-            c => out.push(c),
+    let mut out = String::with_capacity(escaped.len() + 16);
+    for c in escaped.chars() {
+        if (c as u32) < 0x20 {
+            out.push_str(&format!("&#{};", c as u32));
+        } else {
+            out.push(c);
         }
     }
     Cow::Owned(out)

@@ -183,8 +183,9 @@ class System:
                 result = system.simulate(stop_time=30.0, step_size=1e-3, start_values={"plant.m": m})
     """
 
-    def __init__(self, filename: str | os.PathLike, fmi_type: str | None = None):
-        self._native = _native.NativeSystem(os.fspath(filename), fmi_type)
+    def __init__(self, filename: str | os.PathLike, fmi_type: str | None = None,
+                 use_event_mode: bool | None = None):
+        self._native = _native.NativeSystem(os.fspath(filename), fmi_type, use_event_mode)
         self._filename = os.fspath(filename)
         self._start_values: dict[str, Any] = {}
         self._run: _native.NativeRun | None = None
@@ -403,6 +404,7 @@ def simulate_fmu(
     debug_logging: bool = False,
     fmi_call_logger: Any = None,
     step_finished: Any = None,
+    use_event_mode: bool | None = None,
     **fmpy_keywords: Any,
 ) -> np.ndarray:
     """Simulates an FMU as ``fmpy.simulate_fmu`` does and returns its structured array.
@@ -426,11 +428,17 @@ def simulate_fmu(
     ``validate=False``, ``debug_logging=True``, ``step_finished`` and ``fmi_call_logger`` are
     refused with an :class:`Error` that says what to use instead. An ``.ssp`` is refused:
     use :func:`simulate_ssp`.
+
+    ``use_event_mode`` (fmpy's name) chooses FMI 3.0 Co-Simulation Event Mode
+    (``eventModeUsed``): ``None`` (default) only for an FMU with clocks, which needs it (an
+    FMU without clocks handles its events inside its step, as fmpy's default
+    ``use_event_mode=False`` runs it); ``True`` for every such FMU (one without
+    ``hasEventMode`` is refused); ``False`` never (an FMU with clocks is refused, naming them).
     """
     if Path(os.fspath(filename)).suffix.lower() in (".ssp", ".ssd"):
         raise LoadError(f"{os.fspath(filename)}: an SSP system, not an FMU: use nigel_cosim.simulate_ssp "
                         "(or nigel_cosim.System for many runs)")
-    with System(filename, fmi_type) as system:
+    with System(filename, fmi_type, use_event_mode) as system:
         interface = fmi_type or system.interfaces[0]
         _fmpy_keywords(interface, validate, debug_logging, record_events, apply_default_start_values, step_finished,
                        fmi_call_logger, fmpy_keywords)
@@ -458,12 +466,14 @@ def simulate_ssp(
     input: np.ndarray | None = None,
     output: Iterable[str] | None = None,
     timeout: float | None = None,
+    use_event_mode: bool | None = None,
 ) -> np.ndarray:
     """Simulates an SSP system as ``cosim run`` does (its parameter bindings, parameter
     mappings and system connector values applied; the SSD's DefaultExperiment start and
     stop time where none is given); fields are named ``instance.variable``; the same
-    numbers as the command line. What reading the SSP noted is warned (``UserWarning``)."""
-    with System(filename) as system:
+    numbers as the command line. What reading the SSP noted is warned (``UserWarning``).
+    ``use_event_mode`` applies to each FMU as :func:`simulate_fmu`'s does."""
+    with System(filename, use_event_mode=use_event_mode) as system:
         import warnings
 
         for note in system.notes:

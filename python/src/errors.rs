@@ -49,7 +49,8 @@ pub(crate) fn to_py(e: CosimError) -> PyErr {
             | I::NoInterface { .. }
             | I::MissingBinary { .. }
             | I::LoadLibrary { .. }
-            | I::MissingSymbol { .. },
+            | I::MissingSymbol { .. }
+            | I::EventMode { .. },
         )
         | E::Ssp { .. } => LoadError::new_err(message),
         E::UnknownVariable { .. }

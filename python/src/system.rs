@@ -97,10 +97,17 @@ pub(crate) fn column_type(system: &System, r: &VariableRef) -> &'static str {
 
 #[pymethods]
 impl NativeSystem {
-    /// Loads an `.fmu` (as one instance named `model`) or an `.ssp`/`.ssd`.
+    /// Loads an `.fmu` (as one instance named `model`) or an `.ssp`/`.ssd`;
+    /// `use_event_mode` (fmpy's name): FMI 3.0 Co-Simulation Event Mode, `None` where an
+    /// FMU needs it (its clocks), else always (`True`) or never (`False`).
     #[new]
-    #[pyo3(signature = (filename, fmi_type=None))]
-    fn new(py: Python<'_>, filename: PathBuf, fmi_type: Option<&str>) -> PyResult<NativeSystem> {
+    #[pyo3(signature = (filename, fmi_type=None, use_event_mode=None))]
+    fn new(
+        py: Python<'_>,
+        filename: PathBuf,
+        fmi_type: Option<&str>,
+        use_event_mode: Option<bool>,
+    ) -> PyResult<NativeSystem> {
         let interface = match fmi_type {
             None => None,
             Some(name) => Some(Interface::from_element_name(name).ok_or_else(|| {
@@ -109,7 +116,8 @@ impl NativeSystem {
                 ))
             })?),
         };
-        let options = ImportOptions { interface, ..ImportOptions::default() };
+        let event_mode = nigel_cosim::EventModeChoice::from_flag(use_event_mode);
+        let options = ImportOptions { interface, event_mode, ..ImportOptions::default() };
         py.detach(|| {
             let setup = RunSetup::load(&filename, &options)?;
             let d = setup.default_experiment().clone();

@@ -579,3 +579,45 @@ def test_an_ssp_of_int64_connectors_gives_exact_int64_and_uint64_fields(counter3
     for result in (whole, stepped):
         assert [result.dtype[n] for n in output] == [np.int64, np.int64, np.uint64, np.uint64]
         assert [[int(v) for v in result[n]] for n in output] == [[v] * 3 for v in (2**62 + 1, 2**62, 2**63 + 1, 2**63)]
+
+
+@pytest.fixture(scope="module")
+def event_mode_fmu(tmp_path_factory):
+    """cosim's FMI 3.0 Co-Simulation test FMU with Event Mode and no clocks
+    (cosim/tests/cfmu/fmi3_event_mode.c): x integrates a rate of 1 that becomes 2 at x = 0.55,
+    inside the step without Event Mode, at the step's end in Event Mode; event_mode_used says
+    how it was instantiated."""
+    import zipfile
+
+    cfmu = REPO / "cosim" / "tests" / "cfmu"
+    headers = Path(fmpy.__file__).parent / "c-code"
+    d = tmp_path_factory.mktemp("event_mode")
+    so = d / "fmi3_event_mode.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-I", str(headers), str(cfmu / "fmi3_event_mode.c"),
+                    str(cfmu / "fmi3_rest.c"), "-o", str(so)], check=True)
+    fmu = d / "fmi3_event_mode.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.write(cfmu / "fmi3_event_mode.xml", "modelDescription.xml")
+        z.write(so, "binaries/x86_64-linux/fmi3_event_mode.so")
+    return fmu
+
+
+def test_use_event_mode_as_fmpy_names_it(event_mode_fmu):
+    # by hand (cosim/tests/event_mode.rs expected_x): without Event Mode the rate changes at
+    # t = 0.55 s, x(1) = 0.55 + 2 * 0.45 = 1.45; in Event Mode at the step's end 0.6 s,
+    # x(1) = 0.6 + 2 * 0.4 = 1.4; to the rounding of ten summed steps (1e-12)
+    kwargs = dict(stop_time=1.0, output_interval=0.1)
+    default = nigel_cosim.simulate_fmu(event_mode_fmu, **kwargs)
+    on = nigel_cosim.simulate_fmu(event_mode_fmu, use_event_mode=True, **kwargs)
+    assert default["x"][-1] == pytest.approx(1.45, abs=1e-12) and not default["event_mode_used"].any()
+    assert on["x"][-1] == pytest.approx(1.4, abs=1e-12) and on["event_mode_used"].all()
+    # the default is fmpy's default run (no Event Mode), row for row
+    theirs = fmpy.simulate_fmu(str(event_mode_fmu), **kwargs)
+    assert np.array_equal(default["x"], theirs["x"])
+    assert np.array_equal(nigel_cosim.simulate_fmu(event_mode_fmu, use_event_mode=False, **kwargs)["x"], default["x"])
+    # FMI 3.0 plant: no hasEventMode, so Event Mode cannot be asked for
+    with pytest.raises(nigel_cosim.LoadError, match="declares no hasEventMode"):
+        nigel_cosim.simulate_fmu(FMU / "fmi3" / "nigel_plant.fmu", stop_time=0.01, use_event_mode=True)
+    # the FMI 3.0 controller declares its sample clock: no Event Mode refused, naming it
+    with pytest.raises(nigel_cosim.LoadError, match='declares the clocks "sample_clock"'):
+        nigel_cosim.simulate_fmu(FMU / "fmi3" / "nigel_controller.fmu", stop_time=0.01, use_event_mode=False)

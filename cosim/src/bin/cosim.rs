@@ -172,6 +172,12 @@ struct RunArgs {
     /// integrator's internal steps): a run that would take more stops with an error.
     #[arg(long, default_value_t = nigel_cosim::simulate::DEFAULT_MAX_STEPS)]
     max_steps: u64,
+    /// FMI 3.0 Co-Simulation Event Mode (`eventModeUsed`), for every FMU of the model: auto
+    /// (only for an FMU with clocks, which needs it; one without handles its events inside
+    /// fmi3DoStep, as fmpy runs it by default), on (every FMI 3.0 Co-Simulation FMU, each
+    /// must declare hasEventMode) or off (refused for an FMU with clocks).
+    #[arg(long, default_value = "auto", value_name = "auto|on|off")]
+    event_mode: nigel_cosim::EventModeChoice,
     /// Crash boundaries: `--isolate` (= `--isolate=fmu`) runs every FMU in a host process
     /// of its own (`cosim-host`, one round trip per call); `--isolate=run` runs the whole
     /// run in one host process, the FMUs called in it directly (in-process speed). Either
@@ -345,7 +351,13 @@ fn run(args: RunArgs) -> Result<bool, Failure> {
     // the parent of --isolate=run loads no FMU library (its host does)
     let host_of_run = nigel_cosim::isolate::whole::is_host();
     let isolated = args.isolate.is_some() && !host_of_run;
-    let options = ImportOptions { interface, limits, allow_non_finite: args.allow_non_finite, isolated };
+    let options = ImportOptions {
+        interface,
+        limits,
+        allow_non_finite: args.allow_non_finite,
+        isolated,
+        event_mode: args.event_mode,
+    };
     // --interface applies to every FMU of a system (one without it is refused by name)
     let mut setup = RunSetup::load(&args.model, &options)?;
     if !host_of_run {

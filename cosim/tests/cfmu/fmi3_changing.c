@@ -18,26 +18,19 @@
 typedef struct {
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
+    fmi3ClockUpdateCallback update;
     double first_delay, t_steps, last_time, next_steps, interval;
     int n_steps, n_fast, first, changed, initializing;
 } Changing;
 
 FMI3_TEST_FAIL(Changing)
 
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,
-    fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
-    if (!token || strcmp(token, "{fmi3-changing}") != 0) return NULL;
-    Changing *c = calloc(1, sizeof(Changing));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
+static void start(Changing *c, fmi3LockPreemptionCallback lock, fmi3UnlockPreemptionCallback unlock) {
     c->first_delay = 0.25;
     c->last_time = -1.0;
-    return c;
 }
 
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+FMI3_TEST_SCHEDULED_INSTANCE(Changing, "{fmi3-changing}", start)
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
     fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
@@ -54,8 +47,6 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     c->initializing = 0;
     return fmi3OK;
 }
-
-fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {
     Changing *c = instance;

@@ -34,16 +34,7 @@ static void start(Exchange *c) {
 
 FMI3_TEST_EVENT_MODE_INSTANCE(Exchange, "{fmi3-clocked-exchange}", start)
 
-fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
-    if (!token || strcmp(token, "{fmi3-clocked-exchange}") != 0) return NULL;
-    Exchange *c = calloc(1, sizeof(Exchange));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
-    start(c);
-    return c;
-}
+FMI3_TEST_MODEL_EXCHANGE_INSTANCE(Exchange, "{fmi3-clocked-exchange}", start)
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
     fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log,

@@ -279,44 +279,74 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
     return fmi3OK;
 }
 
-fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    fmi3Int64 values[], size_t nValues) {
-    Counter *c = instance;
-    size_t j = 0; /* the next value: an array takes as many as it has elements */
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 36 || vr[i] == 37) {
-            if (j + 2 > nValues) return fail(c, "fmi3GetInt64: nValues too small");
-            for (int k = 0; k < 2; k++) values[j++] = vr[i] == 36 ? c->s.i64ain[k] : c->s.i64ain[k] ^ 1;
-            continue;
-        }
-        if (j + 1 > nValues) return fail(c, "fmi3GetInt64: nValues too small");
-        if (vr[i] == 5) values[j++] = c->s.mode;
-        else if (vr[i] == 21) values[j++] = -(1LL << 40) * c->s.n;
-        else if (vr[i] == 32) values[j++] = c->s.i64in;
-        else if (vr[i] == 33) values[j++] = c->s.i64in ^ 1;
-        else return fail(c, "fmi3GetInt64: no such Int64");
+/* fmi3Get<Kind> and fmi3Set<Kind> of the 64-bit integers (C type fmi3<Kind>): the 2-element
+ * array input `array` (value reference `array_vr`) and its output (array_vr + 1), each element
+ * with its lowest bit flipped, then the scalars, read by `get_scalar(c, vr, &value)` (0: no such
+ * variable) and set by `set_scalar(c, vr, value)` (NULL, or why not). Values are consumed in
+ * order, an array taking as many as it has elements. */
+#define WIDE_GET_SET(Kind, array_vr, array, get_scalar, set_scalar)                                \
+    fmi3Status fmi3Get##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,    \
+        fmi3##Kind values[], size_t nValues) {                                                     \
+        Counter *c = instance;                                                                     \
+        size_t j = 0;                                                                              \
+        for (size_t i = 0; i < nvr; i++) {                                                         \
+            size_t size = vr[i] == array_vr || vr[i] == array_vr + 1 ? 2 : 1;                      \
+            if (j + size > nValues) return fail(c, "fmi3Get" #Kind ": nValues too small");          \
+            if (size == 2)                                                                         \
+                for (int k = 0; k < 2; k++) values[j++] = vr[i] == array_vr ? c->s.array[k] : c->s.array[k] ^ 1; \
+            else if (!get_scalar(c, vr[i], &values[j++]))                                          \
+                return fail(c, "fmi3Get" #Kind ": no such variable");                              \
+        }                                                                                          \
+        return j == nValues ? fmi3OK : fail(c, "fmi3Get" #Kind ": nValues does not match");        \
+    }                                                                                              \
+    fmi3Status fmi3Set##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,    \
+        const fmi3##Kind values[], size_t nValues) {                                               \
+        Counter *c = instance;                                                                     \
+        size_t j = 0;                                                                              \
+        for (size_t i = 0; i < nvr; i++) {                                                         \
+            size_t size = vr[i] == array_vr ? 2 : 1;                                               \
+            if (j + size > nValues) return fail(c, "fmi3Set" #Kind ": nValues too small");          \
+            const char *refusal = NULL;                                                            \
+            if (size == 2)                                                                         \
+                for (int k = 0; k < 2; k++) c->s.array[k] = values[j++];                           \
+            else if ((refusal = set_scalar(c, vr[i], values[j++])))                                \
+                return fail(c, refusal);                                                           \
+        }                                                                                          \
+        return j == nValues ? fmi3OK : fail(c, "fmi3Set" #Kind ": nValues does not match");        \
     }
-    return j == nValues ? fmi3OK : fail(c, "fmi3GetInt64: nValues does not match");
-}
 
-fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    const fmi3Int64 values[], size_t nValues) {
-    Counter *c = instance;
-    size_t j = 0;
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 36) {
-            if (j + 2 > nValues) return fail(c, "fmi3SetInt64: nValues too small");
-            for (int k = 0; k < 2; k++) c->s.i64ain[k] = values[j++];
-            continue;
-        }
-        if (j + 1 > nValues) return fail(c, "fmi3SetInt64: nValues too small");
-        if (vr[i] == 32) { c->s.i64in = values[j++]; continue; }
-        if (vr[i] != 5) return fail(c, "fmi3SetInt64: not settable");
-        if (values[j] != 1 && values[j] != 2) return fail(c, "fmi3SetInt64: mode must be 1 or 2");
-        c->s.mode = values[j++];
+static int get_int64(const Counter *c, fmi3ValueReference vr, fmi3Int64 *value) {
+    switch (vr) {
+    case 5: *value = c->s.mode; return 1;
+    case 21: *value = -(1LL << 40) * c->s.n; return 1;
+    case 32: *value = c->s.i64in; return 1;
+    case 33: *value = c->s.i64in ^ 1; return 1;
+    default: return 0;
     }
-    return j == nValues ? fmi3OK : fail(c, "fmi3SetInt64: nValues does not match");
 }
+static const char *set_int64(Counter *c, fmi3ValueReference vr, fmi3Int64 value) {
+    if (vr == 32) c->s.i64in = value;
+    else if (vr != 5) return "fmi3SetInt64: not settable";
+    else if (value != 1 && value != 2) return "fmi3SetInt64: mode must be 1 or 2";
+    else c->s.mode = value;
+    return NULL;
+}
+WIDE_GET_SET(Int64, 36, i64ain, get_int64, set_int64)
+
+static int get_uint64(const Counter *c, fmi3ValueReference vr, fmi3UInt64 *value) {
+    switch (vr) {
+    case 22: *value = (1ULL << 48) * (unsigned long long)c->s.n; return 1;
+    case 34: *value = c->s.u64in; return 1;
+    case 35: *value = c->s.u64in ^ 1; return 1;
+    default: return 0;
+    }
+}
+static const char *set_uint64(Counter *c, fmi3ValueReference vr, fmi3UInt64 value) {
+    if (vr != 34) return "fmi3SetUInt64: not settable";
+    c->s.u64in = value;
+    return NULL;
+}
+WIDE_GET_SET(UInt64, 38, u64ain, get_uint64, set_uint64)
 
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Boolean values[], size_t nValues) {
@@ -403,38 +433,6 @@ SCALAR_GETTER(UInt8, 17, 20 * c->s.n)
 SCALAR_GETTER(Int16, 18, -1000 * c->s.n)
 SCALAR_GETTER(UInt16, 19, 6000 * c->s.n)
 SCALAR_GETTER(UInt32, 20, 400000000u * (unsigned)c->s.n)
-fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 values[], size_t nValues) {
-    Counter *c = instance;
-    size_t j = 0;
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 38 || vr[i] == 39) {
-            if (j + 2 > nValues) return fail(c, "fmi3GetUInt64: nValues too small");
-            for (int k = 0; k < 2; k++) values[j++] = vr[i] == 38 ? c->s.u64ain[k] : c->s.u64ain[k] ^ 1;
-            continue;
-        }
-        if (j + 1 > nValues) return fail(c, "fmi3GetUInt64: nValues too small");
-        if (vr[i] == 22) values[j++] = (1ULL << 48) * (unsigned long long)c->s.n;
-        else if (vr[i] == 34) values[j++] = c->s.u64in;
-        else if (vr[i] == 35) values[j++] = c->s.u64in ^ 1;
-        else return fail(c, "fmi3GetUInt64: no such variable");
-    }
-    return j == nValues ? fmi3OK : fail(c, "fmi3GetUInt64: nValues does not match");
-}
-fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 values[], size_t nValues) {
-    Counter *c = instance;
-    size_t j = 0;
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 38) {
-            if (j + 2 > nValues) return fail(c, "fmi3SetUInt64: nValues too small");
-            for (int k = 0; k < 2; k++) c->s.u64ain[k] = values[j++];
-            continue;
-        }
-        if (j + 1 > nValues) return fail(c, "fmi3SetUInt64: nValues too small");
-        if (vr[i] != 34) return fail(c, "fmi3SetUInt64: not settable");
-        c->s.u64in = values[j++];
-    }
-    return j == nValues ? fmi3OK : fail(c, "fmi3SetUInt64: nValues does not match");
-}
 
 fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float32 values[], size_t nValues) {
     Counter *c = instance;

@@ -35,6 +35,7 @@ static void start(Partitions *p, fmi3LockPreemptionCallback lock, fmi3UnlockPree
 }
 
 FMI3_TEST_SCHEDULED_INSTANCE(Partitions, "{fmi3-partitions}", start)
+FMI3_TEST_NOTHING_TO_INITIALIZE
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { return fmi3OK; }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time) {

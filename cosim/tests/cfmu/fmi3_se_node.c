@@ -32,6 +32,7 @@ static void start(Node *p, fmi3LockPreemptionCallback lock, fmi3UnlockPreemption
 }
 
 FMI3_TEST_SCHEDULED_INSTANCE(Node, "{fmi3-se-node}", start)
+FMI3_TEST_NOTHING_TO_INITIALIZE
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     ((Node *)instance)->initialized = 1;
     return fmi3OK;

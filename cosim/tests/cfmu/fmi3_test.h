@@ -1,14 +1,15 @@
-/* Shared by the FMI 3.0 C test FMUs of the master's tests (fmi3_clocks.c, fmi3_counter.c,
- * fmi3_partitions.c, fmi3_se_node.c, fmi3_sized.c), written against the standard's headers (the tests pass
- * their folder with -I; fmi3_clocked_exchange.c too): fmi3GetVersion and the helpers that are the same in each. Each .c
- * file is one shared library and includes this header once. After its instance's struct (a
- * `Type` with members `fmi3InstanceEnvironment env` and `fmi3LogMessageCallback log`), a
- * file writes FMI3_TEST_FAIL(Type) for its `fail`; an Event Mode only Co-Simulation FMU
- * FMI3_TEST_EVENT_MODE_INSTANCE, FMI3_TEST_EVENT_MODE_STEPS and FMI3_TEST_RESET for its
- * lifecycle, a Scheduled Execution FMU FMI3_TEST_SCHEDULED_INSTANCE; FMI3_TEST_GET and
- * FMI3_TEST_SET give typed gets and sets from a table of the variables' addresses,
- * FMI3_TEST_OUTPUT_CLOCK the read of a single output clock, FMI3_TEST_ONE_INTERVAL the
- * interval of a single clock. */
+/* Shared by the FMI 3.0 C test FMUs of the master's tests (fmi3_*.c), written against the
+ * standard's headers (the tests pass their folder with -I): fmi3GetVersion and the helpers
+ * that are the same in each. Each .c file is one shared library and includes this header
+ * once. After its instance's struct (a `Type` with members `fmi3InstanceEnvironment env`
+ * and `fmi3LogMessageCallback log`), a file writes FMI3_TEST_FAIL(Type) for its `fail`; an
+ * Event Mode only Co-Simulation FMU FMI3_TEST_EVENT_MODE_INSTANCE, FMI3_TEST_EVENT_MODE_STEPS
+ * and FMI3_TEST_RESET for its lifecycle, a Scheduled Execution FMU
+ * FMI3_TEST_SCHEDULED_INSTANCE, a Model Exchange FMU FMI3_TEST_MODEL_EXCHANGE_INSTANCE (and
+ * FMI3_TEST_NO_CONTINUOUS_STATES or FMI3_TEST_NO_STEP_EVENTS where they say what it does);
+ * FMI3_TEST_GET and FMI3_TEST_SET give typed gets and sets from a table of the variables'
+ * addresses, FMI3_TEST_OUTPUT_CLOCK the read of a single output clock,
+ * FMI3_TEST_ONE_INTERVAL the interval of a single clock. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
@@ -27,6 +28,22 @@ const char *fmi3GetVersion(void) { return fmi3Version; }
         return fmi3Error;                                                                  \
     }
 
+/* The body of an fmi3Instantiate* of a `Type` (members `env` and `log`; `token`, `env` and
+ * `log` the function's parameters): when `refused` (an expression), NULL with `reason` logged
+ * through `log` when there is one; else the zeroed instance `c` with env and log set, on which
+ * `then` (statements of `c`) runs before it is returned. */
+#define FMI3_TEST_NEW(Type, refused, reason, then)                                                 \
+    if (refused) {                                                                                 \
+        if (log) log(env, fmi3Error, "logStatusError", reason);                                    \
+        return NULL;                                                                               \
+    }                                                                                              \
+    Type *c = calloc(1, sizeof(Type));                                                             \
+    if (!c) return NULL;                                                                           \
+    c->env = env;                                                                                  \
+    c->log = log;                                                                                  \
+    then;                                                                                          \
+    return c;
+
 /* The lifecycle of a Co-Simulation `Type` (members `env` and `log`) that runs in Event Mode
  * only: fmi3InstantiateCoSimulation refuses (NULL, logged) another instantiation token than
  * `token_text` and eventModeUsed false, else calls `start(Type *)` on the zeroed instance;
@@ -36,16 +53,8 @@ const char *fmi3GetVersion(void) { return fmi3Version; }
         fmi3Boolean visible, fmi3Boolean logging, fmi3Boolean eventMode, fmi3Boolean earlyReturnAllowed, \
         const fmi3ValueReference req[], size_t nReq, fmi3InstanceEnvironment env,                  \
         fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback update) {                       \
-        if (!token || strcmp(token, token_text) != 0 || !eventMode) {                              \
-            if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken or no eventModeUsed"); \
-            return NULL;                                                                           \
-        }                                                                                          \
-        Type *c = calloc(1, sizeof(Type));                                                         \
-        if (!c) return NULL;                                                                       \
-        c->env = env;                                                                              \
-        c->log = log;                                                                              \
-        start(c);                                                                                  \
-        return c;                                                                                  \
+        FMI3_TEST_NEW(Type, !token || strcmp(token, token_text) != 0 || !eventMode,               \
+            "wrong instantiationToken or no eventModeUsed", start(c))                              \
     }                                                                                              \
     void fmi3FreeInstance(fmi3Instance instance) { free(instance); }                               \
     fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
@@ -93,38 +102,46 @@ static inline fmi3Status step_reached(fmi3Float64 time, fmi3Boolean *eventHandli
     }
 
 /* The lifecycle of a Scheduled Execution `Type` (members `env`, `log` and `update`):
- * fmi3InstantiateScheduledExecution refuses (NULL) another instantiation token than
+ * fmi3InstantiateScheduledExecution refuses (NULL, logged) another instantiation token than
  * `token_text` or no clockUpdate callback, else calls `start(Type *, lock, unlock)` on the
- * zeroed instance with env, log and update set; fmi3FreeInstance frees it; entering
- * initialization and terminating do nothing. */
+ * zeroed instance with env, log and update set; fmi3FreeInstance frees it; terminating does
+ * nothing. */
 #define FMI3_TEST_SCHEDULED_INSTANCE(Type, token_text, start)                                      \
     fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token,             \
         fmi3String resources, fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, \
         fmi3LogMessageCallback log, fmi3ClockUpdateCallback update, fmi3LockPreemptionCallback lock, \
         fmi3UnlockPreemptionCallback unlock) {                                                     \
-        if (!token || strcmp(token, token_text) != 0 || !update) return NULL;                      \
-        Type *p = calloc(1, sizeof(Type));                                                         \
-        if (!p) return NULL;                                                                       \
-        p->env = env;                                                                              \
-        p->log = log;                                                                              \
-        p->update = update;                                                                        \
-        start(p, lock, unlock);                                                                    \
-        return p;                                                                                  \
+        FMI3_TEST_NEW(Type, !token || strcmp(token, token_text) != 0 || !update,                  \
+            "wrong instantiationToken or no clockUpdate", c->update = update; start(c, lock, unlock))     \
     }                                                                                              \
     void fmi3FreeInstance(fmi3Instance instance) { free(instance); }                               \
+    fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+
+/* fmi3EnterInitializationMode of an FMU that has nothing to do there. */
+#define FMI3_TEST_NOTHING_TO_INITIALIZE                                                            \
     fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,    \
         fmi3Float64 tolerance, fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) { \
         return fmi3OK;                                                                             \
-    }                                                                                              \
-    fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
+    }
 
-/* fmi3Get<Kind> (values of C type `CType`) of a `Type`: `...` the addresses of its variables
- * as designated initializers `[vr] = &c->member` (`c` the instance); another value reference
- * is no such variable, fmi3Error. */
+/* fmi3InstantiateModelExchange of a `Type` (members `env` and `log`): refuses (NULL, logged)
+ * another instantiation token than `token_text`, else calls `start(Type *)` on the zeroed
+ * instance with env and log set. */
+#define FMI3_TEST_MODEL_EXCHANGE_INSTANCE(Type, token_text, start)                                 \
+    fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources, \
+        fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) { \
+        FMI3_TEST_NEW(Type, !token || strcmp(token, token_text) != 0, "wrong instantiationToken", start(c)) \
+    }
+
+/* fmi3Get<Kind> (values of C type `CType`) of a `Type`: `...` the addresses of its scalar
+ * variables as designated initializers `[vr] = &c->member` (`c` the instance); another value
+ * reference is no such variable, and nValues other than the number of value references
+ * wrong, fmi3Error. */
 #define FMI3_TEST_GET(Kind, CType, Type, ...)                                                      \
     fmi3Status fmi3Get##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,      \
         CType values[], size_t nValues) {                                                          \
         Type *c = instance;                                                                        \
+        if (nValues != n) return fail(c, "fmi3Get" #Kind ": nValues is not nValueReferences");    \
         CType *slots[] = {__VA_ARGS__};                                                            \
         for (size_t k = 0; k < n; k++) {                                                           \
             if (vr[k] >= sizeof slots / sizeof *slots || !slots[vr[k]])                            \
@@ -136,11 +153,13 @@ static inline fmi3Status step_reached(fmi3Float64 time, fmi3Boolean *eventHandli
 
 /* fmi3Set<Kind> (values of C type `CType`) of a `Type`: `...` the addresses of the variables
  * that may be set now, as FMI3_TEST_GET's (an address may be an expression giving NULL:
- * not now); another value reference is refused (fmi3Error, logged as `refusal`). */
+ * not now); another value reference is refused (fmi3Error, logged as `refusal`), as is
+ * nValues other than the number of value references. */
 #define FMI3_TEST_SET(Kind, CType, Type, refusal, ...)                                             \
     fmi3Status fmi3Set##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,      \
         const CType values[], size_t nValues) {                                                    \
         Type *c = instance;                                                                        \
+        if (nValues != n) return fail(c, "fmi3Set" #Kind ": nValues is not nValueReferences");    \
         CType *slots[] = {__VA_ARGS__};                                                            \
         for (size_t k = 0; k < n; k++) {                                                           \
             if (vr[k] >= sizeof slots / sizeof *slots || !slots[vr[k]])                            \
@@ -202,6 +221,14 @@ static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Bo
     return fmi3OK;
 }
 
+/* Model Exchange whose integrator steps ask for no event and no end. */
+#define FMI3_TEST_NO_STEP_EVENTS                                                                   \
+    fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior,          \
+        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {                           \
+        *enterEventMode = 0;                                                                       \
+        *terminateSimulation = 0;                                                                  \
+        return fmi3OK;                                                                             \
+    }
 
 /* Model Exchange without continuous states or event indicators: the counts 0, the state
  * and indicator calls accept their empty arrays, no integrator step asks for an event. */
@@ -219,11 +246,6 @@ static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Bo
     fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
-    fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior,          \
-        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {                           \
-        *enterEventMode = 0;                                                                       \
-        *terminateSimulation = 0;                                                                  \
-        return fmi3OK;                                                                             \
-    }
+    FMI3_TEST_NO_STEP_EVENTS
 
 #endif

@@ -15,17 +15,12 @@ typedef struct {
 
 FMI3_TEST_FAIL(Vdp)
 
-fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
-    fmi3Boolean visible, fmi3Boolean logging, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
-    if (!token || strcmp(token, "{fmi3-vdp}") != 0) return NULL;
-    Vdp *v = calloc(1, sizeof(Vdp));
-    if (!v) return NULL;
+static void start(Vdp *v) {
     v->x0 = 2.0;
     v->mu = 1.0;
-    v->env = env;
-    v->log = log;
-    return v;
 }
+
+FMI3_TEST_MODEL_EXCHANGE_INSTANCE(Vdp, "{fmi3-vdp}", start)
 void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
 fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
@@ -40,16 +35,10 @@ fmi3Status fmi3Terminate(fmi3Instance instance) { return fmi3OK; }
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
     fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined, fmi3Float64 *nextEventTime) {
-    *discreteStatesNeedUpdate = *terminateSimulation = *nominalsOfContinuousStatesChanged = 0;
-    *valuesOfContinuousStatesChanged = *nextEventTimeDefined = 0;
-    *nextEventTime = 0.0;
-    return fmi3OK;
+    return updated_discrete_states(discreteStatesNeedUpdate, terminateSimulation, nominalsOfContinuousStatesChanged,
+        valuesOfContinuousStatesChanged, nextEventTimeDefined, nextEventTime);
 }
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
-    fmi3Boolean *terminateSimulation) {
-    *enterEventMode = *terminateSimulation = 0;
-    return fmi3OK;
-}
+FMI3_TEST_NO_STEP_EVENTS
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     ((Vdp *)instance)->time = time;
     return fmi3OK;
@@ -74,18 +63,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     }
     return fmi3OK;
 }
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-    const fmi3Float64 values[], size_t nValues) {
-    Vdp *v = instance;
-    if (nvr != nValues) return fail(v, "fmi3SetFloat64: nValues != nValueReferences");
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == 1) v->x0 = values[i];
-        else if (vr[i] == 3) v->x1 = values[i];
-        else if (vr[i] == 5) v->mu = values[i];
-        else return fail(v, "fmi3SetFloat64: not settable");
-    }
-    return fmi3OK;
-}
+FMI3_TEST_SET(Float64, fmi3Float64, Vdp, "not settable", [1] = &c->x0, [3] = &c->x1, [5] = &c->mu)
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
     *n = 2;
     return fmi3OK;

@@ -76,24 +76,3 @@ pub fn corpus() -> PathBuf {
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus"))
 }
-
-/// An FMI 3.0 Scheduled Execution description of the C FMU `model_identifier` (its
-/// instantiation token `{fmi3-<model_name with - for _>}` as the C file checks it): the
-/// independent variable `time` (value reference 0), then `variables` (XML elements, one a
-/// line), and the ModelStructure's outputs `outputs` (value references, in order).
-pub fn scheduled_description(model_name: &str, model_identifier: &str, variables: &str, outputs: &[u32]) -> String {
-    let token = format!("{{fmi3-{}}}", model_name.replace('_', "-"));
-    let outputs: String = outputs.iter().map(|vr| format!("    <Output valueReference=\"{vr}\"/>\n")).collect();
-    format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="3.0" modelName="{model_name}" instantiationToken="{token}">
-  <ScheduledExecution modelIdentifier="{model_identifier}"/>
-  <ModelVariables>
-    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
-    {variables}  </ModelVariables>
-  <ModelStructure>
-{outputs}  </ModelStructure>
-</fmiModelDescription>
-"#
-    )
-}

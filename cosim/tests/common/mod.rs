@@ -89,12 +89,28 @@ impl Model {
     }
 }
 
+/// The target folder: the build's, with the FMUs and SSPs the test command builds
+/// (target/fmu, target/ssp).
+pub fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"))
+}
+
+/// `target/ssp/<file>`, one of our SSPs built by `cargo run --release -p build-fmu`.
+pub fn built_ssp(file: &str) -> PathBuf {
+    let p = target_dir().join("ssp").join(file);
+    assert!(
+        p.is_file(),
+        "{} missing: run `cargo run --release -p build-fmu -- --platforms linux64 --this-glibc` first",
+        p.display()
+    );
+    p
+}
+
 /// A fresh folder for one test's files, under target/cosim-tests/.
 pub fn work_dir(test: &str) -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
-    let dir = target.join("cosim-tests").join(format!("{test}-{}", std::process::id()));
+    let dir = target_dir().join("cosim-tests").join(format!("{test}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("work dir");
     dir
@@ -168,10 +184,7 @@ pub fn unpack_dirs() -> Vec<PathBuf> {
 
 /// The plant FMU built by `cargo run --release -p build-fmu`.
 pub fn plant_fmu() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("target"));
-    let p = target.join("fmu").join("nigel_plant.fmu");
+    let p = target_dir().join("fmu").join("nigel_plant.fmu");
     assert!(p.is_file(), "{} missing: run `cargo run --release -p build-fmu` first", p.display());
     p
 }

@@ -92,12 +92,7 @@ fn build_declaration() -> DeclarationSpec<Field<OwnController>> {
         description: "A user's own sampled (1 ms) steering controller: P on the yaw rate, P on the speed",
         version: env!("CARGO_PKG_VERSION"),
         interfaces: Interfaces { model_exchange: false, co_simulation: true },
-        default_experiment: Some(DefaultExperiment {
-            start_time: Some(0.0),
-            stop_time: Some(30.0),
-            tolerance: None,
-            step_size: Some(SAMPLE_PERIOD),
-        }),
+        default_experiment: Some(DefaultExperiment::fixed_step(30.0, SAMPLE_PERIOD)),
         variables: v.into_vec(),
         ..Default::default()
     }

@@ -5,12 +5,11 @@
 //! `unlockPreemption` have nothing to lock, and the results do not depend on timing. No
 //! callback can panic (atomic loads and stores; the logger catches its own).
 
-use std::ffi::c_void;
 use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 
-use fmi_sys::fmi3::{fmi3InstanceEnvironment, fmi3Status, fmi3String};
+use fmi_sys::fmi3::fmi3InstanceEnvironment;
 
-use crate::log::LogSink;
+use crate::log::{Fmi3LogEnvironment, LogSink};
 
 /// What the FMU's callbacks receive as their instance environment in Scheduled Execution.
 #[derive(Debug, Default)]
@@ -22,21 +21,11 @@ pub(crate) struct ScheduledEnvironment {
     pub(super) clock_update: AtomicBool,
 }
 
-/// `fmi3LogMessageCallback` of Scheduled Execution: on to the instance's log sink.
-pub(super) unsafe extern "C" fn log_message(
-    environment: fmi3InstanceEnvironment,
-    status: fmi3Status,
-    category: fmi3String,
-    message: fmi3String,
-) {
-    if environment.is_null() {
-        return;
+/// The log callback's sink (`crate::log::log_message::<ScheduledEnvironment>`).
+impl Fmi3LogEnvironment for ScheduledEnvironment {
+    fn sink(&self) -> *const LogSink {
+        self.log.load(Ordering::Relaxed)
     }
-    // SAFETY: the environment is the instance's boxed ScheduledEnvironment, alive while
-    // the FMU lives; the log sink it holds outlives the FMU.
-    let sink = unsafe { &*(environment as *const ScheduledEnvironment) }.log.load(Ordering::Relaxed);
-    // SAFETY: as `crate::log::log_message` takes it (its own catch_unwind inside).
-    unsafe { crate::log::log_message(sink as *mut c_void, status, category, message) };
 }
 
 /// `fmi3ClockUpdateCallback`: raises the flag (an atomic store: nothing here can panic).
@@ -44,7 +33,8 @@ pub(super) unsafe extern "C" fn clock_update(environment: fmi3InstanceEnvironmen
     if environment.is_null() {
         return;
     }
-    // SAFETY: as in `log_message`.
+    // SAFETY: the environment is the instance's boxed ScheduledEnvironment, alive while
+    // the FMU lives.
     unsafe { &*(environment as *const ScheduledEnvironment) }.clock_update.store(true, Ordering::Release);
 }
 

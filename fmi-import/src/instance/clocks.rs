@@ -65,16 +65,9 @@ impl ClockCalls for Fmi3 {
                 call!(core, "fmi3GetShiftDecimal", None, f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr()))?
             }
             (None, Some(f)) => {
-                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
-                call!(
-                    core,
-                    "fmi3GetShiftFraction",
-                    None,
-                    f(c, vrs.as_ptr(), vrs.len(), counters.as_mut_ptr(), resolutions.as_mut_ptr())
-                )?;
-                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
-                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
-                }
+                values = fraction_seconds(vrs.len(), |counters, resolutions| {
+                    call!(core, "fmi3GetShiftFraction", None, f(c, vrs.as_ptr(), vrs.len(), counters, resolutions))
+                })?
             }
             (None, None) => return Err(core.optional(None::<()>, "fmi3GetShiftDecimal").unwrap_err()),
         }
@@ -146,28 +139,28 @@ impl Fmi3 {
                 f(c, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), qualifiers.as_mut_ptr())
             )?,
             (None, Some(f)) => {
-                let (mut counters, mut resolutions) = (vec![0u64; vrs.len()], vec![0u64; vrs.len()]);
-                call!(
-                    core,
-                    "fmi3GetIntervalFraction",
-                    None,
-                    f(
-                        c,
-                        vrs.as_ptr(),
-                        vrs.len(),
-                        counters.as_mut_ptr(),
-                        resolutions.as_mut_ptr(),
-                        qualifiers.as_mut_ptr()
+                let q = qualifiers.as_mut_ptr();
+                values = fraction_seconds(vrs.len(), |counters, resolutions| {
+                    call!(
+                        core,
+                        "fmi3GetIntervalFraction",
+                        None,
+                        f(c, vrs.as_ptr(), vrs.len(), counters, resolutions, q)
                     )
-                )?;
-                for ((v, n), r) in values.iter_mut().zip(&counters).zip(&resolutions) {
-                    *v = if *r == 0 { f64::NAN } else { *n as f64 / *r as f64 };
-                }
+                })?
             }
             (None, None) => return Err(core.optional(None::<()>, "fmi3GetIntervalDecimal").unwrap_err()),
         }
         Ok((values, qualifiers))
     }
+}
+
+/// The times of an FMI 3.0 `*Fraction` call of `n` clocks, each its counter over its
+/// resolution (NaN for resolution 0): `call` writes the counters and the resolutions.
+fn fraction_seconds(n: usize, call: impl FnOnce(*mut u64, *mut u64) -> Result<()>) -> Result<Vec<f64>> {
+    let (mut counters, mut resolutions) = (vec![0u64; n], vec![0u64; n]);
+    call(counters.as_mut_ptr(), resolutions.as_mut_ptr())?;
+    Ok(counters.iter().zip(&resolutions).map(|(c, r)| if *r == 0 { f64::NAN } else { *c as f64 / *r as f64 }).collect())
 }
 
 /// The error of a clock call on an instance whose generation has no clocks.

@@ -61,7 +61,7 @@ impl std::fmt::Debug for Instance {
 fn calls_of(fmu: &Fmu) -> Box<dyn Calls> {
     match &fmu.abi {
         Abi::Fmi2(t) => Box::new(fmi2::Fmi2::new(t.clone())),
-        Abi::Fmi3(a) => Box::new(fmi3::Fmi3::new(a.clone(), fmu.interface)),
+        Abi::Fmi3(a) => Box::new(fmi3::Fmi3::new(a.clone(), fmu.interface, fmu.event_mode().is_some_and(|e| e.used))),
     }
 }
 

@@ -9,7 +9,7 @@
 use std::ffi::{c_void, CString};
 use std::sync::atomic::Ordering;
 
-use super::callbacks::{clock_update, lock_preemption, log_message, unlock_preemption, ScheduledEnvironment};
+use super::callbacks::{clock_update, lock_preemption, unlock_preemption, ScheduledEnvironment};
 use super::core::ClockCalls;
 use super::core::{call, Core};
 use super::fmi3::Fmi3;
@@ -49,7 +49,7 @@ impl Fmi3 {
                 0,
                 0,
                 env,
-                Some(log_message),
+                Some(crate::log::log_message::<ScheduledEnvironment>),
                 Some(clock_update),
                 Some(lock_preemption),
                 Some(unlock_preemption),

@@ -423,7 +423,8 @@ impl Channel {
         }
     }
 
-    fn push_log(&self, status: Status, message: String) {
+    /// Keeps `message` in the instance's log (category "host").
+    pub(crate) fn push_log(&self, status: Status, message: String) {
         if self.log.is_null() {
             return;
         }

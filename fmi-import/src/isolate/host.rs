@@ -434,7 +434,7 @@ impl Host {
                         std::ptr::null(),
                         0,
                         environment,
-                        Some(crate::log::log_message),
+                        Some(crate::log::log_message::<crate::log::LogSink>),
                         None,
                     );
                     if self.c.is_null() {
@@ -448,7 +448,8 @@ impl Host {
                     let environment = &*self.log as *const LogSink as *mut c_void;
                     let Some(g) = f.instantiate_model_exchange else { return missing };
                     // visible false, logging off: as `Instance::new_fmi3`
-                    let logger = Some(crate::log::log_message as fmi_sys::fmi3::Fmi3LogMessageCallback);
+                    let logger =
+                        Some(crate::log::log_message::<crate::log::LogSink> as fmi_sys::fmi3::Fmi3LogMessageCallback);
                     self.c = g(name.as_ptr(), token.as_ptr(), resources.as_ptr(), 0, 0, environment, logger);
                     if self.c.is_null() {
                         3

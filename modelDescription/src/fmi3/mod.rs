@@ -553,7 +553,8 @@ pub struct ModelStructure {
 }
 
 /// An FMI 3.0 `modelDescription.xml`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// (`Default`: no attribute, no element; a base for `..Default::default()`.)
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct ModelDescription {
     /// `fmiVersion` ("3.0", or "3.0.x").
     pub fmi_version: String,

@@ -309,15 +309,6 @@ mod tests {
             fmi_version: "3.0".into(),
             model_name: "m".into(),
             instantiation_token: "{t}".into(),
-            description: None,
-            author: None,
-            version: None,
-            copyright: None,
-            license: None,
-            generation_tool: None,
-            generation_date_and_time: None,
-            variable_naming_convention: None,
-            model_exchange: None,
             co_simulation: Some(CoSimulation {
                 common: InterfaceCommon {
                     model_identifier: "m".into(),
@@ -327,7 +318,6 @@ mod tests {
                 can_handle_variable_communication_step_size: true,
                 ..Default::default()
             }),
-            scheduled_execution: None,
             unit_definitions: vec![Unit { name: "m".into(), base_unit: Some(BaseUnit { m: 1, ..Default::default() }) }],
             type_definitions: vec![TypeDefinition {
                 name: "Mode".into(),
@@ -337,7 +327,6 @@ mod tests {
                     items: vec![EnumerationItem { name: "a".into(), value: 2, description: None }],
                 },
             }],
-            log_categories: vec![],
             default_experiment: Some(DefaultExperiment { stop_time: Some(0.1 + 0.2), ..Default::default() }),
             model_variables: vec![time, x, dx, mode, s],
             model_structure: ModelStructure {
@@ -350,6 +339,7 @@ mod tests {
                 initial_unknowns: vec![Unknown { value_reference: 2, dependencies: None, dependencies_kind: None }],
                 ..Default::default()
             },
+            ..Default::default()
         }
     }
 

@@ -237,23 +237,9 @@ pub fn minimal() -> ModelDescription {
         fmi_version: "2.0".into(),
         model_name: "m".into(),
         guid: "{g}".into(),
-        description: None,
-        author: None,
-        version: None,
-        copyright: None,
-        license: None,
-        generation_tool: None,
-        generation_date_and_time: None,
-        variable_naming_convention: None,
-        number_of_event_indicators: 0,
-        model_exchange: None,
         co_simulation: Some(CoSimulation { model_identifier: "m".into(), ..Default::default() }),
-        unit_definitions: vec![],
-        type_definitions: vec![],
-        log_categories: vec![],
-        default_experiment: None,
         model_variables: vec![real("p", 0, Causality::Parameter, Variability::Fixed, None, Some(1.0), None)],
-        model_structure: ModelStructure::default(),
+        ..Default::default()
     }
 }
 

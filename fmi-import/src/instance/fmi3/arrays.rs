@@ -205,17 +205,40 @@ impl Fmi3 {
             }
             return self.set_wide_element(core, access, whole);
         }
+        self.set_kept_element(core, access, value, |a| &mut a.arrays, Fmi3::array_start, Fmi3::set_all)
+    }
+
+    /// Sets element `access.element` of an Int64 or UInt64 array to the integer `value`
+    /// exactly: the other elements keep the integers set or read before (the start values
+    /// at first).
+    pub(super) fn set_wide_element(&mut self, core: &mut Core, access: Access, value: i128) -> Result<()> {
+        self.set_kept_element(core, access, value, |a| &mut a.wide_arrays, Fmi3::wide_array_start, Fmi3::set_wide)
+    }
+
+    /// Sets element `access.element` of its variable to `value`: the other elements keep
+    /// the values set or read before, kept in `kept` (f64, or i128 for the integers of a
+    /// 64-bit array, which an f64 holds only up to 2^53), from `start` at first; the whole
+    /// array is set with `set`.
+    fn set_kept_element<T: Copy + ToString>(
+        &mut self,
+        core: &mut Core,
+        access: Access,
+        value: T,
+        kept: fn(&mut Fmi3) -> &mut HashMap<u32, Vec<T>>,
+        start: fn(&mut Fmi3, &mut Core, Access) -> Result<Vec<T>>,
+        set: fn(&mut Fmi3, &mut Core, Access, &[T]) -> Result<()>,
+    ) -> Result<()> {
         let (n, element) = self.now(access);
         let Some(element) = element else {
             return Err(self.absent_element(core, access, n, value.to_string()));
         };
-        let mut values = match self.arrays.remove(&access.vr) {
+        let mut values = match kept(self).remove(&access.vr) {
             Some(v) if v.len() == n => v,
-            _ => self.array_start(core, access)?,
+            _ => start(self, core, access)?,
         };
         values[element] = value;
-        let result = self.set_all(core, access, &values);
-        self.arrays.insert(access.vr, values);
+        let result = set(self, core, access, &values);
+        kept(self).insert(access.vr, values);
         result
     }
 
@@ -230,24 +253,6 @@ impl Fmi3 {
                 access.element + 1
             ),
         }
-    }
-
-    /// Sets element `access.element` of an Int64 or UInt64 array to the integer `value`
-    /// exactly: the other elements keep the integers set or read before (the start values
-    /// at first).
-    pub(super) fn set_wide_element(&mut self, core: &mut Core, access: Access, value: i128) -> Result<()> {
-        let (n, element) = self.now(access);
-        let Some(element) = element else {
-            return Err(self.absent_element(core, access, n, value.to_string()));
-        };
-        let mut values = match self.wide_arrays.remove(&access.vr) {
-            Some(v) if v.len() == n => v,
-            _ => self.wide_array_start(core, access)?,
-        };
-        values[element] = value;
-        let result = self.set_wide(core, access, &values);
-        self.wide_arrays.insert(access.vr, values);
-        result
     }
 
     /// The integers a 64-bit array starts from for element-wise sets: its start values,
@@ -284,28 +289,34 @@ impl Fmi3 {
     pub(super) fn set_wide(&mut self, core: &mut Core, access: Access, values: &[i128]) -> Result<()> {
         use model_description::fmi3::ValueType as T;
         let (c, vr, n) = (core.component, access.vr, values.len());
-        // the FMU's own name of the variable (the view's element names are not its)
-        let name = self.a.description.variable(vr).map_or_else(|| format!("<vr {vr}>"), |v| v.name.clone());
-        let out_of_range = |core: &Core, value: i128, ty: &str| Error::InvalidValue {
-            variable: format!("{}.{name}", core.name),
-            value: value.to_string(),
-            reason: format!("outside the range of {ty}"),
-        };
         if access.value_type == T::Int64 {
-            let buf = values
-                .iter()
-                .map(|x| i64::try_from(*x).map_err(|_| out_of_range(core, *x, "Int64")))
-                .collect::<Result<Vec<i64>>>()?;
+            let buf: Vec<i64> = self.narrowed(core, vr, values, "Int64")?;
             let f = f3!(core, self.a, set_int64, "fmi3SetInt64");
             call!(core, "fmi3SetInt64", None, f(c, &vr, 1, buf.as_ptr(), n))
         } else {
-            let buf = values
-                .iter()
-                .map(|x| u64::try_from(*x).map_err(|_| out_of_range(core, *x, "UInt64")))
-                .collect::<Result<Vec<u64>>>()?;
+            let buf: Vec<u64> = self.narrowed(core, vr, values, "UInt64")?;
             let f = f3!(core, self.a, set_uint64, "fmi3SetUInt64");
             call!(core, "fmi3SetUInt64", None, f(c, &vr, 1, buf.as_ptr(), n))
         }
+    }
+
+    /// `values` as the 64-bit integers of type `T` (FMI 3.0's `type_name`) of the variable
+    /// `vr`, or the error that names the variable and the first value outside T's range.
+    fn narrowed<T: TryFrom<i128>>(&self, core: &Core, vr: u32, values: &[i128], type_name: &str) -> Result<Vec<T>> {
+        values
+            .iter()
+            .map(|&x| {
+                T::try_from(x).map_err(|_| {
+                    // the FMU's own name of the variable (the view's element names are not its)
+                    let name = self.a.description.variable(vr).map_or_else(|| format!("<vr {vr}>"), |v| v.name.clone());
+                    Error::InvalidValue {
+                        variable: format!("{}.{name}", core.name),
+                        value: x.to_string(),
+                        reason: format!("outside the range of {type_name}"),
+                    }
+                })
+            })
+            .collect()
     }
 
     /// The values an array starts from for element-wise sets: its start values, else what

@@ -40,8 +40,9 @@ pub(crate) struct Fmi3 {
     pub(super) resized: HashMap<u32, (Vec<u64>, Vec<u64>)>,
     /// The structural parameters whose value now is not the view's (value reference, value).
     pub(super) sizes_now: Vec<(u32, f64)>,
-    /// Co-Simulation with `eventModeUsed` (an FMU with `hasEventMode`; false again when the
-    /// FMU refused to be instantiated with it and accepted without).
+    /// Co-Simulation with `eventModeUsed` (as [`crate::Fmu::event_mode`] decided: an FMU
+    /// with clocks, or asked for; false again when an FMU without clocks refused to be
+    /// instantiated with it and accepted without).
     event_mode: std::cell::Cell<bool>,
     /// The FMU's output clocks (value references), read by `fmi3GetClock` in every event.
     pub(super) output_clocks: Vec<u32>,
@@ -84,9 +85,10 @@ mod arrays;
 mod typed;
 
 impl Fmi3 {
-    pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface) -> Fmi3 {
-        let event_mode = interface == Interface::CoSimulation
-            && a.description.co_simulation.as_ref().is_some_and(|cs| cs.has_event_mode);
+    /// The calls of an instance of `interface`; `event_mode`: Co-Simulation with
+    /// `eventModeUsed` (the FMU's decision, [`crate::Fmu::event_mode`]).
+    pub(crate) fn new(a: Arc<Fmi3Abi>, interface: Interface, event_mode: bool) -> Fmi3 {
+        let event_mode = interface == Interface::CoSimulation && event_mode;
         use crate::clocks::{ClockCausality, ClockKind};
         // Scheduled Execution runs the clocks through its own calls (`scheduled.rs`)
         let clocks = if interface == Interface::ScheduledExecution {
@@ -184,6 +186,14 @@ impl Fmi3 {
     }
 }
 
+/// The warning of a second instantiation without Event Mode after `function` refused it.
+fn refused_event_mode(function: &str) -> String {
+    format!(
+        "{function} returned NULL with eventModeUsed = true although the FMU declares hasEventMode: instantiated \
+         again without Event Mode (the FMU handles its events inside fmi3DoStep)"
+    )
+}
+
 /// The error of a Scheduled Execution call on an instance of another interface.
 #[cold]
 pub(super) fn not_scheduled(name: &str) -> Error {
@@ -233,8 +243,8 @@ impl Calls for Fmi3 {
         }
     }
 
-    /// `fmi3InstantiateCoSimulation` (early return allowed, event mode used when the FMU
-    /// has it, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
+    /// `fmi3InstantiateCoSimulation` (early return allowed, `eventModeUsed` as the FMU's
+    /// decision says, no intermediate update) or `fmi3InstantiateModelExchange`, logging off, the
     /// messages to `log` (which outlives the instance).
     fn instantiate(
         &self,
@@ -246,7 +256,7 @@ impl Calls for Fmi3 {
     ) -> Result<Component> {
         let a = &self.a;
         let environment = log as *const LogSink as *mut c_void;
-        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message);
+        let logger: Option<fmi_sys::fmi3::Fmi3LogMessageCallback> = Some(crate::log::log_message::<LogSink>);
         let missing = |symbol| Error::MissingSymbol { path: fmu.source.clone(), symbol };
         let function = self.instantiate_function(fmu.interface);
         let component = match fmu.interface {
@@ -282,11 +292,20 @@ impl Calls for Fmi3 {
                 None => return Err(not_scheduled(name)),
             },
         };
-        if component.is_null() && fmu.interface == Interface::CoSimulation && self.event_mode.get() {
+        if component.is_null()
+            && fmu.interface == Interface::CoSimulation
+            && self.event_mode.get()
+            && crate::clocks::clocks_of(&a.description).is_empty()
+        {
             // an FMU that declares hasEventMode may still refuse eventModeUsed (the Reference
-            // FMUs' Roberts does): a second try without it, the run then stepping without
-            // Event Mode as for an FMU without it
+            // FMUs' Roberts does): without clocks, which need Event Mode, a second try
+            // without it, the run then stepping without Event Mode as for an FMU without it
             self.event_mode.set(false);
+            log.push(crate::log::LogRecord {
+                status: Status::Warning,
+                category: "cosim".into(),
+                message: refused_event_mode(function),
+            });
             return self.instantiate(fmu, name, name_c, _callbacks, log);
         }
         if component.is_null() {
@@ -309,7 +328,16 @@ impl Calls for Fmi3 {
             });
         }
         let event_mode = (fmu.interface == Interface::CoSimulation).then_some(self.event_mode.get());
-        Ok(crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode))
+        let status =
+            crate::isolate::proxy3::instantiate_in(channel, name_c, &self.a.token, &self.a.resource_path, event_mode);
+        let refused = status != 0 && channel.failure.is_none() && channel.over_limit.is_none();
+        if refused && event_mode == Some(true) && crate::clocks::clocks_of(&self.a.description).is_empty() {
+            // the second try of `instantiate`, in the host
+            self.event_mode.set(false);
+            channel.push_log(Status::Warning, refused_event_mode("fmi3InstantiateCoSimulation"));
+            return self.instantiate_in(fmu, channel, name_c);
+        }
+        Ok(status)
     }
 
     fn reset_name(&self) -> &'static str {
@@ -504,9 +532,11 @@ impl Calls for Fmi3 {
                 return Ok(());
             }
             // an early return at the time already reached is progress when it was to handle
-            // an event there (Event Mode was entered and left above): the next fmi3DoStep
-            // goes on from the settled discrete states
-            let settled_here = event != 0 && self.event_mode.get() && reached == at;
+            // an event there: in Event Mode, entered and left above, or, instantiated without
+            // it, inside the FMU, which said so (Dymola 2025x CoupledClutches with Dassl
+            // returns early so at t = 0 and steps on from there, as in fmpy's loop): the next
+            // fmi3DoStep goes on from the settled discrete states (at most 1000 returns a step)
+            let settled_here = event != 0 && reached == at;
             let progressed = settled_here || (reached > at && reached <= end);
             if !progressed {
                 core.state = InstanceState::Errored;
