@@ -117,6 +117,12 @@ impl Core {
         Err(Error::Fmi { instance: self.name.clone(), function, status, time, log: self.log.recent_problems() })
     }
 
+    /// Marks a call of `function` made outside `call!` (reset, free), whose status is not
+    /// read: the exit guard names it, and it is owned by the call it is inside.
+    pub(crate) fn mark_call(&self, function: &'static str) -> crate::call_site::InCall {
+        crate::call_site::enter(&self.name, &self.fmu.source, function, self.time, crate::call_site::owner_of_call())
+    }
+
     /// The function `f` of the table, or the error naming it as missing.
     pub(crate) fn optional<T>(&self, f: Option<T>, function: &'static str) -> Result<T> {
         f.ok_or_else(|| Error::MissingSymbol { path: self.fmu.source.clone(), symbol: function })

@@ -368,13 +368,7 @@ impl Instance {
         }
         let function = self.calls.reset_name();
         let f = self.calls.reset_function(&self.core)?;
-        let mark = crate::call_site::enter(
-            &self.core.name,
-            &self.core.fmu.source,
-            function,
-            self.core.time,
-            crate::call_site::owner_of_call(),
-        );
+        let mark = self.core.mark_call(function);
         // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.core.component) };
         drop(mark);
@@ -739,13 +733,7 @@ impl Instance {
                 unsafe { free_state(self.core.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(
-            &self.core.name,
-            &self.core.fmu.source,
-            function,
-            self.core.time,
-            crate::call_site::owner_of_call(),
-        );
+        let _mark = self.core.mark_call(function);
         // SAFETY: the component came from the instantiate call and is freed once (the
         // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };
