@@ -25,6 +25,7 @@ use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};
 use crate::log::{callbacks_for, LogRecord, LogSink};
+use crate::status::Status;
 
 /// A saved FMU state (`fmi2FMUstate`), freed by [`Instance::free_state`] or with the instance.
 #[derive(Debug)]
@@ -136,6 +137,7 @@ impl Instance {
                 time: 0.0,
                 host,
                 saved: Vec::new(),
+                last_status: Status::Ok,
             },
             calls,
             _name_c: name_c,
@@ -410,8 +412,13 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
+        let function = match self.core.fmu.abi {
+            Abi::Fmi2(_) => "fmi2GetReal",
+            Abi::Fmi3(_) => "fmi3GetFloat64",
+        };
         Some(Error::NonFinite {
             instance: self.core.name.clone(),
+            function,
             fmu: self.core.fmu.source.clone(),
             variable,
             value: values[k],
