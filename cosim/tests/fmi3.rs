@@ -918,6 +918,17 @@ fn early_returns_without_progress_or_past_the_bound_say_what_the_fmu_returned() 
     );
 }
 
+/// A non-finite FMI 3.0 value names the FMI 3.0 getter and status: the counter with u = 1e38
+/// in steps of 1 s has y = 1e38 k at t = k s (exact enough: 1e38 k < f64's max), and its
+/// f32 = (float)y overflows f32's largest 3.4028e38 to inf first at t = 4 s (3e38 still fits).
+#[test]
+fn a_non_finite_fmi3_value_names_the_fmi3_getter() {
+    let Some((_dir, fmu)) = counter("fmi3-non-finite") else { return };
+    let system = with_starts(&fmu, &[("u", Value::Real(1e38))]);
+    let e = simulate(&system, &Experiment::new(6.0, 1.0)).unwrap_err().to_string();
+    assert!(e.contains("c (fmi3_counter.fmu): f32 = inf at t = 4 s, returned with fmi3OK by fmi3GetFloat32"), "{e}");
+}
+
 /// A description of a later FMI 3 minor version ("3.1") runs as FMI 3.0, with a note saying
 /// so; a revision of 3.0 ("3.0.2") needs none.
 #[test]

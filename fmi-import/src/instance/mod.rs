@@ -412,9 +412,13 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
-        let function = match self.core.fmu.abi {
-            Abi::Fmi2(_) => "fmi2GetReal",
-            Abi::Fmi3(_) => "fmi3GetFloat64",
+        // the getter of the variable's type (an array element of the view: its array's)
+        let function = match self.core.fmu.fmi3_description() {
+            None => "fmi2GetReal",
+            Some(md) => match md.model_variables.iter().find(|v| v.value_reference == vrs[k]) {
+                Some(v) if v.value_type == model_description::fmi3::ValueType::Float32 => "fmi3GetFloat32",
+                _ => "fmi3GetFloat64",
+            },
         };
         Some(Error::NonFinite {
             instance: self.core.name.clone(),
