@@ -6,7 +6,8 @@
 #   linux-x86_64     ...-cp310-abi3-manylinux2014_x86_64.manylinux_2_17_x86_64.whl
 #   linux-aarch64    ...-cp310-abi3-manylinux2014_aarch64.manylinux_2_17_aarch64.whl
 #   windows-x86_64   ...-cp310-abi3-win_amd64.whl (mingw-w64; python3.dll through raw-dylib)
-#   macos-universal2 ...-cp310-abi3-macosx_11_0_universal2.whl (x86-64 and arm64, macOS 11)
+#   macos-universal2 ...-cp310-abi3-macosx_11_0_arm64.macosx_11_0_universal2.macosx_11_0_x86_64.whl
+#                    (one module with x86-64 and arm64 slices, macOS 11)
 # (manylinux2014 is manylinux_2_17: the two names of one platform tag.) The Linux wheels are
 # linked by zig against glibc 2.17, as the FMUs' libraries are; the others use the toolchains
 # of the FMUs' and the master's recipes (build-fmu/src/platform.rs, Platform::cargo_build:
@@ -41,10 +42,18 @@ case "$platform" in
         tag=win_amd64
         export CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc
         export CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUSTFLAGS="-C link-arg=-Wl,--no-insert-timestamp"
-        args=(--target x86_64-pc-windows-gnu -Zbuild-std=std,panic_unwind) ;;
+        # --strip: without the COFF symbol table (4 of the module's 12.7 MB), as the FMUs' DLLs
+        args=(--strip --target x86_64-pc-windows-gnu -Zbuild-std=std,panic_unwind) ;;
     macos-universal2)
-        tag=macosx_11_0_universal2
+        # (maturin names a universal2 wheel with its two slices' tags too: a pip that does not
+        # know universal2 installs it)
+        tag=macosx_11_0_arm64.macosx_11_0_universal2.macosx_11_0_x86_64
         export MACOSX_DEPLOYMENT_TARGET=11.0
+        # the flags of the macOS FMUs' recipe (Platform::cargo_build); maturin adds
+        # -undefined dynamic_lookup to every crate's and names the module
+        # @rpath/nigel_cosim._native.abi3.so itself, so no crate of the FMUs' build is reused
+        export CARGO_TARGET_X86_64_APPLE_DARWIN_RUSTFLAGS=-Zosx-rpath-install-name
+        export CARGO_TARGET_AARCH64_APPLE_DARWIN_RUSTFLAGS=-Zosx-rpath-install-name
         args=(--zig --target universal2-apple-darwin -Zbuild-std=std,panic_unwind) ;;
     *) echo "python-wheel: unknown platform $platform (linux-x86_64, linux-aarch64, windows-x86_64, macos-universal2)" >&2; exit 2 ;;
 esac

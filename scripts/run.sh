@@ -2,7 +2,7 @@
 # The main job: installs the system packages and cross toolchains (as the test command does),
 # builds every binary of the workspace into target/release/ (cosim, cosim-host, campaign,
 # table3, synthesize, build-fmu, ...), the Python package's wheels into target/wheels/ (x86-64
-# and aarch64 Linux), the master's release archives for five platforms
+# and aarch64 Linux, Windows, macOS), the master's release archives for five platforms
 # into target/dist/ (scripts/dist.sh), the venv
 # of the README's quick start (target/venv: fmpy, pandas, matplotlib and nigel_cosim), the three FMUs for all four platforms (the release
 # archives: linux64 with the glibc 2.17 baseline, win64, aarch64-linux, darwin64) into
@@ -22,10 +22,12 @@ cargo build --release --quiet --workspace --bins
 
 echo "== the Python package's wheel (target/wheels: pip install it into any CPython >= 3.10)"
 wheel="$(bash scripts/python-wheel.sh)"
-# (the Windows and macOS wheels, `python-wheel.sh windows-x86_64|macos-universal2`, are not
-# built here yet: never built to the end on this machine, docs/platforms.md)
-echo "== the Python package's wheel for aarch64 Linux (manylinux2014)"
-bash scripts/python-wheel.sh linux-aarch64
+python3 scripts/wheel-check.py "$wheel" linux-x86_64
+echo "== its wheels for aarch64 Linux (manylinux2014), Windows (win_amd64), macOS 11 (universal2), each checked"
+for platform in linux-aarch64 windows-x86_64 macos-universal2; do
+    other="$(bash scripts/python-wheel.sh "$platform")"
+    python3 scripts/wheel-check.py "$other" "$platform"
+done
 echo "== the venv of the README's quick start: target/venv with fmpy, pandas, matplotlib and nigel_cosim"
 bash scripts/python-venv-wheel.sh "$wheel"
 
