@@ -123,6 +123,27 @@ fn the_default_solver_switches_to_bdf_on_a_stiff_system_and_matches_the_closed_f
     assert!(sa.notes.iter().all(|n| !n.contains("stiff at")), "{:?}", sa.notes);
 }
 
+/// dopri5 on the stiff linear system (lambda = 1e4) is right but slow, and says why once:
+/// Hairer and Wanner's stiffness test (h lambda above 3.25 on 15 tested steps, the tests
+/// from the 1000th accepted step on; `integrator/dopri5.rs`) names the instance, the time
+/// and the solvers that suit it.
+#[test]
+fn dopri5_on_a_stiff_system_notes_once_that_it_is_stiff() {
+    let dir = work_dir("stiff-dopri5");
+    let fmu = build_linear(&dir);
+    let (r, s) = run(&fmu, "lin", &[], 10.0, 0.01, Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 });
+    let notes: Vec<&String> = s.notes.iter().filter(|n| n.contains("stiff at")).collect();
+    assert_eq!(notes.len(), 1, "{:?}", s.notes);
+    assert!(notes[0].starts_with("lin: stiff at t = "), "{}", notes[0]);
+    assert!(notes[0].contains("--solver auto (the default) or bdf suits a stiff system"), "{}", notes[0]);
+    // held by stability: h < 3.7 / lambda (the largest h lambda its steps reach), more than
+    // 2.7e4 steps for 10 s, where bdf needs fewer than 2000 for 2 s
+    assert!(s.integrator_steps.0 > 27_000, "{:?}", s.integrator_steps);
+    // and right: the local errors below rtol |x| + atol, damped by the decay: 10 rtol
+    let worst = linear_error(&r, 1e4);
+    assert!(worst < 1e-5, "{worst:e}");
+}
+
 #[test]
 fn bdf_on_van_der_pol_uses_the_fmus_directional_derivatives_and_matches_dopri5() {
     let dir = work_dir("stiff-vdp");

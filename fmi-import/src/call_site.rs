@@ -1,4 +1,6 @@
-//! The marker of the FMU call in progress: which instance, which function, at what time.
+//! The marker of the FMU call in progress: which instance, which function, at what time,
+//! and which instance owns the memory the FMU allocates in it (fmi-sys's `fmi2::guard`
+//! reads that through [`owner_of_call`]: one thread-local for both).
 //!
 //! Every call into an FMU is marked (two stores per call, a thread-local): the master's
 //! `atexit` handler reads the mark when an FMU ends the process with `exit()` inside a call
@@ -43,6 +45,10 @@ struct Site {
     fmu: *const Path,
     function: &'static str,
     time: f64,
+    /// The instance's `componentEnvironment`, which owns the blocks the FMU allocates in
+    /// the call (fmi-sys's `fmi2::guard` reads it through [`owner_of_call`]): one
+    /// thread-local per call for both.
+    owner: usize,
 }
 
 thread_local! {
@@ -117,10 +123,11 @@ fn copy_name(dst: &mut [u8; NAME], len: &AtomicU32, s: &str) {
 pub(crate) struct InCall(Option<Site>, bool);
 
 /// Marks the call `function` of `instance` (of the FMU archive `fmu`) at `time` as in progress in this
-/// thread.
+/// thread, the blocks the FMU allocates in it owned by `owner` (the instance's
+/// `componentEnvironment`; [`owner_of_call`] for the owner of the call this one is in).
 #[inline]
-pub(crate) fn enter(instance: &str, fmu: &Path, function: &'static str, time: f64) -> InCall {
-    let site = Site { instance, fmu, function, time };
+pub(crate) fn enter(instance: &str, fmu: &Path, function: &'static str, time: f64, owner: usize) -> InCall {
+    let site = Site { instance, fmu, function, time, owner };
     let p = SHARED.load(Ordering::Relaxed);
     let shared = !p.is_null();
     if shared {
@@ -153,6 +160,13 @@ impl Drop for InCall {
             }
         }
     }
+}
+
+/// The owner of the call this thread is in (0: none, or the thread-local is gone): the
+/// function fmi-sys's `fmi2::guard` reads the owner of a block through
+/// (`fmi_sys::fmi2::guard::owners_from`).
+pub(crate) fn owner_of_call() -> usize {
+    CALL.try_with(|c| c.get().map_or(0, |site| site.owner)).unwrap_or(0)
 }
 
 /// The call this thread is in (`None`: none, or the thread-local is gone). For the

@@ -113,6 +113,12 @@ pub trait Integrator: std::fmt::Debug + Send {
         None
     }
 
+    /// The step where a method that does not change itself found the system stiff, once
+    /// a run, for the master's note that another method suits it (dopri5's stiffness test).
+    fn take_found_stiff(&mut self) -> Option<rk4::StiffStep> {
+        None
+    }
+
     /// Whether it has switched to bdf (its work is then reported as bdf's).
     fn switched(&self) -> bool {
         false

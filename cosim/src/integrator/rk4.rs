@@ -29,7 +29,8 @@ use crate::error::Result;
 /// margin over the bound: the estimate of rho is the quotient along one direction).
 pub const STIFF_H_RHO: f64 = 3.0;
 
-/// A step found stiff, not taken.
+/// A step found stiff: RK4's, not taken (where it stopped); dopri5's, the accepted step
+/// of its last stiff test (`h_rho` its estimate of h lambda).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StiffStep {
     /// Its start, s (where the method stopped).

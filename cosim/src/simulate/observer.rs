@@ -47,6 +47,11 @@ pub(crate) struct Recorder<'s> {
     /// [`Results::exact`](crate::simulate::Results::exact)), read from their instances at
     /// each row.
     exact: Vec<ExactSource>,
+    /// The same per instance: (instance, its value references, their places in `exact`),
+    /// read in one call each, so that an array is read once per row.
+    exact_reads: Vec<(usize, Vec<u32>, Vec<usize>)>,
+    /// The values of one such call.
+    exact_values: Vec<crate::fmi3::Exact>,
     /// Their text at the row being recorded.
     exact_row: Vec<String>,
     /// (column, text) of that row, for the sink.
@@ -82,6 +87,16 @@ impl<'s> Recorder<'s> {
         let row = Vec::with_capacity(slots.len());
         let columns =
             exact.iter().map(|e| crate::simulate::ExactColumn { column: e.column, rows: Vec::new() }).collect();
+        let mut exact_reads: Vec<(usize, Vec<u32>, Vec<usize>)> = Vec::new();
+        for (k, e) in exact.iter().enumerate() {
+            match exact_reads.iter_mut().find(|(instance, ..)| *instance == e.instance) {
+                Some((_, vrs, places)) => {
+                    vrs.push(e.value_reference);
+                    places.push(k);
+                }
+                None => exact_reads.push((e.instance, vec![e.value_reference], vec![k])),
+            }
+        }
         Recorder {
             shared: std::sync::Arc::new(crate::exit_guard::RunRows {
                 results: std::sync::Mutex::new(Results { names, values: Vec::new(), exact: columns }),
@@ -92,6 +107,8 @@ impl<'s> Recorder<'s> {
             row,
             last: None,
             exact,
+            exact_reads,
+            exact_values: Vec::new(),
             exact_row: Vec::new(),
             exact_cells: Vec::new(),
         }
@@ -108,9 +125,12 @@ impl<'s> Recorder<'s> {
     /// `fmi3GetString`).
     pub(crate) fn read_exact(&mut self, lanes: &mut [crate::simulate::lane::Lane]) -> Result<()> {
         self.exact_row.clear();
-        for e in &self.exact {
-            let value = lanes[e.instance].inst.get_exact(e.value_reference)?;
-            self.exact_row.push(value.to_text());
+        self.exact_row.resize(self.exact.len(), String::new());
+        for (instance, vrs, places) in &self.exact_reads {
+            lanes[*instance].inst.get_exact_many(vrs, &mut self.exact_values)?;
+            for (place, value) in places.iter().zip(&self.exact_values) {
+                self.exact_row[*place] = value.to_text();
+            }
         }
         Ok(())
     }

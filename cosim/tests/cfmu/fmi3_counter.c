@@ -30,6 +30,8 @@
  * and, in the descriptions of the tests of large arrays only (j from 0):
  *   40 big Float64[BIG] output y + j   41 bigi Int32[BIG] output n + j
  *   42 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
+ *   43 bigw Int64[BIG] output 2^62 + 1 + n + j (none of them an f64)
+ *   44 bigw_reads Int32 output: the number of fmi3GetInt64 calls that asked for bigw so far
  * Co-Simulation: each step adds mode * u * h to y (the whole step, or, when the importer allows early
  * return, the part up to early_at when it lies inside it: then it returns early there, once); the step that reaches stop_at says
  * terminateSimulation; with eventModeUsed (a description with hasEventMode), the step in which
@@ -57,6 +59,7 @@ typedef struct {
     long long i64in, i64ain[2];
     unsigned long long u64in, u64ain[2];
     unsigned char bytes[64];
+    int bigw_reads;
 } State;
 
 typedef struct {
@@ -266,6 +269,7 @@ fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
         case 3: values[i] = c->s.n; break;
         case 9: values[i] = c->s.k; break;
         case 31: values[i] = c->s.crash_how; break;
+        case 44: values[i] = c->s.bigw_reads; break;
         case 10: values[i] = 2 * c->s.k; break;
         default: return fail(c, "fmi3GetInt32: no such Int32");
         }
@@ -289,15 +293,22 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
 
 /* fmi3Get<Kind> and fmi3Set<Kind> of the 64-bit integers (C type fmi3<Kind>): the 2-element
  * array input `array` (value reference `array_vr`) and its output (array_vr + 1), each element
- * with its lowest bit flipped, then the scalars, read by `get_scalar(c, vr, &value)` (0: no such
+ * with its lowest bit flipped, the output array of BIG elements `big_vr` read by
+ * `get_big(c, values)`, then the scalars, read by `get_scalar(c, vr, &value)` (0: no such
  * variable) and set by `set_scalar(c, vr, value)` (NULL, or why not). Values are consumed in
  * order, an array taking as many as it has elements. */
-#define WIDE_GET_SET(Kind, array_vr, array, get_scalar, set_scalar)                                \
+#define WIDE_GET_SET(Kind, array_vr, array, big_vr, get_big, get_scalar, set_scalar)               \
     fmi3Status fmi3Get##Kind(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,    \
         fmi3##Kind values[], size_t nValues) {                                                     \
         Counter *c = instance;                                                                     \
         size_t j = 0;                                                                              \
         for (size_t i = 0; i < nvr; i++) {                                                         \
+            if (vr[i] == big_vr) {                                                                 \
+                if (j + BIG > nValues) return fail(c, "fmi3Get" #Kind ": nValues too small");       \
+                get_big(c, values + j);                                                            \
+                j += BIG;                                                                          \
+                continue;                                                                          \
+            }                                                                                      \
             size_t size = vr[i] == array_vr || vr[i] == array_vr + 1 ? 2 : 1;                      \
             if (j + size > nValues) return fail(c, "fmi3Get" #Kind ": nValues too small");          \
             if (size == 2)                                                                         \
@@ -339,7 +350,12 @@ static const char *set_int64(Counter *c, fmi3ValueReference vr, fmi3Int64 value)
     else c->s.mode = value;
     return NULL;
 }
-WIDE_GET_SET(Int64, 36, i64ain, get_int64, set_int64)
+/* bigw, counting its reads */
+static void get_bigw(Counter *c, fmi3Int64 values[]) {
+    for (size_t e = 0; e < BIG; e++) values[e] = (1LL << 62) + 1 + c->s.n + (fmi3Int64)e;
+    c->s.bigw_reads += 1;
+}
+WIDE_GET_SET(Int64, 36, i64ain, 43, get_bigw, get_int64, set_int64)
 
 static int get_uint64(const Counter *c, fmi3ValueReference vr, fmi3UInt64 *value) {
     switch (vr) {
@@ -354,7 +370,9 @@ static const char *set_uint64(Counter *c, fmi3ValueReference vr, fmi3UInt64 valu
     c->s.u64in = value;
     return NULL;
 }
-WIDE_GET_SET(UInt64, 38, u64ain, get_uint64, set_uint64)
+/* no UInt64 array of BIG elements: a value reference no variable has */
+static void no_big(Counter *c, fmi3UInt64 values[]) {}
+WIDE_GET_SET(UInt64, 38, u64ain, 0xFFFFFFFFu, no_big, get_uint64, set_uint64)
 
 fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
     fmi3Boolean values[], size_t nValues) {

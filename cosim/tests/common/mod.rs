@@ -544,20 +544,28 @@ pub fn build_counter_with_flags(dir: &Path, stem: &str, xml: &str, flags: &[&str
 }
 
 /// The FMI 3.0 test FMU's description (tests/cfmu/fmi3_counter.xml) with the large array
-/// outputs `arrays` (of `big` Float64, `bigi` Int32, `bigb` Boolean) of `n` elements each
-/// (fmi3_counter.c built with `-DBIG=n`).
+/// outputs `arrays` (of `big` Float64, `bigi` Int32, `bigb` Boolean, `bigw` Int64 with its
+/// read counter `bigw_reads`) of `n` elements each (fmi3_counter.c built with `-DBIG=n`).
 pub fn counter_xml_with_large_arrays(n: usize, arrays: &[&str]) -> String {
     let xml = include_str!("../cfmu/fmi3_counter.xml");
     let arr = r#"<Float64 name="arr" valueReference="24" causality="output"><Dimension start="3"/></Float64>"#;
     assert!(xml.contains(arr));
     let mut declared = arr.to_string();
-    for (name, ty, vr) in [("big", "Float64", 40), ("bigi", "Int32", 41), ("bigb", "Boolean", 42)] {
+    for (name, ty, vr) in
+        [("big", "Float64", 40), ("bigi", "Int32", 41), ("bigb", "Boolean", 42), ("bigw", "Int64", 43)]
+    {
         if arrays.contains(&name) {
             declared.push_str(&format!(
                 r#"
     <{ty} name="{name}" valueReference="{vr}" causality="output"><Dimension start="{n}"/></{ty}>"#
             ));
         }
+    }
+    if arrays.contains(&"bigw") {
+        declared.push_str(
+            r#"
+    <Int32 name="bigw_reads" valueReference="44" causality="output" variability="discrete"/>"#,
+        );
     }
     xml.replace(arr, &declared)
 }

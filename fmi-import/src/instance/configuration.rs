@@ -7,7 +7,7 @@
 //! in an event of a Model Exchange instance (from Event Mode), the arrays it sizes read and
 //! set with their new size from then on.
 
-use super::core::{call, Core, InstanceState};
+use super::core::{call, Core};
 use super::fmi3::Fmi3;
 use super::Instance;
 use crate::error::{Error, Result};
@@ -72,7 +72,7 @@ impl Fmi3 {
                     .into(),
             ));
         }
-        if core.state != InstanceState::Running {
+        if !core.state.is_running() {
             return Err(bad(
                 first,
                 *x,

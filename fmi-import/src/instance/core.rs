@@ -18,8 +18,12 @@ pub enum InstanceState {
     Instantiated,
     /// After `fmi2EnterInitializationMode`.
     Initialization,
-    /// After `fmi2ExitInitializationMode` (step complete / event or continuous-time mode).
+    /// After `fmi2ExitInitializationMode` (step complete / event mode; Model Exchange after
+    /// `fmi2EnterEventMode`).
     Running,
+    /// Model Exchange after `fmi2EnterContinuousTimeMode`, until `fmi2EnterEventMode`: only
+    /// continuous inputs may change (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2.1).
+    ContinuousTime,
     /// After `fmi2Terminate`.
     Terminated,
     /// After an `fmi2Error`: only free is called.
@@ -29,11 +33,18 @@ pub enum InstanceState {
 }
 
 impl InstanceState {
+    /// Whether it runs: after initialization, in any mode, before termination or an error.
+    #[inline]
+    pub fn is_running(self) -> bool {
+        matches!(self, InstanceState::Running | InstanceState::ContinuousTime)
+    }
+
     pub(crate) fn as_str(self) -> &'static str {
         match self {
             InstanceState::Instantiated => "instantiated",
             InstanceState::Initialization => "initialization mode",
             InstanceState::Running => "running",
+            InstanceState::ContinuousTime => "continuous-time mode",
             InstanceState::Terminated => "terminated",
             InstanceState::Errored => "errored",
             InstanceState::Fatal => "fatal",
@@ -68,12 +79,11 @@ macro_rules! call {
         let core: &mut $crate::instance::core::Core = $core;
         core.check_callable($name)?;
         let time: Option<f64> = $time;
-        let mark = $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time));
         // the blocks the FMU allocates in the call are this instance's (fmi-sys's guard)
-        let owner = fmi_sys::fmi2::guard::enter_owner(core.log.owner());
+        let mark =
+            $crate::call_site::enter(&core.name, &core.fmu.source, $name, time.unwrap_or(core.time), core.log.owner());
         // SAFETY: the component is live (not freed), the arguments are valid for the call.
         let raw = unsafe { $f };
-        drop(owner);
         drop(mark);
         core.status($name, raw, time)
     }};
@@ -215,8 +225,9 @@ pub(crate) trait Calls: Send {
     /// The string of `vr` as the FMU returns it (valid until its next call).
     fn get_string(&mut self, core: &mut Core, vr: u32) -> Result<*const std::ffi::c_char>;
     fn set_string(&mut self, core: &mut Core, vr: u32, value: *const std::ffi::c_char) -> Result<()>;
-    /// The exact value of a variable of [`crate::Fmu::exact_kind`] (FMI 3.0 only).
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact>;
+    /// The exact values of variables of [`crate::Fmu::exact_kind`], appended to `values`
+    /// (FMI 3.0 only): an array read once for all its elements among `vrs`.
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()>;
     /// Sets a 64-bit integer variable of [`crate::Fmu::exact_kind`] exactly (FMI 3.0 only).
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()>;
     fn do_step(&mut self, core: &mut Core, time: f64, step: f64) -> Result<()>;

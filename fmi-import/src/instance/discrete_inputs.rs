@@ -5,7 +5,8 @@
 //! discrete input in Continuous-Time Mode is therefore not passed on: a value the FMU
 //! already holds is dropped, a new one waits ([`DiscreteInputs::defer`]) until the importer
 //! brings the instance into Event Mode and applies it there
-//! ([`super::Instance::apply_pending_inputs`]).
+//! ([`super::Instance::apply_pending_inputs`]). Whether the instance is in Continuous-Time
+//! Mode is its state machine's ([`super::InstanceState::ContinuousTime`]), told with each set.
 
 use std::collections::{HashMap, HashSet};
 
@@ -36,8 +37,6 @@ pub(crate) enum Held {
 pub(crate) struct DiscreteInputs {
     /// The value references of the continuous Real inputs (set in any mode).
     continuous: HashSet<u32>,
-    /// The instance is in Continuous-Time Mode.
-    pub(crate) continuous_time: bool,
     /// The value last given to the FMU of every other variable set so far.
     given: HashMap<(Kind, u32), Held>,
     /// The sets waiting for Event Mode, in the order made, one per variable (the last).
@@ -62,22 +61,17 @@ impl DiscreteInputs {
         if inputs == continuous.len() {
             return None;
         }
-        Some(Box::new(DiscreteInputs {
-            continuous,
-            continuous_time: false,
-            given: HashMap::new(),
-            pending: Vec::new(),
-        }))
+        Some(Box::new(DiscreteInputs { continuous, given: HashMap::new(), pending: Vec::new() }))
     }
 
     /// Whether a set of `vr` through `kind` waits (or is dropped) instead of reaching the
-    /// FMU now: in Continuous-Time Mode, anything but a continuous Real input. A value
-    /// that reaches the FMU is noted as what it holds.
-    pub(crate) fn defer(&mut self, kind: Kind, vr: u32, value: Held) -> bool {
+    /// FMU now: in Continuous-Time Mode (`continuous_time`), anything but a continuous Real
+    /// input. A value that reaches the FMU is noted as what it holds.
+    pub(crate) fn defer(&mut self, continuous_time: bool, kind: Kind, vr: u32, value: Held) -> bool {
         if kind == Kind::Real && self.continuous.contains(&vr) {
             return false;
         }
-        if !self.continuous_time {
+        if !continuous_time {
             self.given.insert((kind, vr), value);
             return false;
         }
@@ -94,9 +88,10 @@ impl DiscreteInputs {
         self.given.clear();
     }
 
-    /// Whether any of `vrs` (set through `kind`) would wait: the batch must be split.
-    pub(crate) fn any_deferred(&self, kind: Kind, vrs: &[u32]) -> bool {
-        self.continuous_time && (kind != Kind::Real || vrs.iter().any(|vr| !self.continuous.contains(vr)))
+    /// Whether any of `vrs` (set through `kind`) would wait in Continuous-Time Mode
+    /// (`continuous_time`): the batch must be split.
+    pub(crate) fn any_deferred(&self, continuous_time: bool, kind: Kind, vrs: &[u32]) -> bool {
+        continuous_time && (kind != Kind::Real || vrs.iter().any(|vr| !self.continuous.contains(vr)))
     }
 }
 
@@ -105,12 +100,7 @@ mod tests {
     use super::*;
 
     fn inputs() -> DiscreteInputs {
-        DiscreteInputs {
-            continuous: [1].into_iter().collect(),
-            continuous_time: false,
-            given: HashMap::new(),
-            pending: Vec::new(),
-        }
+        DiscreteInputs { continuous: [1].into_iter().collect(), given: HashMap::new(), pending: Vec::new() }
     }
 
     /// Out of Continuous-Time Mode everything passes (and is noted); in it a continuous
@@ -119,20 +109,19 @@ mod tests {
     #[test]
     fn discrete_sets_wait_in_continuous_time_mode_unless_the_fmu_holds_the_value() {
         let mut d = inputs();
-        assert!(!d.defer(Kind::Integer, 7, Held::Integer(3)));
-        d.continuous_time = true;
-        assert!(!d.defer(Kind::Real, 1, Held::Real(2.0f64.to_bits())));
-        assert!(d.defer(Kind::Integer, 7, Held::Integer(3)));
+        assert!(!d.defer(false, Kind::Integer, 7, Held::Integer(3)));
+        assert!(!d.defer(true, Kind::Real, 1, Held::Real(2.0f64.to_bits())));
+        assert!(d.defer(true, Kind::Integer, 7, Held::Integer(3)));
         assert!(d.pending.is_empty());
-        assert!(d.defer(Kind::Integer, 7, Held::Integer(4)));
-        assert!(d.defer(Kind::Integer, 7, Held::Integer(5)));
+        assert!(d.defer(true, Kind::Integer, 7, Held::Integer(4)));
+        assert!(d.defer(true, Kind::Integer, 7, Held::Integer(5)));
         assert_eq!(d.pending, vec![(Kind::Integer, 7, Held::Integer(5))]);
-        assert!(d.defer(Kind::Integer, 7, Held::Integer(3)));
+        assert!(d.defer(true, Kind::Integer, 7, Held::Integer(3)));
         assert!(d.pending.is_empty());
         // the same value reference of another type is another variable (FMI 2.0)
-        assert!(d.defer(Kind::Boolean, 7, Held::Boolean(true)));
-        assert!(d.defer(Kind::Real, 2, Held::Real(0.5f64.to_bits())));
+        assert!(d.defer(true, Kind::Boolean, 7, Held::Boolean(true)));
+        assert!(d.defer(true, Kind::Real, 2, Held::Real(0.5f64.to_bits())));
         assert_eq!(d.pending.len(), 2);
-        assert!(d.any_deferred(Kind::Real, &[1, 2]) && !d.any_deferred(Kind::Real, &[1]));
+        assert!(d.any_deferred(true, Kind::Real, &[1, 2]) && !d.any_deferred(true, Kind::Real, &[1]));
     }
 }

@@ -55,8 +55,9 @@ impl Calls for Fmi2 {
     ) -> Result<Component> {
         let guid = CString::new(fmu.description.guid.as_str())
             .map_err(|_| Error::ModelDescription { path: fmu.source.clone(), reason: "NUL in guid".into() })?;
-        let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0);
-        let owner = fmi_sys::fmi2::guard::enter_owner(log.owner());
+        // the guard reads the owner of a block from the call's mark (once a process)
+        fmi_sys::fmi2::guard::owners_from(crate::call_site::owner_of_call);
+        let mark = crate::call_site::enter(name, &fmu.source, "fmi2Instantiate", 0.0, log.owner());
         // SAFETY: every pointer is valid for the call; callbacks and log live as long as the instance.
         let component = unsafe {
             (self.t.instantiate)(
@@ -69,7 +70,6 @@ impl Calls for Fmi2 {
                 0,
             )
         };
-        drop(owner);
         drop(mark);
         if component.is_null() {
             return Err(Error::Instantiate {
@@ -162,8 +162,8 @@ impl Calls for Fmi2 {
         call!(core, "fmi2SetString", None, f(c, &vr, 1, &p))
     }
 
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
-        Err(no_exact(core, vr, String::new()))
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], _values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        Err(no_exact(core, vrs.first().copied().unwrap_or_default(), String::new()))
     }
 
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {

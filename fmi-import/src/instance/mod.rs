@@ -272,16 +272,14 @@ impl Instance {
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
         self.calls.exit_initialization_mode(&mut self.core)?;
         self.core.state = InstanceState::Running;
-        self.set_continuous_time(false);
         Ok(())
     }
 
     /// Model Exchange: whether the instance is in Continuous-Time Mode (discrete inputs
     /// wait for Event Mode then).
-    fn set_continuous_time(&mut self, on: bool) {
-        if let Some(d) = self.discrete.as_deref_mut() {
-            d.continuous_time = on;
-        }
+    #[inline]
+    fn in_continuous_time(&self) -> bool {
+        self.core.state == InstanceState::ContinuousTime
     }
 
     /// Model Exchange: whether discrete inputs set in Continuous-Time Mode wait for Event
@@ -294,8 +292,7 @@ impl Instance {
     /// The discrete inputs that wait (see [`Instance::has_pending_inputs`]) set, in the
     /// order they were set; in Event Mode (after [`Instance::enter_event_mode`]).
     pub fn apply_pending_inputs(&mut self) -> Result<()> {
-        let Some(d) = self.discrete.as_deref_mut() else { return Ok(()) };
-        if d.continuous_time {
+        if self.in_continuous_time() {
             let instance = self.core.name.clone();
             return Err(Error::IllegalCall {
                 instance,
@@ -303,6 +300,7 @@ impl Instance {
                 state: "Continuous-Time Mode",
             });
         }
+        let Some(d) = self.discrete.as_deref_mut() else { return Ok(()) };
         for (_, vr, value) in std::mem::take(&mut d.pending) {
             match value {
                 Held::Real(bits) => self.set_real(&[vr], &[f64::from_bits(bits)])?,
@@ -326,12 +324,13 @@ impl Instance {
         values: &[T],
         set: impl Fn(&mut (dyn Calls + 'static), &mut Core, &[u32], &[T]) -> Result<()>,
     ) -> Result<()> {
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.any_deferred(kind, vrs) {
+            if d.any_deferred(continuous_time, kind, vrs) {
                 let (vrs, values): (Vec<u32>, Vec<T>) = vrs
                     .iter()
                     .zip(values)
-                    .filter(|(vr, v)| !d.defer(kind, **vr, held(**v)))
+                    .filter(|(vr, v)| !d.defer(continuous_time, kind, **vr, held(**v)))
                     .map(|(vr, v)| (*vr, *v))
                     .unzip();
                 if vrs.is_empty() {
@@ -339,9 +338,9 @@ impl Instance {
                 }
                 return set(self.calls.as_mut(), &mut self.core, &vrs, &values);
             }
-            if !d.continuous_time {
+            if !continuous_time {
                 for (vr, v) in vrs.iter().zip(values) {
-                    d.defer(kind, *vr, held(*v));
+                    d.defer(false, kind, *vr, held(*v));
                 }
             }
         }
@@ -351,7 +350,10 @@ impl Instance {
     /// `fmi2Terminate` / `fmi3Terminate` (only from initialization or running; otherwise
     /// nothing to do).
     pub fn terminate(&mut self) -> Result<()> {
-        if !matches!(self.core.state, InstanceState::Running | InstanceState::Initialization) {
+        if !matches!(
+            self.core.state,
+            InstanceState::Running | InstanceState::ContinuousTime | InstanceState::Initialization
+        ) {
             return Ok(());
         }
         self.calls.terminate(&mut self.core)?;
@@ -368,7 +370,13 @@ impl Instance {
         }
         let function = self.calls.reset_name();
         let f = self.calls.reset_function(&self.core)?;
-        let mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
+        let mark = crate::call_site::enter(
+            &self.core.name,
+            &self.core.fmu.source,
+            function,
+            self.core.time,
+            crate::call_site::owner_of_call(),
+        );
         // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.core.component) };
         drop(mark);
@@ -468,20 +476,46 @@ impl Instance {
     /// ([`Fmu::exact_kind`]: `fmi3GetInt64`, `fmi3GetUInt64`, `fmi3GetBinary` of the
     /// element), or a String's text.
     pub fn get_exact(&mut self, vr: u32) -> Result<crate::fmi3::Exact> {
-        let is_string = self.core.fmu.description.model_variables.iter().any(|v| {
-            v.value_reference == vr && matches!(v.variable_type, model_description::VariableType::String { .. })
-        });
-        if is_string {
-            return self.get_string(vr).map(crate::fmi3::Exact::Text);
+        let mut values = Vec::with_capacity(1);
+        self.get_exact_many(&[vr], &mut values)?;
+        Ok(values.pop().expect("one value per value reference"))
+    }
+
+    /// [`Instance::get_exact`] of each of `vrs` into `values` (cleared first, then one per
+    /// value reference): each array is read once for all its elements among `vrs`, so
+    /// that a row of the results costs time linear in the elements.
+    pub fn get_exact_many(&mut self, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        values.clear();
+        let mut rest = vrs;
+        while let Some(&first) = rest.first() {
+            if self.is_string(first) {
+                values.push(self.get_string(first).map(crate::fmi3::Exact::Text)?);
+                rest = &rest[1..];
+                continue;
+            }
+            // the run of values up to the next String, in one call
+            let run = rest.iter().position(|vr| self.is_string(*vr)).unwrap_or(rest.len());
+            self.calls.get_exact(&mut self.core, &rest[..run], values)?;
+            rest = &rest[run..];
         }
-        self.calls.get_exact(&mut self.core, vr)
+        Ok(())
+    }
+
+    /// Whether the view's variable `vr` is a String (an Int64, UInt64 or Binary found in
+    /// the view's map first: no scan of the variables per element of an array).
+    fn is_string(&self, vr: u32) -> bool {
+        self.core.fmu.exact_kind(vr).is_none()
+            && self.core.fmu.description.model_variables.iter().any(|v| {
+                v.value_reference == vr && matches!(v.variable_type, model_description::VariableType::String { .. })
+            })
     }
 
     /// `fmi3SetInt64` / `fmi3SetUInt64` of `vr` exactly (a variable of
     /// [`Fmu::exact_kind`] Int64 or UInt64); a value outside its type's range is refused.
     pub fn set_exact_integer(&mut self, vr: u32, value: i128) -> Result<()> {
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.defer(Kind::Exact, vr, Held::Exact(value)) {
+            if d.defer(continuous_time, Kind::Exact, vr, Held::Exact(value)) {
                 return Ok(());
             }
         }
@@ -495,8 +529,9 @@ impl Instance {
             value: value.into(),
             reason: "NUL in string".into(),
         })?;
+        let continuous_time = self.in_continuous_time();
         if let Some(d) = self.discrete.as_deref_mut() {
-            if d.defer(Kind::String, vr, Held::String(value.into())) {
+            if d.defer(continuous_time, Kind::String, vr, Held::String(value.into())) {
                 return Ok(());
             }
         }
@@ -523,7 +558,7 @@ impl Instance {
     pub fn post_step(&mut self, time: f64, step: f64) -> bool {
         let Some((op, step)) = self.calls.posted_step(time, step) else { return false };
         let Some(host) = self.core.host.as_deref_mut() else { return false };
-        if self.core.state != InstanceState::Running {
+        if !self.core.state.is_running() {
             return false;
         }
         crate::isolate::proxy::post_step(host, op, time, step);
@@ -645,7 +680,9 @@ impl Instance {
     /// `fmi2EnterEventMode` / `fmi3EnterEventMode`.
     pub fn enter_event_mode(&mut self) -> Result<()> {
         self.calls.enter_event_mode(&mut self.core)?;
-        self.set_continuous_time(false);
+        if self.core.state == InstanceState::ContinuousTime {
+            self.core.state = InstanceState::Running;
+        }
         Ok(())
     }
 
@@ -658,7 +695,9 @@ impl Instance {
     /// `fmi2EnterContinuousTimeMode` / `fmi3EnterContinuousTimeMode`.
     pub fn enter_continuous_time_mode(&mut self) -> Result<()> {
         self.calls.enter_continuous_time_mode(&mut self.core)?;
-        self.set_continuous_time(true);
+        if self.core.state == InstanceState::Running {
+            self.core.state = InstanceState::ContinuousTime;
+        }
         Ok(())
     }
 
@@ -711,7 +750,13 @@ impl Instance {
                 unsafe { free_state(self.core.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(&self.core.name, &self.core.fmu.source, function, self.core.time);
+        let _mark = crate::call_site::enter(
+            &self.core.name,
+            &self.core.fmu.source,
+            function,
+            self.core.time,
+            crate::call_site::owner_of_call(),
+        );
         // SAFETY: the component came from the instantiate call and is freed once (the
         // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };

@@ -38,7 +38,7 @@ impl Fmi3 {
             .ok_or(Error::MissingSymbol { path: fmu.source.clone(), symbol: function })?;
         environment.log.store(log as *const LogSink as *mut LogSink, Ordering::Relaxed);
         let env = environment as *const ScheduledEnvironment as *mut c_void;
-        let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+        let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0, crate::call_site::owner_of_call());
         // SAFETY: every pointer is valid for the call; the environment (owned by the
         // instance's calls, boxed) and the log outlive the FMU instance.
         Ok(unsafe {

@@ -5,9 +5,11 @@
 //!
 //! The blocks alive are kept by owner, the instance whose call allocated them: the
 //! allocator has no `componentEnvironment` argument, so the importer marks each call it makes
-//! with the calling instance's `componentEnvironment` in a thread-local ([`enter_owner`]),
-//! and a block allocated during the call belongs to that instance (an FMU's calls run on
-//! the thread that called it; a block allocated on a thread of the FMU's own has owner 0).
+//! with the calling instance's `componentEnvironment` (in the mark of the call in progress it
+//! keeps anyway, one thread-local) and tells this module how to read it ([`owners_from`]);
+//! a block allocated during the call belongs to that instance (an FMU's calls run on the
+//! thread that called it; a block allocated on a thread of the FMU's own, or with no
+//! importer's function told, has owner 0).
 //! [`overruns_of`] tells how many blocks of one owner have had their red zone written,
 //! alive or freed, and the first such write it saw, reading that owner's blocks only; an
 //! importer compares it before and after a call to know whether the call wrote past a block
@@ -21,12 +23,11 @@
 //! gets from `malloc` itself, and FMI 3.0 (no memory callbacks), are not guarded.
 //!
 //! ```
-//! use fmi_sys::fmi2::guard::{allocate, enter_owner, overruns_of, release};
+//! use fmi_sys::fmi2::guard::{allocate, overruns_of, owners_from, release};
 //! let owner = 0x5eed; // an instance's componentEnvironment
-//! let p = {
-//!     let _call = enter_owner(owner); // the importer's mark around a call of that instance
-//!     unsafe { allocate(6, 8) as *mut f64 }
-//! };
+//! // the importer's mark of the call in progress on this thread (here: always that instance)
+//! owners_from(|| 0x5eed);
+//! let p = unsafe { allocate(6, 8) as *mut f64 };
 //! unsafe {
 //!     *p.add(6) = 1.0; // one past the six doubles: into the red zone
 //!     assert_eq!(overruns_of(owner).count, 1);
@@ -36,10 +37,9 @@
 //! assert_eq!(overruns_of(owner).count, 1);
 //! ```
 
-use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::ffi::{c_char, c_void};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// The bytes after every block that an overrun writes into harmlessly (and is seen in).
 pub const RED_ZONE: usize = 64;
@@ -59,26 +59,21 @@ struct Seen {
     first: Option<(usize, usize)>,
 }
 
-thread_local! {
-    /// The owner of the blocks allocated on this thread now (0: none marked).
-    static OWNER: Cell<usize> = const { Cell::new(0) };
+/// The importer's function that tells the owner of the call in progress on the calling
+/// thread (0: none), told once ([`owners_from`]).
+static OWNER_OF_CALL: OnceLock<fn() -> usize> = OnceLock::new();
+
+/// Tells the function that gives the owner of the call in progress on the calling thread
+/// (the calling instance's `componentEnvironment`, 0 outside any call): the blocks
+/// [`allocate`] gives during a call are that instance's. The first function told stays
+/// (one importer per process marks the calls).
+pub fn owners_from(owner_of_call: fn() -> usize) {
+    let _ = OWNER_OF_CALL.set(owner_of_call);
 }
 
-/// The mark of a call of one instance ([`enter_owner`]); the owner before it again when
-/// dropped.
-#[must_use]
-pub struct OwnerMark(usize);
-
-impl Drop for OwnerMark {
-    fn drop(&mut self) {
-        OWNER.with(|o| o.set(self.0));
-    }
-}
-
-/// Marks the calls that follow on this thread, until the mark is dropped, as those of the
-/// instance `owner` (its `componentEnvironment`): the blocks they allocate are its own.
-pub fn enter_owner(owner: usize) -> OwnerMark {
-    OwnerMark(OWNER.with(|o| o.replace(owner)))
+/// The owner of the blocks allocated on this thread now (0: none marked).
+fn owner_now() -> usize {
+    OWNER_OF_CALL.get().map_or(0, |owner_of_call| owner_of_call())
 }
 
 extern "C" {
@@ -168,7 +163,7 @@ pub unsafe extern "C" fn allocate(n: usize, size: usize) -> *mut c_void {
         return p;
     }
     std::ptr::write_bytes(p.cast::<u8>().add(bytes), PATTERN, RED_ZONE);
-    let owner = OWNER.with(|o| o.get());
+    let owner = owner_now();
     lock(&LIVE).insert((owner, p as usize), bytes);
     lock(&OWNER_OF).insert(p as usize, owner);
     p

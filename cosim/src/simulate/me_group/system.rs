@@ -206,6 +206,19 @@ impl GroupIntegrator {
                 ));
             }
         }
+        if let Some(stiff) = self.integrator.take_found_stiff() {
+            let names: Vec<String> = members.iter().map(|m| lanes.instance(*m).name().to_string()).collect();
+            if let Some((_, u)) = members.first().and_then(|m| lanes.member(*m)) {
+                u.notes.push(format!(
+                    "{}: stiff at t = {} s: dopri5's steps are held by its stability, not its accuracy (h*lambda = \
+                     {:.3e} on 15 tested steps, above its bound of 3.25; Hairer and Wanner's test), so it takes many \
+                     small steps; --solver auto (the default) or bdf suits a stiff system",
+                    names.join(", "),
+                    stiff.t,
+                    stiff.h_rho
+                ));
+            }
+        }
         if let Some((_, u)) = members.first().and_then(|m| lanes.member(*m)) {
             if matches!(solver, Solver::Bdf { .. }) || self.integrator.switched() {
                 u.stiff = work;

@@ -93,6 +93,42 @@ impl Fmi3 {
         })
     }
 
+    /// All values of the Int64, UInt64 or Binary variable of `access` (as many as it has
+    /// now) as the FMU holds them.
+    pub(super) fn exact_all(&mut self, core: &mut Core, access: Access) -> Result<Vec<crate::fmi3::Exact>> {
+        use crate::fmi3::Exact;
+        use model_description::fmi3::ValueType as T;
+        let n = self.now(access).0;
+        let (c, a, vr) = (core.component, &*self.a, access.vr);
+        Ok(match access.value_type {
+            T::Int64 => {
+                let f = f3!(core, a, get_int64, "fmi3GetInt64");
+                let mut buf = vec![0i64; n];
+                call!(core, "fmi3GetInt64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf.into_iter().map(|x| Exact::Integer(i128::from(x))).collect()
+            }
+            T::UInt64 => {
+                let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
+                let mut buf = vec![0u64; n];
+                call!(core, "fmi3GetUInt64", None, f(c, &vr, 1, buf.as_mut_ptr(), n))?;
+                buf.into_iter().map(|x| Exact::Integer(i128::from(x))).collect()
+            }
+            T::Binary => {
+                let f = f3!(core, a, get_binary, "fmi3GetBinary");
+                let mut sizes = vec![0usize; n];
+                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
+                call!(core, "fmi3GetBinary", None, f(c, &vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
+                let bytes = |(p, size): (*const u8, usize)| match p.is_null() || size == 0 {
+                    true => Exact::Bytes(Vec::new()),
+                    // SAFETY: the FMU returned `size` bytes at `p`, valid until its next call.
+                    false => Exact::Bytes(unsafe { std::slice::from_raw_parts(p, size) }.to_vec()),
+                };
+                data.into_iter().zip(sizes).map(bytes).collect()
+            }
+            _ => return Err(not_exact(core, access.vr, String::new())),
+        })
+    }
+
     /// Element `access` within one get call, whose last array read is `array`: an array is
     /// read once per call, not once per element (the elements of one array are asked
     /// together, a row of the results, and the FMU does not change in between), so that

@@ -219,7 +219,7 @@ macro_rules! get_set {
     ($($get:ident, $set:ident, $t:ty, $fmu_get:ident, $fmu_set:ident;)*) => {$(
         #[inline]
         fn $get(&mut self, core: &mut Core, vrs: &[u32], values: &mut [$t]) -> Result<()> {
-            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            if !self.clocked.is_empty() && core.state.is_running() {
                 return self.get_held(core, vrs, values, Self::$fmu_get);
             }
             self.$fmu_get(core, vrs, values)
@@ -227,7 +227,7 @@ macro_rules! get_set {
 
         #[inline]
         fn $set(&mut self, core: &mut Core, vrs: &[u32], values: &[$t]) -> Result<()> {
-            if !self.clocked.is_empty() && core.state == InstanceState::Running {
+            if !self.clocked.is_empty() && core.state.is_running() {
                 return self.set_queued(core, vrs, values, Self::$fmu_set);
             }
             self.$fmu_set(core, vrs, values)
@@ -264,7 +264,8 @@ impl Calls for Fmi3 {
         let component = match fmu.interface {
             Interface::CoSimulation => {
                 let f = a.functions.instantiate_co_simulation.ok_or(missing(function))?;
-                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                let _mark =
+                    crate::call_site::enter(name, &fmu.source, function, 0.0, crate::call_site::owner_of_call());
                 // SAFETY: every pointer is valid for the call; the log outlives the instance.
                 unsafe {
                     f(
@@ -285,7 +286,8 @@ impl Calls for Fmi3 {
             }
             Interface::ModelExchange => {
                 let f = a.functions.instantiate_model_exchange.ok_or(missing(function))?;
-                let _mark = crate::call_site::enter(name, &fmu.source, function, 0.0);
+                let _mark =
+                    crate::call_site::enter(name, &fmu.source, function, 0.0, crate::call_site::owner_of_call());
                 // SAFETY: as above.
                 unsafe { f(name_c.as_ptr(), a.token.as_ptr(), a.resource_path.as_ptr(), 0, 0, environment, logger) }
             }
@@ -455,40 +457,25 @@ impl Calls for Fmi3 {
         call!(core, "fmi3SetString", None, f(c, &vr, 1, &p, 1))
     }
 
-    fn get_exact(&mut self, core: &mut Core, vr: u32) -> Result<crate::fmi3::Exact> {
-        use crate::fmi3::Exact;
-        use model_description::fmi3::ValueType as T;
-        let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
-        let (c, a, n, k) = (core.component, &*self.a, access.count, access.element);
-        let fmu_vr = access.vr;
-        Ok(match access.value_type {
-            T::Int64 => {
-                let f = f3!(core, a, get_int64, "fmi3GetInt64");
-                let mut buf = vec![0i64; n];
-                call!(core, "fmi3GetInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
-                Exact::Integer(i128::from(buf[k]))
+    fn get_exact(&mut self, core: &mut Core, vrs: &[u32], values: &mut Vec<crate::fmi3::Exact>) -> Result<()> {
+        // each array read once for all its elements asked here (a row of the results):
+        // the FMU does not change in between, and a row costs time linear in the elements
+        let mut arrays: HashMap<u32, Vec<crate::fmi3::Exact>> = HashMap::new();
+        for &vr in vrs {
+            let Some(access) = self.special(vr) else { return Err(not_exact(core, vr, String::new())) };
+            let (n, element) = self.now(access);
+            let Some(k) = element else { return Err(self.absent_element(core, access, n, String::new())) };
+            if access.count <= 1 {
+                values.extend(self.exact_all(core, access)?);
+                continue;
             }
-            T::UInt64 => {
-                let f = f3!(core, a, get_uint64, "fmi3GetUInt64");
-                let mut buf = vec![0u64; n];
-                call!(core, "fmi3GetUInt64", None, f(c, &fmu_vr, 1, buf.as_mut_ptr(), n))?;
-                Exact::Integer(i128::from(buf[k]))
-            }
-            T::Binary => {
-                let f = f3!(core, a, get_binary, "fmi3GetBinary");
-                let mut sizes = vec![0usize; n];
-                let mut data: Vec<*const u8> = vec![std::ptr::null(); n];
-                call!(core, "fmi3GetBinary", None, f(c, &fmu_vr, 1, sizes.as_mut_ptr(), data.as_mut_ptr(), n))?;
-                let (p, size) = (data[k], sizes[k]);
-                if p.is_null() || size == 0 {
-                    Exact::Bytes(Vec::new())
-                } else {
-                    // SAFETY: the FMU returned `size` bytes at `p`, valid until its next call.
-                    Exact::Bytes(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
-                }
-            }
-            _ => return Err(not_exact(core, vr, String::new())),
-        })
+            let all = match arrays.entry(access.vr) {
+                std::collections::hash_map::Entry::Occupied(read) => read.into_mut(),
+                std::collections::hash_map::Entry::Vacant(unread) => unread.insert(self.exact_all(core, access)?),
+            };
+            values.push(all[k].clone());
+        }
+        Ok(())
     }
 
     fn set_exact_integer(&mut self, core: &mut Core, vr: u32, value: i128) -> Result<()> {

@@ -159,7 +159,7 @@ impl Fmi3 {
         fmu_get: fn(&mut Fmi3, &mut Core, &[u32], &mut [T]) -> Result<()>,
     ) -> Result<()> {
         let at = |me: &Fmi3, vr: u32| me.clocked.clocked(vr, me.special(vr));
-        if core.state != InstanceState::Running {
+        if !core.state.is_running() {
             fmu_get(self, core, vrs, values)?;
             for (vr, value) in vrs.iter().zip(values.iter()) {
                 if let Some((slot, element)) = at(self, *vr) {
@@ -227,7 +227,7 @@ impl Fmi3 {
         fmu_set: fn(&mut Fmi3, &mut Core, &[u32], &[T]) -> Result<()>,
     ) -> Result<()> {
         let at = |me: &Fmi3, vr: u32| me.clocked.clocked(vr, me.special(vr));
-        if core.state != InstanceState::Running {
+        if !core.state.is_running() {
             fmu_set(self, core, vrs, values)?;
             for (vr, value) in vrs.iter().zip(values) {
                 if let Some((slot, element)) = at(self, *vr) {
