@@ -879,6 +879,55 @@ fn an_early_return_past_the_step_is_an_error_not_a_row() {
     assert!(last <= 0.1, "a row at {last} s");
 }
 
+/// An early return that makes no progress (the counter with crash_how = 5: lastSuccessfulTime
+/// = t from the step at 0.05 s) and one that creeps (crash_how = 6: a 4000th of what is left
+/// of the step a return, so 1000 returns do not reach its end) end the run, each with fmi3OK named as
+/// what the FMU returned: the first breaks the standard's early return, the second only
+/// cosim's bound of 1000 early returns a step, and neither is an fmi3Error of the FMU.
+#[test]
+fn early_returns_without_progress_or_past_the_bound_say_what_the_fmu_returned() {
+    let Some((dir, fmu)) = counter("fmi3-early-stuck") else { return };
+    let run = |how: &str| {
+        let csv = dir.join(format!("out{how}.csv"));
+        let how = format!("crash_how={how}");
+        let args = ["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.01", "--set", "crash_at=0.05"];
+        let out = cosim(&[&args[..], &["--set", &how, "-o", csv.to_str().unwrap()]].concat());
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let stuck = run("5");
+    assert!(
+        stuck.contains(
+            "fmi3DoStep returned fmi3OK at t = 0.05 s, but earlyReturn = true with lastSuccessfulTime = 0.05 s made \
+             no progress from 0.05 s toward the step's end 0.06 s"
+        ) && !stuck.contains("fmi3Error"),
+        "{stuck}"
+    );
+    let creeping = run("6");
+    // each return goes a 4000th of what is left of the step: the 1000th reaches
+    // 0.06 - 0.01 (3999/4000)^1000 s = 0.06 - 0.01 * 0.778778 s = 0.0522122 s (6 digits)
+    assert!(
+        creeping.contains("fmi3DoStep returned fmi3OK at t = 0.052212")
+            && creeping.contains(
+                "but it returned early (earlyReturn = true) for the 1000th time in the step from 0.05 s to 0.06 s: 1000 early \
+                 returns in one step is cosim's bound"
+            )
+            && !creeping.contains("fmi3Error"),
+        "{creeping}"
+    );
+}
+
+/// A non-finite FMI 3.0 value names the FMI 3.0 getter and status: the counter with u = 1e38
+/// in steps of 1 s has y = 1e38 k at t = k s (exact enough: 1e38 k < f64's max), and its
+/// f32 = (float)y overflows f32's largest 3.4028e38 to inf first at t = 4 s (3e38 still fits).
+#[test]
+fn a_non_finite_fmi3_value_names_the_fmi3_getter() {
+    let Some((_dir, fmu)) = counter("fmi3-non-finite") else { return };
+    let system = with_starts(&fmu, &[("u", Value::Real(1e38))]);
+    let e = simulate(&system, &Experiment::new(6.0, 1.0)).unwrap_err().to_string();
+    assert!(e.contains("c (fmi3_counter.fmu): f32 = inf at t = 4 s, returned with fmi3OK by fmi3GetFloat32"), "{e}");
+}
+
 /// A description of a later FMI 3 minor version ("3.1") runs as FMI 3.0, with a note saying
 /// so; a revision of 3.0 ("3.0.2") needs none.
 #[test]

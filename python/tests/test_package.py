@@ -608,3 +608,22 @@ def test_use_event_mode_as_fmpy_names_it(event_mode_fmu):
     # the FMI 3.0 controller declares its sample clock: no Event Mode refused, naming it
     with pytest.raises(nigel_cosim.LoadError, match='declares the clocks "sample_clock"'):
         nigel_cosim.simulate_fmu(FMU / "fmi3" / "nigel_controller.fmu", stop_time=0.01, use_event_mode=False)
+
+
+def test_a_model_cosim_cannot_run_raises_load_error(tmp_path):
+    # the FMI 3.0 controller without hasEventMode: its sample clock cannot run in Co-Simulation
+    # without Event Mode, so cosim refuses the model at loading (LoadError), before any run
+    import zipfile
+
+    source = FMU / "fmi3" / "nigel_controller.fmu"
+    fmu = tmp_path / "no_event_mode.fmu"
+    with zipfile.ZipFile(source) as src, zipfile.ZipFile(fmu, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'hasEventMode="true"', b'hasEventMode="false"')
+                assert b'hasEventMode="false"' in data
+            dst.writestr(item, data)
+    with pytest.raises(nigel_cosim.LoadError, match='which cosim does not support') as raised:
+        nigel_cosim.simulate_fmu(fmu, stop_time=0.01)
+    assert "sample_clock" in str(raised.value) and not isinstance(raised.value, nigel_cosim.SimulationError)

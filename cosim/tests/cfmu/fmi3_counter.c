@@ -24,7 +24,9 @@
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
  *      (SIGABRT), 3 exit(0); 4 no crash: Co-Simulation's step says terminateSimulation with an
- *      early return at lastSuccessfulTime = t + 1000 s, past the step
+ *      early return at lastSuccessfulTime = t + 1000 s, past the step; 5 no crash: an early
+ *      return at lastSuccessfulTime = t, no progress; 6 no crash: every call returns early
+ *      1/4000 of the way to the step's end (1000 returns do not reach it)
  * and, in the descriptions of the tests of large arrays only (j from 0):
  *   40 big Float64[BIG] output y + j   41 bigi Int32[BIG] output n + j
  *   42 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
@@ -173,6 +175,12 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
         *lastSuccessfulTime = t + 1000.0;
         return fmi3OK;
     }
+    if (t >= s->crash_at && (s->crash_how == 5 || s->crash_how == 6)) {
+        /* no crash: an early return without progress (5) or by a 4000th of the step (6) */
+        *earlyReturn = fmi3True;
+        *lastSuccessfulTime = s->crash_how == 5 ? t : t + h / 4000.0;
+        return fmi3OK;
+    }
     if (t >= s->crash_at) crash(s);
     if (s->early_allowed && !s->early_done && s->early_at > t && s->early_at < end) {
         s->early_done = 1;
@@ -270,7 +278,7 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
         if (vr[i] == 9 && c->s.me_continuous)
             return fail(c, "fmi3SetInt32: Illegal call sequence (the discrete input k in Continuous-Time Mode)");
         if (vr[i] == 9) c->s.k = values[i];
-        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 4) c->s.crash_how = values[i];
+        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 6) c->s.crash_how = values[i];
         else return fail(c, "fmi3SetInt32: not settable");
     }
     return fmi3OK;

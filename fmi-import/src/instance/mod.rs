@@ -25,6 +25,7 @@ use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};
 use crate::log::{callbacks_for, LogRecord, LogSink};
+use crate::status::Status;
 
 /// A saved FMU state (`fmi2FMUstate`), freed by [`Instance::free_state`] or with the instance.
 #[derive(Debug)]
@@ -136,6 +137,7 @@ impl Instance {
                 time: 0.0,
                 host,
                 saved: Vec::new(),
+                last_status: Status::Ok,
             },
             calls,
             _name_c: name_c,
@@ -412,8 +414,17 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
+        // the getter of the variable's type (an array element of the view: its array's)
+        let function = match self.core.fmu.fmi3_description() {
+            None => "fmi2GetReal",
+            Some(md) => match md.model_variables.iter().find(|v| v.value_reference == vrs[k]) {
+                Some(v) if v.value_type == model_description::fmi3::ValueType::Float32 => "fmi3GetFloat32",
+                _ => "fmi3GetFloat64",
+            },
+        };
         Some(Error::NonFinite {
             instance: self.core.name.clone(),
+            function,
             fmu: self.core.fmu.source.clone(),
             variable,
             value: values[k],
