@@ -154,6 +154,17 @@ fn libraries(folder: &str, dir: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
+/// The libraries of `folder` unpacked into the work folder `test` (and that folder), `None`
+/// when `folder` is not in the archives ([`built`]).
+fn built_libraries(folder: &str, test: &str) -> Option<(PathBuf, Vec<PathBuf>)> {
+    if !built(folder) {
+        return None;
+    }
+    let dir = work_dir(test);
+    let libs = libraries(folder, &dir);
+    Some((dir, libs))
+}
+
 /// `llvm-lipo` (Debian's llvm-22 names it `llvm-lipo-22`).
 fn llvm_lipo() -> PathBuf {
     ["llvm-lipo", "llvm-lipo-22"]
@@ -452,10 +463,8 @@ fn highest_glibc(objdump: &str, lib: &Path) -> (u32, u32) {
 
 #[test]
 fn linux64_needs_glibc_2_17_and_two_importers_agree_bit_for_bit() {
-    if !built("linux64") {
-        return;
-    }
-    for lib in libraries("linux64", &work_dir("linux64-exports")) {
+    let Some((_, libs)) = built_libraries("linux64", "linux64-exports") else { return };
+    for lib in libs {
         let v = highest_glibc("objdump", &lib);
         assert!(((2, 2)..=(2, 17)).contains(&v), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
         assert_eq!(exports(&LINUX64, &lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
@@ -505,11 +514,7 @@ fn wine_runner(dir: &Path) -> impl FnMut(&Path) -> Command {
 
 #[test]
 fn win64_closed_loop_under_wine_matches_linux64() {
-    if !built("win64") {
-        return;
-    }
-    let dir = work_dir("win64");
-    let libs = libraries("win64", &dir);
+    let Some((_, libs)) = built_libraries("win64", "win64") else { return };
     for lib in &libs {
         assert_eq!(exports(&WIN64, lib, "fmi2").len(), 44, "{}: fmi2 exports", lib.display());
         let text = run(Command::new("x86_64-w64-mingw32-objdump").arg("-p").arg(lib));
@@ -675,11 +680,8 @@ fn assert_same_bits(what: &str, fmi2: &Table, fmi3: &Table) {
 
 #[test]
 fn aarch64_closed_loop_under_qemu_matches_linux64() {
-    if !built("aarch64-linux") {
-        return;
-    }
-    let dir = work_dir("aarch64-linux");
-    for lib in libraries("aarch64-linux", &dir) {
+    let Some((_, libs)) = built_libraries("aarch64-linux", "aarch64-linux") else { return };
+    for lib in libs {
         let v = highest_glibc("aarch64-linux-gnu-objdump", &lib);
         assert!(v <= (2, 17), "{}: needs GLIBC_{}.{}", lib.display(), v.0, v.1);
     }
@@ -909,12 +911,9 @@ fn check_darwin_slice(lib: &Path, cpu: u32, slice: &Slice) {
 
 #[test]
 fn darwin64_is_universal_macos_11_with_the_fmi2_and_fmi3_exports_and_system_libraries_only() {
-    if !built("darwin64") {
-        return;
-    }
-    let dir = work_dir("darwin64");
+    let Some((dir, libs)) = built_libraries("darwin64", "darwin64") else { return };
     // the FMI 2.0 archives' darwin64: one universal library of both architectures
-    for lib in libraries("darwin64", &dir) {
+    for lib in libs {
         let b = std::fs::read(&lib).unwrap();
         assert_eq!(u32_be(&b, 0), FAT_MAGIC, "{}: not a universal binary", lib.display());
         let n = u32_be(&b, 4) as usize;

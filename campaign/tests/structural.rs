@@ -18,17 +18,7 @@ const XML: &str = include_str!("../../cosim/tests/cfmu/fmi3_sized.xml");
 
 /// `fmi3_sized.fmu` built in `dir`; `None` (skipped) without fmpy's FMI 3.0 headers.
 fn sized_fmu(dir: &Path) -> Option<PathBuf> {
-    let headers = cosim_common::fmi3_c::headers()?;
-    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu");
-    let so = dir.join("fmi3_sized.so");
-    cosim_common::cc(
-        &cosim_common::fmi3_c::flags(&headers),
-        &[cfmu.join("fmi3_sized.c"), cfmu.join("fmi3_rest.c")],
-        &so,
-    );
-    let fmu = dir.join("fmi3_sized.fmu");
-    cosim_common::pack_library(&fmu, XML, "binaries/x86_64-linux/fmi3_sized.so", &so);
-    Some(fmu)
+    cosim_common::fmi3_c::build(dir, "fmi3_sized", XML)
 }
 
 #[test]

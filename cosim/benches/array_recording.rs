@@ -9,7 +9,7 @@
 
 #[path = "../tests/common/mod.rs"]
 mod common;
-use common::{build_counter_with_flags, counter_xml_with_large_arrays, work_dir};
+use common::{build_counter_with, counter_xml_with_large_arrays, work_dir};
 use std::time::{Duration, Instant};
 
 const LIMIT: Duration = Duration::from_secs(60);
@@ -46,10 +46,10 @@ fn main() {
     println!("| elements n | type | cosim run, 11 rows (best of 3) | per element and row |");
     println!("|---:|---|---:|---:|");
     for n in [10_000usize, 30_000, 100_000] {
-        let flag = format!("-DBIG={n}");
+        let big = format!("BIG={n}");
         for (variable, ty) in [("big", "Float64"), ("bigi", "Int32"), ("bigb", "Boolean")] {
             let xml = counter_xml_with_large_arrays(n, &[variable]);
-            let Some(fmu) = build_counter_with_flags(&dir, &format!("{variable}{n}"), &xml, &[&flag]) else {
+            let Some(fmu) = build_counter_with(&dir, &format!("{variable}{n}"), &xml, &[&big]) else {
                 eprintln!("no fmpy headers (FMPY_PYTHON=target/venv/bin/python): nothing measured");
                 return;
             };

@@ -159,3 +159,48 @@ fn scheduled_execution_with_isolation_is_refused_saying_why() {
         assert!(stderr.contains("Scheduled Execution is run in process only"), "{flag}: {stderr}");
     }
 }
+
+/// A tick of a periodic clock that resets a continuous state (`tests/cfmu/fmi3_sawtooth.c`:
+/// x' = 1, each tick of `sample` sets x = 0 and says valuesOfContinuousStatesChanged), run
+/// in Model Exchange from 0 to 1 s with steps of 0.1 s under every solver: the integrator
+/// starts again from the state the FMU gives after each tick. The ticks are at 0, 0.25, 0.5,
+/// 0.75 s (and 1 s, the stop time), so x at a row between ticks is the time since the last
+/// tick: 0.1, 0.2 at 0.1, 0.2 s; 0.05, 0.15 at 0.3, 0.4 s; 0.1, 0.2 at 0.6, 0.7 s; 0.05,
+/// 0.15 at 0.8, 0.9 s; a row at a tick holds the value before it (0.25; docs/clocks.md),
+/// the row at 0 s the start value 0. Integrated on from its own state instead, x would be
+/// the time itself (0.3 at 0.3 s). `resets` counts the ticks before the row (the start
+/// tick's at 0 s included). x' is constant, so every method is exact up to the rounding of
+/// the sums of step sizes: 1e-12.
+#[test]
+fn a_tick_that_resets_a_state_restarts_the_integrator_from_it() {
+    let dir = work_dir("clocked-sawtooth");
+    let Some(path) = common::fmi3_c::build(&dir, "fmi3_sawtooth", include_str!("cfmu/fmi3_sawtooth.xml")) else {
+        return;
+    };
+    let solvers = [
+        nigel_cosim::Solver::Rk4 { max_step: None },
+        nigel_cosim::Solver::Dopri5 { rtol: 1e-6, atol: 1e-8 },
+        nigel_cosim::Solver::Bdf { rtol: 1e-6, atol: 1e-8 },
+    ];
+    for solver in solvers {
+        let system = System::single("s", Fmu::load(&path).unwrap()).unwrap();
+        let mut experiment = Experiment::new(1.0, 0.1);
+        experiment.solver = solver;
+        let results = simulate(&system, &experiment).unwrap().0;
+        let time = results.column("time").unwrap();
+        let x = results.column("x").unwrap();
+        let resets = results.column("resets").unwrap();
+        // the points 0, 0.1, ..., 1 s and the ticks between points, 0.25 and 0.75 s
+        assert_eq!(time.len(), 13, "{solver:?}: {time:?}");
+        let ticks = [0.0, 0.25, 0.5, 0.75, 1.0];
+        for ((t, x), n) in time.iter().zip(&x).zip(&resets) {
+            // the last tick before the row (the start tick at the row at 0 s); ticks and
+            // points differ by ulps at most
+            let before: Vec<f64> = ticks.iter().copied().filter(|tick| *tick == 0.0 || *tick < t - 1e-9).collect();
+            let last = *before.last().unwrap();
+            let expected = if *t < 1e-9 { 0.0 } else { t - last };
+            assert!((x - expected).abs() < 1e-12, "{solver:?}: x = {x} at t = {t} s, expected {expected}");
+            assert_eq!(*n, before.len() as f64, "{solver:?}: resets at t = {t} s");
+        }
+    }
+}

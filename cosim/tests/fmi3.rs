@@ -750,9 +750,7 @@ fn an_array_sized_by_a_structural_parameter_has_its_start_size_unless_set() {
 #[test]
 fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     let Some((dir, path)) = counter_with_event_mode("fmi3-event-mode") else { return };
-    let mut b = SystemBuilder::new();
-    b.add_instance("c", event_mode_on(&path)).unwrap();
-    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
+    let r = run_with_event_mode(&path, "c");
     let (time, n) = (r.column("time").unwrap(), r.column("n").unwrap());
     for k in 0..r.rows() {
         // the step count, and 1 from the event at the end of the step to 0.6 s
@@ -769,10 +767,13 @@ fn cs_event_mode_where_the_fmu_has_it_as_fmpy_runs_it() {
     assert_eq!(ours, theirs, "ours vs fmpy's last row at each time");
 }
 
-/// The counter loaded with Event Mode asked for (`cosim run --event-mode on`).
-fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
+/// The counter at `path` loaded with Event Mode asked for (`cosim run --event-mode on`) as
+/// the one instance `name`, run 1 s at 0.1 s.
+fn run_with_event_mode(path: &Path, name: &str) -> nigel_cosim::Results {
     let options = nigel_cosim::ImportOptions { event_mode: nigel_cosim::EventModeChoice::On, ..Default::default() };
-    Fmu::load_with(path, &options).unwrap()
+    let mut b = SystemBuilder::new();
+    b.add_instance(name, Fmu::load_with(path, &options).unwrap()).unwrap();
+    simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap().0
 }
 
 /// An FMU that declares `hasEventMode` but refuses to be instantiated with `eventModeUsed`
@@ -783,9 +784,7 @@ fn event_mode_on(path: &Path) -> std::sync::Arc<Fmu> {
 #[test]
 fn an_fmu_that_refuses_event_mode_is_instantiated_again_without_it() {
     let Some((_, path)) = counter_with_event_mode("fmi3-refuses-event-mode") else { return };
-    let mut b = SystemBuilder::new();
-    b.add_instance("c-no-event-mode", event_mode_on(&path)).unwrap();
-    let (r, _) = simulate(&b.build(), &Experiment::new(1.0, 0.1)).unwrap();
+    let r = run_with_event_mode(&path, "c-no-event-mode");
     let n = r.column("c-no-event-mode.n").or_else(|| r.column("n")).expect("the column n");
     assert_eq!(n, (0..11).map(|k| k as f64).collect::<Vec<_>>());
 }
@@ -878,6 +877,55 @@ fn an_early_return_past_the_step_is_an_error_not_a_row() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let last: f64 = text.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
     assert!(last <= 0.1, "a row at {last} s");
+}
+
+/// An early return that makes no progress (the counter with crash_how = 5: lastSuccessfulTime
+/// = t from the step at 0.05 s) and one that creeps (crash_how = 6: a 4000th of what is left
+/// of the step a return, so 1000 returns do not reach its end) end the run, each with fmi3OK named as
+/// what the FMU returned: the first breaks the standard's early return, the second only
+/// cosim's bound of 1000 early returns a step, and neither is an fmi3Error of the FMU.
+#[test]
+fn early_returns_without_progress_or_past_the_bound_say_what_the_fmu_returned() {
+    let Some((dir, fmu)) = counter("fmi3-early-stuck") else { return };
+    let run = |how: &str| {
+        let csv = dir.join(format!("out{how}.csv"));
+        let how = format!("crash_how={how}");
+        let args = ["run", fmu.to_str().unwrap(), "--stop-time", "0.1", "--step", "0.01", "--set", "crash_at=0.05"];
+        let out = cosim(&[&args[..], &["--set", &how, "-o", csv.to_str().unwrap()]].concat());
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let stuck = run("5");
+    assert!(
+        stuck.contains(
+            "fmi3DoStep returned fmi3OK at t = 0.05 s, but earlyReturn = true with lastSuccessfulTime = 0.05 s made \
+             no progress from 0.05 s toward the step's end 0.06 s"
+        ) && !stuck.contains("fmi3Error"),
+        "{stuck}"
+    );
+    let creeping = run("6");
+    // each return goes a 4000th of what is left of the step: the 1000th reaches
+    // 0.06 - 0.01 (3999/4000)^1000 s = 0.06 - 0.01 * 0.778778 s = 0.0522122 s (6 digits)
+    assert!(
+        creeping.contains("fmi3DoStep returned fmi3OK at t = 0.052212")
+            && creeping.contains(
+                "but it returned early (earlyReturn = true) for the 1000th time in the step from 0.05 s to 0.06 s: 1000 early \
+                 returns in one step is cosim's bound"
+            )
+            && !creeping.contains("fmi3Error"),
+        "{creeping}"
+    );
+}
+
+/// A non-finite FMI 3.0 value names the FMI 3.0 getter and status: the counter with u = 1e38
+/// in steps of 1 s has y = 1e38 k at t = k s (exact enough: 1e38 k < f64's max), and its
+/// f32 = (float)y overflows f32's largest 3.4028e38 to inf first at t = 4 s (3e38 still fits).
+#[test]
+fn a_non_finite_fmi3_value_names_the_fmi3_getter() {
+    let Some((_dir, fmu)) = counter("fmi3-non-finite") else { return };
+    let system = with_starts(&fmu, &[("u", Value::Real(1e38))]);
+    let e = simulate(&system, &Experiment::new(6.0, 1.0)).unwrap_err().to_string();
+    assert!(e.contains("c (fmi3_counter.fmu): f32 = inf at t = 4 s, returned with fmi3OK by fmi3GetFloat32"), "{e}");
 }
 
 /// A description of a later FMI 3 minor version ("3.1") runs as FMI 3.0, with a note saying

@@ -5,7 +5,7 @@
 //! array_recording` (docs/third-party-fmus.md), not here.
 
 mod common;
-use common::{build_counter, build_counter_with_flags, counter_xml_with_large_arrays, run_to_csv, work_dir};
+use common::{build_counter, build_counter_with, counter_xml_with_large_arrays, run_to_csv, work_dir};
 
 #[test]
 fn every_element_of_100000_element_arrays_is_recorded() {
@@ -53,7 +53,7 @@ fn a_64_bit_array_is_read_once_per_row_and_recorded_exactly() {
     const BIG: usize = 1000;
     let dir = work_dir("large-int64-array");
     let xml = counter_xml_with_large_arrays(BIG, &["bigw"]);
-    let Some(fmu) = build_counter_with_flags(&dir, "bigw", &xml, &[&format!("-DBIG={BIG}")]) else { return };
+    let Some(fmu) = build_counter_with(&dir, "bigw", &xml, &[&format!("BIG={BIG}")]) else { return };
     let csv = dir.join("out.csv");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_cosim"))
         .arg("run")

@@ -207,12 +207,17 @@ impl Function {
     /// The functions of FMI 3.0 clocks: offered when the model declares a clock
     /// ([`crate::ClockDecl`]), else refused as [`Function::undeclared_feature`]s.
     pub fn is_clock_function(self) -> bool {
+        matches!(self, Function::Fmi3GetClock | Function::Fmi3SetClock) || self.is_clock_timing_function()
+    }
+
+    /// The functions of FMI 3.0 clocks' intervals and shifts (the `fmi3Get`/`fmi3Set`
+    /// `Interval`/`Shift` `Decimal`/`Fraction` eight): the [`Function::is_clock_function`]s
+    /// but fmi3GetClock and fmi3SetClock.
+    pub fn is_clock_timing_function(self) -> bool {
         use Function::*;
         matches!(
             self,
-            Fmi3GetClock
-                | Fmi3SetClock
-                | Fmi3GetIntervalDecimal
+            Fmi3GetIntervalDecimal
                 | Fmi3GetIntervalFraction
                 | Fmi3GetShiftDecimal
                 | Fmi3GetShiftFraction

@@ -122,11 +122,27 @@ pub enum Error {
         /// The last messages the FMU logged.
         log: String,
     },
+    /// A call returned OK (or Warning) but what it returned breaks the standard or a bound
+    /// of the master (`what` says which): the FMU did not report an error.
+    Returned {
+        /// The instance name.
+        instance: String,
+        /// The function, e.g. `fmi3DoStep`.
+        function: &'static str,
+        /// The status it returned.
+        status_returned: Status,
+        /// The simulation time of the call, s.
+        time: f64,
+        /// What it returned and why the master cannot take it.
+        what: String,
+    },
     /// An FMU returned a NaN or infinite Real with fmi2OK (refused where it came from,
     /// before it reaches another FMU or the results).
     NonFinite {
         /// The instance.
         instance: String,
+        /// The function that returned it, e.g. `fmi2GetReal`, `fmi3GetFloat64`.
+        function: &'static str,
         /// The FMU file.
         fmu: PathBuf,
         /// The variable.
@@ -318,11 +334,17 @@ impl fmt::Display for Error {
                 }
                 f.write_str(&tail(log))
             }
-            Error::NonFinite { instance, fmu, variable, value, time } => write!(
+            Error::Returned { instance, function, status_returned, time, what } => write!(
                 f,
-                "{instance} ({}): {variable} = {value} at t = {time} s, returned with fmi2OK by fmi2GetReal \
+                "{instance}: {function} returned {} at t = {time} s, but {what}",
+                status_returned.spelled_for(function)
+            ),
+            Error::NonFinite { instance, function, fmu, variable, value, time } => write!(
+                f,
+                "{instance} ({}): {variable} = {value} at t = {time} s, returned with {} by {function} \
                  (a non-finite value; --allow-non-finite passes such values on)",
-                fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+                fmu.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(),
+                Status::Ok.spelled_for(function)
             ),
             Error::IllegalCall { instance, function, state } => {
                 write!(f, "{instance}: {function} is not allowed in state {state}")

@@ -10,7 +10,7 @@ create_exception!(
     nigel_cosim,
     LoadError,
     Error,
-    "An FMU or SSP could not be loaded: a missing or malformed file, a hostile archive, a missing binary."
+    "An FMU or SSP could not be loaded: a missing or malformed file, a hostile archive, a missing binary, a feature cosim does not run."
 );
 create_exception!(
     nigel_cosim,
@@ -50,6 +50,7 @@ pub(crate) fn to_py(e: CosimError) -> PyErr {
             | I::MissingBinary { .. }
             | I::LoadLibrary { .. }
             | I::MissingSymbol { .. }
+            | I::Unsupported { .. }
             | I::EventMode { .. },
         )
         | E::Ssp { .. } => LoadError::new_err(message),

@@ -214,16 +214,7 @@ def test_a_run_that_can_record_none_of_the_outputs_is_refused(tmp_path):
     # array of 200,000 elements that the master leaves out of its view: a result of the time
     # column alone is not what simulate_fmu was asked for (every output), so it raises, as
     # `cosim run` exits 1 (cosim/tests/fmi3.rs a_run_that_can_record_none_of_the_outputs_fails)
-    import zipfile
-    xml = (REPO / "cosim/tests/cfmu/fmi3_counter_no_output.xml").read_text()
-    headers = Path(fmpy.__file__).parent / "c-code"
-    so = tmp_path / "fmi3_counter.so"
-    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter", "-I",
-                    str(headers), str(REPO / "cosim/tests/cfmu/fmi3_counter.c"), "-o", str(so)], check=True)
-    fmu = tmp_path / "no_output.fmu"
-    with zipfile.ZipFile(fmu, "w") as z:
-        z.writestr("modelDescription.xml", xml)
-        z.write(so, "binaries/x86_64-linux/fmi3_counter.so")
+    fmu = _fmi3_c_fmu(tmp_path, "fmi3_counter", "fmi3_counter_no_output.xml", "no_output.fmu")
     with pytest.raises(nigel_cosim.ExperimentError, match=r"no output of the system can be recorded: model\.big .*output"):
         nigel_cosim.simulate_fmu(fmu, stop_time=0.1, step_size=0.05)
 
@@ -528,18 +519,25 @@ def counter3_fmu(tmp_path_factory):
     """The FMI 3.0 test FMU of our own (cosim/tests/cfmu/fmi3_counter.c, built against the
     standard's headers in fmpy's package): i64out = i64in ^ 1 and u64out = u64in ^ 1 (the
     lowest bit flipped, so that a rounding shows), the String parameter label = "abc"."""
+    return _fmi3_c_fmu(tmp_path_factory.mktemp("counter3"), "fmi3_counter", "fmi3_counter.xml", "fmi3_counter.fmu")
+
+
+def _fmi3_c_fmu(folder, id, description, name):
+    """`folder / name`: cosim's FMI 3.0 C test FMU cosim/tests/cfmu/`id`.c with fmi3_rest.c
+    (every other function answering fmi3Error, as cosim/tests/common/fmi3_c.rs builds it)
+    compiled against the standard's headers in fmpy's package, described by
+    cosim/tests/cfmu/`description`."""
     import zipfile
 
     cfmu = REPO / "cosim" / "tests" / "cfmu"
     headers = Path(fmpy.__file__).parent / "c-code"
-    d = tmp_path_factory.mktemp("counter3")
-    so = d / "fmi3_counter.so"
-    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-I", str(headers), str(cfmu / "fmi3_counter.c"), "-o", str(so)],
-                   check=True)
-    fmu = d / "fmi3_counter.fmu"
+    so = folder / f"{id}.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-fvisibility=hidden", "-Wno-unused-parameter", "-I", str(headers),
+                    str(cfmu / f"{id}.c"), str(cfmu / "fmi3_rest.c"), "-o", str(so)], check=True)
+    fmu = folder / name
     with zipfile.ZipFile(fmu, "w") as z:
-        z.write(cfmu / "fmi3_counter.xml", "modelDescription.xml")
-        z.write(so, "binaries/x86_64-linux/fmi3_counter.so")
+        z.write(cfmu / description, "modelDescription.xml")
+        z.write(so, f"binaries/x86_64-linux/{id}.so")
     return fmu
 
 
@@ -587,19 +585,8 @@ def event_mode_fmu(tmp_path_factory):
     (cosim/tests/cfmu/fmi3_event_mode.c): x integrates a rate of 1 that becomes 2 at x = 0.55,
     inside the step without Event Mode, at the step's end in Event Mode; event_mode_used says
     how it was instantiated."""
-    import zipfile
-
-    cfmu = REPO / "cosim" / "tests" / "cfmu"
-    headers = Path(fmpy.__file__).parent / "c-code"
-    d = tmp_path_factory.mktemp("event_mode")
-    so = d / "fmi3_event_mode.so"
-    subprocess.run(["cc", "-shared", "-fPIC", "-O2", "-I", str(headers), str(cfmu / "fmi3_event_mode.c"),
-                    str(cfmu / "fmi3_rest.c"), "-o", str(so)], check=True)
-    fmu = d / "fmi3_event_mode.fmu"
-    with zipfile.ZipFile(fmu, "w") as z:
-        z.write(cfmu / "fmi3_event_mode.xml", "modelDescription.xml")
-        z.write(so, "binaries/x86_64-linux/fmi3_event_mode.so")
-    return fmu
+    return _fmi3_c_fmu(tmp_path_factory.mktemp("event_mode"), "fmi3_event_mode", "fmi3_event_mode.xml",
+                       "fmi3_event_mode.fmu")
 
 
 def test_use_event_mode_as_fmpy_names_it(event_mode_fmu):
@@ -621,3 +608,22 @@ def test_use_event_mode_as_fmpy_names_it(event_mode_fmu):
     # the FMI 3.0 controller declares its sample clock: no Event Mode refused, naming it
     with pytest.raises(nigel_cosim.LoadError, match='declares the clocks "sample_clock"'):
         nigel_cosim.simulate_fmu(FMU / "fmi3" / "nigel_controller.fmu", stop_time=0.01, use_event_mode=False)
+
+
+def test_a_model_cosim_cannot_run_raises_load_error(tmp_path):
+    # the FMI 3.0 controller without hasEventMode: its sample clock cannot run in Co-Simulation
+    # without Event Mode, so cosim refuses the model at loading (LoadError), before any run
+    import zipfile
+
+    source = FMU / "fmi3" / "nigel_controller.fmu"
+    fmu = tmp_path / "no_event_mode.fmu"
+    with zipfile.ZipFile(source) as src, zipfile.ZipFile(fmu, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'hasEventMode="true"', b'hasEventMode="false"')
+                assert b'hasEventMode="false"' in data
+            dst.writestr(item, data)
+    with pytest.raises(nigel_cosim.LoadError, match='which cosim does not support') as raised:
+        nigel_cosim.simulate_fmu(fmu, stop_time=0.01)
+    assert "sample_clock" in str(raised.value) and not isinstance(raised.value, nigel_cosim.SimulationError)

@@ -242,7 +242,8 @@ fn step_ticking(inst: &mut Instance, ticks: &mut Ticks, t: f64, t_next: f64) -> 
 
 /// A Model Exchange step from `t` to `t_next` of an instance with clocks (integrated on its
 /// own): integrated to each tick of its input clocks in the step, the event there (Event
-/// Mode, `fmi3SetClock` of the ticking clocks, the event iteration), on to the next.
+/// Mode, `fmi3SetClock` of the ticking clocks, the event iteration, the integrator started
+/// again from the states after it), on to the next.
 fn me_ticking(
     inst: &mut Instance,
     unit: &mut MeUnit,
@@ -268,9 +269,9 @@ fn me_ticking(
         }
         let Some((tick, vrs)) = due else { return Ok(()) };
         inst.set_time(tick)?;
-        inst.enter_event_mode()?;
-        inst.set_clocks(&vrs)?;
-        group.iterate(&mut Solo { inst, unit }, tick)?;
+        // an input event: the integrator starts again from the states the FMU gives after
+        // it (a clocked partition may reset continuous states: valuesOfContinuousStatesChanged)
+        group.input_event(&mut Solo { inst, unit }, tick, "clock", &[], |solo| Ok(solo.inst.set_clocks(&vrs)?))?;
         group.ended(&mut Solo { inst, unit }, tick)?;
         ticks.ticked(&vrs);
         ticks.after_events(inst, false)?;

@@ -24,7 +24,9 @@
  *      Model Exchange: a time event there, whose fmi3UpdateDiscreteStates crashes
  *   31 crash_how Int32 parameter: how it crashes: 1 writes through NULL (SIGSEGV), 2 abort()
  *      (SIGABRT), 3 exit(0); 4 no crash: Co-Simulation's step says terminateSimulation with an
- *      early return at lastSuccessfulTime = t + 1000 s, past the step
+ *      early return at lastSuccessfulTime = t + 1000 s, past the step; 5 no crash: an early
+ *      return at lastSuccessfulTime = t, no progress; 6 no crash: every call returns early
+ *      1/4000 of the way to the step's end (1000 returns do not reach it)
  * and, in the descriptions of the tests of large arrays only (j from 0):
  *   40 big Float64[BIG] output y + j   41 bigi Int32[BIG] output n + j
  *   42 bigb Boolean[BIG] output (n + j) odd   (BIG 100000 unless -DBIG=N)
@@ -37,7 +39,8 @@
  * Model Exchange: y is the state, der(y) = mode * u; the event
  * indicator z = y - 0.55 crossing zero adds 1 to n, the time event at 0.75 s adds 10, and
  * the time event at stop_at says terminateSimulation; the discrete inputs k and b cannot be set in
- * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function exists and returns fmi3Error. */
+ * Continuous-Time Mode (fmi3SetInt32 / fmi3SetBoolean: Illegal call sequence, as the Reference FMUs). Every other fmi3 function
+ * exists and returns fmi3Error (fmi3_rest.c, linked beside it). */
 #include "fmi3_test.h"
 
 #ifndef BIG
@@ -107,16 +110,8 @@ static Counter *make(fmi3String token, fmi3String resources, fmi3InstanceEnviron
         if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken");
         return NULL;
     }
-    if (!resources || resources[0] != '/' || resources[strlen(resources) - 1] != '/') {
-        if (log) log(env, fmi3Error, "logStatusError", "resourcePath is not an absolute path ending in /");
-        return NULL;
-    }
-    Counter *c = calloc(1, sizeof(Counter));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
-    defaults(&c->s);
-    return c;
+    FMI3_TEST_NEW(Counter, !resources || resources[0] != '/' || resources[strlen(resources) - 1] != '/',
+        "resourcePath is not an absolute path ending in /", defaults(&c->s))
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
@@ -178,6 +173,12 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h, fmi3B
         *terminateSimulation = fmi3True;
         *earlyReturn = fmi3True;
         *lastSuccessfulTime = t + 1000.0;
+        return fmi3OK;
+    }
+    if (t >= s->crash_at && (s->crash_how == 5 || s->crash_how == 6)) {
+        /* no crash: an early return without progress (5) or by a 4000th of the step (6) */
+        *earlyReturn = fmi3True;
+        *lastSuccessfulTime = s->crash_how == 5 ? t : t + h / 4000.0;
         return fmi3OK;
     }
     if (t >= s->crash_at) crash(s);
@@ -277,7 +278,7 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], si
         if (vr[i] == 9 && c->s.me_continuous)
             return fail(c, "fmi3SetInt32: Illegal call sequence (the discrete input k in Continuous-Time Mode)");
         if (vr[i] == 9) c->s.k = values[i];
-        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 4) c->s.crash_how = values[i];
+        else if (vr[i] == 31 && values[i] >= 1 && values[i] <= 6) c->s.crash_how = values[i];
         else return fail(c, "fmi3SetInt32: not settable");
     }
     return fmi3OK;
@@ -556,47 +557,9 @@ fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 
 }
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) { *n = 1; return fmi3OK; }
-
-/* The functions this FMU does not implement: each returns fmi3Error. */
-#define UNSUPPORTED(name, ...) fmi3Status name(__VA_ARGS__) { return fmi3Error; }
-fmi3Instance fmi3InstantiateScheduledExecution(fmi3String a, fmi3String b, fmi3String c, fmi3Boolean d,
-    fmi3Boolean e, fmi3InstanceEnvironment f, fmi3LogMessageCallback g, fmi3ClockUpdateCallback h,
-    fmi3LockPreemptionCallback i, fmi3UnlockPreemptionCallback j) { return NULL; }
-UNSUPPORTED(fmi3SetDebugLogging, fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[])
-#define GETSET(T) \
-    UNSUPPORTED(fmi3Get##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3##T v[], size_t m) \
-    UNSUPPORTED(fmi3Set##T, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3##T v[], size_t m)
-UNSUPPORTED(fmi3SetInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int8 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt8, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt8 v[], size_t m)
-UNSUPPORTED(fmi3SetInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int16 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt16, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt16 v[], size_t m)
-UNSUPPORTED(fmi3SetUInt32, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt32 v[], size_t m)
-UNSUPPORTED(fmi3SetBinary, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const size_t s[], const fmi3Binary v[], size_t m)
-UNSUPPORTED(fmi3GetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Clock v[])
-UNSUPPORTED(fmi3SetClock, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[])
-UNSUPPORTED(fmi3GetNumberOfVariableDependencies, fmi3Instance i, fmi3ValueReference vr, size_t *n)
-UNSUPPORTED(fmi3GetVariableDependencies, fmi3Instance i, fmi3ValueReference d, size_t e[], fmi3ValueReference k[], size_t ke[], fmi3DependencyKind dk[], size_t n)
-UNSUPPORTED(fmi3SerializedFMUStateSize, fmi3Instance i, fmi3FMUState s, size_t *n)
-UNSUPPORTED(fmi3SerializeFMUState, fmi3Instance i, fmi3FMUState s, fmi3Byte b[], size_t n)
-UNSUPPORTED(fmi3DeserializeFMUState, fmi3Instance i, const fmi3Byte b[], size_t n, fmi3FMUState *s)
-UNSUPPORTED(fmi3GetDirectionalDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
-UNSUPPORTED(fmi3GetAdjointDerivative, fmi3Instance i, const fmi3ValueReference u[], size_t nu, const fmi3ValueReference k[], size_t nk, const fmi3Float64 s[], size_t ns, fmi3Float64 r[], size_t nr)
-UNSUPPORTED(fmi3EnterConfigurationMode, fmi3Instance i)
-UNSUPPORTED(fmi3ExitConfigurationMode, fmi3Instance i)
-UNSUPPORTED(fmi3GetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[], fmi3IntervalQualifier q[])
-UNSUPPORTED(fmi3GetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[], fmi3IntervalQualifier q[])
-UNSUPPORTED(fmi3GetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[])
-UNSUPPORTED(fmi3GetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, fmi3UInt64 c[], fmi3UInt64 r[])
-UNSUPPORTED(fmi3SetIntervalDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
-UNSUPPORTED(fmi3SetIntervalFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
-UNSUPPORTED(fmi3SetShiftDecimal, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Float64 v[])
-UNSUPPORTED(fmi3SetShiftFraction, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3UInt64 c[], const fmi3UInt64 r[])
-UNSUPPORTED(fmi3EvaluateDiscreteStates, fmi3Instance i)
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
     Counter *c = instance;
     if (!c->s.event_mode) return fail(c, "fmi3EnterStepMode: not instantiated with eventModeUsed");
     c->s.in_event_mode = 0;
     return fmi3OK;
 }
-UNSUPPORTED(fmi3GetOutputDerivatives, fmi3Instance i, const fmi3ValueReference vr[], size_t n, const fmi3Int32 o[], fmi3Float64 v[], size_t m)
-UNSUPPORTED(fmi3ActivateModelPartition, fmi3Instance i, fmi3ValueReference c, fmi3Float64 t)

@@ -40,18 +40,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
         if (log) log(env, fmi3Error, "logStatusError", "wrong instantiationToken");
         return NULL;
     }
-    if (eventMode && name && strstr(name, "refuses")) {
-        if (log) log(env, fmi3Error, "logStatusError", "eventModeUsed is not supported");
-        return NULL;
-    }
-    EventModel *c = calloc(1, sizeof(EventModel));
-    if (!c) return NULL;
-    c->env = env;
-    c->log = log;
-    c->event_mode_used = eventMode;
-    c->early_allowed = earlyReturnAllowed;
-    start(c);
-    return c;
+    FMI3_TEST_NEW(EventModel, eventMode && name && strstr(name, "refuses"), "eventModeUsed is not supported",
+        c->event_mode_used = eventMode; c->early_allowed = earlyReturnAllowed; start(c))
 }
 void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
 fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const fmi3String c[]) { return fmi3OK; }

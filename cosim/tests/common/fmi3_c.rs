@@ -58,13 +58,19 @@ pub fn build(dir: &Path, id: &str, xml: &str) -> Option<PathBuf> {
 
 /// The same, compiled with the preprocessor `defines` (`-D` each, in both files).
 pub fn build_with(dir: &Path, id: &str, xml: &str, defines: &[&str]) -> Option<PathBuf> {
+    build_named(dir, id, id, xml, defines)
+}
+
+/// [`build_with`], the archive named `<dir>/<stem>.fmu` (several builds of one FMU in `dir`).
+pub fn build_named(dir: &Path, id: &str, stem: &str, xml: &str, defines: &[&str]) -> Option<PathBuf> {
     let headers = headers()?;
-    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cfmu");
+    // from cosim's manifest folder or a sibling's (the campaign's tests include this module)
+    let cfmu = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cosim/tests/cfmu");
     let so = dir.join(format!("{id}.so"));
     let mut flags = flags(&headers);
     flags.extend(defines.iter().map(|d| OsString::from(format!("-D{d}"))));
     super::cc(&flags, &[cfmu.join(format!("{id}.c")), cfmu.join("fmi3_rest.c")], &so);
-    let fmu = dir.join(format!("{id}.fmu"));
+    let fmu = dir.join(format!("{stem}.fmu"));
     super::pack_library(&fmu, xml, &format!("binaries/x86_64-linux/{id}.so"), &so);
     Some(fmu)
 }

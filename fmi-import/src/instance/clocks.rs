@@ -41,17 +41,20 @@ impl ClockCalls for Fmi3 {
             .zip(values.iter().zip(&qualifiers))
             .map(|(vr, (v, q))| match q {
                 0 => Ok(Interval::NotYetKnown),
-                1 | 2 if !(v.is_finite() && (*v > 0.0 || zero && *v == 0.0)) => Err(core.error(
+                1 | 2 if !(v.is_finite() && (*v > 0.0 || zero && *v == 0.0)) => Err(core.returned(
                     "fmi3GetIntervalDecimal",
                     core.time,
-                    format!("clock {vr}: interval {v} s is {least}"),
+                    format!("the interval {v} s of clock {vr} is {least}"),
                 )),
                 1 => Ok(Interval::Unchanged(*v)),
                 2 => Ok(Interval::Changed(*v)),
-                other => Err(core.error(
+                other => Err(core.returned(
                     "fmi3GetIntervalDecimal",
                     core.time,
-                    format!("clock {vr}: qualifier {other} is none of fmi3IntervalNotYetKnown, Unchanged, Changed"),
+                    format!(
+                        "the qualifier {other} of clock {vr} is none of fmi3IntervalNotYetKnown, fmi3IntervalUnchanged, \
+                         fmi3IntervalChanged"
+                    ),
                 )),
             })
             .collect()
@@ -72,7 +75,11 @@ impl ClockCalls for Fmi3 {
             (None, None) => return Err(core.optional(None::<()>, "fmi3GetShiftDecimal").unwrap_err()),
         }
         if let Some((vr, v)) = vrs.iter().zip(&values).find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
-            return Err(core.error("fmi3GetShiftDecimal", core.time, format!("clock {vr}: shift {v} s is no time")));
+            return Err(core.returned(
+                "fmi3GetShiftDecimal",
+                core.time,
+                format!("the shift {v} s of clock {vr} is no time (negative or not finite)"),
+            ));
         }
         Ok(values)
     }

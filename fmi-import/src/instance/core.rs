@@ -66,6 +66,9 @@ pub(crate) struct Core {
     pub(crate) host: Option<Box<crate::isolate::channel::Channel>>,
     /// The saved FMU states not freed yet (freed with the instance).
     pub(crate) saved: Vec<*mut c_void>,
+    /// The status of the last call (OK or Warning when it went on), for
+    /// [`Error::Returned`].
+    pub(crate) last_status: Status,
 }
 
 /// Calls the C function `$f` (an expression using the component copied beforehand) named
@@ -101,6 +104,7 @@ impl Core {
     /// invalid status: errored; Fatal: fatal).
     pub(crate) fn status(&mut self, function: &'static str, raw: RawStatus, time: Option<f64>) -> Result<()> {
         let status = Status::from_raw(raw);
+        self.last_status = status;
         match status {
             Status::Ok | Status::Warning => return Ok(()),
             Status::Discard => {}
@@ -117,16 +121,23 @@ impl Core {
         Err(Error::Fmi { instance: self.name.clone(), function, status, time, log: self.log.recent_problems() })
     }
 
+    /// Marks a call of `function` made outside `call!` (reset, free), whose status is not
+    /// read: the exit guard names it, and it is owned by the call it is inside.
+    pub(crate) fn mark_call(&self, function: &'static str) -> crate::call_site::InCall {
+        crate::call_site::enter(&self.name, &self.fmu.source, function, self.time, crate::call_site::owner_of_call())
+    }
+
     /// The function `f` of the table, or the error naming it as missing.
     pub(crate) fn optional<T>(&self, f: Option<T>, function: &'static str) -> Result<T> {
         f.ok_or_else(|| Error::MissingSymbol { path: self.fmu.source.clone(), symbol: function })
     }
 
-    /// An error the layer finds in what `function`, called at `time`, did (`log` says
-    /// what); the caller moves the state.
+    /// The error of what `function`, called at `time`, returned with the status of the last
+    /// call (OK or Warning) but the standard or a bound of the master does not take (`what`
+    /// says why); the caller moves the state.
     #[cold]
-    pub(crate) fn error(&self, function: &'static str, time: f64, log: String) -> Error {
-        Error::Fmi { instance: self.name.clone(), function, status: Status::Error, time: Some(time), log }
+    pub(crate) fn returned(&self, function: &'static str, time: f64, what: String) -> Error {
+        Error::Returned { instance: self.name.clone(), function, status_returned: self.last_status, time, what }
     }
 }
 

@@ -25,6 +25,7 @@ use crate::c_types::{CallbackFunctions, EventInfo};
 use crate::error::{Error, Result};
 use crate::fmu::{Abi, Fmu};
 use crate::log::{callbacks_for, LogRecord, LogSink};
+use crate::status::Status;
 
 /// A saved FMU state (`fmi2FMUstate`), freed by [`Instance::free_state`] or with the instance.
 #[derive(Debug)]
@@ -136,6 +137,7 @@ impl Instance {
                 time: 0.0,
                 host,
                 saved: Vec::new(),
+                last_status: Status::Ok,
             },
             calls,
             _name_c: name_c,
@@ -368,13 +370,7 @@ impl Instance {
         }
         let function = self.calls.reset_name();
         let f = self.calls.reset_function(&self.core)?;
-        let mark = crate::call_site::enter(
-            &self.core.name,
-            &self.core.fmu.source,
-            function,
-            self.core.time,
-            crate::call_site::owner_of_call(),
-        );
+        let mark = self.core.mark_call(function);
         // SAFETY: live component; both generations' reset take the instance only.
         let raw = unsafe { f(self.core.component) };
         drop(mark);
@@ -418,8 +414,17 @@ impl Instance {
             .iter()
             .find(|v| v.is_real() && v.value_reference == vrs[k])
             .map_or_else(|| format!("<Real value reference {}>", vrs[k]), |v| v.name.clone());
+        // the getter of the variable's type (an array element of the view: its array's)
+        let function = match self.core.fmu.fmi3_description() {
+            None => "fmi2GetReal",
+            Some(md) => match md.model_variables.iter().find(|v| v.value_reference == vrs[k]) {
+                Some(v) if v.value_type == model_description::fmi3::ValueType::Float32 => "fmi3GetFloat32",
+                _ => "fmi3GetFloat64",
+            },
+        };
         Some(Error::NonFinite {
             instance: self.core.name.clone(),
+            function,
             fmu: self.core.fmu.source.clone(),
             variable,
             value: values[k],
@@ -739,13 +744,7 @@ impl Instance {
                 unsafe { free_state(self.core.component, &mut s) };
             }
         }
-        let _mark = crate::call_site::enter(
-            &self.core.name,
-            &self.core.fmu.source,
-            function,
-            self.core.time,
-            crate::call_site::owner_of_call(),
-        );
+        let _mark = self.core.mark_call(function);
         // SAFETY: the component came from the instantiate call and is freed once (the
         // state is Fatal after, and nothing is called then).
         unsafe { free_instance(self.core.component) };

@@ -89,10 +89,10 @@ impl Fmi3 {
         if !(interval.is_finite() && interval >= 0.0) {
             core.state = super::core::InstanceState::Errored;
             let time = core.time;
-            return Err(core.error(
+            return Err(core.returned(
                 "fmi3GetIntervalDecimal",
                 time,
-                format!("the interval of clock {clock} is {interval} s (a countdown is finite and not negative)"),
+                format!("the interval of clock {clock} is {interval} s: a countdown is finite and not negative"),
             ));
         }
         Ok(Some(interval))

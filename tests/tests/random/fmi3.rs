@@ -285,14 +285,7 @@ impl<'f> Generation for Fmi3<'f> {
                 }
                 Fmi3EnterConfigurationMode => (f.enter_configuration_mode.unwrap())(c),
                 Fmi3ExitConfigurationMode => (f.exit_configuration_mode.unwrap())(c),
-                Fmi3GetIntervalDecimal
-                | Fmi3GetIntervalFraction
-                | Fmi3GetShiftDecimal
-                | Fmi3GetShiftFraction
-                | Fmi3SetIntervalDecimal
-                | Fmi3SetIntervalFraction
-                | Fmi3SetShiftDecimal
-                | Fmi3SetShiftFraction => {
+                _ if function.is_clock_timing_function() => {
                     let v = vrs(rng, &p.any);
                     let (mut x, mut a, mut b, mut q) = ([0.0; 5], [0u64; 5], [0u64; 5], [0i32; 5]);
                     match function {

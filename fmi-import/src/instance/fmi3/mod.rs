@@ -178,10 +178,12 @@ impl Fmi3 {
             }
         }
         core.state = InstanceState::Errored;
-        Err(core.error(
+        Err(core.returned(
             "fmi3UpdateDiscreteStates",
             time,
-            "asked for new discrete states 1000 times in one event".into(),
+            "it asked for new discrete states (newDiscreteStatesNeeded = true) for the 1000th time in one event: \
+             1000 updates in one event is cosim's bound"
+                .into(),
         ))
     }
 }
@@ -527,11 +529,11 @@ impl Calls for Fmi3 {
             let progressed = settled_here || (reached > at && reached <= end);
             if !progressed {
                 core.state = InstanceState::Errored;
-                return Err(core.error(
+                return Err(core.returned(
                     "fmi3DoStep",
                     at,
                     format!(
-                        "returned early at lastSuccessfulTime = {reached} s, no progress from {at} s toward the step's end {end} s"
+                        "earlyReturn = true with lastSuccessfulTime = {reached} s made no progress from {at} s toward the step's end {end} s"
                     ),
                 ));
             }
@@ -542,7 +544,14 @@ impl Calls for Fmi3 {
             at = reached;
         }
         core.state = InstanceState::Errored;
-        Err(core.error("fmi3DoStep", at, format!("returned early 1000 times in the step from {time} s to {end} s")))
+        Err(core.returned(
+            "fmi3DoStep",
+            at,
+            format!(
+                "it returned early (earlyReturn = true) for the 1000th time in the step from {time} s to {end} s: \
+                 1000 early returns in one step is cosim's bound"
+            ),
+        ))
     }
 
     fn posted_step(&self, time: f64, step: f64) -> Option<(crate::isolate::protocol::Op, f64)> {

@@ -40,12 +40,16 @@ impl Fmi3 {
                 Some(access) => {
                     let x = self.element_of_call(core, access, &mut array)?;
                     // the view's Integers are Int8 .. Int32 and Enumerations of i32 items
-                    *value = i32::try_from(x as i64).map_err(|_| Error::Fmi {
-                        instance: core.name.clone(),
-                        function: "fmi3GetInt64",
-                        status: Status::Error,
-                        time: Some(core.time),
-                        log: format!("value {x} of value reference {} is outside the Integer range", access.vr),
+                    *value = i32::try_from(x as i64).map_err(|_| {
+                        core.returned(
+                            "fmi3GetInt64",
+                            core.time,
+                            format!(
+                                "the value {x} of value reference {} is outside the range of the Integer (32 bits) \
+                                 cosim reads it as",
+                                access.vr
+                            ),
+                        )
                     })?;
                 }
                 None => {
