@@ -105,20 +105,7 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], si
     return fmi3OK;
 }
 
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 v[], fmi3IntervalQualifier q[]) {
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] != 1) return fail(instance, "fmi3GetIntervalDecimal: no interval");
-        v[k] = 0.25;
-        q[k] = fmi3IntervalUnchanged;
-    }
-    return fmi3OK;
-}
-
-fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[]) {
-    for (size_t k = 0; k < n; k++) v[k] = 0.0;
-    return fmi3OK;
-}
+FMI3_TEST_CONSTANT_CLOCK(Exchange, 1, 0.25)
 
 /* the end of the clock's activation */
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,

@@ -60,19 +60,7 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], si
     return fmi3OK;
 }
 
-fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n,
-    fmi3Float64 v[], fmi3IntervalQualifier q[]) {
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] != 1) return fail(instance, "fmi3GetIntervalDecimal: no interval");
-        v[k] = 0.25;
-        q[k] = fmi3IntervalUnchanged;
-    }
-    return fmi3OK;
-}
-fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Float64 v[]) {
-    for (size_t k = 0; k < n; k++) v[k] = 0.0;
-    return fmi3OK;
-}
+FMI3_TEST_CONSTANT_CLOCK(Sawtooth, 1, 0.25)
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,
     fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined, fmi3Float64 *next) {
@@ -84,37 +72,13 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpda
     return fmi3OK;
 }
 
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
-    *n = 1;
-    return fmi3OK;
-}
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
-    *n = 0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
-    Sawtooth *s = instance;
-    if (n != 1) return fail(s, "fmi3GetContinuousStates: n != 1");
-    x[0] = s->x;
-    return fmi3OK;
-}
-fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {
-    Sawtooth *s = instance;
-    if (n != 1) return fail(s, "fmi3SetContinuousStates: n != 1");
-    s->x = x[0];
-    return fmi3OK;
-}
+FMI3_TEST_CONTINUOUS_STATES(Sawtooth, 1, &c->x)
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
     Sawtooth *s = instance;
     if (n != 1) return fail(s, "fmi3GetContinuousStateDerivatives: n != 1");
     dx[0] = s->dx;
     return fmi3OK;
 }
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
-    for (size_t i = 0; i < n; i++) x[i] = 1.0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
 
 FMI3_TEST_GET(Float64, fmi3Float64, Sawtooth, [0] = &c->time, [2] = &c->x, [3] = &c->dx)
 FMI3_TEST_SET(Float64, fmi3Float64, Sawtooth, "not settable", [2] = &c->x)

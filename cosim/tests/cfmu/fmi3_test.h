@@ -9,7 +9,8 @@
  * FMI3_TEST_NO_CONTINUOUS_STATES or FMI3_TEST_NO_STEP_EVENTS where they say what it does);
  * FMI3_TEST_GET and FMI3_TEST_SET give typed gets and sets from a table of the variables'
  * addresses, FMI3_TEST_OUTPUT_CLOCK the read of a single output clock,
- * FMI3_TEST_ONE_INTERVAL the interval of a single clock. */
+ * FMI3_TEST_ONE_INTERVAL the interval of a single clock, FMI3_TEST_CONSTANT_CLOCK the interval
+ * and shift of a single constant clock, FMI3_TEST_CONTINUOUS_STATES Model Exchange's states. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
@@ -247,5 +248,56 @@ static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Bo
     fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
     FMI3_TEST_NO_STEP_EVENTS
+
+/* A single clock of constant interval: fmi3GetIntervalDecimal gives `interval` for value
+ * reference `clock` (fmi3IntervalUnchanged), fmi3GetShiftDecimal a shift of 0. */
+#define FMI3_TEST_CONSTANT_CLOCK(Type, clock, interval)                                            \
+    fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, \
+        fmi3Float64 v[], fmi3IntervalQualifier q[]) {                                              \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] != clock) return fail((Type *)instance, "fmi3GetIntervalDecimal: no interval"); \
+            v[k] = interval;                                                                       \
+            q[k] = fmi3IntervalUnchanged;                                                          \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, \
+        fmi3Float64 v[]) {                                                                         \
+        for (size_t k = 0; k < n; k++) v[k] = 0.0;                                                 \
+        return fmi3OK;                                                                             \
+    }
+
+/* Model Exchange's continuous states of a test FMU without event indicators: `count` states,
+ * the doubles at the addresses listed (expressions of `c`, the instance), read and written in
+ * that order, each of nominal 1. */
+#define FMI3_TEST_CONTINUOUS_STATES(Type, count, ...)                                              \
+    fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {                 \
+        *n = count;                                                                                \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {                  \
+        *n = 0;                                                                                    \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
+    fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {         \
+        Type *c = instance;                                                                        \
+        double *states[] = {__VA_ARGS__};                                                          \
+        if (n != count) return fail(c, "fmi3GetContinuousStates: n != " #count);                   \
+        for (size_t i = 0; i < n; i++) x[i] = *states[i];                                          \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {   \
+        Type *c = instance;                                                                        \
+        double *states[] = {__VA_ARGS__};                                                          \
+        if (n != count) return fail(c, "fmi3SetContinuousStates: n != " #count);                   \
+        for (size_t i = 0; i < n; i++) *states[i] = x[i];                                          \
+        return fmi3OK;                                                                             \
+    }                                                                                              \
+    fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { \
+        for (size_t i = 0; i < n; i++) x[i] = 1.0;                                                 \
+        return fmi3OK;                                                                             \
+    }
+
 
 #endif

@@ -64,28 +64,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     return fmi3OK;
 }
 FMI3_TEST_SET(Float64, fmi3Float64, Vdp, "not settable", [1] = &c->x0, [3] = &c->x1, [5] = &c->mu)
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
-    *n = 2;
-    return fmi3OK;
-}
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
-    *n = 0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
-    Vdp *v = instance;
-    if (n != 2) return fail(v, "fmi3GetContinuousStates: n != 2");
-    x[0] = v->x0;
-    x[1] = v->x1;
-    return fmi3OK;
-}
-fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) {
-    Vdp *v = instance;
-    if (n != 2) return fail(v, "fmi3SetContinuousStates: n != 2");
-    v->x0 = x[0];
-    v->x1 = x[1];
-    return fmi3OK;
-}
+FMI3_TEST_CONTINUOUS_STATES(Vdp, 2, &c->x0, &c->x1)
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
     Vdp *v = instance;
     if (n != 2) return fail(v, "fmi3GetContinuousStateDerivatives: n != 2");
@@ -93,11 +72,6 @@ fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 
     dx[1] = derivative(v, 1);
     return fmi3OK;
 }
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {
-    for (size_t i = 0; i < n; i++) x[i] = 1.0;
-    return fmi3OK;
-}
-fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
 
 /* d der(unknown) / d state(known), by value reference */
 static int partial(const Vdp *v, fmi3ValueReference unknown, fmi3ValueReference known, double *out) {
