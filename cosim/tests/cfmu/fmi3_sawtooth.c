@@ -47,19 +47,11 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
 }
 FMI3_TEST_NO_STEP_EVENTS
 
-fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) {
-    Sawtooth *s = instance;
-    if (!s->in_event_mode) return fail(s, "fmi3SetClock outside Event Mode");
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] != 1) return fail(s, "fmi3SetClock: not an input clock");
-        if (!v[k]) continue;
-        s->x = 0.0;
-        s->resets++;
-        s->reset_pending = 1;
-    }
-    return fmi3OK;
-}
-
+FMI3_TEST_INPUT_CLOCK(Sawtooth, 1, {
+    c->x = 0.0;
+    c->resets++;
+    c->reset_pending = 1;
+})
 FMI3_TEST_CONSTANT_CLOCK(Sawtooth, 1, 0.25)
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *needUpdate, fmi3Boolean *terminate,

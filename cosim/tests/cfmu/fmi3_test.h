@@ -9,8 +9,9 @@
  * FMI3_TEST_NO_CONTINUOUS_STATES or FMI3_TEST_NO_STEP_EVENTS where they say what it does);
  * FMI3_TEST_GET and FMI3_TEST_SET give typed gets and sets from a table of the variables'
  * addresses, FMI3_TEST_OUTPUT_CLOCK the read of a single output clock,
- * FMI3_TEST_ONE_INTERVAL the interval of a single clock, FMI3_TEST_CONSTANT_CLOCK the interval
- * and shift of a single constant clock, FMI3_TEST_CONTINUOUS_STATES Model Exchange's states. */
+ * FMI3_TEST_ONE_INTERVAL the interval of a single clock, FMI3_TEST_INPUT_CLOCK the ticks of a
+ * single input clock, FMI3_TEST_CONSTANT_CLOCK the interval and shift of a single constant
+ * clock, FMI3_TEST_CONTINUOUS_STATES Model Exchange's states. */
 #ifndef FMI3_TEST_H
 #define FMI3_TEST_H
 
@@ -231,23 +232,43 @@ static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Bo
         return fmi3OK;                                                                             \
     }
 
-/* Model Exchange without continuous states or event indicators: the counts 0, the state
- * and indicator calls accept their empty arrays, no integrator step asks for an event. */
-#define FMI3_TEST_NO_CONTINUOUS_STATES                                                             \
+/* Model Exchange's counts of a test FMU without event indicators: `count` continuous states,
+ * no event indicators (their call accepts the empty array). */
+#define FMI3_TEST_STATE_COUNTS(count)                                                              \
     fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {                 \
-        *n = 0;                                                                                    \
+        *n = count;                                                                                \
         return fmi3OK;                                                                             \
     }                                                                                              \
     fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {                  \
         *n = 0;                                                                                    \
         return fmi3OK;                                                                             \
     }                                                                                              \
+    fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; }
+
+/* Model Exchange without continuous states or event indicators: the counts 0, the state
+ * and indicator calls accept their empty arrays, no integrator step asks for an event. */
+#define FMI3_TEST_NO_CONTINUOUS_STATES                                                             \
+    FMI3_TEST_STATE_COUNTS(0)                                                                      \
     fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) { return fmi3OK; } \
     fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) { return fmi3OK; } \
-    fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
     FMI3_TEST_NO_STEP_EVENTS
+
+/* fmi3SetClock of a single input clock, value reference `clock`, in Event Mode only (the
+ * instance's int member in_event_mode): each tick runs `on_tick` (statements on `c`, the
+ * instance). */
+#define FMI3_TEST_INPUT_CLOCK(Type, clock, on_tick)                                                \
+    fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Clock v[]) { \
+        Type *c = instance;                                                                        \
+        if (!c->in_event_mode) return fail(c, "fmi3SetClock outside Event Mode");                  \
+        for (size_t k = 0; k < n; k++) {                                                           \
+            if (vr[k] != clock) return fail(c, "fmi3SetClock: not an input clock");                \
+            if (!v[k]) continue;                                                                   \
+            on_tick                                                                                \
+        }                                                                                          \
+        return fmi3OK;                                                                             \
+    }
 
 /* A single clock of constant interval: fmi3GetIntervalDecimal gives `interval` for value
  * reference `clock` (fmi3IntervalUnchanged), fmi3GetShiftDecimal a shift of 0. */
@@ -271,15 +292,7 @@ static inline fmi3Status updated_discrete_states(fmi3Boolean *needUpdate, fmi3Bo
  * the doubles at the addresses listed (expressions of `c`, the instance), read and written in
  * that order, each of nominal 1. */
 #define FMI3_TEST_CONTINUOUS_STATES(Type, count, ...)                                              \
-    fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {                 \
-        *n = count;                                                                                \
-        return fmi3OK;                                                                             \
-    }                                                                                              \
-    fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {                  \
-        *n = 0;                                                                                    \
-        return fmi3OK;                                                                             \
-    }                                                                                              \
-    fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 z[], size_t n) { return fmi3OK; } \
+    FMI3_TEST_STATE_COUNTS(count)                                                                  \
     fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t n) {         \
         Type *c = instance;                                                                        \
         double *states[] = {__VA_ARGS__};                                                          \
